@@ -1,0 +1,208 @@
+//! The expression DAG: an arena of hash-consed nodes with typed ids.
+//!
+//! Invariants:
+//! * Every node is interned once: equal nodes have equal [`ExprId`]s, so
+//!   structural equality is id equality and common subexpressions are shared
+//!   by construction.
+//! * Children are created before parents, so ids are a topological order.
+//! * Nodes are only created through the canonical constructors in
+//!   `canonical.rs`; `Add` and `Mul` are flattened, sorted by child id and have
+//!   like terms collected (see there).
+//! * Ids are handed out in creation order, and construction is deterministic,
+//!   so the same model always gives the same ids and byte-identical output.
+
+use std::collections::HashMap;
+
+/// Handle of an interned expression.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
+pub struct ExprId(pub(crate) u32);
+
+/// Handle of a symbol.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
+pub struct SymId(pub(crate) u32);
+
+/// What a symbol stands for when the expression is evaluated or lowered.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+pub enum SymKind {
+    /// Generalised coordinate q[i].
+    Q(u32),
+    /// Its rate qd[i].
+    Qd(u32),
+    /// Its acceleration qdd[i] (only inside derivations, never lowered).
+    Qdd(u32),
+    /// Runtime parameter p[i].
+    Param(u32),
+    /// Time t.
+    Time,
+    /// A free symbol (tests, intermediate algebra).
+    Free,
+}
+
+/// Unary functions. `Sinc(k)` and `Cosc(k)` are the k-th derivatives of
+/// sin(x)/x and (1 - cos x)/x: removable singularities as first-class ops.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
+pub enum Func {
+    Sin,
+    Cos,
+    Tan,
+    Exp,
+    Ln,
+    Abs,
+    Sign,
+    Sinc(u8),
+    Cosc(u8),
+}
+
+impl Func {
+    /// Numeric value, shared with the runtime so that every backend agrees.
+    pub fn apply(self, x: f64) -> f64 {
+        use runtime::special;
+        match self {
+            Func::Sin => x.sin(),
+            Func::Cos => x.cos(),
+            Func::Tan => x.tan(),
+            Func::Exp => x.exp(),
+            Func::Ln => x.ln(),
+            Func::Abs => x.abs(),
+            Func::Sign => special::sign(x),
+            Func::Sinc(k) => special::sinc(k, x),
+            Func::Cosc(k) => special::cosc(k, x),
+        }
+    }
+
+    /// f(-x) = parity * f(x), when f is even (1) or odd (-1).
+    pub fn parity(self) -> Option<f64> {
+        let alt = |k: u8| if k % 2 == 0 { 1.0 } else { -1.0 };
+        match self {
+            Func::Sin | Func::Tan | Func::Sign => Some(-1.0),
+            Func::Cos | Func::Abs => Some(1.0),
+            Func::Sinc(k) => Some(alt(k)),
+            Func::Cosc(k) => Some(-alt(k)),
+            Func::Exp | Func::Ln => None,
+        }
+    }
+}
+
+/// One interned node.
+#[derive(Clone, PartialEq, Eq, Hash, Debug)]
+pub enum Node {
+    /// Bits of a finite f64 (never -0.0).
+    Const(u64),
+    Sym(SymId),
+    /// At least two terms: an optional constant first, then the rest by id.
+    Add(Box<[ExprId]>),
+    /// At least two factors: an optional constant first, then the rest by id.
+    Mul(Box<[ExprId]>),
+    Pow(ExprId, ExprId),
+    Func(Func, ExprId),
+    /// An intermediate quantity kept whole: canonicalisation does not look
+    /// inside it (a sum under `Bind` is not merged into an outer sum), but
+    /// evaluation and differentiation go through it. Kinematic chains bind
+    /// each frame so that frame k+1 reuses frame k instead of re-expanding it.
+    Bind(ExprId),
+}
+
+/// The arena: nodes, their index, and the symbol table.
+#[derive(Default)]
+pub struct Cas {
+    pub(crate) nodes: Vec<Node>,
+    index: HashMap<Node, ExprId>,
+    symbols: Vec<(String, SymKind)>,
+    sym_index: HashMap<String, SymId>,
+    pub(crate) diff_memo: HashMap<(ExprId, SymId), ExprId>,
+}
+
+impl Cas {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Intern a node that is already canonical.
+    pub(crate) fn intern(&mut self, node: Node) -> ExprId {
+        if let Some(&id) = self.index.get(&node) {
+            return id;
+        }
+        let id = ExprId(u32::try_from(self.nodes.len()).expect("expression arena overflow"));
+        self.nodes.push(node.clone());
+        self.index.insert(node, id);
+        id
+    }
+
+    pub fn node(&self, e: ExprId) -> &Node {
+        &self.nodes[e.0 as usize]
+    }
+
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// The symbol named `name`, created with `kind` if new.
+    pub fn symbol(&mut self, name: &str, kind: SymKind) -> ExprId {
+        let id = match self.sym_index.get(name) {
+            Some(&s) => s,
+            None => {
+                let s = SymId(self.symbols.len() as u32);
+                self.symbols.push((name.to_string(), kind));
+                self.sym_index.insert(name.to_string(), s);
+                s
+            }
+        };
+        self.intern(Node::Sym(id))
+    }
+
+    pub fn sym_id(&self, e: ExprId) -> Option<SymId> {
+        match self.node(e) {
+            Node::Sym(s) => Some(*s),
+            _ => None,
+        }
+    }
+
+    pub fn sym_name(&self, s: SymId) -> &str {
+        &self.symbols[s.0 as usize].0
+    }
+
+    pub fn sym_kind(&self, s: SymId) -> SymKind {
+        self.symbols[s.0 as usize].1
+    }
+
+    /// The value of a constant node.
+    pub fn as_const(&self, e: ExprId) -> Option<f64> {
+        match self.node(e) {
+            Node::Const(bits) => Some(f64::from_bits(*bits)),
+            _ => None,
+        }
+    }
+
+    pub fn is_zero(&self, e: ExprId) -> bool {
+        self.as_const(e) == Some(0.0)
+    }
+
+    /// Children of a node, in canonical order.
+    pub fn children(&self, e: ExprId) -> Vec<ExprId> {
+        match self.node(e) {
+            Node::Const(_) | Node::Sym(_) => vec![],
+            Node::Add(xs) | Node::Mul(xs) => xs.to_vec(),
+            Node::Pow(b, x) => vec![*b, *x],
+            Node::Func(_, x) | Node::Bind(x) => vec![*x],
+        }
+    }
+
+    /// Number of distinct nodes reachable from `roots`.
+    pub fn dag_size(&self, roots: &[ExprId]) -> usize {
+        let mut seen = vec![false; self.nodes.len()];
+        let mut stack: Vec<ExprId> = roots.to_vec();
+        let mut count = 0;
+        while let Some(e) = stack.pop() {
+            if std::mem::replace(&mut seen[e.0 as usize], true) {
+                continue;
+            }
+            count += 1;
+            stack.extend(self.children(e));
+        }
+        count
+    }
+}

@@ -1,0 +1,18 @@
+//! softarm's computer algebra system.
+//!
+//! * `expr`: the hash-consed DAG (arena, interning, typed ids).
+//! * `canonical`: canonical constructors and the rewrite rules.
+//! * `diff`: memoised partial and time derivatives.
+//! * `eval`: direct evaluation.
+//! * `lower`: CSE and linearisation into a runtime tape.
+
+mod canonical;
+mod diff;
+mod eval;
+mod expr;
+mod lower;
+#[cfg(test)]
+mod tests;
+
+pub use expr::{Cas, ExprId, Func, Node, SymId, SymKind};
+pub use lower::Lowerer;

@@ -1,0 +1,174 @@
+//! An arm: a kernel set plus its parameter values, with the physics on top
+//! (full mass matrix, Cholesky solve for accelerations, energies).
+
+use std::cell::RefCell;
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::kernels::{KernelKind, Kernels, ModelInfo};
+use crate::tape::Inputs;
+
+/// The equations of motion `M(q) qdd + h(q, qd, t) = 0` of one arm.
+///
+/// Both backends implement it through [`Arm`]; integrators, statics and the
+/// CLI see only this trait.
+pub trait Dynamics {
+    fn info(&self) -> &ModelInfo;
+    fn backend(&self) -> &'static str;
+    fn dof(&self) -> usize {
+        self.info().dof()
+    }
+    /// Full symmetric M(q) into `m` (dof x dof).
+    fn mass(&self, t: f64, q: &[f64], m: &mut DMatrix<f64>);
+    /// h(q, qd, t) into `h`.
+    fn bias(&self, t: f64, q: &[f64], qd: &[f64], h: &mut DVector<f64>);
+    /// Both at once, sharing subexpressions.
+    fn mass_bias(&self, t: f64, q: &[f64], qd: &[f64], m: &mut DMatrix<f64>, h: &mut DVector<f64>);
+    /// Tip position and energies, laid out as [`crate::OUTPUT_NAMES`].
+    fn outputs(&self, t: f64, q: &[f64], qd: &[f64]) -> [f64; 5];
+}
+
+/// Why the accelerations could not be computed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum AccelError {
+    #[error(
+        "mass matrix is not positive definite at t = {t} (estimated condition number {condition:.3e}); \
+         check masses and lengths for zero or negative values"
+    )]
+    SingularMass { t: f64, condition: f64 },
+    #[error("non-finite {what} at t = {t}: the state has left the model's valid range")]
+    NonFinite { t: f64, what: &'static str },
+}
+
+/// A model's kernels with numeric parameter values bound.
+pub struct Arm<K> {
+    kernels: K,
+    params: Vec<f64>,
+    packed: RefCell<Vec<f64>>,
+}
+
+impl<K: Kernels> Arm<K> {
+    /// `params` must follow `kernels.info().parameters`.
+    pub fn new(kernels: K, params: Vec<f64>) -> Self {
+        assert_eq!(
+            params.len(),
+            kernels.info().parameters.len(),
+            "parameter vector does not match the model's layout"
+        );
+        Self { kernels, params, packed: RefCell::new(Vec::new()) }
+    }
+
+    pub fn params(&self) -> &[f64] {
+        &self.params
+    }
+
+    pub fn kernels(&self) -> &K {
+        &self.kernels
+    }
+
+    fn eval_packed(&self, kind: KernelKind, t: f64, q: &[f64], qd: &[f64], f: impl FnOnce(&[f64])) {
+        let n = self.kernels.info().dof();
+        let mut packed = self.packed.borrow_mut();
+        packed.resize(kind.output_len(n), 0.0);
+        let inp = Inputs { t, q, qd, p: &self.params };
+        self.kernels.eval(kind, &inp, &mut packed);
+        f(&packed);
+    }
+}
+
+/// Unpack the upper triangle (row by row) into a full symmetric matrix.
+fn unpack_symmetric(packed: &[f64], m: &mut DMatrix<f64>) {
+    let n = m.nrows();
+    let mut k = 0;
+    for i in 0..n {
+        for j in i..n {
+            m[(i, j)] = packed[k];
+            m[(j, i)] = packed[k];
+            k += 1;
+        }
+    }
+}
+
+impl<K: Kernels> Dynamics for Arm<K> {
+    fn info(&self) -> &ModelInfo {
+        self.kernels.info()
+    }
+    fn backend(&self) -> &'static str {
+        self.kernels.backend()
+    }
+    fn mass(&self, t: f64, q: &[f64], m: &mut DMatrix<f64>) {
+        let zeros = vec![0.0; q.len()];
+        self.eval_packed(KernelKind::Mass, t, q, &zeros, |p| unpack_symmetric(p, m));
+    }
+    fn bias(&self, t: f64, q: &[f64], qd: &[f64], h: &mut DVector<f64>) {
+        self.eval_packed(KernelKind::Bias, t, q, qd, |p| h.copy_from_slice(p));
+    }
+    fn mass_bias(&self, t: f64, q: &[f64], qd: &[f64], m: &mut DMatrix<f64>, h: &mut DVector<f64>) {
+        let tri = KernelKind::Mass.output_len(q.len());
+        self.eval_packed(KernelKind::MassBias, t, q, qd, |p| {
+            unpack_symmetric(&p[..tri], m);
+            h.copy_from_slice(&p[tri..]);
+        });
+    }
+    fn outputs(&self, t: f64, q: &[f64], qd: &[f64]) -> [f64; 5] {
+        let mut out = [0.0; 5];
+        self.eval_packed(KernelKind::Outputs, t, q, qd, |p| out.copy_from_slice(p));
+        out
+    }
+}
+
+impl<K: Kernels + ?Sized> Kernels for Box<K> {
+    fn info(&self) -> &ModelInfo {
+        (**self).info()
+    }
+    fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
+        (**self).eval(kind, inp, out)
+    }
+    fn backend(&self) -> &'static str {
+        (**self).backend()
+    }
+}
+
+/// Reusable buffers for [`accelerations`].
+pub struct Workspace {
+    m: DMatrix<f64>,
+    h: DVector<f64>,
+}
+
+impl Workspace {
+    pub fn new(dof: usize) -> Self {
+        Self { m: DMatrix::zeros(dof, dof), h: DVector::zeros(dof) }
+    }
+}
+
+/// qdd = -M(q)^-1 h(q, qd, t), by Cholesky (M is symmetric positive definite).
+pub fn accelerations<D: Dynamics + ?Sized>(
+    d: &D,
+    ws: &mut Workspace,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &mut [f64],
+) -> Result<(), AccelError> {
+    d.mass_bias(t, q, qd, &mut ws.m, &mut ws.h);
+    if ws.h.iter().any(|v| !v.is_finite()) {
+        return Err(AccelError::NonFinite { t, what: "bias (generalised force)" });
+    }
+    if ws.m.iter().any(|v| !v.is_finite()) {
+        return Err(AccelError::NonFinite { t, what: "mass matrix" });
+    }
+    match ws.m.clone().cholesky() {
+        Some(chol) => {
+            let x = chol.solve(&ws.h);
+            for (a, b) in qdd.iter_mut().zip(x.iter()) {
+                *a = -b;
+            }
+            Ok(())
+        }
+        None => {
+            let sv = ws.m.clone().singular_values();
+            let condition = sv.max() / sv.min().max(f64::MIN_POSITIVE);
+            Err(AccelError::SingularMass { t, condition })
+        }
+    }
+}

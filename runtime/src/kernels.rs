@@ -1,0 +1,123 @@
+//! Kernels: the numbered functions every model provides, and the trait that
+//! both backends (generated Rust and the tape interpreter) implement.
+
+use std::cell::RefCell;
+
+use serde::{Deserialize, Serialize};
+
+use crate::tape::{Inputs, Tape};
+
+/// The functions derived for every model. Output layouts are fixed here and
+/// relied on by [`crate::Arm`]:
+///
+/// * `Mass`: the upper triangle of M(q), row by row: (0,0), (0,1), ..., (1,1), ...
+/// * `Bias`: h(q, qd, t), n values.
+/// * `MassBias`: `Mass` followed by `Bias` (one pass, shared subexpressions).
+/// * `Outputs`: see [`OUTPUT_NAMES`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum KernelKind {
+    Mass,
+    Bias,
+    MassBias,
+    Outputs,
+}
+
+impl KernelKind {
+    pub const ALL: [KernelKind; 4] = [Self::Mass, Self::Bias, Self::MassBias, Self::Outputs];
+
+    pub fn output_len(self, dof: usize) -> usize {
+        let tri = dof * (dof + 1) / 2;
+        match self {
+            Self::Mass => tri,
+            Self::Bias => dof,
+            Self::MassBias => tri + dof,
+            Self::Outputs => OUTPUT_NAMES.len(),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Mass => "mass",
+            Self::Bias => "bias",
+            Self::MassBias => "mass_bias",
+            Self::Outputs => "outputs",
+        }
+    }
+}
+
+/// Layout of the `Outputs` kernel.
+pub const OUTPUT_NAMES: [&str; 5] = ["tip_x", "tip_y", "tip_z", "kinetic", "potential"];
+
+/// What a derived model is: its coordinates and parameter layout.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelInfo {
+    /// Structural hash of the model (the cache key).
+    pub hash: String,
+    pub coordinates: Vec<String>,
+    pub parameters: Vec<String>,
+}
+
+impl ModelInfo {
+    pub fn dof(&self) -> usize {
+        self.coordinates.len()
+    }
+}
+
+/// A set of kernels for one model structure.
+pub trait Kernels {
+    fn info(&self) -> &ModelInfo;
+    /// Evaluate `kind` into `out` (length `kind.output_len(dof)`).
+    fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]);
+    /// Which backend this is, for reports.
+    fn backend(&self) -> &'static str;
+}
+
+/// Derived tapes of one model: the interpreted backend, and what eomgen
+/// emits as Rust for the compiled one.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TapeSet {
+    pub info: ModelInfo,
+    pub mass: Tape,
+    pub bias: Tape,
+    pub mass_bias: Tape,
+    pub outputs: Tape,
+}
+
+impl TapeSet {
+    pub fn tape(&self, kind: KernelKind) -> &Tape {
+        match kind {
+            KernelKind::Mass => &self.mass,
+            KernelKind::Bias => &self.bias,
+            KernelKind::MassBias => &self.mass_bias,
+            KernelKind::Outputs => &self.outputs,
+        }
+    }
+}
+
+/// The interpreted backend.
+pub struct Interpreted {
+    tapes: TapeSet,
+    scratch: RefCell<Vec<f64>>,
+}
+
+impl Interpreted {
+    pub fn new(tapes: TapeSet) -> Self {
+        Self { tapes, scratch: RefCell::new(Vec::new()) }
+    }
+    pub fn tapes(&self) -> &TapeSet {
+        &self.tapes
+    }
+}
+
+impl Kernels for Interpreted {
+    fn info(&self) -> &ModelInfo {
+        &self.tapes.info
+    }
+    fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
+        let mut slots = self.scratch.borrow_mut();
+        self.tapes.tape(kind).eval(inp, &mut slots, out);
+    }
+    fn backend(&self) -> &'static str {
+        "interpreted"
+    }
+}

@@ -1,0 +1,16 @@
+//! The runtime of softarm: what generated code and the CLI run on.
+//!
+//! It knows nothing of the CAS. Generated models implement [`Kernels`];
+//! the tape interpreter ([`Interpreted`]) implements it too. [`Arm`] binds
+//! parameter values and provides [`Dynamics`]; [`integrate`] simulates.
+
+pub mod arm;
+pub mod integrate;
+pub mod kernels;
+pub mod special;
+pub mod tape;
+
+pub use arm::{AccelError, Arm, Dynamics, Workspace, accelerations};
+pub use integrate::{SimFailure, SimOptions, SimStats, Solver, Trajectory, simulate};
+pub use kernels::{Interpreted, KernelKind, Kernels, ModelInfo, OUTPUT_NAMES, TapeSet};
+pub use tape::{Inputs, Op, Slot, Tape};

@@ -1,0 +1,110 @@
+//! The tape: a flat, SSA instruction list that evaluates one kernel.
+//!
+//! eomgen linearises the CSE'd expression DAG into a tape. The same tape is
+//! either interpreted here (models not compiled in) or emitted as Rust by
+//! eomgen (compiled-in models), so both backends run the same operations in
+//! the same order.
+//!
+//! Invariant: an instruction only reads slots with smaller indices; slot `i`
+//! holds the value of `ops[i]`.
+
+use serde::{Deserialize, Serialize};
+
+use crate::special;
+
+/// Slot index into the tape.
+pub type Slot = u32;
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Op {
+    Const(f64),
+    /// Generalised coordinate q[i].
+    Q(u32),
+    /// Generalised rate qd[i].
+    Qd(u32),
+    /// Runtime parameter p[i].
+    Param(u32),
+    Time,
+    Add(Slot, Slot),
+    Sub(Slot, Slot),
+    Mul(Slot, Slot),
+    Div(Slot, Slot),
+    Neg(Slot),
+    Powi(Slot, i32),
+    Powf(Slot, Slot),
+    Sqrt(Slot),
+    Sin(Slot),
+    Cos(Slot),
+    Tan(Slot),
+    Exp(Slot),
+    Ln(Slot),
+    Abs(Slot),
+    Sign(Slot),
+    /// k-th derivative of sin(x)/x.
+    Sinc(u8, Slot),
+    /// k-th derivative of (1 - cos x)/x.
+    Cosc(u8, Slot),
+}
+
+/// The values a kernel reads.
+#[derive(Clone, Copy, Debug)]
+pub struct Inputs<'a> {
+    pub t: f64,
+    pub q: &'a [f64],
+    pub qd: &'a [f64],
+    pub p: &'a [f64],
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Tape {
+    pub ops: Vec<Op>,
+    /// Slot of each output, in output order.
+    pub outputs: Vec<Slot>,
+}
+
+impl Tape {
+    /// Evaluate into `out` (length `outputs.len()`), using `slots` as scratch.
+    pub fn eval(&self, inp: &Inputs, slots: &mut Vec<f64>, out: &mut [f64]) {
+        slots.clear();
+        slots.reserve(self.ops.len());
+        for op in &self.ops {
+            let s = |i: Slot| slots[i as usize];
+            let v = match *op {
+                Op::Const(c) => c,
+                Op::Q(i) => inp.q[i as usize],
+                Op::Qd(i) => inp.qd[i as usize],
+                Op::Param(i) => inp.p[i as usize],
+                Op::Time => inp.t,
+                Op::Add(a, b) => s(a) + s(b),
+                Op::Sub(a, b) => s(a) - s(b),
+                Op::Mul(a, b) => s(a) * s(b),
+                Op::Div(a, b) => s(a) / s(b),
+                Op::Neg(a) => -s(a),
+                Op::Powi(a, n) => s(a).powi(n),
+                Op::Powf(a, b) => s(a).powf(s(b)),
+                Op::Sqrt(a) => s(a).sqrt(),
+                Op::Sin(a) => s(a).sin(),
+                Op::Cos(a) => s(a).cos(),
+                Op::Tan(a) => s(a).tan(),
+                Op::Exp(a) => s(a).exp(),
+                Op::Ln(a) => s(a).ln(),
+                Op::Abs(a) => s(a).abs(),
+                Op::Sign(a) => special::sign(s(a)),
+                Op::Sinc(k, a) => special::sinc(k, s(a)),
+                Op::Cosc(k, a) => special::cosc(k, s(a)),
+            };
+            slots.push(v);
+        }
+        for (o, &slot) in out.iter_mut().zip(&self.outputs) {
+            *o = slots[slot as usize];
+        }
+    }
+
+    /// Number of arithmetic operations (inputs and constants excluded).
+    pub fn op_count(&self) -> usize {
+        self.ops
+            .iter()
+            .filter(|op| !matches!(op, Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Param(_) | Op::Time))
+            .count()
+    }
+}
