@@ -1,1 +1,71 @@
-fn main(){}
+//! The `softarm` command line. See README.md for the commands.
+
+mod commands;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand};
+use softarm::backend::BackendChoice;
+
+#[derive(Parser)]
+#[command(
+    name = "softarm",
+    version,
+    about = "Soft robot arm dynamics: derive, compile, simulate."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Options shared by every command that takes a model.
+#[derive(Args, Clone)]
+pub struct ModelArgs {
+    /// A model file (TOML or JSON) or the name of a compiled-in model.
+    pub model: String,
+    /// Override a model value: PATH=VALUE, e.g. segment.0.length=0.25 or tip.force=[0,-2,0].
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub set: Vec<String>,
+    /// Backend: compiled when available (auto), or force one.
+    #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
+    pub backend: BackendChoice,
+    /// Directory of the tape cache (default: $SOFTARM_CACHE_DIR or .softarm-cache).
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List the compiled-in models with their degrees of freedom.
+    List {
+        #[arg(long)]
+        json: bool,
+    },
+    /// Regenerate generated/ from models/ (or check that it is current).
+    Derive(commands::DeriveArgs),
+    /// Simulate a model; writes trajectory.csv and summary.json.
+    Simulate(commands::SimulateArgs),
+    /// Print M(q), h(q, qd, t), the tip position and energies at a state.
+    Eom(commands::EomArgs),
+    /// Time derivation and kernel evaluation in-process.
+    Bench(commands::BenchArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::List { json } => commands::list(json),
+        Command::Derive(a) => commands::derive(a),
+        Command::Simulate(a) => commands::simulate(a),
+        Command::Eom(a) => commands::eom(a),
+        Command::Bench(a) => commands::bench(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -6,3 +6,8 @@
 //! build.rs and the CLI.
 
 pub mod cas;
+pub mod derive;
+pub mod emit;
+pub mod generate;
+pub mod model;
+pub mod tmt;

@@ -159,7 +159,8 @@ impl Solout<f64, Vec<f64>> for Recorder<'_> {
             self.blown_up.set(Some(t_prev));
             return ControlFlag::Terminate;
         }
-        self.even.solout(t_curr, t_prev, y_curr, y_prev, interpolator, solution)
+        self.even
+            .solout(t_curr, t_prev, y_curr, y_prev, interpolator, solution)
     }
 }
 

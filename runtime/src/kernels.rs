@@ -102,7 +102,10 @@ pub struct Interpreted {
 
 impl Interpreted {
     pub fn new(tapes: TapeSet) -> Self {
-        Self { tapes, scratch: RefCell::new(Vec::new()) }
+        Self {
+            tapes,
+            scratch: RefCell::new(Vec::new()),
+        }
     }
     pub fn tapes(&self) -> &TapeSet {
         &self.tapes
@@ -120,4 +123,15 @@ impl Kernels for Interpreted {
     fn backend(&self) -> &'static str {
         "interpreted"
     }
+}
+
+/// A model compiled into the binary (an entry of `generated/mod.rs`).
+pub struct CompiledModel {
+    /// File stem of the model (`models/<name>.toml`).
+    pub name: &'static str,
+    pub hash: &'static str,
+    pub dof: usize,
+    /// The model file as it was when compiled in.
+    pub source: &'static str,
+    pub kernels: fn() -> Box<dyn Kernels>,
 }

@@ -12,5 +12,7 @@ pub mod tape;
 
 pub use arm::{AccelError, Arm, Dynamics, Workspace, accelerations};
 pub use integrate::{SimFailure, SimOptions, SimStats, Solver, Trajectory, simulate};
-pub use kernels::{Interpreted, KernelKind, Kernels, ModelInfo, OUTPUT_NAMES, TapeSet};
+pub use kernels::{
+    CompiledModel, Interpreted, KernelKind, Kernels, ModelInfo, OUTPUT_NAMES, TapeSet,
+};
 pub use tape::{Inputs, Op, Slot, Tape};

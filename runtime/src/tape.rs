@@ -104,7 +104,12 @@ impl Tape {
     pub fn op_count(&self) -> usize {
         self.ops
             .iter()
-            .filter(|op| !matches!(op, Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Param(_) | Op::Time))
+            .filter(|op| {
+                !matches!(
+                    op,
+                    Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Param(_) | Op::Time
+                )
+            })
             .count()
     }
 }

@@ -21,7 +21,11 @@ use super::expr::{Cas, ExprId, Func, Node};
 
 fn canon_bits(c: f64) -> u64 {
     debug_assert!(c.is_finite());
-    if c == 0.0 { 0.0f64.to_bits() } else { c.to_bits() }
+    if c == 0.0 {
+        0.0f64.to_bits()
+    } else {
+        c.to_bits()
+    }
 }
 
 fn is_integer(c: f64) -> bool {
@@ -53,7 +57,11 @@ impl Cas {
             && let Some(c) = self.as_const(fs[0])
         {
             let rest: Vec<ExprId> = fs[1..].to_vec();
-            let rest = if rest.len() == 1 { rest[0] } else { self.intern(Node::Mul(rest.into())) };
+            let rest = if rest.len() == 1 {
+                rest[0]
+            } else {
+                self.intern(Node::Mul(rest.into()))
+            };
             return (c, rest);
         }
         (1.0, t)

@@ -13,7 +13,9 @@ use super::expr::{Cas, ExprId, Func, Node, SymId};
 impl Cas {
     /// d e / d s, memoised across calls.
     pub fn diff(&mut self, e: ExprId, s: ExprId) -> ExprId {
-        let sid = self.sym_id(s).expect("diff: differentiate with respect to a symbol");
+        let sid = self
+            .sym_id(s)
+            .expect("diff: differentiate with respect to a symbol");
         self.diff_sym(e, sid)
     }
 
@@ -34,7 +36,12 @@ impl Cas {
     pub fn time_derivative(&mut self, e: ExprId, pairs: &[(ExprId, ExprId)]) -> ExprId {
         let map: HashMap<SymId, ExprId> = pairs
             .iter()
-            .map(|&(x, xd)| (self.sym_id(x).expect("time_derivative: pair of symbols"), xd))
+            .map(|&(x, xd)| {
+                (
+                    self.sym_id(x).expect("time_derivative: pair of symbols"),
+                    xd,
+                )
+            })
             .collect();
         let mut memo = HashMap::new();
         self.directional(e, &map, &mut memo)
@@ -45,10 +52,17 @@ impl Cas {
     pub fn time_derivatives(&mut self, es: &[ExprId], pairs: &[(ExprId, ExprId)]) -> Vec<ExprId> {
         let map: HashMap<SymId, ExprId> = pairs
             .iter()
-            .map(|&(x, xd)| (self.sym_id(x).expect("time_derivative: pair of symbols"), xd))
+            .map(|&(x, xd)| {
+                (
+                    self.sym_id(x).expect("time_derivative: pair of symbols"),
+                    xd,
+                )
+            })
             .collect();
         let mut memo = HashMap::new();
-        es.iter().map(|&e| self.directional(e, &map, &mut memo)).collect()
+        es.iter()
+            .map(|&e| self.directional(e, &map, &mut memo))
+            .collect()
     }
 
     fn directional(
@@ -65,7 +79,11 @@ impl Cas {
                 Some(&v) => v,
                 None => self.zero(),
             },
-            _ => self.chain_rule(e, &mut |cas, child| cas.directional(child, seed, memo), &|_| None),
+            _ => self.chain_rule(
+                e,
+                &mut |cas, child| cas.directional(child, seed, memo),
+                &|_| None,
+            ),
         };
         memo.insert(e, d);
         d
@@ -97,7 +115,12 @@ impl Cas {
                         continue;
                     }
                     let mut fs: Vec<ExprId> = Vec::with_capacity(xs.len());
-                    fs.extend(xs.iter().enumerate().filter(|&(j, _)| j != i).map(|(_, &x)| x));
+                    fs.extend(
+                        xs.iter()
+                            .enumerate()
+                            .filter(|&(j, _)| j != i)
+                            .map(|(_, &x)| x),
+                    );
                     fs.push(di);
                     terms.push(self.mul_all(&fs));
                 }

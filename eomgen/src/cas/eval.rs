@@ -28,8 +28,9 @@ impl Cas {
         for &e in &reach {
             let v = match self.node(e) {
                 Node::Const(bits) => f64::from_bits(*bits),
-                Node::Sym(s) => value(*s)
-                    .ok_or_else(|| format!("symbol {} has no value", self.sym_name(*s)))?,
+                Node::Sym(s) => {
+                    value(*s).ok_or_else(|| format!("symbol {} has no value", self.sym_name(*s)))?
+                }
                 Node::Add(xs) => xs.iter().map(|x| val[x]).sum(),
                 Node::Mul(xs) => xs.iter().map(|x| val[x]).product(),
                 Node::Pow(b, x) => pow_value(val[b], val[x]),

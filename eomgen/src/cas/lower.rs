@@ -50,7 +50,12 @@ fn key(op: &Op) -> (u8, u64, u64) {
 
 impl<'a> Lowerer<'a> {
     pub fn new(cas: &'a Cas) -> Self {
-        Self { cas, ops: Vec::new(), numbering: HashMap::new(), done: HashMap::new() }
+        Self {
+            cas,
+            ops: Vec::new(),
+            numbering: HashMap::new(),
+            done: HashMap::new(),
+        }
     }
 
     fn push(&mut self, op: Op) -> Slot {
@@ -81,7 +86,10 @@ impl<'a> Lowerer<'a> {
                 SymKind::Param(i) => self.push(Op::Param(i)),
                 SymKind::Time => self.push(Op::Time),
                 k @ (SymKind::Qdd(_) | SymKind::Free) => {
-                    panic!("symbol {} ({k:?}) cannot be lowered", self.cas.sym_name(sym))
+                    panic!(
+                        "symbol {} ({k:?}) cannot be lowered",
+                        self.cas.sym_name(sym)
+                    )
                 }
             },
             Node::Add(xs) => self.lower_sum(&xs),
@@ -143,7 +151,11 @@ impl<'a> Lowerer<'a> {
                     if j == i {
                         continue;
                     }
-                    acc = self.push(if neg { Op::Sub(acc, s) } else { Op::Add(acc, s) });
+                    acc = self.push(if neg {
+                        Op::Sub(acc, s)
+                    } else {
+                        Op::Add(acc, s)
+                    });
                 }
                 acc
             }
@@ -193,7 +205,11 @@ impl<'a> Lowerer<'a> {
             }
             acc = self.push(Op::Div(acc, d));
         }
-        if c == -1.0 { self.push(Op::Neg(acc)) } else { acc }
+        if c == -1.0 {
+            self.push(Op::Neg(acc))
+        } else {
+            acc
+        }
     }
 
     fn lower_pow(&mut self, b: ExprId, x: ExprId) -> Slot {
@@ -232,7 +248,10 @@ impl<'a> Lowerer<'a> {
     /// Lower all `outputs` and finish the tape.
     pub fn finish(mut self, outputs: &[ExprId]) -> Tape {
         let outs: Vec<Slot> = outputs.iter().map(|&e| self.lower(e)).collect();
-        Tape { ops: self.ops, outputs: outs }
+        Tape {
+            ops: self.ops,
+            outputs: outs,
+        }
     }
 }
 

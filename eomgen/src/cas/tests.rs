@@ -369,7 +369,11 @@ fn build(c: &mut Cas, s: &Syms, t: &Tree) -> ExprId {
             let one = c.one();
             let a2 = c.powi(a, 2);
             let u = c.add(one, a2);
-            if matches!(t, Tree::LnSafe(_)) { c.func(Func::Ln, u) } else { c.sqrt(u) }
+            if matches!(t, Tree::LnSafe(_)) {
+                c.func(Func::Ln, u)
+            } else {
+                c.sqrt(u)
+            }
         }
         Tree::Sinc(a) => {
             let a = r(c, a);

@@ -1,0 +1,356 @@
+//! Tapes -> Rust source, with quote and prettyplease.
+//!
+//! Each kernel becomes straight-line SSA split into `#[inline(never)]`
+//! chunks of at most [`CHUNK_OPS`] operations (DESIGN.md section 6: one giant
+//! function makes rustc superlinear). A value used by a later chunk is
+//! spilled to a workspace array; inputs and constants are read in place.
+
+use proc_macro2::{Ident, Literal, Span, TokenStream};
+use quote::{format_ident, quote};
+use runtime::{KernelKind, Op, Slot, Tape, TapeSet};
+
+/// Operations per emitted function.
+pub const CHUNK_OPS: usize = 2000;
+
+fn lit(c: f64) -> TokenStream {
+    let l = Literal::f64_suffixed(c.abs());
+    if c.is_sign_negative() {
+        quote!((-#l))
+    } else {
+        quote!(#l)
+    }
+}
+
+fn is_leaf(op: &Op) -> bool {
+    matches!(
+        op,
+        Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Param(_) | Op::Time
+    )
+}
+
+struct KernelEmitter<'a> {
+    tape: &'a Tape,
+    /// Chunk of each slot (leaves: none).
+    chunk_of: Vec<Option<usize>>,
+    /// Workspace index of spilled slots.
+    spill: Vec<Option<usize>>,
+    n_spill: usize,
+}
+
+impl<'a> KernelEmitter<'a> {
+    fn new(tape: &'a Tape) -> Self {
+        let mut chunk_of = vec![None; tape.ops.len()];
+        let mut count = 0;
+        for (i, op) in tape.ops.iter().enumerate() {
+            if !is_leaf(op) {
+                chunk_of[i] = Some(count / CHUNK_OPS);
+                count += 1;
+            }
+        }
+        let mut spill = vec![None; tape.ops.len()];
+        let mut n_spill = 0;
+        let mut mark = |s: Slot, user_chunk: usize| {
+            if let Some(c) = chunk_of[s as usize]
+                && c != user_chunk
+                && spill[s as usize].is_none()
+            {
+                spill[s as usize] = Some(n_spill);
+                n_spill += 1;
+            }
+        };
+        for (i, op) in tape.ops.iter().enumerate() {
+            if let Some(c) = chunk_of[i] {
+                for a in operands(op) {
+                    mark(a, c);
+                }
+            }
+        }
+        Self {
+            tape,
+            chunk_of,
+            spill,
+            n_spill,
+        }
+    }
+
+    fn n_chunks(&self) -> usize {
+        self.chunk_of.iter().flatten().max().map_or(0, |c| c + 1)
+    }
+
+    /// How slot `s` is read from inside chunk `c`.
+    fn read(&self, s: Slot, c: usize) -> TokenStream {
+        let i = s as usize;
+        match self.tape.ops[i] {
+            Op::Const(v) => lit(v),
+            Op::Q(k) => {
+                let k = k as usize;
+                quote!(q[#k])
+            }
+            Op::Qd(k) => {
+                let k = k as usize;
+                quote!(qd[#k])
+            }
+            Op::Param(k) => {
+                let k = k as usize;
+                quote!(p[#k])
+            }
+            Op::Time => quote!(t),
+            _ => {
+                if self.chunk_of[i] == Some(c) {
+                    let v = format_ident!("v{}", i);
+                    quote!(#v)
+                } else {
+                    let w = self.spill[i].expect("value read across chunks is spilled");
+                    quote!(w[#w])
+                }
+            }
+        }
+    }
+
+    fn expr(&self, op: &Op, c: usize) -> TokenStream {
+        let r = |s: Slot| self.read(s, c);
+        match *op {
+            Op::Add(a, b) => {
+                let (a, b) = (r(a), r(b));
+                quote!(#a + #b)
+            }
+            Op::Sub(a, b) => {
+                let (a, b) = (r(a), r(b));
+                quote!(#a - #b)
+            }
+            Op::Mul(a, b) => {
+                let (a, b) = (r(a), r(b));
+                quote!(#a * #b)
+            }
+            Op::Div(a, b) => {
+                let (a, b) = (r(a), r(b));
+                quote!(#a / #b)
+            }
+            Op::Neg(a) => {
+                let a = r(a);
+                quote!(-#a)
+            }
+            Op::Powi(a, n) => {
+                let a = r(a);
+                quote!(#a.powi(#n))
+            }
+            Op::Powf(a, b) => {
+                let (a, b) = (r(a), r(b));
+                quote!(#a.powf(#b))
+            }
+            Op::Sqrt(a) => {
+                let a = r(a);
+                quote!(#a.sqrt())
+            }
+            Op::Sin(a) => {
+                let a = r(a);
+                quote!(#a.sin())
+            }
+            Op::Cos(a) => {
+                let a = r(a);
+                quote!(#a.cos())
+            }
+            Op::Tan(a) => {
+                let a = r(a);
+                quote!(#a.tan())
+            }
+            Op::Exp(a) => {
+                let a = r(a);
+                quote!(#a.exp())
+            }
+            Op::Ln(a) => {
+                let a = r(a);
+                quote!(#a.ln())
+            }
+            Op::Abs(a) => {
+                let a = r(a);
+                quote!(#a.abs())
+            }
+            Op::Sign(a) => {
+                let a = r(a);
+                quote!(runtime::special::sign(#a))
+            }
+            Op::Sinc(k, a) => {
+                let a = r(a);
+                quote!(runtime::special::sinc(#k, #a))
+            }
+            Op::Cosc(k, a) => {
+                let a = r(a);
+                quote!(runtime::special::cosc(#k, #a))
+            }
+            _ => unreachable!("leaves are read in place"),
+        }
+    }
+
+    /// The kernel function `name` and its chunks.
+    fn emit(&self, name: &str, dof: usize, n_params: usize) -> TokenStream {
+        let n_out = self.tape.outputs.len();
+        let n_chunks = self.n_chunks().max(1);
+        let n_spill = self.n_spill;
+        let mut chunks = Vec::new();
+        let mut calls = Vec::new();
+        for c in 0..n_chunks {
+            let mut body = Vec::new();
+            for (i, op) in self.tape.ops.iter().enumerate() {
+                if self.chunk_of[i] != Some(c) {
+                    continue;
+                }
+                let v = format_ident!("v{}", i);
+                let e = self.expr(op, c);
+                body.push(quote!(let #v: f64 = #e;));
+                if let Some(w) = self.spill[i] {
+                    body.push(quote!(w[#w] = #v;));
+                }
+            }
+            // Outputs are written by the chunk that computes them; leaf
+            // outputs (constants, inputs) by the last chunk.
+            for (k, &s) in self.tape.outputs.iter().enumerate() {
+                let owner = self.chunk_of[s as usize].unwrap_or(n_chunks - 1);
+                if owner == c {
+                    let val = self.read(s, c);
+                    body.push(quote!(out[#k] = #val;));
+                }
+            }
+            let f = format_ident!("{}_{}", name, c);
+            chunks.push(quote! {
+                #[inline(never)]
+                #[allow(unused_variables, clippy::all)]
+                fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params],
+                      w: &mut [f64; #n_spill], out: &mut [f64; #n_out]) {
+                    #(#body)*
+                }
+            });
+            calls.push(quote!(#f(t, q, qd, p, w, out);));
+        }
+        let f = Ident::new(name, Span::call_site());
+        let doc = format!(
+            " Kernel `{name}`: {} operations in {n_chunks} chunk(s).",
+            self.tape.op_count()
+        );
+        // Large workspaces go on the heap rather than the stack.
+        let workspace = if n_spill > 4096 {
+            quote! {
+                let mut heap = vec![0.0f64; #n_spill];
+                let w: &mut [f64; #n_spill] = (&mut heap[..]).try_into().expect("workspace length");
+            }
+        } else {
+            quote! {
+                let mut stack = [0.0f64; #n_spill];
+                let w = &mut stack;
+            }
+        };
+        quote! {
+            #[doc = #doc]
+            pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+                #workspace
+                #(#calls)*
+            }
+            #(#chunks)*
+        }
+    }
+}
+
+fn operands(op: &Op) -> Vec<Slot> {
+    match *op {
+        Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Powf(a, b) => {
+            vec![a, b]
+        }
+        Op::Neg(a)
+        | Op::Powi(a, _)
+        | Op::Sqrt(a)
+        | Op::Sin(a)
+        | Op::Cos(a)
+        | Op::Tan(a)
+        | Op::Exp(a)
+        | Op::Ln(a)
+        | Op::Abs(a)
+        | Op::Sign(a)
+        | Op::Sinc(_, a)
+        | Op::Cosc(_, a) => vec![a],
+        _ => vec![],
+    }
+}
+
+/// The header line that carries the structural hash.
+pub const HASH_PREFIX: &str = "// structural-hash: ";
+
+/// Rust source of one compiled-in model.
+pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
+    let info = &tapes.info;
+    let dof = info.dof();
+    let n_params = info.parameters.len();
+    let hash = &info.hash;
+    let coords = &info.coordinates;
+    let params = &info.parameters;
+    let mut kernels = Vec::new();
+    let mut arms = Vec::new();
+    for kind in KernelKind::ALL {
+        let name = kind.name();
+        kernels.push(KernelEmitter::new(tapes.tape(kind)).emit(name, dof, n_params));
+        let f = Ident::new(name, Span::call_site());
+        let variant = Ident::new(&format!("{kind:?}"), Span::call_site());
+        arms.push(quote! {
+            KernelKind::#variant => #f(inp.t, q, qd, p, out.try_into().expect("output length")),
+        });
+    }
+    let tokens = quote! {
+        use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
+
+        /// Structural hash of the model this was derived from.
+        pub const HASH: &str = #hash;
+        pub const DOF: usize = #dof;
+        pub const COORDINATES: &[&str] = &[#(#coords),*];
+        pub const PARAMETERS: &[&str] = &[#(#params),*];
+
+        /// The compiled kernels of this structure.
+        pub struct Compiled {
+            info: ModelInfo,
+        }
+
+        impl Default for Compiled {
+            fn default() -> Self {
+                Self {
+                    info: ModelInfo {
+                        hash: HASH.to_string(),
+                        coordinates: COORDINATES.iter().map(|s| s.to_string()).collect(),
+                        parameters: PARAMETERS.iter().map(|s| s.to_string()).collect(),
+                    },
+                }
+            }
+        }
+
+        impl Kernels for Compiled {
+            fn info(&self) -> &ModelInfo {
+                &self.info
+            }
+            fn backend(&self) -> &'static str {
+                "compiled"
+            }
+            fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
+                let q: &[f64; #dof] = inp.q.try_into().expect("q has DOF entries");
+                let qd: &[f64; #dof] = inp.qd.try_into().expect("qd has DOF entries");
+                let p: &[f64; #n_params] = inp.p.try_into().expect("parameter vector length");
+                match kind {
+                    #(#arms)*
+                }
+            }
+        }
+
+        #(#kernels)*
+    };
+    let file: syn::File = syn::parse2(tokens).expect("emitted tokens parse as a Rust file");
+    format!(
+        "// @generated by eomgen from {source_path}: do not edit; `cargo build` or `softarm derive` rewrites it.\n\
+         {HASH_PREFIX}{hash}\n\n{}",
+        prettyplease::unparse(&file)
+    )
+}
+
+/// The structural hash recorded in a generated file's header, if any.
+pub fn hash_in_header(source: &str) -> Option<&str> {
+    source
+        .lines()
+        .take(3)
+        .find_map(|l| l.strip_prefix(HASH_PREFIX))
+        .map(str::trim)
+}

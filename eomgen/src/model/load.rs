@@ -1,0 +1,152 @@
+//! Reading a model: TOML or JSON text, `--set` overrides, typed
+//! deserialisation with key paths, then validation.
+
+use std::path::Path;
+
+use super::error::ModelError;
+use super::schema::Model;
+use super::validate::validate;
+
+/// One `--set PATH=VALUE` override.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Override {
+    /// Dotted path; array items by index (`segment.1.length`).
+    pub path: Vec<String>,
+    pub value: toml::Value,
+    /// The text as given, for messages.
+    pub text: String,
+}
+
+impl Override {
+    /// Parse `PATH=VALUE`. VALUE is a TOML value (`0.25`, `[0, -2, 0]`,
+    /// `"pcc"`); a bare word is taken as a string.
+    pub fn parse(s: &str) -> Result<Self, ModelError> {
+        let (path, value) = s.split_once('=').ok_or_else(|| {
+            ModelError::new(
+                "--set",
+                s,
+                "expected PATH=VALUE, e.g. segment.0.length=0.25",
+            )
+        })?;
+        let path = path.trim();
+        if path.is_empty() || path.split('.').any(|p| p.trim().is_empty()) {
+            return Err(ModelError::new(
+                "--set",
+                path,
+                "the path must be dotted keys and indices, e.g. segment.0.length",
+            ));
+        }
+        let value = value.trim();
+        let parsed = toml::from_str::<toml::Table>(&format!("v = {value}"))
+            .ok()
+            .and_then(|mut t| t.remove("v"));
+        let value = match parsed {
+            Some(v) => v,
+            None if !value.is_empty()
+                && value
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') =>
+            {
+                toml::Value::String(value.to_string())
+            }
+            None => {
+                return Err(ModelError::new(
+                    "--set",
+                    path,
+                    format!(
+                        "cannot read the value `{value}`: give a number, an array like [0, -2, 0], or a word"
+                    ),
+                ));
+            }
+        };
+        Ok(Self {
+            path: path.split('.').map(|p| p.trim().to_string()).collect(),
+            value,
+            text: s.to_string(),
+        })
+    }
+
+    fn apply(&self, root: &mut toml::Value) -> Result<(), ModelError> {
+        let err = |m: String| ModelError::new("--set", self.path.join("."), m);
+        let mut cur = root;
+        for (depth, key) in self.path.iter().enumerate() {
+            let last = depth + 1 == self.path.len();
+            cur = match cur {
+                toml::Value::Table(t) => {
+                    if last {
+                        t.insert(key.clone(), self.value.clone());
+                        return Ok(());
+                    }
+                    // A missing table on the way is created; the schema
+                    // check afterwards rejects keys that do not exist.
+                    t.entry(key.clone())
+                        .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+                }
+                toml::Value::Array(a) => {
+                    let n = a.len();
+                    let i: usize = key.parse().map_err(|_| {
+                        err(format!("`{key}` is not an index: this level is a list of {n} items, use 0 to {}", n.saturating_sub(1)))
+                    })?;
+                    let item = a.get_mut(i).ok_or_else(|| {
+                        err(format!("index {i} is out of range: the list has {n} items"))
+                    })?;
+                    if last {
+                        *item = self.value.clone();
+                        return Ok(());
+                    }
+                    item
+                }
+                _ => {
+                    let at = self.path[..depth].join(".");
+                    return Err(err(format!(
+                        "`{at}` is a value, not a table or list: `{key}` cannot be set inside it"
+                    )));
+                }
+            };
+        }
+        Ok(())
+    }
+}
+
+/// Parse model text (TOML, or JSON when `json`), apply overrides, check.
+pub fn parse_model(
+    text: &str,
+    file: &str,
+    json: bool,
+    overrides: &[Override],
+) -> Result<Model, ModelError> {
+    let mut tree: toml::Value = if json {
+        serde_json::from_str(text)
+            .map_err(|e| ModelError::new(file, "", format!("invalid JSON: {e}")))?
+    } else {
+        let table: toml::Table = toml::from_str(text).map_err(|e| {
+            ModelError::new(
+                file,
+                "",
+                format!("invalid TOML: {}", e.to_string().trim_end()),
+            )
+        })?;
+        toml::Value::Table(table)
+    };
+    for o in overrides {
+        o.apply(&mut tree)?;
+    }
+    let model: Model = serde_path_to_error::deserialize(tree).map_err(|e| {
+        let path = e.path().to_string();
+        let path = if path == "." { String::new() } else { path };
+        ModelError::new(file, path, e.into_inner().to_string())
+    })?;
+    validate(&model, file)?;
+    Ok(model)
+}
+
+/// Read a model file (`.json` is read as JSON, anything else as TOML).
+pub fn load_model(path: &Path, overrides: &[Override]) -> Result<Model, ModelError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ModelError::new(&file, "", format!("cannot read the file: {e}")))?;
+    let json = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    parse_model(&text, &file, json, overrides)
+}

@@ -1,0 +1,13 @@
+//! Model files: schema, loading with overrides, validation, structure.
+
+mod error;
+mod load;
+mod schema;
+mod structure;
+mod validate;
+
+pub use error::ModelError;
+pub use load::{Override, load_model, parse_model};
+pub use schema::{Base, Method, Model, Segment, Tip};
+pub use structure::{ElementProps, GENERATOR_VERSION, Structure, element_props, parameters};
+pub use validate::MAX_ELEMENTS;

@@ -1,0 +1,10 @@
+//! The TMT method: kinematics modules describe a [`System`]; [`assemble`]
+//! derives M, h and the outputs from it.
+
+mod assemble;
+mod planar;
+mod system;
+
+pub use assemble::{Equations, assemble};
+pub use planar::planar_system;
+pub use system::{Body, Coordinates, PointForce, System};

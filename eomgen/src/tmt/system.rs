@@ -1,0 +1,76 @@
+//! A mechanical system as the TMT method sees it: generalised coordinates,
+//! lumped bodies, potentials, a Rayleigh function and applied forces, all as
+//! CAS expressions. Kinematics modules build one; `assemble` derives the EOM.
+
+use crate::cas::{Cas, ExprId, SymKind};
+
+/// q, qd symbols and their names.
+pub struct Coordinates {
+    pub names: Vec<String>,
+    pub q: Vec<ExprId>,
+    pub qd: Vec<ExprId>,
+}
+
+impl Coordinates {
+    pub fn new(cas: &mut Cas, names: Vec<String>) -> Self {
+        let q = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| cas.symbol(n, SymKind::Q(i as u32)))
+            .collect();
+        let qd = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| cas.symbol(&format!("{n}_dot"), SymKind::Qd(i as u32)))
+            .collect();
+        Self { names, q, qd }
+    }
+
+    pub fn len(&self) -> usize {
+        self.q.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.q.is_empty()
+    }
+
+    /// (q_i, qd_i) pairs: the time derivative with qdd = 0.
+    pub fn rate_pairs(&self) -> Vec<(ExprId, ExprId)> {
+        self.q
+            .iter()
+            .copied()
+            .zip(self.qd.iter().copied())
+            .collect()
+    }
+}
+
+/// A lumped rigid body: Mbar = diag(m I3, I) with I in the body frame.
+pub struct Body {
+    pub mass: ExprId,
+    /// Principal moments of inertia about the centre of mass, body frame.
+    pub inertia: [ExprId; 3],
+    /// Centre of mass in the world frame, a function of q.
+    pub position: [ExprId; 3],
+    /// Angular velocity in the body frame, linear in qd.
+    pub omega: [ExprId; 3],
+}
+
+/// A world-frame force applied at a point (a function of q).
+pub struct PointForce {
+    pub point: [ExprId; 3],
+    pub force: [ExprId; 3],
+}
+
+pub struct System {
+    pub coords: Coordinates,
+    pub bodies: Vec<Body>,
+    pub gravity: [ExprId; 3],
+    /// Elastic potential V_e(q).
+    pub elastic: ExprId,
+    /// Rayleigh dissipation function R(q, qd).
+    pub rayleigh: ExprId,
+    /// Constant (conservative) forces at points.
+    pub point_forces: Vec<PointForce>,
+    /// Tip position, an output.
+    pub tip: [ExprId; 3],
+}

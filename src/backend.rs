@@ -1,0 +1,140 @@
+//! From a MODEL argument to runnable dynamics: find the model (a file, or
+//! the name of a compiled-in model), apply overrides, and pick the backend.
+//!
+//! The compiled backend is used whenever a compiled-in model has the same
+//! structural hash (numeric overrides keep it); otherwise the model is
+//! derived into tapes and interpreted, through the disk cache.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use eomgen::model::{Model, Override, Structure, parameters, parse_model};
+use runtime::{Arm, CompiledModel, Dynamics, Interpreted, Kernels};
+use serde::Serialize;
+
+use crate::cache;
+use crate::generated::MODELS;
+
+/// Which backend to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Default)]
+pub enum BackendChoice {
+    /// Compiled when a compiled-in model has this structure, else interpreted.
+    #[default]
+    Auto,
+    Compiled,
+    Interpreted,
+}
+
+/// Whether the tape cache was used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CacheStatus {
+    /// Compiled backend: no tape needed.
+    Unused,
+    Hit,
+    Miss,
+}
+
+pub struct Loaded {
+    pub model: Model,
+    /// Where the model came from (a path or `compiled-in:<name>`).
+    pub origin: String,
+    pub hash: String,
+    pub arm: Box<dyn Dynamics>,
+    pub cache: CacheStatus,
+    /// Time spent deriving (0 when compiled or cached).
+    pub derive_s: f64,
+}
+
+pub fn compiled_by_name(name: &str) -> Option<&'static CompiledModel> {
+    MODELS.iter().find(|m| m.name == name)
+}
+
+pub fn compiled_by_hash(hash: &str) -> Option<&'static CompiledModel> {
+    MODELS.iter().find(|m| m.hash == hash)
+}
+
+/// Read the model named by `spec`: a file path, or a compiled-in model's name.
+pub fn read_model(spec: &str, overrides: &[Override]) -> Result<(Model, String)> {
+    let path = Path::new(spec);
+    if path.exists() {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("{spec}: cannot read the file"))?;
+        let json = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+        let model = parse_model(&text, spec, json, overrides)?;
+        return Ok((model, spec.to_string()));
+    }
+    if let Some(m) = compiled_by_name(spec) {
+        let label = format!("compiled-in:{}", m.name);
+        let model = parse_model(m.source, &label, false, overrides)?;
+        return Ok((model, label));
+    }
+    let names: Vec<&str> = MODELS.iter().map(|m| m.name).collect();
+    bail!(
+        "{spec}: no such model file, and no compiled-in model of that name (compiled in: {})",
+        names.join(", ")
+    )
+}
+
+/// Load a model and bind its parameters to the chosen backend.
+pub fn load(
+    spec: &str,
+    overrides: &[Override],
+    choice: BackendChoice,
+    cache_dir: Option<PathBuf>,
+) -> Result<Loaded> {
+    let (model, origin) = read_model(spec, overrides)?;
+    let hash = Structure::of(&model).hash();
+    let params: Vec<(String, f64)> = parameters(&model);
+    let compiled = compiled_by_hash(&hash);
+    let (kernels, cache, derive_s): (Box<dyn Kernels>, CacheStatus, f64) = match (choice, compiled)
+    {
+        (BackendChoice::Compiled, None) => bail!(
+            "{origin}: no compiled-in model has this structure (hash {hash}); \
+             add the file to models/ and rebuild, or use --backend interpreted"
+        ),
+        (BackendChoice::Auto | BackendChoice::Compiled, Some(c)) => {
+            ((c.kernels)(), CacheStatus::Unused, 0.0)
+        }
+        _ => {
+            let dir = cache_dir.unwrap_or_else(cache::default_dir);
+            match cache::load(&dir, &hash) {
+                Some(tapes) => (Box::new(Interpreted::new(tapes)), CacheStatus::Hit, 0.0),
+                None => {
+                    let start = Instant::now();
+                    let tapes = eomgen::derive::derive(&model);
+                    let derive_s = start.elapsed().as_secs_f64();
+                    if let Err(e) = cache::store(&dir, &tapes) {
+                        eprintln!("warning: {e}");
+                    }
+                    (
+                        Box::new(Interpreted::new(tapes)),
+                        CacheStatus::Miss,
+                        derive_s,
+                    )
+                }
+            }
+        }
+    };
+    let names: Vec<&String> = params.iter().map(|(n, _)| n).collect();
+    if kernels.info().parameters.iter().collect::<Vec<_>>() != names {
+        bail!(
+            "{origin}: the {} kernels do not match this generator's parameter layout; \
+             run `softarm derive` (or `cargo build`) to regenerate",
+            kernels.backend()
+        );
+    }
+    let values = params.into_iter().map(|(_, v)| v).collect();
+    let arm: Box<dyn Dynamics> = Box::new(Arm::new(kernels, values));
+    Ok(Loaded {
+        model,
+        origin,
+        hash,
+        arm,
+        cache,
+        derive_s,
+    })
+}

@@ -1,0 +1,466 @@
+//! The CLI's commands. Errors go to stderr with a non-zero exit; JSON to
+//! stdout.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use eomgen::model::Override;
+use nalgebra::{DMatrix, DVector};
+use runtime::{Dynamics, OUTPUT_NAMES, SimOptions, Solver, Trajectory, Workspace, accelerations};
+use serde_json::json;
+use softarm::backend::{self, Loaded};
+use softarm::generated::MODELS;
+
+use crate::ModelArgs;
+
+fn load(a: &ModelArgs) -> Result<Loaded> {
+    let overrides = a
+        .set
+        .iter()
+        .map(|s| Override::parse(s))
+        .collect::<Result<Vec<_>, _>>()?;
+    backend::load(&a.model, &overrides, a.backend, a.cache_dir.clone())
+}
+
+/// Parse a comma-separated vector of `n` numbers for option `name`.
+fn parse_vector(name: &str, s: &str, n: usize, coords: &[String]) -> Result<Vec<f64>> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("{name}: expected comma-separated numbers, got `{s}`"))?;
+    if v.len() != n {
+        bail!(
+            "{name}: expected {n} values (one per coordinate: {}), got {}",
+            coords.join(", "),
+            v.len()
+        );
+    }
+    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+        bail!("{name}: values must be finite, got {x}");
+    }
+    Ok(v)
+}
+
+fn optional_vector(
+    name: &str,
+    s: &Option<String>,
+    n: usize,
+    coords: &[String],
+) -> Result<Vec<f64>> {
+    match s {
+        Some(s) => parse_vector(name, s, n, coords),
+        None => Ok(vec![0.0; n]),
+    }
+}
+
+pub fn list(json: bool) -> Result<ExitCode> {
+    if json {
+        let items: Vec<_> = MODELS
+            .iter()
+            .map(|m| json!({"name": m.name, "dof": m.dof, "hash": m.hash}))
+            .collect();
+        println!("{}", serde_json::to_string_pretty(&items)?);
+    } else {
+        println!("{:<24} {:>5}  hash", "model", "dof");
+        for m in MODELS {
+            println!("{:<24} {:>5}  {}", m.name, m.dof, m.hash);
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
+pub struct DeriveArgs {
+    /// Derive these models (files or compiled-in names) into the tape cache
+    /// and report their size, instead of syncing generated/.
+    pub models: Vec<String>,
+    /// Do not write: exit non-zero if generated/ is not what the models give.
+    #[arg(long)]
+    pub check: bool,
+    /// Re-derive every model even when its structural hash is unchanged.
+    #[arg(long)]
+    pub force: bool,
+    /// Project root holding models/ and generated/.
+    #[arg(long, default_value = ".")]
+    pub root: PathBuf,
+}
+
+pub fn derive(a: DeriveArgs) -> Result<ExitCode> {
+    if !a.models.is_empty() {
+        for spec in &a.models {
+            let (model, origin) = backend::read_model(spec, &[])?;
+            let start = Instant::now();
+            let tapes = eomgen::derive::derive(&model);
+            let s = start.elapsed().as_secs_f64();
+            softarm::cache::store(&softarm::cache::default_dir(), &tapes)
+                .map_err(anyhow::Error::msg)?;
+            println!(
+                "{origin}: dof {}, mass {} ops, bias {} ops, derived in {:.3} s (hash {})",
+                tapes.info.dof(),
+                tapes.mass.op_count(),
+                tapes.bias.op_count(),
+                s,
+                tapes.info.hash
+            );
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let models = a.root.join("models");
+    let generated = a.root.join("generated");
+    // A check re-derives everything: a stale file with a current hash
+    // (generator changed without a version bump) is caught too.
+    let opts = eomgen::generate::SyncOptions {
+        force: a.force || a.check,
+        check: a.check,
+        absolute_paths: false,
+    };
+    let report = eomgen::generate::sync(&models, &generated, &opts)?;
+    if a.check {
+        if report.is_clean() {
+            println!(
+                "generated/ is current ({} models checked)",
+                report.derived.len()
+            );
+            return Ok(ExitCode::SUCCESS);
+        }
+        for p in &report.written {
+            eprintln!("stale: {}", p.display());
+        }
+        for p in &report.removed {
+            eprintln!("stray: {} (its model is gone)", p.display());
+        }
+        eprintln!("error: generated/ is out of date: run `softarm derive` and commit the result");
+        return Ok(ExitCode::FAILURE);
+    }
+    println!(
+        "derived {} model(s), wrote {} file(s), removed {}",
+        report.derived.len(),
+        report.written.len(),
+        report.removed.len()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
+pub struct SimulateArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// End time (s).
+    #[arg(long, default_value_t = 5.0)]
+    pub t_end: f64,
+    /// Integrator.
+    #[arg(long, default_value = "dopri5", value_parser = Solver::NAMES)]
+    pub solver: String,
+    /// Step of fixed-step solvers (s).
+    #[arg(long, default_value_t = 1e-3)]
+    pub dt: f64,
+    #[arg(long, default_value_t = 1e-6)]
+    pub rtol: f64,
+    #[arg(long, default_value_t = 1e-9)]
+    pub atol: f64,
+    /// Spacing of trajectory.csv rows (s); default t_end / 500.
+    #[arg(long)]
+    pub output_dt: Option<f64>,
+    /// Initial coordinates, comma-separated (default 0).
+    #[arg(long, allow_hyphen_values = true)]
+    pub q0: Option<String>,
+    /// Initial rates, comma-separated (default 0).
+    #[arg(long, allow_hyphen_values = true)]
+    pub qd0: Option<String>,
+    /// Output directory (default out/<model name>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Write `content` to `path` through a temporary file, so that a failed run
+/// never leaves a half-written file.
+fn write_atomic(path: &Path, content: &[u8]) -> Result<()> {
+    let tmp = path.with_extension("tmp");
+    std::fs::write(&tmp, content).with_context(|| format!("cannot write {}", tmp.display()))?;
+    std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
+}
+
+fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
+    let n = arm.dof();
+    let coords = &arm.info().coordinates;
+    let mut s = String::from("t");
+    for c in coords {
+        s.push_str(&format!(",{c}"));
+    }
+    for c in coords {
+        s.push_str(&format!(",{c}_dot"));
+    }
+    for o in OUTPUT_NAMES {
+        s.push_str(&format!(",{o}"));
+    }
+    s.push('\n');
+    for (t, x) in traj.t.iter().zip(&traj.x) {
+        s.push_str(&format!("{t:.9}"));
+        for v in x {
+            s.push_str(&format!(",{v:.12e}"));
+        }
+        for v in arm.outputs(*t, &x[..n], &x[n..]) {
+            s.push_str(&format!(",{v:.12e}"));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
+    let loaded = load(&a.model)?;
+    let arm = &*loaded.arm;
+    let n = arm.dof();
+    let coords = arm.info().coordinates.clone();
+    if !(a.t_end > 0.0 && a.t_end.is_finite()) {
+        bail!(
+            "--t-end must be a positive number of seconds, got {}",
+            a.t_end
+        );
+    }
+    for (name, v) in [("--dt", a.dt), ("--rtol", a.rtol), ("--atol", a.atol)] {
+        if !(v > 0.0 && v.is_finite()) {
+            bail!("{name} must be positive, got {v}");
+        }
+    }
+    let q0 = optional_vector("--q0", &a.q0, n, &coords)?;
+    let qd0 = optional_vector("--qd0", &a.qd0, n, &coords)?;
+    let solver = Solver::parse(&a.solver).expect("clap checked the solver name");
+    let output_dt = a.output_dt.unwrap_or(a.t_end / 500.0);
+    if !(output_dt > 0.0 && output_dt.is_finite()) {
+        bail!("--output-dt must be positive, got {output_dt}");
+    }
+    let opts = SimOptions {
+        t_end: a.t_end,
+        solver,
+        rtol: a.rtol,
+        atol: a.atol,
+        dt: a.dt,
+        output_dt,
+        ..Default::default()
+    };
+    let out_dir = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(&loaded.model.name));
+    std::fs::create_dir_all(&out_dir)
+        .with_context(|| format!("cannot create {}", out_dir.display()))?;
+
+    let x0: Vec<f64> = q0.iter().chain(&qd0).copied().collect();
+    let result = runtime::simulate(arm, x0, &opts);
+    let (traj, stats, failure) = match result {
+        Ok((traj, stats)) => (traj, stats, None),
+        Err(f) => {
+            let f = *f;
+            let msg = f.to_string();
+            let fail = json!({"t_reached": f.t_reached, "reason": f.reason, "suggestion": f.suggestion, "state": f.state});
+            (f.trajectory, f.stats, Some((msg, fail)))
+        }
+    };
+    write_atomic(
+        &out_dir.join("trajectory.csv"),
+        trajectory_csv(arm, &traj).as_bytes(),
+    )?;
+    let final_state = traj.x.last().cloned().unwrap_or_default();
+    let t_final = traj.t.last().copied().unwrap_or(0.0);
+    let tip = if final_state.len() == 2 * n {
+        arm.outputs(t_final, &final_state[..n], &final_state[n..])
+    } else {
+        [f64::NAN; 5]
+    };
+    let summary = json!({
+        "model": loaded.model.name,
+        "origin": loaded.origin,
+        "structural_hash": loaded.hash,
+        "backend": arm.backend(),
+        "cache": loaded.cache,
+        "derive_s": loaded.derive_s,
+        "solver": stats.solver,
+        "rtol": a.rtol,
+        "atol": a.atol,
+        "dt": if solver == Solver::Rk4 { Some(a.dt) } else { None },
+        "t_end": a.t_end,
+        "steps": stats.steps,
+        "rejected_steps": stats.rejected_steps,
+        "rhs_evaluations": stats.rhs_evaluations,
+        "wall_s": stats.wall_s,
+        "status": if failure.is_some() { "failed" } else { "ok" },
+        "failure": failure.as_ref().map(|f| f.1.clone()),
+        "final_state": {
+            "t": t_final,
+            "q": final_state.get(..n),
+            "qd": final_state.get(n..),
+            "tip_position": &tip[..3],
+            "kinetic_energy": tip[3],
+            "potential_energy": tip[4],
+        },
+    });
+    write_atomic(
+        &out_dir.join("summary.json"),
+        serde_json::to_string_pretty(&summary)?.as_bytes(),
+    )?;
+    eprintln!(
+        "{}: {} backend{}, {} {} steps, {} rhs evaluations, {:.3} s wall; wrote {}",
+        loaded.model.name,
+        arm.backend(),
+        match loaded.cache {
+            backend::CacheStatus::Hit => " (tape cache hit)",
+            backend::CacheStatus::Miss => " (derived, tape cached)",
+            backend::CacheStatus::Unused => "",
+        },
+        stats.solver.name(),
+        stats.steps,
+        stats.rhs_evaluations,
+        stats.wall_s,
+        out_dir.display()
+    );
+    if let Some((msg, _)) = failure {
+        eprintln!("error: {msg}");
+        eprintln!(
+            "the trajectory up to then is in {}",
+            out_dir.join("trajectory.csv").display()
+        );
+        return Ok(ExitCode::FAILURE);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
+pub struct EomArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Coordinates, comma-separated.
+    #[arg(long, allow_hyphen_values = true)]
+    pub q: Option<String>,
+    /// Rates, comma-separated (default 0).
+    #[arg(long, allow_hyphen_values = true)]
+    pub qd: Option<String>,
+    #[arg(long, default_value_t = 0.0)]
+    pub t: f64,
+    /// Print JSON (the only format for now; accepted for scripts).
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn eom(a: EomArgs) -> Result<ExitCode> {
+    let loaded = load(&a.model)?;
+    let arm = &*loaded.arm;
+    let n = arm.dof();
+    let coords = arm.info().coordinates.clone();
+    let q = optional_vector("--q", &a.q, n, &coords)?;
+    let qd = optional_vector("--qd", &a.qd, n, &coords)?;
+    let mut m = DMatrix::zeros(n, n);
+    let mut h = DVector::zeros(n);
+    arm.mass_bias(a.t, &q, &qd, &mut m, &mut h);
+    let out = arm.outputs(a.t, &q, &qd);
+    let rows: Vec<Vec<f64>> = (0..n).map(|i| m.row(i).iter().copied().collect()).collect();
+    let v = json!({
+        "model": loaded.model.name,
+        "backend": arm.backend(),
+        "coordinates": coords,
+        "mass": rows,
+        "bias": h.as_slice(),
+        "tip_position": &out[..3],
+        "kinetic_energy": out[3],
+        "potential_energy": out[4],
+    });
+    println!("{}", serde_json::to_string_pretty(&v)?);
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
+pub struct BenchArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Number of timed batches (the median is reported).
+    #[arg(long, default_value_t = 21)]
+    pub batches: usize,
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Median over batches of the time per call of `f`, in ns.
+fn time_ns(batches: usize, mut f: impl FnMut()) -> f64 {
+    // Size a batch to about 20 ms.
+    let start = Instant::now();
+    let mut calls = 0u64;
+    while start.elapsed().as_secs_f64() < 0.02 {
+        f();
+        calls += 1;
+    }
+    let mut per_call: Vec<f64> = (0..batches.max(1))
+        .map(|_| {
+            let t = Instant::now();
+            for _ in 0..calls {
+                f();
+            }
+            t.elapsed().as_nanos() as f64 / calls as f64
+        })
+        .collect();
+    per_call.sort_by(f64::total_cmp);
+    per_call[per_call.len() / 2]
+}
+
+pub fn bench(a: BenchArgs) -> Result<ExitCode> {
+    let loaded = load(&a.model)?;
+    let arm = &*loaded.arm;
+    let n = arm.dof();
+    // Derivation from scratch, whatever backend runs.
+    let start = Instant::now();
+    let tapes = eomgen::derive::derive(&loaded.model);
+    let derive_s = start.elapsed().as_secs_f64();
+    let q: Vec<f64> = (0..n).map(|i| 0.3 * ((i as f64) * 0.7).sin()).collect();
+    let qd: Vec<f64> = (0..n).map(|i| 0.2 * ((i as f64) * 1.3).cos()).collect();
+    let mut m = DMatrix::zeros(n, n);
+    let mut h = DVector::zeros(n);
+    let mut ws = Workspace::new(n);
+    let mut qdd = vec![0.0; n];
+    let mass_ns = time_ns(a.batches, || {
+        arm.mass(0.0, std::hint::black_box(&q), &mut m)
+    });
+    let bias_ns = time_ns(a.batches, || {
+        arm.bias(0.0, std::hint::black_box(&q), &qd, &mut h)
+    });
+    let mass_bias_ns = time_ns(a.batches, || {
+        arm.mass_bias(0.0, std::hint::black_box(&q), &qd, &mut m, &mut h)
+    });
+    let rhs_ns = time_ns(a.batches, || {
+        let _ = accelerations(arm, &mut ws, 0.0, std::hint::black_box(&q), &qd, &mut qdd);
+    });
+    let v = json!({
+        "model": loaded.model.name,
+        "backend": arm.backend(),
+        "dof": n,
+        "derive_s": derive_s,
+        "mass_ops": tapes.mass.op_count(),
+        "bias_ops": tapes.bias.op_count(),
+        "mass_ns": mass_ns,
+        "bias_ns": bias_ns,
+        "mass_bias_ns": mass_bias_ns,
+        "rhs_ns": rhs_ns,
+    });
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        let mut out = std::io::stdout().lock();
+        writeln!(
+            out,
+            "{} ({} backend, {} dof)",
+            loaded.model.name,
+            arm.backend(),
+            n
+        )?;
+        writeln!(out, "  derive      {:>10.4} s", derive_s)?;
+        writeln!(out, "  mass        {:>10.1} ns", mass_ns)?;
+        writeln!(out, "  bias        {:>10.1} ns", bias_ns)?;
+        writeln!(out, "  mass+bias   {:>10.1} ns", mass_bias_ns)?;
+        writeln!(out, "  rhs (qdd)   {:>10.1} ns", rhs_ns)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
