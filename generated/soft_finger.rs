@@ -119,12 +119,18 @@ impl Kernels for Compiled {
         let qd: &[f64; 12usize] = inp.qd.try_into().expect("qd has DOF entries");
         let p: &[f64; 71usize] = inp.p.try_into().expect("parameter vector length");
         match kind {
-            KernelKind::Mass => mass(inp.t, q, qd, p, out.try_into().expect("output length")),
-            KernelKind::Bias => bias(inp.t, q, qd, p, out.try_into().expect("output length")),
+            KernelKind::Mass => {
+                mass(inp.t, q, qd, p, out.try_into().expect("output length"))
+            }
+            KernelKind::Bias => {
+                bias(inp.t, q, qd, p, out.try_into().expect("output length"))
+            }
             KernelKind::MassBias => {
                 mass_bias(inp.t, q, qd, p, out.try_into().expect("output length"))
             }
-            KernelKind::Outputs => outputs(inp.t, q, qd, p, out.try_into().expect("output length")),
+            KernelKind::Outputs => {
+                outputs(inp.t, q, qd, p, out.try_into().expect("output length"))
+            }
         }
     }
 }
