@@ -151,20 +151,20 @@ pub struct SimulateArgs {
     #[command(flatten)]
     pub model: ModelArgs,
     /// End time (s).
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
     pub t_end: f64,
     /// Integrator.
     #[arg(long, default_value = "dopri5", value_parser = Solver::NAMES)]
     pub solver: String,
     /// Step of fixed-step solvers (s).
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = 1e-3, allow_negative_numbers = true)]
     pub dt: f64,
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
     pub rtol: f64,
-    #[arg(long, default_value_t = 1e-9)]
+    #[arg(long, default_value_t = 1e-9, allow_negative_numbers = true)]
     pub atol: f64,
     /// Spacing of trajectory.csv rows (s); default t_end / 500.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub output_dt: Option<f64>,
     /// Initial coordinates, comma-separated (default 0).
     #[arg(long, allow_hyphen_values = true)]
@@ -341,7 +341,7 @@ pub struct EomArgs {
     /// Rates, comma-separated (default 0).
     #[arg(long, allow_hyphen_values = true)]
     pub qd: Option<String>,
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub t: f64,
     /// Print JSON (the only format for now; accepted for scripts).
     #[arg(long)]

@@ -1,0 +1,135 @@
+//! Compiled and interpreted backends agree to round-off on random states
+//! for every bundled model, and the tape cache is hit on a second run.
+
+mod common;
+
+use common::*;
+use runtime::{Inputs, Interpreted, KernelKind, Kernels};
+use softarm::backend::{BackendChoice, load};
+use softarm::generated::MODELS;
+
+#[test]
+fn compiled_and_interpreted_agree_on_every_bundled_model() {
+    let mut rng = Rng::new(7);
+    assert!(MODELS.len() >= 3);
+    for m in MODELS {
+        let l = load(m.name, &[], BackendChoice::Compiled, None).unwrap();
+        let compiled = (m.kernels)();
+        let interpreted = Interpreted::new(eomgen::derive::derive(&l.model));
+        assert_eq!(
+            compiled.info(),
+            interpreted.info(),
+            "{}: layouts differ",
+            m.name
+        );
+        let n = compiled.info().dof();
+        let p: Vec<f64> = eomgen::model::parameters(&l.model)
+            .into_iter()
+            .map(|(_, v)| v)
+            .collect();
+        for _ in 0..10 {
+            let q = rng.vec(n, -2.0, 2.0);
+            let qd = rng.vec(n, -3.0, 3.0);
+            let t = rng.uniform(0.0, 10.0);
+            let inp = Inputs {
+                t,
+                q: &q,
+                qd: &qd,
+                p: &p,
+            };
+            for kind in KernelKind::ALL {
+                let len = kind.output_len(n);
+                let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
+                compiled.eval(kind, &inp, &mut a);
+                interpreted.eval(kind, &inp, &mut b);
+                for k in 0..len {
+                    assert!(a[k].is_finite(), "{} {kind:?}[{k}] not finite", m.name);
+                    assert_close(a[k], b[k], 1e-12, 0.0, &format!("{} {kind:?}[{k}]", m.name));
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn second_interpreted_run_hits_the_disk_cache() {
+    let dir = tempfile::tempdir().unwrap();
+    // A structure no compiled-in model has: 3 links.
+    let text = std::fs::read_to_string(model_path("chain"))
+        .unwrap()
+        .replace("elements = 8", "elements = 3");
+    let model = dir.path().join("three.toml");
+    std::fs::write(&model, text).unwrap();
+    let m = model.to_str().unwrap();
+    let mut seen = Vec::new();
+    for run in 0..2 {
+        let out = softarm(
+            &["simulate", m, "--t-end", "0.2", "--out", "run"],
+            dir.path(),
+        );
+        assert!(out.status.success(), "run {run}: {}", stderr(&out));
+        let summary: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join("run/summary.json")).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(summary["backend"], "interpreted");
+        seen.push(summary["cache"].as_str().unwrap().to_string());
+    }
+    assert_eq!(seen, ["miss", "hit"]);
+    assert_eq!(
+        std::fs::read_dir(dir.path().join("cache")).unwrap().count(),
+        1
+    );
+}
+
+#[test]
+fn structural_override_derives_anew_numeric_keeps_compiled() {
+    let dir = tempfile::tempdir().unwrap();
+    let numeric = softarm(
+        &[
+            "simulate",
+            "chain",
+            "--t-end",
+            "0.05",
+            "--set",
+            "segment.0.length=1.0",
+            "--out",
+            "a",
+        ],
+        dir.path(),
+    );
+    assert!(numeric.status.success(), "{}", stderr(&numeric));
+    assert!(stderr(&numeric).contains("compiled backend"));
+    let structural = softarm(
+        &[
+            "simulate",
+            "chain",
+            "--t-end",
+            "0.05",
+            "--set",
+            "segment.0.elements=5",
+            "--out",
+            "b",
+        ],
+        dir.path(),
+    );
+    assert!(structural.status.success(), "{}", stderr(&structural));
+    assert!(stderr(&structural).contains("interpreted backend"));
+}
+
+#[test]
+fn corrupt_cache_entry_is_rederived() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(model_path("chain"))
+        .unwrap()
+        .replace("elements = 8", "elements = 2");
+    std::fs::write(dir.path().join("two.toml"), text).unwrap();
+    let first = softarm(&["eom", "two.toml", "--json"], dir.path());
+    assert!(first.status.success());
+    for e in std::fs::read_dir(dir.path().join("cache")).unwrap() {
+        std::fs::write(e.unwrap().path(), "{ not json").unwrap();
+    }
+    let second = softarm(&["eom", "two.toml", "--json"], dir.path());
+    assert!(second.status.success(), "{}", stderr(&second));
+    assert_eq!(stdout(&first), stdout(&second));
+}

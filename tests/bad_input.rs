@@ -1,0 +1,308 @@
+//! Bad input gets a clear error: the file, the key path, what is wrong and
+//! what is allowed; a non-zero exit; never a panic.
+
+mod common;
+
+use common::*;
+
+const GOOD: &str = r#"
+name = "t"
+gravity = [0.0, -9.81, 0.0]
+[base]
+direction = [0.0, -1.0, 0.0]
+[[segment]]
+method = "rigid"
+length = 0.3
+elements = 2
+mass = 0.5
+joint_stiffness = 1.0
+joint_damping = 0.1
+[tip]
+mass = 0.1
+force = [0.0, 0.0, 0.0]
+"#;
+
+/// (label, file text, extra CLI args, expected fragments of stderr).
+fn cases() -> Vec<(&'static str, String, Vec<&'static str>, Vec<&'static str>)> {
+    let r = |a: &str, b: &str| GOOD.replacen(a, b, 1);
+    vec![
+        (
+            "toml syntax",
+            r("length = 0.3", "length = = 0.3"),
+            vec![],
+            vec!["m.toml", "invalid TOML", "line"],
+        ),
+        (
+            "unknown top-level key",
+            format!("colour = 1\n{GOOD}"),
+            vec![],
+            vec!["unknown field `colour`", "expected one of"],
+        ),
+        (
+            "unknown segment key",
+            r("length = 0.3", "lenght = 0.3"),
+            vec![],
+            vec!["segment[0]", "unknown field `lenght`"],
+        ),
+        (
+            "wrong type",
+            r("length = 0.3", "length = \"long\""),
+            vec![],
+            vec!["segment[0].length", "invalid type: string"],
+        ),
+        (
+            "negative length",
+            r("length = 0.3", "length = -0.3"),
+            vec![],
+            vec!["segment[0].length", "must be positive"],
+        ),
+        (
+            "zero elements",
+            r("elements = 2", "elements = 0"),
+            vec![],
+            vec!["segment[0].elements", "between 1 and"],
+        ),
+        (
+            "fractional elements",
+            r("elements = 2", "elements = 2.5"),
+            vec![],
+            vec!["segment[0].elements", "invalid type"],
+        ),
+        (
+            "NaN mass",
+            r("mass = 0.5", "mass = nan"),
+            vec![],
+            vec!["segment[0].mass", "finite"],
+        ),
+        (
+            "infinite gravity",
+            r("[0.0, -9.81, 0.0]", "[0.0, -inf, 0.0]"),
+            vec![],
+            vec!["gravity[1]", "finite"],
+        ),
+        (
+            "zero base direction",
+            r("[0.0, -1.0, 0.0]", "[0.0, 0.0, 0.0]"),
+            vec![],
+            vec!["base.direction", "non-zero"],
+        ),
+        (
+            "out-of-plane direction",
+            r("[0.0, -1.0, 0.0]", "[0.0, -1.0, 0.5]"),
+            vec![],
+            vec!["base.direction", "x-y plane"],
+        ),
+        (
+            "unknown method",
+            r("\"rigid\"", "\"spaghetti\""),
+            vec![],
+            vec!["segment[0].method", "unknown variant `spaghetti`", "rigid"],
+        ),
+        (
+            "no mass",
+            r("mass = 0.5\n", ""),
+            vec![],
+            vec!["segment[0].mass", "missing", "density"],
+        ),
+        (
+            "mass and density",
+            r(
+                "mass = 0.5",
+                "mass = 0.5\ndensity = 1000.0\nouter_radius = 0.01",
+            ),
+            vec![],
+            vec!["segment[0].mass", "either"],
+        ),
+        (
+            "density without radius",
+            r("mass = 0.5", "density = 1000.0"),
+            vec![],
+            vec!["segment[0].outer_radius", "missing"],
+        ),
+        (
+            "inner radius too large",
+            r(
+                "mass = 0.5",
+                "density = 1000.0\nouter_radius = 0.01\ninner_radius = 0.02",
+            ),
+            vec![],
+            vec!["segment[0].inner_radius", "smaller than outer_radius"],
+        ),
+        (
+            "negative stiffness",
+            r("joint_stiffness = 1.0", "joint_stiffness = -1.0"),
+            vec![],
+            vec!["segment[0].joint_stiffness", "zero or positive"],
+        ),
+        (
+            "negative tip mass",
+            r("mass = 0.1", "mass = -0.1"),
+            vec![],
+            vec!["tip.mass"],
+        ),
+        (
+            "missing gravity",
+            r("gravity = [0.0, -9.81, 0.0]\n", ""),
+            vec![],
+            vec!["missing field `gravity`"],
+        ),
+        (
+            "short vector",
+            r("[0.0, -9.81, 0.0]", "[0.0, -9.81]"),
+            vec![],
+            vec!["gravity", "invalid length 2"],
+        ),
+        (
+            "no segments",
+            format!(
+                "segment = []\n{}",
+                GOOD.split("[[segment]]").next().unwrap()
+            ),
+            vec![],
+            vec!["segment", "at least one"],
+        ),
+        (
+            "set without =",
+            GOOD.into(),
+            vec!["--set", "segment.0.length"],
+            vec!["--set", "PATH=VALUE"],
+        ),
+        (
+            "set index out of range",
+            GOOD.into(),
+            vec!["--set", "segment.5.length=1"],
+            vec!["segment.5.length", "out of range", "1 items"],
+        ),
+        (
+            "set unknown key",
+            GOOD.into(),
+            vec!["--set", "segment.0.lenght=1"],
+            vec!["segment[0]", "unknown field `lenght`"],
+        ),
+        (
+            "set negative value",
+            GOOD.into(),
+            vec!["--set", "segment.0.length=-1"],
+            vec!["segment[0].length", "must be positive"],
+        ),
+        (
+            "set non-index",
+            GOOD.into(),
+            vec!["--set", "segment.first.length=1"],
+            vec!["segment.first.length", "not an index"],
+        ),
+        (
+            "set wrong type",
+            GOOD.into(),
+            vec!["--set", "tip.mass=heavy"],
+            vec!["tip.mass", "invalid type: string"],
+        ),
+        (
+            "set inside a value",
+            GOOD.into(),
+            vec!["--set", "name.x=1"],
+            vec!["name.x", "is a value"],
+        ),
+        (
+            "set zero elements",
+            GOOD.into(),
+            vec!["--set", "segment.0.elements=0"],
+            vec!["segment[0].elements"],
+        ),
+        (
+            "set bad value",
+            GOOD.into(),
+            vec!["--set", "tip.force=[0,"],
+            vec!["tip.force", "cannot read the value"],
+        ),
+        (
+            "wrong --q length",
+            GOOD.into(),
+            vec!["--q", "0.1"],
+            vec!["--q", "expected 2 values"],
+        ),
+        (
+            "non-numeric --q",
+            GOOD.into(),
+            vec!["--q", "0.1,abc"],
+            vec!["--q", "comma-separated numbers"],
+        ),
+    ]
+}
+
+#[test]
+fn malformed_models_and_overrides_are_rejected_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = cases();
+    assert!(cases.len() >= 15);
+    for (label, text, extra, expect) in cases {
+        std::fs::write(dir.path().join("m.toml"), &text).unwrap();
+        let mut args = vec!["eom", "m.toml", "--json"];
+        args.extend(extra);
+        let out = softarm(&args, dir.path());
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{label}: accepted");
+        assert!(!err.contains("panicked"), "{label}: panic: {err}");
+        assert!(
+            stdout(&out).is_empty(),
+            "{label}: printed output on failure"
+        );
+        for e in expect {
+            assert!(err.contains(e), "{label}: expected `{e}` in: {err}");
+        }
+    }
+}
+
+#[test]
+fn the_good_model_is_accepted() {
+    // The baseline of the table above really is valid.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("m.toml"), GOOD).unwrap();
+    let out = softarm(&["eom", "m.toml", "--json"], dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+#[test]
+fn json_models_are_accepted_and_json_errors_located() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = serde_json::json!({
+        "name": "j", "gravity": [0.0, -9.81, 0.0], "base": {"direction": [1.0, 0.0, 0.0]},
+        "segment": [{"method": "rigid", "length": 0.2, "elements": 2, "mass": 0.1}]
+    });
+    std::fs::write(dir.path().join("j.json"), good.to_string()).unwrap();
+    let out = softarm(&["eom", "j.json", "--json"], dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+    std::fs::write(dir.path().join("bad.json"), "{\"name\": ").unwrap();
+    let out = softarm(&["eom", "bad.json"], dir.path());
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("bad.json: invalid JSON"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn missing_model_names_the_compiled_in_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = softarm(&["eom", "no_such_arm"], dir.path());
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(
+        err.contains("no_such_arm") && err.contains("double_pendulum"),
+        "{err}"
+    );
+}
+
+#[test]
+fn failed_simulation_writes_no_partial_files() {
+    // A rejected option fails before anything is written.
+    let dir = tempfile::tempdir().unwrap();
+    let out = softarm(
+        &["simulate", "chain", "--t-end", "-1", "--out", "o"],
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("--t-end"));
+    assert!(!dir.path().join("o/summary.json").exists());
+}

@@ -1,0 +1,66 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A small deterministic generator (xorshift64*), so failures reproduce.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Self(seed.max(1))
+    }
+    pub fn next_f64(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        let x = self.0.wrapping_mul(0x2545_F491_4F6C_DD1D);
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Uniform in [lo, hi).
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next_f64()
+    }
+    pub fn vec(&mut self, n: usize, lo: f64, hi: f64) -> Vec<f64> {
+        (0..n).map(|_| self.uniform(lo, hi)).collect()
+    }
+}
+
+/// |a - b| <= rel * max(|a|, |b|, floor): relative, with an absolute floor
+/// for entries that are zero in closed form.
+pub fn assert_close(a: f64, b: f64, rel: f64, floor: f64, what: &str) {
+    let scale = a.abs().max(b.abs()).max(floor);
+    assert!(
+        (a - b).abs() <= rel * scale,
+        "{what}: {a:e} vs {b:e} (difference {:e}, allowed {:e})",
+        (a - b).abs(),
+        rel * scale
+    );
+}
+
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+pub fn model_path(name: &str) -> PathBuf {
+    root().join("models").join(format!("{name}.toml"))
+}
+
+/// Run the softarm binary with `args` in `cwd`.
+pub fn softarm(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_softarm"))
+        .args(args)
+        .current_dir(cwd)
+        .env("SOFTARM_CACHE_DIR", cwd.join("cache"))
+        .output()
+        .expect("the softarm binary runs")
+}
+
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}

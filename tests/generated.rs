@@ -1,0 +1,117 @@
+//! `generated/` is committed and in sync, and the generator's cache works:
+//! an unchanged model is neither re-derived nor rewritten.
+
+mod common;
+
+use std::path::Path;
+
+use common::*;
+use eomgen::generate::{SyncOptions, sync};
+
+#[test]
+fn generated_is_in_sync_with_models() {
+    // Full re-derivation and byte comparison: also catches a generator
+    // change made without bumping GENERATOR_VERSION.
+    let opts = SyncOptions {
+        force: true,
+        check: true,
+        absolute_paths: false,
+    };
+    let report = sync(&root().join("models"), &root().join("generated"), &opts).unwrap();
+    assert!(
+        report.is_clean(),
+        "generated/ is stale: run `cargo run -- derive --force` and commit. Stale: {:?} {:?}",
+        report.written,
+        report.removed
+    );
+}
+
+fn copy_models(to: &Path, names: &[&str]) {
+    std::fs::create_dir_all(to).unwrap();
+    for n in names {
+        std::fs::copy(model_path(n), to.join(format!("{n}.toml"))).unwrap();
+    }
+}
+
+fn snapshot(dir: &Path) -> Vec<(String, std::time::SystemTime, String)> {
+    let mut v: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let p = e.unwrap().path();
+            let meta = std::fs::metadata(&p).unwrap();
+            (
+                p.display().to_string(),
+                meta.modified().unwrap(),
+                std::fs::read_to_string(&p).unwrap(),
+            )
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn unchanged_models_are_not_rederived_or_rewritten() {
+    let dir = tempfile::tempdir().unwrap();
+    let (models, out) = (dir.path().join("models"), dir.path().join("generated"));
+    copy_models(&models, &["double_pendulum", "chain"]);
+    let first = sync(&models, &out, &SyncOptions::default()).unwrap();
+    assert_eq!(first.derived, ["chain", "double_pendulum"]);
+    assert_eq!(first.written.len(), 3); // two models and mod.rs
+    let before = snapshot(&out);
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let second = sync(&models, &out, &SyncOptions::default()).unwrap();
+    assert!(second.derived.is_empty(), "re-derived {:?}", second.derived);
+    assert!(second.written.is_empty(), "rewrote {:?}", second.written);
+    assert_eq!(snapshot(&out), before, "files touched");
+}
+
+#[test]
+fn numeric_edit_reuses_structural_edit_rederives() {
+    let dir = tempfile::tempdir().unwrap();
+    let (models, out) = (dir.path().join("models"), dir.path().join("generated"));
+    copy_models(&models, &["double_pendulum", "chain"]);
+    sync(&models, &out, &SyncOptions::default()).unwrap();
+    let chain = models.join("chain.toml");
+    let text = std::fs::read_to_string(&chain).unwrap();
+    std::fs::write(&chain, text.replace("mass = 0.4", "mass = 0.7")).unwrap();
+    let numeric = sync(&models, &out, &SyncOptions::default()).unwrap();
+    assert!(numeric.derived.is_empty() && numeric.written.is_empty());
+    std::fs::write(&chain, text.replace("elements = 8", "elements = 4")).unwrap();
+    let structural = sync(&models, &out, &SyncOptions::default()).unwrap();
+    assert_eq!(structural.derived, ["chain"]);
+    assert_eq!(structural.written, [out.join("chain.rs")]);
+}
+
+#[test]
+fn removed_model_removes_its_generated_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (models, out) = (dir.path().join("models"), dir.path().join("generated"));
+    copy_models(&models, &["double_pendulum", "chain"]);
+    sync(&models, &out, &SyncOptions::default()).unwrap();
+    std::fs::remove_file(models.join("chain.toml")).unwrap();
+    let r = sync(&models, &out, &SyncOptions::default()).unwrap();
+    assert_eq!(r.removed, [out.join("chain.rs")]);
+    assert!(!out.join("chain.rs").exists());
+    assert!(
+        !std::fs::read_to_string(out.join("mod.rs"))
+            .unwrap()
+            .contains("chain")
+    );
+}
+
+#[test]
+fn cli_derive_check_detects_a_stale_file() {
+    let dir = tempfile::tempdir().unwrap();
+    copy_models(&dir.path().join("models"), &["double_pendulum"]);
+    let ok = softarm(&["derive"], dir.path());
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    let check = softarm(&["derive", "--check"], dir.path());
+    assert!(check.status.success(), "{}", stderr(&check));
+    let f = dir.path().join("generated/double_pendulum.rs");
+    let text = std::fs::read_to_string(&f).unwrap();
+    std::fs::write(&f, text.replace("pub const DOF", "pub const  DOF")).unwrap();
+    let stale = softarm(&["derive", "--check"], dir.path());
+    assert!(!stale.status.success());
+    assert!(stderr(&stale).contains("stale: ") && stderr(&stale).contains("double_pendulum.rs"));
+}
