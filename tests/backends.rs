@@ -4,7 +4,7 @@
 mod common;
 
 use common::*;
-use runtime::{Inputs, Interpreted, KernelKind, Kernels};
+use runtime::{Arm, Dynamics, Interpreted, KernelKind};
 use softarm::backend::{BackendChoice, load};
 use softarm::generated::MODELS;
 
@@ -14,34 +14,42 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
     assert!(MODELS.len() >= 3);
     for m in MODELS {
         let l = load(m.name, &[], BackendChoice::Compiled, None).unwrap();
-        let compiled = (m.kernels)();
-        let interpreted = Interpreted::new(eomgen::derive::derive(&l.model));
+        let p: Vec<f64> = eomgen::model::parameters(&l.model)
+            .into_iter()
+            .map(|(_, v)| v)
+            .collect();
+        let compiled = Arm::new((m.kernels)(), p.clone());
+        let interpreted = Arm::new(Interpreted::new(eomgen::derive::derive(&l.model)), p);
         assert_eq!(
             compiled.info(),
             interpreted.info(),
             "{}: layouts differ",
             m.name
         );
-        let n = compiled.info().dof();
-        let p: Vec<f64> = eomgen::model::parameters(&l.model)
-            .into_iter()
-            .map(|(_, v)| v)
-            .collect();
+        // The derived parameters (the `Derived` kernel) agree.
+        for (k, (a, b)) in compiled
+            .params()
+            .iter()
+            .zip(interpreted.params())
+            .enumerate()
+        {
+            assert_close(*a, *b, 1e-12, 0.0, &format!("{} parameter {k}", m.name));
+        }
+        let n = compiled.dof();
         for _ in 0..10 {
             let q = rng.vec(n, -2.0, 2.0);
             let qd = rng.vec(n, -3.0, 3.0);
             let t = rng.uniform(0.0, 10.0);
-            let inp = Inputs {
-                t,
-                q: &q,
-                qd: &qd,
-                p: &p,
-            };
-            for kind in KernelKind::ALL {
-                let len = kind.output_len(n);
+            for kind in [
+                KernelKind::Mass,
+                KernelKind::Bias,
+                KernelKind::MassBias,
+                KernelKind::Outputs,
+            ] {
+                let len = kind.output_len(compiled.info());
                 let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
-                compiled.eval(kind, &inp, &mut a);
-                interpreted.eval(kind, &inp, &mut b);
+                compiled.eval_kernel(kind, t, &q, &qd, &mut a);
+                interpreted.eval_kernel(kind, t, &q, &qd, &mut b);
                 for k in 0..len {
                     assert!(a[k].is_finite(), "{} {kind:?}[{k}] not finite", m.name);
                     assert_close(a[k], b[k], 1e-12, 0.0, &format!("{} {kind:?}[{k}]", m.name));

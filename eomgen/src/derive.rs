@@ -2,7 +2,7 @@
 
 use runtime::{ModelInfo, TapeSet};
 
-use crate::cas::Cas;
+use crate::cas::{Cas, Hoist};
 use crate::model::{Model, Structure, parameters};
 use crate::tmt::{assemble, planar_system};
 
@@ -13,15 +13,24 @@ pub fn derive(model: &Model) -> TapeSet {
     let eq = assemble(&mut cas, &sys);
     let mut mass_bias = eq.mass_upper.clone();
     mass_bias.extend_from_slice(&eq.bias);
+    let params: Vec<String> = parameters(model).into_iter().map(|(n, _)| n).collect();
+    let mut hoist = Hoist::new(params.len());
+    let mass = cas.to_tape_hoisted(&eq.mass_upper, &mut hoist);
+    let bias = cas.to_tape_hoisted(&eq.bias, &mut hoist);
+    let mass_bias = cas.to_tape_hoisted(&mass_bias, &mut hoist);
+    let outputs = cas.to_tape_hoisted(&eq.outputs, &mut hoist);
+    let derived = hoist.finish(&mut cas);
     TapeSet {
         info: ModelInfo {
             hash: Structure::of(model).hash(),
             coordinates: sys.coords.names.clone(),
-            parameters: parameters(model).into_iter().map(|(n, _)| n).collect(),
+            parameters: params,
+            derived: hoist.len(),
         },
-        mass: cas.to_tape(&eq.mass_upper),
-        bias: cas.to_tape(&eq.bias),
-        mass_bias: cas.to_tape(&mass_bias),
-        outputs: cas.to_tape(&eq.outputs),
+        mass,
+        bias,
+        mass_bias,
+        outputs,
+        derived,
     }
 }

@@ -278,7 +278,8 @@ pub const HASH_PREFIX: &str = "// structural-hash: ";
 pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     let info = &tapes.info;
     let dof = info.dof();
-    let n_params = info.parameters.len();
+    let n_params = info.extended_params();
+    let n_derived = info.derived;
     let hash = &info.hash;
     let coords = &info.coordinates;
     let params = &info.parameters;
@@ -301,6 +302,8 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         pub const DOF: usize = #dof;
         pub const COORDINATES: &[&str] = &[#(#coords),*];
         pub const PARAMETERS: &[&str] = &[#(#params),*];
+        /// Derived parameters, computed once per parameter set.
+        pub const DERIVED: usize = #n_derived;
 
         /// The compiled kernels of this structure.
         pub struct Compiled {
@@ -314,6 +317,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                         hash: HASH.to_string(),
                         coordinates: COORDINATES.iter().map(|s| s.to_string()).collect(),
                         parameters: PARAMETERS.iter().map(|s| s.to_string()).collect(),
+                        derived: DERIVED,
                     },
                 }
             }

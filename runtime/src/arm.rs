@@ -26,6 +26,9 @@ pub trait Dynamics {
     fn mass_bias(&self, t: f64, q: &[f64], qd: &[f64], m: &mut DMatrix<f64>, h: &mut DVector<f64>);
     /// Tip position and energies, laid out as [`crate::OUTPUT_NAMES`].
     fn outputs(&self, t: f64, q: &[f64], qd: &[f64]) -> [f64; 5];
+    /// A kernel's raw output (layouts in [`KernelKind`]); the hot path of
+    /// the integrators, free of matrix copies.
+    fn eval_kernel(&self, kind: KernelKind, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]);
 }
 
 /// Why the accelerations could not be computed.
@@ -71,9 +74,8 @@ impl<K: Kernels> Arm<K> {
     }
 
     fn eval_packed(&self, kind: KernelKind, t: f64, q: &[f64], qd: &[f64], f: impl FnOnce(&[f64])) {
-        let n = self.kernels.info().dof();
         let mut packed = self.packed.borrow_mut();
-        packed.resize(kind.output_len(n), 0.0);
+        packed.resize(kind.output_len(self.kernels.info()), 0.0);
         let inp = Inputs {
             t,
             q,
@@ -113,7 +115,7 @@ impl<K: Kernels> Dynamics for Arm<K> {
         self.eval_packed(KernelKind::Bias, t, q, qd, |p| h.copy_from_slice(p));
     }
     fn mass_bias(&self, t: f64, q: &[f64], qd: &[f64], m: &mut DMatrix<f64>, h: &mut DVector<f64>) {
-        let tri = KernelKind::Mass.output_len(q.len());
+        let tri = q.len() * (q.len() + 1) / 2;
         self.eval_packed(KernelKind::MassBias, t, q, qd, |p| {
             unpack_symmetric(&p[..tri], m);
             h.copy_from_slice(&p[tri..]);
@@ -123,6 +125,18 @@ impl<K: Kernels> Dynamics for Arm<K> {
         let mut out = [0.0; 5];
         self.eval_packed(KernelKind::Outputs, t, q, qd, |p| out.copy_from_slice(p));
         out
+    }
+    fn eval_kernel(&self, kind: KernelKind, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        self.kernels.eval(
+            kind,
+            &Inputs {
+                t,
+                q,
+                qd,
+                p: &self.params,
+            },
+            out,
+        );
     }
 }
 
@@ -140,64 +154,73 @@ impl<K: Kernels + ?Sized> Kernels for Box<K> {
 
 /// Reusable buffers for [`accelerations`].
 pub struct Workspace {
-    m: DMatrix<f64>,
-    h: DVector<f64>,
+    n: usize,
+    /// `MassBias` kernel output: packed upper triangle of M, then h.
+    packed: Vec<f64>,
+    /// Cholesky factor L, row-major n x n (lower triangle used).
+    l: Vec<f64>,
 }
 
 impl Workspace {
     pub fn new(dof: usize) -> Self {
         Self {
-            m: DMatrix::zeros(dof, dof),
-            h: DVector::zeros(dof),
+            n: dof,
+            packed: vec![0.0; dof * (dof + 1) / 2 + dof],
+            l: vec![0.0; dof * dof],
         }
     }
 }
 
-/// In-place Cholesky factorisation M = L L^T into the lower triangle of `m`
-/// (column-major, as nalgebra stores it). nalgebra's `Cholesky` allocates
-/// on every call, which cost more than the whole EOM evaluation of an
-/// 8-link chain (measured: 400 ns of a 615 ns right-hand side); this is the
-/// same algorithm without allocation. Returns false unless M is positive
-/// definite.
-fn cholesky_in_place(m: &mut DMatrix<f64>) -> bool {
-    let n = m.nrows();
-    for j in 0..n {
-        let mut d = m[(j, j)];
-        for k in 0..j {
-            d -= m[(j, k)] * m[(j, k)];
-        }
-        if !(d > 0.0) {
-            return false;
-        }
-        let d = d.sqrt();
-        m[(j, j)] = d;
-        for i in j + 1..n {
-            let mut s = m[(i, j)];
-            for k in 0..j {
-                s -= m[(i, k)] * m[(j, k)];
+/// Index of (i, j), i <= j, in the packed upper triangle.
+#[inline]
+fn packed_index(n: usize, i: usize, j: usize) -> usize {
+    i * n - i * (i + 1) / 2 + j
+}
+
+/// Cholesky-Banachiewicz M = L L^T, reading M from the packed upper
+/// triangle and writing L row-major, so that every inner product runs over
+/// contiguous rows. nalgebra's `Cholesky` allocates on every call, which
+/// cost more than the whole EOM of an 8-link chain (measured: 400 ns of a
+/// 615 ns right-hand side); this is the same algorithm without allocation.
+/// Returns false unless M is positive definite.
+fn cholesky_packed(n: usize, packed: &[f64], l: &mut [f64]) -> bool {
+    for i in 0..n {
+        let (done, rest) = l.split_at_mut(i * n);
+        let row_i = &mut rest[..n];
+        for j in 0..=i {
+            let row_j: &[f64] = if j < i {
+                &done[j * n..j * n + j]
+            } else {
+                &row_i[..j]
+            };
+            let dot: f64 = row_i[..j].iter().zip(row_j).map(|(a, b)| a * b).sum();
+            let s = packed[packed_index(n, j, i)] - dot;
+            if j == i {
+                if !(s > 0.0) {
+                    return false;
+                }
+                row_i[i] = s.sqrt();
+            } else {
+                row_i[j] = s / done[j * n + j];
             }
-            m[(i, j)] = s / d;
         }
     }
     true
 }
 
-/// Solve L L^T x = b in place (b becomes x), L in the lower triangle.
-fn cholesky_solve(l: &DMatrix<f64>, b: &mut [f64]) {
-    let n = l.nrows();
+/// Solve L L^T x = b in place (b becomes x), L row-major lower.
+fn cholesky_solve(n: usize, l: &[f64], b: &mut [f64]) {
     for i in 0..n {
-        let mut s = b[i];
-        for k in 0..i {
-            s -= l[(i, k)] * b[k];
-        }
-        b[i] = s / l[(i, i)];
+        let row = &l[i * n..i * n + i];
+        let dot: f64 = row.iter().zip(&b[..i]).map(|(a, x)| a * x).sum();
+        b[i] = (b[i] - dot) / l[i * n + i];
     }
     for i in (0..n).rev() {
         let mut s = b[i];
         for k in i + 1..n {
-            s -= l[(k, i)] * b[k];
+            s -= l[k * n + i] * b[k];
         }
-        b[i] = s / l[(i, i)];
+        b[i] = s / l[i * n + i];
     }
 }
 
@@ -210,30 +233,32 @@ pub fn accelerations<D: Dynamics + ?Sized>(
     qd: &[f64],
     qdd: &mut [f64],
 ) -> Result<(), AccelError> {
-    d.mass_bias(t, q, qd, &mut ws.m, &mut ws.h);
-    if ws.h.iter().any(|v| !v.is_finite()) {
+    let n = ws.n;
+    d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
+    let (mass, bias) = ws.packed.split_at(n * (n + 1) / 2);
+    if bias.iter().any(|v| !v.is_finite()) {
         return Err(AccelError::NonFinite {
             t,
             what: "bias (generalised force)",
         });
     }
-    if ws.m.iter().any(|v| !v.is_finite()) {
+    if mass.iter().any(|v| !v.is_finite()) {
         return Err(AccelError::NonFinite {
             t,
             what: "mass matrix",
         });
     }
-    if !cholesky_in_place(&mut ws.m) {
-        let mut m = DMatrix::zeros(q.len(), q.len());
+    if !cholesky_packed(n, mass, &mut ws.l) {
+        let mut m = DMatrix::zeros(n, n);
         d.mass(t, q, &mut m);
         let sv = m.singular_values();
         let condition = sv.max() / sv.min().max(f64::MIN_POSITIVE);
         return Err(AccelError::SingularMass { t, condition });
     }
-    for (a, b) in qdd.iter_mut().zip(ws.h.iter()) {
+    for (a, b) in qdd.iter_mut().zip(bias) {
         *a = -b;
     }
-    cholesky_solve(&ws.m, qdd);
+    cholesky_solve(n, &ws.l, qdd);
     Ok(())
 }
 
@@ -241,18 +266,29 @@ pub fn accelerations<D: Dynamics + ?Sized>(
 mod tests {
     use super::*;
 
+    fn pack(m: &DMatrix<f64>) -> Vec<f64> {
+        let n = m.nrows();
+        let mut p = Vec::new();
+        for i in 0..n {
+            for j in i..n {
+                p.push(m[(i, j)]);
+            }
+        }
+        p
+    }
+
     #[test]
-    fn in_place_cholesky_solves_like_nalgebra() {
+    fn packed_cholesky_solves_like_nalgebra() {
         // A random SPD matrix: A^T A + n I.
         let n = 7;
         let a = DMatrix::from_fn(n, n, |i, j| ((i * 7 + j * 3) as f64 * 0.37).sin());
         let m = a.transpose() * &a + DMatrix::identity(n, n) * n as f64;
         let b = DVector::from_fn(n, |i, _| (i as f64).cos());
         let reference = m.clone().cholesky().unwrap().solve(&b);
-        let mut l = m.clone();
-        assert!(cholesky_in_place(&mut l));
+        let mut l = vec![0.0; n * n];
+        assert!(cholesky_packed(n, &pack(&m), &mut l));
         let mut x: Vec<f64> = b.iter().copied().collect();
-        cholesky_solve(&l, &mut x);
+        cholesky_solve(n, &l, &mut x);
         for i in 0..n {
             assert!((x[i] - reference[i]).abs() < 1e-13 * (1.0 + reference[i].abs()));
         }
@@ -260,7 +296,8 @@ mod tests {
 
     #[test]
     fn indefinite_matrix_is_rejected() {
-        let mut m = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
-        assert!(!cholesky_in_place(&mut m));
+        let m = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        let mut l = vec![0.0; 4];
+        assert!(!cholesky_packed(2, &pack(&m), &mut l));
     }
 }

@@ -198,7 +198,12 @@ pub fn simulate<D: Dynamics + ?Sized>(
             .solout(recorder)
             .solve(),
         Solver::Rk4 => problem
-            .method(ExplicitRungeKutta::rk4(opts.dt))
+            .method(
+                ExplicitRungeKutta::rk4(opts.dt).max_steps(
+                    opts.max_steps
+                        .max((opts.t_end / opts.dt).ceil() as usize + 2),
+                ),
+            )
             .solout(recorder)
             .solve(),
     };

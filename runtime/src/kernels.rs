@@ -14,24 +14,36 @@ use crate::tape::{Inputs, Tape};
 /// * `Bias`: h(q, qd, t), n values.
 /// * `MassBias`: `Mass` followed by `Bias` (one pass, shared subexpressions).
 /// * `Outputs`: see [`OUTPUT_NAMES`].
+/// * `Derived`: the derived parameters (parameter-only subexpressions the
+///   generator hoisted out of the other kernels), computed once per
+///   parameter set; the other kernels read them after the base parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum KernelKind {
     Mass,
     Bias,
     MassBias,
     Outputs,
+    Derived,
 }
 
 impl KernelKind {
-    pub const ALL: [KernelKind; 4] = [Self::Mass, Self::Bias, Self::MassBias, Self::Outputs];
+    pub const ALL: [KernelKind; 5] = [
+        Self::Mass,
+        Self::Bias,
+        Self::MassBias,
+        Self::Outputs,
+        Self::Derived,
+    ];
 
-    pub fn output_len(self, dof: usize) -> usize {
+    pub fn output_len(self, info: &ModelInfo) -> usize {
+        let dof = info.dof();
         let tri = dof * (dof + 1) / 2;
         match self {
             Self::Mass => tri,
             Self::Bias => dof,
             Self::MassBias => tri + dof,
             Self::Outputs => OUTPUT_NAMES.len(),
+            Self::Derived => info.derived,
         }
     }
 
@@ -41,6 +53,7 @@ impl KernelKind {
             Self::Bias => "bias",
             Self::MassBias => "mass_bias",
             Self::Outputs => "outputs",
+            Self::Derived => "derived",
         }
     }
 }
@@ -54,19 +67,28 @@ pub struct ModelInfo {
     /// Structural hash of the model (the cache key).
     pub hash: String,
     pub coordinates: Vec<String>,
+    /// Names of the base parameters, in order.
     pub parameters: Vec<String>,
+    /// Number of derived parameters, stored after the base ones.
+    pub derived: usize,
 }
 
 impl ModelInfo {
     pub fn dof(&self) -> usize {
         self.coordinates.len()
     }
+
+    /// Length of the parameter vector the kernels read: base + derived.
+    pub fn extended_params(&self) -> usize {
+        self.parameters.len() + self.derived
+    }
 }
 
 /// A set of kernels for one model structure.
 pub trait Kernels {
     fn info(&self) -> &ModelInfo;
-    /// Evaluate `kind` into `out` (length `kind.output_len(dof)`).
+    /// Evaluate `kind` into `out` (length `kind.output_len(info)`); `inp.p`
+    /// is the extended parameter vector (base, then derived).
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]);
     /// Which backend this is, for reports.
     fn backend(&self) -> &'static str;
@@ -81,6 +103,7 @@ pub struct TapeSet {
     pub bias: Tape,
     pub mass_bias: Tape,
     pub outputs: Tape,
+    pub derived: Tape,
 }
 
 impl TapeSet {
@@ -90,6 +113,7 @@ impl TapeSet {
             KernelKind::Bias => &self.bias,
             KernelKind::MassBias => &self.mass_bias,
             KernelKind::Outputs => &self.outputs,
+            KernelKind::Derived => &self.derived,
         }
     }
 }

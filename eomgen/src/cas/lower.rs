@@ -5,6 +5,12 @@
 //! subtracted), products become `Mul` chains with negative powers moved into
 //! one `Div`, and `x^2` becomes `x * x`. Identical instructions are emitted
 //! once.
+//!
+//! With a [`Hoist`], every subexpression that depends on parameters alone
+//! (and the parameter-only part of each sum and product) is not computed in
+//! the kernel but read as a *derived parameter*: `Param(n_params + k)`. The
+//! derived parameters are computed once per parameter set by their own tape
+//! ([`Hoist::finish`]), not on every call.
 
 use std::collections::HashMap;
 
@@ -12,9 +18,83 @@ use runtime::tape::{Op, Slot, Tape};
 
 use super::expr::{Cas, ExprId, Func, Node, SymKind};
 
+/// Parameter-only subexpressions hoisted out of kernels, shared by all
+/// kernels of one model.
+pub struct Hoist {
+    n_params: u32,
+    exprs: Vec<ExprId>,
+    index: HashMap<ExprId, u32>,
+    param_only: HashMap<ExprId, bool>,
+}
+
+impl Hoist {
+    pub fn new(n_params: usize) -> Self {
+        Self {
+            n_params: n_params as u32,
+            exprs: Vec::new(),
+            index: HashMap::new(),
+            param_only: HashMap::new(),
+        }
+    }
+
+    /// Parameter index of a hoisted expression.
+    fn slot_param(&mut self, e: ExprId) -> u32 {
+        let k = *self.index.entry(e).or_insert_with(|| {
+            self.exprs.push(e);
+            (self.exprs.len() - 1) as u32
+        });
+        self.n_params + k
+    }
+
+    /// Whether `e` depends on parameters (and constants) only, and on at
+    /// least one parameter.
+    fn is_param_only(&mut self, cas: &Cas, e: ExprId) -> bool {
+        if let Some(&b) = self.param_only.get(&e) {
+            return b;
+        }
+        let b = match cas.node(e) {
+            Node::Const(_) => false,
+            Node::Sym(s) => matches!(cas.sym_kind(*s), SymKind::Param(_)),
+            _ => {
+                let kids = cas.children(e);
+                let mut any_param = false;
+                let mut ok = true;
+                for k in kids {
+                    if cas.as_const(k).is_some() {
+                        continue;
+                    }
+                    if self.is_param_only(cas, k) {
+                        any_param = true;
+                    } else {
+                        ok = false;
+                        break;
+                    }
+                }
+                ok && any_param
+            }
+        };
+        self.param_only.insert(e, b);
+        b
+    }
+
+    pub fn len(&self) -> usize {
+        self.exprs.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.exprs.is_empty()
+    }
+
+    /// The tape computing the derived parameters from the base ones.
+    pub fn finish(&self, cas: &mut Cas) -> Tape {
+        Lowerer::new(cas).finish(&self.exprs.clone())
+    }
+}
+
 /// Builds one tape from any number of output expressions.
 pub struct Lowerer<'a> {
-    cas: &'a Cas,
+    cas: &'a mut Cas,
+    hoist: Option<&'a mut Hoist>,
     ops: Vec<Op>,
     numbering: HashMap<(u8, u64, u64), Slot>,
     done: HashMap<ExprId, Slot>,
@@ -49,12 +129,31 @@ fn key(op: &Op) -> (u8, u64, u64) {
 }
 
 impl<'a> Lowerer<'a> {
-    pub fn new(cas: &'a Cas) -> Self {
+    pub fn new(cas: &'a mut Cas) -> Self {
         Self {
             cas,
+            hoist: None,
             ops: Vec::new(),
             numbering: HashMap::new(),
             done: HashMap::new(),
+        }
+    }
+
+    /// A lowerer that reads parameter-only subexpressions from `hoist`.
+    pub fn hoisting(cas: &'a mut Cas, hoist: &'a mut Hoist) -> Self {
+        Self {
+            cas,
+            hoist: Some(hoist),
+            ops: Vec::new(),
+            numbering: HashMap::new(),
+            done: HashMap::new(),
+        }
+    }
+
+    fn param_only(&mut self, e: ExprId) -> bool {
+        match self.hoist.as_deref_mut() {
+            Some(h) => h.is_param_only(self.cas, e),
+            None => false,
         }
     }
 
@@ -76,6 +175,16 @@ impl<'a> Lowerer<'a> {
     /// Lower `e`, returning the slot holding its value.
     pub fn lower(&mut self, e: ExprId) -> Slot {
         if let Some(&s) = self.done.get(&e) {
+            return s;
+        }
+        if !matches!(self.cas.node(e), Node::Sym(_)) && self.param_only(e) {
+            let k = self
+                .hoist
+                .as_deref_mut()
+                .expect("param_only implies hoisting")
+                .slot_param(e);
+            let s = self.push(Op::Param(k));
+            self.done.insert(e, s);
             return s;
         }
         let s = match self.cas.node(e).clone() {
@@ -124,9 +233,20 @@ impl<'a> Lowerer<'a> {
     fn lower_sum(&mut self, xs: &[ExprId]) -> Slot {
         // (negated?, slot of the magnitude)
         let mut parts: Vec<(bool, Slot)> = Vec::with_capacity(xs.len());
-        for &t in xs {
+        // The parameter-only terms are one hoisted sum.
+        let (fixed, dynamic): (Vec<ExprId>, Vec<ExprId>) = xs
+            .iter()
+            .partition(|&&t| self.cas.as_const(t).is_some() || self.param_only(t));
+        let xs: Vec<ExprId> = if fixed.len() >= 2 && fixed.iter().any(|&t| self.param_only(t)) {
+            let f = self.cas.add_all(&fixed);
+            std::iter::once(f).chain(dynamic).collect()
+        } else {
+            xs.to_vec()
+        };
+        for &t in &xs {
+            let hoisted = self.param_only(t);
             match self.cas.node(t) {
-                Node::Mul(fs) if self.cas.as_const(fs[0]).is_some_and(|c| c < 0.0) => {
+                Node::Mul(fs) if self.cas.as_const(fs[0]).is_some_and(|c| c < 0.0) && !hoisted => {
                     let c = -self.cas.as_const(fs[0]).unwrap_or(-1.0);
                     let fs = fs.clone();
                     let s = self.lower_product(c, &fs[1..]);
@@ -171,6 +291,20 @@ impl<'a> Lowerer<'a> {
 
     /// c * prod(factors), with negative constant powers moved to a divisor.
     fn lower_product(&mut self, c: f64, factors: &[ExprId]) -> Slot {
+        // The coefficient and the parameter-only factors are one hoisted
+        // product.
+        let (fixed, dynamic): (Vec<ExprId>, Vec<ExprId>) =
+            factors.iter().partition(|&&f| self.param_only(f));
+        if !fixed.is_empty() && !dynamic.is_empty() && (fixed.len() >= 2 || (c != 1.0 && c != -1.0))
+        {
+            let k = self.cas.constant(c);
+            let mut group = vec![k];
+            group.extend(&fixed);
+            let g = self.cas.mul_all(&group);
+            let mut fs = vec![g];
+            fs.extend(dynamic);
+            return self.lower_product(1.0, &fs);
+        }
         let mut num: Vec<Slot> = Vec::new();
         let mut den: Vec<Slot> = Vec::new();
         for &f in factors {
@@ -257,7 +391,12 @@ impl<'a> Lowerer<'a> {
 
 impl Cas {
     /// Linearise `outputs` into one tape.
-    pub fn to_tape(&self, outputs: &[ExprId]) -> Tape {
+    pub fn to_tape(&mut self, outputs: &[ExprId]) -> Tape {
         Lowerer::new(self).finish(outputs)
+    }
+
+    /// Linearise with parameter-only subexpressions read from `hoist`.
+    pub fn to_tape_hoisted(&mut self, outputs: &[ExprId], hoist: &mut Hoist) -> Tape {
+        Lowerer::hoisting(self, hoist).finish(outputs)
     }
 }

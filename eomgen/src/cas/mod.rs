@@ -15,4 +15,4 @@ mod lower;
 mod tests;
 
 pub use expr::{Cas, ExprId, Func, Node, SymId, SymKind};
-pub use lower::Lowerer;
+pub use lower::{Hoist, Lowerer};
