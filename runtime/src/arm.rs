@@ -52,19 +52,36 @@ pub struct Arm<K> {
 
 impl<K: Kernels> Arm<K> {
     /// `params` must follow `kernels.info().parameters`.
+    /// `params` must follow `kernels.info().parameters`; the derived
+    /// parameters are computed from them here, once.
     pub fn new(kernels: K, params: Vec<f64>) -> Self {
+        let info = kernels.info();
         assert_eq!(
             params.len(),
-            kernels.info().parameters.len(),
+            info.parameters.len(),
             "parameter vector does not match the model's layout"
         );
+        let n_base = params.len();
+        let mut extended = params;
+        extended.resize(info.extended_params(), 0.0);
+        let zeros = vec![0.0; info.dof()];
+        let mut derived = vec![0.0; info.derived];
+        let inp = Inputs {
+            t: 0.0,
+            q: &zeros,
+            qd: &zeros,
+            p: &extended,
+        };
+        kernels.eval(KernelKind::Derived, &inp, &mut derived);
+        extended[n_base..].copy_from_slice(&derived);
         Self {
             kernels,
-            params,
+            params: extended,
             packed: RefCell::new(Vec::new()),
         }
     }
 
+    /// Base parameters followed by the derived ones.
     pub fn params(&self) -> &[f64] {
         &self.params
     }
