@@ -164,7 +164,7 @@ impl Cas {
     }
 
     /// f'(x) in closed form.
-    fn func_derivative(&mut self, f: Func, x: ExprId) -> ExprId {
+    pub(crate) fn func_derivative(&mut self, f: Func, x: ExprId) -> ExprId {
         match f {
             Func::Sin => self.cos(x),
             Func::Cos => {

@@ -11,6 +11,7 @@ mod diff;
 mod eval;
 mod expr;
 mod lower;
+mod reverse;
 #[cfg(test)]
 mod tests;
 
