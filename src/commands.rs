@@ -10,7 +10,9 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use eomgen::model::Override;
 use nalgebra::{DMatrix, DVector};
-use runtime::{Dynamics, OUTPUT_NAMES, SimOptions, Solver, Trajectory, Workspace, accelerations};
+use runtime::{
+    Dynamics, KernelKind, OUTPUT_NAMES, SimOptions, Solver, Trajectory, Workspace, accelerations,
+};
 use serde_json::json;
 use softarm::backend::{self, Loaded};
 use softarm::generated::MODELS;
@@ -417,19 +419,18 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     let derive_s = start.elapsed().as_secs_f64();
     let q: Vec<f64> = (0..n).map(|i| 0.3 * ((i as f64) * 0.7).sin()).collect();
     let qd: Vec<f64> = (0..n).map(|i| 0.2 * ((i as f64) * 1.3).cos()).collect();
-    let mut m = DMatrix::zeros(n, n);
-    let mut h = DVector::zeros(n);
     let mut ws = Workspace::new(n);
     let mut qdd = vec![0.0; n];
-    let mass_ns = time_ns(a.batches, || {
-        arm.mass(0.0, std::hint::black_box(&q), &mut m)
-    });
-    let bias_ns = time_ns(a.batches, || {
-        arm.bias(0.0, std::hint::black_box(&q), &qd, &mut h)
-    });
-    let mass_bias_ns = time_ns(a.batches, || {
-        arm.mass_bias(0.0, std::hint::black_box(&q), &qd, &mut m, &mut h)
-    });
+    // Kernels as the integrators call them (packed outputs, no matrix copies).
+    let kernel_ns = |kind: KernelKind| {
+        let mut out = vec![0.0; kind.output_len(arm.info())];
+        time_ns(a.batches, || {
+            arm.eval_kernel(kind, 0.0, std::hint::black_box(&q), &qd, &mut out)
+        })
+    };
+    let mass_ns = kernel_ns(KernelKind::Mass);
+    let bias_ns = kernel_ns(KernelKind::Bias);
+    let mass_bias_ns = kernel_ns(KernelKind::MassBias);
     let rhs_ns = time_ns(a.batches, || {
         let _ = accelerations(arm, &mut ws, 0.0, std::hint::black_box(&q), &qd, &mut qdd);
     });

@@ -144,11 +144,11 @@ impl<'a> KernelEmitter<'a> {
             }
             Op::Sin(a) => {
                 let a = r(a);
-                quote!(#a.sin())
+                quote!(runtime::special::sin(#a))
             }
             Op::Cos(a) => {
                 let a = r(a);
-                quote!(#a.cos())
+                quote!(runtime::special::cos(#a))
             }
             Op::Tan(a) => {
                 let a = r(a);
@@ -189,17 +189,52 @@ impl<'a> KernelEmitter<'a> {
         let n_spill = self.n_spill;
         let mut chunks = Vec::new();
         let mut calls = Vec::new();
+        // sin and cos of the same argument in one chunk: one sincos call.
+        let mut sin_of = std::collections::HashMap::new();
+        let mut cos_of = std::collections::HashMap::new();
+        for (i, op) in self.tape.ops.iter().enumerate() {
+            match *op {
+                Op::Sin(a) => sin_of.insert(a, i),
+                Op::Cos(a) => cos_of.insert(a, i),
+                _ => None,
+            };
+        }
+        let partner = |i: usize| -> Option<(usize, usize, Slot)> {
+            let (s, c, a) = match self.tape.ops[i] {
+                Op::Sin(a) => (i, *cos_of.get(&a)?, a),
+                Op::Cos(a) => (*sin_of.get(&a)?, i, a),
+                _ => return None,
+            };
+            (self.chunk_of[s] == self.chunk_of[c]).then_some((s, c, a))
+        };
         for c in 0..n_chunks {
             let mut body = Vec::new();
             for (i, op) in self.tape.ops.iter().enumerate() {
                 if self.chunk_of[i] != Some(c) {
                     continue;
                 }
-                let v = format_ident!("v{}", i);
-                let e = self.expr(op, c);
-                body.push(quote!(let #v: f64 = #e;));
-                if let Some(w) = self.spill[i] {
-                    body.push(quote!(w[#w] = #v;));
+                let defined: Vec<usize> = match partner(i) {
+                    Some((s, co, a)) if i == s.min(co) => {
+                        let (vs, vc) = (format_ident!("v{}", s), format_ident!("v{}", co));
+                        let a = self.read(a, c);
+                        body.push(
+                            quote!(let (#vs, #vc): (f64, f64) = runtime::special::sin_cos(#a);),
+                        );
+                        vec![s, co]
+                    }
+                    Some(_) => vec![],
+                    None => {
+                        let v = format_ident!("v{}", i);
+                        let e = self.expr(op, c);
+                        body.push(quote!(let #v: f64 = #e;));
+                        vec![i]
+                    }
+                };
+                for d in defined {
+                    if let Some(w) = self.spill[d] {
+                        let v = format_ident!("v{}", d);
+                        body.push(quote!(w[#w] = #v;));
+                    }
                 }
             }
             // Outputs are written by the chunk that computes them; leaf

@@ -174,8 +174,12 @@ pub struct Workspace {
     n: usize,
     /// `MassBias` kernel output: packed upper triangle of M, then h.
     packed: Vec<f64>,
-    /// Cholesky factor L, row-major n x n (lower triangle used).
+    /// Unit lower factor L of M = L D L^T, row-major n x n.
     l: Vec<f64>,
+    /// W = L D row by row (W[i][k] = L[i][k] D[k]): plain dot products.
+    w: Vec<f64>,
+    /// 1 / D[j].
+    inv_d: Vec<f64>,
 }
 
 impl Workspace {
@@ -184,64 +188,79 @@ impl Workspace {
             n: dof,
             packed: vec![0.0; dof * (dof + 1) / 2 + dof],
             l: vec![0.0; dof * dof],
+            w: vec![0.0; dof * dof],
+            inv_d: vec![0.0; dof],
         }
     }
 }
 
-/// Index of (i, j), i <= j, in the packed upper triangle.
-#[inline]
-fn packed_index(n: usize, i: usize, j: usize) -> usize {
-    i * n - i * (i + 1) / 2 + j
-}
-
-/// Cholesky-Banachiewicz M = L L^T, reading M from the packed upper
-/// triangle and writing L row-major, so that every inner product runs over
-/// contiguous rows. nalgebra's `Cholesky` allocates on every call, which
-/// cost more than the whole EOM of an 8-link chain (measured: 400 ns of a
-/// 615 ns right-hand side); this is the same algorithm without allocation.
-/// Returns false unless M is positive definite.
-fn cholesky_packed(n: usize, packed: &[f64], l: &mut [f64]) -> bool {
+/// M = L D L^T (the square-root-free Cholesky factorisation), reading M from
+/// the packed upper triangle (row j of it is column j of M) and writing L
+/// and W = L D row-major, so every inner product runs over contiguous rows.
+/// nalgebra's `Cholesky` allocates and copies on every call, which cost more
+/// than the whole EOM of an 8-link chain (measured: 400 ns of a 615 ns
+/// right-hand side), and its square roots sit on the critical path; this
+/// does neither. Returns false unless M is positive definite (all D > 0).
+fn ldlt_packed(n: usize, packed: &[f64], l: &mut [f64], w: &mut [f64], inv_d: &mut [f64]) -> bool {
+    let mut row_start = 0; // start of row j of the packed upper triangle
+    let mut starts = Vec::new();
+    let starts_small = &mut [0usize; 64];
+    let starts: &mut [usize] = if n <= 64 {
+        &mut starts_small[..n]
+    } else {
+        starts.resize(n, 0);
+        &mut starts[..]
+    };
+    for (j, s) in starts.iter_mut().enumerate() {
+        *s = row_start;
+        row_start += n - j;
+    }
     for i in 0..n {
-        let (done, rest) = l.split_at_mut(i * n);
-        let row_i = &mut rest[..n];
-        for j in 0..=i {
-            let row_j: &[f64] = if j < i {
-                &done[j * n..j * n + j]
-            } else {
-                &row_i[..j]
-            };
-            let dot: f64 = row_i[..j].iter().zip(row_j).map(|(a, b)| a * b).sum();
-            let s = packed[packed_index(n, j, i)] - dot;
-            if j == i {
-                if !(s > 0.0) {
-                    return false;
-                }
-                row_i[i] = s.sqrt();
-            } else {
-                row_i[j] = s / done[j * n + j];
-            }
+        let (l_done, l_rest) = l.split_at_mut(i * n);
+        let (_, w_rest) = w.split_at_mut(i * n);
+        let (l_i, w_i) = (&mut l_rest[..i], &mut w_rest[..i]);
+        for j in 0..i {
+            let l_j = &l_done[j * n..j * n + j];
+            // v = M[i][j] - sum_k L[i][k] D[k] L[j][k]
+            let dot: f64 = w_i[..j].iter().zip(l_j).map(|(a, b)| a * b).sum();
+            let v = packed[starts[j] + (i - j)] - dot;
+            w_i[j] = v;
+            l_i[j] = v * inv_d[j];
         }
+        let dot: f64 = w_i.iter().zip(l_i.iter()).map(|(a, b)| a * b).sum();
+        let d = packed[starts[i]] - dot;
+        if !(d > 0.0) {
+            return false;
+        }
+        inv_d[i] = 1.0 / d;
     }
     true
 }
 
-/// Solve L L^T x = b in place (b becomes x), L row-major lower.
-fn cholesky_solve(n: usize, l: &[f64], b: &mut [f64]) {
+/// Solve L D L^T x = b in place (b becomes x).
+fn ldlt_solve(n: usize, l: &[f64], inv_d: &[f64], b: &mut [f64]) {
     for i in 0..n {
-        let row = &l[i * n..i * n + i];
-        let dot: f64 = row.iter().zip(&b[..i]).map(|(a, x)| a * x).sum();
-        b[i] = (b[i] - dot) / l[i * n + i];
+        let dot: f64 = l[i * n..i * n + i]
+            .iter()
+            .zip(&b[..i])
+            .map(|(a, x)| a * x)
+            .sum();
+        b[i] -= dot;
+    }
+    for (x, d) in b.iter_mut().zip(inv_d) {
+        *x *= d;
     }
     for i in (0..n).rev() {
         let mut s = b[i];
         for k in i + 1..n {
             s -= l[k * n + i] * b[k];
         }
-        b[i] = s / l[i * n + i];
+        b[i] = s;
     }
 }
 
-/// qdd = -M(q)^-1 h(q, qd, t), by Cholesky (M is symmetric positive definite).
+/// qdd = -M(q)^-1 h(q, qd, t), by the L D L^T Cholesky factorisation (M is
+/// symmetric positive definite).
 pub fn accelerations<D: Dynamics + ?Sized>(
     d: &D,
     ws: &mut Workspace,
@@ -252,20 +271,18 @@ pub fn accelerations<D: Dynamics + ?Sized>(
 ) -> Result<(), AccelError> {
     let n = ws.n;
     d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
+    // One pass: a NaN or infinity anywhere makes the sum non-finite.
+    if !ws.packed.iter().sum::<f64>().is_finite() {
+        let (mass, _) = ws.packed.split_at(n * (n + 1) / 2);
+        let what = if mass.iter().all(|v| v.is_finite()) {
+            "bias (generalised force)"
+        } else {
+            "mass matrix"
+        };
+        return Err(AccelError::NonFinite { t, what });
+    }
     let (mass, bias) = ws.packed.split_at(n * (n + 1) / 2);
-    if bias.iter().any(|v| !v.is_finite()) {
-        return Err(AccelError::NonFinite {
-            t,
-            what: "bias (generalised force)",
-        });
-    }
-    if mass.iter().any(|v| !v.is_finite()) {
-        return Err(AccelError::NonFinite {
-            t,
-            what: "mass matrix",
-        });
-    }
-    if !cholesky_packed(n, mass, &mut ws.l) {
+    if !ldlt_packed(n, mass, &mut ws.l, &mut ws.w, &mut ws.inv_d) {
         let mut m = DMatrix::zeros(n, n);
         d.mass(t, q, &mut m);
         let sv = m.singular_values();
@@ -275,7 +292,7 @@ pub fn accelerations<D: Dynamics + ?Sized>(
     for (a, b) in qdd.iter_mut().zip(bias) {
         *a = -b;
     }
-    cholesky_solve(n, &ws.l, qdd);
+    ldlt_solve(n, &ws.l, &ws.inv_d, qdd);
     Ok(())
 }
 
@@ -295,17 +312,17 @@ mod tests {
     }
 
     #[test]
-    fn packed_cholesky_solves_like_nalgebra() {
+    fn packed_ldlt_solves_like_nalgebra() {
         // A random SPD matrix: A^T A + n I.
         let n = 7;
         let a = DMatrix::from_fn(n, n, |i, j| ((i * 7 + j * 3) as f64 * 0.37).sin());
         let m = a.transpose() * &a + DMatrix::identity(n, n) * n as f64;
         let b = DVector::from_fn(n, |i, _| (i as f64).cos());
         let reference = m.clone().cholesky().unwrap().solve(&b);
-        let mut l = vec![0.0; n * n];
-        assert!(cholesky_packed(n, &pack(&m), &mut l));
+        let (mut l, mut w, mut inv) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n]);
+        assert!(ldlt_packed(n, &pack(&m), &mut l, &mut w, &mut inv));
         let mut x: Vec<f64> = b.iter().copied().collect();
-        cholesky_solve(n, &l, &mut x);
+        ldlt_solve(n, &l, &inv, &mut x);
         for i in 0..n {
             assert!((x[i] - reference[i]).abs() < 1e-13 * (1.0 + reference[i].abs()));
         }
@@ -314,7 +331,7 @@ mod tests {
     #[test]
     fn indefinite_matrix_is_rejected() {
         let m = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
-        let mut l = vec![0.0; 4];
-        assert!(!cholesky_packed(2, &pack(&m), &mut l));
+        let (mut l, mut w, mut inv) = (vec![0.0; 4], vec![0.0; 4], vec![0.0; 2]);
+        assert!(!ldlt_packed(2, &pack(&m), &mut l, &mut w, &mut inv));
     }
 }

@@ -51,6 +51,39 @@ pub fn cosc(k: u8, x: f64) -> f64 {
     }
 }
 
+/// (sin x, cos x) in one call. On glibc this is `sincos`, which shares the
+/// argument reduction; std's `f64::sin_cos` is two separate calls. Every
+/// backend takes its sines and cosines from here, so they agree bit for bit.
+#[inline]
+pub fn sin_cos(x: f64) -> (f64, f64) {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        unsafe extern "C" {
+            fn sincos(x: f64, s: *mut f64, c: *mut f64);
+        }
+        let (mut s, mut c) = (0.0, 0.0);
+        // SAFETY: sincos writes one f64 through each of two valid pointers.
+        unsafe { sincos(x, &mut s, &mut c) };
+        (s, c)
+    }
+    #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+    {
+        x.sin_cos()
+    }
+}
+
+/// sin x, the same value [`sin_cos`] gives.
+#[inline]
+pub fn sin(x: f64) -> f64 {
+    sin_cos(x).0
+}
+
+/// cos x, the same value [`sin_cos`] gives.
+#[inline]
+pub fn cos(x: f64) -> f64 {
+    sin_cos(x).1
+}
+
 /// sign(x): -1, 0 or 1 (the derivative of |x|; 0 at 0 rather than NaN).
 #[inline]
 pub fn sign(x: f64) -> f64 {

@@ -58,8 +58,8 @@ impl Func {
     pub fn apply(self, x: f64) -> f64 {
         use runtime::special;
         match self {
-            Func::Sin => x.sin(),
-            Func::Cos => x.cos(),
+            Func::Sin => special::sin(x),
+            Func::Cos => special::cos(x),
             Func::Tan => x.tan(),
             Func::Exp => x.exp(),
             Func::Ln => x.ln(),
