@@ -41,7 +41,7 @@ proptest! {
 fn overrides_reach_nested_values() {
     let o = Override::parse("tip.force=[0, -2, 0]").unwrap();
     let m = parse_model(GOOD, "m.toml", false, &[o]).unwrap();
-    assert_eq!(m.tip.force, [0.0, -2.0, 0.0]);
+    assert_eq!(m.tip.force, Some([0.0, -2.0, 0.0]));
     let o = Override::parse("segment.1.length=0.25").unwrap();
     let m = parse_model(GOOD, "m.toml", false, &[o]).unwrap();
     assert_eq!(m.segments[1].length, 0.25);

@@ -202,19 +202,8 @@ impl Workspace {
 /// right-hand side), and its square roots sit on the critical path; this
 /// does neither. Returns false unless M is positive definite (all D > 0).
 fn ldlt_packed(n: usize, packed: &[f64], l: &mut [f64], w: &mut [f64], inv_d: &mut [f64]) -> bool {
-    let mut row_start = 0; // start of row j of the packed upper triangle
-    let mut starts = Vec::new();
-    let starts_small = &mut [0usize; 64];
-    let starts: &mut [usize] = if n <= 64 {
-        &mut starts_small[..n]
-    } else {
-        starts.resize(n, 0);
-        &mut starts[..]
-    };
-    for (j, s) in starts.iter_mut().enumerate() {
-        *s = row_start;
-        row_start += n - j;
-    }
+    // Row j of the packed upper triangle starts at j n - j (j - 1) / 2.
+    let start = |j: usize| j * n - j * j.saturating_sub(1) / 2;
     for i in 0..n {
         let (l_done, l_rest) = l.split_at_mut(i * n);
         let (_, w_rest) = w.split_at_mut(i * n);
@@ -223,13 +212,13 @@ fn ldlt_packed(n: usize, packed: &[f64], l: &mut [f64], w: &mut [f64], inv_d: &m
             let l_j = &l_done[j * n..j * n + j];
             // v = M[i][j] - sum_k L[i][k] D[k] L[j][k]
             let dot: f64 = w_i[..j].iter().zip(l_j).map(|(a, b)| a * b).sum();
-            let v = packed[starts[j] + (i - j)] - dot;
+            let v = packed[start(j) + (i - j)] - dot;
             w_i[j] = v;
             l_i[j] = v * inv_d[j];
         }
         let dot: f64 = w_i.iter().zip(l_i.iter()).map(|(a, b)| a * b).sum();
-        let d = packed[starts[i]] - dot;
-        if !(d > 0.0) {
+        let d = packed[start(i)] - dot;
+        if d.is_nan() || d <= 0.0 {
             return false;
         }
         inv_d[i] = 1.0 / d;
@@ -271,18 +260,14 @@ pub fn accelerations<D: Dynamics + ?Sized>(
 ) -> Result<(), AccelError> {
     let n = ws.n;
     d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
-    // One pass: a NaN or infinity anywhere makes the sum non-finite.
-    if !ws.packed.iter().sum::<f64>().is_finite() {
-        let (mass, _) = ws.packed.split_at(n * (n + 1) / 2);
-        let what = if mass.iter().all(|v| v.is_finite()) {
-            "bias (generalised force)"
-        } else {
-            "mass matrix"
-        };
-        return Err(AccelError::NonFinite { t, what });
-    }
     let (mass, bias) = ws.packed.split_at(n * (n + 1) / 2);
     if !ldlt_packed(n, mass, &mut ws.l, &mut ws.w, &mut ws.inv_d) {
+        if mass.iter().any(|v| !v.is_finite()) {
+            return Err(AccelError::NonFinite {
+                t,
+                what: "mass matrix",
+            });
+        }
         let mut m = DMatrix::zeros(n, n);
         d.mass(t, q, &mut m);
         let sv = m.singular_values();
@@ -293,6 +278,15 @@ pub fn accelerations<D: Dynamics + ?Sized>(
         *a = -b;
     }
     ldlt_solve(n, &ws.l, &ws.inv_d, qdd);
+    // A NaN or infinity in M or h reaches qdd; only then look closer.
+    if qdd.iter().any(|v| !v.is_finite()) {
+        let what = if mass.iter().all(|v| v.is_finite()) {
+            "bias (generalised force)"
+        } else {
+            "mass matrix"
+        };
+        return Err(AccelError::NonFinite { t, what });
+    }
     Ok(())
 }
 

@@ -26,7 +26,7 @@ pub fn sinc(k: u8, x: f64) -> f64 {
             s / factorial(m + 1)
         })
     } else {
-        leibniz_over_x(k, x, |i, x| sin_deriv(i, x))
+        leibniz_over_x(k, x, sin_deriv)
     }
 }
 

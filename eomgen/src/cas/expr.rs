@@ -72,7 +72,7 @@ impl Func {
 
     /// f(-x) = parity * f(x), when f is even (1) or odd (-1).
     pub fn parity(self) -> Option<f64> {
-        let alt = |k: u8| if k % 2 == 0 { 1.0 } else { -1.0 };
+        let alt = |k: u8| if k.is_multiple_of(2) { 1.0 } else { -1.0 };
         match self {
             Func::Sin | Func::Tan | Func::Sign => Some(-1.0),
             Func::Cos | Func::Abs => Some(1.0),

@@ -79,13 +79,16 @@ fn one() -> usize {
     1
 }
 
+/// The tip payload. Which of its keys are present is structural: a model
+/// without `mass` has no tip body and one without `force` no tip force, so
+/// neither costs anything in the generated code.
 #[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Tip {
     /// Point mass at the tip (kg).
     #[serde(default)]
-    pub mass: f64,
+    pub mass: Option<f64>,
     /// Constant force at the tip, world frame (N).
     #[serde(default)]
-    pub force: [f64; 3],
+    pub force: Option<[f64; 3]>,
 }

@@ -11,18 +11,24 @@ use super::schema::{Method, Model};
 
 /// Bumped whenever derivation or emission changes what is generated, so
 /// that cached tapes and generated files are re-derived.
-pub const GENERATOR_VERSION: u32 = 5;
+pub const GENERATOR_VERSION: u32 = 6;
 
 /// Everything that shapes the equations; numbers are left out.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Structure {
     pub segments: Vec<(Method, usize)>,
+    /// A tip body exists (`tip.mass` given).
+    pub tip_mass: bool,
+    /// A tip force exists (`tip.force` given).
+    pub tip_force: bool,
 }
 
 impl Structure {
     pub fn of(m: &Model) -> Self {
         Self {
             segments: m.segments.iter().map(|s| (s.method, s.elements)).collect(),
+            tip_mass: m.tip.mass.is_some(),
+            tip_force: m.tip.force.is_some(),
         }
     }
 
@@ -32,6 +38,10 @@ impl Structure {
         for (m, n) in &self.segments {
             s.push_str(&format!("segment {} {}\n", m.name(), n));
         }
+        s.push_str(&format!(
+            "tip mass {} force {}\n",
+            self.tip_mass, self.tip_force
+        ));
         s
     }
 
@@ -97,11 +107,15 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
         ("base.z".to_string(), m.base.position[2]),
         // Planar: the angle of the base direction from +x.
         ("base.angle".to_string(), d[1].atan2(d[0])),
-        ("tip.mass".to_string(), m.tip.mass),
-        ("tip.force.x".to_string(), m.tip.force[0]),
-        ("tip.force.y".to_string(), m.tip.force[1]),
-        ("tip.force.z".to_string(), m.tip.force[2]),
     ];
+    if let Some(mass) = m.tip.mass {
+        p.push(("tip.mass".to_string(), mass));
+    }
+    if let Some(f) = m.tip.force {
+        p.push(("tip.force.x".to_string(), f[0]));
+        p.push(("tip.force.y".to_string(), f[1]));
+        p.push(("tip.force.z".to_string(), f[2]));
+    }
     for (k, e) in element_props(m).iter().enumerate() {
         p.push((format!("element[{k}].length"), e.length));
         p.push((format!("element[{k}].mass"), e.mass));

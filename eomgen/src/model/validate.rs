@@ -141,7 +141,11 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
         non_negative(&p("joint_stiffness"), s.joint_stiffness)?;
         non_negative(&p("joint_damping"), s.joint_damping)?;
     }
-    non_negative("tip.mass", m.tip.mass)?;
-    vec3("tip.force", &m.tip.force)?;
+    if let Some(mass) = m.tip.mass {
+        non_negative("tip.mass", mass)?;
+    }
+    if let Some(force) = &m.tip.force {
+        vec3("tip.force", force)?;
+    }
     Ok(())
 }

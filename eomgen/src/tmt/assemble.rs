@@ -89,9 +89,9 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     // M: the Jacobian of the generalised momentum T^T Mbar T qd.
     let momentum = cas.vjp(&outs[..6 * nb], &momentum_cot, &sys.coords.qd);
     let mut mass = Vec::with_capacity(n * (n + 1) / 2);
-    for i in 0..n {
-        for j in i..n {
-            mass.push(cas.diff(momentum[i], sys.coords.qd[j]));
+    for (i, &p) in momentum.iter().enumerate() {
+        for &qd in &sys.coords.qd[i..] {
+            mass.push(cas.diff(p, qd));
         }
     }
 

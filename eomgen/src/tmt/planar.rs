@@ -88,18 +88,24 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
     }
 
     let tip = [x, y, z];
-    let tip_mass = param("tip.mass");
-    bodies.push(Body {
-        mass: tip_mass,
-        inertia: [zero; 3],
-        position: tip,
-        omega: [zero; 3],
-    });
-    let force = [
-        param("tip.force.x"),
-        param("tip.force.y"),
-        param("tip.force.z"),
-    ];
+    if structure.tip_mass {
+        let mass = param("tip.mass");
+        bodies.push(Body {
+            mass,
+            inertia: [zero; 3],
+            position: tip,
+            omega: [zero; 3],
+        });
+    }
+    let mut point_forces = Vec::new();
+    if structure.tip_force {
+        let force = [
+            param("tip.force.x"),
+            param("tip.force.y"),
+            param("tip.force.z"),
+        ];
+        point_forces.push(PointForce { point: tip, force });
+    }
     let gravity = [param("gravity.x"), param("gravity.y"), param("gravity.z")];
     let elastic = cas.add_all(&elastic);
     let rayleigh = cas.add_all(&rayleigh);
@@ -109,7 +115,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
         gravity,
         elastic,
         rayleigh,
-        point_forces: vec![PointForce { point: tip, force }],
+        point_forces,
         tip,
     }
 }

@@ -1,0 +1,91 @@
+//! Criterion benchmarks behind BENCHMARKS.md: derivation time, compiled
+//! kernel evaluation and the integrator's right-hand side.
+//!
+//! Run: `cargo bench --bench kernels` (add a filter, e.g. `-- mass_bias`).
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use eomgen::model::{Model, Override};
+use runtime::{Dynamics, KernelKind, Workspace, accelerations};
+use softarm::backend::{BackendChoice, load};
+
+fn chain_with(elements: usize) -> Model {
+    let length = 0.1 * elements as f64;
+    let mass = 0.05 * elements as f64;
+    let sets = [
+        format!("segment.0.elements={elements}"),
+        format!("segment.0.length={length}"),
+        format!("segment.0.mass={mass}"),
+    ];
+    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    softarm::backend::read_model("chain", &overrides).unwrap().0
+}
+
+fn derivation(c: &mut Criterion) {
+    let mut g = c.benchmark_group("derive");
+    g.sample_size(10);
+    for n in [10, 32] {
+        let model = chain_with(n);
+        g.bench_function(format!("chain{n}"), |b| {
+            b.iter(|| eomgen::derive::derive(black_box(&model)))
+        });
+    }
+    g.finish();
+}
+
+fn state(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let q = (0..n).map(|i| 0.3 * ((i as f64) * 0.7).sin()).collect();
+    let qd = (0..n).map(|i| 0.2 * ((i as f64) * 1.3).cos()).collect();
+    (q, qd)
+}
+
+fn kernels(c: &mut Criterion) {
+    let mut g = c.benchmark_group("compiled");
+    for name in ["chain", "chain32"] {
+        let l = load(name, &[], BackendChoice::Compiled, None).unwrap();
+        let arm = &*l.arm;
+        let n = arm.dof();
+        let (q, qd) = state(n);
+        let mut out = vec![0.0; KernelKind::MassBias.output_len(arm.info())];
+        g.bench_function(format!("{name}/mass_bias"), |b| {
+            b.iter(|| {
+                arm.eval_kernel(
+                    KernelKind::MassBias,
+                    0.0,
+                    black_box(&q),
+                    black_box(&qd),
+                    &mut out,
+                )
+            })
+        });
+        let mut ws = Workspace::new(n);
+        let mut qdd = vec![0.0; n];
+        g.bench_function(format!("{name}/rhs"), |b| {
+            b.iter(|| accelerations(arm, &mut ws, 0.0, black_box(&q), black_box(&qd), &mut qdd))
+        });
+    }
+    g.finish();
+}
+
+fn interpreted(c: &mut Criterion) {
+    let dir = std::env::temp_dir().join("softarm-bench-cache");
+    let l = load("chain", &[], BackendChoice::Interpreted, Some(dir)).unwrap();
+    let arm = &*l.arm;
+    let (q, qd) = state(arm.dof());
+    let mut out = vec![0.0; KernelKind::MassBias.output_len(arm.info())];
+    c.bench_function("interpreted/chain/mass_bias", |b| {
+        b.iter(|| {
+            arm.eval_kernel(
+                KernelKind::MassBias,
+                0.0,
+                black_box(&q),
+                black_box(&qd),
+                &mut out,
+            )
+        })
+    });
+}
+
+criterion_group!(benches, derivation, kernels, interpreted);
+criterion_main!(benches);
