@@ -7,7 +7,7 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use eomgen::model::{Model, Override};
-use runtime::{Dynamics, KernelKind, Workspace, accelerations};
+use runtime::{KernelKind, Workspace, accelerations};
 use softarm::backend::{BackendChoice, load};
 
 fn chain_with(elements: usize) -> Model {
