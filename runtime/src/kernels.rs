@@ -5,6 +5,7 @@ use std::cell::RefCell;
 
 use serde::{Deserialize, Serialize};
 
+use crate::linalg::Ldlt;
 use crate::tape::{Inputs, Tape};
 
 /// The functions derived for every model. Output layouts are fixed here and
@@ -92,6 +93,16 @@ pub trait Kernels {
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]);
     /// Which backend this is, for reports.
     fn backend(&self) -> &'static str;
+    /// Solve M x = b in place, M packed as the `Mass` kernel lays it out;
+    /// false unless M is positive definite. Generated code overrides this
+    /// with a solver specialised to its size.
+    fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
+        if !ws.factor(packed) {
+            return false;
+        }
+        ws.solve(b);
+        true
+    }
 }
 
 /// Derived tapes of one model: the interpreted backend, and what eomgen

@@ -7,6 +7,7 @@
 pub mod arm;
 pub mod integrate;
 pub mod kernels;
+pub mod linalg;
 pub mod special;
 pub mod tape;
 
@@ -15,4 +16,5 @@ pub use integrate::{SimFailure, SimOptions, SimStats, Solver, Trajectory, simula
 pub use kernels::{
     CompiledModel, Interpreted, KernelKind, Kernels, ModelInfo, OUTPUT_NAMES, TapeSet,
 };
+pub use linalg::Ldlt;
 pub use tape::{Inputs, Op, Slot, Tape};
