@@ -63,6 +63,7 @@ impl Ldlt {
     }
 
     /// Solve L D L^T x = b in place, after a successful [`Ldlt::factor`].
+    #[allow(clippy::needless_range_loop)] // triangular index ranges read clearer
     pub fn solve(&self, b: &mut [f64]) {
         let n = self.n;
         for i in 0..n {
@@ -89,6 +90,7 @@ impl Ldlt {
 /// Factor and solve in one go for a size known at compile time (stack
 /// arrays, loops LLVM unrolls). Use for small N: it needs N^2 f64 of stack.
 #[inline]
+#[allow(clippy::needless_range_loop)] // triangular index ranges read clearer
 pub fn solve_fixed<const N: usize>(packed: &[f64], b: &mut [f64]) -> bool {
     let packed = &packed[..N * (N + 1) / 2];
     let b: &mut [f64; N] = b.try_into().expect("right-hand side of length N");
