@@ -4,7 +4,7 @@ use runtime::{ModelInfo, TapeSet};
 
 use crate::cas::{Cas, Hoist};
 use crate::model::{Model, Structure, parameters};
-use crate::tmt::{assemble, planar_system};
+use crate::tmt::{SYMBOLIC_SOLVE_MAX_DOF, assemble, planar_system, solve_accelerations};
 
 /// Derive the kernels of a model's structure.
 pub fn derive(model: &Model) -> TapeSet {
@@ -19,6 +19,15 @@ pub fn derive(model: &Model) -> TapeSet {
     let bias = cas.to_tape_hoisted(&eq.bias, &mut hoist);
     let mass_bias = cas.to_tape_hoisted(&mass_bias, &mut hoist);
     let outputs = cas.to_tape_hoisted(&eq.outputs, &mut hoist);
+    let n = eq.bias.len();
+    let accel = n <= SYMBOLIC_SOLVE_MAX_DOF;
+    let accel_tape = if accel {
+        let (qdd, pivots) = solve_accelerations(&mut cas, &eq.mass_upper, &eq.bias);
+        let outs: Vec<_> = qdd.into_iter().chain(pivots).collect();
+        cas.to_tape_hoisted(&outs, &mut hoist)
+    } else {
+        runtime::Tape::default()
+    };
     let derived = hoist.finish(&mut cas);
     TapeSet {
         info: ModelInfo {
@@ -26,11 +35,13 @@ pub fn derive(model: &Model) -> TapeSet {
             coordinates: sys.coords.names.clone(),
             parameters: params,
             derived: hoist.len(),
+            accel,
         },
         mass,
         bias,
         mass_bias,
         outputs,
         derived,
+        accel: accel_tape,
     }
 }

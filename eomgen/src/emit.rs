@@ -12,10 +12,6 @@ use runtime::{KernelKind, Op, Slot, Tape, TapeSet};
 /// Operations per emitted function.
 pub const CHUNK_OPS: usize = 2000;
 
-/// Largest DOF that gets a size-specialised mass solver (2 N^2 f64 on the
-/// stack, fully unrolled code).
-pub const FIXED_SOLVE_MAX_DOF: usize = 24;
-
 fn lit(c: f64) -> TokenStream {
     let l = Literal::f64_suffixed(c.abs());
     if c.is_sign_negative() {
@@ -319,6 +315,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     let dof = info.dof();
     let n_params = info.extended_params();
     let n_derived = info.derived;
+    let accel = info.accel;
     let hash = &info.hash;
     let coords = &info.coordinates;
     let params = &info.parameters;
@@ -333,18 +330,6 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
             KernelKind::#variant => #f(inp.t, q, qd, p, out.try_into().expect("output length")),
         });
     }
-    // Small arms get a mass-matrix solver specialised to their size (fully
-    // unrolled by LLVM); large ones keep the runtime's, which is not on the
-    // stack.
-    let solver = if dof <= FIXED_SOLVE_MAX_DOF {
-        quote! {
-            fn solve_mass(&self, packed: &[f64], b: &mut [f64], _ws: &mut runtime::Ldlt) -> bool {
-                runtime::linalg::solve_fixed::<#dof>(packed, b)
-            }
-        }
-    } else {
-        quote!()
-    };
     let tokens = quote! {
         use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
 
@@ -355,6 +340,8 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         pub const PARAMETERS: &[&str] = &[#(#params),*];
         /// Derived parameters, computed once per parameter set.
         pub const DERIVED: usize = #n_derived;
+        /// Whether the mass solve is generated (the `accel` kernel).
+        pub const ACCEL: bool = #accel;
 
         /// The compiled kernels of this structure.
         pub struct Compiled {
@@ -369,6 +356,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                         coordinates: COORDINATES.iter().map(|s| s.to_string()).collect(),
                         parameters: PARAMETERS.iter().map(|s| s.to_string()).collect(),
                         derived: DERIVED,
+                        accel: ACCEL,
                     },
                 }
             }
@@ -381,7 +369,6 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
             fn backend(&self) -> &'static str {
                 "compiled"
             }
-            #solver
             fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
                 let q: &[f64; #dof] = inp.q.try_into().expect("q has DOF entries");
                 let qd: &[f64; #dof] = inp.qd.try_into().expect("qd has DOF entries");

@@ -184,6 +184,8 @@ pub struct Workspace {
     n: usize,
     /// `MassBias` kernel output: packed upper triangle of M, then h.
     packed: Vec<f64>,
+    /// `Accel` kernel output: qdd, then the pivots of M = L D L^T.
+    accel: Vec<f64>,
     ldlt: Ldlt,
 }
 
@@ -192,13 +194,15 @@ impl Workspace {
         Self {
             n: dof,
             packed: vec![0.0; dof * (dof + 1) / 2 + dof],
+            accel: vec![0.0; 2 * dof],
             ldlt: Ldlt::new(dof),
         }
     }
 }
 
 /// qdd = -M(q)^-1 h(q, qd, t), by the L D L^T Cholesky factorisation (M is
-/// symmetric positive definite).
+/// symmetric positive definite). Small arms run the generated solve (the
+/// `Accel` kernel); larger ones factor the `MassBias` output here.
 pub fn accelerations<D: Dynamics + ?Sized>(
     d: &D,
     ws: &mut Workspace,
@@ -208,33 +212,44 @@ pub fn accelerations<D: Dynamics + ?Sized>(
     qdd: &mut [f64],
 ) -> Result<(), AccelError> {
     let n = ws.n;
-    d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
-    let (mass, bias) = ws.packed.split_at(n * (n + 1) / 2);
-    for (a, b) in qdd.iter_mut().zip(bias) {
-        *a = -b;
-    }
-    if !d.solve_mass(mass, qdd, &mut ws.ldlt) {
-        if mass.iter().any(|v| !v.is_finite()) {
-            return Err(AccelError::NonFinite {
-                t,
-                what: "mass matrix",
-            });
+    let solved = if d.info().accel {
+        d.eval_kernel(KernelKind::Accel, t, q, qd, &mut ws.accel);
+        qdd.copy_from_slice(&ws.accel[..n]);
+        // Positive pivots: M positive definite (false for NaN too).
+        ws.accel[n..].iter().all(|&p| p > 0.0)
+    } else {
+        d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
+        let (mass, bias) = ws.packed.split_at(n * (n + 1) / 2);
+        for (a, b) in qdd.iter_mut().zip(bias) {
+            *a = -b;
         }
-        let mut m = DMatrix::zeros(n, n);
-        d.mass(t, q, &mut m);
-        let sv = m.singular_values();
-        let condition = sv.max() / sv.min().max(f64::MIN_POSITIVE);
-        return Err(AccelError::SingularMass { t, condition });
-    }
-
-    // A NaN or infinity in M or h reaches qdd; only then look closer.
-    if qdd.iter().any(|v| !v.is_finite()) {
-        let what = if mass.iter().all(|v| v.is_finite()) {
-            "bias (generalised force)"
-        } else {
-            "mass matrix"
-        };
-        return Err(AccelError::NonFinite { t, what });
+        d.solve_mass(mass, qdd, &mut ws.ldlt)
+    };
+    if !solved || qdd.iter().any(|v| !v.is_finite()) {
+        return Err(diagnose(d, t, q, qd));
     }
     Ok(())
+}
+
+/// Why the accelerations failed: off the hot path, so it may allocate.
+fn diagnose<D: Dynamics + ?Sized>(d: &D, t: f64, q: &[f64], qd: &[f64]) -> AccelError {
+    let n = q.len();
+    let mut m = DMatrix::zeros(n, n);
+    let mut h = DVector::zeros(n);
+    d.mass_bias(t, q, qd, &mut m, &mut h);
+    if m.iter().any(|v| !v.is_finite()) {
+        return AccelError::NonFinite {
+            t,
+            what: "mass matrix",
+        };
+    }
+    if h.iter().any(|v| !v.is_finite()) {
+        return AccelError::NonFinite {
+            t,
+            what: "bias (generalised force)",
+        };
+    }
+    let sv = m.singular_values();
+    let condition = sv.max() / sv.min().max(f64::MIN_POSITIVE);
+    AccelError::SingularMass { t, condition }
 }

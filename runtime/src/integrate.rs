@@ -114,6 +114,8 @@ struct ArmOde<'a, D: ?Sized> {
     qdd: RefCell<Vec<f64>>,
     evals: Cell<usize>,
     first_error: RefCell<Option<AccelError>>,
+    /// Set when a right-hand side failed since the last accepted step.
+    failed_in_step: Cell<bool>,
 }
 
 impl<D: Dynamics + ?Sized> ODE<f64, Vec<f64>> for ArmOde<'_, D> {
@@ -129,17 +131,22 @@ impl<D: Dynamics + ?Sized> ODE<f64, Vec<f64>> for ArmOde<'_, D> {
                 // NaN makes an adaptive method reject the step; the record
                 // explains the failure if the method then gives up.
                 self.first_error.borrow_mut().get_or_insert(e);
+                self.failed_in_step.set(true);
                 dx[n..].fill(f64::NAN);
             }
         }
     }
 }
 
-/// Samples evenly and stops on a non-finite accepted state (a fixed-step
-/// method has no error estimate to reject it).
+/// Samples evenly and stops on a non-finite accepted state. A fixed-step
+/// method has no error estimate to reject a step whose right-hand side
+/// failed, so for those a failure anywhere in the step stops it too (its
+/// dense output would be NaN); adaptive methods reject such steps.
 struct Recorder<'a> {
     even: EvenSolout<f64>,
     blown_up: &'a Cell<Option<f64>>,
+    failed_in_step: &'a Cell<bool>,
+    fixed_step: bool,
 }
 
 impl Solout<f64, Vec<f64>> for Recorder<'_> {
@@ -155,7 +162,8 @@ impl Solout<f64, Vec<f64>> for Recorder<'_> {
     where
         I: Interpolation<f64, Vec<f64>> + ?Sized,
     {
-        if y_curr.iter().any(|v| !v.is_finite()) {
+        let rhs_failed = self.failed_in_step.replace(false) && self.fixed_step;
+        if rhs_failed || y_curr.iter().any(|v| !v.is_finite()) {
             self.blown_up.set(Some(t_prev));
             return ControlFlag::Terminate;
         }
@@ -179,11 +187,14 @@ pub fn simulate<D: Dynamics + ?Sized>(
         qdd: RefCell::new(vec![0.0; n]),
         evals: Cell::new(0),
         first_error: RefCell::new(None),
+        failed_in_step: Cell::new(false),
     };
     let blown_up = Cell::new(None);
     let recorder = Recorder {
         even: EvenSolout::new(opts.output_dt, 0.0, opts.t_end),
         blown_up: &blown_up,
+        failed_in_step: &ode.failed_in_step,
+        fixed_step: matches!(opts.solver, Solver::Rk4),
     };
     let start = Instant::now();
     let problem = IVP::ode(&ode, 0.0, opts.t_end, x0.clone());

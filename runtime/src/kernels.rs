@@ -15,6 +15,10 @@ use crate::tape::{Inputs, Tape};
 /// * `Bias`: h(q, qd, t), n values.
 /// * `MassBias`: `Mass` followed by `Bias` (one pass, shared subexpressions).
 /// * `Outputs`: see [`OUTPUT_NAMES`].
+/// * `Accel`: qdd = -M^-1 h (n values) then the pivots D of M = L D L^T
+///   (n values, all positive when M is positive definite): the mass solve
+///   generated as straight-line code. Present only when `ModelInfo::accel`
+///   (small arms); otherwise the runtime solves `MassBias` output.
 /// * `Derived`: the derived parameters (parameter-only subexpressions the
 ///   generator hoisted out of the other kernels), computed once per
 ///   parameter set; the other kernels read them after the base parameters.
@@ -24,11 +28,13 @@ pub enum KernelKind {
     Bias,
     MassBias,
     Outputs,
+    Accel,
     Derived,
 }
 
 impl KernelKind {
-    pub const ALL: [KernelKind; 5] = [
+    pub const ALL: [KernelKind; 6] = [
+        Self::Accel,
         Self::Mass,
         Self::Bias,
         Self::MassBias,
@@ -45,6 +51,13 @@ impl KernelKind {
             Self::MassBias => tri + dof,
             Self::Outputs => OUTPUT_NAMES.len(),
             Self::Derived => info.derived,
+            Self::Accel => {
+                if info.accel {
+                    2 * dof
+                } else {
+                    0
+                }
+            }
         }
     }
 
@@ -55,6 +68,7 @@ impl KernelKind {
             Self::MassBias => "mass_bias",
             Self::Outputs => "outputs",
             Self::Derived => "derived",
+            Self::Accel => "accel",
         }
     }
 }
@@ -72,6 +86,8 @@ pub struct ModelInfo {
     pub parameters: Vec<String>,
     /// Number of derived parameters, stored after the base ones.
     pub derived: usize,
+    /// Whether the `Accel` kernel exists.
+    pub accel: bool,
 }
 
 impl ModelInfo {
@@ -115,6 +131,8 @@ pub struct TapeSet {
     pub mass_bias: Tape,
     pub outputs: Tape,
     pub derived: Tape,
+    /// Empty unless `info.accel`.
+    pub accel: Tape,
 }
 
 impl TapeSet {
@@ -125,6 +143,7 @@ impl TapeSet {
             KernelKind::MassBias => &self.mass_bias,
             KernelKind::Outputs => &self.outputs,
             KernelKind::Derived => &self.derived,
+            KernelKind::Accel => &self.accel,
         }
     }
 }

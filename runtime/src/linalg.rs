@@ -6,9 +6,8 @@
 //! product runs over contiguous memory. nalgebra's `Cholesky` allocates and
 //! copies on every call, which cost more than the whole EOM of an 8-link
 //! chain (measured: 400 ns of a 615 ns right-hand side), and its square
-//! roots sit on the critical path; this does neither. [`solve_fixed`] is the
-//! same algorithm for a size known at compile time, which generated code
-//! uses for small arms so that LLVM unrolls it completely.
+//! roots sit on the critical path; this does neither. Small arms do not come
+//! here: their solve is generated with the EOM (`KernelKind::Accel`).
 
 /// Start of row j of a packed upper triangle of size n: j n - j (j - 1) / 2.
 #[inline(always)]
@@ -87,57 +86,6 @@ impl Ldlt {
     }
 }
 
-/// Factor and solve in one go for a size known at compile time (stack
-/// arrays, loops LLVM unrolls). Use for small N: it needs N^2 f64 of stack.
-#[inline]
-#[allow(clippy::needless_range_loop)] // triangular index ranges read clearer
-pub fn solve_fixed<const N: usize>(packed: &[f64], b: &mut [f64]) -> bool {
-    let packed = &packed[..N * (N + 1) / 2];
-    let b: &mut [f64; N] = b.try_into().expect("right-hand side of length N");
-    let mut l = [[0.0f64; N]; N];
-    let mut inv_d = [0.0f64; N];
-    // Row i of W = L D is only read while row i of L is formed.
-    let mut w = [0.0f64; N];
-    for i in 0..N {
-        for j in 0..i {
-            let mut dot = 0.0;
-            for k in 0..j {
-                dot += w[k] * l[j][k];
-            }
-            let v = packed[row_start(N, j) + (i - j)] - dot;
-            w[j] = v;
-            l[i][j] = v * inv_d[j];
-        }
-        let mut dot = 0.0;
-        for k in 0..i {
-            dot += w[k] * l[i][k];
-        }
-        let d = packed[row_start(N, i)] - dot;
-        if d.is_nan() || d <= 0.0 {
-            return false;
-        }
-        inv_d[i] = 1.0 / d;
-    }
-    for i in 0..N {
-        let mut dot = 0.0;
-        for k in 0..i {
-            dot += l[i][k] * b[k];
-        }
-        b[i] -= dot;
-    }
-    for i in 0..N {
-        b[i] *= inv_d[i];
-    }
-    for i in (0..N).rev() {
-        let mut s = b[i];
-        for k in i + 1..N {
-            s -= l[k][i] * b[k];
-        }
-        b[i] = s;
-    }
-    true
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -159,7 +107,7 @@ mod tests {
     }
 
     #[test]
-    fn dynamic_and_fixed_solves_match_nalgebra() {
+    fn solve_matches_nalgebra() {
         for n in [1, 2, 7] {
             let (m, b) = problem(n);
             let reference = m.clone().cholesky().unwrap().solve(&b);
@@ -167,16 +115,8 @@ mod tests {
             assert!(ldlt.factor(&pack(&m)));
             let mut x: Vec<f64> = b.iter().copied().collect();
             ldlt.solve(&mut x);
-            let mut y: Vec<f64> = b.iter().copied().collect();
-            let ok = match n {
-                1 => solve_fixed::<1>(&pack(&m), &mut y),
-                2 => solve_fixed::<2>(&pack(&m), &mut y),
-                _ => solve_fixed::<7>(&pack(&m), &mut y),
-            };
-            assert!(ok);
             for i in 0..n {
                 assert!((x[i] - reference[i]).abs() < 1e-13 * (1.0 + reference[i].abs()));
-                assert!((y[i] - reference[i]).abs() < 1e-13 * (1.0 + reference[i].abs()));
             }
         }
     }
@@ -185,7 +125,6 @@ mod tests {
     fn indefinite_and_nan_matrices_are_rejected() {
         let bad = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
         assert!(!Ldlt::new(2).factor(&pack(&bad)));
-        assert!(!solve_fixed::<2>(&pack(&bad), &mut [1.0, 1.0]));
         let nan = DMatrix::from_row_slice(2, 2, &[f64::NAN, 0.0, 0.0, 1.0]);
         assert!(!Ldlt::new(2).factor(&pack(&nan)));
     }

@@ -3,8 +3,10 @@
 
 mod assemble;
 mod planar;
+mod solve;
 mod system;
 
 pub use assemble::{Equations, assemble};
 pub use planar::planar_system;
+pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
 pub use system::{Body, Coordinates, PointForce, System};

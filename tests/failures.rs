@@ -1,0 +1,93 @@
+//! When an integrator gives up, softarm says when, why and what to try,
+//! keeps the trajectory so far and exits non-zero.
+
+mod common;
+
+use common::*;
+
+#[test]
+fn unstable_fixed_step_is_explained_and_the_trajectory_kept() {
+    // The chain's fastest mode is about 55 rad/s; rk4 is stable below
+    // dt ~ 2.8 / 55 = 0.05 s, so dt = 0.5 s must blow up.
+    let dir = tempfile::tempdir().unwrap();
+    let out = softarm(
+        &[
+            "simulate",
+            "chain",
+            "--solver",
+            "rk4",
+            "--dt",
+            "0.5",
+            "--t-end",
+            "50",
+            "--q0",
+            "1,0,0,0,0,0,0,0",
+            "--out",
+            "o",
+        ],
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("integration stopped at t ="), "{err}");
+    assert!(err.contains("reduce --dt"), "{err}");
+    assert!(!err.contains("panicked"));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("o/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["status"], "failed");
+    let t_reached = summary["failure"]["t_reached"].as_f64().unwrap();
+    assert!(t_reached > 0.0 && t_reached < 50.0);
+    let csv = std::fs::read_to_string(dir.path().join("o/trajectory.csv")).unwrap();
+    assert!(
+        csv.lines().count() > 2,
+        "the trajectory up to the failure is kept"
+    );
+    for line in csv.lines().skip(1) {
+        assert!(
+            !line.contains("NaN") && !line.contains("inf"),
+            "only finite rows are written: {line}"
+        );
+    }
+}
+
+#[test]
+fn summary_reports_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = softarm(
+        &[
+            "simulate",
+            "double_pendulum",
+            "--t-end",
+            "1",
+            "--q0",
+            "0.5,0",
+            "--out",
+            "o",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("o/summary.json")).unwrap())
+            .unwrap();
+    for key in [
+        "backend",
+        "solver",
+        "steps",
+        "rhs_evaluations",
+        "wall_s",
+        "final_state",
+    ] {
+        assert!(!s[key].is_null(), "summary.json lacks {key}");
+    }
+    assert_eq!(s["backend"], "compiled");
+    assert_eq!(s["solver"], "dopri5");
+    assert!(s["rhs_evaluations"].as_u64().unwrap() >= 6 * s["steps"].as_u64().unwrap());
+    let csv = std::fs::read_to_string(dir.path().join("o/trajectory.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert_eq!(
+        header,
+        "t,theta_0_0,theta_1_0,theta_0_0_dot,theta_1_0_dot,tip_x,tip_y,tip_z,kinetic,potential"
+    );
+}
