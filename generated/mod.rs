@@ -3,6 +3,8 @@
 use runtime::CompiledModel;
 
 #[allow(clippy::all, clippy::pedantic)]
+pub mod cantilever;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod chain;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod chain32;
@@ -13,6 +15,13 @@ pub mod soft_finger;
 
 /// Every compiled-in model, by name.
 pub static MODELS: &[CompiledModel] = &[
+    CompiledModel {
+        name: "cantilever",
+        hash: cantilever::HASH,
+        dof: cantilever::DOF,
+        source: include_str!("../models/cantilever.toml"),
+        kernels: || Box::new(cantilever::Compiled::default()),
+    },
     CompiledModel {
         name: "chain",
         hash: chain::HASH,

@@ -465,3 +465,76 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     }
     Ok(ExitCode::SUCCESS)
 }
+
+#[derive(Args)]
+pub struct StaticArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Starting configuration, comma-separated (default: straight).
+    #[arg(long, allow_hyphen_values = true)]
+    pub q0: Option<String>,
+    /// Print JSON (the only format; accepted for scripts).
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Solve the static equilibrium of a loaded model, or explain why not.
+fn equilibrium(loaded: &mut Loaded, q0: &Option<String>) -> Result<runtime::StaticSolution> {
+    let n = loaded.arm.dof();
+    let coords = loaded.arm.info().coordinates.clone();
+    let q0 = optional_vector("--q0", q0, n, &coords)?;
+    runtime::solve_static(&mut *loaded.arm, &q0, &runtime::StaticOptions::default())
+        .map_err(|e| anyhow::anyhow!("{}: {e}", loaded.origin))
+}
+
+pub fn statics(a: StaticArgs) -> Result<ExitCode> {
+    let mut loaded = load(&a.model)?;
+    let sol = equilibrium(&mut loaded, &a.q0)?;
+    let n = sol.q.len();
+    let out = loaded.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
+    let v = json!({
+        "model": loaded.model.name,
+        "backend": loaded.arm.backend(),
+        "coordinates": loaded.arm.info().coordinates,
+        "q": sol.q,
+        "tip_position": &out[..3],
+        "residual": sol.residual,
+        "iterations": sol.iterations,
+        "load_steps": sol.load_steps,
+    });
+    println!("{}", serde_json::to_string_pretty(&v)?);
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
+pub struct ModesArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Starting configuration of the static solve, comma-separated.
+    #[arg(long, allow_hyphen_values = true)]
+    pub q0: Option<String>,
+    /// Also print the mode shapes (generalised coordinates).
+    #[arg(long)]
+    pub shapes: bool,
+    /// Print JSON (the only format; accepted for scripts).
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn modes(a: ModesArgs) -> Result<ExitCode> {
+    let mut loaded = load(&a.model)?;
+    let sol = equilibrium(&mut loaded, &a.q0)?;
+    let m = runtime::modes(&*loaded.arm, &sol.q)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", loaded.origin))?;
+    let mut v = json!({
+        "model": loaded.model.name,
+        "backend": loaded.arm.backend(),
+        "frequencies_hz": m.frequencies_hz,
+        "equilibrium_q": sol.q,
+    });
+    if a.shapes {
+        v["shapes"] = json!(m.shapes);
+    }
+    println!("{}", serde_json::to_string_pretty(&v)?);
+    Ok(ExitCode::SUCCESS)
+}

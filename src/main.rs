@@ -50,6 +50,10 @@ enum Command {
     Eom(commands::EomArgs),
     /// Time derivation and kernel evaluation in-process.
     Bench(commands::BenchArgs),
+    /// Static equilibrium under gravity and the applied loads.
+    Static(commands::StaticArgs),
+    /// Natural frequencies (and mode shapes) about the static equilibrium.
+    Modes(commands::ModesArgs),
 }
 
 fn main() -> ExitCode {
@@ -60,6 +64,8 @@ fn main() -> ExitCode {
         Command::Simulate(a) => commands::simulate(a),
         Command::Eom(a) => commands::eom(a),
         Command::Bench(a) => commands::bench(a),
+        Command::Static(a) => commands::statics(a),
+        Command::Modes(a) => commands::modes(a),
     };
     match result {
         Ok(code) => code,

@@ -107,8 +107,8 @@ fn model_file_holds_the_textbook_values() {
     let m = load_model(&model_path("double_pendulum"), &[]).unwrap();
     assert_eq!((m.segments[0].length, m.segments[0].mass), (L1, Some(M1)));
     assert_eq!((m.segments[1].length, m.segments[1].mass), (L2, Some(M2)));
-    assert_eq!(m.segments[0].joint_stiffness, K);
-    assert_eq!(m.segments[1].joint_damping, C);
+    assert_eq!(m.segments[0].joint_stiffness, Some(K));
+    assert_eq!(m.segments[1].joint_damping, Some(C));
     assert_eq!(m.gravity, [0.0, -G, 0.0]);
 }
 

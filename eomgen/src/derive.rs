@@ -28,6 +28,13 @@ pub fn derive(model: &Model) -> TapeSet {
     } else {
         runtime::Tape::default()
     };
+    let stiffness = cas.to_tape_hoisted(&eq.stiffness, &mut hoist);
+    let loads = params
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| n.starts_with("gravity.") || n.starts_with("tip.force."))
+        .map(|(i, _)| i)
+        .collect();
     let derived = hoist.finish(&mut cas);
     TapeSet {
         info: ModelInfo {
@@ -36,6 +43,7 @@ pub fn derive(model: &Model) -> TapeSet {
             parameters: params,
             derived: hoist.len(),
             accel,
+            loads,
         },
         mass,
         bias,
@@ -43,5 +51,6 @@ pub fn derive(model: &Model) -> TapeSet {
         outputs,
         derived,
         accel: accel_tape,
+        stiffness,
     }
 }

@@ -178,6 +178,10 @@ impl<'a> KernelEmitter<'a> {
                 let a = r(a);
                 quote!(runtime::special::cosc(#k, #a))
             }
+            Op::SincRem(k, a) => {
+                let a = r(a);
+                quote!(runtime::special::sinc_rem(#k, #a))
+            }
             _ => unreachable!("leaves are read in place"),
         }
     }
@@ -301,7 +305,8 @@ fn operands(op: &Op) -> Vec<Slot> {
         | Op::Abs(a)
         | Op::Sign(a)
         | Op::Sinc(_, a)
-        | Op::Cosc(_, a) => vec![a],
+        | Op::Cosc(_, a)
+        | Op::SincRem(_, a) => vec![a],
         _ => vec![],
     }
 }
@@ -316,6 +321,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     let n_params = info.extended_params();
     let n_derived = info.derived;
     let accel = info.accel;
+    let loads = &info.loads;
     let hash = &info.hash;
     let coords = &info.coordinates;
     let params = &info.parameters;
@@ -342,6 +348,8 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         pub const DERIVED: usize = #n_derived;
         /// Whether the mass solve is generated (the `accel` kernel).
         pub const ACCEL: bool = #accel;
+        /// Base parameters that are loads (scaled by load continuation).
+        pub const LOADS: &[usize] = &[#(#loads),*];
 
         /// The compiled kernels of this structure.
         pub struct Compiled {
@@ -357,6 +365,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                         parameters: PARAMETERS.iter().map(|s| s.to_string()).collect(),
                         derived: DERIVED,
                         accel: ACCEL,
+                        loads: LOADS.to_vec(),
                     },
                 }
             }

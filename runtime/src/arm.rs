@@ -33,6 +33,10 @@ pub trait Dynamics {
     /// Solve M x = b in place for x, M given as the packed upper triangle
     /// (the `Mass` layout); false unless M is positive definite.
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool;
+    /// The base parameter values (layout `info().parameters`).
+    fn base_params(&self) -> &[f64];
+    /// Replace the base parameters; the derived ones are recomputed.
+    fn set_base_params(&mut self, params: &[f64]);
 }
 
 /// Why the accelerations could not be computed.
@@ -59,25 +63,14 @@ impl<K: Kernels> Arm<K> {
     /// `params` must follow `kernels.info().parameters`; the derived
     /// parameters are computed from them here, once.
     pub fn new(kernels: K, params: Vec<f64>) -> Self {
-        let info = kernels.info();
         assert_eq!(
             params.len(),
-            info.parameters.len(),
+            kernels.info().parameters.len(),
             "parameter vector does not match the model's layout"
         );
-        let n_base = params.len();
+        let derived = derived_params(&kernels, &params);
         let mut extended = params;
-        extended.resize(info.extended_params(), 0.0);
-        let zeros = vec![0.0; info.dof()];
-        let mut derived = vec![0.0; info.derived];
-        let inp = Inputs {
-            t: 0.0,
-            q: &zeros,
-            qd: &zeros,
-            p: &extended,
-        };
-        kernels.eval(KernelKind::Derived, &inp, &mut derived);
-        extended[n_base..].copy_from_slice(&derived);
+        extended.extend(derived);
         Self {
             kernels,
             params: extended,
@@ -106,6 +99,23 @@ impl<K: Kernels> Arm<K> {
         self.kernels.eval(kind, &inp, &mut packed);
         f(&packed);
     }
+}
+
+/// The derived parameters of `base` (the `Derived` kernel).
+fn derived_params<K: Kernels + ?Sized>(kernels: &K, base: &[f64]) -> Vec<f64> {
+    let info = kernels.info();
+    let mut extended = base.to_vec();
+    extended.resize(info.extended_params(), 0.0);
+    let zeros = vec![0.0; info.dof()];
+    let mut derived = vec![0.0; info.derived];
+    let inp = Inputs {
+        t: 0.0,
+        q: &zeros,
+        qd: &zeros,
+        p: &extended,
+    };
+    kernels.eval(KernelKind::Derived, &inp, &mut derived);
+    derived
 }
 
 /// Unpack the upper triangle (row by row) into a full symmetric matrix.
@@ -161,6 +171,15 @@ impl<K: Kernels> Dynamics for Arm<K> {
     }
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
         self.kernels.solve_mass(packed, b, ws)
+    }
+    fn base_params(&self) -> &[f64] {
+        &self.params[..self.kernels.info().parameters.len()]
+    }
+    fn set_base_params(&mut self, params: &[f64]) {
+        let derived = derived_params(&self.kernels, params);
+        let n = params.len();
+        self.params[..n].copy_from_slice(params);
+        self.params[n..].copy_from_slice(&derived);
     }
 }
 

@@ -19,6 +19,8 @@ use crate::tape::{Inputs, Tape};
 ///   (n values, all positive when M is positive definite): the mass solve
 ///   generated as straight-line code. Present only when `ModelInfo::accel`
 ///   (small arms); otherwise the runtime solves `MassBias` output.
+/// * `Stiffness`: K = d h(q, 0) / dq, row-major n x n: the tangent
+///   stiffness of the static generalised forces (gravity, elastic, applied).
 /// * `Derived`: the derived parameters (parameter-only subexpressions the
 ///   generator hoisted out of the other kernels), computed once per
 ///   parameter set; the other kernels read them after the base parameters.
@@ -29,11 +31,13 @@ pub enum KernelKind {
     MassBias,
     Outputs,
     Accel,
+    Stiffness,
     Derived,
 }
 
 impl KernelKind {
-    pub const ALL: [KernelKind; 6] = [
+    pub const ALL: [KernelKind; 7] = [
+        Self::Stiffness,
         Self::Accel,
         Self::Mass,
         Self::Bias,
@@ -51,6 +55,7 @@ impl KernelKind {
             Self::MassBias => tri + dof,
             Self::Outputs => OUTPUT_NAMES.len(),
             Self::Derived => info.derived,
+            Self::Stiffness => dof * dof,
             Self::Accel => {
                 if info.accel {
                     2 * dof
@@ -68,6 +73,7 @@ impl KernelKind {
             Self::MassBias => "mass_bias",
             Self::Outputs => "outputs",
             Self::Derived => "derived",
+            Self::Stiffness => "stiffness",
             Self::Accel => "accel",
         }
     }
@@ -88,6 +94,9 @@ pub struct ModelInfo {
     pub derived: usize,
     /// Whether the `Accel` kernel exists.
     pub accel: bool,
+    /// Indices of the base parameters that are loads (gravity, applied
+    /// forces): statics scales them for load continuation.
+    pub loads: Vec<usize>,
 }
 
 impl ModelInfo {
@@ -133,6 +142,7 @@ pub struct TapeSet {
     pub derived: Tape,
     /// Empty unless `info.accel`.
     pub accel: Tape,
+    pub stiffness: Tape,
 }
 
 impl TapeSet {
@@ -144,6 +154,7 @@ impl TapeSet {
             KernelKind::Outputs => &self.outputs,
             KernelKind::Derived => &self.derived,
             KernelKind::Accel => &self.accel,
+            KernelKind::Stiffness => &self.stiffness,
         }
     }
 }

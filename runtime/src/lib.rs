@@ -8,7 +8,9 @@ pub mod arm;
 pub mod integrate;
 pub mod kernels;
 pub mod linalg;
+pub mod modes;
 pub mod special;
+pub mod statics;
 pub mod tape;
 
 pub use arm::{AccelError, Arm, Dynamics, Workspace, accelerations};
@@ -17,4 +19,6 @@ pub use kernels::{
     CompiledModel, Interpreted, KernelKind, Kernels, ModelInfo, OUTPUT_NAMES, TapeSet,
 };
 pub use linalg::Ldlt;
+pub use modes::{Modes, ModesError, modes};
+pub use statics::{StaticError, StaticOptions, StaticSolution, solve_static};
 pub use tape::{Inputs, Op, Slot, Tape};

@@ -26,7 +26,7 @@ pub fn sinc(k: u8, x: f64) -> f64 {
             s / factorial(m + 1)
         })
     } else {
-        leibniz_over_x(k, x, sin_deriv)
+        leibniz_over_xp(k, x, 1, sin_deriv)
     }
 }
 
@@ -41,12 +41,32 @@ pub fn cosc(k: u8, x: f64) -> f64 {
             s / factorial(m + 1)
         })
     } else {
-        leibniz_over_x(k, x, |i, x| {
+        leibniz_over_xp(k, x, 1, |i, x| {
             if i == 0 {
                 1.0 - x.cos()
             } else {
                 -cos_deriv(i, x)
             }
+        })
+    }
+}
+
+/// d^k/dx^k [(x - sin x) / x^3]  (k = 0 is 1/6 at x = 0). With sinc and cosc
+/// it gives the centroid and rotational inertia of a bent (PCC) element.
+#[inline]
+pub fn sinc_rem(k: u8, x: f64) -> f64 {
+    if x.abs() < SERIES_BELOW {
+        // (x - sin x)/x^3 = sum_{n>=0} (-1)^n x^(2n) / (2n + 3)!
+        series(k, x, 0, |m| {
+            let n = m / 2;
+            let s = if n % 2 == 0 { 1.0 } else { -1.0 };
+            s / factorial(m + 3)
+        })
+    } else {
+        leibniz_over_xp(k, x, 3, |i, x| match i {
+            0 => x - x.sin(),
+            1 => 1.0 - x.cos(),
+            _ => -sin_deriv(i, x),
         })
     }
 }
@@ -116,16 +136,18 @@ fn series(k: u8, x: f64, first: u32, coef: impl Fn(u32) -> f64) -> f64 {
     sum * powi_u(x, m - k)
 }
 
-/// d^k/dx^k [g(x) / x] by Leibniz: sum_j C(k,j) g^(k-j)(x) (-1)^j j! x^(-j-1).
+/// d^k/dx^k [g(x) / x^p] by Leibniz:
+/// sum_j C(k,j) g^(k-j)(x) (-1)^j (p + j - 1)! / (p - 1)! x^(-p-j).
 #[inline]
-fn leibniz_over_x(k: u8, x: f64, g: impl Fn(u32, f64) -> f64) -> f64 {
+fn leibniz_over_xp(k: u8, x: f64, p: u32, g: impl Fn(u32, f64) -> f64) -> f64 {
     let k = u32::from(k);
     let inv = 1.0 / x;
     let mut sum = 0.0;
-    let mut xp = inv; // x^(-j-1)
+    let mut xp = powi_u(inv, p); // x^(-p-j)
     for j in 0..=k {
         let sgn = if j % 2 == 0 { 1.0 } else { -1.0 };
-        sum += binomial(k, j) * g(k - j, x) * sgn * factorial(j) * xp;
+        let rising = factorial(p + j - 1) / factorial(p - 1);
+        sum += binomial(k, j) * g(k - j, x) * sgn * rising * xp;
         xp *= inv;
     }
     sum
@@ -195,6 +217,17 @@ mod tests {
     }
 
     #[test]
+    fn sinc_rem_matches_its_closed_form_and_limits() {
+        for &x in &[-2.5f64, -1.0, -0.5, 0.3, 0.999, 1.001, 1.7, 3.0] {
+            let closed = (x - x.sin()) / (x * x * x);
+            assert!(close(sinc_rem(0, x), closed, 1e-9), "x={x}");
+        }
+        assert!(close(sinc_rem(0, 0.0), 1.0 / 6.0, 1e-15));
+        assert_eq!(sinc_rem(1, 0.0), 0.0);
+        assert!(close(sinc_rem(2, 0.0), -2.0 / 120.0, 1e-15));
+    }
+
+    #[test]
     fn limits_at_zero() {
         assert_eq!(sinc(0, 0.0), 1.0);
         assert_eq!(sinc(1, 0.0), 0.0);
@@ -213,6 +246,10 @@ mod tests {
             let above = 1.0 + 1e-12;
             assert!(close(sinc(k, below), sinc(k, above), 1e-11), "sinc k={k}");
             assert!(close(cosc(k, below), cosc(k, above), 1e-11), "cosc k={k}");
+            assert!(
+                close(sinc_rem(k, below), sinc_rem(k, above), 1e-10),
+                "sinc_rem k={k}"
+            );
             assert!(close(sinc(k, -below), sinc(k, -above), 1e-11));
             assert!(close(cosc(k, -below), cosc(k, -above), 1e-11));
         }
@@ -227,6 +264,8 @@ mod tests {
                 assert!(close(sinc(k + 1, x), fd, 1e-7), "sinc k={k} x={x}");
                 let fd = (cosc(k, x + h) - cosc(k, x - h)) / (2.0 * h);
                 assert!(close(cosc(k + 1, x), fd, 1e-7), "cosc k={k} x={x}");
+                let fd = (sinc_rem(k, x + h) - sinc_rem(k, x - h)) / (2.0 * h);
+                assert!(close(sinc_rem(k + 1, x), fd, 1e-7), "sinc_rem k={k} x={x}");
             }
         }
     }

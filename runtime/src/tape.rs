@@ -44,6 +44,8 @@ pub enum Op {
     Sinc(u8, Slot),
     /// k-th derivative of (1 - cos x)/x.
     Cosc(u8, Slot),
+    /// k-th derivative of (x - sin x)/x^3.
+    SincRem(u8, Slot),
 }
 
 /// The values a kernel reads.
@@ -92,6 +94,7 @@ impl Tape {
                 Op::Sign(a) => special::sign(s(a)),
                 Op::Sinc(k, a) => special::sinc(k, s(a)),
                 Op::Cosc(k, a) => special::cosc(k, s(a)),
+                Op::SincRem(k, a) => special::sinc_rem(k, s(a)),
             };
             slots.push(v);
         }

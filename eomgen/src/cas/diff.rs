@@ -187,6 +187,7 @@ impl Cas {
             Func::Sign => self.zero(),
             Func::Sinc(k) => self.func(Func::Sinc(k + 1), x),
             Func::Cosc(k) => self.func(Func::Cosc(k + 1), x),
+            Func::SincRem(k) => self.func(Func::SincRem(k + 1), x),
         }
     }
 }

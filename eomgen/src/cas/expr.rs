@@ -38,8 +38,9 @@ pub enum SymKind {
     Free,
 }
 
-/// Unary functions. `Sinc(k)` and `Cosc(k)` are the k-th derivatives of
-/// sin(x)/x and (1 - cos x)/x: removable singularities as first-class ops.
+/// Unary functions. `Sinc(k)`, `Cosc(k)` and `SincRem(k)` are the k-th
+/// derivatives of sin(x)/x, (1 - cos x)/x and (x - sin x)/x^3: removable
+/// singularities as first-class ops.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]
 pub enum Func {
     Sin,
@@ -51,6 +52,8 @@ pub enum Func {
     Sign,
     Sinc(u8),
     Cosc(u8),
+    /// k-th derivative of (x - sin x) / x^3.
+    SincRem(u8),
 }
 
 impl Func {
@@ -67,6 +70,7 @@ impl Func {
             Func::Sign => special::sign(x),
             Func::Sinc(k) => special::sinc(k, x),
             Func::Cosc(k) => special::cosc(k, x),
+            Func::SincRem(k) => special::sinc_rem(k, x),
         }
     }
 
@@ -76,7 +80,7 @@ impl Func {
         match self {
             Func::Sin | Func::Tan | Func::Sign => Some(-1.0),
             Func::Cos | Func::Abs => Some(1.0),
-            Func::Sinc(k) => Some(alt(k)),
+            Func::Sinc(k) | Func::SincRem(k) => Some(alt(k)),
             Func::Cosc(k) => Some(-alt(k)),
             Func::Exp | Func::Ln => None,
         }

@@ -125,6 +125,7 @@ fn key(op: &Op) -> (u8, u64, u64) {
         Op::Sign(a) => (19, u(a), 0),
         Op::Sinc(k, a) => (20, u(a), u64::from(k)),
         Op::Cosc(k, a) => (21, u(a), u64::from(k)),
+        Op::SincRem(k, a) => (22, u(a), u64::from(k)),
     }
 }
 
@@ -222,6 +223,7 @@ impl<'a> Lowerer<'a> {
                     Func::Sign => Op::Sign(a),
                     Func::Sinc(k) => Op::Sinc(k, a),
                     Func::Cosc(k) => Op::Cosc(k, a),
+                    Func::SincRem(k) => Op::SincRem(k, a),
                 })
             }
             Node::Bind(x) => self.lower(x),

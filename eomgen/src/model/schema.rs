@@ -36,14 +36,28 @@ pub struct Base {
 pub enum Method {
     /// A chain of `elements` rigid links joined by revolute joints.
     Rigid,
+    /// Piecewise constant curvature: `elements` arcs, one bending angle each.
+    Pcc,
 }
 
 impl Method {
     pub fn name(self) -> &'static str {
         match self {
             Method::Rigid => "rigid",
+            Method::Pcc => "pcc",
         }
     }
+}
+
+/// Where the joints of a rigid segment sit. Structural.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
+#[serde(rename_all = "lowercase")]
+pub enum Joints {
+    /// At the base of each link (a pendulum chain).
+    Base,
+    /// At the middle of each element (Hencky's pseudo-rigid-body model of a
+    /// continuous rod): half a link at the clamp and at the tip.
+    Midpoint,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -67,12 +81,55 @@ pub struct Segment {
     /// Inner radius of a hollow section (m).
     #[serde(default)]
     pub inner_radius: Option<f64>,
-    /// Rotational stiffness of each joint (N m / rad).
+    /// Rotational stiffness of each joint (N m / rad); rigid segments.
     #[serde(default)]
-    pub joint_stiffness: f64,
-    /// Rotational damping of each joint (N m s / rad).
+    pub joint_stiffness: Option<f64>,
+    /// Rotational damping of each joint (N m s / rad); rigid segments.
     #[serde(default)]
-    pub joint_damping: f64,
+    pub joint_damping: Option<f64>,
+    /// Young's modulus (Pa): bending stiffness E I from the section.
+    #[serde(default)]
+    pub youngs_modulus: Option<f64>,
+    /// Bending stiffness E I (N m^2), instead of `youngs_modulus`.
+    #[serde(default)]
+    pub bending_stiffness: Option<f64>,
+    /// Bending damping (N m^2 s): Rayleigh function eta kappa_dot^2 / 2 per
+    /// unit length, i.e. (eta / l_e) theta_dot^2 / 2 per element.
+    #[serde(default)]
+    pub bending_damping: Option<f64>,
+    /// Curvature at rest (1/m).
+    #[serde(default)]
+    pub rest_curvature: f64,
+    /// Joint placement of a rigid segment (structural). Default: `midpoint`
+    /// when the segment's stiffness comes from E I, else `base`.
+    #[serde(default)]
+    pub joints: Option<Joints>,
+}
+
+impl Segment {
+    /// Joint placement actually used (rigid segments).
+    pub fn joint_placement(&self) -> Joints {
+        self.joints.unwrap_or(
+            if self.youngs_modulus.is_some() || self.bending_stiffness.is_some() {
+                Joints::Midpoint
+            } else {
+                Joints::Base
+            },
+        )
+    }
+
+    /// Second moment of area of the section (m^4), if it has a radius.
+    pub fn second_moment(&self) -> Option<f64> {
+        let ro = self.outer_radius?;
+        let ri = self.inner_radius.unwrap_or(0.0);
+        Some(std::f64::consts::PI / 4.0 * (ro.powi(4) - ri.powi(4)))
+    }
+
+    /// Bending stiffness E I (N m^2), if declared.
+    pub fn ei(&self) -> Option<f64> {
+        self.bending_stiffness
+            .or_else(|| Some(self.youngs_modulus? * self.second_moment()?))
+    }
 }
 
 fn one() -> usize {

@@ -7,16 +7,25 @@
 
 use sha2::{Digest, Sha256};
 
-use super::schema::{Method, Model};
+use super::schema::{Joints, Method, Model};
 
 /// Bumped whenever derivation or emission changes what is generated, so
 /// that cached tapes and generated files are re-derived.
-pub const GENERATOR_VERSION: u32 = 8;
+pub const GENERATOR_VERSION: u32 = 9;
+
+/// The structural part of one segment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SegmentShape {
+    pub method: Method,
+    pub elements: usize,
+    /// Joint placement (rigid segments; `Base` for others).
+    pub joints: Joints,
+}
 
 /// Everything that shapes the equations; numbers are left out.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Structure {
-    pub segments: Vec<(Method, usize)>,
+    pub segments: Vec<SegmentShape>,
     /// A tip body exists (`tip.mass` given).
     pub tip_mass: bool,
     /// A tip force exists (`tip.force` given).
@@ -26,7 +35,18 @@ pub struct Structure {
 impl Structure {
     pub fn of(m: &Model) -> Self {
         Self {
-            segments: m.segments.iter().map(|s| (s.method, s.elements)).collect(),
+            segments: m
+                .segments
+                .iter()
+                .map(|s| SegmentShape {
+                    method: s.method,
+                    elements: s.elements,
+                    joints: match s.method {
+                        Method::Rigid => s.joint_placement(),
+                        Method::Pcc => Joints::Base,
+                    },
+                })
+                .collect(),
             tip_mass: m.tip.mass.is_some(),
             tip_force: m.tip.force.is_some(),
         }
@@ -35,8 +55,13 @@ impl Structure {
     /// Canonical text of the structure (what is hashed).
     pub fn canonical(&self) -> String {
         let mut s = format!("eomgen {GENERATOR_VERSION}\nplanar\n");
-        for (m, n) in &self.segments {
-            s.push_str(&format!("segment {} {}\n", m.name(), n));
+        for g in &self.segments {
+            s.push_str(&format!(
+                "segment {} {} {:?}\n",
+                g.method.name(),
+                g.elements,
+                g.joints
+            ));
         }
         s.push_str(&format!(
             "tip mass {} force {}\n",
@@ -52,7 +77,7 @@ impl Structure {
     }
 
     pub fn elements(&self) -> usize {
-        self.segments.iter().map(|s| s.1).sum()
+        self.segments.iter().map(|s| s.elements).sum()
     }
 }
 
@@ -61,10 +86,18 @@ impl Structure {
 pub struct ElementProps {
     pub length: f64,
     pub mass: f64,
-    /// About the centre of mass, about the axis normal to the plane.
+    /// Rotational inertia (about the axis normal to the plane) of each rigid
+    /// body of the element about its centre of mass: the whole link (rigid,
+    /// base joints), each half link (rigid, midpoint joints), or the
+    /// section's part m (r_o^2 + r_i^2) / 4 (pcc: the arc's part depends on
+    /// the bend and is derived symbolically).
     pub inertia: f64,
+    /// Joint or bending stiffness of the element (N m/rad): E I / l_e.
     pub stiffness: f64,
+    /// Joint or bending damping (N m s/rad): eta / l_e.
     pub damping: f64,
+    /// Angle at rest (rad): rest curvature times l_e.
+    pub rest: f64,
 }
 
 pub fn element_props(m: &Model) -> Vec<ElementProps> {
@@ -79,16 +112,32 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
             (None, Some(rho)) => rho * std::f64::consts::PI * (ro * ro - ri * ri) * l,
             (None, None) => 0.0, // rejected by validation
         };
-        // A uniform cylinder (hollow or solid) about a diameter through its
-        // centre; a slender rod when no radius is given.
-        let inertia = mass * (l * l / 12.0 + (ro * ro + ri * ri) / 4.0);
+        // Uniform cylinders (hollow or solid) about a diameter through the
+        // centre; slender rods when no radius is given.
+        let section = mass * (ro * ro + ri * ri) / 4.0;
+        let inertia = match (s.method, s.joint_placement()) {
+            (Method::Rigid, Joints::Base) => mass * l * l / 12.0 + section,
+            (Method::Rigid, Joints::Midpoint) => {
+                (mass / 2.0) * (l / 2.0).powi(2) / 12.0 + section / 2.0
+            }
+            (Method::Pcc, _) => section,
+        };
+        let stiffness = match s.ei() {
+            Some(ei) => ei / l,
+            None => s.joint_stiffness.unwrap_or(0.0),
+        };
+        let damping = match s.bending_damping {
+            Some(eta) => eta / l,
+            None => s.joint_damping.unwrap_or(0.0),
+        };
         for _ in 0..s.elements {
             out.push(ElementProps {
                 length: l,
                 mass,
                 inertia,
-                stiffness: s.joint_stiffness,
-                damping: s.joint_damping,
+                stiffness,
+                damping,
+                rest: s.rest_curvature * l,
             });
         }
     }
@@ -122,6 +171,7 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
         p.push((format!("element[{k}].inertia"), e.inertia));
         p.push((format!("joint[{k}].stiffness"), e.stiffness));
         p.push((format!("joint[{k}].damping"), e.damping));
+        p.push((format!("joint[{k}].rest"), e.rest));
     }
     p
 }

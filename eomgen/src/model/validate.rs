@@ -66,7 +66,10 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             "must be a non-zero vector (the undeformed arm axis)".into(),
         );
     }
-    let planar = m.segments.iter().all(|s| matches!(s.method, Method::Rigid));
+    let planar = m
+        .segments
+        .iter()
+        .all(|s| matches!(s.method, Method::Rigid | Method::Pcc));
     if planar {
         if d[2].abs() > 1e-12 * norm {
             return err(
@@ -138,8 +141,65 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
         } else if s.inner_radius.is_some() {
             return err(p("inner_radius"), "needs `outer_radius`".into());
         }
-        non_negative(&p("joint_stiffness"), s.joint_stiffness)?;
-        non_negative(&p("joint_damping"), s.joint_damping)?;
+        if let (Some(_), Some(_)) = (s.youngs_modulus, s.bending_stiffness) {
+            return err(
+                p("bending_stiffness"),
+                "give either `youngs_modulus` or `bending_stiffness`, not both".into(),
+            );
+        }
+        if let Some(e) = s.youngs_modulus {
+            positive(&p("youngs_modulus"), e)?;
+            if s.outer_radius.is_none() {
+                return err(
+                    p("outer_radius"),
+                    "missing: `youngs_modulus` needs the section's `outer_radius` (m)".into(),
+                );
+            }
+        }
+        if let Some(ei) = s.bending_stiffness {
+            positive(&p("bending_stiffness"), ei)?;
+        }
+        if let Some(c) = s.bending_damping {
+            non_negative(&p("bending_damping"), c)?;
+        }
+        finite(&p("rest_curvature"), s.rest_curvature)?;
+        let has_ei = s.ei().is_some();
+        match s.method {
+            Method::Rigid => {
+                if let Some(k) = s.joint_stiffness {
+                    non_negative(&p("joint_stiffness"), k)?;
+                    if has_ei {
+                        return err(
+                            p("joint_stiffness"),
+                            "give either `joint_stiffness` or the continuum's `youngs_modulus`/`bending_stiffness` (joint stiffness E I / l_e), not both".into(),
+                        );
+                    }
+                }
+                if let Some(c) = s.joint_damping {
+                    non_negative(&p("joint_damping"), c)?;
+                    if s.bending_damping.is_some() {
+                        return err(
+                            p("joint_damping"),
+                            "give either `joint_damping` or `bending_damping`, not both".into(),
+                        );
+                    }
+                }
+            }
+            Method::Pcc => {
+                for (key, given) in [
+                    ("joint_stiffness", s.joint_stiffness.is_some()),
+                    ("joint_damping", s.joint_damping.is_some()),
+                    ("joints", s.joints.is_some()),
+                ] {
+                    if given {
+                        return err(p(key), "not a key of pcc segments: they take `youngs_modulus` or `bending_stiffness`, and `bending_damping`".into());
+                    }
+                }
+                if !has_ei {
+                    return err(p("youngs_modulus"), "missing: a pcc segment needs `youngs_modulus` (with `outer_radius`) or `bending_stiffness`".into());
+                }
+            }
+        }
     }
     if let Some(mass) = m.tip.mass {
         non_negative("tip.mass", mass)?;

@@ -14,6 +14,13 @@
 //! momentum, in O(n^2) (the composite-body recursion falls out of the
 //! reverse sweep). The matrix is the same; only the order of evaluation
 //! differs.
+//!
+//! A lumped body whose inertia changes with the configuration (a bent pcc
+//! element) gets the exact Lagrangian terms T_w^T (dI/dt w) - (1/2) w^T
+//! (dI/dq) w on top; for rigid bodies they fold to zero.
+//!
+//! For statics: the static generalised force h(q, 0) (gravity, elastic and
+//! applied forces) and the stiffness K = d h(q, 0) / dq.
 
 use crate::cas::{Cas, ExprId};
 
@@ -26,6 +33,8 @@ pub struct Equations {
     pub bias: Vec<ExprId>,
     /// tip x, y, z, kinetic energy, potential energy.
     pub outputs: Vec<ExprId>,
+    /// K = d h(q, 0) / dq, row-major n x n.
+    pub stiffness: Vec<ExprId>,
 }
 
 fn cross(cas: &mut Cas, a: &[ExprId; 3], b: &[ExprId; 3]) -> [ExprId; 3] {
@@ -69,15 +78,21 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         }
     }
     let mut angular_force = Vec::new();
+    let mut inertia_rate_force = Vec::new(); // -(1/2) w^T (dI/dq) w, per coordinate
     for (b, body) in sys.bodies.iter().enumerate() {
         let (w, alpha) = (body.omega, triple(&conv_ang, b));
         let iw: [ExprId; 3] = std::array::from_fn(|k| cas.mul(body.inertia[k], w[k]));
         let gyro = cross(cas, &w, &iw);
+        let idot = cas.time_derivatives(&body.inertia, &pairs);
         for k in 0..3 {
             momentum_cot.push(iw[k]);
             let ia = cas.mul(body.inertia[k], alpha[k]);
-            angular_force.push(cas.add(ia, gyro[k]));
+            let id = cas.mul(idot[k], w[k]);
+            angular_force.push(cas.add_all(&[ia, gyro[k], id]));
         }
+        let w2: [ExprId; 3] = w.map(|e| cas.powi(e, 2));
+        let half_w2 = w2.map(|e| cas.scaled(-0.5, e));
+        inertia_rate_force.push(cas.vjp(&body.inertia, &half_w2, &sys.coords.q));
     }
     force_cot.extend(angular_force);
     for (f, force) in sys.point_forces.iter().enumerate() {
@@ -102,9 +117,38 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         .map(|i| {
             let de = cas.diff(sys.elastic, sys.coords.q[i]);
             let dr = cas.diff(sys.rayleigh, sys.coords.qd[i]);
-            cas.add_all(&[forces[i], de, dr])
+            let mut terms = vec![forces[i], de, dr];
+            terms.extend(inertia_rate_force.iter().map(|f| f[i]));
+            cas.add_all(&terms)
         })
         .collect();
+
+    // Statics: h(q, 0) = -J^T (m g) - J^T F + dV_e/dq, and its Jacobian.
+    let mut static_cot = Vec::with_capacity(outs.len());
+    for body in &sys.bodies {
+        for k in 0..3 {
+            let mg = cas.mul(body.mass, sys.gravity[k]);
+            static_cot.push(cas.neg(mg));
+        }
+    }
+    let zero = cas.zero();
+    static_cot.extend(std::iter::repeat_n(zero, 3 * nb));
+    for force in &sys.point_forces {
+        static_cot.extend(force.force.map(|c| cas.neg(c)));
+    }
+    let static_loads = cas.vjp(&outs, &static_cot, &sys.coords.qd);
+    let static_force: Vec<ExprId> = (0..n)
+        .map(|i| {
+            let de = cas.diff(sys.elastic, sys.coords.q[i]);
+            cas.add(static_loads[i], de)
+        })
+        .collect();
+    let mut stiffness = Vec::with_capacity(n * n);
+    for &g in &static_force {
+        for &q in &sys.coords.q {
+            stiffness.push(cas.diff(g, q));
+        }
+    }
 
     // Energies: KE = (v . m v + w . I w) / 2 = qd . momentum / 2 would hide
     // the bodies; sum them directly.
@@ -133,5 +177,6 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         mass_upper: mass,
         bias,
         outputs,
+        stiffness,
     }
 }

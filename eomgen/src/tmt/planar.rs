@@ -1,13 +1,32 @@
 //! Planar kinematics: chains in the x-y plane, rotations about z.
 //!
-//! Rigid elements: each element k has a revolute joint at its base with
-//! relative angle q_k; its frame is the previous frame rotated by q_k. The
-//! body is the element's centre of mass at half its length.
+//! A frame is an origin (x, y) and an absolute angle phi from +x; each
+//! element maps its base frame to its end frame and adds its lumped bodies:
+//!
+//! * rigid, joints at the base: joint angle q, then a uniform link; one body.
+//! * rigid, joints at the midpoint (Hencky's model of a rod): half a link,
+//!   the joint, half a link; two bodies.
+//! * pcc: an arc of length l bent by theta = q (the chapter's chord
+//!   construction, written with sinc and cosc so theta = 0 is regular); one
+//!   body at the arc's exact centroid, oriented along the chord, with the
+//!   bent arc's rotational inertia about it.
+//!
+//! Absolute angles keep the velocity map cheap: d(cos phi)/dt = -sin(phi) w,
+//! whose partial derivative in any qd_i is one shared node.
 
-use crate::cas::{Cas, ExprId, SymKind};
-use crate::model::{Method, Model, Structure, parameters};
+use crate::cas::{Cas, ExprId, Func, SymKind};
+use crate::model::{Joints, Method, Model, Structure, parameters};
 
 use super::system::{Body, Coordinates, PointForce, System};
+
+/// A planar frame: origin, absolute angle and its rate.
+#[derive(Clone, Copy)]
+struct Frame {
+    x: ExprId,
+    y: ExprId,
+    phi: ExprId,
+    w: ExprId,
+}
 
 /// Build the planar system of a model. Only the structure and the
 /// parameter layout are read from `model`; values stay symbols.
@@ -28,66 +47,75 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
     };
 
     let mut coord_names = Vec::new();
-    for (s, &(method, n)) in structure.segments.iter().enumerate() {
-        for e in 0..n {
-            coord_names.push(match method {
-                Method::Rigid => format!("theta_{s}_{e}"),
-            });
+    for (s, g) in structure.segments.iter().enumerate() {
+        for e in 0..g.elements {
+            coord_names.push(format!("theta_{s}_{e}"));
         }
     }
     let coords = Coordinates::new(cas, coord_names);
     let zero = cas.zero();
 
-    // Frame: origin (x, y) and absolute angle phi (from +x); w = its rate.
-    // Absolute angles keep the velocity map cheap: d(cos phi)/dt = -sin(phi) w,
-    // whose partial derivative in any qd_i (i <= k) is one shared node.
-    let mut x = param("base.x");
-    let mut y = param("base.y");
+    let mut f = Frame {
+        x: param("base.x"),
+        y: param("base.y"),
+        phi: param("base.angle"),
+        w: zero,
+    };
     let z = param("base.z");
-    let mut phi = param("base.angle");
-    let mut w = zero;
-
     let mut bodies = Vec::new();
     let mut elastic = Vec::new();
     let mut rayleigh = Vec::new();
     let mut k = 0;
-    for &(method, n) in &structure.segments {
-        for _ in 0..n {
+    for g in &structure.segments {
+        for _ in 0..g.elements {
             let (q, qd) = (coords.q[k], coords.qd[k]);
             let l = param(&format!("element[{k}].length"));
             let m = param(&format!("element[{k}].mass"));
             let inertia = param(&format!("element[{k}].inertia"));
             let stiff = param(&format!("joint[{k}].stiffness"));
             let damp = param(&format!("joint[{k}].damping"));
-            match method {
-                Method::Rigid => {
-                    let p1 = cas.add(phi, q);
-                    phi = cas.bind(p1);
-                    let w1 = cas.add(w, qd);
-                    w = cas.bind(w1);
-                    let (c, s) = (cas.cos(phi), cas.sin(phi));
+            let rest = param(&format!("joint[{k}].rest"));
+            let body =
+                |cas: &mut Cas, pos: [ExprId; 2], w: ExprId, mass: ExprId, inertia: ExprId| Body {
+                    mass,
+                    inertia: [inertia; 3],
+                    position: [cas.bind(pos[0]), cas.bind(pos[1]), z],
+                    omega: [zero, zero, w],
+                };
+            match (g.method, g.joints) {
+                (Method::Rigid, Joints::Base) => {
+                    f = rotate(cas, f, q, qd);
                     let half = cas.scaled(0.5, l);
-                    let cx = offset(cas, x, half, c);
-                    let cy = offset(cas, y, half, s);
-                    bodies.push(Body {
-                        mass: m,
-                        inertia: [inertia; 3],
-                        position: [cas.bind(cx), cas.bind(cy), z],
-                        omega: [zero, zero, w],
-                    });
-                    let nx = offset(cas, x, l, c);
-                    let ny = offset(cas, y, l, s);
-                    x = cas.bind(nx);
-                    y = cas.bind(ny);
-                    elastic.push(half_k_sq(cas, stiff, q));
-                    rayleigh.push(half_k_sq(cas, damp, qd));
+                    let c = along(cas, &f, half);
+                    bodies.push(body(cas, c, f.w, m, inertia));
+                    f = advance(cas, f, l);
+                }
+                (Method::Rigid, Joints::Midpoint) => {
+                    let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
+                    let half_m = cas.scaled(0.5, m);
+                    let c = along(cas, &f, quarter);
+                    bodies.push(body(cas, c, f.w, half_m, inertia));
+                    f = advance(cas, f, half);
+                    f = rotate(cas, f, q, qd);
+                    let c = along(cas, &f, quarter);
+                    bodies.push(body(cas, c, f.w, half_m, inertia));
+                    f = advance(cas, f, half);
+                }
+                (Method::Pcc, _) => {
+                    let (c, psi_rate, arc_inertia) = pcc_body(cas, &f, l, m, q, qd);
+                    let total = cas.add(arc_inertia, inertia);
+                    bodies.push(body(cas, c, psi_rate, m, total));
+                    f = pcc_end(cas, f, l, q, qd);
                 }
             }
+            let dq = cas.sub(q, rest);
+            elastic.push(half_k_sq(cas, stiff, dq));
+            rayleigh.push(half_k_sq(cas, damp, qd));
             k += 1;
         }
     }
 
-    let tip = [x, y, z];
+    let tip = [f.x, f.y, z];
     if structure.tip_mass {
         let mass = param("tip.mass");
         bodies.push(Body {
@@ -120,10 +148,102 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
     }
 }
 
-/// x + l * dir
-fn offset(cas: &mut Cas, x: ExprId, l: ExprId, dir: ExprId) -> ExprId {
-    let d = cas.mul(l, dir);
-    cas.add(x, d)
+/// The frame turned by the joint angle q (rate qd).
+fn rotate(cas: &mut Cas, f: Frame, q: ExprId, qd: ExprId) -> Frame {
+    let phi = cas.add(f.phi, q);
+    let w = cas.add(f.w, qd);
+    Frame {
+        phi: cas.bind(phi),
+        w: cas.bind(w),
+        ..f
+    }
+}
+
+/// The point at distance d along the frame's axis.
+fn along(cas: &mut Cas, f: &Frame, d: ExprId) -> [ExprId; 2] {
+    let (c, s) = (cas.cos(f.phi), cas.sin(f.phi));
+    [offset(cas, f.x, d, c), offset(cas, f.y, d, s)]
+}
+
+/// The frame moved by d along its axis.
+fn advance(cas: &mut Cas, f: Frame, d: ExprId) -> Frame {
+    let [x, y] = along(cas, &f, d);
+    Frame {
+        x: cas.bind(x),
+        y: cas.bind(y),
+        ..f
+    }
+}
+
+/// A point at (a, b) in the frame's (axis, normal) coordinates.
+fn local(cas: &mut Cas, f: &Frame, a: ExprId, b: ExprId) -> [ExprId; 2] {
+    let (c, s) = (cas.cos(f.phi), cas.sin(f.phi));
+    // x + a c - b s, y + a s + b c
+    let (ac, bs) = (cas.mul(a, c), cas.mul(b, s));
+    let (as_, bc) = (cas.mul(a, s), cas.mul(b, c));
+    let x = cas.add_all(&[f.x, ac]);
+    let x = cas.sub(x, bs);
+    let y = cas.add_all(&[f.y, as_, bc]);
+    [x, y]
+}
+
+/// The end frame of a pcc element: tip at l (sinc theta, cosc theta) in the
+/// base frame's (axis, normal) coordinates, turned by theta.
+fn pcc_end(cas: &mut Cas, f: Frame, l: ExprId, theta: ExprId, rate: ExprId) -> Frame {
+    let (sc, cc) = (cas.sinc(theta), cas.cosc(theta));
+    let (a, b) = (cas.mul(l, sc), cas.mul(l, cc));
+    let [x, y] = local(cas, &f, a, b);
+    let g = Frame {
+        x: cas.bind(x),
+        y: cas.bind(y),
+        ..f
+    };
+    rotate(cas, g, theta, rate)
+}
+
+/// Centroid, angular rate and arc inertia of a pcc element. For an arc of
+/// length l and angle theta from the base frame:
+///
+/// * centroid, axis: l (1 - cos theta) / theta^2 = l sinc(theta/2)^2 / 2;
+/// * centroid, normal: l (theta - sin theta) / theta^2 = l (cosc + sinc')(theta);
+/// * mean squared distance from the base: 2 l^2 (theta - sin theta) / theta^3;
+///
+/// so the arc's inertia about its centroid is m (2 l^2 sinc_rem(theta) - |c|^2).
+/// The body turns with the chord: angle phi + theta/2.
+fn pcc_body(
+    cas: &mut Cas,
+    f: &Frame,
+    l: ExprId,
+    m: ExprId,
+    theta: ExprId,
+    rate: ExprId,
+) -> ([ExprId; 2], ExprId, ExprId) {
+    let half_theta = cas.scaled(0.5, theta);
+    let s2 = cas.sinc(half_theta);
+    let s2sq = cas.powi(s2, 2);
+    let axis = cas.scaled(0.5, s2sq);
+    let cc = cas.cosc(theta);
+    let ds = cas.func(Func::Sinc(1), theta);
+    let normal = cas.add(cc, ds);
+    let (a, b) = (cas.mul(l, axis), cas.mul(l, normal));
+    let c = local(cas, f, a, b);
+    // I = m l^2 (2 sinc_rem - axis^2 - normal^2)
+    let sr = cas.func(Func::SincRem(0), theta);
+    let two_sr = cas.scaled(2.0, sr);
+    let (a2, b2) = (cas.powi(axis, 2), cas.powi(normal, 2));
+    let shape = cas.sub(two_sr, a2);
+    let shape = cas.sub(shape, b2);
+    let l2 = cas.powi(l, 2);
+    let arc = cas.mul_all(&[m, l2, shape]);
+    let half_rate = cas.scaled(0.5, rate);
+    let w = cas.add(f.w, half_rate);
+    (c, cas.bind(w), cas.bind(arc))
+}
+
+/// x + d * dir
+fn offset(cas: &mut Cas, x: ExprId, d: ExprId, dir: ExprId) -> ExprId {
+    let t = cas.mul(d, dir);
+    cas.add(x, t)
 }
 
 /// k x^2 / 2

@@ -1,0 +1,190 @@
+//! Static equilibrium: h(q, 0) = 0 (gravity, elastic and applied forces
+//! balance), by Newton's method on the generalised forces with the analytic
+//! tangent stiffness K = dh/dq (the `Stiffness` kernel), a backtracking line
+//! search, and load continuation: the load parameters (gravity, applied
+//! forces) are scaled from 0 to 1 in steps that grow on success and shrink on
+//! failure, so that large deflections converge.
+
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+use crate::arm::Dynamics;
+use crate::kernels::KernelKind;
+
+#[derive(Clone, Debug)]
+pub struct StaticOptions {
+    /// Converged when the Newton step is below `step_tol * (1 + |q|)`.
+    pub step_tol: f64,
+    /// Newton iterations per load step.
+    pub max_iterations: usize,
+    /// Smallest load increment tried before giving up.
+    pub min_load_step: f64,
+}
+
+impl Default for StaticOptions {
+    fn default() -> Self {
+        Self {
+            step_tol: 1e-12,
+            max_iterations: 40,
+            min_load_step: 1e-4,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct StaticSolution {
+    pub q: Vec<f64>,
+    /// max |h(q, 0)| at the solution.
+    pub residual: f64,
+    /// Newton iterations over all load steps.
+    pub iterations: usize,
+    /// Accepted load steps.
+    pub load_steps: usize,
+}
+
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "the static solve did not converge: the last converged load fraction is {last_fraction:.4} \\
+     (0 = unloaded, 1 = the full load); {reason}. Try more elements, a smaller load, or a starting \\
+     configuration closer to the answer (--q0)"
+)]
+pub struct StaticError {
+    pub last_fraction: f64,
+    pub reason: String,
+    /// The configuration at the last converged load fraction.
+    pub q: Vec<f64>,
+}
+
+fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// Static forces and stiffness at q.
+fn forces(d: &dyn Dynamics, q: &[f64], g: &mut [f64], k: &mut [f64]) {
+    let zeros = vec![0.0; q.len()];
+    d.eval_kernel(KernelKind::Bias, 0.0, q, &zeros, g);
+    d.eval_kernel(KernelKind::Stiffness, 0.0, q, &zeros, k);
+}
+
+/// Newton from `q` at the current parameters. Ok: (iterations, residual).
+fn newton(d: &dyn Dynamics, q: &mut [f64], opts: &StaticOptions) -> Result<(usize, f64), String> {
+    let n = q.len();
+    let (mut g, mut kbuf) = (vec![0.0; n], vec![0.0; n * n]);
+    let mut trial = vec![0.0; n];
+    let mut g_trial = vec![0.0; n];
+    let zeros = vec![0.0; n];
+    forces(d, q, &mut g, &mut kbuf);
+    for it in 1..=opts.max_iterations {
+        if g.iter().chain(&kbuf).any(|v| !v.is_finite()) {
+            return Err("non-finite forces or stiffness".into());
+        }
+        let k = DMatrix::from_row_slice(n, n, &kbuf);
+        let step = match k.lu().solve(&DVector::from_column_slice(&g)) {
+            Some(s) => s,
+            None => {
+                return Err(
+                    "the tangent stiffness is singular (a buckling or snap-through point?)".into(),
+                );
+            }
+        };
+        // Backtracking on the residual norm.
+        let r0 = inf_norm(&g);
+        let mut alpha = 1.0;
+        loop {
+            for i in 0..n {
+                trial[i] = q[i] - alpha * step[i];
+            }
+            d.eval_kernel(KernelKind::Bias, 0.0, &trial, &zeros, &mut g_trial);
+            let r = inf_norm(&g_trial);
+            if r.is_finite() && (r < r0 || alpha < 1.0 / 64.0 || r0 == 0.0) {
+                break;
+            }
+            alpha *= 0.5;
+        }
+        q.copy_from_slice(&trial);
+        forces(d, q, &mut g, &mut kbuf);
+        let dq = alpha * inf_norm(step.as_slice());
+        if dq <= opts.step_tol * (1.0 + inf_norm(q)) {
+            return Ok((it, inf_norm(&g)));
+        }
+    }
+    Err(format!(
+        "Newton did not converge in {} iterations",
+        opts.max_iterations
+    ))
+}
+
+/// Static equilibrium at the model's full load, from `q0`. The model's
+/// parameters are left as they were.
+pub fn solve_static(
+    d: &mut dyn Dynamics,
+    q0: &[f64],
+    opts: &StaticOptions,
+) -> Result<StaticSolution, StaticError> {
+    let base = d.base_params().to_vec();
+    let loads = d.info().loads.clone();
+    let scaled = |lambda: f64| {
+        let mut p = base.clone();
+        for &i in &loads {
+            p[i] *= lambda;
+        }
+        p
+    };
+    let mut q = q0.to_vec();
+    let mut iterations = 0;
+    let mut load_steps = 0;
+    let mut fraction = 0.0;
+    // Equilibrium without loads first (elastic forces alone, rest shape).
+    d.set_base_params(&scaled(0.0));
+    let result = (|| {
+        match newton(d, &mut q, opts) {
+            Ok((it, _)) => iterations += it,
+            Err(reason) => {
+                return Err(StaticError {
+                    last_fraction: 0.0,
+                    reason,
+                    q: q0.to_vec(),
+                });
+            }
+        }
+        let mut step: f64 = 1.0;
+        let mut last_reason = String::new();
+        while fraction < 1.0 {
+            let target = (fraction + step).min(1.0);
+            d.set_base_params(&scaled(target));
+            let mut trial = q.clone();
+            match newton(d, &mut trial, opts) {
+                Ok((it, _)) => {
+                    iterations += it;
+                    load_steps += 1;
+                    q = trial;
+                    fraction = target;
+                    step = (step * 2.0).min(1.0);
+                }
+                Err(reason) => {
+                    last_reason = reason;
+                    step *= 0.25;
+                    if step < opts.min_load_step {
+                        return Err(StaticError {
+                            last_fraction: fraction,
+                            reason: last_reason,
+                            q: q.clone(),
+                        });
+                    }
+                }
+            }
+        }
+        let _ = last_reason;
+        Ok(())
+    })();
+    d.set_base_params(&base);
+    result?;
+    let mut g = vec![0.0; q.len()];
+    d.eval_kernel(KernelKind::Bias, 0.0, &q, &vec![0.0; q.len()], &mut g);
+    Ok(StaticSolution {
+        residual: inf_norm(&g),
+        q,
+        iterations,
+        load_steps,
+    })
+}
