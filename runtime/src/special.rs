@@ -19,12 +19,7 @@ const TERMS: u32 = 14;
 #[inline]
 pub fn sinc(k: u8, x: f64) -> f64 {
     if x.abs() < SERIES_BELOW {
-        // sin(x)/x = sum_n (-1)^n x^(2n) / (2n + 1)!
-        series(k, x, 0, |m| {
-            let n = m / 2;
-            let s = if n % 2 == 0 { 1.0 } else { -1.0 };
-            s / factorial(m + 1)
-        })
+        SINC.eval(k, x)
     } else {
         leibniz_over_xp(k, x, 1, sin_deriv)
     }
@@ -34,12 +29,7 @@ pub fn sinc(k: u8, x: f64) -> f64 {
 #[inline]
 pub fn cosc(k: u8, x: f64) -> f64 {
     if x.abs() < SERIES_BELOW {
-        // (1 - cos x)/x = sum_{n>=1} (-1)^(n+1) x^(2n-1) / (2n)!
-        series(k, x, 1, |m| {
-            let n = m.div_ceil(2);
-            let s = if n % 2 == 1 { 1.0 } else { -1.0 };
-            s / factorial(m + 1)
-        })
+        COSC.eval(k, x)
     } else {
         leibniz_over_xp(k, x, 1, |i, x| {
             if i == 0 {
@@ -56,12 +46,7 @@ pub fn cosc(k: u8, x: f64) -> f64 {
 #[inline]
 pub fn sinc_rem(k: u8, x: f64) -> f64 {
     if x.abs() < SERIES_BELOW {
-        // (x - sin x)/x^3 = sum_{n>=0} (-1)^n x^(2n) / (2n + 3)!
-        series(k, x, 0, |m| {
-            let n = m / 2;
-            let s = if n % 2 == 0 { 1.0 } else { -1.0 };
-            s / factorial(m + 3)
-        })
+        SINC_REM.eval(k, x)
     } else {
         leibniz_over_xp(k, x, 3, |i, x| match i {
             0 => x - x.sin(),
@@ -116,25 +101,94 @@ pub fn sign(x: f64) -> f64 {
     }
 }
 
-/// k-th derivative of a power series whose non-zero coefficients sit at
-/// exponents `first, first + 2, ...` with coefficient `coef(m)` for x^m.
-#[inline]
-fn series(k: u8, x: f64, first: u32, coef: impl Fn(u32) -> f64) -> f64 {
-    let k = u32::from(k);
-    // Lowest exponent m >= k with the right parity.
-    let mut m = first;
-    while m < k {
-        m += 2;
-    }
-    let mut sum = 0.0;
-    let x2 = x * x;
-    // Horner from the top term down: sum_j c_j x^(m + 2j - k) m!/(m-k)!.
-    for j in (0..TERMS).rev() {
-        let mj = m + 2 * j;
-        sum = sum * x2 + coef(mj) * falling(mj, k);
-    }
-    sum * powi_u(x, m - k)
+/// Derivative orders with precomputed Taylor tables; higher orders (never
+/// needed by the generator so far) are computed term by term.
+const TABLE_ORDERS: usize = 8;
+
+/// Taylor series of an even or odd removable function, with the Horner
+/// coefficients of its first derivatives computed at compile time (the
+/// series branch is the hot path of every pcc kernel).
+struct Series {
+    /// Lowest exponent with a non-zero coefficient (0 or 1).
+    first: u32,
+    /// coef(m) of x^m for m = first, first + 2, ...: `coef[j]` for m = first + 2 j.
+    coef: [f64; TERMS as usize + TABLE_ORDERS],
+    /// table[k][i]: the coefficient of x^(lowest(k) - k + 2 i) in the k-th derivative.
+    table: [[f64; TERMS as usize]; TABLE_ORDERS],
 }
+
+impl Series {
+    const fn new(first: u32, coef: [f64; TERMS as usize + TABLE_ORDERS]) -> Self {
+        let mut table = [[0.0; TERMS as usize]; TABLE_ORDERS];
+        let mut k = 0;
+        while k < TABLE_ORDERS {
+            // Index of the lowest exponent >= k with the right parity.
+            let mut j0 = 0;
+            while first + 2 * j0 < k as u32 {
+                j0 += 1;
+            }
+            let mut i = 0;
+            while i < TERMS as usize {
+                let m = first + 2 * (j0 + i as u32);
+                table[k][i] = coef[j0 as usize + i] * falling(m, k as u32);
+                i += 1;
+            }
+            k += 1;
+        }
+        Self { first, coef, table }
+    }
+
+    #[inline]
+    fn eval(&self, k: u8, x: f64) -> f64 {
+        let k32 = u32::from(k);
+        let mut m0 = self.first;
+        while m0 < k32 {
+            m0 += 2;
+        }
+        let x2 = x * x;
+        let mut sum = 0.0;
+        if (k as usize) < TABLE_ORDERS {
+            for &c in self.table[k as usize].iter().rev() {
+                sum = sum * x2 + c;
+            }
+        } else {
+            let j0 = ((m0 - self.first) / 2) as usize;
+            for i in (0..TERMS as usize).rev() {
+                let c = self.coef.get(j0 + i).copied().unwrap_or(0.0);
+                sum = sum * x2 + c * falling(m0 + 2 * i as u32, k32);
+            }
+        }
+        if m0 > k32 { sum * x } else { sum }
+    }
+}
+
+/// Coefficients sign(j) / (m + shift)! for m = first + 2 j.
+const fn alternating(
+    first: u32,
+    shift: u32,
+    sign_offset: u32,
+) -> [f64; TERMS as usize + TABLE_ORDERS] {
+    let mut c = [0.0; TERMS as usize + TABLE_ORDERS];
+    let mut j = 0;
+    while j < c.len() {
+        let m = first + 2 * j as u32;
+        let sign = if (j as u32 + sign_offset) % 2 == 0 {
+            1.0
+        } else {
+            -1.0
+        };
+        c[j] = sign / factorial(m + shift);
+        j += 1;
+    }
+    c
+}
+
+/// sin(x)/x = sum_j (-1)^j x^(2j) / (2j + 1)!
+static SINC: Series = Series::new(0, alternating(0, 1, 0));
+/// (1 - cos x)/x = sum_j (-1)^j x^(2j+1) / (2j + 2)!
+static COSC: Series = Series::new(1, alternating(1, 1, 0));
+/// (x - sin x)/x^3 = sum_j (-1)^j x^(2j) / (2j + 3)!
+static SINC_REM: Series = Series::new(0, alternating(0, 3, 0));
 
 /// d^k/dx^k [g(x) / x^p] by Leibniz:
 /// sum_j C(k,j) g^(k-j)(x) (-1)^j (p + j - 1)! / (p - 1)! x^(-p-j).
@@ -174,14 +228,26 @@ fn cos_deriv(i: u32, x: f64) -> f64 {
 }
 
 #[inline]
-fn factorial(n: u32) -> f64 {
-    (1..=n).fold(1.0, |acc, i| acc * f64::from(i))
+const fn factorial(n: u32) -> f64 {
+    let mut acc = 1.0;
+    let mut i = 2;
+    while i <= n {
+        acc *= i as f64;
+        i += 1;
+    }
+    acc
 }
 
 /// m (m-1) ... (m-k+1)
 #[inline]
-fn falling(m: u32, k: u32) -> f64 {
-    (0..k).fold(1.0, |acc, i| acc * f64::from(m - i))
+const fn falling(m: u32, k: u32) -> f64 {
+    let mut acc = 1.0;
+    let mut i = 0;
+    while i < k {
+        acc *= (m - i) as f64;
+        i += 1;
+    }
+    acc
 }
 
 #[inline]

@@ -102,10 +102,10 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
                     f = advance(cas, f, half);
                 }
                 (Method::Pcc, _) => {
-                    let (c, psi_rate, arc_inertia) = pcc_body(cas, &f, l, m, q, qd);
+                    let (c, chord_rate, arc_inertia, end) = pcc_element(cas, f, l, m, q, qd);
                     let total = cas.add(arc_inertia, inertia);
-                    bodies.push(body(cas, c, psi_rate, m, total));
-                    f = pcc_end(cas, f, l, q, qd);
+                    bodies.push(body(cas, c, chord_rate, m, total));
+                    f = end;
                 }
             }
             let dq = cas.sub(q, rest);
@@ -187,57 +187,53 @@ fn local(cas: &mut Cas, f: &Frame, a: ExprId, b: ExprId) -> [ExprId; 2] {
     [x, y]
 }
 
-/// The end frame of a pcc element: tip at l (sinc theta, cosc theta) in the
-/// base frame's (axis, normal) coordinates, turned by theta.
-fn pcc_end(cas: &mut Cas, f: Frame, l: ExprId, theta: ExprId, rate: ExprId) -> Frame {
-    let (sc, cc) = (cas.sinc(theta), cas.cosc(theta));
-    let (a, b) = (cas.mul(l, sc), cas.mul(l, cc));
-    let [x, y] = local(cas, &f, a, b);
-    let g = Frame {
-        x: cas.bind(x),
-        y: cas.bind(y),
-        ..f
-    };
-    rotate(cas, g, theta, rate)
-}
-
-/// Centroid, angular rate and arc inertia of a pcc element. For an arc of
-/// length l and angle theta from the base frame:
+/// A pcc element of length l bent by theta, by the chord construction:
+/// turn theta/2, go the chord l sinc(theta/2), turn theta/2. Returns the
+/// centroid of the arc, the chord's angular rate (the body's orientation),
+/// the arc's rotational inertia about its centroid, and the end frame.
 ///
-/// * centroid, axis: l (1 - cos theta) / theta^2 = l sinc(theta/2)^2 / 2;
-/// * centroid, normal: l (theta - sin theta) / theta^2 = l (cosc + sinc')(theta);
-/// * mean squared distance from the base: 2 l^2 (theta - sin theta) / theta^3;
+/// In the base frame's (axis, normal) coordinates, with S = sinc(theta/2)
+/// and R = (theta - sin theta)/theta^3:
 ///
-/// so the arc's inertia about its centroid is m (2 l^2 sinc_rem(theta) - |c|^2).
-/// The body turns with the chord: angle phi + theta/2.
-fn pcc_body(
+/// * centroid: l (1 - cos theta)/theta^2 = l S^2/2 along the axis,
+///   l (theta - sin theta)/theta^2 = l theta R along the normal;
+/// * mean squared distance of the arc from its base: 2 l^2 R;
+///
+/// so the inertia is m l^2 (2 R - S^4/4 - theta^2 R^2). Only sinc and
+/// sinc_rem appear: theta = 0 is an ordinary point.
+fn pcc_element(
     cas: &mut Cas,
-    f: &Frame,
+    f: Frame,
     l: ExprId,
     m: ExprId,
     theta: ExprId,
     rate: ExprId,
-) -> ([ExprId; 2], ExprId, ExprId) {
+) -> ([ExprId; 2], ExprId, ExprId, Frame) {
     let half_theta = cas.scaled(0.5, theta);
-    let s2 = cas.sinc(half_theta);
-    let s2sq = cas.powi(s2, 2);
-    let axis = cas.scaled(0.5, s2sq);
-    let cc = cas.cosc(theta);
-    let ds = cas.func(Func::Sinc(1), theta);
-    let normal = cas.add(cc, ds);
+    let half_rate = cas.scaled(0.5, rate);
+    let s = cas.sinc(half_theta);
+    let s = cas.bind(s);
+    let r = cas.func(Func::SincRem(0), theta);
+    let r = cas.bind(r);
+    // Centroid.
+    let s2 = cas.powi(s, 2);
+    let axis = cas.scaled(0.5, s2);
+    let normal = cas.mul(theta, r);
     let (a, b) = (cas.mul(l, axis), cas.mul(l, normal));
-    let c = local(cas, f, a, b);
-    // I = m l^2 (2 sinc_rem - axis^2 - normal^2)
-    let sr = cas.func(Func::SincRem(0), theta);
-    let two_sr = cas.scaled(2.0, sr);
+    let c = local(cas, &f, a, b);
+    // Inertia of the arc about its centroid.
+    let two_r = cas.scaled(2.0, r);
     let (a2, b2) = (cas.powi(axis, 2), cas.powi(normal, 2));
-    let shape = cas.sub(two_sr, a2);
+    let shape = cas.sub(two_r, a2);
     let shape = cas.sub(shape, b2);
     let l2 = cas.powi(l, 2);
     let arc = cas.mul_all(&[m, l2, shape]);
-    let half_rate = cas.scaled(0.5, rate);
-    let w = cas.add(f.w, half_rate);
-    (c, cas.bind(w), cas.bind(arc))
+    // Chord and end frame.
+    let chord = rotate(cas, f, half_theta, half_rate);
+    let len = cas.mul(l, s);
+    let moved = advance(cas, chord, len);
+    let end = rotate(cas, moved, half_theta, half_rate);
+    (c, chord.w, cas.bind(arc), end)
 }
 
 /// x + d * dir
