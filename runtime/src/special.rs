@@ -172,7 +172,7 @@ const fn alternating(
     let mut j = 0;
     while j < c.len() {
         let m = first + 2 * j as u32;
-        let sign = if (j as u32 + sign_offset) % 2 == 0 {
+        let sign = if (j as u32).is_multiple_of(2) {
             1.0
         } else {
             -1.0
@@ -184,11 +184,11 @@ const fn alternating(
 }
 
 /// sin(x)/x = sum_j (-1)^j x^(2j) / (2j + 1)!
-static SINC: Series = Series::new(0, alternating(0, 1, 0));
+static SINC: Series = Series::new(0, alternating(0, 1));
 /// (1 - cos x)/x = sum_j (-1)^j x^(2j+1) / (2j + 2)!
-static COSC: Series = Series::new(1, alternating(1, 1, 0));
+static COSC: Series = Series::new(1, alternating(1, 1));
 /// (x - sin x)/x^3 = sum_j (-1)^j x^(2j) / (2j + 3)!
-static SINC_REM: Series = Series::new(0, alternating(0, 3, 0));
+static SINC_REM: Series = Series::new(0, alternating(0, 3));
 
 /// d^k/dx^k [g(x) / x^p] by Leibniz:
 /// sum_j C(k,j) g^(k-j)(x) (-1)^j (p + j - 1)! / (p - 1)! x^(-p-j).
