@@ -162,12 +162,8 @@ impl Series {
     }
 }
 
-/// Coefficients sign(j) / (m + shift)! for m = first + 2 j.
-const fn alternating(
-    first: u32,
-    shift: u32,
-    sign_offset: u32,
-) -> [f64; TERMS as usize + TABLE_ORDERS] {
+/// Coefficients (-1)^j / (m + shift)! for m = first + 2 j.
+const fn alternating(first: u32, shift: u32) -> [f64; TERMS as usize + TABLE_ORDERS] {
     let mut c = [0.0; TERMS as usize + TABLE_ORDERS];
     let mut j = 0;
     while j < c.len() {
