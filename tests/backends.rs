@@ -36,8 +36,15 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
             assert_close(*a, *b, 1e-12, 0.0, &format!("{} parameter {k}", m.name));
         }
         let n = compiled.dof();
-        for _ in 0..10 {
-            let q = rng.vec(n, -2.0, 2.0);
+        for it in 0..12 {
+            let mut q = rng.vec(n, -2.0, 2.0);
+            // The straight configuration, and some angles exactly 0: the
+            // removable singularities of pcc segments.
+            match it % 3 {
+                0 => q.fill(0.0),
+                1 => q.iter_mut().step_by(2).for_each(|x| *x = 0.0),
+                _ => {}
+            }
             let qd = rng.vec(n, -3.0, 3.0);
             let t = rng.uniform(0.0, 10.0);
             for kind in [
@@ -46,6 +53,7 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
                 KernelKind::MassBias,
                 KernelKind::Outputs,
                 KernelKind::Accel,
+                KernelKind::Stiffness,
             ] {
                 let len = kind.output_len(compiled.info());
                 let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
