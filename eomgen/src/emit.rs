@@ -10,7 +10,7 @@ use quote::{format_ident, quote};
 use runtime::{KernelKind, Op, Slot, Tape, TapeSet};
 
 /// Operations per emitted function.
-pub const CHUNK_OPS: usize = 2000;
+pub const CHUNK_OPS: usize = 4000;
 
 fn lit(c: f64) -> TokenStream {
     let l = Literal::f64_suffixed(c.abs());
