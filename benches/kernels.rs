@@ -31,6 +31,11 @@ fn derivation(c: &mut Criterion) {
             b.iter(|| eomgen::derive::derive(black_box(&model)))
         });
     }
+    let sets = [Override::parse("segment.0.elements=20").unwrap()];
+    let pcc20 = softarm::backend::read_model("cantilever", &sets).unwrap().0;
+    g.bench_function("cantilever_pcc20", |b| {
+        b.iter(|| eomgen::derive::derive(black_box(&pcc20)))
+    });
     g.finish();
 }
 
@@ -42,7 +47,7 @@ fn state(n: usize) -> (Vec<f64>, Vec<f64>) {
 
 fn kernels(c: &mut Criterion) {
     let mut g = c.benchmark_group("compiled");
-    for name in ["chain", "chain32"] {
+    for name in ["chain", "chain32", "cantilever"] {
         let l = load(name, &[], BackendChoice::Compiled, None).unwrap();
         let arm = &*l.arm;
         let n = arm.dof();
