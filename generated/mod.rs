@@ -11,6 +11,8 @@ pub mod chain32;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod double_pendulum;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod hybrid_arm;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod soft_finger;
 
 /// Every compiled-in model, by name.
@@ -42,6 +44,13 @@ pub static MODELS: &[CompiledModel] = &[
         dof: double_pendulum::DOF,
         source: include_str!("../models/double_pendulum.toml"),
         kernels: || Box::new(double_pendulum::Compiled::default()),
+    },
+    CompiledModel {
+        name: "hybrid_arm",
+        hash: hybrid_arm::HASH,
+        dof: hybrid_arm::DOF,
+        source: include_str!("../models/hybrid_arm.toml"),
+        kernels: || Box::new(hybrid_arm::Compiled::default()),
     },
     CompiledModel {
         name: "soft_finger",

@@ -162,6 +162,59 @@ fn cases() -> Vec<(&'static str, String, Vec<&'static str>, Vec<&'static str>)> 
             vec!["segment", "at least one"],
         ),
         (
+            "pcc with a joint spring",
+            r("\"rigid\"", "\"pcc\""),
+            vec![],
+            vec!["segment[0].joint_stiffness", "not a key of pcc segments"],
+        ),
+        (
+            "pcc without stiffness",
+            r("\"rigid\"", "\"pcc\"")
+                .replace("joint_stiffness = 1.0\n", "")
+                .replace("joint_damping = 0.1\n", ""),
+            vec![],
+            vec!["segment[0].youngs_modulus", "missing"],
+        ),
+        (
+            "modulus without radius",
+            r("joint_stiffness = 1.0", "youngs_modulus = 1e6"),
+            vec![],
+            vec!["segment[0].outer_radius", "youngs_modulus"],
+        ),
+        (
+            "modulus and EI",
+            r(
+                "joint_stiffness = 1.0",
+                "youngs_modulus = 1e6\nbending_stiffness = 0.1\nouter_radius = 0.01",
+            ),
+            vec![],
+            vec!["segment[0].bending_stiffness", "either"],
+        ),
+        (
+            "joint spring and EI",
+            r(
+                "joint_stiffness = 1.0",
+                "joint_stiffness = 1.0\nbending_stiffness = 0.1",
+            ),
+            vec![],
+            vec!["segment[0].joint_stiffness", "not both"],
+        ),
+        (
+            "negative bending damping",
+            r("joint_damping = 0.1", "bending_damping = -1.0"),
+            vec![],
+            vec!["segment[0].bending_damping", "zero or positive"],
+        ),
+        (
+            "unknown joint placement",
+            r(
+                "joint_damping = 0.1",
+                "joint_damping = 0.1\njoints = \"elbow\"",
+            ),
+            vec![],
+            vec!["segment[0].joints", "unknown variant `elbow`", "midpoint"],
+        ),
+        (
             "set without =",
             GOOD.into(),
             vec!["--set", "segment.0.length"],

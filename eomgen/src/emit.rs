@@ -9,8 +9,9 @@ use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 use runtime::{KernelKind, Op, Slot, Tape, TapeSet};
 
-/// Operations per emitted function.
-pub const CHUNK_OPS: usize = 4000;
+/// Operations per emitted function. Also bounds rustc's stack: 4000-op
+/// functions overflowed it at opt-level 1 with debug info (measured).
+pub const CHUNK_OPS: usize = 2000;
 
 fn lit(c: f64) -> TokenStream {
     let l = Literal::f64_suffixed(c.abs());
