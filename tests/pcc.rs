@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use common::*;
 use eomgen::cas::{Cas, SymKind};
 use eomgen::model::Override;
-use runtime::{Dynamics, KernelKind, SimOptions, StaticOptions, modes, simulate, solve_static};
+use runtime::{KernelKind, SimOptions, StaticOptions, modes, simulate, solve_static};
 use softarm::backend::{BackendChoice, Loaded, load};
 
 const L: f64 = 0.3;
