@@ -34,17 +34,7 @@ impl Cas {
     /// over the pairs (x_k, xdot_k) given. Pass (q, qd) pairs alone for the
     /// convective part (qdd = 0); add (qd, qdd) pairs for the full one.
     pub fn time_derivative(&mut self, e: ExprId, pairs: &[(ExprId, ExprId)]) -> ExprId {
-        let map: HashMap<SymId, ExprId> = pairs
-            .iter()
-            .map(|&(x, xd)| {
-                (
-                    self.sym_id(x).expect("time_derivative: pair of symbols"),
-                    xd,
-                )
-            })
-            .collect();
-        let mut memo = HashMap::new();
-        self.directional(e, &map, &mut memo)
+        self.time_derivatives(&[e], pairs)[0]
     }
 
     /// Several time derivatives sharing one memo (so shared subexpressions
