@@ -2,8 +2,8 @@
 //!
 //! A model file is parsed and validated (`model`), its structure is derived
 //! into expressions by the TMT method (`tmt`) in our CAS (`cas`), lowered to
-//! tapes, and emitted as Rust (`emit`). `generate` ties these together for
-//! build.rs and the CLI.
+//! tapes (`derive`), and emitted as Rust (`emit`). `generate` keeps a
+//! `generated/` folder in step with `models/` for build.rs and the CLI.
 
 pub mod cas;
 pub mod derive;
