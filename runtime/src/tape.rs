@@ -18,11 +18,11 @@ pub type Slot = u32;
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Op {
     Const(f64),
-    /// Generalised coordinate q[i].
+    /// Generalised coordinate `q[i]`.
     Q(u32),
-    /// Generalised rate qd[i].
+    /// Generalised rate `qd[i]`.
     Qd(u32),
-    /// Runtime parameter p[i].
+    /// Runtime parameter `p[i]`.
     Param(u32),
     Time,
     Add(Slot, Slot),

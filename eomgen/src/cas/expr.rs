@@ -24,13 +24,13 @@ pub struct SymId(pub(crate) u32);
 /// What a symbol stands for when the expression is evaluated or lowered.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
 pub enum SymKind {
-    /// Generalised coordinate q[i].
+    /// Generalised coordinate `q[i]`.
     Q(u32),
-    /// Its rate qd[i].
+    /// Its rate `qd[i]`.
     Qd(u32),
-    /// Its acceleration qdd[i] (only inside derivations, never lowered).
+    /// Its acceleration `qdd[i]` (only inside derivations, never lowered).
     Qdd(u32),
-    /// Runtime parameter p[i].
+    /// Runtime parameter `p[i]`.
     Param(u32),
     /// Time t.
     Time,

@@ -11,7 +11,7 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 use super::expr::{Cas, ExprId, Node, SymId};
 
 impl Cas {
-    /// For each symbol s in `wrt`: sum_k cotangents[k] * d outputs[k] / d s.
+    /// For each symbol s in `wrt`: `sum_k cotangents[k] * d outputs[k] / d s`.
     pub fn vjp(
         &mut self,
         outputs: &[ExprId],
