@@ -3,7 +3,7 @@
 //! It knows nothing of the CAS. Generated models implement [`Kernels`];
 //! the tape interpreter ([`Interpreted`]) implements it too. [`Arm`] binds
 //! parameter values and provides [`Dynamics`]; [`integrate`] simulates,
-//! [`statics`] finds equilibria, [`modes`] linearises about them.
+//! [`statics`] finds equilibria, [`modes`](mod@modes) linearises about them.
 
 pub mod arm;
 pub mod integrate;
