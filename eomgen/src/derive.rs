@@ -29,6 +29,7 @@ pub fn derive(model: &Model) -> TapeSet {
         runtime::Tape::default()
     };
     let stiffness = cas.to_tape_hoisted(&eq.stiffness, &mut hoist);
+    let jacobian = cas.to_tape_hoisted(&eq.jacobian, &mut hoist);
     let loads = params
         .iter()
         .enumerate()
@@ -52,5 +53,6 @@ pub fn derive(model: &Model) -> TapeSet {
         derived,
         accel: accel_tape,
         stiffness,
+        jacobian,
     }
 }

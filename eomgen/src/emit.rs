@@ -25,7 +25,7 @@ fn lit(c: f64) -> TokenStream {
 fn is_leaf(op: &Op) -> bool {
     matches!(
         op,
-        Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Param(_) | Op::Time
+        Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Qdd(_) | Op::Param(_) | Op::Time
     )
 }
 
@@ -90,6 +90,10 @@ impl<'a> KernelEmitter<'a> {
             Op::Qd(k) => {
                 let k = k as usize;
                 quote!(qd[#k])
+            }
+            Op::Qdd(k) => {
+                let k = k as usize;
+                quote!(qdd[#k])
             }
             Op::Param(k) => {
                 let k = k as usize;
@@ -255,12 +259,12 @@ impl<'a> KernelEmitter<'a> {
             chunks.push(quote! {
                 #[inline(never)]
                 #[allow(unused_variables, clippy::all)]
-                fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params],
+                fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], p: &[f64; #n_params],
                       w: &mut [f64; #n_spill], out: &mut [f64; #n_out]) {
                     #(#body)*
                 }
             });
-            calls.push(quote!(#f(t, q, qd, p, w, out);));
+            calls.push(quote!(#f(t, q, qd, qdd, p, w, out);));
         }
         let f = Ident::new(name, Span::call_site());
         let doc = format!(
@@ -281,7 +285,7 @@ impl<'a> KernelEmitter<'a> {
         };
         quote! {
             #[doc = #doc]
-            pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+            pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
                 #workspace
                 #(#calls)*
             }
@@ -334,7 +338,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         let f = Ident::new(name, Span::call_site());
         let variant = Ident::new(&format!("{kind:?}"), Span::call_site());
         arms.push(quote! {
-            KernelKind::#variant => #f(inp.t, q, qd, p, out.try_into().expect("output length")),
+            KernelKind::#variant => #f(inp.t, q, qd, qdd, p, out.try_into().expect("output length")),
         });
     }
     let tokens = quote! {
@@ -383,6 +387,13 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                 let q: &[f64; #dof] = inp.q.try_into().expect("q has DOF entries");
                 let qd: &[f64; #dof] = inp.qd.try_into().expect("qd has DOF entries");
                 let p: &[f64; #n_params] = inp.p.try_into().expect("parameter vector length");
+                // Only the Jacobian kernel reads accelerations.
+                let no_qdd = [0.0f64; #dof];
+                let qdd: &[f64; #dof] = if inp.qdd.is_empty() {
+                    &no_qdd
+                } else {
+                    inp.qdd.try_into().expect("qdd has DOF entries")
+                };
                 match kind {
                     #(#arms)*
                 }

@@ -33,6 +33,9 @@ pub trait Dynamics {
     /// Solve M x = b in place for x, M given as the packed upper triangle
     /// (the `Mass` layout); false unless M is positive definite.
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool;
+    /// The `Jacobian` kernel (dh/dq, dh/dqd, d(M qdd)/dq) at the given
+    /// accelerations.
+    fn jacobian_parts(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]);
     /// The base parameter values (layout `info().parameters`).
     fn base_params(&self) -> &[f64];
     /// Replace the base parameters; the derived ones are recomputed.
@@ -94,6 +97,7 @@ impl<K: Kernels> Arm<K> {
             t,
             q,
             qd,
+            qdd: &[],
             p: &self.params,
         };
         self.kernels.eval(kind, &inp, &mut packed);
@@ -112,6 +116,7 @@ fn derived_params<K: Kernels + ?Sized>(kernels: &K, base: &[f64]) -> Vec<f64> {
         t: 0.0,
         q: &zeros,
         qd: &zeros,
+        qdd: &[],
         p: &extended,
     };
     kernels.eval(KernelKind::Derived, &inp, &mut derived);
@@ -164,6 +169,7 @@ impl<K: Kernels> Dynamics for Arm<K> {
                 t,
                 q,
                 qd,
+                qdd: &[],
                 p: &self.params,
             },
             out,
@@ -171,6 +177,16 @@ impl<K: Kernels> Dynamics for Arm<K> {
     }
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
         self.kernels.solve_mass(packed, b, ws)
+    }
+    fn jacobian_parts(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        let inp = Inputs {
+            t,
+            q,
+            qd,
+            qdd,
+            p: &self.params,
+        };
+        self.kernels.eval(KernelKind::Jacobian, &inp, out);
     }
     fn base_params(&self) -> &[f64] {
         &self.params[..self.kernels.info().parameters.len()]

@@ -1,45 +1,89 @@
 //! Time integration of an arm, on the `differential-equations` crate.
 //!
-//! The state is x = [q, qd]; the right-hand side solves M qdd = -h by
-//! Cholesky. Failures are explained: where, why, and what to try.
+//! The state is x = [q, qd]; the right-hand side solves M qdd = -h (see
+//! `accelerations`), and implicit methods get the analytic Jacobian
+//! (`rhs_jacobian`). Failures are explained: where, why, and what to try.
+//!
+//! Explicit methods carry the state as a `Vec`. The crate's implicit methods
+//! (Radau5, BDF, DIRK) only work with fixed-size states (their buffers start
+//! as `Y::zeros()`, which is empty for a `Vec`), so implicit runs use an
+//! array `[f64; P]` with P the next size of [`IMPLICIT_SIZES`]; the extra
+//! components are inert (x' = 0, zero Jacobian rows) and cost no accuracy.
 
 use std::cell::{Cell, RefCell};
 use std::time::Instant;
 
 use differential_equations::prelude::*;
 use differential_equations::solout::EvenSolout;
+use nalgebra::DMatrix;
 use serde::Serialize;
 
 use crate::arm::{AccelError, Dynamics, Workspace, accelerations};
+use crate::jacobian::rhs_jacobian;
 
-/// Integrators available now. Names are the CLI's and the model files'.
+/// Integrators. Names are the CLI's and the model files'.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Solver {
-    /// Adaptive Dormand-Prince 5(4).
+    /// Adaptive Dormand-Prince 5(4), explicit.
     Dopri5,
-    /// Classic fixed-step Runge-Kutta 4.
+    /// Adaptive Dormand-Prince 8(5,3), explicit.
+    Dop853,
+    /// Classic fixed-step Runge-Kutta 4, explicit.
     Rk4,
+    /// Fixed-step explicit Euler.
+    Euler,
+    /// Radau IIA order 5, implicit, L-stable, adaptive (stiff systems).
+    Radau5,
+    /// Variable-order BDF 1-5, implicit, adaptive (the ode15s family).
+    Bdf,
+    /// ESDIRK 3(2) 4-stage, L-stable, adaptive (the ode23tb family).
+    Esdirk,
 }
 
 impl Solver {
-    pub const NAMES: [&'static str; 2] = ["dopri5", "rk4"];
+    pub const NAMES: [&'static str; 7] = [
+        "dopri5", "dop853", "rk4", "euler", "radau5", "bdf", "esdirk",
+    ];
 
     pub fn parse(s: &str) -> Option<Self> {
-        match s {
-            "dopri5" => Some(Self::Dopri5),
-            "rk4" => Some(Self::Rk4),
-            _ => None,
-        }
+        Some(match s {
+            "dopri5" => Self::Dopri5,
+            "dop853" => Self::Dop853,
+            "rk4" => Self::Rk4,
+            "euler" => Self::Euler,
+            "radau5" => Self::Radau5,
+            "bdf" => Self::Bdf,
+            "esdirk" => Self::Esdirk,
+            _ => return None,
+        })
     }
 
     pub fn name(self) -> &'static str {
         match self {
             Self::Dopri5 => "dopri5",
+            Self::Dop853 => "dop853",
             Self::Rk4 => "rk4",
+            Self::Euler => "euler",
+            Self::Radau5 => "radau5",
+            Self::Bdf => "bdf",
+            Self::Esdirk => "esdirk",
         }
     }
+
+    /// Fixed-step methods (no error estimate: `dt` sets the step).
+    pub fn fixed_step(self) -> bool {
+        matches!(self, Self::Rk4 | Self::Euler)
+    }
+
+    /// Implicit methods (they use the analytic Jacobian).
+    pub fn implicit(self) -> bool {
+        matches!(self, Self::Radau5 | Self::Bdf | Self::Esdirk)
+    }
 }
+
+/// State lengths (2 x DOF, padded) the implicit methods are compiled for.
+pub const IMPLICIT_SIZES: [usize; 10] = [4, 8, 12, 16, 24, 32, 48, 64, 96, 128];
 
 #[derive(Clone, Debug)]
 pub struct SimOptions {
@@ -82,6 +126,7 @@ pub struct SimStats {
     pub steps: usize,
     pub rejected_steps: usize,
     pub rhs_evaluations: usize,
+    pub jacobian_evaluations: usize,
     pub wall_s: f64,
 }
 
@@ -106,35 +151,94 @@ impl std::fmt::Display for SimFailure {
     }
 }
 
-/// The first-order system x' = f(t, x) of an arm.
+/// A state the integrators can carry: a `Vec` or a fixed-size array.
+pub trait StateVec:
+    differential_equations::traits::State<f64> + AsRef<[f64]> + AsMut<[f64]>
+{
+}
+impl<Y: differential_equations::traits::State<f64> + AsRef<[f64]> + AsMut<[f64]>> StateVec for Y {}
+
+/// The first-order system x' = f(t, x) of an arm; components past 2 n are
+/// padding.
 struct ArmOde<'a, D: ?Sized> {
     arm: &'a D,
     n: usize,
     ws: RefCell<Workspace>,
     qdd: RefCell<Vec<f64>>,
     evals: Cell<usize>,
+    jac_evals: Cell<usize>,
+    jac: RefCell<DMatrix<f64>>,
     first_error: RefCell<Option<AccelError>>,
     /// Set when a right-hand side failed since the last accepted step.
     failed_in_step: Cell<bool>,
 }
 
-impl<D: Dynamics + ?Sized> ODE<f64, Vec<f64>> for ArmOde<'_, D> {
-    fn diff(&self, t: f64, x: &Vec<f64>, dx: &mut Vec<f64>) {
+impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
+    fn new(arm: &'a D) -> Self {
+        let n = arm.dof();
+        Self {
+            arm,
+            n,
+            ws: RefCell::new(Workspace::new(n)),
+            qdd: RefCell::new(vec![0.0; n]),
+            evals: Cell::new(0),
+            jac_evals: Cell::new(0),
+            jac: RefCell::new(DMatrix::zeros(2 * n, 2 * n)),
+            first_error: RefCell::new(None),
+            failed_in_step: Cell::new(false),
+        }
+    }
+
+    fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
         self.evals.set(self.evals.get() + 1);
         let n = self.n;
-        let (q, qd) = x.split_at(n);
+        let (q, rest) = x.split_at(n);
+        let qd = &rest[..n];
         dx[..n].copy_from_slice(qd);
+        dx[2 * n..].fill(0.0);
         let mut qdd = self.qdd.borrow_mut();
         match accelerations(self.arm, &mut self.ws.borrow_mut(), t, q, qd, &mut qdd) {
-            Ok(()) => dx[n..].copy_from_slice(&qdd),
+            Ok(()) => dx[n..2 * n].copy_from_slice(&qdd),
             Err(e) => {
                 // NaN makes an adaptive method reject the step; the record
                 // explains the failure if the method then gives up.
                 self.first_error.borrow_mut().get_or_insert(e);
                 self.failed_in_step.set(true);
-                dx[n..].fill(f64::NAN);
+                dx[n..2 * n].fill(f64::NAN);
             }
         }
+    }
+
+    fn jacobian_into(&self, t: f64, x: &[f64], j: &mut Matrix<f64>) {
+        self.jac_evals.set(self.jac_evals.get() + 1);
+        let m = 2 * self.n;
+        let mut jac = self.jac.borrow_mut();
+        let ok = match rhs_jacobian(self.arm, &mut self.ws.borrow_mut(), t, &x[..m], &mut jac) {
+            Ok(_) => true,
+            Err(e) => {
+                self.first_error.borrow_mut().get_or_insert(e);
+                false
+            }
+        };
+        for r in 0..x.len() {
+            for c in 0..x.len() {
+                j[(r, c)] = match (r < m && c < m, ok) {
+                    (true, true) => jac[(r, c)],
+                    (true, false) => f64::NAN,
+                    (false, _) => 0.0,
+                };
+            }
+        }
+    }
+}
+
+impl<D: Dynamics + ?Sized, Y: StateVec> ODE<f64, Y> for ArmOde<'_, D> {
+    fn diff(&self, t: f64, x: &Y, dx: &mut Y) {
+        self.rhs(t, x.as_ref(), dx.as_mut());
+    }
+
+    fn jacobian(&self, t: f64, x: &Y, j: &mut Matrix<f64>) {
+        self.jacobian_into(t, x.as_ref(), j);
     }
 }
 
@@ -149,21 +253,21 @@ struct Recorder<'a> {
     fixed_step: bool,
 }
 
-impl Solout<f64, Vec<f64>> for Recorder<'_> {
+impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
     fn solout<I>(
         &mut self,
         t_curr: f64,
         t_prev: f64,
-        y_curr: &Vec<f64>,
-        y_prev: &Vec<f64>,
+        y_curr: &Y,
+        y_prev: &Y,
         interpolator: &mut I,
-        solution: &mut Solution<f64, Vec<f64>>,
-    ) -> ControlFlag<f64, Vec<f64>>
+        solution: &mut Solution<f64, Y>,
+    ) -> ControlFlag<f64, Y>
     where
-        I: Interpolation<f64, Vec<f64>> + ?Sized,
+        I: Interpolation<f64, Y> + ?Sized,
     {
         let rhs_failed = self.failed_in_step.replace(false) && self.fixed_step;
-        if rhs_failed || y_curr.iter().any(|v| !v.is_finite()) {
+        if rhs_failed || y_curr.as_ref().iter().any(|v| !v.is_finite()) {
             self.blown_up.set(Some(t_prev));
             return ControlFlag::Terminate;
         }
@@ -171,6 +275,8 @@ impl Solout<f64, Vec<f64>> for Recorder<'_> {
             .solout(t_curr, t_prev, y_curr, y_prev, interpolator, solution)
     }
 }
+
+type Outcome<Y> = Result<Solution<f64, Y>, Error<f64, Y>>;
 
 /// Integrate from x0 = [q0, qd0] over [0, t_end].
 pub fn simulate<D: Dynamics + ?Sized>(
@@ -180,50 +286,162 @@ pub fn simulate<D: Dynamics + ?Sized>(
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let n = arm.dof();
     assert_eq!(x0.len(), 2 * n, "state must be [q, qd]");
-    let ode = ArmOde {
-        arm,
-        n,
-        ws: RefCell::new(Workspace::new(n)),
-        qdd: RefCell::new(vec![0.0; n]),
-        evals: Cell::new(0),
-        first_error: RefCell::new(None),
-        failed_in_step: Cell::new(false),
-    };
+    if !opts.solver.implicit() {
+        return run_explicit(arm, x0, opts);
+    }
+    macro_rules! sized {
+        ($($p:literal),*) => {
+            $(if x0.len() <= $p {
+                return run_implicit::<D, $p>(arm, x0, opts);
+            })*
+        };
+    }
+    sized!(4, 8, 12, 16, 24, 32, 48, 64, 96, 128);
+    Err(Box::new(SimFailure {
+        t_reached: 0.0,
+        reason: format!(
+            "the implicit solvers are compiled for up to {} coordinates, this arm has {n}",
+            IMPLICIT_SIZES[IMPLICIT_SIZES.len() - 1] / 2
+        ),
+        suggestion: "use --solver dopri5, or fewer elements".into(),
+        state: x0,
+        trajectory: Trajectory::default(),
+        stats: SimStats {
+            solver: opts.solver,
+            steps: 0,
+            rejected_steps: 0,
+            rhs_evaluations: 0,
+            jacobian_evaluations: 0,
+            wall_s: 0.0,
+        },
+    }))
+}
+
+fn run_explicit<D: Dynamics + ?Sized>(
+    arm: &D,
+    x0: Vec<f64>,
+    opts: &SimOptions,
+) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
+    let ode = ArmOde::new(arm);
     let blown_up = Cell::new(None);
     let recorder = Recorder {
         even: EvenSolout::new(opts.output_dt, 0.0, opts.t_end),
         blown_up: &blown_up,
         failed_in_step: &ode.failed_in_step,
-        fixed_step: matches!(opts.solver, Solver::Rk4),
+        fixed_step: opts.solver.fixed_step(),
     };
     let start = Instant::now();
     let problem = IVP::ode(&ode, 0.0, opts.t_end, x0.clone());
-    let result = match opts.solver {
+    let fixed_steps = opts
+        .max_steps
+        .max((opts.t_end / opts.dt).ceil() as usize + 2);
+    let (rtol, atol, max) = (opts.rtol, opts.atol, opts.max_steps);
+    let result: Outcome<Vec<f64>> = match opts.solver {
         Solver::Dopri5 => problem
             .method(
                 ExplicitRungeKutta::dopri5()
-                    .rtol(opts.rtol)
-                    .atol(opts.atol)
-                    .max_steps(opts.max_steps),
+                    .rtol(rtol)
+                    .atol(atol)
+                    .max_steps(max),
+            )
+            .solout(recorder)
+            .solve(),
+        Solver::Dop853 => problem
+            .method(
+                ExplicitRungeKutta::dop853()
+                    .rtol(rtol)
+                    .atol(atol)
+                    .max_steps(max),
             )
             .solout(recorder)
             .solve(),
         Solver::Rk4 => problem
+            .method(ExplicitRungeKutta::rk4(opts.dt).max_steps(fixed_steps))
+            .solout(recorder)
+            .solve(),
+        Solver::Euler => problem
+            .method(ExplicitRungeKutta::euler(opts.dt).max_steps(fixed_steps))
+            .solout(recorder)
+            .solve(),
+        Solver::Radau5 | Solver::Bdf | Solver::Esdirk => {
+            unreachable!("implicit methods run on arrays")
+        }
+    };
+    finish(result, &ode, blown_up.get(), &x0, opts, start)
+}
+
+fn run_implicit<D: Dynamics + ?Sized, const P: usize>(
+    arm: &D,
+    x0: Vec<f64>,
+    opts: &SimOptions,
+) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
+    let ode = ArmOde::new(arm);
+    let blown_up = Cell::new(None);
+    let recorder = Recorder {
+        even: EvenSolout::new(opts.output_dt, 0.0, opts.t_end),
+        blown_up: &blown_up,
+        failed_in_step: &ode.failed_in_step,
+        fixed_step: false,
+    };
+    let mut y0 = [0.0; P];
+    y0[..x0.len()].copy_from_slice(&x0);
+    let start = Instant::now();
+    let problem = IVP::ode(&ode, 0.0, opts.t_end, y0);
+    let (rtol, atol, max) = (opts.rtol, opts.atol, opts.max_steps);
+    let result: Outcome<[f64; P]> = match opts.solver {
+        Solver::Radau5 => problem
             .method(
-                ExplicitRungeKutta::rk4(opts.dt).max_steps(
-                    opts.max_steps
-                        .max((opts.t_end / opts.dt).ceil() as usize + 2),
-                ),
+                ImplicitRungeKutta::radau5()
+                    .rtol(rtol)
+                    .atol(atol)
+                    .max_steps(max),
             )
             .solout(recorder)
             .solve(),
+        // The crate's initial-step estimate fails for a state at rest (it
+        // returns a step below the minimum): start small, the controller grows it.
+        Solver::Bdf => problem
+            .method(
+                BackwardDifferentiationFormula::adaptive()
+                    .rtol(rtol)
+                    .atol(atol)
+                    .max_steps(max)
+                    .h0(1e-6 * opts.t_end),
+            )
+            .solout(recorder)
+            .solve(),
+        Solver::Esdirk => problem
+            .method(
+                DiagonallyImplicitRungeKutta::esdirk324l2sa()
+                    .rtol(rtol)
+                    .atol(atol)
+                    .max_steps(max),
+            )
+            .solout(recorder)
+            .solve(),
+        _ => unreachable!("explicit methods run on vectors"),
     };
+    finish(result, &ode, blown_up.get(), &x0, opts, start)
+}
+
+/// Turn the crate's outcome into a trajectory (padding dropped) or an
+/// explained failure.
+fn finish<D: Dynamics + ?Sized, Y: StateVec>(
+    result: Outcome<Y>,
+    ode: &ArmOde<'_, D>,
+    blown_up: Option<f64>,
+    x0: &[f64],
+    opts: &SimOptions,
+    start: Instant,
+) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let wall_s = start.elapsed().as_secs_f64();
+    let m = 2 * ode.n;
     let stats_of = |steps: usize, rejected: usize| SimStats {
         solver: opts.solver,
         steps,
         rejected_steps: rejected,
         rhs_evaluations: ode.evals.get(),
+        jacobian_evaluations: ode.jac_evals.get(),
         wall_s,
     };
     let cause = ode.first_error.borrow().clone();
@@ -231,19 +449,22 @@ pub fn simulate<D: Dynamics + ?Sized>(
         Some(e) => e.to_string(),
         None => fallback,
     };
+    let unpad = |y: &Y| y.as_ref()[..m].to_vec();
     match result {
         Ok(sol) => {
             let stats = stats_of(sol.steps.accepted, sol.steps.rejected);
-            let (t, x) = sol.into_tuple();
-            let traj = Trajectory { t, x };
-            if let Some(t_bad) = blown_up.get() {
-                let state = traj.x.last().cloned().unwrap_or(x0);
+            let traj = Trajectory {
+                t: sol.t.clone(),
+                x: sol.y.iter().map(unpad).collect(),
+            };
+            if let Some(t_bad) = blown_up {
+                let state = traj.x.last().cloned().unwrap_or_else(|| x0.to_vec());
                 return Err(Box::new(SimFailure {
                     t_reached: t_bad,
                     reason: explain("the state became non-finite (NaN or infinite)".into()),
                     suggestion: format!(
                         "the fixed step dt = {} is probably above the stability limit: reduce --dt, \
-                         or use the adaptive --solver dopri5",
+                         or use an adaptive solver (dopri5, or radau5 for stiff arms)",
                         opts.dt
                     ),
                     state,
@@ -257,27 +478,32 @@ pub fn simulate<D: Dynamics + ?Sized>(
             let (t_reached, state, reason, suggestion) = match e {
                 Error::StepSize { t, y } => (
                     t,
-                    y,
+                    unpad(&y),
                     explain("the step size fell below the smallest allowed step".into()),
-                    "the problem may be stiff or the tolerances too tight: relax --rtol/--atol, \
-                     or reduce the element count"
-                        .to_string(),
+                    if opts.solver.implicit() {
+                        "relax --rtol/--atol, or reduce the element count".to_string()
+                    } else {
+                        "the arm may be stiff: try --solver radau5 or bdf, relax --rtol/--atol, \
+                         or reduce the element count"
+                            .to_string()
+                    },
                 ),
                 Error::MaxSteps { t, y } => (
                     t,
-                    y,
+                    unpad(&y),
                     format!("the step budget of {} steps ran out", opts.max_steps),
-                    "shorten --t-end, relax --rtol/--atol, or reduce the element count".to_string(),
+                    "shorten --t-end, relax --rtol/--atol, or use an implicit solver for stiff arms"
+                        .to_string(),
                 ),
                 Error::Stiffness { t, y } => (
                     t,
-                    y,
-                    "the method detected stiffness".into(),
-                    "relax --rtol/--atol or reduce the element count".to_string(),
+                    unpad(&y),
+                    explain("the method detected stiffness".into()),
+                    "use an implicit solver: --solver radau5, bdf or esdirk".to_string(),
                 ),
                 other => (
                     0.0,
-                    x0.clone(),
+                    x0.to_vec(),
                     explain(format!("{other:?}")),
                     "check the model and the solver options".to_string(),
                 ),

@@ -19,6 +19,9 @@ use crate::tape::{Inputs, Tape};
 ///   (n values, all positive when M is positive definite): the mass solve
 ///   generated as straight-line code. Present only when `ModelInfo::accel`
 ///   (small arms); otherwise the runtime solves `MassBias` output.
+/// * `Jacobian`: the parts of the right-hand side's Jacobian, row-major
+///   n x n each: dh/dq, dh/dqd, then d(M a)/dq at a = the input `qdd`.
+///   With them J_q = -M^-1 (dh/dq + d(M qdd)/dq) and J_qd = -M^-1 dh/dqd.
 /// * `Stiffness`: K = d h(q, 0) / dq, row-major n x n: the tangent
 ///   stiffness of the static generalised forces (gravity, elastic, applied).
 /// * `Derived`: the derived parameters (parameter-only subexpressions the
@@ -32,11 +35,13 @@ pub enum KernelKind {
     Outputs,
     Accel,
     Stiffness,
+    Jacobian,
     Derived,
 }
 
 impl KernelKind {
-    pub const ALL: [KernelKind; 7] = [
+    pub const ALL: [KernelKind; 8] = [
+        Self::Jacobian,
         Self::Stiffness,
         Self::Accel,
         Self::Mass,
@@ -56,6 +61,7 @@ impl KernelKind {
             Self::Outputs => OUTPUT_NAMES.len(),
             Self::Derived => info.derived,
             Self::Stiffness => dof * dof,
+            Self::Jacobian => 3 * dof * dof,
             Self::Accel => {
                 if info.accel {
                     2 * dof
@@ -74,6 +80,7 @@ impl KernelKind {
             Self::Outputs => "outputs",
             Self::Derived => "derived",
             Self::Stiffness => "stiffness",
+            Self::Jacobian => "jacobian",
             Self::Accel => "accel",
         }
     }
@@ -143,6 +150,7 @@ pub struct TapeSet {
     /// Empty unless `info.accel`.
     pub accel: Tape,
     pub stiffness: Tape,
+    pub jacobian: Tape,
 }
 
 impl TapeSet {
@@ -155,6 +163,7 @@ impl TapeSet {
             KernelKind::Derived => &self.derived,
             KernelKind::Accel => &self.accel,
             KernelKind::Stiffness => &self.stiffness,
+            KernelKind::Jacobian => &self.jacobian,
         }
     }
 }

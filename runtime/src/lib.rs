@@ -7,6 +7,7 @@
 
 pub mod arm;
 pub mod integrate;
+pub mod jacobian;
 pub mod kernels;
 pub mod linalg;
 pub mod modes;
@@ -16,6 +17,7 @@ pub mod tape;
 
 pub use arm::{AccelError, Arm, Dynamics, Workspace, accelerations};
 pub use integrate::{SimFailure, SimOptions, SimStats, Solver, Trajectory, simulate};
+pub use jacobian::rhs_jacobian;
 pub use kernels::{
     CompiledModel, Interpreted, KernelKind, Kernels, ModelInfo, OUTPUT_NAMES, TapeSet,
 };

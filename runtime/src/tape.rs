@@ -22,6 +22,8 @@ pub enum Op {
     Q(u32),
     /// Generalised rate `qd[i]`.
     Qd(u32),
+    /// Generalised acceleration `qdd[i]` (read by the `Jacobian` kernel).
+    Qdd(u32),
     /// Runtime parameter `p[i]`.
     Param(u32),
     Time,
@@ -54,6 +56,9 @@ pub struct Inputs<'a> {
     pub t: f64,
     pub q: &'a [f64],
     pub qd: &'a [f64],
+    /// Accelerations; only the `Jacobian` kernel reads them (may be empty
+    /// for the others).
+    pub qdd: &'a [f64],
     pub p: &'a [f64],
 }
 
@@ -75,6 +80,7 @@ impl Tape {
                 Op::Const(c) => c,
                 Op::Q(i) => inp.q[i as usize],
                 Op::Qd(i) => inp.qd[i as usize],
+                Op::Qdd(i) => inp.qdd[i as usize],
                 Op::Param(i) => inp.p[i as usize],
                 Op::Time => inp.t,
                 Op::Add(a, b) => s(a) + s(b),
@@ -110,7 +116,7 @@ impl Tape {
             .filter(|op| {
                 !matches!(
                     op,
-                    Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Param(_) | Op::Time
+                    Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Qdd(_) | Op::Param(_) | Op::Time
                 )
             })
             .count()

