@@ -332,9 +332,10 @@ fn run_explicit<D: Dynamics + ?Sized>(
     };
     let start = Instant::now();
     let problem = IVP::ode(&ode, 0.0, opts.t_end, x0.clone());
+    // (dt only matters for fixed-step methods; t_end / 0 saturates.)
     let fixed_steps = opts
         .max_steps
-        .max((opts.t_end / opts.dt).ceil() as usize + 2);
+        .max(((opts.t_end / opts.dt).ceil() as usize).saturating_add(2));
     let (rtol, atol, max) = (opts.rtol, opts.atol, opts.max_steps);
     let result: Outcome<Vec<f64>> = match opts.solver {
         Solver::Dopri5 => problem
