@@ -539,3 +539,39 @@ pub fn modes(a: ModesArgs) -> Result<ExitCode> {
     println!("{}", serde_json::to_string_pretty(&v)?);
     Ok(ExitCode::SUCCESS)
 }
+
+#[derive(Args)]
+pub struct InspectArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// The configuration to linearise at (default: the static equilibrium).
+    #[arg(long, allow_hyphen_values = true)]
+    pub q: Option<String>,
+    /// Rates at that configuration (default 0).
+    #[arg(long, allow_hyphen_values = true)]
+    pub qd: Option<String>,
+    /// Print JSON (the only format; accepted for scripts).
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn inspect(a: InspectArgs) -> Result<ExitCode> {
+    let mut loaded = load(&a.model)?;
+    let n = loaded.arm.dof();
+    let coords = loaded.arm.info().coordinates.clone();
+    let q = match &a.q {
+        Some(_) => optional_vector("--q", &a.q, n, &coords)?,
+        None => equilibrium(&mut loaded, &None)?.q,
+    };
+    let qd = optional_vector("--qd", &a.qd, n, &coords)?;
+    let x: Vec<f64> = q.iter().chain(&qd).copied().collect();
+    let mut jac = DMatrix::zeros(2 * n, 2 * n);
+    runtime::rhs_jacobian(&*loaded.arm, &mut Workspace::new(n), 0.0, &x, &mut jac)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", loaded.origin))?;
+    let report = runtime::analyse_stiffness(&jac);
+    let mut v = serde_json::to_value(&report)?;
+    v["model"] = json!(loaded.model.name);
+    v["q"] = json!(q);
+    println!("{}", serde_json::to_string_pretty(&v)?);
+    Ok(ExitCode::SUCCESS)
+}

@@ -54,6 +54,8 @@ enum Command {
     Static(commands::StaticArgs),
     /// Natural frequencies (and mode shapes) about the static equilibrium.
     Modes(commands::ModesArgs),
+    /// Stiffness analysis: eigenvalues, stiffness ratio, recommended solver.
+    Inspect(commands::InspectArgs),
 }
 
 fn main() -> ExitCode {
@@ -66,6 +68,7 @@ fn main() -> ExitCode {
         Command::Bench(a) => commands::bench(a),
         Command::Static(a) => commands::statics(a),
         Command::Modes(a) => commands::modes(a),
+        Command::Inspect(a) => commands::inspect(a),
     };
     match result {
         Ok(code) => code,

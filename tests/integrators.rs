@@ -97,3 +97,64 @@ fn damped_pcc_cantilever_with_the_adaptive_integrators() {
         ],
     );
 }
+
+#[test]
+fn stiffness_analysis_predicts_the_explicit_step() {
+    // The eigenvalue analysis at the equilibrium against what dopri5
+    // actually does: on a stiff arm its average step sits at the stability
+    // limit 3.3 / max |lambda|.
+    let sets = [
+        "segment.0.youngs_modulus=1e8",
+        "segment.0.bending_damping=1e-5",
+        "gravity=[0, -9.81, 0]",
+    ];
+    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    let mut l = load("cantilever", &overrides, BackendChoice::Auto, None).unwrap();
+    let n = l.arm.dof();
+    let eq = runtime::solve_static(
+        &mut *l.arm,
+        &vec![0.0; n],
+        &runtime::StaticOptions::default(),
+    )
+    .unwrap();
+    let x: Vec<f64> = eq.q.iter().copied().chain(vec![0.0; n]).collect();
+    let mut jac = nalgebra::DMatrix::zeros(2 * n, 2 * n);
+    runtime::rhs_jacobian(&*l.arm, &mut runtime::Workspace::new(n), 0.0, &x, &mut jac).unwrap();
+    let report = runtime::analyse_stiffness(&jac);
+    assert!(
+        report.stiffness_ratio > 1000.0,
+        "ratio {}",
+        report.stiffness_ratio
+    );
+    assert_eq!(report.class, "stiff");
+    assert_eq!(report.recommended_solver, "radau5");
+    let t_end = 0.05;
+    let opts = SimOptions {
+        t_end,
+        output_dt: t_end,
+        ..Default::default()
+    };
+    let (_, stats) = simulate(&*l.arm, x, &opts).unwrap();
+    let mean_step = t_end / stats.steps as f64;
+    let ratio = mean_step / report.stable_explicit_step_s;
+    assert!(
+        (0.5..2.0).contains(&ratio),
+        "dopri5 mean step {mean_step:e} vs predicted {:e}",
+        report.stable_explicit_step_s
+    );
+    // The double pendulum is not stiff: dopri5 is recommended.
+    let l = load("double_pendulum", &[], BackendChoice::Auto, None).unwrap();
+    let mut jac = nalgebra::DMatrix::zeros(4, 4);
+    runtime::rhs_jacobian(
+        &*l.arm,
+        &mut runtime::Workspace::new(2),
+        0.0,
+        &[0.0; 4],
+        &mut jac,
+    )
+    .unwrap();
+    assert_eq!(
+        runtime::analyse_stiffness(&jac).recommended_solver,
+        "dopri5"
+    );
+}

@@ -13,6 +13,7 @@ pub mod linalg;
 pub mod modes;
 pub mod special;
 pub mod statics;
+pub mod stiffness;
 pub mod tape;
 
 pub use arm::{AccelError, Arm, Dynamics, Workspace, accelerations};
@@ -24,4 +25,5 @@ pub use kernels::{
 pub use linalg::Ldlt;
 pub use modes::{Modes, ModesError, modes};
 pub use statics::{StaticError, StaticOptions, StaticSolution, solve_static};
+pub use stiffness::{StiffnessReport, analyse as analyse_stiffness};
 pub use tape::{Inputs, Op, Slot, Tape};
