@@ -292,6 +292,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         "rejected_steps": stats.rejected_steps,
         "rhs_evaluations": stats.rhs_evaluations,
         "jacobian_evaluations": stats.jacobian_evaluations,
+        "solver_switch": stats.switched,
         "wall_s": stats.wall_s,
         "status": if failure.is_some() { "failed" } else { "ok" },
         "failure": failure.as_ref().map(|f| f.1.clone()),
@@ -323,6 +324,14 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         stats.wall_s,
         out_dir.display()
     );
+    if let Some(sw) = &stats.switched {
+        eprintln!(
+            "auto: switched to {} at t = {} s ({})",
+            sw.to.name(),
+            sw.at_s,
+            sw.reason
+        );
+    }
     if let Some((msg, _)) = failure {
         eprintln!("error: {msg}");
         eprintln!(

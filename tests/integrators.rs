@@ -158,3 +158,56 @@ fn stiffness_analysis_predicts_the_explicit_step() {
         "dopri5"
     );
 }
+
+#[test]
+fn auto_stays_explicit_on_the_pendulum_and_switches_on_the_stiff_arm() {
+    let opts = SimOptions {
+        t_end: 0.5,
+        solver: Solver::Auto,
+        output_dt: 0.05,
+        ..Default::default()
+    };
+    let l = load("double_pendulum", &[], BackendChoice::Auto, None).unwrap();
+    let (_, stats) = simulate(&*l.arm, vec![0.5, 0.0, 0.0, 0.0], &opts).unwrap();
+    assert_eq!(stats.solver, Solver::Auto);
+    assert!(stats.switched.is_none(), "the double pendulum is not stiff");
+    assert_eq!(stats.jacobian_evaluations, 0, "dopri5 ran throughout");
+
+    let sets = [
+        "segment.0.youngs_modulus=1e8",
+        "segment.0.bending_damping=1e-5",
+        "gravity=[0, -9.81, 0]",
+    ];
+    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    let l = load("cantilever", &overrides, BackendChoice::Auto, None).unwrap();
+    let n = l.arm.dof();
+    let opts = SimOptions {
+        t_end: 0.2,
+        solver: Solver::Auto,
+        output_dt: 0.01,
+        ..Default::default()
+    };
+    let (traj, stats) = simulate(&*l.arm, vec![0.0; 2 * n], &opts).unwrap();
+    let switch = stats
+        .switched
+        .expect("the stiff arm switches to an implicit method");
+    assert_eq!(switch.to, Solver::Radau5);
+    assert!(switch.reason.contains("stiffness ratio"));
+    assert!(stats.jacobian_evaluations > 0);
+    // The same answer as dopri5 on its own, to the tolerance.
+    let explicit = SimOptions {
+        solver: Solver::Dopri5,
+        ..opts.clone()
+    };
+    let (reference, _) = simulate(&*l.arm, vec![0.0; 2 * n], &explicit).unwrap();
+    let (a, b) = (traj.x.last().unwrap(), reference.x.last().unwrap());
+    let scale = b[..n].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for i in 0..n {
+        assert!(
+            (a[i] - b[i]).abs() < 1e-3 * scale,
+            "q[{i}]: {} vs {}",
+            a[i],
+            b[i]
+        );
+    }
+}

@@ -39,11 +39,26 @@ pub enum Solver {
     Bdf,
     /// ESDIRK 3(2) 4-stage, L-stable, adaptive (the ode23tb family).
     Esdirk,
+    /// dopri5, switching to radau5 when the arm turns out stiff (checked
+    /// from the Jacobian's eigenvalues at the start and every
+    /// [`AUTO_CHECK_STEPS`] accepted steps).
+    Auto,
+}
+
+/// How often `auto` re-checks stiffness (accepted explicit steps).
+pub const AUTO_CHECK_STEPS: usize = 200;
+
+/// A change of solver made by `auto`.
+#[derive(Clone, Debug, Serialize)]
+pub struct SolverSwitch {
+    pub at_s: f64,
+    pub to: Solver,
+    pub reason: String,
 }
 
 impl Solver {
-    pub const NAMES: [&'static str; 7] = [
-        "dopri5", "dop853", "rk4", "euler", "radau5", "bdf", "esdirk",
+    pub const NAMES: [&'static str; 8] = [
+        "dopri5", "dop853", "rk4", "euler", "radau5", "bdf", "esdirk", "auto",
     ];
 
     pub fn parse(s: &str) -> Option<Self> {
@@ -55,6 +70,7 @@ impl Solver {
             "radau5" => Self::Radau5,
             "bdf" => Self::Bdf,
             "esdirk" => Self::Esdirk,
+            "auto" => Self::Auto,
             _ => return None,
         })
     }
@@ -68,6 +84,7 @@ impl Solver {
             Self::Radau5 => "radau5",
             Self::Bdf => "bdf",
             Self::Esdirk => "esdirk",
+            Self::Auto => "auto",
         }
     }
 
@@ -128,6 +145,8 @@ pub struct SimStats {
     pub rhs_evaluations: usize,
     pub jacobian_evaluations: usize,
     pub wall_s: f64,
+    /// Set when `auto` switched solvers.
+    pub switched: Option<SolverSwitch>,
 }
 
 /// An integration that gave up, with what was computed up to then.
@@ -251,7 +270,14 @@ struct Recorder<'a> {
     blown_up: &'a Cell<Option<f64>>,
     failed_in_step: &'a Cell<bool>,
     fixed_step: bool,
+    /// `auto`: called every AUTO_CHECK_STEPS accepted steps with the state
+    /// and the last step; Some(reason) stops the run for a switch.
+    watch: Option<&'a Watch<'a>>,
+    switch: &'a RefCell<Option<(f64, Vec<f64>, String)>>,
+    accepted: usize,
 }
+
+type Watch<'a> = dyn Fn(&[f64], f64) -> Option<String> + 'a;
 
 impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
     fn solout<I>(
@@ -271,8 +297,18 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
             self.blown_up.set(Some(t_prev));
             return ControlFlag::Terminate;
         }
-        self.even
-            .solout(t_curr, t_prev, y_curr, y_prev, interpolator, solution)
+        let flag = self
+            .even
+            .solout(t_curr, t_prev, y_curr, y_prev, interpolator, solution);
+        self.accepted += 1;
+        if let Some(watch) = self.watch
+            && self.accepted.is_multiple_of(AUTO_CHECK_STEPS)
+            && let Some(reason) = watch(y_curr.as_ref(), t_curr - t_prev)
+        {
+            *self.switch.borrow_mut() = Some((t_curr, y_curr.as_ref().to_vec(), reason));
+            return ControlFlag::Terminate;
+        }
+        flag
     }
 }
 
@@ -286,19 +322,31 @@ pub fn simulate<D: Dynamics + ?Sized>(
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let n = arm.dof();
     assert_eq!(x0.len(), 2 * n, "state must be [q, qd]");
-    if !opts.solver.implicit() {
-        return run_explicit(arm, x0, opts);
+    match opts.solver {
+        Solver::Auto => run_auto(arm, x0, opts),
+        s if s.implicit() => simulate_implicit(arm, 0.0, x0, opts),
+        _ => run_explicit(arm, 0.0, x0, opts, None, &RefCell::new(None)),
     }
+}
+
+/// An implicit run from (t0, x0), on the smallest fixed-size state that fits.
+fn simulate_implicit<D: Dynamics + ?Sized>(
+    arm: &D,
+    t0: f64,
+    x0: Vec<f64>,
+    opts: &SimOptions,
+) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
+    let n = arm.dof();
     macro_rules! sized {
         ($($p:literal),*) => {
             $(if x0.len() <= $p {
-                return run_implicit::<D, $p>(arm, x0, opts);
+                return run_implicit::<D, $p>(arm, t0, x0, opts);
             })*
         };
     }
     sized!(4, 8, 12, 16, 24, 32, 48, 64, 96, 128);
     Err(Box::new(SimFailure {
-        t_reached: 0.0,
+        t_reached: t0,
         reason: format!(
             "the implicit solvers are compiled for up to {} coordinates, this arm has {n}",
             IMPLICIT_SIZES[IMPLICIT_SIZES.len() - 1] / 2
@@ -313,14 +361,105 @@ pub fn simulate<D: Dynamics + ?Sized>(
             rhs_evaluations: 0,
             jacobian_evaluations: 0,
             wall_s: 0.0,
+            switched: None,
         },
     }))
 }
 
-fn run_explicit<D: Dynamics + ?Sized>(
+/// dopri5 while the arm is not stiff, radau5 once it is.
+fn run_auto<D: Dynamics + ?Sized>(
     arm: &D,
     x0: Vec<f64>,
     opts: &SimOptions,
+) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
+    let n = arm.dof();
+    let analyse_at = |t: f64, x: &[f64]| {
+        let mut jac = DMatrix::zeros(2 * n, 2 * n);
+        rhs_jacobian(arm, &mut Workspace::new(n), t, &x[..2 * n], &mut jac)
+            .ok()
+            .map(|_| crate::stiffness::analyse(&jac))
+    };
+    let implicit_opts = SimOptions {
+        solver: Solver::Radau5,
+        ..opts.clone()
+    };
+    let as_auto = |mut stats: SimStats, switch: SolverSwitch| {
+        stats.solver = Solver::Auto;
+        stats.switched = Some(switch);
+        stats
+    };
+    if let Some(r) = analyse_at(0.0, &x0)
+        && r.stiffness_ratio > 1000.0
+    {
+        let (traj, stats) = simulate_implicit(arm, 0.0, x0, &implicit_opts)?;
+        let reason = format!("stiff from the start: {}", r.reason);
+        return Ok((
+            traj,
+            as_auto(
+                stats,
+                SolverSwitch {
+                    at_s: 0.0,
+                    to: Solver::Radau5,
+                    reason,
+                },
+            ),
+        ));
+    }
+    let watch = |x: &[f64], h: f64| -> Option<String> {
+        let r = analyse_at(0.0, x)?;
+        (r.stiffness_ratio > 1000.0 && h > 0.5 * r.stable_explicit_step_s).then(|| {
+            format!(
+                "dopri5 held at the stability limit ({h:.2e} s steps) of a stiff arm: {}",
+                r.reason
+            )
+        })
+    };
+    let switch = RefCell::new(None);
+    let explicit_opts = SimOptions {
+        solver: Solver::Dopri5,
+        ..opts.clone()
+    };
+    let (mut traj, mut stats) = run_explicit(arm, 0.0, x0, &explicit_opts, Some(&watch), &switch)?;
+    stats.solver = Solver::Auto;
+    let Some((t_switch, x_switch, reason)) = switch.take() else {
+        return Ok((traj, stats));
+    };
+    let (rest, more) = simulate_implicit(arm, t_switch, x_switch, &implicit_opts)?;
+    for (t, x) in rest.t.into_iter().zip(rest.x) {
+        if traj.t.last().is_none_or(|&last| t > last) {
+            traj.t.push(t);
+            traj.x.push(x);
+        }
+    }
+    let merged = SimStats {
+        solver: Solver::Auto,
+        steps: stats.steps + more.steps,
+        rejected_steps: stats.rejected_steps + more.rejected_steps,
+        rhs_evaluations: stats.rhs_evaluations + more.rhs_evaluations,
+        jacobian_evaluations: stats.jacobian_evaluations + more.jacobian_evaluations,
+        wall_s: stats.wall_s + more.wall_s,
+        switched: None,
+    };
+    Ok((
+        traj,
+        as_auto(
+            merged,
+            SolverSwitch {
+                at_s: t_switch,
+                to: Solver::Radau5,
+                reason,
+            },
+        ),
+    ))
+}
+
+fn run_explicit<D: Dynamics + ?Sized>(
+    arm: &D,
+    t0: f64,
+    x0: Vec<f64>,
+    opts: &SimOptions,
+    watch: Option<&Watch<'_>>,
+    switch: &RefCell<Option<(f64, Vec<f64>, String)>>,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let ode = ArmOde::new(arm);
     let blown_up = Cell::new(None);
@@ -329,9 +468,12 @@ fn run_explicit<D: Dynamics + ?Sized>(
         blown_up: &blown_up,
         failed_in_step: &ode.failed_in_step,
         fixed_step: opts.solver.fixed_step(),
+        watch,
+        switch,
+        accepted: 0,
     };
     let start = Instant::now();
-    let problem = IVP::ode(&ode, 0.0, opts.t_end, x0.clone());
+    let problem = IVP::ode(&ode, t0, opts.t_end, x0.clone());
     // (dt only matters for fixed-step methods; t_end / 0 saturates.)
     let fixed_steps = opts
         .max_steps
@@ -364,8 +506,8 @@ fn run_explicit<D: Dynamics + ?Sized>(
             .method(ExplicitRungeKutta::euler(opts.dt).max_steps(fixed_steps))
             .solout(recorder)
             .solve(),
-        Solver::Radau5 | Solver::Bdf | Solver::Esdirk => {
-            unreachable!("implicit methods run on arrays")
+        Solver::Radau5 | Solver::Bdf | Solver::Esdirk | Solver::Auto => {
+            unreachable!("implicit methods run on arrays, auto dispatches")
         }
     };
     finish(result, &ode, blown_up.get(), &x0, opts, start)
@@ -373,21 +515,26 @@ fn run_explicit<D: Dynamics + ?Sized>(
 
 fn run_implicit<D: Dynamics + ?Sized, const P: usize>(
     arm: &D,
+    t0: f64,
     x0: Vec<f64>,
     opts: &SimOptions,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let ode = ArmOde::new(arm);
     let blown_up = Cell::new(None);
+    let no_switch = RefCell::new(None);
     let recorder = Recorder {
         even: EvenSolout::new(opts.output_dt, 0.0, opts.t_end),
         blown_up: &blown_up,
         failed_in_step: &ode.failed_in_step,
         fixed_step: false,
+        watch: None,
+        switch: &no_switch,
+        accepted: 0,
     };
     let mut y0 = [0.0; P];
     y0[..x0.len()].copy_from_slice(&x0);
     let start = Instant::now();
-    let problem = IVP::ode(&ode, 0.0, opts.t_end, y0);
+    let problem = IVP::ode(&ode, t0, opts.t_end, y0);
     let (rtol, atol, max) = (opts.rtol, opts.atol, opts.max_steps);
     let result: Outcome<[f64; P]> = match opts.solver {
         Solver::Radau5 => problem
@@ -444,6 +591,7 @@ fn finish<D: Dynamics + ?Sized, Y: StateVec>(
         rhs_evaluations: ode.evals.get(),
         jacobian_evaluations: ode.jac_evals.get(),
         wall_s,
+        switched: None,
     };
     let cause = ode.first_error.borrow().clone();
     let explain = |fallback: String| match &cause {
