@@ -44,8 +44,8 @@ pub struct StaticSolution {
 
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error(
-    "the static solve did not converge: the last converged load fraction is {last_fraction:.4} \\
-     (0 = unloaded, 1 = the full load); {reason}. Try more elements, a smaller load, or a starting \\
+    "the static solve did not converge: the last converged load fraction is {last_fraction:.4} \
+     (0 = unloaded, 1 = the full load); {reason}. Try more elements, a smaller load, or a starting \
      configuration closer to the answer (--q0)"
 )]
 pub struct StaticError {
