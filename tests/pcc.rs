@@ -318,5 +318,8 @@ fn static_failure_names_the_last_converged_load_fraction() {
         "{err}"
     );
     assert!(err.contains("singular"), "{err}");
-    assert!(!err.contains('\\') && !err.contains("     "), "message is one clean line: {err}");
+    assert!(
+        !err.contains('\\') && !err.contains("     "),
+        "message is one clean line: {err}"
+    );
 }
