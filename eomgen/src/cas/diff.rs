@@ -8,7 +8,7 @@
 
 use std::collections::HashMap;
 
-use super::expr::{Cas, ExprId, Func, Node, SymId};
+use super::expr::{Cas, ExprId, Func, Node, SymId, Variables};
 
 impl Cas {
     /// d e / d s, memoised across calls.
@@ -64,11 +64,29 @@ impl Cas {
         if let Some(&d) = memo.get(&e) {
             return d;
         }
-        let d = match self.node(e) {
-            Node::Sym(s) => match seed.get(s) {
+        let node = self.node(e).clone();
+        let d = match node {
+            Node::Sym(s) => match seed.get(&s) {
                 Some(&v) => v,
                 None => self.zero(),
             },
+            // A bound function of one variable, f(x): f'(x) xdot with f'
+            // bound too, so that second derivatives read f''(x) xdot^2 off
+            // a chain of bound scalars instead of re-expanding products of
+            // f's pieces (the local geometry of a pcc element).
+            Node::Bind(x) if matches!(self.variables(x), Variables::One(_)) => {
+                let Variables::One(s) = self.variables(x) else {
+                    unreachable!()
+                };
+                match seed.get(&s) {
+                    Some(&rate) => {
+                        let fp = self.diff_sym(x, s);
+                        let fp = self.bind(fp);
+                        self.mul(fp, rate)
+                    }
+                    None => self.zero(),
+                }
+            }
             _ => self.chain_rule(
                 e,
                 &mut |cas, child| cas.directional(child, seed, memo),

@@ -114,6 +114,26 @@ pub struct Cas {
     symbols: Vec<(String, SymKind)>,
     sym_index: HashMap<String, SymId>,
     pub(crate) diff_memo: HashMap<(ExprId, SymId), ExprId>,
+    pub(crate) variables_memo: HashMap<ExprId, Variables>,
+}
+
+/// The non-parameter symbols an expression depends on, as far as the time
+/// derivative cares: none, exactly one, or more.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(crate) enum Variables {
+    None,
+    One(SymId),
+    Many,
+}
+
+impl Variables {
+    fn union(self, other: Self) -> Self {
+        match (self, other) {
+            (Self::None, x) | (x, Self::None) => x,
+            (Self::One(a), Self::One(b)) if a == b => Self::One(a),
+            _ => Self::Many,
+        }
+    }
 }
 
 impl Cas {
@@ -130,6 +150,32 @@ impl Cas {
         self.nodes.push(node.clone());
         self.index.insert(node, id);
         id
+    }
+
+    /// The variables (non-parameter symbols) `e` depends on, memoised.
+    pub(crate) fn variables(&mut self, e: ExprId) -> Variables {
+        if let Some(&v) = self.variables_memo.get(&e) {
+            return v;
+        }
+        let v = match self.node(e) {
+            Node::Const(_) => Variables::None,
+            Node::Sym(s) => match self.sym_kind(*s) {
+                SymKind::Param(_) => Variables::None,
+                _ => Variables::One(*s),
+            },
+            _ => {
+                let mut acc = Variables::None;
+                for c in self.children(e) {
+                    acc = acc.union(self.variables(c));
+                    if acc == Variables::Many {
+                        break;
+                    }
+                }
+                acc
+            }
+        };
+        self.variables_memo.insert(e, v);
+        v
     }
 
     pub fn node(&self, e: ExprId) -> &Node {

@@ -6,13 +6,17 @@
 //! one `Div`, and `x^2` becomes `x * x`. Identical instructions are emitted
 //! once.
 //!
+//! Sines and cosines of a bound angle plus an increment that several angles
+//! share (a pcc element turns its frame by theta/2 twice) come from the
+//! addition theorems: six flops instead of a `sin_cos` call each.
+//!
 //! With a [`Hoist`], every subexpression that depends on parameters alone
 //! (and the parameter-only part of each sum and product) is not computed in
 //! the kernel but read as a *derived parameter*: `Param(n_params + k)`. The
 //! derived parameters are computed once per parameter set by their own tape
 //! ([`Hoist::finish`]), not on every call.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use runtime::tape::{Op, Slot, Tape};
 
@@ -98,6 +102,8 @@ pub struct Lowerer<'a> {
     ops: Vec<Op>,
     numbering: HashMap<(u8, u64, u64), Slot>,
     done: HashMap<ExprId, Slot>,
+    /// Angle increments shared by two or more trigonometric arguments.
+    shared_increments: HashSet<ExprId>,
 }
 
 fn key(op: &Op) -> (u8, u64, u64) {
@@ -138,6 +144,7 @@ impl<'a> Lowerer<'a> {
             ops: Vec::new(),
             numbering: HashMap::new(),
             done: HashMap::new(),
+            shared_increments: HashSet::new(),
         }
     }
 
@@ -149,6 +156,7 @@ impl<'a> Lowerer<'a> {
             ops: Vec::new(),
             numbering: HashMap::new(),
             done: HashMap::new(),
+            shared_increments: HashSet::new(),
         }
     }
 
@@ -213,6 +221,14 @@ impl<'a> Lowerer<'a> {
                 self.lower_product(c, rest)
             }
             Node::Pow(b, x) => self.lower_pow(b, x),
+            Node::Func(f @ (Func::Sin | Func::Cos), x)
+                if self
+                    .split_angle(x)
+                    .is_some_and(|(_, rest)| self.shared_increments.contains(&rest)) =>
+            {
+                let (base, rest) = self.split_angle(x).expect("checked above");
+                self.lower_angle_sum(f == Func::Sin, base, rest)
+            }
             Node::Func(f, x) => {
                 let a = self.lower(x);
                 self.push(match f {
@@ -234,6 +250,75 @@ impl<'a> Lowerer<'a> {
         s
     }
 
+    /// An angle `x = base + rest` with `base` a bound angle (a frame's):
+    /// the split that the addition theorems use.
+    fn split_angle(&mut self, x: ExprId) -> Option<(ExprId, ExprId)> {
+        let sum = match self.cas.node(x) {
+            Node::Bind(y) => *y,
+            _ => x,
+        };
+        let Node::Add(terms) = self.cas.node(sum) else {
+            return None;
+        };
+        let terms = terms.clone();
+        let mut binds = terms
+            .iter()
+            .filter(|&&t| matches!(self.cas.node(t), Node::Bind(_)));
+        let base = *binds.next()?;
+        if binds.next().is_some() {
+            return None;
+        }
+        let rest: Vec<ExprId> = terms.into_iter().filter(|&t| t != base).collect();
+        Some((base, self.cas.add_all(&rest)))
+    }
+
+    /// sin or cos of base + rest by the addition theorems.
+    fn lower_angle_sum(&mut self, sine: bool, base: ExprId, rest: ExprId) -> Slot {
+        let (sb, cb) = (self.cas.sin(base), self.cas.cos(base));
+        let (sr, cr) = (self.cas.sin(rest), self.cas.cos(rest));
+        let [sb, cb, sr, cr] = [sb, cb, sr, cr].map(|e| self.lower(e));
+        if sine {
+            // sin b cos r + cos b sin r
+            let a = self.push(Op::Mul(sb, cr));
+            let b = self.push(Op::Mul(cb, sr));
+            self.push(Op::Add(a, b))
+        } else {
+            // cos b cos r - sin b sin r
+            let a = self.push(Op::Mul(cb, cr));
+            let b = self.push(Op::Mul(sb, sr));
+            self.push(Op::Sub(a, b))
+        }
+    }
+
+    /// Find the increments that two or more trigonometric arguments share.
+    fn find_shared_increments(&mut self, roots: &[ExprId]) {
+        let mut seen = HashSet::new();
+        let mut stack = roots.to_vec();
+        let mut angles = HashSet::new();
+        while let Some(e) = stack.pop() {
+            if !seen.insert(e) {
+                continue;
+            }
+            if let Node::Func(Func::Sin | Func::Cos, x) = self.cas.node(e) {
+                angles.insert(*x);
+            }
+            stack.extend(self.cas.children(e));
+        }
+        let mut uses: HashMap<ExprId, usize> = HashMap::new();
+        let mut angles: Vec<ExprId> = angles.into_iter().collect();
+        angles.sort();
+        for x in angles {
+            if let Some((_, rest)) = self.split_angle(x) {
+                *uses.entry(rest).or_default() += 1;
+            }
+        }
+        self.shared_increments = uses
+            .into_iter()
+            .filter(|&(_, n)| n >= 2)
+            .map(|(r, _)| r)
+            .collect();
+    }
+
     fn lower_sum(&mut self, xs: &[ExprId]) -> Slot {
         // (negated?, slot of the magnitude)
         let mut parts: Vec<(bool, Slot)> = Vec::with_capacity(xs.len());
@@ -247,6 +332,9 @@ impl<'a> Lowerer<'a> {
         } else {
             xs.to_vec()
         };
+        if let Some(factored) = self.factor_sum(&xs) {
+            return self.lower(factored);
+        }
         for &t in &xs {
             let hoisted = self.param_only(t);
             match self.cas.node(t) {
@@ -291,6 +379,67 @@ impl<'a> Lowerer<'a> {
                 self.push(Op::Neg(acc))
             }
         }
+    }
+
+    /// The factors of a term, without its numeric coefficient.
+    fn factors(&self, t: ExprId) -> Vec<ExprId> {
+        match self.cas.node(t) {
+            Node::Mul(fs) => fs
+                .iter()
+                .copied()
+                .filter(|&f| self.cas.as_const(f).is_none())
+                .collect(),
+            Node::Const(_) => Vec::new(),
+            _ => vec![t],
+        }
+    }
+
+    /// `f (sum of quotients) + rest` for the factor f that most terms share
+    /// (greedy multivariate Horner): derivatives come out of the CAS as sums
+    /// of products, and collecting, say, cos(phi) out of a dozen of them
+    /// saves a multiplication for each. None when no factor is shared.
+    fn factor_sum(&mut self, xs: &[ExprId]) -> Option<ExprId> {
+        let mut count: HashMap<ExprId, usize> = HashMap::new();
+        for &t in xs {
+            let mut fs = self.factors(t);
+            fs.sort();
+            fs.dedup();
+            for f in fs {
+                *count.entry(f).or_default() += 1;
+            }
+        }
+        let (&f, &n) = count
+            .iter()
+            .max_by_key(|&(&f, &n)| (n, std::cmp::Reverse(f)))?;
+        if n < 2 {
+            return None;
+        }
+        let mut quotients = Vec::new();
+        let mut rest = Vec::new();
+        for &t in xs {
+            if !self.factors(t).contains(&f) {
+                rest.push(t);
+                continue;
+            }
+            let q = match self.cas.node(t).clone() {
+                Node::Mul(fs) => {
+                    let i = fs.iter().position(|&x| x == f).expect("factor present");
+                    let others: Vec<ExprId> = fs
+                        .iter()
+                        .enumerate()
+                        .filter(|&(j, _)| j != i)
+                        .map(|(_, &x)| x)
+                        .collect();
+                    self.cas.mul_all(&others)
+                }
+                _ => self.cas.one(),
+            };
+            quotients.push(q);
+        }
+        let inner = self.cas.add_all(&quotients);
+        let product = self.cas.mul(f, inner);
+        rest.push(product);
+        Some(self.cas.add_all(&rest))
     }
 
     /// c * prod(factors), with negative constant powers moved to a divisor.
@@ -385,6 +534,7 @@ impl<'a> Lowerer<'a> {
 
     /// Lower all `outputs` and finish the tape.
     pub fn finish(mut self, outputs: &[ExprId]) -> Tape {
+        self.find_shared_increments(outputs);
         let outs: Vec<Slot> = outputs.iter().map(|&e| self.lower(e)).collect();
         Tape {
             ops: self.ops,

@@ -24,6 +24,7 @@
 
 use crate::cas::{Cas, ExprId};
 
+use super::chain::mass_by_composites;
 use super::system::System;
 
 /// The derived equations, as expressions.
@@ -61,7 +62,12 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     // one memo per batch, so chains are shared between bodies.
     let mut points: Vec<ExprId> = sys.bodies.iter().flat_map(|b| b.position).collect();
     points.extend(sys.point_forces.iter().flat_map(|f| f.point));
-    let velocities = cas.time_derivatives(&points, &pairs);
+    let n_points = points.len();
+    if let Some(chain) = &sys.chain {
+        points.extend(chain.links.iter().flat_map(|l| l.end));
+    }
+    let all_velocities = cas.time_derivatives(&points, &pairs);
+    let (velocities, link_velocities) = all_velocities.split_at(n_points);
     let conv_lin = cas.time_derivatives(&velocities[..3 * nb], &pairs);
     let omegas: Vec<ExprId> = sys.bodies.iter().flat_map(|b| b.omega).collect();
     let conv_ang = cas.time_derivatives(&omegas, &pairs);
@@ -72,7 +78,7 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     let mut momentum_cot = Vec::with_capacity(outs.len());
     let mut force_cot = Vec::with_capacity(outs.len() + 3 * sys.point_forces.len());
     for (b, body) in sys.bodies.iter().enumerate() {
-        let (v, a) = (triple(&velocities, b), triple(&conv_lin, b));
+        let (v, a) = (triple(velocities, b), triple(&conv_lin, b));
         for k in 0..3 {
             momentum_cot.push(cas.mul(body.mass, v[k]));
             let d = cas.sub(a[k], sys.gravity[k]);
@@ -98,19 +104,27 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     }
     force_cot.extend(angular_force);
     for (f, force) in sys.point_forces.iter().enumerate() {
-        let v = triple(&velocities, nb + f);
+        let v = triple(velocities, nb + f);
         outs.extend(v);
         force_cot.extend(force.force.map(|c| cas.neg(c)));
     }
 
-    // M: the Jacobian of the generalised momentum T^T Mbar T qd.
+    // M: by composite bodies for a chain, else the Jacobian of the
+    // generalised momentum T^T Mbar T qd (which the Jacobian kernel needs
+    // anyway).
     let momentum = cas.vjp(&outs[..6 * nb], &momentum_cot, &sys.coords.qd);
-    let mut mass = Vec::with_capacity(n * (n + 1) / 2);
-    for (i, &p) in momentum.iter().enumerate() {
-        for &qd in &sys.coords.qd[i..] {
-            mass.push(cas.diff(p, qd));
+    let mass = match &sys.chain {
+        Some(chain) => mass_by_composites(cas, sys, chain, velocities, link_velocities),
+        None => {
+            let mut mass = Vec::with_capacity(n * (n + 1) / 2);
+            for (i, &p) in momentum.iter().enumerate() {
+                for &qd in &sys.coords.qd[i..] {
+                    mass.push(cas.diff(p, qd));
+                }
+            }
+            mass
         }
-    }
+    };
 
     // h: inertial, gravity and applied forces by one transpose product,
     // then the elastic and dissipative forces.
@@ -157,7 +171,7 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     let mut kinetic = Vec::new();
     let mut potential = vec![sys.elastic];
     for (b, body) in sys.bodies.iter().enumerate() {
-        let v = triple(&velocities, b);
+        let v = triple(velocities, b);
         let mv = triple(&momentum_cot, b);
         let iw = triple(&momentum_cot, nb + b);
         let lin = cas.dot(&v, &mv);

@@ -2,6 +2,7 @@
 //! derives M, h and the outputs from it.
 
 mod assemble;
+mod chain;
 mod planar;
 mod solve;
 mod system;
@@ -9,4 +10,4 @@ mod system;
 pub use assemble::{Equations, assemble};
 pub use planar::planar_system;
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
-pub use system::{Body, Coordinates, PointForce, System};
+pub use system::{Body, Chain, Coordinates, Link, PointForce, System};

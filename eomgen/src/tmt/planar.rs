@@ -17,7 +17,7 @@
 use crate::cas::{Cas, ExprId, Func, SymKind};
 use crate::model::{Joints, Method, Model, Structure, parameters};
 
-use super::system::{Body, Coordinates, PointForce, System};
+use super::system::{Body, Chain, Coordinates, Link, PointForce, System};
 
 /// A planar frame: origin, absolute angle and its rate.
 #[derive(Clone, Copy)]
@@ -65,6 +65,8 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
     let mut bodies = Vec::new();
     let mut elastic = Vec::new();
     let mut rayleigh = Vec::new();
+    let mut links = Vec::new();
+    let mut body_link = Vec::new();
     let mut k = 0;
     for g in &structure.segments {
         for _ in 0..g.elements {
@@ -108,6 +110,12 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
                     f = end;
                 }
             }
+            body_link.resize(bodies.len(), links.len());
+            links.push(Link {
+                coords: vec![k],
+                end: [f.x, f.y, z],
+                end_omega: [zero, zero, f.w],
+            });
             let dq = cas.sub(q, rest);
             elastic.push(half_k_sq(cas, stiff, dq));
             rayleigh.push(half_k_sq(cas, damp, qd));
@@ -124,6 +132,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
             position: tip,
             omega: [zero; 3],
         });
+        body_link.push(links.len().saturating_sub(1));
     }
     let mut point_forces = Vec::new();
     if structure.tip_force {
@@ -145,6 +154,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
         rayleigh,
         point_forces,
         tip,
+        chain: (!links.is_empty()).then_some(Chain { links, body_link }),
     }
 }
 
@@ -219,7 +229,9 @@ fn pcc_element(
     let s2 = cas.powi(s, 2);
     let axis = cas.scaled(0.5, s2);
     let normal = cas.mul(theta, r);
+    // Bound functions of theta alone: their rates are f'(theta) theta_dot.
     let (a, b) = (cas.mul(l, axis), cas.mul(l, normal));
+    let (a, b) = (cas.bind(a), cas.bind(b));
     let c = local(cas, &f, a, b);
     // Inertia of the arc about its centroid.
     let two_r = cas.scaled(2.0, r);

@@ -80,4 +80,27 @@ pub struct System {
     pub point_forces: Vec<PointForce>,
     /// Tip position, an output.
     pub tip: [ExprId; 3],
+    /// Serial-chain structure, when the kinematics has it (M by composites).
+    pub chain: Option<Chain>,
+}
+
+/// A serial chain of links, each owning a run of coordinates.
+///
+/// Invariants: links own the coordinates in order; a body of link L depends
+/// on no coordinate past L and moves rigidly with the end frame of link L - 1
+/// under the coordinates before L. World-frame angular velocities and
+/// inertias (true of planar systems, where both are about z).
+pub struct Chain {
+    pub links: Vec<Link>,
+    /// The link of each body.
+    pub body_link: Vec<usize>,
+}
+
+pub struct Link {
+    /// Indices of the coordinates this link owns.
+    pub coords: Vec<usize>,
+    /// Origin of the link's end frame, world coordinates, a function of q.
+    pub end: [ExprId; 3],
+    /// Angular velocity of the end frame, world coordinates, linear in qd.
+    pub end_omega: [ExprId; 3],
 }

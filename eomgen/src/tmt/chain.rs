@@ -1,0 +1,247 @@
+//! The mass matrix of a serial chain by composite bodies.
+//!
+//! M = sum_b T_b^T Mbar_b T_b is the same matrix whatever the order of the
+//! sum. Summed per body it costs O(n) per entry (the lever arm of every
+//! downstream body is a sum over the links between), O(n^3) in all. In a
+//! chain, a coordinate j moves everything past its link rigidly, by one
+//! twist S_j; the downstream bodies then enter only through their summed
+//! spatial inertia about the world origin (m, h = sum m r, J = sum I + m
+//! ([r]x^T [r]x)), which is a suffix sum over links. So, for coordinates
+//! i <= j in links L(i) <= L(j):
+//!
+//! * L(i) < L(j): M_ij = S_i . Phi_j, with Phi_j the spatial momentum of
+//!   unit qd_j: the composite past L(j) moving with S_j plus the bodies of
+//!   L(j) moving with their own columns of T;
+//! * L(i) = L(j): M_ij = S_i . C_{>L} S_j + sum over the bodies of L of
+//!   their own T columns, T_bi^T Mbar_b T_bj.
+//!
+//! Five operations an entry plus O(n) set-up: Featherstone's composite
+//! rigid body algorithm, written as CAS expressions so that everything
+//! downstream (the symbolic L D L^T solve, hoisting, CSE) treats it like any
+//! other expression.
+
+use crate::cas::{Cas, ExprId};
+
+use super::system::{Chain, System};
+
+/// A spatial inertia about the world origin: mass, first moment m r and
+/// rotational inertia J, symmetric, stored xx, yy, zz, xy, xz, yz.
+#[derive(Clone, Copy)]
+struct SpatialInertia {
+    m: ExprId,
+    h: [ExprId; 3],
+    j: [ExprId; 6],
+}
+
+/// A twist (angular velocity, velocity of the point at the world origin)
+/// or a spatial momentum (angular momentum about the origin, linear
+/// momentum): the pairing of one with the other is the power.
+type Spatial = ([ExprId; 3], [ExprId; 3]);
+
+fn cross(cas: &mut Cas, a: &[ExprId; 3], b: &[ExprId; 3]) -> [ExprId; 3] {
+    std::array::from_fn(|k| {
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        let p = cas.mul(a[i], b[j]);
+        let m = cas.mul(a[j], b[i]);
+        cas.sub(p, m)
+    })
+}
+
+fn sym_mul(cas: &mut Cas, j: &[ExprId; 6], w: &[ExprId; 3]) -> [ExprId; 3] {
+    // Row k of the symmetric matrix, by index into the packed storage.
+    const ROWS: [[usize; 3]; 3] = [[0, 3, 4], [3, 1, 5], [4, 5, 2]];
+    ROWS.map(|row| {
+        let terms: Vec<ExprId> = (0..3).map(|c| cas.mul(j[row[c]], w[c])).collect();
+        cas.add_all(&terms)
+    })
+}
+
+impl SpatialInertia {
+    /// A body of mass m at r with rotational inertia diag(i) about its
+    /// centre of mass.
+    fn of_body(cas: &mut Cas, m: ExprId, r: &[ExprId; 3], i: &[ExprId; 3]) -> Self {
+        let h = r.map(|c| cas.mul(m, c));
+        let r2 = cas.dot(r, r);
+        // I + m (|r|^2 1 - r r^T)
+        let diag: [ExprId; 3] = std::array::from_fn(|k| {
+            let rk2 = cas.powi(r[k], 2);
+            let d = cas.sub(r2, rk2);
+            let md = cas.mul(m, d);
+            cas.add(i[k], md)
+        });
+        let off = [(0, 1), (0, 2), (1, 2)].map(|(a, b)| {
+            let p = cas.mul(h[a], r[b]);
+            cas.neg(p)
+        });
+        Self {
+            m,
+            h,
+            j: [diag[0], diag[1], diag[2], off[0], off[1], off[2]],
+        }
+    }
+
+    fn sum(cas: &mut Cas, parts: &[Self]) -> Self {
+        let m = cas.add_all(&parts.iter().map(|p| p.m).collect::<Vec<_>>());
+        let h = std::array::from_fn(|k| {
+            let terms: Vec<ExprId> = parts.iter().map(|p| p.h[k]).collect();
+            cas.add_all(&terms)
+        });
+        let j = std::array::from_fn(|k| {
+            let terms: Vec<ExprId> = parts.iter().map(|p| p.j[k]).collect();
+            cas.add_all(&terms)
+        });
+        Self { m, h, j }.bound(cas)
+    }
+
+    /// Bound, so that the suffix sums nest instead of flattening into
+    /// O(n^2) terms.
+    fn bound(self, cas: &mut Cas) -> Self {
+        Self {
+            m: cas.bind(self.m),
+            h: self.h.map(|e| cas.bind(e)),
+            j: self.j.map(|e| cas.bind(e)),
+        }
+    }
+
+    /// The momentum of the twist (w, v): (J w + h x v, m v + w x h).
+    fn momentum(&self, cas: &mut Cas, twist: &Spatial) -> Spatial {
+        let (w, v) = twist;
+        let jw = sym_mul(cas, &self.j, w);
+        let hv = cross(cas, &self.h, v);
+        let wh = cross(cas, w, &self.h);
+        let ang = std::array::from_fn(|k| cas.add(jw[k], hv[k]));
+        let lin = std::array::from_fn(|k| {
+            let mv = cas.mul(self.m, v[k]);
+            cas.add(mv, wh[k])
+        });
+        (ang, lin)
+    }
+}
+
+fn pair(cas: &mut Cas, a: &Spatial, b: &Spatial) -> ExprId {
+    let x = cas.dot(&a.0, &b.0);
+    let y = cas.dot(&a.1, &b.1);
+    cas.add(x, y)
+}
+
+/// The upper triangle of M, row by row, for a system with chain structure.
+///
+/// `velocities` and `link_velocities` are the time derivatives of the body
+/// positions and of the link end points.
+pub fn mass_by_composites(
+    cas: &mut Cas,
+    sys: &System,
+    chain: &Chain,
+    velocities: &[ExprId],
+    link_velocities: &[ExprId],
+) -> Vec<ExprId> {
+    let n = sys.coords.len();
+    let nl = chain.links.len();
+    let mut link_of = vec![usize::MAX; n];
+    for (l, link) in chain.links.iter().enumerate() {
+        for &c in &link.coords {
+            link_of[c] = l;
+        }
+    }
+    assert!(
+        link_of.windows(2).all(|w| w[0] <= w[1]) && link_of.iter().all(|&l| l < nl),
+        "chain links must own the coordinates in order"
+    );
+    let triple = |v: &[ExprId], i: usize| [v[3 * i], v[3 * i + 1], v[3 * i + 2]];
+
+    // Twists of the coordinates: the rigid motion past their link.
+    let twists: Vec<Spatial> = (0..n)
+        .map(|j| {
+            let link = &chain.links[link_of[j]];
+            let ve = triple(link_velocities, link_of[j]);
+            let w = link.end_omega.map(|e| cas.diff(e, sys.coords.qd[j]));
+            let v = ve.map(|e| cas.diff(e, sys.coords.qd[j]));
+            let wr = cross(cas, &w, &link.end);
+            let v0: [ExprId; 3] = std::array::from_fn(|k| cas.sub(v[k], wr[k]));
+            (w.map(|e| cas.bind(e)), v0.map(|e| cas.bind(e)))
+        })
+        .collect();
+
+    // Own columns of T: body b under a coordinate of its own link.
+    let own_column = |cas: &mut Cas, b: usize, j: usize| -> Spatial {
+        let v = triple(velocities, b).map(|e| cas.diff(e, sys.coords.qd[j]));
+        let w = sys.bodies[b].omega.map(|e| cas.diff(e, sys.coords.qd[j]));
+        (w, v)
+    };
+    let bodies_of: Vec<Vec<usize>> = (0..nl)
+        .map(|l| {
+            (0..sys.bodies.len())
+                .filter(|&b| chain.body_link[b] == l)
+                .collect()
+        })
+        .collect();
+
+    // Suffix sums of spatial inertia: past[l] is everything beyond link l.
+    let zero = cas.zero();
+    let empty = SpatialInertia {
+        m: zero,
+        h: [zero; 3],
+        j: [zero; 6],
+    };
+    let mut past = vec![empty; nl];
+    for l in (0..nl.saturating_sub(1)).rev() {
+        let mut parts = vec![past[l + 1]];
+        for &b in &bodies_of[l + 1] {
+            let body = &sys.bodies[b];
+            parts.push(SpatialInertia::of_body(
+                cas,
+                body.mass,
+                &body.position,
+                &body.inertia,
+            ));
+        }
+        past[l] = SpatialInertia::sum(cas, &parts);
+    }
+
+    // The momentum of unit qd_j: composite past its link plus its link's own bodies.
+    let momenta: Vec<Spatial> = (0..n)
+        .map(|j| {
+            let l = link_of[j];
+            let (mut ang, mut lin) = past[l].momentum(cas, &twists[j]);
+            for &b in &bodies_of[l] {
+                let body = &sys.bodies[b];
+                let (w, v) = own_column(cas, b, j);
+                let r = &body.position;
+                let mv = v.map(|e| cas.mul(body.mass, e));
+                let rmv = cross(cas, r, &mv);
+                for k in 0..3 {
+                    let iw = cas.mul(body.inertia[k], w[k]);
+                    ang[k] = cas.add_all(&[ang[k], iw, rmv[k]]);
+                    lin[k] = cas.add(lin[k], mv[k]);
+                }
+            }
+            (ang.map(|e| cas.bind(e)), lin.map(|e| cas.bind(e)))
+        })
+        .collect();
+
+    let mut mass = Vec::with_capacity(n * (n + 1) / 2);
+    for i in 0..n {
+        for j in i..n {
+            let entry = if link_of[i] < link_of[j] {
+                pair(cas, &twists[i], &momenta[j])
+            } else {
+                let l = link_of[i];
+                let past_part = past[l].momentum(cas, &twists[j]);
+                let mut terms = vec![pair(cas, &twists[i], &past_part)];
+                for &b in &bodies_of[l] {
+                    let body = &sys.bodies[b];
+                    let (wi, vi) = own_column(cas, b, i);
+                    let (wj, vj) = own_column(cas, b, j);
+                    let vv = cas.dot(&vi, &vj);
+                    terms.push(cas.mul(body.mass, vv));
+                    for k in 0..3 {
+                        terms.push(cas.mul_all(&[body.inertia[k], wi[k], wj[k]]));
+                    }
+                }
+                cas.add_all(&terms)
+            };
+            mass.push(entry);
+        }
+    }
+    mass
+}
