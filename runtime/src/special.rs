@@ -322,7 +322,9 @@ mod tests {
 
     #[test]
     fn truncated_series_match_the_long_series_to_round_off() {
-        let cases: [(&str, fn(u8, f64) -> f64, u32, u32); 3] = [
+        type Removable = fn(u8, f64) -> f64;
+        // (name, function, lowest exponent, factorial shift)
+        let cases: [(&str, Removable, u32, u32); 3] = [
             ("sinc", sinc, 0, 1),
             ("cosc", cosc, 1, 1),
             ("sinc_rem", sinc_rem, 0, 3),
