@@ -37,8 +37,17 @@ pub fn sinc(k: u8, x: f64) -> f64 {
     if x.abs() < SERIES_BELOW {
         SINC.eval(k, x)
     } else {
-        leibniz_over_xp(k, x, 1, sin_deriv)
+        sinc_closed(k, x)
     }
+}
+
+// The closed forms are kept out of line: inlined into every call site of a
+// kernel they would triple its code and crowd the instruction cache, while
+// the bent elements of a soft arm mostly take the series branch.
+#[cold]
+#[inline(never)]
+fn sinc_closed(k: u8, x: f64) -> f64 {
+    leibniz_over_xp(k, x, 1, sin_deriv)
 }
 
 /// d^k/dx^k [(1 - cos(x)) / x]  (k = 0 is 0 at x = 0, slope 1/2).
@@ -47,6 +56,14 @@ pub fn cosc(k: u8, x: f64) -> f64 {
     if x.abs() < SERIES_BELOW {
         COSC.eval(k, x)
     } else {
+        cosc_closed(k, x)
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn cosc_closed(k: u8, x: f64) -> f64 {
+    {
         leibniz_over_xp(k, x, 1, |i, x| {
             if i == 0 {
                 1.0 - x.cos()
@@ -64,6 +81,14 @@ pub fn sinc_rem(k: u8, x: f64) -> f64 {
     if x.abs() < SERIES_BELOW {
         SINC_REM.eval(k, x)
     } else {
+        sinc_rem_closed(k, x)
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn sinc_rem_closed(k: u8, x: f64) -> f64 {
+    {
         leibniz_over_xp(k, x, 3, |i, x| match i {
             0 => x - x.sin(),
             1 => 1.0 - x.cos(),
@@ -75,8 +100,51 @@ pub fn sinc_rem(k: u8, x: f64) -> f64 {
 /// (sin x, cos x) in one call. On glibc this is `sincos`, which shares the
 /// argument reduction; std's `f64::sin_cos` is two separate calls. Every
 /// backend takes its sines and cosines from here, so they agree bit for bit.
+///
+/// Below pi/4 (half the bending angle of a pcc element, nearly always) the
+/// Taylor polynomials are used instead, inlined: a libm call costs more
+/// than the twenty flops, and the kernels make one per element.
 #[inline]
 pub fn sin_cos(x: f64) -> (f64, f64) {
+    if x.abs() <= std::f64::consts::FRAC_PI_4 {
+        small_sin_cos(x)
+    } else {
+        libm_sin_cos(x)
+    }
+}
+
+/// Coefficients (-1)^j / (2j + 1)! and (-1)^j / (2j)!; at |x| = pi/4 the
+/// first omitted terms are below 1e-19.
+const SIN_TAYLOR: [f64; 9] = taylor(1);
+const COS_TAYLOR: [f64; 10] = taylor(0);
+
+const fn taylor<const N: usize>(first: u32) -> [f64; N] {
+    let mut c = [0.0; N];
+    let mut j = 0;
+    while j < N {
+        let sign = if j % 2 == 0 { 1.0 } else { -1.0 };
+        c[j] = sign / factorial(first + 2 * j as u32);
+        j += 1;
+    }
+    c
+}
+
+#[inline(always)]
+fn small_sin_cos(x: f64) -> (f64, f64) {
+    let x2 = x * x;
+    let mut s = 0.0;
+    for &c in SIN_TAYLOR.iter().rev() {
+        s = s * x2 + c;
+    }
+    let mut c = 0.0;
+    for &k in COS_TAYLOR.iter().rev() {
+        c = c * x2 + k;
+    }
+    (s * x, c)
+}
+
+#[inline(never)]
+fn libm_sin_cos(x: f64) -> (f64, f64) {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     {
         unsafe extern "C" {
@@ -162,20 +230,47 @@ impl Series {
             m0 += 2;
         }
         let x2 = x * x;
-        let mut sum = 0.0;
-        if (k as usize) < TABLE_ORDERS {
-            for &c in self.table[k as usize][..terms_for(x)].iter().rev() {
-                sum = sum * x2 + c;
+        let sum = if (k as usize) < TABLE_ORDERS {
+            // Fixed trip counts, so each Horner loop unrolls into straight
+            // code at the (constant-order) call sites of a kernel.
+            let row = &self.table[k as usize];
+            match terms_for(x) {
+                6 => horner::<6>(row, x2),
+                8 => horner::<8>(row, x2),
+                _ => horner::<{ TERMS as usize }>(row, x2),
             }
         } else {
-            let j0 = ((m0 - self.first) / 2) as usize;
-            for i in (0..TERMS as usize).rev() {
-                let c = self.coef.get(j0 + i).copied().unwrap_or(0.0);
-                sum = sum * x2 + c * falling(m0 + 2 * i as u32, k32);
-            }
-        }
+            self.high_order(k, x2)
+        };
         if m0 > k32 { sum * x } else { sum }
     }
+
+    /// The series of a derivative past the tables, term by term.
+    #[cold]
+    #[inline(never)]
+    fn high_order(&self, k: u8, x2: f64) -> f64 {
+        let k32 = u32::from(k);
+        let mut m0 = self.first;
+        while m0 < k32 {
+            m0 += 2;
+        }
+        let j0 = ((m0 - self.first) / 2) as usize;
+        let mut sum = 0.0;
+        for i in (0..TERMS as usize).rev() {
+            let c = self.coef.get(j0 + i).copied().unwrap_or(0.0);
+            sum = sum * x2 + c * falling(m0 + 2 * i as u32, k32);
+        }
+        sum
+    }
+}
+
+#[inline(always)]
+fn horner<const N: usize>(row: &[f64; TERMS as usize], x2: f64) -> f64 {
+    let mut sum = 0.0;
+    for &c in row[..N].iter().rev() {
+        sum = sum * x2 + c;
+    }
+    sum
 }
 
 /// Coefficients (-1)^j / (m + shift)! for m = first + 2 j.
@@ -343,6 +438,29 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn small_angle_sin_cos_matches_libm_to_two_ulp() {
+        for i in -2000..=2000 {
+            let x = i as f64 / 2000.0 * std::f64::consts::FRAC_PI_4;
+            let (s, c) = sin_cos(x);
+            assert!(
+                (s - x.sin()).abs() <= 2.0 * f64::EPSILON * x.sin().abs(),
+                "sin {x}"
+            );
+            assert!(
+                (c - x.cos()).abs() <= 2.0 * f64::EPSILON * x.cos(),
+                "cos {x}"
+            );
+        }
+        // Past pi/4 the libm path; both sides of the switch agree.
+        let (a, b) = (
+            std::f64::consts::FRAC_PI_4,
+            std::f64::consts::FRAC_PI_4.next_up(),
+        );
+        assert!((sin_cos(a).0 - sin_cos(b).0).abs() < 1e-15);
+        assert!((sin_cos(a).1 - sin_cos(b).1).abs() < 1e-15);
     }
 
     #[test]
