@@ -6,7 +6,7 @@
 //! qdd). Results are memoised per node, and `Bind` maps to `Bind`, so the
 //! derivative of a kinematic chain is again a chain that shares its links.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 use super::expr::{Cas, ExprId, Func, Node, SymId, Variables};
 
@@ -49,7 +49,7 @@ impl Cas {
                 )
             })
             .collect();
-        let mut memo = HashMap::new();
+        let mut memo = HashMap::default();
         es.iter()
             .map(|&e| self.directional(e, &map, &mut memo))
             .collect()

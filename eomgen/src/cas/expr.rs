@@ -11,7 +11,7 @@
 //! * Ids are handed out in creation order, and construction is deterministic,
 //!   so the same model always gives the same ids and byte-identical output.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 /// Handle of an interned expression.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Debug)]

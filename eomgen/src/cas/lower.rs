@@ -16,7 +16,7 @@
 //! derived parameters are computed once per parameter set by their own tape
 //! ([`Hoist::finish`]), not on every call.
 
-use std::collections::{HashMap, HashSet};
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 use runtime::tape::{Op, Slot, Tape};
 
@@ -36,8 +36,8 @@ impl Hoist {
         Self {
             n_params: n_params as u32,
             exprs: Vec::new(),
-            index: HashMap::new(),
-            param_only: HashMap::new(),
+            index: HashMap::default(),
+            param_only: HashMap::default(),
         }
     }
 
@@ -136,15 +136,18 @@ fn key(op: &Op) -> (u8, u64, u64) {
     }
 }
 
+/// Sums longer than this are not factored (see `Lowerer::factor_sum`).
+const MAX_FACTORED_TERMS: usize = 24;
+
 impl<'a> Lowerer<'a> {
     pub fn new(cas: &'a mut Cas) -> Self {
         Self {
             cas,
             hoist: None,
             ops: Vec::new(),
-            numbering: HashMap::new(),
-            done: HashMap::new(),
-            shared_increments: HashSet::new(),
+            numbering: HashMap::default(),
+            done: HashMap::default(),
+            shared_increments: HashSet::default(),
         }
     }
 
@@ -154,9 +157,9 @@ impl<'a> Lowerer<'a> {
             cas,
             hoist: Some(hoist),
             ops: Vec::new(),
-            numbering: HashMap::new(),
-            done: HashMap::new(),
-            shared_increments: HashSet::new(),
+            numbering: HashMap::default(),
+            done: HashMap::default(),
+            shared_increments: HashSet::default(),
         }
     }
 
@@ -292,9 +295,9 @@ impl<'a> Lowerer<'a> {
 
     /// Find the increments that two or more trigonometric arguments share.
     fn find_shared_increments(&mut self, roots: &[ExprId]) {
-        let mut seen = HashSet::new();
+        let mut seen = HashSet::default();
         let mut stack = roots.to_vec();
-        let mut angles = HashSet::new();
+        let mut angles = HashSet::default();
         while let Some(e) = stack.pop() {
             if !seen.insert(e) {
                 continue;
@@ -304,7 +307,7 @@ impl<'a> Lowerer<'a> {
             }
             stack.extend(self.cas.children(e));
         }
-        let mut uses: HashMap<ExprId, usize> = HashMap::new();
+        let mut uses: HashMap<ExprId, usize> = HashMap::default();
         let mut angles: Vec<ExprId> = angles.into_iter().collect();
         angles.sort();
         for x in angles {
@@ -399,7 +402,12 @@ impl<'a> Lowerer<'a> {
     /// of products, and collecting, say, cos(phi) out of a dozen of them
     /// saves a multiplication for each. None when no factor is shared.
     fn factor_sum(&mut self, xs: &[ExprId]) -> Option<ExprId> {
-        let mut count: HashMap<ExprId, usize> = HashMap::new();
+        // Each step re-counts what is left: quadratic in the terms. Long
+        // sums (Jacobian entries of long chains) are left as they are.
+        if xs.len() > MAX_FACTORED_TERMS {
+            return None;
+        }
+        let mut count: HashMap<ExprId, usize> = HashMap::default();
         for &t in xs {
             let mut fs = self.factors(t);
             fs.sort();

@@ -6,7 +6,9 @@
 //! so along a kinematic chain the adjoints are shared suffix sums: the
 //! composite-body recursion emerges from the algebra, for any kinematics.
 
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::BTreeMap;
+
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 use super::expr::{Cas, ExprId, Node, SymId};
 
@@ -30,7 +32,7 @@ impl Cas {
                     .expect("vjp: differentiate with respect to symbols")
             })
             .collect();
-        let mut depends: HashMap<ExprId, bool> = HashMap::new();
+        let mut depends: HashMap<ExprId, bool> = HashMap::default();
         // Contributions to each node's adjoint; processed from the largest
         // id down, so a node's parents (larger ids) have all contributed.
         let mut pending: BTreeMap<ExprId, Vec<ExprId>> = BTreeMap::new();
@@ -39,7 +41,7 @@ impl Cas {
                 pending.entry(o).or_default().push(c);
             }
         }
-        let mut adjoint_of_symbol: HashMap<SymId, ExprId> = HashMap::new();
+        let mut adjoint_of_symbol: HashMap<SymId, ExprId> = HashMap::default();
         while let Some((e, contributions)) = pending.pop_last() {
             let adj = self.add_all(&contributions);
             if self.is_zero(adj) {
