@@ -5,6 +5,8 @@
 //! function makes rustc superlinear). A value used by a later chunk is
 //! spilled to a workspace array; inputs and constants are read in place.
 
+use std::collections::HashMap;
+
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 use runtime::{KernelKind, Op, Slot, Tape, TapeSet};
@@ -198,40 +200,39 @@ impl<'a> KernelEmitter<'a> {
         let n_spill = self.n_spill;
         let mut chunks = Vec::new();
         let mut calls = Vec::new();
-        // sin and cos of the same argument in one chunk: one sincos call.
-        let mut sin_of = std::collections::HashMap::new();
-        let mut cos_of = std::collections::HashMap::new();
+        // Members of one family at the same argument in one chunk come from
+        // one call: sin and cos from `sin_cos`, the orders of a removable
+        // function from `*_orders`.
+        let mut groups: HashMap<(Family, Slot, Option<usize>), Vec<(u8, usize)>> = HashMap::new();
         for (i, op) in self.tape.ops.iter().enumerate() {
-            match *op {
-                Op::Sin(a) => sin_of.insert(a, i),
-                Op::Cos(a) => cos_of.insert(a, i),
-                _ => None,
-            };
+            if let Some((family, order, a)) = family_of(op) {
+                groups
+                    .entry((family, a, self.chunk_of[i]))
+                    .or_default()
+                    .push((order, i));
+            }
         }
-        let partner = |i: usize| -> Option<(usize, usize, Slot)> {
-            let (s, c, a) = match self.tape.ops[i] {
-                Op::Sin(a) => (i, *cos_of.get(&a)?, a),
-                Op::Cos(a) => (*sin_of.get(&a)?, i, a),
-                _ => return None,
-            };
-            (self.chunk_of[s] == self.chunk_of[c]).then_some((s, c, a))
-        };
+        groups.retain(|_, members| members.len() >= 2);
+        let group_of: HashMap<usize, (Family, Slot)> = groups
+            .iter()
+            .flat_map(|(&(f, a, _), ms)| ms.iter().map(move |&(_, i)| (i, (f, a))))
+            .collect();
         for c in 0..n_chunks {
             let mut body = Vec::new();
             for (i, op) in self.tape.ops.iter().enumerate() {
                 if self.chunk_of[i] != Some(c) {
                     continue;
                 }
-                let defined: Vec<usize> = match partner(i) {
-                    Some((s, co, a)) if i == s.min(co) => {
-                        let (vs, vc) = (format_ident!("v{}", s), format_ident!("v{}", co));
+                let defined: Vec<usize> = match group_of.get(&i) {
+                    Some(&(family, a)) => {
+                        let members = &groups[&(family, a, Some(c))];
+                        if members.iter().map(|m| m.1).min() != Some(i) {
+                            continue;
+                        }
                         let a = self.read(a, c);
-                        body.push(
-                            quote!(let (#vs, #vc): (f64, f64) = runtime::special::sin_cos(#a);),
-                        );
-                        vec![s, co]
+                        body.push(family.call(members, a));
+                        members.iter().map(|m| m.1).collect()
                     }
-                    Some(_) => vec![],
                     None => {
                         let v = format_ident!("v{}", i);
                         let e = self.expr(op, c);
@@ -291,6 +292,52 @@ impl<'a> KernelEmitter<'a> {
             }
             #(#chunks)*
         }
+    }
+}
+
+/// Functions evaluated together when several members share an argument.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+enum Family {
+    /// Order 0: sin, 1: cos.
+    SinCos,
+    Sinc,
+    Cosc,
+    SincRem,
+}
+
+fn family_of(op: &Op) -> Option<(Family, u8, Slot)> {
+    match *op {
+        Op::Sin(a) => Some((Family::SinCos, 0, a)),
+        Op::Cos(a) => Some((Family::SinCos, 1, a)),
+        Op::Sinc(k, a) => Some((Family::Sinc, k, a)),
+        Op::Cosc(k, a) => Some((Family::Cosc, k, a)),
+        Op::SincRem(k, a) => Some((Family::SincRem, k, a)),
+        _ => None,
+    }
+}
+
+impl Family {
+    /// `let` binding the members (order, op index) from one call at `a`.
+    fn call(self, members: &[(u8, usize)], a: TokenStream) -> TokenStream {
+        let n = members.iter().map(|m| usize::from(m.0)).max().unwrap_or(0) + 1;
+        let names: Vec<TokenStream> = (0..n)
+            .map(|k| match members.iter().find(|m| usize::from(m.0) == k) {
+                Some(&(_, i)) => {
+                    let v = format_ident!("v{}", i);
+                    quote!(#v)
+                }
+                None => quote!(_),
+            })
+            .collect();
+        let f = match self {
+            Family::SinCos => {
+                return quote!(let (#(#names),*): (f64, f64) = runtime::special::sin_cos(#a););
+            }
+            Family::Sinc => quote!(sinc_orders),
+            Family::Cosc => quote!(cosc_orders),
+            Family::SincRem => quote!(sinc_rem_orders),
+        };
+        quote!(let [#(#names),*]: [f64; #n] = runtime::special::#f::<#n>(#a);)
     }
 }
 

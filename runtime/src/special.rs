@@ -50,6 +50,37 @@ fn sinc_closed(k: u8, x: f64) -> f64 {
     leibniz_over_xp(k, x, 1, sin_deriv)
 }
 
+/// [`sinc`] of orders 0..K at one argument, bit for bit: the kernels need
+/// a pcc element's sinc with its first two derivatives together.
+#[inline]
+pub fn sinc_orders<const K: usize>(x: f64) -> [f64; K] {
+    if x.abs() < SERIES_BELOW {
+        SINC.orders(x)
+    } else {
+        std::array::from_fn(|k| sinc_closed(k as u8, x))
+    }
+}
+
+/// [`cosc`] of orders 0..K at one argument, bit for bit.
+#[inline]
+pub fn cosc_orders<const K: usize>(x: f64) -> [f64; K] {
+    if x.abs() < SERIES_BELOW {
+        COSC.orders(x)
+    } else {
+        std::array::from_fn(|k| cosc_closed(k as u8, x))
+    }
+}
+
+/// [`sinc_rem`] of orders 0..K at one argument, bit for bit.
+#[inline]
+pub fn sinc_rem_orders<const K: usize>(x: f64) -> [f64; K] {
+    if x.abs() < SERIES_BELOW {
+        SINC_REM.orders(x)
+    } else {
+        std::array::from_fn(|k| sinc_rem_closed(k as u8, x))
+    }
+}
+
 /// d^k/dx^k [(1 - cos(x)) / x]  (k = 0 is 0 at x = 0, slope 1/2).
 #[inline]
 pub fn cosc(k: u8, x: f64) -> f64 {
@@ -224,6 +255,28 @@ impl Series {
 
     #[inline]
     fn eval(&self, k: u8, x: f64) -> f64 {
+        match terms_for(x) {
+            6 => self.eval_n::<6>(k, x),
+            8 => self.eval_n::<8>(k, x),
+            _ => self.eval_n::<{ TERMS as usize }>(k, x),
+        }
+    }
+
+    /// Orders 0..K at one argument: one branch and K independent Horner
+    /// chains, each the same arithmetic as [`Series::eval`].
+    #[inline]
+    fn orders<const K: usize>(&self, x: f64) -> [f64; K] {
+        match terms_for(x) {
+            6 => std::array::from_fn(|k| self.eval_n::<6>(k as u8, x)),
+            8 => std::array::from_fn(|k| self.eval_n::<8>(k as u8, x)),
+            _ => std::array::from_fn(|k| self.eval_n::<{ TERMS as usize }>(k as u8, x)),
+        }
+    }
+
+    /// The k-th derivative with N series terms. Fixed trip counts, so the
+    /// Horner loops unroll into straight code at constant-order call sites.
+    #[inline(always)]
+    fn eval_n<const N: usize>(&self, k: u8, x: f64) -> f64 {
         let k32 = u32::from(k);
         let mut m0 = self.first;
         while m0 < k32 {
@@ -231,14 +284,7 @@ impl Series {
         }
         let x2 = x * x;
         let sum = if (k as usize) < TABLE_ORDERS {
-            // Fixed trip counts, so each Horner loop unrolls into straight
-            // code at the (constant-order) call sites of a kernel.
-            let row = &self.table[k as usize];
-            match terms_for(x) {
-                6 => horner::<6>(row, x2),
-                8 => horner::<8>(row, x2),
-                _ => horner::<{ TERMS as usize }>(row, x2),
-            }
+            horner::<N>(&self.table[k as usize], x2)
         } else {
             self.high_order(k, x2)
         };
@@ -461,6 +507,22 @@ mod tests {
         );
         assert!((sin_cos(a).0 - sin_cos(b).0).abs() < 1e-15);
         assert!((sin_cos(a).1 - sin_cos(b).1).abs() < 1e-15);
+    }
+
+    #[test]
+    fn orders_agree_bit_for_bit_with_single_orders() {
+        for i in -300..300 {
+            let x = i as f64 / 97.0;
+            let s: [f64; 4] = sinc_orders(x);
+            let c: [f64; 4] = cosc_orders(x);
+            let r: [f64; 4] = sinc_rem_orders(x);
+            for k in 0..4u8 {
+                let j = k as usize;
+                assert_eq!(s[j].to_bits(), sinc(k, x).to_bits(), "sinc {k} {x}");
+                assert_eq!(c[j].to_bits(), cosc(k, x).to_bits(), "cosc {k} {x}");
+                assert_eq!(r[j].to_bits(), sinc_rem(k, x).to_bits(), "rem {k} {x}");
+            }
+        }
     }
 
     #[test]
