@@ -24,7 +24,7 @@
 
 use crate::cas::{Cas, ExprId};
 
-use super::chain::mass_by_composites;
+use super::chain::{ChainKinematics, PointItem};
 use super::system::System;
 
 /// The derived equations, as expressions.
@@ -113,8 +113,12 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     // generalised momentum T^T Mbar T qd (which the Jacobian kernel needs
     // anyway).
     let momentum = cas.vjp(&outs[..6 * nb], &momentum_cot, &sys.coords.qd);
-    let mass = match &sys.chain {
-        Some(chain) => mass_by_composites(cas, sys, chain, velocities, link_velocities),
+    let kinematics = sys
+        .chain
+        .as_ref()
+        .map(|chain| ChainKinematics::new(cas, sys, chain, velocities, link_velocities));
+    let mass = match &kinematics {
+        Some(k) => k.mass(cas),
         None => {
             let mut mass = Vec::with_capacity(n * (n + 1) / 2);
             for (i, &p) in momentum.iter().enumerate() {
@@ -128,7 +132,26 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
 
     // h: inertial, gravity and applied forces by one transpose product,
     // then the elastic and dissipative forces.
-    let forces = cas.vjp(&outs, &force_cot, &sys.coords.qd);
+    let forces = match (&kinematics, &sys.chain) {
+        (Some(k), Some(chain)) => {
+            let body_forces: Vec<([ExprId; 3], [ExprId; 3])> = (0..nb)
+                .map(|b| (triple(&force_cot, b), triple(&force_cot, nb + b)))
+                .collect();
+            let points: Vec<PointItem> = sys
+                .point_forces
+                .iter()
+                .enumerate()
+                .map(|(f, force)| PointItem {
+                    link: chain.point_force_link[f],
+                    position: force.point,
+                    velocity: triple(velocities, nb + f),
+                    force: triple(&force_cot, 2 * nb + f),
+                })
+                .collect();
+            k.generalized_forces(cas, &body_forces, &points)
+        }
+        _ => cas.vjp(&outs, &force_cot, &sys.coords.qd),
+    };
     let bias: Vec<ExprId> = (0..n)
         .map(|i| {
             let de = cas.diff(sys.elastic, sys.coords.q[i]);

@@ -124,124 +124,223 @@ fn pair(cas: &mut Cas, a: &Spatial, b: &Spatial) -> ExprId {
     cas.add(x, y)
 }
 
-/// The upper triangle of M, row by row, for a system with chain structure.
-///
-/// `velocities` and `link_velocities` are the time derivatives of the body
-/// positions and of the link end points.
-pub fn mass_by_composites(
-    cas: &mut Cas,
-    sys: &System,
-    chain: &Chain,
-    velocities: &[ExprId],
-    link_velocities: &[ExprId],
-) -> Vec<ExprId> {
-    let n = sys.coords.len();
-    let nl = chain.links.len();
-    let mut link_of = vec![usize::MAX; n];
-    for (l, link) in chain.links.iter().enumerate() {
-        for &c in &link.coords {
-            link_of[c] = l;
-        }
-    }
-    assert!(
-        link_of.windows(2).all(|w| w[0] <= w[1]) && link_of.iter().all(|&l| l < nl),
-        "chain links must own the coordinates in order"
-    );
-    let triple = |v: &[ExprId], i: usize| [v[3 * i], v[3 * i + 1], v[3 * i + 2]];
+/// What the composite sums need of a chain: each coordinate's link and
+/// twist, and the bodies of each link.
+pub struct ChainKinematics<'a> {
+    sys: &'a System,
+    link_of: Vec<usize>,
+    twists: Vec<Spatial>,
+    bodies_of: Vec<Vec<usize>>,
+    /// Velocities of the bodies' centres of mass, world frame.
+    velocities: &'a [ExprId],
+}
 
-    // Twists of the coordinates: the rigid motion past their link.
-    let twists: Vec<Spatial> = (0..n)
-        .map(|j| {
-            let link = &chain.links[link_of[j]];
-            let ve = triple(link_velocities, link_of[j]);
-            let w = link.end_omega.map(|e| cas.diff(e, sys.coords.qd[j]));
-            let v = ve.map(|e| cas.diff(e, sys.coords.qd[j]));
-            let wr = cross(cas, &w, &link.end);
-            let v0: [ExprId; 3] = std::array::from_fn(|k| cas.sub(v[k], wr[k]));
-            (w.map(|e| cas.bind(e)), v0.map(|e| cas.bind(e)))
-        })
-        .collect();
+fn triple(v: &[ExprId], i: usize) -> [ExprId; 3] {
+    [v[3 * i], v[3 * i + 1], v[3 * i + 2]]
+}
 
-    // Own columns of T: body b under a coordinate of its own link.
-    let own_column = |cas: &mut Cas, b: usize, j: usize| -> Spatial {
-        let v = triple(velocities, b).map(|e| cas.diff(e, sys.coords.qd[j]));
-        let w = sys.bodies[b].omega.map(|e| cas.diff(e, sys.coords.qd[j]));
-        (w, v)
-    };
-    let bodies_of: Vec<Vec<usize>> = (0..nl)
-        .map(|l| {
-            (0..sys.bodies.len())
-                .filter(|&b| chain.body_link[b] == l)
-                .collect()
-        })
-        .collect();
-
-    // Suffix sums of spatial inertia: past[l] is everything beyond link l.
-    let zero = cas.zero();
-    let empty = SpatialInertia {
-        m: zero,
-        h: [zero; 3],
-        j: [zero; 6],
-    };
-    let mut past = vec![empty; nl];
-    for l in (0..nl.saturating_sub(1)).rev() {
-        let mut parts = vec![past[l + 1]];
-        for &b in &bodies_of[l + 1] {
-            let body = &sys.bodies[b];
-            parts.push(SpatialInertia::of_body(
-                cas,
-                body.mass,
-                &body.position,
-                &body.inertia,
-            ));
-        }
-        past[l] = SpatialInertia::sum(cas, &parts);
-    }
-
-    // The momentum of unit qd_j: composite past its link plus its link's own bodies.
-    let momenta: Vec<Spatial> = (0..n)
-        .map(|j| {
-            let l = link_of[j];
-            let (mut ang, mut lin) = past[l].momentum(cas, &twists[j]);
-            for &b in &bodies_of[l] {
-                let body = &sys.bodies[b];
-                let (w, v) = own_column(cas, b, j);
-                let r = &body.position;
-                let mv = v.map(|e| cas.mul(body.mass, e));
-                let rmv = cross(cas, r, &mv);
-                for k in 0..3 {
-                    let iw = cas.mul(body.inertia[k], w[k]);
-                    ang[k] = cas.add_all(&[ang[k], iw, rmv[k]]);
-                    lin[k] = cas.add(lin[k], mv[k]);
-                }
+impl<'a> ChainKinematics<'a> {
+    /// `velocities` and `link_velocities` are the time derivatives of the
+    /// body positions and of the link end points.
+    pub fn new(
+        cas: &mut Cas,
+        sys: &'a System,
+        chain: &Chain,
+        velocities: &'a [ExprId],
+        link_velocities: &[ExprId],
+    ) -> Self {
+        let n = sys.coords.len();
+        let nl = chain.links.len();
+        let mut link_of = vec![usize::MAX; n];
+        for (l, link) in chain.links.iter().enumerate() {
+            for &c in &link.coords {
+                link_of[c] = l;
             }
-            (ang.map(|e| cas.bind(e)), lin.map(|e| cas.bind(e)))
-        })
-        .collect();
+        }
+        assert!(
+            link_of.windows(2).all(|w| w[0] <= w[1]) && link_of.iter().all(|&l| l < nl),
+            "chain links must own the coordinates in order"
+        );
+        // Twists of the coordinates: the rigid motion past their link.
+        let twists = (0..n)
+            .map(|j| {
+                let link = &chain.links[link_of[j]];
+                let ve = triple(link_velocities, link_of[j]);
+                let w = link.end_omega.map(|e| cas.diff(e, sys.coords.qd[j]));
+                let v = ve.map(|e| cas.diff(e, sys.coords.qd[j]));
+                let wr = cross(cas, &w, &link.end);
+                let v0: [ExprId; 3] = std::array::from_fn(|k| cas.sub(v[k], wr[k]));
+                (w.map(|e| cas.bind(e)), v0.map(|e| cas.bind(e)))
+            })
+            .collect();
+        let bodies_of = (0..nl)
+            .map(|l| (0..sys.bodies.len()).filter(|&b| chain.body_link[b] == l).collect())
+            .collect();
+        Self {
+            sys,
+            link_of,
+            twists,
+            bodies_of,
+            velocities,
+        }
+    }
 
-    let mut mass = Vec::with_capacity(n * (n + 1) / 2);
-    for i in 0..n {
-        for j in i..n {
-            let entry = if link_of[i] < link_of[j] {
-                pair(cas, &twists[i], &momenta[j])
-            } else {
-                let l = link_of[i];
-                let past_part = past[l].momentum(cas, &twists[j]);
-                let mut terms = vec![pair(cas, &twists[i], &past_part)];
-                for &b in &bodies_of[l] {
+    fn links(&self) -> usize {
+        self.bodies_of.len()
+    }
+
+    /// Own column of T: body b under a coordinate of its own link.
+    fn own_column(&self, cas: &mut Cas, b: usize, j: usize) -> Spatial {
+        let qd = self.sys.coords.qd[j];
+        let v = triple(self.velocities, b).map(|e| cas.diff(e, qd));
+        let w = self.sys.bodies[b].omega.map(|e| cas.diff(e, qd));
+        (w, v)
+    }
+
+    /// The upper triangle of M, row by row.
+    pub fn mass(&self, cas: &mut Cas) -> Vec<ExprId> {
+        let sys = self.sys;
+        let n = sys.coords.len();
+        let nl = self.links();
+        // Suffix sums of spatial inertia: past[l] is everything beyond link l.
+        let zero = cas.zero();
+        let empty = SpatialInertia {
+            m: zero,
+            h: [zero; 3],
+            j: [zero; 6],
+        };
+        let mut past = vec![empty; nl];
+        for l in (0..nl.saturating_sub(1)).rev() {
+            let mut parts = vec![past[l + 1]];
+            for &b in &self.bodies_of[l + 1] {
+                let body = &sys.bodies[b];
+                parts.push(SpatialInertia::of_body(
+                    cas,
+                    body.mass,
+                    &body.position,
+                    &body.inertia,
+                ));
+            }
+            past[l] = SpatialInertia::sum(cas, &parts);
+        }
+
+        // The momentum of unit qd_j: composite past its link plus its link's
+        // own bodies.
+        let momenta: Vec<Spatial> = (0..n)
+            .map(|j| {
+                let l = self.link_of[j];
+                let (mut ang, mut lin) = past[l].momentum(cas, &self.twists[j]);
+                for &b in &self.bodies_of[l] {
                     let body = &sys.bodies[b];
-                    let (wi, vi) = own_column(cas, b, i);
-                    let (wj, vj) = own_column(cas, b, j);
-                    let vv = cas.dot(&vi, &vj);
-                    terms.push(cas.mul(body.mass, vv));
+                    let (w, v) = self.own_column(cas, b, j);
+                    let mv = v.map(|e| cas.mul(body.mass, e));
+                    let rmv = cross(cas, &body.position, &mv);
                     for k in 0..3 {
-                        terms.push(cas.mul_all(&[body.inertia[k], wi[k], wj[k]]));
+                        let iw = cas.mul(body.inertia[k], w[k]);
+                        ang[k] = cas.add_all(&[ang[k], iw, rmv[k]]);
+                        lin[k] = cas.add(lin[k], mv[k]);
                     }
                 }
-                cas.add_all(&terms)
-            };
-            mass.push(entry);
+                (ang.map(|e| cas.bind(e)), lin.map(|e| cas.bind(e)))
+            })
+            .collect();
+
+        let mut mass = Vec::with_capacity(n * (n + 1) / 2);
+        for i in 0..n {
+            for j in i..n {
+                let entry = if self.link_of[i] < self.link_of[j] {
+                    pair(cas, &self.twists[i], &momenta[j])
+                } else {
+                    let l = self.link_of[i];
+                    let past_part = past[l].momentum(cas, &self.twists[j]);
+                    let mut terms = vec![pair(cas, &self.twists[i], &past_part)];
+                    for &b in &self.bodies_of[l] {
+                        let body = &sys.bodies[b];
+                        let (wi, vi) = self.own_column(cas, b, i);
+                        let (wj, vj) = self.own_column(cas, b, j);
+                        let vv = cas.dot(&vi, &vj);
+                        terms.push(cas.mul(body.mass, vv));
+                        for k in 0..3 {
+                            terms.push(cas.mul_all(&[body.inertia[k], wi[k], wj[k]]));
+                        }
+                    }
+                    cas.add_all(&terms)
+                };
+                mass.push(entry);
+            }
         }
+        mass
     }
-    mass
+
+    /// Generalised forces T^T f of wrenches on the bodies, and of forces at
+    /// points: sum_b T_b^T (F_b, tau_b) + sum_p J_p^T F_p. A coordinate sees
+    /// the summed wrench past its link through its twist, and the items of
+    /// its own link through their own columns: O(n) for the chain.
+    ///
+    /// `body_forces[b]` is (F, tau) of body b (world frame); `points` are
+    /// (link, position, velocity, force).
+    pub fn generalized_forces(
+        &self,
+        cas: &mut Cas,
+        body_forces: &[([ExprId; 3], [ExprId; 3])],
+        points: &[PointItem],
+    ) -> Vec<ExprId> {
+        let sys = self.sys;
+        let n = sys.coords.len();
+        let nl = self.links();
+        // Wrenches about the origin per link: (tau + r x F, F).
+        let mut link_wrench: Vec<Vec<Spatial>> = vec![Vec::new(); nl];
+        for (l, bodies) in self.bodies_of.iter().enumerate() {
+            for &b in bodies {
+                let (f, tau) = body_forces[b];
+                let rf = cross(cas, &sys.bodies[b].position, &f);
+                let ang = std::array::from_fn(|k| cas.add(tau[k], rf[k]));
+                link_wrench[l].push((ang, f));
+            }
+        }
+        for p in points {
+            let rf = cross(cas, &p.position, &p.force);
+            link_wrench[p.link].push((rf, p.force));
+        }
+        let zero = cas.zero();
+        let mut past: Vec<Spatial> = vec![([zero; 3], [zero; 3]); nl];
+        for l in (0..nl.saturating_sub(1)).rev() {
+            let mut parts = vec![past[l + 1]];
+            parts.extend(link_wrench[l + 1].iter().copied());
+            let sum = |cas: &mut Cas, pick: &dyn Fn(&Spatial) -> ExprId| {
+                let terms: Vec<ExprId> = parts.iter().map(pick).collect();
+                let s = cas.add_all(&terms);
+                cas.bind(s)
+            };
+            let ang = [0, 1, 2].map(|k| sum(cas, &|w: &Spatial| w.0[k]));
+            let lin = [0, 1, 2].map(|k| sum(cas, &|w: &Spatial| w.1[k]));
+            past[l] = (ang, lin);
+        }
+        (0..n)
+            .map(|j| {
+                let l = self.link_of[j];
+                let qd = sys.coords.qd[j];
+                let mut terms = vec![pair(cas, &self.twists[j], &past[l])];
+                for &b in &self.bodies_of[l] {
+                    let (f, tau) = body_forces[b];
+                    let (w, v) = self.own_column(cas, b, j);
+                    terms.push(cas.dot(&v, &f));
+                    terms.push(cas.dot(&w, &tau));
+                }
+                for p in points.iter().filter(|p| p.link == l) {
+                    let v = p.velocity.map(|e| cas.diff(e, qd));
+                    terms.push(cas.dot(&v, &p.force));
+                }
+                cas.add_all(&terms)
+            })
+            .collect()
+    }
+}
+
+/// A force applied at a point of a chain.
+pub struct PointItem {
+    pub link: usize,
+    pub position: [ExprId; 3],
+    pub velocity: [ExprId; 3],
+    pub force: [ExprId; 3],
 }

@@ -135,6 +135,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
         body_link.push(links.len().saturating_sub(1));
     }
     let mut point_forces = Vec::new();
+    let mut point_force_link = Vec::new();
     if structure.tip_force {
         let force = [
             param("tip.force.x"),
@@ -142,6 +143,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
             param("tip.force.z"),
         ];
         point_forces.push(PointForce { point: tip, force });
+        point_force_link.push(links.len().saturating_sub(1));
     }
     let gravity = [param("gravity.x"), param("gravity.y"), param("gravity.z")];
     let elastic = cas.add_all(&elastic);
@@ -154,7 +156,11 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
         rayleigh,
         point_forces,
         tip,
-        chain: (!links.is_empty()).then_some(Chain { links, body_link }),
+        chain: (!links.is_empty()).then_some(Chain {
+            links,
+            body_link,
+            point_force_link,
+        }),
     }
 }
 

@@ -94,6 +94,9 @@ pub struct Chain {
     pub links: Vec<Link>,
     /// The link of each body.
     pub body_link: Vec<usize>,
+    /// The link of each point force (the link whose coordinates move the
+    /// point non-rigidly).
+    pub point_force_link: Vec<usize>,
 }
 
 pub struct Link {

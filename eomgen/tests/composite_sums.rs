@@ -1,6 +1,7 @@
-//! The composite-body mass matrix of a chain against the same M summed body
-//! by body (the Jacobian of the generalised momentum): two evaluation orders
-//! of M = sum T^T Mbar T that share no code past the kinematics.
+//! The composite-body sums of a chain against the same quantities summed
+//! body by body: M = sum T^T Mbar T against the Jacobian of the generalised
+//! momentum, and h = sum T^T f against one vector-Jacobian product. Two
+//! evaluation orders that share no code past the kinematics.
 
 use std::path::Path;
 
@@ -9,7 +10,7 @@ use eomgen::model::{load_model, parameters};
 use eomgen::tmt::{assemble, planar_system};
 
 #[test]
-fn composite_mass_equals_body_by_body_mass_on_every_bundled_model() {
+fn composite_sums_equal_body_by_body_sums_on_every_bundled_model() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
     let mut checked = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
@@ -18,7 +19,17 @@ fn composite_mass_equals_body_by_body_mass_on_every_bundled_model() {
             continue;
         }
         let model = load_model(&path, &[]).unwrap();
-        let values: Vec<f64> = parameters(&model).into_iter().map(|(_, v)| v).collect();
+        // Loads on, whatever the file says, so that every force path counts.
+        let values: Vec<f64> = parameters(&model)
+            .into_iter()
+            .map(|(name, v)| match name.as_str() {
+                "gravity.x" => 1.3,
+                "gravity.y" => -9.81,
+                "tip.force.x" => 0.7,
+                "tip.force.y" => -0.4,
+                _ => v,
+            })
+            .collect();
         let mut cas = Cas::new();
         let mut sys = planar_system(&mut cas, &model);
         assert!(
@@ -26,9 +37,11 @@ fn composite_mass_equals_body_by_body_mass_on_every_bundled_model() {
             "{}: planar arms are chains",
             path.display()
         );
-        let composite = assemble(&mut cas, &sys).mass_upper;
+        let eq = assemble(&mut cas, &sys);
+        let composite: Vec<_> = eq.mass_upper.iter().chain(&eq.bias).copied().collect();
         sys.chain = None;
-        let body_by_body = assemble(&mut cas, &sys).mass_upper;
+        let eq = assemble(&mut cas, &sys);
+        let body_by_body: Vec<_> = eq.mass_upper.iter().chain(&eq.bias).copied().collect();
         let n = sys.coords.len();
         for trial in 0..5 {
             // Deterministic states spanning bent and straight (theta = 0) ones.
@@ -38,18 +51,25 @@ fn composite_mass_equals_body_by_body_mass_on_every_bundled_model() {
                     _ => 1.3 * ((i * 7 + trial * 3) as f64).sin(),
                 })
                 .collect();
+            let qd: Vec<f64> = (0..n)
+                .map(|i| 2.1 * ((i * 5 + trial) as f64).cos())
+                .collect();
             let value = |s| match cas.sym_kind(s) {
                 SymKind::Q(i) => Some(q[i as usize]),
+                SymKind::Qd(i) => Some(qd[i as usize]),
                 SymKind::Param(i) => Some(values[i as usize]),
                 _ => Some(0.0),
             };
             let a = cas.eval_many(&composite, &value).unwrap();
             let b = cas.eval_many(&body_by_body, &value).unwrap();
-            let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let m = n * (n + 1) / 2;
+            let scale = |r: std::ops::Range<usize>| b[r].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let (scale_m, scale_h) = (scale(0..m), scale(m..b.len()));
             for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+                let s = if k < m { scale_m } else { scale_h };
                 assert!(
-                    (x - y).abs() <= 1e-12 * scale,
-                    "{}: M entry {k} at trial {trial}: {x} vs {y}",
+                    (x - y).abs() <= 1e-12 * s,
+                    "{}: entry {k} of M then h at trial {trial}: {x} vs {y}",
                     path.display()
                 );
             }
