@@ -11,9 +11,12 @@ use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 use runtime::{KernelKind, Op, Slot, Tape, TapeSet};
 
-/// Operations per emitted function. Also bounds rustc's stack: 4000-op
-/// functions overflowed it at opt-level 1 with debug info (measured).
-pub const CHUNK_OPS: usize = 2000;
+/// Operations per emitted function. A cut costs a store and a load per
+/// value that crosses it (the 10-element pcc cantilever's mass + bias:
+/// 450 ns in two chunks, 405 ns in one). Functions this long overflow
+/// rustc's default stack at opt-level 1 with debug info (4000 ops did at
+/// 8 MiB, 3000 did too): `.cargo/config.toml` raises `RUST_MIN_STACK`.
+pub const CHUNK_OPS: usize = 3000;
 
 fn lit(c: f64) -> TokenStream {
     let l = Literal::f64_suffixed(c.abs());

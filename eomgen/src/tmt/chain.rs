@@ -174,7 +174,11 @@ impl<'a> ChainKinematics<'a> {
             })
             .collect();
         let bodies_of = (0..nl)
-            .map(|l| (0..sys.bodies.len()).filter(|&b| chain.body_link[b] == l).collect())
+            .map(|l| {
+                (0..sys.bodies.len())
+                    .filter(|&b| chain.body_link[b] == l)
+                    .collect()
+            })
             .collect();
         Self {
             sys,
