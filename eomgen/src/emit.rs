@@ -206,7 +206,7 @@ impl<'a> KernelEmitter<'a> {
         // Members of one family at the same argument in one chunk come from
         // one call: sin and cos from `sin_cos`, the orders of a removable
         // function from `*_orders`.
-        let mut groups: HashMap<(Family, Slot, Option<usize>), Vec<(u8, usize)>> = HashMap::new();
+        let mut groups: HashMap<GroupKey, Vec<(u8, usize)>> = HashMap::new();
         for (i, op) in self.tape.ops.iter().enumerate() {
             if let Some((family, order, a)) = family_of(op) {
                 groups
@@ -297,6 +297,9 @@ impl<'a> KernelEmitter<'a> {
         }
     }
 }
+
+/// A family, its argument and the chunk of a member.
+type GroupKey = (Family, Slot, Option<usize>);
 
 /// Functions evaluated together when several members share an argument.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]

@@ -251,9 +251,9 @@ impl<'a> ChainKinematics<'a> {
 
         let mut mass = Vec::with_capacity(n * (n + 1) / 2);
         for i in 0..n {
-            for j in i..n {
+            for (j, momentum) in momenta.iter().enumerate().skip(i) {
                 let entry = if self.link_of[i] < self.link_of[j] {
-                    pair(cas, &self.twists[i], &momenta[j])
+                    pair(cas, &self.twists[i], momentum)
                 } else {
                     let l = self.link_of[i];
                     let past_part = past[l].momentum(cas, &self.twists[j]);
