@@ -19,6 +19,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use crate::arm::{AccelError, Dynamics, Workspace, accelerations};
+use crate::events::{Event, EventHit, EventWatch};
 use crate::jacobian::rhs_jacobian;
 
 /// Integrators. Names are the CLI's and the model files'.
@@ -112,6 +113,11 @@ pub struct SimOptions {
     pub dt: f64,
     /// Spacing of the written trajectory (s).
     pub output_dt: f64,
+    /// Sample at these times instead (ascending; from the methods' dense
+    /// output, so they cost no extra steps).
+    pub output_times: Option<Vec<f64>>,
+    /// Zero crossings to locate (and to stop at, if terminal).
+    pub events: Vec<Event>,
     /// Give up after this many steps.
     pub max_steps: usize,
 }
@@ -125,6 +131,8 @@ impl Default for SimOptions {
             atol: 1e-9,
             dt: 1e-3,
             output_dt: 1e-2,
+            output_times: None,
+            events: Vec::new(),
             max_steps: 10_000_000,
         }
     }
@@ -135,6 +143,8 @@ impl Default for SimOptions {
 pub struct Trajectory {
     pub t: Vec<f64>,
     pub x: Vec<Vec<f64>>,
+    /// The located events, in time order.
+    pub events: Vec<EventHit>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -266,7 +276,8 @@ impl<D: Dynamics + ?Sized, Y: StateVec> ODE<f64, Y> for ArmOde<'_, D> {
 /// failed, so for those a failure anywhere in the step stops it too (its
 /// dense output would be NaN); adaptive methods reject such steps.
 struct Recorder<'a> {
-    even: EvenSolout<f64>,
+    sampler: Sampler,
+    events: &'a RefCell<EventWatch>,
     blown_up: &'a Cell<Option<f64>>,
     failed_in_step: &'a Cell<bool>,
     fixed_step: bool,
@@ -297,9 +308,21 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
             self.blown_up.set(Some(t_prev));
             return ControlFlag::Terminate;
         }
+        let hit = self
+            .events
+            .borrow_mut()
+            .check(t_prev, t_curr, y_prev, y_curr, interpolator);
+        if let Some((t_event, y_event)) = hit {
+            self.sampler
+                .sample(t_event, t_prev, &y_event, y_prev, interpolator, solution);
+            if solution.t.last() != Some(&t_event) {
+                solution.push(t_event, y_event);
+            }
+            return ControlFlag::Terminate;
+        }
         let flag = self
-            .even
-            .solout(t_curr, t_prev, y_curr, y_prev, interpolator, solution);
+            .sampler
+            .sample(t_curr, t_prev, y_curr, y_prev, interpolator, solution);
         self.accepted += 1;
         if let Some(watch) = self.watch
             && self.accepted.is_multiple_of(AUTO_CHECK_STEPS)
@@ -309,6 +332,59 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
             return ControlFlag::Terminate;
         }
         flag
+    }
+}
+
+/// Where the trajectory is sampled.
+enum Sampler {
+    Even(EvenSolout<f64>),
+    /// Ascending times, and the index of the next one due.
+    At(Vec<f64>, usize),
+}
+
+impl Sampler {
+    fn new(opts: &SimOptions) -> Self {
+        match &opts.output_times {
+            Some(times) => Self::At(times.clone(), 0),
+            None => Self::Even(EvenSolout::new(opts.output_dt, 0.0, opts.t_end)),
+        }
+    }
+
+    fn sample<Y: StateVec, I: Interpolation<f64, Y> + ?Sized>(
+        &mut self,
+        t_curr: f64,
+        t_prev: f64,
+        y_curr: &Y,
+        y_prev: &Y,
+        interpolator: &mut I,
+        solution: &mut Solution<f64, Y>,
+    ) -> ControlFlag<f64, Y> {
+        match self {
+            Self::Even(even) => even.solout(t_curr, t_prev, y_curr, y_prev, interpolator, solution),
+            Self::At(times, next) => {
+                while let Some(&t) = times.get(*next) {
+                    if t > t_curr {
+                        break;
+                    }
+                    *next += 1;
+                    if t < t_prev {
+                        continue;
+                    }
+                    let y = if t == t_curr {
+                        y_curr.clone()
+                    } else if t == t_prev {
+                        y_prev.clone()
+                    } else {
+                        match interpolator.interpolate(t) {
+                            Ok(y) => y,
+                            Err(_) => continue,
+                        }
+                    };
+                    solution.push(t, y);
+                }
+                ControlFlag::Continue
+            }
+        }
     }
 }
 
@@ -425,6 +501,7 @@ fn run_auto<D: Dynamics + ?Sized>(
         return Ok((traj, stats));
     };
     let (rest, more) = simulate_implicit(arm, t_switch, x_switch, &implicit_opts)?;
+    traj.events.extend(rest.events);
     for (t, x) in rest.t.into_iter().zip(rest.x) {
         if traj.t.last().is_none_or(|&last| t > last) {
             traj.t.push(t);
@@ -463,8 +540,10 @@ fn run_explicit<D: Dynamics + ?Sized>(
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let ode = ArmOde::new(arm);
     let blown_up = Cell::new(None);
+    let events = RefCell::new(EventWatch::new(&opts.events, 2 * ode.n));
     let recorder = Recorder {
-        even: EvenSolout::new(opts.output_dt, 0.0, opts.t_end),
+        sampler: Sampler::new(opts),
+        events: &events,
         blown_up: &blown_up,
         failed_in_step: &ode.failed_in_step,
         fixed_step: opts.solver.fixed_step(),
@@ -510,7 +589,15 @@ fn run_explicit<D: Dynamics + ?Sized>(
             unreachable!("implicit methods run on arrays, auto dispatches")
         }
     };
-    finish(result, &ode, blown_up.get(), &x0, opts, start)
+    finish(
+        result,
+        &ode,
+        blown_up.get(),
+        &x0,
+        opts,
+        start,
+        events.into_inner().hits,
+    )
 }
 
 fn run_implicit<D: Dynamics + ?Sized, const P: usize>(
@@ -522,8 +609,10 @@ fn run_implicit<D: Dynamics + ?Sized, const P: usize>(
     let ode = ArmOde::new(arm);
     let blown_up = Cell::new(None);
     let no_switch = RefCell::new(None);
+    let events = RefCell::new(EventWatch::new(&opts.events, 2 * ode.n));
     let recorder = Recorder {
-        even: EvenSolout::new(opts.output_dt, 0.0, opts.t_end),
+        sampler: Sampler::new(opts),
+        events: &events,
         blown_up: &blown_up,
         failed_in_step: &ode.failed_in_step,
         fixed_step: false,
@@ -569,7 +658,15 @@ fn run_implicit<D: Dynamics + ?Sized, const P: usize>(
             .solve(),
         _ => unreachable!("explicit methods run on vectors"),
     };
-    finish(result, &ode, blown_up.get(), &x0, opts, start)
+    finish(
+        result,
+        &ode,
+        blown_up.get(),
+        &x0,
+        opts,
+        start,
+        events.into_inner().hits,
+    )
 }
 
 /// Turn the crate's outcome into a trajectory (padding dropped) or an
@@ -581,6 +678,7 @@ fn finish<D: Dynamics + ?Sized, Y: StateVec>(
     x0: &[f64],
     opts: &SimOptions,
     start: Instant,
+    hits: Vec<EventHit>,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let wall_s = start.elapsed().as_secs_f64();
     let m = 2 * ode.n;
@@ -605,6 +703,7 @@ fn finish<D: Dynamics + ?Sized, Y: StateVec>(
             let traj = Trajectory {
                 t: sol.t.clone(),
                 x: sol.y.iter().map(unpad).collect(),
+                events: hits,
             };
             if let Some(t_bad) = blown_up {
                 let state = traj.x.last().cloned().unwrap_or_else(|| x0.to_vec());

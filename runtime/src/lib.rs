@@ -6,6 +6,7 @@
 //! [`statics`] finds equilibria, [`modes`](mod@modes) linearises about them.
 
 pub mod arm;
+pub mod events;
 pub mod integrate;
 pub mod jacobian;
 pub mod kernels;
@@ -17,6 +18,7 @@ pub mod stiffness;
 pub mod tape;
 
 pub use arm::{AccelError, Arm, Dynamics, Workspace, accelerations};
+pub use events::{Crossing, Event, EventHit};
 pub use integrate::{SimFailure, SimOptions, SimStats, Solver, Trajectory, simulate};
 pub use jacobian::rhs_jacobian;
 pub use kernels::{
