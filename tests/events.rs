@@ -45,6 +45,7 @@ fn crossings_of_the_vertical_are_located_to_the_closed_form() {
     for (solver, rtol, tol) in [
         (Solver::Dopri5, 1e-10, 1e-7),
         (Solver::Dop853, 1e-10, 1e-7),
+        (Solver::Radau5, 1e-10, 1e-7),
         (Solver::Bdf, 1e-10, 1e-6),
     ] {
         let opts = SimOptions {
@@ -124,7 +125,11 @@ fn dense_output_at_requested_times_matches_a_fixed_step_run() {
     };
     let reference = run(Solver::Rk4, 0.0);
     assert_eq!(reference.t, times);
-    for (solver, rtol) in [(Solver::Dopri5, 1e-9), (Solver::Bdf, 1e-10)] {
+    for (solver, rtol) in [
+        (Solver::Dopri5, 1e-9),
+        (Solver::Radau5, 1e-9),
+        (Solver::Bdf, 1e-10),
+    ] {
         let traj = run(solver, rtol);
         assert_eq!(
             traj.t, times,

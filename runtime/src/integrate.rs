@@ -21,6 +21,7 @@ use serde::Serialize;
 use crate::arm::{AccelError, Dynamics, Workspace, accelerations};
 use crate::events::{Event, EventHit, EventWatch};
 use crate::jacobian::rhs_jacobian;
+use crate::radau5;
 
 /// Integrators. Names are the CLI's and the model files'.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -238,6 +239,15 @@ impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
         }
     }
 
+    /// The Jacobian of the unpadded system into `j` (NaN if it fails).
+    fn jacobian_dense(&self, t: f64, x: &[f64], j: &mut DMatrix<f64>) {
+        self.jac_evals.set(self.jac_evals.get() + 1);
+        if let Err(e) = rhs_jacobian(self.arm, &mut self.ws.borrow_mut(), t, x, j) {
+            self.first_error.borrow_mut().get_or_insert(e);
+            j.fill(f64::NAN);
+        }
+    }
+
     fn jacobian_into(&self, t: f64, x: &[f64], j: &mut Matrix<f64>) {
         self.jac_evals.set(self.jac_evals.get() + 1);
         let m = 2 * self.n;
@@ -258,6 +268,16 @@ impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
                 };
             }
         }
+    }
+}
+
+impl<D: Dynamics + ?Sized> radau5::OdeSystem for &ArmOde<'_, D> {
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        ArmOde::rhs(self, t, y, dy);
+    }
+
+    fn jacobian(&mut self, t: f64, y: &[f64], j: &mut DMatrix<f64>) {
+        self.jacobian_dense(t, y, j);
     }
 }
 
@@ -413,6 +433,9 @@ fn simulate_implicit<D: Dynamics + ?Sized>(
     opts: &SimOptions,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let n = arm.dof();
+    if opts.solver == Solver::Radau5 {
+        return run_radau5(arm, t0, x0, opts);
+    }
     macro_rules! sized {
         ($($p:literal),*) => {
             $(if x0.len() <= $p {
@@ -591,6 +614,71 @@ fn run_explicit<D: Dynamics + ?Sized>(
     };
     finish(
         result,
+        &ode,
+        blown_up.get(),
+        &x0,
+        opts,
+        start,
+        events.into_inner().hits,
+    )
+}
+
+/// Radau IIA on our own implementation (see `radau5`), fed through the
+/// same recorder as the crate's methods.
+fn run_radau5<D: Dynamics + ?Sized>(
+    arm: &D,
+    t0: f64,
+    x0: Vec<f64>,
+    opts: &SimOptions,
+) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
+    let ode = ArmOde::new(arm);
+    let blown_up = Cell::new(None);
+    let events = RefCell::new(EventWatch::new(&opts.events, 2 * ode.n));
+    let no_switch = RefCell::new(None);
+    let mut recorder = Recorder {
+        sampler: Sampler::new(opts),
+        events: &events,
+        blown_up: &blown_up,
+        failed_in_step: &ode.failed_in_step,
+        fixed_step: false,
+        watch: None,
+        switch: &no_switch,
+        accepted: 0,
+    };
+    let mut solution: Solution<f64, Vec<f64>> = Solution::new();
+    let mut counts = radau5::Counts::default();
+    let radau_opts = radau5::Options {
+        t_end: opts.t_end,
+        rtol: opts.rtol,
+        atol: opts.atol,
+        max_steps: opts.max_steps,
+    };
+    let start = Instant::now();
+    let result = radau5::integrate(
+        &mut &ode,
+        t0,
+        x0.clone(),
+        &radau_opts,
+        &mut |t_prev, t_curr, y_prev, y_curr, dense| {
+            let flag = recorder.solout(
+                t_curr,
+                t_prev,
+                &y_curr.to_vec(),
+                &y_prev.to_vec(),
+                dense,
+                &mut solution,
+            );
+            !matches!(flag, ControlFlag::Terminate)
+        },
+        &mut counts,
+    );
+    let outcome: Outcome<Vec<f64>> = result.map(|_| {
+        solution.steps.accepted = counts.accepted;
+        solution.steps.rejected = counts.rejected;
+        solution
+    });
+    finish(
+        outcome,
         &ode,
         blown_up.get(),
         &x0,

@@ -12,6 +12,7 @@ pub mod jacobian;
 pub mod kernels;
 pub mod linalg;
 pub mod modes;
+pub mod radau5;
 pub mod special;
 pub mod statics;
 pub mod stiffness;

@@ -1,0 +1,346 @@
+//! Radau IIA of order 5 (three stages), after Hairer and Wanner's RADAU5
+//! (Solving ODEs II, section IV.8): simplified Newton on the stage
+//! increments with the analytic Jacobian, the embedded error estimate
+//! filtered through (gamma/h - J)^-1, and the collocation polynomial as
+//! dense output.
+//!
+//! Ours rather than the `differential-equations` crate's because that one
+//! stalls at about 1e-6 on nonlinear problems whatever the tolerance (a
+//! plain pendulum at rtol 1e-12: 31 steps, error 1.4e-6; measured
+//! 2026-11-21), which an accurate reference solver cannot afford. The
+//! Newton system is solved whole (3m x 3m LU) rather than in Hairer's
+//! real + complex transformed form: simpler, and for the state sizes of
+//! lumped arms (m <= 256) the factorisation is a small part of a step.
+
+use differential_equations::error::Error;
+use differential_equations::interpolate::Interpolation;
+use nalgebra::{DMatrix, DVector};
+
+/// sqrt(6)
+const SQ6: f64 = 2.449_489_742_783_178;
+/// Collocation nodes.
+const C: [f64; 3] = [(4.0 - SQ6) / 10.0, (4.0 + SQ6) / 10.0, 1.0];
+/// The Butcher matrix of Radau IIA, order 5.
+const A: [[f64; 3]; 3] = [
+    [
+        (88.0 - 7.0 * SQ6) / 360.0,
+        (296.0 - 169.0 * SQ6) / 1800.0,
+        (-2.0 + 3.0 * SQ6) / 225.0,
+    ],
+    [
+        (296.0 + 169.0 * SQ6) / 1800.0,
+        (88.0 + 7.0 * SQ6) / 360.0,
+        (-2.0 - 3.0 * SQ6) / 225.0,
+    ],
+    [(16.0 - SQ6) / 36.0, (16.0 + SQ6) / 36.0, 1.0 / 9.0],
+];
+/// The real eigenvalue of A^-1 and the error estimate's weights.
+const GAMMA: f64 = 3.637_834_252_744_496;
+const DD: [f64; 3] = [
+    -(13.0 + 7.0 * SQ6) / 3.0,
+    (-13.0 + 7.0 * SQ6) / 3.0,
+    -1.0 / 3.0,
+];
+const MAX_NEWTON: usize = 7;
+
+pub struct Options {
+    pub t_end: f64,
+    pub rtol: f64,
+    pub atol: f64,
+    pub max_steps: usize,
+}
+
+/// y' = f(t, y) with its Jacobian df/dy.
+pub trait OdeSystem {
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]);
+    fn jacobian(&mut self, t: f64, y: &[f64], j: &mut DMatrix<f64>);
+}
+
+/// Sees every accepted step (t_prev, t, y_prev, y, dense output); returns
+/// false to stop.
+pub type StepFn<'a> = dyn FnMut(f64, f64, &[f64], &[f64], &mut Dense) -> bool + 'a;
+
+/// Why a run stopped early.
+pub enum Stop {
+    /// The callback asked to stop.
+    Requested,
+}
+
+/// Counters of a run.
+#[derive(Default)]
+pub struct Counts {
+    pub accepted: usize,
+    pub rejected: usize,
+}
+
+/// The dense output of the last accepted step.
+pub struct Dense {
+    t_prev: f64,
+    t_curr: f64,
+    h: f64,
+    y_curr: Vec<f64>,
+    /// Newton divided differences of the collocation polynomial.
+    cont: [Vec<f64>; 3],
+}
+
+impl Interpolation<f64, Vec<f64>> for Dense {
+    fn interpolate(&mut self, t: f64) -> Result<Vec<f64>, Error<f64, Vec<f64>>> {
+        if t < self.t_prev - 1e-12 * self.h.abs() || t > self.t_curr + 1e-12 * self.h.abs() {
+            return Err(Error::OutOfBounds {
+                t_interp: t,
+                t_prev: self.t_prev,
+                t_curr: self.t_curr,
+            });
+        }
+        let s = (t - self.t_curr) / self.h;
+        let (c1m1, c2m1) = (C[0] - 1.0, C[1] - 1.0);
+        Ok((0..self.y_curr.len())
+            .map(|i| {
+                let c = &self.cont;
+                self.y_curr[i] + s * (c[0][i] + (s - c2m1) * (c[1][i] + (s - c1m1) * c[2][i]))
+            })
+            .collect())
+    }
+}
+
+/// Integrate from (t0, y0) to `opts.t_end`. Errors carry the time and
+/// state reached.
+pub fn integrate(
+    sys: &mut dyn OdeSystem,
+    t0: f64,
+    y0: Vec<f64>,
+    opts: &Options,
+    step: &mut StepFn<'_>,
+    counts: &mut Counts,
+) -> Result<Option<Stop>, Error<f64, Vec<f64>>> {
+    let t_end = opts.t_end;
+    let m = y0.len();
+    // Hairer's tolerance transformation: the estimate is of order 3, so
+    // rtol' = 0.1 rtol^(2/3) makes the global error track rtol.
+    let rtol = 0.1 * opts.rtol.powf(2.0 / 3.0);
+    let atol = rtol * (opts.atol / opts.rtol);
+    let newton_tol = (10.0 * f64::EPSILON / rtol).max(0.03f64.min(rtol.sqrt()));
+    let (mut t, mut y) = (t0, y0);
+    let mut f0 = vec![0.0; m];
+    sys.rhs(t, &y, &mut f0);
+    let mut j = DMatrix::zeros(m, m);
+    let span = t_end - t0;
+    let mut h = (1e-6 * span).max(1e-12).min(span);
+    let mut first = true;
+    let mut last_rejected = false;
+    let mut z = vec![vec![0.0; m]; 3];
+    let mut fz = vec![vec![0.0; m]; 3];
+    let mut yi = vec![0.0; m];
+    let mut dense: Option<Dense> = None;
+    let mut jacobian_at: Option<f64> = None;
+    while t < t_end {
+        if counts.accepted + counts.rejected >= opts.max_steps {
+            return Err(Error::MaxSteps { t, y });
+        }
+        if h.abs() < 1e-14 * t.abs().max(1.0) {
+            return Err(Error::StepSize { t, y });
+        }
+        let last = t + h >= t_end;
+        if last {
+            h = t_end - t;
+        }
+        // A rejected step retries from the same point: keep its Jacobian.
+        if jacobian_at != Some(t) {
+            sys.jacobian(t, &y, &mut j);
+            jacobian_at = Some(t);
+        }
+        let scale: Vec<f64> = y.iter().map(|v| atol + rtol * v.abs()).collect();
+        // E = I - h (A (x) J), factored once per step.
+        let mut e = DMatrix::<f64>::identity(3 * m, 3 * m);
+        for (a, row) in A.iter().enumerate() {
+            for (b, &ab) in row.iter().enumerate() {
+                for r in 0..m {
+                    for c in 0..m {
+                        e[(a * m + r, b * m + c)] -= h * ab * j[(r, c)];
+                    }
+                }
+            }
+        }
+        let lu = e.lu();
+        // Start from the last step's collocation polynomial, extrapolated.
+        match &mut dense {
+            Some(d) if !first => {
+                for (k, zk) in z.iter_mut().enumerate() {
+                    let tk = t + C[k] * h;
+                    let yk = d.extrapolate(tk);
+                    for i in 0..m {
+                        zk[i] = yk[i] - y[i];
+                    }
+                }
+            }
+            _ => z.iter_mut().for_each(|zk| zk.fill(0.0)),
+        }
+        // Simplified Newton on G(Z) = Z - h (A (x) I) F(Z).
+        let mut converged = false;
+        let mut previous_norm = f64::INFINITY;
+        let mut theta = 0.5;
+        let mut iterations = 0;
+        for it in 0..MAX_NEWTON {
+            iterations = it + 1;
+            for k in 0..3 {
+                for i in 0..m {
+                    yi[i] = y[i] + z[k][i];
+                }
+                sys.rhs(t + C[k] * h, &yi, &mut fz[k]);
+            }
+            let mut rhs = DVector::<f64>::zeros(3 * m);
+            for a in 0..3 {
+                for i in 0..m {
+                    let hf: f64 = (0..3).map(|b| A[a][b] * fz[b][i]).sum::<f64>() * h;
+                    rhs[a * m + i] = hf - z[a][i];
+                }
+            }
+            let Some(dz) = lu.solve(&rhs) else {
+                return Err(Error::LinearAlgebra {
+                    t,
+                    y,
+                    msg: "the Newton matrix I - h (A x J) is singular".into(),
+                });
+            };
+            if dz.iter().any(|v| !v.is_finite()) {
+                break;
+            }
+            let norm = (dz
+                .iter()
+                .enumerate()
+                .map(|(k, v)| (v / scale[k % m]).powi(2))
+                .sum::<f64>()
+                / (3 * m) as f64)
+                .sqrt();
+            for a in 0..3 {
+                for i in 0..m {
+                    z[a][i] += dz[a * m + i];
+                }
+            }
+            if it > 0 {
+                theta = norm / previous_norm;
+                if theta >= 0.99 {
+                    break;
+                }
+            }
+            previous_norm = norm;
+            if theta / (1.0 - theta) * norm <= newton_tol || norm <= 1e-3 * newton_tol {
+                converged = true;
+                break;
+            }
+        }
+        if !converged {
+            counts.rejected += 1;
+            last_rejected = true;
+            h *= 0.5;
+            continue;
+        }
+        // Error estimate: (gamma/h - J)^-1 (f(t, y) + sum dd_k Z_k / h).
+        let mut err = estimate(&j, h, &f0, &z, &scale, m);
+        if err.1 >= 1.0 && (first || last_rejected) {
+            // Hairer's second estimate, better near stiff transients.
+            let perturbed: Vec<f64> = (0..m).map(|i| y[i] + err.0[i]).collect();
+            let mut fp = vec![0.0; m];
+            sys.rhs(t, &perturbed, &mut fp);
+            err = estimate(&j, h, &fp, &z, &scale, m);
+        }
+        let err = err.1.max(1e-10);
+        let safety = 0.9 * (2 * MAX_NEWTON + 1) as f64 / (2 * MAX_NEWTON + iterations) as f64;
+        let quot = (err.powf(0.25) / safety).clamp(1.0 / 8.0, 5.0);
+        let h_new = h / quot;
+        if err < 1.0 {
+            let y_new: Vec<f64> = (0..m).map(|i| y[i] + z[2][i]).collect();
+            let t_new = if last { t_end } else { t + h };
+            let cont = divided_differences(&z);
+            let d = dense.insert(Dense {
+                t_prev: t,
+                t_curr: t_new,
+                h,
+                y_curr: y_new.clone(),
+                cont,
+            });
+            counts.accepted += 1;
+            if y_new.iter().any(|v| !v.is_finite()) {
+                return Err(Error::StepSize { t, y });
+            }
+            let keep_going = step(t, t_new, &y, &y_new, d);
+            t = t_new;
+            y = y_new;
+            sys.rhs(t, &y, &mut f0);
+            first = false;
+            h = if last_rejected { h_new.min(h) } else { h_new };
+            last_rejected = false;
+            if !keep_going {
+                return Ok(Some(Stop::Requested));
+            }
+        } else {
+            counts.rejected += 1;
+            last_rejected = true;
+            h = if first { 0.1 * h } else { h_new };
+        }
+    }
+    Ok(None)
+}
+
+impl Dense {
+    /// The collocation polynomial past its step (the next step's Newton guess).
+    fn extrapolate(&self, t: f64) -> Vec<f64> {
+        let s = (t - self.t_curr) / self.h;
+        let (c1m1, c2m1) = (C[0] - 1.0, C[1] - 1.0);
+        let c = &self.cont;
+        (0..self.y_curr.len())
+            .map(|i| self.y_curr[i] + s * (c[0][i] + (s - c2m1) * (c[1][i] + (s - c1m1) * c[2][i])))
+            .collect()
+    }
+}
+
+/// Divided differences of the collocation polynomial through y (s = -1)
+/// and y + Z_k (s = c_k - 1), in the variable s = (t - t_new) / h.
+fn divided_differences(z: &[Vec<f64>]) -> [Vec<f64>; 3] {
+    let m = z[0].len();
+    let (c1, c2) = (C[0], C[1]);
+    let (c1m1, c2m1) = (c1 - 1.0, c2 - 1.0);
+    let mut d = [vec![0.0; m], vec![0.0; m], vec![0.0; m]];
+    for i in 0..m {
+        let first = (z[1][i] - z[2][i]) / c2m1;
+        let ak = (z[0][i] - z[1][i]) / (c1 - c2);
+        let acont3 = (ak - z[0][i] / c1) / c2;
+        let second = (ak - first) / c1m1;
+        d[0][i] = first;
+        d[1][i] = second;
+        d[2][i] = second - acont3;
+    }
+    d
+}
+
+/// The filtered error vector and its scaled RMS norm.
+fn estimate(
+    j: &DMatrix<f64>,
+    h: f64,
+    f0: &[f64],
+    z: &[Vec<f64>],
+    scale: &[f64],
+    m: usize,
+) -> (Vec<f64>, f64) {
+    let mut a = -j.clone();
+    for i in 0..m {
+        a[(i, i)] += GAMMA / h;
+    }
+    let rhs = DVector::from_iterator(
+        m,
+        (0..m).map(|i| f0[i] + (DD[0] * z[0][i] + DD[1] * z[1][i] + DD[2] * z[2][i]) / h),
+    );
+    let e: Vec<f64> = a
+        .lu()
+        .solve(&rhs)
+        .map(|e| e.iter().copied().collect())
+        .unwrap_or_else(|| vec![f64::INFINITY; m]);
+    let norm = (e
+        .iter()
+        .zip(scale)
+        .map(|(v, s)| (v / s).powi(2))
+        .sum::<f64>()
+        / m as f64)
+        .sqrt();
+    (e, norm)
+}
