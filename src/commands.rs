@@ -165,6 +165,9 @@ pub struct SimulateArgs {
     pub rtol: f64,
     #[arg(long, default_value_t = 1e-9, allow_negative_numbers = true)]
     pub atol: f64,
+    /// Give up after this many steps (accepted and rejected).
+    #[arg(long, default_value_t = 10_000_000)]
+    pub max_steps: usize,
     /// Spacing of trajectory.csv rows (s); default t_end / 500.
     #[arg(long, allow_negative_numbers = true)]
     pub output_dt: Option<f64>,
@@ -245,6 +248,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         atol: a.atol,
         dt: a.dt,
         output_dt,
+        max_steps: a.max_steps,
         ..Default::default()
     };
     let out_dir = a

@@ -45,6 +45,7 @@ fn crossings_of_the_vertical_are_located_to_the_closed_form() {
     for (solver, rtol, tol) in [
         (Solver::Dopri5, 1e-10, 1e-7),
         (Solver::Dop853, 1e-10, 1e-7),
+        (Solver::Bs23, 1e-10, 1e-6),
         (Solver::Radau5, 1e-10, 1e-7),
         (Solver::Bdf, 1e-10, 1e-6),
     ] {

@@ -52,6 +52,65 @@ fn unstable_fixed_step_is_explained_and_the_trajectory_kept() {
 }
 
 #[test]
+fn an_impossible_step_budget_is_explained_for_every_adaptive_solver() {
+    // 200 steps cannot cover 2 s of the double pendulum at rtol 1e-10.
+    for solver in ["dopri5", "bs23", "radau5", "bdf"] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = softarm(
+            &[
+                "simulate",
+                "double_pendulum",
+                "--solver",
+                solver,
+                "--rtol",
+                "1e-10",
+                "--atol",
+                "1e-12",
+                "--max-steps",
+                "200",
+                "--t-end",
+                "2",
+                "--q0",
+                "1.2,-0.5",
+                "--out",
+                "o",
+            ],
+            dir.path(),
+        );
+        assert!(!out.status.success(), "{solver}");
+        let err = stderr(&out);
+        assert!(
+            err.contains("step budget of 200 steps ran out"),
+            "{solver}: {err}"
+        );
+        assert!(err.contains("what to try"), "{solver}: {err}");
+        let summary: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join("o/summary.json")).unwrap(),
+        )
+        .unwrap();
+        let t_reached = summary["failure"]["t_reached"].as_f64().unwrap();
+        assert!(t_reached > 0.0 && t_reached < 2.0, "{solver}: {t_reached}");
+        let csv = std::fs::read_to_string(dir.path().join("o/trajectory.csv")).unwrap();
+        let rows = csv.lines().count() - 1;
+        let last_t: f64 = csv
+            .lines()
+            .last()
+            .unwrap()
+            .split(',')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        // Rows at every output time passed (t_end / 500 apart) are kept.
+        let due = (t_reached / (2.0 / 500.0)).floor() as usize + 1;
+        assert!(
+            rows == due && last_t <= t_reached + 1e-9,
+            "{solver}: {rows} rows kept, {due} due before t = {t_reached}"
+        );
+    }
+}
+
+#[test]
 fn summary_reports_the_run() {
     let dir = tempfile::tempdir().unwrap();
     let out = softarm(

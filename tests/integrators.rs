@@ -65,6 +65,8 @@ fn double_pendulum_with_every_integrator() {
         &[
             (Solver::Dopri5, 1e-9, 0.0, 1e-6),
             (Solver::Dop853, 1e-9, 0.0, 1e-6),
+            (Solver::Bs23, 1e-9, 0.0, 1e-6),
+            (Solver::Bs23, 1e-5, 0.0, 1e-3),
             (Solver::Radau5, 1e-9, 0.0, 1e-6),
             (Solver::Bdf, 1e-9, 0.0, 1e-5),
             (Solver::Esdirk, 1e-8, 0.0, 1e-5),
@@ -87,6 +89,7 @@ fn damped_pcc_cantilever_with_the_adaptive_integrators() {
         0.5,
         &[
             (Solver::Dopri5, 1e-9, 0.0, 1e-6),
+            (Solver::Bs23, 1e-8, 0.0, 1e-5),
             (Solver::Bdf, 1e-9, 0.0, 1e-5),
             (Solver::Radau5, 1e-9, 0.0, 1e-6),
             (Solver::Radau5, 1e-6, 0.0, 1e-4),

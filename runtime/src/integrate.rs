@@ -21,7 +21,18 @@ use serde::Serialize;
 use crate::arm::{AccelError, Dynamics, Workspace, accelerations};
 use crate::events::{Event, EventHit, EventWatch};
 use crate::jacobian::rhs_jacobian;
-use crate::radau5;
+use crate::stepper::{self, Counts, OdeSystem, StepFn};
+use crate::{bs23, radau5};
+
+/// The signature of our integrators' entry points.
+type OwnIntegrator = fn(
+    &mut dyn OdeSystem,
+    f64,
+    Vec<f64>,
+    &stepper::Options,
+    &mut StepFn<'_>,
+    &mut Counts,
+) -> Result<(), Error<f64, Vec<f64>>>;
 
 /// Integrators. Names are the CLI's and the model files'.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -31,6 +42,8 @@ pub enum Solver {
     Dopri5,
     /// Adaptive Dormand-Prince 8(5,3), explicit.
     Dop853,
+    /// Adaptive Bogacki-Shampine 3(2), explicit (the ode23 family).
+    Bs23,
     /// Classic fixed-step Runge-Kutta 4, explicit.
     Rk4,
     /// Fixed-step explicit Euler.
@@ -59,14 +72,15 @@ pub struct SolverSwitch {
 }
 
 impl Solver {
-    pub const NAMES: [&'static str; 8] = [
-        "dopri5", "dop853", "rk4", "euler", "radau5", "bdf", "esdirk", "auto",
+    pub const NAMES: [&'static str; 9] = [
+        "dopri5", "bs23", "dop853", "rk4", "euler", "radau5", "bdf", "esdirk", "auto",
     ];
 
     pub fn parse(s: &str) -> Option<Self> {
         Some(match s {
             "dopri5" => Self::Dopri5,
             "dop853" => Self::Dop853,
+            "bs23" => Self::Bs23,
             "rk4" => Self::Rk4,
             "euler" => Self::Euler,
             "radau5" => Self::Radau5,
@@ -81,6 +95,7 @@ impl Solver {
         match self {
             Self::Dopri5 => "dopri5",
             Self::Dop853 => "dop853",
+            Self::Bs23 => "bs23",
             Self::Rk4 => "rk4",
             Self::Euler => "euler",
             Self::Radau5 => "radau5",
@@ -271,7 +286,7 @@ impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
     }
 }
 
-impl<D: Dynamics + ?Sized> radau5::OdeSystem for &ArmOde<'_, D> {
+impl<D: Dynamics + ?Sized> OdeSystem for &ArmOde<'_, D> {
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
         ArmOde::rhs(self, t, y, dy);
     }
@@ -297,6 +312,10 @@ impl<D: Dynamics + ?Sized, Y: StateVec> ODE<f64, Y> for ArmOde<'_, D> {
 /// dense output would be NaN); adaptive methods reject such steps.
 struct Recorder<'a> {
     sampler: Sampler,
+    /// The samples so far, unpadded, kept outside the crate's solution so
+    /// that a run that fails still returns them.
+    kept: &'a RefCell<Trajectory>,
+    m: usize,
     events: &'a RefCell<EventWatch>,
     blown_up: &'a Cell<Option<f64>>,
     failed_in_step: &'a Cell<bool>,
@@ -309,6 +328,16 @@ struct Recorder<'a> {
 }
 
 type Watch<'a> = dyn Fn(&[f64], f64) -> Option<String> + 'a;
+
+impl Recorder<'_> {
+    fn keep<Y: StateVec>(&self, solution: &Solution<f64, Y>) {
+        let mut kept = self.kept.borrow_mut();
+        for k in kept.t.len()..solution.t.len() {
+            kept.t.push(solution.t[k]);
+            kept.x.push(solution.y[k].as_ref()[..self.m].to_vec());
+        }
+    }
+}
 
 impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
     fn solout<I>(
@@ -338,11 +367,13 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
             if solution.t.last() != Some(&t_event) {
                 solution.push(t_event, y_event);
             }
+            self.keep(solution);
             return ControlFlag::Terminate;
         }
         let flag = self
             .sampler
             .sample(t_curr, t_prev, y_curr, y_prev, interpolator, solution);
+        self.keep(solution);
         self.accepted += 1;
         if let Some(watch) = self.watch
             && self.accepted.is_multiple_of(AUTO_CHECK_STEPS)
@@ -420,6 +451,7 @@ pub fn simulate<D: Dynamics + ?Sized>(
     assert_eq!(x0.len(), 2 * n, "state must be [q, qd]");
     match opts.solver {
         Solver::Auto => run_auto(arm, x0, opts),
+        Solver::Bs23 => run_own(arm, 0.0, x0, opts, bs23::integrate),
         s if s.implicit() => simulate_implicit(arm, 0.0, x0, opts),
         _ => run_explicit(arm, 0.0, x0, opts, None, &RefCell::new(None)),
     }
@@ -434,7 +466,7 @@ fn simulate_implicit<D: Dynamics + ?Sized>(
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let n = arm.dof();
     if opts.solver == Solver::Radau5 {
-        return run_radau5(arm, t0, x0, opts);
+        return run_own(arm, t0, x0, opts, radau5::integrate);
     }
     macro_rules! sized {
         ($($p:literal),*) => {
@@ -564,8 +596,11 @@ fn run_explicit<D: Dynamics + ?Sized>(
     let ode = ArmOde::new(arm);
     let blown_up = Cell::new(None);
     let events = RefCell::new(EventWatch::new(&opts.events, 2 * ode.n));
+    let kept = RefCell::new(Trajectory::default());
     let recorder = Recorder {
         sampler: Sampler::new(opts),
+        kept: &kept,
+        m: 2 * ode.n,
         events: &events,
         blown_up: &blown_up,
         failed_in_step: &ode.failed_in_step,
@@ -608,8 +643,8 @@ fn run_explicit<D: Dynamics + ?Sized>(
             .method(ExplicitRungeKutta::euler(opts.dt).max_steps(fixed_steps))
             .solout(recorder)
             .solve(),
-        Solver::Radau5 | Solver::Bdf | Solver::Esdirk | Solver::Auto => {
-            unreachable!("implicit methods run on arrays, auto dispatches")
+        Solver::Radau5 | Solver::Bdf | Solver::Esdirk | Solver::Auto | Solver::Bs23 => {
+            unreachable!("implicit methods run on arrays, bs23 is ours, auto dispatches")
         }
     };
     finish(
@@ -619,24 +654,28 @@ fn run_explicit<D: Dynamics + ?Sized>(
         &x0,
         opts,
         start,
-        events.into_inner().hits,
+        recorded(events, kept),
     )
 }
 
-/// Radau IIA on our own implementation (see `radau5`), fed through the
-/// same recorder as the crate's methods.
-fn run_radau5<D: Dynamics + ?Sized>(
+/// An integrator of ours (`radau5`, `bs23`), fed through the same recorder
+/// as the crate's methods.
+fn run_own<D: Dynamics + ?Sized>(
     arm: &D,
     t0: f64,
     x0: Vec<f64>,
     opts: &SimOptions,
+    integrate: OwnIntegrator,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let ode = ArmOde::new(arm);
     let blown_up = Cell::new(None);
     let events = RefCell::new(EventWatch::new(&opts.events, 2 * ode.n));
     let no_switch = RefCell::new(None);
+    let kept = RefCell::new(Trajectory::default());
     let mut recorder = Recorder {
         sampler: Sampler::new(opts),
+        kept: &kept,
+        m: 2 * ode.n,
         events: &events,
         blown_up: &blown_up,
         failed_in_step: &ode.failed_in_step,
@@ -646,19 +685,19 @@ fn run_radau5<D: Dynamics + ?Sized>(
         accepted: 0,
     };
     let mut solution: Solution<f64, Vec<f64>> = Solution::new();
-    let mut counts = radau5::Counts::default();
-    let radau_opts = radau5::Options {
+    let mut counts = Counts::default();
+    let own_opts = stepper::Options {
         t_end: opts.t_end,
         rtol: opts.rtol,
         atol: opts.atol,
         max_steps: opts.max_steps,
     };
     let start = Instant::now();
-    let result = radau5::integrate(
+    let result = integrate(
         &mut &ode,
         t0,
         x0.clone(),
-        &radau_opts,
+        &own_opts,
         &mut |t_prev, t_curr, y_prev, y_curr, dense| {
             let flag = recorder.solout(
                 t_curr,
@@ -684,7 +723,7 @@ fn run_radau5<D: Dynamics + ?Sized>(
         &x0,
         opts,
         start,
-        events.into_inner().hits,
+        recorded(events, kept),
     )
 }
 
@@ -698,8 +737,11 @@ fn run_implicit<D: Dynamics + ?Sized, const P: usize>(
     let blown_up = Cell::new(None);
     let no_switch = RefCell::new(None);
     let events = RefCell::new(EventWatch::new(&opts.events, 2 * ode.n));
+    let kept = RefCell::new(Trajectory::default());
     let recorder = Recorder {
         sampler: Sampler::new(opts),
+        kept: &kept,
+        m: 2 * ode.n,
         events: &events,
         blown_up: &blown_up,
         failed_in_step: &ode.failed_in_step,
@@ -753,8 +795,16 @@ fn run_implicit<D: Dynamics + ?Sized, const P: usize>(
         &x0,
         opts,
         start,
-        events.into_inner().hits,
+        recorded(events, kept),
     )
+}
+
+/// The samples kept by a run's recorder, with its events.
+fn recorded(events: RefCell<EventWatch>, kept: RefCell<Trajectory>) -> Trajectory {
+    Trajectory {
+        events: events.into_inner().hits,
+        ..kept.into_inner()
+    }
 }
 
 /// Turn the crate's outcome into a trajectory (padding dropped) or an
@@ -766,8 +816,9 @@ fn finish<D: Dynamics + ?Sized, Y: StateVec>(
     x0: &[f64],
     opts: &SimOptions,
     start: Instant,
-    hits: Vec<EventHit>,
+    kept: Trajectory,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
+    let hits = kept.events.clone();
     let wall_s = start.elapsed().as_secs_f64();
     let m = 2 * ode.n;
     let stats_of = |steps: usize, rejected: usize| SimStats {
@@ -849,7 +900,7 @@ fn finish<D: Dynamics + ?Sized, Y: StateVec>(
                 reason,
                 suggestion,
                 state,
-                trajectory: Trajectory::default(),
+                trajectory: kept,
                 stats: stats_of(0, 0),
             }))
         }

@@ -6,6 +6,7 @@
 //! [`statics`] finds equilibria, [`modes`](mod@modes) linearises about them.
 
 pub mod arm;
+pub mod bs23;
 pub mod events;
 pub mod integrate;
 pub mod jacobian;
@@ -15,6 +16,7 @@ pub mod modes;
 pub mod radau5;
 pub mod special;
 pub mod statics;
+pub mod stepper;
 pub mod stiffness;
 pub mod tape;
 

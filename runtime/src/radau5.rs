@@ -16,6 +16,8 @@ use differential_equations::error::Error;
 use differential_equations::interpolate::Interpolation;
 use nalgebra::{DMatrix, DVector};
 
+use crate::stepper::{Counts, OdeSystem, Options, StepFn};
+
 /// sqrt(6)
 const SQ6: f64 = 2.449_489_742_783_178;
 /// Collocation nodes.
@@ -42,36 +44,6 @@ const DD: [f64; 3] = [
     -1.0 / 3.0,
 ];
 const MAX_NEWTON: usize = 7;
-
-pub struct Options {
-    pub t_end: f64,
-    pub rtol: f64,
-    pub atol: f64,
-    pub max_steps: usize,
-}
-
-/// y' = f(t, y) with its Jacobian df/dy.
-pub trait OdeSystem {
-    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]);
-    fn jacobian(&mut self, t: f64, y: &[f64], j: &mut DMatrix<f64>);
-}
-
-/// Sees every accepted step (t_prev, t, y_prev, y, dense output); returns
-/// false to stop.
-pub type StepFn<'a> = dyn FnMut(f64, f64, &[f64], &[f64], &mut Dense) -> bool + 'a;
-
-/// Why a run stopped early.
-pub enum Stop {
-    /// The callback asked to stop.
-    Requested,
-}
-
-/// Counters of a run.
-#[derive(Default)]
-pub struct Counts {
-    pub accepted: usize,
-    pub rejected: usize,
-}
 
 /// The dense output of the last accepted step.
 pub struct Dense {
@@ -112,7 +84,7 @@ pub fn integrate(
     opts: &Options,
     step: &mut StepFn<'_>,
     counts: &mut Counts,
-) -> Result<Option<Stop>, Error<f64, Vec<f64>>> {
+) -> Result<(), Error<f64, Vec<f64>>> {
     let t_end = opts.t_end;
     let m = y0.len();
     // Hairer's tolerance transformation: the estimate is of order 3, so
@@ -271,7 +243,7 @@ pub fn integrate(
             h = if last_rejected { h_new.min(h) } else { h_new };
             last_rejected = false;
             if !keep_going {
-                return Ok(Some(Stop::Requested));
+                return Ok(());
             }
         } else {
             counts.rejected += 1;
@@ -279,7 +251,7 @@ pub fn integrate(
             h = if first { 0.1 * h } else { h_new };
         }
     }
-    Ok(None)
+    Ok(())
 }
 
 impl Dense {

@@ -1,0 +1,136 @@
+//! Bogacki-Shampine 3(2), explicit and adaptive (MATLAB's ode23): three
+//! new stages per step thanks to first-same-as-last, a second-order
+//! embedded estimate, and cubic Hermite dense output. For loose tolerances
+//! and mildly stiff arms, where dopri5's higher order buys little. Written
+//! here because `differential-equations` 0.7 has no such tableau and its
+//! explicit methods cannot take one from outside the crate.
+
+use differential_equations::error::Error;
+use differential_equations::interpolate::Interpolation;
+
+use crate::stepper::{Counts, OdeSystem, Options, StepFn, error_norm};
+
+/// Cubic Hermite interpolation over one step from values and slopes.
+struct Hermite<'a> {
+    t0: f64,
+    h: f64,
+    y0: &'a [f64],
+    y1: &'a [f64],
+    f0: &'a [f64],
+    f1: &'a [f64],
+}
+
+impl Interpolation<f64, Vec<f64>> for Hermite<'_> {
+    fn interpolate(&mut self, t: f64) -> Result<Vec<f64>, Error<f64, Vec<f64>>> {
+        let s = (t - self.t0) / self.h;
+        if !(-1e-12..=1.0 + 1e-12).contains(&s) {
+            return Err(Error::OutOfBounds {
+                t_interp: t,
+                t_prev: self.t0,
+                t_curr: self.t0 + self.h,
+            });
+        }
+        let (s2, s3) = (s * s, s * s * s);
+        let (h00, h10) = (2.0 * s3 - 3.0 * s2 + 1.0, s3 - 2.0 * s2 + s);
+        let (h01, h11) = (-2.0 * s3 + 3.0 * s2, s3 - s2);
+        Ok((0..self.y0.len())
+            .map(|i| {
+                h00 * self.y0[i]
+                    + self.h * h10 * self.f0[i]
+                    + h01 * self.y1[i]
+                    + self.h * h11 * self.f1[i]
+            })
+            .collect())
+    }
+}
+
+/// Integrate from (t0, y0) to `opts.t_end`.
+pub fn integrate(
+    sys: &mut dyn OdeSystem,
+    t0: f64,
+    y0: Vec<f64>,
+    opts: &Options,
+    step: &mut StepFn<'_>,
+    counts: &mut Counts,
+) -> Result<(), Error<f64, Vec<f64>>> {
+    let m = y0.len();
+    let t_end = opts.t_end;
+    let (mut t, mut y) = (t0, y0);
+    let mut k1 = vec![0.0; m];
+    sys.rhs(t, &y, &mut k1);
+    let (mut k2, mut k3, mut k4) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+    let (mut stage, mut y_new, mut err) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+    // Initial step from the size of the state and of its rate (Hairer's
+    // simple estimate), within the span.
+    let d0 = error_norm(&y, &y, &y, opts.rtol, opts.atol);
+    let d1 = error_norm(&k1, &y, &y, opts.rtol, opts.atol);
+    let span = t_end - t0;
+    let mut h = if d0 > 1e-5 && d1 > 1e-5 {
+        0.01 * d0 / d1
+    } else {
+        1e-6
+    }
+    .min(span);
+    let mut rejected_last = false;
+    while t < t_end {
+        if counts.accepted + counts.rejected >= opts.max_steps {
+            return Err(Error::MaxSteps { t, y });
+        }
+        if h < 1e-14 * t.abs().max(1.0) {
+            return Err(Error::StepSize { t, y });
+        }
+        let last = t + h >= t_end;
+        if last {
+            h = t_end - t;
+        }
+        for i in 0..m {
+            stage[i] = y[i] + 0.5 * h * k1[i];
+        }
+        sys.rhs(t + 0.5 * h, &stage, &mut k2);
+        for i in 0..m {
+            stage[i] = y[i] + 0.75 * h * k2[i];
+        }
+        sys.rhs(t + 0.75 * h, &stage, &mut k3);
+        for i in 0..m {
+            y_new[i] = y[i] + h * (2.0 / 9.0 * k1[i] + 1.0 / 3.0 * k2[i] + 4.0 / 9.0 * k3[i]);
+        }
+        let t_new = if last { t_end } else { t + h };
+        sys.rhs(t_new, &y_new, &mut k4);
+        for i in 0..m {
+            err[i] =
+                h * (-5.0 / 72.0 * k1[i] + 1.0 / 12.0 * k2[i] + 1.0 / 9.0 * k3[i] - 0.125 * k4[i]);
+        }
+        let e = error_norm(&err, &y, &y_new, opts.rtol, opts.atol);
+        let e = if e.is_finite() { e } else { f64::INFINITY };
+        let factor = (0.9 * e.max(1e-10).powf(-1.0 / 3.0)).clamp(0.2, 5.0);
+        if e <= 1.0 {
+            counts.accepted += 1;
+            let mut dense = Hermite {
+                t0: t,
+                h: t_new - t,
+                y0: &y,
+                y1: &y_new,
+                f0: &k1,
+                f1: &k4,
+            };
+            let keep_going = step(t, t_new, &y, &y_new, &mut dense);
+            t = t_new;
+            std::mem::swap(&mut y, &mut y_new);
+            std::mem::swap(&mut k1, &mut k4);
+            h *= if rejected_last {
+                factor.min(1.0)
+            } else {
+                factor
+            };
+            rejected_last = false;
+            if !keep_going {
+                return Ok(());
+            }
+        } else {
+            counts.rejected += 1;
+            rejected_last = true;
+            h *= if e.is_finite() { factor.min(0.9) } else { 0.25 };
+        }
+    }
+    Ok(())
+}
