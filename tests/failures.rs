@@ -54,7 +54,7 @@ fn unstable_fixed_step_is_explained_and_the_trajectory_kept() {
 #[test]
 fn an_impossible_step_budget_is_explained_for_every_adaptive_solver() {
     // 200 steps cannot cover 2 s of the double pendulum at rtol 1e-10.
-    for solver in ["dopri5", "bs23", "radau5", "bdf"] {
+    for solver in ["dopri5", "bs23", "radau5", "trbdf2", "bdf"] {
         let dir = tempfile::tempdir().unwrap();
         let out = softarm(
             &[

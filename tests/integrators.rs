@@ -69,6 +69,7 @@ fn double_pendulum_with_every_integrator() {
             (Solver::Bs23, 1e-5, 0.0, 1e-3),
             (Solver::Radau5, 1e-9, 0.0, 1e-6),
             (Solver::Bdf, 1e-9, 0.0, 1e-5),
+            (Solver::Trbdf2, 1e-8, 0.0, 1e-4),
             (Solver::Esdirk, 1e-8, 0.0, 1e-5),
             (Solver::Rk4, 0.0, 1e-3, 1e-6),
             (Solver::Euler, 0.0, 1e-5, 1e-2),
@@ -93,6 +94,7 @@ fn damped_pcc_cantilever_with_the_adaptive_integrators() {
             (Solver::Bdf, 1e-9, 0.0, 1e-5),
             (Solver::Radau5, 1e-9, 0.0, 1e-6),
             (Solver::Radau5, 1e-6, 0.0, 1e-4),
+            (Solver::Trbdf2, 1e-7, 0.0, 1e-4),
         ],
     );
 }

@@ -22,7 +22,7 @@ use crate::arm::{AccelError, Dynamics, Workspace, accelerations};
 use crate::events::{Event, EventHit, EventWatch};
 use crate::jacobian::rhs_jacobian;
 use crate::stepper::{self, Counts, OdeSystem, StepFn};
-use crate::{bs23, radau5};
+use crate::{bs23, radau5, trbdf2};
 
 /// The signature of our integrators' entry points.
 type OwnIntegrator = fn(
@@ -52,7 +52,9 @@ pub enum Solver {
     Radau5,
     /// Variable-order BDF 1-5, implicit, adaptive (the ode15s family).
     Bdf,
-    /// ESDIRK 3(2) 4-stage, L-stable, adaptive (the ode23tb family).
+    /// TR-BDF2, L-stable, second order, adaptive (MATLAB's ode23tb).
+    Trbdf2,
+    /// ESDIRK 3(2) 4-stage, L-stable, adaptive (the crate's).
     Esdirk,
     /// dopri5, switching to radau5 when the arm turns out stiff (checked
     /// from the Jacobian's eigenvalues at the start and every
@@ -72,8 +74,8 @@ pub struct SolverSwitch {
 }
 
 impl Solver {
-    pub const NAMES: [&'static str; 9] = [
-        "dopri5", "bs23", "dop853", "rk4", "euler", "radau5", "bdf", "esdirk", "auto",
+    pub const NAMES: [&'static str; 10] = [
+        "dopri5", "bs23", "dop853", "rk4", "euler", "radau5", "bdf", "trbdf2", "esdirk", "auto",
     ];
 
     pub fn parse(s: &str) -> Option<Self> {
@@ -85,6 +87,7 @@ impl Solver {
             "euler" => Self::Euler,
             "radau5" => Self::Radau5,
             "bdf" => Self::Bdf,
+            "trbdf2" => Self::Trbdf2,
             "esdirk" => Self::Esdirk,
             "auto" => Self::Auto,
             _ => return None,
@@ -100,6 +103,7 @@ impl Solver {
             Self::Euler => "euler",
             Self::Radau5 => "radau5",
             Self::Bdf => "bdf",
+            Self::Trbdf2 => "trbdf2",
             Self::Esdirk => "esdirk",
             Self::Auto => "auto",
         }
@@ -112,7 +116,7 @@ impl Solver {
 
     /// Implicit methods (they use the analytic Jacobian).
     pub fn implicit(self) -> bool {
-        matches!(self, Self::Radau5 | Self::Bdf | Self::Esdirk)
+        matches!(self, Self::Radau5 | Self::Bdf | Self::Trbdf2 | Self::Esdirk)
     }
 }
 
@@ -465,8 +469,10 @@ fn simulate_implicit<D: Dynamics + ?Sized>(
     opts: &SimOptions,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let n = arm.dof();
-    if opts.solver == Solver::Radau5 {
-        return run_own(arm, t0, x0, opts, radau5::integrate);
+    match opts.solver {
+        Solver::Radau5 => return run_own(arm, t0, x0, opts, radau5::integrate),
+        Solver::Trbdf2 => return run_own(arm, t0, x0, opts, trbdf2::integrate),
+        _ => {}
     }
     macro_rules! sized {
         ($($p:literal),*) => {
@@ -643,7 +649,12 @@ fn run_explicit<D: Dynamics + ?Sized>(
             .method(ExplicitRungeKutta::euler(opts.dt).max_steps(fixed_steps))
             .solout(recorder)
             .solve(),
-        Solver::Radau5 | Solver::Bdf | Solver::Esdirk | Solver::Auto | Solver::Bs23 => {
+        Solver::Radau5
+        | Solver::Bdf
+        | Solver::Trbdf2
+        | Solver::Esdirk
+        | Solver::Auto
+        | Solver::Bs23 => {
             unreachable!("implicit methods run on arrays, bs23 is ours, auto dispatches")
         }
     };

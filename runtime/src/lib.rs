@@ -19,6 +19,7 @@ pub mod statics;
 pub mod stepper;
 pub mod stiffness;
 pub mod tape;
+pub mod trbdf2;
 
 pub use arm::{AccelError, Arm, Dynamics, Workspace, accelerations};
 pub use events::{Crossing, Event, EventHit};
