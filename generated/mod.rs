@@ -13,6 +13,8 @@ pub mod double_pendulum;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod hybrid_arm;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod long_arm;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod soft_finger;
 
 /// Every compiled-in model, by name.
@@ -51,6 +53,13 @@ pub static MODELS: &[CompiledModel] = &[
         dof: hybrid_arm::DOF,
         source: include_str!("../models/hybrid_arm.toml"),
         kernels: || Box::new(hybrid_arm::Compiled::default()),
+    },
+    CompiledModel {
+        name: "long_arm",
+        hash: long_arm::HASH,
+        dof: long_arm::DOF,
+        source: include_str!("../models/long_arm.toml"),
+        kernels: || Box::new(long_arm::Compiled::default()),
     },
     CompiledModel {
         name: "soft_finger",
