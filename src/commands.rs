@@ -152,19 +152,21 @@ pub fn derive(a: DeriveArgs) -> Result<ExitCode> {
 pub struct SimulateArgs {
     #[command(flatten)]
     pub model: ModelArgs,
-    /// End time (s).
-    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
-    pub t_end: f64,
-    /// Integrator.
-    #[arg(long, default_value = "dopri5", value_parser = Solver::NAMES)]
-    pub solver: String,
-    /// Step of fixed-step solvers (s).
-    #[arg(long, default_value_t = 1e-3, allow_negative_numbers = true)]
-    pub dt: f64,
-    #[arg(long, default_value_t = 1e-6, allow_negative_numbers = true)]
-    pub rtol: f64,
-    #[arg(long, default_value_t = 1e-9, allow_negative_numbers = true)]
-    pub atol: f64,
+    /// End time (s) [default: the model's simulate.t_end, else 5].
+    #[arg(long, allow_negative_numbers = true)]
+    pub t_end: Option<f64>,
+    /// Integrator [default: the model's simulate.solver, else dopri5].
+    #[arg(long, value_parser = Solver::NAMES)]
+    pub solver: Option<String>,
+    /// Step of fixed-step solvers (s) [default: simulate.dt, else 1e-3].
+    #[arg(long, allow_negative_numbers = true)]
+    pub dt: Option<f64>,
+    /// Relative tolerance [default: simulate.rtol, else 1e-6].
+    #[arg(long, allow_negative_numbers = true)]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance [default: simulate.atol, else 1e-9].
+    #[arg(long, allow_negative_numbers = true)]
+    pub atol: Option<f64>,
     /// Give up after this many steps (accepted and rejected).
     #[arg(long, default_value_t = 10_000_000)]
     pub max_steps: usize,
@@ -223,30 +225,38 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     let arm = &*loaded.arm;
     let n = arm.dof();
     let coords = arm.info().coordinates.clone();
-    if !(a.t_end > 0.0 && a.t_end.is_finite()) {
-        bail!(
-            "--t-end must be a positive number of seconds, got {}",
-            a.t_end
-        );
+    // The command line, else the model's [simulate], else the defaults.
+    let file = &loaded.model.simulate;
+    let t_end = a.t_end.or(file.t_end).unwrap_or(5.0);
+    let dt = a.dt.or(file.dt).unwrap_or(1e-3);
+    let rtol = a.rtol.or(file.rtol).unwrap_or(1e-6);
+    let atol = a.atol.or(file.atol).unwrap_or(1e-9);
+    let solver_name = a
+        .solver
+        .clone()
+        .or(file.solver.clone())
+        .unwrap_or_else(|| "dopri5".into());
+    if !(t_end > 0.0 && t_end.is_finite()) {
+        bail!("--t-end must be a positive number of seconds, got {t_end}");
     }
-    for (name, v) in [("--dt", a.dt), ("--rtol", a.rtol), ("--atol", a.atol)] {
+    for (name, v) in [("--dt", dt), ("--rtol", rtol), ("--atol", atol)] {
         if !(v > 0.0 && v.is_finite()) {
             bail!("{name} must be positive, got {v}");
         }
     }
     let q0 = optional_vector("--q0", &a.q0, n, &coords)?;
     let qd0 = optional_vector("--qd0", &a.qd0, n, &coords)?;
-    let solver = Solver::parse(&a.solver).expect("clap checked the solver name");
-    let output_dt = a.output_dt.unwrap_or(a.t_end / 500.0);
+    let solver = Solver::parse(&solver_name).expect("clap and validation checked the name");
+    let output_dt = a.output_dt.unwrap_or(t_end / 500.0);
     if !(output_dt > 0.0 && output_dt.is_finite()) {
         bail!("--output-dt must be positive, got {output_dt}");
     }
     let opts = SimOptions {
-        t_end: a.t_end,
+        t_end,
         solver,
-        rtol: a.rtol,
-        atol: a.atol,
-        dt: a.dt,
+        rtol,
+        atol,
+        dt,
         output_dt,
         max_steps: a.max_steps,
         ..Default::default()

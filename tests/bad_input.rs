@@ -135,6 +135,29 @@ fn cases() -> Vec<(&'static str, String, Vec<&'static str>, Vec<&'static str>)> 
             vec!["segment[0].joint_stiffness", "zero or positive"],
         ),
         (
+            "unknown solver in [simulate]",
+            format!("{GOOD}[simulate]\nsolver = \"ode45\"\n"),
+            vec![],
+            vec![
+                "simulate.solver",
+                "unknown solver \"ode45\"",
+                "radau5",
+                "trbdf2",
+            ],
+        ),
+        (
+            "negative tolerance in [simulate]",
+            format!("{GOOD}[simulate]\nrtol = -1e-6\n"),
+            vec![],
+            vec!["simulate.rtol", "must be positive"],
+        ),
+        (
+            "unknown key in [simulate]",
+            format!("{GOOD}[simulate]\nintegrator = \"radau5\"\n"),
+            vec![],
+            vec!["unknown field `integrator`", "solver"],
+        ),
+        (
             "negative tip mass",
             r("mass = 0.1", "mass = -0.1"),
             vec![],

@@ -18,6 +18,22 @@ pub struct Model {
     pub segments: Vec<Segment>,
     #[serde(default)]
     pub tip: Tip,
+    /// Defaults for `softarm simulate`; its options override them.
+    #[serde(default)]
+    pub simulate: SimulateDefaults,
+}
+
+/// `[simulate]`: how this arm is best simulated. Not structural.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SimulateDefaults {
+    /// An integrator name, as `--solver` takes it.
+    pub solver: Option<String>,
+    pub t_end: Option<f64>,
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+    /// Step of the fixed-step solvers (s).
+    pub dt: Option<f64>,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]

@@ -52,6 +52,28 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
         }
     };
 
+    let sim = &m.simulate;
+    if let Some(solver) = &sim.solver
+        && !runtime::Solver::NAMES.contains(&solver.as_str())
+    {
+        return err(
+            "simulate.solver".into(),
+            format!(
+                "unknown solver \"{solver}\"; allowed: {}",
+                runtime::Solver::NAMES.join(", ")
+            ),
+        );
+    }
+    for (key, v) in [
+        ("simulate.t_end", sim.t_end),
+        ("simulate.rtol", sim.rtol),
+        ("simulate.atol", sim.atol),
+        ("simulate.dt", sim.dt),
+    ] {
+        if let Some(v) = v {
+            positive(key, v)?;
+        }
+    }
     if m.name.trim().is_empty() {
         return err("name".into(), "must not be empty".into());
     }
