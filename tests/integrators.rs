@@ -78,7 +78,7 @@ fn double_pendulum_with_every_integrator() {
 }
 
 #[test]
-fn damped_pcc_cantilever_with_the_adaptive_integrators() {
+fn damped_pcc_cantilever_with_every_integrator() {
     check(
         "cantilever",
         &[
@@ -95,6 +95,10 @@ fn damped_pcc_cantilever_with_the_adaptive_integrators() {
             (Solver::Radau5, 1e-9, 0.0, 1e-6),
             (Solver::Radau5, 1e-6, 0.0, 1e-4),
             (Solver::Trbdf2, 1e-7, 0.0, 1e-4),
+            (Solver::Dop853, 1e-9, 0.0, 1e-6),
+            (Solver::Esdirk, 1e-8, 0.0, 1e-4),
+            (Solver::Rk4, 0.0, 2e-5, 1e-6),
+            (Solver::Euler, 0.0, 1e-5, 1e-2),
         ],
     );
 }
