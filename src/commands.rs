@@ -275,7 +275,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         Err(f) => {
             let f = *f;
             let msg = f.to_string();
-            let fail = json!({"t_reached": f.t_reached, "reason": f.reason, "suggestion": f.suggestion, "state": f.state});
+            let fail = json!({"t_reached": f.t_reached, "last_step_s": f.last_step_s, "reason": f.reason, "suggestion": f.suggestion, "state": f.state});
             (f.trajectory, f.stats, Some((msg, fail)))
         }
     };

@@ -84,6 +84,7 @@ fn an_impossible_step_budget_is_explained_for_every_adaptive_solver() {
             "{solver}: {err}"
         );
         assert!(err.contains("what to try"), "{solver}: {err}");
+        assert!(err.contains("last accepted step"), "{solver}: {err}");
         let summary: serde_json::Value = serde_json::from_str(
             &std::fs::read_to_string(dir.path().join("o/summary.json")).unwrap(),
         )

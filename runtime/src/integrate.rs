@@ -183,6 +183,8 @@ pub struct SimStats {
 #[derive(Debug)]
 pub struct SimFailure {
     pub t_reached: f64,
+    /// The last accepted step (s); None if none was accepted.
+    pub last_step_s: Option<f64>,
     pub reason: String,
     pub suggestion: String,
     pub state: Vec<f64>,
@@ -192,11 +194,11 @@ pub struct SimFailure {
 
 impl std::fmt::Display for SimFailure {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "integration stopped at t = {:.6} s: {}\n  what to try: {}",
-            self.t_reached, self.reason, self.suggestion
-        )
+        write!(f, "integration stopped at t = {:.6} s", self.t_reached)?;
+        if let Some(h) = self.last_step_s {
+            write!(f, " (last accepted step {h:.3e} s)")?;
+        }
+        write!(f, ": {}\n  what to try: {}", self.reason, self.suggestion)
     }
 }
 
@@ -320,6 +322,8 @@ struct Recorder<'a> {
     /// that a run that fails still returns them.
     kept: &'a RefCell<Trajectory>,
     m: usize,
+    /// The last accepted step, for failure reports.
+    last_step: &'a Cell<Option<f64>>,
     events: &'a RefCell<EventWatch>,
     blown_up: &'a Cell<Option<f64>>,
     failed_in_step: &'a Cell<bool>,
@@ -356,6 +360,9 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
     where
         I: Interpolation<f64, Y> + ?Sized,
     {
+        if t_curr > t_prev {
+            self.last_step.set(Some(t_curr - t_prev));
+        }
         let rhs_failed = self.failed_in_step.replace(false) && self.fixed_step;
         if rhs_failed || y_curr.as_ref().iter().any(|v| !v.is_finite()) {
             self.blown_up.set(Some(t_prev));
@@ -484,6 +491,7 @@ fn simulate_implicit<D: Dynamics + ?Sized>(
     sized!(4, 8, 12, 16, 24, 32, 48, 64, 96, 128);
     Err(Box::new(SimFailure {
         t_reached: t0,
+        last_step_s: None,
         reason: format!(
             "the implicit solvers are compiled for up to {} coordinates, this arm has {n}",
             IMPLICIT_SIZES[IMPLICIT_SIZES.len() - 1] / 2
@@ -603,10 +611,12 @@ fn run_explicit<D: Dynamics + ?Sized>(
     let blown_up = Cell::new(None);
     let events = RefCell::new(EventWatch::new(&opts.events, 2 * ode.n));
     let kept = RefCell::new(Trajectory::default());
+    let last_step = Cell::new(None);
     let recorder = Recorder {
         sampler: Sampler::new(opts),
         kept: &kept,
         m: 2 * ode.n,
+        last_step: &last_step,
         events: &events,
         blown_up: &blown_up,
         failed_in_step: &ode.failed_in_step,
@@ -665,7 +675,7 @@ fn run_explicit<D: Dynamics + ?Sized>(
         &x0,
         opts,
         start,
-        recorded(events, kept),
+        recorded(events, kept, &last_step),
     )
 }
 
@@ -683,10 +693,12 @@ fn run_own<D: Dynamics + ?Sized>(
     let events = RefCell::new(EventWatch::new(&opts.events, 2 * ode.n));
     let no_switch = RefCell::new(None);
     let kept = RefCell::new(Trajectory::default());
+    let last_step = Cell::new(None);
     let mut recorder = Recorder {
         sampler: Sampler::new(opts),
         kept: &kept,
         m: 2 * ode.n,
+        last_step: &last_step,
         events: &events,
         blown_up: &blown_up,
         failed_in_step: &ode.failed_in_step,
@@ -734,7 +746,7 @@ fn run_own<D: Dynamics + ?Sized>(
         &x0,
         opts,
         start,
-        recorded(events, kept),
+        recorded(events, kept, &last_step),
     )
 }
 
@@ -749,10 +761,12 @@ fn run_implicit<D: Dynamics + ?Sized, const P: usize>(
     let no_switch = RefCell::new(None);
     let events = RefCell::new(EventWatch::new(&opts.events, 2 * ode.n));
     let kept = RefCell::new(Trajectory::default());
+    let last_step = Cell::new(None);
     let recorder = Recorder {
         sampler: Sampler::new(opts),
         kept: &kept,
         m: 2 * ode.n,
+        last_step: &last_step,
         events: &events,
         blown_up: &blown_up,
         failed_in_step: &ode.failed_in_step,
@@ -806,15 +820,28 @@ fn run_implicit<D: Dynamics + ?Sized, const P: usize>(
         &x0,
         opts,
         start,
-        recorded(events, kept),
+        recorded(events, kept, &last_step),
     )
 }
 
-/// The samples kept by a run's recorder, with its events.
-fn recorded(events: RefCell<EventWatch>, kept: RefCell<Trajectory>) -> Trajectory {
-    Trajectory {
-        events: events.into_inner().hits,
-        ..kept.into_inner()
+/// What a run's recorder saw: the samples with the events, and the last
+/// accepted step.
+struct Recorded {
+    kept: Trajectory,
+    last_step_s: Option<f64>,
+}
+
+fn recorded(
+    events: RefCell<EventWatch>,
+    kept: RefCell<Trajectory>,
+    last_step: &Cell<Option<f64>>,
+) -> Recorded {
+    Recorded {
+        kept: Trajectory {
+            events: events.into_inner().hits,
+            ..kept.into_inner()
+        },
+        last_step_s: last_step.get(),
     }
 }
 
@@ -827,8 +854,9 @@ fn finish<D: Dynamics + ?Sized, Y: StateVec>(
     x0: &[f64],
     opts: &SimOptions,
     start: Instant,
-    kept: Trajectory,
+    recorded: Recorded,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
+    let Recorded { kept, last_step_s } = recorded;
     let hits = kept.events.clone();
     let wall_s = start.elapsed().as_secs_f64();
     let m = 2 * ode.n;
@@ -859,6 +887,7 @@ fn finish<D: Dynamics + ?Sized, Y: StateVec>(
                 let state = traj.x.last().cloned().unwrap_or_else(|| x0.to_vec());
                 return Err(Box::new(SimFailure {
                     t_reached: t_bad,
+                    last_step_s,
                     reason: explain("the state became non-finite (NaN or infinite)".into()),
                     suggestion: format!(
                         "the fixed step dt = {} is probably above the stability limit: reduce --dt, \
@@ -908,6 +937,7 @@ fn finish<D: Dynamics + ?Sized, Y: StateVec>(
             };
             Err(Box::new(SimFailure {
                 t_reached,
+                last_step_s,
                 reason,
                 suggestion,
                 state,
