@@ -253,8 +253,8 @@ impl<'a> Lowerer<'a> {
         s
     }
 
-    /// An angle `x = base + rest` with `base` a bound angle (a frame's):
-    /// the split that the addition theorems use.
+    /// An angle `x = base + rest` with `base` a frame's angle: the split
+    /// that the addition theorems use.
     fn split_angle(&mut self, x: ExprId) -> Option<(ExprId, ExprId)> {
         let sum = match self.cas.node(x) {
             Node::Bind(y) => *y,
@@ -264,13 +264,25 @@ impl<'a> Lowerer<'a> {
             return None;
         };
         let terms = terms.clone();
-        let mut binds = terms
+        // The frame's angle: a bound one, or at the base a parameter-only
+        // one (whose sine and cosine are hoisted out of the kernel).
+        let only = |ts: Vec<ExprId>| (ts.len() == 1).then(|| ts[0]);
+        let binds: Vec<ExprId> = terms
             .iter()
-            .filter(|&&t| matches!(self.cas.node(t), Node::Bind(_)));
-        let base = *binds.next()?;
-        if binds.next().is_some() {
-            return None;
-        }
+            .copied()
+            .filter(|&t| matches!(self.cas.node(t), Node::Bind(_)))
+            .collect();
+        let base = match binds.len() {
+            0 => {
+                let fixed: Vec<ExprId> = terms
+                    .iter()
+                    .copied()
+                    .filter(|&t| self.param_only(t))
+                    .collect();
+                only(fixed)?
+            }
+            _ => only(binds)?,
+        };
         let rest: Vec<ExprId> = terms.into_iter().filter(|&t| t != base).collect();
         Some((base, self.cas.add_all(&rest)))
     }
