@@ -7,6 +7,7 @@
 
 pub mod arm;
 pub mod bs23;
+pub mod cosserat;
 pub mod events;
 pub mod integrate;
 pub mod jacobian;
