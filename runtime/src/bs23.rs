@@ -6,43 +6,8 @@
 //! explicit methods cannot take one from outside the crate.
 
 use differential_equations::error::Error;
-use differential_equations::interpolate::Interpolation;
 
-use crate::stepper::{Counts, OdeSystem, Options, StepFn, error_norm};
-
-/// Cubic Hermite interpolation over one step from values and slopes.
-struct Hermite<'a> {
-    t0: f64,
-    h: f64,
-    y0: &'a [f64],
-    y1: &'a [f64],
-    f0: &'a [f64],
-    f1: &'a [f64],
-}
-
-impl Interpolation<f64, Vec<f64>> for Hermite<'_> {
-    fn interpolate(&mut self, t: f64) -> Result<Vec<f64>, Error<f64, Vec<f64>>> {
-        let s = (t - self.t0) / self.h;
-        if !(-1e-12..=1.0 + 1e-12).contains(&s) {
-            return Err(Error::OutOfBounds {
-                t_interp: t,
-                t_prev: self.t0,
-                t_curr: self.t0 + self.h,
-            });
-        }
-        let (s2, s3) = (s * s, s * s * s);
-        let (h00, h10) = (2.0 * s3 - 3.0 * s2 + 1.0, s3 - 2.0 * s2 + s);
-        let (h01, h11) = (-2.0 * s3 + 3.0 * s2, s3 - s2);
-        Ok((0..self.y0.len())
-            .map(|i| {
-                h00 * self.y0[i]
-                    + self.h * h10 * self.f0[i]
-                    + h01 * self.y1[i]
-                    + self.h * h11 * self.f1[i]
-            })
-            .collect())
-    }
-}
+use crate::stepper::{Counts, Hermite, OdeSystem, Options, StepFn, error_norm};
 
 /// Integrate from (t0, y0) to `opts.t_end`.
 pub fn integrate(

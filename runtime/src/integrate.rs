@@ -608,23 +608,8 @@ fn run_explicit<D: Dynamics + ?Sized>(
     switch: &RefCell<Option<(f64, Vec<f64>, String)>>,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let ode = ArmOde::new(arm);
-    let blown_up = Cell::new(None);
-    let events = RefCell::new(EventWatch::new(&opts.events, 2 * ode.n));
-    let kept = RefCell::new(Trajectory::default());
-    let last_step = Cell::new(None);
-    let recorder = Recorder {
-        sampler: Sampler::new(opts),
-        kept: &kept,
-        m: 2 * ode.n,
-        last_step: &last_step,
-        events: &events,
-        blown_up: &blown_up,
-        failed_in_step: &ode.failed_in_step,
-        fixed_step: opts.solver.fixed_step(),
-        watch,
-        switch,
-        accepted: 0,
-    };
+    let log = RunLog::new(opts, ode.n);
+    let recorder = log.recorder(opts, &ode, opts.solver.fixed_step(), watch, switch);
     let start = Instant::now();
     let problem = IVP::ode(&ode, t0, opts.t_end, x0.clone());
     // (dt only matters for fixed-step methods; t_end / 0 saturates.)
@@ -671,11 +656,11 @@ fn run_explicit<D: Dynamics + ?Sized>(
     finish(
         result,
         &ode,
-        blown_up.get(),
+        log.blown_up.get(),
         &x0,
         opts,
         start,
-        recorded(events, kept, &last_step),
+        log.finish(),
     )
 }
 
@@ -689,24 +674,9 @@ fn run_own<D: Dynamics + ?Sized>(
     integrate: OwnIntegrator,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let ode = ArmOde::new(arm);
-    let blown_up = Cell::new(None);
-    let events = RefCell::new(EventWatch::new(&opts.events, 2 * ode.n));
+    let log = RunLog::new(opts, ode.n);
     let no_switch = RefCell::new(None);
-    let kept = RefCell::new(Trajectory::default());
-    let last_step = Cell::new(None);
-    let mut recorder = Recorder {
-        sampler: Sampler::new(opts),
-        kept: &kept,
-        m: 2 * ode.n,
-        last_step: &last_step,
-        events: &events,
-        blown_up: &blown_up,
-        failed_in_step: &ode.failed_in_step,
-        fixed_step: false,
-        watch: None,
-        switch: &no_switch,
-        accepted: 0,
-    };
+    let mut recorder = log.recorder(opts, &ode, false, None, &no_switch);
     let mut solution: Solution<f64, Vec<f64>> = Solution::new();
     let mut counts = Counts::default();
     let own_opts = stepper::Options {
@@ -742,11 +712,11 @@ fn run_own<D: Dynamics + ?Sized>(
     finish(
         outcome,
         &ode,
-        blown_up.get(),
+        log.blown_up.get(),
         &x0,
         opts,
         start,
-        recorded(events, kept, &last_step),
+        log.finish(),
     )
 }
 
@@ -757,24 +727,9 @@ fn run_implicit<D: Dynamics + ?Sized, const P: usize>(
     opts: &SimOptions,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let ode = ArmOde::new(arm);
-    let blown_up = Cell::new(None);
+    let log = RunLog::new(opts, ode.n);
     let no_switch = RefCell::new(None);
-    let events = RefCell::new(EventWatch::new(&opts.events, 2 * ode.n));
-    let kept = RefCell::new(Trajectory::default());
-    let last_step = Cell::new(None);
-    let recorder = Recorder {
-        sampler: Sampler::new(opts),
-        kept: &kept,
-        m: 2 * ode.n,
-        last_step: &last_step,
-        events: &events,
-        blown_up: &blown_up,
-        failed_in_step: &ode.failed_in_step,
-        fixed_step: false,
-        watch: None,
-        switch: &no_switch,
-        accepted: 0,
-    };
+    let recorder = log.recorder(opts, &ode, false, None, &no_switch);
     let mut y0 = [0.0; P];
     y0[..x0.len()].copy_from_slice(&x0);
     let start = Instant::now();
@@ -816,11 +771,11 @@ fn run_implicit<D: Dynamics + ?Sized, const P: usize>(
     finish(
         result,
         &ode,
-        blown_up.get(),
+        log.blown_up.get(),
         &x0,
         opts,
         start,
-        recorded(events, kept, &last_step),
+        log.finish(),
     )
 }
 
@@ -831,17 +786,55 @@ struct Recorded {
     last_step_s: Option<f64>,
 }
 
-fn recorded(
+/// The shared state a run's `Recorder` writes to.
+struct RunLog {
+    blown_up: Cell<Option<f64>>,
     events: RefCell<EventWatch>,
     kept: RefCell<Trajectory>,
-    last_step: &Cell<Option<f64>>,
-) -> Recorded {
-    Recorded {
-        kept: Trajectory {
-            events: events.into_inner().hits,
-            ..kept.into_inner()
-        },
-        last_step_s: last_step.get(),
+    last_step: Cell<Option<f64>>,
+}
+
+impl RunLog {
+    fn new(opts: &SimOptions, dof: usize) -> Self {
+        Self {
+            blown_up: Cell::new(None),
+            events: RefCell::new(EventWatch::new(&opts.events, 2 * dof)),
+            kept: RefCell::new(Trajectory::default()),
+            last_step: Cell::new(None),
+        }
+    }
+
+    fn recorder<'a, D: ?Sized>(
+        &'a self,
+        opts: &SimOptions,
+        ode: &'a ArmOde<'_, D>,
+        fixed_step: bool,
+        watch: Option<&'a Watch<'a>>,
+        switch: &'a RefCell<Option<(f64, Vec<f64>, String)>>,
+    ) -> Recorder<'a> {
+        Recorder {
+            sampler: Sampler::new(opts),
+            kept: &self.kept,
+            m: 2 * ode.n,
+            last_step: &self.last_step,
+            events: &self.events,
+            blown_up: &self.blown_up,
+            failed_in_step: &ode.failed_in_step,
+            fixed_step,
+            watch,
+            switch,
+            accepted: 0,
+        }
+    }
+
+    fn finish(&self) -> Recorded {
+        Recorded {
+            kept: Trajectory {
+                events: std::mem::take(&mut self.events.borrow_mut().hits),
+                ..self.kept.take()
+            },
+            last_step_s: self.last_step.get(),
+        }
     }
 }
 

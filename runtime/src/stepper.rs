@@ -2,6 +2,7 @@
 //! the system, the options, and the per-step callback through which
 //! `integrate` samples, locates events and stops them.
 
+use differential_equations::error::Error;
 use differential_equations::interpolate::Interpolation;
 use nalgebra::DMatrix;
 
@@ -38,4 +39,38 @@ pub fn error_norm(e: &[f64], a: &[f64], b: &[f64], rtol: f64, atol: f64) -> f64 
         .map(|(e, (a, b))| (e / (atol + rtol * a.abs().max(b.abs()))).powi(2))
         .sum();
     (sum / e.len().max(1) as f64).sqrt()
+}
+
+/// Cubic Hermite interpolation over one step from values and slopes.
+pub struct Hermite<'a> {
+    pub t0: f64,
+    pub h: f64,
+    pub y0: &'a [f64],
+    pub y1: &'a [f64],
+    pub f0: &'a [f64],
+    pub f1: &'a [f64],
+}
+
+impl Interpolation<f64, Vec<f64>> for Hermite<'_> {
+    fn interpolate(&mut self, t: f64) -> Result<Vec<f64>, Error<f64, Vec<f64>>> {
+        let s = (t - self.t0) / self.h;
+        if !(-1e-12..=1.0 + 1e-12).contains(&s) {
+            return Err(Error::OutOfBounds {
+                t_interp: t,
+                t_prev: self.t0,
+                t_curr: self.t0 + self.h,
+            });
+        }
+        let (s2, s3) = (s * s, s * s * s);
+        let (h00, h10) = (2.0 * s3 - 3.0 * s2 + 1.0, s3 - 2.0 * s2 + s);
+        let (h01, h11) = (-2.0 * s3 + 3.0 * s2, s3 - s2);
+        Ok((0..self.y0.len())
+            .map(|i| {
+                h00 * self.y0[i]
+                    + self.h * h10 * self.f0[i]
+                    + h01 * self.y1[i]
+                    + self.h * h11 * self.f1[i]
+            })
+            .collect())
+    }
 }

@@ -10,10 +10,9 @@
 //! detected" at t = 0.021 s on the stiff cantilever of BENCHMARKS.md).
 
 use differential_equations::error::Error;
-use differential_equations::interpolate::Interpolation;
 use nalgebra::{DMatrix, DVector};
 
-use crate::stepper::{Counts, OdeSystem, Options, StepFn, error_norm};
+use crate::stepper::{Counts, Hermite, OdeSystem, Options, StepFn, error_norm};
 
 const SQRT2: f64 = std::f64::consts::SQRT_2;
 const GAMMA: f64 = 2.0 - SQRT2;
@@ -24,40 +23,6 @@ const E0: f64 = (4.0 * W - 1.0) / 3.0;
 const E1: f64 = -1.0 / 3.0;
 const E2: f64 = 2.0 * D / 3.0;
 const MAX_NEWTON: usize = 6;
-
-/// Cubic Hermite interpolation over one step.
-struct Hermite<'a> {
-    t0: f64,
-    h: f64,
-    y0: &'a [f64],
-    y1: &'a [f64],
-    f0: &'a [f64],
-    f1: &'a [f64],
-}
-
-impl Interpolation<f64, Vec<f64>> for Hermite<'_> {
-    fn interpolate(&mut self, t: f64) -> Result<Vec<f64>, Error<f64, Vec<f64>>> {
-        let s = (t - self.t0) / self.h;
-        if !(-1e-12..=1.0 + 1e-12).contains(&s) {
-            return Err(Error::OutOfBounds {
-                t_interp: t,
-                t_prev: self.t0,
-                t_curr: self.t0 + self.h,
-            });
-        }
-        let (s2, s3) = (s * s, s * s * s);
-        let (h00, h10) = (2.0 * s3 - 3.0 * s2 + 1.0, s3 - 2.0 * s2 + s);
-        let (h01, h11) = (-2.0 * s3 + 3.0 * s2, s3 - s2);
-        Ok((0..self.y0.len())
-            .map(|i| {
-                h00 * self.y0[i]
-                    + self.h * h10 * self.f0[i]
-                    + h01 * self.y1[i]
-                    + self.h * h11 * self.f1[i]
-            })
-            .collect())
-    }
-}
 
 /// Solve x = base + d h f(t, x) by simplified Newton from `x` (in place);
 /// `k` receives f(t, x). False if it does not converge.
