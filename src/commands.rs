@@ -244,6 +244,9 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
             bail!("{name} must be positive, got {v}");
         }
     }
+    if a.max_steps == 0 {
+        bail!("--max-steps must be at least 1");
+    }
     let q0 = optional_vector("--q0", &a.q0, n, &coords)?;
     let qd0 = optional_vector("--qd0", &a.qd0, n, &coords)?;
     let solver = Solver::parse(&solver_name).expect("clap and validation checked the name");

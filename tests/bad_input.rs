@@ -382,3 +382,25 @@ fn failed_simulation_writes_no_partial_files() {
     assert!(stderr(&out).contains("--t-end"));
     assert!(!dir.path().join("o/summary.json").exists());
 }
+
+#[test]
+fn bad_simulate_options_are_rejected_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, expect) in [
+        (vec!["--rtol=-1e-6"], "--rtol must be positive"),
+        (vec!["--t-end", "0"], "--t-end must be a positive number"),
+        (vec!["--max-steps", "0"], "--max-steps must be at least 1"),
+        (vec!["--solver", "ode45"], "possible values"),
+    ] {
+        let mut all = vec!["simulate", "double_pendulum", "--out", "o"];
+        all.extend(&args);
+        let out = softarm(&all, dir.path());
+        assert!(!out.status.success(), "{args:?}");
+        let err = stderr(&out);
+        assert!(
+            err.contains(expect),
+            "{args:?}: expected `{expect}` in: {err}"
+        );
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+}

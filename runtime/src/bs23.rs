@@ -7,7 +7,9 @@
 
 use differential_equations::error::Error;
 
-use crate::stepper::{Counts, Hermite, OdeSystem, Options, StepFn, error_norm};
+use crate::stepper::{
+    Counts, Hermite, OdeSystem, Options, StepFn, begin_step, error_norm, next_step,
+};
 
 /// Integrate from (t0, y0) to `opts.t_end`.
 pub fn integrate(
@@ -38,16 +40,7 @@ pub fn integrate(
     .min(span);
     let mut rejected_last = false;
     while t < t_end {
-        if counts.accepted + counts.rejected >= opts.max_steps {
-            return Err(Error::MaxSteps { t, y });
-        }
-        if h < 1e-14 * t.abs().max(1.0) {
-            return Err(Error::StepSize { t, y });
-        }
-        let last = t + h >= t_end;
-        if last {
-            h = t_end - t;
-        }
+        let last = begin_step(counts, opts, t, &mut h, &y)?;
         for i in 0..m {
             stage[i] = y[i] + 0.5 * h * k1[i];
         }
@@ -66,8 +59,6 @@ pub fn integrate(
                 h * (-5.0 / 72.0 * k1[i] + 1.0 / 12.0 * k2[i] + 1.0 / 9.0 * k3[i] - 0.125 * k4[i]);
         }
         let e = error_norm(&err, &y, &y_new, opts.rtol, opts.atol);
-        let e = if e.is_finite() { e } else { f64::INFINITY };
-        let factor = (0.9 * e.max(1e-10).powf(-1.0 / 3.0)).clamp(0.2, 5.0);
         if e <= 1.0 {
             counts.accepted += 1;
             let mut dense = Hermite {
@@ -82,19 +73,15 @@ pub fn integrate(
             t = t_new;
             std::mem::swap(&mut y, &mut y_new);
             std::mem::swap(&mut k1, &mut k4);
-            h *= if rejected_last {
-                factor.min(1.0)
-            } else {
-                factor
-            };
+            h = next_step(h, e, true, rejected_last);
             rejected_last = false;
             if !keep_going {
                 return Ok(());
             }
         } else {
             counts.rejected += 1;
+            h = next_step(h, e, false, rejected_last);
             rejected_last = true;
-            h *= if e.is_finite() { factor.min(0.9) } else { 0.25 };
         }
     }
     Ok(())

@@ -179,14 +179,36 @@ pub fn solve_rod(
     loads: &RodLoads,
     opts: &RodOptions,
 ) -> Result<RodSolution, RodError> {
-    let positive = rod.length > 0.0
-        && rod.ei.iter().all(|&k| k > 0.0)
-        && rod.gj > 0.0
-        && (rod.inextensible || (rod.ea > 0.0 && rod.ga > 0.0));
-    if !positive {
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    let stiff = positive(rod.length)
+        && rod.ei.iter().all(|&k| positive(k))
+        && positive(rod.gj)
+        && (rod.inextensible || (positive(rod.ea) && positive(rod.ga)));
+    if !stiff {
         return Err(RodError::Invalid(
-            "length and stiffnesses must be positive".into(),
+            "length and stiffnesses must be finite and positive".into(),
         ));
+    }
+    let vectors_finite = [
+        &position,
+        &loads.gravity,
+        &loads.distributed_force,
+        &loads.tip_force,
+        &loads.tip_moment,
+    ]
+    .iter()
+    .all(|v| v.iter().all(|x| x.is_finite()));
+    let valid = rod.rho_a.is_finite()
+        && rod.rho_a >= 0.0
+        && vectors_finite
+        && frame.iter().all(|x| x.is_finite());
+    if !valid {
+        return Err(RodError::Invalid(
+            "mass per length must be zero or positive, positions, frames and loads finite".into(),
+        ));
+    }
+    if opts.steps == 0 {
+        return Err(RodError::Invalid("steps must be at least 1".into()));
     }
     let base = (Vector3::from(position), frame);
     let v3 = Vector3::from;
@@ -333,6 +355,20 @@ mod tests {
         // The base holds the load.
         let n0 = Vector3::from(sol.base_force);
         assert!((n0 - load).norm() < 1e-9 * f);
+    }
+
+    #[test]
+    fn invalid_rods_and_loads_are_errors_not_nans() {
+        let mut bad = rod(false);
+        bad.ei[1] = 0.0;
+        let none = RodLoads::default();
+        let opts = RodOptions::default();
+        assert!(solve_rod(&bad, [0.0; 3], along_x(), &none, &opts).is_err());
+        let nan = RodLoads {
+            tip_force: [f64::NAN, 0.0, 0.0],
+            ..Default::default()
+        };
+        assert!(solve_rod(&rod(false), [0.0; 3], along_x(), &nan, &opts).is_err());
     }
 
     #[test]

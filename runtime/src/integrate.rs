@@ -407,7 +407,12 @@ enum Sampler {
 impl Sampler {
     fn new(opts: &SimOptions) -> Self {
         match &opts.output_times {
-            Some(times) => Self::At(times.clone(), 0),
+            Some(times) => {
+                // In time order, whatever order they were given in.
+                let mut times = times.clone();
+                times.sort_by(f64::total_cmp);
+                Self::At(times, 0)
+            }
             None => Self::Even(EvenSolout::new(opts.output_dt, 0.0, opts.t_end)),
         }
     }

@@ -16,7 +16,7 @@ use differential_equations::error::Error;
 use differential_equations::interpolate::Interpolation;
 use nalgebra::{DMatrix, DVector};
 
-use crate::stepper::{Counts, OdeSystem, Options, StepFn};
+use crate::stepper::{Counts, OdeSystem, Options, StepFn, begin_step};
 
 /// sqrt(6)
 const SQ6: f64 = 2.449_489_742_783_178;
@@ -106,16 +106,7 @@ pub fn integrate(
     let mut dense: Option<Dense> = None;
     let mut jacobian_at: Option<f64> = None;
     while t < t_end {
-        if counts.accepted + counts.rejected >= opts.max_steps {
-            return Err(Error::MaxSteps { t, y });
-        }
-        if h.abs() < 1e-14 * t.abs().max(1.0) {
-            return Err(Error::StepSize { t, y });
-        }
-        let last = t + h >= t_end;
-        if last {
-            h = t_end - t;
-        }
+        let last = begin_step(counts, opts, t, &mut h, &y)?;
         // A rejected step retries from the same point: keep its Jacobian.
         if jacobian_at != Some(t) {
             sys.jacobian(t, &y, &mut j);
@@ -215,6 +206,13 @@ pub fn integrate(
             let mut fp = vec![0.0; m];
             sys.rhs(t, &perturbed, &mut fp);
             err = estimate(&j, h, &fp, &z, &scale, m);
+        }
+        if !err.1.is_finite() {
+            // A failed right-hand side or a singular matrix: retry smaller.
+            counts.rejected += 1;
+            last_rejected = true;
+            h *= 0.25;
+            continue;
         }
         let err = err.1.max(1e-10);
         let safety = 0.9 * (2 * MAX_NEWTON + 1) as f64 / (2 * MAX_NEWTON + iterations) as f64;

@@ -31,6 +31,45 @@ pub struct Counts {
     pub rejected: usize,
 }
 
+/// Checks before a step from (t, y) of size `h`: the step budget and the
+/// step-size floor. Clamps `h` to end on `t_end`; true for the last step.
+pub fn begin_step(
+    counts: &Counts,
+    opts: &Options,
+    t: f64,
+    h: &mut f64,
+    y: &[f64],
+) -> Result<bool, Error<f64, Vec<f64>>> {
+    if counts.accepted + counts.rejected >= opts.max_steps {
+        return Err(Error::MaxSteps { t, y: y.to_vec() });
+    }
+    // A NaN step counts as too small.
+    if h.is_nan() || *h < 1e-14 * t.abs().max(1.0) {
+        return Err(Error::StepSize { t, y: y.to_vec() });
+    }
+    let last = t + *h >= opts.t_end;
+    if last {
+        *h = opts.t_end - t;
+    }
+    Ok(last)
+}
+
+/// The next step size of a method with a third-order-accurate estimate:
+/// h 0.9 err^(-1/3) within [h/5, 5h]; no growth right after a rejection, a
+/// cut below 0.9 h on one, and a quarter of h when the estimate is not
+/// finite (a failed right-hand side).
+pub fn next_step(h: f64, err: f64, accepted: bool, rejected_last: bool) -> f64 {
+    if !err.is_finite() {
+        return 0.25 * h;
+    }
+    let factor = (0.9 * err.max(1e-10).powf(-1.0 / 3.0)).clamp(0.2, 5.0);
+    h * match (accepted, rejected_last) {
+        (true, false) => factor,
+        (true, true) => factor.min(1.0),
+        (false, _) => factor.min(0.9),
+    }
+}
+
 /// RMS of e_i / (atol + rtol max(|a_i|, |b_i|)).
 pub fn error_norm(e: &[f64], a: &[f64], b: &[f64], rtol: f64, atol: f64) -> f64 {
     let sum: f64 = e

@@ -12,7 +12,9 @@
 use differential_equations::error::Error;
 use nalgebra::{DMatrix, DVector};
 
-use crate::stepper::{Counts, Hermite, OdeSystem, Options, StepFn, error_norm};
+use crate::stepper::{
+    Counts, Hermite, OdeSystem, Options, StepFn, begin_step, error_norm, next_step,
+};
 
 const SQRT2: f64 = std::f64::consts::SQRT_2;
 const GAMMA: f64 = 2.0 - SQRT2;
@@ -97,16 +99,7 @@ pub fn integrate(
     let mut h = if d1 > 1e-5 { 0.01 / d1 } else { 1e-6 * span }.clamp(1e-10 * span, span);
     let mut rejected_last = false;
     while t < t_end {
-        if counts.accepted + counts.rejected >= opts.max_steps {
-            return Err(Error::MaxSteps { t, y });
-        }
-        if h < 1e-14 * t.abs().max(1.0) {
-            return Err(Error::StepSize { t, y });
-        }
-        let last = t + h >= t_end;
-        if last {
-            h = t_end - t;
-        }
+        let last = begin_step(counts, opts, t, &mut h, &y)?;
         if jacobian_at != Some(t) {
             sys.jacobian(t, &y, &mut j);
             jacobian_at = Some(t);
@@ -168,8 +161,6 @@ pub fn integrate(
             .map(|v| v.iter().copied().collect())
             .unwrap_or_else(|| vec![f64::INFINITY; m]);
         let err = error_norm(&filtered, &y, &y_new, rtol, atol);
-        let err = if err.is_finite() { err } else { f64::INFINITY };
-        let factor = (0.9 * err.max(1e-10).powf(-1.0 / 3.0)).clamp(0.2, 5.0);
         if err <= 1.0 {
             counts.accepted += 1;
             let t_new = if last { t_end } else { t + h };
@@ -185,23 +176,15 @@ pub fn integrate(
             t = t_new;
             std::mem::swap(&mut y, &mut y_new);
             std::mem::swap(&mut k1, &mut k3);
-            h *= if rejected_last {
-                factor.min(1.0)
-            } else {
-                factor
-            };
+            h = next_step(h, err, true, rejected_last);
             rejected_last = false;
             if !keep_going {
                 return Ok(());
             }
         } else {
             counts.rejected += 1;
+            h = next_step(h, err, false, rejected_last);
             rejected_last = true;
-            h *= if err.is_finite() {
-                factor.min(0.9)
-            } else {
-                0.25
-            };
         }
     }
     Ok(())

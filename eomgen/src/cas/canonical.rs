@@ -303,4 +303,14 @@ impl Cas {
         let terms: Vec<ExprId> = a.iter().zip(b).map(|(&x, &y)| self.mul(x, y)).collect();
         self.add_all(&terms)
     }
+
+    /// The cross product a x b of 3-vectors.
+    pub fn cross(&mut self, a: &[ExprId; 3], b: &[ExprId; 3]) -> [ExprId; 3] {
+        std::array::from_fn(|k| {
+            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+            let p = self.mul(a[i], b[j]);
+            let m = self.mul(a[j], b[i]);
+            self.sub(p, m)
+        })
+    }
 }

@@ -40,15 +40,6 @@ pub struct Equations {
     pub jacobian: Vec<ExprId>,
 }
 
-fn cross(cas: &mut Cas, a: &[ExprId; 3], b: &[ExprId; 3]) -> [ExprId; 3] {
-    std::array::from_fn(|k| {
-        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-        let p = cas.mul(a[i], b[j]);
-        let m = cas.mul(a[j], b[i]);
-        cas.sub(p, m)
-    })
-}
-
 fn triple(v: &[ExprId], i: usize) -> [ExprId; 3] {
     [v[3 * i], v[3 * i + 1], v[3 * i + 2]]
 }
@@ -90,7 +81,7 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     for (b, body) in sys.bodies.iter().enumerate() {
         let (w, alpha) = (body.omega, triple(&conv_ang, b));
         let iw: [ExprId; 3] = std::array::from_fn(|k| cas.mul(body.inertia[k], w[k]));
-        let gyro = cross(cas, &w, &iw);
+        let gyro = cas.cross(&w, &iw);
         let idot = cas.time_derivatives(&body.inertia, &pairs);
         for k in 0..3 {
             momentum_cot.push(iw[k]);

@@ -38,15 +38,6 @@ struct SpatialInertia {
 /// momentum): the pairing of one with the other is the power.
 type Spatial = ([ExprId; 3], [ExprId; 3]);
 
-fn cross(cas: &mut Cas, a: &[ExprId; 3], b: &[ExprId; 3]) -> [ExprId; 3] {
-    std::array::from_fn(|k| {
-        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-        let p = cas.mul(a[i], b[j]);
-        let m = cas.mul(a[j], b[i]);
-        cas.sub(p, m)
-    })
-}
-
 fn sym_mul(cas: &mut Cas, j: &[ExprId; 6], w: &[ExprId; 3]) -> [ExprId; 3] {
     // Row k of the symmetric matrix, by index into the packed storage.
     const ROWS: [[usize; 3]; 3] = [[0, 3, 4], [3, 1, 5], [4, 5, 2]];
@@ -107,8 +98,8 @@ impl SpatialInertia {
     fn momentum(&self, cas: &mut Cas, twist: &Spatial) -> Spatial {
         let (w, v) = twist;
         let jw = sym_mul(cas, &self.j, w);
-        let hv = cross(cas, &self.h, v);
-        let wh = cross(cas, w, &self.h);
+        let hv = cas.cross(&self.h, v);
+        let wh = cas.cross(w, &self.h);
         let ang = std::array::from_fn(|k| cas.add(jw[k], hv[k]));
         let lin = std::array::from_fn(|k| {
             let mv = cas.mul(self.m, v[k]);
@@ -168,7 +159,7 @@ impl<'a> ChainKinematics<'a> {
                 let ve = triple(link_velocities, link_of[j]);
                 let w = link.end_omega.map(|e| cas.diff(e, sys.coords.qd[j]));
                 let v = ve.map(|e| cas.diff(e, sys.coords.qd[j]));
-                let wr = cross(cas, &w, &link.end);
+                let wr = cas.cross(&w, &link.end);
                 let v0: [ExprId; 3] = std::array::from_fn(|k| cas.sub(v[k], wr[k]));
                 (w.map(|e| cas.bind(e)), v0.map(|e| cas.bind(e)))
             })
@@ -238,7 +229,7 @@ impl<'a> ChainKinematics<'a> {
                     let body = &sys.bodies[b];
                     let (w, v) = self.own_column(cas, b, j);
                     let mv = v.map(|e| cas.mul(body.mass, e));
-                    let rmv = cross(cas, &body.position, &mv);
+                    let rmv = cas.cross(&body.position, &mv);
                     for k in 0..3 {
                         let iw = cas.mul(body.inertia[k], w[k]);
                         ang[k] = cas.add_all(&[ang[k], iw, rmv[k]]);
@@ -297,13 +288,13 @@ impl<'a> ChainKinematics<'a> {
         for (l, bodies) in self.bodies_of.iter().enumerate() {
             for &b in bodies {
                 let (f, tau) = body_forces[b];
-                let rf = cross(cas, &sys.bodies[b].position, &f);
+                let rf = cas.cross(&sys.bodies[b].position, &f);
                 let ang = std::array::from_fn(|k| cas.add(tau[k], rf[k]));
                 link_wrench[l].push((ang, f));
             }
         }
         for p in points {
-            let rf = cross(cas, &p.position, &p.force);
+            let rf = cas.cross(&p.position, &p.force);
             link_wrench[p.link].push((rf, p.force));
         }
         let zero = cas.zero();
