@@ -192,6 +192,10 @@ impl<'a> KernelEmitter<'a> {
                 let a = r(a);
                 quote!(runtime::special::sinc_rem(#k, #a))
             }
+            Op::Rodrigues(j, n, a) => {
+                let a = r(a);
+                quote!(runtime::rodrigues::rodrigues(#j, #n, #a))
+            }
             _ => unreachable!("leaves are read in place"),
         }
     }
@@ -309,6 +313,8 @@ enum Family {
     Sinc,
     Cosc,
     SincRem,
+    /// c_j of `runtime::rodrigues` (its orders are the derivatives).
+    Rodrigues(u8),
 }
 
 fn family_of(op: &Op) -> Option<(Family, u8, Slot)> {
@@ -318,6 +324,7 @@ fn family_of(op: &Op) -> Option<(Family, u8, Slot)> {
         Op::Sinc(k, a) => Some((Family::Sinc, k, a)),
         Op::Cosc(k, a) => Some((Family::Cosc, k, a)),
         Op::SincRem(k, a) => Some((Family::SincRem, k, a)),
+        Op::Rodrigues(j, n, a) => Some((Family::Rodrigues(j), n, a)),
         _ => None,
     }
 }
@@ -342,6 +349,9 @@ impl Family {
             Family::Sinc => quote!(sinc_orders),
             Family::Cosc => quote!(cosc_orders),
             Family::SincRem => quote!(sinc_rem_orders),
+            Family::Rodrigues(j) => {
+                return quote!(let [#(#names),*]: [f64; #n] = runtime::rodrigues::rodrigues_orders::<#n>(#j, #a););
+            }
         };
         quote!(let [#(#names),*]: [f64; #n] = runtime::special::#f::<#n>(#a);)
     }
@@ -364,7 +374,8 @@ fn operands(op: &Op) -> Vec<Slot> {
         | Op::Sign(a)
         | Op::Sinc(_, a)
         | Op::Cosc(_, a)
-        | Op::SincRem(_, a) => vec![a],
+        | Op::SincRem(_, a)
+        | Op::Rodrigues(_, _, a) => vec![a],
         _ => vec![],
     }
 }

@@ -15,6 +15,7 @@ pub mod kernels;
 pub mod linalg;
 pub mod modes;
 pub mod radau5;
+pub mod rodrigues;
 pub mod special;
 pub mod statics;
 pub mod stepper;

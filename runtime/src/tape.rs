@@ -48,6 +48,8 @@ pub enum Op {
     Cosc(u8, Slot),
     /// k-th derivative of (x - sin x)/x^3.
     SincRem(u8, Slot),
+    /// n-th derivative of the Rodrigues coefficient c_j(w) (`rodrigues`).
+    Rodrigues(u8, u8, Slot),
 }
 
 /// The values a kernel reads.
@@ -101,6 +103,7 @@ impl Tape {
                 Op::Sinc(k, a) => special::sinc(k, s(a)),
                 Op::Cosc(k, a) => special::cosc(k, s(a)),
                 Op::SincRem(k, a) => special::sinc_rem(k, s(a)),
+                Op::Rodrigues(j, n, a) => crate::rodrigues::rodrigues(j, n, s(a)),
             };
             slots.push(v);
         }

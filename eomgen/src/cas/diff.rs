@@ -196,6 +196,7 @@ impl Cas {
             Func::Sinc(k) => self.func(Func::Sinc(k + 1), x),
             Func::Cosc(k) => self.func(Func::Cosc(k + 1), x),
             Func::SincRem(k) => self.func(Func::SincRem(k + 1), x),
+            Func::Rodrigues(j, n) => self.func(Func::Rodrigues(j, n + 1), x),
         }
     }
 }

@@ -54,6 +54,9 @@ pub enum Func {
     Cosc(u8),
     /// k-th derivative of (x - sin x) / x^3.
     SincRem(u8),
+    /// n-th derivative of the Rodrigues coefficient c_j(w), a function of
+    /// the squared rotation angle (`runtime::rodrigues`): (j, n).
+    Rodrigues(u8, u8),
 }
 
 impl Func {
@@ -71,6 +74,7 @@ impl Func {
             Func::Sinc(k) => special::sinc(k, x),
             Func::Cosc(k) => special::cosc(k, x),
             Func::SincRem(k) => special::sinc_rem(k, x),
+            Func::Rodrigues(j, n) => runtime::rodrigues::rodrigues(j, n, x),
         }
     }
 
@@ -82,7 +86,7 @@ impl Func {
             Func::Cos | Func::Abs => Some(1.0),
             Func::Sinc(k) | Func::SincRem(k) => Some(alt(k)),
             Func::Cosc(k) => Some(-alt(k)),
-            Func::Exp | Func::Ln => None,
+            Func::Exp | Func::Ln | Func::Rodrigues(..) => None,
         }
     }
 }

@@ -133,6 +133,7 @@ fn key(op: &Op) -> (u8, u64, u64) {
         Op::Sinc(k, a) => (20, u(a), u64::from(k)),
         Op::Cosc(k, a) => (21, u(a), u64::from(k)),
         Op::SincRem(k, a) => (22, u(a), u64::from(k)),
+        Op::Rodrigues(j, n, a) => (24, u(a), (u64::from(j) << 8) | u64::from(n)),
     }
 }
 
@@ -245,6 +246,7 @@ impl<'a> Lowerer<'a> {
                     Func::Sinc(k) => Op::Sinc(k, a),
                     Func::Cosc(k) => Op::Cosc(k, a),
                     Func::SincRem(k) => Op::SincRem(k, a),
+                    Func::Rodrigues(j, n) => Op::Rodrigues(j, n, a),
                 })
             }
             Node::Bind(x) => self.lower(x),

@@ -77,21 +77,18 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         }
     }
     let mut angular_force = Vec::new();
-    let mut inertia_rate_force = Vec::new(); // -(1/2) w^T (dI/dq) w, per coordinate
+    let mut inertia_rate_force = Vec::new(); // -(1/2) w^T (dJ/dq)_shape w, per coordinate
     for (b, body) in sys.bodies.iter().enumerate() {
         let (w, alpha) = (body.omega, triple(&conv_ang, b));
-        let iw: [ExprId; 3] = std::array::from_fn(|k| cas.mul(body.inertia[k], w[k]));
-        let gyro = cas.cross(&w, &iw);
-        let idot = cas.time_derivatives(&body.inertia, &pairs);
+        let iw = body.inertia.apply(cas, &w);
+        let ia = body.inertia.apply(cas, &alpha);
+        let gyro = body.inertia.gyroscopic(cas, &w);
+        let id = body.inertia.shape_rate(cas, &pairs, &w);
         for k in 0..3 {
             momentum_cot.push(iw[k]);
-            let ia = cas.mul(body.inertia[k], alpha[k]);
-            let id = cas.mul(idot[k], w[k]);
-            angular_force.push(cas.add_all(&[ia, gyro[k], id]));
+            angular_force.push(cas.add_all(&[ia[k], gyro[k], id[k]]));
         }
-        let w2: [ExprId; 3] = w.map(|e| cas.powi(e, 2));
-        let half_w2 = w2.map(|e| cas.scaled(-0.5, e));
-        inertia_rate_force.push(cas.vjp(&body.inertia, &half_w2, &sys.coords.q));
+        inertia_rate_force.push(body.inertia.shape_force(cas, &w, &sys.coords.q));
     }
     force_cot.extend(angular_force);
     for (f, force) in sys.point_forces.iter().enumerate() {

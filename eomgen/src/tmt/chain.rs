@@ -22,7 +22,7 @@
 
 use crate::cas::{Cas, ExprId};
 
-use super::system::{Chain, System};
+use super::system::{Chain, Inertia, System};
 
 /// A spatial inertia about the world origin: mass, first moment m r and
 /// rotational inertia J, symmetric, stored xx, yy, zz, xy, xz, yz.
@@ -48,21 +48,22 @@ fn sym_mul(cas: &mut Cas, j: &[ExprId; 6], w: &[ExprId; 3]) -> [ExprId; 3] {
 }
 
 impl SpatialInertia {
-    /// A body of mass m at r with rotational inertia diag(i) about its
+    /// A body of mass m at r with rotational inertia `inertia` about its
     /// centre of mass.
-    fn of_body(cas: &mut Cas, m: ExprId, r: &[ExprId; 3], i: &[ExprId; 3]) -> Self {
+    fn of_body(cas: &mut Cas, m: ExprId, r: &[ExprId; 3], inertia: &Inertia) -> Self {
         let h = r.map(|c| cas.mul(m, c));
         let r2 = cas.dot(r, r);
-        // I + m (|r|^2 1 - r r^T)
+        let i = inertia.packed(cas);
+        // J + m (|r|^2 1 - r r^T)
         let diag: [ExprId; 3] = std::array::from_fn(|k| {
             let rk2 = cas.powi(r[k], 2);
             let d = cas.sub(r2, rk2);
             let md = cas.mul(m, d);
             cas.add(i[k], md)
         });
-        let off = [(0, 1), (0, 2), (1, 2)].map(|(a, b)| {
+        let off = [(0, 1, 3), (0, 2, 4), (1, 2, 5)].map(|(a, b, k)| {
             let p = cas.mul(h[a], r[b]);
-            cas.neg(p)
+            cas.sub(i[k], p)
         });
         Self {
             m,
@@ -230,9 +231,9 @@ impl<'a> ChainKinematics<'a> {
                     let (w, v) = self.own_column(cas, b, j);
                     let mv = v.map(|e| cas.mul(body.mass, e));
                     let rmv = cas.cross(&body.position, &mv);
+                    let iw = body.inertia.apply(cas, &w);
                     for k in 0..3 {
-                        let iw = cas.mul(body.inertia[k], w[k]);
-                        ang[k] = cas.add_all(&[ang[k], iw, rmv[k]]);
+                        ang[k] = cas.add_all(&[ang[k], iw[k], rmv[k]]);
                         lin[k] = cas.add(lin[k], mv[k]);
                     }
                 }
@@ -255,9 +256,7 @@ impl<'a> ChainKinematics<'a> {
                         let (wj, vj) = self.own_column(cas, b, j);
                         let vv = cas.dot(&vi, &vj);
                         terms.push(cas.mul(body.mass, vv));
-                        for k in 0..3 {
-                            terms.push(cas.mul_all(&[body.inertia[k], wi[k], wj[k]]));
-                        }
+                        terms.push(body.inertia.quadratic(cas, &wi, &wj));
                     }
                     cas.add_all(&terms)
                 };

@@ -3,6 +3,7 @@
 
 mod assemble;
 mod chain;
+mod inertia;
 mod planar;
 mod solve;
 mod system;
@@ -10,4 +11,4 @@ mod system;
 pub use assemble::{Equations, assemble};
 pub use planar::planar_system;
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
-pub use system::{Body, Chain, Coordinates, Link, PointForce, System};
+pub use system::{Body, Chain, Coordinates, Inertia, Link, PointForce, System};

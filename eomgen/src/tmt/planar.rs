@@ -17,7 +17,7 @@
 use crate::cas::{Cas, ExprId, Func, SymKind};
 use crate::model::{Joints, Method, Model, Structure, parameters};
 
-use super::system::{Body, Chain, Coordinates, Link, PointForce, System};
+use super::system::{Body, Chain, Coordinates, Inertia, Link, PointForce, System};
 
 /// A planar frame: origin, absolute angle and its rate.
 #[derive(Clone, Copy)]
@@ -80,7 +80,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
             let body =
                 |cas: &mut Cas, pos: [ExprId; 2], w: ExprId, mass: ExprId, inertia: ExprId| Body {
                     mass,
-                    inertia: [inertia; 3],
+                    inertia: Inertia::Isotropic(inertia),
                     position: [cas.bind(pos[0]), cas.bind(pos[1]), z],
                     omega: [zero, zero, w],
                 };
@@ -128,7 +128,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
         let mass = param("tip.mass");
         bodies.push(Body {
             mass,
-            inertia: [zero; 3],
+            inertia: Inertia::Isotropic(zero),
             position: tip,
             omega: [zero; 3],
         });

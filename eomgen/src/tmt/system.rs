@@ -4,6 +4,8 @@
 
 use crate::cas::{Cas, ExprId, SymKind};
 
+pub use super::inertia::Inertia;
+
 /// q, qd symbols and their names.
 pub struct Coordinates {
     pub names: Vec<String>,
@@ -51,14 +53,14 @@ impl Coordinates {
     }
 }
 
-/// A lumped rigid body: Mbar = diag(m I3, I) with I in the body frame.
+/// A lumped rigid body: Mbar = diag(m I3, J), all in the world frame.
 pub struct Body {
     pub mass: ExprId,
-    /// Principal moments of inertia about the centre of mass, body frame.
-    pub inertia: [ExprId; 3],
+    /// Rotational inertia about the centre of mass.
+    pub inertia: Inertia,
     /// Centre of mass in the world frame, a function of q.
     pub position: [ExprId; 3],
-    /// Angular velocity in the body frame, linear in qd.
+    /// Angular velocity in the world frame, linear in qd.
     pub omega: [ExprId; 3],
 }
 
@@ -88,8 +90,7 @@ pub struct System {
 ///
 /// Invariants: links own the coordinates in order; a body of link L depends
 /// on no coordinate past L and moves rigidly with the end frame of link L - 1
-/// under the coordinates before L. World-frame angular velocities and
-/// inertias (true of planar systems, where both are about z).
+/// under the coordinates before L.
 pub struct Chain {
     pub links: Vec<Link>,
     /// The link of each body.
