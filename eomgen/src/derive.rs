@@ -4,12 +4,18 @@ use runtime::{ModelInfo, TapeSet};
 
 use crate::cas::{Cas, Hoist};
 use crate::model::{Model, Structure, parameters};
-use crate::tmt::{SYMBOLIC_SOLVE_MAX_DOF, assemble, planar_system, solve_accelerations};
+use crate::tmt::{
+    SYMBOLIC_SOLVE_MAX_DOF, assemble, planar_system, solve_accelerations, spatial_system,
+};
 
 /// Derive the kernels of a model's structure.
 pub fn derive(model: &Model) -> TapeSet {
     let mut cas = Cas::new();
-    let sys = planar_system(&mut cas, model);
+    let sys = if model.dimensions == 3 {
+        spatial_system(&mut cas, model)
+    } else {
+        planar_system(&mut cas, model)
+    };
     let eq = assemble(&mut cas, &sys);
     let mut mass_bias = eq.mass_upper.clone();
     mass_bias.extend_from_slice(&eq.bias);
@@ -33,7 +39,9 @@ pub fn derive(model: &Model) -> TapeSet {
     let loads = params
         .iter()
         .enumerate()
-        .filter(|(_, n)| n.starts_with("gravity.") || n.starts_with("tip.force."))
+        .filter(|(_, n)| {
+            n.starts_with("gravity.") || n.starts_with("tip.force.") || n.starts_with("tip.moment.")
+        })
         .map(|(i, _)| i)
         .collect();
     let derived = hoist.finish(&mut cas);

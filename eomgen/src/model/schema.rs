@@ -11,6 +11,9 @@ pub struct Model {
     pub name: String,
     #[serde(default)]
     pub description: Option<String>,
+    /// 2 (planar, in the x-y plane) or 3 (spatial). Structural.
+    #[serde(default = "two")]
+    pub dimensions: u8,
     /// Gravitational acceleration in the world frame (m/s^2).
     pub gravity: [f64; 3],
     pub base: Base,
@@ -52,8 +55,18 @@ pub struct Base {
 pub enum Method {
     /// A chain of `elements` rigid links joined by revolute joints.
     Rigid,
-    /// Piecewise constant curvature: `elements` arcs, one bending angle each.
+    /// Piecewise constant curvature: `elements` arcs, one bending angle each
+    /// (planar) or two bending angles, optional twist and stretch (3D).
     Pcc,
+    /// Variable curvature: one constant-curvature arc per segment, each
+    /// segment with its own length, section and material.
+    Vc,
+    /// Euler-Bernoulli elements with relative states: rigid elements joined
+    /// at their midpoints by a rotation (two bending angles and a twist, as
+    /// a rotation vector) and an optional stretch. 3D only.
+    Ebr,
+    /// The Cosserat rod, solved as a boundary value problem: statics only.
+    Cosserat,
 }
 
 impl Method {
@@ -61,6 +74,9 @@ impl Method {
         match self {
             Method::Rigid => "rigid",
             Method::Pcc => "pcc",
+            Method::Vc => "vc",
+            Method::Ebr => "ebr",
+            Method::Cosserat => "cosserat",
         }
     }
 }
@@ -120,6 +136,31 @@ pub struct Segment {
     /// when the segment's stiffness comes from E I, else `base`.
     #[serde(default)]
     pub joints: Option<Joints>,
+    /// 3D: the revolute axes of each joint of a rigid segment, in order, in
+    /// the element frame (structural). Default `["z", "y"]`, plus `"x"` with
+    /// twist: a universal or spherical joint.
+    #[serde(default)]
+    pub joint_axes: Option<Vec<Axis>>,
+    /// 3D: whether elements twist about their axis (structural; default true).
+    #[serde(default)]
+    pub twist: Option<bool>,
+    /// 3D: whether elements stretch (structural; default false).
+    #[serde(default)]
+    pub extension: Option<bool>,
+    /// Shear modulus G (Pa) for the torsional stiffness G J; default E / 3
+    /// (incompressible).
+    #[serde(default)]
+    pub shear_modulus: Option<f64>,
+    /// Torsional stiffness G J (N m^2), instead of the shear modulus.
+    #[serde(default)]
+    pub torsional_stiffness: Option<f64>,
+    /// Axial stiffness E A (N), instead of `youngs_modulus` times the area.
+    #[serde(default)]
+    pub axial_stiffness: Option<f64>,
+    /// Axial damping (N s): Rayleigh function (c / l_e) stretch_dot^2 / 2
+    /// per element.
+    #[serde(default)]
+    pub axial_damping: Option<f64>,
 }
 
 impl Segment {
@@ -146,10 +187,78 @@ impl Segment {
         self.bending_stiffness
             .or_else(|| Some(self.youngs_modulus? * self.second_moment()?))
     }
+
+    /// Area of the section (m^2), if it has a radius.
+    pub fn area(&self) -> Option<f64> {
+        let ro = self.outer_radius?;
+        let ri = self.inner_radius.unwrap_or(0.0);
+        Some(std::f64::consts::PI * (ro * ro - ri * ri))
+    }
+
+    /// Torsional stiffness G J (N m^2): J = 2 I for circular sections, G
+    /// defaulting to E / 3.
+    pub fn gj(&self) -> Option<f64> {
+        self.torsional_stiffness.or_else(|| {
+            let g = self
+                .shear_modulus
+                .or_else(|| Some(self.youngs_modulus? / 3.0))?;
+            Some(g * 2.0 * self.second_moment()?)
+        })
+    }
+
+    /// Axial stiffness E A (N).
+    pub fn ea(&self) -> Option<f64> {
+        self.axial_stiffness
+            .or_else(|| Some(self.youngs_modulus? * self.area()?))
+    }
+
+    /// 3D: elements twist.
+    pub fn twists(&self) -> bool {
+        self.twist.unwrap_or(true)
+    }
+
+    /// 3D: elements stretch.
+    pub fn stretches(&self) -> bool {
+        self.extension.unwrap_or(false)
+    }
+
+    /// 3D: the revolute axes of each joint of a rigid segment.
+    pub fn axes(&self) -> Vec<Axis> {
+        self.joint_axes.clone().unwrap_or_else(|| {
+            let mut a = vec![Axis::Z, Axis::Y];
+            if self.twists() {
+                a.push(Axis::X);
+            }
+            a
+        })
+    }
 }
 
 fn one() -> usize {
     1
+}
+
+fn two() -> u8 {
+    2
+}
+
+/// An axis of an element's frame (x along the element).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    X,
+    Y,
+    Z,
+}
+
+impl Axis {
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
 }
 
 /// The tip payload. Which of its keys are present is structural: a model
@@ -164,4 +273,7 @@ pub struct Tip {
     /// Constant force at the tip, world frame (N).
     #[serde(default)]
     pub force: Option<[f64; 3]>,
+    /// Constant moment on the tip, world frame (N m).
+    #[serde(default)]
+    pub moment: Option<[f64; 3]>,
 }

@@ -7,34 +7,56 @@
 
 use sha2::{Digest, Sha256};
 
-use super::schema::{Joints, Method, Model};
+use super::schema::{Axis, Joints, Method, Model};
 
 /// Bumped whenever derivation or emission changes what is generated, so
 /// that cached tapes and generated files are re-derived.
 pub const GENERATOR_VERSION: u32 = 21;
 
 /// The structural part of one segment.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct SegmentShape {
     pub method: Method,
     pub elements: usize,
-    /// Joint placement (rigid segments; `Base` for others).
+    /// Joint placement (rigid segments, and `Midpoint` for ebr; `Base` for
+    /// others).
     pub joints: Joints,
+    /// 3D: twist and stretch coordinates, and the joint axes of rigid
+    /// segments (empty for other methods and in 2D).
+    pub twist: bool,
+    pub extension: bool,
+    pub axes: Vec<Axis>,
+}
+
+impl SegmentShape {
+    /// Coordinates per element in 3D.
+    pub fn coordinates_3d(&self) -> usize {
+        match self.method {
+            Method::Rigid => self.axes.len(),
+            _ => 2 + usize::from(self.twist) + usize::from(self.extension),
+        }
+    }
 }
 
 /// Everything that shapes the equations; numbers are left out.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Structure {
+    /// 2 or 3.
+    pub dimensions: u8,
     pub segments: Vec<SegmentShape>,
     /// A tip body exists (`tip.mass` given).
     pub tip_mass: bool,
     /// A tip force exists (`tip.force` given).
     pub tip_force: bool,
+    /// A tip moment exists (`tip.moment` given).
+    pub tip_moment: bool,
 }
 
 impl Structure {
     pub fn of(m: &Model) -> Self {
+        let spatial = m.dimensions == 3;
         Self {
+            dimensions: m.dimensions,
             segments: m
                 .segments
                 .iter()
@@ -43,30 +65,55 @@ impl Structure {
                     elements: s.elements,
                     joints: match s.method {
                         Method::Rigid => s.joint_placement(),
-                        Method::Pcc => Joints::Base,
+                        Method::Ebr => Joints::Midpoint,
+                        _ => Joints::Base,
+                    },
+                    twist: spatial && s.method != Method::Rigid && s.twists(),
+                    extension: spatial && s.method != Method::Rigid && s.stretches(),
+                    axes: if spatial && s.method == Method::Rigid {
+                        s.axes()
+                    } else {
+                        Vec::new()
                     },
                 })
                 .collect(),
             tip_mass: m.tip.mass.is_some(),
             tip_force: m.tip.force.is_some(),
+            tip_moment: m.tip.moment.is_some(),
         }
     }
 
     /// Canonical text of the structure (what is hashed).
     pub fn canonical(&self) -> String {
-        let mut s = format!("eomgen {GENERATOR_VERSION}\nplanar\n");
+        let space = if self.dimensions == 3 {
+            "spatial"
+        } else {
+            "planar"
+        };
+        let mut s = format!("eomgen {GENERATOR_VERSION}\n{space}\n");
         for g in &self.segments {
             s.push_str(&format!(
-                "segment {} {} {:?}\n",
+                "segment {} {} {:?}",
                 g.method.name(),
                 g.elements,
                 g.joints
             ));
+            if self.dimensions == 3 {
+                s.push_str(&format!(
+                    " twist {} extension {} axes {:?}",
+                    g.twist, g.extension, g.axes
+                ));
+            }
+            s.push('\n');
         }
         s.push_str(&format!(
-            "tip mass {} force {}\n",
+            "tip mass {} force {}",
             self.tip_mass, self.tip_force
         ));
+        if self.tip_moment {
+            s.push_str(" moment true");
+        }
+        s.push('\n');
         s
     }
 
@@ -98,6 +145,14 @@ pub struct ElementProps {
     pub damping: f64,
     /// Angle at rest (rad): rest curvature times l_e.
     pub rest: f64,
+    /// 3D: moment of inertia of each body about its own axis.
+    pub axial_inertia: f64,
+    /// 3D: G J / l_e (N m/rad) and its damping.
+    pub twist_stiffness: f64,
+    pub twist_damping: f64,
+    /// 3D: E A / l_e (N/m) and c / l_e (N s/m).
+    pub stretch_stiffness: f64,
+    pub stretch_damping: f64,
 }
 
 pub fn element_props(m: &Model) -> Vec<ElementProps> {
@@ -115,12 +170,27 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
         // Uniform cylinders (hollow or solid) about a diameter through the
         // centre; slender rods when no radius is given.
         let section = mass * (ro * ro + ri * ri) / 4.0;
-        let inertia = match (s.method, s.joint_placement()) {
-            (Method::Rigid, Joints::Base) => mass * l * l / 12.0 + section,
-            (Method::Rigid, Joints::Midpoint) => {
-                (mass / 2.0) * (l / 2.0).powi(2) / 12.0 + section / 2.0
+        // Bodies: the whole link, or two half links (midpoint joints), or
+        // the section's part of a pcc arc (in 2D the arc's part is derived
+        // symbolically; in 3D the arc is lumped as a straight slice, below).
+        let halves = matches!(
+            (s.method, s.joint_placement()),
+            (Method::Rigid, Joints::Midpoint) | (Method::Ebr, _)
+        );
+        let (inertia, axial_inertia) = match s.method {
+            Method::Rigid if !halves => (mass * l * l / 12.0 + section, 2.0 * section),
+            Method::Rigid | Method::Ebr => (
+                (mass / 2.0) * (l / 2.0).powi(2) / 12.0 + section / 2.0,
+                section,
+            ),
+            Method::Pcc | Method::Vc | Method::Cosserat => {
+                let slice = if m.dimensions == 3 {
+                    mass * l * l / 12.0
+                } else {
+                    0.0
+                };
+                (section + slice, 2.0 * section)
             }
-            (Method::Pcc, _) => section,
         };
         let stiffness = match s.ei() {
             Some(ei) => ei / l,
@@ -130,6 +200,12 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
             Some(eta) => eta / l,
             None => s.joint_damping.unwrap_or(0.0),
         };
+        let twist_stiffness = match s.gj() {
+            Some(gj) => gj / l,
+            None => s.joint_stiffness.unwrap_or(0.0),
+        };
+        let stretch_stiffness = s.ea().unwrap_or(0.0) / l;
+        let stretch_damping = s.axial_damping.unwrap_or(0.0) / l;
         for _ in 0..s.elements {
             out.push(ElementProps {
                 length: l,
@@ -138,6 +214,11 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
                 stiffness,
                 damping,
                 rest: s.rest_curvature * l,
+                axial_inertia,
+                twist_stiffness,
+                twist_damping: damping,
+                stretch_stiffness,
+                stretch_damping,
             });
         }
     }
@@ -154,9 +235,17 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
         ("base.x".to_string(), m.base.position[0]),
         ("base.y".to_string(), m.base.position[1]),
         ("base.z".to_string(), m.base.position[2]),
-        // Planar: the angle of the base direction from +x.
-        ("base.angle".to_string(), d[1].atan2(d[0])),
     ];
+    if m.dimensions == 3 {
+        for (i, row) in base_rotation(d).iter().enumerate() {
+            for (j, v) in row.iter().enumerate() {
+                p.push((format!("base.R{i}{j}"), *v));
+            }
+        }
+    } else {
+        // Planar: the angle of the base direction from +x.
+        p.push(("base.angle".to_string(), d[1].atan2(d[0])));
+    }
     if let Some(mass) = m.tip.mass {
         p.push(("tip.mass".to_string(), mass));
     }
@@ -165,6 +254,11 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
         p.push(("tip.force.y".to_string(), f[1]));
         p.push(("tip.force.z".to_string(), f[2]));
     }
+    if let Some(mo) = m.tip.moment {
+        p.push(("tip.moment.x".to_string(), mo[0]));
+        p.push(("tip.moment.y".to_string(), mo[1]));
+        p.push(("tip.moment.z".to_string(), mo[2]));
+    }
     for (k, e) in element_props(m).iter().enumerate() {
         p.push((format!("element[{k}].length"), e.length));
         p.push((format!("element[{k}].mass"), e.mass));
@@ -172,6 +266,35 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
         p.push((format!("joint[{k}].stiffness"), e.stiffness));
         p.push((format!("joint[{k}].damping"), e.damping));
         p.push((format!("joint[{k}].rest"), e.rest));
+        if m.dimensions == 3 {
+            p.push((format!("element[{k}].axial_inertia"), e.axial_inertia));
+            p.push((format!("twist[{k}].stiffness"), e.twist_stiffness));
+            p.push((format!("twist[{k}].damping"), e.twist_damping));
+            p.push((format!("stretch[{k}].stiffness"), e.stretch_stiffness));
+            p.push((format!("stretch[{k}].damping"), e.stretch_damping));
+        }
     }
     p
+}
+
+/// The rotation (rows) taking +x to the unit vector along `d` by the
+/// shortest turn; a half turn about z when `d` points along -x.
+pub fn base_rotation(d: [f64; 3]) -> [[f64; 3]; 3] {
+    let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let u = [d[0] / n, d[1] / n, d[2] / n];
+    let c = u[0];
+    if c < -1.0 + 1e-12 {
+        return [[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]];
+    }
+    // v = x × u = (0, -u_z, u_y); R = I + [v]x + [v]x^2 / (1 + c)
+    let v = [0.0, -u[2], u[1]];
+    let k = [[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]];
+    let mut r = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            let k2: f64 = (0..3).map(|m| k[i][m] * k[m][j]).sum();
+            r[i][j] = f64::from(u8::from(i == j)) + k[i][j] + k2 / (1.0 + c);
+        }
+    }
+    r
 }

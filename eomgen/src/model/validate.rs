@@ -88,10 +88,13 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             "must be a non-zero vector (the undeformed arm axis)".into(),
         );
     }
-    let planar = m
-        .segments
-        .iter()
-        .all(|s| matches!(s.method, Method::Rigid | Method::Pcc));
+    if !matches!(m.dimensions, 2 | 3) {
+        return err(
+            "dimensions".into(),
+            format!("must be 2 (planar) or 3 (spatial), got {}", m.dimensions),
+        );
+    }
+    let planar = m.dimensions == 2;
     if planar {
         if d[2].abs() > 1e-12 * norm {
             return err(
@@ -185,6 +188,63 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             non_negative(&p("bending_damping"), c)?;
         }
         finite(&p("rest_curvature"), s.rest_curvature)?;
+        for (key, v) in [
+            ("shear_modulus", s.shear_modulus),
+            ("torsional_stiffness", s.torsional_stiffness),
+            ("axial_stiffness", s.axial_stiffness),
+        ] {
+            if let Some(v) = v {
+                positive(&p(key), v)?;
+            }
+        }
+        if let Some(c) = s.axial_damping {
+            non_negative(&p("axial_damping"), c)?;
+        }
+        if planar {
+            for (key, given) in [
+                ("twist", s.twist.is_some()),
+                ("extension", s.extension.is_some()),
+                ("joint_axes", s.joint_axes.is_some()),
+                ("shear_modulus", s.shear_modulus.is_some()),
+                ("torsional_stiffness", s.torsional_stiffness.is_some()),
+                ("axial_stiffness", s.axial_stiffness.is_some()),
+                ("axial_damping", s.axial_damping.is_some()),
+            ] {
+                if given {
+                    return err(
+                        p(key),
+                        "a 3D key: set `dimensions = 3` at the top of the file to use it".into(),
+                    );
+                }
+            }
+        } else {
+            if let Some(axes) = &s.joint_axes
+                && (axes.is_empty() || axes.len() > 3)
+            {
+                return err(
+                    p("joint_axes"),
+                    format!("give 1 to 3 axes (\"x\", \"y\", \"z\"), got {}", axes.len()),
+                );
+            }
+            let rigid_joints = s.method == Method::Rigid && s.joint_stiffness.is_some();
+            let twisting = if s.method == Method::Rigid {
+                s.axes().contains(&super::schema::Axis::X)
+            } else {
+                s.twists()
+            };
+            if twisting && !rigid_joints && s.ei().is_some() && s.gj().is_none() {
+                return err(
+                    p("torsional_stiffness"),
+                    "missing: twisting elements need `torsional_stiffness` (G J), or `youngs_modulus` with the section (G = E/3 unless `shear_modulus` is given)".into(),
+                );
+            }
+            if s.method != Method::Rigid && s.stretches() && s.ea().is_none() {
+                return err(
+                    p("axial_stiffness"),
+                    "missing: `extension = true` needs `axial_stiffness` (E A), or `youngs_modulus` with the section".into(),
+                );
+            }
+        }
         let has_ei = s.ei().is_some();
         match s.method {
             Method::Rigid => {
@@ -207,18 +267,24 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
                     }
                 }
             }
-            Method::Pcc => {
+            Method::Pcc | Method::Vc | Method::Ebr | Method::Cosserat => {
                 for (key, given) in [
                     ("joint_stiffness", s.joint_stiffness.is_some()),
                     ("joint_damping", s.joint_damping.is_some()),
                     ("joints", s.joints.is_some()),
                 ] {
                     if given {
-                        return err(p(key), "not a key of pcc segments: they take `youngs_modulus` or `bending_stiffness`, and `bending_damping`".into());
+                        return err(p(key), format!("not a key of {} segments: they take `youngs_modulus` or `bending_stiffness`, and `bending_damping`", s.method.name()));
                     }
                 }
                 if !has_ei {
-                    return err(p("youngs_modulus"), "missing: a pcc segment needs `youngs_modulus` (with `outer_radius`) or `bending_stiffness`".into());
+                    return err(p("youngs_modulus"), format!("missing: a {} segment needs `youngs_modulus` (with `outer_radius`) or `bending_stiffness`", s.method.name()));
+                }
+                if s.method == Method::Ebr && planar {
+                    return err(p("method"), "ebr is a 3D method: set `dimensions = 3` at the top of the file".into());
+                }
+                if s.joint_axes.is_some() {
+                    return err(p("joint_axes"), "only rigid segments have joint axes".into());
                 }
             }
         }
@@ -228,6 +294,9 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
     }
     if let Some(force) = &m.tip.force {
         vec3("tip.force", force)?;
+    }
+    if let Some(moment) = &m.tip.moment {
+        vec3("tip.moment", moment)?;
     }
     Ok(())
 }

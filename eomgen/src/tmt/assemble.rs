@@ -24,7 +24,7 @@
 
 use crate::cas::{Cas, ExprId};
 
-use super::chain::{ChainKinematics, PointItem};
+use super::chain::{ChainKinematics, MomentItem, PointItem};
 use super::system::System;
 
 /// The derived equations, as expressions.
@@ -96,6 +96,10 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         outs.extend(v);
         force_cot.extend(force.force.map(|c| cas.neg(c)));
     }
+    for moment in &sys.moments {
+        outs.extend(moment.omega);
+        force_cot.extend(moment.moment.map(|c| cas.neg(c)));
+    }
 
     // M: by composite bodies for a chain, else the Jacobian of the
     // generalised momentum T^T Mbar T qd (which the Jacobian kernel needs
@@ -136,7 +140,16 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
                     force: triple(&force_cot, 2 * nb + f),
                 })
                 .collect();
-            k.generalized_forces(cas, &body_forces, &points)
+            let moments: Vec<MomentItem> = sys
+                .moments
+                .iter()
+                .enumerate()
+                .map(|(i, m)| MomentItem {
+                    link: chain.moment_link[i],
+                    moment: m.moment.map(|c| cas.neg(c)),
+                })
+                .collect();
+            k.generalized_forces(cas, &body_forces, &points, &moments)
         }
         _ => cas.vjp(&outs, &force_cot, &sys.coords.qd),
     };
@@ -162,6 +175,9 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     static_cot.extend(std::iter::repeat_n(zero, 3 * nb));
     for force in &sys.point_forces {
         static_cot.extend(force.force.map(|c| cas.neg(c)));
+    }
+    for moment in &sys.moments {
+        static_cot.extend(moment.moment.map(|c| cas.neg(c)));
     }
     let static_loads = cas.vjp(&outs, &static_cot, &sys.coords.qd);
     let static_force: Vec<ExprId> = (0..n)

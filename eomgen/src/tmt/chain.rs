@@ -278,6 +278,7 @@ impl<'a> ChainKinematics<'a> {
         cas: &mut Cas,
         body_forces: &[([ExprId; 3], [ExprId; 3])],
         points: &[PointItem],
+        moments: &[MomentItem],
     ) -> Vec<ExprId> {
         let sys = self.sys;
         let n = sys.coords.len();
@@ -297,6 +298,9 @@ impl<'a> ChainKinematics<'a> {
             link_wrench[p.link].push((rf, p.force));
         }
         let zero = cas.zero();
+        for m in moments {
+            link_wrench[m.link].push((m.moment, [zero; 3]));
+        }
         let mut past: Vec<Spatial> = vec![([zero; 3], [zero; 3]); nl];
         for l in (0..nl.saturating_sub(1)).rev() {
             let mut parts = vec![past[l + 1]];
@@ -325,10 +329,21 @@ impl<'a> ChainKinematics<'a> {
                     let v = p.velocity.map(|e| cas.diff(e, qd));
                     terms.push(cas.dot(&v, &p.force));
                 }
+                // A moment at the end of link l turns with the end frame,
+                // whose angular velocity column is the twist's.
+                for m in moments.iter().filter(|m| m.link == l) {
+                    terms.push(cas.dot(&self.twists[j].0, &m.moment));
+                }
                 cas.add_all(&terms)
             })
             .collect()
     }
+}
+
+/// A moment on the end frame of a link.
+pub struct MomentItem {
+    pub link: usize,
+    pub moment: [ExprId; 3],
 }
 
 /// A force applied at a point of a chain.

@@ -17,7 +17,7 @@
 use crate::cas::{Cas, ExprId, Func, SymKind};
 use crate::model::{Joints, Method, Model, Structure, parameters};
 
-use super::system::{Body, Chain, Coordinates, Inertia, Link, PointForce, System};
+use super::system::{AppliedMoment, Body, Chain, Coordinates, Inertia, Link, PointForce, System};
 
 /// A planar frame: origin, absolute angle and its rate.
 #[derive(Clone, Copy)]
@@ -103,11 +103,14 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
                     bodies.push(body(cas, c, f.w, half_m, inertia));
                     f = advance(cas, f, half);
                 }
-                (Method::Pcc, _) => {
+                (Method::Pcc | Method::Vc, _) => {
                     let (c, chord_rate, arc_inertia, end) = pcc_element(cas, f, l, m, q, qd);
                     let total = cas.add(arc_inertia, inertia);
                     bodies.push(body(cas, c, chord_rate, m, total));
                     f = end;
+                }
+                (Method::Ebr | Method::Cosserat, _) => {
+                    unreachable!("validated: ebr is 3D, cosserat statics only")
                 }
             }
             body_link.resize(bodies.len(), links.len());
@@ -145,6 +148,20 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
         point_forces.push(PointForce { point: tip, force });
         point_force_link.push(links.len().saturating_sub(1));
     }
+    let mut moments = Vec::new();
+    let mut moment_link = Vec::new();
+    if structure.tip_moment {
+        let moment = [
+            param("tip.moment.x"),
+            param("tip.moment.y"),
+            param("tip.moment.z"),
+        ];
+        moments.push(AppliedMoment {
+            omega: [zero, zero, f.w],
+            moment,
+        });
+        moment_link.push(links.len().saturating_sub(1));
+    }
     let gravity = [param("gravity.x"), param("gravity.y"), param("gravity.z")];
     let elastic = cas.add_all(&elastic);
     let rayleigh = cas.add_all(&rayleigh);
@@ -155,11 +172,13 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
         elastic,
         rayleigh,
         point_forces,
+        moments,
         tip,
         chain: (!links.is_empty()).then_some(Chain {
             links,
             body_link,
             point_force_link,
+            moment_link,
         }),
     }
 }

@@ -70,6 +70,12 @@ pub struct PointForce {
     pub force: [ExprId; 3],
 }
 
+/// A constant world-frame moment on a frame turning at `omega`.
+pub struct AppliedMoment {
+    pub omega: [ExprId; 3],
+    pub moment: [ExprId; 3],
+}
+
 pub struct System {
     pub coords: Coordinates,
     pub bodies: Vec<Body>,
@@ -80,6 +86,8 @@ pub struct System {
     pub rayleigh: ExprId,
     /// Constant (conservative) forces at points.
     pub point_forces: Vec<PointForce>,
+    /// Constant moments on frames (no potential: not in the energy output).
+    pub moments: Vec<AppliedMoment>,
     /// Tip position, an output.
     pub tip: [ExprId; 3],
     /// Serial-chain structure, when the kinematics has it (M by composites).
@@ -98,6 +106,8 @@ pub struct Chain {
     /// The link of each point force (the link whose coordinates move the
     /// point non-rigidly).
     pub point_force_link: Vec<usize>,
+    /// The link at whose end each moment acts.
+    pub moment_link: Vec<usize>,
 }
 
 pub struct Link {

@@ -1,0 +1,460 @@
+//! 3D kinematics: serial chains of frames (rotation R, origin p, world
+//! angular velocity w) that each element maps from its base to its end.
+//!
+//! Rotations are built from rotation vectors rho (components along the
+//! frame's x, y, z: twist, bend about y, bend about z) with the Rodrigues
+//! coefficients c_j(|rho|^2) (`runtime::rodrigues`), entire functions of
+//! the squared angle, so the straight configuration is an ordinary point
+//! with full rank:
+//!
+//! * `pcc`, `vc`: an arc of constant strain rho (bending pair, optional
+//!   twist) and optional stretch d: R = exp([rho]x), end at
+//!   (l + d) (I + c2 K + c3 K^2) e_x, one body at the arc's exact centroid
+//!   (l + d) (I/2 + c3 K + c4 K^2) e_x, turning with the mid-arc frame
+//!   exp([rho/2]x), with the inertia of a straight slice.
+//! * `ebr`: half a rigid element, a joint rotating by exp([rho]x) and
+//!   stretching by d, the other half: two bodies per element.
+//! * `rigid`: revolute joints about the element frame's axes in sequence
+//!   (a universal or spherical joint), at the base or midpoint of each link.
+//!
+//! Angular velocities come from the left Jacobian of exp:
+//! w = c1 rho' + c2 rho x rho' + c3 (rho . rho') rho in the base frame;
+//! positions are differentiated by the CAS.
+
+use crate::cas::{Cas, ExprId, Func, SymKind};
+use crate::model::{Joints, Method, Model, Structure, parameters};
+
+use super::system::{AppliedMoment, Body, Chain, Coordinates, Inertia, Link, PointForce, System};
+
+type V3 = [ExprId; 3];
+/// Rows of a rotation matrix.
+type M3 = [[ExprId; 3]; 3];
+
+/// A frame: R (world from frame), origin and world angular velocity.
+#[derive(Clone, Copy)]
+struct Frame {
+    r: M3,
+    p: V3,
+    w: V3,
+}
+
+impl Frame {
+    /// The frame's x axis in the world.
+    fn axis(&self) -> V3 {
+        [self.r[0][0], self.r[1][0], self.r[2][0]]
+    }
+}
+
+fn mat_vec(cas: &mut Cas, r: &M3, v: &V3) -> V3 {
+    std::array::from_fn(|i| cas.dot(&r[i], v))
+}
+
+fn add3(cas: &mut Cas, a: &V3, b: &V3) -> V3 {
+    std::array::from_fn(|k| cas.add(a[k], b[k]))
+}
+
+fn bind3(cas: &mut Cas, v: V3) -> V3 {
+    v.map(|e| cas.bind(e))
+}
+
+/// The frame moved by a relative rotation `r_rel`, offset `p_rel` and
+/// relative angular velocity `w_rel`, all in the frame's own coordinates.
+fn compose(cas: &mut Cas, f: &Frame, r_rel: Option<&M3>, p_rel: Option<&V3>, w_rel: Option<&V3>) -> Frame {
+    let p = match p_rel {
+        Some(d) => {
+            let wd = mat_vec(cas, &f.r, d);
+            {
+                let s = add3(cas, &f.p, &wd);
+                bind3(cas, s)
+            }
+        }
+        None => f.p,
+    };
+    let w = match w_rel {
+        Some(w) => {
+            let ww = mat_vec(cas, &f.r, w);
+            {
+                let s = add3(cas, &f.w, &ww);
+                bind3(cas, s)
+            }
+        }
+        None => f.w,
+    };
+    let r = match r_rel {
+        Some(s) => std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                let col = [s[0][j], s[1][j], s[2][j]];
+                let e = cas.dot(&f.r[i], &col);
+                cas.bind(e)
+            })
+        }),
+        None => f.r,
+    };
+    Frame { r, p, w }
+}
+
+/// The Rodrigues coefficients c_j(w) for j in `js`, bound.
+fn coefficients<const N: usize>(cas: &mut Cas, w: ExprId, js: [u8; N]) -> [ExprId; N] {
+    js.map(|j| {
+        let c = cas.func(Func::Rodrigues(j, 0), w);
+        cas.bind(c)
+    })
+}
+
+/// exp([rho]x) = c0 I + c1 [rho]x + c2 rho rho^T.
+fn rotation(cas: &mut Cas, rho: &V3, c: [ExprId; 3]) -> M3 {
+    let [c0, c1, c2] = c;
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            let outer = cas.mul_all(&[c2, rho[i], rho[j]]);
+            let mut terms = vec![outer];
+            if i == j {
+                terms.push(c0);
+            } else {
+                // [rho]x_ij = -eps_ijk rho_k
+                let k = 3 - i - j;
+                let sign = if (i + 1) % 3 == j { -1.0 } else { 1.0 };
+                let t = cas.mul(c1, rho[k]);
+                terms.push(cas.scaled(sign, t));
+            }
+            let e = cas.add_all(&terms);
+            cas.bind(e)
+        })
+    })
+}
+
+/// The left Jacobian of exp applied to a rate: a c1 rho' + c2 rho x rho'
+/// + c3 (rho . rho') rho, the angular velocity of exp([rho]x) in the base.
+fn left_jacobian(cas: &mut Cas, rho: &V3, rate: &V3, c: [ExprId; 3]) -> V3 {
+    let [c1, c2, c3] = c;
+    let cr = cas.cross(rho, rate);
+    let rr = cas.dot(rho, rate);
+    let s = cas.mul(c3, rr);
+    std::array::from_fn(|k| {
+        let a = cas.mul(c1, rate[k]);
+        let b = cas.mul(c2, cr[k]);
+        let d = cas.mul(s, rho[k]);
+        let e = cas.add_all(&[a, b, d]);
+        cas.bind(e)
+    })
+}
+
+/// (a I + b [rho]x + c [rho]x^2) e_x, with [rho]x e_x = (0, rho_z, -rho_y)
+/// and [rho]x^2 e_x = rho rho_x - w e_x.
+fn series_on_x(cas: &mut Cas, rho: &V3, w: ExprId, a: ExprId, b: ExprId, c: ExprId) -> V3 {
+    let cx = cas.mul(c, rho[0]);
+    let cw = cas.mul(c, w);
+    let x0 = cas.sub(a, cw);
+    let x0t = cas.mul(cx, rho[0]);
+    let x = cas.add(x0, x0t);
+    let by = cas.mul(b, rho[2]);
+    let cy = cas.mul(cx, rho[1]);
+    let y = cas.add(by, cy);
+    let bz = cas.mul(b, rho[1]);
+    let cz = cas.mul(cx, rho[2]);
+    let z = cas.sub(cz, bz);
+    [x, y, z]
+}
+
+/// A constant-strain arc of length `len` (rest length plus stretch) and
+/// strain `rho` from frame `f`: its centroid, its body's axis and angular
+/// velocity (the mid-arc frame), and the end frame.
+fn arc(cas: &mut Cas, f: &Frame, rho: &V3, rate: &V3, len: ExprId) -> (V3, V3, V3, Frame) {
+    let w = cas.dot(rho, rho);
+    let w = cas.bind(w);
+    let [c0, c1, c2, c3, c4] = coefficients(cas, w, [0, 1, 2, 3, 4]);
+    let one = cas.one();
+    let half = cas.constant(0.5);
+    // End frame.
+    let chord = series_on_x(cas, rho, w, one, c2, c3);
+    let chord = chord.map(|e| cas.mul(len, e));
+    let r_rel = rotation(cas, rho, [c0, c1, c2]);
+    let w_rel = left_jacobian(cas, rho, rate, [c1, c2, c3]);
+    let end = compose(cas, f, Some(&r_rel), Some(&chord), Some(&w_rel));
+    // Centroid.
+    let c = series_on_x(cas, rho, w, half, c3, c4);
+    let c = c.map(|e| {
+        let e = cas.mul(len, e);
+        cas.bind(e)
+    });
+    let wc = mat_vec(cas, &f.r, &c);
+    let centroid = add3(cas, &f.p, &wc);
+    // Mid-arc frame: exp([rho/2]x).
+    let rho_h = rho.map(|e| cas.scaled(0.5, e));
+    let rate_h = rate.map(|e| cas.scaled(0.5, e));
+    let w_h = cas.scaled(0.25, w);
+    let w_h = cas.bind(w_h);
+    let [h1, h2, h3] = coefficients(cas, w_h, [1, 2, 3]);
+    let axis_rel = series_on_x(cas, &rho_h, w_h, one, h1, h2);
+    let axis = mat_vec(cas, &f.r, &axis_rel);
+    let axis = bind3(cas, axis);
+    let wm_rel = left_jacobian(cas, &rho_h, &rate_h, [h1, h2, h3]);
+    let wm = mat_vec(cas, &f.r, &wm_rel);
+    let omega = add3(cas, &f.w, &wm);
+    let omega = bind3(cas, omega);
+    (centroid, axis, omega, end)
+}
+
+/// The frame turned by `q` about its own axis `k`.
+fn revolute(cas: &mut Cas, f: &Frame, k: usize, q: ExprId, qd: ExprId) -> Frame {
+    let (c, s) = (cas.cos(q), cas.sin(q));
+    let (zero, one) = (cas.zero(), cas.one());
+    let ns = cas.neg(s);
+    let mut r = [[zero; 3]; 3];
+    let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+    r[k][k] = one;
+    r[a][a] = c;
+    r[b][b] = c;
+    r[a][b] = ns;
+    r[b][a] = s;
+    let mut w = [zero; 3];
+    w[k] = qd;
+    compose(cas, f, Some(&r), None, Some(&w))
+}
+
+/// The frame moved by `d` along its axis.
+fn advance(cas: &mut Cas, f: &Frame, d: ExprId) -> Frame {
+    let zero = cas.zero();
+    compose(cas, f, None, Some(&[d, zero, zero]), None)
+}
+
+/// Build the 3D system of a model. Only the structure and the parameter
+/// layout are read from `model`; values stay symbols.
+pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
+    let structure = Structure::of(model);
+    let names: Vec<String> = parameters(model).into_iter().map(|(n, _)| n).collect();
+    let p: Vec<ExprId> = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| cas.symbol(n, SymKind::Param(i as u32)))
+        .collect();
+    let param = |name: &str| -> ExprId {
+        let i = names
+            .iter()
+            .position(|n| n == name)
+            .unwrap_or_else(|| panic!("no parameter {name}"));
+        p[i]
+    };
+
+    // Coordinates: per element, by method.
+    let mut coord_names = Vec::new();
+    for (s, g) in structure.segments.iter().enumerate() {
+        for e in 0..g.elements {
+            if g.method == Method::Rigid {
+                for a in &g.axes {
+                    coord_names.push(format!("joint_{a:?}_{s}_{e}").to_lowercase());
+                }
+            } else {
+                coord_names.push(format!("bend_y_{s}_{e}"));
+                coord_names.push(format!("bend_z_{s}_{e}"));
+                if g.twist {
+                    coord_names.push(format!("twist_{s}_{e}"));
+                }
+                if g.extension {
+                    coord_names.push(format!("stretch_{s}_{e}"));
+                }
+            }
+        }
+    }
+    let coords = Coordinates::new(cas, coord_names);
+    let zero = cas.zero();
+
+    let r0: M3 = std::array::from_fn(|i| std::array::from_fn(|j| param(&format!("base.R{i}{j}"))));
+    let mut f = Frame {
+        r: r0,
+        p: [param("base.x"), param("base.y"), param("base.z")],
+        w: [zero; 3],
+    };
+    let mut bodies = Vec::new();
+    let mut elastic = Vec::new();
+    let mut rayleigh = Vec::new();
+    let mut links = Vec::new();
+    let mut body_link = Vec::new();
+    let mut c = 0; // next coordinate
+    let mut k = 0; // element
+    for g in &structure.segments {
+        for _ in 0..g.elements {
+            let l = param(&format!("element[{k}].length"));
+            let m = param(&format!("element[{k}].mass"));
+            let lateral = param(&format!("element[{k}].inertia"));
+            let axial = param(&format!("element[{k}].axial_inertia"));
+            let first = c;
+            let body = |axis: V3, position: V3, omega: V3, mass: ExprId| Body {
+                mass,
+                inertia: Inertia::Axisymmetric {
+                    axis,
+                    axial,
+                    lateral,
+                },
+                position,
+                omega,
+            };
+            if g.method == Method::Rigid {
+                let stiff = param(&format!("joint[{k}].stiffness"));
+                let twist = param(&format!("twist[{k}].stiffness"));
+                let damp = param(&format!("joint[{k}].damping"));
+                let rest = param(&format!("joint[{k}].rest"));
+                let mut turn = |cas: &mut Cas, f: &Frame| {
+                    let mut f = *f;
+                    for &a in &g.axes {
+                        let (q, qd) = (coords.q[c], coords.qd[c]);
+                        f = revolute(cas, &f, a.index(), q, qd);
+                        let (kq, q_rest) = if a.index() == 0 { (twist, zero) } else { (stiff, if a.index() == 2 { rest } else { zero }) };
+                        let dq = cas.sub(q, q_rest);
+                        elastic.push(half_k_sq(cas, kq, dq));
+                        rayleigh.push(half_k_sq(cas, damp, qd));
+                        c += 1;
+                    }
+                    f
+                };
+                match g.joints {
+                    Joints::Base => {
+                        f = turn(cas, &f);
+                        let half = cas.scaled(0.5, l);
+                        let mid = advance(cas, &f, half);
+                        bodies.push(body(f.axis(), mid.p, f.w, m));
+                        f = advance(cas, &f, l);
+                    }
+                    Joints::Midpoint => {
+                        let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
+                        let half_m = cas.scaled(0.5, m);
+                        let b = advance(cas, &f, quarter);
+                        bodies.push(body(f.axis(), b.p, f.w, half_m));
+                        f = advance(cas, &f, half);
+                        f = turn(cas, &f);
+                        let b = advance(cas, &f, quarter);
+                        bodies.push(body(f.axis(), b.p, f.w, half_m));
+                        f = advance(cas, &f, half);
+                    }
+                }
+            } else {
+                // Strain coordinates: bend about y, about z, twist, stretch.
+                let take = |c: &mut usize| {
+                    let i = *c;
+                    *c += 1;
+                    (coords.q[i], coords.qd[i])
+                };
+                let (by, by_d) = take(&mut c);
+                let (bz, bz_d) = take(&mut c);
+                let (tw, tw_d) = if g.twist { take(&mut c) } else { (zero, zero) };
+                let (st, st_d) = if g.extension { take(&mut c) } else { (zero, zero) };
+                let rho = [tw, by, bz];
+                let rate = [tw_d, by_d, bz_d];
+                let len = cas.add(l, st);
+                let kb = param(&format!("joint[{k}].stiffness"));
+                let db = param(&format!("joint[{k}].damping"));
+                let rest = param(&format!("joint[{k}].rest"));
+                let bz_rel = cas.sub(bz, rest);
+                elastic.push(half_k_sq(cas, kb, by));
+                elastic.push(half_k_sq(cas, kb, bz_rel));
+                rayleigh.push(half_k_sq(cas, db, by_d));
+                rayleigh.push(half_k_sq(cas, db, bz_d));
+                if g.twist {
+                    let kt = param(&format!("twist[{k}].stiffness"));
+                    let dt = param(&format!("twist[{k}].damping"));
+                    elastic.push(half_k_sq(cas, kt, tw));
+                    rayleigh.push(half_k_sq(cas, dt, tw_d));
+                }
+                if g.extension {
+                    let ks = param(&format!("stretch[{k}].stiffness"));
+                    let ds = param(&format!("stretch[{k}].damping"));
+                    elastic.push(half_k_sq(cas, ks, st));
+                    rayleigh.push(half_k_sq(cas, ds, st_d));
+                }
+                match g.method {
+                    Method::Ebr => {
+                        let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
+                        let half_m = cas.scaled(0.5, m);
+                        let b = advance(cas, &f, quarter);
+                        bodies.push(body(f.axis(), b.p, f.w, half_m));
+                        f = advance(cas, &f, half);
+                        let wsq = cas.dot(&rho, &rho);
+                        let wsq = cas.bind(wsq);
+                        let [c0, c1, c2, c3] = coefficients(cas, wsq, [0, 1, 2, 3]);
+                        let r_rel = rotation(cas, &rho, [c0, c1, c2]);
+                        let w_rel = left_jacobian(cas, &rho, &rate, [c1, c2, c3]);
+                        f = compose(cas, &f, Some(&r_rel), None, Some(&w_rel));
+                        let b_len = cas.add(half, st);
+                        let half_b = cas.scaled(0.5, b_len);
+                        let b = advance(cas, &f, half_b);
+                        bodies.push(body(f.axis(), b.p, f.w, half_m));
+                        f = advance(cas, &f, b_len);
+                    }
+                    _ => {
+                        let (centroid, axis, omega, end) = arc(cas, &f, &rho, &rate, len);
+                        let centroid = bind3(cas, centroid);
+                        bodies.push(body(axis, centroid, omega, m));
+                        f = end;
+                    }
+                }
+            }
+            body_link.resize(bodies.len(), links.len());
+            links.push(Link {
+                coords: (first..c).collect(),
+                end: f.p,
+                end_omega: f.w,
+            });
+            k += 1;
+        }
+    }
+
+    let tip = f.p;
+    let last_link = links.len().saturating_sub(1);
+    if structure.tip_mass {
+        bodies.push(Body {
+            mass: param("tip.mass"),
+            inertia: Inertia::Isotropic(zero),
+            position: tip,
+            omega: f.w,
+        });
+        body_link.push(last_link);
+    }
+    let mut point_forces = Vec::new();
+    let mut point_force_link = Vec::new();
+    if structure.tip_force {
+        let force = [
+            param("tip.force.x"),
+            param("tip.force.y"),
+            param("tip.force.z"),
+        ];
+        point_forces.push(PointForce { point: tip, force });
+        point_force_link.push(last_link);
+    }
+    let mut moments = Vec::new();
+    let mut moment_link = Vec::new();
+    if structure.tip_moment {
+        let moment = [
+            param("tip.moment.x"),
+            param("tip.moment.y"),
+            param("tip.moment.z"),
+        ];
+        moments.push(AppliedMoment { omega: f.w, moment });
+        moment_link.push(last_link);
+    }
+    let gravity = [param("gravity.x"), param("gravity.y"), param("gravity.z")];
+    let elastic = cas.add_all(&elastic);
+    let rayleigh = cas.add_all(&rayleigh);
+    System {
+        coords,
+        bodies,
+        gravity,
+        elastic,
+        rayleigh,
+        point_forces,
+        moments,
+        tip,
+        chain: (!links.is_empty()).then_some(Chain {
+            links,
+            body_link,
+            point_force_link,
+            moment_link,
+        }),
+    }
+}
+
+/// k x^2 / 2
+fn half_k_sq(cas: &mut Cas, k: ExprId, x: ExprId) -> ExprId {
+    let x2 = cas.powi(x, 2);
+    let e = cas.mul(k, x2);
+    cas.scaled(0.5, e)
+}
