@@ -5,6 +5,8 @@ use runtime::CompiledModel;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod cantilever;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod cantilever3d;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod chain;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod chain32;
@@ -25,6 +27,13 @@ pub static MODELS: &[CompiledModel] = &[
         dof: cantilever::DOF,
         source: include_str!("../models/cantilever.toml"),
         kernels: || Box::new(cantilever::Compiled::default()),
+    },
+    CompiledModel {
+        name: "cantilever3d",
+        hash: cantilever3d::HASH,
+        dof: cantilever3d::DOF,
+        source: include_str!("../models/cantilever3d.toml"),
+        kernels: || Box::new(cantilever3d::Compiled::default()),
     },
     CompiledModel {
         name: "chain",

@@ -126,7 +126,10 @@ mod tests {
         for &w in &[0.3f64, 1.0, 2.5, 8.9, 9.1, 20.0, 80.0] {
             for j in 0..=3 {
                 let (a, b) = (rodrigues(j, 0, w), c(j, w));
-                assert!((a - b).abs() <= 1e-14 * b.abs().max(0.1), "c{j}({w}): {a} vs {b}");
+                assert!(
+                    (a - b).abs() <= 1e-14 * b.abs().max(0.1),
+                    "c{j}({w}): {a} vs {b}"
+                );
             }
         }
     }

@@ -274,17 +274,35 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
                     ("joints", s.joints.is_some()),
                 ] {
                     if given {
-                        return err(p(key), format!("not a key of {} segments: they take `youngs_modulus` or `bending_stiffness`, and `bending_damping`", s.method.name()));
+                        return err(
+                            p(key),
+                            format!(
+                                "not a key of {} segments: they take `youngs_modulus` or `bending_stiffness`, and `bending_damping`",
+                                s.method.name()
+                            ),
+                        );
                     }
                 }
                 if !has_ei {
-                    return err(p("youngs_modulus"), format!("missing: a {} segment needs `youngs_modulus` (with `outer_radius`) or `bending_stiffness`", s.method.name()));
+                    return err(
+                        p("youngs_modulus"),
+                        format!(
+                            "missing: a {} segment needs `youngs_modulus` (with `outer_radius`) or `bending_stiffness`",
+                            s.method.name()
+                        ),
+                    );
                 }
                 if s.method == Method::Ebr && planar {
-                    return err(p("method"), "ebr is a 3D method: set `dimensions = 3` at the top of the file".into());
+                    return err(
+                        p("method"),
+                        "ebr is a 3D method: set `dimensions = 3` at the top of the file".into(),
+                    );
                 }
                 if s.joint_axes.is_some() {
-                    return err(p("joint_axes"), "only rigid segments have joint axes".into());
+                    return err(
+                        p("joint_axes"),
+                        "only rigid segments have joint axes".into(),
+                    );
                 }
             }
         }

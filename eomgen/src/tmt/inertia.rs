@@ -72,7 +72,8 @@ impl Inertia {
                     let t = cas.mul(diff, a2);
                     cas.add(*lateral, t)
                 });
-                let off = [(0, 1), (0, 2), (1, 2)].map(|(a, b)| cas.mul_all(&[diff, axis[a], axis[b]]));
+                let off =
+                    [(0, 1), (0, 2), (1, 2)].map(|(a, b)| cas.mul_all(&[diff, axis[a], axis[b]]));
                 [diag[0], diag[1], diag[2], off[0], off[1], off[2]]
             }
         }

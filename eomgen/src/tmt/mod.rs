@@ -11,6 +11,6 @@ mod system;
 
 pub use assemble::{Equations, assemble};
 pub use planar::planar_system;
-pub use spatial::spatial_system;
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
+pub use spatial::spatial_system;
 pub use system::{AppliedMoment, Body, Chain, Coordinates, Inertia, Link, PointForce, System};

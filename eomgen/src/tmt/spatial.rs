@@ -59,7 +59,13 @@ fn bind3(cas: &mut Cas, v: V3) -> V3 {
 
 /// The frame moved by a relative rotation `r_rel`, offset `p_rel` and
 /// relative angular velocity `w_rel`, all in the frame's own coordinates.
-fn compose(cas: &mut Cas, f: &Frame, r_rel: Option<&M3>, p_rel: Option<&V3>, w_rel: Option<&V3>) -> Frame {
+fn compose(
+    cas: &mut Cas,
+    f: &Frame,
+    r_rel: Option<&M3>,
+    p_rel: Option<&V3>,
+    w_rel: Option<&V3>,
+) -> Frame {
     let p = match p_rel {
         Some(d) => {
             let wd = mat_vec(cas, &f.r, d);
@@ -299,7 +305,11 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                     for &a in &g.axes {
                         let (q, qd) = (coords.q[c], coords.qd[c]);
                         f = revolute(cas, &f, a.index(), q, qd);
-                        let (kq, q_rest) = if a.index() == 0 { (twist, zero) } else { (stiff, if a.index() == 2 { rest } else { zero }) };
+                        let (kq, q_rest) = if a.index() == 0 {
+                            (twist, zero)
+                        } else {
+                            (stiff, if a.index() == 2 { rest } else { zero })
+                        };
                         let dq = cas.sub(q, q_rest);
                         elastic.push(half_k_sq(cas, kq, dq));
                         rayleigh.push(half_k_sq(cas, damp, qd));
@@ -337,7 +347,11 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                 let (by, by_d) = take(&mut c);
                 let (bz, bz_d) = take(&mut c);
                 let (tw, tw_d) = if g.twist { take(&mut c) } else { (zero, zero) };
-                let (st, st_d) = if g.extension { take(&mut c) } else { (zero, zero) };
+                let (st, st_d) = if g.extension {
+                    take(&mut c)
+                } else {
+                    (zero, zero)
+                };
                 let rho = [tw, by, bz];
                 let rate = [tw_d, by_d, bz_d];
                 let len = cas.add(l, st);

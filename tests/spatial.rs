@@ -1,0 +1,241 @@
+//! 3D arms (`dimensions = 3`) against continuum mechanics: the constant-
+//! strain arc (against nalgebra's exponential map integrated numerically),
+//! the small-load cantilever F L^3 / (3 E I) in a skew lateral direction,
+//! the circular arc of a pure tip moment, Euler-Bernoulli and Saint-Venant
+//! frequencies, and conservation of energy with bending and twist.
+
+mod common;
+
+use common::*;
+use eomgen::model::Override;
+use nalgebra::{Rotation3, Vector3};
+use runtime::{KernelKind, SimOptions, StaticOptions, modes, simulate, solve_static};
+use softarm::backend::{BackendChoice, Loaded, load};
+
+const L: f64 = 0.3;
+const E: f64 = 1e6;
+const R: f64 = 0.01;
+const RHO: f64 = 1000.0;
+const METHODS: [&str; 4] = ["pcc", "vc", "ebr", "rigid"];
+
+fn ei() -> f64 {
+    E * std::f64::consts::PI * R.powi(4) / 4.0
+}
+
+fn cantilever3d(sets: &[String]) -> Loaded {
+    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    let dir = std::env::temp_dir().join("softarm-test-cache");
+    load("cantilever3d", &overrides, BackendChoice::Auto, Some(dir)).unwrap()
+}
+
+/// (L) int_0^1 exp(s [rho]x) e_x ds by Simpson's rule on nalgebra's exp.
+fn arc_tip(rho: [f64; 3]) -> [f64; 3] {
+    let n = 2000;
+    let mut sum = Vector3::zeros();
+    for i in 0..=n {
+        let s = i as f64 / n as f64;
+        let w = if i == 0 || i == n {
+            1.0
+        } else if i % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        };
+        let r = Rotation3::new(Vector3::from(rho) * s);
+        sum += w * (r * Vector3::x());
+    }
+    let p = sum * (L / (3.0 * n as f64));
+    [p.x, p.y, p.z]
+}
+
+#[test]
+fn one_element_tip_is_the_exponential_map_arc_with_bend_and_twist() {
+    let l = cantilever3d(&["segment.0.elements=1".into()]);
+    assert_eq!(l.arm.dof(), 3); // bend y, bend z, twist
+    let mut rng = Rng::new(7);
+    let mut cases: Vec<[f64; 3]> = vec![
+        [0.0, 0.0, 0.0],
+        [0.0, 1e-9, -1e-9],
+        [1e-12, 0.0, 3e-13],
+        [0.0, 0.0, 2.9],
+        [0.0, -2.9, 0.0],
+        [0.7, 0.0, 0.0],
+    ];
+    for _ in 0..40 {
+        // (twist, bend y, bend z) in the coordinate order (bend y, bend z, twist)
+        cases.push([
+            rng.uniform(-1.5, 1.5),
+            rng.uniform(-2.0, 2.0),
+            rng.uniform(-2.0, 2.0),
+        ]);
+    }
+    for rho in cases {
+        let q = [rho[1], rho[2], rho[0]];
+        let o = l.arm.outputs(0.0, &q, &[0.0; 3]);
+        let tip = arc_tip(rho);
+        for k in 0..3 {
+            assert!(
+                (o[k] - tip[k]).abs() < 1e-12,
+                "rho {rho:?}: tip[{k}] {} vs {}",
+                o[k],
+                tip[k]
+            );
+        }
+        let mut m = nalgebra::DMatrix::zeros(3, 3);
+        let mut h = nalgebra::DVector::zeros(3);
+        l.arm.mass_bias(0.0, &q, &[0.3, -1.1, 2.0], &mut m, &mut h);
+        let mut k = [0.0; 9];
+        l.arm
+            .eval_kernel(KernelKind::Stiffness, 0.0, &q, &[0.0; 3], &mut k);
+        let mut j = vec![0.0; 27];
+        l.arm
+            .jacobian_parts(0.0, &q, &[0.3, -1.1, 2.0], &[0.5, 0.2, -0.7], &mut j);
+        assert!(
+            m.iter()
+                .chain(h.iter())
+                .chain(&k)
+                .chain(&j)
+                .all(|v| v.is_finite())
+        );
+        // Full rank at the straight state too.
+        assert!(
+            m.clone().cholesky().is_some(),
+            "M not positive definite at {rho:?}"
+        );
+    }
+}
+
+#[test]
+fn small_skew_tip_load_matches_beam_theory_for_every_method() {
+    // Along (0, -0.6, 0.8): neither principal axis of the section's frame.
+    let f = 1e-3;
+    let dir = [0.0, -0.6, 0.8];
+    let linear = f * L.powi(3) / (3.0 * ei());
+    assert!(linear < 0.01 * L);
+    for method in METHODS {
+        let mut l = cantilever3d(&[
+            format!("segment.0.method={method}"),
+            format!("tip.force=[0, {}, {}]", f * dir[1], f * dir[2]),
+        ]);
+        let n = l.arm.dof();
+        let sol = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
+        let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
+        for k in 1..3 {
+            let want = linear * dir[k];
+            assert!(
+                (o[k] - want).abs() < 0.01 * linear,
+                "{method}: tip[{k}] {} vs {want} (F L^3 / 3 E I along the load)",
+                o[k]
+            );
+        }
+    }
+}
+
+#[test]
+fn pure_tip_moment_bends_a_pcc_arm_into_a_circular_arc_in_any_plane() {
+    for (angle_deg, kappa_l) in [
+        (0.0, 1.2),
+        (40.0, -0.8),
+        (125.0, 2.0),
+        (250.0, 0.6),
+        (90.0, 0.0),
+    ] {
+        let phi = f64::to_radians(angle_deg);
+        // Moment about n, normal to the arm: the arm bends in the plane
+        // normal to n with curvature M / E I.
+        let n = [0.0, phi.cos(), phi.sin()];
+        let m = kappa_l / L * ei();
+        let mut l = cantilever3d(&[format!("tip.moment=[0, {}, {}]", m * n[1], m * n[2])]);
+        let dof = l.arm.dof();
+        let sol = solve_static(&mut *l.arm, &vec![0.0; dof], &StaticOptions::default()).unwrap();
+        let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; dof]);
+        let tip = arc_tip([0.0, kappa_l * n[1], kappa_l * n[2]]);
+        for k in 0..3 {
+            assert!(
+                (o[k] - tip[k]).abs() < 1e-9 * L,
+                "plane {angle_deg} deg, kappa L {kappa_l}: tip[{k}] {} vs {}",
+                o[k],
+                tip[k]
+            );
+        }
+    }
+}
+
+#[test]
+fn torsion_and_both_bending_frequencies_match_beam_theory() {
+    let l = cantilever3d(&["segment.0.elements=20".into()]);
+    let n = l.arm.dof();
+    let m = modes(&*l.arm, &vec![0.0; n]).unwrap();
+    let area = std::f64::consts::PI * R * R;
+    let scale = (ei() / (RHO * area * L.powi(4))).sqrt();
+    let two_pi = 2.0 * std::f64::consts::PI;
+    // Modes come in bending pairs (y and z) and torsion; tell them apart by
+    // their shapes: twist is every third coordinate.
+    let twist_share = |s: &[f64]| {
+        let t: f64 = s.iter().skip(2).step_by(3).map(|v| v * v).sum();
+        t / s.iter().map(|v| v * v).sum::<f64>()
+    };
+    let bending: Vec<f64> = (0..n)
+        .filter(|&i| twist_share(&m.shapes[i]) < 0.01)
+        .map(|i| m.frequencies_hz[i])
+        .collect();
+    let torsion: Vec<f64> = (0..n)
+        .filter(|&i| twist_share(&m.shapes[i]) > 0.99)
+        .map(|i| m.frequencies_hz[i])
+        .collect();
+    for (k, beta) in [1.875104f64, 4.694091].into_iter().enumerate() {
+        let exact = beta * beta / two_pi * scale;
+        for f in &bending[2 * k..2 * k + 2] {
+            assert_close(*f, exact, 0.02, 0.0, &format!("bending mode {}", k + 1));
+        }
+    }
+    let g = E / 3.0;
+    let exact = (g / RHO).sqrt() / (4.0 * L);
+    assert_close(torsion[0], exact, 0.02, 0.0, "first torsional mode");
+}
+
+#[test]
+fn undamped_3d_arm_swinging_with_twist_conserves_energy_for_every_method() {
+    for method in METHODS {
+        let l = cantilever3d(&[
+            format!("segment.0.method={method}"),
+            "segment.0.elements=3".into(),
+            "gravity=[0, -4, -9.81]".into(),
+        ]);
+        let arm = &*l.arm;
+        let n = arm.dof();
+        let mut rng = Rng::new(3);
+        let mut x0 = rng.vec(n, -0.4, 0.4);
+        x0.extend(rng.vec(n, -2.0, 2.0));
+        let opts = SimOptions {
+            t_end: 5.0,
+            rtol: 1e-10,
+            atol: 1e-12,
+            output_dt: 0.01,
+            ..Default::default()
+        };
+        let (traj, _) = simulate(arm, x0, &opts).unwrap();
+        let energy = |x: &[f64]| {
+            let o = arm.outputs(0.0, &x[..n], &x[n..]);
+            (o[3], o[3] + o[4])
+        };
+        let e0 = energy(&traj.x[0]).1;
+        let ke_max = traj.x.iter().map(|x| energy(x).0).fold(0.0, f64::max);
+        let drift = traj
+            .x
+            .iter()
+            .map(|x| (energy(x).1 - e0).abs())
+            .fold(0.0, f64::max)
+            / e0.abs().max(ke_max);
+        assert!(drift < 1e-7, "{method}: relative energy drift {drift:e}");
+        // It really twists: some twist coordinate changes sign.
+        let twisted = (0..n).any(|i| {
+            traj.x
+                .windows(2)
+                .filter(|w| w[0][i].signum() != w[1][i].signum())
+                .count()
+                >= 2
+        });
+        assert!(twisted, "{method}: nothing swung through zero");
+    }
+}
