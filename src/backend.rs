@@ -87,6 +87,11 @@ pub fn load(
     cache_dir: Option<PathBuf>,
 ) -> Result<Loaded> {
     let (model, origin) = read_model(spec, overrides)?;
+    if crate::continuum::is_cosserat(&model) {
+        bail!(
+            "{origin}: segment.method: \"cosserat\" is solved as a static boundary value problem: run `softarm static` with it, or choose pcc, vc, ebr or rigid for the dynamics"
+        );
+    }
     let hash = Structure::of(&model).hash();
     let params: Vec<(String, f64)> = parameters(&model);
     let compiled = compiled_by_hash(&hash);

@@ -515,6 +515,28 @@ fn equilibrium(loaded: &mut Loaded, q0: &Option<String>) -> Result<runtime::Stat
 }
 
 pub fn statics(a: StaticArgs) -> Result<ExitCode> {
+    let overrides = a
+        .model
+        .set
+        .iter()
+        .map(|s| Override::parse(s))
+        .collect::<Result<Vec<_>, _>>()?;
+    let (model, origin) = backend::read_model(&a.model.model, &overrides)?;
+    if softarm::continuum::is_cosserat(&model) {
+        let sol = softarm::continuum::solve(&model, &origin)?;
+        let v = json!({
+            "model": model.name,
+            "method": "cosserat",
+            "tip_position": sol.tip_position,
+            "base_force": sol.base_force,
+            "base_moment": sol.base_moment,
+            "iterations": sol.iterations,
+            "load_steps": sol.load_steps,
+            "centerline": sol.positions,
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(ExitCode::SUCCESS);
+    }
     let mut loaded = load(&a.model)?;
     let sol = equilibrium(&mut loaded, &a.q0)?;
     let n = sol.q.len();

@@ -18,3 +18,4 @@ pub mod generated {
 
 pub mod backend;
 pub mod cache;
+pub mod continuum;

@@ -239,3 +239,81 @@ fn undamped_3d_arm_swinging_with_twist_conserves_energy_for_every_method() {
         assert!(twisted, "{method}: nothing swung through zero");
     }
 }
+
+/// Static tip of cantilever3d under `sets`, by a lumped method or by the
+/// Cosserat rod.
+fn tip_by(method: &str, elements: usize, load: &str) -> [f64; 3] {
+    let sets = vec![
+        format!("segment.0.method={method}"),
+        format!("segment.0.elements={elements}"),
+        "segment.0.twist=false".to_string(),
+        load.to_string(),
+    ];
+    if method == "cosserat" {
+        let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+        let (model, origin) = softarm::backend::read_model("cantilever3d", &overrides).unwrap();
+        return softarm::continuum::solve(&model, &origin)
+            .unwrap()
+            .tip_position;
+    }
+    let mut l = cantilever3d(&sets);
+    let n = l.arm.dof();
+    let sol = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
+    let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
+    [o[0], o[1], o[2]]
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+#[test]
+fn cosserat_statics_match_beam_theory_for_a_small_skew_load() {
+    let f = 1e-3;
+    let tip = tip_by(
+        "cosserat",
+        1,
+        &format!("tip.force=[0, {}, {}]", -0.6 * f, 0.8 * f),
+    );
+    let linear = f * L.powi(3) / (3.0 * ei());
+    assert_close(tip[1], -0.6 * linear, 0.005, 0.0, "cosserat tip y");
+    assert_close(tip[2], 0.8 * linear, 0.005, 0.0, "cosserat tip z");
+}
+
+#[test]
+fn large_skew_tip_load_lumped_methods_converge_to_the_cosserat_rod() {
+    // P L^2 / E I = 10 along (0, -0.6, 0.8): a tip deflection of 81 % of L.
+    let p = 10.0 * ei() / (L * L);
+    let load = format!("tip.force=[0, {}, {}]", -0.6 * p, 0.8 * p);
+    let reference = tip_by("cosserat", 1, &load);
+    let deflection = (reference[1].powi(2) + reference[2].powi(2)).sqrt();
+    assert!(deflection > 0.75 * L);
+    for (method, fine_bound) in [("pcc", 0.005), ("ebr", 0.01)] {
+        let coarse = dist(tip_by(method, 4, &load), reference);
+        let fine = dist(tip_by(method, 8, &load), reference);
+        // Second order: halving the element length quarters the error.
+        assert!(
+            fine < coarse / 3.0,
+            "{method}: error {coarse:e} at 4 elements, {fine:e} at 8"
+        );
+        assert!(
+            fine < fine_bound * deflection,
+            "{method}: error {fine:e} at 8 elements"
+        );
+    }
+}
+
+#[test]
+fn pcc_reaches_one_percent_under_self_weight_with_twelve_dof() {
+    // The headline of docs/validation.md: the soft cantilever sagging under
+    // its own weight (71 % of L), against the Cosserat rod.
+    let load = "gravity=[0, -9.81, 0]";
+    let reference = tip_by("cosserat", 1, load);
+    let deflection = reference[1].abs();
+    let err = dist(tip_by("pcc", 6, load), reference);
+    assert!(
+        err < 0.01 * deflection,
+        "pcc, 12 DOF: error {:.3} %",
+        100.0 * err / deflection
+    );
+}

@@ -8,8 +8,9 @@ mod validate;
 
 pub use error::ModelError;
 pub use load::{Override, load_model, parse_model};
-pub use schema::{Base, Joints, Method, Model, Segment, Tip};
+pub use schema::{Axis, Base, Joints, Method, Model, Segment, Tip};
 pub use structure::{
-    ElementProps, GENERATOR_VERSION, SegmentShape, Structure, element_props, parameters,
+    ElementProps, GENERATOR_VERSION, SegmentShape, Structure, base_rotation, element_props,
+    parameters,
 };
 pub use validate::MAX_ELEMENTS;
