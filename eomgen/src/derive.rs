@@ -4,18 +4,12 @@ use runtime::{ModelInfo, TapeSet};
 
 use crate::cas::{Cas, Hoist};
 use crate::model::{Model, Structure, parameters};
-use crate::tmt::{
-    SYMBOLIC_SOLVE_MAX_DOF, assemble, planar_system, solve_accelerations, spatial_system,
-};
+use crate::tmt::{SYMBOLIC_SOLVE_MAX_DOF, assemble, solve_accelerations, system};
 
 /// Derive the kernels of a model's structure.
 pub fn derive(model: &Model) -> TapeSet {
     let mut cas = Cas::new();
-    let sys = if model.dimensions == 3 {
-        spatial_system(&mut cas, model)
-    } else {
-        planar_system(&mut cas, model)
-    };
+    let sys = system(&mut cas, model);
     let eq = assemble(&mut cas, &sys);
     let mut mass_bias = eq.mass_upper.clone();
     mass_bias.extend_from_slice(&eq.bias);

@@ -13,4 +13,13 @@ pub use assemble::{Equations, assemble};
 pub use planar::planar_system;
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
 pub use spatial::spatial_system;
+
+/// The system of a model: planar or spatial kinematics by `dimensions`.
+pub fn system(cas: &mut crate::cas::Cas, model: &crate::model::Model) -> System {
+    if model.dimensions == 3 {
+        spatial_system(cas, model)
+    } else {
+        planar_system(cas, model)
+    }
+}
 pub use system::{AppliedMoment, Body, Chain, Coordinates, Inertia, Link, PointForce, System};
