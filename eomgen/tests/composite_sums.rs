@@ -12,7 +12,7 @@ use eomgen::tmt::{assemble, system};
 
 fn check(model: &Model, label: &str) {
     // Loads on, whatever the file says, so that every force path counts.
-    let values: Vec<f64> = parameters(&model)
+    let values: Vec<f64> = parameters(model)
         .into_iter()
         .map(|(name, v)| match name.as_str() {
             "gravity.x" => 1.3,
@@ -28,7 +28,7 @@ fn check(model: &Model, label: &str) {
         })
         .collect();
     let mut cas = Cas::new();
-    let mut sys = system(&mut cas, &model);
+    let mut sys = system(&mut cas, model);
     assert!(
         sys.chain.is_some(),
         "{}: the bundled arms are chains",
