@@ -21,11 +21,12 @@ def table(load_sets, counts, label):
     ref = static(load_sets + ["segment.0.method=cosserat"])["tip_position"]
     defl = math.hypot(ref[1], ref[2])
     print(f"{label}: Cosserat tip {ref}, lateral deflection {defl:.6g} m\n")
-    print("| method | elements | DOF | tip error (m) | error / deflection |")
+    print("| method | elements (rom: order) | DOF | tip error (m) | error / deflection |")
     print("|---|---|---|---|---|")
-    for method in ["pcc", "ebr", "rigid"]:
-        for n in counts:
-            sets = load_sets + [f"segment.0.method={method}", f"segment.0.elements={n}", "segment.0.twist=false"]
+    for method in ["pcc", "ebr", "rigid", "rom"]:
+        key = "order" if method == "rom" else "elements"
+        for n in ([0, 1, 2, 3, 4, 5] if method == "rom" else counts):
+            sets = load_sets + [f"segment.0.method={method}", f"segment.0.{key}={n}", "segment.0.twist=false"]
             d = static(sets)
             tip, dof = d["tip_position"], len(d["q"])
             err = math.dist(tip, ref)

@@ -16,7 +16,7 @@ const L: f64 = 0.3;
 const E: f64 = 1e6;
 const R: f64 = 0.01;
 const RHO: f64 = 1000.0;
-const METHODS: [&str; 4] = ["pcc", "vc", "ebr", "rigid"];
+const METHODS: [&str; 5] = ["pcc", "vc", "ebr", "rigid", "rom"];
 
 fn ei() -> f64 {
     E * std::f64::consts::PI * R.powi(4) / 4.0
@@ -197,11 +197,21 @@ fn torsion_and_both_bending_frequencies_match_beam_theory() {
 #[test]
 fn undamped_3d_arm_swinging_with_twist_conserves_energy_for_every_method() {
     for method in METHODS {
-        let l = cantilever3d(&[
+        let size = if method == "rom" {
+            // Linear strain fields over 6 slices: 6 DOF.
+            "segment.0.order=1".to_string()
+        } else {
+            "segment.0.elements=3".to_string()
+        };
+        let mut sets = vec![
             format!("segment.0.method={method}"),
-            "segment.0.elements=3".into(),
             "gravity=[0, -4, -9.81]".into(),
-        ]);
+        ];
+        if method == "rom" {
+            sets.push("segment.0.quadrature=6".into());
+        }
+        sets.push(size);
+        let l = cantilever3d(&sets);
         let arm = &*l.arm;
         let n = arm.dof();
         let mut rng = Rng::new(3);
@@ -242,10 +252,12 @@ fn undamped_3d_arm_swinging_with_twist_conserves_energy_for_every_method() {
 
 /// Static tip of cantilever3d under `sets`, by a lumped method or by the
 /// Cosserat rod.
-fn tip_by(method: &str, elements: usize, load: &str) -> [f64; 3] {
+/// `size` is the element count, or the polynomial degree for rom.
+fn tip_by(method: &str, size: usize, load: &str) -> [f64; 3] {
+    let key = if method == "rom" { "order" } else { "elements" };
     let sets = vec![
         format!("segment.0.method={method}"),
-        format!("segment.0.elements={elements}"),
+        format!("segment.0.{key}={size}"),
         "segment.0.twist=false".to_string(),
         load.to_string(),
     ];
@@ -301,10 +313,21 @@ fn large_skew_tip_load_lumped_methods_converge_to_the_cosserat_rod() {
             "{method}: error {fine:e} at 8 elements"
         );
     }
+    // rom: linear, then cubic strain fields (4 and 8 DOF).
+    let linear = dist(tip_by("rom", 1, &load), reference);
+    let cubic = dist(tip_by("rom", 3, &load), reference);
+    assert!(
+        cubic < linear / 5.0,
+        "rom: error {linear:e} at order 1, {cubic:e} at 3"
+    );
+    assert!(
+        cubic < 0.005 * deflection,
+        "rom: error {cubic:e} at order 3"
+    );
 }
 
 #[test]
-fn pcc_reaches_one_percent_under_self_weight_with_twelve_dof() {
+fn pcc_and_rom_reach_one_percent_under_self_weight_with_twelve_and_six_dof() {
     // The headline of docs/validation.md: the soft cantilever sagging under
     // its own weight (71 % of L), against the Cosserat rod.
     let load = "gravity=[0, -9.81, 0]";
@@ -314,6 +337,13 @@ fn pcc_reaches_one_percent_under_self_weight_with_twelve_dof() {
     assert!(
         err < 0.01 * deflection,
         "pcc, 12 DOF: error {:.3} %",
+        100.0 * err / deflection
+    );
+    // rom: quadratic strain fields, 6 DOF.
+    let err = dist(tip_by("rom", 2, load), reference);
+    assert!(
+        err < 0.01 * deflection,
+        "rom, 6 DOF: error {:.3} %",
         100.0 * err / deflection
     );
 }

@@ -65,6 +65,10 @@ pub enum Method {
     /// at their midpoints by a rotation (two bending angles and a twist, as
     /// a rotation vector) and an optional stretch. 3D only.
     Ebr,
+    /// Reduced-order model: curvature, twist and stretch as polynomials in
+    /// s of degree `order`, the coefficients the coordinates; kinematics,
+    /// mass and energies by `quadrature` slices along s. 3D only.
+    Rom,
     /// The Cosserat rod, solved as a boundary value problem: statics only.
     Cosserat,
 }
@@ -76,6 +80,7 @@ impl Method {
             Method::Pcc => "pcc",
             Method::Vc => "vc",
             Method::Ebr => "ebr",
+            Method::Rom => "rom",
             Method::Cosserat => "cosserat",
         }
     }
@@ -161,6 +166,13 @@ pub struct Segment {
     /// per element.
     #[serde(default)]
     pub axial_damping: Option<f64>,
+    /// rom: polynomial degree of the strain fields (structural; default 3).
+    #[serde(default)]
+    pub order: Option<usize>,
+    /// rom: slices along s for kinematics, mass and energies (structural;
+    /// default 4 (order + 1)).
+    #[serde(default)]
+    pub quadrature: Option<usize>,
 }
 
 impl Segment {
@@ -210,6 +222,19 @@ impl Segment {
     pub fn ea(&self) -> Option<f64> {
         self.axial_stiffness
             .or_else(|| Some(self.youngs_modulus? * self.area()?))
+    }
+
+    /// Lumped slices of the segment: `elements`, or `quadrature` for rom.
+    pub fn slices(&self) -> usize {
+        match self.method {
+            Method::Rom => self.quadrature.unwrap_or(4 * (self.rom_order() + 1)),
+            _ => self.elements,
+        }
+    }
+
+    /// rom: the polynomial degree.
+    pub fn rom_order(&self) -> usize {
+        self.order.unwrap_or(3)
     }
 
     /// 3D: elements twist.

@@ -26,6 +26,8 @@ pub struct SegmentShape {
     pub twist: bool,
     pub extension: bool,
     pub axes: Vec<Axis>,
+    /// rom: the polynomial degree (0 otherwise).
+    pub order: usize,
 }
 
 impl SegmentShape {
@@ -62,7 +64,12 @@ impl Structure {
                 .iter()
                 .map(|s| SegmentShape {
                     method: s.method,
-                    elements: s.elements,
+                    elements: s.slices(),
+                    order: if s.method == Method::Rom {
+                        s.rom_order()
+                    } else {
+                        0
+                    },
                     joints: match s.method {
                         Method::Rigid => s.joint_placement(),
                         Method::Ebr => Joints::Midpoint,
@@ -103,6 +110,9 @@ impl Structure {
                     " twist {} extension {} axes {:?}",
                     g.twist, g.extension, g.axes
                 ));
+            }
+            if g.method == Method::Rom {
+                s.push_str(&format!(" order {}", g.order));
             }
             s.push('\n');
         }
@@ -158,7 +168,7 @@ pub struct ElementProps {
 pub fn element_props(m: &Model) -> Vec<ElementProps> {
     let mut out = Vec::new();
     for s in &m.segments {
-        let n = s.elements as f64;
+        let n = s.slices() as f64;
         let l = s.length / n;
         let ro = s.outer_radius.unwrap_or(0.0);
         let ri = s.inner_radius.unwrap_or(0.0);
@@ -183,7 +193,7 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
                 (mass / 2.0) * (l / 2.0).powi(2) / 12.0 + section / 2.0,
                 section,
             ),
-            Method::Pcc | Method::Vc | Method::Cosserat => {
+            Method::Pcc | Method::Vc | Method::Rom | Method::Cosserat => {
                 let slice = if m.dimensions == 3 {
                     mass * l * l / 12.0
                 } else {
@@ -206,7 +216,7 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
         };
         let stretch_stiffness = s.ea().unwrap_or(0.0) / l;
         let stretch_damping = s.axial_damping.unwrap_or(0.0) / l;
-        for _ in 0..s.elements {
+        for _ in 0..s.slices() {
             out.push(ElementProps {
                 length: l,
                 mass,

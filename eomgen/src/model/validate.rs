@@ -267,7 +267,7 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
                     }
                 }
             }
-            Method::Pcc | Method::Vc | Method::Ebr | Method::Cosserat => {
+            Method::Pcc | Method::Vc | Method::Ebr | Method::Rom | Method::Cosserat => {
                 for (key, given) in [
                     ("joint_stiffness", s.joint_stiffness.is_some()),
                     ("joint_damping", s.joint_damping.is_some()),
@@ -292,11 +292,40 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
                         ),
                     );
                 }
-                if s.method == Method::Ebr && planar {
+                if matches!(s.method, Method::Ebr | Method::Rom) && planar {
                     return err(
                         p("method"),
-                        "ebr is a 3D method: set `dimensions = 3` at the top of the file".into(),
+                        format!(
+                            "{} is a 3D method: set `dimensions = 3` at the top of the file",
+                            s.method.name()
+                        ),
                     );
+                }
+                if s.method == Method::Rom {
+                    if s.rom_order() > 8 {
+                        return err(
+                            p("order"),
+                            format!(
+                                "must be between 0 and 8 (the polynomial degree of the strains), got {}",
+                                s.rom_order()
+                            ),
+                        );
+                    }
+                    if s.slices() == 0 || s.slices() > 64 {
+                        return err(
+                            p("quadrature"),
+                            format!("must be between 1 and 64 slices, got {}", s.slices()),
+                        );
+                    }
+                } else {
+                    for (key, given) in [
+                        ("order", s.order.is_some()),
+                        ("quadrature", s.quadrature.is_some()),
+                    ] {
+                        if given {
+                            return err(p(key), "only rom segments take `order` and `quadrature`; others take `elements`".into());
+                        }
+                    }
                 }
                 if s.joint_axes.is_some() {
                     return err(

@@ -112,10 +112,38 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     let mass = match &kinematics {
         Some(k) => k.mass(cas),
         None => {
+            // Body by body from the columns of T: sum_b m v_bi . v_bj +
+            // w_bi^T J_b w_bj. (Differentiating the momentum instead costs a
+            // derivative of the whole reverse sweep per entry.)
+            let zero = cas.zero();
+            let columns: Vec<Vec<([ExprId; 3], [ExprId; 3])>> = (0..nb)
+                .map(|b| {
+                    let v = triple(velocities, b);
+                    let w = sys.bodies[b].omega;
+                    sys.coords
+                        .qd
+                        .iter()
+                        .map(|&qd| (v.map(|e| cas.diff(e, qd)), w.map(|e| cas.diff(e, qd))))
+                        .collect()
+                })
+                .collect();
             let mut mass = Vec::with_capacity(n * (n + 1) / 2);
-            for (i, &p) in momentum.iter().enumerate() {
-                for &qd in &sys.coords.qd[i..] {
-                    mass.push(cas.diff(p, qd));
+            for i in 0..n {
+                for j in i..n {
+                    let mut terms = Vec::new();
+                    for (b, body) in sys.bodies.iter().enumerate() {
+                        let ((vi, wi), (vj, wj)) = (columns[b][i], columns[b][j]);
+                        let none = |v: &[ExprId; 3], w: &[ExprId; 3]| {
+                            v.iter().chain(w).all(|&e| e == zero)
+                        };
+                        if none(&vi, &wi) || none(&vj, &wj) {
+                            continue;
+                        }
+                        let vv = cas.dot(&vi, &vj);
+                        terms.push(cas.mul(body.mass, vv));
+                        terms.push(body.inertia.quadratic(cas, &wi, &wj));
+                    }
+                    mass.push(cas.add_all(&terms));
                 }
             }
             mass

@@ -245,6 +245,14 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
     // Coordinates: per element, by method.
     let mut coord_names = Vec::new();
     for (s, g) in structure.segments.iter().enumerate() {
+        if g.method == Method::Rom {
+            for field in rom_fields(g) {
+                for i in 0..=g.order {
+                    coord_names.push(format!("{field}_{s}_c{i}"));
+                }
+            }
+            continue;
+        }
         for e in 0..g.elements {
             if g.method == Method::Rigid {
                 for a in &g.axes {
@@ -279,7 +287,23 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
     let mut c = 0; // next coordinate
     let mut k = 0; // element
     for g in &structure.segments {
-        for _ in 0..g.elements {
+        // rom: the segment's coefficients, shared by its slices, and its
+        // strain energy integrated exactly.
+        let rom = (g.method == Method::Rom).then(|| {
+            let r = Rom {
+                first: c,
+                order: g.order,
+                slices: g.elements,
+                twist: g.twist,
+                extension: g.extension,
+            };
+            c += r.coordinates();
+            let [e, d] = r.energies(cas, &coords, &param, k);
+            elastic.push(e);
+            rayleigh.push(d);
+            r
+        });
+        for e in 0..g.elements {
             let l = param(&format!("element[{k}].length"));
             let m = param(&format!("element[{k}].mass"));
             let lateral = param(&format!("element[{k}].inertia"));
@@ -337,6 +361,13 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                         f = advance(cas, &f, half);
                     }
                 }
+            } else if let Some(rom) = &rom {
+                let (rho, rate, st) = rom.slice(cas, &coords, e, l);
+                let len = cas.add(l, st);
+                let (centroid, axis, omega, end) = arc(cas, &f, &rho, &rate, len);
+                let centroid = bind3(cas, centroid);
+                bodies.push(body(axis, centroid, omega, m));
+                f = end;
             } else {
                 // Strain coordinates: bend about y, about z, twist, stretch.
                 let take = |c: &mut usize| {
@@ -412,6 +443,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
         }
     }
 
+    let has_rom = structure.segments.iter().any(|g| g.method == Method::Rom);
     let tip = f.p;
     let last_link = links.len().saturating_sub(1);
     if structure.tip_mass {
@@ -457,12 +489,172 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
         point_forces,
         moments,
         tip,
-        chain: (!links.is_empty()).then_some(Chain {
+        // rom slices share their segment's coordinates: not a chain of
+        // links that own theirs, so M and h by the general sums.
+        chain: (!links.is_empty() && !has_rom).then_some(Chain {
             links,
             body_link,
             point_force_link,
             moment_link,
         }),
+    }
+}
+
+/// The strain fields of a rom segment, in coordinate order.
+fn rom_fields(g: &crate::model::SegmentShape) -> Vec<&'static str> {
+    let mut f = vec!["bend_y", "bend_z"];
+    if g.twist {
+        f.push("twist");
+    }
+    if g.extension {
+        f.push("stretch");
+    }
+    f
+}
+
+/// A rom segment: strain fields sum_i c_i sigma^i over sigma = s / L in
+/// [0, 1], the coefficients c (angles: curvature times L; the stretch
+/// field is dimensionless) its coordinates, field by field.
+struct Rom {
+    first: usize,
+    order: usize,
+    slices: usize,
+    twist: bool,
+    extension: bool,
+}
+
+impl Rom {
+    fn coordinates(&self) -> usize {
+        (2 + usize::from(self.twist) + usize::from(self.extension)) * (self.order + 1)
+    }
+
+    /// Coordinate index of coefficient i of field f.
+    fn index(&self, f: usize, i: usize) -> usize {
+        self.first + f * (self.order + 1) + i
+    }
+
+    /// int over slice e of sigma^i d sigma, for each i.
+    fn weights(&self, e: usize) -> Vec<f64> {
+        let n = self.slices as f64;
+        let (a, b) = (e as f64 / n, (e + 1) as f64 / n);
+        (0..=self.order)
+            .map(|i| {
+                let p = (i + 1) as i32;
+                (b.powi(p) - a.powi(p)) / p as f64
+            })
+            .collect()
+    }
+
+    /// One field integrated over slice e, of q (or, with `rates`, of qd).
+    fn field(
+        &self,
+        cas: &mut Cas,
+        coords: &Coordinates,
+        f: usize,
+        e: usize,
+        rates: bool,
+    ) -> ExprId {
+        let terms: Vec<ExprId> = self
+            .weights(e)
+            .into_iter()
+            .enumerate()
+            .map(|(i, w)| {
+                let j = self.index(f, i);
+                let x = if rates { coords.qd[j] } else { coords.q[j] };
+                cas.scaled(w, x)
+            })
+            .collect();
+        cas.add_all(&terms)
+    }
+
+    /// The rotation vector of slice e (twist, bend y, bend z), its rate,
+    /// and the slice's stretch, given the slice length l.
+    fn slice(&self, cas: &mut Cas, coords: &Coordinates, e: usize, l: ExprId) -> (V3, V3, ExprId) {
+        let zero = cas.zero();
+        let mut rho = [zero; 3];
+        let mut rate = [zero; 3];
+        // Fields 0, 1 bend about y, z; then twist (about x); then stretch.
+        for (f, axis) in [(0, 1), (1, 2)] {
+            rho[axis] = self.field(cas, coords, f, e, false);
+            rate[axis] = self.field(cas, coords, f, e, true);
+        }
+        if self.twist {
+            rho[0] = self.field(cas, coords, 2, e, false);
+            rate[0] = self.field(cas, coords, 2, e, true);
+        }
+        let stretch = if self.extension {
+            // The strain integrated over the slice, times L = slices * l.
+            let f = 2 + usize::from(self.twist);
+            let s = self.field(cas, coords, f, e, false);
+            let ls = cas.mul(l, s);
+            cas.scaled(self.slices as f64, ls)
+        } else {
+            zero
+        };
+        (rho.map(|x| cas.bind(x)), rate.map(|x| cas.bind(x)), stretch)
+    }
+
+    /// Strain energy and Rayleigh function, integrated exactly:
+    /// (k / 2) int_0^1 (field - rest)^2 d sigma with int sigma^(i+j) = 1 /
+    /// (i + j + 1). Per-slice parameters of slice k: E I / l = slices E I / L.
+    fn energies(
+        &self,
+        cas: &mut Cas,
+        coords: &Coordinates,
+        param: &dyn Fn(&str) -> ExprId,
+        k: usize,
+    ) -> [ExprId; 2] {
+        let n = self.slices as f64;
+        let quad = |cas: &mut Cas, x: &[ExprId]| {
+            let mut terms = Vec::new();
+            for (i, &a) in x.iter().enumerate() {
+                for (j, &b) in x.iter().enumerate() {
+                    let ab = cas.mul(a, b);
+                    terms.push(cas.scaled(1.0 / (i + j + 1) as f64, ab));
+                }
+            }
+            cas.add_all(&terms)
+        };
+        let fields = 2 + usize::from(self.twist) + usize::from(self.extension);
+        let (mut elastic, mut rayleigh) = (Vec::new(), Vec::new());
+        for f in 0..fields {
+            let stretch = self.extension && f == fields - 1;
+            let (stiff, damp) = match f {
+                _ if stretch => ("stretch", "stretch"),
+                0 | 1 => ("joint", "joint"),
+                _ => ("twist", "twist"),
+            };
+            let ks = param(&format!("{stiff}[{k}].stiffness"));
+            let ds = param(&format!("{damp}[{k}].damping"));
+            // Bending, twist: (E I / L) c^T G c = (k_slice / n) ...; stretch:
+            // E A L e^T G e = k_slice n l^2 ....
+            let scale = if stretch {
+                let l = param(&format!("element[{k}].length"));
+                let l2 = cas.powi(l, 2);
+                cas.scaled(n, l2)
+            } else {
+                cas.constant(1.0 / n)
+            };
+            let mut x: Vec<ExprId> = (0..=self.order)
+                .map(|i| coords.q[self.index(f, i)])
+                .collect();
+            if f == 1 {
+                // Rest curvature about z, constant along s: kappa0 L = n rest.
+                let rest = param(&format!("joint[{k}].rest"));
+                let r = cas.scaled(n, rest);
+                x[0] = cas.sub(x[0], r);
+            }
+            let xd: Vec<ExprId> = (0..=self.order)
+                .map(|i| coords.qd[self.index(f, i)])
+                .collect();
+            let e = quad(cas, &x);
+            let d = quad(cas, &xd);
+            elastic.push(cas.mul_all(&[ks, scale, e]));
+            rayleigh.push(cas.mul_all(&[ds, scale, d]));
+        }
+        let e = cas.add_all(&elastic);
+        let d = cas.add_all(&rayleigh);
+        [cas.scaled(0.5, e), cas.scaled(0.5, d)]
     }
 }
 
