@@ -65,6 +65,11 @@ pub enum Method {
     /// at their midpoints by a rotation (two bending angles and a twist, as
     /// a rotation vector) and an optional stretch. 3D only.
     Ebr,
+    /// Euler-Bernoulli elements with absolute states: each element's
+    /// position and orientation in the world frame (6 coordinates), the
+    /// elements coupled by beam springs (bending, twist, axial, shear).
+    /// 3D only; twist and stretch are always present.
+    Eba,
     /// Reduced-order model: curvature, twist and stretch as polynomials in
     /// s of degree `order`, the coefficients the coordinates; kinematics,
     /// mass and energies by `quadrature` slices along s. 3D only.
@@ -80,6 +85,7 @@ impl Method {
             Method::Pcc => "pcc",
             Method::Vc => "vc",
             Method::Ebr => "ebr",
+            Method::Eba => "eba",
             Method::Rom => "rom",
             Method::Cosserat => "cosserat",
         }
@@ -216,6 +222,14 @@ impl Segment {
                 .or_else(|| Some(self.youngs_modulus? / 3.0))?;
             Some(g * 2.0 * self.second_moment()?)
         })
+    }
+
+    /// Shear stiffness G A (N), shear coefficient 1.
+    pub fn ga(&self) -> Option<f64> {
+        let g = self
+            .shear_modulus
+            .or_else(|| Some(self.youngs_modulus? / 3.0))?;
+        Some(g * self.area()?)
     }
 
     /// Axial stiffness E A (N).

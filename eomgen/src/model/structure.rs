@@ -11,7 +11,7 @@ use super::schema::{Axis, Joints, Method, Model};
 
 /// Bumped whenever derivation or emission changes what is generated, so
 /// that cached tapes and generated files are re-derived.
-pub const GENERATOR_VERSION: u32 = 21;
+pub const GENERATOR_VERSION: u32 = 22;
 
 /// The structural part of one segment.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -75,8 +75,11 @@ impl Structure {
                         Method::Ebr => Joints::Midpoint,
                         _ => Joints::Base,
                     },
-                    twist: spatial && s.method != Method::Rigid && s.twists(),
-                    extension: spatial && s.method != Method::Rigid && s.stretches(),
+                    twist: spatial
+                        && (s.method == Method::Eba || (s.method != Method::Rigid && s.twists())),
+                    extension: spatial
+                        && (s.method == Method::Eba
+                            || (s.method != Method::Rigid && s.stretches())),
                     axes: if spatial && s.method == Method::Rigid {
                         s.axes()
                     } else {
@@ -163,6 +166,8 @@ pub struct ElementProps {
     /// 3D: E A / l_e (N/m) and c / l_e (N s/m).
     pub stretch_stiffness: f64,
     pub stretch_damping: f64,
+    /// 3D, eba: G A / l_e (N/m).
+    pub shear_stiffness: f64,
 }
 
 pub fn element_props(m: &Model) -> Vec<ElementProps> {
@@ -193,7 +198,7 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
                 (mass / 2.0) * (l / 2.0).powi(2) / 12.0 + section / 2.0,
                 section,
             ),
-            Method::Pcc | Method::Vc | Method::Rom | Method::Cosserat => {
+            Method::Pcc | Method::Vc | Method::Rom | Method::Eba | Method::Cosserat => {
                 let slice = if m.dimensions == 3 {
                     mass * l * l / 12.0
                 } else {
@@ -216,6 +221,7 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
         };
         let stretch_stiffness = s.ea().unwrap_or(0.0) / l;
         let stretch_damping = s.axial_damping.unwrap_or(0.0) / l;
+        let shear_stiffness = s.ga().unwrap_or(0.0) / l;
         for _ in 0..s.slices() {
             out.push(ElementProps {
                 length: l,
@@ -229,6 +235,7 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
                 twist_damping: damping,
                 stretch_stiffness,
                 stretch_damping,
+                shear_stiffness,
             });
         }
     }
@@ -282,6 +289,7 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
             p.push((format!("twist[{k}].damping"), e.twist_damping));
             p.push((format!("stretch[{k}].stiffness"), e.stretch_stiffness));
             p.push((format!("stretch[{k}].damping"), e.stretch_damping));
+            p.push((format!("shear[{k}].stiffness"), e.shear_stiffness));
         }
     }
     p

@@ -267,7 +267,12 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
                     }
                 }
             }
-            Method::Pcc | Method::Vc | Method::Ebr | Method::Rom | Method::Cosserat => {
+            Method::Pcc
+            | Method::Vc
+            | Method::Ebr
+            | Method::Eba
+            | Method::Rom
+            | Method::Cosserat => {
                 for (key, given) in [
                     ("joint_stiffness", s.joint_stiffness.is_some()),
                     ("joint_damping", s.joint_damping.is_some()),
@@ -292,7 +297,18 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
                         ),
                     );
                 }
-                if matches!(s.method, Method::Ebr | Method::Rom) && planar {
+                if s.method == Method::Eba {
+                    if m.segments.iter().any(|o| o.method != Method::Eba) {
+                        return err(p("method"), "eba segments take absolute coordinates: every segment of the arm must be eba".into());
+                    }
+                    if s.rest_curvature != 0.0 {
+                        return err(p("rest_curvature"), "eba elements are straight at rest: remove the key or use pcc, ebr or rom".into());
+                    }
+                    if s.ea().is_none() || s.ga().is_none() {
+                        return err(p("youngs_modulus"), "missing: eba couples elements by axial and shear springs: give `youngs_modulus` with `outer_radius`".into());
+                    }
+                }
+                if matches!(s.method, Method::Ebr | Method::Eba | Method::Rom) && planar {
                     return err(
                         p("method"),
                         format!(

@@ -1,6 +1,7 @@
 //! The TMT method: kinematics modules describe a [`System`]; [`assemble`]
 //! derives M, h and the outputs from it.
 
+mod absolute;
 mod assemble;
 mod chain;
 mod inertia;
@@ -14,9 +15,16 @@ pub use planar::planar_system;
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
 pub use spatial::spatial_system;
 
-/// The system of a model: planar or spatial kinematics by `dimensions`.
+/// The system of a model: planar or spatial kinematics by `dimensions`,
+/// absolute coordinates for eba.
 pub fn system(cas: &mut crate::cas::Cas, model: &crate::model::Model) -> System {
-    if model.dimensions == 3 {
+    if model
+        .segments
+        .iter()
+        .any(|s| s.method == crate::model::Method::Eba)
+    {
+        absolute::absolute_system(cas, model)
+    } else if model.dimensions == 3 {
         spatial_system(cas, model)
     } else {
         planar_system(cas, model)

@@ -109,8 +109,8 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
                     bodies.push(body(cas, c, chord_rate, m, total));
                     f = end;
                 }
-                (Method::Ebr | Method::Rom | Method::Cosserat, _) => {
-                    unreachable!("validated: ebr and rom are 3D, cosserat statics only")
+                (Method::Ebr | Method::Eba | Method::Rom | Method::Cosserat, _) => {
+                    unreachable!("validated: ebr, eba and rom are 3D, cosserat statics only")
                 }
             }
             body_link.resize(bodies.len(), links.len());

@@ -26,9 +26,9 @@ use crate::model::{Joints, Method, Model, Structure, parameters};
 
 use super::system::{AppliedMoment, Body, Chain, Coordinates, Inertia, Link, PointForce, System};
 
-type V3 = [ExprId; 3];
+pub(super) type V3 = [ExprId; 3];
 /// Rows of a rotation matrix.
-type M3 = [[ExprId; 3]; 3];
+pub(super) type M3 = [[ExprId; 3]; 3];
 
 /// A frame: R (world from frame), origin and world angular velocity.
 #[derive(Clone, Copy)]
@@ -45,15 +45,15 @@ impl Frame {
     }
 }
 
-fn mat_vec(cas: &mut Cas, r: &M3, v: &V3) -> V3 {
+pub(super) fn mat_vec(cas: &mut Cas, r: &M3, v: &V3) -> V3 {
     std::array::from_fn(|i| cas.dot(&r[i], v))
 }
 
-fn add3(cas: &mut Cas, a: &V3, b: &V3) -> V3 {
+pub(super) fn add3(cas: &mut Cas, a: &V3, b: &V3) -> V3 {
     std::array::from_fn(|k| cas.add(a[k], b[k]))
 }
 
-fn bind3(cas: &mut Cas, v: V3) -> V3 {
+pub(super) fn bind3(cas: &mut Cas, v: V3) -> V3 {
     v.map(|e| cas.bind(e))
 }
 
@@ -100,7 +100,7 @@ fn compose(
 }
 
 /// The Rodrigues coefficients c_j(w) for j in `js`, bound.
-fn coefficients<const N: usize>(cas: &mut Cas, w: ExprId, js: [u8; N]) -> [ExprId; N] {
+pub(super) fn coefficients<const N: usize>(cas: &mut Cas, w: ExprId, js: [u8; N]) -> [ExprId; N] {
     js.map(|j| {
         let c = cas.func(Func::Rodrigues(j, 0), w);
         cas.bind(c)
@@ -108,7 +108,7 @@ fn coefficients<const N: usize>(cas: &mut Cas, w: ExprId, js: [u8; N]) -> [ExprI
 }
 
 /// exp([rho]x) = c0 I + c1 [rho]x + c2 rho rho^T.
-fn rotation(cas: &mut Cas, rho: &V3, c: [ExprId; 3]) -> M3 {
+pub(super) fn rotation(cas: &mut Cas, rho: &V3, c: [ExprId; 3]) -> M3 {
     let [c0, c1, c2] = c;
     std::array::from_fn(|i| {
         std::array::from_fn(|j| {
@@ -131,7 +131,7 @@ fn rotation(cas: &mut Cas, rho: &V3, c: [ExprId; 3]) -> M3 {
 
 /// The left Jacobian of exp applied to a rate: a c1 rho' + c2 rho x rho'
 /// + c3 (rho . rho') rho, the angular velocity of exp([rho]x) in the base.
-fn left_jacobian(cas: &mut Cas, rho: &V3, rate: &V3, c: [ExprId; 3]) -> V3 {
+pub(super) fn left_jacobian(cas: &mut Cas, rho: &V3, rate: &V3, c: [ExprId; 3]) -> V3 {
     let [c1, c2, c3] = c;
     let cr = cas.cross(rho, rate);
     let rr = cas.dot(rho, rate);
@@ -659,7 +659,7 @@ impl Rom {
 }
 
 /// k x^2 / 2
-fn half_k_sq(cas: &mut Cas, k: ExprId, x: ExprId) -> ExprId {
+pub(super) fn half_k_sq(cas: &mut Cas, k: ExprId, x: ExprId) -> ExprId {
     let x2 = cas.powi(x, 2);
     let e = cas.mul(k, x2);
     cas.scaled(0.5, e)

@@ -1,0 +1,225 @@
+//! `eba`: Euler-Bernoulli elements with absolute states.
+//!
+//! Element i is a rigid straight slice with six coordinates of its own: the
+//! displacement u_i of its centre from the straight arm and the rotation
+//! vector psi_i of its orientation, R_i = R0 exp([psi_i]x) (components in
+//! the base frame), so q = 0 is the straight arm and its Jacobian has full
+//! rank there. Nothing is chained: each body depends on its own six
+//! coordinates only, M is block diagonal, and the elements hold together by
+//! beam springs between neighbours (the clamp counting as element -1):
+//!
+//! * rotation: v = vee(R_rel - R_rel^T) / 2 of R_rel = R_a^T R_b (sin of
+//!   the relative angle times its axis), with E I / span about the two
+//!   section axes and G J / span about the element, span = l_e between
+//!   centres (l_e / 2 from the clamp to the first);
+//! * translation: the gap from the end of one element to the start of the
+//!   next, in the first one's frame, with E A / l_e along it and G A / l_e
+//!   across: the rod's axial and shear compliance.
+//!
+//! A finite-difference rod (strains between element centres) that converges
+//! to the extensible, shearable Cosserat rod as l_e -> 0.
+
+use crate::cas::{Cas, ExprId, SymKind};
+use crate::model::{Model, Structure, parameters};
+
+use super::spatial::{M3, V3, bind3, coefficients, half_k_sq, left_jacobian, mat_vec, rotation};
+use super::system::{AppliedMoment, Body, Coordinates, Inertia, PointForce, System};
+
+/// An element's (or the clamp's) frame: rotation, centre and half length.
+struct Slab {
+    r: M3,
+    centre: V3,
+    half: ExprId,
+}
+
+impl Slab {
+    /// The point at `sign` half lengths along the axis from the centre.
+    fn end(&self, cas: &mut Cas, sign: f64) -> V3 {
+        let d = cas.scaled(sign, self.half);
+        let axis = [self.r[0][0], self.r[1][0], self.r[2][0]];
+        std::array::from_fn(|k| {
+            let t = cas.mul(d, axis[k]);
+            cas.add(self.centre[k], t)
+        })
+    }
+}
+
+fn transpose_mul(cas: &mut Cas, a: &M3, b: &M3) -> M3 {
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            let ai = [a[0][i], a[1][i], a[2][i]];
+            let bj = [b[0][j], b[1][j], b[2][j]];
+            cas.dot(&ai, &bj)
+        })
+    })
+}
+
+pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
+    let structure = Structure::of(model);
+    let names: Vec<String> = parameters(model).into_iter().map(|(n, _)| n).collect();
+    let p: Vec<ExprId> = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| cas.symbol(n, SymKind::Param(i as u32)))
+        .collect();
+    let param = |name: &str| -> ExprId {
+        let i = names
+            .iter()
+            .position(|n| n == name)
+            .unwrap_or_else(|| panic!("no parameter {name}"));
+        p[i]
+    };
+    let mut coord_names = Vec::new();
+    for (s, g) in structure.segments.iter().enumerate() {
+        for e in 0..g.elements {
+            for c in ["ux", "uy", "uz", "rx", "ry", "rz"] {
+                coord_names.push(format!("{c}_{s}_{e}"));
+            }
+        }
+    }
+    let coords = Coordinates::new(cas, coord_names);
+    let zero = cas.zero();
+    let r0: M3 = std::array::from_fn(|i| std::array::from_fn(|j| param(&format!("base.R{i}{j}"))));
+    let p0 = [param("base.x"), param("base.y"), param("base.z")];
+    let base_axis = [r0[0][0], r0[1][0], r0[2][0]];
+
+    let mut bodies = Vec::new();
+    let mut elastic = Vec::new();
+    let mut rayleigh = Vec::new();
+    let mut prev = Slab {
+        r: r0,
+        centre: p0,
+        half: zero,
+    };
+    let mut along = zero; // arc length to the current element's start
+    let mut omega = [zero; 3];
+    let n_el = structure.elements();
+    for k in 0..n_el {
+        let c = 6 * k;
+        let u: V3 = std::array::from_fn(|i| coords.q[c + i]);
+        let psi: V3 = std::array::from_fn(|i| coords.q[c + 3 + i]);
+        let psi_d: V3 = std::array::from_fn(|i| coords.qd[c + 3 + i]);
+        let l = param(&format!("element[{k}].length"));
+        let half = cas.scaled(0.5, l);
+        // Centre of the straight arm plus the displacement.
+        let s_mid = cas.add(along, half);
+        let centre: V3 = std::array::from_fn(|i| {
+            let straight = cas.mul(s_mid, base_axis[i]);
+            cas.add_all(&[p0[i], straight, u[i]])
+        });
+        let centre = bind3(cas, centre);
+        along = cas.add(along, l);
+        let w = cas.dot(&psi, &psi);
+        let w = cas.bind(w);
+        let [c0, c1, c2, c3] = coefficients(cas, w, [0, 1, 2, 3]);
+        let rel = rotation(cas, &psi, [c0, c1, c2]);
+        let r: M3 = std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                let col = [rel[0][j], rel[1][j], rel[2][j]];
+                let e = cas.dot(&r0[i], &col);
+                cas.bind(e)
+            })
+        });
+        let w_local = left_jacobian(cas, &psi, &psi_d, [c1, c2, c3]);
+        omega = mat_vec(cas, &r0, &w_local);
+        omega = bind3(cas, omega);
+        let axis = [r[0][0], r[1][0], r[2][0]];
+        bodies.push(Body {
+            mass: param(&format!("element[{k}].mass")),
+            inertia: Inertia::Axisymmetric {
+                axis,
+                axial: param(&format!("element[{k}].axial_inertia")),
+                lateral: param(&format!("element[{k}].inertia")),
+            },
+            position: centre,
+            omega,
+        });
+        let slab = Slab { r, centre, half };
+
+        // Beam springs to the previous element (or the clamp).
+        let first = k == 0;
+        let span = if first { 2.0 } else { 1.0 }; // stiffness factor l_e / span
+        let kb = param(&format!("joint[{k}].stiffness"));
+        let kt = param(&format!("twist[{k}].stiffness"));
+        let db = param(&format!("joint[{k}].damping"));
+        let dt = param(&format!("twist[{k}].damping"));
+        let ka = param(&format!("stretch[{k}].stiffness"));
+        let da = param(&format!("stretch[{k}].damping"));
+        let ks = param(&format!("shear[{k}].stiffness"));
+        let r_rel = transpose_mul(cas, &prev.r, &slab.r);
+        // vee of the skew part: (R32 - R23, R13 - R31, R21 - R12) / 2
+        let v: V3 = [(2, 1), (0, 2), (1, 0)].map(|(a, b)| {
+            let d = cas.sub(r_rel[a][b], r_rel[b][a]);
+            let h = cas.scaled(0.5, d);
+            cas.bind(h)
+        });
+        let pairs = coords.rate_pairs();
+        let v_d = cas.time_derivatives(&v, &pairs);
+        for (i, (&x, &xd)) in v.iter().zip(&v_d).enumerate() {
+            let (kk, dd) = if i == 0 { (kt, dt) } else { (kb, db) };
+            let kk = cas.scaled(span, kk);
+            let dd = cas.scaled(span, dd);
+            elastic.push(half_k_sq(cas, kk, x));
+            rayleigh.push(half_k_sq(cas, dd, xd));
+        }
+        let end_a = prev.end(cas, 1.0);
+        let start_b = slab.end(cas, -1.0);
+        let gap: V3 = std::array::from_fn(|i| cas.sub(start_b[i], end_a[i]));
+        // In the previous frame: R_a^T gap.
+        let local: V3 = std::array::from_fn(|i| {
+            let col = [prev.r[0][i], prev.r[1][i], prev.r[2][i]];
+            let e = cas.dot(&col, &gap);
+            cas.bind(e)
+        });
+        let local_d = cas.time_derivatives(&local[..1], &pairs);
+        elastic.push(half_k_sq(cas, ka, local[0]));
+        rayleigh.push(half_k_sq(cas, da, local_d[0]));
+        for &x in &local[1..] {
+            elastic.push(half_k_sq(cas, ks, x));
+        }
+        prev = slab;
+    }
+
+    let tip = prev.end(cas, 1.0);
+    let tip = bind3(cas, tip);
+    if structure.tip_mass {
+        bodies.push(Body {
+            mass: param("tip.mass"),
+            inertia: Inertia::Isotropic(zero),
+            position: tip,
+            omega,
+        });
+    }
+    let mut point_forces = Vec::new();
+    if structure.tip_force {
+        let force = [
+            param("tip.force.x"),
+            param("tip.force.y"),
+            param("tip.force.z"),
+        ];
+        point_forces.push(PointForce { point: tip, force });
+    }
+    let mut moments = Vec::new();
+    if structure.tip_moment {
+        let moment = [
+            param("tip.moment.x"),
+            param("tip.moment.y"),
+            param("tip.moment.z"),
+        ];
+        moments.push(AppliedMoment { omega, moment });
+    }
+    let gravity = [param("gravity.x"), param("gravity.y"), param("gravity.z")];
+    let elastic = cas.add_all(&elastic);
+    let rayleigh = cas.add_all(&rayleigh);
+    System {
+        coords,
+        bodies,
+        gravity,
+        elastic,
+        rayleigh,
+        point_forces,
+        moments,
+        tip,
+        chain: None,
+    }
+}
