@@ -251,7 +251,9 @@ mod tests {
 
     #[test]
     fn tabled_series_match_the_long_series() {
-        for &w in &[0.0f64, 0.1, -0.2, 0.249, 0.3, 0.99, 1.5, 3.99, 4.5, 8.99, -8.0] {
+        for &w in &[
+            0.0f64, 0.1, -0.2, 0.249, 0.3, 0.99, 1.5, 3.99, 4.5, 8.99, -8.0,
+        ] {
             for j in 0..=TABLE_J {
                 for n in 0..=TABLE_N {
                     let (a, b) = (rodrigues(j, n, w), series(j, n, w));

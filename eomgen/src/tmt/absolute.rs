@@ -8,8 +8,8 @@
 //! coordinates only, M is block diagonal, and the elements hold together by
 //! beam springs between neighbours (the clamp counting as element -1):
 //!
-//! * rotation: v = vee(R_rel - R_rel^T) / 2 of R_rel = R_a^T R_b (sin of
-//!   the relative angle times its axis), with E I / span about the two
+//! * rotation: v = 2 tan(theta / 2) n of R_rel = R_a^T R_b (theta, n its
+//!   angle and axis; a rational function of R_rel), with E I / span about the two
 //!   section axes and G J / span about the element, span = l_e between
 //!   centres (l_e / 2 from the clamp to the first);
 //! * translation: the gap from the end of one element to the start of the
@@ -147,10 +147,18 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
         let da = param(&format!("stretch[{k}].damping"));
         let ks = param(&format!("shear[{k}].stiffness"));
         let r_rel = transpose_mul(cas, &prev.r, &slab.r);
-        // vee of the skew part: (R32 - R23, R13 - R31, R21 - R12) / 2
+        // 2 tan(theta / 2) n = 2 vee(R - R^T) / (1 + tr R): the relative
+        // rotation to second order, and stiffening up to a half turn, so
+        // that equilibria exist under any load.
+        let tr = cas.add_all(&[r_rel[0][0], r_rel[1][1], r_rel[2][2]]);
+        let one = cas.one();
+        let denom = cas.add(one, tr);
+        let inv = cas.powi(denom, -1);
+        let inv = cas.bind(inv);
         let v: V3 = [(2, 1), (0, 2), (1, 0)].map(|(a, b)| {
             let d = cas.sub(r_rel[a][b], r_rel[b][a]);
-            let h = cas.scaled(0.5, d);
+            let h = cas.mul(d, inv);
+            let h = cas.scaled(2.0, h);
             cas.bind(h)
         });
         let pairs = coords.rate_pairs();
