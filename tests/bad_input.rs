@@ -404,3 +404,131 @@ fn bad_simulate_options_are_rejected_clearly() {
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
 }
+
+const GOOD3: &str = r#"
+name = "t3"
+dimensions = 3
+gravity = [0.0, 0.0, -9.81]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.3
+elements = 2
+density = 1000.0
+outer_radius = 0.01
+youngs_modulus = 1e6
+"#;
+
+#[test]
+fn malformed_3d_models_are_rejected_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = |a: &str, b: &str| GOOD3.replacen(a, b, 1);
+    let second = "\n[[segment]]\nmethod = \"pcc\"\nlength = 0.1\ndensity = 1000.0\nouter_radius = 0.01\nyoungs_modulus = 1e6\n";
+    let cases: Vec<(&str, String, Vec<&str>)> = vec![
+        (
+            "dimensions 4",
+            r("dimensions = 3", "dimensions = 4"),
+            vec!["dimensions", "must be 2 (planar) or 3"],
+        ),
+        (
+            "ebr in 2D",
+            r("dimensions = 3\n", "")
+                .replace("\"pcc\"", "\"ebr\"")
+                .replace("-9.81]", "0.0]"),
+            vec!["segment[0].method", "ebr is a 3D method", "dimensions = 3"],
+        ),
+        (
+            "twist in 2D",
+            r("dimensions = 3\n", "")
+                .replace("elements = 2", "elements = 2\ntwist = false")
+                .replace("-9.81]", "0.0]"),
+            vec!["segment[0].twist", "a 3D key"],
+        ),
+        (
+            "rom order 12",
+            r("method = \"pcc\"", "method = \"rom\"\norder = 12"),
+            vec!["segment[0].order", "between 0 and 8"],
+        ),
+        (
+            "order on pcc",
+            r("elements = 2", "order = 2"),
+            vec!["segment[0].order", "only rom segments"],
+        ),
+        (
+            "eba mixed",
+            format!("{}{second}", r("method = \"pcc\"", "method = \"eba\"")),
+            vec!["segment[0].method", "every segment of the arm must be eba"],
+        ),
+        (
+            "four joint axes",
+            r(
+                "method = \"pcc\"",
+                "method = \"rigid\"\njoint_axes = [\"x\", \"y\", \"z\", \"x\"]",
+            ),
+            vec!["segment[0].joint_axes", "1 to 3 axes"],
+        ),
+        (
+            "joint axes on pcc",
+            r("elements = 2", "joint_axes = [\"z\"]"),
+            vec!["segment[0].joint_axes", "only rigid segments"],
+        ),
+        (
+            "unknown axis",
+            r(
+                "method = \"pcc\"",
+                "method = \"rigid\"\njoint_axes = [\"w\"]",
+            ),
+            vec!["segment[0].joint_axes", "unknown variant `w`"],
+        ),
+        (
+            "twist without G J",
+            r("youngs_modulus = 1e6", "bending_stiffness = 0.01"),
+            vec!["segment[0].torsional_stiffness", "missing"],
+        ),
+        (
+            "cosserat dynamics",
+            r("method = \"pcc\"", "method = \"cosserat\""),
+            vec!["cosserat", "softarm static"],
+        ),
+        (
+            "unknown method",
+            r("method = \"pcc\"", "method = \"fem\""),
+            vec!["segment[0].method", "unknown variant `fem`", "rom"],
+        ),
+    ];
+    for (label, text, expect) in cases {
+        std::fs::write(dir.path().join("m.toml"), &text).unwrap();
+        let out = softarm(&["eom", "m.toml", "--json"], dir.path());
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{label}: accepted");
+        assert!(!err.contains("panicked"), "{label}: panic: {err}");
+        assert!(
+            stdout(&out).is_empty(),
+            "{label}: printed output on failure"
+        );
+        for e in expect {
+            assert!(err.contains(e), "{label}: expected `{e}` in: {err}");
+        }
+    }
+    // The baseline is valid, and the Cosserat statics reject what they
+    // cannot model.
+    std::fs::write(dir.path().join("m.toml"), GOOD3).unwrap();
+    assert!(
+        softarm(&["static", "m.toml", "--json"], dir.path())
+            .status
+            .success()
+    );
+    std::fs::write(
+        dir.path().join("m.toml"),
+        format!("{}{second}", r("method = \"pcc\"", "method = \"cosserat\"")),
+    )
+    .unwrap();
+    let out = softarm(&["static", "m.toml", "--json"], dir.path());
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("one uniform [[segment]]"),
+        "{}",
+        stderr(&out)
+    );
+}
