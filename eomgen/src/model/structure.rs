@@ -63,7 +63,12 @@ impl Structure {
                 .segments
                 .iter()
                 .map(|s| SegmentShape {
-                    method: s.method,
+                    // vc is pcc one module per segment: the same kinematics,
+                    // so the same derivation (and compiled code) serves both.
+                    method: match s.method {
+                        Method::Vc => Method::Pcc,
+                        m => m,
+                    },
                     elements: s.slices(),
                     order: if s.method == Method::Rom {
                         s.rom_order()
