@@ -291,7 +291,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     let tip = if final_state.len() == 2 * n {
         arm.outputs(t_final, &final_state[..n], &final_state[n..])
     } else {
-        [f64::NAN; 5]
+        [f64::NAN; runtime::N_OUTPUTS]
     };
     let summary = json!({
         "model": loaded.model.name,

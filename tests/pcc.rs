@@ -65,6 +65,11 @@ fn one_element_tip_is_the_closed_form_arc() {
             "theta {theta}: y {} vs {across}",
             o[1]
         );
+        // The tip frame has turned by theta about z.
+        let q = [(theta / 2.0).cos(), 0.0, 0.0, (theta / 2.0).sin()];
+        for k in 0..4 {
+            assert!((o[5 + k] - q[k]).abs() < 1e-12, "theta {theta}: quaternion");
+        }
         // M, h and K are finite there, at any rate.
         let mut m = nalgebra::DMatrix::zeros(1, 1);
         let mut h = nalgebra::DVector::zeros(1);

@@ -8,7 +8,7 @@ mod common;
 
 use common::*;
 use eomgen::model::Override;
-use nalgebra::{Rotation3, Vector3};
+use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 use runtime::{KernelKind, SimOptions, StaticOptions, modes, simulate, solve_static};
 use softarm::backend::{BackendChoice, Loaded, load};
 
@@ -79,6 +79,28 @@ fn one_element_tip_is_the_exponential_map_arc_with_bend_and_twist() {
                 "rho {rho:?}: tip[{k}] {} vs {}",
                 o[k],
                 tip[k]
+            );
+        }
+        // Tip orientation: nalgebra's exp, as a quaternion (up to sign).
+        let want = UnitQuaternion::from_scaled_axis(Vector3::from(rho));
+        let got = [o[5], o[6], o[7], o[8]];
+        let w = [want.w, want.i, want.j, want.k];
+        let sign = if got[0] * w[0]
+            + got[1..]
+                .iter()
+                .zip(&w[1..])
+                .map(|(a, b)| a * b)
+                .sum::<f64>()
+            < 0.0
+        {
+            -1.0
+        } else {
+            1.0
+        };
+        for k in 0..4 {
+            assert!(
+                (got[k] - sign * w[k]).abs() < 1e-12,
+                "rho {rho:?}: quaternion {got:?} vs {w:?}"
             );
         }
         let mut m = nalgebra::DMatrix::zeros(3, 3);
@@ -415,4 +437,49 @@ fn eba_converges_to_the_extensible_cosserat_rod_under_a_large_load() {
         fine < 0.015 * deflection,
         "eba: error {fine:e} at 16 elements"
     );
+}
+
+/// The output quaternion as nalgebra's, up to sign.
+fn assert_same_rotation(o: &[f64], want: UnitQuaternion<f64>, what: &str) {
+    let w = [want.w, want.i, want.j, want.k];
+    let dot: f64 = (0..4).map(|k| o[5 + k] * w[k]).sum();
+    let sign = dot.signum();
+    for k in 0..4 {
+        assert!(
+            (o[5 + k] - sign * w[k]).abs() < 1e-12,
+            "{what}: quaternion {:?} vs {w:?}",
+            &o[5..9]
+        );
+    }
+}
+
+#[test]
+fn eba_and_rigid_tip_orientations_are_their_rotations() {
+    let mut rng = Rng::new(11);
+    let eba = cantilever3d(&["segment.0.method=eba".into(), "segment.0.elements=1".into()]);
+    let rigid = cantilever3d(&[
+        "segment.0.method=rigid".into(),
+        "segment.0.elements=1".into(),
+        "segment.0.joint_axes=[\"z\", \"y\", \"x\"]".into(),
+    ]);
+    for _ in 0..20 {
+        let psi = rng.vec(3, -1.5, 1.5);
+        let mut q = rng.vec(3, -0.01, 0.01); // centre displacement
+        q.extend(&psi);
+        let o = eba.arm.outputs(0.0, &q, &[0.0; 6]);
+        let want = UnitQuaternion::from_scaled_axis(Vector3::new(psi[0], psi[1], psi[2]));
+        assert_same_rotation(&o, want, "eba");
+        // The tip is half an element along the element's axis.
+        let tip = Vector3::new(0.15 + q[0], q[1], q[2]) + want * Vector3::new(0.15, 0.0, 0.0);
+        for k in 0..3 {
+            assert!((o[k] - tip[k]).abs() < 1e-12, "eba tip[{k}]");
+        }
+        // Rigid: joints about z, then y, then x of the turned frame.
+        let a = rng.vec(3, -1.5, 1.5);
+        let o = rigid.arm.outputs(0.0, &a, &[0.0; 3]);
+        let want = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), a[0])
+            * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), a[1])
+            * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), a[2]);
+        assert_same_rotation(&o, want, "rigid");
+    }
 }

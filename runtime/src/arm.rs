@@ -5,7 +5,7 @@ use std::cell::RefCell;
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::kernels::{KernelKind, Kernels, ModelInfo};
+use crate::kernels::{KernelKind, Kernels, ModelInfo, N_OUTPUTS};
 use crate::linalg::Ldlt;
 use crate::tape::Inputs;
 
@@ -26,7 +26,7 @@ pub trait Dynamics {
     /// Both at once, sharing subexpressions.
     fn mass_bias(&self, t: f64, q: &[f64], qd: &[f64], m: &mut DMatrix<f64>, h: &mut DVector<f64>);
     /// Tip position and energies, laid out as [`crate::OUTPUT_NAMES`].
-    fn outputs(&self, t: f64, q: &[f64], qd: &[f64]) -> [f64; 5];
+    fn outputs(&self, t: f64, q: &[f64], qd: &[f64]) -> [f64; N_OUTPUTS];
     /// A kernel's raw output (layouts in [`KernelKind`]); the hot path of
     /// the integrators, free of matrix copies.
     fn eval_kernel(&self, kind: KernelKind, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]);
@@ -157,8 +157,8 @@ impl<K: Kernels> Dynamics for Arm<K> {
             h.copy_from_slice(&p[tri..]);
         });
     }
-    fn outputs(&self, t: f64, q: &[f64], qd: &[f64]) -> [f64; 5] {
-        let mut out = [0.0; 5];
+    fn outputs(&self, t: f64, q: &[f64], qd: &[f64]) -> [f64; N_OUTPUTS] {
+        let mut out = [0.0; N_OUTPUTS];
         self.eval_packed(KernelKind::Outputs, t, q, qd, |p| out.copy_from_slice(p));
         out
     }

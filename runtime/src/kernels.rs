@@ -86,8 +86,22 @@ impl KernelKind {
     }
 }
 
-/// Layout of the `Outputs` kernel.
-pub const OUTPUT_NAMES: [&str; 5] = ["tip_x", "tip_y", "tip_z", "kinetic", "potential"];
+/// Layout of the `Outputs` kernel: tip position, energies, and the tip
+/// frame's orientation as a unit quaternion (w, x, y, z; x along the arm).
+pub const OUTPUT_NAMES: [&str; N_OUTPUTS] = [
+    "tip_x",
+    "tip_y",
+    "tip_z",
+    "kinetic",
+    "potential",
+    "tip_qw",
+    "tip_qx",
+    "tip_qy",
+    "tip_qz",
+];
+
+/// Number of outputs.
+pub const N_OUTPUTS: usize = 9;
 
 /// What a derived model is: its coordinates and parameter layout.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -28,7 +28,7 @@ pub use events::{Crossing, Event, EventHit};
 pub use integrate::{SimFailure, SimOptions, SimStats, Solver, Trajectory, simulate};
 pub use jacobian::rhs_jacobian;
 pub use kernels::{
-    CompiledModel, Interpreted, KernelKind, Kernels, ModelInfo, OUTPUT_NAMES, TapeSet,
+    CompiledModel, Interpreted, KernelKind, Kernels, ModelInfo, N_OUTPUTS, OUTPUT_NAMES, TapeSet,
 };
 pub use linalg::Ldlt;
 pub use modes::{Modes, ModesError, modes};

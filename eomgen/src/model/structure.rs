@@ -11,7 +11,7 @@ use super::schema::{Axis, Joints, Method, Model};
 
 /// Bumped whenever derivation or emission changes what is generated, so
 /// that cached tapes and generated files are re-derived.
-pub const GENERATOR_VERSION: u32 = 23;
+pub const GENERATOR_VERSION: u32 = 24;
 
 /// The structural part of one segment.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -264,6 +264,9 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
                 p.push((format!("base.R{i}{j}"), *v));
             }
         }
+        for (c, v) in ["qw", "qx", "qy", "qz"].iter().zip(base_quaternion(d)) {
+            p.push((format!("base.{c}"), v));
+        }
     } else {
         // Planar: the angle of the base direction from +x.
         p.push(("base.angle".to_string(), d[1].atan2(d[0])));
@@ -298,6 +301,19 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
         }
     }
     p
+}
+
+/// The quaternion (w, x, y, z) of [`base_rotation`]: (1 + c, x × u)
+/// normalised, with c = x . u.
+pub fn base_quaternion(d: [f64; 3]) -> [f64; 4] {
+    let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let u = [d[0] / n, d[1] / n, d[2] / n];
+    let c = u[0];
+    if c < -1.0 + 1e-12 {
+        return [0.0, 0.0, 0.0, 1.0];
+    }
+    let s = (2.0 * (1.0 + c)).sqrt();
+    [(1.0 + c) / s, 0.0, -u[2] / s, u[1] / s]
 }
 
 /// The rotation (rows) taking +x to the unit vector along `d` by the

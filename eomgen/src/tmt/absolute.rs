@@ -22,7 +22,10 @@
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{Model, Structure, parameters};
 
-use super::spatial::{M3, V3, bind3, coefficients, half_k_sq, left_jacobian, mat_vec, rotation};
+use super::spatial::{
+    M3, V3, bind3, coefficients, half_k_sq, left_jacobian, mat_vec, quat_mul, rotation,
+    rotation_quat,
+};
 use super::system::{AppliedMoment, Body, Coordinates, Inertia, PointForce, System};
 
 /// An element's (or the clamp's) frame: rotation, centre and half length.
@@ -93,6 +96,8 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
     };
     let mut along = zero; // arc length to the current element's start
     let mut omega = [zero; 3];
+    let q0 = ["qw", "qx", "qy", "qz"].map(|c| param(&format!("base.{c}")));
+    let mut quat = q0;
     let n_el = structure.elements();
     for k in 0..n_el {
         let c = 6 * k;
@@ -121,6 +126,8 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
             })
         });
         let w_local = left_jacobian(cas, &psi, &psi_d, [c1, c2, c3]);
+        let q_rel = rotation_quat(cas, &psi, w);
+        quat = quat_mul(cas, &q0, &q_rel);
         omega = mat_vec(cas, &r0, &w_local);
         omega = bind3(cas, omega);
         let axis = [r[0][0], r[1][0], r[2][0]];
@@ -228,6 +235,7 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
         point_forces,
         moments,
         tip,
+        tip_orientation: quat,
         chain: None,
     }
 }

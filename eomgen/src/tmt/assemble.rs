@@ -32,7 +32,7 @@ pub struct Equations {
     /// Upper triangle of M, row by row.
     pub mass_upper: Vec<ExprId>,
     pub bias: Vec<ExprId>,
-    /// tip x, y, z, kinetic energy, potential energy.
+    /// tip x, y, z, kinetic energy, potential energy, tip quaternion.
     pub outputs: Vec<ExprId>,
     /// K = d h(q, 0) / dq, row-major n x n.
     pub stiffness: Vec<ExprId>,
@@ -243,7 +243,8 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     }
     let ke = cas.add_all(&kinetic);
     let pe = cas.add_all(&potential);
-    let outputs = vec![sys.tip[0], sys.tip[1], sys.tip[2], ke, pe];
+    let mut outputs = vec![sys.tip[0], sys.tip[1], sys.tip[2], ke, pe];
+    outputs.extend(sys.tip_orientation);
     // Jacobian parts. M qdd is the derivative of the momentum along qdd in
     // qd-space: one directional derivative, shared structure.
     let accel_pairs: Vec<(ExprId, ExprId)> = sys

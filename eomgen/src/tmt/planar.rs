@@ -127,6 +127,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
     }
 
     let tip = [f.x, f.y, z];
+    let half_phi = cas.scaled(0.5, f.phi);
     if structure.tip_mass {
         let mass = param("tip.mass");
         bodies.push(Body {
@@ -174,6 +175,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
         point_forces,
         moments,
         tip,
+        tip_orientation: [cas.cos(half_phi), zero, zero, cas.sin(half_phi)],
         chain: (!links.is_empty()).then_some(Chain {
             links,
             body_link,

@@ -29,6 +29,42 @@ use super::system::{AppliedMoment, Body, Chain, Coordinates, Inertia, Link, Poin
 pub(super) type V3 = [ExprId; 3];
 /// Rows of a rotation matrix.
 pub(super) type M3 = [[ExprId; 3]; 3];
+/// A quaternion (w, x, y, z).
+pub(super) type Quat = [ExprId; 4];
+
+/// The Hamilton product a b, bound.
+pub(super) fn quat_mul(cas: &mut Cas, a: &Quat, b: &Quat) -> Quat {
+    let t = |cas: &mut Cas, terms: [(f64, usize, usize); 4]| {
+        let parts: Vec<ExprId> = terms
+            .iter()
+            .map(|&(s, i, j)| {
+                let m = cas.mul(a[i], b[j]);
+                cas.scaled(s, m)
+            })
+            .collect();
+        let e = cas.add_all(&parts);
+        cas.bind(e)
+    };
+    [
+        t(cas, [(1.0, 0, 0), (-1.0, 1, 1), (-1.0, 2, 2), (-1.0, 3, 3)]),
+        t(cas, [(1.0, 0, 1), (1.0, 1, 0), (1.0, 2, 3), (-1.0, 3, 2)]),
+        t(cas, [(1.0, 0, 2), (-1.0, 1, 3), (1.0, 2, 0), (1.0, 3, 1)]),
+        t(cas, [(1.0, 0, 3), (1.0, 1, 2), (-1.0, 2, 1), (1.0, 3, 0)]),
+    ]
+}
+
+/// The quaternion of exp([rho]x): (c0(w/4), c1(w/4) rho / 2), w = |rho|^2.
+pub(super) fn rotation_quat(cas: &mut Cas, rho: &V3, w: ExprId) -> Quat {
+    let w4 = cas.scaled(0.25, w);
+    let [h0, h1] = coefficients(cas, w4, [0, 1]);
+    let s = cas.scaled(0.5, h1);
+    [
+        h0,
+        cas.mul(s, rho[0]),
+        cas.mul(s, rho[1]),
+        cas.mul(s, rho[2]),
+    ]
+}
 
 /// A frame: R (world from frame), origin and world angular velocity.
 #[derive(Clone, Copy)]
@@ -36,6 +72,9 @@ struct Frame {
     r: M3,
     p: V3,
     w: V3,
+    /// The orientation as a unit quaternion (w, x, y, z), composed alongside
+    /// R (an output only: exact products, no square roots).
+    quat: Quat,
 }
 
 impl Frame {
@@ -62,10 +101,15 @@ pub(super) fn bind3(cas: &mut Cas, v: V3) -> V3 {
 fn compose(
     cas: &mut Cas,
     f: &Frame,
-    r_rel: Option<&M3>,
+    r_rel: Option<(&M3, &Quat)>,
     p_rel: Option<&V3>,
     w_rel: Option<&V3>,
 ) -> Frame {
+    let quat = match r_rel {
+        Some((_, q)) => quat_mul(cas, &f.quat, q),
+        None => f.quat,
+    };
+    let r_rel = r_rel.map(|(r, _)| r);
     let p = match p_rel {
         Some(d) => {
             let wd = mat_vec(cas, &f.r, d);
@@ -96,7 +140,7 @@ fn compose(
         }),
         None => f.r,
     };
-    Frame { r, p, w }
+    Frame { r, p, w, quat }
 }
 
 /// The Rodrigues coefficients c_j(w) for j in `js`, bound.
@@ -176,7 +220,8 @@ fn arc(cas: &mut Cas, f: &Frame, rho: &V3, rate: &V3, len: ExprId) -> (V3, V3, V
     let chord = chord.map(|e| cas.mul(len, e));
     let r_rel = rotation(cas, rho, [c0, c1, c2]);
     let w_rel = left_jacobian(cas, rho, rate, [c1, c2, c3]);
-    let end = compose(cas, f, Some(&r_rel), Some(&chord), Some(&w_rel));
+    let q_rel = rotation_quat(cas, rho, w);
+    let end = compose(cas, f, Some((&r_rel, &q_rel)), Some(&chord), Some(&w_rel));
     // Centroid.
     let c = series_on_x(cas, rho, w, half, c3, c4);
     let c = c.map(|e| {
@@ -215,7 +260,11 @@ fn revolute(cas: &mut Cas, f: &Frame, k: usize, q: ExprId, qd: ExprId) -> Frame 
     r[b][a] = s;
     let mut w = [zero; 3];
     w[k] = qd;
-    compose(cas, f, Some(&r), None, Some(&w))
+    let half = cas.scaled(0.5, q);
+    let mut quat = [zero; 4];
+    quat[0] = cas.cos(half);
+    quat[k + 1] = cas.sin(half);
+    compose(cas, f, Some((&r, &quat)), None, Some(&w))
 }
 
 /// The frame moved by `d` along its axis.
@@ -278,6 +327,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
         r: r0,
         p: [param("base.x"), param("base.y"), param("base.z")],
         w: [zero; 3],
+        quat: ["qw", "qx", "qy", "qz"].map(|c| param(&format!("base.{c}"))),
     };
     let mut bodies = Vec::new();
     let mut elastic = Vec::new();
@@ -418,7 +468,8 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                         let [c0, c1, c2, c3] = coefficients(cas, wsq, [0, 1, 2, 3]);
                         let r_rel = rotation(cas, &rho, [c0, c1, c2]);
                         let w_rel = left_jacobian(cas, &rho, &rate, [c1, c2, c3]);
-                        f = compose(cas, &f, Some(&r_rel), None, Some(&w_rel));
+                        let q_rel = rotation_quat(cas, &rho, wsq);
+                        f = compose(cas, &f, Some((&r_rel, &q_rel)), None, Some(&w_rel));
                         let b_len = cas.add(half, st);
                         let half_b = cas.scaled(0.5, b_len);
                         let b = advance(cas, &f, half_b);
@@ -489,6 +540,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
         point_forces,
         moments,
         tip,
+        tip_orientation: f.quat,
         // rom slices share their segment's coordinates: not a chain of
         // links that own theirs, so M and h by the general sums.
         chain: (!links.is_empty() && !has_rom).then_some(Chain {

@@ -90,6 +90,8 @@ pub struct System {
     pub moments: Vec<AppliedMoment>,
     /// Tip position, an output.
     pub tip: [ExprId; 3],
+    /// Tip frame's orientation (unit quaternion w, x, y, z), an output.
+    pub tip_orientation: [ExprId; 4],
     /// Serial-chain structure, when the kinematics has it (M by composites).
     pub chain: Option<Chain>,
 }
