@@ -496,6 +496,30 @@ fn malformed_3d_models_are_rejected_clearly() {
             r("method = \"pcc\"", "method = \"fem\""),
             vec!["segment[0].method", "unknown variant `fem`", "rom"],
         ),
+        (
+            "two chambers",
+            r(
+                "elements = 2",
+                "chambers = { count = 2, radius = 0.002, distance = 0.005 }",
+            ),
+            vec!["segment[0].chambers.count", "at least 3"],
+        ),
+        (
+            "overlapping chambers",
+            r(
+                "elements = 2",
+                "chambers = { count = 8, radius = 0.002, distance = 0.005 }",
+            ),
+            vec!["segment[0].chambers", "overlap"],
+        ),
+        (
+            "chamber outside the wall",
+            r(
+                "elements = 2",
+                "chambers = { count = 3, radius = 0.002, distance = 0.009 }",
+            ),
+            vec!["segment[0].chambers", "must lie in the wall"],
+        ),
     ];
     for (label, text, expect) in cases {
         std::fs::write(dir.path().join("m.toml"), &text).unwrap();

@@ -148,6 +148,6 @@ fn summary_reports_the_run() {
     let header = csv.lines().next().unwrap();
     assert_eq!(
         header,
-        "t,theta_0_0,theta_1_0,theta_0_0_dot,theta_1_0_dot,tip_x,tip_y,tip_z,kinetic,potential"
+        "t,theta_0_0,theta_1_0,theta_0_0_dot,theta_1_0_dot,tip_x,tip_y,tip_z,kinetic,potential,tip_qw,tip_qx,tip_qy,tip_qz"
     );
 }

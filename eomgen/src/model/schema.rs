@@ -172,6 +172,10 @@ pub struct Segment {
     /// per element.
     #[serde(default)]
     pub axial_damping: Option<f64>,
+    /// Chamber holes along the segment (pneumatic actuators): they reduce
+    /// the area, mass and second moments of the section.
+    #[serde(default)]
+    pub chambers: Option<Chambers>,
     /// rom: polynomial degree of the strain fields (structural; default 3).
     #[serde(default)]
     pub order: Option<usize>,
@@ -197,7 +201,14 @@ impl Segment {
     pub fn second_moment(&self) -> Option<f64> {
         let ro = self.outer_radius?;
         let ri = self.inner_radius.unwrap_or(0.0);
-        Some(std::f64::consts::PI / 4.0 * (ro.powi(4) - ri.powi(4)))
+        let pi = std::f64::consts::PI;
+        // n equally spaced holes at distance d: sum of d^2 sin^2 = n d^2 / 2
+        // about any diameter (n >= 3), so the section stays isotropic.
+        let holes = self.chambers.as_ref().map_or(0.0, |c| {
+            let a = pi * c.radius * c.radius;
+            c.count as f64 * (a * c.radius * c.radius / 4.0 + a * c.distance * c.distance / 2.0)
+        });
+        Some(pi / 4.0 * (ro.powi(4) - ri.powi(4)) - holes)
     }
 
     /// Bending stiffness E I (N m^2), if declared.
@@ -206,11 +217,16 @@ impl Segment {
             .or_else(|| Some(self.youngs_modulus? * self.second_moment()?))
     }
 
-    /// Area of the section (m^2), if it has a radius.
+    /// Area of the section (m^2), if it has a radius: the ring less the
+    /// chamber holes.
     pub fn area(&self) -> Option<f64> {
         let ro = self.outer_radius?;
         let ri = self.inner_radius.unwrap_or(0.0);
-        Some(std::f64::consts::PI * (ro * ro - ri * ri))
+        let holes = self
+            .chambers
+            .as_ref()
+            .map_or(0.0, |c| c.count as f64 * c.radius * c.radius);
+        Some(std::f64::consts::PI * (ro * ro - ri * ri - holes))
     }
 
     /// Torsional stiffness G J (N m^2): J = 2 I for circular sections, G
@@ -281,6 +297,19 @@ fn two() -> u8 {
     2
 }
 
+/// Equally spaced circular chamber holes in a section.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Chambers {
+    /// Number of holes (at least 3, equally spaced: the section stays
+    /// isotropic in bending).
+    pub count: usize,
+    /// Hole radius (m).
+    pub radius: f64,
+    /// Distance of the hole centres from the axis (m).
+    pub distance: f64,
+}
+
 /// An axis of an element's frame (x along the element).
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
 #[serde(rename_all = "lowercase")]
@@ -315,4 +344,53 @@ pub struct Tip {
     /// Constant moment on the tip, world frame (N m).
     #[serde(default)]
     pub moment: Option<[f64; 3]>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chamber_holes_reduce_area_and_second_moment_as_a_grid_integral_says() {
+        let seg: Segment = toml::from_str(
+            r#"
+            method = "pcc"
+            length = 0.1
+            outer_radius = 0.0125
+            inner_radius = 0.002
+            chambers = { count = 6, radius = 0.0018, distance = 0.007 }
+            "#,
+        )
+        .unwrap();
+        let c = seg.chambers.clone().unwrap();
+        // Midpoint rule on a fine grid over the square around the section.
+        let (ro, ri) = (0.0125f64, 0.002f64);
+        let n = 2000;
+        let h = 2.0 * ro / n as f64;
+        let (mut area, mut iy, mut iz) = (0.0, 0.0, 0.0);
+        for a in 0..n {
+            for b in 0..n {
+                let (y, z) = (-ro + (a as f64 + 0.5) * h, -ro + (b as f64 + 0.5) * h);
+                let r2 = y * y + z * z;
+                if r2 > ro * ro || r2 < ri * ri {
+                    continue;
+                }
+                let hole = (0..c.count).any(|k| {
+                    let phi = 2.0 * std::f64::consts::PI * k as f64 / c.count as f64 + 0.3;
+                    let (cy, cz) = (c.distance * phi.cos(), c.distance * phi.sin());
+                    (y - cy).powi(2) + (z - cz).powi(2) < c.radius * c.radius
+                });
+                if !hole {
+                    area += h * h;
+                    iy += z * z * h * h;
+                    iz += y * y * h * h;
+                }
+            }
+        }
+        let (a, i) = (seg.area().unwrap(), seg.second_moment().unwrap());
+        assert!((a - area).abs() < 2e-3 * a, "area {a} vs grid {area}");
+        for grid in [iy, iz] {
+            assert!((i - grid).abs() < 2e-3 * i, "I {i} vs grid {grid}");
+        }
+    }
 }

@@ -184,12 +184,16 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
         let ri = s.inner_radius.unwrap_or(0.0);
         let mass = match (s.mass, s.density) {
             (Some(mass), _) => mass / n,
-            (None, Some(rho)) => rho * std::f64::consts::PI * (ro * ro - ri * ri) * l,
+            (None, Some(rho)) => rho * s.area().unwrap_or(0.0) * l,
             (None, None) => 0.0, // rejected by validation
         };
-        // Uniform cylinders (hollow or solid) about a diameter through the
-        // centre; slender rods when no radius is given.
-        let section = mass * (ro * ro + ri * ri) / 4.0;
+        // Uniform cylinders (hollow, solid, with chamber holes) about a
+        // diameter through the centre, m I / A ((r_o^2 + r_i^2) / 4 for a
+        // ring); slender rods when no radius is given.
+        let section = match (s.second_moment(), s.area()) {
+            (Some(i), Some(a)) if a > 0.0 => mass * i / a,
+            _ => mass * (ro * ro + ri * ri) / 4.0,
+        };
         // Bodies: the whole link, or two half links (midpoint joints), or
         // the section's part of a pcc arc (in 2D the arc's part is derived
         // symbolically; in 3D the arc is lumped as a straight slice, below).

@@ -166,6 +166,42 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
         } else if s.inner_radius.is_some() {
             return err(p("inner_radius"), "needs `outer_radius`".into());
         }
+        if let Some(c) = &s.chambers {
+            let Some(ro) = s.outer_radius else {
+                return err(p("chambers"), "needs the section's `outer_radius`".into());
+            };
+            if c.count < 3 {
+                return err(
+                    p("chambers.count"),
+                    format!(
+                        "must be at least 3 (equally spaced holes keep the bending stiffness the same in every direction), got {}",
+                        c.count
+                    ),
+                );
+            }
+            positive(&p("chambers.radius"), c.radius)?;
+            positive(&p("chambers.distance"), c.distance)?;
+            let ri = s.inner_radius.unwrap_or(0.0);
+            if c.distance - c.radius < ri || c.distance + c.radius > ro {
+                return err(
+                    p("chambers"),
+                    format!(
+                        "holes of radius {} at distance {} must lie in the wall between inner radius {ri} and outer radius {ro}",
+                        c.radius, c.distance
+                    ),
+                );
+            }
+            let spacing = 2.0 * c.distance * (std::f64::consts::PI / c.count as f64).sin();
+            if spacing <= 2.0 * c.radius {
+                return err(
+                    p("chambers"),
+                    format!(
+                        "{} holes of radius {} at distance {} overlap",
+                        c.count, c.radius, c.distance
+                    ),
+                );
+            }
+        }
         if let (Some(_), Some(_)) = (s.youngs_modulus, s.bending_stiffness) {
             return err(
                 p("bending_stiffness"),
