@@ -36,6 +36,19 @@ fn derivation(c: &mut Criterion) {
     g.bench_function("cantilever_pcc20", |b| {
         b.iter(|| eomgen::derive::derive(black_box(&pcc20)))
     });
+    // 3D: every method at 10 elements (rom: its default cubic fields).
+    for method in ["pcc", "ebr", "eba", "rigid", "rom"] {
+        let sets = [
+            Override::parse(&format!("segment.0.method={method}")).unwrap(),
+            Override::parse("segment.0.elements=10").unwrap(),
+        ];
+        let model = softarm::backend::read_model("cantilever3d", &sets)
+            .unwrap()
+            .0;
+        g.bench_function(format!("cantilever3d_{method}10"), |b| {
+            b.iter(|| eomgen::derive::derive(black_box(&model)))
+        });
+    }
     g.finish();
 }
 
@@ -47,7 +60,7 @@ fn state(n: usize) -> (Vec<f64>, Vec<f64>) {
 
 fn kernels(c: &mut Criterion) {
     let mut g = c.benchmark_group("compiled");
-    for name in ["chain", "chain32", "cantilever"] {
+    for name in ["chain", "chain32", "cantilever", "cantilever3d"] {
         let l = load(name, &[], BackendChoice::Compiled, None).unwrap();
         let arm = &*l.arm;
         let n = arm.dof();
