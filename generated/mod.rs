@@ -18,6 +18,8 @@ pub mod hybrid_arm;
 pub mod long_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod soft_finger;
+#[allow(clippy::all, clippy::pedantic)]
+pub mod vc_arm;
 
 /// Every compiled-in model, by name.
 pub static MODELS: &[CompiledModel] = &[
@@ -76,5 +78,12 @@ pub static MODELS: &[CompiledModel] = &[
         dof: soft_finger::DOF,
         source: include_str!("../models/soft_finger.toml"),
         kernels: || Box::new(soft_finger::Compiled::default()),
+    },
+    CompiledModel {
+        name: "vc_arm",
+        hash: vc_arm::HASH,
+        dof: vc_arm::DOF,
+        source: include_str!("../models/vc_arm.toml"),
+        kernels: || Box::new(vc_arm::Compiled::default()),
     },
 ];

@@ -19,14 +19,14 @@
 //! A finite-difference rod (strains between element centres) that converges
 //! to the extensible, shearable Cosserat rod as l_e -> 0.
 
-use crate::cas::{Cas, ExprId, SymKind};
-use crate::model::{Model, Structure, parameters};
+use crate::cas::{Cas, ExprId};
+use crate::model::{Model, Structure};
 
 use super::spatial::{
     M3, V3, bind3, coefficients, half_k_sq, left_jacobian, mat_vec, quat_mul, rotation,
     rotation_quat,
 };
-use super::system::{AppliedMoment, Body, Coordinates, Inertia, PointForce, System};
+use super::system::{AppliedMoment, Body, Coordinates, Inertia, ParamSymbols, PointForce, System};
 
 /// An element's (or the clamp's) frame: rotation, centre and half length.
 struct Slab {
@@ -59,19 +59,8 @@ fn transpose_mul(cas: &mut Cas, a: &M3, b: &M3) -> M3 {
 
 pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
     let structure = Structure::of(model);
-    let names: Vec<String> = parameters(model).into_iter().map(|(n, _)| n).collect();
-    let p: Vec<ExprId> = names
-        .iter()
-        .enumerate()
-        .map(|(i, n)| cas.symbol(n, SymKind::Param(i as u32)))
-        .collect();
-    let param = |name: &str| -> ExprId {
-        let i = names
-            .iter()
-            .position(|n| n == name)
-            .unwrap_or_else(|| panic!("no parameter {name}"));
-        p[i]
-    };
+    let symbols = ParamSymbols::new(cas, model);
+    let param = |name: &str| symbols.get(name);
     let mut coord_names = Vec::new();
     for (s, g) in structure.segments.iter().enumerate() {
         for e in 0..g.elements {

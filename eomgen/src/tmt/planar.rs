@@ -14,10 +14,12 @@
 //! Absolute angles keep the velocity map cheap: d(cos phi)/dt = -sin(phi) w,
 //! whose partial derivative in any qd_i is one shared node.
 
-use crate::cas::{Cas, ExprId, Func, SymKind};
-use crate::model::{Joints, Method, Model, Structure, parameters};
+use crate::cas::{Cas, ExprId, Func};
+use crate::model::{Joints, Method, Model, Structure};
 
-use super::system::{AppliedMoment, Body, Chain, Coordinates, Inertia, Link, PointForce, System};
+use super::system::{
+    AppliedMoment, Body, Chain, Coordinates, Inertia, Link, ParamSymbols, PointForce, System,
+};
 
 /// A planar frame: origin, absolute angle and its rate.
 #[derive(Clone, Copy)]
@@ -32,19 +34,8 @@ struct Frame {
 /// parameter layout are read from `model`; values stay symbols.
 pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
     let structure = Structure::of(model);
-    let names: Vec<String> = parameters(model).into_iter().map(|(n, _)| n).collect();
-    let p: Vec<ExprId> = names
-        .iter()
-        .enumerate()
-        .map(|(i, n)| cas.symbol(n, SymKind::Param(i as u32)))
-        .collect();
-    let param = |name: &str| -> ExprId {
-        let i = names
-            .iter()
-            .position(|n| n == name)
-            .unwrap_or_else(|| panic!("no parameter {name}"));
-        p[i]
-    };
+    let symbols = ParamSymbols::new(cas, model);
+    let param = |name: &str| symbols.get(name);
 
     let mut coord_names = Vec::new();
     for (s, g) in structure.segments.iter().enumerate() {

@@ -21,10 +21,12 @@
 //! w = c1 rho' + c2 rho x rho' + c3 (rho . rho') rho in the base frame;
 //! positions are differentiated by the CAS.
 
-use crate::cas::{Cas, ExprId, Func, SymKind};
-use crate::model::{Joints, Method, Model, Structure, parameters};
+use crate::cas::{Cas, ExprId, Func};
+use crate::model::{Joints, Method, Model, Structure};
 
-use super::system::{AppliedMoment, Body, Chain, Coordinates, Inertia, Link, PointForce, System};
+use super::system::{
+    AppliedMoment, Body, Chain, Coordinates, Inertia, Link, ParamSymbols, PointForce, System,
+};
 
 pub(super) type V3 = [ExprId; 3];
 /// Rows of a rotation matrix.
@@ -277,19 +279,8 @@ fn advance(cas: &mut Cas, f: &Frame, d: ExprId) -> Frame {
 /// layout are read from `model`; values stay symbols.
 pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
     let structure = Structure::of(model);
-    let names: Vec<String> = parameters(model).into_iter().map(|(n, _)| n).collect();
-    let p: Vec<ExprId> = names
-        .iter()
-        .enumerate()
-        .map(|(i, n)| cas.symbol(n, SymKind::Param(i as u32)))
-        .collect();
-    let param = |name: &str| -> ExprId {
-        let i = names
-            .iter()
-            .position(|n| n == name)
-            .unwrap_or_else(|| panic!("no parameter {name}"));
-        p[i]
-    };
+    let symbols = ParamSymbols::new(cas, model);
+    let param = |name: &str| symbols.get(name);
 
     // Coordinates: per element, by method.
     let mut coord_names = Vec::new();

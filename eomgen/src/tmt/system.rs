@@ -6,6 +6,39 @@ use crate::cas::{Cas, ExprId, SymKind};
 
 pub use super::inertia::Inertia;
 
+/// The parameter symbols of a model, looked up by name (the layout of
+/// `model::parameters`).
+pub struct ParamSymbols {
+    names: Vec<String>,
+    ids: Vec<ExprId>,
+}
+
+impl ParamSymbols {
+    pub fn new(cas: &mut Cas, model: &crate::model::Model) -> Self {
+        let names: Vec<String> = crate::model::parameters(model)
+            .into_iter()
+            .map(|(n, _)| n)
+            .collect();
+        let ids = names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| cas.symbol(n, SymKind::Param(i as u32)))
+            .collect();
+        Self { names, ids }
+    }
+
+    /// The symbol of parameter `name`; kinematics only asks for names the
+    /// layout has, so a miss is a generator bug.
+    pub fn get(&self, name: &str) -> ExprId {
+        let i = self
+            .names
+            .iter()
+            .position(|n| n == name)
+            .unwrap_or_else(|| panic!("no parameter {name}"));
+        self.ids[i]
+    }
+}
+
 /// q, qd symbols and their names.
 pub struct Coordinates {
     pub names: Vec<String>,
