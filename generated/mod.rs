@@ -19,6 +19,8 @@ pub mod long_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod soft_finger;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod stiff_flop;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod vc_arm;
 
 /// Every compiled-in model, by name.
@@ -78,6 +80,13 @@ pub static MODELS: &[CompiledModel] = &[
         dof: soft_finger::DOF,
         source: include_str!("../models/soft_finger.toml"),
         kernels: || Box::new(soft_finger::Compiled::default()),
+    },
+    CompiledModel {
+        name: "stiff_flop",
+        hash: stiff_flop::HASH,
+        dof: stiff_flop::DOF,
+        source: include_str!("../models/stiff_flop.toml"),
+        kernels: || Box::new(stiff_flop::Compiled::default()),
     },
     CompiledModel {
         name: "vc_arm",

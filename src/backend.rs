@@ -42,6 +42,8 @@ pub struct Loaded {
     pub origin: String,
     pub hash: String,
     pub arm: Box<dyn Dynamics>,
+    /// The folder that paths in the model file are relative to.
+    pub base_dir: PathBuf,
     pub cache: CacheStatus,
     /// Time spent deriving (0 when compiled or cached).
     pub derive_s: f64,
@@ -53,6 +55,18 @@ pub fn compiled_by_name(name: &str) -> Option<&'static CompiledModel> {
 
 pub fn compiled_by_hash(hash: &str) -> Option<&'static CompiledModel> {
     MODELS.iter().find(|m| m.hash == hash)
+}
+
+/// The folder paths in a model are relative to: the model file's, or for
+/// a compiled-in model the `models/` folder it was built from.
+pub fn base_dir(spec: &str) -> PathBuf {
+    let path = Path::new(spec);
+    if path.exists() {
+        path.parent()
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("models")
+    }
 }
 
 /// Read the model named by `spec`: a file path, or a compiled-in model's name.
@@ -133,12 +147,18 @@ pub fn load(
         );
     }
     let values = params.into_iter().map(|(_, v)| v).collect();
-    let arm: Box<dyn Dynamics> = Box::new(Arm::new(kernels, values));
+    let layout = kernels.info().parameters.clone();
+    let mut arm: Box<dyn Dynamics> = Box::new(Arm::new(kernels, values));
+    let base_dir = base_dir(spec);
+    let drives = crate::inputs::model_drives(&model, &layout, &base_dir)
+        .with_context(|| format!("{origin}: reading the input channels"))?;
+    arm.set_drives(drives);
     Ok(Loaded {
         model,
         origin,
         hash,
         arm,
+        base_dir,
         cache,
         derive_s,
     })

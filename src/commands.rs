@@ -15,6 +15,7 @@ use runtime::{
 };
 use serde_json::json;
 use softarm::backend::{self, Loaded};
+use softarm::compare;
 use softarm::generated::MODELS;
 
 use crate::ModelArgs;
@@ -254,6 +255,24 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     if !(output_dt > 0.0 && output_dt.is_finite()) {
         bail!("--output-dt must be positive, got {output_dt}");
     }
+    // Measured data to compare with: sampled at its own times.
+    let measured = match &loaded.model.compare {
+        Some(spec) => {
+            let start = arm.outputs(0.0, &q0, &qd0);
+            Some(
+                compare::measured(spec, &loaded.base_dir, |_| [start[0], start[1], start[2]])
+                    .with_context(|| format!("{}: [compare]", loaded.origin))?,
+            )
+        }
+        None => None,
+    };
+    let output_times = measured.as_ref().map(|m| {
+        let mut t: Vec<f64> = m.t.iter().copied().filter(|&t| t <= t_end).collect();
+        if t.last() != Some(&t_end) {
+            t.push(t_end);
+        }
+        t
+    });
     let opts = SimOptions {
         t_end,
         solver,
@@ -261,6 +280,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         atol,
         dt,
         output_dt,
+        output_times,
         max_steps: a.max_steps,
         ..Default::default()
     };
@@ -293,6 +313,40 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     } else {
         [f64::NAN; runtime::N_OUTPUTS]
     };
+    let tip_error = match (&measured, &loaded.model.compare) {
+        (Some(m), Some(spec)) => {
+            let tips: Vec<(f64, [f64; 3])> = traj
+                .t
+                .iter()
+                .zip(&traj.x)
+                .map(|(t, x)| {
+                    let o = arm.outputs(*t, &x[..n], &x[n..]);
+                    (*t, [o[0], o[1], o[2]])
+                })
+                .collect();
+            let window = spec
+                .window
+                .unwrap_or([m.t[0], *m.t.last().expect("a CSV has rows")]);
+            let length = loaded.model.segments.iter().map(|s| s.length).sum::<f64>()
+                + loaded.model.tip.length.unwrap_or(0.0);
+            let err = compare::tip_error(m, window, length, |t| {
+                tips.iter().find(|s| (s.0 - t).abs() < 1e-9).map(|s| s.1)
+            })?;
+            compare::plot(
+                &out_dir.join("tip"),
+                &format!(
+                    "{}: mean tip error {:.2} mm ({:.2} % of length)",
+                    loaded.model.name,
+                    1e3 * err.mean_m,
+                    err.mean_percent_length
+                ),
+                &tips,
+                m,
+            )?;
+            Some(err)
+        }
+        _ => None,
+    };
     let summary = json!({
         "model": loaded.model.name,
         "origin": loaded.origin,
@@ -312,6 +366,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         "solver_switch": stats.switched,
         "wall_s": stats.wall_s,
         "status": if failure.is_some() { "failed" } else { "ok" },
+        "tip_error": tip_error,
         "failure": failure.as_ref().map(|f| f.1.clone()),
         "final_state": {
             "t": t_final,
@@ -341,6 +396,19 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         stats.wall_s,
         out_dir.display()
     );
+    if let Some(e) = &tip_error {
+        eprintln!(
+            "tip error over {} to {} s ({} samples): mean {:.3} mm ({:.2} % of length), rms {:.3} mm, max {:.3} mm; plot in {}",
+            e.window_s[0],
+            e.window_s[1],
+            e.samples,
+            1e3 * e.mean_m,
+            e.mean_percent_length,
+            1e3 * e.rms_m,
+            1e3 * e.max_m,
+            out_dir.join("tip.png").display()
+        );
+    }
     if let Some(sw) = &stats.switched {
         eprintln!(
             "auto: switched to {} at t = {} s ({})",

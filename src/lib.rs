@@ -18,4 +18,7 @@ pub mod generated {
 
 pub mod backend;
 pub mod cache;
+pub mod compare;
 pub mod continuum;
+pub mod data;
+pub mod inputs;

@@ -3,7 +3,7 @@
 use runtime::{ModelInfo, TapeSet};
 
 use crate::cas::{Cas, Hoist};
-use crate::model::{Model, Structure, parameters};
+use crate::model::{Model, Structure, drives, parameters};
 use crate::tmt::{SYMBOLIC_SOLVE_MAX_DOF, assemble, solve_accelerations, system};
 
 /// Derive the kernels of a model's structure.
@@ -14,7 +14,13 @@ pub fn derive(model: &Model) -> TapeSet {
     let mut mass_bias = eq.mass_upper.clone();
     mass_bias.extend_from_slice(&eq.bias);
     let params: Vec<String> = parameters(model).into_iter().map(|(n, _)| n).collect();
-    let mut hoist = Hoist::new(params.len());
+    let driven: Vec<String> = drives(model).into_iter().map(|(p, _)| p).collect();
+    let inputs = params
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| driven.contains(n))
+        .map(|(i, _)| i);
+    let mut hoist = Hoist::new(params.len()).with_inputs(inputs);
     let mass = cas.to_tape_hoisted(&eq.mass_upper, &mut hoist);
     let bias = cas.to_tape_hoisted(&eq.bias, &mut hoist);
     let mass_bias = cas.to_tape_hoisted(&mass_bias, &mut hoist);

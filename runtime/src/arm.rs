@@ -7,6 +7,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::kernels::{KernelKind, Kernels, ModelInfo, N_OUTPUTS};
 use crate::linalg::Ldlt;
+use crate::signal::Drive;
 use crate::tape::Inputs;
 
 /// The equations of motion `M(q) qdd + h(q, qd, t) = 0` of one arm.
@@ -40,6 +41,8 @@ pub trait Dynamics {
     fn base_params(&self) -> &[f64];
     /// Replace the base parameters; the derived ones are recomputed.
     fn set_base_params(&mut self, params: &[f64]);
+    /// Drive parameters by signals of time (inputs); replaces earlier ones.
+    fn set_drives(&mut self, drives: Vec<Drive>);
 }
 
 /// Why the accelerations could not be computed.
@@ -59,6 +62,11 @@ pub struct Arm<K> {
     kernels: K,
     params: Vec<f64>,
     packed: RefCell<Vec<f64>>,
+    /// Inputs: parameters set from signals at each evaluation's time (never
+    /// inside derived parameters: the generator keeps them in the kernels).
+    drives: Vec<Drive>,
+    /// `params` with the driven entries at the last time asked for.
+    live: RefCell<Vec<f64>>,
 }
 
 impl<K: Kernels> Arm<K> {
@@ -78,7 +86,25 @@ impl<K: Kernels> Arm<K> {
             kernels,
             params: extended,
             packed: RefCell::new(Vec::new()),
+            drives: Vec::new(),
+            live: RefCell::new(Vec::new()),
         }
+    }
+
+    /// The parameters at time t: the bound values, driven ones from their
+    /// signals.
+    fn with_params<R>(&self, t: f64, f: impl FnOnce(&[f64]) -> R) -> R {
+        if self.drives.is_empty() {
+            return f(&self.params);
+        }
+        let mut live = self.live.borrow_mut();
+        if live.len() != self.params.len() {
+            live.clone_from(&self.params);
+        }
+        for d in &self.drives {
+            live[d.param] = d.signal.at(t);
+        }
+        f(&live)
     }
 
     /// Base parameters followed by the derived ones.
@@ -93,14 +119,16 @@ impl<K: Kernels> Arm<K> {
     fn eval_packed(&self, kind: KernelKind, t: f64, q: &[f64], qd: &[f64], f: impl FnOnce(&[f64])) {
         let mut packed = self.packed.borrow_mut();
         packed.resize(kind.output_len(self.kernels.info()), 0.0);
-        let inp = Inputs {
-            t,
-            q,
-            qd,
-            qdd: &[],
-            p: &self.params,
-        };
-        self.kernels.eval(kind, &inp, &mut packed);
+        self.with_params(t, |p| {
+            let inp = Inputs {
+                t,
+                q,
+                qd,
+                qdd: &[],
+                p,
+            };
+            self.kernels.eval(kind, &inp, &mut packed);
+        });
         f(&packed);
     }
 }
@@ -163,30 +191,25 @@ impl<K: Kernels> Dynamics for Arm<K> {
         out
     }
     fn eval_kernel(&self, kind: KernelKind, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
-        self.kernels.eval(
-            kind,
-            &Inputs {
+        self.with_params(t, |p| {
+            let inp = Inputs {
                 t,
                 q,
                 qd,
                 qdd: &[],
-                p: &self.params,
-            },
-            out,
-        );
+                p,
+            };
+            self.kernels.eval(kind, &inp, out);
+        });
     }
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
         self.kernels.solve_mass(packed, b, ws)
     }
     fn jacobian_parts(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        let inp = Inputs {
-            t,
-            q,
-            qd,
-            qdd,
-            p: &self.params,
-        };
-        self.kernels.eval(KernelKind::Jacobian, &inp, out);
+        self.with_params(t, |p| {
+            let inp = Inputs { t, q, qd, qdd, p };
+            self.kernels.eval(KernelKind::Jacobian, &inp, out);
+        });
     }
     fn base_params(&self) -> &[f64] {
         &self.params[..self.kernels.info().parameters.len()]
@@ -196,6 +219,16 @@ impl<K: Kernels> Dynamics for Arm<K> {
         let n = params.len();
         self.params[..n].copy_from_slice(params);
         self.params[n..].copy_from_slice(&derived);
+        self.live.borrow_mut().clear();
+    }
+    fn set_drives(&mut self, drives: Vec<Drive>) {
+        let n = self.kernels.info().parameters.len();
+        assert!(
+            drives.iter().all(|d| d.param < n),
+            "a drive names a parameter outside the layout"
+        );
+        self.drives = drives;
+        self.live.borrow_mut().clear();
     }
 }
 

@@ -16,6 +16,7 @@ pub mod linalg;
 pub mod modes;
 pub mod radau5;
 pub mod rodrigues;
+pub mod signal;
 pub mod special;
 pub mod statics;
 pub mod stepper;
@@ -32,6 +33,7 @@ pub use kernels::{
 };
 pub use linalg::Ldlt;
 pub use modes::{Modes, ModesError, modes};
+pub use signal::{Drive, Signal, Table};
 pub use statics::{StaticError, StaticOptions, StaticSolution, solve_static};
 pub use stiffness::{StiffnessReport, analyse as analyse_stiffness};
 pub use tape::{Inputs, Op, Slot, Tape};

@@ -26,6 +26,8 @@ use super::expr::{Cas, ExprId, Func, Node, SymKind};
 /// kernels of one model.
 pub struct Hoist {
     n_params: u32,
+    /// Parameters that change during a run (driven by inputs): never hoisted.
+    inputs: HashSet<u32>,
     exprs: Vec<ExprId>,
     index: HashMap<ExprId, u32>,
     param_only: HashMap<ExprId, bool>,
@@ -35,10 +37,17 @@ impl Hoist {
     pub fn new(n_params: usize) -> Self {
         Self {
             n_params: n_params as u32,
+            inputs: HashSet::default(),
             exprs: Vec::new(),
             index: HashMap::default(),
             param_only: HashMap::default(),
         }
+    }
+
+    /// Mark parameters as inputs: expressions of them stay in the kernels.
+    pub fn with_inputs(mut self, inputs: impl IntoIterator<Item = usize>) -> Self {
+        self.inputs = inputs.into_iter().map(|i| i as u32).collect();
+        self
     }
 
     /// Parameter index of a hoisted expression.
@@ -58,7 +67,9 @@ impl Hoist {
         }
         let b = match cas.node(e) {
             Node::Const(_) => false,
-            Node::Sym(s) => matches!(cas.sym_kind(*s), SymKind::Param(_)),
+            Node::Sym(s) => {
+                matches!(cas.sym_kind(*s), SymKind::Param(i) if !self.inputs.contains(&i))
+            }
             _ => {
                 let kids = cas.children(e);
                 let mut any_param = false;

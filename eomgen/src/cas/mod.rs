@@ -15,5 +15,6 @@ mod reverse;
 #[cfg(test)]
 mod tests;
 
+pub(crate) use expr::Variables;
 pub use expr::{Cas, ExprId, Func, Node, SymId, SymKind};
 pub use lower::{Hoist, Lowerer};

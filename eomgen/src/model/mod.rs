@@ -3,14 +3,18 @@
 mod error;
 mod load;
 mod schema;
+mod signals;
 mod structure;
 mod validate;
 
 pub use error::ModelError;
 pub use load::{Override, load_model, parse_model};
-pub use schema::{Axis, Base, Chambers, Joints, Method, Model, Segment, Tip};
+pub use schema::{
+    Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, Tendon, Tip, WrenchFrame,
+};
+pub use signals::{Compare, Input, Offset};
 pub use structure::{
-    ElementProps, GENERATOR_VERSION, SegmentShape, Structure, base_rotation, element_props,
+    ElementProps, GENERATOR_VERSION, SegmentShape, Structure, base_rotation, drives, element_props,
     parameters,
 };
 pub use validate::MAX_ELEMENTS;

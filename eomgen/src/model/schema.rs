@@ -21,6 +21,17 @@ pub struct Model {
     pub segments: Vec<Segment>,
     #[serde(default)]
     pub tip: Tip,
+    /// Tendons (3D): each pulled by an input channel.
+    #[serde(default, rename = "tendon")]
+    pub tendons: Vec<Tendon>,
+    /// Input channels by name: time signals that drive pressures, tensions
+    /// and tip loads at run time (not structural: swapping a data file or a
+    /// signal needs no rebuild).
+    #[serde(default)]
+    pub inputs: std::collections::BTreeMap<String, super::signals::Input>,
+    /// Measured tip motion to compare a simulation with.
+    #[serde(default)]
+    pub compare: Option<super::signals::Compare>,
     /// Defaults for `softarm simulate`; its options override them.
     #[serde(default)]
     pub simulate: SimulateDefaults,
@@ -202,11 +213,12 @@ impl Segment {
         let ro = self.outer_radius?;
         let ri = self.inner_radius.unwrap_or(0.0);
         let pi = std::f64::consts::PI;
-        // n equally spaced holes at distance d: sum of d^2 sin^2 = n d^2 / 2
-        // about any diameter (n >= 3), so the section stays isotropic.
+        // Holes at distance d in an isotropic pattern (validated): sum of
+        // d^2 sin^2 = n d^2 / 2 about any diameter.
         let holes = self.chambers.as_ref().map_or(0.0, |c| {
             let a = pi * c.radius * c.radius;
-            c.count as f64 * (a * c.radius * c.radius / 4.0 + a * c.distance * c.distance / 2.0)
+            let n = c.holes().len() as f64;
+            n * (a * c.radius * c.radius / 4.0 + a * c.distance * c.distance / 2.0)
         });
         Some(pi / 4.0 * (ro.powi(4) - ri.powi(4)) - holes)
     }
@@ -225,7 +237,7 @@ impl Segment {
         let holes = self
             .chambers
             .as_ref()
-            .map_or(0.0, |c| c.count as f64 * c.radius * c.radius);
+            .map_or(0.0, |c| c.holes().len() as f64 * c.radius * c.radius);
         Some(std::f64::consts::PI * (ro * ro - ri * ri - holes))
     }
 
@@ -297,17 +309,103 @@ fn two() -> u8 {
     2
 }
 
-/// Equally spaced circular chamber holes in a section.
+/// Circular chamber holes along a segment, in the wall of its section:
+/// pneumatic actuators when `inputs` drive them, passive holes otherwise.
+///
+/// Holes sit at `positions()` (degrees in the section, from the element
+/// frame's y axis towards its z axis), each position a single hole or,
+/// with `pair_spacing`, a pair at +- that angle (STIFF-FLOP's braided
+/// pairs). The hole pattern must leave the section isotropic in bending.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Chambers {
-    /// Number of holes (at least 3, equally spaced: the section stays
-    /// isotropic in bending).
-    pub count: usize,
+    /// Number of equally spaced positions, the first at angle 0.
+    #[serde(default)]
+    pub count: Option<usize>,
+    /// Or the positions' angles (degrees) explicitly.
+    #[serde(default)]
+    pub angles: Option<Vec<f64>>,
+    /// Each position a pair of holes at +- this angle (degrees).
+    #[serde(default)]
+    pub pair_spacing: Option<f64>,
     /// Hole radius (m).
     pub radius: f64,
     /// Distance of the hole centres from the axis (m).
     pub distance: f64,
+    /// Area the pressure acts on, per hole (m^2); default pi radius^2.
+    #[serde(default)]
+    pub area: Option<f64>,
+    /// Input channel (pressure, Pa, gauge) of each position: structural.
+    #[serde(default)]
+    pub inputs: Option<Vec<String>>,
+}
+
+impl Chambers {
+    /// Angles (degrees) of the positions.
+    pub fn positions(&self) -> Vec<f64> {
+        match (&self.angles, self.count) {
+            (Some(a), _) => a.clone(),
+            (None, Some(n)) => (0..n).map(|k| 360.0 * k as f64 / n as f64).collect(),
+            (None, None) => Vec::new(),
+        }
+    }
+
+    /// Angles (degrees) of every hole: positions, or pairs about them.
+    pub fn holes(&self) -> Vec<f64> {
+        let pos = self.positions();
+        match self.pair_spacing {
+            Some(h) => pos.iter().flat_map(|&a| [a - h, a + h]).collect(),
+            None => pos,
+        }
+    }
+
+    /// Holes per position.
+    pub fn per_position(&self) -> usize {
+        if self.pair_spacing.is_some() { 2 } else { 1 }
+    }
+
+    /// Pressure area of one hole (m^2).
+    pub fn hole_area(&self) -> f64 {
+        self.area
+            .unwrap_or(std::f64::consts::PI * self.radius * self.radius)
+    }
+}
+
+/// A tendon: a cable embedded at a fixed offset from the axis, pulled at the
+/// base, terminated at the end of segment `end`. It does virtual work
+/// -T dL on the fibre length L(q) it runs along, and only pulls.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Tendon {
+    /// Input channel of its tension (N); a negative command is slack.
+    pub input: String,
+    /// Distance from the axis (m): one value, or one per segment it spans.
+    pub distance: OneOrMany,
+    /// Angle in the section (degrees, from the element frame's y axis
+    /// towards z): one value, or one per segment it spans.
+    #[serde(default)]
+    pub angle: Option<OneOrMany>,
+    /// Index of the segment at whose end it is terminated; default the last.
+    #[serde(default)]
+    pub end: Option<usize>,
+}
+
+/// A number, or one per segment.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum OneOrMany {
+    One(f64),
+    Many(Vec<f64>),
+}
+
+impl OneOrMany {
+    /// The value for segment `s`.
+    pub fn at(&self, s: usize) -> f64 {
+        match self {
+            OneOrMany::One(v) => *v,
+            OneOrMany::Many(v) => v.get(s).copied().unwrap_or(f64::NAN),
+        }
+    }
 }
 
 /// An axis of an element's frame (x along the element).
@@ -344,6 +442,31 @@ pub struct Tip {
     /// Constant moment on the tip, world frame (N m).
     #[serde(default)]
     pub moment: Option<[f64; 3]>,
+    /// Length of a rigid tip body (a cylinder along the tip axis, m): the
+    /// tip point, where forces act and outputs are taken, is at its end.
+    #[serde(default)]
+    pub length: Option<f64>,
+    /// Radius of that cylinder (m), for its rotational inertia.
+    #[serde(default)]
+    pub radius: Option<f64>,
+    /// Input channels driving the three force components (structural).
+    #[serde(default)]
+    pub force_inputs: Option<[String; 3]>,
+    /// Input channels driving the three moment components (structural).
+    #[serde(default)]
+    pub moment_inputs: Option<[String; 3]>,
+    /// Frame of the tip force and moment: "world" (default) or "tip" (a
+    /// load cell's frame, turning with the tip). Structural.
+    #[serde(default)]
+    pub wrench_frame: Option<WrenchFrame>,
+}
+
+/// The frame a tip wrench is given in.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
+#[serde(rename_all = "lowercase")]
+pub enum WrenchFrame {
+    World,
+    Tip,
 }
 
 #[cfg(test)]
@@ -352,45 +475,52 @@ mod tests {
 
     #[test]
     fn chamber_holes_reduce_area_and_second_moment_as_a_grid_integral_says() {
-        let seg: Segment = toml::from_str(
-            r#"
-            method = "pcc"
-            length = 0.1
-            outer_radius = 0.0125
-            inner_radius = 0.002
-            chambers = { count = 6, radius = 0.0018, distance = 0.007 }
-            "#,
-        )
-        .unwrap();
-        let c = seg.chambers.clone().unwrap();
-        // Midpoint rule on a fine grid over the square around the section.
-        let (ro, ri) = (0.0125f64, 0.002f64);
-        let n = 2000;
-        let h = 2.0 * ro / n as f64;
-        let (mut area, mut iy, mut iz) = (0.0, 0.0, 0.0);
-        for a in 0..n {
-            for b in 0..n {
-                let (y, z) = (-ro + (a as f64 + 0.5) * h, -ro + (b as f64 + 0.5) * h);
-                let r2 = y * y + z * z;
-                if r2 > ro * ro || r2 < ri * ri {
-                    continue;
-                }
-                let hole = (0..c.count).any(|k| {
-                    let phi = 2.0 * std::f64::consts::PI * k as f64 / c.count as f64 + 0.3;
-                    let (cy, cz) = (c.distance * phi.cos(), c.distance * phi.sin());
-                    (y - cy).powi(2) + (z - cz).powi(2) < c.radius * c.radius
-                });
-                if !hole {
-                    area += h * h;
-                    iy += z * z * h * h;
-                    iz += y * y * h * h;
+        // Six equally spaced holes, and STIFF-FLOP's three pairs at +-20.33
+        // degrees: both isotropic, each pattern also turned by 0.3 rad.
+        for chambers in [
+            "chambers = { count = 6, radius = 0.0018, distance = 0.007 }",
+            "chambers = { angles = [0, 240, 120], pair_spacing = 20.33, radius = 0.0025, distance = 0.0085 }",
+        ] {
+            let seg: Segment = toml::from_str(&format!(
+                r#"
+                method = "pcc"
+                length = 0.1
+                outer_radius = 0.0125
+                inner_radius = 0.004
+                {chambers}
+                "#
+            ))
+            .unwrap();
+            let c = seg.chambers.clone().unwrap();
+            // Midpoint rule on a fine grid over the square around the section.
+            let (ro, ri) = (0.0125f64, 0.004f64);
+            let n = 2000;
+            let h = 2.0 * ro / n as f64;
+            let (mut area, mut iy, mut iz) = (0.0, 0.0, 0.0);
+            for a in 0..n {
+                for b in 0..n {
+                    let (y, z) = (-ro + (a as f64 + 0.5) * h, -ro + (b as f64 + 0.5) * h);
+                    let r2 = y * y + z * z;
+                    if r2 > ro * ro || r2 < ri * ri {
+                        continue;
+                    }
+                    let hole = c.holes().iter().any(|deg| {
+                        let phi = deg.to_radians() + 0.3;
+                        let (cy, cz) = (c.distance * phi.cos(), c.distance * phi.sin());
+                        (y - cy).powi(2) + (z - cz).powi(2) < c.radius * c.radius
+                    });
+                    if !hole {
+                        area += h * h;
+                        iy += z * z * h * h;
+                        iz += y * y * h * h;
+                    }
                 }
             }
-        }
-        let (a, i) = (seg.area().unwrap(), seg.second_moment().unwrap());
-        assert!((a - area).abs() < 2e-3 * a, "area {a} vs grid {area}");
-        for grid in [iy, iz] {
-            assert!((i - grid).abs() < 2e-3 * i, "I {i} vs grid {grid}");
+            let (a, i) = (seg.area().unwrap(), seg.second_moment().unwrap());
+            assert!((a - area).abs() < 2e-3 * a, "area {a} vs grid {area}");
+            for grid in [iy, iz] {
+                assert!((i - grid).abs() < 2e-3 * i, "I {i} vs grid {grid}");
+            }
         }
     }
 }

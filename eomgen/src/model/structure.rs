@@ -7,7 +7,7 @@
 
 use sha2::{Digest, Sha256};
 
-use super::schema::{Axis, Joints, Method, Model};
+use super::schema::{Axis, Joints, Method, Model, WrenchFrame};
 
 /// Bumped whenever derivation or emission changes what is generated, so
 /// that cached tapes and generated files are re-derived.
@@ -52,6 +52,19 @@ pub struct Structure {
     pub tip_force: bool,
     /// A tip moment exists (`tip.moment` given).
     pub tip_moment: bool,
+    /// The tip body has a length (`tip.length` given): a cylinder whose end
+    /// is the tip point.
+    pub tip_length: bool,
+    /// The tip force and moment turn with the tip (`wrench_frame = "tip"`).
+    pub tip_frame_wrench: bool,
+    /// Inputs drive the tip force, the tip moment: they are never folded
+    /// into derived parameters.
+    pub tip_force_driven: bool,
+    pub tip_moment_driven: bool,
+    /// Per segment: how many chamber positions inputs drive.
+    pub chambers: Vec<usize>,
+    /// Per tendon: the segment at whose end it is terminated.
+    pub tendons: Vec<usize>,
 }
 
 impl Structure {
@@ -93,8 +106,27 @@ impl Structure {
                 })
                 .collect(),
             tip_mass: m.tip.mass.is_some(),
-            tip_force: m.tip.force.is_some(),
-            tip_moment: m.tip.moment.is_some(),
+            tip_force: m.tip.force.is_some() || m.tip.force_inputs.is_some(),
+            tip_moment: m.tip.moment.is_some() || m.tip.moment_inputs.is_some(),
+            tip_length: m.tip.length.is_some(),
+            tip_frame_wrench: m.tip.wrench_frame == Some(WrenchFrame::Tip),
+            tip_force_driven: m.tip.force_inputs.is_some(),
+            tip_moment_driven: m.tip.moment_inputs.is_some(),
+            chambers: m
+                .segments
+                .iter()
+                .map(|s| {
+                    s.chambers
+                        .as_ref()
+                        .and_then(|c| c.inputs.as_ref())
+                        .map_or(0, Vec::len)
+                })
+                .collect(),
+            tendons: m
+                .tendons
+                .iter()
+                .map(|t| t.end.unwrap_or(m.segments.len() - 1))
+                .collect(),
         }
     }
 
@@ -131,7 +163,26 @@ impl Structure {
         if self.tip_moment {
             s.push_str(" moment true");
         }
+        if self.tip_length {
+            s.push_str(" length true");
+        }
+        if self.tip_frame_wrench {
+            s.push_str(" frame tip");
+        }
+        if self.tip_force_driven || self.tip_moment_driven {
+            s.push_str(&format!(
+                " driven {} {}",
+                self.tip_force_driven, self.tip_moment_driven
+            ));
+        }
         s.push('\n');
+        // Actuators only when present: models without them keep their hash.
+        if self.chambers.iter().any(|&n| n > 0) {
+            s.push_str(&format!("chambers {:?}\n", self.chambers));
+        }
+        if !self.tendons.is_empty() {
+            s.push_str(&format!("tendons {:?}\n", self.tendons));
+        }
         s
     }
 
@@ -283,10 +334,27 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
         p.push(("tip.force.y".to_string(), f[1]));
         p.push(("tip.force.z".to_string(), f[2]));
     }
-    if let Some(mo) = m.tip.moment {
+    if m.tip.force.is_none() && m.tip.force_inputs.is_some() {
+        for c in ["x", "y", "z"] {
+            p.push((format!("tip.force.{c}"), 0.0));
+        }
+    }
+    if m.tip.moment.is_some() || m.tip.moment_inputs.is_some() {
+        let mo = m.tip.moment.unwrap_or_default();
         p.push(("tip.moment.x".to_string(), mo[0]));
         p.push(("tip.moment.y".to_string(), mo[1]));
         p.push(("tip.moment.z".to_string(), mo[2]));
+    }
+    if let Some(len) = m.tip.length {
+        // A uniform cylinder along the tip axis, about its centre.
+        let mass = m.tip.mass.unwrap_or(0.0);
+        let r = m.tip.radius.unwrap_or(0.0);
+        p.push(("tip.length".to_string(), len));
+        p.push((
+            "tip.inertia".to_string(),
+            mass * (3.0 * r * r + len * len) / 12.0,
+        ));
+        p.push(("tip.axial_inertia".to_string(), mass * r * r / 2.0));
     }
     for (k, e) in element_props(m).iter().enumerate() {
         p.push((format!("element[{k}].length"), e.length));
@@ -304,7 +372,72 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
             p.push((format!("shear[{k}].stiffness"), e.shear_stiffness));
         }
     }
+    // Actuators: per driven chamber position its pressure (an input) and
+    // the pressure's lever: the holes' total area and first moments
+    // a sum(z), a sum(y) in the section; per tendon its tension (an input)
+    // and its offset in each segment it spans.
+    for (s, seg) in m.segments.iter().enumerate() {
+        let Some(c) = &seg.chambers else { continue };
+        if c.inputs.is_none() {
+            continue;
+        }
+        let a = c.hole_area();
+        let spacing = c.pair_spacing.unwrap_or(0.0);
+        for (j, angle) in c.positions().iter().enumerate() {
+            let holes: Vec<f64> = if c.pair_spacing.is_some() {
+                vec![angle - spacing, angle + spacing]
+            } else {
+                vec![*angle]
+            };
+            let (y, z) = holes.iter().fold((0.0, 0.0), |(y, z), h| {
+                let h = h.to_radians();
+                (y + c.distance * h.cos(), z + c.distance * h.sin())
+            });
+            p.push((format!("chamber[{s}][{j}].pressure"), 0.0));
+            p.push((format!("chamber[{s}][{j}].area"), a * holes.len() as f64));
+            p.push((format!("chamber[{s}][{j}].arm_y"), a * z));
+            p.push((format!("chamber[{s}][{j}].arm_z"), a * y));
+        }
+    }
+    for (i, t) in m.tendons.iter().enumerate() {
+        p.push((format!("tendon[{i}].tension"), 0.0));
+        let end = t.end.unwrap_or(m.segments.len() - 1);
+        for s in 0..=end {
+            let d = t.distance.at(s);
+            let angle = t.angle.as_ref().map_or(0.0, |a| a.at(s)).to_radians();
+            p.push((format!("tendon[{i}][{s}].y"), d * angle.cos()));
+            p.push((format!("tendon[{i}][{s}].z"), d * angle.sin()));
+        }
+    }
     p
+}
+
+/// The runtime parameters that input channels drive: (parameter, channel).
+/// They change during a run, so derivation never folds them into derived
+/// (precomputed) parameters.
+pub fn drives(m: &Model) -> Vec<(String, String)> {
+    let mut d = Vec::new();
+    for (key, names) in [
+        ("tip.force", &m.tip.force_inputs),
+        ("tip.moment", &m.tip.moment_inputs),
+    ] {
+        if let Some(names) = names {
+            for (c, n) in ["x", "y", "z"].iter().zip(names) {
+                d.push((format!("{key}.{c}"), n.clone()));
+            }
+        }
+    }
+    for (s, seg) in m.segments.iter().enumerate() {
+        if let Some(inputs) = seg.chambers.as_ref().and_then(|c| c.inputs.as_ref()) {
+            for (j, n) in inputs.iter().enumerate() {
+                d.push((format!("chamber[{s}][{j}].pressure"), n.clone()));
+            }
+        }
+    }
+    for (i, t) in m.tendons.iter().enumerate() {
+        d.push((format!("tendon[{i}].tension"), t.input.clone()));
+    }
+    d
 }
 
 /// The quaternion (w, x, y, z) of [`base_rotation`]: (1 + c, x × u)

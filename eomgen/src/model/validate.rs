@@ -167,40 +167,7 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             return err(p("inner_radius"), "needs `outer_radius`".into());
         }
         if let Some(c) = &s.chambers {
-            let Some(ro) = s.outer_radius else {
-                return err(p("chambers"), "needs the section's `outer_radius`".into());
-            };
-            if c.count < 3 {
-                return err(
-                    p("chambers.count"),
-                    format!(
-                        "must be at least 3 (equally spaced holes keep the bending stiffness the same in every direction), got {}",
-                        c.count
-                    ),
-                );
-            }
-            positive(&p("chambers.radius"), c.radius)?;
-            positive(&p("chambers.distance"), c.distance)?;
-            let ri = s.inner_radius.unwrap_or(0.0);
-            if c.distance - c.radius < ri || c.distance + c.radius > ro {
-                return err(
-                    p("chambers"),
-                    format!(
-                        "holes of radius {} at distance {} must lie in the wall between inner radius {ri} and outer radius {ro}",
-                        c.radius, c.distance
-                    ),
-                );
-            }
-            let spacing = 2.0 * c.distance * (std::f64::consts::PI / c.count as f64).sin();
-            if spacing <= 2.0 * c.radius {
-                return err(
-                    p("chambers"),
-                    format!(
-                        "{} holes of radius {} at distance {} overlap",
-                        c.count, c.radius, c.distance
-                    ),
-                );
-            }
+            check_chambers(c, &p("chambers"), s.outer_radius, s.inner_radius, file)?;
         }
         if let (Some(_), Some(_)) = (s.youngs_modulus, s.bending_stiffness) {
             return err(
@@ -396,6 +363,241 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
     }
     if let Some(moment) = &m.tip.moment {
         vec3("tip.moment", moment)?;
+    }
+    if let Some(l) = m.tip.length {
+        non_negative("tip.length", l)?;
+        if m.tip.mass.is_none() {
+            return err(
+                "tip.length".into(),
+                "a tip body needs its `mass` (kg) too".into(),
+            );
+        }
+    }
+    if let Some(r) = m.tip.radius {
+        non_negative("tip.radius", r)?;
+        if m.tip.length.is_none() {
+            return err(
+                "tip.radius".into(),
+                "needs `tip.length` (the tip body is a cylinder of that length)".into(),
+            );
+        }
+    }
+    let channel = |path: &str, name: &str| -> Result<(), ModelError> {
+        if m.inputs.contains_key(name) {
+            return Ok(());
+        }
+        let known: Vec<&str> = m.inputs.keys().map(String::as_str).collect();
+        Err(ModelError::new(
+            file,
+            path,
+            if known.is_empty() {
+                format!("no input channel \"{name}\": declare it as [inputs.{name}]")
+            } else {
+                format!(
+                    "no input channel \"{name}\"; declared: {} (or add [inputs.{name}])",
+                    known.join(", ")
+                )
+            },
+        ))
+    };
+    for (key, names) in [
+        ("tip.force_inputs", &m.tip.force_inputs),
+        ("tip.moment_inputs", &m.tip.moment_inputs),
+    ] {
+        if let Some(names) = names {
+            for (i, n) in names.iter().enumerate() {
+                channel(&format!("{key}[{i}]"), n)?;
+            }
+        }
+    }
+    for (i, s) in m.segments.iter().enumerate() {
+        if let Some(inputs) = s.chambers.as_ref().and_then(|c| c.inputs.as_ref()) {
+            for (j, n) in inputs.iter().enumerate() {
+                channel(&format!("segment[{i}].chambers.inputs[{j}]"), n)?;
+            }
+        }
+    }
+    for (i, t) in m.tendons.iter().enumerate() {
+        let p = |k: &str| format!("tendon[{i}].{k}");
+        channel(&p("input"), &t.input)?;
+        let end = t.end.unwrap_or(m.segments.len() - 1);
+        if end >= m.segments.len() {
+            return err(
+                p("end"),
+                format!(
+                    "must be a segment index, 0 to {}, got {end}",
+                    m.segments.len() - 1
+                ),
+            );
+        }
+        for (key, v) in [("distance", Some(&t.distance)), ("angle", t.angle.as_ref())] {
+            let Some(v) = v else { continue };
+            if let super::schema::OneOrMany::Many(list) = v
+                && list.len() != end + 1
+            {
+                return err(
+                    p(key),
+                    format!(
+                        "give one value, or one per segment the tendon spans ({}), got {}",
+                        end + 1,
+                        list.len()
+                    ),
+                );
+            }
+            for s in 0..=end {
+                finite(&p(key), v.at(s))?;
+            }
+        }
+        for s in 0..=end {
+            let d = t.distance.at(s);
+            non_negative(&p("distance"), d)?;
+            if let Some(ro) = m.segments[s].outer_radius
+                && d > ro
+            {
+                return err(
+                    p("distance"),
+                    format!("{d} m lies outside segment {s}'s section (outer radius {ro} m)"),
+                );
+            }
+        }
+    }
+    for (name, input) in &m.inputs {
+        super::signals::check_input(name, input, file)?;
+    }
+    if let Some(c) = &m.compare {
+        super::signals::check_compare(c, file)?;
+    }
+    Ok(())
+}
+
+/// Chamber holes: one way to place them, inside the wall, not overlapping,
+/// in an isotropic pattern, with declared input channels.
+fn check_chambers(
+    c: &super::schema::Chambers,
+    path: &str,
+    outer: Option<f64>,
+    inner: Option<f64>,
+    file: &str,
+) -> Result<(), ModelError> {
+    let err = |key: &str, msg: String| {
+        let at = if key.is_empty() {
+            path.to_string()
+        } else {
+            format!("{path}.{key}")
+        };
+        Err(ModelError::new(file, at, msg))
+    };
+    let Some(ro) = outer else {
+        return err("", "needs the section's `outer_radius`".into());
+    };
+    match (c.count, &c.angles) {
+        (Some(_), Some(_)) => {
+            return err(
+                "angles",
+                "give either `count` (equally spaced) or `angles`, not both".into(),
+            );
+        }
+        (None, None) => {
+            return err(
+                "count",
+                "missing: give `count` (equally spaced positions) or `angles` (degrees)".into(),
+            );
+        }
+        (Some(n), None) if n < 3 && c.pair_spacing.is_none() => {
+            return err(
+                "count",
+                format!(
+                    "must be at least 3 (equally spaced holes keep the bending stiffness the same in every direction), got {n}"
+                ),
+            );
+        }
+        (Some(0), None) => return err("count", "must be at least 1".into()),
+        (None, Some(a)) => {
+            if a.is_empty() {
+                return err("angles", "give at least one angle (degrees)".into());
+            }
+            if let Some(v) = a.iter().find(|v| !v.is_finite()) {
+                return err("angles", format!("must be finite numbers, got {v}"));
+            }
+        }
+        _ => {}
+    }
+    if let Some(h) = c.pair_spacing
+        && !(h.is_finite() && h > 0.0 && h < 90.0)
+    {
+        return err(
+            "pair_spacing",
+            format!("must be an angle between 0 and 90 degrees, got {h}"),
+        );
+    }
+    for (key, v) in [("radius", c.radius), ("distance", c.distance)] {
+        if !(v.is_finite() && v > 0.0) {
+            return err(key, format!("must be positive, got {v}"));
+        }
+    }
+    if let Some(a) = c.area
+        && !(a.is_finite() && a > 0.0)
+    {
+        return err("area", format!("must be positive, got {a}"));
+    }
+    let ri = inner.unwrap_or(0.0);
+    if c.distance - c.radius < ri || c.distance + c.radius > ro {
+        return err(
+            "",
+            format!(
+                "holes of radius {} at distance {} must lie in the wall between inner radius {ri} and outer radius {ro}",
+                c.radius, c.distance
+            ),
+        );
+    }
+    let holes = c.holes();
+    let centre = |a: f64| {
+        let a = a.to_radians();
+        (c.distance * a.cos(), c.distance * a.sin())
+    };
+    for (i, &a) in holes.iter().enumerate() {
+        for &b in &holes[i + 1..] {
+            let ((ya, za), (yb, zb)) = (centre(a), centre(b));
+            if (ya - yb).hypot(za - zb) <= 2.0 * c.radius {
+                return err(
+                    "",
+                    format!(
+                        "holes of radius {} at distance {} and angles {a} and {b} degrees overlap",
+                        c.radius, c.distance
+                    ),
+                );
+            }
+        }
+    }
+    // Isotropy: sum cos 2a = sum sin 2a = 0 makes I_y = I_z and I_yz = 0.
+    let (cs, sn) = holes.iter().fold((0.0, 0.0), |(x, y), a| {
+        let t = 2.0 * a.to_radians();
+        (x + t.cos(), y + t.sin())
+    });
+    if cs.hypot(sn) > 1e-6 * holes.len() as f64 {
+        return err(
+            "",
+            format!(
+                "the holes at {holes:?} degrees make the section stiffer in one direction than another; anisotropic sections are not supported yet: use 3 or more equally spaced positions, or pairs about them"
+            ),
+        );
+    }
+    if let Some(inputs) = &c.inputs {
+        let n = c.positions().len();
+        if inputs.len() != n {
+            return err(
+                "inputs",
+                format!(
+                    "give one input channel per position ({n}{}), got {}",
+                    if c.pair_spacing.is_some() {
+                        ", a pair sharing one"
+                    } else {
+                        ""
+                    },
+                    inputs.len()
+                ),
+            );
+        }
     }
     Ok(())
 }

@@ -22,11 +22,12 @@
 use crate::cas::{Cas, ExprId};
 use crate::model::{Model, Structure};
 
+use super::actuation::{Strain, actuation};
 use super::spatial::{
     M3, V3, bind3, coefficients, half_k_sq, left_jacobian, mat_vec, quat_mul, rotation,
     rotation_quat,
 };
-use super::system::{AppliedMoment, Body, Coordinates, Inertia, ParamSymbols, PointForce, System};
+use super::system::{Body, Coordinates, Inertia, ParamSymbols, System, TipMount, tip_loads};
 
 /// An element's (or the clamp's) frame: rotation, centre and half length.
 struct Slab {
@@ -87,8 +88,14 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
     let mut omega = [zero; 3];
     let q0 = ["qw", "qx", "qy", "qz"].map(|c| param(&format!("base.{c}")));
     let mut quat = q0;
-    let n_el = structure.elements();
-    for k in 0..n_el {
+    let segment_of: Vec<usize> = structure
+        .segments
+        .iter()
+        .enumerate()
+        .flat_map(|(s, g)| std::iter::repeat_n(s, g.elements))
+        .collect();
+    let mut strains = Vec::new();
+    for (k, &segment) in segment_of.iter().enumerate() {
         let c = 6 * k;
         let u: V3 = std::array::from_fn(|i| coords.q[c + i]);
         let psi: V3 = std::array::from_fn(|i| coords.q[c + 3 + i]);
@@ -175,6 +182,13 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
             let e = cas.dot(&col, &gap);
             cas.bind(e)
         });
+        // The joint's lumped strain: the gap along the previous axis and
+        // the relative rotation measure.
+        strains.push(Strain {
+            segment,
+            stretch: local[0],
+            rho: v,
+        });
         let local_d = cas.time_derivatives(&local[..1], &pairs);
         elastic.push(half_k_sq(cas, ka, local[0]));
         rayleigh.push(half_k_sq(cas, da, local_d[0]));
@@ -186,45 +200,29 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
 
     let tip = prev.end(cas, 1.0);
     let tip = bind3(cas, tip);
-    if structure.tip_mass {
-        bodies.push(Body {
-            mass: param("tip.mass"),
-            inertia: Inertia::Isotropic(zero),
-            position: tip,
-            omega,
-        });
-    }
-    let mut point_forces = Vec::new();
-    if structure.tip_force {
-        let force = [
-            param("tip.force.x"),
-            param("tip.force.y"),
-            param("tip.force.z"),
-        ];
-        point_forces.push(PointForce { point: tip, force });
-    }
-    let mut moments = Vec::new();
-    if structure.tip_moment {
-        let moment = [
-            param("tip.moment.x"),
-            param("tip.moment.y"),
-            param("tip.moment.z"),
-        ];
-        moments.push(AppliedMoment { omega, moment });
-    }
-    let gravity = [param("gravity.x"), param("gravity.y"), param("gravity.z")];
     let elastic = cas.add_all(&elastic);
     let rayleigh = cas.add_all(&rayleigh);
-    System {
+    let actuation = actuation(cas, &symbols, &structure, &strains);
+    let mut sys = System {
         coords,
         bodies,
-        gravity,
+        gravity: symbols.gravity(),
         elastic,
         rayleigh,
-        point_forces,
-        moments,
+        actuation,
+        point_forces: Vec::new(),
+        moments: Vec::new(),
         tip,
         tip_orientation: quat,
         chain: None,
-    }
+    };
+    let mount = TipMount {
+        point: tip,
+        axis: [prev.r[0][0], prev.r[1][0], prev.r[2][0]],
+        omega,
+        rotation: prev.r,
+    };
+    let loads = tip_loads(cas, &symbols, &structure, &mount);
+    sys.attach_tip(loads, 0);
+    sys
 }

@@ -22,7 +22,7 @@
 //! For statics: the static generalised force h(q, 0) (gravity, elastic and
 //! applied forces) and the stiffness K = d h(q, 0) / dq.
 
-use crate::cas::{Cas, ExprId};
+use crate::cas::{Cas, ExprId, Variables};
 
 use super::chain::{ChainKinematics, MomentItem, PointItem};
 use super::system::System;
@@ -181,9 +181,11 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         }
         _ => cas.vjp(&outs, &force_cot, &sys.coords.qd),
     };
+    // Elastic and actuator potentials act alike on the coordinates.
+    let stored = cas.add(sys.elastic, sys.actuation);
     let bias: Vec<ExprId> = (0..n)
         .map(|i| {
-            let de = cas.diff(sys.elastic, sys.coords.q[i]);
+            let de = cas.diff(stored, sys.coords.q[i]);
             let dr = cas.diff(sys.rayleigh, sys.coords.qd[i]);
             let mut terms = vec![forces[i], de, dr];
             terms.extend(inertia_rate_force.iter().map(|f| f[i]));
@@ -210,7 +212,7 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     let static_loads = cas.vjp(&outs, &static_cot, &sys.coords.qd);
     let static_force: Vec<ExprId> = (0..n)
         .map(|i| {
-            let de = cas.diff(sys.elastic, sys.coords.q[i]);
+            let de = cas.diff(stored, sys.coords.q[i]);
             cas.add(static_loads[i], de)
         })
         .collect();
@@ -237,7 +239,12 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         let pe = cas.mul(body.mass, gr);
         potential.push(cas.neg(pe));
     }
+    // A constant force has the potential -F . p; a follower force (turning
+    // with the tip) has none.
     for f in &sys.point_forces {
+        if f.force.iter().any(|&c| cas.variables(c) != Variables::None) {
+            continue;
+        }
         let fp = cas.dot(&f.force, &f.point);
         potential.push(cas.neg(fp));
     }

@@ -2,6 +2,7 @@
 //! derives M, h and the outputs from it.
 
 mod absolute;
+mod actuation;
 mod assemble;
 mod chain;
 mod inertia;

@@ -17,8 +17,9 @@
 use crate::cas::{Cas, ExprId, Func};
 use crate::model::{Joints, Method, Model, Structure};
 
+use super::actuation::{Strain, actuation};
 use super::system::{
-    AppliedMoment, Body, Chain, Coordinates, Inertia, Link, ParamSymbols, PointForce, System,
+    Body, Chain, Coordinates, Inertia, Link, ParamSymbols, System, TipMount, tip_loads,
 };
 
 /// A planar frame: origin, absolute angle and its rate.
@@ -58,10 +59,17 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
     let mut rayleigh = Vec::new();
     let mut links = Vec::new();
     let mut body_link = Vec::new();
+    let mut strains = Vec::new();
     let mut k = 0;
-    for g in &structure.segments {
+    for (s, g) in structure.segments.iter().enumerate() {
         for _ in 0..g.elements {
             let (q, qd) = (coords.q[k], coords.qd[k]);
+            // In the plane every element bends about z.
+            strains.push(Strain {
+                segment: s,
+                stretch: zero,
+                rho: [zero, zero, q],
+            });
             let l = param(&format!("element[{k}].length"));
             let m = param(&format!("element[{k}].mass"));
             let inertia = param(&format!("element[{k}].inertia"));
@@ -117,63 +125,51 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
         }
     }
 
-    let tip = [f.x, f.y, z];
     let half_phi = cas.scaled(0.5, f.phi);
-    if structure.tip_mass {
-        let mass = param("tip.mass");
-        bodies.push(Body {
-            mass,
-            inertia: Inertia::Isotropic(zero),
-            position: tip,
-            omega: [zero; 3],
-        });
-        body_link.push(links.len().saturating_sub(1));
-    }
-    let mut point_forces = Vec::new();
-    let mut point_force_link = Vec::new();
-    if structure.tip_force {
-        let force = [
-            param("tip.force.x"),
-            param("tip.force.y"),
-            param("tip.force.z"),
-        ];
-        point_forces.push(PointForce { point: tip, force });
-        point_force_link.push(links.len().saturating_sub(1));
-    }
-    let mut moments = Vec::new();
-    let mut moment_link = Vec::new();
-    if structure.tip_moment {
-        let moment = [
-            param("tip.moment.x"),
-            param("tip.moment.y"),
-            param("tip.moment.z"),
-        ];
-        moments.push(AppliedMoment {
-            omega: [zero, zero, f.w],
-            moment,
-        });
-        moment_link.push(links.len().saturating_sub(1));
-    }
-    let gravity = [param("gravity.x"), param("gravity.y"), param("gravity.z")];
+    let last_link = links.len().saturating_sub(1);
     let elastic = cas.add_all(&elastic);
     let rayleigh = cas.add_all(&rayleigh);
-    System {
+    let actuation = actuation(cas, &symbols, &structure, &strains);
+    let tip_orientation = [cas.cos(half_phi), zero, zero, cas.sin(half_phi)];
+    let mut sys = System {
         coords,
         bodies,
-        gravity,
+        gravity: symbols.gravity(),
         elastic,
         rayleigh,
-        point_forces,
-        moments,
-        tip,
-        tip_orientation: [cas.cos(half_phi), zero, zero, cas.sin(half_phi)],
+        actuation,
+        point_forces: Vec::new(),
+        moments: Vec::new(),
+        tip: [f.x, f.y, z],
+        tip_orientation,
         chain: (!links.is_empty()).then_some(Chain {
             links,
             body_link,
-            point_force_link,
-            moment_link,
+            point_force_link: Vec::new(),
+            moment_link: Vec::new(),
         }),
-    }
+    };
+    // The end frame's axis and rotation only when the tip needs them (a
+    // tip body with length, a wrench in the tip frame).
+    let (axis, rotation) = if structure.tip_length || structure.tip_frame_wrench {
+        let (c, s) = (cas.cos(f.phi), cas.sin(f.phi));
+        let (zero, one, ns) = (cas.zero(), cas.one(), cas.neg(s));
+        (
+            [c, s, zero],
+            [[c, ns, zero], [s, c, zero], [zero, zero, one]],
+        )
+    } else {
+        ([zero; 3], [[zero; 3]; 3])
+    };
+    let mount = TipMount {
+        point: [f.x, f.y, z],
+        axis,
+        omega: [zero, zero, f.w],
+        rotation,
+    };
+    let tip = tip_loads(cas, &symbols, &structure, &mount);
+    sys.attach_tip(tip, last_link);
+    sys
 }
 
 /// The frame turned by the joint angle q (rate qd).

@@ -24,8 +24,9 @@
 use crate::cas::{Cas, ExprId, Func};
 use crate::model::{Joints, Method, Model, Structure};
 
+use super::actuation::{Strain, actuation};
 use super::system::{
-    AppliedMoment, Body, Chain, Coordinates, Inertia, Link, ParamSymbols, PointForce, System,
+    Body, Chain, Coordinates, Inertia, Link, ParamSymbols, System, TipMount, tip_loads,
 };
 
 pub(super) type V3 = [ExprId; 3];
@@ -325,9 +326,10 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
     let mut rayleigh = Vec::new();
     let mut links = Vec::new();
     let mut body_link = Vec::new();
+    let mut strains = Vec::new();
     let mut c = 0; // next coordinate
     let mut k = 0; // element
-    for g in &structure.segments {
+    for (s, g) in structure.segments.iter().enumerate() {
         // rom: the segment's coefficients, shared by its slices, and its
         // strain energy integrated exactly.
         let rom = (g.method == Method::Rom).then(|| {
@@ -367,8 +369,12 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                 let rest = param(&format!("joint[{k}].rest"));
                 let mut turn = |cas: &mut Cas, f: &Frame| {
                     let mut f = *f;
+                    // The joint's lumped strain: its angles about their
+                    // axes (exact for one axis, first order for several).
+                    let mut rho = [zero; 3];
                     for &a in &g.axes {
                         let (q, qd) = (coords.q[c], coords.qd[c]);
+                        rho[a.index()] = cas.add(rho[a.index()], q);
                         f = revolute(cas, &f, a.index(), q, qd);
                         let (kq, q_rest) = if a.index() == 0 {
                             (twist, zero)
@@ -380,6 +386,11 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                         rayleigh.push(half_k_sq(cas, damp, qd));
                         c += 1;
                     }
+                    strains.push(Strain {
+                        segment: s,
+                        stretch: zero,
+                        rho,
+                    });
                     f
                 };
                 match g.joints {
@@ -404,6 +415,11 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                 }
             } else if let Some(rom) = &rom {
                 let (rho, rate, st) = rom.slice(cas, &coords, e, l);
+                strains.push(Strain {
+                    segment: s,
+                    stretch: st,
+                    rho,
+                });
                 let len = cas.add(l, st);
                 let (centroid, axis, omega, end) = arc(cas, &f, &rho, &rate, len);
                 let centroid = bind3(cas, centroid);
@@ -426,6 +442,11 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                 };
                 let rho = [tw, by, bz];
                 let rate = [tw_d, by_d, bz_d];
+                strains.push(Strain {
+                    segment: s,
+                    stretch: st,
+                    rho,
+                });
                 let len = cas.add(l, st);
                 let kb = param(&format!("joint[{k}].stiffness"));
                 let db = param(&format!("joint[{k}].damping"));
@@ -486,61 +507,39 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
     }
 
     let has_rom = structure.segments.iter().any(|g| g.method == Method::Rom);
-    let tip = f.p;
     let last_link = links.len().saturating_sub(1);
-    if structure.tip_mass {
-        bodies.push(Body {
-            mass: param("tip.mass"),
-            inertia: Inertia::Isotropic(zero),
-            position: tip,
-            omega: f.w,
-        });
-        body_link.push(last_link);
-    }
-    let mut point_forces = Vec::new();
-    let mut point_force_link = Vec::new();
-    if structure.tip_force {
-        let force = [
-            param("tip.force.x"),
-            param("tip.force.y"),
-            param("tip.force.z"),
-        ];
-        point_forces.push(PointForce { point: tip, force });
-        point_force_link.push(last_link);
-    }
-    let mut moments = Vec::new();
-    let mut moment_link = Vec::new();
-    if structure.tip_moment {
-        let moment = [
-            param("tip.moment.x"),
-            param("tip.moment.y"),
-            param("tip.moment.z"),
-        ];
-        moments.push(AppliedMoment { omega: f.w, moment });
-        moment_link.push(last_link);
-    }
-    let gravity = [param("gravity.x"), param("gravity.y"), param("gravity.z")];
     let elastic = cas.add_all(&elastic);
     let rayleigh = cas.add_all(&rayleigh);
-    System {
+    let actuation = actuation(cas, &symbols, &structure, &strains);
+    let mut sys = System {
         coords,
         bodies,
-        gravity,
+        gravity: symbols.gravity(),
         elastic,
         rayleigh,
-        point_forces,
-        moments,
-        tip,
+        actuation,
+        point_forces: Vec::new(),
+        moments: Vec::new(),
+        tip: f.p,
         tip_orientation: f.quat,
         // rom slices share their segment's coordinates: not a chain of
         // links that own theirs, so M and h by the general sums.
         chain: (!links.is_empty() && !has_rom).then_some(Chain {
             links,
             body_link,
-            point_force_link,
-            moment_link,
+            point_force_link: Vec::new(),
+            moment_link: Vec::new(),
         }),
-    }
+    };
+    let mount = TipMount {
+        point: f.p,
+        axis: f.axis(),
+        omega: f.w,
+        rotation: f.r,
+    };
+    let tip = tip_loads(cas, &symbols, &structure, &mount);
+    sys.attach_tip(tip, last_link);
+    sys
 }
 
 /// The strain fields of a rom segment, in coordinate order.

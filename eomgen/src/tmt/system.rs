@@ -29,6 +29,11 @@ impl ParamSymbols {
 
     /// The symbol of parameter `name`; kinematics only asks for names the
     /// layout has, so a miss is a generator bug.
+    /// The gravity vector.
+    pub fn gravity(&self) -> [ExprId; 3] {
+        ["x", "y", "z"].map(|c| self.get(&format!("gravity.{c}")))
+    }
+
     pub fn get(&self, name: &str) -> ExprId {
         let i = self
             .names
@@ -117,6 +122,10 @@ pub struct System {
     pub elastic: ExprId,
     /// Rayleigh dissipation function R(q, qd).
     pub rayleigh: ExprId,
+    /// The actuators' potential V_a(q) = -(their virtual work's integral):
+    /// generalised forces like V_e's, but not stored energy (not in the
+    /// potential-energy output).
+    pub actuation: ExprId,
     /// Constant (conservative) forces at points.
     pub point_forces: Vec<PointForce>,
     /// Constant moments on frames (no potential: not in the energy output).
@@ -127,6 +136,122 @@ pub struct System {
     pub tip_orientation: [ExprId; 4],
     /// Serial-chain structure, when the kinematics has it (M by composites).
     pub chain: Option<Chain>,
+}
+
+impl System {
+    /// Add the tip payload and loads, moving with `link` of the chain.
+    pub fn attach_tip(&mut self, tip: TipLoads, link: usize) {
+        self.tip = tip.point;
+        if let Some(b) = tip.body {
+            self.bodies.push(b);
+            if let Some(c) = &mut self.chain {
+                c.body_link.push(link);
+            }
+        }
+        if let Some(f) = tip.force {
+            self.point_forces.push(f);
+            if let Some(c) = &mut self.chain {
+                c.point_force_link.push(link);
+            }
+        }
+        if let Some(m) = tip.moment {
+            self.moments.push(m);
+            if let Some(c) = &mut self.chain {
+                c.moment_link.push(link);
+            }
+        }
+    }
+}
+
+/// The arm's end frame, where the tip payload mounts.
+pub struct TipMount {
+    pub point: [ExprId; 3],
+    /// The frame's x axis (along the arm) in the world.
+    pub axis: [ExprId; 3],
+    pub omega: [ExprId; 3],
+    /// World from tip frame (rows), for wrenches given in the tip frame.
+    pub rotation: [[ExprId; 3]; 3],
+}
+
+/// The tip payload as the TMT method sees it.
+pub struct TipLoads {
+    /// The tip point: the mount, or the end of the tip body.
+    pub point: [ExprId; 3],
+    pub body: Option<Body>,
+    pub force: Option<PointForce>,
+    pub moment: Option<AppliedMoment>,
+}
+
+/// The tip body (a point mass, or a cylinder along the tip axis), the tip
+/// force at the tip point and the tip moment, as the structure declares
+/// them; one definition for every kinematics.
+pub fn tip_loads(
+    cas: &mut Cas,
+    symbols: &ParamSymbols,
+    structure: &crate::model::Structure,
+    mount: &TipMount,
+) -> TipLoads {
+    let zero = cas.zero();
+    let param = |name: &str| symbols.get(name);
+    let along = |cas: &mut Cas, d: ExprId| -> [ExprId; 3] {
+        std::array::from_fn(|k| {
+            let o = cas.mul(d, mount.axis[k]);
+            let e = cas.add(mount.point[k], o);
+            cas.bind(e)
+        })
+    };
+    let (point, centre) = if structure.tip_length {
+        let len = param("tip.length");
+        let half = cas.scaled(0.5, len);
+        (along(cas, len), along(cas, half))
+    } else {
+        (mount.point, mount.point)
+    };
+    let body = structure.tip_mass.then(|| Body {
+        mass: param("tip.mass"),
+        inertia: if structure.tip_length {
+            Inertia::Axisymmetric {
+                axis: mount.axis,
+                axial: param("tip.axial_inertia"),
+                lateral: param("tip.inertia"),
+            }
+        } else {
+            Inertia::Isotropic(zero)
+        },
+        position: centre,
+        omega: mount.omega,
+    });
+    // A wrench in the tip frame turns with it: world = R local.
+    let oriented = |cas: &mut Cas, v: [ExprId; 3]| -> [ExprId; 3] {
+        if structure.tip_frame_wrench {
+            std::array::from_fn(|i| {
+                let e = cas.dot(&mount.rotation[i], &v);
+                cas.bind(e)
+            })
+        } else {
+            v
+        }
+    };
+    let force = structure.tip_force.then(|| {
+        let f = ["x", "y", "z"].map(|c| param(&format!("tip.force.{c}")));
+        PointForce {
+            point,
+            force: oriented(cas, f),
+        }
+    });
+    let moment = structure.tip_moment.then(|| {
+        let m = ["x", "y", "z"].map(|c| param(&format!("tip.moment.{c}")));
+        AppliedMoment {
+            omega: mount.omega,
+            moment: oriented(cas, m),
+        }
+    });
+    TipLoads {
+        point,
+        body,
+        force,
+        moment,
+    }
 }
 
 /// A serial chain of links, each owning a run of coordinates.

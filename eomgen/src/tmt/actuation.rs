@@ -1,0 +1,108 @@
+//! Actuators by virtual work on fibre lengths.
+//!
+//! Every kinematics reports the lumped strain of each element, slice or
+//! joint (a [`Strain`]: its stretch and its rotation vector in the element
+//! frame). A fibre embedded at (y, z) in the section (a chamber, a tendon)
+//! changes its length across that strain by
+//!
+//! dL = stretch + rho_y z - rho_z y,
+//!
+//! exact for a constant-curvature arc without twist, to first order
+//! otherwise. A chamber at pressure p does virtual work p a dL (it pushes its
+//! ends apart: an axial force p a and a moment p a r about the axis normal
+//! to its direction); a tendon at tension T does -T dL, and only pulls
+//! (T is clamped at 0). Both enter as a potential V_a(q) = -W(q), so that
+//! the generalised forces are -dV_a/dq and the static stiffness includes
+//! their change with the configuration.
+
+use crate::cas::{Cas, ExprId, Func};
+use crate::model::Structure;
+
+use super::system::ParamSymbols;
+
+/// The lumped strain of one element, slice or joint.
+pub struct Strain {
+    pub segment: usize,
+    /// Length change (m).
+    pub stretch: ExprId,
+    /// Rotation vector across it in its base frame (twist, bend about y,
+    /// bend about z), rad.
+    pub rho: [ExprId; 3],
+}
+
+/// V_a(q) of the structure's chambers and tendons; zero without them.
+pub fn actuation(
+    cas: &mut Cas,
+    symbols: &ParamSymbols,
+    structure: &Structure,
+    strains: &[Strain],
+) -> ExprId {
+    if structure.chambers.iter().all(|&c| c == 0) && structure.tendons.is_empty() {
+        return cas.zero();
+    }
+    let param = |name: &str| symbols.get(name);
+    let n = structure.segments.len();
+    // Per segment: total stretch and total bend about y and z.
+    let mut sums = vec![[Vec::new(), Vec::new(), Vec::new()]; n];
+    for s in strains {
+        sums[s.segment][0].push(s.stretch);
+        sums[s.segment][1].push(s.rho[1]);
+        sums[s.segment][2].push(s.rho[2]);
+    }
+    let totals: Vec<[ExprId; 3]> = sums
+        .iter()
+        .map(|parts| {
+            parts.clone().map(|p| {
+                let e = cas.add_all(&p);
+                cas.bind(e)
+            })
+        })
+        .collect();
+    // Length change of a fibre at (y, z) through segment s.
+    let fibre = |cas: &mut Cas, s: usize, y: ExprId, z: ExprId| {
+        let [st, by, bz] = totals[s];
+        let a = cas.mul(by, z);
+        let b = cas.mul(bz, y);
+        let b = cas.neg(b);
+        cas.add_all(&[st, a, b])
+    };
+    let mut potential = Vec::new();
+    for (s, &count) in structure.chambers.iter().enumerate() {
+        for j in 0..count {
+            let key = |k: &str| format!("chamber[{s}][{j}].{k}");
+            let p = param(&key("pressure"));
+            // The position's holes together: area a, first moments a sum z
+            // (lever of bend y) and a sum y (of bend z).
+            let (area, arm_y, arm_z) = (
+                param(&key("area")),
+                param(&key("arm_y")),
+                param(&key("arm_z")),
+            );
+            let [st, by, bz] = totals[s];
+            let a = cas.mul(area, st);
+            let b = cas.mul(arm_y, by);
+            let c = cas.mul(arm_z, bz);
+            let c = cas.neg(c);
+            let work = cas.add_all(&[a, b, c]);
+            let w = cas.mul(p, work);
+            potential.push(cas.neg(w));
+        }
+    }
+    for (i, &end) in structure.tendons.iter().enumerate() {
+        let t = param(&format!("tendon[{i}].tension"));
+        // Tension only: (T + |T|) / 2.
+        let abs = cas.func(Func::Abs, t);
+        let sum = cas.add(t, abs);
+        let pull = cas.scaled(0.5, sum);
+        let lengths: Vec<ExprId> = (0..=end)
+            .map(|s| {
+                let y = param(&format!("tendon[{i}][{s}].y"));
+                let z = param(&format!("tendon[{i}][{s}].z"));
+                fibre(cas, s, y, z)
+            })
+            .collect();
+        let length = cas.add_all(&lengths);
+        potential.push(cas.mul(pull, length));
+    }
+    cas.add_all(&potential)
+}

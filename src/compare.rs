@@ -1,0 +1,266 @@
+//! Simulation against measurement: a model's `[compare]` section maps a
+//! recorded tip motion into the model frame; the tip error statistics go to
+//! summary.json and a plot of simulated against measured tip x, y, z.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use eomgen::model::Compare;
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use runtime::signal::moving_average;
+use serde::Serialize;
+
+use crate::data::{Csv, resolve};
+
+/// The measured tip in the model frame.
+pub struct Measured {
+    pub t: Vec<f64>,
+    pub tip: Vec<[f64; 3]>,
+}
+
+/// Read and transform the measured tip motion:
+/// p = rotation (scale (position - reference) - R_c offset - (p_0 - offset)) + initial,
+/// R_c the tip rotation relative to the first sample. `initial` defaults to
+/// `initial_default(t_0)` (the simulated tip at the first sample's time).
+pub fn measured(
+    spec: &Compare,
+    base: &Path,
+    initial_default: impl FnOnce(f64) -> [f64; 3],
+) -> Result<Measured> {
+    let path = resolve(base, &spec.file);
+    let csv = Csv::read(&path).context("compare.file")?;
+    let t = csv.time_column(&spec.time).context("compare.time")?;
+    let mut pos: Vec<Vec<f64>> = Vec::with_capacity(3);
+    for (k, name) in spec.position.iter().enumerate() {
+        let mut v = csv
+            .column(name)
+            .with_context(|| format!("compare.position[{k}]"))?;
+        if let Some(r) = &spec.reference {
+            let base = csv
+                .column(&r[k])
+                .with_context(|| format!("compare.reference[{k}]"))?;
+            for (a, b) in v.iter_mut().zip(base) {
+                *a -= b;
+            }
+        }
+        pos.push(
+            moving_average(&v, spec.smooth)
+                .iter()
+                .map(|x| spec.scale * x)
+                .collect(),
+        );
+    }
+    let n = t.len();
+    let p = |i: usize| Vector3::new(pos[0][i], pos[1][i], pos[2][i]);
+    // Tip rotation relative to the first sample.
+    let relative: Vec<Matrix3<f64>> = match &spec.orientation {
+        None => vec![Matrix3::identity(); n],
+        Some(cols) => {
+            let c = cols
+                .iter()
+                .enumerate()
+                .map(|(k, name)| {
+                    csv.column(name)
+                        .with_context(|| format!("compare.orientation[{k}]"))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            let mut rot = Vec::with_capacity(n);
+            for (i, ((w, x), (y, z))) in c[0]
+                .iter()
+                .zip(&c[1])
+                .zip(c[2].iter().zip(&c[3]))
+                .enumerate()
+            {
+                let q = nalgebra::Quaternion::new(*w, *x, *y, *z);
+                if q.norm().is_nan() || q.norm() <= 1e-6 {
+                    bail!(
+                        "{}: row {}: the tip quaternion is zero",
+                        path.display(),
+                        i + 2
+                    );
+                }
+                rot.push(
+                    UnitQuaternion::from_quaternion(q)
+                        .to_rotation_matrix()
+                        .into_inner(),
+                );
+            }
+            let r0t = rot[0].transpose();
+            rot.iter().map(|r| r * r0t).collect()
+        }
+    };
+    let offset = Vector3::from(spec.sensor_offset.unwrap_or([0.0; 3]));
+    let frame = match spec.rotation {
+        Some(r) => Matrix3::from_fn(|i, j| r[i][j]),
+        None => Matrix3::identity(),
+    };
+    let initial = Vector3::from(spec.initial.unwrap_or_else(|| initial_default(t[0])));
+    let p0 = p(0);
+    let tip = (0..n)
+        .map(|i| {
+            let v = frame * (p(i) - relative[i] * offset - (p0 - offset)) + initial;
+            [v.x, v.y, v.z]
+        })
+        .collect();
+    Ok(Measured { t, tip })
+}
+
+/// Tip error statistics over a window, as summary.json reports them.
+#[derive(Clone, Debug, Serialize)]
+pub struct TipError {
+    pub window_s: [f64; 2],
+    pub samples: usize,
+    pub mean_m: f64,
+    pub rms_m: f64,
+    pub max_m: f64,
+    pub mean_percent_length: f64,
+}
+
+/// Euclidean tip errors at the measured times inside `window` (and inside
+/// the simulated span); `simulated(t)` gives the simulated tip.
+pub fn tip_error(
+    measured: &Measured,
+    window: [f64; 2],
+    length: f64,
+    mut simulated: impl FnMut(f64) -> Option<[f64; 3]>,
+) -> Result<TipError> {
+    let mut errors = Vec::new();
+    for (t, m) in measured.t.iter().zip(&measured.tip) {
+        if *t < window[0] || *t > window[1] {
+            continue;
+        }
+        let Some(s) = simulated(*t) else { continue };
+        let e = ((s[0] - m[0]).powi(2) + (s[1] - m[1]).powi(2) + (s[2] - m[2]).powi(2)).sqrt();
+        errors.push(e);
+    }
+    if errors.is_empty() {
+        bail!(
+            "compare.window: no measured sample between {} s and {} s within the simulated time",
+            window[0],
+            window[1]
+        );
+    }
+    let n = errors.len() as f64;
+    let mean = errors.iter().sum::<f64>() / n;
+    Ok(TipError {
+        window_s: window,
+        samples: errors.len(),
+        mean_m: mean,
+        rms_m: (errors.iter().map(|e| e * e).sum::<f64>() / n).sqrt(),
+        max_m: errors.iter().copied().fold(0.0, f64::max),
+        mean_percent_length: 100.0 * mean / length,
+    })
+}
+
+/// Simulated against measured tip x, y, z over time, one panel each, as
+/// `<stem>.png` and `<stem>.svg`.
+pub fn plot(
+    stem: &Path,
+    title: &str,
+    simulated: &[(f64, [f64; 3])],
+    measured: &Measured,
+) -> Result<()> {
+    use plotters::prelude::*;
+    register_font();
+    fn draw<DB: DrawingBackend>(
+        root: DrawingArea<DB, plotters::coord::Shift>,
+        title: &str,
+        simulated: &[(f64, [f64; 3])],
+        measured: &Measured,
+    ) -> Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let root = root
+            .titled(title, ("sans-serif", 20))
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        let panels = root.split_evenly((3, 1));
+        let t_max = simulated
+            .iter()
+            .map(|s| s.0)
+            .chain(measured.t.iter().copied())
+            .fold(0.0, f64::max);
+        for (k, panel) in panels.iter().enumerate() {
+            let values = simulated
+                .iter()
+                .map(|s| s.1[k])
+                .chain(measured.tip.iter().map(|m| m[k]))
+                .map(|v| 1e3 * v);
+            let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            });
+            let pad = 0.05 * (hi - lo).max(1.0);
+            let mut chart = ChartBuilder::on(panel)
+                .margin(8)
+                .x_label_area_size(30)
+                .y_label_area_size(60)
+                .build_cartesian_2d(0.0..t_max, (lo - pad)..(hi + pad))
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+            chart
+                .configure_mesh()
+                .x_desc("t (s)")
+                .y_desc(format!("tip {} (mm)", ["x", "y", "z"][k]))
+                .light_line_style(WHITE)
+                .draw()
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+            chart
+                .draw_series(LineSeries::new(
+                    measured
+                        .t
+                        .iter()
+                        .zip(&measured.tip)
+                        .map(|(t, m)| (*t, 1e3 * m[k])),
+                    BLACK.stroke_width(1),
+                ))
+                .map_err(|e| anyhow::anyhow!("{e}"))?
+                .label("measured")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK));
+            chart
+                .draw_series(LineSeries::new(
+                    simulated.iter().map(|(t, s)| (*t, 1e3 * s[k])),
+                    RED.stroke_width(2),
+                ))
+                .map_err(|e| anyhow::anyhow!("{e}"))?
+                .label("simulated")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+        }
+        root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
+        Ok(())
+    }
+    let size = (1000, 900);
+    let png = stem.with_extension("png");
+    let svg = stem.with_extension("svg");
+    draw(
+        BitMapBackend::new(&png, size).into_drawing_area(),
+        title,
+        simulated,
+        measured,
+    )
+    .with_context(|| format!("cannot write {}", png.display()))?;
+    draw(
+        SVGBackend::new(&svg, size).into_drawing_area(),
+        title,
+        simulated,
+        measured,
+    )
+    .with_context(|| format!("cannot write {}", svg.display()))?;
+    Ok(())
+}
+
+/// The bundled font (DejaVu Sans Mono, assets/fonts): plots need no system
+/// fonts.
+fn register_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let font: &'static [u8] = include_bytes!("../assets/fonts/DejaVuSansMono.ttf");
+        let _ =
+            plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, font);
+    });
+}

@@ -1,0 +1,101 @@
+//! A model's input channels as runtime signals, bound to the parameters
+//! they drive.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use eomgen::model::{Input, Model, Offset, drives};
+use runtime::signal::{Drive, Signal, Table, moving_average};
+
+use crate::data::{Csv, resolve};
+
+/// The signal of one channel; CSV paths are relative to `base`.
+pub fn signal(name: &str, input: &Input, base: &Path) -> Result<Signal> {
+    Ok(match input {
+        Input::Constant { value } => Signal::Constant(*value),
+        Input::Step {
+            before,
+            after,
+            time,
+        } => Signal::Step {
+            before: *before,
+            after: *after,
+            time: *time,
+        },
+        Input::Ramp {
+            from,
+            to,
+            start,
+            end,
+        } => Signal::Ramp {
+            from: *from,
+            to: *to,
+            start: *start,
+            end: *end,
+        },
+        Input::Sine {
+            amplitude,
+            frequency,
+            phase,
+            bias,
+            start,
+        } => Signal::Sine {
+            amplitude: *amplitude,
+            frequency: *frequency,
+            phase: phase.to_radians(),
+            bias: *bias,
+            start: *start,
+        },
+        Input::Csv {
+            file,
+            column,
+            time,
+            scale,
+            offset,
+            smooth,
+        } => {
+            let path = resolve(base, file);
+            let csv = Csv::read(&path).with_context(|| format!("inputs.{name}.file"))?;
+            let times = csv
+                .time_column(time)
+                .with_context(|| format!("inputs.{name}.time"))?;
+            let raw = csv
+                .column(column)
+                .with_context(|| format!("inputs.{name}.column"))?;
+            let shift = match offset {
+                None => 0.0,
+                Some(Offset::Value(v)) => *v,
+                Some(Offset::Named(_)) => raw[0], // "first", validated
+            };
+            let values: Vec<f64> = raw.iter().map(|v| scale * (v - shift)).collect();
+            let values = moving_average(&values, *smooth);
+            Signal::Table(
+                Table::new(times, values)
+                    .with_context(|| format!("inputs.{name}: {}", path.display()))?,
+            )
+        }
+    })
+}
+
+/// The drives of a model whose parameter layout is `layout`.
+pub fn model_drives(model: &Model, layout: &[String], base: &Path) -> Result<Vec<Drive>> {
+    let mut signals: BTreeMap<&str, Signal> = BTreeMap::new();
+    let mut out = Vec::new();
+    for (param, channel) in drives(model) {
+        let input = &model.inputs[&channel]; // validated
+        if !signals.contains_key(channel.as_str()) {
+            let key = model.inputs.get_key_value(&channel).expect("validated").0;
+            signals.insert(key, signal(&channel, input, base)?);
+        }
+        let index = layout
+            .iter()
+            .position(|p| *p == param)
+            .with_context(|| format!("parameter {param} is not in the layout (generator bug)"))?;
+        out.push(Drive {
+            param: index,
+            signal: signals[channel.as_str()].clone(),
+        });
+    }
+    Ok(out)
+}
