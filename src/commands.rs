@@ -9,6 +9,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use eomgen::model::Override;
+use eomgen::model::Start;
 use nalgebra::{DMatrix, DVector};
 use runtime::{
     Dynamics, KernelKind, OUTPUT_NAMES, SimOptions, Solver, Trajectory, Workspace, accelerations,
@@ -180,9 +181,20 @@ pub struct SimulateArgs {
     /// Initial rates, comma-separated (default 0).
     #[arg(long, allow_hyphen_values = true)]
     pub qd0: Option<String>,
+    /// Initial state: `rest` (q0 as given, at rest) or `static` (the
+    /// equilibrium at t = 0 under the loads and inputs, found from q0).
+    #[arg(long, value_enum)]
+    pub start: Option<StartArg>,
     /// Output directory (default out/<model name>).
     #[arg(long)]
     pub out: Option<PathBuf>,
+}
+
+/// `--start`: how a simulation starts (the model's `[simulate] start`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum StartArg {
+    Rest,
+    Static,
 }
 
 /// Write `content` to `path` through a temporary file, so that a failed run
@@ -222,10 +234,27 @@ fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
 }
 
 pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
-    let loaded = load(&a.model)?;
+    let mut loaded = load(&a.model)?;
+    let n = loaded.arm.dof();
+    let coords = loaded.arm.info().coordinates.clone();
+    let mut q0 = optional_vector("--q0", &a.q0, n, &coords)?;
+    let start = match a.start {
+        Some(StartArg::Rest) => Start::Rest,
+        Some(StartArg::Static) => Start::Static,
+        None => loaded.model.simulate.start.unwrap_or(Start::Rest),
+    };
+    if start == Start::Static {
+        // At rest in equilibrium under the loads and inputs at t = 0.
+        q0 = runtime::solve_static(&mut *loaded.arm, &q0, &runtime::StaticOptions::default())
+            .map_err(|e| {
+                anyhow::anyhow!(
+                    "{}: --start static: no equilibrium at t = 0: {e}; start from --start rest instead",
+                    loaded.origin
+                )
+            })?
+            .q;
+    }
     let arm = &*loaded.arm;
-    let n = arm.dof();
-    let coords = arm.info().coordinates.clone();
     // The command line, else the model's [simulate], else the defaults.
     let file = &loaded.model.simulate;
     let t_end = a.t_end.or(file.t_end).unwrap_or(5.0);
@@ -248,7 +277,6 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     if a.max_steps == 0 {
         bail!("--max-steps must be at least 1");
     }
-    let q0 = optional_vector("--q0", &a.q0, n, &coords)?;
     let qd0 = optional_vector("--qd0", &a.qd0, n, &coords)?;
     let solver = Solver::parse(&solver_name).expect("clap and validation checked the name");
     let output_dt = a.output_dt.unwrap_or(t_end / 500.0);

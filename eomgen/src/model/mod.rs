@@ -10,7 +10,8 @@ mod validate;
 pub use error::ModelError;
 pub use load::{Override, load_model, parse_model};
 pub use schema::{
-    Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, Tendon, Tip, WrenchFrame,
+    Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, Start, Tendon, Tip,
+    WrenchFrame,
 };
 pub use signals::{Compare, Input, Offset};
 pub use structure::{

@@ -48,6 +48,18 @@ pub struct SimulateDefaults {
     pub atol: Option<f64>,
     /// Step of the fixed-step solvers (s).
     pub dt: Option<f64>,
+    /// Initial state: "rest" (default) or "static" (the equilibrium at t = 0).
+    pub start: Option<Start>,
+}
+
+/// How a simulation starts.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Start {
+    /// At q0 (default straight), at rest.
+    Rest,
+    /// At rest in the static equilibrium at t = 0, found from q0.
+    Static,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -169,6 +181,10 @@ pub struct Segment {
     /// 3D: whether elements stretch (structural; default false).
     #[serde(default)]
     pub extension: Option<bool>,
+    /// 3D, pcc/vc/ebr with `extension`: the material keeps its volume, so a
+    /// stretch lambda thins the section (structural; default false).
+    #[serde(default)]
+    pub incompressible: Option<bool>,
     /// Shear modulus G (Pa) for the torsional stiffness G J; default E / 3
     /// (incompressible).
     #[serde(default)]

@@ -25,6 +25,10 @@ pub struct SegmentShape {
     /// segments (empty for other methods and in 2D).
     pub twist: bool,
     pub extension: bool,
+    /// Stretching thins the section at constant volume (pcc, vc, ebr with
+    /// extension): bending and twist stiffness scale by lambda^-3, fibre
+    /// offsets by lambda^-1/2.
+    pub incompressible: bool,
     pub axes: Vec<Axis>,
     /// rom: the polynomial degree (0 otherwise).
     pub order: usize,
@@ -98,6 +102,7 @@ impl Structure {
                     extension: spatial
                         && (s.method == Method::Eba
                             || (s.method != Method::Rigid && s.stretches())),
+                    incompressible: spatial && s.incompressible.unwrap_or(false),
                     axes: if spatial && s.method == Method::Rigid {
                         s.axes()
                     } else {
@@ -150,6 +155,9 @@ impl Structure {
                     " twist {} extension {} axes {:?}",
                     g.twist, g.extension, g.axes
                 ));
+                if g.incompressible {
+                    s.push_str(" incompressible");
+                }
             }
             if g.method == Method::Rom {
                 s.push_str(&format!(" order {}", g.order));

@@ -212,6 +212,7 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
                 ("torsional_stiffness", s.torsional_stiffness.is_some()),
                 ("axial_stiffness", s.axial_stiffness.is_some()),
                 ("axial_damping", s.axial_damping.is_some()),
+                ("incompressible", s.incompressible.is_some()),
             ] {
                 if given {
                     return err(
@@ -239,6 +240,16 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
                 return err(
                     p("torsional_stiffness"),
                     "missing: twisting elements need `torsional_stiffness` (G J), or `youngs_modulus` with the section (G = E/3 unless `shear_modulus` is given)".into(),
+                );
+            }
+            // Rigid links do not stretch: there it has nothing to act on.
+            if s.incompressible == Some(true)
+                && !matches!(s.method, Method::Rigid | Method::Eba | Method::Cosserat)
+                && !s.stretches()
+            {
+                return err(
+                    p("incompressible"),
+                    "acts on stretching elements: set `extension = true` too".into(),
                 );
             }
             if s.method != Method::Rigid && s.stretches() && s.ea().is_none() {

@@ -165,14 +165,6 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
             cas.bind(h)
         });
         let pairs = coords.rate_pairs();
-        let v_d = cas.time_derivatives(&v, &pairs);
-        for (i, (&x, &xd)) in v.iter().zip(&v_d).enumerate() {
-            let (kk, dd) = if i == 0 { (kt, dt) } else { (kb, db) };
-            let kk = cas.scaled(span, kk);
-            let dd = cas.scaled(span, dd);
-            elastic.push(half_k_sq(cas, kk, x));
-            rayleigh.push(half_k_sq(cas, dd, xd));
-        }
         let end_a = prev.end(cas, 1.0);
         let start_b = slab.end(cas, -1.0);
         let gap: V3 = std::array::from_fn(|i| cas.sub(start_b[i], end_a[i]));
@@ -182,13 +174,37 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
             let e = cas.dot(&col, &gap);
             cas.bind(e)
         });
+        // Incompressible: a stretch lambda = (l + gap) / l thins the section
+        // (as in spatial::spatial_system).
+        let thinning = structure.segments[segment].incompressible.then(|| {
+            let len = cas.add(l, local[0]);
+            let inv = cas.powi(len, -1);
+            let ratio = cas.mul(l, inv);
+            let ratio = cas.bind(ratio);
+            let soft = cas.powi(ratio, 3);
+            let off = cas.sqrt(ratio);
+            (cas.bind(soft), cas.bind(off))
+        });
         // The joint's lumped strain: the gap along the previous axis and
         // the relative rotation measure.
         strains.push(Strain {
             segment,
             stretch: local[0],
             rho: v,
+            offset_scale: thinning.map(|t| t.1),
         });
+        let v_d = cas.time_derivatives(&v, &pairs);
+        for (i, (&x, &xd)) in v.iter().zip(&v_d).enumerate() {
+            let (kk, dd) = if i == 0 { (kt, dt) } else { (kb, db) };
+            let kk = cas.scaled(span, kk);
+            let kk = match thinning {
+                Some((soft, _)) => cas.mul(kk, soft),
+                None => kk,
+            };
+            let dd = cas.scaled(span, dd);
+            elastic.push(half_k_sq(cas, kk, x));
+            rayleigh.push(half_k_sq(cas, dd, xd));
+        }
         let local_d = cas.time_derivatives(&local[..1], &pairs);
         elastic.push(half_k_sq(cas, ka, local[0]));
         rayleigh.push(half_k_sq(cas, da, local_d[0]));

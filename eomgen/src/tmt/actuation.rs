@@ -8,7 +8,8 @@
 //! dL = stretch + rho_y z - rho_z y,
 //!
 //! exact for a constant-curvature arc without twist, to first order
-//! otherwise. A chamber at pressure p does virtual work p a dL (it pushes its
+//! otherwise (with offsets scaled by lambda^-1/2 when a stretched
+//! incompressible element has thinned). A chamber at pressure p does virtual work p a dL (it pushes its
 //! ends apart: an axial force p a and a moment p a r about the axis normal
 //! to its direction); a tendon at tension T does -T dL, and only pulls
 //! (T is clamped at 0). Both enter as a potential V_a(q) = -W(q), so that
@@ -28,6 +29,9 @@ pub struct Strain {
     /// Rotation vector across it in its base frame (twist, bend about y,
     /// bend about z), rad.
     pub rho: [ExprId; 3],
+    /// Fibre offsets scale by this (lambda^-1/2 in a stretched
+    /// incompressible element); None for 1.
+    pub offset_scale: Option<ExprId>,
 }
 
 /// V_a(q) of the structure's chambers and tendons; zero without them.
@@ -45,9 +49,13 @@ pub fn actuation(
     // Per segment: total stretch and total bend about y and z.
     let mut sums = vec![[Vec::new(), Vec::new(), Vec::new()]; n];
     for s in strains {
+        let (by, bz) = match s.offset_scale {
+            Some(k) => (cas.mul(s.rho[1], k), cas.mul(s.rho[2], k)),
+            None => (s.rho[1], s.rho[2]),
+        };
         sums[s.segment][0].push(s.stretch);
-        sums[s.segment][1].push(s.rho[1]);
-        sums[s.segment][2].push(s.rho[2]);
+        sums[s.segment][1].push(by);
+        sums[s.segment][2].push(bz);
     }
     let totals: Vec<[ExprId; 3]> = sums
         .iter()

@@ -69,6 +69,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
                 segment: s,
                 stretch: zero,
                 rho: [zero, zero, q],
+                offset_scale: None,
             });
             let l = param(&format!("element[{k}].length"));
             let m = param(&format!("element[{k}].mass"));

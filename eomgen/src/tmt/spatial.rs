@@ -339,6 +339,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                 slices: g.elements,
                 twist: g.twist,
                 extension: g.extension,
+                incompressible: g.incompressible,
             };
             c += r.coordinates();
             let [e, d] = r.energies(cas, &coords, &param, k);
@@ -390,6 +391,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                         segment: s,
                         stretch: zero,
                         rho,
+                        offset_scale: None,
                     });
                     f
                 };
@@ -415,12 +417,32 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                 }
             } else if let Some(rom) = &rom {
                 let (rho, rate, st) = rom.slice(cas, &coords, e, l);
+                let len = cas.add(l, st);
+                // Incompressible: bending and twist energy slice by slice
+                // with the slice's thinning (Rom::energies leaves them out).
+                let thinning = rom.incompressible.then(|| {
+                    let inv = cas.powi(len, -1);
+                    let ratio = cas.mul(l, inv);
+                    let ratio = cas.bind(ratio);
+                    let soft = cas.powi(ratio, 3);
+                    let off = cas.sqrt(ratio);
+                    let (soft, off) = (cas.bind(soft), cas.bind(off));
+                    let kb = param(&format!("joint[{k}].stiffness"));
+                    let kt = param(&format!("twist[{k}].stiffness"));
+                    let rest = param(&format!("joint[{k}].rest"));
+                    let bz = cas.sub(rho[2], rest);
+                    for (kk, x) in [(kb, rho[1]), (kb, bz), (kt, rho[0])] {
+                        let kk = cas.mul(kk, soft);
+                        elastic.push(half_k_sq(cas, kk, x));
+                    }
+                    off
+                });
                 strains.push(Strain {
                     segment: s,
                     stretch: st,
                     rho,
+                    offset_scale: thinning,
                 });
-                let len = cas.add(l, st);
                 let (centroid, axis, omega, end) = arc(cas, &f, &rho, &rate, len);
                 let centroid = bind3(cas, centroid);
                 bodies.push(body(axis, centroid, omega, m));
@@ -442,13 +464,31 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                 };
                 let rho = [tw, by, bz];
                 let rate = [tw_d, by_d, bz_d];
+                let len = cas.add(l, st);
+                // Incompressible: a stretch lambda = len / l thins the
+                // section, I by lambda^-2 over a length lambda l: bending
+                // and twist stiffness per angle by lambda^-3, offsets in the
+                // section by lambda^-1/2.
+                let thinning = g.incompressible.then(|| {
+                    let inv = cas.powi(len, -1);
+                    let ratio = cas.mul(l, inv);
+                    let ratio = cas.bind(ratio);
+                    let soft = cas.powi(ratio, 3);
+                    let off = cas.sqrt(ratio);
+                    (cas.bind(soft), cas.bind(off))
+                });
                 strains.push(Strain {
                     segment: s,
                     stretch: st,
                     rho,
+                    offset_scale: thinning.map(|t| t.1),
                 });
-                let len = cas.add(l, st);
+                let soften = |cas: &mut Cas, k: ExprId| match thinning {
+                    Some((soft, _)) => cas.mul(k, soft),
+                    None => k,
+                };
                 let kb = param(&format!("joint[{k}].stiffness"));
+                let kb = soften(cas, kb);
                 let db = param(&format!("joint[{k}].damping"));
                 let rest = param(&format!("joint[{k}].rest"));
                 let bz_rel = cas.sub(bz, rest);
@@ -458,6 +498,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                 rayleigh.push(half_k_sq(cas, db, bz_d));
                 if g.twist {
                     let kt = param(&format!("twist[{k}].stiffness"));
+                    let kt = soften(cas, kt);
                     let dt = param(&format!("twist[{k}].damping"));
                     elastic.push(half_k_sq(cas, kt, tw));
                     rayleigh.push(half_k_sq(cas, dt, tw_d));
@@ -563,6 +604,8 @@ struct Rom {
     slices: usize,
     twist: bool,
     extension: bool,
+    /// Bending and twist energy by slices (see `spatial_system`), not here.
+    incompressible: bool,
 }
 
 impl Rom {
@@ -661,6 +704,20 @@ impl Rom {
         let (mut elastic, mut rayleigh) = (Vec::new(), Vec::new());
         for f in 0..fields {
             let stretch = self.extension && f == fields - 1;
+            if self.incompressible && !stretch {
+                // Only the elastic part moves to the slices; damping stays.
+                let ds = param(&format!(
+                    "{}[{k}].damping",
+                    if f < 2 { "joint" } else { "twist" }
+                ));
+                let xd: Vec<ExprId> = (0..=self.order)
+                    .map(|i| coords.qd[self.index(f, i)])
+                    .collect();
+                let d = quad(cas, &xd);
+                let scale = cas.constant(1.0 / n);
+                rayleigh.push(cas.mul_all(&[ds, scale, d]));
+                continue;
+            }
             let (stiff, damp) = match f {
                 _ if stretch => ("stretch", "stretch"),
                 0 | 1 => ("joint", "joint"),
