@@ -1,0 +1,303 @@
+//! Actuators and measured inputs against closed forms: a pressurised
+//! chamber and a pulled tendon bend a one-element arm into the arc of
+//! curvature M / (E I) away from (towards) them, a slack tendon pulls
+//! nothing, inputs drive parameters exactly as constants do, the measured
+//! tip transform removes a turning sensor offset, and the STIFF-FLOP run
+//! beats TMTDyn's best published tip error.
+
+mod common;
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+use common::*;
+use eomgen::model::{Compare, Override};
+use runtime::{StaticOptions, solve_static};
+use softarm::backend::{BackendChoice, load};
+use softarm::compare::{measured, tip_error};
+
+const L: f64 = 0.1;
+const E: f64 = 1e6;
+const R: f64 = 0.01;
+
+fn arm(body: &str) -> String {
+    format!(
+        r#"
+name = "actuated"
+dimensions = 3
+gravity = [0.0, 0.0, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+{body}
+"#
+    )
+}
+
+fn segment(length: f64, extra: &str) -> String {
+    format!(
+        r#"
+[[segment]]
+method = "pcc"
+length = {length}
+elements = 1
+density = 1000.0
+outer_radius = {R}
+youngs_modulus = {E}
+{extra}
+"#
+    )
+}
+
+/// Static tip and coordinates of a model file written to `dir`.
+fn static_tip(dir: &Path, text: &str, sets: &[&str]) -> ([f64; 3], Vec<f64>) {
+    let path = dir.join("actuated.toml");
+    std::fs::write(&path, text).unwrap();
+    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    let mut l = load(
+        path.to_str().unwrap(),
+        &overrides,
+        BackendChoice::Auto,
+        Some(dir.join("cache")),
+    )
+    .unwrap();
+    let n = l.arm.dof();
+    let sol = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
+    let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
+    ([o[0], o[1], o[2]], sol.q)
+}
+
+/// The tip of an arc of length `len` along +x turned by `theta` about the
+/// unit axis `n` (normal to x): (len / theta) (sin theta x + (1 - cos theta) n x x).
+fn arc(len: f64, theta: f64, n: [f64; 3]) -> [f64; 3] {
+    let nx = [0.0, n[2], -n[1]]; // n x e_x
+    let (a, b) = (len * theta.sin() / theta, len * (1.0 - theta.cos()) / theta);
+    [a + b * nx[0], b * nx[1], b * nx[2]]
+}
+
+fn assert_tip(got: [f64; 3], want: [f64; 3], what: &str) {
+    for k in 0..3 {
+        assert_close(got[k], want[k], 1e-9, L, &format!("{what}, component {k}"));
+    }
+}
+
+#[test]
+fn one_pressurised_chamber_bends_the_arm_away_from_it_with_curvature_m_over_ei() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rc, d, p) = (0.002, 0.006, 2.0e5);
+    // Three holes (an isotropic section), only the first pressurised, at a
+    // skew angle.
+    let alpha: f64 = 35.0;
+    let text = arm(&(segment(L, "twist = false")
+        + &format!(
+            r#"
+[segment.chambers]
+angles = [{alpha}, {}, {}]
+radius = {rc}
+distance = {d}
+inputs = ["p", "none", "none"]
+[inputs.p]
+kind = "constant"
+value = {p}
+[inputs.none]
+kind = "constant"
+value = 0.0
+"#,
+            alpha + 120.0,
+            alpha + 240.0
+        )));
+    let (tip, _) = static_tip(dir.path(), &text, &[]);
+    // Closed form: M = p a r about the section axis normal to the chamber,
+    // I of the section with its three holes.
+    let a = PI * rc * rc;
+    let i = PI * R.powi(4) / 4.0 - 3.0 * (a * rc * rc / 4.0 + a * d * d / 2.0);
+    let theta = p * a * d * L / (E * i);
+    let al = alpha.to_radians();
+    // Chamber direction (0, cos, sin): the bend turns x away from it.
+    let n = [0.0, al.sin(), -al.cos()];
+    assert_tip(tip, arc(L, theta, n), "pressurised chamber");
+    let lateral = tip[1] * al.cos() + tip[2] * al.sin();
+    assert!(lateral < 0.0, "bends away from the chamber: {lateral}");
+}
+
+#[test]
+fn a_pulled_tendon_bends_its_segments_towards_it_and_a_slack_one_pulls_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let (dist, beta, t) = (0.008, 200.0f64, 2.0);
+    // Two segments; the tendon ends at the first one's end.
+    let text = arm(&(segment(L, "twist = false")
+        + &segment(L, "twist = false")
+        + &format!(
+            r#"
+[[tendon]]
+input = "t"
+distance = {dist}
+angle = {beta}
+end = 0
+[inputs.t]
+kind = "constant"
+value = {t}
+"#
+        )));
+    let (tip, q) = static_tip(dir.path(), &text, &[]);
+    let i = PI * R.powi(4) / 4.0;
+    let theta = t * dist * L / (E * i);
+    let b = beta.to_radians();
+    let n = [0.0, -b.sin(), b.cos()];
+    // Segment 0 is the arc; segment 1 stays straight along its end tangent.
+    let first = arc(L, theta, n);
+    let nx = [0.0, n[2], -n[1]];
+    let tangent = [theta.cos(), theta.sin() * nx[1], theta.sin() * nx[2]];
+    let want: [f64; 3] = std::array::from_fn(|k| first[k] + L * tangent[k]);
+    assert_tip(tip, want, "tendon over segment 0");
+    assert!(
+        q[2].abs() < 1e-12 && q[3].abs() < 1e-12,
+        "segment 1 unbent: {q:?}"
+    );
+    let towards = tip[1] * b.cos() + tip[2] * b.sin();
+    assert!(towards > 0.0, "bends towards the tendon: {towards}");
+    // A negative command is a slack tendon: the arm stays straight.
+    let (tip, q) = static_tip(dir.path(), &text, &["inputs.t.value=-2.0"]);
+    assert!(
+        q.iter().all(|v| v.abs() < 1e-14),
+        "slack tendon pushed: {q:?}"
+    );
+    assert_tip(tip, [2.0 * L, 0.0, 0.0], "slack tendon");
+}
+
+#[test]
+fn tip_loads_driven_by_inputs_act_as_the_same_constant_loads() {
+    let dir = tempfile::tempdir().unwrap();
+    let constant =
+        arm(&(segment(L, "") + "[tip]\nforce = [0.0, 0.02, -0.01]\nmoment = [0.0, 0.0, 0.0005]\n"));
+    let driven = arm(&(segment(L, "")
+        + r#"
+[tip]
+force_inputs = ["fx", "fy", "fz"]
+moment_inputs = ["mx", "my", "mz"]
+[inputs.fx]
+kind = "constant"
+value = 0.0
+[inputs.fy]
+kind = "step"
+before = 0.0
+after = 0.02
+time = -1.0
+[inputs.fz]
+kind = "ramp"
+from = 0.0
+to = -0.02
+start = -1.0
+end = 1.0
+[inputs.mx]
+kind = "constant"
+value = 0.0
+[inputs.my]
+kind = "constant"
+value = 0.0
+[inputs.mz]
+kind = "sine"
+amplitude = 0.0005
+frequency = 0.25
+start = -1.0
+"#));
+    // At t = 0 the step is on, the ramp half way (-0.01) and the sine at
+    // its crest (a quarter period after its start).
+    let (a, qa) = static_tip(dir.path(), &constant, &[]);
+    let (b, qb) = static_tip(dir.path(), &driven, &[]);
+    for (x, y) in qa.iter().zip(&qb) {
+        assert_close(*x, *y, 1e-10, 1e-9, "coordinates");
+    }
+    assert_tip(a, b, "driven vs constant");
+}
+
+fn quat_z(phi: f64, q0: [f64; 4]) -> [f64; 4] {
+    // qz(phi) (x) q0
+    let (c, s) = ((phi / 2.0).cos(), (phi / 2.0).sin());
+    let [w, x, y, z] = q0;
+    [c * w - s * z, c * x - s * y, c * y + s * x, c * z + s * w]
+}
+
+#[test]
+fn measured_tip_transform_removes_a_turning_sensor_offset() {
+    let dir = tempfile::tempdir().unwrap();
+    // The tip point moves along +y by 2 mm/s while the tip turns about z
+    // by 0.5 rad/s; the marker sits s = 10 mm along the initial x, turning
+    // with the tip; the base marker is at (5, 6, 7) mm.
+    let q0 = {
+        let v: [f64; 4] = [0.3, -0.5, 0.7, 0.2];
+        let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        v.map(|x| x / n)
+    };
+    let mut csv = String::from("time,X,Y,Z,X1,Y1,Z1,QW,QX,QY,QZ\n");
+    for i in 0..=20 {
+        let t = 0.1 * i as f64;
+        let phi = 0.5 * t;
+        let p = [1.0, 2.0 + 2.0 * t, 40.0];
+        let m = [
+            5.0 + p[0] + 10.0 * phi.cos(),
+            6.0 + p[1] + 10.0 * phi.sin(),
+            7.0 + p[2],
+        ];
+        let q = quat_z(phi, q0);
+        csv.push_str(&format!(
+            "{t},5,6,7,{},{},{},{},{},{},{}\n",
+            m[0], m[1], m[2], q[0], q[1], q[2], q[3]
+        ));
+    }
+    std::fs::write(dir.path().join("m.csv"), csv).unwrap();
+    let spec: Compare = toml::from_str(
+        r#"
+file = "m.csv"
+position = ["X1", "Y1", "Z1"]
+reference = ["X", "Y", "Z"]
+scale = 1.0e-3
+orientation = ["QW", "QX", "QY", "QZ"]
+sensor_offset = [0.010, 0.0, 0.0]
+"#,
+    )
+    .unwrap();
+    let initial = [0.0, 0.0, 0.05];
+    let m = measured(&spec, dir.path(), |_| initial).unwrap();
+    for (t, p) in m.t.iter().zip(&m.tip) {
+        let want = [0.0, 0.002 * t, 0.05];
+        for k in 0..3 {
+            assert_close(
+                p[k],
+                want[k],
+                1e-12,
+                1e-3,
+                &format!("t = {t}, component {k}"),
+            );
+        }
+    }
+    // The error statistics of a constant offset are that offset.
+    let e = tip_error(&m, [0.5, 1.5], 0.1, |t| {
+        let p = m.tip[m.t.iter().position(|x| (x - t).abs() < 1e-12).unwrap()];
+        Some([p[0] + 0.003, p[1] - 0.004, p[2]])
+    })
+    .unwrap();
+    assert_eq!(e.samples, 11);
+    for v in [e.mean_m, e.rms_m, e.max_m] {
+        assert_close(v, 0.005, 1e-12, 0.0, "constant 5 mm offset");
+    }
+    assert_close(e.mean_percent_length, 5.0, 1e-12, 0.0, "percent of 0.1 m");
+}
+
+#[test]
+fn stiff_flop_from_its_recorded_pressures_beats_tmtdyns_best_tip_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = softarm(
+        &["simulate", "stiff_flop", "--out", out.to_str().unwrap()],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let e = &s["tip_error"];
+    assert_eq!(e["window_s"][0].as_f64(), Some(7.0));
+    let mean = e["mean_m"].as_f64().unwrap();
+    // TMTDyn's best on this data set: 2.57 mm (series rigid links).
+    assert!(mean < 2.57e-3, "mean tip error {mean} m");
+    assert!(out.join("tip.png").exists() && out.join("tip.svg").exists());
+}
