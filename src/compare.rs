@@ -234,24 +234,47 @@ pub fn plot(
         root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
         Ok(())
     }
-    let size = (1000, 900);
+    let size = (1000u32, 900u32);
     let png = stem.with_extension("png");
     let svg = stem.with_extension("svg");
+    // Drawn into a buffer and encoded by the `png` crate: plotters' own
+    // encoder would pull in the whole `image` crate.
+    let mut rgb = vec![255u8; 3 * (size.0 * size.1) as usize];
     draw(
-        BitMapBackend::new(&png, size).into_drawing_area(),
+        BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area(),
         title,
         simulated,
         measured,
-    )
-    .with_context(|| format!("cannot write {}", png.display()))?;
+    )?;
+    write_png(&png, size, &rgb)?;
+    let mut text = String::new();
     draw(
-        SVGBackend::new(&svg, size).into_drawing_area(),
+        SVGBackend::with_string(&mut text, size).into_drawing_area(),
         title,
         simulated,
         measured,
-    )
-    .with_context(|| format!("cannot write {}", svg.display()))?;
-    Ok(())
+    )?;
+    write_atomic(&svg, text.as_bytes())
+}
+
+/// Write through a temporary file, so that a failure leaves nothing
+/// half-written.
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = path.with_extension("tmp");
+    std::fs::write(&tmp, bytes).with_context(|| format!("cannot write {}", tmp.display()))?;
+    std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Encode 8-bit RGB pixels as a PNG file.
+fn write_png(path: &Path, size: (u32, u32), rgb: &[u8]) -> Result<()> {
+    let mut bytes = Vec::new();
+    let mut enc = png::Encoder::new(&mut bytes, size.0, size.1);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut w = enc.write_header()?;
+    w.write_image_data(rgb)?;
+    w.finish()?;
+    write_atomic(path, &bytes)
 }
 
 /// The bundled font (DejaVu Sans Mono, assets/fonts): plots need no system
