@@ -357,21 +357,24 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
                 .unwrap_or([m.t[0], *m.t.last().expect("a CSV has rows")]);
             let length = loaded.model.segments.iter().map(|s| s.length).sum::<f64>()
                 + loaded.model.tip.length.unwrap_or(0.0);
+            // A run that ends before the window has no statistics, but
+            // still its plot.
             let err = compare::tip_error(m, window, length, |t| {
                 tips.iter().find(|s| (s.0 - t).abs() < 1e-9).map(|s| s.1)
-            })?;
-            compare::plot(
-                &out_dir.join("tip"),
-                &format!(
+            })
+            .map_err(|e| eprintln!("warning: no tip error: {e}"))
+            .ok();
+            let title = match &err {
+                Some(e) => format!(
                     "{}: mean tip error {:.2} mm ({:.2} % of length)",
                     loaded.model.name,
-                    1e3 * err.mean_m,
-                    err.mean_percent_length
+                    1e3 * e.mean_m,
+                    e.mean_percent_length
                 ),
-                &tips,
-                m,
-            )?;
-            Some(err)
+                None => format!("{}: simulated and measured tip", loaded.model.name),
+            };
+            compare::plot(&out_dir.join("tip"), &title, &tips, m)?;
+            err
         }
         _ => None,
     };
