@@ -22,7 +22,7 @@
 use crate::cas::{Cas, ExprId};
 use crate::model::{Model, Structure};
 
-use super::actuation::{Strain, actuation};
+use super::actuation::{Strain, actuation, thinning};
 use super::spatial::{
     M3, V3, bind3, coefficients, half_k_sq, left_jacobian, mat_vec, quat_mul, rotation,
     rotation_quat,
@@ -176,14 +176,9 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
         });
         // Incompressible: a stretch lambda = (l + gap) / l thins the section
         // (as in spatial::spatial_system).
-        let thinning = structure.segments[segment].incompressible.then(|| {
+        let thin = structure.segments[segment].incompressible.then(|| {
             let len = cas.add(l, local[0]);
-            let inv = cas.powi(len, -1);
-            let ratio = cas.mul(l, inv);
-            let ratio = cas.bind(ratio);
-            let soft = cas.powi(ratio, 3);
-            let off = cas.sqrt(ratio);
-            (cas.bind(soft), cas.bind(off))
+            thinning(cas, l, len)
         });
         // The joint's lumped strain: the gap along the previous axis and
         // the relative rotation measure.
@@ -191,13 +186,13 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
             segment,
             stretch: local[0],
             rho: v,
-            offset_scale: thinning.map(|t| t.1),
+            offset_scale: thin.map(|t| t.1),
         });
         let v_d = cas.time_derivatives(&v, &pairs);
         for (i, (&x, &xd)) in v.iter().zip(&v_d).enumerate() {
             let (kk, dd) = if i == 0 { (kt, dt) } else { (kb, db) };
             let kk = cas.scaled(span, kk);
-            let kk = match thinning {
+            let kk = match thin {
                 Some((soft, _)) => cas.mul(kk, soft),
                 None => kk,
             };

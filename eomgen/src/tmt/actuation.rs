@@ -34,6 +34,19 @@ pub struct Strain {
     pub offset_scale: Option<ExprId>,
 }
 
+/// An incompressible element stretched to `len` from rest length `l`
+/// (lambda = len / l): the factor lambda^-3 of its bending and twist
+/// stiffness per angle (I by lambda^-2 over a length lambda l) and the
+/// factor lambda^-1/2 of offsets in its section, both bound.
+pub fn thinning(cas: &mut Cas, l: ExprId, len: ExprId) -> (ExprId, ExprId) {
+    let inv = cas.powi(len, -1);
+    let ratio = cas.mul(l, inv);
+    let ratio = cas.bind(ratio);
+    let soft = cas.powi(ratio, 3);
+    let off = cas.sqrt(ratio);
+    (cas.bind(soft), cas.bind(off))
+}
+
 /// V_a(q) of the structure's chambers and tendons; zero without them.
 pub fn actuation(
     cas: &mut Cas,

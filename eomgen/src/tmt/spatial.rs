@@ -24,7 +24,7 @@
 use crate::cas::{Cas, ExprId, Func};
 use crate::model::{Joints, Method, Model, Structure};
 
-use super::actuation::{Strain, actuation};
+use super::actuation::{Strain, actuation, thinning};
 use super::system::{
     Body, Chain, Coordinates, Inertia, Link, ParamSymbols, System, TipMount, tip_loads,
 };
@@ -420,13 +420,8 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                 let len = cas.add(l, st);
                 // Incompressible: bending and twist energy slice by slice
                 // with the slice's thinning (Rom::energies leaves them out).
-                let thinning = rom.incompressible.then(|| {
-                    let inv = cas.powi(len, -1);
-                    let ratio = cas.mul(l, inv);
-                    let ratio = cas.bind(ratio);
-                    let soft = cas.powi(ratio, 3);
-                    let off = cas.sqrt(ratio);
-                    let (soft, off) = (cas.bind(soft), cas.bind(off));
+                let thin = rom.incompressible.then(|| {
+                    let (soft, off) = thinning(cas, l, len);
                     let kb = param(&format!("joint[{k}].stiffness"));
                     let kt = param(&format!("twist[{k}].stiffness"));
                     let rest = param(&format!("joint[{k}].rest"));
@@ -441,7 +436,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                     segment: s,
                     stretch: st,
                     rho,
-                    offset_scale: thinning,
+                    offset_scale: thin,
                 });
                 let (centroid, axis, omega, end) = arc(cas, &f, &rho, &rate, len);
                 let centroid = bind3(cas, centroid);
@@ -465,25 +460,15 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                 let rho = [tw, by, bz];
                 let rate = [tw_d, by_d, bz_d];
                 let len = cas.add(l, st);
-                // Incompressible: a stretch lambda = len / l thins the
-                // section, I by lambda^-2 over a length lambda l: bending
-                // and twist stiffness per angle by lambda^-3, offsets in the
-                // section by lambda^-1/2.
-                let thinning = g.incompressible.then(|| {
-                    let inv = cas.powi(len, -1);
-                    let ratio = cas.mul(l, inv);
-                    let ratio = cas.bind(ratio);
-                    let soft = cas.powi(ratio, 3);
-                    let off = cas.sqrt(ratio);
-                    (cas.bind(soft), cas.bind(off))
-                });
+                // Incompressible: the stretch thins the section.
+                let thin = g.incompressible.then(|| thinning(cas, l, len));
                 strains.push(Strain {
                     segment: s,
                     stretch: st,
                     rho,
-                    offset_scale: thinning.map(|t| t.1),
+                    offset_scale: thin.map(|t| t.1),
                 });
-                let soften = |cas: &mut Cas, k: ExprId| match thinning {
+                let soften = |cas: &mut Cas, k: ExprId| match thin {
                     Some((soft, _)) => cas.mul(k, soft),
                     None => k,
                 };
