@@ -301,3 +301,46 @@ fn stiff_flop_from_its_recorded_pressures_beats_tmtdyns_best_tip_error() {
     assert!(mean < 2.57e-3, "mean tip error {mean} m");
     assert!(out.join("tip.png").exists() && out.join("tip.svg").exists());
 }
+
+#[test]
+fn stiff_flop_takes_a_measured_tip_wrench_by_swapping_in_a_data_file() {
+    // A load cell record (tip frame) of 0.5 N along the tip axis: the
+    // straight arm hanging under gravity stretches by a further F L / (E A).
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("loads.csv");
+    std::fs::write(
+        &csv,
+        "time,Fx,Fy,Fz,Mx,My,Mz\n0,0.5,0,0,0,0,0\n1,0.5,0,0,0,0,0\n",
+    )
+    .unwrap();
+    let tip_z = |sets: &[String]| {
+        let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+        let mut l = load(
+            "stiff_flop",
+            &overrides,
+            BackendChoice::Auto,
+            Some(dir.path().join("cache")),
+        )
+        .unwrap();
+        assert_eq!(
+            l.arm.backend(),
+            "compiled",
+            "an input swap needs no rebuild"
+        );
+        let n = l.arm.dof();
+        let sol = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
+        l.arm.outputs(0.0, &sol.q, &vec![0.0; n])
+    };
+    let free = tip_z(&[]);
+    let loaded = tip_z(&[format!(
+        "inputs.fx={{kind = \"csv\", file = \"{}\", column = \"Fx\"}}",
+        csv.display()
+    )]);
+    let (ro, ri, rc) = (0.0125f64, 0.0045f64, 0.0025f64);
+    let ea = 1.2e5 * PI * (ro * ro - ri * ri - 6.0 * rc * rc);
+    assert_close(loaded[2] - free[2], 0.5 * 0.044 / ea, 1e-9, 0.0, "stretch");
+    assert!(
+        free[0].abs() < 1e-12 && loaded[1].abs() < 1e-12,
+        "stays straight"
+    );
+}
