@@ -36,8 +36,9 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
             assert_close(*a, *b, 1e-12, 0.0, &format!("{} parameter {k}", m.name));
         }
         let n = compiled.dof();
+        let names = compiled.info().coordinates.clone();
         for it in 0..12 {
-            let mut q = rng.vec(n, -2.0, 2.0);
+            let mut q = rng.coordinates(&names, -2.0, 2.0);
             // The straight configuration, and some angles exactly 0: the
             // removable singularities of pcc segments.
             match it % 3 {
@@ -164,7 +165,7 @@ fn generated_mass_solve_matches_a_dense_solve() {
             continue;
         }
         for _ in 0..10 {
-            let q = rng.vec(n, -2.0, 2.0);
+            let q = rng.coordinates(&arm.info().coordinates, -2.0, 2.0);
             let qd = rng.vec(n, -3.0, 3.0);
             let mut out = vec![0.0; 2 * n];
             arm.eval_kernel(KernelKind::Accel, 0.0, &q, &qd, &mut out);

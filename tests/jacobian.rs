@@ -41,7 +41,8 @@ fn generated_jacobian_matches_central_differences() {
         let n = d.dof();
         let mut ws = Workspace::new(n);
         for it in 0..4 {
-            let mut x = rng.vec(2 * n, -1.0, 1.0);
+            let mut x = rng.coordinates(&d.info().coordinates, -1.0, 1.0);
+            x.extend(rng.vec(n, -1.0, 1.0));
             if it == 0 {
                 x[..n].fill(0.0);
             }

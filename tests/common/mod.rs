@@ -25,6 +25,18 @@ impl Rng {
     pub fn vec(&mut self, n: usize, lo: f64, hi: f64) -> Vec<f64> {
         (0..n).map(|_| self.uniform(lo, hi)).collect()
     }
+    /// Random coordinates in [lo, hi), except stretches (m), which stay in
+    /// [lo, hi) mm: an element stretched past its own length is outside
+    /// any model's range (an incompressible section has no square root).
+    pub fn coordinates(&mut self, names: &[String], lo: f64, hi: f64) -> Vec<f64> {
+        names
+            .iter()
+            .map(|n| {
+                let s = if n.starts_with("stretch") { 1e-3 } else { 1.0 };
+                s * self.uniform(lo, hi)
+            })
+            .collect()
+    }
 }
 
 /// |a - b| <= rel * max(|a|, |b|, floor): relative, with an absolute floor
