@@ -105,5 +105,11 @@ fn interpreted(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, derivation, kernels, interpreted);
+// No plots: criterion draws them with plotters, which this workspace builds
+// with pure-Rust text (ab_glyph) and a font the CLI registers, not criterion.
+criterion_group! {
+    name = benches;
+    config = Criterion::default().without_plots();
+    targets = derivation, kernels, interpreted
+}
 criterion_main!(benches);
