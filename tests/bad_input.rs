@@ -556,3 +556,163 @@ fn malformed_3d_models_are_rejected_clearly() {
         stderr(&out)
     );
 }
+
+#[test]
+fn malformed_actuators_inputs_and_measurements_are_rejected_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("d.csv"), "time,P,X\n0,1,0\n0.1,x,0\n").unwrap();
+    std::fs::write(dir.path().join("back.csv"), "time,P\n0,1\n0.1,2\n0.05,3\n").unwrap();
+    std::fs::write(dir.path().join("ok.csv"), "time,P,X\n0,1,0\n0.1,2,0\n").unwrap();
+    let chambers = "[segment.chambers]\nangles = [0, 120, 240]\nradius = 0.002\ndistance = 0.006\ninputs = [\"p\", \"p\", \"p\"]\n";
+    let channel = "[inputs.p]\nkind = \"constant\"\nvalue = 1.0\n";
+    let base = format!("{GOOD3}{chambers}{channel}");
+    let r = |a: &str, b: &str| base.replacen(a, b, 1);
+    let cases: Vec<(&str, String, Vec<&str>)> = vec![
+        (
+            "anisotropic holes",
+            r("angles = [0, 120, 240]", "angles = [0, 90, 240]"),
+            vec!["segment[0].chambers", "anisotropic"],
+        ),
+        (
+            "count and angles",
+            r(
+                "angles = [0, 120, 240]",
+                "count = 3\nangles = [0, 120, 240]",
+            ),
+            vec!["segment[0].chambers.angles", "not both"],
+        ),
+        (
+            "inputs per position",
+            r("inputs = [\"p\", \"p\", \"p\"]", "inputs = [\"p\"]"),
+            vec![
+                "segment[0].chambers.inputs",
+                "one input channel per position",
+            ],
+        ),
+        (
+            "undeclared channel",
+            r(
+                "inputs = [\"p\", \"p\", \"p\"]",
+                "inputs = [\"p\", \"q\", \"p\"]",
+            ),
+            vec![
+                "segment[0].chambers.inputs[1]",
+                "no input channel \"q\"",
+                "declared: p",
+            ],
+        ),
+        (
+            "pair spacing",
+            r("distance = 0.006", "distance = 0.006\npair_spacing = 95"),
+            vec!["segment[0].chambers.pair_spacing", "between 0 and 90"],
+        ),
+        (
+            "unknown signal kind",
+            r("kind = \"constant\"", "kind = \"square\""),
+            vec!["inputs.p", "unknown variant `square`", "csv"],
+        ),
+        (
+            "ramp backwards",
+            r(
+                "kind = \"constant\"\nvalue = 1.0",
+                "kind = \"ramp\"\nto = 1.0\nstart = 2.0\nend = 1.0",
+            ),
+            vec!["inputs.p.end", "must be after start"],
+        ),
+        (
+            "csv offset word",
+            r(
+                "kind = \"constant\"\nvalue = 1.0",
+                "kind = \"csv\"\nfile = \"d.csv\"\ncolumn = \"P\"\noffset = \"last\"",
+            ),
+            vec!["inputs.p.offset", "\"first\""],
+        ),
+        (
+            "csv missing column",
+            r(
+                "kind = \"constant\"\nvalue = 1.0",
+                "kind = \"csv\"\nfile = \"ok.csv\"\ncolumn = \"Q\"",
+            ),
+            vec!["inputs.p.column", "no column \"Q\"", "time, P, X"],
+        ),
+        (
+            "csv not a number",
+            r(
+                "kind = \"constant\"\nvalue = 1.0",
+                "kind = \"csv\"\nfile = \"d.csv\"\ncolumn = \"P\"",
+            ),
+            vec!["d.csv", "row 3", "`x` is not a number"],
+        ),
+        (
+            "csv time backwards",
+            r(
+                "kind = \"constant\"\nvalue = 1.0",
+                "kind = \"csv\"\nfile = \"back.csv\"\ncolumn = \"P\"",
+            ),
+            vec!["back.csv", "must increase", "row 4"],
+        ),
+        (
+            "csv missing file",
+            r(
+                "kind = \"constant\"\nvalue = 1.0",
+                "kind = \"csv\"\nfile = \"none.csv\"\ncolumn = \"P\"",
+            ),
+            vec!["none.csv", "cannot read"],
+        ),
+        (
+            "tendon past the last segment",
+            format!("{base}[[tendon]]\ninput = \"p\"\ndistance = 0.005\nend = 3\n"),
+            vec!["tendon[0].end", "segment index"],
+        ),
+        (
+            "tendon outside the section",
+            format!("{base}[[tendon]]\ninput = \"p\"\ndistance = 0.05\n"),
+            vec!["tendon[0].distance", "outside"],
+        ),
+        (
+            "compare rotation",
+            format!(
+                "{base}[compare]\nfile = \"d.csv\"\nposition = [\"X\", \"X\", \"X\"]\nrotation = [[1, 0, 0], [0, 1, 0], [0, 0, 2]]\n"
+            ),
+            vec!["compare.rotation", "rotation matrix"],
+        ),
+        (
+            "sensor offset without orientation",
+            format!(
+                "{base}[compare]\nfile = \"d.csv\"\nposition = [\"X\", \"X\", \"X\"]\nsensor_offset = [0.01, 0, 0]\n"
+            ),
+            vec!["compare.sensor_offset", "orientation"],
+        ),
+        (
+            "incompressible without extension",
+            r(
+                "youngs_modulus = 1e6",
+                "youngs_modulus = 1e6\nincompressible = true",
+            ),
+            vec!["segment[0].incompressible", "extension = true"],
+        ),
+        (
+            "tip radius without length",
+            format!("{base}[tip]\nmass = 0.01\nradius = 0.005\n"),
+            vec!["tip.radius", "tip.length"],
+        ),
+    ];
+    for (label, text, expect) in cases {
+        std::fs::write(dir.path().join("m.toml"), &text).unwrap();
+        let out = softarm(&["eom", "m.toml", "--json"], dir.path());
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{label}: accepted");
+        assert!(!err.contains("panicked"), "{label}: panic: {err}");
+        assert!(
+            stdout(&out).is_empty(),
+            "{label}: printed output on failure"
+        );
+        for e in expect {
+            assert!(err.contains(e), "{label}: expected `{e}` in: {err}");
+        }
+    }
+    // The baseline is valid.
+    std::fs::write(dir.path().join("m.toml"), &base).unwrap();
+    let out = softarm(&["eom", "m.toml", "--json"], dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+}
