@@ -8,8 +8,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use eomgen::model::Override;
-use eomgen::model::Start;
+use eomgen::model::{Override, Start};
 use nalgebra::{DMatrix, DVector};
 use runtime::{
     Dynamics, KernelKind, OUTPUT_NAMES, SimOptions, Solver, Trajectory, Workspace, accelerations,
@@ -288,7 +287,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         Some(spec) => {
             let start = arm.outputs(0.0, &q0, &qd0);
             Some(
-                compare::measured(spec, &loaded.base_dir, |_| [start[0], start[1], start[2]])
+                compare::measured(spec, &loaded.base_dir, [start[0], start[1], start[2]])
                     .with_context(|| format!("{}: [compare]", loaded.origin))?,
             )
         }

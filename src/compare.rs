@@ -21,12 +21,8 @@ pub struct Measured {
 /// Read and transform the measured tip motion:
 /// p = rotation (scale (position - reference) - R_c offset - (p_0 - offset)) + initial,
 /// R_c the tip rotation relative to the first sample. `initial` defaults to
-/// `initial_default(t_0)` (the simulated tip at the first sample's time).
-pub fn measured(
-    spec: &Compare,
-    base: &Path,
-    initial_default: impl FnOnce(f64) -> [f64; 3],
-) -> Result<Measured> {
+/// `initial_default` (the caller's simulated tip at the start).
+pub fn measured(spec: &Compare, base: &Path, initial_default: [f64; 3]) -> Result<Measured> {
     let path = resolve(base, &spec.file);
     let csv = Csv::read(&path).context("compare.file")?;
     let t = csv.time_column(&spec.time).context("compare.time")?;
@@ -94,7 +90,7 @@ pub fn measured(
         Some(r) => Matrix3::from_fn(|i, j| r[i][j]),
         None => Matrix3::identity(),
     };
-    let initial = Vector3::from(spec.initial.unwrap_or_else(|| initial_default(t[0])));
+    let initial = Vector3::from(spec.initial.unwrap_or(initial_default));
     let p0 = p(0);
     let tip = (0..n)
         .map(|i| {

@@ -257,7 +257,7 @@ sensor_offset = [0.010, 0.0, 0.0]
     )
     .unwrap();
     let initial = [0.0, 0.0, 0.05];
-    let m = measured(&spec, dir.path(), |_| initial).unwrap();
+    let m = measured(&spec, dir.path(), initial).unwrap();
     for (t, p) in m.t.iter().zip(&m.tip) {
         let want = [0.0, 0.002 * t, 0.05];
         for k in 0..3 {

@@ -521,20 +521,7 @@ fn malformed_3d_models_are_rejected_clearly() {
             vec!["segment[0].chambers", "must lie in the wall"],
         ),
     ];
-    for (label, text, expect) in cases {
-        std::fs::write(dir.path().join("m.toml"), &text).unwrap();
-        let out = softarm(&["eom", "m.toml", "--json"], dir.path());
-        let err = stderr(&out);
-        assert!(!out.status.success(), "{label}: accepted");
-        assert!(!err.contains("panicked"), "{label}: panic: {err}");
-        assert!(
-            stdout(&out).is_empty(),
-            "{label}: printed output on failure"
-        );
-        for e in expect {
-            assert!(err.contains(e), "{label}: expected `{e}` in: {err}");
-        }
-    }
+    assert_rejected(dir.path(), cases);
     // The baseline is valid, and the Cosserat statics reject what they
     // cannot model.
     std::fs::write(dir.path().join("m.toml"), GOOD3).unwrap();
@@ -697,9 +684,19 @@ fn malformed_actuators_inputs_and_measurements_are_rejected_clearly() {
             vec!["tip.radius", "tip.length"],
         ),
     ];
+    assert_rejected(dir.path(), cases);
+    // The baseline is valid.
+    std::fs::write(dir.path().join("m.toml"), &base).unwrap();
+    let out = softarm(&["eom", "m.toml", "--json"], dir.path());
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+/// Each case's model file, given to `softarm eom`, fails without a panic or
+/// output, and its message contains every expected piece.
+fn assert_rejected(dir: &std::path::Path, cases: Vec<(&str, String, Vec<&str>)>) {
     for (label, text, expect) in cases {
-        std::fs::write(dir.path().join("m.toml"), &text).unwrap();
-        let out = softarm(&["eom", "m.toml", "--json"], dir.path());
+        std::fs::write(dir.join("m.toml"), &text).unwrap();
+        let out = softarm(&["eom", "m.toml", "--json"], dir);
         let err = stderr(&out);
         assert!(!out.status.success(), "{label}: accepted");
         assert!(!err.contains("panicked"), "{label}: panic: {err}");
@@ -711,8 +708,4 @@ fn malformed_actuators_inputs_and_measurements_are_rejected_clearly() {
             assert!(err.contains(e), "{label}: expected `{e}` in: {err}");
         }
     }
-    // The baseline is valid.
-    std::fs::write(dir.path().join("m.toml"), &base).unwrap();
-    let out = softarm(&["eom", "m.toml", "--json"], dir.path());
-    assert!(out.status.success(), "{}", stderr(&out));
 }

@@ -21,7 +21,7 @@ pub struct Model {
     pub segments: Vec<Segment>,
     #[serde(default)]
     pub tip: Tip,
-    /// Tendons (3D): each pulled by an input channel.
+    /// Tendons, each pulled by an input channel.
     #[serde(default, rename = "tendon")]
     pub tendons: Vec<Tendon>,
     /// Input channels by name: time signals that drive pressures, tensions
@@ -181,8 +181,9 @@ pub struct Segment {
     /// 3D: whether elements stretch (structural; default false).
     #[serde(default)]
     pub extension: Option<bool>,
-    /// 3D, pcc/vc/ebr with `extension`: the material keeps its volume, so a
-    /// stretch lambda thins the section (structural; default false).
+    /// 3D, stretching elements (`extension`; eba always): the material
+    /// keeps its volume, so a stretch lambda thins the section (structural;
+    /// default false; no effect on rigid links).
     #[serde(default)]
     pub incompressible: Option<bool>,
     /// Shear modulus G (Pa) for the torsional stiffness G J; default E / 3

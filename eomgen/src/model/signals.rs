@@ -107,7 +107,7 @@ pub struct Compare {
     #[serde(default)]
     pub rotation: Option<[[f64; 3]; 3]>,
     /// Where the first sample sits in the model frame (m); default the
-    /// simulated tip at the first sample's time.
+    /// simulated tip at the start of the run (t = 0).
     #[serde(default)]
     pub initial: Option<[f64; 3]>,
     /// Time window of the error statistics (s); default the whole record.
