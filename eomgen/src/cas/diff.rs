@@ -40,6 +40,23 @@ impl Cas {
     /// Several time derivatives sharing one memo (so shared subexpressions
     /// are differentiated once).
     pub fn time_derivatives(&mut self, es: &[ExprId], pairs: &[(ExprId, ExprId)]) -> Vec<ExprId> {
+        self.time_derivatives_by(es, pairs, false)
+    }
+
+    /// Convective time derivatives (`pairs`: each q with its qd, the seed the
+    /// frames' angular velocities were built with) that use the rate rules of
+    /// turned vectors (`turning.rs`): velocities and accelerations of a chain
+    /// by w x u instead of by differentiating its rotation matrices.
+    pub fn kinematic_rates(&mut self, es: &[ExprId], pairs: &[(ExprId, ExprId)]) -> Vec<ExprId> {
+        self.time_derivatives_by(es, pairs, true)
+    }
+
+    fn time_derivatives_by(
+        &mut self,
+        es: &[ExprId],
+        pairs: &[(ExprId, ExprId)],
+        turned: bool,
+    ) -> Vec<ExprId> {
         let map: HashMap<SymId, ExprId> = pairs
             .iter()
             .map(|&(x, xd)| {
@@ -51,7 +68,7 @@ impl Cas {
             .collect();
         let mut memo = HashMap::default();
         es.iter()
-            .map(|&e| self.directional(e, &map, &mut memo))
+            .map(|&e| self.directional(e, &map, &mut memo, turned))
             .collect()
     }
 
@@ -60,9 +77,17 @@ impl Cas {
         e: ExprId,
         seed: &HashMap<SymId, ExprId>,
         memo: &mut HashMap<ExprId, ExprId>,
+        turned: bool,
     ) -> ExprId {
         if let Some(&d) = memo.get(&e) {
             return d;
+        }
+        if turned {
+            let rule = self.turned_rate(e, &mut |cas, x| cas.directional(x, seed, memo, true));
+            if let Some(d) = rule {
+                memo.insert(e, d);
+                return d;
+            }
         }
         let node = self.node(e).clone();
         let d = match node {
@@ -89,7 +114,7 @@ impl Cas {
             }
             _ => self.chain_rule(
                 e,
-                &mut |cas, child| cas.directional(child, seed, memo),
+                &mut |cas, child| cas.directional(child, seed, memo, turned),
                 &|_| None,
             ),
         };

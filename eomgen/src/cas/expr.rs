@@ -119,6 +119,8 @@ pub struct Cas {
     sym_index: HashMap<String, SymId>,
     pub(crate) diff_memo: HashMap<(ExprId, SymId), ExprId>,
     pub(crate) variables_memo: HashMap<ExprId, Variables>,
+    /// Rate rules of turned vectors (`turning.rs`).
+    pub(crate) turned: HashMap<ExprId, super::turning::Turned>,
 }
 
 /// The non-parameter symbols an expression depends on, as far as the time

@@ -5,6 +5,7 @@
 //! * `diff`: memoised partial and time derivatives.
 //! * `eval`: direct evaluation.
 //! * `lower`: CSE and linearisation into a runtime tape.
+//! * `turning`: vectors turned by a moving frame, with their rates by w x u.
 
 mod canonical;
 mod diff;
@@ -14,6 +15,7 @@ mod lower;
 mod reverse;
 #[cfg(test)]
 mod tests;
+mod turning;
 
 pub(crate) use expr::Variables;
 pub use expr::{Cas, ExprId, Func, Node, SymId, SymKind};

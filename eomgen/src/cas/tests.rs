@@ -233,6 +233,66 @@ fn time_derivative_by_chain_rule() {
     assert_eq!(conv, t1);
 }
 
+#[test]
+fn turned_vectors_move_by_w_cross_u() {
+    // Two frames: Rz(q0), then Rx(q1) on top, each with its angular
+    // velocity; a local vector that also moves. The rule's velocity and
+    // convective acceleration must equal the chain rule through R.
+    let mut c = Cas::new();
+    let (q0, q1) = (c.symbol("q0", SymKind::Q(0)), c.symbol("q1", SymKind::Q(1)));
+    let (u0, u1) = (
+        c.symbol("u0", SymKind::Qd(0)),
+        c.symbol("u1", SymKind::Qd(1)),
+    );
+    let (zero, one) = (c.zero(), c.one());
+    let rot = |c: &mut Cas, q: ExprId, axis: usize| {
+        let (co, si) = (c.cos(q), c.sin(q));
+        let ns = c.neg(si);
+        let mut r = [[zero; 3]; 3];
+        let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+        r[axis][axis] = one;
+        (r[a][a], r[b][b], r[a][b], r[b][a]) = (co, co, ns, si);
+        r
+    };
+    let r1 = rot(&mut c, q0, 2);
+    let w1 = [zero, zero, u0];
+    let e = rot(&mut c, q1, 0);
+    let r2: [[ExprId; 3]; 3] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            let col = [e[0][j], e[1][j], e[2][j]];
+            let x = c.dot(&r1[i], &col);
+            c.bind(x)
+        })
+    });
+    let rel = c.turn(&r1, &w1, &[u1, zero, zero]);
+    let w2: [ExprId; 3] = std::array::from_fn(|k| c.add(w1[k], rel[k]));
+    let q1sq = c.powi(q1, 2);
+    let half = c.constant(0.5);
+    let local = [one, q1, q1sq];
+    let a = c.turn(&r1, &w1, &[half, zero, q1]);
+    let b = c.turn(&r2, &w2, &local);
+    let p: Vec<ExprId> = (0..3).map(|k| c.add(a[k], b[k])).collect();
+    let pairs = [(q0, u0), (q1, u1)];
+    let v_rule = c.kinematic_rates(&p, &pairs);
+    let a_rule = c.kinematic_rates(&v_rule, &pairs);
+    let v_chain = c.time_derivatives(&p, &pairs);
+    let a_chain = c.time_derivatives(&v_chain, &pairs);
+    let at = vals(&[("q0", 0.7), ("q1", -1.3), ("u0", 0.4), ("u1", 2.1)]);
+    for (x, y) in v_rule
+        .iter()
+        .chain(&a_rule)
+        .zip(v_chain.iter().chain(&a_chain))
+    {
+        let (x, y) = (
+            c.eval_named(*x, &at).unwrap(),
+            c.eval_named(*y, &at).unwrap(),
+        );
+        assert!((x - y).abs() < 1e-13 * (1.0 + y.abs()), "{x} vs {y}");
+    }
+    // The rule is what was used: the chain rule's velocity differs in form.
+    assert_ne!(v_rule, v_chain);
+}
+
 // ---- property tests --------------------------------------------------------
 
 /// An expression tree, evaluated naively as the independent reference.

@@ -57,11 +57,11 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     if let Some(chain) = &sys.chain {
         points.extend(chain.links.iter().flat_map(|l| l.end));
     }
-    let all_velocities = cas.time_derivatives(&points, &pairs);
+    let all_velocities = cas.kinematic_rates(&points, &pairs);
     let (velocities, link_velocities) = all_velocities.split_at(n_points);
-    let conv_lin = cas.time_derivatives(&velocities[..3 * nb], &pairs);
+    let conv_lin = cas.kinematic_rates(&velocities[..3 * nb], &pairs);
     let omegas: Vec<ExprId> = sys.bodies.iter().flat_map(|b| b.omega).collect();
-    let conv_ang = cas.time_derivatives(&omegas, &pairs);
+    let conv_ang = cas.kinematic_rates(&omegas, &pairs);
 
     // The velocity outputs whose Jacobian in qd is T.
     let mut outs: Vec<ExprId> = velocities[..3 * nb].to_vec();

@@ -18,8 +18,10 @@
 //!   (a universal or spherical joint), at the base or midpoint of each link.
 //!
 //! Angular velocities come from the left Jacobian of exp:
-//! w = c1 rho' + c2 rho x rho' + c3 (rho . rho') rho in the base frame;
-//! positions are differentiated by the CAS.
+//! w = c1 rho' + c2 rho x rho' + c3 (rho . rho') rho in the base frame.
+//! Every vector a frame turns into the world goes through `Cas::turn`, so
+//! velocities and accelerations follow by w x u (`cas/turning.rs`) rather
+//! than by differentiating the chain of rotation matrices.
 
 use crate::cas::{Cas, ExprId, Func};
 use crate::model::{Joints, Method, Model, Structure};
@@ -115,21 +117,17 @@ fn compose(
     let r_rel = r_rel.map(|(r, _)| r);
     let p = match p_rel {
         Some(d) => {
-            let wd = mat_vec(cas, &f.r, d);
-            {
-                let s = add3(cas, &f.p, &wd);
-                bind3(cas, s)
-            }
+            let wd = cas.turn(&f.r, &f.w, d);
+            let s = add3(cas, &f.p, &wd);
+            bind3(cas, s)
         }
         None => f.p,
     };
     let w = match w_rel {
         Some(w) => {
-            let ww = mat_vec(cas, &f.r, w);
-            {
-                let s = add3(cas, &f.w, &ww);
-                bind3(cas, s)
-            }
+            let ww = cas.turn(&f.r, &f.w, w);
+            let s = add3(cas, &f.w, &ww);
+            bind3(cas, s)
         }
         None => f.w,
     };
@@ -231,7 +229,7 @@ fn arc(cas: &mut Cas, f: &Frame, rho: &V3, rate: &V3, len: ExprId) -> (V3, V3, V
         let e = cas.mul(len, e);
         cas.bind(e)
     });
-    let wc = mat_vec(cas, &f.r, &c);
+    let wc = cas.turn(&f.r, &f.w, &c);
     let centroid = add3(cas, &f.p, &wc);
     // Mid-arc frame: exp([rho/2]x).
     let rho_h = rho.map(|e| cas.scaled(0.5, e));
@@ -240,10 +238,10 @@ fn arc(cas: &mut Cas, f: &Frame, rho: &V3, rate: &V3, len: ExprId) -> (V3, V3, V
     let w_h = cas.bind(w_h);
     let [h1, h2, h3] = coefficients(cas, w_h, [1, 2, 3]);
     let axis_rel = series_on_x(cas, &rho_h, w_h, one, h1, h2);
-    let axis = mat_vec(cas, &f.r, &axis_rel);
+    let axis = cas.turn(&f.r, &f.w, &axis_rel);
     let axis = bind3(cas, axis);
     let wm_rel = left_jacobian(cas, &rho_h, &rate_h, [h1, h2, h3]);
-    let wm = mat_vec(cas, &f.r, &wm_rel);
+    let wm = cas.turn(&f.r, &f.w, &wm_rel);
     let omega = add3(cas, &f.w, &wm);
     let omega = bind3(cas, omega);
     (centroid, axis, omega, end)
