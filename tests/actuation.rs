@@ -344,3 +344,69 @@ fn stiff_flop_takes_a_measured_tip_wrench_by_swapping_in_a_data_file() {
         "stays straight"
     );
 }
+
+#[test]
+fn joint_torques_bend_a_soft_element_and_spin_a_rigid_link_as_closed_forms_say() {
+    let dir = tempfile::tempdir().unwrap();
+    // A generalised force on a pcc element's bending angle is a moment at
+    // its end: the arc of curvature tau / (E I), about z and about y.
+    let tau = 2e-4;
+    let text = arm(&(segment(L, "twist = false")
+        + r#"
+[[torque]]
+coordinate = "bend_z_0_0"
+input = "tau"
+[inputs.tau]
+kind = "constant"
+value = 2e-4
+"#));
+    let ei = E * PI * R.powi(4) / 4.0;
+    let (tip, _) = static_tip(dir.path(), &text, &[]);
+    assert_tip(tip, arc(L, tau * L / ei, [0.0, 0.0, 1.0]), "torque about z");
+    let (tip, _) = static_tip(dir.path(), &text, &["torque.0.coordinate=bend_y_0_0"]);
+    assert_tip(tip, arc(L, tau * L / ei, [0.0, 1.0, 0.0]), "torque about y");
+
+    // A free rigid link (planar, joint at its base, no gravity or spring)
+    // under a sine torque: theta'' = tau(t) / (m l^2 / 3 + m r^2 / 4).
+    let (l, m, r) = (0.2, 0.05, 0.01);
+    let link = format!(
+        r#"
+name = "link"
+gravity = [0.0, 0.0, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "rigid"
+length = {l}
+mass = {m}
+outer_radius = {r}
+elements = 1
+joint_stiffness = 0.0
+[[torque]]
+coordinate = "theta_0_0"
+input = "drive"
+[inputs.drive]
+kind = "sine"
+amplitude = 0.03
+frequency = 2.0
+"#
+    );
+    let path = dir.path().join("link.toml");
+    std::fs::write(&path, link).unwrap();
+    let loaded = load(
+        path.to_str().unwrap(),
+        &[],
+        BackendChoice::Auto,
+        Some(dir.path().join("cache")),
+    )
+    .unwrap();
+    let arm = &*loaded.arm;
+    let inertia = m * l * l / 3.0 + m * r * r / 4.0;
+    let mut ws = runtime::Workspace::new(1);
+    for t in [0.05, 0.1, 0.3] {
+        let mut qdd = [0.0];
+        runtime::accelerations(arm, &mut ws, t, &[0.7], &[-1.1], &mut qdd).unwrap();
+        let want = 0.03 * (2.0 * PI * 2.0 * t).sin() / inertia;
+        assert_close(qdd[0], want, 1e-12, 0.0, &format!("theta'' at t = {t}"));
+    }
+}

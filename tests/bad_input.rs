@@ -683,6 +683,20 @@ fn malformed_actuators_inputs_and_measurements_are_rejected_clearly() {
             format!("{base}[tip]\nmass = 0.01\nradius = 0.005\n"),
             vec!["tip.radius", "tip.length"],
         ),
+        (
+            "torque on a coordinate the model lacks",
+            format!("{base}[[torque]]\ncoordinate = \"theta_0_0\"\ninput = \"p\"\n"),
+            vec![
+                "torque[0].coordinate",
+                "no coordinate \"theta_0_0\"",
+                "bend_y_0_0, bend_z_0_0, twist_0_0",
+            ],
+        ),
+        (
+            "torque from an undeclared channel",
+            format!("{base}[[torque]]\ncoordinate = \"bend_y_0_1\"\ninput = \"tau\"\n"),
+            vec!["torque[0].input", "no input channel \"tau\""],
+        ),
     ];
     assert_rejected(dir.path(), cases);
     // The baseline is valid.

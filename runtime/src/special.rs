@@ -163,15 +163,10 @@ const fn taylor<const N: usize>(first: u32) -> [f64; N] {
 #[inline(always)]
 fn small_sin_cos(x: f64) -> (f64, f64) {
     let x2 = x * x;
-    let mut s = 0.0;
-    for &c in SIN_TAYLOR.iter().rev() {
-        s = s * x2 + c;
-    }
-    let mut c = 0.0;
-    for &k in COS_TAYLOR.iter().rev() {
-        c = c * x2 + k;
-    }
-    (s * x, c)
+    (
+        split_horner(&SIN_TAYLOR, x2) * x,
+        split_horner(&COS_TAYLOR, x2),
+    )
 }
 
 #[inline(never)]
@@ -310,13 +305,30 @@ impl Series {
     }
 }
 
+/// sum_i row[i] x2^i for i < N.
 #[inline(always)]
 fn horner<const N: usize>(row: &[f64; TERMS as usize], x2: f64) -> f64 {
-    let mut sum = 0.0;
-    for &c in row[..N].iter().rev() {
-        sum = sum * x2 + c;
+    let head: &[f64; N] = row[..N].try_into().expect("N <= TERMS");
+    split_horner(head, x2)
+}
+
+/// sum_i row[i] x2^i as two interleaved Horner chains in x2^2 (even and
+/// odd i): half the dependency chain of plain Horner, for the kernels'
+/// many short series.
+#[inline(always)]
+fn split_horner<const N: usize>(row: &[f64; N], x2: f64) -> f64 {
+    let x4 = x2 * x2;
+    let (mut even, mut odd) = (0.0, 0.0);
+    let mut i = N;
+    while i > 0 {
+        i -= 1;
+        if i.is_multiple_of(2) {
+            even = even * x4 + row[i];
+        } else {
+            odd = odd * x4 + row[i];
+        }
     }
-    sum
+    even + x2 * odd
 }
 
 /// Coefficients (-1)^j / (m + shift)! for m = first + 2 j.

@@ -24,6 +24,10 @@ pub struct Model {
     /// Tendons, each pulled by an input channel.
     #[serde(default, rename = "tendon")]
     pub tendons: Vec<Tendon>,
+    /// Generalised forces on named coordinates (joint torques), each
+    /// driven by an input channel.
+    #[serde(default, rename = "torque")]
+    pub torques: Vec<Torque>,
     /// Input channels by name: time signals that drive pressures, tensions
     /// and tip loads at run time (not structural: swapping a data file or a
     /// signal needs no rebuild).
@@ -405,6 +409,17 @@ pub struct Tendon {
     /// Index of the segment at whose end it is terminated; default the last.
     #[serde(default)]
     pub end: Option<usize>,
+}
+
+/// A joint torque: a generalised force Q on one coordinate (N m on an angle,
+/// N on a stretch), virtual work Q dq. The coordinate is named as
+/// `softarm eom` lists them (`theta_0_3`, `bend_y_0_2`, `joint_z_1_0`, ...).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Torque {
+    pub coordinate: String,
+    /// Input channel of its value.
+    pub input: String,
 }
 
 /// A number, or one per segment.

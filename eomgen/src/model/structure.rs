@@ -69,6 +69,8 @@ pub struct Structure {
     pub chambers: Vec<usize>,
     /// Per tendon: the segment at whose end it is terminated.
     pub tendons: Vec<usize>,
+    /// The coordinates that driven generalised forces act on.
+    pub torques: Vec<String>,
 }
 
 impl Structure {
@@ -132,6 +134,7 @@ impl Structure {
                 .iter()
                 .map(|t| t.end.unwrap_or(m.segments.len() - 1))
                 .collect(),
+            torques: m.torques.iter().map(|t| t.coordinate.clone()).collect(),
         }
     }
 
@@ -190,6 +193,9 @@ impl Structure {
         }
         if !self.tendons.is_empty() {
             s.push_str(&format!("tendons {:?}\n", self.tendons));
+        }
+        if !self.torques.is_empty() {
+            s.push_str(&format!("torques {:?}\n", self.torques));
         }
         s
     }
@@ -417,6 +423,9 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
             p.push((format!("tendon[{i}][{s}].z"), d * angle.sin()));
         }
     }
+    for i in 0..m.torques.len() {
+        p.push((format!("torque[{i}]"), 0.0));
+    }
     p
 }
 
@@ -444,6 +453,9 @@ pub fn drives(m: &Model) -> Vec<(String, String)> {
     }
     for (i, t) in m.tendons.iter().enumerate() {
         d.push((format!("tendon[{i}].tension"), t.input.clone()));
+    }
+    for (i, t) in m.torques.iter().enumerate() {
+        d.push((format!("torque[{i}]"), t.input.clone()));
     }
     d
 }

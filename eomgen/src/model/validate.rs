@@ -472,6 +472,22 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             }
         }
     }
+    if !m.torques.is_empty() {
+        let names = crate::tmt::coordinate_names(m);
+        for (i, t) in m.torques.iter().enumerate() {
+            channel(&format!("torque[{i}].input"), &t.input)?;
+            if !names.contains(&t.coordinate) {
+                return err(
+                    format!("torque[{i}].coordinate"),
+                    format!(
+                        "no coordinate \"{}\"; this model's are {}",
+                        t.coordinate,
+                        names.join(", ")
+                    ),
+                );
+            }
+        }
+    }
     for (name, input) in &m.inputs {
         super::signals::check_input(name, input, file)?;
     }
