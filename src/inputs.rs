@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use eomgen::model::{Input, Model, Offset, drives};
+use eomgen::model::{Driven, Input, Model, Offset, drives};
 use runtime::signal::{Drive, Signal, Table, moving_average};
 
 use crate::data::{Csv, resolve};
@@ -82,7 +82,12 @@ pub fn signal(name: &str, input: &Input, base: &Path) -> Result<Signal> {
 pub fn model_drives(model: &Model, layout: &[String], base: &Path) -> Result<Vec<Drive>> {
     let mut signals: BTreeMap<&str, Signal> = BTreeMap::new();
     let mut out = Vec::new();
-    for (param, channel) in drives(model) {
+    for Driven {
+        param,
+        channel,
+        derivative,
+    } in drives(model)
+    {
         let input = &model.inputs[&channel]; // validated
         if !signals.contains_key(channel.as_str()) {
             let key = model.inputs.get_key_value(&channel).expect("validated").0;
@@ -92,9 +97,13 @@ pub fn model_drives(model: &Model, layout: &[String], base: &Path) -> Result<Vec
             .iter()
             .position(|p| *p == param)
             .with_context(|| format!("parameter {param} is not in the layout (generator bug)"))?;
+        let mut signal = signals[channel.as_str()].clone();
+        for _ in 0..derivative {
+            signal = signal.derivative();
+        }
         out.push(Drive {
             param: index,
-            signal: signals[channel.as_str()].clone(),
+            signal,
         });
     }
     Ok(out)

@@ -693,6 +693,43 @@ fn malformed_actuators_inputs_and_measurements_are_rejected_clearly() {
             ],
         ),
         (
+            "base translation inputs per axis",
+            r(
+                "direction = [1.0, 0.0, 0.0]",
+                "direction = [1.0, 0.0, 0.0]\ntranslation_inputs = [\"p\", \"p\"]",
+            ),
+            vec![
+                "base.translation_inputs",
+                "one input channel per axis",
+                "x, y, z",
+            ],
+        ),
+        (
+            "base turned by an undeclared channel",
+            r(
+                "direction = [1.0, 0.0, 0.0]",
+                "direction = [1.0, 0.0, 0.0]\nrotation_input = \"spin\"",
+            ),
+            vec!["base.rotation_input", "no input channel \"spin\""],
+        ),
+        (
+            "base rotation axis zero",
+            r(
+                "direction = [1.0, 0.0, 0.0]",
+                "direction = [1.0, 0.0, 0.0]\nrotation_input = \"p\"\nrotation_axis = [0, 0, 0]",
+            ),
+            vec!["base.rotation_axis", "non-zero"],
+        ),
+        (
+            "moving base with eba",
+            r(
+                "direction = [1.0, 0.0, 0.0]",
+                "direction = [1.0, 0.0, 0.0]\nrotation_input = \"p\"",
+            )
+            .replacen("method = \"pcc\"", "method = \"eba\"", 1),
+            vec!["base", "not supported with eba"],
+        ),
+        (
             "torque from an undeclared channel",
             format!("{base}[[torque]]\ncoordinate = \"bend_y_0_1\"\ninput = \"tau\"\n"),
             vec!["torque[0].input", "no input channel \"tau\""],

@@ -14,7 +14,7 @@ pub fn derive(model: &Model) -> TapeSet {
     let mut mass_bias = eq.mass_upper.clone();
     mass_bias.extend_from_slice(&eq.bias);
     let params: Vec<String> = parameters(model).into_iter().map(|(n, _)| n).collect();
-    let driven: Vec<String> = drives(model).into_iter().map(|(p, _)| p).collect();
+    let driven: Vec<String> = drives(model).into_iter().map(|d| d.param).collect();
     let inputs = params
         .iter()
         .enumerate()

@@ -35,6 +35,12 @@ pub enum Signal {
     },
     /// Samples, linearly interpolated; the end values held outside.
     Table(Table),
+    /// `value` from `start` until `end`, 0 outside (a ramp's rate).
+    Window {
+        value: f64,
+        start: f64,
+        end: f64,
+    },
 }
 
 impl Signal {
@@ -76,6 +82,49 @@ impl Signal {
                 }
             }
             Signal::Table(tab) => tab.at(t),
+            Signal::Window { value, start, end } => {
+                if (*start..*end).contains(&t) {
+                    *value
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+
+    /// The signal's time derivative (what a moving base's velocity and
+    /// acceleration follow): exact for the analytic signals (a step's jump
+    /// is left out), and for a table the central differences of its
+    /// samples (one-sided at the ends), interpolated linearly in turn.
+    pub fn derivative(&self) -> Signal {
+        match self {
+            Signal::Constant(_) | Signal::Step { .. } | Signal::Window { .. } => {
+                Signal::Constant(0.0)
+            }
+            Signal::Ramp {
+                from,
+                to,
+                start,
+                end,
+            } => Signal::Window {
+                value: (to - from) / (end - start),
+                start: *start,
+                end: *end,
+            },
+            Signal::Sine {
+                amplitude,
+                frequency,
+                phase,
+                start,
+                ..
+            } => Signal::Sine {
+                amplitude: amplitude * 2.0 * std::f64::consts::PI * frequency,
+                frequency: *frequency,
+                phase: phase + std::f64::consts::FRAC_PI_2,
+                bias: 0.0,
+                start: *start,
+            },
+            Signal::Table(tab) => Signal::Table(tab.derivative()),
         }
     }
 }
@@ -140,6 +189,25 @@ impl Table {
         &self.times
     }
 
+    /// Central differences of the samples, one-sided at the ends (zero for
+    /// a single sample).
+    pub fn derivative(&self) -> Table {
+        let (ts, vs) = (&self.times, &self.values);
+        let n = ts.len();
+        let slope = |a: usize, b: usize| (vs[b] - vs[a]) / (ts[b] - ts[a]);
+        let values = (0..n)
+            .map(|i| match n {
+                1 => 0.0,
+                _ => slope(i.saturating_sub(1), (i + 1).min(n - 1)),
+            })
+            .collect();
+        Table {
+            times: ts.clone(),
+            values,
+            last: Cell::new(0),
+        }
+    }
+
     pub fn values(&self) -> &[f64] {
         &self.values
     }
@@ -195,6 +263,49 @@ pub struct Drive {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn derivatives_are_exact_for_analytic_signals_and_second_order_for_tables() {
+        let sine = Signal::Sine {
+            amplitude: 0.3,
+            frequency: 1.5,
+            phase: 0.4,
+            bias: 2.0,
+            start: 0.1,
+        };
+        let ramp = Signal::Ramp {
+            from: 1.0,
+            to: 3.0,
+            start: 0.5,
+            end: 1.5,
+        };
+        // Central differences of the signal itself, away from kinks.
+        let h = 1e-5;
+        for s in [&sine, &ramp] {
+            let (d, dd) = (s.derivative(), s.derivative().derivative());
+            for t in [0.3, 0.7, 1.2, 2.0] {
+                let fd = (s.at(t + h) - s.at(t - h)) / (2.0 * h);
+                assert!(
+                    (d.at(t) - fd).abs() < 1e-6,
+                    "rate at {t}: {} vs {fd}",
+                    d.at(t)
+                );
+                let fdd = (d.at(t + h) - d.at(t - h)) / (2.0 * h);
+                assert!((dd.at(t) - fdd).abs() < 1e-5, "second at {t}");
+            }
+        }
+        assert_eq!(sine.derivative().at(0.0), 0.0, "still before start");
+        // A table of a parabola: central differences are exact for it.
+        let times: Vec<f64> = (0..11).map(|i| 0.1 * f64::from(i)).collect();
+        let values = times.iter().map(|t| 3.0 * t * t - t).collect();
+        let d = Signal::Table(Table::new(times, values).unwrap()).derivative();
+        for t in [0.1, 0.5, 0.9] {
+            assert!(
+                (d.at(t) - (6.0 * t - 1.0)).abs() < 1e-12,
+                "table rate at {t}"
+            );
+        }
+    }
 
     #[test]
     fn table_interpolates_linearly_and_holds_the_ends() {

@@ -121,6 +121,9 @@ pub struct Cas {
     pub(crate) variables_memo: HashMap<ExprId, Variables>,
     /// Rate rules of turned vectors (`turning.rs`).
     pub(crate) turned: HashMap<ExprId, super::turning::Turned>,
+    /// Parameters that change with time (a prescribed base motion): to
+    /// time derivatives they are variables, not constants.
+    moving: rustc_hash::FxHashSet<SymId>,
 }
 
 /// The non-parameter symbols an expression depends on, as far as the time
@@ -166,7 +169,7 @@ impl Cas {
         let v = match self.node(e) {
             Node::Const(_) => Variables::None,
             Node::Sym(s) => match self.sym_kind(*s) {
-                SymKind::Param(_) => Variables::None,
+                SymKind::Param(_) if !self.moving.contains(s) => Variables::None,
                 _ => Variables::One(*s),
             },
             _ => {
@@ -208,6 +211,14 @@ impl Cas {
             }
         };
         self.intern(Node::Sym(id))
+    }
+
+    /// Declare parameter `e` time-varying (before building expressions of
+    /// it: the variable sets are memoised).
+    pub fn set_moving(&mut self, e: ExprId) {
+        let s = self.sym_id(e).expect("set_moving: a parameter symbol");
+        debug_assert!(!self.variables_memo.contains_key(&e), "declared too late");
+        self.moving.insert(s);
     }
 
     pub fn sym_id(&self, e: ExprId) -> Option<SymId> {

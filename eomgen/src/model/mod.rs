@@ -10,12 +10,12 @@ mod validate;
 pub use error::ModelError;
 pub use load::{Override, load_model, parse_model};
 pub use schema::{
-    Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, Start, Tendon, Tip,
+    Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, Start, Tendon, Tip, Torque,
     WrenchFrame,
 };
 pub use signals::{Compare, Input, Offset};
 pub use structure::{
-    ElementProps, GENERATOR_VERSION, SegmentShape, Structure, base_rotation, drives, element_props,
-    parameters,
+    BASE_TRANSLATION, BASE_TURN, Driven, ElementProps, GENERATOR_VERSION, SegmentShape, Structure,
+    base_rotation, drives, element_props, parameters,
 };
 pub use validate::MAX_ELEMENTS;

@@ -74,6 +74,18 @@ pub struct Base {
     pub position: [f64; 3],
     /// Direction of the undeformed arm (any length; normalised).
     pub direction: [f64; 3],
+    /// A prescribed base motion: input channels of the displacement from
+    /// `position` along x, y, z (m). Structural (the base's velocity and
+    /// acceleration enter the equations).
+    #[serde(default)]
+    pub translation_inputs: Option<Vec<String>>,
+    /// A prescribed base rotation: input channel of the angle (rad) turned
+    /// about `rotation_axis` (3D; z in the plane), on top of `direction`.
+    #[serde(default)]
+    pub rotation_input: Option<String>,
+    /// World axis of `rotation_input` (3D, any length; default z).
+    #[serde(default)]
+    pub rotation_axis: Option<[f64; 3]>,
 }
 
 /// How a segment is modelled. Structural: changing it derives anew.

@@ -71,6 +71,9 @@ pub struct Structure {
     pub tendons: Vec<usize>,
     /// The coordinates that driven generalised forces act on.
     pub torques: Vec<String>,
+    /// The base translates, turns (prescribed by inputs).
+    pub base_translates: bool,
+    pub base_turns: bool,
 }
 
 impl Structure {
@@ -135,6 +138,8 @@ impl Structure {
                 .map(|t| t.end.unwrap_or(m.segments.len() - 1))
                 .collect(),
             torques: m.torques.iter().map(|t| t.coordinate.clone()).collect(),
+            base_translates: m.base.translation_inputs.is_some(),
+            base_turns: m.base.rotation_input.is_some(),
         }
     }
 
@@ -196,6 +201,12 @@ impl Structure {
         }
         if !self.torques.is_empty() {
             s.push_str(&format!("torques {:?}\n", self.torques));
+        }
+        if self.base_translates || self.base_turns {
+            s.push_str(&format!(
+                "base moves {} {}\n",
+                self.base_translates, self.base_turns
+            ));
         }
         s
     }
@@ -340,6 +351,27 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
         // Planar: the angle of the base direction from +x.
         p.push(("base.angle".to_string(), d[1].atan2(d[0])));
     }
+    // A moving base: the displacement and turn (inputs) with their first
+    // and second time derivatives (inputs too, the signals' derivatives).
+    if m.base.translation_inputs.is_some() {
+        for (quantity, _) in BASE_TRANSLATION {
+            for c in ["x", "y", "z"] {
+                p.push((format!("base.{quantity}{c}"), 0.0));
+            }
+        }
+    }
+    if m.base.rotation_input.is_some() {
+        for (quantity, _) in BASE_TURN {
+            p.push((format!("base.{quantity}"), 0.0));
+        }
+        if m.dimensions == 3 {
+            let a = m.base.rotation_axis.unwrap_or([0.0, 0.0, 1.0]);
+            let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+            for (c, v) in ["x", "y", "z"].iter().zip(a) {
+                p.push((format!("base.axis.{c}"), v / n));
+            }
+        }
+    }
     if let Some(mass) = m.tip.mass {
         p.push(("tip.mass".to_string(), mass));
     }
@@ -429,33 +461,74 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
     p
 }
 
-/// The runtime parameters that input channels drive: (parameter, channel).
-/// They change during a run, so derivation never folds them into derived
-/// (precomputed) parameters.
-pub fn drives(m: &Model) -> Vec<(String, String)> {
+/// The base-motion parameters (name prefix) and the time derivative of
+/// the input they take: displacement s, velocity v, acceleration a.
+pub const BASE_TRANSLATION: [(&str, u8); 3] = [("s", 0), ("v", 1), ("a", 2)];
+/// The turn angle, its rate and its acceleration.
+pub const BASE_TURN: [(&str, u8); 3] = [("turn", 0), ("omega", 1), ("alpha", 2)];
+
+/// A runtime parameter an input channel drives: the channel's value, or its
+/// first or second time derivative (a moving base's velocity and
+/// acceleration).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Driven {
+    pub param: String,
+    pub channel: String,
+    pub derivative: u8,
+}
+
+/// The runtime parameters that input channels drive. They change during a
+/// run, so derivation never folds them into derived (precomputed)
+/// parameters.
+pub fn drives(m: &Model) -> Vec<Driven> {
+    let value = |param: String, channel: &String| Driven {
+        param,
+        channel: channel.clone(),
+        derivative: 0,
+    };
     let mut d = Vec::new();
+    if let Some(names) = &m.base.translation_inputs {
+        for (quantity, derivative) in BASE_TRANSLATION {
+            for (c, n) in ["x", "y", "z"].iter().zip(names) {
+                d.push(Driven {
+                    param: format!("base.{quantity}{c}"),
+                    channel: n.clone(),
+                    derivative,
+                });
+            }
+        }
+    }
+    if let Some(n) = &m.base.rotation_input {
+        for (quantity, derivative) in BASE_TURN {
+            d.push(Driven {
+                param: format!("base.{quantity}"),
+                channel: n.clone(),
+                derivative,
+            });
+        }
+    }
     for (key, names) in [
         ("tip.force", &m.tip.force_inputs),
         ("tip.moment", &m.tip.moment_inputs),
     ] {
         if let Some(names) = names {
             for (c, n) in ["x", "y", "z"].iter().zip(names) {
-                d.push((format!("{key}.{c}"), n.clone()));
+                d.push(value(format!("{key}.{c}"), n));
             }
         }
     }
     for (s, seg) in m.segments.iter().enumerate() {
         if let Some(inputs) = seg.chambers.as_ref().and_then(|c| c.inputs.as_ref()) {
             for (j, n) in inputs.iter().enumerate() {
-                d.push((format!("chamber[{s}][{j}].pressure"), n.clone()));
+                d.push(value(format!("chamber[{s}][{j}].pressure"), n));
             }
         }
     }
     for (i, t) in m.tendons.iter().enumerate() {
-        d.push((format!("tendon[{i}].tension"), t.input.clone()));
+        d.push(value(format!("tendon[{i}].tension"), &t.input));
     }
     for (i, t) in m.torques.iter().enumerate() {
-        d.push((format!("torque[{i}]"), t.input.clone()));
+        d.push(value(format!("torque[{i}]"), &t.input));
     }
     d
 }

@@ -472,6 +472,52 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             }
         }
     }
+    if let Some(names) = &m.base.translation_inputs {
+        let want = if m.dimensions == 3 { 3 } else { 2 };
+        if names.len() != want {
+            return err(
+                "base.translation_inputs".into(),
+                format!(
+                    "give one input channel per axis ({}), got {}",
+                    if want == 3 {
+                        "x, y, z"
+                    } else {
+                        "x, y: a planar base"
+                    },
+                    names.len()
+                ),
+            );
+        }
+        for (i, n) in names.iter().enumerate() {
+            channel(&format!("base.translation_inputs[{i}]"), n)?;
+        }
+    }
+    if let Some(n) = &m.base.rotation_input {
+        channel("base.rotation_input", n)?;
+    }
+    if let Some(a) = &m.base.rotation_axis {
+        if m.dimensions != 3 {
+            return err(
+                "base.rotation_axis".into(),
+                "a planar base turns about z: leave rotation_axis out".into(),
+            );
+        }
+        vec3("base.rotation_axis", a)?;
+        if a.iter().all(|&c| c == 0.0) {
+            return err(
+                "base.rotation_axis".into(),
+                "must be a non-zero vector".into(),
+            );
+        }
+    }
+    let moving = m.base.translation_inputs.is_some() || m.base.rotation_input.is_some();
+    if moving && m.segments.iter().any(|s| s.method == Method::Eba) {
+        return err(
+            "base".into(),
+            "a moving base is not supported with eba segments (absolute states); use pcc, vc, ebr, rom or rigid"
+                .into(),
+        );
+    }
     if !m.torques.is_empty() {
         let names = crate::tmt::coordinate_names(m);
         for (i, t) in m.torques.iter().enumerate() {

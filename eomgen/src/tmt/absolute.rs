@@ -226,6 +226,8 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
         tip,
         tip_orientation: quat,
         chain: None,
+        // Validation keeps eba's base still.
+        seeds: Vec::new(),
     };
     let mount = TipMount {
         point: tip,

@@ -47,7 +47,8 @@ fn triple(v: &[ExprId], i: usize) -> [ExprId; 3] {
 pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     let n = sys.coords.len();
     let nb = sys.bodies.len();
-    let pairs = sys.coords.rate_pairs();
+    let mut pairs = sys.coords.rate_pairs();
+    pairs.extend(&sys.seeds);
 
     // Velocities (bodies, then force points) and convective accelerations;
     // one memo per batch, so chains are shared between bodies.

@@ -47,13 +47,18 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
     let coords = Coordinates::new(cas, coord_names);
     let zero = cas.zero();
 
-    let mut f = Frame {
-        x: param("base.x"),
-        y: param("base.y"),
-        phi: param("base.angle"),
-        w: zero,
+    let base = symbols.base_motion(cas);
+    let (phi, w) = match base.turn {
+        Some((angle, rate)) => (cas.add(param("base.angle"), angle), rate),
+        None => (param("base.angle"), zero),
     };
-    let z = param("base.z");
+    let mut f = Frame {
+        x: base.position[0],
+        y: base.position[1],
+        phi,
+        w,
+    };
+    let z = base.position[2];
     let mut bodies = Vec::new();
     let mut elastic = Vec::new();
     let mut rayleigh = Vec::new();
@@ -149,6 +154,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
             point_force_link: Vec::new(),
             moment_link: Vec::new(),
         }),
+        seeds: base.seeds,
     };
     // The end frame's axis and rotation only when the tip needs them (a
     // tip body with length, a wrench in the tip frame).

@@ -312,12 +312,13 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
     let coords = Coordinates::new(cas, coord_names);
     let zero = cas.zero();
 
-    let r0: M3 = std::array::from_fn(|i| std::array::from_fn(|j| param(&format!("base.R{i}{j}"))));
+    let base = symbols.base_motion(cas);
+    let (r0, w0, quat0) = base_frame(cas, &symbols, base.turn);
     let mut f = Frame {
         r: r0,
-        p: [param("base.x"), param("base.y"), param("base.z")],
-        w: [zero; 3],
-        quat: ["qw", "qx", "qy", "qz"].map(|c| param(&format!("base.{c}"))),
+        p: base.position,
+        w: w0,
+        quat: quat0,
     };
     let mut bodies = Vec::new();
     let mut elastic = Vec::new();
@@ -554,6 +555,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
             point_force_link: Vec::new(),
             moment_link: Vec::new(),
         }),
+        seeds: base.seeds,
     };
     let mount = TipMount {
         point: f.p,
@@ -564,6 +566,40 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
     let tip = tip_loads(cas, &symbols, &structure, &mount);
     sys.attach_tip(tip, last_link);
     sys
+}
+
+/// The base frame: the declared orientation (rotation, quaternion), turned
+/// by the prescribed angle about `base.axis` when the base turns, and its
+/// angular velocity.
+fn base_frame(
+    cas: &mut Cas,
+    symbols: &super::system::ParamSymbols,
+    turn: Option<(ExprId, ExprId)>,
+) -> (M3, V3, Quat) {
+    let param = |name: &str| symbols.get(name);
+    let r: M3 = std::array::from_fn(|i| std::array::from_fn(|j| param(&format!("base.R{i}{j}"))));
+    let quat = ["qw", "qx", "qy", "qz"].map(|c| param(&format!("base.{c}")));
+    let Some((angle, rate)) = turn else {
+        return (r, [cas.zero(); 3], quat);
+    };
+    let n = ["x", "y", "z"].map(|c| param(&format!("base.axis.{c}")));
+    // exp(angle [n]x) = cos I + sin [n]x + (1 - cos) n n^T, n a unit vector.
+    let (c, s) = (cas.cos(angle), cas.sin(angle));
+    let one = cas.one();
+    let versine = cas.sub(one, c);
+    let turn = rotation(cas, &n, [c, s, versine]);
+    let r = std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            let col = [r[0][j], r[1][j], r[2][j]];
+            let e = cas.dot(&turn[i], &col);
+            cas.bind(e)
+        })
+    });
+    let w = n.map(|k| cas.mul(k, rate));
+    let half = cas.scaled(0.5, angle);
+    let (ch, sh) = (cas.cos(half), cas.sin(half));
+    let q_turn = [ch, cas.mul(sh, n[0]), cas.mul(sh, n[1]), cas.mul(sh, n[2])];
+    (r, w, quat_mul(cas, &q_turn, &quat))
 }
 
 /// The strain fields of a rom segment, in coordinate order.

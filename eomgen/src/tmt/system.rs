@@ -3,6 +3,7 @@
 //! CAS expressions. Kinematics modules build one; `assemble` derives the EOM.
 
 use crate::cas::{Cas, ExprId, SymKind};
+use crate::model::{BASE_TRANSLATION, BASE_TURN};
 
 pub use super::inertia::Inertia;
 
@@ -19,12 +20,48 @@ impl ParamSymbols {
             .into_iter()
             .map(|(n, _)| n)
             .collect();
-        let ids = names
+        let ids: Vec<ExprId> = names
             .iter()
             .enumerate()
             .map(|(i, n)| cas.symbol(n, SymKind::Param(i as u32)))
             .collect();
-        Self { names, ids }
+        let sym = Self { names, ids };
+        for (n, &id) in sym.names.iter().zip(&sym.ids) {
+            if BaseMotion::moves(n) {
+                cas.set_moving(id);
+            }
+        }
+        sym
+    }
+
+    fn has(&self, name: &str) -> bool {
+        self.names.iter().any(|n| n == name)
+    }
+
+    /// The base's position and turn, moving when the model prescribes it.
+    pub fn base_motion(&self, cas: &mut Cas) -> BaseMotion {
+        let mut position = ["x", "y", "z"].map(|c| self.get(&format!("base.{c}")));
+        let mut seeds = Vec::new();
+        let chain = |seeds: &mut Vec<(ExprId, ExprId)>, [x, v, a]: [ExprId; 3]| {
+            seeds.extend([(x, v), (v, a)]);
+        };
+        if self.has("base.sx") {
+            for (k, c) in ["x", "y", "z"].iter().enumerate() {
+                let sva = BASE_TRANSLATION.map(|(q, _)| self.get(&format!("base.{q}{c}")));
+                position[k] = cas.add(position[k], sva[0]);
+                chain(&mut seeds, sva);
+            }
+        }
+        let turn = self.has("base.turn").then(|| {
+            let t = BASE_TURN.map(|(q, _)| self.get(&format!("base.{q}")));
+            chain(&mut seeds, t);
+            (t[0], t[1])
+        });
+        BaseMotion {
+            position,
+            turn,
+            seeds,
+        }
     }
 
     /// The symbol of parameter `name`; kinematics only asks for names the
@@ -41,6 +78,32 @@ impl ParamSymbols {
             .position(|n| n == name)
             .unwrap_or_else(|| panic!("no parameter {name}"));
         self.ids[i]
+    }
+}
+
+/// Where the base is and how it moves: a prescribed displacement and turn
+/// are parameters (inputs) whose rates are parameters too, so the time
+/// derivatives of the kinematics see them through `seeds`.
+pub struct BaseMotion {
+    /// The declared position plus the displacement.
+    pub position: [ExprId; 3],
+    /// Turn angle and its rate, about z (planar) or `base.axis` (3D).
+    pub turn: Option<(ExprId, ExprId)>,
+    /// (parameter, its rate) pairs for the kinematic time derivatives.
+    pub seeds: Vec<(ExprId, ExprId)>,
+}
+
+impl BaseMotion {
+    /// Whether parameter `name` is one of a moving base's.
+    fn moves(name: &str) -> bool {
+        let Some(rest) = name.strip_prefix("base.") else {
+            return false;
+        };
+        BASE_TURN.iter().any(|(q, _)| *q == rest)
+            || BASE_TRANSLATION.iter().any(|(q, _)| {
+                rest.strip_prefix(q)
+                    .is_some_and(|c| matches!(c, "x" | "y" | "z"))
+            })
     }
 }
 
@@ -136,6 +199,9 @@ pub struct System {
     pub tip_orientation: [ExprId; 4],
     /// Serial-chain structure, when the kinematics has it (M by composites).
     pub chain: Option<Chain>,
+    /// Extra (parameter, rate) pairs of the kinematic time derivatives: a
+    /// prescribed base motion.
+    pub seeds: Vec<(ExprId, ExprId)>,
 }
 
 impl System {

@@ -1,0 +1,230 @@
+//! A prescribed base motion against closed forms. A rigid link on a
+//! translating base feels the inertial force -m a_base at its centre of
+//! mass; on a turning base its absolute angle obeys I_O (alpha'' +
+//! theta'') = -k theta; a soft arm carried at constant velocity moves as
+//! the same arm at rest (Galilean invariance).
+
+mod common;
+
+use std::f64::consts::PI;
+
+use common::*;
+use eomgen::model::Override;
+use softarm::backend::{BackendChoice, Loaded, load};
+
+const L: f64 = 0.2;
+const M: f64 = 0.05;
+const R: f64 = 0.01;
+/// The base joint's inertia: m l^2 / 3 plus the section's m r^2 / 4.
+const I_O: f64 = M * L * L / 3.0 + M * R * R / 4.0;
+
+/// One rigid link with its joint at the base, free (no spring, no
+/// gravity) unless `extra` says otherwise; planar, or 3D with a joint
+/// about z.
+fn link(dimensions: u8, base: &str, extra: &str) -> String {
+    let axes = if dimensions == 3 {
+        "joint_axes = [\"z\"]"
+    } else {
+        ""
+    };
+    format!(
+        r#"
+name = "carried"
+dimensions = {dimensions}
+gravity = [0.0, 0.0, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+{base}
+[[segment]]
+method = "rigid"
+length = {L}
+mass = {M}
+outer_radius = {R}
+elements = 1
+joint_stiffness = 0.0
+{axes}
+{extra}
+"#
+    )
+}
+
+const SHAKE: &str = r#"
+[inputs.sx]
+kind = "sine"
+amplitude = 0.02
+frequency = 3.0
+[inputs.sy]
+kind = "sine"
+amplitude = 0.01
+frequency = 2.0
+phase = 30.0
+[inputs.still]
+kind = "constant"
+value = 0.0
+"#;
+
+fn loaded(dir: &std::path::Path, text: &str, sets: &[&str]) -> Loaded {
+    let path = dir.join("carried.toml");
+    std::fs::write(&path, text).unwrap();
+    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    load(
+        path.to_str().unwrap(),
+        &overrides,
+        BackendChoice::Auto,
+        Some(dir.join("cache")),
+    )
+    .unwrap()
+}
+
+fn accel(l: &Loaded, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
+    let mut ws = runtime::Workspace::new(q.len());
+    let mut qdd = vec![0.0; q.len()];
+    runtime::accelerations(&*l.arm, &mut ws, t, q, qd, &mut qdd).unwrap();
+    qdd
+}
+
+/// d^2/dt^2 of a sin(2 pi f t + phase).
+fn sine_accel(a: f64, f: f64, phase_deg: f64, t: f64) -> f64 {
+    let w = 2.0 * PI * f;
+    -a * w * w * (w * t + phase_deg.to_radians()).sin()
+}
+
+#[test]
+fn a_link_on_a_shaken_base_feels_minus_m_a_at_its_centre_of_mass() {
+    let dir = tempfile::tempdir().unwrap();
+    for dimensions in [2, 3] {
+        let inputs = if dimensions == 3 {
+            r#"translation_inputs = ["sx", "sy", "still"]"#
+        } else {
+            r#"translation_inputs = ["sx", "sy"]"#
+        };
+        let l = loaded(dir.path(), &link(dimensions, inputs, SHAKE), &[]);
+        for (t, theta, rate) in [(0.03, 0.4, -2.0), (0.11, -1.2, 0.5), (0.4, 2.5, 3.0)] {
+            let (ax, ay) = (
+                sine_accel(0.02, 3.0, 0.0, t),
+                sine_accel(0.01, 2.0, 30.0, t),
+            );
+            // Moment about the joint of -m a at (l/2)(cos, sin).
+            let (c, s) = (f64::cos(theta), f64::sin(theta));
+            let want = -M * (L / 2.0) * (c * ay - s * ax) / I_O;
+            let got = accel(&l, t, &[theta], &[rate])[0];
+            assert_close(
+                got,
+                want,
+                1e-10,
+                1e-12,
+                &format!("{dimensions}D theta'' at t = {t}"),
+            );
+        }
+    }
+}
+
+#[test]
+fn a_link_on_a_turning_base_keeps_its_absolute_angle_against_its_spring() {
+    // I_O (alpha'' + theta'') = -k theta, whatever the base's turn rate.
+    let dir = tempfile::tempdir().unwrap();
+    let k = 0.3;
+    let turn = r#"
+[inputs.turn]
+kind = "sine"
+amplitude = 0.5
+frequency = 1.5
+phase = 10.0
+"#;
+    for dimensions in [2, 3] {
+        let base = if dimensions == 3 {
+            "rotation_input = \"turn\"\nrotation_axis = [0.0, 0.0, 2.0]"
+        } else {
+            "rotation_input = \"turn\""
+        };
+        let l = loaded(
+            dir.path(),
+            &link(dimensions, base, turn),
+            &[&format!("segment.0.joint_stiffness={k}")],
+        );
+        for (t, theta, rate) in [(0.05, 0.3, 1.0), (0.5, -0.8, -4.0)] {
+            let alpha_dd = sine_accel(0.5, 1.5, 10.0, t);
+            let want = -k * theta / I_O - alpha_dd;
+            let got = accel(&l, t, &[theta], &[rate])[0];
+            assert_close(
+                got,
+                want,
+                1e-10,
+                1e-12,
+                &format!("{dimensions}D theta'' at t = {t}"),
+            );
+        }
+    }
+}
+
+#[test]
+fn a_soft_arm_carried_at_constant_velocity_moves_as_at_rest() {
+    // Galilean invariance: a ramp (constant velocity, zero acceleration)
+    // changes no acceleration of a 3D pcc arm under gravity, and the tip
+    // output moves with the base.
+    let dir = tempfile::tempdir().unwrap();
+    let arm = |base: &str| {
+        format!(
+            r#"
+name = "carried"
+dimensions = 3
+gravity = [0.0, -9.81, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+{base}
+[[segment]]
+method = "pcc"
+length = 0.3
+elements = 3
+density = 1000.0
+outer_radius = 0.01
+youngs_modulus = 1e6
+[inputs.slide]
+kind = "ramp"
+from = 0.0
+to = 0.5
+start = 0.0
+end = 10.0
+[inputs.still]
+kind = "constant"
+value = 0.0
+"#
+        )
+    };
+    let still = loaded(dir.path(), &arm(""), &[]);
+    let carried = loaded(
+        dir.path(),
+        &arm(r#"translation_inputs = ["slide", "still", "slide"]"#),
+        &[],
+    );
+    let n = still.arm.dof();
+    let mut rng = Rng::new(11);
+    let names = still.arm.info().coordinates.clone();
+    for t in [1.0, 4.0] {
+        let q = rng.coordinates(&names, -0.5, 0.5);
+        let qd = rng.vec(n, -1.0, 1.0);
+        let (a, b) = (accel(&still, t, &q, &qd), accel(&carried, t, &q, &qd));
+        for i in 0..n {
+            assert_close(b[i], a[i], 1e-10, 1e-9, &format!("qdd[{i}] at t = {t}"));
+        }
+        let (oa, ob) = (
+            still.arm.outputs(t, &q, &qd),
+            carried.arm.outputs(t, &q, &qd),
+        );
+        let shift = 0.05 * t;
+        assert_close(
+            ob[0] - oa[0],
+            shift,
+            1e-12,
+            1e-12,
+            "tip x moves with the base",
+        );
+        assert_close(
+            ob[2] - oa[2],
+            shift,
+            1e-12,
+            1e-12,
+            "tip z moves with the base",
+        );
+    }
+}
