@@ -35,7 +35,7 @@ pub fn derive(model: &Model) -> TapeSet {
         runtime::Tape::default()
     };
     let stiffness = cas.to_tape_hoisted(&eq.stiffness, &mut hoist);
-    let jacobian = cas.to_tape_hoisted(&eq.jacobian, &mut hoist);
+    let jvp = cas.to_tape_hoisted(&eq.jvp, &mut hoist);
     let loads = params
         .iter()
         .enumerate()
@@ -61,6 +61,6 @@ pub fn derive(model: &Model) -> TapeSet {
         derived,
         accel: accel_tape,
         stiffness,
-        jacobian,
+        jvp,
     }
 }

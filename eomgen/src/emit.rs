@@ -30,7 +30,7 @@ fn lit(c: f64) -> TokenStream {
 fn is_leaf(op: &Op) -> bool {
     matches!(
         op,
-        Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Qdd(_) | Op::Param(_) | Op::Time
+        Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Qdd(_) | Op::Dir(_) | Op::Param(_) | Op::Time
     )
 }
 
@@ -99,6 +99,10 @@ impl<'a> KernelEmitter<'a> {
             Op::Qdd(k) => {
                 let k = k as usize;
                 quote!(qdd[#k])
+            }
+            Op::Dir(k) => {
+                let k = k as usize;
+                quote!(dir[#k])
             }
             Op::Param(k) => {
                 let k = k as usize;
@@ -205,6 +209,7 @@ impl<'a> KernelEmitter<'a> {
         let n_out = self.tape.outputs.len();
         let n_chunks = self.n_chunks().max(1);
         let n_spill = self.n_spill;
+        let n_dir = 2 * dof;
         let mut chunks = Vec::new();
         let mut calls = Vec::new();
         // Members of one family at the same argument in one chunk come from
@@ -267,12 +272,12 @@ impl<'a> KernelEmitter<'a> {
             chunks.push(quote! {
                 #[inline(never)]
                 #[allow(unused_variables, clippy::all)]
-                fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], p: &[f64; #n_params],
-                      w: &mut [f64; #n_spill], out: &mut [f64; #n_out]) {
+                fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir],
+                      p: &[f64; #n_params], w: &mut [f64; #n_spill], out: &mut [f64; #n_out]) {
                     #(#body)*
                 }
             });
-            calls.push(quote!(#f(t, q, qd, qdd, p, w, out);));
+            calls.push(quote!(#f(t, q, qd, qdd, dir, p, w, out);));
         }
         let f = Ident::new(name, Span::call_site());
         let doc = format!(
@@ -293,7 +298,7 @@ impl<'a> KernelEmitter<'a> {
         };
         quote! {
             #[doc = #doc]
-            pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+            pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
                 #workspace
                 #(#calls)*
             }
@@ -388,6 +393,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     let info = &tapes.info;
     let dof = info.dof();
     let n_params = info.extended_params();
+    let n_dir = 2 * dof;
     let n_derived = info.derived;
     let accel = info.accel;
     let loads = &info.loads;
@@ -402,7 +408,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         let f = Ident::new(name, Span::call_site());
         let variant = Ident::new(&format!("{kind:?}"), Span::call_site());
         arms.push(quote! {
-            KernelKind::#variant => #f(inp.t, q, qd, qdd, p, out.try_into().expect("output length")),
+            KernelKind::#variant => #f(inp.t, q, qd, qdd, dir, p, out.try_into().expect("output length")),
         });
     }
     let tokens = quote! {
@@ -451,12 +457,18 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                 let q: &[f64; #dof] = inp.q.try_into().expect("q has DOF entries");
                 let qd: &[f64; #dof] = inp.qd.try_into().expect("qd has DOF entries");
                 let p: &[f64; #n_params] = inp.p.try_into().expect("parameter vector length");
-                // Only the Jacobian kernel reads accelerations.
+                // Only the Jvp kernel reads accelerations and a direction.
                 let no_qdd = [0.0f64; #dof];
                 let qdd: &[f64; #dof] = if inp.qdd.is_empty() {
                     &no_qdd
                 } else {
                     inp.qdd.try_into().expect("qdd has DOF entries")
+                };
+                let no_dir = [0.0f64; #n_dir];
+                let dir: &[f64; #n_dir] = if inp.dir.is_empty() {
+                    &no_dir
+                } else {
+                    inp.dir.try_into().expect("dir has 2 DOF entries")
                 };
                 match kind {
                     #(#arms)*

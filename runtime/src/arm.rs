@@ -34,8 +34,8 @@ pub trait Dynamics {
     /// Solve M x = b in place for x, M given as the packed upper triangle
     /// (the `Mass` layout); false unless M is positive definite.
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool;
-    /// The `Jacobian` kernel (dh/dq, dh/dqd, d(M qdd)/dq) at the given
-    /// accelerations.
+    /// dh/dq, dh/dqd and d(M qdd)/dq (row-major n x n each) at the given
+    /// accelerations, column by column from the `Jvp` kernel.
     fn jacobian_parts(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]);
     /// The base parameter values (layout `info().parameters`).
     fn base_params(&self) -> &[f64];
@@ -125,6 +125,7 @@ impl<K: Kernels> Arm<K> {
                 q,
                 qd,
                 qdd: &[],
+                dir: &[],
                 p,
             };
             self.kernels.eval(kind, &inp, &mut packed);
@@ -145,6 +146,7 @@ fn derived_params<K: Kernels + ?Sized>(kernels: &K, base: &[f64]) -> Vec<f64> {
         q: &zeros,
         qd: &zeros,
         qdd: &[],
+        dir: &[],
         p: &extended,
     };
     kernels.eval(KernelKind::Derived, &inp, &mut derived);
@@ -197,6 +199,7 @@ impl<K: Kernels> Dynamics for Arm<K> {
                 q,
                 qd,
                 qdd: &[],
+                dir: &[],
                 p,
             };
             self.kernels.eval(kind, &inp, out);
@@ -206,9 +209,31 @@ impl<K: Kernels> Dynamics for Arm<K> {
         self.kernels.solve_mass(packed, b, ws)
     }
     fn jacobian_parts(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
+        // Column j of dh/dq and d(M qdd)/dq along dq = e_j; of dh/dqd along
+        // dqd = e_j.
+        let n = q.len();
+        let (mut dir, mut col) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
         self.with_params(t, |p| {
-            let inp = Inputs { t, q, qd, qdd, p };
-            self.kernels.eval(KernelKind::Jacobian, &inp, out);
+            for j in 0..2 * n {
+                dir[j] = 1.0;
+                let inp = Inputs {
+                    t,
+                    q,
+                    qd,
+                    qdd,
+                    dir: &dir,
+                    p,
+                };
+                self.kernels.eval(KernelKind::Jvp, &inp, &mut col);
+                dir[j] = 0.0;
+                let (part, c) = if j < n { (0, j) } else { (1, j - n) };
+                for i in 0..n {
+                    out[part * n * n + i * n + c] = col[i];
+                    if part == 0 {
+                        out[2 * n * n + i * n + c] = col[n + i];
+                    }
+                }
+            }
         });
     }
     fn base_params(&self) -> &[f64] {

@@ -4,8 +4,9 @@
 //!   J = [[0, I], [J_q, J_qd]],  J_q = -M^-1 (dh/dq + d(M qdd)/dq),
 //!                               J_qd = -M^-1 dh/dqd,
 //!
-//! from the generated `Jacobian` kernel (differentiate M qdd + h = 0). No
-//! finite differences: implicit integrators and stiffness analysis use this.
+//! from the generated `Jvp` kernel's directional derivatives of M qdd + h = 0
+//! (`Dynamics::jacobian_parts`). No finite differences: implicit
+//! integrators and stiffness analysis use this.
 
 use nalgebra::DMatrix;
 

@@ -19,9 +19,11 @@ use crate::tape::{Inputs, Tape};
 ///   (n values, all positive when M is positive definite): the mass solve
 ///   generated as straight-line code. Present only when `ModelInfo::accel`
 ///   (small arms); otherwise the runtime solves `MassBias` output.
-/// * `Jacobian`: the parts of the right-hand side's Jacobian, row-major
-///   n x n each: dh/dq, dh/dqd, then d(M a)/dq at a = the input `qdd`.
-///   With them J_q = -M^-1 (dh/dq + d(M qdd)/dq) and J_qd = -M^-1 dh/dqd.
+/// * `Jvp`: Jacobian-vector products along the input direction (dq, dqd):
+///   dh/dq dq + dh/dqd dqd (n values), then d(M a)/dq dq at a = the input
+///   `qdd` (n values). The runtime assembles the right-hand side's
+///   Jacobian column by column from them (`Dynamics::jacobian_parts`): a
+///   kernel the size of a few `Bias` kernels instead of 3 n^2 entries.
 /// * `Stiffness`: K = d h(q, 0) / dq, row-major n x n: the tangent
 ///   stiffness of the static generalised forces (gravity, elastic, applied).
 /// * `Derived`: the derived parameters (parameter-only subexpressions the
@@ -35,13 +37,13 @@ pub enum KernelKind {
     Outputs,
     Accel,
     Stiffness,
-    Jacobian,
+    Jvp,
     Derived,
 }
 
 impl KernelKind {
     pub const ALL: [KernelKind; 8] = [
-        Self::Jacobian,
+        Self::Jvp,
         Self::Stiffness,
         Self::Accel,
         Self::Mass,
@@ -61,7 +63,7 @@ impl KernelKind {
             Self::Outputs => OUTPUT_NAMES.len(),
             Self::Derived => info.derived,
             Self::Stiffness => dof * dof,
-            Self::Jacobian => 3 * dof * dof,
+            Self::Jvp => 2 * dof,
             Self::Accel => {
                 if info.accel {
                     2 * dof
@@ -80,7 +82,7 @@ impl KernelKind {
             Self::Outputs => "outputs",
             Self::Derived => "derived",
             Self::Stiffness => "stiffness",
-            Self::Jacobian => "jacobian",
+            Self::Jvp => "jvp",
             Self::Accel => "accel",
         }
     }
@@ -164,7 +166,7 @@ pub struct TapeSet {
     /// Empty unless `info.accel`.
     pub accel: Tape,
     pub stiffness: Tape,
-    pub jacobian: Tape,
+    pub jvp: Tape,
 }
 
 impl TapeSet {
@@ -177,7 +179,7 @@ impl TapeSet {
             KernelKind::Derived => &self.derived,
             KernelKind::Accel => &self.accel,
             KernelKind::Stiffness => &self.stiffness,
-            KernelKind::Jacobian => &self.jacobian,
+            KernelKind::Jvp => &self.jvp,
         }
     }
 }

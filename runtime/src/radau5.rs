@@ -44,6 +44,11 @@ const DD: [f64; 3] = [
     -1.0 / 3.0,
 ];
 const MAX_NEWTON: usize = 7;
+/// Keep the Jacobian for the next step when the Newton iteration contracted
+/// faster than this (Hairer's THET; 0.1 is his advice for Jacobians that
+/// cost much more than a right-hand side, as an arm's, assembled from 2n
+/// directional derivatives, does).
+const REUSE_JACOBIAN_BELOW: f64 = 0.1;
 
 /// The dense output of the last accepted step.
 pub struct Dense {
@@ -104,13 +109,14 @@ pub fn integrate(
     let mut fz = vec![vec![0.0; m]; 3];
     let mut yi = vec![0.0; m];
     let mut dense: Option<Dense> = None;
-    let mut jacobian_at: Option<f64> = None;
+    // Whether J must be evaluated before the next attempt, and whether the J
+    // in hand was evaluated at the current point.
+    let (mut need_jacobian, mut fresh) = (true, false);
     while t < t_end {
         let last = begin_step(counts, opts, t, &mut h, &y)?;
-        // A rejected step retries from the same point: keep its Jacobian.
-        if jacobian_at != Some(t) {
+        if need_jacobian {
             sys.jacobian(t, &y, &mut j);
-            jacobian_at = Some(t);
+            (need_jacobian, fresh) = (false, true);
         }
         let scale: Vec<f64> = y.iter().map(|v| atol + rtol * v.abs()).collect();
         // E = I - h (A (x) J), factored once per step.
@@ -193,8 +199,10 @@ pub fn integrate(
             }
         }
         if !converged {
+            // A stale Jacobian may be why: take a new one as well.
             counts.rejected += 1;
             last_rejected = true;
+            need_jacobian = !fresh;
             h *= 0.5;
             continue;
         }
@@ -211,6 +219,7 @@ pub fn integrate(
             // A failed right-hand side or a singular matrix: retry smaller.
             counts.rejected += 1;
             last_rejected = true;
+            need_jacobian = !fresh;
             h *= 0.25;
             continue;
         }
@@ -237,6 +246,10 @@ pub fn integrate(
             t = t_new;
             y = y_new;
             sys.rhs(t, &y, &mut f0);
+            // One Newton iteration measures no contraction: J was good.
+            let contraction = if iterations > 1 { theta } else { 0.0 };
+            need_jacobian = contraction > REUSE_JACOBIAN_BELOW;
+            fresh = false;
             first = false;
             h = if last_rejected { h_new.min(h) } else { h_new };
             last_rejected = false;

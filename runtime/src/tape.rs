@@ -22,8 +22,10 @@ pub enum Op {
     Q(u32),
     /// Generalised rate `qd[i]`.
     Qd(u32),
-    /// Generalised acceleration `qdd[i]` (read by the `Jacobian` kernel).
+    /// Generalised acceleration `qdd[i]` (read by the `Jvp` kernel).
     Qdd(u32),
+    /// Component i of the `Jvp` kernel's direction (dq, then dqd).
+    Dir(u32),
     /// Runtime parameter `p[i]`.
     Param(u32),
     Time,
@@ -58,9 +60,12 @@ pub struct Inputs<'a> {
     pub t: f64,
     pub q: &'a [f64],
     pub qd: &'a [f64],
-    /// Accelerations; only the `Jacobian` kernel reads them (may be empty
-    /// for the others).
+    /// Accelerations; only the `Jvp` kernel reads them (may be empty for
+    /// the others).
     pub qdd: &'a [f64],
+    /// The `Jvp` kernel's direction (dq, dqd), 2n values (may be empty for
+    /// the others).
+    pub dir: &'a [f64],
     pub p: &'a [f64],
 }
 
@@ -83,6 +88,7 @@ impl Tape {
                 Op::Q(i) => inp.q[i as usize],
                 Op::Qd(i) => inp.qd[i as usize],
                 Op::Qdd(i) => inp.qdd[i as usize],
+                Op::Dir(i) => inp.dir[i as usize],
                 Op::Param(i) => inp.p[i as usize],
                 Op::Time => inp.t,
                 Op::Add(a, b) => s(a) + s(b),
@@ -119,7 +125,13 @@ impl Tape {
             .filter(|op| {
                 !matches!(
                     op,
-                    Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Qdd(_) | Op::Param(_) | Op::Time
+                    Op::Const(_)
+                        | Op::Q(_)
+                        | Op::Qd(_)
+                        | Op::Qdd(_)
+                        | Op::Dir(_)
+                        | Op::Param(_)
+                        | Op::Time
                 )
             })
             .count()

@@ -30,6 +30,9 @@ pub enum SymKind {
     Qd(u32),
     /// Its acceleration `qdd[i]` (only inside derivations, never lowered).
     Qdd(u32),
+    /// Component i of a directional derivative's direction (dq, then dqd):
+    /// the `Jvp` kernel's input.
+    Dir(u32),
     /// Runtime parameter `p[i]`.
     Param(u32),
     /// Time t.

@@ -22,7 +22,7 @@
 //! For statics: the static generalised force h(q, 0) (gravity, elastic and
 //! applied forces) and the stiffness K = d h(q, 0) / dq.
 
-use crate::cas::{Cas, ExprId, Variables};
+use crate::cas::{Cas, ExprId, SymKind, Variables};
 
 use super::chain::{ChainKinematics, MomentItem, PointItem};
 use super::system::System;
@@ -36,8 +36,9 @@ pub struct Equations {
     pub outputs: Vec<ExprId>,
     /// K = d h(q, 0) / dq, row-major n x n.
     pub stiffness: Vec<ExprId>,
-    /// dh/dq, dh/dqd and d(M qdd)/dq, each row-major n x n.
-    pub jacobian: Vec<ExprId>,
+    /// Along the direction (dq, dqd) (`SymKind::Dir` symbols): dh/dq dq +
+    /// dh/dqd dqd, then d(M qdd)/dq dq; 2n values.
+    pub jvp: Vec<ExprId>,
 }
 
 fn triple(v: &[ExprId], i: usize) -> [ExprId; 3] {
@@ -103,7 +104,7 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     }
 
     // M: by composite bodies for a chain, else the Jacobian of the
-    // generalised momentum T^T Mbar T qd (which the Jacobian kernel needs
+    // generalised momentum T^T Mbar T qd (which the Jvp kernel needs
     // anyway).
     let momentum = cas.vjp(&outs[..6 * nb], &momentum_cot, &sys.coords.qd);
     let kinematics = sys
@@ -263,23 +264,28 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         .zip(sys.coords.qdd.iter().copied())
         .collect();
     let m_qdd = cas.time_derivatives(&momentum, &accel_pairs);
-    let mut jacobian = Vec::with_capacity(3 * n * n);
-    for (set, wrt) in [
-        (&bias, &sys.coords.q),
-        (&bias, &sys.coords.qd),
-        (&m_qdd, &sys.coords.q),
-    ] {
-        for &e in set.iter() {
-            for &x in wrt.iter() {
-                jacobian.push(cas.diff(e, x));
-            }
-        }
-    }
+    // One directional derivative each, not n^2 partials: the runtime takes
+    // the Jacobian's columns along unit directions.
+    let names = &sys.coords.names;
+    let dq: Vec<ExprId> = (0..n)
+        .map(|i| cas.symbol(&format!("{}_dir", names[i]), SymKind::Dir(i as u32)))
+        .collect();
+    let dqd: Vec<ExprId> = (0..n)
+        .map(|i| {
+            let k = (n + i) as u32;
+            cas.symbol(&format!("{}_dot_dir", names[i]), SymKind::Dir(k))
+        })
+        .collect();
+    let along_q: Vec<(ExprId, ExprId)> = sys.coords.q.iter().copied().zip(dq).collect();
+    let mut along_both = along_q.clone();
+    along_both.extend(sys.coords.qd.iter().copied().zip(dqd));
+    let mut jvp = cas.time_derivatives(&bias, &along_both);
+    jvp.extend(cas.time_derivatives(&m_qdd, &along_q));
     Equations {
         mass_upper: mass,
         bias,
         outputs,
         stiffness,
-        jacobian,
+        jvp,
     }
 }

@@ -112,7 +112,7 @@ pub struct Coordinates {
     pub names: Vec<String>,
     pub q: Vec<ExprId>,
     pub qd: Vec<ExprId>,
-    /// Accelerations (inputs of the `Jacobian` kernel only).
+    /// Accelerations (inputs of the `Jvp` kernel only).
     pub qdd: Vec<ExprId>,
 }
 
