@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Fresh clone to the STIFF-FLOP result (issue 6, BENCHMARKS.md): clone this
+# repository, build the release binary from scratch (crates already
+# downloaded), simulate the 54.65 s record. Prints the three wall times.
+# Usage: benches/end_to_end.sh [REPO] [WORKDIR]
+set -euo pipefail
+repo=${1:-$(git -C "$(dirname "$0")/.." rev-parse --show-toplevel)}
+work=${2:-$(mktemp -d)}
+rm -rf "$work/e2e"
+start=$(date +%s.%N)
+git clone -q "$repo" "$work/e2e"
+cd "$work/e2e"
+cloned=$(date +%s.%N)
+cargo build --release --quiet
+built=$(date +%s.%N)
+./target/release/softarm simulate stiff_flop --out "$work/e2e-out" > /dev/null 2>&1
+done_=$(date +%s.%N)
+python3 - "$start" "$cloned" "$built" "$done_" "$work/e2e-out/summary.json" <<'PY'
+import json, sys
+s, c, b, d = map(float, sys.argv[1:5])
+e = json.load(open(sys.argv[5]))["tip_error"]
+print(f"clone {c - s:.1f} s, build {b - c:.1f} s, simulate {d - b:.1f} s, total {d - s:.1f} s; "
+      f"mean tip error {1e3 * e['mean_m']:.3f} mm")
+PY
