@@ -708,23 +708,34 @@ fn malformed_actuators_inputs_and_measurements_are_rejected_clearly() {
             "base turned by an undeclared channel",
             r(
                 "direction = [1.0, 0.0, 0.0]",
-                "direction = [1.0, 0.0, 0.0]\nrotation_input = \"spin\"",
+                "direction = [1.0, 0.0, 0.0]\nrotation_inputs = [\"p\", \"spin\"]",
             ),
-            vec!["base.rotation_input", "no input channel \"spin\""],
+            vec!["base.rotation_inputs[1]", "no input channel \"spin\""],
         ),
         (
             "base rotation axis zero",
             r(
                 "direction = [1.0, 0.0, 0.0]",
-                "direction = [1.0, 0.0, 0.0]\nrotation_input = \"p\"\nrotation_axis = [0, 0, 0]",
+                "direction = [1.0, 0.0, 0.0]\nrotation_inputs = [\"p\"]\nrotation_axes = [[0, 0, 0]]",
             ),
-            vec!["base.rotation_axis", "non-zero"],
+            vec!["base.rotation_axes[0]", "non-zero"],
+        ),
+        (
+            "base rotation axes per input",
+            r(
+                "direction = [1.0, 0.0, 0.0]",
+                "direction = [1.0, 0.0, 0.0]\nrotation_inputs = [\"p\", \"p\"]\nrotation_axes = [[0, 0, 1]]",
+            ),
+            vec![
+                "base.rotation_axes",
+                "one axis per rotation input (2), got 1",
+            ],
         ),
         (
             "moving base with eba",
             r(
                 "direction = [1.0, 0.0, 0.0]",
-                "direction = [1.0, 0.0, 0.0]\nrotation_input = \"p\"",
+                "direction = [1.0, 0.0, 0.0]\nrotation_inputs = [\"p\"]",
             )
             .replacen("method = \"pcc\"", "method = \"eba\"", 1),
             vec!["base", "not supported with eba"],

@@ -130,20 +130,36 @@ kind = "sine"
 amplitude = 0.5
 frequency = 1.5
 phase = 10.0
+[inputs.turn2]
+kind = "sine"
+amplitude = 0.2
+frequency = 0.7
 "#;
-    for dimensions in [2, 3] {
-        let base = if dimensions == 3 {
-            "rotation_input = \"turn\"\nrotation_axis = [0.0, 0.0, 2.0]"
-        } else {
-            "rotation_input = \"turn\""
-        };
+    // In 3D also as two turns about z (the second after the first): the
+    // angles add.
+    let cases = [
+        (2, "rotation_inputs = [\"turn\"]"),
+        (
+            3,
+            "rotation_inputs = [\"turn\"]\nrotation_axes = [[0.0, 0.0, 2.0]]",
+        ),
+        (
+            3,
+            "rotation_inputs = [\"turn\", \"turn2\"]\nrotation_axes = [[0.0, 0.0, 1.0], [0.0, 0.0, 3.0]]",
+        ),
+    ];
+    for (dimensions, base) in cases {
         let l = loaded(
             dir.path(),
             &link(dimensions, base, turn),
             &[&format!("segment.0.joint_stiffness={k}")],
         );
+        let two = base.contains("turn2");
         for (t, theta, rate) in [(0.05, 0.3, 1.0), (0.5, -0.8, -4.0)] {
-            let alpha_dd = sine_accel(0.5, 1.5, 10.0, t);
+            let mut alpha_dd = sine_accel(0.5, 1.5, 10.0, t);
+            if two {
+                alpha_dd += sine_accel(0.2, 0.7, 0.0, t);
+            }
             let want = -k * theta / I_O - alpha_dd;
             let got = accel(&l, t, &[theta], &[rate])[0];
             assert_close(
@@ -151,9 +167,32 @@ phase = 10.0
                 want,
                 1e-10,
                 1e-12,
-                &format!("{dimensions}D theta'' at t = {t}"),
+                &format!("{dimensions}D ({base}) theta'' at t = {t}"),
             );
         }
+    }
+}
+
+#[test]
+fn base_turns_compose_in_sequence_about_the_turned_axes() {
+    // Yaw 90 degrees about z, then pitch 90 degrees about the turned y:
+    // Rz(90) Ry(90) takes the arm's +x to -z. A straight arm without loads
+    // stays straight, so its tip is L below the base.
+    let dir = tempfile::tempdir().unwrap();
+    let base = r#"position = [0.1, 0.2, 0.3]
+rotation_inputs = ["yaw", "pitch"]"#;
+    let inputs = r#"
+[inputs.yaw]
+kind = "constant"
+value = 1.5707963267948966
+[inputs.pitch]
+kind = "constant"
+value = 1.5707963267948966
+"#;
+    let l = loaded(dir.path(), &link(3, base, inputs), &[]);
+    let o = l.arm.outputs(0.0, &[0.0], &[0.0]);
+    for (k, want) in [0.1, 0.2, 0.3 - L].into_iter().enumerate() {
+        assert_close(o[k], want, 1e-12, 1e-15, &format!("tip component {k}"));
     }
 }
 

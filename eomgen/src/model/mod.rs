@@ -16,6 +16,6 @@ pub use schema::{
 pub use signals::{Compare, Input, Offset};
 pub use structure::{
     BASE_TRANSLATION, BASE_TURN, Driven, ElementProps, GENERATOR_VERSION, SegmentShape, Structure,
-    base_rotation, drives, element_props, parameters,
+    base_rotation, base_turn_axis, drives, element_props, parameters,
 };
 pub use validate::MAX_ELEMENTS;

@@ -79,13 +79,15 @@ pub struct Base {
     /// acceleration enter the equations).
     #[serde(default)]
     pub translation_inputs: Option<Vec<String>>,
-    /// A prescribed base rotation: input channel of the angle (rad) turned
-    /// about `rotation_axis` (3D; z in the plane), on top of `direction`.
+    /// A prescribed base rotation: input channels of angles (rad) turned in
+    /// sequence, each about its axis in the frame the turns before it left
+    /// (intrinsic: z, y, x are yaw, pitch and roll), then `direction`. One
+    /// turn, about z, in the plane. Structural.
     #[serde(default)]
-    pub rotation_input: Option<String>,
-    /// World axis of `rotation_input` (3D, any length; default z).
+    pub rotation_inputs: Option<Vec<String>>,
+    /// The axis of each turn (3D, any length); default z, y, x in turn.
     #[serde(default)]
-    pub rotation_axis: Option<[f64; 3]>,
+    pub rotation_axes: Option<Vec<[f64; 3]>>,
 }
 
 /// How a segment is modelled. Structural: changing it derives anew.

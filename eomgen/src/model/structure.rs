@@ -71,9 +71,9 @@ pub struct Structure {
     pub tendons: Vec<usize>,
     /// The coordinates that driven generalised forces act on.
     pub torques: Vec<String>,
-    /// The base translates, turns (prescribed by inputs).
+    /// The base translates; how many prescribed turns it makes.
     pub base_translates: bool,
-    pub base_turns: bool,
+    pub base_turns: usize,
 }
 
 impl Structure {
@@ -139,7 +139,7 @@ impl Structure {
                 .collect(),
             torques: m.torques.iter().map(|t| t.coordinate.clone()).collect(),
             base_translates: m.base.translation_inputs.is_some(),
-            base_turns: m.base.rotation_input.is_some(),
+            base_turns: m.base.rotation_inputs.as_ref().map_or(0, Vec::len),
         }
     }
 
@@ -202,7 +202,7 @@ impl Structure {
         if !self.torques.is_empty() {
             s.push_str(&format!("torques {:?}\n", self.torques));
         }
-        if self.base_translates || self.base_turns {
+        if self.base_translates || self.base_turns > 0 {
             s.push_str(&format!(
                 "base moves {} {}\n",
                 self.base_translates, self.base_turns
@@ -360,15 +360,15 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
             }
         }
     }
-    if m.base.rotation_input.is_some() {
+    for i in 0..m.base.rotation_inputs.as_ref().map_or(0, Vec::len) {
         for (quantity, _) in BASE_TURN {
-            p.push((format!("base.{quantity}"), 0.0));
+            p.push((format!("base.{quantity}[{i}]"), 0.0));
         }
         if m.dimensions == 3 {
-            let a = m.base.rotation_axis.unwrap_or([0.0, 0.0, 1.0]);
+            let a = base_turn_axis(m, i);
             let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
             for (c, v) in ["x", "y", "z"].iter().zip(a) {
-                p.push((format!("base.axis.{c}"), v / n));
+                p.push((format!("base.axis[{i}].{c}"), v / n));
             }
         }
     }
@@ -464,7 +464,17 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
 /// The base-motion parameters (name prefix) and the time derivative of
 /// the input they take: displacement s, velocity v, acceleration a.
 pub const BASE_TRANSLATION: [(&str, u8); 3] = [("s", 0), ("v", 1), ("a", 2)];
-/// The turn angle, its rate and its acceleration.
+/// The axis of base turn i: as declared, else z, y, x in turn.
+pub fn base_turn_axis(m: &Model, i: usize) -> [f64; 3] {
+    const DEFAULT: [[f64; 3]; 3] = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]];
+    m.base
+        .rotation_axes
+        .as_ref()
+        .and_then(|a| a.get(i).copied())
+        .unwrap_or(DEFAULT[i % 3])
+}
+
+/// A turn's angle, rate and acceleration (one set per turn, `[i]`).
 pub const BASE_TURN: [(&str, u8); 3] = [("turn", 0), ("omega", 1), ("alpha", 2)];
 
 /// A runtime parameter an input channel drives: the channel's value, or its
@@ -498,10 +508,10 @@ pub fn drives(m: &Model) -> Vec<Driven> {
             }
         }
     }
-    if let Some(n) = &m.base.rotation_input {
+    for (i, n) in m.base.rotation_inputs.iter().flatten().enumerate() {
         for (quantity, derivative) in BASE_TURN {
             d.push(Driven {
-                param: format!("base.{quantity}"),
+                param: format!("base.{quantity}[{i}]"),
                 channel: n.clone(),
                 derivative,
             });

@@ -492,25 +492,45 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             channel(&format!("base.translation_inputs[{i}]"), n)?;
         }
     }
-    if let Some(n) = &m.base.rotation_input {
-        channel("base.rotation_input", n)?;
+    let turns = m.base.rotation_inputs.as_deref().unwrap_or_default();
+    if m.dimensions != 3 && turns.len() > 1 {
+        return err(
+            "base.rotation_inputs".into(),
+            format!(
+                "a planar base turns about z only: give one input channel, got {}",
+                turns.len()
+            ),
+        );
     }
-    if let Some(a) = &m.base.rotation_axis {
+    for (i, n) in turns.iter().enumerate() {
+        channel(&format!("base.rotation_inputs[{i}]"), n)?;
+    }
+    if let Some(axes) = &m.base.rotation_axes {
         if m.dimensions != 3 {
             return err(
-                "base.rotation_axis".into(),
-                "a planar base turns about z: leave rotation_axis out".into(),
+                "base.rotation_axes".into(),
+                "a planar base turns about z: leave rotation_axes out".into(),
             );
         }
-        vec3("base.rotation_axis", a)?;
-        if a.iter().all(|&c| c == 0.0) {
+        if axes.len() != turns.len() {
             return err(
-                "base.rotation_axis".into(),
-                "must be a non-zero vector".into(),
+                "base.rotation_axes".into(),
+                format!(
+                    "give one axis per rotation input ({}), got {}",
+                    turns.len(),
+                    axes.len()
+                ),
             );
+        }
+        for (i, a) in axes.iter().enumerate() {
+            let key = format!("base.rotation_axes[{i}]");
+            vec3(&key, a)?;
+            if a.iter().all(|&c| c == 0.0) {
+                return err(key, "must be a non-zero vector".into());
+            }
         }
     }
-    let moving = m.base.translation_inputs.is_some() || m.base.rotation_input.is_some();
+    let moving = m.base.translation_inputs.is_some() || !turns.is_empty();
     if moving && m.segments.iter().any(|s| s.method == Method::Eba) {
         return err(
             "base".into(),

@@ -48,7 +48,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
     let zero = cas.zero();
 
     let base = symbols.base_motion(cas);
-    let (phi, w) = match base.turn {
+    let (phi, w) = match base.turns.first().copied() {
         Some((angle, rate)) => (cas.add(param("base.angle"), angle), rate),
         None => (param("base.angle"), zero),
     };

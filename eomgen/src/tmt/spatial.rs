@@ -313,13 +313,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
     let zero = cas.zero();
 
     let base = symbols.base_motion(cas);
-    let (r0, w0, quat0) = base_frame(cas, &symbols, base.turn);
-    let mut f = Frame {
-        r: r0,
-        p: base.position,
-        w: w0,
-        quat: quat0,
-    };
+    let mut f = base_frame(cas, &symbols, base.position, &base.turns);
     let mut bodies = Vec::new();
     let mut elastic = Vec::new();
     let mut rayleigh = Vec::new();
@@ -568,38 +562,42 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
     sys
 }
 
-/// The base frame: the declared orientation (rotation, quaternion), turned
-/// by the prescribed angle about `base.axis` when the base turns, and its
-/// angular velocity.
+/// The base frame at `position`: the prescribed turns in sequence, each
+/// about its axis `base.axis[i]` in the frame the turns before it left,
+/// then the declared direction (rotation and quaternion parameters).
 fn base_frame(
     cas: &mut Cas,
     symbols: &super::system::ParamSymbols,
-    turn: Option<(ExprId, ExprId)>,
-) -> (M3, V3, Quat) {
+    position: V3,
+    turns: &[(ExprId, ExprId)],
+) -> Frame {
     let param = |name: &str| symbols.get(name);
-    let r: M3 = std::array::from_fn(|i| std::array::from_fn(|j| param(&format!("base.R{i}{j}"))));
-    let quat = ["qw", "qx", "qy", "qz"].map(|c| param(&format!("base.{c}")));
-    let Some((angle, rate)) = turn else {
-        return (r, [cas.zero(); 3], quat);
+    let (zero, one) = (cas.zero(), cas.one());
+    let mut f = Frame {
+        r: std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one } else { zero })),
+        p: position,
+        w: [zero; 3],
+        quat: [one, zero, zero, zero],
     };
-    let n = ["x", "y", "z"].map(|c| param(&format!("base.axis.{c}")));
-    // exp(angle [n]x) = cos I + sin [n]x + (1 - cos) n n^T, n a unit vector.
-    let (c, s) = (cas.cos(angle), cas.sin(angle));
-    let one = cas.one();
-    let versine = cas.sub(one, c);
-    let turn = rotation(cas, &n, [c, s, versine]);
-    let r = std::array::from_fn(|i| {
-        std::array::from_fn(|j| {
-            let col = [r[0][j], r[1][j], r[2][j]];
-            let e = cas.dot(&turn[i], &col);
-            cas.bind(e)
-        })
-    });
-    let w = n.map(|k| cas.mul(k, rate));
-    let half = cas.scaled(0.5, angle);
-    let (ch, sh) = (cas.cos(half), cas.sin(half));
-    let q_turn = [ch, cas.mul(sh, n[0]), cas.mul(sh, n[1]), cas.mul(sh, n[2])];
-    (r, w, quat_mul(cas, &q_turn, &quat))
+    for (i, &(angle, rate)) in turns.iter().enumerate() {
+        let n = ["x", "y", "z"].map(|c| param(&format!("base.axis[{i}].{c}")));
+        // exp(angle [n]x) = cos I + sin [n]x + (1 - cos) n n^T, n a unit vector.
+        let (c, s) = (cas.cos(angle), cas.sin(angle));
+        let versine = cas.sub(one, c);
+        let r = rotation(cas, &n, [c, s, versine]);
+        let half = cas.scaled(0.5, angle);
+        let (ch, sh) = (cas.cos(half), cas.sin(half));
+        let q = [ch, cas.mul(sh, n[0]), cas.mul(sh, n[1]), cas.mul(sh, n[2])];
+        let w = n.map(|k| cas.mul(k, rate));
+        f = compose(cas, &f, Some((&r, &q)), None, Some(&w));
+    }
+    let r: M3 = std::array::from_fn(|i| std::array::from_fn(|j| param(&format!("base.R{i}{j}"))));
+    let q = ["qw", "qx", "qy", "qz"].map(|c| param(&format!("base.{c}")));
+    if turns.is_empty() {
+        // The identity folds away, but say so: a still base is its parameters.
+        return Frame { r, quat: q, ..f };
+    }
+    compose(cas, &f, Some((&r, &q)), None, None)
 }
 
 /// The strain fields of a rom segment, in coordinate order.

@@ -52,14 +52,16 @@ impl ParamSymbols {
                 chain(&mut seeds, sva);
             }
         }
-        let turn = self.has("base.turn").then(|| {
-            let t = BASE_TURN.map(|(q, _)| self.get(&format!("base.{q}")));
+        let mut turns = Vec::new();
+        while self.has(&format!("base.turn[{}]", turns.len())) {
+            let i = turns.len();
+            let t = BASE_TURN.map(|(q, _)| self.get(&format!("base.{q}[{i}]")));
             chain(&mut seeds, t);
-            (t[0], t[1])
-        });
+            turns.push((t[0], t[1]));
+        }
         BaseMotion {
             position,
-            turn,
+            turns,
             seeds,
         }
     }
@@ -87,8 +89,9 @@ impl ParamSymbols {
 pub struct BaseMotion {
     /// The declared position plus the displacement.
     pub position: [ExprId; 3],
-    /// Turn angle and its rate, about z (planar) or `base.axis` (3D).
-    pub turn: Option<(ExprId, ExprId)>,
+    /// Turn angles and their rates, in sequence: about z (planar, one) or
+    /// `base.axis[i]` (3D, each in the frame the turns before it left).
+    pub turns: Vec<(ExprId, ExprId)>,
     /// (parameter, its rate) pairs for the kinematic time derivatives.
     pub seeds: Vec<(ExprId, ExprId)>,
 }
@@ -99,7 +102,9 @@ impl BaseMotion {
         let Some(rest) = name.strip_prefix("base.") else {
             return false;
         };
-        BASE_TURN.iter().any(|(q, _)| *q == rest)
+        BASE_TURN
+            .iter()
+            .any(|(q, _)| rest.strip_prefix(q).is_some_and(|i| i.starts_with('[')))
             || BASE_TRANSLATION.iter().any(|(q, _)| {
                 rest.strip_prefix(q)
                     .is_some_and(|c| matches!(c, "x" | "y" | "z"))
