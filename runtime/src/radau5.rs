@@ -16,7 +16,7 @@ use differential_equations::error::Error;
 use differential_equations::interpolate::Interpolation;
 use nalgebra::{DMatrix, DVector};
 
-use crate::stepper::{Counts, OdeSystem, Options, StepFn, begin_step};
+use crate::stepper::{Counts, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, begin_step};
 
 /// sqrt(6)
 const SQ6: f64 = 2.449_489_742_783_178;
@@ -44,11 +44,6 @@ const DD: [f64; 3] = [
     -1.0 / 3.0,
 ];
 const MAX_NEWTON: usize = 7;
-/// Keep the Jacobian for the next step when the Newton iteration contracted
-/// faster than this (Hairer's THET; 0.1 is his advice for Jacobians that
-/// cost much more than a right-hand side, as an arm's, assembled from 2n
-/// directional derivatives, does).
-const REUSE_JACOBIAN_BELOW: f64 = 0.1;
 
 /// The dense output of the last accepted step.
 pub struct Dense {

@@ -6,6 +6,12 @@ use differential_equations::error::Error;
 use differential_equations::interpolate::Interpolation;
 use nalgebra::DMatrix;
 
+/// Keep the Jacobian for the next step when the Newton iteration contracted
+/// faster than this (Hairer's THET; 0.1 is his advice for Jacobians that
+/// cost much more than a right-hand side, as an arm's, assembled from 2n
+/// directional derivatives, does). radau5 and trbdf2 share it.
+pub const REUSE_JACOBIAN_BELOW: f64 = 0.1;
+
 /// y' = f(t, y), with its Jacobian df/dy for implicit methods.
 pub trait OdeSystem {
     fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]);

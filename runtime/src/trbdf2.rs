@@ -13,7 +13,8 @@ use differential_equations::error::Error;
 use nalgebra::{DMatrix, DVector};
 
 use crate::stepper::{
-    Counts, Hermite, OdeSystem, Options, StepFn, begin_step, error_norm, next_step,
+    Counts, Hermite, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, begin_step, error_norm,
+    next_step,
 };
 
 const SQRT2: f64 = std::f64::consts::SQRT_2;
@@ -39,15 +40,15 @@ fn newton(
     k: &mut [f64],
     scale: &[f64],
     tol: f64,
-) -> bool {
+) -> Option<f64> {
     let m = x.len();
     let mut previous = f64::INFINITY;
+    // The slowest contraction seen (none after a single iteration).
+    let mut slowest: f64 = 0.0;
     for it in 0..MAX_NEWTON {
         sys.rhs(t, x, k);
         let r = DVector::from_iterator(m, (0..m).map(|i| base[i] + dh * k[i] - x[i]));
-        let Some(dx) = lu.solve(&r) else {
-            return false;
-        };
+        let dx = lu.solve(&r)?;
         let norm = (dx
             .iter()
             .zip(scale)
@@ -56,22 +57,25 @@ fn newton(
             / m as f64)
             .sqrt();
         if !norm.is_finite() {
-            return false;
+            return None;
         }
         for i in 0..m {
             x[i] += dx[i];
         }
         let rate = if it == 0 { 0.5 } else { norm / previous };
         if rate >= 0.9 {
-            return false;
+            return None;
+        }
+        if it > 0 {
+            slowest = slowest.max(rate);
         }
         previous = norm;
         if rate / (1.0 - rate) * norm <= tol || norm <= 1e-3 * tol {
             sys.rhs(t, x, k);
-            return true;
+            return Some(slowest);
         }
     }
-    false
+    None
 }
 
 /// Integrate from (t0, y0) to `opts.t_end`.
@@ -93,16 +97,19 @@ pub fn integrate(
     let (mut k2, mut k3) = (vec![0.0; m], vec![0.0; m]);
     let (mut z, mut y_new, mut base) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
     let mut j = DMatrix::zeros(m, m);
-    let mut jacobian_at: Option<f64> = None;
+    // Whether J must be evaluated before the next attempt, and whether the J
+    // in hand was evaluated at the current point (kept while Newton
+    // contracts fast, as radau5 does).
+    let (mut need_jacobian, mut fresh) = (true, false);
     let span = t_end - t0;
     let d1 = error_norm(&k1, &y, &y, rtol, atol);
     let mut h = if d1 > 1e-5 { 0.01 / d1 } else { 1e-6 * span }.clamp(1e-10 * span, span);
     let mut rejected_last = false;
     while t < t_end {
         let last = begin_step(counts, opts, t, &mut h, &y)?;
-        if jacobian_at != Some(t) {
+        if need_jacobian {
             sys.jacobian(t, &y, &mut j);
-            jacobian_at = Some(t);
+            (need_jacobian, fresh) = (false, true);
         }
         let mut e = -(&j) * (D * h);
         for i in 0..m {
@@ -127,7 +134,7 @@ pub fn integrate(
             newton_tol,
         );
         // BDF2 stage: y_new = y + w h (k1 + k2) + d h f(t + h, y_new).
-        let ok = ok && {
+        let ok = ok.and_then(|first| {
             for i in 0..m {
                 base[i] = y[i] + W * h * (k1[i] + k2[i]);
                 y_new[i] = y[i] + h * k2[i];
@@ -144,13 +151,16 @@ pub fn integrate(
                 &scale,
                 newton_tol,
             )
-        };
-        if !ok {
+            .map(|second| first.max(second))
+        });
+        let Some(contraction) = ok else {
+            // A stale Jacobian may be why: take a new one as well.
             counts.rejected += 1;
             rejected_last = true;
+            need_jacobian = !fresh;
             h *= 0.25;
             continue;
-        }
+        };
         // The estimate, filtered by (I - d h J)^-1 as in ode23tb.
         let raw = DVector::from_iterator(
             m,
@@ -176,6 +186,8 @@ pub fn integrate(
             t = t_new;
             std::mem::swap(&mut y, &mut y_new);
             std::mem::swap(&mut k1, &mut k3);
+            need_jacobian = contraction > REUSE_JACOBIAN_BELOW;
+            fresh = false;
             h = next_step(h, err, true, rejected_last);
             rejected_last = false;
             if !keep_going {
