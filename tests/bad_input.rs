@@ -732,15 +732,6 @@ fn malformed_actuators_inputs_and_measurements_are_rejected_clearly() {
             ],
         ),
         (
-            "moving base with eba",
-            r(
-                "direction = [1.0, 0.0, 0.0]",
-                "direction = [1.0, 0.0, 0.0]\nrotation_inputs = [\"p\"]",
-            )
-            .replacen("method = \"pcc\"", "method = \"eba\"", 1),
-            vec!["base", "not supported with eba"],
-        ),
-        (
             "torque from an undeclared channel",
             format!("{base}[[torque]]\ncoordinate = \"bend_y_0_1\"\ninput = \"tau\"\n"),
             vec!["torque[0].input", "no input channel \"tau\""],

@@ -267,3 +267,69 @@ value = 0.0
         );
     }
 }
+
+#[test]
+fn a_base_accelerating_up_at_g_is_gravity_for_every_method() {
+    // The equivalence principle: without gravity, a base whose height
+    // follows g t^2 / 2 (a measured-style CSV table: its central
+    // differences are exact for a parabola inside the record) gives every
+    // method the accelerations that gravity gives it on a still base.
+    let dir = tempfile::tempdir().unwrap();
+    let g = 9.81;
+    let mut csv = String::from("time,height\n");
+    for i in 0..=40 {
+        let t = 0.05 * f64::from(i);
+        csv.push_str(&format!("{t},{}\n", 0.5 * g * t * t));
+    }
+    std::fs::write(dir.path().join("lift.csv"), csv).unwrap();
+    let arm = |method: &str, gravity: f64, base: &str| {
+        format!(
+            r#"
+name = "lifted"
+dimensions = 3
+gravity = [0.0, {gravity}, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+{base}
+[[segment]]
+method = "{method}"
+length = 0.3
+elements = 2
+density = 1000.0
+outer_radius = 0.01
+youngs_modulus = 1e6
+[inputs.lift]
+kind = "csv"
+file = "{}"
+column = "height"
+[inputs.still]
+kind = "constant"
+value = 0.0
+"#,
+            dir.path().join("lift.csv").display()
+        )
+    };
+    let lifted = r#"translation_inputs = ["still", "lift", "still"]"#;
+    for method in ["pcc", "ebr", "eba", "rom", "rigid"] {
+        let still = loaded(dir.path(), &arm(method, -g, ""), &[]);
+        let moving = loaded(dir.path(), &arm(method, 0.0, lifted), &[]);
+        let n = still.arm.dof();
+        let names = still.arm.info().coordinates.clone();
+        let mut rng = Rng::new(5);
+        for t in [0.52, 1.23] {
+            let q: Vec<f64> = rng.coordinates(&names, -0.3, 0.3);
+            let q: Vec<f64> = q.iter().map(|v| 0.2 * v).collect();
+            let qd = rng.vec(n, -0.5, 0.5);
+            let (a, b) = (accel(&still, t, &q, &qd), accel(&moving, t, &q, &qd));
+            for i in 0..n {
+                assert_close(
+                    b[i],
+                    a[i],
+                    1e-9,
+                    1e-9,
+                    &format!("{method}: qdd[{i}] ({}) at t = {t}", names[i]),
+                );
+            }
+        }
+    }
+}

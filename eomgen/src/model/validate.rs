@@ -530,14 +530,6 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             }
         }
     }
-    let moving = m.base.translation_inputs.is_some() || !turns.is_empty();
-    if moving && m.segments.iter().any(|s| s.method == Method::Eba) {
-        return err(
-            "base".into(),
-            "a moving base is not supported with eba segments (absolute states); use pcc, vc, ebr, rom or rigid"
-                .into(),
-        );
-    }
     if !m.torques.is_empty() {
         let names = crate::tmt::coordinate_names(m);
         for (i, t) in m.torques.iter().enumerate() {

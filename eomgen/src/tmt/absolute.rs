@@ -24,8 +24,7 @@ use crate::model::{Model, Structure};
 
 use super::actuation::{Strain, actuation, thinning};
 use super::spatial::{
-    M3, V3, bind3, coefficients, half_k_sq, left_jacobian, mat_vec, quat_mul, rotation,
-    rotation_quat,
+    M3, V3, add3, bind3, coefficients, half_k_sq, left_jacobian, quat_mul, rotation, rotation_quat,
 };
 use super::system::{Body, Coordinates, Inertia, ParamSymbols, System, TipMount, tip_loads};
 
@@ -72,9 +71,15 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
     }
     let coords = Coordinates::new(cas, coord_names);
     let zero = cas.zero();
-    let r0: M3 = std::array::from_fn(|i| std::array::from_fn(|j| param(&format!("base.R{i}{j}"))));
-    let p0 = [param("base.x"), param("base.y"), param("base.z")];
+    // The base frame, moving when prescribed: the absolute states are then
+    // measured from the moving base's straight arm.
+    let base = symbols.base_motion(cas);
+    let frame = super::spatial::base_frame(cas, &symbols, base.position, &base.turns);
+    let (r0, p0, w0) = (frame.r, frame.p, frame.w);
     let base_axis = [r0[0][0], r0[1][0], r0[2][0]];
+    // Rates (of the damping) relative to a moving base, too.
+    let mut pairs = coords.rate_pairs();
+    pairs.extend(&base.seeds);
 
     let mut bodies = Vec::new();
     let mut elastic = Vec::new();
@@ -86,7 +91,7 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
     };
     let mut along = zero; // arc length to the current element's start
     let mut omega = [zero; 3];
-    let q0 = ["qw", "qx", "qy", "qz"].map(|c| param(&format!("base.{c}")));
+    let q0 = frame.quat;
     let mut quat = q0;
     let segment_of: Vec<usize> = structure
         .segments
@@ -124,7 +129,8 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
         let w_local = left_jacobian(cas, &psi, &psi_d, [c1, c2, c3]);
         let q_rel = rotation_quat(cas, &psi, w);
         quat = quat_mul(cas, &q0, &q_rel);
-        omega = mat_vec(cas, &r0, &w_local);
+        let turned = cas.turn(&r0, &w0, &w_local);
+        omega = add3(cas, &w0, &turned);
         omega = bind3(cas, omega);
         let axis = [r[0][0], r[1][0], r[2][0]];
         bodies.push(Body {
@@ -164,7 +170,6 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
             let h = cas.scaled(2.0, h);
             cas.bind(h)
         });
-        let pairs = coords.rate_pairs();
         let end_a = prev.end(cas, 1.0);
         let start_b = slab.end(cas, -1.0);
         let gap: V3 = std::array::from_fn(|i| cas.sub(start_b[i], end_a[i]));
@@ -226,8 +231,7 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
         tip,
         tip_orientation: quat,
         chain: None,
-        // Validation keeps eba's base still.
-        seeds: Vec::new(),
+        seeds: base.seeds,
     };
     let mount = TipMount {
         point: tip,

@@ -73,13 +73,13 @@ pub(super) fn rotation_quat(cas: &mut Cas, rho: &V3, w: ExprId) -> Quat {
 
 /// A frame: R (world from frame), origin and world angular velocity.
 #[derive(Clone, Copy)]
-struct Frame {
-    r: M3,
-    p: V3,
-    w: V3,
+pub(super) struct Frame {
+    pub r: M3,
+    pub p: V3,
+    pub w: V3,
     /// The orientation as a unit quaternion (w, x, y, z), composed alongside
     /// R (an output only: exact products, no square roots).
-    quat: Quat,
+    pub quat: Quat,
 }
 
 impl Frame {
@@ -87,10 +87,6 @@ impl Frame {
     fn axis(&self) -> V3 {
         [self.r[0][0], self.r[1][0], self.r[2][0]]
     }
-}
-
-pub(super) fn mat_vec(cas: &mut Cas, r: &M3, v: &V3) -> V3 {
-    std::array::from_fn(|i| cas.dot(&r[i], v))
 }
 
 pub(super) fn add3(cas: &mut Cas, a: &V3, b: &V3) -> V3 {
@@ -565,7 +561,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
 /// The base frame at `position`: the prescribed turns in sequence, each
 /// about its axis `base.axis[i]` in the frame the turns before it left,
 /// then the declared direction (rotation and quaternion parameters).
-fn base_frame(
+pub(super) fn base_frame(
     cas: &mut Cas,
     symbols: &super::system::ParamSymbols,
     position: V3,
