@@ -65,6 +65,21 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
                     assert_close(a[k], b[k], 1e-12, 0.0, &format!("{} {kind:?}[{k}]", m.name));
                 }
             }
+            // The Jacobian's parts, column by column from the Jvp kernel.
+            let qdd = rng.vec(n, -5.0, 5.0);
+            let (mut a, mut b) = (vec![0.0; 3 * n * n], vec![0.0; 3 * n * n]);
+            compiled.jacobian_parts(t, &q, &qd, &qdd, &mut a);
+            interpreted.jacobian_parts(t, &q, &qd, &qdd, &mut b);
+            for k in 0..3 * n * n {
+                assert!(a[k].is_finite(), "{} Jacobian part {k} not finite", m.name);
+                assert_close(
+                    a[k],
+                    b[k],
+                    1e-12,
+                    1e-12,
+                    &format!("{} Jacobian part {k}", m.name),
+                );
+            }
         }
     }
 }

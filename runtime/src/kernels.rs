@@ -208,7 +208,24 @@ impl Kernels for Interpreted {
     }
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
         let mut slots = self.scratch.borrow_mut();
-        self.tapes.tape(kind).eval(inp, &mut slots, out);
+        let tape = self.tapes.tape(kind);
+        if kind == KernelKind::Jvp && (inp.qdd.is_empty() || inp.dir.is_empty()) {
+            // As the compiled models do: absent accelerations and direction
+            // read as zeros (only this kernel reads them).
+            let n = self.tapes.info.dof();
+            let zeros = vec![0.0; 2 * n];
+            let inp = Inputs {
+                qdd: if inp.qdd.is_empty() {
+                    &zeros[..n]
+                } else {
+                    inp.qdd
+                },
+                dir: if inp.dir.is_empty() { &zeros } else { inp.dir },
+                ..*inp
+            };
+            return tape.eval(&inp, &mut slots, out);
+        }
+        tape.eval(inp, &mut slots, out);
     }
     fn backend(&self) -> &'static str {
         "interpreted"
