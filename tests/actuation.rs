@@ -50,16 +50,7 @@ youngs_modulus = {E}
 
 /// Static tip and coordinates of a model file written to `dir`.
 fn static_tip(dir: &Path, text: &str, sets: &[&str]) -> ([f64; 3], Vec<f64>) {
-    let path = dir.join("actuated.toml");
-    std::fs::write(&path, text).unwrap();
-    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
-    let mut l = load(
-        path.to_str().unwrap(),
-        &overrides,
-        BackendChoice::Auto,
-        Some(dir.join("cache")),
-    )
-    .unwrap();
+    let mut l = load_text(dir, text, sets);
     let n = l.arm.dof();
     let sol = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
     let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
@@ -391,21 +382,10 @@ amplitude = 0.03
 frequency = 2.0
 "#
     );
-    let path = dir.path().join("link.toml");
-    std::fs::write(&path, link).unwrap();
-    let loaded = load(
-        path.to_str().unwrap(),
-        &[],
-        BackendChoice::Auto,
-        Some(dir.path().join("cache")),
-    )
-    .unwrap();
-    let arm = &*loaded.arm;
+    let loaded = load_text(dir.path(), &link, &[]);
     let inertia = m * l * l / 3.0 + m * r * r / 4.0;
-    let mut ws = runtime::Workspace::new(1);
     for t in [0.05, 0.1, 0.3] {
-        let mut qdd = [0.0];
-        runtime::accelerations(arm, &mut ws, t, &[0.7], &[-1.1], &mut qdd).unwrap();
+        let qdd = accelerations(&loaded, t, &[0.7], &[-1.1]);
         let want = 0.03 * (2.0 * PI * 2.0 * t).sin() / inertia;
         assert_close(qdd[0], want, 1e-12, 0.0, &format!("theta'' at t = {t}"));
     }

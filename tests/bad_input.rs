@@ -732,6 +732,15 @@ fn malformed_actuators_inputs_and_measurements_are_rejected_clearly() {
             ],
         ),
         (
+            "inputs on the Cosserat statics",
+            r(
+                "direction = [1.0, 0.0, 0.0]",
+                "direction = [1.0, 0.0, 0.0]\nrotation_inputs = [\"p\"]",
+            )
+            .replacen("method = \"pcc\"", "method = \"cosserat\"", 1),
+            vec!["base.rotation_inputs", "Cosserat statics", "lumped method"],
+        ),
+        (
             "torque from an undeclared channel",
             format!("{base}[[torque]]\ncoordinate = \"bend_y_0_1\"\ninput = \"tau\"\n"),
             vec!["torque[0].input", "no input channel \"tau\""],

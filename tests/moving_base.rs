@@ -9,8 +9,6 @@ mod common;
 use std::f64::consts::PI;
 
 use common::*;
-use eomgen::model::Override;
-use softarm::backend::{BackendChoice, Loaded, load};
 
 const L: f64 = 0.2;
 const M: f64 = 0.05;
@@ -63,26 +61,6 @@ kind = "constant"
 value = 0.0
 "#;
 
-fn loaded(dir: &std::path::Path, text: &str, sets: &[&str]) -> Loaded {
-    let path = dir.join("carried.toml");
-    std::fs::write(&path, text).unwrap();
-    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
-    load(
-        path.to_str().unwrap(),
-        &overrides,
-        BackendChoice::Auto,
-        Some(dir.join("cache")),
-    )
-    .unwrap()
-}
-
-fn accel(l: &Loaded, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
-    let mut ws = runtime::Workspace::new(q.len());
-    let mut qdd = vec![0.0; q.len()];
-    runtime::accelerations(&*l.arm, &mut ws, t, q, qd, &mut qdd).unwrap();
-    qdd
-}
-
 /// d^2/dt^2 of a sin(2 pi f t + phase).
 fn sine_accel(a: f64, f: f64, phase_deg: f64, t: f64) -> f64 {
     let w = 2.0 * PI * f;
@@ -98,7 +76,7 @@ fn a_link_on_a_shaken_base_feels_minus_m_a_at_its_centre_of_mass() {
         } else {
             r#"translation_inputs = ["sx", "sy"]"#
         };
-        let l = loaded(dir.path(), &link(dimensions, inputs, SHAKE), &[]);
+        let l = load_text(dir.path(), &link(dimensions, inputs, SHAKE), &[]);
         for (t, theta, rate) in [(0.03, 0.4, -2.0), (0.11, -1.2, 0.5), (0.4, 2.5, 3.0)] {
             let (ax, ay) = (
                 sine_accel(0.02, 3.0, 0.0, t),
@@ -107,7 +85,7 @@ fn a_link_on_a_shaken_base_feels_minus_m_a_at_its_centre_of_mass() {
             // Moment about the joint of -m a at (l/2)(cos, sin).
             let (c, s) = (f64::cos(theta), f64::sin(theta));
             let want = -M * (L / 2.0) * (c * ay - s * ax) / I_O;
-            let got = accel(&l, t, &[theta], &[rate])[0];
+            let got = accelerations(&l, t, &[theta], &[rate])[0];
             assert_close(
                 got,
                 want,
@@ -149,7 +127,7 @@ frequency = 0.7
         ),
     ];
     for (dimensions, base) in cases {
-        let l = loaded(
+        let l = load_text(
             dir.path(),
             &link(dimensions, base, turn),
             &[&format!("segment.0.joint_stiffness={k}")],
@@ -161,7 +139,7 @@ frequency = 0.7
                 alpha_dd += sine_accel(0.2, 0.7, 0.0, t);
             }
             let want = -k * theta / I_O - alpha_dd;
-            let got = accel(&l, t, &[theta], &[rate])[0];
+            let got = accelerations(&l, t, &[theta], &[rate])[0];
             assert_close(
                 got,
                 want,
@@ -189,7 +167,7 @@ value = 1.5707963267948966
 kind = "constant"
 value = 1.5707963267948966
 "#;
-    let l = loaded(dir.path(), &link(3, base, inputs), &[]);
+    let l = load_text(dir.path(), &link(3, base, inputs), &[]);
     let o = l.arm.outputs(0.0, &[0.0], &[0.0]);
     for (k, want) in [0.1, 0.2, 0.3 - L].into_iter().enumerate() {
         assert_close(o[k], want, 1e-12, 1e-15, &format!("tip component {k}"));
@@ -230,8 +208,8 @@ value = 0.0
 "#
         )
     };
-    let still = loaded(dir.path(), &arm(""), &[]);
-    let carried = loaded(
+    let still = load_text(dir.path(), &arm(""), &[]);
+    let carried = load_text(
         dir.path(),
         &arm(r#"translation_inputs = ["slide", "still", "slide"]"#),
         &[],
@@ -242,7 +220,10 @@ value = 0.0
     for t in [1.0, 4.0] {
         let q = rng.coordinates(&names, -0.5, 0.5);
         let qd = rng.vec(n, -1.0, 1.0);
-        let (a, b) = (accel(&still, t, &q, &qd), accel(&carried, t, &q, &qd));
+        let (a, b) = (
+            accelerations(&still, t, &q, &qd),
+            accelerations(&carried, t, &q, &qd),
+        );
         for i in 0..n {
             assert_close(b[i], a[i], 1e-10, 1e-9, &format!("qdd[{i}] at t = {t}"));
         }
@@ -311,8 +292,8 @@ value = 0.0
     };
     let lifted = r#"translation_inputs = ["still", "lift", "still"]"#;
     for method in ["pcc", "ebr", "eba", "rom", "rigid"] {
-        let still = loaded(dir.path(), &arm(method, -g, ""), &[]);
-        let moving = loaded(dir.path(), &arm(method, 0.0, lifted), &[]);
+        let still = load_text(dir.path(), &arm(method, -g, ""), &[]);
+        let moving = load_text(dir.path(), &arm(method, 0.0, lifted), &[]);
         let n = still.arm.dof();
         let names = still.arm.info().coordinates.clone();
         let mut rng = Rng::new(5);
@@ -320,7 +301,10 @@ value = 0.0
             let q: Vec<f64> = rng.coordinates(&names, -0.3, 0.3);
             let q: Vec<f64> = q.iter().map(|v| 0.2 * v).collect();
             let qd = rng.vec(n, -0.5, 0.5);
-            let (a, b) = (accel(&still, t, &q, &qd), accel(&moving, t, &q, &qd));
+            let (a, b) = (
+                accelerations(&still, t, &q, &qd),
+                accelerations(&moving, t, &q, &qd),
+            );
             for i in 0..n {
                 assert_close(
                     b[i],

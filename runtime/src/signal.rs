@@ -35,9 +35,10 @@ pub enum Signal {
     },
     /// Samples, linearly interpolated; the end values held outside.
     Table(Table),
-    /// `value` from `start` until `end`, 0 outside (a ramp's rate).
-    Window {
-        value: f64,
+    /// `inner` from `start` to `end` (both included), 0 outside: the rate
+    /// of a ramp, or of a table (whose held end values do not move).
+    Gate {
+        inner: Box<Signal>,
         start: f64,
         end: f64,
     },
@@ -82,9 +83,9 @@ impl Signal {
                 }
             }
             Signal::Table(tab) => tab.at(t),
-            Signal::Window { value, start, end } => {
-                if (*start..*end).contains(&t) {
-                    *value
+            Signal::Gate { inner, start, end } => {
+                if (*start..=*end).contains(&t) {
+                    inner.at(t)
                 } else {
                     0.0
                 }
@@ -93,21 +94,25 @@ impl Signal {
     }
 
     /// The signal's time derivative (what a moving base's velocity and
-    /// acceleration follow): exact for the analytic signals (a step's jump
-    /// is left out), and for a table the central differences of its
-    /// samples (one-sided at the ends), interpolated linearly in turn.
+    /// acceleration follow): exact for the analytic signals (the jumps of a
+    /// step or at a gate's edges are left out), and for a table the
+    /// differences of its samples (central, one-sided at the ends),
+    /// interpolated linearly in turn, zero outside the record.
     pub fn derivative(&self) -> Signal {
         match self {
-            Signal::Constant(_) | Signal::Step { .. } | Signal::Window { .. } => {
-                Signal::Constant(0.0)
-            }
+            Signal::Constant(_) | Signal::Step { .. } => Signal::Constant(0.0),
             Signal::Ramp {
                 from,
                 to,
                 start,
                 end,
-            } => Signal::Window {
-                value: (to - from) / (end - start),
+            } => Signal::Gate {
+                inner: Box::new(Signal::Constant((to - from) / (end - start))),
+                start: *start,
+                end: *end,
+            },
+            Signal::Gate { inner, start, end } => Signal::Gate {
+                inner: Box::new(inner.derivative()),
                 start: *start,
                 end: *end,
             },
@@ -124,7 +129,14 @@ impl Signal {
                 bias: 0.0,
                 start: *start,
             },
-            Signal::Table(tab) => Signal::Table(tab.derivative()),
+            Signal::Table(tab) => {
+                let (t0, t1) = (tab.times[0], tab.times[tab.times.len() - 1]);
+                Signal::Gate {
+                    inner: Box::new(Signal::Table(tab.derivative())),
+                    start: t0,
+                    end: t1,
+                }
+            }
         }
     }
 }
@@ -304,6 +316,10 @@ mod tests {
                 (d.at(t) - (6.0 * t - 1.0)).abs() < 1e-12,
                 "table rate at {t}"
             );
+        }
+        // The table holds its end values: nothing moves outside the record.
+        for t in [-0.5, 1.5] {
+            assert_eq!(d.at(t), 0.0, "rate outside the record at {t}");
         }
     }
 

@@ -76,3 +76,29 @@ pub fn stdout(o: &Output) -> String {
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
+
+/// The model file `text` written to `dir` and loaded (tape cache in `dir`),
+/// with `--set`-style overrides.
+pub fn load_text(dir: &Path, text: &str, sets: &[&str]) -> softarm::backend::Loaded {
+    let path = dir.join("model.toml");
+    std::fs::write(&path, text).unwrap();
+    let overrides: Vec<eomgen::model::Override> = sets
+        .iter()
+        .map(|s| eomgen::model::Override::parse(s).unwrap())
+        .collect();
+    softarm::backend::load(
+        path.to_str().unwrap(),
+        &overrides,
+        softarm::backend::BackendChoice::Auto,
+        Some(dir.join("cache")),
+    )
+    .unwrap()
+}
+
+/// qdd of a loaded model at (t, q, qd).
+pub fn accelerations(l: &softarm::backend::Loaded, t: f64, q: &[f64], qd: &[f64]) -> Vec<f64> {
+    let mut ws = runtime::Workspace::new(q.len());
+    let mut qdd = vec![0.0; q.len()];
+    runtime::accelerations(&*l.arm, &mut ws, t, q, qd, &mut qdd).unwrap();
+    qdd
+}

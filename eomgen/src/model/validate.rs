@@ -530,6 +530,33 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             }
         }
     }
+    // The Cosserat statics solve a rod under constant loads: nothing that
+    // inputs drive reaches it, so say so rather than ignore it.
+    if m.segments.iter().any(|s| s.method == Method::Cosserat) {
+        let driven = [
+            (
+                "base.translation_inputs",
+                m.base.translation_inputs.is_some(),
+            ),
+            ("base.rotation_inputs", m.base.rotation_inputs.is_some()),
+            ("torque", !m.torques.is_empty()),
+            ("tendon", !m.tendons.is_empty()),
+            ("tip.force_inputs", m.tip.force_inputs.is_some()),
+            ("tip.moment_inputs", m.tip.moment_inputs.is_some()),
+            (
+                "segment[0].chambers.inputs",
+                m.segments
+                    .iter()
+                    .any(|s| s.chambers.as_ref().is_some_and(|c| c.inputs.is_some())),
+            ),
+        ];
+        if let Some((key, _)) = driven.iter().find(|(_, given)| *given) {
+            return err(
+                (*key).into(),
+                "the Cosserat statics take constant tip loads and gravity only; actuators, joint torques, driven loads and a moving base need a lumped method (pcc, vc, ebr, eba, rom, rigid)".into(),
+            );
+        }
+    }
     if !m.torques.is_empty() {
         let names = crate::tmt::coordinate_names(m);
         for (i, t) in m.torques.iter().enumerate() {
