@@ -21,6 +21,8 @@ pub mod soft_finger;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod stiff_flop;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod tentacle3d;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod vc_arm;
 
 /// Every compiled-in model, by name.
@@ -87,6 +89,13 @@ pub static MODELS: &[CompiledModel] = &[
         dof: stiff_flop::DOF,
         source: include_str!("../models/stiff_flop.toml"),
         kernels: || Box::new(stiff_flop::Compiled::default()),
+    },
+    CompiledModel {
+        name: "tentacle3d",
+        hash: tentacle3d::HASH,
+        dof: tentacle3d::DOF,
+        source: include_str!("../models/tentacle3d.toml"),
+        kernels: || Box::new(tentacle3d::Compiled::default()),
     },
     CompiledModel {
         name: "vc_arm",

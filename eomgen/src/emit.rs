@@ -53,6 +53,15 @@ impl<'a> KernelEmitter<'a> {
                 count += 1;
             }
         }
+        // A family's members are computed by one call where the first of
+        // them is; the later ones are read from there (spilled when that
+        // is an earlier chunk) instead of being evaluated again.
+        let mut first: HashMap<(Family, Slot), Option<usize>> = HashMap::new();
+        for (i, op) in tape.ops.iter().enumerate() {
+            if let Some((family, _, a)) = family_of(op) {
+                chunk_of[i] = *first.entry((family, a)).or_insert(chunk_of[i]);
+            }
+        }
         let mut spill = vec![None; tape.ops.len()];
         let mut n_spill = 0;
         let mut mark = |s: Slot, user_chunk: usize| {
@@ -215,19 +224,16 @@ impl<'a> KernelEmitter<'a> {
         // Members of one family at the same argument in one chunk come from
         // one call: sin and cos from `sin_cos`, the orders of a removable
         // function from `*_orders`.
-        let mut groups: HashMap<GroupKey, Vec<(u8, usize)>> = HashMap::new();
+        let mut groups: HashMap<(Family, Slot), Vec<(Member, usize)>> = HashMap::new();
         for (i, op) in self.tape.ops.iter().enumerate() {
-            if let Some((family, order, a)) = family_of(op) {
-                groups
-                    .entry((family, a, self.chunk_of[i]))
-                    .or_default()
-                    .push((order, i));
+            if let Some((family, member, a)) = family_of(op) {
+                groups.entry((family, a)).or_default().push((member, i));
             }
         }
         groups.retain(|_, members| members.len() >= 2);
         let group_of: HashMap<usize, (Family, Slot)> = groups
             .iter()
-            .flat_map(|(&(f, a, _), ms)| ms.iter().map(move |&(_, i)| (i, (f, a))))
+            .flat_map(|(&(f, a), ms)| ms.iter().map(move |&(_, i)| (i, (f, a))))
             .collect();
         for c in 0..n_chunks {
             let mut body = Vec::new();
@@ -237,7 +243,7 @@ impl<'a> KernelEmitter<'a> {
                 }
                 let defined: Vec<usize> = match group_of.get(&i) {
                     Some(&(family, a)) => {
-                        let members = &groups[&(family, a, Some(c))];
+                        let members = &groups[&(family, a)];
                         if members.iter().map(|m| m.1).min() != Some(i) {
                             continue;
                         }
@@ -284,31 +290,39 @@ impl<'a> KernelEmitter<'a> {
             " Kernel `{name}`: {} operations in {n_chunks} chunk(s).",
             self.tape.op_count()
         );
-        // Large workspaces go on the heap rather than the stack.
-        let workspace = if n_spill > 4096 {
+        // The workspace is a per-thread buffer, allocated on the first call:
+        // a fresh array would be zeroed on every call (a memset of several
+        // kilobytes for a 3D arm) and a large one would crowd the stack.
+        let body = if n_spill == 0 {
             quote! {
-                let mut heap = vec![0.0f64; #n_spill];
-                let w: &mut [f64; #n_spill] = (&mut heap[..]).try_into().expect("workspace length");
+                let w = &mut [0.0f64; 0];
+                #(#calls)*
             }
         } else {
             quote! {
-                let mut stack = [0.0f64; #n_spill];
-                let w = &mut stack;
+                thread_local! {
+                    static WORKSPACE: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+                }
+                WORKSPACE.with_borrow_mut(|heap| {
+                    heap.resize(#n_spill, 0.0);
+                    let w: &mut [f64; #n_spill] = (&mut heap[..]).try_into().expect("workspace length");
+                    #(#calls)*
+                });
             }
         };
         quote! {
             #[doc = #doc]
             pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
-                #workspace
-                #(#calls)*
+                #body
             }
             #(#chunks)*
         }
     }
 }
 
-/// A family, its argument and the chunk of a member.
-type GroupKey = (Family, Slot, Option<usize>);
+/// Which member of its family an op is: the derivative order (sin 0, cos
+/// 1), and for the Rodrigues coefficients c_j also j.
+type Member = (u8, u8);
 
 /// Functions evaluated together when several members share an argument.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
@@ -318,28 +332,49 @@ enum Family {
     Sinc,
     Cosc,
     SincRem,
-    /// c_j of `runtime::rodrigues` (its orders are the derivatives).
-    Rodrigues(u8),
+    /// The c_j of `runtime::rodrigues::family`, members (j, order).
+    Rodrigues,
 }
 
-fn family_of(op: &Op) -> Option<(Family, u8, Slot)> {
+fn family_of(op: &Op) -> Option<(Family, Member, Slot)> {
     match *op {
-        Op::Sin(a) => Some((Family::SinCos, 0, a)),
-        Op::Cos(a) => Some((Family::SinCos, 1, a)),
-        Op::Sinc(k, a) => Some((Family::Sinc, k, a)),
-        Op::Cosc(k, a) => Some((Family::Cosc, k, a)),
-        Op::SincRem(k, a) => Some((Family::SincRem, k, a)),
-        Op::Rodrigues(j, n, a) => Some((Family::Rodrigues(j), n, a)),
+        Op::Sin(a) => Some((Family::SinCos, (0, 0), a)),
+        Op::Cos(a) => Some((Family::SinCos, (0, 1), a)),
+        Op::Sinc(k, a) => Some((Family::Sinc, (0, k), a)),
+        Op::Cosc(k, a) => Some((Family::Cosc, (0, k), a)),
+        Op::SincRem(k, a) => Some((Family::SincRem, (0, k), a)),
+        Op::Rodrigues(j, n, a)
+            if usize::from(j) < runtime::rodrigues::FAMILY_J
+                && usize::from(n) < runtime::rodrigues::FAMILY_ORDERS =>
+        {
+            Some((Family::Rodrigues, (j, n), a))
+        }
         _ => None,
     }
 }
 
 impl Family {
-    /// `let` binding the members (order, op index) from one call at `a`.
-    fn call(self, members: &[(u8, usize)], a: TokenStream) -> TokenStream {
-        let n = members.iter().map(|m| usize::from(m.0)).max().unwrap_or(0) + 1;
+    /// `let` binding the members (member, op index) from one call at `a`.
+    fn call(self, members: &[(Member, usize)], a: TokenStream) -> TokenStream {
+        let n = members
+            .iter()
+            .map(|m| usize::from(m.0.1))
+            .max()
+            .unwrap_or(0)
+            + 1;
+        if self == Family::Rodrigues {
+            let lets = members.iter().map(|&((j, k), i)| {
+                let (j, k) = (usize::from(j), usize::from(k));
+                let v = format_ident!("v{}", i);
+                quote!(let #v: f64 = c[#j][#k];)
+            });
+            return quote! {
+                let c: [[f64; #n]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<#n>(#a);
+                #(#lets)*
+            };
+        }
         let names: Vec<TokenStream> = (0..n)
-            .map(|k| match members.iter().find(|m| usize::from(m.0) == k) {
+            .map(|k| match members.iter().find(|m| usize::from(m.0.1) == k) {
                 Some(&(_, i)) => {
                     let v = format_ident!("v{}", i);
                     quote!(#v)
@@ -354,9 +389,7 @@ impl Family {
             Family::Sinc => quote!(sinc_orders),
             Family::Cosc => quote!(cosc_orders),
             Family::SincRem => quote!(sinc_rem_orders),
-            Family::Rodrigues(j) => {
-                return quote!(let [#(#names),*]: [f64; #n] = runtime::rodrigues::rodrigues_orders::<#n>(#j, #a););
-            }
+            Family::Rodrigues => unreachable!("handled above"),
         };
         quote!(let [#(#names),*]: [f64; #n] = runtime::special::#f::<#n>(#a);)
     }

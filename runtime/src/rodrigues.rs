@@ -22,40 +22,72 @@
 /// most 1.5 times the value's scale there, so it loses under one digit.
 pub const SERIES_BELOW: f64 = 9.0;
 
-/// Largest `j` and derivative order the generator uses (bounds the tables).
-pub const MAX_J: u8 = 6;
-
-/// d^n/dw^n c_j(w).
+/// d^n/dw^n c_j(w): a member of [`family`] when it has one (bit for bit
+/// the value a kernel's family call gives), else the long series or the
+/// closed form.
 #[inline]
 pub fn rodrigues(j: u8, n: u8, w: f64) -> f64 {
-    if w.abs() < SERIES_BELOW {
-        if j <= TABLE_J && n <= TABLE_N {
-            horner(&TABLE[j as usize][n as usize], terms_for(w), w)
-        } else {
-            series(j, n, w)
-        }
+    if usize::from(j) < FAMILY_J && usize::from(n) < FAMILY_ORDERS {
+        family::<FAMILY_ORDERS>(w)[usize::from(j)][usize::from(n)]
+    } else if w.abs() < SERIES_BELOW {
+        series(j, n, w)
     } else {
         closed(j, n, w)
     }
 }
 
-/// Orders and indices with precomputed series (what the kernels use).
-const TABLE_J: u8 = 6;
-const TABLE_N: u8 = 4;
-const TABLE_TERMS: usize = 22;
+/// The family covers c_0 ..= c_8 ...
+pub const FAMILY_J: usize = 9;
+/// ... and their derivatives of orders 0 ..= 4.
+pub const FAMILY_ORDERS: usize = 5;
 
-/// TABLE[j][n][k]: (-1)^(k+n) (k+n)! / (k! (2k + 2n + j)!), the coefficient
-/// of w^k in d^n/dw^n c_j.
-static TABLE: [[[f64; TABLE_TERMS]; TABLE_N as usize + 1]; TABLE_J as usize + 1] = table();
+/// `family::<N>(w)[j][n]` = d^n/dw^n c_j(w) for j <= 8, n < N: every
+/// coefficient a kernel needs at one argument from one call.
+///
+/// Below |w| = 9 only the two top members c_7, c_8 (and their
+/// derivatives) are summed as series, which converge fast that high; the
+/// rest follow downward from c_j = 1/j! - w c_{j+2} and its derivatives
+/// d^n c_j = -w d^n c_{j+2} - n d^(n-1) c_{j+2}, which is stable there (the
+/// error of a step is at most w / ((j + 1) (j + 2)) of the one before;
+/// checked against the long series to 2e-15 in the tests). A pcc element's
+/// 17 coefficients cost about a third of their separate series. Above
+/// |w| = 9, where the downward recursion would amplify errors by w a step,
+/// each member comes from the closed forms.
+///
+/// Order n depends only on orders below it, and the chains start from the
+/// same tops whatever is asked for, so every member has the same bits for
+/// every `N`: the interpreter's single values and a kernel's family agree.
+#[inline]
+pub fn family<const N: usize>(w: f64) -> [[f64; N]; FAMILY_J] {
+    const { assert!(N <= FAMILY_ORDERS) };
+    let a = w.abs();
+    if a < 1.0 {
+        downward(w, tops::<N, 8>(w))
+    } else if a < SERIES_BELOW {
+        downward(w, tops::<N, 12>(w))
+    } else {
+        closed_family(w)
+    }
+}
 
-const fn table() -> [[[f64; TABLE_TERMS]; TABLE_N as usize + 1]; TABLE_J as usize + 1] {
-    let mut t = [[[0.0; TABLE_TERMS]; TABLE_N as usize + 1]; TABLE_J as usize + 1];
-    let mut j = 0;
-    while j <= TABLE_J as usize {
+/// Series terms kept for the tops: 8 reach round-off below |w| = 1, 12
+/// below 9, for every order up to 4 (first omitted term under 1e-17 of
+/// the leading one).
+const TOP_TERMS: usize = 12;
+
+/// TOPS[t][n][k]: (-1)^(k+n) (k+n)! / (k! (2k + 2n + j)!) for j = 7 + t,
+/// the coefficient of w^k in d^n/dw^n c_j.
+static TOPS: [[[f64; TOP_TERMS]; FAMILY_ORDERS]; 2] = tops_table();
+
+const fn tops_table() -> [[[f64; TOP_TERMS]; FAMILY_ORDERS]; 2] {
+    let mut t = [[[0.0; TOP_TERMS]; FAMILY_ORDERS]; 2];
+    let mut top = 0;
+    while top < 2 {
+        let j = FAMILY_J - 2 + top;
         let mut n = 0;
-        while n <= TABLE_N as usize {
+        while n < FAMILY_ORDERS {
             let mut k = 0;
-            while k < TABLE_TERMS {
+            while k < TOP_TERMS {
                 // (k+n)! / k! / (2k+2n+j)!, accumulated as a product.
                 let mut c = 1.0;
                 let mut i = k + 1;
@@ -68,46 +100,62 @@ const fn table() -> [[[f64; TABLE_TERMS]; TABLE_N as usize + 1]; TABLE_J as usiz
                     c /= i as f64;
                     i += 1;
                 }
-                t[j][n][k] = if (k + n) % 2 == 0 { c } else { -c };
+                t[top][n][k] = if (k + n) % 2 == 0 { c } else { -c };
                 k += 1;
             }
             n += 1;
         }
-        j += 1;
+        top += 1;
     }
     t
 }
 
-/// Terms for round-off accuracy at |w| (the omitted tail is below 1e-17
-/// of c_j(0) for every tabled order; checked against the long series in
-/// the tests).
-#[inline]
-fn terms_for(w: f64) -> usize {
-    let a = w.abs();
-    if a < 0.25 {
-        11
-    } else if a < 1.0 {
-        13
-    } else if a < 4.0 {
-        17
-    } else {
-        TABLE_TERMS
+/// 1/j! for the recursion's constant.
+const INV_FACTORIAL: [f64; FAMILY_J] = {
+    let mut f = [1.0; FAMILY_J];
+    let mut j = 1;
+    while j < FAMILY_J {
+        f[j] = f[j - 1] / j as f64;
+        j += 1;
     }
-}
+    f
+};
 
-#[inline]
-fn horner(c: &[f64; TABLE_TERMS], terms: usize, w: f64) -> f64 {
-    let mut s = 0.0;
-    for &k in c[..terms].iter().rev() {
-        s = s * w + k;
+/// Orders 0..N of c_7 and c_8 by T-term Horner sums.
+#[inline(always)]
+fn tops<const N: usize, const T: usize>(w: f64) -> [[f64; N]; 2] {
+    let mut s = [[0.0; N]; 2];
+    for k in (0..T).rev() {
+        for t in 0..2 {
+            for n in 0..N {
+                s[t][n] = s[t][n] * w + TOPS[t][n][k];
+            }
+        }
     }
     s
 }
 
-/// [`rodrigues`] of orders 0..N of one c_j at one argument, bit for bit.
-#[inline]
-pub fn rodrigues_orders<const N: usize>(j: u8, w: f64) -> [f64; N] {
-    std::array::from_fn(|n| rodrigues(j, n as u8, w))
+#[inline(always)]
+fn downward<const N: usize>(w: f64, tops: [[f64; N]; 2]) -> [[f64; N]; FAMILY_J] {
+    let mut c = [[0.0; N]; FAMILY_J];
+    c[FAMILY_J - 2] = tops[0];
+    c[FAMILY_J - 1] = tops[1];
+    for j in (0..FAMILY_J - 2).rev() {
+        for n in 0..N {
+            c[j][n] = if n == 0 {
+                INV_FACTORIAL[j] - w * c[j + 2][0]
+            } else {
+                -(w * c[j + 2][n]) - n as f64 * c[j + 2][n - 1]
+            };
+        }
+    }
+    c
+}
+
+#[cold]
+#[inline(never)]
+fn closed_family<const N: usize>(w: f64) -> [[f64; N]; FAMILY_J] {
+    std::array::from_fn(|j| std::array::from_fn(|n| closed(j as u8, n as u8, w)))
 }
 
 /// sum_k (-1)^(k+n) (k+n)! / (k! (2k + 2n + j)!) w^k, summed until the
@@ -161,7 +209,7 @@ fn closed(j: u8, n: u8, w: f64) -> f64 {
             -g[m][1] / 2.0
         } else {
             // c0' = -c1 / 2, computed directly.
-            -rodrigues(1, m as u8, w) / 2.0
+            -closed(1, m as u8, w) / 2.0
         };
         for i in 1..=j {
             g[m + 1][i] = (g[m][i - 1] - (i + 2 * m) as f64 * g[m][i]) / (2.0 * w);
@@ -254,13 +302,34 @@ mod tests {
         for &w in &[
             0.0f64, 0.1, -0.2, 0.249, 0.3, 0.99, 1.5, 3.99, 4.5, 8.99, -8.0,
         ] {
-            for j in 0..=TABLE_J {
-                for n in 0..=TABLE_N {
+            for j in 0..FAMILY_J as u8 {
+                for n in 0..FAMILY_ORDERS as u8 {
                     let (a, b) = (rodrigues(j, n, w), series(j, n, w));
                     let scale = series(j, n, 0.0).abs();
                     assert!(
                         (a - b).abs() <= 2e-15 * scale.max(b.abs()),
-                        "c{j}^({n})({w}): table {a:e} vs series {b:e}"
+                        "c{j}^({n})({w}): family {a:e} vs series {b:e}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn family_members_do_not_depend_on_how_many_orders_are_asked() {
+        for &w in &[0.0f64, 1e-12, -0.3, 0.7, 2.0, 8.5, 9.5, 30.0] {
+            let all = family::<FAMILY_ORDERS>(w);
+            let two = family::<2>(w);
+            let three = family::<3>(w);
+            for j in 0..FAMILY_J {
+                for n in 0..2 {
+                    assert_eq!(two[j][n].to_bits(), all[j][n].to_bits(), "c{j}^({n})({w})");
+                }
+                for n in 0..3 {
+                    assert_eq!(
+                        three[j][n].to_bits(),
+                        all[j][n].to_bits(),
+                        "c{j}^({n})({w})"
                     );
                 }
             }

@@ -10,7 +10,11 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::rodrigues;
 use crate::special;
+
+/// Every member of one argument's Rodrigues family.
+type Family = [[f64; rodrigues::FAMILY_ORDERS]; rodrigues::FAMILY_J];
 
 /// Slot index into the tape.
 pub type Slot = u32;
@@ -81,9 +85,25 @@ impl Tape {
     pub fn eval(&self, inp: &Inputs, slots: &mut Vec<f64>, out: &mut [f64]) {
         slots.clear();
         slots.reserve(self.ops.len());
+        // Rodrigues coefficients come in families (`rodrigues::family`):
+        // each argument's is computed once and its members read from it.
+        let mut families: Vec<(Slot, Family)> = Vec::new();
         for op in &self.ops {
             let s = |i: Slot| slots[i as usize];
             let v = match *op {
+                Op::Rodrigues(j, n, a)
+                    if usize::from(j) < rodrigues::FAMILY_J
+                        && usize::from(n) < rodrigues::FAMILY_ORDERS =>
+                {
+                    let c = match families.iter().find(|f| f.0 == a) {
+                        Some(f) => &f.1,
+                        None => {
+                            families.push((a, rodrigues::family(s(a))));
+                            &families[families.len() - 1].1
+                        }
+                    };
+                    c[usize::from(j)][usize::from(n)]
+                }
                 Op::Const(c) => c,
                 Op::Q(i) => inp.q[i as usize],
                 Op::Qd(i) => inp.qd[i as usize],
@@ -109,7 +129,7 @@ impl Tape {
                 Op::Sinc(k, a) => special::sinc(k, s(a)),
                 Op::Cosc(k, a) => special::cosc(k, s(a)),
                 Op::SincRem(k, a) => special::sinc_rem(k, s(a)),
-                Op::Rodrigues(j, n, a) => crate::rodrigues::rodrigues(j, n, s(a)),
+                Op::Rodrigues(j, n, a) => rodrigues::rodrigues(j, n, s(a)),
             };
             slots.push(v);
         }
