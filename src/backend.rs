@@ -108,7 +108,15 @@ pub fn load(
     }
     let hash = Structure::of(&model).hash();
     let params: Vec<(String, f64)> = parameters(&model);
+    // Compiled kernels use fused multiply-adds; without them the
+    // interpreter gives the same bits.
     let compiled = compiled_by_hash(&hash);
+    if choice == BackendChoice::Compiled && compiled.is_some() && !runtime::cpu::has_fma() {
+        bail!(
+            "{origin}: the compiled kernels need a processor with fused multiply-add (FMA3),              which this one lacks; use --backend interpreted (the same results, slower)"
+        );
+    }
+    let compiled = compiled.filter(|_| runtime::cpu::has_fma());
     let (kernels, cache, derive_s): (Box<dyn Kernels>, CacheStatus, f64) = match (choice, compiled)
     {
         (BackendChoice::Compiled, None) => bail!(

@@ -75,7 +75,7 @@ impl<'a> KernelEmitter<'a> {
         };
         for (i, op) in tape.ops.iter().enumerate() {
             if let Some(c) = chunk_of[i] {
-                for a in operands(op) {
+                for a in Tape::operands(op) {
                     mark(a, c);
                 }
             }
@@ -144,6 +144,18 @@ impl<'a> KernelEmitter<'a> {
             Op::Mul(a, b) => {
                 let (a, b) = (r(a), r(b));
                 quote!(#a * #b)
+            }
+            Op::MulAdd(a, b, c) => {
+                let (a, b, c) = (r(a), r(b), r(c));
+                quote!(#a.mul_add(#b, #c))
+            }
+            Op::MulSub(a, b, c) => {
+                let (a, b, c) = (r(a), r(b), r(c));
+                quote!(#a.mul_add(#b, -#c))
+            }
+            Op::NegMulAdd(a, b, c) => {
+                let (a, b, c) = (r(a), r(b), r(c));
+                quote!((-#a).mul_add(#b, #c))
             }
             Op::Div(a, b) => {
                 let (a, b) = (r(a), r(b));
@@ -278,12 +290,16 @@ impl<'a> KernelEmitter<'a> {
             chunks.push(quote! {
                 #[inline(never)]
                 #[allow(unused_variables, clippy::all)]
+                #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
                 fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir],
                       p: &[f64; #n_params], w: &mut [f64; #n_spill], out: &mut [f64; #n_out]) {
                     #(#body)*
                 }
             });
-            calls.push(quote!(#f(t, q, qd, qdd, dir, p, w, out);));
+            calls.push(quote!(
+                // SAFETY: `require_fma` has checked that the processor has FMA.
+                unsafe { #f(t, q, qd, qdd, dir, p, w, out) };
+            ));
         }
         let f = Ident::new(name, Span::call_site());
         let doc = format!(
@@ -312,7 +328,9 @@ impl<'a> KernelEmitter<'a> {
         };
         quote! {
             #[doc = #doc]
+            #[allow(unused_unsafe)]
             pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+                runtime::cpu::require_fma();
                 #body
             }
             #(#chunks)*
@@ -392,29 +410,6 @@ impl Family {
             Family::Rodrigues => unreachable!("handled above"),
         };
         quote!(let [#(#names),*]: [f64; #n] = runtime::special::#f::<#n>(#a);)
-    }
-}
-
-fn operands(op: &Op) -> Vec<Slot> {
-    match *op {
-        Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Powf(a, b) => {
-            vec![a, b]
-        }
-        Op::Neg(a)
-        | Op::Powi(a, _)
-        | Op::Sqrt(a)
-        | Op::Sin(a)
-        | Op::Cos(a)
-        | Op::Tan(a)
-        | Op::Exp(a)
-        | Op::Ln(a)
-        | Op::Abs(a)
-        | Op::Sign(a)
-        | Op::Sinc(_, a)
-        | Op::Cosc(_, a)
-        | Op::SincRem(_, a)
-        | Op::Rodrigues(_, _, a) => vec![a],
-        _ => vec![],
     }
 }
 

@@ -9,6 +9,7 @@
 // the generator needs; everything that simulates sits behind the default
 // feature `simulate`, so that build.rs's copy of the generator compiles
 // without nalgebra and the ODE crate.
+pub mod cpu;
 pub mod kernels;
 pub mod linalg;
 pub mod rodrigues;

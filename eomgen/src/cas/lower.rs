@@ -146,6 +146,9 @@ fn key(op: &Op) -> (u8, u64, u64) {
         Op::Cosc(k, a) => (21, u(a), u64::from(k)),
         Op::SincRem(k, a) => (22, u(a), u64::from(k)),
         Op::Rodrigues(j, n, a) => (24, u(a), (u64::from(j) << 8) | u64::from(n)),
+        Op::MulAdd(..) | Op::MulSub(..) | Op::NegMulAdd(..) => {
+            unreachable!("fused only after value numbering")
+        }
     }
 }
 
@@ -571,10 +574,10 @@ impl<'a> Lowerer<'a> {
     pub fn finish(mut self, outputs: &[ExprId]) -> Tape {
         self.find_shared_increments(outputs);
         let outs: Vec<Slot> = outputs.iter().map(|&e| self.lower(e)).collect();
-        Tape {
+        super::fuse::fuse_multiply_adds(Tape {
             ops: self.ops,
             outputs: outs,
-        }
+        })
     }
 }
 

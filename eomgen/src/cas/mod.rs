@@ -5,12 +5,14 @@
 //! * `diff`: memoised partial and time derivatives.
 //! * `eval`: direct evaluation.
 //! * `lower`: CSE and linearisation into a runtime tape.
+//! * `fuse`: single-use products fused into the sums that read them.
 //! * `turning`: vectors turned by a moving frame, with their rates by w x u.
 
 mod canonical;
 mod diff;
 mod eval;
 mod expr;
+mod fuse;
 mod lower;
 mod reverse;
 #[cfg(test)]
