@@ -19,7 +19,7 @@ const TERMS: u32 = 10;
 /// Terms needed at |x|: the pcc kernels spend much of their time in these
 /// series, and small angles need few terms (the bounds are checked against
 /// the full series in the tests below).
-#[inline]
+#[inline(always)]
 fn terms_for(x: f64) -> usize {
     let a = x.abs();
     if a < 0.25 {
@@ -52,7 +52,7 @@ fn sinc_closed(k: u8, x: f64) -> f64 {
 
 /// [`sinc`] of orders 0..K at one argument, bit for bit: the kernels need
 /// a pcc element's sinc with its first two derivatives together.
-#[inline]
+#[inline(always)]
 pub fn sinc_orders<const K: usize>(x: f64) -> [f64; K] {
     if x.abs() < SERIES_BELOW {
         SINC.orders(x)
@@ -62,7 +62,7 @@ pub fn sinc_orders<const K: usize>(x: f64) -> [f64; K] {
 }
 
 /// [`cosc`] of orders 0..K at one argument, bit for bit.
-#[inline]
+#[inline(always)]
 pub fn cosc_orders<const K: usize>(x: f64) -> [f64; K] {
     if x.abs() < SERIES_BELOW {
         COSC.orders(x)
@@ -72,7 +72,7 @@ pub fn cosc_orders<const K: usize>(x: f64) -> [f64; K] {
 }
 
 /// [`sinc_rem`] of orders 0..K at one argument, bit for bit.
-#[inline]
+#[inline(always)]
 pub fn sinc_rem_orders<const K: usize>(x: f64) -> [f64; K] {
     if x.abs() < SERIES_BELOW {
         SINC_REM.orders(x)
@@ -259,7 +259,7 @@ impl Series {
 
     /// Orders 0..K at one argument: one branch and K independent Horner
     /// chains, each the same arithmetic as [`Series::eval`].
-    #[inline]
+    #[inline(always)]
     fn orders<const K: usize>(&self, x: f64) -> [f64; K] {
         match terms_for(x) {
             6 => std::array::from_fn(|k| self.eval_n::<6>(k as u8, x)),
