@@ -60,7 +60,13 @@ fn state(n: usize) -> (Vec<f64>, Vec<f64>) {
 
 fn kernels(c: &mut Criterion) {
     let mut g = c.benchmark_group("compiled");
-    for name in ["chain", "chain32", "cantilever", "cantilever3d", "tentacle3d"] {
+    for name in [
+        "chain",
+        "chain32",
+        "cantilever",
+        "cantilever3d",
+        "tentacle3d",
+    ] {
         let l = load(name, &[], BackendChoice::Compiled, None).unwrap();
         let arm = &*l.arm;
         let n = arm.dof();
