@@ -108,13 +108,15 @@ impl Tape {
 
     #[inline(always)]
     fn eval_body(&self, inp: &Inputs, slots: &mut Vec<f64>, out: &mut [f64]) {
-        slots.clear();
-        slots.reserve(self.ops.len());
+        slots.resize(self.ops.len(), 0.0);
         // Rodrigues coefficients come in families (`rodrigues::family`):
         // each argument's is computed once and its members read from it.
         let mut families: Vec<(Slot, Family)> = Vec::new();
-        for op in &self.ops {
-            let s = |i: Slot| slots[i as usize];
+        for (i, op) in self.ops.iter().enumerate() {
+            // Operands come from the slots before this one (the tape's
+            // invariant, checked by the split's bounds).
+            let (done, rest) = slots.split_at_mut(i);
+            let s = |k: Slot| done[k as usize];
             let v = match *op {
                 Op::Rodrigues(j, n, a)
                     if usize::from(j) < rodrigues::FAMILY_J
@@ -159,7 +161,7 @@ impl Tape {
                 Op::SincRem(k, a) => special::sinc_rem(k, s(a)),
                 Op::Rodrigues(j, n, a) => rodrigues::rodrigues(j, n, s(a)),
             };
-            slots.push(v);
+            rest[0] = v;
         }
         for (o, &slot) in out.iter_mut().zip(&self.outputs) {
             *o = slots[slot as usize];
