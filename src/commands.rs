@@ -628,6 +628,7 @@ pub fn statics(a: StaticArgs) -> Result<ExitCode> {
             "tip_position": sol.tip_position,
             "base_force": sol.base_force,
             "base_moment": sol.base_moment,
+            "residual": sol.residual,
             "iterations": sol.iterations,
             "load_steps": sol.load_steps,
             "centerline": sol.positions,

@@ -513,6 +513,14 @@ fn malformed_3d_models_are_rejected_clearly() {
             vec!["segment[0].chambers", "overlap"],
         ),
         (
+            "incompressible Cosserat rod",
+            r(
+                "method = \"pcc\"",
+                "method = \"cosserat\"\nincompressible = true",
+            ),
+            vec!["segment[0].incompressible", "keeps its section"],
+        ),
+        (
             "chamber outside the wall",
             r(
                 "elements = 2",

@@ -75,6 +75,9 @@ pub struct RodSolution {
     /// The base reaction: internal force and moment at s = 0.
     pub base_force: [f64; 3],
     pub base_moment: [f64; 3],
+    /// What the shooting leaves of the tip boundary condition: the norm of
+    /// (n(L) - F_tip) / force scale and (m(L) - M_tip) / moment scale.
+    pub residual: f64,
     pub iterations: usize,
     pub load_steps: usize,
 }
@@ -289,13 +292,18 @@ pub fn solve_rod(
         guess.fixed_rows::<3>(3).into(),
         opts.steps,
     );
-    let tip = xs[xs.len() - 1].p;
+    let end = xs[xs.len() - 1];
+    let tip = end.p;
+    let dn = (end.n - tip_f) / force_scale;
+    let dm = (end.m - tip_m) / moment_scale;
+    let residual = Vector6::new(dn.x, dn.y, dn.z, dm.x, dm.y, dm.z).norm();
     Ok(RodSolution {
         positions: xs.iter().map(|x| [x.p.x, x.p.y, x.p.z]).collect(),
         frames: xs.iter().map(|x| x.r).collect(),
         tip_position: [tip.x, tip.y, tip.z],
         base_force: [guess[0], guess[1], guess[2]],
         base_moment: [guess[3], guess[4], guess[5]],
+        residual,
         iterations,
         load_steps,
     })
@@ -355,6 +363,8 @@ mod tests {
         // The base holds the load.
         let n0 = Vector3::from(sol.base_force);
         assert!((n0 - load).norm() < 1e-9 * f);
+        // The reported residual is the converged tip condition's.
+        assert!(sol.residual < RodOptions::default().tol, "{}", sol.residual);
     }
 
     #[test]

@@ -242,6 +242,12 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
                     "missing: twisting elements need `torsional_stiffness` (G J), or `youngs_modulus` with the section (G = E/3 unless `shear_modulus` is given)".into(),
                 );
             }
+            if s.incompressible == Some(true) && s.method == Method::Cosserat {
+                return err(
+                    p("incompressible"),
+                    "the Cosserat rod keeps its section as it stretches: remove the key, or use a lumped method (pcc, vc, ebr, eba, rom) to thin the section with the stretch".into(),
+                );
+            }
             // Rigid links do not stretch: there it has nothing to act on.
             if s.incompressible == Some(true)
                 && !matches!(s.method, Method::Rigid | Method::Eba | Method::Cosserat)
