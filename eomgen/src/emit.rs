@@ -27,13 +27,6 @@ fn lit(c: f64) -> TokenStream {
     }
 }
 
-fn is_leaf(op: &Op) -> bool {
-    matches!(
-        op,
-        Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Qdd(_) | Op::Dir(_) | Op::Param(_) | Op::Time
-    )
-}
-
 struct KernelEmitter<'a> {
     tape: &'a Tape,
     /// Chunk of each slot (leaves: none).
@@ -48,7 +41,7 @@ impl<'a> KernelEmitter<'a> {
         let mut chunk_of = vec![None; tape.ops.len()];
         let mut count = 0;
         for (i, op) in tape.ops.iter().enumerate() {
-            if !is_leaf(op) {
+            if !op.is_leaf() {
                 chunk_of[i] = Some(count / CHUNK_OPS);
                 count += 1;
             }

@@ -79,6 +79,16 @@ pub struct Inputs<'a> {
     pub p: &'a [f64],
 }
 
+impl Op {
+    /// An input or a constant: read, not computed.
+    pub fn is_leaf(&self) -> bool {
+        matches!(
+            self,
+            Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Qdd(_) | Op::Dir(_) | Op::Param(_) | Op::Time
+        )
+    }
+}
+
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Tape {
     pub ops: Vec<Op>,
@@ -174,13 +184,7 @@ impl Tape {
         self.ops
             .iter()
             .map(|op| match op {
-                Op::Const(_)
-                | Op::Q(_)
-                | Op::Qd(_)
-                | Op::Qdd(_)
-                | Op::Dir(_)
-                | Op::Param(_)
-                | Op::Time => 0,
+                _ if op.is_leaf() => 0,
                 Op::MulAdd(..) | Op::MulSub(..) | Op::NegMulAdd(..) => 2,
                 _ => 1,
             })
