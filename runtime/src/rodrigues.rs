@@ -14,12 +14,14 @@
 //! what makes 3D pcc, ebr and rom kinematics singularity-free. (Written in
 //! theta they would need sqrt(w), whose derivative is infinite at 0.)
 //!
-//! The series is summed for |w| below [`SERIES_BELOW`]; beyond it the closed
-//! forms in theta and the recurrence 2 w c_j' = c_{j-1} - j c_j (from the
-//! series term by term) give every order.
+//! Kernels take every coefficient they need at one argument from one
+//! [`family`] call. Below |w| = [`SERIES_BELOW`] it sums the series of the
+//! top members only and recurs downward; beyond it the closed forms in
+//! theta and the recurrence 2 w c_j' = c_{j-1} - j c_j (from the series
+//! term by term) give every order.
 
-/// Below this |w| (|theta| < 3) the series is used: its largest term is at
-/// most 1.5 times the value's scale there, so it loses under one digit.
+/// Below this |w| (|theta| < 3) series are used: their largest term is at
+/// most 1.5 times the value's scale there, so they lose under one digit.
 pub const SERIES_BELOW: f64 = 9.0;
 
 /// d^n/dw^n c_j(w): a member of [`family`] when it has one (bit for bit
