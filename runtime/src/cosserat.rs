@@ -3,10 +3,10 @@
 //!
 //! Along the arc length s, with the rod's frame R (third column the
 //! tangent direction of the undeformed rod), strains v = R^T p' and
-//! curvatures u (R' = R [u]x):
+//! curvatures u (R' = R \[u\]x):
 //!
 //!   p' = R v,   v = v* + K_se^-1 R^T n     (K_se = diag(G A, G A, E A))
-//!   R' = R [u]x, u = u* + K_bt^-1 R^T m    (K_bt = diag(E I1, E I2, G J))
+//!   R' = R \[u\]x, u = u* + K_bt^-1 R^T m    (K_bt = diag(E I1, E I2, G J))
 //!   n' = -f,    m' = -p' x n - l
 //!
 //! with the base clamped (p, R given at s = 0) and the tip wrench given

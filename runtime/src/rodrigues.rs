@@ -1,7 +1,7 @@
 //! The Rodrigues coefficient functions of a rotation vector, as functions
 //! of its squared angle, and all their derivatives.
 //!
-//! For a rotation vector rho with w = |rho|^2 and K = [rho]x,
+//! For a rotation vector rho with w = |rho|^2 and K = \[rho\]x,
 //!
 //!   exp(K)             = I + c1(w) K + c2(w) K^2        (the rotation)
 //!   int_0^1 exp(sK) ds = I + c2(w) K + c3(w) K^2        (an arc's chord)
