@@ -49,8 +49,6 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
             let qd = rng.vec(n, -3.0, 3.0);
             let t = rng.uniform(0.0, 10.0);
             for kind in [
-                KernelKind::Mass,
-                KernelKind::Bias,
                 KernelKind::MassBias,
                 KernelKind::Outputs,
                 KernelKind::Accel,

@@ -21,8 +21,6 @@ pub fn derive(model: &Model) -> TapeSet {
         .filter(|(_, n)| driven.contains(n))
         .map(|(i, _)| i);
     let mut hoist = Hoist::new(params.len()).with_inputs(inputs);
-    let mass = cas.to_tape_hoisted(&eq.mass_upper, &mut hoist);
-    let bias = cas.to_tape_hoisted(&eq.bias, &mut hoist);
     let mass_bias = cas.to_tape_hoisted(&mass_bias, &mut hoist);
     let outputs = cas.to_tape_hoisted(&eq.outputs, &mut hoist);
     let n = eq.bias.len();
@@ -54,8 +52,6 @@ pub fn derive(model: &Model) -> TapeSet {
             accel,
             loads,
         },
-        mass,
-        bias,
         mass_bias,
         outputs,
         derived,

@@ -175,10 +175,16 @@ impl<K: Kernels> Dynamics for Arm<K> {
     }
     fn mass(&self, t: f64, q: &[f64], m: &mut DMatrix<f64>) {
         let zeros = vec![0.0; q.len()];
-        self.eval_packed(KernelKind::Mass, t, q, &zeros, |p| unpack_symmetric(p, m));
+        let tri = q.len() * (q.len() + 1) / 2;
+        self.eval_packed(KernelKind::MassBias, t, q, &zeros, |p| {
+            unpack_symmetric(&p[..tri], m)
+        });
     }
     fn bias(&self, t: f64, q: &[f64], qd: &[f64], h: &mut DVector<f64>) {
-        self.eval_packed(KernelKind::Bias, t, q, qd, |p| h.copy_from_slice(p));
+        let tri = q.len() * (q.len() + 1) / 2;
+        self.eval_packed(KernelKind::MassBias, t, q, qd, |p| {
+            h.copy_from_slice(&p[tri..])
+        });
     }
     fn mass_bias(&self, t: f64, q: &[f64], qd: &[f64], m: &mut DMatrix<f64>, h: &mut DVector<f64>) {
         let tri = q.len() * (q.len() + 1) / 2;

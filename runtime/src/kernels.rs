@@ -11,9 +11,10 @@ use crate::tape::{Inputs, Tape};
 /// The functions derived for every model. Output layouts are fixed here and
 /// relied on by [`crate::Arm`]:
 ///
-/// * `Mass`: the upper triangle of M(q), row by row: (0,0), (0,1), ..., (1,1), ...
-/// * `Bias`: h(q, qd, t), n values.
-/// * `MassBias`: `Mass` followed by `Bias` (one pass, shared subexpressions).
+/// * `MassBias`: the upper triangle of M(q), row by row: (0,0), (0,1),
+///   ..., (1,1), ..., then h(q, qd, t), n values (one pass, shared
+///   subexpressions; M or h alone are read from it rather than generated
+///   again, which kept a sixth of every model's generated code).
 /// * `Outputs`: see [`OUTPUT_NAMES`].
 /// * `Accel`: qdd = -M^-1 h (n values) then the pivots D of M = L D L^T
 ///   (n values, all positive when M is positive definite): the mass solve
@@ -23,7 +24,7 @@ use crate::tape::{Inputs, Tape};
 ///   dh/dq dq + dh/dqd dqd (n values), then d(M a)/dq dq at a = the input
 ///   `qdd` (n values). The runtime assembles the right-hand side's
 ///   Jacobian column by column from them (`Dynamics::jacobian_parts`): a
-///   kernel the size of a few `Bias` kernels instead of 3 n^2 entries.
+///   kernel the size of a few h kernels instead of 3 n^2 entries.
 /// * `Stiffness`: K = d h(q, 0) / dq, row-major n x n: the tangent
 ///   stiffness of the static generalised forces (gravity, elastic, applied).
 /// * `Derived`: the derived parameters (parameter-only subexpressions the
@@ -31,8 +32,6 @@ use crate::tape::{Inputs, Tape};
 ///   parameter set; the other kernels read them after the base parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum KernelKind {
-    Mass,
-    Bias,
     MassBias,
     Outputs,
     Accel,
@@ -42,12 +41,10 @@ pub enum KernelKind {
 }
 
 impl KernelKind {
-    pub const ALL: [KernelKind; 8] = [
+    pub const ALL: [KernelKind; 6] = [
         Self::Jvp,
         Self::Stiffness,
         Self::Accel,
-        Self::Mass,
-        Self::Bias,
         Self::MassBias,
         Self::Outputs,
         Self::Derived,
@@ -57,8 +54,6 @@ impl KernelKind {
         let dof = info.dof();
         let tri = dof * (dof + 1) / 2;
         match self {
-            Self::Mass => tri,
-            Self::Bias => dof,
             Self::MassBias => tri + dof,
             Self::Outputs => OUTPUT_NAMES.len(),
             Self::Derived => info.derived,
@@ -76,8 +71,6 @@ impl KernelKind {
 
     pub fn name(self) -> &'static str {
         match self {
-            Self::Mass => "mass",
-            Self::Bias => "bias",
             Self::MassBias => "mass_bias",
             Self::Outputs => "outputs",
             Self::Derived => "derived",
@@ -158,8 +151,6 @@ pub trait Kernels {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TapeSet {
     pub info: ModelInfo,
-    pub mass: Tape,
-    pub bias: Tape,
     pub mass_bias: Tape,
     pub outputs: Tape,
     pub derived: Tape,
@@ -172,8 +163,6 @@ pub struct TapeSet {
 impl TapeSet {
     pub fn tape(&self, kind: KernelKind) -> &Tape {
         match kind {
-            KernelKind::Mass => &self.mass,
-            KernelKind::Bias => &self.bias,
             KernelKind::MassBias => &self.mass_bias,
             KernelKind::Outputs => &self.outputs,
             KernelKind::Derived => &self.derived,

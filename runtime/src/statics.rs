@@ -61,9 +61,17 @@ fn inf_norm(v: &[f64]) -> f64 {
 
 /// Static forces and stiffness at q.
 fn forces(d: &dyn Dynamics, q: &[f64], g: &mut [f64], k: &mut [f64]) {
+    static_forces(d, q, g);
     let zeros = vec![0.0; q.len()];
-    d.eval_kernel(KernelKind::Bias, 0.0, q, &zeros, g);
     d.eval_kernel(KernelKind::Stiffness, 0.0, q, &zeros, k);
+}
+
+/// h(q, 0): the static generalised forces, from the `MassBias` kernel.
+fn static_forces(d: &dyn Dynamics, q: &[f64], g: &mut [f64]) {
+    let n = q.len();
+    let mut packed = vec![0.0; n * (n + 1) / 2 + n];
+    d.eval_kernel(KernelKind::MassBias, 0.0, q, &vec![0.0; n], &mut packed);
+    g.copy_from_slice(&packed[n * (n + 1) / 2..]);
 }
 
 /// Newton from `q` at the current parameters. Ok: (iterations, residual).
@@ -72,7 +80,6 @@ fn newton(d: &dyn Dynamics, q: &mut [f64], opts: &StaticOptions) -> Result<(usiz
     let (mut g, mut kbuf) = (vec![0.0; n], vec![0.0; n * n]);
     let mut trial = vec![0.0; n];
     let mut g_trial = vec![0.0; n];
-    let zeros = vec![0.0; n];
     forces(d, q, &mut g, &mut kbuf);
     for it in 1..=opts.max_iterations {
         if g.iter().chain(&kbuf).any(|v| !v.is_finite()) {
@@ -94,7 +101,7 @@ fn newton(d: &dyn Dynamics, q: &mut [f64], opts: &StaticOptions) -> Result<(usiz
             for i in 0..n {
                 trial[i] = q[i] - alpha * step[i];
             }
-            d.eval_kernel(KernelKind::Bias, 0.0, &trial, &zeros, &mut g_trial);
+            static_forces(d, &trial, &mut g_trial);
             let r = inf_norm(&g_trial);
             if r.is_finite() && (r < r0 || alpha < 1.0 / 64.0 || r0 == 0.0) {
                 break;
@@ -180,7 +187,7 @@ pub fn solve_static(
     d.set_base_params(&base);
     result?;
     let mut g = vec![0.0; q.len()];
-    d.eval_kernel(KernelKind::Bias, 0.0, &q, &vec![0.0; q.len()], &mut g);
+    static_forces(d, &q, &mut g);
     Ok(StaticSolution {
         residual: inf_norm(&g),
         q,
