@@ -1,0 +1,73 @@
+//! Compiled `MassBias` timings of several models, interleaved: 200 rounds,
+//! each timing a batch of 2000 calls of every model in turn, and for each
+//! model the minimum, 10th percentile and median of its batch means.
+//!
+//! This machine's speed drifts by up to a factor of two from minute to
+//! minute; interleaving puts every model in the same phases, so their
+//! ratios hold even when the absolute figures move (BENCHMARKS.md).
+//!
+//! `cargo bench --bench interleaved -- cantilever chain tentacle3d`
+//! (`ROUNDS=50` for a quicker look).
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use runtime::KernelKind;
+use softarm::backend::{BackendChoice, load};
+
+const CALLS: usize = 2000;
+
+fn main() {
+    // `cargo bench` passes `--bench`; every other argument is a model.
+    let names: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
+    let names = if names.is_empty() {
+        vec!["cantilever".to_string(), "chain".to_string()]
+    } else {
+        names
+    };
+    let rounds: usize = std::env::var("ROUNDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(200)
+        .max(1);
+    let arms: Vec<_> = names
+        .iter()
+        .map(|n| {
+            load(n, &[], BackendChoice::Compiled, None).unwrap_or_else(|e| panic!("{n}: {e:#}"))
+        })
+        .collect();
+    let mut means: Vec<Vec<f64>> = vec![Vec::with_capacity(rounds); arms.len()];
+    for _ in 0..rounds {
+        for (l, batch) in arms.iter().zip(&mut means) {
+            let arm = &*l.arm;
+            let n = arm.dof();
+            // The state of the criterion benches (benches/kernels.rs).
+            let q: Vec<f64> = (0..n).map(|i| 0.3 * ((i as f64) * 0.7).sin()).collect();
+            let qd: Vec<f64> = (0..n).map(|i| 0.2 * ((i as f64) * 1.3).cos()).collect();
+            let mut out = vec![0.0; KernelKind::MassBias.output_len(arm.info())];
+            let start = Instant::now();
+            for _ in 0..CALLS {
+                arm.eval_kernel(
+                    KernelKind::MassBias,
+                    0.0,
+                    black_box(&q),
+                    black_box(&qd),
+                    &mut out,
+                );
+            }
+            batch.push(start.elapsed().as_nanos() as f64 / CALLS as f64);
+        }
+    }
+    for (name, mut batch) in names.iter().zip(means) {
+        batch.sort_by(f64::total_cmp);
+        println!(
+            "{name}: min {:.1} ns  p10 {:.1}  median {:.1}",
+            batch[0],
+            batch[rounds / 10],
+            batch[rounds / 2]
+        );
+    }
+}
