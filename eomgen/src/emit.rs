@@ -68,7 +68,7 @@ impl<'a> KernelEmitter<'a> {
         };
         for (i, op) in tape.ops.iter().enumerate() {
             if let Some(c) = chunk_of[i] {
-                for a in Tape::operands(op) {
+                for a in op.operands() {
                     mark(a, c);
                 }
             }
@@ -226,9 +226,10 @@ impl<'a> KernelEmitter<'a> {
         let n_dir = 2 * dof;
         let mut chunks = Vec::new();
         let mut calls = Vec::new();
-        // Members of one family at the same argument in one chunk come from
-        // one call: sin and cos from `sin_cos`, the orders of a removable
-        // function from `*_orders`.
+        // Members of one family at the same argument come from one call (in
+        // the chunk of the first, see `new`): sin and cos from `sin_cos`, the
+        // orders of a removable function from `*_orders`, the Rodrigues
+        // coefficients from `rodrigues::family`.
         let mut groups: HashMap<(Family, Slot), Vec<(Member, usize)>> = HashMap::new();
         for (i, op) in self.tape.ops.iter().enumerate() {
             if let Some((family, member, a)) = family_of(op) {

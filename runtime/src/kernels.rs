@@ -134,7 +134,7 @@ pub trait Kernels {
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]);
     /// Which backend this is, for reports.
     fn backend(&self) -> &'static str;
-    /// Solve M x = b in place, M packed as the `Mass` kernel lays it out;
+    /// Solve M x = b in place, M packed as `MassBias` lays it out (its first n(n+1)/2 values);
     /// false unless M is positive definite. Generated code overrides this
     /// with a solver specialised to its size.
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {

@@ -87,6 +87,74 @@ impl Op {
             Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Qdd(_) | Op::Dir(_) | Op::Param(_) | Op::Time
         )
     }
+
+    /// Operands, in order.
+    pub fn operands(&self) -> impl Iterator<Item = Slot> {
+        let (n, s) = match *self {
+            Op::MulAdd(a, b, c) | Op::MulSub(a, b, c) | Op::NegMulAdd(a, b, c) => (3, [a, b, c]),
+            Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Powf(a, b) => {
+                (2, [a, b, 0])
+            }
+            Op::Neg(a)
+            | Op::Powi(a, _)
+            | Op::Sqrt(a)
+            | Op::Sin(a)
+            | Op::Cos(a)
+            | Op::Tan(a)
+            | Op::Exp(a)
+            | Op::Ln(a)
+            | Op::Abs(a)
+            | Op::Sign(a)
+            | Op::Sinc(_, a)
+            | Op::Cosc(_, a)
+            | Op::SincRem(_, a)
+            | Op::Rodrigues(_, _, a) => (1, [a, 0, 0]),
+            Op::Const(_)
+            | Op::Q(_)
+            | Op::Qd(_)
+            | Op::Qdd(_)
+            | Op::Dir(_)
+            | Op::Param(_)
+            | Op::Time => (0, [0; 3]),
+        };
+        s.into_iter().take(n)
+    }
+
+    /// The same operation reading slot `f(a)` wherever it read slot `a`
+    /// (for passes that renumber a tape).
+    pub fn map_slots(&self, f: impl Fn(Slot) -> Slot) -> Op {
+        match *self {
+            Op::Add(a, b) => Op::Add(f(a), f(b)),
+            Op::Sub(a, b) => Op::Sub(f(a), f(b)),
+            Op::Mul(a, b) => Op::Mul(f(a), f(b)),
+            Op::MulAdd(a, b, c) => Op::MulAdd(f(a), f(b), f(c)),
+            Op::MulSub(a, b, c) => Op::MulSub(f(a), f(b), f(c)),
+            Op::NegMulAdd(a, b, c) => Op::NegMulAdd(f(a), f(b), f(c)),
+            Op::Div(a, b) => Op::Div(f(a), f(b)),
+            Op::Powf(a, b) => Op::Powf(f(a), f(b)),
+            Op::Neg(a) => Op::Neg(f(a)),
+            Op::Powi(a, k) => Op::Powi(f(a), k),
+            Op::Sqrt(a) => Op::Sqrt(f(a)),
+            Op::Sin(a) => Op::Sin(f(a)),
+            Op::Cos(a) => Op::Cos(f(a)),
+            Op::Tan(a) => Op::Tan(f(a)),
+            Op::Exp(a) => Op::Exp(f(a)),
+            Op::Ln(a) => Op::Ln(f(a)),
+            Op::Abs(a) => Op::Abs(f(a)),
+            Op::Sign(a) => Op::Sign(f(a)),
+            Op::Sinc(k, a) => Op::Sinc(k, f(a)),
+            Op::Cosc(k, a) => Op::Cosc(k, f(a)),
+            Op::SincRem(k, a) => Op::SincRem(k, f(a)),
+            Op::Rodrigues(j, k, a) => Op::Rodrigues(j, k, f(a)),
+            leaf @ (Op::Const(_)
+            | Op::Q(_)
+            | Op::Qd(_)
+            | Op::Qdd(_)
+            | Op::Dir(_)
+            | Op::Param(_)
+            | Op::Time) => leaf,
+        }
+    }
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -189,37 +257,5 @@ impl Tape {
                 _ => 1,
             })
             .sum()
-    }
-
-    /// Operands of `op`, in order.
-    pub fn operands(op: &Op) -> impl Iterator<Item = Slot> {
-        let (n, s) = match *op {
-            Op::MulAdd(a, b, c) | Op::MulSub(a, b, c) | Op::NegMulAdd(a, b, c) => (3, [a, b, c]),
-            Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) | Op::Powf(a, b) => {
-                (2, [a, b, 0])
-            }
-            Op::Neg(a)
-            | Op::Powi(a, _)
-            | Op::Sqrt(a)
-            | Op::Sin(a)
-            | Op::Cos(a)
-            | Op::Tan(a)
-            | Op::Exp(a)
-            | Op::Ln(a)
-            | Op::Abs(a)
-            | Op::Sign(a)
-            | Op::Sinc(_, a)
-            | Op::Cosc(_, a)
-            | Op::SincRem(_, a)
-            | Op::Rodrigues(_, _, a) => (1, [a, 0, 0]),
-            Op::Const(_)
-            | Op::Q(_)
-            | Op::Qd(_)
-            | Op::Qdd(_)
-            | Op::Dir(_)
-            | Op::Param(_)
-            | Op::Time => (0, [0; 3]),
-        };
-        s.into_iter().take(n)
     }
 }

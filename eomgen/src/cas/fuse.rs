@@ -14,7 +14,7 @@ pub fn fuse_multiply_adds(tape: Tape) -> Tape {
     let n = tape.ops.len();
     let mut uses = vec![0u32; n];
     for op in &tape.ops {
-        for a in Tape::operands(op) {
+        for a in op.operands() {
             uses[a as usize] += 1;
         }
     }
@@ -52,51 +52,16 @@ pub fn fuse_multiply_adds(tape: Tape) -> Tape {
     for (i, op) in ops.iter().enumerate() {
         if !dead[i] {
             new_slot[i] = kept.len() as Slot;
-            kept.push(renumber(op, &new_slot));
+            kept.push(op.map_slots(|a| {
+                let s = new_slot[a as usize];
+                debug_assert!(s != Slot::MAX, "an operand was fused away");
+                s
+            }));
         }
     }
     Tape {
         ops: kept,
         outputs: tape.outputs.iter().map(|&o| new_slot[o as usize]).collect(),
-    }
-}
-
-fn renumber(op: &Op, new_slot: &[Slot]) -> Op {
-    let m = |a: Slot| {
-        let s = new_slot[a as usize];
-        debug_assert!(s != Slot::MAX, "an operand was fused away");
-        s
-    };
-    match *op {
-        Op::Add(a, b) => Op::Add(m(a), m(b)),
-        Op::Sub(a, b) => Op::Sub(m(a), m(b)),
-        Op::Mul(a, b) => Op::Mul(m(a), m(b)),
-        Op::MulAdd(a, b, c) => Op::MulAdd(m(a), m(b), m(c)),
-        Op::MulSub(a, b, c) => Op::MulSub(m(a), m(b), m(c)),
-        Op::NegMulAdd(a, b, c) => Op::NegMulAdd(m(a), m(b), m(c)),
-        Op::Div(a, b) => Op::Div(m(a), m(b)),
-        Op::Powf(a, b) => Op::Powf(m(a), m(b)),
-        Op::Neg(a) => Op::Neg(m(a)),
-        Op::Powi(a, k) => Op::Powi(m(a), k),
-        Op::Sqrt(a) => Op::Sqrt(m(a)),
-        Op::Sin(a) => Op::Sin(m(a)),
-        Op::Cos(a) => Op::Cos(m(a)),
-        Op::Tan(a) => Op::Tan(m(a)),
-        Op::Exp(a) => Op::Exp(m(a)),
-        Op::Ln(a) => Op::Ln(m(a)),
-        Op::Abs(a) => Op::Abs(m(a)),
-        Op::Sign(a) => Op::Sign(m(a)),
-        Op::Sinc(k, a) => Op::Sinc(k, m(a)),
-        Op::Cosc(k, a) => Op::Cosc(k, m(a)),
-        Op::SincRem(k, a) => Op::SincRem(k, m(a)),
-        Op::Rodrigues(j, k, a) => Op::Rodrigues(j, k, m(a)),
-        leaf @ (Op::Const(_)
-        | Op::Q(_)
-        | Op::Qd(_)
-        | Op::Qdd(_)
-        | Op::Dir(_)
-        | Op::Param(_)
-        | Op::Time) => leaf,
     }
 }
 
