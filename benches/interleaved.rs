@@ -7,7 +7,11 @@
 //! ratios hold even when the absolute figures move (BENCHMARKS.md).
 //!
 //! `cargo bench --bench interleaved -- cantilever chain tentacle3d`
-//! (`ROUNDS=50` for a quicker look).
+//! (`ROUNDS=50` for a quicker look). `recursion:tentacle3d` times the
+//! numeric element-by-element recursion of tests/common/pcc3d.rs instead.
+
+#[path = "../tests/common/pcc3d.rs"]
+mod pcc3d;
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -33,30 +37,46 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(200)
         .max(1);
-    let arms: Vec<_> = names
+    // Each name times a callable on the criterion benches' state
+    // (benches/kernels.rs); `recursion:MODEL` times the numeric recursion
+    // of tests/common/pcc3d.rs on MODEL's parameters (3D pcc arms without
+    // twist): a kernel of one element's code run in a loop.
+    let mut timed: Vec<Box<dyn FnMut()>> = names
         .iter()
         .map(|n| {
-            load(n, &[], BackendChoice::Compiled, None).unwrap_or_else(|e| panic!("{n}: {e:#}"))
+            let (recursion, model) = match n.strip_prefix("recursion:") {
+                Some(m) => (true, m),
+                None => (false, n.as_str()),
+            };
+            let l = load(model, &[], BackendChoice::Compiled, None)
+                .unwrap_or_else(|e| panic!("{model}: {e:#}"));
+            let dof = l.arm.dof();
+            let q: Vec<f64> = (0..dof).map(|i| 0.3 * ((i as f64) * 0.7).sin()).collect();
+            let qd: Vec<f64> = (0..dof).map(|i| 0.2 * ((i as f64) * 1.3).cos()).collect();
+            let mut out = vec![0.0; KernelKind::MassBias.output_len(l.arm.info())];
+            if recursion {
+                let mut r = pcc3d::Pcc3d::new(&l.arm.info().parameters, l.arm.base_params());
+                Box::new(move || r.mass_bias(black_box(&q), black_box(&qd), &mut out))
+                    as Box<dyn FnMut()>
+            } else {
+                Box::new(move || {
+                    l.arm.eval_kernel(
+                        KernelKind::MassBias,
+                        0.0,
+                        black_box(&q),
+                        black_box(&qd),
+                        &mut out,
+                    )
+                })
+            }
         })
         .collect();
-    let mut means: Vec<Vec<f64>> = vec![Vec::with_capacity(rounds); arms.len()];
+    let mut means: Vec<Vec<f64>> = vec![Vec::with_capacity(rounds); timed.len()];
     for _ in 0..rounds {
-        for (l, batch) in arms.iter().zip(&mut means) {
-            let arm = &*l.arm;
-            let n = arm.dof();
-            // The state of the criterion benches (benches/kernels.rs).
-            let q: Vec<f64> = (0..n).map(|i| 0.3 * ((i as f64) * 0.7).sin()).collect();
-            let qd: Vec<f64> = (0..n).map(|i| 0.2 * ((i as f64) * 1.3).cos()).collect();
-            let mut out = vec![0.0; KernelKind::MassBias.output_len(arm.info())];
+        for (f, batch) in timed.iter_mut().zip(&mut means) {
             let start = Instant::now();
             for _ in 0..CALLS {
-                arm.eval_kernel(
-                    KernelKind::MassBias,
-                    0.0,
-                    black_box(&q),
-                    black_box(&qd),
-                    &mut out,
-                );
+                f();
             }
             batch.push(start.elapsed().as_nanos() as f64 / CALLS as f64);
         }

@@ -531,3 +531,42 @@ fn damped_two_module_vc_arm_never_gains_energy_and_swings_about_its_equilibrium(
         );
     }
 }
+
+#[test]
+fn tentacle3d_mass_and_bias_match_a_numeric_composite_body_recursion() {
+    // Every load the kernel has, a turned base and a rest curvature, so
+    // each term of the recursion is checked (tests/common/pcc3d.rs).
+    let sets = [
+        "tip.force=[0.3,-0.2,0.5]",
+        "tip.moment=[0.01,0.02,-0.015]",
+        "gravity=[1.0,-2.0,-9.81]",
+        "base.direction=[0.6,0.0,0.8]",
+    ];
+    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    let dir = std::env::temp_dir().join("softarm-test-cache");
+    let l = load("tentacle3d", &overrides, BackendChoice::Compiled, Some(dir)).unwrap();
+    let arm = &*l.arm;
+    let n = arm.dof();
+    let mut reference = pcc3d::Pcc3d::new(&arm.info().parameters, arm.base_params());
+    assert_eq!(reference.dof(), n);
+    let len = KernelKind::MassBias.output_len(arm.info());
+    let (mut got, mut want) = (vec![0.0; len], vec![0.0; len]);
+    let mut rng = Rng::new(7);
+    for trial in 0..20 {
+        // The straight state first, then bends up to 0.8 rad an element.
+        let (q, qd) = if trial == 0 {
+            (vec![0.0; n], rng.vec(n, -2.0, 2.0))
+        } else {
+            (rng.vec(n, -0.8, 0.8), rng.vec(n, -2.0, 2.0))
+        };
+        arm.eval_kernel(KernelKind::MassBias, 0.0, &q, &qd, &mut got);
+        reference.mass_bias(&q, &qd, &mut want);
+        let (m, h) = want.split_at(n * (n + 1) / 2);
+        let m_scale = m.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let h_scale = h.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        for (k, (&g, &w)) in got.iter().zip(&want).enumerate() {
+            let floor = if k < m.len() { m_scale } else { h_scale };
+            assert_close(g, w, 1e-11, floor, &format!("trial {trial}, entry {k}"));
+        }
+    }
+}
