@@ -16,25 +16,31 @@
 type V3 = [f64; 3];
 type M3 = [[f64; 3]; 3];
 
+#[inline(always)]
 fn add(a: V3, b: V3) -> V3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
+#[inline(always)]
 fn sub(a: V3, b: V3) -> V3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
+#[inline(always)]
 fn scale(s: f64, a: V3) -> V3 {
     [s * a[0], s * a[1], s * a[2]]
 }
+#[inline(always)]
 fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    a[0].mul_add(b[0], a[1].mul_add(b[1], a[2] * b[2]))
 }
+#[inline(always)]
 fn cross(a: V3, b: V3) -> V3 {
     [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
+        a[1].mul_add(b[2], -(a[2] * b[1])),
+        a[2].mul_add(b[0], -(a[0] * b[2])),
+        a[0].mul_add(b[1], -(a[1] * b[0])),
     ]
 }
+#[inline(always)]
 fn mat_vec(r: &M3, v: V3) -> V3 {
     [dot(r[0], v), dot(r[1], v), dot(r[2], v)]
 }
@@ -44,6 +50,7 @@ fn mat_mat(a: &M3, b: &M3) -> M3 {
     })
 }
 /// a0 + a1 + ..., for the sums of several terms.
+#[inline(always)]
 fn sum(vs: &[V3]) -> V3 {
     vs.iter().fold([0.0; 3], |s, &v| add(s, v))
 }
@@ -60,6 +67,7 @@ struct OnX {
 }
 
 impl OnX {
+    #[inline(always)]
     fn value(&self, rho: V3, w: f64) -> V3 {
         let p = sub(scale(rho[0], rho), scale(w, EX));
         sum(&[
@@ -70,6 +78,7 @@ impl OnX {
     }
 
     /// The derivative along `d`.
+    #[inline(always)]
     fn along(&self, rho: V3, w: f64, d: V3) -> V3 {
         let wd = 2.0 * dot(rho, d);
         let p = sub(scale(rho[0], rho), scale(w, EX));
@@ -84,6 +93,7 @@ impl OnX {
     }
 
     /// The second derivative along `d` twice.
+    #[inline(always)]
     fn along_twice(&self, rho: V3, w: f64, d: V3) -> V3 {
         let wd = 2.0 * dot(rho, d);
         let wdd = 2.0 * dot(d, d);
@@ -110,6 +120,7 @@ struct LeftJacobian {
 }
 
 impl LeftJacobian {
+    #[inline(always)]
     fn apply(&self, rho: V3, u: V3) -> V3 {
         sum(&[
             scale(self.a[0], u),
@@ -119,6 +130,7 @@ impl LeftJacobian {
     }
 
     /// d/dt (g(rho) rho') at rho'' = 0.
+    #[inline(always)]
     fn rate(&self, rho: V3, rate: V3) -> V3 {
         let wd = 2.0 * dot(rho, rate);
         let rr = dot(rho, rate);
@@ -141,6 +153,7 @@ struct Inertia {
 }
 
 impl Inertia {
+    #[inline(always)]
     fn of_body(m: f64, r: V3, lateral: f64, axial: f64, axis: V3) -> Self {
         let r2 = dot(r, r);
         let j = std::array::from_fn(|i| {
@@ -156,6 +169,7 @@ impl Inertia {
         }
     }
 
+    #[inline(always)]
     fn add(&mut self, o: &Self) {
         self.m += o.m;
         self.h = add(self.h, o.h);
@@ -167,6 +181,7 @@ impl Inertia {
     }
 
     /// The momentum of the twist (w, v): (J w + h x v, m v + w x h).
+    #[inline(always)]
     fn momentum(&self, (w, v): (V3, V3)) -> (V3, V3) {
         (
             add(mat_vec(&self.j, w), cross(self.h, v)),
@@ -175,11 +190,13 @@ impl Inertia {
     }
 }
 
+#[inline(always)]
 fn pair(a: (V3, V3), b: (V3, V3)) -> f64 {
     dot(a.0, b.0) + dot(a.1, b.1)
 }
 
 /// Axisymmetric body inertia applied to a vector.
+#[inline(always)]
 fn apply_body(lateral: f64, axial: f64, axis: V3, w: V3) -> V3 {
     add(
         scale(lateral, w),
@@ -267,6 +284,23 @@ impl Pcc3d {
 
     /// The upper triangle of M row by row, then h: the `MassBias` layout.
     pub fn mass_bias(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        // Built for FMA where the processor has it, like the kernels.
+        #[cfg(target_arch = "x86_64")]
+        if runtime::cpu::has_fma() {
+            // SAFETY: the processor has FMA (checked just above).
+            return unsafe { self.mass_bias_fma(q, qd, out) };
+        }
+        self.mass_bias_any(q, qd, out)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "fma")]
+    unsafe fn mass_bias_fma(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        self.mass_bias_any(q, qd, out)
+    }
+
+    #[inline(always)]
+    fn mass_bias_any(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) {
         let n = self.dof();
         assert_eq!(out.len(), n * (n + 1) / 2 + n);
         let (mut r, mut p) = (self.base_r, self.base_p);
@@ -444,11 +478,14 @@ impl Pcc3d {
                 );
             }
         }
+        // Coordinates of different elements: twist . momentum, a row at a
+        // time from the element after i's.
         for i in 0..n {
-            for j in i + 1..n {
-                if i / 2 < j / 2 {
-                    mass[index(i, j)] = pair(self.computed[i / 2].twist[i % 2], self.momenta[j]);
-                }
+            let (w, v) = self.computed[i / 2].twist[i % 2];
+            let first = 2 * (i / 2 + 1);
+            let row = &mut mass[index(i, first)..index(i, n - 1) + 1];
+            for (m, &(a, l)) in row.iter_mut().zip(&self.momenta[first..]) {
+                *m = pair((w, v), (a, l));
             }
         }
     }
