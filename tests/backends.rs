@@ -58,9 +58,30 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
                 let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
                 compiled.eval_kernel(kind, t, &q, &qd, &mut a);
                 interpreted.eval_kernel(kind, t, &q, &qd, &mut b);
+                // A compiled 3D chain computes MassBias by the link
+                // recursion (runtime/src/links.rs), not the interpreter's
+                // flat tape: entries zero in closed form come out as
+                // different round-off, so M and h are each held to 1e-12
+                // of their largest entry. The other kernels run the same
+                // operations in both backends.
+                let m_len = n * (n + 1) / 2;
+                let largest =
+                    |r: std::ops::Range<usize>| b[r].iter().fold(0.0f64, |s, x| s.max(x.abs()));
+                let (m_scale, h_scale) = (largest(0..m_len.min(len)), largest(m_len.min(len)..len));
                 for k in 0..len {
                     assert!(a[k].is_finite(), "{} {kind:?}[{k}] not finite", m.name);
-                    assert_close(a[k], b[k], 1e-12, 0.0, &format!("{} {kind:?}[{k}]", m.name));
+                    let floor = match kind {
+                        KernelKind::MassBias if k < m_len => m_scale,
+                        KernelKind::MassBias => h_scale,
+                        _ => 0.0,
+                    };
+                    assert_close(
+                        a[k],
+                        b[k],
+                        1e-12,
+                        floor,
+                        &format!("{} {kind:?}[{k}]", m.name),
+                    );
                 }
             }
             // The Jacobian's parts, column by column from the Jvp kernel.

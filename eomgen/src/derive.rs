@@ -4,7 +4,7 @@ use runtime::{ModelInfo, TapeSet};
 
 use crate::cas::{Cas, Hoist};
 use crate::model::{Model, Structure, drives, parameters};
-use crate::tmt::{SYMBOLIC_SOLVE_MAX_DOF, assemble, solve_accelerations, system};
+use crate::tmt::{SYMBOLIC_SOLVE_MAX_DOF, assemble, link_chain, solve_accelerations, system};
 
 /// Derive the kernels of a model's structure.
 pub fn derive(model: &Model) -> TapeSet {
@@ -58,5 +58,6 @@ pub fn derive(model: &Model) -> TapeSet {
         accel: accel_tape,
         stiffness,
         jvp,
+        links: link_chain(model),
     }
 }

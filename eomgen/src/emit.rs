@@ -332,6 +332,85 @@ impl<'a> KernelEmitter<'a> {
     }
 }
 
+/// `mass_bias` as the link recursion (`runtime::links`) over the model's
+/// cells, each cell a kernel of one link's coordinates and parameters.
+fn emit_link_recursion(
+    layout: &runtime::links::LinkLayout,
+    cells: &[Tape],
+    dof: usize,
+    n_params: usize,
+    n_out: usize,
+) -> TokenStream {
+    use runtime::links::{CELL_PARAMS, LinkSpec};
+    let n_dir = 2 * dof;
+    let mut defs = Vec::new();
+    let mut arms = Vec::new();
+    for (c, tape) in cells.iter().enumerate() {
+        let n = layout
+            .links
+            .iter()
+            .find(|l| l.cell == c)
+            .map_or(0, |l| l.count);
+        let name = format!("cell_{c}");
+        defs.push(KernelEmitter::new(tape).emit(&name, n, CELL_PARAMS));
+        let f = Ident::new(&name, Span::call_site());
+        let n2 = 2 * n;
+        arms.push(quote! {
+            #c => #f(0.0, q.try_into().expect("link coordinates"), qd.try_into().expect("link rates"),
+                     &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
+                     out.try_into().expect("cell outputs")),
+        });
+    }
+    let links = layout.links.iter().map(|LinkSpec { cell, first, count, params }| {
+        quote!(runtime::links::LinkSpec { cell: #cell, first: #first, count: #count, params: vec![#(#params),*] })
+    });
+    let [g, bp] = [layout.gravity, layout.base_position];
+    let br = layout.base_rotation;
+    let opt = |v: Option<[usize; 3]>| match v {
+        Some(v) => quote!(Some([#(#v),*])),
+        None => quote!(None),
+    };
+    let (tf, tm) = (opt(layout.tip_force), opt(layout.tip_moment));
+    let frame = layout.tip_frame;
+    let doc = format!(
+        " Kernel `mass_bias`: the link recursion (`runtime::links`) over {} links, {} cell(s).",
+        layout.links.len(),
+        cells.len()
+    );
+    quote! {
+        static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(|| {
+            runtime::links::LinkLayout {
+                links: vec![#(#links),*],
+                gravity: [#(#g),*],
+                base_position: [#(#bp),*],
+                base_rotation: [#(#br),*],
+                tip_force: #tf,
+                tip_moment: #tm,
+                tip_frame: #frame,
+            }
+        });
+        #[doc = #doc]
+        #[allow(unused_variables)]
+        pub fn mass_bias(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+            runtime::cpu::require_fma();
+            // SAFETY: `require_fma` has checked that the processor has FMA.
+            unsafe { mass_bias_links(q, qd, p, out) }
+        }
+        #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+        unsafe fn mass_bias_links(q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+            runtime::links::mass_bias(
+                &LINKS,
+                |c: usize, q: &[f64], qd: &[f64], p: &[f64], out: &mut [f64]| match c {
+                    #(#arms)*
+                    _ => unreachable!("cell index from the layout"),
+                },
+                q, qd, p, out,
+            )
+        }
+        #(#defs)*
+    }
+}
+
 /// Which member of its family an op is: the derivative order (sin 0, cos
 /// 1), and for the Rodrigues coefficients c_j also j.
 type Member = (u8, u8);
@@ -426,7 +505,13 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     let mut arms = Vec::new();
     for kind in KernelKind::ALL {
         let name = kind.name();
-        kernels.push(KernelEmitter::new(tapes.tape(kind)).emit(name, dof, n_params));
+        match (&tapes.links, kind) {
+            (Some((layout, cells)), KernelKind::MassBias) => {
+                let n_out = tapes.mass_bias.outputs.len();
+                kernels.push(emit_link_recursion(layout, cells, dof, n_params, n_out));
+            }
+            _ => kernels.push(KernelEmitter::new(tapes.tape(kind)).emit(name, dof, n_params)),
+        }
         let f = Ident::new(name, Span::call_site());
         let variant = Ident::new(&format!("{kind:?}"), Span::call_site());
         arms.push(quote! {

@@ -12,6 +12,7 @@
 pub mod cpu;
 pub mod kernels;
 pub mod linalg;
+pub mod links;
 pub mod rodrigues;
 pub mod special;
 pub mod tape;

@@ -39,8 +39,10 @@ impl Cas {
         });
         for (component, &u) in world.iter().enumerate() {
             // Constants and symbols have exact chain-rule rates already; a
-            // node bound twice keeps its first rule (both are true).
-            if matches!(self.node(u), super::Node::Bind(_)) {
+            // node bound twice keeps its first rule (both are true). Under
+            // the identity at rest (a link cell's base frame) R x is x
+            // itself: the rule would define x's rate by x's rate.
+            if matches!(self.node(u), super::Node::Bind(_)) && u != x[component] {
                 self.turned.entry(u).or_insert(Turned {
                     r: *r,
                     w: *w,

@@ -4,6 +4,7 @@
 mod absolute;
 mod actuation;
 mod assemble;
+mod cell;
 mod chain;
 mod inertia;
 mod planar;
@@ -12,6 +13,7 @@ mod spatial;
 mod system;
 
 pub use assemble::{Equations, assemble};
+pub use cell::link_chain;
 pub use planar::planar_system;
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
 pub use spatial::spatial_system;

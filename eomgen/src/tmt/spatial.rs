@@ -206,7 +206,13 @@ fn series_on_x(cas: &mut Cas, rho: &V3, w: ExprId, a: ExprId, b: ExprId, c: Expr
 /// A constant-strain arc of length `len` (rest length plus stretch) and
 /// strain `rho` from frame `f`: its centroid, its body's axis and angular
 /// velocity (the mid-arc frame), and the end frame.
-fn arc(cas: &mut Cas, f: &Frame, rho: &V3, rate: &V3, len: ExprId) -> (V3, V3, V3, Frame) {
+pub(super) fn arc(
+    cas: &mut Cas,
+    f: &Frame,
+    rho: &V3,
+    rate: &V3,
+    len: ExprId,
+) -> (V3, V3, V3, Frame) {
     let w = cas.dot(rho, rho);
     let w = cas.bind(w);
     let [c0, c1, c2, c3, c4] = coefficients(cas, w, [0, 1, 2, 3, 4]);

@@ -1,0 +1,209 @@
+//! Link cells: one constant-strain link of a 3D chain derived on its own,
+//! in its base frame at rest, for `runtime::links` to run in a loop.
+//!
+//! The cell is the arm's own arc (`spatial::arc`) under the identity frame:
+//! its relative rotation and end point, the body's centroid, axis and
+//! angular velocity, their rates and convective accelerations (qdd = 0),
+//! the columns of the link's coordinates, and the link's elastic and
+//! dissipative generalised forces, as one tape of the link's coordinates
+//! and [`CELL_PARAMS`] parameters. Links of the same shape share a cell.
+//!
+//! Chains this covers: every segment pcc or vc, base still, no actuators
+//! or driven torques (whose potentials couple links), no tip body. Other
+//! models keep the flat `MassBias` kernel.
+
+use runtime::Tape;
+use runtime::links::{CELL_PARAMS, LinkLayout, LinkSpec, cell};
+
+use crate::cas::{Cas, ExprId, SymKind};
+use crate::model::{Method, Model, Structure, parameters};
+
+use super::actuation::thinning;
+use super::spatial::{Frame, V3, arc, half_k_sq};
+
+/// The layout and cells of a model whose mass + bias the link recursion
+/// computes, or `None` when its structure is outside the recursion.
+pub fn link_chain(model: &Model) -> Option<(LinkLayout, Vec<Tape>)> {
+    let st = Structure::of(model);
+    let covered = st.dimensions == 3
+        && st
+            .segments
+            .iter()
+            .all(|g| matches!(g.method, Method::Pcc | Method::Vc))
+        && !st.tip_mass
+        && st.chambers.iter().all(|&c| c == 0)
+        && st.tendons.is_empty()
+        && st.torques.is_empty()
+        && !st.base_translates
+        && st.base_turns == 0;
+    if !covered {
+        return None;
+    }
+    let names: Vec<String> = parameters(model).into_iter().map(|(n, _)| n).collect();
+    let index = |n: &str| {
+        names
+            .iter()
+            .position(|x| x == n)
+            .expect("parameter in the layout")
+    };
+    let triple = |pre: &str| ["x", "y", "z"].map(|c| index(&format!("{pre}.{c}")));
+    let mut cells: Vec<((bool, bool, bool), Tape)> = Vec::new();
+    let mut links = Vec::new();
+    let (mut first, mut k) = (0, 0);
+    for g in &st.segments {
+        let shape = (g.twist, g.extension, g.incompressible);
+        let c = match cells.iter().position(|(s, _)| *s == shape) {
+            Some(c) => c,
+            None => {
+                cells.push((shape, derive_cell(shape)));
+                cells.len() - 1
+            }
+        };
+        let count = g.coordinates_3d();
+        for _ in 0..g.elements {
+            let params = [
+                "element[{k}].length",
+                "element[{k}].mass",
+                "element[{k}].inertia",
+                "element[{k}].axial_inertia",
+                "joint[{k}].stiffness",
+                "joint[{k}].damping",
+                "joint[{k}].rest",
+                "twist[{k}].stiffness",
+                "twist[{k}].damping",
+                "stretch[{k}].stiffness",
+                "stretch[{k}].damping",
+            ]
+            .map(|n| index(&n.replace("{k}", &k.to_string())))
+            .to_vec();
+            links.push(LinkSpec {
+                cell: c,
+                first,
+                count,
+                params,
+            });
+            first += count;
+            k += 1;
+        }
+    }
+    let layout = LinkLayout {
+        links,
+        gravity: triple("gravity"),
+        base_position: triple("base"),
+        base_rotation: std::array::from_fn(|i| index(&format!("base.R{}{}", i / 3, i % 3))),
+        tip_force: st.tip_force.then(|| triple("tip.force")),
+        tip_moment: st.tip_moment.then(|| triple("tip.moment")),
+        tip_frame: st.tip_frame_wrench,
+    };
+    Some((layout, cells.into_iter().map(|(_, t)| t).collect()))
+}
+
+/// The cell of a link with the bend pair, and twist and stretch when asked.
+fn derive_cell((twist, extension, incompressible): (bool, bool, bool)) -> Tape {
+    let mut cas = Cas::new();
+    let cas = &mut cas;
+    let mut names = vec!["bend_y", "bend_z"];
+    if twist {
+        names.push("twist");
+    }
+    if extension {
+        names.push("stretch");
+    }
+    let q: Vec<ExprId> = (0..names.len())
+        .map(|i| cas.symbol(names[i], SymKind::Q(i as u32)))
+        .collect();
+    let qd: Vec<ExprId> = (0..names.len())
+        .map(|i| cas.symbol(&format!("{}_dot", names[i]), SymKind::Qd(i as u32)))
+        .collect();
+    let p: Vec<ExprId> = (0..CELL_PARAMS)
+        .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
+        .collect();
+    let [l, m, lateral, axial, kb, db, rest, kt, dt, ks, ds] = std::array::from_fn(|i| p[i]);
+    let zero = cas.zero();
+    let take = |i: Option<usize>| i.map_or((zero, zero), |i| (q[i], qd[i]));
+    let (by, by_d) = take(Some(0));
+    let (bz, bz_d) = take(Some(1));
+    let (tw, tw_d) = take(twist.then_some(2));
+    let (st, st_d) = take(extension.then_some(2 + usize::from(twist)));
+
+    // The link's potential and Rayleigh function, as spatial.rs has them.
+    let len = cas.add(l, st);
+    let soft = incompressible.then(|| thinning(cas, l, len).0);
+    let soften = |cas: &mut Cas, k: ExprId| soft.map_or(k, |s| cas.mul(k, s));
+    let kb = soften(cas, kb);
+    let bz_rel = cas.sub(bz, rest);
+    let mut elastic = vec![half_k_sq(cas, kb, by), half_k_sq(cas, kb, bz_rel)];
+    let mut rayleigh = vec![half_k_sq(cas, db, by_d), half_k_sq(cas, db, bz_d)];
+    if twist {
+        let kt = soften(cas, kt);
+        elastic.push(half_k_sq(cas, kt, tw));
+        rayleigh.push(half_k_sq(cas, dt, tw_d));
+    }
+    if extension {
+        elastic.push(half_k_sq(cas, ks, st));
+        rayleigh.push(half_k_sq(cas, ds, st_d));
+    }
+    let elastic = cas.add_all(&elastic);
+    let rayleigh = cas.add_all(&rayleigh);
+
+    let one = cas.one();
+    let identity = Frame {
+        r: std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one } else { zero })),
+        p: [zero; 3],
+        w: [zero; 3],
+        quat: [one, zero, zero, zero],
+    };
+    let rho = [tw, by, bz];
+    let rate = [tw_d, by_d, bz_d];
+    let (centroid, axis, omega, end) = arc(cas, &identity, &rho, &rate, len);
+    let pairs: Vec<(ExprId, ExprId)> = q.iter().copied().zip(qd.iter().copied()).collect();
+    let rates = |cas: &mut Cas, v: &V3| -> V3 {
+        let r = cas.kinematic_rates(v, &pairs);
+        [r[0], r[1], r[2]]
+    };
+    let end_rate = rates(cas, &end.p);
+    let end_accel = rates(cas, &end_rate);
+    let omega_rate = rates(cas, &end.w);
+    let centroid_rate = rates(cas, &centroid);
+    let centroid_accel = rates(cas, &centroid_rate);
+    let body_omega_rate = rates(cas, &omega);
+
+    let mut out = vec![zero; cell::len(q.len())];
+    for i in 0..3 {
+        for j in 0..3 {
+            out[cell::ROTATION + 3 * i + j] = end.r[i][j];
+        }
+    }
+    for (at, v) in [
+        (cell::END, end.p),
+        (cell::END_RATE, end_rate),
+        (cell::END_ACCEL, end_accel),
+        (cell::OMEGA, end.w),
+        (cell::OMEGA_RATE, omega_rate),
+        (cell::CENTROID, centroid),
+        (cell::CENTROID_RATE, centroid_rate),
+        (cell::CENTROID_ACCEL, centroid_accel),
+        (cell::BODY_OMEGA, omega),
+        (cell::BODY_OMEGA_RATE, body_omega_rate),
+        (cell::AXIS, axis),
+    ] {
+        out[at..at + 3].copy_from_slice(&v);
+    }
+    out[cell::MASS] = m;
+    out[cell::LATERAL] = lateral;
+    out[cell::AXIAL] = axial;
+    let n = q.len();
+    for c in 0..n {
+        let col = cell::COLUMNS + 12 * c;
+        let columns = [&end.w, &end_rate, &omega, &centroid_rate];
+        for (s, v) in columns.into_iter().enumerate() {
+            for k in 0..3 {
+                out[col + 3 * s + k] = cas.diff(v[k], qd[c]);
+            }
+        }
+        let de = cas.diff(elastic, q[c]);
+        let dr = cas.diff(rayleigh, qd[c]);
+        out[cell::COLUMNS + 12 * n + c] = cas.add(de, dr);
+    }
+    cas.to_tape(&out)
+}

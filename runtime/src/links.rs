@@ -1,0 +1,390 @@
+//! Mass + bias of a serial chain of constant-strain links (3D pcc and vc
+//! arms) by a recursion over the links, each link's local kinematics from
+//! one generated *cell*.
+//!
+//! A fully unrolled kernel of a 20-DOF 3D arm is over 100 KB of machine
+//! code, past the processor's instruction caches: it runs at half the
+//! instructions per nanosecond of a small one (BENCHMARKS.md, session 7).
+//! Here the CAS derives one link on its own, in its base frame at rest (the
+//! cell: relative rotation and end point, the body's centroid and axis,
+//! their rates and convective accelerations, the columns of the link's
+//! coordinates, the link's elastic and dissipative forces), identical links
+//! share one cell, and this loop composes the world frame link by link and
+//! sums M and h by composite bodies from the tip (Featherstone's CRBA and
+//! RNEA, in the world frame as `eomgen/src/tmt/chain.rs` does symbolically).
+//! The flat `MassBias` tape stays the interpreter's form: the two are
+//! independent computations of the same M and h (tests/backends.rs).
+
+use std::cell::RefCell;
+
+use serde::{Deserialize, Serialize};
+
+/// Parameters a cell reads, in this order, per link: element[k].length,
+/// .mass, .inertia, .axial_inertia, joint[k].stiffness, .damping, .rest,
+/// twist[k].stiffness, .damping, stretch[k].stiffness, .damping.
+pub const CELL_PARAMS: usize = 11;
+
+/// Where a cell's outputs sit, for a link of `n` coordinates.
+pub mod cell {
+    /// Relative rotation, rows.
+    pub const ROTATION: usize = 0;
+    /// End point in the base frame, its rate and convective acceleration.
+    pub const END: usize = 9;
+    pub const END_RATE: usize = 12;
+    pub const END_ACCEL: usize = 15;
+    /// Relative angular velocity of the end frame, its convective rate.
+    pub const OMEGA: usize = 18;
+    pub const OMEGA_RATE: usize = 21;
+    /// The body: centroid, its rate and convective acceleration.
+    pub const CENTROID: usize = 24;
+    pub const CENTROID_RATE: usize = 27;
+    pub const CENTROID_ACCEL: usize = 30;
+    /// The body's angular velocity and its convective rate.
+    pub const BODY_OMEGA: usize = 33;
+    pub const BODY_OMEGA_RATE: usize = 36;
+    /// The body's axis (its inertia is axisymmetric about it).
+    pub const AXIS: usize = 39;
+    pub const MASS: usize = 42;
+    pub const LATERAL: usize = 43;
+    pub const AXIAL: usize = 44;
+    /// Then per coordinate c: the end frame's angular velocity column and
+    /// end point velocity column (6), the body's angular and centroid
+    /// velocity columns (6), and last the n generalised elastic and
+    /// dissipative forces.
+    pub const COLUMNS: usize = 45;
+
+    pub fn len(n: usize) -> usize {
+        COLUMNS + 13 * n
+    }
+}
+
+/// One link: its cell, its coordinates and its parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LinkSpec {
+    pub cell: usize,
+    pub first: usize,
+    pub count: usize,
+    /// Indices into the parameter vector, [`CELL_PARAMS`] of them.
+    pub params: Vec<usize>,
+}
+
+/// A chain of links and where its global parameters are.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LinkLayout {
+    pub links: Vec<LinkSpec>,
+    pub gravity: [usize; 3],
+    pub base_position: [usize; 3],
+    /// Rows of the base rotation.
+    pub base_rotation: [usize; 9],
+    pub tip_force: Option<[usize; 3]>,
+    pub tip_moment: Option<[usize; 3]>,
+    /// The tip force and moment turn with the tip frame.
+    pub tip_frame: bool,
+}
+
+impl LinkLayout {
+    pub fn dof(&self) -> usize {
+        self.links.last().map_or(0, |l| l.first + l.count)
+    }
+}
+
+type V3 = [f64; 3];
+type M3 = [[f64; 3]; 3];
+
+#[inline(always)]
+fn add(a: V3, b: V3) -> V3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+#[inline(always)]
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+#[inline(always)]
+fn scale(s: f64, a: V3) -> V3 {
+    [s * a[0], s * a[1], s * a[2]]
+}
+#[inline(always)]
+fn dot(a: V3, b: V3) -> f64 {
+    a[0].mul_add(b[0], a[1].mul_add(b[1], a[2] * b[2]))
+}
+#[inline(always)]
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1].mul_add(b[2], -(a[2] * b[1])),
+        a[2].mul_add(b[0], -(a[0] * b[2])),
+        a[0].mul_add(b[1], -(a[1] * b[0])),
+    ]
+}
+#[inline(always)]
+fn mat_vec(r: &M3, v: V3) -> V3 {
+    [dot(r[0], v), dot(r[1], v), dot(r[2], v)]
+}
+#[inline(always)]
+fn mat_mat(a: &M3, b: &M3) -> M3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| dot(a[i], [b[0][j], b[1][j], b[2][j]])))
+}
+#[inline(always)]
+fn v3(x: &[f64], at: usize) -> V3 {
+    [x[at], x[at + 1], x[at + 2]]
+}
+#[inline(always)]
+fn pair(a: (V3, V3), b: (V3, V3)) -> f64 {
+    dot(a.0, b.0) + dot(a.1, b.1)
+}
+/// Axisymmetric inertia applied to a vector.
+#[inline(always)]
+fn apply_body(lateral: f64, axial: f64, axis: V3, w: V3) -> V3 {
+    add(
+        scale(lateral, w),
+        scale((axial - lateral) * dot(axis, w), axis),
+    )
+}
+
+/// A spatial inertia about the world origin.
+#[derive(Clone, Copy, Default)]
+struct Inertia {
+    m: f64,
+    h: V3,
+    j: M3,
+}
+
+impl Inertia {
+    #[inline(always)]
+    fn add_body(&mut self, m: f64, r: V3, lateral: f64, axial: f64, axis: V3) {
+        let r2 = dot(r, r);
+        self.m += m;
+        self.h = add(self.h, scale(m, r));
+        for i in 0..3 {
+            for k in 0..3 {
+                let id = if i == k { 1.0 } else { 0.0 };
+                self.j[i][k] += lateral * id
+                    + (axial - lateral) * axis[i] * axis[k]
+                    + m * (r2 * id - r[i] * r[k]);
+            }
+        }
+    }
+
+    /// The momentum of the twist (w, v): (J w + h x v, m v + w x h).
+    #[inline(always)]
+    fn momentum(&self, (w, v): (V3, V3)) -> (V3, V3) {
+        (
+            add(mat_vec(&self.j, w), cross(self.h, v)),
+            add(scale(self.m, v), cross(w, self.h)),
+        )
+    }
+}
+
+/// What the sweep from the tip needs of a link, world frame.
+#[derive(Clone, Copy, Default)]
+struct Link {
+    end: V3,
+    centroid: V3,
+    axis: V3,
+    m: f64,
+    lateral: f64,
+    axial: f64,
+    force: V3,
+    torque: V3,
+}
+
+/// Most coordinates a link has (bend pair, twist, stretch).
+const MAX_LINK_DOF: usize = 4;
+
+#[derive(Default)]
+struct Scratch {
+    links: Vec<Link>,
+    /// Per coordinate: twist, own columns, end velocity column, momentum,
+    /// generalised elastic and dissipative force.
+    twist: Vec<(V3, V3)>,
+    own: Vec<(V3, V3)>,
+    end_velocity: Vec<V3>,
+    momentum: Vec<(V3, V3)>,
+    local_force: Vec<f64>,
+    cell_out: Vec<f64>,
+    cell_params: Vec<f64>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+/// M (upper triangle, row by row) and h of the chain into `out` (the
+/// `MassBias` layout). `cell(c, q_k, qd_k, p_k, out)` evaluates cell `c`
+/// of a link's coordinates and parameters ([`CELL_PARAMS`]).
+/// Inlined into its caller, which the generated code builds for FMA.
+#[inline(always)]
+pub fn mass_bias<F>(
+    layout: &LinkLayout,
+    mut cell: F,
+    q: &[f64],
+    qd: &[f64],
+    p: &[f64],
+    out: &mut [f64],
+) where
+    F: FnMut(usize, &[f64], &[f64], &[f64], &mut [f64]),
+{
+    let n = layout.dof();
+    let nl = layout.links.len();
+    assert!(layout.links.iter().all(|l| l.count <= MAX_LINK_DOF));
+    assert_eq!(out.len(), n * (n + 1) / 2 + n, "MassBias output length");
+    // Out of the thread-local for the call: code inside `LocalKey::with`'s
+    // closure is not inlined into the caller, which is built for FMA.
+    let mut scratch = SCRATCH.take();
+    {
+        let s = &mut scratch;
+        s.links.resize(nl, Link::default());
+        for v in [&mut s.twist, &mut s.own, &mut s.momentum] {
+            v.resize(n, ([0.0; 3], [0.0; 3]));
+        }
+        s.end_velocity.resize(n, [0.0; 3]);
+        s.local_force.resize(n, 0.0);
+        s.cell_out.resize(cell::len(MAX_LINK_DOF), 0.0);
+        s.cell_params.resize(CELL_PARAMS, 0.0);
+
+        let gravity = layout.gravity.map(|i| p[i]);
+        let mut r: M3 =
+            std::array::from_fn(|i| std::array::from_fn(|j| p[layout.base_rotation[3 * i + j]]));
+        let mut pos = layout.base_position.map(|i| p[i]);
+        let (mut omega, mut alpha, mut acc) = ([0.0; 3], [0.0; 3], [0.0; 3]);
+        let mut tip_rotation = r;
+        for (k, spec) in layout.links.iter().enumerate() {
+            let (a, b) = (spec.first, spec.first + spec.count);
+            for (x, &i) in s.cell_params.iter_mut().zip(&spec.params) {
+                *x = p[i];
+            }
+            let c = &mut s.cell_out[..cell::len(spec.count)];
+            cell(spec.cell, &q[a..b], &qd[a..b], &s.cell_params, c);
+            let c = &*c;
+            let rel: M3 = std::array::from_fn(|i| v3(c, cell::ROTATION + 3 * i));
+            let turn = |at: usize| mat_vec(&r, v3(c, at));
+            let (d, dd, ddd) = (turn(cell::END), turn(cell::END_RATE), turn(cell::END_ACCEL));
+            let (cen, cend, cendd) = (
+                turn(cell::CENTROID),
+                turn(cell::CENTROID_RATE),
+                turn(cell::CENTROID_ACCEL),
+            );
+            let (w_rel, w_rel_d) = (turn(cell::OMEGA), turn(cell::OMEGA_RATE));
+            let (w_b, w_b_d) = (turn(cell::BODY_OMEGA), turn(cell::BODY_OMEGA_RATE));
+            let axis = turn(cell::AXIS);
+            let (m, lateral, axial) = (c[cell::MASS], c[cell::LATERAL], c[cell::AXIAL]);
+
+            // The body: centroid, convective accelerations, inertial and
+            // gravity forces.
+            let body_a = add(
+                add(add(acc, cross(alpha, cen)), cross(omega, cross(omega, cen))),
+                add(scale(2.0, cross(omega, cend)), cendd),
+            );
+            let body_w = add(omega, w_b);
+            let body_alpha = add(add(alpha, cross(omega, w_b)), w_b_d);
+            let iw = apply_body(lateral, axial, axis, body_w);
+            let end = add(pos, d);
+            s.links[k] = Link {
+                end,
+                centroid: add(pos, cen),
+                axis,
+                m,
+                lateral,
+                axial,
+                force: scale(m, sub(body_a, gravity)),
+                torque: add(
+                    apply_body(lateral, axial, axis, body_alpha),
+                    cross(body_w, iw),
+                ),
+            };
+            let force_at = cell::COLUMNS + 12 * spec.count;
+            for ci in 0..spec.count {
+                let j = a + ci;
+                let col = cell::COLUMNS + 12 * ci;
+                let s_w = turn(col);
+                let v_end = turn(col + 3);
+                s.twist[j] = (s_w, sub(v_end, cross(s_w, end)));
+                s.end_velocity[j] = v_end;
+                s.own[j] = (turn(col + 6), turn(col + 9));
+                s.local_force[j] = c[force_at + ci];
+            }
+
+            // The next frame.
+            acc = add(
+                add(add(acc, cross(alpha, d)), cross(omega, cross(omega, d))),
+                add(scale(2.0, cross(omega, dd)), ddd),
+            );
+            alpha = add(add(alpha, cross(omega, w_rel)), w_rel_d);
+            omega = add(omega, w_rel);
+            pos = end;
+            r = mat_mat(&r, &rel);
+            tip_rotation = r;
+        }
+
+        // Tip loads act as forces of the opposite sign.
+        let load = |idx: Option<[usize; 3]>| -> V3 {
+            idx.map_or([0.0; 3], |i| {
+                let v = i.map(|i| -p[i]);
+                if layout.tip_frame {
+                    mat_vec(&tip_rotation, v)
+                } else {
+                    v
+                }
+            })
+        };
+        let (tip_f, tip_m) = (load(layout.tip_force), load(layout.tip_moment));
+
+        let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
+        let index = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
+        let mut past = Inertia::default();
+        let mut wrench: (V3, V3) = ([0.0; 3], [0.0; 3]);
+        for (k, spec) in layout.links.iter().enumerate().rev() {
+            let l = s.links[k];
+            let last = k == nl - 1;
+            let (a, b) = (spec.first, spec.first + spec.count);
+            for (j, hj) in bias.iter_mut().enumerate().take(b).skip(a) {
+                let (ow, ov) = s.own[j];
+                let mv = scale(l.m, ov);
+                let (pa, pl) = past.momentum(s.twist[j]);
+                s.momentum[j] = (
+                    add(
+                        add(pa, apply_body(l.lateral, l.axial, l.axis, ow)),
+                        cross(l.centroid, mv),
+                    ),
+                    add(pl, mv),
+                );
+                let mut g = pair(s.twist[j], wrench) + dot(ov, l.force) + dot(ow, l.torque);
+                if last {
+                    g += dot(s.end_velocity[j], tip_f) + dot(s.twist[j].0, tip_m);
+                }
+                *hj = g + s.local_force[j];
+            }
+            for i in a..b {
+                for j in i..b {
+                    let (wi, vi) = s.own[i];
+                    let (wj, vj) = s.own[j];
+                    mass[index(i, j)] = pair(s.twist[i], past.momentum(s.twist[j]))
+                        + l.m * dot(vi, vj)
+                        + dot(wi, apply_body(l.lateral, l.axial, l.axis, wj));
+                }
+            }
+            past.add_body(l.m, l.centroid, l.lateral, l.axial, l.axis);
+            let torque = add(l.torque, cross(l.centroid, l.force));
+            wrench = (add(wrench.0, torque), add(wrench.1, l.force));
+            if last {
+                wrench = (
+                    add(wrench.0, add(cross(l.end, tip_f), tip_m)),
+                    add(wrench.1, tip_f),
+                );
+            }
+        }
+        // Coordinates of different links: twist . momentum, a row at a
+        // time from the link after i's.
+        for spec in &layout.links {
+            let next = spec.first + spec.count;
+            for i in spec.first..next {
+                if next < n {
+                    let row = &mut mass[index(i, next)..=index(i, n - 1)];
+                    for (m, &phi) in row.iter_mut().zip(&s.momentum[next..]) {
+                        *m = pair(s.twist[i], phi);
+                    }
+                }
+            }
+        }
+    }
+    SCRATCH.set(scratch);
+}
