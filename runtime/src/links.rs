@@ -140,35 +140,45 @@ fn apply_body(lateral: f64, axial: f64, axis: V3, w: V3) -> V3 {
     )
 }
 
-/// A spatial inertia about the world origin.
+/// A spatial inertia about the world origin: mass, first moment m r and
+/// rotational inertia J, symmetric, stored xx, yy, zz, xy, xz, yz.
 #[derive(Clone, Copy, Default)]
 struct Inertia {
     m: f64,
     h: V3,
-    j: M3,
+    j: [f64; 6],
 }
 
 impl Inertia {
+    /// Adds a body of mass m at r, axisymmetric about `axis`:
+    /// J += lateral 1 + (axial - lateral) a a^T + m (|r|^2 1 - r r^T).
     #[inline(always)]
     fn add_body(&mut self, m: f64, r: V3, lateral: f64, axial: f64, axis: V3) {
         let r2 = dot(r, r);
+        let d = axial - lateral;
+        let diag = lateral + m * r2;
         self.m += m;
         self.h = add(self.h, scale(m, r));
-        for i in 0..3 {
-            for k in 0..3 {
-                let id = if i == k { 1.0 } else { 0.0 };
-                self.j[i][k] += lateral * id
-                    + (axial - lateral) * axis[i] * axis[k]
-                    + m * (r2 * id - r[i] * r[k]);
-            }
+        for (k, (a, b)) in [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)]
+            .into_iter()
+            .enumerate()
+        {
+            let base = if k < 3 { diag } else { 0.0 };
+            self.j[k] += base + d * axis[a] * axis[b] - m * r[a] * r[b];
         }
     }
 
     /// The momentum of the twist (w, v): (J w + h x v, m v + w x h).
     #[inline(always)]
     fn momentum(&self, (w, v): (V3, V3)) -> (V3, V3) {
+        let j = &self.j;
+        let jw = [
+            j[0] * w[0] + j[3] * w[1] + j[4] * w[2],
+            j[3] * w[0] + j[1] * w[1] + j[5] * w[2],
+            j[4] * w[0] + j[5] * w[1] + j[2] * w[2],
+        ];
         (
-            add(mat_vec(&self.j, w), cross(self.h, v)),
+            add(jw, cross(self.h, v)),
             add(scale(self.m, v), cross(w, self.h)),
         )
     }
@@ -336,10 +346,15 @@ pub fn mass_bias<F>(
             let l = s.links[k];
             let last = k == nl - 1;
             let (a, b) = (spec.first, spec.first + spec.count);
+            // The momentum of the composite past this link under each of
+            // its coordinates' twists: in the momenta and in the link's
+            // own block of M.
+            let mut composite = [([0.0; 3], [0.0; 3]); MAX_LINK_DOF];
             for (j, hj) in bias.iter_mut().enumerate().take(b).skip(a) {
                 let (ow, ov) = s.own[j];
                 let mv = scale(l.m, ov);
                 let (pa, pl) = past.momentum(s.twist[j]);
+                composite[j - a] = (pa, pl);
                 s.momentum[j] = (
                     add(
                         add(pa, apply_body(l.lateral, l.axial, l.axis, ow)),
@@ -357,7 +372,7 @@ pub fn mass_bias<F>(
                 for j in i..b {
                     let (wi, vi) = s.own[i];
                     let (wj, vj) = s.own[j];
-                    mass[index(i, j)] = pair(s.twist[i], past.momentum(s.twist[j]))
+                    mass[index(i, j)] = pair(s.twist[i], composite[j - a])
                         + l.m * dot(vi, vj)
                         + dot(wi, apply_body(l.lateral, l.axial, l.axis, wj));
                 }
