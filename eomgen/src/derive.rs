@@ -24,7 +24,11 @@ pub fn derive(model: &Model) -> TapeSet {
     let mass_bias = cas.to_tape_hoisted(&mass_bias, &mut hoist);
     let outputs = cas.to_tape_hoisted(&eq.outputs, &mut hoist);
     let n = eq.bias.len();
-    let accel = n <= SYMBOLIC_SOLVE_MAX_DOF;
+    // Chains the link recursion covers solve M qdd = -h at run time: their
+    // compiled mass + bias and an L D L^T solve beat a generated symbolic
+    // solve, whose unrolled code is past the instruction caches.
+    let links = link_chain(model);
+    let accel = n <= SYMBOLIC_SOLVE_MAX_DOF && links.is_none();
     let accel_tape = if accel {
         let (qdd, pivots) = solve_accelerations(&mut cas, &eq.mass_upper, &eq.bias);
         let outs: Vec<_> = qdd.into_iter().chain(pivots).collect();
@@ -58,6 +62,6 @@ pub fn derive(model: &Model) -> TapeSet {
         accel: accel_tape,
         stiffness,
         jvp,
-        links: link_chain(model),
+        links,
     }
 }
