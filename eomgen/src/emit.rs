@@ -372,6 +372,15 @@ fn emit_link_recursion(
     };
     let (tf, tm) = (opt(layout.tip_force), opt(layout.tip_moment));
     let frame = layout.tip_frame;
+    let one = |v: Option<usize>| match v {
+        Some(v) => quote!(Some(#v)),
+        None => quote!(None),
+    };
+    let (t_mass, t_len) = (one(layout.tip_mass), one(layout.tip_length));
+    let t_inertia = match layout.tip_inertia {
+        Some(v) => quote!(Some([#(#v),*])),
+        None => quote!(None),
+    };
     let doc = format!(
         " Kernel `mass_bias`: the link recursion (`runtime::links`) over {} links, {} cell(s).",
         layout.links.len(),
@@ -387,6 +396,9 @@ fn emit_link_recursion(
                 tip_force: #tf,
                 tip_moment: #tm,
                 tip_frame: #frame,
+                tip_mass: #t_mass,
+                tip_length: #t_len,
+                tip_inertia: #t_inertia,
             }
         });
         #[doc = #doc]

@@ -80,6 +80,11 @@ pub struct LinkLayout {
     pub tip_moment: Option<[usize; 3]>,
     /// The tip force and moment turn with the tip frame.
     pub tip_frame: bool,
+    /// A tip body: its mass, and with a length (a cylinder along the tip
+    /// axis, the tip point at its far end) its lateral and axial inertia.
+    pub tip_mass: Option<usize>,
+    pub tip_length: Option<usize>,
+    pub tip_inertia: Option<[usize; 2]>,
 }
 
 impl LinkLayout {
@@ -187,7 +192,6 @@ impl Inertia {
 /// What the sweep from the tip needs of a link, world frame.
 #[derive(Clone, Copy, Default)]
 struct Link {
-    end: V3,
     centroid: V3,
     axis: V3,
     m: f64,
@@ -207,7 +211,6 @@ struct Scratch {
     /// generalised elastic and dissipative force.
     twist: Vec<(V3, V3)>,
     own: Vec<(V3, V3)>,
-    end_velocity: Vec<V3>,
     momentum: Vec<(V3, V3)>,
     local_force: Vec<f64>,
     cell_out: Vec<f64>,
@@ -246,7 +249,6 @@ pub fn mass_bias<F>(
         for v in [&mut s.twist, &mut s.own, &mut s.momentum] {
             v.resize(n, ([0.0; 3], [0.0; 3]));
         }
-        s.end_velocity.resize(n, [0.0; 3]);
         s.local_force.resize(n, 0.0);
         s.cell_out.resize(cell::len(MAX_LINK_DOF), 0.0);
         s.cell_params.resize(CELL_PARAMS, 0.0);
@@ -256,7 +258,6 @@ pub fn mass_bias<F>(
             std::array::from_fn(|i| std::array::from_fn(|j| p[layout.base_rotation[3 * i + j]]));
         let mut pos = layout.base_position.map(|i| p[i]);
         let (mut omega, mut alpha, mut acc) = ([0.0; 3], [0.0; 3], [0.0; 3]);
-        let mut tip_rotation = r;
         for (k, spec) in layout.links.iter().enumerate() {
             let (a, b) = (spec.first, spec.first + spec.count);
             for (x, &i) in s.cell_params.iter_mut().zip(&spec.params) {
@@ -289,7 +290,6 @@ pub fn mass_bias<F>(
             let iw = apply_body(lateral, axial, axis, body_w);
             let end = add(pos, d);
             s.links[k] = Link {
-                end,
                 centroid: add(pos, cen),
                 axis,
                 m,
@@ -308,7 +308,6 @@ pub fn mass_bias<F>(
                 let s_w = turn(col);
                 let v_end = turn(col + 3);
                 s.twist[j] = (s_w, sub(v_end, cross(s_w, end)));
-                s.end_velocity[j] = v_end;
                 s.own[j] = (turn(col + 6), turn(col + 9));
                 s.local_force[j] = c[force_at + ci];
             }
@@ -322,29 +321,46 @@ pub fn mass_bias<F>(
             omega = add(omega, w_rel);
             pos = end;
             r = mat_mat(&r, &rel);
-            tip_rotation = r;
         }
 
-        // Tip loads act as forces of the opposite sign.
+        // What hangs on the end frame moves rigidly with it: the tip body
+        // and the tip loads start the composite sums.
+        let mut past = Inertia::default();
+        let mut wrench: (V3, V3) = ([0.0; 3], [0.0; 3]);
+        let axis = [r[0][0], r[1][0], r[2][0]];
+        let length = layout.tip_length.map_or(0.0, |i| p[i]);
+        let point = add(pos, scale(length, axis));
+        if let Some(m) = layout.tip_mass.map(|i| p[i]) {
+            let offset = scale(0.5 * length, axis);
+            let centre = add(pos, offset);
+            let (lateral, axial) = layout.tip_inertia.map_or((0.0, 0.0), |[l, a]| (p[l], p[a]));
+            let a_c = add(
+                add(acc, cross(alpha, offset)),
+                cross(omega, cross(omega, offset)),
+            );
+            let force = scale(m, sub(a_c, gravity));
+            let iw = apply_body(lateral, axial, axis, omega);
+            let torque = add(apply_body(lateral, axial, axis, alpha), cross(omega, iw));
+            past.add_body(m, centre, lateral, axial, axis);
+            wrench = (add(torque, cross(centre, force)), force);
+        }
+        // Applied loads enter as forces of the opposite sign.
         let load = |idx: Option<[usize; 3]>| -> V3 {
             idx.map_or([0.0; 3], |i| {
                 let v = i.map(|i| -p[i]);
-                if layout.tip_frame {
-                    mat_vec(&tip_rotation, v)
-                } else {
-                    v
-                }
+                if layout.tip_frame { mat_vec(&r, v) } else { v }
             })
         };
         let (tip_f, tip_m) = (load(layout.tip_force), load(layout.tip_moment));
+        wrench = (
+            add(wrench.0, add(cross(point, tip_f), tip_m)),
+            add(wrench.1, tip_f),
+        );
 
         let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
         let index = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
-        let mut past = Inertia::default();
-        let mut wrench: (V3, V3) = ([0.0; 3], [0.0; 3]);
         for (k, spec) in layout.links.iter().enumerate().rev() {
             let l = s.links[k];
-            let last = k == nl - 1;
             let (a, b) = (spec.first, spec.first + spec.count);
             // The momentum of the composite past this link under each of
             // its coordinates' twists: in the momenta and in the link's
@@ -362,10 +378,7 @@ pub fn mass_bias<F>(
                     ),
                     add(pl, mv),
                 );
-                let mut g = pair(s.twist[j], wrench) + dot(ov, l.force) + dot(ow, l.torque);
-                if last {
-                    g += dot(s.end_velocity[j], tip_f) + dot(s.twist[j].0, tip_m);
-                }
+                let g = pair(s.twist[j], wrench) + dot(ov, l.force) + dot(ow, l.torque);
                 *hj = g + s.local_force[j];
             }
             for i in a..b {
@@ -380,12 +393,6 @@ pub fn mass_bias<F>(
             past.add_body(l.m, l.centroid, l.lateral, l.axial, l.axis);
             let torque = add(l.torque, cross(l.centroid, l.force));
             wrench = (add(wrench.0, torque), add(wrench.1, l.force));
-            if last {
-                wrench = (
-                    add(wrench.0, add(cross(l.end, tip_f), tip_m)),
-                    add(wrench.1, tip_f),
-                );
-            }
         }
         // Coordinates of different links: twist . momentum, a row at a
         // time from the link after i's.

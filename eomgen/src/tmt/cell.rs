@@ -9,8 +9,8 @@
 //! and [`CELL_PARAMS`] parameters. Links of the same shape share a cell.
 //!
 //! Chains this covers: every segment pcc or vc, base still, no actuators
-//! or driven torques (whose potentials couple links), no tip body. Other
-//! models keep the flat `MassBias` kernel.
+//! or driven torques (whose potentials couple links). Other models keep
+//! the flat `MassBias` kernel.
 
 use runtime::Tape;
 use runtime::links::{CELL_PARAMS, LinkLayout, LinkSpec, cell};
@@ -30,7 +30,6 @@ pub fn link_chain(model: &Model) -> Option<(LinkLayout, Vec<Tape>)> {
             .segments
             .iter()
             .all(|g| matches!(g.method, Method::Pcc | Method::Vc))
-        && !st.tip_mass
         && st.chambers.iter().all(|&c| c == 0)
         && st.tendons.is_empty()
         && st.torques.is_empty()
@@ -94,6 +93,10 @@ pub fn link_chain(model: &Model) -> Option<(LinkLayout, Vec<Tape>)> {
         tip_force: st.tip_force.then(|| triple("tip.force")),
         tip_moment: st.tip_moment.then(|| triple("tip.moment")),
         tip_frame: st.tip_frame_wrench,
+        tip_mass: st.tip_mass.then(|| index("tip.mass")),
+        tip_length: st.tip_length.then(|| index("tip.length")),
+        tip_inertia: (st.tip_mass && st.tip_length)
+            .then(|| [index("tip.inertia"), index("tip.axial_inertia")]),
     };
     Some((layout, cells.into_iter().map(|(_, t)| t).collect()))
 }
