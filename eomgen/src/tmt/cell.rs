@@ -19,7 +19,7 @@ use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{Method, Model, Structure, parameters};
 
 use super::actuation::thinning;
-use super::spatial::{Frame, V3, arc, half_k_sq};
+use super::spatial::{Frame, Springs, V3, arc};
 
 /// The layout and cells of a model whose mass + bias the link recursion
 /// computes, or `None` when its structure is outside the recursion.
@@ -123,31 +123,30 @@ fn derive_cell((twist, extension, incompressible): (bool, bool, bool)) -> Tape {
         .collect();
     let [l, m, lateral, axial, kb, db, rest, kt, dt, ks, ds] = std::array::from_fn(|i| p[i]);
     let zero = cas.zero();
-    let take = |i: Option<usize>| i.map_or((zero, zero), |i| (q[i], qd[i]));
-    let (by, by_d) = take(Some(0));
-    let (bz, bz_d) = take(Some(1));
-    let (tw, tw_d) = take(twist.then_some(2));
-    let (st, st_d) = take(extension.then_some(2 + usize::from(twist)));
+    // Coordinates bend y, bend z, then twist and stretch where present.
+    let mut strain = [zero; 4];
+    let mut rates = [zero; 4];
+    let slots = [Some(0), Some(1), twist.then_some(2), extension.then_some(3)];
+    for (i, k) in slots.into_iter().flatten().enumerate() {
+        strain[k] = q[i];
+        rates[k] = qd[i];
+    }
+    let [by, bz, tw, st] = strain;
+    let [by_d, bz_d, tw_d, _] = rates;
 
-    // The link's potential and Rayleigh function, as spatial.rs has them.
+    // The link's potential and Rayleigh function, as the whole arm has them.
     let len = cas.add(l, st);
     let soft = incompressible.then(|| thinning(cas, l, len).0);
-    let soften = |cas: &mut Cas, k: ExprId| soft.map_or(k, |s| cas.mul(k, s));
-    let kb = soften(cas, kb);
-    let bz_rel = cas.sub(bz, rest);
-    let mut elastic = vec![half_k_sq(cas, kb, by), half_k_sq(cas, kb, bz_rel)];
-    let mut rayleigh = vec![half_k_sq(cas, db, by_d), half_k_sq(cas, db, bz_d)];
-    if twist {
-        let kt = soften(cas, kt);
-        elastic.push(half_k_sq(cas, kt, tw));
-        rayleigh.push(half_k_sq(cas, dt, tw_d));
-    }
-    if extension {
-        elastic.push(half_k_sq(cas, ks, st));
-        rayleigh.push(half_k_sq(cas, ds, st_d));
-    }
-    let elastic = cas.add_all(&elastic);
-    let rayleigh = cas.add_all(&rayleigh);
+    let springs = Springs {
+        bend: kb,
+        bend_damping: db,
+        rest,
+        twist: kt,
+        twist_damping: dt,
+        stretch: ks,
+        stretch_damping: ds,
+    };
+    let (elastic, rayleigh) = springs.energies(cas, strain, rates, soft);
 
     let one = cas.one();
     let identity = Frame {

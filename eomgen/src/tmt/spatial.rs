@@ -463,32 +463,23 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                     rho,
                     offset_scale: thin.map(|t| t.1),
                 });
-                let soften = |cas: &mut Cas, k: ExprId| match thin {
-                    Some((soft, _)) => cas.mul(k, soft),
-                    None => k,
+                let springs = Springs {
+                    bend: param(&format!("joint[{k}].stiffness")),
+                    bend_damping: param(&format!("joint[{k}].damping")),
+                    rest: param(&format!("joint[{k}].rest")),
+                    twist: param(&format!("twist[{k}].stiffness")),
+                    twist_damping: param(&format!("twist[{k}].damping")),
+                    stretch: param(&format!("stretch[{k}].stiffness")),
+                    stretch_damping: param(&format!("stretch[{k}].damping")),
                 };
-                let kb = param(&format!("joint[{k}].stiffness"));
-                let kb = soften(cas, kb);
-                let db = param(&format!("joint[{k}].damping"));
-                let rest = param(&format!("joint[{k}].rest"));
-                let bz_rel = cas.sub(bz, rest);
-                elastic.push(half_k_sq(cas, kb, by));
-                elastic.push(half_k_sq(cas, kb, bz_rel));
-                rayleigh.push(half_k_sq(cas, db, by_d));
-                rayleigh.push(half_k_sq(cas, db, bz_d));
-                if g.twist {
-                    let kt = param(&format!("twist[{k}].stiffness"));
-                    let kt = soften(cas, kt);
-                    let dt = param(&format!("twist[{k}].damping"));
-                    elastic.push(half_k_sq(cas, kt, tw));
-                    rayleigh.push(half_k_sq(cas, dt, tw_d));
-                }
-                if g.extension {
-                    let ks = param(&format!("stretch[{k}].stiffness"));
-                    let ds = param(&format!("stretch[{k}].damping"));
-                    elastic.push(half_k_sq(cas, ks, st));
-                    rayleigh.push(half_k_sq(cas, ds, st_d));
-                }
+                let (e, d) = springs.energies(
+                    cas,
+                    [by, bz, tw, st],
+                    [by_d, bz_d, tw_d, st_d],
+                    thin.map(|t| t.0),
+                );
+                elastic.push(e);
+                rayleigh.push(d);
                 match g.method {
                     Method::Ebr => {
                         let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
@@ -773,6 +764,50 @@ impl Rom {
         let e = cas.add_all(&elastic);
         let d = cas.add_all(&rayleigh);
         [cas.scaled(0.5, e), cas.scaled(0.5, d)]
+    }
+}
+
+/// An element's springs and dampers (pcc, vc, ebr; a link cell's too).
+pub(super) struct Springs {
+    pub bend: ExprId,
+    pub bend_damping: ExprId,
+    /// Rest bend about z.
+    pub rest: ExprId,
+    pub twist: ExprId,
+    pub twist_damping: ExprId,
+    pub stretch: ExprId,
+    pub stretch_damping: ExprId,
+}
+
+impl Springs {
+    /// Strain energy and Rayleigh function of the strain coordinates (bend
+    /// about y, about z, twist, stretch; a zero where the element has
+    /// none, whose terms then fold away), bending and twist stiffness
+    /// scaled by `soft` when stretching thins the section.
+    pub(super) fn energies(
+        &self,
+        cas: &mut Cas,
+        [by, bz, tw, st]: [ExprId; 4],
+        [by_d, bz_d, tw_d, st_d]: [ExprId; 4],
+        soft: Option<ExprId>,
+    ) -> (ExprId, ExprId) {
+        let soften = |cas: &mut Cas, k: ExprId| soft.map_or(k, |s| cas.mul(k, s));
+        let kb = soften(cas, self.bend);
+        let kt = soften(cas, self.twist);
+        let bz_rel = cas.sub(bz, self.rest);
+        let elastic = [
+            half_k_sq(cas, kb, by),
+            half_k_sq(cas, kb, bz_rel),
+            half_k_sq(cas, kt, tw),
+            half_k_sq(cas, self.stretch, st),
+        ];
+        let rayleigh = [
+            half_k_sq(cas, self.bend_damping, by_d),
+            half_k_sq(cas, self.bend_damping, bz_d),
+            half_k_sq(cas, self.twist_damping, tw_d),
+            half_k_sq(cas, self.stretch_damping, st_d),
+        ];
+        (cas.add_all(&elastic), cas.add_all(&rayleigh))
     }
 }
 
