@@ -541,6 +541,7 @@ fn tentacle3d_tmt_mass_and_bias_match_a_numeric_composite_body_recursion() {
         "tip.moment=[0.01,0.02,-0.015]",
         "gravity=[1.0,-2.0,-9.81]",
         "base.direction=[0.6,0.0,0.8]",
+        "segment.0.rest_curvature=2.0",
     ];
     let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
     let dir = std::env::temp_dir().join("softarm-test-cache");
