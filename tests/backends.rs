@@ -224,12 +224,40 @@ fn generated_mass_solve_matches_a_dense_solve() {
 
 /// The link recursion (runtime/src/links.rs) with its cells interpreted
 /// against the flat `MassBias` tape of the TMT sums, for every link shape
-/// and tip it covers: twist, stretch, thinning, vc modules, a tip point
-/// mass, a tip cylinder, loads in the tip frame, a turned base.
+/// and tip it covers: twist, stretch, thinning, vc modules, rom slices, a
+/// tip point mass, a tip cylinder, loads in the tip frame, a turned base.
 #[test]
 fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
     let dir = std::env::temp_dir().join("softarm-test-cache");
-    let cases: [&[&str]; 6] = [
+    let cases: [&[&str]; 9] = [
+        // rom slices: coordinates shared along the segment, the segment's
+        // energies from the forces kernel.
+        &[
+            "segment.0.method=rom",
+            "segment.0.order=3",
+            "segment.0.rest_curvature=2.0",
+            "segment.0.bending_damping=0.01",
+            "tip.force=[0.1,-0.2,0.05]",
+            "gravity=[1,-2,-9.81]",
+        ],
+        &[
+            "segment.0.method=rom",
+            "segment.0.order=2",
+            "segment.0.quadrature=5",
+            "segment.0.extension=true",
+            "segment.0.axial_damping=0.02",
+            "tip.mass=0.01",
+            "tip.moment=[0.01,-0.02,0.005]",
+        ],
+        &[
+            "segment.0.method=rom",
+            "segment.0.order=1",
+            "segment.0.twist=false",
+            "segment.0.extension=true",
+            "segment.0.incompressible=true",
+            "segment.0.rest_curvature=-1.0",
+            "tip.force=[0.0,0.3,0.0]",
+        ],
         &["segment.0.twist=false", "tip.force=[0.2,0.1,-0.3]"],
         &[
             "segment.0.extension=true",
@@ -276,7 +304,7 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
         )
         .unwrap();
         let tapes = eomgen::derive::derive(&l.model);
-        let (layout, cells) = tapes
+        let links = tapes
             .links
             .clone()
             .expect("the recursion covers this chain");
@@ -307,8 +335,9 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
             };
             flat.eval(&inp, &mut Vec::new(), &mut want);
             let mut slots = Vec::new();
+            let mut force_slots = Vec::new();
             runtime::links::mass_bias(
-                &layout,
+                &links.layout,
                 |c, q, qd, pl, out| {
                     let inp = runtime::Inputs {
                         t: 0.0,
@@ -318,7 +347,11 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
                         dir: &[],
                         p: pl,
                     };
-                    cells[c].eval(&inp, &mut slots, out)
+                    links.cells[c].eval(&inp, &mut slots, out)
+                },
+                |out| {
+                    let forces = links.forces.as_ref().expect("a forces kernel");
+                    forces.eval(&inp, &mut force_slots, out)
                 },
                 &q,
                 &qd,

@@ -335,22 +335,21 @@ impl<'a> KernelEmitter<'a> {
 /// `mass_bias` as the link recursion (`runtime::links`) over the model's
 /// cells, each cell a kernel of one link's coordinates and parameters.
 fn emit_link_recursion(
-    layout: &runtime::links::LinkLayout,
-    cells: &[Tape],
+    links: &runtime::links::LinkKernels,
     dof: usize,
     n_params: usize,
     n_out: usize,
 ) -> TokenStream {
-    use runtime::links::{CELL_PARAMS, LinkSpec};
-    let n_dir = 2 * dof;
+    use runtime::links::CELL_PARAMS;
+    let layout = &links.layout;
     let mut defs = Vec::new();
     let mut arms = Vec::new();
-    for (c, tape) in cells.iter().enumerate() {
+    for (c, tape) in links.cells.iter().enumerate() {
         let n = layout
             .links
             .iter()
             .find(|l| l.cell == c)
-            .map_or(0, |l| l.count);
+            .map_or(0, |l| l.map.len());
         let name = format!("cell_{c}");
         defs.push(KernelEmitter::new(tape).emit(&name, n, CELL_PARAMS));
         let f = Ident::new(&name, Span::call_site());
@@ -361,45 +360,26 @@ fn emit_link_recursion(
                      out.try_into().expect("cell outputs")),
         });
     }
-    let links = layout.links.iter().map(|LinkSpec { cell, first, count, params }| {
-        quote!(runtime::links::LinkSpec { cell: #cell, first: #first, count: #count, params: vec![#(#params),*] })
-    });
-    let [g, bp] = [layout.gravity, layout.base_position];
-    let br = layout.base_rotation;
-    let opt = |v: Option<[usize; 3]>| match v {
-        Some(v) => quote!(Some([#(#v),*])),
-        None => quote!(None),
+    let n_dir = 2 * dof;
+    let forces = match &links.forces {
+        Some(tape) => {
+            defs.push(KernelEmitter::new(tape).emit("link_forces", dof, n_params));
+            quote! {
+                |out: &mut [f64]| link_forces(0.0, q, qd, &[0.0; #dof], &[0.0; #n_dir], p,
+                                              out.try_into().expect("force outputs"))
+            }
+        }
+        None => quote!(|_: &mut [f64]| unreachable!("no forces kernel")),
     };
-    let (tf, tm) = (opt(layout.tip_force), opt(layout.tip_moment));
-    let frame = layout.tip_frame;
-    let one = |v: Option<usize>| match v {
-        Some(v) => quote!(Some(#v)),
-        None => quote!(None),
-    };
-    let (t_mass, t_len) = (one(layout.tip_mass), one(layout.tip_length));
-    let t_inertia = match layout.tip_inertia {
-        Some(v) => quote!(Some([#(#v),*])),
-        None => quote!(None),
-    };
+    let json = serde_json::to_string(layout).expect("a link layout serialises");
     let doc = format!(
         " Kernel `mass_bias`: the link recursion (`runtime::links`) over {} links, {} cell(s).",
         layout.links.len(),
-        cells.len()
+        links.cells.len()
     );
     quote! {
         static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(|| {
-            runtime::links::LinkLayout {
-                links: vec![#(#links),*],
-                gravity: [#(#g),*],
-                base_position: [#(#bp),*],
-                base_rotation: [#(#br),*],
-                tip_force: #tf,
-                tip_moment: #tm,
-                tip_frame: #frame,
-                tip_mass: #t_mass,
-                tip_length: #t_len,
-                tip_inertia: #t_inertia,
-            }
+            serde_json::from_str(#json).expect("the generated link layout parses")
         });
         #[doc = #doc]
         #[allow(unused_variables)]
@@ -416,6 +396,7 @@ fn emit_link_recursion(
                     #(#arms)*
                     _ => unreachable!("cell index from the layout"),
                 },
+                #forces,
                 q, qd, p, out,
             )
         }
@@ -518,9 +499,9 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     for kind in KernelKind::ALL {
         let name = kind.name();
         match (&tapes.links, kind) {
-            (Some((layout, cells)), KernelKind::MassBias) => {
+            (Some(links), KernelKind::MassBias) => {
                 let n_out = tapes.mass_bias.outputs.len();
-                kernels.push(emit_link_recursion(layout, cells, dof, n_params, n_out));
+                kernels.push(emit_link_recursion(links, dof, n_params, n_out));
             }
             _ => kernels.push(KernelEmitter::new(tapes.tape(kind)).emit(name, dof, n_params)),
         }

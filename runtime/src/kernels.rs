@@ -158,11 +158,11 @@ pub struct TapeSet {
     pub accel: Tape,
     pub stiffness: Tape,
     pub jvp: Tape,
-    /// The layout and cells of the link recursion (`crate::links`), which
-    /// compiled models of the chains it covers use for `MassBias`; the
-    /// interpreter keeps the flat tape.
+    /// The layout and kernels of the link recursion (`crate::links`),
+    /// which compiled models of the chains it covers use for `MassBias`;
+    /// the interpreter keeps the flat tape.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub links: Option<(crate::links::LinkLayout, Vec<Tape>)>,
+    pub links: Option<crate::links::LinkKernels>,
 }
 
 impl TapeSet {

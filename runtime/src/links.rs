@@ -58,12 +58,23 @@ pub mod cell {
     }
 }
 
+/// A coordinate of a cell: a fixed linear combination of the arm's
+/// coordinates, times a parameter where `scale` names one. A pcc link's
+/// coordinates are the arm's own (one term, weight 1); a rom slice's strain
+/// is its segment's coefficients integrated over the slice.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LocalCoordinate {
+    /// (arm coordinate, weight)
+    pub terms: Vec<(usize, f64)>,
+    pub scale: Option<usize>,
+}
+
 /// One link: its cell, its coordinates and its parameters.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LinkSpec {
     pub cell: usize,
-    pub first: usize,
-    pub count: usize,
+    /// The cell's coordinates, in its order.
+    pub map: Vec<LocalCoordinate>,
     /// Indices into the parameter vector, [`CELL_PARAMS`] of them.
     pub params: Vec<usize>,
 }
@@ -72,6 +83,12 @@ pub struct LinkSpec {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LinkLayout {
     pub links: Vec<LinkSpec>,
+    /// The arm's coordinates.
+    pub dof: usize,
+    /// Generalised forces not local to a link (a rom segment's strain
+    /// energy and damping, integrated over the whole segment) come from a
+    /// kernel of the arm's coordinates: `mass_bias`'s `forces`.
+    pub forces: bool,
     pub gravity: [usize; 3],
     pub base_position: [usize; 3],
     /// Rows of the base rotation.
@@ -87,10 +104,13 @@ pub struct LinkLayout {
     pub tip_inertia: Option<[usize; 2]>,
 }
 
-impl LinkLayout {
-    pub fn dof(&self) -> usize {
-        self.links.last().map_or(0, |l| l.first + l.count)
-    }
+/// The link recursion of a model: its layout, the cells, and the kernel of
+/// the non-local forces when `layout.forces`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LinkKernels {
+    pub layout: LinkLayout,
+    pub cells: Vec<crate::Tape>,
+    pub forces: Option<crate::Tape>,
 }
 
 type V3 = [f64; 3];
@@ -201,18 +221,28 @@ struct Link {
     torque: V3,
 }
 
-/// Most coordinates a link has (bend pair, twist, stretch).
+/// Most coordinates a cell has (bend pair, twist, stretch).
 const MAX_LINK_DOF: usize = 4;
+
+type Twist = (V3, V3);
 
 #[derive(Default)]
 struct Scratch {
     links: Vec<Link>,
-    /// Per coordinate: twist, own columns, end velocity column, momentum,
-    /// generalised elastic and dissipative force.
-    twist: Vec<(V3, V3)>,
-    own: Vec<(V3, V3)>,
-    momentum: Vec<(V3, V3)>,
+    /// Per cell coordinate of every link (link k's from `start[k]`): the
+    /// twist its rate gives everything past the link (spatial, about the
+    /// world origin), the velocity it gives the link's own body (angular,
+    /// centroid), its elastic and dissipative force.
+    start: Vec<usize>,
+    twist: Vec<Twist>,
+    own: Vec<Twist>,
     local_force: Vec<f64>,
+    /// Per arm coordinate b: the momentum its rate gives the links past
+    /// the one the sweep from the tip is at, and whether any has it.
+    reach: Vec<Twist>,
+    reached: Vec<usize>,
+    in_reach: Vec<bool>,
+    forces: Vec<f64>,
     cell_out: Vec<f64>,
     cell_params: Vec<f64>,
 }
@@ -221,24 +251,51 @@ thread_local! {
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
 
+/// The value of cell coordinate `c`: its combination of `x` (coordinates
+/// or rates).
+#[inline(always)]
+fn local(c: &LocalCoordinate, x: &[f64], p: &[f64]) -> f64 {
+    let s = c.terms.iter().fold(0.0, |s, &(a, w)| w.mul_add(x[a], s));
+    c.scale.map_or(s, |i| s * p[i])
+}
+
+/// The weight of a term of cell coordinate `c`.
+#[inline(always)]
+fn weight(c: &LocalCoordinate, w: f64, p: &[f64]) -> f64 {
+    c.scale.map_or(w, |i| w * p[i])
+}
+
 /// M (upper triangle, row by row) and h of the chain into `out` (the
-/// `MassBias` layout). `cell(c, q_k, qd_k, p_k, out)` evaluates cell `c`
-/// of a link's coordinates and parameters ([`CELL_PARAMS`]).
+/// `MassBias` layout). `cell(c, x, xd, p_k, out)` evaluates cell `c` at a
+/// link's cell coordinates and rates and its parameters ([`CELL_PARAMS`]);
+/// `forces(out)` writes the non-local generalised forces, added to h, when
+/// `layout.forces`.
+///
+/// With J_e the map from the arm's rates to link e's cell rates (rows of
+/// `LinkSpec::map`), S_e the twists of e's cell rates and F_e the momenta
+/// they give the bodies from e on: M = sum_e J_e^T D_e J_e + X + X^T, D_e
+/// e's own block, X = sum_e J_e^T S_e^T R_e with R_e = sum_{e' > e}
+/// F_e' J_e' the momenta the arm's rates give the links past e. For
+/// links that own their coordinates (pcc) J_e selects them and this is
+/// the composite-body algorithm; for rom slices, which share their
+/// segment's coordinates, the same sums with the slice weights.
 /// Inlined into its caller, which the generated code builds for FMA.
 #[inline(always)]
-pub fn mass_bias<F>(
+pub fn mass_bias<F, G>(
     layout: &LinkLayout,
     mut cell: F,
+    mut forces: G,
     q: &[f64],
     qd: &[f64],
     p: &[f64],
     out: &mut [f64],
 ) where
     F: FnMut(usize, &[f64], &[f64], &[f64], &mut [f64]),
+    G: FnMut(&mut [f64]),
 {
-    let n = layout.dof();
+    let n = layout.dof;
     let nl = layout.links.len();
-    assert!(layout.links.iter().all(|l| l.count <= MAX_LINK_DOF));
+    assert!(layout.links.iter().all(|l| l.map.len() <= MAX_LINK_DOF));
     assert_eq!(out.len(), n * (n + 1) / 2 + n, "MassBias output length");
     // Out of the thread-local for the call: code inside `LocalKey::with`'s
     // closure is not inlined into the caller, which is built for FMA.
@@ -246,10 +303,21 @@ pub fn mass_bias<F>(
     {
         let s = &mut scratch;
         s.links.resize(nl, Link::default());
-        for v in [&mut s.twist, &mut s.own, &mut s.momentum] {
-            v.resize(n, ([0.0; 3], [0.0; 3]));
+        s.start.clear();
+        let mut total = 0;
+        for spec in &layout.links {
+            s.start.push(total);
+            total += spec.map.len();
         }
-        s.local_force.resize(n, 0.0);
+        for v in [&mut s.twist, &mut s.own] {
+            v.resize(total, ([0.0; 3], [0.0; 3]));
+        }
+        s.local_force.resize(total, 0.0);
+        s.reach.clear();
+        s.reach.resize(n, ([0.0; 3], [0.0; 3]));
+        s.in_reach.clear();
+        s.in_reach.resize(n, false);
+        s.reached.clear();
         s.cell_out.resize(cell::len(MAX_LINK_DOF), 0.0);
         s.cell_params.resize(CELL_PARAMS, 0.0);
 
@@ -258,13 +326,18 @@ pub fn mass_bias<F>(
             std::array::from_fn(|i| std::array::from_fn(|j| p[layout.base_rotation[3 * i + j]]));
         let mut pos = layout.base_position.map(|i| p[i]);
         let (mut omega, mut alpha, mut acc) = ([0.0; 3], [0.0; 3], [0.0; 3]);
+        let (mut x, mut xd) = ([0.0; MAX_LINK_DOF], [0.0; MAX_LINK_DOF]);
         for (k, spec) in layout.links.iter().enumerate() {
-            let (a, b) = (spec.first, spec.first + spec.count);
-            for (x, &i) in s.cell_params.iter_mut().zip(&spec.params) {
-                *x = p[i];
+            let nc = spec.map.len();
+            for (f, c) in spec.map.iter().enumerate() {
+                x[f] = local(c, q, p);
+                xd[f] = local(c, qd, p);
             }
-            let c = &mut s.cell_out[..cell::len(spec.count)];
-            cell(spec.cell, &q[a..b], &qd[a..b], &s.cell_params, c);
+            for (v, &i) in s.cell_params.iter_mut().zip(&spec.params) {
+                *v = p[i];
+            }
+            let c = &mut s.cell_out[..cell::len(nc)];
+            cell(spec.cell, &x[..nc], &xd[..nc], &s.cell_params, c);
             let c = &*c;
             let rel: M3 = std::array::from_fn(|i| v3(c, cell::ROTATION + 3 * i));
             let turn = |at: usize| mat_vec(&r, v3(c, at));
@@ -301,15 +374,15 @@ pub fn mass_bias<F>(
                     cross(body_w, iw),
                 ),
             };
-            let force_at = cell::COLUMNS + 12 * spec.count;
-            for ci in 0..spec.count {
-                let j = a + ci;
-                let col = cell::COLUMNS + 12 * ci;
+            let force_at = cell::COLUMNS + 12 * nc;
+            for f in 0..nc {
+                let j = s.start[k] + f;
+                let col = cell::COLUMNS + 12 * f;
                 let s_w = turn(col);
                 let v_end = turn(col + 3);
                 s.twist[j] = (s_w, sub(v_end, cross(s_w, end)));
                 s.own[j] = (turn(col + 6), turn(col + 9));
-                s.local_force[j] = c[force_at + ci];
+                s.local_force[j] = c[force_at + f];
             }
 
             // The next frame.
@@ -358,53 +431,94 @@ pub fn mass_bias<F>(
         );
 
         let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
+        mass.fill(0.0);
+        bias.fill(0.0);
         let index = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
         for (k, spec) in layout.links.iter().enumerate().rev() {
             let l = s.links[k];
-            let (a, b) = (spec.first, spec.first + spec.count);
-            // The momentum of the composite past this link under each of
-            // its coordinates' twists: in the momenta and in the link's
-            // own block of M.
-            let mut composite = [([0.0; 3], [0.0; 3]); MAX_LINK_DOF];
-            for (j, hj) in bias.iter_mut().enumerate().take(b).skip(a) {
-                let (ow, ov) = s.own[j];
+            let nc = spec.map.len();
+            let at = s.start[k];
+            // Per cell coordinate: the momentum its twist gives the links
+            // past this one and this link's body, the link's own block of
+            // M, and the generalised bias.
+            let mut momentum = [([0.0; 3], [0.0; 3]); MAX_LINK_DOF];
+            let mut block = [[0.0; MAX_LINK_DOF]; MAX_LINK_DOF];
+            let mut g = [0.0; MAX_LINK_DOF];
+            for f in 0..nc {
+                let (ow, ov) = s.own[at + f];
                 let mv = scale(l.m, ov);
-                let (pa, pl) = past.momentum(s.twist[j]);
-                composite[j - a] = (pa, pl);
-                s.momentum[j] = (
+                let composite = past.momentum(s.twist[at + f]);
+                momentum[f] = (
                     add(
-                        add(pa, apply_body(l.lateral, l.axial, l.axis, ow)),
+                        add(composite.0, apply_body(l.lateral, l.axial, l.axis, ow)),
                         cross(l.centroid, mv),
                     ),
-                    add(pl, mv),
+                    add(composite.1, mv),
                 );
-                let g = pair(s.twist[j], wrench) + dot(ov, l.force) + dot(ow, l.torque);
-                *hj = g + s.local_force[j];
+                g[f] = pair(s.twist[at + f], wrench)
+                    + dot(ov, l.force)
+                    + dot(ow, l.torque)
+                    + s.local_force[at + f];
+                for f2 in f..nc {
+                    let (wj, vj) = s.own[at + f2];
+                    block[f][f2] = pair(s.twist[at + f2], composite)
+                        + l.m * dot(ov, vj)
+                        + dot(ow, apply_body(l.lateral, l.axial, l.axis, wj));
+                    block[f2][f] = block[f][f2];
+                }
             }
-            for i in a..b {
-                for j in i..b {
-                    let (wi, vi) = s.own[i];
-                    let (wj, vj) = s.own[j];
-                    mass[index(i, j)] = pair(s.twist[i], composite[j - a])
-                        + l.m * dot(vi, vj)
-                        + dot(wi, apply_body(l.lateral, l.axial, l.axis, wj));
+            // Onto the arm's coordinates: h, the own block, and the
+            // coupling to the links past this one (X above).
+            for (f, cf) in spec.map.iter().enumerate() {
+                let twist = s.twist[at + f];
+                for &(a, w) in &cf.terms {
+                    let w = weight(cf, w, p);
+                    bias[a] = w.mul_add(g[f], bias[a]);
+                    for (f2, cf2) in spec.map.iter().enumerate() {
+                        for &(b, w2) in &cf2.terms {
+                            if a <= b {
+                                let w2 = weight(cf2, w2, p);
+                                mass[index(a, b)] += w * w2 * block[f][f2];
+                            }
+                        }
+                    }
+                }
+                for &b in &s.reached {
+                    let d = pair(twist, s.reach[b]);
+                    for &(a, w) in &cf.terms {
+                        let w = weight(cf, w, p);
+                        let (i, j, twice) = match a.cmp(&b) {
+                            std::cmp::Ordering::Less => (a, b, 1.0),
+                            std::cmp::Ordering::Equal => (a, b, 2.0),
+                            std::cmp::Ordering::Greater => (b, a, 1.0),
+                        };
+                        mass[index(i, j)] = (twice * w).mul_add(d, mass[index(i, j)]);
+                    }
+                }
+            }
+            for (f, cf) in spec.map.iter().enumerate() {
+                for &(b, w) in &cf.terms {
+                    let w = weight(cf, w, p);
+                    let (rw, rv) = s.reach[b];
+                    s.reach[b] = (
+                        add(rw, scale(w, momentum[f].0)),
+                        add(rv, scale(w, momentum[f].1)),
+                    );
+                    if !s.in_reach[b] {
+                        s.in_reach[b] = true;
+                        s.reached.push(b);
+                    }
                 }
             }
             past.add_body(l.m, l.centroid, l.lateral, l.axial, l.axis);
             let torque = add(l.torque, cross(l.centroid, l.force));
             wrench = (add(wrench.0, torque), add(wrench.1, l.force));
         }
-        // Coordinates of different links: twist . momentum, a row at a
-        // time from the link after i's.
-        for spec in &layout.links {
-            let next = spec.first + spec.count;
-            for i in spec.first..next {
-                if next < n {
-                    let row = &mut mass[index(i, next)..=index(i, n - 1)];
-                    for (m, &phi) in row.iter_mut().zip(&s.momentum[next..]) {
-                        *m = pair(s.twist[i], phi);
-                    }
-                }
+        if layout.forces {
+            s.forces.resize(n, 0.0);
+            forces(&mut s.forces);
+            for (h, f) in bias.iter_mut().zip(&s.forces) {
+                *h += f;
             }
         }
     }

@@ -8,28 +8,32 @@
 //! dissipative generalised forces, as one tape of the link's coordinates
 //! and [`CELL_PARAMS`] parameters. Links of the same shape share a cell.
 //!
-//! Chains this covers: every segment pcc or vc, base still, no actuators
-//! or driven torques (whose potentials couple links). Other models keep
-//! the flat `MassBias` kernel.
+//! Chains this covers: every segment pcc, vc or rom, base still, no
+//! actuators or driven torques (whose potentials couple links). A rom
+//! segment's slices are links whose cell coordinates are fixed
+//! combinations of the segment's coefficients (`LocalCoordinate`); its
+//! strain energy, integrated exactly over the segment, is one more small
+//! kernel (`derive_forces`). Other models keep the flat `MassBias` kernel.
 
 use runtime::Tape;
-use runtime::links::{CELL_PARAMS, LinkLayout, LinkSpec, cell};
+use runtime::links::{CELL_PARAMS, LinkKernels, LinkLayout, LinkSpec, LocalCoordinate, cell};
 
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{Method, Model, Structure, parameters};
 
 use super::actuation::thinning;
-use super::spatial::{Frame, Springs, V3, arc};
+use super::spatial::{Frame, Rom, Springs, V3, arc};
+use super::system::{Coordinates, ParamSymbols};
 
-/// The layout and cells of a model whose mass + bias the link recursion
+/// The layout and kernels of a model whose mass + bias the link recursion
 /// computes, or `None` when its structure is outside the recursion.
-pub fn link_chain(model: &Model) -> Option<(LinkLayout, Vec<Tape>)> {
+pub fn link_chain(model: &Model) -> Option<LinkKernels> {
     let st = Structure::of(model);
     let covered = st.dimensions == 3
         && st
             .segments
             .iter()
-            .all(|g| matches!(g.method, Method::Pcc | Method::Vc))
+            .all(|g| matches!(g.method, Method::Pcc | Method::Vc | Method::Rom))
         && st.chambers.iter().all(|&c| c == 0)
         && st.tendons.is_empty()
         && st.torques.is_empty()
@@ -46,11 +50,18 @@ pub fn link_chain(model: &Model) -> Option<(LinkLayout, Vec<Tape>)> {
             .expect("parameter in the layout")
     };
     let triple = |pre: &str| ["x", "y", "z"].map(|c| index(&format!("{pre}.{c}")));
-    let mut cells: Vec<((bool, bool, bool), Tape)> = Vec::new();
+    let mut cells: Vec<(Shape, Tape)> = Vec::new();
     let mut links = Vec::new();
+    let mut roms = Vec::new();
     let (mut first, mut k) = (0, 0);
     for g in &st.segments {
-        let shape = (g.twist, g.extension, g.incompressible);
+        let rom = (g.method == Method::Rom).then(|| Rom::of(g, first));
+        let shape = Shape {
+            twist: g.twist,
+            extension: g.extension,
+            incompressible: g.incompressible,
+            rom: rom.is_some(),
+        };
         let c = match cells.iter().position(|(s, _)| *s == shape) {
             Some(c) => c,
             None => {
@@ -59,7 +70,7 @@ pub fn link_chain(model: &Model) -> Option<(LinkLayout, Vec<Tape>)> {
             }
         };
         let count = g.coordinates_3d();
-        for _ in 0..g.elements {
+        for e in 0..g.elements {
             let params = [
                 "element[{k}].length",
                 "element[{k}].mass",
@@ -75,18 +86,50 @@ pub fn link_chain(model: &Model) -> Option<(LinkLayout, Vec<Tape>)> {
             ]
             .map(|n| index(&n.replace("{k}", &k.to_string())))
             .to_vec();
+            let map = match &rom {
+                // Cell coordinate f is field f integrated over the slice;
+                // the stretch, a strain, times the segment's length.
+                Some(r) => (0..count)
+                    .map(|f| {
+                        let stretch = r.extension && f == count - 1;
+                        let n = if stretch { r.slices as f64 } else { 1.0 };
+                        LocalCoordinate {
+                            terms: r
+                                .weights(e)
+                                .into_iter()
+                                .enumerate()
+                                .map(|(i, w)| (r.index(f, i), n * w))
+                                .collect(),
+                            scale: stretch.then_some(params[0]),
+                        }
+                    })
+                    .collect(),
+                None => (0..count)
+                    .map(|f| LocalCoordinate {
+                        terms: vec![(first + f, 1.0)],
+                        scale: None,
+                    })
+                    .collect(),
+            };
             links.push(LinkSpec {
                 cell: c,
-                first,
-                count,
+                map,
                 params,
             });
-            first += count;
+            if rom.is_none() {
+                first += count;
+            }
             k += 1;
+        }
+        if let Some(r) = rom {
+            first += r.coordinates();
+            roms.push((r, k - g.elements));
         }
     }
     let layout = LinkLayout {
         links,
+        dof: first,
+        forces: !roms.is_empty(),
         gravity: triple("gravity"),
         base_position: triple("base"),
         base_rotation: std::array::from_fn(|i| index(&format!("base.R{}{}", i / 3, i % 3))),
@@ -98,11 +141,61 @@ pub fn link_chain(model: &Model) -> Option<(LinkLayout, Vec<Tape>)> {
         tip_inertia: (st.tip_mass && st.tip_length)
             .then(|| [index("tip.inertia"), index("tip.axial_inertia")]),
     };
-    Some((layout, cells.into_iter().map(|(_, t)| t).collect()))
+    let forces = (!roms.is_empty()).then(|| derive_forces(model, first, &roms));
+    Some(LinkKernels {
+        layout,
+        cells: cells.into_iter().map(|(_, t)| t).collect(),
+        forces,
+    })
+}
+
+/// What a cell depends on besides its parameters' values.
+#[derive(Clone, Copy, PartialEq, Eq)]
+struct Shape {
+    twist: bool,
+    extension: bool,
+    incompressible: bool,
+    /// A rom slice: the segment's stretch and damping are integrated over
+    /// the whole segment (`derive_forces`), and its bending and twist too
+    /// unless the section thins, when they go slice by slice as here.
+    rom: bool,
+}
+
+/// The generalised forces of the rom segments' strain energy and Rayleigh
+/// function (`Rom::energies`, exact quadratics in the coefficients), as one
+/// kernel of the arm's coordinates and parameters.
+fn derive_forces(model: &Model, dof: usize, roms: &[(Rom, usize)]) -> Tape {
+    let mut cas = Cas::new();
+    let cas = &mut cas;
+    let symbols = ParamSymbols::new(cas, model);
+    let coords = Coordinates::new(cas, (0..dof).map(|i| format!("q{i}")).collect());
+    let mut elastic = Vec::new();
+    let mut rayleigh = Vec::new();
+    for (r, k) in roms {
+        let [e, d] = r.energies(cas, &coords, &|n: &str| symbols.get(n), *k);
+        elastic.push(e);
+        rayleigh.push(d);
+    }
+    let elastic = cas.add_all(&elastic);
+    let rayleigh = cas.add_all(&rayleigh);
+    let out: Vec<ExprId> = (0..dof)
+        .map(|i| {
+            let de = cas.diff(elastic, coords.q[i]);
+            let dr = cas.diff(rayleigh, coords.qd[i]);
+            cas.add(de, dr)
+        })
+        .collect();
+    cas.to_tape(&out)
 }
 
 /// The cell of a link with the bend pair, and twist and stretch when asked.
-fn derive_cell((twist, extension, incompressible): (bool, bool, bool)) -> Tape {
+fn derive_cell(shape: Shape) -> Tape {
+    let Shape {
+        twist,
+        extension,
+        incompressible,
+        rom,
+    } = shape;
     let mut cas = Cas::new();
     let cas = &mut cas;
     let mut names = vec!["bend_y", "bend_z"];
@@ -137,14 +230,27 @@ fn derive_cell((twist, extension, incompressible): (bool, bool, bool)) -> Tape {
     // The link's potential and Rayleigh function, as the whole arm has them.
     let len = cas.add(l, st);
     let soft = incompressible.then(|| thinning(cas, l, len).0);
-    let springs = Springs {
-        bend: kb,
-        bend_damping: db,
-        rest,
-        twist: kt,
-        twist_damping: dt,
-        stretch: ks,
-        stretch_damping: ds,
+    let springs = if rom {
+        let local = |k: ExprId| if incompressible { k } else { zero };
+        Springs {
+            bend: local(kb),
+            bend_damping: zero,
+            rest: local(rest),
+            twist: local(kt),
+            twist_damping: zero,
+            stretch: zero,
+            stretch_damping: zero,
+        }
+    } else {
+        Springs {
+            bend: kb,
+            bend_damping: db,
+            rest,
+            twist: kt,
+            twist_damping: dt,
+            stretch: ks,
+            stretch_damping: ds,
+        }
     };
     let (elastic, rayleigh) = springs.energies(cas, strain, rates, soft);
 

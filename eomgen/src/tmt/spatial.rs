@@ -328,14 +328,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
         // rom: the segment's coefficients, shared by its slices, and its
         // strain energy integrated exactly.
         let rom = (g.method == Method::Rom).then(|| {
-            let r = Rom {
-                first: c,
-                order: g.order,
-                slices: g.elements,
-                twist: g.twist,
-                extension: g.extension,
-                incompressible: g.incompressible,
-            };
+            let r = Rom::of(g, c);
             c += r.coordinates();
             let [e, d] = r.energies(cas, &coords, &param, k);
             elastic.push(e);
@@ -608,28 +601,40 @@ fn rom_fields(g: &crate::model::SegmentShape) -> Vec<&'static str> {
 /// A rom segment: strain fields sum_i c_i sigma^i over sigma = s / L in
 /// [0, 1], the coefficients c (angles: curvature times L; the stretch
 /// field is dimensionless) its coordinates, field by field.
-struct Rom {
-    first: usize,
-    order: usize,
-    slices: usize,
-    twist: bool,
-    extension: bool,
+pub(super) struct Rom {
+    pub first: usize,
+    pub order: usize,
+    pub slices: usize,
+    pub twist: bool,
+    pub extension: bool,
     /// Bending and twist energy by slices (see `spatial_system`), not here.
-    incompressible: bool,
+    pub incompressible: bool,
 }
 
 impl Rom {
-    fn coordinates(&self) -> usize {
+    /// The rom of segment shape `g` whose coefficients start at `first`.
+    pub(super) fn of(g: &crate::model::SegmentShape, first: usize) -> Self {
+        Rom {
+            first,
+            order: g.order,
+            slices: g.elements,
+            twist: g.twist,
+            extension: g.extension,
+            incompressible: g.incompressible,
+        }
+    }
+
+    pub(super) fn coordinates(&self) -> usize {
         (2 + usize::from(self.twist) + usize::from(self.extension)) * (self.order + 1)
     }
 
     /// Coordinate index of coefficient i of field f.
-    fn index(&self, f: usize, i: usize) -> usize {
+    pub(super) fn index(&self, f: usize, i: usize) -> usize {
         self.first + f * (self.order + 1) + i
     }
 
     /// int over slice e of sigma^i d sigma, for each i.
-    fn weights(&self, e: usize) -> Vec<f64> {
+    pub(super) fn weights(&self, e: usize) -> Vec<f64> {
         let n = self.slices as f64;
         let (a, b) = (e as f64 / n, (e + 1) as f64 / n);
         (0..=self.order)
@@ -692,7 +697,7 @@ impl Rom {
     /// Strain energy and Rayleigh function, integrated exactly:
     /// (k / 2) int_0^1 (field - rest)^2 d sigma with int sigma^(i+j) = 1 /
     /// (i + j + 1). Per-slice parameters of slice k: E I / l = slices E I / L.
-    fn energies(
+    pub(super) fn energies(
         &self,
         cas: &mut Cas,
         coords: &Coordinates,
