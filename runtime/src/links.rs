@@ -79,6 +79,18 @@ pub struct LinkSpec {
     pub params: Vec<usize>,
 }
 
+impl LinkSpec {
+    /// The first of the arm's coordinates when the cell's coordinates are
+    /// the arm's own, in order (pcc, vc), rather than shared combinations.
+    pub fn owned(&self) -> Option<usize> {
+        let first = self.map.first()?.terms.first()?.0;
+        let own = self.map.iter().enumerate().all(|(f, c)| {
+            c.scale.is_none() && c.terms.len() == 1 && c.terms[0] == (first + f, 1.0)
+        });
+        own.then_some(first)
+    }
+}
+
 /// A chain of links and where its global parameters are.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LinkLayout {
@@ -234,14 +246,17 @@ struct Scratch {
     /// world origin), the velocity it gives the link's own body (angular,
     /// centroid), its elastic and dissipative force.
     start: Vec<usize>,
+    owned: Vec<Option<usize>>,
     twist: Vec<Twist>,
     own: Vec<Twist>,
     local_force: Vec<f64>,
     /// Per arm coordinate b: the momentum its rate gives the links past
-    /// the one the sweep from the tip is at, and whether any has it.
+    /// the one the sweep from the tip is at (R_e below); after the sweep,
+    /// the momentum it gives the whole arm.
     reach: Vec<Twist>,
-    reached: Vec<usize>,
-    in_reach: Vec<bool>,
+    /// X below, `dof` by `dof`, row-major, for links of shared
+    /// coordinates.
+    cross: Vec<f64>,
     forces: Vec<f64>,
     cell_out: Vec<f64>,
     cell_params: Vec<f64>,
@@ -273,12 +288,12 @@ fn weight(c: &LocalCoordinate, w: f64, p: &[f64]) -> f64 {
 ///
 /// With J_e the map from the arm's rates to link e's cell rates (rows of
 /// `LinkSpec::map`), S_e the twists of e's cell rates and F_e the momenta
-/// they give the bodies from e on: M = sum_e J_e^T D_e J_e + X + X^T, D_e
-/// e's own block, X = sum_e J_e^T S_e^T R_e with R_e = sum_{e' > e}
-/// F_e' J_e' the momenta the arm's rates give the links past e. For
-/// links that own their coordinates (pcc) J_e selects them and this is
-/// the composite-body algorithm; for rom slices, which share their
-/// segment's coordinates, the same sums with the slice weights.
+/// they give the bodies from e on: M = X + X^T with X = sum_e J_e^T (S_e^T
+/// R_e + D_e J_e / 2), D_e e's own block and R_e = sum_{e' > e} F_e' J_e'
+/// the momenta the arm's rates give the links past e. For links that own
+/// their coordinates (pcc) J_e selects them and this is the composite-body
+/// algorithm; for rom slices, which share their segment's coordinates, the
+/// same sums with the slice weights.
 /// Inlined into its caller, which the generated code builds for FMA.
 #[inline(always)]
 pub fn mass_bias<F, G>(
@@ -304,6 +319,7 @@ pub fn mass_bias<F, G>(
         let s = &mut scratch;
         s.links.resize(nl, Link::default());
         s.start.clear();
+        s.owned.resize(nl, None);
         let mut total = 0;
         for spec in &layout.links {
             s.start.push(total);
@@ -315,9 +331,7 @@ pub fn mass_bias<F, G>(
         s.local_force.resize(total, 0.0);
         s.reach.clear();
         s.reach.resize(n, ([0.0; 3], [0.0; 3]));
-        s.in_reach.clear();
-        s.in_reach.resize(n, false);
-        s.reached.clear();
+        s.cross.clear();
         s.cell_out.resize(cell::len(MAX_LINK_DOF), 0.0);
         s.cell_params.resize(CELL_PARAMS, 0.0);
 
@@ -329,9 +343,19 @@ pub fn mass_bias<F, G>(
         let (mut x, mut xd) = ([0.0; MAX_LINK_DOF], [0.0; MAX_LINK_DOF]);
         for (k, spec) in layout.links.iter().enumerate() {
             let nc = spec.map.len();
-            for (f, c) in spec.map.iter().enumerate() {
-                x[f] = local(c, q, p);
-                xd[f] = local(c, qd, p);
+            let owned = spec.owned();
+            s.owned[k] = owned;
+            match owned {
+                Some(a) => {
+                    x[..nc].copy_from_slice(&q[a..a + nc]);
+                    xd[..nc].copy_from_slice(&qd[a..a + nc]);
+                }
+                None => {
+                    for (f, c) in spec.map.iter().enumerate() {
+                        x[f] = local(c, q, p);
+                        xd[f] = local(c, qd, p);
+                    }
+                }
             }
             for (v, &i) in s.cell_params.iter_mut().zip(&spec.params) {
                 *v = p[i];
@@ -459,6 +483,7 @@ pub fn mass_bias<F, G>(
                     + dot(ov, l.force)
                     + dot(ow, l.torque)
                     + s.local_force[at + f];
+                #[allow(clippy::needless_range_loop)] // fills both halves
                 for f2 in f..nc {
                     let (wj, vj) = s.own[at + f2];
                     block[f][f2] = pair(s.twist[at + f2], composite)
@@ -467,52 +492,79 @@ pub fn mass_bias<F, G>(
                     block[f2][f] = block[f][f2];
                 }
             }
-            // Onto the arm's coordinates: h, the own block, and the
-            // coupling to the links past this one (X above).
-            for (f, cf) in spec.map.iter().enumerate() {
-                let twist = s.twist[at + f];
-                for &(a, w) in &cf.terms {
-                    let w = weight(cf, w, p);
-                    bias[a] = w.mul_add(g[f], bias[a]);
-                    for (f2, cf2) in spec.map.iter().enumerate() {
-                        for &(b, w2) in &cf2.terms {
-                            if a <= b {
-                                let w2 = weight(cf2, w2, p);
-                                mass[index(a, b)] += w * w2 * block[f][f2];
+            match s.owned[k] {
+                // The link owns coordinates a.. : its block of M and its h
+                // directly; its rows past the block after the sweep.
+                Some(a) => {
+                    for f in 0..nc {
+                        bias[a + f] = g[f];
+                        for f2 in f..nc {
+                            mass[index(a + f, a + f2)] = block[f][f2];
+                        }
+                        s.reach[a + f] = momentum[f];
+                    }
+                }
+                // Shared coordinates: through the link's weights, into X
+                // the coupling S_f . R_e to the links past and half the
+                // own block (M = X + X^T), and into h.
+                None => {
+                    if s.cross.is_empty() {
+                        s.cross.resize(n * n, 0.0);
+                    }
+                    for (f, cf) in spec.map.iter().enumerate() {
+                        let twist = s.twist[at + f];
+                        for (b, &r) in s.reach.iter().enumerate() {
+                            let d = pair(twist, r);
+                            for &(a, wa) in &cf.terms {
+                                let x = &mut s.cross[a * n + b];
+                                *x = weight(cf, wa, p).mul_add(d, *x);
+                            }
+                        }
+                        for &(a, wa) in &cf.terms {
+                            let wa = weight(cf, wa, p);
+                            bias[a] = wa.mul_add(g[f], bias[a]);
+                            for (f2, cf2) in spec.map.iter().enumerate() {
+                                let half = 0.5 * wa * block[f][f2];
+                                for &(b, wb) in &cf2.terms {
+                                    s.cross[a * n + b] += half * weight(cf2, wb, p);
+                                }
                             }
                         }
                     }
-                }
-                for &b in &s.reached {
-                    let d = pair(twist, s.reach[b]);
-                    for &(a, w) in &cf.terms {
-                        let w = weight(cf, w, p);
-                        let (i, j, twice) = match a.cmp(&b) {
-                            std::cmp::Ordering::Less => (a, b, 1.0),
-                            std::cmp::Ordering::Equal => (a, b, 2.0),
-                            std::cmp::Ordering::Greater => (b, a, 1.0),
-                        };
-                        mass[index(i, j)] = (twice * w).mul_add(d, mass[index(i, j)]);
-                    }
-                }
-            }
-            for (f, cf) in spec.map.iter().enumerate() {
-                for &(b, w) in &cf.terms {
-                    let w = weight(cf, w, p);
-                    let (rw, rv) = s.reach[b];
-                    s.reach[b] = (
-                        add(rw, scale(w, momentum[f].0)),
-                        add(rv, scale(w, momentum[f].1)),
-                    );
-                    if !s.in_reach[b] {
-                        s.in_reach[b] = true;
-                        s.reached.push(b);
+                    for (f, cf) in spec.map.iter().enumerate() {
+                        let (mw, mv) = momentum[f];
+                        for &(b, wb) in &cf.terms {
+                            let wb = weight(cf, wb, p);
+                            let (rw, rv) = &mut s.reach[b];
+                            *rw = add(*rw, scale(wb, mw));
+                            *rv = add(*rv, scale(wb, mv));
+                        }
                     }
                 }
             }
             past.add_body(l.m, l.centroid, l.lateral, l.axial, l.axis);
             let torque = add(l.torque, cross(l.centroid, l.force));
             wrench = (add(wrench.0, torque), add(wrench.1, l.force));
+        }
+        // Rows of owned coordinates past their link: twist . momentum.
+        for (k, spec) in layout.links.iter().enumerate() {
+            if let Some(a) = s.owned[k] {
+                let next = a + spec.map.len();
+                for f in 0..spec.map.len() {
+                    let twist = s.twist[s.start[k] + f];
+                    let row = &mut mass[index(a + f, next)..index(a + f, n)];
+                    for (m, &r) in row.iter_mut().zip(&s.reach[next..]) {
+                        *m = pair(twist, r);
+                    }
+                }
+            }
+        }
+        if !s.cross.is_empty() {
+            for i in 0..n {
+                for j in i..n {
+                    mass[index(i, j)] += s.cross[i * n + j] + s.cross[j * n + i];
+                }
+            }
         }
         if layout.forces {
             s.forces.resize(n, 0.0);
