@@ -238,6 +238,26 @@ const MAX_LINK_DOF: usize = 4;
 
 type Twist = (V3, V3);
 
+#[inline(always)]
+fn flat((w, v): Twist) -> [f64; 6] {
+    [w[0], w[1], w[2], v[0], v[1], v[2]]
+}
+
+/// Rows over the arm's coordinates, four to a chunk, zero padded:
+/// fixed-width loops the compiler turns into vector instructions.
+type Lanes = [f64; 4];
+const LANES: usize = 4;
+
+/// y += a x
+#[inline(always)]
+fn axpy(y: &mut [Lanes], a: f64, x: &[Lanes]) {
+    for (y, x) in y.iter_mut().zip(x) {
+        for l in 0..LANES {
+            y[l] = a.mul_add(x[l], y[l]);
+        }
+    }
+}
+
 #[derive(Default)]
 struct Scratch {
     links: Vec<Link>,
@@ -253,10 +273,13 @@ struct Scratch {
     /// Per arm coordinate b: the momentum its rate gives the links past
     /// the one the sweep from the tip is at (R_e below); after the sweep,
     /// the momentum it gives the whole arm.
-    reach: Vec<Twist>,
+    reach: Vec<Lanes>,
+    /// The same after the sweep, by coordinate.
+    momentum: Vec<Twist>,
     /// X below, `dof` by `dof`, row-major, for links of shared
     /// coordinates.
-    cross: Vec<f64>,
+    cross: Vec<Lanes>,
+    row: Vec<Lanes>,
     forces: Vec<f64>,
     cell_out: Vec<f64>,
     cell_params: Vec<f64>,
@@ -329,8 +352,14 @@ pub fn mass_bias<F, G>(
             v.resize(total, ([0.0; 3], [0.0; 3]));
         }
         s.local_force.resize(total, 0.0);
+        // By component (angular x, y, z, linear x, y, z), `dof` each, in
+        // chunks of four, so that loops over the arm's coordinates
+        // vectorise whatever its size.
+        let w = n.div_ceil(LANES);
         s.reach.clear();
-        s.reach.resize(n, ([0.0; 3], [0.0; 3]));
+        s.reach.resize(6 * w, [0.0; LANES]);
+        s.row.resize(w, [0.0; LANES]);
+        s.momentum.resize(n, ([0.0; 3], [0.0; 3]));
         s.cross.clear();
         s.cell_out.resize(cell::len(MAX_LINK_DOF), 0.0);
         s.cell_params.resize(CELL_PARAMS, 0.0);
@@ -501,7 +530,9 @@ pub fn mass_bias<F, G>(
                         for f2 in f..nc {
                             mass[index(a + f, a + f2)] = block[f][f2];
                         }
-                        s.reach[a + f] = momentum[f];
+                        for (k, &m) in flat(momentum[f]).iter().enumerate() {
+                            s.reach[k * w + (a + f) / LANES][(a + f) % LANES] = m;
+                        }
                     }
                 }
                 // Shared coordinates: through the link's weights, into X
@@ -509,35 +540,34 @@ pub fn mass_bias<F, G>(
                 // own block (M = X + X^T), and into h.
                 None => {
                     if s.cross.is_empty() {
-                        s.cross.resize(n * n, 0.0);
+                        s.cross.resize(n * w, [0.0; LANES]);
                     }
                     for (f, cf) in spec.map.iter().enumerate() {
-                        let twist = s.twist[at + f];
-                        for (b, &r) in s.reach.iter().enumerate() {
-                            let d = pair(twist, r);
-                            for &(a, wa) in &cf.terms {
-                                let x = &mut s.cross[a * n + b];
-                                *x = weight(cf, wa, p).mul_add(d, *x);
+                        let row = &mut s.row;
+                        row.fill([0.0; LANES]);
+                        for (k, &t) in flat(s.twist[at + f]).iter().enumerate() {
+                            axpy(row, t, &s.reach[k * w..(k + 1) * w]);
+                        }
+                        for (f2, cf2) in spec.map.iter().enumerate() {
+                            let half = 0.5 * block[f][f2];
+                            for &(b, wb) in &cf2.terms {
+                                row[b / LANES][b % LANES] += half * weight(cf2, wb, p);
                             }
                         }
                         for &(a, wa) in &cf.terms {
                             let wa = weight(cf, wa, p);
                             bias[a] = wa.mul_add(g[f], bias[a]);
-                            for (f2, cf2) in spec.map.iter().enumerate() {
-                                let half = 0.5 * wa * block[f][f2];
-                                for &(b, wb) in &cf2.terms {
-                                    s.cross[a * n + b] += half * weight(cf2, wb, p);
-                                }
-                            }
+                            axpy(&mut s.cross[a * w..(a + 1) * w], wa, row);
                         }
                     }
                     for (f, cf) in spec.map.iter().enumerate() {
-                        let (mw, mv) = momentum[f];
+                        let m = flat(momentum[f]);
                         for &(b, wb) in &cf.terms {
                             let wb = weight(cf, wb, p);
-                            let (rw, rv) = &mut s.reach[b];
-                            *rw = add(*rw, scale(wb, mw));
-                            *rv = add(*rv, scale(wb, mv));
+                            for (k, &mk) in m.iter().enumerate() {
+                                let r = &mut s.reach[k * w + b / LANES][b % LANES];
+                                *r = wb.mul_add(mk, *r);
+                            }
                         }
                     }
                 }
@@ -547,13 +577,17 @@ pub fn mass_bias<F, G>(
             wrench = (add(wrench.0, torque), add(wrench.1, l.force));
         }
         // Rows of owned coordinates past their link: twist . momentum.
+        for (j, m) in s.momentum.iter_mut().enumerate() {
+            let c = |k: usize| s.reach[k * w + j / LANES][j % LANES];
+            *m = ([c(0), c(1), c(2)], [c(3), c(4), c(5)]);
+        }
         for (k, spec) in layout.links.iter().enumerate() {
             if let Some(a) = s.owned[k] {
                 let next = a + spec.map.len();
                 for f in 0..spec.map.len() {
                     let twist = s.twist[s.start[k] + f];
                     let row = &mut mass[index(a + f, next)..index(a + f, n)];
-                    for (m, &r) in row.iter_mut().zip(&s.reach[next..]) {
+                    for (m, &r) in row.iter_mut().zip(&s.momentum[next..]) {
                         *m = pair(twist, r);
                     }
                 }
@@ -562,7 +596,8 @@ pub fn mass_bias<F, G>(
         if !s.cross.is_empty() {
             for i in 0..n {
                 for j in i..n {
-                    mass[index(i, j)] += s.cross[i * n + j] + s.cross[j * n + i];
+                    mass[index(i, j)] += s.cross[i * w + j / LANES][j % LANES]
+                        + s.cross[j * w + i / LANES][i % LANES];
                 }
             }
         }
