@@ -303,6 +303,107 @@ fn weight(c: &LocalCoordinate, w: f64, p: &[f64]) -> f64 {
     c.scale.map_or(w, |i| w * p[i])
 }
 
+type SharedArgs<'a> = (
+    &'a LinkSpec,
+    &'a [Twist],
+    &'a [[f64; MAX_LINK_DOF]; MAX_LINK_DOF],
+    &'a [f64; MAX_LINK_DOF],
+    &'a [Twist; MAX_LINK_DOF],
+    &'a [f64],
+);
+
+/// A link of shared coordinates onto the arm's: into X the coupling
+/// S_f . R_e to the links past and half the own block (M = X + X^T), into
+/// h its bias, into R its momenta. `W` chunks a row.
+#[inline(always)]
+fn shared_sums<const W: usize>(
+    (spec, twists, block, g, momentum, p): SharedArgs,
+    reach: &mut [Lanes],
+    cross: &mut [Lanes],
+    bias: &mut [f64],
+) {
+    for (f, cf) in spec.map.iter().enumerate() {
+        let mut row = [[0.0; LANES]; W];
+        for (k, &t) in flat(twists[f]).iter().enumerate() {
+            let r: &[Lanes; W] = reach[k * W..(k + 1) * W].try_into().expect("W chunks");
+            for i in 0..W {
+                for l in 0..LANES {
+                    row[i][l] = t.mul_add(r[i][l], row[i][l]);
+                }
+            }
+        }
+        for (f2, cf2) in spec.map.iter().enumerate() {
+            let half = 0.5 * block[f][f2];
+            for &(b, wb) in &cf2.terms {
+                row[b / LANES][b % LANES] += half * weight(cf2, wb, p);
+            }
+        }
+        for &(a, wa) in &cf.terms {
+            let wa = weight(cf, wa, p);
+            bias[a] = wa.mul_add(g[f], bias[a]);
+            let x: &mut [Lanes; W] = (&mut cross[a * W..(a + 1) * W])
+                .try_into()
+                .expect("W chunks");
+            for i in 0..W {
+                for l in 0..LANES {
+                    x[i][l] = wa.mul_add(row[i][l], x[i][l]);
+                }
+            }
+        }
+    }
+    add_momenta(W, spec, momentum, p, reach);
+}
+
+/// `shared_sums` for rows of any length.
+fn shared_sums_any(
+    w: usize,
+    (spec, twists, block, g, momentum, p): SharedArgs,
+    reach: &mut [Lanes],
+    cross: &mut [Lanes],
+    bias: &mut [f64],
+) {
+    let mut row = vec![[0.0; LANES]; w];
+    for (f, cf) in spec.map.iter().enumerate() {
+        row.fill([0.0; LANES]);
+        for (k, &t) in flat(twists[f]).iter().enumerate() {
+            axpy(&mut row, t, &reach[k * w..(k + 1) * w]);
+        }
+        for (f2, cf2) in spec.map.iter().enumerate() {
+            let half = 0.5 * block[f][f2];
+            for &(b, wb) in &cf2.terms {
+                row[b / LANES][b % LANES] += half * weight(cf2, wb, p);
+            }
+        }
+        for &(a, wa) in &cf.terms {
+            let wa = weight(cf, wa, p);
+            bias[a] = wa.mul_add(g[f], bias[a]);
+            axpy(&mut cross[a * w..(a + 1) * w], wa, &row);
+        }
+    }
+    add_momenta(w, spec, momentum, p, reach);
+}
+
+/// R += the link's momenta through its weights.
+#[inline(always)]
+fn add_momenta(
+    w: usize,
+    spec: &LinkSpec,
+    momentum: &[Twist; MAX_LINK_DOF],
+    p: &[f64],
+    reach: &mut [Lanes],
+) {
+    for (f, cf) in spec.map.iter().enumerate() {
+        let m = flat(momentum[f]);
+        for &(b, wb) in &cf.terms {
+            let wb = weight(cf, wb, p);
+            for (k, &mk) in m.iter().enumerate() {
+                let r = &mut reach[k * w + b / LANES][b % LANES];
+                *r = wb.mul_add(mk, *r);
+            }
+        }
+    }
+}
+
 /// M (upper triangle, row by row) and h of the chain into `out` (the
 /// `MassBias` layout). `cell(c, x, xd, p_k, out)` evaluates cell `c` at a
 /// link's cell coordinates and rates and its parameters ([`CELL_PARAMS`]);
@@ -542,33 +643,22 @@ pub fn mass_bias<F, G>(
                     if s.cross.is_empty() {
                         s.cross.resize(n * w, [0.0; LANES]);
                     }
-                    for (f, cf) in spec.map.iter().enumerate() {
-                        let row = &mut s.row;
-                        row.fill([0.0; LANES]);
-                        for (k, &t) in flat(s.twist[at + f]).iter().enumerate() {
-                            axpy(row, t, &s.reach[k * w..(k + 1) * w]);
-                        }
-                        for (f2, cf2) in spec.map.iter().enumerate() {
-                            let half = 0.5 * block[f][f2];
-                            for &(b, wb) in &cf2.terms {
-                                row[b / LANES][b % LANES] += half * weight(cf2, wb, p);
-                            }
-                        }
-                        for &(a, wa) in &cf.terms {
-                            let wa = weight(cf, wa, p);
-                            bias[a] = wa.mul_add(g[f], bias[a]);
-                            axpy(&mut s.cross[a * w..(a + 1) * w], wa, row);
-                        }
-                    }
-                    for (f, cf) in spec.map.iter().enumerate() {
-                        let m = flat(momentum[f]);
-                        for &(b, wb) in &cf.terms {
-                            let wb = weight(cf, wb, p);
-                            for (k, &mk) in m.iter().enumerate() {
-                                let r = &mut s.reach[k * w + b / LANES][b % LANES];
-                                *r = wb.mul_add(mk, *r);
-                            }
-                        }
+                    let twists = &s.twist[at..at + nc];
+                    let (reach, cross) = (&mut s.reach[..], &mut s.cross[..]);
+                    let args = (spec, twists, &block, &g, &momentum, p);
+                    // Monomorphised by the row's chunk count, so that the
+                    // loops over the arm's coordinates have fixed trip
+                    // counts (runtime lengths left them mostly scalar).
+                    match w {
+                        1 => shared_sums::<1>(args, reach, cross, bias),
+                        2 => shared_sums::<2>(args, reach, cross, bias),
+                        3 => shared_sums::<3>(args, reach, cross, bias),
+                        4 => shared_sums::<4>(args, reach, cross, bias),
+                        5 => shared_sums::<5>(args, reach, cross, bias),
+                        6 => shared_sums::<6>(args, reach, cross, bias),
+                        7 => shared_sums::<7>(args, reach, cross, bias),
+                        8 => shared_sums::<8>(args, reach, cross, bias),
+                        _ => shared_sums_any(w, args, reach, cross, bias),
                     }
                 }
             }
