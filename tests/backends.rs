@@ -336,9 +336,15 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
             flat.eval(&inp, &mut Vec::new(), &mut want);
             let mut slots = Vec::new();
             let mut force_slots = Vec::new();
-            runtime::links::mass_bias(
-                &links.layout,
-                |c, q, qd, pl, out| {
+            let m_len = n * (n + 1) / 2;
+            let largest =
+                |r: std::ops::Range<usize>| want[r].iter().fold(0.0f64, |s, x| s.max(x.abs()));
+            let (m_scale, h_scale) = (largest(0..m_len), largest(m_len..len));
+            // The recursion as generated code picks it, and the shared
+            // sums on every chain (for owned links a second strategy).
+            for shared in [false, true] {
+                got.fill(f64::NAN);
+                let cell = |c: usize, q: &[f64], qd: &[f64], pl: &[f64], out: &mut [f64]| {
                     let inp = runtime::Inputs {
                         t: 0.0,
                         q,
@@ -348,29 +354,27 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
                         p: pl,
                     };
                     links.cells[c].eval(&inp, &mut slots, out)
-                },
-                |out| {
+                };
+                let forces = |out: &mut [f64]| {
                     let forces = links.forces.as_ref().expect("a forces kernel");
                     forces.eval(&inp, &mut force_slots, out)
-                },
-                &q,
-                &qd,
-                &p,
-                &mut got,
-            );
-            let m_len = n * (n + 1) / 2;
-            let largest =
-                |r: std::ops::Range<usize>| want[r].iter().fold(0.0f64, |s, x| s.max(x.abs()));
-            let (m_scale, h_scale) = (largest(0..m_len), largest(m_len..len));
-            for k in 0..len {
-                let floor = if k < m_len { m_scale } else { h_scale };
-                assert_close(
-                    got[k],
-                    want[k],
-                    1e-12,
-                    floor,
-                    &format!("{sets:?} trial {trial} entry {k}"),
-                );
+                };
+                let layout = &links.layout;
+                if shared {
+                    runtime::links::mass_bias_shared_dyn(layout, cell, forces, &q, &qd, &p, &mut got);
+                } else {
+                    runtime::links::mass_bias(layout, cell, forces, &q, &qd, &p, &mut got);
+                }
+                for k in 0..len {
+                    let floor = if k < m_len { m_scale } else { h_scale };
+                    assert_close(
+                        got[k],
+                        want[k],
+                        1e-12,
+                        floor,
+                        &format!("{sets:?} trial {trial} shared {shared} entry {k}"),
+                    );
+                }
             }
         }
     }

@@ -369,7 +369,15 @@ fn emit_link_recursion(
                                               out.try_into().expect("force outputs"))
             }
         }
-        None => quote!(|_: &mut [f64]| unreachable!("no forces kernel")),
+        None => quote!(|_: &mut [f64]| {}),
+    };
+    // Chains of owned links sum by composite bodies; shared links (rom
+    // slices) need the arm's coordinates in rows of a fixed length.
+    let call = if runtime::links::all_owned(layout) {
+        quote!(runtime::links::mass_bias_owned(&LINKS, cells, q, qd, p, out))
+    } else {
+        let rows = runtime::links::padded(dof);
+        quote!(runtime::links::mass_bias_shared::<#rows, _, _>(&LINKS, cells, #forces, q, qd, p, out))
     };
     let json = serde_json::to_string(layout).expect("a link layout serialises");
     let doc = format!(
@@ -390,15 +398,11 @@ fn emit_link_recursion(
         }
         #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
         unsafe fn mass_bias_links(q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
-            runtime::links::mass_bias(
-                &LINKS,
-                |c: usize, q: &[f64], qd: &[f64], p: &[f64], out: &mut [f64]| match c {
-                    #(#arms)*
-                    _ => unreachable!("cell index from the layout"),
-                },
-                #forces,
-                q, qd, p, out,
-            )
+            let cells = |c: usize, q: &[f64], qd: &[f64], p: &[f64], out: &mut [f64]| match c {
+                #(#arms)*
+                _ => unreachable!("cell index from the layout"),
+            };
+            #call
         }
         #(#defs)*
     }

@@ -243,21 +243,7 @@ fn flat((w, v): Twist) -> [f64; 6] {
     [w[0], w[1], w[2], v[0], v[1], v[2]]
 }
 
-/// Rows over the arm's coordinates, four to a chunk, zero padded:
-/// fixed-width loops the compiler turns into vector instructions.
-type Lanes = [f64; 4];
-const LANES: usize = 4;
-
-/// y += a x
-#[inline(always)]
-fn axpy(y: &mut [Lanes], a: f64, x: &[Lanes]) {
-    for (y, x) in y.iter_mut().zip(x) {
-        for l in 0..LANES {
-            y[l] = a.mul_add(x[l], y[l]);
-        }
-    }
-}
-
+/// What the forward sweep leaves for the sums from the tip.
 #[derive(Default)]
 struct Scratch {
     links: Vec<Link>,
@@ -266,20 +252,12 @@ struct Scratch {
     /// world origin), the velocity it gives the link's own body (angular,
     /// centroid), its elastic and dissipative force.
     start: Vec<usize>,
-    owned: Vec<Option<usize>>,
     twist: Vec<Twist>,
     own: Vec<Twist>,
     local_force: Vec<f64>,
-    /// Per arm coordinate b: the momentum its rate gives the links past
-    /// the one the sweep from the tip is at (R_e below); after the sweep,
-    /// the momentum it gives the whole arm.
-    reach: Vec<Lanes>,
-    /// The same after the sweep, by coordinate.
+    /// Per arm coordinate, composite sums: the momentum its rate gives
+    /// the links past the one being summed.
     momentum: Vec<Twist>,
-    /// X below, `dof` by `dof`, row-major, for links of shared
-    /// coordinates.
-    cross: Vec<Lanes>,
-    row: Vec<Lanes>,
     forces: Vec<f64>,
     cell_out: Vec<f64>,
     cell_params: Vec<f64>,
@@ -297,130 +275,305 @@ fn local(c: &LocalCoordinate, x: &[f64], p: &[f64]) -> f64 {
     c.scale.map_or(s, |i| s * p[i])
 }
 
-/// The weight of a term of cell coordinate `c`.
-#[inline(always)]
-fn weight(c: &LocalCoordinate, w: f64, p: &[f64]) -> f64 {
-    c.scale.map_or(w, |i| w * p[i])
+/// Whether every link's cell coordinates are the arm's own, in order
+/// (pcc, vc): then M and h come by composite bodies, [`mass_bias_owned`].
+pub fn all_owned(layout: &LinkLayout) -> bool {
+    let mut next = 0;
+    layout.links.iter().all(|l| {
+        let own = l.map.iter().enumerate().all(|(f, c)| {
+            c.scale.is_none() && c.terms.len() == 1 && c.terms[0] == (next + f, 1.0)
+        });
+        next += l.map.len();
+        own
+    }) && next == layout.dof
 }
 
-type SharedArgs<'a> = (
-    &'a LinkSpec,
-    &'a [Twist],
-    &'a [[f64; MAX_LINK_DOF]; MAX_LINK_DOF],
-    &'a [f64; MAX_LINK_DOF],
-    &'a [Twist; MAX_LINK_DOF],
-    &'a [f64],
-);
-
-/// A link of shared coordinates onto the arm's: into X the coupling
-/// S_f . R_e to the links past and half the own block (M = X + X^T), into
-/// h its bias, into R its momenta. `W` chunks a row.
-#[inline(always)]
-fn shared_sums<const W: usize>(
-    (spec, twists, block, g, momentum, p): SharedArgs,
-    reach: &mut [Lanes],
-    cross: &mut [Lanes],
-    bias: &mut [f64],
-) {
-    for (f, cf) in spec.map.iter().enumerate() {
-        let mut row = [[0.0; LANES]; W];
-        for (k, &t) in flat(twists[f]).iter().enumerate() {
-            let r: &[Lanes; W] = reach[k * W..(k + 1) * W].try_into().expect("W chunks");
-            for i in 0..W {
-                for l in 0..LANES {
-                    row[i][l] = t.mul_add(r[i][l], row[i][l]);
-                }
-            }
-        }
-        for (f2, cf2) in spec.map.iter().enumerate() {
-            let half = 0.5 * block[f][f2];
-            for &(b, wb) in &cf2.terms {
-                row[b / LANES][b % LANES] += half * weight(cf2, wb, p);
-            }
-        }
-        for &(a, wa) in &cf.terms {
-            let wa = weight(cf, wa, p);
-            bias[a] = wa.mul_add(g[f], bias[a]);
-            let x: &mut [Lanes; W] = (&mut cross[a * W..(a + 1) * W])
-                .try_into()
-                .expect("W chunks");
-            for i in 0..W {
-                for l in 0..LANES {
-                    x[i][l] = wa.mul_add(row[i][l], x[i][l]);
-                }
-            }
-        }
-    }
-    add_momenta(W, spec, momentum, p, reach);
+/// The end frame of the chain after the forward sweep, and what hangs on
+/// it: the composite inertia and wrench the sums from the tip start with.
+struct Tip {
+    past: Inertia,
+    wrench: Twist,
 }
 
-/// `shared_sums` for rows of any length.
-fn shared_sums_any(
-    w: usize,
-    (spec, twists, block, g, momentum, p): SharedArgs,
-    reach: &mut [Lanes],
-    cross: &mut [Lanes],
-    bias: &mut [f64],
-) {
-    let mut row = vec![[0.0; LANES]; w];
-    for (f, cf) in spec.map.iter().enumerate() {
-        row.fill([0.0; LANES]);
-        for (k, &t) in flat(twists[f]).iter().enumerate() {
-            axpy(&mut row, t, &reach[k * w..(k + 1) * w]);
-        }
-        for (f2, cf2) in spec.map.iter().enumerate() {
-            let half = 0.5 * block[f][f2];
-            for &(b, wb) in &cf2.terms {
-                row[b / LANES][b % LANES] += half * weight(cf2, wb, p);
-            }
-        }
-        for &(a, wa) in &cf.terms {
-            let wa = weight(cf, wa, p);
-            bias[a] = wa.mul_add(g[f], bias[a]);
-            axpy(&mut cross[a * w..(a + 1) * w], wa, &row);
-        }
-    }
-    add_momenta(w, spec, momentum, p, reach);
-}
-
-/// R += the link's momenta through its weights.
+/// The forward sweep: each link's cell under the world frame composed so
+/// far, its body's inertial and gravity forces, the twists of its cell
+/// coordinates; then the tip body and loads. `owned`: the cell
+/// coordinates are the arm's, `start[k]..` (see [`all_owned`]).
 #[inline(always)]
-fn add_momenta(
-    w: usize,
-    spec: &LinkSpec,
-    momentum: &[Twist; MAX_LINK_DOF],
+fn forward<F>(
+    layout: &LinkLayout,
+    cell: &mut F,
+    owned: bool,
+    q: &[f64],
+    qd: &[f64],
     p: &[f64],
-    reach: &mut [Lanes],
-) {
-    for (f, cf) in spec.map.iter().enumerate() {
-        let m = flat(momentum[f]);
-        for &(b, wb) in &cf.terms {
-            let wb = weight(cf, wb, p);
-            for (k, &mk) in m.iter().enumerate() {
-                let r = &mut reach[k * w + b / LANES][b % LANES];
-                *r = wb.mul_add(mk, *r);
-            }
-        }
+    s: &mut Scratch,
+) -> Tip
+where
+    F: FnMut(usize, &[f64], &[f64], &[f64], &mut [f64]),
+{
+    let nl = layout.links.len();
+    s.links.resize(nl, Link::default());
+    s.start.clear();
+    let mut total = 0;
+    for spec in &layout.links {
+        s.start.push(total);
+        total += spec.map.len();
     }
+    for v in [&mut s.twist, &mut s.own] {
+        v.resize(total, ([0.0; 3], [0.0; 3]));
+    }
+    s.local_force.resize(total, 0.0);
+    s.cell_out.resize(cell::len(MAX_LINK_DOF), 0.0);
+    s.cell_params.resize(CELL_PARAMS, 0.0);
+
+    let gravity = layout.gravity.map(|i| p[i]);
+    let mut r: M3 =
+        std::array::from_fn(|i| std::array::from_fn(|j| p[layout.base_rotation[3 * i + j]]));
+    let mut pos = layout.base_position.map(|i| p[i]);
+    let (mut omega, mut alpha, mut acc) = ([0.0; 3], [0.0; 3], [0.0; 3]);
+    let (mut x, mut xd) = ([0.0; MAX_LINK_DOF], [0.0; MAX_LINK_DOF]);
+    for (k, spec) in layout.links.iter().enumerate() {
+        let nc = spec.map.len();
+        let at = s.start[k];
+        let (x, xd) = if owned {
+            (&q[at..at + nc], &qd[at..at + nc])
+        } else {
+            for (f, c) in spec.map.iter().enumerate() {
+                x[f] = local(c, q, p);
+                xd[f] = local(c, qd, p);
+            }
+            (&x[..nc], &xd[..nc])
+        };
+        for (v, &i) in s.cell_params.iter_mut().zip(&spec.params) {
+            *v = p[i];
+        }
+        let c = &mut s.cell_out[..cell::len(nc)];
+        cell(spec.cell, x, xd, &s.cell_params, c);
+        let c = &*c;
+        let rel: M3 = std::array::from_fn(|i| v3(c, cell::ROTATION + 3 * i));
+        let turn = |at: usize| mat_vec(&r, v3(c, at));
+        let (d, dd, ddd) = (turn(cell::END), turn(cell::END_RATE), turn(cell::END_ACCEL));
+        let (cen, cend, cendd) = (
+            turn(cell::CENTROID),
+            turn(cell::CENTROID_RATE),
+            turn(cell::CENTROID_ACCEL),
+        );
+        let (w_rel, w_rel_d) = (turn(cell::OMEGA), turn(cell::OMEGA_RATE));
+        let (w_b, w_b_d) = (turn(cell::BODY_OMEGA), turn(cell::BODY_OMEGA_RATE));
+        let axis = turn(cell::AXIS);
+        let (m, lateral, axial) = (c[cell::MASS], c[cell::LATERAL], c[cell::AXIAL]);
+
+        // The body: centroid, convective accelerations, inertial and
+        // gravity forces.
+        let body_a = add(
+            add(add(acc, cross(alpha, cen)), cross(omega, cross(omega, cen))),
+            add(scale(2.0, cross(omega, cend)), cendd),
+        );
+        let body_w = add(omega, w_b);
+        let body_alpha = add(add(alpha, cross(omega, w_b)), w_b_d);
+        let iw = apply_body(lateral, axial, axis, body_w);
+        let end = add(pos, d);
+        s.links[k] = Link {
+            centroid: add(pos, cen),
+            axis,
+            m,
+            lateral,
+            axial,
+            force: scale(m, sub(body_a, gravity)),
+            torque: add(
+                apply_body(lateral, axial, axis, body_alpha),
+                cross(body_w, iw),
+            ),
+        };
+        let force_at = cell::COLUMNS + 12 * nc;
+        for f in 0..nc {
+            let col = cell::COLUMNS + 12 * f;
+            let s_w = turn(col);
+            let v_end = turn(col + 3);
+            s.twist[at + f] = (s_w, sub(v_end, cross(s_w, end)));
+            s.own[at + f] = (turn(col + 6), turn(col + 9));
+            s.local_force[at + f] = c[force_at + f];
+        }
+
+        // The next frame.
+        acc = add(
+            add(add(acc, cross(alpha, d)), cross(omega, cross(omega, d))),
+            add(scale(2.0, cross(omega, dd)), ddd),
+        );
+        alpha = add(add(alpha, cross(omega, w_rel)), w_rel_d);
+        omega = add(omega, w_rel);
+        pos = end;
+        r = mat_mat(&r, &rel);
+    }
+
+    // What hangs on the end frame moves rigidly with it: the tip body and
+    // the tip loads start the composite sums.
+    let mut past = Inertia::default();
+    let mut wrench: Twist = ([0.0; 3], [0.0; 3]);
+    let axis = [r[0][0], r[1][0], r[2][0]];
+    let length = layout.tip_length.map_or(0.0, |i| p[i]);
+    let point = add(pos, scale(length, axis));
+    if let Some(m) = layout.tip_mass.map(|i| p[i]) {
+        let offset = scale(0.5 * length, axis);
+        let centre = add(pos, offset);
+        let (lateral, axial) = layout.tip_inertia.map_or((0.0, 0.0), |[l, a]| (p[l], p[a]));
+        let a_c = add(
+            add(acc, cross(alpha, offset)),
+            cross(omega, cross(omega, offset)),
+        );
+        let force = scale(m, sub(a_c, gravity));
+        let iw = apply_body(lateral, axial, axis, omega);
+        let torque = add(apply_body(lateral, axial, axis, alpha), cross(omega, iw));
+        past.add_body(m, centre, lateral, axial, axis);
+        wrench = (add(torque, cross(centre, force)), force);
+    }
+    // Applied loads enter as forces of the opposite sign.
+    let load = |idx: Option<[usize; 3]>| -> V3 {
+        idx.map_or([0.0; 3], |i| {
+            let v = i.map(|i| -p[i]);
+            if layout.tip_frame { mat_vec(&r, v) } else { v }
+        })
+    };
+    let (tip_f, tip_m) = (load(layout.tip_force), load(layout.tip_moment));
+    wrench = (
+        add(wrench.0, add(cross(point, tip_f), tip_m)),
+        add(wrench.1, tip_f),
+    );
+    Tip { past, wrench }
 }
 
-/// M (upper triangle, row by row) and h of the chain into `out` (the
-/// `MassBias` layout). `cell(c, x, xd, p_k, out)` evaluates cell `c` at a
-/// link's cell coordinates and rates and its parameters ([`CELL_PARAMS`]);
-/// `forces(out)` writes the non-local generalised forces, added to h, when
-/// `layout.forces`.
-///
-/// With J_e the map from the arm's rates to link e's cell rates (rows of
-/// `LinkSpec::map`), S_e the twists of e's cell rates and F_e the momenta
-/// they give the bodies from e on: M = X + X^T with X = sum_e J_e^T (S_e^T
-/// R_e + D_e J_e / 2), D_e e's own block and R_e = sum_{e' > e} F_e' J_e'
-/// the momenta the arm's rates give the links past e. For links that own
-/// their coordinates (pcc) J_e selects them and this is the composite-body
-/// algorithm; for rom slices, which share their segment's coordinates, the
-/// same sums with the slice weights.
+/// A link's part of the sums from the tip, per cell coordinate f: the
+/// momentum its twist gives this link's body and the links past it, the
+/// link's own block of M, the generalised bias. Then the link joins the
+/// composite.
+#[inline(always)]
+fn link_sums(
+    s: &Scratch,
+    k: usize,
+    nc: usize,
+    tip: &mut Tip,
+) -> (
+    [Twist; MAX_LINK_DOF],
+    [[f64; MAX_LINK_DOF]; MAX_LINK_DOF],
+    [f64; MAX_LINK_DOF],
+) {
+    let l = s.links[k];
+    let at = s.start[k];
+    let mut momentum = [([0.0; 3], [0.0; 3]); MAX_LINK_DOF];
+    let mut block = [[0.0; MAX_LINK_DOF]; MAX_LINK_DOF];
+    let mut g = [0.0; MAX_LINK_DOF];
+    for f in 0..nc {
+        let (ow, ov) = s.own[at + f];
+        let mv = scale(l.m, ov);
+        let composite = tip.past.momentum(s.twist[at + f]);
+        momentum[f] = (
+            add(
+                add(composite.0, apply_body(l.lateral, l.axial, l.axis, ow)),
+                cross(l.centroid, mv),
+            ),
+            add(composite.1, mv),
+        );
+        g[f] = pair(s.twist[at + f], tip.wrench)
+            + dot(ov, l.force)
+            + dot(ow, l.torque)
+            + s.local_force[at + f];
+        #[allow(clippy::needless_range_loop)] // fills both halves
+        for f2 in f..nc {
+            let (wj, vj) = s.own[at + f2];
+            block[f][f2] = pair(s.twist[at + f2], composite)
+                + l.m * dot(ov, vj)
+                + dot(ow, apply_body(l.lateral, l.axial, l.axis, wj));
+            block[f2][f] = block[f][f2];
+        }
+    }
+    tip.past
+        .add_body(l.m, l.centroid, l.lateral, l.axial, l.axis);
+    let torque = add(l.torque, cross(l.centroid, l.force));
+    tip.wrench = (add(tip.wrench.0, torque), add(tip.wrench.1, l.force));
+    (momentum, block, g)
+}
+
+/// Checks the output length and runs `body` on the thread's scratch.
+/// Out of the thread-local for the call: code inside `LocalKey::with`'s
+/// closure is not inlined into the caller, which is built for FMA.
+#[inline(always)]
+fn with_scratch(layout: &LinkLayout, out: &mut [f64], body: impl FnOnce(&mut Scratch, &mut [f64])) {
+    let n = layout.dof;
+    assert!(layout.links.iter().all(|l| l.map.len() <= MAX_LINK_DOF));
+    assert_eq!(out.len(), n * (n + 1) / 2 + n, "MassBias output length");
+    let mut scratch = SCRATCH.take();
+    body(&mut scratch, out);
+    SCRATCH.set(scratch);
+}
+
+/// M (upper triangle, row by row) and h of a chain whose links own their
+/// coordinates ([`all_owned`]: pcc, vc) into `out` (the `MassBias`
+/// layout), by composite bodies from the tip: a link's rows of M are its
+/// coordinates' twists against the momenta of the composite past it.
+/// `cell(c, x, xd, p_k, out)` evaluates cell `c` at a link's coordinates
+/// and rates and its parameters ([`CELL_PARAMS`]).
 /// Inlined into its caller, which the generated code builds for FMA.
 #[inline(always)]
-pub fn mass_bias<F, G>(
+pub fn mass_bias_owned<F>(
+    layout: &LinkLayout,
+    mut cell: F,
+    q: &[f64],
+    qd: &[f64],
+    p: &[f64],
+    out: &mut [f64],
+) where
+    F: FnMut(usize, &[f64], &[f64], &[f64], &mut [f64]),
+{
+    debug_assert!(all_owned(layout));
+    let n = layout.dof;
+    with_scratch(layout, out, |s, out| {
+        let mut tip = forward(layout, &mut cell, true, q, qd, p, s);
+        s.momentum.resize(n, ([0.0; 3], [0.0; 3]));
+        let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
+        let index = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
+        for (k, spec) in layout.links.iter().enumerate().rev() {
+            let (a, nc) = (s.start[k], spec.map.len());
+            let (momentum, block, g) = link_sums(s, k, nc, &mut tip);
+            for f in 0..nc {
+                bias[a + f] = g[f];
+                for f2 in f..nc {
+                    mass[index(a + f, a + f2)] = block[f][f2];
+                }
+                s.momentum[a + f] = momentum[f];
+            }
+        }
+        // Coordinates of different links: twist . momentum, a row at a
+        // time from the link after i's.
+        for (k, spec) in layout.links.iter().enumerate() {
+            let next = s.start[k] + spec.map.len();
+            for i in s.start[k]..next {
+                let row = &mut mass[index(i, next)..index(i, n)];
+                for (m, &phi) in row.iter_mut().zip(&s.momentum[next..]) {
+                    *m = pair(s.twist[i], phi);
+                }
+            }
+        }
+    });
+}
+
+/// M and h like [`mass_bias_owned`] for any chain, links of shared
+/// coordinates included (a rom segment's slices), `N` at least the arm's
+/// coordinates (rows padded with zeros: fixed-length rows the compiler
+/// turns into vector instructions). `forces(out)` writes the generalised
+/// forces that are not any link's (a rom segment's strain energy and
+/// damping, integrated over the segment), added to h, when
+/// `layout.forces`.
+///
+/// With W_e the map from the arm's rates to link e's cell rates (rows of
+/// `LinkSpec::map`), S_e the twists of e's cell rates, D_e e's own block
+/// and R_e = sum_{e' > e} F_e' W_e' the momenta the arm's rates give the
+/// links past e (F_e: the momenta of e's cell rates on e and past):
+/// M = X + X^T with X = sum_e W_e^T (S_e^T R_e + D_e W_e / 2). Each link
+/// costs O(cell coordinates x arm coordinates), not a Jacobian product
+/// over all pairs of the arm's coordinates.
+#[inline(always)]
+pub fn mass_bias_shared<const N: usize, F, G>(
     layout: &LinkLayout,
     mut cell: F,
     mut forces: G,
@@ -433,264 +586,64 @@ pub fn mass_bias<F, G>(
     G: FnMut(&mut [f64]),
 {
     let n = layout.dof;
-    let nl = layout.links.len();
-    assert!(layout.links.iter().all(|l| l.map.len() <= MAX_LINK_DOF));
-    assert_eq!(out.len(), n * (n + 1) / 2 + n, "MassBias output length");
-    // Out of the thread-local for the call: code inside `LocalKey::with`'s
-    // closure is not inlined into the caller, which is built for FMA.
-    let mut scratch = SCRATCH.take();
-    {
-        let s = &mut scratch;
-        s.links.resize(nl, Link::default());
-        s.start.clear();
-        s.owned.resize(nl, None);
-        let mut total = 0;
-        for spec in &layout.links {
-            s.start.push(total);
-            total += spec.map.len();
-        }
-        for v in [&mut s.twist, &mut s.own] {
-            v.resize(total, ([0.0; 3], [0.0; 3]));
-        }
-        s.local_force.resize(total, 0.0);
-        // By component (angular x, y, z, linear x, y, z), `dof` each, in
-        // chunks of four, so that loops over the arm's coordinates
-        // vectorise whatever its size.
-        let w = n.div_ceil(LANES);
-        s.reach.clear();
-        s.reach.resize(6 * w, [0.0; LANES]);
-        s.row.resize(w, [0.0; LANES]);
-        s.momentum.resize(n, ([0.0; 3], [0.0; 3]));
-        s.cross.clear();
-        s.cell_out.resize(cell::len(MAX_LINK_DOF), 0.0);
-        s.cell_params.resize(CELL_PARAMS, 0.0);
-
-        let gravity = layout.gravity.map(|i| p[i]);
-        let mut r: M3 =
-            std::array::from_fn(|i| std::array::from_fn(|j| p[layout.base_rotation[3 * i + j]]));
-        let mut pos = layout.base_position.map(|i| p[i]);
-        let (mut omega, mut alpha, mut acc) = ([0.0; 3], [0.0; 3], [0.0; 3]);
-        let (mut x, mut xd) = ([0.0; MAX_LINK_DOF], [0.0; MAX_LINK_DOF]);
-        for (k, spec) in layout.links.iter().enumerate() {
-            let nc = spec.map.len();
-            let owned = spec.owned();
-            s.owned[k] = owned;
-            match owned {
-                Some(a) => {
-                    x[..nc].copy_from_slice(&q[a..a + nc]);
-                    xd[..nc].copy_from_slice(&qd[a..a + nc]);
-                }
-                None => {
-                    for (f, c) in spec.map.iter().enumerate() {
-                        x[f] = local(c, q, p);
-                        xd[f] = local(c, qd, p);
-                    }
-                }
-            }
-            for (v, &i) in s.cell_params.iter_mut().zip(&spec.params) {
-                *v = p[i];
-            }
-            let c = &mut s.cell_out[..cell::len(nc)];
-            cell(spec.cell, &x[..nc], &xd[..nc], &s.cell_params, c);
-            let c = &*c;
-            let rel: M3 = std::array::from_fn(|i| v3(c, cell::ROTATION + 3 * i));
-            let turn = |at: usize| mat_vec(&r, v3(c, at));
-            let (d, dd, ddd) = (turn(cell::END), turn(cell::END_RATE), turn(cell::END_ACCEL));
-            let (cen, cend, cendd) = (
-                turn(cell::CENTROID),
-                turn(cell::CENTROID_RATE),
-                turn(cell::CENTROID_ACCEL),
-            );
-            let (w_rel, w_rel_d) = (turn(cell::OMEGA), turn(cell::OMEGA_RATE));
-            let (w_b, w_b_d) = (turn(cell::BODY_OMEGA), turn(cell::BODY_OMEGA_RATE));
-            let axis = turn(cell::AXIS);
-            let (m, lateral, axial) = (c[cell::MASS], c[cell::LATERAL], c[cell::AXIAL]);
-
-            // The body: centroid, convective accelerations, inertial and
-            // gravity forces.
-            let body_a = add(
-                add(add(acc, cross(alpha, cen)), cross(omega, cross(omega, cen))),
-                add(scale(2.0, cross(omega, cend)), cendd),
-            );
-            let body_w = add(omega, w_b);
-            let body_alpha = add(add(alpha, cross(omega, w_b)), w_b_d);
-            let iw = apply_body(lateral, axial, axis, body_w);
-            let end = add(pos, d);
-            s.links[k] = Link {
-                centroid: add(pos, cen),
-                axis,
-                m,
-                lateral,
-                axial,
-                force: scale(m, sub(body_a, gravity)),
-                torque: add(
-                    apply_body(lateral, axial, axis, body_alpha),
-                    cross(body_w, iw),
-                ),
-            };
-            let force_at = cell::COLUMNS + 12 * nc;
-            for f in 0..nc {
-                let j = s.start[k] + f;
-                let col = cell::COLUMNS + 12 * f;
-                let s_w = turn(col);
-                let v_end = turn(col + 3);
-                s.twist[j] = (s_w, sub(v_end, cross(s_w, end)));
-                s.own[j] = (turn(col + 6), turn(col + 9));
-                s.local_force[j] = c[force_at + f];
-            }
-
-            // The next frame.
-            acc = add(
-                add(add(acc, cross(alpha, d)), cross(omega, cross(omega, d))),
-                add(scale(2.0, cross(omega, dd)), ddd),
-            );
-            alpha = add(add(alpha, cross(omega, w_rel)), w_rel_d);
-            omega = add(omega, w_rel);
-            pos = end;
-            r = mat_mat(&r, &rel);
-        }
-
-        // What hangs on the end frame moves rigidly with it: the tip body
-        // and the tip loads start the composite sums.
-        let mut past = Inertia::default();
-        let mut wrench: (V3, V3) = ([0.0; 3], [0.0; 3]);
-        let axis = [r[0][0], r[1][0], r[2][0]];
-        let length = layout.tip_length.map_or(0.0, |i| p[i]);
-        let point = add(pos, scale(length, axis));
-        if let Some(m) = layout.tip_mass.map(|i| p[i]) {
-            let offset = scale(0.5 * length, axis);
-            let centre = add(pos, offset);
-            let (lateral, axial) = layout.tip_inertia.map_or((0.0, 0.0), |[l, a]| (p[l], p[a]));
-            let a_c = add(
-                add(acc, cross(alpha, offset)),
-                cross(omega, cross(omega, offset)),
-            );
-            let force = scale(m, sub(a_c, gravity));
-            let iw = apply_body(lateral, axial, axis, omega);
-            let torque = add(apply_body(lateral, axial, axis, alpha), cross(omega, iw));
-            past.add_body(m, centre, lateral, axial, axis);
-            wrench = (add(torque, cross(centre, force)), force);
-        }
-        // Applied loads enter as forces of the opposite sign.
-        let load = |idx: Option<[usize; 3]>| -> V3 {
-            idx.map_or([0.0; 3], |i| {
-                let v = i.map(|i| -p[i]);
-                if layout.tip_frame { mat_vec(&r, v) } else { v }
-            })
-        };
-        let (tip_f, tip_m) = (load(layout.tip_force), load(layout.tip_moment));
-        wrench = (
-            add(wrench.0, add(cross(point, tip_f), tip_m)),
-            add(wrench.1, tip_f),
-        );
-
-        let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
-        mass.fill(0.0);
-        bias.fill(0.0);
-        let index = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
+    assert!(n <= N, "{n} coordinates in rows of {N}");
+    with_scratch(layout, out, |s, out| {
+        let mut tip = forward(layout, &mut cell, false, q, qd, p, s);
+        let mut reach = [[0.0; N]; 6];
+        let mut x = [[0.0; N]; N];
+        let mut h = [0.0; N];
         for (k, spec) in layout.links.iter().enumerate().rev() {
-            let l = s.links[k];
             let nc = spec.map.len();
-            let at = s.start[k];
-            // Per cell coordinate: the momentum its twist gives the links
-            // past this one and this link's body, the link's own block of
-            // M, and the generalised bias.
-            let mut momentum = [([0.0; 3], [0.0; 3]); MAX_LINK_DOF];
-            let mut block = [[0.0; MAX_LINK_DOF]; MAX_LINK_DOF];
-            let mut g = [0.0; MAX_LINK_DOF];
+            let mut w = [[0.0; N]; MAX_LINK_DOF];
+            for (f, c) in spec.map.iter().enumerate() {
+                let sc = c.scale.map_or(1.0, |i| p[i]);
+                for &(a, wa) in &c.terms {
+                    w[f][a] = wa * sc;
+                }
+            }
+            let (momentum, block, g) = link_sums(s, k, nc, &mut tip);
             for f in 0..nc {
-                let (ow, ov) = s.own[at + f];
-                let mv = scale(l.m, ov);
-                let composite = past.momentum(s.twist[at + f]);
-                momentum[f] = (
-                    add(
-                        add(composite.0, apply_body(l.lateral, l.axial, l.axis, ow)),
-                        cross(l.centroid, mv),
-                    ),
-                    add(composite.1, mv),
-                );
-                g[f] = pair(s.twist[at + f], wrench)
-                    + dot(ov, l.force)
-                    + dot(ow, l.torque)
-                    + s.local_force[at + f];
-                #[allow(clippy::needless_range_loop)] // fills both halves
-                for f2 in f..nc {
-                    let (wj, vj) = s.own[at + f2];
-                    block[f][f2] = pair(s.twist[at + f2], composite)
-                        + l.m * dot(ov, vj)
-                        + dot(ow, apply_body(l.lateral, l.axial, l.axis, wj));
-                    block[f2][f] = block[f][f2];
-                }
-            }
-            match s.owned[k] {
-                // The link owns coordinates a.. : its block of M and its h
-                // directly; its rows past the block after the sweep.
-                Some(a) => {
-                    for f in 0..nc {
-                        bias[a + f] = g[f];
-                        for f2 in f..nc {
-                            mass[index(a + f, a + f2)] = block[f][f2];
-                        }
-                        for (k, &m) in flat(momentum[f]).iter().enumerate() {
-                            s.reach[k * w + (a + f) / LANES][(a + f) % LANES] = m;
-                        }
+                let t = flat(s.twist[s.start[k] + f]);
+                let mut row = [0.0; N];
+                for (tk, rk) in t.iter().zip(&reach) {
+                    for c in 0..N {
+                        row[c] = tk.mul_add(rk[c], row[c]);
                     }
                 }
-                // Shared coordinates: through the link's weights, into X
-                // the coupling S_f . R_e to the links past and half the
-                // own block (M = X + X^T), and into h.
-                None => {
-                    if s.cross.is_empty() {
-                        s.cross.resize(n * w, [0.0; LANES]);
+                for (b, wb) in block[f].iter().zip(&w).take(nc) {
+                    let half = 0.5 * b;
+                    for c in 0..N {
+                        row[c] = half.mul_add(wb[c], row[c]);
                     }
-                    let twists = &s.twist[at..at + nc];
-                    let (reach, cross) = (&mut s.reach[..], &mut s.cross[..]);
-                    let args = (spec, twists, &block, &g, &momentum, p);
-                    // Monomorphised by the row's chunk count, so that the
-                    // loops over the arm's coordinates have fixed trip
-                    // counts (runtime lengths left them mostly scalar).
-                    match w {
-                        1 => shared_sums::<1>(args, reach, cross, bias),
-                        2 => shared_sums::<2>(args, reach, cross, bias),
-                        3 => shared_sums::<3>(args, reach, cross, bias),
-                        4 => shared_sums::<4>(args, reach, cross, bias),
-                        5 => shared_sums::<5>(args, reach, cross, bias),
-                        6 => shared_sums::<6>(args, reach, cross, bias),
-                        7 => shared_sums::<7>(args, reach, cross, bias),
-                        8 => shared_sums::<8>(args, reach, cross, bias),
-                        _ => shared_sums_any(w, args, reach, cross, bias),
+                }
+                for c in 0..N {
+                    h[c] = g[f].mul_add(w[f][c], h[c]);
+                }
+                // Terms name distinct coordinates (eomgen's maps).
+                for &(a, _) in &spec.map[f].terms {
+                    let wa = w[f][a];
+                    for c in 0..N {
+                        x[a][c] = wa.mul_add(row[c], x[a][c]);
                     }
                 }
             }
-            past.add_body(l.m, l.centroid, l.lateral, l.axial, l.axis);
-            let torque = add(l.torque, cross(l.centroid, l.force));
-            wrench = (add(wrench.0, torque), add(wrench.1, l.force));
-        }
-        // Rows of owned coordinates past their link: twist . momentum.
-        for (j, m) in s.momentum.iter_mut().enumerate() {
-            let c = |k: usize| s.reach[k * w + j / LANES][j % LANES];
-            *m = ([c(0), c(1), c(2)], [c(3), c(4), c(5)]);
-        }
-        for (k, spec) in layout.links.iter().enumerate() {
-            if let Some(a) = s.owned[k] {
-                let next = a + spec.map.len();
-                for f in 0..spec.map.len() {
-                    let twist = s.twist[s.start[k] + f];
-                    let row = &mut mass[index(a + f, next)..index(a + f, n)];
-                    for (m, &r) in row.iter_mut().zip(&s.momentum[next..]) {
-                        *m = pair(twist, r);
+            for (m, wf) in momentum.iter().zip(&w).take(nc) {
+                for (mk, rk) in flat(*m).iter().zip(&mut reach) {
+                    for c in 0..N {
+                        rk[c] = mk.mul_add(wf[c], rk[c]);
                     }
                 }
             }
         }
-        if !s.cross.is_empty() {
-            for i in 0..n {
-                for j in i..n {
-                    mass[index(i, j)] += s.cross[i * w + j / LANES][j % LANES]
-                        + s.cross[j * w + i / LANES][i % LANES];
-                }
+        let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
+        let mut at = 0;
+        for i in 0..n {
+            for j in i..n {
+                mass[at] = x[i][j] + x[j][i];
+                at += 1;
             }
         }
+        bias.copy_from_slice(&h[..n]);
         if layout.forces {
             s.forces.resize(n, 0.0);
             forces(&mut s.forces);
@@ -698,6 +651,61 @@ pub fn mass_bias<F, G>(
                 *h += f;
             }
         }
+    });
+}
+
+/// Rows a chain of `dof` coordinates is summed in by the generated
+/// [`mass_bias_shared`]: the next multiple of four.
+pub fn padded(dof: usize) -> usize {
+    dof.div_ceil(4) * 4
+}
+
+/// The link recursion for any layout, choosing as the generated code does
+/// ([`all_owned`], [`padded`]); for tests and tools, not built for FMA.
+pub fn mass_bias<F, G>(
+    layout: &LinkLayout,
+    cell: F,
+    forces: G,
+    q: &[f64],
+    qd: &[f64],
+    p: &[f64],
+    out: &mut [f64],
+) where
+    F: FnMut(usize, &[f64], &[f64], &[f64], &mut [f64]),
+    G: FnMut(&mut [f64]),
+{
+    if all_owned(layout) {
+        mass_bias_owned(layout, cell, q, qd, p, out)
+    } else {
+        mass_bias_shared_dyn(layout, cell, forces, q, qd, p, out)
     }
-    SCRATCH.set(scratch);
+}
+
+/// Most coordinates a chain with shared links may have: the generator
+/// keeps larger ones on the flat kernel.
+pub const MAX_SHARED_DOF: usize = 64;
+
+/// [`mass_bias_shared`] with `N` picked at run time ([`padded`]); for any
+/// chain, owned links included (tests check the two strategies agree).
+pub fn mass_bias_shared_dyn<F, G>(
+    layout: &LinkLayout,
+    cell: F,
+    forces: G,
+    q: &[f64],
+    qd: &[f64],
+    p: &[f64],
+    out: &mut [f64],
+) where
+    F: FnMut(usize, &[f64], &[f64], &[f64], &mut [f64]),
+    G: FnMut(&mut [f64]),
+{
+    macro_rules! pick {
+        ($($n:literal)*) => {
+            match padded(layout.dof) {
+                $($n => mass_bias_shared::<$n, F, G>(layout, cell, forces, q, qd, p, out),)*
+                w => panic!("shared sums stop at {MAX_SHARED_DOF} coordinates, not {w}"),
+            }
+        };
+    }
+    pick!(4 8 12 16 20 24 28 32 36 40 44 48 52 56 60 64)
 }

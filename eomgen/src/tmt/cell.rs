@@ -141,6 +141,10 @@ pub fn link_chain(model: &Model) -> Option<LinkKernels> {
         tip_inertia: (st.tip_mass && st.tip_length)
             .then(|| [index("tip.inertia"), index("tip.axial_inertia")]),
     };
+    // The shared sums hold the arm's coordinates in fixed rows.
+    if !roms.is_empty() && first > runtime::links::MAX_SHARED_DOF {
+        return None;
+    }
     let forces = (!roms.is_empty()).then(|| derive_forces(model, first, &roms));
     Some(LinkKernels {
         layout,
