@@ -34,8 +34,6 @@ struct KernelEmitter<'a> {
     /// Workspace index of spilled slots.
     spill: Vec<Option<usize>>,
     n_spill: usize,
-    /// Four evaluations at once in `runtime::lanes::X4` (`emit_lanes`).
-    lanes: bool,
 }
 
 impl<'a> KernelEmitter<'a> {
@@ -80,15 +78,6 @@ impl<'a> KernelEmitter<'a> {
             chunk_of,
             spill,
             n_spill,
-            lanes: false,
-        }
-    }
-
-    /// The emitter of `emit_lanes`.
-    fn new_lanes(tape: &'a Tape) -> Self {
-        Self {
-            lanes: true,
-            ..Self::new(tape)
         }
     }
 
@@ -98,19 +87,6 @@ impl<'a> KernelEmitter<'a> {
 
     /// How slot `s` is read from inside chunk `c`.
     fn read(&self, s: Slot, c: usize) -> TokenStream {
-        let leaf = self.read_scalar(s, c);
-        if self.lanes {
-            match self.tape.ops[s as usize] {
-                Op::Const(_) | Op::Time => quote!(runtime::lanes::X4::splat(#leaf)),
-                op if op.is_leaf() => quote!(runtime::lanes::X4(#leaf)),
-                _ => leaf,
-            }
-        } else {
-            leaf
-        }
-    }
-
-    fn read_scalar(&self, s: Slot, c: usize) -> TokenStream {
         let i = s as usize;
         match self.tape.ops[i] {
             Op::Const(v) => lit(v),
@@ -194,52 +170,51 @@ impl<'a> KernelEmitter<'a> {
                 let a = r(a);
                 quote!(#a.sqrt())
             }
-            Op::Sin(a) => self.call1(r(a), quote!(runtime::special::sin)),
-            Op::Cos(a) => self.call1(r(a), quote!(runtime::special::cos)),
-            Op::Tan(a) => self.call1(r(a), quote!(f64::tan)),
-            Op::Exp(a) => self.call1(r(a), quote!(f64::exp)),
-            Op::Ln(a) => self.call1(r(a), quote!(f64::ln)),
+            Op::Sin(a) => {
+                let a = r(a);
+                quote!(runtime::special::sin(#a))
+            }
+            Op::Cos(a) => {
+                let a = r(a);
+                quote!(runtime::special::cos(#a))
+            }
+            Op::Tan(a) => {
+                let a = r(a);
+                quote!(#a.tan())
+            }
+            Op::Exp(a) => {
+                let a = r(a);
+                quote!(#a.exp())
+            }
+            Op::Ln(a) => {
+                let a = r(a);
+                quote!(#a.ln())
+            }
             Op::Abs(a) => {
                 let a = r(a);
                 quote!(#a.abs())
             }
-            Op::Sign(a) => self.call1(r(a), quote!(runtime::special::sign)),
-            Op::Sinc(k, a) => self.call1(r(a), quote!(runtime::special::sinc, #k)),
-            Op::Cosc(k, a) => self.call1(r(a), quote!(runtime::special::cosc, #k)),
-            Op::SincRem(k, a) => self.call1(r(a), quote!(runtime::special::sinc_rem, #k)),
+            Op::Sign(a) => {
+                let a = r(a);
+                quote!(runtime::special::sign(#a))
+            }
+            Op::Sinc(k, a) => {
+                let a = r(a);
+                quote!(runtime::special::sinc(#k, #a))
+            }
+            Op::Cosc(k, a) => {
+                let a = r(a);
+                quote!(runtime::special::cosc(#k, #a))
+            }
+            Op::SincRem(k, a) => {
+                let a = r(a);
+                quote!(runtime::special::sinc_rem(#k, #a))
+            }
             Op::Rodrigues(j, n, a) => {
-                self.call1(r(a), quote!(runtime::rodrigues::rodrigues, #j, #n))
+                let a = r(a);
+                quote!(runtime::rodrigues::rodrigues(#j, #n, #a))
             }
             _ => unreachable!("leaves are read in place"),
-        }
-    }
-
-    /// `f(leading.., a)`, `f` and its leading constant arguments given as
-    /// `f, leading..`: lane by lane in lane kernels.
-    fn call1(&self, a: TokenStream, f_and_leading: TokenStream) -> TokenStream {
-        let mut parts = f_and_leading.into_iter().collect::<Vec<_>>();
-        let comma = parts
-            .iter()
-            .position(|t| matches!(t, proc_macro2::TokenTree::Punct(p) if p.as_char() == ','));
-        // "f, k": leading is ", k", and the arguments "k, a".
-        let leading: TokenStream = match comma {
-            Some(i) => parts.drain(i..).skip(1).collect(),
-            None => TokenStream::new(),
-        };
-        let f: TokenStream = parts.into_iter().collect();
-        let args = |x: TokenStream| {
-            if leading.is_empty() {
-                x
-            } else {
-                quote!(#leading, #x)
-            }
-        };
-        if self.lanes {
-            let args = args(quote!(x));
-            quote!(#a.map(|x| #f(#args)))
-        } else {
-            let args = args(a);
-            quote!(#f(#args))
         }
     }
 
@@ -279,18 +254,13 @@ impl<'a> KernelEmitter<'a> {
                             continue;
                         }
                         let a = self.read(a, c);
-                        body.push(family.call(members, a, self.lanes));
+                        body.push(family.call(members, a));
                         members.iter().map(|m| m.1).collect()
                     }
                     None => {
                         let v = format_ident!("v{}", i);
                         let e = self.expr(op, c);
-                        let ty = if self.lanes {
-                            quote!(runtime::lanes::X4)
-                        } else {
-                            quote!(f64)
-                        };
-                        body.push(quote!(let #v: #ty = #e;));
+                        body.push(quote!(let #v: f64 = #e;));
                         vec![i]
                     }
                 };
@@ -307,34 +277,8 @@ impl<'a> KernelEmitter<'a> {
                 let owner = self.chunk_of[s as usize].unwrap_or(n_chunks - 1);
                 if owner == c {
                     let val = self.read(s, c);
-                    body.push(if self.lanes {
-                        quote!(out[#k] = #val.0;)
-                    } else {
-                        quote!(out[#k] = #val;)
-                    });
+                    body.push(quote!(out[#k] = #val;));
                 }
-            }
-            if self.lanes {
-                assert!(n_chunks == 1 && n_spill == 0, "lane kernels are one chunk");
-                assert!(
-                    !self.tape.ops.iter().any(|op| matches!(op, Op::Time | Op::Qdd(_) | Op::Dir(_))),
-                    "lane kernels read q, qd and p"
-                );
-                let f = format_ident!("{}", name);
-                let doc = format!(
-                    " Kernel `{name}`: {} operations, four evaluations in vector lanes.",
-                    self.tape.op_count()
-                );
-                return quote! {
-                    #[doc = #doc]
-                    #[inline(never)]
-                    #[allow(unused_variables, clippy::all)]
-                    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-                    fn #f(q: &[[f64; 4]; #dof], qd: &[[f64; 4]; #dof], p: &[[f64; 4]; #n_params],
-                          out: &mut [[f64; 4]; #n_out]) {
-                        #(#body)*
-                    }
-                };
             }
             let f = format_ident!("{}_{}", name, c);
             chunks.push(quote! {
@@ -399,7 +343,7 @@ fn emit_link_recursion(
     use runtime::links::CELL_PARAMS;
     let layout = &links.layout;
     let mut defs = Vec::new();
-    let (mut ones, mut fours) = (Vec::new(), Vec::new());
+    let mut arms = Vec::new();
     for (c, tape) in links.cells.iter().enumerate() {
         let n = layout
             .links
@@ -407,20 +351,13 @@ fn emit_link_recursion(
             .find(|l| l.cell == c)
             .map_or(0, |l| l.map.len());
         let name = format!("cell_{c}");
-        let name4 = format!("cell_{c}_x4");
         defs.push(KernelEmitter::new(tape).emit(&name, n, CELL_PARAMS));
-        defs.push(KernelEmitter::new_lanes(tape).emit(&name4, n, CELL_PARAMS));
-        let (f, f4) = (Ident::new(&name, Span::call_site()), Ident::new(&name4, Span::call_site()));
+        let f = Ident::new(&name, Span::call_site());
         let n2 = 2 * n;
-        ones.push(quote! {
-            #c => #f(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+        arms.push(quote! {
+            #c => #f(0.0, q.try_into().expect("link coordinates"), qd.try_into().expect("link rates"),
                      &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
                      out.try_into().expect("cell outputs")),
-        });
-        fours.push(quote! {
-            // SAFETY: `mass_bias` has checked that the processor has FMA.
-            #c => unsafe { #f4(x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
-                               p.try_into().expect("cell parameters"), out.try_into().expect("cell outputs")) },
         });
     }
     let n_dir = 2 * dof;
@@ -428,47 +365,19 @@ fn emit_link_recursion(
         Some(tape) => {
             defs.push(KernelEmitter::new(tape).emit("link_forces", dof, n_params));
             quote! {
-                link_forces(0.0, self.q, self.qd, &[0.0; #dof], &[0.0; #n_dir], self.p,
-                            out.try_into().expect("force outputs"))
+                |out: &mut [f64]| link_forces(0.0, q, qd, &[0.0; #dof], &[0.0; #n_dir], p,
+                                              out.try_into().expect("force outputs"))
             }
         }
-        None => quote!(unreachable!("no non-local forces")),
+        None => quote!(|_: &mut [f64]| {}),
     };
     // Chains of owned links sum by composite bodies; shared links (rom
     // slices) need the arm's coordinates in rows of a fixed length.
     let call = if runtime::links::all_owned(layout) {
-        quote!(runtime::links::mass_bias_owned(&LINKS, &mut cells, q, qd, p, out))
+        quote!(runtime::links::mass_bias_owned(&LINKS, cells, q, qd, p, out))
     } else {
         let rows = runtime::links::padded(dof);
-        quote!(runtime::links::mass_bias_shared::<#rows, _>(&LINKS, &mut cells, q, qd, p, out))
-    };
-    let cells_impl = quote! {
-        /// The compiled cells and forces the link recursion evaluates.
-        struct LinkCells<'a> {
-            q: &'a [f64; #dof],
-            qd: &'a [f64; #dof],
-            p: &'a [f64; #n_params],
-        }
-        impl runtime::links::Cells for LinkCells<'_> {
-            #[inline(always)]
-            fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
-                match c {
-                    #(#ones)*
-                    _ => unreachable!("cell index from the layout"),
-                }
-            }
-            #[inline(always)]
-            fn four(&mut self, c: usize, x: &[[f64; 4]], xd: &[[f64; 4]], p: &[[f64; 4]], out: &mut [[f64; 4]]) {
-                match c {
-                    #(#fours)*
-                    _ => unreachable!("cell index from the layout"),
-                }
-            }
-            #[inline(always)]
-            fn forces(&mut self, out: &mut [f64]) {
-                #forces
-            }
-        }
+        quote!(runtime::links::mass_bias_shared::<#rows, _, _>(&LINKS, cells, #forces, q, qd, p, out))
     };
     let json = serde_json::to_string(layout).expect("a link layout serialises");
     let doc = format!(
@@ -489,10 +398,12 @@ fn emit_link_recursion(
         }
         #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
         unsafe fn mass_bias_links(q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
-            let mut cells = LinkCells { q, qd, p };
+            let cells = |c: usize, q: &[f64], qd: &[f64], p: &[f64], out: &mut [f64]| match c {
+                #(#arms)*
+                _ => unreachable!("cell index from the layout"),
+            };
             #call
         }
-        #cells_impl
         #(#defs)*
     }
 }
@@ -532,12 +443,7 @@ fn family_of(op: &Op) -> Option<(Family, Member, Slot)> {
 
 impl Family {
     /// `let` binding the members (member, op index) from one call at `a`.
-    fn call(self, members: &[(Member, usize)], a: TokenStream, lanes: bool) -> TokenStream {
-        let ty = if lanes {
-            quote!(runtime::lanes::X4)
-        } else {
-            quote!(f64)
-        };
+    fn call(self, members: &[(Member, usize)], a: TokenStream) -> TokenStream {
         let n = members
             .iter()
             .map(|m| usize::from(m.0.1))
@@ -548,15 +454,10 @@ impl Family {
             let lets = members.iter().map(|&((j, k), i)| {
                 let (j, k) = (usize::from(j), usize::from(k));
                 let v = format_ident!("v{}", i);
-                quote!(let #v: #ty = c[#j][#k];)
+                quote!(let #v: f64 = c[#j][#k];)
             });
-            let family = if lanes {
-                quote!(runtime::lanes::family)
-            } else {
-                quote!(runtime::rodrigues::family)
-            };
             return quote! {
-                let c: [[#ty; #n]; runtime::rodrigues::FAMILY_J] = #family::<#n>(#a);
+                let c: [[f64; #n]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<#n>(#a);
                 #(#lets)*
             };
         }
@@ -570,9 +471,6 @@ impl Family {
             })
             .collect();
         let f = match self {
-            Family::SinCos if lanes => {
-                return quote!(let (#(#names),*): (#ty, #ty) = runtime::lanes::sin_cos(#a););
-            }
             Family::SinCos => {
                 return quote!(let (#(#names),*): (f64, f64) = runtime::special::sin_cos(#a););
             }
@@ -581,11 +479,7 @@ impl Family {
             Family::SincRem => quote!(sinc_rem_orders),
             Family::Rodrigues => unreachable!("handled above"),
         };
-        if lanes {
-            quote!(let [#(#names),*]: [#ty; #n] = runtime::lanes::orders(#a, runtime::special::#f::<#n>);)
-        } else {
-            quote!(let [#(#names),*]: [f64; #n] = runtime::special::#f::<#n>(#a);)
-        }
+        quote!(let [#(#names),*]: [f64; #n] = runtime::special::#f::<#n>(#a);)
     }
 }
 

@@ -11,7 +11,6 @@
 // without nalgebra and the ODE crate.
 pub mod cpu;
 pub mod kernels;
-pub mod lanes;
 pub mod linalg;
 pub mod links;
 pub mod rodrigues;
