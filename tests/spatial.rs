@@ -339,7 +339,12 @@ fn tip_of(method: &str, size: usize, load: &str, extensible: bool) -> [f64; 3] {
             .unwrap()
             .tip_position;
     }
-    let mut l = cantilever3d(&sets);
+    static_tip(&sets)
+}
+
+/// Static tip of cantilever3d under `sets`, from the straight state.
+fn static_tip(sets: &[String]) -> [f64; 3] {
+    let mut l = cantilever3d(sets);
     let n = l.arm.dof();
     let sol = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
     let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
@@ -416,6 +421,45 @@ fn pcc_and_rom_reach_one_percent_under_self_weight_with_twelve_and_six_dof() {
         err < 0.01 * deflection,
         "rom, 6 DOF: error {:.3} %",
         100.0 * err / deflection
+    );
+}
+
+#[test]
+fn rom_slices_converge_at_second_order_to_the_cosserat_rod() {
+    // rom's positions, orientations and mass come from `quadrature`
+    // constant-strain slices: the slice count, not only the order, sets
+    // its accuracy (BENCHMARKS.md weighs slices against speed). Cubic
+    // fields under self-weight, 4, 8 and 16 slices.
+    let load = "gravity=[0, -9.81, 0]";
+    let reference = tip_by("cosserat", 1, load);
+    let deflection = reference[1].abs();
+    let err: Vec<f64> = [4, 8, 16]
+        .iter()
+        .map(|slices| {
+            let sets = [
+                "segment.0.method=rom".to_string(),
+                "segment.0.order=3".to_string(),
+                format!("segment.0.quadrature={slices}"),
+                "segment.0.twist=false".to_string(),
+                load.to_string(),
+            ];
+            dist(static_tip(&sets), reference) / deflection
+        })
+        .collect();
+    // Halving the slice quarters the error (what remains at 16 slices
+    // includes the cubic fields' own error, so the second ratio is less).
+    assert!(
+        err[1] < err[0] / 3.0,
+        "rom errors by slices 4, 8, 16: {err:?}"
+    );
+    assert!(
+        err[2] < err[1] / 2.0,
+        "rom errors by slices 4, 8, 16: {err:?}"
+    );
+    assert!(
+        err[1] < 0.01,
+        "rom, 8 slices: error {:.3} %",
+        100.0 * err[1]
     );
 }
 
