@@ -17,8 +17,6 @@ pub mod hybrid_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod long_arm;
 #[allow(clippy::all, clippy::pedantic)]
-pub mod rom_arm;
-#[allow(clippy::all, clippy::pedantic)]
 pub mod soft_finger;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod stiff_flop;
@@ -77,13 +75,6 @@ pub static MODELS: &[CompiledModel] = &[
         dof: long_arm::DOF,
         source: include_str!("../models/long_arm.toml"),
         kernels: || Box::new(long_arm::Compiled::default()),
-    },
-    CompiledModel {
-        name: "rom_arm",
-        hash: rom_arm::HASH,
-        dof: rom_arm::DOF,
-        source: include_str!("../models/rom_arm.toml"),
-        kernels: || Box::new(rom_arm::Compiled::default()),
     },
     CompiledModel {
         name: "soft_finger",

@@ -361,7 +361,9 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
                 };
                 let layout = &links.layout;
                 if shared {
-                    runtime::links::mass_bias_shared_dyn(layout, cell, forces, &q, &qd, &p, &mut got);
+                    runtime::links::mass_bias_shared_dyn(
+                        layout, cell, forces, &q, &qd, &p, &mut got,
+                    );
                 } else {
                     runtime::links::mass_bias(layout, cell, forces, &q, &qd, &p, &mut got);
                 }

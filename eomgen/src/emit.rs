@@ -374,7 +374,9 @@ fn emit_link_recursion(
     // Chains of owned links sum by composite bodies; shared links (rom
     // slices) need the arm's coordinates in rows of a fixed length.
     let call = if runtime::links::all_owned(layout) {
-        quote!(runtime::links::mass_bias_owned(&LINKS, cells, q, qd, p, out))
+        quote!(runtime::links::mass_bias_owned(
+            &LINKS, cells, q, qd, p, out
+        ))
     } else {
         let rows = runtime::links::padded(dof);
         quote!(runtime::links::mass_bias_shared::<#rows, _, _>(&LINKS, cells, #forces, q, qd, p, out))

@@ -280,9 +280,10 @@ fn local(c: &LocalCoordinate, x: &[f64], p: &[f64]) -> f64 {
 pub fn all_owned(layout: &LinkLayout) -> bool {
     let mut next = 0;
     layout.links.iter().all(|l| {
-        let own = l.map.iter().enumerate().all(|(f, c)| {
-            c.scale.is_none() && c.terms.len() == 1 && c.terms[0] == (next + f, 1.0)
-        });
+        let own =
+            l.map.iter().enumerate().all(|(f, c)| {
+                c.scale.is_none() && c.terms.len() == 1 && c.terms[0] == (next + f, 1.0)
+            });
         next += l.map.len();
         own
     }) && next == layout.dof
@@ -637,6 +638,7 @@ pub fn mass_bias_shared<const N: usize, F, G>(
         }
         let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
         let mut at = 0;
+        #[allow(clippy::needless_range_loop)] // X's row and column
         for i in 0..n {
             for j in i..n {
                 mass[at] = x[i][j] + x[j][i];
