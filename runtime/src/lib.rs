@@ -14,6 +14,7 @@ pub mod kernels;
 pub mod linalg;
 pub mod links;
 pub mod rodrigues;
+pub mod rows;
 pub mod special;
 pub mod tape;
 

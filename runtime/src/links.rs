@@ -19,6 +19,8 @@ use std::cell::RefCell;
 
 use serde::{Deserialize, Serialize};
 
+use crate::rows;
+
 /// Parameters a cell reads, in this order, per link: element[k].length,
 /// .mass, .inertia, .axial_inertia, joint[k].stiffness, .damping, .rest,
 /// twist[k].stiffness, .damping, stretch[k].stiffness, .damping.
@@ -267,12 +269,19 @@ thread_local! {
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
 
-/// The value of cell coordinate `c`: its combination of `x` (coordinates
-/// or rates).
+/// The value and rate of cell coordinate `c`: its combinations of the
+/// coordinates and rates.
 #[inline(always)]
-fn local(c: &LocalCoordinate, x: &[f64], p: &[f64]) -> f64 {
-    let s = c.terms.iter().fold(0.0, |s, &(a, w)| w.mul_add(x[a], s));
-    c.scale.map_or(s, |i| s * p[i])
+fn local(c: &LocalCoordinate, q: &[f64], qd: &[f64], p: &[f64]) -> (f64, f64) {
+    let (mut x, mut xd) = (0.0, 0.0);
+    for &(a, w) in &c.terms {
+        x = w.mul_add(q[a], x);
+        xd = w.mul_add(qd[a], xd);
+    }
+    match c.scale {
+        Some(i) => (x * p[i], xd * p[i]),
+        None => (x, xd),
+    }
 }
 
 /// Whether every link's cell coordinates are the arm's own, in order
@@ -341,8 +350,7 @@ where
             (&q[at..at + nc], &qd[at..at + nc])
         } else {
             for (f, c) in spec.map.iter().enumerate() {
-                x[f] = local(c, q, p);
-                xd[f] = local(c, qd, p);
+                (x[f], xd[f]) = local(c, q, qd, p);
             }
             (&x[..nc], &xd[..nc])
         };
@@ -495,17 +503,16 @@ fn link_sums(
     (momentum, block, g)
 }
 
-/// Checks the output length and runs `body` on the thread's scratch.
-/// Out of the thread-local for the call: code inside `LocalKey::with`'s
-/// closure is not inlined into the caller, which is built for FMA.
+/// The thread's scratch, out of the thread-local for the call (code in
+/// `LocalKey::with`'s closure, or in any closure, may stay out of line,
+/// not built for FMA like the generated caller); after checking the
+/// output length. Put back with `SCRATCH.set`.
 #[inline(always)]
-fn with_scratch(layout: &LinkLayout, out: &mut [f64], body: impl FnOnce(&mut Scratch, &mut [f64])) {
+fn take_scratch(layout: &LinkLayout, out: &[f64]) -> Scratch {
     let n = layout.dof;
     assert!(layout.links.iter().all(|l| l.map.len() <= MAX_LINK_DOF));
     assert_eq!(out.len(), n * (n + 1) / 2 + n, "MassBias output length");
-    let mut scratch = SCRATCH.take();
-    body(&mut scratch, out);
-    SCRATCH.set(scratch);
+    SCRATCH.take()
 }
 
 /// M (upper triangle, row by row) and h of a chain whose links own their
@@ -528,7 +535,9 @@ pub fn mass_bias_owned<F>(
 {
     debug_assert!(all_owned(layout));
     let n = layout.dof;
-    with_scratch(layout, out, |s, out| {
+    let mut scratch = take_scratch(layout, out);
+    {
+        let s = &mut scratch;
         let mut tip = forward(layout, &mut cell, true, q, qd, p, s);
         s.momentum.resize(n, ([0.0; 3], [0.0; 3]));
         let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
@@ -555,7 +564,8 @@ pub fn mass_bias_owned<F>(
                 }
             }
         }
-    });
+    }
+    SCRATCH.set(scratch);
 }
 
 /// M and h like [`mass_bias_owned`] for any chain, links of shared
@@ -588,8 +598,11 @@ pub fn mass_bias_shared<const N: usize, F, G>(
 {
     let n = layout.dof;
     assert!(n <= N, "{n} coordinates in rows of {N}");
-    with_scratch(layout, out, |s, out| {
+    let mut scratch = take_scratch(layout, out);
+    {
+        let s = &mut scratch;
         let mut tip = forward(layout, &mut cell, false, q, qd, p, s);
+        let simd = rows::simd_available();
         let mut reach = [[0.0; N]; 6];
         let mut x = [[0.0; N]; N];
         let mut h = [0.0; N];
@@ -602,37 +615,27 @@ pub fn mass_bias_shared<const N: usize, F, G>(
                     w[f][a] = wa * sc;
                 }
             }
+            let w_rows: [&[f64; N]; MAX_LINK_DOF] = std::array::from_fn(|f| &w[f]);
             let (momentum, block, g) = link_sums(s, k, nc, &mut tip);
+            // Unused cell coordinates have zero blocks, forces and momenta.
+            rows::add_combination(simd, &mut h, &g, w_rows);
             for f in 0..nc {
                 let t = flat(s.twist[s.start[k] + f]);
                 let mut row = [0.0; N];
-                for (tk, rk) in t.iter().zip(&reach) {
-                    for c in 0..N {
-                        row[c] = tk.mul_add(rk[c], row[c]);
-                    }
-                }
-                for (b, wb) in block[f].iter().zip(&w).take(nc) {
-                    let half = 0.5 * b;
-                    for c in 0..N {
-                        row[c] = half.mul_add(wb[c], row[c]);
-                    }
-                }
-                for c in 0..N {
-                    h[c] = g[f].mul_add(w[f][c], h[c]);
-                }
+                rows::add_combination(simd, &mut row, &t, std::array::from_fn(|k| &reach[k]));
+                let half = block[f].map(|b| 0.5 * b);
+                rows::add_combination(simd, &mut row, &half, w_rows);
                 // Terms name distinct coordinates (eomgen's maps).
                 for &(a, _) in &spec.map[f].terms {
-                    let wa = w[f][a];
-                    for c in 0..N {
-                        x[a][c] = wa.mul_add(row[c], x[a][c]);
-                    }
+                    rows::add_combination(simd, &mut x[a], &[w[f][a]], [&row]);
                 }
             }
-            for (m, wf) in momentum.iter().zip(&w).take(nc) {
-                for (mk, rk) in flat(*m).iter().zip(&mut reach) {
-                    for c in 0..N {
-                        rk[c] = mk.mul_add(wf[c], rk[c]);
-                    }
+            let m: [[f64; 6]; MAX_LINK_DOF] = momentum.map(flat);
+            for (kk, rk) in reach.iter_mut().enumerate() {
+                let mk: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| m[f][kk]);
+                match nc {
+                    3 => rows::add_combination(simd, rk, &[mk[0], mk[1], mk[2]], [&w[0], &w[1], &w[2]]),
+                    _ => rows::add_combination(simd, rk, &mk, w_rows),
                 }
             }
         }
@@ -653,7 +656,8 @@ pub fn mass_bias_shared<const N: usize, F, G>(
                 *h += f;
             }
         }
-    });
+    }
+    SCRATCH.set(scratch);
 }
 
 /// Rows a chain of `dof` coordinates is summed in by the generated

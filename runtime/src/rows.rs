@@ -1,0 +1,89 @@
+//! Rows over an arm's coordinates, fixed length `N` (a multiple of four),
+//! combined with 256-bit fused multiply-adds where the processor has them.
+//!
+//! The compiler's vectoriser leaves these loops scalar inside the link
+//! recursion's large inlined body (BENCHMARKS.md, session 9), so the
+//! vector form is written out. Every lane is the scalar `mul_add`, so
+//! both forms give the same bits.
+
+/// Whether [`add_combination`] may use its vector form here.
+pub fn simd_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx") && std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// y += sum_k coef[k] rows[k]. `simd`: [`simd_available`].
+#[inline(always)]
+pub fn add_combination<const N: usize, const K: usize>(
+    simd: bool,
+    y: &mut [f64; N],
+    coef: &[f64; K],
+    rows: [&[f64; N]; K],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if simd {
+        // SAFETY: the caller has checked that the processor has AVX and FMA.
+        unsafe { add_combination_avx(y, coef, rows) };
+        return;
+    }
+    let _ = simd;
+    for (k, row) in rows.iter().enumerate() {
+        for c in 0..N {
+            y[c] = coef[k].mul_add(row[c], y[c]);
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,fma")]
+#[inline]
+unsafe fn add_combination_avx<const N: usize, const K: usize>(
+    y: &mut [f64; N],
+    coef: &[f64; K],
+    rows: [&[f64; N]; K],
+) {
+    use std::arch::x86_64::*;
+    const { assert!(N % 4 == 0, "rows are whole vectors") };
+    let c: [__m256d; K] = std::array::from_fn(|k| _mm256_set1_pd(coef[k]));
+    for at in (0..N).step_by(4) {
+        // SAFETY: at + 4 <= N for every row.
+        unsafe {
+            let mut acc = _mm256_loadu_pd(y.as_ptr().add(at));
+            for k in 0..K {
+                acc = _mm256_fmadd_pd(c[k], _mm256_loadu_pd(rows[k].as_ptr().add(at)), acc);
+            }
+            _mm256_storeu_pd(y.as_mut_ptr().add(at), acc);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The vector form against the scalar one, bit for bit.
+    #[test]
+    fn vector_and_scalar_combinations_agree() {
+        let rows: [[f64; 8]; 3] =
+            std::array::from_fn(|k| std::array::from_fn(|c| (k * 8 + c) as f64 * 0.37 - 2.1));
+        let coef = [1.5, -0.25, 3.125e-3];
+        let start: [f64; 8] = std::array::from_fn(|c| c as f64 / 7.0);
+        let (mut a, mut b) = (start, start);
+        add_combination(false, &mut a, &coef, [&rows[0], &rows[1], &rows[2]]);
+        add_combination(simd_available(), &mut b, &coef, [&rows[0], &rows[1], &rows[2]]);
+        let mut want = start;
+        for k in 0..3 {
+            for c in 0..8 {
+                want[c] = coef[k].mul_add(rows[k][c], want[c]);
+            }
+        }
+        assert_eq!(a, want);
+        assert_eq!(b, want);
+    }
+}
