@@ -226,6 +226,33 @@ fn generated_mass_solve_matches_a_dense_solve() {
 /// against the flat `MassBias` tape of the TMT sums, for every link shape
 /// and tip it covers: twist, stretch, thinning, vc modules, rom slices, a
 /// tip point mass, a tip cylinder, loads in the tip frame, a turned base.
+
+/// The link recursion's cells and forces evaluated from their tapes.
+struct TapeCells<'a> {
+    links: &'a runtime::links::LinkKernels,
+    inp: runtime::Inputs<'a>,
+    slots: &'a mut Vec<f64>,
+    force_slots: &'a mut Vec<f64>,
+}
+
+impl runtime::links::Cells for TapeCells<'_> {
+    fn one(&mut self, c: usize, q: &[f64], qd: &[f64], p: &[f64], out: &mut [f64]) {
+        let inp = runtime::Inputs {
+            t: 0.0,
+            q,
+            qd,
+            qdd: &[],
+            dir: &[],
+            p,
+        };
+        self.links.cells[c].eval(&inp, self.slots, out)
+    }
+    fn forces(&mut self, out: &mut [f64]) {
+        let forces = self.links.forces.as_ref().expect("a forces kernel");
+        forces.eval(&self.inp, self.force_slots, out)
+    }
+}
+
 #[test]
 fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
     let dir = std::env::temp_dir().join("softarm-test-cache");
@@ -344,28 +371,17 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
             // sums on every chain (for owned links a second strategy).
             for shared in [false, true] {
                 got.fill(f64::NAN);
-                let cell = |c: usize, q: &[f64], qd: &[f64], pl: &[f64], out: &mut [f64]| {
-                    let inp = runtime::Inputs {
-                        t: 0.0,
-                        q,
-                        qd,
-                        qdd: &[],
-                        dir: &[],
-                        p: pl,
-                    };
-                    links.cells[c].eval(&inp, &mut slots, out)
-                };
-                let forces = |out: &mut [f64]| {
-                    let forces = links.forces.as_ref().expect("a forces kernel");
-                    forces.eval(&inp, &mut force_slots, out)
+                let mut cells = TapeCells {
+                    links: &links,
+                    inp,
+                    slots: &mut slots,
+                    force_slots: &mut force_slots,
                 };
                 let layout = &links.layout;
                 if shared {
-                    runtime::links::mass_bias_shared_dyn(
-                        layout, cell, forces, &q, &qd, &p, &mut got,
-                    );
+                    runtime::links::mass_bias_shared_dyn(layout, &mut cells, &q, &qd, &p, &mut got);
                 } else {
-                    runtime::links::mass_bias(layout, cell, forces, &q, &qd, &p, &mut got);
+                    runtime::links::mass_bias(layout, &mut cells, &q, &qd, &p, &mut got);
                 }
                 for k in 0..len {
                     let floor = if k < m_len { m_scale } else { h_scale };

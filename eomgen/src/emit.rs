@@ -34,6 +34,8 @@ struct KernelEmitter<'a> {
     /// Workspace index of spilled slots.
     spill: Vec<Option<usize>>,
     n_spill: usize,
+    /// Four evaluations at once in `runtime::lanes::X4` (`emit_lanes`).
+    lanes: bool,
 }
 
 impl<'a> KernelEmitter<'a> {
@@ -78,6 +80,15 @@ impl<'a> KernelEmitter<'a> {
             chunk_of,
             spill,
             n_spill,
+            lanes: false,
+        }
+    }
+
+    /// The emitter of `emit_lanes`.
+    fn new_lanes(tape: &'a Tape) -> Self {
+        Self {
+            lanes: true,
+            ..Self::new(tape)
         }
     }
 
@@ -87,6 +98,19 @@ impl<'a> KernelEmitter<'a> {
 
     /// How slot `s` is read from inside chunk `c`.
     fn read(&self, s: Slot, c: usize) -> TokenStream {
+        let leaf = self.read_scalar(s, c);
+        if self.lanes {
+            match self.tape.ops[s as usize] {
+                Op::Const(_) | Op::Time => quote!(_mm256_set1_pd(#leaf)),
+                op if op.is_leaf() => quote!(runtime::lanes::from_array(#leaf)),
+                _ => leaf,
+            }
+        } else {
+            leaf
+        }
+    }
+
+    fn read_scalar(&self, s: Slot, c: usize) -> TokenStream {
         let i = s as usize;
         match self.tape.ops[i] {
             Op::Const(v) => lit(v),
@@ -125,6 +149,43 @@ impl<'a> KernelEmitter<'a> {
 
     fn expr(&self, op: &Op, c: usize) -> TokenStream {
         let r = |s: Slot| self.read(s, c);
+        if self.lanes {
+            // One instruction per operation, each lane the scalar one.
+            match *op {
+                Op::Add(a, b) => return self.intrinsic(quote!(_mm256_add_pd), &[r(a), r(b)]),
+                Op::Sub(a, b) => return self.intrinsic(quote!(_mm256_sub_pd), &[r(a), r(b)]),
+                Op::Mul(a, b) => return self.intrinsic(quote!(_mm256_mul_pd), &[r(a), r(b)]),
+                Op::Div(a, b) => return self.intrinsic(quote!(_mm256_div_pd), &[r(a), r(b)]),
+                Op::MulAdd(a, b, c) => {
+                    return self.intrinsic(quote!(_mm256_fmadd_pd), &[r(a), r(b), r(c)]);
+                }
+                Op::MulSub(a, b, c) => {
+                    return self.intrinsic(quote!(_mm256_fmsub_pd), &[r(a), r(b), r(c)]);
+                }
+                Op::NegMulAdd(a, b, c) => {
+                    return self.intrinsic(quote!(_mm256_fnmadd_pd), &[r(a), r(b), r(c)]);
+                }
+                Op::Neg(a) => {
+                    return self.intrinsic(quote!(_mm256_xor_pd), &[r(a), quote!(_mm256_set1_pd(-0.0))]);
+                }
+                Op::Sqrt(a) => return self.intrinsic(quote!(_mm256_sqrt_pd), &[r(a)]),
+                Op::Abs(a) => {
+                    return self.intrinsic(quote!(_mm256_andnot_pd), &[quote!(_mm256_set1_pd(-0.0)), r(a)]);
+                }
+                Op::Powi(a, n) => {
+                    let a = r(a);
+                    return quote!(runtime::lanes::map(#a, |x| x.powi(#n)));
+                }
+                Op::Powf(a, b) => {
+                    let (a, b) = (r(a), r(b));
+                    return quote!(runtime::lanes::from_array({
+                        let (a, b) = (runtime::lanes::to_array(#a), runtime::lanes::to_array(#b));
+                        std::array::from_fn(|l| a[l].powf(b[l]))
+                    }));
+                }
+                _ => {}
+            }
+        }
         match *op {
             Op::Add(a, b) => {
                 let (a, b) = (r(a), r(b));
@@ -170,51 +231,56 @@ impl<'a> KernelEmitter<'a> {
                 let a = r(a);
                 quote!(#a.sqrt())
             }
-            Op::Sin(a) => {
-                let a = r(a);
-                quote!(runtime::special::sin(#a))
-            }
-            Op::Cos(a) => {
-                let a = r(a);
-                quote!(runtime::special::cos(#a))
-            }
-            Op::Tan(a) => {
-                let a = r(a);
-                quote!(#a.tan())
-            }
-            Op::Exp(a) => {
-                let a = r(a);
-                quote!(#a.exp())
-            }
-            Op::Ln(a) => {
-                let a = r(a);
-                quote!(#a.ln())
-            }
+            Op::Sin(a) => self.call1(r(a), quote!(runtime::special::sin)),
+            Op::Cos(a) => self.call1(r(a), quote!(runtime::special::cos)),
+            Op::Tan(a) => self.call1(r(a), quote!(f64::tan)),
+            Op::Exp(a) => self.call1(r(a), quote!(f64::exp)),
+            Op::Ln(a) => self.call1(r(a), quote!(f64::ln)),
             Op::Abs(a) => {
                 let a = r(a);
                 quote!(#a.abs())
             }
-            Op::Sign(a) => {
-                let a = r(a);
-                quote!(runtime::special::sign(#a))
-            }
-            Op::Sinc(k, a) => {
-                let a = r(a);
-                quote!(runtime::special::sinc(#k, #a))
-            }
-            Op::Cosc(k, a) => {
-                let a = r(a);
-                quote!(runtime::special::cosc(#k, #a))
-            }
-            Op::SincRem(k, a) => {
-                let a = r(a);
-                quote!(runtime::special::sinc_rem(#k, #a))
-            }
+            Op::Sign(a) => self.call1(r(a), quote!(runtime::special::sign)),
+            Op::Sinc(k, a) => self.call1(r(a), quote!(runtime::special::sinc, #k)),
+            Op::Cosc(k, a) => self.call1(r(a), quote!(runtime::special::cosc, #k)),
+            Op::SincRem(k, a) => self.call1(r(a), quote!(runtime::special::sinc_rem, #k)),
             Op::Rodrigues(j, n, a) => {
-                let a = r(a);
-                quote!(runtime::rodrigues::rodrigues(#j, #n, #a))
+                self.call1(r(a), quote!(runtime::rodrigues::rodrigues, #j, #n))
             }
             _ => unreachable!("leaves are read in place"),
+        }
+    }
+
+    fn intrinsic(&self, f: TokenStream, args: &[TokenStream]) -> TokenStream {
+        quote!(#f(#(#args),*))
+    }
+
+    /// `f(leading.., a)`, `f` and its leading constant arguments given as
+    /// `f, leading..`: lane by lane in lane kernels.
+    fn call1(&self, a: TokenStream, f_and_leading: TokenStream) -> TokenStream {
+        let mut parts = f_and_leading.into_iter().collect::<Vec<_>>();
+        let comma = parts
+            .iter()
+            .position(|t| matches!(t, proc_macro2::TokenTree::Punct(p) if p.as_char() == ','));
+        // "f, k": leading is ", k", and the arguments "k, a".
+        let leading: TokenStream = match comma {
+            Some(i) => parts.drain(i..).skip(1).collect(),
+            None => TokenStream::new(),
+        };
+        let f: TokenStream = parts.into_iter().collect();
+        let args = |x: TokenStream| {
+            if leading.is_empty() {
+                x
+            } else {
+                quote!(#leading, #x)
+            }
+        };
+        if self.lanes {
+            let args = args(quote!(x));
+            quote!(runtime::lanes::map(#a, |x| #f(#args)))
+        } else {
+            let args = args(a);
+            quote!(#f(#args))
         }
     }
 
@@ -254,13 +320,18 @@ impl<'a> KernelEmitter<'a> {
                             continue;
                         }
                         let a = self.read(a, c);
-                        body.push(family.call(members, a));
+                        body.push(family.call(members, a, self.lanes));
                         members.iter().map(|m| m.1).collect()
                     }
                     None => {
                         let v = format_ident!("v{}", i);
                         let e = self.expr(op, c);
-                        body.push(quote!(let #v: f64 = #e;));
+                        let ty = if self.lanes {
+                            quote!(__m256d)
+                        } else {
+                            quote!(f64)
+                        };
+                        body.push(quote!(let #v: #ty = #e;));
                         vec![i]
                     }
                 };
@@ -277,8 +348,36 @@ impl<'a> KernelEmitter<'a> {
                 let owner = self.chunk_of[s as usize].unwrap_or(n_chunks - 1);
                 if owner == c {
                     let val = self.read(s, c);
-                    body.push(quote!(out[#k] = #val;));
+                    body.push(if self.lanes {
+                        quote!(out[#k] = runtime::lanes::to_array(#val);)
+                    } else {
+                        quote!(out[#k] = #val;)
+                    });
                 }
+            }
+            if self.lanes {
+                assert!(n_chunks == 1 && n_spill == 0, "lane kernels are one chunk");
+                assert!(
+                    !self.tape.ops.iter().any(|op| matches!(op, Op::Time | Op::Qdd(_) | Op::Dir(_))),
+                    "lane kernels read q, qd and p"
+                );
+                let f = format_ident!("{}", name);
+                let doc = format!(
+                    " Kernel `{name}`: {} operations, four evaluations in vector lanes.",
+                    self.tape.op_count()
+                );
+                return quote! {
+                    #[doc = #doc]
+                    #[cfg(target_arch = "x86_64")]
+                    #[inline(never)]
+                    #[allow(unused_variables, unused_parens, clippy::all)]
+                    #[target_feature(enable = "avx,fma")]
+                    fn #f(q: &[[f64; 4]; #dof], qd: &[[f64; 4]; #dof], p: &[[f64; 4]; #n_params],
+                          out: &mut [[f64; 4]; #n_out]) {
+                        use std::arch::x86_64::*;
+                        #(#body)*
+                    }
+                };
             }
             let f = format_ident!("{}_{}", name, c);
             chunks.push(quote! {
@@ -343,7 +442,7 @@ fn emit_link_recursion(
     use runtime::links::CELL_PARAMS;
     let layout = &links.layout;
     let mut defs = Vec::new();
-    let mut arms = Vec::new();
+    let (mut ones, mut fours) = (Vec::new(), Vec::new());
     for (c, tape) in links.cells.iter().enumerate() {
         let n = layout
             .links
@@ -351,13 +450,22 @@ fn emit_link_recursion(
             .find(|l| l.cell == c)
             .map_or(0, |l| l.map.len());
         let name = format!("cell_{c}");
+        let name4 = format!("cell_{c}_x4");
         defs.push(KernelEmitter::new(tape).emit(&name, n, CELL_PARAMS));
-        let f = Ident::new(&name, Span::call_site());
+        defs.push(KernelEmitter::new_lanes(tape).emit(&name4, n, CELL_PARAMS));
+        let (f, f4) = (Ident::new(&name, Span::call_site()), Ident::new(&name4, Span::call_site()));
         let n2 = 2 * n;
-        arms.push(quote! {
-            #c => #f(0.0, q.try_into().expect("link coordinates"), qd.try_into().expect("link rates"),
+        ones.push(quote! {
+            #c => #f(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
                      &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
                      out.try_into().expect("cell outputs")),
+        });
+        fours.push(quote! {
+            // SAFETY: `mass_bias` has checked that the processor has FMA
+            // (and so AVX: `is_x86_feature_detected` reports FMA only
+            // where the system saves the AVX registers).
+            #c => unsafe { #f4(x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+                               p.try_into().expect("cell parameters"), out.try_into().expect("cell outputs")) },
         });
     }
     let n_dir = 2 * dof;
@@ -365,21 +473,49 @@ fn emit_link_recursion(
         Some(tape) => {
             defs.push(KernelEmitter::new(tape).emit("link_forces", dof, n_params));
             quote! {
-                |out: &mut [f64]| link_forces(0.0, q, qd, &[0.0; #dof], &[0.0; #n_dir], p,
-                                              out.try_into().expect("force outputs"))
+                link_forces(0.0, self.q, self.qd, &[0.0; #dof], &[0.0; #n_dir], self.p,
+                            out.try_into().expect("force outputs"))
             }
         }
-        None => quote!(|_: &mut [f64]| {}),
+        None => quote!(unreachable!("no non-local forces")),
     };
     // Chains of owned links sum by composite bodies; shared links (rom
     // slices) need the arm's coordinates in rows of a fixed length.
     let call = if runtime::links::all_owned(layout) {
-        quote!(runtime::links::mass_bias_owned(
-            &LINKS, cells, q, qd, p, out
-        ))
+        quote!(runtime::links::mass_bias_owned(&LINKS, &mut cells, q, qd, p, out))
     } else {
         let rows = runtime::links::padded(dof);
-        quote!(runtime::links::mass_bias_shared::<#rows, _, _>(&LINKS, cells, #forces, q, qd, p, out))
+        quote!(runtime::links::mass_bias_shared::<#rows, _>(&LINKS, &mut cells, q, qd, p, out))
+    };
+    let cells_impl = quote! {
+        /// The compiled cells and forces the link recursion evaluates.
+        struct LinkCells<'a> {
+            q: &'a [f64; #dof],
+            qd: &'a [f64; #dof],
+            p: &'a [f64; #n_params],
+        }
+        impl runtime::links::Cells for LinkCells<'_> {
+            #[inline(always)]
+            fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+                match c {
+                    #(#ones)*
+                    _ => unreachable!("cell index from the layout"),
+                }
+            }
+            #[cfg(target_arch = "x86_64")]
+            #[inline(always)]
+            fn four(&mut self, c: usize, x: &[[f64; 4]], xd: &[[f64; 4]], p: &[[f64; 4]], out: &mut [[f64; 4]]) {
+                match c {
+                    #(#fours)*
+                    _ => unreachable!("cell index from the layout"),
+                }
+            }
+            #[inline(always)]
+            #[allow(unused_variables)]
+            fn forces(&mut self, out: &mut [f64]) {
+                #forces
+            }
+        }
     };
     let json = serde_json::to_string(layout).expect("a link layout serialises");
     let doc = format!(
@@ -400,12 +536,10 @@ fn emit_link_recursion(
         }
         #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
         unsafe fn mass_bias_links(q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
-            let cells = |c: usize, q: &[f64], qd: &[f64], p: &[f64], out: &mut [f64]| match c {
-                #(#arms)*
-                _ => unreachable!("cell index from the layout"),
-            };
+            let mut cells = LinkCells { q, qd, p };
             #call
         }
+        #cells_impl
         #(#defs)*
     }
 }
@@ -445,7 +579,12 @@ fn family_of(op: &Op) -> Option<(Family, Member, Slot)> {
 
 impl Family {
     /// `let` binding the members (member, op index) from one call at `a`.
-    fn call(self, members: &[(Member, usize)], a: TokenStream) -> TokenStream {
+    fn call(self, members: &[(Member, usize)], a: TokenStream, lanes: bool) -> TokenStream {
+        let ty = if lanes {
+            quote!(__m256d)
+        } else {
+            quote!(f64)
+        };
         let n = members
             .iter()
             .map(|m| usize::from(m.0.1))
@@ -456,10 +595,15 @@ impl Family {
             let lets = members.iter().map(|&((j, k), i)| {
                 let (j, k) = (usize::from(j), usize::from(k));
                 let v = format_ident!("v{}", i);
-                quote!(let #v: f64 = c[#j][#k];)
+                quote!(let #v: #ty = c[#j][#k];)
             });
+            let family = if lanes {
+                quote!(runtime::lanes::family)
+            } else {
+                quote!(runtime::rodrigues::family)
+            };
             return quote! {
-                let c: [[f64; #n]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<#n>(#a);
+                let c: [[#ty; #n]; runtime::rodrigues::FAMILY_J] = #family::<#n>(#a);
                 #(#lets)*
             };
         }
@@ -473,6 +617,9 @@ impl Family {
             })
             .collect();
         let f = match self {
+            Family::SinCos if lanes => {
+                return quote!(let (#(#names),*): (#ty, #ty) = runtime::lanes::sin_cos(#a););
+            }
             Family::SinCos => {
                 return quote!(let (#(#names),*): (f64, f64) = runtime::special::sin_cos(#a););
             }
@@ -481,7 +628,11 @@ impl Family {
             Family::SincRem => quote!(sinc_rem_orders),
             Family::Rodrigues => unreachable!("handled above"),
         };
-        quote!(let [#(#names),*]: [f64; #n] = runtime::special::#f::<#n>(#a);)
+        if lanes {
+            quote!(let [#(#names),*]: [#ty; #n] = runtime::lanes::orders(#a, runtime::special::#f::<#n>);)
+        } else {
+            quote!(let [#(#names),*]: [f64; #n] = runtime::special::#f::<#n>(#a);)
+        }
     }
 }
 

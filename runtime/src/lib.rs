@@ -11,6 +11,7 @@
 // without nalgebra and the ODE crate.
 pub mod cpu;
 pub mod kernels;
+pub mod lanes;
 pub mod linalg;
 pub mod links;
 pub mod rodrigues;

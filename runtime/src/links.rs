@@ -127,6 +127,38 @@ pub struct LinkKernels {
     pub forces: Option<crate::Tape>,
 }
 
+/// What the recursion evaluates: the cells and the non-local forces.
+/// Generated code implements it over its compiled kernels (`four` in
+/// vector lanes); tests over the tapes.
+pub trait Cells {
+    /// Cell `c` of one link at its cell coordinates `x`, rates `xd` and
+    /// parameters `p` ([`CELL_PARAMS`]).
+    fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]);
+
+    /// Cell `c` of four links at once, lane l of every value link l's.
+    fn four(
+        &mut self,
+        c: usize,
+        x: &[[f64; 4]],
+        xd: &[[f64; 4]],
+        p: &[[f64; 4]],
+        out: &mut [[f64; 4]],
+    ) {
+        let lane = |v: &[[f64; 4]], l: usize| -> Vec<f64> { v.iter().map(|v| v[l]).collect() };
+        let mut o = vec![0.0; out.len()];
+        for l in 0..4 {
+            self.one(c, &lane(x, l), &lane(xd, l), &lane(p, l), &mut o);
+            for (out, v) in out.iter_mut().zip(&o) {
+                out[l] = *v;
+            }
+        }
+    }
+
+    /// The generalised forces no link has (`LinkLayout::forces`), over
+    /// the arm's coordinates.
+    fn forces(&mut self, out: &mut [f64]);
+}
+
 type V3 = [f64; 3];
 type M3 = [[f64; 3]; 3];
 
@@ -161,10 +193,6 @@ fn mat_vec(r: &M3, v: V3) -> V3 {
 #[inline(always)]
 fn mat_mat(a: &M3, b: &M3) -> M3 {
     std::array::from_fn(|i| std::array::from_fn(|j| dot(a[i], [b[0][j], b[1][j], b[2][j]])))
-}
-#[inline(always)]
-fn v3(x: &[f64], at: usize) -> V3 {
-    [x[at], x[at + 1], x[at + 2]]
 }
 #[inline(always)]
 fn pair(a: (V3, V3), b: (V3, V3)) -> f64 {
@@ -237,6 +265,8 @@ struct Link {
 
 /// Most coordinates a cell has (bend pair, twist, stretch).
 const MAX_LINK_DOF: usize = 4;
+/// Room for the outputs of any cell.
+const CELL_STRIDE: usize = cell::COLUMNS + 13 * MAX_LINK_DOF;
 
 type Twist = (V3, V3);
 
@@ -261,8 +291,14 @@ struct Scratch {
     /// the links past the one being summed.
     momentum: Vec<Twist>,
     forces: Vec<f64>,
+    /// Per link: cell coordinates, rates and parameters.
+    x: Vec<[f64; MAX_LINK_DOF]>,
+    xd: Vec<[f64; MAX_LINK_DOF]>,
+    params: Vec<[f64; CELL_PARAMS]>,
+    /// The cells' outputs, [`CELL_STRIDE`] a link, and those of a group
+    /// of four in lanes.
     cell_out: Vec<f64>,
-    cell_params: Vec<f64>,
+    lanes: Vec<[f64; 4]>,
 }
 
 thread_local! {
@@ -305,23 +341,82 @@ struct Tip {
     wrench: Twist,
 }
 
-/// The forward sweep: each link's cell under the world frame composed so
-/// far, its body's inertial and gravity forces, the twists of its cell
-/// coordinates; then the tip body and loads. `owned`: the cell
-/// coordinates are the arm's, `start[k]..` (see [`all_owned`]).
+/// Every link's cell, four links at once where four in a row share a
+/// cell (their cell coordinates depend on q, qd and p alone, so all are
+/// known before the sweep), into `s.outs` at `s.slot`.
 #[inline(always)]
-fn forward<F>(
+fn evaluate_cells<C: Cells>(
     layout: &LinkLayout,
-    cell: &mut F,
+    cells: &mut C,
     owned: bool,
     q: &[f64],
     qd: &[f64],
     p: &[f64],
     s: &mut Scratch,
-) -> Tip
-where
-    F: FnMut(usize, &[f64], &[f64], &[f64], &mut [f64]),
-{
+) {
+    let nl = layout.links.len();
+    s.x.resize(nl, [0.0; MAX_LINK_DOF]);
+    s.xd.resize(nl, [0.0; MAX_LINK_DOF]);
+    s.params.resize(nl, [0.0; CELL_PARAMS]);
+    for (k, spec) in layout.links.iter().enumerate() {
+        let nc = spec.map.len();
+        let at = s.start[k];
+        if owned {
+            s.x[k][..nc].copy_from_slice(&q[at..at + nc]);
+            s.xd[k][..nc].copy_from_slice(&qd[at..at + nc]);
+        } else {
+            for (f, c) in spec.map.iter().enumerate() {
+                (s.x[k][f], s.xd[k][f]) = local(c, q, qd, p);
+            }
+        }
+        for (v, &i) in s.params[k].iter_mut().zip(&spec.params) {
+            *v = p[i];
+        }
+    }
+    s.cell_out.resize(nl * CELL_STRIDE, 0.0);
+    s.lanes.resize(CELL_STRIDE, [0.0; 4]);
+    let mut k = 0;
+    while k < nl {
+        let (c, nc) = (layout.links[k].cell, layout.links[k].map.len());
+        let len = cell::len(nc);
+        if k + 4 <= nl && layout.links[k..k + 4].iter().all(|l| l.cell == c) {
+            let x: [[f64; 4]; MAX_LINK_DOF] =
+                std::array::from_fn(|f| std::array::from_fn(|l| s.x[k + l][f]));
+            let xd: [[f64; 4]; MAX_LINK_DOF] =
+                std::array::from_fn(|f| std::array::from_fn(|l| s.xd[k + l][f]));
+            let pl: [[f64; 4]; CELL_PARAMS] =
+                std::array::from_fn(|i| std::array::from_fn(|l| s.params[k + l][i]));
+            let lanes = &mut s.lanes[..len];
+            cells.four(c, &x[..nc], &xd[..nc], &pl, lanes);
+            let group = &mut s.cell_out[k * CELL_STRIDE..(k + 4) * CELL_STRIDE];
+            for (l, out) in group.chunks_exact_mut(CELL_STRIDE).enumerate() {
+                for (o, v) in out.iter_mut().zip(lanes.iter()) {
+                    *o = v[l];
+                }
+            }
+            k += 4;
+        } else {
+            let out = &mut s.cell_out[k * CELL_STRIDE..][..len];
+            cells.one(c, &s.x[k][..nc], &s.xd[k][..nc], &s.params[k], out);
+            k += 1;
+        }
+    }
+}
+
+/// The forward sweep: each link's cell under the world frame composed so
+/// far, its body's inertial and gravity forces, the twists of its cell
+/// coordinates; then the tip body and loads. `owned`: the cell
+/// coordinates are the arm's, `start[k]..` (see [`all_owned`]).
+#[inline(always)]
+fn forward<C: Cells>(
+    layout: &LinkLayout,
+    cells: &mut C,
+    owned: bool,
+    q: &[f64],
+    qd: &[f64],
+    p: &[f64],
+    s: &mut Scratch,
+) -> Tip {
     let nl = layout.links.len();
     s.links.resize(nl, Link::default());
     s.start.clear();
@@ -334,34 +429,23 @@ where
         v.resize(total, ([0.0; 3], [0.0; 3]));
     }
     s.local_force.resize(total, 0.0);
-    s.cell_out.resize(cell::len(MAX_LINK_DOF), 0.0);
-    s.cell_params.resize(CELL_PARAMS, 0.0);
+    evaluate_cells(layout, cells, owned, q, qd, p, s);
 
     let gravity = layout.gravity.map(|i| p[i]);
     let mut r: M3 =
         std::array::from_fn(|i| std::array::from_fn(|j| p[layout.base_rotation[3 * i + j]]));
     let mut pos = layout.base_position.map(|i| p[i]);
     let (mut omega, mut alpha, mut acc) = ([0.0; 3], [0.0; 3], [0.0; 3]);
-    let (mut x, mut xd) = ([0.0; MAX_LINK_DOF], [0.0; MAX_LINK_DOF]);
     for (k, spec) in layout.links.iter().enumerate() {
         let nc = spec.map.len();
         let at = s.start[k];
-        let (x, xd) = if owned {
-            (&q[at..at + nc], &qd[at..at + nc])
-        } else {
-            for (f, c) in spec.map.iter().enumerate() {
-                (x[f], xd[f]) = local(c, q, qd, p);
-            }
-            (&x[..nc], &xd[..nc])
-        };
-        for (v, &i) in s.cell_params.iter_mut().zip(&spec.params) {
-            *v = p[i];
-        }
-        let c = &mut s.cell_out[..cell::len(nc)];
-        cell(spec.cell, x, xd, &s.cell_params, c);
-        let c = &*c;
-        let rel: M3 = std::array::from_fn(|i| v3(c, cell::ROTATION + 3 * i));
-        let turn = |at: usize| mat_vec(&r, v3(c, at));
+        let out: &[f64; CELL_STRIDE] = s.cell_out[k * CELL_STRIDE..][..CELL_STRIDE]
+            .try_into()
+            .expect("a cell's outputs");
+        let c = |i: usize| out[i];
+        let v3 = |i: usize| [c(i), c(i + 1), c(i + 2)];
+        let rel: M3 = std::array::from_fn(|i| v3(cell::ROTATION + 3 * i));
+        let turn = |at: usize| mat_vec(&r, v3(at));
         let (d, dd, ddd) = (turn(cell::END), turn(cell::END_RATE), turn(cell::END_ACCEL));
         let (cen, cend, cendd) = (
             turn(cell::CENTROID),
@@ -371,7 +455,7 @@ where
         let (w_rel, w_rel_d) = (turn(cell::OMEGA), turn(cell::OMEGA_RATE));
         let (w_b, w_b_d) = (turn(cell::BODY_OMEGA), turn(cell::BODY_OMEGA_RATE));
         let axis = turn(cell::AXIS);
-        let (m, lateral, axial) = (c[cell::MASS], c[cell::LATERAL], c[cell::AXIAL]);
+        let (m, lateral, axial) = (c(cell::MASS), c(cell::LATERAL), c(cell::AXIAL));
 
         // The body: centroid, convective accelerations, inertial and
         // gravity forces.
@@ -402,7 +486,7 @@ where
             let v_end = turn(col + 3);
             s.twist[at + f] = (s_w, sub(v_end, cross(s_w, end)));
             s.own[at + f] = (turn(col + 6), turn(col + 9));
-            s.local_force[at + f] = c[force_at + f];
+            s.local_force[at + f] = c(force_at + f);
         }
 
         // The next frame.
@@ -523,22 +607,20 @@ fn take_scratch(layout: &LinkLayout, out: &[f64]) -> Scratch {
 /// and rates and its parameters ([`CELL_PARAMS`]).
 /// Inlined into its caller, which the generated code builds for FMA.
 #[inline(always)]
-pub fn mass_bias_owned<F>(
+pub fn mass_bias_owned<C: Cells>(
     layout: &LinkLayout,
-    mut cell: F,
+    cells: &mut C,
     q: &[f64],
     qd: &[f64],
     p: &[f64],
     out: &mut [f64],
-) where
-    F: FnMut(usize, &[f64], &[f64], &[f64], &mut [f64]),
-{
+) {
     debug_assert!(all_owned(layout));
     let n = layout.dof;
     let mut scratch = take_scratch(layout, out);
     {
         let s = &mut scratch;
-        let mut tip = forward(layout, &mut cell, true, q, qd, p, s);
+        let mut tip = forward(layout, cells, true, q, qd, p, s);
         s.momentum.resize(n, ([0.0; 3], [0.0; 3]));
         let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
         let index = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
@@ -584,24 +666,20 @@ pub fn mass_bias_owned<F>(
 /// costs O(cell coordinates x arm coordinates), not a Jacobian product
 /// over all pairs of the arm's coordinates.
 #[inline(always)]
-pub fn mass_bias_shared<const N: usize, F, G>(
+pub fn mass_bias_shared<const N: usize, C: Cells>(
     layout: &LinkLayout,
-    mut cell: F,
-    mut forces: G,
+    cells: &mut C,
     q: &[f64],
     qd: &[f64],
     p: &[f64],
     out: &mut [f64],
-) where
-    F: FnMut(usize, &[f64], &[f64], &[f64], &mut [f64]),
-    G: FnMut(&mut [f64]),
-{
+) {
     let n = layout.dof;
     assert!(n <= N, "{n} coordinates in rows of {N}");
     let mut scratch = take_scratch(layout, out);
     {
         let s = &mut scratch;
-        let mut tip = forward(layout, &mut cell, false, q, qd, p, s);
+        let mut tip = forward(layout, cells, false, q, qd, p, s);
         let simd = rows::simd_available();
         let mut reach = [[0.0; N]; 6];
         let mut x = [[0.0; N]; N];
@@ -651,7 +729,7 @@ pub fn mass_bias_shared<const N: usize, F, G>(
         bias.copy_from_slice(&h[..n]);
         if layout.forces {
             s.forces.resize(n, 0.0);
-            forces(&mut s.forces);
+            cells.forces(&mut s.forces);
             for (h, f) in bias.iter_mut().zip(&s.forces) {
                 *h += f;
             }
@@ -668,22 +746,18 @@ pub fn padded(dof: usize) -> usize {
 
 /// The link recursion for any layout, choosing as the generated code does
 /// ([`all_owned`], [`padded`]); for tests and tools, not built for FMA.
-pub fn mass_bias<F, G>(
+pub fn mass_bias<C: Cells>(
     layout: &LinkLayout,
-    cell: F,
-    forces: G,
+    cells: &mut C,
     q: &[f64],
     qd: &[f64],
     p: &[f64],
     out: &mut [f64],
-) where
-    F: FnMut(usize, &[f64], &[f64], &[f64], &mut [f64]),
-    G: FnMut(&mut [f64]),
-{
+) {
     if all_owned(layout) {
-        mass_bias_owned(layout, cell, q, qd, p, out)
+        mass_bias_owned(layout, cells, q, qd, p, out)
     } else {
-        mass_bias_shared_dyn(layout, cell, forces, q, qd, p, out)
+        mass_bias_shared_dyn(layout, cells, q, qd, p, out)
     }
 }
 
@@ -693,22 +767,18 @@ pub const MAX_SHARED_DOF: usize = 64;
 
 /// [`mass_bias_shared`] with `N` picked at run time ([`padded`]); for any
 /// chain, owned links included (tests check the two strategies agree).
-pub fn mass_bias_shared_dyn<F, G>(
+pub fn mass_bias_shared_dyn<C: Cells>(
     layout: &LinkLayout,
-    cell: F,
-    forces: G,
+    cells: &mut C,
     q: &[f64],
     qd: &[f64],
     p: &[f64],
     out: &mut [f64],
-) where
-    F: FnMut(usize, &[f64], &[f64], &[f64], &mut [f64]),
-    G: FnMut(&mut [f64]),
-{
+) {
     macro_rules! pick {
         ($($n:literal)*) => {
             match padded(layout.dof) {
-                $($n => mass_bias_shared::<$n, F, G>(layout, cell, forces, q, qd, p, out),)*
+                $($n => mass_bias_shared::<$n, C>(layout, cells, q, qd, p, out),)*
                 w => panic!("shared sums stop at {MAX_SHARED_DOF} coordinates, not {w}"),
             }
         };

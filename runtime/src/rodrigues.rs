@@ -350,3 +350,63 @@ mod tests {
         }
     }
 }
+
+/// [`family`] of four arguments in the lanes of a vector, with the bits
+/// of four scalar calls: the same sums in the same order (the scalar code
+/// does not fuse them either), lane by lane where the lanes would take
+/// different branches.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,fma")]
+#[inline]
+pub fn family_x4<const N: usize>(
+    w: std::arch::x86_64::__m256d,
+) -> [[std::arch::x86_64::__m256d; N]; FAMILY_J] {
+    use crate::lanes::{from_array, to_array};
+    use std::arch::x86_64::*;
+    const { assert!(N <= FAMILY_ORDERS) };
+    let lanes = to_array(w);
+    let below = |limit: f64| lanes.iter().all(|x| x.abs() < limit);
+    let tops: [[__m256d; N]; 2] = if below(1.0) {
+        tops_x4::<N, 8>(w)
+    } else if below(SERIES_BELOW) && lanes.iter().all(|x| x.abs() >= 1.0) {
+        tops_x4::<N, 12>(w)
+    } else {
+        let v = lanes.map(family::<N>);
+        return std::array::from_fn(|j| {
+            std::array::from_fn(|n| from_array(std::array::from_fn(|l| v[l][j][n])))
+        });
+    };
+    let mut c = [[_mm256_setzero_pd(); N]; FAMILY_J];
+    c[FAMILY_J - 2] = tops[0];
+    c[FAMILY_J - 1] = tops[1];
+    for j in (0..FAMILY_J - 2).rev() {
+        for n in 0..N {
+            let wc = _mm256_mul_pd(w, c[j + 2][n]);
+            c[j][n] = if n == 0 {
+                _mm256_sub_pd(_mm256_set1_pd(INV_FACTORIAL[j]), wc)
+            } else {
+                let neg = _mm256_xor_pd(wc, _mm256_set1_pd(-0.0));
+                _mm256_sub_pd(neg, _mm256_mul_pd(_mm256_set1_pd(n as f64), c[j + 2][n - 1]))
+            };
+        }
+    }
+    c
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,fma")]
+#[inline]
+fn tops_x4<const N: usize, const T: usize>(
+    w: std::arch::x86_64::__m256d,
+) -> [[std::arch::x86_64::__m256d; N]; 2] {
+    use std::arch::x86_64::*;
+    let mut s = [[_mm256_setzero_pd(); N]; 2];
+    for k in (0..T).rev() {
+        for t in 0..2 {
+            for n in 0..N {
+                s[t][n] = _mm256_add_pd(_mm256_mul_pd(s[t][n], w), _mm256_set1_pd(TOPS[t][n][k]));
+            }
+        }
+    }
+    s
+}
