@@ -116,6 +116,30 @@ pub struct LinkLayout {
     pub tip_mass: Option<usize>,
     pub tip_length: Option<usize>,
     pub tip_inertia: Option<[usize; 2]>,
+    /// [`LinkLayout::weights`], computed on first use.
+    #[serde(skip)]
+    pub weights: std::sync::OnceLock<Vec<f64>>,
+}
+
+impl LinkLayout {
+    /// The weights of every link's cell coordinates, dense: for link k
+    /// and cell coordinate f < [`MAX_LINK_DOF`], a row of the arm's
+    /// coordinates padded to [`padded`]`(dof)` (zeros for unused f), at
+    /// `(k * MAX_LINK_DOF + f) * padded(dof)`; without `scale`.
+    pub fn weights(&self) -> &[f64] {
+        self.weights.get_or_init(|| {
+            let n = padded(self.dof);
+            let mut w = vec![0.0; self.links.len() * MAX_LINK_DOF * n];
+            for (k, spec) in self.links.iter().enumerate() {
+                for (f, c) in spec.map.iter().enumerate() {
+                    for &(a, wa) in &c.terms {
+                        w[(k * MAX_LINK_DOF + f) * n + a] += wa;
+                    }
+                }
+            }
+            w
+        })
+    }
 }
 
 /// The link recursion of a model: its layout, the cells, and the kernel of
@@ -264,7 +288,7 @@ struct Link {
 }
 
 /// Most coordinates a cell has (bend pair, twist, stretch).
-const MAX_LINK_DOF: usize = 4;
+pub const MAX_LINK_DOF: usize = 4;
 /// Room for the outputs of any cell.
 const CELL_STRIDE: usize = cell::COLUMNS + 13 * MAX_LINK_DOF;
 
@@ -295,10 +319,11 @@ struct Scratch {
     x: Vec<[f64; MAX_LINK_DOF]>,
     xd: Vec<[f64; MAX_LINK_DOF]>,
     params: Vec<[f64; CELL_PARAMS]>,
-    /// The cells' outputs, [`CELL_STRIDE`] a link, and those of a group
-    /// of four in lanes.
-    cell_out: Vec<f64>,
-    lanes: Vec<[f64; 4]>,
+    /// The cells' outputs in lanes, [`CELL_STRIDE`] vectors a link or a
+    /// group of four, and where link k's are (`slot[k]`: start, lane).
+    cell_out: Vec<[f64; 4]>,
+    slot: Vec<(usize, usize)>,
+    one_out: Vec<f64>,
 }
 
 thread_local! {
@@ -373,12 +398,18 @@ fn evaluate_cells<C: Cells>(
             *v = p[i];
         }
     }
-    s.cell_out.resize(nl * CELL_STRIDE, 0.0);
-    s.lanes.resize(CELL_STRIDE, [0.0; 4]);
+    // Link k's outputs: lane `slot[k].1` of the CELL_STRIDE vectors from
+    // `slot[k].0`, four links sharing them where evaluated together.
+    s.slot.resize(nl, (0, 0));
+    let mut used = 0;
     let mut k = 0;
     while k < nl {
         let (c, nc) = (layout.links[k].cell, layout.links[k].map.len());
         let len = cell::len(nc);
+        if s.cell_out.len() < used + CELL_STRIDE {
+            s.cell_out.resize(used + CELL_STRIDE, [0.0; 4]);
+        }
+        let out = &mut s.cell_out[used..used + len];
         if k + 4 <= nl && layout.links[k..k + 4].iter().all(|l| l.cell == c) {
             let x: [[f64; 4]; MAX_LINK_DOF] =
                 std::array::from_fn(|f| std::array::from_fn(|l| s.x[k + l][f]));
@@ -386,20 +417,21 @@ fn evaluate_cells<C: Cells>(
                 std::array::from_fn(|f| std::array::from_fn(|l| s.xd[k + l][f]));
             let pl: [[f64; 4]; CELL_PARAMS] =
                 std::array::from_fn(|i| std::array::from_fn(|l| s.params[k + l][i]));
-            let lanes = &mut s.lanes[..len];
-            cells.four(c, &x[..nc], &xd[..nc], &pl, lanes);
-            let group = &mut s.cell_out[k * CELL_STRIDE..(k + 4) * CELL_STRIDE];
-            for (l, out) in group.chunks_exact_mut(CELL_STRIDE).enumerate() {
-                for (o, v) in out.iter_mut().zip(lanes.iter()) {
-                    *o = v[l];
-                }
+            cells.four(c, &x[..nc], &xd[..nc], &pl, out);
+            for l in 0..4 {
+                s.slot[k + l] = (used, l);
             }
             k += 4;
         } else {
-            let out = &mut s.cell_out[k * CELL_STRIDE..][..len];
-            cells.one(c, &s.x[k][..nc], &s.xd[k][..nc], &s.params[k], out);
+            s.one_out.resize(len, 0.0);
+            cells.one(c, &s.x[k][..nc], &s.xd[k][..nc], &s.params[k], &mut s.one_out);
+            for (o, v) in out.iter_mut().zip(&s.one_out) {
+                o[0] = *v;
+            }
+            s.slot[k] = (used, 0);
             k += 1;
         }
+        used += CELL_STRIDE;
     }
 }
 
@@ -439,10 +471,12 @@ fn forward<C: Cells>(
     for (k, spec) in layout.links.iter().enumerate() {
         let nc = spec.map.len();
         let at = s.start[k];
-        let out: &[f64; CELL_STRIDE] = s.cell_out[k * CELL_STRIDE..][..CELL_STRIDE]
+        let (base, lane) = s.slot[k];
+        let out: &[[f64; 4]; CELL_STRIDE] = s.cell_out[base..base + CELL_STRIDE]
             .try_into()
             .expect("a cell's outputs");
-        let c = |i: usize| out[i];
+        let lane = lane & 3;
+        let c = |i: usize| out[i][lane];
         let v3 = |i: usize| [c(i), c(i + 1), c(i + 2)];
         let rel: M3 = std::array::from_fn(|i| v3(cell::ROTATION + 3 * i));
         let turn = |at: usize| mat_vec(&r, v3(at));
@@ -556,15 +590,19 @@ fn link_sums(
     let mut momentum = [([0.0; 3], [0.0; 3]); MAX_LINK_DOF];
     let mut block = [[0.0; MAX_LINK_DOF]; MAX_LINK_DOF];
     let mut g = [0.0; MAX_LINK_DOF];
+    // The momentum each coordinate's own velocity gives the body, about
+    // its centroid: (I w, m v).
+    let mut body = [([0.0; 3], [0.0; 3]); MAX_LINK_DOF];
     for f in 0..nc {
         let (ow, ov) = s.own[at + f];
-        let mv = scale(l.m, ov);
+        body[f] = (apply_body(l.lateral, l.axial, l.axis, ow), scale(l.m, ov));
+    }
+    for f in 0..nc {
+        let (ow, ov) = s.own[at + f];
+        let (iw, mv) = body[f];
         let composite = tip.past.momentum(s.twist[at + f]);
         momentum[f] = (
-            add(
-                add(composite.0, apply_body(l.lateral, l.axial, l.axis, ow)),
-                cross(l.centroid, mv),
-            ),
+            add(add(composite.0, iw), cross(l.centroid, mv)),
             add(composite.1, mv),
         );
         g[f] = pair(s.twist[at + f], tip.wrench)
@@ -573,10 +611,7 @@ fn link_sums(
             + s.local_force[at + f];
         #[allow(clippy::needless_range_loop)] // fills both halves
         for f2 in f..nc {
-            let (wj, vj) = s.own[at + f2];
-            block[f][f2] = pair(s.twist[at + f2], composite)
-                + l.m * dot(ov, vj)
-                + dot(ow, apply_body(l.lateral, l.axial, l.axis, wj));
+            block[f][f2] = pair(s.twist[at + f2], composite) + pair(s.own[at + f2], body[f]);
             block[f2][f] = block[f][f2];
         }
     }
@@ -675,7 +710,7 @@ pub fn mass_bias_shared<const N: usize, C: Cells>(
     out: &mut [f64],
 ) {
     let n = layout.dof;
-    assert!(n <= N, "{n} coordinates in rows of {N}");
+    assert_eq!(N, padded(n), "rows of padded(dof)");
     let mut scratch = take_scratch(layout, out);
     {
         let s = &mut scratch;
@@ -684,36 +719,39 @@ pub fn mass_bias_shared<const N: usize, C: Cells>(
         let mut reach = [[0.0; N]; 6];
         let mut x = [[0.0; N]; N];
         let mut h = [0.0; N];
+        let weights = layout.weights();
         for (k, spec) in layout.links.iter().enumerate().rev() {
             let nc = spec.map.len();
-            let mut w = [[0.0; N]; MAX_LINK_DOF];
-            for (f, c) in spec.map.iter().enumerate() {
-                let sc = c.scale.map_or(1.0, |i| p[i]);
-                for &(a, wa) in &c.terms {
-                    w[f][a] = wa * sc;
-                }
-            }
-            let w_rows: [&[f64; N]; MAX_LINK_DOF] = std::array::from_fn(|f| &w[f]);
+            let w: [&[f64; N]; MAX_LINK_DOF] = std::array::from_fn(|f| {
+                let at = (k * MAX_LINK_DOF + f) * N;
+                weights[at..at + N].try_into().expect("rows of N")
+            });
+            // A cell coordinate's scale goes into every coefficient of its
+            // weights.
+            let sc: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| {
+                spec.map.get(f).and_then(|c| c.scale).map_or(1.0, |i| p[i])
+            });
             let (momentum, block, g) = link_sums(s, k, nc, &mut tip);
             // Unused cell coordinates have zero blocks, forces and momenta.
-            rows::add_combination(simd, &mut h, &g, w_rows);
+            let gs: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| g[f] * sc[f]);
+            rows::add_combination(simd, &mut h, &gs, w);
             for f in 0..nc {
                 let t = flat(s.twist[s.start[k] + f]);
                 let mut row = [0.0; N];
                 rows::add_combination(simd, &mut row, &t, std::array::from_fn(|k| &reach[k]));
-                let half = block[f].map(|b| 0.5 * b);
-                rows::add_combination(simd, &mut row, &half, w_rows);
+                let half: [f64; MAX_LINK_DOF] = std::array::from_fn(|f2| 0.5 * block[f][f2] * sc[f2]);
+                rows::add_combination(simd, &mut row, &half, w);
                 // Terms name distinct coordinates (eomgen's maps).
                 for &(a, _) in &spec.map[f].terms {
-                    rows::add_combination(simd, &mut x[a], &[w[f][a]], [&row]);
+                    rows::add_combination(simd, &mut x[a], &[w[f][a] * sc[f]], [&row]);
                 }
             }
             let m: [[f64; 6]; MAX_LINK_DOF] = momentum.map(flat);
             for (kk, rk) in reach.iter_mut().enumerate() {
-                let mk: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| m[f][kk]);
+                let mk: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| m[f][kk] * sc[f]);
                 match nc {
-                    3 => rows::add_combination(simd, rk, &[mk[0], mk[1], mk[2]], [&w[0], &w[1], &w[2]]),
-                    _ => rows::add_combination(simd, rk, &mk, w_rows),
+                    3 => rows::add_combination(simd, rk, &[mk[0], mk[1], mk[2]], [w[0], w[1], w[2]]),
+                    _ => rows::add_combination(simd, rk, &mk, w),
                 }
             }
         }

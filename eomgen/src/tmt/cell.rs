@@ -140,6 +140,7 @@ pub fn link_chain(model: &Model) -> Option<LinkKernels> {
         tip_length: st.tip_length.then(|| index("tip.length")),
         tip_inertia: (st.tip_mass && st.tip_length)
             .then(|| [index("tip.inertia"), index("tip.axial_inertia")]),
+        weights: Default::default(),
     };
     // The shared sums hold the arm's coordinates in fixed rows.
     if !roms.is_empty() && first > runtime::links::MAX_SHARED_DOF {
