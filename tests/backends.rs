@@ -222,11 +222,6 @@ fn generated_mass_solve_matches_a_dense_solve() {
     }
 }
 
-/// The link recursion (runtime/src/links.rs) with its cells interpreted
-/// against the flat `MassBias` tape of the TMT sums, for every link shape
-/// and tip it covers: twist, stretch, thinning, vc modules, rom slices, a
-/// tip point mass, a tip cylinder, loads in the tip frame, a turned base.
-
 /// The link recursion's cells and forces evaluated from their tapes.
 struct TapeCells<'a> {
     links: &'a runtime::links::LinkKernels,
@@ -253,6 +248,11 @@ impl runtime::links::Cells for TapeCells<'_> {
     }
 }
 
+/// The link recursion (runtime/src/links.rs) with its cells interpreted
+/// against the flat `MassBias` tape of the TMT sums, for every link shape
+/// and tip it covers: twist, stretch, thinning, vc modules, rom slices, a
+/// tip point mass, a tip cylinder, loads in the tip frame, a turned base;
+/// by both strategies (composite rows for owned links, shared sums).
 #[test]
 fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
     let dir = std::env::temp_dir().join("softarm-test-cache");

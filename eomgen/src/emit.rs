@@ -166,11 +166,15 @@ impl<'a> KernelEmitter<'a> {
                     return self.intrinsic(quote!(_mm256_fnmadd_pd), &[r(a), r(b), r(c)]);
                 }
                 Op::Neg(a) => {
-                    return self.intrinsic(quote!(_mm256_xor_pd), &[r(a), quote!(_mm256_set1_pd(-0.0))]);
+                    return self
+                        .intrinsic(quote!(_mm256_xor_pd), &[r(a), quote!(_mm256_set1_pd(-0.0))]);
                 }
                 Op::Sqrt(a) => return self.intrinsic(quote!(_mm256_sqrt_pd), &[r(a)]),
                 Op::Abs(a) => {
-                    return self.intrinsic(quote!(_mm256_andnot_pd), &[quote!(_mm256_set1_pd(-0.0)), r(a)]);
+                    return self.intrinsic(
+                        quote!(_mm256_andnot_pd),
+                        &[quote!(_mm256_set1_pd(-0.0)), r(a)],
+                    );
                 }
                 Op::Powi(a, n) => {
                     let a = r(a);
@@ -358,7 +362,11 @@ impl<'a> KernelEmitter<'a> {
             if self.lanes {
                 assert!(n_chunks == 1 && n_spill == 0, "lane kernels are one chunk");
                 assert!(
-                    !self.tape.ops.iter().any(|op| matches!(op, Op::Time | Op::Qdd(_) | Op::Dir(_))),
+                    !self
+                        .tape
+                        .ops
+                        .iter()
+                        .any(|op| matches!(op, Op::Time | Op::Qdd(_) | Op::Dir(_))),
                     "lane kernels read q, qd and p"
                 );
                 let f = format_ident!("{}", name);
@@ -453,7 +461,10 @@ fn emit_link_recursion(
         let name4 = format!("cell_{c}_x4");
         defs.push(KernelEmitter::new(tape).emit(&name, n, CELL_PARAMS));
         defs.push(KernelEmitter::new_lanes(tape).emit(&name4, n, CELL_PARAMS));
-        let (f, f4) = (Ident::new(&name, Span::call_site()), Ident::new(&name4, Span::call_site()));
+        let (f, f4) = (
+            Ident::new(&name, Span::call_site()),
+            Ident::new(&name4, Span::call_site()),
+        );
         let n2 = 2 * n;
         ones.push(quote! {
             #c => #f(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
@@ -482,13 +493,16 @@ fn emit_link_recursion(
     // Chains of owned links sum by composite bodies; shared links (rom
     // slices) need the arm's coordinates in rows of a fixed length.
     let call = if runtime::links::all_owned(layout) {
-        quote!(runtime::links::mass_bias_owned(&LINKS, &mut cells, q, qd, p, out))
+        quote!(runtime::links::mass_bias_owned(
+            &LINKS, &mut cells, q, qd, p, out
+        ))
     } else {
         let rows = runtime::links::padded(dof);
         quote!(runtime::links::mass_bias_shared::<#rows, _>(&LINKS, &mut cells, q, qd, p, out))
     };
     let cells_impl = quote! {
         /// The compiled cells and forces the link recursion evaluates.
+        #[allow(dead_code)] // the arm's coordinates serve the forces kernel alone
         struct LinkCells<'a> {
             q: &'a [f64; #dof],
             qd: &'a [f64; #dof],
@@ -580,11 +594,7 @@ fn family_of(op: &Op) -> Option<(Family, Member, Slot)> {
 impl Family {
     /// `let` binding the members (member, op index) from one call at `a`.
     fn call(self, members: &[(Member, usize)], a: TokenStream, lanes: bool) -> TokenStream {
-        let ty = if lanes {
-            quote!(__m256d)
-        } else {
-            quote!(f64)
-        };
+        let ty = if lanes { quote!(__m256d) } else { quote!(f64) };
         let n = members
             .iter()
             .map(|m| usize::from(m.0.1))

@@ -46,6 +46,10 @@ pub fn sin_cos(x: __m256d) -> (__m256d, __m256d) {
 }
 
 /// `rodrigues::family` of the four lanes (`rodrigues::family_x4`).
+///
+/// # Safety
+/// The processor must have AVX and FMA (code built with both calls it
+/// without `unsafe`).
 #[target_feature(enable = "avx,fma")]
 #[inline]
 pub fn family<const N: usize>(w: __m256d) -> [[__m256d; N]; crate::rodrigues::FAMILY_J] {

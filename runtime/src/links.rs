@@ -330,21 +330,6 @@ thread_local! {
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
 }
 
-/// The value and rate of cell coordinate `c`: its combinations of the
-/// coordinates and rates.
-#[inline(always)]
-fn local(c: &LocalCoordinate, q: &[f64], qd: &[f64], p: &[f64]) -> (f64, f64) {
-    let (mut x, mut xd) = (0.0, 0.0);
-    for &(a, w) in &c.terms {
-        x = w.mul_add(q[a], x);
-        xd = w.mul_add(qd[a], xd);
-    }
-    match c.scale {
-        Some(i) => (x * p[i], xd * p[i]),
-        None => (x, xd),
-    }
-}
-
 /// Whether every link's cell coordinates are the arm's own, in order
 /// (pcc, vc): then M and h come by composite bodies, [`mass_bias_owned`].
 pub fn all_owned(layout: &LinkLayout) -> bool {
@@ -366,34 +351,14 @@ struct Tip {
     wrench: Twist,
 }
 
-/// Every link's cell, four links at once where four in a row share a
-/// cell (their cell coordinates depend on q, qd and p alone, so all are
-/// known before the sweep), into `s.outs` at `s.slot`.
+/// Every link's cell at its cell coordinates and rates (`s.x`, `s.xd`),
+/// four links at once where four in a row share a cell (cell coordinates
+/// depend on q, qd and p alone, so all are known before the sweep).
 #[inline(always)]
-fn evaluate_cells<C: Cells>(
-    layout: &LinkLayout,
-    cells: &mut C,
-    owned: bool,
-    q: &[f64],
-    qd: &[f64],
-    p: &[f64],
-    s: &mut Scratch,
-) {
+fn evaluate_cells<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scratch) {
     let nl = layout.links.len();
-    s.x.resize(nl, [0.0; MAX_LINK_DOF]);
-    s.xd.resize(nl, [0.0; MAX_LINK_DOF]);
     s.params.resize(nl, [0.0; CELL_PARAMS]);
     for (k, spec) in layout.links.iter().enumerate() {
-        let nc = spec.map.len();
-        let at = s.start[k];
-        if owned {
-            s.x[k][..nc].copy_from_slice(&q[at..at + nc]);
-            s.xd[k][..nc].copy_from_slice(&qd[at..at + nc]);
-        } else {
-            for (f, c) in spec.map.iter().enumerate() {
-                (s.x[k][f], s.xd[k][f]) = local(c, q, qd, p);
-            }
-        }
         for (v, &i) in s.params[k].iter_mut().zip(&spec.params) {
             *v = p[i];
         }
@@ -424,7 +389,13 @@ fn evaluate_cells<C: Cells>(
             k += 4;
         } else {
             s.one_out.resize(len, 0.0);
-            cells.one(c, &s.x[k][..nc], &s.xd[k][..nc], &s.params[k], &mut s.one_out);
+            cells.one(
+                c,
+                &s.x[k][..nc],
+                &s.xd[k][..nc],
+                &s.params[k],
+                &mut s.one_out,
+            );
             for (o, v) in out.iter_mut().zip(&s.one_out) {
                 o[0] = *v;
             }
@@ -437,18 +408,11 @@ fn evaluate_cells<C: Cells>(
 
 /// The forward sweep: each link's cell under the world frame composed so
 /// far, its body's inertial and gravity forces, the twists of its cell
-/// coordinates; then the tip body and loads. `owned`: the cell
-/// coordinates are the arm's, `start[k]..` (see [`all_owned`]).
+/// coordinates; then the tip body and loads. The caller has put the cell
+/// coordinates and rates in `s.x`, `s.xd` and the links' starts in
+/// `s.start`.
 #[inline(always)]
-fn forward<C: Cells>(
-    layout: &LinkLayout,
-    cells: &mut C,
-    owned: bool,
-    q: &[f64],
-    qd: &[f64],
-    p: &[f64],
-    s: &mut Scratch,
-) -> Tip {
+fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scratch) -> Tip {
     let nl = layout.links.len();
     s.links.resize(nl, Link::default());
     s.start.clear();
@@ -461,7 +425,7 @@ fn forward<C: Cells>(
         v.resize(total, ([0.0; 3], [0.0; 3]));
     }
     s.local_force.resize(total, 0.0);
-    evaluate_cells(layout, cells, owned, q, qd, p, s);
+    evaluate_cells(layout, cells, p, s);
 
     let gravity = layout.gravity.map(|i| p[i]);
     let mut r: M3 =
@@ -593,6 +557,7 @@ fn link_sums(
     // The momentum each coordinate's own velocity gives the body, about
     // its centroid: (I w, m v).
     let mut body = [([0.0; 3], [0.0; 3]); MAX_LINK_DOF];
+    #[allow(clippy::needless_range_loop)] // own and body side by side
     for f in 0..nc {
         let (ow, ov) = s.own[at + f];
         body[f] = (apply_body(l.lateral, l.axial, l.axis, ow), scale(l.m, ov));
@@ -655,7 +620,17 @@ pub fn mass_bias_owned<C: Cells>(
     let mut scratch = take_scratch(layout, out);
     {
         let s = &mut scratch;
-        let mut tip = forward(layout, cells, true, q, qd, p, s);
+        let nl = layout.links.len();
+        s.x.resize(nl, [0.0; MAX_LINK_DOF]);
+        s.xd.resize(nl, [0.0; MAX_LINK_DOF]);
+        let mut at = 0;
+        for (k, spec) in layout.links.iter().enumerate() {
+            let nc = spec.map.len();
+            s.x[k][..nc].copy_from_slice(&q[at..at + nc]);
+            s.xd[k][..nc].copy_from_slice(&qd[at..at + nc]);
+            at += nc;
+        }
+        let mut tip = forward(layout, cells, p, s);
         s.momentum.resize(n, ([0.0; 3], [0.0; 3]));
         let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
         let index = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
@@ -714,18 +689,34 @@ pub fn mass_bias_shared<const N: usize, C: Cells>(
     let mut scratch = take_scratch(layout, out);
     {
         let s = &mut scratch;
-        let mut tip = forward(layout, cells, false, q, qd, p, s);
         let simd = rows::simd_available();
+        let weights = layout.weights();
+        let row = |k: usize, f: usize| -> &[f64; N] {
+            let at = (k * MAX_LINK_DOF + f) * N;
+            weights[at..at + N].try_into().expect("rows of N")
+        };
+        let (mut qp, mut qdp) = ([0.0; N], [0.0; N]);
+        qp[..n].copy_from_slice(&q[..n]);
+        qdp[..n].copy_from_slice(&qd[..n]);
+        let nl = layout.links.len();
+        s.x.resize(nl, [0.0; MAX_LINK_DOF]);
+        s.xd.resize(nl, [0.0; MAX_LINK_DOF]);
+        for (k, spec) in layout.links.iter().enumerate() {
+            for (f, c) in spec.map.iter().enumerate() {
+                let (x, xd) = rows::dot2(simd, row(k, f), &qp, &qdp);
+                (s.x[k][f], s.xd[k][f]) = match c.scale {
+                    Some(i) => (x * p[i], xd * p[i]),
+                    None => (x, xd),
+                };
+            }
+        }
+        let mut tip = forward(layout, cells, p, s);
         let mut reach = [[0.0; N]; 6];
         let mut x = [[0.0; N]; N];
         let mut h = [0.0; N];
-        let weights = layout.weights();
         for (k, spec) in layout.links.iter().enumerate().rev() {
             let nc = spec.map.len();
-            let w: [&[f64; N]; MAX_LINK_DOF] = std::array::from_fn(|f| {
-                let at = (k * MAX_LINK_DOF + f) * N;
-                weights[at..at + N].try_into().expect("rows of N")
-            });
+            let w: [&[f64; N]; MAX_LINK_DOF] = std::array::from_fn(|f| row(k, f));
             // A cell coordinate's scale goes into every coefficient of its
             // weights.
             let sc: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| {
@@ -739,7 +730,8 @@ pub fn mass_bias_shared<const N: usize, C: Cells>(
                 let t = flat(s.twist[s.start[k] + f]);
                 let mut row = [0.0; N];
                 rows::add_combination(simd, &mut row, &t, std::array::from_fn(|k| &reach[k]));
-                let half: [f64; MAX_LINK_DOF] = std::array::from_fn(|f2| 0.5 * block[f][f2] * sc[f2]);
+                let half: [f64; MAX_LINK_DOF] =
+                    std::array::from_fn(|f2| 0.5 * block[f][f2] * sc[f2]);
                 rows::add_combination(simd, &mut row, &half, w);
                 // Terms name distinct coordinates (eomgen's maps).
                 for &(a, _) in &spec.map[f].terms {
@@ -750,7 +742,9 @@ pub fn mass_bias_shared<const N: usize, C: Cells>(
             for (kk, rk) in reach.iter_mut().enumerate() {
                 let mk: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| m[f][kk] * sc[f]);
                 match nc {
-                    3 => rows::add_combination(simd, rk, &[mk[0], mk[1], mk[2]], [w[0], w[1], w[2]]),
+                    3 => {
+                        rows::add_combination(simd, rk, &[mk[0], mk[1], mk[2]], [w[0], w[1], w[2]])
+                    }
                     _ => rows::add_combination(simd, rk, &mk, w),
                 }
             }

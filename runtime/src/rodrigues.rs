@@ -338,6 +338,39 @@ mod tests {
         }
     }
 
+    /// Four arguments in lanes give the bits of four scalar calls, when
+    /// the lanes share a branch and when they do not.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn family_in_lanes_has_the_bits_of_the_scalar_family() {
+        if !crate::rows::simd_available() {
+            return;
+        }
+        let groups = [
+            [0.0, 1e-9, -0.3, 0.97],
+            [1.0, -2.5, 8.9, 4.0],
+            [0.5, 3.0, -20.0, 120.0],
+            [-1e-300, 0.999_999, 1.000_001, -8.999],
+        ];
+        for w in groups {
+            // SAFETY: AVX and FMA are available (checked above).
+            let lanes = unsafe { family_x4::<3>(crate::lanes::from_array(w)) };
+            for (l, &wl) in w.iter().enumerate() {
+                let scalar = family::<3>(wl);
+                for j in 0..FAMILY_J {
+                    for n in 0..3 {
+                        let got = crate::lanes::to_array(lanes[j][n])[l];
+                        assert_eq!(
+                            got.to_bits(),
+                            scalar[j][n].to_bits(),
+                            "w {wl} c_{j} order {n}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn recurrence_identity_holds() {
         // c_j = 1/j! - w c_{j+2}
@@ -355,6 +388,10 @@ mod tests {
 /// of four scalar calls: the same sums in the same order (the scalar code
 /// does not fuse them either), lane by lane where the lanes would take
 /// different branches.
+///
+/// # Safety
+/// The processor must have AVX and FMA (code built with both calls it
+/// without `unsafe`).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,fma")]
 #[inline]
@@ -386,7 +423,10 @@ pub fn family_x4<const N: usize>(
                 _mm256_sub_pd(_mm256_set1_pd(INV_FACTORIAL[j]), wc)
             } else {
                 let neg = _mm256_xor_pd(wc, _mm256_set1_pd(-0.0));
-                _mm256_sub_pd(neg, _mm256_mul_pd(_mm256_set1_pd(n as f64), c[j + 2][n - 1]))
+                _mm256_sub_pd(
+                    neg,
+                    _mm256_mul_pd(_mm256_set1_pd(n as f64), c[j + 2][n - 1]),
+                )
             };
         }
     }

@@ -40,6 +40,42 @@ pub fn add_combination<const N: usize, const K: usize>(
     }
 }
 
+/// (w . a, w . b).
+#[inline(always)]
+pub fn dot2<const N: usize>(simd: bool, w: &[f64; N], a: &[f64; N], b: &[f64; N]) -> (f64, f64) {
+    #[cfg(target_arch = "x86_64")]
+    if simd {
+        // SAFETY: the caller has checked that the processor has AVX and FMA.
+        return unsafe { dot2_avx(w, a, b) };
+    }
+    let _ = simd;
+    let (mut x, mut y) = (0.0, 0.0);
+    for c in 0..N {
+        x = w[c].mul_add(a[c], x);
+        y = w[c].mul_add(b[c], y);
+    }
+    (x, y)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,fma")]
+#[inline]
+unsafe fn dot2_avx<const N: usize>(w: &[f64; N], a: &[f64; N], b: &[f64; N]) -> (f64, f64) {
+    use std::arch::x86_64::*;
+    const { assert!(N.is_multiple_of(4), "rows are whole vectors") };
+    let (mut x, mut y) = (_mm256_setzero_pd(), _mm256_setzero_pd());
+    for at in (0..N).step_by(4) {
+        // SAFETY: at + 4 <= N for every row.
+        unsafe {
+            let wv = _mm256_loadu_pd(w.as_ptr().add(at));
+            x = _mm256_fmadd_pd(wv, _mm256_loadu_pd(a.as_ptr().add(at)), x);
+            y = _mm256_fmadd_pd(wv, _mm256_loadu_pd(b.as_ptr().add(at)), y);
+        }
+    }
+    let (x, y) = (crate::lanes::to_array(x), crate::lanes::to_array(y));
+    ((x[0] + x[1]) + (x[2] + x[3]), (y[0] + y[1]) + (y[2] + y[3]))
+}
+
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,fma")]
 #[inline]
@@ -49,7 +85,7 @@ unsafe fn add_combination_avx<const N: usize, const K: usize>(
     rows: [&[f64; N]; K],
 ) {
     use std::arch::x86_64::*;
-    const { assert!(N % 4 == 0, "rows are whole vectors") };
+    const { assert!(N.is_multiple_of(4), "rows are whole vectors") };
     let c: [__m256d; K] = std::array::from_fn(|k| _mm256_set1_pd(coef[k]));
     for at in (0..N).step_by(4) {
         // SAFETY: at + 4 <= N for every row.
@@ -76,7 +112,12 @@ mod tests {
         let start: [f64; 8] = std::array::from_fn(|c| c as f64 / 7.0);
         let (mut a, mut b) = (start, start);
         add_combination(false, &mut a, &coef, [&rows[0], &rows[1], &rows[2]]);
-        add_combination(simd_available(), &mut b, &coef, [&rows[0], &rows[1], &rows[2]]);
+        add_combination(
+            simd_available(),
+            &mut b,
+            &coef,
+            [&rows[0], &rows[1], &rows[2]],
+        );
         let mut want = start;
         for k in 0..3 {
             for c in 0..8 {
