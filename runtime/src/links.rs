@@ -1,6 +1,6 @@
 //! Mass + bias of a serial chain of constant-strain links (3D pcc and vc
-//! arms) by a recursion over the links, each link's local kinematics from
-//! one generated *cell*.
+//! arms, rom slices) by a recursion over the links, each link's local
+//! kinematics from one generated *cell*.
 //!
 //! A fully unrolled kernel of a 20-DOF 3D arm is over 100 KB of machine
 //! code, past the processor's instruction caches: it runs at half the
@@ -10,8 +10,10 @@
 //! their rates and convective accelerations, the columns of the link's
 //! coordinates, the link's elastic and dissipative forces), identical links
 //! share one cell, and this loop composes the world frame link by link and
-//! sums M and h by composite bodies from the tip (Featherstone's CRBA and
-//! RNEA, in the world frame as `eomgen/src/tmt/chain.rs` does symbolically).
+//! sums M and h from the tip: by composite bodies (Featherstone's CRBA and
+//! RNEA, in the world frame as `eomgen/src/tmt/chain.rs` does symbolically)
+//! where links own their coordinates, over rows of the arm's coordinates
+//! where they share them (rom).
 //! The flat `MassBias` tape stays the interpreter's form: the two are
 //! independent computations of the same M and h (tests/backends.rs).
 
@@ -79,18 +81,6 @@ pub struct LinkSpec {
     pub map: Vec<LocalCoordinate>,
     /// Indices into the parameter vector, [`CELL_PARAMS`] of them.
     pub params: Vec<usize>,
-}
-
-impl LinkSpec {
-    /// The first of the arm's coordinates when the cell's coordinates are
-    /// the arm's own, in order (pcc, vc), rather than shared combinations.
-    pub fn owned(&self) -> Option<usize> {
-        let first = self.map.first()?.terms.first()?.0;
-        let own = self.map.iter().enumerate().all(|(f, c)| {
-            c.scale.is_none() && c.terms.len() == 1 && c.terms[0] == (first + f, 1.0)
-        });
-        own.then_some(first)
-    }
 }
 
 /// A chain of links and where its global parameters are.
@@ -603,8 +593,7 @@ fn take_scratch(layout: &LinkLayout, out: &[f64]) -> Scratch {
 /// coordinates ([`all_owned`]: pcc, vc) into `out` (the `MassBias`
 /// layout), by composite bodies from the tip: a link's rows of M are its
 /// coordinates' twists against the momenta of the composite past it.
-/// `cell(c, x, xd, p_k, out)` evaluates cell `c` at a link's coordinates
-/// and rates and its parameters ([`CELL_PARAMS`]).
+/// `cells` evaluates the links' cells ([`Cells`]).
 /// Inlined into its caller, which the generated code builds for FMA.
 #[inline(always)]
 pub fn mass_bias_owned<C: Cells>(
@@ -661,12 +650,11 @@ pub fn mass_bias_owned<C: Cells>(
 }
 
 /// M and h like [`mass_bias_owned`] for any chain, links of shared
-/// coordinates included (a rom segment's slices), `N` at least the arm's
-/// coordinates (rows padded with zeros: fixed-length rows the compiler
-/// turns into vector instructions). `forces(out)` writes the generalised
-/// forces that are not any link's (a rom segment's strain energy and
-/// damping, integrated over the segment), added to h, when
-/// `layout.forces`.
+/// coordinates included (a rom segment's slices), `N` the arm's
+/// coordinates padded to whole vectors ([`padded`]). `Cells::forces`
+/// gives the generalised forces that are not any link's (a rom segment's
+/// strain energy and damping, integrated over the segment), added to h,
+/// when `layout.forces`.
 ///
 /// With W_e the map from the arm's rates to link e's cell rates (rows of
 /// `LinkSpec::map`), S_e the twists of e's cell rates, D_e e's own block
