@@ -3,8 +3,9 @@
 //!
 //! The compiler's vectoriser leaves these loops scalar inside the link
 //! recursion's large inlined body (BENCHMARKS.md, session 9), so the
-//! vector form is written out. Every lane is the scalar `mul_add`, so
-//! both forms give the same bits.
+//! vector form is written out. In `add_combination` every lane is the
+//! scalar `mul_add`, so both forms give the same bits; `dot2` adds its
+//! four partial sums at the end, so its forms agree to round-off only.
 
 /// Whether [`add_combination`] may use its vector form here.
 pub fn simd_available() -> bool {
@@ -102,6 +103,25 @@ unsafe fn add_combination_avx<const N: usize, const K: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Both forms of the dot products against a sum in exact rationals
+    /// (small integers over a power of two: every product and partial
+    /// sum is exact in f64, so any order gives the one true value).
+    #[test]
+    fn dot_products_match_an_exact_sum() {
+        let w: [f64; 12] = std::array::from_fn(|c| (c as f64 - 5.0) / 8.0);
+        let a: [f64; 12] = std::array::from_fn(|c| (3 * c % 7) as f64 / 4.0 - 1.0);
+        let b: [f64; 12] = std::array::from_fn(|c| (c * c % 5) as f64 / 2.0);
+        // By hand: sum over c of w_c a_c and w_c b_c in integers.
+        let (mut ia, mut ib) = (0i64, 0i64);
+        for c in 0..12i64 {
+            ia += (c - 5) * (3 * c % 7 - 4);
+            ib += (c - 5) * (c * c % 5);
+        }
+        let want = (ia as f64 / 32.0, ib as f64 / 16.0);
+        assert_eq!(dot2(false, &w, &a, &b), want);
+        assert_eq!(dot2(simd_available(), &w, &a, &b), want);
+    }
 
     /// The vector form against the scalar one, bit for bit.
     #[test]
