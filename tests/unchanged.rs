@@ -1,0 +1,270 @@
+//! Every bundled model computes what it computed when its fixture was
+//! recorded: M and h, the outputs, the generated solve, the stiffness and
+//! the right-hand side's Jacobian (applied to a fixed vector) at fixed
+//! states, in both backends; the static solution; and a 1 s trajectory.
+//!
+//! The fixtures in `tests/fixtures/` were recorded before the issue-18
+//! redesign (typed parameters, one home per method, runtime in two layers)
+//! from the code of commit e697e9d, and are the reference that the redesign
+//! changes no behaviour: values agree to 1e-13 of each vector's largest
+//! entry. Re-record only for an intended change of the physics, with
+//! `SOFTARM_RECORD_FIXTURES=1 cargo test --test unchanged`, and say why in
+//! the commit.
+
+mod common;
+
+use std::path::PathBuf;
+
+use common::*;
+use nalgebra::{DMatrix, DVector};
+use runtime::{Dynamics, KernelKind, SimOptions, Solver, StaticOptions, Workspace};
+use serde_json::{Map, Value, json};
+use softarm::backend::{BackendChoice, load};
+use softarm::generated::MODELS;
+
+fn fixture_path(model: &str) -> PathBuf {
+    root()
+        .join("tests")
+        .join("fixtures")
+        .join(format!("{model}.json"))
+}
+
+/// Deterministic states: straight at rest, straight and moving, and bent.
+fn states(names: &[String], seed: u64) -> Vec<(f64, Vec<f64>, Vec<f64>)> {
+    let mut rng = Rng::new(seed);
+    let n = names.len();
+    let bent = rng.coordinates(names, -0.6, 0.6);
+    let moving = rng.vec(n, -1.5, 1.5);
+    let moving2 = rng.vec(n, -1.5, 1.5);
+    vec![
+        (0.0, vec![0.0; n], vec![0.0; n]),
+        (0.3, vec![0.0; n], moving),
+        (1.7, bent, moving2),
+    ]
+}
+
+/// The kernel outputs of one backend at the fixed states.
+fn kernels_at_states(arm: &dyn Dynamics, seed: u64) -> Value {
+    let n = arm.dof();
+    let names = arm.info().coordinates.clone();
+    let mut rng = Rng::new(seed + 1);
+    let v = rng.vec(2 * n, -1.0, 1.0);
+    let mut out = Vec::new();
+    for (t, q, qd) in states(&names, seed) {
+        let mut entry = Map::new();
+        for kind in [KernelKind::MassBias, KernelKind::Outputs, KernelKind::Accel] {
+            let mut o = vec![0.0; kind.output_len(arm.info())];
+            arm.eval_kernel(kind, t, &q, &qd, &mut o);
+            entry.insert(kind.name().into(), json!(o));
+        }
+        // The n x n stiffness and 2n x 2n Jacobian, applied to a fixed
+        // vector: a change of any entry changes the product.
+        let mut k = vec![0.0; n * n];
+        arm.eval_kernel(KernelKind::Stiffness, t, &q, &qd, &mut k);
+        let kv = DMatrix::from_row_slice(n, n, &k) * DVector::from_column_slice(&v[..n]);
+        entry.insert("stiffness_times_v".into(), json!(kv.as_slice()));
+        let mut ws = Workspace::new(n);
+        let mut jac = DMatrix::zeros(2 * n, 2 * n);
+        let x: Vec<f64> = q.iter().chain(&qd).copied().collect();
+        let qdd = runtime::rhs_jacobian(arm, &mut ws, t, &x, &mut jac).unwrap();
+        entry.insert("qdd".into(), json!(qdd));
+        let jv = &jac * DVector::from_column_slice(&v);
+        entry.insert("jacobian_times_v".into(), json!(jv.as_slice()));
+        out.push(Value::Object(entry));
+    }
+    Value::Array(out)
+}
+
+/// Static solution and a 1 s trajectory, compiled backend.
+fn simulations(loaded: &mut softarm::backend::Loaded) -> Value {
+    let n = loaded.arm.dof();
+    let statics =
+        match runtime::solve_static(&mut *loaded.arm, &vec![0.0; n], &StaticOptions::default()) {
+            Ok(s) => json!({"q": s.q}),
+            Err(e) => json!({"error": e.to_string()}),
+        };
+    let file = &loaded.model.simulate;
+    let opts = SimOptions {
+        t_end: 1.0,
+        solver: Solver::parse(file.solver.as_deref().unwrap_or("dopri5")).unwrap(),
+        rtol: file.rtol.unwrap_or(1e-6),
+        atol: file.atol.unwrap_or(1e-9),
+        dt: file.dt.unwrap_or(1e-3),
+        output_dt: 0.1,
+        ..Default::default()
+    };
+    // Start bent, so that every model moves.
+    let mut x0 = vec![0.0; 2 * n];
+    for (k, x) in x0.iter_mut().take(n).enumerate() {
+        let stretch = loaded.arm.info().coordinates[k].starts_with("stretch");
+        *x = if stretch { 1e-3 } else { 0.2 };
+    }
+    let (traj, stats) = runtime::simulate(&*loaded.arm, x0, &opts).unwrap();
+    json!({"static": statics, "t": traj.t, "x": traj.x, "steps": stats.steps})
+}
+
+/// Model variants that exercise what the bundled models do not (every
+/// method under actuation, torques, a moving base and tip wrenches): the
+/// interpreted kernels at the fixed states and the static solution.
+const VARIANTS: &[(&str, &str, &[&str])] = &[
+    (
+        "everything3d",
+        "tests/fixtures/variants/everything3d.toml",
+        &["pcc", "vc", "ebr", "rom", "rigid"],
+    ),
+    (
+        "everything2d",
+        "tests/fixtures/variants/everything2d.toml",
+        &["pcc", "vc", "rigid"],
+    ),
+    (
+        "stiff_flop",
+        "stiff_flop",
+        &["eba", "rom", "ebr", "vc", "rigid"],
+    ),
+];
+
+fn record_variant(file: &str, segment: usize, method: &str) -> Value {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = if file.ends_with(".toml") {
+        root().join(file).to_string_lossy().into_owned()
+    } else {
+        file.to_string()
+    };
+    let set =
+        eomgen::model::Override::parse(&format!("segment.{segment}.method={method}")).unwrap();
+    let mut l = load(
+        &spec,
+        &[set],
+        BackendChoice::Interpreted,
+        Some(dir.path().to_path_buf()),
+    )
+    .unwrap();
+    let n = l.arm.dof();
+    let statics = match runtime::solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default())
+    {
+        Ok(s) => json!({"q": s.q}),
+        Err(e) => json!({"error": e.to_string()}),
+    };
+    json!({"interpreted": kernels_at_states(&*l.arm, 5), "static": statics})
+}
+
+fn record(name: &str) -> Value {
+    let mut compiled = load(name, &[], BackendChoice::Compiled, None).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let interpreted = load(
+        name,
+        &[],
+        BackendChoice::Interpreted,
+        Some(dir.path().to_path_buf()),
+    )
+    .unwrap();
+    let seed = 1 + name.len() as u64;
+    json!({
+        "model": name,
+        "compiled": kernels_at_states(&*compiled.arm, seed),
+        "interpreted": kernels_at_states(&*interpreted.arm, seed),
+        "simulation": simulations(&mut compiled),
+    })
+}
+
+/// Every number of `now` within 1e-13 of the largest entry of its array in
+/// `then`; structure (keys, lengths, integers) equal.
+fn compare(now: &Value, then: &Value, path: &str, failures: &mut Vec<String>) {
+    match (now, then) {
+        (Value::Object(a), Value::Object(b)) => {
+            let (ka, kb): (Vec<_>, Vec<_>) = (a.keys().collect(), b.keys().collect());
+            if ka != kb {
+                failures.push(format!("{path}: keys {ka:?} vs {kb:?}"));
+                return;
+            }
+            for (k, v) in a {
+                compare(v, &b[k], &format!("{path}.{k}"), failures);
+            }
+        }
+        (Value::Array(a), Value::Array(b)) => {
+            if a.len() != b.len() {
+                failures.push(format!("{path}: length {} vs {}", a.len(), b.len()));
+                return;
+            }
+            let scale = b
+                .iter()
+                .filter_map(Value::as_f64)
+                .fold(0.0f64, |s, x| s.max(x.abs()));
+            for (k, (x, y)) in a.iter().zip(b).enumerate() {
+                match (x.as_f64(), y.as_f64()) {
+                    (Some(x), Some(y)) if x.is_finite() && y.is_finite() => {
+                        if (x - y).abs() > 1e-13 * scale.max(x.abs()).max(1e-300) {
+                            failures.push(format!("{path}[{k}]: {x:e} vs recorded {y:e}"));
+                        }
+                    }
+                    _ => compare(x, y, &format!("{path}[{k}]"), failures),
+                }
+            }
+        }
+        (a, b) if a != b => failures.push(format!("{path}: {a} vs recorded {b}")),
+        _ => {}
+    }
+}
+
+#[test]
+fn every_bundled_model_computes_what_its_fixture_recorded() {
+    let recording = std::env::var_os("SOFTARM_RECORD_FIXTURES").is_some();
+    let mut failures = Vec::new();
+    for m in MODELS {
+        let now = record(m.name);
+        let path = fixture_path(m.name);
+        if recording {
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(&path, serde_json::to_string(&now).unwrap()).unwrap();
+            continue;
+        }
+        let then: Value = serde_json::from_str(
+            &std::fs::read_to_string(&path)
+                .unwrap_or_else(|e| panic!("{}: {e} (record it first)", path.display())),
+        )
+        .unwrap();
+        let before = failures.len();
+        compare(&now, &then, m.name, &mut failures);
+        failures.truncate(before + 20);
+    }
+    assert!(
+        failures.is_empty(),
+        "behaviour changed:\n{}",
+        failures.join("\n")
+    );
+    for (name, file, methods) in VARIANTS {
+        let segment = if file.ends_with(".toml") { 1 } else { 0 };
+        for method in *methods {
+            let now = record_variant(file, segment, method);
+            let key = format!("{name}-{method}");
+            let path = root()
+                .join("tests/fixtures/variants")
+                .join(format!("{key}.json"));
+            if recording {
+                std::fs::write(&path, serde_json::to_string(&now).unwrap()).unwrap();
+                continue;
+            }
+            let then: Value =
+                serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+            let before = failures.len();
+            compare(&now, &then, &key, &mut failures);
+            failures.truncate(before + 20);
+        }
+    }
+    // Every fixture is of a bundled model: a fixture left behind by a
+    // removed model would silently test nothing.
+    let recorded = std::fs::read_dir(root().join("tests").join("fixtures")).unwrap();
+    for e in recorded {
+        let e = e.unwrap();
+        if e.file_type().unwrap().is_dir() {
+            continue;
+        }
+        let name = e.file_name().to_string_lossy().into_owned();
+        let stem = name.trim_end_matches(".json");
+        assert!(
+            MODELS.iter().any(|m| m.name == stem),
+            "tests/fixtures/{name} belongs to no bundled model"
+        );
+    }
+}
