@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use eomgen::model::{Model, Override, Structure, parameters, parse_model};
+use eomgen::model::{Model, Override, ParamLayout, Structure, parse_model};
 use runtime::{Arm, CompiledModel, Dynamics, Interpreted, Kernels};
 use serde::Serialize;
 
@@ -106,8 +106,9 @@ pub fn load(
             "{origin}: segment.method: \"cosserat\" is solved as a static boundary value problem: run `softarm static` with it, or choose pcc, vc, ebr or rigid for the dynamics"
         );
     }
-    let hash = Structure::of(&model).hash();
-    let params: Vec<(String, f64)> = parameters(&model);
+    let structure = Structure::of(&model);
+    let hash = structure.hash();
+    let layout = ParamLayout::of(&structure);
     // Compiled kernels use fused multiply-adds; without them the
     // interpreter gives the same bits.
     let compiled = compiled_by_hash(&hash);
@@ -146,16 +147,15 @@ pub fn load(
             }
         }
     };
-    let names: Vec<&String> = params.iter().map(|(n, _)| n).collect();
-    if kernels.info().parameters.iter().collect::<Vec<_>>() != names {
+    // The kernels' metadata names their layout: it must be this one.
+    if kernels.info().parameters != layout.names() {
         bail!(
             "{origin}: the {} kernels do not match this generator's parameter layout; \
              run `softarm derive` (or `cargo build`) to regenerate",
             kernels.backend()
         );
     }
-    let values = params.into_iter().map(|(_, v)| v).collect();
-    let layout = kernels.info().parameters.clone();
+    let values = layout.values(&model);
     let mut arm: Box<dyn Dynamics> = Box::new(Arm::new(kernels, values));
     let base_dir = base_dir(spec);
     let drives = crate::inputs::model_drives(&model, &layout, &base_dir)

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use eomgen::model::{Driven, Input, Model, Offset, drives};
+use eomgen::model::{Input, Model, Offset, ParamLayout, channel};
 use runtime::signal::{Drive, Signal, Table, moving_average};
 
 use crate::data::{Csv, resolve};
@@ -79,30 +79,22 @@ pub fn signal(name: &str, input: &Input, base: &Path) -> Result<Signal> {
 }
 
 /// The drives of a model whose parameter layout is `layout`.
-pub fn model_drives(model: &Model, layout: &[String], base: &Path) -> Result<Vec<Drive>> {
+pub fn model_drives(model: &Model, layout: &ParamLayout, base: &Path) -> Result<Vec<Drive>> {
     let mut signals: BTreeMap<&str, Signal> = BTreeMap::new();
     let mut out = Vec::new();
-    for Driven {
-        param,
-        channel,
-        derivative,
-    } in drives(model)
-    {
-        let input = &model.inputs[&channel]; // validated
-        if !signals.contains_key(channel.as_str()) {
-            let key = model.inputs.get_key_value(&channel).expect("validated").0;
-            signals.insert(key, signal(&channel, input, base)?);
+    for d in layout.driven() {
+        let name = channel(model, d.param)
+            .with_context(|| format!("{}: no input channel (generator bug)", d.param.name()))?;
+        let (key, input) = model.inputs.get_key_value(name).expect("validated");
+        if !signals.contains_key(name) {
+            signals.insert(key, signal(name, input, base)?);
         }
-        let index = layout
-            .iter()
-            .position(|p| *p == param)
-            .with_context(|| format!("parameter {param} is not in the layout (generator bug)"))?;
-        let mut signal = signals[channel.as_str()].clone();
-        for _ in 0..derivative {
+        let mut signal = signals[name].clone();
+        for _ in 0..d.derivative {
             signal = signal.derivative();
         }
         out.push(Drive {
-            param: index,
+            param: layout.index(d.param),
             signal,
         });
     }

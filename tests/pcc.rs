@@ -5,8 +5,6 @@
 
 mod common;
 
-use std::collections::HashMap;
-
 use common::*;
 use eomgen::cas::{Cas, SymKind};
 use eomgen::model::Override;
@@ -91,7 +89,9 @@ fn jacobians_of_mass_and_bias_are_finite_at_the_straight_state() {
     ])
     .model;
     let mut cas = Cas::new();
-    let sys = eomgen::tmt::planar_system(&mut cas, &model);
+    let structure = eomgen::model::Structure::of(&model);
+    let layout = eomgen::model::ParamLayout::of(&structure);
+    let sys = eomgen::tmt::system(&mut cas, &structure, &layout);
     let eq = eomgen::tmt::assemble(&mut cas, &sys);
     let mut exprs = Vec::new();
     for &e in eq.mass_upper.iter().chain(&eq.bias) {
@@ -99,14 +99,14 @@ fn jacobians_of_mass_and_bias_are_finite_at_the_straight_state() {
             exprs.push(cas.diff(e, x));
         }
     }
-    let params: HashMap<String, f64> = eomgen::model::parameters(&model).into_iter().collect();
+    let params = layout.values(&model);
     for q in [[0.0, 0.0, 0.0], [1e-9, -1e-12, 0.0], [0.0, 0.5, -1e-10]] {
         let qd = [0.7, -1.1, 0.4];
         let values = cas
             .eval_many(&exprs, &|s| match cas.sym_kind(s) {
                 SymKind::Q(i) => Some(q[i as usize]),
                 SymKind::Qd(i) => Some(qd[i as usize]),
-                SymKind::Param(_) => params.get(cas.sym_name(s)).copied(),
+                SymKind::Param(i) => params.get(i as usize).copied(),
                 _ => None,
             })
             .unwrap();

@@ -11,7 +11,7 @@
 use std::path::Path;
 
 use eomgen::cas::{Cas, ExprId, Hoist};
-use eomgen::model::{Override, load_model, parameters};
+use eomgen::model::{Override, ParamLayout, Structure, load_model};
 use eomgen::tmt::{assemble, system};
 use runtime::Tape;
 
@@ -25,8 +25,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .collect::<Result<Vec<_>, _>>()?;
     let model = load_model(Path::new(&path), &sets)?;
     let mut cas = Cas::new();
-    let sys = system(&mut cas, &model);
-    let n_params = parameters(&model).len();
+    let structure = Structure::of(&model);
+    let layout = ParamLayout::of(&structure);
+    let sys = system(&mut cas, &structure, &layout);
+    let n_params = layout.len();
     let tape =
         |cas: &mut Cas, outs: &[ExprId]| cas.to_tape_hoisted(outs, &mut Hoist::new(n_params));
 

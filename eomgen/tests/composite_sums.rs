@@ -7,28 +7,26 @@
 use std::path::Path;
 
 use eomgen::cas::{Cas, SymKind};
-use eomgen::model::{Model, Override, load_model, parameters};
+use eomgen::model::{Model, Override, Param, ParamLayout, Structure, load_model};
 use eomgen::tmt::{assemble, system};
 
 fn check(model: &Model, label: &str) {
     // Loads on, whatever the file says, so that every force path counts.
-    let values: Vec<f64> = parameters(model)
-        .into_iter()
-        .map(|(name, v)| match name.as_str() {
-            "gravity.x" => 1.3,
-            "gravity.y" => -9.81,
-            "tip.force.x" => 0.7,
-            "tip.force.y" => -0.4,
-            "gravity.z" => 2.2,
-            "tip.force.z" => 0.3,
-            "tip.moment.x" => 0.05,
-            "tip.moment.y" => -0.02,
-            "tip.moment.z" => 0.04,
+    let structure = Structure::of(model);
+    let layout = ParamLayout::of(&structure);
+    let values: Vec<f64> = layout
+        .params()
+        .iter()
+        .zip(layout.values(model))
+        .map(|(p, v)| match p {
+            Param::Gravity(c) => [1.3, -9.81, 2.2][c.index()],
+            Param::TipForce(c) => [0.7, -0.4, 0.3][c.index()],
+            Param::TipMoment(c) => [0.05, -0.02, 0.04][c.index()],
             _ => v,
         })
         .collect();
     let mut cas = Cas::new();
-    let mut sys = system(&mut cas, model);
+    let mut sys = system(&mut cas, &structure, &layout);
     assert!(
         sys.chain.is_some(),
         "{}: the bundled arms are chains",

@@ -2,6 +2,7 @@
 
 mod error;
 mod load;
+mod params;
 mod schema;
 mod signals;
 mod structure;
@@ -9,13 +10,14 @@ mod validate;
 
 pub use error::ModelError;
 pub use load::{Override, load_model, parse_model};
+pub use params::{
+    ChamberParam, Driven, ElementParam, ElementProps, Param, ParamLayout, Rate, Xyz, base_rotation,
+    base_turn_axis, channel, element_props, parameters,
+};
 pub use schema::{
     Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, Start, Tendon, Tip, Torque,
     WrenchFrame,
 };
 pub use signals::{Compare, Input, Offset};
-pub use structure::{
-    BASE_TRANSLATION, BASE_TURN, Driven, ElementProps, GENERATOR_VERSION, SegmentShape, Structure,
-    base_rotation, base_turn_axis, drives, element_props, parameters,
-};
+pub use structure::{GENERATOR_VERSION, SegmentShape, Structure};
 pub use validate::MAX_ELEMENTS;

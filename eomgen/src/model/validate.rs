@@ -564,7 +564,7 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
         }
     }
     if !m.torques.is_empty() {
-        let names = crate::tmt::coordinate_names(m);
+        let names = super::Structure::of(m).coordinate_names();
         for (i, t) in m.torques.iter().enumerate() {
             channel(&format!("torque[{i}].input"), &t.input)?;
             if !names.contains(&t.coordinate) {

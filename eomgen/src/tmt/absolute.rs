@@ -20,7 +20,7 @@
 //! to the extensible, shearable Cosserat rod as l_e -> 0.
 
 use crate::cas::{Cas, ExprId};
-use crate::model::{Model, Structure};
+use crate::model::{ElementParam, Structure};
 
 use super::actuation::{Strain, actuation, thinning};
 use super::spatial::{
@@ -57,24 +57,13 @@ fn transpose_mul(cas: &mut Cas, a: &M3, b: &M3) -> M3 {
     })
 }
 
-pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
-    let structure = Structure::of(model);
-    let symbols = ParamSymbols::new(cas, model);
-    let param = |name: &str| symbols.get(name);
-    let mut coord_names = Vec::new();
-    for (s, g) in structure.segments.iter().enumerate() {
-        for e in 0..g.elements {
-            for c in ["ux", "uy", "uz", "rx", "ry", "rz"] {
-                coord_names.push(format!("{c}_{s}_{e}"));
-            }
-        }
-    }
-    let coords = Coordinates::new(cas, coord_names);
+pub fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
+    let coords = Coordinates::new(cas, structure.coordinate_names());
     let zero = cas.zero();
     // The base frame, moving when prescribed: the absolute states are then
     // measured from the moving base's straight arm.
     let base = symbols.base_motion(cas);
-    let frame = super::spatial::base_frame(cas, &symbols, base.position, &base.turns);
+    let frame = super::spatial::base_frame(cas, symbols, base.position, &base.turns);
     let (r0, p0, w0) = (frame.r, frame.p, frame.w);
     let base_axis = [r0[0][0], r0[1][0], r0[2][0]];
     // Rates (of the damping) relative to a moving base, too.
@@ -105,7 +94,7 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
         let u: V3 = std::array::from_fn(|i| coords.q[c + i]);
         let psi: V3 = std::array::from_fn(|i| coords.q[c + 3 + i]);
         let psi_d: V3 = std::array::from_fn(|i| coords.qd[c + 3 + i]);
-        let l = param(&format!("element[{k}].length"));
+        let l = symbols.element(k, ElementParam::Length);
         let half = cas.scaled(0.5, l);
         // Centre of the straight arm plus the displacement.
         let s_mid = cas.add(along, half);
@@ -134,11 +123,11 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
         omega = bind3(cas, omega);
         let axis = [r[0][0], r[1][0], r[2][0]];
         bodies.push(Body {
-            mass: param(&format!("element[{k}].mass")),
+            mass: symbols.element(k, ElementParam::Mass),
             inertia: Inertia::Axisymmetric {
                 axis,
-                axial: param(&format!("element[{k}].axial_inertia")),
-                lateral: param(&format!("element[{k}].inertia")),
+                axial: symbols.element(k, ElementParam::AxialInertia),
+                lateral: symbols.element(k, ElementParam::Inertia),
             },
             position: centre,
             omega,
@@ -148,13 +137,13 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
         // Beam springs to the previous element (or the clamp).
         let first = k == 0;
         let span = if first { 2.0 } else { 1.0 }; // stiffness factor l_e / span
-        let kb = param(&format!("joint[{k}].stiffness"));
-        let kt = param(&format!("twist[{k}].stiffness"));
-        let db = param(&format!("joint[{k}].damping"));
-        let dt = param(&format!("twist[{k}].damping"));
-        let ka = param(&format!("stretch[{k}].stiffness"));
-        let da = param(&format!("stretch[{k}].damping"));
-        let ks = param(&format!("shear[{k}].stiffness"));
+        let kb = symbols.element(k, ElementParam::BendStiffness);
+        let kt = symbols.element(k, ElementParam::TwistStiffness);
+        let db = symbols.element(k, ElementParam::BendDamping);
+        let dt = symbols.element(k, ElementParam::TwistDamping);
+        let ka = symbols.element(k, ElementParam::StretchStiffness);
+        let da = symbols.element(k, ElementParam::StretchDamping);
+        let ks = symbols.element(k, ElementParam::ShearStiffness);
         let r_rel = transpose_mul(cas, &prev.r, &slab.r);
         // 2 tan(theta / 2) n = 2 vee(R - R^T) / (1 + tr R): the relative
         // rotation to second order, and stiffening up to a half turn, so
@@ -218,7 +207,7 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
     let tip = bind3(cas, tip);
     let elastic = cas.add_all(&elastic);
     let rayleigh = cas.add_all(&rayleigh);
-    let actuation = actuation(cas, &symbols, &structure, &strains);
+    let actuation = actuation(cas, symbols, structure, &strains);
     let mut sys = System {
         coords,
         bodies,
@@ -239,7 +228,7 @@ pub fn absolute_system(cas: &mut Cas, model: &Model) -> System {
         omega,
         rotation: prev.r,
     };
-    let loads = tip_loads(cas, &symbols, &structure, &mount);
+    let loads = tip_loads(cas, symbols, structure, &mount);
     sys.attach_tip(loads, 0);
     sys
 }

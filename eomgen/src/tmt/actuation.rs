@@ -17,7 +17,7 @@
 //! their change with the configuration.
 
 use crate::cas::{Cas, ExprId, Func};
-use crate::model::Structure;
+use crate::model::{ChamberParam, Param, Structure};
 
 use super::system::ParamSymbols;
 
@@ -57,7 +57,6 @@ pub fn actuation(
     if structure.chambers.iter().all(|&c| c == 0) && structure.tendons.is_empty() {
         return cas.zero();
     }
-    let param = |name: &str| symbols.get(name);
     let n = structure.segments.len();
     // Per segment: total stretch and total bend about y and z.
     let mut sums = vec![[Vec::new(), Vec::new(), Vec::new()]; n];
@@ -90,14 +89,20 @@ pub fn actuation(
     let mut potential = Vec::new();
     for (s, &count) in structure.chambers.iter().enumerate() {
         for j in 0..count {
-            let key = |k: &str| format!("chamber[{s}][{j}].{k}");
-            let p = param(&key("pressure"));
+            let key = |what| {
+                symbols.get(Param::Chamber {
+                    segment: s,
+                    position: j,
+                    what,
+                })
+            };
+            let p = key(ChamberParam::Pressure);
             // The position's holes together: area a, first moments a sum z
             // (lever of bend y) and a sum y (of bend z).
             let (area, arm_y, arm_z) = (
-                param(&key("area")),
-                param(&key("arm_y")),
-                param(&key("arm_z")),
+                key(ChamberParam::Area),
+                key(ChamberParam::ArmY),
+                key(ChamberParam::ArmZ),
             );
             let [st, by, bz] = totals[s];
             let a = cas.mul(area, st);
@@ -110,15 +115,21 @@ pub fn actuation(
         }
     }
     for (i, &end) in structure.tendons.iter().enumerate() {
-        let t = param(&format!("tendon[{i}].tension"));
+        let t = symbols.get(Param::TendonTension(i));
         // Tension only: (T + |T|) / 2.
         let abs = cas.func(Func::Abs, t);
         let sum = cas.add(t, abs);
         let pull = cas.scaled(0.5, sum);
         let lengths: Vec<ExprId> = (0..=end)
             .map(|s| {
-                let y = param(&format!("tendon[{i}][{s}].y"));
-                let z = param(&format!("tendon[{i}][{s}].z"));
+                let offset = |z| {
+                    symbols.get(Param::TendonOffset {
+                        tendon: i,
+                        segment: s,
+                        z,
+                    })
+                };
+                let (y, z) = (offset(false), offset(true));
                 fibre(cas, s, y, z)
             })
             .collect();

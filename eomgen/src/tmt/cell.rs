@@ -19,7 +19,7 @@ use runtime::Tape;
 use runtime::links::{CELL_PARAMS, LinkKernels, LinkLayout, LinkSpec, LocalCoordinate, cell};
 
 use crate::cas::{Cas, ExprId, SymKind};
-use crate::model::{Method, Model, Structure, parameters};
+use crate::model::{ElementParam, Method, Param, ParamLayout, Structure, Xyz};
 
 use super::actuation::thinning;
 use super::spatial::{Frame, Rom, Springs, V3, arc};
@@ -27,8 +27,7 @@ use super::system::{Coordinates, ParamSymbols};
 
 /// The layout and kernels of a model whose mass + bias the link recursion
 /// computes, or `None` when its structure is outside the recursion.
-pub fn link_chain(model: &Model) -> Option<LinkKernels> {
-    let st = Structure::of(model);
+pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     let covered = st.dimensions == 3
         && st
             .segments
@@ -42,14 +41,8 @@ pub fn link_chain(model: &Model) -> Option<LinkKernels> {
     if !covered {
         return None;
     }
-    let names: Vec<String> = parameters(model).into_iter().map(|(n, _)| n).collect();
-    let index = |n: &str| {
-        names
-            .iter()
-            .position(|x| x == n)
-            .expect("parameter in the layout")
-    };
-    let triple = |pre: &str| ["x", "y", "z"].map(|c| index(&format!("{pre}.{c}")));
+    let index = |p: Param| params.index(p);
+    let triple = |p: fn(Xyz) -> Param| Xyz::ALL.map(|c| index(p(c)));
     let mut cells: Vec<(Shape, Tape)> = Vec::new();
     let mut links = Vec::new();
     let mut roms = Vec::new();
@@ -71,21 +64,9 @@ pub fn link_chain(model: &Model) -> Option<LinkKernels> {
         };
         let count = g.coordinates_3d();
         for e in 0..g.elements {
-            let params = [
-                "element[{k}].length",
-                "element[{k}].mass",
-                "element[{k}].inertia",
-                "element[{k}].axial_inertia",
-                "joint[{k}].stiffness",
-                "joint[{k}].damping",
-                "joint[{k}].rest",
-                "twist[{k}].stiffness",
-                "twist[{k}].damping",
-                "stretch[{k}].stiffness",
-                "stretch[{k}].damping",
-            ]
-            .map(|n| index(&n.replace("{k}", &k.to_string())))
-            .to_vec();
+            let params = ElementParam::CELL
+                .map(|e| index(Param::Element(k, e)))
+                .to_vec();
             let map = match &rom {
                 // Cell coordinate f is field f integrated over the slice;
                 // the stretch, a strain, times the segment's length.
@@ -130,23 +111,25 @@ pub fn link_chain(model: &Model) -> Option<LinkKernels> {
         links,
         dof: first,
         forces: !roms.is_empty(),
-        gravity: triple("gravity"),
-        base_position: triple("base"),
-        base_rotation: std::array::from_fn(|i| index(&format!("base.R{}{}", i / 3, i % 3))),
-        tip_force: st.tip_force.then(|| triple("tip.force")),
-        tip_moment: st.tip_moment.then(|| triple("tip.moment")),
+        gravity: triple(Param::Gravity),
+        base_position: triple(Param::BasePosition),
+        base_rotation: std::array::from_fn(|i| {
+            index(Param::BaseRotation((i / 3) as u8, (i % 3) as u8))
+        }),
+        tip_force: st.tip_force.then(|| triple(Param::TipForce)),
+        tip_moment: st.tip_moment.then(|| triple(Param::TipMoment)),
         tip_frame: st.tip_frame_wrench,
-        tip_mass: st.tip_mass.then(|| index("tip.mass")),
-        tip_length: st.tip_length.then(|| index("tip.length")),
+        tip_mass: st.tip_mass.then(|| index(Param::TipMass)),
+        tip_length: st.tip_length.then(|| index(Param::TipLength)),
         tip_inertia: (st.tip_mass && st.tip_length)
-            .then(|| [index("tip.inertia"), index("tip.axial_inertia")]),
+            .then(|| [index(Param::TipInertia), index(Param::TipAxialInertia)]),
         weights: Default::default(),
     };
     // The shared sums hold the arm's coordinates in fixed rows.
     if !roms.is_empty() && first > runtime::links::MAX_SHARED_DOF {
         return None;
     }
-    let forces = (!roms.is_empty()).then(|| derive_forces(model, first, &roms));
+    let forces = (!roms.is_empty()).then(|| derive_forces(params, first, &roms));
     Some(LinkKernels {
         layout,
         cells: cells.into_iter().map(|(_, t)| t).collect(),
@@ -169,15 +152,15 @@ struct Shape {
 /// The generalised forces of the rom segments' strain energy and Rayleigh
 /// function (`Rom::energies`, exact quadratics in the coefficients), as one
 /// kernel of the arm's coordinates and parameters.
-fn derive_forces(model: &Model, dof: usize, roms: &[(Rom, usize)]) -> Tape {
+fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(Rom, usize)]) -> Tape {
     let mut cas = Cas::new();
     let cas = &mut cas;
-    let symbols = ParamSymbols::new(cas, model);
+    let symbols = ParamSymbols::new(cas, params);
     let coords = Coordinates::new(cas, (0..dof).map(|i| format!("q{i}")).collect());
     let mut elastic = Vec::new();
     let mut rayleigh = Vec::new();
     for (r, k) in roms {
-        let [e, d] = r.energies(cas, &coords, &|n: &str| symbols.get(n), *k);
+        let [e, d] = r.energies(cas, &coords, &symbols, *k);
         elastic.push(e);
         rayleigh.push(d);
     }
@@ -219,6 +202,7 @@ fn derive_cell(shape: Shape) -> Tape {
     let p: Vec<ExprId> = (0..CELL_PARAMS)
         .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
         .collect();
+    // In the order of `ElementParam::CELL`.
     let [l, m, lateral, axial, kb, db, rest, kt, dt, ks, ds] = std::array::from_fn(|i| p[i]);
     let zero = cas.zero();
     // Coordinates bend y, bend z, then twist and stretch where present.

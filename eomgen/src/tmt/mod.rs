@@ -12,56 +12,53 @@ mod solve;
 mod spatial;
 mod system;
 
+use crate::cas::Cas;
+use crate::model::{Method, Param, ParamLayout, Structure};
+
 pub use assemble::{Equations, assemble};
 pub use cell::link_chain;
 pub use planar::planar_system;
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
 pub use spatial::spatial_system;
+pub use system::ParamSymbols;
 
-/// The system of a model: planar or spatial kinematics by `dimensions`,
-/// absolute coordinates for eba.
-pub fn system(cas: &mut crate::cas::Cas, model: &crate::model::Model) -> System {
-    let mut sys = kinematics(cas, model);
-    apply_torques(cas, model, &mut sys);
+/// The system of a structure: planar or spatial kinematics by
+/// `dimensions`, absolute coordinates for eba; its parameters are the
+/// symbols of `layout` (values never reach the derivation).
+pub fn system(cas: &mut Cas, structure: &Structure, layout: &ParamLayout) -> System {
+    let symbols = ParamSymbols::new(cas, layout);
+    let mut sys = kinematics(cas, structure, &symbols);
+    apply_torques(cas, structure, &symbols, &mut sys);
     sys
 }
 
-/// The coordinate names of a model's system (what `[[torque]]` may name).
-pub fn coordinate_names(model: &crate::model::Model) -> Vec<String> {
-    kinematics(&mut crate::cas::Cas::new(), model).coords.names
-}
-
-fn kinematics(cas: &mut crate::cas::Cas, model: &crate::model::Model) -> System {
-    if model
-        .segments
-        .iter()
-        .any(|s| s.method == crate::model::Method::Eba)
-    {
-        absolute::absolute_system(cas, model)
-    } else if model.dimensions == 3 {
-        spatial_system(cas, model)
+fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
+    if structure.segments.iter().any(|s| s.method == Method::Eba) {
+        absolute::absolute_system(cas, structure, symbols)
+    } else if structure.dimensions == 3 {
+        spatial_system(cas, structure, symbols)
     } else {
-        planar_system(cas, model)
+        planar_system(cas, structure, symbols)
     }
 }
+
 /// Driven generalised forces Q_k on named coordinates as the potential
 /// -sum Q_k q_k added to the actuators' (the same path as chambers and
 /// tendons: h and the static forces get -Q_k, the stiffness nothing).
-fn apply_torques(cas: &mut crate::cas::Cas, model: &crate::model::Model, sys: &mut System) {
-    if model.torques.is_empty() {
+fn apply_torques(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols, sys: &mut System) {
+    if structure.torques.is_empty() {
         return;
     }
-    let symbols = system::ParamSymbols::new(cas, model);
     let mut terms = vec![sys.actuation];
-    for (i, t) in model.torques.iter().enumerate() {
-        // Validation checked the name against `coordinate_names`.
+    for (i, name) in structure.torques.iter().enumerate() {
+        // Validation checked the name against the coordinates.
         let k = sys
             .coords
             .names
             .iter()
-            .position(|n| *n == t.coordinate)
+            .position(|n| n == name)
             .expect("validated coordinate name");
-        let work = cas.mul(symbols.get(&format!("torque[{i}]")), sys.coords.q[k]);
+        let work = cas.mul(symbols.get(Param::Torque(i)), sys.coords.q[k]);
         terms.push(cas.neg(work));
     }
     sys.actuation = cas.add_all(&terms);

@@ -15,7 +15,7 @@
 //! whose partial derivative in any qd_i is one shared node.
 
 use crate::cas::{Cas, ExprId, Func};
-use crate::model::{Joints, Method, Model, Structure};
+use crate::model::{ElementParam, Joints, Method, Param, Structure};
 
 use super::actuation::{Strain, actuation};
 use super::system::{
@@ -33,24 +33,14 @@ struct Frame {
 
 /// Build the planar system of a model. Only the structure and the
 /// parameter layout are read from `model`; values stay symbols.
-pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
-    let structure = Structure::of(model);
-    let symbols = ParamSymbols::new(cas, model);
-    let param = |name: &str| symbols.get(name);
-
-    let mut coord_names = Vec::new();
-    for (s, g) in structure.segments.iter().enumerate() {
-        for e in 0..g.elements {
-            coord_names.push(format!("theta_{s}_{e}"));
-        }
-    }
-    let coords = Coordinates::new(cas, coord_names);
+pub fn planar_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
+    let coords = Coordinates::new(cas, structure.coordinate_names());
     let zero = cas.zero();
 
     let base = symbols.base_motion(cas);
     let (phi, w) = match base.turns.first().copied() {
-        Some((angle, rate)) => (cas.add(param("base.angle"), angle), rate),
-        None => (param("base.angle"), zero),
+        Some((angle, rate)) => (cas.add(symbols.get(Param::BaseAngle), angle), rate),
+        None => (symbols.get(Param::BaseAngle), zero),
     };
     let mut f = Frame {
         x: base.position[0],
@@ -76,12 +66,12 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
                 rho: [zero, zero, q],
                 offset_scale: None,
             });
-            let l = param(&format!("element[{k}].length"));
-            let m = param(&format!("element[{k}].mass"));
-            let inertia = param(&format!("element[{k}].inertia"));
-            let stiff = param(&format!("joint[{k}].stiffness"));
-            let damp = param(&format!("joint[{k}].damping"));
-            let rest = param(&format!("joint[{k}].rest"));
+            let l = symbols.element(k, ElementParam::Length);
+            let m = symbols.element(k, ElementParam::Mass);
+            let inertia = symbols.element(k, ElementParam::Inertia);
+            let stiff = symbols.element(k, ElementParam::BendStiffness);
+            let damp = symbols.element(k, ElementParam::BendDamping);
+            let rest = symbols.element(k, ElementParam::Rest);
             let body =
                 |cas: &mut Cas, pos: [ExprId; 2], w: ExprId, mass: ExprId, inertia: ExprId| Body {
                     mass,
@@ -135,7 +125,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
     let last_link = links.len().saturating_sub(1);
     let elastic = cas.add_all(&elastic);
     let rayleigh = cas.add_all(&rayleigh);
-    let actuation = actuation(cas, &symbols, &structure, &strains);
+    let actuation = actuation(cas, symbols, structure, &strains);
     let tip_orientation = [cas.cos(half_phi), zero, zero, cas.sin(half_phi)];
     let mut sys = System {
         coords,
@@ -174,7 +164,7 @@ pub fn planar_system(cas: &mut Cas, model: &Model) -> System {
         omega: [zero, zero, f.w],
         rotation,
     };
-    let tip = tip_loads(cas, &symbols, &structure, &mount);
+    let tip = tip_loads(cas, symbols, structure, &mount);
     sys.attach_tip(tip, last_link);
     sys
 }

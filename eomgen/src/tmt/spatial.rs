@@ -24,7 +24,7 @@
 //! than by differentiating the chain of rotation matrices.
 
 use crate::cas::{Cas, ExprId, Func};
-use crate::model::{Joints, Method, Model, Structure};
+use crate::model::{ElementParam, Joints, Method, Param, Structure};
 
 use super::actuation::{Strain, actuation, thinning};
 use super::system::{
@@ -278,44 +278,12 @@ fn advance(cas: &mut Cas, f: &Frame, d: ExprId) -> Frame {
 
 /// Build the 3D system of a model. Only the structure and the parameter
 /// layout are read from `model`; values stay symbols.
-pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
-    let structure = Structure::of(model);
-    let symbols = ParamSymbols::new(cas, model);
-    let param = |name: &str| symbols.get(name);
-
-    // Coordinates: per element, by method.
-    let mut coord_names = Vec::new();
-    for (s, g) in structure.segments.iter().enumerate() {
-        if g.method == Method::Rom {
-            for field in rom_fields(g) {
-                for i in 0..=g.order {
-                    coord_names.push(format!("{field}_{s}_c{i}"));
-                }
-            }
-            continue;
-        }
-        for e in 0..g.elements {
-            if g.method == Method::Rigid {
-                for a in &g.axes {
-                    coord_names.push(format!("joint_{a:?}_{s}_{e}").to_lowercase());
-                }
-            } else {
-                coord_names.push(format!("bend_y_{s}_{e}"));
-                coord_names.push(format!("bend_z_{s}_{e}"));
-                if g.twist {
-                    coord_names.push(format!("twist_{s}_{e}"));
-                }
-                if g.extension {
-                    coord_names.push(format!("stretch_{s}_{e}"));
-                }
-            }
-        }
-    }
-    let coords = Coordinates::new(cas, coord_names);
+pub fn spatial_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
+    let coords = Coordinates::new(cas, structure.coordinate_names());
     let zero = cas.zero();
 
     let base = symbols.base_motion(cas);
-    let mut f = base_frame(cas, &symbols, base.position, &base.turns);
+    let mut f = base_frame(cas, symbols, base.position, &base.turns);
     let mut bodies = Vec::new();
     let mut elastic = Vec::new();
     let mut rayleigh = Vec::new();
@@ -330,16 +298,16 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
         let rom = (g.method == Method::Rom).then(|| {
             let r = Rom::of(g, c);
             c += r.coordinates();
-            let [e, d] = r.energies(cas, &coords, &param, k);
+            let [e, d] = r.energies(cas, &coords, symbols, k);
             elastic.push(e);
             rayleigh.push(d);
             r
         });
         for e in 0..g.elements {
-            let l = param(&format!("element[{k}].length"));
-            let m = param(&format!("element[{k}].mass"));
-            let lateral = param(&format!("element[{k}].inertia"));
-            let axial = param(&format!("element[{k}].axial_inertia"));
+            let l = symbols.element(k, ElementParam::Length);
+            let m = symbols.element(k, ElementParam::Mass);
+            let lateral = symbols.element(k, ElementParam::Inertia);
+            let axial = symbols.element(k, ElementParam::AxialInertia);
             let first = c;
             let body = |axis: V3, position: V3, omega: V3, mass: ExprId| Body {
                 mass,
@@ -352,10 +320,10 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                 omega,
             };
             if g.method == Method::Rigid {
-                let stiff = param(&format!("joint[{k}].stiffness"));
-                let twist = param(&format!("twist[{k}].stiffness"));
-                let damp = param(&format!("joint[{k}].damping"));
-                let rest = param(&format!("joint[{k}].rest"));
+                let stiff = symbols.element(k, ElementParam::BendStiffness);
+                let twist = symbols.element(k, ElementParam::TwistStiffness);
+                let damp = symbols.element(k, ElementParam::BendDamping);
+                let rest = symbols.element(k, ElementParam::Rest);
                 let mut turn = |cas: &mut Cas, f: &Frame| {
                     let mut f = *f;
                     // The joint's lumped strain: its angles about their
@@ -410,9 +378,9 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                 // with the slice's thinning (Rom::energies leaves them out).
                 let thin = rom.incompressible.then(|| {
                     let (soft, off) = thinning(cas, l, len);
-                    let kb = param(&format!("joint[{k}].stiffness"));
-                    let kt = param(&format!("twist[{k}].stiffness"));
-                    let rest = param(&format!("joint[{k}].rest"));
+                    let kb = symbols.element(k, ElementParam::BendStiffness);
+                    let kt = symbols.element(k, ElementParam::TwistStiffness);
+                    let rest = symbols.element(k, ElementParam::Rest);
                     let bz = cas.sub(rho[2], rest);
                     for (kk, x) in [(kb, rho[1]), (kb, bz), (kt, rho[0])] {
                         let kk = cas.mul(kk, soft);
@@ -457,13 +425,13 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
                     offset_scale: thin.map(|t| t.1),
                 });
                 let springs = Springs {
-                    bend: param(&format!("joint[{k}].stiffness")),
-                    bend_damping: param(&format!("joint[{k}].damping")),
-                    rest: param(&format!("joint[{k}].rest")),
-                    twist: param(&format!("twist[{k}].stiffness")),
-                    twist_damping: param(&format!("twist[{k}].damping")),
-                    stretch: param(&format!("stretch[{k}].stiffness")),
-                    stretch_damping: param(&format!("stretch[{k}].damping")),
+                    bend: symbols.element(k, ElementParam::BendStiffness),
+                    bend_damping: symbols.element(k, ElementParam::BendDamping),
+                    rest: symbols.element(k, ElementParam::Rest),
+                    twist: symbols.element(k, ElementParam::TwistStiffness),
+                    twist_damping: symbols.element(k, ElementParam::TwistDamping),
+                    stretch: symbols.element(k, ElementParam::StretchStiffness),
+                    stretch_damping: symbols.element(k, ElementParam::StretchDamping),
                 };
                 let (e, d) = springs.energies(
                     cas,
@@ -515,7 +483,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
     let last_link = links.len().saturating_sub(1);
     let elastic = cas.add_all(&elastic);
     let rayleigh = cas.add_all(&rayleigh);
-    let actuation = actuation(cas, &symbols, &structure, &strains);
+    let actuation = actuation(cas, symbols, structure, &strains);
     let mut sys = System {
         coords,
         bodies,
@@ -543,7 +511,7 @@ pub fn spatial_system(cas: &mut Cas, model: &Model) -> System {
         omega: f.w,
         rotation: f.r,
     };
-    let tip = tip_loads(cas, &symbols, &structure, &mount);
+    let tip = tip_loads(cas, symbols, structure, &mount);
     sys.attach_tip(tip, last_link);
     sys
 }
@@ -557,7 +525,6 @@ pub(super) fn base_frame(
     position: V3,
     turns: &[(ExprId, ExprId)],
 ) -> Frame {
-    let param = |name: &str| symbols.get(name);
     let (zero, one) = (cas.zero(), cas.one());
     let mut f = Frame {
         r: std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one } else { zero })),
@@ -566,7 +533,7 @@ pub(super) fn base_frame(
         quat: [one, zero, zero, zero],
     };
     for (i, &(angle, rate)) in turns.iter().enumerate() {
-        let n = ["x", "y", "z"].map(|c| param(&format!("base.axis[{i}].{c}")));
+        let n = symbols.xyz(|c| Param::BaseTurnAxis(i, c));
         // exp(angle [n]x) = cos I + sin [n]x + (1 - cos) n n^T, n a unit vector.
         let (c, s) = (cas.cos(angle), cas.sin(angle));
         let versine = cas.sub(one, c);
@@ -577,25 +544,15 @@ pub(super) fn base_frame(
         let w = n.map(|k| cas.mul(k, rate));
         f = compose(cas, &f, Some((&r, &q)), None, Some(&w));
     }
-    let r: M3 = std::array::from_fn(|i| std::array::from_fn(|j| param(&format!("base.R{i}{j}"))));
-    let q = ["qw", "qx", "qy", "qz"].map(|c| param(&format!("base.{c}")));
+    let r: M3 = std::array::from_fn(|i| {
+        std::array::from_fn(|j| symbols.get(Param::BaseRotation(i as u8, j as u8)))
+    });
+    let q = std::array::from_fn(|c| symbols.get(Param::BaseQuaternion(c as u8)));
     if turns.is_empty() {
         // The identity folds away, but say so: a still base is its parameters.
         return Frame { r, quat: q, ..f };
     }
     compose(cas, &f, Some((&r, &q)), None, None)
-}
-
-/// The strain fields of a rom segment, in coordinate order.
-fn rom_fields(g: &crate::model::SegmentShape) -> Vec<&'static str> {
-    let mut f = vec!["bend_y", "bend_z"];
-    if g.twist {
-        f.push("twist");
-    }
-    if g.extension {
-        f.push("stretch");
-    }
-    f
 }
 
 /// A rom segment: strain fields sum_i c_i sigma^i over sigma = s / L in
@@ -701,7 +658,7 @@ impl Rom {
         &self,
         cas: &mut Cas,
         coords: &Coordinates,
-        param: &dyn Fn(&str) -> ExprId,
+        symbols: &ParamSymbols,
         k: usize,
     ) -> [ExprId; 2] {
         let n = self.slices as f64;
@@ -721,10 +678,13 @@ impl Rom {
             let stretch = self.extension && f == fields - 1;
             if self.incompressible && !stretch {
                 // Only the elastic part moves to the slices; damping stays.
-                let ds = param(&format!(
-                    "{}[{k}].damping",
-                    if f < 2 { "joint" } else { "twist" }
-                ));
+                let ds = symbols.element(
+                    k,
+                    match f {
+                        0 | 1 => ElementParam::BendDamping,
+                        _ => ElementParam::TwistDamping,
+                    },
+                );
                 let xd: Vec<ExprId> = (0..=self.order)
                     .map(|i| coords.qd[self.index(f, i)])
                     .collect();
@@ -734,16 +694,16 @@ impl Rom {
                 continue;
             }
             let (stiff, damp) = match f {
-                _ if stretch => ("stretch", "stretch"),
-                0 | 1 => ("joint", "joint"),
-                _ => ("twist", "twist"),
+                _ if stretch => (ElementParam::StretchStiffness, ElementParam::StretchDamping),
+                0 | 1 => (ElementParam::BendStiffness, ElementParam::BendDamping),
+                _ => (ElementParam::TwistStiffness, ElementParam::TwistDamping),
             };
-            let ks = param(&format!("{stiff}[{k}].stiffness"));
-            let ds = param(&format!("{damp}[{k}].damping"));
+            let ks = symbols.element(k, stiff);
+            let ds = symbols.element(k, damp);
             // Bending, twist: (E I / L) c^T G c = (k_slice / n) ...; stretch:
             // E A L e^T G e = k_slice n l^2 ....
             let scale = if stretch {
-                let l = param(&format!("element[{k}].length"));
+                let l = symbols.element(k, ElementParam::Length);
                 let l2 = cas.powi(l, 2);
                 cas.scaled(n, l2)
             } else {
@@ -754,7 +714,7 @@ impl Rom {
                 .collect();
             if f == 1 {
                 // Rest curvature about z, constant along s: kappa0 L = n rest.
-                let rest = param(&format!("joint[{k}].rest"));
+                let rest = symbols.element(k, ElementParam::Rest);
                 let r = cas.scaled(n, rest);
                 x[0] = cas.sub(x[0], r);
             }

@@ -3,59 +3,75 @@
 //! CAS expressions. Kinematics modules build one; `assemble` derives the EOM.
 
 use crate::cas::{Cas, ExprId, SymKind};
-use crate::model::{BASE_TRANSLATION, BASE_TURN};
+use crate::model::{ElementParam, Param, ParamLayout, Rate, Xyz};
 
 pub use super::inertia::Inertia;
 
-/// The parameter symbols of a model, looked up by name (the layout of
-/// `model::parameters`).
+/// The parameter symbols of a structure, one per slot of its
+/// [`ParamLayout`]: kinematics ask for a [`Param`], never a name.
 pub struct ParamSymbols {
-    names: Vec<String>,
+    layout: ParamLayout,
     ids: Vec<ExprId>,
 }
 
 impl ParamSymbols {
-    pub fn new(cas: &mut Cas, model: &crate::model::Model) -> Self {
-        let names: Vec<String> = crate::model::parameters(model)
-            .into_iter()
-            .map(|(n, _)| n)
-            .collect();
-        let ids: Vec<ExprId> = names
+    pub fn new(cas: &mut Cas, layout: &ParamLayout) -> Self {
+        let ids: Vec<ExprId> = layout
+            .params()
             .iter()
             .enumerate()
-            .map(|(i, n)| cas.symbol(n, SymKind::Param(i as u32)))
+            .map(|(i, p)| cas.symbol(&p.name(), SymKind::Param(i as u32)))
             .collect();
-        let sym = Self { names, ids };
-        for (n, &id) in sym.names.iter().zip(&sym.ids) {
-            if BaseMotion::moves(n) {
+        for (p, &id) in layout.params().iter().zip(&ids) {
+            if p.moves_base() {
                 cas.set_moving(id);
             }
         }
-        sym
+        Self {
+            layout: layout.clone(),
+            ids,
+        }
     }
 
-    fn has(&self, name: &str) -> bool {
-        self.names.iter().any(|n| n == name)
+    /// The symbol of `p`; kinematics only ask for parameters their
+    /// structure has, so a miss is a generator bug.
+    pub fn get(&self, p: Param) -> ExprId {
+        self.ids[self.layout.index(p)]
+    }
+
+    /// Element k's quantity `e`.
+    pub fn element(&self, k: usize, e: ElementParam) -> ExprId {
+        self.get(Param::Element(k, e))
+    }
+
+    /// A vector of three parameters.
+    pub fn xyz(&self, p: impl Fn(Xyz) -> Param) -> [ExprId; 3] {
+        Xyz::ALL.map(|c| self.get(p(c)))
     }
 
     /// The base's position and turn, moving when the model prescribes it.
     pub fn base_motion(&self, cas: &mut Cas) -> BaseMotion {
-        let mut position = ["x", "y", "z"].map(|c| self.get(&format!("base.{c}")));
+        let mut position = self.xyz(Param::BasePosition);
         let mut seeds = Vec::new();
         let chain = |seeds: &mut Vec<(ExprId, ExprId)>, [x, v, a]: [ExprId; 3]| {
             seeds.extend([(x, v), (v, a)]);
         };
-        if self.has("base.sx") {
-            for (k, c) in ["x", "y", "z"].iter().enumerate() {
-                let sva = BASE_TRANSLATION.map(|(q, _)| self.get(&format!("base.{q}{c}")));
-                position[k] = cas.add(position[k], sva[0]);
+        let translates = self
+            .layout
+            .get(Param::BaseTranslation(Rate::Value, Xyz::X))
+            .is_some();
+        if translates {
+            for c in Xyz::ALL {
+                let sva = Rate::ALL.map(|r| self.get(Param::BaseTranslation(r, c)));
+                position[c.index()] = cas.add(position[c.index()], sva[0]);
                 chain(&mut seeds, sva);
             }
         }
         let mut turns = Vec::new();
-        while self.has(&format!("base.turn[{}]", turns.len())) {
+        let turn = |i| Param::BaseTurn(Rate::Value, i);
+        while self.layout.get(turn(turns.len())).is_some() {
             let i = turns.len();
-            let t = BASE_TURN.map(|(q, _)| self.get(&format!("base.{q}[{i}]")));
+            let t = Rate::ALL.map(|r| self.get(Param::BaseTurn(r, i)));
             chain(&mut seeds, t);
             turns.push((t[0], t[1]));
         }
@@ -66,20 +82,9 @@ impl ParamSymbols {
         }
     }
 
-    /// The symbol of parameter `name`; kinematics only asks for names the
-    /// layout has, so a miss is a generator bug.
     /// The gravity vector.
     pub fn gravity(&self) -> [ExprId; 3] {
-        ["x", "y", "z"].map(|c| self.get(&format!("gravity.{c}")))
-    }
-
-    pub fn get(&self, name: &str) -> ExprId {
-        let i = self
-            .names
-            .iter()
-            .position(|n| n == name)
-            .unwrap_or_else(|| panic!("no parameter {name}"));
-        self.ids[i]
+        self.xyz(Param::Gravity)
     }
 }
 
@@ -94,22 +99,6 @@ pub struct BaseMotion {
     pub turns: Vec<(ExprId, ExprId)>,
     /// (parameter, its rate) pairs for the kinematic time derivatives.
     pub seeds: Vec<(ExprId, ExprId)>,
-}
-
-impl BaseMotion {
-    /// Whether parameter `name` is one of a moving base's.
-    fn moves(name: &str) -> bool {
-        let Some(rest) = name.strip_prefix("base.") else {
-            return false;
-        };
-        BASE_TURN
-            .iter()
-            .any(|(q, _)| rest.strip_prefix(q).is_some_and(|i| i.starts_with('[')))
-            || BASE_TRANSLATION.iter().any(|(q, _)| {
-                rest.strip_prefix(q)
-                    .is_some_and(|c| matches!(c, "x" | "y" | "z"))
-            })
-    }
 }
 
 /// q, qd symbols and their names.
@@ -263,7 +252,7 @@ pub fn tip_loads(
     mount: &TipMount,
 ) -> TipLoads {
     let zero = cas.zero();
-    let param = |name: &str| symbols.get(name);
+    let param = |p: Param| symbols.get(p);
     let along = |cas: &mut Cas, d: ExprId| -> [ExprId; 3] {
         std::array::from_fn(|k| {
             let o = cas.mul(d, mount.axis[k]);
@@ -272,19 +261,19 @@ pub fn tip_loads(
         })
     };
     let (point, centre) = if structure.tip_length {
-        let len = param("tip.length");
+        let len = param(Param::TipLength);
         let half = cas.scaled(0.5, len);
         (along(cas, len), along(cas, half))
     } else {
         (mount.point, mount.point)
     };
     let body = structure.tip_mass.then(|| Body {
-        mass: param("tip.mass"),
+        mass: param(Param::TipMass),
         inertia: if structure.tip_length {
             Inertia::Axisymmetric {
                 axis: mount.axis,
-                axial: param("tip.axial_inertia"),
-                lateral: param("tip.inertia"),
+                axial: param(Param::TipAxialInertia),
+                lateral: param(Param::TipInertia),
             }
         } else {
             Inertia::Isotropic(zero)
@@ -304,14 +293,14 @@ pub fn tip_loads(
         }
     };
     let force = structure.tip_force.then(|| {
-        let f = ["x", "y", "z"].map(|c| param(&format!("tip.force.{c}")));
+        let f = symbols.xyz(Param::TipForce);
         PointForce {
             point,
             force: oriented(cas, f),
         }
     });
     let moment = structure.tip_moment.then(|| {
-        let m = ["x", "y", "z"].map(|c| param(&format!("tip.moment.{c}")));
+        let m = symbols.xyz(Param::TipMoment);
         AppliedMoment {
             omega: mount.omega,
             moment: oriented(cas, m),

@@ -1,0 +1,766 @@
+//! Typed runtime parameters and their layout.
+//!
+//! A [`Param`] says what a parameter is (the stiffness of element 3's bend,
+//! the tension of tendon 0); a [`ParamLayout`] is the ordered list of the
+//! parameters a structure has, computed once by [`ParamLayout::of`], with
+//! an index per parameter. The generator, the link cells and the input
+//! channels all find a parameter's slot through the layout, never by its
+//! text name: names ([`Param::name`]) exist only for output, error
+//! messages and the tape's metadata.
+//!
+//! Invariant: the layout is a function of the [`Structure`] alone, so one
+//! derivation serves every model with that structure; the values come from
+//! the model at run time ([`ParamLayout::values`]).
+
+use std::collections::HashMap;
+
+use super::schema::{Joints, Method, Model};
+use super::structure::Structure;
+
+/// A component of a vector in the world frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Xyz {
+    X,
+    Y,
+    Z,
+}
+
+impl Xyz {
+    pub const ALL: [Xyz; 3] = [Xyz::X, Xyz::Y, Xyz::Z];
+
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    fn name(self) -> &'static str {
+        ["x", "y", "z"][self as usize]
+    }
+}
+
+/// A prescribed base quantity and its time derivatives: the input channel
+/// gives the value, its first and its second derivative.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Rate {
+    Value,
+    First,
+    Second,
+}
+
+impl Rate {
+    pub const ALL: [Rate; 3] = [Rate::Value, Rate::First, Rate::Second];
+
+    /// How often the input channel is differentiated.
+    pub fn derivative(self) -> u8 {
+        self as u8
+    }
+}
+
+/// One element's (link's, slice's) lumped quantities.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ElementParam {
+    /// Length at rest (m).
+    Length,
+    Mass,
+    /// Rotational inertia of each body about a lateral axis (planar: about
+    /// the plane's normal).
+    Inertia,
+    /// 3D: about the body's own axis.
+    AxialInertia,
+    /// Joint or bending stiffness E I / l_e (N m/rad) and its damping.
+    BendStiffness,
+    BendDamping,
+    /// Angle at rest: rest curvature times l_e.
+    Rest,
+    /// 3D: G J / l_e and its damping.
+    TwistStiffness,
+    TwistDamping,
+    /// 3D: E A / l_e and c / l_e.
+    StretchStiffness,
+    StretchDamping,
+    /// 3D, eba: G A / l_e.
+    ShearStiffness,
+}
+
+impl ElementParam {
+    /// The parameters of every element, in layout order.
+    pub const PLANAR: [ElementParam; 6] = [
+        Self::Length,
+        Self::Mass,
+        Self::Inertia,
+        Self::BendStiffness,
+        Self::BendDamping,
+        Self::Rest,
+    ];
+    /// The parameters 3D elements add, in layout order.
+    pub const SPATIAL: [ElementParam; 6] = [
+        Self::AxialInertia,
+        Self::TwistStiffness,
+        Self::TwistDamping,
+        Self::StretchStiffness,
+        Self::StretchDamping,
+        Self::ShearStiffness,
+    ];
+    /// A link cell's parameters, in the order the cell tape reads them
+    /// (`runtime::links::CELL_PARAMS` of them).
+    pub const CELL: [ElementParam; runtime::links::CELL_PARAMS] = [
+        Self::Length,
+        Self::Mass,
+        Self::Inertia,
+        Self::AxialInertia,
+        Self::BendStiffness,
+        Self::BendDamping,
+        Self::Rest,
+        Self::TwistStiffness,
+        Self::TwistDamping,
+        Self::StretchStiffness,
+        Self::StretchDamping,
+    ];
+
+    fn name(self, k: usize) -> String {
+        let (group, what) = match self {
+            Self::Length => ("element", "length"),
+            Self::Mass => ("element", "mass"),
+            Self::Inertia => ("element", "inertia"),
+            Self::AxialInertia => ("element", "axial_inertia"),
+            Self::BendStiffness => ("joint", "stiffness"),
+            Self::BendDamping => ("joint", "damping"),
+            Self::Rest => ("joint", "rest"),
+            Self::TwistStiffness => ("twist", "stiffness"),
+            Self::TwistDamping => ("twist", "damping"),
+            Self::StretchStiffness => ("stretch", "stiffness"),
+            Self::StretchDamping => ("stretch", "damping"),
+            Self::ShearStiffness => ("shear", "stiffness"),
+        };
+        format!("{group}[{k}].{what}")
+    }
+}
+
+/// What a driven chamber position contributes: its pressure (an input) and
+/// the lever of the pressure, the holes' total area and first moments.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ChamberParam {
+    Pressure,
+    Area,
+    /// a sum(z): the lever of a bend about y.
+    ArmY,
+    /// a sum(y): the lever of a bend about z.
+    ArmZ,
+}
+
+impl ChamberParam {
+    pub const ALL: [ChamberParam; 4] = [Self::Pressure, Self::Area, Self::ArmY, Self::ArmZ];
+}
+
+/// One runtime parameter, by what it is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Param {
+    Gravity(Xyz),
+    /// The declared clamp position.
+    BasePosition(Xyz),
+    /// 3D: the rotation taking +x to the base direction, row i, column j.
+    BaseRotation(u8, u8),
+    /// 3D: that rotation as a quaternion, w, x, y, z.
+    BaseQuaternion(u8),
+    /// Planar: the base direction's angle from +x.
+    BaseAngle,
+    /// A prescribed displacement of the base, its velocity and acceleration
+    /// (inputs).
+    BaseTranslation(Rate, Xyz),
+    /// Prescribed turn i of the base, its rate and acceleration (inputs).
+    BaseTurn(Rate, usize),
+    /// 3D: the unit axis of turn i.
+    BaseTurnAxis(usize, Xyz),
+    TipMass,
+    TipForce(Xyz),
+    TipMoment(Xyz),
+    /// A tip body's length, lateral and axial inertia (a cylinder).
+    TipLength,
+    TipInertia,
+    TipAxialInertia,
+    /// Element k's quantity.
+    Element(usize, ElementParam),
+    /// Driven chamber position `position` of segment `segment`.
+    Chamber {
+        segment: usize,
+        position: usize,
+        what: ChamberParam,
+    },
+    /// Tendon i's tension (an input).
+    TendonTension(usize),
+    /// Tendon i's offset in the section of a segment it spans: y, z.
+    TendonOffset {
+        tendon: usize,
+        segment: usize,
+        z: bool,
+    },
+    /// Joint torque i's generalised force (an input).
+    Torque(usize),
+}
+
+impl Param {
+    /// The parameter's name, as outputs, errors and the tape's metadata
+    /// show it.
+    pub fn name(self) -> String {
+        match self {
+            Self::Gravity(c) => format!("gravity.{}", c.name()),
+            Self::BasePosition(c) => format!("base.{}", c.name()),
+            Self::BaseRotation(i, j) => format!("base.R{i}{j}"),
+            Self::BaseQuaternion(c) => format!("base.{}", ["qw", "qx", "qy", "qz"][c as usize]),
+            Self::BaseAngle => "base.angle".into(),
+            Self::BaseTranslation(r, c) => {
+                format!("base.{}{}", ["s", "v", "a"][r as usize], c.name())
+            }
+            Self::BaseTurn(r, i) => format!("base.{}[{i}]", ["turn", "omega", "alpha"][r as usize]),
+            Self::BaseTurnAxis(i, c) => format!("base.axis[{i}].{}", c.name()),
+            Self::TipMass => "tip.mass".into(),
+            Self::TipForce(c) => format!("tip.force.{}", c.name()),
+            Self::TipMoment(c) => format!("tip.moment.{}", c.name()),
+            Self::TipLength => "tip.length".into(),
+            Self::TipInertia => "tip.inertia".into(),
+            Self::TipAxialInertia => "tip.axial_inertia".into(),
+            Self::Element(k, e) => e.name(k),
+            Self::Chamber {
+                segment,
+                position,
+                what,
+            } => {
+                let w = ["pressure", "area", "arm_y", "arm_z"][what as usize];
+                format!("chamber[{segment}][{position}].{w}")
+            }
+            Self::TendonTension(i) => format!("tendon[{i}].tension"),
+            Self::TendonOffset { tendon, segment, z } => {
+                format!("tendon[{tendon}][{segment}].{}", if z { "z" } else { "y" })
+            }
+            Self::Torque(i) => format!("torque[{i}]"),
+        }
+    }
+
+    /// A load that statics scales from 0 to 1 in its load continuation.
+    pub fn is_load(self) -> bool {
+        matches!(
+            self,
+            Self::Gravity(_) | Self::TipForce(_) | Self::TipMoment(_)
+        )
+    }
+
+    /// A parameter of a moving base: a variable of the kinematic time
+    /// derivatives (its rate is the next derivative's parameter).
+    pub fn moves_base(self) -> bool {
+        matches!(self, Self::BaseTranslation(..) | Self::BaseTurn(..))
+    }
+}
+
+/// A parameter an input channel drives, and how often the channel is
+/// differentiated for it (a moving base's velocity and acceleration).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Driven {
+    pub param: Param,
+    pub derivative: u8,
+}
+
+/// The ordered parameters of one structure, with an index per parameter.
+#[derive(Clone, Debug)]
+pub struct ParamLayout {
+    params: Vec<Param>,
+    index: HashMap<Param, usize>,
+    driven: Vec<Driven>,
+}
+
+impl ParamLayout {
+    /// The layout of `st`: gravity, base, base motion, tip, elements,
+    /// actuators, torques.
+    pub fn of(st: &Structure) -> Self {
+        let spatial = st.dimensions == 3;
+        let mut p = Vec::new();
+        let mut driven = Vec::new();
+        let mut drive = |p: &mut Vec<Param>, param: Param, derivative: u8| {
+            driven.push(Driven { param, derivative });
+            p.push(param);
+        };
+        p.extend(Xyz::ALL.map(Param::Gravity));
+        p.extend(Xyz::ALL.map(Param::BasePosition));
+        if spatial {
+            for i in 0..3 {
+                p.extend((0..3).map(|j| Param::BaseRotation(i, j)));
+            }
+            p.extend((0..4).map(Param::BaseQuaternion));
+        } else {
+            p.push(Param::BaseAngle);
+        }
+        if st.base_translates {
+            // In the plane the base moves in x and y; its z stays put.
+            let moving = if spatial { 3 } else { 2 };
+            for r in Rate::ALL {
+                for c in Xyz::ALL {
+                    let param = Param::BaseTranslation(r, c);
+                    match c.index() < moving {
+                        true => drive(&mut p, param, r.derivative()),
+                        false => p.push(param),
+                    }
+                }
+            }
+        }
+        for i in 0..st.base_turns {
+            for r in Rate::ALL {
+                drive(&mut p, Param::BaseTurn(r, i), r.derivative());
+            }
+            if spatial {
+                p.extend(Xyz::ALL.map(|c| Param::BaseTurnAxis(i, c)));
+            }
+        }
+        if st.tip_mass {
+            p.push(Param::TipMass);
+        }
+        if st.tip_force {
+            for c in Xyz::ALL {
+                match st.tip_force_driven {
+                    true => drive(&mut p, Param::TipForce(c), 0),
+                    false => p.push(Param::TipForce(c)),
+                }
+            }
+        }
+        if st.tip_moment {
+            for c in Xyz::ALL {
+                match st.tip_moment_driven {
+                    true => drive(&mut p, Param::TipMoment(c), 0),
+                    false => p.push(Param::TipMoment(c)),
+                }
+            }
+        }
+        if st.tip_length {
+            p.extend([Param::TipLength, Param::TipInertia, Param::TipAxialInertia]);
+        }
+        for k in 0..st.elements() {
+            p.extend(ElementParam::PLANAR.map(|e| Param::Element(k, e)));
+            if spatial {
+                p.extend(ElementParam::SPATIAL.map(|e| Param::Element(k, e)));
+            }
+        }
+        for (segment, &count) in st.chambers.iter().enumerate() {
+            for position in 0..count {
+                for what in ChamberParam::ALL {
+                    let param = Param::Chamber {
+                        segment,
+                        position,
+                        what,
+                    };
+                    match what {
+                        ChamberParam::Pressure => drive(&mut p, param, 0),
+                        _ => p.push(param),
+                    }
+                }
+            }
+        }
+        for (tendon, &end) in st.tendons.iter().enumerate() {
+            drive(&mut p, Param::TendonTension(tendon), 0);
+            for segment in 0..=end {
+                for z in [false, true] {
+                    p.push(Param::TendonOffset { tendon, segment, z });
+                }
+            }
+        }
+        for i in 0..st.torques.len() {
+            drive(&mut p, Param::Torque(i), 0);
+        }
+        // Drives in the order input channels are bound: base, tip, chambers,
+        // tendons, torques (the layout's order).
+        let index = p.iter().enumerate().map(|(i, &q)| (q, i)).collect();
+        Self {
+            params: p,
+            index,
+            driven,
+        }
+    }
+
+    /// The slot of `p`. The generator asks only for parameters its
+    /// structure has, so a miss is a generator bug.
+    pub fn index(&self, p: Param) -> usize {
+        match self.index.get(&p) {
+            Some(&i) => i,
+            None => panic!("parameter {} is not in the layout", p.name()),
+        }
+    }
+
+    /// The slot of `p`, if the structure has it.
+    pub fn get(&self, p: Param) -> Option<usize> {
+        self.index.get(&p).copied()
+    }
+
+    pub fn len(&self) -> usize {
+        self.params.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.params.is_empty()
+    }
+
+    /// The parameters in layout order.
+    pub fn params(&self) -> &[Param] {
+        &self.params
+    }
+
+    pub fn names(&self) -> Vec<String> {
+        self.params.iter().map(|p| p.name()).collect()
+    }
+
+    /// The parameters input channels drive (never folded into derived
+    /// parameters: they change during a run).
+    pub fn driven(&self) -> &[Driven] {
+        &self.driven
+    }
+
+    /// The slots of the loads (statics scales them).
+    pub fn loads(&self) -> Vec<usize> {
+        (0..self.params.len())
+            .filter(|&i| self.params[i].is_load())
+            .collect()
+    }
+
+    /// The values of a model with this layout's structure, in layout order
+    /// (driven parameters start at 0: their signals set them).
+    pub fn values(&self, m: &Model) -> Vec<f64> {
+        let elements = element_props(m);
+        let d = m.base.direction;
+        let rotation = base_rotation(d);
+        let quaternion = base_quaternion(d);
+        self.params
+            .iter()
+            .map(|&p| match p {
+                Param::Gravity(c) => m.gravity[c.index()],
+                Param::BasePosition(c) => m.base.position[c.index()],
+                Param::BaseRotation(i, j) => rotation[i as usize][j as usize],
+                Param::BaseQuaternion(c) => quaternion[c as usize],
+                Param::BaseAngle => d[1].atan2(d[0]),
+                Param::BaseTranslation(..) | Param::BaseTurn(..) => 0.0,
+                Param::BaseTurnAxis(i, c) => {
+                    let a = base_turn_axis(m, i);
+                    a[c.index()] / (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+                }
+                Param::TipMass => m.tip.mass.unwrap_or(0.0),
+                Param::TipForce(c) => m.tip.force.map_or(0.0, |f| f[c.index()]),
+                Param::TipMoment(c) => m.tip.moment.map_or(0.0, |f| f[c.index()]),
+                Param::TipLength => m.tip.length.unwrap_or(0.0),
+                // A uniform cylinder along the tip axis, about its centre.
+                Param::TipInertia => {
+                    let (mass, r) = (m.tip.mass.unwrap_or(0.0), m.tip.radius.unwrap_or(0.0));
+                    let len = m.tip.length.unwrap_or(0.0);
+                    mass * (3.0 * r * r + len * len) / 12.0
+                }
+                Param::TipAxialInertia => {
+                    let (mass, r) = (m.tip.mass.unwrap_or(0.0), m.tip.radius.unwrap_or(0.0));
+                    mass * r * r / 2.0
+                }
+                Param::Element(k, e) => elements[k].get(e),
+                Param::Chamber {
+                    segment,
+                    position,
+                    what,
+                } => chamber_value(m, segment, position, what),
+                Param::TendonTension(_) | Param::Torque(_) => 0.0,
+                Param::TendonOffset { tendon, segment, z } => {
+                    let t = &m.tendons[tendon];
+                    let d = t.distance.at(segment);
+                    let angle = t.angle.as_ref().map_or(0.0, |a| a.at(segment)).to_radians();
+                    if z { d * angle.sin() } else { d * angle.cos() }
+                }
+            })
+            .collect()
+    }
+}
+
+/// The input channel that drives `p` in model `m` (`None` for a parameter
+/// no channel drives).
+pub fn channel(m: &Model, p: Param) -> Option<&str> {
+    let name = match p {
+        Param::BaseTranslation(_, c) => m.base.translation_inputs.as_ref()?.get(c.index()),
+        Param::BaseTurn(_, i) => m.base.rotation_inputs.as_ref()?.get(i),
+        Param::TipForce(c) => m.tip.force_inputs.as_ref()?.get(c.index()),
+        Param::TipMoment(c) => m.tip.moment_inputs.as_ref()?.get(c.index()),
+        Param::Chamber {
+            segment,
+            position,
+            what: ChamberParam::Pressure,
+        } => m.segments[segment]
+            .chambers
+            .as_ref()?
+            .inputs
+            .as_ref()?
+            .get(position),
+        Param::TendonTension(i) => Some(&m.tendons[i].input),
+        Param::Torque(i) => Some(&m.torques[i].input),
+        _ => None,
+    };
+    name.map(String::as_str)
+}
+
+/// A driven chamber position's pressure (0: its input sets it) and lever:
+/// the holes' total area and first moments a sum(z), a sum(y).
+fn chamber_value(m: &Model, segment: usize, position: usize, what: ChamberParam) -> f64 {
+    let c = m.segments[segment]
+        .chambers
+        .as_ref()
+        .expect("the structure has this segment's chambers");
+    let a = c.hole_area();
+    let angle = c.positions()[position];
+    let holes: Vec<f64> = match c.pair_spacing {
+        Some(spacing) => vec![angle - spacing, angle + spacing],
+        None => vec![angle],
+    };
+    let (y, z) = holes.iter().fold((0.0, 0.0), |(y, z), h| {
+        let h = h.to_radians();
+        (y + c.distance * h.cos(), z + c.distance * h.sin())
+    });
+    match what {
+        ChamberParam::Pressure => 0.0,
+        ChamberParam::Area => a * holes.len() as f64,
+        ChamberParam::ArmY => a * z,
+        ChamberParam::ArmZ => a * y,
+    }
+}
+
+/// Names and values of a model's runtime parameters, in layout order.
+pub fn parameters(m: &Model) -> Vec<(String, f64)> {
+    let layout = ParamLayout::of(&Structure::of(m));
+    layout.names().into_iter().zip(layout.values(m)).collect()
+}
+
+/// Per-element physical quantities, from the declared segment.
+#[derive(Clone, Copy, Debug)]
+pub struct ElementProps {
+    pub length: f64,
+    pub mass: f64,
+    /// Rotational inertia (about the axis normal to the plane) of each rigid
+    /// body of the element about its centre of mass: the whole link (rigid,
+    /// base joints), each half link (rigid, midpoint joints), or the
+    /// section's part m (r_o^2 + r_i^2) / 4 (pcc: the arc's part depends on
+    /// the bend and is derived symbolically).
+    pub inertia: f64,
+    /// Joint or bending stiffness of the element (N m/rad): E I / l_e.
+    pub stiffness: f64,
+    /// Joint or bending damping (N m s/rad): eta / l_e.
+    pub damping: f64,
+    /// Angle at rest (rad): rest curvature times l_e.
+    pub rest: f64,
+    /// 3D: moment of inertia of each body about its own axis.
+    pub axial_inertia: f64,
+    /// 3D: G J / l_e (N m/rad) and its damping.
+    pub twist_stiffness: f64,
+    pub twist_damping: f64,
+    /// 3D: E A / l_e (N/m) and c / l_e (N s/m).
+    pub stretch_stiffness: f64,
+    pub stretch_damping: f64,
+    /// 3D, eba: G A / l_e (N/m).
+    pub shear_stiffness: f64,
+}
+
+impl ElementProps {
+    pub fn get(&self, e: ElementParam) -> f64 {
+        match e {
+            ElementParam::Length => self.length,
+            ElementParam::Mass => self.mass,
+            ElementParam::Inertia => self.inertia,
+            ElementParam::AxialInertia => self.axial_inertia,
+            ElementParam::BendStiffness => self.stiffness,
+            ElementParam::BendDamping => self.damping,
+            ElementParam::Rest => self.rest,
+            ElementParam::TwistStiffness => self.twist_stiffness,
+            ElementParam::TwistDamping => self.twist_damping,
+            ElementParam::StretchStiffness => self.stretch_stiffness,
+            ElementParam::StretchDamping => self.stretch_damping,
+            ElementParam::ShearStiffness => self.shear_stiffness,
+        }
+    }
+}
+
+pub fn element_props(m: &Model) -> Vec<ElementProps> {
+    let mut out = Vec::new();
+    for s in &m.segments {
+        let n = s.slices() as f64;
+        let l = s.length / n;
+        let ro = s.outer_radius.unwrap_or(0.0);
+        let ri = s.inner_radius.unwrap_or(0.0);
+        let mass = match (s.mass, s.density) {
+            (Some(mass), _) => mass / n,
+            (None, Some(rho)) => rho * s.area().unwrap_or(0.0) * l,
+            (None, None) => 0.0, // rejected by validation
+        };
+        // Uniform cylinders (hollow, solid, with chamber holes) about a
+        // diameter through the centre, m I / A ((r_o^2 + r_i^2) / 4 for a
+        // ring); slender rods when no radius is given.
+        let section = match (s.second_moment(), s.area()) {
+            (Some(i), Some(a)) if a > 0.0 => mass * i / a,
+            _ => mass * (ro * ro + ri * ri) / 4.0,
+        };
+        // Bodies: the whole link, or two half links (midpoint joints), or
+        // the section's part of a pcc arc (in 2D the arc's part is derived
+        // symbolically; in 3D the arc is lumped as a straight slice, below).
+        let halves = matches!(
+            (s.method, s.joint_placement()),
+            (Method::Rigid, Joints::Midpoint) | (Method::Ebr, _)
+        );
+        let (inertia, axial_inertia) = match s.method {
+            Method::Rigid if !halves => (mass * l * l / 12.0 + section, 2.0 * section),
+            Method::Rigid | Method::Ebr => (
+                (mass / 2.0) * (l / 2.0).powi(2) / 12.0 + section / 2.0,
+                section,
+            ),
+            Method::Pcc | Method::Vc | Method::Rom | Method::Eba | Method::Cosserat => {
+                let slice = if m.dimensions == 3 {
+                    mass * l * l / 12.0
+                } else {
+                    0.0
+                };
+                (section + slice, 2.0 * section)
+            }
+        };
+        let stiffness = match s.ei() {
+            Some(ei) => ei / l,
+            None => s.joint_stiffness.unwrap_or(0.0),
+        };
+        let damping = match s.bending_damping {
+            Some(eta) => eta / l,
+            None => s.joint_damping.unwrap_or(0.0),
+        };
+        let twist_stiffness = match s.gj() {
+            Some(gj) => gj / l,
+            None => s.joint_stiffness.unwrap_or(0.0),
+        };
+        let stretch_stiffness = s.ea().unwrap_or(0.0) / l;
+        let stretch_damping = s.axial_damping.unwrap_or(0.0) / l;
+        let shear_stiffness = s.ga().unwrap_or(0.0) / l;
+        for _ in 0..s.slices() {
+            out.push(ElementProps {
+                length: l,
+                mass,
+                inertia,
+                stiffness,
+                damping,
+                rest: s.rest_curvature * l,
+                axial_inertia,
+                twist_stiffness,
+                twist_damping: damping,
+                stretch_stiffness,
+                stretch_damping,
+                shear_stiffness,
+            });
+        }
+    }
+    out
+}
+
+/// The axis of base turn i: as declared, else z, y, x in turn.
+pub fn base_turn_axis(m: &Model, i: usize) -> [f64; 3] {
+    const DEFAULT: [[f64; 3]; 3] = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]];
+    m.base
+        .rotation_axes
+        .as_ref()
+        .and_then(|a| a.get(i).copied())
+        .unwrap_or(DEFAULT[i % 3])
+}
+
+/// The quaternion (w, x, y, z) of [`base_rotation`]: (1 + c, x × u)
+/// normalised, with c = x . u.
+pub fn base_quaternion(d: [f64; 3]) -> [f64; 4] {
+    let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let u = [d[0] / n, d[1] / n, d[2] / n];
+    let c = u[0];
+    if c < -1.0 + 1e-12 {
+        return [0.0, 0.0, 0.0, 1.0];
+    }
+    let s = (2.0 * (1.0 + c)).sqrt();
+    [(1.0 + c) / s, 0.0, -u[2] / s, u[1] / s]
+}
+
+/// The rotation (rows) taking +x to the unit vector along `d` by the
+/// shortest turn; a half turn about z when `d` points along -x.
+pub fn base_rotation(d: [f64; 3]) -> [[f64; 3]; 3] {
+    let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let u = [d[0] / n, d[1] / n, d[2] / n];
+    let c = u[0];
+    if c < -1.0 + 1e-12 {
+        return [[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]];
+    }
+    // v = x × u = (0, -u_z, u_y); R = I + [v]x + [v]x^2 / (1 + c)
+    let v = [0.0, -u[2], u[1]];
+    let k = [[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]];
+    let mut r = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            let k2: f64 = (0..3).map(|m| k[i][m] * k[m][j]).sum();
+            r[i][j] = f64::from(u8::from(i == j)) + k[i][j] + k2 / (1.0 + c);
+        }
+    }
+    r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::parse_model;
+
+    /// Every parameter's name is unique and its index is its position: the
+    /// typed layout and the named one are one list.
+    #[test]
+    fn names_are_unique_and_indices_are_positions() {
+        let text = r#"
+name = "t"
+dimensions = 3
+gravity = [0.0, 0.0, -9.81]
+[base]
+direction = [1.0, 0.0, 0.0]
+translation_inputs = ["a", "a", "a"]
+rotation_inputs = ["a", "a"]
+[[segment]]
+method = "pcc"
+length = 0.1
+elements = 2
+density = 1000.0
+outer_radius = 0.01
+youngs_modulus = 1e6
+extension = true
+[segment.chambers]
+count = 3
+radius = 0.002
+distance = 0.005
+inputs = ["a", "a", "a"]
+[[tendon]]
+input = "a"
+distance = 0.006
+[[torque]]
+coordinate = "bend_y_0_0"
+input = "a"
+[tip]
+mass = 0.01
+length = 0.01
+radius = 0.005
+force_inputs = ["a", "a", "a"]
+moment = [0.0, 0.0, 0.0]
+[inputs.a]
+kind = "constant"
+value = 1.0
+"#;
+        let m = parse_model(text, "t.toml", false, &[]).unwrap();
+        let layout = ParamLayout::of(&Structure::of(&m));
+        let names = layout.names();
+        let mut sorted = names.clone();
+        sorted.sort();
+        sorted.dedup();
+        assert_eq!(sorted.len(), names.len(), "duplicate names: {names:?}");
+        for (i, &p) in layout.params().iter().enumerate() {
+            assert_eq!(layout.index(p), i);
+        }
+        for d in layout.driven() {
+            assert_eq!(channel(&m, d.param), Some("a"), "{}", d.param.name());
+        }
+        // Driven: 9 base translation, 6 turn, 3 tip force, 3 pressures,
+        // 1 tension, 1 torque; the tip moment is a constant.
+        assert_eq!(layout.driven().len(), 9 + 6 + 3 + 3 + 1 + 1);
+        assert!(
+            layout
+                .driven()
+                .iter()
+                .all(|d| !matches!(d.param, Param::TipMoment(_)))
+        );
+        assert_eq!(layout.values(&m).len(), layout.len());
+    }
+}
