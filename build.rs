@@ -1,4 +1,4 @@
-//! Keeps `generated/` in step with `models/` (DESIGN.md section 1).
+//! Keeps `generated/` in step with `models/` (docs/design.md section 1).
 //!
 //! A model whose structural hash matches its generated file is not
 //! re-derived; files are rewritten only when their content changes. Set

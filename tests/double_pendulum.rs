@@ -1,5 +1,5 @@
 //! The TMT derivation against the textbook double pendulum of uniform rods
-//! (DESIGN.md section 5), with joint springs and dampers, through the
+//! (docs/design.md section 5), with joint springs and dampers, through the
 //! library (both backends) and through `softarm eom`.
 
 mod common;

@@ -1,7 +1,7 @@
 //! Tapes -> Rust source, with quote and prettyplease.
 //!
 //! Each kernel becomes straight-line SSA split into `#[inline(never)]`
-//! chunks of at most [`CHUNK_OPS`] operations (DESIGN.md section 6: one giant
+//! chunks of at most [`CHUNK_OPS`] operations (docs/design.md section 6: one giant
 //! function makes rustc superlinear). A value used by a later chunk is
 //! spilled to a workspace array; inputs and constants are read in place.
 

@@ -1,4 +1,4 @@
-//! TMT assembly (DESIGN.md section 2):
+//! TMT assembly (docs/design.md section 2):
 //!
 //!   M = sum_i T_i^T Mbar_i T_i,
 //!   h = sum_i T_i^T (Mbar_i a_i + [0; w_i x I_i w_i] - [m_i g; 0])
