@@ -168,7 +168,7 @@ pub struct SimulateArgs {
     #[arg(long, allow_negative_numbers = true)]
     pub atol: Option<f64>,
     /// Give up after this many steps (accepted and rejected).
-    #[arg(long, default_value_t = 10_000_000)]
+    #[arg(long, default_value_t = SimOptions::default().max_steps)]
     pub max_steps: usize,
     /// Spacing of trajectory.csv rows (s); default t_end / 500.
     #[arg(long, allow_negative_numbers = true)]
@@ -253,17 +253,19 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
             .q;
     }
     let arm = &*loaded.arm;
-    // The command line, else the model's [simulate], else the defaults.
+    // The command line, else the model's [simulate], else runtime's
+    // defaults.
     let file = &loaded.model.simulate;
-    let t_end = a.t_end.or(file.t_end).unwrap_or(5.0);
-    let dt = a.dt.or(file.dt).unwrap_or(1e-3);
-    let rtol = a.rtol.or(file.rtol).unwrap_or(1e-6);
-    let atol = a.atol.or(file.atol).unwrap_or(1e-9);
+    let defaults = SimOptions::default();
+    let t_end = a.t_end.or(file.t_end).unwrap_or(defaults.t_end);
+    let dt = a.dt.or(file.dt).unwrap_or(defaults.dt);
+    let rtol = a.rtol.or(file.rtol).unwrap_or(defaults.rtol);
+    let atol = a.atol.or(file.atol).unwrap_or(defaults.atol);
     let solver_name = a
         .solver
         .clone()
         .or(file.solver.clone())
-        .unwrap_or_else(|| "dopri5".into());
+        .unwrap_or_else(|| defaults.solver.name().into());
     if !(t_end > 0.0 && t_end.is_finite()) {
         bail!("--t-end must be a positive number of seconds, got {t_end}");
     }
@@ -277,7 +279,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     }
     let qd0 = optional_vector("--qd0", &a.qd0, n, &coords)?;
     let solver = Solver::parse(&solver_name).expect("clap and validation checked the name");
-    let output_dt = a.output_dt.unwrap_or(t_end / 500.0);
+    let output_dt = a.output_dt.unwrap_or(t_end / runtime::DEFAULT_SAMPLES);
     if !(output_dt > 0.0 && output_dt.is_finite()) {
         bail!("--output-dt must be positive, got {output_dt}");
     }

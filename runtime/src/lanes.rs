@@ -11,6 +11,8 @@
 
 use std::arch::x86_64::__m256d;
 
+use crate::rodrigues::{self, FAMILY_J, FAMILY_ORDERS, INV_FACTORIAL, SERIES_BELOW, TOPS};
+
 /// The lanes as an array.
 #[inline(always)]
 pub fn to_array(v: __m256d) -> [f64; 4] {
@@ -52,6 +54,107 @@ pub fn sin_cos(x: __m256d) -> (__m256d, __m256d) {
 /// without `unsafe`).
 #[target_feature(enable = "avx,fma")]
 #[inline]
-pub fn family<const N: usize>(w: __m256d) -> [[__m256d; N]; crate::rodrigues::FAMILY_J] {
-    crate::rodrigues::family_x4::<N>(w)
+pub fn family<const N: usize>(w: __m256d) -> [[__m256d; N]; FAMILY_J] {
+    family_x4::<N>(w)
+}
+
+/// [`family`](crate::rodrigues::family) of four arguments in the lanes of a vector, with the bits
+/// of four scalar calls: the same sums in the same order (the scalar code
+/// does not fuse them either), lane by lane where the lanes would take
+/// different branches.
+///
+/// # Safety
+/// The processor must have AVX and FMA (code built with both calls it
+/// without `unsafe`).
+#[target_feature(enable = "avx,fma")]
+#[inline]
+pub fn family_x4<const N: usize>(
+    w: std::arch::x86_64::__m256d,
+) -> [[std::arch::x86_64::__m256d; N]; FAMILY_J] {
+    use std::arch::x86_64::*;
+    const { assert!(N <= FAMILY_ORDERS) };
+    let lanes = to_array(w);
+    let below = |limit: f64| lanes.iter().all(|x| x.abs() < limit);
+    let tops: [[__m256d; N]; 2] = if below(1.0) {
+        tops_x4::<N, 8>(w)
+    } else if below(SERIES_BELOW) && lanes.iter().all(|x| x.abs() >= 1.0) {
+        tops_x4::<N, 12>(w)
+    } else {
+        let v = lanes.map(rodrigues::family::<N>);
+        return std::array::from_fn(|j| {
+            std::array::from_fn(|n| from_array(std::array::from_fn(|l| v[l][j][n])))
+        });
+    };
+    let mut c = [[_mm256_setzero_pd(); N]; FAMILY_J];
+    c[FAMILY_J - 2] = tops[0];
+    c[FAMILY_J - 1] = tops[1];
+    for j in (0..FAMILY_J - 2).rev() {
+        for n in 0..N {
+            let wc = _mm256_mul_pd(w, c[j + 2][n]);
+            c[j][n] = if n == 0 {
+                _mm256_sub_pd(_mm256_set1_pd(INV_FACTORIAL[j]), wc)
+            } else {
+                let neg = _mm256_xor_pd(wc, _mm256_set1_pd(-0.0));
+                _mm256_sub_pd(
+                    neg,
+                    _mm256_mul_pd(_mm256_set1_pd(n as f64), c[j + 2][n - 1]),
+                )
+            };
+        }
+    }
+    c
+}
+
+#[target_feature(enable = "avx,fma")]
+#[inline]
+fn tops_x4<const N: usize, const T: usize>(
+    w: std::arch::x86_64::__m256d,
+) -> [[std::arch::x86_64::__m256d; N]; 2] {
+    use std::arch::x86_64::*;
+    let mut s = [[_mm256_setzero_pd(); N]; 2];
+    for k in (0..T).rev() {
+        for t in 0..2 {
+            for n in 0..N {
+                s[t][n] = _mm256_add_pd(_mm256_mul_pd(s[t][n], w), _mm256_set1_pd(TOPS[t][n][k]));
+            }
+        }
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Four arguments in lanes give the bits of four scalar calls, when
+    /// the lanes share a branch and when they do not.
+    #[test]
+    fn family_in_lanes_has_the_bits_of_the_scalar_family() {
+        if !(is_x86_feature_detected!("avx") && is_x86_feature_detected!("fma")) {
+            return;
+        }
+        let groups = [
+            [0.0, 1e-9, -0.3, 0.97],
+            [1.0, -2.5, 8.9, 4.0],
+            [0.5, 3.0, -20.0, 120.0],
+            [-1e-300, 0.999_999, 1.000_001, -8.999],
+        ];
+        for w in groups {
+            // SAFETY: AVX and FMA are available (checked above).
+            let lanes = unsafe { family_x4::<3>(from_array(w)) };
+            for (l, &wl) in w.iter().enumerate() {
+                let scalar = rodrigues::family::<3>(wl);
+                for j in 0..FAMILY_J {
+                    for n in 0..3 {
+                        let got = to_array(lanes[j][n])[l];
+                        assert_eq!(
+                            got.to_bits(),
+                            scalar[j][n].to_bits(),
+                            "w {wl} c_{j} order {n}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 }

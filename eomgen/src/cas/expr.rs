@@ -123,7 +123,7 @@ pub struct Cas {
     pub(crate) diff_memo: HashMap<(ExprId, SymId), ExprId>,
     pub(crate) variables_memo: HashMap<ExprId, Variables>,
     /// Rate rules of turned vectors (`turning.rs`).
-    pub(crate) turned: HashMap<ExprId, super::turning::Turned>,
+    pub(crate) turned: HashMap<ExprId, Turned>,
     /// Parameters that change with time (a prescribed base motion): to
     /// time derivatives they are variables, not constants.
     moving: rustc_hash::FxHashSet<SymId>,
@@ -275,4 +275,16 @@ impl Cas {
         }
         count
     }
+}
+
+/// How a bound component of R x moves: the frame (R, w) and the local x
+/// (recorded by `Cas::turn`, applied by `Cas::kinematic_rates`).
+#[derive(Clone, Copy)]
+pub(crate) struct Turned {
+    pub(crate) r: [[ExprId; 3]; 3],
+    pub(crate) w: [ExprId; 3],
+    pub(crate) local: [ExprId; 3],
+    /// The bound components of R x, this one among them.
+    pub(crate) world: [ExprId; 3],
+    pub(crate) component: usize,
 }

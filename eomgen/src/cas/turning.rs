@@ -15,18 +15,7 @@
 //! point applies it: the other directional derivatives (a partial
 //! derivative, M qdd as the derivative along qd -> qdd) go through R_f.
 
-use super::expr::{Cas, ExprId};
-
-/// How a bound component of R x moves: the frame (R, w) and the local x.
-#[derive(Clone, Copy)]
-pub(crate) struct Turned {
-    r: [[ExprId; 3]; 3],
-    w: [ExprId; 3],
-    local: [ExprId; 3],
-    /// The bound components of R x, this one among them.
-    world: [ExprId; 3],
-    component: usize,
-}
+use super::expr::{Cas, ExprId, Turned};
 
 impl Cas {
     /// R x for a frame with rotation `r` (rows, world from frame) and world

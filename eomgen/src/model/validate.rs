@@ -54,13 +54,13 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
 
     let sim = &m.simulate;
     if let Some(solver) = &sim.solver
-        && !runtime::SOLVER_NAMES.contains(&solver.as_str())
+        && !runtime::Solver::NAMES.contains(&solver.as_str())
     {
         return err(
             "simulate.solver".into(),
             format!(
                 "unknown solver \"{solver}\"; allowed: {}",
-                runtime::SOLVER_NAMES.join(", ")
+                runtime::Solver::NAMES.join(", ")
             ),
         );
     }

@@ -12,7 +12,7 @@
 use differential_equations::error::Error;
 use nalgebra::{DMatrix, DVector};
 
-use crate::stepper::{
+use super::stepper::{
     Counts, Hermite, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, begin_step, error_norm,
     next_step,
 };

@@ -7,7 +7,7 @@
 
 use differential_equations::error::Error;
 
-use crate::stepper::{
+use super::stepper::{
     Counts, Hermite, OdeSystem, Options, StepFn, begin_step, error_norm, next_step,
 };
 

@@ -16,7 +16,7 @@ use differential_equations::error::Error;
 use differential_equations::interpolate::Interpolation;
 use nalgebra::{DMatrix, DVector};
 
-use crate::stepper::{Counts, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, begin_step};
+use super::stepper::{Counts, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, begin_step};
 
 /// sqrt(6)
 const SQ6: f64 = 2.449_489_742_783_178;

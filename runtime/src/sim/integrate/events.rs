@@ -12,7 +12,7 @@ use std::sync::Arc;
 use differential_equations::interpolate::Interpolation;
 use serde::Serialize;
 
-use crate::integrate::StateVec;
+use super::state::StateVec;
 
 /// Which sign changes count.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

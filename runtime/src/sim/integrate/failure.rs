@@ -1,0 +1,139 @@
+//! An integration that gave up, explained: when, why, and what to try.
+
+use std::time::Instant;
+
+use differential_equations::prelude::*;
+
+use super::ode::ArmOde;
+use super::options::SimOptions;
+use super::record::{Recorded, SimStats, Trajectory};
+use super::state::StateVec;
+use crate::arm::Dynamics;
+
+pub(super) type Outcome<Y> = Result<Solution<f64, Y>, Error<f64, Y>>;
+
+/// An integration that gave up, with what was computed up to then.
+#[derive(Debug)]
+pub struct SimFailure {
+    pub t_reached: f64,
+    /// The last accepted step (s); None if none was accepted.
+    pub last_step_s: Option<f64>,
+    pub reason: String,
+    pub suggestion: String,
+    pub state: Vec<f64>,
+    pub trajectory: Trajectory,
+    pub stats: SimStats,
+}
+
+impl std::fmt::Display for SimFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "integration stopped at t = {:.6} s", self.t_reached)?;
+        if let Some(h) = self.last_step_s {
+            write!(f, " (last accepted step {h:.3e} s)")?;
+        }
+        write!(f, ": {}\n  what to try: {}", self.reason, self.suggestion)
+    }
+}
+
+/// Turn the crate's outcome into a trajectory (padding dropped) or an
+/// explained failure.
+pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
+    result: Outcome<Y>,
+    ode: &ArmOde<'_, D>,
+    blown_up: Option<f64>,
+    x0: &[f64],
+    opts: &SimOptions,
+    start: Instant,
+    recorded: Recorded,
+) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
+    let Recorded { kept, last_step_s } = recorded;
+    let hits = kept.events.clone();
+    let wall_s = start.elapsed().as_secs_f64();
+    let m = 2 * ode.n;
+    let stats_of = |steps: usize, rejected: usize| SimStats {
+        solver: opts.solver,
+        steps,
+        rejected_steps: rejected,
+        rhs_evaluations: ode.evals.get(),
+        jacobian_evaluations: ode.jac_evals.get(),
+        wall_s,
+        switched: None,
+    };
+    let cause = ode.first_error.borrow().clone();
+    let explain = |fallback: String| match &cause {
+        Some(e) => e.to_string(),
+        None => fallback,
+    };
+    let unpad = |y: &Y| y.as_ref()[..m].to_vec();
+    match result {
+        Ok(sol) => {
+            let stats = stats_of(sol.steps.accepted, sol.steps.rejected);
+            let traj = Trajectory {
+                t: sol.t.clone(),
+                x: sol.y.iter().map(unpad).collect(),
+                events: hits,
+            };
+            if let Some(t_bad) = blown_up {
+                let state = traj.x.last().cloned().unwrap_or_else(|| x0.to_vec());
+                return Err(Box::new(SimFailure {
+                    t_reached: t_bad,
+                    last_step_s,
+                    reason: explain("the state became non-finite (NaN or infinite)".into()),
+                    suggestion: format!(
+                        "the fixed step dt = {} is probably above the stability limit: reduce --dt, \
+                         or use an adaptive solver (dopri5, or radau5 for stiff arms)",
+                        opts.dt
+                    ),
+                    state,
+                    trajectory: traj,
+                    stats,
+                }));
+            }
+            Ok((traj, stats))
+        }
+        Err(e) => {
+            let (t_reached, state, reason, suggestion) = match e {
+                Error::StepSize { t, y } => (
+                    t,
+                    unpad(&y),
+                    explain("the step size fell below the smallest allowed step".into()),
+                    if opts.solver.implicit() {
+                        "relax --rtol/--atol, or reduce the element count".to_string()
+                    } else {
+                        "the arm may be stiff: try --solver radau5 or bdf, relax --rtol/--atol, \
+                         or reduce the element count"
+                            .to_string()
+                    },
+                ),
+                Error::MaxSteps { t, y } => (
+                    t,
+                    unpad(&y),
+                    format!("the step budget of {} steps ran out", opts.max_steps),
+                    "shorten --t-end, relax --rtol/--atol, or use an implicit solver for stiff arms"
+                        .to_string(),
+                ),
+                Error::Stiffness { t, y } => (
+                    t,
+                    unpad(&y),
+                    explain("the method detected stiffness".into()),
+                    "use an implicit solver: --solver radau5, bdf or esdirk".to_string(),
+                ),
+                other => (
+                    0.0,
+                    x0.to_vec(),
+                    explain(format!("{other:?}")),
+                    "check the model and the solver options".to_string(),
+                ),
+            };
+            Err(Box::new(SimFailure {
+                t_reached,
+                last_step_s,
+                reason,
+                suggestion,
+                state,
+                trajectory: kept,
+                stats: stats_of(0, 0),
+            }))
+        }
+    }
+}

@@ -1,0 +1,58 @@
+//! Time integration of an arm, on the `differential-equations` crate.
+//!
+//! The state is x = [q, qd]; the right-hand side solves M qdd = -h (see
+//! `accelerations`), and implicit methods get the analytic Jacobian
+//! (`rhs_jacobian`). Failures are explained: where, why, and what to try.
+//!
+//! Explicit methods carry the state as a `Vec`. The crate's implicit methods
+//! (Radau5, BDF, DIRK) only work with fixed-size states (their buffers start
+//! as `Y::zeros()`, which is empty for a `Vec`), so implicit runs use an
+//! array `[f64; P]` with P the next size of [`IMPLICIT_SIZES`]; the extra
+//! components are inert (x' = 0, zero Jacobian rows) and cost no accuracy.
+//!
+//! One concern a file: [`options`] (what a run is
+//! asked, with the CLI's defaults), `dispatch` (solver to run), `auto` (the
+//! stiffness switch), `record` (samples, events, counts), `failure` (the
+//! explained failure), `ode` (the arm as x' = f(t, x)); beside them the
+//! in-house steppers `bs23`, `radau5`, `trbdf2` on `stepper`, and
+//! [`events`] (zero crossings). The solver names are `crate::solver`'s.
+
+mod auto;
+pub mod bs23;
+mod dispatch;
+pub mod events;
+mod failure;
+mod ode;
+pub mod options;
+pub mod radau5;
+mod record;
+pub mod state;
+pub mod stepper;
+pub mod trbdf2;
+
+pub use crate::solver::Solver;
+pub use dispatch::IMPLICIT_SIZES;
+pub use failure::SimFailure;
+pub use options::{DEFAULT_SAMPLES, DEFAULT_T_END, SimOptions};
+pub use record::{AUTO_CHECK_STEPS, SimStats, SolverSwitch, Trajectory};
+pub use state::StateVec;
+
+use std::cell::RefCell;
+
+use crate::arm::Dynamics;
+
+/// Integrate from x0 = [q0, qd0] over [0, t_end].
+pub fn simulate<D: Dynamics + ?Sized>(
+    arm: &D,
+    x0: Vec<f64>,
+    opts: &SimOptions,
+) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
+    let n = arm.dof();
+    assert_eq!(x0.len(), 2 * n, "state must be [q, qd]");
+    match opts.solver {
+        Solver::Auto => auto::run_auto(arm, x0, opts),
+        Solver::Bs23 => dispatch::run_own(arm, 0.0, x0, opts, bs23::integrate),
+        s if s.implicit() => dispatch::simulate_implicit(arm, 0.0, x0, opts),
+        _ => dispatch::run_explicit(arm, 0.0, x0, opts, None, &RefCell::new(None)),
+    }
+}

@@ -1,0 +1,115 @@
+//! An arm as the first-order system x' = f(t, x), x = [q, qd], with its
+//! analytic Jacobian; the first failure of either is kept for the report.
+
+use std::cell::{Cell, RefCell};
+
+use differential_equations::prelude::*;
+use nalgebra::DMatrix;
+
+use super::state::StateVec;
+use super::stepper::OdeSystem;
+use crate::arm::{AccelError, Dynamics, Workspace, accelerations};
+use crate::jacobian::rhs_jacobian;
+
+/// The first-order system x' = f(t, x) of an arm; components past 2 n are
+/// padding.
+pub(super) struct ArmOde<'a, D: ?Sized> {
+    arm: &'a D,
+    pub(super) n: usize,
+    ws: RefCell<Workspace>,
+    qdd: RefCell<Vec<f64>>,
+    pub(super) evals: Cell<usize>,
+    pub(super) jac_evals: Cell<usize>,
+    jac: RefCell<DMatrix<f64>>,
+    pub(super) first_error: RefCell<Option<AccelError>>,
+    /// Set when a right-hand side failed since the last accepted step.
+    pub(super) failed_in_step: Cell<bool>,
+}
+
+impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
+    pub(super) fn new(arm: &'a D) -> Self {
+        let n = arm.dof();
+        Self {
+            arm,
+            n,
+            ws: RefCell::new(Workspace::new(n)),
+            qdd: RefCell::new(vec![0.0; n]),
+            evals: Cell::new(0),
+            jac_evals: Cell::new(0),
+            jac: RefCell::new(DMatrix::zeros(2 * n, 2 * n)),
+            first_error: RefCell::new(None),
+            failed_in_step: Cell::new(false),
+        }
+    }
+
+    fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
+        self.evals.set(self.evals.get() + 1);
+        let n = self.n;
+        let (q, rest) = x.split_at(n);
+        let qd = &rest[..n];
+        dx[..n].copy_from_slice(qd);
+        dx[2 * n..].fill(0.0);
+        let mut qdd = self.qdd.borrow_mut();
+        match accelerations(self.arm, &mut self.ws.borrow_mut(), t, q, qd, &mut qdd) {
+            Ok(()) => dx[n..2 * n].copy_from_slice(&qdd),
+            Err(e) => {
+                // NaN makes an adaptive method reject the step; the record
+                // explains the failure if the method then gives up.
+                self.first_error.borrow_mut().get_or_insert(e);
+                self.failed_in_step.set(true);
+                dx[n..2 * n].fill(f64::NAN);
+            }
+        }
+    }
+
+    /// The Jacobian of the unpadded system into `j` (NaN if it fails).
+    fn jacobian_dense(&self, t: f64, x: &[f64], j: &mut DMatrix<f64>) {
+        self.jac_evals.set(self.jac_evals.get() + 1);
+        if let Err(e) = rhs_jacobian(self.arm, &mut self.ws.borrow_mut(), t, x, j) {
+            self.first_error.borrow_mut().get_or_insert(e);
+            j.fill(f64::NAN);
+        }
+    }
+
+    fn jacobian_into(&self, t: f64, x: &[f64], j: &mut Matrix<f64>) {
+        self.jac_evals.set(self.jac_evals.get() + 1);
+        let m = 2 * self.n;
+        let mut jac = self.jac.borrow_mut();
+        let ok = match rhs_jacobian(self.arm, &mut self.ws.borrow_mut(), t, &x[..m], &mut jac) {
+            Ok(_) => true,
+            Err(e) => {
+                self.first_error.borrow_mut().get_or_insert(e);
+                false
+            }
+        };
+        for r in 0..x.len() {
+            for c in 0..x.len() {
+                j[(r, c)] = match (r < m && c < m, ok) {
+                    (true, true) => jac[(r, c)],
+                    (true, false) => f64::NAN,
+                    (false, _) => 0.0,
+                };
+            }
+        }
+    }
+}
+
+impl<D: Dynamics + ?Sized> OdeSystem for &ArmOde<'_, D> {
+    fn rhs(&mut self, t: f64, y: &[f64], dy: &mut [f64]) {
+        ArmOde::rhs(self, t, y, dy);
+    }
+
+    fn jacobian(&mut self, t: f64, y: &[f64], j: &mut DMatrix<f64>) {
+        self.jacobian_dense(t, y, j);
+    }
+}
+
+impl<D: Dynamics + ?Sized, Y: StateVec> ODE<f64, Y> for ArmOde<'_, D> {
+    fn diff(&self, t: f64, x: &Y, dx: &mut Y) {
+        self.rhs(t, x.as_ref(), dx.as_mut());
+    }
+
+    fn jacobian(&self, t: f64, x: &Y, j: &mut Matrix<f64>) {
+        self.jacobian_into(t, x.as_ref(), j);
+    }
+}

@@ -1,0 +1,46 @@
+//! What a simulation is asked to do. The defaults here are the CLI's
+//! defaults too (`softarm simulate` falls back on them), so the two cannot
+//! disagree.
+
+use super::events::Event;
+use crate::solver::Solver;
+
+/// The simulated time when neither the command line nor the model says.
+pub const DEFAULT_T_END: f64 = 5.0;
+/// Samples of the written trajectory when no spacing is given: t_end / this.
+pub const DEFAULT_SAMPLES: f64 = 500.0;
+
+#[derive(Clone, Debug)]
+pub struct SimOptions {
+    pub t_end: f64,
+    pub solver: Solver,
+    pub rtol: f64,
+    pub atol: f64,
+    /// Step of fixed-step solvers (s).
+    pub dt: f64,
+    /// Spacing of the written trajectory (s).
+    pub output_dt: f64,
+    /// Sample at these times instead (ascending; from the methods' dense
+    /// output, so they cost no extra steps).
+    pub output_times: Option<Vec<f64>>,
+    /// Zero crossings to locate (and to stop at, if terminal).
+    pub events: Vec<Event>,
+    /// Give up after this many steps.
+    pub max_steps: usize,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        Self {
+            t_end: DEFAULT_T_END,
+            solver: Solver::Dopri5,
+            rtol: 1e-6,
+            atol: 1e-9,
+            dt: 1e-3,
+            output_dt: DEFAULT_T_END / DEFAULT_SAMPLES,
+            output_times: None,
+            events: Vec::new(),
+            max_steps: 10_000_000,
+        }
+    }
+}

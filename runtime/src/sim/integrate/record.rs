@@ -1,0 +1,250 @@
+//! Recording a run: the samples (evenly spaced or at given times), the
+//! located events, the last accepted step, and a stop on a non-finite
+//! state; what the run counted.
+
+use std::cell::{Cell, RefCell};
+
+use differential_equations::prelude::*;
+use differential_equations::solout::EvenSolout;
+use serde::Serialize;
+
+use super::events::{EventHit, EventWatch};
+use super::ode::ArmOde;
+use super::options::SimOptions;
+use super::state::StateVec;
+use crate::solver::Solver;
+
+/// How often `auto` re-checks stiffness (accepted explicit steps): the
+/// recorder calls its watch this often.
+pub const AUTO_CHECK_STEPS: usize = 200;
+
+/// A change of solver made by `auto`.
+#[derive(Clone, Debug, Serialize)]
+pub struct SolverSwitch {
+    pub at_s: f64,
+    pub to: Solver,
+    pub reason: String,
+}
+
+/// Sampled states x = [q, qd] at times t.
+#[derive(Clone, Debug, Default)]
+pub struct Trajectory {
+    pub t: Vec<f64>,
+    pub x: Vec<Vec<f64>>,
+    /// The located events, in time order.
+    pub events: Vec<EventHit>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SimStats {
+    pub solver: Solver,
+    pub steps: usize,
+    pub rejected_steps: usize,
+    pub rhs_evaluations: usize,
+    pub jacobian_evaluations: usize,
+    pub wall_s: f64,
+    /// Set when `auto` switched solvers.
+    pub switched: Option<SolverSwitch>,
+}
+
+/// Samples evenly and stops on a non-finite accepted state. A fixed-step
+/// method has no error estimate to reject a step whose right-hand side
+/// failed, so for those a failure anywhere in the step stops it too (its
+/// dense output would be NaN); adaptive methods reject such steps.
+pub(super) struct Recorder<'a> {
+    sampler: Sampler,
+    /// The samples so far, unpadded, kept outside the crate's solution so
+    /// that a run that fails still returns them.
+    kept: &'a RefCell<Trajectory>,
+    m: usize,
+    /// The last accepted step, for failure reports.
+    last_step: &'a Cell<Option<f64>>,
+    events: &'a RefCell<EventWatch>,
+    blown_up: &'a Cell<Option<f64>>,
+    failed_in_step: &'a Cell<bool>,
+    fixed_step: bool,
+    /// `auto`: called every AUTO_CHECK_STEPS accepted steps with the state
+    /// and the last step; Some(reason) stops the run for a switch.
+    watch: Option<&'a Watch<'a>>,
+    switch: &'a RefCell<Option<(f64, Vec<f64>, String)>>,
+    accepted: usize,
+}
+
+pub(super) type Watch<'a> = dyn Fn(&[f64], f64) -> Option<String> + 'a;
+
+impl Recorder<'_> {
+    fn keep<Y: StateVec>(&self, solution: &Solution<f64, Y>) {
+        let mut kept = self.kept.borrow_mut();
+        for k in kept.t.len()..solution.t.len() {
+            kept.t.push(solution.t[k]);
+            kept.x.push(solution.y[k].as_ref()[..self.m].to_vec());
+        }
+    }
+}
+
+impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
+    fn solout<I>(
+        &mut self,
+        t_curr: f64,
+        t_prev: f64,
+        y_curr: &Y,
+        y_prev: &Y,
+        interpolator: &mut I,
+        solution: &mut Solution<f64, Y>,
+    ) -> ControlFlag<f64, Y>
+    where
+        I: Interpolation<f64, Y> + ?Sized,
+    {
+        if t_curr > t_prev {
+            self.last_step.set(Some(t_curr - t_prev));
+        }
+        let rhs_failed = self.failed_in_step.replace(false) && self.fixed_step;
+        if rhs_failed || y_curr.as_ref().iter().any(|v| !v.is_finite()) {
+            self.blown_up.set(Some(t_prev));
+            return ControlFlag::Terminate;
+        }
+        let hit = self
+            .events
+            .borrow_mut()
+            .check(t_prev, t_curr, y_prev, y_curr, interpolator);
+        if let Some((t_event, y_event)) = hit {
+            self.sampler
+                .sample(t_event, t_prev, &y_event, y_prev, interpolator, solution);
+            if solution.t.last() != Some(&t_event) {
+                solution.push(t_event, y_event);
+            }
+            self.keep(solution);
+            return ControlFlag::Terminate;
+        }
+        let flag = self
+            .sampler
+            .sample(t_curr, t_prev, y_curr, y_prev, interpolator, solution);
+        self.keep(solution);
+        self.accepted += 1;
+        if let Some(watch) = self.watch
+            && self.accepted.is_multiple_of(AUTO_CHECK_STEPS)
+            && let Some(reason) = watch(y_curr.as_ref(), t_curr - t_prev)
+        {
+            *self.switch.borrow_mut() = Some((t_curr, y_curr.as_ref().to_vec(), reason));
+            return ControlFlag::Terminate;
+        }
+        flag
+    }
+}
+
+/// Where the trajectory is sampled.
+pub(super) enum Sampler {
+    Even(EvenSolout<f64>),
+    /// Ascending times, and the index of the next one due.
+    At(Vec<f64>, usize),
+}
+
+impl Sampler {
+    fn new(opts: &SimOptions) -> Self {
+        match &opts.output_times {
+            Some(times) => {
+                // In time order, whatever order they were given in.
+                let mut times = times.clone();
+                times.sort_by(f64::total_cmp);
+                Self::At(times, 0)
+            }
+            None => Self::Even(EvenSolout::new(opts.output_dt, 0.0, opts.t_end)),
+        }
+    }
+
+    fn sample<Y: StateVec, I: Interpolation<f64, Y> + ?Sized>(
+        &mut self,
+        t_curr: f64,
+        t_prev: f64,
+        y_curr: &Y,
+        y_prev: &Y,
+        interpolator: &mut I,
+        solution: &mut Solution<f64, Y>,
+    ) -> ControlFlag<f64, Y> {
+        match self {
+            Self::Even(even) => even.solout(t_curr, t_prev, y_curr, y_prev, interpolator, solution),
+            Self::At(times, next) => {
+                while let Some(&t) = times.get(*next) {
+                    if t > t_curr {
+                        break;
+                    }
+                    *next += 1;
+                    if t < t_prev {
+                        continue;
+                    }
+                    let y = if t == t_curr {
+                        y_curr.clone()
+                    } else if t == t_prev {
+                        y_prev.clone()
+                    } else {
+                        match interpolator.interpolate(t) {
+                            Ok(y) => y,
+                            Err(_) => continue,
+                        }
+                    };
+                    solution.push(t, y);
+                }
+                ControlFlag::Continue
+            }
+        }
+    }
+}
+
+/// What a run's recorder saw: the samples with the events, and the last
+/// accepted step.
+pub(super) struct Recorded {
+    pub(super) kept: Trajectory,
+    pub(super) last_step_s: Option<f64>,
+}
+
+/// The shared state a run's `Recorder` writes to.
+pub(super) struct RunLog {
+    pub(super) blown_up: Cell<Option<f64>>,
+    events: RefCell<EventWatch>,
+    kept: RefCell<Trajectory>,
+    last_step: Cell<Option<f64>>,
+}
+
+impl RunLog {
+    pub(super) fn new(opts: &SimOptions, dof: usize) -> Self {
+        Self {
+            blown_up: Cell::new(None),
+            events: RefCell::new(EventWatch::new(&opts.events, 2 * dof)),
+            kept: RefCell::new(Trajectory::default()),
+            last_step: Cell::new(None),
+        }
+    }
+
+    pub(super) fn recorder<'a, D: ?Sized>(
+        &'a self,
+        opts: &SimOptions,
+        ode: &'a ArmOde<'_, D>,
+        fixed_step: bool,
+        watch: Option<&'a Watch<'a>>,
+        switch: &'a RefCell<Option<(f64, Vec<f64>, String)>>,
+    ) -> Recorder<'a> {
+        Recorder {
+            sampler: Sampler::new(opts),
+            kept: &self.kept,
+            m: 2 * ode.n,
+            last_step: &self.last_step,
+            events: &self.events,
+            blown_up: &self.blown_up,
+            failed_in_step: &ode.failed_in_step,
+            fixed_step,
+            watch,
+            switch,
+            accepted: 0,
+        }
+    }
+
+    pub(super) fn finish(&self) -> Recorded {
+        Recorded {
+            kept: Trajectory {
+                events: std::mem::take(&mut self.events.borrow_mut().hits),
+                ..self.kept.take()
+            },
+            last_step_s: self.last_step.get(),
+        }
+    }
+}

@@ -1,0 +1,99 @@
+//! The integrators by name: one table that the CLI, the model files'
+//! validation and the simulation layer's dispatch all read. It sits in the
+//! always-built layer because the generator validates `[simulate] solver`.
+
+use serde::Serialize;
+
+/// Integrators. Names are the CLI's and the model files'.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Solver {
+    /// Adaptive Dormand-Prince 5(4), explicit.
+    Dopri5,
+    /// Adaptive Dormand-Prince 8(5,3), explicit.
+    Dop853,
+    /// Adaptive Bogacki-Shampine 3(2), explicit (the ode23 family).
+    Bs23,
+    /// Classic fixed-step Runge-Kutta 4, explicit.
+    Rk4,
+    /// Fixed-step explicit Euler.
+    Euler,
+    /// Radau IIA order 5, implicit, L-stable, adaptive (stiff systems).
+    Radau5,
+    /// Variable-order BDF 1-5, implicit, adaptive (the ode15s family).
+    Bdf,
+    /// TR-BDF2, L-stable, second order, adaptive (MATLAB's ode23tb).
+    Trbdf2,
+    /// ESDIRK 3(2) 4-stage, L-stable, adaptive (the crate's).
+    Esdirk,
+    /// dopri5, switching to radau5 when the arm turns out stiff (checked
+    /// from the Jacobian's eigenvalues at the start and every
+    /// `AUTO_CHECK_STEPS` accepted steps).
+    Auto,
+}
+
+/// Every solver with its name, in the order `--solver` lists them.
+const TABLE: [(Solver, &str); 10] = [
+    (Solver::Dopri5, "dopri5"),
+    (Solver::Bs23, "bs23"),
+    (Solver::Dop853, "dop853"),
+    (Solver::Rk4, "rk4"),
+    (Solver::Euler, "euler"),
+    (Solver::Radau5, "radau5"),
+    (Solver::Bdf, "bdf"),
+    (Solver::Trbdf2, "trbdf2"),
+    (Solver::Esdirk, "esdirk"),
+    (Solver::Auto, "auto"),
+];
+
+impl Solver {
+    /// The names `--solver` and `[simulate] solver` take.
+    pub const NAMES: [&'static str; TABLE.len()] = {
+        let mut names = [""; TABLE.len()];
+        let mut i = 0;
+        while i < TABLE.len() {
+            names[i] = TABLE[i].1;
+            i += 1;
+        }
+        names
+    };
+
+    pub fn parse(s: &str) -> Option<Self> {
+        TABLE
+            .iter()
+            .find(|(_, n)| *n == s)
+            .map(|(solver, _)| *solver)
+    }
+
+    pub fn name(self) -> &'static str {
+        TABLE
+            .iter()
+            .find(|(solver, _)| *solver == self)
+            .map(|(_, n)| *n)
+            .expect("every solver is in the table")
+    }
+
+    /// Fixed-step methods (no error estimate: `dt` sets the step).
+    pub fn fixed_step(self) -> bool {
+        matches!(self, Self::Rk4 | Self::Euler)
+    }
+
+    /// Implicit methods (they use the analytic Jacobian).
+    pub fn implicit(self) -> bool {
+        matches!(self, Self::Radau5 | Self::Bdf | Self::Trbdf2 | Self::Esdirk)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_name_parses_to_the_solver_that_prints_it() {
+        for name in Solver::NAMES {
+            let s = Solver::parse(name).expect("listed names parse");
+            assert_eq!(s.name(), name);
+        }
+        assert_eq!(Solver::parse("radau"), None);
+    }
+}
