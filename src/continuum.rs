@@ -5,7 +5,7 @@
 //! methods, unless `extension = true`: then extensible (E A) and shearable
 //! (G A, shear coefficient 1).
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use eomgen::model::{Method, Model, base_rotation};
 use nalgebra::Matrix3;
 use runtime::cosserat::{Rod, RodLoads, RodOptions, RodSolution, solve_rod};
@@ -15,47 +15,18 @@ pub fn is_cosserat(model: &Model) -> bool {
     model.segments.iter().any(|s| s.method == Method::Cosserat)
 }
 
-/// Solve the static rod of a model whose segment is `cosserat`.
+/// Solve the static rod of a model whose segment is `cosserat`
+/// (validation checked the model: one uniform segment, its stiffnesses).
 pub fn solve(model: &Model, origin: &str) -> Result<RodSolution> {
-    let [s] = model.segments.as_slice() else {
-        bail!(
-            "{origin}: segment: the Cosserat statics take one uniform [[segment]], got {}",
-            model.segments.len()
-        );
-    };
-    if s.rest_curvature != 0.0 {
-        bail!(
-            "{origin}: segment[0].rest_curvature: the Cosserat rod is straight at rest; remove the key"
-        );
-    }
-    if model.tip.mass.is_some() {
-        bail!(
-            "{origin}: tip.mass: a tip mass is a load under gravity; give it as tip.force for the Cosserat statics"
-        );
-    }
-    let need = |v: Option<f64>, key: &str| -> Result<f64> {
-        v.ok_or_else(|| {
-            anyhow::anyhow!("{origin}: segment[0].{key}: missing, the Cosserat rod needs it (or `youngs_modulus` with `outer_radius`)")
-        })
-    };
-    let ei = need(s.ei(), "bending_stiffness")?;
-    let gj = need(s.gj(), "torsional_stiffness")?;
+    let s = &model.segments[0];
+    let stiffness = |v: Option<f64>| v.expect("validated: the Cosserat rod's stiffness");
     let extensible = s.stretches();
-    let (ea, ga) = if extensible {
-        let ea = need(s.ea(), "axial_stiffness")?;
-        let g = s
-            .shear_modulus
-            .or(s.youngs_modulus.map(|e| e / 3.0))
-            .unwrap_or(0.0);
-        (ea, g * s.area().unwrap_or(0.0))
-    } else {
-        (0.0, 0.0)
+    let (ea, ga) = match extensible {
+        true => (stiffness(s.ea()), s.ga().unwrap_or(0.0)),
+        false => (0.0, 0.0),
     };
-    let mass = match (s.mass, s.density) {
-        (Some(m), _) => m,
-        (None, Some(rho)) => rho * s.area().unwrap_or(0.0) * s.length,
-        (None, None) => 0.0,
-    };
+    let (ei, gj) = (stiffness(s.ei()), stiffness(s.gj()));
+    let mass = s.total_mass().unwrap_or(0.0);
     let rod = Rod {
         length: s.length,
         ea,

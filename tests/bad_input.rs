@@ -521,6 +521,20 @@ fn malformed_3d_models_are_rejected_clearly() {
             vec!["segment[0].incompressible", "keeps its section"],
         ),
         (
+            "curved Cosserat rod",
+            r(
+                "method = \"pcc\"",
+                "method = \"cosserat\"\nrest_curvature = 2.0",
+            ),
+            vec!["segment[0].rest_curvature", "straight at rest"],
+        ),
+        (
+            "Cosserat rod without twist stiffness",
+            r("method = \"pcc\"", "method = \"cosserat\"\ntwist = false")
+                .replace("youngs_modulus = 1e6", "bending_stiffness = 0.01"),
+            vec!["segment[0].torsional_stiffness", "missing", "Cosserat"],
+        ),
+        (
             "chamber outside the wall",
             r(
                 "elements = 2",
@@ -546,7 +560,7 @@ fn malformed_3d_models_are_rejected_clearly() {
     let out = softarm(&["static", "m.toml", "--json"], dir.path());
     assert!(!out.status.success());
     assert!(
-        stderr(&out).contains("one uniform [[segment]]"),
+        stderr(&out).contains("segment: the Cosserat statics take one uniform [[segment]], got 2"),
         "{}",
         stderr(&out)
     );

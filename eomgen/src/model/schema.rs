@@ -301,6 +301,16 @@ impl Segment {
             .or_else(|| Some(self.youngs_modulus? * self.area()?))
     }
 
+    /// The whole segment's mass (kg): `mass`, or `density` times the
+    /// section's area and the length.
+    pub fn total_mass(&self) -> Option<f64> {
+        match (self.mass, self.density) {
+            (Some(m), _) => Some(m),
+            (None, Some(rho)) => Some(rho * self.area()? * self.length),
+            (None, None) => None,
+        }
+    }
+
     /// Lumped slices of the segment: `elements`, or `quadrature` for rom.
     pub fn slices(&self) -> usize {
         match self.method {

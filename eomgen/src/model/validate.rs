@@ -2,61 +2,103 @@
 //! path and says what is allowed.
 
 use super::error::ModelError;
-use super::schema::{Method, Model};
+use super::schema::{Method, Model, Segment};
 
 /// Largest element count per segment: beyond it derivation and simulation
 /// times are impractical for a planar chain.
 pub const MAX_ELEMENTS: usize = 500;
 
+/// Check what the types alone cannot express, concern by concern; the
+/// first problem found is the error.
 pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
-    let err = |path: String, msg: String| Err(ModelError::new(file, path, msg));
-    let finite = |path: &str, v: f64| -> Result<(), ModelError> {
+    let ck = Check { m, file };
+    simulate_defaults(&ck)?;
+    frame(&ck)?;
+    for (i, s) in m.segments.iter().enumerate() {
+        segment_section(&ck, i, s)?;
+        segment_dimension_keys(&ck, i, s)?;
+        segment_method_keys(&ck, i, s)?;
+    }
+    tip(&ck)?;
+    driven_loads_and_chambers(&ck)?;
+    tendons(&ck)?;
+    base_motion(&ck)?;
+    cosserat_inputs(&ck)?;
+    cosserat_rod(&ck)?;
+    torques(&ck)?;
+    signals(&ck)
+}
+
+/// The model under check and its file, with the checks every concern uses.
+struct Check<'a> {
+    m: &'a Model,
+    file: &'a str,
+}
+
+impl Check<'_> {
+    fn err(&self, path: String, msg: String) -> Result<(), ModelError> {
+        Err(ModelError::new(self.file, path, msg))
+    }
+
+    fn finite(&self, path: &str, v: f64) -> Result<(), ModelError> {
         if v.is_finite() {
-            Ok(())
-        } else {
-            Err(ModelError::new(
-                file,
-                path,
-                format!("must be a finite number, got {v}"),
-            ))
+            return Ok(());
         }
-    };
-    let vec3 = |path: &str, v: &[f64; 3]| -> Result<(), ModelError> {
+        self.err(path.into(), format!("must be a finite number, got {v}"))
+    }
+
+    fn vec3(&self, path: &str, v: &[f64; 3]) -> Result<(), ModelError> {
         for (i, x) in v.iter().enumerate() {
-            finite(&format!("{path}[{i}]"), *x)?;
+            self.finite(&format!("{path}[{i}]"), *x)?;
         }
         Ok(())
-    };
-    let positive = |path: &str, v: f64| -> Result<(), ModelError> {
-        finite(path, v)?;
-        if v > 0.0 {
-            Ok(())
-        } else {
-            Err(ModelError::new(
-                file,
-                path,
-                format!("must be positive, got {v}"),
-            ))
-        }
-    };
-    let non_negative = |path: &str, v: f64| -> Result<(), ModelError> {
-        finite(path, v)?;
-        if v >= 0.0 {
-            Ok(())
-        } else {
-            Err(ModelError::new(
-                file,
-                path,
-                format!("must be zero or positive, got {v}"),
-            ))
-        }
-    };
+    }
 
+    fn positive(&self, path: &str, v: f64) -> Result<(), ModelError> {
+        self.finite(path, v)?;
+        if v > 0.0 {
+            return Ok(());
+        }
+        self.err(path.into(), format!("must be positive, got {v}"))
+    }
+
+    fn non_negative(&self, path: &str, v: f64) -> Result<(), ModelError> {
+        self.finite(path, v)?;
+        if v >= 0.0 {
+            return Ok(());
+        }
+        self.err(path.into(), format!("must be zero or positive, got {v}"))
+    }
+
+    /// `name` is a declared input channel.
+    fn channel(&self, path: &str, name: &str) -> Result<(), ModelError> {
+        let inputs = &self.m.inputs;
+        if inputs.contains_key(name) {
+            return Ok(());
+        }
+        let known: Vec<&str> = inputs.keys().map(String::as_str).collect();
+        self.err(
+            path.into(),
+            if known.is_empty() {
+                format!("no input channel \"{name}\": declare it as [inputs.{name}]")
+            } else {
+                format!(
+                    "no input channel \"{name}\"; declared: {} (or add [inputs.{name}])",
+                    known.join(", ")
+                )
+            },
+        )
+    }
+}
+
+/// `[simulate]`: a known solver, positive times and tolerances.
+fn simulate_defaults(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
     let sim = &m.simulate;
     if let Some(solver) = &sim.solver
         && !runtime::Solver::NAMES.contains(&solver.as_str())
     {
-        return err(
+        return ck.err(
             "simulate.solver".into(),
             format!(
                 "unknown solver \"{solver}\"; allowed: {}",
@@ -71,25 +113,31 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
         ("simulate.dt", sim.dt),
     ] {
         if let Some(v) = v {
-            positive(key, v)?;
+            ck.positive(key, v)?;
         }
     }
+    Ok(())
+}
+
+/// Name, gravity, the base frame and the plane.
+fn frame(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
     if m.name.trim().is_empty() {
-        return err("name".into(), "must not be empty".into());
+        return ck.err("name".into(), "must not be empty".into());
     }
-    vec3("gravity", &m.gravity)?;
-    vec3("base.position", &m.base.position)?;
-    vec3("base.direction", &m.base.direction)?;
+    ck.vec3("gravity", &m.gravity)?;
+    ck.vec3("base.position", &m.base.position)?;
+    ck.vec3("base.direction", &m.base.direction)?;
     let d = m.base.direction;
     let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
     if norm == 0.0 {
-        return err(
+        return ck.err(
             "base.direction".into(),
             "must be a non-zero vector (the undeformed arm axis)".into(),
         );
     }
     if !matches!(m.dimensions, 2 | 3) {
-        return err(
+        return ck.err(
             "dimensions".into(),
             format!("must be 2 (planar) or 3 (spatial), got {}", m.dimensions),
         );
@@ -97,7 +145,7 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
     let planar = m.dimensions == 2;
     if planar {
         if d[2].abs() > 1e-12 * norm {
-            return err(
+            return ck.err(
                 "base.direction".into(),
                 format!(
                     "planar arms move in the x-y plane: the z component must be 0, got {}",
@@ -106,340 +154,86 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             );
         }
         if m.base.position[2] != 0.0 {
-            return err(
+            return ck.err(
                 "base.position".into(),
                 "planar arms move in the x-y plane: the z component must be 0".into(),
             );
         }
     }
     if m.segments.is_empty() {
-        return err(
+        return ck.err(
             "segment".into(),
             "at least one [[segment]] is needed".into(),
         );
     }
-    for (i, s) in m.segments.iter().enumerate() {
-        let p = |k: &str| format!("segment[{i}].{k}");
-        positive(&p("length"), s.length)?;
-        if s.elements == 0 || s.elements > MAX_ELEMENTS {
-            return err(
-                p("elements"),
-                format!("must be between 1 and {MAX_ELEMENTS}, got {}", s.elements),
-            );
-        }
-        match (s.mass, s.density) {
-            (Some(_), Some(_)) => {
-                return err(
-                    p("mass"),
-                    "give either `mass` or `density` (with `outer_radius`), not both".into(),
-                );
-            }
-            (None, None) => {
-                return err(
-                    p("mass"),
-                    "missing: give `mass` (kg) or `density` (kg/m^3) with `outer_radius` (m)"
-                        .into(),
-                );
-            }
-            (Some(mass), None) => positive(&p("mass"), mass)?,
-            (None, Some(rho)) => {
-                positive(&p("density"), rho)?;
-                if s.outer_radius.is_none() {
-                    return err(
-                        p("outer_radius"),
-                        "missing: `density` needs `outer_radius` (m)".into(),
-                    );
-                }
-            }
-        }
-        if let Some(ro) = s.outer_radius {
-            positive(&p("outer_radius"), ro)?;
-            if let Some(ri) = s.inner_radius {
-                non_negative(&p("inner_radius"), ri)?;
-                if ri >= ro {
-                    return err(
-                        p("inner_radius"),
-                        format!("must be smaller than outer_radius ({ro}), got {ri}"),
-                    );
-                }
-            }
-        } else if s.inner_radius.is_some() {
-            return err(p("inner_radius"), "needs `outer_radius`".into());
-        }
-        if let Some(c) = &s.chambers {
-            check_chambers(c, &p("chambers"), s.outer_radius, s.inner_radius, file)?;
-        }
-        if let (Some(_), Some(_)) = (s.youngs_modulus, s.bending_stiffness) {
-            return err(
-                p("bending_stiffness"),
-                "give either `youngs_modulus` or `bending_stiffness`, not both".into(),
-            );
-        }
-        if let Some(e) = s.youngs_modulus {
-            positive(&p("youngs_modulus"), e)?;
-            if s.outer_radius.is_none() {
-                return err(
-                    p("outer_radius"),
-                    "missing: `youngs_modulus` needs the section's `outer_radius` (m)".into(),
-                );
-            }
-        }
-        if let Some(ei) = s.bending_stiffness {
-            positive(&p("bending_stiffness"), ei)?;
-        }
-        if let Some(c) = s.bending_damping {
-            non_negative(&p("bending_damping"), c)?;
-        }
-        finite(&p("rest_curvature"), s.rest_curvature)?;
-        for (key, v) in [
-            ("shear_modulus", s.shear_modulus),
-            ("torsional_stiffness", s.torsional_stiffness),
-            ("axial_stiffness", s.axial_stiffness),
-        ] {
-            if let Some(v) = v {
-                positive(&p(key), v)?;
-            }
-        }
-        if let Some(c) = s.axial_damping {
-            non_negative(&p("axial_damping"), c)?;
-        }
-        if planar {
-            for (key, given) in [
-                ("twist", s.twist.is_some()),
-                ("extension", s.extension.is_some()),
-                ("joint_axes", s.joint_axes.is_some()),
-                ("shear_modulus", s.shear_modulus.is_some()),
-                ("torsional_stiffness", s.torsional_stiffness.is_some()),
-                ("axial_stiffness", s.axial_stiffness.is_some()),
-                ("axial_damping", s.axial_damping.is_some()),
-                ("incompressible", s.incompressible.is_some()),
-            ] {
-                if given {
-                    return err(
-                        p(key),
-                        "a 3D key: set `dimensions = 3` at the top of the file to use it".into(),
-                    );
-                }
-            }
-        } else {
-            if let Some(axes) = &s.joint_axes
-                && (axes.is_empty() || axes.len() > 3)
-            {
-                return err(
-                    p("joint_axes"),
-                    format!("give 1 to 3 axes (\"x\", \"y\", \"z\"), got {}", axes.len()),
-                );
-            }
-            let rigid_joints = s.method == Method::Rigid && s.joint_stiffness.is_some();
-            let twisting = if s.method == Method::Rigid {
-                s.axes().contains(&super::schema::Axis::X)
-            } else {
-                s.twists()
-            };
-            if twisting && !rigid_joints && s.ei().is_some() && s.gj().is_none() {
-                return err(
-                    p("torsional_stiffness"),
-                    "missing: twisting elements need `torsional_stiffness` (G J), or `youngs_modulus` with the section (G = E/3 unless `shear_modulus` is given)".into(),
-                );
-            }
-            if s.incompressible == Some(true) && s.method == Method::Cosserat {
-                return err(
-                    p("incompressible"),
-                    "the Cosserat rod keeps its section as it stretches: remove the key, or use a lumped method (pcc, vc, ebr, eba, rom) to thin the section with the stretch".into(),
-                );
-            }
-            // Rigid links do not stretch: there it has nothing to act on.
-            if s.incompressible == Some(true)
-                && !matches!(s.method, Method::Rigid | Method::Eba | Method::Cosserat)
-                && !s.stretches()
-            {
-                return err(
-                    p("incompressible"),
-                    "acts on stretching elements: set `extension = true` too".into(),
-                );
-            }
-            if s.method != Method::Rigid && s.stretches() && s.ea().is_none() {
-                return err(
-                    p("axial_stiffness"),
-                    "missing: `extension = true` needs `axial_stiffness` (E A), or `youngs_modulus` with the section".into(),
-                );
-            }
-        }
-        let has_ei = s.ei().is_some();
-        match s.method {
-            Method::Rigid => {
-                if let Some(k) = s.joint_stiffness {
-                    non_negative(&p("joint_stiffness"), k)?;
-                    if has_ei {
-                        return err(
-                            p("joint_stiffness"),
-                            "give either `joint_stiffness` or the continuum's `youngs_modulus`/`bending_stiffness` (joint stiffness E I / l_e), not both".into(),
-                        );
-                    }
-                }
-                if let Some(c) = s.joint_damping {
-                    non_negative(&p("joint_damping"), c)?;
-                    if s.bending_damping.is_some() {
-                        return err(
-                            p("joint_damping"),
-                            "give either `joint_damping` or `bending_damping`, not both".into(),
-                        );
-                    }
-                }
-            }
-            Method::Pcc
-            | Method::Vc
-            | Method::Ebr
-            | Method::Eba
-            | Method::Rom
-            | Method::Cosserat => {
-                for (key, given) in [
-                    ("joint_stiffness", s.joint_stiffness.is_some()),
-                    ("joint_damping", s.joint_damping.is_some()),
-                    ("joints", s.joints.is_some()),
-                ] {
-                    if given {
-                        return err(
-                            p(key),
-                            format!(
-                                "not a key of {} segments: they take `youngs_modulus` or `bending_stiffness`, and `bending_damping`",
-                                s.method.name()
-                            ),
-                        );
-                    }
-                }
-                if !has_ei {
-                    return err(
-                        p("youngs_modulus"),
-                        format!(
-                            "missing: a {} segment needs `youngs_modulus` (with `outer_radius`) or `bending_stiffness`",
-                            s.method.name()
-                        ),
-                    );
-                }
-                if s.method == Method::Eba {
-                    if m.segments.iter().any(|o| o.method != Method::Eba) {
-                        return err(p("method"), "eba segments take absolute coordinates: every segment of the arm must be eba".into());
-                    }
-                    if s.rest_curvature != 0.0 {
-                        return err(p("rest_curvature"), "eba elements are straight at rest: remove the key or use pcc, ebr or rom".into());
-                    }
-                    if s.ea().is_none() || s.ga().is_none() {
-                        return err(p("youngs_modulus"), "missing: eba couples elements by axial and shear springs: give `youngs_modulus` with `outer_radius`".into());
-                    }
-                }
-                if matches!(s.method, Method::Ebr | Method::Eba | Method::Rom) && planar {
-                    return err(
-                        p("method"),
-                        format!(
-                            "{} is a 3D method: set `dimensions = 3` at the top of the file",
-                            s.method.name()
-                        ),
-                    );
-                }
-                if s.method == Method::Rom {
-                    if s.rom_order() > 8 {
-                        return err(
-                            p("order"),
-                            format!(
-                                "must be between 0 and 8 (the polynomial degree of the strains), got {}",
-                                s.rom_order()
-                            ),
-                        );
-                    }
-                    if s.slices() == 0 || s.slices() > 64 {
-                        return err(
-                            p("quadrature"),
-                            format!("must be between 1 and 64 slices, got {}", s.slices()),
-                        );
-                    }
-                } else {
-                    for (key, given) in [
-                        ("order", s.order.is_some()),
-                        ("quadrature", s.quadrature.is_some()),
-                    ] {
-                        if given {
-                            return err(p(key), "only rom segments take `order` and `quadrature`; others take `elements`".into());
-                        }
-                    }
-                }
-                if s.joint_axes.is_some() {
-                    return err(
-                        p("joint_axes"),
-                        "only rigid segments have joint axes".into(),
-                    );
-                }
-            }
-        }
-    }
+    Ok(())
+}
+
+/// The tip body and its constant loads.
+fn tip(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
     if let Some(mass) = m.tip.mass {
-        non_negative("tip.mass", mass)?;
+        ck.non_negative("tip.mass", mass)?;
     }
     if let Some(force) = &m.tip.force {
-        vec3("tip.force", force)?;
+        ck.vec3("tip.force", force)?;
     }
     if let Some(moment) = &m.tip.moment {
-        vec3("tip.moment", moment)?;
+        ck.vec3("tip.moment", moment)?;
     }
     if let Some(l) = m.tip.length {
-        non_negative("tip.length", l)?;
+        ck.non_negative("tip.length", l)?;
         if m.tip.mass.is_none() {
-            return err(
+            return ck.err(
                 "tip.length".into(),
                 "a tip body needs its `mass` (kg) too".into(),
             );
         }
     }
     if let Some(r) = m.tip.radius {
-        non_negative("tip.radius", r)?;
+        ck.non_negative("tip.radius", r)?;
         if m.tip.length.is_none() {
-            return err(
+            return ck.err(
                 "tip.radius".into(),
                 "needs `tip.length` (the tip body is a cylinder of that length)".into(),
             );
         }
     }
-    let channel = |path: &str, name: &str| -> Result<(), ModelError> {
-        if m.inputs.contains_key(name) {
-            return Ok(());
-        }
-        let known: Vec<&str> = m.inputs.keys().map(String::as_str).collect();
-        Err(ModelError::new(
-            file,
-            path,
-            if known.is_empty() {
-                format!("no input channel \"{name}\": declare it as [inputs.{name}]")
-            } else {
-                format!(
-                    "no input channel \"{name}\"; declared: {} (or add [inputs.{name}])",
-                    known.join(", ")
-                )
-            },
-        ))
-    };
+    Ok(())
+}
+
+/// Input channels of the tip loads and the chambers exist.
+fn driven_loads_and_chambers(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
     for (key, names) in [
         ("tip.force_inputs", &m.tip.force_inputs),
         ("tip.moment_inputs", &m.tip.moment_inputs),
     ] {
         if let Some(names) = names {
             for (i, n) in names.iter().enumerate() {
-                channel(&format!("{key}[{i}]"), n)?;
+                ck.channel(&format!("{key}[{i}]"), n)?;
             }
         }
     }
     for (i, s) in m.segments.iter().enumerate() {
         if let Some(inputs) = s.chambers.as_ref().and_then(|c| c.inputs.as_ref()) {
             for (j, n) in inputs.iter().enumerate() {
-                channel(&format!("segment[{i}].chambers.inputs[{j}]"), n)?;
+                ck.channel(&format!("segment[{i}].chambers.inputs[{j}]"), n)?;
             }
         }
     }
+    Ok(())
+}
+
+/// Tendons: a declared channel, the segments they span, inside the section.
+fn tendons(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
     for (i, t) in m.tendons.iter().enumerate() {
         let p = |k: &str| format!("tendon[{i}].{k}");
-        channel(&p("input"), &t.input)?;
+        ck.channel(&p("input"), &t.input)?;
         let end = t.end.unwrap_or(m.segments.len() - 1);
         if end >= m.segments.len() {
-            return err(
+            return ck.err(
                 p("end"),
                 format!(
                     "must be a segment index, 0 to {}, got {end}",
@@ -452,7 +246,7 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             if let super::schema::OneOrMany::Many(list) = v
                 && list.len() != end + 1
             {
-                return err(
+                return ck.err(
                     p(key),
                     format!(
                         "give one value, or one per segment the tendon spans ({}), got {}",
@@ -462,26 +256,32 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
                 );
             }
             for s in 0..=end {
-                finite(&p(key), v.at(s))?;
+                ck.finite(&p(key), v.at(s))?;
             }
         }
         for s in 0..=end {
             let d = t.distance.at(s);
-            non_negative(&p("distance"), d)?;
+            ck.non_negative(&p("distance"), d)?;
             if let Some(ro) = m.segments[s].outer_radius
                 && d > ro
             {
-                return err(
+                return ck.err(
                     p("distance"),
                     format!("{d} m lies outside segment {s}'s section (outer radius {ro} m)"),
                 );
             }
         }
     }
+    Ok(())
+}
+
+/// A prescribed base motion: one channel per axis or turn, non-zero axes.
+fn base_motion(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
     if let Some(names) = &m.base.translation_inputs {
         let want = if m.dimensions == 3 { 3 } else { 2 };
         if names.len() != want {
-            return err(
+            return ck.err(
                 "base.translation_inputs".into(),
                 format!(
                     "give one input channel per axis ({}), got {}",
@@ -495,12 +295,12 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             );
         }
         for (i, n) in names.iter().enumerate() {
-            channel(&format!("base.translation_inputs[{i}]"), n)?;
+            ck.channel(&format!("base.translation_inputs[{i}]"), n)?;
         }
     }
     let turns = m.base.rotation_inputs.as_deref().unwrap_or_default();
     if m.dimensions != 3 && turns.len() > 1 {
-        return err(
+        return ck.err(
             "base.rotation_inputs".into(),
             format!(
                 "a planar base turns about z only: give one input channel, got {}",
@@ -509,17 +309,17 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
         );
     }
     for (i, n) in turns.iter().enumerate() {
-        channel(&format!("base.rotation_inputs[{i}]"), n)?;
+        ck.channel(&format!("base.rotation_inputs[{i}]"), n)?;
     }
     if let Some(axes) = &m.base.rotation_axes {
         if m.dimensions != 3 {
-            return err(
+            return ck.err(
                 "base.rotation_axes".into(),
                 "a planar base turns about z: leave rotation_axes out".into(),
             );
         }
         if axes.len() != turns.len() {
-            return err(
+            return ck.err(
                 "base.rotation_axes".into(),
                 format!(
                     "give one axis per rotation input ({}), got {}",
@@ -530,12 +330,19 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
         }
         for (i, a) in axes.iter().enumerate() {
             let key = format!("base.rotation_axes[{i}]");
-            vec3(&key, a)?;
+            ck.vec3(&key, a)?;
             if a.iter().all(|&c| c == 0.0) {
-                return err(key, "must be a non-zero vector".into());
+                return ck.err(key, "must be a non-zero vector".into());
             }
         }
     }
+    Ok(())
+}
+
+/// The Cosserat statics solve a rod under constant loads: nothing that
+/// inputs drive reaches it, so say so rather than ignore it.
+fn cosserat_inputs(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
     // The Cosserat statics solve a rod under constant loads: nothing that
     // inputs drive reaches it, so say so rather than ignore it.
     if m.segments.iter().any(|s| s.method == Method::Cosserat) {
@@ -557,18 +364,69 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             ),
         ];
         if let Some((key, _)) = driven.iter().find(|(_, given)| *given) {
-            return err(
+            return ck.err(
                 (*key).into(),
                 "the Cosserat statics take constant tip loads and gravity only; actuators, joint torques, driven loads and a moving base need a lumped method (pcc, vc, ebr, eba, rom, rigid)".into(),
             );
         }
     }
+    Ok(())
+}
+
+/// The Cosserat statics take one uniform, straight segment with its
+/// bending and twist stiffness, loaded by gravity and tip loads.
+fn cosserat_rod(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
+    if !m.segments.iter().any(|s| s.method == Method::Cosserat) {
+        return Ok(());
+    }
+    let [s] = m.segments.as_slice() else {
+        return ck.err(
+            "segment".into(),
+            format!(
+                "the Cosserat statics take one uniform [[segment]], got {}",
+                m.segments.len()
+            ),
+        );
+    };
+    if s.rest_curvature != 0.0 {
+        return ck.err(
+            "segment[0].rest_curvature".into(),
+            "the Cosserat rod is straight at rest; remove the key".into(),
+        );
+    }
+    if m.tip.mass.is_some() {
+        return ck.err(
+            "tip.mass".into(),
+            "a tip mass is a load under gravity; give it as tip.force for the Cosserat statics"
+                .into(),
+        );
+    }
+    for (key, given) in [
+        ("bending_stiffness", s.ei().is_some()),
+        ("torsional_stiffness", s.gj().is_some()),
+        ("axial_stiffness", !s.stretches() || s.ea().is_some()),
+    ] {
+        if !given {
+            return ck.err(
+                format!("segment[0].{key}"),
+                "missing, the Cosserat rod needs it (or `youngs_modulus` with `outer_radius`)"
+                    .into(),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Joint torques: a declared channel and a coordinate the structure has.
+fn torques(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
     if !m.torques.is_empty() {
         let names = super::Structure::of(m).coordinate_names();
         for (i, t) in m.torques.iter().enumerate() {
-            channel(&format!("torque[{i}].input"), &t.input)?;
+            ck.channel(&format!("torque[{i}].input"), &t.input)?;
             if !names.contains(&t.coordinate) {
-                return err(
+                return ck.err(
                     format!("torque[{i}].coordinate"),
                     format!(
                         "no coordinate \"{}\"; this model's are {}",
@@ -579,11 +437,287 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
             }
         }
     }
+    Ok(())
+}
+
+/// Input channels and `[compare]`, by `signals`.
+fn signals(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
     for (name, input) in &m.inputs {
-        super::signals::check_input(name, input, file)?;
+        super::signals::check_input(name, input, ck.file)?;
     }
     if let Some(c) = &m.compare {
-        super::signals::check_compare(c, file)?;
+        super::signals::check_compare(c, ck.file)?;
+    }
+    Ok(())
+}
+
+/// A segment's size, mass, section and material values.
+fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
+    let p = |k: &str| format!("segment[{i}].{k}");
+    ck.positive(&p("length"), s.length)?;
+    if s.elements == 0 || s.elements > MAX_ELEMENTS {
+        return ck.err(
+            p("elements"),
+            format!("must be between 1 and {MAX_ELEMENTS}, got {}", s.elements),
+        );
+    }
+    match (s.mass, s.density) {
+        (Some(_), Some(_)) => {
+            return ck.err(
+                p("mass"),
+                "give either `mass` or `density` (with `outer_radius`), not both".into(),
+            );
+        }
+        (None, None) => {
+            return ck.err(
+                p("mass"),
+                "missing: give `mass` (kg) or `density` (kg/m^3) with `outer_radius` (m)".into(),
+            );
+        }
+        (Some(mass), None) => ck.positive(&p("mass"), mass)?,
+        (None, Some(rho)) => {
+            ck.positive(&p("density"), rho)?;
+            if s.outer_radius.is_none() {
+                return ck.err(
+                    p("outer_radius"),
+                    "missing: `density` needs `outer_radius` (m)".into(),
+                );
+            }
+        }
+    }
+    if let Some(ro) = s.outer_radius {
+        ck.positive(&p("outer_radius"), ro)?;
+        if let Some(ri) = s.inner_radius {
+            ck.non_negative(&p("inner_radius"), ri)?;
+            if ri >= ro {
+                return ck.err(
+                    p("inner_radius"),
+                    format!("must be smaller than outer_radius ({ro}), got {ri}"),
+                );
+            }
+        }
+    } else if s.inner_radius.is_some() {
+        return ck.err(p("inner_radius"), "needs `outer_radius`".into());
+    }
+    if let Some(c) = &s.chambers {
+        check_chambers(c, &p("chambers"), s.outer_radius, s.inner_radius, ck.file)?;
+    }
+    if let (Some(_), Some(_)) = (s.youngs_modulus, s.bending_stiffness) {
+        return ck.err(
+            p("bending_stiffness"),
+            "give either `youngs_modulus` or `bending_stiffness`, not both".into(),
+        );
+    }
+    if let Some(e) = s.youngs_modulus {
+        ck.positive(&p("youngs_modulus"), e)?;
+        if s.outer_radius.is_none() {
+            return ck.err(
+                p("outer_radius"),
+                "missing: `youngs_modulus` needs the section's `outer_radius` (m)".into(),
+            );
+        }
+    }
+    if let Some(ei) = s.bending_stiffness {
+        ck.positive(&p("bending_stiffness"), ei)?;
+    }
+    if let Some(c) = s.bending_damping {
+        ck.non_negative(&p("bending_damping"), c)?;
+    }
+    ck.finite(&p("rest_curvature"), s.rest_curvature)?;
+    for (key, v) in [
+        ("shear_modulus", s.shear_modulus),
+        ("torsional_stiffness", s.torsional_stiffness),
+        ("axial_stiffness", s.axial_stiffness),
+    ] {
+        if let Some(v) = v {
+            ck.positive(&p(key), v)?;
+        }
+    }
+    if let Some(c) = s.axial_damping {
+        ck.non_negative(&p("axial_damping"), c)?;
+    }
+    Ok(())
+}
+
+/// Keys of the other dimension: 3D keys in a planar arm, and in 3D what
+/// twist and stretch need.
+fn segment_dimension_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
+    let p = |k: &str| format!("segment[{i}].{k}");
+    let planar = ck.m.dimensions == 2;
+    if planar {
+        for (key, given) in [
+            ("twist", s.twist.is_some()),
+            ("extension", s.extension.is_some()),
+            ("joint_axes", s.joint_axes.is_some()),
+            ("shear_modulus", s.shear_modulus.is_some()),
+            ("torsional_stiffness", s.torsional_stiffness.is_some()),
+            ("axial_stiffness", s.axial_stiffness.is_some()),
+            ("axial_damping", s.axial_damping.is_some()),
+            ("incompressible", s.incompressible.is_some()),
+        ] {
+            if given {
+                return ck.err(
+                    p(key),
+                    "a 3D key: set `dimensions = 3` at the top of the file to use it".into(),
+                );
+            }
+        }
+    } else {
+        if let Some(axes) = &s.joint_axes
+            && (axes.is_empty() || axes.len() > 3)
+        {
+            return ck.err(
+                p("joint_axes"),
+                format!("give 1 to 3 axes (\"x\", \"y\", \"z\"), got {}", axes.len()),
+            );
+        }
+        let rigid_joints = s.method == Method::Rigid && s.joint_stiffness.is_some();
+        let twisting = if s.method == Method::Rigid {
+            s.axes().contains(&super::schema::Axis::X)
+        } else {
+            s.twists()
+        };
+        if twisting && !rigid_joints && s.ei().is_some() && s.gj().is_none() {
+            return ck.err(
+                p("torsional_stiffness"),
+                "missing: twisting elements need `torsional_stiffness` (G J), or `youngs_modulus` with the section (G = E/3 unless `shear_modulus` is given)".into(),
+            );
+        }
+        if s.incompressible == Some(true) && s.method == Method::Cosserat {
+            return ck.err(
+                p("incompressible"),
+                "the Cosserat rod keeps its section as it stretches: remove the key, or use a lumped method (pcc, vc, ebr, eba, rom) to thin the section with the stretch".into(),
+            );
+        }
+        // Rigid links do not stretch: there it has nothing to act on.
+        if s.incompressible == Some(true)
+            && !matches!(s.method, Method::Rigid | Method::Eba | Method::Cosserat)
+            && !s.stretches()
+        {
+            return ck.err(
+                p("incompressible"),
+                "acts on stretching elements: set `extension = true` too".into(),
+            );
+        }
+        if s.method != Method::Rigid && s.stretches() && s.ea().is_none() {
+            return ck.err(
+                p("axial_stiffness"),
+                "missing: `extension = true` needs `axial_stiffness` (E A), or `youngs_modulus` with the section".into(),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Keys by modelling method: what each method takes and needs.
+fn segment_method_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
+    let p = |k: &str| format!("segment[{i}].{k}");
+    let (m, planar) = (ck.m, ck.m.dimensions == 2);
+    let has_ei = s.ei().is_some();
+    match s.method {
+        Method::Rigid => {
+            if let Some(k) = s.joint_stiffness {
+                ck.non_negative(&p("joint_stiffness"), k)?;
+                if has_ei {
+                    return ck.err(
+                        p("joint_stiffness"),
+                        "give either `joint_stiffness` or the continuum's `youngs_modulus`/`bending_stiffness` (joint stiffness E I / l_e), not both".into(),
+                    );
+                }
+            }
+            if let Some(c) = s.joint_damping {
+                ck.non_negative(&p("joint_damping"), c)?;
+                if s.bending_damping.is_some() {
+                    return ck.err(
+                        p("joint_damping"),
+                        "give either `joint_damping` or `bending_damping`, not both".into(),
+                    );
+                }
+            }
+        }
+        Method::Pcc | Method::Vc | Method::Ebr | Method::Eba | Method::Rom | Method::Cosserat => {
+            for (key, given) in [
+                ("joint_stiffness", s.joint_stiffness.is_some()),
+                ("joint_damping", s.joint_damping.is_some()),
+                ("joints", s.joints.is_some()),
+            ] {
+                if given {
+                    return ck.err(
+                        p(key),
+                        format!(
+                            "not a key of {} segments: they take `youngs_modulus` or `bending_stiffness`, and `bending_damping`",
+                            s.method.name()
+                        ),
+                    );
+                }
+            }
+            if !has_ei {
+                return ck.err(
+                    p("youngs_modulus"),
+                    format!(
+                        "missing: a {} segment needs `youngs_modulus` (with `outer_radius`) or `bending_stiffness`",
+                        s.method.name()
+                    ),
+                );
+            }
+            if s.method == Method::Eba {
+                if m.segments.iter().any(|o| o.method != Method::Eba) {
+                    return ck.err(p("method"), "eba segments take absolute coordinates: every segment of the arm must be eba".into());
+                }
+                if s.rest_curvature != 0.0 {
+                    return ck.err(
+                        p("rest_curvature"),
+                        "eba elements are straight at rest: remove the key or use pcc, ebr or rom"
+                            .into(),
+                    );
+                }
+                if s.ea().is_none() || s.ga().is_none() {
+                    return ck.err(p("youngs_modulus"), "missing: eba couples elements by axial and shear springs: give `youngs_modulus` with `outer_radius`".into());
+                }
+            }
+            if matches!(s.method, Method::Ebr | Method::Eba | Method::Rom) && planar {
+                return ck.err(
+                    p("method"),
+                    format!(
+                        "{} is a 3D method: set `dimensions = 3` at the top of the file",
+                        s.method.name()
+                    ),
+                );
+            }
+            if s.method == Method::Rom {
+                if s.rom_order() > 8 {
+                    return ck.err(
+                        p("order"),
+                        format!(
+                            "must be between 0 and 8 (the polynomial degree of the strains), got {}",
+                            s.rom_order()
+                        ),
+                    );
+                }
+                if s.slices() == 0 || s.slices() > 64 {
+                    return ck.err(
+                        p("quadrature"),
+                        format!("must be between 1 and 64 slices, got {}", s.slices()),
+                    );
+                }
+            } else {
+                for (key, given) in [
+                    ("order", s.order.is_some()),
+                    ("quadrature", s.quadrature.is_some()),
+                ] {
+                    if given {
+                        return ck.err(p(key), "only rom segments take `order` and `quadrature`; others take `elements`".into());
+                    }
+                }
+            }
+            if s.joint_axes.is_some() {
+                return ck.err(
+                    p("joint_axes"),
+                    "only rigid segments have joint axes".into(),
+                );
+            }
+        }
     }
     Ok(())
 }
