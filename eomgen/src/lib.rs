@@ -9,5 +9,6 @@ pub mod cas;
 pub mod derive;
 pub mod emit;
 pub mod generate;
+pub mod method;
 pub mod model;
 pub mod tmt;

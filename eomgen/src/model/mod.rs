@@ -1,5 +1,6 @@
 //! Model files: schema, loading with overrides, validation, structure.
 
+mod check;
 mod error;
 mod load;
 mod params;
@@ -8,6 +9,7 @@ mod signals;
 mod structure;
 mod validate;
 
+pub(crate) use check::Check;
 pub use error::ModelError;
 pub use load::{Override, load_model, parse_model};
 pub use params::{

@@ -220,51 +220,9 @@ impl Structure {
     pub fn elements(&self) -> usize {
         self.segments.iter().map(|s| s.elements).sum()
     }
-
-    /// The generalised coordinates' names, in order: what the kinematics
-    /// number and what `[[torque]]` may name.
-    pub fn coordinate_names(&self) -> Vec<String> {
-        let absolute = self.segments.iter().any(|g| g.method == Method::Eba);
-        let mut names = Vec::new();
-        for (s, g) in self.segments.iter().enumerate() {
-            names.extend(g.coordinate_names(s, self.dimensions, absolute));
-        }
-        names
-    }
 }
 
 impl SegmentShape {
-    /// The names of segment `s`'s coordinates.
-    fn coordinate_names(&self, s: usize, dimensions: u8, absolute: bool) -> Vec<String> {
-        let mut names = Vec::new();
-        if absolute {
-            for e in 0..self.elements {
-                for c in ["ux", "uy", "uz", "rx", "ry", "rz"] {
-                    names.push(format!("{c}_{s}_{e}"));
-                }
-            }
-        } else if dimensions != 3 {
-            names.extend((0..self.elements).map(|e| format!("theta_{s}_{e}")));
-        } else if self.method == Method::Rom {
-            for field in self.strain_fields() {
-                names.extend((0..=self.order).map(|i| format!("{field}_{s}_c{i}")));
-            }
-        } else if self.method == Method::Rigid {
-            for e in 0..self.elements {
-                for a in &self.axes {
-                    names.push(format!("joint_{a:?}_{s}_{e}").to_lowercase());
-                }
-            }
-        } else {
-            for e in 0..self.elements {
-                for field in self.strain_fields() {
-                    names.push(format!("{field}_{s}_{e}"));
-                }
-            }
-        }
-        names
-    }
-
     /// 3D: the strain fields of a soft element, in coordinate order: the
     /// bend pair, then twist and stretch where present.
     pub fn strain_fields(&self) -> Vec<&'static str> {

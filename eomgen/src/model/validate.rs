@@ -1,6 +1,7 @@
 //! Checks that the types alone cannot express. Every message names the key
 //! path and says what is allowed.
 
+use super::check::Check;
 use super::error::ModelError;
 use super::schema::{Method, Model, Segment};
 
@@ -17,78 +18,14 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
     for (i, s) in m.segments.iter().enumerate() {
         segment_section(&ck, i, s)?;
         segment_dimension_keys(&ck, i, s)?;
-        segment_method_keys(&ck, i, s)?;
+        crate::method::check_segment(&ck, i, s)?;
     }
     tip(&ck)?;
     driven_loads_and_chambers(&ck)?;
     tendons(&ck)?;
     base_motion(&ck)?;
-    cosserat_inputs(&ck)?;
-    cosserat_rod(&ck)?;
     torques(&ck)?;
     signals(&ck)
-}
-
-/// The model under check and its file, with the checks every concern uses.
-struct Check<'a> {
-    m: &'a Model,
-    file: &'a str,
-}
-
-impl Check<'_> {
-    fn err(&self, path: String, msg: String) -> Result<(), ModelError> {
-        Err(ModelError::new(self.file, path, msg))
-    }
-
-    fn finite(&self, path: &str, v: f64) -> Result<(), ModelError> {
-        if v.is_finite() {
-            return Ok(());
-        }
-        self.err(path.into(), format!("must be a finite number, got {v}"))
-    }
-
-    fn vec3(&self, path: &str, v: &[f64; 3]) -> Result<(), ModelError> {
-        for (i, x) in v.iter().enumerate() {
-            self.finite(&format!("{path}[{i}]"), *x)?;
-        }
-        Ok(())
-    }
-
-    fn positive(&self, path: &str, v: f64) -> Result<(), ModelError> {
-        self.finite(path, v)?;
-        if v > 0.0 {
-            return Ok(());
-        }
-        self.err(path.into(), format!("must be positive, got {v}"))
-    }
-
-    fn non_negative(&self, path: &str, v: f64) -> Result<(), ModelError> {
-        self.finite(path, v)?;
-        if v >= 0.0 {
-            return Ok(());
-        }
-        self.err(path.into(), format!("must be zero or positive, got {v}"))
-    }
-
-    /// `name` is a declared input channel.
-    fn channel(&self, path: &str, name: &str) -> Result<(), ModelError> {
-        let inputs = &self.m.inputs;
-        if inputs.contains_key(name) {
-            return Ok(());
-        }
-        let known: Vec<&str> = inputs.keys().map(String::as_str).collect();
-        self.err(
-            path.into(),
-            if known.is_empty() {
-                format!("no input channel \"{name}\": declare it as [inputs.{name}]")
-            } else {
-                format!(
-                    "no input channel \"{name}\"; declared: {} (or add [inputs.{name}])",
-                    known.join(", ")
-                )
-            },
-        )
-    }
 }
 
 /// `[simulate]`: a known solver, positive times and tolerances.
@@ -339,90 +276,11 @@ fn base_motion(ck: &Check) -> Result<(), ModelError> {
     Ok(())
 }
 
-/// The Cosserat statics solve a rod under constant loads: nothing that
-/// inputs drive reaches it, so say so rather than ignore it.
-fn cosserat_inputs(ck: &Check) -> Result<(), ModelError> {
-    let m = ck.m;
-    // The Cosserat statics solve a rod under constant loads: nothing that
-    // inputs drive reaches it, so say so rather than ignore it.
-    if m.segments.iter().any(|s| s.method == Method::Cosserat) {
-        let driven = [
-            (
-                "base.translation_inputs",
-                m.base.translation_inputs.is_some(),
-            ),
-            ("base.rotation_inputs", m.base.rotation_inputs.is_some()),
-            ("torque", !m.torques.is_empty()),
-            ("tendon", !m.tendons.is_empty()),
-            ("tip.force_inputs", m.tip.force_inputs.is_some()),
-            ("tip.moment_inputs", m.tip.moment_inputs.is_some()),
-            (
-                "segment[0].chambers.inputs",
-                m.segments
-                    .iter()
-                    .any(|s| s.chambers.as_ref().is_some_and(|c| c.inputs.is_some())),
-            ),
-        ];
-        if let Some((key, _)) = driven.iter().find(|(_, given)| *given) {
-            return ck.err(
-                (*key).into(),
-                "the Cosserat statics take constant tip loads and gravity only; actuators, joint torques, driven loads and a moving base need a lumped method (pcc, vc, ebr, eba, rom, rigid)".into(),
-            );
-        }
-    }
-    Ok(())
-}
-
-/// The Cosserat statics take one uniform, straight segment with its
-/// bending and twist stiffness, loaded by gravity and tip loads.
-fn cosserat_rod(ck: &Check) -> Result<(), ModelError> {
-    let m = ck.m;
-    if !m.segments.iter().any(|s| s.method == Method::Cosserat) {
-        return Ok(());
-    }
-    let [s] = m.segments.as_slice() else {
-        return ck.err(
-            "segment".into(),
-            format!(
-                "the Cosserat statics take one uniform [[segment]], got {}",
-                m.segments.len()
-            ),
-        );
-    };
-    if s.rest_curvature != 0.0 {
-        return ck.err(
-            "segment[0].rest_curvature".into(),
-            "the Cosserat rod is straight at rest; remove the key".into(),
-        );
-    }
-    if m.tip.mass.is_some() {
-        return ck.err(
-            "tip.mass".into(),
-            "a tip mass is a load under gravity; give it as tip.force for the Cosserat statics"
-                .into(),
-        );
-    }
-    for (key, given) in [
-        ("bending_stiffness", s.ei().is_some()),
-        ("torsional_stiffness", s.gj().is_some()),
-        ("axial_stiffness", !s.stretches() || s.ea().is_some()),
-    ] {
-        if !given {
-            return ck.err(
-                format!("segment[0].{key}"),
-                "missing, the Cosserat rod needs it (or `youngs_modulus` with `outer_radius`)"
-                    .into(),
-            );
-        }
-    }
-    Ok(())
-}
-
 /// Joint torques: a declared channel and a coordinate the structure has.
 fn torques(ck: &Check) -> Result<(), ModelError> {
     let m = ck.m;
     if !m.torques.is_empty() {
-        let names = super::Structure::of(m).coordinate_names();
+        let names = crate::method::coordinate_names(&super::Structure::of(m));
         for (i, t) in m.torques.iter().enumerate() {
             ck.channel(&format!("torque[{i}].input"), &t.input)?;
             if !names.contains(&t.coordinate) {
@@ -584,12 +442,6 @@ fn segment_dimension_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), Model
                 "missing: twisting elements need `torsional_stiffness` (G J), or `youngs_modulus` with the section (G = E/3 unless `shear_modulus` is given)".into(),
             );
         }
-        if s.incompressible == Some(true) && s.method == Method::Cosserat {
-            return ck.err(
-                p("incompressible"),
-                "the Cosserat rod keeps its section as it stretches: remove the key, or use a lumped method (pcc, vc, ebr, eba, rom) to thin the section with the stretch".into(),
-            );
-        }
         // Rigid links do not stretch: there it has nothing to act on.
         if s.incompressible == Some(true)
             && !matches!(s.method, Method::Rigid | Method::Eba | Method::Cosserat)
@@ -605,118 +457,6 @@ fn segment_dimension_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), Model
                 p("axial_stiffness"),
                 "missing: `extension = true` needs `axial_stiffness` (E A), or `youngs_modulus` with the section".into(),
             );
-        }
-    }
-    Ok(())
-}
-
-/// Keys by modelling method: what each method takes and needs.
-fn segment_method_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
-    let p = |k: &str| format!("segment[{i}].{k}");
-    let (m, planar) = (ck.m, ck.m.dimensions == 2);
-    let has_ei = s.ei().is_some();
-    match s.method {
-        Method::Rigid => {
-            if let Some(k) = s.joint_stiffness {
-                ck.non_negative(&p("joint_stiffness"), k)?;
-                if has_ei {
-                    return ck.err(
-                        p("joint_stiffness"),
-                        "give either `joint_stiffness` or the continuum's `youngs_modulus`/`bending_stiffness` (joint stiffness E I / l_e), not both".into(),
-                    );
-                }
-            }
-            if let Some(c) = s.joint_damping {
-                ck.non_negative(&p("joint_damping"), c)?;
-                if s.bending_damping.is_some() {
-                    return ck.err(
-                        p("joint_damping"),
-                        "give either `joint_damping` or `bending_damping`, not both".into(),
-                    );
-                }
-            }
-        }
-        Method::Pcc | Method::Vc | Method::Ebr | Method::Eba | Method::Rom | Method::Cosserat => {
-            for (key, given) in [
-                ("joint_stiffness", s.joint_stiffness.is_some()),
-                ("joint_damping", s.joint_damping.is_some()),
-                ("joints", s.joints.is_some()),
-            ] {
-                if given {
-                    return ck.err(
-                        p(key),
-                        format!(
-                            "not a key of {} segments: they take `youngs_modulus` or `bending_stiffness`, and `bending_damping`",
-                            s.method.name()
-                        ),
-                    );
-                }
-            }
-            if !has_ei {
-                return ck.err(
-                    p("youngs_modulus"),
-                    format!(
-                        "missing: a {} segment needs `youngs_modulus` (with `outer_radius`) or `bending_stiffness`",
-                        s.method.name()
-                    ),
-                );
-            }
-            if s.method == Method::Eba {
-                if m.segments.iter().any(|o| o.method != Method::Eba) {
-                    return ck.err(p("method"), "eba segments take absolute coordinates: every segment of the arm must be eba".into());
-                }
-                if s.rest_curvature != 0.0 {
-                    return ck.err(
-                        p("rest_curvature"),
-                        "eba elements are straight at rest: remove the key or use pcc, ebr or rom"
-                            .into(),
-                    );
-                }
-                if s.ea().is_none() || s.ga().is_none() {
-                    return ck.err(p("youngs_modulus"), "missing: eba couples elements by axial and shear springs: give `youngs_modulus` with `outer_radius`".into());
-                }
-            }
-            if matches!(s.method, Method::Ebr | Method::Eba | Method::Rom) && planar {
-                return ck.err(
-                    p("method"),
-                    format!(
-                        "{} is a 3D method: set `dimensions = 3` at the top of the file",
-                        s.method.name()
-                    ),
-                );
-            }
-            if s.method == Method::Rom {
-                if s.rom_order() > 8 {
-                    return ck.err(
-                        p("order"),
-                        format!(
-                            "must be between 0 and 8 (the polynomial degree of the strains), got {}",
-                            s.rom_order()
-                        ),
-                    );
-                }
-                if s.slices() == 0 || s.slices() > 64 {
-                    return ck.err(
-                        p("quadrature"),
-                        format!("must be between 1 and 64 slices, got {}", s.slices()),
-                    );
-                }
-            } else {
-                for (key, given) in [
-                    ("order", s.order.is_some()),
-                    ("quadrature", s.quadrature.is_some()),
-                ] {
-                    if given {
-                        return ck.err(p(key), "only rom segments take `order` and `quadrature`; others take `elements`".into());
-                    }
-                }
-            }
-            if s.joint_axes.is_some() {
-                return ck.err(
-                    p("joint_axes"),
-                    "only rigid segments have joint axes".into(),
-                );
-            }
         }
     }
     Ok(())

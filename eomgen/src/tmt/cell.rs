@@ -22,8 +22,9 @@ use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{ElementParam, Method, Param, ParamLayout, Structure, Xyz};
 
 use super::actuation::thinning;
-use super::spatial::{Frame, Rom, Springs, V3, arc};
+use super::spatial::{Frame, Springs, V3, arc};
 use super::system::{Coordinates, ParamSymbols};
+use crate::method::rom::RomFields;
 
 /// The layout and kernels of a model whose mass + bias the link recursion
 /// computes, or `None` when its structure is outside the recursion.
@@ -32,7 +33,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         && st
             .segments
             .iter()
-            .all(|g| matches!(g.method, Method::Pcc | Method::Vc | Method::Rom))
+            .all(|g| crate::method::of(g.method).link_cells())
         && st.chambers.iter().all(|&c| c == 0)
         && st.tendons.is_empty()
         && st.torques.is_empty()
@@ -48,7 +49,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     let mut roms = Vec::new();
     let (mut first, mut k) = (0, 0);
     for g in &st.segments {
-        let rom = (g.method == Method::Rom).then(|| Rom::of(g, first));
+        let rom = (g.method == Method::Rom).then(|| RomFields::of(g, first));
         let shape = Shape {
             twist: g.twist,
             extension: g.extension,
@@ -150,9 +151,9 @@ struct Shape {
 }
 
 /// The generalised forces of the rom segments' strain energy and Rayleigh
-/// function (`Rom::energies`, exact quadratics in the coefficients), as one
+/// function (`RomFields::energies`, exact quadratics in the coefficients), as one
 /// kernel of the arm's coordinates and parameters.
-fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(Rom, usize)]) -> Tape {
+fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(RomFields, usize)]) -> Tape {
     let mut cas = Cas::new();
     let cas = &mut cas;
     let symbols = ParamSymbols::new(cas, params);

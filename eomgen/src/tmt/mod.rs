@@ -1,25 +1,25 @@
 //! The TMT method: kinematics modules describe a [`System`]; [`assemble`]
 //! derives M, h and the outputs from it.
 
-mod absolute;
-mod actuation;
+pub(crate) mod actuation;
 mod assemble;
 mod cell;
 mod chain;
 mod inertia;
-mod planar;
+pub(crate) mod planar;
 mod solve;
-mod spatial;
-mod system;
+pub(crate) mod spatial;
+pub(crate) mod system;
 
 use crate::cas::Cas;
-use crate::model::{Method, Param, ParamLayout, Structure};
+use crate::method;
+use crate::model::{Param, ParamLayout, Structure};
+use planar::PlanarArm;
+use spatial::SpatialArm;
 
 pub use assemble::{Equations, assemble};
 pub use cell::link_chain;
-pub use planar::planar_system;
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
-pub use spatial::spatial_system;
 pub use system::ParamSymbols;
 
 /// The system of a structure: planar or spatial kinematics by
@@ -32,13 +32,39 @@ pub fn system(cas: &mut Cas, structure: &Structure, layout: &ParamLayout) -> Sys
     sys
 }
 
+/// The kinematics: a method that builds the whole arm (absolute
+/// coordinates) does; otherwise every segment's method places its elements
+/// on one chain, planar or spatial by `dimensions`.
 fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
-    if structure.segments.iter().any(|s| s.method == Method::Eba) {
-        absolute::absolute_system(cas, structure, symbols)
-    } else if structure.dimensions == 3 {
-        spatial_system(cas, structure, symbols)
+    let methods: Vec<_> = structure
+        .segments
+        .iter()
+        .map(|g| method::of(g.method))
+        .collect();
+    if let Some(sys) = methods
+        .first()
+        .and_then(|m| m.whole_arm(cas, structure, symbols))
+    {
+        return sys;
+    }
+    if structure.dimensions == 3 {
+        let names = method::coordinate_names(structure);
+        let mut arm = SpatialArm::new(cas, names, symbols);
+        for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
+            m.build_spatial(cas, &mut arm, g, s);
+        }
+        arm.finish(cas, structure)
     } else {
-        planar_system(cas, structure, symbols)
+        let names = method::coordinate_names(structure);
+        let mut arm = PlanarArm::new(cas, names, symbols);
+        for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
+            for _ in 0..g.elements {
+                let el = arm.begin_element(s);
+                m.place_planar(cas, &mut arm, g, &el);
+                arm.end_element(cas, &el);
+            }
+        }
+        arm.finish(cas, structure)
     }
 }
 
@@ -63,4 +89,6 @@ fn apply_torques(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols, s
     }
     sys.actuation = cas.add_all(&terms);
 }
-pub use system::{AppliedMoment, Body, Chain, Coordinates, Inertia, Link, PointForce, System};
+pub use system::{
+    AppliedMoment, Body, Chain, Coordinates, Inertia, Link, PointForce, System, TipMount, tip_loads,
+};

@@ -19,14 +19,64 @@
 //! A finite-difference rod (strains between element centres) that converges
 //! to the extensible, shearable Cosserat rod as l_e -> 0.
 
+use super::{ModellingMethod, needs_bending_stiffness};
 use crate::cas::{Cas, ExprId};
-use crate::model::{ElementParam, Structure};
-
-use super::actuation::{Strain, actuation, thinning};
-use super::spatial::{
-    M3, V3, add3, bind3, coefficients, half_k_sq, left_jacobian, quat_mul, rotation, rotation_quat,
+use crate::model::{Check, ElementParam, Method, ModelError, Segment, SegmentShape, Structure};
+use crate::tmt::actuation::{Strain, actuation, thinning};
+use crate::tmt::spatial::{
+    M3, V3, add3, base_frame, bind3, coefficients, half_k_sq, left_jacobian, quat_mul, rotation,
+    rotation_quat,
 };
-use super::system::{Body, Coordinates, Inertia, ParamSymbols, System, TipMount, tip_loads};
+use crate::tmt::system::{Body, Coordinates, Inertia, ParamSymbols, System, TipMount, tip_loads};
+
+pub(super) struct Eba;
+
+impl ModellingMethod for Eba {
+    fn spatial_only(&self) -> bool {
+        true
+    }
+
+    fn check_keys(&self, ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
+        let p = |k: &str| format!("segment[{i}].{k}");
+        needs_bending_stiffness(ck, i, s)?;
+        if ck.m.segments.iter().any(|o| o.method != Method::Eba) {
+            return ck.err(
+                p("method"),
+                "eba segments take absolute coordinates: every segment of the arm must be eba"
+                    .into(),
+            );
+        }
+        if s.rest_curvature != 0.0 {
+            return ck.err(
+                p("rest_curvature"),
+                "eba elements are straight at rest: remove the key or use pcc, ebr or rom".into(),
+            );
+        }
+        if s.ea().is_none() || s.ga().is_none() {
+            return ck.err(
+                p("youngs_modulus"),
+                "missing: eba couples elements by axial and shear springs: give `youngs_modulus` with `outer_radius`".into(),
+            );
+        }
+        Ok(())
+    }
+
+    fn coordinate_names(&self, g: &SegmentShape, s: usize) -> Vec<String> {
+        let mut names = Vec::new();
+        for e in 0..g.elements {
+            for c in ["ux", "uy", "uz", "rx", "ry", "rz"] {
+                names.push(format!("{c}_{s}_{e}"));
+            }
+        }
+        names
+    }
+
+    /// Every segment of an eba arm is eba (validated): the arm is built
+    /// here whole, its elements held by beam springs instead of chained.
+    fn whole_arm(&self, cas: &mut Cas, st: &Structure, symbols: &ParamSymbols) -> Option<System> {
+        Some(absolute_system(cas, st, symbols))
+    }
+}
 
 /// An element's (or the clamp's) frame: rotation, centre and half length.
 struct Slab {
@@ -57,13 +107,13 @@ fn transpose_mul(cas: &mut Cas, a: &M3, b: &M3) -> M3 {
     })
 }
 
-pub fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
-    let coords = Coordinates::new(cas, structure.coordinate_names());
+fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
+    let coords = Coordinates::new(cas, super::coordinate_names(structure));
     let zero = cas.zero();
     // The base frame, moving when prescribed: the absolute states are then
     // measured from the moving base's straight arm.
     let base = symbols.base_motion(cas);
-    let frame = super::spatial::base_frame(cas, symbols, base.position, &base.turns);
+    let frame = base_frame(cas, symbols, base.position, &base.turns);
     let (r0, p0, w0) = (frame.r, frame.p, frame.w);
     let base_axis = [r0[0][0], r0[1][0], r0[2][0]];
     // Rates (of the damping) relative to a moving base, too.
@@ -169,7 +219,7 @@ pub fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymb
             cas.bind(e)
         });
         // Incompressible: a stretch lambda = (l + gap) / l thins the section
-        // (as in spatial::spatial_system).
+        // (as in `SpatialArm::strain_element`).
         let thin = structure.segments[segment].incompressible.then(|| {
             let len = cas.add(l, local[0]);
             thinning(cas, l, len)

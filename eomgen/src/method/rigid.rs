@@ -1,0 +1,142 @@
+//! `rigid`: a chain of rigid links joined by revolute joints, at the base
+//! of each link (a pendulum chain) or at its middle (Hencky's
+//! pseudo-rigid-body model of a rod: half a link at the clamp and the
+//! tip). In 3D each joint turns about the element frame's axes in
+//! sequence (a universal or spherical joint).
+
+use super::ModellingMethod;
+use crate::cas::Cas;
+use crate::model::{Check, ElementParam, Joints, ModelError, Segment, SegmentShape};
+use crate::tmt::actuation::Strain;
+use crate::tmt::planar::{self, Element2, PlanarArm};
+use crate::tmt::spatial::{Frame, SpatialArm, advance, half_k_sq, revolute};
+
+pub(super) struct Rigid;
+
+impl ModellingMethod for Rigid {
+    fn own_keys(&self) -> &'static [&'static str] {
+        &["joint_stiffness", "joint_damping", "joints", "joint_axes"]
+    }
+
+    fn check_keys(&self, ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
+        let p = |k: &str| format!("segment[{i}].{k}");
+        if let Some(k) = s.joint_stiffness {
+            ck.non_negative(&p("joint_stiffness"), k)?;
+            if s.ei().is_some() {
+                return ck.err(
+                    p("joint_stiffness"),
+                    "give either `joint_stiffness` or the continuum's `youngs_modulus`/`bending_stiffness` (joint stiffness E I / l_e), not both".into(),
+                );
+            }
+        }
+        if let Some(c) = s.joint_damping {
+            ck.non_negative(&p("joint_damping"), c)?;
+            if s.bending_damping.is_some() {
+                return ck.err(
+                    p("joint_damping"),
+                    "give either `joint_damping` or `bending_damping`, not both".into(),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn coordinate_names(&self, g: &SegmentShape, s: usize) -> Vec<String> {
+        let mut names = Vec::new();
+        for e in 0..g.elements {
+            for a in &g.axes {
+                names.push(format!("joint_{a:?}_{s}_{e}").to_lowercase());
+            }
+        }
+        names
+    }
+
+    fn place_planar(&self, cas: &mut Cas, arm: &mut PlanarArm, g: &SegmentShape, el: &Element2) {
+        let (l, m) = (el.l, el.m);
+        match g.joints {
+            Joints::Base => {
+                arm.f = planar::rotate(cas, arm.f, el.q, el.qd);
+                let half = cas.scaled(0.5, l);
+                let c = planar::along(cas, &arm.f, half);
+                arm.body(cas, c, arm.f.w, m, el.inertia);
+                arm.f = planar::advance(cas, arm.f, l);
+            }
+            Joints::Midpoint => {
+                let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
+                let half_m = cas.scaled(0.5, m);
+                let c = planar::along(cas, &arm.f, quarter);
+                arm.body(cas, c, arm.f.w, half_m, el.inertia);
+                arm.f = planar::advance(cas, arm.f, half);
+                arm.f = planar::rotate(cas, arm.f, el.q, el.qd);
+                let c = planar::along(cas, &arm.f, quarter);
+                arm.body(cas, c, arm.f.w, half_m, el.inertia);
+                arm.f = planar::advance(cas, arm.f, half);
+            }
+        }
+    }
+
+    fn build_spatial(&self, cas: &mut Cas, arm: &mut SpatialArm, g: &SegmentShape, s: usize) {
+        for _ in 0..g.elements {
+            let el = arm.element();
+            let first = arm.c;
+            let (l, m) = (el.l, el.m);
+            match g.joints {
+                Joints::Base => {
+                    arm.f = joint(cas, arm, g, s);
+                    let half = cas.scaled(0.5, l);
+                    let mid = advance(cas, &arm.f, half);
+                    arm.bodies.push(el.body(arm.f.axis(), mid.p, arm.f.w, m));
+                    arm.advance(cas, l);
+                }
+                Joints::Midpoint => {
+                    let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
+                    let half_m = cas.scaled(0.5, m);
+                    let b = advance(cas, &arm.f, quarter);
+                    arm.bodies.push(el.body(arm.f.axis(), b.p, arm.f.w, half_m));
+                    arm.advance(cas, half);
+                    arm.f = joint(cas, arm, g, s);
+                    let b = advance(cas, &arm.f, quarter);
+                    arm.bodies.push(el.body(arm.f.axis(), b.p, arm.f.w, half_m));
+                    arm.advance(cas, half);
+                }
+            }
+            arm.close_link(first);
+        }
+    }
+}
+
+/// The end frame turned by the element's joint: its angles about their
+/// axes in sequence, each with its spring (twist about x, bend about y and
+/// z, rest angle about z) and damper. The joint's lumped strain is its
+/// angles (exact for one axis, first order for several).
+fn joint(cas: &mut Cas, arm: &mut SpatialArm, g: &SegmentShape, s: usize) -> Frame {
+    let e = |p| arm.symbols.element(arm.k, p);
+    let (stiff, twist) = (
+        e(ElementParam::BendStiffness),
+        e(ElementParam::TwistStiffness),
+    );
+    let (damp, rest) = (e(ElementParam::BendDamping), e(ElementParam::Rest));
+    let zero = arm.zero;
+    let mut f = arm.f;
+    let mut rho = [zero; 3];
+    for &a in &g.axes {
+        let (q, qd) = arm.take();
+        rho[a.index()] = cas.add(rho[a.index()], q);
+        f = revolute(cas, &f, a.index(), q, qd);
+        let (kq, q_rest) = if a.index() == 0 {
+            (twist, zero)
+        } else {
+            (stiff, if a.index() == 2 { rest } else { zero })
+        };
+        let dq = cas.sub(q, q_rest);
+        arm.elastic.push(half_k_sq(cas, kq, dq));
+        arm.rayleigh.push(half_k_sq(cas, damp, qd));
+    }
+    arm.strains.push(Strain {
+        segment: s,
+        stretch: zero,
+        rho,
+        offset_scale: None,
+    });
+    f
+}

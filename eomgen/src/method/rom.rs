@@ -1,0 +1,282 @@
+//! `rom`: a reduced-order model. Curvature, twist and stretch are
+//! polynomials in s of degree `order`, their coefficients the segment's
+//! coordinates; kinematics, masses and energies by `quadrature` slices,
+//! each a constant-strain arc of the fields integrated over it; the strain
+//! energy integrated exactly. 3D only.
+
+use super::{ModellingMethod, needs_bending_stiffness};
+use crate::cas::{Cas, ExprId};
+use crate::model::{Check, ElementParam, ModelError, Segment, SegmentShape};
+use crate::tmt::actuation::{Strain, thinning};
+use crate::tmt::spatial::{SpatialArm, V3, arc, bind3, half_k_sq};
+use crate::tmt::system::{Coordinates, ParamSymbols};
+
+pub(super) struct Rom;
+
+impl ModellingMethod for Rom {
+    fn own_keys(&self) -> &'static [&'static str] {
+        &["order", "quadrature"]
+    }
+
+    fn spatial_only(&self) -> bool {
+        true
+    }
+
+    fn check_keys(&self, ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
+        needs_bending_stiffness(ck, i, s)?;
+        if s.rom_order() > 8 {
+            return ck.err(
+                format!("segment[{i}].order"),
+                format!(
+                    "must be between 0 and 8 (the polynomial degree of the strains), got {}",
+                    s.rom_order()
+                ),
+            );
+        }
+        if s.slices() == 0 || s.slices() > 64 {
+            return ck.err(
+                format!("segment[{i}].quadrature"),
+                format!("must be between 1 and 64 slices, got {}", s.slices()),
+            );
+        }
+        Ok(())
+    }
+
+    fn coordinate_names(&self, g: &SegmentShape, s: usize) -> Vec<String> {
+        let mut names = Vec::new();
+        for field in g.strain_fields() {
+            names.extend((0..=g.order).map(|i| format!("{field}_{s}_c{i}")));
+        }
+        names
+    }
+
+    fn build_spatial(&self, cas: &mut Cas, arm: &mut SpatialArm, g: &SegmentShape, s: usize) {
+        // The segment's coefficients, shared by its slices, and its strain
+        // energy integrated exactly.
+        let rom = RomFields::of(g, arm.c);
+        arm.c += rom.coordinates();
+        arm.shared_coordinates = true;
+        let [e, d] = rom.energies(cas, &arm.coords, arm.symbols, arm.k);
+        arm.elastic.push(e);
+        arm.rayleigh.push(d);
+        for e in 0..g.elements {
+            let el = arm.element();
+            let first = arm.c;
+            let (rho, rate, st) = rom.slice(cas, &arm.coords, e, el.l);
+            let len = cas.add(el.l, st);
+            // Incompressible: bending and twist energy slice by slice with
+            // the slice's thinning (`RomFields::energies` leaves them out).
+            let p = |q| arm.symbols.element(arm.k, q);
+            let kb = p(ElementParam::BendStiffness);
+            let kt = p(ElementParam::TwistStiffness);
+            let rest = p(ElementParam::Rest);
+            let thin = rom.incompressible.then(|| {
+                let (soft, off) = thinning(cas, el.l, len);
+                let bz = cas.sub(rho[2], rest);
+                for (kk, x) in [(kb, rho[1]), (kb, bz), (kt, rho[0])] {
+                    let kk = cas.mul(kk, soft);
+                    arm.elastic.push(half_k_sq(cas, kk, x));
+                }
+                off
+            });
+            arm.strains.push(Strain {
+                segment: s,
+                stretch: st,
+                rho,
+                offset_scale: thin,
+            });
+            let (centroid, axis, omega, end) = arc(cas, &arm.f, &rho, &rate, len);
+            let centroid = bind3(cas, centroid);
+            arm.bodies.push(el.body(axis, centroid, omega, el.m));
+            arm.f = end;
+            arm.close_link(first);
+        }
+    }
+
+    fn link_cells(&self) -> bool {
+        true
+    }
+}
+
+/// A rom segment: strain fields sum_i c_i sigma^i over sigma = s / L in
+/// [0, 1], the coefficients c (angles: curvature times L; the stretch
+/// field is dimensionless) its coordinates, field by field.
+pub(crate) struct RomFields {
+    pub first: usize,
+    pub order: usize,
+    pub slices: usize,
+    pub twist: bool,
+    pub extension: bool,
+    /// Bending and twist energy by slices (see `Rom::build_spatial`), not here.
+    pub incompressible: bool,
+}
+
+impl RomFields {
+    /// The rom of segment shape `g` whose coefficients start at `first`.
+    pub(crate) fn of(g: &crate::model::SegmentShape, first: usize) -> Self {
+        RomFields {
+            first,
+            order: g.order,
+            slices: g.elements,
+            twist: g.twist,
+            extension: g.extension,
+            incompressible: g.incompressible,
+        }
+    }
+
+    pub(crate) fn coordinates(&self) -> usize {
+        (2 + usize::from(self.twist) + usize::from(self.extension)) * (self.order + 1)
+    }
+
+    /// Coordinate index of coefficient i of field f.
+    pub(crate) fn index(&self, f: usize, i: usize) -> usize {
+        self.first + f * (self.order + 1) + i
+    }
+
+    /// int over slice e of sigma^i d sigma, for each i.
+    pub(crate) fn weights(&self, e: usize) -> Vec<f64> {
+        let n = self.slices as f64;
+        let (a, b) = (e as f64 / n, (e + 1) as f64 / n);
+        (0..=self.order)
+            .map(|i| {
+                let p = (i + 1) as i32;
+                (b.powi(p) - a.powi(p)) / p as f64
+            })
+            .collect()
+    }
+
+    /// One field integrated over slice e, of q (or, with `rates`, of qd).
+    fn field(
+        &self,
+        cas: &mut Cas,
+        coords: &Coordinates,
+        f: usize,
+        e: usize,
+        rates: bool,
+    ) -> ExprId {
+        let terms: Vec<ExprId> = self
+            .weights(e)
+            .into_iter()
+            .enumerate()
+            .map(|(i, w)| {
+                let j = self.index(f, i);
+                let x = if rates { coords.qd[j] } else { coords.q[j] };
+                cas.scaled(w, x)
+            })
+            .collect();
+        cas.add_all(&terms)
+    }
+
+    /// The rotation vector of slice e (twist, bend y, bend z), its rate,
+    /// and the slice's stretch, given the slice length l.
+    pub(crate) fn slice(
+        &self,
+        cas: &mut Cas,
+        coords: &Coordinates,
+        e: usize,
+        l: ExprId,
+    ) -> (V3, V3, ExprId) {
+        let zero = cas.zero();
+        let mut rho = [zero; 3];
+        let mut rate = [zero; 3];
+        // Fields 0, 1 bend about y, z; then twist (about x); then stretch.
+        for (f, axis) in [(0, 1), (1, 2)] {
+            rho[axis] = self.field(cas, coords, f, e, false);
+            rate[axis] = self.field(cas, coords, f, e, true);
+        }
+        if self.twist {
+            rho[0] = self.field(cas, coords, 2, e, false);
+            rate[0] = self.field(cas, coords, 2, e, true);
+        }
+        let stretch = if self.extension {
+            // The strain integrated over the slice, times L = slices * l.
+            let f = 2 + usize::from(self.twist);
+            let s = self.field(cas, coords, f, e, false);
+            let ls = cas.mul(l, s);
+            cas.scaled(self.slices as f64, ls)
+        } else {
+            zero
+        };
+        (rho.map(|x| cas.bind(x)), rate.map(|x| cas.bind(x)), stretch)
+    }
+
+    /// Strain energy and Rayleigh function, integrated exactly:
+    /// (k / 2) int_0^1 (field - rest)^2 d sigma with int sigma^(i+j) = 1 /
+    /// (i + j + 1). Per-slice parameters of slice k: E I / l = slices E I / L.
+    pub(crate) fn energies(
+        &self,
+        cas: &mut Cas,
+        coords: &Coordinates,
+        symbols: &ParamSymbols,
+        k: usize,
+    ) -> [ExprId; 2] {
+        let n = self.slices as f64;
+        let quad = |cas: &mut Cas, x: &[ExprId]| {
+            let mut terms = Vec::new();
+            for (i, &a) in x.iter().enumerate() {
+                for (j, &b) in x.iter().enumerate() {
+                    let ab = cas.mul(a, b);
+                    terms.push(cas.scaled(1.0 / (i + j + 1) as f64, ab));
+                }
+            }
+            cas.add_all(&terms)
+        };
+        let fields = 2 + usize::from(self.twist) + usize::from(self.extension);
+        let (mut elastic, mut rayleigh) = (Vec::new(), Vec::new());
+        for f in 0..fields {
+            let stretch = self.extension && f == fields - 1;
+            if self.incompressible && !stretch {
+                // Only the elastic part moves to the slices; damping stays.
+                let ds = symbols.element(
+                    k,
+                    match f {
+                        0 | 1 => ElementParam::BendDamping,
+                        _ => ElementParam::TwistDamping,
+                    },
+                );
+                let xd: Vec<ExprId> = (0..=self.order)
+                    .map(|i| coords.qd[self.index(f, i)])
+                    .collect();
+                let d = quad(cas, &xd);
+                let scale = cas.constant(1.0 / n);
+                rayleigh.push(cas.mul_all(&[ds, scale, d]));
+                continue;
+            }
+            let (stiff, damp) = match f {
+                _ if stretch => (ElementParam::StretchStiffness, ElementParam::StretchDamping),
+                0 | 1 => (ElementParam::BendStiffness, ElementParam::BendDamping),
+                _ => (ElementParam::TwistStiffness, ElementParam::TwistDamping),
+            };
+            let ks = symbols.element(k, stiff);
+            let ds = symbols.element(k, damp);
+            // Bending, twist: (E I / L) c^T G c = (k_slice / n) ...; stretch:
+            // E A L e^T G e = k_slice n l^2 ....
+            let scale = if stretch {
+                let l = symbols.element(k, ElementParam::Length);
+                let l2 = cas.powi(l, 2);
+                cas.scaled(n, l2)
+            } else {
+                cas.constant(1.0 / n)
+            };
+            let mut x: Vec<ExprId> = (0..=self.order)
+                .map(|i| coords.q[self.index(f, i)])
+                .collect();
+            if f == 1 {
+                // Rest curvature about z, constant along s: kappa0 L = n rest.
+                let rest = symbols.element(k, ElementParam::Rest);
+                let r = cas.scaled(n, rest);
+                x[0] = cas.sub(x[0], r);
+            }
+            let xd: Vec<ExprId> = (0..=self.order)
+                .map(|i| coords.qd[self.index(f, i)])
+                .collect();
+            let e = quad(cas, &x);
+            let d = quad(cas, &xd);
+            elastic.push(cas.mul_all(&[ks, scale, e]));
+            rayleigh.push(cas.mul_all(&[ds, scale, d]));
+        }
+        let e = cas.add_all(&elastic);
+        let d = cas.add_all(&rayleigh);
+        [cas.scaled(0.5, e), cas.scaled(0.5, d)]
+    }
+}

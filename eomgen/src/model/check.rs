@@ -1,0 +1,68 @@
+//! The checks every concern of validation uses, each naming the file and
+//! key path and saying what is allowed. Modelling methods check their own
+//! keys with them too (`method/`).
+
+use super::error::ModelError;
+use super::schema::Model;
+
+/// The model under check and its file, with the checks every concern uses.
+pub(crate) struct Check<'a> {
+    pub m: &'a Model,
+    pub file: &'a str,
+}
+
+impl Check<'_> {
+    pub fn err(&self, path: String, msg: String) -> Result<(), ModelError> {
+        Err(ModelError::new(self.file, path, msg))
+    }
+
+    pub fn finite(&self, path: &str, v: f64) -> Result<(), ModelError> {
+        if v.is_finite() {
+            return Ok(());
+        }
+        self.err(path.into(), format!("must be a finite number, got {v}"))
+    }
+
+    pub fn vec3(&self, path: &str, v: &[f64; 3]) -> Result<(), ModelError> {
+        for (i, x) in v.iter().enumerate() {
+            self.finite(&format!("{path}[{i}]"), *x)?;
+        }
+        Ok(())
+    }
+
+    pub fn positive(&self, path: &str, v: f64) -> Result<(), ModelError> {
+        self.finite(path, v)?;
+        if v > 0.0 {
+            return Ok(());
+        }
+        self.err(path.into(), format!("must be positive, got {v}"))
+    }
+
+    pub fn non_negative(&self, path: &str, v: f64) -> Result<(), ModelError> {
+        self.finite(path, v)?;
+        if v >= 0.0 {
+            return Ok(());
+        }
+        self.err(path.into(), format!("must be zero or positive, got {v}"))
+    }
+
+    /// `name` is a declared input channel.
+    pub fn channel(&self, path: &str, name: &str) -> Result<(), ModelError> {
+        let inputs = &self.m.inputs;
+        if inputs.contains_key(name) {
+            return Ok(());
+        }
+        let known: Vec<&str> = inputs.keys().map(String::as_str).collect();
+        self.err(
+            path.into(),
+            if known.is_empty() {
+                format!("no input channel \"{name}\": declare it as [inputs.{name}]")
+            } else {
+                format!(
+                    "no input channel \"{name}\"; declared: {} (or add [inputs.{name}])",
+                    known.join(", ")
+                )
+            },
+        )
+    }
+}
