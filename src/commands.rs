@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use eomgen::model::{Override, Start};
+use eomgen::model::{Compare, Override, SimulateDefaults, Start};
 use nalgebra::{DMatrix, DVector};
 use runtime::{
     Dynamics, KernelKind, OUTPUT_NAMES, SimOptions, Solver, Trajectory, Workspace, accelerations,
@@ -231,41 +231,43 @@ fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
     s
 }
 
-pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
-    let mut loaded = load(&a.model)?;
+/// The initial coordinates: `--q0`, and with `--start static` (or the
+/// model's `[simulate] start`) the equilibrium at t = 0 found from them.
+fn initial_coordinates(a: &SimulateArgs, loaded: &mut Loaded) -> Result<Vec<f64>> {
     let n = loaded.arm.dof();
     let coords = loaded.arm.info().coordinates.clone();
-    let mut q0 = optional_vector("--q0", &a.q0, n, &coords)?;
+    let q0 = optional_vector("--q0", &a.q0, n, &coords)?;
     let start = match a.start {
         Some(StartArg::Rest) => Start::Rest,
         Some(StartArg::Static) => Start::Static,
         None => loaded.model.simulate.start.unwrap_or(Start::Rest),
     };
-    if start == Start::Static {
-        // At rest in equilibrium under the loads and inputs at t = 0.
-        q0 = runtime::solve_static(&mut *loaded.arm, &q0, &runtime::StaticOptions::default())
-            .map_err(|e| {
-                anyhow::anyhow!(
-                    "{}: --start static: no equilibrium at t = 0: {e}; start from --start rest instead",
-                    loaded.origin
-                )
-            })?
-            .q;
+    if start == Start::Rest {
+        return Ok(q0);
     }
-    let arm = &*loaded.arm;
-    // The command line, else the model's [simulate], else runtime's
-    // defaults.
-    let file = &loaded.model.simulate;
+    // At rest in equilibrium under the loads and inputs at t = 0.
+    let sol = runtime::solve_static(&mut *loaded.arm, &q0, &runtime::StaticOptions::default())
+        .map_err(|e| {
+            anyhow::anyhow!(
+                "{}: --start static: no equilibrium at t = 0: {e}; start from --start rest instead",
+                loaded.origin
+            )
+        })?;
+    Ok(sol.q)
+}
+
+/// What the run is asked: the command line, else the model's
+/// `[simulate]`, else runtime's defaults (`SimOptions::default`).
+fn run_options(a: &SimulateArgs, file: &SimulateDefaults) -> Result<SimOptions> {
     let defaults = SimOptions::default();
     let t_end = a.t_end.or(file.t_end).unwrap_or(defaults.t_end);
     let dt = a.dt.or(file.dt).unwrap_or(defaults.dt);
     let rtol = a.rtol.or(file.rtol).unwrap_or(defaults.rtol);
     let atol = a.atol.or(file.atol).unwrap_or(defaults.atol);
-    let solver_name = a
-        .solver
-        .clone()
-        .or(file.solver.clone())
-        .unwrap_or_else(|| defaults.solver.name().into());
+    let solver = match a.solver.as_ref().or(file.solver.as_ref()) {
+        Some(name) => Solver::parse(name).expect("clap and validation checked the name"),
+        None => defaults.solver,
+    };
     if !(t_end > 0.0 && t_end.is_finite()) {
         bail!("--t-end must be a positive number of seconds, got {t_end}");
     }
@@ -277,12 +279,76 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     if a.max_steps == 0 {
         bail!("--max-steps must be at least 1");
     }
-    let qd0 = optional_vector("--qd0", &a.qd0, n, &coords)?;
-    let solver = Solver::parse(&solver_name).expect("clap and validation checked the name");
     let output_dt = a.output_dt.unwrap_or(t_end / runtime::DEFAULT_SAMPLES);
     if !(output_dt > 0.0 && output_dt.is_finite()) {
         bail!("--output-dt must be positive, got {output_dt}");
     }
+    Ok(SimOptions {
+        t_end,
+        solver,
+        rtol,
+        atol,
+        dt,
+        output_dt,
+        max_steps: a.max_steps,
+        ..defaults
+    })
+}
+
+/// The simulated tip against the measured one: the error statistics over
+/// the comparison window (none if the run ended before it) and the plot.
+fn compare_tip(
+    loaded: &Loaded,
+    spec: &Compare,
+    m: &compare::Measured,
+    traj: &Trajectory,
+    out_dir: &Path,
+) -> Result<Option<compare::TipError>> {
+    let arm = &*loaded.arm;
+    let n = arm.dof();
+    let tips: Vec<(f64, [f64; 3])> = traj
+        .t
+        .iter()
+        .zip(&traj.x)
+        .map(|(t, x)| {
+            let o = arm.outputs(*t, &x[..n], &x[n..]);
+            (*t, [o[0], o[1], o[2]])
+        })
+        .collect();
+    let window = spec
+        .window
+        .unwrap_or([m.t[0], *m.t.last().expect("a CSV has rows")]);
+    let length = loaded.model.segments.iter().map(|s| s.length).sum::<f64>()
+        + loaded.model.tip.length.unwrap_or(0.0);
+    // A run that ends before the window has no statistics, but
+    // still its plot.
+    let err = compare::tip_error(m, window, length, |t| {
+        tips.iter().find(|s| (s.0 - t).abs() < 1e-9).map(|s| s.1)
+    })
+    .map_err(|e| eprintln!("warning: no tip error: {e}"))
+    .ok();
+    let title = match &err {
+        Some(e) => format!(
+            "{}: mean tip error {:.2} mm ({:.2} % of length)",
+            loaded.model.name,
+            1e3 * e.mean_m,
+            e.mean_percent_length
+        ),
+        None => format!("{}: simulated and measured tip", loaded.model.name),
+    };
+    compare::plot(&out_dir.join("tip"), &title, &tips, m)?;
+    Ok(err)
+}
+
+pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
+    let mut loaded = load(&a.model)?;
+    let n = loaded.arm.dof();
+    let coords = loaded.arm.info().coordinates.clone();
+    let q0 = initial_coordinates(&a, &mut loaded)?;
+    let arm = &*loaded.arm;
+    let mut opts = run_options(&a, &loaded.model.simulate)?;
+    let (t_end, solver) = (opts.t_end, opts.solver);
+    let qd0 = optional_vector("--qd0", &a.qd0, n, &coords)?;
     // Measured data to compare with: sampled at its own times.
     let measured = match &loaded.model.compare {
         Some(spec) => {
@@ -301,17 +367,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         }
         t
     });
-    let opts = SimOptions {
-        t_end,
-        solver,
-        rtol,
-        atol,
-        dt,
-        output_dt,
-        output_times,
-        max_steps: a.max_steps,
-        ..Default::default()
-    };
+    opts.output_times = output_times;
     let out_dir = a
         .out
         .clone()
@@ -342,40 +398,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         [f64::NAN; runtime::N_OUTPUTS]
     };
     let tip_error = match (&measured, &loaded.model.compare) {
-        (Some(m), Some(spec)) => {
-            let tips: Vec<(f64, [f64; 3])> = traj
-                .t
-                .iter()
-                .zip(&traj.x)
-                .map(|(t, x)| {
-                    let o = arm.outputs(*t, &x[..n], &x[n..]);
-                    (*t, [o[0], o[1], o[2]])
-                })
-                .collect();
-            let window = spec
-                .window
-                .unwrap_or([m.t[0], *m.t.last().expect("a CSV has rows")]);
-            let length = loaded.model.segments.iter().map(|s| s.length).sum::<f64>()
-                + loaded.model.tip.length.unwrap_or(0.0);
-            // A run that ends before the window has no statistics, but
-            // still its plot.
-            let err = compare::tip_error(m, window, length, |t| {
-                tips.iter().find(|s| (s.0 - t).abs() < 1e-9).map(|s| s.1)
-            })
-            .map_err(|e| eprintln!("warning: no tip error: {e}"))
-            .ok();
-            let title = match &err {
-                Some(e) => format!(
-                    "{}: mean tip error {:.2} mm ({:.2} % of length)",
-                    loaded.model.name,
-                    1e3 * e.mean_m,
-                    e.mean_percent_length
-                ),
-                None => format!("{}: simulated and measured tip", loaded.model.name),
-            };
-            compare::plot(&out_dir.join("tip"), &title, &tips, m)?;
-            err
-        }
+        (Some(m), Some(spec)) => compare_tip(&loaded, spec, m, &traj, &out_dir)?,
         _ => None,
     };
     let summary = json!({
@@ -386,10 +409,10 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         "cache": loaded.cache,
         "derive_s": loaded.derive_s,
         "solver": stats.solver,
-        "rtol": a.rtol,
-        "atol": a.atol,
-        "dt": if solver.fixed_step() { Some(a.dt) } else { None },
-        "t_end": a.t_end,
+        "rtol": opts.rtol,
+        "atol": opts.atol,
+        "dt": solver.fixed_step().then_some(opts.dt),
+        "t_end": t_end,
         "steps": stats.steps,
         "rejected_steps": stats.rejected_steps,
         "rhs_evaluations": stats.rhs_evaluations,

@@ -17,8 +17,8 @@ pub use params::{
     base_turn_axis, channel, element_props, parameters,
 };
 pub use schema::{
-    Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, Start, Tendon, Tip, Torque,
-    WrenchFrame,
+    Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, SimulateDefaults, Start,
+    Tendon, Tip, Torque, WrenchFrame,
 };
 pub use signals::{Compare, Input, Offset};
 pub use structure::{GENERATOR_VERSION, SegmentShape, Structure};
