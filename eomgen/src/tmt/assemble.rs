@@ -113,43 +113,7 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         .map(|chain| ChainKinematics::new(cas, sys, chain, velocities, link_velocities));
     let mass = match &kinematics {
         Some(k) => k.mass(cas),
-        None => {
-            // Body by body from the columns of T: sum_b m v_bi . v_bj +
-            // w_bi^T J_b w_bj. (Differentiating the momentum instead costs a
-            // derivative of the whole reverse sweep per entry.)
-            let zero = cas.zero();
-            let columns: Vec<Vec<([ExprId; 3], [ExprId; 3])>> = (0..nb)
-                .map(|b| {
-                    let v = triple(velocities, b);
-                    let w = sys.bodies[b].omega;
-                    sys.coords
-                        .qd
-                        .iter()
-                        .map(|&qd| (v.map(|e| cas.diff(e, qd)), w.map(|e| cas.diff(e, qd))))
-                        .collect()
-                })
-                .collect();
-            let mut mass = Vec::with_capacity(n * (n + 1) / 2);
-            for i in 0..n {
-                for j in i..n {
-                    let mut terms = Vec::new();
-                    for (b, body) in sys.bodies.iter().enumerate() {
-                        let ((vi, wi), (vj, wj)) = (columns[b][i], columns[b][j]);
-                        let none = |v: &[ExprId; 3], w: &[ExprId; 3]| {
-                            v.iter().chain(w).all(|&e| e == zero)
-                        };
-                        if none(&vi, &wi) || none(&vj, &wj) {
-                            continue;
-                        }
-                        let vv = cas.dot(&vi, &vj);
-                        terms.push(cas.mul(body.mass, vv));
-                        terms.push(body.inertia.quadratic(cas, &wi, &wj));
-                    }
-                    mass.push(cas.add_all(&terms));
-                }
-            }
-            mass
-        }
+        None => mass_by_bodies(cas, sys, velocities),
     };
 
     // h: inertial, gravity and applied forces by one transpose product,
@@ -195,7 +159,61 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         })
         .collect();
 
-    // Statics: h(q, 0) = -J^T (m g) - J^T F + dV_e/dq, and its Jacobian.
+    let stiffness = static_stiffness(cas, sys, &outs, stored);
+
+    let outputs = energy_outputs(cas, sys, velocities, &momentum_cot);
+    let jvp = jacobian_parts(cas, sys, &momentum, &bias);
+    Equations {
+        mass_upper: mass,
+        bias,
+        outputs,
+        stiffness,
+        jvp,
+    }
+}
+
+/// M body by body from the columns of T: sum_b m v_bi . v_bj + w_bi^T J_b
+/// w_bj (differentiating the momentum instead costs a derivative of the
+/// whole reverse sweep per entry); entries whose columns vanish skipped.
+fn mass_by_bodies(cas: &mut Cas, sys: &System, velocities: &[ExprId]) -> Vec<ExprId> {
+    let (n, nb) = (sys.coords.len(), sys.bodies.len());
+    let zero = cas.zero();
+    let columns: Vec<Vec<([ExprId; 3], [ExprId; 3])>> = (0..nb)
+        .map(|b| {
+            let v = triple(velocities, b);
+            let w = sys.bodies[b].omega;
+            sys.coords
+                .qd
+                .iter()
+                .map(|&qd| (v.map(|e| cas.diff(e, qd)), w.map(|e| cas.diff(e, qd))))
+                .collect()
+        })
+        .collect();
+    let mut mass = Vec::with_capacity(n * (n + 1) / 2);
+    for i in 0..n {
+        for j in i..n {
+            let mut terms = Vec::new();
+            for (b, body) in sys.bodies.iter().enumerate() {
+                let ((vi, wi), (vj, wj)) = (columns[b][i], columns[b][j]);
+                let none = |v: &[ExprId; 3], w: &[ExprId; 3]| v.iter().chain(w).all(|&e| e == zero);
+                if none(&vi, &wi) || none(&vj, &wj) {
+                    continue;
+                }
+                let vv = cas.dot(&vi, &vj);
+                terms.push(cas.mul(body.mass, vv));
+                terms.push(body.inertia.quadratic(cas, &wi, &wj));
+            }
+            mass.push(cas.add_all(&terms));
+        }
+    }
+    mass
+}
+
+/// The static generalised forces h(q, 0) = -J^T (m g) - J^T F + dV/dq and
+/// their Jacobian in q, row-major (the tangent stiffness).
+fn static_stiffness(cas: &mut Cas, sys: &System, outs: &[ExprId], stored: ExprId) -> Vec<ExprId> {
+    let (n, nb) = (sys.coords.len(), sys.bodies.len());
+
     let mut static_cot = Vec::with_capacity(outs.len());
     for body in &sys.bodies {
         for k in 0..3 {
@@ -211,7 +229,7 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     for moment in &sys.moments {
         static_cot.extend(moment.moment.map(|c| cas.neg(c)));
     }
-    let static_loads = cas.vjp(&outs, &static_cot, &sys.coords.qd);
+    let static_loads = cas.vjp(outs, &static_cot, &sys.coords.qd);
     let static_force: Vec<ExprId> = (0..n)
         .map(|i| {
             let de = cas.diff(stored, sys.coords.q[i]);
@@ -225,14 +243,26 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         }
     }
 
+    stiffness
+}
+
+/// The outputs: tip position, kinetic and potential energy, tip
+/// orientation.
+fn energy_outputs(
+    cas: &mut Cas,
+    sys: &System,
+    velocities: &[ExprId],
+    momentum_cot: &[ExprId],
+) -> Vec<ExprId> {
+    let nb = sys.bodies.len();
     // Energies: KE = (v . m v + w . I w) / 2 = qd . momentum / 2 would hide
     // the bodies; sum them directly.
     let mut kinetic = Vec::new();
     let mut potential = vec![sys.elastic];
     for (b, body) in sys.bodies.iter().enumerate() {
         let v = triple(velocities, b);
-        let mv = triple(&momentum_cot, b);
-        let iw = triple(&momentum_cot, nb + b);
+        let mv = triple(momentum_cot, b);
+        let iw = triple(momentum_cot, nb + b);
         let lin = cas.dot(&v, &mv);
         let ang = cas.dot(&body.omega, &iw);
         let ke = cas.add(lin, ang);
@@ -254,6 +284,19 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     let pe = cas.add_all(&potential);
     let mut outputs = vec![sys.tip[0], sys.tip[1], sys.tip[2], ke, pe];
     outputs.extend(sys.tip_orientation);
+    outputs
+}
+
+/// The `Jvp` kernel's outputs: dh/dq dq + dh/dqd dqd, then d(M qdd)/dq dq,
+/// one directional derivative each (the runtime takes the Jacobian's
+/// columns along unit directions), not n^2 partials.
+fn jacobian_parts(
+    cas: &mut Cas,
+    sys: &System,
+    momentum: &[ExprId],
+    bias: &[ExprId],
+) -> Vec<ExprId> {
+    let n = sys.coords.len();
     // Jacobian parts. M qdd is the derivative of the momentum along qdd in
     // qd-space: one directional derivative, shared structure.
     let accel_pairs: Vec<(ExprId, ExprId)> = sys
@@ -263,7 +306,7 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         .copied()
         .zip(sys.coords.qdd.iter().copied())
         .collect();
-    let m_qdd = cas.time_derivatives(&momentum, &accel_pairs);
+    let m_qdd = cas.time_derivatives(momentum, &accel_pairs);
     // One directional derivative each, not n^2 partials: the runtime takes
     // the Jacobian's columns along unit directions.
     let names = &sys.coords.names;
@@ -279,13 +322,7 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
     let along_q: Vec<(ExprId, ExprId)> = sys.coords.q.iter().copied().zip(dq).collect();
     let mut along_both = along_q.clone();
     along_both.extend(sys.coords.qd.iter().copied().zip(dqd));
-    let mut jvp = cas.time_derivatives(&bias, &along_both);
+    let mut jvp = cas.time_derivatives(bias, &along_both);
     jvp.extend(cas.time_derivatives(&m_qdd, &along_q));
-    Equations {
-        mass_upper: mass,
-        bias,
-        outputs,
-        stiffness,
-        jvp,
-    }
+    jvp
 }
