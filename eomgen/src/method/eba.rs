@@ -185,71 +185,14 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         let slab = Slab { r, centre, half };
 
         // Beam springs to the previous element (or the clamp).
-        let first = k == 0;
-        let span = if first { 2.0 } else { 1.0 }; // stiffness factor l_e / span
-        let kb = symbols.element(k, ElementParam::BendStiffness);
-        let kt = symbols.element(k, ElementParam::TwistStiffness);
-        let db = symbols.element(k, ElementParam::BendDamping);
-        let dt = symbols.element(k, ElementParam::TwistDamping);
-        let ka = symbols.element(k, ElementParam::StretchStiffness);
-        let da = symbols.element(k, ElementParam::StretchDamping);
-        let ks = symbols.element(k, ElementParam::ShearStiffness);
-        let r_rel = transpose_mul(cas, &prev.r, &slab.r);
-        // 2 tan(theta / 2) n = 2 vee(R - R^T) / (1 + tr R): the relative
-        // rotation to second order, and stiffening up to a half turn, so
-        // that equilibria exist under any load.
-        let tr = cas.add_all(&[r_rel[0][0], r_rel[1][1], r_rel[2][2]]);
-        let one = cas.one();
-        let denom = cas.add(one, tr);
-        let inv = cas.powi(denom, -1);
-        let inv = cas.bind(inv);
-        let v: V3 = [(2, 1), (0, 2), (1, 0)].map(|(a, b)| {
-            let d = cas.sub(r_rel[a][b], r_rel[b][a]);
-            let h = cas.mul(d, inv);
-            let h = cas.scaled(2.0, h);
-            cas.bind(h)
-        });
-        let end_a = prev.end(cas, 1.0);
-        let start_b = slab.end(cas, -1.0);
-        let gap: V3 = std::array::from_fn(|i| cas.sub(start_b[i], end_a[i]));
-        // In the previous frame: R_a^T gap.
-        let local: V3 = std::array::from_fn(|i| {
-            let col = [prev.r[0][i], prev.r[1][i], prev.r[2][i]];
-            let e = cas.dot(&col, &gap);
-            cas.bind(e)
-        });
-        // Incompressible: a stretch lambda = (l + gap) / l thins the section
-        // (as in `SpatialArm::strain_element`).
-        let thin = structure.segments[segment].incompressible.then(|| {
-            let len = cas.add(l, local[0]);
-            thinning(cas, l, len)
-        });
-        // The joint's lumped strain: the gap along the previous axis and
-        // the relative rotation measure.
+        let incompressible = structure.segments[segment].incompressible;
+        let joint = beam_springs(cas, symbols, k, &prev, &slab, incompressible, &pairs);
         strains.push(Strain {
             segment,
-            stretch: local[0],
-            rho: v,
-            offset_scale: thin.map(|t| t.1),
+            ..joint.strain
         });
-        let v_d = cas.time_derivatives(&v, &pairs);
-        for (i, (&x, &xd)) in v.iter().zip(&v_d).enumerate() {
-            let (kk, dd) = if i == 0 { (kt, dt) } else { (kb, db) };
-            let kk = cas.scaled(span, kk);
-            let kk = match thin {
-                Some((soft, _)) => cas.mul(kk, soft),
-                None => kk,
-            };
-            let dd = cas.scaled(span, dd);
-            elastic.push(half_k_sq(cas, kk, x));
-            rayleigh.push(half_k_sq(cas, dd, xd));
-        }
-        let local_d = cas.time_derivatives(&local[..1], &pairs);
-        elastic.push(half_k_sq(cas, ka, local[0]));
-        rayleigh.push(half_k_sq(cas, da, local_d[0]));
-        for &x in &local[1..] {
-            elastic.push(half_k_sq(cas, ks, x));
-        }
+        elastic.extend(joint.elastic);
+        rayleigh.extend(joint.rayleigh);
         prev = slab;
     }
 
@@ -281,4 +224,98 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
     let loads = tip_loads(cas, symbols, structure, &mount);
     sys.attach_tip(loads, 0);
     sys
+}
+
+/// The beam springs between element k and the previous one (or the clamp):
+/// bending and twist on the relative rotation measure, axial and shear on
+/// the gap in the previous frame, thinned with the stretch if
+/// incompressible; and the joint's lumped strain (its segment left to the
+/// caller).
+struct BeamJoint {
+    strain: Strain,
+    elastic: Vec<ExprId>,
+    rayleigh: Vec<ExprId>,
+}
+
+fn beam_springs(
+    cas: &mut Cas,
+    symbols: &ParamSymbols,
+    k: usize,
+    prev: &Slab,
+    slab: &Slab,
+    incompressible: bool,
+    pairs: &[(ExprId, ExprId)],
+) -> BeamJoint {
+    let l = symbols.element(k, ElementParam::Length);
+    let first = k == 0;
+    let span = if first { 2.0 } else { 1.0 }; // stiffness factor l_e / span
+    let kb = symbols.element(k, ElementParam::BendStiffness);
+    let kt = symbols.element(k, ElementParam::TwistStiffness);
+    let db = symbols.element(k, ElementParam::BendDamping);
+    let dt = symbols.element(k, ElementParam::TwistDamping);
+    let ka = symbols.element(k, ElementParam::StretchStiffness);
+    let da = symbols.element(k, ElementParam::StretchDamping);
+    let ks = symbols.element(k, ElementParam::ShearStiffness);
+    let r_rel = transpose_mul(cas, &prev.r, &slab.r);
+    // 2 tan(theta / 2) n = 2 vee(R - R^T) / (1 + tr R): the relative
+    // rotation to second order, and stiffening up to a half turn, so
+    // that equilibria exist under any load.
+    let tr = cas.add_all(&[r_rel[0][0], r_rel[1][1], r_rel[2][2]]);
+    let one = cas.one();
+    let denom = cas.add(one, tr);
+    let inv = cas.powi(denom, -1);
+    let inv = cas.bind(inv);
+    let v: V3 = [(2, 1), (0, 2), (1, 0)].map(|(a, b)| {
+        let d = cas.sub(r_rel[a][b], r_rel[b][a]);
+        let h = cas.mul(d, inv);
+        let h = cas.scaled(2.0, h);
+        cas.bind(h)
+    });
+    let end_a = prev.end(cas, 1.0);
+    let start_b = slab.end(cas, -1.0);
+    let gap: V3 = std::array::from_fn(|i| cas.sub(start_b[i], end_a[i]));
+    // In the previous frame: R_a^T gap.
+    let local: V3 = std::array::from_fn(|i| {
+        let col = [prev.r[0][i], prev.r[1][i], prev.r[2][i]];
+        let e = cas.dot(&col, &gap);
+        cas.bind(e)
+    });
+    // Incompressible: a stretch lambda = (l + gap) / l thins the section
+    // (as in `SpatialArm::strain_element`).
+    let thin = incompressible.then(|| {
+        let len = cas.add(l, local[0]);
+        thinning(cas, l, len)
+    });
+    // The joint's lumped strain: the gap along the previous axis and
+    // the relative rotation measure.
+    let strain = Strain {
+        segment: 0,
+        stretch: local[0],
+        rho: v,
+        offset_scale: thin.map(|t| t.1),
+    };
+    let (mut elastic, mut rayleigh) = (Vec::new(), Vec::new());
+    let v_d = cas.time_derivatives(&v, pairs);
+    for (i, (&x, &xd)) in v.iter().zip(&v_d).enumerate() {
+        let (kk, dd) = if i == 0 { (kt, dt) } else { (kb, db) };
+        let kk = cas.scaled(span, kk);
+        let kk = match thin {
+            Some((soft, _)) => cas.mul(kk, soft),
+            None => kk,
+        };
+        let dd = cas.scaled(span, dd);
+        elastic.push(half_k_sq(cas, kk, x));
+        rayleigh.push(half_k_sq(cas, dd, xd));
+    }
+    let local_d = cas.time_derivatives(&local[..1], pairs);
+    elastic.push(half_k_sq(cas, ka, local[0]));
+    rayleigh.push(half_k_sq(cas, da, local_d[0]));
+    for &x in &local[1..] {
+        elastic.push(half_k_sq(cas, ks, x));
+    }
+    BeamJoint {
+        strain,
+        elastic,
+        rayleigh,
+    }
 }
