@@ -102,7 +102,6 @@ pub fn integrate(
     let mut last_rejected = false;
     let mut z = vec![vec![0.0; m]; 3];
     let mut fz = vec![vec![0.0; m]; 3];
-    let mut yi = vec![0.0; m];
     let mut dense: Option<Dense> = None;
     // Whether J must be evaluated before the next attempt, and whether the J
     // in hand was evaluated at the current point.
@@ -114,18 +113,7 @@ pub fn integrate(
             (need_jacobian, fresh) = (false, true);
         }
         let scale: Vec<f64> = y.iter().map(|v| atol + rtol * v.abs()).collect();
-        // E = I - h (A (x) J), factored once per step.
-        let mut e = DMatrix::<f64>::identity(3 * m, 3 * m);
-        for (a, row) in A.iter().enumerate() {
-            for (b, &ab) in row.iter().enumerate() {
-                for r in 0..m {
-                    for c in 0..m {
-                        e[(a * m + r, b * m + c)] -= h * ab * j[(r, c)];
-                    }
-                }
-            }
-        }
-        let lu = e.lu();
+        let lu = newton_matrix(&j, h, m);
         // Start from the last step's collocation polynomial, extrapolated.
         match &mut dense {
             Some(d) if !first => {
@@ -139,60 +127,9 @@ pub fn integrate(
             }
             _ => z.iter_mut().for_each(|zk| zk.fill(0.0)),
         }
-        // Simplified Newton on G(Z) = Z - h (A (x) I) F(Z).
-        let mut converged = false;
-        let mut previous_norm = f64::INFINITY;
-        let mut theta = 0.5;
-        let mut iterations = 0;
-        for it in 0..MAX_NEWTON {
-            iterations = it + 1;
-            for k in 0..3 {
-                for i in 0..m {
-                    yi[i] = y[i] + z[k][i];
-                }
-                sys.rhs(t + C[k] * h, &yi, &mut fz[k]);
-            }
-            let mut rhs = DVector::<f64>::zeros(3 * m);
-            for a in 0..3 {
-                for i in 0..m {
-                    let hf: f64 = (0..3).map(|b| A[a][b] * fz[b][i]).sum::<f64>() * h;
-                    rhs[a * m + i] = hf - z[a][i];
-                }
-            }
-            let Some(dz) = lu.solve(&rhs) else {
-                return Err(Error::LinearAlgebra {
-                    t,
-                    y,
-                    msg: "the Newton matrix I - h (A x J) is singular".into(),
-                });
-            };
-            if dz.iter().any(|v| !v.is_finite()) {
-                break;
-            }
-            let norm = (dz
-                .iter()
-                .enumerate()
-                .map(|(k, v)| (v / scale[k % m]).powi(2))
-                .sum::<f64>()
-                / (3 * m) as f64)
-                .sqrt();
-            for a in 0..3 {
-                for i in 0..m {
-                    z[a][i] += dz[a * m + i];
-                }
-            }
-            if it > 0 {
-                theta = norm / previous_norm;
-                if theta >= 0.99 {
-                    break;
-                }
-            }
-            previous_norm = norm;
-            if theta / (1.0 - theta) * norm <= newton_tol || norm <= 1e-3 * newton_tol {
-                converged = true;
-                break;
-            }
-        }
+        let stage = StagePoint { t, y: &y, h };
+        let (converged, iterations, theta) =
+            simplified_newton(sys, &lu, &stage, &mut z, &mut fz, &scale, newton_tol)?;
         if !converged {
             // A stale Jacobian may be why: take a new one as well.
             counts.rejected += 1;
@@ -321,4 +258,101 @@ fn estimate(
         / m as f64)
         .sqrt();
     (e, norm)
+}
+
+/// E = I - h (A (x) J), factored once per step.
+fn newton_matrix(
+    j: &DMatrix<f64>,
+    h: f64,
+    m: usize,
+) -> nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn> {
+    let mut e = DMatrix::<f64>::identity(3 * m, 3 * m);
+    for (a, row) in A.iter().enumerate() {
+        for (b, &ab) in row.iter().enumerate() {
+            for r in 0..m {
+                for c in 0..m {
+                    e[(a * m + r, b * m + c)] -= h * ab * j[(r, c)];
+                }
+            }
+        }
+    }
+    e.lu()
+}
+
+/// Where a step starts: time, state and step size.
+struct StagePoint<'a> {
+    t: f64,
+    y: &'a [f64],
+    h: f64,
+}
+
+/// Simplified Newton on G(Z) = Z - h (A (x) I) F(Z) from the given Z,
+/// with the matrix factored by [`newton_matrix`]: whether it converged,
+/// the iterations taken and the last contraction rate theta.
+fn simplified_newton(
+    sys: &mut dyn OdeSystem,
+    lu: &nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    at: &StagePoint,
+    z: &mut [Vec<f64>],
+    fz: &mut [Vec<f64>],
+    scale: &[f64],
+    newton_tol: f64,
+) -> Result<(bool, usize, f64), Error<f64, Vec<f64>>> {
+    let StagePoint { t, y, h } = *at;
+    let m = y.len();
+    let mut yi = vec![0.0; m];
+    let mut converged = false;
+    let mut previous_norm = f64::INFINITY;
+    let mut theta = 0.5;
+    let mut iterations = 0;
+    for it in 0..MAX_NEWTON {
+        iterations = it + 1;
+        for k in 0..3 {
+            for i in 0..m {
+                yi[i] = y[i] + z[k][i];
+            }
+            sys.rhs(t + C[k] * h, &yi, &mut fz[k]);
+        }
+        let mut rhs = DVector::<f64>::zeros(3 * m);
+        for a in 0..3 {
+            for i in 0..m {
+                let hf: f64 = (0..3).map(|b| A[a][b] * fz[b][i]).sum::<f64>() * h;
+                rhs[a * m + i] = hf - z[a][i];
+            }
+        }
+        let Some(dz) = lu.solve(&rhs) else {
+            return Err(Error::LinearAlgebra {
+                t,
+                y: y.to_vec(),
+                msg: "the Newton matrix I - h (A x J) is singular".into(),
+            });
+        };
+        if dz.iter().any(|v| !v.is_finite()) {
+            break;
+        }
+        let norm = (dz
+            .iter()
+            .enumerate()
+            .map(|(k, v)| (v / scale[k % m]).powi(2))
+            .sum::<f64>()
+            / (3 * m) as f64)
+            .sqrt();
+        for a in 0..3 {
+            for i in 0..m {
+                z[a][i] += dz[a * m + i];
+            }
+        }
+        if it > 0 {
+            theta = norm / previous_norm;
+            if theta >= 0.99 {
+                break;
+            }
+        }
+        previous_norm = norm;
+        if theta / (1.0 - theta) * norm <= newton_tol || norm <= 1e-3 * newton_tol {
+            converged = true;
+            break;
+        }
+    }
+    Ok((converged, iterations, theta))
 }
