@@ -8,7 +8,7 @@ mod common;
 use common::*;
 use eomgen::cas::{Cas, SymKind};
 use eomgen::model::Override;
-use runtime::{KernelKind, SimOptions, StaticOptions, modes, simulate, solve_static};
+use runtime::{SimOptions, StaticOptions, modes, simulate, solve_static};
 use softarm::backend::{BackendChoice, Loaded, load};
 
 const L: f64 = 0.3;
@@ -73,8 +73,7 @@ fn one_element_tip_is_the_closed_form_arc() {
         let mut h = nalgebra::DVector::zeros(1);
         l.arm.mass_bias(0.0, &[theta], &[2.5], &mut m, &mut h);
         let mut k = [0.0];
-        l.arm
-            .eval_kernel(KernelKind::Stiffness, 0.0, &[theta], &[0.0], &mut k);
+        l.arm.stiffness(0.0, &[theta], &mut k);
         assert!(m[(0, 0)].is_finite() && m[(0, 0)] > 0.0 && h[0].is_finite() && k[0].is_finite());
     }
 }

@@ -60,7 +60,7 @@ fn kernels_at_states(arm: &dyn Dynamics, seed: u64) -> Value {
         // The n x n stiffness and 2n x 2n Jacobian, applied to a fixed
         // vector: a change of any entry changes the product.
         let mut k = vec![0.0; n * n];
-        arm.eval_kernel(KernelKind::Stiffness, t, &q, &qd, &mut k);
+        arm.stiffness(t, &q, &mut k);
         let kv = DMatrix::from_row_slice(n, n, &k) * DVector::from_column_slice(&v[..n]);
         entry.insert("stiffness_times_v".into(), json!(kv.as_slice()));
         let mut ws = Workspace::new(n);

@@ -37,7 +37,6 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
     } else {
         runtime::Tape::default()
     };
-    let stiffness = cas.to_tape_hoisted(&eq.stiffness, &mut hoist);
     let jvp = cas.to_tape_hoisted(&eq.jvp, &mut hoist);
     let derived = hoist.finish(&mut cas);
     TapeSet {
@@ -53,7 +52,6 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
         outputs,
         derived,
         accel: accel_tape,
-        stiffness,
         jvp,
         links,
     }

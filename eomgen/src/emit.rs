@@ -439,8 +439,10 @@ impl<'a> KernelEmitter<'a> {
     }
 }
 
-/// `mass_bias` as the link recursion (`runtime::links`) over the model's
-/// cells, each cell a kernel of one link's coordinates and parameters.
+/// `mass_bias` and `jvp` as the link recursion (`runtime::links`) over the
+/// model's cells: each cell a kernel of one link's coordinates and
+/// parameters, with its lane form (four links at once) and its tangent
+/// (outputs and their directional derivatives, for the Jvp's dual sweep).
 fn emit_link_recursion(
     links: &runtime::links::LinkKernels,
     dof: usize,
@@ -450,8 +452,8 @@ fn emit_link_recursion(
     use runtime::links::CELL_PARAMS;
     let layout = &links.layout;
     let mut defs = Vec::new();
-    let (mut ones, mut fours) = (Vec::new(), Vec::new());
-    for (c, tape) in links.cells.iter().enumerate() {
+    let (mut ones, mut fours, mut tangents) = (Vec::new(), Vec::new(), Vec::new());
+    for (c, (tape, tangent)) in links.cells.iter().zip(&links.tangents).enumerate() {
         let n = layout
             .links
             .iter()
@@ -459,11 +461,14 @@ fn emit_link_recursion(
             .map_or(0, |l| l.map.len());
         let name = format!("cell_{c}");
         let name4 = format!("cell_{c}_x4");
+        let name_t = format!("cell_{c}_tangent");
         defs.push(KernelEmitter::new(tape).emit(&name, n, CELL_PARAMS));
         defs.push(KernelEmitter::new_lanes(tape).emit(&name4, n, CELL_PARAMS));
-        let (f, f4) = (
+        defs.push(KernelEmitter::new(tangent).emit(&name_t, n, CELL_PARAMS));
+        let (f, f4, ft) = (
             Ident::new(&name, Span::call_site()),
             Ident::new(&name4, Span::call_site()),
+            Ident::new(&name_t, Span::call_site()),
         );
         let n2 = 2 * n;
         ones.push(quote! {
@@ -478,17 +483,38 @@ fn emit_link_recursion(
             #c => unsafe { #f4(x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
                                p.try_into().expect("cell parameters"), out.try_into().expect("cell outputs")) },
         });
+        tangents.push(quote! {
+            #c => {
+                let mut dir = [0.0; #n2];
+                dir[..#n].copy_from_slice(dx);
+                dir[#n..].copy_from_slice(dxd);
+                #ft(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+                    &[0.0; #n], &dir, p.try_into().expect("cell parameters"),
+                    out.try_into().expect("cell outputs and derivatives"))
+            }
+        });
     }
     let n_dir = 2 * dof;
-    let forces = match &links.forces {
-        Some(tape) => {
+    let (forces, forces_tangent) = match (&links.forces, &links.forces_tangent) {
+        (Some(tape), Some(tangent)) => {
             defs.push(KernelEmitter::new(tape).emit("link_forces", dof, n_params));
-            quote! {
-                link_forces(0.0, self.q, self.qd, &[0.0; #dof], &[0.0; #n_dir], self.p,
-                            out.try_into().expect("force outputs"))
-            }
+            defs.push(KernelEmitter::new(tangent).emit("link_forces_tangent", dof, n_params));
+            (
+                quote! {
+                    link_forces(0.0, self.q, self.qd, &[0.0; #dof], &[0.0; #n_dir], self.p,
+                                out.try_into().expect("force outputs"))
+                },
+                quote! {
+                    link_forces_tangent(0.0, self.q, self.qd, &[0.0; #dof],
+                                        dir.try_into().expect("a direction of 2 DOF entries"), self.p,
+                                        out.try_into().expect("force outputs and derivatives"))
+                },
+            )
         }
-        None => quote!(unreachable!("no non-local forces")),
+        _ => (
+            quote!(unreachable!("no non-local forces")),
+            quote!(unreachable!("no non-local forces")),
+        ),
     };
     // Chains of owned links sum by composite bodies; shared links (rom
     // slices) need the arm's coordinates in rows of a fixed length.
@@ -529,6 +555,16 @@ fn emit_link_recursion(
             fn forces(&mut self, out: &mut [f64]) {
                 #forces
             }
+            fn tangent(&mut self, c: usize, x: &[f64], xd: &[f64], dx: &[f64], dxd: &[f64], p: &[f64], out: &mut [f64]) {
+                match c {
+                    #(#tangents)*
+                    _ => unreachable!("cell index from the layout"),
+                }
+            }
+            #[allow(unused_variables)]
+            fn forces_tangent(&mut self, dir: &[f64], out: &mut [f64]) {
+                #forces_tangent
+            }
         }
     };
     let json = serde_json::to_string(layout).expect("a link layout serialises");
@@ -536,6 +572,10 @@ fn emit_link_recursion(
         " Kernel `mass_bias`: the link recursion (`runtime::links`) over {} links, {} cell(s).",
         layout.links.len(),
         links.cells.len()
+    );
+    let doc_jvp = format!(
+        " Kernel `jvp`: the inverse dynamics' tangent by the link recursion (`runtime::links::inverse_dynamics_tangent`) over {} links.",
+        layout.links.len(),
     );
     quote! {
         static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(|| {
@@ -552,6 +592,14 @@ fn emit_link_recursion(
         unsafe fn mass_bias_links(q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
             let mut cells = LinkCells { q, qd, p };
             #call
+        }
+        #[doc = #doc_jvp]
+        #[allow(unused_variables)]
+        pub fn jvp(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #dof]) {
+            runtime::cpu::require_fma();
+            let mut cells = LinkCells { q, qd, p };
+            let mut tau = [0.0; #dof];
+            runtime::links::inverse_dynamics_tangent(&LINKS, &mut cells, q, qd, qdd, dir, p, &mut tau, out)
         }
         #cells_impl
         #(#defs)*
@@ -670,6 +718,8 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                 let n_out = tapes.mass_bias.outputs.len();
                 kernels.push(emit_link_recursion(links, dof, n_params, n_out));
             }
+            // Emitted with the recursion, above.
+            (Some(_), KernelKind::Jvp) => {}
             _ => kernels.push(KernelEmitter::new(tapes.tape(kind)).emit(name, dof, n_params)),
         }
         let f = Ident::new(name, Span::call_site());

@@ -20,13 +20,13 @@ use crate::tape::{Inputs, Tape};
 ///   (n values, all positive when M is positive definite): the mass solve
 ///   generated as straight-line code. Present only when `ModelInfo::accel`
 ///   (small arms); otherwise the runtime solves `MassBias` output.
-/// * `Jvp`: Jacobian-vector products along the input direction (dq, dqd):
-///   dh/dq dq + dh/dqd dqd (n values), then d(M a)/dq dq at a = the input
-///   `qdd` (n values). The runtime assembles the right-hand side's
-///   Jacobian column by column from them (`Dynamics::jacobian_parts`): a
-///   kernel the size of a few h kernels instead of 3 n^2 entries.
-/// * `Stiffness`: K = d h(q, 0) / dq, row-major n x n: the tangent
-///   stiffness of the static generalised forces (gravity, elastic, applied).
+/// * `Jvp`: the directional derivative of the inverse dynamics
+///   tau(q, qd, qdd) = M qdd + h along the input direction (dq, dqd), at
+///   the input `qdd` (n values). The runtime assembles the right-hand
+///   side's Jacobian column by column from it (`Dynamics::jacobian_parts`)
+///   and the tangent stiffness K = d h(q, 0) / dq as its columns at
+///   qd = qdd = 0 (`Dynamics::stiffness`): one kernel the size of a few h
+///   kernels instead of n^2 entries each.
 /// * `Derived`: the derived parameters (parameter-only subexpressions the
 ///   generator hoisted out of the other kernels), computed once per
 ///   parameter set; the other kernels read them after the base parameters.
@@ -35,15 +35,13 @@ pub enum KernelKind {
     MassBias,
     Outputs,
     Accel,
-    Stiffness,
     Jvp,
     Derived,
 }
 
 impl KernelKind {
-    pub const ALL: [KernelKind; 6] = [
+    pub const ALL: [KernelKind; 5] = [
         Self::Jvp,
-        Self::Stiffness,
         Self::Accel,
         Self::MassBias,
         Self::Outputs,
@@ -57,8 +55,7 @@ impl KernelKind {
             Self::MassBias => tri + dof,
             Self::Outputs => OUTPUT_NAMES.len(),
             Self::Derived => info.derived,
-            Self::Stiffness => dof * dof,
-            Self::Jvp => 2 * dof,
+            Self::Jvp => dof,
             Self::Accel => {
                 if info.accel {
                     2 * dof
@@ -74,7 +71,6 @@ impl KernelKind {
             Self::MassBias => "mass_bias",
             Self::Outputs => "outputs",
             Self::Derived => "derived",
-            Self::Stiffness => "stiffness",
             Self::Jvp => "jvp",
             Self::Accel => "accel",
         }
@@ -156,7 +152,6 @@ pub struct TapeSet {
     pub derived: Tape,
     /// Empty unless `info.accel`.
     pub accel: Tape,
-    pub stiffness: Tape,
     pub jvp: Tape,
     /// The layout and kernels of the link recursion (`crate::links`),
     /// which compiled models of the chains it covers use for `MassBias`;
@@ -172,7 +167,6 @@ impl TapeSet {
             KernelKind::Outputs => &self.outputs,
             KernelKind::Derived => &self.derived,
             KernelKind::Accel => &self.accel,
-            KernelKind::Stiffness => &self.stiffness,
             KernelKind::Jvp => &self.jvp,
         }
     }

@@ -19,8 +19,11 @@
 //! element) gets the exact Lagrangian terms T_w^T (dI/dt w) - (1/2) w^T
 //! (dI/dq) w on top; for rigid bodies they fold to zero.
 //!
-//! For statics: the static generalised force h(q, 0) (gravity, elastic and
-//! applied forces) and the stiffness K = d h(q, 0) / dq.
+//! The Jacobians come from one kernel: the directional derivative of the
+//! inverse dynamics tau = M qdd + h along (dq, dqd) (`jvp`). The runtime
+//! takes the right-hand side's Jacobian and the static stiffness
+//! K = d h(q, 0) / dq (= d tau / dq at qd = qdd = 0: the inertial and
+//! damping forces vanish there to first order) from its columns.
 
 use crate::cas::{Cas, ExprId, SymKind, Variables};
 
@@ -34,10 +37,8 @@ pub struct Equations {
     pub bias: Vec<ExprId>,
     /// tip x, y, z, kinetic energy, potential energy, tip quaternion.
     pub outputs: Vec<ExprId>,
-    /// K = d h(q, 0) / dq, row-major n x n.
-    pub stiffness: Vec<ExprId>,
-    /// Along the direction (dq, dqd) (`SymKind::Dir` symbols): dh/dq dq +
-    /// dh/dqd dqd, then d(M qdd)/dq dq; 2n values.
+    /// d tau along the direction (dq, dqd) (`SymKind::Dir` symbols),
+    /// tau = M qdd + h: n values.
     pub jvp: Vec<ExprId>,
 }
 
@@ -159,15 +160,12 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
         })
         .collect();
 
-    let stiffness = static_stiffness(cas, sys, &outs, stored);
-
     let outputs = energy_outputs(cas, sys, velocities, &momentum_cot);
     let jvp = jacobian_parts(cas, sys, &momentum, &bias);
     Equations {
         mass_upper: mass,
         bias,
         outputs,
-        stiffness,
         jvp,
     }
 }
@@ -207,43 +205,6 @@ fn mass_by_bodies(cas: &mut Cas, sys: &System, velocities: &[ExprId]) -> Vec<Exp
         }
     }
     mass
-}
-
-/// The static generalised forces h(q, 0) = -J^T (m g) - J^T F + dV/dq and
-/// their Jacobian in q, row-major (the tangent stiffness).
-fn static_stiffness(cas: &mut Cas, sys: &System, outs: &[ExprId], stored: ExprId) -> Vec<ExprId> {
-    let (n, nb) = (sys.coords.len(), sys.bodies.len());
-
-    let mut static_cot = Vec::with_capacity(outs.len());
-    for body in &sys.bodies {
-        for k in 0..3 {
-            let mg = cas.mul(body.mass, sys.gravity[k]);
-            static_cot.push(cas.neg(mg));
-        }
-    }
-    let zero = cas.zero();
-    static_cot.extend(std::iter::repeat_n(zero, 3 * nb));
-    for force in &sys.point_forces {
-        static_cot.extend(force.force.map(|c| cas.neg(c)));
-    }
-    for moment in &sys.moments {
-        static_cot.extend(moment.moment.map(|c| cas.neg(c)));
-    }
-    let static_loads = cas.vjp(outs, &static_cot, &sys.coords.qd);
-    let static_force: Vec<ExprId> = (0..n)
-        .map(|i| {
-            let de = cas.diff(stored, sys.coords.q[i]);
-            cas.add(static_loads[i], de)
-        })
-        .collect();
-    let mut stiffness = Vec::with_capacity(n * n);
-    for &g in &static_force {
-        for &q in &sys.coords.q {
-            stiffness.push(cas.diff(g, q));
-        }
-    }
-
-    stiffness
 }
 
 /// The outputs: tip position, kinetic and potential energy, tip
@@ -287,9 +248,9 @@ fn energy_outputs(
     outputs
 }
 
-/// The `Jvp` kernel's outputs: dh/dq dq + dh/dqd dqd, then d(M qdd)/dq dq,
-/// one directional derivative each (the runtime takes the Jacobian's
-/// columns along unit directions), not n^2 partials.
+/// The `Jvp` kernel's outputs: d tau = dh/dq dq + dh/dqd dqd + d(M qdd)/dq
+/// dq, one directional derivative (the runtime takes the Jacobian's columns
+/// along unit directions), not n^2 partials.
 fn jacobian_parts(
     cas: &mut Cas,
     sys: &System,
@@ -322,7 +283,10 @@ fn jacobian_parts(
     let along_q: Vec<(ExprId, ExprId)> = sys.coords.q.iter().copied().zip(dq).collect();
     let mut along_both = along_q.clone();
     along_both.extend(sys.coords.qd.iter().copied().zip(dqd));
-    let mut jvp = cas.time_derivatives(bias, &along_both);
-    jvp.extend(cas.time_derivatives(&m_qdd, &along_q));
-    jvp
+    let dh = cas.time_derivatives(bias, &along_both);
+    let dmq = cas.time_derivatives(&m_qdd, &along_q);
+    dh.into_iter()
+        .zip(dmq)
+        .map(|(a, b)| cas.add(a, b))
+        .collect()
 }

@@ -44,7 +44,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     }
     let index = |p: Param| params.index(p);
     let triple = |p: fn(Xyz) -> Param| Xyz::ALL.map(|c| index(p(c)));
-    let mut cells: Vec<(Shape, Tape)> = Vec::new();
+    let mut cells: Vec<(Shape, [Tape; 2])> = Vec::new();
     let mut links = Vec::new();
     let mut roms = Vec::new();
     let (mut first, mut k) = (0, 0);
@@ -131,10 +131,14 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         return None;
     }
     let forces = (!roms.is_empty()).then(|| derive_forces(params, first, &roms));
+    let (forces, forces_tangent) = forces.map(|[f, t]| (f, t)).unzip();
+    let (cells, tangents) = cells.into_iter().map(|(_, [c, t])| (c, t)).unzip();
     Some(LinkKernels {
         layout,
-        cells: cells.into_iter().map(|(_, t)| t).collect(),
+        cells,
+        tangents,
         forces,
+        forces_tangent,
     })
 }
 
@@ -152,8 +156,9 @@ struct Shape {
 
 /// The generalised forces of the rom segments' strain energy and Rayleigh
 /// function (`RomFields::energies`, exact quadratics in the coefficients), as one
-/// kernel of the arm's coordinates and parameters.
-fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(RomFields, usize)]) -> Tape {
+/// kernel of the arm's coordinates and parameters; and that kernel's
+/// [`with_tangent`].
+fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(RomFields, usize)]) -> [Tape; 2] {
     let mut cas = Cas::new();
     let cas = &mut cas;
     let symbols = ParamSymbols::new(cas, params);
@@ -174,11 +179,33 @@ fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(RomFields, usize)]) 
             cas.add(de, dr)
         })
         .collect();
-    cas.to_tape(&out)
+    [
+        cas.to_tape(&out),
+        with_tangent(cas, &out, &coords.q, &coords.qd),
+    ]
 }
 
-/// The cell of a link with the bend pair, and twist and stretch when asked.
-fn derive_cell(shape: Shape) -> Tape {
+/// The tape of `out` followed by its directional derivative along (dx,
+/// dxd) of the coordinates `x` and rates `xd` (`SymKind::Dir` symbols:
+/// dx first, then dxd): what `runtime::links::tangent` runs the recursion
+/// on in dual numbers. One tape, so the values and their derivatives share
+/// subexpressions.
+fn with_tangent(cas: &mut Cas, out: &[ExprId], x: &[ExprId], xd: &[ExprId]) -> Tape {
+    let n = x.len();
+    let mut along = Vec::with_capacity(2 * n);
+    for (i, &v) in x.iter().chain(xd).enumerate() {
+        let dir = cas.symbol(&format!("dir{i}"), SymKind::Dir(i as u32));
+        along.push((v, dir));
+    }
+    debug_assert_eq!(along.len(), 2 * n);
+    let mut all = out.to_vec();
+    all.extend(cas.time_derivatives(out, &along));
+    cas.to_tape(&all)
+}
+
+/// The cell of a link with the bend pair, and twist and stretch when asked;
+/// and the cell [`with_tangent`].
+fn derive_cell(shape: Shape) -> [Tape; 2] {
     let Shape {
         twist,
         extension,
@@ -303,5 +330,5 @@ fn derive_cell(shape: Shape) -> Tape {
         let dr = cas.diff(rayleigh, qd[c]);
         out[cell::COLUMNS + 12 * n + c] = cas.add(de, dr);
     }
-    cas.to_tape(&out)
+    [cas.to_tape(&out), with_tangent(cas, &out, &q, &qd)]
 }

@@ -34,9 +34,20 @@ pub trait Dynamics {
     /// Solve M x = b in place for x, M given as the packed upper triangle
     /// (the `Mass` layout); false unless M is positive definite.
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool;
-    /// dh/dq, dh/dqd and d(M qdd)/dq (row-major n x n each) at the given
-    /// accelerations, column by column from the `Jvp` kernel.
+    /// d tau/dq and d tau/dqd of the inverse dynamics tau = M qdd + h
+    /// (row-major n x n each) at the given accelerations, column by column
+    /// from the `Jvp` kernel.
     fn jacobian_parts(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]);
+    /// The tangent stiffness K = d h(q, 0) / dq (row-major n x n) at time
+    /// t: d tau/dq at qd = qdd = 0, where inertial and damping forces
+    /// vanish to first order.
+    fn stiffness(&self, t: f64, q: &[f64], k: &mut [f64]) {
+        let n = q.len();
+        let zeros = vec![0.0; n];
+        let mut parts = vec![0.0; 2 * n * n];
+        self.jacobian_parts(t, q, &zeros, &zeros, &mut parts);
+        k.copy_from_slice(&parts[..n * n]);
+    }
     /// The base parameter values (layout `info().parameters`).
     fn base_params(&self) -> &[f64];
     /// Replace the base parameters; the derived ones are recomputed.
@@ -215,10 +226,9 @@ impl<K: Kernels> Dynamics for Arm<K> {
         self.kernels.solve_mass(packed, b, ws)
     }
     fn jacobian_parts(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
-        // Column j of dh/dq and d(M qdd)/dq along dq = e_j; of dh/dqd along
-        // dqd = e_j.
+        // Column j of d tau/dq along dq = e_j, of d tau/dqd along dqd = e_j.
         let n = q.len();
-        let (mut dir, mut col) = (vec![0.0; 2 * n], vec![0.0; 2 * n]);
+        let (mut dir, mut col) = (vec![0.0; 2 * n], vec![0.0; n]);
         self.with_params(t, |p| {
             for j in 0..2 * n {
                 dir[j] = 1.0;
@@ -235,9 +245,6 @@ impl<K: Kernels> Dynamics for Arm<K> {
                 let (part, c) = if j < n { (0, j) } else { (1, j - n) };
                 for i in 0..n {
                     out[part * n * n + i * n + c] = col[i];
-                    if part == 0 {
-                        out[2 * n * n + i * n + c] = col[n + i];
-                    }
                 }
             }
         });

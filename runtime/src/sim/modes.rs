@@ -1,5 +1,5 @@
 //! Small vibrations about an equilibrium: the generalised eigenproblem
-//! K v = w^2 M v with the analytic tangent stiffness (the `Stiffness` kernel)
+//! K v = w^2 M v with the analytic tangent stiffness (`Dynamics::stiffness`)
 //! and the mass matrix, reduced to a symmetric standard one through the
 //! Cholesky factor of M.
 
@@ -7,7 +7,6 @@ use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use serde::Serialize;
 
 use crate::arm::Dynamics;
-use crate::kernels::KernelKind;
 
 #[derive(Clone, Debug, Serialize)]
 pub struct Modes {
@@ -30,9 +29,8 @@ pub enum ModesError {
 /// Modes of the linearisation at `q` (normally a static equilibrium).
 pub fn modes(d: &dyn Dynamics, q: &[f64]) -> Result<Modes, ModesError> {
     let n = q.len();
-    let zeros = vec![0.0; n];
     let mut kbuf = vec![0.0; n * n];
-    d.eval_kernel(KernelKind::Stiffness, 0.0, q, &zeros, &mut kbuf);
+    d.stiffness(0.0, q, &mut kbuf);
     let k = DMatrix::from_row_slice(n, n, &kbuf);
     // Conservative loads give a symmetric K; symmetrise the round-off.
     let k = (&k + k.transpose()) * 0.5;

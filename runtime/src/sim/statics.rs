@@ -1,6 +1,6 @@
 //! Static equilibrium: h(q, 0) = 0 (gravity, elastic and applied forces
 //! balance), by Newton's method on the generalised forces with the analytic
-//! tangent stiffness K = dh/dq (the `Stiffness` kernel), a backtracking line
+//! tangent stiffness K = dh/dq (`Dynamics::stiffness`), a backtracking line
 //! search, and load continuation: the load parameters (gravity, applied
 //! forces) are scaled from 0 to 1 in steps that grow on success and shrink on
 //! failure, so that large deflections converge.
@@ -62,8 +62,7 @@ fn inf_norm(v: &[f64]) -> f64 {
 /// Static forces and stiffness at q.
 fn forces(d: &dyn Dynamics, q: &[f64], g: &mut [f64], k: &mut [f64]) {
     static_forces(d, q, g);
-    let zeros = vec![0.0; q.len()];
-    d.eval_kernel(KernelKind::Stiffness, 0.0, q, &zeros, k);
+    d.stiffness(0.0, q, k);
 }
 
 /// h(q, 0): the static generalised forces, from the `MassBias` kernel.

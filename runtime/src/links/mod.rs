@@ -23,6 +23,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::rows;
 
+mod tangent;
+pub use tangent::inverse_dynamics_tangent;
+
 /// Parameters a cell reads, in this order, per link: element[k].length,
 /// .mass, .inertia, .axial_inertia, joint[k].stiffness, .damping, .rest,
 /// twist[k].stiffness, .damping, stretch[k].stiffness, .damping.
@@ -138,7 +141,13 @@ impl LinkLayout {
 pub struct LinkKernels {
     pub layout: LinkLayout,
     pub cells: Vec<crate::Tape>,
+    /// Each cell's outputs followed by their directional derivative along
+    /// (dx, dxd) (the tape's `dir` input): [`inverse_dynamics_tangent`].
+    pub tangents: Vec<crate::Tape>,
     pub forces: Option<crate::Tape>,
+    /// The forces and their directional derivative along the arm's (dq,
+    /// dqd).
+    pub forces_tangent: Option<crate::Tape>,
 }
 
 /// What the recursion evaluates: the cells and the non-local forces.
@@ -171,6 +180,25 @@ pub trait Cells {
     /// The generalised forces no link has (`LinkLayout::forces`), over
     /// the arm's coordinates.
     fn forces(&mut self, out: &mut [f64]);
+
+    /// Cell `c` as [`Cells::one`] (the first [`cell::len`] values of
+    /// `out`), then its outputs' directional derivatives along the cell
+    /// coordinates' (dx, dxd) (as many again).
+    #[allow(clippy::too_many_arguments)]
+    fn tangent(
+        &mut self,
+        c: usize,
+        x: &[f64],
+        xd: &[f64],
+        dx: &[f64],
+        dxd: &[f64],
+        p: &[f64],
+        out: &mut [f64],
+    );
+
+    /// [`Cells::forces`] (the first `dof` values of `out`), then their
+    /// directional derivative along the arm's (dq, dqd) = `dir`.
+    fn forces_tangent(&mut self, dir: &[f64], out: &mut [f64]);
 }
 
 type V3 = [f64; 3];
