@@ -8,12 +8,20 @@
 use std::path::PathBuf;
 
 fn main() {
-    println!("cargo::rerun-if-changed=models");
-    println!("cargo::rerun-if-changed=generated");
+    // The build script of the generated crate: its manifest is
+    // generated/Cargo.toml, the project root one folder up. Only models/
+    // is watched: watching generated/, which this script writes, would mark
+    // every run stale and compile the kernels twice per change (a hand edit
+    // of generated/ is caught by `softarm derive --check` and the sync test).
+    println!("cargo::rerun-if-changed=../models");
     println!("cargo::rerun-if-env-changed=SOFTARM_GENERATED_IN_OUT_DIR");
     println!("cargo::rustc-check-cfg=cfg(softarm_out_dir)");
-    let root =
+    let manifest =
         PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
+    let root = manifest
+        .parent()
+        .expect("generated/ has a parent")
+        .to_path_buf();
     let in_out_dir =
         std::env::var_os("SOFTARM_GENERATED_IN_OUT_DIR").is_some_and(|v| !v.is_empty() && v != "0");
     let (out, opts) = if in_out_dir {

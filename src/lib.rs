@@ -4,17 +4,7 @@
 //! choosing a backend for a model ([`backend`]) and the on-disk tape cache
 //! ([`cache`]). The generator is `eomgen`; the numerics are in `runtime`.
 
-// Generated code is formatted by prettyplease, not rustfmt: `cargo fmt`
-// must leave it byte-identical to what `softarm derive --check` expects.
-#[cfg(not(softarm_out_dir))]
-#[rustfmt::skip]
-#[path = "../generated/mod.rs"]
-pub mod generated;
-
-#[cfg(softarm_out_dir)]
-pub mod generated {
-    include!(concat!(env!("OUT_DIR"), "/generated/mod.rs"));
-}
+pub use softarm_models as generated;
 
 pub mod backend;
 pub mod cache;

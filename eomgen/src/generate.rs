@@ -52,8 +52,15 @@ fn io_err(path: &Path, e: std::io::Error) -> GenerateError {
     }
 }
 
+/// Files of the output folder that are not a model's: the registry and
+/// the crate root (hand-written).
+const NOT_MODELS: [&str; 2] = ["mod", "lib"];
+
 fn valid_stem(s: &str) -> bool {
     let mut chars = s.chars();
+    if NOT_MODELS.contains(&s) {
+        return false;
+    }
     chars.next().is_some_and(|c| c.is_ascii_lowercase())
         && chars.all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
 }
@@ -90,7 +97,7 @@ pub fn sync(
             return Err(GenerateError::Model(ModelError::new(
                 &path.display().to_string(),
                 "",
-                "a compiled-in model's file name must be lower_snake_case (it names a Rust module)",
+                "a compiled-in model's file name must be lower_snake_case (it names a Rust module), and not `mod` or `lib`",
             )));
         }
         let model = load_model(&path, &[])?;
@@ -117,7 +124,7 @@ pub fn sync(
             .filter(|p| p.extension().is_some_and(|x| x == "rs"))
             .filter(|p| {
                 let s = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
-                s != "mod" && !stems.iter().any(|(st, _)| st == s)
+                !NOT_MODELS.contains(&s) && !stems.iter().any(|(st, _)| st == s)
             })
             .collect();
         stray.sort();
