@@ -17,9 +17,13 @@ pub mod hybrid_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod long_arm;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod rom_arm;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod soft_finger;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod stiff_flop;
+#[allow(clippy::all, clippy::pedantic)]
+pub mod stiff_flop_rom;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod tentacle3d;
 #[allow(clippy::all, clippy::pedantic)]
@@ -77,6 +81,13 @@ pub static MODELS: &[CompiledModel] = &[
         kernels: || Box::new(long_arm::Compiled::default()),
     },
     CompiledModel {
+        name: "rom_arm",
+        hash: rom_arm::HASH,
+        dof: rom_arm::DOF,
+        source: include_str!("../models/rom_arm.toml"),
+        kernels: || Box::new(rom_arm::Compiled::default()),
+    },
+    CompiledModel {
         name: "soft_finger",
         hash: soft_finger::HASH,
         dof: soft_finger::DOF,
@@ -89,6 +100,13 @@ pub static MODELS: &[CompiledModel] = &[
         dof: stiff_flop::DOF,
         source: include_str!("../models/stiff_flop.toml"),
         kernels: || Box::new(stiff_flop::Compiled::default()),
+    },
+    CompiledModel {
+        name: "stiff_flop_rom",
+        hash: stiff_flop_rom::HASH,
+        dof: stiff_flop_rom::DOF,
+        source: include_str!("../models/stiff_flop_rom.toml"),
+        kernels: || Box::new(stiff_flop_rom::Compiled::default()),
     },
     CompiledModel {
         name: "tentacle3d",

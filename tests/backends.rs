@@ -267,12 +267,88 @@ impl runtime::links::Cells for TapeCells<'_> {
         };
         self.links.tangents[c].eval(&inp, self.slots, out)
     }
+    fn loads(&mut self, out: &mut [f64]) {
+        let loads = self.links.loads.as_ref().expect("a loads kernel");
+        loads.eval(&self.inp, self.force_slots, out)
+    }
+    fn pose(&mut self, c: usize, q: &[f64], qd: &[f64], p: &[f64], out: &mut [f64]) {
+        let inp = runtime::Inputs {
+            t: 0.0,
+            q,
+            qd,
+            qdd: &[],
+            dir: &[],
+            p,
+        };
+        self.links.poses[c].eval(&inp, self.slots, out)
+    }
+    fn energy(&mut self) -> f64 {
+        let energy = self.links.energy.as_ref().expect("an energy kernel");
+        let mut out = [0.0];
+        energy.eval(&self.inp, self.force_slots, &mut out);
+        out[0]
+    }
     fn forces_tangent(&mut self, dir: &[f64], out: &mut [f64]) {
         let tangent = self.links.forces_tangent.as_ref().expect("a forces kernel");
         let inp = runtime::Inputs { dir, ..self.inp };
         tangent.eval(&inp, self.force_slots, out)
     }
 }
+
+/// A 3D arm whose pcc and rom segments both carry chambers, with a tendon
+/// through both.
+const ACTUATED_3D: &str = r#"
+name = "actuated3d"
+dimensions = 3
+gravity = [0.0, -3.0, -9.81]
+[base]
+position = [0.0, 0.0, 0.0]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.12
+elements = 3
+density = 1100.0
+outer_radius = 0.012
+inner_radius = 0.003
+youngs_modulus = 2.0e5
+extension = true
+[segment.chambers]
+angles = [0.0, 120.0, 240.0]
+radius = 0.002
+distance = 0.007
+inputs = ["p0", "p1", "p0"]
+[[segment]]
+method = "rom"
+order = 2
+length = 0.1
+elements = 4
+density = 1100.0
+outer_radius = 0.01
+youngs_modulus = 2.0e5
+extension = true
+[segment.chambers]
+angles = [30.0, 150.0, 270.0]
+radius = 0.002
+distance = 0.006
+inputs = ["p1", "p0", "p0"]
+[[tendon]]
+input = "pull"
+distance = 0.009
+angle = 45.0
+end = 1
+[tip]
+mass = 0.01
+[inputs.p0]
+kind = "constant"
+value = 2.0e4
+[inputs.p1]
+kind = "constant"
+value = 1.0e4
+[inputs.pull]
+kind = "constant"
+value = 0.5
+"#;
 
 /// The link recursion (runtime/src/links.rs) with its cells interpreted
 /// against the flat `MassBias` tape of the TMT sums, for every link shape
@@ -282,6 +358,19 @@ impl runtime::links::Cells for TapeCells<'_> {
 #[test]
 fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
     let dir = std::env::temp_dir().join("softarm-test-cache");
+    // Actuators on every covered method: chambers on a pcc and a rom
+    // segment, a tendon through both, each link loaded by its segment's
+    // loads (the `loads` kernel).
+    let actuated = dir.join("actuated3d.toml");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(&actuated, ACTUATED_3D).unwrap();
+    let actuated = actuated.to_str().unwrap().to_string();
+    let mut models: Vec<(&str, &[&str])> = vec![
+        ("stiff_flop", &[]),
+        ("stiff_flop", &["segment.0.method=rom", "segment.0.order=2"]),
+        (&actuated, &[]),
+        (&actuated, &["segment.1.incompressible=true"]),
+    ];
     let cases: [&[&str]; 9] = [
         // rom slices: coordinates shared along the segment, the segment's
         // energies from the forces kernel.
@@ -343,14 +432,15 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
             "gravity=[0,-9.81,0]",
         ],
     ];
+    models.extend(cases.iter().map(|&sets| ("cantilever3d", sets)));
     let mut rng = Rng::new(11);
-    for sets in cases {
+    for (model, sets) in models {
         let overrides: Vec<eomgen::model::Override> = sets
             .iter()
             .map(|s| eomgen::model::Override::parse(s).unwrap())
             .collect();
         let l = load(
-            "cantilever3d",
+            model,
             &overrides,
             BackendChoice::Interpreted,
             Some(dir.clone()),
@@ -363,10 +453,26 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
             .expect("the recursion covers this chain");
         let flat = tapes.mass_bias.clone();
         let jvp = tapes.jvp.clone();
-        let p: Vec<f64> = eomgen::model::parameters(&l.model)
+        let outputs = tapes.outputs.clone();
+        let mut p: Vec<f64> = eomgen::model::parameters(&l.model)
             .into_iter()
             .map(|(_, v)| v)
             .collect();
+        // Inputs at values of their kind's scale (a constant input's value
+        // is not in the model's numbers).
+        let layout = eomgen::model::ParamLayout::of(&eomgen::model::Structure::of(&l.model));
+        for d in layout.driven() {
+            use eomgen::model::{ChamberParam, Param};
+            let scale = match d.param {
+                Param::Chamber {
+                    what: ChamberParam::Pressure,
+                    ..
+                } => 3e4,
+                Param::TendonTension(_) => 2.0,
+                _ => 0.2,
+            };
+            p[layout.index(d.param)] = rng.uniform(-scale, scale);
+        }
         let arm = Arm::new(Interpreted::new(tapes), p);
         let p = arm.params().to_vec();
         let n = arm.dof();
@@ -417,9 +523,31 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
                         want[k],
                         1e-12,
                         floor,
-                        &format!("{sets:?} trial {trial} shared {shared} entry {k}"),
+                        &format!("{model} {sets:?} trial {trial} shared {shared} entry {k}"),
                     );
                 }
+            }
+            // The outputs by the pose cells against the flat tape's.
+            let mut want_out = vec![0.0; runtime::N_OUTPUTS];
+            outputs.eval(&inp, &mut Vec::new(), &mut want_out);
+            let mut got_out = vec![f64::NAN; runtime::N_OUTPUTS];
+            let mut cells = TapeCells {
+                links: &links,
+                inp,
+                slots: &mut slots,
+                force_slots: &mut force_slots,
+            };
+            runtime::links::outputs(&links.layout, &mut cells, &q, &qd, &p, &mut got_out);
+            let energy_scale = want_out[3].abs().max(want_out[4].abs());
+            let position_scale = want_out[..3].iter().fold(0.0f64, |s, x| s.max(x.abs()));
+            for (k, name) in runtime::OUTPUT_NAMES.iter().enumerate() {
+                let floor = match k {
+                    0..3 => position_scale,
+                    3 | 4 => energy_scale,
+                    _ => 1.0,
+                };
+                let what = format!("{model} {sets:?} trial {trial} output {name}");
+                assert_close(got_out[k], want_out[k], 1e-12, floor, &what);
             }
             // The Jvp by dual numbers through the cells' tangents against
             // the flat tape's symbolic derivative, and tau = M qdd + h
@@ -461,7 +589,7 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
             let scale = |v: &[f64]| v.iter().fold(0.0f64, |s, x| s.max(x.abs()));
             let (tau_scale, jvp_scale) = (scale(&want_tau), scale(&want_jvp));
             for i in 0..n {
-                let what = format!("{sets:?} trial {trial} coordinate {i}");
+                let what = format!("{model} {sets:?} trial {trial} coordinate {i}");
                 assert_close(
                     tau[i],
                     want_tau[i],

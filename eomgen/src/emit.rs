@@ -452,8 +452,15 @@ fn emit_link_recursion(
     use runtime::links::CELL_PARAMS;
     let layout = &links.layout;
     let mut defs = Vec::new();
-    let (mut ones, mut fours, mut tangents) = (Vec::new(), Vec::new(), Vec::new());
-    for (c, (tape, tangent)) in links.cells.iter().zip(&links.tangents).enumerate() {
+    let (mut ones, mut fours, mut tangents, mut poses) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for (c, ((tape, tangent), pose)) in links
+        .cells
+        .iter()
+        .zip(&links.tangents)
+        .zip(&links.poses)
+        .enumerate()
+    {
         let n = layout
             .links
             .iter()
@@ -462,6 +469,9 @@ fn emit_link_recursion(
         let name = format!("cell_{c}");
         let name4 = format!("cell_{c}_x4");
         let name_t = format!("cell_{c}_tangent");
+        let name_p = format!("cell_{c}_pose");
+        defs.push(KernelEmitter::new(pose).emit(&name_p, n, CELL_PARAMS));
+        let fp = Ident::new(&name_p, Span::call_site());
         defs.push(KernelEmitter::new(tape).emit(&name, n, CELL_PARAMS));
         defs.push(KernelEmitter::new_lanes(tape).emit(&name4, n, CELL_PARAMS));
         defs.push(KernelEmitter::new(tangent).emit(&name_t, n, CELL_PARAMS));
@@ -483,6 +493,11 @@ fn emit_link_recursion(
             #c => unsafe { #f4(x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
                                p.try_into().expect("cell parameters"), out.try_into().expect("cell outputs")) },
         });
+        poses.push(quote! {
+            #c => #fp(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+                      &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
+                      out.try_into().expect("pose outputs")),
+        });
         tangents.push(quote! {
             #c => {
                 let mut dir = [0.0; #n2];
@@ -495,6 +510,7 @@ fn emit_link_recursion(
         });
     }
     let n_dir = 2 * dof;
+    let n_outputs = runtime::N_OUTPUTS;
     let (forces, forces_tangent) = match (&links.forces, &links.forces_tangent) {
         (Some(tape), Some(tangent)) => {
             defs.push(KernelEmitter::new(tape).emit("link_forces", dof, n_params));
@@ -515,6 +531,27 @@ fn emit_link_recursion(
             quote!(unreachable!("no non-local forces")),
             quote!(unreachable!("no non-local forces")),
         ),
+    };
+    let energy = match &links.energy {
+        Some(tape) => {
+            defs.push(KernelEmitter::new(tape).emit("link_energy", dof, n_params));
+            quote! {
+                let mut out = [0.0];
+                link_energy(0.0, self.q, self.qd, &[0.0; #dof], &[0.0; #n_dir], self.p, &mut out);
+                out[0]
+            }
+        }
+        None => quote!(unreachable!("no non-local forces")),
+    };
+    let loads = match &links.loads {
+        Some(tape) => {
+            defs.push(KernelEmitter::new(tape).emit("link_loads", dof, n_params));
+            quote! {
+                link_loads(0.0, self.q, self.qd, &[0.0; #dof], &[0.0; #n_dir], self.p,
+                           out.try_into().expect("load outputs"))
+            }
+        }
+        None => quote!(unreachable!("no actuators")),
     };
     // Chains of owned links sum by composite bodies; shared links (rom
     // slices) need the arm's coordinates in rows of a fixed length.
@@ -565,6 +602,20 @@ fn emit_link_recursion(
             fn forces_tangent(&mut self, dir: &[f64], out: &mut [f64]) {
                 #forces_tangent
             }
+            #[inline(always)]
+            #[allow(unused_variables)]
+            fn loads(&mut self, out: &mut [f64]) {
+                #loads
+            }
+            fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+                match c {
+                    #(#poses)*
+                    _ => unreachable!("cell index from the layout"),
+                }
+            }
+            fn energy(&mut self) -> f64 {
+                #energy
+            }
         }
     };
     let json = serde_json::to_string(layout).expect("a link layout serialises");
@@ -600,6 +651,13 @@ fn emit_link_recursion(
             let mut cells = LinkCells { q, qd, p };
             let mut tau = [0.0; #dof];
             runtime::links::inverse_dynamics_tangent(&LINKS, &mut cells, q, qd, qdd, dir, p, &mut tau, out)
+        }
+        /// Kernel `outputs`: one sweep over the links' pose cells (`runtime::links::outputs`).
+        #[allow(unused_variables)]
+        pub fn outputs(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_outputs]) {
+            runtime::cpu::require_fma();
+            let mut cells = LinkCells { q, qd, p };
+            runtime::links::outputs(&LINKS, &mut cells, q, qd, p, out)
         }
         #cells_impl
         #(#defs)*
@@ -719,7 +777,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                 kernels.push(emit_link_recursion(links, dof, n_params, n_out));
             }
             // Emitted with the recursion, above.
-            (Some(_), KernelKind::Jvp) => {}
+            (Some(_), KernelKind::Jvp | KernelKind::Outputs) => {}
             _ => kernels.push(KernelEmitter::new(tapes.tape(kind)).emit(name, dof, n_params)),
         }
         let f = Ident::new(name, Span::call_site());

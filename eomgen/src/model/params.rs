@@ -101,8 +101,8 @@ impl ElementParam {
         Self::ShearStiffness,
     ];
     /// A link cell's parameters, in the order the cell tape reads them
-    /// (`runtime::links::CELL_PARAMS` of them).
-    pub const CELL: [ElementParam; runtime::links::CELL_PARAMS] = [
+    /// (`runtime::links::ELEMENT_PARAMS` of them).
+    pub const CELL: [ElementParam; runtime::links::ELEMENT_PARAMS] = [
         Self::Length,
         Self::Mass,
         Self::Inertia,

@@ -47,46 +47,26 @@ pub fn thinning(cas: &mut Cas, l: ExprId, len: ExprId) -> (ExprId, ExprId) {
     (cas.bind(soft), cas.bind(off))
 }
 
-/// V_a(q) of the structure's chambers and tendons; zero without them.
-pub fn actuation(
+/// The actuators' loads on a segment's fibre strains: V_a of one element
+/// is -(st c_st + k (by c_by + bz c_bz)) for its strain (stretch st,
+/// bends by, bz, offset scale k), linear in the strain, so the loads are
+/// per segment and the potential a sum over elements (which lets the link
+/// recursion give each link's cell its segment's loads as parameters).
+/// With chambers j (pressure p, area a, first moments arm_y, arm_z) and
+/// tendons i through the segment (pull T+ = max(T, 0), offset (y, z)):
+///
+///   c_st = sum_j p_j a_j - sum_i T+_i,
+///   c_by = sum_j p_j arm_y_j - sum_i T+_i z_i,
+///   c_bz = -sum_j p_j arm_z_j + sum_i T+_i y_i.
+///
+/// None for a segment no actuator acts on.
+pub fn segment_loads(
     cas: &mut Cas,
     symbols: &ParamSymbols,
     structure: &Structure,
-    strains: &[Strain],
-) -> ExprId {
-    if structure.chambers.iter().all(|&c| c == 0) && structure.tendons.is_empty() {
-        return cas.zero();
-    }
+) -> Vec<Option<[ExprId; 3]>> {
     let n = structure.segments.len();
-    // Per segment: total stretch and total bend about y and z.
-    let mut sums = vec![[Vec::new(), Vec::new(), Vec::new()]; n];
-    for s in strains {
-        let (by, bz) = match s.offset_scale {
-            Some(k) => (cas.mul(s.rho[1], k), cas.mul(s.rho[2], k)),
-            None => (s.rho[1], s.rho[2]),
-        };
-        sums[s.segment][0].push(s.stretch);
-        sums[s.segment][1].push(by);
-        sums[s.segment][2].push(bz);
-    }
-    let totals: Vec<[ExprId; 3]> = sums
-        .iter()
-        .map(|parts| {
-            parts.clone().map(|p| {
-                let e = cas.add_all(&p);
-                cas.bind(e)
-            })
-        })
-        .collect();
-    // Length change of a fibre at (y, z) through segment s.
-    let fibre = |cas: &mut Cas, s: usize, y: ExprId, z: ExprId| {
-        let [st, by, bz] = totals[s];
-        let a = cas.mul(by, z);
-        let b = cas.mul(bz, y);
-        let b = cas.neg(b);
-        cas.add_all(&[st, a, b])
-    };
-    let mut potential = Vec::new();
+    let mut terms = vec![[Vec::new(), Vec::new(), Vec::new()]; n];
     for (s, &count) in structure.chambers.iter().enumerate() {
         for j in 0..count {
             let key = |what| {
@@ -99,19 +79,12 @@ pub fn actuation(
             let p = key(ChamberParam::Pressure);
             // The position's holes together: area a, first moments a sum z
             // (lever of bend y) and a sum y (of bend z).
-            let (area, arm_y, arm_z) = (
-                key(ChamberParam::Area),
-                key(ChamberParam::ArmY),
-                key(ChamberParam::ArmZ),
-            );
-            let [st, by, bz] = totals[s];
-            let a = cas.mul(area, st);
-            let b = cas.mul(arm_y, by);
-            let c = cas.mul(arm_z, bz);
-            let c = cas.neg(c);
-            let work = cas.add_all(&[a, b, c]);
-            let w = cas.mul(p, work);
-            potential.push(cas.neg(w));
+            let area = cas.mul(p, key(ChamberParam::Area));
+            let arm_y = cas.mul(p, key(ChamberParam::ArmY));
+            let arm_z = cas.mul(p, key(ChamberParam::ArmZ));
+            terms[s][0].push(area);
+            terms[s][1].push(arm_y);
+            terms[s][2].push(cas.neg(arm_z));
         }
     }
     for (i, &end) in structure.tendons.iter().enumerate() {
@@ -120,21 +93,63 @@ pub fn actuation(
         let abs = cas.func(Func::Abs, t);
         let sum = cas.add(t, abs);
         let pull = cas.scaled(0.5, sum);
-        let lengths: Vec<ExprId> = (0..=end)
-            .map(|s| {
-                let offset = |z| {
-                    symbols.get(Param::TendonOffset {
-                        tendon: i,
-                        segment: s,
-                        z,
-                    })
-                };
-                let (y, z) = (offset(false), offset(true));
-                fibre(cas, s, y, z)
-            })
-            .collect();
-        let length = cas.add_all(&lengths);
-        potential.push(cas.mul(pull, length));
+        for (s, parts) in terms.iter_mut().enumerate().take(end + 1) {
+            let offset = |z| {
+                symbols.get(Param::TendonOffset {
+                    tendon: i,
+                    segment: s,
+                    z,
+                })
+            };
+            let (y, z) = (offset(false), offset(true));
+            parts[0].push(cas.neg(pull));
+            let pz = cas.mul(pull, z);
+            parts[1].push(cas.neg(pz));
+            parts[2].push(cas.mul(pull, y));
+        }
     }
-    cas.add_all(&potential)
+    terms
+        .into_iter()
+        .map(|parts| (!parts[0].is_empty()).then(|| parts.map(|p| cas.add_all(&p))))
+        .collect()
+}
+
+/// The virtual work of a segment's loads ([`segment_loads`]) on one
+/// element's strain, in the strain's own symbols: st c_st + k (by c_by +
+/// bz c_bz) with by, bz the bends about y and z and k the offset scale.
+pub fn strain_work(
+    cas: &mut Cas,
+    [c_st, c_by, c_bz]: [ExprId; 3],
+    stretch: ExprId,
+    rho: [ExprId; 3],
+    offset_scale: Option<ExprId>,
+) -> ExprId {
+    let a = cas.mul(c_by, rho[1]);
+    let b = cas.mul(c_bz, rho[2]);
+    let bend = cas.add(a, b);
+    let bend = match offset_scale {
+        Some(k) => cas.mul(k, bend),
+        None => bend,
+    };
+    let st = cas.mul(c_st, stretch);
+    cas.add(st, bend)
+}
+
+/// V_a(q) of the structure's chambers and tendons: minus the work of each
+/// segment's loads on its elements' strains; zero without actuators.
+pub fn actuation(
+    cas: &mut Cas,
+    symbols: &ParamSymbols,
+    structure: &Structure,
+    strains: &[Strain],
+) -> ExprId {
+    let loads = segment_loads(cas, symbols, structure);
+    let mut work = Vec::new();
+    for s in strains {
+        if let Some(load) = loads[s.segment] {
+            work.push(strain_work(cas, load, s.stretch, s.rho, s.offset_scale));
+        }
+    }
+    let work = cas.add_all(&work);
+    cas.neg(work)
 }

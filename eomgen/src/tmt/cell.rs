@@ -9,19 +9,25 @@
 //! and [`CELL_PARAMS`] parameters. Links of the same shape share a cell.
 //!
 //! Chains this covers: every segment pcc, vc or rom, base still, no
-//! actuators or driven torques (whose potentials couple links). A rom
+//! driven joint torques. Chambers and tendons load each element's strain
+//! by their segment's loads (`actuation::segment_loads`: linear in the
+//! strain), which a small kernel of the parameters gives and the cells
+//! read as parameters. A rom
 //! segment's slices are links whose cell coordinates are fixed
 //! combinations of the segment's coefficients (`LocalCoordinate`); its
 //! strain energy, integrated exactly over the segment, is one more small
 //! kernel (`derive_forces`). Other models keep the flat `MassBias` kernel.
 
 use runtime::Tape;
-use runtime::links::{CELL_PARAMS, LinkKernels, LinkLayout, LinkSpec, LocalCoordinate, cell};
+use runtime::links::{
+    ACTUATION_LOADS, CELL_PARAMS, ELEMENT_PARAMS, LinkKernels, LinkLayout, LinkSpec,
+    LocalCoordinate, cell, pose,
+};
 
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{ElementParam, Method, Param, ParamLayout, Structure, Xyz};
 
-use super::actuation::thinning;
+use super::actuation::{segment_loads, strain_work, thinning};
 use super::spatial::{Frame, Springs, V3, arc};
 use super::system::{Coordinates, ParamSymbols};
 use crate::method::rom::RomFields;
@@ -34,8 +40,6 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             .segments
             .iter()
             .all(|g| crate::method::of(g.method).link_cells())
-        && st.chambers.iter().all(|&c| c == 0)
-        && st.tendons.is_empty()
         && st.torques.is_empty()
         && !st.base_translates
         && st.base_turns == 0;
@@ -44,17 +48,20 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     }
     let index = |p: Param| params.index(p);
     let triple = |p: fn(Xyz) -> Param| Xyz::ALL.map(|c| index(p(c)));
-    let mut cells: Vec<(Shape, [Tape; 2])> = Vec::new();
+    let (loads, actuated) = derive_loads(params, st);
+    let mut cells: Vec<(Shape, [Tape; 3])> = Vec::new();
     let mut links = Vec::new();
     let mut roms = Vec::new();
     let (mut first, mut k) = (0, 0);
-    for g in &st.segments {
+    for (s, g) in st.segments.iter().enumerate() {
         let rom = (g.method == Method::Rom).then(|| RomFields::of(g, first));
+        let load = actuated.iter().position(|&a| a == s);
         let shape = Shape {
             twist: g.twist,
             extension: g.extension,
             incompressible: g.incompressible,
             rom: rom.is_some(),
+            actuated: load.is_some(),
         };
         let c = match cells.iter().position(|(s, _)| *s == shape) {
             Some(c) => c,
@@ -97,6 +104,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                 cell: c,
                 map,
                 params,
+                load,
             });
             if rom.is_none() {
                 first += count;
@@ -112,11 +120,13 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         links,
         dof: first,
         forces: !roms.is_empty(),
+        loads: actuated.len(),
         gravity: triple(Param::Gravity),
         base_position: triple(Param::BasePosition),
         base_rotation: std::array::from_fn(|i| {
             index(Param::BaseRotation((i / 3) as u8, (i % 3) as u8))
         }),
+        base_quaternion: std::array::from_fn(|i| index(Param::BaseQuaternion(i as u8))),
         tip_force: st.tip_force.then(|| triple(Param::TipForce)),
         tip_moment: st.tip_moment.then(|| triple(Param::TipMoment)),
         tip_frame: st.tip_frame_wrench,
@@ -131,15 +141,24 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         return None;
     }
     let forces = (!roms.is_empty()).then(|| derive_forces(params, first, &roms));
-    let (forces, forces_tangent) = forces.map(|[f, t]| (f, t)).unzip();
-    let (cells, tangents) = cells.into_iter().map(|(_, [c, t])| (c, t)).unzip();
-    Some(LinkKernels {
+    let [forces, forces_tangent, energy] = match forces {
+        Some(kernels) => kernels.map(Some),
+        None => [None, None, None],
+    };
+    let mut kernels = LinkKernels {
         layout,
-        cells,
-        tangents,
         forces,
         forces_tangent,
-    })
+        energy,
+        loads,
+        ..Default::default()
+    };
+    for (_, [cell, tangent, pose]) in cells {
+        kernels.cells.push(cell);
+        kernels.tangents.push(tangent);
+        kernels.poses.push(pose);
+    }
+    Some(kernels)
 }
 
 /// What a cell depends on besides its parameters' values.
@@ -152,13 +171,32 @@ struct Shape {
     /// the whole segment (`derive_forces`), and its bending and twist too
     /// unless the section thins, when they go slice by slice as here.
     rom: bool,
+    /// Actuators load the link's strain (the last `ACTUATION_LOADS`
+    /// parameters).
+    actuated: bool,
+}
+
+/// The kernel of the actuated segments' loads (`actuation::segment_loads`,
+/// three per segment, of the parameters alone) and which segments they
+/// are; none without actuators.
+fn derive_loads(params: &ParamLayout, st: &Structure) -> (Option<Tape>, Vec<usize>) {
+    let mut cas = Cas::new();
+    let cas = &mut cas;
+    let symbols = ParamSymbols::new(cas, params);
+    let loads = segment_loads(cas, &symbols, st);
+    let actuated: Vec<usize> = (0..loads.len()).filter(|&s| loads[s].is_some()).collect();
+    if actuated.is_empty() {
+        return (None, actuated);
+    }
+    let out: Vec<ExprId> = loads.into_iter().flatten().flatten().collect();
+    (Some(cas.to_tape(&out)), actuated)
 }
 
 /// The generalised forces of the rom segments' strain energy and Rayleigh
 /// function (`RomFields::energies`, exact quadratics in the coefficients), as one
-/// kernel of the arm's coordinates and parameters; and that kernel's
-/// [`with_tangent`].
-fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(RomFields, usize)]) -> [Tape; 2] {
+/// kernel of the arm's coordinates and parameters; that kernel's
+/// [`with_tangent`]; and the strain energy (for the `Outputs`).
+fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(RomFields, usize)]) -> [Tape; 3] {
     let mut cas = Cas::new();
     let cas = &mut cas;
     let symbols = ParamSymbols::new(cas, params);
@@ -182,6 +220,7 @@ fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(RomFields, usize)]) 
     [
         cas.to_tape(&out),
         with_tangent(cas, &out, &coords.q, &coords.qd),
+        cas.to_tape(&[elastic]),
     ]
 }
 
@@ -204,13 +243,15 @@ fn with_tangent(cas: &mut Cas, out: &[ExprId], x: &[ExprId], xd: &[ExprId]) -> T
 }
 
 /// The cell of a link with the bend pair, and twist and stretch when asked;
-/// and the cell [`with_tangent`].
-fn derive_cell(shape: Shape) -> [Tape; 2] {
+/// the cell [`with_tangent`]; and its pose cell (`runtime::links::pose`:
+/// what the `Outputs` need of the link).
+fn derive_cell(shape: Shape) -> [Tape; 3] {
     let Shape {
         twist,
         extension,
         incompressible,
         rom,
+        actuated,
     } = shape;
     let mut cas = Cas::new();
     let cas = &mut cas;
@@ -230,8 +271,9 @@ fn derive_cell(shape: Shape) -> [Tape; 2] {
     let p: Vec<ExprId> = (0..CELL_PARAMS)
         .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
         .collect();
-    // In the order of `ElementParam::CELL`.
+    // In the order of `ElementParam::CELL`, then the actuation loads.
     let [l, m, lateral, axial, kb, db, rest, kt, dt, ks, ds] = std::array::from_fn(|i| p[i]);
+    let loads: [ExprId; ACTUATION_LOADS] = std::array::from_fn(|i| p[ELEMENT_PARAMS + i]);
     let zero = cas.zero();
     // Coordinates bend y, bend z, then twist and stretch where present.
     let mut strain = [zero; 4];
@@ -246,7 +288,8 @@ fn derive_cell(shape: Shape) -> [Tape; 2] {
 
     // The link's potential and Rayleigh function, as the whole arm has them.
     let len = cas.add(l, st);
-    let soft = incompressible.then(|| thinning(cas, l, len).0);
+    let thin = incompressible.then(|| thinning(cas, l, len));
+    let soft = thin.map(|t| t.0);
     let springs = if rom {
         let local = |k: ExprId| if incompressible { k } else { zero };
         Springs {
@@ -270,6 +313,15 @@ fn derive_cell(shape: Shape) -> [Tape; 2] {
         }
     };
     let (elastic, rayleigh) = springs.energies(cas, strain, rates, soft);
+    // The actuators' potential on the link's strain, as the whole arm has
+    // it (the outputs' potential energy is the strain energy alone).
+    let stored = elastic;
+    let elastic = if actuated {
+        let work = strain_work(cas, loads, st, [tw, by, bz], thin.map(|t| t.1));
+        cas.sub(elastic, work)
+    } else {
+        elastic
+    };
 
     let one = cas.one();
     let identity = Frame {
@@ -330,5 +382,31 @@ fn derive_cell(shape: Shape) -> [Tape; 2] {
         let dr = cas.diff(rayleigh, qd[c]);
         out[cell::COLUMNS + 12 * n + c] = cas.add(de, dr);
     }
-    [cas.to_tape(&out), with_tangent(cas, &out, &q, &qd)]
+    let mut pose_out = vec![zero; pose::LEN];
+    for i in 0..3 {
+        for j in 0..3 {
+            pose_out[pose::ROTATION + 3 * i + j] = end.r[i][j];
+        }
+    }
+    for (at, v) in [
+        (pose::END, end.p),
+        (pose::END_RATE, end_rate),
+        (pose::OMEGA, end.w),
+        (pose::CENTROID, centroid),
+        (pose::CENTROID_RATE, centroid_rate),
+        (pose::BODY_OMEGA, omega),
+        (pose::AXIS, axis),
+    ] {
+        pose_out[at..at + 3].copy_from_slice(&v);
+    }
+    pose_out[pose::MASS] = m;
+    pose_out[pose::LATERAL] = lateral;
+    pose_out[pose::AXIAL] = axial;
+    pose_out[pose::QUAT..pose::QUAT + 4].copy_from_slice(&end.quat);
+    pose_out[pose::ENERGY] = stored;
+    [
+        cas.to_tape(&out),
+        with_tangent(cas, &out, &q, &qd),
+        cas.to_tape(&pose_out),
+    ]
 }

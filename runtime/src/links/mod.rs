@@ -23,13 +23,21 @@ use serde::{Deserialize, Serialize};
 
 use crate::rows;
 
+mod outputs;
 mod tangent;
+pub use outputs::outputs;
 pub use tangent::inverse_dynamics_tangent;
 
-/// Parameters a cell reads, in this order, per link: element[k].length,
-/// .mass, .inertia, .axial_inertia, joint[k].stiffness, .damping, .rest,
-/// twist[k].stiffness, .damping, stretch[k].stiffness, .damping.
-pub const CELL_PARAMS: usize = 11;
+/// The element parameters a cell reads, in this order, per link:
+/// element[k].length, .mass, .inertia, .axial_inertia, joint[k].stiffness,
+/// .damping, .rest, twist[k].stiffness, .damping, stretch[k].stiffness,
+/// .damping.
+pub const ELEMENT_PARAMS: usize = 11;
+/// Then the actuators' loads on the link's strain (c_st, c_by, c_bz: its
+/// segment's, from the `loads` kernel; zero where no actuator acts).
+pub const ACTUATION_LOADS: usize = 3;
+/// Everything a cell reads besides its coordinates.
+pub const CELL_PARAMS: usize = ELEMENT_PARAMS + ACTUATION_LOADS;
 
 /// Where a cell's outputs sit, for a link of `n` coordinates.
 pub mod cell {
@@ -65,6 +73,29 @@ pub mod cell {
     }
 }
 
+/// Where a *pose cell*'s outputs sit: what the `Outputs` kernel needs of a
+/// link (no accelerations or columns; the link's quaternion and strain
+/// energy besides), a kernel of its own so that `mass_bias`'s cells carry
+/// nothing the hot path does not read.
+pub mod pose {
+    pub const ROTATION: usize = 0;
+    pub const END: usize = 9;
+    pub const END_RATE: usize = 12;
+    pub const OMEGA: usize = 15;
+    pub const CENTROID: usize = 18;
+    pub const CENTROID_RATE: usize = 21;
+    pub const BODY_OMEGA: usize = 24;
+    pub const AXIS: usize = 27;
+    pub const MASS: usize = 30;
+    pub const LATERAL: usize = 31;
+    pub const AXIAL: usize = 32;
+    /// The relative rotation as a unit quaternion (w, x, y, z).
+    pub const QUAT: usize = 33;
+    /// The link's strain energy (springs; not the actuators' potential).
+    pub const ENERGY: usize = 37;
+    pub const LEN: usize = 38;
+}
+
 /// A coordinate of a cell: a fixed linear combination of the arm's
 /// coordinates, times a parameter where `scale` names one. A pcc link's
 /// coordinates are the arm's own (one term, weight 1); a rom slice's strain
@@ -77,17 +108,21 @@ pub struct LocalCoordinate {
 }
 
 /// One link: its cell, its coordinates and its parameters.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct LinkSpec {
     pub cell: usize,
     /// The cell's coordinates, in its order.
     pub map: Vec<LocalCoordinate>,
-    /// Indices into the parameter vector, [`CELL_PARAMS`] of them.
+    /// Indices into the parameter vector, [`ELEMENT_PARAMS`] of them.
     pub params: Vec<usize>,
+    /// Which triple of the `loads` kernel's outputs the link's actuation
+    /// loads are; None: none act on it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load: Option<usize>,
 }
 
 /// A chain of links and where its global parameters are.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct LinkLayout {
     pub links: Vec<LinkSpec>,
     /// The arm's coordinates.
@@ -96,10 +131,17 @@ pub struct LinkLayout {
     /// energy and damping, integrated over the whole segment) come from a
     /// kernel of the arm's coordinates: `mass_bias`'s `forces`.
     pub forces: bool,
+    /// Triples of actuation loads the `loads` kernel (of the parameters
+    /// alone, driven ones included) gives, one per actuated segment.
+    #[serde(default)]
+    pub loads: usize,
     pub gravity: [usize; 3],
     pub base_position: [usize; 3],
     /// Rows of the base rotation.
     pub base_rotation: [usize; 9],
+    /// The base orientation as a quaternion (w, x, y, z).
+    #[serde(default)]
+    pub base_quaternion: [usize; 4],
     pub tip_force: Option<[usize; 3]>,
     pub tip_moment: Option<[usize; 3]>,
     /// The tip force and moment turn with the tip frame.
@@ -137,10 +179,17 @@ impl LinkLayout {
 
 /// The link recursion of a model: its layout, the cells, and the kernel of
 /// the non-local forces when `layout.forces`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct LinkKernels {
     pub layout: LinkLayout,
     pub cells: Vec<crate::Tape>,
+    /// Each cell's pose cell ([`pose`]), for [`outputs`].
+    #[serde(default)]
+    pub poses: Vec<crate::Tape>,
+    /// The strain energy of what the non-local forces come from (one
+    /// value), for [`outputs`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub energy: Option<crate::Tape>,
     /// Each cell's outputs followed by their directional derivative along
     /// (dx, dxd) (the tape's `dir` input): [`inverse_dynamics_tangent`].
     pub tangents: Vec<crate::Tape>,
@@ -148,6 +197,9 @@ pub struct LinkKernels {
     /// The forces and their directional derivative along the arm's (dq,
     /// dqd).
     pub forces_tangent: Option<crate::Tape>,
+    /// The actuation loads ([`LinkLayout::loads`] triples).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loads: Option<crate::Tape>,
 }
 
 /// What the recursion evaluates: the cells and the non-local forces.
@@ -199,6 +251,59 @@ pub trait Cells {
     /// [`Cells::forces`] (the first `dof` values of `out`), then their
     /// directional derivative along the arm's (dq, dqd) = `dir`.
     fn forces_tangent(&mut self, dir: &[f64], out: &mut [f64]);
+
+    /// The actuation loads, [`LinkLayout::loads`] triples.
+    fn loads(&mut self, out: &mut [f64]);
+
+    /// Cell `c`'s pose cell ([`pose`]) at cell coordinates `x`, rates `xd`
+    /// and parameters `p`.
+    fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]);
+
+    /// The strain energy the non-local forces derive from
+    /// ([`LinkLayout::forces`]).
+    fn energy(&mut self) -> f64;
+}
+
+/// A link's cell coordinates (or their rates, accelerations, directions)
+/// from the arm's `v`: each [`LocalCoordinate`]'s combination, scaled.
+pub(crate) fn local(spec: &LinkSpec, p: &[f64], v: &[f64]) -> [f64; MAX_LINK_DOF] {
+    let mut x = [0.0; MAX_LINK_DOF];
+    for (x, c) in x.iter_mut().zip(&spec.map) {
+        let sc = c.scale.map_or(1.0, |i| p[i]);
+        *x = sc * c.terms.iter().map(|&(a, w)| w * v[a]).sum::<f64>();
+    }
+    x
+}
+
+/// Every link's cell parameters: its element parameters from `p`, then its
+/// segment's actuation loads (zero where none act).
+pub(crate) fn cell_params<C: Cells>(
+    layout: &LinkLayout,
+    cells: &mut C,
+    p: &[f64],
+    params: &mut Vec<[f64; CELL_PARAMS]>,
+) {
+    let mut loads = [0.0; 3 * 8];
+    let mut heap = Vec::new();
+    let loads: &mut [f64] = if layout.loads <= 8 {
+        &mut loads[..3 * layout.loads]
+    } else {
+        heap.resize(3 * layout.loads, 0.0);
+        &mut heap
+    };
+    if layout.loads > 0 {
+        cells.loads(loads);
+    }
+    params.resize(layout.links.len(), [0.0; CELL_PARAMS]);
+    for (v, spec) in params.iter_mut().zip(&layout.links) {
+        for (v, &i) in v.iter_mut().zip(&spec.params) {
+            *v = p[i];
+        }
+        let at = spec.load.map(|l| 3 * l);
+        for (f, v) in v[ELEMENT_PARAMS..].iter_mut().enumerate() {
+            *v = at.map_or(0.0, |at| loads[at + f]);
+        }
+    }
 }
 
 type V3 = [f64; 3];
@@ -375,12 +480,7 @@ struct Tip {
 #[inline(always)]
 fn evaluate_cells<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scratch) {
     let nl = layout.links.len();
-    s.params.resize(nl, [0.0; CELL_PARAMS]);
-    for (k, spec) in layout.links.iter().enumerate() {
-        for (v, &i) in s.params[k].iter_mut().zip(&spec.params) {
-            *v = p[i];
-        }
-    }
+    cell_params(layout, cells, p, &mut s.params);
     // Link k's outputs: lane `slot[k].1` of the CELL_STRIDE vectors from
     // `slot[k].0`, four links sharing them where evaluated together.
     s.slot.resize(nl, (0, 0));

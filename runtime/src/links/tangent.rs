@@ -16,7 +16,7 @@
 
 use std::ops::{Add, Mul, Neg, Sub};
 
-use super::{CELL_PARAMS, Cells, LinkLayout, MAX_LINK_DOF, cell};
+use super::{Cells, LinkLayout, MAX_LINK_DOF, cell, local};
 
 /// A value and its directional derivative.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -134,17 +134,6 @@ fn point_accel(a: V3, alpha: V3, w: V3, r: V3, rate: V3, accel: V3) -> V3 {
     )
 }
 
-/// A cell coordinate: value, rate and acceleration, and the direction's
-/// components (dx, dxd).
-#[derive(Clone, Copy, Default)]
-struct LocalState {
-    x: f64,
-    xd: f64,
-    xdd: f64,
-    dx: f64,
-    dxd: f64,
-}
-
 /// What the sweep back needs of a link: its body's centroid, force and
 /// torque; per cell coordinate the twist it gives the links past, the
 /// velocity it gives the body, its elastic and dissipative force.
@@ -198,42 +187,24 @@ pub fn inverse_dynamics_tangent<C: Cells>(
         alpha: V0,
         acc: V0,
     };
+    let mut params = Vec::new();
+    super::cell_params(layout, cells, p, &mut params);
     let mut links = Vec::with_capacity(layout.links.len());
-    let mut states = Vec::with_capacity(layout.links.len());
     let mut out = vec![0.0; 2 * cell::len(MAX_LINK_DOF)];
-    for spec in &layout.links {
+    for (spec, params) in layout.links.iter().zip(&params) {
         let nc = spec.map.len();
-        let mut st = [LocalState::default(); MAX_LINK_DOF];
-        for (s, c) in st.iter_mut().zip(&spec.map) {
-            let sc = c.scale.map_or(1.0, |i| p[i]);
-            let comb = |v: &[f64]| sc * c.terms.iter().map(|&(a, w)| w * v[a]).sum::<f64>();
-            *s = LocalState {
-                x: comb(q),
-                xd: comb(qd),
-                xdd: comb(qdd),
-                dx: comb(dq),
-                dxd: comb(dqd),
-            };
-        }
-        let params: [f64; CELL_PARAMS] = std::array::from_fn(|i| p[spec.params[i]]);
+        let [x, xd, xdd, dx, dxd] = [q, qd, qdd, dq, dqd].map(|v| local(spec, p, v));
         let len = cell::len(nc);
-        let pick = |f: fn(&LocalState) -> f64| -> Vec<f64> { st[..nc].iter().map(f).collect() };
-        let (x, xd, dx, dxd) = (
-            pick(|s| s.x),
-            pick(|s| s.xd),
-            pick(|s| s.dx),
-            pick(|s| s.dxd),
-        );
+        let (x, xd, dx, dxd) = (&x[..nc], &xd[..nc], &dx[..nc], &dxd[..nc]);
         let out = &mut out[..2 * len];
-        if dx.iter().chain(&dxd).all(|&v| v == 0.0) {
+        if dx.iter().chain(dxd).all(|&v| v == 0.0) {
             // The direction does not move this link's coordinates.
-            cells.one(spec.cell, &x, &xd, &params, &mut out[..len]);
+            cells.one(spec.cell, x, xd, params, &mut out[..len]);
             out[len..].fill(0.0);
         } else {
-            cells.tangent(spec.cell, &x, &xd, &dx, &dxd, &params, out);
+            cells.tangent(spec.cell, x, xd, dx, dxd, params, out);
         }
-        links.push(link_forward(&mut frame, out, nc, &st, gravity));
-        states.push(st);
+        links.push(link_forward(&mut frame, out, nc, &xdd, gravity));
     }
     let mut wrench = tip_wrench(layout, &frame, p, gravity);
 
@@ -273,14 +244,14 @@ pub fn inverse_dynamics_tangent<C: Cells>(
 }
 
 /// One link of the sweep out: its cell's outputs (`out`: values, then
-/// derivatives) under `frame`, its coordinates' accelerations added to
+/// derivatives) under `frame`, its coordinates' accelerations `xdd` added to
 /// the cell's convective ones; `frame` becomes the link's end frame.
 #[inline(always)]
 fn link_forward(
     frame: &mut Frame,
     out: &[f64],
     nc: usize,
-    st: &[LocalState; MAX_LINK_DOF],
+    xdd: &[f64; MAX_LINK_DOF],
     gravity: V3,
 ) -> LinkForces {
     let len = cell::len(nc);
@@ -315,7 +286,7 @@ fn link_forward(
         let col = cell::COLUMNS + 12 * f;
         let (s_w, v_end) = (turn(col), turn(col + 3));
         let (own_w, own_v) = (turn(col + 6), turn(col + 9));
-        let xdd = Dual::constant(st[f].xdd);
+        let xdd = Dual::constant(xdd[f]);
         ddd = add(ddd, scale(xdd, v_end));
         w_rel_d = add(w_rel_d, scale(xdd, s_w));
         cendd = add(cendd, scale(xdd, own_v));

@@ -1,0 +1,120 @@
+//! The `Outputs` of a link chain (tip position, kinetic and potential
+//! energy, tip orientation) by one sweep out over the links' *pose cells*:
+//! the world frame composed link by link, as `mass_bias` does, with each
+//! link's quaternion composed alongside its rotation and its body's
+//! energies summed. The flat `Outputs` kernel of a chain of shared
+//! coordinates (rom) sums every body's velocity over all coordinates, its
+//! size the slices times the coordinates; this is one pose cell per
+//! distinct cell.
+
+use super::{CELL_PARAMS, Cells, LinkLayout, MAX_LINK_DOF, cell_params, local, pose};
+
+type V3 = [f64; 3];
+type M3 = [[f64; 3]; 3];
+
+fn add(a: V3, b: V3) -> V3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn scale(s: f64, a: V3) -> V3 {
+    [s * a[0], s * a[1], s * a[2]]
+}
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn mat_vec(r: &M3, v: V3) -> V3 {
+    [dot(r[0], v), dot(r[1], v), dot(r[2], v)]
+}
+fn mat_mat(a: &M3, b: &M3) -> M3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| dot(a[i], [b[0][j], b[1][j], b[2][j]])))
+}
+/// The Hamilton product a b, (w, x, y, z).
+fn quat_mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+/// Kinetic energy of a body of mass m, axisymmetric inertia about `axis`,
+/// moving at (v, w).
+fn kinetic(m: f64, lateral: f64, axial: f64, axis: V3, v: V3, w: V3) -> f64 {
+    let aw = dot(axis, w);
+    let iw = add(scale(lateral, w), scale((axial - lateral) * aw, axis));
+    0.5 * (m * dot(v, v) + dot(w, iw))
+}
+
+/// The outputs (`runtime::OUTPUT_NAMES`: tip x, y, z, kinetic energy,
+/// potential energy, tip quaternion w, x, y, z) of a chain the link
+/// recursion covers, into `out`. The potential energy is gravity's, the
+/// springs' (the actuators' work is not stored energy) and a world-frame
+/// tip force's -F . p; a force turning with the tip has none.
+pub fn outputs<C: Cells>(
+    layout: &LinkLayout,
+    cells: &mut C,
+    q: &[f64],
+    qd: &[f64],
+    p: &[f64],
+    out: &mut [f64],
+) {
+    let gravity: V3 = layout.gravity.map(|i| p[i]);
+    let mut r: M3 =
+        std::array::from_fn(|i| std::array::from_fn(|j| p[layout.base_rotation[3 * i + j]]));
+    let mut quat = layout.base_quaternion.map(|i| p[i]);
+    let mut pos = layout.base_position.map(|i| p[i]);
+    let (mut v, mut omega) = ([0.0; 3], [0.0; 3]);
+    let (mut ke, mut pe) = (0.0, 0.0);
+    let mut params: Vec<[f64; CELL_PARAMS]> = Vec::new();
+    cell_params(layout, cells, p, &mut params);
+    let mut o = [0.0; pose::LEN];
+    for (spec, params) in layout.links.iter().zip(&params) {
+        let nc = spec.map.len();
+        debug_assert!(nc <= MAX_LINK_DOF);
+        let (x, xd) = (local(spec, p, q), local(spec, p, qd));
+        cells.pose(spec.cell, &x[..nc], &xd[..nc], params, &mut o);
+        let v3 = |i: usize| [o[i], o[i + 1], o[i + 2]];
+        let rel: M3 = std::array::from_fn(|i| v3(pose::ROTATION + 3 * i));
+        let turn = |at: usize| mat_vec(&r, v3(at));
+        let (d, dd, w_rel) = (turn(pose::END), turn(pose::END_RATE), turn(pose::OMEGA));
+        let (cen, cend) = (turn(pose::CENTROID), turn(pose::CENTROID_RATE));
+        let (w_b, axis) = (turn(pose::BODY_OMEGA), turn(pose::AXIS));
+        let m = o[pose::MASS];
+        let body_v = add(add(v, cross(omega, cen)), cend);
+        let body_w = add(omega, w_b);
+        ke += kinetic(m, o[pose::LATERAL], o[pose::AXIAL], axis, body_v, body_w);
+        pe += o[pose::ENERGY] - m * dot(gravity, add(pos, cen));
+        v = add(add(v, cross(omega, d)), dd);
+        omega = add(omega, w_rel);
+        pos = add(pos, d);
+        r = mat_mat(&r, &rel);
+        quat = quat_mul(quat, std::array::from_fn(|k| o[pose::QUAT + k]));
+    }
+    let axis = [r[0][0], r[1][0], r[2][0]];
+    let length = layout.tip_length.map_or(0.0, |i| p[i]);
+    if let Some(m) = layout.tip_mass.map(|i| p[i]) {
+        let offset = scale(0.5 * length, axis);
+        let (lateral, axial) = layout.tip_inertia.map_or((0.0, 0.0), |[l, a]| (p[l], p[a]));
+        let v_c = add(v, cross(omega, offset));
+        ke += kinetic(m, lateral, axial, axis, v_c, omega);
+        pe -= m * dot(gravity, add(pos, offset));
+    }
+    // The tip point: the far end of a tip body with a length.
+    let point = add(pos, scale(length, axis));
+    if let (Some(f), false) = (layout.tip_force, layout.tip_frame) {
+        pe -= dot(f.map(|i| p[i]), point);
+    }
+    if layout.forces {
+        pe += cells.energy();
+    }
+    out[..3].copy_from_slice(&point);
+    out[3] = ke;
+    out[4] = pe;
+    out[5..9].copy_from_slice(&quat);
+}
