@@ -106,14 +106,24 @@ pub fn integrate(
     // Whether J must be evaluated before the next attempt, and whether the J
     // in hand was evaluated at the current point.
     let (mut need_jacobian, mut fresh) = (true, false);
+    // The Newton matrix and the error estimate's matrix, factored for the
+    // J in hand at step size `.0`: reused while neither changes (Hairer's
+    // RADAU5 keeps h when the new one is within 1 to 1.2 times it, for
+    // this; a factorisation of the 3m x 3m matrix costs more than the
+    // right-hand sides of a step).
+    let mut factored: Option<(f64, Lu, Lu)> = None;
     while t < t_end {
         let last = begin_step(counts, opts, t, &mut h, &y)?;
         if need_jacobian {
             sys.jacobian(t, &y, &mut j);
             (need_jacobian, fresh) = (false, true);
+            factored = None;
         }
         let scale: Vec<f64> = y.iter().map(|v| atol + rtol * v.abs()).collect();
-        let lu = newton_matrix(&j, h, m);
+        if factored.as_ref().is_none_or(|f| f.0 != h) {
+            factored = Some((h, newton_matrix(&j, h, m), estimate_matrix(&j, h, m)));
+        }
+        let (_, lu, est) = factored.as_ref().expect("factored above");
         // Start from the last step's collocation polynomial, extrapolated.
         match &mut dense {
             Some(d) if !first => {
@@ -129,7 +139,7 @@ pub fn integrate(
         }
         let stage = StagePoint { t, y: &y, h };
         let (converged, iterations, theta) =
-            simplified_newton(sys, &lu, &stage, &mut z, &mut fz, &scale, newton_tol)?;
+            simplified_newton(sys, lu, &stage, &mut z, &mut fz, &scale, newton_tol)?;
         if !converged {
             // A stale Jacobian may be why: take a new one as well.
             counts.rejected += 1;
@@ -139,13 +149,13 @@ pub fn integrate(
             continue;
         }
         // Error estimate: (gamma/h - J)^-1 (f(t, y) + sum dd_k Z_k / h).
-        let mut err = estimate(&j, h, &f0, &z, &scale, m);
+        let mut err = estimate(est, h, &f0, &z, &scale, m);
         if err.1 >= 1.0 && (first || last_rejected) {
             // Hairer's second estimate, better near stiff transients.
             let perturbed: Vec<f64> = (0..m).map(|i| y[i] + err.0[i]).collect();
             let mut fp = vec![0.0; m];
             sys.rhs(t, &perturbed, &mut fp);
-            err = estimate(&j, h, &fp, &z, &scale, m);
+            err = estimate(est, h, &fp, &z, &scale, m);
         }
         if !err.1.is_finite() {
             // A failed right-hand side or a singular matrix: retry smaller.
@@ -158,7 +168,7 @@ pub fn integrate(
         let err = err.1.max(1e-10);
         let safety = 0.9 * (2 * MAX_NEWTON + 1) as f64 / (2 * MAX_NEWTON + iterations) as f64;
         let quot = (err.powf(0.25) / safety).clamp(1.0 / 8.0, 5.0);
-        let h_new = h / quot;
+        let mut h_new = h / quot;
         if err < 1.0 {
             let y_new: Vec<f64> = (0..m).map(|i| y[i] + z[2][i]).collect();
             let t_new = if last { t_end } else { t + h };
@@ -183,6 +193,10 @@ pub fn integrate(
             need_jacobian = contraction > REUSE_JACOBIAN_BELOW;
             fresh = false;
             first = false;
+            if !need_jacobian && (1.0..=1.2).contains(&(h_new / h)) {
+                // Keep h, and with it the factorisations.
+                h_new = h;
+            }
             h = if last_rejected { h_new.min(h) } else { h_new };
             last_rejected = false;
             if !keep_going {
@@ -228,25 +242,32 @@ fn divided_differences(z: &[Vec<f64>]) -> [Vec<f64>; 3] {
     d
 }
 
-/// The filtered error vector and its scaled RMS norm.
+type Lu = nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>;
+
+/// gamma/h - J, factored: the error estimate's filter.
+fn estimate_matrix(j: &DMatrix<f64>, h: f64, m: usize) -> Lu {
+    let mut a = -j.clone();
+    for i in 0..m {
+        a[(i, i)] += GAMMA / h;
+    }
+    a.lu()
+}
+
+/// The filtered error vector and its scaled RMS norm, `filter` from
+/// [`estimate_matrix`] at `h`.
 fn estimate(
-    j: &DMatrix<f64>,
+    filter: &Lu,
     h: f64,
     f0: &[f64],
     z: &[Vec<f64>],
     scale: &[f64],
     m: usize,
 ) -> (Vec<f64>, f64) {
-    let mut a = -j.clone();
-    for i in 0..m {
-        a[(i, i)] += GAMMA / h;
-    }
     let rhs = DVector::from_iterator(
         m,
         (0..m).map(|i| f0[i] + (DD[0] * z[0][i] + DD[1] * z[1][i] + DD[2] * z[2][i]) / h),
     );
-    let e: Vec<f64> = a
-        .lu()
+    let e: Vec<f64> = filter
         .solve(&rhs)
         .map(|e| e.iter().copied().collect())
         .unwrap_or_else(|| vec![f64::INFINITY; m]);
@@ -261,11 +282,7 @@ fn estimate(
 }
 
 /// E = I - h (A (x) J), factored once per step.
-fn newton_matrix(
-    j: &DMatrix<f64>,
-    h: f64,
-    m: usize,
-) -> nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn> {
+fn newton_matrix(j: &DMatrix<f64>, h: f64, m: usize) -> Lu {
     let mut e = DMatrix::<f64>::identity(3 * m, 3 * m);
     for (a, row) in A.iter().enumerate() {
         for (b, &ab) in row.iter().enumerate() {
@@ -291,7 +308,7 @@ struct StagePoint<'a> {
 /// the iterations taken and the last contraction rate theta.
 fn simplified_newton(
     sys: &mut dyn OdeSystem,
-    lu: &nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    lu: &Lu,
     at: &StagePoint,
     z: &mut [Vec<f64>],
     fz: &mut [Vec<f64>],
