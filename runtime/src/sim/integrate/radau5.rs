@@ -8,13 +8,16 @@
 //! stalls at about 1e-6 on nonlinear problems whatever the tolerance (a
 //! plain pendulum at rtol 1e-12: 31 steps, error 1.4e-6; measured
 //! 2026-11-21), which an accurate reference solver cannot afford. The
-//! Newton system is solved whole (3m x 3m LU) rather than in Hairer's
-//! real + complex transformed form: simpler, and for the state sizes of
-//! lumped arms (m <= 256) the factorisation is a small part of a step.
+//! Newton system is solved in Hairer's transformed form: A^-1 = T Lambda
+//! T^-1 with one real eigenvalue and a complex pair, so the 3m x 3m
+//! matrix I - h (A (x) J) becomes one real m x m matrix (u1/h - J) and
+//! one complex one ((alpha + i beta)/h - J), about a fifth of the work of
+//! factoring it whole (which was half the run time of the STIFF-FLOP
+//! record by rom). The real one is also the error estimate's filter.
 
 use differential_equations::error::Error;
 use differential_equations::interpolate::Interpolation;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{Complex, DMatrix, DVector};
 
 use super::stepper::{Counts, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, begin_step};
 
@@ -22,7 +25,9 @@ use super::stepper::{Counts, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, b
 const SQ6: f64 = 2.449_489_742_783_178;
 /// Collocation nodes.
 const C: [f64; 3] = [(4.0 - SQ6) / 10.0, (4.0 + SQ6) / 10.0, 1.0];
-/// The Butcher matrix of Radau IIA, order 5.
+/// The Butcher matrix of Radau IIA, order 5 (the Newton iteration uses
+/// its inverse's eigendecomposition, [`T`]).
+#[cfg_attr(not(test), allow(dead_code))]
 const A: [[f64; 3]; 3] = [
     [
         (88.0 - 7.0 * SQ6) / 360.0,
@@ -38,6 +43,42 @@ const A: [[f64; 3]; 3] = [
 ];
 /// The real eigenvalue of A^-1 and the error estimate's weights.
 const GAMMA: f64 = 3.637_834_252_744_496;
+/// The complex pair alpha +- i beta of A^-1's eigenvalues (Hairer's
+/// ALPH, BETA after division by ALPH^2 + BETA^2).
+const ALPHA: f64 = 2.681_082_873_627_752;
+const BETA: f64 = 3.050_430_199_247_411;
+/// T and T^-1 (Hairer's RADAU5): T^-1 A^-1 T = [[gamma, 0, 0], [0, alpha,
+/// -beta], [0, beta, alpha]].
+const T: [[f64; 3]; 3] = [
+    [
+        9.123_239_487_089_294e-2,
+        -0.141_255_295_020_954_2,
+        -3.002_919_410_514_742e-2,
+    ],
+    [
+        0.241_717_932_707_107,
+        0.204_129_352_293_8,
+        0.382_942_112_757_261_9,
+    ],
+    [0.966_048_182_615_093, 1.0, 0.0],
+];
+const TI: [[f64; 3]; 3] = [
+    [
+        4.325_579_890_063_155,
+        0.339_199_251_815_809_9,
+        0.541_770_539_935_874_9,
+    ],
+    [
+        -4.178_718_591_551_905,
+        -0.327_682_820_761_062_4,
+        0.476_623_554_500_550_5,
+    ],
+    [
+        -0.502_872_634_945_786_9,
+        2.571_926_949_855_605,
+        -0.596_039_204_828_225,
+    ],
+];
 const DD: [f64; 3] = [
     -(13.0 + 7.0 * SQ6) / 3.0,
     (-13.0 + 7.0 * SQ6) / 3.0,
@@ -106,12 +147,10 @@ pub fn integrate(
     // Whether J must be evaluated before the next attempt, and whether the J
     // in hand was evaluated at the current point.
     let (mut need_jacobian, mut fresh) = (true, false);
-    // The Newton matrix and the error estimate's matrix, factored for the
-    // J in hand at step size `.0`: reused while neither changes (Hairer's
-    // RADAU5 keeps h when the new one is within 1 to 1.2 times it, for
-    // this; a factorisation of the 3m x 3m matrix costs more than the
-    // right-hand sides of a step).
-    let mut factored: Option<(f64, Lu, Lu)> = None;
+    // The Newton matrices, factored for the J in hand at step size `.0`:
+    // reused while neither changes (Hairer's RADAU5 keeps h when the new
+    // one is within 1 to 1.2 times it, for this).
+    let mut factored: Option<(f64, Lu, ComplexLu)> = None;
     while t < t_end {
         let last = begin_step(counts, opts, t, &mut h, &y)?;
         if need_jacobian {
@@ -121,9 +160,10 @@ pub fn integrate(
         }
         let scale: Vec<f64> = y.iter().map(|v| atol + rtol * v.abs()).collect();
         if factored.as_ref().is_none_or(|f| f.0 != h) {
-            factored = Some((h, newton_matrix(&j, h, m), estimate_matrix(&j, h, m)));
+            let (real, complex) = newton_matrices(&j, h, m);
+            factored = Some((h, real, complex));
         }
-        let (_, lu, est) = factored.as_ref().expect("factored above");
+        let (_, real, complex) = factored.as_ref().expect("factored above");
         // Start from the last step's collocation polynomial, extrapolated.
         match &mut dense {
             Some(d) if !first => {
@@ -138,8 +178,15 @@ pub fn integrate(
             _ => z.iter_mut().for_each(|zk| zk.fill(0.0)),
         }
         let stage = StagePoint { t, y: &y, h };
-        let (converged, iterations, theta) =
-            simplified_newton(sys, lu, &stage, &mut z, &mut fz, &scale, newton_tol)?;
+        let (converged, iterations, theta) = simplified_newton(
+            sys,
+            (real, complex),
+            &stage,
+            &mut z,
+            &mut fz,
+            &scale,
+            newton_tol,
+        )?;
         if !converged {
             // A stale Jacobian may be why: take a new one as well.
             counts.rejected += 1;
@@ -149,13 +196,13 @@ pub fn integrate(
             continue;
         }
         // Error estimate: (gamma/h - J)^-1 (f(t, y) + sum dd_k Z_k / h).
-        let mut err = estimate(est, h, &f0, &z, &scale, m);
+        let mut err = estimate(real, h, &f0, &z, &scale, m);
         if err.1 >= 1.0 && (first || last_rejected) {
             // Hairer's second estimate, better near stiff transients.
             let perturbed: Vec<f64> = (0..m).map(|i| y[i] + err.0[i]).collect();
             let mut fp = vec![0.0; m];
             sys.rhs(t, &perturbed, &mut fp);
-            err = estimate(est, h, &fp, &z, &scale, m);
+            err = estimate(real, h, &fp, &z, &scale, m);
         }
         if !err.1.is_finite() {
             // A failed right-hand side or a singular matrix: retry smaller.
@@ -244,17 +291,8 @@ fn divided_differences(z: &[Vec<f64>]) -> [Vec<f64>; 3] {
 
 type Lu = nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>;
 
-/// gamma/h - J, factored: the error estimate's filter.
-fn estimate_matrix(j: &DMatrix<f64>, h: f64, m: usize) -> Lu {
-    let mut a = -j.clone();
-    for i in 0..m {
-        a[(i, i)] += GAMMA / h;
-    }
-    a.lu()
-}
-
-/// The filtered error vector and its scaled RMS norm, `filter` from
-/// [`estimate_matrix`] at `h`.
+/// The filtered error vector and its scaled RMS norm, `filter` the real
+/// Newton matrix gamma/h - J at `h` ([`newton_matrices`]).
 fn estimate(
     filter: &Lu,
     h: f64,
@@ -281,19 +319,18 @@ fn estimate(
     (e, norm)
 }
 
-/// E = I - h (A (x) J), factored once per step.
-fn newton_matrix(j: &DMatrix<f64>, h: f64, m: usize) -> Lu {
-    let mut e = DMatrix::<f64>::identity(3 * m, 3 * m);
-    for (a, row) in A.iter().enumerate() {
-        for (b, &ab) in row.iter().enumerate() {
-            for r in 0..m {
-                for c in 0..m {
-                    e[(a * m + r, b * m + c)] -= h * ab * j[(r, c)];
-                }
-            }
-        }
+type ComplexLu = nalgebra::LU<Complex<f64>, nalgebra::Dyn, nalgebra::Dyn>;
+
+/// The transformed Newton matrices gamma/h - J and (alpha + i beta)/h - J,
+/// factored.
+fn newton_matrices(j: &DMatrix<f64>, h: f64, m: usize) -> (Lu, ComplexLu) {
+    let mut real = -j.clone();
+    let mut complex = j.map(|v| Complex::new(-v, 0.0));
+    for i in 0..m {
+        real[(i, i)] += GAMMA / h;
+        complex[(i, i)] += Complex::new(ALPHA / h, BETA / h);
     }
-    e.lu()
+    (real.lu(), complex.lu())
 }
 
 /// Where a step starts: time, state and step size.
@@ -303,12 +340,13 @@ struct StagePoint<'a> {
     h: f64,
 }
 
-/// Simplified Newton on G(Z) = Z - h (A (x) I) F(Z) from the given Z,
-/// with the matrix factored by [`newton_matrix`]: whether it converged,
-/// the iterations taken and the last contraction rate theta.
+/// Simplified Newton on G(Z) = Z - h (A (x) I) F(Z) from the given Z, in
+/// the transformed variables W = T^-1 Z, with the matrices of
+/// [`newton_matrices`]: whether it converged, the iterations taken and
+/// the last contraction rate theta.
 fn simplified_newton(
     sys: &mut dyn OdeSystem,
-    lu: &Lu,
+    (real, complex): (&Lu, &ComplexLu),
     at: &StagePoint,
     z: &mut [Vec<f64>],
     fz: &mut [Vec<f64>],
@@ -322,6 +360,18 @@ fn simplified_newton(
     let mut previous_norm = f64::INFINITY;
     let mut theta = 0.5;
     let mut iterations = 0;
+    let transform = |mat: &[[f64; 3]; 3], v: &[Vec<f64>], k: usize, i: usize| {
+        mat[k][0] * v[0][i] + mat[k][1] * v[1][i] + mat[k][2] * v[2][i]
+    };
+    let mut w: Vec<Vec<f64>> = (0..3)
+        .map(|k| (0..m).map(|i| transform(&TI, z, k, i)).collect())
+        .collect();
+    let (gamma, alpha, beta) = (GAMMA / h, ALPHA / h, BETA / h);
+    let singular = || Error::LinearAlgebra {
+        t,
+        y: y.to_vec(),
+        msg: "the Newton matrix I - h (A x J) is singular".into(),
+    };
     for it in 0..MAX_NEWTON {
         iterations = it + 1;
         for k in 0..3 {
@@ -330,33 +380,34 @@ fn simplified_newton(
             }
             sys.rhs(t + C[k] * h, &yi, &mut fz[k]);
         }
-        let mut rhs = DVector::<f64>::zeros(3 * m);
-        for a in 0..3 {
-            for i in 0..m {
-                let hf: f64 = (0..3).map(|b| A[a][b] * fz[b][i]).sum::<f64>() * h;
-                rhs[a * m + i] = hf - z[a][i];
+        // T^-1 F - (Lambda / h) W, then the increments of W.
+        let mut r1 = DVector::<f64>::zeros(m);
+        let mut r23 = DVector::<Complex<f64>>::zeros(m);
+        for i in 0..m {
+            let tf = [0, 1, 2].map(|k| transform(&TI, fz, k, i));
+            r1[i] = tf[0] - gamma * w[0][i];
+            r23[i] = Complex::new(
+                tf[1] - alpha * w[1][i] + beta * w[2][i],
+                tf[2] - alpha * w[2][i] - beta * w[1][i],
+            );
+        }
+        let dw1 = real.solve(&r1).ok_or_else(singular)?;
+        let dw23 = complex.solve(&r23).ok_or_else(singular)?;
+        let mut sum = 0.0;
+        for i in 0..m {
+            let d = [dw1[i], dw23[i].re, dw23[i].im];
+            for k in 0..3 {
+                w[k][i] += d[k];
+                sum += (d[k] / scale[i]).powi(2);
             }
         }
-        let Some(dz) = lu.solve(&rhs) else {
-            return Err(Error::LinearAlgebra {
-                t,
-                y: y.to_vec(),
-                msg: "the Newton matrix I - h (A x J) is singular".into(),
-            });
-        };
-        if dz.iter().any(|v| !v.is_finite()) {
+        let norm = (sum / (3 * m) as f64).sqrt();
+        if !norm.is_finite() {
             break;
         }
-        let norm = (dz
-            .iter()
-            .enumerate()
-            .map(|(k, v)| (v / scale[k % m]).powi(2))
-            .sum::<f64>()
-            / (3 * m) as f64)
-            .sqrt();
-        for a in 0..3 {
-            for i in 0..m {
-                z[a][i] += dz[a * m + i];
+        for (k, zk) in z.iter_mut().enumerate() {
+            for (i, v) in zk.iter_mut().enumerate() {
+                *v = transform(&T, &w, k, i);
             }
         }
         if it > 0 {
@@ -372,4 +423,38 @@ fn simplified_newton(
         }
     }
     Ok((converged, iterations, theta))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn product(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+        std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
+    }
+
+    /// T^-1 A^-1 T = [[gamma, 0, 0], [0, alpha, -beta], [0, beta, alpha]],
+    /// checked as A T Lambda = T (no inverse of A needed).
+    #[test]
+    fn transformation_diagonalises_the_inverse_butcher_matrix() {
+        let id = product(&T, &TI);
+        for (i, row) in id.iter().enumerate() {
+            for (j, v) in row.iter().enumerate() {
+                let want = if i == j { 1.0 } else { 0.0 };
+                assert!((v - want).abs() < 1e-14, "T T^-1 [{i}][{j}] = {v}");
+            }
+        }
+        let lambda = [[GAMMA, 0.0, 0.0], [0.0, ALPHA, -BETA], [0.0, BETA, ALPHA]];
+        let lhs = product(&product(&A, &T), &lambda);
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!(
+                    (lhs[i][j] - T[i][j]).abs() < 1e-14,
+                    "A T Lambda [{i}][{j}] = {} vs T {}",
+                    lhs[i][j],
+                    T[i][j]
+                );
+            }
+        }
+    }
 }
