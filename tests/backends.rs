@@ -350,6 +350,58 @@ kind = "constant"
 value = 0.5
 "#;
 
+/// A planar arm of a rigid link and a pcc segment with a tendon through
+/// both and chambers on the pcc segment, a tip body with a length and a
+/// tip wrench.
+const ACTUATED_2D: &str = r#"
+name = "actuated2d"
+gravity = [0.0, -9.81, 0.0]
+[base]
+direction = [1.0, -0.3, 0.0]
+[[segment]]
+method = "rigid"
+length = 0.1
+elements = 1
+density = 1000.0
+outer_radius = 0.01
+youngs_modulus = 1.0e6
+joints = "base"
+[[segment]]
+method = "pcc"
+length = 0.15
+elements = 4
+density = 1000.0
+outer_radius = 0.01
+youngs_modulus = 5.0e5
+rest_curvature = -2.0
+bending_damping = 1e-4
+[segment.chambers]
+angles = [90.0, 210.0, 330.0]
+radius = 0.002
+distance = 0.006
+inputs = ["p0", "p1", "p1"]
+[[tendon]]
+input = "pull"
+distance = 0.006
+angle = 90.0
+end = 1
+[tip]
+mass = 0.01
+length = 0.02
+radius = 0.005
+force = [0.1, 0.02, 0.0]
+moment = [0.0, 0.0, 0.001]
+[inputs.p0]
+kind = "constant"
+value = 2.0e4
+[inputs.p1]
+kind = "constant"
+value = 1.0e4
+[inputs.pull]
+kind = "constant"
+value = 0.3
+"#;
+
 /// The link recursion (runtime/src/links.rs) with its cells interpreted
 /// against the flat `MassBias` tape of the TMT sums, for every link shape
 /// and tip it covers: twist, stretch, thinning, vc modules, rom slices, a
@@ -365,7 +417,20 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(&actuated, ACTUATED_3D).unwrap();
     let actuated = actuated.to_str().unwrap().to_string();
+    let actuated2d = dir.join("actuated2d.toml");
+    std::fs::write(&actuated2d, ACTUATED_2D).unwrap();
+    let actuated2d = actuated2d.to_str().unwrap().to_string();
     let mut models: Vec<(&str, &[&str])> = vec![
+        // Planar chains: rigid links and pcc arcs (whose inertia changes
+        // with the bend), a turned base, actuators, tip bodies and loads.
+        ("double_pendulum", &[]),
+        ("chain", &["base.direction=[0.6,-0.8,0.0]"]),
+        ("cantilever", &["tip.mass=0.02"]),
+        ("hybrid_arm", &[]),
+        ("long_arm", &[]),
+        ("soft_finger", &[]),
+        (&actuated2d, &[]),
+        (&actuated2d, &["tip.wrench_frame=\"tip\""]),
         ("stiff_flop", &[]),
         ("stiff_flop", &["segment.0.method=rom", "segment.0.order=2"]),
         (&actuated, &[]),
@@ -450,7 +515,7 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
         let links = tapes
             .links
             .clone()
-            .expect("the recursion covers this chain");
+            .unwrap_or_else(|| panic!("the recursion covers {model} {sets:?}"));
         let flat = tapes.mass_bias.clone();
         let jvp = tapes.jvp.clone();
         let outputs = tapes.outputs.clone();

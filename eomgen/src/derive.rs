@@ -25,11 +25,12 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
     let mass_bias = cas.to_tape_hoisted(&mass_bias, &mut hoist);
     let outputs = cas.to_tape_hoisted(&eq.outputs, &mut hoist);
     let n = eq.bias.len();
-    // Chains the link recursion covers solve M qdd = -h at run time: their
-    // compiled mass + bias and an L D L^T solve beat a generated symbolic
-    // solve, whose unrolled code is past the instruction caches.
+    // Chains whose mass + bias the link recursion computes solve M qdd =
+    // -h at run time: their compiled mass + bias and an L D L^T solve beat
+    // a generated symbolic solve, whose unrolled code is past the
+    // instruction caches.
     let links = link_chain(structure, &layout);
-    let accel = n <= SYMBOLIC_SOLVE_MAX_DOF && links.is_none();
+    let accel = n <= SYMBOLIC_SOLVE_MAX_DOF && !links.as_ref().is_some_and(|l| l.mass_bias);
     let accel_tape = if accel {
         let (qdd, pivots) = solve_accelerations(&mut cas, &eq.mass_upper, &eq.bias);
         let outs: Vec<_> = qdd.into_iter().chain(pivots).collect();

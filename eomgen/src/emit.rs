@@ -473,7 +473,9 @@ fn emit_link_recursion(
         defs.push(KernelEmitter::new(pose).emit(&name_p, n, CELL_PARAMS));
         let fp = Ident::new(&name_p, Span::call_site());
         defs.push(KernelEmitter::new(tape).emit(&name, n, CELL_PARAMS));
-        defs.push(KernelEmitter::new_lanes(tape).emit(&name4, n, CELL_PARAMS));
+        if links.mass_bias {
+            defs.push(KernelEmitter::new_lanes(tape).emit(&name4, n, CELL_PARAMS));
+        }
         defs.push(KernelEmitter::new(tangent).emit(&name_t, n, CELL_PARAMS));
         let (f, f4, ft) = (
             Ident::new(&name, Span::call_site()),
@@ -563,6 +565,20 @@ fn emit_link_recursion(
         let rows = runtime::links::padded(dof);
         quote!(runtime::links::mass_bias_shared::<#rows, _>(&LINKS, &mut cells, q, qd, p, out))
     };
+    // Lane kernels serve the recursion's mass + bias alone.
+    let four = match links.mass_bias {
+        true => quote! {
+            #[cfg(target_arch = "x86_64")]
+            #[inline(always)]
+            fn four(&mut self, c: usize, x: &[[f64; 4]], xd: &[[f64; 4]], p: &[[f64; 4]], out: &mut [[f64; 4]]) {
+                match c {
+                    #(#fours)*
+                    _ => unreachable!("cell index from the layout"),
+                }
+            }
+        },
+        false => quote!(),
+    };
     let cells_impl = quote! {
         /// The compiled cells and forces the link recursion evaluates.
         #[allow(dead_code)] // the arm's coordinates serve the forces kernel alone
@@ -579,14 +595,7 @@ fn emit_link_recursion(
                     _ => unreachable!("cell index from the layout"),
                 }
             }
-            #[cfg(target_arch = "x86_64")]
-            #[inline(always)]
-            fn four(&mut self, c: usize, x: &[[f64; 4]], xd: &[[f64; 4]], p: &[[f64; 4]], out: &mut [[f64; 4]]) {
-                match c {
-                    #(#fours)*
-                    _ => unreachable!("cell index from the layout"),
-                }
-            }
+            #four
             #[inline(always)]
             #[allow(unused_variables)]
             fn forces(&mut self, out: &mut [f64]) {
@@ -618,12 +627,29 @@ fn emit_link_recursion(
             }
         }
     };
-    let json = serde_json::to_string(layout).expect("a link layout serialises");
     let doc = format!(
         " Kernel `mass_bias`: the link recursion (`runtime::links`) over {} links, {} cell(s).",
         layout.links.len(),
         links.cells.len()
     );
+    let mass_bias = match links.mass_bias {
+        true => quote! {
+            #[doc = #doc]
+            #[allow(unused_variables)]
+            pub fn mass_bias(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+                runtime::cpu::require_fma();
+                // SAFETY: `require_fma` has checked that the processor has FMA.
+                unsafe { mass_bias_links(q, qd, p, out) }
+            }
+            #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+            unsafe fn mass_bias_links(q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+                let mut cells = LinkCells { q, qd, p };
+                #call
+            }
+        },
+        false => quote!(),
+    };
+    let json = serde_json::to_string(layout).expect("a link layout serialises");
     let doc_jvp = format!(
         " Kernel `jvp`: the inverse dynamics' tangent by the link recursion (`runtime::links::inverse_dynamics_tangent`) over {} links.",
         layout.links.len(),
@@ -632,18 +658,7 @@ fn emit_link_recursion(
         static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(|| {
             serde_json::from_str(#json).expect("the generated link layout parses")
         });
-        #[doc = #doc]
-        #[allow(unused_variables)]
-        pub fn mass_bias(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
-            runtime::cpu::require_fma();
-            // SAFETY: `require_fma` has checked that the processor has FMA.
-            unsafe { mass_bias_links(q, qd, p, out) }
-        }
-        #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-        unsafe fn mass_bias_links(q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
-            let mut cells = LinkCells { q, qd, p };
-            #call
-        }
+        #mass_bias
         #[doc = #doc_jvp]
         #[allow(unused_variables)]
         pub fn jvp(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #dof]) {
@@ -772,12 +787,9 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     for kind in KernelKind::ALL {
         let name = kind.name();
         match (&tapes.links, kind) {
-            (Some(links), KernelKind::MassBias) => {
-                let n_out = tapes.mass_bias.outputs.len();
-                kernels.push(emit_link_recursion(links, dof, n_params, n_out));
-            }
-            // Emitted with the recursion, above.
+            // Emitted with the recursion, below.
             (Some(_), KernelKind::Jvp | KernelKind::Outputs) => {}
+            (Some(links), KernelKind::MassBias) if links.mass_bias => {}
             _ => kernels.push(KernelEmitter::new(tapes.tape(kind)).emit(name, dof, n_params)),
         }
         let f = Ident::new(name, Span::call_site());
@@ -785,6 +797,10 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         arms.push(quote! {
             KernelKind::#variant => #f(inp.t, q, qd, qdd, dir, p, out.try_into().expect("output length")),
         });
+    }
+    if let Some(links) = &tapes.links {
+        let n_out = tapes.mass_bias.outputs.len();
+        kernels.push(emit_link_recursion(links, dof, n_params, n_out));
     }
     let tokens = quote! {
         use runtime::{Inputs, KernelKind, Kernels, ModelInfo};

@@ -259,7 +259,9 @@ pub struct Driven {
 }
 
 /// The ordered parameters of one structure, with an index per parameter.
-#[derive(Clone, Debug)]
+/// (The default is empty: what a link cell, whose parameters are its own,
+/// may not read.)
+#[derive(Clone, Debug, Default)]
 pub struct ParamLayout {
     params: Vec<Param>,
     index: HashMap<Param, usize>,

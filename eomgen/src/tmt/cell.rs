@@ -25,21 +25,26 @@ use runtime::links::{
 };
 
 use crate::cas::{Cas, ExprId, SymKind};
-use crate::model::{ElementParam, Method, Param, ParamLayout, Structure, Xyz};
+use crate::model::{ElementParam, Joints, Method, Param, ParamLayout, Structure, Xyz};
 
 use super::actuation::{segment_loads, strain_work, thinning};
+use super::planar_cell::derive_planar_cell;
 use super::spatial::{Frame, Springs, V3, arc};
 use super::system::{Coordinates, ParamSymbols};
 use crate::method::rom::RomFields;
 
-/// The layout and kernels of a model whose mass + bias the link recursion
-/// computes, or `None` when its structure is outside the recursion.
+/// The layout and kernels of a chain the link recursion covers, or `None`
+/// when its structure is outside it. Compiled 3D chains take every kernel
+/// from it; planar chains all but `MassBias` (and the symbolic solve on
+/// it), whose flat form is the quicker for their few coordinates.
 pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
-    let covered = st.dimensions == 3
-        && st
+    let spatial = st.dimensions == 3;
+    // A planar element is covered when it is one body (`planar_cell`).
+    let covered = (!spatial
+        || st
             .segments
             .iter()
-            .all(|g| crate::method::of(g.method).link_cells())
+            .all(|g| crate::method::of(g.method).link_cells()))
         && st.torques.is_empty()
         && !st.base_translates
         && st.base_turns == 0;
@@ -62,18 +67,26 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             incompressible: g.incompressible,
             rom: rom.is_some(),
             actuated: load.is_some(),
+            planar: (!spatial).then_some((g.method, g.joints)),
         };
         let c = match cells.iter().position(|(s, _)| *s == shape) {
             Some(c) => c,
             None => {
-                cells.push((shape, derive_cell(shape)));
+                let kernels = match spatial {
+                    true => derive_cell(shape),
+                    false => derive_planar_cell(g, shape.actuated)?,
+                };
+                cells.push((shape, kernels));
                 cells.len() - 1
             }
         };
-        let count = g.coordinates_3d();
+        let count = if spatial { g.coordinates_3d() } else { 1 };
         for e in 0..g.elements {
+            // A planar cell reads no spatial parameter: their slots repeat
+            // the length's.
+            let length = index(Param::Element(k, ElementParam::Length));
             let params = ElementParam::CELL
-                .map(|e| index(Param::Element(k, e)))
+                .map(|e| params.get(Param::Element(k, e)).unwrap_or(length))
                 .to_vec();
             let map = match &rom {
                 // Cell coordinate f is field f integrated over the slice;
@@ -123,10 +136,18 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         loads: actuated.len(),
         gravity: triple(Param::Gravity),
         base_position: triple(Param::BasePosition),
-        base_rotation: std::array::from_fn(|i| {
-            index(Param::BaseRotation((i / 3) as u8, (i % 3) as u8))
-        }),
-        base_quaternion: std::array::from_fn(|i| index(Param::BaseQuaternion(i as u8))),
+        base_rotation: match spatial {
+            true => {
+                std::array::from_fn(|i| index(Param::BaseRotation((i / 3) as u8, (i % 3) as u8)))
+            }
+            false => [0; 9],
+        },
+        base_quaternion: match spatial {
+            true => std::array::from_fn(|i| index(Param::BaseQuaternion(i as u8))),
+            false => [0; 4],
+        },
+        base_angle: (!spatial).then(|| index(Param::BaseAngle)),
+        variable_inertia: !spatial,
         tip_force: st.tip_force.then(|| triple(Param::TipForce)),
         tip_moment: st.tip_moment.then(|| triple(Param::TipMoment)),
         tip_frame: st.tip_frame_wrench,
@@ -147,6 +168,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     };
     let mut kernels = LinkKernels {
         layout,
+        mass_bias: spatial,
         forces,
         forces_tangent,
         energy,
@@ -174,6 +196,9 @@ struct Shape {
     /// Actuators load the link's strain (the last `ACTUATION_LOADS`
     /// parameters).
     actuated: bool,
+    /// A planar element of this method and joint placement
+    /// (`planar_cell`).
+    planar: Option<(Method, Joints)>,
 }
 
 /// The kernel of the actuated segments' loads (`actuation::segment_loads`,
@@ -229,7 +254,7 @@ fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(RomFields, usize)]) 
 /// dx first, then dxd): what `runtime::links::tangent` runs the recursion
 /// on in dual numbers. One tape, so the values and their derivatives share
 /// subexpressions.
-fn with_tangent(cas: &mut Cas, out: &[ExprId], x: &[ExprId], xd: &[ExprId]) -> Tape {
+pub(super) fn with_tangent(cas: &mut Cas, out: &[ExprId], x: &[ExprId], xd: &[ExprId]) -> Tape {
     let n = x.len();
     let mut along = Vec::with_capacity(2 * n);
     for (i, &v) in x.iter().chain(xd).enumerate() {
@@ -252,6 +277,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         incompressible,
         rom,
         actuated,
+        ..
     } = shape;
     let mut cas = Cas::new();
     let cas = &mut cas;

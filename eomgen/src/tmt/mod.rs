@@ -7,6 +7,7 @@ mod cell;
 mod chain;
 mod inertia;
 pub(crate) mod planar;
+mod planar_cell;
 mod solve;
 pub(crate) mod spatial;
 pub(crate) mod system;

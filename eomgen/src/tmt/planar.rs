@@ -56,9 +56,9 @@ pub(crate) struct Element2 {
     pub l: ExprId,
     pub m: ExprId,
     pub inertia: ExprId,
-    stiff: ExprId,
-    damp: ExprId,
-    rest: ExprId,
+    pub stiff: ExprId,
+    pub damp: ExprId,
+    pub rest: ExprId,
 }
 
 impl<'a> PlanarArm<'a> {
@@ -92,6 +92,37 @@ impl<'a> PlanarArm<'a> {
             seeds: base.seeds,
             k: 0,
         }
+    }
+
+    /// An arm at rest at the origin (angle 0, height 0) for one element
+    /// derived on its own: a planar link cell (`tmt::planar_cell`).
+    pub fn at_origin(cas: &mut Cas, coords: Coordinates, symbols: &'a ParamSymbols) -> Self {
+        let zero = cas.zero();
+        Self {
+            symbols,
+            coords,
+            zero,
+            f: Frame {
+                x: zero,
+                y: zero,
+                phi: zero,
+                w: zero,
+            },
+            z: zero,
+            bodies: Vec::new(),
+            elastic: Vec::new(),
+            rayleigh: Vec::new(),
+            links: Vec::new(),
+            body_link: Vec::new(),
+            strains: Vec::new(),
+            seeds: Vec::new(),
+            k: 0,
+        }
+    }
+
+    /// The bodies placed so far.
+    pub fn bodies(&self) -> &[Body] {
+        &self.bodies
     }
 
     /// The next element, of segment s: in the plane every element bends

@@ -64,12 +64,24 @@ pub mod cell {
     pub const AXIAL: usize = 44;
     /// Then per coordinate c: the end frame's angular velocity column and
     /// end point velocity column (6), the body's angular and centroid
-    /// velocity columns (6), and last the n generalised elastic and
-    /// dissipative forces.
+    /// velocity columns (6); then the n generalised elastic and
+    /// dissipative forces; last the n derivatives of an isotropic body
+    /// inertia in the coordinates (read when the layout has
+    /// `variable_inertia`: a planar pcc arc's; zero otherwise).
     pub const COLUMNS: usize = 45;
 
-    pub fn len(n: usize) -> usize {
+    /// Where the generalised forces of a cell of `n` coordinates start.
+    pub const fn forces(n: usize) -> usize {
+        COLUMNS + 12 * n
+    }
+
+    /// Where the inertia derivatives start.
+    pub const fn inertia_rates(n: usize) -> usize {
         COLUMNS + 13 * n
+    }
+
+    pub const fn len(n: usize) -> usize {
+        COLUMNS + 14 * n
     }
 }
 
@@ -137,8 +149,17 @@ pub struct LinkLayout {
     pub loads: usize,
     pub gravity: [usize; 3],
     pub base_position: [usize; 3],
-    /// Rows of the base rotation.
+    /// Rows of the base rotation (3D chains).
     pub base_rotation: [usize; 9],
+    /// A planar chain's base angle about z, which stands for the rotation
+    /// and quaternion parameters.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base_angle: Option<usize>,
+    /// Bodies whose (isotropic) inertia changes with the cell coordinates
+    /// (planar pcc arcs): the recursion adds the torque I' w and the forces
+    /// -|w|^2 dI/dx / 2 of T = I(x) |w|^2 / 2 ([`cell::inertia_rates`]).
+    #[serde(default)]
+    pub variable_inertia: bool,
     /// The base orientation as a quaternion (w, x, y, z).
     #[serde(default)]
     pub base_quaternion: [usize; 4],
@@ -182,6 +203,11 @@ impl LinkLayout {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct LinkKernels {
     pub layout: LinkLayout,
+    /// Whether compiled code takes `MassBias` from the recursion too (3D
+    /// chains); planar chains keep the flat kernel, quicker for their few
+    /// coordinates, and take the Jvp and outputs from here.
+    #[serde(default)]
+    pub mass_bias: bool,
     pub cells: Vec<crate::Tape>,
     /// Each cell's pose cell ([`pose`]), for [`outputs`].
     #[serde(default)]
@@ -262,6 +288,25 @@ pub trait Cells {
     /// The strain energy the non-local forces derive from
     /// ([`LinkLayout::forces`]).
     fn energy(&mut self) -> f64;
+}
+
+/// The base frame's rotation (rows) and quaternion (w, x, y, z): from the
+/// rotation and quaternion parameters, or about z by a planar base angle.
+pub(crate) fn base_orientation(layout: &LinkLayout, p: &[f64]) -> ([[f64; 3]; 3], [f64; 4]) {
+    match layout.base_angle {
+        Some(i) => {
+            let (s, c) = p[i].sin_cos();
+            let (sh, ch) = (0.5 * p[i]).sin_cos();
+            (
+                [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]],
+                [ch, 0.0, 0.0, sh],
+            )
+        }
+        None => (
+            std::array::from_fn(|i| std::array::from_fn(|j| p[layout.base_rotation[3 * i + j]])),
+            layout.base_quaternion.map(|i| p[i]),
+        ),
+    }
 }
 
 /// A link's cell coordinates (or their rates, accelerations, directions)
@@ -413,7 +458,7 @@ struct Link {
 /// Most coordinates a cell has (bend pair, twist, stretch).
 pub const MAX_LINK_DOF: usize = 4;
 /// Room for the outputs of any cell.
-const CELL_STRIDE: usize = cell::COLUMNS + 13 * MAX_LINK_DOF;
+const CELL_STRIDE: usize = cell::len(MAX_LINK_DOF);
 
 type Twist = (V3, V3);
 
@@ -546,8 +591,7 @@ fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scra
     evaluate_cells(layout, cells, p, s);
 
     let gravity = layout.gravity.map(|i| p[i]);
-    let mut r: M3 =
-        std::array::from_fn(|i| std::array::from_fn(|j| p[layout.base_rotation[3 * i + j]]));
+    let mut r: M3 = base_orientation(layout, p).0;
     let mut pos = layout.base_position.map(|i| p[i]);
     let (mut omega, mut alpha, mut acc) = ([0.0; 3], [0.0; 3], [0.0; 3]);
     for (k, spec) in layout.links.iter().enumerate() {
@@ -595,7 +639,7 @@ fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scra
                 cross(body_w, iw),
             ),
         };
-        let force_at = cell::COLUMNS + 12 * nc;
+        let force_at = cell::forces(nc);
         for f in 0..nc {
             let col = cell::COLUMNS + 12 * f;
             let s_w = turn(col);
@@ -603,6 +647,17 @@ fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scra
             s.twist[at + f] = (s_w, sub(v_end, cross(s_w, end)));
             s.own[at + f] = (turn(col + 6), turn(col + 9));
             s.local_force[at + f] = c(force_at + f);
+        }
+        if layout.variable_inertia {
+            // T = I(x) |w|^2 / 2: d(I w)/dt has I' w besides I alpha, and
+            // dT/dx = |w|^2 dI/dx / 2 (an isotropic body: no gyroscopic term).
+            let rates = cell::inertia_rates(nc);
+            let i_dot: f64 = (0..nc).map(|f| c(rates + f) * s.xd[k][f]).sum();
+            let half_w2 = 0.5 * dot(body_w, body_w);
+            s.links[k].torque = add(s.links[k].torque, scale(i_dot, body_w));
+            for f in 0..nc {
+                s.local_force[at + f] -= half_w2 * c(rates + f);
+            }
         }
 
         // The next frame.

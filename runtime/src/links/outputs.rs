@@ -65,9 +65,7 @@ pub fn outputs<C: Cells>(
     out: &mut [f64],
 ) {
     let gravity: V3 = layout.gravity.map(|i| p[i]);
-    let mut r: M3 =
-        std::array::from_fn(|i| std::array::from_fn(|j| p[layout.base_rotation[3 * i + j]]));
-    let mut quat = layout.base_quaternion.map(|i| p[i]);
+    let (mut r, mut quat) = super::base_orientation(layout, p);
     let mut pos = layout.base_position.map(|i| p[i]);
     let (mut v, mut omega) = ([0.0; 3], [0.0; 3]);
     let (mut ke, mut pe) = (0.0, 0.0);

@@ -178,10 +178,9 @@ pub fn inverse_dynamics_tangent<C: Cells>(
     assert!(layout.links.iter().all(|l| l.map.len() <= MAX_LINK_DOF));
     let (dq, dqd) = dir.split_at(n);
     let gravity: V3 = layout.gravity.map(|i| Dual::constant(p[i]));
+    let base = super::base_orientation(layout, p).0;
     let mut frame = Frame {
-        r: std::array::from_fn(|i| {
-            std::array::from_fn(|j| Dual::constant(p[layout.base_rotation[3 * i + j]]))
-        }),
+        r: base.map(|row| row.map(Dual::constant)),
         pos: layout.base_position.map(|i| Dual::constant(p[i])),
         omega: V0,
         alpha: V0,
@@ -204,7 +203,19 @@ pub fn inverse_dynamics_tangent<C: Cells>(
         } else {
             cells.tangent(spec.cell, x, xd, dx, dxd, params, out);
         }
-        links.push(link_forward(&mut frame, out, nc, &xdd, gravity));
+        let xd: [Dual; MAX_LINK_DOF] = std::array::from_fn(|f| Dual {
+            v: xd.get(f).copied().unwrap_or(0.0),
+            d: dxd.get(f).copied().unwrap_or(0.0),
+        });
+        let inertia_rates = layout.variable_inertia.then_some(&xd);
+        links.push(link_forward(
+            &mut frame,
+            out,
+            nc,
+            &xdd,
+            inertia_rates,
+            gravity,
+        ));
     }
     let mut wrench = tip_wrench(layout, &frame, p, gravity);
 
@@ -252,6 +263,7 @@ fn link_forward(
     out: &[f64],
     nc: usize,
     xdd: &[f64; MAX_LINK_DOF],
+    inertia_rates: Option<&[Dual; MAX_LINK_DOF]>,
     gravity: V3,
 ) -> LinkForces {
     let len = cell::len(nc);
@@ -293,20 +305,34 @@ fn link_forward(
         w_b_d = add(w_b_d, scale(xdd, own_w));
         twist[f] = (s_w, sub(v_end, cross(s_w, end)));
         own[f] = (own_w, own_v);
-        local_force[f] = o(cell::COLUMNS + 12 * nc + f);
+        local_force[f] = o(cell::forces(nc) + f);
     }
 
     let body_a = point_accel(acc, alpha, omega, cen, cend, cendd);
     let body_w = add(omega, w_b);
     let body_alpha = add(add(alpha, cross(omega, w_b)), w_b_d);
     let iw = apply_body(lateral, axial, axis, body_w);
+    let mut torque = add(
+        apply_body(lateral, axial, axis, body_alpha),
+        cross(body_w, iw),
+    );
+    if let Some(xd) = inertia_rates {
+        // As `forward` in `links`: the torque I' w and -|w|^2 dI/dx / 2.
+        let rates = cell::inertia_rates(nc);
+        let mut i_dot = Dual::ZERO;
+        for (f, &xd) in xd.iter().enumerate().take(nc) {
+            i_dot = i_dot + o(rates + f) * xd;
+        }
+        let half_w2 = Dual::constant(0.5) * dot(body_w, body_w);
+        torque = add(torque, scale(i_dot, body_w));
+        for (f, force) in local_force.iter_mut().enumerate().take(nc) {
+            *force = *force - half_w2 * o(rates + f);
+        }
+    }
     let forces = LinkForces {
         centroid: add(pos, cen),
         force: scale(m, sub(body_a, gravity)),
-        torque: add(
-            apply_body(lateral, axial, axis, body_alpha),
-            cross(body_w, iw),
-        ),
+        torque,
         twist,
         own,
         local_force,
