@@ -13,6 +13,8 @@ pub mod chain32;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod double_pendulum;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod ebr_arm;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod hybrid_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod long_arm;
@@ -65,6 +67,13 @@ pub static MODELS: &[CompiledModel] = &[
         dof: double_pendulum::DOF,
         source: include_str!("../models/double_pendulum.toml"),
         kernels: || Box::new(double_pendulum::Compiled::default()),
+    },
+    CompiledModel {
+        name: "ebr_arm",
+        hash: ebr_arm::HASH,
+        dof: ebr_arm::DOF,
+        source: include_str!("../models/ebr_arm.toml"),
+        kernels: || Box::new(ebr_arm::Compiled::default()),
     },
     CompiledModel {
         name: "hybrid_arm",

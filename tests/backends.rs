@@ -433,6 +433,23 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
         (&actuated2d, &["tip.wrench_frame=\"tip\""]),
         ("stiff_flop", &[]),
         ("stiff_flop", &["segment.0.method=rom", "segment.0.order=2"]),
+        // ebr: each element two links, the half before its joint without
+        // coordinates.
+        ("ebr_arm", &[]),
+        ("stiff_flop", &["segment.0.method=ebr"]),
+        (
+            "cantilever3d",
+            &[
+                "segment.0.method=ebr",
+                "segment.0.extension=true",
+                "segment.0.incompressible=true",
+                "segment.0.twist=false",
+                "tip.length=0.05",
+                "tip.mass=0.005",
+                "tip.radius=0.005",
+                "gravity=[0,-9.81,0]",
+            ],
+        ),
         (&actuated, &[]),
         (&actuated, &["segment.1.incompressible=true"]),
     ];

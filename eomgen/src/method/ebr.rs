@@ -5,9 +5,10 @@
 
 use super::{ModellingMethod, needs_bending_stiffness, strain_coordinate_names};
 use crate::cas::Cas;
+use crate::cas::ExprId;
 use crate::model::{Check, ModelError, Segment, SegmentShape};
 use crate::tmt::spatial::{
-    SpatialArm, advance, coefficients, compose, left_jacobian, rotation, rotation_quat,
+    Frame, SpatialArm, V3, advance, coefficients, compose, left_jacobian, rotation, rotation_quat,
 };
 
 pub(super) struct Ebr;
@@ -25,6 +26,12 @@ impl ModellingMethod for Ebr {
         strain_coordinate_names(g, s)
     }
 
+    /// Each element is two links of the recursion: the half before the
+    /// joint (no coordinates) and the joint with the half past it.
+    fn link_cells(&self) -> bool {
+        true
+    }
+
     fn build_spatial(&self, cas: &mut Cas, arm: &mut SpatialArm, g: &SegmentShape, s: usize) {
         for _ in 0..g.elements {
             let el = arm.element();
@@ -33,22 +40,46 @@ impl ModellingMethod for Ebr {
             let (rho, rate) = (st.rho, st.rate);
             let (quarter, half) = (cas.scaled(0.25, el.l), cas.scaled(0.5, el.l));
             let half_m = cas.scaled(0.5, el.m);
-            let b = advance(cas, &arm.f, quarter);
-            arm.bodies.push(el.body(arm.f.axis(), b.p, arm.f.w, half_m));
-            arm.advance(cas, half);
-            let wsq = cas.dot(&rho, &rho);
-            let wsq = cas.bind(wsq);
-            let [c0, c1, c2, c3] = coefficients(cas, wsq, [0, 1, 2, 3]);
-            let r_rel = rotation(cas, &rho, [c0, c1, c2]);
-            let w_rel = left_jacobian(cas, &rho, &rate, [c1, c2, c3]);
-            let q_rel = rotation_quat(cas, &rho, wsq);
-            arm.f = compose(cas, &arm.f, Some((&r_rel, &q_rel)), None, Some(&w_rel));
-            let b_len = cas.add(half, st.stretch);
-            let half_b = cas.scaled(0.5, b_len);
-            let b = advance(cas, &arm.f, half_b);
-            arm.bodies.push(el.body(arm.f.axis(), b.p, arm.f.w, half_m));
-            arm.advance(cas, b_len);
+            let (b, end) = before_joint(cas, &arm.f, quarter, half);
+            arm.bodies.push(el.body(arm.f.axis(), b, arm.f.w, half_m));
+            arm.f = end;
+            let (b, axis, omega, end) = past_joint(cas, &arm.f, &rho, &rate, half, st.stretch);
+            arm.bodies.push(el.body(axis, b, omega, half_m));
+            arm.f = end;
             arm.close_link(first);
         }
     }
+}
+
+/// The half of an ebr element before its joint, from frame `f`: its body's
+/// centroid (a quarter element along) and the joint's frame (a half).
+pub(crate) fn before_joint(cas: &mut Cas, f: &Frame, quarter: ExprId, half: ExprId) -> (V3, Frame) {
+    let b = advance(cas, f, quarter);
+    (b.p, advance(cas, f, half))
+}
+
+/// The part of an ebr element past its joint, from the joint's frame `f`:
+/// the turn exp([rho]x), then the half element of length `half +
+/// stretch`: its body's centroid, axis and angular velocity, and the end
+/// frame (as `spatial::arc` gives them for a pcc element).
+pub(crate) fn past_joint(
+    cas: &mut Cas,
+    f: &Frame,
+    rho: &V3,
+    rate: &V3,
+    half: ExprId,
+    stretch: ExprId,
+) -> (V3, V3, V3, Frame) {
+    let wsq = cas.dot(rho, rho);
+    let wsq = cas.bind(wsq);
+    let [c0, c1, c2, c3] = coefficients(cas, wsq, [0, 1, 2, 3]);
+    let r_rel = rotation(cas, rho, [c0, c1, c2]);
+    let w_rel = left_jacobian(cas, rho, rate, [c1, c2, c3]);
+    let q_rel = rotation_quat(cas, rho, wsq);
+    let joint = compose(cas, f, Some((&r_rel, &q_rel)), None, Some(&w_rel));
+    let b_len = cas.add(half, stretch);
+    let half_b = cas.scaled(0.5, b_len);
+    let b = advance(cas, &joint, half_b);
+    let end = advance(cas, &joint, b_len);
+    (b.p, joint.axis(), joint.w, end)
 }

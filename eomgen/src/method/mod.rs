@@ -14,7 +14,7 @@
 
 mod cosserat;
 mod eba;
-mod ebr;
+pub(crate) mod ebr;
 mod pcc;
 mod rigid;
 pub(crate) mod rom;

@@ -31,6 +31,7 @@ use super::actuation::{segment_loads, strain_work, thinning};
 use super::planar_cell::derive_planar_cell;
 use super::spatial::{Frame, Springs, V3, arc};
 use super::system::{Coordinates, ParamSymbols};
+use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
 
 /// The layout and kernels of a chain the link recursion covers, or `None`
@@ -68,18 +69,34 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             rom: rom.is_some(),
             actuated: load.is_some(),
             planar: (!spatial).then_some((g.method, g.joints)),
+            kind: match g.method {
+                Method::Ebr => CellKind::PastJoint,
+                _ => CellKind::Arc,
+            },
         };
-        let c = match cells.iter().position(|(s, _)| *s == shape) {
-            Some(c) => c,
-            None => {
-                let kernels = match spatial {
-                    true => derive_cell(shape),
-                    false => derive_planar_cell(g, shape.actuated)?,
-                };
-                cells.push((shape, kernels));
-                cells.len() - 1
+        let mut cell_of = |shape: Shape| -> Option<usize> {
+            if let Some(c) = cells.iter().position(|(s, _)| *s == shape) {
+                return Some(c);
             }
+            let kernels = match spatial {
+                true => derive_cell(shape),
+                false => derive_planar_cell(g, shape.actuated)?,
+            };
+            cells.push((shape, kernels));
+            Some(cells.len() - 1)
         };
+        let c = cell_of(shape)?;
+        // An ebr element's first half is a link of its own, before the
+        // joint's.
+        let before = (shape.kind == CellKind::PastJoint)
+            .then(|| {
+                cell_of(Shape {
+                    kind: CellKind::BeforeJoint,
+                    actuated: false,
+                    ..shape
+                })
+            })
+            .flatten();
         let count = if spatial { g.coordinates_3d() } else { 1 };
         for e in 0..g.elements {
             // A planar cell reads no spatial parameter: their slots repeat
@@ -113,6 +130,14 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                     })
                     .collect(),
             };
+            if let Some(b) = before {
+                links.push(LinkSpec {
+                    cell: b,
+                    map: Vec::new(),
+                    params: params.clone(),
+                    load: None,
+                });
+            }
             links.push(LinkSpec {
                 cell: c,
                 map,
@@ -199,6 +224,19 @@ struct Shape {
     /// A planar element of this method and joint placement
     /// (`planar_cell`).
     planar: Option<(Method, Joints)>,
+    /// What the link is of a 3D element.
+    kind: CellKind,
+}
+
+/// The kinematics of a 3D link.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum CellKind {
+    /// A constant-strain arc (pcc, vc, a rom slice).
+    Arc,
+    /// An ebr element's half before its joint: no coordinates.
+    BeforeJoint,
+    /// An ebr element's joint and the half past it.
+    PastJoint,
 }
 
 /// The kernel of the actuated segments' loads (`actuation::segment_loads`,
@@ -277,6 +315,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         incompressible,
         rom,
         actuated,
+        kind,
         ..
     } = shape;
     let mut cas = Cas::new();
@@ -287,6 +326,9 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     }
     if extension {
         names.push("stretch");
+    }
+    if kind == CellKind::BeforeJoint {
+        names.clear();
     }
     let q: Vec<ExprId> = (0..names.len())
         .map(|i| cas.symbol(names[i], SymKind::Q(i as u32)))
@@ -305,7 +347,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     let mut strain = [zero; 4];
     let mut rates = [zero; 4];
     let slots = [Some(0), Some(1), twist.then_some(2), extension.then_some(3)];
-    for (i, k) in slots.into_iter().flatten().enumerate() {
+    for (i, k) in slots.into_iter().flatten().take(q.len()).enumerate() {
         strain[k] = q[i];
         rates[k] = qd[i];
     }
@@ -338,7 +380,10 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
             stretch_damping: ds,
         }
     };
-    let (elastic, rayleigh) = springs.energies(cas, strain, rates, soft);
+    let (elastic, rayleigh) = match kind {
+        CellKind::BeforeJoint => (zero, zero),
+        _ => springs.energies(cas, strain, rates, soft),
+    };
     // The actuators' potential on the link's strain, as the whole arm has
     // it (the outputs' potential energy is the strain energy alone).
     let stored = elastic;
@@ -358,7 +403,23 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     };
     let rho = [tw, by, bz];
     let rate = [tw_d, by_d, bz_d];
-    let (centroid, axis, omega, end) = arc(cas, &identity, &rho, &rate, len);
+    let half_m = cas.scaled(0.5, m);
+    let (centroid, axis, omega, end, mass) = match kind {
+        CellKind::Arc => {
+            let (c, a, w, end) = arc(cas, &identity, &rho, &rate, len);
+            (c, a, w, end, m)
+        }
+        CellKind::BeforeJoint => {
+            let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
+            let (c, end) = before_joint(cas, &identity, quarter, half);
+            (c, identity.axis(), identity.w, end, half_m)
+        }
+        CellKind::PastJoint => {
+            let half = cas.scaled(0.5, l);
+            let (c, a, w, end) = past_joint(cas, &identity, &rho, &rate, half, st);
+            (c, a, w, end, half_m)
+        }
+    };
     let pairs: Vec<(ExprId, ExprId)> = q.iter().copied().zip(qd.iter().copied()).collect();
     let rates = |cas: &mut Cas, v: &V3| -> V3 {
         let r = cas.kinematic_rates(v, &pairs);
@@ -392,7 +453,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     ] {
         out[at..at + 3].copy_from_slice(&v);
     }
-    out[cell::MASS] = m;
+    out[cell::MASS] = mass;
     out[cell::LATERAL] = lateral;
     out[cell::AXIAL] = axial;
     let n = q.len();
@@ -425,7 +486,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     ] {
         pose_out[at..at + 3].copy_from_slice(&v);
     }
-    pose_out[pose::MASS] = m;
+    pose_out[pose::MASS] = mass;
     pose_out[pose::LATERAL] = lateral;
     pose_out[pose::AXIAL] = axial;
     pose_out[pose::QUAT..pose::QUAT + 4].copy_from_slice(&end.quat);
