@@ -7,8 +7,10 @@
 //! ratios hold even when the absolute figures move (BENCHMARKS.md).
 //!
 //! `cargo bench --bench interleaved -- cantilever chain tentacle3d`
-//! (`ROUNDS=50` for a quicker look). `recursion:tentacle3d` times the
-//! numeric element-by-element recursion of tests/common/pcc3d.rs instead.
+//! (`ROUNDS=50` for a quicker look). `rhs:MODEL` times the right-hand
+//! side instead (`runtime::accelerations`: mass + bias and the mass solve,
+//! or the generated symbolic solve); `recursion:tentacle3d` the numeric
+//! element-by-element recursion of tests/common/pcc3d.rs.
 
 #[path = "../tests/common/pcc3d.rs"]
 mod pcc3d;
@@ -48,13 +50,32 @@ fn main() {
                 Some(m) => (true, m),
                 None => (false, n.as_str()),
             };
+            let (rhs, model) = match model.strip_prefix("rhs:") {
+                Some(m) => (true, m),
+                None => (false, model),
+            };
             let l = load(model, &[], BackendChoice::Compiled, None)
                 .unwrap_or_else(|e| panic!("{model}: {e:#}"));
             let dof = l.arm.dof();
             let q: Vec<f64> = (0..dof).map(|i| 0.3 * ((i as f64) * 0.7).sin()).collect();
             let qd: Vec<f64> = (0..dof).map(|i| 0.2 * ((i as f64) * 1.3).cos()).collect();
             let mut out = vec![0.0; KernelKind::MassBias.output_len(l.arm.info())];
-            if recursion {
+            if rhs {
+                let mut ws = runtime::Workspace::new(dof);
+                let mut qdd = vec![0.0; dof];
+                Box::new(move || {
+                    runtime::accelerations(
+                        &*l.arm,
+                        &mut ws,
+                        0.0,
+                        black_box(&q),
+                        black_box(&qd),
+                        &mut qdd,
+                    )
+                    .expect("accelerations");
+                    black_box(&qdd);
+                })
+            } else if recursion {
                 let mut r = pcc3d::Pcc3d::new(&l.arm.info().parameters, l.arm.base_params());
                 Box::new(move || r.mass_bias(black_box(&q), black_box(&qd), &mut out))
                     as Box<dyn FnMut()>
