@@ -57,7 +57,19 @@ fn main() {
             let l = load(model, &[], BackendChoice::Compiled, None)
                 .unwrap_or_else(|e| panic!("{model}: {e:#}"));
             let dof = l.arm.dof();
-            let q: Vec<f64> = (0..dof).map(|i| 0.3 * ((i as f64) * 0.7).sin()).collect();
+            // Angles of a few tenths of a radian; stretches (metres) of
+            // a few tenths of a millimetre.
+            let names = &l.arm.info().coordinates;
+            let q: Vec<f64> = (0..dof)
+                .map(|i| {
+                    let scale = if names[i].contains("stretch") {
+                        1e-3
+                    } else {
+                        1.0
+                    };
+                    scale * 0.3 * ((i as f64) * 0.7).sin()
+                })
+                .collect();
             let qd: Vec<f64> = (0..dof).map(|i| 0.2 * ((i as f64) * 1.3).cos()).collect();
             let mut out = vec![0.0; KernelKind::MassBias.output_len(l.arm.info())];
             if rhs {

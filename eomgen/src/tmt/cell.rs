@@ -34,6 +34,12 @@ use super::system::{Coordinates, ParamSymbols};
 use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
 
+/// Chains of fewer links keep the flat `MassBias` and its symbolic solve:
+/// the recursion's overhead is not paid back below four links (the lanes
+/// take four at once). Measured on stiff_flop (two links, 8 DOF): right-hand
+/// side 757 ns flat against 1039 ns by the recursion (BENCHMARKS.md).
+const RECURSION_MIN_LINKS: usize = 4;
+
 /// The layout and kernels of a chain the link recursion covers, or `None`
 /// when its structure is outside it. Compiled 3D chains take every kernel
 /// from it; planar chains all but `MassBias` (and the symbolic solve on
@@ -191,9 +197,10 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         Some(kernels) => kernels.map(Some),
         None => [None, None, None],
     };
+    let mass_bias = spatial && layout.links.len() >= RECURSION_MIN_LINKS;
     let mut kernels = LinkKernels {
         layout,
-        mass_bias: spatial,
+        mass_bias,
         forces,
         forces_tangent,
         energy,
