@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use eomgen::cas::{Cas, SymKind};
-use eomgen::model::{Model, Override, Param, ParamLayout, Structure, load_model};
+use eomgen::model::{Method, Model, Override, Param, ParamLayout, Structure, load_model};
 use eomgen::tmt::{assemble, system};
 
 fn check(model: &Model, label: &str) {
@@ -90,6 +90,17 @@ fn composite_sums_equal_body_by_body_sums_on_every_bundled_model() {
             continue;
         }
         let model = load_model(&path, &[]).unwrap();
+        // rom shares its coordinates along a segment and eba has absolute
+        // ones: no chain, no composite sums (tests/backends.rs checks their
+        // link recursion and flat tapes instead).
+        let structure = Structure::of(&model);
+        if structure
+            .segments
+            .iter()
+            .any(|g| matches!(g.method, Method::Rom | Method::Eba))
+        {
+            continue;
+        }
         check(&model, &path.display().to_string());
         checked += 1;
     }
