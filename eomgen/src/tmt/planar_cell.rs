@@ -9,12 +9,13 @@
 //! midpoint joints) are not covered: their chains keep the flat kernels.
 
 use runtime::Tape;
-use runtime::links::{ACTUATION_LOADS, CELL_PARAMS, ELEMENT_PARAMS, cell, pose};
+use runtime::links::{ACTUATION_LOADS, CELL_PARAMS, ELEMENT_PARAMS};
 
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::SegmentShape;
 
 use super::actuation::strain_work;
+use super::cell::{LinkKinematics, Motion, Rates};
 use super::inertia::Inertia;
 use super::planar::{Element2, PlanarArm, half_k_sq};
 use super::system::{Coordinates, ParamSymbols};
@@ -70,85 +71,29 @@ pub(super) fn derive_planar_cell(g: &SegmentShape, actuated: bool) -> Option<[Ta
         stored
     };
 
-    let pairs = [(q, qd)];
-    let rate = |cas: &mut Cas, v: &[ExprId; 3]| -> [ExprId; 3] {
-        let r = cas.time_derivatives(v, &pairs);
-        [r[0], r[1], r[2]]
-    };
-    let end = [f.x, f.y, zero];
-    let end_rate = rate(cas, &end);
-    let end_accel = rate(cas, &end_rate);
-    let omega = [zero, zero, f.w];
-    let omega_rate = rate(cas, &omega);
-    let centroid = [centroid[0], centroid[1], zero];
-    let centroid_rate = rate(cas, &centroid);
-    let centroid_accel = rate(cas, &centroid_rate);
-    let body_omega = [zero, zero, body_w];
-    let body_omega_rate = rate(cas, &body_omega);
     let (c, s) = (cas.cos(f.phi), cas.sin(f.phi));
     let ns = cas.neg(s);
-    let rotation = [[c, ns, zero], [s, c, zero], [zero, zero, one]];
-    let axis = [one, zero, zero];
-
-    let mut out = vec![zero; cell::len(1)];
-    for i in 0..3 {
-        for j in 0..3 {
-            out[cell::ROTATION + 3 * i + j] = rotation[i][j];
-        }
-    }
-    for (at, v) in [
-        (cell::END, end),
-        (cell::END_RATE, end_rate),
-        (cell::END_ACCEL, end_accel),
-        (cell::OMEGA, omega),
-        (cell::OMEGA_RATE, omega_rate),
-        (cell::CENTROID, centroid),
-        (cell::CENTROID_RATE, centroid_rate),
-        (cell::CENTROID_ACCEL, centroid_accel),
-        (cell::BODY_OMEGA, body_omega),
-        (cell::BODY_OMEGA_RATE, body_omega_rate),
-        (cell::AXIS, axis),
-    ] {
-        out[at..at + 3].copy_from_slice(&v);
-    }
-    out[cell::MASS] = mass;
-    out[cell::LATERAL] = inertia;
-    out[cell::AXIAL] = inertia;
-    let columns = [&omega, &end_rate, &body_omega, &centroid_rate];
-    for (s, v) in columns.into_iter().enumerate() {
-        for k in 0..3 {
-            out[cell::COLUMNS + 3 * s + k] = cas.diff(v[k], qd);
-        }
-    }
-    let de = cas.diff(elastic, q);
-    let dr = cas.diff(rayleigh, qd);
-    out[cell::forces(1)] = cas.add(de, dr);
-    out[cell::inertia_rates(1)] = cas.diff(inertia, q);
-
-    let mut pose_out = vec![zero; pose::LEN];
-    for i in 0..3 {
-        for j in 0..3 {
-            pose_out[pose::ROTATION + 3 * i + j] = rotation[i][j];
-        }
-    }
-    for (at, v) in [
-        (pose::END, end),
-        (pose::END_RATE, end_rate),
-        (pose::OMEGA, omega),
-        (pose::CENTROID, centroid),
-        (pose::CENTROID_RATE, centroid_rate),
-        (pose::BODY_OMEGA, body_omega),
-        (pose::AXIS, axis),
-    ] {
-        pose_out[at..at + 3].copy_from_slice(&v);
-    }
-    pose_out[pose::MASS] = mass;
-    pose_out[pose::LATERAL] = inertia;
-    pose_out[pose::AXIAL] = inertia;
     let half = cas.scaled(0.5, f.phi);
-    pose_out[pose::QUAT] = cas.cos(half);
-    pose_out[pose::QUAT + 3] = cas.sin(half);
-    pose_out[pose::ENERGY] = stored;
+    let quat = [cas.cos(half), zero, zero, cas.sin(half)];
+    let kin = LinkKinematics::new(
+        cas,
+        Motion {
+            rotation: [[c, ns, zero], [s, c, zero], [zero, zero, one]],
+            end: [f.x, f.y, zero],
+            omega: [zero, zero, f.w],
+            quat,
+            centroid: [centroid[0], centroid[1], zero],
+            body_omega: [zero, zero, body_w],
+            // Isotropic: any axis.
+            axis: [one, zero, zero],
+        },
+        [mass, inertia, inertia, stored],
+        &[q],
+        &[qd],
+        Rates::Plain,
+    );
+    let out = kin.cell(cas, &[q], &[qd], elastic, rayleigh);
+    let pose_out = kin.pose(cas);
     Some([
         cas.to_tape(&out),
         super::cell::with_tangent(cas, &out, &[q], &[qd]),

@@ -351,27 +351,27 @@ pub(crate) fn cell_params<C: Cells>(
     }
 }
 
-type V3 = [f64; 3];
-type M3 = [[f64; 3]; 3];
+pub(super) type V3 = [f64; 3];
+pub(super) type M3 = [[f64; 3]; 3];
 
 #[inline(always)]
-fn add(a: V3, b: V3) -> V3 {
+pub(super) fn add(a: V3, b: V3) -> V3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 #[inline(always)]
-fn sub(a: V3, b: V3) -> V3 {
+pub(super) fn sub(a: V3, b: V3) -> V3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 #[inline(always)]
-fn scale(s: f64, a: V3) -> V3 {
+pub(super) fn scale(s: f64, a: V3) -> V3 {
     [s * a[0], s * a[1], s * a[2]]
 }
 #[inline(always)]
-fn dot(a: V3, b: V3) -> f64 {
+pub(super) fn dot(a: V3, b: V3) -> f64 {
     a[0].mul_add(b[0], a[1].mul_add(b[1], a[2] * b[2]))
 }
 #[inline(always)]
-fn cross(a: V3, b: V3) -> V3 {
+pub(super) fn cross(a: V3, b: V3) -> V3 {
     [
         a[1].mul_add(b[2], -(a[2] * b[1])),
         a[2].mul_add(b[0], -(a[0] * b[2])),
@@ -379,11 +379,11 @@ fn cross(a: V3, b: V3) -> V3 {
     ]
 }
 #[inline(always)]
-fn mat_vec(r: &M3, v: V3) -> V3 {
+pub(super) fn mat_vec(r: &M3, v: V3) -> V3 {
     [dot(r[0], v), dot(r[1], v), dot(r[2], v)]
 }
 #[inline(always)]
-fn mat_mat(a: &M3, b: &M3) -> M3 {
+pub(super) fn mat_mat(a: &M3, b: &M3) -> M3 {
     std::array::from_fn(|i| std::array::from_fn(|j| dot(a[i], [b[0][j], b[1][j], b[2][j]])))
 }
 #[inline(always)]

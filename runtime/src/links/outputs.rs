@@ -7,33 +7,11 @@
 //! size the slices times the coordinates; this is one pose cell per
 //! distinct cell.
 
-use super::{CELL_PARAMS, Cells, LinkLayout, MAX_LINK_DOF, cell_params, local, pose};
+use super::{
+    CELL_PARAMS, Cells, LinkLayout, M3, MAX_LINK_DOF, V3, add, cell_params, cross, dot, local,
+    mat_mat, mat_vec, pose, scale,
+};
 
-type V3 = [f64; 3];
-type M3 = [[f64; 3]; 3];
-
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn scale(s: f64, a: V3) -> V3 {
-    [s * a[0], s * a[1], s * a[2]]
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn mat_vec(r: &M3, v: V3) -> V3 {
-    [dot(r[0], v), dot(r[1], v), dot(r[2], v)]
-}
-fn mat_mat(a: &M3, b: &M3) -> M3 {
-    std::array::from_fn(|i| std::array::from_fn(|j| dot(a[i], [b[0][j], b[1][j], b[2][j]])))
-}
 /// The Hamilton product a b, (w, x, y, z).
 fn quat_mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
     [
