@@ -425,6 +425,13 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
         // with the bend), a turned base, actuators, tip bodies and loads.
         ("double_pendulum", &[]),
         ("chain", &["base.direction=[0.6,-0.8,0.0]"]),
+        ("chain32", &[]),
+        // Every bundled 3D model as it is.
+        ("cantilever3d", &[]),
+        ("tentacle3d", &[]),
+        ("vc_arm", &[]),
+        ("rom_arm", &[]),
+        ("stiff_flop_rom", &[]),
         ("cantilever", &["tip.mass=0.02"]),
         ("hybrid_arm", &[]),
         ("long_arm", &[]),
