@@ -13,6 +13,8 @@ pub mod chain32;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod double_pendulum;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod eba_arm;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod ebr_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod hybrid_arm;
@@ -67,6 +69,13 @@ pub static MODELS: &[CompiledModel] = &[
         dof: double_pendulum::DOF,
         source: include_str!("../models/double_pendulum.toml"),
         kernels: || Box::new(double_pendulum::Compiled::default()),
+    },
+    CompiledModel {
+        name: "eba_arm",
+        hash: eba_arm::HASH,
+        dof: eba_arm::DOF,
+        source: include_str!("../models/eba_arm.toml"),
+        kernels: || Box::new(eba_arm::Compiled::default()),
     },
     CompiledModel {
         name: "ebr_arm",

@@ -19,7 +19,14 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
             .map(|(_, v)| v)
             .collect();
         let compiled = Arm::new((m.kernels)(), p.clone());
-        let interpreted = Arm::new(Interpreted::new(eomgen::derive::derive(&l.model)), p);
+        let tapes = eomgen::derive::derive(&l.model);
+        // A system of parts (eba) takes its beam springs' gaps from
+        // positions relative to each other, the flat tape from absolute
+        // ones along the arm: the flat tape's round-off in h is the
+        // springs' stiffness times eps times the arm's length, about 1e-12
+        // of h (see `eba_parts_match_the_flat_tapes`).
+        let h_rel = if tapes.parts.is_some() { 1e-10 } else { 1e-12 };
+        let interpreted = Arm::new(Interpreted::new(tapes), p);
         assert_eq!(
             compiled.info(),
             interpreted.info(),
@@ -65,18 +72,12 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
                 let (m_scale, h_scale) = (largest(0..m_len.min(len)), largest(m_len.min(len)..len));
                 for k in 0..len {
                     assert!(a[k].is_finite(), "{} {kind:?}[{k}] not finite", m.name);
-                    let floor = match kind {
-                        KernelKind::MassBias if k < m_len => m_scale,
-                        KernelKind::MassBias => h_scale,
-                        _ => 0.0,
+                    let (rel, floor) = match kind {
+                        KernelKind::MassBias if k < m_len => (1e-12, m_scale),
+                        KernelKind::MassBias => (h_rel, h_scale),
+                        _ => (1e-12, 0.0),
                     };
-                    assert_close(
-                        a[k],
-                        b[k],
-                        1e-12,
-                        floor,
-                        &format!("{} {kind:?}[{k}]", m.name),
-                    );
+                    assert_close(a[k], b[k], rel, floor, &format!("{} {kind:?}[{k}]", m.name));
                 }
             }
             // The Jacobian's parts, column by column from the Jvp kernel.
@@ -85,8 +86,9 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
             compiled.jacobian_parts(t, &q, &qd, &qdd, &mut a);
             interpreted.jacobian_parts(t, &q, &qd, &qdd, &mut b);
             // Compiled chains take the Jvp from the link recursion in dual
-            // numbers (runtime/src/links/tangent.rs): another order of the
-            // same sums, held to 1e-12 of each block's largest entry.
+            // numbers (runtime/src/links/tangent.rs), eba from its parts:
+            // another order of the same sums, held to 1e-12 (parts: 1e-10,
+            // as h) of each block's largest entry.
             for k in 0..2 * n * n {
                 assert!(a[k].is_finite(), "{} Jacobian part {k} not finite", m.name);
                 let block = &b[(k / (n * n)) * n * n..][..n * n];
@@ -94,7 +96,7 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
                 assert_close(
                     a[k],
                     b[k],
-                    1e-12,
+                    h_rel,
                     floor,
                     &format!("{} Jacobian part {k}", m.name),
                 );
@@ -690,6 +692,174 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
                     dtau[i],
                     want_jvp[i],
                     1e-12,
+                    jvp_scale,
+                    &format!("jvp {what}"),
+                );
+            }
+        }
+    }
+}
+
+/// The part kernels evaluated from their tapes.
+struct TapeParts<'a> {
+    parts: &'a runtime::parts::PartKernels,
+    slots: Vec<f64>,
+}
+
+impl runtime::parts::Parts for TapeParts<'_> {
+    fn eval(&mut self, k: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+        let inp = runtime::Inputs {
+            t: 0.0,
+            q: x,
+            qd: xd,
+            qdd: &[],
+            dir: &[],
+            p,
+        };
+        self.parts.kernels[k].eval(&inp, &mut self.slots, out)
+    }
+    fn tangent(
+        &mut self,
+        k: usize,
+        x: &[f64],
+        xd: &[f64],
+        dx: &[f64],
+        dxd: &[f64],
+        p: &[f64],
+        out: &mut [f64],
+    ) {
+        let dir: Vec<f64> = dx.iter().chain(dxd).copied().collect();
+        let inp = runtime::Inputs {
+            t: 0.0,
+            q: x,
+            qd: xd,
+            qdd: &[],
+            dir: &dir,
+            p,
+        };
+        self.parts.tangents[k].eval(&inp, &mut self.slots, out)
+    }
+}
+
+/// An eba arm as a sum of parts (runtime/src/parts.rs: bodies, beam
+/// springs, the tip) against the flat `MassBias` and `Jvp` tapes of the
+/// whole system: M, h, tau and its directional derivative at 1e-12 of
+/// their scale, with tip bodies and loads, extension and thinning.
+#[test]
+fn eba_parts_match_the_flat_tapes() {
+    let dir = std::env::temp_dir().join("softarm-test-cache");
+    let cases: [&[&str]; 4] = [
+        &["segment.0.method=eba", "gravity=[1,-2,-9.81]"],
+        &[
+            "segment.0.method=eba",
+            "segment.0.elements=3",
+            "tip.force=[0.1,-0.2,0.05]",
+            "tip.moment=[0.01,0.02,-0.03]",
+            "gravity=[0,0,-9.81]",
+        ],
+        &[
+            "segment.0.method=eba",
+            "segment.0.incompressible=true",
+            "tip.mass=0.02",
+            "tip.length=0.03",
+            "tip.radius=0.01",
+            "tip.force=[0.1,0.2,0.3]",
+            "tip.wrench_frame=\"tip\"",
+            "base.direction=[0.6,0.0,0.8]",
+        ],
+        &["segment.0.method=eba", "segment.0.bending_damping=0.01"],
+    ];
+    let mut rng = Rng::new(29);
+    let mut models: Vec<(&str, &[&str])> = vec![("ebr_arm", &["segment.0.method=eba"])];
+    models.extend(cases.iter().map(|&s| ("cantilever3d", s)));
+    for (model, sets) in models {
+        let overrides: Vec<eomgen::model::Override> = sets
+            .iter()
+            .map(|s| eomgen::model::Override::parse(s).unwrap())
+            .collect();
+        let l = load(
+            model,
+            &overrides,
+            BackendChoice::Interpreted,
+            Some(dir.clone()),
+        )
+        .unwrap();
+        let tapes = eomgen::derive::derive(&l.model);
+        let parts = tapes
+            .parts
+            .clone()
+            .unwrap_or_else(|| panic!("parts cover {model} {sets:?}"));
+        let (flat, jvp) = (tapes.mass_bias.clone(), tapes.jvp.clone());
+        let p: Vec<f64> = eomgen::model::parameters(&l.model)
+            .into_iter()
+            .map(|(_, v)| v)
+            .collect();
+        let arm = Arm::new(Interpreted::new(tapes), p);
+        let p = arm.params().to_vec();
+        let n = arm.dof();
+        let mut tp = TapeParts {
+            parts: &parts,
+            slots: Vec::new(),
+        };
+        for trial in 0..4 {
+            let mut q = rng.vec(n, -0.3, 0.3);
+            if trial == 0 {
+                q.fill(0.0);
+            }
+            let qd = rng.vec(n, -2.0, 2.0);
+            let qdd = rng.vec(n, -5.0, 5.0);
+            let dir = rng.vec(2 * n, -1.0, 1.0);
+            let inp = runtime::Inputs {
+                t: 0.0,
+                q: &q,
+                qd: &qd,
+                qdd: &qdd,
+                dir: &dir,
+                p: &p,
+            };
+            let len = flat.outputs.len();
+            let (mut want, mut got) = (vec![0.0; len], vec![f64::NAN; len]);
+            flat.eval(&inp, &mut Vec::new(), &mut want);
+            runtime::parts::mass_bias(&parts.layout, &mut tp, &q, &qd, &p, &mut got);
+            let m_len = n * (n + 1) / 2;
+            let scale = |v: &[f64]| v.iter().fold(1e-300f64, |s, x| s.max(x.abs()));
+            let (m_scale, h_scale) = (scale(&want[..m_len]), scale(&want[m_len..]));
+            // The flat tape's beam springs act on the gap between element
+            // ends taken from their absolute positions along the arm, so
+            // its round-off is the springs' stiffness times eps times the
+            // arm's length (1e-12 of h here); the parts take positions
+            // relative to each other. h and the Jvp are held to 1e-10 of
+            // their scale, M to 1e-12.
+            for k in 0..len {
+                let (rel, floor) = if k < m_len {
+                    (1e-12, m_scale)
+                } else {
+                    (1e-10, h_scale)
+                };
+                let what = format!("{model} {sets:?} trial {trial} entry {k}");
+                assert_close(got[k], want[k], rel, floor, &what);
+            }
+            let mut want_jvp = vec![0.0; n];
+            jvp.eval(&inp, &mut Vec::new(), &mut want_jvp);
+            let (mut tau, mut dtau) = (vec![f64::NAN; n], vec![f64::NAN; n]);
+            runtime::parts::inverse_dynamics_tangent(
+                &parts.layout,
+                &mut tp,
+                &q,
+                &qd,
+                &qdd,
+                &dir,
+                &p,
+                &mut tau,
+                &mut dtau,
+            );
+            let jvp_scale = scale(&want_jvp);
+            for i in 0..n {
+                let what = format!("{model} {sets:?} trial {trial} coordinate {i}");
+                assert_close(
+                    dtau[i],
+                    want_jvp[i],
+                    1e-10,
                     jvp_scale,
                     &format!("jvp {what}"),
                 );

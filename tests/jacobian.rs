@@ -28,10 +28,23 @@ fn generated_jacobian_matches_central_differences() {
     .iter()
     .map(|s| eomgen::model::Override::parse(s).unwrap())
     .collect();
+    let eba: Vec<eomgen::model::Override> = [
+        "segment.0.method=eba",
+        "segment.0.elements=3",
+        "segment.0.bending_damping=1e-3",
+        "gravity=[0, -9.81, 0]",
+        "tip.force=[0.1, 0.2, -0.3]",
+    ]
+    .iter()
+    .map(|s| eomgen::model::Override::parse(s).unwrap())
+    .collect();
     let cases: Vec<(&str, &[eomgen::model::Override], BackendChoice)> = MODELS
         .iter()
         .map(|m| (m.name, &[][..], BackendChoice::Compiled))
-        .chain([("cantilever", &damped[..], BackendChoice::Interpreted)])
+        .chain([
+            ("cantilever", &damped[..], BackendChoice::Interpreted),
+            ("cantilever3d", &eba[..], BackendChoice::Interpreted),
+        ])
         .collect();
     for (name, sets, backend) in cases {
         let dir = std::env::temp_dir().join("softarm-test-cache");

@@ -54,6 +54,10 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
         derived,
         accel: accel_tape,
         jvp,
+        parts: match links {
+            None => crate::method::eba::part_kernels(structure, &layout),
+            Some(_) => None,
+        },
         links,
     }
 }

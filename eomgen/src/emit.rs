@@ -679,6 +679,92 @@ fn emit_link_recursion(
     }
 }
 
+/// `mass_bias` and `jvp` of a system of parts (`runtime::parts`): the
+/// layout as JSON and one kernel and its tangent per kind of part.
+fn emit_parts(
+    parts: &runtime::parts::PartKernels,
+    dof: usize,
+    n_params: usize,
+    n_out: usize,
+) -> TokenStream {
+    let mut defs = Vec::new();
+    let (mut evals, mut tangents) = (Vec::new(), Vec::new());
+    for (k, (tape, tangent)) in parts.kernels.iter().zip(&parts.tangents).enumerate() {
+        let spec = parts
+            .layout
+            .parts
+            .iter()
+            .find(|s| s.kernel == k)
+            .expect("every part kernel is used");
+        let (m, np) = (spec.coords.len(), spec.params.len());
+        let (name, name_t) = (format!("part_{k}"), format!("part_{k}_tangent"));
+        defs.push(KernelEmitter::new(tape).emit(&name, m, np));
+        defs.push(KernelEmitter::new(tangent).emit(&name_t, m, np));
+        let (f, ft) = (
+            Ident::new(&name, Span::call_site()),
+            Ident::new(&name_t, Span::call_site()),
+        );
+        let m2 = 2 * m;
+        evals.push(quote! {
+            #k => #f(0.0, x.try_into().expect("part coordinates"), xd.try_into().expect("part rates"),
+                     &[0.0; #m], &[0.0; #m2], p.try_into().expect("part parameters"),
+                     out.try_into().expect("part outputs")),
+        });
+        tangents.push(quote! {
+            #k => {
+                let mut dir = [0.0; #m2];
+                dir[..#m].copy_from_slice(dx);
+                dir[#m..].copy_from_slice(dxd);
+                #ft(0.0, x.try_into().expect("part coordinates"), xd.try_into().expect("part rates"),
+                    &[0.0; #m], &dir, p.try_into().expect("part parameters"),
+                    out.try_into().expect("part outputs and derivatives"))
+            }
+        });
+    }
+    let json = serde_json::to_string(&parts.layout).expect("a part layout serialises");
+    let n_dir = 2 * dof;
+    let doc = format!(
+        " Kernel `mass_bias`: the sum of {} parts (`runtime::parts`), {} kind(s).",
+        parts.layout.parts.len(),
+        parts.kernels.len()
+    );
+    quote! {
+        static PARTS: std::sync::LazyLock<runtime::parts::PartLayout> = std::sync::LazyLock::new(|| {
+            serde_json::from_str(#json).expect("the generated part layout parses")
+        });
+        /// The compiled part kernels.
+        struct PartKernels;
+        impl runtime::parts::Parts for PartKernels {
+            fn eval(&mut self, k: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+                match k {
+                    #(#evals)*
+                    _ => unreachable!("part kernel index from the layout"),
+                }
+            }
+            fn tangent(&mut self, k: usize, x: &[f64], xd: &[f64], dx: &[f64], dxd: &[f64], p: &[f64], out: &mut [f64]) {
+                match k {
+                    #(#tangents)*
+                    _ => unreachable!("part kernel index from the layout"),
+                }
+            }
+        }
+        #[doc = #doc]
+        #[allow(unused_variables)]
+        pub fn mass_bias(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+            runtime::cpu::require_fma();
+            runtime::parts::mass_bias(&PARTS, &mut PartKernels, q, qd, p, out)
+        }
+        /// Kernel `jvp`: the inverse dynamics' tangent, part by part (`runtime::parts`).
+        #[allow(unused_variables)]
+        pub fn jvp(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #dof]) {
+            runtime::cpu::require_fma();
+            let mut tau = [0.0; #dof];
+            runtime::parts::inverse_dynamics_tangent(&PARTS, &mut PartKernels, q, qd, qdd, dir, p, &mut tau, out)
+        }
+        #(#defs)*
+    }
+}
+
 /// Which member of its family an op is: the derivative order (sin 0, cos
 /// 1), and for the Rodrigues coefficients c_j also j.
 type Member = (u8, u8);
@@ -786,7 +872,11 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     let mut arms = Vec::new();
     for kind in KernelKind::ALL {
         let name = kind.name();
+        let by_parts =
+            tapes.parts.is_some() && matches!(kind, KernelKind::MassBias | KernelKind::Jvp);
         match (&tapes.links, kind) {
+            // Emitted with the parts, below.
+            _ if by_parts => {}
             // Emitted with the recursion, below.
             (Some(_), KernelKind::Jvp | KernelKind::Outputs) => {}
             (Some(links), KernelKind::MassBias) if links.mass_bias => {}
@@ -797,6 +887,10 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         arms.push(quote! {
             KernelKind::#variant => #f(inp.t, q, qd, qdd, dir, p, out.try_into().expect("output length")),
         });
+    }
+    if let Some(parts) = &tapes.parts {
+        let n_out = tapes.mass_bias.outputs.len();
+        kernels.push(emit_parts(parts, dof, n_params, n_out));
     }
     if let Some(links) = &tapes.links {
         let n_out = tapes.mass_bias.outputs.len();

@@ -158,6 +158,10 @@ pub struct TapeSet {
     /// the interpreter keeps the flat tape.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub links: Option<crate::links::LinkKernels>,
+    /// The parts of a system that is a sum of small kernels (eba), which
+    /// compiled models use for `MassBias` and `Jvp`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parts: Option<crate::parts::PartKernels>,
 }
 
 impl TapeSet {

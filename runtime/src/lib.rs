@@ -18,6 +18,7 @@ pub mod kernels;
 pub mod lanes;
 pub mod linalg;
 pub mod links;
+pub mod parts;
 pub mod rodrigues;
 pub mod rows;
 pub mod solver;

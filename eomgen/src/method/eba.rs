@@ -19,10 +19,17 @@
 //! A finite-difference rod (strains between element centres) that converges
 //! to the extensible, shearable Cosserat rod as l_e -> 0.
 
+use runtime::Tape;
+use runtime::parts::{PartKernels, PartLayout, PartSpec};
+
 use super::{ModellingMethod, needs_bending_stiffness};
-use crate::cas::{Cas, ExprId};
-use crate::model::{Check, ElementParam, Method, ModelError, Segment, SegmentShape, Structure};
+use crate::cas::{Cas, ExprId, SymKind};
+use crate::model::{
+    Check, ElementParam, Method, ModelError, Param, ParamLayout, Segment, SegmentShape, Structure,
+    Xyz,
+};
 use crate::tmt::actuation::{Strain, actuation, thinning};
+use crate::tmt::assemble;
 use crate::tmt::spatial::{
     M3, V3, add3, base_frame, bind3, coefficients, half_k_sq, left_jacobian, quat_mul, rotation,
     rotation_quat,
@@ -154,23 +161,9 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         });
         let centre = bind3(cas, centre);
         along = cas.add(along, l);
-        let w = cas.dot(&psi, &psi);
-        let w = cas.bind(w);
-        let [c0, c1, c2, c3] = coefficients(cas, w, [0, 1, 2, 3]);
-        let rel = rotation(cas, &psi, [c0, c1, c2]);
-        let r: M3 = std::array::from_fn(|i| {
-            std::array::from_fn(|j| {
-                let col = [rel[0][j], rel[1][j], rel[2][j]];
-                let e = cas.dot(&r0[i], &col);
-                cas.bind(e)
-            })
-        });
-        let w_local = left_jacobian(cas, &psi, &psi_d, [c1, c2, c3]);
-        let q_rel = rotation_quat(cas, &psi, w);
+        let (r, element_omega, q_rel) = element_frame(cas, &r0, &w0, &psi, &psi_d);
         quat = quat_mul(cas, &q0, &q_rel);
-        let turned = cas.turn(&r0, &w0, &w_local);
-        omega = add3(cas, &w0, &turned);
-        omega = bind3(cas, omega);
+        omega = element_omega;
         let axis = [r[0][0], r[1][0], r[2][0]];
         bodies.push(Body {
             mass: symbols.element(k, ElementParam::Mass),
@@ -186,7 +179,8 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
 
         // Beam springs to the previous element (or the clamp).
         let incompressible = structure.segments[segment].incompressible;
-        let joint = beam_springs(cas, symbols, k, &prev, &slab, incompressible, &pairs);
+        let jp = JointParams::of(symbols, k);
+        let joint = beam_springs(cas, &jp, k == 0, &prev, &slab, incompressible, &pairs);
         strains.push(Strain {
             segment,
             ..joint.strain
@@ -226,6 +220,28 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
     sys
 }
 
+/// An element's orientation R = R0 exp([psi]x) (rows), its angular
+/// velocity (the base's w0 plus R0 times the left Jacobian's rate) and the
+/// relative quaternion exp([psi]x).
+fn element_frame(cas: &mut Cas, r0: &M3, w0: &V3, psi: &V3, psi_d: &V3) -> (M3, V3, [ExprId; 4]) {
+    let w = cas.dot(psi, psi);
+    let w = cas.bind(w);
+    let [c0, c1, c2, c3] = coefficients(cas, w, [0, 1, 2, 3]);
+    let rel = rotation(cas, psi, [c0, c1, c2]);
+    let r: M3 = std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            let col = [rel[0][j], rel[1][j], rel[2][j]];
+            let e = cas.dot(&r0[i], &col);
+            cas.bind(e)
+        })
+    });
+    let w_local = left_jacobian(cas, psi, psi_d, [c1, c2, c3]);
+    let q_rel = rotation_quat(cas, psi, w);
+    let turned = cas.turn(r0, w0, &w_local);
+    let omega = add3(cas, w0, &turned);
+    (r, bind3(cas, omega), q_rel)
+}
+
 /// The beam springs between element k and the previous one (or the clamp):
 /// bending and twist on the relative rotation measure, axial and shear on
 /// the gap in the previous frame, thinned with the stretch if
@@ -237,25 +253,70 @@ struct BeamJoint {
     rayleigh: Vec<ExprId>,
 }
 
+/// The parameters of the beam springs to element k, in this order (as a
+/// joint part reads them after the previous element's length).
+#[derive(Clone, Copy)]
+struct JointParams {
+    l: ExprId,
+    kb: ExprId,
+    kt: ExprId,
+    db: ExprId,
+    dt: ExprId,
+    ka: ExprId,
+    da: ExprId,
+    ks: ExprId,
+}
+
+impl JointParams {
+    const ORDER: [ElementParam; 8] = [
+        ElementParam::Length,
+        ElementParam::BendStiffness,
+        ElementParam::TwistStiffness,
+        ElementParam::BendDamping,
+        ElementParam::TwistDamping,
+        ElementParam::StretchStiffness,
+        ElementParam::StretchDamping,
+        ElementParam::ShearStiffness,
+    ];
+
+    fn of(symbols: &ParamSymbols, k: usize) -> Self {
+        Self::from(Self::ORDER.map(|e| symbols.element(k, e)))
+    }
+
+    fn from([l, kb, kt, db, dt, ka, da, ks]: [ExprId; 8]) -> Self {
+        Self {
+            l,
+            kb,
+            kt,
+            db,
+            dt,
+            ka,
+            da,
+            ks,
+        }
+    }
+}
+
 fn beam_springs(
     cas: &mut Cas,
-    symbols: &ParamSymbols,
-    k: usize,
+    jp: &JointParams,
+    first: bool,
     prev: &Slab,
     slab: &Slab,
     incompressible: bool,
     pairs: &[(ExprId, ExprId)],
 ) -> BeamJoint {
-    let l = symbols.element(k, ElementParam::Length);
-    let first = k == 0;
     let span = if first { 2.0 } else { 1.0 }; // stiffness factor l_e / span
-    let kb = symbols.element(k, ElementParam::BendStiffness);
-    let kt = symbols.element(k, ElementParam::TwistStiffness);
-    let db = symbols.element(k, ElementParam::BendDamping);
-    let dt = symbols.element(k, ElementParam::TwistDamping);
-    let ka = symbols.element(k, ElementParam::StretchStiffness);
-    let da = symbols.element(k, ElementParam::StretchDamping);
-    let ks = symbols.element(k, ElementParam::ShearStiffness);
+    let JointParams {
+        l,
+        kb,
+        kt,
+        db,
+        dt,
+        ka,
+        da,
+        ks,
+    } = *jp;
     let r_rel = transpose_mul(cas, &prev.r, &slab.r);
     // 2 tan(theta / 2) n = 2 vee(R - R^T) / (1 + tr R): the relative
     // rotation to second order, and stiffening up to a half turn, so
@@ -318,4 +379,268 @@ fn beam_springs(
         elastic,
         rayleigh,
     }
+}
+
+/// The kernels of an eba arm as a sum of parts (`runtime::parts`): every
+/// element's body (one kernel for all), the beam springs between
+/// neighbours (one) and to the clamp (one), and the tip's loads and body
+/// (one, reading the model's parameters). Centres are taken relative to a
+/// common point, which changes neither M nor h, so a part does not depend
+/// on the arc length to its element. None for an arm with actuators, a
+/// moving base or joint torques (terms not split into parts yet).
+pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartKernels> {
+    let covered = st.segments.iter().all(|g| g.method == Method::Eba)
+        && !st.base_translates
+        && st.base_turns == 0
+        && st.torques.is_empty()
+        && st.chambers.iter().all(|&c| c == 0)
+        && st.tendons.is_empty();
+    if !covered {
+        return None;
+    }
+    let index = |p: Param| layout.index(p);
+    let r0: Vec<usize> = (0..9)
+        .map(|i| index(Param::BaseRotation((i / 3) as u8, (i % 3) as u8)))
+        .collect();
+    let joint = |k: usize| JointParams::ORDER.map(|e| index(Param::Element(k, e)));
+    let incompressible: Vec<bool> = st
+        .segments
+        .iter()
+        .flat_map(|g| std::iter::repeat_n(g.incompressible, g.elements))
+        .collect();
+    let mut kernels = PartKernels::default();
+    // Kernel keys: 0 body; 1 + (incompressible) clamp joint; 3 + (..) joint.
+    let mut keys: Vec<usize> = Vec::new();
+    let mut kernel = |kernels: &mut PartKernels, key: usize, make: &dyn Fn() -> [Tape; 2]| {
+        match keys.iter().position(|&x| x == key) {
+            Some(k) => k,
+            None => {
+                let [t, d] = make();
+                kernels.kernels.push(t);
+                kernels.tangents.push(d);
+                keys.push(key);
+                keys.len() - 1
+            }
+        }
+    };
+    let n = st.elements();
+    let mut parts = Vec::new();
+    for (k, &inc) in incompressible.iter().enumerate() {
+        let coords: Vec<usize> = (6 * k..6 * k + 6).collect();
+        let mut params: Vec<usize> = [ElementParam::Mass, ElementParam::Inertia]
+            .into_iter()
+            .chain([ElementParam::AxialInertia])
+            .map(|e| index(Param::Element(k, e)))
+            .collect();
+        params.extend(Xyz::ALL.map(|c| index(Param::Gravity(c))));
+        params.extend(&r0);
+        let b = kernel(&mut kernels, 0, &body_part);
+        parts.push(PartSpec {
+            kernel: b,
+            coords,
+            params,
+        });
+        let (coords, mut params, key) = match k {
+            0 => ((0..6).collect(), Vec::new(), 1 + inc as usize),
+            _ => (
+                (6 * k - 6..6 * k + 6).collect(),
+                vec![index(Param::Element(k - 1, ElementParam::Length))],
+                3 + inc as usize,
+            ),
+        };
+        params.extend(joint(k));
+        params.extend(&r0);
+        let j = kernel(&mut kernels, key, &|| joint_part(k == 0, inc));
+        parts.push(PartSpec {
+            kernel: j,
+            coords,
+            params,
+        });
+    }
+    if let Some(tip) = tip_part(st, layout) {
+        kernels.kernels.push(tip[0].clone());
+        kernels.tangents.push(tip[1].clone());
+        parts.push(PartSpec {
+            kernel: kernels.kernels.len() - 1,
+            coords: (6 * n - 6..6 * n).collect(),
+            params: (0..layout.len()).collect(),
+        });
+    }
+    kernels.layout = PartLayout { dof: 6 * n, parts };
+    Some(kernels)
+}
+
+/// An element's coordinates (u, psi) in a fresh CAS.
+fn element_coordinates(cas: &mut Cas, prefix: &str) -> Coordinates {
+    let names = ["ux", "uy", "uz", "rx", "ry", "rz"]
+        .map(|c| format!("{c}{prefix}"))
+        .to_vec();
+    Coordinates::new(cas, names)
+}
+
+/// Parameter symbols p0, p1, ... of a part.
+fn part_params(cas: &mut Cas, n: usize) -> Vec<ExprId> {
+    (0..n)
+        .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
+        .collect()
+}
+
+fn rows(p: &[ExprId]) -> M3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| p[3 * i + j]))
+}
+
+/// A part's [M block, h block] and its tangent, from a system of its
+/// coordinates.
+fn part_tapes(cas: &mut Cas, sys: &System) -> [Tape; 2] {
+    let eq = assemble(cas, sys);
+    let out: Vec<ExprId> = eq.mass_upper.iter().chain(&eq.bias).copied().collect();
+    [
+        cas.to_tape(&out),
+        crate::tmt::with_tangent(cas, &out, &sys.coords.q, &sys.coords.qd),
+    ]
+}
+
+/// A system of `coords` with nothing in it yet.
+fn empty_system(cas: &mut Cas, coords: Coordinates, gravity: V3) -> System {
+    let (zero, one) = (cas.zero(), cas.one());
+    System {
+        coords,
+        bodies: Vec::new(),
+        gravity,
+        elastic: zero,
+        rayleigh: zero,
+        actuation: zero,
+        point_forces: Vec::new(),
+        moments: Vec::new(),
+        tip: [zero; 3],
+        tip_orientation: [one, zero, zero, zero],
+        chain: None,
+        seeds: Vec::new(),
+    }
+}
+
+/// One element's body: parameters mass, inertia, axial inertia, gravity
+/// (3), base rotation rows (9).
+fn body_part() -> [Tape; 2] {
+    let mut cas = Cas::new();
+    let cas = &mut cas;
+    let coords = element_coordinates(cas, "");
+    let p = part_params(cas, 15);
+    let zero = cas.zero();
+    let r0 = rows(&p[6..15]);
+    let u: V3 = std::array::from_fn(|i| coords.q[i]);
+    let psi: V3 = std::array::from_fn(|i| coords.q[3 + i]);
+    let psi_d: V3 = std::array::from_fn(|i| coords.qd[3 + i]);
+    let (r, omega, _) = element_frame(cas, &r0, &[zero; 3], &psi, &psi_d);
+    let body = Body {
+        mass: p[0],
+        inertia: Inertia::Axisymmetric {
+            axis: [r[0][0], r[1][0], r[2][0]],
+            axial: p[2],
+            lateral: p[1],
+        },
+        position: bind3(cas, u),
+        omega,
+    };
+    let mut sys = empty_system(cas, coords, [p[3], p[4], p[5]]);
+    sys.bodies.push(body);
+    part_tapes(cas, &sys)
+}
+
+/// The beam springs to an element from the previous one (coordinates of
+/// both, parameters: the previous length, `JointParams`, base rotation) or
+/// from the clamp (`first`: its coordinates, `JointParams`, base rotation).
+fn joint_part(first: bool, incompressible: bool) -> [Tape; 2] {
+    let mut cas = Cas::new();
+    let cas = &mut cas;
+    let zero = cas.zero();
+    let (coords, before) = if first {
+        (element_coordinates(cas, ""), 0)
+    } else {
+        let mut names: Vec<String> = ["ux", "uy", "uz", "rx", "ry", "rz"]
+            .map(|c| format!("{c}_a"))
+            .to_vec();
+        names.extend(["ux", "uy", "uz", "rx", "ry", "rz"].map(|c| format!("{c}_b")));
+        (Coordinates::new(cas, names), 1)
+    };
+    let p = part_params(cas, before + 8 + 9);
+    let jp = JointParams::from(std::array::from_fn(|i| p[before + i]));
+    let r0 = rows(&p[before + 8..]);
+    let base_axis = [r0[0][0], r0[1][0], r0[2][0]];
+    let half_b = cas.scaled(0.5, jp.l);
+    let (prev, b) = if first {
+        let prev = Slab {
+            r: r0,
+            centre: [zero; 3],
+            half: zero,
+        };
+        (prev, 0)
+    } else {
+        let psi: V3 = std::array::from_fn(|i| coords.q[3 + i]);
+        let psi_d: V3 = std::array::from_fn(|i| coords.qd[3 + i]);
+        let (r, _, _) = element_frame(cas, &r0, &[zero; 3], &psi, &psi_d);
+        let centre = bind3(cas, std::array::from_fn(|i| coords.q[i]));
+        let half = cas.scaled(0.5, p[0]);
+        (Slab { r, centre, half }, 6)
+    };
+    // Centres relative to the straight arm's centre of the previous
+    // element (or the clamp): the next one is a half of each element along
+    // the base axis on, plus its displacement.
+    let gap = cas.add(prev.half, half_b);
+    let u: V3 = std::array::from_fn(|i| coords.q[b + i]);
+    let psi: V3 = std::array::from_fn(|i| coords.q[b + 3 + i]);
+    let psi_d: V3 = std::array::from_fn(|i| coords.qd[b + 3 + i]);
+    let (r, _, _) = element_frame(cas, &r0, &[zero; 3], &psi, &psi_d);
+    let centre: V3 = std::array::from_fn(|i| {
+        let straight = cas.mul(gap, base_axis[i]);
+        cas.add(straight, u[i])
+    });
+    let slab = Slab {
+        r,
+        centre: bind3(cas, centre),
+        half: half_b,
+    };
+    let pairs = coords.rate_pairs();
+    let joint = beam_springs(cas, &jp, first, &prev, &slab, incompressible, &pairs);
+    let mut sys = empty_system(cas, coords, [zero; 3]);
+    sys.elastic = cas.add_all(&joint.elastic);
+    sys.rayleigh = cas.add_all(&joint.rayleigh);
+    part_tapes(cas, &sys)
+}
+
+/// The tip's loads and body on the last element, reading the model's
+/// parameters; None without any.
+fn tip_part(st: &Structure, layout: &ParamLayout) -> Option<[Tape; 2]> {
+    if !(st.tip_mass || st.tip_force || st.tip_moment) {
+        return None;
+    }
+    let mut cas = Cas::new();
+    let cas = &mut cas;
+    let symbols = ParamSymbols::new(cas, layout);
+    let coords = element_coordinates(cas, "");
+    let zero = cas.zero();
+    let r0: M3 = std::array::from_fn(|i| {
+        std::array::from_fn(|j| symbols.get(Param::BaseRotation(i as u8, j as u8)))
+    });
+    let psi: V3 = std::array::from_fn(|i| coords.q[3 + i]);
+    let psi_d: V3 = std::array::from_fn(|i| coords.qd[3 + i]);
+    let (r, omega, _) = element_frame(cas, &r0, &[zero; 3], &psi, &psi_d);
+    let last = st.elements() - 1;
+    let half = cas.scaled(0.5, symbols.element(last, ElementParam::Length));
+    let slab = Slab {
+        r,
+        centre: bind3(cas, std::array::from_fn(|i| coords.q[i])),
+        half,
+    };
+    let tip = slab.end(cas, 1.0);
+    let mount = TipMount {
+        point: bind3(cas, tip),
+        axis: [r[0][0], r[1][0], r[2][0]],
+        omega,
+        rotation: r,
+    };
+    let loads = tip_loads(cas, &symbols, st, &mount);
+    let mut sys = empty_system(cas, coords, symbols.gravity());
+    sys.attach_tip(loads, 0);
+    Some(part_tapes(cas, &sys))
 }

@@ -13,7 +13,7 @@
 //! `model::Method`, and its line in [`of`].
 
 mod cosserat;
-mod eba;
+pub(crate) mod eba;
 pub(crate) mod ebr;
 mod pcc;
 mod rigid;

@@ -299,7 +299,7 @@ fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(RomFields, usize)]) 
 /// dx first, then dxd): what `runtime::links::tangent` runs the recursion
 /// on in dual numbers. One tape, so the values and their derivatives share
 /// subexpressions.
-pub(super) fn with_tangent(cas: &mut Cas, out: &[ExprId], x: &[ExprId], xd: &[ExprId]) -> Tape {
+pub(crate) fn with_tangent(cas: &mut Cas, out: &[ExprId], x: &[ExprId], xd: &[ExprId]) -> Tape {
     let n = x.len();
     let mut along = Vec::with_capacity(2 * n);
     for (i, &v) in x.iter().chain(xd).enumerate() {

@@ -20,6 +20,7 @@ use spatial::SpatialArm;
 
 pub use assemble::{Equations, assemble};
 pub use cell::link_chain;
+pub(crate) use cell::with_tangent;
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
 pub use system::ParamSymbols;
 
