@@ -700,47 +700,6 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
     }
 }
 
-/// The part kernels evaluated from their tapes.
-struct TapeParts<'a> {
-    parts: &'a runtime::parts::PartKernels,
-    slots: Vec<f64>,
-}
-
-impl runtime::parts::Parts for TapeParts<'_> {
-    fn eval(&mut self, k: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
-        let inp = runtime::Inputs {
-            t: 0.0,
-            q: x,
-            qd: xd,
-            qdd: &[],
-            dir: &[],
-            p,
-        };
-        self.parts.kernels[k].eval(&inp, &mut self.slots, out)
-    }
-    fn tangent(
-        &mut self,
-        k: usize,
-        x: &[f64],
-        xd: &[f64],
-        dx: &[f64],
-        dxd: &[f64],
-        p: &[f64],
-        out: &mut [f64],
-    ) {
-        let dir: Vec<f64> = dx.iter().chain(dxd).copied().collect();
-        let inp = runtime::Inputs {
-            t: 0.0,
-            q: x,
-            qd: xd,
-            qdd: &[],
-            dir: &dir,
-            p,
-        };
-        self.parts.tangents[k].eval(&inp, &mut self.slots, out)
-    }
-}
-
 /// An eba arm as a sum of parts (runtime/src/parts.rs: bodies, beam
 /// springs, the tip) against the flat `MassBias` and `Jvp` tapes of the
 /// whole system: M, h, tau and its directional derivative at 1e-12 of
@@ -797,8 +756,8 @@ fn eba_parts_match_the_flat_tapes() {
         let arm = Arm::new(Interpreted::new(tapes), p);
         let p = arm.params().to_vec();
         let n = arm.dof();
-        let mut tp = TapeParts {
-            parts: &parts,
+        let mut tp = runtime::parts::TapeParts {
+            kernels: &parts,
             slots: Vec::new(),
         };
         for trial in 0..4 {
@@ -841,18 +800,8 @@ fn eba_parts_match_the_flat_tapes() {
             }
             let mut want_jvp = vec![0.0; n];
             jvp.eval(&inp, &mut Vec::new(), &mut want_jvp);
-            let (mut tau, mut dtau) = (vec![f64::NAN; n], vec![f64::NAN; n]);
-            runtime::parts::inverse_dynamics_tangent(
-                &parts.layout,
-                &mut tp,
-                &q,
-                &qd,
-                &qdd,
-                &dir,
-                &p,
-                &mut tau,
-                &mut dtau,
-            );
+            let mut dtau = vec![f64::NAN; n];
+            runtime::parts::jvp(&parts.layout, &mut tp, &q, &qd, &qdd, &dir, &p, &mut dtau);
             let jvp_scale = scale(&want_jvp);
             for i in 0..n {
                 let what = format!("{model} {sets:?} trial {trial} coordinate {i}");

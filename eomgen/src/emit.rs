@@ -754,12 +754,11 @@ fn emit_parts(
             runtime::cpu::require_fma();
             runtime::parts::mass_bias(&PARTS, &mut PartKernels, q, qd, p, out)
         }
-        /// Kernel `jvp`: the inverse dynamics' tangent, part by part (`runtime::parts`).
+        /// Kernel `jvp`: the inverse dynamics' tangent, over the parts the direction moves (`runtime::parts`).
         #[allow(unused_variables)]
         pub fn jvp(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #dof]) {
             runtime::cpu::require_fma();
-            let mut tau = [0.0; #dof];
-            runtime::parts::inverse_dynamics_tangent(&PARTS, &mut PartKernels, q, qd, qdd, dir, p, &mut tau, out)
+            runtime::parts::jvp(&PARTS, &mut PartKernels, q, qd, qdd, dir, p, out)
         }
         #(#defs)*
     }

@@ -215,12 +215,43 @@ impl Kernels for Interpreted {
                 dir: if inp.dir.is_empty() { &zeros } else { inp.dir },
                 ..*inp
             };
-            return tape.eval(&inp, &mut slots, out);
+            return self.jvp(&inp, &mut slots, out);
+        }
+        if kind == KernelKind::Jvp {
+            return self.jvp(inp, &mut slots, out);
         }
         tape.eval(inp, &mut slots, out);
     }
     fn backend(&self) -> &'static str {
         "interpreted"
+    }
+}
+
+impl Interpreted {
+    /// The Jvp: a system of parts by its part tapes (a column of the
+    /// Jacobian touches a few parts, where the flat tape is the whole
+    /// system), anything else by the flat tape.
+    fn jvp(&self, inp: &Inputs, slots: &mut Vec<f64>, out: &mut [f64]) {
+        match &self.tapes.parts {
+            Some(parts) => {
+                let mut tp = crate::parts::TapeParts {
+                    kernels: parts,
+                    slots: std::mem::take(slots),
+                };
+                crate::parts::jvp(
+                    &parts.layout,
+                    &mut tp,
+                    inp.q,
+                    inp.qd,
+                    inp.qdd,
+                    inp.dir,
+                    inp.p,
+                    out,
+                );
+                *slots = tp.slots;
+            }
+            None => self.tapes.jvp.eval(inp, slots, out),
+        }
     }
 }
 

@@ -105,12 +105,12 @@ pub fn mass_bias<P: Parts>(
     }
 }
 
-/// tau = M qdd + h into `tau` and its directional derivative along `dir`
-/// = (dq, dqd) into `dtau`, part by part (a part the direction does not
-/// move adds its tau and nothing to dtau): the `Jvp` kernel of a system of
-/// parts.
+/// The directional derivative of tau = M qdd + h along `dir` = (dq, dqd)
+/// into `dtau`: the `Jvp` kernel of a system of parts. Only the parts the
+/// direction moves are evaluated, so a column of the Jacobian (a unit
+/// direction) costs the few parts of one coordinate, not the whole system.
 #[allow(clippy::too_many_arguments)]
-pub fn inverse_dynamics_tangent<P: Parts>(
+pub fn jvp<P: Parts>(
     layout: &PartLayout,
     parts: &mut P,
     q: &[f64],
@@ -118,42 +118,78 @@ pub fn inverse_dynamics_tangent<P: Parts>(
     qdd: &[f64],
     dir: &[f64],
     p: &[f64],
-    tau: &mut [f64],
     dtau: &mut [f64],
 ) {
     let n = layout.dof;
-    assert!(dir.len() == 2 * n && tau.len() == n && dtau.len() == n);
+    assert!(dir.len() == 2 * n && dtau.len() == n);
     let (dq, dqd) = dir.split_at(n);
-    tau.fill(0.0);
     dtau.fill(0.0);
     let mut out = Vec::new();
     for spec in &layout.parts {
+        let (dx, dxd) = (gather(spec, dq), gather(spec, dqd));
+        if dx.iter().chain(&dxd).all(|&v| v == 0.0) {
+            continue;
+        }
         let m = spec.coords.len();
         let len = tri(m) + m;
         out.resize(2 * len, 0.0);
         let params: Vec<f64> = spec.params.iter().map(|&i| p[i]).collect();
         let (x, xd) = (gather(spec, q), gather(spec, qd));
-        let (dx, dxd) = (gather(spec, dq), gather(spec, dqd));
-        if dx.iter().chain(&dxd).all(|&v| v == 0.0) {
-            parts.eval(spec.kernel, &x, &xd, &params, &mut out[..len]);
-            out[len..].fill(0.0);
-        } else {
-            parts.tangent(spec.kernel, &x, &xd, &dx, &dxd, &params, &mut out);
-        }
+        parts.tangent(spec.kernel, &x, &xd, &dx, &dxd, &params, &mut out);
         let a_local = gather(spec, qdd);
-        // Row a of the symmetric block times the local accelerations.
+        // Row a of the block's derivative times the local accelerations.
         let entry = |a: usize, b: usize| {
             let (a, b) = (a.min(b), a.max(b));
             a * m - a * (a + 1) / 2 + b
         };
         for a in 0..m {
-            let (mut t, mut d) = (out[tri(m) + a], out[len + tri(m) + a]);
+            let mut d = out[len + tri(m) + a];
             for (b, &acc) in a_local.iter().enumerate() {
-                t += out[entry(a, b)] * acc;
                 d += out[len + entry(a, b)] * acc;
             }
-            tau[spec.coords[a]] += t;
             dtau[spec.coords[a]] += d;
         }
+    }
+}
+
+/// The part kernels run by the tape interpreter: the interpreted
+/// backend's `MassBias` and `Jvp` of a system of parts, and the tests'.
+pub struct TapeParts<'a> {
+    pub kernels: &'a PartKernels,
+    pub slots: Vec<f64>,
+}
+
+impl Parts for TapeParts<'_> {
+    fn eval(&mut self, k: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+        let inp = crate::Inputs {
+            t: 0.0,
+            q: x,
+            qd: xd,
+            qdd: &[],
+            dir: &[],
+            p,
+        };
+        self.kernels.kernels[k].eval(&inp, &mut self.slots, out)
+    }
+    fn tangent(
+        &mut self,
+        k: usize,
+        x: &[f64],
+        xd: &[f64],
+        dx: &[f64],
+        dxd: &[f64],
+        p: &[f64],
+        out: &mut [f64],
+    ) {
+        let dir: Vec<f64> = dx.iter().chain(dxd).copied().collect();
+        let inp = crate::Inputs {
+            t: 0.0,
+            q: x,
+            qd: xd,
+            qdd: &[],
+            dir: &dir,
+            p,
+        };
+        self.kernels.tangents[k].eval(&inp, &mut self.slots, out)
     }
 }

@@ -411,8 +411,11 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
     let mut kernels = PartKernels::default();
     // Kernel keys: 0 body; 1 + (incompressible) clamp joint; 3 + (..) joint.
     let mut keys: Vec<usize> = Vec::new();
-    let mut kernel = |kernels: &mut PartKernels, key: usize, make: &dyn Fn() -> [Tape; 2]| {
-        match keys.iter().position(|&x| x == key) {
+    let mut kernel =
+        |kernels: &mut PartKernels, key: usize, make: &dyn Fn() -> [Tape; 2]| match keys
+            .iter()
+            .position(|&x| x == key)
+        {
             Some(k) => k,
             None => {
                 let [t, d] = make();
@@ -421,8 +424,7 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
                 keys.push(key);
                 keys.len() - 1
             }
-        }
-    };
+        };
     let n = st.elements();
     let mut parts = Vec::new();
     for (k, &inc) in incompressible.iter().enumerate() {
