@@ -20,12 +20,6 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
             .collect();
         let compiled = Arm::new((m.kernels)(), p.clone());
         let tapes = eomgen::derive::derive(&l.model);
-        // A system of parts (eba) takes its beam springs' gaps from
-        // positions relative to each other, the flat tape from absolute
-        // ones along the arm: the flat tape's round-off in h is the
-        // springs' stiffness times eps times the arm's length, about 1e-12
-        // of h (see `eba_parts_match_the_flat_tapes`).
-        let h_rel = if tapes.parts.is_some() { 1e-10 } else { 1e-12 };
         let interpreted = Arm::new(Interpreted::new(tapes), p);
         assert_eq!(
             compiled.info(),
@@ -74,7 +68,7 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
                     assert!(a[k].is_finite(), "{} {kind:?}[{k}] not finite", m.name);
                     let (rel, floor) = match kind {
                         KernelKind::MassBias if k < m_len => (1e-12, m_scale),
-                        KernelKind::MassBias => (h_rel, h_scale),
+                        KernelKind::MassBias => (1e-12, h_scale),
                         _ => (1e-12, 0.0),
                     };
                     assert_close(a[k], b[k], rel, floor, &format!("{} {kind:?}[{k}]", m.name));
@@ -87,8 +81,8 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
             interpreted.jacobian_parts(t, &q, &qd, &qdd, &mut b);
             // Compiled chains take the Jvp from the link recursion in dual
             // numbers (runtime/src/links/tangent.rs), eba from its parts:
-            // another order of the same sums, held to 1e-12 (parts: 1e-10,
-            // as h) of each block's largest entry.
+            // another order of the same sums, held to 1e-12 of each
+            // block's largest entry.
             for k in 0..2 * n * n {
                 assert!(a[k].is_finite(), "{} Jacobian part {k} not finite", m.name);
                 let block = &b[(k / (n * n)) * n * n..][..n * n];
@@ -96,7 +90,7 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
                 assert_close(
                     a[k],
                     b[k],
-                    h_rel,
+                    1e-12,
                     floor,
                     &format!("{} Jacobian part {k}", m.name),
                 );
@@ -701,9 +695,9 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
 }
 
 /// An eba arm as a sum of parts (runtime/src/parts.rs: bodies, beam
-/// springs, the tip) against the flat `MassBias` and `Jvp` tapes of the
-/// whole system: M, h, tau and its directional derivative at 1e-12 of
-/// their scale, with tip bodies and loads, extension and thinning.
+/// springs, the tip) against the flat `MassBias`, `Jvp` and `Outputs`
+/// tapes of the whole system at 1e-12 of their scale, with tip bodies and
+/// loads, extension and thinning.
 #[test]
 fn eba_parts_match_the_flat_tapes() {
     let dir = std::env::temp_dir().join("softarm-test-cache");
@@ -749,6 +743,7 @@ fn eba_parts_match_the_flat_tapes() {
             .clone()
             .unwrap_or_else(|| panic!("parts cover {model} {sets:?}"));
         let (flat, jvp) = (tapes.mass_bias.clone(), tapes.jvp.clone());
+        let flat_outputs = tapes.outputs.clone();
         let p: Vec<f64> = eomgen::model::parameters(&l.model)
             .into_iter()
             .map(|(_, v)| v)
@@ -783,23 +778,29 @@ fn eba_parts_match_the_flat_tapes() {
             let m_len = n * (n + 1) / 2;
             let scale = |v: &[f64]| v.iter().fold(1e-300f64, |s, x| s.max(x.abs()));
             let (m_scale, h_scale) = (scale(&want[..m_len]), scale(&want[m_len..]));
-            // The flat tape's beam springs act on the gap between element
-            // ends taken from their absolute positions along the arm, so
-            // its round-off is the springs' stiffness times eps times the
-            // arm's length (1e-12 of h here); the parts take positions
-            // relative to each other. h and the Jvp are held to 1e-10 of
-            // their scale, M to 1e-12.
             for k in 0..len {
-                let (rel, floor) = if k < m_len {
-                    (1e-12, m_scale)
-                } else {
-                    (1e-10, h_scale)
-                };
+                let floor = if k < m_len { m_scale } else { h_scale };
                 let what = format!("{model} {sets:?} trial {trial} entry {k}");
-                assert_close(got[k], want[k], rel, floor, &what);
+                assert_close(got[k], want[k], 1e-12, floor, &what);
             }
             let mut want_jvp = vec![0.0; n];
             jvp.eval(&inp, &mut Vec::new(), &mut want_jvp);
+            // The outputs, each at 1e-12 of its kind's scale.
+            let mut want_out = vec![0.0; runtime::N_OUTPUTS];
+            flat_outputs.eval(&inp, &mut Vec::new(), &mut want_out);
+            let mut got_out = vec![f64::NAN; runtime::N_OUTPUTS];
+            runtime::parts::outputs(&parts.layout, &mut tp, &q, &qd, &p, &mut got_out);
+            let energy = want_out[3].abs().max(want_out[4].abs());
+            let position = scale(&want_out[..3]);
+            for (k, name) in runtime::OUTPUT_NAMES.iter().enumerate() {
+                let (rel, floor) = match k {
+                    0..3 => (1e-12, position),
+                    3 | 4 => (1e-12, energy),
+                    _ => (1e-12, 1.0),
+                };
+                let what = format!("{model} {sets:?} trial {trial} output {name}");
+                assert_close(got_out[k], want_out[k], rel, floor, &what);
+            }
             let mut dtau = vec![f64::NAN; n];
             runtime::parts::jvp(&parts.layout, &mut tp, &q, &qd, &qdd, &dir, &p, &mut dtau);
             let jvp_scale = scale(&want_jvp);
@@ -808,7 +809,7 @@ fn eba_parts_match_the_flat_tapes() {
                 assert_close(
                     dtau[i],
                     want_jvp[i],
-                    1e-10,
+                    1e-12,
                     jvp_scale,
                     &format!("jvp {what}"),
                 );

@@ -721,6 +721,14 @@ fn emit_parts(
             }
         });
     }
+    let (pose, offsets) = (
+        parts.pose.as_ref().expect("a pose kernel"),
+        parts.offsets.as_ref().expect("an offsets kernel"),
+    );
+    let np = parts.layout.pose_coords.len();
+    defs.push(KernelEmitter::new(pose).emit("part_pose", np, n_params));
+    defs.push(KernelEmitter::new(offsets).emit("part_offsets", 0, n_params));
+    let np2 = 2 * np;
     let json = serde_json::to_string(&parts.layout).expect("a part layout serialises");
     let n_dir = 2 * dof;
     let doc = format!(
@@ -747,6 +755,21 @@ fn emit_parts(
                     _ => unreachable!("part kernel index from the layout"),
                 }
             }
+            fn pose(&mut self, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+                part_pose(0.0, x.try_into().expect("pose coordinates"), xd.try_into().expect("pose rates"),
+                          &[0.0; #np], &[0.0; #np2], p.try_into().expect("parameter vector length"),
+                          out.try_into().expect("pose outputs"))
+            }
+            fn offsets(&mut self, p: &[f64], out: &mut [f64]) {
+                part_offsets(0.0, &[], &[], &[], &[], p.try_into().expect("parameter vector length"),
+                             out.try_into().expect("offsets outputs"))
+            }
+        }
+        /// Kernel `outputs`: the parts' energies, the pose and the offsets (`runtime::parts::outputs`).
+        #[allow(unused_variables)]
+        pub fn outputs(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; runtime::N_OUTPUTS]) {
+            runtime::cpu::require_fma();
+            runtime::parts::outputs(&PARTS, &mut PartKernels, q, qd, p, out)
         }
         #[doc = #doc]
         #[allow(unused_variables)]
@@ -871,8 +894,11 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     let mut arms = Vec::new();
     for kind in KernelKind::ALL {
         let name = kind.name();
-        let by_parts =
-            tapes.parts.is_some() && matches!(kind, KernelKind::MassBias | KernelKind::Jvp);
+        let by_parts = tapes.parts.is_some()
+            && matches!(
+                kind,
+                KernelKind::MassBias | KernelKind::Jvp | KernelKind::Outputs
+            );
         match (&tapes.links, kind) {
             // Emitted with the parts, below.
             _ if by_parts => {}

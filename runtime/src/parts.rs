@@ -23,17 +23,26 @@ pub struct PartSpec {
 pub struct PartLayout {
     pub dof: usize,
     pub parts: Vec<PartSpec>,
+    /// The coordinates the pose kernel reads (the last element's).
+    pub pose_coords: Vec<usize>,
 }
 
 /// The part kernels of a model: kernel k maps a part's local coordinates,
-/// rates and parameters to its block of M (upper triangle, row by row)
-/// and of h; `tangents[k]` gives those and their directional derivatives
-/// along the local (dx, dxd).
+/// rates and parameters to its block of M (upper triangle, row by row),
+/// its block of h and its potential energy (positions relative to a
+/// straight-arm centre); `tangents[k]` gives those and their directional
+/// derivatives along the local (dx, dxd). For the outputs, `pose` (of the
+/// layout's `pose_coords` and the model's parameters) gives the tip
+/// point relative to the same kind of centre and the tip quaternion, and
+/// `offsets` (of the parameters) the potential energy the parts leave out
+/// and that centre.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct PartKernels {
     pub layout: PartLayout,
     pub kernels: Vec<crate::Tape>,
     pub tangents: Vec<crate::Tape>,
+    pub pose: Option<crate::Tape>,
+    pub offsets: Option<crate::Tape>,
 }
 
 /// What the sums evaluate: generated code, or the tapes in tests.
@@ -52,6 +61,16 @@ pub trait Parts {
         p: &[f64],
         out: &mut [f64],
     );
+    /// The pose kernel at the pose coordinates `x`, the model's `p`.
+    fn pose(&mut self, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]);
+    /// The offsets kernel of the model's `p`.
+    fn offsets(&mut self, p: &[f64], out: &mut [f64]);
+}
+
+/// What a part kernel writes for `m` coordinates: M's block, h's block,
+/// the potential energy.
+fn part_len(m: usize) -> usize {
+    tri(m) + m + 1
 }
 
 /// Entries of an m x m upper triangle.
@@ -85,7 +104,7 @@ pub fn mass_bias<P: Parts>(
     let mut local = Vec::new();
     for spec in &layout.parts {
         let m = spec.coords.len();
-        local.resize(tri(m) + m, 0.0);
+        local.resize(part_len(m), 0.0);
         let params: Vec<f64> = spec.params.iter().map(|&i| p[i]).collect();
         parts.eval(
             spec.kernel,
@@ -131,7 +150,7 @@ pub fn jvp<P: Parts>(
             continue;
         }
         let m = spec.coords.len();
-        let len = tri(m) + m;
+        let len = part_len(m);
         out.resize(2 * len, 0.0);
         let params: Vec<f64> = spec.params.iter().map(|&i| p[i]).collect();
         let (x, xd) = (gather(spec, q), gather(spec, qd));
@@ -150,6 +169,49 @@ pub fn jvp<P: Parts>(
             dtau[spec.coords[a]] += d;
         }
     }
+}
+
+/// The outputs (`crate::OUTPUT_NAMES`) of a system of parts: the tip from
+/// the pose kernel and the offsets, the kinetic energy qd^T M qd / 2 block
+/// by block, the potential energy the parts' plus the offsets'.
+pub fn outputs<P: Parts>(
+    layout: &PartLayout,
+    parts: &mut P,
+    q: &[f64],
+    qd: &[f64],
+    p: &[f64],
+    out: &mut [f64],
+) {
+    let mut offsets = [0.0; 4];
+    parts.offsets(p, &mut offsets);
+    let (mut ke, mut pe) = (0.0, offsets[0]);
+    let mut local = Vec::new();
+    for spec in &layout.parts {
+        let m = spec.coords.len();
+        local.resize(part_len(m), 0.0);
+        let params: Vec<f64> = spec.params.iter().map(|&i| p[i]).collect();
+        let xd = gather(spec, qd);
+        parts.eval(spec.kernel, &gather(spec, q), &xd, &params, &mut local);
+        let mut at = 0;
+        for a in 0..m {
+            for b in a..m {
+                let twice = if a == b { 1.0 } else { 2.0 };
+                ke += 0.5 * twice * local[at] * xd[a] * xd[b];
+                at += 1;
+            }
+        }
+        pe += local[tri(m) + m];
+    }
+    let x: Vec<f64> = layout.pose_coords.iter().map(|&i| q[i]).collect();
+    let xd: Vec<f64> = layout.pose_coords.iter().map(|&i| qd[i]).collect();
+    let mut pose = [0.0; 7];
+    parts.pose(&x, &xd, p, &mut pose);
+    for k in 0..3 {
+        out[k] = offsets[1 + k] + pose[k];
+    }
+    out[3] = ke;
+    out[4] = pe;
+    out[5..9].copy_from_slice(&pose[3..7]);
 }
 
 /// The part kernels run by the tape interpreter: the interpreted
@@ -191,5 +253,29 @@ impl Parts for TapeParts<'_> {
             p,
         };
         self.kernels.tangents[k].eval(&inp, &mut self.slots, out)
+    }
+    fn pose(&mut self, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+        let inp = crate::Inputs {
+            t: 0.0,
+            q: x,
+            qd: xd,
+            qdd: &[],
+            dir: &[],
+            p,
+        };
+        let pose = self.kernels.pose.as_ref().expect("a pose kernel");
+        pose.eval(&inp, &mut self.slots, out)
+    }
+    fn offsets(&mut self, p: &[f64], out: &mut [f64]) {
+        let inp = crate::Inputs {
+            t: 0.0,
+            q: &[],
+            qd: &[],
+            qdd: &[],
+            dir: &[],
+            p,
+        };
+        let offsets = self.kernels.offsets.as_ref().expect("an offsets kernel");
+        offsets.eval(&inp, &mut self.slots, out)
     }
 }

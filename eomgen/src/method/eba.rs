@@ -177,10 +177,41 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         });
         let slab = Slab { r, centre, half };
 
-        // Beam springs to the previous element (or the clamp).
+        // Beam springs to the previous element (or the clamp), on centres
+        // relative to the previous element's straight-arm centre: the gap
+        // between element ends is then no difference of positions along
+        // the whole arm (whose round-off grows with the arm's length), and
+        // the same expression as the joint's part (`joint_part`).
         let incompressible = structure.segments[segment].incompressible;
         let jp = JointParams::of(symbols, k);
-        let joint = beam_springs(cas, &jp, k == 0, &prev, &slab, incompressible, &pairs);
+        let prev_rel = Slab {
+            r: prev.r,
+            centre: if k == 0 {
+                [zero; 3]
+            } else {
+                bind3(cas, std::array::from_fn(|i| coords.q[c - 6 + i]))
+            },
+            half: prev.half,
+        };
+        let gap = cas.add(prev.half, half);
+        let rel_centre: V3 = std::array::from_fn(|i| {
+            let straight = cas.mul(gap, base_axis[i]);
+            cas.add(straight, u[i])
+        });
+        let slab_rel = Slab {
+            r: slab.r,
+            centre: bind3(cas, rel_centre),
+            half,
+        };
+        let joint = beam_springs(
+            cas,
+            &jp,
+            k == 0,
+            &prev_rel,
+            &slab_rel,
+            incompressible,
+            &pairs,
+        );
         strains.push(Strain {
             segment,
             ..joint.strain
@@ -468,7 +499,13 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
             params: (0..layout.len()).collect(),
         });
     }
-    kernels.layout = PartLayout { dof: 6 * n, parts };
+    kernels.layout = PartLayout {
+        dof: 6 * n,
+        parts,
+        pose_coords: (6 * n - 6..6 * n).collect(),
+    };
+    kernels.pose = Some(pose_tape(st, layout));
+    kernels.offsets = Some(offsets_tape(st, layout));
     Some(kernels)
 }
 
@@ -491,11 +528,13 @@ fn rows(p: &[ExprId]) -> M3 {
     std::array::from_fn(|i| std::array::from_fn(|j| p[3 * i + j]))
 }
 
-/// A part's [M block, h block] and its tangent, from a system of its
-/// coordinates.
+/// A part's [M block, h block, potential energy] and its tangent, from a
+/// system of its coordinates (positions relative to its first element's
+/// straight-arm centre: `offsets` adds what that leaves out).
 fn part_tapes(cas: &mut Cas, sys: &System) -> [Tape; 2] {
     let eq = assemble(cas, sys);
-    let out: Vec<ExprId> = eq.mass_upper.iter().chain(&eq.bias).copied().collect();
+    let mut out: Vec<ExprId> = eq.mass_upper.iter().chain(&eq.bias).copied().collect();
+    out.push(eq.outputs[4]);
     [
         cas.to_tape(&out),
         crate::tmt::with_tangent(cas, &out, &sys.coords.q, &sys.coords.qd),
@@ -617,7 +656,67 @@ fn tip_part(st: &Structure, layout: &ParamLayout) -> Option<[Tape; 2]> {
         return None;
     }
     let mut cas = Cas::new();
+    let sys = tip_system(&mut cas, st, layout);
+    Some(part_tapes(&mut cas, &sys))
+}
+
+/// The tip point relative to the last element's straight-arm centre and
+/// the tip orientation, of the last element's coordinates: the `pose`
+/// kernel of `runtime::parts::outputs`.
+fn pose_tape(st: &Structure, layout: &ParamLayout) -> Tape {
+    let mut cas = Cas::new();
+    let sys = tip_system(&mut cas, st, layout);
+    let eq = assemble(&mut cas, &sys);
+    let out: Vec<ExprId> = [0, 1, 2, 5, 6, 7, 8].map(|i| eq.outputs[i]).to_vec();
+    cas.to_tape(&out)
+}
+
+/// The parameters-only offsets of the outputs (`runtime::parts::outputs`):
+/// the potential energy the parts leave out (every body's and the tip's
+/// weight, and a world-frame tip force, at the straight-arm centres they
+/// are relative to), then the last element's straight-arm centre.
+fn offsets_tape(st: &Structure, layout: &ParamLayout) -> Tape {
+    let mut cas = Cas::new();
     let cas = &mut cas;
+    let symbols = ParamSymbols::new(cas, layout);
+    let g = symbols.gravity();
+    let p0 = symbols.xyz(Param::BasePosition);
+    let axis = [0, 1, 2].map(|i| symbols.get(Param::BaseRotation(i, 0)));
+    let mut along = cas.zero();
+    let mut terms = Vec::new();
+    let mut centre = p0;
+    for k in 0..st.elements() {
+        let l = symbols.element(k, ElementParam::Length);
+        let half = cas.scaled(0.5, l);
+        let s_mid = cas.add(along, half);
+        along = cas.add(along, l);
+        centre = std::array::from_fn(|i| {
+            let straight = cas.mul(s_mid, axis[i]);
+            cas.add(p0[i], straight)
+        });
+        let m = symbols.element(k, ElementParam::Mass);
+        let gc = cas.dot(&g, &centre);
+        let mgc = cas.mul(m, gc);
+        terms.push(cas.neg(mgc));
+    }
+    if st.tip_mass {
+        let gc = cas.dot(&g, &centre);
+        let mgc = cas.mul(symbols.get(Param::TipMass), gc);
+        terms.push(cas.neg(mgc));
+    }
+    if st.tip_force && !st.tip_frame_wrench {
+        let f = symbols.xyz(Param::TipForce);
+        let fc = cas.dot(&f, &centre);
+        terms.push(cas.neg(fc));
+    }
+    let mut out = vec![cas.add_all(&terms)];
+    out.extend(centre);
+    cas.to_tape(&out)
+}
+
+/// The last element with the tip's loads and body, its centre at its
+/// straight-arm centre's origin, orientation composed with the base's.
+fn tip_system(cas: &mut Cas, st: &Structure, layout: &ParamLayout) -> System {
     let symbols = ParamSymbols::new(cas, layout);
     let coords = element_coordinates(cas, "");
     let zero = cas.zero();
@@ -626,7 +725,7 @@ fn tip_part(st: &Structure, layout: &ParamLayout) -> Option<[Tape; 2]> {
     });
     let psi: V3 = std::array::from_fn(|i| coords.q[3 + i]);
     let psi_d: V3 = std::array::from_fn(|i| coords.qd[3 + i]);
-    let (r, omega, _) = element_frame(cas, &r0, &[zero; 3], &psi, &psi_d);
+    let (r, omega, q_rel) = element_frame(cas, &r0, &[zero; 3], &psi, &psi_d);
     let last = st.elements() - 1;
     let half = cas.scaled(0.5, symbols.element(last, ElementParam::Length));
     let slab = Slab {
@@ -644,5 +743,7 @@ fn tip_part(st: &Structure, layout: &ParamLayout) -> Option<[Tape; 2]> {
     let loads = tip_loads(cas, &symbols, st, &mount);
     let mut sys = empty_system(cas, coords, symbols.gravity());
     sys.attach_tip(loads, 0);
-    Some(part_tapes(cas, &sys))
+    let q0 = std::array::from_fn(|c| symbols.get(Param::BaseQuaternion(c as u8)));
+    sys.tip_orientation = quat_mul(cas, &q0, &q_rel);
+    sys
 }
