@@ -21,15 +21,16 @@
 use runtime::Tape;
 use runtime::links::{
     ACTUATION_LOADS, CELL_PARAMS, ELEMENT_PARAMS, LinkKernels, LinkLayout, LinkSpec,
-    LocalCoordinate, cell, pose,
+    LocalCoordinate,
 };
 
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{ElementParam, Joints, Method, Param, ParamLayout, Structure, Xyz};
 
 use super::actuation::{segment_loads, strain_work, thinning};
+use super::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
 use super::planar_cell::derive_planar_cell;
-use super::spatial::{Frame, Springs, V3, arc};
+use super::spatial::{Frame, Springs, arc};
 use super::system::{Coordinates, ParamSymbols};
 use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
@@ -59,7 +60,6 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         return None;
     }
     let index = |p: Param| params.index(p);
-    let triple = |p: fn(Xyz) -> Param| Xyz::ALL.map(|c| index(p(c)));
     let (loads, actuated) = derive_loads(params, st);
     let mut cells: Vec<(Shape, [Tape; 3])> = Vec::new();
     let mut links = Vec::new();
@@ -165,28 +165,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         dof: first,
         forces: !roms.is_empty(),
         loads: actuated.len(),
-        gravity: triple(Param::Gravity),
-        base_position: triple(Param::BasePosition),
-        base_rotation: match spatial {
-            true => {
-                std::array::from_fn(|i| index(Param::BaseRotation((i / 3) as u8, (i % 3) as u8)))
-            }
-            false => [0; 9],
-        },
-        base_quaternion: match spatial {
-            true => std::array::from_fn(|i| index(Param::BaseQuaternion(i as u8))),
-            false => [0; 4],
-        },
-        base_angle: (!spatial).then(|| index(Param::BaseAngle)),
-        variable_inertia: !spatial,
-        tip_force: st.tip_force.then(|| triple(Param::TipForce)),
-        tip_moment: st.tip_moment.then(|| triple(Param::TipMoment)),
-        tip_frame: st.tip_frame_wrench,
-        tip_mass: st.tip_mass.then(|| index(Param::TipMass)),
-        tip_length: st.tip_length.then(|| index(Param::TipLength)),
-        tip_inertia: (st.tip_mass && st.tip_length)
-            .then(|| [index(Param::TipInertia), index(Param::TipAxialInertia)]),
-        weights: Default::default(),
+        ..globals(st, params)
     };
     // The shared sums hold the arm's coordinates in fixed rows.
     if !roms.is_empty() && first > runtime::links::MAX_SHARED_DOF {
@@ -213,6 +192,38 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         kernels.poses.push(pose);
     }
     Some(kernels)
+}
+
+/// Where a chain's gravity, base, tip body and tip loads are in the
+/// parameter vector (its links, coordinates and kernels left empty).
+fn globals(st: &Structure, params: &ParamLayout) -> LinkLayout {
+    let spatial = st.dimensions == 3;
+    let index = |p: Param| params.index(p);
+    let triple = |p: fn(Xyz) -> Param| Xyz::ALL.map(|c| index(p(c)));
+    LinkLayout {
+        gravity: triple(Param::Gravity),
+        base_position: triple(Param::BasePosition),
+        base_rotation: match spatial {
+            true => {
+                std::array::from_fn(|i| index(Param::BaseRotation((i / 3) as u8, (i % 3) as u8)))
+            }
+            false => [0; 9],
+        },
+        base_quaternion: match spatial {
+            true => std::array::from_fn(|i| index(Param::BaseQuaternion(i as u8))),
+            false => [0; 4],
+        },
+        base_angle: (!spatial).then(|| index(Param::BaseAngle)),
+        variable_inertia: !spatial,
+        tip_force: st.tip_force.then(|| triple(Param::TipForce)),
+        tip_moment: st.tip_moment.then(|| triple(Param::TipMoment)),
+        tip_frame: st.tip_frame_wrench,
+        tip_mass: st.tip_mass.then(|| index(Param::TipMass)),
+        tip_length: st.tip_length.then(|| index(Param::TipLength)),
+        tip_inertia: (st.tip_mass && st.tip_length)
+            .then(|| [index(Param::TipInertia), index(Param::TipAxialInertia)]),
+        ..Default::default()
+    }
 }
 
 /// What a cell depends on besides its parameters' values.
@@ -292,24 +303,6 @@ fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(RomFields, usize)]) 
         with_tangent(cas, &out, &coords.q, &coords.qd),
         cas.to_tape(&[elastic]),
     ]
-}
-
-/// The tape of `out` followed by its directional derivative along (dx,
-/// dxd) of the coordinates `x` and rates `xd` (`SymKind::Dir` symbols:
-/// dx first, then dxd): what `runtime::links::tangent` runs the recursion
-/// on in dual numbers. One tape, so the values and their derivatives share
-/// subexpressions.
-pub(crate) fn with_tangent(cas: &mut Cas, out: &[ExprId], x: &[ExprId], xd: &[ExprId]) -> Tape {
-    let n = x.len();
-    let mut along = Vec::with_capacity(2 * n);
-    for (i, &v) in x.iter().chain(xd).enumerate() {
-        let dir = cas.symbol(&format!("dir{i}"), SymKind::Dir(i as u32));
-        along.push((v, dir));
-    }
-    debug_assert_eq!(along.len(), 2 * n);
-    let mut all = out.to_vec();
-    all.extend(cas.time_derivatives(out, &along));
-    cas.to_tape(&all)
 }
 
 /// The cell of a link with the bend pair, and twist and stretch when asked;
@@ -450,160 +443,4 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         with_tangent(cas, &out, &q, &qd),
         cas.to_tape(&pose_out),
     ]
-}
-
-/// How a cell's rates are taken: by the rate rule of turned vectors (3D
-/// frames, `Cas::kinematic_rates`) or by plain time derivatives (planar).
-#[derive(Clone, Copy)]
-pub(super) enum Rates {
-    Turned,
-    Plain,
-}
-
-/// Where a link's end frame and body are, in its base frame at rest.
-pub(super) struct Motion {
-    /// Rows of the end frame's rotation.
-    pub rotation: [V3; 3],
-    pub end: V3,
-    /// The end frame's angular velocity.
-    pub omega: V3,
-    pub quat: [ExprId; 4],
-    pub centroid: V3,
-    pub body_omega: V3,
-    /// The body's axis (its inertia is axisymmetric about it).
-    pub axis: V3,
-}
-
-/// A link's motion with the rates and convective accelerations a cell
-/// reports, its body's mass and inertias and its springs' energy: what a
-/// cell (`runtime::links::cell`) and a pose cell (`runtime::links::pose`)
-/// are written from, for 3D and planar links alike.
-pub(super) struct LinkKinematics {
-    m: Motion,
-    end_rate: V3,
-    end_accel: V3,
-    omega_rate: V3,
-    centroid_rate: V3,
-    centroid_accel: V3,
-    body_omega_rate: V3,
-    /// Mass, lateral and axial inertia, the springs' energy.
-    body: [ExprId; 4],
-}
-
-impl LinkKinematics {
-    pub fn new(
-        cas: &mut Cas,
-        m: Motion,
-        body: [ExprId; 4],
-        q: &[ExprId],
-        qd: &[ExprId],
-        how: Rates,
-    ) -> Self {
-        let pairs: Vec<(ExprId, ExprId)> = q.iter().copied().zip(qd.iter().copied()).collect();
-        let rates = |cas: &mut Cas, v: &V3| -> V3 {
-            let r = match how {
-                Rates::Turned => cas.kinematic_rates(v, &pairs),
-                Rates::Plain => cas.time_derivatives(v, &pairs),
-            };
-            [r[0], r[1], r[2]]
-        };
-        let end_rate = rates(cas, &m.end);
-        let end_accel = rates(cas, &end_rate);
-        let omega_rate = rates(cas, &m.omega);
-        let centroid_rate = rates(cas, &m.centroid);
-        let centroid_accel = rates(cas, &centroid_rate);
-        let body_omega_rate = rates(cas, &m.body_omega);
-        Self {
-            m,
-            end_rate,
-            end_accel,
-            omega_rate,
-            centroid_rate,
-            centroid_accel,
-            body_omega_rate,
-            body,
-        }
-    }
-
-    /// The cell's outputs for coordinates `q` (rates `qd`): the columns,
-    /// the generalised forces of the potential `elastic` (springs and
-    /// actuators) and the Rayleigh function, and the inertia's derivatives
-    /// in q (zero unless it changes with them: a planar arc's).
-    pub fn cell(
-        &self,
-        cas: &mut Cas,
-        q: &[ExprId],
-        qd: &[ExprId],
-        elastic: ExprId,
-        rayleigh: ExprId,
-    ) -> Vec<ExprId> {
-        let m = &self.m;
-        let zero = cas.zero();
-        let n = q.len();
-        let mut out = vec![zero; cell::len(n)];
-        for i in 0..3 {
-            out[cell::ROTATION + 3 * i..][..3].copy_from_slice(&m.rotation[i]);
-        }
-        for (at, v) in [
-            (cell::END, m.end),
-            (cell::END_RATE, self.end_rate),
-            (cell::END_ACCEL, self.end_accel),
-            (cell::OMEGA, m.omega),
-            (cell::OMEGA_RATE, self.omega_rate),
-            (cell::CENTROID, m.centroid),
-            (cell::CENTROID_RATE, self.centroid_rate),
-            (cell::CENTROID_ACCEL, self.centroid_accel),
-            (cell::BODY_OMEGA, m.body_omega),
-            (cell::BODY_OMEGA_RATE, self.body_omega_rate),
-            (cell::AXIS, m.axis),
-        ] {
-            out[at..at + 3].copy_from_slice(&v);
-        }
-        let [mass, lateral, axial, _] = self.body;
-        out[cell::MASS] = mass;
-        out[cell::LATERAL] = lateral;
-        out[cell::AXIAL] = axial;
-        for c in 0..n {
-            let col = cell::COLUMNS + 12 * c;
-            let columns = [&m.omega, &self.end_rate, &m.body_omega, &self.centroid_rate];
-            for (s, v) in columns.into_iter().enumerate() {
-                for k in 0..3 {
-                    out[col + 3 * s + k] = cas.diff(v[k], qd[c]);
-                }
-            }
-            let de = cas.diff(elastic, q[c]);
-            let dr = cas.diff(rayleigh, qd[c]);
-            out[cell::forces(n) + c] = cas.add(de, dr);
-            out[cell::inertia_rates(n) + c] = cas.diff(lateral, q[c]);
-        }
-        out
-    }
-
-    /// The pose cell's outputs.
-    pub fn pose(&self, cas: &mut Cas) -> Vec<ExprId> {
-        let m = &self.m;
-        let zero = cas.zero();
-        let mut out = vec![zero; pose::LEN];
-        for i in 0..3 {
-            out[pose::ROTATION + 3 * i..][..3].copy_from_slice(&m.rotation[i]);
-        }
-        for (at, v) in [
-            (pose::END, m.end),
-            (pose::END_RATE, self.end_rate),
-            (pose::OMEGA, m.omega),
-            (pose::CENTROID, m.centroid),
-            (pose::CENTROID_RATE, self.centroid_rate),
-            (pose::BODY_OMEGA, m.body_omega),
-            (pose::AXIS, m.axis),
-        ] {
-            out[at..at + 3].copy_from_slice(&v);
-        }
-        let [mass, lateral, axial, stored] = self.body;
-        out[pose::MASS] = mass;
-        out[pose::LATERAL] = lateral;
-        out[pose::AXIAL] = axial;
-        out[pose::QUAT..pose::QUAT + 4].copy_from_slice(&m.quat);
-        out[pose::ENERGY] = stored;
-        out
-    }
 }

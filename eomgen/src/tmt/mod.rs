@@ -4,6 +4,7 @@
 pub(crate) mod actuation;
 mod assemble;
 mod cell;
+mod cell_outputs;
 mod chain;
 mod inertia;
 pub(crate) mod planar;
@@ -20,7 +21,7 @@ use spatial::SpatialArm;
 
 pub use assemble::{Equations, assemble};
 pub use cell::link_chain;
-pub(crate) use cell::with_tangent;
+pub(crate) use cell_outputs::with_tangent;
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
 pub use system::ParamSymbols;
 

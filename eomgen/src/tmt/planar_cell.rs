@@ -15,7 +15,7 @@ use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::SegmentShape;
 
 use super::actuation::strain_work;
-use super::cell::{LinkKinematics, Motion, Rates};
+use super::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
 use super::inertia::Inertia;
 use super::planar::{Element2, PlanarArm, half_k_sq};
 use super::system::{Coordinates, ParamSymbols};
@@ -96,7 +96,7 @@ pub(super) fn derive_planar_cell(g: &SegmentShape, actuated: bool) -> Option<[Ta
     let pose_out = kin.pose(cas);
     Some([
         cas.to_tape(&out),
-        super::cell::with_tangent(cas, &out, &[q], &[qd]),
+        with_tangent(cas, &out, &[q], &[qd]),
         cas.to_tape(&pose_out),
     ])
 }
