@@ -54,11 +54,13 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
                 let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
                 compiled.eval_kernel(kind, t, &q, &qd, &mut a);
                 interpreted.eval_kernel(kind, t, &q, &qd, &mut b);
-                // A compiled 3D chain computes MassBias by the link
-                // recursion (runtime/src/links.rs), not the interpreter's
-                // flat tape: entries zero in closed form come out as
-                // different round-off, so M and h are each held to 1e-12
-                // of their largest entry. The other kernels run the same
+                // Compiled chains take MassBias (3D) and Outputs from the
+                // link recursion (runtime/src/links/), eba from its parts
+                // (runtime/src/parts.rs), not the interpreter's flat tapes:
+                // entries zero in closed form come out as different
+                // round-off, so M and h are each held to 1e-12 of their
+                // largest entry, and the outputs to 1e-12 of their kind's
+                // (position, energy, quaternion). Accel runs the same
                 // operations in both backends.
                 let m_len = n * (n + 1) / 2;
                 let largest =
@@ -69,6 +71,11 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
                     let (rel, floor) = match kind {
                         KernelKind::MassBias if k < m_len => (1e-12, m_scale),
                         KernelKind::MassBias => (1e-12, h_scale),
+                        KernelKind::Outputs => match k {
+                            0..3 => (1e-12, largest(0..3)),
+                            3 | 4 => (1e-12, largest(3..5)),
+                            _ => (1e-12, 1.0),
+                        },
                         _ => (1e-12, 0.0),
                     };
                     assert_close(a[k], b[k], rel, floor, &format!("{} {kind:?}[{k}]", m.name));
@@ -398,7 +405,7 @@ kind = "constant"
 value = 0.3
 "#;
 
-/// The link recursion (runtime/src/links.rs) with its cells interpreted
+/// The link recursion (runtime/src/links/) with its cells interpreted
 /// against the flat `MassBias` tape of the TMT sums, for every link shape
 /// and tip it covers: twist, stretch, thinning, vc modules, rom slices, a
 /// tip point mass, a tip cylinder, loads in the tip frame, a turned base;
