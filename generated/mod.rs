@@ -17,6 +17,8 @@ pub mod eba_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod ebr_arm;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod falling_ball;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod hybrid_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod long_arm;
@@ -83,6 +85,13 @@ pub static MODELS: &[CompiledModel] = &[
         dof: ebr_arm::DOF,
         source: include_str!("../models/ebr_arm.toml"),
         kernels: || Box::new(ebr_arm::Compiled::default()),
+    },
+    CompiledModel {
+        name: "falling_ball",
+        hash: falling_ball::HASH,
+        dof: falling_ball::DOF,
+        source: include_str!("../models/falling_ball.toml"),
+        kernels: || Box::new(falling_ball::Compiled::default()),
     },
     CompiledModel {
         name: "hybrid_arm",

@@ -217,6 +217,9 @@ fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
     for o in OUTPUT_NAMES {
         s.push_str(&format!(",{o}"));
     }
+    for r in softarm::joints::reaction_names(arm) {
+        s.push_str(&format!(",{r}"));
+    }
     s.push('\n');
     for (t, x) in traj.t.iter().zip(&traj.x) {
         s.push_str(&format!("{t:.9}"));
@@ -225,6 +228,11 @@ fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
         }
         for v in arm.outputs(*t, &x[..n], &x[n..]) {
             s.push_str(&format!(",{v:.12e}"));
+        }
+        if !arm.info().constraints.is_empty() {
+            for v in softarm::joints::reactions(arm, *t, x) {
+                s.push_str(&format!(",{v:.12e}"));
+            }
         }
         s.push('\n');
     }
@@ -236,7 +244,12 @@ fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
 fn initial_coordinates(a: &SimulateArgs, loaded: &mut Loaded) -> Result<Vec<f64>> {
     let n = loaded.arm.dof();
     let coords = loaded.arm.info().coordinates.clone();
-    let q0 = optional_vector("--q0", &a.q0, n, &coords)?;
+    let q0 = match &a.q0 {
+        Some(s) => parse_vector("--q0", s, n, &coords)?,
+        None => {
+            eomgen::model::assembly::initial_coordinates(&loaded.model, &coords, &loaded.origin)?
+        }
+    };
     let start = match a.start {
         Some(StartArg::Rest) => Start::Rest,
         Some(StartArg::Static) => Start::Static,
@@ -348,7 +361,15 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     let arm = &*loaded.arm;
     let mut opts = run_options(&a, &loaded.model.simulate)?;
     let (t_end, solver) = (opts.t_end, opts.solver);
-    let qd0 = optional_vector("--qd0", &a.qd0, n, &coords)?;
+    let mut qd0 = optional_vector("--qd0", &a.qd0, n, &coords)?;
+    let mut q0 = q0;
+    let assembled_m = softarm::joints::assemble(arm, &loaded.origin, &mut q0, &mut qd0)?;
+    if assembled_m > 0.0 {
+        eprintln!(
+            "{}: the initial state was assembled onto the joints, moving the coordinates by {:.3e} (Euclidean norm)",
+            loaded.model.name, assembled_m
+        );
+    }
     // Measured data to compare with: sampled at its own times.
     let measured = match &loaded.model.compare {
         Some(spec) => {
@@ -390,6 +411,12 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         &out_dir.join("trajectory.csv"),
         trajectory_csv(arm, &traj).as_bytes(),
     )?;
+    let body_names: Vec<String> = loaded.model.bodies.iter().map(|b| b.name.clone()).collect();
+    for (body, ix) in softarm::joints::free_bodies(arm, &body_names) {
+        let path: Vec<(f64, f64)> = traj.x.iter().map(|x| (x[ix], x[ix + 1])).collect();
+        let title = format!("{}: path of {body}", loaded.model.name);
+        softarm::joints::plot_path(&out_dir.join(&body), &title, &path)?;
+    }
     let final_state = traj.x.last().cloned().unwrap_or_default();
     let t_final = traj.t.last().copied().unwrap_or(0.0);
     let tip = if final_state.len() == 2 * n {
@@ -421,6 +448,9 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         "wall_s": stats.wall_s,
         "status": if failure.is_some() { "failed" } else { "ok" },
         "tip_error": tip_error,
+        "assembly_moved": assembled_m,
+        "constraint_drift_max_m": stats.constraints.map(|c| c.drift_max_m),
+        "constraints": stats.constraints,
         "failure": failure.as_ref().map(|f| f.1.clone()),
         "final_state": {
             "t": t_final,

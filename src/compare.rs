@@ -262,7 +262,7 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 /// Encode 8-bit RGB pixels as a PNG file.
-fn write_png(path: &Path, size: (u32, u32), rgb: &[u8]) -> Result<()> {
+pub fn write_png(path: &Path, size: (u32, u32), rgb: &[u8]) -> Result<()> {
     let mut bytes = Vec::new();
     let mut enc = png::Encoder::new(&mut bytes, size.0, size.1);
     enc.set_color(png::ColorType::Rgb);
@@ -275,7 +275,7 @@ fn write_png(path: &Path, size: (u32, u32), rgb: &[u8]) -> Result<()> {
 
 /// The bundled font (DejaVu Sans Mono, assets/fonts): plots need no system
 /// fonts.
-fn register_font() {
+pub fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         let font: &'static [u8] = include_bytes!("../assets/fonts/DejaVuSansMono.ttf");

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use eomgen::model::{Input, Model, Offset, ParamLayout, channel};
+use eomgen::model::{Input, Model, Offset, ParamLayout};
 use runtime::signal::{Drive, Signal, Table, moving_average};
 
 use crate::data::{Csv, resolve};
@@ -83,8 +83,10 @@ pub fn model_drives(model: &Model, layout: &ParamLayout, base: &Path) -> Result<
     let mut signals: BTreeMap<&str, Signal> = BTreeMap::new();
     let mut out = Vec::new();
     for d in layout.driven() {
-        let name = channel(model, d.param)
+        let name = layout
+            .channel(model, d.param)
             .with_context(|| format!("{}: no input channel (generator bug)", d.param.name()))?;
+        let name = name.as_str();
         let (key, input) = model.inputs.get_key_value(name).expect("validated");
         if !signals.contains_key(name) {
             signals.insert(key, signal(name, input, base)?);

@@ -12,3 +12,4 @@ pub mod compare;
 pub mod continuum;
 pub mod data;
 pub mod inputs;
+pub mod joints;

@@ -2,9 +2,13 @@
 
 use runtime::{ModelInfo, TapeSet};
 
+use crate::cas::ExprId;
 use crate::cas::{Cas, Hoist};
 use crate::model::{Model, ParamLayout, Structure};
-use crate::tmt::{SYMBOLIC_SOLVE_MAX_DOF, assemble, link_chain, solve_accelerations, system};
+use crate::tmt::{
+    SYMBOLIC_SOLVE_MAX_DOF, System, assemble, assembly_system, link_chain, solve_accelerations,
+    system,
+};
 
 /// Derive the kernels of a model's structure.
 pub fn derive(model: &Model) -> TapeSet {
@@ -16,7 +20,13 @@ pub fn derive(model: &Model) -> TapeSet {
 pub fn derive_structure(structure: &Structure) -> TapeSet {
     let layout = ParamLayout::of(structure);
     let mut cas = Cas::new();
-    let sys = system(&mut cas, structure, &layout);
+    let (sys, phi, rows) = match &structure.assembly {
+        Some(a) => {
+            let assembled = assembly_system(&mut cas, a, &layout);
+            (assembled.sys, assembled.constraints, assembled.rows)
+        }
+        None => (system(&mut cas, structure, &layout), Vec::new(), Vec::new()),
+    };
     let eq = assemble(&mut cas, &sys);
     let mut mass_bias = eq.mass_upper.clone();
     mass_bias.extend_from_slice(&eq.bias);
@@ -29,8 +39,17 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
     // -h at run time: their compiled mass + bias and an L D L^T solve beat
     // a generated symbolic solve, whose unrolled code is past the
     // instruction caches.
-    let links = link_chain(structure, &layout);
-    let accel = n <= SYMBOLIC_SOLVE_MAX_DOF && !links.as_ref().is_some_and(|l| l.mass_bias);
+    // An assembly is many chains and bodies: flat kernels.
+    let single = structure.assembly.is_none();
+    let links = if single {
+        link_chain(structure, &layout)
+    } else {
+        None
+    };
+    // Joints need M and h apart (the constrained solve is at run time).
+    let accel = n <= SYMBOLIC_SOLVE_MAX_DOF
+        && !links.as_ref().is_some_and(|l| l.mass_bias)
+        && phi.is_empty();
     let accel_tape = if accel {
         let (qdd, pivots) = solve_accelerations(&mut cas, &eq.mass_upper, &eq.bias);
         let outs: Vec<_> = qdd.into_iter().chain(pivots).collect();
@@ -39,6 +58,12 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
         runtime::Tape::default()
     };
     let jvp = cas.to_tape_hoisted(&eq.jvp, &mut hoist);
+    let constraints = if phi.is_empty() {
+        runtime::Tape::default()
+    } else {
+        let outs = constraint_outputs(&mut cas, &sys, &phi);
+        cas.to_tape_hoisted(&outs, &mut hoist)
+    };
     let derived = hoist.finish(&mut cas);
     TapeSet {
         info: ModelInfo {
@@ -48,16 +73,35 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
             derived: hoist.len(),
             accel,
             loads: layout.loads(),
+            constraints: rows,
         },
         mass_bias,
         outputs,
         derived,
         accel: accel_tape,
         jvp,
+        constraints,
         parts: match links {
-            None => crate::method::eba::part_kernels(structure, &layout),
+            None if single => crate::method::eba::part_kernels(structure, &layout),
+            None => None,
             Some(_) => None,
         },
         links,
     }
+}
+
+/// The `Constraints` kernel's outputs: phi, J = d phi/dq row by row, and
+/// gamma = (d/dt J) qd, the time derivative of phi' = J qd at qdd = 0.
+fn constraint_outputs(cas: &mut Cas, sys: &System, phi: &[ExprId]) -> Vec<ExprId> {
+    let mut pairs = sys.coords.rate_pairs();
+    pairs.extend(&sys.seeds);
+    let mut outs = phi.to_vec();
+    for &row in phi {
+        for &q in &sys.coords.q {
+            outs.push(cas.diff(row, q));
+        }
+    }
+    let rate = cas.kinematic_rates(phi, &pairs);
+    outs.extend(cas.kinematic_rates(&rate, &pairs));
+    outs
 }

@@ -351,7 +351,17 @@ impl<'a> KernelEmitter<'a> {
             for (k, &s) in self.tape.outputs.iter().enumerate() {
                 let owner = self.chunk_of[s as usize].unwrap_or(n_chunks - 1);
                 if owner == c {
-                    let val = self.read(s, c);
+                    let val = match self.tape.ops[s as usize] {
+                        // A constant output without lit's parentheses.
+                        Op::Const(v) if !self.lanes => {
+                            let l = Literal::f64_suffixed(v.abs());
+                            match v.is_sign_negative() {
+                                true => quote!(-#l),
+                                false => quote!(#l),
+                            }
+                        }
+                        _ => self.read(s, c),
+                    };
                     body.push(if self.lanes {
                         quote!(out[#k] = runtime::lanes::to_array(#val);)
                     } else {
@@ -887,6 +897,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     let n_derived = info.derived;
     let accel = info.accel;
     let loads = &info.loads;
+    let rows = &info.constraints;
     let hash = &info.hash;
     let coords = &info.coordinates;
     let params = &info.parameters;
@@ -935,6 +946,8 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         pub const ACCEL: bool = #accel;
         /// Base parameters that are loads (scaled by load continuation).
         pub const LOADS: &[usize] = &[#(#loads),*];
+        /// The rows of the joints' constraint equations.
+        pub const CONSTRAINTS: &[&str] = &[#(#rows),*];
 
         /// The compiled kernels of this structure.
         pub struct Compiled {
@@ -951,6 +964,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                         derived: DERIVED,
                         accel: ACCEL,
                         loads: LOADS.to_vec(),
+                        constraints: CONSTRAINTS.iter().map(|s| s.to_string()).collect(),
                     },
                 }
             }

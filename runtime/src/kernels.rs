@@ -27,6 +27,11 @@ use crate::tape::{Inputs, Tape};
 ///   and the tangent stiffness K = d h(q, 0) / dq as its columns at
 ///   qd = qdd = 0 (`Dynamics::stiffness`): one kernel the size of a few h
 ///   kernels instead of n^2 entries each.
+/// * `Constraints`: the joints of an assembly as phi(q) = 0, m rows
+///   (`ModelInfo::constraints`): phi (m values), its Jacobian J = d phi/dq
+///   (m x n, row-major) and the velocity product gamma = (d/dt J) qd
+///   (m values), so that J qdd + gamma = 0 holds the joints at the
+///   acceleration level. Empty for a model without joints.
 /// * `Derived`: the derived parameters (parameter-only subexpressions the
 ///   generator hoisted out of the other kernels), computed once per
 ///   parameter set; the other kernels read them after the base parameters.
@@ -37,15 +42,17 @@ pub enum KernelKind {
     Accel,
     Jvp,
     Derived,
+    Constraints,
 }
 
 impl KernelKind {
-    pub const ALL: [KernelKind; 5] = [
+    pub const ALL: [KernelKind; 6] = [
         Self::Jvp,
         Self::Accel,
         Self::MassBias,
         Self::Outputs,
         Self::Derived,
+        Self::Constraints,
     ];
 
     pub fn output_len(self, info: &ModelInfo) -> usize {
@@ -56,6 +63,7 @@ impl KernelKind {
             Self::Outputs => OUTPUT_NAMES.len(),
             Self::Derived => info.derived,
             Self::Jvp => dof,
+            Self::Constraints => info.constraints.len() * (dof + 2),
             Self::Accel => {
                 if info.accel {
                     2 * dof
@@ -73,6 +81,7 @@ impl KernelKind {
             Self::Derived => "derived",
             Self::Jvp => "jvp",
             Self::Accel => "accel",
+            Self::Constraints => "constraints",
         }
     }
 }
@@ -109,6 +118,10 @@ pub struct ModelInfo {
     /// Indices of the base parameters that are loads (gravity, applied
     /// forces): statics scales them for load continuation.
     pub loads: Vec<usize>,
+    /// The rows of the `Constraints` kernel by name, `JOINT.x`, `JOINT.y`,
+    /// `JOINT.angle` (none for a model without joints).
+    #[serde(default)]
+    pub constraints: Vec<String>,
 }
 
 impl ModelInfo {
@@ -153,6 +166,9 @@ pub struct TapeSet {
     /// Empty unless `info.accel`.
     pub accel: Tape,
     pub jvp: Tape,
+    /// Empty unless `info.constraints > 0`.
+    #[serde(default)]
+    pub constraints: Tape,
     /// The layout and kernels of the link recursion (`crate::links`),
     /// which compiled models of the chains it covers use for `MassBias`;
     /// the interpreter keeps the flat tape.
@@ -172,6 +188,7 @@ impl TapeSet {
             KernelKind::Derived => &self.derived,
             KernelKind::Accel => &self.accel,
             KernelKind::Jvp => &self.jvp,
+            KernelKind::Constraints => &self.constraints,
         }
     }
 }

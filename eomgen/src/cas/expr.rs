@@ -127,6 +127,19 @@ pub struct Cas {
     /// Parameters that change with time (a prescribed base motion): to
     /// time derivatives they are variables, not constants.
     moving: rustc_hash::FxHashSet<SymId>,
+    /// Symbols created now belong to one subsystem of an assembly
+    /// (`Cas::scoped`).
+    scope: Option<Scope>,
+}
+
+/// A subsystem's place in an assembly: its symbols' names get `prefix`, its
+/// coordinate and parameter indices the offsets, so a kinematics written
+/// for one arm builds any arm of several unchanged.
+#[derive(Clone, Debug)]
+pub struct Scope {
+    pub prefix: String,
+    pub coordinates: u32,
+    pub parameters: u32,
 }
 
 /// The non-parameter symbols an expression depends on, as far as the time
@@ -204,6 +217,21 @@ impl Cas {
 
     /// The symbol named `name`, created with `kind` if new.
     pub fn symbol(&mut self, name: &str, kind: SymKind) -> ExprId {
+        let scoped;
+        let (name, kind) = match &self.scope {
+            None => (name, kind),
+            Some(sc) => {
+                scoped = format!("{}{name}", sc.prefix);
+                let kind = match kind {
+                    SymKind::Q(i) => SymKind::Q(i + sc.coordinates),
+                    SymKind::Qd(i) => SymKind::Qd(i + sc.coordinates),
+                    SymKind::Qdd(i) => SymKind::Qdd(i + sc.coordinates),
+                    SymKind::Param(i) => SymKind::Param(i + sc.parameters),
+                    k => k,
+                };
+                (scoped.as_str(), kind)
+            }
+        };
         let id = match self.sym_index.get(name) {
             Some(&s) => s,
             None => {
@@ -214,6 +242,14 @@ impl Cas {
             }
         };
         self.intern(Node::Sym(id))
+    }
+
+    /// Run `f` with the symbols it creates in `scope` (one arm of several).
+    pub fn scoped<R>(&mut self, scope: Scope, f: impl FnOnce(&mut Self) -> R) -> R {
+        let outer = self.scope.replace(scope);
+        let r = f(self);
+        self.scope = outer;
+        r
     }
 
     /// Declare parameter `e` time-varying (before building expressions of

@@ -20,5 +20,5 @@ mod tests;
 mod turning;
 
 pub(crate) use expr::Variables;
-pub use expr::{Cas, ExprId, Func, Node, SymId, SymKind};
+pub use expr::{Cas, ExprId, Func, Node, Scope, SymId, SymKind};
 pub use lower::{Hoist, Lowerer};

@@ -239,6 +239,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         tip_orientation: quat,
         chain: None,
         seeds: base.seeds,
+        planar: None,
     };
     let mount = TipMount {
         point: tip,
@@ -557,6 +558,7 @@ fn empty_system(cas: &mut Cas, coords: Coordinates, gravity: V3) -> System {
         tip_orientation: [one, zero, zero, zero],
         chain: None,
         seeds: Vec::new(),
+        planar: None,
     }
 }
 

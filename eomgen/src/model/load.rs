@@ -10,7 +10,8 @@ use super::validate::validate;
 /// One `--set PATH=VALUE` override.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Override {
-    /// Dotted path; array items by index (`segment.1.length`).
+    /// Dotted path; array items by index (`segment.1.length`) or name
+    /// (`arm.left.segment.0.length`).
     pub path: Vec<String>,
     pub value: toml::Value,
     /// The text as given, for messages.
@@ -84,9 +85,20 @@ impl Override {
                 }
                 toml::Value::Array(a) => {
                     let n = a.len();
-                    let i: usize = key.parse().map_err(|_| {
-                        err(format!("`{key}` is not an index: this level is a list of {n} items, use 0 to {}", n.saturating_sub(1)))
-                    })?;
+                    // An item by index, or by its `name` (`arm.left`).
+                    let named = a.iter().position(|item| {
+                        item.get("name").and_then(toml::Value::as_str) == Some(key.as_str())
+                    });
+                    let i: usize = match (key.parse(), named) {
+                        (Ok(i), _) => i,
+                        (Err(_), Some(i)) => i,
+                        (Err(_), None) => {
+                            return Err(err(format!(
+                                "`{key}` is neither an index nor an item's name: this level is a list of {n} items, use 0 to {} or a name",
+                                n.saturating_sub(1)
+                            )));
+                        }
+                    };
                     let item = a.get_mut(i).ok_or_else(|| {
                         err(format!("index {i} is out of range: the list has {n} items"))
                     })?;

@@ -195,6 +195,45 @@ pub enum Param {
     },
     /// Joint torque i's generalised force (an input).
     Torque(usize),
+    /// An assembly: parameter `index` of arm `arm`'s own layout.
+    Scoped {
+        arm: u16,
+        index: u32,
+    },
+    /// An assembly's body `0`'s quantity.
+    Body(u16, BodyParam),
+    /// An assembly's joint `0`'s offsets and angle.
+    Joint(u16, JointParam),
+    /// Arm `0`'s compliant base.
+    BaseSpring(u16, SpringParam),
+}
+
+/// A rigid body's quantities: mass, planar inertia, and where a fixed body
+/// sits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum BodyParam {
+    Mass,
+    Inertia,
+    Position(Xyz),
+    Angle,
+}
+
+/// A joint's points in its two frames, and a weld's angle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum JointParam {
+    OffsetA(Xyz),
+    OffsetB(Xyz),
+    Angle,
+}
+
+/// A compliant base: its mass, spring and damper, and the driven point it
+/// follows (displacement and velocity: inputs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum SpringParam {
+    Mass,
+    Stiffness,
+    Damping,
+    Follow(Rate, Xyz),
 }
 
 impl Param {
@@ -232,6 +271,30 @@ impl Param {
                 format!("tendon[{tendon}][{segment}].{}", if z { "z" } else { "y" })
             }
             Self::Torque(i) => format!("torque[{i}]"),
+            Self::Scoped { arm, index } => format!("arm[{arm}].p[{index}]"),
+            Self::Body(b, what) => match what {
+                BodyParam::Mass => format!("body[{b}].mass"),
+                BodyParam::Inertia => format!("body[{b}].inertia"),
+                BodyParam::Position(c) => format!("body[{b}].{}", c.name()),
+                BodyParam::Angle => format!("body[{b}].angle"),
+            },
+            Self::Joint(j, what) => match what {
+                JointParam::OffsetA(c) => format!("joint[{j}].offset_a.{}", c.name()),
+                JointParam::OffsetB(c) => format!("joint[{j}].offset_b.{}", c.name()),
+                JointParam::Angle => format!("joint[{j}].angle"),
+            },
+            Self::BaseSpring(a, what) => match what {
+                SpringParam::Mass => format!("arm[{a}].base.mass"),
+                SpringParam::Stiffness => format!("arm[{a}].base.stiffness"),
+                SpringParam::Damping => format!("arm[{a}].base.damping"),
+                SpringParam::Follow(r, c) => {
+                    format!(
+                        "arm[{a}].base.follow_{}{}",
+                        ["s", "v", "a"][r as usize],
+                        c.name()
+                    )
+                }
+            },
         }
     }
 
@@ -263,15 +326,20 @@ pub struct Driven {
 /// may not read.)
 #[derive(Clone, Debug, Default)]
 pub struct ParamLayout {
-    params: Vec<Param>,
-    index: HashMap<Param, usize>,
-    driven: Vec<Driven>,
+    pub(super) params: Vec<Param>,
+    pub(super) index: HashMap<Param, usize>,
+    pub(super) driven: Vec<Driven>,
+    /// An assembly's arms: name, first slot, own layout.
+    pub(super) arms: Vec<(String, usize, ParamLayout)>,
 }
 
 impl ParamLayout {
     /// The layout of `st`: gravity, base, base motion, tip, elements,
     /// actuators, torques.
     pub fn of(st: &Structure) -> Self {
+        if let Some(a) = &st.assembly {
+            return Self::of_assembly(a);
+        }
         let spatial = st.dimensions == 3;
         let mut p = Vec::new();
         let mut driven = Vec::new();
@@ -371,6 +439,7 @@ impl ParamLayout {
             params: p,
             index,
             driven,
+            arms: Vec::new(),
         }
     }
 
@@ -402,7 +471,28 @@ impl ParamLayout {
     }
 
     pub fn names(&self) -> Vec<String> {
-        self.params.iter().map(|p| p.name()).collect()
+        self.params.iter().map(|&p| self.name(p)).collect()
+    }
+
+    /// `p`'s name; an assembly arm's parameters by the arm's name.
+    pub fn name(&self, p: Param) -> String {
+        match p {
+            Param::Scoped { arm, index } => {
+                let (name, _, layout) = &self.arms[arm as usize];
+                let inner = layout.params[index as usize].name();
+                if name.is_empty() {
+                    inner
+                } else {
+                    format!("{name}.{inner}")
+                }
+            }
+            p => p.name(),
+        }
+    }
+
+    /// An assembly's arms: name, first slot, own layout (empty otherwise).
+    pub fn arms(&self) -> &[(String, usize, ParamLayout)] {
+        &self.arms
     }
 
     /// The parameters input channels drive (never folded into derived
@@ -414,13 +504,21 @@ impl ParamLayout {
     /// The slots of the loads (statics scales them).
     pub fn loads(&self) -> Vec<usize> {
         (0..self.params.len())
-            .filter(|&i| self.params[i].is_load())
+            .filter(|&i| match self.params[i] {
+                Param::Scoped { arm, index } => {
+                    self.arms[arm as usize].2.params[index as usize].is_load()
+                }
+                p => p.is_load(),
+            })
             .collect()
     }
 
     /// The values of a model with this layout's structure, in layout order
     /// (driven parameters start at 0: their signals set them).
     pub fn values(&self, m: &Model) -> Vec<f64> {
+        if !self.arms.is_empty() || m.is_assembly() {
+            return self.assembly_values(m);
+        }
         let elements = element_props(m);
         let d = m.base.direction;
         let rotation = base_rotation(d);
@@ -465,6 +563,7 @@ impl ParamLayout {
                     let angle = t.angle.as_ref().map_or(0.0, |a| a.at(segment)).to_radians();
                     if z { d * angle.sin() } else { d * angle.cos() }
                 }
+                _ => unreachable!("assembly parameters have their own values"),
             })
             .collect()
     }

@@ -16,8 +16,10 @@ pub struct Model {
     pub dimensions: u8,
     /// Gravitational acceleration in the world frame (m/s^2).
     pub gravity: [f64; 3],
+    /// The arm of a single-arm file (absent when `[[arm]]`s declare them).
+    #[serde(default)]
     pub base: Base,
-    #[serde(rename = "segment")]
+    #[serde(default, rename = "segment")]
     pub segments: Vec<Segment>,
     #[serde(default)]
     pub tip: Tip,
@@ -39,6 +41,14 @@ pub struct Model {
     /// Defaults for `softarm simulate`; its options override them.
     #[serde(default)]
     pub simulate: SimulateDefaults,
+    /// Several arms (`[[arm]]`), rigid bodies and joints: an assembly
+    /// (`model::assembly`).
+    #[serde(default, rename = "arm")]
+    pub arms: Vec<super::assembly::ArmDecl>,
+    #[serde(default, rename = "body")]
+    pub bodies: Vec<super::assembly::BodyDecl>,
+    #[serde(default, rename = "joint")]
+    pub joints: Vec<super::assembly::JointDecl>,
 }
 
 /// `[simulate]`: how this arm is best simulated. Not structural.
@@ -54,6 +64,10 @@ pub struct SimulateDefaults {
     pub dt: Option<f64>,
     /// Initial state: "rest" (default) or "static" (the equilibrium at t = 0).
     pub start: Option<Start>,
+    /// Initial coordinates by name (the rest 0, a free body's from its
+    /// `position` and `angle`); `--q0` replaces them all.
+    #[serde(default)]
+    pub q0: std::collections::BTreeMap<String, f64>,
 }
 
 /// How a simulation starts.
@@ -66,7 +80,7 @@ pub enum Start {
     Static,
 }
 
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Base {
     /// Where the arm is clamped (m).
@@ -88,6 +102,20 @@ pub struct Base {
     /// The axis of each turn (3D, any length); default z, y, x in turn.
     #[serde(default)]
     pub rotation_axes: Option<Vec<[f64; 3]>>,
+    /// A compliant base (planar): the clamp is a mass on a spring and a
+    /// damper to a driven point, `follow` (input channels of the point's
+    /// displacement from `position` along x, y; none: it stays put).
+    /// Structural: present or not.
+    #[serde(default)]
+    pub mass: Option<f64>,
+    /// N/m.
+    #[serde(default)]
+    pub stiffness: Option<f64>,
+    /// N s/m.
+    #[serde(default)]
+    pub damping: Option<f64>,
+    #[serde(default)]
+    pub follow: Option<Vec<String>>,
 }
 
 /// How a segment is modelled. Structural: changing it derives anew.

@@ -7,11 +7,12 @@
 
 use sha2::{Digest, Sha256};
 
+use super::assembly::{FrameRef, JointKind};
 use super::schema::{Axis, Joints, Method, Model, WrenchFrame};
 
 /// Bumped whenever derivation or emission changes what is generated, so
 /// that cached tapes and generated files are re-derived.
-pub const GENERATOR_VERSION: u32 = 55;
+pub const GENERATOR_VERSION: u32 = 57;
 
 /// The structural part of one segment.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -74,10 +75,81 @@ pub struct Structure {
     /// The base translates; how many prescribed turns it makes.
     pub base_translates: bool,
     pub base_turns: usize,
+    /// The base is a mass on springs (coordinates of the assembly).
+    pub base_compliant: bool,
+    /// ... and follows a driven point (`base.follow`).
+    pub base_follows: bool,
+    /// Several arms, bodies and joints: the arms' own structures and what
+    /// joins them (the fields above are then empty).
+    pub assembly: Option<Box<AssemblyShape>>,
+}
+
+/// The structure of an assembly: its arms, which bodies are free, and
+/// which frames each joint holds together, how.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct AssemblyShape {
+    pub arms: Vec<(String, Structure)>,
+    /// Per body: its name (it names coordinates) and whether it is free
+    /// (its own coordinates) or fixed.
+    pub bodies: Vec<(String, bool)>,
+    pub joints: Vec<JointShape>,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct JointShape {
+    pub name: String,
+    pub kind: JointKind,
+    pub a: FrameRef,
+    pub b: FrameRef,
 }
 
 impl Structure {
     pub fn of(m: &Model) -> Self {
+        if !m.is_assembly() {
+            return Self::of_arm(m);
+        }
+        let frame = |t: &str| FrameRef::parse(t, m).unwrap_or(FrameRef::World);
+        let assembly = AssemblyShape {
+            arms: m
+                .arm_models()
+                .iter()
+                .map(|(name, a)| (name.clone(), Self::of_arm(a)))
+                .collect(),
+            bodies: m.bodies.iter().map(|b| (b.name.clone(), b.free)).collect(),
+            joints: m
+                .joints
+                .iter()
+                .map(|j| JointShape {
+                    name: j.name.clone(),
+                    kind: j.kind,
+                    a: frame(&j.a),
+                    b: frame(&j.b),
+                })
+                .collect(),
+        };
+        Self {
+            dimensions: m.dimensions,
+            segments: Vec::new(),
+            tip_mass: false,
+            tip_force: false,
+            tip_moment: false,
+            tip_length: false,
+            tip_frame_wrench: false,
+            tip_force_driven: false,
+            tip_moment_driven: false,
+            chambers: Vec::new(),
+            tendons: Vec::new(),
+            torques: Vec::new(),
+            base_translates: false,
+            base_turns: 0,
+            base_compliant: false,
+            base_follows: false,
+            assembly: Some(Box::new(assembly)),
+        }
+    }
+
+    /// The structure of one arm (the model's own, or one of an assembly's).
+    fn of_arm(m: &Model) -> Self {
         let spatial = m.dimensions == 3;
         Self {
             dimensions: m.dimensions,
@@ -140,11 +212,31 @@ impl Structure {
             torques: m.torques.iter().map(|t| t.coordinate.clone()).collect(),
             base_translates: m.base.translation_inputs.is_some(),
             base_turns: m.base.rotation_inputs.as_ref().map_or(0, Vec::len),
+            base_compliant: m.base.is_compliant(),
+            base_follows: m.base.is_compliant() && m.base.follow.is_some(),
+            assembly: None,
         }
     }
 
     /// Canonical text of the structure (what is hashed).
     pub fn canonical(&self) -> String {
+        if let Some(a) = &self.assembly {
+            let mut s = format!("assembly of {} arms\n", a.arms.len());
+            for (name, arm) in &a.arms {
+                s.push_str(&format!("arm {name:?}\n{}", arm.canonical()));
+            }
+            s.push_str(&format!("bodies {:?}\n", a.bodies));
+            for j in &a.joints {
+                s.push_str(&format!(
+                    "joint {:?} {} {:?} {:?}\n",
+                    j.name,
+                    j.kind.name(),
+                    j.a,
+                    j.b
+                ));
+            }
+            return s;
+        }
         let space = if self.dimensions == 3 {
             "spatial"
         } else {
@@ -201,6 +293,9 @@ impl Structure {
         }
         if !self.torques.is_empty() {
             s.push_str(&format!("torques {:?}\n", self.torques));
+        }
+        if self.base_compliant {
+            s.push_str(&format!("base compliant follows {}\n", self.base_follows));
         }
         if self.base_translates || self.base_turns > 0 {
             s.push_str(&format!(

@@ -12,6 +12,16 @@ pub const MAX_ELEMENTS: usize = 500;
 /// Check what the types alone cannot express, concern by concern; the
 /// first problem found is the error.
 pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
+    if m.is_assembly() {
+        let ck = Check { m, file };
+        super::assembly_check::check_assembly(&ck, |arm| validate_arm(arm, file))?;
+        return simulate_defaults(&ck).and_then(|_| signals(&ck));
+    }
+    validate_arm(m, file)
+}
+
+/// The checks of one arm (a single-arm file, or an assembly's arm).
+fn validate_arm(m: &Model, file: &str) -> Result<(), ModelError> {
     let ck = Check { m, file };
     simulate_defaults(&ck)?;
     frame(&ck)?;

@@ -3,6 +3,7 @@
 
 pub(crate) mod actuation;
 mod assemble;
+mod assembly;
 mod cell;
 mod cell_outputs;
 mod chain;
@@ -20,6 +21,7 @@ use planar::PlanarArm;
 use spatial::SpatialArm;
 
 pub use assemble::{Equations, assemble};
+pub use assembly::{Assembled, assembly_system};
 pub use cell::link_chain;
 pub(crate) use cell_outputs::with_tangent;
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
@@ -30,8 +32,14 @@ pub use system::ParamSymbols;
 /// symbols of `layout` (values never reach the derivation).
 pub fn system(cas: &mut Cas, structure: &Structure, layout: &ParamLayout) -> System {
     let symbols = ParamSymbols::new(cas, layout);
-    let mut sys = kinematics(cas, structure, &symbols);
-    apply_torques(cas, structure, &symbols, &mut sys);
+    arm_system(cas, structure, &symbols)
+}
+
+/// One arm's system on the given parameter symbols (an assembly's arm
+/// passes scoped ones).
+pub(crate) fn arm_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
+    let mut sys = kinematics(cas, structure, symbols);
+    apply_torques(cas, structure, symbols, &mut sys);
     sys
 }
 

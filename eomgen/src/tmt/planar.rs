@@ -13,7 +13,8 @@ use crate::model::{ElementParam, Param, Structure};
 
 use super::actuation::{Strain, actuation};
 use super::system::{
-    Body, Chain, Coordinates, Inertia, Link, ParamSymbols, System, TipMount, tip_loads,
+    Body, Chain, Coordinates, Inertia, Link, ParamSymbols, PlanarFrames, PlanarPose, System,
+    TipMount, tip_loads,
 };
 
 /// A planar frame: origin, absolute angle and its rate.
@@ -47,6 +48,9 @@ pub(crate) struct PlanarArm<'a> {
     seeds: Vec<(ExprId, ExprId)>,
     /// The next element.
     k: usize,
+    /// The segment of the element being placed, and each segment's end.
+    segment: usize,
+    ends: Vec<PlanarPose>,
 }
 
 /// One planar element: its angle, rate and parameters.
@@ -91,6 +95,8 @@ impl<'a> PlanarArm<'a> {
             strains: Vec::new(),
             seeds: base.seeds,
             k: 0,
+            segment: 0,
+            ends: Vec::new(),
         }
     }
 
@@ -117,6 +123,8 @@ impl<'a> PlanarArm<'a> {
             strains: Vec::new(),
             seeds: Vec::new(),
             k: 0,
+            segment: 0,
+            ends: Vec::new(),
         }
     }
 
@@ -129,6 +137,7 @@ impl<'a> PlanarArm<'a> {
     /// about z by its one angle.
     pub fn begin_element(&mut self, s: usize) -> Element2 {
         let k = self.k;
+        self.segment = s;
         let (q, qd) = (self.coords.q[k], self.coords.qd[k]);
         let zero = self.zero;
         self.strains.push(Strain {
@@ -181,6 +190,12 @@ impl<'a> PlanarArm<'a> {
         self.elastic.push(half_k_sq(cas, el.stiff, dq));
         self.rayleigh.push(half_k_sq(cas, el.damp, el.qd));
         self.k += 1;
+        let end = PlanarPose {
+            point: [f.x, f.y, self.z],
+            angle: f.phi,
+        };
+        self.ends.resize(self.segment + 1, end);
+        self.ends[self.segment] = end;
     }
 
     /// The system: what the elements built, plus gravity, actuation and the
@@ -199,6 +214,7 @@ impl<'a> PlanarArm<'a> {
             body_link,
             strains,
             seeds,
+            ends,
             ..
         } = self;
         let half_phi = cas.scaled(0.5, f.phi);
@@ -225,6 +241,13 @@ impl<'a> PlanarArm<'a> {
                 moment_link: Vec::new(),
             }),
             seeds,
+            planar: Some(PlanarFrames {
+                segment_ends: ends,
+                tip: PlanarPose {
+                    point: [f.x, f.y, z],
+                    angle: f.phi,
+                },
+            }),
         };
         // The end frame's axis and rotation only when the tip needs them (a
         // tip body with length, a wrench in the tip frame).

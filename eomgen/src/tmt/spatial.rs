@@ -498,6 +498,7 @@ impl<'a> SpatialArm<'a> {
                 moment_link: Vec::new(),
             }),
             seeds,
+            planar: None,
         };
         let mount = TipMount {
             point: f.p,

@@ -12,6 +12,8 @@ pub use super::inertia::Inertia;
 pub struct ParamSymbols {
     layout: ParamLayout,
     ids: Vec<ExprId>,
+    /// A compliant base's displacement: coordinates of the assembly.
+    base_offset: Option<[ExprId; 3]>,
 }
 
 impl ParamSymbols {
@@ -30,7 +32,15 @@ impl ParamSymbols {
         Self {
             layout: layout.clone(),
             ids,
+            base_offset: None,
         }
+    }
+
+    /// The base rides on coordinates (a compliant base of an assembly):
+    /// its displacement from the declared position.
+    pub fn with_base_offset(mut self, offset: [ExprId; 3]) -> Self {
+        self.base_offset = Some(offset);
+        self
     }
 
     /// The symbol of `p`; kinematics only ask for parameters their
@@ -65,6 +75,11 @@ impl ParamSymbols {
                 let sva = Rate::ALL.map(|r| self.get(Param::BaseTranslation(r, c)));
                 position[c.index()] = cas.add(position[c.index()], sva[0]);
                 chain(&mut seeds, sva);
+            }
+        }
+        if let Some(offset) = self.base_offset {
+            for c in 0..3 {
+                position[c] = cas.add(position[c], offset[c]);
             }
         }
         let mut turns = Vec::new();
@@ -196,6 +211,24 @@ pub struct System {
     /// Extra (parameter, rate) pairs of the kinematic time derivatives: a
     /// prescribed base motion.
     pub seeds: Vec<(ExprId, ExprId)>,
+    /// Planar chains: the frames joints may hold (`None` in 3D).
+    pub planar: Option<PlanarFrames>,
+}
+
+/// A planar frame: origin and angle from the world's x axis.
+#[derive(Clone, Copy, Debug)]
+pub struct PlanarPose {
+    pub point: [ExprId; 3],
+    pub angle: ExprId,
+}
+
+/// The frames of a planar chain a joint may name.
+#[derive(Clone, Debug)]
+pub struct PlanarFrames {
+    /// The end of each segment.
+    pub segment_ends: Vec<PlanarPose>,
+    /// The tip point, the end frame's angle.
+    pub tip: PlanarPose,
 }
 
 impl System {

@@ -66,6 +66,12 @@ pub enum AccelError {
     SingularMass { t: f64, condition: f64 },
     #[error("non-finite {what} at t = {t}: the state has left the model's valid range")]
     NonFinite { t: f64, what: &'static str },
+    #[error(
+        "the joints' constraints became dependent at t = {t} (the constraint Jacobian lost rank: \
+         redundant or conflicting joints, or a loop stretched straight); check that no two joints \
+         hold the same freedom"
+    )]
+    DependentJoints { t: f64 },
 }
 
 /// A model's kernels with numeric parameter values bound.
@@ -293,6 +299,8 @@ pub struct Workspace {
     /// `Accel` kernel output: qdd, then the pivots of M = L D L^T.
     accel: Vec<f64>,
     ldlt: Ldlt,
+    /// The constrained solve's buffers, made on first use.
+    kkt: Option<crate::constraints::KktWorkspace>,
 }
 
 impl Workspace {
@@ -302,7 +310,14 @@ impl Workspace {
             packed: vec![0.0; dof * (dof + 1) / 2 + dof],
             accel: vec![0.0; 2 * dof],
             ldlt: Ldlt::new(dof),
+            kkt: None,
         }
+    }
+
+    /// The joint forces of the last constrained solve (empty without
+    /// joints).
+    pub fn lambda(&self) -> &[f64] {
+        self.kkt.as_ref().map_or(&[], |k| &k.lambda)
     }
 }
 
@@ -318,7 +333,23 @@ pub fn accelerations<D: Dynamics + ?Sized>(
     qdd: &mut [f64],
 ) -> Result<(), AccelError> {
     let n = ws.n;
-    let solved = if d.info().accel {
+    let rows = d.info().constraints.len();
+    let solved = if rows > 0 {
+        d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
+        let (mass, bias) = ws.packed.split_at(n * (n + 1) / 2);
+        for (a, b) in qdd.iter_mut().zip(bias) {
+            *a = -b;
+        }
+        let factored = ws.ldlt.factor(mass);
+        if factored {
+            ws.ldlt.solve(qdd);
+            let kkt = ws
+                .kkt
+                .get_or_insert_with(|| crate::constraints::KktWorkspace::new(n, rows));
+            crate::constraints::solve_constrained(d, kkt, &ws.ldlt, t, q, qd, qdd)?;
+        }
+        factored
+    } else if d.info().accel {
         d.eval_kernel(KernelKind::Accel, t, q, qd, &mut ws.accel);
         qdd.copy_from_slice(&ws.accel[..n]);
         // Positive pivots: M positive definite (false for NaN too).

@@ -5,7 +5,8 @@
 //!
 //! tau = M qdd + h (= 0 along solutions), from the generated `Jvp` kernel's
 //! directional derivatives (`Dynamics::jacobian_parts`). No finite differences: implicit
-//! integrators and stiffness analysis use this.
+//! integrators and stiffness analysis use this. A system with joints is
+//! the exception (`constrained_jacobian`).
 
 use nalgebra::DMatrix;
 
@@ -19,6 +20,9 @@ pub fn rhs_jacobian<D: Dynamics + ?Sized>(
     x: &[f64],
     jac: &mut DMatrix<f64>,
 ) -> Result<Vec<f64>, AccelError> {
+    if !d.info().constraints.is_empty() {
+        return constrained_jacobian(d, ws, t, x, jac);
+    }
     let n = d.dof();
     let (q, qd) = x.split_at(n);
     let mut qdd = vec![0.0; n];
@@ -41,6 +45,40 @@ pub fn rhs_jacobian<D: Dynamics + ?Sized>(
         for j in 0..n {
             jac[(n + i, j)] = jq[(i, j)];
             jac[(n + i, n + j)] = jqd[(i, j)];
+        }
+    }
+    Ok(qdd)
+}
+
+/// J of a system with joints by central differences of the constrained
+/// accelerations: the multipliers' own dependence on the state (through J,
+/// gamma and the Schur complement) has no kernel, and 4 n solves of a
+/// few-dozen-coordinate assembly cost less than deriving one. Implicit
+/// methods reuse J across steps, so this is off the hot path.
+fn constrained_jacobian<D: Dynamics + ?Sized>(
+    d: &D,
+    ws: &mut Workspace,
+    t: f64,
+    x: &[f64],
+    jac: &mut DMatrix<f64>,
+) -> Result<Vec<f64>, AccelError> {
+    let n = d.dof();
+    let mut qdd = vec![0.0; n];
+    accelerations(d, ws, t, &x[..n], &x[n..2 * n], &mut qdd)?;
+    let (mut xp, mut plus, mut minus) = (x[..2 * n].to_vec(), vec![0.0; n], vec![0.0; n]);
+    jac.fill(0.0);
+    for i in 0..n {
+        jac[(i, n + i)] = 1.0;
+    }
+    for j in 0..2 * n {
+        let step = f64::EPSILON.cbrt() * x[j].abs().max(1.0);
+        xp[j] = x[j] + step;
+        accelerations(d, ws, t, &xp[..n], &xp[n..], &mut plus)?;
+        xp[j] = x[j] - step;
+        accelerations(d, ws, t, &xp[..n], &xp[n..], &mut minus)?;
+        xp[j] = x[j];
+        for i in 0..n {
+            jac[(n + i, j)] = (plus[i] - minus[i]) / (2.0 * step);
         }
     }
     Ok(qdd)

@@ -5,6 +5,7 @@
 //! needs the kernel layer alone).
 
 pub mod arm;
+pub mod constraints;
 pub mod cosserat;
 pub mod integrate;
 pub mod jacobian;

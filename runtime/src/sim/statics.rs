@@ -1,5 +1,5 @@
 //! Static equilibrium: h(q, 0) = 0 (gravity, elastic and applied forces
-//! balance), by Newton's method on the generalised forces with the analytic
+//! balance; with joints h + J^T lambda = 0 and phi = 0), by Newton's method on the generalised forces with the analytic
 //! tangent stiffness K = dh/dq (`Dynamics::stiffness`), a backtracking line
 //! search, and load continuation: the load parameters (gravity, applied
 //! forces) are scaled from 0 to 1 in steps that grow on success and shrink on
@@ -9,6 +9,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
 use crate::arm::Dynamics;
+use crate::constraints;
 use crate::kernels::KernelKind;
 
 #[derive(Clone, Debug)]
@@ -34,8 +35,11 @@ impl Default for StaticOptions {
 #[derive(Clone, Debug, Serialize)]
 pub struct StaticSolution {
     pub q: Vec<f64>,
-    /// max |h(q, 0)| at the solution.
+    /// max |h(q, 0) + J^T lambda| (and |phi|) at the solution.
     pub residual: f64,
+    /// The joint forces (rows as `ModelInfo::constraints`; empty without
+    /// joints).
+    pub lambda: Vec<f64>,
     /// Newton iterations over all load steps.
     pub iterations: usize,
     /// Accepted load steps.
@@ -59,12 +63,6 @@ fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
-/// Static forces and stiffness at q.
-fn forces(d: &dyn Dynamics, q: &[f64], g: &mut [f64], k: &mut [f64]) {
-    static_forces(d, q, g);
-    d.stiffness(0.0, q, k);
-}
-
 /// h(q, 0): the static generalised forces, from the `MassBias` kernel.
 fn static_forces(d: &dyn Dynamics, q: &[f64], g: &mut [f64]) {
     let n = q.len();
@@ -73,23 +71,77 @@ fn static_forces(d: &dyn Dynamics, q: &[f64], g: &mut [f64]) {
     g.copy_from_slice(&packed[n * (n + 1) / 2..]);
 }
 
-/// Newton from `q` at the current parameters. Ok: (iterations, residual).
-fn newton(d: &dyn Dynamics, q: &mut [f64], opts: &StaticOptions) -> Result<(usize, f64), String> {
-    let n = q.len();
-    let (mut g, mut kbuf) = (vec![0.0; n], vec![0.0; n * n]);
-    let mut trial = vec![0.0; n];
-    let mut g_trial = vec![0.0; n];
-    forces(d, q, &mut g, &mut kbuf);
+/// The static residual of z = [q, lambda]: h(q, 0) + J^T lambda and, with
+/// joints, phi(q) (section 9 of docs/design.md).
+fn residual(d: &dyn Dynamics, z: &[f64], r: &mut [f64]) {
+    let n = d.dof();
+    let (q, lambda) = z.split_at(n);
+    static_forces(d, q, &mut r[..n]);
+    if lambda.is_empty() {
+        return;
+    }
+    let c = constraints::evaluate(d, 0.0, q, &vec![0.0; n]);
+    let jt_l = c.jac.transpose() * DVector::from_column_slice(lambda);
+    for i in 0..n {
+        r[i] += jt_l[i];
+    }
+    r[n..].copy_from_slice(&c.phi);
+}
+
+/// The residual's Jacobian: K = dh/dq (analytic), and with joints
+/// [K + d(J^T lambda)/dq, J^T; J, 0], the middle term by central
+/// differences of the constraint kernel.
+fn tangent(d: &dyn Dynamics, z: &[f64]) -> DMatrix<f64> {
+    let n = d.dof();
+    let (q, lambda) = z.split_at(n);
+    let m = lambda.len();
+    let mut kbuf = vec![0.0; n * n];
+    d.stiffness(0.0, q, &mut kbuf);
+    let mut k = DMatrix::zeros(n + m, n + m);
+    k.view_mut((0, 0), (n, n))
+        .copy_from(&DMatrix::from_row_slice(n, n, &kbuf));
+    if m == 0 {
+        return k;
+    }
+    let zeros = vec![0.0; n];
+    let l = DVector::from_column_slice(lambda);
+    let c = constraints::evaluate(d, 0.0, q, &zeros);
+    k.view_mut((0, n), (n, m)).copy_from(&c.jac.transpose());
+    k.view_mut((n, 0), (m, n)).copy_from(&c.jac);
+    let mut qp = q.to_vec();
+    for j in 0..n {
+        let step = f64::EPSILON.cbrt() * q[j].abs().max(1.0);
+        qp[j] = q[j] + step;
+        let plus = constraints::evaluate(d, 0.0, &qp, &zeros).jac.transpose() * &l;
+        qp[j] = q[j] - step;
+        let minus = constraints::evaluate(d, 0.0, &qp, &zeros).jac.transpose() * &l;
+        qp[j] = q[j];
+        for i in 0..n {
+            k[(i, j)] += (plus[i] - minus[i]) / (2.0 * step);
+        }
+    }
+    k
+}
+
+/// Newton from `z` = [q, lambda] at the current parameters. Ok:
+/// (iterations, residual).
+fn newton(d: &dyn Dynamics, z: &mut [f64], opts: &StaticOptions) -> Result<(usize, f64), String> {
+    let len = z.len();
+    let mut g = vec![0.0; len];
+    let mut trial = vec![0.0; len];
+    let mut g_trial = vec![0.0; len];
+    residual(d, z, &mut g);
+    let mut k = tangent(d, z);
     for it in 1..=opts.max_iterations {
-        if g.iter().chain(&kbuf).any(|v| !v.is_finite()) {
+        if g.iter().chain(k.iter()).any(|v| !v.is_finite()) {
             return Err("non-finite forces or stiffness".into());
         }
-        let k = DMatrix::from_row_slice(n, n, &kbuf);
-        let step = match k.lu().solve(&DVector::from_column_slice(&g)) {
+        let step = match k.clone().lu().solve(&DVector::from_column_slice(&g)) {
             Some(s) => s,
             None => {
                 return Err(
-                    "the tangent stiffness is singular (a buckling or snap-through point?)".into(),
+                    "the tangent stiffness is singular (a buckling or snap-through point, or dependent joints?)"
+                        .into(),
                 );
             }
         };
@@ -97,20 +149,21 @@ fn newton(d: &dyn Dynamics, q: &mut [f64], opts: &StaticOptions) -> Result<(usiz
         let r0 = inf_norm(&g);
         let mut alpha = 1.0;
         loop {
-            for i in 0..n {
-                trial[i] = q[i] - alpha * step[i];
+            for i in 0..len {
+                trial[i] = z[i] - alpha * step[i];
             }
-            static_forces(d, &trial, &mut g_trial);
+            residual(d, &trial, &mut g_trial);
             let r = inf_norm(&g_trial);
             if r.is_finite() && (r < r0 || alpha < 1.0 / 64.0 || r0 == 0.0) {
                 break;
             }
             alpha *= 0.5;
         }
-        q.copy_from_slice(&trial);
-        forces(d, q, &mut g, &mut kbuf);
-        let dq = alpha * inf_norm(step.as_slice());
-        if dq <= opts.step_tol * (1.0 + inf_norm(q)) {
+        z.copy_from_slice(&trial);
+        residual(d, z, &mut g);
+        k = tangent(d, z);
+        let dz = alpha * inf_norm(step.as_slice());
+        if dz <= opts.step_tol * (1.0 + inf_norm(z)) {
             return Ok((it, inf_norm(&g)));
         }
     }
@@ -136,7 +189,10 @@ pub fn solve_static(
         }
         p
     };
+    let n = q0.len();
+    // With joints the unknowns are [q, lambda].
     let mut q = q0.to_vec();
+    q.resize(n + d.info().constraints.len(), 0.0);
     let mut iterations = 0;
     let mut load_steps = 0;
     let mut fraction = 0.0;
@@ -174,7 +230,7 @@ pub fn solve_static(
                         return Err(StaticError {
                             last_fraction: fraction,
                             reason: last_reason,
-                            q: q.clone(),
+                            q: q[..n].to_vec(),
                         });
                     }
                 }
@@ -186,10 +242,12 @@ pub fn solve_static(
     d.set_base_params(&base);
     result?;
     let mut g = vec![0.0; q.len()];
-    static_forces(d, &q, &mut g);
+    residual(d, &q, &mut g);
+    let lambda = q.split_off(n);
     Ok(StaticSolution {
         residual: inf_norm(&g),
         q,
+        lambda,
         iterations,
         load_steps,
     })

@@ -17,6 +17,7 @@ use crate::solver::Solver;
 /// dopri5 while the arm is not stiff, radau5 once it is.
 pub(super) fn run_auto<D: Dynamics + ?Sized>(
     arm: &D,
+    t0: f64,
     x0: Vec<f64>,
     opts: &SimOptions,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
@@ -36,17 +37,17 @@ pub(super) fn run_auto<D: Dynamics + ?Sized>(
         stats.switched = Some(switch);
         stats
     };
-    if let Some(r) = analyse_at(0.0, &x0)
+    if let Some(r) = analyse_at(t0, &x0)
         && r.stiffness_ratio > 1000.0
     {
-        let (traj, stats) = simulate_implicit(arm, 0.0, x0, &implicit_opts)?;
+        let (traj, stats) = simulate_implicit(arm, t0, x0, &implicit_opts)?;
         let reason = format!("stiff from the start: {}", r.reason);
         return Ok((
             traj,
             as_auto(
                 stats,
                 SolverSwitch {
-                    at_s: 0.0,
+                    at_s: t0,
                     to: Solver::Radau5,
                     reason,
                 },
@@ -67,7 +68,7 @@ pub(super) fn run_auto<D: Dynamics + ?Sized>(
         solver: Solver::Dopri5,
         ..opts.clone()
     };
-    let (mut traj, mut stats) = run_explicit(arm, 0.0, x0, &explicit_opts, Some(&watch), &switch)?;
+    let (mut traj, mut stats) = run_explicit(arm, t0, x0, &explicit_opts, Some(&watch), &switch)?;
     stats.solver = Solver::Auto;
     let Some((t_switch, x_switch, reason)) = switch.take() else {
         return Ok((traj, stats));
@@ -88,6 +89,7 @@ pub(super) fn run_auto<D: Dynamics + ?Sized>(
         jacobian_evaluations: stats.jacobian_evaluations + more.jacobian_evaluations,
         wall_s: stats.wall_s + more.wall_s,
         switched: None,
+        constraints: None,
     };
     Ok((
         traj,

@@ -83,6 +83,7 @@ pub(super) fn simulate_implicit<D: Dynamics + ?Sized>(
             jacobian_evaluations: 0,
             wall_s: 0.0,
             switched: None,
+            constraints: None,
         },
     }))
 }

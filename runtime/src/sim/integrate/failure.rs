@@ -58,6 +58,7 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
         jacobian_evaluations: ode.jac_evals.get(),
         wall_s,
         switched: None,
+        constraints: None,
     };
     let cause = ode.first_error.borrow().clone();
     let explain = |fallback: String| match &cause {

@@ -24,6 +24,7 @@ pub mod events;
 mod failure;
 mod ode;
 pub mod options;
+mod projected;
 pub mod radau5;
 mod record;
 pub mod state;
@@ -34,6 +35,7 @@ pub use crate::solver::Solver;
 pub use dispatch::IMPLICIT_SIZES;
 pub use failure::SimFailure;
 pub use options::{DEFAULT_SAMPLES, DEFAULT_T_END, SimOptions};
+pub use projected::ConstraintStats;
 pub use record::{AUTO_CHECK_STEPS, SimStats, SolverSwitch, Trajectory};
 pub use state::StateVec;
 
@@ -49,10 +51,23 @@ pub fn simulate<D: Dynamics + ?Sized>(
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let n = arm.dof();
     assert_eq!(x0.len(), 2 * n, "state must be [q, qd]");
+    if !arm.info().constraints.is_empty() {
+        return projected::run(arm, x0, opts);
+    }
+    run_from(arm, 0.0, x0, opts)
+}
+
+/// Integrate from (t0, x0) to `opts.t_end` by the chosen solver.
+fn run_from<D: Dynamics + ?Sized>(
+    arm: &D,
+    t0: f64,
+    x0: Vec<f64>,
+    opts: &SimOptions,
+) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     match opts.solver {
-        Solver::Auto => auto::run_auto(arm, x0, opts),
-        Solver::Bs23 => dispatch::run_own(arm, 0.0, x0, opts, bs23::integrate),
-        s if s.implicit() => dispatch::simulate_implicit(arm, 0.0, x0, opts),
-        _ => dispatch::run_explicit(arm, 0.0, x0, opts, None, &RefCell::new(None)),
+        Solver::Auto => auto::run_auto(arm, t0, x0, opts),
+        Solver::Bs23 => dispatch::run_own(arm, t0, x0, opts, bs23::integrate),
+        s if s.implicit() => dispatch::simulate_implicit(arm, t0, x0, opts),
+        _ => dispatch::run_explicit(arm, t0, x0, opts, None, &RefCell::new(None)),
     }
 }

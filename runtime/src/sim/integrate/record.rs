@@ -45,6 +45,8 @@ pub struct SimStats {
     pub wall_s: f64,
     /// Set when `auto` switched solvers.
     pub switched: Option<SolverSwitch>,
+    /// A system with joints: how far integration drifted off them.
+    pub constraints: Option<super::projected::ConstraintStats>,
 }
 
 /// Samples evenly and stops on a non-finite accepted state. A fixed-step

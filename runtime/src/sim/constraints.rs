@@ -1,0 +1,271 @@
+//! Joints that close loops: the constraint equations phi(q) = 0 of the
+//! `Constraints` kernel, held by Lagrange multipliers (docs/design.md
+//! section 9).
+//!
+//! The accelerations solve
+//!
+//!   [M J^T; J 0] [qdd; lambda] = [-h; -gamma],   gamma = (d/dt J) qd,
+//!
+//! by the range-space method, without forming an inverse: M = L D L^T
+//! once, X = M^-1 J^T (m solves), the Schur complement S = J X (m x m,
+//! symmetric positive definite while the joints are independent),
+//! S lambda = J a0 + gamma with a0 = -M^-1 h, qdd = a0 - X lambda. The
+//! generalised joint force on the system is -J^T lambda; for the rows of a
+//! joint (point gap of frame a minus frame b, then b's angle minus a's),
+//! lambda is the force (N) and moment (N m) the joint applies to frame b,
+//! in the world frame.
+//!
+//! The drift off phi = 0 and phi' = J qd = 0 that integration leaves is
+//! removed by projection (`project`), never by a stabilising gain.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::arm::{AccelError, Dynamics};
+use crate::kernels::KernelKind;
+use crate::linalg::Ldlt;
+
+/// The `Constraints` kernel's output split: phi, J (row-major), gamma.
+pub struct ConstraintEval {
+    pub phi: Vec<f64>,
+    pub jac: DMatrix<f64>,
+    pub gamma: Vec<f64>,
+}
+
+/// phi, J and gamma at (t, q, qd).
+pub fn evaluate<D: Dynamics + ?Sized>(d: &D, t: f64, q: &[f64], qd: &[f64]) -> ConstraintEval {
+    let (m, n) = (d.info().constraints.len(), d.dof());
+    let mut out = vec![0.0; m * (n + 2)];
+    d.eval_kernel(KernelKind::Constraints, t, q, qd, &mut out);
+    ConstraintEval {
+        phi: out[..m].to_vec(),
+        jac: DMatrix::from_row_slice(m, n, &out[m..m + m * n]),
+        gamma: out[m + m * n..].to_vec(),
+    }
+}
+
+/// Buffers of the constrained solve, reused between evaluations.
+pub struct KktWorkspace {
+    m: usize,
+    out: Vec<f64>,
+    /// X = M^-1 J^T, column by column (m columns of n).
+    x: Vec<f64>,
+    /// S = J X, packed upper triangle.
+    s: Vec<f64>,
+    schur: Ldlt,
+    pub lambda: Vec<f64>,
+}
+
+impl KktWorkspace {
+    pub fn new(n: usize, m: usize) -> Self {
+        Self {
+            m,
+            out: vec![0.0; m * (n + 2)],
+            x: vec![0.0; n * m],
+            s: vec![0.0; m * (m + 1) / 2],
+            schur: Ldlt::new(m),
+            lambda: vec![0.0; m],
+        }
+    }
+}
+
+/// qdd of the constrained system, given M = L D L^T already factored in
+/// `mass` and a0 = -M^-1 h in `qdd`; lambda left in `ws.lambda`.
+pub(crate) fn solve_constrained<D: Dynamics + ?Sized>(
+    d: &D,
+    ws: &mut KktWorkspace,
+    mass: &Ldlt,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &mut [f64],
+) -> Result<(), AccelError> {
+    let (m, n) = (ws.m, q.len());
+    d.eval_kernel(KernelKind::Constraints, t, q, qd, &mut ws.out);
+    let (jac, gamma) = ws.out[m..].split_at(m * n);
+    for r in 0..m {
+        let col = &mut ws.x[r * n..(r + 1) * n];
+        col.copy_from_slice(&jac[r * n..(r + 1) * n]);
+        mass.solve(col);
+    }
+    let mut k = 0;
+    for r in 0..m {
+        let row = &jac[r * n..(r + 1) * n];
+        for c in r..m {
+            ws.s[k] = dot(row, &ws.x[c * n..(c + 1) * n]);
+            k += 1;
+        }
+        ws.lambda[r] = dot(row, qdd) + gamma[r];
+    }
+    if !ws.schur.factor(&ws.s) {
+        return Err(AccelError::DependentJoints { t });
+    }
+    ws.schur.solve(&mut ws.lambda);
+    for (r, l) in ws.lambda.iter().enumerate() {
+        for (a, x) in qdd.iter_mut().zip(&ws.x[r * n..(r + 1) * n]) {
+            *a -= l * x;
+        }
+    }
+    Ok(())
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// The joint forces lambda at a state (rows as `info().constraints`).
+pub fn forces<D: Dynamics + ?Sized>(
+    d: &D,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+) -> Result<Vec<f64>, AccelError> {
+    let n = d.dof();
+    let mut ws = crate::arm::Workspace::new(n);
+    let mut qdd = vec![0.0; n];
+    crate::arm::accelerations(d, &mut ws, t, q, qd, &mut qdd)?;
+    Ok(ws.lambda().to_vec())
+}
+
+/// How far a state is off the joints: the largest point gap (m), angle gap
+/// (rad) and velocity gap |J qd| (m/s or rad/s).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Drift {
+    pub position_m: f64,
+    pub angle_rad: f64,
+    pub velocity: f64,
+}
+
+pub fn drift<D: Dynamics + ?Sized>(d: &D, t: f64, q: &[f64], qd: &[f64]) -> Drift {
+    let c = evaluate(d, t, q, qd);
+    let rows = &d.info().constraints;
+    let v = &c.jac * DVector::from_column_slice(qd);
+    let mut out = Drift::default();
+    for (i, name) in rows.iter().enumerate() {
+        let gap = c.phi[i].abs();
+        if name.ends_with(".angle") {
+            out.angle_rad = out.angle_rad.max(gap);
+        } else {
+            out.position_m = out.position_m.max(gap);
+        }
+        out.velocity = out.velocity.max(v[i].abs());
+    }
+    out
+}
+
+/// Why a state could not be put on the joints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AssemblyFailure {
+    /// The row with the largest residual and the residual.
+    pub row: String,
+    pub residual: f64,
+    pub iterations: usize,
+}
+
+/// The state moved onto phi = 0, J qd = 0 by the least change of its
+/// coordinates (Gauss-Newton on the minimum-norm correction
+/// dq = -J^T (J J^T)^-1 phi; then qd projected on the null space of J),
+/// with the distance |dq| it moved. Rows whose J J^T is singular
+/// (dependent joints) are handled by the pseudo-inverse.
+pub fn project<D: Dynamics + ?Sized>(
+    d: &D,
+    t: f64,
+    q: &mut [f64],
+    qd: &mut [f64],
+    tol: f64,
+) -> Result<f64, AssemblyFailure> {
+    let start = q.to_vec();
+    let mut iterations = 0;
+    loop {
+        let c = evaluate(d, t, q, qd);
+        let (worst, residual) = c
+            .phi
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (i, v.abs()))
+            .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
+        if residual <= tol || iterations == 50 || !residual.is_finite() {
+            if residual > tol || !residual.is_finite() {
+                return Err(AssemblyFailure {
+                    row: d.info().constraints[worst].clone(),
+                    residual,
+                    iterations,
+                });
+            }
+            let v = min_norm(&c.jac, &(&c.jac * DVector::from_column_slice(qd)));
+            for (a, b) in qd.iter_mut().zip(v.iter()) {
+                *a -= b;
+            }
+            let moved = q
+                .iter()
+                .zip(&start)
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum::<f64>()
+                .sqrt();
+            return Ok(moved);
+        }
+        let dq = min_norm(&c.jac, &DVector::from_column_slice(&c.phi));
+        for (a, b) in q.iter_mut().zip(dq.iter()) {
+            *a -= b;
+        }
+        iterations += 1;
+    }
+}
+
+/// J^T (J J^T)^+ r: the least-norm dq with J dq = r (pseudo-inverse, so
+/// dependent rows do no harm).
+fn min_norm(jac: &DMatrix<f64>, r: &DVector<f64>) -> DVector<f64> {
+    let jjt = jac * jac.transpose();
+    let scale = jjt.diagonal().max().max(f64::MIN_POSITIVE);
+    let y = jjt
+        .pseudo_inverse(1e-12 * scale)
+        .map(|p| p * r)
+        .unwrap_or_else(|_| DVector::zeros(r.len()));
+    jac.transpose() * y
+}
+
+/// Groups of constraint rows that depend on each other at q: the rows that
+/// carry each null vector of J^T (redundant or conflicting joints), by
+/// name. Empty when J has full row rank.
+pub fn dependent_rows<D: Dynamics + ?Sized>(d: &D, t: f64, q: &[f64]) -> Vec<Vec<String>> {
+    let n = d.dof();
+    let c = evaluate(d, t, q, &vec![0.0; n]);
+    let rows = &d.info().constraints;
+    let m = rows.len();
+    if m == 0 {
+        return Vec::new();
+    }
+    // Null vectors of J^T: eigenvectors of J J^T with (numerically) zero
+    // eigenvalues.
+    let jjt = &c.jac * c.jac.transpose();
+    let eig = jjt.symmetric_eigen();
+    let top = eig.eigenvalues.amax().max(f64::MIN_POSITIVE);
+    let mut groups = Vec::new();
+    for k in 0..m {
+        if eig.eigenvalues[k] > 1e-10 * top {
+            continue;
+        }
+        let v = eig.eigenvectors.column(k);
+        let big = v.amax();
+        let group: Vec<String> = (0..m)
+            .filter(|&i| v[i].abs() > 1e-6 * big)
+            .map(|i| rows[i].clone())
+            .collect();
+        groups.push(group);
+    }
+    groups
+}
+
+/// The joints of a set of row names (`JOINT.x` -> `JOINT`), in order.
+pub fn joints_of(rows: &[String]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for r in rows {
+        let j = r
+            .rsplit_once('.')
+            .map_or(r.as_str(), |(j, _)| j)
+            .to_string();
+        if !out.contains(&j) {
+            out.push(j);
+        }
+    }
+    out
+}
