@@ -75,6 +75,7 @@ impl ParamLayout {
             index,
             driven,
             arms,
+            assembly: true,
         }
     }
 

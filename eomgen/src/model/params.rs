@@ -331,6 +331,8 @@ pub struct ParamLayout {
     pub(super) driven: Vec<Driven>,
     /// An assembly's arms: name, first slot, own layout.
     pub(super) arms: Vec<(String, usize, ParamLayout)>,
+    /// The layout of an assembly (`of_assembly`).
+    pub(super) assembly: bool,
 }
 
 impl ParamLayout {
@@ -440,6 +442,7 @@ impl ParamLayout {
             index,
             driven,
             arms: Vec::new(),
+            assembly: false,
         }
     }
 
@@ -516,7 +519,7 @@ impl ParamLayout {
     /// The values of a model with this layout's structure, in layout order
     /// (driven parameters start at 0: their signals set them).
     pub fn values(&self, m: &Model) -> Vec<f64> {
-        if !self.arms.is_empty() || m.is_assembly() {
+        if self.assembly {
             return self.assembly_values(m);
         }
         let elements = element_props(m);

@@ -8,9 +8,9 @@
 //! so projection needs no hook inside the steppers; a restart costs a
 //! first step estimate (and a Jacobian for the implicit methods) per leg,
 //! so legs double while the drift over a leg stays below a tenth of its
-//! budget (`drift_budget`) and halve when it exceeds it. The drift is
-//! measured at every sample: the largest is what `ConstraintStats`
-//! reports (docs/design.md section 9).
+//! budget (`drift_budget`); a leg that exceeds it is run again in halves,
+//! down to one sample interval. The drift is measured at every sample: the
+//! largest is what `ConstraintStats` reports (docs/design.md section 9).
 
 use serde::Serialize;
 
@@ -126,6 +126,13 @@ pub(super) fn run<D: Dynamics + ?Sized>(
             worst.angle_rad = worst.angle_rad.max(gap.angle_rad);
             worst.velocity = worst.velocity.max(gap.velocity);
         }
+        let worst_gap = worst.position_m.max(worst.angle_rad);
+        if worst_gap > budget && leg_len > 1 {
+            // Over budget: this leg again, in halves.
+            leg_len /= 2;
+            x = traj.x.last().expect("the start is a sample").clone();
+            continue;
+        }
         let cs = stats.constraints.as_mut().expect("set above");
         cs.drift_max_m = cs.drift_max_m.max(worst.position_m);
         cs.drift_max_rad = cs.drift_max_rad.max(worst.angle_rad);
@@ -163,13 +170,9 @@ pub(super) fn run<D: Dynamics + ?Sized>(
             break;
         }
         next += leg_times.len();
-        // Longer legs while the drift stays well inside its budget,
-        // shorter once it does not.
-        let worst_gap = worst.position_m.max(worst.angle_rad);
+        // Longer legs while the drift stays well inside its budget.
         if worst_gap < 0.1 * budget {
             leg_len *= 2;
-        } else if worst_gap > budget {
-            leg_len = (leg_len / 2).max(1);
         }
         t0 = t1;
         x = traj.x.last().expect("just pushed").clone();

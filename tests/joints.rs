@@ -1,0 +1,364 @@
+//! Assemblies with joints against independent references: a pendulum built
+//! as a loop (a free body pinned to the world) against the same pendulum
+//! built as a tree (a rigid arm); the undamped falling ball's energy and
+//! constraint drift; the mirror symmetry of a symmetric release; the
+//! equilibrium of the ball on straight arms against clamped-guided beam
+//! theory, and its joint forces against the weights; a compliant base
+//! against the closed-form steady response of a mass-spring-damper.
+
+mod common;
+
+use common::*;
+use runtime::{SimOptions, Solver, simulate};
+
+const FALLING_BALL: &str = include_str!("../models/falling_ball.toml");
+
+/// The model's initial state put onto its joints.
+fn start(l: &softarm::backend::Loaded) -> Vec<f64> {
+    let arm = &*l.arm;
+    let n = arm.dof();
+    let mut q =
+        eomgen::model::assembly::initial_coordinates(&l.model, &arm.info().coordinates, &l.origin)
+            .unwrap();
+    let mut qd = vec![0.0; n];
+    softarm::joints::assemble(arm, &l.origin, &mut q, &mut qd).unwrap();
+    q.extend(qd);
+    q
+}
+
+/// |a - b| <= tol.
+fn assert_abs(a: f64, b: f64, tol: f64, what: &str) {
+    assert!(
+        (a - b).abs() <= tol,
+        "{what}: {a:e} vs {b:e} (difference {:e}, allowed {tol:e})",
+        (a - b).abs()
+    );
+}
+
+fn coordinate(l: &softarm::backend::Loaded, name: &str) -> usize {
+    let coords = &l.arm.info().coordinates;
+    coords
+        .iter()
+        .position(|c| c == name)
+        .unwrap_or_else(|| panic!("no coordinate {name} in {coords:?}"))
+}
+
+/// A uniform rod of length L, mass M swinging about one end, built twice.
+const L: f64 = 0.4;
+const M: f64 = 0.3;
+
+const TREE: &str = r#"
+name = "tree"
+gravity = [0.0, -9.81, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "rigid"
+length = 0.4
+mass = 0.3
+elements = 1
+joint_stiffness = 0.0
+"#;
+
+/// The same rod as a free body (a box 0.4 long, its inertia given as the
+/// rod's, M L^2 / 12), its end pinned to the world at the origin.
+const LOOP: &str = r#"
+name = "loop"
+gravity = [0.0, -9.81, 0.0]
+[[body]]
+name = "rod"
+shape = "box"
+size = [0.4, 0.01, 0.01]
+mass = 0.3
+inertia = 0.004
+position = [0.2, 0.0, 0.0]
+[[joint]]
+name = "hinge"
+kind = "pin"
+a = "world"
+b = "rod"
+offset_b = [-0.2, 0.0, 0.0]
+"#;
+
+#[test]
+fn a_pendulum_built_as_a_loop_swings_as_the_tree() {
+    assert!((M * L * L / 12.0 - 0.004).abs() < 1e-15);
+    let dir = tempfile::tempdir().unwrap();
+    let tree = load_text(dir.path(), TREE, &[]);
+    let dir2 = tempfile::tempdir().unwrap();
+    let closed = load_text(dir2.path(), LOOP, &[]);
+    assert_eq!(closed.arm.info().constraints, ["hinge.x", "hinge.y"]);
+    let opts = SimOptions {
+        t_end: 2.0,
+        output_dt: 0.05,
+        rtol: 1e-10,
+        atol: 1e-12,
+        solver: Solver::Dopri5,
+        ..SimOptions::default()
+    };
+    // Released horizontal, from rest.
+    let (a, _) = simulate(&*tree.arm, vec![0.0, 0.0], &opts).unwrap();
+    let (b, stats) = simulate(&*closed.arm, start(&closed), &opts).unwrap();
+    let angle = coordinate(&closed, "rod.angle");
+    let (x, y) = (coordinate(&closed, "rod.x"), coordinate(&closed, "rod.y"));
+    assert_eq!(a.t.len(), b.t.len());
+    for (xa, xb) in a.x.iter().zip(&b.x) {
+        // Two integrations at rtol 1e-10 agree to about 1e-8.
+        assert_abs(xb[angle], xa[0], 1e-7, "rod angle");
+        // The centre half a rod from the pin, along the rod.
+        assert_abs(xb[x], 0.5 * L * xa[0].cos(), 2e-8, "centre x");
+        assert_abs(xb[y], 0.5 * L * xa[0].sin(), 2e-8, "centre y");
+    }
+    let drift = stats.constraints.unwrap();
+    assert!(drift.drift_max_m < 1e-9, "{drift:?}");
+}
+
+/// The pin's force on the rod at rest hanging straight down holds its
+/// weight: lambda is the physical force.
+#[test]
+fn the_pin_carries_the_hanging_rod() {
+    let dir = tempfile::tempdir().unwrap();
+    let closed = load_text(dir.path(), LOOP, &[]);
+    let n = closed.arm.dof();
+    // Hanging: centre below the pin, angle -pi/2.
+    let mut q = vec![0.0; n];
+    q[coordinate(&closed, "rod.y")] = -0.5 * L;
+    q[coordinate(&closed, "rod.angle")] = -std::f64::consts::FRAC_PI_2;
+    let f = runtime::constraints::forces(&*closed.arm, 0.0, &q, &vec![0.0; n]).unwrap();
+    assert_abs(f[0], 0.0, 1e-12, "horizontal force");
+    assert_close(f[1], M * 9.81, 1e-12, 0.0, "vertical force on the rod");
+}
+
+#[test]
+fn the_undamped_falling_ball_keeps_its_energy_and_its_joints() {
+    let dir = tempfile::tempdir().unwrap();
+    let sets: Vec<String> = ["left", "right"]
+        .iter()
+        .flat_map(|a| (0..2).map(move |s| format!("arm.{a}.segment.{s}.bending_damping=0.0")))
+        .collect();
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    let l = load_text(dir.path(), FALLING_BALL, &sets);
+    assert_eq!(l.arm.backend(), "compiled");
+    let x0 = start(&l);
+    let opts = SimOptions {
+        t_end: 10.0,
+        output_dt: 0.02,
+        rtol: 1e-11,
+        atol: 1e-13,
+        solver: Solver::Radau5,
+        ..SimOptions::default()
+    };
+    let (traj, stats) = simulate(&*l.arm, x0, &opts).unwrap();
+    assert_eq!(traj.t.last().copied(), Some(10.0));
+    let n = l.arm.dof();
+    let energy: Vec<f64> = traj
+        .t
+        .iter()
+        .zip(&traj.x)
+        .map(|(t, x)| {
+            let o = l.arm.outputs(*t, &x[..n], &x[n..]);
+            o[3] + o[4]
+        })
+        .collect();
+    // The scale: the largest kinetic energy of the swing.
+    let scale = traj
+        .t
+        .iter()
+        .zip(&traj.x)
+        .map(|(t, x)| l.arm.outputs(*t, &x[..n], &x[n..])[3])
+        .fold(0.0, f64::max);
+    assert!(
+        scale > 0.1,
+        "the ball falls and swings: kinetic energy {scale}"
+    );
+    let worst = energy
+        .iter()
+        .map(|e| (e - energy[0]).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 1e-7 * scale,
+        "energy drift {worst:.3e} J of {scale:.3e} J"
+    );
+    let c = stats.constraints.unwrap();
+    assert!(c.drift_max_m < 1e-9, "{c:?}");
+}
+
+#[test]
+fn a_symmetric_release_stays_symmetric() {
+    let dir = tempfile::tempdir().unwrap();
+    let l = load_text(dir.path(), FALLING_BALL, &[]);
+    let x0 = start(&l);
+    let opts = SimOptions {
+        t_end: 3.0,
+        output_dt: 0.05,
+        solver: Solver::Radau5,
+        rtol: 1e-9,
+        atol: 1e-11,
+        ..SimOptions::default()
+    };
+    let (traj, _) = simulate(&*l.arm, x0, &opts).unwrap();
+    assert_eq!(traj.t.last().copied(), Some(3.0));
+    let coords = l.arm.info().coordinates.clone();
+    let (bx, ba) = (coordinate(&l, "ball.x"), coordinate(&l, "ball.angle"));
+    for x in &traj.x {
+        for (i, c) in coords.iter().enumerate() {
+            if let Some(rest) = c.strip_prefix("left.") {
+                let j = coordinate(&l, &format!("right.{rest}"));
+                assert_abs(x[i], -x[j], 1e-9, c);
+            }
+        }
+        assert_abs(x[bx], 0.5, 1e-9, "ball x");
+        assert_abs(x[ba], 0.0, 1e-9, "ball angle");
+    }
+}
+
+/// A cantilever (the falling ball's arm: 0.6 m, 2.5 kg, E I = 0.6 N m^2,
+/// 10 pcc elements) with a 1 kg ball welded at its tip, under a small
+/// gravity: the equivalent clamped beam's tip sinks by
+/// P L^3 / (3 EI) + w L^4 / (8 EI).
+const HELD_BALL: &str = r#"
+name = "held_ball"
+gravity = [0.0, -0.01, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.6
+elements = 10
+mass = 2.5
+bending_stiffness = 0.6
+[[body]]
+name = "ball"
+shape = "sphere"
+radius = 0.05
+mass = 1.0
+position = [0.6, 0.0, 0.0]
+[[joint]]
+name = "grip"
+kind = "weld"
+a = "tip"
+b = "ball"
+"#;
+
+#[test]
+fn a_ball_welded_to_a_cantilever_sinks_as_the_clamped_beam() {
+    let dir = tempfile::tempdir().unwrap();
+    let l = load_text(dir.path(), HELD_BALL, &[]);
+    let n = l.arm.dof();
+    let mut q0 = vec![0.0; n];
+    q0[coordinate(&l, "ball.x")] = 0.6;
+    let by = coordinate(&l, "ball.y");
+    let mut arm = l.arm;
+    let sol = runtime::solve_static(&mut *arm, &q0, &runtime::StaticOptions::default()).unwrap();
+    let (g, ei, len, w, p): (f64, f64, f64, f64, f64) = (0.01, 0.6, 0.6, 2.5 / 0.6, 1.0);
+    let sag = p * g * len.powi(3) / (3.0 * ei) + w * g * len.powi(4) / (8.0 * ei);
+    assert_close(-sol.q[by], sag, 0.01, 0.0, "tip sag against beam theory");
+    // The weld holds the ball up with its weight.
+    assert_close(sol.lambda[1], p * g, 1e-9, 0.0, "weld force on the ball");
+}
+
+/// The falling ball at rest in its bent equilibrium: the welds hold the
+/// ball up with its weight, so the walls (each arm's weight plus what the
+/// ball hangs on it) carry the whole weight; the horizontal pulls cancel.
+#[test]
+fn in_equilibrium_the_walls_carry_the_whole_weight() {
+    let dir = tempfile::tempdir().unwrap();
+    let l = load_text(dir.path(), FALLING_BALL, &[]);
+    let n = l.arm.dof();
+    let x0 = start(&l);
+    let mut arm = l.arm;
+    let sol =
+        runtime::solve_static(&mut *arm, &x0[..n], &runtime::StaticOptions::default()).unwrap();
+    let (g, arm_mass, ball) = (9.81, 2.5, 1.0);
+    let rows = &arm.info().constraints;
+    let sum = |axis: &str| -> f64 {
+        rows.iter()
+            .zip(&sol.lambda)
+            .filter(|(r, _)| r.ends_with(axis))
+            .map(|(_, f)| f)
+            .sum()
+    };
+    let walls = 2.0 * arm_mass * g + sum(".y");
+    let weight = (2.0 * arm_mass + ball) * g;
+    assert_close(walls, weight, 1e-9, 0.0, "vertical wall reactions");
+    assert_abs(
+        sum(".x"),
+        0.0,
+        1e-9 * weight,
+        "horizontal forces on the ball",
+    );
+    // The constraint forces hold: the residual is at round-off.
+    assert!(sol.residual < 1e-9, "{}", sol.residual);
+}
+
+fn coordinate_of(arm: &dyn runtime::Dynamics, name: &str) -> usize {
+    arm.info()
+        .coordinates
+        .iter()
+        .position(|c| c == name)
+        .unwrap()
+}
+
+/// A rigid arm hanging from a compliant base shaken vertically along the
+/// arm: the arm cannot swing (the base's motion is along it), so base and
+/// arm move as one mass M = m_b + m_a on the spring k and damper c to the
+/// driven point f = A sin(w t): steady response
+/// y = -M g / k + Re[(k + i c w) / (k - M w^2 + i c w) A e^{i w t}].
+#[test]
+fn a_compliant_base_follows_its_driven_point_as_a_mass_spring_damper() {
+    let (mb, ma, k, c, amp, hz) = (0.5, 0.3, 200.0, 4.0, 0.01, 2.0);
+    let text = format!(
+        r#"
+name = "shaken"
+gravity = [0.0, -9.81, 0.0]
+[base]
+direction = [0.0, -1.0, 0.0]
+mass = {mb}
+stiffness = {k}
+damping = {c}
+follow = ["still", "shake"]
+[[segment]]
+method = "rigid"
+length = 0.3
+mass = {ma}
+elements = 1
+joint_stiffness = 1.0
+[inputs.still]
+kind = "constant"
+value = 0.0
+[inputs.shake]
+kind = "sine"
+amplitude = {amp}
+frequency = {hz}
+"#
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let l = load_text(dir.path(), &text, &[]);
+    let n = l.arm.dof();
+    let total = mb + ma;
+    let by = coordinate(&l, "base_y");
+    let mut x0 = vec![0.0; 2 * n];
+    x0[by] = -total * 9.81 / k;
+    let t_end = 12.0;
+    let opts = SimOptions {
+        t_end,
+        output_dt: 0.01,
+        rtol: 1e-10,
+        atol: 1e-12,
+        solver: Solver::Dopri5,
+        ..SimOptions::default()
+    };
+    let (traj, _) = simulate(&*l.arm, x0, &opts).unwrap();
+    let w = 2.0 * std::f64::consts::PI * hz;
+    // (k + i c w) / (k - M w^2 + i c w)
+    let (nr, ni) = (k, c * w);
+    let (dr, di) = (k - total * w * w, c * w);
+    let d2 = dr * dr + di * di;
+    let (gr, gi) = ((nr * dr + ni * di) / d2, (ni * dr - nr * di) / d2);
+    // Decay rate c / (2 M): e^{-2.5 * 10} by t = 10 s.
+    for (t, x) in traj.t.iter().zip(&traj.x).filter(|(t, _)| **t >= 10.0) {
+        let expected = -total * 9.81 / k + amp * (gr * (w * t).sin() + gi * (w * t).cos());
+        assert_abs(x[by], expected, 1e-4 * amp, "base y");
+        assert_abs(x[coordinate(&l, "theta_0_0")], 0.0, 1e-12, "arm angle");
+    }
+}
