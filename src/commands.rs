@@ -242,14 +242,7 @@ fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
 /// The initial coordinates: `--q0`, and with `--start static` (or the
 /// model's `[simulate] start`) the equilibrium at t = 0 found from them.
 fn initial_coordinates(a: &SimulateArgs, loaded: &mut Loaded) -> Result<Vec<f64>> {
-    let n = loaded.arm.dof();
-    let coords = loaded.arm.info().coordinates.clone();
-    let q0 = match &a.q0 {
-        Some(s) => parse_vector("--q0", s, n, &coords)?,
-        None => {
-            eomgen::model::assembly::initial_coordinates(&loaded.model, &coords, &loaded.origin)?
-        }
-    };
+    let q0 = start_coordinates(loaded, &a.q0)?;
     let start = match a.start {
         Some(StartArg::Rest) => Start::Rest,
         Some(StartArg::Static) => Start::Static,
@@ -402,7 +395,19 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         Ok((traj, stats)) => (traj, stats, None),
         Err(f) => {
             let f = *f;
-            let msg = f.to_string();
+            let mut msg = f.to_string();
+            // Joints that became dependent during the run, by name.
+            if f.state.len() == 2 * n {
+                let rows = runtime::constraints::dependent_rows(arm, f.t_reached, &f.state[..n]);
+                for group in rows {
+                    msg.push_str(&format!(
+                        "\n  dependent joints at t = {:.6} s: {} (rows {})",
+                        f.t_reached,
+                        runtime::constraints::joints_of(&group).join(", "),
+                        group.join(", ")
+                    ));
+                }
+            }
             let fail = json!({"t_reached": f.t_reached, "last_step_s": f.last_step_s, "reason": f.reason, "suggestion": f.suggestion, "state": f.state});
             (f.trajectory, f.stats, Some((msg, fail)))
         }
@@ -413,7 +418,12 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     )?;
     let body_names: Vec<String> = loaded.model.bodies.iter().map(|b| b.name.clone()).collect();
     for (body, ix) in softarm::joints::free_bodies(arm, &body_names) {
-        let path: Vec<(f64, f64)> = traj.x.iter().map(|x| (x[ix], x[ix + 1])).collect();
+        let path: Vec<(f64, f64, f64)> = traj
+            .t
+            .iter()
+            .zip(&traj.x)
+            .map(|(t, x)| (*t, x[ix], x[ix + 1]))
+            .collect();
         let title = format!("{}: path of {body}", loaded.model.name);
         softarm::joints::plot_path(&out_dir.join(&body), &title, &path)?;
     }
@@ -650,11 +660,24 @@ pub struct StaticArgs {
     pub json: bool,
 }
 
-/// Solve the static equilibrium of a loaded model, or explain why not.
-fn equilibrium(loaded: &mut Loaded, q0: &Option<String>) -> Result<runtime::StaticSolution> {
+/// The coordinates to start from: `--q0`, else the model's (`[simulate]
+/// q0`, free bodies where declared, the rest 0), put onto the joints.
+fn start_coordinates(loaded: &Loaded, q0: &Option<String>) -> Result<Vec<f64>> {
     let n = loaded.arm.dof();
     let coords = loaded.arm.info().coordinates.clone();
-    let q0 = optional_vector("--q0", q0, n, &coords)?;
+    let mut q = match q0 {
+        Some(s) => parse_vector("--q0", s, n, &coords)?,
+        None => {
+            eomgen::model::assembly::initial_coordinates(&loaded.model, &coords, &loaded.origin)?
+        }
+    };
+    softarm::joints::assemble(&*loaded.arm, &loaded.origin, &mut q, &mut vec![0.0; n])?;
+    Ok(q)
+}
+
+/// Solve the static equilibrium of a loaded model, or explain why not.
+fn equilibrium(loaded: &mut Loaded, q0: &Option<String>) -> Result<runtime::StaticSolution> {
+    let q0 = start_coordinates(loaded, q0)?;
     runtime::solve_static(&mut *loaded.arm, &q0, &runtime::StaticOptions::default())
         .map_err(|e| anyhow::anyhow!("{}: {e}", loaded.origin))
 }
@@ -693,6 +716,10 @@ pub fn statics(a: StaticArgs) -> Result<ExitCode> {
         "coordinates": loaded.arm.info().coordinates,
         "q": sol.q,
         "tip_position": &out[..3],
+        "joint_forces": softarm::joints::reaction_names(&*loaded.arm)
+            .into_iter()
+            .zip(&sol.lambda)
+            .collect::<std::collections::BTreeMap<_, _>>(),
         "residual": sol.residual,
         "iterations": sol.iterations,
         "load_steps": sol.load_steps,

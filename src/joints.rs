@@ -16,16 +16,7 @@ pub fn assemble(arm: &dyn Dynamics, origin: &str, q: &mut [f64], qd: &mut [f64])
     if arm.info().constraints.is_empty() {
         return Ok(0.0);
     }
-    let dependent = dependent_rows(arm, 0.0, q);
-    if let Some(rows) = dependent.first() {
-        bail!(
-            "{origin}: joints {} hold the same freedom twice (redundant or conflicting constraints: \
-             rows {} are dependent at the start); remove one of them or make it a pin",
-            joints_of(rows).join(", "),
-            rows.join(", ")
-        );
-    }
-    project(arm, 0.0, q, qd, 1e-12).map_err(|e| {
+    let moved = project(arm, 0.0, q, qd, 1e-12).map_err(|e| {
         anyhow::anyhow!(
             "{origin}: the initial state cannot be assembled onto the joints: joint {} is still \
              {:.3e} {} apart after {} Newton iterations; start the arms and bodies closer to \
@@ -39,7 +30,18 @@ pub fn assemble(arm: &dyn Dynamics, origin: &str, q: &mut [f64], qd: &mut [f64])
             },
             e.iterations
         )
-    })
+    })?;
+    let dependent = dependent_rows(arm, 0.0, q);
+    if let Some(rows) = dependent.first() {
+        bail!(
+            "{origin}: joints {} hold the same freedom twice at the start (rows {} are dependent): \
+             redundant or conflicting joints, or a loop stretched straight; remove one of them, \
+             make a weld a pin, or start the loop bent ([simulate] q0)",
+            joints_of(rows).join(", "),
+            rows.join(", ")
+        );
+    }
+    Ok(moved)
 }
 
 /// The extra trajectory columns of a model with joints: every joint's
@@ -80,38 +82,45 @@ pub fn free_bodies(arm: &dyn Dynamics, bodies: &[String]) -> Vec<(String, usize)
         .collect()
 }
 
-/// A body's path in the plane, `<stem>.png`.
-pub fn plot_path(stem: &Path, title: &str, path: &[(f64, f64)]) -> Result<()> {
+/// A body's path in the plane and its height against time,
+/// `<stem>.png`; `path` is (t, x, y).
+pub fn plot_path(stem: &Path, title: &str, path: &[(f64, f64, f64)]) -> Result<()> {
     use plotters::prelude::*;
-    let (mut x0, mut x1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for &(x, y) in path.iter().filter(|p| p.0.is_finite() && p.1.is_finite()) {
-        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
-    }
-    if !x0.is_finite() {
+    let finite: Vec<(f64, f64, f64)> = path
+        .iter()
+        .copied()
+        .filter(|p| p.1.is_finite() && p.2.is_finite())
+        .collect();
+    let Some(&(_, fx, fy)) = finite.first() else {
         bail!("{}: no finite positions to plot", stem.display());
-    }
-    let pad = 0.05 * (x1 - x0).max(y1 - y0).max(1e-3);
+    };
+    let range = |f: &dyn Fn(&(f64, f64, f64)) -> f64, start: f64| {
+        finite
+            .iter()
+            .map(f)
+            .fold((start, start), |(a, b), v| (a.min(v), b.max(v)))
+    };
+    let (x0, x1) = range(&|p| 1e3 * p.1, 1e3 * fx);
+    let (y0, y1) = range(&|p| 1e3 * p.2, 1e3 * fy);
+    let t1 = finite.last().map_or(1.0, |p| p.0).max(1e-9);
+    let pad = 0.05 * (x1 - x0).max(y1 - y0).max(1.0);
     crate::compare::register_font();
-    let size = (800u32, 600u32);
+    let size = (900u32, 900u32);
     let mut rgb = vec![255u8; 3 * (size.0 * size.1) as usize];
     {
         let e = |e: &dyn std::fmt::Display| anyhow::anyhow!("{}: {e}", stem.display());
         let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
         root.fill(&WHITE).map_err(|x| e(&x))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
+        let root = root.titled(title, ("sans-serif", 20)).map_err(|x| e(&x))?;
+        let (top, bottom) = root.split_vertically(540);
+        // The path with equal scales on both axes.
+        let half = 0.5 * (x1 - x0).max(y1 - y0) + pad;
+        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+        let mut chart = ChartBuilder::on(&top)
             .margin(10)
             .x_label_area_size(35)
             .y_label_area_size(60)
-            .build_cartesian_2d(
-                (1e3 * (x0 - pad))..(1e3 * (x1 + pad)),
-                (1e3 * (y0 - pad))..(1e3 * (y1 + pad)),
-            )
+            .build_cartesian_2d((cx - half)..(cx + half), (cy - half)..(cy + half))
             .map_err(|x| e(&x))?;
         chart
             .configure_mesh()
@@ -121,15 +130,31 @@ pub fn plot_path(stem: &Path, title: &str, path: &[(f64, f64)]) -> Result<()> {
             .map_err(|x| e(&x))?;
         chart
             .draw_series(LineSeries::new(
-                path.iter().map(|&(x, y)| (1e3 * x, 1e3 * y)),
-                BLUE.stroke_width(1),
+                finite.iter().map(|p| (1e3 * p.1, 1e3 * p.2)),
+                BLUE.stroke_width(2),
             ))
             .map_err(|x| e(&x))?;
-        if let Some(&(x, y)) = path.first() {
-            chart
-                .draw_series([Circle::new((1e3 * x, 1e3 * y), 4, BLACK.filled())])
-                .map_err(|x| e(&x))?;
-        }
+        chart
+            .draw_series([Circle::new((1e3 * fx, 1e3 * fy), 5, BLACK.filled())])
+            .map_err(|x| e(&x))?;
+        let mut chart = ChartBuilder::on(&bottom)
+            .margin(10)
+            .x_label_area_size(35)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..t1, (y0 - pad)..(y1 + pad))
+            .map_err(|x| e(&x))?;
+        chart
+            .configure_mesh()
+            .x_desc("t (s)")
+            .y_desc("y (mm)")
+            .draw()
+            .map_err(|x| e(&x))?;
+        chart
+            .draw_series(LineSeries::new(
+                finite.iter().map(|p| (p.0, 1e3 * p.2)),
+                RED.stroke_width(2),
+            ))
+            .map_err(|x| e(&x))?;
         root.present().map_err(|x| e(&x))?;
     }
     crate::compare::write_png(&stem.with_extension("png"), size, &rgb)

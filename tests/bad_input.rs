@@ -22,6 +22,188 @@ mass = 0.1
 force = [0.0, 0.0, 0.0]
 "#;
 
+/// Two rigid arms from walls 0.45 m apart holding a ball between their
+/// tips, started bent.
+const HELD: &str = r#"
+name = "held"
+gravity = [0.0, -9.81, 0.0]
+[simulate]
+t_end = 0.1
+q0 = { "left.theta_0_0" = -0.3, "left.theta_0_1" = 0.6, "right.theta_0_0" = 0.3, "right.theta_0_1" = -0.6 }
+[[arm]]
+name = "left"
+base = { position = [0.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0] }
+[[arm.segment]]
+method = "rigid"
+length = 0.2
+elements = 2
+mass = 0.2
+joint_stiffness = 1.0
+[[arm]]
+name = "right"
+base = { position = [0.45, 0.0, 0.0], direction = [-1.0, 0.0, 0.0] }
+[[arm.segment]]
+method = "rigid"
+length = 0.2
+elements = 2
+mass = 0.2
+joint_stiffness = 1.0
+[[body]]
+name = "ball"
+shape = "sphere"
+radius = 0.05
+mass = 0.1
+position = [0.225, -0.05, 0.0]
+[[joint]]
+name = "left_grip"
+kind = "weld"
+a = "left.tip"
+b = "ball"
+offset_b = [-0.05, 0.0, 0.0]
+[[joint]]
+name = "right_grip"
+kind = "pin"
+a = "right.tip"
+b = "ball"
+offset_b = [0.05, 0.0, 0.0]
+"#;
+
+/// Assembly errors found when the model is read.
+fn assembly_cases() -> Vec<(&'static str, String, Vec<&'static str>)> {
+    let r = |a: &str, b: &str| {
+        assert!(HELD.contains(a), "{a}");
+        HELD.replacen(a, b, 1)
+    };
+    vec![
+        (
+            "joint names an unknown arm",
+            r("a = \"left.tip\"", "a = \"middle.tip\""),
+            vec![
+                "joint.left_grip.a",
+                "no frame \"middle.tip\"",
+                "left.tip",
+                "ball",
+            ],
+        ),
+        (
+            "joint names an unknown body",
+            r("b = \"ball\"", "b = \"bal\""),
+            vec!["joint.left_grip.b", "no frame \"bal\""],
+        ),
+        (
+            "joint between a frame and itself",
+            r("b = \"ball\"", "b = \"left.tip\""),
+            vec!["joint.left_grip.b", "to itself"],
+        ),
+        (
+            "zero body mass",
+            r("mass = 0.1", "mass = 0.0"),
+            vec!["body.ball.mass", "must be positive"],
+        ),
+        (
+            "negative body mass",
+            r("mass = 0.1", "mass = -1.0"),
+            vec!["body.ball.mass", "must be positive"],
+        ),
+        (
+            "non-positive inertia",
+            r("mass = 0.1", "mass = 0.1\ninertia = -0.001"),
+            vec!["body.ball.inertia", "positive-definite"],
+        ),
+        (
+            "duplicate arm names",
+            r("name = \"right\"", "name = \"left\""),
+            vec!["arm.left.name", "duplicate name"],
+        ),
+        (
+            "a body named as an arm",
+            r("name = \"ball\"", "name = \"left\""),
+            vec!["body.left.name", "duplicate name"],
+        ),
+        (
+            "duplicate joint names",
+            r("name = \"right_grip\"", "name = \"left_grip\""),
+            vec!["joint.left_grip.name", "duplicate joint name"],
+        ),
+        (
+            "negative base stiffness",
+            r(
+                "base = { position = [0.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0] }",
+                "base = { position = [0.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0], mass = 1.0, stiffness = -5.0 }",
+            ),
+            vec!["arm.left.base.stiffness", "must be zero or positive"],
+        ),
+        (
+            "an arm's own error under its name",
+            r("length = 0.2", "length = -0.2"),
+            vec!["arm.left.segment[0].length", "must be positive"],
+        ),
+        (
+            "a sphere without its radius",
+            r("radius = 0.05\n", ""),
+            vec!["body.ball.radius", "needs its radius"],
+        ),
+    ]
+}
+
+#[test]
+fn assembly_mistakes_name_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    for (label, text, expect) in assembly_cases() {
+        std::fs::write(dir.path().join("m.toml"), &text).unwrap();
+        let out = softarm(&["eom", "m.toml", "--json"], dir.path());
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{label}: accepted");
+        assert!(!err.contains("panicked"), "{label}: panic: {err}");
+        assert!(stdout(&out).is_empty(), "{label}: printed output");
+        for e in expect {
+            assert!(err.contains(e), "{label}: expected `{e}` in: {err}");
+        }
+    }
+}
+
+/// What needs the numbers: joints that hold one freedom twice, and a
+/// start the joints cannot reach, stop `simulate` before it writes
+/// anything.
+#[test]
+fn dependent_joints_and_unreachable_starts_are_errors_before_any_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let twice = format!(
+        "{HELD}\n[[joint]]\nname = \"again\"\nkind = \"pin\"\na = \"left.tip\"\nb = \"ball\"\noffset_b = [-0.05, 0.0, 0.0]\n"
+    );
+    let far = HELD.replacen(
+        "position = [0.45, 0.0, 0.0]",
+        "position = [5.0, 0.0, 0.0]",
+        1,
+    );
+    let cases = [
+        ("redundant", twice, vec!["left_grip", "again", "dependent"]),
+        (
+            "unreachable",
+            far,
+            vec!["cannot be assembled", "joint", "apart"],
+        ),
+    ];
+    std::fs::write(dir.path().join("m.toml"), HELD).unwrap();
+    let out = softarm(&["simulate", "m.toml", "--out", "run"], dir.path());
+    assert!(
+        out.status.success(),
+        "the good assembly runs: {}",
+        stderr(&out)
+    );
+    for (label, text, expect) in cases {
+        std::fs::write(dir.path().join("m.toml"), &text).unwrap();
+        let out = softarm(&["simulate", "m.toml", "--out", "bad"], dir.path());
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{label}: accepted");
+        assert!(!err.contains("panicked"), "{label}: panic: {err}");
+        for e in expect {
+            assert!(err.contains(e), "{label}: expected `{e}` in: {err}");
+        }
+        assert!(!dir.path().join("bad").exists(), "{label}: wrote output");
+    }
+}
+
 /// (label, file text, extra CLI args, expected fragments of stderr).
 fn cases() -> Vec<(&'static str, String, Vec<&'static str>, Vec<&'static str>)> {
     let r = |a: &str, b: &str| GOOD.replacen(a, b, 1);
@@ -265,7 +447,10 @@ fn cases() -> Vec<(&'static str, String, Vec<&'static str>, Vec<&'static str>)> 
             "set non-index",
             GOOD.into(),
             vec!["--set", "segment.first.length=1"],
-            vec!["segment.first.length", "not an index"],
+            vec![
+                "segment.first.length",
+                "neither an index nor an item's name",
+            ],
         ),
         (
             "set wrong type",

@@ -362,3 +362,40 @@ frequency = {hz}
         assert_abs(x[coordinate(&l, "theta_0_0")], 0.0, 1e-12, "arm angle");
     }
 }
+
+/// Modes of a system with joints are those of the motions the joints
+/// allow: the pinned rod hanging at rest swings at sqrt(3 g / (2 L)), its
+/// restoring moment coming from the pin's force alone (the free body's own
+/// stiffness is zero).
+#[test]
+fn the_pinned_rod_swings_at_the_compound_pendulum_frequency() {
+    let dir = tempfile::tempdir().unwrap();
+    let closed = load_text(dir.path(), LOOP, &[]);
+    let n = closed.arm.dof();
+    let mut q = vec![0.0; n];
+    q[coordinate(&closed, "rod.y")] = -0.5 * L;
+    q[coordinate(&closed, "rod.angle")] = -std::f64::consts::FRAC_PI_2;
+    let modes = runtime::modes(&*closed.arm, &q).unwrap();
+    assert_eq!(modes.frequencies_hz.len(), 1, "one freedom left by the pin");
+    let expected = (3.0 * 9.81 / (2.0 * L)).sqrt() / (2.0 * std::f64::consts::PI);
+    assert_close(
+        modes.frequencies_hz[0],
+        expected,
+        1e-7,
+        0.0,
+        "pendulum frequency",
+    );
+    // The shape turns the rod and carries its centre along the circle.
+    let shape = &modes.shapes[0];
+    let (x, a) = (
+        coordinate(&closed, "rod.x"),
+        coordinate(&closed, "rod.angle"),
+    );
+    assert_close(
+        shape[x],
+        0.5 * L * shape[a],
+        1e-7,
+        1e-12,
+        "centre moves with the turn",
+    );
+}

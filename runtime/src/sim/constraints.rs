@@ -269,3 +269,37 @@ pub fn joints_of(rows: &[String]) -> Vec<String> {
     }
     out
 }
+
+/// d(J^T lambda)/dq at fixed lambda (n x n): the joint forces' stiffness,
+/// by central differences of the constraint kernel.
+pub fn geometric_stiffness<D: Dynamics + ?Sized>(d: &D, q: &[f64], lambda: &[f64]) -> DMatrix<f64> {
+    let n = q.len();
+    let zeros = vec![0.0; n];
+    let l = DVector::from_column_slice(lambda);
+    let mut k = DMatrix::zeros(n, n);
+    let mut qp = q.to_vec();
+    for j in 0..n {
+        let step = f64::EPSILON.cbrt() * q[j].abs().max(1.0);
+        qp[j] = q[j] + step;
+        let plus = evaluate(d, 0.0, &qp, &zeros).jac.transpose() * &l;
+        qp[j] = q[j] - step;
+        let minus = evaluate(d, 0.0, &qp, &zeros).jac.transpose() * &l;
+        qp[j] = q[j];
+        for i in 0..n {
+            k[(i, j)] = (plus[i] - minus[i]) / (2.0 * step);
+        }
+    }
+    k
+}
+
+/// The joint forces that hold a configuration at rest against the static
+/// forces h(q, 0): the least-squares lambda of J^T lambda = -h.
+pub fn static_forces<D: Dynamics + ?Sized>(d: &D, q: &[f64], h: &[f64]) -> Vec<f64> {
+    let c = evaluate(d, 0.0, q, &vec![0.0; q.len()]);
+    let jt = c.jac.transpose();
+    let rhs = -DVector::from_column_slice(h);
+    jt.svd(true, true)
+        .solve(&rhs, 1e-12)
+        .map(|v| v.as_slice().to_vec())
+        .unwrap_or_else(|_| vec![0.0; c.phi.len()])
+}

@@ -103,23 +103,12 @@ fn tangent(d: &dyn Dynamics, z: &[f64]) -> DMatrix<f64> {
     if m == 0 {
         return k;
     }
-    let zeros = vec![0.0; n];
-    let l = DVector::from_column_slice(lambda);
-    let c = constraints::evaluate(d, 0.0, q, &zeros);
+    let c = constraints::evaluate(d, 0.0, q, &vec![0.0; n]);
     k.view_mut((0, n), (n, m)).copy_from(&c.jac.transpose());
     k.view_mut((n, 0), (m, n)).copy_from(&c.jac);
-    let mut qp = q.to_vec();
-    for j in 0..n {
-        let step = f64::EPSILON.cbrt() * q[j].abs().max(1.0);
-        qp[j] = q[j] + step;
-        let plus = constraints::evaluate(d, 0.0, &qp, &zeros).jac.transpose() * &l;
-        qp[j] = q[j] - step;
-        let minus = constraints::evaluate(d, 0.0, &qp, &zeros).jac.transpose() * &l;
-        qp[j] = q[j];
-        for i in 0..n {
-            k[(i, j)] += (plus[i] - minus[i]) / (2.0 * step);
-        }
-    }
+    let g = constraints::geometric_stiffness(d, q, lambda);
+    let mut top = k.view_mut((0, 0), (n, n));
+    top += g;
     k
 }
 
