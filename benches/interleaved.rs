@@ -9,8 +9,12 @@
 //! `cargo bench --bench interleaved -- cantilever chain tentacle3d`
 //! (`ROUNDS=50` for a quicker look). `rhs:MODEL` times the right-hand
 //! side instead (`runtime::accelerations`: mass + bias and the mass solve,
-//! or the generated symbolic solve); `recursion:tentacle3d` the numeric
-//! element-by-element recursion of tests/common/pcc3d.rs.
+//! or the generated symbolic solve, and for a model with joints the
+//! constrained solve); `free:MODEL` the same without its joints (mass +
+//! bias and the mass solve alone: what the constraint solve adds is the
+//! difference); `joints:MODEL` the constraint kernel alone;
+//! `recursion:tentacle3d` the numeric element-by-element
+//! recursion of tests/common/pcc3d.rs.
 
 #[path = "../tests/common/pcc3d.rs"]
 mod pcc3d;
@@ -54,6 +58,14 @@ fn main() {
                 Some(m) => (true, m),
                 None => (false, model),
             };
+            let (free, model) = match model.strip_prefix("free:") {
+                Some(m) => (true, m),
+                None => (false, model),
+            };
+            let (joints, model) = match model.strip_prefix("joints:") {
+                Some(m) => (true, m),
+                None => (false, model),
+            };
             let l = load(model, &[], BackendChoice::Compiled, None)
                 .unwrap_or_else(|e| panic!("{model}: {e:#}"));
             let dof = l.arm.dof();
@@ -85,6 +97,35 @@ fn main() {
                         &mut qdd,
                     )
                     .expect("accelerations");
+                    black_box(&qdd);
+                })
+            } else if joints {
+                let mut c = vec![0.0; KernelKind::Constraints.output_len(l.arm.info())];
+                Box::new(move || {
+                    l.arm.eval_kernel(
+                        KernelKind::Constraints,
+                        0.0,
+                        black_box(&q),
+                        black_box(&qd),
+                        &mut c,
+                    )
+                })
+            } else if free {
+                let mut ldlt = runtime::Ldlt::new(dof);
+                let mut qdd = vec![0.0; dof];
+                Box::new(move || {
+                    l.arm.eval_kernel(
+                        KernelKind::MassBias,
+                        0.0,
+                        black_box(&q),
+                        black_box(&qd),
+                        &mut out,
+                    );
+                    let (mass, bias) = out.split_at(dof * (dof + 1) / 2);
+                    for (a, b) in qdd.iter_mut().zip(bias) {
+                        *a = -b;
+                    }
+                    assert!(l.arm.solve_mass(mass, &mut qdd, &mut ldlt));
                     black_box(&qdd);
                 })
             } else if recursion {

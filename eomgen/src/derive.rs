@@ -20,12 +20,18 @@ pub fn derive(model: &Model) -> TapeSet {
 pub fn derive_structure(structure: &Structure) -> TapeSet {
     let layout = ParamLayout::of(structure);
     let mut cas = Cas::new();
-    let (sys, phi, rows) = match &structure.assembly {
+    let (sys, phi, rows, blocks) = match &structure.assembly {
         Some(a) => {
             let assembled = assembly_system(&mut cas, a, &layout);
-            (assembled.sys, assembled.constraints, assembled.rows)
+            let blocks = assembled.blocks;
+            (assembled.sys, assembled.constraints, assembled.rows, blocks)
         }
-        None => (system(&mut cas, structure, &layout), Vec::new(), Vec::new()),
+        None => (
+            system(&mut cas, structure, &layout),
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+        ),
     };
     let eq = assemble(&mut cas, &sys);
     let mut mass_bias = eq.mass_upper.clone();
@@ -74,6 +80,7 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
             accel,
             loads: layout.loads(),
             constraints: rows,
+            blocks,
         },
         mass_bias,
         outputs,

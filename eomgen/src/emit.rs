@@ -898,6 +898,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     let accel = info.accel;
     let loads = &info.loads;
     let rows = &info.constraints;
+    let blocks = &info.blocks;
     let hash = &info.hash;
     let coords = &info.coordinates;
     let params = &info.parameters;
@@ -948,6 +949,8 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         pub const LOADS: &[usize] = &[#(#loads),*];
         /// The rows of the joints' constraint equations.
         pub const CONSTRAINTS: &[&str] = &[#(#rows),*];
+        /// Coordinates per independent subsystem (M block diagonal).
+        pub const BLOCKS: &[usize] = &[#(#blocks),*];
 
         /// The compiled kernels of this structure.
         pub struct Compiled {
@@ -965,6 +968,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                         accel: ACCEL,
                         loads: LOADS.to_vec(),
                         constraints: CONSTRAINTS.iter().map(|s| s.to_string()).collect(),
+                        blocks: BLOCKS.to_vec(),
                     },
                 }
             }

@@ -122,6 +122,11 @@ pub struct ModelInfo {
     /// `JOINT.angle` (none for a model without joints).
     #[serde(default)]
     pub constraints: Vec<String>,
+    /// Sizes of the runs of coordinates whose bodies move independently
+    /// (an assembly's arms and free bodies): M is block diagonal over them,
+    /// which the constrained solve exploits. Empty: one block.
+    #[serde(default)]
+    pub blocks: Vec<usize>,
 }
 
 impl ModelInfo {

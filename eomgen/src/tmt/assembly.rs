@@ -26,6 +26,9 @@ pub struct Assembled {
     pub constraints: Vec<ExprId>,
     /// Their names: `JOINT.x`, `JOINT.y`, `JOINT.angle`.
     pub rows: Vec<String>,
+    /// Coordinates per independent subsystem (an arm with its compliant
+    /// base, a free body), in order: M is block diagonal over them.
+    pub blocks: Vec<usize>,
 }
 
 /// The assembly's own parameters (gravity, bodies, joints, bases) by
@@ -96,6 +99,7 @@ pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -
     let (mut point_forces, mut moments, mut seeds) = (Vec::new(), Vec::new(), Vec::new());
     let mut tips = Vec::new();
     let mut arm_frames = Vec::new();
+    let mut blocks = Vec::new();
     for (k, ((name, st), (_, offset, arm_layout))) in a.arms.iter().zip(layout.arms()).enumerate() {
         let prefix = if name.is_empty() {
             String::new()
@@ -103,6 +107,7 @@ pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -
             format!("{name}.")
         };
         let spring = |w| own.get(Param::BaseSpring(k as u16, w));
+        let first = coords.names.len();
         let base_offset = st.base_compliant.then(|| {
             let (x, xd) = coords.push(cas, format!("{prefix}base_x"));
             let (y, yd) = coords.push(cas, format!("{prefix}base_y"));
@@ -135,6 +140,7 @@ pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -
             super::arm_system(cas, st, &symbols)
         });
         coords.extend(&prefix, &sys.coords);
+        blocks.push(coords.names.len() - first);
         bodies.extend(sys.bodies);
         elastic.push(sys.elastic);
         rayleigh.push(sys.rayleigh);
@@ -159,6 +165,7 @@ pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -
             let (x, _) = coords.push(cas, format!("{name}.x"));
             let (y, _) = coords.push(cas, format!("{name}.y"));
             let (angle, rate) = coords.push(cas, format!("{name}.angle"));
+            blocks.push(3);
             let point = [x, y, p(BodyParam::Position(Xyz::Z))];
             bodies.push(Body {
                 mass: p(BodyParam::Mass),
@@ -236,6 +243,7 @@ pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -
         sys,
         constraints,
         rows,
+        blocks,
     }
 }
 

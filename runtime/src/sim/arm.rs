@@ -336,19 +336,10 @@ pub fn accelerations<D: Dynamics + ?Sized>(
     let rows = d.info().constraints.len();
     let solved = if rows > 0 {
         d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
-        let (mass, bias) = ws.packed.split_at(n * (n + 1) / 2);
-        for (a, b) in qdd.iter_mut().zip(bias) {
-            *a = -b;
-        }
-        let factored = ws.ldlt.factor(mass);
-        if factored {
-            ws.ldlt.solve(qdd);
-            let kkt = ws
-                .kkt
-                .get_or_insert_with(|| crate::constraints::KktWorkspace::new(n, rows));
-            crate::constraints::solve_constrained(d, kkt, &ws.ldlt, t, q, qd, qdd)?;
-        }
-        factored
+        let kkt = ws.kkt.get_or_insert_with(|| {
+            crate::constraints::KktWorkspace::new(n, rows, &d.info().blocks)
+        });
+        crate::constraints::solve_constrained(d, kkt, &ws.packed, t, q, qd, qdd)?
     } else if d.info().accel {
         d.eval_kernel(KernelKind::Accel, t, q, qd, &mut ws.accel);
         qdd.copy_from_slice(&ws.accel[..n]);

@@ -7,7 +7,9 @@
 //!   [M J^T; J 0] [qdd; lambda] = [-h; -gamma],   gamma = (d/dt J) qd,
 //!
 //! by the range-space method, without forming an inverse: M = L D L^T
-//! once, X = M^-1 J^T (m solves), the Schur complement S = J X (m x m,
+//! once (block by block: an assembly's arms and bodies are independent
+//! blocks of M), X = M^-1 J^T (m solves, each on the blocks its row
+//! touches), the Schur complement S = J X (m x m,
 //! symmetric positive definite while the joints are independent),
 //! S lambda = J a0 + gamma with a0 = -M^-1 h, qdd = a0 - X lambda. The
 //! generalised joint force on the system is -J^T lambda; for the rows of a
@@ -47,8 +49,13 @@ pub fn evaluate<D: Dynamics + ?Sized>(d: &D, t: f64, q: &[f64], qd: &[f64]) -> C
 pub struct KktWorkspace {
     m: usize,
     out: Vec<f64>,
+    /// The independent blocks of M: first coordinate, size, the block's
+    /// packed upper triangle and its factorisation.
+    blocks: Vec<(usize, usize, Vec<f64>, Ldlt)>,
     /// X = M^-1 J^T, column by column (m columns of n).
     x: Vec<f64>,
+    /// Per row, the blocks its J row touches.
+    touches: Vec<Vec<bool>>,
     /// S = J X, packed upper triangle.
     s: Vec<f64>,
     schur: Ldlt,
@@ -56,36 +63,100 @@ pub struct KktWorkspace {
 }
 
 impl KktWorkspace {
-    pub fn new(n: usize, m: usize) -> Self {
+    /// For `n` coordinates in blocks of the given sizes (empty: one), `m`
+    /// constraint rows.
+    pub fn new(n: usize, m: usize, blocks: &[usize]) -> Self {
+        let sizes = if blocks.iter().sum::<usize>() == n && !blocks.is_empty() {
+            blocks.to_vec()
+        } else {
+            vec![n]
+        };
+        let mut first = 0;
+        let blocks = sizes
+            .iter()
+            .map(|&nb| {
+                let b = (first, nb, vec![0.0; nb * (nb + 1) / 2], Ldlt::new(nb));
+                first += nb;
+                b
+            })
+            .collect::<Vec<_>>();
         Self {
             m,
             out: vec![0.0; m * (n + 2)],
+            touches: vec![vec![false; blocks.len()]; m],
+            blocks,
             x: vec![0.0; n * m],
             s: vec![0.0; m * (m + 1) / 2],
             schur: Ldlt::new(m),
             lambda: vec![0.0; m],
         }
     }
+
+    /// Factor M block by block from its packed upper triangle (n x n);
+    /// false unless every block is positive definite.
+    fn factor(&mut self, n: usize, packed: &[f64]) -> bool {
+        for (first, nb, tri, ldlt) in &mut self.blocks {
+            let mut k = 0;
+            for i in 0..*nb {
+                let row = *first + i;
+                // Row `row` of the big triangle starts at row n - row (row - 1) / 2.
+                let start = row * n - row * row.saturating_sub(1) / 2;
+                for j in i..*nb {
+                    tri[k] = packed[start + (j - i)];
+                    k += 1;
+                }
+            }
+            if !ldlt.factor(tri) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// b = M^-1 b on the blocks `only` marks (all when None).
+    fn solve(&self, b: &mut [f64], only: Option<&[bool]>) {
+        for (k, (first, nb, _, ldlt)) in self.blocks.iter().enumerate() {
+            if only.is_none_or(|o| o[k]) {
+                ldlt.solve(&mut b[*first..*first + *nb]);
+            }
+        }
+    }
 }
 
-/// qdd of the constrained system, given M = L D L^T already factored in
-/// `mass` and a0 = -M^-1 h in `qdd`; lambda left in `ws.lambda`.
+/// qdd of the constrained system from the packed `MassBias` output
+/// (M's upper triangle, then h); lambda left in `ws.lambda`. M is factored
+/// block by block, and each row's X column is solved only on the blocks
+/// its J row touches (a joint's row touches two subsystems). Ok(false)
+/// when M is not positive definite.
 pub(crate) fn solve_constrained<D: Dynamics + ?Sized>(
     d: &D,
     ws: &mut KktWorkspace,
-    mass: &Ldlt,
+    packed: &[f64],
     t: f64,
     q: &[f64],
     qd: &[f64],
     qdd: &mut [f64],
-) -> Result<(), AccelError> {
+) -> Result<bool, AccelError> {
     let (m, n) = (ws.m, q.len());
+    let (_, bias) = packed.split_at(n * (n + 1) / 2);
+    for (a, b) in qdd.iter_mut().zip(bias) {
+        *a = -b;
+    }
+    if !ws.factor(n, packed) {
+        return Ok(false);
+    }
+    ws.solve(qdd, None);
     d.eval_kernel(KernelKind::Constraints, t, q, qd, &mut ws.out);
     let (jac, gamma) = ws.out[m..].split_at(m * n);
     for r in 0..m {
-        let col = &mut ws.x[r * n..(r + 1) * n];
-        col.copy_from_slice(&jac[r * n..(r + 1) * n]);
-        mass.solve(col);
+        let row = &jac[r * n..(r + 1) * n];
+        for (k, (first, nb, _, _)) in ws.blocks.iter().enumerate() {
+            ws.touches[r][k] = row[*first..*first + *nb].iter().any(|&v| v != 0.0);
+        }
+        let mut col = std::mem::take(&mut ws.x);
+        col[r * n..(r + 1) * n].copy_from_slice(row);
+        ws.solve(&mut col[r * n..(r + 1) * n], Some(&ws.touches[r]));
+        ws.x = col;
     }
     let mut k = 0;
     for r in 0..m {
@@ -105,7 +176,7 @@ pub(crate) fn solve_constrained<D: Dynamics + ?Sized>(
             *a -= l * x;
         }
     }
-    Ok(())
+    Ok(true)
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
