@@ -241,15 +241,16 @@ fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
 
 /// The initial coordinates: `--q0`, and with `--start static` (or the
 /// model's `[simulate] start`) the equilibrium at t = 0 found from them.
-fn initial_coordinates(a: &SimulateArgs, loaded: &mut Loaded) -> Result<Vec<f64>> {
-    let q0 = start_coordinates(loaded, &a.q0)?;
+/// Also how far assembling onto the joints moved the coordinates.
+fn initial_coordinates(a: &SimulateArgs, loaded: &mut Loaded) -> Result<(Vec<f64>, f64)> {
+    let (q0, moved) = start_coordinates(loaded, &a.q0)?;
     let start = match a.start {
         Some(StartArg::Rest) => Start::Rest,
         Some(StartArg::Static) => Start::Static,
         None => loaded.model.simulate.start.unwrap_or(Start::Rest),
     };
     if start == Start::Rest {
-        return Ok(q0);
+        return Ok((q0, moved));
     }
     // At rest in equilibrium under the loads and inputs at t = 0.
     let sol = runtime::solve_static(&mut *loaded.arm, &q0, &runtime::StaticOptions::default())
@@ -259,7 +260,7 @@ fn initial_coordinates(a: &SimulateArgs, loaded: &mut Loaded) -> Result<Vec<f64>
                 loaded.origin
             )
         })?;
-    Ok(sol.q)
+    Ok((sol.q, moved))
 }
 
 /// What the run is asked: the command line, else the model's
@@ -350,19 +351,14 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     let mut loaded = load(&a.model)?;
     let n = loaded.arm.dof();
     let coords = loaded.arm.info().coordinates.clone();
-    let q0 = initial_coordinates(&a, &mut loaded)?;
+    let (q0, assembled_m) = initial_coordinates(&a, &mut loaded)?;
     let arm = &*loaded.arm;
     let mut opts = run_options(&a, &loaded.model.simulate)?;
     let (t_end, solver) = (opts.t_end, opts.solver);
     let mut qd0 = optional_vector("--qd0", &a.qd0, n, &coords)?;
     let mut q0 = q0;
-    let assembled_m = softarm::joints::assemble(arm, &loaded.origin, &mut q0, &mut qd0)?;
-    if assembled_m > 0.0 {
-        eprintln!(
-            "{}: the initial state was assembled onto the joints, moving the coordinates by {:.3e} (Euclidean norm)",
-            loaded.model.name, assembled_m
-        );
-    }
+    // The rates onto the joints too (the coordinates already are).
+    softarm::joints::assemble(arm, &loaded.origin, &mut q0, &mut qd0)?;
     // Measured data to compare with: sampled at its own times.
     let measured = match &loaded.model.compare {
         Some(spec) => {
@@ -662,7 +658,7 @@ pub struct StaticArgs {
 
 /// The coordinates to start from: `--q0`, else the model's (`[simulate]
 /// q0`, free bodies where declared, the rest 0), put onto the joints.
-fn start_coordinates(loaded: &Loaded, q0: &Option<String>) -> Result<Vec<f64>> {
+fn start_coordinates(loaded: &Loaded, q0: &Option<String>) -> Result<(Vec<f64>, f64)> {
     let n = loaded.arm.dof();
     let coords = loaded.arm.info().coordinates.clone();
     let mut q = match q0 {
@@ -671,13 +667,19 @@ fn start_coordinates(loaded: &Loaded, q0: &Option<String>) -> Result<Vec<f64>> {
             eomgen::model::assembly::initial_coordinates(&loaded.model, &coords, &loaded.origin)?
         }
     };
-    softarm::joints::assemble(&*loaded.arm, &loaded.origin, &mut q, &mut vec![0.0; n])?;
-    Ok(q)
+    let moved = softarm::joints::assemble(&*loaded.arm, &loaded.origin, &mut q, &mut vec![0.0; n])?;
+    if moved > 0.0 {
+        eprintln!(
+            "{}: the initial state was assembled onto the joints, moving the coordinates by {moved:.3e} (Euclidean norm)",
+            loaded.model.name
+        );
+    }
+    Ok((q, moved))
 }
 
 /// Solve the static equilibrium of a loaded model, or explain why not.
 fn equilibrium(loaded: &mut Loaded, q0: &Option<String>) -> Result<runtime::StaticSolution> {
-    let q0 = start_coordinates(loaded, q0)?;
+    let (q0, _) = start_coordinates(loaded, q0)?;
     runtime::solve_static(&mut *loaded.arm, &q0, &runtime::StaticOptions::default())
         .map_err(|e| anyhow::anyhow!("{}: {e}", loaded.origin))
 }

@@ -175,6 +175,10 @@ fn the_undamped_falling_ball_keeps_its_energy_and_its_joints() {
         .iter()
         .map(|e| (e - energy[0]).abs())
         .fold(0.0, f64::max);
+    eprintln!(
+        "undamped falling ball: energy drift {worst:.3e} J of {scale:.3e} J; {:?}",
+        stats.constraints
+    );
     assert!(
         worst < 1e-7 * scale,
         "energy drift {worst:.3e} J of {scale:.3e} J"
@@ -198,18 +202,21 @@ fn a_symmetric_release_stays_symmetric() {
     };
     let (traj, _) = simulate(&*l.arm, x0, &opts).unwrap();
     assert_eq!(traj.t.last().copied(), Some(3.0));
+    let mut worst: f64 = 0.0;
     let coords = l.arm.info().coordinates.clone();
     let (bx, ba) = (coordinate(&l, "ball.x"), coordinate(&l, "ball.angle"));
     for x in &traj.x {
         for (i, c) in coords.iter().enumerate() {
             if let Some(rest) = c.strip_prefix("left.") {
                 let j = coordinate(&l, &format!("right.{rest}"));
+                worst = worst.max((x[i] + x[j]).abs());
                 assert_abs(x[i], -x[j], 1e-9, c);
             }
         }
         assert_abs(x[bx], 0.5, 1e-9, "ball x");
         assert_abs(x[ba], 0.0, 1e-9, "ball angle");
     }
+    eprintln!("symmetric release: largest mirror mismatch {worst:.3e}");
 }
 
 /// A cantilever (the falling ball's arm: 0.6 m, 2.5 kg, E I = 0.6 N m^2,
@@ -252,6 +259,11 @@ fn a_ball_welded_to_a_cantilever_sinks_as_the_clamped_beam() {
     let sol = runtime::solve_static(&mut *arm, &q0, &runtime::StaticOptions::default()).unwrap();
     let (g, ei, len, w, p): (f64, f64, f64, f64, f64) = (0.01, 0.6, 0.6, 2.5 / 0.6, 1.0);
     let sag = p * g * len.powi(3) / (3.0 * ei) + w * g * len.powi(4) / (8.0 * ei);
+    eprintln!(
+        "welded ball: sag {:.6e} m, beam theory {sag:.6e} m ({:.3} %)",
+        -sol.q[by],
+        100.0 * (-sol.q[by] / sag - 1.0)
+    );
     assert_close(-sol.q[by], sag, 0.01, 0.0, "tip sag against beam theory");
     // The weld holds the ball up with its weight.
     assert_close(sol.lambda[1], p * g, 1e-9, 0.0, "weld force on the ball");
@@ -280,6 +292,7 @@ fn in_equilibrium_the_walls_carry_the_whole_weight() {
     };
     let walls = 2.0 * arm_mass * g + sum(".y");
     let weight = (2.0 * arm_mass + ball) * g;
+    eprintln!("walls carry {walls:.15} N of {weight:.15} N");
     assert_close(walls, weight, 1e-9, 0.0, "vertical wall reactions");
     assert_abs(
         sum(".x"),
@@ -377,6 +390,7 @@ fn the_pinned_rod_swings_at_the_compound_pendulum_frequency() {
     q[coordinate(&closed, "rod.angle")] = -std::f64::consts::FRAC_PI_2;
     let modes = runtime::modes(&*closed.arm, &q).unwrap();
     assert_eq!(modes.frequencies_hz.len(), 1, "one freedom left by the pin");
+    eprintln!("pinned rod: {:.12} Hz", modes.frequencies_hz[0]);
     let expected = (3.0 * 9.81 / (2.0 * L)).sqrt() / (2.0 * std::f64::consts::PI);
     assert_close(
         modes.frequencies_hz[0],

@@ -1,7 +1,7 @@
 //! Several arms, rigid bodies and the joints between them: the keys of an
 //! assembly (`[[arm]]`, `[[body]]`, `[[joint]]`), the frames a joint may
 //! name, and each arm as the single-arm `Model` the rest of the generator
-//! already knows (docs/design.md section 9).
+//! already knows (docs/design.md section 7).
 
 use serde::{Deserialize, Serialize};
 

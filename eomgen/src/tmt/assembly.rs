@@ -2,7 +2,7 @@
 //! arm's, in its own scope of coordinates and parameters (`Cas::scoped`),
 //! the free bodies and compliant bases with coordinates of their own, and
 //! the joints as constraint equations phi(q) = 0 on the frames they name
-//! (docs/design.md section 9).
+//! (docs/design.md section 7).
 //!
 //! Invariant: the coordinates are the arms' in declaration order (each
 //! preceded by its compliant base's x, y), then the free bodies' x, y and

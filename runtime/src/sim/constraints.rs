@@ -1,6 +1,6 @@
 //! Joints that close loops: the constraint equations phi(q) = 0 of the
 //! `Constraints` kernel, held by Lagrange multipliers (docs/design.md
-//! section 9).
+//! section 7).
 //!
 //! The accelerations solve
 //!

@@ -72,7 +72,7 @@ fn static_forces(d: &dyn Dynamics, q: &[f64], g: &mut [f64]) {
 }
 
 /// The static residual of z = [q, lambda]: h(q, 0) + J^T lambda and, with
-/// joints, phi(q) (section 9 of docs/design.md).
+/// joints, phi(q) (section 7 of docs/design.md).
 fn residual(d: &dyn Dynamics, z: &[f64], r: &mut [f64]) {
     let n = d.dof();
     let (q, lambda) = z.split_at(n);

@@ -10,7 +10,7 @@
 //! so legs double while the drift over a leg stays below a tenth of its
 //! budget (`drift_budget`); a leg that exceeds it is run again in halves,
 //! down to one sample interval. The drift is measured at every sample: the
-//! largest is what `ConstraintStats` reports (docs/design.md section 9).
+//! largest is what `ConstraintStats` reports (docs/design.md section 7).
 
 use serde::Serialize;
 
