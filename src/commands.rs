@@ -718,10 +718,7 @@ pub fn statics(a: StaticArgs) -> Result<ExitCode> {
         "coordinates": loaded.arm.info().coordinates,
         "q": sol.q,
         "tip_position": &out[..3],
-        "joint_forces": softarm::joints::reaction_names(&*loaded.arm)
-            .into_iter()
-            .zip(&sol.lambda)
-            .collect::<std::collections::BTreeMap<_, _>>(),
+        "joint_forces": softarm::joints::static_forces(&*loaded.arm, &sol.lambda),
         "residual": sol.residual,
         "iterations": sol.iterations,
         "load_steps": sol.load_steps,

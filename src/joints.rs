@@ -44,29 +44,57 @@ pub fn assemble(arm: &dyn Dynamics, origin: &str, q: &mut [f64], qd: &mut [f64])
     Ok(moved)
 }
 
-/// The extra trajectory columns of a model with joints: every joint's
-/// force on its second frame (fx, fy) and a weld's moment (m), world frame.
+/// A constraint row's output column: a joint's force on its second frame
+/// (fx, fy, fz) and a weld's moment (m in the plane; mx, my, mz), world
+/// frame. A free 3D body's unit-quaternion row is not a joint: none.
+fn column(row: &str) -> Option<String> {
+    let (joint, what) = row.rsplit_once('.')?;
+    let what = match what {
+        "x" => "fx",
+        "y" => "fy",
+        "z" => "fz",
+        "angle" => "m",
+        "rx" => "mx",
+        "ry" => "my",
+        "rz" => "mz",
+        _ => return None,
+    };
+    Some(format!("joint_{joint}_{what}"))
+}
+
+/// The extra trajectory columns of a model with joints.
 pub fn reaction_names(arm: &dyn Dynamics) -> Vec<String> {
     arm.info()
         .constraints
         .iter()
-        .map(|row| {
-            let (joint, what) = row.rsplit_once('.').unwrap_or((row, ""));
-            let what = match what {
-                "x" => "fx",
-                "y" => "fy",
-                _ => "m",
-            };
-            format!("joint_{joint}_{what}")
-        })
+        .filter_map(|r| column(r))
         .collect()
 }
 
-/// The joint forces at a sample (NaN where the solve fails).
+/// The joint forces of a static solution by column name.
+pub fn static_forces(
+    arm: &dyn Dynamics,
+    lambda: &[f64],
+) -> std::collections::BTreeMap<String, f64> {
+    arm.info()
+        .constraints
+        .iter()
+        .zip(lambda)
+        .filter_map(|(r, &l)| Some((column(r)?, l)))
+        .collect()
+}
+
+/// The joint forces at a sample, as `reaction_names` (NaN where the solve
+/// fails).
 pub fn reactions(arm: &dyn Dynamics, t: f64, x: &[f64]) -> Vec<f64> {
     let n = arm.dof();
-    forces(arm, t, &x[..n], &x[n..])
-        .unwrap_or_else(|_| vec![f64::NAN; arm.info().constraints.len()])
+    let rows = &arm.info().constraints;
+    let lambda = forces(arm, t, &x[..n], &x[n..]).unwrap_or_else(|_| vec![f64::NAN; rows.len()]);
+    rows.iter()
+        .zip(lambda)
+        .filter(|(r, _)| column(r).is_some())
+        .map(|(_, l)| l)
+        .collect()
 }
 
 /// Free bodies: (name, index of its x coordinate), from the coordinate

@@ -304,14 +304,6 @@ fn in_equilibrium_the_walls_carry_the_whole_weight() {
     assert!(sol.residual < 1e-9, "{}", sol.residual);
 }
 
-fn coordinate_of(arm: &dyn runtime::Dynamics, name: &str) -> usize {
-    arm.info()
-        .coordinates
-        .iter()
-        .position(|c| c == name)
-        .unwrap()
-}
-
 /// A rigid arm hanging from a compliant base shaken vertically along the
 /// arm: the arm cannot swing (the base's motion is along it), so base and
 /// arm move as one mass M = m_b + m_a on the spring k and damper c to the
@@ -319,23 +311,38 @@ fn coordinate_of(arm: &dyn runtime::Dynamics, name: &str) -> usize {
 /// y = -M g / k + Re[(k + i c w) / (k - M w^2 + i c w) A e^{i w t}].
 #[test]
 fn a_compliant_base_follows_its_driven_point_as_a_mass_spring_damper() {
+    for dimensions in [2, 3] {
+        compliant_base_in(dimensions);
+    }
+}
+
+fn compliant_base_in(dimensions: u8) {
     let (mb, ma, k, c, amp, hz) = (0.5, 0.3, 200.0, 4.0, 0.01, 2.0);
+    let (follow, axes) = match dimensions {
+        2 => (r#"["still", "shake"]"#, ""),
+        _ => (
+            r#"["still", "shake", "still"]"#,
+            r#"joint_axes = ["z", "y"]"#,
+        ),
+    };
     let text = format!(
         r#"
 name = "shaken"
+dimensions = {dimensions}
 gravity = [0.0, -9.81, 0.0]
 [base]
 direction = [0.0, -1.0, 0.0]
 mass = {mb}
 stiffness = {k}
 damping = {c}
-follow = ["still", "shake"]
+follow = {follow}
 [[segment]]
 method = "rigid"
 length = 0.3
 mass = {ma}
 elements = 1
 joint_stiffness = 1.0
+{axes}
 [inputs.still]
 kind = "constant"
 value = 0.0
@@ -372,7 +379,11 @@ frequency = {hz}
     for (t, x) in traj.t.iter().zip(&traj.x).filter(|(t, _)| **t >= 10.0) {
         let expected = -total * 9.81 / k + amp * (gr * (w * t).sin() + gi * (w * t).cos());
         assert_abs(x[by], expected, 1e-4 * amp, "base y");
-        assert_abs(x[coordinate(&l, "theta_0_0")], 0.0, 1e-12, "arm angle");
+        for (i, name) in l.arm.info().coordinates.iter().enumerate() {
+            if !name.starts_with("base_") {
+                assert_abs(x[i], 0.0, 1e-12, name);
+            }
+        }
     }
 }
 
@@ -412,4 +423,228 @@ fn the_pinned_rod_swings_at_the_compound_pendulum_frequency() {
         1e-12,
         "centre moves with the turn",
     );
+}
+
+/// A 3D rod (0.4 m, 0.3 kg, radius 1 cm) on a ball-and-socket at one end,
+/// built as a tree (a rigid link turning about z, then y, then its own x:
+/// a spherical joint) and as a free
+/// body on quaternion coordinates pinned to the world; released from rest
+/// tilted 0.5 rad out of the horizontal plane: a spherical pendulum.
+const TREE_3D: &str = r#"
+name = "tree3d"
+dimensions = 3
+gravity = [0.0, -9.81, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "rigid"
+length = 0.4
+mass = 0.3
+outer_radius = 0.01
+elements = 1
+joint_stiffness = 0.0
+joint_axes = ["z", "y", "x"]
+"#;
+
+const LOOP_3D: &str = r#"
+name = "loop3d"
+dimensions = 3
+gravity = [0.0, -9.81, 0.0]
+[[body]]
+name = "rod"
+shape = "cylinder"
+radius = 0.01
+length = 0.4
+mass = 0.3
+position = [0.17551651237807456, 0.0, -0.09588510772084060]
+orientation = [0.9689124217106447, 0.0, 0.24740395925452294, 0.0]
+[[joint]]
+name = "socket"
+kind = "pin"
+a = "world"
+b = "rod"
+offset_b = [-0.2, 0.0, 0.0]
+"#;
+
+#[test]
+fn a_3d_pendulum_on_quaternions_swings_as_the_tree() {
+    // The body starts where the tree's link is at (theta_z, theta_y) =
+    // (0, 0.5): centre R (L/2, 0, 0), R = Ry(0.5).
+    let half: f64 = 0.25;
+    assert!((half.cos() - 0.9689124217106447).abs() < 1e-15);
+    assert!((0.2 * 0.5f64.cos() - 0.17551651237807456).abs() < 1e-15);
+    let dir = tempfile::tempdir().unwrap();
+    let tree = load_text(dir.path(), TREE_3D, &[]);
+    let dir2 = tempfile::tempdir().unwrap();
+    let body = load_text(dir2.path(), LOOP_3D, &[]);
+    assert_eq!(
+        body.arm.info().constraints,
+        ["socket.x", "socket.y", "socket.z", "rod.unit"]
+    );
+    let opts = SimOptions {
+        t_end: 2.0,
+        output_dt: 0.05,
+        rtol: 1e-10,
+        atol: 1e-12,
+        solver: Solver::Dopri5,
+        ..SimOptions::default()
+    };
+    let n_tree = tree.arm.dof();
+    let mut x_tree = vec![0.0; 2 * n_tree];
+    x_tree[1] = 0.5;
+    let (a, _) = simulate(&*tree.arm, x_tree, &opts).unwrap();
+    let (b, stats) = simulate(&*body.arm, start(&body), &opts).unwrap();
+    let centre = ["rod.x", "rod.y", "rod.z"].map(|c| coordinate(&body, c));
+    let mut swing: f64 = 0.0;
+    for ((t, xa), xb) in a.t.iter().zip(&a.x).zip(&b.x) {
+        let tip = tree.arm.outputs(*t, &xa[..n_tree], &xa[n_tree..]);
+        for c in 0..3 {
+            assert_abs(xb[centre[c]], 0.5 * tip[c], 2e-8, "centre");
+        }
+        swing = swing.max((xb[centre[1]]).abs());
+    }
+    assert!(swing > 0.1, "it swings: {swing}");
+    let c = stats.constraints.unwrap();
+    assert!(c.drift_max_m < 1e-9 && c.drift_max_rad < 1e-9, "{c:?}");
+}
+
+/// A free box (distinct principal moments) spinning without gravity or
+/// joints: its kinetic energy and its angular momentum in the world,
+/// L = R diag(I) R^T w, are constants of the motion.
+#[test]
+fn a_free_body_keeps_its_energy_and_angular_momentum() {
+    let text = r#"
+name = "tumbling"
+dimensions = 3
+gravity = [0.0, 0.0, 0.0]
+[[body]]
+name = "brick"
+shape = "box"
+size = [0.3, 0.2, 0.1]
+mass = 2.0
+orientation = [1.0, 0.2, -0.3, 0.1]
+"#;
+    let dir = tempfile::tempdir().unwrap();
+    let l = load_text(dir.path(), text, &[]);
+    let n = l.arm.dof();
+    assert_eq!(n, 7);
+    let mut x0 = start(&l);
+    // Spinning mostly about the intermediate axis (the unstable one): the
+    // body tumbles. q' = (1/2) (0, w) q for a world angular velocity w.
+    let w = [0.3, 5.0, 0.2];
+    let q = [x0[3], x0[4], x0[5], x0[6]];
+    let qd = [
+        -0.5 * (w[0] * q[1] + w[1] * q[2] + w[2] * q[3]),
+        0.5 * (w[0] * q[0] + w[1] * q[3] - w[2] * q[2]),
+        0.5 * (-w[0] * q[3] + w[1] * q[0] + w[2] * q[1]),
+        0.5 * (w[0] * q[2] - w[1] * q[1] + w[2] * q[0]),
+    ];
+    x0[n + 3..n + 7].copy_from_slice(&qd);
+    let opts = SimOptions {
+        t_end: 5.0,
+        output_dt: 0.05,
+        rtol: 1e-11,
+        atol: 1e-13,
+        solver: Solver::Dopri5,
+        ..SimOptions::default()
+    };
+    let (traj, stats) = simulate(&*l.arm, x0, &opts).unwrap();
+    let (m, s) = (2.0, [0.09, 0.04, 0.01]);
+    let moments = [
+        m * (s[1] + s[2]) / 12.0,
+        m * (s[0] + s[2]) / 12.0,
+        m * (s[0] + s[1]) / 12.0,
+    ];
+    let momentum = |x: &[f64]| -> [f64; 3] {
+        let (q, qd) = (&x[3..7], &x[n + 3..n + 7]);
+        // w = 2 (qw u' - qw' u + u x u')
+        let (u, du) = ([q[1], q[2], q[3]], [qd[1], qd[2], qd[3]]);
+        let cross = [
+            u[1] * du[2] - u[2] * du[1],
+            u[2] * du[0] - u[0] * du[2],
+            u[0] * du[1] - u[1] * du[0],
+        ];
+        let w: Vec<f64> = (0..3)
+            .map(|c| 2.0 * (q[0] * du[c] - qd[0] * u[c] + cross[c]))
+            .collect();
+        // Columns of R: the body axes in the world.
+        let r = |v: [f64; 3]| -> [f64; 3] {
+            let uv = [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ];
+            let uuv = [
+                u[1] * uv[2] - u[2] * uv[1],
+                u[2] * uv[0] - u[0] * uv[2],
+                u[0] * uv[1] - u[1] * uv[0],
+            ];
+            std::array::from_fn(|c| v[c] + 2.0 * (q[0] * uv[c] + uuv[c]))
+        };
+        let mut l = [0.0; 3];
+        for (k, &i_k) in moments.iter().enumerate() {
+            let mut e = [0.0; 3];
+            e[k] = 1.0;
+            let a = r(e);
+            let aw: f64 = (0..3).map(|c| a[c] * w[c]).sum();
+            for c in 0..3 {
+                l[c] += i_k * aw * a[c];
+            }
+        }
+        l
+    };
+    let l0 = momentum(&traj.x[0]);
+    let scale = l0.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let e0 = l.arm.outputs(0.0, &traj.x[0][..n], &traj.x[0][n..])[3];
+    let axis = coordinate(&l, "brick.qx");
+    let mut turned: f64 = 0.0;
+    for (t, x) in traj.t.iter().zip(&traj.x) {
+        let lt = momentum(x);
+        for c in 0..3 {
+            assert_abs(lt[c], l0[c], 1e-8 * scale, "angular momentum");
+        }
+        let e = l.arm.outputs(*t, &x[..n], &x[n..])[3];
+        assert_abs(e, e0, 1e-8 * e0, "kinetic energy");
+        turned = turned.max((x[axis] - traj.x[0][axis]).abs());
+    }
+    assert!(turned > 0.5, "the brick tumbles: {turned}");
+    assert!(stats.constraints.unwrap().drift_max_rad < 1e-9);
+}
+
+/// The held ball in 3D: the arm (3D pcc, bending both ways) welded to a
+/// free 3D ball sinks as the clamped beam, and the weld's moment on the
+/// ball is zero (its centre at the tip).
+#[test]
+fn a_ball_welded_to_a_3d_cantilever_sinks_as_the_clamped_beam() {
+    let text = HELD_BALL
+        .replace(
+            "name = \"held_ball\"",
+            "name = \"held_ball_3d\"\ndimensions = 3",
+        )
+        .replace(
+            "bending_stiffness = 0.6",
+            "bending_stiffness = 0.6\ntwist = false",
+        );
+    let dir = tempfile::tempdir().unwrap();
+    let l = load_text(dir.path(), &text, &[]);
+    let n = l.arm.dof();
+    let mut q0 = vec![0.0; n];
+    q0[coordinate(&l, "ball.x")] = 0.6;
+    q0[coordinate(&l, "ball.qw")] = 1.0;
+    let by = coordinate(&l, "ball.y");
+    let mut arm = l.arm;
+    let sol = runtime::solve_static(&mut *arm, &q0, &runtime::StaticOptions::default()).unwrap();
+    let (g, ei, len, w, p): (f64, f64, f64, f64, f64) = (0.01, 0.6, 0.6, 2.5 / 0.6, 1.0);
+    let sag = p * g * len.powi(3) / (3.0 * ei) + w * g * len.powi(4) / (8.0 * ei);
+    eprintln!(
+        "3D welded ball: sag {:.6e} m, beam theory {sag:.6e} m",
+        -sol.q[by]
+    );
+    assert_close(-sol.q[by], sag, 0.01, 0.0, "tip sag against beam theory");
+    let rows = arm.info().constraints.clone();
+    let force = |r: &str| sol.lambda[rows.iter().position(|x| x == r).unwrap()];
+    assert_close(force("grip.y"), p * g, 1e-9, 0.0, "weld force on the ball");
+    for r in ["grip.rx", "grip.ry", "grip.rz"] {
+        assert_abs(force(r), 0.0, 1e-12, r);
+    }
 }

@@ -239,6 +239,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         tip_orientation: quat,
         chain: None,
         seeds: base.seeds,
+        segment_ends: Vec::new(),
         planar: None,
     };
     let mount = TipMount {
@@ -558,6 +559,7 @@ fn empty_system(cas: &mut Cas, coords: Coordinates, gravity: V3) -> System {
         tip_orientation: [one, zero, zero, zero],
         chain: None,
         seeds: Vec::new(),
+        segment_ends: Vec::new(),
         planar: None,
     }
 }

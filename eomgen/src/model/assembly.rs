@@ -54,12 +54,20 @@ pub struct BodyDecl {
     /// the plane (kg m^2); default from the shape.
     #[serde(default)]
     pub inertia: Option<f64>,
+    /// 3D: the principal moments about the body's x, y, z axes through its
+    /// centre (kg m^2); default from the shape.
+    #[serde(default)]
+    pub principal_inertia: Option<[f64; 3]>,
     /// Initial position of the centre (m).
     #[serde(default)]
     pub position: [f64; 3],
     /// Initial angle of the body's frame from the world's (rad, planar).
     #[serde(default)]
     pub angle: f64,
+    /// 3D: initial orientation of the body's frame, a quaternion (w, x, y,
+    /// z; any non-zero length, normalised).
+    #[serde(default)]
+    pub orientation: Option<[f64; 4]>,
     /// Free (its own coordinates) or fixed where declared. Structural.
     #[serde(default = "yes")]
     pub free: bool,
@@ -75,7 +83,8 @@ fn yes() -> bool {
 pub enum JointKind {
     /// Position and orientation: the two frames move as one.
     Weld,
-    /// Position only: a revolute joint in the plane.
+    /// Position only: a revolute joint in the plane, a ball-and-socket in
+    /// 3D.
     Pin,
 }
 
@@ -84,14 +93,6 @@ impl JointKind {
         match self {
             Self::Weld => "weld",
             Self::Pin => "pin",
-        }
-    }
-
-    /// Constraint equations in the plane: x, y (and the angle for a weld).
-    pub fn planar_rows(self) -> usize {
-        match self {
-            Self::Weld => 3,
-            Self::Pin => 2,
         }
     }
 }
@@ -112,6 +113,10 @@ pub struct JointDecl {
     pub offset_b: [f64; 3],
     #[serde(default)]
     pub angle: f64,
+    /// 3D weld: b's frame is a's turned by this quaternion (w, x, y, z; any
+    /// non-zero length, normalised); default none.
+    #[serde(default)]
+    pub orientation: Option<[f64; 4]>,
 }
 
 /// A frame a joint names. Arms and bodies by their index in the model.
@@ -263,15 +268,48 @@ impl BodyDecl {
         if self.inertia.is_some() {
             return self.inertia;
         }
+        Some(self.principal()?[2])
+    }
+
+    /// The principal moments about the body's x, y, z through its centre:
+    /// `principal_inertia`, or the shape's (a cylinder's axis along x).
+    pub fn principal(&self) -> Option<[f64; 3]> {
+        if self.principal_inertia.is_some() {
+            return self.principal_inertia;
+        }
         let m = self.total_mass()?;
         Some(match self.shape {
-            BodyShape::Sphere => 0.4 * m * self.radius?.powi(2),
-            BodyShape::Cylinder => m * (3.0 * self.radius?.powi(2) + self.length?.powi(2)) / 12.0,
+            BodyShape::Sphere => [0.4 * m * self.radius?.powi(2); 3],
+            BodyShape::Cylinder => {
+                let r2 = self.radius?.powi(2);
+                let lateral = m * (3.0 * r2 + self.length?.powi(2)) / 12.0;
+                [0.5 * m * r2, lateral, lateral]
+            }
             BodyShape::Box => {
-                let s = self.size?;
-                m * (s[0] * s[0] + s[1] * s[1]) / 12.0
+                let s = self.size?.map(|v| v * v);
+                [
+                    m * (s[1] + s[2]) / 12.0,
+                    m * (s[0] + s[2]) / 12.0,
+                    m * (s[0] + s[1]) / 12.0,
+                ]
             }
         })
+    }
+
+    /// The initial (or fixed) orientation, normalised; identity if absent.
+    pub fn quaternion(&self) -> [f64; 4] {
+        normalised(self.orientation)
+    }
+}
+
+/// A quaternion normalised, identity when absent or zero.
+pub fn normalised(q: Option<[f64; 4]>) -> [f64; 4] {
+    let q = q.unwrap_or([1.0, 0.0, 0.0, 0.0]);
+    let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if n > 0.0 && n.is_finite() {
+        q.map(|v| v / n)
+    } else {
+        [1.0, 0.0, 0.0, 0.0]
     }
 }
 
@@ -297,9 +335,13 @@ pub fn initial_coordinates(
         }
     };
     for b in m.bodies.iter().filter(|b| b.free) {
-        set(&format!("{}.x", b.name), b.position[0]);
-        set(&format!("{}.y", b.name), b.position[1]);
+        for (c, v) in ["x", "y", "z"].iter().zip(b.position) {
+            set(&format!("{}.{c}", b.name), v);
+        }
         set(&format!("{}.angle", b.name), b.angle);
+        for (c, v) in ["qw", "qx", "qy", "qz"].iter().zip(b.quaternion()) {
+            set(&format!("{}.{c}", b.name), v);
+        }
     }
     for (name, &v) in &m.simulate.q0 {
         let key = format!("simulate.q0.{name}");

@@ -8,7 +8,7 @@ use std::collections::HashSet;
 use super::assembly::{BodyDecl, BodyShape, FrameRef};
 use super::check::Check;
 use super::error::ModelError;
-use super::schema::{Base, Model};
+use super::schema::{Base, Method, Model};
 
 /// The assembly's own checks; `arm` checks one arm as a single-arm model.
 pub(super) fn check_assembly(
@@ -16,13 +16,6 @@ pub(super) fn check_assembly(
     arm: impl Fn(&Model) -> Result<(), ModelError>,
 ) -> Result<(), ModelError> {
     let m = ck.m;
-    if m.dimensions != 2 {
-        return ck.err(
-            "dimensions".into(),
-            "several arms, bodies, joints and compliant bases are planar so far: set dimensions = 2"
-                .into(),
-        );
-    }
     if !m.arms.is_empty() && !m.segments.is_empty() {
         return ck.err(
             "segment".into(),
@@ -59,7 +52,7 @@ pub(super) fn check_assembly(
             }
         };
         arm(&am).map_err(|e| ModelError::new(ck.file, key(&e.path), e.message))?;
-        compliant_base(ck, &am.base, &key("base"))?;
+        compliant_base(ck, &am.base, &key("base"), m.dimensions as usize)?;
     }
     for b in &m.bodies {
         body(ck, b)?;
@@ -141,6 +134,55 @@ fn body(ck: &Check, b: &BodyDecl) -> Result<(), ModelError> {
             );
         }
     }
+    let spatial = ck.m.dimensions == 3;
+    let wrong = match (
+        spatial,
+        b.inertia.is_some(),
+        b.principal_inertia.is_some(),
+        b.orientation.is_some(),
+    ) {
+        (true, true, _, _) => Some((
+            "inertia",
+            "a planar key: in 3D give principal_inertia = [Ixx, Iyy, Izz]",
+        )),
+        (false, _, true, _) => Some((
+            "principal_inertia",
+            "a 3D key: in the plane give inertia (about z)",
+        )),
+        (false, _, _, true) => Some(("orientation", "a 3D key: in the plane give angle")),
+        _ => None,
+    };
+    if let Some((k, why)) = wrong {
+        return ck.err(key(k), why.into());
+    }
+    if let Some(p) = b.principal_inertia {
+        for (i, v) in p.iter().enumerate() {
+            ck.finite(&format!("{}[{i}]", key("principal_inertia")), *v)?;
+        }
+        let ok = p.iter().all(|&v| v > 0.0)
+            && p[0] <= p[1] + p[2]
+            && p[1] <= p[0] + p[2]
+            && p[2] <= p[0] + p[1];
+        if !ok {
+            return ck.err(
+                key("principal_inertia"),
+                format!(
+                    "not the inertia of a body: the moments must be positive (a positive-definite inertia) and each at most the sum of the other two, got {p:?}"
+                ),
+            );
+        }
+    }
+    if let Some(q) = b.orientation {
+        for (i, v) in q.iter().enumerate() {
+            ck.finite(&format!("{}[{i}]", key("orientation")), *v)?;
+        }
+        if q.iter().all(|&v| v == 0.0) {
+            return ck.err(
+                key("orientation"),
+                "must be a non-zero quaternion (w, x, y, z)".into(),
+            );
+        }
+    }
     if let Some(i) = b.inertia {
         ck.finite(&key("inertia"), i)?;
         if i <= 0.0 {
@@ -177,6 +219,34 @@ fn joints(ck: &Check) -> Result<(), ModelError> {
                 "a joint between the world and itself holds nothing".into(),
             );
         }
+        for (k, f) in [("a", a), ("b", b)] {
+            if let FrameRef::SegmentEnd { arm, .. } = f
+                && m.arm_models()[arm]
+                    .1
+                    .segments
+                    .iter()
+                    .any(|s| s.method == Method::Eba)
+            {
+                return ck.err(
+                    key(k),
+                    "an eba arm's segment ends are not frames yet: hold its tip".into(),
+                );
+            }
+        }
+        if let Some(q) = j.orientation {
+            if m.dimensions != 3 || j.kind != super::assembly::JointKind::Weld {
+                return ck.err(
+                    key("orientation"),
+                    "a 3D weld's key (the plane's weld takes angle)".into(),
+                );
+            }
+            if q.iter().any(|v| !v.is_finite()) || q.iter().all(|&v| v == 0.0) {
+                return ck.err(
+                    key("orientation"),
+                    "must be a finite, non-zero quaternion (w, x, y, z)".into(),
+                );
+            }
+        }
         ck.vec3(&key("offset_a"), &j.offset_a)?;
         ck.vec3(&key("offset_b"), &j.offset_b)?;
         ck.finite(&key("angle"), j.angle)?;
@@ -184,7 +254,7 @@ fn joints(ck: &Check) -> Result<(), ModelError> {
     Ok(())
 }
 
-fn compliant_base(ck: &Check, base: &Base, key: &str) -> Result<(), ModelError> {
+fn compliant_base(ck: &Check, base: &Base, key: &str, axes: usize) -> Result<(), ModelError> {
     if !base.is_compliant() {
         return Ok(());
     }
@@ -206,10 +276,15 @@ fn compliant_base(ck: &Check, base: &Base, key: &str) -> Result<(), ModelError> 
         );
     }
     if let Some(f) = &base.follow {
-        if f.len() != 2 {
+        if f.len() != axes {
+            let which = if axes == 3 {
+                "three (x, y, z)"
+            } else {
+                "two (x, y)"
+            };
             return ck.err(
                 k("follow"),
-                format!("give two input channels (x, y), got {}", f.len()),
+                format!("give {which} input channels, got {}", f.len()),
             );
         }
         for (i, c) in f.iter().enumerate() {

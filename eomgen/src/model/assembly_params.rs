@@ -30,17 +30,25 @@ impl ParamLayout {
             arms.push((name.clone(), params.len(), own.clone()));
             params.extend((0..own.len()).map(scoped));
         }
+        let spatial = a.dimensions == 3;
         for (b, _) in a.bodies.iter().enumerate() {
             let b = b as u16;
             params.extend([BodyParam::Mass, BodyParam::Inertia].map(|w| Param::Body(b, w)));
             params.extend(Xyz::ALL.map(|c| Param::Body(b, BodyParam::Position(c))));
             params.push(Param::Body(b, BodyParam::Angle));
+            if spatial {
+                params.extend(Xyz::ALL.map(|c| Param::Body(b, BodyParam::Moment(c))));
+                params.extend((0..4).map(|i| Param::Body(b, BodyParam::Quaternion(i))));
+            }
         }
         for (j, _) in a.joints.iter().enumerate() {
             let j = j as u16;
             params.extend(Xyz::ALL.map(|c| Param::Joint(j, JointParam::OffsetA(c))));
             params.extend(Xyz::ALL.map(|c| Param::Joint(j, JointParam::OffsetB(c))));
             params.push(Param::Joint(j, JointParam::Angle));
+            if spatial {
+                params.extend((0..4).map(|i| Param::Joint(j, JointParam::Quaternion(i))));
+            }
         }
         for (k, (_, st)) in a.arms.iter().enumerate() {
             if !st.base_compliant {
@@ -55,8 +63,13 @@ impl ParamLayout {
                 params.push(Param::BaseSpring(arm, w));
             }
             // Without `follow` the point stays put: zeros, not inputs.
+            let axes = if spatial {
+                &Xyz::ALL[..]
+            } else {
+                &Xyz::ALL[..2]
+            };
             for r in [Rate::Value, Rate::First] {
-                for c in [Xyz::X, Xyz::Y] {
+                for &c in axes {
                     let p = Param::BaseSpring(arm, SpringParam::Follow(r, c));
                     if st.base_follows {
                         driven.push(Driven {
@@ -100,6 +113,8 @@ impl ParamLayout {
                         BodyParam::Inertia => body.planar_inertia().unwrap_or(0.0),
                         BodyParam::Position(c) => body.position[c.index()],
                         BodyParam::Angle => body.angle,
+                        BodyParam::Moment(c) => body.principal().map_or(0.0, |i| i[c.index()]),
+                        BodyParam::Quaternion(i) => body.quaternion()[i as usize],
                     }
                 }
                 Param::Joint(j, what) => {
@@ -108,6 +123,9 @@ impl ParamLayout {
                         JointParam::OffsetA(c) => joint.offset_a[c.index()],
                         JointParam::OffsetB(c) => joint.offset_b[c.index()],
                         JointParam::Angle => joint.angle,
+                        JointParam::Quaternion(i) => {
+                            super::assembly::normalised(joint.orientation)[i as usize]
+                        }
                     }
                 }
                 Param::BaseSpring(a, what) => {

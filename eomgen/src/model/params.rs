@@ -216,6 +216,10 @@ pub enum BodyParam {
     Inertia,
     Position(Xyz),
     Angle,
+    /// 3D: the principal moment about the body's axis.
+    Moment(Xyz),
+    /// 3D: a fixed body's orientation, w, x, y, z.
+    Quaternion(u8),
 }
 
 /// A joint's points in its two frames, and a weld's angle.
@@ -224,6 +228,8 @@ pub enum JointParam {
     OffsetA(Xyz),
     OffsetB(Xyz),
     Angle,
+    /// 3D weld: b's orientation in a's, w, x, y, z.
+    Quaternion(u8),
 }
 
 /// A compliant base: its mass, spring and damper, and the driven point it
@@ -277,11 +283,18 @@ impl Param {
                 BodyParam::Inertia => format!("body[{b}].inertia"),
                 BodyParam::Position(c) => format!("body[{b}].{}", c.name()),
                 BodyParam::Angle => format!("body[{b}].angle"),
+                BodyParam::Moment(c) => format!("body[{b}].moment.{}", c.name()),
+                BodyParam::Quaternion(i) => {
+                    format!("body[{b}].q{}", ["w", "x", "y", "z"][i as usize])
+                }
             },
             Self::Joint(j, what) => match what {
                 JointParam::OffsetA(c) => format!("joint[{j}].offset_a.{}", c.name()),
                 JointParam::OffsetB(c) => format!("joint[{j}].offset_b.{}", c.name()),
                 JointParam::Angle => format!("joint[{j}].angle"),
+                JointParam::Quaternion(i) => {
+                    format!("joint[{j}].q{}", ["w", "x", "y", "z"][i as usize])
+                }
             },
             Self::BaseSpring(a, what) => match what {
                 SpringParam::Mass => format!("arm[{a}].base.mass"),

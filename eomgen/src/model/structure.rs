@@ -88,6 +88,8 @@ pub struct Structure {
 /// which frames each joint holds together, how.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct AssemblyShape {
+    /// 2 or 3.
+    pub dimensions: u8,
     pub arms: Vec<(String, Structure)>,
     /// Per body: its name (it names coordinates) and whether it is free
     /// (its own coordinates) or fixed.
@@ -110,6 +112,7 @@ impl Structure {
         }
         let frame = |t: &str| FrameRef::parse(t, m).unwrap_or(FrameRef::World);
         let assembly = AssemblyShape {
+            dimensions: m.dimensions,
             arms: m
                 .arm_models()
                 .iter()
@@ -221,7 +224,11 @@ impl Structure {
     /// Canonical text of the structure (what is hashed).
     pub fn canonical(&self) -> String {
         if let Some(a) = &self.assembly {
-            let mut s = format!("assembly of {} arms\n", a.arms.len());
+            let mut s = format!(
+                "assembly of {} arms in {} dimensions\n",
+                a.arms.len(),
+                a.dimensions
+            );
             for (name, arm) in &a.arms {
                 s.push_str(&format!("arm {name:?}\n{}", arm.canonical()));
             }

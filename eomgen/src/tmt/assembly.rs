@@ -5,63 +5,160 @@
 //! (docs/design.md section 7).
 //!
 //! Invariant: the coordinates are the arms' in declaration order (each
-//! preceded by its compliant base's x, y), then the free bodies' x, y and
-//! angle; every joint contributes its rows in declaration order, x and y of
-//! the point gap, then a weld's angle gap.
+//! preceded by its compliant base's x, y (, z)), then the free bodies' (x,
+//! y and angle in the plane; x, y, z and a quaternion qw, qx, qy, qz in 3D);
+//! every joint contributes its rows in declaration order, the point gap
+//! (x, y (, z)), then a weld's angle gap (planar `angle`, 3D `rx, ry, rz`),
+//! and last each free 3D body its quaternion's unit norm (`unit`).
 
 use std::collections::HashMap;
 
 use crate::cas::{Cas, ExprId, Scope, SymKind};
 use crate::model::assembly::{FrameRef, JointKind};
 use crate::model::{
-    AssemblyShape, BodyParam, JointParam, Param, ParamLayout, Rate, SpringParam, Xyz,
+    AssemblyShape, BodyParam, JointParam, JointShape, Param, ParamLayout, Rate, SpringParam, Xyz,
 };
 
-use super::system::{Body, Coordinates, Inertia, ParamSymbols, PlanarPose, System};
+use super::system::{Body, Coordinates, Inertia, ParamSymbols, PointForce, System};
 
 /// The assembled system and its constraint equations.
 pub struct Assembled {
     pub sys: System,
     /// phi(q) = 0, rows as the module's invariant orders them.
     pub constraints: Vec<ExprId>,
-    /// Their names: `JOINT.x`, `JOINT.y`, `JOINT.angle`.
+    /// Their names: `JOINT.x`, `JOINT.angle`, `JOINT.rx`, `BODY.unit`, ...
     pub rows: Vec<String>,
     /// Coordinates per independent subsystem (an arm with its compliant
     /// base, a free body), in order: M is block diagonal over them.
     pub blocks: Vec<usize>,
 }
 
-/// The assembly's own parameters (gravity, bodies, joints, bases) by
-/// `Param`; the arms' come through their scoped `ParamSymbols`.
-struct OwnParams(HashMap<Param, ExprId>);
-
-impl OwnParams {
-    fn new(cas: &mut Cas, layout: &ParamLayout) -> Self {
-        let mut ids = HashMap::new();
-        for (i, &p) in layout.params().iter().enumerate() {
-            if !matches!(p, Param::Scoped { .. }) {
-                ids.insert(p, cas.symbol(&layout.name(p), SymKind::Param(i as u32)));
-            }
-        }
-        Self(ids)
-    }
-
-    fn get(&self, p: Param) -> ExprId {
-        self.0[&p]
-    }
+/// A frame a joint may hold: its origin, and its orientation as a planar
+/// angle (the plane) or a unit quaternion w, x, y, z (3D).
+#[derive(Clone, Copy)]
+struct Pose {
+    point: [ExprId; 3],
+    angle: ExprId,
+    quat: [ExprId; 4],
 }
 
-/// Coordinates of the assembly under construction: names, and their
-/// symbols created at the next index.
-struct Coords {
+/// An arm's frames for joints: its segment ends and its tip.
+struct ArmFrames {
+    segment_ends: Vec<Pose>,
+    tip: Pose,
+}
+
+/// The system of an assembly structure.
+pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -> Assembled {
+    let mut b = Builder::new(cas, layout, a.dimensions == 3);
+    let mut tips = Vec::new();
+    let mut arm_frames = Vec::new();
+    for (k, ((name, st), (_, offset, arm_layout))) in a.arms.iter().zip(layout.arms()).enumerate() {
+        let frames = b.arm(cas, k, name, st, *offset, arm_layout);
+        tips.push((frames.tip.point, frames.tip.quat));
+        arm_frames.push(frames);
+    }
+    let body_frames: Vec<Pose> = a
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(k, (name, free))| b.body(cas, k, name, *free))
+        .collect();
+    let frame = |f: FrameRef| match f {
+        FrameRef::World => b.world,
+        FrameRef::Body(k) => body_frames[k],
+        FrameRef::Tip(arm) => arm_frames[arm].tip,
+        FrameRef::SegmentEnd { arm, segment } => arm_frames[arm].segment_ends[segment],
+    };
+    let frames: Vec<(Pose, Pose)> = a.joints.iter().map(|j| (frame(j.a), frame(j.b))).collect();
+    for (k, (joint, (fa, fb))) in a.joints.iter().zip(frames).enumerate() {
+        b.joint(cas, k, joint, fa, fb);
+    }
+    let units = std::mem::take(&mut b.units);
+    for (name, q) in units {
+        let sq: Vec<ExprId> = q.iter().map(|&c| cas.powi(c, 2)).collect();
+        let norm = cas.add_all(&sq);
+        let one = cas.one();
+        let gap = cas.sub(norm, one);
+        b.constraints.push(cas.scaled(0.5, gap));
+        b.rows.push(format!("{name}.unit"));
+    }
+    let zero = cas.zero();
+    let (tip, tip_orientation) = tips
+        .first()
+        .copied()
+        .unwrap_or(([zero; 3], [cas.one(), zero, zero, zero]));
+    b.finish(cas, tip, tip_orientation)
+}
+
+/// What the assembly has gathered so far.
+struct Builder {
+    own: HashMap<Param, ExprId>,
+    spatial: bool,
+    zero: ExprId,
+    world: Pose,
     names: Vec<String>,
     q: Vec<ExprId>,
     qd: Vec<ExprId>,
     qdd: Vec<ExprId>,
+    bodies: Vec<Body>,
+    elastic: Vec<ExprId>,
+    rayleigh: Vec<ExprId>,
+    actuation: Vec<ExprId>,
+    point_forces: Vec<PointForce>,
+    moments: Vec<super::system::AppliedMoment>,
+    seeds: Vec<(ExprId, ExprId)>,
+    blocks: Vec<usize>,
+    constraints: Vec<ExprId>,
+    rows: Vec<String>,
+    /// Free 3D bodies' quaternions, held to unit norm by the last rows.
+    units: Vec<(String, [ExprId; 4])>,
 }
 
-impl Coords {
-    fn push(&mut self, cas: &mut Cas, name: String) -> (ExprId, ExprId) {
+impl Builder {
+    /// The assembly's own parameters (gravity, bodies, joints, bases) as
+    /// symbols; the arms' come through their scoped `ParamSymbols`.
+    fn new(cas: &mut Cas, layout: &ParamLayout, spatial: bool) -> Self {
+        let mut own = HashMap::new();
+        for (i, &p) in layout.params().iter().enumerate() {
+            if !matches!(p, Param::Scoped { .. }) {
+                own.insert(p, cas.symbol(&layout.name(p), SymKind::Param(i as u32)));
+            }
+        }
+        let (zero, one) = (cas.zero(), cas.one());
+        Self {
+            own,
+            spatial,
+            zero,
+            world: Pose {
+                point: [zero; 3],
+                angle: zero,
+                quat: [one, zero, zero, zero],
+            },
+            names: Vec::new(),
+            q: Vec::new(),
+            qd: Vec::new(),
+            qdd: Vec::new(),
+            bodies: Vec::new(),
+            elastic: Vec::new(),
+            rayleigh: Vec::new(),
+            actuation: Vec::new(),
+            point_forces: Vec::new(),
+            moments: Vec::new(),
+            seeds: Vec::new(),
+            blocks: Vec::new(),
+            constraints: Vec::new(),
+            rows: Vec::new(),
+            units: Vec::new(),
+        }
+    }
+
+    fn get(&self, p: Param) -> ExprId {
+        self.own[&p]
+    }
+
+    /// A coordinate at the next index: (q, qd).
+    fn coordinate(&mut self, cas: &mut Cas, name: String) -> (ExprId, ExprId) {
         let i = self.names.len() as u32;
         let q = cas.symbol(&name, SymKind::Q(i));
         let qd = cas.symbol(&format!("{name}_dot"), SymKind::Qd(i));
@@ -73,182 +170,285 @@ impl Coords {
         (q, qd)
     }
 
-    /// The coordinates of a system built in a scope at this index.
-    fn extend(&mut self, prefix: &str, c: &Coordinates) {
-        self.names
-            .extend(c.names.iter().map(|n| format!("{prefix}{n}")));
-        self.q.extend(&c.q);
-        self.qd.extend(&c.qd);
-        self.qdd.extend(&c.qdd);
-    }
-}
-
-/// The system of an assembly structure (planar).
-pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -> Assembled {
-    let own = OwnParams::new(cas, layout);
-    let zero = cas.zero();
-    let gravity = Xyz::ALL.map(|c| own.get(Param::Gravity(c)));
-    let mut coords = Coords {
-        names: Vec::new(),
-        q: Vec::new(),
-        qd: Vec::new(),
-        qdd: Vec::new(),
-    };
-    let mut bodies = Vec::new();
-    let (mut elastic, mut rayleigh, mut actuation) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut point_forces, mut moments, mut seeds) = (Vec::new(), Vec::new(), Vec::new());
-    let mut tips = Vec::new();
-    let mut arm_frames = Vec::new();
-    let mut blocks = Vec::new();
-    for (k, ((name, st), (_, offset, arm_layout))) in a.arms.iter().zip(layout.arms()).enumerate() {
+    /// Arm k built in its scope, and its frames for joints.
+    fn arm(
+        &mut self,
+        cas: &mut Cas,
+        k: usize,
+        name: &str,
+        st: &crate::model::Structure,
+        offset: usize,
+        arm_layout: &ParamLayout,
+    ) -> ArmFrames {
         let prefix = if name.is_empty() {
             String::new()
         } else {
             format!("{name}.")
         };
-        let spring = |w| own.get(Param::BaseSpring(k as u16, w));
-        let first = coords.names.len();
-        let base_offset = st.base_compliant.then(|| {
-            let (x, xd) = coords.push(cas, format!("{prefix}base_x"));
-            let (y, yd) = coords.push(cas, format!("{prefix}base_y"));
-            let follow = |r, c| spring(SpringParam::Follow(r, c));
-            for (s, v, c) in [(x, xd, Xyz::X), (y, yd, Xyz::Y)] {
-                let gap = cas.sub(s, follow(Rate::Value, c));
-                elastic.push(half_k_sq(cas, spring(SpringParam::Stiffness), gap));
-                let slip = cas.sub(v, follow(Rate::First, c));
-                rayleigh.push(half_k_sq(cas, spring(SpringParam::Damping), slip));
-            }
-            [x, y, zero]
-        });
+        let first = self.names.len();
+        let base_offset = st
+            .base_compliant
+            .then(|| self.compliant_base(cas, k, &prefix));
         let scope = Scope {
             prefix: prefix.clone(),
-            coordinates: coords.names.len() as u32,
-            parameters: *offset as u32,
+            coordinates: self.names.len() as u32,
+            parameters: offset as u32,
         };
+        let base_mass = self
+            .own
+            .get(&Param::BaseSpring(k as u16, SpringParam::Mass));
+        let (zero, mut bodies) = (self.zero, Vec::new());
         let sys = cas.scoped(scope, |cas| {
             let mut symbols = ParamSymbols::new(cas, arm_layout);
-            if let Some(o) = base_offset {
+            if let (Some(o), Some(&mass)) = (base_offset, base_mass) {
                 symbols = symbols.with_base_offset(o);
-                let position = symbols.base_motion(cas).position;
                 bodies.push(Body {
-                    mass: spring(SpringParam::Mass),
+                    mass,
                     inertia: Inertia::Isotropic(zero),
-                    position,
+                    position: symbols.base_motion(cas).position,
                     omega: [zero; 3],
                 });
             }
             super::arm_system(cas, st, &symbols)
         });
-        coords.extend(&prefix, &sys.coords);
-        blocks.push(coords.names.len() - first);
-        bodies.extend(sys.bodies);
-        elastic.push(sys.elastic);
-        rayleigh.push(sys.rayleigh);
-        actuation.push(sys.actuation);
-        point_forces.extend(sys.point_forces);
-        moments.extend(sys.moments);
-        seeds.extend(sys.seeds);
-        tips.push((sys.tip, sys.tip_orientation));
-        let planar = sys.planar.expect("assemblies are planar (validated)");
-        arm_frames.push((
-            planar.segment_ends,
-            PlanarPose {
-                point: sys.tip,
-                angle: planar.tip.angle,
-            },
-        ));
+        self.names
+            .extend(sys.coords.names.iter().map(|n| format!("{prefix}{n}")));
+        self.q.extend(&sys.coords.q);
+        self.qd.extend(&sys.coords.qd);
+        self.qdd.extend(&sys.coords.qdd);
+        self.blocks.push(self.names.len() - first);
+        self.bodies.extend(bodies);
+        self.bodies.extend(sys.bodies);
+        self.elastic.push(sys.elastic);
+        self.rayleigh.push(sys.rayleigh);
+        self.actuation.push(sys.actuation);
+        self.point_forces.extend(sys.point_forces);
+        self.moments.extend(sys.moments);
+        self.seeds.extend(sys.seeds);
+        match sys.planar {
+            Some(planar) => {
+                let pose = |p: super::system::PlanarPose| Pose {
+                    point: p.point,
+                    angle: p.angle,
+                    quat: [zero; 4],
+                };
+                ArmFrames {
+                    segment_ends: planar.segment_ends.into_iter().map(pose).collect(),
+                    tip: Pose {
+                        point: sys.tip,
+                        quat: sys.tip_orientation,
+                        ..pose(planar.tip)
+                    },
+                }
+            }
+            None => {
+                let pose = |(point, quat)| Pose {
+                    point,
+                    angle: zero,
+                    quat,
+                };
+                ArmFrames {
+                    segment_ends: sys.segment_ends.into_iter().map(pose).collect(),
+                    tip: pose((sys.tip, sys.tip_orientation)),
+                }
+            }
+        }
     }
-    let mut body_frames = Vec::new();
-    for (b, (name, free)) in a.bodies.iter().enumerate() {
-        let p = |w| own.get(Param::Body(b as u16, w));
-        let pose = if *free {
-            let (x, _) = coords.push(cas, format!("{name}.x"));
-            let (y, _) = coords.push(cas, format!("{name}.y"));
-            let (angle, rate) = coords.push(cas, format!("{name}.angle"));
-            blocks.push(3);
-            let point = [x, y, p(BodyParam::Position(Xyz::Z))];
-            bodies.push(Body {
-                mass: p(BodyParam::Mass),
-                inertia: Inertia::Isotropic(p(BodyParam::Inertia)),
+
+    /// A compliant base's coordinates (its displacement), with its spring
+    /// and damper to the driven point.
+    fn compliant_base(&mut self, cas: &mut Cas, k: usize, prefix: &str) -> [ExprId; 3] {
+        let spring = |w| Param::BaseSpring(k as u16, w);
+        let axes = if self.spatial { 3 } else { 2 };
+        let mut offset = [self.zero; 3];
+        for (c, axis) in Xyz::ALL.iter().take(axes).enumerate() {
+            let (s, v) = self.coordinate(cas, format!("{prefix}base_{}", ["x", "y", "z"][c]));
+            offset[c] = s;
+            let gap = cas.sub(s, self.get(spring(SpringParam::Follow(Rate::Value, *axis))));
+            let k_s = self.get(spring(SpringParam::Stiffness));
+            self.elastic.push(half_k_sq(cas, k_s, gap));
+            let slip = cas.sub(v, self.get(spring(SpringParam::Follow(Rate::First, *axis))));
+            let c_s = self.get(spring(SpringParam::Damping));
+            self.rayleigh.push(half_k_sq(cas, c_s, slip));
+        }
+        offset
+    }
+
+    /// Body k: free (coordinates of its own) or fixed (parameters).
+    fn body(&mut self, cas: &mut Cas, k: usize, name: &str, free: bool) -> Pose {
+        let p = |w| Param::Body(k as u16, w);
+        let zero = self.zero;
+        if !free {
+            return Pose {
+                point: Xyz::ALL.map(|c| self.get(p(BodyParam::Position(c)))),
+                angle: self.get(p(BodyParam::Angle)),
+                quat: if self.spatial {
+                    [0, 1, 2, 3].map(|i| self.get(p(BodyParam::Quaternion(i))))
+                } else {
+                    [zero; 4]
+                },
+            };
+        }
+        let first = self.names.len();
+        let mass = self.get(p(BodyParam::Mass));
+        let pose = if self.spatial {
+            let point = ["x", "y", "z"].map(|c| self.coordinate(cas, format!("{name}.{c}")).0);
+            let both =
+                ["qw", "qx", "qy", "qz"].map(|c| self.coordinate(cas, format!("{name}.{c}")));
+            let (quat, rate) = (both.map(|b| b.0), both.map(|b| b.1));
+            let moments = Xyz::ALL.map(|c| self.get(p(BodyParam::Moment(c))));
+            self.spatial_body(cas, mass, point, quat, rate, moments);
+            self.units.push((name.to_string(), quat));
+            Pose {
+                point,
+                angle: zero,
+                quat,
+            }
+        } else {
+            let (x, _) = self.coordinate(cas, format!("{name}.x"));
+            let (y, _) = self.coordinate(cas, format!("{name}.y"));
+            let (angle, rate) = self.coordinate(cas, format!("{name}.angle"));
+            let point = [x, y, self.get(p(BodyParam::Position(Xyz::Z)))];
+            self.bodies.push(Body {
+                mass,
+                inertia: Inertia::Isotropic(self.get(p(BodyParam::Inertia))),
                 position: point,
                 omega: [zero, zero, rate],
             });
-            PlanarPose { point, angle }
-        } else {
-            PlanarPose {
-                point: Xyz::ALL.map(|c| p(BodyParam::Position(c))),
-                angle: p(BodyParam::Angle),
+            Pose {
+                point,
+                angle,
+                quat: [zero; 4],
             }
         };
-        body_frames.push(pose);
+        self.blocks.push(self.names.len() - first);
+        pose
     }
-    let frame = |f: FrameRef| match f {
-        FrameRef::World => PlanarPose {
-            point: [zero; 3],
-            angle: zero,
-        },
-        FrameRef::Body(b) => body_frames[b],
-        FrameRef::Tip(arm) => arm_frames[arm].1,
-        FrameRef::SegmentEnd { arm, segment } => arm_frames[arm].0[segment],
-    };
-    let (mut constraints, mut rows) = (Vec::new(), Vec::new());
-    for (j, joint) in a.joints.iter().enumerate() {
-        rows.extend(["x", "y"].map(|c| format!("{}.{c}", joint.name)));
-        let p = |w| own.get(Param::Joint(j as u16, w));
-        let (fa, fb) = (frame(joint.a), frame(joint.b));
-        let pa = point_at(
-            cas,
-            fa,
-            [JointParam::OffsetA(Xyz::X), JointParam::OffsetA(Xyz::Y)].map(p),
-        );
-        let pb = point_at(
-            cas,
-            fb,
-            [JointParam::OffsetB(Xyz::X), JointParam::OffsetB(Xyz::Y)].map(p),
-        );
-        for c in 0..2 {
-            constraints.push(cas.sub(pa[c], pb[c]));
+
+    /// A free 3D body on quaternion coordinates: world angular velocity
+    /// w = 2 (qw u' - qw' u + u x u') (u the vector part), its principal
+    /// axes turned by the quaternion. Four coordinates for three freedoms
+    /// leave M singular along q itself; a kinetic term c (q . q')^2 / 2,
+    /// zero on the unit sphere the `unit` row holds q to, makes it
+    /// positive definite without changing the motion.
+    fn spatial_body(
+        &mut self,
+        cas: &mut Cas,
+        mass: ExprId,
+        point: [ExprId; 3],
+        quat: [ExprId; 4],
+        rate: [ExprId; 4],
+        moments: [ExprId; 3],
+    ) {
+        let zero = self.zero;
+        let (u, du) = ([quat[1], quat[2], quat[3]], [rate[1], rate[2], rate[3]]);
+        let cross = cas.cross(&u, &du);
+        let omega: [ExprId; 3] = std::array::from_fn(|c| {
+            let a = cas.mul(quat[0], du[c]);
+            let b = cas.mul(rate[0], u[c]);
+            let d = cas.sub(a, b);
+            let s = cas.add(d, cross[c]);
+            let s = cas.scaled(2.0, s);
+            cas.bind(s)
+        });
+        let axes = [0, 1, 2].map(|k| {
+            let mut e = [zero; 3];
+            e[k] = cas.one();
+            rotate(cas, quat, e).map(|c| cas.bind(c))
+        });
+        self.bodies.push(Body {
+            mass,
+            inertia: Inertia::Principal { axes, moments },
+            position: point,
+            omega,
+        });
+        let sum = cas.add_all(&moments);
+        let c = cas.scaled(4.0 / 3.0, sum);
+        let radial = cas.dot(&quat, &rate);
+        self.bodies.push(Body {
+            mass: zero,
+            inertia: Inertia::Isotropic(c),
+            position: [zero; 3],
+            omega: [radial, zero, zero],
+        });
+    }
+
+    /// Joint k's rows: the gap between its two points, then a weld's angle
+    /// (planar) or rotation (3D, 2 vec(q_b conj(q_a q_offset)): the world
+    /// rotation from a's turned frame to b's, to first order).
+    fn joint(&mut self, cas: &mut Cas, k: usize, joint: &JointShape, fa: Pose, fb: Pose) {
+        let p = |w| Param::Joint(k as u16, w);
+        let off_a = Xyz::ALL.map(|c| self.get(p(JointParam::OffsetA(c))));
+        let off_b = Xyz::ALL.map(|c| self.get(p(JointParam::OffsetB(c))));
+        let axes = if self.spatial { 3 } else { 2 };
+        let (pa, pb) = if self.spatial {
+            (point_at(cas, &fa, off_a), point_at(cas, &fb, off_b))
+        } else {
+            (planar_point(cas, &fa, off_a), planar_point(cas, &fb, off_b))
+        };
+        for c in 0..axes {
+            self.constraints.push(cas.sub(pa[c], pb[c]));
+            self.rows
+                .push(format!("{}.{}", joint.name, ["x", "y", "z"][c]));
         }
-        if joint.kind == JointKind::Weld {
-            let turned = cas.add(fa.angle, p(JointParam::Angle));
-            constraints.push(cas.sub(fb.angle, turned));
-            rows.push(format!("{}.angle", joint.name));
+        if joint.kind != JointKind::Weld {
+            return;
+        }
+        if !self.spatial {
+            let turned = cas.add(fa.angle, self.get(p(JointParam::Angle)));
+            self.constraints.push(cas.sub(fb.angle, turned));
+            self.rows.push(format!("{}.angle", joint.name));
+            return;
+        }
+        let offset = [0, 1, 2, 3].map(|i| self.get(p(JointParam::Quaternion(i))));
+        let target = quat_mul(cas, fa.quat, offset);
+        let conj = [
+            target[0],
+            cas.neg(target[1]),
+            cas.neg(target[2]),
+            cas.neg(target[3]),
+        ];
+        let rel = quat_mul(cas, fb.quat, conj);
+        for (c, name) in ["rx", "ry", "rz"].iter().enumerate() {
+            self.constraints.push(cas.scaled(2.0, rel[c + 1]));
+            self.rows.push(format!("{}.{name}", joint.name));
         }
     }
-    let (tip, tip_orientation) = tips
-        .first()
-        .copied()
-        .unwrap_or(([zero; 3], [cas.one(), zero, zero, zero]));
-    let sys = System {
-        coords: Coordinates {
-            names: coords.names,
-            q: coords.q,
-            qd: coords.qd,
-            qdd: coords.qdd,
-        },
-        bodies,
-        gravity,
-        elastic: cas.add_all(&elastic),
-        rayleigh: cas.add_all(&rayleigh),
-        actuation: cas.add_all(&actuation),
-        point_forces,
-        moments,
-        tip,
-        tip_orientation,
-        chain: None,
-        seeds,
-        planar: None,
-    };
-    Assembled {
-        sys,
-        constraints,
-        rows,
-        blocks,
+
+    fn finish(self, cas: &mut Cas, tip: [ExprId; 3], tip_orientation: [ExprId; 4]) -> Assembled {
+        let gravity = Xyz::ALL.map(|c| self.get(Param::Gravity(c)));
+        let sys = System {
+            coords: Coordinates {
+                names: self.names,
+                q: self.q,
+                qd: self.qd,
+                qdd: self.qdd,
+            },
+            bodies: self.bodies,
+            gravity,
+            elastic: cas.add_all(&self.elastic),
+            rayleigh: cas.add_all(&self.rayleigh),
+            actuation: cas.add_all(&self.actuation),
+            point_forces: self.point_forces,
+            moments: self.moments,
+            tip,
+            tip_orientation,
+            chain: None,
+            seeds: self.seeds,
+            planar: None,
+            segment_ends: Vec::new(),
+        };
+        Assembled {
+            sys,
+            constraints: self.constraints,
+            rows: self.rows,
+            blocks: self.blocks,
+        }
     }
 }
 
 /// The point at `offset` (in the frame's own axes) of a planar frame.
-fn point_at(cas: &mut Cas, f: PlanarPose, offset: [ExprId; 2]) -> [ExprId; 2] {
+fn planar_point(cas: &mut Cas, f: &Pose, offset: [ExprId; 3]) -> [ExprId; 3] {
     let (c, s) = (cas.cos(f.angle), cas.sin(f.angle));
     let x = {
         let a = cas.mul(c, offset[0]);
@@ -262,7 +462,41 @@ fn point_at(cas: &mut Cas, f: PlanarPose, offset: [ExprId; 2]) -> [ExprId; 2] {
         let d = cas.add(a, b);
         cas.add(f.point[1], d)
     };
-    [x, y]
+    [x, y, f.point[2]]
+}
+
+/// The point at `offset` (in the frame's own axes) of a 3D frame.
+fn point_at(cas: &mut Cas, f: &Pose, offset: [ExprId; 3]) -> [ExprId; 3] {
+    let turned = rotate(cas, f.quat, offset);
+    std::array::from_fn(|c| cas.add(f.point[c], turned[c]))
+}
+
+/// v turned by the unit quaternion q: v + 2 w (u x v) + 2 u x (u x v).
+fn rotate(cas: &mut Cas, q: [ExprId; 4], v: [ExprId; 3]) -> [ExprId; 3] {
+    let u = [q[1], q[2], q[3]];
+    let uv = cas.cross(&u, &v);
+    let uuv = cas.cross(&u, &uv);
+    std::array::from_fn(|c| {
+        let a = cas.mul(q[0], uv[c]);
+        let s = cas.add(a, uuv[c]);
+        let s = cas.scaled(2.0, s);
+        cas.add(v[c], s)
+    })
+}
+
+/// The quaternion product a b (w, x, y, z).
+fn quat_mul(cas: &mut Cas, a: [ExprId; 4], b: [ExprId; 4]) -> [ExprId; 4] {
+    let (av, bv) = ([a[1], a[2], a[3]], [b[1], b[2], b[3]]);
+    let dot = cas.dot(&av, &bv);
+    let ww = cas.mul(a[0], b[0]);
+    let w = cas.sub(ww, dot);
+    let cross = cas.cross(&av, &bv);
+    let v: [ExprId; 3] = std::array::from_fn(|c| {
+        let x = cas.mul(a[0], bv[c]);
+        let y = cas.mul(b[0], av[c]);
+        cas.add_all(&[x, y, cross[c]])
+    });
+    [w, v[0], v[1], v[2]]
 }
 
 /// k x^2 / 2.

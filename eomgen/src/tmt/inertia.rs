@@ -24,6 +24,12 @@ pub enum Inertia {
         axial: ExprId,
         lateral: ExprId,
     },
+    /// A rigid body of three principal moments about its unit world-frame
+    /// axes (the columns of its rotation): a free body of an assembly.
+    Principal {
+        axes: [[ExprId; 3]; 3],
+        moments: [ExprId; 3],
+    },
 }
 
 impl Inertia {
@@ -43,6 +49,18 @@ impl Inertia {
                     let l = cas.mul(*lateral, w[k]);
                     let a = cas.mul(along, axis[k]);
                     cas.add(l, a)
+                })
+            }
+            // sum_k I_k a_k (a_k . w)
+            Inertia::Principal { axes, moments } => {
+                let along: [ExprId; 3] = std::array::from_fn(|k| {
+                    let aw = cas.dot(&axes[k], w);
+                    cas.mul(moments[k], aw)
+                });
+                std::array::from_fn(|c| {
+                    let terms: Vec<ExprId> =
+                        (0..3).map(|k| cas.mul(along[k], axes[k][c])).collect();
+                    cas.add_all(&terms)
                 })
             }
         }
@@ -76,6 +94,16 @@ impl Inertia {
                     [(0, 1), (0, 2), (1, 2)].map(|(a, b)| cas.mul_all(&[diff, axis[a], axis[b]]));
                 [diag[0], diag[1], diag[2], off[0], off[1], off[2]]
             }
+            Inertia::Principal { axes, moments } => {
+                let entry = |cas: &mut Cas, a: usize, b: usize| {
+                    let t: Vec<ExprId> = (0..3)
+                        .map(|k| cas.mul_all(&[moments[k], axes[k][a], axes[k][b]]))
+                        .collect();
+                    cas.add_all(&t)
+                };
+                let e = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
+                e.map(|(a, b)| entry(cas, a, b))
+            }
         }
     }
 
@@ -94,6 +122,10 @@ impl Inertia {
                 let s = cas.mul(diff, aw);
                 let wa = cas.cross(w, axis);
                 wa.map(|c| cas.mul(s, c))
+            }
+            Inertia::Principal { .. } => {
+                let jw = self.apply(cas, w);
+                cas.cross(w, &jw)
             }
         }
     }
@@ -123,6 +155,14 @@ impl Inertia {
                 }
                 .apply(cas, w)
             }
+            Inertia::Principal { axes, moments } => {
+                let d = cas.time_derivatives(moments, pairs);
+                Inertia::Principal {
+                    axes: *axes,
+                    moments: [d[0], d[1], d[2]],
+                }
+                .apply(cas, w)
+            }
         }
     }
 
@@ -149,6 +189,17 @@ impl Inertia {
                 let normal = cas.sub(w2, aw2);
                 let cot = [cas.scaled(-0.5, aw2), cas.scaled(-0.5, normal)];
                 cas.vjp(&[*axial, *lateral], &cot, q)
+            }
+            // w^T J w = sum_k I_k (a_k . w)^2
+            Inertia::Principal { axes, moments } => {
+                let cot: Vec<ExprId> = (0..3)
+                    .map(|k| {
+                        let aw = cas.dot(&axes[k], w);
+                        let aw2 = cas.powi(aw, 2);
+                        cas.scaled(-0.5, aw2)
+                    })
+                    .collect();
+                cas.vjp(moments, &cot, q)
             }
         }
     }

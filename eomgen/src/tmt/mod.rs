@@ -61,10 +61,14 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
     if structure.dimensions == 3 {
         let names = method::coordinate_names(structure);
         let mut arm = SpatialArm::new(cas, names, symbols);
+        let mut ends = Vec::new();
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
             m.build_spatial(cas, &mut arm, g, s);
+            ends.push((arm.f.p, arm.f.quat));
         }
-        arm.finish(cas, structure)
+        let mut sys = arm.finish(cas, structure);
+        sys.segment_ends = ends;
+        sys
     } else {
         let names = method::coordinate_names(structure);
         let mut arm = PlanarArm::new(cas, names, symbols);

@@ -241,6 +241,7 @@ impl<'a> PlanarArm<'a> {
                 moment_link: Vec::new(),
             }),
             seeds,
+            segment_ends: Vec::new(),
             planar: Some(PlanarFrames {
                 segment_ends: ends,
                 tip: PlanarPose {

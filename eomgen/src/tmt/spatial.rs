@@ -498,6 +498,7 @@ impl<'a> SpatialArm<'a> {
                 moment_link: Vec::new(),
             }),
             seeds,
+            segment_ends: Vec::new(),
             planar: None,
         };
         let mount = TipMount {

@@ -213,6 +213,9 @@ pub struct System {
     pub seeds: Vec<(ExprId, ExprId)>,
     /// Planar chains: the frames joints may hold (`None` in 3D).
     pub planar: Option<PlanarFrames>,
+    /// 3D chains: each segment's end frame, origin and orientation (w, x,
+    /// y, z), for joints (empty for a method that builds the whole arm).
+    pub segment_ends: Vec<([ExprId; 3], [ExprId; 4])>,
 }
 
 /// A planar frame: origin and angle from the world's x axis.

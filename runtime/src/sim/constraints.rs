@@ -198,7 +198,8 @@ pub fn forces<D: Dynamics + ?Sized>(
 }
 
 /// How far a state is off the joints: the largest point gap (m), angle gap
-/// (rad) and velocity gap |J qd| (m/s or rad/s).
+/// (rad; also a free body's quaternion off unit norm) and velocity gap
+/// |J qd| (m/s or rad/s).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Drift {
     pub position_m: f64,
@@ -213,10 +214,10 @@ pub fn drift<D: Dynamics + ?Sized>(d: &D, t: f64, q: &[f64], qd: &[f64]) -> Drif
     let mut out = Drift::default();
     for (i, name) in rows.iter().enumerate() {
         let gap = c.phi[i].abs();
-        if name.ends_with(".angle") {
-            out.angle_rad = out.angle_rad.max(gap);
-        } else {
+        if [".x", ".y", ".z"].iter().any(|s| name.ends_with(s)) {
             out.position_m = out.position_m.max(gap);
+        } else {
+            out.angle_rad = out.angle_rad.max(gap);
         }
         out.velocity = out.velocity.max(v[i].abs());
     }

@@ -51,6 +51,31 @@ pub fn simulate<D: Dynamics + ?Sized>(
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let n = arm.dof();
     assert_eq!(x0.len(), 2 * n, "state must be [q, qd]");
+    // A start whose accelerations cannot be computed fails now, with the
+    // reason, rather than after a solver has shrunk its step to nothing.
+    let mut qdd = vec![0.0; n];
+    let mut ws = crate::arm::Workspace::new(n);
+    if let Err(e) = crate::arm::accelerations(arm, &mut ws, 0.0, &x0[..n], &x0[n..], &mut qdd) {
+        return Err(Box::new(SimFailure {
+            t_reached: 0.0,
+            last_step_s: None,
+            reason: format!("at the initial state: {e}"),
+            suggestion:
+                "check the initial state (--q0) and the model's masses, inertias and joints".into(),
+            state: x0,
+            trajectory: Trajectory::default(),
+            stats: SimStats {
+                solver: opts.solver,
+                steps: 0,
+                rejected_steps: 0,
+                rhs_evaluations: 1,
+                jacobian_evaluations: 0,
+                wall_s: 0.0,
+                switched: None,
+                constraints: None,
+            },
+        }));
+    }
     if !arm.info().constraints.is_empty() {
         return projected::run(arm, x0, opts);
     }
