@@ -139,6 +139,41 @@ fn assembly_cases() -> Vec<(&'static str, String, Vec<&'static str>)> {
             vec!["arm.left.segment[0].length", "must be positive"],
         ),
         (
+            "a 3D body with an impossible inertia",
+            r(
+                "gravity = [0.0, -9.81, 0.0]",
+                "dimensions = 3\ngravity = [0.0, -9.81, 0.0]",
+            )
+            .replacen(
+                "mass = 0.1",
+                "mass = 0.1\nprincipal_inertia = [1.0, 0.1, 0.1]",
+                1,
+            ),
+            vec!["body.ball.principal_inertia", "each at most the sum"],
+        ),
+        (
+            "a planar inertia in 3D",
+            r(
+                "gravity = [0.0, -9.81, 0.0]",
+                "dimensions = 3\ngravity = [0.0, -9.81, 0.0]",
+            )
+            .replacen("mass = 0.1", "mass = 0.1\ninertia = 0.01", 1),
+            vec!["body.ball.inertia", "principal_inertia"],
+        ),
+        (
+            "a zero orientation",
+            r(
+                "gravity = [0.0, -9.81, 0.0]",
+                "dimensions = 3\ngravity = [0.0, -9.81, 0.0]",
+            )
+            .replacen(
+                "mass = 0.1",
+                "mass = 0.1\norientation = [0.0, 0.0, 0.0, 0.0]",
+                1,
+            ),
+            vec!["body.ball.orientation", "non-zero quaternion"],
+        ),
+        (
             "a sphere without its radius",
             r("radius = 0.05\n", ""),
             vec!["body.ball.radius", "needs its radius"],
