@@ -9,8 +9,10 @@
 //! first step estimate (and a Jacobian for the implicit methods) per leg,
 //! so legs double while the drift over a leg stays below a tenth of its
 //! budget (`drift_budget`); a leg that exceeds it is run again in halves,
-//! down to one sample interval. The drift is measured at every sample: the
-//! largest is what `ConstraintStats` reports (docs/design.md section 7).
+//! down to one sample interval, and that interval in up to `MAX_PIECES`
+//! pieces, projected after each. The drift is measured at every sample and
+//! piece end: the largest is what `ConstraintStats` reports (docs/design.md
+//! section 7).
 
 use serde::Serialize;
 
@@ -60,51 +62,40 @@ fn sample_times(opts: &SimOptions) -> Vec<f64> {
     times
 }
 
+/// Most pieces one sample interval is cut into when a single interval
+/// drifts past the budget.
+const MAX_PIECES: usize = 64;
+
+/// A leg's run: its samples (the last one projected), what it cost, and
+/// the largest drift seen at them before projection.
+struct Leg {
+    traj: Trajectory,
+    stats: SimStats,
+    worst: Drift,
+}
+
 pub(super) fn run<D: Dynamics + ?Sized>(
     arm: &D,
     x0: Vec<f64>,
     opts: &SimOptions,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
-    let n = arm.dof();
     let mut traj = Trajectory {
         t: vec![0.0],
-        x: vec![x0.clone()],
+        x: vec![x0],
         events: Vec::new(),
     };
-    let mut stats = SimStats {
-        solver: opts.solver,
-        steps: 0,
-        rejected_steps: 0,
-        rhs_evaluations: 0,
-        jacobian_evaluations: 0,
-        wall_s: 0.0,
-        switched: None,
-        constraints: Some(ConstraintStats::default()),
-    };
-    let add = |stats: &mut SimStats, more: &SimStats| {
-        stats.steps += more.steps;
-        stats.rejected_steps += more.rejected_steps;
-        stats.rhs_evaluations += more.rhs_evaluations;
-        stats.jacobian_evaluations += more.jacobian_evaluations;
-        stats.wall_s += more.wall_s;
-        if stats.switched.is_none() {
-            stats.switched.clone_from(&more.switched);
-        }
-    };
-    let (mut t0, mut x) = (0.0, x0);
+    let mut stats = empty_stats(opts);
     let times = sample_times(opts);
     let budget = drift_budget(opts);
-    let (mut next, mut leg_len) = (0, 1);
+    // Legs span `leg_len` sample intervals; a single interval that drifts
+    // too far is cut into `pieces`, projected after each.
+    let (mut next, mut leg_len, mut pieces) = (0, 1, 1);
     while next < times.len() {
+        let t0 = *traj.t.last().expect("the start is a sample");
+        let x = traj.x.last().expect("as many states as times").clone();
         let leg_times = &times[next..(next + leg_len).min(times.len())];
-        let t1 = *leg_times.last().expect("a leg has a sample");
-        let leg = SimOptions {
-            t_end: t1,
-            output_times: Some(leg_times.to_vec()),
-            ..opts.clone()
-        };
-        let (mut seg, more) = match super::run_from(arm, t0, x, &leg) {
-            Ok(r) => r,
+        let leg = match run_leg(arm, t0, x, leg_times, pieces, opts) {
+            Ok(leg) => leg,
             Err(mut f) => {
                 add(&mut stats, &f.stats);
                 let mut before = std::mem::take(&mut traj);
@@ -117,32 +108,105 @@ pub(super) fn run<D: Dynamics + ?Sized>(
                 return Err(f);
             }
         };
-        add(&mut stats, &more);
-        let skip = seg.t.iter().take_while(|&&t| t <= t0).count();
-        let mut worst = Drift::default();
-        for (t, state) in seg.t.iter().zip(&seg.x).skip(skip) {
-            let gap = drift(arm, *t, &state[..n], &state[n..]);
-            worst.position_m = worst.position_m.max(gap.position_m);
-            worst.angle_rad = worst.angle_rad.max(gap.angle_rad);
-            worst.velocity = worst.velocity.max(gap.velocity);
-        }
-        let worst_gap = worst.position_m.max(worst.angle_rad);
+        add(&mut stats, &leg.stats);
+        let worst_gap = leg.worst.position_m.max(leg.worst.angle_rad);
         if worst_gap > budget && leg_len > 1 {
             // Over budget: this leg again, in halves.
             leg_len /= 2;
-            x = traj.x.last().expect("the start is a sample").clone();
+            continue;
+        }
+        if worst_gap > budget && pieces < MAX_PIECES {
+            pieces *= 2;
             continue;
         }
         let cs = stats.constraints.as_mut().expect("set above");
-        cs.drift_max_m = cs.drift_max_m.max(worst.position_m);
-        cs.drift_max_rad = cs.drift_max_rad.max(worst.angle_rad);
-        cs.velocity_drift_max = cs.velocity_drift_max.max(worst.velocity);
-        let Some(&t_end) = seg.t.last() else {
+        cs.drift_max_m = cs.drift_max_m.max(leg.worst.position_m);
+        cs.drift_max_rad = cs.drift_max_rad.max(leg.worst.angle_rad);
+        cs.velocity_drift_max = cs.velocity_drift_max.max(leg.worst.velocity);
+        cs.projections += leg.stats.constraints.map_or(0, |c| c.projections);
+        let t_end = leg.traj.t.last().copied();
+        traj.events.extend(leg.traj.events);
+        traj.t.extend(leg.traj.t);
+        traj.x.extend(leg.traj.x);
+        // A terminal event ended the leg early: the run ends there.
+        if t_end < leg_times.last().copied() {
             break;
+        }
+        next += leg_times.len();
+        // Longer legs (or fewer pieces) while the drift stays well inside
+        // its budget.
+        if worst_gap < 0.1 * budget {
+            if pieces > 1 {
+                pieces /= 2;
+            } else {
+                leg_len *= 2;
+            }
+        }
+    }
+    stats.solver = opts.solver;
+    Ok((traj, stats))
+}
+
+/// One leg from (t0, x) through `times`, in `pieces` runs when it is one
+/// sample interval; the state projected at the end of every run, only the
+/// samples kept.
+fn run_leg<D: Dynamics + ?Sized>(
+    arm: &D,
+    t0: f64,
+    x: Vec<f64>,
+    times: &[f64],
+    pieces: usize,
+    opts: &SimOptions,
+) -> Result<Leg, Box<SimFailure>> {
+    let n = arm.dof();
+    let t1 = *times.last().expect("a leg has a sample");
+    let stops: Vec<f64> = if times.len() == 1 && pieces > 1 {
+        (1..=pieces)
+            .map(|k| {
+                if k == pieces {
+                    t1
+                } else {
+                    t0 + (t1 - t0) * k as f64 / pieces as f64
+                }
+            })
+            .collect()
+    } else {
+        vec![t1]
+    };
+    let mut leg = Leg {
+        traj: Trajectory::default(),
+        stats: empty_stats(opts),
+        worst: Drift::default(),
+    };
+    let (mut from, mut state) = (t0, x);
+    for &stop in &stops {
+        let sampled: Vec<f64> = times
+            .iter()
+            .copied()
+            .filter(|&t| t > from && t <= stop)
+            .collect();
+        let run_opts = SimOptions {
+            t_end: stop,
+            output_times: Some(if sampled.is_empty() {
+                vec![stop]
+            } else {
+                sampled
+            }),
+            ..opts.clone()
         };
-        let mut state = seg.x.pop().expect("as many states as times");
-        seg.t.pop();
-        let (q, qd) = state.split_at_mut(n);
+        let (mut seg, more) = super::run_from(arm, from, state, &run_opts)?;
+        add(&mut leg.stats, &more);
+        let skip = seg.t.iter().take_while(|&&t| t <= from).count();
+        for (t, x) in seg.t.iter().zip(&seg.x).skip(skip) {
+            let gap = drift(arm, *t, &x[..n], &x[n..]);
+            leg.worst.position_m = leg.worst.position_m.max(gap.position_m);
+            leg.worst.angle_rad = leg.worst.angle_rad.max(gap.angle_rad);
+            leg.worst.velocity = leg.worst.velocity.max(gap.velocity);
+        }
+        let (Some(t_end), Some(mut end)) = (seg.t.pop(), seg.x.pop()) else {
+            return Ok(leg);
+        };
+        let (q, qd) = end.split_at_mut(n);
         if let Err(e) = project(arm, t_end, q, qd, 1e-12) {
             return Err(Box::new(SimFailure {
                 t_reached: t_end,
@@ -152,31 +216,56 @@ pub(super) fn run<D: Dynamics + ?Sized>(
                     e.row, e.residual, e.iterations
                 ),
                 suggestion: "tighten --rtol and --atol, or sample more often (--output-dt)".into(),
-                state,
-                trajectory: traj,
-                stats,
+                state: end,
+                trajectory: leg.traj,
+                stats: leg.stats,
             }));
         }
-        cs.projections += 1;
-        traj.events.extend(seg.events);
-        for (t, s) in seg.t.into_iter().zip(seg.x).skip(skip) {
-            traj.t.push(t);
-            traj.x.push(s);
+        if let Some(c) = leg.stats.constraints.as_mut() {
+            c.projections += 1;
         }
-        traj.t.push(t_end);
-        traj.x.push(state);
-        // A terminal event ended the leg early: the run ends there.
-        if t_end < t1 {
+        leg.traj.events.extend(seg.events);
+        for (t, x) in seg.t.into_iter().zip(seg.x).skip(skip) {
+            if times.contains(&t) {
+                leg.traj.t.push(t);
+                leg.traj.x.push(x);
+            }
+        }
+        // The end of a piece is kept only when it is a sample (or where a
+        // terminal event stopped the run).
+        let early = t_end < stop;
+        if times.contains(&t_end) || early {
+            leg.traj.t.push(t_end);
+            leg.traj.x.push(end.clone());
+        }
+        if early {
             break;
         }
-        next += leg_times.len();
-        // Longer legs while the drift stays well inside its budget.
-        if worst_gap < 0.1 * budget {
-            leg_len *= 2;
-        }
-        t0 = t1;
-        x = traj.x.last().expect("just pushed").clone();
+        (from, state) = (t_end, end);
     }
-    stats.solver = opts.solver;
-    Ok((traj, stats))
+    Ok(leg)
+}
+
+fn empty_stats(opts: &SimOptions) -> SimStats {
+    SimStats {
+        solver: opts.solver,
+        steps: 0,
+        rejected_steps: 0,
+        rhs_evaluations: 0,
+        jacobian_evaluations: 0,
+        wall_s: 0.0,
+        switched: None,
+        constraints: Some(ConstraintStats::default()),
+    }
+}
+
+fn add(stats: &mut SimStats, more: &SimStats) {
+    stats.steps += more.steps;
+    stats.rejected_steps += more.rejected_steps;
+    stats.rhs_evaluations += more.rhs_evaluations;
+    stats.jacobian_evaluations += more.jacobian_evaluations;
+    stats.wall_s += more.wall_s;
+    if stats.switched.is_none() {
+        stats.switched.clone_from(&more.switched);
+    }
 }
