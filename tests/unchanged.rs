@@ -52,7 +52,16 @@ fn kernels_at_states(arm: &dyn Dynamics, seed: u64) -> Value {
     let mut out = Vec::new();
     for (t, q, qd) in states(&names, seed) {
         let mut entry = Map::new();
-        for kind in [KernelKind::MassBias, KernelKind::Outputs, KernelKind::Accel] {
+        for kind in [
+            KernelKind::MassBias,
+            KernelKind::Outputs,
+            KernelKind::Accel,
+            KernelKind::Constraints,
+        ] {
+            // (Only models with joints have constraint rows.)
+            if kind.output_len(arm.info()) == 0 && kind == KernelKind::Constraints {
+                continue;
+            }
             let mut o = vec![0.0; kind.output_len(arm.info())];
             arm.eval_kernel(kind, t, &q, &qd, &mut o);
             entry.insert(kind.name().into(), json!(o));
@@ -66,10 +75,17 @@ fn kernels_at_states(arm: &dyn Dynamics, seed: u64) -> Value {
         let mut ws = Workspace::new(n);
         let mut jac = DMatrix::zeros(2 * n, 2 * n);
         let x: Vec<f64> = q.iter().chain(&qd).copied().collect();
-        let qdd = runtime::rhs_jacobian(arm, &mut ws, t, &x, &mut jac).unwrap();
-        entry.insert("qdd".into(), json!(qdd));
-        let jv = &jac * DVector::from_column_slice(&v);
-        entry.insert("jacobian_times_v".into(), json!(jv.as_slice()));
+        // (A state may be singular for joints: the error is recorded.)
+        match runtime::rhs_jacobian(arm, &mut ws, t, &x, &mut jac) {
+            Ok(qdd) => {
+                entry.insert("qdd".into(), json!(qdd));
+                let jv = &jac * DVector::from_column_slice(&v);
+                entry.insert("jacobian_times_v".into(), json!(jv.as_slice()));
+            }
+            Err(e) => {
+                entry.insert("jacobian_error".into(), json!(e.to_string()));
+            }
+        }
         out.push(Value::Object(entry));
     }
     Value::Array(out)
@@ -93,11 +109,20 @@ fn simulations(loaded: &mut softarm::backend::Loaded) -> Value {
         output_dt: 0.1,
         ..Default::default()
     };
-    // Start bent, so that every model moves.
+    // Start bent, so that every model moves; a model with joints from its
+    // own start, put onto them.
     let mut x0 = vec![0.0; 2 * n];
     for (k, x) in x0.iter_mut().take(n).enumerate() {
         let stretch = loaded.arm.info().coordinates[k].starts_with("stretch");
         *x = if stretch { 1e-3 } else { 0.2 };
+    }
+    if !loaded.arm.info().constraints.is_empty() {
+        let coords = loaded.arm.info().coordinates.clone();
+        let (q, qd) = x0.split_at_mut(n);
+        let start =
+            eomgen::model::assembly::initial_coordinates(&loaded.model, &coords, "").unwrap();
+        q.copy_from_slice(&start);
+        softarm::joints::assemble(&*loaded.arm, "", q, qd).unwrap();
     }
     let (traj, stats) = runtime::simulate(&*loaded.arm, x0, &opts).unwrap();
     json!({"static": statics, "t": traj.t, "x": traj.x, "steps": stats.steps})
