@@ -134,6 +134,17 @@ fn assembly_cases() -> Vec<(&'static str, String, Vec<&'static str>)> {
             vec!["arm.left.base.stiffness", "must be zero or positive"],
         ),
         (
+            "negative rotational stiffness of a compliant base",
+            r(
+                "base = { position = [0.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0] }",
+                "base = { position = [0.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0], mass = 1.0, stiffness = 5.0, rotational_stiffness = -2.0 }",
+            ),
+            vec![
+                "arm.left.base.rotational_stiffness",
+                "must be zero or positive",
+            ],
+        ),
+        (
             "an arm's own error under its name",
             r("length = 0.2", "length = -0.2"),
             vec!["arm.left.segment[0].length", "must be positive"],

@@ -120,7 +120,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
     // The base frame, moving when prescribed: the absolute states are then
     // measured from the moving base's straight arm.
     let base = symbols.base_motion(cas);
-    let frame = base_frame(cas, symbols, base.position, &base.turns);
+    let frame = base_frame(cas, symbols, &base);
     let (r0, p0, w0) = (frame.r, frame.p, frame.w);
     let base_axis = [r0[0][0], r0[1][0], r0[2][0]];
     // Rates (of the damping) relative to a moving base, too.

@@ -7,9 +7,7 @@ use super::{ModellingMethod, needs_bending_stiffness, strain_coordinate_names};
 use crate::cas::Cas;
 use crate::cas::ExprId;
 use crate::model::{Check, ModelError, Segment, SegmentShape};
-use crate::tmt::spatial::{
-    Frame, SpatialArm, V3, advance, coefficients, compose, left_jacobian, rotation, rotation_quat,
-};
+use crate::tmt::spatial::{Frame, SpatialArm, V3, advance, compose, exp_turn};
 
 pub(super) struct Ebr;
 
@@ -70,12 +68,7 @@ pub(crate) fn past_joint(
     half: ExprId,
     stretch: ExprId,
 ) -> (V3, V3, V3, Frame) {
-    let wsq = cas.dot(rho, rho);
-    let wsq = cas.bind(wsq);
-    let [c0, c1, c2, c3] = coefficients(cas, wsq, [0, 1, 2, 3]);
-    let r_rel = rotation(cas, rho, [c0, c1, c2]);
-    let w_rel = left_jacobian(cas, rho, rate, [c1, c2, c3]);
-    let q_rel = rotation_quat(cas, rho, wsq);
+    let (r_rel, q_rel, w_rel) = exp_turn(cas, rho, rate);
     let joint = compose(cas, f, Some((&r_rel, &q_rel)), None, Some(&w_rel));
     let b_len = cas.add(half, stretch);
     let half_b = cas.scaled(0.5, b_len);

@@ -316,7 +316,17 @@ pub fn normalised(q: Option<[f64; 4]>) -> [f64; 4] {
 impl Base {
     /// The base rides on springs (`mass`, `stiffness`, `damping` given).
     pub fn is_compliant(&self) -> bool {
-        self.mass.is_some() || self.stiffness.is_some() || self.damping.is_some()
+        self.mass.is_some()
+            || self.stiffness.is_some()
+            || self.damping.is_some()
+            || self.turns_compliantly()
+    }
+
+    /// The compliant base turns on its rotational spring and damper.
+    pub fn turns_compliantly(&self) -> bool {
+        self.rotational_stiffness.is_some()
+            || self.rotational_damping.is_some()
+            || self.inertia.is_some()
     }
 }
 

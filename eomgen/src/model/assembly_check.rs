@@ -266,7 +266,13 @@ fn compliant_base(ck: &Check, base: &Base, key: &str, axes: usize) -> Result<(),
         );
     };
     ck.positive(&k("mass"), mass)?;
-    for (name, v) in [("stiffness", base.stiffness), ("damping", base.damping)] {
+    for (name, v) in [
+        ("stiffness", base.stiffness),
+        ("damping", base.damping),
+        ("rotational_stiffness", base.rotational_stiffness),
+        ("rotational_damping", base.rotational_damping),
+        ("inertia", base.inertia),
+    ] {
         ck.non_negative(&k(name), v.unwrap_or(0.0))?;
     }
     if base.translation_inputs.is_some() || base.rotation_inputs.is_some() {

@@ -62,6 +62,15 @@ impl ParamLayout {
             ] {
                 params.push(Param::BaseSpring(arm, w));
             }
+            if st.base_twists {
+                for w in [
+                    SpringParam::RotationalStiffness,
+                    SpringParam::RotationalDamping,
+                    SpringParam::Inertia,
+                ] {
+                    params.push(Param::BaseSpring(arm, w));
+                }
+            }
             // Without `follow` the point stays put: zeros, not inputs.
             let axes = if spatial {
                 &Xyz::ALL[..]
@@ -134,6 +143,11 @@ impl ParamLayout {
                         SpringParam::Mass => base.mass.unwrap_or(0.0),
                         SpringParam::Stiffness => base.stiffness.unwrap_or(0.0),
                         SpringParam::Damping => base.damping.unwrap_or(0.0),
+                        SpringParam::RotationalStiffness => {
+                            base.rotational_stiffness.unwrap_or(0.0)
+                        }
+                        SpringParam::RotationalDamping => base.rotational_damping.unwrap_or(0.0),
+                        SpringParam::Inertia => base.inertia.unwrap_or(0.0),
                         SpringParam::Follow(..) => 0.0,
                     }
                 }

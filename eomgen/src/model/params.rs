@@ -239,6 +239,10 @@ pub enum SpringParam {
     Mass,
     Stiffness,
     Damping,
+    /// The rotational spring and damper, and the base's rotational inertia.
+    RotationalStiffness,
+    RotationalDamping,
+    Inertia,
     Follow(Rate, Xyz),
 }
 
@@ -300,6 +304,11 @@ impl Param {
                 SpringParam::Mass => format!("arm[{a}].base.mass"),
                 SpringParam::Stiffness => format!("arm[{a}].base.stiffness"),
                 SpringParam::Damping => format!("arm[{a}].base.damping"),
+                SpringParam::RotationalStiffness => {
+                    format!("arm[{a}].base.rotational_stiffness")
+                }
+                SpringParam::RotationalDamping => format!("arm[{a}].base.rotational_damping"),
+                SpringParam::Inertia => format!("arm[{a}].base.inertia"),
                 SpringParam::Follow(r, c) => {
                     format!(
                         "arm[{a}].base.follow_{}{}",

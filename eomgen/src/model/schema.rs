@@ -102,10 +102,10 @@ pub struct Base {
     /// The axis of each turn (3D, any length); default z, y, x in turn.
     #[serde(default)]
     pub rotation_axes: Option<Vec<[f64; 3]>>,
-    /// A compliant base (planar): the clamp is a mass on a spring and a
-    /// damper to a driven point, `follow` (input channels of the point's
-    /// displacement from `position` along x, y; none: it stays put).
-    /// Structural: present or not.
+    /// A compliant base: the clamp is a mass on a spring and a damper to a
+    /// driven point, `follow` (input channels of the point's displacement
+    /// from `position` along x, y (, z); none: it stays put). Structural:
+    /// present or not.
     #[serde(default)]
     pub mass: Option<f64>,
     /// N/m.
@@ -116,6 +116,15 @@ pub struct Base {
     pub damping: Option<f64>,
     #[serde(default)]
     pub follow: Option<Vec<String>>,
+    /// A compliant base that also turns: a rotational spring (N m/rad) and
+    /// damper (N m s/rad) to the driven point's orientation, and the base's
+    /// rotational inertia (kg m^2, default 0). Structural: present or not.
+    #[serde(default)]
+    pub rotational_stiffness: Option<f64>,
+    #[serde(default)]
+    pub rotational_damping: Option<f64>,
+    #[serde(default)]
+    pub inertia: Option<f64>,
 }
 
 /// How a segment is modelled. Structural: changing it derives anew.

@@ -79,6 +79,8 @@ pub struct Structure {
     pub base_compliant: bool,
     /// ... and follows a driven point (`base.follow`).
     pub base_follows: bool,
+    /// ... and turns on a rotational spring (coordinates of the assembly).
+    pub base_twists: bool,
     /// Several arms, bodies and joints: the arms' own structures and what
     /// joins them (the fields above are then empty).
     pub assembly: Option<Box<AssemblyShape>>,
@@ -147,6 +149,7 @@ impl Structure {
             base_turns: 0,
             base_compliant: false,
             base_follows: false,
+            base_twists: false,
             assembly: Some(Box::new(assembly)),
         }
     }
@@ -217,6 +220,7 @@ impl Structure {
             base_turns: m.base.rotation_inputs.as_ref().map_or(0, Vec::len),
             base_compliant: m.base.is_compliant(),
             base_follows: m.base.is_compliant() && m.base.follow.is_some(),
+            base_twists: m.base.turns_compliantly(),
             assembly: None,
         }
     }
@@ -303,6 +307,9 @@ impl Structure {
         }
         if self.base_compliant {
             s.push_str(&format!("base compliant follows {}\n", self.base_follows));
+            if self.base_twists {
+                s.push_str("base compliant turns\n");
+            }
         }
         if self.base_translates || self.base_turns > 0 {
             s.push_str(&format!(

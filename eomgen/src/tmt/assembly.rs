@@ -5,7 +5,8 @@
 //! (docs/design.md section 7).
 //!
 //! Invariant: the coordinates are the arms' in declaration order (each
-//! preceded by its compliant base's x, y (, z)), then the free bodies' (x,
+//! preceded by its compliant base's x, y (, z) and, when it turns, its
+//! `base_angle` (plane) or rotation vector `base_rx, base_ry, base_rz`), then the free bodies' (x,
 //! y and angle in the plane; x, y, z and a quaternion qw, qx, qy, qz in 3D);
 //! every joint contributes its rows in declaration order, the point gap
 //! (x, y (, z)), then a weld's angle gap (planar `angle`, 3D `rx, ry, rz`),
@@ -31,6 +32,16 @@ pub struct Assembled {
     /// Coordinates per independent subsystem (an arm with its compliant
     /// base, a free body), in order: M is block diagonal over them.
     pub blocks: Vec<usize>,
+}
+
+/// A compliant base's coordinates: its displacement, and its turn (a
+/// rotation vector, with the base's inertia and angular velocity) when it
+/// turns.
+struct Sway {
+    offset: [ExprId; 3],
+    twist: Option<([ExprId; 3], [ExprId; 3])>,
+    inertia: Option<ExprId>,
+    omega: Option<[ExprId; 3]>,
 }
 
 /// A frame a joint may hold: its origin, and its orientation as a planar
@@ -186,9 +197,9 @@ impl Builder {
             format!("{name}.")
         };
         let first = self.names.len();
-        let base_offset = st
+        let base = st
             .base_compliant
-            .then(|| self.compliant_base(cas, k, &prefix));
+            .then(|| self.compliant_base(cas, k, &prefix, st.base_twists));
         let scope = Scope {
             prefix: prefix.clone(),
             coordinates: self.names.len() as u32,
@@ -200,13 +211,16 @@ impl Builder {
         let (zero, mut bodies) = (self.zero, Vec::new());
         let sys = cas.scoped(scope, |cas| {
             let mut symbols = ParamSymbols::new(cas, arm_layout);
-            if let (Some(o), Some(&mass)) = (base_offset, base_mass) {
-                symbols = symbols.with_base_offset(o);
+            if let (Some(base), Some(&mass)) = (&base, base_mass) {
+                symbols = symbols.with_base_offset(base.offset);
+                if let Some((rho, rate)) = base.twist {
+                    symbols = symbols.with_base_twist(rho, rate);
+                }
                 bodies.push(Body {
                     mass,
-                    inertia: Inertia::Isotropic(zero),
+                    inertia: Inertia::Isotropic(base.inertia.unwrap_or(zero)),
                     position: symbols.base_motion(cas).position,
-                    omega: [zero; 3],
+                    omega: base.omega.unwrap_or([zero; 3]),
                 });
             }
             super::arm_system(cas, st, &symbols)
@@ -255,9 +269,9 @@ impl Builder {
         }
     }
 
-    /// A compliant base's coordinates (its displacement), with its spring
-    /// and damper to the driven point.
-    fn compliant_base(&mut self, cas: &mut Cas, k: usize, prefix: &str) -> [ExprId; 3] {
+    /// A compliant base's coordinates (its displacement, then its turn),
+    /// with its springs and dampers to the driven point.
+    fn compliant_base(&mut self, cas: &mut Cas, k: usize, prefix: &str, twists: bool) -> Sway {
         let spring = |w| Param::BaseSpring(k as u16, w);
         let axes = if self.spatial { 3 } else { 2 };
         let mut offset = [self.zero; 3];
@@ -271,7 +285,53 @@ impl Builder {
             let c_s = self.get(spring(SpringParam::Damping));
             self.rayleigh.push(half_k_sq(cas, c_s, slip));
         }
-        offset
+        let mut sway = Sway {
+            offset,
+            twist: None,
+            inertia: None,
+            omega: None,
+        };
+        if twists {
+            self.base_twist(cas, k, prefix, &mut sway);
+        }
+        sway
+    }
+
+    /// A compliant base's turn: a rotation vector from the driven
+    /// orientation (about z alone in the plane) on a spring of energy
+    /// k |rho|^2 / 2 (the geodesic angle's) and a damper on the angular
+    /// velocity it makes, c |w|^2 / 2.
+    fn base_twist(&mut self, cas: &mut Cas, k: usize, prefix: &str, sway: &mut Sway) {
+        let spring = |w| self.get(Param::BaseSpring(k as u16, w));
+        let (k_r, c_r) = (
+            spring(SpringParam::RotationalStiffness),
+            spring(SpringParam::RotationalDamping),
+        );
+        sway.inertia = Some(spring(SpringParam::Inertia));
+        let zero = self.zero;
+        let (mut rho, mut rate) = ([zero; 3], [zero; 3]);
+        let axes: &[usize] = if self.spatial { &[0, 1, 2] } else { &[2] };
+        for &c in axes {
+            let name = if self.spatial {
+                format!("{prefix}base_r{}", ["x", "y", "z"][c])
+            } else {
+                format!("{prefix}base_angle")
+            };
+            (rho[c], rate[c]) = self.coordinate(cas, name);
+        }
+        let omega = if self.spatial {
+            super::spatial::exp_turn(cas, &rho, &rate).2
+        } else {
+            rate
+        };
+        for c in 0..3 {
+            let e = half_k_sq(cas, k_r, rho[c]);
+            self.elastic.push(e);
+            let r = half_k_sq(cas, c_r, omega[c]);
+            self.rayleigh.push(r);
+        }
+        sway.twist = Some((rho, rate));
+        sway.omega = Some(omega);
     }
 
     /// Body k: free (coordinates of its own) or fixed (parameters).

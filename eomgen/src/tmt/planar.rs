@@ -71,10 +71,14 @@ impl<'a> PlanarArm<'a> {
         let coords = Coordinates::new(cas, names);
         let zero = cas.zero();
         let base = symbols.base_motion(cas);
-        let (phi, w) = match base.turns.first().copied() {
+        let (mut phi, mut w) = match base.turns.first().copied() {
             Some((angle, rate)) => (cas.add(symbols.get(Param::BaseAngle), angle), rate),
             None => (symbols.get(Param::BaseAngle), zero),
         };
+        if let Some((rho, rate)) = base.twist {
+            phi = cas.add(phi, rho[2]);
+            w = cas.add(w, rate[2]);
+        }
         let f = Frame {
             x: base.position[0],
             y: base.position[1],

@@ -252,6 +252,18 @@ pub(crate) fn arc(
     (centroid, axis, omega, end)
 }
 
+/// The turn exp([rho]x): its rotation, quaternion and angular velocity
+/// (the left Jacobian applied to the rate) in the frame it turns from.
+pub(crate) fn exp_turn(cas: &mut Cas, rho: &V3, rate: &V3) -> (M3, Quat, V3) {
+    let wsq = cas.dot(rho, rho);
+    let wsq = cas.bind(wsq);
+    let [c0, c1, c2, c3] = coefficients(cas, wsq, [0, 1, 2, 3]);
+    let r = rotation(cas, rho, [c0, c1, c2]);
+    let w = left_jacobian(cas, rho, rate, [c1, c2, c3]);
+    let q = rotation_quat(cas, rho, wsq);
+    (r, q, w)
+}
+
 /// The frame turned by `q` about its own axis `k`.
 pub(crate) fn revolute(cas: &mut Cas, f: &Frame, k: usize, q: ExprId, qd: ExprId) -> Frame {
     let (c, s) = (cas.cos(q), cas.sin(q));
@@ -349,7 +361,7 @@ impl<'a> SpatialArm<'a> {
         let coords = Coordinates::new(cas, names);
         let zero = cas.zero();
         let base = symbols.base_motion(cas);
-        let f = base_frame(cas, symbols, base.position, &base.turns);
+        let f = base_frame(cas, symbols, &base);
         Self {
             symbols,
             coords,
@@ -513,15 +525,16 @@ impl<'a> SpatialArm<'a> {
     }
 }
 
-/// The base frame at `position`: the prescribed turns in sequence, each
-/// about its axis `base.axis[i]` in the frame the turns before it left,
-/// then the declared direction (rotation and quaternion parameters).
+/// The base frame at its position: the prescribed turns in sequence, each
+/// about its axis `base.axis[i]` in the frame the turns before it left, a
+/// compliant base's turn exp([rho]x), then the declared direction
+/// (rotation and quaternion parameters).
 pub(crate) fn base_frame(
     cas: &mut Cas,
     symbols: &super::system::ParamSymbols,
-    position: V3,
-    turns: &[(ExprId, ExprId)],
+    base: &super::system::BaseMotion,
 ) -> Frame {
+    let (position, turns) = (base.position, &base.turns);
     let (zero, one) = (cas.zero(), cas.one());
     let mut f = Frame {
         r: std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one } else { zero })),
@@ -541,11 +554,16 @@ pub(crate) fn base_frame(
         let w = n.map(|k| cas.mul(k, rate));
         f = compose(cas, &f, Some((&r, &q)), None, Some(&w));
     }
+    let still = turns.is_empty() && base.twist.is_none();
+    if let Some((rho, rate)) = &base.twist {
+        let (r, q, w) = exp_turn(cas, rho, rate);
+        f = compose(cas, &f, Some((&r, &q)), None, Some(&w));
+    }
     let r: M3 = std::array::from_fn(|i| {
         std::array::from_fn(|j| symbols.get(Param::BaseRotation(i as u8, j as u8)))
     });
     let q = std::array::from_fn(|c| symbols.get(Param::BaseQuaternion(c as u8)));
-    if turns.is_empty() {
+    if still {
         // The identity folds away, but say so: a still base is its parameters.
         return Frame { r, quat: q, ..f };
     }

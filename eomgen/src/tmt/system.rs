@@ -14,6 +14,8 @@ pub struct ParamSymbols {
     ids: Vec<ExprId>,
     /// A compliant base's displacement: coordinates of the assembly.
     base_offset: Option<[ExprId; 3]>,
+    /// A compliant base's turn: a rotation vector and its rate.
+    base_twist: Option<([ExprId; 3], [ExprId; 3])>,
 }
 
 impl ParamSymbols {
@@ -33,6 +35,7 @@ impl ParamSymbols {
             layout: layout.clone(),
             ids,
             base_offset: None,
+            base_twist: None,
         }
     }
 
@@ -40,6 +43,13 @@ impl ParamSymbols {
     /// its displacement from the declared position.
     pub fn with_base_offset(mut self, offset: [ExprId; 3]) -> Self {
         self.base_offset = Some(offset);
+        self
+    }
+
+    /// The base turns on coordinates too: the rotation vector (about z
+    /// alone in the plane) from the driven orientation, and its rate.
+    pub fn with_base_twist(mut self, rho: [ExprId; 3], rate: [ExprId; 3]) -> Self {
+        self.base_twist = Some((rho, rate));
         self
     }
 
@@ -93,6 +103,7 @@ impl ParamSymbols {
         BaseMotion {
             position,
             turns,
+            twist: self.base_twist,
             seeds,
         }
     }
@@ -112,6 +123,9 @@ pub struct BaseMotion {
     /// Turn angles and their rates, in sequence: about z (planar, one) or
     /// `base.axis[i]` (3D, each in the frame the turns before it left).
     pub turns: Vec<(ExprId, ExprId)>,
+    /// A compliant base's rotation vector and its rate (coordinates), after
+    /// the turns.
+    pub twist: Option<([ExprId; 3], [ExprId; 3])>,
     /// (parameter, its rate) pairs for the kinematic time derivatives.
     pub seeds: Vec<(ExprId, ExprId)>,
 }
