@@ -161,6 +161,9 @@ pub fn load(
     let drives = crate::inputs::model_drives(&model, &layout, &base_dir)
         .with_context(|| format!("{origin}: reading the input channels"))?;
     arm.set_drives(drives);
+    let contact = crate::contact::contact_set(&model, &base_dir, arm.info().contact_points)
+        .with_context(|| format!("{origin}: contact"))?;
+    arm.set_contact(contact);
     Ok(Loaded {
         model,
         origin,

@@ -9,6 +9,7 @@ pub use softarm_models as generated;
 pub mod backend;
 pub mod cache;
 pub mod compare;
+pub mod contact;
 pub mod continuum;
 pub mod data;
 pub mod inputs;

@@ -1024,3 +1024,109 @@ fn assert_rejected(dir: &std::path::Path, cases: Vec<(&str, String, Vec<&str>)>)
         }
     }
 }
+
+/// A soft arm over a table: the base of the contact cases.
+const TABLE: &str = r#"
+name = "tap"
+gravity = [0.0, -9.81, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.3
+mass = 0.1
+elements = 3
+outer_radius = 0.01
+bending_stiffness = 0.2
+[[obstacle]]
+name = "table"
+shape = "plane"
+point = [0.0, -0.1, 0.0]
+normal = [0.0, 1.0, 0.0]
+[contact]
+model = "hunt_crossley"
+stiffness = 1e4
+restitution = 0.5
+"#;
+
+/// Contact mistakes: each names its key and says what is allowed, and
+/// nothing is written.
+#[test]
+fn contact_mistakes_name_the_key() {
+    let r = |from: &str, to: &str| {
+        assert!(TABLE.contains(from), "{from}");
+        TABLE.replacen(from, to, 1)
+    };
+    let cases = [
+        (
+            "unknown contact model",
+            r("model = \"hunt_crossley\"", "model = \"velcro\""),
+            vec!["contact.model", "spring_dashpot"],
+        ),
+        (
+            "negative stiffness",
+            r("stiffness = 1e4", "stiffness = -1e4"),
+            vec!["contact.stiffness", "must be positive"],
+        ),
+        (
+            "restitution above one",
+            r("restitution = 0.5", "restitution = 1.5"),
+            vec!["contact.restitution", "[0, 1]"],
+        ),
+        (
+            "a plane without a direction",
+            r("normal = [0.0, 1.0, 0.0]", "normal = [0.0, 0.0, 0.0]"),
+            vec!["obstacle[0].normal", "zero vector"],
+        ),
+        (
+            "no points per element",
+            r("[contact]\n", "[contact]\npoints_per_element = 0\n"),
+            vec!["contact.points_per_element", "1 to"],
+        ),
+        (
+            "a key of another shape",
+            r(
+                "normal = [0.0, 1.0, 0.0]",
+                "normal = [0.0, 1.0, 0.0]\nradius = 0.1",
+            ),
+            vec!["obstacle[0].radius", "plane obstacle takes point, normal"],
+        ),
+        (
+            "a shape's missing key",
+            r(
+                "shape = \"plane\"",
+                "shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]",
+            ),
+            vec!["obstacle[0]", "sphere obstacle"],
+        ),
+        (
+            "a law without stiffness",
+            r("stiffness = 1e4\n", ""),
+            vec!["obstacle[0].contact.stiffness", "missing"],
+        ),
+        (
+            "hunt_crossley stopped dead",
+            r("restitution = 0.5", "restitution = 0.0"),
+            vec!["contact.restitution", "impulse"],
+        ),
+        (
+            "duplicate obstacle names",
+            format!(
+                "{TABLE}[[obstacle]]\nname = \"table\"\nshape = \"sphere\"\ncenter = [0.1, 0.0, 0.0]\nradius = 0.01\n"
+            ),
+            vec!["obstacle[1].name", "names of their own"],
+        ),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for (label, text, expect) in cases {
+        std::fs::write(dir.path().join("m.toml"), &text).unwrap();
+        let out = softarm(&["eom", "m.toml", "--json"], dir.path());
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{label}: accepted");
+        assert!(!err.contains("panicked"), "{label}: panic: {err}");
+        assert!(stdout(&out).is_empty(), "{label}: printed output");
+        for e in expect {
+            assert!(err.contains(e), "{label}: expected `{e}` in: {err}");
+        }
+    }
+}

@@ -3,7 +3,7 @@
 use runtime::{ModelInfo, TapeSet};
 
 use crate::cas::ExprId;
-use crate::cas::{Cas, Hoist};
+use crate::cas::{Cas, Hoist, SymKind};
 use crate::model::{Model, ParamLayout, Structure};
 use crate::tmt::{
     SYMBOLIC_SOLVE_MAX_DOF, System, assemble, assembly_system, link_chain, solve_accelerations,
@@ -70,6 +70,15 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
         let outs = constraint_outputs(&mut cas, &sys, &phi);
         cas.to_tape_hoisted(&outs, &mut hoist)
     };
+    let (contact, contact_jvp) = if sys.samples.is_empty() {
+        (runtime::Tape::default(), runtime::Tape::default())
+    } else {
+        let (points, tangent) = contact_outputs(&mut cas, &sys);
+        (
+            cas.to_tape_hoisted(&points, &mut hoist),
+            cas.to_tape_hoisted(&tangent, &mut hoist),
+        )
+    };
     let derived = hoist.finish(&mut cas);
     TapeSet {
         info: ModelInfo {
@@ -81,6 +90,7 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
             loads: layout.loads(),
             constraints: rows,
             blocks,
+            contact_points: sys.samples.len(),
         },
         mass_bias,
         outputs,
@@ -88,6 +98,8 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
         accel: accel_tape,
         jvp,
         constraints,
+        contact,
+        contact_jvp,
         parts: match links {
             None if single => crate::method::eba::part_kernels(structure, &layout),
             None => None,
@@ -111,4 +123,37 @@ fn constraint_outputs(cas: &mut Cas, sys: &System, phi: &[ExprId]) -> Vec<ExprId
     let rate = cas.kinematic_rates(phi, &pairs);
     outs.extend(cas.kinematic_rates(&rate, &pairs));
     outs
+}
+
+/// The `Contact` kernel's outputs (per point p, v = dp/dt, J = dp/dq row
+/// by row) and the `ContactJvp` kernel's (per point dv and dJ along the
+/// direction dq, the `Dir` symbols the `Jvp` kernel reads first).
+fn contact_outputs(cas: &mut Cas, sys: &System) -> (Vec<ExprId>, Vec<ExprId>) {
+    let mut pairs = sys.coords.rate_pairs();
+    pairs.extend(&sys.seeds);
+    let names = &sys.coords.names;
+    let dq: Vec<(ExprId, ExprId)> = sys
+        .coords
+        .q
+        .iter()
+        .enumerate()
+        .map(|(i, &q)| {
+            let d = cas.symbol(&format!("{}_dir", names[i]), SymKind::Dir(i as u32));
+            (q, d)
+        })
+        .collect();
+    let (mut points, mut tangent) = (Vec::new(), Vec::new());
+    for p in &sys.samples {
+        let v = cas.kinematic_rates(p, &pairs);
+        let jac: Vec<ExprId> = p
+            .iter()
+            .flat_map(|&c| sys.coords.q.iter().map(move |&q| (c, q)))
+            .map(|(c, q)| cas.diff(c, q))
+            .collect();
+        let dv = cas.time_derivatives(&v, &dq);
+        let djac = cas.time_derivatives(&jac, &dq);
+        points.extend(p.iter().chain(&v).chain(&jac));
+        tangent.extend(dv.iter().chain(&djac));
+    }
+    (points, tangent)
 }

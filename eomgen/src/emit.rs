@@ -899,6 +899,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     let loads = &info.loads;
     let rows = &info.constraints;
     let blocks = &info.blocks;
+    let contact_points = info.contact_points;
     let hash = &info.hash;
     let coords = &info.coordinates;
     let params = &info.parameters;
@@ -951,6 +952,8 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         pub const CONSTRAINTS: &[&str] = &[#(#rows),*];
         /// Coordinates per independent subsystem (M block diagonal).
         pub const BLOCKS: &[usize] = &[#(#blocks),*];
+        /// Contact points along the arms and at the bodies.
+        pub const CONTACT_POINTS: usize = #contact_points;
 
         /// The compiled kernels of this structure.
         pub struct Compiled {
@@ -969,6 +972,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                         loads: LOADS.to_vec(),
                         constraints: CONSTRAINTS.iter().map(|s| s.to_string()).collect(),
                         blocks: BLOCKS.to_vec(),
+                        contact_points: CONTACT_POINTS,
                     },
                 }
             }

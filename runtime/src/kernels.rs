@@ -32,6 +32,14 @@ use crate::tape::{Inputs, Tape};
 ///   (m x n, row-major) and the velocity product gamma = (d/dt J) qd
 ///   (m values), so that J qdd + gamma = 0 holds the joints at the
 ///   acceleration level. Empty for a model without joints.
+/// * `Contact`: the contact points along the arms (and the bodies'
+///   centres), `ModelInfo::contact_points` of them, each as its position
+///   p (3), velocity v (3) and Jacobian dp/dq (3 x n, row-major): the
+///   runtime finds gaps and forces and maps them by J^T. Empty without
+///   contact.
+/// * `ContactJvp`: the same points' dv and d(dp/dq) along the direction
+///   dq (the first n of `dir`; 3 + 3 n values a point): the exact
+///   Jacobian of the contact forces, column by column.
 /// * `Derived`: the derived parameters (parameter-only subexpressions the
 ///   generator hoisted out of the other kernels), computed once per
 ///   parameter set; the other kernels read them after the base parameters.
@@ -43,16 +51,20 @@ pub enum KernelKind {
     Jvp,
     Derived,
     Constraints,
+    Contact,
+    ContactJvp,
 }
 
 impl KernelKind {
-    pub const ALL: [KernelKind; 6] = [
+    pub const ALL: [KernelKind; 8] = [
         Self::Jvp,
         Self::Accel,
         Self::MassBias,
         Self::Outputs,
         Self::Derived,
         Self::Constraints,
+        Self::Contact,
+        Self::ContactJvp,
     ];
 
     pub fn output_len(self, info: &ModelInfo) -> usize {
@@ -64,6 +76,8 @@ impl KernelKind {
             Self::Derived => info.derived,
             Self::Jvp => dof,
             Self::Constraints => info.constraints.len() * (dof + 2),
+            Self::Contact => info.contact_points * (6 + 3 * dof),
+            Self::ContactJvp => info.contact_points * (3 + 3 * dof),
             Self::Accel => {
                 if info.accel {
                     2 * dof
@@ -82,6 +96,8 @@ impl KernelKind {
             Self::Jvp => "jvp",
             Self::Accel => "accel",
             Self::Constraints => "constraints",
+            Self::Contact => "contact",
+            Self::ContactJvp => "contact_jvp",
         }
     }
 }
@@ -127,6 +143,10 @@ pub struct ModelInfo {
     /// which the constrained solve exploits. Empty: one block.
     #[serde(default)]
     pub blocks: Vec<usize>,
+    /// Contact points (the `Contact` kernel's): each arm's, element by
+    /// element, `points_per_element` each, then every body's centre.
+    #[serde(default)]
+    pub contact_points: usize,
 }
 
 impl ModelInfo {
@@ -174,6 +194,11 @@ pub struct TapeSet {
     /// Empty unless `info.constraints > 0`.
     #[serde(default)]
     pub constraints: Tape,
+    /// Empty unless `info.contact_points > 0`.
+    #[serde(default)]
+    pub contact: Tape,
+    #[serde(default)]
+    pub contact_jvp: Tape,
     /// The layout and kernels of the link recursion (`crate::links`),
     /// which compiled models of the chains it covers use for `MassBias`;
     /// the interpreter keeps the flat tape.
@@ -194,6 +219,8 @@ impl TapeSet {
             KernelKind::Accel => &self.accel,
             KernelKind::Jvp => &self.jvp,
             KernelKind::Constraints => &self.constraints,
+            KernelKind::Contact => &self.contact,
+            KernelKind::ContactJvp => &self.contact_jvp,
         }
     }
 }

@@ -240,6 +240,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         chain: None,
         seeds: base.seeds,
         segment_ends: Vec::new(),
+        samples: Vec::new(),
         planar: None,
     };
     let mount = TipMount {
@@ -560,6 +561,7 @@ fn empty_system(cas: &mut Cas, coords: Coordinates, gravity: V3) -> System {
         chain: None,
         seeds: Vec::new(),
         segment_ends: Vec::new(),
+        samples: Vec::new(),
         planar: None,
     }
 }

@@ -38,6 +38,20 @@ impl ModellingMethod for Ebr {
             let (rho, rate) = (st.rho, st.rate);
             let (quarter, half) = (cas.scaled(0.25, el.l), cas.scaled(0.5, el.l));
             let half_m = cas.scaled(0.5, el.m);
+            let f = arm.f;
+            arm.sample(cas, |cas, s| {
+                if s <= 0.5 {
+                    let d = cas.scaled(s, el.l);
+                    return advance(cas, &f, d).p;
+                }
+                // Past the joint: the turned half, stretched.
+                let at_joint = advance(cas, &f, half);
+                let (r, q, w) = exp_turn(cas, &rho, &rate);
+                let joint = compose(cas, &at_joint, Some((&r, &q)), None, Some(&w));
+                let b_len = cas.add(half, st.stretch);
+                let d = cas.scaled(2.0 * (s - 0.5), b_len);
+                advance(cas, &joint, d).p
+            });
             let (b, end) = before_joint(cas, &arm.f, quarter, half);
             arm.bodies.push(el.body(arm.f.axis(), b, arm.f.w, half_m));
             arm.f = end;

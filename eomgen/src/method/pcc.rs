@@ -22,6 +22,13 @@ impl ModellingMethod for Pcc {
     }
 
     fn place_planar(&self, cas: &mut Cas, arm: &mut PlanarArm, _g: &SegmentShape, el: &Element2) {
+        // The arc's first fraction s is the arc of length s l bent by s theta.
+        let (f, l, m, q, qd) = (arm.f, el.l, el.m, el.q, el.qd);
+        arm.sample(cas, |cas, s| {
+            let [sl, sq, sqd] = [l, q, qd].map(|e| cas.scaled(s, e));
+            let end = pcc_element(cas, f, sl, m, sq, sqd).3;
+            [end.x, end.y]
+        });
         let (c, chord_rate, arc_inertia, end) = pcc_element(cas, arm.f, el.l, el.m, el.q, el.qd);
         let total = cas.add(arc_inertia, el.inertia);
         arm.body(cas, c, chord_rate, el.m, total);
@@ -33,6 +40,13 @@ impl ModellingMethod for Pcc {
             let el = arm.element();
             let first = arm.c;
             let st = arm.strain_element(cas, g, s, &el);
+            let f = arm.f;
+            arm.sample(cas, |cas, s| {
+                let rho = st.rho.map(|e| cas.scaled(s, e));
+                let rate = st.rate.map(|e| cas.scaled(s, e));
+                let len = cas.scaled(s, st.len);
+                arc(cas, &f, &rho, &rate, len).3.p
+            });
             let (centroid, axis, omega, end) = arc(cas, &arm.f, &st.rho, &st.rate, st.len);
             let centroid = bind3(cas, centroid);
             arm.bodies.push(el.body(axis, centroid, omega, el.m));

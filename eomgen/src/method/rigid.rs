@@ -56,6 +56,11 @@ impl ModellingMethod for Rigid {
         match g.joints {
             Joints::Base => {
                 arm.f = planar::rotate(cas, arm.f, el.q, el.qd);
+                let f = arm.f;
+                arm.sample(cas, |cas, s| {
+                    let d = cas.scaled(s, l);
+                    planar::along(cas, &f, d)
+                });
                 let half = cas.scaled(0.5, l);
                 let c = planar::along(cas, &arm.f, half);
                 arm.body(cas, c, arm.f.w, m, el.inertia);
@@ -64,6 +69,17 @@ impl ModellingMethod for Rigid {
             Joints::Midpoint => {
                 let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
                 let half_m = cas.scaled(0.5, m);
+                let f = arm.f;
+                arm.sample(cas, |cas, s| {
+                    if s <= 0.5 {
+                        let d = cas.scaled(s, l);
+                        return planar::along(cas, &f, d);
+                    }
+                    let mid = planar::advance(cas, f, half);
+                    let turned = planar::rotate(cas, mid, el.q, el.qd);
+                    let d = cas.scaled(s - 0.5, l);
+                    planar::along(cas, &turned, d)
+                });
                 let c = planar::along(cas, &arm.f, quarter);
                 arm.body(cas, c, arm.f.w, half_m, el.inertia);
                 arm.f = planar::advance(cas, arm.f, half);
@@ -83,6 +99,11 @@ impl ModellingMethod for Rigid {
             match g.joints {
                 Joints::Base => {
                     arm.f = joint(cas, arm, g, s);
+                    let f = arm.f;
+                    arm.sample(cas, |cas, s| {
+                        let d = cas.scaled(s, l);
+                        advance(cas, &f, d).p
+                    });
                     let half = cas.scaled(0.5, l);
                     let mid = advance(cas, &arm.f, half);
                     arm.bodies.push(el.body(arm.f.axis(), mid.p, arm.f.w, m));
@@ -93,8 +114,19 @@ impl ModellingMethod for Rigid {
                     let half_m = cas.scaled(0.5, m);
                     let b = advance(cas, &arm.f, quarter);
                     arm.bodies.push(el.body(arm.f.axis(), b.p, arm.f.w, half_m));
+                    let f = arm.f;
                     arm.advance(cas, half);
                     arm.f = joint(cas, arm, g, s);
+                    let turned = arm.f;
+                    arm.sample(cas, |cas, s| {
+                        let (from, d) = if s <= 0.5 {
+                            (&f, s)
+                        } else {
+                            (&turned, s - 0.5)
+                        };
+                        let d = cas.scaled(d, l);
+                        advance(cas, from, d).p
+                    });
                     let b = advance(cas, &arm.f, quarter);
                     arm.bodies.push(el.body(arm.f.axis(), b.p, arm.f.w, half_m));
                     arm.advance(cas, half);

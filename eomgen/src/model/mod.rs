@@ -4,6 +4,8 @@ pub mod assembly;
 mod assembly_check;
 mod assembly_params;
 mod check;
+pub mod contact;
+mod contact_check;
 mod error;
 mod load;
 mod params;

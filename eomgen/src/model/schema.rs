@@ -49,6 +49,11 @@ pub struct Model {
     pub bodies: Vec<super::assembly::BodyDecl>,
     #[serde(default, rename = "joint")]
     pub joints: Vec<super::assembly::JointDecl>,
+    /// The default contact law and the arms' sampling.
+    #[serde(default)]
+    pub contact: Option<super::contact::ContactDecl>,
+    #[serde(default, rename = "obstacle")]
+    pub obstacles: Vec<super::contact::ObstacleDecl>,
 }
 
 /// `[simulate]`: how this arm is best simulated. Not structural.

@@ -12,7 +12,7 @@ use super::schema::{Axis, Joints, Method, Model, WrenchFrame};
 
 /// Bumped whenever derivation or emission changes what is generated, so
 /// that cached tapes and generated files are re-derived.
-pub const GENERATOR_VERSION: u32 = 58;
+pub const GENERATOR_VERSION: u32 = 59;
 
 /// The structural part of one segment.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -81,6 +81,8 @@ pub struct Structure {
     pub base_follows: bool,
     /// ... and turns on a rotational spring (coordinates of the assembly).
     pub base_twists: bool,
+    /// Contact points sampled along each element (0: no contact).
+    pub contact_points: usize,
     /// Several arms, bodies and joints: the arms' own structures and what
     /// joins them (the fields above are then empty).
     pub assembly: Option<Box<AssemblyShape>>,
@@ -97,6 +99,8 @@ pub struct AssemblyShape {
     /// (its own coordinates) or fixed.
     pub bodies: Vec<(String, bool)>,
     pub joints: Vec<JointShape>,
+    /// Contact: every body's centre is a contact point, after the arms'.
+    pub contact: bool,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -121,6 +125,7 @@ impl Structure {
                 .map(|(name, a)| (name.clone(), Self::of_arm(a)))
                 .collect(),
             bodies: m.bodies.iter().map(|b| (b.name.clone(), b.free)).collect(),
+            contact: m.has_contact(),
             joints: m
                 .joints
                 .iter()
@@ -150,6 +155,7 @@ impl Structure {
             base_compliant: false,
             base_follows: false,
             base_twists: false,
+            contact_points: 0,
             assembly: Some(Box::new(assembly)),
         }
     }
@@ -221,6 +227,7 @@ impl Structure {
             base_compliant: m.base.is_compliant(),
             base_follows: m.base.is_compliant() && m.base.follow.is_some(),
             base_twists: m.base.turns_compliantly(),
+            contact_points: m.contact_points(),
             assembly: None,
         }
     }
@@ -245,6 +252,9 @@ impl Structure {
                     j.a,
                     j.b
                 ));
+            }
+            if a.contact {
+                s.push_str("contact\n");
             }
             return s;
         }
@@ -310,6 +320,9 @@ impl Structure {
             if self.base_twists {
                 s.push_str("base compliant turns\n");
             }
+        }
+        if self.contact_points > 0 {
+            s.push_str(&format!("contact points {}\n", self.contact_points));
         }
         if self.base_translates || self.base_turns > 0 {
             s.push_str(&format!(

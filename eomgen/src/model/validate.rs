@@ -12,12 +12,15 @@ pub const MAX_ELEMENTS: usize = 500;
 /// Check what the types alone cannot express, concern by concern; the
 /// first problem found is the error.
 pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
+    let ck = Check { m, file };
     if m.is_assembly() {
-        let ck = Check { m, file };
         super::assembly_check::check_assembly(&ck, |arm| validate_arm(arm, file))?;
-        return simulate_defaults(&ck).and_then(|_| signals(&ck));
+        simulate_defaults(&ck)?;
+        signals(&ck)?;
+    } else {
+        validate_arm(m, file)?;
     }
-    validate_arm(m, file)
+    super::contact_check::check_contact(&ck)
 }
 
 /// The checks of one arm (a single-arm file, or an assembly's arm).

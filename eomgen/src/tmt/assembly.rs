@@ -75,6 +75,9 @@ pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -
         .enumerate()
         .map(|(k, (name, free))| b.body(cas, k, name, *free))
         .collect();
+    if a.contact {
+        b.samples.extend(body_frames.iter().map(|f| f.point));
+    }
     let frame = |f: FrameRef| match f {
         FrameRef::World => b.world,
         FrameRef::Body(k) => body_frames[k],
@@ -124,6 +127,8 @@ struct Builder {
     rows: Vec<String>,
     /// Free 3D bodies' quaternions, held to unit norm by the last rows.
     units: Vec<(String, [ExprId; 4])>,
+    /// Contact points: the arms' samples, then the bodies' centres.
+    samples: Vec<[ExprId; 3]>,
 }
 
 impl Builder {
@@ -161,6 +166,7 @@ impl Builder {
             constraints: Vec::new(),
             rows: Vec::new(),
             units: Vec::new(),
+            samples: Vec::new(),
         }
     }
 
@@ -237,6 +243,7 @@ impl Builder {
         self.rayleigh.push(sys.rayleigh);
         self.actuation.push(sys.actuation);
         self.point_forces.extend(sys.point_forces);
+        self.samples.extend(sys.samples.iter().copied());
         self.moments.extend(sys.moments);
         self.seeds.extend(sys.seeds);
         match sys.planar {
@@ -497,6 +504,7 @@ impl Builder {
             seeds: self.seeds,
             planar: None,
             segment_ends: Vec::new(),
+            samples: self.samples,
         };
         Assembled {
             sys,

@@ -61,6 +61,7 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
     if structure.dimensions == 3 {
         let names = method::coordinate_names(structure);
         let mut arm = SpatialArm::new(cas, names, symbols);
+        arm.points = structure.contact_points;
         let mut ends = Vec::new();
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
             m.build_spatial(cas, &mut arm, g, s);
@@ -72,6 +73,7 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
     } else {
         let names = method::coordinate_names(structure);
         let mut arm = PlanarArm::new(cas, names, symbols);
+        arm.points = structure.contact_points;
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
             for _ in 0..g.elements {
                 let el = arm.begin_element(s);

@@ -51,6 +51,9 @@ pub(crate) struct PlanarArm<'a> {
     /// The segment of the element being placed, and each segment's end.
     segment: usize,
     ends: Vec<PlanarPose>,
+    /// Contact points per element, and the points sampled so far.
+    pub points: usize,
+    samples: Vec<[ExprId; 3]>,
 }
 
 /// One planar element: its angle, rate and parameters.
@@ -101,6 +104,8 @@ impl<'a> PlanarArm<'a> {
             k: 0,
             segment: 0,
             ends: Vec::new(),
+            points: 0,
+            samples: Vec::new(),
         }
     }
 
@@ -129,6 +134,8 @@ impl<'a> PlanarArm<'a> {
             k: 0,
             segment: 0,
             ends: Vec::new(),
+            points: 0,
+            samples: Vec::new(),
         }
     }
 
@@ -181,6 +188,16 @@ impl<'a> PlanarArm<'a> {
         });
     }
 
+    /// Contact points along the element: `at(s)` is the centreline at the
+    /// fraction s of the element, for s = 1/P, 2/P, ..., 1.
+    pub fn sample(&mut self, cas: &mut Cas, at: impl Fn(&mut Cas, f64) -> [ExprId; 2]) {
+        for j in 1..=self.points {
+            let [x, y] = at(cas, j as f64 / self.points as f64);
+            let point = [cas.bind(x), cas.bind(y), self.z];
+            self.samples.push(point);
+        }
+    }
+
     /// The element ends at the end frame: its link, spring and damper.
     pub fn end_element(&mut self, cas: &mut Cas, el: &Element2) {
         let (zero, f) = (self.zero, self.f);
@@ -219,6 +236,7 @@ impl<'a> PlanarArm<'a> {
             strains,
             seeds,
             ends,
+            samples,
             ..
         } = self;
         let half_phi = cas.scaled(0.5, f.phi);
@@ -246,6 +264,7 @@ impl<'a> PlanarArm<'a> {
             }),
             seeds,
             segment_ends: Vec::new(),
+            samples,
             planar: Some(PlanarFrames {
                 segment_ends: ends,
                 tip: PlanarPose {

@@ -317,6 +317,9 @@ pub(crate) struct SpatialArm<'a> {
     /// Some links' coordinates are shared (rom slices): not a chain of
     /// links that own theirs, so M and h by the general sums.
     pub shared_coordinates: bool,
+    /// Contact points per element, and the points sampled so far.
+    pub points: usize,
+    samples: Vec<V3>,
 }
 
 /// An element's lumped quantities (parameters).
@@ -377,6 +380,8 @@ impl<'a> SpatialArm<'a> {
             c: 0,
             k: 0,
             shared_coordinates: false,
+            points: 0,
+            samples: Vec::new(),
         }
     }
 
@@ -396,6 +401,16 @@ impl<'a> SpatialArm<'a> {
         let i = self.c;
         self.c += 1;
         (self.coords.q[i], self.coords.qd[i])
+    }
+
+    /// Contact points along the element: `at(s)` is the centreline at the
+    /// fraction s of the element, for s = 1/P, 2/P, ..., 1.
+    pub fn sample(&mut self, cas: &mut Cas, at: impl Fn(&mut Cas, f64) -> V3) {
+        for j in 1..=self.points {
+            let p = at(cas, j as f64 / self.points as f64);
+            let p = bind3(cas, p);
+            self.samples.push(p);
+        }
     }
 
     /// Move the end frame by `d` along its axis.
@@ -486,6 +501,7 @@ impl<'a> SpatialArm<'a> {
             body_link,
             seeds,
             shared_coordinates,
+            samples,
             ..
         } = self;
         let last_link = links.len().saturating_sub(1);
@@ -511,6 +527,7 @@ impl<'a> SpatialArm<'a> {
             }),
             seeds,
             segment_ends: Vec::new(),
+            samples,
             planar: None,
         };
         let mount = TipMount {

@@ -230,6 +230,9 @@ pub struct System {
     /// 3D chains: each segment's end frame, origin and orientation (w, x,
     /// y, z), for joints (empty for a method that builds the whole arm).
     pub segment_ends: Vec<([ExprId; 3], [ExprId; 4])>,
+    /// Contact points along the arm's centreline, element by element
+    /// (`Structure::contact_points` each, the last at the element's end).
+    pub samples: Vec<[ExprId; 3]>,
 }
 
 /// A planar frame: origin and angle from the world's x axis.

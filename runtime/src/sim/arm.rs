@@ -54,6 +54,23 @@ pub trait Dynamics {
     fn set_base_params(&mut self, params: &[f64]);
     /// Drive parameters by signals of time (inputs); replaces earlier ones.
     fn set_drives(&mut self, drives: Vec<Drive>);
+    /// A kernel along a direction `dir` (2n: dq, then dqd), as the `Jvp`
+    /// and `ContactJvp` kernels read it.
+    fn eval_direction(
+        &self,
+        kind: KernelKind,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        dir: &[f64],
+        out: &mut [f64],
+    );
+    /// The obstacles and pairs this system touches (none by default).
+    fn contact(&self) -> Option<&crate::contact::ContactSet> {
+        None
+    }
+    /// Give the system its contacts (replacing any).
+    fn set_contact(&mut self, _contact: Option<crate::contact::ContactSet>) {}
 }
 
 /// Why the accelerations could not be computed.
@@ -84,6 +101,8 @@ pub struct Arm<K> {
     drives: Vec<Drive>,
     /// `params` with the driven entries at the last time asked for.
     live: RefCell<Vec<f64>>,
+    /// Contact forces on the right-hand side (`crate::contact`).
+    contact: Option<crate::contact::ContactSet>,
 }
 
 impl<K: Kernels> Arm<K> {
@@ -105,6 +124,7 @@ impl<K: Kernels> Arm<K> {
             packed: RefCell::new(Vec::new()),
             drives: Vec::new(),
             live: RefCell::new(Vec::new()),
+            contact: None,
         }
     }
 
@@ -202,6 +222,7 @@ impl<K: Kernels> Dynamics for Arm<K> {
         self.eval_packed(KernelKind::MassBias, t, q, qd, |p| {
             h.copy_from_slice(&p[tri..])
         });
+        crate::contact::subtract_from_bias(self, t, q, qd, h.as_mut_slice());
     }
     fn mass_bias(&self, t: f64, q: &[f64], qd: &[f64], m: &mut DMatrix<f64>, h: &mut DVector<f64>) {
         let tri = q.len() * (q.len() + 1) / 2;
@@ -209,6 +230,7 @@ impl<K: Kernels> Dynamics for Arm<K> {
             unpack_symmetric(&p[..tri], m);
             h.copy_from_slice(&p[tri..]);
         });
+        crate::contact::subtract_from_bias(self, t, q, qd, h.as_mut_slice());
     }
     fn outputs(&self, t: f64, q: &[f64], qd: &[f64]) -> [f64; N_OUTPUTS] {
         let mut out = [0.0; N_OUTPUTS];
@@ -254,6 +276,34 @@ impl<K: Kernels> Dynamics for Arm<K> {
                 }
             }
         });
+        crate::contact::subtract_from_jacobian(self, t, q, qd, out);
+    }
+    fn eval_direction(
+        &self,
+        kind: KernelKind,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        dir: &[f64],
+        out: &mut [f64],
+    ) {
+        self.with_params(t, |p| {
+            let inp = Inputs {
+                t,
+                q,
+                qd,
+                qdd: &[],
+                dir,
+                p,
+            };
+            self.kernels.eval(kind, &inp, out);
+        });
+    }
+    fn contact(&self) -> Option<&crate::contact::ContactSet> {
+        self.contact.as_ref()
+    }
+    fn set_contact(&mut self, contact: Option<crate::contact::ContactSet>) {
+        self.contact = contact;
     }
     fn base_params(&self) -> &[f64] {
         &self.params[..self.kernels.info().parameters.len()]
@@ -334,19 +384,28 @@ pub fn accelerations<D: Dynamics + ?Sized>(
 ) -> Result<(), AccelError> {
     let n = ws.n;
     let rows = d.info().constraints.len();
+    let contact = d.contact().is_some();
     let solved = if rows > 0 {
         d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
+        if contact {
+            let tri = n * (n + 1) / 2;
+            crate::contact::subtract_from_bias(d, t, q, qd, &mut ws.packed[tri..]);
+        }
         let kkt = ws.kkt.get_or_insert_with(|| {
             crate::constraints::KktWorkspace::new(n, rows, &d.info().blocks)
         });
         crate::constraints::solve_constrained(d, kkt, &ws.packed, t, q, qd, qdd)?
-    } else if d.info().accel {
+    } else if d.info().accel && !contact {
         d.eval_kernel(KernelKind::Accel, t, q, qd, &mut ws.accel);
         qdd.copy_from_slice(&ws.accel[..n]);
         // Positive pivots: M positive definite (false for NaN too).
         ws.accel[n..].iter().all(|&p| p > 0.0)
     } else {
         d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
+        if contact {
+            let tri = n * (n + 1) / 2;
+            crate::contact::subtract_from_bias(d, t, q, qd, &mut ws.packed[tri..]);
+        }
         let (mass, bias) = ws.packed.split_at(n * (n + 1) / 2);
         for (a, b) in qdd.iter_mut().zip(bias) {
             *a = -b;

@@ -6,6 +6,7 @@
 
 pub mod arm;
 pub mod constraints;
+pub mod contact;
 pub mod cosserat;
 pub mod integrate;
 pub mod jacobian;

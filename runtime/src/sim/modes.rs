@@ -64,7 +64,9 @@ fn constrained(
         &vec![0.0; n],
         &mut packed,
     );
-    let h = &packed[n * (n + 1) / 2..];
+    let h = &mut packed[n * (n + 1) / 2..];
+    crate::contact::subtract_from_bias(d, 0.0, q, &vec![0.0; n], h);
+    let h = &*h;
     let lambda = crate::constraints::static_forces(d, q, h);
     let k = k + crate::constraints::geometric_stiffness(d, q, &lambda);
     let k = (&k + k.transpose()) * 0.5;

@@ -67,8 +67,10 @@ fn inf_norm(v: &[f64]) -> f64 {
 fn static_forces(d: &dyn Dynamics, q: &[f64], g: &mut [f64]) {
     let n = q.len();
     let mut packed = vec![0.0; n * (n + 1) / 2 + n];
-    d.eval_kernel(KernelKind::MassBias, 0.0, q, &vec![0.0; n], &mut packed);
+    let zeros = vec![0.0; n];
+    d.eval_kernel(KernelKind::MassBias, 0.0, q, &zeros, &mut packed);
     g.copy_from_slice(&packed[n * (n + 1) / 2..]);
+    crate::contact::subtract_from_bias(d, 0.0, q, &zeros, g);
 }
 
 /// The static residual of z = [q, lambda]: h(q, 0) + J^T lambda and, with

@@ -28,6 +28,9 @@ pub enum Crossing {
 /// The event function g(t, x), x = [q, qd].
 pub type EventFn = dyn Fn(f64, &[f64]) -> f64 + Send + Sync;
 
+/// A g(t, x) that borrows (the contact switch reads the arm).
+pub type SwitchFn<'a> = dyn Fn(f64, &[f64]) -> f64 + 'a;
+
 /// A zero crossing to watch for.
 #[derive(Clone)]
 pub struct Event {
@@ -73,10 +76,15 @@ pub struct EventHit {
     pub x: Vec<f64>,
 }
 
+/// The name of the event that ends a leg when a contact begins or ends
+/// (`integrate::touch`).
+pub const CONTACT_EVENT: &str = "contact";
+
 /// The events of one run and what they have seen.
 pub(crate) struct EventWatch {
     events: Vec<Event>,
-    /// g at the start of the current step, per event.
+    /// g at the start of the current step, per event, then the contact
+    /// switch's.
     last: Vec<Option<f64>>,
     /// The length of the unpadded state.
     m: usize,
@@ -87,7 +95,7 @@ impl EventWatch {
     pub fn new(events: &[Event], m: usize) -> Self {
         Self {
             events: events.to_vec(),
-            last: vec![None; events.len()],
+            last: vec![None; events.len() + 1],
             m,
             hits: Vec::new(),
         }
@@ -95,6 +103,8 @@ impl EventWatch {
 
     /// Check the step [t_prev, t_curr]: record its crossings in time order
     /// and return the first terminal one's time and state, if any.
+    /// `switch` is the contact switch (a terminal falling crossing, named
+    /// [`CONTACT_EVENT`]), which reads the arm and so is no `Event`.
     pub fn check<Y: StateVec, I: Interpolation<f64, Y> + ?Sized>(
         &mut self,
         t_prev: f64,
@@ -102,17 +112,24 @@ impl EventWatch {
         y_prev: &Y,
         y_curr: &Y,
         interpolator: &mut I,
+        switch: Option<&SwitchFn>,
     ) -> Option<(f64, Y)> {
         let m = self.m;
         let mut found: Vec<(f64, usize, Y)> = Vec::new();
-        for (k, event) in self.events.iter().enumerate() {
+        let count = self.events.len();
+        for k in 0..=count {
+            let (g, crossing): (&SwitchFn, Crossing) = match (k < count, switch) {
+                (true, _) => (&*self.events[k].g, self.events[k].crossing),
+                (false, Some(s)) => (s, Crossing::Falling),
+                (false, None) => break,
+            };
             let g0 = match self.last[k] {
                 Some(g) => g,
-                None => (event.g)(t_prev, &y_prev.as_ref()[..m]),
+                None => g(t_prev, &y_prev.as_ref()[..m]),
             };
-            let g1 = (event.g)(t_curr, &y_curr.as_ref()[..m]);
+            let g1 = g(t_curr, &y_curr.as_ref()[..m]);
             self.last[k] = Some(g1);
-            let crossed = match event.crossing {
+            let crossed = match crossing {
                 Crossing::Rising => g0 < 0.0 && g1 >= 0.0,
                 Crossing::Falling => g0 > 0.0 && g1 <= 0.0,
                 Crossing::Either => (g0 < 0.0 && g1 >= 0.0) || (g0 > 0.0 && g1 <= 0.0),
@@ -129,20 +146,22 @@ impl EventWatch {
                         .unwrap_or_else(|_| y_curr.clone())
                 }
             };
-            let t = illinois(t_prev, t_curr, g0, g1, |t| {
-                (event.g)(t, &state_at(t).as_ref()[..m])
-            });
+            let t = illinois(t_prev, t_curr, g0, g1, |t| g(t, &state_at(t).as_ref()[..m]));
             found.push((t, k, state_at(t)));
         }
         found.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut terminal = None;
         for (t, k, y) in found {
+            let (name, stops) = match self.events.get(k) {
+                Some(e) => (e.name.clone(), e.terminal),
+                None => (CONTACT_EVENT.to_string(), true),
+            };
             self.hits.push(EventHit {
-                name: self.events[k].name.clone(),
+                name,
                 t,
                 x: y.as_ref()[..m].to_vec(),
             });
-            if self.events[k].terminal {
+            if stops {
                 terminal = Some((t, y));
                 break;
             }

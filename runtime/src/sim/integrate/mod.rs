@@ -15,7 +15,9 @@
 //! stiffness switch), `record` (samples, events, counts), `failure` (the
 //! explained failure), `ode` (the arm as x' = f(t, x)); beside them the
 //! in-house steppers `bs23`, `radau5`, `trbdf2` on `stepper`, and
-//! [`events`] (zero crossings). The solver names are `crate::solver`'s.
+//! [`events`] (zero crossings); `projected` (joints held) and `touch`
+//! (legs between contact switches) run those in legs. The solver names
+//! are `crate::solver`'s.
 
 mod auto;
 pub mod bs23;
@@ -29,6 +31,7 @@ pub mod radau5;
 mod record;
 pub mod state;
 pub mod stepper;
+mod touch;
 pub mod trbdf2;
 
 pub use crate::solver::Solver;
@@ -76,10 +79,24 @@ pub fn simulate<D: Dynamics + ?Sized>(
             },
         }));
     }
-    if !arm.info().constraints.is_empty() {
-        return projected::run(arm, x0, opts);
+    if arm.contact().is_some_and(|c| c.keeps_records()) {
+        return touch::run(arm, x0, opts);
     }
-    run_from(arm, 0.0, x0, opts)
+    run_leg(arm, 0.0, x0, opts)
+}
+
+/// From (t0, x0) to `opts.t_end` or a terminal event: with the joints
+/// held (`projected`) or by the solver alone.
+fn run_leg<D: Dynamics + ?Sized>(
+    arm: &D,
+    t0: f64,
+    x0: Vec<f64>,
+    opts: &SimOptions,
+) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
+    if !arm.info().constraints.is_empty() {
+        return projected::run(arm, t0, x0, opts);
+    }
+    run_from(arm, t0, x0, opts)
 }
 
 /// Integrate from (t0, x0) to `opts.t_end` by the chosen solver.

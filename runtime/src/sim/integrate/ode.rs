@@ -42,6 +42,19 @@ impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
         }
     }
 
+    /// The contact switch g(t, x) of the arm's pairs that keep records,
+    /// if any: it falls through zero when one begins or ends to touch.
+    pub(super) fn contact_switch(&self) -> Option<Box<super::events::SwitchFn<'_>>> {
+        let set = self.arm.contact()?;
+        if !set.keeps_records() {
+            return None;
+        }
+        let n = self.n;
+        Some(Box::new(move |t, x| {
+            crate::contact::switching_gap(self.arm, set, t, &x[..n], &x[n..2 * n])
+        }))
+    }
+
     fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
         self.evals.set(self.evals.get() + 1);
         let n = self.n;

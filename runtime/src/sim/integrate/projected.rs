@@ -42,8 +42,8 @@ pub fn drift_budget(opts: &SimOptions) -> f64 {
     10.0 * opts.atol
 }
 
-/// The sample times after 0: `output_times`, or the even grid to t_end.
-fn sample_times(opts: &SimOptions) -> Vec<f64> {
+/// The sample times after t0: `output_times`, or the even grid to t_end.
+fn sample_times(opts: &SimOptions, t0: f64) -> Vec<f64> {
     let mut times: Vec<f64> = match &opts.output_times {
         Some(t) => t.clone(),
         None => {
@@ -53,7 +53,7 @@ fn sample_times(opts: &SimOptions) -> Vec<f64> {
                 .collect()
         }
     };
-    times.retain(|&t| t > 0.0 && t <= opts.t_end);
+    times.retain(|&t| t > t0 && t <= opts.t_end);
     times.sort_by(f64::total_cmp);
     times.dedup();
     if times.last() != Some(&opts.t_end) {
@@ -76,16 +76,17 @@ struct Leg {
 
 pub(super) fn run<D: Dynamics + ?Sized>(
     arm: &D,
+    t0: f64,
     x0: Vec<f64>,
     opts: &SimOptions,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let mut traj = Trajectory {
-        t: vec![0.0],
+        t: vec![t0],
         x: vec![x0],
         events: Vec::new(),
     };
     let mut stats = empty_stats(opts);
-    let times = sample_times(opts);
+    let times = sample_times(opts, t0);
     let budget = drift_budget(opts);
     // Legs span `leg_len` sample intervals; a single interval that drifts
     // too far is cut into `pieces`, projected after each.

@@ -70,6 +70,8 @@ pub(super) struct Recorder<'a> {
     watch: Option<&'a Watch<'a>>,
     switch: &'a RefCell<Option<(f64, Vec<f64>, String)>>,
     accepted: usize,
+    /// The contact switch (`integrate::touch`), when the arm has one.
+    contact: Option<Box<super::events::SwitchFn<'a>>>,
 }
 
 pub(super) type Watch<'a> = dyn Fn(&[f64], f64) -> Option<String> + 'a;
@@ -105,10 +107,14 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
             self.blown_up.set(Some(t_prev));
             return ControlFlag::Terminate;
         }
-        let hit = self
-            .events
-            .borrow_mut()
-            .check(t_prev, t_curr, y_prev, y_curr, interpolator);
+        let hit = self.events.borrow_mut().check(
+            t_prev,
+            t_curr,
+            y_prev,
+            y_curr,
+            interpolator,
+            self.contact.as_deref(),
+        );
         if let Some((t_event, y_event)) = hit {
             self.sampler
                 .sample(t_event, t_prev, &y_event, y_prev, interpolator, solution);
@@ -217,7 +223,7 @@ impl RunLog {
         }
     }
 
-    pub(super) fn recorder<'a, D: ?Sized>(
+    pub(super) fn recorder<'a, D: crate::arm::Dynamics + ?Sized>(
         &'a self,
         opts: &SimOptions,
         ode: &'a ArmOde<'_, D>,
@@ -237,6 +243,7 @@ impl RunLog {
             watch,
             switch,
             accepted: 0,
+            contact: ode.contact_switch(),
         }
     }
 

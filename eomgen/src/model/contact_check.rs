@@ -1,0 +1,255 @@
+//! Checks of `[contact]` and `[[obstacle]]`: each law complete and in
+//! range, each obstacle with exactly its shape's keys, names unique, and
+//! every sampled segment of a method that can be sampled.
+
+use super::check::Check;
+use super::contact::{ContactLaw, ContactModel, ObstacleDecl, ObstacleShape};
+use super::error::ModelError;
+use super::schema::{Method, Model};
+
+/// Largest `points_per_element`: past it contact costs more than the arm.
+pub const MAX_POINTS_PER_ELEMENT: usize = 20;
+
+pub(super) fn check_contact(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
+    if !m.has_contact() {
+        return Ok(());
+    }
+    let decl = m.contact.clone().unwrap_or_default();
+    if let Some(p) = decl.points_per_element
+        && !(1..=MAX_POINTS_PER_ELEMENT).contains(&p)
+    {
+        return ck.err(
+            "contact.points_per_element".into(),
+            format!("must be 1 to {MAX_POINTS_PER_ELEMENT}, got {p}"),
+        );
+    }
+    law_ranges(ck, "contact", &decl.law())?;
+    sampled_methods(ck)?;
+    let mut seen = std::collections::HashSet::new();
+    for (i, o) in m.obstacles.iter().enumerate() {
+        let key = format!("obstacle[{i}]");
+        if o.name.is_empty() || !seen.insert(o.name.as_str()) {
+            return ck.err(
+                format!("{key}.name"),
+                format!(
+                    "obstacles need names of their own, got \"{}\" twice or empty",
+                    o.name
+                ),
+            );
+        }
+        shape_keys(ck, &key, o)?;
+        law_ranges(ck, &format!("{key}.contact"), &o.contact)?;
+        law_complete(ck, &key, &o.contact, &decl.law())?;
+        if let Some(channels) = &o.translation_inputs {
+            let axes = m.dimensions as usize;
+            if channels.len() != axes {
+                return ck.err(
+                    format!("{key}.translation_inputs"),
+                    format!(
+                        "give {axes} input channels (x, y{}), got {}",
+                        if axes == 3 { ", z" } else { "" },
+                        channels.len()
+                    ),
+                );
+            }
+            for (c, name) in channels.iter().enumerate() {
+                ck.channel(&format!("{key}.translation_inputs[{c}]"), name)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Each given key in its range.
+fn law_ranges(ck: &Check, key: &str, law: &ContactLaw) -> Result<(), ModelError> {
+    let k = |s: &str| format!("{key}.{s}");
+    if let Some(v) = law.stiffness {
+        ck.positive(&k("stiffness"), v)?;
+    }
+    if let Some(v) = law.exponent {
+        ck.positive(&k("exponent"), v)?;
+    }
+    for (name, v) in [("damping", law.damping), ("friction", law.friction)] {
+        if let Some(v) = v {
+            ck.non_negative(&k(name), v)?;
+        }
+    }
+    if let Some(v) = law.slip_velocity {
+        ck.positive(&k("slip_velocity"), v)?;
+    }
+    if let Some(e) = law.restitution
+        && !(0.0..=1.0).contains(&e)
+    {
+        return ck.err(
+            k("restitution"),
+            format!("a coefficient of restitution is in [0, 1], got {e}"),
+        );
+    }
+    Ok(())
+}
+
+/// The law an obstacle ends up with (its own keys over `[contact]`'s) has
+/// what its model needs; an error names the key where the value came from.
+fn law_complete(
+    ck: &Check,
+    key: &str,
+    own: &ContactLaw,
+    defaults: &ContactLaw,
+) -> Result<(), ModelError> {
+    let law = own.over(defaults);
+    let model = law.model.unwrap_or(ContactModel::HuntCrossley);
+    let at = |field: &str, mine: bool| {
+        if mine {
+            format!("{key}.contact.{field}")
+        } else {
+            format!("contact.{field}")
+        }
+    };
+    if model != ContactModel::Impulse && law.stiffness.is_none() {
+        return ck.err(
+            format!("{key}.contact.stiffness"),
+            "missing: a penalty contact law needs `stiffness` (in [contact] or the obstacle's own contact table)".into(),
+        );
+    }
+    if model == ContactModel::HuntCrossley && law.restitution == Some(0.0) {
+        return ck.err(
+            at("restitution", own.restitution.is_some()),
+            "hunt_crossley needs e > 0: no finite damping stops a penalty contact dead; for the chapter's no-rebound impact use model = \"impulse\"".into(),
+        );
+    }
+    if model == ContactModel::HuntCrossley && law.damping.is_some() && law.restitution.is_some() {
+        return ck.err(
+            at("damping", own.damping.is_some()),
+            "give hunt_crossley either `damping` or `restitution` (its damping then follows from e and the impact speed), not both".into(),
+        );
+    }
+    if model == ContactModel::Hertz && law.damping.is_some() {
+        return ck.err(
+            at("damping", own.damping.is_some()),
+            "hertz is undamped; use hunt_crossley for a damped Hertz contact".into(),
+        );
+    }
+    Ok(())
+}
+
+/// Exactly the shape's keys, each in range.
+fn shape_keys(ck: &Check, key: &str, o: &ObstacleDecl) -> Result<(), ModelError> {
+    let k = |s: &str| format!("{key}.{s}");
+    let given = [
+        ("point", o.point.is_some()),
+        ("normal", o.normal.is_some()),
+        ("center", o.center.is_some()),
+        ("radius", o.radius.is_some()),
+        ("axis", o.axis.is_some()),
+        ("length", o.length.is_some()),
+        ("size", o.size.is_some()),
+        ("orientation", o.orientation.is_some()),
+    ];
+    let (needs, may): (&[&str], &[&str]) = match o.shape {
+        ObstacleShape::Plane => (&["point", "normal"], &[]),
+        ObstacleShape::Sphere => (&["center", "radius"], &[]),
+        ObstacleShape::Cylinder => (&["center", "axis", "radius", "length"], &[]),
+        ObstacleShape::Box => (&["center", "size"], &["orientation"]),
+    };
+    let shape = format!("{:?}", o.shape).to_lowercase();
+    for (name, present) in given {
+        if present && !needs.contains(&name) && !may.contains(&name) {
+            return ck.err(
+                k(name),
+                format!(
+                    "a {shape} obstacle takes {}; `{name}` is not one of them",
+                    needs.join(", ")
+                ),
+            );
+        }
+        if !present && needs.contains(&name) {
+            return ck.err(
+                k(name),
+                format!("missing: a {shape} obstacle needs {}", needs.join(", ")),
+            );
+        }
+    }
+    for (name, v) in [("point", o.point), ("center", o.center)] {
+        if let Some(v) = v {
+            ck.vec3(&k(name), &v)?;
+        }
+    }
+    for (name, v) in [("normal", o.normal), ("axis", o.axis)] {
+        if let Some(v) = v {
+            ck.vec3(&k(name), &v)?;
+            if v.iter().map(|x| x * x).sum::<f64>() == 0.0 {
+                return ck.err(
+                    k(name),
+                    format!("must not be the zero vector: it gives the {shape}'s direction"),
+                );
+            }
+            if ck.m.dimensions == 2 && name == "normal" && v[2] != 0.0 {
+                return ck.err(k(name), "a planar model's plane has a normal in the x-y plane: the z component must be 0".into());
+            }
+        }
+    }
+    for (name, v) in [("radius", o.radius), ("length", o.length)] {
+        if let Some(v) = v {
+            ck.positive(&k(name), v)?;
+        }
+    }
+    if let Some(size) = o.size {
+        for (i, v) in size.iter().enumerate() {
+            ck.positive(&format!("{}[{i}]", k("size")), *v)?;
+        }
+    }
+    if let Some(q) = o.orientation
+        && (q.iter().any(|v| !v.is_finite()) || q.iter().all(|v| *v == 0.0))
+    {
+        return ck.err(
+            k("orientation"),
+            "a quaternion (w, x, y, z) of non-zero, finite length".into(),
+        );
+    }
+    Ok(())
+}
+
+/// Methods whose elements the kinematics sample.
+const SAMPLED: [Method; 4] = [Method::Rigid, Method::Pcc, Method::Vc, Method::Ebr];
+
+fn sampled_methods(ck: &Check) -> Result<(), ModelError> {
+    for (prefix, arm) in ck.m.arm_models() {
+        for (i, s) in arm.segments.iter().enumerate() {
+            if !SAMPLED.contains(&s.method) {
+                let key = if prefix.is_empty() {
+                    format!("segment[{i}].method")
+                } else {
+                    format!("arm.{prefix}.segment[{i}].method")
+                };
+                return ck.err(
+                    key,
+                    format!(
+                        "contact samples rigid, pcc, vc and ebr segments; {:?} is not sampled yet",
+                        s.method
+                    )
+                    .to_lowercase(),
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+impl Model {
+    /// The model has obstacles or self contact.
+    pub fn has_contact(&self) -> bool {
+        !self.obstacles.is_empty() || self.contact.as_ref().is_some_and(|c| c.self_contact)
+    }
+
+    /// Points sampled along each element (structural): 0 without contact.
+    pub fn contact_points(&self) -> usize {
+        if !self.has_contact() {
+            return 0;
+        }
+        self.contact
+            .as_ref()
+            .and_then(|c| c.points_per_element)
+            .unwrap_or(super::contact::POINTS_PER_ELEMENT)
+    }
+}

@@ -1,0 +1,159 @@
+//! Contact force laws (the chapter's section 8.3.2): the normal force from
+//! the penetration depth and its rate, and regularised Coulomb friction,
+//! written once over any number type so that their exact derivatives come
+//! from dual numbers.
+
+use num_dual::DualNum;
+
+use super::geometry::V;
+
+/// The normal law.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Normal {
+    /// F = k delta + c delta', never pulling.
+    SpringDashpot { k: f64, c: f64 },
+    /// F = k delta^n.
+    Hertz { k: f64, n: f64 },
+    /// F = k delta^n (1 + alpha delta'), never pulling: `damping` gives
+    /// k alpha directly; `restitution` gives alpha = a(e) / v_in at each
+    /// impact (see [`restitution_damping`]).
+    HuntCrossley { k: f64, n: f64, damping: Damping },
+    /// The impact stage: a velocity jump with restitution e, then a
+    /// unilateral constraint (`integrate::contact`).
+    Impulse { e: f64 },
+}
+
+/// How Hunt-Crossley's damping is given.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Damping {
+    /// k alpha (N s / m^(n+1)).
+    Given(f64),
+    /// The coefficient of restitution; a = alpha v_in solved from it.
+    Restitution { e: f64, a: f64 },
+}
+
+/// A contact law: normal and friction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Law {
+    pub normal: Normal,
+    /// Coulomb coefficient.
+    pub friction: f64,
+    /// Regularisation speed v_s of the friction (m/s).
+    pub slip: f64,
+}
+
+/// The slowest impact speed (m/s) that sets Hunt-Crossley's damping from
+/// the restitution: a contact that begins slower (a resting start, a
+/// creeping touch) is damped as if it hit at this speed, not infinitely.
+pub const SLOWEST_IMPACT: f64 = 1e-3;
+
+impl Law {
+    /// The normal force magnitude at depth `delta` (> 0: penetrating)
+    /// growing at `rate`, for a contact that began at normal speed `v_in`.
+    pub fn normal_force<T: DualNum<Primitive = f64> + Copy>(
+        &self,
+        delta: T,
+        rate: T,
+        v_in: f64,
+    ) -> T {
+        let zero = T::from(0.0);
+        if delta.re() <= 0.0 {
+            return zero;
+        }
+        let f = match self.normal {
+            Normal::SpringDashpot { k, c } => delta * k + rate * c,
+            Normal::Hertz { k, n } => delta.powf(n) * k,
+            Normal::HuntCrossley { k, n, damping } => {
+                let alpha = match damping {
+                    Damping::Given(b) => b / k,
+                    Damping::Restitution { a, .. } => a / v_in.max(SLOWEST_IMPACT),
+                };
+                delta.powf(n) * k * (rate * alpha + 1.0)
+            }
+            // Held by the constraint, not by a force law.
+            Normal::Impulse { .. } => zero,
+        };
+        if f.re() < 0.0 { zero } else { f }
+    }
+
+    /// Friction on the point sliding at `v_t` (tangential) under normal
+    /// force `f_n`: -mu f_n v_t / sqrt(|v_t|^2 + v_s^2), smooth through
+    /// v_t = 0 and within v_s of Coulomb's magnitude when sliding.
+    pub fn friction_force<T: DualNum<Primitive = f64> + Copy>(&self, f_n: T, v_t: V<T>) -> V<T> {
+        if self.friction == 0.0 || f_n.re() == 0.0 {
+            return [T::from(0.0); 3];
+        }
+        // |v_t|^2 as a dot product: the norm's derivative is undefined at
+        // rest, where friction's is largest.
+        let sq = v_t[0] * v_t[0] + v_t[1] * v_t[1] + v_t[2] * v_t[2];
+        let speed = (sq + self.slip * self.slip).sqrt();
+        let scale = f_n * (-self.friction) / speed;
+        v_t.map(|c| c * scale)
+    }
+}
+
+/// Hunt-Crossley's a = alpha v_in for restitution e, exactly: a particle
+/// on F = k delta^n (1 + alpha delta') has the first integral
+/// m (v / alpha - ln(1 + alpha v) / alpha^2) + k delta^(n+1) / (n+1), so
+/// between touching at v_in and leaving at -e v_in,
+///
+///   a (1 + e) - ln(1 + a) + ln(1 - a e) = 0,
+///
+/// independent of k, n and m. Near e = 1 its root is Hunt and Crossley's
+/// 3 (1 - e) / 2; solved on (0, 1/e), where the left
+/// side falls from positive to minus infinity (bisection in
+/// b = -ln(1 - a e)). e = 1 gives 0; e = 0 has
+/// no root (no finite damping stops a penalty contact dead).
+pub fn restitution_damping(e: f64) -> Option<f64> {
+    if !(e > 0.0 && e <= 1.0) {
+        return None;
+    }
+    if e == 1.0 {
+        return Some(0.0);
+    }
+    // In b = -ln(1 - a e) the root is well conditioned even by the pole
+    // (a -> 1/e as e -> 0): a = (1 - exp(-b)) / e.
+    let a_of = |b: f64| -(-b).exp_m1() / e;
+    let g = |b: f64| {
+        let a = a_of(b);
+        a * (1.0 + e) - a.ln_1p() - b
+    };
+    let (mut lo, mut hi) = (0.0, 1.0);
+    while g(hi) > 0.0 {
+        hi *= 2.0;
+    }
+    // g > 0 just above 0 (its leading term a^2 (1 - e^2) / 2).
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid == lo || mid == hi {
+            break;
+        }
+        if g(mid) > 0.0 { lo = mid } else { hi = mid }
+    }
+    Some(a_of(0.5 * (lo + hi)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The root satisfies its equation, and near e = 1 it is Hunt and
+    /// Crossley's 3 (1 - e) / 2 to second order.
+    #[test]
+    fn restitution_damping_solves_its_equation() {
+        for e in [0.1, 0.2, 0.5, 0.9, 0.999] {
+            let a = restitution_damping(e).unwrap();
+            let g = a * (1.0 + e) - a.ln_1p() + (-a * e).ln_1p();
+            // Relative to the terms' size: near e = 0 the root sits by the
+            // pole at a = 1/e, where the left side is steep.
+            let scale = a * (1.0 + e) + (-a * e).ln_1p().abs();
+            assert!(g.abs() < 1e-12 * scale, "e = {e}: a = {a}, residual {g}");
+            assert!(a > 0.0 && a * e < 1.0);
+        }
+        let e: f64 = 0.999;
+        let a = restitution_damping(e).unwrap();
+        assert!((a / (1.5 * (1.0 - e)) - 1.0).abs() < 2e-3, "{a}");
+        assert_eq!(restitution_damping(1.0), Some(0.0));
+        assert_eq!(restitution_damping(0.0), None);
+    }
+}

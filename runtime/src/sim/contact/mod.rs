@@ -1,0 +1,552 @@
+//! Contact along the whole arm (docs/design.md section 8): the generated
+//! `Contact` kernel gives every sampled point's position, velocity and
+//! Jacobian; here each pair (a point and an obstacle, two points of the
+//! arms, a point and a body) gets its gap, its normal and friction forces
+//! from its law, and the forces reach the equations as the generalised
+//! force Q_c = sum J^T f (virtual work), subtracted from h.
+//!
+//! Invariant: contact is a force on the right-hand side, never a change of
+//! the generated kernels; an obstacle or a law changes without a rebuild.
+//! Its Jacobian is exact: the `ContactJvp` kernel's dJ and dv along each
+//! coordinate, and the laws' derivatives by dual numbers.
+
+pub mod geometry;
+pub mod law;
+
+use std::sync::Mutex;
+
+use num_dual::{Dual64, DualNum};
+
+use crate::arm::Dynamics;
+use crate::kernels::KernelKind;
+use crate::signal::Signal;
+
+pub use geometry::Shape;
+pub use law::{Damping, Law, Normal, restitution_damping};
+
+use geometry::V;
+
+/// A sampled point: the radius of the tube (or body) around it, and where
+/// it is on the arms.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactPoint {
+    pub radius: f64,
+    /// Arm and element index along that arm; `None` for a body's centre.
+    pub element: Option<(usize, usize)>,
+}
+
+/// A moving obstacle's displacement along x, y, z (input signals) and
+/// their rates.
+#[derive(Clone, Debug)]
+pub struct Motion {
+    pub displacement: [Signal; 3],
+    pub velocity: [Signal; 3],
+}
+
+impl Motion {
+    pub fn new(displacement: [Signal; 3]) -> Self {
+        let velocity = [0, 1, 2].map(|c| displacement[c].derivative());
+        Self {
+            displacement,
+            velocity,
+        }
+    }
+
+    pub fn at(&self, t: f64) -> ([f64; 3], [f64; 3]) {
+        (
+            [0, 1, 2].map(|c| self.displacement[c].at(t)),
+            [0, 1, 2].map(|c| self.velocity[c].at(t)),
+        )
+    }
+}
+
+/// An obstacle: a shape, its law, and its motion if it moves.
+#[derive(Clone, Debug)]
+pub struct Obstacle {
+    pub name: String,
+    pub shape: Shape,
+    pub law: Law,
+    pub motion: Option<Motion>,
+}
+
+/// What a point touches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Against {
+    Obstacle(usize),
+    /// Another sampled point (self contact, a body): sphere on sphere.
+    Point(usize),
+}
+
+/// A pair that may touch, its law, and the output channel its forces add
+/// to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pair {
+    pub point: usize,
+    pub other: Against,
+    pub law: Law,
+    pub channel: usize,
+}
+
+/// Per run, for the pairs that keep records (Hunt-Crossley from a
+/// restitution): whether each touches, and the normal speed at which it
+/// began to, which its damping reads. Changed only between legs
+/// (`integrate::touch`), so the right-hand side stays smooth in a leg.
+#[derive(Clone, Debug, Default)]
+pub struct ContactState {
+    pub touching: Vec<bool>,
+    pub impact: Vec<f64>,
+}
+
+/// Every pair of a model, and its running state.
+#[derive(Debug)]
+pub struct ContactSet {
+    pub points: Vec<ContactPoint>,
+    pub obstacles: Vec<Obstacle>,
+    pub pairs: Vec<Pair>,
+    /// Output channels by name (`contact_<name>_fn`, `_ft`).
+    pub channels: Vec<String>,
+    pub state: Mutex<ContactState>,
+}
+
+impl Clone for ContactSet {
+    fn clone(&self) -> Self {
+        Self {
+            points: self.points.clone(),
+            obstacles: self.obstacles.clone(),
+            pairs: self.pairs.clone(),
+            channels: self.channels.clone(),
+            state: Mutex::new(self.state()),
+        }
+    }
+}
+
+impl ContactSet {
+    /// Pairs every point with every obstacle (its channel the obstacle's
+    /// name); with `self_law`, every two arm points of elements that are
+    /// not neighbours (channel `self`); with `body_law`, every arm point
+    /// with every body centre (the body's name, from `bodies`).
+    pub fn new(
+        points: Vec<ContactPoint>,
+        obstacles: Vec<Obstacle>,
+        self_law: Option<Law>,
+        bodies: Option<(Law, Vec<String>)>,
+    ) -> Self {
+        let mut pairs = Vec::new();
+        let mut channels: Vec<String> = obstacles.iter().map(|o| o.name.clone()).collect();
+        for (i, _) in points.iter().enumerate() {
+            for (k, o) in obstacles.iter().enumerate() {
+                pairs.push(Pair {
+                    point: i,
+                    other: Against::Obstacle(k),
+                    law: o.law,
+                    channel: k,
+                });
+            }
+        }
+        if let Some(law) = self_law {
+            let channel = channels.len();
+            channels.push("self".into());
+            for (i, a) in points.iter().enumerate() {
+                for (j, b) in points.iter().enumerate().skip(i + 1) {
+                    if let (Some((arm_a, ea)), Some((arm_b, eb))) = (a.element, b.element)
+                        && (arm_a != arm_b || ea.abs_diff(eb) >= 2)
+                    {
+                        pairs.push(Pair {
+                            point: i,
+                            other: Against::Point(j),
+                            law,
+                            channel,
+                        });
+                    }
+                }
+            }
+        }
+        if let Some((law, names)) = bodies {
+            let centres: Vec<usize> = (0..points.len())
+                .filter(|&i| points[i].element.is_none())
+                .collect();
+            for (b, &j) in centres.iter().enumerate() {
+                let channel = channels.len();
+                channels.push(names.get(b).cloned().unwrap_or_else(|| format!("body{b}")));
+                for (i, a) in points.iter().enumerate() {
+                    if a.element.is_some() {
+                        pairs.push(Pair {
+                            point: i,
+                            other: Against::Point(j),
+                            law,
+                            channel,
+                        });
+                    }
+                }
+            }
+        }
+        let state = ContactState {
+            touching: vec![false; pairs.len()],
+            impact: vec![0.0; pairs.len()],
+        };
+        Self {
+            points,
+            obstacles,
+            pairs,
+            channels,
+            state: Mutex::new(state),
+        }
+    }
+
+    /// A pair whose force depends on how it began (its impact speed).
+    pub fn keeps_record(&self, pair: usize) -> bool {
+        matches!(
+            self.pairs[pair].law.normal,
+            Normal::HuntCrossley {
+                damping: Damping::Restitution { .. },
+                ..
+            }
+        )
+    }
+
+    /// Some pair keeps records: runs go in legs between contact switches.
+    pub fn keeps_records(&self) -> bool {
+        (0..self.pairs.len()).any(|i| self.keeps_record(i))
+    }
+
+    /// Bring the records up to the state at `forces`: a pair that keeps
+    /// records and now touches (gap <= 0) without a record gets one, its
+    /// speed of approach; one that no longer touches loses it. Returns
+    /// the pairs that began to touch.
+    pub fn update_records(&self, forces: &[PairForce<f64>]) -> Vec<usize> {
+        let mut state = self.state();
+        let mut began = Vec::new();
+        for (i, f) in forces.iter().enumerate() {
+            if !self.keeps_record(i) {
+                continue;
+            }
+            // Exactly at the surface, the pair touches if it approaches.
+            let touches = f.gap < 0.0 || (f.gap == 0.0 && f.approach > 0.0);
+            if touches && !state.touching[i] {
+                state.impact[i] = f.approach.max(0.0);
+                began.push(i);
+            }
+            state.touching[i] = touches;
+        }
+        self.set_state(state);
+        began
+    }
+
+    /// A copy of the running state.
+    pub fn state(&self) -> ContactState {
+        self.state.lock().map(|s| s.clone()).unwrap_or_default()
+    }
+
+    /// Replace the running state (the contact driver, between legs).
+    pub fn set_state(&self, s: ContactState) {
+        if let Ok(mut g) = self.state.lock() {
+            *g = s;
+        }
+    }
+}
+
+/// The `Contact` kernel's output at one state: per point p, v, J.
+pub struct PointKinematics {
+    n: usize,
+    buf: Vec<f64>,
+}
+
+impl PointKinematics {
+    pub fn eval<D: Dynamics + ?Sized>(d: &D, t: f64, q: &[f64], qd: &[f64]) -> Self {
+        let n = q.len();
+        let mut buf = vec![0.0; KernelKind::Contact.output_len(d.info())];
+        d.eval_kernel(KernelKind::Contact, t, q, qd, &mut buf);
+        Self { n, buf }
+    }
+
+    fn block(&self, i: usize) -> &[f64] {
+        let len = 6 + 3 * self.n;
+        &self.buf[i * len..(i + 1) * len]
+    }
+
+    pub fn position(&self, i: usize) -> [f64; 3] {
+        let b = self.block(i);
+        [b[0], b[1], b[2]]
+    }
+
+    pub fn velocity(&self, i: usize) -> [f64; 3] {
+        let b = self.block(i);
+        [b[3], b[4], b[5]]
+    }
+
+    /// Row c of dp/dq.
+    pub fn jacobian_row(&self, i: usize, c: usize) -> &[f64] {
+        &self.block(i)[6 + c * self.n..6 + (c + 1) * self.n]
+    }
+}
+
+/// A pair's state: gap, normal force, total force on the point (normal
+/// plus friction), friction magnitude, and the normal speed of approach.
+#[derive(Clone, Copy, Debug)]
+pub struct PairForce<T> {
+    pub gap: T,
+    pub normal: T,
+    pub force: V<T>,
+    pub friction: T,
+    pub approach: T,
+}
+
+/// The other side of a pair: its position and velocity offsets and radius.
+struct Other<T> {
+    p: V<T>,
+    v: V<T>,
+    radius: f64,
+}
+
+/// The force of `pair` with the point at (p, v) and the other side as
+/// given.
+fn pair_force<T: DualNum<Primitive = f64> + Copy>(
+    set: &ContactSet,
+    pair: &Pair,
+    t: f64,
+    p: V<T>,
+    v: V<T>,
+    other: Option<Other<T>>,
+    v_in: f64,
+) -> PairForce<T> {
+    let r = set.points[pair.point].radius;
+    let (dist, n, v_rel) = match (pair.other, other) {
+        (Against::Obstacle(k), _) => {
+            let o = &set.obstacles[k];
+            let (offset, speed) = o.motion.as_ref().map_or(([0.0; 3], [0.0; 3]), |m| m.at(t));
+            let (d, n) = o.shape.distance(p, offset);
+            let v_rel = [0, 1, 2].map(|c| v[c] - speed[c]);
+            (d - r, n, v_rel)
+        }
+        (Against::Point(_), Some(b)) => {
+            let rel = [0, 1, 2].map(|c| p[c] - b.p[c]);
+            let n = geometry::unit(rel, [0.0, 0.0, 1.0]);
+            let d = geometry::norm(rel) - b.radius;
+            let v_rel = [0, 1, 2].map(|c| v[c] - b.v[c]);
+            (d - r, n, v_rel)
+        }
+        (Against::Point(_), None) => unreachable!("a point pair is evaluated with its other point"),
+    };
+    let v_n = v_rel[0] * n[0] + v_rel[1] * n[1] + v_rel[2] * n[2];
+    let depth = -dist;
+    let f_n = pair.law.normal_force(depth, -v_n, v_in);
+    let v_t = [0, 1, 2].map(|c| v_rel[c] - v_n * n[c]);
+    let f_t = pair.law.friction_force(f_n, v_t);
+    PairForce {
+        gap: dist,
+        normal: f_n,
+        force: [0, 1, 2].map(|c| n[c] * f_n + f_t[c]),
+        friction: geometry::norm(f_t),
+        approach: -v_n,
+    }
+}
+
+/// Every pair's force at the given point kinematics (f64).
+pub fn pair_forces(set: &ContactSet, k: &PointKinematics, t: f64) -> Vec<PairForce<f64>> {
+    let state = set.state();
+    set.pairs
+        .iter()
+        .enumerate()
+        .map(|(i, pair)| {
+            let other = match pair.other {
+                Against::Point(j) => Some(Other {
+                    p: k.position(j),
+                    v: k.velocity(j),
+                    radius: set.points[j].radius,
+                }),
+                Against::Obstacle(_) => None,
+            };
+            let v_in = state.impact.get(i).copied().unwrap_or(0.0);
+            pair_force(
+                set,
+                pair,
+                t,
+                k.position(pair.point),
+                k.velocity(pair.point),
+                other,
+                v_in,
+            )
+        })
+        .collect()
+}
+
+/// Add the generalised contact force Q_c = sum J^T f to `q_force`.
+pub fn generalised_force(
+    set: &ContactSet,
+    k: &PointKinematics,
+    forces: &[PairForce<f64>],
+    q_force: &mut [f64],
+) {
+    for (pair, f) in set.pairs.iter().zip(forces) {
+        if f.normal == 0.0 {
+            continue;
+        }
+        add_jt(k, pair.point, f.force, 1.0, q_force);
+        if let Against::Point(j) = pair.other {
+            add_jt(k, j, f.force, -1.0, q_force);
+        }
+    }
+}
+
+fn add_jt(k: &PointKinematics, i: usize, f: [f64; 3], sign: f64, out: &mut [f64]) {
+    for (c, fc) in f.iter().enumerate() {
+        for (o, j) in out.iter_mut().zip(k.jacobian_row(i, c)) {
+            *o += sign * fc * j;
+        }
+    }
+}
+
+/// Subtract Q_c from h (a contact force is an applied force): `h` as the
+/// `MassBias` kernel gives it, at (t, q, qd).
+pub fn subtract_from_bias<D: Dynamics + ?Sized>(
+    d: &D,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    h: &mut [f64],
+) {
+    let Some(set) = d.contact() else { return };
+    let k = PointKinematics::eval(d, t, q, qd);
+    let forces = pair_forces(set, &k, t);
+    let mut qc = vec![0.0; q.len()];
+    generalised_force(set, &k, &forces, &mut qc);
+    for (h, f) in h.iter_mut().zip(qc) {
+        *h -= f;
+    }
+}
+
+/// Subtract dQ_c/dq and dQ_c/dqd from the Jacobian parts of tau
+/// (row-major n x n each, as `Dynamics::jacobian_parts` lays them out):
+/// the force's own derivative J^T df by dual numbers, and along q the
+/// turning of J itself, dJ^T f, from the `ContactJvp` kernel.
+pub fn subtract_from_jacobian<D: Dynamics + ?Sized>(
+    d: &D,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    parts: &mut [f64],
+) {
+    let Some(set) = d.contact() else { return };
+    let n = q.len();
+    let k = PointKinematics::eval(d, t, q, qd);
+    let forces = pair_forces(set, &k, t);
+    // Only touching pairs have force or derivative.
+    let active: Vec<usize> = (0..set.pairs.len())
+        .filter(|&i| forces[i].gap < 0.0)
+        .collect();
+    if active.is_empty() {
+        return;
+    }
+    let state = set.state();
+    let width = 3 + 3 * n;
+    let mut tangent = vec![0.0; KernelKind::ContactJvp.output_len(d.info())];
+    let mut col = vec![0.0; n];
+    for j in 0..2 * n {
+        let along_q = j < n;
+        if along_q {
+            let mut dir = vec![0.0; 2 * n];
+            dir[j] = 1.0;
+            d.eval_direction(KernelKind::ContactJvp, t, q, qd, &dir, &mut tangent);
+        }
+        col.fill(0.0);
+        for &i in &active {
+            let pair = &set.pairs[i];
+            // The point's (p, v) and their derivatives along this column.
+            let lift = |pt: usize| -> (V<Dual64>, V<Dual64>, Option<&[f64]>) {
+                let (p, v) = (k.position(pt), k.velocity(pt));
+                if along_q {
+                    let tb = &tangent[pt * width..(pt + 1) * width];
+                    let dp = [0, 1, 2].map(|c| k.jacobian_row(pt, c)[j]);
+                    (
+                        [0, 1, 2].map(|c| Dual64::new(p[c], dp[c])),
+                        [0, 1, 2].map(|c| Dual64::new(v[c], tb[c])),
+                        Some(&tb[3..]),
+                    )
+                } else {
+                    let jj = j - n;
+                    let dv = [0, 1, 2].map(|c| k.jacobian_row(pt, c)[jj]);
+                    (
+                        p.map(Dual64::from),
+                        [0, 1, 2].map(|c| Dual64::new(v[c], dv[c])),
+                        None,
+                    )
+                }
+            };
+            let (p, v, dj_a) = lift(pair.point);
+            let (other, dj_b) = match pair.other {
+                Against::Point(b) => {
+                    let (pb, vb, dj) = lift(b);
+                    let radius = set.points[b].radius;
+                    (
+                        Some(Other {
+                            p: pb,
+                            v: vb,
+                            radius,
+                        }),
+                        dj,
+                    )
+                }
+                Against::Obstacle(_) => (None, None),
+            };
+            let v_in = state.impact.get(i).copied().unwrap_or(0.0);
+            let f = pair_force(set, pair, t, p, v, other, v_in);
+            let f_re = f.force.map(|c| c.re);
+            let df = f.force.map(|c| c.eps);
+            add_jt(&k, pair.point, df, 1.0, &mut col);
+            if let Some(dj) = dj_a {
+                add_djt(dj, n, f_re, 1.0, &mut col);
+            }
+            if let Against::Point(b) = pair.other {
+                add_jt(&k, b, df, -1.0, &mut col);
+                if let Some(dj) = dj_b {
+                    add_djt(dj, n, f_re, -1.0, &mut col);
+                }
+            }
+        }
+        let (part, c) = if along_q { (0, j) } else { (1, j - n) };
+        for (r, v) in col.iter().enumerate() {
+            parts[part * n * n + r * n + c] -= v;
+        }
+    }
+}
+
+/// dJ^T f for the directional derivative dJ (3 x n, row-major).
+fn add_djt(dj: &[f64], n: usize, f: [f64; 3], sign: f64, out: &mut [f64]) {
+    for (c, fc) in f.iter().enumerate() {
+        for (o, j) in out.iter_mut().zip(&dj[c * n..(c + 1) * n]) {
+            *o += sign * fc * j;
+        }
+    }
+}
+
+/// Per output channel, the total normal and friction force magnitudes.
+pub fn channel_forces(set: &ContactSet, forces: &[PairForce<f64>]) -> Vec<(f64, f64)> {
+    let mut out = vec![(0.0, 0.0); set.channels.len()];
+    for (pair, f) in set.pairs.iter().zip(forces) {
+        out[pair.channel].0 += f.normal;
+        out[pair.channel].1 += f.friction;
+    }
+    out
+}
+
+/// The contact switch: over the pairs that keep records, the gap of those
+/// apart and minus the gap of those touching, the least. It falls through
+/// zero when a pair begins or ends to touch, where the run stops to update
+/// the records.
+pub fn switching_gap<D: Dynamics + ?Sized>(
+    d: &D,
+    set: &ContactSet,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+) -> f64 {
+    let k = PointKinematics::eval(d, t, q, qd);
+    let forces = pair_forces(set, &k, t);
+    let state = set.state();
+    forces
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| set.keeps_record(*i))
+        .map(|(i, f)| if state.touching[i] { -f.gap } else { f.gap })
+        .fold(f64::INFINITY, f64::min)
+}

@@ -1,0 +1,119 @@
+//! Contacts whose force depends on how they began (Hunt-Crossley damping
+//! from a coefficient of restitution reads the impact speed): the run goes
+//! in legs between contact switches. Each leg is an ordinary run (with the
+//! joints held, if any) that the contact switch stops where a pair begins
+//! or ends to touch, located on the solver's dense output; between legs the
+//! records are brought up to date (`ContactSet::update_records`), so
+//! within a leg the right-hand side is a smooth function of the state.
+
+use super::events::CONTACT_EVENT;
+use super::failure::SimFailure;
+use super::options::SimOptions;
+use super::record::{SimStats, Trajectory};
+use crate::arm::Dynamics;
+use crate::contact::{PointKinematics, pair_forces};
+
+/// Legs that end within this time of their start before the run gives up:
+/// contacts that switch without the time moving (a chattering contact).
+const MAX_STALLED_LEGS: usize = 50;
+
+pub(super) fn run<D: Dynamics + ?Sized>(
+    arm: &D,
+    x0: Vec<f64>,
+    opts: &SimOptions,
+) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
+    let set = arm
+        .contact()
+        .expect("touch::run is for systems with contact");
+    let n = arm.dof();
+    let mut traj = Trajectory::default();
+    let mut stats: Option<SimStats> = None;
+    let (mut t0, mut x) = (0.0, x0);
+    let mut stalled = 0;
+    loop {
+        let k = PointKinematics::eval(arm, t0, &x[..n], &x[n..]);
+        set.update_records(&pair_forces(set, &k, t0));
+        let leg = super::run_leg(arm, t0, x.clone(), opts);
+        let (mut seg, more) = match leg {
+            Ok(r) => r,
+            Err(mut f) => {
+                extend(&mut traj, f.trajectory, t0);
+                f.trajectory = traj;
+                add(&mut stats, &f.stats);
+                f.stats = stats.expect("set above");
+                return Err(f);
+            }
+        };
+        add(&mut stats, &more);
+        let switched = seg
+            .events
+            .last()
+            .is_some_and(|e| e.name == CONTACT_EVENT && Some(&e.t) == seg.t.last());
+        let end = (seg.t.pop(), seg.x.pop());
+        let (Some(t_end), Some(x_end)) = end else {
+            break;
+        };
+        seg.t.push(t_end);
+        seg.x.push(x_end.clone());
+        extend(&mut traj, seg, t0);
+        if !switched || t_end >= opts.t_end {
+            break;
+        }
+        stalled = if t_end - t0 <= 1e-12 * t_end.abs().max(1.0) {
+            stalled + 1
+        } else {
+            0
+        };
+        if stalled > MAX_STALLED_LEGS {
+            return Err(Box::new(SimFailure {
+                t_reached: t_end,
+                last_step_s: None,
+                reason: format!(
+                    "contacts switched {MAX_STALLED_LEGS} times at t = {t_end:.6} s without the time moving on (a contact chattering on its surface)"
+                ),
+                suggestion: "give the contact more damping (a lower restitution or `damping`), or use a law without restitution records (hertz, spring_dashpot)".into(),
+                state: x_end,
+                trajectory: traj,
+                stats: stats.expect("set above"),
+            }));
+        }
+        (t0, x) = (t_end, x_end);
+    }
+    let mut stats = stats.expect("at least one leg");
+    stats.solver = opts.solver;
+    Ok((traj, stats))
+}
+
+/// Append `seg`'s samples after `t0` (where the previous leg ended; all of
+/// them for the first leg).
+fn extend(traj: &mut Trajectory, seg: Trajectory, t0: f64) {
+    let skip = if traj.t.is_empty() {
+        0
+    } else {
+        seg.t.iter().take_while(|&&t| t <= t0).count()
+    };
+    traj.t.extend(seg.t.into_iter().skip(skip));
+    traj.x.extend(seg.x.into_iter().skip(skip));
+    traj.events.extend(seg.events);
+}
+
+fn add(stats: &mut Option<SimStats>, more: &SimStats) {
+    let Some(s) = stats else {
+        *stats = Some(more.clone());
+        return;
+    };
+    s.steps += more.steps;
+    s.rejected_steps += more.rejected_steps;
+    s.rhs_evaluations += more.rhs_evaluations;
+    s.jacobian_evaluations += more.jacobian_evaluations;
+    s.wall_s += more.wall_s;
+    if s.switched.is_none() {
+        s.switched.clone_from(&more.switched);
+    }
+    if let (Some(c), Some(m)) = (s.constraints.as_mut(), more.constraints.as_ref()) {
+        c.drift_max_m = c.drift_max_m.max(m.drift_max_m);
+        c.drift_max_rad = c.drift_max_rad.max(m.drift_max_rad);
+        c.velocity_drift_max = c.velocity_drift_max.max(m.velocity_drift_max);
+        c.projections += m.projections;
+    }
+}

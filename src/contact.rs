@@ -1,0 +1,198 @@
+//! A model's contacts as the runtime sees them: the sampled points with
+//! their tube radii (in the generator's order: each arm's elements,
+//! `points_per_element` each, then the bodies' centres), the obstacles
+//! with their laws and motions, and the pairs (docs/design.md section 8).
+
+use std::path::Path;
+
+use anyhow::{Result, bail};
+use eomgen::model::Model;
+use eomgen::model::assembly::BodyShape;
+use eomgen::model::contact::{ContactLaw, ContactModel, ObstacleDecl, ObstacleShape};
+use runtime::contact::{ContactPoint, ContactSet, Damping, Law, Normal, Obstacle, Shape};
+
+/// Default regularisation speed of friction (m/s).
+pub const SLIP_VELOCITY: f64 = 1e-3;
+/// Default Hertz exponent (a sphere on a flat).
+pub const HERTZ_EXPONENT: f64 = 1.5;
+
+/// The contact set of `model`, or `None` without contact; `points` is the
+/// kernel's count, which the sampling here must match.
+pub fn contact_set(model: &Model, base: &Path, points: usize) -> Result<Option<ContactSet>> {
+    if !model.has_contact() {
+        return Ok(None);
+    }
+    let per = model.contact_points();
+    let mut sampled = Vec::new();
+    for (arm, (_, am)) in model.arm_models().iter().enumerate() {
+        let mut element = 0;
+        for s in &am.segments {
+            let radius = s.outer_radius.unwrap_or(0.0);
+            for _ in 0..s.elements {
+                for _ in 0..per {
+                    sampled.push(ContactPoint {
+                        radius,
+                        element: Some((arm, element)),
+                    });
+                }
+                element += 1;
+            }
+        }
+    }
+    for b in &model.bodies {
+        sampled.push(ContactPoint {
+            radius: body_radius(b),
+            element: None,
+        });
+    }
+    if sampled.len() != points {
+        bail!(
+            "the model samples {} contact points but its kernels have {points}: regenerate (cargo build)",
+            sampled.len()
+        );
+    }
+    let decl = model.contact.clone().unwrap_or_default();
+    let defaults = decl.law();
+    let obstacles = model
+        .obstacles
+        .iter()
+        .map(|o| obstacle(model, o, &defaults, base))
+        .collect::<Result<Vec<_>>>()?;
+    let default_law = law(&defaults);
+    let self_law = decl.self_contact.then_some(default_law);
+    let bodies = (!model.bodies.is_empty()).then(|| {
+        (
+            default_law,
+            model.bodies.iter().map(|b| b.name.clone()).collect(),
+        )
+    });
+    Ok(Some(ContactSet::new(sampled, obstacles, self_law, bodies)))
+}
+
+/// A body touches as the sphere around its centre: exact for a sphere,
+/// the bounding sphere of a cylinder or a box.
+fn body_radius(b: &eomgen::model::assembly::BodyDecl) -> f64 {
+    match b.shape {
+        BodyShape::Sphere => b.radius.unwrap_or(0.0),
+        BodyShape::Cylinder => {
+            let (r, l) = (b.radius.unwrap_or(0.0), b.length.unwrap_or(0.0));
+            (r * r + l * l / 4.0).sqrt()
+        }
+        BodyShape::Box => {
+            let s = b.size.unwrap_or([0.0; 3]);
+            0.5 * (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt()
+        }
+    }
+}
+
+/// The runtime law of a model law (validated: complete and in range).
+pub fn law(l: &ContactLaw) -> Law {
+    let k = l.stiffness.unwrap_or(0.0);
+    let n = l.exponent.unwrap_or(HERTZ_EXPONENT);
+    let normal = match l.model.unwrap_or(ContactModel::HuntCrossley) {
+        ContactModel::SpringDashpot => Normal::SpringDashpot {
+            k,
+            c: l.damping.unwrap_or(0.0),
+        },
+        ContactModel::Hertz => Normal::Hertz { k, n },
+        ContactModel::HuntCrossley => Normal::HuntCrossley {
+            k,
+            n,
+            damping: match (l.damping, l.restitution) {
+                (Some(b), _) => Damping::Given(b),
+                (None, Some(e)) => match runtime::contact::restitution_damping(e) {
+                    Some(a) => Damping::Restitution { e, a },
+                    None => Damping::Given(0.0),
+                },
+                (None, None) => Damping::Given(0.0),
+            },
+        },
+        ContactModel::Impulse => Normal::Impulse {
+            e: l.restitution.unwrap_or(0.0),
+        },
+    };
+    Law {
+        normal,
+        friction: l.friction.unwrap_or(0.0),
+        slip: l.slip_velocity.unwrap_or(SLIP_VELOCITY),
+    }
+}
+
+fn unit(v: [f64; 3]) -> [f64; 3] {
+    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    v.map(|c| c / len)
+}
+
+/// The rotation of a unit quaternion (w, x, y, z).
+fn rotation(q: [f64; 4]) -> [[f64; 3]; 3] {
+    let len = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+    let [w, x, y, z] = q.map(|c| c / len);
+    [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ]
+}
+
+fn obstacle(
+    model: &Model,
+    o: &ObstacleDecl,
+    defaults: &ContactLaw,
+    base: &Path,
+) -> Result<Obstacle> {
+    // Validation checked each shape's keys.
+    let v = |x: Option<[f64; 3]>| x.unwrap_or([0.0; 3]);
+    let shape = match o.shape {
+        ObstacleShape::Plane => Shape::Plane {
+            point: v(o.point),
+            normal: unit(v(o.normal)),
+        },
+        ObstacleShape::Sphere => Shape::Sphere {
+            center: v(o.center),
+            radius: o.radius.unwrap_or(0.0),
+        },
+        ObstacleShape::Cylinder => Shape::Cylinder {
+            center: v(o.center),
+            axis: unit(v(o.axis)),
+            radius: o.radius.unwrap_or(0.0),
+            half_length: 0.5 * o.length.unwrap_or(0.0),
+        },
+        ObstacleShape::Box => Shape::Box {
+            center: v(o.center),
+            rotation: rotation(o.orientation.unwrap_or([1.0, 0.0, 0.0, 0.0])),
+            half: o.size.unwrap_or([0.0; 3]).map(|s| 0.5 * s),
+        },
+    };
+    let motion = match &o.translation_inputs {
+        None => None,
+        Some(channels) => {
+            let mut signals = Vec::new();
+            for name in channels {
+                let input = model.inputs.get(name).expect("validated channel");
+                signals.push(crate::inputs::signal(name, input, base)?);
+            }
+            // A planar model moves its obstacles in x and y.
+            signals.resize(3, runtime::Signal::Constant(0.0));
+            let [x, y, z]: [runtime::Signal; 3] = signals.try_into().expect("three signals");
+            Some(runtime::contact::Motion::new([x, y, z]))
+        }
+    };
+    Ok(Obstacle {
+        name: o.name.clone(),
+        shape,
+        law: law(&o.contact.over(defaults)),
+        motion,
+    })
+}

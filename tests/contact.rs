@@ -1,0 +1,286 @@
+//! Contact against independent references: a sphere dropped on a plane
+//! rebounds with the coefficient of restitution it was given (the exact
+//! Hunt-Crossley damping law); a Hertz contact settles at its static depth
+//! (m g / k)^(1/n); a block on an incline slides with g (sin a - mu cos a)
+//! or creeps at the regularised law's closed-form speed; the contact
+//! forces' analytic Jacobian against central differences.
+
+mod common;
+
+use common::*;
+use runtime::{SimOptions, Solver, simulate};
+
+/// |a - b| <= tol.
+fn assert_abs(a: f64, b: f64, tol: f64, what: &str) {
+    assert!(
+        (a - b).abs() <= tol,
+        "{what}: {a:e} vs {b:e} (difference {:e}, allowed {tol:e})",
+        (a - b).abs()
+    );
+}
+
+fn coordinate(l: &softarm::backend::Loaded, name: &str) -> usize {
+    let coords = &l.arm.info().coordinates;
+    coords
+        .iter()
+        .position(|c| c == name)
+        .unwrap_or_else(|| panic!("no coordinate {name} in {coords:?}"))
+}
+
+/// A 0.2 kg ball of radius 5 cm above a floor at y = 0, and `contact`.
+fn ball_on_floor(gravity: f64, height: f64, contact: &str) -> String {
+    format!(
+        r#"
+name = "drop"
+gravity = [0.0, {gravity}, 0.0]
+[[body]]
+name = "ball"
+shape = "sphere"
+radius = 0.05
+mass = 0.2
+position = [0.0, {height}, 0.0]
+[[obstacle]]
+name = "floor"
+shape = "plane"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+[contact]
+{contact}
+"#
+    )
+}
+
+/// Without gravity the ball meets the floor at 1 m/s and leaves it at e
+/// m/s: the Hunt-Crossley damping solved from e (a (1 + e) - ln(1 + a) +
+/// ln(1 - a e) = 0, a = alpha v_in) makes that exact, not a first-order
+/// approximation; the contact switches (touch, release) are located on
+/// the dense output and carry the velocities.
+#[test]
+fn a_ball_rebounds_with_the_restitution_it_was_given() {
+    for e in [0.2, 0.5, 0.9] {
+        let text = ball_on_floor(
+            0.0,
+            0.1,
+            &format!("model = \"hunt_crossley\"\nstiffness = 1e5\nrestitution = {e}"),
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let l = load_text(dir.path(), &text, &[]);
+        let n = l.arm.dof();
+        let y = coordinate(&l, "ball.y");
+        let mut x0 = vec![0.0; 2 * n];
+        x0[y] = 0.1;
+        x0[n + y] = -1.0;
+        let opts = SimOptions {
+            t_end: 0.2,
+            output_dt: 0.01,
+            rtol: 1e-10,
+            atol: 1e-12,
+            solver: Solver::Radau5,
+            ..SimOptions::default()
+        };
+        let (traj, _) = simulate(&*l.arm, x0, &opts).unwrap();
+        let switches: Vec<_> = traj.events.iter().filter(|h| h.name == "contact").collect();
+        assert!(
+            switches.len() >= 2,
+            "e = {e}: touch and release, got {switches:?}"
+        );
+        let (v_in, v_out) = (switches[0].x[n + y], switches[1].x[n + y]);
+        let measured = -v_out / v_in;
+        eprintln!(
+            "e = {e}: touch at {:.6} s ({v_in:.9} m/s), release at {:.6} s ({v_out:.9} m/s): e = {measured:.9}",
+            switches[0].t, switches[1].t
+        );
+        // The switch's state is the dense output's: 1e-7 is its accuracy.
+        assert_abs(v_in, -1.0, 1e-7, "impact speed");
+        assert_abs(measured, e, 1e-4 * e, "measured restitution");
+    }
+}
+
+/// A damped Hertz contact (Hunt-Crossley with its damping given) comes to
+/// rest where k delta^n = m g.
+#[test]
+fn a_hertz_contact_settles_at_its_static_depth() {
+    let (k, n_exp, m, g, r) = (1e4, 1.5, 0.2, 9.81, 0.05);
+    let text = ball_on_floor(
+        -g,
+        r,
+        &format!("model = \"hunt_crossley\"\nstiffness = {k}\nexponent = {n_exp}\ndamping = 1e5"),
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let l = load_text(dir.path(), &text, &[]);
+    let n = l.arm.dof();
+    let y = coordinate(&l, "ball.y");
+    let mut x0 = vec![0.0; 2 * n];
+    x0[y] = r;
+    let opts = SimOptions {
+        t_end: 3.0,
+        output_dt: 0.1,
+        rtol: 1e-10,
+        atol: 1e-13,
+        solver: Solver::Radau5,
+        ..SimOptions::default()
+    };
+    let (traj, _) = simulate(&*l.arm, x0, &opts).unwrap();
+    let depth = r - traj.x.last().unwrap()[y];
+    let expected = (m * g / k).powf(1.0 / n_exp);
+    eprintln!("hertz: depth {depth:.12e} m, (m g / k)^(1/n) = {expected:.12e} m");
+    assert_close(depth, expected, 1e-6, 0.0, "static depth");
+}
+
+/// A ball on a plane tilted by a (no rolling: the contact force acts at
+/// the sampled point, the centre). Steeper than its friction angle it
+/// slides with g (sin a - mu cos a); shallower, the regularised law
+/// F_t = -mu F_n v / sqrt(v^2 + v_s^2) lets it creep at the speed where
+/// friction balances the slope, v_s t / sqrt(1 - t^2), t = tan a / mu.
+#[test]
+fn a_ball_on_an_incline_slides_or_creeps_by_coulomb() {
+    let (mu, g, r, v_s) = (0.4_f64, 9.81, 0.05, 1e-4);
+    for degrees in [35.0_f64, 11.0] {
+        let a = degrees.to_radians();
+        let (s, c) = a.sin_cos();
+        let text = format!(
+            r#"
+name = "incline"
+gravity = [0.0, {gy}, 0.0]
+[[body]]
+name = "ball"
+shape = "sphere"
+radius = {r}
+mass = 0.2
+position = [0.0, {r}, 0.0]
+[[obstacle]]
+name = "slope"
+shape = "plane"
+point = [0.0, 0.0, 0.0]
+normal = [{nx}, {ny}, 0.0]
+[contact]
+model = "hunt_crossley"
+stiffness = 1e5
+damping = 1e6
+friction = {mu}
+slip_velocity = {v_s}
+"#,
+            gy = -g,
+            nx = -s,
+            ny = c,
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let l = load_text(dir.path(), &text, &[]);
+        let n = l.arm.dof();
+        let (ix, iy) = (coordinate(&l, "ball.x"), coordinate(&l, "ball.y"));
+        let mut x0 = vec![0.0; 2 * n];
+        // At rest on the surface, at its static depth (m g cos a / k)^(2/3).
+        let depth = (0.2 * g * c / 1e5_f64).powf(1.0 / 1.5);
+        x0[ix] = -s * (r - depth);
+        x0[iy] = c * (r - depth);
+        let opts = SimOptions {
+            t_end: 1.0,
+            output_dt: 0.05,
+            rtol: 1e-9,
+            atol: 1e-12,
+            solver: Solver::Radau5,
+            ..SimOptions::default()
+        };
+        let (traj, _) = simulate(&*l.arm, x0, &opts).unwrap();
+        let x = traj.x.last().unwrap();
+        // Speed down the slope (along (-c, -s)).
+        let v = -(c * x[n + ix] + s * x[n + iy]);
+        let t = a.tan() / mu;
+        if t > 1.0 {
+            let expected = g * (s - mu * c) * 1.0;
+            eprintln!(
+                "{degrees} degrees: slides at {v:.6} m/s after 1 s, g (sin a - mu cos a) t = {expected:.6}"
+            );
+            assert_close(v, expected, 0.01, 0.0, "sliding speed");
+        } else {
+            let creep = v_s * t / (1.0 - t * t).sqrt();
+            eprintln!("{degrees} degrees: creeps at {v:.6e} m/s, closed form {creep:.6e}");
+            assert_close(v, creep, 0.01, 0.0, "creep speed");
+        }
+    }
+}
+
+/// The analytic Jacobian of the right-hand side with contacts (the
+/// `ContactJvp` kernel's turning of J, the laws' derivatives by dual
+/// numbers) against central differences of the accelerations, at states
+/// where several points of a soft arm press into a plane and a sphere,
+/// sliding with friction; planar and 3D.
+#[test]
+fn the_contact_jacobian_is_the_derivative_of_the_forces() {
+    for dimensions in [2, 3] {
+        let twist = if dimensions == 3 {
+            "torsional_stiffness = 0.3"
+        } else {
+            ""
+        };
+        let text = format!(
+            r#"
+name = "pressed"
+dimensions = {dimensions}
+gravity = [0.0, -9.81, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.4
+elements = 3
+mass = 0.2
+outer_radius = 0.02
+bending_stiffness = 0.5
+bending_damping = 0.01
+{twist}
+[[obstacle]]
+name = "table"
+shape = "plane"
+point = [0.0, -0.03, 0.0]
+normal = [0.1, 1.0, 0.0]
+[[obstacle]]
+name = "knob"
+shape = "sphere"
+center = [0.3, -0.01, 0.0]
+radius = 0.04
+contact = {{ model = "spring_dashpot", stiffness = 3000.0, damping = 2.0, friction = 0.2 }}
+[contact]
+model = "hunt_crossley"
+stiffness = 2e4
+damping = 3e3
+friction = 0.5
+slip_velocity = 0.05
+points_per_element = 2
+"#
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let l = load_text(dir.path(), &text, &[]);
+        let n = l.arm.dof();
+        let mut rng = Rng::new(7 + dimensions as u64);
+        let mut x: Vec<f64> = (0..n).map(|_| rng.uniform(-0.25, -0.15)).collect();
+        x.extend((0..n).map(|_| rng.uniform(-0.5, 0.5)));
+        // Several points press in: the Jacobian has contact terms.
+        let set = l.arm.contact().unwrap();
+        let k = runtime::contact::PointKinematics::eval(&*l.arm, 0.0, &x[..n], &x[n..]);
+        let forces = runtime::contact::pair_forces(set, &k, 0.0);
+        let touching = forces.iter().filter(|f| f.normal > 0.0).count();
+        assert!(touching >= 2, "{dimensions}D: {touching} points touch");
+        let mut ws = runtime::Workspace::new(n);
+        let mut jac = nalgebra::DMatrix::zeros(2 * n, 2 * n);
+        runtime::rhs_jacobian(&*l.arm, &mut ws, 0.0, &x, &mut jac).unwrap();
+        let h = 1e-6;
+        let mut worst: f64 = 0.0;
+        let scale = jac.amax();
+        for j in 0..2 * n {
+            let (mut a, mut b) = (x.clone(), x.clone());
+            a[j] += h;
+            b[j] -= h;
+            let fa = accelerations(&l, 0.0, &a[..n], &a[n..]);
+            let fb = accelerations(&l, 0.0, &b[..n], &b[n..]);
+            for i in 0..n {
+                let fd = (fa[i] - fb[i]) / (2.0 * h);
+                worst = worst.max((jac[(n + i, j)] - fd).abs());
+            }
+        }
+        eprintln!(
+            "{dimensions}D: {touching} touching, Jacobian vs central differences {worst:.3e} of {scale:.3e}"
+        );
+        assert!(worst < 1e-6 * scale, "{worst:e} of {scale:e}");
+    }
+}
