@@ -220,6 +220,9 @@ fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
     for r in softarm::joints::reaction_names(arm) {
         s.push_str(&format!(",{r}"));
     }
+    for c in softarm::contact::column_names(arm) {
+        s.push_str(&format!(",{c}"));
+    }
     s.push('\n');
     for (t, x) in traj.t.iter().zip(&traj.x) {
         s.push_str(&format!("{t:.9}"));
@@ -233,6 +236,9 @@ fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
             for v in softarm::joints::reactions(arm, *t, x) {
                 s.push_str(&format!(",{v:.12e}"));
             }
+        }
+        for v in softarm::contact::columns(arm, *t, x) {
+            s.push_str(&format!(",{v:.12e}"));
         }
         s.push('\n');
     }
@@ -457,6 +463,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         "assembly_moved": assembled_m,
         "constraint_drift_max_m": stats.constraints.map(|c| c.drift_max_m),
         "constraints": stats.constraints,
+        "contact": softarm::contact::summary(arm, &traj, stats.contact),
         "failure": failure.as_ref().map(|f| f.1.clone()),
         "final_state": {
             "t": t_final,

@@ -196,3 +196,81 @@ fn obstacle(
         motion,
     })
 }
+
+/// The trajectory columns of the contact channels: per obstacle (and
+/// `self`, and per body) the total normal and friction force.
+pub fn column_names(arm: &dyn runtime::Dynamics) -> Vec<String> {
+    arm.contact().map_or_else(Vec::new, |set| {
+        set.channels
+            .iter()
+            .flat_map(|c| [format!("contact_{c}_fn"), format!("contact_{c}_ft")])
+            .collect()
+    })
+}
+
+/// The pairs' forces at a sample.
+fn forces_at(
+    arm: &dyn runtime::Dynamics,
+    t: f64,
+    x: &[f64],
+) -> Option<Vec<runtime::contact::PairForce<f64>>> {
+    let set = arm.contact()?;
+    let n = arm.dof();
+    let k = runtime::contact::PointKinematics::eval(arm, t, &x[..n], &x[n..]);
+    Some(runtime::contact::pair_forces(set, &k, t))
+}
+
+/// The contact columns at a sample (`column_names`' order).
+pub fn columns(arm: &dyn runtime::Dynamics, t: f64, x: &[f64]) -> Vec<f64> {
+    let (Some(set), Some(forces)) = (arm.contact(), forces_at(arm, t, x)) else {
+        return Vec::new();
+    };
+    runtime::contact::channel_forces(set, &forces)
+        .into_iter()
+        .flat_map(|(f_n, f_t)| [f_n, f_t])
+        .collect()
+}
+
+/// The run's contacts for summary.json: the energy they dissipated and
+/// the deepest penetration (metered on every step, `SimStats::contact`),
+/// and the contact switches (where a pair with restitution records began
+/// or ended to touch).
+pub fn summary(
+    arm: &dyn runtime::Dynamics,
+    traj: &runtime::Trajectory,
+    meter: Option<runtime::ContactMeter>,
+) -> serde_json::Value {
+    let Some(set) = arm.contact() else {
+        return serde_json::Value::Null;
+    };
+    let switches: Vec<serde_json::Value> = traj
+        .events
+        .iter()
+        .filter(|e| e.name == runtime::CONTACT_EVENT)
+        .map(|e| {
+            let forces = forces_at(arm, e.t, &e.x).unwrap_or_default();
+            // The pair at its surface is the one that switched.
+            let at = forces
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| set.keeps_record(*i))
+                .min_by(|a, b| a.1.gap.abs().total_cmp(&b.1.gap.abs()));
+            match at {
+                Some((i, f)) => serde_json::json!({
+                    "t": e.t,
+                    "point": set.pairs[i].point,
+                    "with": set.channels[set.pairs[i].channel],
+                    "kind": if f.approach > 0.0 { "touch" } else { "release" },
+                    "normal_speed": f.approach,
+                }),
+                None => serde_json::json!({ "t": e.t }),
+            }
+        })
+        .collect();
+    let meter = meter.unwrap_or_default();
+    serde_json::json!({
+        "max_penetration_m": meter.max_penetration_m,
+        "dissipated_j": meter.dissipated_j,
+        "switches": switches,
+    })
+}

@@ -78,7 +78,12 @@ fn a_ball_rebounds_with_the_restitution_it_was_given() {
             solver: Solver::Radau5,
             ..SimOptions::default()
         };
-        let (traj, _) = simulate(&*l.arm, x0, &opts).unwrap();
+        let (traj, stats) = simulate(&*l.arm, x0, &opts).unwrap();
+        // The energy the contact took: m v_in^2 (1 - e^2) / 2.
+        let meter = stats.contact.unwrap();
+        let lost = 0.5 * 0.2 * (1.0 - e * e);
+        eprintln!("e = {e}: dissipated {:.9} J of {lost:.9} J, deepest {:.6e} m", meter.dissipated_j, meter.max_penetration_m);
+        assert_close(meter.dissipated_j, lost, 1e-5, 0.0, "dissipated energy");
         let switches: Vec<_> = traj.events.iter().filter(|h| h.name == "contact").collect();
         assert!(
             switches.len() >= 2,

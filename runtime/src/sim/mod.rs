@@ -16,9 +16,10 @@ pub mod statics;
 pub mod stiffness;
 
 pub use arm::{AccelError, Arm, Dynamics, Workspace, accelerations};
-pub use integrate::events::{Crossing, Event, EventHit};
+pub use integrate::events::{CONTACT_EVENT, Crossing, Event, EventHit};
 pub use integrate::{
-    DEFAULT_SAMPLES, DEFAULT_T_END, SimFailure, SimOptions, SimStats, Trajectory, simulate,
+    ContactMeter, DEFAULT_SAMPLES, DEFAULT_T_END, SimFailure, SimOptions, SimStats, Trajectory,
+    simulate,
 };
 pub use jacobian::rhs_jacobian;
 pub use modes::{Modes, ModesError, modes};

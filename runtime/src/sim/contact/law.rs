@@ -76,6 +76,19 @@ impl Law {
         if f.re() < 0.0 { zero } else { f }
     }
 
+    /// The conservative part of the normal force, k delta^n (or k delta):
+    /// what the contact gives back. The rest of the force dissipates.
+    pub fn elastic_force<T: DualNum<Primitive = f64> + Copy>(&self, delta: T) -> T {
+        if delta.re() <= 0.0 {
+            return T::from(0.0);
+        }
+        match self.normal {
+            Normal::SpringDashpot { k, .. } => delta * k,
+            Normal::Hertz { k, n } | Normal::HuntCrossley { k, n, .. } => delta.powf(n) * k,
+            Normal::Impulse { .. } => T::from(0.0),
+        }
+    }
+
     /// Friction on the point sliding at `v_t` (tangential) under normal
     /// force `f_n`: -mu f_n v_t / sqrt(|v_t|^2 + v_s^2), smooth through
     /// v_t = 0 and within v_s of Coulomb's magnitude when sliding.

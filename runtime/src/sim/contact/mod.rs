@@ -161,7 +161,8 @@ impl ContactSet {
                 }
             }
         }
-        if let Some((law, names)) = bodies {
+        let arm_points = points.iter().any(|p| p.element.is_some());
+        if let Some((law, names)) = bodies.filter(|_| arm_points) {
             let centres: Vec<usize> = (0..points.len())
                 .filter(|&i| points[i].element.is_none())
                 .collect();
@@ -289,6 +290,9 @@ pub struct PairForce<T> {
     pub force: V<T>,
     pub friction: T,
     pub approach: T,
+    /// The power the contact dissipates (W): its normal force beyond the
+    /// elastic part times the rate of penetration, and friction's.
+    pub power: T,
 }
 
 /// The other side of a pair: its position and velocity offsets and radius.
@@ -332,12 +336,15 @@ fn pair_force<T: DualNum<Primitive = f64> + Copy>(
     let f_n = pair.law.normal_force(depth, -v_n, v_in);
     let v_t = [0, 1, 2].map(|c| v_rel[c] - v_n * n[c]);
     let f_t = pair.law.friction_force(f_n, v_t);
+    let slip_power = f_t[0] * v_t[0] + f_t[1] * v_t[1] + f_t[2] * v_t[2];
+    let damped = f_n - pair.law.elastic_force(depth);
     PairForce {
         gap: dist,
         normal: f_n,
         force: [0, 1, 2].map(|c| n[c] * f_n + f_t[c]),
         friction: geometry::norm(f_t),
         approach: -v_n,
+        power: damped * (-v_n) - slip_power,
     }
 }
 
@@ -549,4 +556,20 @@ pub fn switching_gap<D: Dynamics + ?Sized>(
         .filter(|(i, _)| set.keeps_record(*i))
         .map(|(i, f)| if state.touching[i] { -f.gap } else { f.gap })
         .fold(f64::INFINITY, f64::min)
+}
+
+/// The power the contacts dissipate (W) and the deepest penetration (m)
+/// at (t, q, qd): what `SimStats::contact` meters.
+pub fn power_and_depth<D: Dynamics + ?Sized>(
+    d: &D,
+    set: &ContactSet,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+) -> (f64, f64) {
+    let k = PointKinematics::eval(d, t, q, qd);
+    let forces = pair_forces(set, &k, t);
+    let power = forces.iter().map(|f| f.power).sum();
+    let depth = forces.iter().map(|f| -f.gap).fold(0.0, f64::max);
+    (power, depth)
 }

@@ -90,6 +90,7 @@ pub(super) fn run_auto<D: Dynamics + ?Sized>(
         wall_s: stats.wall_s + more.wall_s,
         switched: None,
         constraints: None,
+        contact: super::record::ContactMeter::then(stats.contact, more.contact),
     };
     Ok((
         traj,

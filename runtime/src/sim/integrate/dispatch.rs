@@ -84,6 +84,7 @@ pub(super) fn simulate_implicit<D: Dynamics + ?Sized>(
             wall_s: 0.0,
             switched: None,
             constraints: None,
+            contact: None,
         },
     }))
 }

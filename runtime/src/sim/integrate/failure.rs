@@ -46,7 +46,11 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
     start: Instant,
     recorded: Recorded,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
-    let Recorded { kept, last_step_s } = recorded;
+    let Recorded {
+        kept,
+        last_step_s,
+        contact,
+    } = recorded;
     let hits = kept.events.clone();
     let wall_s = start.elapsed().as_secs_f64();
     let m = 2 * ode.n;
@@ -59,6 +63,7 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
         wall_s,
         switched: None,
         constraints: None,
+        contact,
     };
     let cause = ode.first_error.borrow().clone();
     let explain = |fallback: String| match &cause {

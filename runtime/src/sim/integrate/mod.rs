@@ -39,7 +39,7 @@ pub use dispatch::IMPLICIT_SIZES;
 pub use failure::SimFailure;
 pub use options::{DEFAULT_SAMPLES, DEFAULT_T_END, SimOptions};
 pub use projected::ConstraintStats;
-pub use record::{AUTO_CHECK_STEPS, SimStats, SolverSwitch, Trajectory};
+pub use record::{AUTO_CHECK_STEPS, ContactMeter, SimStats, SolverSwitch, Trajectory};
 pub use state::StateVec;
 
 use std::cell::RefCell;
@@ -76,6 +76,7 @@ pub fn simulate<D: Dynamics + ?Sized>(
                 wall_s: 0.0,
                 switched: None,
                 constraints: None,
+                contact: None,
             },
         }));
     }

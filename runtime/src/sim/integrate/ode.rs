@@ -11,6 +11,9 @@ use super::stepper::OdeSystem;
 use crate::arm::{AccelError, Dynamics, Workspace, accelerations};
 use crate::jacobian::rhs_jacobian;
 
+/// (power, depth) of the contacts at (t, x).
+pub(super) type MeterFn<'a> = dyn Fn(f64, &[f64]) -> (f64, f64) + 'a;
+
 /// The first-order system x' = f(t, x) of an arm; components past 2 n are
 /// padding.
 pub(super) struct ArmOde<'a, D: ?Sized> {
@@ -52,6 +55,16 @@ impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
         let n = self.n;
         Some(Box::new(move |t, x| {
             crate::contact::switching_gap(self.arm, set, t, &x[..n], &x[n..2 * n])
+        }))
+    }
+
+    /// The contact meter: (dissipated power, deepest penetration) at
+    /// (t, x), when the arm has contacts.
+    pub(super) fn contact_meter(&self) -> Option<Box<MeterFn<'_>>> {
+        let set = self.arm.contact()?;
+        let n = self.n;
+        Some(Box::new(move |t, x| {
+            crate::contact::power_and_depth(self.arm, set, t, &x[..n], &x[n..2 * n])
         }))
     }
 

@@ -257,6 +257,7 @@ fn empty_stats(opts: &SimOptions) -> SimStats {
         wall_s: 0.0,
         switched: None,
         constraints: Some(ConstraintStats::default()),
+        contact: None,
     }
 }
 
@@ -269,4 +270,5 @@ fn add(stats: &mut SimStats, more: &SimStats) {
     if stats.switched.is_none() {
         stats.switched.clone_from(&more.switched);
     }
+    stats.contact = super::record::ContactMeter::then(stats.contact, more.contact);
 }

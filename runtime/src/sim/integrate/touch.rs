@@ -110,6 +110,7 @@ fn add(stats: &mut Option<SimStats>, more: &SimStats) {
     if s.switched.is_none() {
         s.switched.clone_from(&more.switched);
     }
+    s.contact = super::record::ContactMeter::then(s.contact, more.contact);
     if let (Some(c), Some(m)) = (s.constraints.as_mut(), more.constraints.as_ref()) {
         c.drift_max_m = c.drift_max_m.max(m.drift_max_m);
         c.drift_max_rad = c.drift_max_rad.max(m.drift_max_rad);
