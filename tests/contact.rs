@@ -82,7 +82,10 @@ fn a_ball_rebounds_with_the_restitution_it_was_given() {
         // The energy the contact took: m v_in^2 (1 - e^2) / 2.
         let meter = stats.contact.unwrap();
         let lost = 0.5 * 0.2 * (1.0 - e * e);
-        eprintln!("e = {e}: dissipated {:.9} J of {lost:.9} J, deepest {:.6e} m", meter.dissipated_j, meter.max_penetration_m);
+        eprintln!(
+            "e = {e}: dissipated {:.9} J of {lost:.9} J, deepest {:.6e} m",
+            meter.dissipated_j, meter.max_penetration_m
+        );
         assert_close(meter.dissipated_j, lost, 1e-5, 0.0, "dissipated energy");
         let switches: Vec<_> = traj.events.iter().filter(|h| h.name == "contact").collect();
         assert!(
@@ -288,4 +291,135 @@ points_per_element = 2
         );
         assert!(worst < 1e-6 * scale, "{worst:e} of {scale:e}");
     }
+}
+
+/// The chapter's impact stage (`impulse`): without gravity a ball meets
+/// the floor at 1 m/s and leaves at e m/s, the jump exact; a glancing hit
+/// keeps its tangential velocity when frictionless and loses it when the
+/// law has friction (no slip, the chapter's case, held after e = 0).
+#[test]
+fn an_impulse_reverses_the_normal_velocity_by_e() {
+    for (e, friction, vx) in [(0.5, 0.0, 0.0), (0.3, 0.0, 0.7), (0.0, 0.5, 0.7)] {
+        let text = ball_on_floor(
+            0.0,
+            0.1,
+            &format!("model = \"impulse\"\nrestitution = {e}\nfriction = {friction}"),
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let l = load_text(dir.path(), &text, &[]);
+        let n = l.arm.dof();
+        let (ix, iy) = (coordinate(&l, "ball.x"), coordinate(&l, "ball.y"));
+        let mut x0 = vec![0.0; 2 * n];
+        x0[iy] = 0.1;
+        x0[n + iy] = -1.0;
+        x0[n + ix] = vx;
+        let opts = SimOptions {
+            t_end: 0.1,
+            output_dt: 0.01,
+            rtol: 1e-10,
+            atol: 1e-12,
+            solver: Solver::Dopri5,
+            ..SimOptions::default()
+        };
+        let (traj, _) = simulate(&*l.arm, x0, &opts).unwrap();
+        let hit = traj
+            .events
+            .iter()
+            .find(|h| h.name == "contact")
+            .expect("the ball hits");
+        assert_abs(hit.t, 0.05, 1e-9, "time of impact");
+        let last = traj.x.last().unwrap();
+        let what = format!("e = {e}, friction {friction}");
+        eprintln!(
+            "{what}: after the impact v = ({:.12}, {:.12})",
+            last[n + ix],
+            last[n + iy]
+        );
+        assert_abs(last[n + iy], e, 1e-9, &format!("{what}: normal velocity"));
+        let tangential = if friction > 0.0 { 0.0 } else { vx };
+        assert_abs(
+            last[n + ix],
+            tangential,
+            1e-9,
+            &format!("{what}: tangential velocity"),
+        );
+    }
+}
+
+/// A rigid rod pinned at one end swings down onto a support under its
+/// tip: with e = 0 it stops dead at the impact (one freedom, so the whole
+/// velocity is normal at the tip) and rests held there, the support
+/// carrying half the rod's weight, m g / 2.
+#[test]
+fn a_rod_struck_on_its_support_stops_and_rests_on_it() {
+    let (m, g, len) = (0.3, 9.81, 0.4);
+    let text = format!(
+        r#"
+name = "rod"
+gravity = [0.0, {gy}, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "rigid"
+length = {len}
+mass = {m}
+elements = 1
+joint_stiffness = 0.0
+[[obstacle]]
+name = "support"
+shape = "plane"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+[contact]
+model = "impulse"
+restitution = 0.0
+points_per_element = 1
+"#,
+        gy = -g
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let l = load_text(dir.path(), &text, &[]);
+    let n = l.arm.dof();
+    assert_eq!(n, 1);
+    // From 0.3 rad up, at rest: the tip falls onto y = 0 (horizontal).
+    let x0 = vec![0.3, 0.0];
+    let opts = SimOptions {
+        t_end: 1.0,
+        output_dt: 0.01,
+        rtol: 1e-10,
+        atol: 1e-12,
+        solver: Solver::Radau5,
+        ..SimOptions::default()
+    };
+    let (traj, _) = simulate(&*l.arm, x0, &opts).unwrap();
+    let hit = traj
+        .events
+        .iter()
+        .find(|h| h.name == "contact")
+        .expect("the rod hits its support");
+    let last = traj.x.last().unwrap();
+    eprintln!(
+        "rod: impact at {:.6} s, at the end angle {:.3e}, rate {:.3e}",
+        hit.t, last[0], last[1]
+    );
+    assert_abs(last[0], 0.0, 1e-9, "rests horizontal");
+    assert_abs(last[1], 0.0, 1e-9, "at rest");
+    let set = l.arm.contact().unwrap();
+    let held = set.held_pairs();
+    assert_eq!(held.len(), 1, "held on its support");
+    let (_, forces) = runtime::contact::impact::held_accelerations(
+        &*l.arm,
+        set,
+        1.0,
+        &last[..n],
+        &last[n..],
+        &held,
+    )
+    .unwrap();
+    eprintln!(
+        "rod: support force {:.12} N, m g / 2 = {:.12} N",
+        forces[0],
+        m * g / 2.0
+    );
+    assert_close(forces[0], m * g / 2.0, 1e-9, 0.0, "support force");
 }

@@ -385,6 +385,14 @@ pub fn accelerations<D: Dynamics + ?Sized>(
     let n = ws.n;
     let rows = d.info().constraints.len();
     let contact = d.contact().is_some();
+    if let Some(set) = d.contact() {
+        let held = set.held_pairs();
+        if !held.is_empty() {
+            let (a, _) = crate::contact::impact::held_accelerations(d, set, t, q, qd, &held)?;
+            qdd.copy_from_slice(&a);
+            return Ok(());
+        }
+    }
     let solved = if rows > 0 {
         d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
         if contact {

@@ -20,7 +20,8 @@ pub fn rhs_jacobian<D: Dynamics + ?Sized>(
     x: &[f64],
     jac: &mut DMatrix<f64>,
 ) -> Result<Vec<f64>, AccelError> {
-    if !d.info().constraints.is_empty() {
+    let holds = d.contact().is_some_and(|c| !c.held_pairs().is_empty());
+    if !d.info().constraints.is_empty() || holds {
         return constrained_jacobian(d, ws, t, x, jac);
     }
     let n = d.dof();
@@ -50,7 +51,7 @@ pub fn rhs_jacobian<D: Dynamics + ?Sized>(
     Ok(qdd)
 }
 
-/// J of a system with joints by central differences of the constrained
+/// J of a system with joints (or held contacts) by central differences of the constrained
 /// accelerations: the multipliers' own dependence on the state (through J,
 /// gamma and the Schur complement) has no kernel, and 4 n solves of a
 /// few-dozen-coordinate assembly cost less than deriving one. Implicit

@@ -11,6 +11,7 @@
 //! coordinate, and the laws' derivatives by dual numbers.
 
 pub mod geometry;
+pub mod impact;
 pub mod law;
 
 use std::sync::Mutex;
@@ -95,6 +96,8 @@ pub struct Pair {
 pub struct ContactState {
     pub touching: Vec<bool>,
     pub impact: Vec<f64>,
+    /// Impulse pairs held as unilateral constraints (after e = 0).
+    pub held: Vec<bool>,
 }
 
 /// Every pair of a model, and its running state.
@@ -184,6 +187,7 @@ impl ContactSet {
         let state = ContactState {
             touching: vec![false; pairs.len()],
             impact: vec![0.0; pairs.len()],
+            held: vec![false; pairs.len()],
         };
         Self {
             points,
@@ -194,15 +198,24 @@ impl ContactSet {
         }
     }
 
-    /// A pair whose force depends on how it began (its impact speed).
+    /// A pair whose force depends on how it began (its impact speed), or
+    /// that changes the velocities when it begins (impulse).
     pub fn keeps_record(&self, pair: usize) -> bool {
         matches!(
             self.pairs[pair].law.normal,
             Normal::HuntCrossley {
                 damping: Damping::Restitution { .. },
                 ..
-            }
+            } | Normal::Impulse { .. }
         )
+    }
+
+    /// The impulse pairs held now.
+    pub fn held_pairs(&self) -> Vec<usize> {
+        let state = self.state();
+        (0..self.pairs.len())
+            .filter(|&i| state.held.get(i) == Some(&true))
+            .collect()
     }
 
     /// Some pair keeps records: runs go in legs between contact switches.
@@ -212,13 +225,21 @@ impl ContactSet {
 
     /// Bring the records up to the state at `forces`: a pair that keeps
     /// records and now touches (gap <= 0) without a record gets one, its
-    /// speed of approach; one that no longer touches loses it. Returns
-    /// the pairs that began to touch.
-    pub fn update_records(&self, forces: &[PairForce<f64>]) -> Vec<usize> {
+    /// speed of approach; one that no longer touches loses it; a held pair
+    /// whose normal force (`held`: pair, force) no longer pushes is let go.
+    /// Returns the pairs that began to touch (an impulse pair's impact is
+    /// the caller's to apply; with e = 0 it is held from here).
+    pub fn update_records(&self, forces: &[PairForce<f64>], held: &[(usize, f64)]) -> Vec<usize> {
         let mut state = self.state();
         let mut began = Vec::new();
+        for &(i, f_n) in held {
+            if f_n <= 0.0 {
+                state.held[i] = false;
+                state.touching[i] = false;
+            }
+        }
         for (i, f) in forces.iter().enumerate() {
-            if !self.keeps_record(i) {
+            if !self.keeps_record(i) || state.held[i] {
                 continue;
             }
             // Exactly at the surface, the pair touches if it approaches.
@@ -226,8 +247,9 @@ impl ContactSet {
             if touches && !state.touching[i] {
                 state.impact[i] = f.approach.max(0.0);
                 began.push(i);
+                state.held[i] = impact::restitution(self, i) == Some(0.0);
             }
-            state.touching[i] = touches;
+            state.touching[i] = touches || state.held[i];
         }
         self.set_state(state);
         began
@@ -537,9 +559,10 @@ pub fn channel_forces(set: &ContactSet, forces: &[PairForce<f64>]) -> Vec<(f64, 
 }
 
 /// The contact switch: over the pairs that keep records, the gap of those
-/// apart and minus the gap of those touching, the least. It falls through
-/// zero when a pair begins or ends to touch, where the run stops to update
-/// the records.
+/// apart, minus the gap of those touching, and the normal force of those
+/// held, the least. It falls through zero when a pair begins or ends to
+/// touch, or a held one would pull, where the run stops to update the
+/// records.
 pub fn switching_gap<D: Dynamics + ?Sized>(
     d: &D,
     set: &ContactSet,
@@ -550,12 +573,20 @@ pub fn switching_gap<D: Dynamics + ?Sized>(
     let k = PointKinematics::eval(d, t, q, qd);
     let forces = pair_forces(set, &k, t);
     let state = set.state();
+    let held = set.held_pairs();
+    let pushing = if held.is_empty() {
+        f64::INFINITY
+    } else {
+        impact::held_accelerations(d, set, t, q, qd, &held).map_or(f64::NEG_INFINITY, |(_, f)| {
+            f.into_iter().fold(f64::INFINITY, f64::min)
+        })
+    };
     forces
         .iter()
         .enumerate()
-        .filter(|(i, _)| set.keeps_record(*i))
+        .filter(|(i, _)| set.keeps_record(*i) && !state.held[*i])
         .map(|(i, f)| if state.touching[i] { -f.gap } else { f.gap })
-        .fold(f64::INFINITY, f64::min)
+        .fold(pushing, f64::min)
 }
 
 /// The power the contacts dissipate (W) and the deepest penetration (m)

@@ -11,7 +11,7 @@ use super::failure::SimFailure;
 use super::options::SimOptions;
 use super::record::{SimStats, Trajectory};
 use crate::arm::Dynamics;
-use crate::contact::{PointKinematics, pair_forces};
+use crate::contact::{PointKinematics, impact, pair_forces};
 
 /// Legs that end within this time of their start before the run gives up:
 /// contacts that switch without the time moving (a chattering contact).
@@ -32,7 +32,25 @@ pub(super) fn run<D: Dynamics + ?Sized>(
     let mut stalled = 0;
     loop {
         let k = PointKinematics::eval(arm, t0, &x[..n], &x[n..]);
-        set.update_records(&pair_forces(set, &k, t0));
+        let held = set.held_pairs();
+        let held_forces: Vec<(usize, f64)> = if held.is_empty() {
+            Vec::new()
+        } else {
+            let (_, f) = impact::held_accelerations(arm, set, t0, &x[..n], &x[n..], &held)
+                .map_err(|e| fail_at(t0, &x, &traj, &stats, e.to_string()))?;
+            held.into_iter().zip(f).collect()
+        };
+        let began = set.update_records(&pair_forces(set, &k, t0), &held_forces);
+        let hits: Vec<usize> = began
+            .into_iter()
+            .filter(|&i| impact::restitution(set, i).is_some())
+            .collect();
+        if !hits.is_empty() {
+            let (q, qd) = x.split_at(n);
+            let after = impact::jump(arm, set, t0, q, qd, &hits)
+                .map_err(|e| fail_at(t0, &x, &traj, &stats, e.to_string()))?;
+            x[n..].copy_from_slice(&after);
+        }
         let leg = super::run_leg(arm, t0, x.clone(), opts);
         let (mut seg, more) = match leg {
             Ok(r) => r,
@@ -117,4 +135,35 @@ fn add(stats: &mut Option<SimStats>, more: &SimStats) {
         c.velocity_drift_max = c.velocity_drift_max.max(m.velocity_drift_max);
         c.projections += m.projections;
     }
+}
+
+/// A failure between legs (an impact or a held contact that cannot be
+/// solved), with what ran so far.
+fn fail_at(
+    t: f64,
+    x: &[f64],
+    traj: &Trajectory,
+    stats: &Option<SimStats>,
+    reason: String,
+) -> Box<SimFailure> {
+    Box::new(SimFailure {
+        t_reached: t,
+        last_step_s: None,
+        reason: format!("at a contact switch: {reason}"),
+        suggestion: "check that the impulse contacts and the joints do not hold one freedom twice"
+            .into(),
+        state: x.to_vec(),
+        trajectory: traj.clone(),
+        stats: stats.clone().unwrap_or(SimStats {
+            solver: crate::solver::Solver::Auto,
+            steps: 0,
+            rejected_steps: 0,
+            rhs_evaluations: 0,
+            jacobian_evaluations: 0,
+            wall_s: 0.0,
+            switched: None,
+            constraints: None,
+            contact: None,
+        }),
+    })
 }
