@@ -19,6 +19,8 @@ pub mod ebr_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod falling_ball;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod finger_tap;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod hybrid_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod long_arm;
@@ -34,6 +36,8 @@ pub mod stiff_flop_rom;
 pub mod tentacle3d;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod vc_arm;
+#[allow(clippy::all, clippy::pedantic)]
+pub mod wrap;
 
 /// Every compiled-in model, by name.
 pub static MODELS: &[CompiledModel] = &[
@@ -94,6 +98,13 @@ pub static MODELS: &[CompiledModel] = &[
         kernels: || Box::new(falling_ball::Compiled::default()),
     },
     CompiledModel {
+        name: "finger_tap",
+        hash: finger_tap::HASH,
+        dof: finger_tap::DOF,
+        source: include_str!("../models/finger_tap.toml"),
+        kernels: || Box::new(finger_tap::Compiled::default()),
+    },
+    CompiledModel {
         name: "hybrid_arm",
         hash: hybrid_arm::HASH,
         dof: hybrid_arm::DOF,
@@ -148,5 +159,12 @@ pub static MODELS: &[CompiledModel] = &[
         dof: vc_arm::DOF,
         source: include_str!("../models/vc_arm.toml"),
         kernels: || Box::new(vc_arm::Compiled::default()),
+    },
+    CompiledModel {
+        name: "wrap",
+        hash: wrap::HASH,
+        dof: wrap::DOF,
+        source: include_str!("../models/wrap.toml"),
+        kernels: || Box::new(wrap::Compiled::default()),
     },
 ];

@@ -429,6 +429,32 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         let title = format!("{}: path of {body}", loaded.model.name);
         softarm::joints::plot_path(&out_dir.join(&body), &title, &path)?;
     }
+    if let Some(set) = arm.contact() {
+        // The tip's path and the contact forces.
+        let tips: Vec<(f64, f64, f64)> = traj
+            .t
+            .iter()
+            .zip(&traj.x)
+            .map(|(t, x)| {
+                let o = arm.outputs(*t, &x[..n], &x[n..]);
+                (*t, o[0], o[1])
+            })
+            .collect();
+        let name = &loaded.model.name;
+        softarm::joints::plot_path(&out_dir.join("tip"), &format!("{name}: tip path"), &tips)?;
+        let forces: Vec<(f64, Vec<f64>)> = traj
+            .t
+            .iter()
+            .zip(&traj.x)
+            .map(|(t, x)| (*t, softarm::contact::columns(arm, *t, x)))
+            .collect();
+        softarm::contact::plot_forces(
+            &out_dir.join("contact"),
+            &format!("{name}: contact forces"),
+            &set.channels,
+            &forces,
+        )?;
+    }
     let final_state = traj.x.last().cloned().unwrap_or_default();
     let t_final = traj.t.last().copied().unwrap_or(0.0);
     let tip = if final_state.len() == 2 * n {
@@ -675,6 +701,7 @@ fn start_coordinates(loaded: &Loaded, q0: &Option<String>) -> Result<(Vec<f64>, 
         }
     };
     let moved = softarm::joints::assemble(&*loaded.arm, &loaded.origin, &mut q, &mut vec![0.0; n])?;
+    softarm::contact::check_start(&*loaded.arm, &loaded.origin, &q)?;
     if moved > 0.0 {
         eprintln!(
             "{}: the initial state was assembled onto the joints, moving the coordinates by {moved:.3e} (Euclidean norm)",

@@ -274,3 +274,94 @@ pub fn summary(
         "switches": switches,
     })
 }
+
+/// `<stem>.png`: each channel's normal force against time (`forces`: per
+/// sample, t and the channel columns as `columns` gives them).
+pub fn plot_forces(
+    stem: &Path,
+    title: &str,
+    channels: &[String],
+    forces: &[(f64, Vec<f64>)],
+) -> Result<()> {
+    use plotters::prelude::*;
+    let t1 = forces.last().map_or(1.0, |f| f.0).max(1e-9);
+    let top = forces
+        .iter()
+        .flat_map(|(_, v)| v.iter().step_by(2).copied())
+        .filter(|v| v.is_finite())
+        .fold(1e-6, f64::max);
+    crate::compare::register_font();
+    let size = (900u32, 500u32);
+    let mut rgb = vec![255u8; 3 * (size.0 * size.1) as usize];
+    {
+        let e = |e: &dyn std::fmt::Display| anyhow::anyhow!("{}: {e}", stem.display());
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|x| e(&x))?;
+        let root = root.titled(title, ("sans-serif", 20)).map_err(|x| e(&x))?;
+        let mut chart = ChartBuilder::on(&root)
+            .margin(10)
+            .x_label_area_size(35)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..t1, 0.0..1.05 * top)
+            .map_err(|x| e(&x))?;
+        chart
+            .configure_mesh()
+            .x_desc("t (s)")
+            .y_desc("normal force (N)")
+            .draw()
+            .map_err(|x| e(&x))?;
+        for (k, name) in channels.iter().enumerate() {
+            let color = Palette99::pick(k).to_rgba();
+            chart
+                .draw_series(LineSeries::new(
+                    forces.iter().map(|(t, v)| (*t, v[2 * k])),
+                    color.stroke_width(2),
+                ))
+                .map_err(|x| e(&x))?
+                .label(name.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|x| e(&x))?;
+        root.present().map_err(|x| e(&x))?;
+    }
+    crate::compare::write_png(&stem.with_extension("png"), size, &rgb)
+}
+
+/// A start with a point's centreline inside an obstacle (deeper than its
+/// tube) is an error naming the obstacle, the point and the depth: the
+/// penalty laws would throw it out violently, and an impulse contact
+/// cannot begin there.
+pub fn check_start(arm: &dyn runtime::Dynamics, origin: &str, q: &[f64]) -> Result<()> {
+    let Some(set) = arm.contact() else {
+        return Ok(());
+    };
+    let n = arm.dof();
+    let mut x = q.to_vec();
+    x.extend(vec![0.0; n]);
+    let Some(forces) = forces_at(arm, 0.0, &x) else {
+        return Ok(());
+    };
+    for (pair, f) in set.pairs.iter().zip(&forces) {
+        let radius = set.points[pair.point].radius;
+        let depth = -f.gap;
+        if depth > radius.max(1e-9) && matches!(pair.other, runtime::contact::Against::Obstacle(_))
+        {
+            let at = match set.points[pair.point].element {
+                Some((arm_k, e)) => format!("point {} (arm {arm_k}, element {e})", pair.point),
+                None => format!("point {} (a body's centre)", pair.point),
+            };
+            bail!(
+                "{origin}: the start is inside obstacle \"{}\": {at} is {:.3} mm deep (its tube radius is {:.3} mm); move the obstacle or start elsewhere (--q0, [simulate] q0)",
+                set.channels[pair.channel],
+                1e3 * depth,
+                1e3 * radius
+            );
+        }
+    }
+    Ok(())
+}

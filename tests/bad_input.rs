@@ -1130,3 +1130,26 @@ fn contact_mistakes_name_the_key() {
         }
     }
 }
+
+/// A start inside an obstacle stops `simulate` before it writes anything,
+/// naming the obstacle and the depth; the same arm clear of it runs.
+#[test]
+fn a_start_inside_an_obstacle_is_an_error_before_any_output() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("m.toml"), TABLE).unwrap();
+    let out = softarm(
+        &["simulate", "m.toml", "--out", "run", "--t-end", "0.05"],
+        dir.path(),
+    );
+    assert!(out.status.success(), "clear of the table: {}", stderr(&out));
+    let inside = TABLE.replacen("point = [0.0, -0.1, 0.0]", "point = [0.0, 0.005, 0.0]", 1);
+    std::fs::write(dir.path().join("m.toml"), inside).unwrap();
+    let out = softarm(&["simulate", "m.toml", "--out", "bad"], dir.path());
+    let err = stderr(&out);
+    assert!(!out.status.success(), "accepted a start inside the table");
+    assert!(!err.contains("panicked"), "panic: {err}");
+    for e in ["inside obstacle \"table\"", "15.000 mm deep", "--q0"] {
+        assert!(err.contains(e), "expected `{e}` in: {err}");
+    }
+    assert!(!dir.path().join("bad").exists(), "wrote output");
+}
