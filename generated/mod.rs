@@ -3,6 +3,8 @@
 use runtime::CompiledModel;
 
 #[allow(clippy::all, clippy::pedantic)]
+pub mod ball_drop;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod cantilever;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod cantilever3d;
@@ -41,6 +43,13 @@ pub mod wrap;
 
 /// Every compiled-in model, by name.
 pub static MODELS: &[CompiledModel] = &[
+    CompiledModel {
+        name: "ball_drop",
+        hash: ball_drop::HASH,
+        dof: ball_drop::DOF,
+        source: include_str!("../models/ball_drop.toml"),
+        kernels: || Box::new(ball_drop::Compiled::default()),
+    },
     CompiledModel {
         name: "cantilever",
         hash: cantilever::HASH,

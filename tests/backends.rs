@@ -206,9 +206,20 @@ fn generated_mass_solve_matches_a_dense_solve() {
             let qd = rng.vec(n, -3.0, 3.0);
             let mut out = vec![0.0; 2 * n];
             arm.eval_kernel(KernelKind::Accel, 0.0, &q, &qd, &mut out);
+            // The kernel's own M and h (`Dynamics::mass_bias` adds contact
+            // forces, which the Accel kernel does not see).
+            let mut packed = vec![0.0; n * (n + 1) / 2 + n];
+            arm.eval_kernel(KernelKind::MassBias, 0.0, &q, &qd, &mut packed);
             let mut mm = nalgebra::DMatrix::zeros(n, n);
-            let mut h = nalgebra::DVector::zeros(n);
-            arm.mass_bias(0.0, &q, &qd, &mut mm, &mut h);
+            let mut k = 0;
+            for i in 0..n {
+                for j in i..n {
+                    mm[(i, j)] = packed[k];
+                    mm[(j, i)] = packed[k];
+                    k += 1;
+                }
+            }
+            let h = nalgebra::DVector::from_column_slice(&packed[k..]);
             let reference = mm.clone().cholesky().expect("M is SPD").solve(&(-h));
             let scale = reference.amax();
             for i in 0..n {

@@ -117,6 +117,14 @@ pub struct JointDecl {
     /// non-zero length, normalised); default none.
     #[serde(default)]
     pub orientation: Option<[f64; 4]>,
+    /// An inactive joint is checked and then left out (structural): cut it
+    /// with `--set joint.NAME.active=false`.
+    #[serde(default = "active")]
+    pub active: bool,
+}
+
+fn active() -> bool {
+    true
 }
 
 /// A frame a joint names. Arms and bodies by their index in the model.

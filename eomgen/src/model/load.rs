@@ -148,7 +148,10 @@ pub fn parse_model(
         let path = if path == "." { String::new() } else { path };
         ModelError::new(file, path, e.into_inner().to_string())
     })?;
+    let mut model = model;
     validate(&model, file)?;
+    // Checked, then cut.
+    model.joints.retain(|j| j.active);
     Ok(model)
 }
 

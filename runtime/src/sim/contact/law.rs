@@ -89,6 +89,21 @@ impl Law {
         }
     }
 
+    /// The energy stored in the elastic part at depth delta: k delta^2 / 2
+    /// or k delta^(n+1) / (n+1).
+    pub fn potential(&self, delta: f64) -> f64 {
+        if delta <= 0.0 {
+            return 0.0;
+        }
+        match self.normal {
+            Normal::SpringDashpot { k, .. } => 0.5 * k * delta * delta,
+            Normal::Hertz { k, n } | Normal::HuntCrossley { k, n, .. } => {
+                k * delta.powf(n + 1.0) / (n + 1.0)
+            }
+            Normal::Impulse { .. } => 0.0,
+        }
+    }
+
     /// Friction on the point sliding at `v_t` (tangential) under normal
     /// force `f_n`: -mu f_n v_t / sqrt(|v_t|^2 + v_s^2), smooth through
     /// v_t = 0 and within v_s of Coulomb's magnitude when sliding.

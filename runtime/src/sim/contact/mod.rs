@@ -604,3 +604,22 @@ pub fn power_and_depth<D: Dynamics + ?Sized>(
     let depth = forces.iter().map(|f| -f.gap).fold(0.0, f64::max);
     (power, depth)
 }
+
+/// The energy stored in the contacts' elastic parts (J) at (t, q, qd):
+/// with the arm's kinetic and potential energy, the total that only
+/// dissipation lowers.
+pub fn potential_energy<D: Dynamics + ?Sized>(
+    d: &D,
+    set: &ContactSet,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+) -> f64 {
+    let k = PointKinematics::eval(d, t, q, qd);
+    let forces = pair_forces(set, &k, t);
+    set.pairs
+        .iter()
+        .zip(&forces)
+        .map(|(pair, f)| pair.law.potential(-f.gap))
+        .sum()
+}
