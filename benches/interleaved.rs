@@ -13,6 +13,10 @@
 //! constrained solve); `free:MODEL` the same without its joints (mass +
 //! bias and the mass solve alone: what the constraint solve adds is the
 //! difference); `joints:MODEL` the constraint kernel alone;
+//! `nocontact:MODEL` the right-hand side with the model's contacts taken
+//! away (what contact adds is `rhs:MODEL` minus this); `points:MODEL` the
+//! `Contact` kernel alone (the points' positions); `straight:MODEL` the
+//! right-hand side at q = qd = 0 instead of the default state;
 //! `recursion:tentacle3d` the numeric element-by-element
 //! recursion of tests/common/pcc3d.rs.
 
@@ -66,8 +70,24 @@ fn main() {
                 Some(m) => (true, m),
                 None => (false, model),
             };
-            let l = load(model, &[], BackendChoice::Compiled, None)
+            let (points, model) = match model.strip_prefix("points:") {
+                Some(m) => (true, m),
+                None => (false, model),
+            };
+            let (straight, model) = match model.strip_prefix("straight:") {
+                Some(m) => (true, m),
+                None => (false, model),
+            };
+            let (nocontact, model) = match model.strip_prefix("nocontact:") {
+                Some(m) => (true, m),
+                None => (false, model),
+            };
+            let mut l = load(model, &[], BackendChoice::Compiled, None)
                 .unwrap_or_else(|e| panic!("{model}: {e:#}"));
+            if nocontact {
+                l.arm.set_contact(None);
+            }
+            let rhs = rhs || nocontact;
             let dof = l.arm.dof();
             // Angles of a few tenths of a radian; stretches (metres) of
             // a few tenths of a millimetre.
@@ -83,6 +103,12 @@ fn main() {
                 })
                 .collect();
             let qd: Vec<f64> = (0..dof).map(|i| 0.2 * ((i as f64) * 1.3).cos()).collect();
+            let (q, qd) = if straight {
+                (vec![0.0; dof], vec![0.0; dof])
+            } else {
+                (q, qd)
+            };
+            let rhs = rhs || straight;
             let mut out = vec![0.0; KernelKind::MassBias.output_len(l.arm.info())];
             if rhs {
                 let mut ws = runtime::Workspace::new(dof);
@@ -99,16 +125,16 @@ fn main() {
                     .expect("accelerations");
                     black_box(&qdd);
                 })
-            } else if joints {
-                let mut c = vec![0.0; KernelKind::Constraints.output_len(l.arm.info())];
+            } else if joints || points {
+                let kind = if joints {
+                    KernelKind::Constraints
+                } else {
+                    KernelKind::Contact
+                };
+                let mut c = vec![0.0; kind.output_len(l.arm.info())];
                 Box::new(move || {
-                    l.arm.eval_kernel(
-                        KernelKind::Constraints,
-                        0.0,
-                        black_box(&q),
-                        black_box(&qd),
-                        &mut c,
-                    )
+                    l.arm
+                        .eval_kernel(kind, 0.0, black_box(&q), black_box(&qd), &mut c)
                 })
             } else if free {
                 let mut ldlt = runtime::Ldlt::new(dof);

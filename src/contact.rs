@@ -216,8 +216,14 @@ fn forces_at(
 ) -> Option<Vec<runtime::contact::PairForce<f64>>> {
     let set = arm.contact()?;
     let n = arm.dof();
-    let k = runtime::contact::PointKinematics::eval(arm, t, &x[..n], &x[n..]);
-    Some(runtime::contact::pair_forces(set, &k, t))
+    Some(runtime::contact::pair_forces(
+        arm,
+        set,
+        t,
+        &x[..n],
+        &x[n..],
+        true,
+    ))
 }
 
 /// The contact columns at a sample (`column_names`' order).

@@ -265,8 +265,7 @@ points_per_element = 2
         x.extend((0..n).map(|_| rng.uniform(-0.5, 0.5)));
         // Several points press in: the Jacobian has contact terms.
         let set = l.arm.contact().unwrap();
-        let k = runtime::contact::PointKinematics::eval(&*l.arm, 0.0, &x[..n], &x[n..]);
-        let forces = runtime::contact::pair_forces(set, &k, 0.0);
+        let forces = runtime::contact::pair_forces(&*l.arm, set, 0.0, &x[..n], &x[n..], false);
         let touching = forces.iter().filter(|f| f.normal > 0.0).count();
         assert!(touching >= 2, "{dimensions}D: {touching} points touch");
         let mut ws = runtime::Workspace::new(n);
@@ -500,4 +499,77 @@ slip_velocity = 0.01
     assert!(meter.dissipated_j > 0.1 * scale, "the contacts take energy");
     assert!(rise < 1e-8 * scale, "energy rose by {rise:e} J");
     assert_close(lost, meter.dissipated_j, 1e-5, 0.0, "energy balance");
+}
+
+/// A soft arm hanging from a compliant base, its tip pressed onto a table
+/// by a tip load, in static equilibrium: the table and the base's spring
+/// together carry the whole load (1e-9 relative), and the tip sinks into
+/// the table exactly as deep as the law gives for the force it carries,
+/// (F_c / k)^(1/n).
+#[test]
+fn a_tip_load_pressing_on_a_table_is_carried_by_it() {
+    let (k_base, k_c, n_exp, load, r) = (100.0, 1e4, 1.5, 2.0, 0.01);
+    let text = format!(
+        r#"
+name = "pressed"
+gravity = [0.0, 0.0, 0.0]
+[base]
+direction = [0.0, -1.0, 0.0]
+mass = 0.1
+stiffness = {k_base}
+damping = 1.0
+[[segment]]
+method = "pcc"
+length = 0.2
+elements = 4
+mass = 0.05
+outer_radius = {r}
+bending_stiffness = 0.1
+[tip]
+force = [0.0, -{load}, 0.0]
+[[obstacle]]
+name = "table"
+shape = "plane"
+point = [0.0, -0.21, 0.0]
+normal = [0.0, 1.0, 0.0]
+[contact]
+model = "hertz"
+stiffness = {k_c}
+exponent = {n_exp}
+"#
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let l = load_text(dir.path(), &text, &[]);
+    let n = l.arm.dof();
+    let by = coordinate(&l, "base_y");
+    let mut arm = l.arm;
+    let sol = runtime::solve_static(&mut *arm, &vec![0.0; n], &runtime::StaticOptions::default())
+        .unwrap();
+    let mut x = sol.q.clone();
+    x.extend(vec![0.0; n]);
+    let columns = softarm::contact::columns(&*arm, 0.0, &x);
+    let table = columns[0];
+    let spring = -k_base * sol.q[by];
+    let tip_y = arm.outputs(0.0, &sol.q, &vec![0.0; n])[1];
+    let depth = -0.21 - (tip_y - r);
+    eprintln!(
+        "pressed: table {table:.12} N + base spring {spring:.12} N = {:.12} N of {load} N; depth {depth:.6e} m, (F/k)^(1/n) = {:.6e} m",
+        table + spring,
+        (table / k_c).powf(1.0 / n_exp)
+    );
+    assert!(table > 0.5 * load, "the table carries most of it: {table}");
+    assert_close(
+        table + spring,
+        load,
+        1e-9,
+        0.0,
+        "table and base carry the load",
+    );
+    assert_close(
+        depth,
+        (table / k_c).powf(1.0 / n_exp),
+        1e-9,
+        0.0,
+        "depth of the law",
+    );
 }

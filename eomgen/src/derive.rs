@@ -70,12 +70,13 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
         let outs = constraint_outputs(&mut cas, &sys, &phi);
         cas.to_tape_hoisted(&outs, &mut hoist)
     };
-    let (contact, contact_jvp) = if sys.samples.is_empty() {
-        (runtime::Tape::default(), runtime::Tape::default())
+    let (contact, contact_jacobian, contact_jvp) = if sys.samples.is_empty() {
+        Default::default()
     } else {
-        let (points, tangent) = contact_outputs(&mut cas, &sys);
+        let (points, jacobian, tangent) = contact_outputs(&mut cas, &sys);
         (
             cas.to_tape_hoisted(&points, &mut hoist),
+            cas.to_tape_hoisted(&jacobian, &mut hoist),
             cas.to_tape_hoisted(&tangent, &mut hoist),
         )
     };
@@ -99,6 +100,7 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
         jvp,
         constraints,
         contact,
+        contact_jacobian,
         contact_jvp,
         parts: match links {
             None if single => crate::method::eba::part_kernels(structure, &layout),
@@ -125,10 +127,11 @@ fn constraint_outputs(cas: &mut Cas, sys: &System, phi: &[ExprId]) -> Vec<ExprId
     outs
 }
 
-/// The `Contact` kernel's outputs (per point p, v = dp/dt, J = dp/dq row
-/// by row) and the `ContactJvp` kernel's (per point dv and dJ along the
-/// direction dq, the `Dir` symbols the `Jvp` kernel reads first).
-fn contact_outputs(cas: &mut Cas, sys: &System) -> (Vec<ExprId>, Vec<ExprId>) {
+/// The `Contact` kernel's outputs (per point p), the `ContactJacobian`
+/// kernel's (per point v = dp/dt, then J = dp/dq row by row) and the
+/// `ContactJvp` kernel's (per point dv and dJ along the direction dq, the
+/// `Dir` symbols the `Jvp` kernel reads first).
+fn contact_outputs(cas: &mut Cas, sys: &System) -> (Vec<ExprId>, Vec<ExprId>, Vec<ExprId>) {
     let mut pairs = sys.coords.rate_pairs();
     pairs.extend(&sys.seeds);
     let names = &sys.coords.names;
@@ -142,7 +145,7 @@ fn contact_outputs(cas: &mut Cas, sys: &System) -> (Vec<ExprId>, Vec<ExprId>) {
             (q, d)
         })
         .collect();
-    let (mut points, mut tangent) = (Vec::new(), Vec::new());
+    let (mut points, mut jacobian, mut tangent) = (Vec::new(), Vec::new(), Vec::new());
     for p in &sys.samples {
         let v = cas.kinematic_rates(p, &pairs);
         let jac: Vec<ExprId> = p
@@ -152,8 +155,9 @@ fn contact_outputs(cas: &mut Cas, sys: &System) -> (Vec<ExprId>, Vec<ExprId>) {
             .collect();
         let dv = cas.time_derivatives(&v, &dq);
         let djac = cas.time_derivatives(&jac, &dq);
-        points.extend(p.iter().chain(&v).chain(&jac));
+        points.extend(p);
+        jacobian.extend(v.iter().chain(&jac));
         tangent.extend(dv.iter().chain(&djac));
     }
-    (points, tangent)
+    (points, jacobian, tangent)
 }

@@ -34,9 +34,10 @@ use crate::tape::{Inputs, Tape};
 ///   acceleration level. Empty for a model without joints.
 /// * `Contact`: the contact points along the arms (and the bodies'
 ///   centres), `ModelInfo::contact_points` of them, each as its position
-///   p (3), velocity v (3) and Jacobian dp/dq (3 x n, row-major): the
-///   runtime finds gaps and forces and maps them by J^T. Empty without
-///   contact.
+///   p (3): the runtime finds the gaps. Empty without contact.
+/// * `ContactJacobian`: each point's velocity v (3) and dp/dq (3 x n,
+///   row-major), which the forces and their map J^T need: evaluated only
+///   when a pair penetrates.
 /// * `ContactJvp`: the same points' dv and d(dp/dq) along the direction
 ///   dq (the first n of `dir`; 3 + 3 n values a point): the exact
 ///   Jacobian of the contact forces, column by column.
@@ -52,11 +53,12 @@ pub enum KernelKind {
     Derived,
     Constraints,
     Contact,
+    ContactJacobian,
     ContactJvp,
 }
 
 impl KernelKind {
-    pub const ALL: [KernelKind; 8] = [
+    pub const ALL: [KernelKind; 9] = [
         Self::Jvp,
         Self::Accel,
         Self::MassBias,
@@ -64,6 +66,7 @@ impl KernelKind {
         Self::Derived,
         Self::Constraints,
         Self::Contact,
+        Self::ContactJacobian,
         Self::ContactJvp,
     ];
 
@@ -76,7 +79,8 @@ impl KernelKind {
             Self::Derived => info.derived,
             Self::Jvp => dof,
             Self::Constraints => info.constraints.len() * (dof + 2),
-            Self::Contact => info.contact_points * (6 + 3 * dof),
+            Self::Contact => info.contact_points * 3,
+            Self::ContactJacobian => info.contact_points * (3 + 3 * dof),
             Self::ContactJvp => info.contact_points * (3 + 3 * dof),
             Self::Accel => {
                 if info.accel {
@@ -97,6 +101,7 @@ impl KernelKind {
             Self::Accel => "accel",
             Self::Constraints => "constraints",
             Self::Contact => "contact",
+            Self::ContactJacobian => "contact_jacobian",
             Self::ContactJvp => "contact_jvp",
         }
     }
@@ -198,6 +203,8 @@ pub struct TapeSet {
     #[serde(default)]
     pub contact: Tape,
     #[serde(default)]
+    pub contact_jacobian: Tape,
+    #[serde(default)]
     pub contact_jvp: Tape,
     /// The layout and kernels of the link recursion (`crate::links`),
     /// which compiled models of the chains it covers use for `MassBias`;
@@ -220,6 +227,7 @@ impl TapeSet {
             KernelKind::Jvp => &self.jvp,
             KernelKind::Constraints => &self.constraints,
             KernelKind::Contact => &self.contact,
+            KernelKind::ContactJacobian => &self.contact_jacobian,
             KernelKind::ContactJvp => &self.contact_jvp,
         }
     }

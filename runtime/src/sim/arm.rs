@@ -351,6 +351,8 @@ pub struct Workspace {
     ldlt: Ldlt,
     /// The constrained solve's buffers, made on first use.
     kkt: Option<crate::constraints::KktWorkspace>,
+    /// The contact forces Q_c of the last evaluation.
+    contact: Vec<f64>,
 }
 
 impl Workspace {
@@ -361,6 +363,7 @@ impl Workspace {
             accel: vec![0.0; 2 * dof],
             ldlt: Ldlt::new(dof),
             kkt: None,
+            contact: vec![0.0; dof],
         }
     }
 
@@ -384,8 +387,10 @@ pub fn accelerations<D: Dynamics + ?Sized>(
 ) -> Result<(), AccelError> {
     let n = ws.n;
     let rows = d.info().constraints.len();
-    let contact = d.contact().is_some();
-    if let Some(set) = d.contact() {
+    // Contact forces that push make the right-hand side M^-1 (Q_c - h);
+    // otherwise it is the contact-free one (with the generated solve).
+    let contact = crate::contact::generalised_force_at(d, t, q, qd, &mut ws.contact);
+    if let Some(set) = d.contact().filter(|s| s.any_held()) {
         let held = set.held_pairs();
         if !held.is_empty() {
             let (a, _) = crate::contact::impact::held_accelerations(d, set, t, q, qd, &held)?;
@@ -397,7 +402,9 @@ pub fn accelerations<D: Dynamics + ?Sized>(
         d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
         if contact {
             let tri = n * (n + 1) / 2;
-            crate::contact::subtract_from_bias(d, t, q, qd, &mut ws.packed[tri..]);
+            for (h, f) in ws.packed[tri..].iter_mut().zip(&ws.contact) {
+                *h -= f;
+            }
         }
         let kkt = ws.kkt.get_or_insert_with(|| {
             crate::constraints::KktWorkspace::new(n, rows, &d.info().blocks)
@@ -412,7 +419,9 @@ pub fn accelerations<D: Dynamics + ?Sized>(
         d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
         if contact {
             let tri = n * (n + 1) / 2;
-            crate::contact::subtract_from_bias(d, t, q, qd, &mut ws.packed[tri..]);
+            for (h, f) in ws.packed[tri..].iter_mut().zip(&ws.contact) {
+                *h -= f;
+            }
         }
         let (mass, bias) = ws.packed.split_at(n * (n + 1) / 2);
         for (a, b) in qdd.iter_mut().zip(bias) {

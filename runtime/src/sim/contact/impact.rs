@@ -58,7 +58,7 @@ pub fn rows<D: Dynamics + ?Sized>(
     pairs: &[usize],
 ) -> ContactRows {
     let n = q.len();
-    let k = PointKinematics::eval(d, t, q, qd);
+    let k = PointKinematics::with_jacobian(d, t, q, qd);
     let mut tangent = vec![0.0; KernelKind::ContactJvp.output_len(d.info())];
     let mut dir = vec![0.0; 2 * n];
     dir[..n].copy_from_slice(qd);

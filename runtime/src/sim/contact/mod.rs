@@ -109,6 +109,9 @@ pub struct ContactSet {
     /// Output channels by name (`contact_<name>_fn`, `_ft`).
     pub channels: Vec<String>,
     pub state: Mutex<ContactState>,
+    scratch: Mutex<Scratch>,
+    /// Some pair's law is `impulse` (only those are ever held).
+    holds: bool,
 }
 
 impl Clone for ContactSet {
@@ -119,6 +122,8 @@ impl Clone for ContactSet {
             pairs: self.pairs.clone(),
             channels: self.channels.clone(),
             state: Mutex::new(self.state()),
+            scratch: Mutex::new(Scratch::default()),
+            holds: self.holds,
         }
     }
 }
@@ -184,6 +189,9 @@ impl ContactSet {
                 }
             }
         }
+        let holds = pairs
+            .iter()
+            .any(|p| matches!(p.law.normal, Normal::Impulse { .. }));
         let state = ContactState {
             touching: vec![false; pairs.len()],
             impact: vec![0.0; pairs.len()],
@@ -194,7 +202,9 @@ impl ContactSet {
             obstacles,
             pairs,
             channels,
+            holds,
             state: Mutex::new(state),
+            scratch: Mutex::new(Scratch::default()),
         }
     }
 
@@ -212,10 +222,18 @@ impl ContactSet {
 
     /// The impulse pairs held now.
     pub fn held_pairs(&self) -> Vec<usize> {
+        if !self.any_held() {
+            return Vec::new();
+        }
         let state = self.state();
         (0..self.pairs.len())
             .filter(|&i| state.held.get(i) == Some(&true))
             .collect()
+    }
+
+    /// Some impulse pair is held (no copy of the state: the hot path asks).
+    pub fn any_held(&self) -> bool {
+        self.holds && self.state.lock().is_ok_and(|s| s.held.iter().any(|&h| h))
     }
 
     /// Some pair keeps records: runs go in legs between contact switches.
@@ -268,39 +286,81 @@ impl ContactSet {
     }
 }
 
-/// The `Contact` kernel's output at one state: per point p, v, J.
+/// The points at one state: the `Contact` kernel's positions, and the
+/// `ContactJacobian` kernel's velocities and dp/dq once asked for
+/// (`velocities`): a right-hand side where nothing touches needs neither.
+#[derive(Debug)]
 pub struct PointKinematics {
     n: usize,
     buf: Vec<f64>,
+    jac: Vec<f64>,
 }
 
 impl PointKinematics {
+    /// The positions of every point.
     pub fn eval<D: Dynamics + ?Sized>(d: &D, t: f64, q: &[f64], qd: &[f64]) -> Self {
-        let n = q.len();
-        let mut buf = vec![0.0; KernelKind::Contact.output_len(d.info())];
-        d.eval_kernel(KernelKind::Contact, t, q, qd, &mut buf);
-        Self { n, buf }
+        let mut k = Self {
+            n: q.len(),
+            buf: Vec::new(),
+            jac: Vec::new(),
+        };
+        k.update(d, t, q, qd);
+        k
     }
 
-    fn block(&self, i: usize) -> &[f64] {
-        let len = 6 + 3 * self.n;
-        &self.buf[i * len..(i + 1) * len]
+    /// Re-evaluate the positions into the same buffers; the velocities
+    /// and Jacobian are dropped.
+    pub fn update<D: Dynamics + ?Sized>(&mut self, d: &D, t: f64, q: &[f64], qd: &[f64]) {
+        self.n = q.len();
+        self.buf
+            .resize(KernelKind::Contact.output_len(d.info()), 0.0);
+        d.eval_kernel(KernelKind::Contact, t, q, qd, &mut self.buf);
+        self.jac.clear();
+    }
+
+    /// Positions, velocities and dp/dq.
+    pub fn with_jacobian<D: Dynamics + ?Sized>(d: &D, t: f64, q: &[f64], qd: &[f64]) -> Self {
+        let mut k = Self::eval(d, t, q, qd);
+        k.velocities(d, t, q, qd);
+        k
+    }
+
+    /// Evaluate the velocities and dp/dq (once).
+    pub fn velocities<D: Dynamics + ?Sized>(&mut self, d: &D, t: f64, q: &[f64], qd: &[f64]) {
+        if self.jac.is_empty() {
+            self.jac
+                .resize(KernelKind::ContactJacobian.output_len(d.info()), 0.0);
+            d.eval_kernel(KernelKind::ContactJacobian, t, q, qd, &mut self.jac);
+        }
+    }
+
+    pub fn has_velocities(&self) -> bool {
+        !self.jac.is_empty()
     }
 
     pub fn position(&self, i: usize) -> [f64; 3] {
-        let b = self.block(i);
+        let b = &self.buf[3 * i..];
         [b[0], b[1], b[2]]
     }
 
+    /// (after `velocities`)
     pub fn velocity(&self, i: usize) -> [f64; 3] {
-        let b = self.block(i);
-        [b[3], b[4], b[5]]
+        let b = &self.jac[i * (3 + 3 * self.n)..];
+        [b[0], b[1], b[2]]
     }
 
-    /// Row c of dp/dq.
+    /// Row c of dp/dq (after `velocities`).
     pub fn jacobian_row(&self, i: usize, c: usize) -> &[f64] {
-        &self.block(i)[6 + c * self.n..6 + (c + 1) * self.n]
+        let start = i * (3 + 3 * self.n) + 3 + c * self.n;
+        &self.jac[start..start + self.n]
     }
+}
+
+/// Buffers of the right-hand side's contact forces, reused.
+#[derive(Debug, Default)]
+struct Scratch {
+    points: Option<PointKinematics>,
+    forces: Vec<PairForce<f64>>,
 }
 
 /// A pair's state: gap, normal force, total force on the point (normal
@@ -370,33 +430,96 @@ fn pair_force<T: DualNum<Primitive = f64> + Copy>(
     }
 }
 
-/// Every pair's force at the given point kinematics (f64).
-pub fn pair_forces(set: &ContactSet, k: &PointKinematics, t: f64) -> Vec<PairForce<f64>> {
-    let state = set.state();
-    set.pairs
-        .iter()
-        .enumerate()
-        .map(|(i, pair)| {
-            let other = match pair.other {
-                Against::Point(j) => Some(Other {
-                    p: k.position(j),
-                    v: k.velocity(j),
-                    radius: set.points[j].radius,
-                }),
-                Against::Obstacle(_) => None,
-            };
-            let v_in = state.impact.get(i).copied().unwrap_or(0.0);
-            pair_force(
-                set,
-                pair,
-                t,
-                k.position(pair.point),
-                k.velocity(pair.point),
-                other,
-                v_in,
-            )
-        })
-        .collect()
+/// Every pair's force at (t, q, qd) (f64); the velocities are evaluated
+/// when a pair penetrates (`all_velocities`: always, so that pairs apart
+/// report their speed too).
+pub fn pair_forces<D: Dynamics + ?Sized>(
+    d: &D,
+    set: &ContactSet,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    all_velocities: bool,
+) -> Vec<PairForce<f64>> {
+    let mut k = PointKinematics::eval(d, t, q, qd);
+    if all_velocities {
+        k.velocities(d, t, q, qd);
+    }
+    let mut out = Vec::new();
+    pair_forces_into(d, set, &mut k, t, q, qd, &mut out);
+    out
+}
+
+/// `pair_forces` on given kinematics into a reused buffer: the gaps from
+/// the positions, and, when one penetrates (or the velocities are there),
+/// every pair's forces.
+fn pair_forces_into<D: Dynamics + ?Sized>(
+    d: &D,
+    set: &ContactSet,
+    k: &mut PointKinematics,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    out: &mut Vec<PairForce<f64>>,
+) {
+    out.clear();
+    let apart = |gap: f64| PairForce {
+        gap,
+        normal: 0.0,
+        force: [0.0; 3],
+        friction: 0.0,
+        approach: 0.0,
+        power: 0.0,
+    };
+    if !k.has_velocities() {
+        out.extend(set.pairs.iter().map(|pair| apart(gap_of(set, pair, k, t))));
+        if out.iter().all(|f| f.gap >= 0.0) {
+            return;
+        }
+        k.velocities(d, t, q, qd);
+        out.clear();
+    }
+    let guard = set.state.lock();
+    let empty = ContactState::default();
+    let state = guard.as_deref().unwrap_or(&empty);
+    out.extend(set.pairs.iter().enumerate().map(|(i, pair)| {
+        let other = match pair.other {
+            Against::Point(j) => Some(Other {
+                p: k.position(j),
+                v: k.velocity(j),
+                radius: set.points[j].radius,
+            }),
+            Against::Obstacle(_) => None,
+        };
+        let v_in = state.impact.get(i).copied().unwrap_or(0.0);
+        pair_force(
+            set,
+            pair,
+            t,
+            k.position(pair.point),
+            k.velocity(pair.point),
+            other,
+            v_in,
+        )
+    }));
+}
+
+/// A pair's gap from the positions alone.
+fn gap_of(set: &ContactSet, pair: &Pair, k: &PointKinematics, t: f64) -> f64 {
+    let p = k.position(pair.point);
+    let r = set.points[pair.point].radius;
+    match pair.other {
+        Against::Obstacle(o) => {
+            let ob = &set.obstacles[o];
+            let offset = ob.motion.as_ref().map_or([0.0; 3], |m| m.at(t).0);
+            ob.shape.distance(p, offset).0 - r
+        }
+        Against::Point(j) => {
+            let b = k.position(j);
+            let d = [0, 1, 2].map(|c| p[c] - b[c]);
+            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() - set.points[j].radius - r
+        }
+    }
 }
 
 /// Add the generalised contact force Q_c = sum J^T f to `q_force`.
@@ -434,14 +557,47 @@ pub fn subtract_from_bias<D: Dynamics + ?Sized>(
     qd: &[f64],
     h: &mut [f64],
 ) {
-    let Some(set) = d.contact() else { return };
-    let k = PointKinematics::eval(d, t, q, qd);
-    let forces = pair_forces(set, &k, t);
-    let mut qc = vec![0.0; q.len()];
-    generalised_force(set, &k, &forces, &mut qc);
-    for (h, f) in h.iter_mut().zip(qc) {
-        *h -= f;
+    let mut q_force = vec![0.0; q.len()];
+    if generalised_force_at(d, t, q, qd, &mut q_force) {
+        for (h, f) in h.iter_mut().zip(&q_force) {
+            *h -= f;
+        }
     }
+}
+
+/// Q_c at (t, q, qd) into `q_force`; false (and `q_force` untouched) when
+/// no pair pushes. The hot path: buffers are reused, and the points'
+/// velocities and Jacobian are evaluated only when a pair penetrates.
+pub fn generalised_force_at<D: Dynamics + ?Sized>(
+    d: &D,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    q_force: &mut [f64],
+) -> bool {
+    let Some(set) = d.contact() else {
+        return false;
+    };
+    let mut guard = set.scratch.lock();
+    let fresh = &mut Scratch::default();
+    let s = match guard.as_deref_mut() {
+        Ok(s) => s,
+        Err(_) => fresh,
+    };
+    let k = match &mut s.points {
+        Some(k) => {
+            k.update(d, t, q, qd);
+            k
+        }
+        None => s.points.insert(PointKinematics::eval(d, t, q, qd)),
+    };
+    pair_forces_into(d, set, k, t, q, qd, &mut s.forces);
+    if s.forces.iter().all(|f| f.normal == 0.0) {
+        return false;
+    }
+    q_force.fill(0.0);
+    generalised_force(set, k, &s.forces, q_force);
+    true
 }
 
 /// Subtract dQ_c/dq and dQ_c/dqd from the Jacobian parts of tau
@@ -457,8 +613,9 @@ pub fn subtract_from_jacobian<D: Dynamics + ?Sized>(
 ) {
     let Some(set) = d.contact() else { return };
     let n = q.len();
-    let k = PointKinematics::eval(d, t, q, qd);
-    let forces = pair_forces(set, &k, t);
+    let mut k = PointKinematics::with_jacobian(d, t, q, qd);
+    let mut forces = Vec::new();
+    pair_forces_into(d, set, &mut k, t, q, qd, &mut forces);
     // Only touching pairs have force or derivative.
     let active: Vec<usize> = (0..set.pairs.len())
         .filter(|&i| forces[i].gap < 0.0)
@@ -570,8 +727,7 @@ pub fn switching_gap<D: Dynamics + ?Sized>(
     q: &[f64],
     qd: &[f64],
 ) -> f64 {
-    let k = PointKinematics::eval(d, t, q, qd);
-    let forces = pair_forces(set, &k, t);
+    let forces = pair_forces(d, set, t, q, qd, false);
     let state = set.state();
     let held = set.held_pairs();
     let pushing = if held.is_empty() {
@@ -598,8 +754,7 @@ pub fn power_and_depth<D: Dynamics + ?Sized>(
     q: &[f64],
     qd: &[f64],
 ) -> (f64, f64) {
-    let k = PointKinematics::eval(d, t, q, qd);
-    let forces = pair_forces(set, &k, t);
+    let forces = pair_forces(d, set, t, q, qd, false);
     let power = forces.iter().map(|f| f.power).sum();
     let depth = forces.iter().map(|f| -f.gap).fold(0.0, f64::max);
     (power, depth)
@@ -615,8 +770,7 @@ pub fn potential_energy<D: Dynamics + ?Sized>(
     q: &[f64],
     qd: &[f64],
 ) -> f64 {
-    let k = PointKinematics::eval(d, t, q, qd);
-    let forces = pair_forces(set, &k, t);
+    let forces = pair_forces(d, set, t, q, qd, false);
     set.pairs
         .iter()
         .zip(&forces)

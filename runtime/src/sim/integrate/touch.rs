@@ -11,7 +11,7 @@ use super::failure::SimFailure;
 use super::options::SimOptions;
 use super::record::{SimStats, Trajectory};
 use crate::arm::Dynamics;
-use crate::contact::{PointKinematics, impact, pair_forces};
+use crate::contact::{impact, pair_forces};
 
 /// Legs that end within this time of their start before the run gives up:
 /// contacts that switch without the time moving (a chattering contact).
@@ -31,7 +31,6 @@ pub(super) fn run<D: Dynamics + ?Sized>(
     let (mut t0, mut x) = (0.0, x0);
     let mut stalled = 0;
     loop {
-        let k = PointKinematics::eval(arm, t0, &x[..n], &x[n..]);
         let held = set.held_pairs();
         let held_forces: Vec<(usize, f64)> = if held.is_empty() {
             Vec::new()
@@ -40,7 +39,8 @@ pub(super) fn run<D: Dynamics + ?Sized>(
                 .map_err(|e| fail_at(t0, &x, &traj, &stats, e.to_string()))?;
             held.into_iter().zip(f).collect()
         };
-        let began = set.update_records(&pair_forces(set, &k, t0), &held_forces);
+        let forces = pair_forces(arm, set, t0, &x[..n], &x[n..], true);
+        let began = set.update_records(&forces, &held_forces);
         let hits: Vec<usize> = began
             .into_iter()
             .filter(|&i| impact::restitution(set, i).is_some())
