@@ -17,6 +17,8 @@
 //! away (what contact adds is `rhs:MODEL` minus this); `points:MODEL` the
 //! `Contact` kernel alone (the points' positions); `straight:MODEL` the
 //! right-hand side at q = qd = 0 instead of the default state;
+//! `forces:MODEL` the contact forces alone (`generalised_force_at`);
+//! `Q=q0,q1,...` (env) times every model at that configuration, at rest;
 //! `recursion:tentacle3d` the numeric element-by-element
 //! recursion of tests/common/pcc3d.rs.
 
@@ -74,6 +76,10 @@ fn main() {
                 Some(m) => (true, m),
                 None => (false, model),
             };
+            let (forces, model) = match model.strip_prefix("forces:") {
+                Some(m) => (true, m),
+                None => (false, model),
+            };
             let (straight, model) = match model.strip_prefix("straight:") {
                 Some(m) => (true, m),
                 None => (false, model),
@@ -103,14 +109,34 @@ fn main() {
                 })
                 .collect();
             let qd: Vec<f64> = (0..dof).map(|i| 0.2 * ((i as f64) * 1.3).cos()).collect();
-            let (q, qd) = if straight {
-                (vec![0.0; dof], vec![0.0; dof])
-            } else {
-                (q, qd)
+            let given: Option<Vec<f64>> = std::env::var("Q").ok().map(|s| {
+                s.split(',')
+                    .map(|v| v.trim().parse().expect("Q: numbers"))
+                    .collect()
+            });
+            let (q, qd) = match (straight, given) {
+                (true, _) => (vec![0.0; dof], vec![0.0; dof]),
+                (false, Some(g)) => {
+                    assert_eq!(g.len(), dof, "Q: {dof} coordinates");
+                    (g, vec![0.0; dof])
+                }
+                (false, None) => (q, qd),
             };
             let rhs = rhs || straight;
             let mut out = vec![0.0; KernelKind::MassBias.output_len(l.arm.info())];
-            if rhs {
+            if forces {
+                let mut qc = vec![0.0; dof];
+                Box::new(move || {
+                    runtime::contact::generalised_force_at(
+                        &*l.arm,
+                        0.0,
+                        black_box(&q),
+                        black_box(&qd),
+                        &mut qc,
+                    );
+                    black_box(&qc);
+                })
+            } else if rhs {
                 let mut ws = runtime::Workspace::new(dof);
                 let mut qdd = vec![0.0; dof];
                 Box::new(move || {

@@ -573,3 +573,76 @@ exponent = {n_exp}
         "depth of the law",
     );
 }
+
+/// The sampled points of an arm bent to one circle (every element by the
+/// same angle, planar pcc and 3D pcc) lie where the circle puts them:
+/// (sin(k s) / k, (1 - cos(k s)) / k) at arc length s, at curvatures from
+/// straight to a half turn.
+#[test]
+fn sampled_points_lie_on_the_arc() {
+    for dimensions in [2, 3] {
+        let twist = if dimensions == 3 { "twist = false" } else { "" };
+        let text = format!(
+            r#"
+name = "arc"
+dimensions = {dimensions}
+gravity = [0.0, 0.0, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.4
+elements = 4
+mass = 0.1
+bending_stiffness = 0.5
+{twist}
+[[obstacle]]
+name = "far"
+shape = "plane"
+point = [0.0, -10.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+[contact]
+model = "hertz"
+stiffness = 1.0
+points_per_element = 3
+"#
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let l = load_text(dir.path(), &text, &[]);
+        let n = l.arm.dof();
+        let names = l.arm.info().coordinates.clone();
+        for kappa in [0.0, 1.0, 7.85] {
+            // Bend about z: theta_k (planar) or bend_z (3D) = kappa l_e.
+            let q: Vec<f64> = names
+                .iter()
+                .map(|c| {
+                    if c.starts_with("theta") || c.starts_with("bend_z") {
+                        kappa * 0.1
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            let mut buf = vec![0.0; 3 * l.arm.info().contact_points];
+            l.arm.eval_kernel(
+                runtime::KernelKind::Contact,
+                0.0,
+                &q,
+                &vec![0.0; n],
+                &mut buf,
+            );
+            for (i, p) in buf.chunks(3).enumerate() {
+                let s = 0.4 * (i + 1) as f64 / 12.0;
+                let (x, y) = if kappa == 0.0 {
+                    (s, 0.0)
+                } else {
+                    ((kappa * s).sin() / kappa, (1.0 - (kappa * s).cos()) / kappa)
+                };
+                let what = format!("{dimensions}D kappa {kappa} point {i}");
+                assert_abs(p[0], x, 1e-14, &what);
+                assert_abs(p[1], y, 1e-14, &what);
+                assert_abs(p[2], 0.0, 1e-14, &what);
+            }
+        }
+    }
+}

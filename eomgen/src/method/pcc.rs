@@ -22,13 +22,10 @@ impl ModellingMethod for Pcc {
     }
 
     fn place_planar(&self, cas: &mut Cas, arm: &mut PlanarArm, _g: &SegmentShape, el: &Element2) {
-        // The arc's first fraction s is the arc of length s l bent by s theta.
-        let (f, l, m, q, qd) = (arm.f, el.l, el.m, el.q, el.qd);
-        arm.sample(cas, |cas, s| {
-            let [sl, sq, sqd] = [l, q, qd].map(|e| cas.scaled(s, e));
-            let end = pcc_element(cas, f, sl, m, sq, sqd).3;
-            [end.x, end.y]
-        });
+        if arm.points > 0 {
+            let points = arc_points(cas, arm.f, el.l, el.q, arm.points);
+            arm.sample_all(cas, points);
+        }
         let (c, chord_rate, arc_inertia, end) = pcc_element(cas, arm.f, el.l, el.m, el.q, el.qd);
         let total = cas.add(arc_inertia, el.inertia);
         arm.body(cas, c, chord_rate, el.m, total);
@@ -109,4 +106,55 @@ fn pcc_element(
     let moved = planar::advance(cas, chord, len);
     let end = planar::rotate(cas, moved, half_theta, half_rate);
     (c, chord.w, cas.bind(arc), end)
+}
+
+/// The points at s = j/P (j = 1..P) of a planar arc of length l bent by
+/// theta from frame f: the arc's first fraction s is the arc of length s l
+/// bent by s theta, whose chord is s l sinc(s theta / 2) at the angle
+/// phi + s theta / 2. With a = theta / (2P), c = cos a and u = e^{i a},
+/// the chord directions are e^{i phi} u^j and
+/// sinc(j a) = sinc(a) U_{j-1}(c) / j (Chebyshev's U: sin(j a) =
+/// sin(a) U_{j-1}(cos a)), so the P points cost one sin_cos of phi, one of
+/// a and one sinc, not P of each; theta = 0 is an ordinary point.
+fn arc_points(
+    cas: &mut Cas,
+    f: Frame,
+    l: ExprId,
+    theta: ExprId,
+    points: usize,
+) -> Vec<[ExprId; 2]> {
+    let a = cas.scaled(0.5 / points as f64, theta);
+    let (ca, sa) = (cas.cos(a), cas.sin(a));
+    let (ca, sa) = (cas.bind(ca), cas.bind(sa));
+    let sinc_a = cas.sinc(a);
+    let sinc_a = cas.bind(sinc_a);
+    let (cp, sp) = (cas.cos(f.phi), cas.sin(f.phi));
+    let (cp, sp) = (cas.bind(cp), cas.bind(sp));
+    // u^j = (re, im), U_{j-1}(c): running products.
+    let (mut re, mut im) = (cp, sp);
+    let one = cas.one();
+    let two_c = cas.scaled(2.0, ca);
+    let (mut u_prev, mut u) = (cas.zero(), one);
+    let mut out = Vec::with_capacity(points);
+    for _ in 0..points {
+        // Direction e^{i (phi + j a)}, j = 1, 2, ...
+        let (r1, r2) = (cas.mul(re, ca), cas.mul(im, sa));
+        let (i1, i2) = (cas.mul(re, sa), cas.mul(im, ca));
+        let next_re = cas.sub(r1, r2);
+        let next_im = cas.add(i1, i2);
+        re = cas.bind(next_re);
+        im = cas.bind(next_im);
+        // Chord length s l sinc(j a) = l sinc(a) U_{j-1}(c) / P.
+        let len = cas.mul_all(&[l, sinc_a, u]);
+        let len = cas.scaled(1.0 / points as f64, len);
+        let len = cas.bind(len);
+        let (dx, dy) = (cas.mul(len, re), cas.mul(len, im));
+        out.push([cas.add(f.x, dx), cas.add(f.y, dy)]);
+        // U_j = 2 c U_{j-1} - U_{j-2}.
+        let t = cas.mul(two_c, u);
+        let next = cas.sub(t, u_prev);
+        u_prev = u;
+        u = cas.bind(next);
+    }
+    out
 }

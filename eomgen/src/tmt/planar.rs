@@ -198,6 +198,16 @@ impl<'a> PlanarArm<'a> {
         }
     }
 
+    /// Contact points along the element given all at once (P of them, at
+    /// s = 1/P, ..., 1), by a method that shares work between them.
+    pub fn sample_all(&mut self, cas: &mut Cas, points: Vec<[ExprId; 2]>) {
+        debug_assert_eq!(points.len(), self.points);
+        for [x, y] in points {
+            let point = [cas.bind(x), cas.bind(y), self.z];
+            self.samples.push(point);
+        }
+    }
+
     /// The element ends at the end frame: its link, spring and damper.
     pub fn end_element(&mut self, cas: &mut Cas, el: &Element2) {
         let (zero, f) = (self.zero, self.f);

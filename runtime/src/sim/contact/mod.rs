@@ -109,7 +109,7 @@ pub struct ContactSet {
     /// Output channels by name (`contact_<name>_fn`, `_ft`).
     pub channels: Vec<String>,
     pub state: Mutex<ContactState>,
-    scratch: Mutex<Scratch>,
+    scratch: std::cell::RefCell<Scratch>,
     /// Some pair's law is `impulse` (only those are ever held).
     holds: bool,
 }
@@ -122,7 +122,7 @@ impl Clone for ContactSet {
             pairs: self.pairs.clone(),
             channels: self.channels.clone(),
             state: Mutex::new(self.state()),
-            scratch: Mutex::new(Scratch::default()),
+            scratch: std::cell::RefCell::new(Scratch::default()),
             holds: self.holds,
         }
     }
@@ -204,7 +204,7 @@ impl ContactSet {
             channels,
             holds,
             state: Mutex::new(state),
-            scratch: Mutex::new(Scratch::default()),
+            scratch: std::cell::RefCell::new(Scratch::default()),
         }
     }
 
@@ -338,6 +338,7 @@ impl PointKinematics {
         !self.jac.is_empty()
     }
 
+    #[inline]
     pub fn position(&self, i: usize) -> [f64; 3] {
         let b = &self.buf[3 * i..];
         [b[0], b[1], b[2]]
@@ -504,13 +505,43 @@ fn pair_forces_into<D: Dynamics + ?Sized>(
     }));
 }
 
-/// A pair's gap from the positions alone.
+/// Whether any pair penetrates: every right-hand side asks, so fixed
+/// planes (every point against each) are one tight loop over the points,
+/// the other pairs one by one.
+fn any_penetrates(set: &ContactSet, k: &PointKinematics, t: f64) -> bool {
+    for o in &set.obstacles {
+        if let (Shape::Plane { point, normal }, None) = (&o.shape, &o.motion) {
+            let c = point[0] * normal[0] + point[1] * normal[1] + point[2] * normal[2];
+            let hit = k.buf.chunks_exact(3).zip(&set.points).any(|(p, pt)| {
+                p[0] * normal[0] + p[1] * normal[1] + p[2] * normal[2] - pt.radius < c
+            });
+            if hit {
+                return true;
+            }
+        }
+    }
+    set.pairs.iter().any(|pair| {
+        let fixed_plane = matches!(pair.other, Against::Obstacle(o)
+            if matches!((&set.obstacles[o].shape, &set.obstacles[o].motion), (Shape::Plane { .. }, None)));
+        !fixed_plane && gap_of(set, pair, k, t) < 0.0
+    })
+}
+
+/// A pair's gap from the positions alone: every pair, every right-hand
+/// side, so a fixed plane (the common obstacle) takes the short way.
+#[inline]
 fn gap_of(set: &ContactSet, pair: &Pair, k: &PointKinematics, t: f64) -> f64 {
     let p = k.position(pair.point);
     let r = set.points[pair.point].radius;
     match pair.other {
         Against::Obstacle(o) => {
             let ob = &set.obstacles[o];
+            if let (Shape::Plane { point, normal }, None) = (&ob.shape, &ob.motion) {
+                return (p[0] - point[0]) * normal[0]
+                    + (p[1] - point[1]) * normal[1]
+                    + (p[2] - point[2]) * normal[2]
+                    - r;
+            }
             let offset = ob.motion.as_ref().map_or([0.0; 3], |m| m.at(t).0);
             ob.shape.distance(p, offset).0 - r
         }
@@ -578,12 +609,9 @@ pub fn generalised_force_at<D: Dynamics + ?Sized>(
     let Some(set) = d.contact() else {
         return false;
     };
-    let mut guard = set.scratch.lock();
-    let fresh = &mut Scratch::default();
-    let s = match guard.as_deref_mut() {
-        Ok(s) => s,
-        Err(_) => fresh,
-    };
+    // Not re-entered: nothing below evaluates contact forces.
+    let mut guard = set.scratch.borrow_mut();
+    let s = &mut *guard;
     let k = match &mut s.points {
         Some(k) => {
             k.update(d, t, q, qd);
@@ -591,6 +619,10 @@ pub fn generalised_force_at<D: Dynamics + ?Sized>(
         }
         None => s.points.insert(PointKinematics::eval(d, t, q, qd)),
     };
+    // Most right-hand sides touch nothing: a gap check and out.
+    if !any_penetrates(set, k, t) {
+        return false;
+    }
     pair_forces_into(d, set, k, t, q, qd, &mut s.forces);
     if s.forces.iter().all(|f| f.normal == 0.0) {
         return false;
