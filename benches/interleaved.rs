@@ -132,6 +132,7 @@ fn main() {
                         0.0,
                         black_box(&q),
                         black_box(&qd),
+                        None,
                         &mut qc,
                     );
                     black_box(&qc);

@@ -21,6 +21,8 @@ pub mod ebr_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod falling_ball;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod finger_free;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod finger_tap;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod hybrid_arm;
@@ -105,6 +107,13 @@ pub static MODELS: &[CompiledModel] = &[
         dof: falling_ball::DOF,
         source: include_str!("../models/falling_ball.toml"),
         kernels: || Box::new(falling_ball::Compiled::default()),
+    },
+    CompiledModel {
+        name: "finger_free",
+        hash: finger_free::HASH,
+        dof: finger_free::DOF,
+        source: include_str!("../models/finger_free.toml"),
+        kernels: || Box::new(finger_free::Compiled::default()),
     },
     CompiledModel {
         name: "finger_tap",

@@ -204,7 +204,7 @@ fn generated_mass_solve_matches_a_dense_solve() {
         for _ in 0..10 {
             let q = rng.coordinates(&arm.info().coordinates, -2.0, 2.0);
             let qd = rng.vec(n, -3.0, 3.0);
-            let mut out = vec![0.0; 2 * n];
+            let mut out = vec![0.0; KernelKind::Accel.output_len(arm.info())];
             arm.eval_kernel(KernelKind::Accel, 0.0, &q, &qd, &mut out);
             // The kernel's own M and h (`Dynamics::mass_bias` adds contact
             // forces, which the Accel kernel does not see).
@@ -231,6 +231,36 @@ fn generated_mass_solve_matches_a_dense_solve() {
                     &format!("{} qdd[{i}]", m.name),
                 );
                 assert!(out[n + i] > 0.0, "{}: pivot {i} not positive", m.name);
+            }
+            // Its factors: L D L^T is M.
+            let (d, lower) = (&out[n..2 * n], &out[2 * n..]);
+            let l = |i: usize, j: usize| match i.cmp(&j) {
+                std::cmp::Ordering::Equal => 1.0,
+                std::cmp::Ordering::Less => 0.0,
+                std::cmp::Ordering::Greater => lower[i * (i - 1) / 2 + j],
+            };
+            let m_scale = mm.amax();
+            for i in 0..n {
+                for j in 0..n {
+                    let ldlt: f64 = (0..n).map(|k| l(i, k) * d[k] * l(j, k)).sum();
+                    let what = format!("{} (L D L^T)[{i}][{j}]", m.name);
+                    assert_close(ldlt, mm[(i, j)], 1e-12, m_scale, &what);
+                }
+            }
+            // The contact points it carries are the Contact kernel's.
+            let points = arm.info().contact_points;
+            let mut reference = vec![0.0; 3 * points];
+            arm.eval_kernel(KernelKind::Contact, 0.0, &q, &qd, &mut reference);
+            let carried = &out[2 * n + n * (n - 1) / 2..];
+            assert_eq!(carried.len(), 3 * points, "{}: points carried", m.name);
+            for (i, (a, b)) in carried.iter().zip(&reference).enumerate() {
+                assert_close(
+                    *a,
+                    *b,
+                    1e-14,
+                    1.0,
+                    &format!("{} point coordinate {i}", m.name),
+                );
             }
         }
     }

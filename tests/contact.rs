@@ -646,3 +646,53 @@ points_per_element = 3
         }
     }
 }
+
+/// finger_tap is finger_free with a table: above the table their
+/// right-hand sides agree (the generated solve that carries the contact
+/// points changes nothing), and pressed into it finger_tap's is the
+/// dense solve of M qdd = Q_c - h, with Q_c found from the `Contact`
+/// kernel's points and M, h from `MassBias` (a second path through the
+/// contact forces and the mass solve: the hot path takes the points from
+/// the `Accel` kernel and solves by its L D L^T factors).
+#[test]
+fn finger_tap_is_finger_free_until_it_touches() {
+    use softarm::backend::{BackendChoice, load};
+    let tap = load("finger_tap", &[], BackendChoice::Compiled, None).unwrap();
+    let free = load("finger_free", &[], BackendChoice::Compiled, None).unwrap();
+    let n = tap.arm.dof();
+    let qd: Vec<f64> = (0..n).map(|i| 0.3 * (i as f64 * 0.9).cos()).collect();
+    // Bent up (away from the table), then down onto it by 0.02 to 0.08 rad
+    // an element: the tip goes from well above to well into the table.
+    let mut touched = 0;
+    for bend in [0.05, -0.02, -0.05, -0.065, -0.08] {
+        let q: Vec<f64> = (0..n).map(|i| bend * (1.0 + 0.05 * i as f64)).collect();
+        let a_tap = accelerations(&tap, 0.5, &q, &qd);
+        let a_free = accelerations(&free, 0.5, &q, &qd);
+        let mut m = nalgebra::DMatrix::zeros(n, n);
+        let mut h = nalgebra::DVector::zeros(n);
+        tap.arm.mass_bias(0.5, &q, &qd, &mut m, &mut h);
+        let dense = m.cholesky().expect("M is SPD").solve(&(-h));
+        let tip_y = tap.arm.outputs(0.5, &q, &qd)[1];
+        let touches = tip_y - 0.008 < -0.035;
+        let scale = dense.amax();
+        for i in 0..n {
+            let what = format!("bend {bend} (tip y {tip_y:.4}) qdd[{i}]");
+            assert_close(a_tap[i], dense[i], 1e-9, scale, &what);
+            if !touches {
+                assert_close(a_tap[i], a_free[i], 1e-12, scale, &what);
+            }
+        }
+        if touches {
+            // At rest (moving away, the damped law may not push at all).
+            let rest = vec![0.0; n];
+            let (a_tap, a_free) = (
+                accelerations(&tap, 0.5, &q, &rest),
+                accelerations(&free, 0.5, &q, &rest),
+            );
+            let differs = (0..n).any(|i| (a_tap[i] - a_free[i]).abs() > 1e-6 * scale);
+            assert!(differs, "bend {bend}: the table pushes");
+            touched += 1;
+        }
+    }
+    assert_eq!(touched, 3, "states pressed into the table");
+}

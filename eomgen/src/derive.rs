@@ -57,8 +57,18 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
         && !links.as_ref().is_some_and(|l| l.mass_bias)
         && phi.is_empty();
     let accel_tape = if accel {
-        let (qdd, pivots) = solve_accelerations(&mut cas, &eq.mass_upper, &eq.bias);
-        let outs: Vec<_> = qdd.into_iter().chain(pivots).collect();
+        // The contact points ride along: their positions share the
+        // kinematics' trig with M and h, and a right-hand side that touches
+        // nothing needs nothing else.
+        let s = solve_accelerations(&mut cas, &eq.mass_upper, &eq.bias);
+        let points = sys.samples.iter().flatten().copied();
+        let outs: Vec<_> = s
+            .qdd
+            .into_iter()
+            .chain(s.pivots)
+            .chain(s.lower)
+            .chain(points)
+            .collect();
         cas.to_tape_hoisted(&outs, &mut hoist)
     } else {
         runtime::Tape::default()
@@ -70,14 +80,19 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
         let outs = constraint_outputs(&mut cas, &sys, &phi);
         cas.to_tape_hoisted(&outs, &mut hoist)
     };
-    let (contact, contact_jacobian, contact_jvp) = if sys.samples.is_empty() {
+    let (contact, contact_jacobian, contact_jvp, contact_groups) = if sys.samples.is_empty() {
         Default::default()
     } else {
-        let (points, jacobian, tangent) = contact_outputs(&mut cas, &sys);
+        let c = contact_outputs(&mut cas, &sys);
+        let groups: Vec<usize> = c.groups.iter().map(|g| g.len() / c.width).collect();
         (
-            cas.to_tape_hoisted(&points, &mut hoist),
-            cas.to_tape_hoisted(&jacobian, &mut hoist),
-            cas.to_tape_hoisted(&tangent, &mut hoist),
+            cas.to_tape_hoisted(&c.points, &mut hoist),
+            c.groups
+                .iter()
+                .map(|g| cas.to_tape_hoisted(g, &mut hoist))
+                .collect(),
+            cas.to_tape_hoisted(&c.tangent, &mut hoist),
+            groups,
         )
     };
     let derived = hoist.finish(&mut cas);
@@ -92,6 +107,7 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
             constraints: rows,
             blocks,
             contact_points: sys.samples.len(),
+            contact_groups,
         },
         mass_bias,
         outputs,
@@ -127,14 +143,27 @@ fn constraint_outputs(cas: &mut Cas, sys: &System, phi: &[ExprId]) -> Vec<ExprId
     outs
 }
 
-/// The `Contact` kernel's outputs (per point p), the `ContactJacobian`
-/// kernel's (per point v = dp/dt, then J = dp/dq row by row) and the
-/// `ContactJvp` kernel's (per point dv and dJ along the direction dq, the
-/// `Dir` symbols the `Jvp` kernel reads first).
-fn contact_outputs(cas: &mut Cas, sys: &System) -> (Vec<ExprId>, Vec<ExprId>, Vec<ExprId>) {
+/// The contact kernels' outputs: the `Contact` kernel's (per point p), the
+/// `ContactJacobian` kernel's in groups (per point v = dp/dt, then
+/// J = dp/dq row by row) and the `ContactJvp` kernel's (per point dv and
+/// dJ along the direction dq, the `Dir` symbols the `Jvp` kernel reads
+/// first).
+struct ContactOutputs {
+    points: Vec<ExprId>,
+    /// Consecutive points that depend on the same coordinates (an arm
+    /// element's, a body's), at most 2 n groups: the runtime evaluates the
+    /// groups of the points that touch, selected by `dir`.
+    groups: Vec<Vec<ExprId>>,
+    tangent: Vec<ExprId>,
+    /// Outputs per point in a group: 3 + 3 n.
+    width: usize,
+}
+
+fn contact_outputs(cas: &mut Cas, sys: &System) -> ContactOutputs {
     let mut pairs = sys.coords.rate_pairs();
     pairs.extend(&sys.seeds);
     let names = &sys.coords.names;
+    let n = sys.coords.q.len();
     let dq: Vec<(ExprId, ExprId)> = sys
         .coords
         .q
@@ -145,7 +174,9 @@ fn contact_outputs(cas: &mut Cas, sys: &System) -> (Vec<ExprId>, Vec<ExprId>, Ve
             (q, d)
         })
         .collect();
-    let (mut points, mut jacobian, mut tangent) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut points, mut tangent) = (Vec::new(), Vec::new());
+    // (coordinates the point depends on, its v and J)
+    let mut per_point: Vec<(Vec<bool>, Vec<ExprId>)> = Vec::new();
     for p in &sys.samples {
         let v = cas.kinematic_rates(p, &pairs);
         let jac: Vec<ExprId> = p
@@ -155,9 +186,30 @@ fn contact_outputs(cas: &mut Cas, sys: &System) -> (Vec<ExprId>, Vec<ExprId>, Ve
             .collect();
         let dv = cas.time_derivatives(&v, &dq);
         let djac = cas.time_derivatives(&jac, &dq);
+        let depends: Vec<bool> = (0..n)
+            .map(|k| (0..3).any(|c| !cas.is_zero(jac[c * n + k])))
+            .collect();
         points.extend(p);
-        jacobian.extend(v.iter().chain(&jac));
+        per_point.push((depends, v.iter().chain(&jac).copied().collect()));
         tangent.extend(dv.iter().chain(&djac));
     }
-    (points, jacobian, tangent)
+    let mut groups: Vec<(Vec<bool>, Vec<ExprId>)> = Vec::new();
+    for (depends, outs) in per_point {
+        match groups.last_mut() {
+            Some((d, g)) if *d == depends => g.extend(outs),
+            _ => groups.push((depends, outs)),
+        }
+    }
+    let mut groups: Vec<Vec<ExprId>> = groups.into_iter().map(|(_, g)| g).collect();
+    // `dir` (2 n values) selects the groups: merge neighbours past that.
+    let per = groups.len().div_ceil((2 * n).max(1));
+    if per > 1 {
+        groups = groups.chunks(per).map(|c| c.concat()).collect();
+    }
+    ContactOutputs {
+        points,
+        groups,
+        tangent,
+        width: 3 + 3 * n,
+    }
 }

@@ -885,6 +885,42 @@ impl Family {
     }
 }
 
+/// The `contact_jacobian` kernel: one kernel per group of points, and the
+/// function that runs the groups `dir` selects (all of them when `all`).
+fn emit_groups(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream {
+    let info = &tapes.info;
+    let n_dir = 2 * dof;
+    let width = 3 + 3 * dof;
+    let n_out = info.contact_points * width;
+    let mut kernels = Vec::new();
+    let mut calls = Vec::new();
+    let groups = info.contact_group_ranges();
+    for (g, ((first, len), tape)) in groups.zip(&tapes.contact_jacobian).enumerate() {
+        let name = format!("contact_jacobian_{g}");
+        kernels.push(KernelEmitter::new(tape).emit(&name, dof, n_params));
+        let f = Ident::new(&name, Span::call_site());
+        let (a, b) = (first * width, (first + len) * width);
+        calls.push(quote! {
+            if all || dir[#g] != 0.0 {
+                #f(t, q, qd, qdd, dir, p, (&mut out[#a..#b]).try_into().expect("group output length"));
+            }
+        });
+    }
+    let doc = format!(
+        " Kernel `contact_jacobian`: the points' velocities and Jacobians in {} groups; group g runs when `all` or `dir[g] != 0`.",
+        info.contact_groups.len()
+    );
+    quote! {
+        #[doc = #doc]
+        #[allow(unused_variables)]
+        pub fn contact_jacobian(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir],
+                                all: bool, p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+            #(#calls)*
+        }
+        #(#kernels)*
+    }
+}
+
 /// The header line that carries the structural hash.
 pub const HASH_PREFIX: &str = "// structural-hash: ";
 
@@ -900,6 +936,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     let rows = &info.constraints;
     let blocks = &info.blocks;
     let contact_points = info.contact_points;
+    let contact_groups = &info.contact_groups;
     let hash = &info.hash;
     let coords = &info.coordinates;
     let params = &info.parameters;
@@ -918,12 +955,21 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
             // Emitted with the recursion, below.
             (Some(_), KernelKind::Jvp | KernelKind::Outputs) => {}
             (Some(links), KernelKind::MassBias) if links.mass_bias => {}
-            _ => kernels.push(KernelEmitter::new(tapes.tape(kind)).emit(name, dof, n_params)),
+            (_, KernelKind::ContactJacobian) => kernels.push(emit_groups(tapes, dof, n_params)),
+            _ => {
+                let tape = &tapes.tapes(kind)[0];
+                kernels.push(KernelEmitter::new(tape).emit(name, dof, n_params))
+            }
         }
         let f = Ident::new(name, Span::call_site());
         let variant = Ident::new(&format!("{kind:?}"), Span::call_site());
+        // A grouped kernel reads an empty direction as "every group".
+        let all = match kind {
+            KernelKind::ContactJacobian => quote!(inp.dir.is_empty(),),
+            _ => quote!(),
+        };
         arms.push(quote! {
-            KernelKind::#variant => #f(inp.t, q, qd, qdd, dir, p, out.try_into().expect("output length")),
+            KernelKind::#variant => #f(inp.t, q, qd, qdd, dir, #all p, out.try_into().expect("output length")),
         });
     }
     if let Some(parts) = &tapes.parts {
@@ -954,6 +1000,8 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         pub const BLOCKS: &[usize] = &[#(#blocks),*];
         /// Contact points along the arms and at the bodies.
         pub const CONTACT_POINTS: usize = #contact_points;
+        /// Points per group of the `contact_jacobian` kernel.
+        pub const CONTACT_GROUPS: &[usize] = &[#(#contact_groups),*];
 
         /// The compiled kernels of this structure.
         pub struct Compiled {
@@ -973,6 +1021,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                         constraints: CONSTRAINTS.iter().map(|s| s.to_string()).collect(),
                         blocks: BLOCKS.to_vec(),
                         contact_points: CONTACT_POINTS,
+                        contact_groups: CONTACT_GROUPS.to_vec(),
                     },
                 }
             }

@@ -16,10 +16,14 @@ use crate::tape::{Inputs, Tape};
 ///   subexpressions; M or h alone are read from it rather than generated
 ///   again, which kept a sixth of every model's generated code).
 /// * `Outputs`: see [`OUTPUT_NAMES`].
-/// * `Accel`: qdd = -M^-1 h (n values) then the pivots D of M = L D L^T
-///   (n values, all positive when M is positive definite): the mass solve
-///   generated as straight-line code. Present only when `ModelInfo::accel`
-///   (small arms); otherwise the runtime solves `MassBias` output.
+/// * `Accel`: qdd = -M^-1 h (n values), the pivots D of M = L D L^T
+///   (n values, all positive when M is positive definite), L below its
+///   unit diagonal row by row (n (n - 1) / 2 values), then the contact
+///   points' positions as `Contact` gives them (3 per point): the mass
+///   solve generated as straight-line code, with what a contact force
+///   found after it needs (the gaps, and L D L^T to solve for it).
+///   Present only when `ModelInfo::accel` (small arms); otherwise the
+///   runtime solves `MassBias` output.
 /// * `Jvp`: the directional derivative of the inverse dynamics
 ///   tau(q, qd, qdd) = M qdd + h along the input direction (dq, dqd), at
 ///   the input `qdd` (n values). The runtime assembles the right-hand
@@ -36,8 +40,12 @@ use crate::tape::{Inputs, Tape};
 ///   centres), `ModelInfo::contact_points` of them, each as its position
 ///   p (3): the runtime finds the gaps. Empty without contact.
 /// * `ContactJacobian`: each point's velocity v (3) and dp/dq (3 x n,
-///   row-major), which the forces and their map J^T need: evaluated only
-///   when a pair penetrates.
+///   row-major), which the forces and their map J^T need. Split into
+///   groups of points that depend on the same coordinates
+///   (`ModelInfo::contact_groups`, an arm's element or a body): group g is
+///   evaluated only when `dir[g]` is non-zero (an empty `dir`: every
+///   group), so a right-hand side where the tip presses evaluates the
+///   tip's group alone; the others' outputs are left as they were.
 /// * `ContactJvp`: the same points' dv and d(dp/dq) along the direction
 ///   dq (the first n of `dir`; 3 + 3 n values a point): the exact
 ///   Jacobian of the contact forces, column by column.
@@ -84,7 +92,7 @@ impl KernelKind {
             Self::ContactJvp => info.contact_points * (3 + 3 * dof),
             Self::Accel => {
                 if info.accel {
-                    2 * dof
+                    2 * dof + dof * dof.saturating_sub(1) / 2 + 3 * info.contact_points
                 } else {
                     0
                 }
@@ -152,6 +160,10 @@ pub struct ModelInfo {
     /// element, `points_per_element` each, then every body's centre.
     #[serde(default)]
     pub contact_points: usize,
+    /// Points per `ContactJacobian` group, consecutive (their sum is
+    /// `contact_points`; at most 2 n groups, so that `dir` can select them).
+    #[serde(default)]
+    pub contact_groups: Vec<usize>,
 }
 
 impl ModelInfo {
@@ -162,6 +174,15 @@ impl ModelInfo {
     /// Length of the parameter vector the kernels read: base + derived.
     pub fn extended_params(&self) -> usize {
         self.parameters.len() + self.derived
+    }
+
+    /// The `ContactJacobian` groups as (first point, points).
+    pub fn contact_group_ranges(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.contact_groups.iter().scan(0, |start, &len| {
+            let first = *start;
+            *start += len;
+            Some((first, len))
+        })
     }
 }
 
@@ -202,8 +223,9 @@ pub struct TapeSet {
     /// Empty unless `info.contact_points > 0`.
     #[serde(default)]
     pub contact: Tape,
+    /// One tape per group of `info.contact_groups`.
     #[serde(default)]
-    pub contact_jacobian: Tape,
+    pub contact_jacobian: Vec<Tape>,
     #[serde(default)]
     pub contact_jvp: Tape,
     /// The layout and kernels of the link recursion (`crate::links`),
@@ -218,7 +240,16 @@ pub struct TapeSet {
 }
 
 impl TapeSet {
-    pub fn tape(&self, kind: KernelKind) -> &Tape {
+    /// The tapes of `kind`: one, or for `ContactJacobian` one per group.
+    pub fn tapes(&self, kind: KernelKind) -> &[Tape] {
+        match kind {
+            KernelKind::ContactJacobian => &self.contact_jacobian,
+            _ => std::slice::from_ref(self.tape(kind)),
+        }
+    }
+
+    /// The tape of a kernel that is one tape (not `ContactJacobian`).
+    fn tape(&self, kind: KernelKind) -> &Tape {
         match kind {
             KernelKind::MassBias => &self.mass_bias,
             KernelKind::Outputs => &self.outputs,
@@ -227,8 +258,8 @@ impl TapeSet {
             KernelKind::Jvp => &self.jvp,
             KernelKind::Constraints => &self.constraints,
             KernelKind::Contact => &self.contact,
-            KernelKind::ContactJacobian => &self.contact_jacobian,
             KernelKind::ContactJvp => &self.contact_jvp,
+            KernelKind::ContactJacobian => unreachable!("ContactJacobian is grouped: `tapes`"),
         }
     }
 }
@@ -257,6 +288,20 @@ impl Kernels for Interpreted {
     }
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
         let mut slots = self.scratch.borrow_mut();
+        if kind == KernelKind::ContactJacobian {
+            let width = out.len() / self.tapes.info.contact_points.max(1);
+            let groups = self.tapes.info.contact_group_ranges();
+            for (g, ((first, len), tape)) in groups.zip(&self.tapes.contact_jacobian).enumerate() {
+                if inp.dir.is_empty() || inp.dir[g] != 0.0 {
+                    tape.eval(
+                        inp,
+                        &mut slots,
+                        &mut out[first * width..(first + len) * width],
+                    );
+                }
+            }
+            return;
+        }
         let tape = self.tapes.tape(kind);
         if kind == KernelKind::Jvp && (inp.qdd.is_empty() || inp.dir.is_empty()) {
             // As the compiled models do: absent accelerations and direction

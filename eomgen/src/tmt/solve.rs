@@ -9,13 +9,20 @@ use crate::cas::{Cas, ExprId};
 /// Largest DOF whose mass solve is generated.
 pub const SYMBOLIC_SOLVE_MAX_DOF: usize = 24;
 
-/// (qdd, D): the accelerations and the pivots of M = L D L^T. `mass_upper`
-/// is the upper triangle row by row.
-pub fn solve_accelerations(
-    cas: &mut Cas,
-    mass_upper: &[ExprId],
-    bias: &[ExprId],
-) -> (Vec<ExprId>, Vec<ExprId>) {
+/// The generated mass solve: the accelerations, and the factors of
+/// M = L D L^T, which solve M x = f for a further force at run time (the
+/// contact forces, found after the kernel ran).
+pub struct MassSolve {
+    pub qdd: Vec<ExprId>,
+    /// The pivots D.
+    pub pivots: Vec<ExprId>,
+    /// L below its unit diagonal, row by row: (1,0), (2,0), (2,1), ...
+    pub lower: Vec<ExprId>,
+}
+
+/// qdd = -M^-1 h and the factors. `mass_upper` is the upper triangle row
+/// by row.
+pub fn solve_accelerations(cas: &mut Cas, mass_upper: &[ExprId], bias: &[ExprId]) -> MassSolve {
     let n = bias.len();
     let m = |i: usize, j: usize| {
         let (a, b) = (i.min(j), i.max(j));
@@ -57,5 +64,10 @@ pub fn solve_accelerations(
         let xi = cas.sub(z, dot);
         x[i] = cas.bind(xi);
     }
-    (x, d)
+    let lower = (1..n).flat_map(|i| l[i][..i].to_vec()).collect();
+    MassSolve {
+        qdd: x,
+        pivots: d,
+        lower,
+    }
 }

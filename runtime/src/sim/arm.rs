@@ -351,7 +351,7 @@ pub struct Workspace {
     ldlt: Ldlt,
     /// The constrained solve's buffers, made on first use.
     kkt: Option<crate::constraints::KktWorkspace>,
-    /// The contact forces Q_c of the last evaluation.
+    /// The contact forces Q_c of the last evaluation (or M^-1 Q_c).
     contact: Vec<f64>,
 }
 
@@ -386,10 +386,8 @@ pub fn accelerations<D: Dynamics + ?Sized>(
     qdd: &mut [f64],
 ) -> Result<(), AccelError> {
     let n = ws.n;
-    let rows = d.info().constraints.len();
-    // Contact forces that push make the right-hand side M^-1 (Q_c - h);
-    // otherwise it is the contact-free one (with the generated solve).
-    let contact = crate::contact::generalised_force_at(d, t, q, qd, &mut ws.contact);
+    let info = d.info();
+    let rows = info.constraints.len();
     if let Some(set) = d.contact().filter(|s| s.any_held()) {
         let held = set.held_pairs();
         if !held.is_empty() {
@@ -398,24 +396,26 @@ pub fn accelerations<D: Dynamics + ?Sized>(
             return Ok(());
         }
     }
-    let solved = if rows > 0 {
-        d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
-        if contact {
-            let tri = n * (n + 1) / 2;
-            for (h, f) in ws.packed[tri..].iter_mut().zip(&ws.contact) {
-                *h -= f;
-            }
-        }
-        let kkt = ws.kkt.get_or_insert_with(|| {
-            crate::constraints::KktWorkspace::new(n, rows, &d.info().blocks)
-        });
-        crate::constraints::solve_constrained(d, kkt, &ws.packed, t, q, qd, qdd)?
-    } else if d.info().accel && !contact {
+    let solved = if rows == 0 && info.accel {
+        // The generated solve, then contact forces that push (found from
+        // the points the kernel gives) solved by its factors: qdd =
+        // -M^-1 h + M^-1 Q_c.
+        ws.accel.resize(KernelKind::Accel.output_len(info), 0.0);
         d.eval_kernel(KernelKind::Accel, t, q, qd, &mut ws.accel);
         qdd.copy_from_slice(&ws.accel[..n]);
+        let (pivots, rest) = ws.accel[n..].split_at(n);
+        let (lower, points) = rest.split_at(n * n.saturating_sub(1) / 2);
+        if crate::contact::generalised_force_at(d, t, q, qd, Some(points), &mut ws.contact) {
+            solve_unit_ldl(lower, pivots, &mut ws.contact);
+            for (a, x) in qdd.iter_mut().zip(&ws.contact) {
+                *a += x;
+            }
+        }
         // Positive pivots: M positive definite (false for NaN too).
-        ws.accel[n..].iter().all(|&p| p > 0.0)
+        pivots.iter().all(|&p| p > 0.0)
     } else {
+        // Contact forces that push make the right-hand side M^-1 (Q_c - h).
+        let contact = crate::contact::generalised_force_at(d, t, q, qd, None, &mut ws.contact);
         d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
         if contact {
             let tri = n * (n + 1) / 2;
@@ -423,16 +423,46 @@ pub fn accelerations<D: Dynamics + ?Sized>(
                 *h -= f;
             }
         }
-        let (mass, bias) = ws.packed.split_at(n * (n + 1) / 2);
-        for (a, b) in qdd.iter_mut().zip(bias) {
-            *a = -b;
+        if rows > 0 {
+            let kkt = ws.kkt.get_or_insert_with(|| {
+                crate::constraints::KktWorkspace::new(n, rows, &info.blocks)
+            });
+            crate::constraints::solve_constrained(d, kkt, &ws.packed, t, q, qd, qdd)?
+        } else {
+            let (mass, bias) = ws.packed.split_at(n * (n + 1) / 2);
+            for (a, b) in qdd.iter_mut().zip(bias) {
+                *a = -b;
+            }
+            d.solve_mass(mass, qdd, &mut ws.ldlt)
         }
-        d.solve_mass(mass, qdd, &mut ws.ldlt)
     };
     if !solved || qdd.iter().any(|v| !v.is_finite()) {
         return Err(diagnose(d, t, q, qd));
     }
     Ok(())
+}
+
+/// Solve L D L^T x = b in place, L unit lower triangular given below its
+/// diagonal row by row (the `Accel` kernel's layout).
+fn solve_unit_ldl(lower: &[f64], pivots: &[f64], b: &mut [f64]) {
+    let n = b.len();
+    for i in 1..n {
+        let row = &lower[i * (i - 1) / 2..][..i];
+        let s: f64 = row.iter().zip(&b[..i]).map(|(l, y)| l * y).sum();
+        b[i] -= s;
+    }
+    for (x, p) in b.iter_mut().zip(pivots) {
+        *x /= p;
+    }
+    // L^T x = z by rows of L (contiguous): x_i is final once the rows
+    // below it have been subtracted.
+    for i in (1..n).rev() {
+        let xi = b[i];
+        let row = &lower[i * (i - 1) / 2..][..i];
+        for (bj, l) in b[..i].iter_mut().zip(row) {
+            *bj -= l * xi;
+        }
+    }
 }
 
 /// Why the accelerations failed: off the hot path, so it may allocate.

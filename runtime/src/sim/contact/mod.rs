@@ -88,6 +88,16 @@ pub struct Pair {
     pub channel: usize,
 }
 
+impl Pair {
+    /// The other point of a point-point pair (self or arm-arm contact).
+    pub fn other_point(&self) -> Option<usize> {
+        match self.other {
+            Against::Point(j) => Some(j),
+            Against::Obstacle(_) => None,
+        }
+    }
+}
+
 /// Per run, for the pairs that keep records (Hunt-Crossley from a
 /// restitution): whether each touches, and the normal speed at which it
 /// began to, which its damping reads. Changed only between legs
@@ -287,22 +297,38 @@ impl ContactSet {
 }
 
 /// The points at one state: the `Contact` kernel's positions, and the
-/// `ContactJacobian` kernel's velocities and dp/dq once asked for
-/// (`velocities`): a right-hand side where nothing touches needs neither.
+/// `ContactJacobian` kernel's velocities and dp/dq for the groups of points
+/// asked for (`velocities_of`): a right-hand side where nothing touches
+/// needs none, one where the tip presses the tip's group alone.
 #[derive(Debug)]
 pub struct PointKinematics {
     n: usize,
     buf: Vec<f64>,
     jac: Vec<f64>,
+    /// Each point's `ContactJacobian` group.
+    group_of: Vec<usize>,
+    /// Whether a group's velocities and dp/dq are in `jac` at this state.
+    have: Vec<bool>,
+    /// The groups to evaluate, as the kernel's `dir` reads them.
+    mask: Vec<f64>,
 }
 
 impl PointKinematics {
     /// The positions of every point.
     pub fn eval<D: Dynamics + ?Sized>(d: &D, t: f64, q: &[f64], qd: &[f64]) -> Self {
+        let info = d.info();
+        let mut group_of = Vec::with_capacity(info.contact_points);
+        for (g, (_, len)) in info.contact_group_ranges().enumerate() {
+            group_of.extend(std::iter::repeat_n(g, len));
+        }
+        let groups = info.contact_groups.len();
         let mut k = Self {
             n: q.len(),
             buf: Vec::new(),
-            jac: Vec::new(),
+            jac: vec![0.0; KernelKind::ContactJacobian.output_len(info)],
+            group_of,
+            have: vec![false; groups],
+            mask: vec![0.0; 2 * q.len()],
         };
         k.update(d, t, q, qd);
         k
@@ -311,11 +337,32 @@ impl PointKinematics {
     /// Re-evaluate the positions into the same buffers; the velocities
     /// and Jacobian are dropped.
     pub fn update<D: Dynamics + ?Sized>(&mut self, d: &D, t: f64, q: &[f64], qd: &[f64]) {
+        self.update_from(d, t, q, qd, None);
+    }
+
+    /// `update`, with the positions given (as another kernel computed
+    /// them) or else evaluated.
+    fn update_from<D: Dynamics + ?Sized>(
+        &mut self,
+        d: &D,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        positions: Option<&[f64]>,
+    ) {
         self.n = q.len();
-        self.buf
-            .resize(KernelKind::Contact.output_len(d.info()), 0.0);
-        d.eval_kernel(KernelKind::Contact, t, q, qd, &mut self.buf);
-        self.jac.clear();
+        match positions {
+            Some(p) => {
+                self.buf.clear();
+                self.buf.extend_from_slice(p);
+            }
+            None => {
+                self.buf
+                    .resize(KernelKind::Contact.output_len(d.info()), 0.0);
+                d.eval_kernel(KernelKind::Contact, t, q, qd, &mut self.buf);
+            }
+        }
+        self.have.fill(false);
     }
 
     /// Positions, velocities and dp/dq.
@@ -325,17 +372,50 @@ impl PointKinematics {
         k
     }
 
-    /// Evaluate the velocities and dp/dq (once).
+    /// Evaluate every point's velocity and dp/dq (once).
     pub fn velocities<D: Dynamics + ?Sized>(&mut self, d: &D, t: f64, q: &[f64], qd: &[f64]) {
-        if self.jac.is_empty() {
-            self.jac
-                .resize(KernelKind::ContactJacobian.output_len(d.info()), 0.0);
-            d.eval_kernel(KernelKind::ContactJacobian, t, q, qd, &mut self.jac);
+        self.velocities_of(d, t, q, qd, 0..self.group_of.len());
+    }
+
+    /// Evaluate the velocities and dp/dq of `points` (their groups, once).
+    pub fn velocities_of<D: Dynamics + ?Sized>(
+        &mut self,
+        d: &D,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        points: impl IntoIterator<Item = usize>,
+    ) {
+        self.mask.fill(0.0);
+        let mut any = false;
+        for i in points {
+            let g = self.group_of[i];
+            if !self.have[g] {
+                self.have[g] = true;
+                self.mask[g] = 1.0;
+                any = true;
+            }
+        }
+        if any {
+            d.eval_direction(
+                KernelKind::ContactJacobian,
+                t,
+                q,
+                qd,
+                &self.mask,
+                &mut self.jac,
+            );
         }
     }
 
-    pub fn has_velocities(&self) -> bool {
-        !self.jac.is_empty()
+    /// Whether some point's velocity and dp/dq are there.
+    pub fn has_velocity_any(&self) -> bool {
+        self.have.iter().any(|&h| h)
+    }
+
+    /// Whether point i's velocity and dp/dq are there.
+    pub fn has_velocity(&self, i: usize) -> bool {
+        self.have[self.group_of[i]]
     }
 
     #[inline]
@@ -344,14 +424,22 @@ impl PointKinematics {
         [b[0], b[1], b[2]]
     }
 
-    /// (after `velocities`)
+    /// (after `velocities` or `velocities_of` point i)
     pub fn velocity(&self, i: usize) -> [f64; 3] {
+        debug_assert!(
+            self.has_velocity(i),
+            "point {i}'s velocity was not evaluated"
+        );
         let b = &self.jac[i * (3 + 3 * self.n)..];
         [b[0], b[1], b[2]]
     }
 
-    /// Row c of dp/dq (after `velocities`).
+    /// Row c of dp/dq (after `velocities` or `velocities_of` point i).
     pub fn jacobian_row(&self, i: usize, c: usize) -> &[f64] {
+        debug_assert!(
+            self.has_velocity(i),
+            "point {i}'s Jacobian was not evaluated"
+        );
         let start = i * (3 + 3 * self.n) + 3 + c * self.n;
         &self.jac[start..start + self.n]
     }
@@ -361,7 +449,8 @@ impl PointKinematics {
 #[derive(Debug, Default)]
 struct Scratch {
     points: Option<PointKinematics>,
-    forces: Vec<PairForce<f64>>,
+    /// The pairs that penetrate.
+    touching: Vec<usize>,
 }
 
 /// A pair's state: gap, normal force, total force on the point (normal
@@ -452,8 +541,8 @@ pub fn pair_forces<D: Dynamics + ?Sized>(
 }
 
 /// `pair_forces` on given kinematics into a reused buffer: the gaps from
-/// the positions, and, when one penetrates (or the velocities are there),
-/// every pair's forces.
+/// the positions, and the forces of the pairs that penetrate (and of every
+/// pair whose velocities are there), with the velocities of their points.
 fn pair_forces_into<D: Dynamics + ?Sized>(
     d: &D,
     set: &ContactSet,
@@ -464,36 +553,39 @@ fn pair_forces_into<D: Dynamics + ?Sized>(
     out: &mut Vec<PairForce<f64>>,
 ) {
     out.clear();
-    let apart = |gap: f64| PairForce {
-        gap,
+    out.extend(set.pairs.iter().map(|pair| PairForce {
+        gap: gap_of(set, pair, k, t),
         normal: 0.0,
         force: [0.0; 3],
         friction: 0.0,
         approach: 0.0,
         power: 0.0,
-    };
-    if !k.has_velocities() {
-        out.extend(set.pairs.iter().map(|pair| apart(gap_of(set, pair, k, t))));
-        if out.iter().all(|f| f.gap >= 0.0) {
-            return;
-        }
-        k.velocities(d, t, q, qd);
-        out.clear();
+    }));
+    if out.iter().all(|f| f.gap >= 0.0) && !k.has_velocity_any() {
+        return;
     }
+    let touching = set
+        .pairs
+        .iter()
+        .zip(out.iter())
+        .filter(|(_, f)| f.gap < 0.0)
+        .flat_map(|(pair, _)| std::iter::once(pair.point).chain(pair.other_point()));
+    k.velocities_of(d, t, q, qd, touching);
     let guard = set.state.lock();
     let empty = ContactState::default();
     let state = guard.as_deref().unwrap_or(&empty);
-    out.extend(set.pairs.iter().enumerate().map(|(i, pair)| {
-        let other = match pair.other {
-            Against::Point(j) => Some(Other {
-                p: k.position(j),
-                v: k.velocity(j),
-                radius: set.points[j].radius,
-            }),
-            Against::Obstacle(_) => None,
-        };
+    for (i, pair) in set.pairs.iter().enumerate() {
+        let known = |p: usize| k.has_velocity(p);
+        if !known(pair.point) || !pair.other_point().is_none_or(known) {
+            continue;
+        }
+        let other = pair.other_point().map(|j| Other {
+            p: k.position(j),
+            v: k.velocity(j),
+            radius: set.points[j].radius,
+        });
         let v_in = state.impact.get(i).copied().unwrap_or(0.0);
-        pair_force(
+        out[i] = pair_force(
             set,
             pair,
             t,
@@ -501,8 +593,8 @@ fn pair_forces_into<D: Dynamics + ?Sized>(
             k.velocity(pair.point),
             other,
             v_in,
-        )
-    }));
+        );
+    }
 }
 
 /// Whether any pair penetrates: every right-hand side asks, so fixed
@@ -589,21 +681,24 @@ pub fn subtract_from_bias<D: Dynamics + ?Sized>(
     h: &mut [f64],
 ) {
     let mut q_force = vec![0.0; q.len()];
-    if generalised_force_at(d, t, q, qd, &mut q_force) {
+    if generalised_force_at(d, t, q, qd, None, &mut q_force) {
         for (h, f) in h.iter_mut().zip(&q_force) {
             *h -= f;
         }
     }
 }
 
-/// Q_c at (t, q, qd) into `q_force`; false (and `q_force` untouched) when
-/// no pair pushes. The hot path: buffers are reused, and the points'
-/// velocities and Jacobian are evaluated only when a pair penetrates.
+/// Q_c at (t, q, qd) into `q_force`; false (`q_force` then not Q_c) when
+/// no pair pushes. `positions`: the points' positions when the caller has
+/// them (the `Accel` kernel gives them), else the `Contact` kernel's. The
+/// hot path: buffers are reused, and the velocities and Jacobians of the
+/// points of the pairs that penetrate are evaluated, no others.
 pub fn generalised_force_at<D: Dynamics + ?Sized>(
     d: &D,
     t: f64,
     q: &[f64],
     qd: &[f64],
+    positions: Option<&[f64]>,
     q_force: &mut [f64],
 ) -> bool {
     let Some(set) = d.contact() else {
@@ -614,7 +709,7 @@ pub fn generalised_force_at<D: Dynamics + ?Sized>(
     let s = &mut *guard;
     let k = match &mut s.points {
         Some(k) => {
-            k.update(d, t, q, qd);
+            k.update_from(d, t, q, qd, positions);
             k
         }
         None => s.points.insert(PointKinematics::eval(d, t, q, qd)),
@@ -623,13 +718,38 @@ pub fn generalised_force_at<D: Dynamics + ?Sized>(
     if !any_penetrates(set, k, t) {
         return false;
     }
-    pair_forces_into(d, set, k, t, q, qd, &mut s.forces);
-    if s.forces.iter().all(|f| f.normal == 0.0) {
-        return false;
-    }
+    s.touching.clear();
+    s.touching
+        .extend((0..set.pairs.len()).filter(|&i| gap_of(set, &set.pairs[i], k, t) < 0.0));
+    let points = s.touching.iter().flat_map(|&i| {
+        let pair = &set.pairs[i];
+        std::iter::once(pair.point).chain(pair.other_point())
+    });
+    k.velocities_of(d, t, q, qd, points);
+    let guard = set.state.lock();
+    let empty = ContactState::default();
+    let state = guard.as_deref().unwrap_or(&empty);
     q_force.fill(0.0);
-    generalised_force(set, k, &s.forces, q_force);
-    true
+    let mut pushes = false;
+    for &i in &s.touching {
+        let pair = &set.pairs[i];
+        let other = pair.other_point().map(|j| Other {
+            p: k.position(j),
+            v: k.velocity(j),
+            radius: set.points[j].radius,
+        });
+        let v_in = state.impact.get(i).copied().unwrap_or(0.0);
+        let (p, v) = (k.position(pair.point), k.velocity(pair.point));
+        let f = pair_force(set, pair, t, p, v, other, v_in);
+        if f.normal != 0.0 {
+            pushes = true;
+            add_jt(k, pair.point, f.force, 1.0, q_force);
+            if let Some(j) = pair.other_point() {
+                add_jt(k, j, f.force, -1.0, q_force);
+            }
+        }
+    }
+    pushes
 }
 
 /// Subtract dQ_c/dq and dQ_c/dqd from the Jacobian parts of tau
