@@ -115,6 +115,9 @@ pub struct ContactState {
 pub struct ContactSet {
     pub points: Vec<ContactPoint>,
     pub obstacles: Vec<Obstacle>,
+    /// Every point against every obstacle, point-major (pair i * obstacles
+    /// + k is point i against obstacle k: `penetrating` relies on it), then
+    /// the point-point pairs.
     pub pairs: Vec<Pair>,
     /// Output channels by name (`contact_<name>_fn`, `_ft`).
     pub channels: Vec<String>,
@@ -597,26 +600,34 @@ fn pair_forces_into<D: Dynamics + ?Sized>(
     }
 }
 
-/// Whether any pair penetrates: every right-hand side asks, so fixed
-/// planes (every point against each) are one tight loop over the points,
-/// the other pairs one by one.
-fn any_penetrates(set: &ContactSet, k: &PointKinematics, t: f64) -> bool {
-    for o in &set.obstacles {
+/// The pairs that penetrate, in order, into `out`: every right-hand side
+/// asks, so a fixed plane (every point against it, the common obstacle)
+/// is one tight loop over the points, the other pairs one by one. The
+/// pairs begin with every point against every obstacle, point-major.
+fn penetrating(set: &ContactSet, k: &PointKinematics, t: f64, out: &mut Vec<usize>) {
+    out.clear();
+    let no = set.obstacles.len();
+    for (ko, o) in set.obstacles.iter().enumerate() {
         if let (Shape::Plane { point, normal }, None) = (&o.shape, &o.motion) {
             let c = point[0] * normal[0] + point[1] * normal[1] + point[2] * normal[2];
-            let hit = k.buf.chunks_exact(3).zip(&set.points).any(|(p, pt)| {
-                p[0] * normal[0] + p[1] * normal[1] + p[2] * normal[2] - pt.radius < c
-            });
-            if hit {
-                return true;
+            for (i, (p, pt)) in k.buf.chunks_exact(3).zip(&set.points).enumerate() {
+                if p[0] * normal[0] + p[1] * normal[1] + p[2] * normal[2] - pt.radius < c {
+                    out.push(i * no + ko);
+                }
+            }
+        } else {
+            for i in 0..set.points.len() {
+                if gap_of(set, &set.pairs[i * no + ko], k, t) < 0.0 {
+                    out.push(i * no + ko);
+                }
             }
         }
     }
-    set.pairs.iter().any(|pair| {
-        let fixed_plane = matches!(pair.other, Against::Obstacle(o)
-            if matches!((&set.obstacles[o].shape, &set.obstacles[o].motion), (Shape::Plane { .. }, None)));
-        !fixed_plane && gap_of(set, pair, k, t) < 0.0
-    })
+    let first = set.points.len() * no;
+    out.extend((first..set.pairs.len()).filter(|&i| gap_of(set, &set.pairs[i], k, t) < 0.0));
+    if no > 1 {
+        out.sort_unstable();
+    }
 }
 
 /// A pair's gap from the positions alone: every pair, every right-hand
@@ -715,12 +726,10 @@ pub fn generalised_force_at<D: Dynamics + ?Sized>(
         None => s.points.insert(PointKinematics::eval(d, t, q, qd)),
     };
     // Most right-hand sides touch nothing: a gap check and out.
-    if !any_penetrates(set, k, t) {
+    penetrating(set, k, t, &mut s.touching);
+    if s.touching.is_empty() {
         return false;
     }
-    s.touching.clear();
-    s.touching
-        .extend((0..set.pairs.len()).filter(|&i| gap_of(set, &set.pairs[i], k, t) < 0.0));
     let points = s.touching.iter().flat_map(|&i| {
         let pair = &set.pairs[i];
         std::iter::once(pair.point).chain(pair.other_point())
