@@ -115,9 +115,9 @@ pub struct ContactState {
 pub struct ContactSet {
     pub points: Vec<ContactPoint>,
     pub obstacles: Vec<Obstacle>,
-    /// Every point against every obstacle, point-major (pair i * obstacles
-    /// + k is point i against obstacle k: `penetrating` relies on it), then
-    /// the point-point pairs.
+    /// Every point against every obstacle, point-major (pair
+    /// `i * obstacles.len() + k` is point i against obstacle k:
+    /// `penetrating` relies on it), then the point-point pairs.
     pub pairs: Vec<Pair>,
     /// Output channels by name (`contact_<name>_fn`, `_ft`).
     pub channels: Vec<String>,
