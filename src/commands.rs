@@ -224,7 +224,7 @@ fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
         s.push_str(&format!(",{c}"));
     }
     s.push('\n');
-    for (t, x) in traj.t.iter().zip(&traj.x) {
+    for (i, (t, x)) in traj.t.iter().zip(&traj.x).enumerate() {
         s.push_str(&format!("{t:.9}"));
         for v in x {
             s.push_str(&format!(",{v:.12e}"));
@@ -237,7 +237,7 @@ fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
                 s.push_str(&format!(",{v:.12e}"));
             }
         }
-        for v in softarm::contact::columns(arm, *t, x) {
+        for v in softarm::contact::columns(arm, traj, i) {
             s.push_str(&format!(",{v:.12e}"));
         }
         s.push('\n');
@@ -445,8 +445,8 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         let forces: Vec<(f64, Vec<f64>)> = traj
             .t
             .iter()
-            .zip(&traj.x)
-            .map(|(t, x)| (*t, softarm::contact::columns(arm, *t, x)))
+            .enumerate()
+            .map(|(i, t)| (*t, softarm::contact::columns(arm, &traj, i)))
             .collect();
         softarm::contact::plot_forces(
             &out_dir.join("contact"),

@@ -226,21 +226,28 @@ fn forces_at(
     ))
 }
 
-/// The contact columns at a sample (`column_names`' order).
-pub fn columns(arm: &dyn runtime::Dynamics, t: f64, x: &[f64]) -> Vec<f64> {
-    let (Some(set), Some(forces)) = (arm.contact(), forces_at(arm, t, x)) else {
+/// The contact columns at sample i (`column_names`' order): as the run
+/// recorded them (under the contact state of that moment), or for a
+/// trajectory without them (a failed run's) from the state alone.
+pub fn columns(arm: &dyn runtime::Dynamics, traj: &runtime::Trajectory, i: usize) -> Vec<f64> {
+    let Some(set) = arm.contact() else {
         return Vec::new();
     };
-    runtime::contact::channel_forces(set, &forces)
-        .into_iter()
-        .flat_map(|(f_n, f_t)| [f_n, f_t])
-        .collect()
+    if let Some(c) = traj.contact.get(i) {
+        return c.clone();
+    }
+    let n = arm.dof();
+    let x = &traj.x[i];
+    runtime::contact::channel_columns(arm, set, traj.t[i], &x[..n], &x[n..])
 }
 
-/// The run's contacts for summary.json: the energy they dissipated and
-/// the deepest penetration (metered on every step, `SimStats::contact`),
-/// and the contact switches (where a pair with restitution records began
-/// or ended to touch).
+/// The run's contacts for summary.json: the energy they dissipated, the
+/// normal impulse their forces transmitted and the deepest penetration
+/// (metered on every step, `SimStats::contact`), and the contact switches
+/// (where a pair with restitution records began or ended to touch): time,
+/// point, obstacle, speed, and the impulse: at a touch, an impulse law's
+/// jump; at a release, what the contact forces transmitted since that
+/// pair's touch.
 pub fn summary(
     arm: &dyn runtime::Dynamics,
     traj: &runtime::Trajectory,
@@ -249,6 +256,13 @@ pub fn summary(
     let Some(set) = arm.contact() else {
         return serde_json::Value::Null;
     };
+    let record_at = |t: f64| {
+        traj.switches
+            .iter()
+            .find(|r| (r.t - t).abs() <= 1e-12 * t.abs().max(1.0))
+    };
+    // The metered impulse at each pair's last touch.
+    let mut touched_at: std::collections::HashMap<usize, f64> = Default::default();
     let switches: Vec<serde_json::Value> = traj
         .events
         .iter()
@@ -261,22 +275,37 @@ pub fn summary(
                 .enumerate()
                 .filter(|(i, _)| set.keeps_record(*i))
                 .min_by(|a, b| a.1.gap.abs().total_cmp(&b.1.gap.abs()));
-            match at {
-                Some((i, f)) => serde_json::json!({
-                    "t": e.t,
-                    "point": set.pairs[i].point,
-                    "with": set.channels[set.pairs[i].channel],
-                    "kind": if f.approach > 0.0 { "touch" } else { "release" },
-                    "normal_speed": f.approach,
-                }),
-                None => serde_json::json!({ "t": e.t }),
-            }
+            let Some((i, f)) = at else {
+                return serde_json::json!({ "t": e.t });
+            };
+            let touch = f.approach > 0.0;
+            let record = record_at(e.t);
+            let metered = record.map(|r| r.metered_impulse_ns);
+            let impulse = if touch {
+                if let Some(m) = metered {
+                    touched_at.insert(i, m);
+                }
+                record.and_then(|r| r.jumps.iter().find(|j| j.0 == i).map(|j| j.1))
+            } else {
+                metered
+                    .zip(touched_at.remove(&i))
+                    .map(|(now, then)| now - then)
+            };
+            serde_json::json!({
+                "t": e.t,
+                "point": set.pairs[i].point,
+                "with": set.channels[set.pairs[i].channel],
+                "kind": if touch { "touch" } else { "release" },
+                "normal_speed": f.approach,
+                "impulse_ns": impulse,
+            })
         })
         .collect();
     let meter = meter.unwrap_or_default();
     serde_json::json!({
         "max_penetration_m": meter.max_penetration_m,
         "dissipated_j": meter.dissipated_j,
+        "normal_impulse_ns": meter.normal_impulse_ns,
         "switches": switches,
     })
 }

@@ -101,6 +101,30 @@ fn a_ball_rebounds_with_the_restitution_it_was_given() {
         // The switch's state is the dense output's: 1e-7 is its accuracy.
         assert_abs(v_in, -1.0, 1e-7, "impact speed");
         assert_abs(measured, e, 1e-4 * e, "measured restitution");
+        // The momentum the floor gave: m (1 + e) |v_in|, the metered
+        // integral of the normal force, in summary.json's release.
+        let summary = softarm::contact::summary(&*l.arm, &traj, stats.contact);
+        let release = &summary["switches"][1];
+        assert_eq!(release["kind"], "release", "e = {e}: {summary}");
+        let impulse = release["impulse_ns"].as_f64().expect("a release's impulse");
+        eprintln!(
+            "e = {e}: impulse {impulse:.9} N s of {:.9}",
+            0.2 * (1.0 + e)
+        );
+        assert_close(
+            impulse,
+            0.2 * (1.0 + e),
+            1e-6,
+            0.0,
+            "impulse of the rebound",
+        );
+        assert_close(
+            meter.normal_impulse_ns,
+            0.2 * (1.0 + e),
+            1e-6,
+            0.0,
+            "run's impulse",
+        );
     }
 }
 
@@ -320,13 +344,21 @@ fn an_impulse_reverses_the_normal_velocity_by_e() {
             solver: Solver::Dopri5,
             ..SimOptions::default()
         };
-        let (traj, _) = simulate(&*l.arm, x0, &opts).unwrap();
+        let (traj, stats) = simulate(&*l.arm, x0, &opts).unwrap();
         let hit = traj
             .events
             .iter()
             .find(|h| h.name == "contact")
             .expect("the ball hits");
         assert_abs(hit.t, 0.05, 1e-9, "time of impact");
+        // The jump's normal impulse, m (1 + e) |v_in|, in summary.json.
+        let summary = softarm::contact::summary(&*l.arm, &traj, stats.contact);
+        let touch = &summary["switches"][0];
+        assert_eq!(touch["kind"], "touch", "{summary}");
+        let impulse = touch["impulse_ns"]
+            .as_f64()
+            .expect("an impulse law's impulse");
+        assert_abs(impulse, 0.2 * (1.0 + e), 1e-12, "impulse of the jump");
         let last = traj.x.last().unwrap();
         let what = format!("e = {e}, friction {friction}");
         eprintln!(
@@ -421,6 +453,27 @@ points_per_element = 1
         m * g / 2.0
     );
     assert_close(forces[0], m * g / 2.0, 1e-9, 0.0, "support force");
+    // The recorded output column carries it: zero before the impact, m g / 2
+    // once resting (the rod at rest by 0.5 s).
+    assert_eq!(traj.contact.len(), traj.t.len(), "a column row per sample");
+    for (t, c) in traj.t.iter().zip(&traj.contact) {
+        if *t < hit.t - 1e-9 {
+            assert_abs(
+                c[0],
+                0.0,
+                0.0,
+                &format!("support force before the impact (t = {t})"),
+            );
+        } else if *t >= 0.5 {
+            assert_close(
+                c[0],
+                m * g / 2.0,
+                1e-6,
+                0.0,
+                &format!("support force column at {t}"),
+            );
+        }
+    }
 }
 
 /// An undamped soft arm swings under gravity onto a table and a knob
@@ -547,7 +600,8 @@ exponent = {n_exp}
         .unwrap();
     let mut x = sol.q.clone();
     x.extend(vec![0.0; n]);
-    let columns = softarm::contact::columns(&*arm, 0.0, &x);
+    let set = arm.contact().unwrap();
+    let columns = runtime::contact::channel_columns(&*arm, set, 0.0, &x[..n], &x[n..]);
     let table = columns[0];
     let spring = -k_base * sol.q[by];
     let tip_y = arm.outputs(0.0, &sol.q, &vec![0.0; n])[1];

@@ -140,8 +140,15 @@ fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+/// What an impact did: the velocities after it, and each pair's normal
+/// impulse (N s, pushing out: positive).
+pub struct Jump {
+    pub qd: Vec<f64>,
+    pub impulses: Vec<(usize, f64)>,
+}
+
 /// The velocities after the pairs `began` hit: the joints' rows kept at
-/// zero velocity, each impact's as its law says. Returns qd+.
+/// zero velocity, each impact's as its law says.
 pub fn jump<D: Dynamics + ?Sized>(
     d: &D,
     set: &ContactSet,
@@ -149,7 +156,7 @@ pub fn jump<D: Dynamics + ?Sized>(
     q: &[f64],
     qd: &[f64],
     began: &[usize],
-) -> Result<Vec<f64>, AccelError> {
+) -> Result<Jump, AccelError> {
     let n = q.len();
     let c = rows(d, set, t, q, qd, began);
     let mut targets: Vec<f64> = Vec::with_capacity(c.velocity.len());
@@ -165,8 +172,10 @@ pub fn jump<D: Dynamics + ?Sized>(
         targets.extend(axes.iter().map(|&a| -e * v_n * normal[a]));
     }
     let (mut a, mut b) = (c.jac, targets);
+    let mut offset = 0;
     if !d.info().constraints.is_empty() {
         let joints = crate::constraints::evaluate(d, t, q, qd);
+        offset = joints.jac.nrows();
         a = stack(&joints.jac, &a);
         let mut zeros = vec![0.0; joints.jac.nrows()];
         zeros.extend(b);
@@ -188,8 +197,29 @@ pub fn jump<D: Dynamics + ?Sized>(
         .map(|c| c.solve(&rhs))
         .or_else(|| s.pseudo_inverse(1e-12).ok().map(|p| p * &rhs))
         .ok_or(AccelError::DependentJoints { t })?;
+    // The rows' impulses are -mu (qd+ = qd- + M^-1 A^T (-mu)); a pair's
+    // normal impulse is its rows' along the normal.
+    let impulses = began
+        .iter()
+        .zip(&c.pairs)
+        .map(|(&i, (first, axes, normal))| {
+            let row = |k: usize| -mu[offset + first + k];
+            let along = if axes.is_empty() {
+                row(0)
+            } else {
+                axes.iter()
+                    .enumerate()
+                    .map(|(k, &a)| row(k) * normal[a])
+                    .sum()
+            };
+            (i, along)
+        })
+        .collect();
     let out = qd_v - minv_at * mu;
-    Ok(out.iter().copied().collect())
+    Ok(Jump {
+        qd: out.iter().copied().collect(),
+        impulses,
+    })
 }
 
 fn stack(a: &DMatrix<f64>, b: &DMatrix<f64>) -> DMatrix<f64> {

@@ -876,6 +876,45 @@ pub fn channel_forces(set: &ContactSet, forces: &[PairForce<f64>]) -> Vec<(f64, 
     out
 }
 
+/// Each channel's total normal and friction force at (t, q, qd), flattened
+/// (normal, friction, normal, ...), under the run's contact state as it
+/// is now: held contacts carry their constraint force.
+pub fn channel_columns<D: Dynamics + ?Sized>(
+    d: &D,
+    set: &ContactSet,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+) -> Vec<f64> {
+    let forces = pair_forces(d, set, t, q, qd, false);
+    let mut channels = channel_forces(set, &forces);
+    let held = set.held_pairs();
+    if !held.is_empty()
+        && let Ok((_, f)) = impact::held_accelerations(d, set, t, q, qd, &held)
+    {
+        for (&i, f) in held.iter().zip(f) {
+            channels[set.pairs[i].channel].0 += f;
+        }
+    }
+    channels.into_iter().flat_map(|(n, f)| [n, f]).collect()
+}
+
+/// `traj.contact` for the samples from `from` on (`channel_columns` under
+/// the contact state they ran with).
+pub fn record_columns<D: Dynamics + ?Sized>(
+    d: &D,
+    set: &ContactSet,
+    traj: &mut crate::Trajectory,
+    from: usize,
+) {
+    let n = d.dof();
+    traj.contact.truncate(from);
+    for (t, x) in traj.t[from..].iter().zip(&traj.x[from..]) {
+        let c = channel_columns(d, set, *t, &x[..n], &x[n..]);
+        traj.contact.push(c);
+    }
+}
+
 /// The contact switch: over the pairs that keep records, the gap of those
 /// apart, minus the gap of those touching, and the normal force of those
 /// held, the least. It falls through zero when a pair begins or ends to
@@ -906,19 +945,22 @@ pub fn switching_gap<D: Dynamics + ?Sized>(
         .fold(pushing, f64::min)
 }
 
-/// The power the contacts dissipate (W) and the deepest penetration (m)
-/// at (t, q, qd): what `SimStats::contact` meters.
-pub fn power_and_depth<D: Dynamics + ?Sized>(
+/// The power the contacts dissipate (W), the deepest penetration (m) and
+/// the sum of the normal forces (N) at (t, q, qd): what `SimStats::contact`
+/// meters.
+pub fn meter_sample<D: Dynamics + ?Sized>(
     d: &D,
     set: &ContactSet,
     t: f64,
     q: &[f64],
     qd: &[f64],
-) -> (f64, f64) {
+) -> crate::MeterSample {
     let forces = pair_forces(d, set, t, q, qd, false);
-    let power = forces.iter().map(|f| f.power).sum();
-    let depth = forces.iter().map(|f| -f.gap).fold(0.0, f64::max);
-    (power, depth)
+    crate::MeterSample {
+        power_w: forces.iter().map(|f| f.power).sum(),
+        depth_m: forces.iter().map(|f| -f.gap).fold(0.0, f64::max),
+        normal_n: forces.iter().map(|f| f.normal).sum(),
+    }
 }
 
 /// The energy stored in the contacts' elastic parts (J) at (t, q, qd):

@@ -78,6 +78,7 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
                 t: sol.t.clone(),
                 x: sol.y.iter().map(unpad).collect(),
                 events: hits,
+                ..Default::default()
             };
             if let Some(t_bad) = blown_up {
                 let state = traj.x.last().cloned().unwrap_or_else(|| x0.to_vec());

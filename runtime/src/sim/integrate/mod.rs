@@ -39,7 +39,9 @@ pub use dispatch::IMPLICIT_SIZES;
 pub use failure::SimFailure;
 pub use options::{DEFAULT_SAMPLES, DEFAULT_T_END, SimOptions};
 pub use projected::ConstraintStats;
-pub use record::{AUTO_CHECK_STEPS, ContactMeter, SimStats, SolverSwitch, Trajectory};
+pub use record::{
+    AUTO_CHECK_STEPS, ContactMeter, MeterSample, SimStats, SolverSwitch, SwitchRecord, Trajectory,
+};
 pub use state::StateVec;
 
 use std::cell::RefCell;
@@ -80,10 +82,15 @@ pub fn simulate<D: Dynamics + ?Sized>(
             },
         }));
     }
-    if arm.contact().is_some_and(|c| c.keeps_records()) {
-        return touch::run(arm, x0, opts);
+    match arm.contact() {
+        Some(set) if set.keeps_records() => touch::run(arm, x0, opts),
+        Some(set) => {
+            let (mut traj, stats) = run_leg(arm, 0.0, x0, opts)?;
+            crate::contact::record_columns(arm, set, &mut traj, 0);
+            Ok((traj, stats))
+        }
+        None => run_leg(arm, 0.0, x0, opts),
     }
-    run_leg(arm, 0.0, x0, opts)
 }
 
 /// From (t0, x0) to `opts.t_end` or a terminal event: with the joints

@@ -12,7 +12,7 @@ use crate::arm::{AccelError, Dynamics, Workspace, accelerations};
 use crate::jacobian::rhs_jacobian;
 
 /// (power, depth) of the contacts at (t, x).
-pub(super) type MeterFn<'a> = dyn Fn(f64, &[f64]) -> (f64, f64) + 'a;
+pub(super) type MeterFn<'a> = dyn Fn(f64, &[f64]) -> super::record::MeterSample + 'a;
 
 /// The first-order system x' = f(t, x) of an arm; components past 2 n are
 /// padding.
@@ -58,13 +58,12 @@ impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
         }))
     }
 
-    /// The contact meter: (dissipated power, deepest penetration) at
-    /// (t, x), when the arm has contacts.
+    /// The contact meter's sample at (t, x), when the arm has contacts.
     pub(super) fn contact_meter(&self) -> Option<Box<MeterFn<'_>>> {
         let set = self.arm.contact()?;
         let n = self.n;
         Some(Box::new(move |t, x| {
-            crate::contact::power_and_depth(self.arm, set, t, &x[..n], &x[n..2 * n])
+            crate::contact::meter_sample(self.arm, set, t, &x[..n], &x[n..2 * n])
         }))
     }
 

@@ -83,7 +83,7 @@ pub(super) fn run<D: Dynamics + ?Sized>(
     let mut traj = Trajectory {
         t: vec![t0],
         x: vec![x0],
-        events: Vec::new(),
+        ..Default::default()
     };
     let mut stats = empty_stats(opts);
     let times = sample_times(opts, t0);

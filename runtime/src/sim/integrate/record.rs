@@ -33,6 +33,24 @@ pub struct Trajectory {
     pub x: Vec<Vec<f64>>,
     /// The located events, in time order.
     pub events: Vec<EventHit>,
+    /// A system with contacts: at each sample, every contact channel's
+    /// total normal and friction force (`contact::channel_columns`),
+    /// recorded while the run's contact state (impact speeds, held
+    /// contacts) was the sample's. Empty otherwise.
+    pub contact: Vec<Vec<f64>>,
+    /// The contact switches' records, in time order.
+    pub switches: Vec<SwitchRecord>,
+}
+
+/// At a contact switch (`integrate::touch`): the normal impulse the
+/// contact forces had transmitted by then (`ContactMeter`), and the
+/// pairs whose impulse law made the velocities jump there, with the
+/// normal impulse of each (N s).
+#[derive(Clone, Debug, Default)]
+pub struct SwitchRecord {
+    pub t: f64,
+    pub metered_impulse_ns: f64,
+    pub jumps: Vec<(usize, f64)>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -52,13 +70,25 @@ pub struct SimStats {
 }
 
 /// What contacts did over a run, metered on every accepted step: the
-/// energy they dissipated (3-point Gauss-Legendre on the step's dense
-/// output, so as accurate as the integration) and the deepest penetration
-/// seen at those points.
+/// energy they dissipated and the normal impulse their forces transmitted
+/// (3-point Gauss-Legendre on the step's dense output, so as accurate as
+/// the integration), and the deepest penetration seen at those points.
 #[derive(Clone, Copy, Debug, Default, Serialize)]
 pub struct ContactMeter {
     pub dissipated_j: f64,
     pub max_penetration_m: f64,
+    /// The integral of every pair's normal force over time (N s); an
+    /// impulse law's jumps are not forces and are not in it.
+    pub normal_impulse_ns: f64,
+}
+
+/// What `ContactMeter` integrates, at one time: the power the contacts
+/// dissipate, the deepest penetration and the sum of the normal forces.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MeterSample {
+    pub power_w: f64,
+    pub depth_m: f64,
+    pub normal_n: f64,
 }
 
 impl ContactMeter {
@@ -68,13 +98,14 @@ impl ContactMeter {
             (Some(a), Some(b)) => Some(Self {
                 dissipated_j: a.dissipated_j + b.dissipated_j,
                 max_penetration_m: a.max_penetration_m.max(b.max_penetration_m),
+                normal_impulse_ns: a.normal_impulse_ns + b.normal_impulse_ns,
             }),
             (a, b) => a.or(b),
         }
     }
 
-    /// Meter the step [t0, t1] by `at(t) = (power, depth)`.
-    fn step(&mut self, t0: f64, t1: f64, mut at: impl FnMut(f64) -> Option<(f64, f64)>) {
+    /// Meter the step [t0, t1] by `at(t)`.
+    fn step(&mut self, t0: f64, t1: f64, mut at: impl FnMut(f64) -> Option<MeterSample>) {
         // The first call of a run sees no step yet.
         if t1 <= t0 {
             return;
@@ -82,9 +113,10 @@ impl ContactMeter {
         let (mid, half) = (0.5 * (t0 + t1), 0.5 * (t1 - t0));
         let r = (0.6_f64).sqrt();
         for (x, w) in [(-r, 5.0 / 9.0), (0.0, 8.0 / 9.0), (r, 5.0 / 9.0)] {
-            if let Some((power, depth)) = at(mid + half * x) {
-                self.dissipated_j += half * w * power;
-                self.max_penetration_m = self.max_penetration_m.max(depth);
+            if let Some(s) = at(mid + half * x) {
+                self.dissipated_j += half * w * s.power_w;
+                self.normal_impulse_ns += half * w * s.normal_n;
+                self.max_penetration_m = self.max_penetration_m.max(s.depth_m);
             }
         }
     }

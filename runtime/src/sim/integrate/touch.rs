@@ -45,11 +45,22 @@ pub(super) fn run<D: Dynamics + ?Sized>(
             .into_iter()
             .filter(|&i| impact::restitution(set, i).is_some())
             .collect();
+        let mut jumps = Vec::new();
         if !hits.is_empty() {
             let (q, qd) = x.split_at(n);
-            let after = impact::jump(arm, set, t0, q, qd, &hits)
+            let jump = impact::jump(arm, set, t0, q, qd, &hits)
                 .map_err(|e| fail_at(t0, &x, &traj, &stats, e.to_string()))?;
-            x[n..].copy_from_slice(&after);
+            x[n..].copy_from_slice(&jump.qd);
+            jumps = jump.impulses;
+        }
+        // Every leg but the first begins at a switch.
+        if !traj.t.is_empty() || !jumps.is_empty() {
+            let metered = stats.as_ref().and_then(|s| s.contact);
+            traj.switches.push(crate::SwitchRecord {
+                t: t0,
+                metered_impulse_ns: metered.map_or(0.0, |m| m.normal_impulse_ns),
+                jumps,
+            });
         }
         let leg = super::run_leg(arm, t0, x.clone(), opts);
         let (mut seg, more) = match leg {
@@ -73,7 +84,10 @@ pub(super) fn run<D: Dynamics + ?Sized>(
         };
         seg.t.push(t_end);
         seg.x.push(x_end.clone());
+        let from = traj.t.len();
         extend(&mut traj, seg, t0);
+        // While the records are still this leg's.
+        crate::contact::record_columns(arm, set, &mut traj, from);
         if !switched || t_end >= opts.t_end {
             break;
         }
@@ -113,6 +127,7 @@ fn extend(traj: &mut Trajectory, seg: Trajectory, t0: f64) {
     traj.t.extend(seg.t.into_iter().skip(skip));
     traj.x.extend(seg.x.into_iter().skip(skip));
     traj.events.extend(seg.events);
+    traj.switches.extend(seg.switches);
 }
 
 fn add(stats: &mut Option<SimStats>, more: &SimStats) {
