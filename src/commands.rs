@@ -186,6 +186,9 @@ pub struct SimulateArgs {
     /// Output directory (default out/<model name>).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// No progress bar (it shows on a terminal for runs over a second).
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 /// `--start`: how a simulation starts (the model's `[simulate] start`).
@@ -267,6 +270,32 @@ fn initial_coordinates(a: &SimulateArgs, loaded: &mut Loaded) -> Result<(Vec<f64
             )
         })?;
     Ok((sol.q, moved))
+}
+
+/// Where each of the run's options came from, for summary.json:
+/// `{"solver": {"value": "radau5", "from": "model"}, ...}`.
+fn option_sources(
+    a: &SimulateArgs,
+    file: &SimulateDefaults,
+    opts: &SimOptions,
+) -> serde_json::Value {
+    let from = |cli: bool, model: bool| match (cli, model) {
+        (true, _) => "command line",
+        (false, true) => "model",
+        (false, false) => "default",
+    };
+    json!({
+        "solver": {"value": opts.solver, "from": from(a.solver.is_some(), file.solver.is_some())},
+        "t_end": {"value": opts.t_end, "from": from(a.t_end.is_some(), file.t_end.is_some())},
+        "rtol": {"value": opts.rtol, "from": from(a.rtol.is_some(), file.rtol.is_some())},
+        "atol": {"value": opts.atol, "from": from(a.atol.is_some(), file.atol.is_some())},
+        "dt": {"value": opts.dt, "from": from(a.dt.is_some(), file.dt.is_some()),
+               "used": opts.solver.fixed_step()},
+        "output_dt": {"value": opts.output_dt,
+                      "from": if a.output_dt.is_some() { "command line" } else { "default (t_end / 500)" }},
+        "max_steps": {"value": opts.max_steps,
+                      "from": if a.max_steps == SimOptions::default().max_steps { "default" } else { "command line" }},
+    })
 }
 
 /// What the run is asked: the command line, else the model's
@@ -392,7 +421,10 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         .with_context(|| format!("cannot create {}", out_dir.display()))?;
 
     let x0: Vec<f64> = q0.iter().chain(&qd0).copied().collect();
+    let progress = softarm::progress::Progress::start(&loaded.model.name, opts.t_end, a.quiet);
+    opts.progress = progress.as_ref().map(|p| p.cell());
     let result = runtime::simulate(arm, x0, &opts);
+    drop(progress);
     let (traj, stats, failure) = match result {
         Ok((traj, stats)) => (traj, stats, None),
         Err(f) => {
@@ -478,6 +510,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         "atol": opts.atol,
         "dt": solver.fixed_step().then_some(opts.dt),
         "t_end": t_end,
+        "options": option_sources(&a, &loaded.model.simulate, &opts),
         "steps": stats.steps,
         "rejected_steps": stats.rejected_steps,
         "rhs_evaluations": stats.rhs_evaluations,

@@ -14,3 +14,4 @@ pub mod continuum;
 pub mod data;
 pub mod inputs;
 pub mod joints;
+pub mod progress;

@@ -517,6 +517,18 @@ fn cases() -> Vec<(&'static str, String, Vec<&'static str>, Vec<&'static str>)> 
             vec!["segment[0].elements"],
         ),
         (
+            "set a misspelt input channel",
+            format!(
+                "{GOOD}\n[inputs.load]\nkind = \"constant\"\nvalue = 0.0\n[inputs.push]\nkind = \"constant\"\nvalue = 1.0\n"
+            ),
+            vec!["--set", "inputs.lod.value=2"],
+            vec![
+                "inputs.lod.value",
+                "`inputs` has no entry `lod`",
+                "load, push",
+            ],
+        ),
+        (
             "set bad value",
             GOOD.into(),
             vec!["--set", "tip.force=[0,"],

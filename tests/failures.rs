@@ -143,6 +143,13 @@ fn summary_reports_the_run() {
     }
     assert_eq!(s["backend"], "compiled");
     assert_eq!(s["solver"], "dopri5");
+    // The effective options and where each came from.
+    let o = &s["options"];
+    assert_eq!(o["t_end"]["value"], 1.0);
+    assert_eq!(o["t_end"]["from"], "command line");
+    assert_eq!(o["rtol"]["value"], runtime::SimOptions::default().rtol);
+    assert_eq!(o["rtol"]["from"], "default");
+    assert_eq!(o["output_dt"]["value"], 1.0 / runtime::DEFAULT_SAMPLES);
     assert!(s["rhs_evaluations"].as_u64().unwrap() >= 6 * s["steps"].as_u64().unwrap());
     let csv = std::fs::read_to_string(dir.path().join("o/trajectory.csv")).unwrap();
     let header = csv.lines().next().unwrap();

@@ -78,8 +78,20 @@ impl Override {
                         t.insert(key.clone(), self.value.clone());
                         return Ok(());
                     }
-                    // A missing table on the way is created; the schema
-                    // check afterwards rejects keys that do not exist.
+                    // A missing table on the way is created (the schema
+                    // check afterwards rejects keys that do not exist), but
+                    // not inside a table of named entries (`inputs`): there
+                    // a missing name is a misspelt entry, not a new table.
+                    let named_entries =
+                        depth > 0 && !t.is_empty() && t.values().all(toml::Value::is_table);
+                    if named_entries && !t.contains_key(key) {
+                        let at = self.path[..depth].join(".");
+                        let names: Vec<&str> = t.keys().map(String::as_str).collect();
+                        return Err(err(format!(
+                            "`{at}` has no entry `{key}`; it has {}",
+                            names.join(", ")
+                        )));
+                    }
                     t.entry(key.clone())
                         .or_insert_with(|| toml::Value::Table(toml::Table::new()))
                 }

@@ -27,6 +27,10 @@ pub struct SimOptions {
     pub events: Vec<Event>,
     /// Give up after this many steps.
     pub max_steps: usize,
+    /// Where the run reports its progress: every accepted step stores the
+    /// time it reached (`f64::to_bits`), for a progress display that
+    /// polls it from another thread.
+    pub progress: Option<std::sync::Arc<std::sync::atomic::AtomicU64>>,
 }
 
 impl Default for SimOptions {
@@ -41,6 +45,7 @@ impl Default for SimOptions {
             output_times: None,
             events: Vec::new(),
             max_steps: 10_000_000,
+            progress: None,
         }
     }
 }

@@ -148,6 +148,8 @@ pub(super) struct Recorder<'a> {
     /// The contact meter's (power, depth) at (t, x), and its running sum.
     meter: Option<Box<super::ode::MeterFn<'a>>>,
     metered: &'a Cell<Option<ContactMeter>>,
+    /// `SimOptions::progress`.
+    progress: Option<std::sync::Arc<std::sync::atomic::AtomicU64>>,
 }
 
 pub(super) type Watch<'a> = dyn Fn(&[f64], f64) -> Option<String> + 'a;
@@ -182,6 +184,9 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
         if rhs_failed || y_curr.as_ref().iter().any(|v| !v.is_finite()) {
             self.blown_up.set(Some(t_prev));
             return ControlFlag::Terminate;
+        }
+        if let Some(p) = &self.progress {
+            p.store(t_curr.to_bits(), std::sync::atomic::Ordering::Relaxed);
         }
         if let Some(meter) = &self.meter {
             let mut m = self.metered.get().unwrap_or_default();
@@ -333,6 +338,7 @@ impl RunLog {
             contact: ode.contact_switch(),
             meter: ode.contact_meter(),
             metered: &self.metered,
+            progress: opts.progress.clone(),
         }
     }
 
