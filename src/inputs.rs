@@ -5,7 +5,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use eomgen::model::{Input, Model, Offset, ParamLayout};
+use eomgen::model::sensor::{Source, wrench_sources};
+use eomgen::model::{Input, Model, Offset, Param, ParamLayout};
 use runtime::signal::{Drive, Signal, Table, moving_average};
 
 use crate::data::{Csv, resolve};
@@ -83,6 +84,37 @@ pub fn model_drives(model: &Model, layout: &ParamLayout, base: &Path) -> Result<
     let mut signals: BTreeMap<&str, Signal> = BTreeMap::new();
     let mut out = Vec::new();
     for d in layout.driven() {
+        // A tip wrench read in a sensor frame: a weighted sum of sources.
+        let row = match d.param {
+            Param::TipForce(c) => Some(c.index()),
+            Param::TipMoment(c) => Some(3 + c.index()),
+            _ => None,
+        };
+        if let Some(sources) = row.and_then(|r| wrench_sources(model, r)) {
+            let mut terms = Vec::new();
+            for (w, source) in sources {
+                let s = match source {
+                    Source::Constant(v) => Signal::Constant(v),
+                    Source::Channel(name) => {
+                        let (key, input) = model.inputs.get_key_value(name).expect("validated");
+                        if !signals.contains_key(name) {
+                            signals.insert(key, signal(name, input, base)?);
+                        }
+                        signals[name].clone()
+                    }
+                };
+                terms.push((w, s));
+            }
+            let mut signal = Signal::Sum(terms);
+            for _ in 0..d.derivative {
+                signal = signal.derivative();
+            }
+            out.push(Drive {
+                param: layout.index(d.param),
+                signal,
+            });
+            continue;
+        }
         let name = layout
             .channel(model, d.param)
             .with_context(|| format!("{}: no input channel (generator bug)", d.param.name()))?;

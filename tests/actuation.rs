@@ -390,3 +390,126 @@ frequency = 2.0
         assert_close(qdd[0], want, 1e-12, 0.0, &format!("theta'' at t = {t}"));
     }
 }
+
+/// R(q) of a unit quaternion (w, x, y, z).
+fn rotation_of(q: [f64; 4]) -> [[f64; 3]; 3] {
+    let [w, x, y, z] = q;
+    [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ]
+}
+
+fn transpose_times(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| (0..3).map(|k| r[k][i] * v[k]).sum())
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn toml3(v: [f64; 3]) -> String {
+    format!("[{:e}, {:e}, {:e}]", v[0], v[1], v[2])
+}
+
+/// One physical load on a bent 3D arm, given three ways: in the world
+/// frame (a force W and a moment M at the tip point), in the tip frame
+/// (R_tip^T W, R_tip^T M, at the equilibrium's tip orientation), and as a
+/// load cell's reading in a sensor frame turned on the tip (axes
+/// ["z", "x", "y"], or a quaternion) and offset from it (the force acts at
+/// the sensor's origin, so its reading's moment is the tip moment less
+/// r x F): all three have the same equilibrium, to 1e-12, constant or
+/// driven by input channels (a weighted sum of the six channels).
+#[test]
+fn a_load_in_the_world_the_tip_and_a_sensor_frame_bends_the_arm_alike() {
+    let dir = tempfile::tempdir().unwrap();
+    let seg = segment(L, "twist = true");
+    let (w, m_w) = ([0.01, 0.03, -0.02], [0.0004, -0.0002, 0.0006]);
+    let world = arm(&format!(
+        "{seg}[tip]\nforce = {}\nmoment = {}\n",
+        toml3(w),
+        toml3(m_w)
+    ));
+    let mut l = load_text(dir.path(), &world, &[]);
+    let n = l.arm.dof();
+    let sol = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
+    let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
+    let tip_w = [o[0], o[1], o[2]];
+    let r_tip = rotation_of([o[5], o[6], o[7], o[8]]);
+    let (f_t, m_t) = (transpose_times(&r_tip, w), transpose_times(&r_tip, m_w));
+    // The sensor: its x along the tip's z, y along the tip's x, z along
+    // the tip's y; its origin 2 cm along the tip's axis, 1 cm aside.
+    let r_s = [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]];
+    let offset = [0.02, 0.01, 0.0];
+    let f_s = transpose_times(&r_s, f_t);
+    let m_s = transpose_times(
+        &r_s,
+        std::array::from_fn(|i| m_t[i] - cross(offset, f_t)[i]),
+    );
+    // The same rotation as a quaternion: -120 degrees about (1, 1, 1).
+    let h = 0.5;
+    let tip = format!(
+        "{seg}[tip]\nwrench_frame = \"tip\"\nforce = {}\nmoment = {}\n",
+        toml3(f_t),
+        toml3(m_t)
+    );
+    let sensor = |rotation: &str| {
+        format!(
+            "{seg}[tip]\nsensor_rotation = {rotation}\nsensor_offset = {}\nforce = {}\nmoment = {}\n",
+            toml3(offset),
+            toml3(f_s),
+            toml3(m_s)
+        )
+    };
+    let channels = |v: [f64; 3], names: [&str; 3]| -> String {
+        (0..3)
+            .map(|k| {
+                format!(
+                    "[inputs.{}]\nkind = \"constant\"\nvalue = {:e}\n",
+                    names[k], v[k]
+                )
+            })
+            .collect()
+    };
+    let driven = format!(
+        "{seg}[tip]\nsensor_rotation = [\"z\", \"x\", \"y\"]\nsensor_offset = {}\nforce_inputs = [\"fx\", \"fy\", \"fz\"]\nmoment_inputs = [\"mx\", \"my\", \"mz\"]\n{}{}",
+        toml3(offset),
+        channels(f_s, ["fx", "fy", "fz"]),
+        channels(m_s, ["mx", "my", "mz"]),
+    );
+    for (what, text) in [
+        ("tip frame", arm(&tip)),
+        ("sensor axes", arm(&sensor("[\"z\", \"x\", \"y\"]"))),
+        (
+            "sensor quaternion",
+            arm(&sensor(&format!("[{h}, -{h}, -{h}, -{h}]"))),
+        ),
+        ("sensor channels", arm(&driven)),
+    ] {
+        let (tip_pos, q) = static_tip(dir.path(), &text, &[]);
+        eprintln!("{what}: tip {tip_pos:?} against {tip_w:?}");
+        for k in 0..3 {
+            assert_close(tip_pos[k], tip_w[k], 1e-12, L, &format!("{what}: tip {k}"));
+        }
+        for (a, b) in q.iter().zip(&sol.q) {
+            assert_close(*a, *b, 1e-10, 1e-6, &format!("{what}: coordinates"));
+        }
+    }
+}

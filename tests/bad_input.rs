@@ -517,6 +517,42 @@ fn cases() -> Vec<(&'static str, String, Vec<&'static str>, Vec<&'static str>)> 
             vec!["segment[0].elements"],
         ),
         (
+            "sensor axes that are no axes",
+            r(
+                "force = [0.0, 0.0, 0.0]",
+                "force = [0.0, 0.0, 0.0]\nsensor_rotation = [\"x\", \"up\", \"z\"]",
+            ),
+            vec![],
+            vec!["tip.sensor_rotation", "`up` is not an axis"],
+        ),
+        (
+            "sensor axes that reflect",
+            r(
+                "force = [0.0, 0.0, 0.0]",
+                "force = [0.0, 0.0, 0.0]\nsensor_rotation = [\"x\", \"z\", \"y\"]",
+            ),
+            vec![],
+            vec!["tip.sensor_rotation", "right-handed"],
+        ),
+        (
+            "sensor matrix that is no rotation",
+            r(
+                "force = [0.0, 0.0, 0.0]",
+                "force = [0.0, 0.0, 0.0]\nsensor_rotation = [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 1.0]]",
+            ),
+            vec![],
+            vec!["tip.sensor_rotation", "orthonormal"],
+        ),
+        (
+            "sensor in the world frame",
+            r(
+                "force = [0.0, 0.0, 0.0]",
+                "force = [0.0, 0.0, 0.0]\nsensor_offset = [0.0, 0.01, 0.0]\nwrench_frame = \"world\"",
+            ),
+            vec![],
+            vec!["tip.wrench_frame", "sensor frame sits on the tip"],
+        ),
+        (
             "set a misspelt input channel",
             format!(
                 "{GOOD}\n[inputs.load]\nkind = \"constant\"\nvalue = 0.0\n[inputs.push]\nkind = \"constant\"\nvalue = 1.0\n"

@@ -10,6 +10,7 @@ mod error;
 mod load;
 mod params;
 mod schema;
+pub mod sensor;
 mod signals;
 mod structure;
 mod validate;

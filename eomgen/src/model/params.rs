@@ -562,6 +562,24 @@ impl ParamLayout {
                     a[c.index()] / (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
                 }
                 Param::TipMass => m.tip.mass.unwrap_or(0.0),
+                // In a sensor frame: the constant part of the map (a
+                // driven component is overwritten by its drive).
+                Param::TipForce(c) | Param::TipMoment(c) if m.tip.has_sensor() => {
+                    let row = c.index()
+                        + if matches!(p, Param::TipMoment(_)) {
+                            3
+                        } else {
+                            0
+                        };
+                    super::sensor::wrench_sources(m, row)
+                        .unwrap_or_default()
+                        .iter()
+                        .map(|(w, s)| match s {
+                            super::sensor::Source::Constant(v) => w * v,
+                            super::sensor::Source::Channel(_) => 0.0,
+                        })
+                        .sum()
+                }
                 Param::TipForce(c) => m.tip.force.map_or(0.0, |f| f[c.index()]),
                 Param::TipMoment(c) => m.tip.moment.map_or(0.0, |f| f[c.index()]),
                 Param::TipLength => m.tip.length.unwrap_or(0.0),

@@ -557,6 +557,15 @@ pub struct Tip {
     /// load cell's frame, turning with the tip). Structural.
     #[serde(default)]
     pub wrench_frame: Option<WrenchFrame>,
+    /// The wrench is a load cell's reading, in its frame: how its axes sit
+    /// on the tip (`super::sensor`). Implies a wrench that turns with the
+    /// tip.
+    #[serde(default)]
+    pub sensor_rotation: Option<super::sensor::SensorRotation>,
+    /// Where the load cell's origin sits, in the tip frame (m): the force
+    /// acts there. Structural (its moment about the tip point).
+    #[serde(default)]
+    pub sensor_offset: Option<[f64; 3]>,
 }
 
 /// The frame a tip wrench is given in.

@@ -201,11 +201,16 @@ impl Structure {
                 .collect(),
             tip_mass: m.tip.mass.is_some(),
             tip_force: m.tip.force.is_some() || m.tip.force_inputs.is_some(),
-            tip_moment: m.tip.moment.is_some() || m.tip.moment_inputs.is_some(),
+            // A sensor's force off the tip point has a moment about it.
+            tip_moment: m.tip.moment.is_some()
+                || m.tip.moment_inputs.is_some()
+                || (m.tip.sensor_offset.is_some()
+                    && (m.tip.force.is_some() || m.tip.force_inputs.is_some())),
             tip_length: m.tip.length.is_some(),
-            tip_frame_wrench: m.tip.wrench_frame == Some(WrenchFrame::Tip),
+            tip_frame_wrench: m.tip.wrench_frame == Some(WrenchFrame::Tip) || m.tip.has_sensor(),
             tip_force_driven: m.tip.force_inputs.is_some(),
-            tip_moment_driven: m.tip.moment_inputs.is_some(),
+            tip_moment_driven: m.tip.moment_inputs.is_some()
+                || (m.tip.sensor_offset.is_some() && m.tip.force_inputs.is_some()),
             chambers: m
                 .segments
                 .iter()

@@ -122,6 +122,7 @@ fn frame(ck: &Check) -> Result<(), ModelError> {
 /// The tip body and its constant loads.
 fn tip(ck: &Check) -> Result<(), ModelError> {
     let m = ck.m;
+    super::sensor::check(m, ck.file)?;
     if let Some(mass) = m.tip.mass {
         ck.non_negative("tip.mass", mass)?;
     }

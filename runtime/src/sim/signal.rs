@@ -42,6 +42,10 @@ pub enum Signal {
         start: f64,
         end: f64,
     },
+    /// A weighted sum of signals: a parameter several channels drive (a
+    /// tip wrench read in a sensor's frame is a fixed linear map of its six
+    /// channels).
+    Sum(Vec<(f64, Signal)>),
 }
 
 impl Signal {
@@ -90,6 +94,7 @@ impl Signal {
                     0.0
                 }
             }
+            Signal::Sum(terms) => terms.iter().map(|(w, s)| w * s.at(t)).sum(),
         }
     }
 
@@ -129,6 +134,9 @@ impl Signal {
                 bias: 0.0,
                 start: *start,
             },
+            Signal::Sum(terms) => {
+                Signal::Sum(terms.iter().map(|(w, s)| (*w, s.derivative())).collect())
+            }
             Signal::Table(tab) => {
                 let (t0, t1) = (tab.times[0], tab.times[tab.times.len() - 1]);
                 Signal::Gate {
