@@ -148,7 +148,7 @@ pub fn derive(a: DeriveArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub struct SimulateArgs {
     #[command(flatten)]
     pub model: ModelArgs,
@@ -537,6 +537,30 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         &out_dir.join("summary.json"),
         serde_json::to_string_pretty(&summary)?.as_bytes(),
     )?;
+    if !a.quiet {
+        report_run(&loaded, &stats, &tip_error, &out_dir);
+    }
+    if let Some((msg, _)) = failure {
+        if !a.quiet {
+            eprintln!("error: {msg}");
+            eprintln!(
+                "the trajectory up to then is in {}",
+                out_dir.join("trajectory.csv").display()
+            );
+        }
+        return Ok(ExitCode::FAILURE);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The lines a finished run prints on stderr.
+fn report_run(
+    loaded: &Loaded,
+    stats: &runtime::SimStats,
+    tip_error: &Option<compare::TipError>,
+    out_dir: &Path,
+) {
+    let arm = &*loaded.arm;
     eprintln!(
         "{}: {} backend{}, {} {} steps, {} rhs evaluations, {:.3} s wall; wrote {}",
         loaded.model.name,
@@ -573,15 +597,6 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
             sw.reason
         );
     }
-    if let Some((msg, _)) = failure {
-        eprintln!("error: {msg}");
-        eprintln!(
-            "the trajectory up to then is in {}",
-            out_dir.join("trajectory.csv").display()
-        );
-        return Ok(ExitCode::FAILURE);
-    }
-    Ok(ExitCode::SUCCESS)
 }
 
 #[derive(Args)]
@@ -710,7 +725,7 @@ pub fn bench(a: BenchArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub struct StaticArgs {
     #[command(flatten)]
     pub model: ModelArgs,
@@ -752,6 +767,13 @@ fn equilibrium(loaded: &mut Loaded, q0: &Option<String>) -> Result<runtime::Stat
 }
 
 pub fn statics(a: StaticArgs) -> Result<ExitCode> {
+    let v = static_value(&a)?;
+    println!("{}", serde_json::to_string_pretty(&v)?);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `softarm static`'s answer, as JSON.
+pub fn static_value(a: &StaticArgs) -> Result<serde_json::Value> {
     let overrides = a
         .model
         .set
@@ -772,8 +794,7 @@ pub fn statics(a: StaticArgs) -> Result<ExitCode> {
             "load_steps": sol.load_steps,
             "centerline": sol.positions,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
-        return Ok(ExitCode::SUCCESS);
+        return Ok(v);
     }
     let mut loaded = load(&a.model)?;
     let sol = equilibrium(&mut loaded, &a.q0)?;
@@ -790,11 +811,10 @@ pub fn statics(a: StaticArgs) -> Result<ExitCode> {
         "iterations": sol.iterations,
         "load_steps": sol.load_steps,
     });
-    println!("{}", serde_json::to_string_pretty(&v)?);
-    Ok(ExitCode::SUCCESS)
+    Ok(v)
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub struct ModesArgs {
     #[command(flatten)]
     pub model: ModelArgs,
@@ -810,6 +830,13 @@ pub struct ModesArgs {
 }
 
 pub fn modes(a: ModesArgs) -> Result<ExitCode> {
+    let v = modes_value(&a)?;
+    println!("{}", serde_json::to_string_pretty(&v)?);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `softarm modes`' answer, as JSON.
+pub fn modes_value(a: &ModesArgs) -> Result<serde_json::Value> {
     let mut loaded = load(&a.model)?;
     let sol = equilibrium(&mut loaded, &a.q0)?;
     let m = runtime::modes(&*loaded.arm, &sol.q)
@@ -823,8 +850,7 @@ pub fn modes(a: ModesArgs) -> Result<ExitCode> {
     if a.shapes {
         v["shapes"] = json!(m.shapes);
     }
-    println!("{}", serde_json::to_string_pretty(&v)?);
-    Ok(ExitCode::SUCCESS)
+    Ok(v)
 }
 
 #[derive(Args)]

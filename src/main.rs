@@ -1,6 +1,7 @@
 //! The `softarm` command line. See README.md for the commands.
 
 mod commands;
+mod sweep;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -56,6 +57,9 @@ enum Command {
     Modes(commands::ModesArgs),
     /// Stiffness analysis: eigenvalues, stiffness ratio, recommended solver.
     Inspect(commands::InspectArgs),
+    /// A parameter study: simulate, static or modes for every combination
+    /// of --vary values, in parallel; writes sweep.csv and sweep.png.
+    Sweep(sweep::SweepArgs),
 }
 
 fn main() -> ExitCode {
@@ -69,6 +73,7 @@ fn main() -> ExitCode {
         Command::Static(a) => commands::statics(a),
         Command::Modes(a) => commands::modes(a),
         Command::Inspect(a) => commands::inspect(a),
+        Command::Sweep(a) => sweep::sweep(a),
     };
     match result {
         Ok(code) => code,

@@ -1,0 +1,490 @@
+//! `softarm sweep`: a parameter study. Every combination of the `--vary`
+//! values (a grid) is one run of `simulate`, `static` or `modes` with
+//! those values as `--set` overrides, in parallel on all cores (rayon),
+//! each in its own folder; `sweep.csv` has a row per run (the values, its
+//! status, the chosen figures) and `sweep.png` one figure against the
+//! first varied value, a line per value of the second.
+//!
+//! A run that fails is a row with its failure; the sweep goes on.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use rayon::prelude::*;
+use serde_json::Value;
+
+use crate::commands::{self, ModesArgs, SimulateArgs, StaticArgs};
+
+#[derive(Args, Clone)]
+pub struct SweepArgs {
+    /// The run for every combination, with its options (`--t-end`,
+    /// `--solver`, `--set`, ...).
+    #[command(flatten)]
+    pub simulate: SimulateArgs,
+    /// What each combination runs.
+    #[arg(long, value_enum, default_value_t = Study::Simulate)]
+    pub run: Study,
+    /// PATH=VALUES: the values of a model key to combine, as a list
+    /// (`0.1,0.2,0.3`), `lin:a:b:n` or `log:a:b:n` (n values from a to b).
+    /// Repeat for a grid.
+    #[arg(long, value_name = "PATH=VALUES", required = true)]
+    pub vary: Vec<String>,
+    /// Runs at once (default: every core).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// The figure sweep.png plots (a column of sweep.csv; default tip_y,
+    /// or f1_hz for modes).
+    #[arg(long)]
+    pub plot: Option<String>,
+}
+
+/// What a sweep runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Study {
+    Simulate,
+    Static,
+    Modes,
+}
+
+/// One varied key and its values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Vary {
+    pub path: String,
+    /// The values as `--set` takes them.
+    pub values: Vec<String>,
+    /// The values as numbers, where they are (for the plot's axis).
+    pub numbers: Vec<Option<f64>>,
+    pub log: bool,
+}
+
+impl Vary {
+    /// `PATH=V1,V2,...`, `PATH=lin:a:b:n` or `PATH=log:a:b:n`.
+    pub fn parse(s: &str) -> Result<Self> {
+        let (path, spec) = s.split_once('=').with_context(|| {
+            format!("--vary {s}: expected PATH=VALUES, e.g. tip.mass=0,0.01,0.02")
+        })?;
+        let path = path.trim().to_string();
+        let spec = spec.trim();
+        let range = |kind: &str, rest: &str| -> Result<Vec<f64>> {
+            let parts: Vec<&str> = rest.split(':').collect();
+            let bad = || {
+                format!("--vary {s}: expected {kind}:a:b:n with numbers a, b and a count n >= 2")
+            };
+            if parts.len() != 3 {
+                bail!(bad());
+            }
+            let a: f64 = parts[0].trim().parse().with_context(bad)?;
+            let b: f64 = parts[1].trim().parse().with_context(bad)?;
+            let n: usize = parts[2].trim().parse().with_context(bad)?;
+            if n < 2 || !a.is_finite() || !b.is_finite() {
+                bail!(bad());
+            }
+            if kind == "log" && (a <= 0.0 || b <= 0.0) {
+                bail!("--vary {s}: a log range needs positive ends");
+            }
+            Ok((0..n)
+                .map(|i| {
+                    let f = i as f64 / (n - 1) as f64;
+                    match kind {
+                        "log" => (a.ln() + f * (b.ln() - a.ln())).exp(),
+                        _ => a + f * (b - a),
+                    }
+                })
+                .collect())
+        };
+        // Twelve significant digits: 1e5, not 1.0000000000000001e5.
+        let show = |v: &f64| {
+            let r: f64 = format!("{v:.11e}").parse().unwrap_or(*v);
+            format!("{r}")
+        };
+        let (values, log): (Vec<String>, bool) = if let Some(rest) = spec.strip_prefix("lin:") {
+            (range("lin", rest)?.iter().map(show).collect(), false)
+        } else if let Some(rest) = spec.strip_prefix("log:") {
+            (range("log", rest)?.iter().map(show).collect(), true)
+        } else {
+            (split_top_level(spec), false)
+        };
+        if path.is_empty() || values.is_empty() || values.iter().any(|v| v.is_empty()) {
+            bail!("--vary {s}: expected PATH=VALUES with at least one value");
+        }
+        let numbers = values.iter().map(|v| v.trim().parse().ok()).collect();
+        Ok(Self {
+            path,
+            values,
+            numbers,
+            log,
+        })
+    }
+}
+
+/// A list split at its commas outside brackets: `[0,1,0],[1,0,0]` is two.
+fn split_top_level(s: &str) -> Vec<String> {
+    let (mut out, mut cur, mut depth) = (Vec::new(), String::new(), 0i32);
+    for c in s.chars() {
+        match c {
+            '[' => depth += 1,
+            ']' => depth -= 1,
+            ',' if depth == 0 => {
+                out.push(cur.trim().to_string());
+                cur.clear();
+                continue;
+            }
+            _ => {}
+        }
+        cur.push(c);
+    }
+    out.push(cur.trim().to_string());
+    out
+}
+
+/// Every combination, the last key fastest: value indices per key.
+pub fn grid(varies: &[Vary]) -> Vec<Vec<usize>> {
+    let mut combos = vec![Vec::new()];
+    for v in varies {
+        combos = combos
+            .into_iter()
+            .flat_map(|c| {
+                (0..v.values.len()).map(move |i| {
+                    let mut c = c.clone();
+                    c.push(i);
+                    c
+                })
+            })
+            .collect();
+    }
+    combos
+}
+
+/// One run's row: its figures by name, or its failure.
+struct Row {
+    status: String,
+    wall_s: f64,
+    figures: Vec<(String, f64)>,
+}
+
+pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
+    let varies: Vec<Vary> = a
+        .vary
+        .iter()
+        .map(|s| Vary::parse(s))
+        .collect::<Result<_>>()?;
+    let combos = grid(&varies);
+    let name = model_name(&a.simulate.model.model);
+    let out_dir = a
+        .simulate
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-sweep")));
+    std::fs::create_dir_all(&out_dir)
+        .with_context(|| format!("cannot create {}", out_dir.display()))?;
+    let jobs = a.jobs.unwrap_or_else(rayon::current_num_threads).max(1);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs)
+        .build()
+        .context("cannot start the sweep's threads")?;
+    eprintln!(
+        "sweep: {} runs of {:?} on {jobs} threads into {}",
+        combos.len(),
+        a.run,
+        out_dir.display()
+    );
+    let started = Instant::now();
+    let rows: Vec<Row> = pool.install(|| {
+        combos
+            .par_iter()
+            .enumerate()
+            .map(|(i, combo)| run_one(&a, &varies, combo, &out_dir.join(format!("run_{i:04}"))))
+            .collect()
+    });
+    let wall = started.elapsed().as_secs_f64();
+    let csv = sweep_csv(&varies, &combos, &rows);
+    std::fs::write(out_dir.join("sweep.csv"), csv).context("cannot write sweep.csv")?;
+    let figure = a.plot.clone().unwrap_or_else(|| match a.run {
+        Study::Modes => "f1_hz".into(),
+        _ => "tip_y".into(),
+    });
+    plot(
+        &out_dir.join("sweep"),
+        &name,
+        &figure,
+        &varies,
+        &combos,
+        &rows,
+    )?;
+    let failed = rows.iter().filter(|r| r.status != "ok").count();
+    let serial: f64 = rows.iter().map(|r| r.wall_s).sum();
+    eprintln!(
+        "sweep: {} runs, {failed} failed, {wall:.2} s wall ({serial:.2} s of runs); wrote {}",
+        rows.len(),
+        out_dir.join("sweep.csv").display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn model_name(model: &str) -> String {
+    Path::new(model)
+        .file_stem()
+        .map_or_else(|| model.to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+/// One combination: its overrides on the sweep's own, the run in `dir`,
+/// its figures.
+fn run_one(a: &SweepArgs, varies: &[Vary], combo: &[usize], dir: &Path) -> Row {
+    let started = Instant::now();
+    let mut model = a.simulate.model.clone();
+    for (v, &i) in varies.iter().zip(combo) {
+        model.set.push(format!("{}={}", v.path, v.values[i]));
+    }
+    let result = std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create {}", dir.display()))
+        .and_then(|()| study(a, model, dir));
+    let wall_s = started.elapsed().as_secs_f64();
+    match result {
+        Ok((status, figures)) => Row {
+            status,
+            wall_s,
+            figures,
+        },
+        Err(e) => {
+            let msg = format!("{e:#}");
+            let _ = std::fs::write(dir.join("error.txt"), &msg);
+            Row {
+                status: format!("failed: {msg}"),
+                wall_s,
+                figures: Vec::new(),
+            }
+        }
+    }
+}
+
+/// Run the study with `model`'s overrides; (status, figures).
+fn study(
+    a: &SweepArgs,
+    model: crate::ModelArgs,
+    dir: &Path,
+) -> Result<(String, Vec<(String, f64)>)> {
+    let tip = |v: &Value| -> Vec<(String, f64)> {
+        ["tip_x", "tip_y", "tip_z"]
+            .iter()
+            .enumerate()
+            .filter_map(|(k, n)| v.get(k).and_then(Value::as_f64).map(|x| (n.to_string(), x)))
+            .collect()
+    };
+    match a.run {
+        Study::Simulate => {
+            let mut s = a.simulate.clone();
+            s.model = model;
+            s.out = Some(dir.to_path_buf());
+            s.quiet = true;
+            commands::simulate(s)?;
+            let text = std::fs::read_to_string(dir.join("summary.json"))
+                .context("the run wrote no summary.json")?;
+            let v: Value = serde_json::from_str(&text)?;
+            let status = match v["failure"].as_str() {
+                Some(f) => format!("failed: {f}"),
+                None => "ok".into(),
+            };
+            let mut figures = tip(&v["final_state"]["tip_position"]);
+            if let Some(e) = v["tip_error"]["mean_m"].as_f64() {
+                figures.push(("tip_error_mean_mm".into(), 1e3 * e));
+            }
+            if let Some(w) = v["wall_s"].as_f64() {
+                figures.push(("run_wall_s".into(), w));
+            }
+            Ok((status, figures))
+        }
+        Study::Static => {
+            let v = commands::static_value(&StaticArgs {
+                model,
+                q0: a.simulate.q0.clone(),
+                json: true,
+            })?;
+            std::fs::write(dir.join("static.json"), serde_json::to_string_pretty(&v)?)?;
+            Ok(("ok".into(), tip(&v["tip_position"])))
+        }
+        Study::Modes => {
+            let v = commands::modes_value(&ModesArgs {
+                model,
+                q0: a.simulate.q0.clone(),
+                shapes: false,
+                json: true,
+            })?;
+            std::fs::write(dir.join("modes.json"), serde_json::to_string_pretty(&v)?)?;
+            let f = v["frequencies_hz"].as_array().cloned().unwrap_or_default();
+            let figures = f
+                .iter()
+                .take(3)
+                .enumerate()
+                .filter_map(|(k, x)| x.as_f64().map(|x| (format!("f{}_hz", k + 1), x)))
+                .collect();
+            Ok(("ok".into(), figures))
+        }
+    }
+}
+
+/// `sweep.csv`: run, the varied values, status, wall time, then every
+/// figure any run reported (empty where a run has none).
+fn sweep_csv(varies: &[Vary], combos: &[Vec<usize>], rows: &[Row]) -> String {
+    let mut names: Vec<String> = Vec::new();
+    for r in rows {
+        for (n, _) in &r.figures {
+            if !names.contains(n) {
+                names.push(n.clone());
+            }
+        }
+    }
+    let quote = |s: &str| format!("\"{}\"", s.replace('"', "\"\""));
+    let mut out = String::from("run");
+    for v in varies {
+        out.push(',');
+        out.push_str(&quote(&v.path));
+    }
+    out.push_str(",status,wall_s");
+    for n in &names {
+        out.push(',');
+        out.push_str(n);
+    }
+    out.push('\n');
+    for (i, (combo, r)) in combos.iter().zip(rows).enumerate() {
+        out.push_str(&i.to_string());
+        for (v, &k) in varies.iter().zip(combo) {
+            out.push(',');
+            out.push_str(&quote(&v.values[k]));
+        }
+        out.push(',');
+        out.push_str(&quote(r.status.lines().next().unwrap_or("")));
+        out.push_str(&format!(",{:.6}", r.wall_s));
+        for n in &names {
+            out.push(',');
+            if let Some((_, x)) = r.figures.iter().find(|(m, _)| m == n) {
+                out.push_str(&format!("{x:.12e}"));
+            }
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// `<stem>.png`: `figure` against the first varied value (numeric), one
+/// line per value of the second.
+fn plot(
+    stem: &Path,
+    name: &str,
+    figure: &str,
+    varies: &[Vary],
+    combos: &[Vec<usize>],
+    rows: &[Row],
+) -> Result<()> {
+    let Some(first) = varies.first() else {
+        return Ok(());
+    };
+    // (series, x, y) of every run that has the figure and a numeric x.
+    let points: Vec<(usize, f64, f64)> = combos
+        .iter()
+        .zip(rows)
+        .filter_map(|(c, r)| {
+            let x = first.numbers[c[0]]?;
+            let y = r.figures.iter().find(|(m, _)| m == figure)?.1;
+            let series = c.get(1).copied().unwrap_or(0);
+            (x.is_finite() && y.is_finite()).then_some((series, x, y))
+        })
+        .collect();
+    if points.is_empty() {
+        eprintln!(
+            "sweep: no run has a numeric `{figure}` against {}: no plot",
+            first.path
+        );
+        return Ok(());
+    }
+    let series: Vec<(String, Vec<(f64, f64)>)> = match varies.get(1) {
+        Some(second) => (0..second.values.len())
+            .map(|s| {
+                let pts = points
+                    .iter()
+                    .filter(|p| p.0 == s)
+                    .map(|p| (p.1, p.2))
+                    .collect();
+                (format!("{} = {}", second.path, second.values[s]), pts)
+            })
+            .collect(),
+        None => vec![(
+            figure.to_string(),
+            points.iter().map(|p| (p.1, p.2)).collect(),
+        )],
+    };
+    let title = format!("{name}: {figure} against {}", first.path);
+    plot_lines(stem, &title, &first.path, figure, first.log, &series)
+}
+
+/// Lines of (x, y) points, x on a log scale when `log` (as log10 x).
+fn plot_lines(
+    stem: &Path,
+    title: &str,
+    x_name: &str,
+    y_name: &str,
+    log: bool,
+    series: &[(String, Vec<(f64, f64)>)],
+) -> Result<()> {
+    use plotters::prelude::*;
+    let fx = |x: f64| if log { x.log10() } else { x };
+    let all = || series.iter().flat_map(|(_, p)| p.iter());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in all() {
+        (x0, x1) = (x0.min(fx(x)), x1.max(fx(x)));
+        (y0, y1) = (y0.min(y), y1.max(y));
+    }
+    let pad = |a: f64, b: f64| {
+        let d = (b - a).abs().max(1e-12 * a.abs().max(1.0));
+        (a - 0.05 * d, b + 0.05 * d)
+    };
+    let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
+    softarm::compare::register_font();
+    let size = (900u32, 500u32);
+    let mut rgb = vec![255u8; 3 * (size.0 * size.1) as usize];
+    {
+        let e = |e: &dyn std::fmt::Display| anyhow::anyhow!("{}: {e}", stem.display());
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|x| e(&x))?;
+        let root = root.titled(title, ("sans-serif", 20)).map_err(|x| e(&x))?;
+        let mut chart = ChartBuilder::on(&root)
+            .margin(10)
+            .x_label_area_size(35)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|x| e(&x))?;
+        let x_desc = if log {
+            format!("log10 {x_name}")
+        } else {
+            x_name.to_string()
+        };
+        chart
+            .configure_mesh()
+            .x_desc(x_desc)
+            .y_desc(y_name)
+            .draw()
+            .map_err(|x| e(&x))?;
+        for (k, (label, pts)) in series.iter().enumerate() {
+            let color = Palette99::pick(k).to_rgba();
+            let line: Vec<(f64, f64)> = pts.iter().map(|&(x, y)| (fx(x), y)).collect();
+            chart
+                .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))
+                .map_err(|x| e(&x))?
+                .label(label.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+            chart
+                .draw_series(line.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                .map_err(|x| e(&x))?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|x| e(&x))?;
+        root.present().map_err(|x| e(&x))?;
+    }
+    softarm::compare::write_png(&stem.with_extension("png"), size, &rgb)
+}
