@@ -189,6 +189,9 @@ pub struct SimulateArgs {
     /// No progress bar (it shows on a terminal for runs over a second).
     #[arg(long)]
     pub quiet: bool,
+    /// Points per element of shape.csv's centreline (0: no shape.csv).
+    #[arg(long, default_value_t = softarm::shape::DEFAULT_POINTS)]
+    pub shape_points: usize,
 }
 
 /// `--start`: how a simulation starts (the model's `[simulate] start`).
@@ -450,6 +453,11 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         &out_dir.join("trajectory.csv"),
         trajectory_csv(arm, &traj).as_bytes(),
     )?;
+    if a.shape_points > 0 {
+        let shape = softarm::shape::Shape::new(&loaded, a.shape_points)?;
+        let csv = shape.csv(arm, &traj.t, &traj.x);
+        write_atomic(&out_dir.join("shape.csv"), csv.as_bytes())?;
+    }
     let body_names: Vec<String> = loaded.model.bodies.iter().map(|b| b.name.clone()).collect();
     for (body, ix) in softarm::joints::free_bodies(arm, &body_names) {
         let path: Vec<(f64, f64, f64)> = traj

@@ -15,3 +15,4 @@ pub mod data;
 pub mod inputs;
 pub mod joints;
 pub mod progress;
+pub mod shape;

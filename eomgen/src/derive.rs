@@ -61,7 +61,7 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
         // kinematics' trig with M and h, and a right-hand side that touches
         // nothing needs nothing else.
         let s = solve_accelerations(&mut cas, &eq.mass_upper, &eq.bias);
-        let points = sys.samples.iter().flatten().copied();
+        let points = sys.samples.iter().flat_map(|s| s.point);
         let outs: Vec<_> = s
             .qdd
             .into_iter()
@@ -177,7 +177,7 @@ fn contact_outputs(cas: &mut Cas, sys: &System) -> ContactOutputs {
     let (mut points, mut tangent) = (Vec::new(), Vec::new());
     // (coordinates the point depends on, its v and J)
     let mut per_point: Vec<(Vec<bool>, Vec<ExprId>)> = Vec::new();
-    for p in &sys.samples {
+    for p in sys.samples.iter().map(|s| &s.point) {
         let v = cas.kinematic_rates(p, &pairs);
         let jac: Vec<ExprId> = p
             .iter()

@@ -11,4 +11,5 @@ pub mod emit;
 pub mod generate;
 pub mod method;
 pub mod model;
+pub mod shape;
 pub mod tmt;

@@ -34,7 +34,9 @@ use crate::tmt::spatial::{
     M3, V3, add3, base_frame, bind3, coefficients, half_k_sq, left_jacobian, quat_mul, rotation,
     rotation_quat,
 };
-use crate::tmt::system::{Body, Coordinates, Inertia, ParamSymbols, System, TipMount, tip_loads};
+use crate::tmt::system::{
+    Body, Coordinates, Inertia, ParamSymbols, Sample, System, TipMount, tip_loads,
+};
 
 pub(super) struct Eba;
 
@@ -146,6 +148,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         .flat_map(|(s, g)| std::iter::repeat_n(s, g.elements))
         .collect();
     let mut strains = Vec::new();
+    let mut samples = Vec::new();
     for (k, &segment) in segment_of.iter().enumerate() {
         let c = 6 * k;
         let u: V3 = std::array::from_fn(|i| coords.q[c + i]);
@@ -165,6 +168,16 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         quat = quat_mul(cas, &q0, &q_rel);
         omega = element_omega;
         let axis = [r[0][0], r[1][0], r[2][0]];
+        // The slab's centreline, straight through its centre.
+        for j in 1..=structure.contact_points {
+            let d = cas.scaled(j as f64 / structure.contact_points as f64 - 0.5, l);
+            let point = std::array::from_fn(|i| {
+                let a = cas.mul(d, axis[i]);
+                cas.add(centre[i], a)
+            });
+            let point = bind3(cas, point);
+            samples.push(Sample { point, frame: quat });
+        }
         bodies.push(Body {
             mass: symbols.element(k, ElementParam::Mass),
             inertia: Inertia::Axisymmetric {
@@ -240,7 +253,14 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         chain: None,
         seeds: base.seeds,
         segment_ends: Vec::new(),
-        samples: Vec::new(),
+        samples,
+        bases: match structure.contact_points {
+            0 => Vec::new(),
+            _ => vec![Sample {
+                point: p0,
+                frame: q0,
+            }],
+        },
         planar: None,
     };
     let mount = TipMount {
@@ -562,6 +582,7 @@ fn empty_system(cas: &mut Cas, coords: Coordinates, gravity: V3) -> System {
         seeds: Vec::new(),
         segment_ends: Vec::new(),
         samples: Vec::new(),
+        bases: Vec::new(),
         planar: None,
     }
 }

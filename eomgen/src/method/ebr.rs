@@ -42,7 +42,7 @@ impl ModellingMethod for Ebr {
             arm.sample(cas, |cas, s| {
                 if s <= 0.5 {
                     let d = cas.scaled(s, el.l);
-                    return advance(cas, &f, d).p;
+                    return advance(cas, &f, d);
                 }
                 // Past the joint: the turned half, stretched.
                 let at_joint = advance(cas, &f, half);
@@ -50,7 +50,7 @@ impl ModellingMethod for Ebr {
                 let joint = compose(cas, &at_joint, Some((&r, &q)), None, Some(&w));
                 let b_len = cas.add(half, st.stretch);
                 let d = cas.scaled(2.0 * (s - 0.5), b_len);
-                advance(cas, &joint, d).p
+                advance(cas, &joint, d)
             });
             let (b, end) = before_joint(cas, &arm.f, quarter, half);
             arm.bodies.push(el.body(arm.f.axis(), b, arm.f.w, half_m));

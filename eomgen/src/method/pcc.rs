@@ -42,7 +42,7 @@ impl ModellingMethod for Pcc {
                 let rho = st.rho.map(|e| cas.scaled(s, e));
                 let rate = st.rate.map(|e| cas.scaled(s, e));
                 let len = cas.scaled(s, st.len);
-                arc(cas, &f, &rho, &rate, len).3.p
+                arc(cas, &f, &rho, &rate, len).3
             });
             let (centroid, axis, omega, end) = arc(cas, &arm.f, &st.rho, &st.rate, st.len);
             let centroid = bind3(cas, centroid);
@@ -108,7 +108,8 @@ fn pcc_element(
     (c, chord.w, cas.bind(arc), end)
 }
 
-/// The points at s = j/P (j = 1..P) of a planar arc of length l bent by
+/// The points at s = j/P (j = 1..P) of a planar arc, with the section's
+/// angle there, of length l bent by
 /// theta from frame f: the arc's first fraction s is the arc of length s l
 /// bent by s theta, whose chord is s l sinc(s theta / 2) at the angle
 /// phi + s theta / 2. With a = theta / (2P), c = cos a and u = e^{i a},
@@ -122,7 +123,7 @@ fn arc_points(
     l: ExprId,
     theta: ExprId,
     points: usize,
-) -> Vec<[ExprId; 2]> {
+) -> Vec<([ExprId; 2], ExprId)> {
     let a = cas.scaled(0.5 / points as f64, theta);
     let (ca, sa) = (cas.cos(a), cas.sin(a));
     let (ca, sa) = (cas.bind(ca), cas.bind(sa));
@@ -136,7 +137,7 @@ fn arc_points(
     let two_c = cas.scaled(2.0, ca);
     let (mut u_prev, mut u) = (cas.zero(), one);
     let mut out = Vec::with_capacity(points);
-    for _ in 0..points {
+    for j in 1..=points {
         // Direction e^{i (phi + j a)}, j = 1, 2, ...
         let (r1, r2) = (cas.mul(re, ca), cas.mul(im, sa));
         let (i1, i2) = (cas.mul(re, sa), cas.mul(im, ca));
@@ -149,7 +150,10 @@ fn arc_points(
         let len = cas.scaled(1.0 / points as f64, len);
         let len = cas.bind(len);
         let (dx, dy) = (cas.mul(len, re), cas.mul(len, im));
-        out.push([cas.add(f.x, dx), cas.add(f.y, dy)]);
+        // The section there is turned by s theta.
+        let turn = cas.scaled(j as f64 / points as f64, theta);
+        let angle = cas.add(f.phi, turn);
+        out.push(([cas.add(f.x, dx), cas.add(f.y, dy)], angle));
         // U_j = 2 c U_{j-1} - U_{j-2}.
         let t = cas.mul(two_c, u);
         let next = cas.sub(t, u_prev);

@@ -59,7 +59,7 @@ impl ModellingMethod for Rigid {
                 let f = arm.f;
                 arm.sample(cas, |cas, s| {
                     let d = cas.scaled(s, l);
-                    planar::along(cas, &f, d)
+                    planar::advance(cas, f, d)
                 });
                 let half = cas.scaled(0.5, l);
                 let c = planar::along(cas, &arm.f, half);
@@ -73,12 +73,12 @@ impl ModellingMethod for Rigid {
                 arm.sample(cas, |cas, s| {
                     if s <= 0.5 {
                         let d = cas.scaled(s, l);
-                        return planar::along(cas, &f, d);
+                        return planar::advance(cas, f, d);
                     }
                     let mid = planar::advance(cas, f, half);
                     let turned = planar::rotate(cas, mid, el.q, el.qd);
                     let d = cas.scaled(s - 0.5, l);
-                    planar::along(cas, &turned, d)
+                    planar::advance(cas, turned, d)
                 });
                 let c = planar::along(cas, &arm.f, quarter);
                 arm.body(cas, c, arm.f.w, half_m, el.inertia);
@@ -102,7 +102,7 @@ impl ModellingMethod for Rigid {
                     let f = arm.f;
                     arm.sample(cas, |cas, s| {
                         let d = cas.scaled(s, l);
-                        advance(cas, &f, d).p
+                        advance(cas, &f, d)
                     });
                     let half = cas.scaled(0.5, l);
                     let mid = advance(cas, &arm.f, half);
@@ -125,7 +125,7 @@ impl ModellingMethod for Rigid {
                             (&turned, s - 0.5)
                         };
                         let d = cas.scaled(d, l);
-                        advance(cas, from, d).p
+                        advance(cas, from, d)
                     });
                     let b = advance(cas, &arm.f, quarter);
                     arm.bodies.push(el.body(arm.f.axis(), b.p, arm.f.w, half_m));

@@ -85,6 +85,14 @@ impl ModellingMethod for Rom {
                 rho,
                 offset_scale: thin,
             });
+            // A slice is an arc of constant strain, as a pcc element.
+            let f = arm.f;
+            arm.sample(cas, |cas, s| {
+                let rho = rho.map(|e| cas.scaled(s, e));
+                let rate = rate.map(|e| cas.scaled(s, e));
+                let len = cas.scaled(s, len);
+                arc(cas, &f, &rho, &rate, len).3
+            });
             let (centroid, axis, omega, end) = arc(cas, &arm.f, &rho, &rate, len);
             let centroid = bind3(cas, centroid);
             arm.bodies.push(el.body(axis, centroid, omega, el.m));

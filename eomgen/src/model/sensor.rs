@@ -5,7 +5,9 @@
 //! The sensor's reading (F_s, M_s) at its origin is, in the tip frame and
 //! about the tip point,
 //!
-//!     F_t = R F_s,    M_t = R M_s + r x (R F_s),
+//! ```text
+//! F_t = R F_s,    M_t = R M_s + r x (R F_s),
+//! ```
 //!
 //! a constant linear map of the six readings. The kinematics never sees
 //! the sensor: the tip wrench parameters turn with the tip as for

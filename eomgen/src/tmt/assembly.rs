@@ -20,7 +20,7 @@ use crate::model::{
     AssemblyShape, BodyParam, JointParam, JointShape, Param, ParamLayout, Rate, SpringParam, Xyz,
 };
 
-use super::system::{Body, Coordinates, Inertia, ParamSymbols, PointForce, System};
+use super::system::{Body, Coordinates, Inertia, ParamSymbols, PointForce, Sample, System};
 
 /// The assembled system and its constraint equations.
 pub struct Assembled {
@@ -76,7 +76,17 @@ pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -
         .map(|(k, (name, free))| b.body(cas, k, name, *free))
         .collect();
     if a.contact {
-        b.samples.extend(body_frames.iter().map(|f| f.point));
+        let spatial = b.spatial;
+        for f in &body_frames {
+            let sample = match spatial {
+                true => Sample {
+                    point: f.point,
+                    frame: f.quat,
+                },
+                false => Sample::planar(cas, f.point, f.angle),
+            };
+            b.samples.push(sample);
+        }
     }
     let frame = |f: FrameRef| match f {
         FrameRef::World => b.world,
@@ -128,7 +138,9 @@ struct Builder {
     /// Free 3D bodies' quaternions, held to unit norm by the last rows.
     units: Vec<(String, [ExprId; 4])>,
     /// Contact points: the arms' samples, then the bodies' centres.
-    samples: Vec<[ExprId; 3]>,
+    samples: Vec<Sample>,
+    /// The arms' base frames.
+    bases: Vec<Sample>,
 }
 
 impl Builder {
@@ -167,6 +179,7 @@ impl Builder {
             rows: Vec::new(),
             units: Vec::new(),
             samples: Vec::new(),
+            bases: Vec::new(),
         }
     }
 
@@ -244,6 +257,7 @@ impl Builder {
         self.actuation.push(sys.actuation);
         self.point_forces.extend(sys.point_forces);
         self.samples.extend(sys.samples.iter().copied());
+        self.bases.extend(sys.bases.iter().copied());
         self.moments.extend(sys.moments);
         self.seeds.extend(sys.seeds);
         match sys.planar {
@@ -505,6 +519,7 @@ impl Builder {
             planar: None,
             segment_ends: Vec::new(),
             samples: self.samples,
+            bases: self.bases,
         };
         Assembled {
             sys,

@@ -62,6 +62,7 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
         let names = method::coordinate_names(structure);
         let mut arm = SpatialArm::new(cas, names, symbols);
         arm.points = structure.contact_points;
+        let base = (arm.points > 0).then(|| arm.base_pose());
         let mut ends = Vec::new();
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
             m.build_spatial(cas, &mut arm, g, s);
@@ -69,11 +70,13 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
         }
         let mut sys = arm.finish(cas, structure);
         sys.segment_ends = ends;
+        sys.bases = base.into_iter().collect();
         sys
     } else {
         let names = method::coordinate_names(structure);
         let mut arm = PlanarArm::new(cas, names, symbols);
         arm.points = structure.contact_points;
+        let base = (arm.points > 0).then(|| arm.base_pose(cas));
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
             for _ in 0..g.elements {
                 let el = arm.begin_element(s);
@@ -81,7 +84,9 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
                 arm.end_element(cas, &el);
             }
         }
-        arm.finish(cas, structure)
+        let mut sys = arm.finish(cas, structure);
+        sys.bases = base.into_iter().collect();
+        sys
     }
 }
 

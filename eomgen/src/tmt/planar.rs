@@ -13,8 +13,8 @@ use crate::model::{ElementParam, Param, Structure};
 
 use super::actuation::{Strain, actuation};
 use super::system::{
-    Body, Chain, Coordinates, Inertia, Link, ParamSymbols, PlanarFrames, PlanarPose, System,
-    TipMount, tip_loads,
+    Body, Chain, Coordinates, Inertia, Link, ParamSymbols, PlanarFrames, PlanarPose, Sample,
+    System, TipMount, tip_loads,
 };
 
 /// A planar frame: origin, absolute angle and its rate.
@@ -53,7 +53,7 @@ pub(crate) struct PlanarArm<'a> {
     ends: Vec<PlanarPose>,
     /// Contact points per element, and the points sampled so far.
     pub points: usize,
-    samples: Vec<[ExprId; 3]>,
+    samples: Vec<Sample>,
 }
 
 /// One planar element: its angle, rate and parameters.
@@ -188,24 +188,32 @@ impl<'a> PlanarArm<'a> {
         });
     }
 
-    /// Contact points along the element: `at(s)` is the centreline at the
+    /// Points along the element: `at(s)` is the centreline's frame at the
     /// fraction s of the element, for s = 1/P, 2/P, ..., 1.
-    pub fn sample(&mut self, cas: &mut Cas, at: impl Fn(&mut Cas, f64) -> [ExprId; 2]) {
+    pub fn sample(&mut self, cas: &mut Cas, at: impl Fn(&mut Cas, f64) -> Frame) {
         for j in 1..=self.points {
-            let [x, y] = at(cas, j as f64 / self.points as f64);
-            let point = [cas.bind(x), cas.bind(y), self.z];
-            self.samples.push(point);
+            let f = at(cas, j as f64 / self.points as f64);
+            let point = [cas.bind(f.x), cas.bind(f.y), self.z];
+            let sample = Sample::planar(cas, point, f.phi);
+            self.samples.push(sample);
         }
     }
 
-    /// Contact points along the element given all at once (P of them, at
-    /// s = 1/P, ..., 1), by a method that shares work between them.
-    pub fn sample_all(&mut self, cas: &mut Cas, points: Vec<[ExprId; 2]>) {
+    /// Points along the element given all at once (P of them, at s = 1/P,
+    /// ..., 1, with the section's angle at each), by a method that shares
+    /// work between them.
+    pub fn sample_all(&mut self, cas: &mut Cas, points: Vec<([ExprId; 2], ExprId)>) {
         debug_assert_eq!(points.len(), self.points);
-        for [x, y] in points {
+        for ([x, y], angle) in points {
             let point = [cas.bind(x), cas.bind(y), self.z];
-            self.samples.push(point);
+            let sample = Sample::planar(cas, point, angle);
+            self.samples.push(sample);
         }
+    }
+
+    /// The shape's first point: the frame the arm starts from.
+    pub fn base_pose(&self, cas: &mut Cas) -> Sample {
+        Sample::planar(cas, [self.f.x, self.f.y, self.z], self.f.phi)
     }
 
     /// The element ends at the end frame: its link, spring and damper.
@@ -275,6 +283,7 @@ impl<'a> PlanarArm<'a> {
             seeds,
             segment_ends: Vec::new(),
             samples,
+            bases: Vec::new(),
             planar: Some(PlanarFrames {
                 segment_ends: ends,
                 tip: PlanarPose {

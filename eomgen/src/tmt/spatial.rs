@@ -31,7 +31,7 @@ use crate::model::{ElementParam, Param, SegmentShape, Structure};
 
 use super::actuation::{Strain, actuation, thinning};
 use super::system::{
-    Body, Chain, Coordinates, Inertia, Link, ParamSymbols, System, TipMount, tip_loads,
+    Body, Chain, Coordinates, Inertia, Link, ParamSymbols, Sample, System, TipMount, tip_loads,
 };
 
 pub(crate) type V3 = [ExprId; 3];
@@ -319,7 +319,7 @@ pub(crate) struct SpatialArm<'a> {
     pub shared_coordinates: bool,
     /// Contact points per element, and the points sampled so far.
     pub points: usize,
-    samples: Vec<V3>,
+    samples: Vec<Sample>,
 }
 
 /// An element's lumped quantities (parameters).
@@ -403,13 +403,24 @@ impl<'a> SpatialArm<'a> {
         (self.coords.q[i], self.coords.qd[i])
     }
 
-    /// Contact points along the element: `at(s)` is the centreline at the
+    /// Points along the element: `at(s)` is the centreline's frame at the
     /// fraction s of the element, for s = 1/P, 2/P, ..., 1.
-    pub fn sample(&mut self, cas: &mut Cas, at: impl Fn(&mut Cas, f64) -> V3) {
+    pub fn sample(&mut self, cas: &mut Cas, at: impl Fn(&mut Cas, f64) -> Frame) {
         for j in 1..=self.points {
-            let p = at(cas, j as f64 / self.points as f64);
-            let p = bind3(cas, p);
-            self.samples.push(p);
+            let f = at(cas, j as f64 / self.points as f64);
+            let point = bind3(cas, f.p);
+            self.samples.push(Sample {
+                point,
+                frame: f.quat,
+            });
+        }
+    }
+
+    /// The shape's first point: the frame the arm starts from.
+    pub fn base_pose(&self) -> Sample {
+        Sample {
+            point: self.f.p,
+            frame: self.f.quat,
         }
     }
 
@@ -528,6 +539,7 @@ impl<'a> SpatialArm<'a> {
             seeds,
             segment_ends: Vec::new(),
             samples,
+            bases: Vec::new(),
             planar: None,
         };
         let mount = TipMount {

@@ -230,9 +230,33 @@ pub struct System {
     /// 3D chains: each segment's end frame, origin and orientation (w, x,
     /// y, z), for joints (empty for a method that builds the whole arm).
     pub segment_ends: Vec<([ExprId; 3], [ExprId; 4])>,
-    /// Contact points along the arm's centreline, element by element
-    /// (`Structure::contact_points` each, the last at the element's end).
-    pub samples: Vec<[ExprId; 3]>,
+    /// Points along the arm's centreline with their cross-section frames,
+    /// element by element (`Structure::contact_points` each, the last at
+    /// the element's end): contact reads the points, the shape both.
+    pub samples: Vec<Sample>,
+    /// The frame each arm's first element starts from (an arm's shape's
+    /// first point), arm by arm.
+    pub bases: Vec<Sample>,
+}
+
+/// A point of the centreline and the orientation of the cross section
+/// there (unit quaternion w, x, y, z; its x axis along the arm).
+#[derive(Clone, Copy, Debug)]
+pub struct Sample {
+    pub point: [ExprId; 3],
+    pub frame: [ExprId; 4],
+}
+
+impl Sample {
+    /// A planar arm's frame: turned by `angle` about z.
+    pub fn planar(cas: &mut Cas, point: [ExprId; 3], angle: ExprId) -> Self {
+        let half = cas.scaled(0.5, angle);
+        let zero = cas.zero();
+        Self {
+            point,
+            frame: [cas.cos(half), zero, zero, cas.sin(half)],
+        }
+    }
 }
 
 /// A planar frame: origin and angle from the world's x axis.

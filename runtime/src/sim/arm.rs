@@ -50,6 +50,9 @@ pub trait Dynamics {
     }
     /// The base parameter values (layout `info().parameters`).
     fn base_params(&self) -> &[f64];
+    /// The parameters at time t (base then derived), driven ones from
+    /// their signals: what the kernels read then.
+    fn params_at(&self, t: f64) -> Vec<f64>;
     /// Replace the base parameters; the derived ones are recomputed.
     fn set_base_params(&mut self, params: &[f64]);
     /// Drive parameters by signals of time (inputs); replaces earlier ones.
@@ -307,6 +310,9 @@ impl<K: Kernels> Dynamics for Arm<K> {
     }
     fn base_params(&self) -> &[f64] {
         &self.params[..self.kernels.info().parameters.len()]
+    }
+    fn params_at(&self, t: f64) -> Vec<f64> {
+        self.with_params(t, <[f64]>::to_vec)
     }
     fn set_base_params(&mut self, params: &[f64]) {
         let derived = derived_params(&self.kernels, params);
