@@ -20,7 +20,7 @@ use softarm::generated::MODELS;
 
 use crate::ModelArgs;
 
-fn load(a: &ModelArgs) -> Result<Loaded> {
+pub fn load(a: &ModelArgs) -> Result<Loaded> {
     let overrides = a
         .set
         .iter()

@@ -15,4 +15,6 @@ pub mod data;
 pub mod inputs;
 pub mod joints;
 pub mod progress;
+pub mod scene;
 pub mod shape;
+pub mod viewer;

@@ -1,5 +1,6 @@
 //! The `softarm` command line. See README.md for the commands.
 
+mod animate;
 mod commands;
 mod sweep;
 
@@ -60,6 +61,10 @@ enum Command {
     /// A parameter study: simulate, static or modes for every combination
     /// of --vary values, in parallel; writes sweep.csv and sweep.png.
     Sweep(sweep::SweepArgs),
+    /// Simulate and show the arm: animation.gif (a shaded tube from a
+    /// view, the time, the tip path, the inputs) and viewer.html (an
+    /// interactive 3D view in one file).
+    Animate(animate::AnimateArgs),
 }
 
 fn main() -> ExitCode {
@@ -74,6 +79,7 @@ fn main() -> ExitCode {
         Command::Modes(a) => commands::modes(a),
         Command::Inspect(a) => commands::inspect(a),
         Command::Sweep(a) => sweep::sweep(a),
+        Command::Animate(a) => animate::animate(a),
     };
     match result {
         Ok(code) => code,

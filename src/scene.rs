@@ -1,0 +1,227 @@
+//! What an animation shows, read from a run's outputs: the parts of
+//! `shape.csv` over time (arms as tubes of their segments' radii, bodies by
+//! their shapes, obstacles), the tip path of `trajectory.csv`, the input
+//! channels' values, and the measured tip of `[compare]`.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use eomgen::model::assembly::BodyShape;
+use runtime::contact::Shape as ObstacleShape;
+use serde::Serialize;
+
+use crate::backend::Loaded;
+use crate::data::Csv;
+
+/// A part of the scene and how it is drawn.
+#[derive(Clone, Debug, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Look {
+    /// A tube; the radius of each row (its segment's outer radius).
+    Tube {
+        radius: Vec<f64>,
+    },
+    Sphere {
+        radius: f64,
+    },
+    /// A cylinder along the row's x axis, or a box of half sizes.
+    Cylinder {
+        radius: f64,
+        half_length: f64,
+    },
+    Box {
+        half: [f64; 3],
+    },
+    /// A plane through the row's point, normal along its x axis.
+    Plane,
+}
+
+/// One part: its name, look and pose rows (x, y, z, qw, qx, qy, qz) at
+/// every frame.
+#[derive(Clone, Debug, Serialize)]
+pub struct Part {
+    pub name: String,
+    pub look: Look,
+    pub frames: Vec<Vec<[f64; 7]>>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Scene {
+    pub model: String,
+    /// 2 or 3; planar arms move in the x-y plane (y up), 3D ones have z up.
+    pub dimensions: u8,
+    pub t: Vec<f64>,
+    pub parts: Vec<Part>,
+    /// The tip at each frame (`trajectory.csv`'s tip_x, tip_y, tip_z).
+    pub tip: Vec<[f64; 3]>,
+    /// Input channels' values at each frame, by name.
+    pub inputs: BTreeMap<String, Vec<f64>>,
+    /// The measured tip (t, x, y, z), if the model has `[compare]`.
+    pub measured: Vec<[f64; 4]>,
+}
+
+impl Scene {
+    /// The scene of the run in `dir` of the model `loaded`.
+    pub fn read(loaded: &Loaded, dir: &Path) -> Result<Self> {
+        let traj = Csv::read(&dir.join("trajectory.csv"))?;
+        let t = traj.column("t")?;
+        let [x, y, z] = ["tip_x", "tip_y", "tip_z"].map(|c| traj.column(c));
+        let (x, y, z) = (x?, y?, z?);
+        let tip = (0..t.len()).map(|i| [x[i], y[i], z[i]]).collect();
+        let parts = read_shape(&dir.join("shape.csv"), &t)?
+            .into_iter()
+            .map(|(name, s, frames)| {
+                let look = look_of(loaded, &name, &s);
+                Part { name, look, frames }
+            })
+            .collect();
+        let mut inputs = BTreeMap::new();
+        for (name, input) in &loaded.model.inputs {
+            let signal = crate::inputs::signal(name, input, &loaded.base_dir)?;
+            inputs.insert(name.clone(), t.iter().map(|&t| signal.at(t)).collect());
+        }
+        let measured = match &loaded.model.compare {
+            Some(spec) => {
+                let m = crate::compare::measured(spec, &loaded.base_dir, [x[0], y[0], z[0]])?;
+                let end = t.last().copied().unwrap_or(0.0);
+                (m.t.iter().zip(&m.tip))
+                    .filter(|(t, _)| **t <= end)
+                    .map(|(t, p)| [*t, p[0], p[1], p[2]])
+                    .collect()
+            }
+            None => Vec::new(),
+        };
+        Ok(Self {
+            model: loaded.model.name.clone(),
+            dimensions: loaded.model.dimensions,
+            t,
+            parts,
+            tip,
+            inputs,
+            measured,
+        })
+    }
+}
+
+/// `shape.csv`'s rows grouped by part, in order of first appearance: the
+/// material coordinate of each row, and the rows at each time of `t`.
+type Tracks = Vec<(String, Vec<f64>, Vec<Vec<[f64; 7]>>)>;
+
+fn read_shape(path: &Path, t: &[f64]) -> Result<Tracks> {
+    let mut reader = csv::Reader::from_path(path).with_context(|| {
+        format!(
+            "{}: cannot read (run with --shape-points > 0)",
+            path.display()
+        )
+    })?;
+    let mut tracks: Tracks = Vec::new();
+    let mut frame = 0usize;
+    let mut last_t = f64::NAN;
+    for record in reader.records() {
+        let r = record.with_context(|| format!("{}: a bad row", path.display()))?;
+        let num = |i: usize| -> Result<f64> {
+            r.get(i)
+                .and_then(|s| s.parse().ok())
+                .with_context(|| format!("{}: column {i} is not a number", path.display()))
+        };
+        let time = num(0)?;
+        if time != last_t {
+            if !last_t.is_nan() {
+                frame += 1;
+            }
+            last_t = time;
+        }
+        let part = r.get(1).unwrap_or_default();
+        let pose: [f64; 7] = [
+            num(4)?,
+            num(5)?,
+            num(6)?,
+            num(7)?,
+            num(8)?,
+            num(9)?,
+            num(10)?,
+        ];
+        let k = match tracks.iter().position(|(n, ..)| n == part) {
+            Some(k) => k,
+            None => {
+                tracks.push((part.to_string(), Vec::new(), Vec::new()));
+                tracks.len() - 1
+            }
+        };
+        let (_, s, frames) = &mut tracks[k];
+        if frame == 0 {
+            s.push(num(3)?);
+        }
+        frames.resize(frame + 1, Vec::new());
+        frames[frame].push(pose);
+    }
+    if frame + 1 != t.len() || tracks.is_empty() {
+        bail!(
+            "{}: {} times, trajectory.csv {}: not the same run",
+            path.display(),
+            frame + 1,
+            t.len()
+        );
+    }
+    Ok(tracks)
+}
+
+/// How a part of `shape.csv` is drawn: an arm by its segments' radii, a
+/// body or an obstacle by its shape.
+fn look_of(loaded: &Loaded, name: &str, s: &[f64]) -> Look {
+    let m = &loaded.model;
+    let radius_of = |segments: &[eomgen::model::Segment]| -> Look {
+        // Each row's segment, by its material coordinate.
+        let radius = s
+            .iter()
+            .map(|&s| {
+                let mut end = 0.0;
+                for g in segments {
+                    end += g.length;
+                    if s <= end * (1.0 + 1e-9) {
+                        return g.outer_radius.unwrap_or(0.01);
+                    }
+                }
+                segments.last().and_then(|g| g.outer_radius).unwrap_or(0.01)
+            })
+            .collect();
+        Look::Tube { radius }
+    };
+    if name == "arm" {
+        return radius_of(&m.segments);
+    }
+    if let Some(a) = m.arms.iter().find(|a| a.name == name) {
+        return radius_of(&a.segments);
+    }
+    if let Some(b) = m.bodies.iter().find(|b| b.name == name) {
+        let r = b.radius.unwrap_or(0.02);
+        return match b.shape {
+            BodyShape::Sphere => Look::Sphere { radius: r },
+            BodyShape::Cylinder => Look::Cylinder {
+                radius: r,
+                half_length: 0.5 * b.length.unwrap_or(2.0 * r),
+            },
+            _ => Look::Box {
+                half: b.size.map_or([r; 3], |s| s.map(|x| 0.5 * x)),
+            },
+        };
+    }
+    let obstacle = loaded
+        .arm
+        .contact()
+        .and_then(|c| c.obstacles.iter().find(|o| o.name == name));
+    match obstacle.map(|o| &o.shape) {
+        Some(ObstacleShape::Sphere { radius, .. }) => Look::Sphere { radius: *radius },
+        Some(ObstacleShape::Cylinder {
+            radius,
+            half_length,
+            ..
+        }) => Look::Cylinder {
+            radius: *radius,
+            half_length: *half_length,
+        },
+        Some(ObstacleShape::Box { half, .. }) => Look::Box { half: *half },
+        _ => Look::Plane,
+    }
+}

@@ -1,0 +1,27 @@
+//! `viewer.html`: the scene in one self-contained page (plain WebGL, no
+//! library, no network at view time): orbit and zoom, play and pause, a
+//! time slider, playback speed, the tip path and the measured tip. The
+//! page is `assets/viewer.html` with the scene's JSON in it.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+
+use crate::scene::Scene;
+
+const PAGE: &str = include_str!("../assets/viewer.html");
+
+/// The page of `scene`.
+pub fn page(scene: &Scene) -> Result<String> {
+    // Inside a <script> element "</" would end it.
+    let json = serde_json::to_string(scene)?.replace("</", "<\\/");
+    Ok(PAGE.replace("/*SCENE*/", &json))
+}
+
+/// Write the page to `path` (through a temporary file).
+pub fn write(scene: &Scene, path: &Path) -> Result<()> {
+    let tmp = path.with_extension("html.tmp");
+    std::fs::write(&tmp, page(scene)?)
+        .with_context(|| format!("cannot write {}", tmp.display()))?;
+    std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))
+}

@@ -1,0 +1,87 @@
+//! `softarm animate`: the GIF has a frame per 1/fps s of playback at the
+//! requested size, and the viewer page carries the run: its tip path is
+//! trajectory.csv's tip and its arm rows are shape.csv's. (The page itself
+//! is checked in a real browser by scripts/check_viewer.py, which CI runs.)
+
+mod common;
+
+use common::*;
+use softarm::data::Csv;
+
+fn frames(path: &std::path::Path) -> (usize, (u16, u16)) {
+    let file = std::fs::File::open(path).expect("animation.gif exists");
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::Indexed);
+    let mut d = options.read_info(file).expect("a GIF");
+    let size = (d.width(), d.height());
+    let mut n = 0;
+    while d.read_next_frame().expect("frames decode").is_some() {
+        n += 1;
+    }
+    (n, size)
+}
+
+#[test]
+fn the_gif_has_a_frame_per_step_of_playback_and_the_page_the_runs_tip() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = softarm(
+        &[
+            "animate",
+            "soft_finger",
+            "--t-end",
+            "1",
+            "--fps",
+            "10",
+            "--speed",
+            "0.5",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let run = out.join("soft_finger");
+    // 1 s at half speed: 2 s of GIF at 10 frames a second, both ends.
+    assert_eq!(frames(&run.join("animation.gif")), (21, (480, 480)));
+    let page = std::fs::read_to_string(run.join("viewer.html")).unwrap();
+    let start = page.find(r#"type="application/json">"#).unwrap() + 24;
+    let end = start + page[start..].find("</script>").unwrap();
+    let scene: serde_json::Value = serde_json::from_str(&page[start..end]).unwrap();
+    let traj = Csv::read(&run.join("trajectory.csv")).unwrap();
+    let t = traj.column("t").unwrap();
+    let tip_x = traj.column("tip_x").unwrap();
+    let tip_y = traj.column("tip_y").unwrap();
+    // Rows at the GIF's steps: 0.05 s of simulated time.
+    assert_eq!(t.len(), 21);
+    for (i, p) in scene["tip"].as_array().unwrap().iter().enumerate() {
+        assert_eq!(p[0].as_f64().unwrap(), tip_x[i]);
+        assert_eq!(p[1].as_f64().unwrap(), tip_y[i]);
+        // The arm drawn at that frame ends there (shape.csv's 9 digits).
+        let rows = scene["parts"][0]["frames"][i].as_array().unwrap();
+        let last = rows.last().unwrap();
+        assert_close(last[0].as_f64().unwrap(), tip_x[i], 1e-8, 1e-9, "end x");
+        assert_close(last[1].as_f64().unwrap(), tip_y[i], 1e-8, 1e-9, "end y");
+    }
+    assert_eq!(scene["parts"][0]["look"]["kind"], "tube");
+}
+
+#[test]
+fn bad_animation_options_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, says) in [
+        (
+            vec!["--size", "12by4"],
+            "--size 12by4: expected WIDTHxHEIGHT",
+        ),
+        (vec!["--fps", "0"], "--fps 0: must be in (0, 100]"),
+        (
+            vec!["--speed", "-1"],
+            "--speed -1: must be a positive number",
+        ),
+    ] {
+        let mut all = vec!["animate", "soft_finger", "--t-end", "0.1"];
+        all.extend(args);
+        let o = softarm(&all, dir.path());
+        assert!(!o.status.success());
+        assert!(stderr(&o).contains(says), "{}", stderr(&o));
+    }
+}
