@@ -22,8 +22,8 @@ pub struct AnimateArgs {
     /// tilted), or auto (front if planar, else iso).
     #[arg(long, value_enum, default_value_t = View::Auto)]
     pub view: View,
-    /// Frames per second of the GIF (and of the run's output rows unless
-    /// --output-dt is given).
+    /// Frames per second of the GIF (the run's output rows come four
+    /// times as often unless --output-dt is given).
     #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
     pub fps: f64,
     /// Playback speed: simulated seconds per second of GIF.
@@ -59,7 +59,8 @@ pub fn animate(a: AnimateArgs) -> Result<ExitCode> {
     }
     let size = parse_size(&a.size)?;
     let mut sim = a.simulate.clone();
-    sim.output_dt = sim.output_dt.or(Some(a.speed / a.fps));
+    // Rows four times a frame: the tip path follows what frames skip.
+    sim.output_dt = sim.output_dt.or(Some(a.speed / a.fps / 4.0));
     sim.shape_points = sim.shape_points.max(1);
     let code = commands::simulate(sim.clone())?;
     let out = (sim.out.clone())

@@ -186,9 +186,9 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         .build()
         .context("cannot start the sweep's threads")?;
     eprintln!(
-        "sweep: {} runs of {:?} on {jobs} threads into {}",
+        "sweep: {} runs of {} on {jobs} threads into {}",
         combos.len(),
-        a.run,
+        format!("{:?}", a.run).to_lowercase(),
         out_dir.display()
     );
     let started = Instant::now();

@@ -50,8 +50,8 @@ fn the_gif_has_a_frame_per_step_of_playback_and_the_page_the_runs_tip() {
     let t = traj.column("t").unwrap();
     let tip_x = traj.column("tip_x").unwrap();
     let tip_y = traj.column("tip_y").unwrap();
-    // Rows at the GIF's steps: 0.05 s of simulated time.
-    assert_eq!(t.len(), 21);
+    // Rows four times a GIF step: every 0.0125 s of simulated time.
+    assert_eq!(t.len(), 81);
     for (i, p) in scene["tip"].as_array().unwrap().iter().enumerate() {
         assert_eq!(p[0].as_f64().unwrap(), tip_x[i]);
         assert_eq!(p[1].as_f64().unwrap(), tip_y[i]);
