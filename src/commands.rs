@@ -740,6 +740,9 @@ pub struct StaticArgs {
     /// Starting configuration, comma-separated (default: straight).
     #[arg(long, allow_hyphen_values = true)]
     pub q0: Option<String>,
+    /// Points per element of the equilibrium's `shape` (0: none).
+    #[arg(long, default_value_t = softarm::shape::DEFAULT_POINTS)]
+    pub shape_points: usize,
     /// Print JSON (the only format; accepted for scripts).
     #[arg(long)]
     pub json: bool,
@@ -808,6 +811,10 @@ pub fn static_value(a: &StaticArgs) -> Result<serde_json::Value> {
     let sol = equilibrium(&mut loaded, &a.q0)?;
     let n = sol.q.len();
     let out = loaded.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
+    let shape = match a.shape_points {
+        0 => None,
+        p => Some(softarm::shape::Shape::new(&loaded, p)?.at(&*loaded.arm, 0.0, &sol.q)),
+    };
     let v = json!({
         "model": loaded.model.name,
         "backend": loaded.arm.backend(),
@@ -818,6 +825,7 @@ pub fn static_value(a: &StaticArgs) -> Result<serde_json::Value> {
         "residual": sol.residual,
         "iterations": sol.iterations,
         "load_steps": sol.load_steps,
+        "shape": shape,
     });
     Ok(v)
 }

@@ -21,8 +21,8 @@ pub struct Shape {
     tape: ShapeTape,
 }
 
-/// One row of `shape.csv` at one time.
-#[derive(Clone, Debug, PartialEq)]
+/// One row of `shape.csv` at one time (and of `static`'s `shape`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct ShapeRow {
     /// The arm's name (`arm` for a model of one arm) or the body's.
     pub part: String,

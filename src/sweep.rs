@@ -300,6 +300,7 @@ fn study(
             let v = commands::static_value(&StaticArgs {
                 model,
                 q0: a.simulate.q0.clone(),
+                shape_points: a.simulate.shape_points,
                 json: true,
             })?;
             std::fs::write(dir.join("static.json"), serde_json::to_string_pretty(&v)?)?;

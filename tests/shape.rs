@@ -150,3 +150,24 @@ fn a_bodys_row_is_its_coordinates_and_an_obstacles_its_place() {
         }
     }
 }
+
+#[test]
+fn the_static_equilibriums_shape_ends_at_its_tip() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = softarm(
+        &["static", "cantilever3d", "--shape-points", "3", "--json"],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let shape = v["shape"].as_array().unwrap();
+    assert_eq!(shape.len(), 1 + 3 * 5);
+    let end = &shape.last().unwrap()["pose"];
+    for c in 0..3 {
+        let (a, b) = (
+            end[c].as_f64().unwrap(),
+            v["tip_position"][c].as_f64().unwrap(),
+        );
+        assert_close(a, b, 1e-12, 1e-12, "static tip");
+    }
+}
