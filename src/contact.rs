@@ -28,7 +28,8 @@ pub fn contact_set(model: &Model, base: &Path, points: usize) -> Result<Option<C
         let mut element = 0;
         for s in &am.segments {
             let radius = s.outer_radius.unwrap_or(0.0);
-            for _ in 0..s.elements {
+            // A rom segment's elements are its quadrature slices.
+            for _ in 0..s.slices() {
                 for _ in 0..per {
                     sampled.push(ContactPoint {
                         radius,

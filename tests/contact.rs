@@ -628,6 +628,83 @@ exponent = {n_exp}
     );
 }
 
+/// The same in 3D for every 3D method, rom's shared coordinates and eba's
+/// absolute ones included: a straight arm hanging from a compliant base,
+/// pushed onto a table by a tip load; the table and the base's spring
+/// carry the whole load (1e-9), the tip sinks as deep as the law gives.
+#[test]
+fn every_3d_method_presses_its_tip_load_onto_a_table() {
+    let (k_base, k_c, n_exp, load, r) = (100.0, 1e4, 1.5, 2.0, 0.01);
+    let methods = [
+        ("pcc", "elements = 4"),
+        ("ebr", "elements = 4"),
+        ("eba", "elements = 4"),
+        ("rom", "order = 2"),
+    ];
+    for (method, count) in methods {
+        let text = format!(
+            r#"
+name = "pressed3d"
+dimensions = 3
+gravity = [0.0, 0.0, 0.0]
+[base]
+direction = [0.0, 0.0, -1.0]
+mass = 0.1
+stiffness = {k_base}
+damping = 1.0
+[[segment]]
+method = "{method}"
+length = 0.2
+{count}
+mass = 0.05
+outer_radius = {r}
+youngs_modulus = 1.0e6
+[tip]
+force = [0.0, 0.0, -{load}]
+[[obstacle]]
+name = "table"
+shape = "plane"
+point = [0.0, 0.0, -0.21]
+normal = [0.0, 0.0, 1.0]
+[contact]
+model = "hertz"
+stiffness = {k_c}
+exponent = {n_exp}
+"#
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let l = load_text(dir.path(), &text, &[]);
+        let n = l.arm.dof();
+        let bz = coordinate(&l, "base_z");
+        let mut arm = l.arm;
+        let sol =
+            runtime::solve_static(&mut *arm, &vec![0.0; n], &runtime::StaticOptions::default())
+                .unwrap();
+        let set = arm.contact().unwrap();
+        let zeros = vec![0.0; n];
+        let table = runtime::contact::channel_columns(&*arm, set, 0.0, &sol.q, &zeros)[0];
+        let spring = -k_base * sol.q[bz];
+        let tip_z = arm.outputs(0.0, &sol.q, &zeros)[2];
+        let depth = -0.21 - (tip_z - r);
+        eprintln!(
+            "{method}: table {table:.12} N + base {spring:.12} N of {load} N, depth {depth:.6e} m"
+        );
+        assert!(
+            table > 0.5 * load,
+            "{method}: the table carries most: {table}"
+        );
+        assert_close(
+            table + spring,
+            load,
+            1e-9,
+            0.0,
+            &format!("{method}: balance"),
+        );
+        let law = (table / k_c).powf(1.0 / n_exp);
+        assert_close(depth, law, 1e-6, 0.0, &format!("{method}: depth"));
+    }
+}
+
 /// The sampled points of an arm bent to one circle (every element by the
 /// same angle, planar pcc and 3D pcc) lie where the circle puts them:
 /// (sin(k s) / k, (1 - cos(k s)) / k) at arc length s, at curvatures from

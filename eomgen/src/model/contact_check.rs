@@ -210,8 +210,16 @@ fn shape_keys(ck: &Check, key: &str, o: &ObstacleDecl) -> Result<(), ModelError>
     Ok(())
 }
 
-/// Methods whose elements the kinematics sample.
-const SAMPLED: [Method; 4] = [Method::Rigid, Method::Pcc, Method::Vc, Method::Ebr];
+/// Methods whose elements the kinematics sample (every method of the
+/// equations of motion: cosserat is a statics method).
+const SAMPLED: [Method; 6] = [
+    Method::Rigid,
+    Method::Pcc,
+    Method::Vc,
+    Method::Ebr,
+    Method::Eba,
+    Method::Rom,
+];
 
 fn sampled_methods(ck: &Check) -> Result<(), ModelError> {
     for (prefix, arm) in ck.m.arm_models() {
@@ -225,10 +233,9 @@ fn sampled_methods(ck: &Check) -> Result<(), ModelError> {
                 return ck.err(
                     key,
                     format!(
-                        "contact samples rigid, pcc, vc and ebr segments; {:?} is not sampled yet",
-                        s.method
-                    )
-                    .to_lowercase(),
+                        "contact samples rigid, pcc, vc, ebr, eba and rom segments; {} solves statics only",
+                        format!("{:?}", s.method).to_lowercase()
+                    ),
                 );
             }
         }
