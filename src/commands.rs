@@ -17,6 +17,7 @@ use serde_json::json;
 use softarm::backend::{self, Loaded};
 use softarm::compare;
 use softarm::generated::MODELS;
+use softarm::run::RunRequest;
 
 use crate::ModelArgs;
 
@@ -251,28 +252,33 @@ fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
     s
 }
 
-/// The initial coordinates: `--q0`, and with `--start static` (or the
-/// model's `[simulate] start`) the equilibrium at t = 0 found from them.
-/// Also how far assembling onto the joints moved the coordinates.
-fn initial_coordinates(a: &SimulateArgs, loaded: &mut Loaded) -> Result<(Vec<f64>, f64)> {
-    let (q0, moved) = start_coordinates(loaded, &a.q0)?;
-    let start = match a.start {
-        Some(StartArg::Rest) => Start::Rest,
-        Some(StartArg::Static) => Start::Static,
-        None => loaded.model.simulate.start.unwrap_or(Start::Rest),
-    };
-    if start == Start::Rest {
-        return Ok((q0, moved));
-    }
-    // At rest in equilibrium under the loads and inputs at t = 0.
-    let sol = runtime::solve_static(&mut *loaded.arm, &q0, &runtime::StaticOptions::default())
-        .map_err(|e| {
-            anyhow::anyhow!(
-                "{}: --start static: no equilibrium at t = 0: {e}; start from --start rest instead",
-                loaded.origin
-            )
-        })?;
-    Ok((sol.q, moved))
+/// The run the command line asks for.
+fn request(a: &SimulateArgs, loaded: &Loaded) -> Result<RunRequest> {
+    let n = loaded.arm.dof();
+    let coords = &loaded.arm.info().coordinates;
+    Ok(RunRequest {
+        t_end: a.t_end,
+        solver: a.solver.clone(),
+        dt: a.dt,
+        rtol: a.rtol,
+        atol: a.atol,
+        max_steps: Some(a.max_steps),
+        output_dt: a.output_dt,
+        q0: a
+            .q0
+            .as_ref()
+            .map(|s| parse_vector("--q0", s, n, coords))
+            .transpose()?,
+        qd0: a
+            .qd0
+            .as_ref()
+            .map(|s| parse_vector("--qd0", s, n, coords))
+            .transpose()?,
+        start: a.start.map(|s| match s {
+            StartArg::Rest => Start::Rest,
+            StartArg::Static => Start::Static,
+        }),
+    })
 }
 
 /// Where each of the run's options came from, for summary.json:
@@ -298,45 +304,6 @@ fn option_sources(
                       "from": if a.output_dt.is_some() { "command line" } else { "default (t_end / 500)" }},
         "max_steps": {"value": opts.max_steps,
                       "from": if a.max_steps == SimOptions::default().max_steps { "default" } else { "command line" }},
-    })
-}
-
-/// What the run is asked: the command line, else the model's
-/// `[simulate]`, else runtime's defaults (`SimOptions::default`).
-fn run_options(a: &SimulateArgs, file: &SimulateDefaults) -> Result<SimOptions> {
-    let defaults = SimOptions::default();
-    let t_end = a.t_end.or(file.t_end).unwrap_or(defaults.t_end);
-    let dt = a.dt.or(file.dt).unwrap_or(defaults.dt);
-    let rtol = a.rtol.or(file.rtol).unwrap_or(defaults.rtol);
-    let atol = a.atol.or(file.atol).unwrap_or(defaults.atol);
-    let solver = match a.solver.as_ref().or(file.solver.as_ref()) {
-        Some(name) => Solver::parse(name).expect("clap and validation checked the name"),
-        None => defaults.solver,
-    };
-    if !(t_end > 0.0 && t_end.is_finite()) {
-        bail!("--t-end must be a positive number of seconds, got {t_end}");
-    }
-    for (name, v) in [("--dt", dt), ("--rtol", rtol), ("--atol", atol)] {
-        if !(v > 0.0 && v.is_finite()) {
-            bail!("{name} must be positive, got {v}");
-        }
-    }
-    if a.max_steps == 0 {
-        bail!("--max-steps must be at least 1");
-    }
-    let output_dt = a.output_dt.unwrap_or(t_end / runtime::DEFAULT_SAMPLES);
-    if !(output_dt > 0.0 && output_dt.is_finite()) {
-        bail!("--output-dt must be positive, got {output_dt}");
-    }
-    Ok(SimOptions {
-        t_end,
-        solver,
-        rtol,
-        atol,
-        dt,
-        output_dt,
-        max_steps: a.max_steps,
-        ..defaults
     })
 }
 
@@ -388,19 +355,18 @@ fn compare_tip(
 pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     let mut loaded = load(&a.model)?;
     let n = loaded.arm.dof();
-    let coords = loaded.arm.info().coordinates.clone();
-    let (q0, assembled_m) = initial_coordinates(&a, &mut loaded)?;
+    let req = request(&a, &loaded)?;
+    let mut opts = softarm::run::options(&req, &loaded.model.simulate)?;
+    let (x0, assembled_m) = softarm::run::initial_state(&req, &mut loaded)?;
+    report_assembly(&loaded, assembled_m);
     let arm = &*loaded.arm;
-    let mut opts = run_options(&a, &loaded.model.simulate)?;
-    let (t_end, solver) = (opts.t_end, opts.solver);
-    let mut qd0 = optional_vector("--qd0", &a.qd0, n, &coords)?;
-    let mut q0 = q0;
-    // The rates onto the joints too (the coordinates already are).
-    softarm::joints::assemble(arm, &loaded.origin, &mut q0, &mut qd0)?;
+    let t_end = opts.t_end;
+    let solver = opts.solver;
+    let (q0, qd0) = x0.split_at(n);
     // Measured data to compare with: sampled at its own times.
     let measured = match &loaded.model.compare {
         Some(spec) => {
-            let start = arm.outputs(0.0, &q0, &qd0);
+            let start = arm.outputs(0.0, q0, qd0);
             Some(
                 compare::measured(spec, &loaded.base_dir, [start[0], start[1], start[2]])
                     .with_context(|| format!("{}: [compare]", loaded.origin))?,
@@ -423,10 +389,9 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     std::fs::create_dir_all(&out_dir)
         .with_context(|| format!("cannot create {}", out_dir.display()))?;
 
-    let x0: Vec<f64> = q0.iter().chain(&qd0).copied().collect();
     let progress = softarm::progress::Progress::start(&loaded.model.name, opts.t_end, a.quiet);
     opts.progress = progress.as_ref().map(|p| p.cell());
-    let result = runtime::simulate(arm, x0, &opts);
+    let result = runtime::simulate(arm, x0.clone(), &opts);
     drop(progress);
     let (traj, stats, failure) = match result {
         Ok((traj, stats)) => (traj, stats, None),
@@ -752,22 +717,24 @@ pub struct StaticArgs {
 /// q0`, free bodies where declared, the rest 0), put onto the joints.
 fn start_coordinates(loaded: &Loaded, q0: &Option<String>) -> Result<(Vec<f64>, f64)> {
     let n = loaded.arm.dof();
-    let coords = loaded.arm.info().coordinates.clone();
-    let mut q = match q0 {
-        Some(s) => parse_vector("--q0", s, n, &coords)?,
-        None => {
-            eomgen::model::assembly::initial_coordinates(&loaded.model, &coords, &loaded.origin)?
-        }
-    };
-    let moved = softarm::joints::assemble(&*loaded.arm, &loaded.origin, &mut q, &mut vec![0.0; n])?;
-    softarm::contact::check_start(&*loaded.arm, &loaded.origin, &q)?;
+    let coords = &loaded.arm.info().coordinates;
+    let q0 = q0
+        .as_ref()
+        .map(|s| parse_vector("--q0", s, n, coords))
+        .transpose()?;
+    let (q, moved) = softarm::run::start_coordinates(loaded, q0.as_deref())?;
+    report_assembly(loaded, moved);
+    Ok((q, moved))
+}
+
+/// Say when the start was moved onto the joints.
+fn report_assembly(loaded: &Loaded, moved: f64) {
     if moved > 0.0 {
         eprintln!(
             "{}: the initial state was assembled onto the joints, moving the coordinates by {moved:.3e} (Euclidean norm)",
             loaded.model.name
         );
     }
-    Ok((q, moved))
 }
 
 /// Solve the static equilibrium of a loaded model, or explain why not.

@@ -15,6 +15,7 @@ pub mod data;
 pub mod inputs;
 pub mod joints;
 pub mod progress;
+pub mod run;
 pub mod scene;
 pub mod shape;
 pub mod viewer;

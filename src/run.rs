@@ -1,0 +1,141 @@
+//! A simulation's setup, shared by every front end (the CLI, Python):
+//! the options asked for, else the model's `[simulate]`, else runtime's
+//! defaults; the start state (given, the model's, assembled onto the
+//! joints, checked against the obstacles, or the equilibrium at t = 0).
+//! One place, so that a run from Python is the CLI's run to the bit.
+
+use anyhow::{Result, anyhow, bail};
+use eomgen::model::{SimulateDefaults, Start};
+use runtime::{SimOptions, Solver};
+
+use crate::backend::Loaded;
+
+/// What a run is asked; `None` leaves the choice to the model's
+/// `[simulate]`, then to the defaults.
+#[derive(Clone, Debug, Default)]
+pub struct RunRequest {
+    pub t_end: Option<f64>,
+    pub solver: Option<String>,
+    pub dt: Option<f64>,
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+    pub max_steps: Option<usize>,
+    pub output_dt: Option<f64>,
+    pub q0: Option<Vec<f64>>,
+    pub qd0: Option<Vec<f64>>,
+    pub start: Option<Start>,
+}
+
+/// The run's options. Errors name the option as the command line spells
+/// it (`--rtol`), which Python's keyword (`rtol`) follows.
+pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> {
+    let defaults = SimOptions::default();
+    let t_end = req.t_end.or(file.t_end).unwrap_or(defaults.t_end);
+    let dt = req.dt.or(file.dt).unwrap_or(defaults.dt);
+    let rtol = req.rtol.or(file.rtol).unwrap_or(defaults.rtol);
+    let atol = req.atol.or(file.atol).unwrap_or(defaults.atol);
+    let solver = match req.solver.as_ref().or(file.solver.as_ref()) {
+        Some(name) => Solver::parse(name).ok_or_else(|| {
+            anyhow!(
+                "--solver {name}: unknown solver; the solvers are {}",
+                Solver::NAMES.join(", ")
+            )
+        })?,
+        None => defaults.solver,
+    };
+    if !(t_end > 0.0 && t_end.is_finite()) {
+        bail!("--t-end must be a positive number of seconds, got {t_end}");
+    }
+    for (name, v) in [("--dt", dt), ("--rtol", rtol), ("--atol", atol)] {
+        if !(v > 0.0 && v.is_finite()) {
+            bail!("{name} must be positive, got {v}");
+        }
+    }
+    let max_steps = req.max_steps.unwrap_or(defaults.max_steps);
+    if max_steps == 0 {
+        bail!("--max-steps must be at least 1");
+    }
+    let output_dt = req.output_dt.unwrap_or(t_end / runtime::DEFAULT_SAMPLES);
+    if !(output_dt > 0.0 && output_dt.is_finite()) {
+        bail!("--output-dt must be positive, got {output_dt}");
+    }
+    Ok(SimOptions {
+        t_end,
+        solver,
+        rtol,
+        atol,
+        dt,
+        output_dt,
+        max_steps,
+        ..defaults
+    })
+}
+
+/// The coordinates to start from: `q0`, else the model's (`[simulate]
+/// q0`, free bodies where declared, the rest 0), put onto the joints and
+/// checked against the obstacles; and how far the joints moved them.
+pub fn start_coordinates(loaded: &Loaded, q0: Option<&[f64]>) -> Result<(Vec<f64>, f64)> {
+    let n = loaded.arm.dof();
+    let coords = loaded.arm.info().coordinates.clone();
+    let mut q = match q0 {
+        Some(q) if q.len() != n => {
+            bail!(
+                "q0 has {} values; the model has {n} coordinates: {}",
+                q.len(),
+                coords.join(", ")
+            )
+        }
+        Some(q) => q.to_vec(),
+        None => {
+            eomgen::model::assembly::initial_coordinates(&loaded.model, &coords, &loaded.origin)?
+        }
+    };
+    if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+        bail!(
+            "q0[{i}] ({}) is {}: the start must be finite",
+            coords[i],
+            q[i]
+        );
+    }
+    let moved = crate::joints::assemble(&*loaded.arm, &loaded.origin, &mut q, &mut vec![0.0; n])?;
+    crate::contact::check_start(&*loaded.arm, &loaded.origin, &q)?;
+    Ok((q, moved))
+}
+
+/// The start state x0 = (q0, qd0) of a run and how far assembling moved
+/// the coordinates: at rest, or (`Start::Static`) in equilibrium at t = 0
+/// under the loads and inputs.
+pub fn initial_state(req: &RunRequest, loaded: &mut Loaded) -> Result<(Vec<f64>, f64)> {
+    let n = loaded.arm.dof();
+    let (q0, moved) = start_coordinates(loaded, req.q0.as_deref())?;
+    let start = req
+        .start
+        .or(loaded.model.simulate.start)
+        .unwrap_or(Start::Rest);
+    let mut q0 = match start {
+        Start::Rest => q0,
+        Start::Static => {
+            runtime::solve_static(&mut *loaded.arm, &q0, &runtime::StaticOptions::default())
+                .map_err(|e| {
+                    anyhow!(
+                        "{}: --start static: no equilibrium at t = 0: {e}; start from rest instead",
+                        loaded.origin
+                    )
+                })?
+                .q
+        }
+    };
+    let mut qd0 = match &req.qd0 {
+        Some(v) if v.len() != n => {
+            bail!("qd0 has {} values; the model has {n} coordinates", v.len())
+        }
+        Some(v) => v.clone(),
+        None => vec![0.0; n],
+    };
+    if let Some(i) = qd0.iter().position(|v| !v.is_finite()) {
+        bail!("qd0[{i}] is {}: the start must be finite", qd0[i]);
+    }
+    // The rates onto the joints too (the coordinates already are).
+    crate::joints::assemble(&*loaded.arm, &loaded.origin, &mut q0, &mut qd0)?;
+    Ok((q0.into_iter().chain(qd0).collect(), moved))
+}
