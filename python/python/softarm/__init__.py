@@ -1,0 +1,161 @@
+"""softarm from Python: soft robot arm dynamics, compiled.
+
+    >>> import softarm
+    >>> arm = softarm.load("soft_finger", set={"tip.mass": 0.01})
+    >>> run = arm.simulate(t_end=2.0)
+    >>> run["tip"].shape                     # (rows, 3)
+
+Every call runs softarm's Rust core: the same equations, solvers and
+defaults as the `softarm` command line, to the bit. Arrays are numpy
+float64; errors are exceptions (`ValueError` naming the key path for a bad
+model or argument, `IntegrationError` when the integrator gives up).
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any, Mapping, Optional
+
+import numpy as np
+
+from . import _softarm
+from ._softarm import IntegrationError
+
+__all__ = ["load", "models", "Model", "IntegrationError", "OUTPUT_NAMES"]
+
+#: The columns of `Model.outputs` and of a run's "outputs".
+OUTPUT_NAMES = tuple(_softarm.OUTPUT_NAMES)
+
+
+def models() -> list[str]:
+    """The names of the compiled-in models."""
+    return list(_softarm.models())
+
+
+def _override(path: str, value: Any) -> str:
+    # Strings go as they are (a method name); numbers and lists as JSON.
+    text = value if isinstance(value, str) else json.dumps(value)
+    return f"{path}={text}"
+
+
+def load(name_or_path: str, set: Optional[Mapping[str, Any]] = None) -> "Model":
+    """Load a compiled-in model by name or a model file (TOML or JSON).
+
+    `set` overrides values as `softarm --set` does, by key path:
+    ``{"segment.0.length": 0.25, "tip.force": [0, -2, 0]}``. A model whose
+    structure is compiled in runs compiled whatever its numbers; another is
+    derived once into the tape cache (``.softarm-cache``).
+    """
+    overrides = [_override(k, v) for k, v in (set or {}).items()]
+    return Model(_softarm.load_model(str(name_or_path), overrides))
+
+
+def _vector(x: Any) -> Optional[np.ndarray]:
+    return None if x is None else np.ascontiguousarray(x, dtype=np.float64)
+
+
+class Model:
+    """A loaded model: its dynamics M(q) qdd + h(q, qd, t) = 0."""
+
+    def __init__(self, core: Any):
+        self._core = core
+
+    @property
+    def name(self) -> str:
+        return self._core.name
+
+    @property
+    def dof(self) -> int:
+        """The number of generalised coordinates n."""
+        return self._core.dof
+
+    @property
+    def coordinates(self) -> list[str]:
+        """The coordinates' names, in order."""
+        return list(self._core.coordinates)
+
+    @property
+    def parameters(self) -> list[str]:
+        """The runtime parameters' names (values change without a rebuild)."""
+        return list(self._core.parameters)
+
+    @property
+    def backend(self) -> str:
+        """"compiled" or "interpreted"."""
+        return self._core.backend
+
+    def __repr__(self) -> str:
+        return f"<softarm.Model {self.name!r}: {self.dof} coordinates, {self.backend}>"
+
+    def mass_bias(self, q, qd=None, t: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """The mass matrix M (n, n) and bias h (n,) at (q, qd, t)."""
+        return self._core.mass_bias(_vector(q), _vector(qd), float(t))
+
+    def outputs(self, q, qd=None, t: float = 0.0) -> np.ndarray:
+        """The outputs (`OUTPUT_NAMES`) at (q, qd, t)."""
+        return self._core.outputs(_vector(q), _vector(qd), float(t))
+
+    def tip(self, q, t: float = 0.0) -> np.ndarray:
+        """The tip position (3,) at q."""
+        return self.outputs(q, None, t)[:3]
+
+    def static(self, q0=None) -> dict:
+        """The static equilibrium under gravity, the loads and the inputs at
+        t = 0, from q0 (default: the model's start): q, tip, residual,
+        iterations."""
+        q, residual, iterations = self._core.equilibrium(_vector(q0))
+        return {"q": q, "tip": self.tip(q), "residual": residual, "iterations": iterations}
+
+    def modes(self, q0=None) -> dict:
+        """Natural frequencies (Hz, ascending) and mode shapes (columns)
+        about the static equilibrium."""
+        q = self.static(q0)["q"]
+        shapes, f = self._core.modes(q)
+        return {"frequencies_hz": f, "shapes": shapes, "equilibrium_q": q}
+
+    def simulate(
+        self,
+        t_end: Optional[float] = None,
+        solver: Optional[str] = None,
+        *,
+        rtol: Optional[float] = None,
+        atol: Optional[float] = None,
+        dt: Optional[float] = None,
+        output_dt: Optional[float] = None,
+        max_steps: Optional[int] = None,
+        q0=None,
+        qd0=None,
+        start: Optional[str] = None,
+    ) -> dict:
+        """Integrate as ``softarm simulate`` does. Options left out come from
+        the model's ``[simulate]``, else the defaults (5 s, dopri5, rtol 1e-6,
+        atol 1e-9, a row every t_end / 500).
+
+        Returns a dict of arrays: ``t`` (N,), ``q`` and ``qd`` (N, n),
+        ``tip`` (N, 3), ``kinetic_energy``, ``potential_energy`` (N,),
+        ``tip_orientation`` (N, 4), ``outputs`` (N, 9), and ``summary``.
+        Raises `IntegrationError` (with ``.report``) when the integrator
+        gives up.
+        """
+        try:
+            t, x, out, summary = self._core.simulate(
+                t_end, solver, rtol, atol, dt, output_dt, max_steps,
+                _vector(q0), _vector(qd0), start,
+            )
+        except IntegrationError as e:
+            message, report = e.args
+            err = IntegrationError(message)
+            err.report = json.loads(report)
+            raise err from None
+        n = self.dof
+        return {
+            "t": t,
+            "q": x[:, :n],
+            "qd": x[:, n:],
+            "tip": out[:, :3],
+            "kinetic_energy": out[:, 3],
+            "potential_energy": out[:, 4],
+            "tip_orientation": out[:, 5:9],
+            "outputs": out,
+            "summary": json.loads(summary),
+        }

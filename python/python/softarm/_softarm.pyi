@@ -1,0 +1,41 @@
+"""Types of the compiled core (`python/src/lib.rs`); use the `softarm` API."""
+
+from typing import Optional
+
+import numpy as np
+import numpy.typing as npt
+
+Vector = npt.NDArray[np.float64]
+
+class IntegrationError(RuntimeError):
+    report: dict
+
+class Model:
+    name: str
+    dof: int
+    coordinates: list[str]
+    parameters: list[str]
+    backend: str
+    origin: str
+    def mass_bias(self, q: Vector, qd: Optional[Vector] = None, t: float = 0.0) -> tuple[Vector, Vector]: ...
+    def outputs(self, q: Vector, qd: Optional[Vector] = None, t: float = 0.0) -> Vector: ...
+    def equilibrium(self, q0: Optional[Vector] = None) -> tuple[Vector, float, int]: ...
+    def modes(self, q: Vector) -> tuple[Vector, Vector]: ...  # shapes (n, k), frequencies (k,)
+    def simulate(
+        self,
+        t_end: Optional[float] = None,
+        solver: Optional[str] = None,
+        rtol: Optional[float] = None,
+        atol: Optional[float] = None,
+        dt: Optional[float] = None,
+        output_dt: Optional[float] = None,
+        max_steps: Optional[int] = None,
+        q0: Optional[Vector] = None,
+        qd0: Optional[Vector] = None,
+        start: Optional[str] = None,
+    ) -> tuple[Vector, Vector, Vector, str]: ...
+
+def load_model(spec: str, overrides: list[str] = ...) -> Model: ...
+def models() -> list[str]: ...
+
+OUTPUT_NAMES: list[str]

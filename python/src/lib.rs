@@ -1,0 +1,270 @@
+//! `softarm._softarm`: the Rust core for Python. A thin layer: numpy in and
+//! out, every error a Python exception (model errors `ValueError` with the
+//! key path, a failed integration `IntegrationError`, a `RuntimeError`),
+//! never a panic across the boundary. The Pythonic surface (keyword
+//! arguments, dicts, docstrings) is `python/softarm/__init__.py`; the
+//! runs themselves are the CLI's (`softarm::run`), so a result here is the
+//! CLI's to the bit.
+
+use nalgebra::{DMatrix, DVector};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use runtime::N_OUTPUTS;
+use softarm::backend::{BackendChoice, Loaded, load};
+use softarm::run::RunRequest;
+
+create_exception!(
+    _softarm,
+    IntegrationError,
+    PyRuntimeError,
+    "The integrator gave up: args are (message, report as JSON)."
+);
+
+/// A matrix and a vector for Python.
+type MatVec<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
+
+/// A model error (a bad file, key or value) as ValueError, with its whole
+/// chain of context (file, key path, what is allowed).
+fn value_error(e: anyhow::Error) -> PyErr {
+    PyValueError::new_err(format!("{e:#}"))
+}
+
+/// A loaded model: its compiled (or interpreted) dynamics and its file.
+#[pyclass(unsendable, module = "softarm._softarm")]
+struct Model {
+    loaded: Loaded,
+}
+
+/// A vector of `n` finite values, or a ValueError naming it.
+fn vector(name: &str, v: Option<PyReadonlyArray1<f64>>, n: usize) -> PyResult<Vec<f64>> {
+    let Some(v) = v else {
+        return Ok(vec![0.0; n]);
+    };
+    let v = v.as_slice()?.to_vec();
+    if v.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "{name} has {} values; the model has {n} coordinates",
+            v.len()
+        )));
+    }
+    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "{name}[{i}] is {}, not a finite number",
+            v[i]
+        )));
+    }
+    Ok(v)
+}
+
+#[pymethods]
+impl Model {
+    #[getter]
+    fn name(&self) -> String {
+        self.loaded.model.name.clone()
+    }
+    #[getter]
+    fn dof(&self) -> usize {
+        self.loaded.arm.dof()
+    }
+    #[getter]
+    fn coordinates(&self) -> Vec<String> {
+        self.loaded.arm.info().coordinates.clone()
+    }
+    #[getter]
+    fn parameters(&self) -> Vec<String> {
+        self.loaded.arm.info().parameters.clone()
+    }
+    #[getter]
+    fn backend(&self) -> &'static str {
+        self.loaded.arm.backend()
+    }
+    #[getter]
+    fn origin(&self) -> String {
+        self.loaded.origin.clone()
+    }
+
+    /// (M, h) at (q, qd, t): M qdd + h = 0.
+    #[pyo3(signature = (q, qd=None, t=0.0))]
+    fn mass_bias<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray1<f64>,
+        qd: Option<PyReadonlyArray1<f64>>,
+        t: f64,
+    ) -> PyResult<MatVec<'py>> {
+        let n = self.dof();
+        let q = vector("q", Some(q), n)?;
+        let qd = vector("qd", qd, n)?;
+        let (mut m, mut h) = (DMatrix::zeros(n, n), DVector::zeros(n));
+        self.loaded.arm.mass_bias(t, &q, &qd, &mut m, &mut h);
+        let m = Array2::from_shape_fn((n, n), |(i, j)| m[(i, j)]);
+        Ok((m.into_pyarray(py), h.as_slice().to_vec().into_pyarray(py)))
+    }
+
+    /// The outputs at (q, qd, t): tip x, y, z, kinetic and potential
+    /// energy, tip orientation w, x, y, z.
+    #[pyo3(signature = (q, qd=None, t=0.0))]
+    fn outputs<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray1<f64>,
+        qd: Option<PyReadonlyArray1<f64>>,
+        t: f64,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let n = self.dof();
+        let q = vector("q", Some(q), n)?;
+        let qd = vector("qd", qd, n)?;
+        Ok(self
+            .loaded
+            .arm
+            .outputs(t, &q, &qd)
+            .to_vec()
+            .into_pyarray(py))
+    }
+
+    /// The static equilibrium from q0: (q, residual, iterations).
+    #[pyo3(signature = (q0=None))]
+    fn equilibrium<'py>(
+        &mut self,
+        py: Python<'py>,
+        q0: Option<PyReadonlyArray1<f64>>,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, f64, usize)> {
+        let n = self.dof();
+        let q0 = q0.map(|v| vector("q0", Some(v), n)).transpose()?;
+        let (q0, _) =
+            softarm::run::start_coordinates(&self.loaded, q0.as_deref()).map_err(value_error)?;
+        let sol = runtime::solve_static(&mut *self.loaded.arm, &q0, &Default::default())
+            .map_err(|e| PyRuntimeError::new_err(format!("{}: {e}", self.loaded.origin)))?;
+        Ok((sol.q.into_pyarray(py), sol.residual, sol.iterations))
+    }
+
+    /// Mode shapes (columns) and natural frequencies (Hz) about q.
+    fn modes<'py>(&self, py: Python<'py>, q: PyReadonlyArray1<f64>) -> PyResult<MatVec<'py>> {
+        let n = self.dof();
+        let q = vector("q", Some(q), n)?;
+        let m = runtime::modes(&*self.loaded.arm, &q)
+            .map_err(|e| PyRuntimeError::new_err(format!("{}: {e}", self.loaded.origin)))?;
+        let k = m.shapes.len();
+        let shapes = Array2::from_shape_fn((n, k), |(i, j)| m.shapes[j][i]);
+        Ok((shapes.into_pyarray(py), m.frequencies_hz.into_pyarray(py)))
+    }
+
+    /// Integrate as `softarm simulate` does: (t, states, outputs, summary
+    /// JSON); states (N, 2n) are q then qd, outputs (N, 9).
+    #[pyo3(signature = (t_end=None, solver=None, rtol=None, atol=None, dt=None,
+                        output_dt=None, max_steps=None, q0=None, qd0=None, start=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn simulate<'py>(
+        &mut self,
+        py: Python<'py>,
+        t_end: Option<f64>,
+        solver: Option<String>,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        dt: Option<f64>,
+        output_dt: Option<f64>,
+        max_steps: Option<usize>,
+        q0: Option<PyReadonlyArray1<f64>>,
+        qd0: Option<PyReadonlyArray1<f64>>,
+        start: Option<String>,
+    ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        let n = self.dof();
+        let start = match start.as_deref() {
+            None => None,
+            Some("rest") => Some(eomgen::model::Start::Rest),
+            Some("static") => Some(eomgen::model::Start::Static),
+            Some(s) => {
+                return Err(PyValueError::new_err(format!(
+                    "start = {s:?}: the starts are \"rest\" and \"static\""
+                )));
+            }
+        };
+        let req = RunRequest {
+            t_end,
+            solver,
+            dt,
+            rtol,
+            atol,
+            max_steps,
+            output_dt,
+            q0: q0.map(|v| vector("q0", Some(v), n)).transpose()?,
+            qd0: qd0.map(|v| vector("qd0", Some(v), n)).transpose()?,
+            start,
+        };
+        let opts = softarm::run::options(&req, &self.loaded.model.simulate).map_err(value_error)?;
+        let (x0, _) = softarm::run::initial_state(&req, &mut self.loaded).map_err(value_error)?;
+        let arm = &*self.loaded.arm;
+        let (traj, stats) = match runtime::simulate(arm, x0, &opts) {
+            Ok(r) => r,
+            Err(f) => {
+                let report = serde_json::json!({
+                    "t_reached": f.t_reached, "last_step_s": f.last_step_s,
+                    "reason": f.reason, "suggestion": f.suggestion, "state": f.state,
+                });
+                return Err(IntegrationError::new_err((
+                    f.to_string(),
+                    report.to_string(),
+                )));
+            }
+        };
+        let rows = traj.t.len();
+        let states = Array2::from_shape_fn((rows, 2 * n), |(i, j)| traj.x[i][j]);
+        let outs: Vec<[f64; N_OUTPUTS]> = (traj.t.iter().zip(&traj.x))
+            .map(|(t, x)| arm.outputs(*t, &x[..n], &x[n..]))
+            .collect();
+        let outputs = Array2::from_shape_fn((rows, N_OUTPUTS), |(i, j)| outs[i][j]);
+        let summary = serde_json::json!({
+            "model": self.loaded.model.name,
+            "backend": arm.backend(),
+            "solver": stats.solver,
+            "t_end": opts.t_end, "rtol": opts.rtol, "atol": opts.atol,
+            "steps": stats.steps,
+            "rejected_steps": stats.rejected_steps,
+            "rhs_evaluations": stats.rhs_evaluations,
+            "jacobian_evaluations": stats.jacobian_evaluations,
+            "wall_s": stats.wall_s,
+            "status": "ok",
+        });
+        let t = traj.t.into_pyarray(py);
+        let items: Vec<Bound<'py, PyAny>> = vec![
+            t.into_any(),
+            states.into_pyarray(py).into_any(),
+            outputs.into_pyarray(py).into_any(),
+            summary.to_string().into_pyobject(py)?.into_any(),
+        ];
+        pyo3::types::PyTuple::new(py, items)
+    }
+}
+
+/// Load a model file or a compiled-in model by name, with `--set`
+/// overrides ("PATH=VALUE").
+#[pyfunction]
+#[pyo3(signature = (spec, overrides=Vec::new()))]
+fn load_model(spec: &str, overrides: Vec<String>) -> PyResult<Model> {
+    let overrides = overrides
+        .iter()
+        .map(|s| eomgen::model::Override::parse(s))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let loaded = load(spec, &overrides, BackendChoice::Auto, None).map_err(value_error)?;
+    Ok(Model { loaded })
+}
+
+/// The compiled-in models' names.
+#[pyfunction]
+fn models() -> Vec<&'static str> {
+    softarm::generated::MODELS.iter().map(|m| m.name).collect()
+}
+
+#[pymodule]
+fn _softarm(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Model>()?;
+    m.add_function(wrap_pyfunction!(load_model, m)?)?;
+    m.add_function(wrap_pyfunction!(models, m)?)?;
+    m.add("IntegrationError", m.py().get_type::<IntegrationError>())?;
+    m.add("OUTPUT_NAMES", runtime::OUTPUT_NAMES.to_vec())?;
+    Ok(())
+}

@@ -1,0 +1,125 @@
+"""softarm from Python against the command line, an independent front end
+over the same core: mass, bias, outputs and the static tip agree exactly
+(JSON prints every bit), a trajectory to the 13 digits trajectory.csv
+prints; bad input raises clear exceptions.
+
+The CLI binary is $SOFTARM_BIN, else target/debug/softarm (built by
+`cargo test`), else target/release/softarm.
+"""
+
+import csv
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import softarm
+
+ROOT = Path(__file__).resolve().parents[2]
+MODELS = ["double_pendulum", "soft_finger"]
+
+
+def cli():
+    for p in [os.environ.get("SOFTARM_BIN"), ROOT / "target/debug/softarm",
+              ROOT / "target/release/softarm"]:
+        if p and Path(p).exists():
+            return str(p)
+    pytest.skip("no softarm binary: run cargo build first")
+
+
+def run(*args, cwd=None):
+    out = subprocess.run([cli(), *args], capture_output=True, text=True, cwd=cwd)
+    assert out.returncode == 0, out.stderr
+    return out.stdout
+
+
+def state(m, seed):
+    rng = np.random.default_rng(seed)
+    return rng.uniform(-0.5, 0.5, m.dof), rng.uniform(-1.0, 1.0, m.dof)
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_mass_bias_and_outputs_are_the_clis(name):
+    m = softarm.load(name)
+    q, qd = state(m, 1)
+    fmt = lambda v: ",".join(repr(float(x)) for x in v)
+    ref = json.loads(run("eom", name, "--q", fmt(q), "--qd", fmt(qd), "--t", "0.3", "--json"))
+    M, h = m.mass_bias(q, qd, 0.3)
+    assert np.array_equal(M, np.array(ref["mass"]))
+    assert np.array_equal(h, np.array(ref["bias"]))
+    assert np.array_equal(m.tip(q, 0.3), np.array(ref["tip_position"]))
+    assert m.coordinates == ref["coordinates"]
+    # M is symmetric positive definite.
+    assert np.array_equal(M, M.T) and np.all(np.linalg.eigvalsh(M) > 0)
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_the_static_tip_is_the_clis(name):
+    ref = json.loads(run("static", name, "--shape-points", "0", "--json"))
+    sol = softarm.load(name).static()
+    assert np.array_equal(sol["q"], np.array(ref["q"]))
+    assert np.array_equal(sol["tip"], np.array(ref["tip_position"]))
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_a_trajectory_is_the_clis(name, tmp_path):
+    run("simulate", name, "--t-end", "1", "--shape-points", "0", "--quiet",
+        "--out", str(tmp_path))
+    with open(tmp_path / "trajectory.csv") as f:
+        rows = list(csv.DictReader(f))
+    r = softarm.load(name).simulate(t_end=1.0)
+    m = softarm.load(name)
+    assert len(rows) == len(r["t"])
+    cols = m.coordinates + [c + "_dot" for c in m.coordinates] + list(softarm.OUTPUT_NAMES)
+    ref = np.array([[float(row[c]) for c in cols] for row in rows])
+    ours = np.hstack([r["q"], r["qd"], r["outputs"]])
+    scale = np.maximum(np.abs(ref), 1e-12)
+    assert np.max(np.abs(ours - ref) / scale) < 1e-12
+    assert np.allclose(r["t"], [float(row["t"]) for row in rows], rtol=0, atol=1e-9)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert r["summary"]["steps"] == summary["steps"]
+    assert r["summary"]["rhs_evaluations"] == summary["rhs_evaluations"]
+
+
+def test_overrides_change_numbers_not_the_backend():
+    light = softarm.load("soft_finger", set={"tip.mass": 0.0})
+    heavy = softarm.load("soft_finger", set={"tip.mass": 0.05})
+    assert light.backend == heavy.backend == "compiled"
+    assert heavy.static()["tip"][1] < light.static()["tip"][1]
+
+
+def test_bad_input_raises_clear_exceptions():
+    m = softarm.load("double_pendulum")
+    with pytest.raises(ValueError, match="q has 3 values; the model has 2"):
+        m.mass_bias(np.zeros(3))
+    with pytest.raises(ValueError, match=r"q\[1\] is NaN"):
+        m.mass_bias(np.array([0.0, np.nan]))
+    with pytest.raises(ValueError, match="no_such_model"):
+        softarm.load("no_such_model")
+    with pytest.raises(ValueError, match="segment"):
+        softarm.load("soft_finger", set={"segment.0.length": -1.0})
+    with pytest.raises(ValueError, match="--rtol must be positive"):
+        m.simulate(t_end=0.1, rtol=-1.0)
+    with pytest.raises(ValueError, match="unknown solver"):
+        m.simulate(t_end=0.1, solver="ode45")
+    with pytest.raises(ValueError, match="the starts are"):
+        m.simulate(t_end=0.1, start="moving")
+
+
+def test_a_run_that_gives_up_raises_with_its_report():
+    m = softarm.load("soft_finger")
+    with pytest.raises(softarm.IntegrationError) as e:
+        m.simulate(t_end=1.0, max_steps=5)
+    assert e.value.report["t_reached"] < 1.0
+    assert e.value.report["suggestion"]
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_the_modes_are_the_clis(name):
+    ref = json.loads(run("modes", name, "--json"))
+    ours = softarm.load(name).modes()
+    assert np.array_equal(ours["frequencies_hz"], np.array(ref["frequencies_hz"]))
+    assert ours["shapes"].shape == (len(ref["equilibrium_q"]), len(ref["frequencies_hz"]))
