@@ -81,6 +81,24 @@ pub fn signal(name: &str, input: &Input, base: &Path) -> Result<Signal> {
 
 /// The drives of a model whose parameter layout is `layout`.
 pub fn model_drives(model: &Model, layout: &ParamLayout, base: &Path) -> Result<Vec<Drive>> {
+    Ok(labelled_drives(model, layout, base)?
+        .into_iter()
+        .map(|(d, _)| d)
+        .collect())
+}
+
+/// A drive bound to one channel: the channel's name and which derivative
+/// of it the parameter takes (0: the value; a moving base's velocity 1).
+pub type DriveLabel = (String, usize);
+
+/// `model_drives`, each with its channel where it reads one alone (a
+/// sensor frame's weighted sum of channels has none): what a controller
+/// replaces to hold a channel at its value over a step.
+pub fn labelled_drives(
+    model: &Model,
+    layout: &ParamLayout,
+    base: &Path,
+) -> Result<Vec<(Drive, Option<DriveLabel>)>> {
     let mut signals: BTreeMap<&str, Signal> = BTreeMap::new();
     let mut out = Vec::new();
     for d in layout.driven() {
@@ -109,10 +127,13 @@ pub fn model_drives(model: &Model, layout: &ParamLayout, base: &Path) -> Result<
             for _ in 0..d.derivative {
                 signal = signal.derivative();
             }
-            out.push(Drive {
-                param: layout.index(d.param),
-                signal,
-            });
+            out.push((
+                Drive {
+                    param: layout.index(d.param),
+                    signal,
+                },
+                None,
+            ));
             continue;
         }
         let name = layout
@@ -127,10 +148,13 @@ pub fn model_drives(model: &Model, layout: &ParamLayout, base: &Path) -> Result<
         for _ in 0..d.derivative {
             signal = signal.derivative();
         }
-        out.push(Drive {
-            param: layout.index(d.param),
-            signal,
-        });
+        out.push((
+            Drive {
+                param: layout.index(d.param),
+                signal,
+            },
+            Some((name.to_string(), d.derivative as usize)),
+        ));
     }
     Ok(out)
 }

@@ -216,3 +216,30 @@ fn auto_stays_explicit_on_the_pendulum_and_switches_on_the_stiff_arm() {
         );
     }
 }
+
+/// A fixed-step run ends at t_end although its summed steps land there
+/// only up to rounding (10,000 steps of 1e-6 s make 0.00999...): its last
+/// row is t_end's state, and a run started at t0 (a controller's step)
+/// continues the same run. Reference: one rk4 run over the whole span.
+#[test]
+fn a_fixed_step_run_records_its_end_and_restarts_at_t0() {
+    let l = load("double_pendulum", &[], BackendChoice::Auto, None).unwrap();
+    let x0 = vec![0.3, -0.2, 0.0, 0.0];
+    let opts = |t0: f64, t_end: f64| SimOptions {
+        t0,
+        t_end,
+        solver: Solver::Rk4,
+        dt: 1e-6,
+        output_times: Some(vec![t_end]),
+        ..SimOptions::default()
+    };
+    let (whole, _) = simulate(&*l.arm, x0.clone(), &opts(0.0, 0.02)).unwrap();
+    assert_eq!(whole.t, vec![0.02]);
+    let (first, _) = simulate(&*l.arm, x0, &opts(0.0, 0.01)).unwrap();
+    assert_eq!(first.t, vec![0.01], "the end's sample is there");
+    let (second, _) = simulate(&*l.arm, first.x[0].clone(), &opts(0.01, 0.02)).unwrap();
+    assert_eq!(second.t, vec![0.02]);
+    for (a, b) in second.x[0].iter().zip(&whole.x[0]) {
+        assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0), "{a} vs {b}");
+    }
+}

@@ -16,6 +16,8 @@ use runtime::N_OUTPUTS;
 use softarm::backend::{BackendChoice, Loaded, load};
 use softarm::run::RunRequest;
 
+mod simulator;
+
 create_exception!(
     _softarm,
     IntegrationError,
@@ -28,7 +30,7 @@ type MatVec<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
 
 /// A model error (a bad file, key or value) as ValueError, with its whole
 /// chain of context (file, key path, what is allowed).
-fn value_error(e: anyhow::Error) -> PyErr {
+pub(crate) fn value_error(e: anyhow::Error) -> PyErr {
     PyValueError::new_err(format!("{e:#}"))
 }
 
@@ -36,10 +38,13 @@ fn value_error(e: anyhow::Error) -> PyErr {
 #[pyclass(unsendable, module = "softarm._softarm")]
 struct Model {
     loaded: Loaded,
+    /// How it was loaded: a simulator loads its own copy.
+    spec: String,
+    overrides: Vec<String>,
 }
 
 /// A vector of `n` finite values, or a ValueError naming it.
-fn vector(name: &str, v: Option<PyReadonlyArray1<f64>>, n: usize) -> PyResult<Vec<f64>> {
+pub(crate) fn vector(name: &str, v: Option<PyReadonlyArray1<f64>>, n: usize) -> PyResult<Vec<f64>> {
     let Some(v) = v else {
         return Ok(vec![0.0; n]);
     };
@@ -61,6 +66,30 @@ fn vector(name: &str, v: Option<PyReadonlyArray1<f64>>, n: usize) -> PyResult<Ve
 
 #[pymethods]
 impl Model {
+    /// A stepping simulator of its own copy of the model (see
+    /// `simulator.rs`).
+    #[pyo3(signature = (dt, inputs=Vec::new(), solver=None, rtol=None, atol=None, step=None))]
+    fn simulator(
+        &self,
+        dt: f64,
+        inputs: Vec<String>,
+        solver: Option<String>,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        step: Option<f64>,
+    ) -> PyResult<simulator::Simulator> {
+        let loaded = load_with(&self.spec, &self.overrides)?;
+        let req = RunRequest {
+            t_end: Some(dt),
+            solver,
+            rtol,
+            atol,
+            dt: step,
+            ..Default::default()
+        };
+        simulator::Simulator::new(loaded, dt, inputs, req)
+    }
+
     #[getter]
     fn name(&self) -> String {
         self.loaded.model.name.clone()
@@ -244,13 +273,21 @@ impl Model {
 #[pyfunction]
 #[pyo3(signature = (spec, overrides=Vec::new()))]
 fn load_model(spec: &str, overrides: Vec<String>) -> PyResult<Model> {
-    let overrides = overrides
+    let loaded = load_with(spec, &overrides)?;
+    Ok(Model {
+        loaded,
+        spec: spec.to_string(),
+        overrides,
+    })
+}
+
+fn load_with(spec: &str, overrides: &[String]) -> PyResult<Loaded> {
+    let parsed = overrides
         .iter()
         .map(|s| eomgen::model::Override::parse(s))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    let loaded = load(spec, &overrides, BackendChoice::Auto, None).map_err(value_error)?;
-    Ok(Model { loaded })
+    load(spec, &parsed, BackendChoice::Auto, None).map_err(value_error)
 }
 
 /// The compiled-in models' names.
@@ -262,6 +299,7 @@ fn models() -> Vec<&'static str> {
 #[pymodule]
 fn _softarm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Model>()?;
+    m.add_class::<simulator::Simulator>()?;
     m.add_function(wrap_pyfunction!(load_model, m)?)?;
     m.add_function(wrap_pyfunction!(models, m)?)?;
     m.add("IntegrationError", m.py().get_type::<IntegrationError>())?;

@@ -123,3 +123,51 @@ def test_the_modes_are_the_clis(name):
     ours = softarm.load(name).modes()
     assert np.array_equal(ours["frequencies_hz"], np.array(ref["frequencies_hz"]))
     assert ours["shapes"].shape == (len(ref["equilibrium_q"]), len(ref["frequencies_hz"]))
+
+
+def test_stepping_reproduces_a_run_at_its_steps():
+    # rk4 at a step dividing the control step: the same arithmetic.
+    m = softarm.load("soft_finger")
+    run = m.simulate(t_end=0.2, solver="rk4", dt=1e-5, output_dt=0.05)
+    sim = m.simulator(0.05, solver="rk4", step=1e-5)
+    assert np.array_equal(sim.state, np.concatenate([run["q"][0], run["qd"][0]]))
+    for k in range(1, len(run["t"])):
+        x = sim.step()
+        ref = np.concatenate([run["q"][k], run["qd"][k]])
+        assert np.allclose(x, ref, rtol=1e-10, atol=1e-12), k
+        assert abs(sim.t - run["t"][k]) < 1e-12
+    # Adaptive: restarting at each step agrees to the tolerance asked.
+    run = m.simulate(t_end=0.5, rtol=1e-10, atol=1e-12, output_dt=0.05)
+    sim = m.simulator(0.05, rtol=1e-10, atol=1e-12)
+    for k in range(1, len(run["t"])):
+        sim.step()
+    assert np.allclose(sim.q, run["q"][-1], rtol=0, atol=1e-7)
+
+
+def test_a_held_input_is_the_constant_channel():
+    # finger_free's pressure held at 1e5 Pa step by step is the run whose
+    # pressure ramps from 1e5 to 1e5 (a constant).
+    c = 1.0e5
+    m = softarm.load("finger_free", set={"inputs.pressure.from": c, "inputs.pressure.to": c})
+    # (rk4 at 1e-6 s: pressed, the finger is stiff.)
+    run = m.simulate(t_end=0.05, solver="rk4", dt=1e-6, output_dt=0.01)
+    sim = softarm.load("finger_free").simulator(0.01, inputs=["pressure"], solver="rk4", step=1e-6)
+    assert sim.inputs == ["pressure"]
+    for k in range(1, len(run["t"])):
+        sim.step([c])
+    assert np.allclose(sim.q, run["q"][-1], rtol=1e-10, atol=1e-12)
+    assert np.allclose(sim.tip, run["tip"][-1], rtol=1e-10, atol=1e-12)
+    # reset: back to the start.
+    x = sim.reset()
+    assert sim.t == 0.0 and np.array_equal(x, np.concatenate([run["q"][0], run["qd"][0]]))
+
+
+def test_bad_simulator_input_is_named():
+    m = softarm.load("finger_free")
+    with pytest.raises(ValueError, match="no channel \"pressur\""):
+        m.simulator(0.01, inputs=["pressur"])
+    sim = m.simulator(0.01, inputs=["pressure"])
+    with pytest.raises(ValueError, match="u has 2 values"):
+        sim.step([1.0, 2.0])
+    with pytest.raises(ValueError, match="dt = 0"):
+        m.simulator(0.0)

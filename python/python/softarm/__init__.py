@@ -14,14 +14,14 @@ model or argument, `IntegrationError` when the integrator gives up).
 from __future__ import annotations
 
 import json
-from typing import Any, Mapping, Optional
+from typing import Any, Mapping, Optional, Sequence
 
 import numpy as np
 
 from . import _softarm
 from ._softarm import IntegrationError
 
-__all__ = ["load", "models", "Model", "IntegrationError", "OUTPUT_NAMES"]
+__all__ = ["load", "models", "Model", "Simulator", "IntegrationError", "OUTPUT_NAMES"]
 
 #: The columns of `Model.outputs` and of a run's "outputs".
 OUTPUT_NAMES = tuple(_softarm.OUTPUT_NAMES)
@@ -86,6 +86,22 @@ class Model:
 
     def __repr__(self) -> str:
         return f"<softarm.Model {self.name!r}: {self.dof} coordinates, {self.backend}>"
+
+    def simulator(
+        self,
+        dt: float,
+        inputs: Sequence[str] = (),
+        solver: Optional[str] = None,
+        rtol: Optional[float] = None,
+        atol: Optional[float] = None,
+        step: Optional[float] = None,
+    ) -> "Simulator":
+        """A stepping simulator for closed-loop control: each ``step(u)``
+        holds the input channels named in `inputs` at u and integrates dt
+        seconds (`step`: a fixed-step solver's own step). It runs its own
+        copy of the model."""
+        core = self._core.simulator(float(dt), list(inputs), solver, rtol, atol, step)
+        return Simulator(core, self.dof)
 
     def mass_bias(self, q, qd=None, t: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """The mass matrix M (n, n) and bias h (n,) at (q, qd, t)."""
@@ -159,3 +175,71 @@ class Model:
             "outputs": out,
             "summary": json.loads(summary),
         }
+
+
+class Simulator:
+    """Closed-loop stepping: ``state = sim.step(u)``.
+
+    The state is (q, qd), 2n values; ``sim.state`` reads and sets it,
+    ``sim.t`` is the time, ``sim.reset()`` returns to t = 0 and the start.
+    Inputs hold zero until the first step.
+    """
+
+    def __init__(self, core: Any, dof: int):
+        self._core = core
+        self._n = dof
+
+    @property
+    def dt(self) -> float:
+        return self._core.dt
+
+    @property
+    def inputs(self) -> list[str]:
+        """The controlled channels, in the order of u."""
+        return list(self._core.inputs)
+
+    @property
+    def t(self) -> float:
+        return self._core.t
+
+    @t.setter
+    def t(self, value: float) -> None:
+        self._core.t = float(value)
+
+    @property
+    def state(self) -> np.ndarray:
+        return self._core.state
+
+    @state.setter
+    def state(self, x) -> None:
+        self._core.state = _vector(x)
+
+    @property
+    def q(self) -> np.ndarray:
+        return self.state[: self._n]
+
+    @property
+    def qd(self) -> np.ndarray:
+        return self.state[self._n :]
+
+    def outputs(self) -> np.ndarray:
+        """The outputs (`OUTPUT_NAMES`) at the current state."""
+        return self._core.outputs()
+
+    @property
+    def tip(self) -> np.ndarray:
+        return self.outputs()[:3]
+
+    def step(self, u=None) -> np.ndarray:
+        """Hold the inputs at u for dt seconds; the new state."""
+        try:
+            return self._core.step(_vector(u))
+        except IntegrationError as e:
+            message, report = e.args
+            err = IntegrationError(message)
+            err.report = json.loads(report)
+            raise err from None
+
+    def reset(self, state=None) -> np.ndarray:
+        """Back to t = 0 and the start state (or `state`); the state."""
+        return self._core.reset(_vector(state))

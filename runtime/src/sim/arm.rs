@@ -57,6 +57,9 @@ pub trait Dynamics {
     fn set_base_params(&mut self, params: &[f64]);
     /// Drive parameters by signals of time (inputs); replaces earlier ones.
     fn set_drives(&mut self, drives: Vec<Drive>);
+    /// Replace the signal of drive k (in `set_drives`' order): a
+    /// controller's input held over a step, without rebuilding the rest.
+    fn set_drive_signal(&mut self, k: usize, signal: crate::signal::Signal);
     /// A kernel along a direction `dir` (2n: dq, then dqd), as the `Jvp`
     /// and `ContactJvp` kernels read it.
     fn eval_direction(
@@ -320,6 +323,9 @@ impl<K: Kernels> Dynamics for Arm<K> {
         self.params[..n].copy_from_slice(params);
         self.params[n..].copy_from_slice(&derived);
         self.live.borrow_mut().clear();
+    }
+    fn set_drive_signal(&mut self, k: usize, signal: crate::signal::Signal) {
+        self.drives[k].signal = signal;
     }
     fn set_drives(&mut self, drives: Vec<Drive>) {
         let n = self.kernels.info().parameters.len();

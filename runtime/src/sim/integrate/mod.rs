@@ -60,9 +60,10 @@ pub fn simulate<D: Dynamics + ?Sized>(
     // reason, rather than after a solver has shrunk its step to nothing.
     let mut qdd = vec![0.0; n];
     let mut ws = crate::arm::Workspace::new(n);
-    if let Err(e) = crate::arm::accelerations(arm, &mut ws, 0.0, &x0[..n], &x0[n..], &mut qdd) {
+    let t0 = opts.t0;
+    if let Err(e) = crate::arm::accelerations(arm, &mut ws, t0, &x0[..n], &x0[n..], &mut qdd) {
         return Err(Box::new(SimFailure {
-            t_reached: 0.0,
+            t_reached: t0,
             last_step_s: None,
             reason: format!("at the initial state: {e}"),
             suggestion:
@@ -85,11 +86,11 @@ pub fn simulate<D: Dynamics + ?Sized>(
     match arm.contact() {
         Some(set) if set.keeps_records() => touch::run(arm, x0, opts),
         Some(set) => {
-            let (mut traj, stats) = run_leg(arm, 0.0, x0, opts)?;
+            let (mut traj, stats) = run_leg(arm, t0, x0, opts)?;
             crate::contact::record_columns(arm, set, &mut traj, 0);
             Ok((traj, stats))
         }
-        None => run_leg(arm, 0.0, x0, opts),
+        None => run_leg(arm, t0, x0, opts),
     }
 }
 

@@ -12,6 +12,8 @@ pub const DEFAULT_SAMPLES: f64 = 500.0;
 
 #[derive(Clone, Debug)]
 pub struct SimOptions {
+    /// The run integrates from t0 (the time x0 is at) to t_end.
+    pub t0: f64,
     pub t_end: f64,
     pub solver: Solver,
     pub rtol: f64,
@@ -36,6 +38,7 @@ pub struct SimOptions {
 impl Default for SimOptions {
     fn default() -> Self {
         Self {
+            t0: 0.0,
             t_end: DEFAULT_T_END,
             solver: Solver::Dopri5,
             rtol: 1e-6,

@@ -128,6 +128,9 @@ impl ContactMeter {
 /// dense output would be NaN); adaptive methods reject such steps.
 pub(super) struct Recorder<'a> {
     sampler: Sampler,
+    /// The run's end: a fixed-step method's last step lands on it only up
+    /// to the rounding of its summed steps, and its sample is still due.
+    t_end: f64,
     /// The samples so far, unpadded, kept outside the crate's solution so
     /// that a run that fails still returns them.
     kept: &'a RefCell<Trajectory>,
@@ -216,6 +219,7 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
         let flag = self
             .sampler
             .sample(t_curr, t_prev, y_curr, y_prev, interpolator, solution);
+        self.sampler.at_end(t_curr, y_curr, self.t_end, solution);
         self.keep(solution);
         self.accepted += 1;
         if let Some(watch) = self.watch
@@ -287,6 +291,41 @@ impl Sampler {
     }
 }
 
+impl Sampler {
+    /// A step that ends within rounding of t_end (1e-9 relative: a fixed
+    /// step's t0 + N h) ends the run there: its state is t_end's sample,
+    /// if that is due and was not taken.
+    fn at_end<Y: StateVec>(
+        &mut self,
+        t_curr: f64,
+        y_curr: &Y,
+        t_end: f64,
+        solution: &mut Solution<f64, Y>,
+    ) {
+        let tol = 1e-9 * t_end.abs().max(f64::MIN_POSITIVE);
+        if t_curr == t_end || (t_end - t_curr).abs() > tol || solution.t.last() == Some(&t_end) {
+            return;
+        }
+        let due = match self {
+            Self::Even(_) => true,
+            Self::At(times, next) => match times.get(*next) {
+                Some(&t) if (t - t_end).abs() <= tol => {
+                    *next += 1;
+                    true
+                }
+                _ => false,
+            },
+        };
+        if due {
+            // A sample the step took at its rounded end is this one.
+            if solution.t.last().is_some_and(|&t| (t - t_end).abs() <= tol) {
+                let _ = solution.pop();
+            }
+            solution.push(t_end, y_curr.clone());
+        }
+    }
+}
+
 /// What a run's recorder saw: the samples with the events, and the last
 /// accepted step.
 pub(super) struct Recorded {
@@ -325,6 +364,7 @@ impl RunLog {
     ) -> Recorder<'a> {
         Recorder {
             sampler: Sampler::new(opts),
+            t_end: opts.t_end,
             kept: &self.kept,
             m: 2 * ode.n,
             last_step: &self.last_step,

@@ -28,7 +28,7 @@ pub(super) fn run<D: Dynamics + ?Sized>(
     let n = arm.dof();
     let mut traj = Trajectory::default();
     let mut stats: Option<SimStats> = None;
-    let (mut t0, mut x) = (0.0, x0);
+    let (mut t0, mut x) = (opts.t0, x0);
     let mut stalled = 0;
     loop {
         let held = set.held_pairs();

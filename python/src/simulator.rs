@@ -1,0 +1,191 @@
+//! A stepping simulator for closed-loop control: `step(u)` holds the
+//! controlled input channels at u (zero-order hold) and integrates one
+//! control step from the current state with the run's solver; the state
+//! can be read, set and reset. Each step is a `runtime::simulate` from
+//! (t, x) to t + dt sampled at its end, so a sequence of steps with a
+//! channel's values is the run that channel would give.
+
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use runtime::SimOptions;
+use runtime::signal::Signal;
+use softarm::backend::Loaded;
+use softarm::run::RunRequest;
+
+use crate::{IntegrationError, value_error, vector};
+
+#[pyclass(unsendable, module = "softarm._softarm")]
+pub struct Simulator {
+    loaded: Loaded,
+    opts: SimOptions,
+    dt: f64,
+    t: f64,
+    x: Vec<f64>,
+    /// The start `reset` returns to.
+    x0: Vec<f64>,
+    inputs: Vec<String>,
+    /// (drive, controlled channel, derivative the drive takes of it).
+    controls: Vec<(usize, usize, usize)>,
+}
+
+impl Simulator {
+    /// `req`: the solver and its tolerances and fixed step; its t_end is
+    /// the control step dt.
+    pub fn new(
+        mut loaded: Loaded,
+        dt: f64,
+        inputs: Vec<String>,
+        req: RunRequest,
+    ) -> PyResult<Self> {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "dt = {dt}: must be a positive step (s)"
+            )));
+        }
+        let opts = softarm::run::options(&req, &loaded.model.simulate).map_err(value_error)?;
+        let (x0, _) = softarm::run::initial_state(&req, &mut loaded).map_err(value_error)?;
+        let structure = eomgen::model::Structure::of(&loaded.model);
+        let layout = eomgen::model::ParamLayout::of(&structure);
+        let labels = softarm::inputs::labelled_drives(&loaded.model, &layout, &loaded.base_dir)
+            .map_err(value_error)?;
+        let mut controls = Vec::new();
+        for (i, name) in inputs.iter().enumerate() {
+            let drives: Vec<_> = (labels.iter().enumerate())
+                .filter_map(|(k, (_, l))| match l {
+                    Some((c, der)) if c == name => Some((k, i, *der)),
+                    _ => None,
+                })
+                .collect();
+            if drives.is_empty() {
+                let known: Vec<&String> = loaded.model.inputs.keys().collect();
+                return Err(PyValueError::new_err(format!(
+                    "inputs: no channel {name:?} drives this model; its channels are {known:?}"
+                )));
+            }
+            controls.extend(drives);
+        }
+        let mut sim = Self {
+            loaded,
+            opts,
+            dt,
+            t: 0.0,
+            x: x0.clone(),
+            x0,
+            inputs,
+            controls,
+        };
+        // Until the first step, the channels hold zero.
+        sim.hold(&vec![0.0; sim.inputs.len()]);
+        Ok(sim)
+    }
+
+    fn hold(&mut self, u: &[f64]) {
+        for &(k, i, der) in &self.controls {
+            let v = if der == 0 { u[i] } else { 0.0 };
+            self.loaded.arm.set_drive_signal(k, Signal::Constant(v));
+        }
+    }
+}
+
+#[pymethods]
+impl Simulator {
+    /// Hold the inputs at u over one step of dt; the new state (q, qd).
+    #[pyo3(signature = (u=None))]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        u: Option<PyReadonlyArray1<f64>>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let u = vector("u", u, self.inputs.len())?;
+        self.hold(&u);
+        self.opts.t0 = self.t;
+        self.opts.t_end = self.t + self.dt;
+        self.opts.output_times = Some(vec![self.opts.t_end]);
+        let arm = &*self.loaded.arm;
+        match runtime::simulate(arm, self.x.clone(), &self.opts) {
+            Ok((traj, _)) => match (traj.t.last(), traj.x.last()) {
+                (Some(&t), Some(x)) if t == self.opts.t_end => {
+                    self.x = x.clone();
+                    self.t = t;
+                }
+                _ => {
+                    return Err(pyo3::exceptions::PyRuntimeError::new_err(format!(
+                        "the step from t = {} did not reach t = {} (a bug: please report it)",
+                        self.t, self.opts.t_end
+                    )));
+                }
+            },
+            Err(f) => {
+                let report = serde_json::json!({
+                    "t_reached": f.t_reached, "last_step_s": f.last_step_s,
+                    "reason": f.reason, "suggestion": f.suggestion, "state": f.state,
+                });
+                return Err(IntegrationError::new_err((
+                    f.to_string(),
+                    report.to_string(),
+                )));
+            }
+        }
+        Ok(self.x.clone().into_pyarray(py))
+    }
+
+    /// The state (q, qd), 2n values.
+    #[getter]
+    fn get_state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.x.clone().into_pyarray(py)
+    }
+
+    #[setter]
+    fn set_state(&mut self, x: PyReadonlyArray1<f64>) -> PyResult<()> {
+        self.x = vector("state", Some(x), self.x.len())?;
+        Ok(())
+    }
+
+    #[getter]
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    #[setter]
+    fn set_t(&mut self, t: f64) -> PyResult<()> {
+        if !t.is_finite() {
+            return Err(PyValueError::new_err(format!("t = {t}: must be finite")));
+        }
+        self.t = t;
+        Ok(())
+    }
+
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    #[getter]
+    fn inputs(&self) -> Vec<String> {
+        self.inputs.clone()
+    }
+
+    /// Back to t = 0 and the start state (or the given one); inputs zero.
+    #[pyo3(signature = (state=None))]
+    fn reset<'py>(
+        &mut self,
+        py: Python<'py>,
+        state: Option<PyReadonlyArray1<f64>>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.x = match state {
+            Some(x) => vector("state", Some(x), self.x.len())?,
+            None => self.x0.clone(),
+        };
+        self.t = 0.0;
+        self.hold(&vec![0.0; self.inputs.len()]);
+        Ok(self.x.clone().into_pyarray(py))
+    }
+
+    /// The outputs (tip, energies, tip orientation) at the current state.
+    fn outputs<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let n = self.x.len() / 2;
+        let o = self.loaded.arm.outputs(self.t, &self.x[..n], &self.x[n..]);
+        o.to_vec().into_pyarray(py)
+    }
+}
