@@ -871,3 +871,58 @@ pub fn inspect(a: InspectArgs) -> Result<ExitCode> {
     println!("{}", serde_json::to_string_pretty(&v)?);
     Ok(ExitCode::SUCCESS)
 }
+
+#[derive(Args)]
+pub struct LinearizeArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// The input channels u, comma-separated (e.g. p0,p1,p2); none for the
+    /// free arm.
+    #[arg(long, value_delimiter = ',')]
+    pub inputs: Vec<String>,
+    /// The inputs' values at the equilibrium (default 0).
+    #[arg(long, allow_hyphen_values = true)]
+    pub u0: Option<String>,
+    /// The coordinates to linearise about (default: the equilibrium under
+    /// u0).
+    #[arg(long, allow_hyphen_values = true)]
+    pub q0: Option<String>,
+    /// Print JSON (the only format; accepted for scripts).
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `softarm linearize`: A, B, C, D about an equilibrium, as JSON.
+pub fn linearize(a: LinearizeArgs) -> Result<ExitCode> {
+    let mut loaded = load(&a.model)?;
+    let n = loaded.arm.dof();
+    let coords = loaded.arm.info().coordinates.clone();
+    let q0 =
+        a.q0.as_ref()
+            .map(|s| parse_vector("--q0", s, n, &coords))
+            .transpose()?;
+    let u0 =
+        a.u0.as_ref()
+            .map(|s| parse_vector("--u0", s, a.inputs.len(), &a.inputs))
+            .transpose()?;
+    let lin = softarm::linearize::linearize(&mut loaded, &a.inputs, u0.as_deref(), q0.as_deref())?;
+    let rows = |m: &DMatrix<f64>| -> Vec<Vec<f64>> {
+        (0..m.nrows())
+            .map(|i| m.row(i).iter().copied().collect())
+            .collect()
+    };
+    let v = json!({
+        "model": loaded.model.name,
+        "states": lin.states,
+        "inputs": lin.inputs,
+        "outputs": lin.outputs,
+        "q0": lin.q0,
+        "u0": lin.u0,
+        "A": rows(&lin.a),
+        "B": rows(&lin.b),
+        "C": rows(&lin.c),
+        "D": rows(&lin.d),
+    });
+    println!("{}", serde_json::to_string_pretty(&v)?);
+    Ok(ExitCode::SUCCESS)
+}

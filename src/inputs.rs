@@ -158,3 +158,52 @@ pub fn labelled_drives(
     }
     Ok(out)
 }
+
+/// Input channels a controller drives: every drive bound to one of them
+/// (a chamber pair's pressure, a tip load's component), to be held at a
+/// value (zero-order hold) in place of the channel's signal.
+#[derive(Clone, Debug)]
+pub struct Controls {
+    pub names: Vec<String>,
+    /// (drive, channel in `names`, derivative the drive takes of it).
+    drives: Vec<(usize, usize, usize)>,
+}
+
+impl Controls {
+    /// The channels `names` of a loaded model, or an error naming the one
+    /// that drives nothing and the channels that exist.
+    pub fn new(loaded: &crate::backend::Loaded, names: &[String]) -> Result<Self> {
+        let structure = eomgen::model::Structure::of(&loaded.model);
+        let layout = ParamLayout::of(&structure);
+        let labels = labelled_drives(&loaded.model, &layout, &loaded.base_dir)?;
+        let mut drives = Vec::new();
+        for (i, name) in names.iter().enumerate() {
+            let of: Vec<_> = (labels.iter().enumerate())
+                .filter_map(|(k, (_, l))| match l {
+                    Some((c, der)) if c == name => Some((k, i, *der)),
+                    _ => None,
+                })
+                .collect();
+            if of.is_empty() {
+                let known: Vec<&String> = loaded.model.inputs.keys().collect();
+                anyhow::bail!(
+                    "inputs: no channel {name:?} drives this model; its channels are {known:?}"
+                );
+            }
+            drives.extend(of);
+        }
+        Ok(Self {
+            names: names.to_vec(),
+            drives,
+        })
+    }
+
+    /// Hold the channels at `u` (one value each; a drive of a channel's
+    /// rate holds zero).
+    pub fn hold(&self, arm: &mut dyn runtime::Dynamics, u: &[f64]) {
+        for &(k, i, der) in &self.drives {
+            let v = if der == 0 { u[i] } else { 0.0 };
+            arm.set_drive_signal(k, Signal::Constant(v));
+        }
+    }
+}

@@ -14,6 +14,7 @@ pub mod continuum;
 pub mod data;
 pub mod inputs;
 pub mod joints;
+pub mod linearize;
 pub mod progress;
 pub mod run;
 pub mod scene;

@@ -65,6 +65,10 @@ enum Command {
     /// view, the time, the tip path, the inputs) and viewer.html (an
     /// interactive 3D view in one file).
     Animate(animate::AnimateArgs),
+    /// The state-space model (A, B, C, D) about an equilibrium, for
+    /// controller design: x = (q, qd), u the named input channels, y the
+    /// tip.
+    Linearize(commands::LinearizeArgs),
 }
 
 fn main() -> ExitCode {
@@ -80,6 +84,7 @@ fn main() -> ExitCode {
         Command::Inspect(a) => commands::inspect(a),
         Command::Sweep(a) => sweep::sweep(a),
         Command::Animate(a) => animate::animate(a),
+        Command::Linearize(a) => commands::linearize(a),
     };
     match result {
         Ok(code) => code,

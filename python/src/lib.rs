@@ -115,6 +115,40 @@ impl Model {
         self.loaded.origin.clone()
     }
 
+    /// (A, B, C, D, q0, u0) about the equilibrium under u0 (or q0), on a
+    /// copy of the model (its channels stay as they are here).
+    #[pyo3(signature = (inputs=Vec::new(), u0=None, q0=None))]
+    fn linearize<'py>(
+        &self,
+        py: Python<'py>,
+        inputs: Vec<String>,
+        u0: Option<PyReadonlyArray1<f64>>,
+        q0: Option<PyReadonlyArray1<f64>>,
+    ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        let mut loaded = load_with(&self.spec, &self.overrides)?;
+        let n = self.dof();
+        let u0 = u0
+            .map(|v| vector("u0", Some(v), inputs.len()))
+            .transpose()?;
+        let q0 = q0.map(|v| vector("q0", Some(v), n)).transpose()?;
+        let lin = softarm::linearize::linearize(&mut loaded, &inputs, u0.as_deref(), q0.as_deref())
+            .map_err(value_error)?;
+        let matrix = |m: &DMatrix<f64>| {
+            Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)])
+                .into_pyarray(py)
+                .into_any()
+        };
+        let items: Vec<Bound<'py, PyAny>> = vec![
+            matrix(&lin.a),
+            matrix(&lin.b),
+            matrix(&lin.c),
+            matrix(&lin.d),
+            lin.q0.into_pyarray(py).into_any(),
+            lin.u0.into_pyarray(py).into_any(),
+        ];
+        pyo3::types::PyTuple::new(py, items)
+    }
+
     /// (M, h) at (q, qd, t): M qdd + h = 0.
     #[pyo3(signature = (q, qd=None, t=0.0))]
     fn mass_bias<'py>(

@@ -9,8 +9,8 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use runtime::SimOptions;
-use runtime::signal::Signal;
 use softarm::backend::Loaded;
+use softarm::inputs::Controls;
 use softarm::run::RunRequest;
 
 use crate::{IntegrationError, value_error, vector};
@@ -24,9 +24,7 @@ pub struct Simulator {
     x: Vec<f64>,
     /// The start `reset` returns to.
     x0: Vec<f64>,
-    inputs: Vec<String>,
-    /// (drive, controlled channel, derivative the drive takes of it).
-    controls: Vec<(usize, usize, usize)>,
+    controls: Controls,
 }
 
 impl Simulator {
@@ -45,26 +43,7 @@ impl Simulator {
         }
         let opts = softarm::run::options(&req, &loaded.model.simulate).map_err(value_error)?;
         let (x0, _) = softarm::run::initial_state(&req, &mut loaded).map_err(value_error)?;
-        let structure = eomgen::model::Structure::of(&loaded.model);
-        let layout = eomgen::model::ParamLayout::of(&structure);
-        let labels = softarm::inputs::labelled_drives(&loaded.model, &layout, &loaded.base_dir)
-            .map_err(value_error)?;
-        let mut controls = Vec::new();
-        for (i, name) in inputs.iter().enumerate() {
-            let drives: Vec<_> = (labels.iter().enumerate())
-                .filter_map(|(k, (_, l))| match l {
-                    Some((c, der)) if c == name => Some((k, i, *der)),
-                    _ => None,
-                })
-                .collect();
-            if drives.is_empty() {
-                let known: Vec<&String> = loaded.model.inputs.keys().collect();
-                return Err(PyValueError::new_err(format!(
-                    "inputs: no channel {name:?} drives this model; its channels are {known:?}"
-                )));
-            }
-            controls.extend(drives);
-        }
+        let controls = Controls::new(&loaded, &inputs).map_err(value_error)?;
         let mut sim = Self {
             loaded,
             opts,
@@ -72,19 +51,15 @@ impl Simulator {
             t: 0.0,
             x: x0.clone(),
             x0,
-            inputs,
             controls,
         };
         // Until the first step, the channels hold zero.
-        sim.hold(&vec![0.0; sim.inputs.len()]);
+        sim.hold(&vec![0.0; sim.controls.names.len()]);
         Ok(sim)
     }
 
     fn hold(&mut self, u: &[f64]) {
-        for &(k, i, der) in &self.controls {
-            let v = if der == 0 { u[i] } else { 0.0 };
-            self.loaded.arm.set_drive_signal(k, Signal::Constant(v));
-        }
+        self.controls.hold(&mut *self.loaded.arm, u);
     }
 }
 
@@ -97,7 +72,7 @@ impl Simulator {
         py: Python<'py>,
         u: Option<PyReadonlyArray1<f64>>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let u = vector("u", u, self.inputs.len())?;
+        let u = vector("u", u, self.controls.names.len())?;
         self.hold(&u);
         self.opts.t0 = self.t;
         self.opts.t_end = self.t + self.dt;
@@ -163,7 +138,7 @@ impl Simulator {
 
     #[getter]
     fn inputs(&self) -> Vec<String> {
-        self.inputs.clone()
+        self.controls.names.clone()
     }
 
     /// Back to t = 0 and the start state (or the given one); inputs zero.
@@ -178,7 +153,7 @@ impl Simulator {
             None => self.x0.clone(),
         };
         self.t = 0.0;
-        self.hold(&vec![0.0; self.inputs.len()]);
+        self.hold(&vec![0.0; self.controls.names.len()]);
         Ok(self.x.clone().into_pyarray(py))
     }
 

@@ -171,3 +171,28 @@ def test_bad_simulator_input_is_named():
         sim.step([1.0, 2.0])
     with pytest.raises(ValueError, match="dt = 0"):
         m.simulator(0.0)
+
+
+def test_linearize_is_the_clis_and_its_a_is_the_rhs_jacobian():
+    ref = json.loads(run("linearize", "stiff_flop", "--inputs", "p0,p1,p2", "--u0", "20000,5000,0",
+                         "--json"))
+    m = softarm.load("stiff_flop")
+    lin = m.linearize(["p0", "p1", "p2"], u0=[2e4, 5e3, 0.0])
+    for key in "ABCD":
+        assert np.array_equal(lin[key], np.array(ref[key])), key
+    assert np.array_equal(lin["q0"], np.array(ref["q0"]))
+    # Small-signal check: one step of the simulator from the equilibrium
+    # with a small pressure change follows A and B to first order.
+    n = m.dof
+    sim = m.simulator(1e-4, inputs=["p0", "p1", "p2"], rtol=1e-12, atol=1e-14)
+    du = np.array([50.0, 0.0, 0.0])
+    sim.reset(np.concatenate([lin["q0"], np.zeros(n)]))
+    x1 = sim.step(lin["u0"] + du)
+    dx = x1 - np.concatenate([lin["q0"], np.zeros(n)])
+    from math import factorial
+    # x(h) - x0 = sum_k h^k A^(k-1) B du / k! for the linear system.
+    h, term, pred = 1e-4, lin["B"] @ du, np.zeros(2 * n)
+    for k in range(1, 12):
+        pred += h**k / factorial(k) * term
+        term = lin["A"] @ term
+    assert np.allclose(dx, pred, rtol=1e-3, atol=1e-3 * np.abs(pred).max())

@@ -103,6 +103,19 @@ class Model:
         core = self._core.simulator(float(dt), list(inputs), solver, rtol, atol, step)
         return Simulator(core, self.dof)
 
+    def linearize(self, inputs: Sequence[str] = (), u0=None, q0=None) -> dict:
+        """The state-space model about an equilibrium, for controller design:
+        d(dx)/dt = A dx + B du, dy = C dx + D du, with x = (q, qd), u the
+        input channels named in `inputs` held at `u0` (default zero), y the
+        tip position. About `q0`, or else the static equilibrium under u0.
+        A is the generated analytic Jacobian; B, C, D central differences.
+        Also as ``softarm linearize MODEL --inputs ... --json``."""
+        a, b, c, d, q, u = self._core.linearize(list(inputs), _vector(u0), _vector(q0))
+        coords = self.coordinates
+        return {"A": a, "B": b, "C": c, "D": d, "q0": q, "u0": u,
+                "states": coords + [f"{c}_dot" for c in coords], "inputs": list(inputs),
+                "outputs": ["tip_x", "tip_y", "tip_z"]}
+
     def mass_bias(self, q, qd=None, t: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """The mass matrix M (n, n) and bias h (n,) at (q, qd, t)."""
         return self._core.mass_bias(_vector(q), _vector(qd), float(t))
