@@ -71,7 +71,7 @@ value = 0.0
 /// module's symmetry.
 #[test]
 fn the_pressed_module_linearises_as_its_differences() {
-    use runtime::{Dynamics, Workspace};
+    use runtime::Workspace;
     use softarm::backend::{BackendChoice, load};
     let names = vec!["p0".to_string(), "p1".to_string(), "p2".to_string()];
     let u0 = [2e4, 5e3, 0.0];
