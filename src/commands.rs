@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use eomgen::model::{Compare, Override, SimulateDefaults, Start};
+use eomgen::model::{Override, SimulateDefaults, Start};
 use nalgebra::{DMatrix, DVector};
 use runtime::{
     Dynamics, KernelKind, OUTPUT_NAMES, SimOptions, Solver, Trajectory, Workspace, accelerations,
@@ -311,34 +311,16 @@ fn option_sources(
 /// the comparison window (none if the run ended before it) and the plot.
 fn compare_tip(
     loaded: &Loaded,
-    spec: &Compare,
     m: &compare::Measured,
     traj: &Trajectory,
     out_dir: &Path,
 ) -> Result<Option<compare::TipError>> {
-    let arm = &*loaded.arm;
-    let n = arm.dof();
-    let tips: Vec<(f64, [f64; 3])> = traj
-        .t
-        .iter()
-        .zip(&traj.x)
-        .map(|(t, x)| {
-            let o = arm.outputs(*t, &x[..n], &x[n..]);
-            (*t, [o[0], o[1], o[2]])
-        })
-        .collect();
-    let window = spec
-        .window
-        .unwrap_or([m.t[0], *m.t.last().expect("a CSV has rows")]);
-    let length = loaded.model.segments.iter().map(|s| s.length).sum::<f64>()
-        + loaded.model.tip.length.unwrap_or(0.0);
+    let tips = softarm::run::tips(loaded, traj);
     // A run that ends before the window has no statistics, but
     // still its plot.
-    let err = compare::tip_error(m, window, length, |t| {
-        tips.iter().find(|s| (s.0 - t).abs() < 1e-9).map(|s| s.1)
-    })
-    .map_err(|e| eprintln!("warning: no tip error: {e}"))
-    .ok();
+    let err = softarm::run::tip_error(loaded, m, &tips)
+        .map_err(|e| eprintln!("warning: no tip error: {e}"))
+        .ok();
     let title = match &err {
         Some(e) => format!(
             "{}: mean tip error {:.2} mm ({:.2} % of length)",
@@ -362,25 +344,11 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     let arm = &*loaded.arm;
     let t_end = opts.t_end;
     let solver = opts.solver;
-    let (q0, qd0) = x0.split_at(n);
     // Measured data to compare with: sampled at its own times.
-    let measured = match &loaded.model.compare {
-        Some(spec) => {
-            let start = arm.outputs(0.0, q0, qd0);
-            Some(
-                compare::measured(spec, &loaded.base_dir, [start[0], start[1], start[2]])
-                    .with_context(|| format!("{}: [compare]", loaded.origin))?,
-            )
-        }
-        None => None,
-    };
-    let output_times = measured.as_ref().map(|m| {
-        let mut t: Vec<f64> = m.t.iter().copied().filter(|&t| t <= t_end).collect();
-        if t.last() != Some(&t_end) {
-            t.push(t_end);
-        }
-        t
-    });
+    let measured = softarm::run::measured(&loaded, &x0)?;
+    let output_times = measured
+        .as_ref()
+        .map(|m| softarm::run::compare_times(m, t_end));
     opts.output_times = output_times;
     let out_dir = a
         .out
@@ -468,7 +436,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         [f64::NAN; runtime::N_OUTPUTS]
     };
     let tip_error = match (&measured, &loaded.model.compare) {
-        (Some(m), Some(spec)) => compare_tip(&loaded, spec, m, &traj, &out_dir)?,
+        (Some(m), Some(_)) => compare_tip(&loaded, m, &traj, &out_dir)?,
         _ => None,
     };
     let summary = json!({

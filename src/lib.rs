@@ -12,6 +12,7 @@ pub mod compare;
 pub mod contact;
 pub mod continuum;
 pub mod data;
+pub mod grid;
 pub mod inputs;
 pub mod joints;
 pub mod linearize;

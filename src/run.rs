@@ -139,3 +139,59 @@ pub fn initial_state(req: &RunRequest, loaded: &mut Loaded) -> Result<(Vec<f64>,
     crate::joints::assemble(&*loaded.arm, &loaded.origin, &mut q0, &mut qd0)?;
     Ok((q0.into_iter().chain(qd0).collect(), moved))
 }
+
+/// The measured tip of the model's `[compare]` in the model frame (its
+/// start at the simulated tip of x0 unless the file says), if it has one.
+pub fn measured(loaded: &Loaded, x0: &[f64]) -> Result<Option<crate::compare::Measured>> {
+    let Some(spec) = &loaded.model.compare else {
+        return Ok(None);
+    };
+    let n = loaded.arm.dof();
+    let start = loaded.arm.outputs(0.0, &x0[..n], &x0[n..]);
+    let m = crate::compare::measured(spec, &loaded.base_dir, [start[0], start[1], start[2]])
+        .map_err(|e| anyhow!("{}: [compare]: {e:#}", loaded.origin))?;
+    Ok(Some(m))
+}
+
+/// A compared run's output times: the measured ones up to t_end, and t_end.
+pub fn compare_times(m: &crate::compare::Measured, t_end: f64) -> Vec<f64> {
+    let mut t: Vec<f64> = m.t.iter().copied().filter(|&t| t <= t_end).collect();
+    if t.last() != Some(&t_end) {
+        t.push(t_end);
+    }
+    t
+}
+
+/// The simulated tip at every row of a trajectory.
+pub fn tips(loaded: &Loaded, traj: &runtime::Trajectory) -> Vec<(f64, [f64; 3])> {
+    let n = loaded.arm.dof();
+    (traj.t.iter().zip(&traj.x))
+        .map(|(t, x)| {
+            let o = loaded.arm.outputs(*t, &x[..n], &x[n..]);
+            (*t, [o[0], o[1], o[2]])
+        })
+        .collect()
+}
+
+/// The tip error over `[compare]`'s window (default: the whole record),
+/// relative to the arm's length with its tip body; an error when the run
+/// ended before the window.
+pub fn tip_error(
+    loaded: &Loaded,
+    m: &crate::compare::Measured,
+    tips: &[(f64, [f64; 3])],
+) -> Result<crate::compare::TipError> {
+    let spec = loaded
+        .model
+        .compare
+        .as_ref()
+        .ok_or_else(|| anyhow!("{}: no [compare]", loaded.origin))?;
+    let window = spec
+        .window
+        .unwrap_or([m.t[0], *m.t.last().expect("a CSV has rows")]);
+    let length = loaded.model.segments.iter().map(|s| s.length).sum::<f64>()
+        + loaded.model.tip.length.unwrap_or(0.0);
+    crate::compare::tip_error(m, window, length, |t| {
+        tips.iter().find(|s| (s.0 - t).abs() < 1e-9).map(|s| s.1)
+    })
+}

@@ -257,8 +257,14 @@ impl Model {
             qd0: qd0.map(|v| vector("qd0", Some(v), n)).transpose()?,
             start,
         };
-        let opts = softarm::run::options(&req, &self.loaded.model.simulate).map_err(value_error)?;
+        let mut opts =
+            softarm::run::options(&req, &self.loaded.model.simulate).map_err(value_error)?;
         let (x0, _) = softarm::run::initial_state(&req, &mut self.loaded).map_err(value_error)?;
+        // A compared model samples at the measured times, as the CLI does.
+        let measured = softarm::run::measured(&self.loaded, &x0).map_err(value_error)?;
+        if let Some(m) = &measured {
+            opts.output_times = Some(softarm::run::compare_times(m, opts.t_end));
+        }
         let arm = &*self.loaded.arm;
         let (traj, stats) = match runtime::simulate(arm, x0, &opts) {
             Ok(r) => r,
@@ -279,7 +285,13 @@ impl Model {
             .map(|(t, x)| arm.outputs(*t, &x[..n], &x[n..]))
             .collect();
         let outputs = Array2::from_shape_fn((rows, N_OUTPUTS), |(i, j)| outs[i][j]);
+        let tip_error = measured.as_ref().and_then(|m| {
+            let tips = softarm::run::tips(&self.loaded, &traj);
+            softarm::run::tip_error(&self.loaded, m, &tips).ok()
+        });
+        let arm = &*self.loaded.arm;
         let summary = serde_json::json!({
+            "tip_error": tip_error,
             "model": self.loaded.model.name,
             "backend": arm.backend(),
             "solver": stats.solver,
@@ -324,6 +336,24 @@ fn load_with(spec: &str, overrides: &[String]) -> PyResult<Loaded> {
     load(spec, &parsed, BackendChoice::Auto, None).map_err(value_error)
 }
 
+/// A sweep's grid (`softarm sweep`'s): the keys, each key's values as
+/// `--set` takes them, and every combination as value indices.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn sweep_grid(specs: Vec<String>) -> PyResult<(Vec<String>, Vec<Vec<String>>, Vec<Vec<usize>>)> {
+    let varies = specs
+        .iter()
+        .map(|s| softarm::grid::Vary::parse(s))
+        .collect::<anyhow::Result<Vec<_>>>()
+        .map_err(value_error)?;
+    let combos = softarm::grid::grid(&varies);
+    Ok((
+        varies.iter().map(|v| v.path.clone()).collect(),
+        varies.into_iter().map(|v| v.values).collect(),
+        combos,
+    ))
+}
+
 /// The compiled-in models' names.
 #[pyfunction]
 fn models() -> Vec<&'static str> {
@@ -336,6 +366,7 @@ fn _softarm(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<simulator::Simulator>()?;
     m.add_function(wrap_pyfunction!(load_model, m)?)?;
     m.add_function(wrap_pyfunction!(models, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_grid, m)?)?;
     m.add("IntegrationError", m.py().get_type::<IntegrationError>())?;
     m.add("OUTPUT_NAMES", runtime::OUTPUT_NAMES.to_vec())?;
     Ok(())

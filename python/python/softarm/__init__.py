@@ -21,7 +21,7 @@ import numpy as np
 from . import _softarm
 from ._softarm import IntegrationError
 
-__all__ = ["load", "models", "Model", "Simulator", "IntegrationError", "OUTPUT_NAMES"]
+__all__ = ["load", "models", "sweep", "Model", "Simulator", "IntegrationError", "OUTPUT_NAMES"]
 
 #: The columns of `Model.outputs` and of a run's "outputs".
 OUTPUT_NAMES = tuple(_softarm.OUTPUT_NAMES)
@@ -256,3 +256,6 @@ class Simulator:
     def reset(self, state=None) -> np.ndarray:
         """Back to t = 0 and the start state (or `state`); the state."""
         return self._core.reset(_vector(state))
+
+
+from .sweeps import sweep  # noqa: E402  (after Model: the sweep's workers load models)

@@ -1,0 +1,120 @@
+"""Parameter sweeps from Python (`softarm.sweep`): the grid of ``softarm sweep``, run in
+parallel here or as tasks on a Dask cluster.
+
+    import softarm
+    df = softarm.sweep("soft_finger", vary={"segment.0.youngs_modulus": "log:5e5:2e6:5",
+                                            "tip.mass": [0, 0.01]}, run="modes")
+
+The combinations, their value strings and the figures are the CLI's: the
+grid comes from the same Rust code (`softarm::grid`) and every run goes
+through the same core, so the DataFrame has ``sweep.csv``'s columns and
+values (wall times aside). A task carries only the model's name or path,
+its overrides and the run's options; each worker loads the compiled core
+itself.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from typing import Any, Mapping, Optional, Sequence, Union
+
+from . import _softarm
+
+Values = Union[str, Sequence[Any]]
+
+
+def _spec(path: str, values: Values) -> str:
+    if isinstance(values, str):
+        return f"{path}={values}"
+    text = ",".join(v if isinstance(v, str) else json.dumps(v) for v in values)
+    return f"{path}={text}"
+
+
+def _tip(tip) -> list:
+    return [(name, float(v)) for name, v in zip(("tip_x", "tip_y", "tip_z"), tip)]
+
+
+def run_one(model: str, sets: Sequence[str], run: str, options: Mapping[str, Any]) -> dict:
+    """One combination: its status, wall time and figures (as the CLI's
+    `sweep.csv` names them). A failure is a status, never an exception."""
+    import softarm  # in the worker
+
+    started = time.perf_counter()
+    figures: list = []
+    status = "ok"
+    try:
+        overrides = dict(s.split("=", 1) for s in sets)
+        m = softarm.load(model, set=overrides)
+        if run == "simulate":
+            try:
+                r = m.simulate(**options)
+                figures = _tip(r["tip"][-1])
+                err = r["summary"].get("tip_error")
+                if err:
+                    figures.append(("tip_error_mean_mm", 1e3 * err["mean_m"]))
+                figures.append(("run_wall_s", r["summary"]["wall_s"]))
+            except softarm.IntegrationError as e:
+                status = f"failed: {e.report.get('reason', str(e))}"
+        elif run == "static":
+            figures = _tip(m.static(options.get("q0"))["tip"])
+        elif run == "modes":
+            f = m.modes(options.get("q0"))["frequencies_hz"]
+            figures = [(f"f{k + 1}_hz", float(x)) for k, x in enumerate(f[:3])]
+        else:
+            raise ValueError(f"run = {run!r}: the runs are simulate, static and modes")
+    except Exception as e:  # the row says what went wrong
+        status = f"failed: {e}"
+    return {"status": status, "wall_s": time.perf_counter() - started, "figures": figures}
+
+
+def sweep(
+    model: str,
+    vary: Mapping[str, Values],
+    run: str = "simulate",
+    figures: Optional[Sequence[str]] = None,
+    client: Any = None,
+    set: Optional[Mapping[str, Any]] = None,
+    jobs: Optional[int] = None,
+    **options: Any,
+):
+    """Run `run` ("simulate", "static" or "modes") for every combination of
+    the `vary` values (a list, or "lin:a:b:n" / "log:a:b:n") and return a
+    pandas DataFrame: run, the varied keys, status, wall_s, the figures
+    (all, or those named in `figures`). `options` go to `Model.simulate`
+    (t_end, solver, rtol, ...). With a `dask.distributed.Client` the runs
+    are tasks on its cluster; else they run here on `jobs` processes
+    (default: every core)."""
+    import pandas as pd
+
+    specs = [_spec(p, v) for p, v in vary.items()]
+    paths, values, combos = _softarm.sweep_grid(specs)
+    base = [f"{k}={v if isinstance(v, str) else json.dumps(v)}" for k, v in (set or {}).items()]
+    tasks = [base + [f"{p}={values[i][c[i]]}" for i, p in enumerate(paths)] for c in combos]
+    if client is not None:
+        futures = [client.submit(run_one, model, t, run, options, pure=False) for t in tasks]
+        rows = client.gather(futures)
+    else:
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(max_workers=jobs or os.cpu_count()) as pool:
+            rows = list(pool.map(run_one, [model] * len(tasks), tasks, [run] * len(tasks),
+                                 [options] * len(tasks)))
+    names: list = []
+    for r in rows:
+        for n, _ in r["figures"]:
+            if n not in names:
+                names.append(n)
+    if figures is not None:
+        names = [n for n in names if n in figures]
+    table = []
+    for k, (c, r) in enumerate(zip(combos, rows)):
+        row = {"run": k}
+        row.update({p: values[i][c[i]] for i, p in enumerate(paths)})
+        row["status"] = r["status"].splitlines()[0] if r["status"] else ""
+        row["wall_s"] = r["wall_s"]
+        got = dict(r["figures"])
+        row.update({n: got.get(n, float("nan")) for n in names})
+        table.append(row)
+    return pd.DataFrame(table, columns=["run", *paths, "status", "wall_s", *names])
