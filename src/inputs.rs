@@ -206,4 +206,18 @@ impl Controls {
             arm.set_drive_signal(k, Signal::Constant(v));
         }
     }
+
+    /// Drive channel `i` by `signal` (its drives of the channel's rate by
+    /// the signal's derivative).
+    pub fn drive(&self, arm: &mut dyn runtime::Dynamics, i: usize, signal: &Signal) {
+        for &(k, c, der) in &self.drives {
+            if c == i {
+                let mut s = signal.clone();
+                for _ in 0..der {
+                    s = s.derivative();
+                }
+                arm.set_drive_signal(k, s);
+            }
+        }
+    }
 }

@@ -13,6 +13,7 @@ use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use runtime::N_OUTPUTS;
+use runtime::signal::Signal;
 use softarm::backend::{BackendChoice, Loaded, load};
 use softarm::run::RunRequest;
 
@@ -218,7 +219,8 @@ impl Model {
     /// Integrate as `softarm simulate` does: (t, states, outputs, summary
     /// JSON); states (N, 2n) are q then qd, outputs (N, 9).
     #[pyo3(signature = (t_end=None, solver=None, rtol=None, atol=None, dt=None,
-                        output_dt=None, max_steps=None, q0=None, qd0=None, start=None))]
+                        output_dt=None, max_steps=None, q0=None, qd0=None, start=None,
+                        inputs=Vec::new()))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &mut self,
@@ -233,7 +235,39 @@ impl Model {
         q0: Option<PyReadonlyArray1<f64>>,
         qd0: Option<PyReadonlyArray1<f64>>,
         start: Option<String>,
+        inputs: Vec<(String, Vec<f64>, Vec<f64>)>,
     ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        // Channels given as samples in time (linear between them) replace
+        // the model's for this run, on a copy of the model.
+        if !inputs.is_empty() {
+            let mut copy = Model {
+                loaded: load_with(&self.spec, &self.overrides)?,
+                spec: self.spec.clone(),
+                overrides: self.overrides.clone(),
+            };
+            let names: Vec<String> = inputs.iter().map(|(n, ..)| n.clone()).collect();
+            let controls =
+                softarm::inputs::Controls::new(&copy.loaded, &names).map_err(value_error)?;
+            for (i, (name, t, v)) in inputs.into_iter().enumerate() {
+                let table = runtime::signal::Table::new(t, v)
+                    .map_err(|e| PyValueError::new_err(format!("inputs[{name:?}]: {e}")))?;
+                controls.drive(&mut *copy.loaded.arm, i, &Signal::Table(table));
+            }
+            return copy.simulate(
+                py,
+                t_end,
+                solver,
+                rtol,
+                atol,
+                dt,
+                output_dt,
+                max_steps,
+                q0,
+                qd0,
+                start,
+                Vec::new(),
+            );
+        }
         let n = self.dof();
         let start = match start.as_deref() {
             None => None,

@@ -196,3 +196,46 @@ def test_linearize_is_the_clis_and_its_a_is_the_rhs_jacobian():
         pred += h**k / factorial(k) * term
         term = lin["A"] @ term
     assert np.allclose(dx, pred, rtol=1e-3, atol=1e-3 * np.abs(pred).max())
+
+
+def test_inputs_as_samples_replace_a_channel():
+    # finger_free's own ramp (0 to 1.5 bar between 0.1 s and 0.11 s),
+    # given as samples instead: the same run.
+    m = softarm.load("finger_free")
+    own = m.simulate(t_end=0.3)
+    given = m.simulate(t_end=0.3, inputs={"pressure": ([0.1, 0.11], [0.0, 1.5e5])})
+    assert np.array_equal(given["q"], own["q"])
+    # A constant as samples: the model with its ramp set flat.
+    c = 7e4
+    flat = softarm.load("finger_free", set={"inputs.pressure.from": c, "inputs.pressure.to": c})
+    assert np.array_equal(m.simulate(t_end=0.2, inputs={"pressure": ([0.0], [c])})["q"],
+                          flat.simulate(t_end=0.2)["q"])
+    # The model itself is unchanged by a run with other inputs.
+    assert np.array_equal(m.simulate(t_end=0.3)["q"], own["q"])
+    with pytest.raises(ValueError, match="no channel"):
+        m.simulate(t_end=0.1, inputs={"presure": ([0.0], [1.0])})
+
+
+def test_a_callable_input_is_a_controller_in_the_loop():
+    m = softarm.load("finger_free")
+    seen = []
+
+    def law(t, x):
+        seen.append(t)
+        return 5e4 if t < 0.05 else 0.0
+
+    run = m.simulate(t_end=0.1, inputs={"pressure": law}, control_dt=0.01)
+    sim = m.simulator(0.01, inputs=["pressure"])
+    for k in range(10):
+        sim.step([5e4 if 0.01 * k < 0.05 - 1e-12 else 0.0])
+    assert np.array_equal(run["q"][-1], sim.q)
+    assert len(run["t"]) == 11 and len(seen) == 10
+    assert np.array_equal(run["inputs"]["pressure"][:5], [5e4] * 5)
+
+    def broken(t, x):
+        if t > 0.02:
+            raise ZeroDivisionError("controller failed")
+        return 0.0
+
+    with pytest.raises(ZeroDivisionError, match="controller failed"):
+        m.simulate(t_end=0.1, inputs={"pressure": broken}, control_dt=0.01)

@@ -155,10 +155,19 @@ class Model:
         q0=None,
         qd0=None,
         start: Optional[str] = None,
+        inputs: Optional[Mapping[str, Any]] = None,
+        control_dt: Optional[float] = None,
     ) -> dict:
         """Integrate as ``softarm simulate`` does. Options left out come from
         the model's ``[simulate]``, else the defaults (5 s, dopri5, rtol 1e-6,
         atol 1e-9, a row every t_end / 500).
+
+        `inputs` replaces input channels for this run, by name: a pair of
+        arrays ``(t, values)`` (linear between samples, held beyond them),
+        or a callable ``f(t, state) -> value`` evaluated every `control_dt`
+        seconds (default: the output spacing) and held in between, a
+        controller in the loop; the rows are then the control steps. An
+        exception raised by a callable stops the run and propagates.
 
         Returns a dict of arrays: ``t`` (N,), ``q`` and ``qd`` (N, n),
         ``tip`` (N, 3), ``kinetic_energy``, ``potential_energy`` (N,),
@@ -166,16 +175,32 @@ class Model:
         Raises `IntegrationError` (with ``.report``) when the integrator
         gives up.
         """
+        inputs = dict(inputs or {})
+        if any(callable(f) for f in inputs.values()):
+            return self._simulate_closed_loop(inputs, t_end, solver, rtol, atol, dt, output_dt,
+                                              control_dt, q0, qd0)
+        sampled = []
+        for name, value in inputs.items():
+            try:
+                ts, vs = value
+            except (TypeError, ValueError):
+                raise ValueError(f"inputs[{name!r}]: give (t, values) arrays or a callable f(t, state)")
+            ts = np.ascontiguousarray(ts, dtype=np.float64).ravel()
+            vs = np.ascontiguousarray(vs, dtype=np.float64).ravel()
+            sampled.append((name, ts.tolist(), vs.tolist()))
         try:
             t, x, out, summary = self._core.simulate(
                 t_end, solver, rtol, atol, dt, output_dt, max_steps,
-                _vector(q0), _vector(qd0), start,
+                _vector(q0), _vector(qd0), start, sampled,
             )
         except IntegrationError as e:
             message, report = e.args
             err = IntegrationError(message)
             err.report = json.loads(report)
             raise err from None
+        return self._arrays(t, x, out, json.loads(summary))
+
+    def _arrays(self, t, x, out, summary) -> dict:
         n = self.dof
         return {
             "t": t,
@@ -186,8 +211,37 @@ class Model:
             "potential_energy": out[:, 4],
             "tip_orientation": out[:, 5:9],
             "outputs": out,
-            "summary": json.loads(summary),
+            "summary": summary,
         }
+
+    def _simulate_closed_loop(self, inputs, t_end, solver, rtol, atol, dt, output_dt,
+                              control_dt, q0, qd0) -> dict:
+        names = list(inputs)
+        if not all(callable(f) for f in inputs.values()):
+            raise ValueError("inputs: give every channel as a callable, or none")
+        t_end = 5.0 if t_end is None else float(t_end)
+        step = control_dt or output_dt or t_end / 500
+        sim = self.simulator(step, inputs=names, solver=solver, rtol=rtol, atol=atol, step=dt)
+        if q0 is not None or qd0 is not None:
+            n = self.dof
+            state = sim.state
+            if q0 is not None:
+                state[:n] = _vector(q0)
+            if qd0 is not None:
+                state[n:] = _vector(qd0)
+            sim.state = state
+        steps = int(round(t_end / step))
+        ts, xs, outs, us = [0.0], [sim.state], [sim.outputs()], []
+        for _ in range(steps):
+            u = np.array([float(inputs[c](sim.t, sim.state)) for c in names])
+            us.append(u)
+            xs.append(sim.step(u))
+            ts.append(sim.t)
+            outs.append(sim.outputs())
+        summary = {"model": self.name, "control_dt": step, "steps": steps, "status": "ok"}
+        run = self._arrays(np.array(ts), np.array(xs), np.array(outs), summary)
+        run["inputs"] = {c: np.array([u[i] for u in us]) for i, c in enumerate(names)}
+        return run
 
 
 class Simulator:
