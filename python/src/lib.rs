@@ -150,6 +150,28 @@ impl Model {
         pyo3::types::PyTuple::new(py, items)
     }
 
+    /// The right-hand side's Jacobian d(q', qd')/d(q, qd) (2n x 2n) at
+    /// (q, qd, t): the generated analytic one the implicit solvers use.
+    #[pyo3(signature = (q, qd=None, t=0.0))]
+    fn jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: PyReadonlyArray1<f64>,
+        qd: Option<PyReadonlyArray1<f64>>,
+        t: f64,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let n = self.dof();
+        let x: Vec<f64> = vector("q", Some(q), n)?
+            .into_iter()
+            .chain(vector("qd", qd, n)?)
+            .collect();
+        let mut ws = runtime::Workspace::new(n);
+        let mut jac = DMatrix::zeros(2 * n, 2 * n);
+        runtime::rhs_jacobian(&*self.loaded.arm, &mut ws, t, &x, &mut jac)
+            .map_err(|e| PyRuntimeError::new_err(format!("{}: {e}", self.loaded.origin)))?;
+        Ok(Array2::from_shape_fn((2 * n, 2 * n), |(i, j)| jac[(i, j)]).into_pyarray(py))
+    }
+
     /// (M, h) at (q, qd, t): M qdd + h = 0.
     #[pyo3(signature = (q, qd=None, t=0.0))]
     fn mass_bias<'py>(
@@ -337,12 +359,31 @@ impl Model {
             "wall_s": stats.wall_s,
             "status": "ok",
         });
+        // The joints' forces and the contacts' forces, as trajectory.csv
+        // has them.
+        let mut names = softarm::joints::reaction_names(arm);
+        let joints = !arm.info().constraints.is_empty();
+        names.extend(softarm::contact::column_names(arm));
+        let extra: Vec<Vec<f64>> = (0..rows)
+            .map(|i| {
+                let mut row = if joints {
+                    softarm::joints::reactions(arm, traj.t[i], &traj.x[i])
+                } else {
+                    Vec::new()
+                };
+                row.extend(softarm::contact::columns(arm, &traj, i));
+                row
+            })
+            .collect();
+        let columns = Array2::from_shape_fn((rows, names.len()), |(i, j)| extra[i][j]);
         let t = traj.t.into_pyarray(py);
         let items: Vec<Bound<'py, PyAny>> = vec![
             t.into_any(),
             states.into_pyarray(py).into_any(),
             outputs.into_pyarray(py).into_any(),
             summary.to_string().into_pyobject(py)?.into_any(),
+            names.into_pyobject(py)?.into_any(),
+            columns.into_pyarray(py).into_any(),
         ];
         pyo3::types::PyTuple::new(py, items)
     }

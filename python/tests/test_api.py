@@ -239,3 +239,37 @@ def test_a_callable_input_is_a_controller_in_the_loop():
 
     with pytest.raises(ZeroDivisionError, match="controller failed"):
         m.simulate(t_end=0.1, inputs={"pressure": broken}, control_dt=0.01)
+
+
+def test_contact_forces_and_the_jacobian_are_the_clis(tmp_path):
+    run("simulate", "finger_tap", "--t-end", "0.5", "--shape-points", "0", "--quiet",
+        "--out", str(tmp_path))
+    with open(tmp_path / "trajectory.csv") as f:
+        rows = list(csv.DictReader(f))
+    r = softarm.load("finger_tap").simulate(t_end=0.5)
+    assert set(r["columns"]) == {"contact_table_fn", "contact_table_ft"}
+    for name, col in r["columns"].items():
+        ref = np.array([float(row[name]) for row in rows])
+        assert np.allclose(col, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
+    assert r["columns"]["contact_table_fn"].max() > 0, "the finger touched"
+    # The Jacobian: central differences of the right-hand side (M, h).
+    m = softarm.load("double_pendulum")
+    q, qd = state(m, 4)
+    J = m.jacobian(q, qd)
+
+    def f(x):
+        M, h = m.mass_bias(x[:2], x[2:])
+        return np.concatenate([x[2:], -np.linalg.solve(M, h)])
+
+    x = np.concatenate([q, qd])
+    fd = np.column_stack([(f(x + e) - f(x - e)) / 2e-6 for e in np.eye(4) * 1e-6])
+    assert np.allclose(J, fd, rtol=1e-6, atol=1e-8)
+
+
+def test_nan_in_an_input_is_refused():
+    m = softarm.load("finger_free")
+    with pytest.raises(ValueError, match="pressure"):
+        m.simulate(t_end=0.1, inputs={"pressure": ([0.0, 1.0], [0.0, np.nan])})
+    sim = m.simulator(0.01, inputs=["pressure"])
+    with pytest.raises(ValueError, match="u\\[0\\] is NaN"):
+        sim.step([np.nan])

@@ -116,6 +116,11 @@ class Model:
                 "states": coords + [f"{c}_dot" for c in coords], "inputs": list(inputs),
                 "outputs": ["tip_x", "tip_y", "tip_z"]}
 
+    def jacobian(self, q, qd=None, t: float = 0.0) -> np.ndarray:
+        """The right-hand side's Jacobian d(q', qd')/d(q, qd), (2n, 2n): the
+        generated analytic one that the implicit solvers use."""
+        return self._core.jacobian(_vector(q), _vector(qd), float(t))
+
     def mass_bias(self, q, qd=None, t: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """The mass matrix M (n, n) and bias h (n,) at (q, qd, t)."""
         return self._core.mass_bias(_vector(q), _vector(qd), float(t))
@@ -171,7 +176,9 @@ class Model:
 
         Returns a dict of arrays: ``t`` (N,), ``q`` and ``qd`` (N, n),
         ``tip`` (N, 3), ``kinetic_energy``, ``potential_energy`` (N,),
-        ``tip_orientation`` (N, 4), ``outputs`` (N, 9), and ``summary``.
+        ``tip_orientation`` (N, 4), ``outputs`` (N, 9), ``columns`` (the
+        joints' and contacts' forces by trajectory.csv's names) and
+        ``summary``.
         Raises `IntegrationError` (with ``.report``) when the integrator
         gives up.
         """
@@ -189,7 +196,7 @@ class Model:
             vs = np.ascontiguousarray(vs, dtype=np.float64).ravel()
             sampled.append((name, ts.tolist(), vs.tolist()))
         try:
-            t, x, out, summary = self._core.simulate(
+            t, x, out, summary, names, columns = self._core.simulate(
                 t_end, solver, rtol, atol, dt, output_dt, max_steps,
                 _vector(q0), _vector(qd0), start, sampled,
             )
@@ -198,7 +205,9 @@ class Model:
             err = IntegrationError(message)
             err.report = json.loads(report)
             raise err from None
-        return self._arrays(t, x, out, json.loads(summary))
+        run = self._arrays(t, x, out, json.loads(summary))
+        run["columns"] = {name: columns[:, k] for k, name in enumerate(names)}
+        return run
 
     def _arrays(self, t, x, out, summary) -> dict:
         n = self.dof

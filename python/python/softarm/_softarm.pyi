@@ -18,6 +18,7 @@ class Model:
     backend: str
     origin: str
     def mass_bias(self, q: Vector, qd: Optional[Vector] = None, t: float = 0.0) -> tuple[Vector, Vector]: ...
+    def jacobian(self, q: Vector, qd: Optional[Vector] = None, t: float = 0.0) -> Vector: ...
     def outputs(self, q: Vector, qd: Optional[Vector] = None, t: float = 0.0) -> Vector: ...
     def linearize(
         self, inputs: list[str] = ..., u0: Optional[Vector] = None, q0: Optional[Vector] = None,
@@ -36,7 +37,8 @@ class Model:
         q0: Optional[Vector] = None,
         qd0: Optional[Vector] = None,
         start: Optional[str] = None,
-    ) -> tuple[Vector, Vector, Vector, str]: ...
+        inputs: list[tuple[str, list[float], list[float]]] = ...,
+    ) -> tuple[Vector, Vector, Vector, str, list[str], Vector]: ...
 
     def simulator(
         self, dt: float, inputs: list[str] = ..., solver: Optional[str] = None,
