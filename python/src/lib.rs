@@ -35,6 +35,21 @@ pub(crate) fn value_error(e: anyhow::Error) -> PyErr {
     PyValueError::new_err(format!("{e:#}"))
 }
 
+/// A value moved into `Python::detach`, which runs its closure on this
+/// same thread without the GIL: the model's dynamics are not `Send`
+/// (interior caches), but they never leave the thread, and `&mut self`
+/// keeps every other caller out while the GIL is released.
+struct AssertSend<T>(T);
+// SAFETY: `detach` runs the closure synchronously on the calling thread;
+// the value is never touched from another thread (see above).
+unsafe impl<T> Send for AssertSend<T> {}
+
+impl<T> AssertSend<T> {
+    fn into_inner(self) -> T {
+        self.0
+    }
+}
+
 /// A loaded model: its compiled (or interpreted) dynamics and its file.
 #[pyclass(unsendable, module = "softarm._softarm")]
 struct Model {
@@ -321,9 +336,28 @@ impl Model {
         if let Some(m) = &measured {
             opts.output_times = Some(softarm::run::compare_times(m, opts.t_end));
         }
+        // Ctrl-C: the run asks Python for pending signals now and then.
+        opts.interrupt = Some(runtime::Interrupt(std::sync::Arc::new(|| {
+            Python::attach(|py| py.check_signals().is_err())
+        })));
         let arm = &*self.loaded.arm;
-        let (traj, stats) = match runtime::simulate(arm, x0, &opts) {
+        // The run releases the GIL: other Python threads go on meanwhile.
+        let job = AssertSend((arm, x0, &opts));
+        let result = py
+            .detach(move || {
+                // (Through a method: the closure takes `job` whole.)
+                let (arm, x0, opts) = job.into_inner();
+                AssertSend(runtime::simulate(arm, x0, opts))
+            })
+            .0;
+        let (traj, stats) = match result {
             Ok(r) => r,
+            Err(f) if f.reason == runtime::INTERRUPTED => {
+                return Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(format!(
+                    "the run stopped at t = {} s",
+                    f.t_reached
+                )));
+            }
             Err(f) => {
                 let report = serde_json::json!({
                     "t_reached": f.t_reached, "last_step_s": f.last_step_s,

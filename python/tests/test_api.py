@@ -273,3 +273,39 @@ def test_nan_in_an_input_is_refused():
     sim = m.simulator(0.01, inputs=["pressure"])
     with pytest.raises(ValueError, match="u\\[0\\] is NaN"):
         sim.step([np.nan])
+
+
+def test_a_long_run_releases_the_gil_and_stops_on_ctrl_c():
+    import signal
+    import threading
+    import time
+
+    m = softarm.load("soft_finger")
+    # Other Python threads run while a simulation does.
+    count = [0]
+    done = threading.Event()
+
+    def spin():
+        while not done.is_set():
+            count[0] += 1
+
+    spinner = threading.Thread(target=spin)
+    spinner.start()
+    time.sleep(0.05)
+    before, t0 = count[0], time.perf_counter()
+    time.sleep(0.2)  # the spinner alone: its rate
+    rate = (count[0] - before) / (time.perf_counter() - t0)
+    before, t0 = count[0], time.perf_counter()
+    m.simulate(t_end=3.0)
+    during = (count[0] - before) / (time.perf_counter() - t0)
+    done.set()
+    spinner.join()
+    # Holding the GIL would leave the spinner a switch interval or two.
+    assert during > 0.3 * rate, f"the other thread ran at {during:.0f}/s of {rate:.0f}/s"
+    # SIGINT (Ctrl-C) stops a run of minutes within moments.
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    started = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        m.simulate(t_end=1e4)
+    assert time.perf_counter() - started < 5.0

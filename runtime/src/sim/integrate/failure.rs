@@ -50,6 +50,7 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
         kept,
         last_step_s,
         contact,
+        interrupted,
     } = recorded;
     let hits = kept.events.clone();
     let wall_s = start.elapsed().as_secs_f64();
@@ -80,6 +81,18 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
                 events: hits,
                 ..Default::default()
             };
+            if let Some(t_stop) = interrupted {
+                let state = traj.x.last().cloned().unwrap_or_else(|| x0.to_vec());
+                return Err(Box::new(SimFailure {
+                    t_reached: t_stop,
+                    last_step_s,
+                    reason: super::options::INTERRUPTED.into(),
+                    suggestion: "the run was asked to stop; run it again to finish".into(),
+                    state,
+                    trajectory: traj,
+                    stats,
+                }));
+            }
             if let Some(t_bad) = blown_up {
                 let state = traj.x.last().cloned().unwrap_or_else(|| x0.to_vec());
                 return Err(Box::new(SimFailure {

@@ -37,7 +37,7 @@ pub mod trbdf2;
 pub use crate::solver::Solver;
 pub use dispatch::IMPLICIT_SIZES;
 pub use failure::SimFailure;
-pub use options::{DEFAULT_SAMPLES, DEFAULT_T_END, SimOptions};
+pub use options::{DEFAULT_SAMPLES, DEFAULT_T_END, INTERRUPTED, Interrupt, SimOptions};
 pub use projected::ConstraintStats;
 pub use record::{
     AUTO_CHECK_STEPS, ContactMeter, MeterSample, SimStats, SolverSwitch, SwitchRecord, Trajectory,

@@ -33,6 +33,23 @@ pub struct SimOptions {
     /// time it reached (`f64::to_bits`), for a progress display that
     /// polls it from another thread.
     pub progress: Option<std::sync::Arc<std::sync::atomic::AtomicU64>>,
+    /// Asked every few accepted steps whether to stop (Ctrl-C in a host
+    /// language): true ends the run as a failure whose reason is
+    /// `INTERRUPTED`, with the trajectory so far.
+    pub interrupt: Option<Interrupt>,
+}
+
+/// The reason of a run stopped by its `SimOptions::interrupt`.
+pub const INTERRUPTED: &str = "interrupted";
+
+/// Whether to stop a run now.
+#[derive(Clone)]
+pub struct Interrupt(pub std::sync::Arc<dyn Fn() -> bool + Send + Sync>);
+
+impl std::fmt::Debug for Interrupt {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Interrupt")
+    }
 }
 
 impl Default for SimOptions {
@@ -49,6 +66,7 @@ impl Default for SimOptions {
             events: Vec::new(),
             max_steps: 10_000_000,
             progress: None,
+            interrupt: None,
         }
     }
 }

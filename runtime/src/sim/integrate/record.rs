@@ -153,6 +153,9 @@ pub(super) struct Recorder<'a> {
     metered: &'a Cell<Option<ContactMeter>>,
     /// `SimOptions::progress`.
     progress: Option<std::sync::Arc<std::sync::atomic::AtomicU64>>,
+    /// `SimOptions::interrupt`, and when it stopped the run.
+    interrupt: Option<super::options::Interrupt>,
+    interrupted: &'a Cell<Option<f64>>,
 }
 
 pub(super) type Watch<'a> = dyn Fn(&[f64], f64) -> Option<String> + 'a;
@@ -190,6 +193,14 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
         }
         if let Some(p) = &self.progress {
             p.store(t_curr.to_bits(), std::sync::atomic::Ordering::Relaxed);
+        }
+        // Asked every 64 accepted steps: a check costs a host call.
+        if let Some(stop) = &self.interrupt
+            && self.accepted.is_multiple_of(64)
+            && (stop.0)()
+        {
+            self.interrupted.set(Some(t_curr));
+            return ControlFlag::Terminate;
         }
         if let Some(meter) = &self.meter {
             let mut m = self.metered.get().unwrap_or_default();
@@ -332,11 +343,14 @@ pub(super) struct Recorded {
     pub(super) kept: Trajectory,
     pub(super) last_step_s: Option<f64>,
     pub(super) contact: Option<ContactMeter>,
+    /// `SimOptions::interrupt` stopped the run at this time.
+    pub(super) interrupted: Option<f64>,
 }
 
 /// The shared state a run's `Recorder` writes to.
 pub(super) struct RunLog {
     pub(super) blown_up: Cell<Option<f64>>,
+    interrupted: Cell<Option<f64>>,
     events: RefCell<EventWatch>,
     kept: RefCell<Trajectory>,
     last_step: Cell<Option<f64>>,
@@ -347,6 +361,7 @@ impl RunLog {
     pub(super) fn new(opts: &SimOptions, dof: usize) -> Self {
         Self {
             blown_up: Cell::new(None),
+            interrupted: Cell::new(None),
             events: RefCell::new(EventWatch::new(&opts.events, 2 * dof)),
             kept: RefCell::new(Trajectory::default()),
             last_step: Cell::new(None),
@@ -379,6 +394,8 @@ impl RunLog {
             meter: ode.contact_meter(),
             metered: &self.metered,
             progress: opts.progress.clone(),
+            interrupt: opts.interrupt.clone(),
+            interrupted: &self.interrupted,
         }
     }
 
@@ -390,6 +407,7 @@ impl RunLog {
             },
             last_step_s: self.last_step.get(),
             contact: self.metered.get(),
+            interrupted: self.interrupted.get(),
         }
     }
 }
