@@ -57,6 +57,8 @@ struct Model {
     /// How it was loaded: a simulator loads its own copy.
     spec: String,
     overrides: Vec<String>,
+    /// Channels this copy's runs take from Python instead of the model.
+    replaced: std::collections::BTreeMap<String, Signal>,
 }
 
 /// A vector of `n` finite values, or a ValueError naming it.
@@ -281,6 +283,7 @@ impl Model {
                 loaded: load_with(&self.spec, &self.overrides)?,
                 spec: self.spec.clone(),
                 overrides: self.overrides.clone(),
+                replaced: Default::default(),
             };
             let names: Vec<String> = inputs.iter().map(|(n, ..)| n.clone()).collect();
             let controls =
@@ -288,7 +291,9 @@ impl Model {
             for (i, (name, t, v)) in inputs.into_iter().enumerate() {
                 let table = runtime::signal::Table::new(t, v)
                     .map_err(|e| PyValueError::new_err(format!("inputs[{name:?}]: {e}")))?;
-                controls.drive(&mut *copy.loaded.arm, i, &Signal::Table(table));
+                let signal = Signal::Table(table);
+                controls.drive(&mut *copy.loaded.arm, i, &signal);
+                copy.replaced.insert(name, signal);
             }
             return copy.simulate(
                 py,
@@ -410,6 +415,22 @@ impl Model {
             })
             .collect();
         let columns = Array2::from_shape_fn((rows, names.len()), |(i, j)| extra[i][j]);
+        // Every input channel's value at the rows.
+        let mut channels = Vec::new();
+        for (name, input) in &self.loaded.model.inputs {
+            let signal = match self.replaced.get(name) {
+                Some(s) => s.clone(),
+                None => softarm::inputs::signal(name, input, &self.loaded.base_dir)
+                    .map_err(value_error)?,
+            };
+            channels.push((
+                name.clone(),
+                traj.t.iter().map(|&t| signal.at(t)).collect::<Vec<_>>(),
+            ));
+        }
+        let channel_names: Vec<String> = channels.iter().map(|(n, _)| n.clone()).collect();
+        let channel_values =
+            Array2::from_shape_fn((rows, channels.len()), |(i, j)| channels[j].1[i]);
         let t = traj.t.into_pyarray(py);
         let items: Vec<Bound<'py, PyAny>> = vec![
             t.into_any(),
@@ -418,6 +439,8 @@ impl Model {
             summary.to_string().into_pyobject(py)?.into_any(),
             names.into_pyobject(py)?.into_any(),
             columns.into_pyarray(py).into_any(),
+            channel_names.into_pyobject(py)?.into_any(),
+            channel_values.into_pyarray(py).into_any(),
         ];
         pyo3::types::PyTuple::new(py, items)
     }
@@ -433,6 +456,7 @@ fn load_model(spec: &str, overrides: Vec<String>) -> PyResult<Model> {
         loaded,
         spec: spec.to_string(),
         overrides,
+        replaced: Default::default(),
     })
 }
 

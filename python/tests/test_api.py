@@ -205,6 +205,10 @@ def test_inputs_as_samples_replace_a_channel():
     own = m.simulate(t_end=0.3)
     given = m.simulate(t_end=0.3, inputs={"pressure": ([0.1, 0.11], [0.0, 1.5e5])})
     assert np.array_equal(given["q"], own["q"])
+    # The run reports the channel: 0 before the ramp, 1.5 bar after it.
+    p = given["inputs"]["pressure"]
+    assert np.array_equal(p, own["inputs"]["pressure"])
+    assert p[given["t"] < 0.1].max() == 0.0 and p[given["t"] > 0.11].min() == 1.5e5
     # A constant as samples: the model with its ramp set flat.
     c = 7e4
     flat = softarm.load("finger_free", set={"inputs.pressure.from": c, "inputs.pressure.to": c})

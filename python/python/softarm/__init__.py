@@ -177,8 +177,8 @@ class Model:
         Returns a dict of arrays: ``t`` (N,), ``q`` and ``qd`` (N, n),
         ``tip`` (N, 3), ``kinetic_energy``, ``potential_energy`` (N,),
         ``tip_orientation`` (N, 4), ``outputs`` (N, 9), ``columns`` (the
-        joints' and contacts' forces by trajectory.csv's names) and
-        ``summary``.
+        joints' and contacts' forces by trajectory.csv's names), ``inputs``
+        (every input channel's value at the rows) and ``summary``.
         Raises `IntegrationError` (with ``.report``) when the integrator
         gives up.
         """
@@ -196,7 +196,7 @@ class Model:
             vs = np.ascontiguousarray(vs, dtype=np.float64).ravel()
             sampled.append((name, ts.tolist(), vs.tolist()))
         try:
-            t, x, out, summary, names, columns = self._core.simulate(
+            t, x, out, summary, names, columns, channels, values = self._core.simulate(
                 t_end, solver, rtol, atol, dt, output_dt, max_steps,
                 _vector(q0), _vector(qd0), start, sampled,
             )
@@ -207,6 +207,7 @@ class Model:
             raise err from None
         run = self._arrays(t, x, out, json.loads(summary))
         run["columns"] = {name: columns[:, k] for k, name in enumerate(names)}
+        run["inputs"] = {name: values[:, k] for k, name in enumerate(channels)}
         return run
 
     def _arrays(self, t, x, out, summary) -> dict:

@@ -38,7 +38,7 @@ class Model:
         qd0: Optional[Vector] = None,
         start: Optional[str] = None,
         inputs: list[tuple[str, list[float], list[float]]] = ...,
-    ) -> tuple[Vector, Vector, Vector, str, list[str], Vector]: ...
+    ) -> tuple[Vector, Vector, Vector, str, list[str], Vector, list[str], Vector]: ...
 
     def simulator(
         self, dt: float, inputs: list[str] = ..., solver: Optional[str] = None,
