@@ -29,6 +29,15 @@ create_exception!(
 /// A matrix and a vector for Python.
 type MatVec<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
 
+/// A failed integration as IntegrationError((message, report JSON)).
+pub(crate) fn integration_error(f: &runtime::SimFailure) -> PyErr {
+    let report = serde_json::json!({
+        "t_reached": f.t_reached, "last_step_s": f.last_step_s,
+        "reason": f.reason, "suggestion": f.suggestion, "state": f.state,
+    });
+    IntegrationError::new_err((f.to_string(), report.to_string()))
+}
+
 /// A model error (a bad file, key or value) as ValueError, with its whole
 /// chain of context (file, key path, what is allowed).
 pub(crate) fn value_error(e: anyhow::Error) -> PyErr {
@@ -363,16 +372,7 @@ impl Model {
                     f.t_reached
                 )));
             }
-            Err(f) => {
-                let report = serde_json::json!({
-                    "t_reached": f.t_reached, "last_step_s": f.last_step_s,
-                    "reason": f.reason, "suggestion": f.suggestion, "state": f.state,
-                });
-                return Err(IntegrationError::new_err((
-                    f.to_string(),
-                    report.to_string(),
-                )));
-            }
+            Err(f) => return Err(integration_error(&f)),
         };
         let rows = traj.t.len();
         let states = Array2::from_shape_fn((rows, 2 * n), |(i, j)| traj.x[i][j]);

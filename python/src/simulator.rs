@@ -13,7 +13,7 @@ use softarm::backend::Loaded;
 use softarm::inputs::Controls;
 use softarm::run::RunRequest;
 
-use crate::{IntegrationError, value_error, vector};
+use crate::{integration_error, value_error, vector};
 
 #[pyclass(unsendable, module = "softarm._softarm")]
 pub struct Simulator {
@@ -91,16 +91,7 @@ impl Simulator {
                     )));
                 }
             },
-            Err(f) => {
-                let report = serde_json::json!({
-                    "t_reached": f.t_reached, "last_step_s": f.last_step_s,
-                    "reason": f.reason, "suggestion": f.suggestion, "state": f.state,
-                });
-                return Err(IntegrationError::new_err((
-                    f.to_string(),
-                    report.to_string(),
-                )));
-            }
+            Err(f) => return Err(integration_error(&f)),
         }
         Ok(self.x.clone().into_pyarray(py))
     }
