@@ -83,7 +83,9 @@ fn frame(ck: &Check) -> Result<(), ModelError> {
     if norm == 0.0 {
         return ck.err(
             "base.direction".into(),
-            "must be a non-zero vector (the undeformed arm axis)".into(),
+            "must be a non-zero vector (the undeformed arm axis); give it in [base], \
+             e.g. direction = [1.0, 0.0, 0.0] (a missing [base] leaves it zero)"
+                .into(),
         );
     }
     if !matches!(m.dimensions, 2 | 3) {
