@@ -106,9 +106,14 @@ impl ModellingMethod for Rom {
     }
 }
 
-/// A rom segment: strain fields sum_i c_i sigma^i over sigma = s / L in
-/// [0, 1], the coefficients c (angles: curvature times L; the stretch
-/// field is dimensionless) its coordinates, field by field.
+/// A rom segment: strain fields sum_i c_i P_i(sigma) over sigma = s / L in
+/// [0, 1], P_i the Legendre polynomials shifted to [0, 1] (orthogonal:
+/// int P_i P_j = delta_ij / (2 i + 1)), the coefficients c (angles:
+/// curvature times L; the stretch field is dimensionless) its
+/// coordinates, field by field. The monomials sigma^i span the same
+/// fields, but their Gram matrix (the Hilbert matrix) is ill-conditioned
+/// past order 5: the mass matrix inherits it and the step control stalls
+/// (issue 24).
 pub(crate) struct RomFields {
     pub first: usize,
     pub order: usize,
@@ -141,14 +146,23 @@ impl RomFields {
         self.first + f * (self.order + 1) + i
     }
 
-    /// int over slice e of sigma^i d sigma, for each i.
+    /// int over slice e of P_i(sigma) d sigma, for each i: with y = 2 sigma
+    /// - 1, int P_i d sigma = (P_{i+1}(y) - P_{i-1}(y)) / (2 (2 i + 1)) for
+    /// i >= 1 (the Legendre identity), the slice's length for i = 0.
     pub(crate) fn weights(&self, e: usize) -> Vec<f64> {
         let n = self.slices as f64;
         let (a, b) = (e as f64 / n, (e + 1) as f64 / n);
+        let (pa, pb) = (
+            legendre(self.order + 1, 2.0 * a - 1.0),
+            legendre(self.order + 1, 2.0 * b - 1.0),
+        );
         (0..=self.order)
-            .map(|i| {
-                let p = (i + 1) as i32;
-                (b.powi(p) - a.powi(p)) / p as f64
+            .map(|i| match i {
+                0 => b - a,
+                _ => {
+                    let at = |p: &[f64]| p[i + 1] - p[i - 1];
+                    (at(&pb) - at(&pa)) / (2.0 * (2 * i + 1) as f64)
+                }
             })
             .collect()
     }
@@ -209,8 +223,8 @@ impl RomFields {
     }
 
     /// Strain energy and Rayleigh function, integrated exactly:
-    /// (k / 2) int_0^1 (field - rest)^2 d sigma with int sigma^(i+j) = 1 /
-    /// (i + j + 1). Per-slice parameters of slice k: E I / l = slices E I / L.
+    /// (k / 2) int_0^1 (field - rest)^2 d sigma with int P_i P_j = delta_ij /
+    /// (2 i + 1). Per-slice parameters of slice k: E I / l = slices E I / L.
     pub(crate) fn energies(
         &self,
         cas: &mut Cas,
@@ -220,13 +234,12 @@ impl RomFields {
     ) -> [ExprId; 2] {
         let n = self.slices as f64;
         let quad = |cas: &mut Cas, x: &[ExprId]| {
-            let mut terms = Vec::new();
-            for (i, &a) in x.iter().enumerate() {
-                for (j, &b) in x.iter().enumerate() {
-                    let ab = cas.mul(a, b);
-                    terms.push(cas.scaled(1.0 / (i + j + 1) as f64, ab));
-                }
-            }
+            let terms: Vec<ExprId> = (x.iter().enumerate())
+                .map(|(i, &a)| {
+                    let aa = cas.mul(a, a);
+                    cas.scaled(1.0 / (2 * i + 1) as f64, aa)
+                })
+                .collect();
             cas.add_all(&terms)
         };
         let fields = 2 + usize::from(self.twist) + usize::from(self.extension);
@@ -286,5 +299,68 @@ impl RomFields {
         let e = cas.add_all(&elastic);
         let d = cas.add_all(&rayleigh);
         [cas.scaled(0.5, e), cas.scaled(0.5, d)]
+    }
+}
+
+/// P_0(y), ..., P_n(y), the Legendre polynomials on [-1, 1], by Bonnet's
+/// recurrence (k + 1) P_{k+1} = (2 k + 1) y P_k - k P_{k-1}: stable, no
+/// large coefficients.
+fn legendre(n: usize, y: f64) -> Vec<f64> {
+    let mut p = vec![1.0, y];
+    for k in 1..n {
+        let k_f = k as f64;
+        p.push(((2.0 * k_f + 1.0) * y * p[k] - k_f * p[k - 1]) / (k_f + 1.0));
+    }
+    p.truncate(n + 1);
+    p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn legendre_polynomials_and_their_slice_integrals() {
+        for &y in &[-1.0, -0.3, 0.0, 0.7, 1.0] {
+            let p = legendre(4, y);
+            let closed = [
+                1.0,
+                y,
+                0.5 * (3.0 * y * y - 1.0),
+                0.5 * (5.0 * y * y * y - 3.0 * y),
+                (35.0 * y.powi(4) - 30.0 * y * y + 3.0) / 8.0,
+            ];
+            for (a, b) in p.iter().zip(closed) {
+                assert!((a - b).abs() < 1e-14, "{a} vs {b} at {y}");
+            }
+        }
+        // Over the whole rod: int_0^1 P_i = 1 for i = 0, else 0; and on
+        // many slices, sum_e w_i w_j n approaches int P_i P_j = delta_ij /
+        // (2 i + 1).
+        let rom = RomFields {
+            first: 0,
+            order: 6,
+            slices: 400,
+            twist: false,
+            extension: false,
+            incompressible: false,
+        };
+        let w: Vec<Vec<f64>> = (0..rom.slices).map(|e| rom.weights(e)).collect();
+        for i in 0..=6 {
+            let total: f64 = w.iter().map(|we| we[i]).sum();
+            assert!(
+                (total - f64::from(u8::from(i == 0))).abs() < 1e-13,
+                "int P_{i} = {total}"
+            );
+            for j in 0..=6 {
+                let gram: f64 = w.iter().map(|we| we[i] * we[j]).sum::<f64>() * rom.slices as f64;
+                let exact = if i == j {
+                    1.0 / (2 * i + 1) as f64
+                } else {
+                    0.0
+                };
+                assert!((gram - exact).abs() < 1e-3, "Gram {i} {j}: {gram}");
+            }
+        }
     }
 }
