@@ -146,9 +146,10 @@ impl RomFields {
         self.first + f * (self.order + 1) + i
     }
 
-    /// int over slice e of P_i(sigma) d sigma, for each i: with y = 2 sigma
-    /// - 1, int P_i d sigma = (P_{i+1}(y) - P_{i-1}(y)) / (2 (2 i + 1)) for
-    /// i >= 1 (the Legendre identity), the slice's length for i = 0.
+    /// int over slice e of P_i(sigma) d sigma, for each i: with
+    /// y = 2 sigma - 1, int P_i d sigma = (P_{i+1}(y) - P_{i-1}(y)) /
+    /// (2 (2 i + 1)) for i at least 1 (the Legendre identity), the slice's
+    /// length for i = 0.
     pub(crate) fn weights(&self, e: usize) -> Vec<f64> {
         let n = self.slices as f64;
         let (a, b) = (e as f64 / n, (e + 1) as f64 / n);
