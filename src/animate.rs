@@ -120,7 +120,6 @@ impl Camera {
             (v, _) => v,
         };
         match view {
-            View::Auto => unreachable!("resolved just above"),
             View::Front => Self {
                 right: x,
                 up,
@@ -136,7 +135,8 @@ impl Camera {
                 up: neg(depth),
                 toward: up,
             },
-            View::Iso => {
+            // (Auto is resolved above.)
+            View::Iso | View::Auto => {
                 // Turned 35 degrees about up, tilted 25 degrees down.
                 let (a, e) = (35f64.to_radians(), 25f64.to_radians());
                 let mix = |u: [f64; 3], v: [f64; 3], cu: f64, cv: f64| {

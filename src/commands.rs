@@ -341,6 +341,10 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     let mut opts = softarm::run::options(&req, &loaded.model.simulate)?;
     let (x0, assembled_m) = softarm::run::initial_state(&req, &mut loaded)?;
     report_assembly(&loaded, assembled_m);
+    // Checked before the run: a bad option writes nothing.
+    let shape = (a.shape_points > 0)
+        .then(|| softarm::shape::Shape::new(&loaded, a.shape_points))
+        .transpose()?;
     let arm = &*loaded.arm;
     let t_end = opts.t_end;
     let solver = opts.solver;
@@ -386,8 +390,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         &out_dir.join("trajectory.csv"),
         trajectory_csv(arm, &traj).as_bytes(),
     )?;
-    if a.shape_points > 0 {
-        let shape = softarm::shape::Shape::new(&loaded, a.shape_points)?;
+    if let Some(shape) = &shape {
         let csv = shape.csv(arm, &traj.t, &traj.x);
         write_atomic(&out_dir.join("shape.csv"), csv.as_bytes())?;
     }

@@ -15,6 +15,9 @@ use crate::backend::Loaded;
 /// Points per element when `--shape-points` is not given: a bent element
 /// reads as a smooth tube.
 pub const DEFAULT_POINTS: usize = 8;
+/// More points per element than a screen can show, and shape.csv grows
+/// with them.
+pub const MAX_POINTS: usize = 64;
 
 /// The shape of a loaded model.
 pub struct Shape {
@@ -37,8 +40,10 @@ pub struct ShapeRow {
 impl Shape {
     /// Derive the shape's tape; `points` per element (at least 1).
     pub fn new(loaded: &Loaded, points: usize) -> Result<Self> {
-        if points == 0 {
-            bail!("the shape needs at least one point per element");
+        if !(1..=MAX_POINTS).contains(&points) {
+            bail!(
+                "--shape-points {points}: must be 1 to {MAX_POINTS} points per element (0: no shape.csv)"
+            );
         }
         let structure = Structure::of(&loaded.model);
         let names = ParamLayout::of(&structure).names();

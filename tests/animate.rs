@@ -53,9 +53,13 @@ fn the_gif_has_a_frame_per_step_of_playback_and_the_page_the_runs_tip() {
     // Rows four times a GIF step: every 0.0125 s of simulated time.
     assert_eq!(t.len(), 81);
     for (i, p) in scene["tip"].as_array().unwrap().iter().enumerate() {
+        // The tip path is trajectory.csv's, carried into the page intact
+        // (a check of the page's data, not of the kinematics) ...
         assert_eq!(p[0].as_f64().unwrap(), tip_x[i]);
         assert_eq!(p[1].as_f64().unwrap(), tip_y[i]);
-        // The arm drawn at that frame ends there (shape.csv's 9 digits).
+        // ... and the arm drawn at that frame, from shape.csv's own tape,
+        // ends where the Outputs kernel put the tip (shape.csv's 9 digits):
+        // the independent check.
         let rows = scene["parts"][0]["frames"][i].as_array().unwrap();
         let last = rows.last().unwrap();
         assert_close(last[0].as_f64().unwrap(), tip_x[i], 1e-8, 1e-9, "end x");

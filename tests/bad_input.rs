@@ -670,6 +670,10 @@ fn bad_simulate_options_are_rejected_clearly() {
         (vec!["--t-end", "0"], "--t-end must be a positive number"),
         (vec!["--max-steps", "0"], "--max-steps must be at least 1"),
         (vec!["--solver", "ode45"], "possible values"),
+        (
+            vec!["--shape-points", "1000"],
+            "--shape-points 1000: must be 1 to 64",
+        ),
     ] {
         let mut all = vec!["simulate", "double_pendulum", "--out", "o"];
         all.extend(&args);
@@ -681,6 +685,8 @@ fn bad_simulate_options_are_rejected_clearly() {
             "{args:?}: expected `{expect}` in: {err}"
         );
         assert!(!err.contains("panicked"), "{args:?}: {err}");
+        // Refused before the run: nothing written.
+        assert!(!dir.path().join("o/trajectory.csv").exists(), "{args:?}");
     }
 }
 
