@@ -1,9 +1,9 @@
 //! `method = "cosserat"`: a model file as a Cosserat rod for
 //! `runtime::cosserat`, the continuum reference of the lumped methods.
 //!
-//! One uniform segment. Inextensible and unshearable like the lumped
-//! methods, unless `extension = true`: then extensible (E A) and shearable
-//! (G A, shear coefficient 1).
+//! One uniform segment. Inextensible and unshearable unless it says
+//! otherwise: `extension = true` stretches it (E A), `shear = true` shears
+//! it (k G A, k the `shear_factor`), as the lumped methods' keys do.
 
 use anyhow::Result;
 use eomgen::model::{Method, Model, base_rotation};
@@ -20,11 +20,8 @@ pub fn is_cosserat(model: &Model) -> bool {
 pub fn solve(model: &Model, origin: &str) -> Result<RodSolution> {
     let s = &model.segments[0];
     let stiffness = |v: Option<f64>| v.expect("validated: the Cosserat rod's stiffness");
-    let extensible = s.stretches();
-    let (ea, ga) = match extensible {
-        true => (stiffness(s.ea()), s.ga().unwrap_or(0.0)),
-        false => (0.0, 0.0),
-    };
+    let ea = s.stretches().then(|| stiffness(s.ea()));
+    let ga = s.shears().then(|| stiffness(s.ga()));
     let (ei, gj) = (stiffness(s.ei()), stiffness(s.gj()));
     let mass = s.total_mass().unwrap_or(0.0);
     let rod = Rod {
@@ -34,7 +31,6 @@ pub fn solve(model: &Model, origin: &str) -> Result<RodSolution> {
         ei: [ei, ei],
         gj,
         rho_a: mass / s.length,
-        inextensible: !extensible,
     };
     // The rod's frame has its tangent third: (y, z, x) of the base frame.
     let r0 = base_rotation(model.base.direction);

@@ -731,6 +731,52 @@ fn malformed_3d_models_are_rejected_clearly() {
             vec!["segment[0].twist", "a 3D key"],
         ),
         (
+            "shear in 2D",
+            r("dimensions = 3\n", "")
+                .replace("elements = 2", "elements = 2\nshear = true")
+                .replace("-9.81]", "0.0]"),
+            vec!["segment[0].shear", "a 3D key"],
+        ),
+        (
+            "pcs in 2D",
+            r("dimensions = 3\n", "")
+                .replace("\"pcc\"", "\"pcs\"")
+                .replace("-9.81]", "0.0]"),
+            vec!["segment[0].method", "pcs is a 3D method", "dimensions = 3"],
+        ),
+        (
+            "shear on ebr",
+            r("method = \"pcc\"", "method = \"ebr\"\nshear = true"),
+            vec![
+                "segment[0].shear",
+                "ebr segments carry no shear strain",
+                "pcs, pcc, vc",
+            ],
+        ),
+        (
+            "eba without shear",
+            r("method = \"pcc\"", "method = \"eba\"\nshear = false"),
+            vec!["segment[0].shear", "eba elements always shear"],
+        ),
+        (
+            "zero shear factor",
+            r("method = \"pcc\"", "method = \"pcs\"\nshear_factor = 0.0"),
+            vec!["segment[0].shear_factor", "positive"],
+        ),
+        (
+            "negative shear factor",
+            r(
+                "elements = 2",
+                "elements = 2\nshear = true\nshear_factor = -0.9",
+            ),
+            vec!["segment[0].shear_factor", "positive"],
+        ),
+        (
+            "shear factor without shear",
+            r("elements = 2", "elements = 2\nshear_factor = 0.9"),
+            vec!["segment[0].shear_factor", "set `shear = true`"],
+        ),
+        (
             "rom order 12",
             r("method = \"pcc\"", "method = \"rom\"\norder = 12"),
             vec!["segment[0].order", "between 0 and 8"],

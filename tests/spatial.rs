@@ -330,6 +330,7 @@ fn tip_of(method: &str, size: usize, load: &str, extensible: bool) -> [f64; 3] {
     ];
     if extensible {
         sets.push("segment.0.extension=true".into());
+        sets.push("segment.0.shear=true".into());
     }
     if method == "cosserat" {
         let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();

@@ -16,6 +16,7 @@ mod cosserat;
 pub(crate) mod eba;
 pub(crate) mod ebr;
 mod pcc;
+mod pcs;
 mod rigid;
 pub(crate) mod rom;
 mod vc;
@@ -84,6 +85,7 @@ pub(crate) fn of(method: Method) -> &'static dyn ModellingMethod {
     match method {
         Method::Rigid => &rigid::Rigid,
         Method::Pcc => &pcc::Pcc,
+        Method::Pcs => &pcs::Pcs,
         Method::Vc => &vc::Vc,
         Method::Ebr => &ebr::Ebr,
         Method::Eba => &eba::Eba,
@@ -93,9 +95,10 @@ pub(crate) fn of(method: Method) -> &'static dyn ModellingMethod {
 }
 
 /// Every method, for the keys they own.
-const ALL: [Method; 7] = [
+const ALL: [Method; 8] = [
     Method::Rigid,
     Method::Pcc,
+    Method::Pcs,
     Method::Vc,
     Method::Ebr,
     Method::Eba,

@@ -8,7 +8,7 @@ use super::{ModellingMethod, needs_bending_stiffness, strain_coordinate_names};
 use crate::cas::{Cas, ExprId, Func};
 use crate::model::{Check, ModelError, Segment, SegmentShape};
 use crate::tmt::planar::{self, Element2, Frame, PlanarArm};
-use crate::tmt::spatial::{SpatialArm, arc, bind3};
+use crate::tmt::spatial::{ArcStrain, SpatialArm, arc, bind3};
 
 pub(super) struct Pcc;
 
@@ -39,12 +39,18 @@ impl ModellingMethod for Pcc {
             let st = arm.strain_element(cas, g, s, &el);
             let f = arm.f;
             arm.sample(cas, |cas, s| {
+                // The arc's first fraction s: every strain integral times s.
                 let rho = st.rho.map(|e| cas.scaled(s, e));
                 let rate = st.rate.map(|e| cas.scaled(s, e));
-                let len = cas.scaled(s, st.len);
-                arc(cas, &f, &rho, &rate, len).3
+                let part = ArcStrain {
+                    rho: &rho,
+                    rate: &rate,
+                    len: cas.scaled(s, st.len),
+                    shear: st.shear.map(|d| d.map(|e| cas.scaled(s, e))),
+                };
+                arc(cas, &f, &part).3
             });
-            let (centroid, axis, omega, end) = arc(cas, &arm.f, &st.rho, &st.rate, st.len);
+            let (centroid, axis, omega, end) = arc(cas, &arm.f, &st.arc());
             let centroid = bind3(cas, centroid);
             arm.bodies.push(el.body(axis, centroid, omega, el.m));
             arm.f = end;

@@ -8,7 +8,7 @@ use super::{ModellingMethod, needs_bending_stiffness};
 use crate::cas::{Cas, ExprId};
 use crate::model::{Check, ElementParam, ModelError, Segment, SegmentShape};
 use crate::tmt::actuation::{Strain, thinning};
-use crate::tmt::spatial::{SpatialArm, V3, arc, bind3, half_k_sq};
+use crate::tmt::spatial::{ArcStrain, SpatialArm, V3, arc, bind3, half_k_sq};
 use crate::tmt::system::{Coordinates, ParamSymbols};
 
 pub(super) struct Rom;
@@ -91,9 +91,25 @@ impl ModellingMethod for Rom {
                 let rho = rho.map(|e| cas.scaled(s, e));
                 let rate = rate.map(|e| cas.scaled(s, e));
                 let len = cas.scaled(s, len);
-                arc(cas, &f, &rho, &rate, len).3
+                arc(
+                    cas,
+                    &f,
+                    &ArcStrain {
+                        rho: &rho,
+                        rate: &rate,
+                        len,
+                        shear: None,
+                    },
+                )
+                .3
             });
-            let (centroid, axis, omega, end) = arc(cas, &arm.f, &rho, &rate, len);
+            let strain = ArcStrain {
+                rho: &rho,
+                rate: &rate,
+                len,
+                shear: None,
+            };
+            let (centroid, axis, omega, end) = arc(cas, &arm.f, &strain);
             let centroid = bind3(cas, centroid);
             arm.bodies.push(el.body(axis, centroid, omega, el.m));
             arm.f = end;

@@ -212,9 +212,10 @@ fn shape_keys(ck: &Check, key: &str, o: &ObstacleDecl) -> Result<(), ModelError>
 
 /// Methods whose elements the kinematics sample (every method of the
 /// equations of motion: cosserat is a statics method).
-const SAMPLED: [Method; 6] = [
+const SAMPLED: [Method; 7] = [
     Method::Rigid,
     Method::Pcc,
+    Method::Pcs,
     Method::Vc,
     Method::Ebr,
     Method::Eba,

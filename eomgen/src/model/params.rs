@@ -748,7 +748,12 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
                 (mass / 2.0) * (l / 2.0).powi(2) / 12.0 + section / 2.0,
                 section,
             ),
-            Method::Pcc | Method::Vc | Method::Rom | Method::Eba | Method::Cosserat => {
+            Method::Pcc
+            | Method::Pcs
+            | Method::Vc
+            | Method::Rom
+            | Method::Eba
+            | Method::Cosserat => {
                 let slice = if m.dimensions == 3 {
                     mass * l * l / 12.0
                 } else {

@@ -141,6 +141,11 @@ pub enum Method {
     /// Piecewise constant curvature: `elements` arcs, one bending angle each
     /// (planar) or two bending angles, optional twist and stretch (3D).
     Pcc,
+    /// Piecewise constant strain (the discrete Cosserat rod): pcc's arcs
+    /// with all six strains of the rod, two bendings, twist, extension and
+    /// two shears, each constant over an element. 3D only; `twist`,
+    /// `extension` and `shear` default to true.
+    Pcs,
     /// Variable curvature: one constant-curvature arc per segment, each
     /// segment with its own length, section and material.
     Vc,
@@ -166,6 +171,7 @@ impl Method {
         match self {
             Method::Rigid => "rigid",
             Method::Pcc => "pcc",
+            Method::Pcs => "pcs",
             Method::Vc => "vc",
             Method::Ebr => "ebr",
             Method::Eba => "eba",
@@ -241,6 +247,14 @@ pub struct Segment {
     /// 3D: whether elements stretch (structural; default false).
     #[serde(default)]
     pub extension: Option<bool>,
+    /// 3D: whether elements shear, their centreline leaving the section's
+    /// normal (structural; default false, true for pcs; eba always).
+    #[serde(default)]
+    pub shear: Option<bool>,
+    /// Shear correction factor k of the shear stiffness k G A (default 1;
+    /// Timoshenko's 0.9 or PyElastica's 27/28 for a solid circle).
+    #[serde(default)]
+    pub shear_factor: Option<f64>,
     /// 3D, stretching elements (`extension`; eba always): the material
     /// keeps its volume, so a stretch lambda thins the section (structural;
     /// default false; no effect on rigid links).
@@ -329,12 +343,12 @@ impl Segment {
         })
     }
 
-    /// Shear stiffness G A (N), shear coefficient 1.
+    /// Shear stiffness k G A (N), k the `shear_factor` (default 1).
     pub fn ga(&self) -> Option<f64> {
         let g = self
             .shear_modulus
             .or_else(|| Some(self.youngs_modulus? / 3.0))?;
-        Some(g * self.area()?)
+        Some(self.shear_factor.unwrap_or(1.0) * g * self.area()?)
     }
 
     /// Axial stiffness E A (N).
@@ -373,7 +387,12 @@ impl Segment {
 
     /// 3D: elements stretch.
     pub fn stretches(&self) -> bool {
-        self.extension.unwrap_or(false)
+        self.extension.unwrap_or(self.method == Method::Pcs)
+    }
+
+    /// 3D: elements shear.
+    pub fn shears(&self) -> bool {
+        self.shear.unwrap_or(self.method == Method::Pcs)
     }
 
     /// 3D: the revolute axes of each joint of a rigid segment.

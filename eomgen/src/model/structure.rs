@@ -26,6 +26,8 @@ pub struct SegmentShape {
     /// segments (empty for other methods and in 2D).
     pub twist: bool,
     pub extension: bool,
+    /// 3D: two shear coordinates an element (pcc, vc, pcs).
+    pub shear: bool,
     /// Stretching thins the section at constant volume (pcc, vc, ebr with
     /// extension): bending and twist stiffness scale by lambda^-3, fibre
     /// offsets by lambda^-1/2.
@@ -40,7 +42,11 @@ impl SegmentShape {
     pub fn coordinates_3d(&self) -> usize {
         match self.method {
             Method::Rigid => self.axes.len(),
-            _ => 2 + usize::from(self.twist) + usize::from(self.extension),
+            _ => {
+                2 + usize::from(self.twist)
+                    + usize::from(self.extension)
+                    + 2 * usize::from(self.shear)
+            }
         }
     }
 }
@@ -169,10 +175,11 @@ impl Structure {
                 .segments
                 .iter()
                 .map(|s| SegmentShape {
-                    // vc is pcc one module per segment: the same kinematics,
-                    // so the same derivation (and compiled code) serves both.
+                    // vc is pcc one module per segment, pcs pcc with all six
+                    // strains: the same kinematics, so the same derivation
+                    // (and compiled code) serves them.
                     method: match s.method {
-                        Method::Vc => Method::Pcc,
+                        Method::Vc | Method::Pcs => Method::Pcc,
                         m => m,
                     },
                     elements: s.slices(),
@@ -191,6 +198,10 @@ impl Structure {
                     extension: spatial
                         && (s.method == Method::Eba
                             || (s.method != Method::Rigid && s.stretches())),
+                    // eba's shear is its beam springs', not coordinates.
+                    shear: spatial
+                        && !matches!(s.method, Method::Rigid | Method::Eba)
+                        && s.shears(),
                     incompressible: spatial && s.incompressible.unwrap_or(false),
                     axes: if spatial && s.method == Method::Rigid {
                         s.axes()
@@ -284,6 +295,10 @@ impl Structure {
                 if g.incompressible {
                     s.push_str(" incompressible");
                 }
+                // Only when set: the hashes of models without shear stay.
+                if g.shear {
+                    s.push_str(" shear");
+                }
             }
             if g.method == Method::Rom {
                 s.push_str(&format!(" order {}", g.order));
@@ -359,6 +374,9 @@ impl SegmentShape {
         }
         if self.extension {
             f.push("stretch");
+        }
+        if self.shear {
+            f.extend(["shear_y", "shear_z"]);
         }
         f
     }

@@ -429,6 +429,8 @@ fn segment_dimension_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), Model
             ("axial_stiffness", s.axial_stiffness.is_some()),
             ("axial_damping", s.axial_damping.is_some()),
             ("incompressible", s.incompressible.is_some()),
+            ("shear", s.shear.is_some()),
+            ("shear_factor", s.shear_factor.is_some()),
         ] {
             if given {
                 return ck.err(
@@ -474,6 +476,52 @@ fn segment_dimension_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), Model
                 "missing: `extension = true` needs `axial_stiffness` (E A), or `youngs_modulus` with the section".into(),
             );
         }
+        shear_keys(ck, i, s)?;
+    }
+    Ok(())
+}
+
+/// 3D: `shear` on a method that carries shear strains, with what its
+/// stiffness k G A needs; `shear_factor` positive, on shearing elements.
+fn shear_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
+    let p = |k: &str| format!("segment[{i}].{k}");
+    let carries = matches!(
+        s.method,
+        Method::Pcc | Method::Pcs | Method::Vc | Method::Cosserat
+    );
+    match (s.shear, s.method) {
+        (Some(false), Method::Eba) => {
+            return ck.err(
+                p("shear"),
+                "eba elements always shear (their absolute poses are held by shear springs): remove the key, or use pcs, pcc or vc to choose".into(),
+            );
+        }
+        (Some(true), m) if !carries && m != Method::Eba => {
+            return ck.err(
+                p("shear"),
+                format!(
+                    "{} segments carry no shear strain: shear is for pcs, pcc, vc and cosserat segments (eba always shears)",
+                    m.name()
+                ),
+            );
+        }
+        _ => {}
+    }
+    let shears = s.method == Method::Eba || (carries && s.shears());
+    if let Some(k) = s.shear_factor {
+        ck.positive(&p("shear_factor"), k)?;
+        if !shears {
+            return ck.err(
+                p("shear_factor"),
+                "acts on shearing elements: set `shear = true` too (or use pcs or eba)".into(),
+            );
+        }
+    }
+    if carries && s.shears() && s.ga().is_none() {
+        return ck.err(
+            p("shear_modulus"),
+            "missing: shearing elements need `shear_modulus`, or `youngs_modulus` with the section (G = E/3)".into(),
+        );
     }
     Ok(())
 }

@@ -30,7 +30,7 @@ use crate::model::{ElementParam, Joints, Method, Param, ParamLayout, Structure, 
 use super::actuation::{segment_loads, strain_work, thinning};
 use super::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
 use super::planar_cell::derive_planar_cell;
-use super::spatial::{Frame, Springs, arc};
+use super::spatial::{ArcStrain, Frame, Springs, arc};
 use super::system::{Coordinates, ParamSymbols};
 use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
@@ -48,11 +48,12 @@ const RECURSION_MIN_LINKS: usize = 4;
 pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     let spatial = st.dimensions == 3;
     // A planar element is covered when it is one body (`planar_cell`).
+    // Cells carry at most four strains: shearing links stay flat.
     let covered = (!spatial
         || st
             .segments
             .iter()
-            .all(|g| crate::method::of(g.method).link_cells()))
+            .all(|g| crate::method::of(g.method).link_cells() && !g.shear))
         && st.torques.is_empty()
         && !st.base_translates
         && st.base_turns == 0;
@@ -406,7 +407,13 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     let half_m = cas.scaled(0.5, m);
     let (centroid, axis, omega, end, mass) = match kind {
         CellKind::Arc => {
-            let (c, a, w, end) = arc(cas, &identity, &rho, &rate, len);
+            let strain = ArcStrain {
+                rho: &rho,
+                rate: &rate,
+                len,
+                shear: None,
+            };
+            let (c, a, w, end) = arc(cas, &identity, &strain);
             (c, a, w, end, m)
         }
         CellKind::BeforeJoint => {

@@ -206,34 +206,84 @@ fn series_on_x(cas: &mut Cas, rho: &V3, w: ExprId, a: ExprId, b: ExprId, c: Expr
     [x, y, z]
 }
 
-/// A constant-strain arc of length `len` (rest length plus stretch) and
-/// strain `rho` from frame `f`: its centroid, its body's axis and angular
-/// velocity (the mid-arc frame), and the end frame.
-pub(crate) fn arc(
-    cas: &mut Cas,
-    f: &Frame,
-    rho: &V3,
-    rate: &V3,
-    len: ExprId,
-) -> (V3, V3, V3, Frame) {
+/// The series (a I + b K + c K^2) t for K = [rho]x, w = |rho|^2:
+/// a t + b rho x t + c (rho (rho . t) - w t).
+fn series_on(cas: &mut Cas, rho: &V3, w: ExprId, [a, b, c]: [ExprId; 3], t: &V3) -> V3 {
+    let cross = cross3(cas, rho, t);
+    let dot = cas.dot(rho, t);
+    std::array::from_fn(|i| {
+        let at = cas.mul(a, t[i]);
+        let bx = cas.mul(b, cross[i]);
+        let wt = cas.mul(w, t[i]);
+        let rd = cas.mul(rho[i], dot);
+        let k2 = cas.sub(rd, wt);
+        let ck2 = cas.mul(c, k2);
+        cas.add_all(&[at, bx, ck2])
+    })
+}
+
+fn cross3(cas: &mut Cas, a: &V3, b: &V3) -> V3 {
+    std::array::from_fn(|i| {
+        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+        let p = cas.mul(a[j], b[k]);
+        let q = cas.mul(a[k], b[j]);
+        cas.sub(p, q)
+    })
+}
+
+/// What a constant-strain arc is made of: its rotation vector rho (twist,
+/// bend y, bend z) and rate, and its translation strain integrated over
+/// the element: the length `len` along the section's normal (rest length
+/// plus stretch) and, when it shears, the shear displacements along y and
+/// z (`shear`).
+pub(crate) struct ArcStrain<'a> {
+    pub rho: &'a V3,
+    pub rate: &'a V3,
+    pub len: ExprId,
+    pub shear: Option<[ExprId; 2]>,
+}
+
+impl ArcStrain<'_> {
+    /// The translation of the arc's series: (len, shear y, shear z).
+    fn translation(&self) -> Option<V3> {
+        self.shear.map(|[y, z]| [self.len, y, z])
+    }
+}
+
+/// A constant-strain arc from frame `f`: its centroid, its body's axis
+/// and angular velocity (the mid-arc frame), and the end frame. The end
+/// is at (I + c2 K + c3 K^2) t and the centroid at (I/2 + c3 K + c4 K^2) t
+/// for the translation t (len e_x without shear: the same series on the
+/// axis alone, which keeps the expressions of unsheared arcs as they were).
+pub(crate) fn arc(cas: &mut Cas, f: &Frame, a: &ArcStrain) -> (V3, V3, V3, Frame) {
+    let (rho, rate, len) = (a.rho, a.rate, a.len);
+    let t = a.translation();
     let w = cas.dot(rho, rho);
     let w = cas.bind(w);
     let [c0, c1, c2, c3, c4] = coefficients(cas, w, [0, 1, 2, 3, 4]);
     let one = cas.one();
     let half = cas.constant(0.5);
     // End frame.
-    let chord = series_on_x(cas, rho, w, one, c2, c3);
-    let chord = chord.map(|e| cas.mul(len, e));
+    let chord = match &t {
+        Some(t) => series_on(cas, rho, w, [one, c2, c3], t),
+        None => {
+            let chord = series_on_x(cas, rho, w, one, c2, c3);
+            chord.map(|e| cas.mul(len, e))
+        }
+    };
     let r_rel = rotation(cas, rho, [c0, c1, c2]);
     let w_rel = left_jacobian(cas, rho, rate, [c1, c2, c3]);
     let q_rel = rotation_quat(cas, rho, w);
     let end = compose(cas, f, Some((&r_rel, &q_rel)), Some(&chord), Some(&w_rel));
     // Centroid.
-    let c = series_on_x(cas, rho, w, half, c3, c4);
-    let c = c.map(|e| {
-        let e = cas.mul(len, e);
-        cas.bind(e)
-    });
+    let c = match &t {
+        Some(t) => series_on(cas, rho, w, [half, c3, c4], t),
+        None => {
+            let c = series_on_x(cas, rho, w, half, c3, c4);
+            c.map(|e| cas.mul(len, e))
+        }
+    };
+    let c = c.map(|e| cas.bind(e));
     let wc = cas.turn(&f.r, &f.w, &c);
     let centroid = add3(cas, &f.p, &wc);
     // Mid-arc frame: exp([rho/2]x).
@@ -356,6 +406,20 @@ pub(crate) struct StrainElement {
     /// The stretch and the stretched length l + stretch.
     pub stretch: ExprId,
     pub len: ExprId,
+    /// The shear displacements along y and z, when the element shears.
+    pub shear: Option<[ExprId; 2]>,
+}
+
+impl StrainElement {
+    /// The arc of this strain.
+    pub fn arc(&self) -> ArcStrain<'_> {
+        ArcStrain {
+            rho: &self.rho,
+            rate: &self.rate,
+            len: self.len,
+            shear: self.shear,
+        }
+    }
 }
 
 impl<'a> SpatialArm<'a> {
@@ -460,6 +524,7 @@ impl<'a> SpatialArm<'a> {
         } else {
             (zero, zero)
         };
+        let shear = g.shear.then(|| [self.take(), self.take()]);
         let rho = [tw, by, bz];
         let rate = [tw_d, by_d, bz_d];
         let len = cas.add(el.l, st);
@@ -481,12 +546,21 @@ impl<'a> SpatialArm<'a> {
             stretch: e(ElementParam::StretchStiffness),
             stretch_damping: e(ElementParam::StretchDamping),
         };
-        let (e, d) = springs.energies(
+        let (mut e, mut d) = springs.energies(
             cas,
             [by, bz, tw, st],
             [by_d, bz_d, tw_d, st_d],
             thin.map(|t| t.0),
         );
+        if let Some(pairs) = shear {
+            let k = self.symbols.element(self.k, ElementParam::ShearStiffness);
+            // Shear rates damped as the stretch's (`axial_damping`).
+            let c = self.symbols.element(self.k, ElementParam::StretchDamping);
+            let terms: Vec<ExprId> = pairs.iter().map(|&(x, _)| half_k_sq(cas, k, x)).collect();
+            let damped: Vec<ExprId> = pairs.iter().map(|&(_, xd)| half_k_sq(cas, c, xd)).collect();
+            e = cas.add_all(&[&[e][..], &terms].concat());
+            d = cas.add_all(&[&[d][..], &damped].concat());
+        }
         self.elastic.push(e);
         self.rayleigh.push(d);
         StrainElement {
@@ -494,6 +568,7 @@ impl<'a> SpatialArm<'a> {
             rate,
             stretch: st,
             len,
+            shear: shear.map(|[(y, _), (z, _)]| [y, z]),
         }
     }
 

@@ -12,8 +12,9 @@
 //! with the base clamped (p, R given at s = 0) and the tip wrench given
 //! (n, m at s = L). The unknown base wrench n(0), m(0) is found by Newton
 //! on the tip residual, the rod integrated by RK4 on a fixed grid, and
-//! large loads reached by continuation in the load factor. An inextensible,
-//! unshearable rod is the limit v = v* (`Rod::inextensible`).
+//! large loads reached by continuation in the load factor. An inextensible
+//! or unshearable rod is the limit of that stiffness to infinity: its
+//! strain stays v* (`Rod::ea`, `Rod::ga` as `None`).
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
@@ -21,16 +22,15 @@ use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 #[derive(Clone, Debug)]
 pub struct Rod {
     pub length: f64,
-    /// Axial and shear stiffness E A and G A (N).
-    pub ea: f64,
-    pub ga: f64,
+    /// Axial stiffness E A (N); `None`: inextensible.
+    pub ea: Option<f64>,
+    /// Shear stiffness k G A (N); `None`: unshearable.
+    pub ga: Option<f64>,
     /// Bending stiffness about the section's two axes and torsion G J (N m^2).
     pub ei: [f64; 2],
     pub gj: f64,
     /// Mass per length (kg/m), for gravity.
     pub rho_a: f64,
-    /// v = v*: no extension or shear.
-    pub inextensible: bool,
 }
 
 /// Loads on a rod (world frame).
@@ -109,11 +109,13 @@ impl Rod {
     fn derivative(&self, x: &State, f: &Vector3<f64>) -> State {
         let e3 = Vector3::z();
         let rt = x.r.transpose();
-        let v = if self.inextensible {
+        let v = if self.ea.is_none() && self.ga.is_none() {
             e3
         } else {
             let local = rt * x.n;
-            e3 + Vector3::new(local.x / self.ga, local.y / self.ga, local.z / self.ea)
+            let compliance = |k: Option<f64>| k.map_or(0.0, |k| 1.0 / k);
+            let (shear, axial) = (compliance(self.ga), compliance(self.ea));
+            e3 + Vector3::new(local.x * shear, local.y * shear, local.z * axial)
         };
         let lm = rt * x.m;
         let u = Vector3::new(lm.x / self.ei[0], lm.y / self.ei[1], lm.z / self.gj);
@@ -186,7 +188,7 @@ pub fn solve_rod(
     let stiff = positive(rod.length)
         && rod.ei.iter().all(|&k| positive(k))
         && positive(rod.gj)
-        && (rod.inextensible || (positive(rod.ea) && positive(rod.ga)));
+        && [rod.ea, rod.ga].iter().flatten().all(|&k| positive(k));
     if !stiff {
         return Err(RodError::Invalid(
             "length and stiffnesses must be finite and positive".into(),
@@ -315,17 +317,17 @@ mod tests {
 
     /// The bench rod of issue 4: L 0.3 m, r 0.01 m, E 1 MPa, G = E/3.
     fn rod(inextensible: bool) -> Rod {
+        let soft = |k: f64| (!inextensible).then_some(k);
         let (e, r) = (1e6, 0.01);
         let area = std::f64::consts::PI * r * r;
         let i = std::f64::consts::PI * r.powi(4) / 4.0;
         Rod {
             length: 0.3,
-            ea: e * area,
-            ga: e / 3.0 * area,
+            ea: soft(e * area),
+            ga: soft(e / 3.0 * area),
             ei: [e * i, e * i],
             gj: e / 3.0 * 2.0 * i,
             rho_a: 1000.0 * area,
-            inextensible,
         }
     }
 
