@@ -29,6 +29,8 @@ pub mod hybrid_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod long_arm;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod rod_swing;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod rom_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod soft_finger;
@@ -135,6 +137,13 @@ pub static MODELS: &[CompiledModel] = &[
         dof: long_arm::DOF,
         source: include_str!("../models/long_arm.toml"),
         kernels: || Box::new(long_arm::Compiled::default()),
+    },
+    CompiledModel {
+        name: "rod_swing",
+        hash: rod_swing::HASH,
+        dof: rod_swing::DOF,
+        source: include_str!("../models/rod_swing.toml"),
+        kernels: || Box::new(rod_swing::Compiled::default()),
     },
     CompiledModel {
         name: "rom_arm",

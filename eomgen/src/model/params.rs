@@ -77,7 +77,7 @@ pub enum ElementParam {
     /// 3D: E A / l_e and c / l_e.
     StretchStiffness,
     StretchDamping,
-    /// 3D, eba: G A / l_e.
+    /// 3D, shearing elements (pcs, eba): k G A / l_e.
     ShearStiffness,
 }
 
@@ -114,6 +114,7 @@ impl ElementParam {
         Self::TwistDamping,
         Self::StretchStiffness,
         Self::StretchDamping,
+        Self::ShearStiffness,
     ];
 
     fn name(self, k: usize) -> String {

@@ -30,7 +30,7 @@ use crate::model::{ElementParam, Joints, Method, Param, ParamLayout, Structure, 
 use super::actuation::{segment_loads, strain_work, thinning};
 use super::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
 use super::planar_cell::derive_planar_cell;
-use super::spatial::{ArcStrain, Frame, Springs, arc};
+use super::spatial::{ArcStrain, Frame, Springs, arc, half_k_sq};
 use super::system::{Coordinates, ParamSymbols};
 use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
@@ -48,12 +48,11 @@ const RECURSION_MIN_LINKS: usize = 4;
 pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     let spatial = st.dimensions == 3;
     // A planar element is covered when it is one body (`planar_cell`).
-    // Cells carry at most four strains: shearing links stay flat.
     let covered = (!spatial
         || st
             .segments
             .iter()
-            .all(|g| crate::method::of(g.method).link_cells() && !g.shear))
+            .all(|g| crate::method::of(g.method).link_cells()))
         && st.torques.is_empty()
         && !st.base_translates
         && st.base_turns == 0;
@@ -72,6 +71,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         let shape = Shape {
             twist: g.twist,
             extension: g.extension,
+            shear: g.shear,
             incompressible: g.incompressible,
             rom: rom.is_some(),
             actuated: load.is_some(),
@@ -232,6 +232,7 @@ fn globals(st: &Structure, params: &ParamLayout) -> LinkLayout {
 struct Shape {
     twist: bool,
     extension: bool,
+    shear: bool,
     incompressible: bool,
     /// A rom slice: the segment's stretch and damping are integrated over
     /// the whole segment (`derive_forces`), and its bending and twist too
@@ -306,13 +307,15 @@ fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(RomFields, usize)]) 
     ]
 }
 
-/// The cell of a link with the bend pair, and twist and stretch when asked;
+/// The cell of a link with the bend pair, and twist, stretch and the shear
+/// pair when asked;
 /// the cell [`with_tangent`]; and its pose cell (`runtime::links::pose`:
 /// what the `Outputs` need of the link).
 fn derive_cell(shape: Shape) -> [Tape; 3] {
     let Shape {
         twist,
         extension,
+        shear,
         incompressible,
         rom,
         actuated,
@@ -328,6 +331,9 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     if extension {
         names.push("stretch");
     }
+    if shear {
+        names.extend(["shear_y", "shear_z"]);
+    }
     if kind == CellKind::BeforeJoint {
         names.clear();
     }
@@ -341,7 +347,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
         .collect();
     // In the order of `ElementParam::CELL`, then the actuation loads.
-    let [l, m, lateral, axial, kb, db, rest, kt, dt, ks, ds] = std::array::from_fn(|i| p[i]);
+    let [l, m, lateral, axial, kb, db, rest, kt, dt, ks, ds, kg] = std::array::from_fn(|i| p[i]);
     let loads: [ExprId; ACTUATION_LOADS] = std::array::from_fn(|i| p[ELEMENT_PARAMS + i]);
     let zero = cas.zero();
     // Coordinates bend y, bend z, then twist and stretch where present.
@@ -354,6 +360,9 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     }
     let [by, bz, tw, st] = strain;
     let [by_d, bz_d, tw_d, _] = rates;
+    // Then the shear pair, last.
+    let first_shear = 2 + usize::from(twist) + usize::from(extension);
+    let shear_at = (shear && kind == CellKind::Arc).then_some(first_shear);
 
     // The link's potential and Rayleigh function, as the whole arm has them.
     let len = cas.add(l, st);
@@ -381,10 +390,27 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
             stretch_damping: ds,
         }
     };
-    let (elastic, rayleigh) = match kind {
+    let (mut elastic, mut rayleigh) = match kind {
         CellKind::BeforeJoint => (zero, zero),
         _ => springs.energies(cas, strain, rates, soft),
     };
+    if let Some(i) = shear_at {
+        // As `SpatialArm::strain_element` has them: k G A / l springs, the
+        // rates damped as the stretch's.
+        let (y, z) = ((q[i], qd[i]), (q[i + 1], qd[i + 1]));
+        let terms = [
+            elastic,
+            half_k_sq(cas, kg, y.0),
+            half_k_sq(cas, kg, z.0),
+        ];
+        elastic = cas.add_all(&terms);
+        let terms = [
+            rayleigh,
+            half_k_sq(cas, ds, y.1),
+            half_k_sq(cas, ds, z.1),
+        ];
+        rayleigh = cas.add_all(&terms);
+    }
     // The actuators' potential on the link's strain, as the whole arm has
     // it (the outputs' potential energy is the strain energy alone).
     let stored = elastic;
@@ -411,7 +437,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
                 rho: &rho,
                 rate: &rate,
                 len,
-                shear: None,
+                shear: shear_at.map(|i| [q[i], q[i + 1]]),
             };
             let (c, a, w, end) = arc(cas, &identity, &strain);
             (c, a, w, end, m)

@@ -31,8 +31,8 @@ pub use tangent::inverse_dynamics_tangent;
 /// The element parameters a cell reads, in this order, per link:
 /// element[k].length, .mass, .inertia, .axial_inertia, joint[k].stiffness,
 /// .damping, .rest, twist[k].stiffness, .damping, stretch[k].stiffness,
-/// .damping.
-pub const ELEMENT_PARAMS: usize = 11;
+/// .damping, shear[k].stiffness.
+pub const ELEMENT_PARAMS: usize = 12;
 /// Then the actuators' loads on the link's strain (c_st, c_by, c_bz: its
 /// segment's, from the `loads` kernel; zero where no actuator acts).
 pub const ACTUATION_LOADS: usize = 3;
@@ -455,8 +455,8 @@ struct Link {
     torque: V3,
 }
 
-/// Most coordinates a cell has (bend pair, twist, stretch).
-pub const MAX_LINK_DOF: usize = 4;
+/// Most coordinates a cell has (bend pair, twist, stretch, shear pair).
+pub const MAX_LINK_DOF: usize = 6;
 /// Room for the outputs of any cell.
 const CELL_STRIDE: usize = cell::len(MAX_LINK_DOF);
 
