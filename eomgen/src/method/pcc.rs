@@ -8,7 +8,7 @@ use super::{ModellingMethod, needs_bending_stiffness, strain_coordinate_names};
 use crate::cas::{Cas, ExprId, Func};
 use crate::model::{Check, ModelError, Segment, SegmentShape};
 use crate::tmt::planar::{self, Element2, Frame, PlanarArm};
-use crate::tmt::spatial::{ArcStrain, SpatialArm, arc, bind3};
+use crate::tmt::spatial::{SpatialArm, arc, bind3, in_halves};
 
 pub(super) struct Pcc;
 
@@ -37,23 +37,22 @@ impl ModellingMethod for Pcc {
             let el = arm.element();
             let first = arm.c;
             let st = arm.strain_element(cas, g, s, &el);
+            let strain = st.arc();
             let f = arm.f;
             arm.sample(cas, |cas, s| {
-                // The arc's first fraction s: every strain integral times s.
-                let rho = st.rho.map(|e| cas.scaled(s, e));
-                let rate = st.rate.map(|e| cas.scaled(s, e));
-                let part = ArcStrain {
-                    rho: &rho,
-                    rate: &rate,
-                    len: cas.scaled(s, st.len),
-                    shear: st.shear.map(|d| d.map(|e| cas.scaled(s, e))),
-                };
+                let part = strain.part(cas, s);
                 arc(cas, &f, &part).3
             });
-            let (centroid, axis, omega, end) = arc(cas, &arm.f, &st.arc());
-            let centroid = bind3(cas, centroid);
-            arm.bodies.push(el.body(axis, centroid, omega, el.m));
-            arm.f = end;
+            let (pieces, part, body) = match in_halves(g) {
+                true => (2, strain.part(cas, 0.5), el.half(cas)),
+                false => (1, strain, el),
+            };
+            for _ in 0..pieces {
+                let (centroid, axis, omega, end) = arc(cas, &arm.f, &part);
+                let centroid = bind3(cas, centroid);
+                arm.bodies.push(body.body(axis, centroid, omega, body.m));
+                arm.f = end;
+            }
             arm.close_link(first);
         }
     }

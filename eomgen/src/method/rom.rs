@@ -95,8 +95,8 @@ impl ModellingMethod for Rom {
                     cas,
                     &f,
                     &ArcStrain {
-                        rho: &rho,
-                        rate: &rate,
+                        rho,
+                        rate,
                         len,
                         shear: None,
                     },
@@ -104,8 +104,8 @@ impl ModellingMethod for Rom {
                 .3
             });
             let strain = ArcStrain {
-                rho: &rho,
-                rate: &rate,
+                rho,
+                rate,
                 len,
                 shear: None,
             };

@@ -30,7 +30,7 @@ use crate::model::{ElementParam, Joints, Method, Param, ParamLayout, Structure, 
 use super::actuation::{segment_loads, strain_work, thinning};
 use super::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
 use super::planar_cell::derive_planar_cell;
-use super::spatial::{ArcStrain, Frame, Springs, arc, half_k_sq};
+use super::spatial::{ArcStrain, Element3, Frame, Springs, arc, half_k_sq, in_halves};
 use super::system::{Coordinates, ParamSymbols};
 use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
@@ -78,6 +78,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             planar: (!spatial).then_some((g.method, g.joints)),
             kind: match g.method {
                 Method::Ebr => CellKind::PastJoint,
+                Method::Pcc if spatial && in_halves(g) => CellKind::HalfArc,
                 _ => CellKind::Arc,
             },
         };
@@ -112,7 +113,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             let params = ElementParam::CELL
                 .map(|e| params.get(Param::Element(k, e)).unwrap_or(length))
                 .to_vec();
-            let map = match &rom {
+            let map: Vec<LocalCoordinate> = match &rom {
                 // Cell coordinate f is field f integrated over the slice;
                 // the stretch, a strain, times the segment's length.
                 Some(r) => (0..count)
@@ -145,6 +146,15 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                     load: None,
                 });
             }
+            // A half-arc element is two links on the same coordinates.
+            if shape.kind == CellKind::HalfArc {
+                links.push(LinkSpec {
+                    cell: c,
+                    map: map.clone(),
+                    params: params.clone(),
+                    load,
+                });
+            }
             links.push(LinkSpec {
                 cell: c,
                 map,
@@ -169,7 +179,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         ..globals(st, params)
     };
     // The shared sums hold the arm's coordinates in fixed rows.
-    if !roms.is_empty() && first > runtime::links::MAX_SHARED_DOF {
+    if !runtime::links::all_owned(&layout) && first > runtime::links::MAX_SHARED_DOF {
         return None;
     }
     let forces = (!roms.is_empty()).then(|| derive_forces(params, first, &roms));
@@ -253,6 +263,10 @@ struct Shape {
 enum CellKind {
     /// A constant-strain arc (pcc, vc, a rom slice).
     Arc,
+    /// Half of a stretching or shearing arc (`spatial::in_halves`): half
+    /// its strain, mass and energies; two links share the element's
+    /// coordinates.
+    HalfArc,
     /// An ebr element's half before its joint: no coordinates.
     BeforeJoint,
     /// An ebr element's joint and the half past it.
@@ -362,7 +376,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     let [by_d, bz_d, tw_d, _] = rates;
     // Then the shear pair, last.
     let first_shear = 2 + usize::from(twist) + usize::from(extension);
-    let shear_at = (shear && kind == CellKind::Arc).then_some(first_shear);
+    let shear_at = (shear && kind != CellKind::BeforeJoint).then_some(first_shear);
 
     // The link's potential and Rayleigh function, as the whole arm has them.
     let len = cas.add(l, st);
@@ -398,17 +412,9 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         // As `SpatialArm::strain_element` has them: k G A / l springs, the
         // rates damped as the stretch's.
         let (y, z) = ((q[i], qd[i]), (q[i + 1], qd[i + 1]));
-        let terms = [
-            elastic,
-            half_k_sq(cas, kg, y.0),
-            half_k_sq(cas, kg, z.0),
-        ];
+        let terms = [elastic, half_k_sq(cas, kg, y.0), half_k_sq(cas, kg, z.0)];
         elastic = cas.add_all(&terms);
-        let terms = [
-            rayleigh,
-            half_k_sq(cas, ds, y.1),
-            half_k_sq(cas, ds, z.1),
-        ];
+        let terms = [rayleigh, half_k_sq(cas, ds, y.1), half_k_sq(cas, ds, z.1)];
         rayleigh = cas.add_all(&terms);
     }
     // The actuators' potential on the link's strain, as the whole arm has
@@ -420,6 +426,16 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     } else {
         elastic
     };
+    // Each half of a half-arc element carries half its energies.
+    let share = |cas: &mut Cas, e: ExprId| match kind {
+        CellKind::HalfArc => cas.scaled(0.5, e),
+        _ => e,
+    };
+    let (stored, elastic, rayleigh) = (
+        share(cas, stored),
+        share(cas, elastic),
+        share(cas, rayleigh),
+    );
 
     let one = cas.one();
     let identity = Frame {
@@ -431,26 +447,44 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     let rho = [tw, by, bz];
     let rate = [tw_d, by_d, bz_d];
     let half_m = cas.scaled(0.5, m);
-    let (centroid, axis, omega, end, mass) = match kind {
-        CellKind::Arc => {
+    let element = Element3 {
+        l,
+        m,
+        lateral,
+        axial,
+    };
+    let (centroid, axis, omega, end, body) = match kind {
+        CellKind::Arc | CellKind::HalfArc => {
             let strain = ArcStrain {
-                rho: &rho,
-                rate: &rate,
+                rho,
+                rate,
                 len,
                 shear: shear_at.map(|i| [q[i], q[i + 1]]),
             };
+            let (strain, body) = match kind {
+                CellKind::HalfArc => (strain.part(cas, 0.5), element.half(cas)),
+                _ => (strain, element),
+            };
             let (c, a, w, end) = arc(cas, &identity, &strain);
-            (c, a, w, end, m)
+            (c, a, w, end, body)
         }
         CellKind::BeforeJoint => {
             let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
             let (c, end) = before_joint(cas, &identity, quarter, half);
-            (c, identity.axis(), identity.w, end, half_m)
+            let body = Element3 {
+                m: half_m,
+                ..element
+            };
+            (c, identity.axis(), identity.w, end, body)
         }
         CellKind::PastJoint => {
             let half = cas.scaled(0.5, l);
             let (c, a, w, end) = past_joint(cas, &identity, &rho, &rate, half, st);
-            (c, a, w, end, half_m)
+            let body = Element3 {
+                m: half_m,
+                ..element
+            };
+            (c, a, w, end, body)
         }
     };
     let kin = LinkKinematics::new(
@@ -464,7 +498,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
             body_omega: omega,
             axis,
         },
-        [mass, lateral, axial, stored],
+        [body.m, body.lateral, body.axial, stored],
         &q,
         &qd,
         Rates::Turned,
