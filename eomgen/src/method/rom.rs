@@ -1,5 +1,5 @@
-//! `rom`: a reduced-order model. Curvature, twist and stretch are
-//! polynomials in s of degree `order`, their coefficients the segment's
+//! `rom`: a reduced-order model. Curvature, twist, stretch and shear are
+//! polynomials in s of degree `order` (the variable-strain rod of SoRoSim), their coefficients the segment's
 //! coordinates; kinematics, masses and energies by `quadrature` slices,
 //! each a constant-strain arc of the fields integrated over it; the strain
 //! energy integrated exactly. 3D only.
@@ -62,7 +62,7 @@ impl ModellingMethod for Rom {
         for e in 0..g.elements {
             let el = arm.element();
             let first = arm.c;
-            let (rho, rate, st) = rom.slice(cas, &arm.coords, e, el.l);
+            let (rho, rate, st, shear) = rom.slice(cas, &arm.coords, e, el.l);
             let len = cas.add(el.l, st);
             // Incompressible: bending and twist energy slice by slice with
             // the slice's thinning (`RomFields::energies` leaves them out).
@@ -86,29 +86,17 @@ impl ModellingMethod for Rom {
                 offset_scale: thin,
             });
             // A slice is an arc of constant strain, as a pcc element.
-            let f = arm.f;
-            arm.sample(cas, |cas, s| {
-                let rho = rho.map(|e| cas.scaled(s, e));
-                let rate = rate.map(|e| cas.scaled(s, e));
-                let len = cas.scaled(s, len);
-                arc(
-                    cas,
-                    &f,
-                    &ArcStrain {
-                        rho,
-                        rate,
-                        len,
-                        shear: None,
-                    },
-                )
-                .3
-            });
             let strain = ArcStrain {
                 rho,
                 rate,
                 len,
-                shear: None,
+                shear,
             };
+            let f = arm.f;
+            arm.sample(cas, |cas, s| {
+                let part = strain.part(cas, s);
+                arc(cas, &f, &part).3
+            });
             let (centroid, axis, omega, end) = arc(cas, &arm.f, &strain);
             let centroid = bind3(cas, centroid);
             arm.bodies.push(el.body(axis, centroid, omega, el.m));
@@ -136,6 +124,7 @@ pub(crate) struct RomFields {
     pub slices: usize,
     pub twist: bool,
     pub extension: bool,
+    pub shear: bool,
     /// Bending and twist energy by slices (see `Rom::build_spatial`), not here.
     pub incompressible: bool,
 }
@@ -149,12 +138,25 @@ impl RomFields {
             slices: g.elements,
             twist: g.twist,
             extension: g.extension,
+            shear: g.shear,
             incompressible: g.incompressible,
         }
     }
 
     pub(crate) fn coordinates(&self) -> usize {
-        (2 + usize::from(self.twist) + usize::from(self.extension)) * (self.order + 1)
+        self.fields() * (self.order + 1)
+    }
+
+    /// The strain fields: bend y, bend z, then twist, stretch and the two
+    /// shears where present.
+    pub(crate) fn fields(&self) -> usize {
+        2 + usize::from(self.twist) + usize::from(self.extension) + 2 * usize::from(self.shear)
+    }
+
+    /// Whether field f is a translation strain (stretch or shear,
+    /// dimensionless) rather than an angle.
+    pub(crate) fn is_translation(&self, f: usize) -> bool {
+        f >= 2 + usize::from(self.twist)
     }
 
     /// Coordinate index of coefficient i of field f.
@@ -207,14 +209,15 @@ impl RomFields {
     }
 
     /// The rotation vector of slice e (twist, bend y, bend z), its rate,
-    /// and the slice's stretch, given the slice length l.
+    /// the slice's stretch and its shear displacements, given the slice
+    /// length l.
     pub(crate) fn slice(
         &self,
         cas: &mut Cas,
         coords: &Coordinates,
         e: usize,
         l: ExprId,
-    ) -> (V3, V3, ExprId) {
+    ) -> (V3, V3, ExprId, Option<[ExprId; 2]>) {
         let zero = cas.zero();
         let mut rho = [zero; 3];
         let mut rate = [zero; 3];
@@ -227,16 +230,28 @@ impl RomFields {
             rho[0] = self.field(cas, coords, 2, e, false);
             rate[0] = self.field(cas, coords, 2, e, true);
         }
-        let stretch = if self.extension {
-            // The strain integrated over the slice, times L = slices * l.
-            let f = 2 + usize::from(self.twist);
+        // A translation strain integrated over the slice, times
+        // L = slices * l: a displacement.
+        let mut displacement = |f: usize| {
             let s = self.field(cas, coords, f, e, false);
             let ls = cas.mul(l, s);
             cas.scaled(self.slices as f64, ls)
-        } else {
-            zero
         };
-        (rho.map(|x| cas.bind(x)), rate.map(|x| cas.bind(x)), stretch)
+        let after_twist = 2 + usize::from(self.twist);
+        let stretch = match self.extension {
+            true => displacement(after_twist),
+            false => zero,
+        };
+        let first_shear = after_twist + usize::from(self.extension);
+        let shear = self
+            .shear
+            .then(|| [displacement(first_shear), displacement(first_shear + 1)]);
+        (
+            rho.map(|x| cas.bind(x)),
+            rate.map(|x| cas.bind(x)),
+            stretch,
+            shear,
+        )
     }
 
     /// Strain energy and Rayleigh function, integrated exactly:
@@ -259,10 +274,10 @@ impl RomFields {
                 .collect();
             cas.add_all(&terms)
         };
-        let fields = 2 + usize::from(self.twist) + usize::from(self.extension);
         let (mut elastic, mut rayleigh) = (Vec::new(), Vec::new());
-        for f in 0..fields {
-            let stretch = self.extension && f == fields - 1;
+        let first_shear = 2 + usize::from(self.twist) + usize::from(self.extension);
+        for f in 0..self.fields() {
+            let stretch = self.is_translation(f);
             if self.incompressible && !stretch {
                 // Only the elastic part moves to the slices; damping stays.
                 let ds = symbols.element(
@@ -280,15 +295,19 @@ impl RomFields {
                 rayleigh.push(cas.mul_all(&[ds, scale, d]));
                 continue;
             }
+            // Shear rates damped as the stretch's, as pcs has them.
             let (stiff, damp) = match f {
+                _ if stretch && f >= first_shear => {
+                    (ElementParam::ShearStiffness, ElementParam::StretchDamping)
+                }
                 _ if stretch => (ElementParam::StretchStiffness, ElementParam::StretchDamping),
                 0 | 1 => (ElementParam::BendStiffness, ElementParam::BendDamping),
                 _ => (ElementParam::TwistStiffness, ElementParam::TwistDamping),
             };
             let ks = symbols.element(k, stiff);
             let ds = symbols.element(k, damp);
-            // Bending, twist: (E I / L) c^T G c = (k_slice / n) ...; stretch:
-            // E A L e^T G e = k_slice n l^2 ....
+            // Bending, twist: (E I / L) c^T G c = (k_slice / n) ...; stretch
+            // and shear: E A L e^T G e = k_slice n l^2 ....
             let scale = if stretch {
                 let l = symbols.element(k, ElementParam::Length);
                 let l2 = cas.powi(l, 2);
@@ -360,6 +379,7 @@ mod tests {
             slices: 400,
             twist: false,
             extension: false,
+            shear: false,
             incompressible: false,
         };
         let w: Vec<Vec<f64>> = (0..rom.slices).map(|e| rom.weights(e)).collect();

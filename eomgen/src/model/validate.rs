@@ -487,7 +487,7 @@ fn shear_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
     let p = |k: &str| format!("segment[{i}].{k}");
     let carries = matches!(
         s.method,
-        Method::Pcc | Method::Pcs | Method::Vc | Method::Cosserat
+        Method::Pcc | Method::Pcs | Method::Vc | Method::Rom | Method::Cosserat
     );
     match (s.shear, s.method) {
         (Some(false), Method::Eba) => {
@@ -500,7 +500,7 @@ fn shear_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
             return ck.err(
                 p("shear"),
                 format!(
-                    "{} segments carry no shear strain: shear is for pcs, pcc, vc and cosserat segments (eba always shears)",
+                    "{} segments carry no shear strain: shear is for pcs, pcc, vc, rom and cosserat segments (eba always shears)",
                     m.name()
                 ),
             );

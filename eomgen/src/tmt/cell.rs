@@ -115,10 +115,10 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                 .to_vec();
             let map: Vec<LocalCoordinate> = match &rom {
                 // Cell coordinate f is field f integrated over the slice;
-                // the stretch, a strain, times the segment's length.
+                // stretch and shear, strains, times the segment's length.
                 Some(r) => (0..count)
                     .map(|f| {
-                        let stretch = r.extension && f == count - 1;
+                        let stretch = r.is_translation(f);
                         let n = if stretch { r.slices as f64 } else { 1.0 };
                         LocalCoordinate {
                             terms: r
@@ -377,6 +377,8 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     // Then the shear pair, last.
     let first_shear = 2 + usize::from(twist) + usize::from(extension);
     let shear_at = (shear && kind != CellKind::BeforeJoint).then_some(first_shear);
+    // A rom slice's shear energy is its segment's (`derive_forces`).
+    let shear_springs = shear_at.filter(|_| !rom);
 
     // The link's potential and Rayleigh function, as the whole arm has them.
     let len = cas.add(l, st);
@@ -408,7 +410,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         CellKind::BeforeJoint => (zero, zero),
         _ => springs.energies(cas, strain, rates, soft),
     };
-    if let Some(i) = shear_at {
+    if let Some(i) = shear_springs {
         // As `SpatialArm::strain_element` has them: k G A / l springs, the
         // rates damped as the stretch's.
         let (y, z) = ((q[i], qd[i]), (q[i + 1], qd[i + 1]));

@@ -1,11 +1,13 @@
-//! pcs, piecewise constant strain (the discrete Cosserat rod): all six
-//! strains of the rod (two bendings, twist, extension, two shears), in
-//! statics and in motion, against closed forms and the Cosserat rod
-//! (`method = "cosserat"`, a shooting solution of the continuum):
+//! The six strains of the rod (two bendings, twist, extension, two shears)
+//! in pcs, piecewise constant strain (the discrete Cosserat rod), and in
+//! rom with shear and extension (the variable-strain rod), in statics and
+//! in motion, against closed forms and the Cosserat rod (`method =
+//! "cosserat"`, a shooting solution of the continuum):
 //!
 //! * a helix of constant strain, held by the tip wrench that the Cosserat
 //!   equilibrium n' + k x n = 0, m' + k x m + v x n = 0 gives for it: exact
-//!   for pcs at any element count, and the Cosserat rod's solution too;
+//!   for pcs at any element count and rom at any order, and the Cosserat
+//!   rod's solution too;
 //! * Timoshenko's shear deflection F L / (k G A), the part of a small
 //!   tip deflection the shear factor k sets;
 //! * second-order convergence to the extensible, shearable rod under a
@@ -38,9 +40,9 @@ fn cantilever3d(sets: &[String]) -> Loaded {
     load("cantilever3d", &overrides, BackendChoice::Auto, Some(dir)).unwrap()
 }
 
-/// The static tip of cantilever3d under `sets`: by pcs (from the straight
-/// state, loads by continuation), or by the Cosserat rod when `sets` say
-/// `method=cosserat`.
+/// The static tip of cantilever3d under `sets`: by a lumped method (from
+/// the straight state, loads by continuation), or by the Cosserat rod when
+/// `sets` say `method=cosserat`.
 fn static_tip(sets: &[String]) -> [f64; 3] {
     if sets.iter().any(|s| s == "segment.0.method=cosserat") {
         let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
@@ -62,7 +64,7 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 fn sets(method: &str, more: &[String]) -> Vec<String> {
     let mut s = vec![format!("segment.0.method={method}")];
-    if method == "cosserat" {
+    if method == "cosserat" || method == "rom" {
         s.extend([
             "segment.0.extension=true".into(),
             "segment.0.shear=true".into(),
@@ -124,7 +126,7 @@ fn helix(kx: f64, ky: f64, gj: f64, ea: f64, kga: f64) -> Helix {
 }
 
 #[test]
-fn a_constant_strain_helix_is_exact_for_pcs_at_any_element_count_and_for_the_rod() {
+fn a_constant_strain_helix_is_exact_for_pcs_and_rom_at_any_resolution_and_for_the_rod() {
     // A rod soft in stretch and shear (E A = 2 N, k G A = 1 N) bent by
     // 1.5 rad and twisted by 0.9 rad: strains of a few per cent.
     let (gj, ea, kga) = (ei() * 2.0 / 3.0, 2.0, 1.0);
@@ -155,6 +157,14 @@ fn a_constant_strain_helix_is_exact_for_pcs_at_any_element_count_and_for_the_rod
         let err = dist(tip, h.tip);
         eprintln!("pcs, {elements} elements: {:.2e} of L", err / L);
         assert!(err < 1e-9 * L, "pcs, {elements} elements: {err:e} m");
+    }
+    for order in [0, 2] {
+        let mut s = sets("rom", &keys);
+        s.push(format!("segment.0.order={order}"));
+        let tip = static_tip(&s);
+        let err = dist(tip, h.tip);
+        eprintln!("rom, order {order}: {:.2e} of L", err / L);
+        assert!(err < 1e-9 * L, "rom, order {order}: {err:e} m");
     }
     let tip = static_tip(&sets("cosserat", &keys));
     let err = dist(tip, h.tip);
@@ -191,7 +201,7 @@ fn the_shear_factor_sets_timoshenkos_shear_deflection() {
 }
 
 #[test]
-fn pcs_converges_at_second_order_to_the_extensible_shearable_rod() {
+fn pcs_and_rom_converge_to_the_extensible_shearable_rod() {
     // P L^2 / E I = 10 along (0, -0.6, 0.8), as for the other methods
     // (tests/spatial.rs); a soft stretch and shear (E A = 20 N, k G A = 10 N)
     // so that they move the tip by centimetres.
@@ -206,12 +216,15 @@ fn pcs_converges_at_second_order_to_the_extensible_shearable_rod() {
     stiff.retain(|s| !s.contains("extension") && !s.contains("shear"));
     let unstretched = static_tip(&stiff);
     assert!(dist(reference, unstretched) > 0.05 * L);
-    let err = |elements: usize| {
-        let mut s = sets("pcs", &keys);
-        s.push(format!("segment.0.elements={elements}"));
+    let err = |method: &str, size: &str| {
+        let mut s = sets(method, &keys);
+        s.push(size.to_string());
         dist(static_tip(&s), reference)
     };
-    let (coarse, fine) = (err(4), err(8));
+    let (coarse, fine) = (
+        err("pcs", "segment.0.elements=4"),
+        err("pcs", "segment.0.elements=8"),
+    );
     eprintln!(
         "pcs: {:.3} % of L at 4 elements, {:.4} % at 8; stretch and shear move the tip {:.1} % of L",
         100.0 * coarse / L,
@@ -223,6 +236,21 @@ fn pcs_converges_at_second_order_to_the_extensible_shearable_rod() {
         "pcs: error {coarse:e} at 4 elements, {fine:e} at 8"
     );
     assert!(fine < 0.005 * L, "pcs: error {fine:e} at 8 elements");
+    // rom: quadratic, then quartic fields (18 and 30 DOF).
+    let (quadratic, quartic) = (
+        err("rom", "segment.0.order=2"),
+        err("rom", "segment.0.order=4"),
+    );
+    eprintln!(
+        "rom: {:.3} % of L at order 2, {:.4} % at 4",
+        100.0 * quadratic / L,
+        100.0 * quartic / L
+    );
+    assert!(
+        quartic < quadratic / 3.0,
+        "rom: error {quadratic:e} at order 2, {quartic:e} at 4"
+    );
+    assert!(quartic < 0.005 * L, "rom: error {quartic:e} at order 4");
 }
 
 #[test]
