@@ -62,13 +62,13 @@ impl Law {
         }
         let f = match self.normal {
             Normal::SpringDashpot { k, c } => delta * k + rate * c,
-            Normal::Hertz { k, n } => delta.powf(n) * k,
+            Normal::Hertz { k, n } => power(delta, n) * k,
             Normal::HuntCrossley { k, n, damping } => {
                 let alpha = match damping {
                     Damping::Given(b) => b / k,
                     Damping::Restitution { a, .. } => a / v_in.max(SLOWEST_IMPACT),
                 };
-                delta.powf(n) * k * (rate * alpha + 1.0)
+                power(delta, n) * k * (rate * alpha + 1.0)
             }
             // Held by the constraint, not by a force law.
             Normal::Impulse { .. } => zero,
@@ -84,7 +84,7 @@ impl Law {
         }
         match self.normal {
             Normal::SpringDashpot { k, .. } => delta * k,
-            Normal::Hertz { k, n } | Normal::HuntCrossley { k, n, .. } => delta.powf(n) * k,
+            Normal::Hertz { k, n } | Normal::HuntCrossley { k, n, .. } => power(delta, n) * k,
             Normal::Impulse { .. } => T::from(0.0),
         }
     }
@@ -161,6 +161,21 @@ pub fn restitution_damping(e: f64) -> Option<f64> {
     Some(a_of(0.5 * (lo + hi)))
 }
 
+/// delta^n for delta > 0: Hertz's 3/2 (the common exponent) by a square
+/// root, whole exponents by products, others by `powf` (several times
+/// the cost, on every right-hand side that touches).
+fn power<T: DualNum<Primitive = f64> + Copy>(delta: T, n: f64) -> T {
+    if n == 1.5 {
+        delta * delta.sqrt()
+    } else if n == 1.0 {
+        delta
+    } else if n == 2.0 {
+        delta * delta
+    } else {
+        delta.powf(n)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -185,3 +200,4 @@ mod tests {
         assert_eq!(restitution_damping(0.0), None);
     }
 }
+

@@ -14,7 +14,7 @@ pub mod geometry;
 pub mod impact;
 pub mod law;
 
-use std::sync::Mutex;
+use std::cell::RefCell;
 
 use num_dual::{Dual64, DualNum};
 
@@ -121,8 +121,10 @@ pub struct ContactSet {
     pub pairs: Vec<Pair>,
     /// Output channels by name (`contact_<name>_fn`, `_ft`).
     pub channels: Vec<String>,
-    pub state: Mutex<ContactState>,
-    scratch: std::cell::RefCell<Scratch>,
+    /// (A `RefCell` like the scratch: the set is used by one thread, and
+    /// every right-hand side that touches reads it.)
+    pub state: RefCell<ContactState>,
+    scratch: RefCell<Scratch>,
     /// Some pair's law is `impulse` (only those are ever held).
     holds: bool,
 }
@@ -134,8 +136,8 @@ impl Clone for ContactSet {
             obstacles: self.obstacles.clone(),
             pairs: self.pairs.clone(),
             channels: self.channels.clone(),
-            state: Mutex::new(self.state()),
-            scratch: std::cell::RefCell::new(Scratch::default()),
+            state: RefCell::new(self.state()),
+            scratch: RefCell::new(Scratch::default()),
             holds: self.holds,
         }
     }
@@ -216,8 +218,8 @@ impl ContactSet {
             pairs,
             channels,
             holds,
-            state: Mutex::new(state),
-            scratch: std::cell::RefCell::new(Scratch::default()),
+            state: RefCell::new(state),
+            scratch: RefCell::new(Scratch::default()),
         }
     }
 
@@ -246,7 +248,7 @@ impl ContactSet {
 
     /// Some impulse pair is held (no copy of the state: the hot path asks).
     pub fn any_held(&self) -> bool {
-        self.holds && self.state.lock().is_ok_and(|s| s.held.iter().any(|&h| h))
+        self.holds && self.state.borrow().held.iter().any(|&h| h)
     }
 
     /// Some pair keeps records: runs go in legs between contact switches.
@@ -288,14 +290,12 @@ impl ContactSet {
 
     /// A copy of the running state.
     pub fn state(&self) -> ContactState {
-        self.state.lock().map(|s| s.clone()).unwrap_or_default()
+        self.state.borrow().clone()
     }
 
     /// Replace the running state (the contact driver, between legs).
     pub fn set_state(&self, s: ContactState) {
-        if let Ok(mut g) = self.state.lock() {
-            *g = s;
-        }
+        *self.state.borrow_mut() = s;
     }
 }
 
@@ -574,9 +574,7 @@ fn pair_forces_into<D: Dynamics + ?Sized>(
         .filter(|(_, f)| f.gap < 0.0)
         .flat_map(|(pair, _)| std::iter::once(pair.point).chain(pair.other_point()));
     k.velocities_of(d, t, q, qd, touching);
-    let guard = set.state.lock();
-    let empty = ContactState::default();
-    let state = guard.as_deref().unwrap_or(&empty);
+    let state = set.state.borrow();
     for (i, pair) in set.pairs.iter().enumerate() {
         let known = |p: usize| k.has_velocity(p);
         if !known(pair.point) || !pair.other_point().is_none_or(known) {
@@ -735,9 +733,7 @@ pub fn generalised_force_at<D: Dynamics + ?Sized>(
         std::iter::once(pair.point).chain(pair.other_point())
     });
     k.velocities_of(d, t, q, qd, points);
-    let guard = set.state.lock();
-    let empty = ContactState::default();
-    let state = guard.as_deref().unwrap_or(&empty);
+    let state = set.state.borrow();
     q_force.fill(0.0);
     let mut pushes = false;
     for &i in &s.touching {
