@@ -53,6 +53,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: ball_drop::DOF,
         source: include_str!("../models/ball_drop.toml"),
         kernels: || Box::new(ball_drop::Compiled::default()),
+        cells: ball_drop::CELLS,
     },
     CompiledModel {
         name: "cantilever",
@@ -60,6 +61,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: cantilever::DOF,
         source: include_str!("../models/cantilever.toml"),
         kernels: || Box::new(cantilever::Compiled::default()),
+        cells: cantilever::CELLS,
     },
     CompiledModel {
         name: "cantilever3d",
@@ -67,6 +69,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: cantilever3d::DOF,
         source: include_str!("../models/cantilever3d.toml"),
         kernels: || Box::new(cantilever3d::Compiled::default()),
+        cells: cantilever3d::CELLS,
     },
     CompiledModel {
         name: "chain",
@@ -74,6 +77,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: chain::DOF,
         source: include_str!("../models/chain.toml"),
         kernels: || Box::new(chain::Compiled::default()),
+        cells: chain::CELLS,
     },
     CompiledModel {
         name: "chain32",
@@ -81,6 +85,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: chain32::DOF,
         source: include_str!("../models/chain32.toml"),
         kernels: || Box::new(chain32::Compiled::default()),
+        cells: chain32::CELLS,
     },
     CompiledModel {
         name: "double_pendulum",
@@ -88,6 +93,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: double_pendulum::DOF,
         source: include_str!("../models/double_pendulum.toml"),
         kernels: || Box::new(double_pendulum::Compiled::default()),
+        cells: double_pendulum::CELLS,
     },
     CompiledModel {
         name: "eba_arm",
@@ -95,6 +101,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: eba_arm::DOF,
         source: include_str!("../models/eba_arm.toml"),
         kernels: || Box::new(eba_arm::Compiled::default()),
+        cells: eba_arm::CELLS,
     },
     CompiledModel {
         name: "ebr_arm",
@@ -102,6 +109,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: ebr_arm::DOF,
         source: include_str!("../models/ebr_arm.toml"),
         kernels: || Box::new(ebr_arm::Compiled::default()),
+        cells: ebr_arm::CELLS,
     },
     CompiledModel {
         name: "falling_ball",
@@ -109,6 +117,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: falling_ball::DOF,
         source: include_str!("../models/falling_ball.toml"),
         kernels: || Box::new(falling_ball::Compiled::default()),
+        cells: falling_ball::CELLS,
     },
     CompiledModel {
         name: "finger_free",
@@ -116,6 +125,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: finger_free::DOF,
         source: include_str!("../models/finger_free.toml"),
         kernels: || Box::new(finger_free::Compiled::default()),
+        cells: finger_free::CELLS,
     },
     CompiledModel {
         name: "finger_tap",
@@ -123,6 +133,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: finger_tap::DOF,
         source: include_str!("../models/finger_tap.toml"),
         kernels: || Box::new(finger_tap::Compiled::default()),
+        cells: finger_tap::CELLS,
     },
     CompiledModel {
         name: "hybrid_arm",
@@ -130,6 +141,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: hybrid_arm::DOF,
         source: include_str!("../models/hybrid_arm.toml"),
         kernels: || Box::new(hybrid_arm::Compiled::default()),
+        cells: hybrid_arm::CELLS,
     },
     CompiledModel {
         name: "long_arm",
@@ -137,6 +149,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: long_arm::DOF,
         source: include_str!("../models/long_arm.toml"),
         kernels: || Box::new(long_arm::Compiled::default()),
+        cells: long_arm::CELLS,
     },
     CompiledModel {
         name: "rod_swing",
@@ -144,6 +157,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: rod_swing::DOF,
         source: include_str!("../models/rod_swing.toml"),
         kernels: || Box::new(rod_swing::Compiled::default()),
+        cells: rod_swing::CELLS,
     },
     CompiledModel {
         name: "rom_arm",
@@ -151,6 +165,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: rom_arm::DOF,
         source: include_str!("../models/rom_arm.toml"),
         kernels: || Box::new(rom_arm::Compiled::default()),
+        cells: rom_arm::CELLS,
     },
     CompiledModel {
         name: "soft_finger",
@@ -158,6 +173,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: soft_finger::DOF,
         source: include_str!("../models/soft_finger.toml"),
         kernels: || Box::new(soft_finger::Compiled::default()),
+        cells: soft_finger::CELLS,
     },
     CompiledModel {
         name: "stiff_flop",
@@ -165,6 +181,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: stiff_flop::DOF,
         source: include_str!("../models/stiff_flop.toml"),
         kernels: || Box::new(stiff_flop::Compiled::default()),
+        cells: stiff_flop::CELLS,
     },
     CompiledModel {
         name: "stiff_flop_rom",
@@ -172,6 +189,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: stiff_flop_rom::DOF,
         source: include_str!("../models/stiff_flop_rom.toml"),
         kernels: || Box::new(stiff_flop_rom::Compiled::default()),
+        cells: stiff_flop_rom::CELLS,
     },
     CompiledModel {
         name: "tentacle3d",
@@ -179,6 +197,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: tentacle3d::DOF,
         source: include_str!("../models/tentacle3d.toml"),
         kernels: || Box::new(tentacle3d::Compiled::default()),
+        cells: tentacle3d::CELLS,
     },
     CompiledModel {
         name: "vc_arm",
@@ -186,6 +205,7 @@ pub static MODELS: &[CompiledModel] = &[
         dof: vc_arm::DOF,
         source: include_str!("../models/vc_arm.toml"),
         kernels: || Box::new(vc_arm::Compiled::default()),
+        cells: vc_arm::CELLS,
     },
     CompiledModel {
         name: "wrap",
@@ -193,5 +213,6 @@ pub static MODELS: &[CompiledModel] = &[
         dof: wrap::DOF,
         source: include_str!("../models/wrap.toml"),
         kernels: || Box::new(wrap::Compiled::default()),
+        cells: wrap::CELLS,
     },
 ];

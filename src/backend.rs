@@ -34,6 +34,9 @@ pub enum CacheStatus {
     Unused,
     Hit,
     Miss,
+    /// Compiled link cells of another model's, linked to this chain's
+    /// layout (`runtime::links::LinkedKernels`): no tape needed.
+    Linked,
 }
 
 pub struct Loaded {
@@ -93,6 +96,29 @@ pub fn read_model(spec: &str, overrides: &[Override]) -> Result<(Model, String)>
     )
 }
 
+/// A 3D chain whose element count (or rom order) no compiled-in model
+/// has, on the compiled cells of its link shapes when every one is
+/// compiled in (found by key), with the seconds its layout took to derive.
+fn linked(structure: &Structure) -> Option<(Box<dyn Kernels>, f64)> {
+    if !runtime::cpu::has_fma() {
+        return None;
+    }
+    let start = Instant::now();
+    let (info, links) = eomgen::derive::derive_links(structure)?;
+    let cells = (links.cells.iter().zip(&links.tangents).zip(&links.poses))
+        .map(|((cell, tangent), pose)| {
+            let key = eomgen::tmt::cell_key(cell, tangent, pose);
+            MODELS
+                .iter()
+                .flat_map(|m| m.cells)
+                .find(|c| c.key == key)
+                .copied()
+        })
+        .collect::<Option<Vec<_>>>()?;
+    let kernels = runtime::links::LinkedKernels::new(info, links, cells);
+    Some((Box::new(kernels), start.elapsed().as_secs_f64()))
+}
+
 /// Load a model and bind its parameters to the chosen backend.
 pub fn load(
     spec: &str,
@@ -126,6 +152,9 @@ pub fn load(
         ),
         (BackendChoice::Auto | BackendChoice::Compiled, Some(c)) => {
             ((c.kernels)(), CacheStatus::Unused, 0.0)
+        }
+        (BackendChoice::Auto, None) if let Some((k, s)) = linked(&structure) => {
+            (k, CacheStatus::Linked, s)
         }
         _ => {
             let dir = cache_dir.unwrap_or_else(cache::default_dir);

@@ -513,6 +513,7 @@ fn report_run(
             backend::CacheStatus::Hit => " (tape cache hit)",
             backend::CacheStatus::Miss => " (derived, tape cached)",
             backend::CacheStatus::Unused => "",
+            backend::CacheStatus::Linked => " (cells linked to this element count)",
         },
         stats.solver.name(),
         stats.steps,

@@ -36,72 +36,85 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
         {
             assert_close(*a, *b, 1e-12, 0.0, &format!("{} parameter {k}", m.name));
         }
-        let n = compiled.dof();
-        let names = compiled.info().coordinates.clone();
-        for it in 0..12 {
-            let mut q = rng.coordinates(&names, -2.0, 2.0);
-            // The straight configuration, and some angles exactly 0: the
-            // removable singularities of pcc segments.
-            match it % 3 {
-                0 => q.fill(0.0),
-                1 => q.iter_mut().step_by(2).for_each(|x| *x = 0.0),
-                _ => {}
+        assert_backends_agree(m.name, &compiled, &interpreted, &mut rng, 12);
+    }
+}
+
+/// The compiled and interpreted arms agree on M, h, the outputs, the
+/// generated solve and the Jacobian's parts, at `rounds` random states
+/// (straight ones among them).
+fn assert_backends_agree(
+    what: &str,
+    compiled: &dyn Dynamics,
+    interpreted: &dyn Dynamics,
+    rng: &mut Rng,
+    rounds: usize,
+) {
+    let n = compiled.dof();
+    let names = compiled.info().coordinates.clone();
+    for it in 0..rounds {
+        let mut q = rng.coordinates(&names, -2.0, 2.0);
+        // The straight configuration, and some angles exactly 0: the
+        // removable singularities of pcc segments.
+        match it % 3 {
+            0 => q.fill(0.0),
+            1 => q.iter_mut().step_by(2).for_each(|x| *x = 0.0),
+            _ => {}
+        }
+        let qd = rng.vec(n, -3.0, 3.0);
+        let t = rng.uniform(0.0, 10.0);
+        for kind in [KernelKind::MassBias, KernelKind::Outputs, KernelKind::Accel] {
+            let len = kind.output_len(compiled.info());
+            let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
+            compiled.eval_kernel(kind, t, &q, &qd, &mut a);
+            interpreted.eval_kernel(kind, t, &q, &qd, &mut b);
+            // Compiled chains take MassBias (3D) and Outputs from the
+            // link recursion (runtime/src/links/), eba from its parts
+            // (runtime/src/parts.rs), not the interpreter's flat tapes:
+            // entries zero in closed form come out as different
+            // round-off, so M and h are each held to 1e-12 of their
+            // largest entry, and the outputs to 1e-12 of their kind's
+            // (position, energy, quaternion). Accel runs the same
+            // operations in both backends.
+            let m_len = n * (n + 1) / 2;
+            let largest =
+                |r: std::ops::Range<usize>| b[r].iter().fold(0.0f64, |s, x| s.max(x.abs()));
+            let (m_scale, h_scale) = (largest(0..m_len.min(len)), largest(m_len.min(len)..len));
+            for k in 0..len {
+                assert!(a[k].is_finite(), "{} {kind:?}[{k}] not finite", what);
+                let (rel, floor) = match kind {
+                    KernelKind::MassBias if k < m_len => (1e-12, m_scale),
+                    KernelKind::MassBias => (1e-12, h_scale),
+                    KernelKind::Outputs => match k {
+                        0..3 => (1e-12, largest(0..3)),
+                        3 | 4 => (1e-12, largest(3..5)),
+                        _ => (1e-12, 1.0),
+                    },
+                    _ => (1e-12, 0.0),
+                };
+                assert_close(a[k], b[k], rel, floor, &format!("{} {kind:?}[{k}]", what));
             }
-            let qd = rng.vec(n, -3.0, 3.0);
-            let t = rng.uniform(0.0, 10.0);
-            for kind in [KernelKind::MassBias, KernelKind::Outputs, KernelKind::Accel] {
-                let len = kind.output_len(compiled.info());
-                let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
-                compiled.eval_kernel(kind, t, &q, &qd, &mut a);
-                interpreted.eval_kernel(kind, t, &q, &qd, &mut b);
-                // Compiled chains take MassBias (3D) and Outputs from the
-                // link recursion (runtime/src/links/), eba from its parts
-                // (runtime/src/parts.rs), not the interpreter's flat tapes:
-                // entries zero in closed form come out as different
-                // round-off, so M and h are each held to 1e-12 of their
-                // largest entry, and the outputs to 1e-12 of their kind's
-                // (position, energy, quaternion). Accel runs the same
-                // operations in both backends.
-                let m_len = n * (n + 1) / 2;
-                let largest =
-                    |r: std::ops::Range<usize>| b[r].iter().fold(0.0f64, |s, x| s.max(x.abs()));
-                let (m_scale, h_scale) = (largest(0..m_len.min(len)), largest(m_len.min(len)..len));
-                for k in 0..len {
-                    assert!(a[k].is_finite(), "{} {kind:?}[{k}] not finite", m.name);
-                    let (rel, floor) = match kind {
-                        KernelKind::MassBias if k < m_len => (1e-12, m_scale),
-                        KernelKind::MassBias => (1e-12, h_scale),
-                        KernelKind::Outputs => match k {
-                            0..3 => (1e-12, largest(0..3)),
-                            3 | 4 => (1e-12, largest(3..5)),
-                            _ => (1e-12, 1.0),
-                        },
-                        _ => (1e-12, 0.0),
-                    };
-                    assert_close(a[k], b[k], rel, floor, &format!("{} {kind:?}[{k}]", m.name));
-                }
-            }
-            // The Jacobian's parts, column by column from the Jvp kernel.
-            let qdd = rng.vec(n, -5.0, 5.0);
-            let (mut a, mut b) = (vec![0.0; 2 * n * n], vec![0.0; 2 * n * n]);
-            compiled.jacobian_parts(t, &q, &qd, &qdd, &mut a);
-            interpreted.jacobian_parts(t, &q, &qd, &qdd, &mut b);
-            // Compiled chains take the Jvp from the link recursion in dual
-            // numbers (runtime/src/links/tangent.rs), eba from its parts:
-            // another order of the same sums, held to 1e-12 of each
-            // block's largest entry.
-            for k in 0..2 * n * n {
-                assert!(a[k].is_finite(), "{} Jacobian part {k} not finite", m.name);
-                let block = &b[(k / (n * n)) * n * n..][..n * n];
-                let floor = block.iter().fold(1e-300f64, |s, x| s.max(x.abs()));
-                assert_close(
-                    a[k],
-                    b[k],
-                    1e-12,
-                    floor,
-                    &format!("{} Jacobian part {k}", m.name),
-                );
-            }
+        }
+        // The Jacobian's parts, column by column from the Jvp kernel.
+        let qdd = rng.vec(n, -5.0, 5.0);
+        let (mut a, mut b) = (vec![0.0; 2 * n * n], vec![0.0; 2 * n * n]);
+        compiled.jacobian_parts(t, &q, &qd, &qdd, &mut a);
+        interpreted.jacobian_parts(t, &q, &qd, &qdd, &mut b);
+        // Compiled chains take the Jvp from the link recursion in dual
+        // numbers (runtime/src/links/tangent.rs), eba from its parts:
+        // another order of the same sums, held to 1e-12 of each
+        // block's largest entry.
+        for k in 0..2 * n * n {
+            assert!(a[k].is_finite(), "{} Jacobian part {k} not finite", what);
+            let block = &b[(k / (n * n)) * n * n..][..n * n];
+            let floor = block.iter().fold(1e-300f64, |s, x| s.max(x.abs()));
+            assert_close(
+                a[k],
+                b[k],
+                1e-12,
+                floor,
+                &format!("{} Jacobian part {k}", what),
+            );
         }
     }
 }
@@ -863,5 +876,40 @@ fn eba_parts_match_the_flat_tapes() {
                 );
             }
         }
+    }
+}
+
+#[test]
+fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
+    // Structures no compiled-in model has, whose link shapes one has:
+    // pcc without twist (tentacle3d's), with twist (cantilever3d's), pcs's
+    // half-arcs (rod_swing's), rom slices of another order (rom_arm's).
+    let mut rng = Rng::new(11);
+    for (model, set) in [
+        ("tentacle3d", "segment.0.elements=13"),
+        ("cantilever3d", "segment.0.elements=7"),
+        ("rod_swing", "segment.0.elements=4"),
+        ("rom_arm", "segment.0.order=5"),
+    ] {
+        let what = format!("{model} {set}");
+        let sets = [eomgen::model::Override::parse(set).unwrap()];
+        let l = load(model, &sets, BackendChoice::Auto, None).unwrap();
+        assert!(
+            matches!(l.cache, softarm::backend::CacheStatus::Linked),
+            "{what}: not linked"
+        );
+        assert_eq!(l.arm.backend(), "compiled", "{what}");
+        let tapes = eomgen::derive::derive(&l.model);
+        let p: Vec<f64> = eomgen::model::parameters(&l.model)
+            .into_iter()
+            .map(|(_, v)| v)
+            .collect();
+        let interpreted = Arm::new(Interpreted::new(tapes), p);
+        assert_eq!(
+            l.arm.info().coordinates,
+            interpreted.info().coordinates,
+            "{what}"
+        );
+        assert_backends_agree(&what, &*l.arm, &interpreted, &mut rng, 4);
     }
 }

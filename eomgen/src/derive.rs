@@ -15,6 +15,33 @@ pub fn derive(model: &Model) -> TapeSet {
     derive_structure(&Structure::of(model))
 }
 
+/// The link recursion's layout and kernels of a structure, with the model
+/// info that goes with them, and none of the flat kernels: all that a 3D
+/// chain of compiled-in link shapes needs to run on linked compiled cells
+/// (`runtime::links::LinkedKernels`), derived in milliseconds at any
+/// element count. `None` where the recursion does not give every kernel:
+/// planar and short chains, assemblies, contact.
+pub fn derive_links(structure: &Structure) -> Option<(ModelInfo, runtime::links::LinkKernels)> {
+    if structure.dimensions != 3 || structure.assembly.is_some() || structure.contact_points > 0 {
+        return None;
+    }
+    let layout = ParamLayout::of(structure);
+    let links = link_chain(structure, &layout).filter(|l| l.mass_bias)?;
+    let info = ModelInfo {
+        hash: structure.hash(),
+        coordinates: crate::method::coordinate_names(structure),
+        parameters: layout.names(),
+        derived: 0,
+        accel: false,
+        loads: layout.loads(),
+        constraints: Vec::new(),
+        blocks: Vec::new(),
+        contact_points: 0,
+        contact_groups: Vec::new(),
+    };
+    Some((info, links))
+}
+
 /// Derive the kernels of a structure. Only the structure and its parameter
 /// layout reach the derivation, so no model number can end up in a kernel.
 pub fn derive_structure(structure: &Structure) -> TapeSet {

@@ -464,6 +464,9 @@ fn emit_link_recursion(
     let mut defs = Vec::new();
     let (mut ones, mut fours, mut tangents, mut poses) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    // The cells other structures may link (`runtime::links::LinkedKernels`):
+    // 3D chains', whose every kernel the recursion gives.
+    let (mut linked, mut registry) = (Vec::new(), Vec::new());
     for (c, ((tape, tangent), pose)) in links
         .cells
         .iter()
@@ -510,6 +513,50 @@ fn emit_link_recursion(
                       &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
                       out.try_into().expect("pose outputs")),
         });
+        if links.mass_bias {
+            let key = crate::tmt::cell_key(tape, tangent, pose);
+            let (lo, l4, lt, lp, four) = (
+                Ident::new(&format!("{name}_linked"), Span::call_site()),
+                Ident::new(&format!("{name}_x4_linked"), Span::call_site()),
+                Ident::new(&format!("{name}_tangent_linked"), Span::call_site()),
+                Ident::new(&format!("{name}_pose_linked"), Span::call_site()),
+                Ident::new(&format!("CELL_{c}_FOUR"), Span::call_site()),
+            );
+            linked.push(quote! {
+                fn #lo(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+                    #f(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+                       &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
+                       out.try_into().expect("cell outputs"))
+                }
+                #[cfg(target_arch = "x86_64")]
+                fn #l4(x: &[[f64; 4]], xd: &[[f64; 4]], p: &[[f64; 4]], out: &mut [[f64; 4]]) {
+                    runtime::cpu::require_fma();
+                    // SAFETY: `require_fma` has checked that the processor has FMA.
+                    unsafe { #f4(x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+                                 p.try_into().expect("cell parameters"), out.try_into().expect("cell outputs")) }
+                }
+                #[cfg(target_arch = "x86_64")]
+                const #four: Option<fn(&[[f64; 4]], &[[f64; 4]], &[[f64; 4]], &mut [[f64; 4]])> = Some(#l4);
+                #[cfg(not(target_arch = "x86_64"))]
+                const #four: Option<fn(&[[f64; 4]], &[[f64; 4]], &[[f64; 4]], &mut [[f64; 4]])> = None;
+                fn #lt(x: &[f64], xd: &[f64], dx: &[f64], dxd: &[f64], p: &[f64], out: &mut [f64]) {
+                    let mut dir = [0.0; #n2];
+                    dir[..#n].copy_from_slice(dx);
+                    dir[#n..].copy_from_slice(dxd);
+                    #ft(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+                        &[0.0; #n], &dir, p.try_into().expect("cell parameters"),
+                        out.try_into().expect("cell outputs and derivatives"))
+                }
+                fn #lp(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+                    #fp(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+                        &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
+                        out.try_into().expect("pose outputs"))
+                }
+            });
+            registry.push(quote! {
+                runtime::links::CompiledCell { key: #key, one: #lo, four: #four, tangent: #lt, pose: #lp },
+            });
+        }
         tangents.push(quote! {
             #c => {
                 let mut dir = [0.0; #n2];
@@ -686,6 +733,9 @@ fn emit_link_recursion(
         }
         #cells_impl
         #(#defs)*
+        #(#linked)*
+        /// This model's cells, for chains of other lengths to link.
+        pub static CELLS: &[runtime::links::CompiledCell] = &[#(#registry)*];
     }
 }
 
@@ -979,6 +1029,11 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     if let Some(links) = &tapes.links {
         let n_out = tapes.mass_bias.outputs.len();
         kernels.push(emit_link_recursion(links, dof, n_params, n_out));
+    } else {
+        kernels.push(quote! {
+            /// This model's cells, for chains of other lengths to link: none.
+            pub static CELLS: &[runtime::links::CompiledCell] = &[];
+        });
     }
     let tokens = quote! {
         use runtime::{Inputs, KernelKind, Kernels, ModelInfo};

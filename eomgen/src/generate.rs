@@ -189,7 +189,7 @@ fn registry_source(stems: &[(String, PathBuf)], absolute: Option<&Path>) -> Stri
             format!("\"../models/{stem}.toml\"")
         };
         s.push_str(&format!(
-            "    CompiledModel {{\n        name: \"{stem}\",\n        hash: {stem}::HASH,\n        dof: {stem}::DOF,\n        source: include_str!({source}),\n        kernels: || Box::new({stem}::Compiled::default()),\n    }},\n"
+            "    CompiledModel {{\n        name: \"{stem}\",\n        hash: {stem}::HASH,\n        dof: {stem}::DOF,\n        source: include_str!({source}),\n        kernels: || Box::new({stem}::Compiled::default()),\n        cells: {stem}::CELLS,\n    }},\n"
         ));
     }
     s.push_str("];\n");

@@ -366,4 +366,7 @@ pub struct CompiledModel {
     /// The model file as it was when compiled in.
     pub source: &'static str,
     pub kernels: fn() -> Box<dyn Kernels>,
+    /// Its link cells, which chains of the same link shapes and other
+    /// lengths link (`links::LinkedKernels`).
+    pub cells: &'static [crate::links::CompiledCell],
 }

@@ -22,7 +22,7 @@ use spatial::SpatialArm;
 
 pub use assemble::{Equations, assemble};
 pub use assembly::{Assembled, assembly_system};
-pub use cell::link_chain;
+pub use cell::{cell_key, link_chain};
 pub(crate) use cell_outputs::with_tangent;
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
 pub use system::ParamSymbols;

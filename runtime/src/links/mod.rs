@@ -23,8 +23,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::rows;
 
+mod linked;
 mod outputs;
 mod tangent;
+pub use linked::{CompiledCell, LinkedKernels};
 pub use outputs::outputs;
 pub use tangent::inverse_dynamics_tangent;
 
@@ -970,6 +972,8 @@ pub const MAX_SHARED_DOF: usize = 64;
 
 /// [`mass_bias_shared`] with `N` picked at run time ([`padded`]); for any
 /// chain, owned links included (tests check the two strategies agree).
+/// Inlined into its caller, which linked chains build for FMA.
+#[inline(always)]
 pub fn mass_bias_shared_dyn<C: Cells>(
     layout: &LinkLayout,
     cells: &mut C,

@@ -200,4 +200,3 @@ mod tests {
         assert_eq!(restitution_damping(0.0), None);
     }
 }
-

@@ -1,0 +1,234 @@
+//! Compiled cells linked at run time: a chain whose element count (or rom
+//! order) no compiled-in model has runs the link recursion over the
+//! compiled cells of the same link shapes, found by their keys. The cell
+//! is what is compiled; the count is the layout's, a runtime value, so
+//! `--set segment.0.elements=20` on a bundled 10-element arm needs neither
+//! a rebuild nor the interpreter.
+//!
+//! Invariant: a key names a cell's three tapes (cell, tangent, pose)
+//! exactly (`eomgen::tmt::cell_key`), so a cell linked by key computes
+//! what the interpreter's tape of that cell computes.
+
+use std::cell::RefCell;
+
+use super::{
+    Cells, LinkKernels, all_owned, inverse_dynamics_tangent, mass_bias_owned, mass_bias_shared_dyn,
+    outputs,
+};
+use crate::kernels::{KernelKind, Kernels, ModelInfo};
+use crate::linalg::Ldlt;
+use crate::tape::{Inputs, Tape};
+
+/// One link cell as compiled into the binary, by its key: its three
+/// kernels behind slices (a link's coordinates, rates, parameters).
+#[derive(Clone, Copy)]
+pub struct CompiledCell {
+    pub key: &'static str,
+    pub one: fn(&[f64], &[f64], &[f64], &mut [f64]),
+    /// Four links in vector lanes, where the model compiled them.
+    pub four: Option<fn(&[[f64; 4]], &[[f64; 4]], &[[f64; 4]], &mut [[f64; 4]])>,
+    /// (x, xd, dx, dxd, p, out)
+    pub tangent: fn(&[f64], &[f64], &[f64], &[f64], &[f64], &mut [f64]),
+    pub pose: fn(&[f64], &[f64], &[f64], &mut [f64]),
+}
+
+/// The kernels of a chain by the link recursion over linked compiled
+/// cells: `MassBias`, `Jvp` and `Outputs`; the few kernels of the
+/// parameters or of the whole arm's coordinates that a layout may have
+/// (a rom segment's forces, the actuation loads) by their tapes.
+pub struct LinkedKernels {
+    info: ModelInfo,
+    links: LinkKernels,
+    cells: Vec<CompiledCell>,
+    slots: RefCell<Vec<f64>>,
+}
+
+impl LinkedKernels {
+    /// `cells[c]` is the compiled cell of `links.cells[c]`.
+    pub fn new(info: ModelInfo, links: LinkKernels, cells: Vec<CompiledCell>) -> Self {
+        assert_eq!(cells.len(), links.cells.len(), "one compiled cell a cell");
+        Self {
+            info,
+            links,
+            cells,
+            slots: RefCell::new(Vec::new()),
+        }
+    }
+}
+
+struct Linked<'a> {
+    links: &'a LinkKernels,
+    cells: &'a [CompiledCell],
+    inp: Inputs<'a>,
+    slots: &'a mut Vec<f64>,
+}
+
+/// A kernel of the layout's own by its tape.
+fn by_tape(tape: &Option<Tape>, what: &str, inp: &Inputs, slots: &mut Vec<f64>, out: &mut [f64]) {
+    let tape = tape
+        .as_ref()
+        .unwrap_or_else(|| panic!("the layout asks for its {what} kernel"));
+    tape.eval(inp, slots, out);
+}
+
+impl Cells for Linked<'_> {
+    fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+        (self.cells[c].one)(x, xd, p, out)
+    }
+
+    fn four(
+        &mut self,
+        c: usize,
+        x: &[[f64; 4]],
+        xd: &[[f64; 4]],
+        p: &[[f64; 4]],
+        out: &mut [[f64; 4]],
+    ) {
+        match self.cells[c].four {
+            Some(four) => four(x, xd, p, out),
+            None => {
+                for l in 0..4 {
+                    let lane = |v: &[[f64; 4]]| -> Vec<f64> { v.iter().map(|v| v[l]).collect() };
+                    let mut o = vec![0.0; out.len()];
+                    (self.cells[c].one)(&lane(x), &lane(xd), &lane(p), &mut o);
+                    for (out, v) in out.iter_mut().zip(&o) {
+                        out[l] = *v;
+                    }
+                }
+            }
+        }
+    }
+
+    fn forces(&mut self, out: &mut [f64]) {
+        by_tape(&self.links.forces, "forces", &self.inp, self.slots, out)
+    }
+
+    fn tangent(
+        &mut self,
+        c: usize,
+        x: &[f64],
+        xd: &[f64],
+        dx: &[f64],
+        dxd: &[f64],
+        p: &[f64],
+        out: &mut [f64],
+    ) {
+        (self.cells[c].tangent)(x, xd, dx, dxd, p, out)
+    }
+
+    fn forces_tangent(&mut self, dir: &[f64], out: &mut [f64]) {
+        let inp = Inputs { dir, ..self.inp };
+        by_tape(
+            &self.links.forces_tangent,
+            "forces' tangent",
+            &inp,
+            self.slots,
+            out,
+        )
+    }
+
+    fn loads(&mut self, out: &mut [f64]) {
+        by_tape(&self.links.loads, "loads", &self.inp, self.slots, out)
+    }
+
+    fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+        (self.cells[c].pose)(x, xd, p, out)
+    }
+
+    fn energy(&mut self) -> f64 {
+        let mut out = [0.0];
+        by_tape(
+            &self.links.energy,
+            "energy",
+            &self.inp,
+            self.slots,
+            &mut out,
+        );
+        out[0]
+    }
+}
+
+impl Kernels for LinkedKernels {
+    fn info(&self) -> &ModelInfo {
+        &self.info
+    }
+
+    fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
+        crate::cpu::require_fma();
+        // SAFETY: `require_fma` has checked that the processor has FMA.
+        unsafe { self.eval_fma(kind, inp, out) }
+    }
+
+    fn backend(&self) -> &'static str {
+        "compiled"
+    }
+
+    fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
+        crate::cpu::require_fma();
+        // SAFETY: `require_fma` has checked that the processor has FMA.
+        unsafe { solve_fma(packed, b, ws) }
+    }
+}
+
+/// The L D L^T solve built for FMA.
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+unsafe fn solve_fma(packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
+    if !ws.factor_fma(packed) {
+        return false;
+    }
+    ws.solve_fma(b);
+    true
+}
+
+impl LinkedKernels {
+    /// The recursion built for FMA as the generated kernels build it: its
+    /// `mul_add`s are instructions, not calls.
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    unsafe fn eval_fma(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
+        let mut slots = self.slots.borrow_mut();
+        let mut cells = Linked {
+            links: &self.links,
+            cells: &self.cells,
+            inp: *inp,
+            slots: &mut slots,
+        };
+        let layout = &self.links.layout;
+        match kind {
+            KernelKind::MassBias if all_owned(layout) => {
+                mass_bias_owned(layout, &mut cells, inp.q, inp.qd, inp.p, out)
+            }
+            KernelKind::MassBias => {
+                mass_bias_shared_dyn(layout, &mut cells, inp.q, inp.qd, inp.p, out)
+            }
+            KernelKind::Outputs => outputs(layout, &mut cells, inp.q, inp.qd, inp.p, out),
+            KernelKind::Jvp => {
+                let n = layout.dof;
+                let zeros = vec![0.0; 2 * n];
+                let qdd = if inp.qdd.is_empty() {
+                    &zeros[..n]
+                } else {
+                    inp.qdd
+                };
+                let dir = if inp.dir.is_empty() {
+                    &zeros[..]
+                } else {
+                    inp.dir
+                };
+                let mut tau = vec![0.0; n];
+                inverse_dynamics_tangent(
+                    layout, &mut cells, inp.q, inp.qd, qdd, dir, inp.p, &mut tau, out,
+                )
+            }
+            // No derived parameters, no symbolic solve, no joints, no
+            // contact: `LinkedKernels` is made only for such models.
+            KernelKind::Derived
+            | KernelKind::Accel
+            | KernelKind::Constraints
+            | KernelKind::Contact
+            | KernelKind::ContactJacobian
+            | KernelKind::ContactJvp => {
+                debug_assert!(out.is_empty(), "{kind:?} of a linked chain");
+            }
+        }
+    }
+}
