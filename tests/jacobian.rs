@@ -59,7 +59,9 @@ fn generated_jacobian_matches_central_differences() {
         }
         let mut ws = Workspace::new(n);
         // Each model its own states: adding a model moves no other's.
-        let seed = name.bytes().fold(5u64, |h, b| h.wrapping_mul(31).wrapping_add(b.into()));
+        let seed = name
+            .bytes()
+            .fold(5u64, |h, b| h.wrapping_mul(31).wrapping_add(b.into()));
         let mut rng = Rng::new(seed);
         for it in 0..4 {
             let mut x = rng.coordinates(&d.info().coordinates, -1.0, 1.0);

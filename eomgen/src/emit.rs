@@ -536,9 +536,9 @@ fn emit_link_recursion(
                                  p.try_into().expect("cell parameters"), out.try_into().expect("cell outputs")) }
                 }
                 #[cfg(target_arch = "x86_64")]
-                const #four: Option<fn(&[[f64; 4]], &[[f64; 4]], &[[f64; 4]], &mut [[f64; 4]])> = Some(#l4);
+                const #four: Option<runtime::links::CellLanesFn> = Some(#l4);
                 #[cfg(not(target_arch = "x86_64"))]
-                const #four: Option<fn(&[[f64; 4]], &[[f64; 4]], &[[f64; 4]], &mut [[f64; 4]])> = None;
+                const #four: Option<runtime::links::CellLanesFn> = None;
                 fn #lt(x: &[f64], xd: &[f64], dx: &[f64], dxd: &[f64], p: &[f64], out: &mut [f64]) {
                     let mut dir = [0.0; #n2];
                     dir[..#n].copy_from_slice(dx);

@@ -19,17 +19,23 @@ use crate::kernels::{KernelKind, Kernels, ModelInfo};
 use crate::linalg::Ldlt;
 use crate::tape::{Inputs, Tape};
 
+/// A cell kernel of one link: (x, xd, p, out).
+pub type CellFn = fn(&[f64], &[f64], &[f64], &mut [f64]);
+/// A cell kernel of four links in vector lanes: (x, xd, p, out).
+pub type CellLanesFn = fn(&[[f64; 4]], &[[f64; 4]], &[[f64; 4]], &mut [[f64; 4]]);
+/// A cell's tangent: (x, xd, dx, dxd, p, out).
+pub type CellTangentFn = fn(&[f64], &[f64], &[f64], &[f64], &[f64], &mut [f64]);
+
 /// One link cell as compiled into the binary, by its key: its three
 /// kernels behind slices (a link's coordinates, rates, parameters).
 #[derive(Clone, Copy)]
 pub struct CompiledCell {
     pub key: &'static str,
-    pub one: fn(&[f64], &[f64], &[f64], &mut [f64]),
+    pub one: CellFn,
     /// Four links in vector lanes, where the model compiled them.
-    pub four: Option<fn(&[[f64; 4]], &[[f64; 4]], &[[f64; 4]], &mut [[f64; 4]])>,
-    /// (x, xd, dx, dxd, p, out)
-    pub tangent: fn(&[f64], &[f64], &[f64], &[f64], &[f64], &mut [f64]),
-    pub pose: fn(&[f64], &[f64], &[f64], &mut [f64]),
+    pub four: Option<CellLanesFn>,
+    pub tangent: CellTangentFn,
+    pub pose: CellFn,
 }
 
 /// The kernels of a chain by the link recursion over linked compiled

@@ -26,7 +26,7 @@ use crate::rows;
 mod linked;
 mod outputs;
 mod tangent;
-pub use linked::{CompiledCell, LinkedKernels};
+pub use linked::{CellFn, CellLanesFn, CellTangentFn, CompiledCell, LinkedKernels};
 pub use outputs::outputs;
 pub use tangent::inverse_dynamics_tangent;
 
