@@ -285,18 +285,7 @@ fn an_undamped_pcs_arm_swinging_in_all_six_strains_conserves_energy() {
         ..Default::default()
     };
     let (traj, _) = simulate(arm, x0, &opts).unwrap();
-    let energy = |x: &[f64]| {
-        let o = arm.outputs(0.0, &x[..n], &x[n..]);
-        (o[3], o[3] + o[4])
-    };
-    let e0 = energy(&traj.x[0]).1;
-    let ke_max = traj.x.iter().map(|x| energy(x).0).fold(0.0, f64::max);
-    let drift = traj
-        .x
-        .iter()
-        .map(|x| (energy(x).1 - e0).abs())
-        .fold(0.0, f64::max)
-        / e0.abs().max(ke_max);
+    let drift = energy_drift(arm, &traj);
     eprintln!("relative energy drift {drift:.1e}");
     assert!(drift < 1e-7, "relative energy drift {drift:e}");
     // Every shear coordinate swings through zero.

@@ -257,18 +257,7 @@ fn conserves_energy_swinging_with_twist(method: &str) {
             ..Default::default()
         };
         let (traj, _) = simulate(arm, x0, &opts).unwrap();
-        let energy = |x: &[f64]| {
-            let o = arm.outputs(0.0, &x[..n], &x[n..]);
-            (o[3], o[3] + o[4])
-        };
-        let e0 = energy(&traj.x[0]).1;
-        let ke_max = traj.x.iter().map(|x| energy(x).0).fold(0.0, f64::max);
-        let drift = traj
-            .x
-            .iter()
-            .map(|x| (energy(x).1 - e0).abs())
-            .fold(0.0, f64::max)
-            / e0.abs().max(ke_max);
+        let drift = energy_drift(arm, &traj);
         assert!(drift < 1e-7, "{method}: relative energy drift {drift:e}");
         // It really twists: some twist coordinate changes sign.
         let twisted = (0..n).any(|i| {

@@ -104,3 +104,21 @@ pub fn accelerations(l: &softarm::backend::Loaded, t: f64, q: &[f64], qd: &[f64]
     runtime::accelerations(&*l.arm, &mut ws, t, q, qd, &mut qdd).unwrap();
     qdd
 }
+
+/// The largest change of the total energy (kinetic + potential, the
+/// `Outputs` kernel's) along a trajectory, relative to the larger of the
+/// initial total and the largest kinetic energy.
+pub fn energy_drift(arm: &dyn runtime::Dynamics, traj: &runtime::Trajectory) -> f64 {
+    let n = arm.dof();
+    let energy = |x: &[f64]| {
+        let o = arm.outputs(0.0, &x[..n], &x[n..]);
+        (o[3], o[3] + o[4])
+    };
+    let e0 = energy(&traj.x[0]).1;
+    let ke_max = traj.x.iter().map(|x| energy(x).0).fold(0.0, f64::max);
+    traj.x
+        .iter()
+        .map(|x| (energy(x).1 - e0).abs())
+        .fold(0.0, f64::max)
+        / e0.abs().max(ke_max)
+}

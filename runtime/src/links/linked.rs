@@ -92,16 +92,7 @@ impl Cells for Linked<'_> {
     ) {
         match self.cells[c].four {
             Some(four) => four(x, xd, p, out),
-            None => {
-                for l in 0..4 {
-                    let lane = |v: &[[f64; 4]]| -> Vec<f64> { v.iter().map(|v| v[l]).collect() };
-                    let mut o = vec![0.0; out.len()];
-                    (self.cells[c].one)(&lane(x), &lane(xd), &lane(p), &mut o);
-                    for (out, v) in out.iter_mut().zip(&o) {
-                        out[l] = *v;
-                    }
-                }
-            }
+            None => super::by_lanes(self.cells[c].one, x, xd, p, out),
         }
     }
 

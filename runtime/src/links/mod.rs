@@ -247,14 +247,7 @@ pub trait Cells {
         p: &[[f64; 4]],
         out: &mut [[f64; 4]],
     ) {
-        let lane = |v: &[[f64; 4]], l: usize| -> Vec<f64> { v.iter().map(|v| v[l]).collect() };
-        let mut o = vec![0.0; out.len()];
-        for l in 0..4 {
-            self.one(c, &lane(x, l), &lane(xd, l), &lane(p, l), &mut o);
-            for (out, v) in out.iter_mut().zip(&o) {
-                out[l] = *v;
-            }
-        }
+        by_lanes(|x, xd, p, o| self.one(c, x, xd, p, o), x, xd, p, out)
     }
 
     /// The generalised forces no link has (`LinkLayout::forces`), over
@@ -290,6 +283,25 @@ pub trait Cells {
     /// The strain energy the non-local forces derive from
     /// ([`LinkLayout::forces`]).
     fn energy(&mut self) -> f64;
+}
+
+/// Four links' cells one lane at a time by `one` (x, xd, p, out): where
+/// no lane kernel is compiled.
+pub(crate) fn by_lanes(
+    mut one: impl FnMut(&[f64], &[f64], &[f64], &mut [f64]),
+    x: &[[f64; 4]],
+    xd: &[[f64; 4]],
+    p: &[[f64; 4]],
+    out: &mut [[f64; 4]],
+) {
+    let lane = |v: &[[f64; 4]], l: usize| -> Vec<f64> { v.iter().map(|v| v[l]).collect() };
+    let mut o = vec![0.0; out.len()];
+    for l in 0..4 {
+        one(&lane(x, l), &lane(xd, l), &lane(p, l), &mut o);
+        for (out, v) in out.iter_mut().zip(&o) {
+            out[l] = *v;
+        }
+    }
 }
 
 /// The base frame's rotation (rows) and quaternion (w, x, y, z): from the
