@@ -509,14 +509,24 @@ proptest! {
         let direct = c.eval_many(&[e, d], &|sym| match c.sym_name(sym) {
             "x" => Some(x), "y" => Some(y), "z" => Some(z), _ => None,
         }).unwrap();
+        // The tape rounds differently (shared subexpressions, fused
+        // multiply-adds): differences of the inputs' size, which an
+        // ill-conditioned expression (sin of (x/z)^-2) amplifies as it
+        // amplifies a nudge of its inputs by 1e-14.
+        let nudge = 1.0 + 1e-14;
+        let nudged = c.eval_many(&[e, d], &|sym| match c.sym_name(sym) {
+            "x" => Some(x * nudge), "y" => Some(y * nudge), "z" => Some(z * nudge), _ => None,
+        }).unwrap();
         let tape = c.to_tape(&[e, d]);
         let mut out = [0.0; 2];
         let mut slots = Vec::new();
         tape.eval(&Inputs { t: 0.0, q: &[x], qd: &[y], qdd: &[], dir: &[], p: &[z] }, &mut slots, &mut out);
         for k in 0..2 {
             let (a, b) = (out[k], direct[k]);
-            prop_assert!(a == b || close(a, b, 1e-12) || (a.is_nan() && b.is_nan()),
-                "output {k}: tape {a} vs direct {b} for {t:?}");
+            let sensitivity = (nudged[k] - b).abs();
+            prop_assert!(a == b || close(a, b, 1e-12) || (a - b).abs() <= 100.0 * sensitivity
+                    || (a.is_nan() && b.is_nan()),
+                "output {k}: tape {a} vs direct {b} (a 1e-14 nudge moves it {sensitivity:e}) for {t:?}");
         }
     }
 
