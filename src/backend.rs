@@ -146,15 +146,17 @@ pub fn load(
     let compiled = compiled.filter(|_| runtime::cpu::has_fma());
     let (kernels, cache, derive_s): (Box<dyn Kernels>, CacheStatus, f64) = match (choice, compiled)
     {
+        (BackendChoice::Auto | BackendChoice::Compiled, None)
+            if let Some((k, s)) = linked(&structure) =>
+        {
+            (k, CacheStatus::Linked, s)
+        }
         (BackendChoice::Compiled, None) => bail!(
-            "{origin}: no compiled-in model has this structure (hash {hash}); \
+            "{origin}: no compiled-in model has this structure (hash {hash}), nor every link shape of it; \
              add the file to models/ and rebuild, or use --backend interpreted"
         ),
         (BackendChoice::Auto | BackendChoice::Compiled, Some(c)) => {
             ((c.kernels)(), CacheStatus::Unused, 0.0)
-        }
-        (BackendChoice::Auto, None) if let Some((k, s)) = linked(&structure) => {
-            (k, CacheStatus::Linked, s)
         }
         _ => {
             let dir = cache_dir.unwrap_or_else(cache::default_dir);

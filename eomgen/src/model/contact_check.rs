@@ -234,7 +234,7 @@ fn sampled_methods(ck: &Check) -> Result<(), ModelError> {
                 return ck.err(
                     key,
                     format!(
-                        "contact samples rigid, pcc, vc, ebr, eba and rom segments; {} solves statics only",
+                        "contact samples rigid, pcc, pcs, vc, ebr, eba and rom segments; {} solves statics only",
                         format!("{:?}", s.method).to_lowercase()
                     ),
                 );
