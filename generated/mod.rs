@@ -31,6 +31,8 @@ pub mod long_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod rod_swing;
 #[allow(clippy::all, clippy::pedantic)]
+pub mod rod_swing_rom;
+#[allow(clippy::all, clippy::pedantic)]
 pub mod rom_arm;
 #[allow(clippy::all, clippy::pedantic)]
 pub mod soft_finger;
@@ -158,6 +160,14 @@ pub static MODELS: &[CompiledModel] = &[
         source: include_str!("../models/rod_swing.toml"),
         kernels: || Box::new(rod_swing::Compiled::default()),
         cells: rod_swing::CELLS,
+    },
+    CompiledModel {
+        name: "rod_swing_rom",
+        hash: rod_swing_rom::HASH,
+        dof: rod_swing_rom::DOF,
+        source: include_str!("../models/rod_swing_rom.toml"),
+        kernels: || Box::new(rod_swing_rom::Compiled::default()),
+        cells: rod_swing_rom::CELLS,
     },
     CompiledModel {
         name: "rom_arm",

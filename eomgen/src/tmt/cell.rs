@@ -79,6 +79,8 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             kind: match g.method {
                 Method::Ebr => CellKind::PastJoint,
                 Method::Pcc if spatial && in_halves(g) => CellKind::HalfArc,
+                // A rom slice is two half-arcs (`RomFields::halves`).
+                Method::Rom => CellKind::HalfArc,
                 _ => CellKind::Arc,
             },
         };
@@ -113,30 +115,44 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             let params = ElementParam::CELL
                 .map(|e| params.get(Param::Element(k, e)).unwrap_or(length))
                 .to_vec();
-            let map: Vec<LocalCoordinate> = match &rom {
-                // Cell coordinate f is field f integrated over the slice;
-                // stretch and shear, strains, times the segment's length.
-                Some(r) => (0..count)
-                    .map(|f| {
-                        let stretch = r.is_translation(f);
-                        let n = if stretch { r.slices as f64 } else { 1.0 };
-                        LocalCoordinate {
-                            terms: r
-                                .weights(e)
-                                .into_iter()
-                                .enumerate()
-                                .map(|(i, w)| (r.index(f, i), n * w))
-                                .collect(),
-                            scale: stretch.then_some(params[0]),
-                        }
+            // Cell coordinate f of a half-arc of a rom slice is field f by
+            // the half's weights; stretch and shear, strains, times the
+            // segment's length. Else the element's own coordinates.
+            let maps: Vec<Vec<LocalCoordinate>> = match &rom {
+                Some(r) => r
+                    .halves(e)
+                    .iter()
+                    .map(|w| {
+                        (0..count)
+                            .map(|f| {
+                                let stretch = r.is_translation(f);
+                                let n = if stretch { r.slices as f64 } else { 1.0 };
+                                LocalCoordinate {
+                                    terms: w
+                                        .iter()
+                                        .enumerate()
+                                        .map(|(i, w)| (r.index(f, i), n * w))
+                                        .collect(),
+                                    scale: stretch.then_some(params[0]),
+                                }
+                            })
+                            .collect()
                     })
                     .collect(),
-                None => (0..count)
-                    .map(|f| LocalCoordinate {
-                        terms: vec![(first + f, 1.0)],
-                        scale: None,
-                    })
-                    .collect(),
+                None => {
+                    let map: Vec<LocalCoordinate> = (0..count)
+                        .map(|f| LocalCoordinate {
+                            terms: vec![(first + f, 1.0)],
+                            scale: None,
+                        })
+                        .collect();
+                    // A half-arc element is two links on the same
+                    // coordinates.
+                    match shape.kind {
+                        CellKind::HalfArc => vec![map.clone(), map],
+                        _ => vec![map],
+                    }
+                }
             };
             if let Some(b) = before {
                 links.push(LinkSpec {
@@ -146,21 +162,14 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                     load: None,
                 });
             }
-            // A half-arc element is two links on the same coordinates.
-            if shape.kind == CellKind::HalfArc {
+            for map in maps {
                 links.push(LinkSpec {
                     cell: c,
-                    map: map.clone(),
+                    map,
                     params: params.clone(),
                     load,
                 });
             }
-            links.push(LinkSpec {
-                cell: c,
-                map,
-                params,
-                load,
-            });
             if rom.is_none() {
                 first += count;
             }
