@@ -204,6 +204,13 @@ pub trait Kernels {
         ws.solve(b);
         true
     }
+    /// qdd = -M^-1 h into `qdd` by a recursion that forms no mass matrix
+    /// (the articulated-body sweeps of a chain, O(links)), where the
+    /// kernel set has one: None where it has not, Some(false) where M is
+    /// not positive definite.
+    fn accelerations(&self, _inp: &Inputs, _qdd: &mut [f64]) -> Option<bool> {
+        None
+    }
 }
 
 /// Derived tapes of one model: the interpreted backend, and what eomgen

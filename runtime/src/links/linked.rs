@@ -12,8 +12,8 @@
 use std::cell::RefCell;
 
 use super::{
-    Cells, LinkKernels, all_owned, inverse_dynamics_tangent, mass_bias_owned, mass_bias_shared_dyn,
-    outputs,
+    Cells, LinkKernels, accelerations_owned, all_owned, inverse_dynamics_tangent, mass_bias_owned,
+    mass_bias_shared_dyn, outputs,
 };
 use crate::kernels::{KernelKind, Kernels, ModelInfo};
 use crate::linalg::Ldlt;
@@ -165,6 +165,16 @@ impl Kernels for LinkedKernels {
         // SAFETY: `require_fma` has checked that the processor has FMA.
         unsafe { solve_fma(packed, b, ws) }
     }
+
+    fn accelerations(&self, inp: &Inputs, qdd: &mut [f64]) -> Option<bool> {
+        let layout = &self.links.layout;
+        if !all_owned(layout) || layout.forces || layout.variable_inertia {
+            return None;
+        }
+        crate::cpu::require_fma();
+        // SAFETY: `require_fma` has checked that the processor has FMA.
+        Some(unsafe { self.accelerations_fma(inp, qdd) })
+    }
 }
 
 /// The L D L^T solve built for FMA.
@@ -178,6 +188,19 @@ unsafe fn solve_fma(packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
 }
 
 impl LinkedKernels {
+    /// The articulated-body sweeps built for FMA.
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    unsafe fn accelerations_fma(&self, inp: &Inputs, qdd: &mut [f64]) -> bool {
+        let mut slots = self.slots.borrow_mut();
+        let mut cells = Linked {
+            links: &self.links,
+            cells: &self.cells,
+            inp: *inp,
+            slots: &mut slots,
+        };
+        accelerations_owned(&self.links.layout, &mut cells, inp.q, inp.qd, inp.p, qdd)
+    }
+
     /// The recursion built for FMA as the generated kernels build it: its
     /// `mul_add`s are instructions, not calls.
     #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]

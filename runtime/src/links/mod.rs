@@ -23,9 +23,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::rows;
 
+mod articulated;
 mod linked;
 mod outputs;
 mod tangent;
+pub use articulated::accelerations_owned;
 pub use linked::{CellFn, CellLanesFn, CellTangentFn, CompiledCell, LinkedKernels};
 pub use outputs::outputs;
 pub use tangent::inverse_dynamics_tangent;
@@ -506,6 +508,9 @@ struct Scratch {
     cell_out: Vec<[f64; 4]>,
     slot: Vec<(usize, usize)>,
     one_out: Vec<f64>,
+    /// Per link, the articulated-body sweep's elimination of its
+    /// coordinates (`articulated`).
+    eliminated: Vec<articulated::Eliminated>,
 }
 
 thread_local! {

@@ -34,6 +34,18 @@ pub trait Dynamics {
     /// Solve M x = b in place for x, M given as the packed upper triangle
     /// (the `Mass` layout); false unless M is positive definite.
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool;
+    /// qdd = -M^-1 h without the mass matrix, where the kernels have a
+    /// recursion for it ([`Kernels::accelerations`]); None where not,
+    /// Some(false) where M is not positive definite.
+    fn direct_accelerations(
+        &self,
+        _t: f64,
+        _q: &[f64],
+        _qd: &[f64],
+        _qdd: &mut [f64],
+    ) -> Option<bool> {
+        None
+    }
     /// d tau/dq and d tau/dqd of the inverse dynamics tau = M qdd + h
     /// (row-major n x n each) at the given accelerations, column by column
     /// from the `Jvp` kernel.
@@ -259,6 +271,21 @@ impl<K: Kernels> Dynamics for Arm<K> {
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
         self.kernels.solve_mass(packed, b, ws)
     }
+    fn direct_accelerations(&self, t: f64, q: &[f64], qd: &[f64], qdd: &mut [f64]) -> Option<bool> {
+        let mut solved = None;
+        self.with_params(t, |p| {
+            let inp = Inputs {
+                t,
+                q,
+                qd,
+                qdd: &[],
+                dir: &[],
+                p,
+            };
+            solved = self.kernels.accelerations(&inp, qdd);
+        });
+        solved
+    }
     fn jacobian_parts(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
         // Column j of d tau/dq along dq = e_j, of d tau/dqd along dqd = e_j.
         let n = q.len();
@@ -351,6 +378,9 @@ impl<K: Kernels + ?Sized> Kernels for Box<K> {
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
         (**self).solve_mass(packed, b, ws)
     }
+    fn accelerations(&self, inp: &Inputs, qdd: &mut [f64]) -> Option<bool> {
+        (**self).accelerations(inp, qdd)
+    }
 }
 
 /// Reusable buffers for [`accelerations`].
@@ -428,6 +458,16 @@ pub fn accelerations<D: Dynamics + ?Sized>(
     } else {
         // Contact forces that push make the right-hand side M^-1 (Q_c - h).
         let contact = crate::contact::generalised_force_at(d, t, q, qd, None, &mut ws.contact);
+        let direct = match contact || rows > 0 {
+            true => None,
+            false => d.direct_accelerations(t, q, qd, qdd),
+        };
+        if let Some(solved) = direct {
+            return match solved && qdd.iter().all(|v| v.is_finite()) {
+                true => Ok(()),
+                false => Err(diagnose(d, t, q, qd)),
+            };
+        }
         d.eval_kernel(KernelKind::MassBias, t, q, qd, &mut ws.packed);
         if contact {
             let tri = n * (n + 1) / 2;
