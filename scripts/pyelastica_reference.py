@@ -40,24 +40,50 @@ is the reference: 50 and 100 differ from it by about 0.32 and 0.09 % of L
 over 2 s, so it is within about 0.03 % of the converged rod. The tables are
 in docs/validation.md.
 
-    python3 -m venv /tmp/pe && /tmp/pe/bin/pip install pyelastica==1.0.0
-    /tmp/pe/bin/python scripts/pyelastica_reference.py [--law section|pyelastica]
+    python3 scripts/pyelastica_reference.py [--law section|pyelastica]
         [--axial-factor F] [n1 n2 ...]          (default 50 100 200)
+
+Without PyElastica at hand it makes a virtual environment of its own
+(target/pyelastica-venv, pyelastica 1.0.0, whose internals the constant
+section patches) and runs itself there.
 """
 
 import argparse
+import os
+import subprocess
+import sys
 import time
 from pathlib import Path
 
-import numpy as np
-import elastica as ea
-import elastica.rod.cosserat_rod as cosserat
-from elastica._calculus import difference_kernel_for_block_structure
+ROOT = Path(__file__).resolve().parents[1]
+VENV = ROOT / "target" / "pyelastica-venv"
+
+
+def in_own_venv():
+    """Re-run this script in VENV, made and filled on first use."""
+    python = VENV / "bin" / "python"
+    if os.environ.get("SOFTARM_PYELASTICA_VENV"):
+        sys.exit(f"PyElastica did not import in {VENV}")
+    if not python.exists():
+        subprocess.run([sys.executable, "-m", "venv", str(VENV)], check=True)
+        subprocess.run([str(python), "-m", "pip", "install", "--quiet", "pyelastica==1.0.0"],
+                       check=True)
+    env = {**os.environ, "SOFTARM_PYELASTICA_VENV": "1"}
+    os.execve(str(python), [str(python), __file__, *sys.argv[1:]], env)
+
+
+try:
+    import numpy as np
+    import elastica as ea
+    import elastica.rod.cosserat_rod as cosserat
+    from elastica._calculus import difference_kernel_for_block_structure
+except ImportError:
+    in_own_venv()
 
 L, R, RHO, E = 0.3, 0.01, 1000.0, 1.0e6
 G = E / 3.0
 T_END, SAMPLE = 2.0, 0.01
-DATA = Path(__file__).resolve().parents[1] / "tests" / "data"
+DATA = ROOT / "tests" / "data"
 
 
 def constant_section():
