@@ -182,10 +182,12 @@ pub fn accelerations_owned<C: Cells>(
             let mut ib_sb = [[0.0; 6]; MAX_LINK_DOF];
             let mut ia_se = [[0.0; 6]; MAX_LINK_DOF];
             for f in 0..nc {
+                // The body's column as a twist about the origin.
                 let (ow, ov) = s.own[at + f];
-                s_b[f] = six((ow, sub(ov, cross(ow, l.centroid))));
+                let twist = (ow, sub(ov, cross(ow, l.centroid)));
+                s_b[f] = six(twist);
+                ib_sb[f] = six(body.momentum(twist));
                 e.s_e[f] = six(s.twist[at + f]);
-                ib_sb[f] = six(body.momentum((ow, sub(ov, cross(ow, l.centroid)))));
                 ia_se[f] = mul6(&ia, &e.s_e[f]);
                 e.u_cols[f] = std::array::from_fn(|i| ib_sb[f][i] + ia_se[f][i]);
                 e.u[f] = dot6(&s_b[f], &fb) + dot6(&e.s_e[f], &pa) + s.local_force[at + f];
@@ -195,12 +197,10 @@ pub fn accelerations_owned<C: Cells>(
                     e.d[f][f2] = dot6(&s_b[f], &ib_sb[f2]) + dot6(&e.s_e[f], &ia_se[f2]);
                 }
             }
-            let mut factors = e.d;
-            if !factor_small(&mut factors, nc) {
+            if !factor_small(&mut e.d, nc) {
                 ok = false;
                 break;
             }
-            e.d = factors;
             // IA <- I_b + IA - U D^-1 U^T, pA <- F_b + pA - U D^-1 u.
             let mut w = [[0.0; 6]; MAX_LINK_DOF];
             for i in 0..6 {
