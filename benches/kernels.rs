@@ -7,7 +7,7 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use eomgen::model::{Model, Override};
-use runtime::{KernelKind, Workspace, accelerations};
+use runtime::{KernelKind, Ldlt, Workspace, accelerations};
 use softarm::backend::{BackendChoice, load};
 
 fn chain_with(elements: usize) -> Model {
@@ -92,6 +92,44 @@ fn kernels(c: &mut Criterion) {
     g.finish();
 }
 
+/// The right-hand side of pcc chains linked at another element count
+/// (the articulated-body sweep): cantilever3d at 10 and 20 elements.
+fn linked(c: &mut Criterion) {
+    let mut g = c.benchmark_group("linked");
+    for elements in [10, 20] {
+        let set = Override::parse(&format!("segment.0.elements={elements}")).unwrap();
+        let l = load("cantilever3d", &[set], BackendChoice::Auto, None).unwrap();
+        let arm = &*l.arm;
+        let n = arm.dof();
+        let (q, qd) = state(n);
+        let mut ws = Workspace::new(n);
+        let mut qdd = vec![0.0; n];
+        g.bench_function(format!("cantilever3d_{elements}/rhs"), |b| {
+            b.iter(|| accelerations(arm, &mut ws, 0.0, black_box(&q), black_box(&qd), &mut qdd))
+        });
+    }
+    g.finish();
+}
+
+/// The L D L^T factorisation of a dense positive definite matrix.
+fn ldlt(c: &mut Criterion) {
+    let mut g = c.benchmark_group("ldlt");
+    for n in [20, 40, 60] {
+        let packed: Vec<f64> = (0..n)
+            .flat_map(|i| (i..n).map(move |j| (i, j)))
+            .map(|(i, j)| match i == j {
+                true => 2.0 * n as f64,
+                false => ((i * 7 + j * 3) as f64 * 0.37).sin(),
+            })
+            .collect();
+        let mut ws = Ldlt::new(n);
+        g.bench_function(format!("factor/{n}"), |b| {
+            b.iter(|| assert!(ws.factor(black_box(&packed))))
+        });
+    }
+    g.finish();
+}
+
 fn interpreted(c: &mut Criterion) {
     let dir = std::env::temp_dir().join("softarm-bench-cache");
     let l = load("chain", &[], BackendChoice::Interpreted, Some(dir)).unwrap();
@@ -116,6 +154,6 @@ fn interpreted(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().without_plots();
-    targets = derivation, kernels, interpreted
+    targets = derivation, kernels, linked, ldlt, interpreted
 }
 criterion_main!(benches);

@@ -195,8 +195,9 @@ pub trait Kernels {
     /// Which backend this is, for reports.
     fn backend(&self) -> &'static str;
     /// Solve M x = b in place, M packed as `MassBias` lays it out (its first n(n+1)/2 values);
-    /// false unless M is positive definite. Generated code overrides this
-    /// with a solver specialised to its size.
+    /// false unless M is positive definite. Linked chains override it with
+    /// the same solve built for FMA; small arms do not come here (their
+    /// solve is the generated `Accel` kernel).
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
         if !ws.factor(packed) {
             return false;

@@ -2,8 +2,8 @@
 //! square-root-free Cholesky factorisation M = L D L^T.
 //!
 //! M arrives as the packed upper triangle the kernels produce (row j of it
-//! is column j of M). L and W = L D are stored row-major so every inner
-//! product runs over contiguous memory. nalgebra's `Cholesky` allocates and
+//! is column j of M). L is stored row-major and factored right-looking, so
+//! every update runs over a contiguous run of a row. nalgebra's `Cholesky` allocates and
 //! copies on every call, which cost more than the whole EOM of an 8-link
 //! chain (measured: 400 ns of a 615 ns right-hand side), and its square
 //! roots sit on the critical path; this does neither. Small arms do not come

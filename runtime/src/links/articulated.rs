@@ -74,9 +74,9 @@ fn mul6(m: &M6, v: &V6) -> V6 {
     std::array::from_fn(|i| dot6(&m[i], v))
 }
 
-/// Solve the n x n symmetric positive definite `d` (n <= MAX_LINK_DOF) in
-/// place by L D L^T: `d` becomes its factors, false unless positive
-/// definite.
+/// Factor the n x n symmetric positive definite `d` (n <= MAX_LINK_DOF,
+/// its lower triangle) in place by L D L^T: `d` becomes its factors (L
+/// below the diagonal, D on it); false unless positive definite.
 #[inline(always)]
 fn factor_small(d: &mut [[f64; MAX_LINK_DOF]; MAX_LINK_DOF], n: usize) -> bool {
     for j in 0..n {
