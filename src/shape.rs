@@ -69,6 +69,7 @@ impl Shape {
             qdd: &[],
             dir: &[],
             p: &p,
+            aux: &[],
         };
         self.tape.tape.eval(&inp, &mut Vec::new(), &mut out);
         let pose = |k: usize| -> [f64; ROW] { std::array::from_fn(|i| out[k * ROW + i]) };

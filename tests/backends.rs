@@ -260,13 +260,18 @@ fn generated_mass_solve_matches_a_dense_solve() {
                     assert_close(ldlt, mm[(i, j)], 1e-12, m_scale, &what);
                 }
             }
-            // The contact points it carries are the Contact kernel's.
+            // The contact frames it carries (or the points, without
+            // frames) are the Contact kernel's.
             let points = arm.info().contact_points;
-            let mut reference = vec![0.0; 3 * points];
-            arm.eval_kernel(KernelKind::Contact, 0.0, &q, &qd, &mut reference);
+            let mut contact = vec![0.0; KernelKind::Contact.output_len(arm.info())];
+            arm.eval_kernel(KernelKind::Contact, 0.0, &q, &qd, &mut contact);
+            let reference = match arm.info().contact_frames {
+                0 => &contact[..],
+                _ => &contact[3 * points..],
+            };
             let carried = &out[2 * n + n * (n - 1) / 2..];
-            assert_eq!(carried.len(), 3 * points, "{}: points carried", m.name);
-            for (i, (a, b)) in carried.iter().zip(&reference).enumerate() {
+            assert_eq!(carried.len(), reference.len(), "{}: carried", m.name);
+            for (i, (a, b)) in carried.iter().zip(reference).enumerate() {
                 assert_close(
                     *a,
                     *b,
@@ -296,6 +301,7 @@ impl runtime::links::Cells for TapeCells<'_> {
             qdd: &[],
             dir: &[],
             p,
+            aux: &[],
         };
         self.links.cells[c].eval(&inp, self.slots, out)
     }
@@ -321,6 +327,7 @@ impl runtime::links::Cells for TapeCells<'_> {
             qdd: &[],
             dir: &dir,
             p,
+            aux: &[],
         };
         self.links.tangents[c].eval(&inp, self.slots, out)
     }
@@ -336,6 +343,7 @@ impl runtime::links::Cells for TapeCells<'_> {
             qdd: &[],
             dir: &[],
             p,
+            aux: &[],
         };
         self.links.poses[c].eval(&inp, self.slots, out)
     }
@@ -638,6 +646,7 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
                 qdd: &[],
                 dir: &[],
                 p: &p,
+                aux: &[],
             };
             flat.eval(&inp, &mut Vec::new(), &mut want);
             let mut slots = Vec::new();
@@ -831,6 +840,7 @@ fn eba_parts_match_the_flat_tapes() {
                 qdd: &qdd,
                 dir: &dir,
                 p: &p,
+                aux: &[],
             };
             let len = flat.outputs.len();
             let (mut want, mut got) = (vec![0.0; len], vec![f64::NAN; len]);

@@ -754,7 +754,9 @@ points_per_element = 3
                     }
                 })
                 .collect();
-            let mut buf = vec![0.0; 3 * l.arm.info().contact_points];
+            // A chain of pcc arcs: the points come with contact frames.
+            assert!(l.arm.info().contact_frames > 0, "{dimensions}D: frames");
+            let mut buf = vec![0.0; runtime::KernelKind::Contact.output_len(l.arm.info())];
             l.arm.eval_kernel(
                 runtime::KernelKind::Contact,
                 0.0,
@@ -762,6 +764,7 @@ points_per_element = 3
                 &vec![0.0; n],
                 &mut buf,
             );
+            buf.truncate(3 * l.arm.info().contact_points);
             for (i, p) in buf.chunks(3).enumerate() {
                 let s = 0.4 * (i + 1) as f64 / 12.0;
                 let (x, y) = if kappa == 0.0 {
@@ -826,4 +829,279 @@ fn finger_tap_is_finger_free_until_it_touches() {
         }
     }
     assert_eq!(touched, 3, "states pressed into the table");
+}
+
+/// 3D pcc arms hanging from a base, a floor far below: with twist, and
+/// with stretch and shear (the centreline longer than the element).
+fn hanging_pcc(extra: &str) -> String {
+    format!(
+        r#"
+name = "hanging"
+dimensions = 3
+gravity = [0.0, 0.0, -9.81]
+[base]
+direction = [0.3, 0.2, -1.0]
+[[segment]]
+method = "pcc"
+length = 0.3
+elements = 5
+density = 1000.0
+outer_radius = 0.01
+youngs_modulus = 1.0e6
+{extra}
+[[obstacle]]
+name = "floor"
+shape = "plane"
+point = [0.0, 0.0, -1.0]
+normal = [0.0, 0.0, 1.0]
+[contact]
+model = "hertz"
+stiffness = 1.0
+points_per_element = 3
+"#
+    )
+}
+
+/// The contact frames the kernel reads: the `Accel` kernel's where the
+/// model has one (the hot path), else the `Contact` kernel's.
+fn contact_frames(arm: &dyn runtime::Dynamics, q: &[f64], qd: &[f64]) -> Vec<f64> {
+    use runtime::KernelKind;
+    let info = arm.info();
+    let kind = match info.accel {
+        true => KernelKind::Accel,
+        false => KernelKind::Contact,
+    };
+    let mut out = vec![0.0; kind.output_len(info)];
+    arm.eval_kernel(kind, 0.0, q, qd, &mut out);
+    out.split_off(out.len() - info.contact_frames)
+}
+
+/// A chain's `ContactJacobian` groups start from the contact frames (each
+/// element's base frame and the earlier coordinates' twists), not from
+/// the base: they must place every point where the flat kinematics (the
+/// `Contact` kernel, the whole chain's expressions) does, with dp/dq the
+/// central differences of those positions and v their rate along qd. For
+/// finger_tap (planar), wrap (3D) and 3D arms with twist, stretch and
+/// shear.
+#[test]
+fn the_contact_frames_place_the_points_as_the_flat_kinematics_does() {
+    use runtime::KernelKind;
+    use softarm::backend::{BackendChoice, load};
+    let dir = tempfile::tempdir().unwrap();
+    let models = [
+        (
+            "finger_tap",
+            load("finger_tap", &[], BackendChoice::Compiled, None).unwrap(),
+        ),
+        (
+            "wrap",
+            load("wrap", &[], BackendChoice::Compiled, None).unwrap(),
+        ),
+        ("3D twist", load_text(dir.path(), &hanging_pcc(""), &[])),
+        (
+            "3D stretch and shear",
+            load_text(
+                dir.path(),
+                &hanging_pcc("extension = true\nshear = true"),
+                &[],
+            ),
+        ),
+    ];
+    let mut rng = Rng::new(21);
+    for (name, l) in &models {
+        let arm = &*l.arm;
+        let info = arm.info();
+        assert!(
+            info.contact_frames > 0,
+            "{name}: a chain has contact frames"
+        );
+        let (n, points) = (arm.dof(), info.contact_points);
+        let flat = |q: &[f64], qd: &[f64]| {
+            let mut b = vec![0.0; KernelKind::Contact.output_len(info)];
+            arm.eval_kernel(KernelKind::Contact, 0.0, q, qd, &mut b);
+            b.truncate(3 * points);
+            b
+        };
+        for _ in 0..4 {
+            let q = rng.coordinates(&info.coordinates, -0.8, 0.8);
+            let qd = rng.vec(n, -2.0, 2.0);
+            let frames = contact_frames(arm, &q, &qd);
+            let mut out = vec![0.0; KernelKind::ContactJacobian.output_len(info)];
+            arm.eval_direction(
+                KernelKind::ContactJacobian,
+                0.0,
+                &q,
+                &qd,
+                &[],
+                &frames,
+                &mut out,
+            );
+            let width = 6 + 3 * n;
+            let p0 = flat(&q, &qd);
+            let h = 1e-6;
+            let moved = |dq: &dyn Fn(usize) -> f64, sign: f64| {
+                let q: Vec<f64> = (0..n).map(|j| q[j] + sign * h * dq(j)).collect();
+                flat(&q, &qd)
+            };
+            let rate = |dq: &dyn Fn(usize) -> f64| -> Vec<f64> {
+                let (a, b) = (moved(dq, 1.0), moved(dq, -1.0));
+                a.iter().zip(&b).map(|(a, b)| (a - b) / (2.0 * h)).collect()
+            };
+            let along_qd = rate(&|j| qd[j]);
+            let columns: Vec<Vec<f64>> = (0..n)
+                .map(|k| rate(&|j| if j == k { 1.0 } else { 0.0 }))
+                .collect();
+            for i in 0..points {
+                let o = &out[i * width..(i + 1) * width];
+                for c in 0..3 {
+                    let what = format!("{name} point {i} axis {c}");
+                    assert_abs(o[c], p0[3 * i + c], 1e-12, &format!("{what}: position"));
+                    assert_abs(o[3 + c], along_qd[3 * i + c], 1e-7, &format!("{what}: v"));
+                    for (k, col) in columns.iter().enumerate() {
+                        let got = o[6 + c * n + k];
+                        assert_abs(got, col[3 * i + c], 1e-7, &format!("{what}: dp/dq{k}"));
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The broad phase of the contact frames skips an element only when its
+/// points cannot touch: with an obstacle put at random close to the arm
+/// (planes, spheres, capped cylinders and boxes, some deep in it, some
+/// clear), the generalised contact force from the `Accel` kernel's frames
+/// (the broad phase, then the groups it keeps) equals the one found from
+/// every point's position (the `Contact` kernel), at random states of
+/// finger_tap and wrap.
+#[test]
+fn the_broad_phase_misses_no_contact() {
+    use runtime::KernelKind;
+    use runtime::contact::{Shape, generalised_force_at};
+    use softarm::backend::{BackendChoice, load};
+    let mut rng = Rng::new(5);
+    for name in ["finger_tap", "wrap"] {
+        let mut l = load(name, &[], BackendChoice::Compiled, None).unwrap();
+        let base_set = l.arm.contact().unwrap().clone();
+        let n = l.arm.dof();
+        let points = l.arm.info().contact_points;
+        let (mut pushed, mut skipped) = (0, 0);
+        for trial in 0..400 {
+            let q = rng.coordinates(&l.arm.info().coordinates, -0.4, 0.4);
+            let qd = rng.vec(n, -1.0, 1.0);
+            let mut flat = vec![0.0; KernelKind::Contact.output_len(l.arm.info())];
+            l.arm
+                .eval_kernel(KernelKind::Contact, 0.0, &q, &qd, &mut flat);
+            // Its surface at a gap delta from a random point of the arm:
+            // within a third of the tube's radius every other trial (the
+            // broad phase's margin decides there), else up to 3 cm either
+            // way (deep in, or clear).
+            let k = (rng.next_f64() * points as f64) as usize;
+            let p: [f64; 3] = std::array::from_fn(|c| flat[3 * k + c]);
+            let r = base_set.points[k].radius;
+            let delta = match trial % 2 {
+                0 => rng.uniform(-0.3, 0.3) * r,
+                _ => rng.uniform(-0.03, 0.03),
+            };
+            let mut unit = || {
+                let v = [0, 1, 2].map(|_| rng.uniform(-1.0, 1.0));
+                let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt().max(1e-3);
+                v.map(|x| x / len)
+            };
+            // Across the arm (the surface along it, where an element's
+            // bound is tightest), every other placement; else any way.
+            let u = match (trial / 8) % 2 {
+                0 => {
+                    let (i, j) = (k.saturating_sub(1), (k + 1).min(points - 1));
+                    let t: [f64; 3] = std::array::from_fn(|c| flat[3 * j + c] - flat[3 * i + c]);
+                    let tt = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
+                    let w = unit();
+                    let wt = w[0] * t[0] + w[1] * t[1] + w[2] * t[2];
+                    let v = [0, 1, 2].map(|c| w[c] - wt / tt * t[c]);
+                    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                    v.map(|c| c / len)
+                }
+                _ => unit(),
+            };
+            // p at distance r + delta from the surface, along u.
+            let back =
+                |d: f64| -> [f64; 3] { std::array::from_fn(|c| p[c] - (r + delta + d) * u[c]) };
+            let shape = match (trial / 2) % 4 {
+                0 => Shape::Plane {
+                    point: back(0.0),
+                    normal: u,
+                },
+                1 => {
+                    let radius = rng.uniform(0.002, 0.03);
+                    Shape::Sphere {
+                        center: back(radius),
+                        radius,
+                    }
+                }
+                2 => {
+                    // The axis normal to u.
+                    let w = unit();
+                    let along = w[0] * u[0] + w[1] * u[1] + w[2] * u[2];
+                    let axis = [0, 1, 2].map(|c| w[c] - along * u[c]);
+                    let len = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+                    let radius = rng.uniform(0.002, 0.02);
+                    Shape::Cylinder {
+                        center: back(radius),
+                        axis: axis.map(|c| c / len),
+                        radius,
+                        half_length: rng.uniform(0.005, 0.05),
+                    }
+                }
+                _ => {
+                    // A box turned about z, its first axis along u's
+                    // projection (the face p is nearest).
+                    let a = u[1].atan2(u[0]);
+                    let half = [0, 1, 2].map(|_| rng.uniform(0.002, 0.02));
+                    let flat_u = [a.cos(), a.sin(), 0.0];
+                    let center = std::array::from_fn(|c| p[c] - (r + delta + half[0]) * flat_u[c]);
+                    Shape::Box {
+                        center,
+                        rotation: [
+                            [a.cos(), -a.sin(), 0.0],
+                            [a.sin(), a.cos(), 0.0],
+                            [0.0, 0.0, 1.0],
+                        ],
+                        half,
+                    }
+                }
+            };
+            let mut set = base_set.clone();
+            set.obstacles[0].shape = shape.clone();
+            l.arm.set_contact(Some(set));
+            let frames = contact_frames(&*l.arm, &q, &qd);
+            let (mut from_frames, mut from_points) = (vec![0.0; n], vec![0.0; n]);
+            let a = generalised_force_at(&*l.arm, 0.0, &q, &qd, Some(&frames), &mut from_frames);
+            let b = generalised_force_at(&*l.arm, 0.0, &q, &qd, None, &mut from_points);
+            assert_eq!(a, b, "{name} trial {trial} ({shape:?}): pushes");
+            if a {
+                pushed += 1;
+                let scale = from_points.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
+                for j in 0..n {
+                    let what = format!("{name} trial {trial} ({shape:?}) Q_c[{j}]");
+                    assert_close(from_frames[j], from_points[j], 1e-9, scale, &what);
+                }
+            }
+            // How many elements the broad phase could skip: those whose
+            // points are all clear of the obstacle.
+            let r = base_set.points[0].radius;
+            skipped += l
+                .arm
+                .info()
+                .contact_group_ranges()
+                .filter(|&(first, len)| {
+                    (first..first + len).all(|i| {
+                        let p = [0, 1, 2].map(|c| flat[3 * i + c]);
+                        shape.distance(p, [0.0; 3]).0 - r > 0.0
+                    })
+                })
+                .count();
+        }
+        assert!(pushed > 60, "{name}: {pushed} of 400 states touch");
+        assert!(skipped > 400, "{name}: {skipped} elements clear");
+    }
 }

@@ -5,6 +5,7 @@ use runtime::{ModelInfo, TapeSet};
 use crate::cas::ExprId;
 use crate::cas::{Cas, Hoist, SymKind};
 use crate::model::{Model, ParamLayout, Structure};
+use crate::tmt::contact_frames::{PointGroup, contact_frames};
 use crate::tmt::{
     SYMBOLIC_SOLVE_MAX_DOF, System, assemble, assembly_system, link_chain, solve_accelerations,
     system,
@@ -38,6 +39,7 @@ pub fn derive_links(structure: &Structure) -> Option<(ModelInfo, runtime::links:
         blocks: Vec::new(),
         contact_points: 0,
         contact_groups: Vec::new(),
+        contact_frames: 0,
     };
     Some((info, links))
 }
@@ -83,12 +85,16 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
     let accel = n <= SYMBOLIC_SOLVE_MAX_DOF
         && !links.as_ref().is_some_and(|l| l.mass_bias)
         && phi.is_empty();
+    let contact = (!sys.samples.is_empty()).then(|| contact_outputs(&mut cas, &sys));
     let accel_tape = if accel {
-        // The contact points ride along: their positions share the
+        // The contact frames ride along (else the points): they share the
         // kinematics' trig with M and h, and a right-hand side that touches
         // nothing needs nothing else.
         let s = solve_accelerations(&mut cas, &eq.mass_upper, &eq.bias);
-        let points = sys.samples.iter().flat_map(|s| s.point);
+        let points: Vec<ExprId> = match &contact {
+            Some(c) if !c.frames.is_empty() => c.frames.clone(),
+            _ => sys.samples.iter().flat_map(|s| s.point).collect(),
+        };
         let outs: Vec<_> = s
             .qdd
             .into_iter()
@@ -107,20 +113,22 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
         let outs = constraint_outputs(&mut cas, &sys, &phi);
         cas.to_tape_hoisted(&outs, &mut hoist)
     };
-    let (contact, contact_jacobian, contact_jvp, contact_groups) = if sys.samples.is_empty() {
-        Default::default()
-    } else {
-        let c = contact_outputs(&mut cas, &sys);
-        let groups: Vec<usize> = c.groups.iter().map(|g| g.len() / c.width).collect();
-        (
-            cas.to_tape_hoisted(&c.points, &mut hoist),
-            c.groups
-                .iter()
-                .map(|g| cas.to_tape_hoisted(g, &mut hoist))
-                .collect(),
-            cas.to_tape_hoisted(&c.tangent, &mut hoist),
-            groups,
-        )
+    let (contact, contact_jacobian, contact_jvp, contact_groups, contact_frames) = match &contact {
+        None => Default::default(),
+        Some(c) => {
+            let groups: Vec<usize> = c.groups.iter().map(|g| g.len() / c.width).collect();
+            let points: Vec<ExprId> = c.points.iter().chain(&c.frames).copied().collect();
+            (
+                cas.to_tape_hoisted(&points, &mut hoist),
+                c.groups
+                    .iter()
+                    .map(|g| cas.to_tape_hoisted(g, &mut hoist))
+                    .collect(),
+                cas.to_tape_hoisted(&c.tangent, &mut hoist),
+                groups,
+                c.frames.len(),
+            )
+        }
     };
     let derived = hoist.finish(&mut cas);
     TapeSet {
@@ -135,6 +143,7 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
             blocks,
             contact_points: sys.samples.len(),
             contact_groups,
+            contact_frames,
         },
         mass_bias,
         outputs,
@@ -170,19 +179,22 @@ fn constraint_outputs(cas: &mut Cas, sys: &System, phi: &[ExprId]) -> Vec<ExprId
     outs
 }
 
-/// The contact kernels' outputs: the `Contact` kernel's (per point p), the
-/// `ContactJacobian` kernel's in groups (per point v = dp/dt, then
-/// J = dp/dq row by row) and the `ContactJvp` kernel's (per point dv and
-/// dJ along the direction dq, the `Dir` symbols the `Jvp` kernel reads
-/// first).
+/// The contact kernels' outputs: the `Contact` kernel's (per point p, then
+/// the contact frames), the `ContactJacobian` kernel's in groups (per point
+/// p, v = dp/dt, then J = dp/dq row by row) and the `ContactJvp` kernel's
+/// (per point dv and dJ along the direction dq, the `Dir` symbols the `Jvp`
+/// kernel reads first).
 struct ContactOutputs {
     points: Vec<ExprId>,
+    /// The contact frames of a serial chain (`tmt::contact_frames`), which
+    /// the groups read; empty where the groups start from the base.
+    frames: Vec<ExprId>,
     /// Consecutive points that depend on the same coordinates (an arm
     /// element's, a body's), at most 2 n groups: the runtime evaluates the
     /// groups of the points that touch, selected by `dir`.
     groups: Vec<Vec<ExprId>>,
     tangent: Vec<ExprId>,
-    /// Outputs per point in a group: 3 + 3 n.
+    /// Outputs per point in a group: 6 + 3 n.
     width: usize,
 }
 
@@ -202,7 +214,7 @@ fn contact_outputs(cas: &mut Cas, sys: &System) -> ContactOutputs {
         })
         .collect();
     let (mut points, mut tangent) = (Vec::new(), Vec::new());
-    // (coordinates the point depends on, its v and J)
+    // (coordinates the point depends on, its p, v and J)
     let mut per_point: Vec<(Vec<bool>, Vec<ExprId>)> = Vec::new();
     for p in sys.samples.iter().map(|s| &s.point) {
         let v = cas.kinematic_rates(p, &pairs);
@@ -217,26 +229,47 @@ fn contact_outputs(cas: &mut Cas, sys: &System) -> ContactOutputs {
             .map(|k| (0..3).any(|c| !cas.is_zero(jac[c * n + k])))
             .collect();
         points.extend(p);
-        per_point.push((depends, v.iter().chain(&jac).copied().collect()));
+        per_point.push((depends, p.iter().chain(&v).chain(&jac).copied().collect()));
         tangent.extend(dv.iter().chain(&djac));
     }
-    let mut groups: Vec<(Vec<bool>, Vec<ExprId>)> = Vec::new();
-    for (depends, outs) in per_point {
+    let mut groups: Vec<(PointGroup, Vec<ExprId>)> = Vec::new();
+    for (i, (depends, outs)) in per_point.into_iter().enumerate() {
         match groups.last_mut() {
-            Some((d, g)) if *d == depends => g.extend(outs),
-            _ => groups.push((depends, outs)),
+            Some((g, o)) if g.depends == depends => {
+                g.points.end = i + 1;
+                o.extend(outs);
+            }
+            _ => groups.push((
+                PointGroup {
+                    depends,
+                    points: i..i + 1,
+                },
+                outs,
+            )),
         }
     }
-    let mut groups: Vec<Vec<ExprId>> = groups.into_iter().map(|(_, g)| g).collect();
+    let width = 6 + 3 * n;
+    let (heads, flat): (Vec<PointGroup>, Vec<Vec<ExprId>>) = groups.into_iter().unzip();
+    if let Some(f) = contact_frames(cas, sys, &heads).filter(|f| f.groups.len() <= 2 * n) {
+        return ContactOutputs {
+            points,
+            frames: f.values,
+            groups: f.groups,
+            tangent,
+            width,
+        };
+    }
     // `dir` (2 n values) selects the groups: merge neighbours past that.
+    let mut groups = flat;
     let per = groups.len().div_ceil((2 * n).max(1));
     if per > 1 {
         groups = groups.chunks(per).map(|c| c.concat()).collect();
     }
     ContactOutputs {
         points,
+        frames: Vec::new(),
         groups,
         tangent,
-        width: 3 + 3 * n,
+        width,
     }
 }

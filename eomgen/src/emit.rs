@@ -134,6 +134,10 @@ impl<'a> KernelEmitter<'a> {
                 let k = k as usize;
                 quote!(p[#k])
             }
+            Op::Aux(k) => {
+                let k = k as usize;
+                quote!(aux[#k])
+            }
             Op::Time => quote!(t),
             _ => {
                 if self.chunk_of[i] == Some(c) {
@@ -288,8 +292,27 @@ impl<'a> KernelEmitter<'a> {
         }
     }
 
-    /// The kernel function `name` and its chunks.
-    fn emit(&self, name: &str, dof: usize, n_params: usize) -> TokenStream {
+    /// The length of the `aux` input this tape reads (0: none).
+    fn aux_len(&self) -> usize {
+        self.tape
+            .ops
+            .iter()
+            .filter_map(|op| match op {
+                Op::Aux(k) => Some(*k as usize + 1),
+                _ => None,
+            })
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// The kernel function `name` and its chunks; a tape that reads `aux`
+    /// takes it after `p`, `n_aux` values.
+    fn emit(&self, name: &str, dof: usize, n_params: usize, n_aux: usize) -> TokenStream {
+        assert!(self.aux_len() <= n_aux, "{name} reads past its aux input");
+        let (aux_param, aux_arg) = match self.aux_len() {
+            0 => (quote!(), quote!()),
+            _ => (quote!(aux: &[f64; #n_aux],), quote!(aux,)),
+        };
         let n_out = self.tape.outputs.len();
         let n_chunks = self.n_chunks().max(1);
         let n_spill = self.n_spill;
@@ -376,7 +399,7 @@ impl<'a> KernelEmitter<'a> {
                         .tape
                         .ops
                         .iter()
-                        .any(|op| matches!(op, Op::Time | Op::Qdd(_) | Op::Dir(_))),
+                        .any(|op| matches!(op, Op::Time | Op::Qdd(_) | Op::Dir(_) | Op::Aux(_))),
                     "lane kernels read q, qd and p"
                 );
                 let f = format_ident!("{}", name);
@@ -403,13 +426,13 @@ impl<'a> KernelEmitter<'a> {
                 #[allow(unused_variables, clippy::all)]
                 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
                 fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir],
-                      p: &[f64; #n_params], w: &mut [f64; #n_spill], out: &mut [f64; #n_out]) {
+                      p: &[f64; #n_params], #aux_param w: &mut [f64; #n_spill], out: &mut [f64; #n_out]) {
                     #(#body)*
                 }
             });
             calls.push(quote!(
                 // SAFETY: `require_fma` has checked that the processor has FMA.
-                unsafe { #f(t, q, qd, qdd, dir, p, w, out) };
+                unsafe { #f(t, q, qd, qdd, dir, p, #aux_arg w, out) };
             ));
         }
         let f = Ident::new(name, Span::call_site());
@@ -440,7 +463,7 @@ impl<'a> KernelEmitter<'a> {
         quote! {
             #[doc = #doc]
             #[allow(unused_unsafe)]
-            pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+            pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], #aux_param out: &mut [f64; #n_out]) {
                 runtime::cpu::require_fma();
                 #body
             }
@@ -483,13 +506,13 @@ fn emit_link_recursion(
         let name4 = format!("cell_{c}_x4");
         let name_t = format!("cell_{c}_tangent");
         let name_p = format!("cell_{c}_pose");
-        defs.push(KernelEmitter::new(pose).emit(&name_p, n, CELL_PARAMS));
+        defs.push(KernelEmitter::new(pose).emit(&name_p, n, CELL_PARAMS, 0));
         let fp = Ident::new(&name_p, Span::call_site());
-        defs.push(KernelEmitter::new(tape).emit(&name, n, CELL_PARAMS));
+        defs.push(KernelEmitter::new(tape).emit(&name, n, CELL_PARAMS, 0));
         if links.mass_bias {
-            defs.push(KernelEmitter::new_lanes(tape).emit(&name4, n, CELL_PARAMS));
+            defs.push(KernelEmitter::new_lanes(tape).emit(&name4, n, CELL_PARAMS, 0));
         }
-        defs.push(KernelEmitter::new(tangent).emit(&name_t, n, CELL_PARAMS));
+        defs.push(KernelEmitter::new(tangent).emit(&name_t, n, CELL_PARAMS, 0));
         let (f, f4, ft) = (
             Ident::new(&name, Span::call_site()),
             Ident::new(&name4, Span::call_site()),
@@ -572,8 +595,8 @@ fn emit_link_recursion(
     let n_outputs = runtime::N_OUTPUTS;
     let (forces, forces_tangent) = match (&links.forces, &links.forces_tangent) {
         (Some(tape), Some(tangent)) => {
-            defs.push(KernelEmitter::new(tape).emit("link_forces", dof, n_params));
-            defs.push(KernelEmitter::new(tangent).emit("link_forces_tangent", dof, n_params));
+            defs.push(KernelEmitter::new(tape).emit("link_forces", dof, n_params, 0));
+            defs.push(KernelEmitter::new(tangent).emit("link_forces_tangent", dof, n_params, 0));
             (
                 quote! {
                     link_forces(0.0, self.q, self.qd, &[0.0; #dof], &[0.0; #n_dir], self.p,
@@ -593,7 +616,7 @@ fn emit_link_recursion(
     };
     let energy = match &links.energy {
         Some(tape) => {
-            defs.push(KernelEmitter::new(tape).emit("link_energy", dof, n_params));
+            defs.push(KernelEmitter::new(tape).emit("link_energy", dof, n_params, 0));
             quote! {
                 let mut out = [0.0];
                 link_energy(0.0, self.q, self.qd, &[0.0; #dof], &[0.0; #n_dir], self.p, &mut out);
@@ -604,7 +627,7 @@ fn emit_link_recursion(
     };
     let loads = match &links.loads {
         Some(tape) => {
-            defs.push(KernelEmitter::new(tape).emit("link_loads", dof, n_params));
+            defs.push(KernelEmitter::new(tape).emit("link_loads", dof, n_params, 0));
             quote! {
                 link_loads(0.0, self.q, self.qd, &[0.0; #dof], &[0.0; #n_dir], self.p,
                            out.try_into().expect("load outputs"))
@@ -758,8 +781,8 @@ fn emit_parts(
             .expect("every part kernel is used");
         let (m, np) = (spec.coords.len(), spec.params.len());
         let (name, name_t) = (format!("part_{k}"), format!("part_{k}_tangent"));
-        defs.push(KernelEmitter::new(tape).emit(&name, m, np));
-        defs.push(KernelEmitter::new(tangent).emit(&name_t, m, np));
+        defs.push(KernelEmitter::new(tape).emit(&name, m, np, 0));
+        defs.push(KernelEmitter::new(tangent).emit(&name_t, m, np, 0));
         let (f, ft) = (
             Ident::new(&name, Span::call_site()),
             Ident::new(&name_t, Span::call_site()),
@@ -786,8 +809,8 @@ fn emit_parts(
         parts.offsets.as_ref().expect("an offsets kernel"),
     );
     let np = parts.layout.pose_coords.len();
-    defs.push(KernelEmitter::new(pose).emit("part_pose", np, n_params));
-    defs.push(KernelEmitter::new(offsets).emit("part_offsets", 0, n_params));
+    defs.push(KernelEmitter::new(pose).emit("part_pose", np, n_params, 0));
+    defs.push(KernelEmitter::new(offsets).emit("part_offsets", 0, n_params, 0));
     let np2 = 2 * np;
     let json = serde_json::to_string(&parts.layout).expect("a part layout serialises");
     let n_dir = 2 * dof;
@@ -940,31 +963,41 @@ impl Family {
 fn emit_groups(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream {
     let info = &tapes.info;
     let n_dir = 2 * dof;
-    let width = 3 + 3 * dof;
+    let width = 6 + 3 * dof;
     let n_out = info.contact_points * width;
+    let n_aux = info.contact_frames;
+    let aux_param = match n_aux {
+        0 => quote!(),
+        _ => quote!(aux: &[f64; #n_aux],),
+    };
     let mut kernels = Vec::new();
     let mut calls = Vec::new();
     let groups = info.contact_group_ranges();
     for (g, ((first, len), tape)) in groups.zip(&tapes.contact_jacobian).enumerate() {
         let name = format!("contact_jacobian_{g}");
-        kernels.push(KernelEmitter::new(tape).emit(&name, dof, n_params));
+        let emitter = KernelEmitter::new(tape);
+        kernels.push(emitter.emit(&name, dof, n_params, n_aux));
         let f = Ident::new(&name, Span::call_site());
         let (a, b) = (first * width, (first + len) * width);
+        let aux_arg = match emitter.aux_len() {
+            0 => quote!(),
+            _ => quote!(aux,),
+        };
         calls.push(quote! {
             if all || dir[#g] != 0.0 {
-                #f(t, q, qd, qdd, dir, p, (&mut out[#a..#b]).try_into().expect("group output length"));
+                #f(t, q, qd, qdd, dir, p, #aux_arg (&mut out[#a..#b]).try_into().expect("group output length"));
             }
         });
     }
     let doc = format!(
-        " Kernel `contact_jacobian`: the points' velocities and Jacobians in {} groups; group g runs when `all` or `dir[g] != 0`.",
+        " Kernel `contact_jacobian`: the points' positions, velocities and Jacobians in {} groups; group g runs when `all` or `dir[g] != 0`.",
         info.contact_groups.len()
     );
     quote! {
         #[doc = #doc]
         #[allow(unused_variables)]
         pub fn contact_jacobian(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir],
-                                all: bool, p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+                                all: bool, p: &[f64; #n_params], #aux_param out: &mut [f64; #n_out]) {
             #(#calls)*
         }
         #(#kernels)*
@@ -987,9 +1020,39 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
     let blocks = &info.blocks;
     let contact_points = info.contact_points;
     let contact_groups = &info.contact_groups;
+    let contact_frames = info.contact_frames;
+    let n_aux = contact_frames;
     let hash = &info.hash;
     let coords = &info.coordinates;
     let params = &info.parameters;
+    // The contact frames the groups read: given, or from the `contact`
+    // kernel (a caller that has not run `accel`).
+    let frames_fn = match n_aux {
+        0 => quote!(),
+        _ => {
+            let n_contact = 3 * contact_points + n_aux;
+            let first = 3 * contact_points;
+            quote! {
+                /// The `contact_jacobian` groups with the frames given, or else
+                /// from the `contact` kernel.
+                #[allow(clippy::too_many_arguments)]
+                fn contact_jacobian_framed(inp: &Inputs, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof],
+                          dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64]) {
+                    let out = out.try_into().expect("output length");
+                    let all = inp.dir.is_empty();
+                    match <&[f64; #n_aux]>::try_from(inp.aux) {
+                        Ok(aux) => contact_jacobian(inp.t, q, qd, qdd, dir, all, p, aux, out),
+                        Err(_) => {
+                            let mut own = [0.0f64; #n_contact];
+                            contact(inp.t, q, qd, qdd, dir, p, &mut own);
+                            let aux = own[#first..].try_into().expect("frames length");
+                            contact_jacobian(inp.t, q, qd, qdd, dir, all, p, aux, out)
+                        }
+                    }
+                }
+            }
+        }
+    };
     let mut kernels = Vec::new();
     let mut arms = Vec::new();
     for kind in KernelKind::ALL {
@@ -1008,18 +1071,24 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
             (_, KernelKind::ContactJacobian) => kernels.push(emit_groups(tapes, dof, n_params)),
             _ => {
                 let tape = &tapes.tapes(kind)[0];
-                kernels.push(KernelEmitter::new(tape).emit(name, dof, n_params))
+                kernels.push(KernelEmitter::new(tape).emit(name, dof, n_params, n_aux))
             }
         }
         let f = Ident::new(name, Span::call_site());
         let variant = Ident::new(&format!("{kind:?}"), Span::call_site());
-        // A grouped kernel reads an empty direction as "every group".
+        // A grouped kernel reads an empty direction as "every group", and
+        // the contact frames as `aux`.
         let all = match kind {
             KernelKind::ContactJacobian => quote!(inp.dir.is_empty(),),
             _ => quote!(),
         };
-        arms.push(quote! {
-            KernelKind::#variant => #f(inp.t, q, qd, qdd, dir, #all p, out.try_into().expect("output length")),
+        arms.push(match kind {
+            KernelKind::ContactJacobian if n_aux > 0 => quote! {
+                KernelKind::#variant => contact_jacobian_framed(inp, q, qd, qdd, dir, p, out),
+            },
+            _ => quote! {
+                KernelKind::#variant => #f(inp.t, q, qd, qdd, dir, #all p, out.try_into().expect("output length")),
+            },
         });
     }
     if let Some(parts) = &tapes.parts {
@@ -1057,6 +1126,8 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         pub const CONTACT_POINTS: usize = #contact_points;
         /// Points per group of the `contact_jacobian` kernel.
         pub const CONTACT_GROUPS: &[usize] = &[#(#contact_groups),*];
+        /// Length of the contact frames the `contact_jacobian` groups read.
+        pub const CONTACT_FRAMES: usize = #contact_frames;
 
         /// The compiled kernels of this structure.
         pub struct Compiled {
@@ -1077,6 +1148,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                         blocks: BLOCKS.to_vec(),
                         contact_points: CONTACT_POINTS,
                         contact_groups: CONTACT_GROUPS.to_vec(),
+                        contact_frames: CONTACT_FRAMES,
                     },
                 }
             }
@@ -1112,6 +1184,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
             }
         }
 
+        #frames_fn
         #(#kernels)*
     };
     let file: syn::File = syn::parse2(tokens).expect("emitted tokens parse as a Rust file");

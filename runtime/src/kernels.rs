@@ -38,14 +38,18 @@ use crate::tape::{Inputs, Tape};
 ///   acceleration level. Empty for a model without joints.
 /// * `Contact`: the contact points along the arms (and the bodies'
 ///   centres), `ModelInfo::contact_points` of them, each as its position
-///   p (3): the runtime finds the gaps. Empty without contact.
-/// * `ContactJacobian`: each point's velocity v (3) and dp/dq (3 x n,
-///   row-major), which the forces and their map J^T need. Split into
-///   groups of points that depend on the same coordinates
+///   p (3): the runtime finds the gaps; then the contact frames
+///   (`ModelInfo::contact_frames` values, none for most structures).
+///   Empty without contact.
+/// * `ContactJacobian`: each point's position p (3), velocity v (3) and
+///   dp/dq (3 x n, row-major), which the forces and their map J^T need.
+///   Split into groups of points that depend on the same coordinates
 ///   (`ModelInfo::contact_groups`, an arm's element or a body): group g is
 ///   evaluated only when `dir[g]` is non-zero (an empty `dir`: every
 ///   group), so a right-hand side where the tip presses evaluates the
-///   tip's group alone; the others' outputs are left as they were.
+///   tip's group alone; the others' outputs are left as they were. With
+///   contact frames, the groups read them as `aux` and start from their
+///   element's base frame instead of from the arm's base.
 /// * `ContactJvp`: the same points' dv and d(dp/dq) along the direction
 ///   dq (the first n of `dir`; 3 + 3 n values a point): the exact
 ///   Jacobian of the contact forces, column by column.
@@ -87,12 +91,12 @@ impl KernelKind {
             Self::Derived => info.derived,
             Self::Jvp => dof,
             Self::Constraints => info.constraints.len() * (dof + 2),
-            Self::Contact => info.contact_points * 3,
-            Self::ContactJacobian => info.contact_points * (3 + 3 * dof),
+            Self::Contact => info.contact_points * 3 + info.contact_frames,
+            Self::ContactJacobian => info.contact_points * (6 + 3 * dof),
             Self::ContactJvp => info.contact_points * (3 + 3 * dof),
             Self::Accel => {
                 if info.accel {
-                    2 * dof + dof * dof.saturating_sub(1) / 2 + 3 * info.contact_points
+                    2 * dof + dof * dof.saturating_sub(1) / 2 + info.accel_contact_len()
                 } else {
                     0
                 }
@@ -164,7 +168,20 @@ pub struct ModelInfo {
     /// `contact_points`; at most 2 n groups, so that `dir` can select them).
     #[serde(default)]
     pub contact_groups: Vec<usize>,
+    /// Length of the contact frames (0: none), which a serial chain's
+    /// contact kernels share (docs/design.md, "Contact along the arm"):
+    /// for each group its base frame's origin A, its last point B and the
+    /// centreline's length L between them (`CONTACT_BOUND` values a
+    /// group: every point of the group lies in the ellipsoid of foci A and
+    /// B and major axis L, the broad phase), then what the groups' kernels
+    /// read as `aux` (the frames' orientations, the coordinates' twists).
+    /// The `Accel` kernel gives them in place of the points.
+    #[serde(default)]
+    pub contact_frames: usize,
 }
+
+/// Values per group at the head of the contact frames: A (3), B (3), L.
+pub const CONTACT_BOUND: usize = 7;
 
 impl ModelInfo {
     pub fn dof(&self) -> usize {
@@ -174,6 +191,15 @@ impl ModelInfo {
     /// Length of the parameter vector the kernels read: base + derived.
     pub fn extended_params(&self) -> usize {
         self.parameters.len() + self.derived
+    }
+
+    /// What the `Accel` kernel gives after the L D L^T factors: the
+    /// contact frames where the chain has them, else every point.
+    pub fn accel_contact_len(&self) -> usize {
+        match self.contact_frames {
+            0 => 3 * self.contact_points,
+            n => n,
+        }
     }
 
     /// The `ContactJacobian` groups as (first point, points).
@@ -297,12 +323,26 @@ impl Kernels for Interpreted {
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
         let mut slots = self.scratch.borrow_mut();
         if kind == KernelKind::ContactJacobian {
-            let width = out.len() / self.tapes.info.contact_points.max(1);
-            let groups = self.tapes.info.contact_group_ranges();
+            let info = &self.tapes.info;
+            // The contact frames: given, or from the `Contact` kernel.
+            let mut own = Vec::new();
+            let inp = match (info.contact_frames, inp.aux.is_empty()) {
+                (0, _) | (_, false) => *inp,
+                _ => {
+                    own.resize(KernelKind::Contact.output_len(info), 0.0);
+                    self.tapes.contact.eval(inp, &mut slots, &mut own);
+                    Inputs {
+                        aux: &own[3 * info.contact_points..],
+                        ..*inp
+                    }
+                }
+            };
+            let width = out.len() / info.contact_points.max(1);
+            let groups = info.contact_group_ranges();
             for (g, ((first, len), tape)) in groups.zip(&self.tapes.contact_jacobian).enumerate() {
                 if inp.dir.is_empty() || inp.dir[g] != 0.0 {
                     tape.eval(
-                        inp,
+                        &inp,
                         &mut slots,
                         &mut out[first * width..(first + len) * width],
                     );

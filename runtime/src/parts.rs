@@ -230,6 +230,7 @@ impl Parts for TapeParts<'_> {
             qdd: &[],
             dir: &[],
             p,
+            aux: &[],
         };
         self.kernels.kernels[k].eval(&inp, &mut self.slots, out)
     }
@@ -251,6 +252,7 @@ impl Parts for TapeParts<'_> {
             qdd: &[],
             dir: &dir,
             p,
+            aux: &[],
         };
         self.kernels.tangents[k].eval(&inp, &mut self.slots, out)
     }
@@ -262,6 +264,7 @@ impl Parts for TapeParts<'_> {
             qdd: &[],
             dir: &[],
             p,
+            aux: &[],
         };
         let pose = self.kernels.pose.as_ref().expect("a pose kernel");
         pose.eval(&inp, &mut self.slots, out)
@@ -274,6 +277,7 @@ impl Parts for TapeParts<'_> {
             qdd: &[],
             dir: &[],
             p,
+            aux: &[],
         };
         let offsets = self.kernels.offsets.as_ref().expect("an offsets kernel");
         offsets.eval(&inp, &mut self.slots, out)

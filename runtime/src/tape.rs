@@ -33,6 +33,10 @@ pub enum Op {
     /// Runtime parameter `p[i]`.
     Param(u32),
     Time,
+    /// Value i of the kernel's `aux` input: what another kernel computed
+    /// for this one (the `Accel` kernel's contact frames, which the
+    /// `ContactJacobian` groups start from).
+    Aux(u32),
     Add(Slot, Slot),
     Sub(Slot, Slot),
     Mul(Slot, Slot),
@@ -77,6 +81,10 @@ pub struct Inputs<'a> {
     /// the others).
     pub dir: &'a [f64],
     pub p: &'a [f64],
+    /// Values another kernel computed for this one: the contact frames
+    /// (`ModelInfo::contact_frames`) the `ContactJacobian` groups read;
+    /// empty for the others.
+    pub aux: &'a [f64],
 }
 
 impl Op {
@@ -84,7 +92,14 @@ impl Op {
     pub fn is_leaf(&self) -> bool {
         matches!(
             self,
-            Op::Const(_) | Op::Q(_) | Op::Qd(_) | Op::Qdd(_) | Op::Dir(_) | Op::Param(_) | Op::Time
+            Op::Const(_)
+                | Op::Q(_)
+                | Op::Qd(_)
+                | Op::Qdd(_)
+                | Op::Dir(_)
+                | Op::Param(_)
+                | Op::Time
+                | Op::Aux(_)
         )
     }
 
@@ -115,7 +130,8 @@ impl Op {
             | Op::Qdd(_)
             | Op::Dir(_)
             | Op::Param(_)
-            | Op::Time => (0, [0; 3]),
+            | Op::Time
+            | Op::Aux(_) => (0, [0; 3]),
         };
         s.into_iter().take(n)
     }
@@ -152,7 +168,8 @@ impl Op {
             | Op::Qdd(_)
             | Op::Dir(_)
             | Op::Param(_)
-            | Op::Time) => leaf,
+            | Op::Time
+            | Op::Aux(_)) => leaf,
         }
     }
 }
@@ -216,6 +233,7 @@ impl Tape {
                 Op::Dir(i) => inp.dir[i as usize],
                 Op::Param(i) => inp.p[i as usize],
                 Op::Time => inp.t,
+                Op::Aux(i) => inp.aux[i as usize],
                 Op::Add(a, b) => s(a) + s(b),
                 Op::Sub(a, b) => s(a) - s(b),
                 Op::Mul(a, b) => s(a) * s(b),

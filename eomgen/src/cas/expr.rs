@@ -37,6 +37,8 @@ pub enum SymKind {
     Param(u32),
     /// Time t.
     Time,
+    /// Value i of the kernel's `aux` input (`runtime::Op::Aux`).
+    Aux(u32),
     /// A free symbol (tests, intermediate algebra).
     Free,
 }

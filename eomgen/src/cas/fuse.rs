@@ -78,6 +78,7 @@ mod tests {
             qdd: &[],
             dir: &[],
             p: &[],
+            aux: &[],
         };
         let mut out = vec![0.0; tape.outputs.len()];
         tape.eval(&inp, &mut Vec::new(), &mut out);

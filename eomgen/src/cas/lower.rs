@@ -125,6 +125,7 @@ fn key(op: &Op) -> (u8, u64, u64) {
         Op::Qd(i) => (2, u64::from(i), 0),
         Op::Qdd(i) => (23, u64::from(i), 0),
         Op::Dir(i) => (25, u64::from(i), 0),
+        Op::Aux(i) => (26, u64::from(i), 0),
         Op::Param(i) => (3, u64::from(i), 0),
         Op::Time => (4, 0, 0),
         Op::Add(a, b) => (5, u(a.min(b)), u(a.max(b))),
@@ -225,6 +226,7 @@ impl<'a> Lowerer<'a> {
                 SymKind::Time => self.push(Op::Time),
                 SymKind::Qdd(i) => self.push(Op::Qdd(i)),
                 SymKind::Dir(i) => self.push(Op::Dir(i)),
+                SymKind::Aux(i) => self.push(Op::Aux(i)),
                 k @ SymKind::Free => {
                     panic!(
                         "symbol {} ({k:?}) cannot be lowered",

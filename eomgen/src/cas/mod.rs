@@ -7,6 +7,7 @@
 //! * `lower`: CSE and linearisation into a runtime tape.
 //! * `fuse`: single-use products fused into the sums that read them.
 //! * `turning`: vectors turned by a moving frame, with their rates by w x u.
+//! * `substitute`: symbols replaced by expressions.
 
 mod canonical;
 mod diff;
@@ -15,6 +16,7 @@ mod expr;
 mod fuse;
 mod lower;
 mod reverse;
+mod substitute;
 #[cfg(test)]
 mod tests;
 mod turning;

@@ -520,7 +520,7 @@ proptest! {
         let tape = c.to_tape(&[e, d]);
         let mut out = [0.0; 2];
         let mut slots = Vec::new();
-        tape.eval(&Inputs { t: 0.0, q: &[x], qd: &[y], qdd: &[], dir: &[], p: &[z] }, &mut slots, &mut out);
+        tape.eval(&Inputs { t: 0.0, q: &[x], qd: &[y], qdd: &[], dir: &[], p: &[z], aux: &[] }, &mut slots, &mut out);
         for k in 0..2 {
             let (a, b) = (out[k], direct[k]);
             let sensitivity = (nudged[k] - b).abs();
@@ -544,9 +544,9 @@ proptest! {
         // p = [z, derived(z)...]: what Arm::new does.
         let mut p = vec![z; 1 + hoist.len()];
         let mut slots = Vec::new();
-        derived.eval(&Inputs { t: 0.0, q: &[], qd: &[], qdd: &[], dir: &[], p: &p.clone() }, &mut slots, &mut p[1..]);
+        derived.eval(&Inputs { t: 0.0, q: &[], qd: &[], qdd: &[], dir: &[], p: &p.clone(), aux: &[] }, &mut slots, &mut p[1..]);
         let mut out = [0.0; 2];
-        tape.eval(&Inputs { t: 0.0, q: &[x], qd: &[y], qdd: &[], dir: &[], p: &p }, &mut slots, &mut out);
+        tape.eval(&Inputs { t: 0.0, q: &[x], qd: &[y], qdd: &[], dir: &[], p: &p, aux: &[] }, &mut slots, &mut out);
         for k in 0..2 {
             let (a, b) = (out[k], direct[k]);
             prop_assert!(a == b || close(a, b, 1e-9) || (a.is_nan() && b.is_nan()) || !b.is_finite() || b.abs() > 1e12,

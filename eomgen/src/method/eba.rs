@@ -176,7 +176,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
                 cas.add(centre[i], a)
             });
             let point = bind3(cas, point);
-            samples.push(Sample { point, frame: quat });
+            samples.push(Sample::spatial(point, quat));
         }
         bodies.push(Body {
             mass: symbols.element(k, ElementParam::Mass),
@@ -256,10 +256,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         samples,
         bases: match structure.contact_points {
             0 => Vec::new(),
-            _ => vec![Sample {
-                point: p0,
-                frame: q0,
-            }],
+            _ => vec![Sample::spatial(p0, q0)],
         },
         planar: None,
     };

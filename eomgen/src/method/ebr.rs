@@ -39,7 +39,7 @@ impl ModellingMethod for Ebr {
             let (quarter, half) = (cas.scaled(0.25, el.l), cas.scaled(0.5, el.l));
             let half_m = cas.scaled(0.5, el.m);
             let f = arm.f;
-            arm.sample(cas, |cas, s| {
+            arm.sample(cas, None, |cas, s| {
                 if s <= 0.5 {
                     let d = cas.scaled(s, el.l);
                     return advance(cas, &f, d);

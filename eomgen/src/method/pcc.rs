@@ -24,7 +24,7 @@ impl ModellingMethod for Pcc {
     fn place_planar(&self, cas: &mut Cas, arm: &mut PlanarArm, _g: &SegmentShape, el: &Element2) {
         if arm.points > 0 {
             let points = arc_points(cas, arm.f, el.l, el.q, arm.points);
-            arm.sample_all(cas, points);
+            arm.sample_all(cas, Some(el.l), points);
         }
         let (c, chord_rate, arc_inertia, end) = pcc_element(cas, arm.f, el.l, el.m, el.q, el.qd);
         let total = cas.add(arc_inertia, el.inertia);
@@ -39,7 +39,17 @@ impl ModellingMethod for Pcc {
             let st = arm.strain_element(cas, g, s, &el);
             let strain = st.arc();
             let f = arm.f;
-            arm.sample(cas, |cas, s| {
+            // The centreline's length: |(len, shear y, shear z)|, constant
+            // strain.
+            let length = match strain.shear {
+                None => strain.len,
+                Some([y, z]) => {
+                    let sq = [strain.len, y, z].map(|c| cas.mul(c, c));
+                    let sum = cas.add_all(&sq);
+                    cas.sqrt(sum)
+                }
+            };
+            arm.sample(cas, Some(length), |cas, s| {
                 let part = strain.part(cas, s);
                 arc(cas, &f, &part).3
             });

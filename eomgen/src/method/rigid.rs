@@ -57,7 +57,7 @@ impl ModellingMethod for Rigid {
             Joints::Base => {
                 arm.f = planar::rotate(cas, arm.f, el.q, el.qd);
                 let f = arm.f;
-                arm.sample(cas, |cas, s| {
+                arm.sample(cas, None, |cas, s| {
                     let d = cas.scaled(s, l);
                     planar::advance(cas, f, d)
                 });
@@ -70,7 +70,7 @@ impl ModellingMethod for Rigid {
                 let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
                 let half_m = cas.scaled(0.5, m);
                 let f = arm.f;
-                arm.sample(cas, |cas, s| {
+                arm.sample(cas, None, |cas, s| {
                     if s <= 0.5 {
                         let d = cas.scaled(s, l);
                         return planar::advance(cas, f, d);
@@ -100,7 +100,7 @@ impl ModellingMethod for Rigid {
                 Joints::Base => {
                     arm.f = joint(cas, arm, g, s);
                     let f = arm.f;
-                    arm.sample(cas, |cas, s| {
+                    arm.sample(cas, None, |cas, s| {
                         let d = cas.scaled(s, l);
                         advance(cas, &f, d)
                     });
@@ -118,7 +118,7 @@ impl ModellingMethod for Rigid {
                     arm.advance(cas, half);
                     arm.f = joint(cas, arm, g, s);
                     let turned = arm.f;
-                    arm.sample(cas, |cas, s| {
+                    arm.sample(cas, None, |cas, s| {
                         let (from, d) = if s <= 0.5 {
                             (&f, s)
                         } else {

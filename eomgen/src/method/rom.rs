@@ -105,7 +105,7 @@ impl ModellingMethod for Rom {
             let [a, b] = [arcs[0], arcs[1]];
             let f = arm.f;
             let middle = arc(cas, &f, &a).3;
-            arm.sample(cas, |cas, s| match s <= 0.5 {
+            arm.sample(cas, None, |cas, s| match s <= 0.5 {
                 true => {
                     let part = a.part(cas, 2.0 * s);
                     arc(cas, &f, &part).3

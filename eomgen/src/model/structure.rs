@@ -12,7 +12,7 @@ use super::schema::{Axis, Joints, Method, Model, WrenchFrame};
 
 /// Bumped whenever derivation or emission changes what is generated, so
 /// that cached tapes and generated files are re-derived.
-pub const GENERATOR_VERSION: u32 = 70;
+pub const GENERATOR_VERSION: u32 = 74;
 
 /// The structural part of one segment.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]

@@ -79,10 +79,7 @@ pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -
         let spatial = b.spatial;
         for f in &body_frames {
             let sample = match spatial {
-                true => Sample {
-                    point: f.point,
-                    frame: f.quat,
-                },
+                true => Sample::spatial(f.point, f.quat),
                 false => Sample::planar(cas, f.point, f.angle),
             };
             b.samples.push(sample);

@@ -7,6 +7,7 @@ mod assembly;
 mod cell;
 mod cell_outputs;
 mod chain;
+pub(crate) mod contact_frames;
 mod inertia;
 pub(crate) mod planar;
 mod planar_cell;

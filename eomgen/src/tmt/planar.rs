@@ -189,24 +189,38 @@ impl<'a> PlanarArm<'a> {
     }
 
     /// Points along the element: `at(s)` is the centreline's frame at the
-    /// fraction s of the element, for s = 1/P, 2/P, ..., 1.
-    pub fn sample(&mut self, cas: &mut Cas, at: impl Fn(&mut Cas, f64) -> Frame) {
-        for j in 1..=self.points {
-            let f = at(cas, j as f64 / self.points as f64);
-            let point = [cas.bind(f.x), cas.bind(f.y), self.z];
-            let sample = Sample::planar(cas, point, f.phi);
-            self.samples.push(sample);
-        }
+    /// fraction s of the element, for s = 1/P, 2/P, ..., 1; `length` the
+    /// centreline's, where the method knows it.
+    pub fn sample(
+        &mut self,
+        cas: &mut Cas,
+        length: Option<ExprId>,
+        at: impl Fn(&mut Cas, f64) -> Frame,
+    ) {
+        let points: Vec<_> = (1..=self.points)
+            .map(|j| {
+                let f = at(cas, j as f64 / self.points as f64);
+                ([f.x, f.y], f.phi)
+            })
+            .collect();
+        self.sample_all(cas, length, points);
     }
 
     /// Points along the element given all at once (P of them, at s = 1/P,
     /// ..., 1, with the section's angle at each), by a method that shares
-    /// work between them.
-    pub fn sample_all(&mut self, cas: &mut Cas, points: Vec<([ExprId; 2], ExprId)>) {
+    /// work between them; `length` as for `sample`.
+    pub fn sample_all(
+        &mut self,
+        cas: &mut Cas,
+        length: Option<ExprId>,
+        points: Vec<([ExprId; 2], ExprId)>,
+    ) {
         debug_assert_eq!(points.len(), self.points);
-        for ([x, y], angle) in points {
+        let count = points.len() as f64;
+        for (j, ([x, y], angle)) in points.into_iter().enumerate() {
             let point = [cas.bind(x), cas.bind(y), self.z];
-            let sample = Sample::planar(cas, point, angle);
+            let arc = length.map(|l| cas.scaled((j + 1) as f64 / count, l));
+            let sample = Sample::planar(cas, point, angle).at_arc(arc);
             self.samples.push(sample);
         }
     }

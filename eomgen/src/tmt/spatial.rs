@@ -505,24 +505,27 @@ impl<'a> SpatialArm<'a> {
     }
 
     /// Points along the element: `at(s)` is the centreline's frame at the
-    /// fraction s of the element, for s = 1/P, 2/P, ..., 1.
-    pub fn sample(&mut self, cas: &mut Cas, at: impl Fn(&mut Cas, f64) -> Frame) {
+    /// fraction s of the element, for s = 1/P, 2/P, ..., 1; `length` the
+    /// centreline's, where the method knows it (a constant strain's).
+    pub fn sample(
+        &mut self,
+        cas: &mut Cas,
+        length: Option<ExprId>,
+        at: impl Fn(&mut Cas, f64) -> Frame,
+    ) {
         for j in 1..=self.points {
-            let f = at(cas, j as f64 / self.points as f64);
+            let s = j as f64 / self.points as f64;
+            let f = at(cas, s);
             let point = bind3(cas, f.p);
-            self.samples.push(Sample {
-                point,
-                frame: f.quat,
-            });
+            let arc = length.map(|l| cas.scaled(s, l));
+            self.samples
+                .push(Sample::spatial(point, f.quat).at_arc(arc));
         }
     }
 
     /// The shape's first point: the frame the arm starts from.
     pub fn base_pose(&self) -> Sample {
-        Sample {
-            point: self.f.p,
-            frame: self.f.quat,
-        }
+        Sample::spatial(self.f.p, self.f.quat)
     }
 
     /// Move the end frame by `d` along its axis.

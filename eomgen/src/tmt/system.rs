@@ -245,9 +245,25 @@ pub struct System {
 pub struct Sample {
     pub point: [ExprId; 3],
     pub frame: [ExprId; 4],
+    /// A planar frame's angle about z (None in 3D).
+    pub angle: Option<ExprId>,
+    /// The centreline's length from its element's start to this point,
+    /// where the method knows it (the contact frames' broad phase needs
+    /// it; None: that arm's contact takes the points from the base).
+    pub arc: Option<ExprId>,
 }
 
 impl Sample {
+    /// A 3D frame: at `point`, turned by the unit quaternion `frame`.
+    pub fn spatial(point: [ExprId; 3], frame: [ExprId; 4]) -> Self {
+        Self {
+            point,
+            frame,
+            angle: None,
+            arc: None,
+        }
+    }
+
     /// A planar arm's frame: turned by `angle` about z.
     pub fn planar(cas: &mut Cas, point: [ExprId; 3], angle: ExprId) -> Self {
         let half = cas.scaled(0.5, angle);
@@ -255,7 +271,14 @@ impl Sample {
         Self {
             point,
             frame: [cas.cos(half), zero, zero, cas.sin(half)],
+            angle: Some(angle),
+            arc: None,
         }
+    }
+
+    /// The same frame, `arc` along its element's centreline.
+    pub fn at_arc(self, arc: Option<ExprId>) -> Self {
+        Self { arc, ..self }
     }
 }
 

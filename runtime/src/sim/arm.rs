@@ -73,7 +73,10 @@ pub trait Dynamics {
     /// controller's input held over a step, without rebuilding the rest.
     fn set_drive_signal(&mut self, k: usize, signal: crate::signal::Signal);
     /// A kernel along a direction `dir` (2n: dq, then dqd), as the `Jvp`
-    /// and `ContactJvp` kernels read it.
+    /// and `ContactJvp` kernels read it (the `ContactJacobian` kernel: the
+    /// groups to evaluate), reading `aux` (the contact frames for
+    /// `ContactJacobian`; else empty).
+    #[allow(clippy::too_many_arguments)]
     fn eval_direction(
         &self,
         kind: KernelKind,
@@ -81,6 +84,7 @@ pub trait Dynamics {
         q: &[f64],
         qd: &[f64],
         dir: &[f64],
+        aux: &[f64],
         out: &mut [f64],
     );
     /// The obstacles and pairs this system touches (none by default).
@@ -182,6 +186,7 @@ impl<K: Kernels> Arm<K> {
                 qdd: &[],
                 dir: &[],
                 p,
+                aux: &[],
             };
             self.kernels.eval(kind, &inp, &mut packed);
         });
@@ -203,6 +208,7 @@ fn derived_params<K: Kernels + ?Sized>(kernels: &K, base: &[f64]) -> Vec<f64> {
         qdd: &[],
         dir: &[],
         p: &extended,
+        aux: &[],
     };
     kernels.eval(KernelKind::Derived, &inp, &mut derived);
     derived
@@ -264,6 +270,7 @@ impl<K: Kernels> Dynamics for Arm<K> {
                 qdd: &[],
                 dir: &[],
                 p,
+                aux: &[],
             };
             self.kernels.eval(kind, &inp, out);
         });
@@ -281,6 +288,7 @@ impl<K: Kernels> Dynamics for Arm<K> {
                 qdd: &[],
                 dir: &[],
                 p,
+                aux: &[],
             };
             solved = self.kernels.accelerations(&inp, qdd);
         });
@@ -300,6 +308,7 @@ impl<K: Kernels> Dynamics for Arm<K> {
                     qdd,
                     dir: &dir,
                     p,
+                    aux: &[],
                 };
                 self.kernels.eval(KernelKind::Jvp, &inp, &mut col);
                 dir[j] = 0.0;
@@ -318,6 +327,7 @@ impl<K: Kernels> Dynamics for Arm<K> {
         q: &[f64],
         qd: &[f64],
         dir: &[f64],
+        aux: &[f64],
         out: &mut [f64],
     ) {
         self.with_params(t, |p| {
@@ -328,6 +338,7 @@ impl<K: Kernels> Dynamics for Arm<K> {
                 qdd: &[],
                 dir,
                 p,
+                aux,
             };
             self.kernels.eval(kind, &inp, out);
         });
@@ -495,8 +506,47 @@ pub fn accelerations<D: Dynamics + ?Sized>(
 }
 
 /// Solve L D L^T x = b in place, L unit lower triangular given below its
-/// diagonal row by row (the `Accel` kernel's layout).
+/// diagonal row by row (the `Accel` kernel's layout). Sizes the `Accel`
+/// kernel has (up to 24) run with the size a constant: loops of known
+/// length unroll, where loops of every length 1 to n - 1 would each
+/// mispredict their exit (most of the cost at n = 10).
 fn solve_unit_ldl(lower: &[f64], pivots: &[f64], b: &mut [f64]) {
+    macro_rules! fixed {
+        ($($n:literal)*) => {
+            match b.len() {
+                $($n => {
+                    let b: &mut [f64; $n] = b.try_into().expect("length matched");
+                    return solve_unit_ldl_n::<$n>(lower, pivots, b);
+                })*
+                _ => {}
+            }
+        };
+    }
+    fixed!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24);
+    solve_unit_ldl_any(lower, pivots, b);
+}
+
+fn solve_unit_ldl_n<const N: usize>(lower: &[f64], pivots: &[f64], b: &mut [f64; N]) {
+    let lower = &lower[..N * N.saturating_sub(1) / 2];
+    // L z = b by columns: one column's updates are independent.
+    for j in 0..N {
+        let zj = b[j];
+        for i in j + 1..N {
+            b[i] -= lower[i * (i - 1) / 2 + j] * zj;
+        }
+    }
+    for (x, p) in b.iter_mut().zip(&pivots[..N]) {
+        *x /= p;
+    }
+    for i in (1..N).rev() {
+        let xi = b[i];
+        for j in 0..i {
+            b[j] -= lower[i * (i - 1) / 2 + j] * xi;
+        }
+    }
+}
+
+fn solve_unit_ldl_any(lower: &[f64], pivots: &[f64], b: &mut [f64]) {
     let n = b.len();
     for i in 1..n {
         let row = &lower[i * (i - 1) / 2..][..i];

@@ -62,7 +62,7 @@ pub fn rows<D: Dynamics + ?Sized>(
     let mut tangent = vec![0.0; KernelKind::ContactJvp.output_len(d.info())];
     let mut dir = vec![0.0; 2 * n];
     dir[..n].copy_from_slice(qd);
-    d.eval_direction(KernelKind::ContactJvp, t, q, qd, &dir, &mut tangent);
+    d.eval_direction(KernelKind::ContactJvp, t, q, qd, &dir, &[], &mut tangent);
     let width = 3 + 3 * n;
     // J, J' qd of a point, and the other side's (zero for an obstacle).
     let point = |i: usize| -> (Vec<[f64; 3]>, [f64; 3]) {

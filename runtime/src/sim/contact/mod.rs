@@ -19,7 +19,7 @@ use std::cell::RefCell;
 use num_dual::{Dual64, DualNum};
 
 use crate::arm::Dynamics;
-use crate::kernels::KernelKind;
+use crate::kernels::{CONTACT_BOUND, KernelKind};
 use crate::signal::Signal;
 
 pub use geometry::Shape;
@@ -299,18 +299,27 @@ impl ContactSet {
     }
 }
 
-/// The points at one state: the `Contact` kernel's positions, and the
-/// `ContactJacobian` kernel's velocities and dp/dq for the groups of points
-/// asked for (`velocities_of`): a right-hand side where nothing touches
-/// needs none, one where the tip presses the tip's group alone.
+/// The points at one state: the `Contact` kernel's positions (or, on the
+/// hot path of a chain with contact frames, none of them: the `Accel`
+/// kernel's frames instead), and the `ContactJacobian` kernel's positions,
+/// velocities and dp/dq for the groups of points asked for
+/// (`velocities_of`): a right-hand side where nothing touches needs none,
+/// one where the tip presses the tip's group alone.
 #[derive(Debug)]
 pub struct PointKinematics {
     n: usize,
+    /// Every point's position (3 each), when `all_positions`.
     buf: Vec<f64>,
+    all_positions: bool,
+    /// The contact frames (`ModelInfo::contact_frames`; empty: none).
+    frames: Vec<f64>,
+    /// The groups' outputs, per point p (3), v (3), dp/dq (3 x n).
     jac: Vec<f64>,
     /// Each point's `ContactJacobian` group.
     group_of: Vec<usize>,
-    /// Whether a group's velocities and dp/dq are in `jac` at this state.
+    /// The first point and count of each group.
+    ranges: Vec<(usize, usize)>,
+    /// Whether a group's outputs are in `jac` at this state.
     have: Vec<bool>,
     /// The groups to evaluate, as the kernel's `dir` reads them.
     mask: Vec<f64>,
@@ -319,50 +328,67 @@ pub struct PointKinematics {
 impl PointKinematics {
     /// The positions of every point.
     pub fn eval<D: Dynamics + ?Sized>(d: &D, t: f64, q: &[f64], qd: &[f64]) -> Self {
-        let info = d.info();
-        let mut group_of = Vec::with_capacity(info.contact_points);
-        for (g, (_, len)) in info.contact_group_ranges().enumerate() {
-            group_of.extend(std::iter::repeat_n(g, len));
-        }
-        let groups = info.contact_groups.len();
-        let mut k = Self {
-            n: q.len(),
-            buf: Vec::new(),
-            jac: vec![0.0; KernelKind::ContactJacobian.output_len(info)],
-            group_of,
-            have: vec![false; groups],
-            mask: vec![0.0; 2 * q.len()],
-        };
+        let mut k = Self::empty(d, q.len());
         k.update(d, t, q, qd);
         k
     }
 
-    /// Re-evaluate the positions into the same buffers; the velocities
-    /// and Jacobian are dropped.
+    fn empty<D: Dynamics + ?Sized>(d: &D, n: usize) -> Self {
+        let info = d.info();
+        let ranges: Vec<(usize, usize)> = info.contact_group_ranges().collect();
+        let mut group_of = Vec::with_capacity(info.contact_points);
+        for (g, &(_, len)) in ranges.iter().enumerate() {
+            group_of.extend(std::iter::repeat_n(g, len));
+        }
+        Self {
+            n,
+            buf: Vec::new(),
+            all_positions: false,
+            frames: vec![0.0; info.contact_frames],
+            jac: vec![0.0; KernelKind::ContactJacobian.output_len(info)],
+            group_of,
+            have: vec![false; ranges.len()],
+            ranges,
+            mask: vec![0.0; 2 * n],
+        }
+    }
+
+    /// Re-evaluate the positions into the same buffers; the groups'
+    /// outputs are dropped.
     pub fn update<D: Dynamics + ?Sized>(&mut self, d: &D, t: f64, q: &[f64], qd: &[f64]) {
         self.update_from(d, t, q, qd, None);
     }
 
-    /// `update`, with the positions given (as another kernel computed
-    /// them) or else evaluated.
+    /// `update`, from what the `Accel` kernel gives after its factors (the
+    /// contact frames, or where the chain has none the positions), or
+    /// else from the `Contact` kernel (every position, then the frames).
     fn update_from<D: Dynamics + ?Sized>(
         &mut self,
         d: &D,
         t: f64,
         q: &[f64],
         qd: &[f64],
-        positions: Option<&[f64]>,
+        accel: Option<&[f64]>,
     ) {
         self.n = q.len();
-        match positions {
+        let info = d.info();
+        match accel {
+            Some(f) if info.contact_frames > 0 => {
+                self.frames.copy_from_slice(f);
+                self.all_positions = false;
+            }
             Some(p) => {
                 self.buf.clear();
                 self.buf.extend_from_slice(p);
+                self.all_positions = true;
             }
             None => {
-                self.buf
-                    .resize(KernelKind::Contact.output_len(d.info()), 0.0);
+                self.buf.resize(KernelKind::Contact.output_len(info), 0.0);
                 d.eval_kernel(KernelKind::Contact, t, q, qd, &mut self.buf);
+                let points = 3 * info.contact_points;
+                self.frames.copy_from_slice(&self.buf[points..]);
+                self.buf.truncate(points);
+                self.all_positions = true;
             }
         }
         self.have.fill(false);
@@ -389,10 +415,24 @@ impl PointKinematics {
         qd: &[f64],
         points: impl IntoIterator<Item = usize>,
     ) {
+        // Moved out while `groups` borrows the rest (no copy).
+        let group_of = std::mem::take(&mut self.group_of);
+        self.groups(d, t, q, qd, points.into_iter().map(|i| group_of[i]));
+        self.group_of = group_of;
+    }
+
+    /// Evaluate `groups` (each once): positions, velocities and dp/dq.
+    pub fn groups<D: Dynamics + ?Sized>(
+        &mut self,
+        d: &D,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        groups: impl IntoIterator<Item = usize>,
+    ) {
         self.mask.fill(0.0);
         let mut any = false;
-        for i in points {
-            let g = self.group_of[i];
+        for g in groups {
             if !self.have[g] {
                 self.have[g] = true;
                 self.mask[g] = 1.0;
@@ -406,6 +446,7 @@ impl PointKinematics {
                 q,
                 qd,
                 &self.mask,
+                &self.frames,
                 &mut self.jac,
             );
         }
@@ -421,10 +462,41 @@ impl PointKinematics {
         self.have[self.group_of[i]]
     }
 
+    /// The points whose positions are there.
+    fn known_points(&self) -> impl Iterator<Item = usize> + '_ {
+        let all = self.all_positions;
+        self.ranges
+            .iter()
+            .zip(&self.have)
+            .filter(move |&(_, &have)| all || have)
+            .flat_map(|(&(first, len), _)| first..first + len)
+    }
+
+    /// Whether point i's position is there (every point's, unless the
+    /// state came from the contact frames: then its group's).
+    pub fn has_position(&self, i: usize) -> bool {
+        self.all_positions || self.has_velocity(i)
+    }
+
     #[inline]
     pub fn position(&self, i: usize) -> [f64; 3] {
-        let b = &self.buf[3 * i..];
+        // Where every position is known, from there (the gaps were found
+        // from them); else from the point's group.
+        let b = match self.all_positions {
+            true => &self.buf[3 * i..],
+            false => {
+                debug_assert!(
+                    self.has_velocity(i),
+                    "point {i}'s position was not evaluated"
+                );
+                &self.jac[i * self.width()..]
+            }
+        };
         [b[0], b[1], b[2]]
+    }
+
+    fn width(&self) -> usize {
+        6 + 3 * self.n
     }
 
     /// (after `velocities` or `velocities_of` point i)
@@ -433,7 +505,7 @@ impl PointKinematics {
             self.has_velocity(i),
             "point {i}'s velocity was not evaluated"
         );
-        let b = &self.jac[i * (3 + 3 * self.n)..];
+        let b = &self.jac[i * self.width() + 3..];
         [b[0], b[1], b[2]]
     }
 
@@ -443,7 +515,7 @@ impl PointKinematics {
             self.has_velocity(i),
             "point {i}'s Jacobian was not evaluated"
         );
-        let start = i * (3 + 3 * self.n) + 3 + c * self.n;
+        let start = i * self.width() + 6 + c * self.n;
         &self.jac[start..start + self.n]
     }
 }
@@ -454,6 +526,20 @@ struct Scratch {
     points: Option<PointKinematics>,
     /// The pairs that penetrate.
     touching: Vec<usize>,
+    broad: BroadPhase,
+}
+
+/// The broad phase's buffers.
+#[derive(Debug, Default)]
+struct BroadPhase {
+    /// The groups it keeps.
+    groups: Vec<usize>,
+    /// Each group's largest radius.
+    radius: Vec<f64>,
+    /// The planes now: normal n and level n.x.
+    planes: Vec<([f64; 3], f64)>,
+    /// The other obstacles and their displacements now.
+    others: Vec<(usize, [f64; 3])>,
 }
 
 /// A pair's state: gap, normal force, total force on the point (normal
@@ -598,6 +684,74 @@ fn pair_forces_into<D: Dynamics + ?Sized>(
     }
 }
 
+/// The groups whose points may touch something, into `out`, from the
+/// contact frames' bounds (`Shape::clears`): the hot path of a chain with
+/// frames, where no point's position is known before its group runs. A
+/// group may touch an obstacle unless its ellipsoid clears it by the
+/// points' largest radius; two groups (self contact) unless their spheres
+/// do.
+fn broad_phase(set: &ContactSet, k: &PointKinematics, t: f64, s: &mut BroadPhase) {
+    s.groups.clear();
+    let groups = k.ranges.len();
+    if s.radius.len() != groups {
+        s.radius = k
+            .ranges
+            .iter()
+            .map(|&(first, len)| {
+                set.points[first..first + len]
+                    .iter()
+                    .fold(0.0, |r: f64, p| r.max(p.radius))
+            })
+            .collect();
+    }
+    // Planes as n.x = level now; the other shapes with their offsets.
+    s.planes.clear();
+    s.others.clear();
+    for (i, o) in set.obstacles.iter().enumerate() {
+        let offset = o.motion.as_ref().map_or([0.0; 3], |m| m.at(t).0);
+        match &o.shape {
+            Shape::Plane { point, normal } => s.planes.push((
+                *normal,
+                geometry::dot(*normal, *point) + geometry::dot(*normal, offset),
+            )),
+            _ => s.others.push((i, offset)),
+        }
+    }
+    let bounds = k.frames[..CONTACT_BOUND * groups].chunks_exact(CONTACT_BOUND);
+    for (g, (b, &r)) in bounds.zip(&s.radius).enumerate() {
+        let (a, e, l) = ([b[0], b[1], b[2]], [b[3], b[4], b[5]], b[6]);
+        // Rounding of the frames' own arithmetic, far below any radius.
+        let margin = r + 1e-9 * l.abs();
+        let near = s
+            .planes
+            .iter()
+            .any(|&(n, level)| !geometry::plane_clears(n, level, a, e, l, margin))
+            || s.others
+                .iter()
+                .any(|&(i, offset)| !set.obstacles[i].shape.clears(offset, a, e, l, margin));
+        if near {
+            s.groups.push(g);
+        }
+    }
+    if set.pairs.len() > set.points.len() * set.obstacles.len() {
+        let sphere = |g: usize| {
+            let b = &k.frames[CONTACT_BOUND * g..];
+            let m = [0, 1, 2].map(|i| 0.5 * (b[i] + b[3 + i]));
+            (m, 0.5 * b[6].abs() + s.radius[g] + 1e-9 * b[6].abs())
+        };
+        for g in 0..groups {
+            let (m, r) = sphere(g);
+            for h in g + 1..groups {
+                let (n, rh) = sphere(h);
+                let between: f64 = (0..3).map(|i| (m[i] - n[i]).powi(2)).sum();
+                if between <= (r + rh).powi(2) {
+                    s.groups.extend([g, h]);
+                }
+            }
+        }
+    }
+}
+
 /// The pairs that penetrate, in order, into `out`: every right-hand side
 /// asks, so a fixed plane (every point against it, the common obstacle)
 /// is one tight loop over the points, the other pairs one by one. The
@@ -608,21 +762,28 @@ fn penetrating(set: &ContactSet, k: &PointKinematics, t: f64, out: &mut Vec<usiz
     for (ko, o) in set.obstacles.iter().enumerate() {
         if let (Shape::Plane { point, normal }, None) = (&o.shape, &o.motion) {
             let c = point[0] * normal[0] + point[1] * normal[1] + point[2] * normal[2];
-            for (i, (p, pt)) in k.buf.chunks_exact(3).zip(&set.points).enumerate() {
-                if p[0] * normal[0] + p[1] * normal[1] + p[2] * normal[2] - pt.radius < c {
-                    out.push(i * no + ko);
+            if k.all_positions {
+                for (i, (p, pt)) in k.buf.chunks_exact(3).zip(&set.points).enumerate() {
+                    if p[0] * normal[0] + p[1] * normal[1] + p[2] * normal[2] - pt.radius < c {
+                        out.push(i * no + ko);
+                    }
                 }
+                continue;
             }
-        } else {
-            for i in 0..set.points.len() {
-                if gap_of(set, &set.pairs[i * no + ko], k, t) < 0.0 {
-                    out.push(i * no + ko);
-                }
+        }
+        for i in k.known_points() {
+            if gap_of(set, &set.pairs[i * no + ko], k, t) < 0.0 {
+                out.push(i * no + ko);
             }
         }
     }
     let first = set.points.len() * no;
-    out.extend((first..set.pairs.len()).filter(|&i| gap_of(set, &set.pairs[i], k, t) < 0.0));
+    out.extend((first..set.pairs.len()).filter(|&i| {
+        let pair = &set.pairs[i];
+        k.has_position(pair.point)
+            && pair.other_point().is_none_or(|j| k.has_position(j))
+            && gap_of(set, pair, k, t) < 0.0
+    }));
     if no > 1 {
         out.sort_unstable();
     }
@@ -716,13 +877,19 @@ pub fn generalised_force_at<D: Dynamics + ?Sized>(
     // Not re-entered: nothing below evaluates contact forces.
     let mut guard = set.scratch.borrow_mut();
     let s = &mut *guard;
-    let k = match &mut s.points {
-        Some(k) => {
-            k.update_from(d, t, q, qd, positions);
-            k
+    let k = s
+        .points
+        .get_or_insert_with(|| PointKinematics::empty(d, q.len()));
+    k.update_from(d, t, q, qd, positions);
+    // From the contact frames: the elements that may touch, and their
+    // points alone.
+    if !k.all_positions {
+        broad_phase(set, k, t, &mut s.broad);
+        if s.broad.groups.is_empty() {
+            return false;
         }
-        None => s.points.insert(PointKinematics::eval(d, t, q, qd)),
-    };
+        k.groups(d, t, q, qd, s.broad.groups.iter().copied());
+    }
     // Most right-hand sides touch nothing: a gap check and out.
     penetrating(set, k, t, &mut s.touching);
     if s.touching.is_empty() {
@@ -789,7 +956,7 @@ pub fn subtract_from_jacobian<D: Dynamics + ?Sized>(
         if along_q {
             let mut dir = vec![0.0; 2 * n];
             dir[j] = 1.0;
-            d.eval_direction(KernelKind::ContactJvp, t, q, qd, &dir, &mut tangent);
+            d.eval_direction(KernelKind::ContactJvp, t, q, qd, &dir, &[], &mut tangent);
         }
         col.fill(0.0);
         for &i in &active {
