@@ -480,16 +480,13 @@ impl PointKinematics {
 
     #[inline]
     pub fn position(&self, i: usize) -> [f64; 3] {
-        // Where every position is known, from there (the gaps were found
-        // from them); else from the point's group.
-        let b = match self.all_positions {
-            true => &self.buf[3 * i..],
+        // From the point's group where it ran (its position, velocity and
+        // dp/dq from one evaluation), else from every point's.
+        let b = match self.has_velocity(i) {
+            true => &self.jac[i * self.width()..],
             false => {
-                debug_assert!(
-                    self.has_velocity(i),
-                    "point {i}'s position was not evaluated"
-                );
-                &self.jac[i * self.width()..]
+                debug_assert!(self.all_positions, "point {i}'s position was not evaluated");
+                &self.buf[3 * i..]
             }
         };
         [b[0], b[1], b[2]]
