@@ -1,9 +1,12 @@
 //! Contact along the whole arm (docs/design.md section 8): the generated
-//! `Contact` kernel gives every sampled point's position, velocity and
-//! Jacobian; here each pair (a point and an obstacle, two points of the
-//! arms, a point and a body) gets its gap, its normal and friction forces
-//! from its law, and the forces reach the equations as the generalised
-//! force Q_c = sum J^T f (virtual work), subtracted from h.
+//! `Contact` kernel gives every sampled point's position (and a chain's
+//! contact frames), the `ContactJacobian` groups their positions,
+//! velocities and Jacobians; here each pair (a point and an obstacle, two
+//! points of the arms, a point and a body) gets its gap, its normal and
+//! friction forces from its law, and the forces reach the equations as
+//! the generalised force Q_c = sum J^T f (virtual work), subtracted from
+//! h. On the hot path of a chain with contact frames no point is computed
+//! before the broad phase has kept its element.
 //!
 //! Invariant: contact is a force on the right-hand side, never a change of
 //! the generated kernels; an obstacle or a law changes without a rebuild.
@@ -856,16 +859,17 @@ pub fn subtract_from_bias<D: Dynamics + ?Sized>(
 }
 
 /// Q_c at (t, q, qd) into `q_force`; false (`q_force` then not Q_c) when
-/// no pair pushes. `positions`: the points' positions when the caller has
-/// them (the `Accel` kernel gives them), else the `Contact` kernel's. The
-/// hot path: buffers are reused, and the velocities and Jacobians of the
-/// points of the pairs that penetrate are evaluated, no others.
+/// no pair pushes. `accel`: what the `Accel` kernel gives after its
+/// factors when the caller has it (the contact frames, or the points'
+/// positions), else the `Contact` kernel runs. The hot path: buffers are
+/// reused; with frames, the groups the broad phase keeps are evaluated,
+/// else the groups of the points that penetrate, no others.
 pub fn generalised_force_at<D: Dynamics + ?Sized>(
     d: &D,
     t: f64,
     q: &[f64],
     qd: &[f64],
-    positions: Option<&[f64]>,
+    accel: Option<&[f64]>,
     q_force: &mut [f64],
 ) -> bool {
     let Some(set) = d.contact() else {
@@ -877,7 +881,7 @@ pub fn generalised_force_at<D: Dynamics + ?Sized>(
     let k = s
         .points
         .get_or_insert_with(|| PointKinematics::empty(d, q.len()));
-    k.update_from(d, t, q, qd, positions);
+    k.update_from(d, t, q, qd, accel);
     // From the contact frames: the elements that may touch, and their
     // points alone.
     if !k.all_positions {
