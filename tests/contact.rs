@@ -862,6 +862,35 @@ points_per_element = 3
     )
 }
 
+/// A planar vc arm of two segments (one arc each, lengths 0.4 and 0.2 m).
+fn two_vc_segments() -> String {
+    let segment = |length: f64| {
+        format!(
+            "[[segment]]\nmethod = \"vc\"\nlength = {length}\nelements = 1\nmass = 0.1\nbending_stiffness = 0.5\n"
+        )
+    };
+    format!(
+        r#"
+name = "vc2"
+gravity = [0.0, -9.81, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+{}{}
+[[obstacle]]
+name = "floor"
+shape = "plane"
+point = [0.0, -10.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+[contact]
+model = "hertz"
+stiffness = 1.0
+points_per_element = 3
+"#,
+        segment(0.4),
+        segment(0.2)
+    )
+}
+
 /// The contact frames the kernel reads: the `Accel` kernel's where the
 /// model has one (the hot path), else the `Contact` kernel's.
 fn contact_frames(arm: &dyn runtime::Dynamics, q: &[f64], qd: &[f64]) -> Vec<f64> {
@@ -881,8 +910,8 @@ fn contact_frames(arm: &dyn runtime::Dynamics, q: &[f64], qd: &[f64]) -> Vec<f64
 /// the base: they must place every point where the flat kinematics (the
 /// `Contact` kernel, the whole chain's expressions) does, with dp/dq the
 /// central differences of those positions and v their rate along qd. For
-/// finger_tap (planar), wrap (3D) and 3D arms with twist, stretch and
-/// shear.
+/// finger_tap and wrap (planar pcc), a planar vc arm of two segments and
+/// 3D pcc arms with twist, and with stretch and shear.
 #[test]
 fn the_contact_frames_place_the_points_as_the_flat_kinematics_does() {
     use runtime::KernelKind;
@@ -898,6 +927,10 @@ fn the_contact_frames_place_the_points_as_the_flat_kinematics_does() {
             load("wrap", &[], BackendChoice::Compiled, None).unwrap(),
         ),
         ("3D twist", load_text(dir.path(), &hanging_pcc(""), &[])),
+        (
+            "vc, two segments",
+            load_text(dir.path(), &two_vc_segments(), &[]),
+        ),
         (
             "3D stretch and shear",
             load_text(
