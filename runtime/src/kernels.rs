@@ -19,9 +19,11 @@ use crate::tape::{Inputs, Tape};
 /// * `Accel`: qdd = -M^-1 h (n values), the pivots D of M = L D L^T
 ///   (n values, all positive when M is positive definite), L below its
 ///   unit diagonal row by row (n (n - 1) / 2 values), then the contact
-///   points' positions as `Contact` gives them (3 per point): the mass
-///   solve generated as straight-line code, with what a contact force
-///   found after it needs (the gaps, and L D L^T to solve for it).
+///   frames as `Contact` gives them (`ModelInfo::contact_frames`), or
+///   where the chain has none the points' positions (3 per point): the
+///   mass solve generated as straight-line code, with what a contact
+///   force found after it needs (the broad phase or the gaps, and
+///   L D L^T to solve for it).
 ///   Present only when `ModelInfo::accel` (small arms); otherwise the
 ///   runtime solves `MassBias` output.
 /// * `Jvp`: the directional derivative of the inverse dynamics
