@@ -783,11 +783,12 @@ points_per_element = 3
 
 /// finger_tap is finger_free with a table: above the table their
 /// right-hand sides agree (the generated solve that carries the contact
-/// points changes nothing), and pressed into it finger_tap's is the
+/// frames changes nothing), and pressed into it finger_tap's is the
 /// dense solve of M qdd = Q_c - h, with Q_c found from the `Contact`
 /// kernel's points and M, h from `MassBias` (a second path through the
-/// contact forces and the mass solve: the hot path takes the points from
-/// the `Accel` kernel and solves by its L D L^T factors).
+/// contact forces and the mass solve: the hot path takes the frames from
+/// the `Accel` kernel, keeps the elements near the table and solves by
+/// its L D L^T factors).
 #[test]
 fn finger_tap_is_finger_free_until_it_touches() {
     use softarm::backend::{BackendChoice, load};
