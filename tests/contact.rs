@@ -1001,6 +1001,28 @@ fn the_contact_frames_place_the_points_as_the_flat_kinematics_does() {
     }
 }
 
+/// Q_c by the hot path from the contact frames (the broad phase, then the
+/// groups it keeps) and from every point's position (the `Contact`
+/// kernel): whether they push must agree, and Q_c to 1e-9. True if they
+/// push.
+fn both_routes_agree(arm: &dyn runtime::Dynamics, q: &[f64], qd: &[f64], what: &str) -> bool {
+    use runtime::contact::generalised_force_at;
+    let n = q.len();
+    let frames = contact_frames(arm, q, qd);
+    let (mut from_frames, mut from_points) = (vec![0.0; n], vec![0.0; n]);
+    let a = generalised_force_at(arm, 0.0, q, qd, Some(&frames), &mut from_frames);
+    let b = generalised_force_at(arm, 0.0, q, qd, None, &mut from_points);
+    assert_eq!(a, b, "{what}: pushes");
+    if a {
+        let scale = from_points.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
+        for j in 0..n {
+            let what = format!("{what} Q_c[{j}]");
+            assert_close(from_frames[j], from_points[j], 1e-9, scale, &what);
+        }
+    }
+    a
+}
+
 /// The broad phase of the contact frames skips an element only when its
 /// points cannot touch: with an obstacle put at random close to the arm
 /// (planes, spheres, capped cylinders and boxes, some deep in it, some
@@ -1011,7 +1033,7 @@ fn the_contact_frames_place_the_points_as_the_flat_kinematics_does() {
 #[test]
 fn the_broad_phase_misses_no_contact() {
     use runtime::KernelKind;
-    use runtime::contact::{Shape, generalised_force_at};
+    use runtime::contact::Shape;
     use softarm::backend::{BackendChoice, load};
     let mut rng = Rng::new(5);
     for name in ["finger_tap", "wrap"] {
@@ -1107,18 +1129,9 @@ fn the_broad_phase_misses_no_contact() {
             let mut set = base_set.clone();
             set.obstacles[0].shape = shape.clone();
             l.arm.set_contact(Some(set));
-            let frames = contact_frames(&*l.arm, &q, &qd);
-            let (mut from_frames, mut from_points) = (vec![0.0; n], vec![0.0; n]);
-            let a = generalised_force_at(&*l.arm, 0.0, &q, &qd, Some(&frames), &mut from_frames);
-            let b = generalised_force_at(&*l.arm, 0.0, &q, &qd, None, &mut from_points);
-            assert_eq!(a, b, "{name} trial {trial} ({shape:?}): pushes");
-            if a {
+            let what = format!("{name} trial {trial} ({shape:?})");
+            if both_routes_agree(&*l.arm, &q, &qd, &what) {
                 pushed += 1;
-                let scale = from_points.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
-                for j in 0..n {
-                    let what = format!("{name} trial {trial} ({shape:?}) Q_c[{j}]");
-                    assert_close(from_frames[j], from_points[j], 1e-9, scale, &what);
-                }
             }
             // How many elements the broad phase could skip: those whose
             // points are all clear of the obstacle.
@@ -1148,7 +1161,7 @@ fn the_broad_phase_misses_no_contact() {
 /// the frames equals Q_c from every point's position, 2000 shapes.
 #[test]
 fn the_broad_phase_between_elements_misses_no_contact() {
-    use runtime::contact::{Shape, generalised_force_at};
+    use runtime::contact::Shape;
     use softarm::backend::{BackendChoice, load};
     let sets = [eomgen::model::Override::parse("contact.self_contact=true").unwrap()];
     let mut l = load("finger_tap", &sets, BackendChoice::Compiled, None).unwrap();
@@ -1168,18 +1181,8 @@ fn the_broad_phase_between_elements_misses_no_contact() {
     for trial in 0..2000 {
         let q = rng.vec(n, -2.5, 2.5);
         let qd = rng.vec(n, -1.0, 1.0);
-        let frames = contact_frames(&*l.arm, &q, &qd);
-        let (mut from_frames, mut from_points) = (vec![0.0; n], vec![0.0; n]);
-        let a = generalised_force_at(&*l.arm, 0.0, &q, &qd, Some(&frames), &mut from_frames);
-        let b = generalised_force_at(&*l.arm, 0.0, &q, &qd, None, &mut from_points);
-        assert_eq!(a, b, "trial {trial}: pushes");
-        if a {
+        if both_routes_agree(&*l.arm, &q, &qd, &format!("trial {trial}")) {
             pushed += 1;
-            let scale = from_points.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
-            for j in 0..n {
-                let what = format!("trial {trial} Q_c[{j}]");
-                assert_close(from_frames[j], from_points[j], 1e-9, scale, &what);
-            }
         }
     }
     assert!(pushed > 500, "{pushed} of 2000 shapes touch themselves");

@@ -425,7 +425,7 @@ impl PointKinematics {
     }
 
     /// Evaluate `groups` (each once): positions, velocities and dp/dq.
-    pub fn groups<D: Dynamics + ?Sized>(
+    fn groups<D: Dynamics + ?Sized>(
         &mut self,
         d: &D,
         t: f64,
