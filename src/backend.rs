@@ -35,7 +35,7 @@ pub enum CacheStatus {
     Hit,
     Miss,
     /// Compiled link cells of another model's, linked to this chain's
-    /// layout (`runtime::links::LinkedKernels`): no tape needed.
+    /// layout (`runtime::linked::LinkedKernels`): no tape needed.
     Linked,
 }
 
@@ -115,7 +115,7 @@ fn linked(structure: &Structure) -> Option<(Box<dyn Kernels>, f64)> {
                 .copied()
         })
         .collect::<Option<Vec<_>>>()?;
-    let kernels = runtime::links::LinkedKernels::new(info, links, cells);
+    let kernels = runtime::linked::LinkedKernels::new(info, links, cells);
     Some((Box::new(kernels), start.elapsed().as_secs_f64()))
 }
 

@@ -170,12 +170,13 @@ pub struct Controls {
 }
 
 impl Controls {
-    /// The channels `names` of a loaded model, or an error naming the one
-    /// that drives nothing and the channels that exist.
-    pub fn new(loaded: &crate::backend::Loaded, names: &[String]) -> Result<Self> {
-        let structure = eomgen::model::Structure::of(&loaded.model);
+    /// The channels `names` of a model (its data files relative to
+    /// `base_dir`), or an error naming the one that drives nothing and the
+    /// channels that exist.
+    pub fn new(model: &Model, base_dir: &Path, names: &[String]) -> Result<Self> {
+        let structure = eomgen::model::Structure::of(model);
         let layout = ParamLayout::of(&structure);
-        let labels = labelled_drives(&loaded.model, &layout, &loaded.base_dir)?;
+        let labels = labelled_drives(model, &layout, base_dir)?;
         let mut drives = Vec::new();
         for (i, name) in names.iter().enumerate() {
             let of: Vec<_> = (labels.iter().enumerate())
@@ -185,7 +186,7 @@ impl Controls {
                 })
                 .collect();
             if of.is_empty() {
-                let known: Vec<&String> = loaded.model.inputs.keys().collect();
+                let known: Vec<&String> = model.inputs.keys().collect();
                 anyhow::bail!(
                     "inputs: no channel {name:?} drives this model; its channels are {known:?}"
                 );

@@ -45,7 +45,8 @@ pub fn linearize(
     u0: Option<&[f64]>,
     q0: Option<&[f64]>,
 ) -> Result<Linearization> {
-    let controls = Controls::new(loaded, inputs).map_err(|e| anyhow!("{}: {e}", loaded.origin))?;
+    let controls = Controls::new(&loaded.model, &loaded.base_dir, inputs)
+        .map_err(|e| anyhow!("{}: {e}", loaded.origin))?;
     let m = inputs.len();
     let u0 = match u0 {
         Some(u) if u.len() != m => bail!("u0 has {} values for {m} inputs", u.len()),

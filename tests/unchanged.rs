@@ -3,11 +3,11 @@
 //! the right-hand side's Jacobian (applied to a fixed vector) at fixed
 //! states, in both backends; the static solution; and a 1 s trajectory.
 //!
-//! The fixtures in `tests/fixtures/` were recorded before the issue-18
-//! redesign (typed parameters, one home per method, runtime in two layers)
-//! from the code of commit e697e9d, and are the reference that the redesign
-//! changes no behaviour: values agree to 1e-13 of each vector's largest
-//! entry. Re-record only for an intended change of the physics, with
+//! The fixtures in `tests/fixtures/` (the bundled models) and
+//! `tests/fixtures/variants/` (variants that exercise what the bundled
+//! models do not) are the reference that a refactoring changes no
+//! behaviour: values agree to 1e-13 of each vector's largest entry.
+//! Re-record only for an intended change of the physics, with
 //! `SOFTARM_RECORD_FIXTURES=1 cargo test --test unchanged`, and say why in
 //! the commit.
 
@@ -258,6 +258,27 @@ fn every_bundled_model_computes_what_its_fixture_recorded() {
         "behaviour changed:\n{}",
         failures.join("\n")
     );
+    // Every fixture is of a bundled model: a fixture left behind by a
+    // removed model would silently test nothing.
+    let recorded = std::fs::read_dir(root().join("tests").join("fixtures")).unwrap();
+    for e in recorded {
+        let e = e.unwrap();
+        if e.file_type().unwrap().is_dir() {
+            continue;
+        }
+        let name = e.file_name().to_string_lossy().into_owned();
+        let stem = name.trim_end_matches(".json");
+        assert!(
+            MODELS.iter().any(|m| m.name == stem),
+            "tests/fixtures/{name} belongs to no bundled model"
+        );
+    }
+}
+
+#[test]
+fn every_variant_computes_what_its_fixture_recorded() {
+    let recording = std::env::var_os("SOFTARM_RECORD_FIXTURES").is_some();
+    let mut failures = Vec::new();
     for (name, file, methods) in VARIANTS {
         let segment = if file.ends_with(".toml") { 1 } else { 0 };
         for method in *methods {
@@ -277,19 +298,9 @@ fn every_bundled_model_computes_what_its_fixture_recorded() {
             failures.truncate(before + 20);
         }
     }
-    // Every fixture is of a bundled model: a fixture left behind by a
-    // removed model would silently test nothing.
-    let recorded = std::fs::read_dir(root().join("tests").join("fixtures")).unwrap();
-    for e in recorded {
-        let e = e.unwrap();
-        if e.file_type().unwrap().is_dir() {
-            continue;
-        }
-        let name = e.file_name().to_string_lossy().into_owned();
-        let stem = name.trim_end_matches(".json");
-        assert!(
-            MODELS.iter().any(|m| m.name == stem),
-            "tests/fixtures/{name} belongs to no bundled model"
-        );
-    }
+    assert!(
+        failures.is_empty(),
+        "behaviour changed:\n{}",
+        failures.join("\n")
+    );
 }

@@ -19,7 +19,7 @@ pub fn derive(model: &Model) -> TapeSet {
 /// The link recursion's layout and kernels of a structure, with the model
 /// info that goes with them, and none of the flat kernels: all that a 3D
 /// chain of compiled-in link shapes needs to run on linked compiled cells
-/// (`runtime::links::LinkedKernels`), derived in milliseconds at any
+/// (`runtime::linked::LinkedKernels`), derived in milliseconds at any
 /// element count. `None` where the recursion does not give every kernel:
 /// planar and short chains, assemblies, contact.
 pub fn derive_links(structure: &Structure) -> Option<(ModelInfo, runtime::links::LinkKernels)> {

@@ -487,7 +487,7 @@ fn emit_link_recursion(
     let mut defs = Vec::new();
     let (mut ones, mut fours, mut tangents, mut poses) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    // The cells other structures may link (`runtime::links::LinkedKernels`):
+    // The cells other structures may link (`runtime::linked::LinkedKernels`):
     // 3D chains', whose every kernel the recursion gives.
     let (mut linked, mut registry) = (Vec::new(), Vec::new());
     for (c, ((tape, tangent), pose)) in links

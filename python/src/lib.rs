@@ -296,7 +296,8 @@ impl Model {
             };
             let names: Vec<String> = inputs.iter().map(|(n, ..)| n.clone()).collect();
             let controls =
-                softarm::inputs::Controls::new(&copy.loaded, &names).map_err(value_error)?;
+                softarm::inputs::Controls::new(&copy.loaded.model, &copy.loaded.base_dir, &names)
+                    .map_err(value_error)?;
             for (i, (name, t, v)) in inputs.into_iter().enumerate() {
                 let table = runtime::signal::Table::new(t, v)
                     .map_err(|e| PyValueError::new_err(format!("inputs[{name:?}]: {e}")))?;

@@ -43,7 +43,8 @@ impl Simulator {
         }
         let opts = softarm::run::options(&req, &loaded.model.simulate).map_err(value_error)?;
         let (x0, _) = softarm::run::initial_state(&req, &mut loaded).map_err(value_error)?;
-        let controls = Controls::new(&loaded, &inputs).map_err(value_error)?;
+        let controls =
+            Controls::new(&loaded.model, &loaded.base_dir, &inputs).map_err(value_error)?;
         let mut sim = Self {
             loaded,
             opts,

@@ -417,6 +417,6 @@ pub struct CompiledModel {
     pub source: &'static str,
     pub kernels: fn() -> Box<dyn Kernels>,
     /// Its link cells, which chains of the same link shapes and other
-    /// lengths link (`links::LinkedKernels`).
+    /// lengths link (`linked::LinkedKernels`).
     pub cells: &'static [crate::links::CompiledCell],
 }

@@ -17,6 +17,7 @@ pub mod cpu;
 pub mod kernels;
 pub mod lanes;
 pub mod linalg;
+pub mod linked;
 pub mod links;
 pub mod parts;
 pub mod rodrigues;

@@ -3,7 +3,7 @@
 //! (a body of its own six coordinates) and the beam springs between
 //! neighbours (twelve). M and h are the parts' blocks scattered and
 //! summed; no frames are composed (that is the link recursion's case,
-//! `crate::links`). Identical parts share one kernel, so generated code
+//! `links`). Identical parts share one kernel, so generated code
 //! grows with the kinds of parts, not with their number.
 
 use serde::{Deserialize, Serialize};

@@ -32,18 +32,19 @@ pub enum Solver {
     Auto,
 }
 
-/// Every solver with its name, in the order `--solver` lists them.
-const TABLE: [(Solver, &str); 10] = [
-    (Solver::Dopri5, "dopri5"),
-    (Solver::Bs23, "bs23"),
-    (Solver::Dop853, "dop853"),
-    (Solver::Rk4, "rk4"),
-    (Solver::Euler, "euler"),
-    (Solver::Radau5, "radau5"),
-    (Solver::Bdf, "bdf"),
-    (Solver::Trbdf2, "trbdf2"),
-    (Solver::Esdirk, "esdirk"),
-    (Solver::Auto, "auto"),
+/// Every solver with its name and the order of its global error (bdf's
+/// highest; auto's dopri5's), in the order `--solver` lists them.
+const TABLE: [(Solver, &str, u32); 10] = [
+    (Solver::Dopri5, "dopri5", 5),
+    (Solver::Bs23, "bs23", 3),
+    (Solver::Dop853, "dop853", 8),
+    (Solver::Rk4, "rk4", 4),
+    (Solver::Euler, "euler", 1),
+    (Solver::Radau5, "radau5", 5),
+    (Solver::Bdf, "bdf", 5),
+    (Solver::Trbdf2, "trbdf2", 2),
+    (Solver::Esdirk, "esdirk", 3),
+    (Solver::Auto, "auto", 5),
 ];
 
 impl Solver {
@@ -58,19 +59,39 @@ impl Solver {
         names
     };
 
+    /// Every solver, in the table's order.
+    pub const ALL: [Solver; TABLE.len()] = {
+        let mut all = [Solver::Auto; TABLE.len()];
+        let mut i = 0;
+        while i < TABLE.len() {
+            all[i] = TABLE[i].0;
+            i += 1;
+        }
+        all
+    };
+
     pub fn parse(s: &str) -> Option<Self> {
         TABLE
             .iter()
-            .find(|(_, n)| *n == s)
-            .map(|(solver, _)| *solver)
+            .find(|(_, n, _)| *n == s)
+            .map(|(solver, _, _)| *solver)
+    }
+
+    fn row(self) -> &'static (Solver, &'static str, u32) {
+        TABLE
+            .iter()
+            .find(|(solver, _, _)| *solver == self)
+            .expect("every solver is in the table")
     }
 
     pub fn name(self) -> &'static str {
-        TABLE
-            .iter()
-            .find(|(solver, _)| *solver == self)
-            .map(|(_, n)| *n)
-            .expect("every solver is in the table")
+        self.row().1
+    }
+
+    /// The order of the method's global error: halving a fixed step
+    /// divides it by 2^order.
+    pub fn order(self) -> u32 {
+        self.row().2
     }
 
     /// Fixed-step methods (no error estimate: `dt` sets the step).

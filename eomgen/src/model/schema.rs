@@ -44,11 +44,11 @@ pub struct Model {
     /// Several arms (`[[arm]]`), rigid bodies and joints: an assembly
     /// (`model::assembly`).
     #[serde(default, rename = "arm")]
-    pub arms: Vec<super::assembly::ArmDecl>,
+    pub arms: Vec<ArmDecl>,
     #[serde(default, rename = "body")]
-    pub bodies: Vec<super::assembly::BodyDecl>,
+    pub bodies: Vec<BodyDecl>,
     #[serde(default, rename = "joint")]
-    pub joints: Vec<super::assembly::JointDecl>,
+    pub joints: Vec<JointDecl>,
     /// The default contact law and the arms' sampling.
     #[serde(default)]
     pub contact: Option<super::contact::ContactDecl>,
@@ -577,10 +577,10 @@ pub struct Tip {
     #[serde(default)]
     pub wrench_frame: Option<WrenchFrame>,
     /// The wrench is a load cell's reading, in its frame: how its axes sit
-    /// on the tip (`super::sensor`). Implies a wrench that turns with the
+    /// on the tip (`model::sensor`). Implies a wrench that turns with the
     /// tip.
     #[serde(default)]
-    pub sensor_rotation: Option<super::sensor::SensorRotation>,
+    pub sensor_rotation: Option<SensorRotation>,
     /// Where the load cell's origin sits, in the tip frame (m): the force
     /// acts there. Structural (its moment about the tip point).
     #[serde(default)]
@@ -594,6 +594,145 @@ pub enum WrenchFrame {
     World,
     Tip,
 }
+
+/// How the sensor's axes sit on the tip.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum SensorRotation {
+    /// A rotation matrix R, v_tip = R v_sensor: its columns are the
+    /// sensor's x, y, z axes in the tip frame.
+    Matrix([[f64; 3]; 3]),
+    /// A unit quaternion [w, x, y, z] turning the tip frame onto the
+    /// sensor's.
+    Quaternion([f64; 4]),
+    /// The tip axis each sensor axis points along, e.g. `["z", "y", "-x"]`:
+    /// the sensor's x is the tip's z, its y the tip's y, its z the tip's -x.
+    Axes([String; 3]),
+}
+
+// The keys of an assembly: `[[arm]]`, `[[body]]`, `[[joint]]`
+// (`model::assembly` gives them their meaning).
+/// `[[arm]]`: one arm of several, keyed as a single-arm file keys its
+/// top-level `[base]`, `[[segment]]` and `[tip]`.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ArmDecl {
+    pub name: String,
+    pub base: Base,
+    #[serde(rename = "segment")]
+    pub segments: Vec<Segment>,
+    #[serde(default)]
+    pub tip: Tip,
+}
+
+/// The shape of a rigid body, for its default inertia.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
+#[serde(rename_all = "lowercase")]
+pub enum BodyShape {
+    /// `radius`.
+    Sphere,
+    /// `radius` and `length`, its axis along the body's x.
+    Cylinder,
+    /// `size = [x, y, z]`.
+    Box,
+}
+
+/// `[[body]]`: a rigid body, free (x, y and its angle in the plane) or
+/// fixed where it is declared.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BodyDecl {
+    pub name: String,
+    pub shape: BodyShape,
+    #[serde(default)]
+    pub radius: Option<f64>,
+    #[serde(default)]
+    pub length: Option<f64>,
+    #[serde(default)]
+    pub size: Option<[f64; 3]>,
+    /// kg; or `density` (kg/m^3) times the shape's volume.
+    #[serde(default)]
+    pub mass: Option<f64>,
+    #[serde(default)]
+    pub density: Option<f64>,
+    /// Planar: the moment of inertia about the body's centre, normal to
+    /// the plane (kg m^2); default from the shape.
+    #[serde(default)]
+    pub inertia: Option<f64>,
+    /// 3D: the principal moments about the body's x, y, z axes through its
+    /// centre (kg m^2); default from the shape.
+    #[serde(default)]
+    pub principal_inertia: Option<[f64; 3]>,
+    /// Initial position of the centre (m).
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Initial angle of the body's frame from the world's (rad, planar).
+    #[serde(default)]
+    pub angle: f64,
+    /// 3D: initial orientation of the body's frame, a quaternion (w, x, y,
+    /// z; any non-zero length, normalised).
+    #[serde(default)]
+    pub orientation: Option<[f64; 4]>,
+    /// Free (its own coordinates) or fixed where declared. Structural.
+    #[serde(default = "yes")]
+    pub free: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// What a joint holds.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
+#[serde(rename_all = "lowercase")]
+pub enum JointKind {
+    /// Position and orientation: the two frames move as one.
+    Weld,
+    /// Position only: a revolute joint in the plane, a ball-and-socket in
+    /// 3D.
+    Pin,
+}
+
+impl JointKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Weld => "weld",
+            Self::Pin => "pin",
+        }
+    }
+}
+
+/// `[[joint]]`: frame `a`'s point at `offset_a` held to frame `b`'s at
+/// `offset_b` (offsets in each frame's own axes); a weld also holds b's
+/// angle at a's plus `angle`.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct JointDecl {
+    pub name: String,
+    pub kind: JointKind,
+    pub a: String,
+    pub b: String,
+    #[serde(default)]
+    pub offset_a: [f64; 3],
+    #[serde(default)]
+    pub offset_b: [f64; 3],
+    #[serde(default)]
+    pub angle: f64,
+    /// 3D weld: b's frame is a's turned by this quaternion (w, x, y, z; any
+    /// non-zero length, normalised); default none.
+    #[serde(default)]
+    pub orientation: Option<[f64; 4]>,
+    /// An inactive joint is checked and then left out (structural): cut it
+    /// with `--set joint.NAME.active=false`.
+    #[serde(default = "active")]
+    pub active: bool,
+}
+
+fn active() -> bool {
+    true
+}
+
+/// A frame a joint names. Arms and bodies by their index in the model.
 
 #[cfg(test)]
 mod tests {

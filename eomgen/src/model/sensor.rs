@@ -15,25 +15,9 @@
 //! (constants) or to the channels that drive them (a weighted sum of
 //! signals, `wrench_sources`).
 
-use serde::{Deserialize, Serialize};
-
 use super::error::ModelError;
+pub use super::schema::SensorRotation;
 use super::schema::{Model, Tip};
-
-/// How the sensor's axes sit on the tip.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(untagged)]
-pub enum SensorRotation {
-    /// A rotation matrix R, v_tip = R v_sensor: its columns are the
-    /// sensor's x, y, z axes in the tip frame.
-    Matrix([[f64; 3]; 3]),
-    /// A unit quaternion [w, x, y, z] turning the tip frame onto the
-    /// sensor's.
-    Quaternion([f64; 4]),
-    /// The tip axis each sensor axis points along, e.g. `["z", "y", "-x"]`:
-    /// the sensor's x is the tip's z, its y the tip's y, its z the tip's -x.
-    Axes([String; 3]),
-}
 
 impl SensorRotation {
     /// R (v_tip = R v_sensor), or what is wrong with it.

@@ -24,11 +24,11 @@ use serde::{Deserialize, Serialize};
 use crate::rows;
 
 mod articulated;
-mod linked;
+mod compiled;
 mod outputs;
 mod tangent;
 pub use articulated::accelerations_owned;
-pub use linked::{CellFn, CellLanesFn, CellTangentFn, CompiledCell, LinkedKernels};
+pub use compiled::{CellFn, CellLanesFn, CellTangentFn, CompiledCell};
 pub use outputs::outputs;
 pub use tangent::inverse_dynamics_tangent;
 

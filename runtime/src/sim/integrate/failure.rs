@@ -6,7 +6,8 @@ use differential_equations::prelude::*;
 
 use super::ode::ArmOde;
 use super::options::SimOptions;
-use super::record::{Recorded, SimStats, Trajectory};
+use super::outcome::{SimStats, Trajectory};
+use super::record::Recorded;
 use super::state::StateVec;
 use crate::arm::Dynamics;
 

@@ -10,47 +10,45 @@
 //! array `[f64; P]` with P the next size of [`IMPLICIT_SIZES`]; the extra
 //! components are inert (x' = 0, zero Jacobian rows) and cost no accuracy.
 //!
-//! One concern a file: [`options`] (what a run is
-//! asked, with the CLI's defaults), `dispatch` (solver to run), `auto` (the
-//! stiffness switch), `record` (samples, events, counts), `failure` (the
-//! explained failure), `ode` (the arm as x' = f(t, x)); beside them the
-//! in-house steppers `bs23`, `radau5`, `trbdf2` on `stepper`, and
+//! One concern a file: [`options`] (what a run is asked, with the CLI's
+//! defaults), `methods` (one file per integration method behind one trait,
+//! and the table from solver to method), `drivers` (how a method is fed
+//! through the recorder), `record` (samples, events, counts), `outcome`
+//! (what a run gives back), `failure` (the explained failure), `ode` (the
+//! arm as x' = f(t, x)), [`stepper`] (the interface of our own steppers),
 //! [`events`] (zero crossings); `projected` (joints held) and `touch`
-//! (legs between contact switches) run those in legs. The solver names
-//! are `crate::solver`'s.
+//! (legs between contact switches) run the methods in legs. The solver
+//! names are `crate::solver`'s.
 
-mod auto;
-pub mod bs23;
-mod dispatch;
+mod drivers;
 pub mod events;
 mod failure;
+mod methods;
 mod ode;
 pub mod options;
+mod outcome;
 mod projected;
-pub mod radau5;
 mod record;
 pub mod state;
 pub mod stepper;
 mod touch;
-pub mod trbdf2;
 
 pub use crate::solver::Solver;
-pub use dispatch::IMPLICIT_SIZES;
+pub use drivers::IMPLICIT_SIZES;
 pub use failure::SimFailure;
+pub use methods::{bs23, radau5, trbdf2};
 pub use options::{DEFAULT_SAMPLES, DEFAULT_T_END, INTERRUPTED, Interrupt, SimOptions};
-pub use projected::ConstraintStats;
-pub use record::{
-    AUTO_CHECK_STEPS, ContactMeter, MeterSample, SimStats, SolverSwitch, SwitchRecord, Trajectory,
+pub use outcome::{
+    ConstraintStats, ContactMeter, MeterSample, SimStats, SolverSwitch, SwitchRecord, Trajectory,
 };
+pub use record::AUTO_CHECK_STEPS;
 pub use state::StateVec;
-
-use std::cell::RefCell;
 
 use crate::arm::Dynamics;
 
 /// Integrate from x0 = [q0, qd0] over [0, t_end].
-pub fn simulate<D: Dynamics + ?Sized>(
-    arm: &D,
+pub fn simulate(
+    arm: &dyn Dynamics,
     x0: Vec<f64>,
     opts: &SimOptions,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
@@ -71,15 +69,8 @@ pub fn simulate<D: Dynamics + ?Sized>(
             state: x0,
             trajectory: Trajectory::default(),
             stats: SimStats {
-                solver: opts.solver,
-                steps: 0,
-                rejected_steps: 0,
                 rhs_evaluations: 1,
-                jacobian_evaluations: 0,
-                wall_s: 0.0,
-                switched: None,
-                constraints: None,
-                contact: None,
+                ..SimStats::none(opts.solver)
             },
         }));
     }
@@ -96,8 +87,8 @@ pub fn simulate<D: Dynamics + ?Sized>(
 
 /// From (t0, x0) to `opts.t_end` or a terminal event: with the joints
 /// held (`projected`) or by the solver alone.
-fn run_leg<D: Dynamics + ?Sized>(
-    arm: &D,
+fn run_leg(
+    arm: &dyn Dynamics,
     t0: f64,
     x0: Vec<f64>,
     opts: &SimOptions,
@@ -109,16 +100,11 @@ fn run_leg<D: Dynamics + ?Sized>(
 }
 
 /// Integrate from (t0, x0) to `opts.t_end` by the chosen solver.
-fn run_from<D: Dynamics + ?Sized>(
-    arm: &D,
+fn run_from(
+    arm: &dyn Dynamics,
     t0: f64,
     x0: Vec<f64>,
     opts: &SimOptions,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
-    match opts.solver {
-        Solver::Auto => auto::run_auto(arm, t0, x0, opts),
-        Solver::Bs23 => dispatch::run_own(arm, t0, x0, opts, bs23::integrate),
-        s if s.implicit() => dispatch::simulate_implicit(arm, t0, x0, opts),
-        _ => dispatch::run_explicit(arm, t0, x0, opts, None, &RefCell::new(None)),
-    }
+    methods::of(opts.solver).run(arm, t0, x0, opts)
 }

@@ -12,7 +12,7 @@ use crate::arm::{AccelError, Dynamics, Workspace, accelerations};
 use crate::jacobian::rhs_jacobian;
 
 /// (power, depth) of the contacts at (t, x).
-pub(super) type MeterFn<'a> = dyn Fn(f64, &[f64]) -> super::record::MeterSample + 'a;
+pub(super) type MeterFn<'a> = dyn Fn(f64, &[f64]) -> super::outcome::MeterSample + 'a;
 
 /// The first-order system x' = f(t, x) of an arm; components past 2 n are
 /// padding.

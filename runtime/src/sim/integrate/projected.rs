@@ -14,26 +14,11 @@
 //! piece end: the largest is what `ConstraintStats` reports (docs/design.md
 //! section 7).
 
-use serde::Serialize;
-
 use super::failure::SimFailure;
 use super::options::SimOptions;
-use super::record::{SimStats, Trajectory};
+use super::outcome::{ConstraintStats, SimStats, Trajectory};
 use crate::arm::Dynamics;
 use crate::constraints::{Drift, drift, project};
-
-/// How far integration drifted off the joints, and how often it was put
-/// back.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
-pub struct ConstraintStats {
-    /// Largest point gap at a sample before projection (m).
-    pub drift_max_m: f64,
-    /// Largest angle gap (rad).
-    pub drift_max_rad: f64,
-    /// Largest |J qd| (m/s or rad/s).
-    pub velocity_drift_max: f64,
-    pub projections: usize,
-}
 
 /// The drift a leg may leave before the next projection (m or rad): ten
 /// times the absolute tolerance, so that the constraint error stays of the
@@ -74,8 +59,8 @@ struct Leg {
     worst: Drift,
 }
 
-pub(super) fn run<D: Dynamics + ?Sized>(
-    arm: &D,
+pub(super) fn run(
+    arm: &dyn Dynamics,
     t0: f64,
     x0: Vec<f64>,
     opts: &SimOptions,
@@ -85,7 +70,10 @@ pub(super) fn run<D: Dynamics + ?Sized>(
         x: vec![x0],
         ..Default::default()
     };
-    let mut stats = empty_stats(opts);
+    let mut stats = SimStats {
+        constraints: Some(ConstraintStats::default()),
+        ..SimStats::none(opts.solver)
+    };
     let times = sample_times(opts, t0);
     let budget = drift_budget(opts);
     // Legs span `leg_len` sample intervals; a single interval that drifts
@@ -98,7 +86,7 @@ pub(super) fn run<D: Dynamics + ?Sized>(
         let leg = match run_leg(arm, t0, x, leg_times, pieces, opts) {
             Ok(leg) => leg,
             Err(mut f) => {
-                add(&mut stats, &f.stats);
+                stats.absorb(&f.stats);
                 let mut before = std::mem::take(&mut traj);
                 let skip = f.trajectory.t.iter().take_while(|&&t| t <= t0).count();
                 before.t.extend(f.trajectory.t.drain(..).skip(skip));
@@ -109,7 +97,7 @@ pub(super) fn run<D: Dynamics + ?Sized>(
                 return Err(f);
             }
         };
-        add(&mut stats, &leg.stats);
+        stats.absorb(&leg.stats);
         let worst_gap = leg.worst.position_m.max(leg.worst.angle_rad);
         if worst_gap > budget && leg_len > 1 {
             // Over budget: this leg again, in halves.
@@ -151,8 +139,8 @@ pub(super) fn run<D: Dynamics + ?Sized>(
 /// One leg from (t0, x) through `times`, in `pieces` runs when it is one
 /// sample interval; the state projected at the end of every run, only the
 /// samples kept.
-fn run_leg<D: Dynamics + ?Sized>(
-    arm: &D,
+fn run_leg(
+    arm: &dyn Dynamics,
     t0: f64,
     x: Vec<f64>,
     times: &[f64],
@@ -176,7 +164,10 @@ fn run_leg<D: Dynamics + ?Sized>(
     };
     let mut leg = Leg {
         traj: Trajectory::default(),
-        stats: empty_stats(opts),
+        stats: SimStats {
+            constraints: Some(ConstraintStats::default()),
+            ..SimStats::none(opts.solver)
+        },
         worst: Drift::default(),
     };
     let (mut from, mut state) = (t0, x);
@@ -196,7 +187,7 @@ fn run_leg<D: Dynamics + ?Sized>(
             ..opts.clone()
         };
         let (mut seg, more) = super::run_from(arm, from, state, &run_opts)?;
-        add(&mut leg.stats, &more);
+        leg.stats.absorb(&more);
         let skip = seg.t.iter().take_while(|&&t| t <= from).count();
         for (t, x) in seg.t.iter().zip(&seg.x).skip(skip) {
             let gap = drift(arm, *t, &x[..n], &x[n..]);
@@ -245,30 +236,4 @@ fn run_leg<D: Dynamics + ?Sized>(
         (from, state) = (t_end, end);
     }
     Ok(leg)
-}
-
-fn empty_stats(opts: &SimOptions) -> SimStats {
-    SimStats {
-        solver: opts.solver,
-        steps: 0,
-        rejected_steps: 0,
-        rhs_evaluations: 0,
-        jacobian_evaluations: 0,
-        wall_s: 0.0,
-        switched: None,
-        constraints: Some(ConstraintStats::default()),
-        contact: None,
-    }
-}
-
-fn add(stats: &mut SimStats, more: &SimStats) {
-    stats.steps += more.steps;
-    stats.rejected_steps += more.rejected_steps;
-    stats.rhs_evaluations += more.rhs_evaluations;
-    stats.jacobian_evaluations += more.jacobian_evaluations;
-    stats.wall_s += more.wall_s;
-    if stats.switched.is_none() {
-        stats.switched.clone_from(&more.switched);
-    }
-    stats.contact = super::record::ContactMeter::then(stats.contact, more.contact);
 }

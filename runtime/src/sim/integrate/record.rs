@@ -4,123 +4,17 @@
 
 use std::cell::{Cell, RefCell};
 
-use differential_equations::prelude::*;
-use differential_equations::solout::EvenSolout;
-use serde::Serialize;
-
-use super::events::{EventHit, EventWatch};
+use super::events::EventWatch;
 use super::ode::ArmOde;
 use super::options::SimOptions;
+use super::outcome::{ContactMeter, Trajectory};
 use super::state::StateVec;
-use crate::solver::Solver;
+use differential_equations::prelude::*;
+use differential_equations::solout::EvenSolout;
 
 /// How often `auto` re-checks stiffness (accepted explicit steps): the
 /// recorder calls its watch this often.
 pub const AUTO_CHECK_STEPS: usize = 200;
-
-/// A change of solver made by `auto`.
-#[derive(Clone, Debug, Serialize)]
-pub struct SolverSwitch {
-    pub at_s: f64,
-    pub to: Solver,
-    pub reason: String,
-}
-
-/// Sampled states x = [q, qd] at times t.
-#[derive(Clone, Debug, Default)]
-pub struct Trajectory {
-    pub t: Vec<f64>,
-    pub x: Vec<Vec<f64>>,
-    /// The located events, in time order.
-    pub events: Vec<EventHit>,
-    /// A system with contacts: at each sample, every contact channel's
-    /// total normal and friction force (`contact::channel_columns`),
-    /// recorded while the run's contact state (impact speeds, held
-    /// contacts) was the sample's. Empty otherwise.
-    pub contact: Vec<Vec<f64>>,
-    /// The contact switches' records, in time order.
-    pub switches: Vec<SwitchRecord>,
-}
-
-/// At a contact switch (`integrate::touch`): the normal impulse the
-/// contact forces had transmitted by then (`ContactMeter`), and the
-/// pairs whose impulse law made the velocities jump there, with the
-/// normal impulse of each (N s).
-#[derive(Clone, Debug, Default)]
-pub struct SwitchRecord {
-    pub t: f64,
-    pub metered_impulse_ns: f64,
-    pub jumps: Vec<(usize, f64)>,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct SimStats {
-    pub solver: Solver,
-    pub steps: usize,
-    pub rejected_steps: usize,
-    pub rhs_evaluations: usize,
-    pub jacobian_evaluations: usize,
-    pub wall_s: f64,
-    /// Set when `auto` switched solvers.
-    pub switched: Option<SolverSwitch>,
-    /// A system with joints: how far integration drifted off them.
-    pub constraints: Option<super::projected::ConstraintStats>,
-    /// A system with contacts: what they did over the run.
-    pub contact: Option<ContactMeter>,
-}
-
-/// What contacts did over a run, metered on every accepted step: the
-/// energy they dissipated and the normal impulse their forces transmitted
-/// (3-point Gauss-Legendre on the step's dense output, so as accurate as
-/// the integration), and the deepest penetration seen at those points.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
-pub struct ContactMeter {
-    pub dissipated_j: f64,
-    pub max_penetration_m: f64,
-    /// The integral of every pair's normal force over time (N s); an
-    /// impulse law's jumps are not forces and are not in it.
-    pub normal_impulse_ns: f64,
-}
-
-/// What `ContactMeter` integrates, at one time: the power the contacts
-/// dissipate, the deepest penetration and the sum of the normal forces.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct MeterSample {
-    pub power_w: f64,
-    pub depth_m: f64,
-    pub normal_n: f64,
-}
-
-impl ContactMeter {
-    /// Two runs' meters, one after the other.
-    pub fn then(a: Option<Self>, b: Option<Self>) -> Option<Self> {
-        match (a, b) {
-            (Some(a), Some(b)) => Some(Self {
-                dissipated_j: a.dissipated_j + b.dissipated_j,
-                max_penetration_m: a.max_penetration_m.max(b.max_penetration_m),
-                normal_impulse_ns: a.normal_impulse_ns + b.normal_impulse_ns,
-            }),
-            (a, b) => a.or(b),
-        }
-    }
-
-    /// Meter the step [t0, t1] by `at(t)`.
-    fn step(&mut self, t0: f64, t1: f64, mut at: impl FnMut(f64) -> Option<MeterSample>) {
-        // The first call of a run sees no step yet.
-        if t1 <= t0 {
-            return;
-        }
-        let (mid, half) = (0.5 * (t0 + t1), 0.5 * (t1 - t0));
-        let r = (0.6_f64).sqrt();
-        for (x, w) in [(-r, 5.0 / 9.0), (0.0, 8.0 / 9.0), (r, 5.0 / 9.0)] {
-            if let Some(s) = at(mid + half * x) {
-                self.dissipated_j += half * w * s.power_w;
-                self.normal_impulse_ns += half * w * s.normal_n;
-                self.max_penetration_m = self.max_penetration_m.max(s.depth_m);
-            }
-        }
-    }
-}
 
 /// Samples evenly and stops on a non-finite accepted state. A fixed-step
 /// method has no error estimate to reject a step whose right-hand side

@@ -9,7 +9,7 @@
 use super::events::CONTACT_EVENT;
 use super::failure::SimFailure;
 use super::options::SimOptions;
-use super::record::{SimStats, Trajectory};
+use super::outcome::{SimStats, Trajectory};
 use crate::arm::Dynamics;
 use crate::contact::{impact, pair_forces};
 
@@ -17,8 +17,8 @@ use crate::contact::{impact, pair_forces};
 /// contacts that switch without the time moving (a chattering contact).
 const MAX_STALLED_LEGS: usize = 50;
 
-pub(super) fn run<D: Dynamics + ?Sized>(
-    arm: &D,
+pub(super) fn run(
+    arm: &dyn Dynamics,
     x0: Vec<f64>,
     opts: &SimOptions,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
@@ -135,20 +135,9 @@ fn add(stats: &mut Option<SimStats>, more: &SimStats) {
         *stats = Some(more.clone());
         return;
     };
-    s.steps += more.steps;
-    s.rejected_steps += more.rejected_steps;
-    s.rhs_evaluations += more.rhs_evaluations;
-    s.jacobian_evaluations += more.jacobian_evaluations;
-    s.wall_s += more.wall_s;
-    if s.switched.is_none() {
-        s.switched.clone_from(&more.switched);
-    }
-    s.contact = super::record::ContactMeter::then(s.contact, more.contact);
+    s.absorb(more);
     if let (Some(c), Some(m)) = (s.constraints.as_mut(), more.constraints.as_ref()) {
-        c.drift_max_m = c.drift_max_m.max(m.drift_max_m);
-        c.drift_max_rad = c.drift_max_rad.max(m.drift_max_rad);
-        c.velocity_drift_max = c.velocity_drift_max.max(m.velocity_drift_max);
-        c.projections += m.projections;
+        c.merge(m);
     }
 }
 
@@ -169,16 +158,8 @@ fn fail_at(
             .into(),
         state: x.to_vec(),
         trajectory: traj.clone(),
-        stats: stats.clone().unwrap_or(SimStats {
-            solver: crate::solver::Solver::Auto,
-            steps: 0,
-            rejected_steps: 0,
-            rhs_evaluations: 0,
-            jacobian_evaluations: 0,
-            wall_s: 0.0,
-            switched: None,
-            constraints: None,
-            contact: None,
-        }),
+        stats: stats
+            .clone()
+            .unwrap_or(SimStats::none(crate::solver::Solver::Auto)),
     })
 }

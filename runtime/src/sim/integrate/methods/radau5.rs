@@ -19,7 +19,7 @@ use differential_equations::error::Error;
 use differential_equations::interpolate::Interpolation;
 use nalgebra::{Complex, DMatrix, DVector};
 
-use super::stepper::{Counts, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, begin_step};
+use super::super::stepper::{Counts, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, begin_step};
 
 /// sqrt(6)
 const SQ6: f64 = 2.449_489_742_783_178;
@@ -423,6 +423,21 @@ fn simplified_newton(
         }
     }
     Ok((converged, iterations, theta))
+}
+
+/// The method behind `--solver radau5`.
+pub(super) struct Radau5;
+
+impl super::Integrator for Radau5 {
+    fn run(
+        &self,
+        arm: &dyn crate::arm::Dynamics,
+        t0: f64,
+        x0: Vec<f64>,
+        opts: &super::super::options::SimOptions,
+    ) -> super::super::drivers::RunResult {
+        super::super::drivers::run_own(arm, t0, x0, opts, integrate)
+    }
 }
 
 #[cfg(test)]

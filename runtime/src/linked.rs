@@ -1,42 +1,19 @@
 //! Compiled cells linked at run time: a chain whose element count (or rom
 //! order) no compiled-in model has runs the link recursion over the
-//! compiled cells of the same link shapes, found by their keys. The cell
-//! is what is compiled; the count is the layout's, a runtime value, so
-//! `--set segment.0.elements=20` on a bundled 10-element arm needs neither
-//! a rebuild nor the interpreter.
-//!
-//! Invariant: a key names a cell's three tapes (cell, tangent, pose)
-//! exactly (`eomgen::tmt::cell_key`), so a cell linked by key computes
-//! what the interpreter's tape of that cell computes.
+//! compiled cells (`links::CompiledCell`) of the same link shapes, found by
+//! their keys. The cell is what is compiled; the count is the layout's, a
+//! runtime value, so `--set segment.0.elements=20` on a bundled 10-element
+//! arm needs neither a rebuild nor the interpreter.
 
 use std::cell::RefCell;
 
-use super::{
-    Cells, LinkKernels, accelerations_owned, all_owned, inverse_dynamics_tangent, mass_bias_owned,
-    mass_bias_shared_dyn, outputs,
-};
 use crate::kernels::{KernelKind, Kernels, ModelInfo};
 use crate::linalg::Ldlt;
+use crate::links::{
+    Cells, CompiledCell, LinkKernels, accelerations_owned, all_owned, by_lanes,
+    inverse_dynamics_tangent, mass_bias_owned, mass_bias_shared_dyn, outputs,
+};
 use crate::tape::{Inputs, Tape};
-
-/// A cell kernel of one link: (x, xd, p, out).
-pub type CellFn = fn(&[f64], &[f64], &[f64], &mut [f64]);
-/// A cell kernel of four links in vector lanes: (x, xd, p, out).
-pub type CellLanesFn = fn(&[[f64; 4]], &[[f64; 4]], &[[f64; 4]], &mut [[f64; 4]]);
-/// A cell's tangent: (x, xd, dx, dxd, p, out).
-pub type CellTangentFn = fn(&[f64], &[f64], &[f64], &[f64], &[f64], &mut [f64]);
-
-/// One link cell as compiled into the binary, by its key: its three
-/// kernels behind slices (a link's coordinates, rates, parameters).
-#[derive(Clone, Copy)]
-pub struct CompiledCell {
-    pub key: &'static str,
-    pub one: CellFn,
-    /// Four links in vector lanes, where the model compiled them.
-    pub four: Option<CellLanesFn>,
-    pub tangent: CellTangentFn,
-    pub pose: CellFn,
-}
 
 /// The kernels of a chain by the link recursion over linked compiled
 /// cells: `MassBias`, `Jvp` and `Outputs`; the few kernels of the
@@ -92,7 +69,7 @@ impl Cells for Linked<'_> {
     ) {
         match self.cells[c].four {
             Some(four) => four(x, xd, p, out),
-            None => super::by_lanes(self.cells[c].one, x, xd, p, out),
+            None => by_lanes(self.cells[c].one, x, xd, p, out),
         }
     }
 

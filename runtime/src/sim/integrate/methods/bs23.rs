@@ -7,7 +7,7 @@
 
 use differential_equations::error::Error;
 
-use super::stepper::{
+use super::super::stepper::{
     Counts, Hermite, OdeSystem, Options, StepFn, begin_step, error_norm, next_step,
 };
 
@@ -85,4 +85,19 @@ pub fn integrate(
         }
     }
     Ok(())
+}
+
+/// The method behind `--solver bs23`.
+pub(super) struct Bs23;
+
+impl super::Integrator for Bs23 {
+    fn run(
+        &self,
+        arm: &dyn crate::arm::Dynamics,
+        t0: f64,
+        x0: Vec<f64>,
+        opts: &super::super::options::SimOptions,
+    ) -> super::super::drivers::RunResult {
+        super::super::drivers::run_own(arm, t0, x0, opts, integrate)
+    }
 }

@@ -12,7 +12,7 @@
 use differential_equations::error::Error;
 use nalgebra::{DMatrix, DVector};
 
-use super::stepper::{
+use super::super::stepper::{
     Counts, Hermite, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, begin_step, error_norm,
     next_step,
 };
@@ -200,4 +200,19 @@ pub fn integrate(
         }
     }
     Ok(())
+}
+
+/// The method behind `--solver trbdf2`.
+pub(super) struct Trbdf2;
+
+impl super::Integrator for Trbdf2 {
+    fn run(
+        &self,
+        arm: &dyn crate::arm::Dynamics,
+        t0: f64,
+        x0: Vec<f64>,
+        opts: &super::super::options::SimOptions,
+    ) -> super::super::drivers::RunResult {
+        super::super::drivers::run_own(arm, t0, x0, opts, integrate)
+    }
 }

@@ -1,0 +1,85 @@
+//! `auto`: dopri5 while the arm is not stiff, radau5 once it is, judged
+//! from the Jacobian's eigenvalues at the start and every
+//! [`AUTO_CHECK_STEPS`](super::super::AUTO_CHECK_STEPS) accepted steps.
+
+use std::cell::RefCell;
+
+use nalgebra::DMatrix;
+
+use super::super::drivers::RunResult;
+use super::super::options::SimOptions;
+use super::super::outcome::{SimStats, SolverSwitch};
+use super::radau5::Radau5;
+use super::{Integrator, dopri5};
+use crate::arm::{Dynamics, Workspace};
+use crate::jacobian::rhs_jacobian;
+use crate::solver::Solver;
+
+pub(super) struct Auto;
+
+/// A stiffness ratio above this makes the arm stiff for `auto`.
+const STIFF_RATIO: f64 = 1000.0;
+
+impl Integrator for Auto {
+    fn run(&self, arm: &dyn Dynamics, t0: f64, x0: Vec<f64>, opts: &SimOptions) -> RunResult {
+        let n = arm.dof();
+        let analyse_at = |t: f64, x: &[f64]| {
+            let mut jac = DMatrix::zeros(2 * n, 2 * n);
+            rhs_jacobian(arm, &mut Workspace::new(n), t, &x[..2 * n], &mut jac)
+                .ok()
+                .map(|_| crate::stiffness::analyse(&jac))
+        };
+        let implicit_opts = SimOptions {
+            solver: Solver::Radau5,
+            ..opts.clone()
+        };
+        let as_auto = |mut stats: SimStats, at_s: f64, reason: String| {
+            stats.solver = Solver::Auto;
+            stats.switched = Some(SolverSwitch {
+                at_s,
+                to: Solver::Radau5,
+                reason,
+            });
+            stats
+        };
+        if let Some(r) = analyse_at(t0, &x0)
+            && r.stiffness_ratio > STIFF_RATIO
+        {
+            let (traj, stats) = Radau5.run(arm, t0, x0, &implicit_opts)?;
+            let reason = format!("stiff from the start: {}", r.reason);
+            return Ok((traj, as_auto(stats, t0, reason)));
+        }
+        let watch = |x: &[f64], h: f64| -> Option<String> {
+            let r = analyse_at(0.0, x)?;
+            (r.stiffness_ratio > STIFF_RATIO && h > 0.5 * r.stable_explicit_step_s).then(|| {
+                format!(
+                    "dopri5 held at the stability limit ({h:.2e} s steps) of a stiff arm: {}",
+                    r.reason
+                )
+            })
+        };
+        let switch = RefCell::new(None);
+        let explicit_opts = SimOptions {
+            solver: Solver::Dopri5,
+            ..opts.clone()
+        };
+        let (mut traj, mut stats) =
+            dopri5::watched(arm, t0, x0, &explicit_opts, Some(&watch), &switch)?;
+        stats.solver = Solver::Auto;
+        let Some((t_switch, x_switch, reason)) = switch.take() else {
+            return Ok((traj, stats));
+        };
+        let (rest, more) = Radau5.run(arm, t_switch, x_switch, &implicit_opts)?;
+        traj.events.extend(rest.events);
+        for (t, x) in rest.t.into_iter().zip(rest.x) {
+            if traj.t.last().is_none_or(|&last| t > last) {
+                traj.t.push(t);
+                traj.x.push(x);
+            }
+        }
+        stats.absorb(&more);
+        stats.switched = None;
+        stats.constraints = None;
+        Ok((traj, as_auto(stats, t_switch, reason)))
+    }
+}
