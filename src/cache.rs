@@ -31,13 +31,8 @@ pub fn load(dir: &Path, hash: &str) -> Option<TapeSet> {
 pub fn store(dir: &Path, tapes: &TapeSet) -> Result<(), String> {
     let write = || -> std::io::Result<()> {
         std::fs::create_dir_all(dir)?;
-        let target = entry_path(dir, &tapes.info.hash);
-        let tmp = target.with_extension(format!("json.tmp{}", std::process::id()));
-        std::fs::write(
-            &tmp,
-            serde_json::to_vec(tapes).map_err(std::io::Error::other)?,
-        )?;
-        std::fs::rename(&tmp, &target)
+        let bytes = serde_json::to_vec(tapes).map_err(std::io::Error::other)?;
+        eomgen::atomic_write::write_atomic(&entry_path(dir, &tapes.info.hash), &bytes)
     };
     write().map_err(|e| format!("could not write the tape cache in {}: {e}", dir.display()))
 }

@@ -8,6 +8,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use eomgen::atomic_write::write_atomic;
 use eomgen::model::{Override, SimulateDefaults, Start};
 use nalgebra::{DMatrix, DVector};
 use runtime::{
@@ -202,15 +203,6 @@ pub enum StartArg {
     Static,
 }
 
-/// Write `content` to `path` through a temporary file, so that a failed run
-/// never leaves a half-written file.
-fn write_atomic(path: &Path, content: &[u8]) -> Result<()> {
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, content).with_context(|| format!("cannot write {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))?;
-    Ok(())
-}
-
 fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
     let n = arm.dof();
     let coords = &arm.info().coordinates;
@@ -367,24 +359,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     drop(progress);
     let (traj, stats, failure) = match result {
         Ok((traj, stats)) => (traj, stats, None),
-        Err(f) => {
-            let f = *f;
-            let mut msg = f.to_string();
-            // Joints that became dependent during the run, by name.
-            if f.state.len() == 2 * n {
-                let rows = runtime::constraints::dependent_rows(arm, f.t_reached, &f.state[..n]);
-                for group in rows {
-                    msg.push_str(&format!(
-                        "\n  dependent joints at t = {:.6} s: {} (rows {})",
-                        f.t_reached,
-                        runtime::constraints::joints_of(&group).join(", "),
-                        group.join(", ")
-                    ));
-                }
-            }
-            let fail = json!({"t_reached": f.t_reached, "last_step_s": f.last_step_s, "reason": f.reason, "suggestion": f.suggestion, "state": f.state});
-            (f.trajectory, f.stats, Some((msg, fail)))
-        }
+        Err(f) => explained(arm, *f),
     };
     write_atomic(
         &out_dir.join("trajectory.csv"),
@@ -394,43 +369,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         let csv = shape.csv(arm, &traj.t, &traj.x);
         write_atomic(&out_dir.join("shape.csv"), csv.as_bytes())?;
     }
-    let body_names: Vec<String> = loaded.model.bodies.iter().map(|b| b.name.clone()).collect();
-    for (body, ix) in softarm::joints::free_bodies(arm, &body_names) {
-        let path: Vec<(f64, f64, f64)> = traj
-            .t
-            .iter()
-            .zip(&traj.x)
-            .map(|(t, x)| (*t, x[ix], x[ix + 1]))
-            .collect();
-        let title = format!("{}: path of {body}", loaded.model.name);
-        softarm::joints::plot_path(&out_dir.join(&body), &title, &path)?;
-    }
-    if let Some(set) = arm.contact() {
-        // The tip's path and the contact forces.
-        let tips: Vec<(f64, f64, f64)> = traj
-            .t
-            .iter()
-            .zip(&traj.x)
-            .map(|(t, x)| {
-                let o = arm.outputs(*t, &x[..n], &x[n..]);
-                (*t, o[0], o[1])
-            })
-            .collect();
-        let name = &loaded.model.name;
-        softarm::joints::plot_path(&out_dir.join("tip"), &format!("{name}: tip path"), &tips)?;
-        let forces: Vec<(f64, Vec<f64>)> = traj
-            .t
-            .iter()
-            .enumerate()
-            .map(|(i, t)| (*t, softarm::contact::columns(arm, &traj, i)))
-            .collect();
-        softarm::contact::plot_forces(
-            &out_dir.join("contact"),
-            &format!("{name}: contact forces"),
-            &set.channels,
-            &forces,
-        )?;
-    }
+    plot_paths_and_contact(&loaded, &traj, &out_dir)?;
     let final_state = traj.x.last().cloned().unwrap_or_default();
     let t_final = traj.t.last().copied().unwrap_or(0.0);
     let tip = if final_state.len() == 2 * n {
@@ -495,6 +434,79 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         return Ok(ExitCode::FAILURE);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// A failed run's trajectory and counts, with its message (the joints
+/// that became dependent named) and its summary entry.
+fn explained(
+    arm: &dyn Dynamics,
+    f: runtime::SimFailure,
+) -> (
+    Trajectory,
+    runtime::SimStats,
+    Option<(String, serde_json::Value)>,
+) {
+    let n = arm.dof();
+    let mut msg = f.to_string();
+    // Joints that became dependent during the run, by name.
+    if f.state.len() == 2 * n {
+        let rows = runtime::constraints::dependent_rows(arm, f.t_reached, &f.state[..n]);
+        for group in rows {
+            msg.push_str(&format!(
+                "\n  dependent joints at t = {:.6} s: {} (rows {})",
+                f.t_reached,
+                runtime::constraints::joints_of(&group).join(", "),
+                group.join(", ")
+            ));
+        }
+    }
+    let fail = json!({"t_reached": f.t_reached, "last_step_s": f.last_step_s, "reason": f.reason, "suggestion": f.suggestion, "state": f.state});
+    (f.trajectory, f.stats, Some((msg, fail)))
+}
+
+/// The free bodies' paths, and with contact the tip's path and the contact
+/// forces, as pictures in `out_dir`.
+fn plot_paths_and_contact(loaded: &Loaded, traj: &Trajectory, out_dir: &Path) -> Result<()> {
+    let arm = &*loaded.arm;
+    let n = arm.dof();
+    let body_names: Vec<String> = loaded.model.bodies.iter().map(|b| b.name.clone()).collect();
+    for (body, ix) in softarm::joints::free_bodies(arm, &body_names) {
+        let path: Vec<(f64, f64, f64)> = traj
+            .t
+            .iter()
+            .zip(&traj.x)
+            .map(|(t, x)| (*t, x[ix], x[ix + 1]))
+            .collect();
+        let title = format!("{}: path of {body}", loaded.model.name);
+        softarm::joints::plot_path(&out_dir.join(&body), &title, &path)?;
+    }
+    if let Some(set) = arm.contact() {
+        // The tip's path and the contact forces.
+        let tips: Vec<(f64, f64, f64)> = traj
+            .t
+            .iter()
+            .zip(&traj.x)
+            .map(|(t, x)| {
+                let o = arm.outputs(*t, &x[..n], &x[n..]);
+                (*t, o[0], o[1])
+            })
+            .collect();
+        let name = &loaded.model.name;
+        softarm::joints::plot_path(&out_dir.join("tip"), &format!("{name}: tip path"), &tips)?;
+        let forces: Vec<(f64, Vec<f64>)> = traj
+            .t
+            .iter()
+            .enumerate()
+            .map(|(i, t)| (*t, softarm::contact::columns(arm, traj, i)))
+            .collect();
+        softarm::contact::plot_forces(
+            &out_dir.join("contact"),
+            &format!("{name}: contact forces"),
+            &set.channels,
+            &forces,
+        )?;
+    }
+    Ok(())
 }
 
 /// The lines a finished run prints on stderr.

@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+use eomgen::atomic_write::write_atomic;
 use eomgen::model::Compare;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use runtime::signal::moving_average;
@@ -250,15 +251,7 @@ pub fn plot(
         simulated,
         measured,
     )?;
-    write_atomic(&svg, text.as_bytes())
-}
-
-/// Write through a temporary file, so that a failure leaves nothing
-/// half-written.
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, bytes).with_context(|| format!("cannot write {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))
+    Ok(write_atomic(&svg, text.as_bytes())?)
 }
 
 /// Encode 8-bit RGB pixels as a PNG file.
@@ -270,7 +263,7 @@ pub fn write_png(path: &Path, size: (u32, u32), rgb: &[u8]) -> Result<()> {
     let mut w = enc.write_header()?;
     w.write_image_data(rgb)?;
     w.finish()?;
-    write_atomic(path, &bytes)
+    Ok(write_atomic(path, &bytes)?)
 }
 
 /// The bundled font (DejaVu Sans Mono, assets/fonts): plots need no system

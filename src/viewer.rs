@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use crate::scene::Scene;
 
@@ -20,8 +20,8 @@ pub fn page(scene: &Scene) -> Result<String> {
 
 /// Write the page to `path` (through a temporary file).
 pub fn write(scene: &Scene, path: &Path) -> Result<()> {
-    let tmp = path.with_extension("html.tmp");
-    std::fs::write(&tmp, page(scene)?)
-        .with_context(|| format!("cannot write {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("cannot write {}", path.display()))
+    Ok(eomgen::atomic_write::write_atomic(
+        path,
+        page(scene)?.as_bytes(),
+    )?)
 }

@@ -149,11 +149,13 @@ fn write_if_changed(
         return Ok(());
     }
     if !opts.check {
-        // Write a sibling and rename, so an interrupted build never leaves a
-        // half-written file.
-        let tmp = target.with_extension("rs.tmp");
-        std::fs::write(&tmp, content).map_err(|e| io_err(&tmp, e))?;
-        std::fs::rename(&tmp, target).map_err(|e| io_err(target, e))?;
+        // An interrupted build never leaves a half-written file.
+        crate::atomic_write::write_atomic(target, content.as_bytes()).map_err(|e| {
+            GenerateError::Io {
+                path: target.display().to_string(),
+                message: e.kind().to_string(),
+            }
+        })?;
     }
     report.written.push(target.to_path_buf());
     Ok(())

@@ -5,6 +5,7 @@
 //! tapes (`derive`), and emitted as Rust (`emit`). `generate` keeps a
 //! `generated/` folder in step with `models/` for build.rs and the CLI.
 
+pub mod atomic_write;
 pub mod cas;
 pub mod derive;
 pub mod emit;

@@ -6,6 +6,7 @@
 pub use super::schema::{ArmDecl, BodyDecl, BodyShape, JointDecl, JointKind};
 use super::schema::{Base, Model};
 
+/// A frame a joint names. Arms and bodies by their index in the model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum FrameRef {
     World,

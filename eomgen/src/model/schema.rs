@@ -732,8 +732,6 @@ fn active() -> bool {
     true
 }
 
-/// A frame a joint names. Arms and bodies by their index in the model.
-
 #[cfg(test)]
 mod tests {
     use super::*;

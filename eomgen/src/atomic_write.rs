@@ -1,0 +1,41 @@
+//! Writing a file so that nobody ever reads half of it.
+
+use std::path::{Path, PathBuf};
+
+/// Write `bytes` to `path` through a sibling temporary file renamed over
+/// it: a failure or an interruption leaves the old file or none, never a
+/// half-written one (a rename within a folder is atomic). The temporary's
+/// name carries the process id, so concurrent writers never share one; a
+/// failed write removes it. The error names the file.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(format!(".tmp{}", std::process::id()));
+    let tmp = PathBuf::from(tmp);
+    std::fs::write(&tmp, bytes)
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            std::io::Error::new(e.kind(), format!("cannot write {}: {e}", path.display()))
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::write_atomic;
+
+    /// The file holds the new bytes, nothing is left beside it, and a
+    /// write that cannot land (its folder is missing) leaves nothing.
+    #[test]
+    fn writes_whole_and_leaves_no_temporary() {
+        let dir = std::env::temp_dir().join(format!("eomgen-atomic-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("out.csv");
+        write_atomic(&path, b"old").unwrap();
+        write_atomic(&path, b"new").unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        assert!(write_atomic(&dir.join("missing/out.csv"), b"x").is_err());
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
