@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The Cosserat rod's answer to the cantilever3d transient (issue 24), from
+"""The Cosserat rod's answer to the cantilever3d transient, from
 PyElastica: the rod of models/cantilever3d.toml (L 0.3 m, r 10 mm, rho 1000
 kg/m^3, E 1 MPa, G = E/3, PyElastica's shear factor 27/28) clamped at the
 origin along +x, released straight under gravity (-z), undamped, for 2 s.

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""rom by order on the cantilever3d rod released straight under gravity
-(issue 24): steps of a 0.5 s run at rtol 1e-9 and the mass matrix's
+"""rom by order on the cantilever3d rod released straight under gravity:
+steps of a 0.5 s run at rtol 1e-9 and the mass matrix's
 condition number at the straight state. Prints a markdown table for
 docs/validation.md. Run from the repository root after `cargo build
 --release` (orders not compiled in are derived once into the cache).

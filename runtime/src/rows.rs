@@ -2,7 +2,7 @@
 //! combined with 256-bit fused multiply-adds where the processor has them.
 //!
 //! The compiler's vectoriser leaves these loops scalar inside the link
-//! recursion's large inlined body (BENCHMARKS.md, session 9), so the
+//! recursion's large inlined body (measured: benches/interleaved.rs), so the
 //! vector form is written out. In `add_combination` every lane is the
 //! scalar `mul_add`, so both forms give the same bits; `dot2` adds its
 //! four partial sums at the end, so its forms agree to round-off only.

@@ -138,7 +138,7 @@ impl ModellingMethod for Rom {
 /// coordinates, field by field. The monomials sigma^i span the same
 /// fields, but their Gram matrix (the Hilbert matrix) is ill-conditioned
 /// past order 5: the mass matrix inherits it and the step control stalls
-/// (issue 24).
+/// (docs/validation.md, the rom conditioning table).
 pub(crate) struct RomFields {
     pub first: usize,
     pub order: usize,

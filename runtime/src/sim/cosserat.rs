@@ -315,7 +315,7 @@ pub fn solve_rod(
 mod tests {
     use super::*;
 
-    /// The bench rod of issue 4: L 0.3 m, r 0.01 m, E 1 MPa, G = E/3.
+    /// The bench rod of models/cantilever3d.toml: L 0.3 m, r 0.01 m, E 1 MPa, G = E/3.
     fn rod(inextensible: bool) -> Rod {
         let soft = |k: f64| (!inextensible).then_some(k);
         let (e, r) = (1e6, 0.01);
