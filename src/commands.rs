@@ -11,9 +11,7 @@ use clap::Args;
 use eomgen::atomic_write::write_atomic;
 use eomgen::model::{Override, SimulateDefaults, Start};
 use nalgebra::{DMatrix, DVector};
-use runtime::{
-    Dynamics, KernelKind, OUTPUT_NAMES, SimOptions, Solver, Trajectory, Workspace, accelerations,
-};
+use runtime::{Dynamics, KernelKind, SimOptions, Solver, Trajectory, Workspace, accelerations};
 use serde_json::json;
 use softarm::backend::{self, Loaded};
 use softarm::compare;
@@ -203,47 +201,6 @@ pub enum StartArg {
     Static,
 }
 
-fn trajectory_csv(arm: &dyn Dynamics, traj: &Trajectory) -> String {
-    let n = arm.dof();
-    let coords = &arm.info().coordinates;
-    let mut s = String::from("t");
-    for c in coords {
-        s.push_str(&format!(",{c}"));
-    }
-    for c in coords {
-        s.push_str(&format!(",{c}_dot"));
-    }
-    for o in OUTPUT_NAMES {
-        s.push_str(&format!(",{o}"));
-    }
-    for r in softarm::joints::reaction_names(arm) {
-        s.push_str(&format!(",{r}"));
-    }
-    for c in softarm::contact::column_names(arm) {
-        s.push_str(&format!(",{c}"));
-    }
-    s.push('\n');
-    for (i, (t, x)) in traj.t.iter().zip(&traj.x).enumerate() {
-        s.push_str(&format!("{t:.9}"));
-        for v in x {
-            s.push_str(&format!(",{v:.12e}"));
-        }
-        for v in arm.outputs(*t, &x[..n], &x[n..]) {
-            s.push_str(&format!(",{v:.12e}"));
-        }
-        if !arm.info().constraints.is_empty() {
-            for v in softarm::joints::reactions(arm, *t, x) {
-                s.push_str(&format!(",{v:.12e}"));
-            }
-        }
-        for v in softarm::contact::columns(arm, traj, i) {
-            s.push_str(&format!(",{v:.12e}"));
-        }
-        s.push('\n');
-    }
-    s
-}
-
 /// The run the command line asks for.
 fn request(a: &SimulateArgs, loaded: &Loaded) -> Result<RunRequest> {
     let n = loaded.arm.dof();
@@ -328,7 +285,6 @@ fn compare_tip(
 
 pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     let mut loaded = load(&a.model)?;
-    let n = loaded.arm.dof();
     let req = request(&a, &loaded)?;
     let mut opts = softarm::run::options(&req, &loaded.model.simulate)?;
     let (x0, assembled_m) = softarm::run::initial_state(&req, &mut loaded)?;
@@ -339,7 +295,6 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         .transpose()?;
     let arm = &*loaded.arm;
     let t_end = opts.t_end;
-    let solver = opts.solver;
     // Measured data to compare with: sampled at its own times.
     let measured = softarm::run::measured(&loaded, &x0)?;
     let output_times = measured
@@ -361,61 +316,27 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         Ok((traj, stats)) => (traj, stats, None),
         Err(f) => explained(arm, *f),
     };
-    write_atomic(
-        &out_dir.join("trajectory.csv"),
-        trajectory_csv(arm, &traj).as_bytes(),
-    )?;
+    let table = softarm::run::Table::of(arm, &traj);
+    write_atomic(&out_dir.join("trajectory.csv"), table.csv().as_bytes())?;
     if let Some(shape) = &shape {
         let csv = shape.csv(arm, &traj.t, &traj.x);
         write_atomic(&out_dir.join("shape.csv"), csv.as_bytes())?;
     }
     plot_paths_and_contact(&loaded, &traj, &out_dir)?;
-    let final_state = traj.x.last().cloned().unwrap_or_default();
-    let t_final = traj.t.last().copied().unwrap_or(0.0);
-    let tip = if final_state.len() == 2 * n {
-        arm.outputs(t_final, &final_state[..n], &final_state[n..])
-    } else {
-        [f64::NAN; runtime::N_OUTPUTS]
-    };
     let tip_error = match (&measured, &loaded.model.compare) {
         (Some(m), Some(_)) => compare_tip(&loaded, m, &traj, &out_dir)?,
         _ => None,
     };
-    let summary = json!({
-        "model": loaded.model.name,
-        "origin": loaded.origin,
-        "structural_hash": loaded.hash,
-        "backend": arm.backend(),
-        "cache": loaded.cache,
-        "derive_s": loaded.derive_s,
-        "solver": stats.solver,
-        "rtol": opts.rtol,
-        "atol": opts.atol,
-        "dt": solver.fixed_step().then_some(opts.dt),
-        "t_end": t_end,
-        "options": option_sources(&a, &loaded.model.simulate, &opts),
-        "steps": stats.steps,
-        "rejected_steps": stats.rejected_steps,
-        "rhs_evaluations": stats.rhs_evaluations,
-        "jacobian_evaluations": stats.jacobian_evaluations,
-        "solver_switch": stats.switched,
-        "wall_s": stats.wall_s,
-        "status": if failure.is_some() { "failed" } else { "ok" },
-        "tip_error": tip_error,
-        "assembly_moved": assembled_m,
-        "constraint_drift_max_m": stats.constraints.map(|c| c.drift_max_m),
-        "constraints": stats.constraints,
-        "contact": softarm::contact::summary(arm, &traj, stats.contact),
-        "failure": failure.as_ref().map(|f| f.1.clone()),
-        "final_state": {
-            "t": t_final,
-            "q": final_state.get(..n),
-            "qd": final_state.get(n..),
-            "tip_position": &tip[..3],
-            "kinetic_energy": tip[3],
-            "potential_energy": tip[4],
-        },
-    });
+    let mut summary = softarm::run::summary(
+        &loaded,
+        &opts,
+        &stats,
+        &traj,
+        tip_error.as_ref(),
+        failure.as_ref().map(|f| f.1.clone()),
+    );
+    summary["options"] = option_sources(&a, &loaded.model.simulate, &opts);
+    summary["assembly_moved"] = json!(assembled_m);
     write_atomic(
         &out_dir.join("summary.json"),
         serde_json::to_string_pretty(&summary)?.as_bytes(),

@@ -6,13 +6,13 @@
 //! it (k G A, k the `shear_factor`), as the lumped methods' keys do.
 
 use anyhow::Result;
-use eomgen::model::{Method, Model, base_rotation};
+use eomgen::model::{Model, base_rotation};
 use nalgebra::Matrix3;
 use runtime::cosserat::{Rod, RodLoads, RodOptions, RodSolution, solve_rod};
 
 /// True when the model asks for the Cosserat rod.
 pub fn is_cosserat(model: &Model) -> bool {
-    model.segments.iter().any(|s| s.method == Method::Cosserat)
+    model.segments.iter().any(|s| s.method.statics_only())
 }
 
 /// Solve the static rod of a model whose segment is `cosserat`

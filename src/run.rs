@@ -195,3 +195,120 @@ pub fn tip_error(
         tips.iter().find(|s| (s.0 - t).abs() < 1e-9).map(|s| s.1)
     })
 }
+
+/// A run's table, every column of `trajectory.csv` by name: t, the
+/// coordinates, their rates (`<name>_dot`), the outputs
+/// (`runtime::OUTPUT_NAMES`), the joints' forces and moments, the
+/// contacts' forces. Built once for the CLI and Python, so that both have
+/// every column.
+pub struct Table {
+    pub names: Vec<String>,
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Table {
+    /// The table of a run of `arm`.
+    pub fn of(arm: &dyn runtime::Dynamics, traj: &runtime::Trajectory) -> Self {
+        let n = arm.dof();
+        let coords = &arm.info().coordinates;
+        let mut names = vec!["t".to_string()];
+        names.extend(coords.iter().cloned());
+        names.extend(coords.iter().map(|c| format!("{c}_dot")));
+        names.extend(runtime::OUTPUT_NAMES.iter().map(|o| o.to_string()));
+        names.extend(crate::joints::reaction_names(arm));
+        names.extend(crate::contact::column_names(arm));
+        let joints = !arm.info().constraints.is_empty();
+        let rows = (traj.t.iter().zip(&traj.x).enumerate())
+            .map(|(i, (t, x))| {
+                let mut row = Vec::with_capacity(names.len());
+                row.push(*t);
+                row.extend_from_slice(x);
+                row.extend(arm.outputs(*t, &x[..n], &x[n..]));
+                if joints {
+                    row.extend(crate::joints::reactions(arm, *t, x));
+                }
+                row.extend(crate::contact::columns(arm, traj, i));
+                row
+            })
+            .collect();
+        Self { names, rows }
+    }
+
+    /// The first column of the forces (joints', then contacts'): after t,
+    /// q, qd and the outputs.
+    pub fn forces_from(dof: usize) -> usize {
+        1 + 2 * dof + runtime::N_OUTPUTS
+    }
+
+    /// As `trajectory.csv`: a header of the names, t to 9 decimals, the
+    /// rest to 13 significant digits.
+    pub fn csv(&self) -> String {
+        let mut s = self.names.join(",");
+        s.push('\n');
+        for row in &self.rows {
+            s.push_str(&format!("{:.9}", row[0]));
+            for v in &row[1..] {
+                s.push_str(&format!(",{v:.12e}"));
+            }
+            s.push('\n');
+        }
+        s
+    }
+}
+
+/// What `summary.json` says of a run, for the CLI and Python alike: the
+/// model and its backend, the options, what the solver counted, the tip
+/// error, the joints' drift, the contacts, the failure (if any) and the
+/// final state. A front end adds only what is its own (the CLI: where each
+/// option came from).
+pub fn summary(
+    loaded: &Loaded,
+    opts: &SimOptions,
+    stats: &runtime::SimStats,
+    traj: &runtime::Trajectory,
+    tip_error: Option<&crate::compare::TipError>,
+    failure: Option<serde_json::Value>,
+) -> serde_json::Value {
+    let arm = &*loaded.arm;
+    let n = arm.dof();
+    let final_state = traj.x.last().cloned().unwrap_or_default();
+    let t_final = traj.t.last().copied().unwrap_or(0.0);
+    let tip = if final_state.len() == 2 * n {
+        arm.outputs(t_final, &final_state[..n], &final_state[n..])
+    } else {
+        [f64::NAN; runtime::N_OUTPUTS]
+    };
+    serde_json::json!({
+        "model": loaded.model.name,
+        "origin": loaded.origin,
+        "structural_hash": loaded.hash,
+        "backend": arm.backend(),
+        "cache": loaded.cache,
+        "derive_s": loaded.derive_s,
+        "solver": stats.solver,
+        "rtol": opts.rtol,
+        "atol": opts.atol,
+        "dt": opts.solver.fixed_step().then_some(opts.dt),
+        "t_end": opts.t_end,
+        "steps": stats.steps,
+        "rejected_steps": stats.rejected_steps,
+        "rhs_evaluations": stats.rhs_evaluations,
+        "jacobian_evaluations": stats.jacobian_evaluations,
+        "solver_switch": stats.switched,
+        "wall_s": stats.wall_s,
+        "status": if failure.is_some() { "failed" } else { "ok" },
+        "tip_error": tip_error,
+        "constraint_drift_max_m": stats.constraints.map(|c| c.drift_max_m),
+        "constraints": stats.constraints,
+        "contact": crate::contact::summary(arm, traj, stats.contact),
+        "failure": failure,
+        "final_state": {
+            "t": t_final,
+            "q": final_state.get(..n),
+            "qd": final_state.get(n..),
+            "tip_position": &tip[..3],
+            "kinetic_energy": tip[3],
+            "potential_energy": tip[4],
+        },
+    })
+}

@@ -750,7 +750,7 @@ fn malformed_3d_models_are_rejected_clearly() {
             vec![
                 "segment[0].shear",
                 "ebr segments carry no shear strain",
-                "pcs, pcc, vc",
+                "shear is for pcc, pcs, vc, rom and cosserat segments",
             ],
         ),
         (

@@ -291,7 +291,8 @@ value = 0.0
         )
     };
     let lifted = r#"translation_inputs = ["still", "lift", "still"]"#;
-    for method in ["pcc", "ebr", "eba", "rom", "rigid"] {
+    let methods = (eomgen::method::ALL.iter()).filter(|m| !m.statics_only());
+    for method in methods.map(|m| m.name()) {
         let still = load_text(dir.path(), &arm(method, -g, ""), &[]);
         let moving = load_text(dir.path(), &arm(method, 0.0, lifted), &[]);
         let n = still.arm.dof();

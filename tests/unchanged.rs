@@ -129,33 +129,55 @@ fn simulations(loaded: &mut softarm::backend::Loaded) -> Value {
 }
 
 /// Model variants that exercise what the bundled models do not (every
-/// method under actuation, torques, a moving base and tip wrenches): the
-/// interpreted kernels at the fixed states and the static solution.
-const VARIANTS: &[(&str, &str, &[&str])] = &[
+/// method under actuation, torques, a moving base and tip wrenches), with
+/// the segment whose method varies: each with every method of the
+/// registry that the file takes, the interpreted kernels at the fixed
+/// states and the static solution.
+const VARIANTS: &[(&str, &str, usize)] = &[
     (
         "everything3d",
         "tests/fixtures/variants/everything3d.toml",
-        &["pcc", "vc", "ebr", "rom", "rigid"],
+        1,
     ),
     (
         "everything2d",
         "tests/fixtures/variants/everything2d.toml",
-        &["pcc", "vc", "rigid"],
+        1,
     ),
-    (
-        "stiff_flop",
-        "stiff_flop",
-        &["eba", "rom", "ebr", "vc", "rigid"],
-    ),
+    ("stiff_flop", "stiff_flop", 0),
 ];
 
-fn record_variant(file: &str, segment: usize, method: &str) -> Value {
-    let dir = tempfile::tempdir().unwrap();
-    let spec = if file.ends_with(".toml") {
+/// A variant's file name (a path, or a bundled model's name).
+fn variant_spec(file: &str) -> String {
+    if file.ends_with(".toml") {
         root().join(file).to_string_lossy().into_owned()
     } else {
         file.to_string()
+    }
+}
+
+/// The methods of the registry a variant takes at its segment (the others
+/// are rejected by the model's checks).
+fn variant_methods(file: &str, segment: usize) -> Vec<&'static str> {
+    let path = if file.ends_with(".toml") {
+        root().join(file)
+    } else {
+        root().join("models").join(format!("{file}.toml"))
     };
+    eomgen::method::ALL
+        .iter()
+        .map(|m| m.name())
+        .filter(|name| {
+            let set = format!("segment.{segment}.method={name}");
+            let set = eomgen::model::Override::parse(&set).unwrap();
+            eomgen::model::load_model(&path, &[set]).is_ok()
+        })
+        .collect()
+}
+
+fn record_variant(file: &str, segment: usize, method: &str) -> Value {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = variant_spec(file);
     let set =
         eomgen::model::Override::parse(&format!("segment.{segment}.method={method}")).unwrap();
     let mut l = load(
@@ -279,11 +301,14 @@ fn every_bundled_model_computes_what_its_fixture_recorded() {
 fn every_variant_computes_what_its_fixture_recorded() {
     let recording = std::env::var_os("SOFTARM_RECORD_FIXTURES").is_some();
     let mut failures = Vec::new();
-    for (name, file, methods) in VARIANTS {
-        let segment = if file.ends_with(".toml") { 1 } else { 0 };
-        for method in *methods {
+    let mut recorded = std::collections::BTreeSet::new();
+    for &(name, file, segment) in VARIANTS {
+        let methods = variant_methods(file, segment);
+        assert!(methods.len() >= 3, "{name}: takes only {methods:?}");
+        for method in methods {
             let now = record_variant(file, segment, method);
             let key = format!("{name}-{method}");
+            recorded.insert(format!("{key}.json"));
             let path = root()
                 .join("tests/fixtures/variants")
                 .join(format!("{key}.json"));
@@ -291,11 +316,24 @@ fn every_variant_computes_what_its_fixture_recorded() {
                 std::fs::write(&path, serde_json::to_string(&now).unwrap()).unwrap();
                 continue;
             }
-            let then: Value =
-                serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+            let Ok(text) = std::fs::read_to_string(&path) else {
+                failures.push(format!("{key}: no fixture (record it)"));
+                continue;
+            };
+            let then: Value = serde_json::from_str(&text).unwrap();
             let before = failures.len();
             compare(&now, &then, &key, &mut failures);
             failures.truncate(before + 20);
+        }
+    }
+    // Every variant fixture is of a method a variant takes: one left behind
+    // would silently test nothing.
+    for e in std::fs::read_dir(root().join("tests/fixtures/variants")).unwrap() {
+        let name = e.unwrap().file_name().to_string_lossy().into_owned();
+        if name.ends_with(".json") && !recording && !recorded.contains(&name) {
+            failures.push(format!(
+                "tests/fixtures/variants/{name}: of no variant's method"
+            ));
         }
     }
     assert!(

@@ -375,63 +375,25 @@ impl Model {
             }
             Err(f) => return Err(integration_error(&f)),
         };
-        let rows = traj.t.len();
-        let states = Array2::from_shape_fn((rows, 2 * n), |(i, j)| traj.x[i][j]);
-        let outs: Vec<[f64; N_OUTPUTS]> = (traj.t.iter().zip(&traj.x))
-            .map(|(t, x)| arm.outputs(*t, &x[..n], &x[n..]))
-            .collect();
-        let outputs = Array2::from_shape_fn((rows, N_OUTPUTS), |(i, j)| outs[i][j]);
+        // trajectory.csv's table, built as the CLI builds it: the states,
+        // the outputs, and every column after them (the joints' and the
+        // contacts' forces) by name.
+        let table = softarm::run::Table::of(arm, &traj);
+        let rows = table.rows.len();
+        let outs_at = 1 + 2 * n;
+        let forces_at = softarm::run::Table::forces_from(n);
+        let states = Array2::from_shape_fn((rows, 2 * n), |(i, j)| table.rows[i][1 + j]);
+        let outputs = Array2::from_shape_fn((rows, N_OUTPUTS), |(i, j)| table.rows[i][outs_at + j]);
+        let names = table.names[forces_at..].to_vec();
+        let columns =
+            Array2::from_shape_fn((rows, names.len()), |(i, j)| table.rows[i][forces_at + j]);
         let tip_error = measured.as_ref().and_then(|m| {
             let tips = softarm::run::tips(&self.loaded, &traj);
             softarm::run::tip_error(&self.loaded, m, &tips).ok()
         });
-        let arm = &*self.loaded.arm;
-        let summary = serde_json::json!({
-            "tip_error": tip_error,
-            "model": self.loaded.model.name,
-            "backend": arm.backend(),
-            "solver": stats.solver,
-            "t_end": opts.t_end, "rtol": opts.rtol, "atol": opts.atol,
-            "steps": stats.steps,
-            "rejected_steps": stats.rejected_steps,
-            "rhs_evaluations": stats.rhs_evaluations,
-            "jacobian_evaluations": stats.jacobian_evaluations,
-            "wall_s": stats.wall_s,
-            "status": "ok",
-        });
-        // The joints' forces and the contacts' forces, as trajectory.csv
-        // has them.
-        let mut names = softarm::joints::reaction_names(arm);
-        let joints = !arm.info().constraints.is_empty();
-        names.extend(softarm::contact::column_names(arm));
-        let extra: Vec<Vec<f64>> = (0..rows)
-            .map(|i| {
-                let mut row = if joints {
-                    softarm::joints::reactions(arm, traj.t[i], &traj.x[i])
-                } else {
-                    Vec::new()
-                };
-                row.extend(softarm::contact::columns(arm, &traj, i));
-                row
-            })
-            .collect();
-        let columns = Array2::from_shape_fn((rows, names.len()), |(i, j)| extra[i][j]);
-        // Every input channel's value at the rows.
-        let mut channels = Vec::new();
-        for (name, input) in &self.loaded.model.inputs {
-            let signal = match self.replaced.get(name) {
-                Some(s) => s.clone(),
-                None => softarm::inputs::signal(name, input, &self.loaded.base_dir)
-                    .map_err(value_error)?,
-            };
-            channels.push((
-                name.clone(),
-                traj.t.iter().map(|&t| signal.at(t)).collect::<Vec<_>>(),
-            ));
-        }
-        let channel_names: Vec<String> = channels.iter().map(|(n, _)| n.clone()).collect();
-        let channel_values =
-            Array2::from_shape_fn((rows, channels.len()), |(i, j)| channels[j].1[i]);
+        let summary =
+            softarm::run::summary(&self.loaded, &opts, &stats, &traj, tip_error.as_ref(), None);
+        let (channel_names, channel_values) = self.channels_at(&traj.t)?;
         let t = traj.t.into_pyarray(py);
         let items: Vec<Bound<'py, PyAny>> = vec![
             t.into_any(),
@@ -444,6 +406,28 @@ impl Model {
             channel_values.into_pyarray(py).into_any(),
         ];
         pyo3::types::PyTuple::new(py, items)
+    }
+}
+
+impl Model {
+    /// Every input channel's name and its values at times `t` (a column a
+    /// channel), the channels this run replaced included.
+    fn channels_at(&self, t: &[f64]) -> PyResult<(Vec<String>, Array2<f64>)> {
+        let mut channels = Vec::new();
+        for (name, input) in &self.loaded.model.inputs {
+            let signal = match self.replaced.get(name) {
+                Some(s) => s.clone(),
+                None => softarm::inputs::signal(name, input, &self.loaded.base_dir)
+                    .map_err(value_error)?,
+            };
+            channels.push((
+                name.clone(),
+                t.iter().map(|&t| signal.at(t)).collect::<Vec<_>>(),
+            ));
+        }
+        let names = channels.iter().map(|(n, _)| n.clone()).collect();
+        let values = Array2::from_shape_fn((t.len(), channels.len()), |(i, j)| channels[j].1[i]);
+        Ok((names, values))
     }
 }
 

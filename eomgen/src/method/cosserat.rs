@@ -9,6 +9,14 @@ use crate::model::{Check, ModelError, Segment, SegmentShape};
 pub(super) struct Cosserat;
 
 impl ModellingMethod for Cosserat {
+    fn statics_only(&self) -> bool {
+        true
+    }
+
+    fn lumps_section(&self) -> bool {
+        false
+    }
+
     fn check_keys(&self, ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
         if s.incompressible == Some(true) {
             return ck.err(

@@ -22,10 +22,10 @@
 use runtime::Tape;
 use runtime::parts::{PartKernels, PartLayout, PartSpec};
 
-use super::{ModellingMethod, needs_bending_stiffness};
+use super::{Carried, Method, ModellingMethod, needs_bending_stiffness};
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{
-    Check, ElementParam, Method, ModelError, Param, ParamLayout, Segment, SegmentShape, Structure,
+    Check, ElementParam, ModelError, Param, ParamLayout, Segment, SegmentShape, Structure,
     Xyz,
 };
 use crate::tmt::actuation::{Strain, actuation, thinning};
@@ -41,6 +41,22 @@ use crate::tmt::system::{
 pub(super) struct Eba;
 
 impl ModellingMethod for Eba {
+    fn twist(&self) -> Carried {
+        Carried::Always
+    }
+
+    fn stretch(&self) -> Carried {
+        Carried::Always
+    }
+
+    fn shear(&self) -> Carried {
+        Carried::Always
+    }
+
+    fn segment_end_frames(&self) -> bool {
+        false
+    }
+
     fn spatial_only(&self) -> bool {
         true
     }

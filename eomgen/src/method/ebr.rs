@@ -3,15 +3,42 @@
 //! and z, optional twist) and stretches, and the other half: two bodies
 //! an element. 3D only.
 
-use super::{ModellingMethod, needs_bending_stiffness, strain_coordinate_names};
+use super::{
+    Carried, ModellingMethod, half_links_inertia, needs_bending_stiffness, strain_coordinate_names,
+};
 use crate::cas::Cas;
 use crate::cas::ExprId;
-use crate::model::{Check, ModelError, Segment, SegmentShape};
+use crate::model::{Check, Joints, ModelError, Segment, SegmentShape};
+use crate::tmt::cell_kind::CellKind;
 use crate::tmt::spatial::{Frame, SpatialArm, V3, advance, compose, exp_turn};
 
 pub(super) struct Ebr;
 
 impl ModellingMethod for Ebr {
+    fn joints(&self, _s: &Segment) -> Joints {
+        Joints::Midpoint
+    }
+
+    fn shear(&self) -> Carried {
+        Carried::Never
+    }
+
+    /// Two half links about the joint.
+    fn element_inertia(
+        &self,
+        _s: &Segment,
+        mass: f64,
+        l: f64,
+        section: f64,
+        _dimensions: u8,
+    ) -> (f64, f64) {
+        half_links_inertia(mass, l, section)
+    }
+
+    fn cell_kind(&self, _g: &SegmentShape, _spatial: bool) -> CellKind {
+        CellKind::PastJoint
+    }
+
     fn spatial_only(&self) -> bool {
         true
     }

@@ -9,23 +9,32 @@
 //! `tmt::spatial::SpatialArm`) and `tmt::system`; a segment's section and
 //! material checks in `model::validate`.
 //!
-//! Adding a method: a file here implementing the trait, a variant of
-//! `model::Method`, and its line in [`of`].
-
-mod cosserat;
-pub(crate) mod eba;
-pub(crate) mod ebr;
-mod pcc;
-mod pcs;
-mod rigid;
-pub(crate) mod rom;
-mod vc;
+//! Nothing outside this folder matches on `model::Method`: what the model
+//! checks, the structure, the parameters, contact and the cells ask of a
+//! method, they ask through [`of`] (`tests/architecture.rs` holds it).
+//!
+//! Adding a method: a file here implementing the trait and its line in
+//! the `registry!` below (its variant, its name in model files, its type).
 
 use crate::cas::Cas;
-use crate::model::{Check, Method, ModelError, Segment, SegmentShape, Structure};
+use serde::{Deserialize, Serialize};
+
+use crate::model::{Axis, Check, Joints, ModelError, Segment, SegmentShape, Structure};
+use crate::tmt::cell_kind::CellKind;
 use crate::tmt::planar::{Element2, PlanarArm};
 use crate::tmt::spatial::SpatialArm;
 use crate::tmt::system::{ParamSymbols, System};
+
+/// Whether a method's elements carry a strain beyond bending (3D).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Carried {
+    /// Never (a rigid link neither stretches nor shears).
+    Never,
+    /// As the segment's keys say (`extension`, `shear`).
+    Optional,
+    /// Always (eba's beam springs stretch and shear).
+    Always,
+}
 
 /// What a modelling method is, to the generator and to validation.
 pub(crate) trait ModellingMethod: Sync {
@@ -78,33 +87,216 @@ pub(crate) trait ModellingMethod: Sync {
     fn link_cells(&self) -> bool {
         false
     }
-}
 
-/// The method of a segment.
-pub(crate) fn of(method: Method) -> &'static dyn ModellingMethod {
-    match method {
-        Method::Rigid => &rigid::Rigid,
-        Method::Pcc => &pcc::Pcc,
-        Method::Pcs => &pcs::Pcs,
-        Method::Vc => &vc::Vc,
-        Method::Ebr => &ebr::Ebr,
-        Method::Eba => &eba::Eba,
-        Method::Rom => &rom::Rom,
-        Method::Cosserat => &cosserat::Cosserat,
+    /// A method of statics alone (no equations of motion: nothing to
+    /// derive, sample or simulate).
+    fn statics_only(&self) -> bool {
+        false
+    }
+
+    /// The method whose derivation serves this one's structure, when
+    /// another's does (vc and pcs are pcc's arcs).
+    fn derived_as(&self) -> Option<Method> {
+        None
+    }
+
+    /// Lumped slices of a segment.
+    fn slices(&self, s: &Segment) -> usize {
+        s.elements
+    }
+
+    /// Its coordinates are the coefficients of polynomial strain fields
+    /// of the segment's `order` (structural, and in the structure's
+    /// canonical form).
+    fn polynomial_fields(&self) -> bool {
+        false
+    }
+
+    /// Where the joints of a segment's elements sit.
+    fn joints(&self, _s: &Segment) -> Joints {
+        Joints::Base
+    }
+
+    /// 3D: the revolute axes of each joint (a method of joints).
+    fn joint_axes(&self, _s: &Segment) -> Vec<Axis> {
+        Vec::new()
+    }
+
+    /// 3D: coordinates per element.
+    fn coordinates_per_element(&self, g: &SegmentShape) -> usize {
+        2 + usize::from(g.twist) + usize::from(g.extension) + 2 * usize::from(g.shear)
+    }
+
+    /// 3D: whether elements twist, stretch and shear (beyond the segment's
+    /// keys, the method decides).
+    fn twist(&self) -> Carried {
+        Carried::Optional
+    }
+    fn stretch(&self) -> Carried {
+        Carried::Optional
+    }
+    fn shear(&self) -> Carried {
+        Carried::Optional
+    }
+
+    /// 3D: `extension` and `shear` are on unless the keys say otherwise.
+    fn all_strains_by_default(&self) -> bool {
+        false
+    }
+
+    /// 3D: a segment twists (a torsional stiffness is then needed).
+    fn twisting(&self, s: &Segment) -> bool {
+        s.twists()
+    }
+
+    /// The section is lumped, so `incompressible` can thin it as an
+    /// element stretches (the Cosserat rod keeps its section).
+    fn lumps_section(&self) -> bool {
+        true
+    }
+
+    /// An element's rotational inertia about a diameter through its centre
+    /// and about its axis, from its mass, length and the section's share
+    /// (m I / A), in `dimensions`.
+    fn element_inertia(
+        &self,
+        _s: &Segment,
+        mass: f64,
+        l: f64,
+        section: f64,
+        dimensions: u8,
+    ) -> (f64, f64) {
+        // The section's part of an arc; in 3D the arc is lumped as a
+        // straight slice (in 2D its part is derived symbolically).
+        let slice = if dimensions == 3 {
+            mass * l * l / 12.0
+        } else {
+            0.0
+        };
+        (section + slice, 2.0 * section)
+    }
+
+    /// A segment's end is a frame a joint may hold.
+    fn segment_end_frames(&self) -> bool {
+        true
+    }
+
+    /// The kind of link cell a segment's elements make (`tmt::cell`).
+    fn cell_kind(&self, _g: &SegmentShape, _spatial: bool) -> CellKind {
+        CellKind::Arc
     }
 }
 
-/// Every method, for the keys they own.
-const ALL: [Method; 8] = [
-    Method::Rigid,
-    Method::Pcc,
-    Method::Pcs,
-    Method::Vc,
-    Method::Ebr,
-    Method::Eba,
-    Method::Rom,
-    Method::Cosserat,
-];
+/// Two half links, each half the element (midpoint joints).
+fn half_links_inertia(mass: f64, l: f64, section: f64) -> (f64, f64) {
+    (
+        (mass / 2.0) * (l / 2.0).powi(2) / 12.0 + section / 2.0,
+        section,
+    )
+}
+
+/// The strains a segment's elements carry in 3D: twist, extension, shear.
+pub(crate) fn strains(s: &Segment) -> (bool, bool, bool) {
+    let m = of(s.method);
+    let by = |c: Carried, key: bool| match c {
+        Carried::Never => false,
+        Carried::Optional => key,
+        Carried::Always => true,
+    };
+    // Shear strain coordinates only where the keys choose them: a method
+    // that always shears (eba) does so through its own coordinates' beam
+    // springs.
+    (
+        by(m.twist(), s.twists()),
+        by(m.stretch(), s.stretches()),
+        m.shear() == Carried::Optional && s.shears(),
+    )
+}
+
+/// The names of the methods `which` picks, as a list in prose ("a, b
+/// and c"), for messages.
+pub(crate) fn named(which: impl Fn(&dyn ModellingMethod) -> bool) -> String {
+    let names: Vec<&str> = (ALL.iter())
+        .filter(|m| which(of(**m)))
+        .map(|m| m.name())
+        .collect();
+    match names.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => names.concat(),
+    }
+}
+
+impl Method {
+    /// A method of statics alone (the Cosserat rod).
+    pub fn statics_only(self) -> bool {
+        of(self).statics_only()
+    }
+}
+
+/// The registry: each method's variant, its name in model files, and its
+/// file and type. Declares the files, the `Method` enum (a segment's
+/// `method` key), [`of`], [`ALL`] and `Method::name`.
+macro_rules! registry {
+    ($($(#[$doc:meta])* $variant:ident = $name:literal => $file:ident::$ty:ident,)*) => {
+        $(pub(crate) mod $file;)*
+
+        /// How a segment is modelled. Structural: changing it derives anew.
+        #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
+        pub enum Method {
+            $($(#[$doc])* #[serde(rename = $name)] $variant,)*
+        }
+
+        /// Every method, in the registry's order.
+        pub const ALL: &[Method] = &[$(Method::$variant),*];
+
+        /// The method of a segment.
+        pub(crate) fn of(method: Method) -> &'static dyn ModellingMethod {
+            match method {
+                $(Method::$variant => &$file::$ty,)*
+            }
+        }
+
+        impl Method {
+            /// Its name in model files and messages.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(Method::$variant => $name,)*
+                }
+            }
+        }
+    };
+}
+
+registry! {
+    /// A chain of `elements` rigid links joined by revolute joints.
+    Rigid = "rigid" => rigid::Rigid,
+    /// Piecewise constant curvature: `elements` arcs, one bending angle each
+    /// (planar) or two bending angles, optional twist and stretch (3D).
+    Pcc = "pcc" => pcc::Pcc,
+    /// Piecewise constant strain (the discrete Cosserat rod): pcc's arcs
+    /// with all six strains of the rod, two bendings, twist, extension and
+    /// two shears, each constant over an element. 3D only; `twist`,
+    /// `extension` and `shear` default to true.
+    Pcs = "pcs" => pcs::Pcs,
+    /// Variable curvature: one constant-curvature arc per segment, each
+    /// segment with its own length, section and material.
+    Vc = "vc" => vc::Vc,
+    /// Euler-Bernoulli elements with relative states: rigid elements joined
+    /// at their midpoints by a rotation (two bending angles and a twist, as
+    /// a rotation vector) and an optional stretch. 3D only.
+    Ebr = "ebr" => ebr::Ebr,
+    /// Euler-Bernoulli elements with absolute states: each element's
+    /// position and orientation in the world frame (6 coordinates), the
+    /// elements coupled by beam springs (bending, twist, axial, shear).
+    /// 3D only; twist and stretch are always present.
+    Eba = "eba" => eba::Eba,
+    /// Reduced-order model: curvature, twist and stretch as polynomials in
+    /// s of degree `order`, the coefficients the coordinates; kinematics,
+    /// mass and energies by `quadrature` slices along s. 3D only.
+    Rom = "rom" => rom::Rom,
+    /// The Cosserat rod, solved as a boundary value problem: statics only.
+    Cosserat = "cosserat" => cosserat::Cosserat,
+}
 
 /// The generalised coordinates' names of a structure, in order: one angle
 /// an element in the plane, else each segment's method's.
@@ -125,7 +317,7 @@ pub fn coordinate_names(st: &Structure) -> Vec<String> {
 pub(crate) fn check_segment(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
     let method = of(s.method);
     let given = serde_json::to_value(s).unwrap_or_default();
-    for other in ALL {
+    for &other in ALL {
         for &key in of(other).own_keys() {
             let present = given.get(key).is_some_and(|v| !v.is_null());
             if present && !method.own_keys().contains(&key) {
@@ -211,19 +403,25 @@ extension = true
     }
 
     /// Each method's coordinates, counted from its definition in the
-    /// chapter: per element 2 bends + twist + stretch (pcc, vc, ebr), 6
-    /// absolute states (eba), one per joint axis (rigid); per strain field
-    /// order + 1 coefficients (rom). Names are unique.
+    /// chapter: per element 2 bends + twist + stretch (pcc, vc, ebr), all
+    /// six strains (pcs), 6 absolute states (eba), one per joint axis
+    /// (rigid); per strain field order + 1 coefficients (rom); none for a
+    /// method of statics alone. Every method of the registry has its count
+    /// here. Names are unique.
     #[test]
     fn coordinates_count_as_each_method_defines_them() {
-        for (method, extra, want) in [
-            ("pcc", "", 3 * 4),
-            ("vc", "", 3 * 4),
-            ("ebr", "", 3 * 4),
-            ("eba", "", 3 * 6),
-            ("rom", "order = 2", 4 * 3),
-            ("rigid", "joint_axes = [\"z\", \"y\"]", 3 * 2),
-        ] {
+        let defined = |method: &str| match method {
+            "pcc" | "vc" | "ebr" => Some(("", 3 * 4)),
+            "pcs" => Some(("", 3 * 6)),
+            "eba" => Some(("", 3 * 6)),
+            "rom" => Some(("order = 2", 4 * 3)),
+            "rigid" => Some(("joint_axes = [\"z\", \"y\"]", 3 * 2)),
+            "cosserat" => Some(("", 0)),
+            _ => None,
+        };
+        for method in ALL.iter().map(|m| m.name()) {
+            let (extra, want) =
+                defined(method).unwrap_or_else(|| panic!("{method}: give its coordinate count"));
             let m = model(method, extra).unwrap_or_else(|e| panic!("{method}: {e}"));
             let names = coordinate_names(&Structure::of(&m));
             assert_eq!(names.len(), want, "{method}: {names:?}");

@@ -7,12 +7,22 @@
 use super::{ModellingMethod, needs_bending_stiffness, strain_coordinate_names};
 use crate::cas::{Cas, ExprId, Func};
 use crate::model::{Check, ModelError, Segment, SegmentShape};
+use crate::tmt::cell_kind::CellKind;
 use crate::tmt::planar::{self, Element2, Frame, PlanarArm};
 use crate::tmt::spatial::{SpatialArm, arc, bind3, in_halves};
 
 pub(super) struct Pcc;
 
 impl ModellingMethod for Pcc {
+    /// A stretching or shearing arc carries its mass as two half-arcs.
+    fn cell_kind(&self, g: &SegmentShape, spatial: bool) -> CellKind {
+        if spatial && in_halves(g) {
+            CellKind::HalfArc
+        } else {
+            CellKind::Arc
+        }
+    }
+
     fn check_keys(&self, ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
         needs_bending_stiffness(ck, i, s)
     }

@@ -7,7 +7,7 @@
 //! derivation and one compiled model serve both); here only what differs:
 //! 3D only, and its name in messages.
 
-use super::ModellingMethod;
+use super::{Method, ModellingMethod};
 use super::pcc::Pcc;
 use crate::cas::Cas;
 use crate::model::{Check, ModelError, Segment, SegmentShape};
@@ -16,6 +16,14 @@ use crate::tmt::spatial::SpatialArm;
 pub(super) struct Pcs;
 
 impl ModellingMethod for Pcs {
+    fn derived_as(&self) -> Option<Method> {
+        Some(Method::Pcc)
+    }
+
+    fn all_strains_by_default(&self) -> bool {
+        true
+    }
+
     fn spatial_only(&self) -> bool {
         true
     }

@@ -4,9 +4,9 @@
 //! tip). In 3D each joint turns about the element frame's axes in
 //! sequence (a universal or spherical joint).
 
-use super::ModellingMethod;
+use super::{Carried, ModellingMethod, half_links_inertia};
 use crate::cas::Cas;
-use crate::model::{Check, ElementParam, Joints, ModelError, Segment, SegmentShape};
+use crate::model::{Axis, Check, ElementParam, Joints, ModelError, Segment, SegmentShape};
 use crate::tmt::actuation::Strain;
 use crate::tmt::planar::{self, Element2, PlanarArm};
 use crate::tmt::spatial::{Frame, SpatialArm, advance, half_k_sq, revolute};
@@ -14,6 +14,50 @@ use crate::tmt::spatial::{Frame, SpatialArm, advance, half_k_sq, revolute};
 pub(super) struct Rigid;
 
 impl ModellingMethod for Rigid {
+    fn joints(&self, s: &Segment) -> Joints {
+        s.joint_placement()
+    }
+
+    fn joint_axes(&self, s: &Segment) -> Vec<Axis> {
+        s.axes()
+    }
+
+    fn coordinates_per_element(&self, g: &SegmentShape) -> usize {
+        g.axes.len()
+    }
+
+    /// Its twist is a joint axis, not a strain coordinate.
+    fn twist(&self) -> Carried {
+        Carried::Never
+    }
+
+    fn stretch(&self) -> Carried {
+        Carried::Never
+    }
+
+    fn shear(&self) -> Carried {
+        Carried::Never
+    }
+
+    fn twisting(&self, s: &Segment) -> bool {
+        s.axes().contains(&Axis::X)
+    }
+
+    /// The whole link, or two half links at midpoint joints.
+    fn element_inertia(
+        &self,
+        s: &Segment,
+        mass: f64,
+        l: f64,
+        section: f64,
+        _dimensions: u8,
+    ) -> (f64, f64) {
+        match s.joint_placement() {
+            Joints::Midpoint => half_links_inertia(mass, l, section),
+            Joints::Base => (mass * l * l / 12.0 + section, 2.0 * section),
+        }
+    }
+
     fn own_keys(&self) -> &'static [&'static str] {
         &["joint_stiffness", "joint_damping", "joints", "joint_axes"]
     }

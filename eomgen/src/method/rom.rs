@@ -8,12 +8,26 @@ use super::{ModellingMethod, needs_bending_stiffness};
 use crate::cas::{Cas, ExprId};
 use crate::model::{Check, ElementParam, ModelError, Segment, SegmentShape};
 use crate::tmt::actuation::{Strain, thinning};
+use crate::tmt::cell_kind::CellKind;
 use crate::tmt::spatial::{ArcStrain, SpatialArm, V3, arc, bind3, half_k_sq};
 use crate::tmt::system::{Coordinates, ParamSymbols};
 
 pub(super) struct Rom;
 
 impl ModellingMethod for Rom {
+    fn slices(&self, s: &Segment) -> usize {
+        s.quadrature.unwrap_or(4 * (s.rom_order() + 1))
+    }
+
+    fn polynomial_fields(&self) -> bool {
+        true
+    }
+
+    /// A slice is two half-arcs (`RomFields::halves`).
+    fn cell_kind(&self, _g: &SegmentShape, _spatial: bool) -> CellKind {
+        CellKind::HalfArc
+    }
+
     fn own_keys(&self) -> &'static [&'static str] {
         &["order", "quadrature"]
     }

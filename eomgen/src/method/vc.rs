@@ -3,7 +3,7 @@
 //! pcc's (`model::Structure` derives a vc segment as a pcc one, so one
 //! derivation and one compiled model serve both).
 
-use super::ModellingMethod;
+use super::{Method, ModellingMethod};
 use super::pcc::Pcc;
 use crate::cas::Cas;
 use crate::model::{Check, ModelError, Segment, SegmentShape};
@@ -13,6 +13,10 @@ use crate::tmt::spatial::SpatialArm;
 pub(super) struct Vc;
 
 impl ModellingMethod for Vc {
+    fn derived_as(&self) -> Option<Method> {
+        Some(Method::Pcc)
+    }
+
     fn check_keys(&self, ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
         Pcc.check_keys(ck, i, s)
     }

@@ -8,7 +8,7 @@ use std::collections::HashSet;
 use super::assembly::{BodyDecl, BodyShape, FrameRef};
 use super::check::Check;
 use super::error::ModelError;
-use super::schema::{Base, Method, Model};
+use super::schema::{Base, Model};
 
 /// The assembly's own checks; `arm` checks one arm as a single-arm model.
 pub(super) fn check_assembly(
@@ -221,15 +221,15 @@ fn joints(ck: &Check) -> Result<(), ModelError> {
         }
         for (k, f) in [("a", a), ("b", b)] {
             if let FrameRef::SegmentEnd { arm, .. } = f
-                && m.arm_models()[arm]
-                    .1
-                    .segments
-                    .iter()
-                    .any(|s| s.method == Method::Eba)
+                && let Some(s) = (m.arm_models()[arm].1.segments.iter())
+                    .find(|s| !crate::method::of(s.method).segment_end_frames())
             {
                 return ck.err(
                     key(k),
-                    "an eba arm's segment ends are not frames yet: hold its tip".into(),
+                    format!(
+                        "an {} arm's segment ends are not frames yet: hold its tip",
+                        s.method.name()
+                    ),
                 );
             }
         }

@@ -5,7 +5,7 @@
 use super::check::Check;
 use super::contact::{ContactLaw, ContactModel, ObstacleDecl, ObstacleShape};
 use super::error::ModelError;
-use super::schema::{Method, Model};
+use super::schema::Model;
 
 /// Largest `points_per_element`: past it contact costs more than the arm.
 pub const MAX_POINTS_PER_ELEMENT: usize = 20;
@@ -210,22 +210,12 @@ fn shape_keys(ck: &Check, key: &str, o: &ObstacleDecl) -> Result<(), ModelError>
     Ok(())
 }
 
-/// Methods whose elements the kinematics sample (every method of the
-/// equations of motion: cosserat is a statics method).
-const SAMPLED: [Method; 7] = [
-    Method::Rigid,
-    Method::Pcc,
-    Method::Pcs,
-    Method::Vc,
-    Method::Ebr,
-    Method::Eba,
-    Method::Rom,
-];
-
 fn sampled_methods(ck: &Check) -> Result<(), ModelError> {
     for (prefix, arm) in ck.m.arm_models() {
         for (i, s) in arm.segments.iter().enumerate() {
-            if !SAMPLED.contains(&s.method) {
+            // The kinematics sample every method of the equations of
+            // motion, none of statics alone.
+            if s.method.statics_only() {
                 let key = if prefix.is_empty() {
                     format!("segment[{i}].method")
                 } else {
@@ -234,8 +224,9 @@ fn sampled_methods(ck: &Check) -> Result<(), ModelError> {
                 return ck.err(
                     key,
                     format!(
-                        "contact samples rigid, pcc, pcs, vc, ebr, eba and rom segments; {} solves statics only",
-                        format!("{:?}", s.method).to_lowercase()
+                        "contact samples {} segments; {} solves statics only",
+                        crate::method::named(|m| !m.statics_only()),
+                        s.method.name()
                     ),
                 );
             }

@@ -14,7 +14,7 @@
 
 use std::collections::HashMap;
 
-use super::schema::{Joints, Method, Model};
+use super::schema::Model;
 use super::structure::Structure;
 
 /// A component of a vector in the world frame.
@@ -737,32 +737,9 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
             _ => mass * (ro * ro + ri * ri) / 4.0,
         };
         // Bodies: the whole link, or two half links (midpoint joints), or
-        // the section's part of a pcc arc (in 2D the arc's part is derived
-        // symbolically; in 3D the arc is lumped as a straight slice, below).
-        let halves = matches!(
-            (s.method, s.joint_placement()),
-            (Method::Rigid, Joints::Midpoint) | (Method::Ebr, _)
-        );
-        let (inertia, axial_inertia) = match s.method {
-            Method::Rigid if !halves => (mass * l * l / 12.0 + section, 2.0 * section),
-            Method::Rigid | Method::Ebr => (
-                (mass / 2.0) * (l / 2.0).powi(2) / 12.0 + section / 2.0,
-                section,
-            ),
-            Method::Pcc
-            | Method::Pcs
-            | Method::Vc
-            | Method::Rom
-            | Method::Eba
-            | Method::Cosserat => {
-                let slice = if m.dimensions == 3 {
-                    mass * l * l / 12.0
-                } else {
-                    0.0
-                };
-                (section + slice, 2.0 * section)
-            }
-        };
+        // the section's part of an arc: the method's.
+        let (inertia, axial_inertia) =
+            crate::method::of(s.method).element_inertia(s, mass, l, section, m.dimensions);
         let stiffness = match s.ei() {
             Some(ei) => ei / l,
             None => s.joint_stiffness.unwrap_or(0.0),

@@ -3,6 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::method::Method;
+
 /// A declared arm (one `models/<arm>.toml`).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -130,55 +132,6 @@ pub struct Base {
     pub rotational_damping: Option<f64>,
     #[serde(default)]
     pub inertia: Option<f64>,
-}
-
-/// How a segment is modelled. Structural: changing it derives anew.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
-#[serde(rename_all = "lowercase")]
-pub enum Method {
-    /// A chain of `elements` rigid links joined by revolute joints.
-    Rigid,
-    /// Piecewise constant curvature: `elements` arcs, one bending angle each
-    /// (planar) or two bending angles, optional twist and stretch (3D).
-    Pcc,
-    /// Piecewise constant strain (the discrete Cosserat rod): pcc's arcs
-    /// with all six strains of the rod, two bendings, twist, extension and
-    /// two shears, each constant over an element. 3D only; `twist`,
-    /// `extension` and `shear` default to true.
-    Pcs,
-    /// Variable curvature: one constant-curvature arc per segment, each
-    /// segment with its own length, section and material.
-    Vc,
-    /// Euler-Bernoulli elements with relative states: rigid elements joined
-    /// at their midpoints by a rotation (two bending angles and a twist, as
-    /// a rotation vector) and an optional stretch. 3D only.
-    Ebr,
-    /// Euler-Bernoulli elements with absolute states: each element's
-    /// position and orientation in the world frame (6 coordinates), the
-    /// elements coupled by beam springs (bending, twist, axial, shear).
-    /// 3D only; twist and stretch are always present.
-    Eba,
-    /// Reduced-order model: curvature, twist and stretch as polynomials in
-    /// s of degree `order`, the coefficients the coordinates; kinematics,
-    /// mass and energies by `quadrature` slices along s. 3D only.
-    Rom,
-    /// The Cosserat rod, solved as a boundary value problem: statics only.
-    Cosserat,
-}
-
-impl Method {
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Rigid => "rigid",
-            Method::Pcc => "pcc",
-            Method::Pcs => "pcs",
-            Method::Vc => "vc",
-            Method::Ebr => "ebr",
-            Method::Eba => "eba",
-            Method::Rom => "rom",
-            Method::Cosserat => "cosserat",
-        }
-    }
 }
 
 /// Where the joints of a rigid segment sit. Structural.
@@ -369,10 +322,7 @@ impl Segment {
 
     /// Lumped slices of the segment: `elements`, or `quadrature` for rom.
     pub fn slices(&self) -> usize {
-        match self.method {
-            Method::Rom => self.quadrature.unwrap_or(4 * (self.rom_order() + 1)),
-            _ => self.elements,
-        }
+        crate::method::of(self.method).slices(self)
     }
 
     /// rom: the polynomial degree.
@@ -387,12 +337,14 @@ impl Segment {
 
     /// 3D: elements stretch.
     pub fn stretches(&self) -> bool {
-        self.extension.unwrap_or(self.method == Method::Pcs)
+        self.extension
+            .unwrap_or(crate::method::of(self.method).all_strains_by_default())
     }
 
     /// 3D: elements shear.
     pub fn shears(&self) -> bool {
-        self.shear.unwrap_or(self.method == Method::Pcs)
+        self.shear
+            .unwrap_or(crate::method::of(self.method).all_strains_by_default())
     }
 
     /// 3D: the revolute axes of each joint of a rigid segment.

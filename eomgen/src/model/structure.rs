@@ -40,14 +40,7 @@ pub struct SegmentShape {
 impl SegmentShape {
     /// Coordinates per element in 3D.
     pub fn coordinates_3d(&self) -> usize {
-        match self.method {
-            Method::Rigid => self.axes.len(),
-            _ => {
-                2 + usize::from(self.twist)
-                    + usize::from(self.extension)
-                    + 2 * usize::from(self.shear)
-            }
-        }
+        crate::method::of(self.method).coordinates_per_element(self)
     }
 }
 
@@ -174,40 +167,31 @@ impl Structure {
             segments: m
                 .segments
                 .iter()
-                .map(|s| SegmentShape {
-                    // vc is pcc one module per segment, pcs pcc with all six
-                    // strains: the same kinematics, so the same derivation
-                    // (and compiled code) serves them.
-                    method: match s.method {
-                        Method::Vc | Method::Pcs => Method::Pcc,
-                        m => m,
-                    },
-                    elements: s.slices(),
-                    order: if s.method == Method::Rom {
-                        s.rom_order()
-                    } else {
-                        0
-                    },
-                    joints: match s.method {
-                        Method::Rigid => s.joint_placement(),
-                        Method::Ebr => Joints::Midpoint,
-                        _ => Joints::Base,
-                    },
-                    twist: spatial
-                        && (s.method == Method::Eba || (s.method != Method::Rigid && s.twists())),
-                    extension: spatial
-                        && (s.method == Method::Eba
-                            || (s.method != Method::Rigid && s.stretches())),
-                    // eba's shear is its beam springs', not coordinates.
-                    shear: spatial
-                        && !matches!(s.method, Method::Rigid | Method::Eba)
-                        && s.shears(),
-                    incompressible: spatial && s.incompressible.unwrap_or(false),
-                    axes: if spatial && s.method == Method::Rigid {
-                        s.axes()
-                    } else {
-                        Vec::new()
-                    },
+                .map(|s| {
+                    let method = crate::method::of(s.method);
+                    let (twist, extension, shear) = crate::method::strains(s);
+                    SegmentShape {
+                        // A method whose kinematics are another's (vc and pcs
+                        // are pcc's arcs) is derived as that one: the same
+                        // derivation (and compiled code) serves both.
+                        method: method.derived_as().unwrap_or(s.method),
+                        elements: s.slices(),
+                        order: if method.polynomial_fields() {
+                            s.rom_order()
+                        } else {
+                            0
+                        },
+                        joints: method.joints(s),
+                        twist: spatial && twist,
+                        extension: spatial && extension,
+                        shear: spatial && shear,
+                        incompressible: spatial && s.incompressible.unwrap_or(false),
+                        axes: if spatial {
+                            method.joint_axes(s)
+                        } else {
+                            Vec::new()
+                        },
+                    }
                 })
                 .collect(),
             tip_mass: m.tip.mass.is_some(),
@@ -300,7 +284,7 @@ impl Structure {
                     s.push_str(" shear");
                 }
             }
-            if g.method == Method::Rom {
+            if crate::method::of(g.method).polynomial_fields() {
                 s.push_str(&format!(" order {}", g.order));
             }
             s.push('\n');

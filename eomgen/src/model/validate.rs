@@ -3,7 +3,8 @@
 
 use super::check::Check;
 use super::error::ModelError;
-use super::schema::{Method, Model, Segment};
+use super::schema::{Model, Segment};
+use crate::method::Carried;
 
 /// Largest element count per segment: beyond it derivation and simulation
 /// times are impractical for a planar chain.
@@ -448,21 +449,21 @@ fn segment_dimension_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), Model
                 format!("give 1 to 3 axes (\"x\", \"y\", \"z\"), got {}", axes.len()),
             );
         }
-        let rigid_joints = s.method == Method::Rigid && s.joint_stiffness.is_some();
-        let twisting = if s.method == Method::Rigid {
-            s.axes().contains(&super::schema::Axis::X)
-        } else {
-            s.twists()
-        };
-        if twisting && !rigid_joints && s.ei().is_some() && s.gj().is_none() {
+        let method = crate::method::of(s.method);
+        // Joints of the method's own with their stiffness hold the twist.
+        let joints_hold =
+            method.own_keys().contains(&"joint_stiffness") && s.joint_stiffness.is_some();
+        if method.twisting(s) && !joints_hold && s.ei().is_some() && s.gj().is_none() {
             return ck.err(
                 p("torsional_stiffness"),
                 "missing: twisting elements need `torsional_stiffness` (G J), or `youngs_modulus` with the section (G = E/3 unless `shear_modulus` is given)".into(),
             );
         }
-        // Rigid links do not stretch: there it has nothing to act on.
+        // Where stretch is a choice and the section lumped, it needs the
+        // stretch to act on.
         if s.incompressible == Some(true)
-            && !matches!(s.method, Method::Rigid | Method::Eba | Method::Cosserat)
+            && method.stretch() == Carried::Optional
+            && method.lumps_section()
             && !s.stretches()
         {
             return ck.err(
@@ -470,7 +471,7 @@ fn segment_dimension_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), Model
                 "acts on stretching elements: set `extension = true` too".into(),
             );
         }
-        if s.method != Method::Rigid && s.stretches() && s.ea().is_none() {
+        if method.stretch() != Carried::Never && s.stretches() && s.ea().is_none() {
             return ck.err(
                 p("axial_stiffness"),
                 "missing: `extension = true` needs `axial_stiffness` (E A), or `youngs_modulus` with the section".into(),
@@ -485,29 +486,38 @@ fn segment_dimension_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), Model
 /// stiffness k G A needs; `shear_factor` positive, on shearing elements.
 fn shear_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
     let p = |k: &str| format!("segment[{i}].{k}");
-    let carries = matches!(
-        s.method,
-        Method::Pcc | Method::Pcs | Method::Vc | Method::Rom | Method::Cosserat
-    );
-    match (s.shear, s.method) {
-        (Some(false), Method::Eba) => {
-            return ck.err(
-                p("shear"),
-                "eba elements always shear (their absolute poses are held by shear springs): remove the key, or use pcs, pcc or vc to choose".into(),
-            );
-        }
-        (Some(true), m) if !carries && m != Method::Eba => {
+    let shear = crate::method::of(s.method).shear();
+    let carries = shear == Carried::Optional;
+    let named = |c: Carried| crate::method::named(|m| m.shear() == c);
+    match (s.shear, shear) {
+        (Some(false), Carried::Always) => {
             return ck.err(
                 p("shear"),
                 format!(
-                    "{} segments carry no shear strain: shear is for pcs, pcc, vc, rom and cosserat segments (eba always shears)",
-                    m.name()
+                    "{} elements always shear (their absolute poses are held by shear springs): remove the key, or use {} to choose",
+                    s.method.name(),
+                    named(Carried::Optional)
+                ),
+            );
+        }
+        (Some(true), Carried::Never) => {
+            return ck.err(
+                p("shear"),
+                format!(
+                    "{} segments carry no shear strain: shear is for {} segments ({} always shears)",
+                    s.method.name(),
+                    named(Carried::Optional),
+                    named(Carried::Always)
                 ),
             );
         }
         _ => {}
     }
-    let shears = s.method == Method::Eba || (carries && s.shears());
+    let shears = match shear {
+        Carried::Never => false,
+        Carried::Optional => s.shears(),
+        Carried::Always => true,
+    };
     if let Some(k) = s.shear_factor {
         ck.positive(&p("shear_factor"), k)?;
         if !shears {

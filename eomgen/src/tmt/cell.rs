@@ -28,9 +28,10 @@ use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{ElementParam, Joints, Method, Param, ParamLayout, Structure, Xyz};
 
 use super::actuation::{segment_loads, strain_work, thinning};
+use super::cell_kind::CellKind;
 use super::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
 use super::planar_cell::derive_planar_cell;
-use super::spatial::{ArcStrain, Element3, Frame, Springs, arc, half_k_sq, in_halves};
+use super::spatial::{ArcStrain, Element3, Frame, Springs, arc, half_k_sq};
 use super::system::{Coordinates, ParamSymbols};
 use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
@@ -66,7 +67,8 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     let mut roms = Vec::new();
     let (mut first, mut k) = (0, 0);
     for (s, g) in st.segments.iter().enumerate() {
-        let rom = (g.method == Method::Rom).then(|| RomFields::of(g, first));
+        let method = crate::method::of(g.method);
+        let rom = method.polynomial_fields().then(|| RomFields::of(g, first));
         let load = actuated.iter().position(|&a| a == s);
         let shape = Shape {
             twist: g.twist,
@@ -76,13 +78,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             rom: rom.is_some(),
             actuated: load.is_some(),
             planar: (!spatial).then_some((g.method, g.joints)),
-            kind: match g.method {
-                Method::Ebr => CellKind::PastJoint,
-                Method::Pcc if spatial && in_halves(g) => CellKind::HalfArc,
-                // A rom slice is two half-arcs (`RomFields::halves`).
-                Method::Rom => CellKind::HalfArc,
-                _ => CellKind::Arc,
-            },
+            kind: method.cell_kind(g, spatial),
         };
         let mut cell_of = |shape: Shape| -> Option<usize> {
             if let Some(c) = cells.iter().position(|(s, _)| *s == shape) {
@@ -285,21 +281,6 @@ struct Shape {
     planar: Option<(Method, Joints)>,
     /// What the link is of a 3D element.
     kind: CellKind,
-}
-
-/// The kinematics of a 3D link.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum CellKind {
-    /// A constant-strain arc (pcc, vc, a rom slice).
-    Arc,
-    /// Half of a stretching or shearing arc (`spatial::in_halves`): half
-    /// its strain, mass and energies; two links share the element's
-    /// coordinates.
-    HalfArc,
-    /// An ebr element's half before its joint: no coordinates.
-    BeforeJoint,
-    /// An ebr element's joint and the half past it.
-    PastJoint,
 }
 
 /// The kernel of the actuated segments' loads (`actuation::segment_loads`,

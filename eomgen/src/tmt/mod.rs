@@ -5,6 +5,7 @@ pub(crate) mod actuation;
 mod assemble;
 mod assembly;
 mod cell;
+pub(crate) mod cell_kind;
 mod cell_outputs;
 mod chain;
 pub(crate) mod contact_frames;
