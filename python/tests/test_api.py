@@ -82,6 +82,17 @@ def test_a_trajectory_is_the_clis(name, tmp_path):
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert r["summary"]["steps"] == summary["steps"]
     assert r["summary"]["rhs_evaluations"] == summary["rhs_evaluations"]
+    # Every column the CLI writes is the run's, by name.
+    header = list(rows[0].keys())
+    assert header == ["t"] + cols + list(r["columns"])
+    for c in r["columns"]:
+        ref = np.array([float(row[c]) for row in rows])
+        assert np.allclose(r["columns"][c], ref, rtol=1e-12, atol=1e-12)
+    # The summaries agree but for the CLI's own keys and the run's timing.
+    own = {"options", "assembly_moved", "wall_s", "derive_s", "cache"}
+    assert set(summary) - own == set(r["summary"]) - own
+    for k in set(summary) - own - {"final_state"}:
+        assert r["summary"][k] == summary[k], k
 
 
 def test_overrides_change_numbers_not_the_backend():
