@@ -6,7 +6,7 @@
 
 use anyhow::{Result, anyhow, bail};
 use eomgen::model::{SimulateDefaults, Start};
-use runtime::{SimOptions, Solver};
+use runtime::{SimOptions, Solver, output};
 
 use crate::backend::Loaded;
 
@@ -306,9 +306,9 @@ pub fn summary(
             "t": t_final,
             "q": final_state.get(..n),
             "qd": final_state.get(n..),
-            "tip_position": &tip[..3],
-            "kinetic_energy": tip[3],
-            "potential_energy": tip[4],
+            "tip_position": &tip[output::TIP],
+            "kinetic_energy": tip[output::KINETIC],
+            "potential_energy": tip[output::POTENTIAL],
         },
     })
 }

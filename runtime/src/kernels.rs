@@ -6,6 +6,7 @@ use std::cell::RefCell;
 use serde::{Deserialize, Serialize};
 
 use crate::linalg::Ldlt;
+pub use crate::output::{N_OUTPUTS, OUTPUT_NAMES};
 use crate::tape::{Inputs, Tape};
 
 /// The functions derived for every model. Output layouts are fixed here and
@@ -120,23 +121,6 @@ impl KernelKind {
         }
     }
 }
-
-/// Layout of the `Outputs` kernel: tip position, energies, and the tip
-/// frame's orientation as a unit quaternion (w, x, y, z; x along the arm).
-pub const OUTPUT_NAMES: [&str; N_OUTPUTS] = [
-    "tip_x",
-    "tip_y",
-    "tip_z",
-    "kinetic",
-    "potential",
-    "tip_qw",
-    "tip_qx",
-    "tip_qy",
-    "tip_qz",
-];
-
-/// Number of outputs.
-pub const N_OUTPUTS: usize = 9;
 
 /// What a derived model is: its coordinates and parameter layout.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -8,6 +8,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::output;
+
 /// One part: its kernel, the arm's coordinates it reads (its local
 /// coordinate i is the arm's `coords[i]`) and its parameters (its local
 /// parameter i is `p[params[i]]`).
@@ -206,12 +208,12 @@ pub fn outputs<P: Parts>(
     let xd: Vec<f64> = layout.pose_coords.iter().map(|&i| qd[i]).collect();
     let mut pose = [0.0; 7];
     parts.pose(&x, &xd, p, &mut pose);
-    for k in 0..3 {
-        out[k] = offsets[1 + k] + pose[k];
+    for (k, o) in output::TIP.enumerate() {
+        out[o] = offsets[1 + k] + pose[k];
     }
-    out[3] = ke;
-    out[4] = pe;
-    out[5..9].copy_from_slice(&pose[3..7]);
+    out[output::KINETIC] = ke;
+    out[output::POTENTIAL] = pe;
+    out[output::ORIENTATION].copy_from_slice(&pose[3..7]);
 }
 
 /// The part kernels run by the tape interpreter: the interpreted

@@ -25,6 +25,8 @@
 //! K = d h(q, 0) / dq (= d tau / dq at qd = qdd = 0: the inertial and
 //! damping forces vanish there to first order) from its columns.
 
+use runtime::output;
+
 use crate::cas::{Cas, ExprId, SymKind, Variables};
 
 use super::chain::{ChainKinematics, MomentItem, PointItem};
@@ -243,8 +245,11 @@ fn energy_outputs(
     }
     let ke = cas.add_all(&kinetic);
     let pe = cas.add_all(&potential);
-    let mut outputs = vec![sys.tip[0], sys.tip[1], sys.tip[2], ke, pe];
-    outputs.extend(sys.tip_orientation);
+    let mut outputs = vec![ke; output::COUNT];
+    outputs[output::TIP].copy_from_slice(&sys.tip);
+    outputs[output::KINETIC] = ke;
+    outputs[output::POTENTIAL] = pe;
+    outputs[output::ORIENTATION].copy_from_slice(&sys.tip_orientation);
     outputs
 }
 

@@ -11,6 +11,7 @@ use super::{
     CELL_PARAMS, Cells, LinkLayout, M3, MAX_LINK_DOF, V3, add, cell_params, cross, dot, local,
     mat_mat, mat_vec, pose, scale,
 };
+use crate::output;
 
 /// The Hamilton product a b, (w, x, y, z).
 fn quat_mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
@@ -89,8 +90,8 @@ pub fn outputs<C: Cells>(
     if layout.forces {
         pe += cells.energy();
     }
-    out[..3].copy_from_slice(&point);
-    out[3] = ke;
-    out[4] = pe;
-    out[5..9].copy_from_slice(&quat);
+    out[output::TIP].copy_from_slice(&point);
+    out[output::KINETIC] = ke;
+    out[output::POTENTIAL] = pe;
+    out[output::ORIENTATION].copy_from_slice(&quat);
 }
