@@ -294,15 +294,6 @@ const KNOWN_LONG_FUNCTIONS: &[(&str, &str)] = &[
         "tests/backends.rs",
         "link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip",
     ),
-    ("tests/bad_input.rs", "cases"),
-    (
-        "tests/bad_input.rs",
-        "malformed_3d_models_are_rejected_clearly",
-    ),
-    (
-        "tests/bad_input.rs",
-        "malformed_actuators_inputs_and_measurements_are_rejected_clearly",
-    ),
     ("tests/common/pcc3d.rs", "mass_bias_any"),
 ];
 

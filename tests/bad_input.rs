@@ -251,7 +251,20 @@ fn dependent_joints_and_unreachable_starts_are_errors_before_any_output() {
 }
 
 /// (label, file text, extra CLI args, expected fragments of stderr).
-fn cases() -> Vec<(&'static str, String, Vec<&'static str>, Vec<&'static str>)> {
+/// (label, file text, expected fragments of stderr).
+type FileCase = (&'static str, String, Vec<&'static str>);
+
+/// (label, file text, extra CLI args, expected fragments of stderr).
+type CliCase = (&'static str, String, Vec<&'static str>, Vec<&'static str>);
+
+fn cases() -> Vec<CliCase> {
+    let mut all = syntax_value_and_section_cases();
+    all.extend(simulate_tip_and_stiffness_cases());
+    all.extend(override_and_sensor_cases());
+    all
+}
+
+fn syntax_value_and_section_cases() -> Vec<CliCase> {
     let r = |a: &str, b: &str| GOOD.replacen(a, b, 1);
     vec![
         (
@@ -362,6 +375,12 @@ fn cases() -> Vec<(&'static str, String, Vec<&'static str>, Vec<&'static str>)> 
             vec![],
             vec!["segment[0].joint_stiffness", "zero or positive"],
         ),
+    ]
+}
+
+fn simulate_tip_and_stiffness_cases() -> Vec<CliCase> {
+    let r = |a: &str, b: &str| GOOD.replacen(a, b, 1);
+    vec![
         (
             "unknown solver in [simulate]",
             format!("{GOOD}[simulate]\nsolver = \"ode45\"\n"),
@@ -465,6 +484,12 @@ fn cases() -> Vec<(&'static str, String, Vec<&'static str>, Vec<&'static str>)> 
             vec![],
             vec!["segment[0].joints", "unknown variant `elbow`", "midpoint"],
         ),
+    ]
+}
+
+fn override_and_sensor_cases() -> Vec<CliCase> {
+    let r = |a: &str, b: &str| GOOD.replacen(a, b, 1);
+    vec![
         (
             "set without =",
             GOOD.into(),
@@ -705,12 +730,16 @@ outer_radius = 0.01
 youngs_modulus = 1e6
 "#;
 
-#[test]
-fn malformed_3d_models_are_rejected_clearly() {
-    let dir = tempfile::tempdir().unwrap();
+/// The cases of `malformed_3d_models_are_rejected_clearly`.
+fn three_d_cases() -> Vec<FileCase> {
+    let mut all = three_d_key_cases();
+    all.extend(three_d_method_cases());
+    all
+}
+
+fn three_d_key_cases() -> Vec<FileCase> {
     let r = |a: &str, b: &str| GOOD3.replacen(a, b, 1);
-    let second = "\n[[segment]]\nmethod = \"pcc\"\nlength = 0.1\ndensity = 1000.0\nouter_radius = 0.01\nyoungs_modulus = 1e6\n";
-    let cases: Vec<(&str, String, Vec<&str>)> = vec![
+    vec![
         (
             "dimensions 4",
             r("dimensions = 3", "dimensions = 4"),
@@ -786,6 +815,13 @@ fn malformed_3d_models_are_rejected_clearly() {
             r("elements = 2", "order = 2"),
             vec!["segment[0].order", "only rom segments"],
         ),
+    ]
+}
+
+fn three_d_method_cases() -> Vec<FileCase> {
+    let r = |a: &str, b: &str| GOOD3.replacen(a, b, 1);
+    let second = "\n[[segment]]\nmethod = \"pcc\"\nlength = 0.1\ndensity = 1000.0\nouter_radius = 0.01\nyoungs_modulus = 1e6\n";
+    vec![
         (
             "eba mixed",
             format!("{}{second}", r("method = \"pcc\"", "method = \"eba\"")),
@@ -873,7 +909,15 @@ fn malformed_3d_models_are_rejected_clearly() {
             ),
             vec!["segment[0].chambers", "must lie in the wall"],
         ),
-    ];
+    ]
+}
+
+#[test]
+fn malformed_3d_models_are_rejected_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = |a: &str, b: &str| GOOD3.replacen(a, b, 1);
+    let second = "\n[[segment]]\nmethod = \"pcc\"\nlength = 0.1\ndensity = 1000.0\nouter_radius = 0.01\nyoungs_modulus = 1e6\n";
+    let cases = three_d_cases();
     assert_rejected(dir.path(), cases);
     // The baseline is valid, and the Cosserat statics reject what they
     // cannot model.
@@ -897,17 +941,19 @@ fn malformed_3d_models_are_rejected_clearly() {
     );
 }
 
-#[test]
-fn malformed_actuators_inputs_and_measurements_are_rejected_clearly() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("d.csv"), "time,P,X\n0,1,0\n0.1,x,0\n").unwrap();
-    std::fs::write(dir.path().join("back.csv"), "time,P\n0,1\n0.1,2\n0.05,3\n").unwrap();
-    std::fs::write(dir.path().join("ok.csv"), "time,P,X\n0,1,0\n0.1,2,0\n").unwrap();
+/// The cases of `malformed_actuators_inputs_and_measurements_are_rejected_clearly`.
+fn actuator_input_and_measurement_cases() -> Vec<FileCase> {
+    let mut all = chamber_and_input_cases();
+    all.extend(tendon_torque_and_measurement_cases());
+    all
+}
+
+fn chamber_and_input_cases() -> Vec<FileCase> {
     let chambers = "[segment.chambers]\nangles = [0, 120, 240]\nradius = 0.002\ndistance = 0.006\ninputs = [\"p\", \"p\", \"p\"]\n";
     let channel = "[inputs.p]\nkind = \"constant\"\nvalue = 1.0\n";
     let base = format!("{GOOD3}{chambers}{channel}");
     let r = |a: &str, b: &str| base.replacen(a, b, 1);
-    let cases: Vec<(&str, String, Vec<&str>)> = vec![
+    vec![
         (
             "anisotropic holes",
             r("angles = [0, 120, 240]", "angles = [0, 90, 240]"),
@@ -999,6 +1045,15 @@ fn malformed_actuators_inputs_and_measurements_are_rejected_clearly() {
             ),
             vec!["none.csv", "cannot read"],
         ),
+    ]
+}
+
+fn tendon_torque_and_measurement_cases() -> Vec<FileCase> {
+    let chambers = "[segment.chambers]\nangles = [0, 120, 240]\nradius = 0.002\ndistance = 0.006\ninputs = [\"p\", \"p\", \"p\"]\n";
+    let channel = "[inputs.p]\nkind = \"constant\"\nvalue = 1.0\n";
+    let base = format!("{GOOD3}{chambers}{channel}");
+    let r = |a: &str, b: &str| base.replacen(a, b, 1);
+    vec![
         (
             "tendon past the last segment",
             format!("{base}[[tendon]]\ninput = \"p\"\ndistance = 0.005\nend = 3\n"),
@@ -1098,7 +1153,19 @@ fn malformed_actuators_inputs_and_measurements_are_rejected_clearly() {
             format!("{base}[[torque]]\ncoordinate = \"bend_y_0_1\"\ninput = \"tau\"\n"),
             vec!["torque[0].input", "no input channel \"tau\""],
         ),
-    ];
+    ]
+}
+
+#[test]
+fn malformed_actuators_inputs_and_measurements_are_rejected_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("d.csv"), "time,P,X\n0,1,0\n0.1,x,0\n").unwrap();
+    std::fs::write(dir.path().join("back.csv"), "time,P\n0,1\n0.1,2\n0.05,3\n").unwrap();
+    std::fs::write(dir.path().join("ok.csv"), "time,P,X\n0,1,0\n0.1,2,0\n").unwrap();
+    let chambers = "[segment.chambers]\nangles = [0, 120, 240]\nradius = 0.002\ndistance = 0.006\ninputs = [\"p\", \"p\", \"p\"]\n";
+    let channel = "[inputs.p]\nkind = \"constant\"\nvalue = 1.0\n";
+    let base = format!("{GOOD3}{chambers}{channel}");
+    let cases = actuator_input_and_measurement_cases();
     assert_rejected(dir.path(), cases);
     // The baseline is valid.
     std::fs::write(dir.path().join("m.toml"), &base).unwrap();
