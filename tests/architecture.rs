@@ -286,7 +286,6 @@ const KNOWN_LONG_FUNCTIONS: &[(&str, &str)] = &[
     ("eomgen/src/emit.rs", "emit"),
     ("eomgen/src/emit.rs", "emit_link_recursion"),
     ("eomgen/src/emit.rs", "emit_model"),
-    ("eomgen/src/method/eba.rs", "absolute_system"),
     ("eomgen/src/tmt/cell.rs", "derive_cell"),
     ("eomgen/src/tmt/cell.rs", "link_chain"),
     ("eomgen/src/tmt/contact_frames.rs", "contact_frames"),

@@ -11,7 +11,7 @@
 //! Two uses: a second method for the generated kernels (tests/spatial.rs),
 //! and what a kernel made of one element's code run in a loop costs
 //! (benches/interleaved.rs), against the unrolled kernels whose size puts
-//! them past the instruction caches (BENCHMARKS.md, evaluation).
+//! them past the instruction caches (measured by benches/interleaved.rs and callgrind).
 
 type V3 = [f64; 3];
 type M3 = [[f64; 3]; 3];

@@ -184,16 +184,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         quat = quat_mul(cas, &q0, &q_rel);
         omega = element_omega;
         let axis = [r[0][0], r[1][0], r[2][0]];
-        // The slab's centreline, straight through its centre.
-        for j in 1..=structure.contact_points {
-            let d = cas.scaled(j as f64 / structure.contact_points as f64 - 0.5, l);
-            let point = std::array::from_fn(|i| {
-                let a = cas.mul(d, axis[i]);
-                cas.add(centre[i], a)
-            });
-            let point = bind3(cas, point);
-            samples.push(Sample::spatial(point, quat));
-        }
+        slab_samples(cas, structure.contact_points, l, centre, axis, quat, &mut samples);
         bodies.push(Body {
             mass: symbols.element(k, ElementParam::Mass),
             inertia: Inertia::Axisymmetric {
@@ -285,6 +276,28 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
     let loads = tip_loads(cas, symbols, structure, &mount);
     sys.attach_tip(loads, 0);
     sys
+}
+
+/// A slab's `points` contact points, on its centreline straight through
+/// its centre.
+fn slab_samples(
+    cas: &mut Cas,
+    points: usize,
+    l: ExprId,
+    centre: V3,
+    axis: V3,
+    quat: [ExprId; 4],
+    samples: &mut Vec<Sample>,
+) {
+    for j in 1..=points {
+        let d = cas.scaled(j as f64 / points as f64 - 0.5, l);
+        let point = std::array::from_fn(|i| {
+            let a = cas.mul(d, axis[i]);
+            cas.add(centre[i], a)
+        });
+        let point = bind3(cas, point);
+        samples.push(Sample::spatial(point, quat));
+    }
 }
 
 /// An element's orientation R = R0 exp([psi]x) (rows), its angular
