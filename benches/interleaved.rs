@@ -33,6 +33,179 @@ use softarm::backend::{BackendChoice, load};
 
 const CALLS: usize = 2000;
 
+/// What a name times: its prefix, or mass + bias without one.
+#[derive(Clone, Copy, PartialEq)]
+enum What {
+    MassBias,
+    /// `rhs:`, `straight:` and `nocontact:`: `runtime::accelerations`.
+    Rhs,
+    /// `free:`: mass + bias and the mass solve, no joints.
+    Free,
+    /// `joints:`: the constraint kernel.
+    Joints,
+    /// `points:`: the `Contact` kernel.
+    Points,
+    /// `forces:`: the contact forces alone.
+    Forces,
+    /// `recursion:`: tests/common/pcc3d.rs's numeric recursion.
+    Recursion,
+}
+
+/// A name's prefixes (any number, e.g. `rhs:straight:cantilever`): what
+/// it times, at the straight state or not, with the model's contacts or
+/// not; and the model.
+fn parse(name: &str) -> (What, bool, bool, &str) {
+    let prefixes = [
+        ("recursion:", What::Recursion),
+        ("rhs:", What::Rhs),
+        ("free:", What::Free),
+        ("joints:", What::Joints),
+        ("points:", What::Points),
+        ("forces:", What::Forces),
+        ("straight:", What::Rhs),
+        ("nocontact:", What::Rhs),
+    ];
+    let (mut asked, mut straight, mut nocontact, mut model) = (Vec::new(), false, false, name);
+    while let Some((prefix, what)) = prefixes.iter().find(|(p, _)| model.starts_with(p)) {
+        model = &model[prefix.len()..];
+        straight |= *prefix == "straight:";
+        nocontact |= *prefix == "nocontact:";
+        asked.push(*what);
+    }
+    // When several are asked, the first of this order is timed.
+    let order = [
+        What::Forces,
+        What::Rhs,
+        What::Joints,
+        What::Points,
+        What::Free,
+        What::Recursion,
+    ];
+    let what = (order.into_iter())
+        .find(|w| asked.contains(w))
+        .unwrap_or(What::MassBias);
+    (what, straight, nocontact, model)
+}
+
+/// The state a model is timed at: angles of a few tenths of a radian and
+/// stretches (metres) of a few tenths of a millimetre; `Q` (env) at rest;
+/// zero at the straight state.
+fn state(coordinates: &[String], straight: bool) -> (Vec<f64>, Vec<f64>) {
+    let dof = coordinates.len();
+    if straight {
+        return (vec![0.0; dof], vec![0.0; dof]);
+    }
+    if let Ok(s) = std::env::var("Q") {
+        let g: Vec<f64> = (s.split(','))
+            .map(|v| v.trim().parse().expect("Q: numbers"))
+            .collect();
+        assert_eq!(g.len(), dof, "Q: {dof} coordinates");
+        return (g, vec![0.0; dof]);
+    }
+    let q = (0..dof)
+        .map(|i| {
+            let scale = if coordinates[i].contains("stretch") {
+                1e-3
+            } else {
+                1.0
+            };
+            scale * 0.3 * ((i as f64) * 0.7).sin()
+        })
+        .collect();
+    let qd = (0..dof).map(|i| 0.2 * ((i as f64) * 1.3).cos()).collect();
+    (q, qd)
+}
+
+/// The callable a name times, on the criterion benches' state
+/// (benches/kernels.rs).
+fn timed(name: &str) -> Box<dyn FnMut()> {
+    let (what, straight, nocontact, model) = parse(name);
+    let mut l = load(model, &[], BackendChoice::Compiled, None)
+        .unwrap_or_else(|e| panic!("{model}: {e:#}"));
+    if nocontact {
+        l.arm.set_contact(None);
+    }
+    let dof = l.arm.dof();
+    let (q, qd) = state(&l.arm.info().coordinates, straight);
+    let mut out = vec![0.0; KernelKind::MassBias.output_len(l.arm.info())];
+    match what {
+        What::Forces => {
+            let mut qc = vec![0.0; dof];
+            Box::new(move || {
+                runtime::contact::generalised_force_at(
+                    &*l.arm,
+                    0.0,
+                    black_box(&q),
+                    black_box(&qd),
+                    None,
+                    &mut qc,
+                );
+                black_box(&qc);
+            })
+        }
+        What::Rhs => {
+            let mut ws = runtime::Workspace::new(dof);
+            let mut qdd = vec![0.0; dof];
+            Box::new(move || {
+                runtime::accelerations(
+                    &*l.arm,
+                    &mut ws,
+                    0.0,
+                    black_box(&q),
+                    black_box(&qd),
+                    &mut qdd,
+                )
+                .expect("accelerations");
+                black_box(&qdd);
+            })
+        }
+        What::Joints | What::Points => {
+            let kind = if what == What::Joints {
+                KernelKind::Constraints
+            } else {
+                KernelKind::Contact
+            };
+            let mut c = vec![0.0; kind.output_len(l.arm.info())];
+            Box::new(move || {
+                l.arm
+                    .eval_kernel(kind, 0.0, black_box(&q), black_box(&qd), &mut c)
+            })
+        }
+        What::Free => {
+            let mut ldlt = runtime::Ldlt::new(dof);
+            let mut qdd = vec![0.0; dof];
+            Box::new(move || {
+                l.arm.eval_kernel(
+                    KernelKind::MassBias,
+                    0.0,
+                    black_box(&q),
+                    black_box(&qd),
+                    &mut out,
+                );
+                let (mass, bias) = out.split_at(dof * (dof + 1) / 2);
+                for (a, b) in qdd.iter_mut().zip(bias) {
+                    *a = -b;
+                }
+                assert!(l.arm.solve_mass(mass, &mut qdd, &mut ldlt));
+                black_box(&qdd);
+            })
+        }
+        What::Recursion => {
+            let mut r = pcc3d::Pcc3d::new(&l.arm.info().parameters, l.arm.base_params());
+            Box::new(move || r.mass_bias(black_box(&q), black_box(&qd), &mut out))
+        }
+        What::MassBias => Box::new(move || {
+            l.arm.eval_kernel(
+                KernelKind::MassBias,
+                0.0,
+                black_box(&q),
+                black_box(&qd),
+                &mut out,
+            )
+        }),
+    }
+}
+
 fn main() {
     // `cargo bench` passes `--bench`; every other argument is a model.
     let names: Vec<String> = std::env::args()
@@ -49,155 +222,7 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(200)
         .max(1);
-    // Each name times a callable on the criterion benches' state
-    // (benches/kernels.rs); `recursion:MODEL` times the numeric recursion
-    // of tests/common/pcc3d.rs on MODEL's parameters (3D pcc arms without
-    // twist): a kernel of one element's code run in a loop.
-    let mut timed: Vec<Box<dyn FnMut()>> = names
-        .iter()
-        .map(|n| {
-            let (recursion, model) = match n.strip_prefix("recursion:") {
-                Some(m) => (true, m),
-                None => (false, n.as_str()),
-            };
-            let (rhs, model) = match model.strip_prefix("rhs:") {
-                Some(m) => (true, m),
-                None => (false, model),
-            };
-            let (free, model) = match model.strip_prefix("free:") {
-                Some(m) => (true, m),
-                None => (false, model),
-            };
-            let (joints, model) = match model.strip_prefix("joints:") {
-                Some(m) => (true, m),
-                None => (false, model),
-            };
-            let (points, model) = match model.strip_prefix("points:") {
-                Some(m) => (true, m),
-                None => (false, model),
-            };
-            let (forces, model) = match model.strip_prefix("forces:") {
-                Some(m) => (true, m),
-                None => (false, model),
-            };
-            let (straight, model) = match model.strip_prefix("straight:") {
-                Some(m) => (true, m),
-                None => (false, model),
-            };
-            let (nocontact, model) = match model.strip_prefix("nocontact:") {
-                Some(m) => (true, m),
-                None => (false, model),
-            };
-            let mut l = load(model, &[], BackendChoice::Compiled, None)
-                .unwrap_or_else(|e| panic!("{model}: {e:#}"));
-            if nocontact {
-                l.arm.set_contact(None);
-            }
-            let rhs = rhs || nocontact;
-            let dof = l.arm.dof();
-            // Angles of a few tenths of a radian; stretches (metres) of
-            // a few tenths of a millimetre.
-            let names = &l.arm.info().coordinates;
-            let q: Vec<f64> = (0..dof)
-                .map(|i| {
-                    let scale = if names[i].contains("stretch") {
-                        1e-3
-                    } else {
-                        1.0
-                    };
-                    scale * 0.3 * ((i as f64) * 0.7).sin()
-                })
-                .collect();
-            let qd: Vec<f64> = (0..dof).map(|i| 0.2 * ((i as f64) * 1.3).cos()).collect();
-            let given: Option<Vec<f64>> = std::env::var("Q").ok().map(|s| {
-                s.split(',')
-                    .map(|v| v.trim().parse().expect("Q: numbers"))
-                    .collect()
-            });
-            let (q, qd) = match (straight, given) {
-                (true, _) => (vec![0.0; dof], vec![0.0; dof]),
-                (false, Some(g)) => {
-                    assert_eq!(g.len(), dof, "Q: {dof} coordinates");
-                    (g, vec![0.0; dof])
-                }
-                (false, None) => (q, qd),
-            };
-            let rhs = rhs || straight;
-            let mut out = vec![0.0; KernelKind::MassBias.output_len(l.arm.info())];
-            if forces {
-                let mut qc = vec![0.0; dof];
-                Box::new(move || {
-                    runtime::contact::generalised_force_at(
-                        &*l.arm,
-                        0.0,
-                        black_box(&q),
-                        black_box(&qd),
-                        None,
-                        &mut qc,
-                    );
-                    black_box(&qc);
-                })
-            } else if rhs {
-                let mut ws = runtime::Workspace::new(dof);
-                let mut qdd = vec![0.0; dof];
-                Box::new(move || {
-                    runtime::accelerations(
-                        &*l.arm,
-                        &mut ws,
-                        0.0,
-                        black_box(&q),
-                        black_box(&qd),
-                        &mut qdd,
-                    )
-                    .expect("accelerations");
-                    black_box(&qdd);
-                })
-            } else if joints || points {
-                let kind = if joints {
-                    KernelKind::Constraints
-                } else {
-                    KernelKind::Contact
-                };
-                let mut c = vec![0.0; kind.output_len(l.arm.info())];
-                Box::new(move || {
-                    l.arm
-                        .eval_kernel(kind, 0.0, black_box(&q), black_box(&qd), &mut c)
-                })
-            } else if free {
-                let mut ldlt = runtime::Ldlt::new(dof);
-                let mut qdd = vec![0.0; dof];
-                Box::new(move || {
-                    l.arm.eval_kernel(
-                        KernelKind::MassBias,
-                        0.0,
-                        black_box(&q),
-                        black_box(&qd),
-                        &mut out,
-                    );
-                    let (mass, bias) = out.split_at(dof * (dof + 1) / 2);
-                    for (a, b) in qdd.iter_mut().zip(bias) {
-                        *a = -b;
-                    }
-                    assert!(l.arm.solve_mass(mass, &mut qdd, &mut ldlt));
-                    black_box(&qdd);
-                })
-            } else if recursion {
-                let mut r = pcc3d::Pcc3d::new(&l.arm.info().parameters, l.arm.base_params());
-                Box::new(move || r.mass_bias(black_box(&q), black_box(&qd), &mut out))
-                    as Box<dyn FnMut()>
-            } else {
-                Box::new(move || {
-                    l.arm.eval_kernel(
-                        KernelKind::MassBias,
-                        0.0,
-                        black_box(&q),
-                        black_box(&qd),
-                        &mut out,
-                    )
-                })
-            }
-        })
-        .collect();
+    let mut timed: Vec<Box<dyn FnMut()>> = names.iter().map(|n| timed(n)).collect();
     let mut means: Vec<Vec<f64>> = vec![Vec::with_capacity(rounds); timed.len()];
     for _ in 0..rounds {
         for (f, batch) in timed.iter_mut().zip(&mut means) {

@@ -305,6 +305,76 @@ impl<'a> KernelEmitter<'a> {
             .unwrap_or(0)
     }
 
+    /// The statements of chunk `c`: its operations (a family's members from
+    /// one call, in the chunk of the first), the values it spills, and the
+    /// outputs it computes (leaf outputs in the last chunk).
+    fn chunk_body(
+        &self,
+        c: usize,
+        n_chunks: usize,
+        groups: &HashMap<(Family, Slot), Vec<(Member, usize)>>,
+        group_of: &HashMap<usize, (Family, Slot)>,
+    ) -> Vec<TokenStream> {
+        let mut body = Vec::new();
+        for (i, op) in self.tape.ops.iter().enumerate() {
+            if self.chunk_of[i] != Some(c) {
+                continue;
+            }
+            let defined: Vec<usize> = match group_of.get(&i) {
+                Some(&(family, a)) => {
+                    let members = &groups[&(family, a)];
+                    if members.iter().map(|m| m.1).min() != Some(i) {
+                        continue;
+                    }
+                    let a = self.read(a, c);
+                    body.push(family.call(members, a, self.lanes));
+                    members.iter().map(|m| m.1).collect()
+                }
+                None => {
+                    let v = format_ident!("v{}", i);
+                    let e = self.expr(op, c);
+                    let ty = if self.lanes {
+                        quote!(__m256d)
+                    } else {
+                        quote!(f64)
+                    };
+                    body.push(quote!(let #v: #ty = #e;));
+                    vec![i]
+                }
+            };
+            for d in defined {
+                if let Some(w) = self.spill[d] {
+                    let v = format_ident!("v{}", d);
+                    body.push(quote!(w[#w] = #v;));
+                }
+            }
+        }
+        // Outputs are written by the chunk that computes them; leaf
+        // outputs (constants, inputs) by the last chunk.
+        for (k, &s) in self.tape.outputs.iter().enumerate() {
+            let owner = self.chunk_of[s as usize].unwrap_or(n_chunks - 1);
+            if owner == c {
+                let val = match self.tape.ops[s as usize] {
+                    // A constant output without lit's parentheses.
+                    Op::Const(v) if !self.lanes => {
+                        let l = Literal::f64_suffixed(v.abs());
+                        match v.is_sign_negative() {
+                            true => quote!(-#l),
+                            false => quote!(#l),
+                        }
+                    }
+                    _ => self.read(s, c),
+                };
+                body.push(if self.lanes {
+                    quote!(out[#k] = runtime::lanes::to_array(#val);)
+                } else {
+                    quote!(out[#k] = #val;)
+                });
+            }
+        }
+        body
+    }
+
     /// The kernel function `name` and its chunks; a tape that reads `aux`
     /// takes it after `p`, `n_aux` values.
     fn emit(&self, name: &str, dof: usize, n_params: usize, n_aux: usize) -> TokenStream {
@@ -335,63 +405,7 @@ impl<'a> KernelEmitter<'a> {
             .flat_map(|(&(f, a), ms)| ms.iter().map(move |&(_, i)| (i, (f, a))))
             .collect();
         for c in 0..n_chunks {
-            let mut body = Vec::new();
-            for (i, op) in self.tape.ops.iter().enumerate() {
-                if self.chunk_of[i] != Some(c) {
-                    continue;
-                }
-                let defined: Vec<usize> = match group_of.get(&i) {
-                    Some(&(family, a)) => {
-                        let members = &groups[&(family, a)];
-                        if members.iter().map(|m| m.1).min() != Some(i) {
-                            continue;
-                        }
-                        let a = self.read(a, c);
-                        body.push(family.call(members, a, self.lanes));
-                        members.iter().map(|m| m.1).collect()
-                    }
-                    None => {
-                        let v = format_ident!("v{}", i);
-                        let e = self.expr(op, c);
-                        let ty = if self.lanes {
-                            quote!(__m256d)
-                        } else {
-                            quote!(f64)
-                        };
-                        body.push(quote!(let #v: #ty = #e;));
-                        vec![i]
-                    }
-                };
-                for d in defined {
-                    if let Some(w) = self.spill[d] {
-                        let v = format_ident!("v{}", d);
-                        body.push(quote!(w[#w] = #v;));
-                    }
-                }
-            }
-            // Outputs are written by the chunk that computes them; leaf
-            // outputs (constants, inputs) by the last chunk.
-            for (k, &s) in self.tape.outputs.iter().enumerate() {
-                let owner = self.chunk_of[s as usize].unwrap_or(n_chunks - 1);
-                if owner == c {
-                    let val = match self.tape.ops[s as usize] {
-                        // A constant output without lit's parentheses.
-                        Op::Const(v) if !self.lanes => {
-                            let l = Literal::f64_suffixed(v.abs());
-                            match v.is_sign_negative() {
-                                true => quote!(-#l),
-                                false => quote!(#l),
-                            }
-                        }
-                        _ => self.read(s, c),
-                    };
-                    body.push(if self.lanes {
-                        quote!(out[#k] = runtime::lanes::to_array(#val);)
-                    } else {
-                        quote!(out[#k] = #val;)
-                    });
-                }
-            }
+            let body = self.chunk_body(c, n_chunks, &groups, &group_of);
             if self.lanes {
                 assert!(n_chunks == 1 && n_spill == 0, "lane kernels are one chunk");
                 assert!(

@@ -111,45 +111,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             let params = ElementParam::CELL
                 .map(|e| params.get(Param::Element(k, e)).unwrap_or(length))
                 .to_vec();
-            // Cell coordinate f of a half-arc of a rom slice is field f by
-            // the half's weights; stretch and shear, strains, times the
-            // segment's length. Else the element's own coordinates.
-            let maps: Vec<Vec<LocalCoordinate>> = match &rom {
-                Some(r) => r
-                    .halves(e)
-                    .iter()
-                    .map(|w| {
-                        (0..count)
-                            .map(|f| {
-                                let stretch = r.is_translation(f);
-                                let n = if stretch { r.slices as f64 } else { 1.0 };
-                                LocalCoordinate {
-                                    terms: w
-                                        .iter()
-                                        .enumerate()
-                                        .map(|(i, w)| (r.index(f, i), n * w))
-                                        .collect(),
-                                    scale: stretch.then_some(params[0]),
-                                }
-                            })
-                            .collect()
-                    })
-                    .collect(),
-                None => {
-                    let map: Vec<LocalCoordinate> = (0..count)
-                        .map(|f| LocalCoordinate {
-                            terms: vec![(first + f, 1.0)],
-                            scale: None,
-                        })
-                        .collect();
-                    // A half-arc element is two links on the same
-                    // coordinates.
-                    match shape.kind {
-                        CellKind::HalfArc => vec![map.clone(), map],
-                        _ => vec![map],
-                    }
-                }
-            };
+            let maps = coordinate_maps(rom.as_ref(), e, count, first, params[0], shape.kind);
             if let Some(b) = before {
                 links.push(LinkSpec {
                     cell: b,
@@ -208,6 +170,57 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         kernels.poses.push(pose);
     }
     Some(kernels)
+}
+
+/// The arm's coordinates each link of element `e` reads, as its cell's
+/// coordinates: a half-arc of a rom slice reads field f by the half's
+/// weights (stretch and shear, strains, times the segment's length in slot
+/// `length`); another element its own `count` coordinates from `first`, on
+/// both links of a half-arc element.
+fn coordinate_maps(
+    rom: Option<&RomFields>,
+    e: usize,
+    count: usize,
+    first: usize,
+    length: usize,
+    kind: CellKind,
+) -> Vec<Vec<LocalCoordinate>> {
+    match rom {
+        Some(r) => r
+            .halves(e)
+            .iter()
+            .map(|w| {
+                (0..count)
+                    .map(|f| {
+                        let stretch = r.is_translation(f);
+                        let n = if stretch { r.slices as f64 } else { 1.0 };
+                        LocalCoordinate {
+                            terms: w
+                                .iter()
+                                .enumerate()
+                                .map(|(i, w)| (r.index(f, i), n * w))
+                                .collect(),
+                            scale: stretch.then_some(length),
+                        }
+                    })
+                    .collect()
+            })
+            .collect(),
+        None => {
+            let map: Vec<LocalCoordinate> = (0..count)
+                .map(|f| LocalCoordinate {
+                    terms: vec![(first + f, 1.0)],
+                    scale: None,
+                })
+                .collect();
+            // A half-arc element is two links on the same
+            // coordinates.
+            match kind {
+                CellKind::HalfArc => vec![map.clone(), map],
+                _ => vec![map],
+            }
+        }
+    }
 }
 
 /// The key a cell is compiled and linked by (`runtime::links::CompiledCell`):
