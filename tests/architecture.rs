@@ -283,7 +283,6 @@ fn a_circle_is_found() {
 /// shrinks).
 const KNOWN_LONG_FUNCTIONS: &[(&str, &str)] = &[
     ("eomgen/src/emit.rs", "emit_link_recursion"),
-    ("eomgen/src/emit.rs", "emit_model"),
     ("eomgen/src/tmt/cell.rs", "derive_cell"),
     ("eomgen/src/tmt/contact_frames.rs", "contact_frames"),
     (

@@ -1021,27 +1021,17 @@ fn emit_groups(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream {
 /// The header line that carries the structural hash.
 pub const HASH_PREFIX: &str = "// structural-hash: ";
 
-/// Rust source of one compiled-in model.
-pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
-    let info = &tapes.info;
-    let dof = info.dof();
-    let n_params = info.extended_params();
+/// `contact_jacobian_framed`: the groups with the contact frames given
+/// (`aux`, `n_aux` values), or from the `contact` kernel for a caller that
+/// has not run `accel`; nothing without frames.
+fn emit_framed_groups(
+    dof: usize,
+    n_params: usize,
+    n_aux: usize,
+    contact_points: usize,
+) -> TokenStream {
     let n_dir = 2 * dof;
-    let n_derived = info.derived;
-    let accel = info.accel;
-    let loads = &info.loads;
-    let rows = &info.constraints;
-    let blocks = &info.blocks;
-    let contact_points = info.contact_points;
-    let contact_groups = &info.contact_groups;
-    let contact_frames = info.contact_frames;
-    let n_aux = contact_frames;
-    let hash = &info.hash;
-    let coords = &info.coordinates;
-    let params = &info.parameters;
-    // The contact frames the groups read: given, or from the `contact`
-    // kernel (a caller that has not run `accel`).
-    let frames_fn = match n_aux {
+    match n_aux {
         0 => quote!(),
         _ => {
             let n_contact = 3 * contact_points + n_aux;
@@ -1066,7 +1056,17 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
                 }
             }
         }
-    };
+    }
+}
+
+/// Every kernel's function (those the parts or the link recursion give
+/// aside) and its arm in `Kernels::eval`.
+fn emit_kernels(
+    tapes: &TapeSet,
+    dof: usize,
+    n_params: usize,
+    n_aux: usize,
+) -> (Vec<TokenStream>, Vec<TokenStream>) {
     let mut kernels = Vec::new();
     let mut arms = Vec::new();
     for kind in KernelKind::ALL {
@@ -1105,6 +1105,29 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
             },
         });
     }
+    (kernels, arms)
+}
+
+/// Rust source of one compiled-in model.
+pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
+    let info = &tapes.info;
+    let dof = info.dof();
+    let n_params = info.extended_params();
+    let n_dir = 2 * dof;
+    let n_derived = info.derived;
+    let accel = info.accel;
+    let loads = &info.loads;
+    let rows = &info.constraints;
+    let blocks = &info.blocks;
+    let contact_points = info.contact_points;
+    let contact_groups = &info.contact_groups;
+    let contact_frames = info.contact_frames;
+    let n_aux = contact_frames;
+    let hash = &info.hash;
+    let coords = &info.coordinates;
+    let params = &info.parameters;
+    let frames_fn = emit_framed_groups(dof, n_params, n_aux, contact_points);
+    let (mut kernels, arms) = emit_kernels(tapes, dof, n_params, n_aux);
     if let Some(parts) = &tapes.parts {
         let n_out = tapes.mass_bias.outputs.len();
         kernels.push(emit_parts(parts, dof, n_params, n_out));
