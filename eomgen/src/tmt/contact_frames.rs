@@ -44,26 +44,16 @@ pub struct PointGroup {
     pub points: Range<usize>,
 }
 
-/// The contact frames of `sys`, when it is one serial chain of elements
-/// each sampled along a centreline of known length, group g on link g;
-/// None where not (assemblies, shared coordinates, a moving base, a method
-/// that does not give its centreline's length): those groups compute the
-/// chain from the base.
-pub fn contact_frames(cas: &mut Cas, sys: &System, groups: &[PointGroup]) -> Option<ContactFrames> {
-    let chain = sys.chain.as_ref()?;
-    if !sys.seeds.is_empty() || sys.bases.len() != 1 || chain.links.len() != groups.len() {
-        return None;
-    }
+/// Each group's base frame: the arm's base, then the last point of the
+/// group before (its link's end); None where a group reads a later link's
+/// coordinates, has no points, or has points without a centreline.
+fn group_bases(
+    sys: &System,
+    groups: &[PointGroup],
+    link_of: &[Option<usize>],
+    planar: bool,
+) -> Option<Vec<Sample>> {
     let n = sys.coords.q.len();
-    let mut link_of = vec![None; n];
-    for (k, l) in chain.links.iter().enumerate() {
-        for &c in &l.coords {
-            link_of[c] = Some(k);
-        }
-    }
-    let planar = sys.bases[0].angle.is_some();
-    // Each group's base frame: the arm's base, then the last point of the
-    // group before (its link's end).
     let mut bases: Vec<Sample> = Vec::with_capacity(groups.len());
     for (g, group) in groups.iter().enumerate() {
         let on_later_link = (0..n).any(|j| group.depends[j] && link_of[j].is_none_or(|k| k > g));
@@ -81,9 +71,22 @@ pub fn contact_frames(cas: &mut Cas, sys: &System, groups: &[PointGroup]) -> Opt
             _ => sys.samples[groups[g - 1].points.end - 1],
         });
     }
+    Some(bases)
+}
 
-    // The values: A, B, L per group (the ends as the chain has them, which
-    // the mass matrix shares); the orientations; the twists.
+/// The values the groups read: A, B, L per group (the ends as the chain
+/// has them, which the mass matrix shares); the base frames' orientations
+/// (from `orientation_at`); the twists of every link's coordinates but
+/// the last's (from `twist_at`, at `twist_index` of a coordinate).
+fn frame_values(
+    cas: &mut Cas,
+    sys: &System,
+    groups: &[PointGroup],
+    bases: &[Sample],
+    link_of: &[Option<usize>],
+) -> (Vec<ExprId>, usize, usize, Vec<usize>) {
+    let chain = sys.chain.as_ref().expect("a chain");
+    let n = sys.coords.q.len();
     let mut values = Vec::new();
     for (g, group) in groups.iter().enumerate() {
         let last = sys.samples[group.points.end - 1];
@@ -95,13 +98,12 @@ pub fn contact_frames(cas: &mut Cas, sys: &System, groups: &[PointGroup]) -> Opt
         values.push(last.arc.expect("checked above"));
     }
     let orientation_at = values.len();
-    for base in &bases {
+    for base in bases {
         match base.angle {
             Some(a) => values.push(a),
             None => values.extend(base.frame),
         }
     }
-    let per_frame = if planar { 1 } else { 4 };
     // Twists of the coordinates of every link but the last.
     let twist_at = values.len();
     let upstream: Vec<usize> = chain.links[..chain.links.len() - 1]
@@ -120,7 +122,31 @@ pub fn contact_frames(cas: &mut Cas, sys: &System, groups: &[PointGroup]) -> Opt
         values.extend(v);
         values.extend(w);
     }
+    (values, orientation_at, twist_at, twist_index)
+}
 
+/// The contact frames of `sys`, when it is one serial chain of elements
+/// each sampled along a centreline of known length, group g on link g;
+/// None where not (assemblies, shared coordinates, a moving base, a method
+/// that does not give its centreline's length): those groups compute the
+/// chain from the base.
+pub fn contact_frames(cas: &mut Cas, sys: &System, groups: &[PointGroup]) -> Option<ContactFrames> {
+    let chain = sys.chain.as_ref()?;
+    if !sys.seeds.is_empty() || sys.bases.len() != 1 || chain.links.len() != groups.len() {
+        return None;
+    }
+    let n = sys.coords.q.len();
+    let mut link_of = vec![None; n];
+    for (k, l) in chain.links.iter().enumerate() {
+        for &c in &l.coords {
+            link_of[c] = Some(k);
+        }
+    }
+    let planar = sys.bases[0].angle.is_some();
+    let bases = group_bases(sys, groups, &link_of, planar)?;
+    let per_frame = if planar { 1 } else { 4 };
+    let (values, orientation_at, twist_at, twist_index) =
+        frame_values(cas, sys, groups, &bases, &link_of);
     // What the groups read: a constant value in place, else `aux[m]`.
     let aux: Vec<ExprId> = values
         .iter()
