@@ -283,7 +283,6 @@ fn a_circle_is_found() {
 /// shrinks).
 const KNOWN_LONG_FUNCTIONS: &[(&str, &str)] = &[
     ("eomgen/src/emit.rs", "emit_link_recursion"),
-    ("eomgen/src/tmt/cell.rs", "derive_cell"),
     (
         "tests/backends.rs",
         "link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip",

@@ -31,7 +31,7 @@ use super::actuation::{segment_loads, strain_work, thinning};
 use super::cell_kind::CellKind;
 use super::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
 use super::planar_cell::derive_planar_cell;
-use super::spatial::{ArcStrain, Element3, Frame, Springs, arc, half_k_sq};
+use super::spatial::{ArcStrain, Element3, Frame, Springs, V3, arc, half_k_sq};
 use super::system::{Coordinates, ParamSymbols};
 use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
@@ -344,6 +344,117 @@ fn derive_forces(params: &ParamLayout, dof: usize, roms: &[(RomFields, usize)]) 
     ]
 }
 
+/// A cell's coordinates: the bend pair, then twist, stretch and the shear
+/// pair where present; none for an ebr element's half before its joint.
+fn cell_coordinates(
+    twist: bool,
+    extension: bool,
+    shear: bool,
+    kind: CellKind,
+) -> Vec<&'static str> {
+    if kind == CellKind::BeforeJoint {
+        return Vec::new();
+    }
+    let mut names = vec!["bend_y", "bend_z"];
+    if twist {
+        names.push("twist");
+    }
+    if extension {
+        names.push("stretch");
+    }
+    if shear {
+        names.extend(["shear_y", "shear_z"]);
+    }
+    names
+}
+
+/// A cell's springs and dampers from its parameters (bend, its damping,
+/// rest curvature, twist, its damping, stretch, its damping): a rom slice
+/// keeps only what thinning makes local, the rest is its segment's
+/// (`derive_forces`).
+fn cell_springs(rom: bool, incompressible: bool, zero: ExprId, k: [ExprId; 7]) -> Springs {
+    let [kb, db, rest, kt, dt, ks, ds] = k;
+    if rom {
+        let local = |k: ExprId| if incompressible { k } else { zero };
+        Springs {
+            bend: local(kb),
+            bend_damping: zero,
+            rest: local(rest),
+            twist: local(kt),
+            twist_damping: zero,
+            stretch: zero,
+            stretch_damping: zero,
+        }
+    } else {
+        Springs {
+            bend: kb,
+            bend_damping: db,
+            rest,
+            twist: kt,
+            twist_damping: dt,
+            stretch: ks,
+            stretch_damping: ds,
+        }
+    }
+}
+
+/// A link's strain as its cell reads it: the rotation vector and its
+/// rate, the centreline's length, the shear pair, the stretch.
+struct LinkStrain {
+    rho: V3,
+    rate: V3,
+    len: ExprId,
+    shear: Option<[ExprId; 2]>,
+    st: ExprId,
+}
+
+/// A link's motion from the identity frame by its kind: its body's
+/// centroid, axis and angular velocity, its end frame and its body (an arc,
+/// half an arc, or an ebr element's half before or past its joint).
+fn link_motion(
+    cas: &mut Cas,
+    kind: CellKind,
+    identity: &Frame,
+    element: Element3,
+    half_m: ExprId,
+    s: LinkStrain,
+) -> (V3, V3, V3, Frame, Element3) {
+    match kind {
+        CellKind::Arc | CellKind::HalfArc => {
+            let strain = ArcStrain {
+                rho: s.rho,
+                rate: s.rate,
+                len: s.len,
+                shear: s.shear,
+            };
+            let (strain, body) = match kind {
+                CellKind::HalfArc => (strain.part(cas, 0.5), element.half(cas)),
+                _ => (strain, element),
+            };
+            let (c, a, w, end) = arc(cas, identity, &strain);
+            (c, a, w, end, body)
+        }
+        CellKind::BeforeJoint => {
+            let (quarter, half) = (cas.scaled(0.25, element.l), cas.scaled(0.5, element.l));
+            let (c, end) = before_joint(cas, identity, quarter, half);
+            let body = Element3 {
+                m: half_m,
+                ..element
+            };
+            (c, identity.axis(), identity.w, end, body)
+        }
+        CellKind::PastJoint => {
+            let half = cas.scaled(0.5, element.l);
+            let (c, a, w, end) = past_joint(cas, identity, &s.rho, &s.rate, half, s.st);
+            let body = Element3 {
+                m: half_m,
+                ..element
+            };
+            (c, a, w, end, body)
+        }
+    }
+}
+
 /// The cell of a link with the bend pair, and twist, stretch and the shear
 /// pair when asked;
 /// the cell [`with_tangent`]; and its pose cell (`runtime::links::pose`:
@@ -361,19 +472,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     } = shape;
     let mut cas = Cas::new();
     let cas = &mut cas;
-    let mut names = vec!["bend_y", "bend_z"];
-    if twist {
-        names.push("twist");
-    }
-    if extension {
-        names.push("stretch");
-    }
-    if shear {
-        names.extend(["shear_y", "shear_z"]);
-    }
-    if kind == CellKind::BeforeJoint {
-        names.clear();
-    }
+    let names = cell_coordinates(twist, extension, shear, kind);
     let q: Vec<ExprId> = (0..names.len())
         .map(|i| cas.symbol(names[i], SymKind::Q(i as u32)))
         .collect();
@@ -407,28 +506,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     let len = cas.add(l, st);
     let thin = incompressible.then(|| thinning(cas, l, len));
     let soft = thin.map(|t| t.0);
-    let springs = if rom {
-        let local = |k: ExprId| if incompressible { k } else { zero };
-        Springs {
-            bend: local(kb),
-            bend_damping: zero,
-            rest: local(rest),
-            twist: local(kt),
-            twist_damping: zero,
-            stretch: zero,
-            stretch_damping: zero,
-        }
-    } else {
-        Springs {
-            bend: kb,
-            bend_damping: db,
-            rest,
-            twist: kt,
-            twist_damping: dt,
-            stretch: ks,
-            stretch_damping: ds,
-        }
-    };
+    let springs = cell_springs(rom, incompressible, zero, [kb, db, rest, kt, dt, ks, ds]);
     let (mut elastic, mut rayleigh) = match kind {
         CellKind::BeforeJoint => (zero, zero),
         _ => springs.energies(cas, strain, rates, soft),
@@ -478,40 +556,21 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         lateral,
         axial,
     };
-    let (centroid, axis, omega, end, body) = match kind {
-        CellKind::Arc | CellKind::HalfArc => {
-            let strain = ArcStrain {
-                rho,
-                rate,
-                len,
-                shear: shear_at.map(|i| [q[i], q[i + 1]]),
-            };
-            let (strain, body) = match kind {
-                CellKind::HalfArc => (strain.part(cas, 0.5), element.half(cas)),
-                _ => (strain, element),
-            };
-            let (c, a, w, end) = arc(cas, &identity, &strain);
-            (c, a, w, end, body)
-        }
-        CellKind::BeforeJoint => {
-            let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
-            let (c, end) = before_joint(cas, &identity, quarter, half);
-            let body = Element3 {
-                m: half_m,
-                ..element
-            };
-            (c, identity.axis(), identity.w, end, body)
-        }
-        CellKind::PastJoint => {
-            let half = cas.scaled(0.5, l);
-            let (c, a, w, end) = past_joint(cas, &identity, &rho, &rate, half, st);
-            let body = Element3 {
-                m: half_m,
-                ..element
-            };
-            (c, a, w, end, body)
-        }
-    };
+    let shear = shear_at.map(|i| [q[i], q[i + 1]]);
+    let (centroid, axis, omega, end, body) = link_motion(
+        cas,
+        kind,
+        &identity,
+        element,
+        half_m,
+        LinkStrain {
+            rho,
+            rate,
+            len,
+            shear,
+            st,
+        },
+    );
     let kin = LinkKinematics::new(
         cas,
         Motion {
