@@ -486,24 +486,88 @@ impl<'a> KernelEmitter<'a> {
     }
 }
 
-/// `mass_bias` and `jvp` as the link recursion (`runtime::links`) over the
-/// model's cells: each cell a kernel of one link's coordinates and
-/// parameters, with its lane form (four links at once) and its tangent
-/// (outputs and their directional derivatives, for the Jvp's dual sweep).
-fn emit_link_recursion(
-    links: &runtime::links::LinkKernels,
-    dof: usize,
-    n_params: usize,
-    n_out: usize,
-) -> TokenStream {
+/// A cell as others link it (`runtime::links::CompiledCell`): its kernels
+/// behind slices, and its entry in `CELLS` under its key. `f`, `f4`, `ft`,
+/// `fp`: the cell's own kernel, lanes, tangent and pose functions.
+fn emit_linked_cell(
+    c: usize,
+    n: usize,
+    (tape, tangent, pose): (&Tape, &Tape, &Tape),
+    (f, f4, ft, fp): (&Ident, &Ident, &Ident, &Ident),
+) -> (TokenStream, TokenStream) {
+    let name = format!("cell_{c}");
+    let n2 = 2 * n;
+    let key = crate::tmt::cell_key(tape, tangent, pose);
+    let (lo, l4, lt, lp, four) = (
+        Ident::new(&format!("{name}_linked"), Span::call_site()),
+        Ident::new(&format!("{name}_x4_linked"), Span::call_site()),
+        Ident::new(&format!("{name}_tangent_linked"), Span::call_site()),
+        Ident::new(&format!("{name}_pose_linked"), Span::call_site()),
+        Ident::new(&format!("CELL_{c}_FOUR"), Span::call_site()),
+    );
+    let linked = quote! {
+        fn #lo(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+            #f(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+               &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
+               out.try_into().expect("cell outputs"))
+        }
+        #[cfg(target_arch = "x86_64")]
+        fn #l4(x: &[[f64; 4]], xd: &[[f64; 4]], p: &[[f64; 4]], out: &mut [[f64; 4]]) {
+            runtime::cpu::require_fma();
+            // SAFETY: `require_fma` has checked that the processor has FMA.
+            unsafe { #f4(x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+                         p.try_into().expect("cell parameters"), out.try_into().expect("cell outputs")) }
+        }
+        #[cfg(target_arch = "x86_64")]
+        const #four: Option<runtime::links::CellLanesFn> = Some(#l4);
+        #[cfg(not(target_arch = "x86_64"))]
+        const #four: Option<runtime::links::CellLanesFn> = None;
+        fn #lt(x: &[f64], xd: &[f64], dx: &[f64], dxd: &[f64], p: &[f64], out: &mut [f64]) {
+            let mut dir = [0.0; #n2];
+            dir[..#n].copy_from_slice(dx);
+            dir[#n..].copy_from_slice(dxd);
+            #ft(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+                &[0.0; #n], &dir, p.try_into().expect("cell parameters"),
+                out.try_into().expect("cell outputs and derivatives"))
+        }
+        fn #lp(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+            #fp(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+                &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
+                out.try_into().expect("pose outputs"))
+        }
+    };
+    let registry = quote! {
+        runtime::links::CompiledCell { key: #key, one: #lo, four: #four, tangent: #lt, pose: #lp },
+    };
+    (linked, registry)
+}
+
+/// The generated cells of a chain: their kernels (`defs`), and the arms
+/// of `Cells::one`, `four`, `tangent` and `pose`; the cells others may link
+/// (3D chains', whose every kernel the recursion gives) and their registry.
+#[derive(Default)]
+struct EmittedCells {
+    defs: Vec<TokenStream>,
+    ones: Vec<TokenStream>,
+    fours: Vec<TokenStream>,
+    tangents: Vec<TokenStream>,
+    poses: Vec<TokenStream>,
+    linked: Vec<TokenStream>,
+    registry: Vec<TokenStream>,
+}
+
+fn emit_cells(links: &runtime::links::LinkKernels) -> EmittedCells {
     use runtime::links::CELL_PARAMS;
     let layout = &links.layout;
-    let mut defs = Vec::new();
-    let (mut ones, mut fours, mut tangents, mut poses) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    // The cells other structures may link (`runtime::linked::LinkedKernels`):
-    // 3D chains', whose every kernel the recursion gives.
-    let (mut linked, mut registry) = (Vec::new(), Vec::new());
+    let EmittedCells {
+        mut defs,
+        mut ones,
+        mut fours,
+        mut tangents,
+        mut poses,
+        mut linked,
+        mut registry,
+    } = EmittedCells::default();
     for (c, ((tape, tangent), pose)) in links
         .cells
         .iter()
@@ -551,48 +615,9 @@ fn emit_link_recursion(
                       out.try_into().expect("pose outputs")),
         });
         if links.mass_bias {
-            let key = crate::tmt::cell_key(tape, tangent, pose);
-            let (lo, l4, lt, lp, four) = (
-                Ident::new(&format!("{name}_linked"), Span::call_site()),
-                Ident::new(&format!("{name}_x4_linked"), Span::call_site()),
-                Ident::new(&format!("{name}_tangent_linked"), Span::call_site()),
-                Ident::new(&format!("{name}_pose_linked"), Span::call_site()),
-                Ident::new(&format!("CELL_{c}_FOUR"), Span::call_site()),
-            );
-            linked.push(quote! {
-                fn #lo(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
-                    #f(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
-                       &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
-                       out.try_into().expect("cell outputs"))
-                }
-                #[cfg(target_arch = "x86_64")]
-                fn #l4(x: &[[f64; 4]], xd: &[[f64; 4]], p: &[[f64; 4]], out: &mut [[f64; 4]]) {
-                    runtime::cpu::require_fma();
-                    // SAFETY: `require_fma` has checked that the processor has FMA.
-                    unsafe { #f4(x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
-                                 p.try_into().expect("cell parameters"), out.try_into().expect("cell outputs")) }
-                }
-                #[cfg(target_arch = "x86_64")]
-                const #four: Option<runtime::links::CellLanesFn> = Some(#l4);
-                #[cfg(not(target_arch = "x86_64"))]
-                const #four: Option<runtime::links::CellLanesFn> = None;
-                fn #lt(x: &[f64], xd: &[f64], dx: &[f64], dxd: &[f64], p: &[f64], out: &mut [f64]) {
-                    let mut dir = [0.0; #n2];
-                    dir[..#n].copy_from_slice(dx);
-                    dir[#n..].copy_from_slice(dxd);
-                    #ft(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
-                        &[0.0; #n], &dir, p.try_into().expect("cell parameters"),
-                        out.try_into().expect("cell outputs and derivatives"))
-                }
-                fn #lp(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
-                    #fp(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
-                        &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
-                        out.try_into().expect("pose outputs"))
-                }
-            });
-            registry.push(quote! {
-                runtime::links::CompiledCell { key: #key, one: #lo, four: #four, tangent: #lt, pose: #lp },
-            });
+            let (one, reg) = emit_linked_cell(c, n, (tape, tangent, pose), (&f, &f4, &ft, &fp));
+            linked.push(one);
+            registry.push(reg);
         }
         tangents.push(quote! {
             #c => {
@@ -605,8 +630,27 @@ fn emit_link_recursion(
             }
         });
     }
+    EmittedCells {
+        defs,
+        ones,
+        fours,
+        tangents,
+        poses,
+        linked,
+        registry,
+    }
+}
+
+/// The chain's kernels of the whole arm, pushed to `defs`, and how
+/// `Cells` calls them: a rom segment's forces and their tangent, its
+/// energy, the actuation loads.
+fn emit_link_globals(
+    links: &runtime::links::LinkKernels,
+    dof: usize,
+    n_params: usize,
+    defs: &mut Vec<TokenStream>,
+) -> [TokenStream; 4] {
     let n_dir = 2 * dof;
-    let n_outputs = runtime::N_OUTPUTS;
     let (forces, forces_tangent) = match (&links.forces, &links.forces_tangent) {
         (Some(tape), Some(tangent)) => {
             defs.push(KernelEmitter::new(tape).emit("link_forces", dof, n_params, 0));
@@ -649,16 +693,25 @@ fn emit_link_recursion(
         }
         None => quote!(unreachable!("no actuators")),
     };
-    // Chains of owned links sum by composite bodies; shared links (rom
-    // slices) need the arm's coordinates in rows of a fixed length.
-    let call = if runtime::links::all_owned(layout) {
-        quote!(runtime::links::mass_bias_owned(
-            &LINKS, &mut cells, q, qd, p, out
-        ))
-    } else {
-        let rows = runtime::links::padded(dof);
-        quote!(runtime::links::mass_bias_shared::<#rows, _>(&LINKS, &mut cells, q, qd, p, out))
-    };
+    [forces, forces_tangent, energy, loads]
+}
+
+/// `LinkCells`, the `Cells` the generated recursion evaluates.
+fn emit_cells_impl(
+    links: &runtime::links::LinkKernels,
+    cells: &EmittedCells,
+    globals: [TokenStream; 4],
+    dof: usize,
+    n_params: usize,
+) -> TokenStream {
+    let EmittedCells {
+        ones,
+        fours,
+        tangents,
+        poses,
+        ..
+    } = cells;
+    let [forces, forces_tangent, loads, energy] = globals;
     // Lane kernels serve the recursion's mass + bias alone.
     let four = match links.mass_bias {
         true => quote! {
@@ -673,7 +726,7 @@ fn emit_link_recursion(
         },
         false => quote!(),
     };
-    let cells_impl = quote! {
+    quote! {
         /// The compiled cells and forces the link recursion evaluates.
         #[allow(dead_code)] // the arm's coordinates serve the forces kernel alone
         struct LinkCells<'a> {
@@ -720,7 +773,48 @@ fn emit_link_recursion(
                 #energy
             }
         }
+    }
+}
+
+/// `mass_bias` and `jvp` as the link recursion (`runtime::links`) over the
+/// model's cells: each cell a kernel of one link's coordinates and
+/// parameters, with its lane form (four links at once) and its tangent
+/// (outputs and their directional derivatives, for the Jvp's dual sweep).
+fn emit_link_recursion(
+    links: &runtime::links::LinkKernels,
+    dof: usize,
+    n_params: usize,
+    n_out: usize,
+) -> TokenStream {
+    let layout = &links.layout;
+    let mut cells = emit_cells(links);
+    let [forces, forces_tangent, energy, loads] =
+        emit_link_globals(links, dof, n_params, &mut cells.defs);
+    let n_dir = 2 * dof;
+    let n_outputs = runtime::N_OUTPUTS;
+    // Chains of owned links sum by composite bodies; shared links (rom
+    // slices) need the arm's coordinates in rows of a fixed length.
+    let call = if runtime::links::all_owned(layout) {
+        quote!(runtime::links::mass_bias_owned(
+            &LINKS, &mut cells, q, qd, p, out
+        ))
+    } else {
+        let rows = runtime::links::padded(dof);
+        quote!(runtime::links::mass_bias_shared::<#rows, _>(&LINKS, &mut cells, q, qd, p, out))
     };
+    let cells_impl = emit_cells_impl(
+        links,
+        &cells,
+        [forces, forces_tangent, loads, energy],
+        dof,
+        n_params,
+    );
+    let EmittedCells {
+        defs,
+        linked,
+        registry,
+        ..
+    } = cells;
     let doc = format!(
         " Kernel `mass_bias`: the link recursion (`runtime::links`) over {} links, {} cell(s).",
         layout.links.len(),
