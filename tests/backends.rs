@@ -4,7 +4,7 @@
 mod common;
 
 use common::*;
-use runtime::{Arm, Dynamics, Interpreted, KernelKind};
+use runtime::{Arm, Dynamics, Interpreted, KernelKind, output};
 use softarm::backend::{BackendChoice, load};
 use softarm::generated::MODELS;
 
@@ -475,17 +475,81 @@ value = 0.3
 #[test]
 fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
     let dir = std::env::temp_dir().join("softarm-test-cache");
+    let mut rng = Rng::new(11);
+    for (model, sets) in link_shapes(&dir) {
+        let overrides: Vec<eomgen::model::Override> = sets
+            .iter()
+            .map(|s| eomgen::model::Override::parse(s).unwrap())
+            .collect();
+        let l = load(
+            &model,
+            &overrides,
+            BackendChoice::Interpreted,
+            Some(dir.clone()),
+        )
+        .unwrap();
+        let tapes = eomgen::derive::derive(&l.model);
+        let links = tapes
+            .links
+            .clone()
+            .unwrap_or_else(|| panic!("the recursion covers {model} {sets:?}"));
+        let chain = Chain {
+            links,
+            flat: tapes.mass_bias.clone(),
+            jvp: tapes.jvp.clone(),
+            outputs: tapes.outputs.clone(),
+        };
+        let mut p: Vec<f64> = eomgen::model::parameters(&l.model)
+            .into_iter()
+            .map(|(_, v)| v)
+            .collect();
+        // Inputs at values of their kind's scale (a constant input's value
+        // is not in the model's numbers).
+        let layout = eomgen::model::ParamLayout::of(&eomgen::model::Structure::of(&l.model));
+        for d in layout.driven() {
+            use eomgen::model::{ChamberParam, Param};
+            let scale = match d.param {
+                Param::Chamber {
+                    what: ChamberParam::Pressure,
+                    ..
+                } => 3e4,
+                Param::TendonTension(_) => 2.0,
+                _ => 0.2,
+            };
+            p[layout.index(d.param)] = rng.uniform(-scale, scale);
+        }
+        let arm = Arm::new(Interpreted::new(tapes), p);
+        let p = arm.params().to_vec();
+        let n = arm.dof();
+        let names = arm.info().coordinates.clone();
+        for trial in 0..6 {
+            let mut q = rng.coordinates(&names, -1.5, 1.5);
+            if trial == 0 {
+                q.fill(0.0);
+            }
+            let qd = rng.vec(n, -3.0, 3.0);
+            let what = format!("{model} {sets:?} trial {trial}");
+            recursion_matches_at(&chain, &p, &q, &qd, &mut rng, &what);
+        }
+    }
+}
+
+/// A chain of every link shape and tip the recursion covers: every
+/// bundled chain, actuated arms of every covered method, and cantilever3d
+/// under rom slices, stretch, thinning, vc, tip wrenches and tip bodies;
+/// with the `--set`s of each.
+fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
     // Actuators on every covered method: chambers on a pcc and a rom
     // segment, a tendon through both, each link loaded by its segment's
     // loads (the `loads` kernel).
     let actuated = dir.join("actuated3d.toml");
-    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::create_dir_all(dir).unwrap();
     std::fs::write(&actuated, ACTUATED_3D).unwrap();
     let actuated = actuated.to_str().unwrap().to_string();
     let actuated2d = dir.join("actuated2d.toml");
     std::fs::write(&actuated2d, ACTUATED_2D).unwrap();
     let actuated2d = actuated2d.to_str().unwrap().to_string();
-    let mut models: Vec<(&str, &[&str])> = vec![
+    let mut models: Vec<(&str, &[&'static str])> = vec![
         // Planar chains: rigid links and pcc arcs (whose inertia changes
         // with the bend), a turned base, actuators, tip bodies and loads.
         ("double_pendulum", &[]),
@@ -587,180 +651,163 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
         ],
     ];
     models.extend(cases.iter().map(|&sets| ("cantilever3d", sets)));
-    let mut rng = Rng::new(11);
-    for (model, sets) in models {
-        let overrides: Vec<eomgen::model::Override> = sets
-            .iter()
-            .map(|s| eomgen::model::Override::parse(s).unwrap())
-            .collect();
-        let l = load(
-            model,
-            &overrides,
-            BackendChoice::Interpreted,
-            Some(dir.clone()),
-        )
-        .unwrap();
-        let tapes = eomgen::derive::derive(&l.model);
-        let links = tapes
-            .links
-            .clone()
-            .unwrap_or_else(|| panic!("the recursion covers {model} {sets:?}"));
-        let flat = tapes.mass_bias.clone();
-        let jvp = tapes.jvp.clone();
-        let outputs = tapes.outputs.clone();
-        let mut p: Vec<f64> = eomgen::model::parameters(&l.model)
-            .into_iter()
-            .map(|(_, v)| v)
-            .collect();
-        // Inputs at values of their kind's scale (a constant input's value
-        // is not in the model's numbers).
-        let layout = eomgen::model::ParamLayout::of(&eomgen::model::Structure::of(&l.model));
-        for d in layout.driven() {
-            use eomgen::model::{ChamberParam, Param};
-            let scale = match d.param {
-                Param::Chamber {
-                    what: ChamberParam::Pressure,
-                    ..
-                } => 3e4,
-                Param::TendonTension(_) => 2.0,
-                _ => 0.2,
-            };
-            p[layout.index(d.param)] = rng.uniform(-scale, scale);
+    (models.into_iter())
+        .map(|(m, sets)| (m.to_string(), sets.to_vec()))
+        .collect()
+}
+
+/// The flat tapes of a chain and its link recursion.
+struct Chain {
+    links: runtime::links::LinkKernels,
+    flat: runtime::Tape,
+    jvp: runtime::Tape,
+    outputs: runtime::Tape,
+}
+
+/// At (q, qd): mass + bias by the recursion (as generated code picks it,
+/// and by the shared sums) and the outputs by the pose cells against the
+/// flat tapes; tau = M qdd + h and its tangent (the Jvp) by the cells'
+/// tangents at a random qdd and direction, at 1e-12 of each block's scale.
+fn recursion_matches_at(
+    chain: &Chain,
+    p: &[f64],
+    q: &[f64],
+    qd: &[f64],
+    rng: &mut Rng,
+    what: &str,
+) {
+    let Chain {
+        links,
+        flat,
+        jvp,
+        outputs,
+    } = chain;
+    let n = q.len();
+    let len = flat.outputs.len();
+    let (mut want, mut got) = (vec![0.0; len], vec![0.0; len]);
+    let inp = runtime::Inputs {
+        t: 0.0,
+        q,
+        qd,
+        qdd: &[],
+        dir: &[],
+        p,
+        aux: &[],
+    };
+    flat.eval(&inp, &mut Vec::new(), &mut want);
+    let mut slots = Vec::new();
+    let mut force_slots = Vec::new();
+    let m_len = n * (n + 1) / 2;
+    let largest = |r: std::ops::Range<usize>| want[r].iter().fold(0.0f64, |s, x| s.max(x.abs()));
+    let (m_scale, h_scale) = (largest(0..m_len), largest(m_len..len));
+    // The recursion as generated code picks it, and the shared
+    // sums on every chain (for owned links a second strategy).
+    for shared in [false, true] {
+        got.fill(f64::NAN);
+        let mut cells = TapeCells {
+            links,
+            inp,
+            slots: &mut slots,
+            force_slots: &mut force_slots,
+        };
+        let layout = &links.layout;
+        if shared {
+            runtime::links::mass_bias_shared_dyn(layout, &mut cells, q, qd, p, &mut got);
+        } else {
+            runtime::links::mass_bias(layout, &mut cells, q, qd, p, &mut got);
         }
-        let arm = Arm::new(Interpreted::new(tapes), p);
-        let p = arm.params().to_vec();
-        let n = arm.dof();
-        let names = arm.info().coordinates.clone();
-        for trial in 0..6 {
-            let mut q = rng.coordinates(&names, -1.5, 1.5);
-            if trial == 0 {
-                q.fill(0.0);
-            }
-            let qd = rng.vec(n, -3.0, 3.0);
-            let len = flat.outputs.len();
-            let (mut want, mut got) = (vec![0.0; len], vec![0.0; len]);
-            let inp = runtime::Inputs {
-                t: 0.0,
-                q: &q,
-                qd: &qd,
-                qdd: &[],
-                dir: &[],
-                p: &p,
-                aux: &[],
-            };
-            flat.eval(&inp, &mut Vec::new(), &mut want);
-            let mut slots = Vec::new();
-            let mut force_slots = Vec::new();
-            let m_len = n * (n + 1) / 2;
-            let largest =
-                |r: std::ops::Range<usize>| want[r].iter().fold(0.0f64, |s, x| s.max(x.abs()));
-            let (m_scale, h_scale) = (largest(0..m_len), largest(m_len..len));
-            // The recursion as generated code picks it, and the shared
-            // sums on every chain (for owned links a second strategy).
-            for shared in [false, true] {
-                got.fill(f64::NAN);
-                let mut cells = TapeCells {
-                    links: &links,
-                    inp,
-                    slots: &mut slots,
-                    force_slots: &mut force_slots,
-                };
-                let layout = &links.layout;
-                if shared {
-                    runtime::links::mass_bias_shared_dyn(layout, &mut cells, &q, &qd, &p, &mut got);
-                } else {
-                    runtime::links::mass_bias(layout, &mut cells, &q, &qd, &p, &mut got);
-                }
-                for k in 0..len {
-                    let floor = if k < m_len { m_scale } else { h_scale };
-                    assert_close(
-                        got[k],
-                        want[k],
-                        1e-12,
-                        floor,
-                        &format!("{model} {sets:?} trial {trial} shared {shared} entry {k}"),
-                    );
-                }
-            }
-            // The outputs by the pose cells against the flat tape's.
-            let mut want_out = vec![0.0; runtime::N_OUTPUTS];
-            outputs.eval(&inp, &mut Vec::new(), &mut want_out);
-            let mut got_out = vec![f64::NAN; runtime::N_OUTPUTS];
-            let mut cells = TapeCells {
-                links: &links,
-                inp,
-                slots: &mut slots,
-                force_slots: &mut force_slots,
-            };
-            runtime::links::outputs(&links.layout, &mut cells, &q, &qd, &p, &mut got_out);
-            let energy_scale = want_out[3].abs().max(want_out[4].abs());
-            let position_scale = want_out[..3].iter().fold(0.0f64, |s, x| s.max(x.abs()));
-            for (k, name) in runtime::OUTPUT_NAMES.iter().enumerate() {
-                let floor = match k {
-                    0..3 => position_scale,
-                    3 | 4 => energy_scale,
-                    _ => 1.0,
-                };
-                let what = format!("{model} {sets:?} trial {trial} output {name}");
-                assert_close(got_out[k], want_out[k], 1e-12, floor, &what);
-            }
-            // The Jvp by dual numbers through the cells' tangents against
-            // the flat tape's symbolic derivative, and tau = M qdd + h
-            // against the flat mass + bias.
-            let qdd = rng.vec(n, -5.0, 5.0);
-            let dir = rng.vec(2 * n, -1.0, 1.0);
-            let inp = runtime::Inputs {
-                qdd: &qdd,
-                dir: &dir,
-                ..inp
-            };
-            let mut want_jvp = vec![0.0; n];
-            jvp.eval(&inp, &mut Vec::new(), &mut want_jvp);
-            let (mut tau, mut dtau) = (vec![f64::NAN; n], vec![f64::NAN; n]);
-            let mut cells = TapeCells {
-                links: &links,
-                inp,
-                slots: &mut slots,
-                force_slots: &mut force_slots,
-            };
-            runtime::links::inverse_dynamics_tangent(
-                &links.layout,
-                &mut cells,
-                &q,
-                &qd,
-                &qdd,
-                &dir,
-                &p,
-                &mut tau,
-                &mut dtau,
+        for k in 0..len {
+            let floor = if k < m_len { m_scale } else { h_scale };
+            assert_close(
+                got[k],
+                want[k],
+                1e-12,
+                floor,
+                &format!("{what} shared {shared} entry {k}"),
             );
-            let mut want_tau = want[m_len..].to_vec();
-            for (i, tau) in want_tau.iter_mut().enumerate() {
-                for (j, a) in qdd.iter().enumerate() {
-                    let (r, c) = (i.min(j), i.max(j));
-                    *tau += want[r * n - r * (r + 1) / 2 + c] * a;
-                }
-            }
-            let scale = |v: &[f64]| v.iter().fold(0.0f64, |s, x| s.max(x.abs()));
-            let (tau_scale, jvp_scale) = (scale(&want_tau), scale(&want_jvp));
-            for i in 0..n {
-                let what = format!("{model} {sets:?} trial {trial} coordinate {i}");
-                assert_close(
-                    tau[i],
-                    want_tau[i],
-                    1e-12,
-                    tau_scale,
-                    &format!("tau {what}"),
-                );
-                assert_close(
-                    dtau[i],
-                    want_jvp[i],
-                    1e-12,
-                    jvp_scale,
-                    &format!("jvp {what}"),
-                );
-            }
         }
+    }
+    // The outputs by the pose cells against the flat tape's.
+    let mut want_out = vec![0.0; runtime::N_OUTPUTS];
+    outputs.eval(&inp, &mut Vec::new(), &mut want_out);
+    let mut got_out = vec![f64::NAN; runtime::N_OUTPUTS];
+    let mut cells = TapeCells {
+        links,
+        inp,
+        slots: &mut slots,
+        force_slots: &mut force_slots,
+    };
+    runtime::links::outputs(&links.layout, &mut cells, q, qd, p, &mut got_out);
+    let energy_scale = want_out[output::KINETIC]
+        .abs()
+        .max(want_out[output::POTENTIAL].abs());
+    let position_scale = want_out[output::TIP]
+        .iter()
+        .fold(0.0f64, |s, x| s.max(x.abs()));
+    for (k, name) in runtime::OUTPUT_NAMES.iter().enumerate() {
+        let floor = match k {
+            0..3 => position_scale,
+            3 | 4 => energy_scale,
+            _ => 1.0,
+        };
+        let what = format!("{what} output {name}");
+        assert_close(got_out[k], want_out[k], 1e-12, floor, &what);
+    }
+    // The Jvp by dual numbers through the cells' tangents against
+    // the flat tape's symbolic derivative, and tau = M qdd + h
+    // against the flat mass + bias.
+    let qdd = rng.vec(n, -5.0, 5.0);
+    let dir = rng.vec(2 * n, -1.0, 1.0);
+    let inp = runtime::Inputs {
+        qdd: &qdd,
+        dir: &dir,
+        ..inp
+    };
+    let mut want_jvp = vec![0.0; n];
+    jvp.eval(&inp, &mut Vec::new(), &mut want_jvp);
+    let (mut tau, mut dtau) = (vec![f64::NAN; n], vec![f64::NAN; n]);
+    let mut cells = TapeCells {
+        links,
+        inp,
+        slots: &mut slots,
+        force_slots: &mut force_slots,
+    };
+    runtime::links::inverse_dynamics_tangent(
+        &links.layout,
+        &mut cells,
+        q,
+        qd,
+        &qdd,
+        &dir,
+        p,
+        &mut tau,
+        &mut dtau,
+    );
+    let mut want_tau = want[m_len..].to_vec();
+    for (i, tau) in want_tau.iter_mut().enumerate() {
+        for (j, a) in qdd.iter().enumerate() {
+            let (r, c) = (i.min(j), i.max(j));
+            *tau += want[r * n - r * (r + 1) / 2 + c] * a;
+        }
+    }
+    let scale = |v: &[f64]| v.iter().fold(0.0f64, |s, x| s.max(x.abs()));
+    let (tau_scale, jvp_scale) = (scale(&want_tau), scale(&want_jvp));
+    for i in 0..n {
+        let what = format!("{what} coordinate {i}");
+        assert_close(
+            tau[i],
+            want_tau[i],
+            1e-12,
+            tau_scale,
+            &format!("tau {what}"),
+        );
+        assert_close(
+            dtau[i],
+            want_jvp[i],
+            1e-12,
+            jvp_scale,
+            &format!("jvp {what}"),
+        );
     }
 }
 
