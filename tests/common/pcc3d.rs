@@ -303,6 +303,13 @@ impl Pcc3d {
     fn mass_bias_any(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) {
         let n = self.dof();
         assert_eq!(out.len(), n * (n + 1) / 2 + n);
+        self.outward(q, qd);
+        self.inward(q, qd, out);
+    }
+
+    /// From the base: every element's frames, its body's motion and the
+    /// force and torque its motion takes, its twists (`computed`).
+    fn outward(&mut self, q: &[f64], qd: &[f64]) {
         let (mut r, mut p) = (self.base_r, self.base_p);
         let (mut omega, mut alpha, mut acc) = ([0.0; 3], [0.0; 3], [0.0; 3]);
         for (k, e) in self.elements.iter().enumerate() {
@@ -421,7 +428,12 @@ impl Pcc3d {
             p = end;
             r = mat_mat(&r, &rel_r);
         }
+    }
 
+    /// From the tip: composite inertias and wrenches, the coordinates'
+    /// momenta, and so M and h into `out`.
+    fn inward(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        let n = self.dof();
         // From the tip: composite inertia and wrench of everything past
         // element k; momenta and generalised forces of its coordinates.
         let n_el = self.elements.len();
