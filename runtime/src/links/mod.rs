@@ -1144,10 +1144,10 @@ mod tests {
                 let j: [f64; 2] = joints[i];
                 [-(c[1] - j[1]), c[0] - j[0]]
             };
-            for i in 0..=b {
-                for k in 0..=b {
+            for (i, row) in m.iter_mut().enumerate().take(b + 1) {
+                for (k, entry) in row.iter_mut().enumerate().take(b + 1) {
                     let (a, d) = (col(i), col(k));
-                    m[i][k] += link[1] * (a[0] * d[0] + a[1] * d[1]) + link[2];
+                    *entry += link[1] * (a[0] * d[0] + a[1] * d[1]) + link[2];
                 }
             }
             joint = [
