@@ -1215,19 +1215,14 @@ mod tests {
             let mut out = vec![f64::NAN; n * (n + 1) / 2 + n];
             mass_bias(&layout, &mut Pendulums, &q, &qd, &p, &mut out);
             let (m, h) = (mass(&q), bias(&q, &qd));
-            let mut at = 0;
-            for i in 0..n {
-                for j in i..n {
-                    assert!((out[at] - m[i][j]).abs() < 1e-12, "M[{i}][{j}] at {q:?}");
-                    at += 1;
-                }
+            let upper = (0..n).flat_map(|i| (i..n).map(move |j| (i, j)));
+            for ((i, j), got) in upper.zip(&out) {
+                assert!((got - m[i][j]).abs() < 1e-12, "M[{i}][{j}] at {q:?}");
             }
-            for i in 0..n {
-                let got = out[n * (n + 1) / 2 + i];
+            for (i, (got, want)) in out[n * (n + 1) / 2..].iter().zip(&h).enumerate() {
                 assert!(
-                    (got - h[i]).abs() < 1e-7,
-                    "h[{i}] at {q:?}: {got} against {}",
-                    h[i]
+                    (got - want).abs() < 1e-7,
+                    "h[{i}] at {q:?}: {got} against {want}"
                 );
             }
         }
