@@ -120,8 +120,11 @@ mod tests {
         let qdd = cas.eval_many(&solve.qdd, &value).unwrap();
         let d = cas.eval_many(&solve.pivots, &value).unwrap();
         let low = cas.eval_many(&solve.lower, &value).unwrap();
-        for i in 0..n {
-            let r: f64 = (0..n).map(|j| m(i, j) * qdd[j]).sum::<f64>() + h[i];
+        for (i, hi) in h.iter().enumerate() {
+            let r: f64 = (qdd.iter().enumerate())
+                .map(|(j, a)| m(i, j) * a)
+                .sum::<f64>()
+                + hi;
             assert!(r.abs() < 1e-13, "row {i}: residual {r}");
         }
         // L below its unit diagonal, row by row.
