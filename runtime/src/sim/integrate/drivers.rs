@@ -16,6 +16,7 @@ use super::ode::ArmOde;
 use super::options::SimOptions;
 use super::outcome::{SimStats, Trajectory};
 use super::record::{RunLog, Watch};
+use super::state::StateVec;
 use super::stepper::{self, Counts, OdeSystem, StepFn};
 use crate::arm::Dynamics;
 
@@ -57,28 +58,19 @@ pub(super) fn run_crate<S>(
     t0: f64,
     x0: Vec<f64>,
     opts: &SimOptions,
-    mut method: S,
+    method: S,
     watch: Option<&Watch<'_>>,
     switch: &RefCell<Option<(f64, Vec<f64>, String)>>,
 ) -> RunResult
 where
     S: OrdinaryNumericalMethod<f64, Vec<f64>> + Interpolation<f64, Vec<f64>>,
 {
-    let ode = ArmOde::new(arm);
-    let log = RunLog::new(opts, ode.n);
-    let mut recorder = log.recorder(opts, &ode, opts.solver.fixed_step(), watch, switch);
-    let start = Instant::now();
-    let result: Outcome<Vec<f64>> =
-        solve_ode(&mut method, &ode, t0, opts.t_end, &x0, &mut recorder);
-    finish(
-        result,
-        &ode,
-        log.blown_up.get(),
-        &x0,
-        opts,
-        start,
-        log.finish(),
-    )
+    let start = Start {
+        t0,
+        y0: x0.clone(),
+        x0,
+    };
+    run_on(arm, start, opts, method, watch, switch)
 }
 
 /// A crate's implicit method, which works only on fixed-size states (its
@@ -125,28 +117,51 @@ pub(super) fn run_sized<M: SizedMethod>(
 }
 
 fn run_array<const P: usize>(
-    mut method: impl OrdinaryNumericalMethod<f64, [f64; P]> + Interpolation<f64, [f64; P]>,
+    method: impl OrdinaryNumericalMethod<f64, [f64; P]> + Interpolation<f64, [f64; P]>,
     arm: &dyn Dynamics,
     t0: f64,
     x0: Vec<f64>,
     opts: &SimOptions,
 ) -> RunResult {
-    let ode = ArmOde::new(arm);
-    let log = RunLog::new(opts, ode.n);
-    let no_switch = RefCell::new(None);
-    let mut recorder = log.recorder(opts, &ode, false, None, &no_switch);
     let mut y0 = [0.0; P];
     y0[..x0.len()].copy_from_slice(&x0);
-    let start = Instant::now();
-    let result: Outcome<[f64; P]> =
-        solve_ode(&mut method, &ode, t0, opts.t_end, &y0, &mut recorder);
+    let start = Start { t0, x0, y0 };
+    run_on(arm, start, opts, method, None, &RefCell::new(None))
+}
+
+/// Where a run starts: at `t0` from `x0`, carried as the method's state
+/// `y0` (`x0`, padded for an array state).
+struct Start<Y> {
+    t0: f64,
+    x0: Vec<f64>,
+    y0: Y,
+}
+
+/// A method of the crate on the state `Y`, through the run's recorder.
+fn run_on<Y: StateVec, S>(
+    arm: &dyn Dynamics,
+    start: Start<Y>,
+    opts: &SimOptions,
+    mut method: S,
+    watch: Option<&Watch<'_>>,
+    switch: &RefCell<Option<(f64, Vec<f64>, String)>>,
+) -> RunResult
+where
+    S: OrdinaryNumericalMethod<f64, Y> + Interpolation<f64, Y>,
+{
+    let Start { t0, x0, y0 } = start;
+    let ode = ArmOde::new(arm);
+    let log = RunLog::new(opts, ode.n);
+    let mut recorder = log.recorder(opts, &ode, opts.solver.fixed_step(), watch, switch);
+    let clock = Instant::now();
+    let result: Outcome<Y> = solve_ode(&mut method, &ode, t0, opts.t_end, &y0, &mut recorder);
     finish(
         result,
         &ode,
         log.blown_up.get(),
         &x0,
         opts,
-        start,
+        clock,
         log.finish(),
     )
 }
