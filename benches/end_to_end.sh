@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Fresh clone to the STIFF-FLOP result and to a passing test suite (issues 6
-# and 19, BENCHMARKS.md): clone this repository, build the release binary
+# Fresh clone to the STIFF-FLOP result and to a passing test suite (the
+# budgets of BENCHMARKS.md, build and tests): clone this repository, build the release binary
 # from scratch (crates already downloaded), simulate the 54.65 s record;
 # then, in a second fresh clone, run the README's test command from
 # scratch. Prints the wall times.

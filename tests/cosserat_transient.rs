@@ -141,9 +141,9 @@ fn the_pcs_rod_that_stretches_and_shears_swings_within_its_recorded_distance() {
 fn the_six_strain_rom_follows_the_cosserat_rod_within_a_tenth_of_a_percent() {
     // rod_swing_rom: rom of order 5 with all six strains, 36 coordinates,
     // at its own rtol 1e-5 (docs/validation.md: 0.058 and 0.089 % of L
-    // against the rod, 0.536 and 0.652 % against PyElastica's law). Issue
-    // 24 asks for 1 % over 2 s; the recorded figures, with a margin, hold
-    // it to what it reaches.
+    // against the rod, 0.536 and 0.652 % against PyElastica's law). The
+    // goal is 1 % over 2 s; the recorded figures, with a margin, hold it to
+    // what it reaches.
     let tips = tips("rod_swing_rom", 1e-5);
     let (half, whole) = distance(&tips, ROD);
     assert!(half <= 0.065, "{half} % of L over 0.5 s");
