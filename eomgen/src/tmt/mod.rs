@@ -2,13 +2,13 @@
 //! derives M, h and the outputs from it.
 
 pub(crate) mod actuation;
-mod assemble;
 mod assembly;
 mod cell;
 pub(crate) mod cell_kind;
 mod cell_outputs;
 mod chain;
 pub(crate) mod contact_frames;
+mod equations;
 mod inertia;
 pub(crate) mod planar;
 mod planar_cell;
@@ -22,10 +22,10 @@ use crate::model::{Param, ParamLayout, Structure};
 use planar::PlanarArm;
 use spatial::SpatialArm;
 
-pub use assemble::{Equations, assemble};
 pub use assembly::{Assembled, assembly_system};
 pub use cell::{cell_key, link_chain};
 pub(crate) use cell_outputs::with_tangent;
+pub use equations::{Equations, assemble};
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
 pub use system::ParamSymbols;
 
