@@ -8,7 +8,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use eomgen::model::assembly::BodyShape;
-use runtime::contact::Shape as ObstacleShape;
+use runtime::contact;
 use serde::Serialize;
 
 use crate::backend::Loaded;
@@ -212,8 +212,8 @@ fn look_of(loaded: &Loaded, name: &str, s: &[f64]) -> Look {
         .contact()
         .and_then(|c| c.obstacles.iter().find(|o| o.name == name));
     match obstacle.map(|o| &o.shape) {
-        Some(ObstacleShape::Sphere { radius, .. }) => Look::Sphere { radius: *radius },
-        Some(ObstacleShape::Cylinder {
+        Some(contact::Shape::Sphere { radius, .. }) => Look::Sphere { radius: *radius },
+        Some(contact::Shape::Cylinder {
             radius,
             half_length,
             ..
@@ -221,7 +221,7 @@ fn look_of(loaded: &Loaded, name: &str, s: &[f64]) -> Look {
             radius: *radius,
             half_length: *half_length,
         },
-        Some(ObstacleShape::Box { half, .. }) => Look::Box { half: *half },
+        Some(contact::Shape::Box { half, .. }) => Look::Box { half: *half },
         _ => Look::Plane,
     }
 }

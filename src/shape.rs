@@ -7,7 +7,7 @@
 use anyhow::{Result, bail};
 use eomgen::model::{ParamLayout, Structure};
 use eomgen::shape::{ROW, ShapeTape, shape_tape};
-use runtime::contact::{Obstacle, Shape as ObstacleShape};
+use runtime::contact::{self, Obstacle};
 use runtime::{Dynamics, Inputs};
 
 use crate::backend::Loaded;
@@ -130,10 +130,10 @@ impl Shape {
 pub fn obstacle_pose(o: &Obstacle, t: f64) -> [f64; ROW] {
     let d = o.motion.as_ref().map_or([0.0; 3], |m| m.at(t).0);
     let (at, r) = match &o.shape {
-        ObstacleShape::Plane { point, normal } => (*point, turn_x_onto(*normal)),
-        ObstacleShape::Sphere { center, .. } => (*center, IDENTITY),
-        ObstacleShape::Cylinder { center, axis, .. } => (*center, turn_x_onto(*axis)),
-        ObstacleShape::Box {
+        contact::Shape::Plane { point, normal } => (*point, turn_x_onto(*normal)),
+        contact::Shape::Sphere { center, .. } => (*center, IDENTITY),
+        contact::Shape::Cylinder { center, axis, .. } => (*center, turn_x_onto(*axis)),
+        contact::Shape::Box {
             center, rotation, ..
         } => (*center, *rotation),
     };
