@@ -788,27 +788,6 @@ mod tests {
         })
     }
 
-    /// The rotation of a unit quaternion (w, x, y, z).
-    fn of_quaternion([w, x, y, z]: [f64; 4]) -> [[f64; 3]; 3] {
-        [
-            [
-                1.0 - 2.0 * (y * y + z * z),
-                2.0 * (x * y - w * z),
-                2.0 * (x * z + w * y),
-            ],
-            [
-                2.0 * (x * y + w * z),
-                1.0 - 2.0 * (x * x + z * z),
-                2.0 * (y * z - w * x),
-            ],
-            [
-                2.0 * (x * z - w * y),
-                2.0 * (y * z + w * x),
-                1.0 - 2.0 * (x * x + y * y),
-            ],
-        ]
-    }
-
     /// The turn's rotation, quaternion and angular velocity at `rho`
     /// moving at `rate`, evaluated.
     fn turn_at(rho: [f64; 3], rate: [f64; 3]) -> ([[f64; 3]; 3], [f64; 4], [f64; 3]) {
@@ -851,7 +830,13 @@ mod tests {
                     assert!((m[i][j] - want[i][j]).abs() < 1e-14, "{rho:?} R[{i}][{j}]");
                 }
             }
-            let from_q = of_quaternion(q);
+            let norm = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+            assert!((norm - 1.0).abs() < 1e-14, "{rho:?}: |q| = {norm}");
+            // The quaternion by the model's own reading of one (a load
+            // cell's `sensor_rotation`).
+            let from_q = crate::model::sensor::SensorRotation::Quaternion(q)
+                .matrix()
+                .unwrap();
             for i in 0..3 {
                 for j in 0..3 {
                     assert!(
