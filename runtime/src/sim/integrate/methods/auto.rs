@@ -9,8 +9,7 @@ use nalgebra::DMatrix;
 use super::super::drivers::RunResult;
 use super::super::options::SimOptions;
 use super::super::outcome::{SimStats, SolverSwitch};
-use super::radau5::Radau5;
-use super::{Integrator, dopri5};
+use super::{Integrator, Own, dopri5, radau5};
 use crate::arm::{Dynamics, Workspace};
 use crate::jacobian::rhs_jacobian;
 use crate::solver::Solver;
@@ -45,7 +44,7 @@ impl Integrator for Auto {
         if let Some(r) = analyse_at(t0, &x0)
             && r.stiffness_ratio > STIFF_RATIO
         {
-            let (traj, stats) = Radau5.run(arm, t0, x0, &implicit_opts)?;
+            let (traj, stats) = Own(radau5::integrate).run(arm, t0, x0, &implicit_opts)?;
             let reason = format!("stiff from the start: {}", r.reason);
             return Ok((traj, as_auto(stats, t0, reason)));
         }
@@ -69,7 +68,7 @@ impl Integrator for Auto {
         let Some((t_switch, x_switch, reason)) = switch.take() else {
             return Ok((traj, stats));
         };
-        let (rest, more) = Radau5.run(arm, t_switch, x_switch, &implicit_opts)?;
+        let (rest, more) = Own(radau5::integrate).run(arm, t_switch, x_switch, &implicit_opts)?;
         traj.events.extend(rest.events);
         for (t, x) in rest.t.into_iter().zip(rest.x) {
             if traj.t.last().is_none_or(|&last| t > last) {

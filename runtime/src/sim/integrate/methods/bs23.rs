@@ -86,18 +86,3 @@ pub fn integrate(
     }
     Ok(())
 }
-
-/// The method behind `--solver bs23`.
-pub(super) struct Bs23;
-
-impl super::Integrator for Bs23 {
-    fn run(
-        &self,
-        arm: &dyn crate::arm::Dynamics,
-        t0: f64,
-        x0: Vec<f64>,
-        opts: &super::super::options::SimOptions,
-    ) -> super::super::drivers::RunResult {
-        super::super::drivers::run_own(arm, t0, x0, opts, integrate)
-    }
-}

@@ -15,7 +15,7 @@ pub mod radau5;
 mod rk4;
 pub mod trbdf2;
 
-use super::drivers::RunResult;
+use super::drivers::{OwnIntegrator, RunResult, run_own};
 use super::options::SimOptions;
 use crate::arm::Dynamics;
 use crate::solver::Solver;
@@ -26,17 +26,27 @@ pub(super) trait Integrator: Sync {
     fn run(&self, arm: &dyn Dynamics, t0: f64, x0: Vec<f64>, opts: &SimOptions) -> RunResult;
 }
 
+/// A stepper written here (`bs23`, `radau5`, `trbdf2`), run through the
+/// recorder by `drivers::run_own`.
+pub(super) struct Own(pub OwnIntegrator);
+
+impl Integrator for Own {
+    fn run(&self, arm: &dyn Dynamics, t0: f64, x0: Vec<f64>, opts: &SimOptions) -> RunResult {
+        run_own(arm, t0, x0, opts, self.0)
+    }
+}
+
 /// The method of each solver.
 pub(super) fn of(solver: Solver) -> &'static dyn Integrator {
     match solver {
         Solver::Dopri5 => &dopri5::Dopri5,
         Solver::Dop853 => &dop853::Dop853,
-        Solver::Bs23 => &bs23::Bs23,
+        Solver::Bs23 => &Own(bs23::integrate),
         Solver::Rk4 => &rk4::Rk4,
         Solver::Euler => &euler::Euler,
-        Solver::Radau5 => &radau5::Radau5,
+        Solver::Radau5 => &Own(radau5::integrate),
         Solver::Bdf => &bdf::Bdf,
-        Solver::Trbdf2 => &trbdf2::Trbdf2,
+        Solver::Trbdf2 => &Own(trbdf2::integrate),
         Solver::Esdirk => &esdirk::Esdirk,
         Solver::Auto => &auto::Auto,
     }

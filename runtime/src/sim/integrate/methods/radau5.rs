@@ -425,21 +425,6 @@ fn simplified_newton(
     Ok((converged, iterations, theta))
 }
 
-/// The method behind `--solver radau5`.
-pub(super) struct Radau5;
-
-impl super::Integrator for Radau5 {
-    fn run(
-        &self,
-        arm: &dyn crate::arm::Dynamics,
-        t0: f64,
-        x0: Vec<f64>,
-        opts: &super::super::options::SimOptions,
-    ) -> super::super::drivers::RunResult {
-        super::super::drivers::run_own(arm, t0, x0, opts, integrate)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
