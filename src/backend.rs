@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use eomgen::model::{Model, Override, ParamLayout, Structure, parse_model};
+use eomgen::load::parse_model;
+use eomgen::model::{Model, Override, ParamLayout, Structure};
 use runtime::{Arm, CompiledModel, Dynamics, Interpreted, Kernels};
 use serde::Serialize;
 
@@ -107,7 +108,7 @@ fn linked(structure: &Structure) -> Option<(Box<dyn Kernels>, f64)> {
     let (info, links) = eomgen::derive::derive_links(structure)?;
     let cells = (links.cells.iter().zip(&links.tangents).zip(&links.poses))
         .map(|((cell, tangent), pose)| {
-            let key = eomgen::tmt::cell_key(cell, tangent, pose);
+            let key = eomgen::build::cell_key(cell, tangent, pose);
             MODELS
                 .iter()
                 .flat_map(|m| m.cells)

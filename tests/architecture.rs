@@ -11,10 +11,70 @@ use std::path::{Path, PathBuf};
 /// The crates' sources.
 const CRATES: &[&str] = &["eomgen/src", "runtime/src", "src", "python/src"];
 
-/// Module circles still to be taken apart, each as its sorted members: a
-/// circle not listed here fails, and so does a listed one that is gone
-/// (so that the list only shrinks).
-const KNOWN_MODULE_CIRCLES: &[(&str, &[&str])] = &[("eomgen/src", &["method", "model", "tmt"])];
+/// Each crate's top-level modules, lowest first (ARCHITECTURE.md's layer
+/// order): a module imports only modules before it. The crate roots
+/// (`lib`, `main`) declare and re-export and are left out.
+const LAYERS: &[(&str, &[&str])] = &[
+    (
+        "eomgen/src",
+        &[
+            "atomic_write",
+            "cas",
+            "model",
+            "tmt",
+            "method",
+            "load",
+            "build",
+            "derive",
+            "shape",
+            "emit",
+            "generate",
+        ],
+    ),
+    (
+        "runtime/src",
+        &[
+            "cpu",
+            "special",
+            "rodrigues",
+            "output",
+            "lanes",
+            "tape",
+            "rows",
+            "linalg",
+            "solver",
+            "links",
+            "parts",
+            "kernels",
+            "linked",
+            "sim",
+        ],
+    ),
+    (
+        "src",
+        &[
+            "data",
+            "cache",
+            "continuum",
+            "progress",
+            "grid",
+            "compare",
+            "inputs",
+            "contact",
+            "joints",
+            "backend",
+            "run",
+            "scene",
+            "shape",
+            "linearize",
+            "viewer",
+            "commands",
+            "animate",
+            "sweep",
+        ],
+    ),
+    ("python/src", &["simulator"]),
+];
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -227,33 +287,56 @@ fn no_two_files_import_each_other() {
     }
 }
 
+/// A crate's top-level modules and who imports whom among them.
+fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for (from, tos) in edges(src) {
+        let a = top_module(src, &from);
+        graph.entry(a.clone()).or_default();
+        for to in tos {
+            let b = top_module(src, &to);
+            if a != b {
+                graph.entry(a.clone()).or_default().insert(b);
+            }
+        }
+    }
+    graph
+}
+
 #[test]
 fn no_crate_has_a_circle_of_top_level_modules() {
     for krate in CRATES {
-        let src = root().join(krate);
-        let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-        for (from, tos) in edges(&src) {
-            let a = top_module(&src, &from);
-            for to in tos {
-                let b = top_module(&src, &to);
-                if a != b {
-                    graph.entry(a.clone()).or_default().insert(b);
-                }
+        let found = circles(&module_graph(&root().join(krate)));
+        assert!(
+            found.is_empty(),
+            "{krate}: top-level modules that import each other: {found:?}"
+        );
+    }
+}
+
+/// Every top-level module has its place in its crate's layer order, and
+/// imports only modules placed before it.
+#[test]
+fn each_crate_keeps_its_layer_order() {
+    for (krate, order) in LAYERS {
+        let rank = |m: &str| order.iter().position(|o| *o == m);
+        for (module, uses) in module_graph(&root().join(krate)) {
+            if matches!(module.as_str(), "lib" | "main") {
+                continue;
+            }
+            let Some(at) = rank(&module) else {
+                panic!("{krate}: `{module}` has no place in LAYERS (tests/architecture.rs)")
+            };
+            for used in uses
+                .iter()
+                .filter(|u| !matches!(u.as_str(), "lib" | "main"))
+            {
+                assert!(
+                    rank(used).is_some_and(|r| r < at),
+                    "{krate}: `{module}` imports `{used}`, which is not below it in the layer order"
+                );
             }
         }
-        let found: BTreeSet<Vec<String>> = circles(&graph)
-            .into_iter()
-            .map(|c| c.into_iter().collect())
-            .collect();
-        let known: BTreeSet<Vec<String>> = KNOWN_MODULE_CIRCLES
-            .iter()
-            .filter(|(k, _)| k == krate)
-            .map(|(_, c)| c.iter().map(|s| s.to_string()).collect())
-            .collect();
-        assert_eq!(
-            found, known,
-            "{krate}: the circles of top-level modules (left) against the known ones (right)"
-        );
     }
 }
 

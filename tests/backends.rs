@@ -14,7 +14,7 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
     assert!(MODELS.len() >= 3);
     for m in MODELS {
         let l = load(m.name, &[], BackendChoice::Compiled, None).unwrap();
-        let p: Vec<f64> = eomgen::model::parameters(&l.model)
+        let p: Vec<f64> = eomgen::load::parameters(&l.model)
             .into_iter()
             .map(|(_, v)| v)
             .collect();
@@ -499,7 +499,7 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
             jvp: tapes.jvp.clone(),
             outputs: tapes.outputs.clone(),
         };
-        let mut p: Vec<f64> = eomgen::model::parameters(&l.model)
+        let mut p: Vec<f64> = eomgen::load::parameters(&l.model)
             .into_iter()
             .map(|(_, v)| v)
             .collect();
@@ -861,7 +861,7 @@ fn eba_parts_match_the_flat_tapes() {
             .unwrap_or_else(|| panic!("parts cover {model} {sets:?}"));
         let (flat, jvp) = (tapes.mass_bias.clone(), tapes.jvp.clone());
         let flat_outputs = tapes.outputs.clone();
-        let p: Vec<f64> = eomgen::model::parameters(&l.model)
+        let p: Vec<f64> = eomgen::load::parameters(&l.model)
             .into_iter()
             .map(|(_, v)| v)
             .collect();
@@ -957,7 +957,7 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         );
         assert_eq!(l.arm.backend(), "compiled", "{what}");
         let tapes = eomgen::derive::derive(&l.model);
-        let p: Vec<f64> = eomgen::model::parameters(&l.model)
+        let p: Vec<f64> = eomgen::load::parameters(&l.model)
             .into_iter()
             .map(|(_, v)| v)
             .collect();
@@ -1004,7 +1004,7 @@ fn articulated_body_accelerations_equal_the_mass_matrix_solve() {
             "{what}: not linked"
         );
         let tapes = eomgen::derive::derive(&l.model);
-        let p: Vec<f64> = eomgen::model::parameters(&l.model)
+        let p: Vec<f64> = eomgen::load::parameters(&l.model)
             .into_iter()
             .map(|(_, v)| v)
             .collect();

@@ -5,7 +5,7 @@
 mod common;
 
 use common::*;
-use eomgen::model::load_model;
+use eomgen::load::load_model;
 use nalgebra::{DMatrix, DVector};
 use runtime::Dynamics;
 use softarm::backend::{BackendChoice, load};

@@ -90,7 +90,7 @@ fn jacobians_of_mass_and_bias_are_finite_at_the_straight_state() {
     let mut cas = Cas::new();
     let structure = eomgen::model::Structure::of(&model);
     let layout = eomgen::model::ParamLayout::of(&structure);
-    let sys = eomgen::tmt::system(&mut cas, &structure, &layout);
+    let sys = eomgen::build::system(&mut cas, &structure, &layout);
     let eq = eomgen::tmt::assemble(&mut cas, &sys);
     let mut exprs = Vec::new();
     for &e in eq.mass_upper.iter().chain(&eq.bias) {

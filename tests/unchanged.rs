@@ -170,7 +170,7 @@ fn variant_methods(file: &str, segment: usize) -> Vec<&'static str> {
         .filter(|name| {
             let set = format!("segment.{segment}.method={name}");
             let set = eomgen::model::Override::parse(&set).unwrap();
-            eomgen::model::load_model(&path, &[set]).is_ok()
+            eomgen::load::load_model(&path, &[set]).is_ok()
         })
         .collect()
 }

@@ -10,9 +10,11 @@
 
 use std::path::Path;
 
+use eomgen::build::system;
 use eomgen::cas::{Cas, ExprId, Hoist};
-use eomgen::model::{Override, ParamLayout, Structure, load_model};
-use eomgen::tmt::{assemble, system};
+use eomgen::load::load_model;
+use eomgen::model::{Override, ParamLayout, Structure};
+use eomgen::tmt::assemble;
 use runtime::Tape;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

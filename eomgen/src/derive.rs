@@ -2,14 +2,12 @@
 
 use runtime::{ModelInfo, TapeSet};
 
+use crate::build::{assembly_system, link_chain, system};
 use crate::cas::ExprId;
 use crate::cas::{Cas, Hoist, SymKind};
 use crate::model::{Model, ParamLayout, Structure};
 use crate::tmt::contact_frames::{PointGroup, contact_frames};
-use crate::tmt::{
-    SYMBOLIC_SOLVE_MAX_DOF, System, assemble, assembly_system, link_chain, solve_accelerations,
-    system,
-};
+use crate::tmt::{SYMBOLIC_SOLVE_MAX_DOF, System, assemble, solve_accelerations};
 
 /// Derive the kernels of a model's structure.
 pub fn derive(model: &Model) -> TapeSet {

@@ -497,7 +497,7 @@ fn emit_linked_cell(
 ) -> (TokenStream, TokenStream) {
     let name = format!("cell_{c}");
     let n2 = 2 * n;
-    let key = crate::tmt::cell_key(tape, tangent, pose);
+    let key = crate::build::cell_key(tape, tangent, pose);
     let (lo, l4, lt, lp, four) = (
         Ident::new(&format!("{name}_linked"), Span::call_site()),
         Ident::new(&format!("{name}_x4_linked"), Span::call_site()),

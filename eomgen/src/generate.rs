@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 
 use crate::derive::derive;
 use crate::emit::{emit_model, hash_in_header};
-use crate::model::{ModelError, Structure, load_model};
+use crate::load::load_model;
+use crate::model::{ModelError, Structure};
 
 #[derive(Clone, Debug, Default)]
 pub struct SyncOptions {

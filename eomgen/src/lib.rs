@@ -6,10 +6,12 @@
 //! `generated/` folder in step with `models/` for build.rs and the CLI.
 
 pub mod atomic_write;
+pub mod build;
 pub mod cas;
 pub mod derive;
 pub mod emit;
 pub mod generate;
+pub mod load;
 pub mod method;
 pub mod model;
 pub mod shape;

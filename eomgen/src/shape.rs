@@ -11,9 +11,9 @@
 
 use runtime::Tape;
 
+use crate::build::{assembly_system, system};
 use crate::cas::{Cas, ExprId};
 use crate::model::{Param, ParamLayout, Structure};
-use crate::tmt::{assembly_system, system};
 
 /// Values a shape row holds: the point (x, y, z) and the section's
 /// orientation as a unit quaternion (w, x, y, z), its x axis along the arm.

@@ -6,9 +6,11 @@
 
 use std::path::Path;
 
+use eomgen::build::system;
 use eomgen::cas::{Cas, SymKind};
-use eomgen::model::{Method, Model, Override, Param, ParamLayout, Structure, load_model};
-use eomgen::tmt::{assemble, system};
+use eomgen::load::load_model;
+use eomgen::model::{Method, Model, Override, Param, ParamLayout, Structure};
+use eomgen::tmt::assemble;
 
 fn check(model: &Model, label: &str) {
     // Loads on, whatever the file says, so that every force path counts.

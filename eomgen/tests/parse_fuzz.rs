@@ -1,7 +1,8 @@
 //! Property tests: the model parser and the override parser never panic,
 //! whatever they are given, and every rejection is located in the file.
 
-use eomgen::model::{Override, parse_model};
+use eomgen::load::parse_model;
+use eomgen::model::Override;
 use proptest::prelude::*;
 
 const GOOD: &str = include_str!("../../models/double_pendulum.toml");

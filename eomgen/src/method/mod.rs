@@ -7,19 +7,19 @@
 //! once elsewhere: the base and its motion, gravity, actuation, tip loads
 //! and joint torques in the arm builders (`tmt::planar::PlanarArm`,
 //! `tmt::spatial::SpatialArm`) and `tmt::system`; a segment's section and
-//! material checks in `model::validate`.
+//! material checks in `load::validate`.
 //!
 //! Nothing outside this folder matches on `model::Method`: what the model
 //! checks, the structure, the parameters, contact and the cells ask of a
 //! method, they ask through [`of`] (`tests/architecture.rs` holds it).
 //!
 //! Adding a method: a file here implementing the trait and its line in
-//! the `registry!` below (its variant, its name in model files, its type).
+//! the registry, `model/methods.rs` (its variant, its name in model files,
+//! its file and type), which `dispatch!` below reads.
 
 use crate::cas::Cas;
-use serde::{Deserialize, Serialize};
 
-use crate::model::{Axis, Check, Joints, ModelError, Segment, SegmentShape, Structure};
+use crate::model::{Axis, Check, Joints, Method, ModelError, Segment, SegmentShape, Structure};
 use crate::tmt::cell_kind::CellKind;
 use crate::tmt::planar::{Element2, PlanarArm};
 use crate::tmt::spatial::SpatialArm;
@@ -181,9 +181,37 @@ pub(crate) trait ModellingMethod: Sync {
         true
     }
 
-    /// The kind of link cell a segment's elements make (`tmt::cell`).
+    /// The kind of link cell a segment's elements make (`build::cell`).
     fn cell_kind(&self, _g: &SegmentShape, _spatial: bool) -> CellKind {
         CellKind::Arc
+    }
+}
+
+/// What a segment's method decides of it (the segment's other answers are
+/// in `model::schema`, which knows methods only by name).
+impl Segment {
+    /// Lumped slices of the segment: `elements`, or `quadrature` for rom.
+    pub fn slices(&self) -> usize {
+        of(self.method).slices(self)
+    }
+
+    /// 3D: elements stretch.
+    pub fn stretches(&self) -> bool {
+        self.extension
+            .unwrap_or(of(self.method).all_strains_by_default())
+    }
+
+    /// 3D: elements shear.
+    pub fn shears(&self) -> bool {
+        self.shear
+            .unwrap_or(of(self.method).all_strains_by_default())
+    }
+}
+
+impl SegmentShape {
+    /// Coordinates per element in 3D.
+    pub fn coordinates_3d(&self) -> usize {
+        of(self.method).coordinates_per_element(self)
     }
 }
 
@@ -233,18 +261,11 @@ impl Method {
     }
 }
 
-/// The registry: each method's variant, its name in model files, and its
-/// file and type. Declares the files, the `Method` enum (a segment's
-/// `method` key), [`of`], [`ALL`] and `Method::name`.
-macro_rules! registry {
+/// Declares the method files and, from the registry's lines
+/// (`model::methods`), [`ALL`] and [`of`].
+macro_rules! dispatch {
     ($($(#[$doc:meta])* $variant:ident = $name:literal => $file:ident::$ty:ident,)*) => {
         $(pub(crate) mod $file;)*
-
-        /// How a segment is modelled. Structural: changing it derives anew.
-        #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
-        pub enum Method {
-            $($(#[$doc])* #[serde(rename = $name)] $variant,)*
-        }
 
         /// Every method, in the registry's order.
         pub const ALL: &[Method] = &[$(Method::$variant),*];
@@ -255,48 +276,10 @@ macro_rules! registry {
                 $(Method::$variant => &$file::$ty,)*
             }
         }
-
-        impl Method {
-            /// Its name in model files and messages.
-            pub fn name(self) -> &'static str {
-                match self {
-                    $(Method::$variant => $name,)*
-                }
-            }
-        }
     };
 }
 
-registry! {
-    /// A chain of `elements` rigid links joined by revolute joints.
-    Rigid = "rigid" => rigid::Rigid,
-    /// Piecewise constant curvature: `elements` arcs, one bending angle each
-    /// (planar) or two bending angles, optional twist and stretch (3D).
-    Pcc = "pcc" => pcc::Pcc,
-    /// Piecewise constant strain (the discrete Cosserat rod): pcc's arcs
-    /// with all six strains of the rod, two bendings, twist, extension and
-    /// two shears, each constant over an element. 3D only; `twist`,
-    /// `extension` and `shear` default to true.
-    Pcs = "pcs" => pcs::Pcs,
-    /// Variable curvature: one constant-curvature arc per segment, each
-    /// segment with its own length, section and material.
-    Vc = "vc" => vc::Vc,
-    /// Euler-Bernoulli elements with relative states: rigid elements joined
-    /// at their midpoints by a rotation (two bending angles and a twist, as
-    /// a rotation vector) and an optional stretch. 3D only.
-    Ebr = "ebr" => ebr::Ebr,
-    /// Euler-Bernoulli elements with absolute states: each element's
-    /// position and orientation in the world frame (6 coordinates), the
-    /// elements coupled by beam springs (bending, twist, axial, shear).
-    /// 3D only; twist and stretch are always present.
-    Eba = "eba" => eba::Eba,
-    /// Reduced-order model: curvature, twist and stretch as polynomials in
-    /// s of degree `order`, the coefficients the coordinates; kinematics,
-    /// mass and energies by `quadrature` slices along s. 3D only.
-    Rom = "rom" => rom::Rom,
-    /// The Cosserat rod, solved as a boundary value problem: statics only.
-    Cosserat = "cosserat" => cosserat::Cosserat,
-}
+crate::model::methods!(dispatch);
 
 /// The generalised coordinates' names of a structure, in order: one angle
 /// an element in the plane, else each segment's method's.
@@ -372,82 +355,4 @@ fn strain_coordinate_names(g: &SegmentShape, s: usize) -> Vec<String> {
         }
     }
     names
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::model::parse_model;
-
-    /// A 3D model of one segment by `method`, with extra keys.
-    fn model(method: &str, extra: &str) -> Result<crate::model::Model, ModelError> {
-        let text = format!(
-            r#"
-name = "t"
-dimensions = 3
-gravity = [0.0, 0.0, -9.81]
-[base]
-direction = [1.0, 0.0, 0.0]
-[[segment]]
-method = "{method}"
-length = 0.2
-elements = 3
-density = 1000.0
-outer_radius = 0.01
-youngs_modulus = 1e6
-extension = true
-{extra}
-"#
-        );
-        parse_model(&text, "t.toml", false, &[])
-    }
-
-    /// Each method's coordinates, counted from its definition in the
-    /// chapter: per element 2 bends + twist + stretch (pcc, vc, ebr), all
-    /// six strains (pcs), 6 absolute states (eba), one per joint axis
-    /// (rigid); per strain field order + 1 coefficients (rom); none for a
-    /// method of statics alone. Every method of the registry has its count
-    /// here. Names are unique.
-    #[test]
-    fn coordinates_count_as_each_method_defines_them() {
-        let defined = |method: &str| match method {
-            "pcc" | "vc" | "ebr" => Some(("", 3 * 4)),
-            "pcs" => Some(("", 3 * 6)),
-            "eba" => Some(("", 3 * 6)),
-            "rom" => Some(("order = 2", 4 * 3)),
-            "rigid" => Some(("joint_axes = [\"z\", \"y\"]", 3 * 2)),
-            "cosserat" => Some(("", 0)),
-            _ => None,
-        };
-        for method in ALL.iter().map(|m| m.name()) {
-            let (extra, want) =
-                defined(method).unwrap_or_else(|| panic!("{method}: give its coordinate count"));
-            let m = model(method, extra).unwrap_or_else(|e| panic!("{method}: {e}"));
-            let names = coordinate_names(&Structure::of(&m));
-            assert_eq!(names.len(), want, "{method}: {names:?}");
-            let mut unique = names.clone();
-            unique.sort();
-            unique.dedup();
-            assert_eq!(unique.len(), names.len(), "{method}: duplicate names");
-        }
-    }
-
-    /// A key one method owns is rejected on every other, naming its owner.
-    #[test]
-    fn a_key_another_method_owns_is_rejected_with_its_owner() {
-        for (method, key, owner) in [
-            ("pcc", "order = 2", "rom"),
-            ("ebr", "joint_damping = 0.1", "rigid"),
-            ("rom", "joints = \"base\"", "rigid"),
-            ("eba", "quadrature = 4", "rom"),
-        ] {
-            let e = model(method, key).unwrap_err().to_string();
-            assert!(
-                e.contains(&format!("not a key of {method} segments: only {owner}")),
-                "{method} with {key}: {e}"
-            );
-        }
-        // Its own keys are accepted.
-        model("rom", "order = 2\nquadrature = 4").unwrap();
-    }
 }

@@ -101,61 +101,6 @@ impl ParamLayout {
         }
     }
 
-    /// The values of an assembly model, in layout order.
-    pub(super) fn assembly_values(&self, m: &Model) -> Vec<f64> {
-        let arm_models = m.arm_models();
-        let arm_values: Vec<Vec<f64>> = self
-            .arms
-            .iter()
-            .zip(&arm_models)
-            .map(|((_, _, layout), (_, am))| layout.values(am))
-            .collect();
-        self.params
-            .iter()
-            .map(|&p| match p {
-                Param::Gravity(c) => m.gravity[c.index()],
-                Param::Scoped { arm, index } => arm_values[arm as usize][index as usize],
-                Param::Body(b, what) => {
-                    let body = &m.bodies[b as usize];
-                    match what {
-                        BodyParam::Mass => body.total_mass().unwrap_or(0.0),
-                        BodyParam::Inertia => body.planar_inertia().unwrap_or(0.0),
-                        BodyParam::Position(c) => body.position[c.index()],
-                        BodyParam::Angle => body.angle,
-                        BodyParam::Moment(c) => body.principal().map_or(0.0, |i| i[c.index()]),
-                        BodyParam::Quaternion(i) => body.quaternion()[i as usize],
-                    }
-                }
-                Param::Joint(j, what) => {
-                    let joint = &m.joints[j as usize];
-                    match what {
-                        JointParam::OffsetA(c) => joint.offset_a[c.index()],
-                        JointParam::OffsetB(c) => joint.offset_b[c.index()],
-                        JointParam::Angle => joint.angle,
-                        JointParam::Quaternion(i) => {
-                            super::assembly::normalised(joint.orientation)[i as usize]
-                        }
-                    }
-                }
-                Param::BaseSpring(a, what) => {
-                    let base = &arm_models[a as usize].1.base;
-                    match what {
-                        SpringParam::Mass => base.mass.unwrap_or(0.0),
-                        SpringParam::Stiffness => base.stiffness.unwrap_or(0.0),
-                        SpringParam::Damping => base.damping.unwrap_or(0.0),
-                        SpringParam::RotationalStiffness => {
-                            base.rotational_stiffness.unwrap_or(0.0)
-                        }
-                        SpringParam::RotationalDamping => base.rotational_damping.unwrap_or(0.0),
-                        SpringParam::Inertia => base.inertia.unwrap_or(0.0),
-                        SpringParam::Follow(..) => 0.0,
-                    }
-                }
-                _ => unreachable!("an assembly layout holds no unscoped arm parameter"),
-            })
-            .collect()
-    }
-
     /// The input channel that drives `p` (an assembly's arm parameters by
     /// their arm's declaration).
     pub fn channel(&self, m: &Model, p: Param) -> Option<String> {

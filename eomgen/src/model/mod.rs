@@ -1,31 +1,34 @@
-//! Model files: schema, loading with overrides, validation, structure.
+//! A model file's data: its schema, the methods by name, overrides of its
+//! keys, its structure and parameter layout. Below `method` in the layer
+//! order: what needs a method's answers (validation, a structure from a
+//! model, parameter values) is in `load`.
 
 pub mod assembly;
-mod assembly_check;
 mod assembly_params;
 mod check;
 pub mod contact;
-mod contact_check;
 mod error;
-mod load;
+mod methods;
+mod overrides;
 mod params;
 mod schema;
 pub mod sensor;
 mod signals;
 mod structure;
-mod validate;
 
 pub(crate) use check::Check;
 pub use error::ModelError;
-pub use load::{Override, load_model, parse_model};
+pub(crate) use methods::methods;
+pub use overrides::Override;
 pub use params::{
-    BodyParam, ChamberParam, Driven, ElementParam, ElementProps, JointParam, Param, ParamLayout,
-    Rate, SpringParam, Xyz, base_rotation, base_turn_axis, channel, element_props, parameters,
+    BodyParam, ChamberParam, Driven, ElementParam, JointParam, Param, ParamLayout, Rate,
+    SpringParam, Xyz, base_rotation, base_turn_axis, channel,
 };
+pub(crate) use params::{base_quaternion, chamber_value};
 pub use schema::{
     Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, SimulateDefaults, Start,
     Tendon, Tip, Torque, WrenchFrame,
 };
 pub use signals::{Compare, Input, Offset};
+pub(crate) use signals::{check_compare, check_input};
 pub use structure::{AssemblyShape, GENERATOR_VERSION, JointShape, SegmentShape, Structure};
-pub use validate::MAX_ELEMENTS;

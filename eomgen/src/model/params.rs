@@ -521,6 +521,11 @@ impl ParamLayout {
         &self.arms
     }
 
+    /// An assembly's layout (its arms' parameters scoped).
+    pub fn is_assembly(&self) -> bool {
+        self.assembly
+    }
+
     /// The parameters input channels drive (never folded into derived
     /// parameters: they change during a run).
     pub fn driven(&self) -> &[Driven] {
@@ -535,79 +540,6 @@ impl ParamLayout {
                     self.arms[arm as usize].2.params[index as usize].is_load()
                 }
                 p => p.is_load(),
-            })
-            .collect()
-    }
-
-    /// The values of a model with this layout's structure, in layout order
-    /// (driven parameters start at 0: their signals set them).
-    pub fn values(&self, m: &Model) -> Vec<f64> {
-        if self.assembly {
-            return self.assembly_values(m);
-        }
-        let elements = element_props(m);
-        let d = m.base.direction;
-        let rotation = base_rotation(d);
-        let quaternion = base_quaternion(d);
-        self.params
-            .iter()
-            .map(|&p| match p {
-                Param::Gravity(c) => m.gravity[c.index()],
-                Param::BasePosition(c) => m.base.position[c.index()],
-                Param::BaseRotation(i, j) => rotation[i as usize][j as usize],
-                Param::BaseQuaternion(c) => quaternion[c as usize],
-                Param::BaseAngle => d[1].atan2(d[0]),
-                Param::BaseTranslation(..) | Param::BaseTurn(..) => 0.0,
-                Param::BaseTurnAxis(i, c) => {
-                    let a = base_turn_axis(m, i);
-                    a[c.index()] / (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
-                }
-                Param::TipMass => m.tip.mass.unwrap_or(0.0),
-                // In a sensor frame: the constant part of the map (a
-                // driven component is overwritten by its drive).
-                Param::TipForce(c) | Param::TipMoment(c) if m.tip.has_sensor() => {
-                    let row = c.index()
-                        + if matches!(p, Param::TipMoment(_)) {
-                            3
-                        } else {
-                            0
-                        };
-                    super::sensor::wrench_sources(m, row)
-                        .unwrap_or_default()
-                        .iter()
-                        .map(|(w, s)| match s {
-                            super::sensor::Source::Constant(v) => w * v,
-                            super::sensor::Source::Channel(_) => 0.0,
-                        })
-                        .sum()
-                }
-                Param::TipForce(c) => m.tip.force.map_or(0.0, |f| f[c.index()]),
-                Param::TipMoment(c) => m.tip.moment.map_or(0.0, |f| f[c.index()]),
-                Param::TipLength => m.tip.length.unwrap_or(0.0),
-                // A uniform cylinder along the tip axis, about its centre.
-                Param::TipInertia => {
-                    let (mass, r) = (m.tip.mass.unwrap_or(0.0), m.tip.radius.unwrap_or(0.0));
-                    let len = m.tip.length.unwrap_or(0.0);
-                    mass * (3.0 * r * r + len * len) / 12.0
-                }
-                Param::TipAxialInertia => {
-                    let (mass, r) = (m.tip.mass.unwrap_or(0.0), m.tip.radius.unwrap_or(0.0));
-                    mass * r * r / 2.0
-                }
-                Param::Element(k, e) => elements[k].get(e),
-                Param::Chamber {
-                    segment,
-                    position,
-                    what,
-                } => chamber_value(m, segment, position, what),
-                Param::TendonTension(_) | Param::Torque(_) => 0.0,
-                Param::TendonOffset { tendon, segment, z } => {
-                    let t = &m.tendons[tendon];
-                    let d = t.distance.at(segment);
-                    let angle = t.angle.as_ref().map_or(0.0, |a| a.at(segment)).to_radians();
-                    if z { d * angle.sin() } else { d * angle.cos() }
-                }
-                _ => unreachable!("assembly parameters have their own values"),
             })
             .collect()
     }
@@ -640,7 +572,7 @@ pub fn channel(m: &Model, p: Param) -> Option<&str> {
 
 /// A driven chamber position's pressure (0: its input sets it) and lever:
 /// the holes' total area and first moments a sum(z), a sum(y).
-fn chamber_value(m: &Model, segment: usize, position: usize, what: ChamberParam) -> f64 {
+pub(crate) fn chamber_value(m: &Model, segment: usize, position: usize, what: ChamberParam) -> f64 {
     let c = m.segments[segment]
         .chambers
         .as_ref()
@@ -661,118 +593,6 @@ fn chamber_value(m: &Model, segment: usize, position: usize, what: ChamberParam)
         ChamberParam::ArmY => a * z,
         ChamberParam::ArmZ => a * y,
     }
-}
-
-/// Names and values of a model's runtime parameters, in layout order.
-pub fn parameters(m: &Model) -> Vec<(String, f64)> {
-    let layout = ParamLayout::of(&Structure::of(m));
-    layout.names().into_iter().zip(layout.values(m)).collect()
-}
-
-/// Per-element physical quantities, from the declared segment.
-#[derive(Clone, Copy, Debug)]
-pub struct ElementProps {
-    pub length: f64,
-    pub mass: f64,
-    /// Rotational inertia (about the axis normal to the plane) of each rigid
-    /// body of the element about its centre of mass: the whole link (rigid,
-    /// base joints), each half link (rigid, midpoint joints), or the
-    /// section's part m (r_o^2 + r_i^2) / 4 (pcc: the arc's part depends on
-    /// the bend and is derived symbolically).
-    pub inertia: f64,
-    /// Joint or bending stiffness of the element (N m/rad): E I / l_e.
-    pub stiffness: f64,
-    /// Joint or bending damping (N m s/rad): eta / l_e.
-    pub damping: f64,
-    /// Angle at rest (rad): rest curvature times l_e.
-    pub rest: f64,
-    /// 3D: moment of inertia of each body about its own axis.
-    pub axial_inertia: f64,
-    /// 3D: G J / l_e (N m/rad) and its damping.
-    pub twist_stiffness: f64,
-    pub twist_damping: f64,
-    /// 3D: E A / l_e (N/m) and c / l_e (N s/m).
-    pub stretch_stiffness: f64,
-    pub stretch_damping: f64,
-    /// 3D, eba: G A / l_e (N/m).
-    pub shear_stiffness: f64,
-}
-
-impl ElementProps {
-    pub fn get(&self, e: ElementParam) -> f64 {
-        match e {
-            ElementParam::Length => self.length,
-            ElementParam::Mass => self.mass,
-            ElementParam::Inertia => self.inertia,
-            ElementParam::AxialInertia => self.axial_inertia,
-            ElementParam::BendStiffness => self.stiffness,
-            ElementParam::BendDamping => self.damping,
-            ElementParam::Rest => self.rest,
-            ElementParam::TwistStiffness => self.twist_stiffness,
-            ElementParam::TwistDamping => self.twist_damping,
-            ElementParam::StretchStiffness => self.stretch_stiffness,
-            ElementParam::StretchDamping => self.stretch_damping,
-            ElementParam::ShearStiffness => self.shear_stiffness,
-        }
-    }
-}
-
-pub fn element_props(m: &Model) -> Vec<ElementProps> {
-    let mut out = Vec::new();
-    for s in &m.segments {
-        let n = s.slices() as f64;
-        let l = s.length / n;
-        let ro = s.outer_radius.unwrap_or(0.0);
-        let ri = s.inner_radius.unwrap_or(0.0);
-        let mass = match (s.mass, s.density) {
-            (Some(mass), _) => mass / n,
-            (None, Some(rho)) => rho * s.area().unwrap_or(0.0) * l,
-            (None, None) => 0.0, // rejected by validation
-        };
-        // Uniform cylinders (hollow, solid, with chamber holes) about a
-        // diameter through the centre, m I / A ((r_o^2 + r_i^2) / 4 for a
-        // ring); slender rods when no radius is given.
-        let section = match (s.second_moment(), s.area()) {
-            (Some(i), Some(a)) if a > 0.0 => mass * i / a,
-            _ => mass * (ro * ro + ri * ri) / 4.0,
-        };
-        // Bodies: the whole link, or two half links (midpoint joints), or
-        // the section's part of an arc: the method's.
-        let (inertia, axial_inertia) =
-            crate::method::of(s.method).element_inertia(s, mass, l, section, m.dimensions);
-        let stiffness = match s.ei() {
-            Some(ei) => ei / l,
-            None => s.joint_stiffness.unwrap_or(0.0),
-        };
-        let damping = match s.bending_damping {
-            Some(eta) => eta / l,
-            None => s.joint_damping.unwrap_or(0.0),
-        };
-        let twist_stiffness = match s.gj() {
-            Some(gj) => gj / l,
-            None => s.joint_stiffness.unwrap_or(0.0),
-        };
-        let stretch_stiffness = s.ea().unwrap_or(0.0) / l;
-        let stretch_damping = s.axial_damping.unwrap_or(0.0) / l;
-        let shear_stiffness = s.ga().unwrap_or(0.0) / l;
-        for _ in 0..s.slices() {
-            out.push(ElementProps {
-                length: l,
-                mass,
-                inertia,
-                stiffness,
-                damping,
-                rest: s.rest_curvature * l,
-                axial_inertia,
-                twist_stiffness,
-                twist_damping: damping,
-                stretch_stiffness,
-                stretch_damping,
-                shear_stiffness,
-            });
-        }
-    }
-    out
 }
 
 /// The axis of base turn i: as declared, else z, y, x in turn.
@@ -818,76 +638,4 @@ pub fn base_rotation(d: [f64; 3]) -> [[f64; 3]; 3] {
         }
     }
     r
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::model::parse_model;
-
-    /// Every parameter's name is unique and its index is its position: the
-    /// typed layout and the named one are one list.
-    #[test]
-    fn names_are_unique_and_indices_are_positions() {
-        let text = r#"
-name = "t"
-dimensions = 3
-gravity = [0.0, 0.0, -9.81]
-[base]
-direction = [1.0, 0.0, 0.0]
-translation_inputs = ["a", "a", "a"]
-rotation_inputs = ["a", "a"]
-[[segment]]
-method = "pcc"
-length = 0.1
-elements = 2
-density = 1000.0
-outer_radius = 0.01
-youngs_modulus = 1e6
-extension = true
-[segment.chambers]
-count = 3
-radius = 0.002
-distance = 0.005
-inputs = ["a", "a", "a"]
-[[tendon]]
-input = "a"
-distance = 0.006
-[[torque]]
-coordinate = "bend_y_0_0"
-input = "a"
-[tip]
-mass = 0.01
-length = 0.01
-radius = 0.005
-force_inputs = ["a", "a", "a"]
-moment = [0.0, 0.0, 0.0]
-[inputs.a]
-kind = "constant"
-value = 1.0
-"#;
-        let m = parse_model(text, "t.toml", false, &[]).unwrap();
-        let layout = ParamLayout::of(&Structure::of(&m));
-        let names = layout.names();
-        let mut sorted = names.clone();
-        sorted.sort();
-        sorted.dedup();
-        assert_eq!(sorted.len(), names.len(), "duplicate names: {names:?}");
-        for (i, &p) in layout.params().iter().enumerate() {
-            assert_eq!(layout.index(p), i);
-        }
-        for d in layout.driven() {
-            assert_eq!(channel(&m, d.param), Some("a"), "{}", d.param.name());
-        }
-        // Driven: 9 base translation, 6 turn, 3 tip force, 3 pressures,
-        // 1 tension, 1 torque; the tip moment is a constant.
-        assert_eq!(layout.driven().len(), 9 + 6 + 3 + 3 + 1 + 1);
-        assert!(
-            layout
-                .driven()
-                .iter()
-                .all(|d| !matches!(d.param, Param::TipMoment(_)))
-        );
-        assert_eq!(layout.values(&m).len(), layout.len());
-    }
 }

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-pub use crate::method::Method;
+pub use super::methods::Method;
 
 /// A declared arm (one `models/<arm>.toml`).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -240,6 +240,8 @@ pub struct Segment {
     pub quadrature: Option<usize>,
 }
 
+/// A segment's answers from its keys alone; those its method decides
+/// (`slices`, `stretches`, `shears`) are in `method/mod.rs`.
 impl Segment {
     /// Joint placement actually used (rigid segments).
     pub fn joint_placement(&self) -> Joints {
@@ -320,11 +322,6 @@ impl Segment {
         }
     }
 
-    /// Lumped slices of the segment: `elements`, or `quadrature` for rom.
-    pub fn slices(&self) -> usize {
-        crate::method::of(self.method).slices(self)
-    }
-
     /// rom: the polynomial degree.
     pub fn rom_order(&self) -> usize {
         self.order.unwrap_or(3)
@@ -333,18 +330,6 @@ impl Segment {
     /// 3D: elements twist.
     pub fn twists(&self) -> bool {
         self.twist.unwrap_or(true)
-    }
-
-    /// 3D: elements stretch.
-    pub fn stretches(&self) -> bool {
-        self.extension
-            .unwrap_or(crate::method::of(self.method).all_strains_by_default())
-    }
-
-    /// 3D: elements shear.
-    pub fn shears(&self) -> bool {
-        self.shear
-            .unwrap_or(crate::method::of(self.method).all_strains_by_default())
     }
 
     /// 3D: the revolute axes of each joint of a rigid segment.

@@ -131,7 +131,7 @@ fn one() -> usize {
 }
 
 /// Checks of one input channel that the types cannot express.
-pub(super) fn check_input(
+pub(crate) fn check_input(
     name: &str,
     input: &Input,
     file: &str,
@@ -241,7 +241,7 @@ pub(super) fn check_input(
 }
 
 /// Checks of `[compare]`.
-pub(super) fn check_compare(c: &Compare, file: &str) -> Result<(), super::error::ModelError> {
+pub(crate) fn check_compare(c: &Compare, file: &str) -> Result<(), super::error::ModelError> {
     let bad = |k: &str, msg: String| {
         Err(super::error::ModelError::new(
             file,

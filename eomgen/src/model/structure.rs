@@ -8,7 +8,7 @@
 use sha2::{Digest, Sha256};
 
 use super::assembly::{FrameRef, JointKind};
-use super::schema::{Axis, Joints, Method, Model, WrenchFrame};
+use super::schema::{Axis, Joints, Method};
 
 /// Bumped whenever derivation or emission changes what is generated, so
 /// that cached tapes and generated files are re-derived.
@@ -33,15 +33,10 @@ pub struct SegmentShape {
     /// offsets by lambda^-1/2.
     pub incompressible: bool,
     pub axes: Vec<Axis>,
-    /// rom: the polynomial degree (0 otherwise).
+    /// Its coordinates are polynomial strain fields' coefficients (rom),
+    /// of degree `order` (0 otherwise).
+    pub polynomial: bool,
     pub order: usize,
-}
-
-impl SegmentShape {
-    /// Coordinates per element in 3D.
-    pub fn coordinates_3d(&self) -> usize {
-        crate::method::of(self.method).coordinates_per_element(self)
-    }
 }
 
 /// Everything that shapes the equations; numbers are left out.
@@ -111,127 +106,6 @@ pub struct JointShape {
 }
 
 impl Structure {
-    pub fn of(m: &Model) -> Self {
-        if !m.is_assembly() {
-            return Self::of_arm(m);
-        }
-        let frame = |t: &str| FrameRef::parse(t, m).unwrap_or(FrameRef::World);
-        let assembly = AssemblyShape {
-            dimensions: m.dimensions,
-            arms: m
-                .arm_models()
-                .iter()
-                .map(|(name, a)| (name.clone(), Self::of_arm(a)))
-                .collect(),
-            bodies: m.bodies.iter().map(|b| (b.name.clone(), b.free)).collect(),
-            contact: m.has_contact(),
-            joints: m
-                .joints
-                .iter()
-                .map(|j| JointShape {
-                    name: j.name.clone(),
-                    kind: j.kind,
-                    a: frame(&j.a),
-                    b: frame(&j.b),
-                })
-                .collect(),
-        };
-        Self {
-            dimensions: m.dimensions,
-            segments: Vec::new(),
-            tip_mass: false,
-            tip_force: false,
-            tip_moment: false,
-            tip_length: false,
-            tip_frame_wrench: false,
-            tip_force_driven: false,
-            tip_moment_driven: false,
-            chambers: Vec::new(),
-            tendons: Vec::new(),
-            torques: Vec::new(),
-            base_translates: false,
-            base_turns: 0,
-            base_compliant: false,
-            base_follows: false,
-            base_twists: false,
-            contact_points: 0,
-            assembly: Some(Box::new(assembly)),
-        }
-    }
-
-    /// The structure of one arm (the model's own, or one of an assembly's).
-    fn of_arm(m: &Model) -> Self {
-        let spatial = m.dimensions == 3;
-        Self {
-            dimensions: m.dimensions,
-            segments: m
-                .segments
-                .iter()
-                .map(|s| {
-                    let method = crate::method::of(s.method);
-                    let (twist, extension, shear) = crate::method::strains(s);
-                    SegmentShape {
-                        // A method whose kinematics are another's (vc and pcs
-                        // are pcc's arcs) is derived as that one: the same
-                        // derivation (and compiled code) serves both.
-                        method: method.derived_as().unwrap_or(s.method),
-                        elements: s.slices(),
-                        order: if method.polynomial_fields() {
-                            s.rom_order()
-                        } else {
-                            0
-                        },
-                        joints: method.joints(s),
-                        twist: spatial && twist,
-                        extension: spatial && extension,
-                        shear: spatial && shear,
-                        incompressible: spatial && s.incompressible.unwrap_or(false),
-                        axes: if spatial {
-                            method.joint_axes(s)
-                        } else {
-                            Vec::new()
-                        },
-                    }
-                })
-                .collect(),
-            tip_mass: m.tip.mass.is_some(),
-            tip_force: m.tip.force.is_some() || m.tip.force_inputs.is_some(),
-            // A sensor's force off the tip point has a moment about it.
-            tip_moment: m.tip.moment.is_some()
-                || m.tip.moment_inputs.is_some()
-                || (m.tip.sensor_offset.is_some()
-                    && (m.tip.force.is_some() || m.tip.force_inputs.is_some())),
-            tip_length: m.tip.length.is_some(),
-            tip_frame_wrench: m.tip.wrench_frame == Some(WrenchFrame::Tip) || m.tip.has_sensor(),
-            tip_force_driven: m.tip.force_inputs.is_some(),
-            tip_moment_driven: m.tip.moment_inputs.is_some()
-                || (m.tip.sensor_offset.is_some() && m.tip.force_inputs.is_some()),
-            chambers: m
-                .segments
-                .iter()
-                .map(|s| {
-                    s.chambers
-                        .as_ref()
-                        .and_then(|c| c.inputs.as_ref())
-                        .map_or(0, Vec::len)
-                })
-                .collect(),
-            tendons: m
-                .tendons
-                .iter()
-                .map(|t| t.end.unwrap_or(m.segments.len() - 1))
-                .collect(),
-            torques: m.torques.iter().map(|t| t.coordinate.clone()).collect(),
-            base_translates: m.base.translation_inputs.is_some(),
-            base_turns: m.base.rotation_inputs.as_ref().map_or(0, Vec::len),
-            base_compliant: m.base.is_compliant(),
-            base_follows: m.base.is_compliant() && m.base.follow.is_some(),
-            base_twists: m.base.turns_compliantly(),
-            contact_points: m.contact_points(),
-            assembly: None,
-        }
-    }
-
     /// Canonical text of the structure (what is hashed).
     pub fn canonical(&self) -> String {
         if let Some(a) = &self.assembly {
@@ -284,7 +158,7 @@ impl Structure {
                     s.push_str(" shear");
                 }
             }
-            if crate::method::of(g.method).polynomial_fields() {
+            if g.polynomial {
                 s.push_str(&format!(" order {}", g.order));
             }
             s.push('\n');

@@ -1,4 +1,4 @@
-//! The kinds of link cell (`tmt::cell`); a method names its own.
+//! The kinds of link cell (`build::cell`); a method names its own.
 
 /// The kinematics of a 3D link.
 #[derive(Clone, Copy, PartialEq, Eq)]

@@ -32,13 +32,13 @@ pub(crate) fn with_tangent(cas: &mut Cas, out: &[ExprId], x: &[ExprId], xd: &[Ex
 /// How a cell's rates are taken: by the rate rule of turned vectors (3D
 /// frames, `Cas::kinematic_rates`) or by plain time derivatives (planar).
 #[derive(Clone, Copy)]
-pub(super) enum Rates {
+pub(crate) enum Rates {
     Turned,
     Plain,
 }
 
 /// Where a link's end frame and body are, in its base frame at rest.
-pub(super) struct Motion {
+pub(crate) struct Motion {
     /// Rows of the end frame's rotation.
     pub rotation: [V3; 3],
     pub end: V3,
@@ -55,7 +55,7 @@ pub(super) struct Motion {
 /// reports, its body's mass and inertias and its springs' energy: what a
 /// cell (`runtime::links::cell`) and a pose cell (`runtime::links::pose`)
 /// are written from, for 3D and planar links alike.
-pub(super) struct LinkKinematics {
+pub(crate) struct LinkKinematics {
     m: Motion,
     end_rate: V3,
     end_accel: V3,

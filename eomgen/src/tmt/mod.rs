@@ -1,118 +1,24 @@
-//! The TMT method: kinematics modules describe a [`System`]; [`assemble`]
-//! derives M, h and the outputs from it.
+//! The TMT method's building blocks: kinematics (planar and spatial arms,
+//! frames, strains, actuation) describe a [`System`]; [`assemble`] derives
+//! M, h and the outputs from it. Below `method` in the layer order: each
+//! method places its elements with these; `build` asks the methods.
 
 pub(crate) mod actuation;
-mod assembly;
-mod cell;
 pub(crate) mod cell_kind;
-mod cell_outputs;
+pub(crate) mod cell_outputs;
 mod chain;
 pub(crate) mod contact_frames;
 mod equations;
-mod inertia;
+pub(crate) mod inertia;
 pub(crate) mod planar;
-mod planar_cell;
 mod solve;
 pub(crate) mod spatial;
 pub(crate) mod system;
 
-use crate::cas::Cas;
-use crate::method;
-use crate::model::{Param, ParamLayout, Structure};
-use planar::PlanarArm;
-use spatial::SpatialArm;
-
-pub use assembly::{Assembled, assembly_system};
-pub use cell::{cell_key, link_chain};
 pub(crate) use cell_outputs::with_tangent;
 pub use equations::{Equations, assemble};
 pub use solve::{SYMBOLIC_SOLVE_MAX_DOF, solve_accelerations};
 pub use system::ParamSymbols;
-
-/// The system of a structure: planar or spatial kinematics by
-/// `dimensions`, absolute coordinates for eba; its parameters are the
-/// symbols of `layout` (values never reach the derivation).
-pub fn system(cas: &mut Cas, structure: &Structure, layout: &ParamLayout) -> System {
-    let symbols = ParamSymbols::new(cas, layout);
-    arm_system(cas, structure, &symbols)
-}
-
-/// One arm's system on the given parameter symbols (an assembly's arm
-/// passes scoped ones).
-pub(crate) fn arm_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
-    let mut sys = kinematics(cas, structure, symbols);
-    apply_torques(cas, structure, symbols, &mut sys);
-    sys
-}
-
-/// The kinematics: a method that builds the whole arm (absolute
-/// coordinates) does; otherwise every segment's method places its elements
-/// on one chain, planar or spatial by `dimensions`.
-fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
-    let methods: Vec<_> = structure
-        .segments
-        .iter()
-        .map(|g| method::of(g.method))
-        .collect();
-    if let Some(sys) = methods
-        .first()
-        .and_then(|m| m.whole_arm(cas, structure, symbols))
-    {
-        return sys;
-    }
-    if structure.dimensions == 3 {
-        let names = method::coordinate_names(structure);
-        let mut arm = SpatialArm::new(cas, names, symbols);
-        arm.points = structure.contact_points;
-        let base = (arm.points > 0).then(|| arm.base_pose());
-        let mut ends = Vec::new();
-        for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
-            m.build_spatial(cas, &mut arm, g, s);
-            ends.push((arm.f.p, arm.f.quat));
-        }
-        let mut sys = arm.finish(cas, structure);
-        sys.segment_ends = ends;
-        sys.bases = base.into_iter().collect();
-        sys
-    } else {
-        let names = method::coordinate_names(structure);
-        let mut arm = PlanarArm::new(cas, names, symbols);
-        arm.points = structure.contact_points;
-        let base = (arm.points > 0).then(|| arm.base_pose(cas));
-        for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
-            for _ in 0..g.elements {
-                let el = arm.begin_element(s);
-                m.place_planar(cas, &mut arm, g, &el);
-                arm.end_element(cas, &el);
-            }
-        }
-        let mut sys = arm.finish(cas, structure);
-        sys.bases = base.into_iter().collect();
-        sys
-    }
-}
-
-/// Driven generalised forces Q_k on named coordinates as the potential
-/// -sum Q_k q_k added to the actuators' (the same path as chambers and
-/// tendons: h and the static forces get -Q_k, the stiffness nothing).
-fn apply_torques(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols, sys: &mut System) {
-    if structure.torques.is_empty() {
-        return;
-    }
-    let mut terms = vec![sys.actuation];
-    for (i, name) in structure.torques.iter().enumerate() {
-        // Validation checked the name against the coordinates.
-        let k = sys
-            .coords
-            .names
-            .iter()
-            .position(|n| n == name)
-            .expect("validated coordinate name");
-        let work = cas.mul(symbols.get(Param::Torque(i)), sys.coords.q[k]);
-        terms.push(cas.neg(work));
-    }
-    sys.actuation = cas.add_all(&terms);
-}
 pub use system::{
     AppliedMoment, Body, Chain, Coordinates, Inertia, Link, PointForce, System, TipMount, tip_loads,
 };

@@ -110,7 +110,7 @@ impl<'a> PlanarArm<'a> {
     }
 
     /// An arm at rest at the origin (angle 0, height 0) for one element
-    /// derived on its own: a planar link cell (`tmt::planar_cell`).
+    /// derived on its own: a planar link cell (`build::planar_cell`).
     pub fn at_origin(cas: &mut Cas, coords: Coordinates, symbols: &'a ParamSymbols) -> Self {
         let zero = cas.zero();
         Self {

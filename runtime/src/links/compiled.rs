@@ -1,5 +1,5 @@
 //! A link cell as compiled into a binary: its three kernels by function
-//! pointer, found by key (`eomgen::tmt::cell_key`). The `linked` module runs
+//! pointer, found by key (`eomgen::build::cell_key`). The `linked` module runs
 //! the recursion over such cells for chains no compiled-in model has.
 //!
 //! Invariant: a key names a cell's three tapes (cell, tangent, pose)

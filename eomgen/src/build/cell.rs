@@ -27,14 +27,14 @@ use runtime::links::{
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{ElementParam, Joints, Method, Param, ParamLayout, Structure, Xyz};
 
-use super::actuation::{segment_loads, strain_work, thinning};
-use super::cell_kind::CellKind;
-use super::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
 use super::planar_cell::derive_planar_cell;
-use super::spatial::{ArcStrain, Element3, Frame, Springs, V3, arc, half_k_sq};
-use super::system::{Coordinates, ParamSymbols};
 use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
+use crate::tmt::actuation::{segment_loads, strain_work, thinning};
+use crate::tmt::cell_kind::CellKind;
+use crate::tmt::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
+use crate::tmt::spatial::{ArcStrain, Element3, Frame, Springs, V3, arc, half_k_sq};
+use crate::tmt::system::{Coordinates, ParamSymbols};
 
 /// Chains of fewer links keep the flat `MassBias` and its symbolic solve:
 /// the recursion's overhead is not paid back below four links (the lanes

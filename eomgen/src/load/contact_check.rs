@@ -2,10 +2,9 @@
 //! range, each obstacle with exactly its shape's keys, names unique, and
 //! every sampled segment of a method that can be sampled.
 
-use super::check::Check;
-use super::contact::{ContactLaw, ContactModel, ObstacleDecl, ObstacleShape};
-use super::error::ModelError;
-use super::schema::Model;
+use crate::model::Model;
+use crate::model::contact::{ContactLaw, ContactModel, ObstacleDecl, ObstacleShape};
+use crate::model::{Check, ModelError};
 
 /// Largest `points_per_element`: past it contact costs more than the arm.
 pub const MAX_POINTS_PER_ELEMENT: usize = 20;
@@ -249,6 +248,6 @@ impl Model {
         self.contact
             .as_ref()
             .and_then(|c| c.points_per_element)
-            .unwrap_or(super::contact::POINTS_PER_ELEMENT)
+            .unwrap_or(crate::model::contact::POINTS_PER_ELEMENT)
     }
 }

@@ -20,7 +20,7 @@ use crate::model::{
     AssemblyShape, BodyParam, JointParam, JointShape, Param, ParamLayout, Rate, SpringParam, Xyz,
 };
 
-use super::system::{Body, Coordinates, Inertia, ParamSymbols, PointForce, Sample, System};
+use crate::tmt::system::{Body, Coordinates, Inertia, ParamSymbols, PointForce, Sample, System};
 
 /// The assembled system and its constraint equations.
 pub struct Assembled {
@@ -127,7 +127,7 @@ struct Builder {
     rayleigh: Vec<ExprId>,
     actuation: Vec<ExprId>,
     point_forces: Vec<PointForce>,
-    moments: Vec<super::system::AppliedMoment>,
+    moments: Vec<crate::tmt::system::AppliedMoment>,
     seeds: Vec<(ExprId, ExprId)>,
     blocks: Vec<usize>,
     constraints: Vec<ExprId>,
@@ -259,7 +259,7 @@ impl Builder {
         self.seeds.extend(sys.seeds);
         match sys.planar {
             Some(planar) => {
-                let pose = |p: super::system::PlanarPose| Pose {
+                let pose = |p: crate::tmt::system::PlanarPose| Pose {
                     point: p.point,
                     angle: p.angle,
                     quat: [zero; 4],
@@ -338,7 +338,7 @@ impl Builder {
             (rho[c], rate[c]) = self.coordinate(cas, name);
         }
         let omega = if self.spatial {
-            super::spatial::exp_turn(cas, &rho, &rate).2
+            crate::tmt::spatial::exp_turn(cas, &rho, &rate).2
         } else {
             rate
         };

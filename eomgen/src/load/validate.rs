@@ -1,10 +1,9 @@
 //! Checks that the types alone cannot express. Every message names the key
 //! path and says what is allowed.
 
-use super::check::Check;
-use super::error::ModelError;
-use super::schema::{Model, Segment};
 use crate::method::Carried;
+use crate::model::{Check, ModelError};
+use crate::model::{Model, Segment};
 
 /// Largest element count per segment: beyond it derivation and simulation
 /// times are impractical for a planar chain.
@@ -125,7 +124,7 @@ fn frame(ck: &Check) -> Result<(), ModelError> {
 /// The tip body and its constant loads.
 fn tip(ck: &Check) -> Result<(), ModelError> {
     let m = ck.m;
-    super::sensor::check(m, ck.file)?;
+    crate::model::sensor::check(m, ck.file)?;
     if let Some(mass) = m.tip.mass {
         ck.non_negative("tip.mass", mass)?;
     }
@@ -197,7 +196,7 @@ fn tendons(ck: &Check) -> Result<(), ModelError> {
         }
         for (key, v) in [("distance", Some(&t.distance)), ("angle", t.angle.as_ref())] {
             let Some(v) = v else { continue };
-            if let super::schema::OneOrMany::Many(list) = v
+            if let crate::model::OneOrMany::Many(list) = v
                 && list.len() != end + 1
             {
                 return ck.err(
@@ -297,7 +296,7 @@ fn base_motion(ck: &Check) -> Result<(), ModelError> {
 fn torques(ck: &Check) -> Result<(), ModelError> {
     let m = ck.m;
     if !m.torques.is_empty() {
-        let names = crate::method::coordinate_names(&super::Structure::of(m));
+        let names = crate::method::coordinate_names(&crate::model::Structure::of(m));
         for (i, t) in m.torques.iter().enumerate() {
             ck.channel(&format!("torque[{i}].input"), &t.input)?;
             if !names.contains(&t.coordinate) {
@@ -319,10 +318,10 @@ fn torques(ck: &Check) -> Result<(), ModelError> {
 fn signals(ck: &Check) -> Result<(), ModelError> {
     let m = ck.m;
     for (name, input) in &m.inputs {
-        super::signals::check_input(name, input, ck.file)?;
+        crate::model::check_input(name, input, ck.file)?;
     }
     if let Some(c) = &m.compare {
-        super::signals::check_compare(c, ck.file)?;
+        crate::model::check_compare(c, ck.file)?;
     }
     Ok(())
 }
@@ -539,7 +538,7 @@ fn shear_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
 /// Chamber holes: one way to place them, inside the wall, not overlapping,
 /// in an isotropic pattern, with declared input channels.
 fn check_chambers(
-    c: &super::schema::Chambers,
+    c: &crate::model::Chambers,
     path: &str,
     outer: Option<f64>,
     inner: Option<f64>,

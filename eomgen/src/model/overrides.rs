@@ -1,11 +1,7 @@
-//! Reading a model: TOML or JSON text, `--set` overrides, typed
-//! deserialisation with key paths, then validation.
-
-use std::path::Path;
+//! `--set PATH=VALUE` overrides of a model file's keys, applied to its
+//! tree before the typed reading.
 
 use super::error::ModelError;
-use super::schema::Model;
-use super::validate::validate;
 
 /// One `--set PATH=VALUE` override.
 #[derive(Clone, Debug, PartialEq)]
@@ -67,7 +63,7 @@ impl Override {
         })
     }
 
-    fn apply(&self, root: &mut toml::Value) -> Result<(), ModelError> {
+    pub(crate) fn apply(&self, root: &mut toml::Value) -> Result<(), ModelError> {
         let err = |m: String| ModelError::new("--set", self.path.join("."), m);
         let mut cur = root;
         for (depth, key) in self.path.iter().enumerate() {
@@ -130,50 +126,4 @@ impl Override {
         }
         Ok(())
     }
-}
-
-/// Parse model text (TOML, or JSON when `json`), apply overrides, check.
-pub fn parse_model(
-    text: &str,
-    file: &str,
-    json: bool,
-    overrides: &[Override],
-) -> Result<Model, ModelError> {
-    let mut tree: toml::Value = if json {
-        serde_json::from_str(text)
-            .map_err(|e| ModelError::new(file, "", format!("invalid JSON: {e}")))?
-    } else {
-        let table: toml::Table = toml::from_str(text).map_err(|e| {
-            ModelError::new(
-                file,
-                "",
-                format!("invalid TOML: {}", e.to_string().trim_end()),
-            )
-        })?;
-        toml::Value::Table(table)
-    };
-    for o in overrides {
-        o.apply(&mut tree)?;
-    }
-    let model: Model = serde_path_to_error::deserialize(tree).map_err(|e| {
-        let path = e.path().to_string();
-        let path = if path == "." { String::new() } else { path };
-        ModelError::new(file, path, e.into_inner().to_string())
-    })?;
-    let mut model = model;
-    validate(&model, file)?;
-    // Checked, then cut.
-    model.joints.retain(|j| j.active);
-    Ok(model)
-}
-
-/// Read a model file (`.json` is read as JSON, anything else as TOML).
-pub fn load_model(path: &Path, overrides: &[Override]) -> Result<Model, ModelError> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| ModelError::new(&file, "", format!("cannot read the file: {e}")))?;
-    let json = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    parse_model(&text, &file, json, overrides)
 }

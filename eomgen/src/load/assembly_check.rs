@@ -5,10 +5,9 @@
 
 use std::collections::HashSet;
 
-use super::assembly::{BodyDecl, BodyShape, FrameRef};
-use super::check::Check;
-use super::error::ModelError;
-use super::schema::{Base, Model};
+use crate::model::assembly::{BodyDecl, BodyShape, FrameRef};
+use crate::model::{Base, Model};
+use crate::model::{Check, ModelError};
 
 /// The assembly's own checks; `arm` checks one arm as a single-arm model.
 pub(super) fn check_assembly(
@@ -234,7 +233,7 @@ fn joints(ck: &Check) -> Result<(), ModelError> {
             }
         }
         if let Some(q) = j.orientation {
-            if m.dimensions != 3 || j.kind != super::assembly::JointKind::Weld {
+            if m.dimensions != 3 || j.kind != crate::model::assembly::JointKind::Weld {
                 return ck.err(
                     key("orientation"),
                     "a 3D weld's key (the plane's weld takes angle)".into(),

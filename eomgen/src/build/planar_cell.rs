@@ -14,11 +14,11 @@ use runtime::links::{ACTUATION_LOADS, CELL_PARAMS, ELEMENT_PARAMS};
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::SegmentShape;
 
-use super::actuation::strain_work;
-use super::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
-use super::inertia::Inertia;
-use super::planar::{Element2, PlanarArm, half_k_sq};
-use super::system::{Coordinates, ParamSymbols};
+use crate::tmt::actuation::strain_work;
+use crate::tmt::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
+use crate::tmt::inertia::Inertia;
+use crate::tmt::planar::{Element2, PlanarArm, half_k_sq};
+use crate::tmt::system::{Coordinates, ParamSymbols};
 
 /// The cell, its tangent and its pose cell of one element of segment
 /// shape `g` (with its segment's actuation loads when `actuated`), or None

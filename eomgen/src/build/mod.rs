@@ -1,0 +1,102 @@
+//! A structure's [`System`] and its link cells, built by asking each
+//! segment's method to place its elements on the TMT building blocks
+//! (`tmt`); several arms, bodies and joints in `assembly`.
+
+mod assembly;
+mod cell;
+mod planar_cell;
+
+use crate::cas::Cas;
+use crate::method;
+use crate::model::{Param, ParamLayout, Structure};
+use crate::tmt::planar::PlanarArm;
+use crate::tmt::spatial::SpatialArm;
+use crate::tmt::{ParamSymbols, System};
+
+pub use assembly::{Assembled, assembly_system};
+pub use cell::{cell_key, link_chain};
+
+/// The system of a structure: planar or spatial kinematics by
+/// `dimensions`, absolute coordinates for eba; its parameters are the
+/// symbols of `layout` (values never reach the derivation).
+pub fn system(cas: &mut Cas, structure: &Structure, layout: &ParamLayout) -> System {
+    let symbols = ParamSymbols::new(cas, layout);
+    arm_system(cas, structure, &symbols)
+}
+
+/// One arm's system on the given parameter symbols (an assembly's arm
+/// passes scoped ones).
+pub(crate) fn arm_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
+    let mut sys = kinematics(cas, structure, symbols);
+    apply_torques(cas, structure, symbols, &mut sys);
+    sys
+}
+
+/// The kinematics: a method that builds the whole arm (absolute
+/// coordinates) does; otherwise every segment's method places its elements
+/// on one chain, planar or spatial by `dimensions`.
+fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
+    let methods: Vec<_> = structure
+        .segments
+        .iter()
+        .map(|g| method::of(g.method))
+        .collect();
+    if let Some(sys) = methods
+        .first()
+        .and_then(|m| m.whole_arm(cas, structure, symbols))
+    {
+        return sys;
+    }
+    if structure.dimensions == 3 {
+        let names = method::coordinate_names(structure);
+        let mut arm = SpatialArm::new(cas, names, symbols);
+        arm.points = structure.contact_points;
+        let base = (arm.points > 0).then(|| arm.base_pose());
+        let mut ends = Vec::new();
+        for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
+            m.build_spatial(cas, &mut arm, g, s);
+            ends.push((arm.f.p, arm.f.quat));
+        }
+        let mut sys = arm.finish(cas, structure);
+        sys.segment_ends = ends;
+        sys.bases = base.into_iter().collect();
+        sys
+    } else {
+        let names = method::coordinate_names(structure);
+        let mut arm = PlanarArm::new(cas, names, symbols);
+        arm.points = structure.contact_points;
+        let base = (arm.points > 0).then(|| arm.base_pose(cas));
+        for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
+            for _ in 0..g.elements {
+                let el = arm.begin_element(s);
+                m.place_planar(cas, &mut arm, g, &el);
+                arm.end_element(cas, &el);
+            }
+        }
+        let mut sys = arm.finish(cas, structure);
+        sys.bases = base.into_iter().collect();
+        sys
+    }
+}
+
+/// Driven generalised forces Q_k on named coordinates as the potential
+/// -sum Q_k q_k added to the actuators' (the same path as chambers and
+/// tendons: h and the static forces get -Q_k, the stiffness nothing).
+fn apply_torques(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols, sys: &mut System) {
+    if structure.torques.is_empty() {
+        return;
+    }
+    let mut terms = vec![sys.actuation];
+    for (i, name) in structure.torques.iter().enumerate() {
+        // Validation checked the name against the coordinates.
+        let k = sys
+            .coords
+            .names
+            .iter()
+            .position(|n| n == name)
+            .expect("validated coordinate name");
+        let work = cas.mul(symbols.get(Param::Torque(i)), sys.coords.q[k]);
+        terms.push(cas.neg(work));
+    }
+    sys.actuation = cas.add_all(&terms);
+}
