@@ -8,8 +8,8 @@ use std::path::Path;
 use anyhow::{Result, bail};
 use eomgen::model::Model;
 use eomgen::model::assembly::BodyShape;
-use eomgen::model::contact::{ContactLaw, ContactModel, ObstacleDecl, ObstacleShape};
-use runtime::contact::{ContactPoint, ContactSet, Damping, Law, Normal, Obstacle, Shape};
+use eomgen::model::contact::{ContactLaw, ContactModel, ObstacleDecl};
+use runtime::contact::{ContactPoint, ContactSet, Damping, Law, Normal, Obstacle};
 
 /// Default regularisation speed of friction (m/s).
 pub const SLIP_VELOCITY: f64 = 1e-3;
@@ -119,63 +119,15 @@ pub fn law(l: &ContactLaw) -> Law {
     }
 }
 
-fn unit(v: [f64; 3]) -> [f64; 3] {
-    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    v.map(|c| c / len)
-}
-
-/// The rotation of a unit quaternion (w, x, y, z).
-fn rotation(q: [f64; 4]) -> [[f64; 3]; 3] {
-    let len = q.iter().map(|c| c * c).sum::<f64>().sqrt();
-    let [w, x, y, z] = q.map(|c| c / len);
-    [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-        ],
-        [
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-        ],
-        [
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ]
-}
-
 fn obstacle(
     model: &Model,
     o: &ObstacleDecl,
     defaults: &ContactLaw,
     base: &Path,
 ) -> Result<Obstacle> {
-    // Validation checked each shape's keys.
-    let v = |x: Option<[f64; 3]>| x.unwrap_or([0.0; 3]);
-    let shape = match o.shape {
-        ObstacleShape::Plane => Shape::Plane {
-            point: v(o.point),
-            normal: unit(v(o.normal)),
-        },
-        ObstacleShape::Sphere => Shape::Sphere {
-            center: v(o.center),
-            radius: o.radius.unwrap_or(0.0),
-        },
-        ObstacleShape::Cylinder => Shape::Cylinder {
-            center: v(o.center),
-            axis: unit(v(o.axis)),
-            radius: o.radius.unwrap_or(0.0),
-            half_length: 0.5 * o.length.unwrap_or(0.0),
-        },
-        ObstacleShape::Box => Shape::Box {
-            center: v(o.center),
-            rotation: rotation(o.orientation.unwrap_or([1.0, 0.0, 0.0, 0.0])),
-            half: o.size.unwrap_or([0.0; 3]).map(|s| 0.5 * s),
-        },
-    };
+    let shape = o
+        .geometry()
+        .map_err(|e| anyhow::anyhow!("obstacle \"{}\": {}: {}", o.name, e.key, e.message))?;
     let motion = match &o.translation_inputs {
         None => None,
         Some(channels) => {

@@ -222,6 +222,7 @@ fn look_of(loaded: &Loaded, name: &str, s: &[f64]) -> Look {
             half_length: *half_length,
         },
         Some(contact::Shape::Box { half, .. }) => Look::Box { half: *half },
-        _ => Look::Plane,
+        // Exhaustive on purpose: a new shape is drawn here, or not at all.
+        Some(contact::Shape::Plane { .. }) | None => Look::Plane,
     }
 }

@@ -19,6 +19,7 @@ pub mod lanes;
 pub mod linalg;
 pub mod linked;
 pub mod links;
+pub mod obstacle;
 pub mod output;
 pub mod parts;
 pub mod rodrigues;

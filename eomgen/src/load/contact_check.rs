@@ -3,8 +3,9 @@
 //! every sampled segment of a method that can be sampled.
 
 use crate::model::Model;
-use crate::model::contact::{ContactLaw, ContactModel, ObstacleDecl, ObstacleShape};
+use crate::model::contact::{ContactLaw, ContactModel, ObstacleDecl};
 use crate::model::{Check, ModelError};
+use runtime::obstacle::Shape;
 
 /// Largest `points_per_element`: past it contact costs more than the arm.
 pub const MAX_POINTS_PER_ELEMENT: usize = 20;
@@ -132,81 +133,19 @@ fn law_complete(
     Ok(())
 }
 
-/// Exactly the shape's keys, each in range.
+/// Exactly the shape's keys, each in range (the shape's own checks), and
+/// a planar model's plane upright.
 fn shape_keys(ck: &Check, key: &str, o: &ObstacleDecl) -> Result<(), ModelError> {
     let k = |s: &str| format!("{key}.{s}");
-    let given = [
-        ("point", o.point.is_some()),
-        ("normal", o.normal.is_some()),
-        ("center", o.center.is_some()),
-        ("radius", o.radius.is_some()),
-        ("axis", o.axis.is_some()),
-        ("length", o.length.is_some()),
-        ("size", o.size.is_some()),
-        ("orientation", o.orientation.is_some()),
-    ];
-    let (needs, may): (&[&str], &[&str]) = match o.shape {
-        ObstacleShape::Plane => (&["point", "normal"], &[]),
-        ObstacleShape::Sphere => (&["center", "radius"], &[]),
-        ObstacleShape::Cylinder => (&["center", "axis", "radius", "length"], &[]),
-        ObstacleShape::Box => (&["center", "size"], &["orientation"]),
-    };
-    let shape = format!("{:?}", o.shape).to_lowercase();
-    for (name, present) in given {
-        if present && !needs.contains(&name) && !may.contains(&name) {
-            return ck.err(
-                k(name),
-                format!(
-                    "a {shape} obstacle takes {}; `{name}` is not one of them",
-                    needs.join(", ")
-                ),
-            );
-        }
-        if !present && needs.contains(&name) {
-            return ck.err(
-                k(name),
-                format!("missing: a {shape} obstacle needs {}", needs.join(", ")),
-            );
-        }
+    match o.geometry() {
+        Err(e) => ck.err(k(&e.key), e.message),
+        Ok(Shape::Plane { normal, .. }) if ck.m.dimensions == 2 && normal[2] != 0.0 => ck.err(
+            k("normal"),
+            "a planar model's plane has a normal in the x-y plane: the z component must be 0"
+                .into(),
+        ),
+        Ok(_) => Ok(()),
     }
-    for (name, v) in [("point", o.point), ("center", o.center)] {
-        if let Some(v) = v {
-            ck.vec3(&k(name), &v)?;
-        }
-    }
-    for (name, v) in [("normal", o.normal), ("axis", o.axis)] {
-        if let Some(v) = v {
-            ck.vec3(&k(name), &v)?;
-            if v.iter().map(|x| x * x).sum::<f64>() == 0.0 {
-                return ck.err(
-                    k(name),
-                    format!("must not be the zero vector: it gives the {shape}'s direction"),
-                );
-            }
-            if ck.m.dimensions == 2 && name == "normal" && v[2] != 0.0 {
-                return ck.err(k(name), "a planar model's plane has a normal in the x-y plane: the z component must be 0".into());
-            }
-        }
-    }
-    for (name, v) in [("radius", o.radius), ("length", o.length)] {
-        if let Some(v) = v {
-            ck.positive(&k(name), v)?;
-        }
-    }
-    if let Some(size) = o.size {
-        for (i, v) in size.iter().enumerate() {
-            ck.positive(&format!("{}[{i}]", k("size")), *v)?;
-        }
-    }
-    if let Some(q) = o.orientation
-        && (q.iter().any(|v| !v.is_finite()) || q.iter().all(|v| *v == 0.0))
-    {
-        return ck.err(
-            k("orientation"),
-            "a quaternion (w, x, y, z) of non-zero, finite length".into(),
-        );
-    }
-    Ok(())
 }
 
 fn sampled_methods(ck: &Check) -> Result<(), ModelError> {

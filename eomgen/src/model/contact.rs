@@ -7,6 +7,7 @@
 //! the runtime computes gaps and forces from the numbers here, so an
 //! obstacle or a law changes without a rebuild.
 
+use runtime::obstacle::{KeyError, Shape, ShapeKeys};
 use serde::{Deserialize, Serialize};
 
 /// The force law of a contact.
@@ -101,48 +102,50 @@ impl ContactDecl {
     }
 }
 
-/// The shape of an obstacle.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Hash)]
-#[serde(rename_all = "lowercase")]
-pub enum ObstacleShape {
-    /// `point` and outward `normal`: a half space.
-    Plane,
-    /// `center`, `radius`.
-    Sphere,
-    /// `center`, `axis`, `radius`, `length`: finite, capped.
-    Cylinder,
-    /// `center`, `size = [x, y, z]`, `orientation` (quaternion w, x, y, z).
-    Box,
-}
-
-/// `[[obstacle]]`: a fixed shape, or one moved by input channels.
+/// `[[obstacle]]`: a fixed shape, or one moved by input channels. The
+/// shapes, their keys and their checks are runtime's
+/// (`runtime::obstacle::Shape::from_keys`): one definition from the model
+/// file to the contact forces.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(deny_unknown_fields)]
 pub struct ObstacleDecl {
     pub name: String,
-    pub shape: ObstacleShape,
-    #[serde(default)]
-    pub point: Option<[f64; 3]>,
-    #[serde(default)]
-    pub normal: Option<[f64; 3]>,
-    #[serde(default)]
-    pub center: Option<[f64; 3]>,
-    #[serde(default)]
-    pub radius: Option<f64>,
-    #[serde(default)]
-    pub axis: Option<[f64; 3]>,
-    #[serde(default)]
-    pub length: Option<f64>,
-    #[serde(default)]
-    pub size: Option<[f64; 3]>,
-    #[serde(default)]
-    pub orientation: Option<[f64; 4]>,
+    /// One of `runtime::obstacle::Shape::NAMES`.
+    pub shape: String,
     /// Input channels of the obstacle's displacement along x, y, z (m).
     #[serde(default)]
     pub translation_inputs: Option<Vec<String>>,
     /// This obstacle's law, over `[contact]`.
     #[serde(default)]
     pub contact: ContactLaw,
+    /// The shape's keys, and any other: [`ObstacleDecl::geometry`] reads
+    /// them (so that a wrong key is named with its path and what an
+    /// obstacle takes).
+    #[serde(flatten)]
+    pub keys: toml::Table,
+}
+
+impl ObstacleDecl {
+    /// The obstacle's shape from its keys, by runtime's recipe for it; an
+    /// error names the key (relative to the obstacle) and what is wrong.
+    pub fn geometry(&self) -> Result<Shape, KeyError> {
+        if let Some(k) = (self.keys.keys()).find(|k| !ShapeKeys::KEYS.contains(&k.as_str())) {
+            return Err(KeyError {
+                key: k.clone(),
+                message: format!(
+                    "not a key of an obstacle: it takes name, shape, translation_inputs, contact and its shape's keys ({})",
+                    ShapeKeys::KEYS.join(", ")
+                ),
+            });
+        }
+        let keys: ShapeKeys = serde_path_to_error::deserialize(toml::Value::Table(
+            self.keys.clone(),
+        ))
+        .map_err(|e| KeyError {
+            key: e.path().to_string(),
+            message: e.into_inner().to_string(),
+        })?;
+        Shape::from_keys(&self.shape, &keys)
+    }
 }
 
 impl ContactLaw {

@@ -96,7 +96,7 @@ pub fn rows<D: Dynamics + ?Sized>(
                 let (pb, vb) = (k.position(b), k.velocity(b));
                 let v_rel = [0, 1, 2].map(|c| v[c] - vb[c]);
                 let rel = [0, 1, 2].map(|c| Dual64::new(p[c] - pb[c], v_rel[c]));
-                let nd = super::geometry::unit(rel, [0.0, 0.0, 1.0]);
+                let nd = crate::obstacle::unit(rel, [0.0, 0.0, 1.0]);
                 let jac = ja
                     .iter()
                     .zip(&jb)

@@ -5,7 +5,7 @@
 
 use num_dual::DualNum;
 
-use super::geometry::V;
+use crate::obstacle::V;
 
 /// The normal law.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -13,7 +13,6 @@
 //! Its Jacobian is exact: the `ContactJvp` kernel's dJ and dv along each
 //! coordinate, and the laws' derivatives by dual numbers.
 
-pub mod geometry;
 pub mod impact;
 pub mod law;
 
@@ -25,10 +24,11 @@ use crate::arm::Dynamics;
 use crate::kernels::{CONTACT_BOUND, KernelKind};
 use crate::signal::Signal;
 
-pub use geometry::Shape;
+use crate::obstacle;
+pub use crate::obstacle::Shape;
 pub use law::{Damping, Law, Normal, restitution_damping};
 
-use geometry::V;
+use crate::obstacle::V;
 
 /// A sampled point: the radius of the tube (or body) around it, and where
 /// it is on the arms.
@@ -585,8 +585,8 @@ fn pair_force<T: DualNum<Primitive = f64> + Copy>(
         }
         (Against::Point(_), Some(b)) => {
             let rel = [0, 1, 2].map(|c| p[c] - b.p[c]);
-            let n = geometry::unit(rel, [0.0, 0.0, 1.0]);
-            let d = geometry::norm(rel) - b.radius;
+            let n = obstacle::unit(rel, [0.0, 0.0, 1.0]);
+            let d = obstacle::norm(rel) - b.radius;
             let v_rel = [0, 1, 2].map(|c| v[c] - b.v[c]);
             (d - r, n, v_rel)
         }
@@ -603,7 +603,7 @@ fn pair_force<T: DualNum<Primitive = f64> + Copy>(
         gap: dist,
         normal: f_n,
         force: [0, 1, 2].map(|c| n[c] * f_n + f_t[c]),
-        friction: geometry::norm(f_t),
+        friction: obstacle::norm(f_t),
         approach: -v_n,
         power: damped * (-v_n) - slip_power,
     }
@@ -712,7 +712,7 @@ fn broad_phase(set: &ContactSet, k: &PointKinematics, t: f64, s: &mut BroadPhase
         match &o.shape {
             Shape::Plane { point, normal } => s.planes.push((
                 *normal,
-                geometry::dot(*normal, *point) + geometry::dot(*normal, offset),
+                obstacle::dot(*normal, *point) + obstacle::dot(*normal, offset),
             )),
             _ => s.others.push((i, offset)),
         }
@@ -725,7 +725,7 @@ fn broad_phase(set: &ContactSet, k: &PointKinematics, t: f64, s: &mut BroadPhase
         let near = s
             .planes
             .iter()
-            .any(|&(n, level)| !geometry::plane_clears(n, level, a, e, l, margin))
+            .any(|&(n, level)| !obstacle::plane_clears(n, level, a, e, l, margin))
             || s.others
                 .iter()
                 .any(|&(i, offset)| !set.obstacles[i].shape.clears(offset, a, e, l, margin));
