@@ -20,9 +20,9 @@
 //! `forces:MODEL` the contact forces alone (`generalised_force_at`);
 //! `Q=q0,q1,...` (env) times every model at that configuration, at rest;
 //! `recursion:tentacle3d` the numeric element-by-element
-//! recursion of tests/common/pcc3d.rs.
+//! recursion of tests/suite/common/pcc3d.rs.
 
-#[path = "../tests/common/pcc3d.rs"]
+#[path = "../tests/suite/common/pcc3d.rs"]
 mod pcc3d;
 
 use std::hint::black_box;
@@ -47,7 +47,7 @@ enum What {
     Points,
     /// `forces:`: the contact forces alone.
     Forces,
-    /// `recursion:`: tests/common/pcc3d.rs's numeric recursion.
+    /// `recursion:`: tests/suite/common/pcc3d.rs's numeric recursion.
     Recursion,
 }
 

@@ -93,9 +93,9 @@ fn composite_sums_equal_body_by_body_sums_on_every_bundled_model() {
         }
         let model = load_model(&path, &[]).unwrap();
         // rom shares its coordinates along a segment and eba has absolute
-        // ones: no chain, no composite sums (tests/backends.rs checks their
+        // ones: no chain, no composite sums (tests/suite/backends.rs checks their
         // link recursion and flat tapes instead); an assembly is several
-        // chains and bodies, summed body by body (tests/joints.rs).
+        // chains and bodies, summed body by body (tests/suite/joints.rs).
         let structure = Structure::of(&model);
         if structure.assembly.is_some()
             || structure

@@ -11,7 +11,7 @@
 //!
 //! Nothing outside this folder matches on `model::Method`: what the model
 //! checks, the structure, the parameters, contact and the cells ask of a
-//! method, they ask through [`of`] (`tests/architecture.rs` holds it).
+//! method, they ask through [`of`] (`tests/suite/architecture.rs` holds it).
 //!
 //! Adding a method: a file here implementing the trait and its line in
 //! the registry, `model/methods.rs` (its variant, its name in model files,

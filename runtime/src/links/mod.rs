@@ -15,7 +15,7 @@
 //! where links own their coordinates, over rows of the arm's coordinates
 //! where they share them (rom).
 //! The flat `MassBias` tape stays the interpreter's form: the two are
-//! independent computations of the same M and h (tests/backends.rs).
+//! independent computations of the same M and h (tests/suite/backends.rs).
 
 use std::cell::RefCell;
 

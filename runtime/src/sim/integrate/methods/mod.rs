@@ -1,7 +1,7 @@
 //! The integration methods: one trait, one file per method, and the one
 //! table ([`of`]) that maps each [`Solver`] to its method. A new method is
 //! a file here, a variant with its name in `crate::solver`, and a line in
-//! the table; `tests/integrators.rs` runs every solver of that table
+//! the table; `tests/suite/integrators.rs` runs every solver of that table
 //! through the same conformance checks.
 
 mod auto;

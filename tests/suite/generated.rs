@@ -1,11 +1,9 @@
 //! `generated/` is committed and in sync, and the generator's cache works:
 //! an unchanged model is neither re-derived nor rewritten.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use eomgen::generate::{SyncOptions, sync};
 
 #[test]

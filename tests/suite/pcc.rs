@@ -3,9 +3,7 @@
 //! elastica (our own shooting solve below), Euler-Bernoulli frequencies and
 //! conservation of energy through the straight configuration.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use eomgen::cas::{Cas, SymKind};
 use eomgen::model::Override;
 use runtime::{SimOptions, StaticOptions, modes, simulate, solve_static};

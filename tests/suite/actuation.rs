@@ -5,12 +5,10 @@
 //! tip transform removes a turning sensor offset, and the STIFF-FLOP run
 //! beats TMTDyn's best published tip error.
 
-mod common;
-
 use std::f64::consts::PI;
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use eomgen::model::{Compare, Override};
 use runtime::{StaticOptions, solve_static};
 use softarm::backend::{BackendChoice, load};

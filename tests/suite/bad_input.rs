@@ -1,9 +1,7 @@
 //! Bad input gets a clear error: the file, the key path, what is wrong and
 //! what is allowed; a non-zero exit; never a panic.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 const GOOD: &str = r#"
 name = "t"

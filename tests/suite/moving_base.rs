@@ -4,11 +4,9 @@
 //! theta'') = -k theta; a soft arm carried at constant velocity moves as
 //! the same arm at rest (Galilean invariance).
 
-mod common;
-
 use std::f64::consts::PI;
 
-use common::*;
+use crate::common::*;
 
 const L: f64 = 0.2;
 const M: f64 = 0.05;

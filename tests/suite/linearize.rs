@@ -1,8 +1,6 @@
 //! `softarm linearize` against closed forms and finite differences.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 /// A uniform rod (mass m, length l) on a torsional spring k and damper c
 /// at its pivot, without gravity, a motor torque tau the input:

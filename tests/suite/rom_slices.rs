@@ -6,9 +6,7 @@
 //! differences must shrink sixteen-fold (one arc of the slice's mean
 //! strain, the scheme before, shrinks them four-fold).
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 fn tip(slices: usize) -> [f64; 3] {
     let dir = tempfile::tempdir().unwrap();

@@ -4,9 +4,7 @@
 //! the circular arc of a pure tip moment, Euler-Bernoulli and Saint-Venant
 //! frequencies, and conservation of energy with bending and twist.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use eomgen::model::Override;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 use runtime::{KernelKind, SimOptions, StaticOptions, modes, simulate, solve_static};
@@ -572,7 +570,7 @@ fn damped_two_module_vc_arm_never_gains_energy_and_swings_about_its_equilibrium(
 #[test]
 fn tentacle3d_tmt_mass_and_bias_match_a_numeric_composite_body_recursion() {
     // Every load the kernel has, a turned base and a rest curvature, so
-    // each term of the recursion is checked (tests/common/pcc3d.rs).
+    // each term of the recursion is checked (tests/suite/common/pcc3d.rs).
     let sets = [
         "tip.force=[0.3,-0.2,0.5]",
         "tip.moment=[0.01,0.02,-0.015]",
@@ -584,7 +582,7 @@ fn tentacle3d_tmt_mass_and_bias_match_a_numeric_composite_body_recursion() {
     let dir = std::env::temp_dir().join("softarm-test-cache");
     // The interpreter runs the flat tape of the TMT sums; the compiled
     // model runs the link recursion of runtime/src/links/, which
-    // tests/backends.rs holds to the interpreter.
+    // tests/suite/backends.rs holds to the interpreter.
     let l = load(
         "tentacle3d",
         &overrides,

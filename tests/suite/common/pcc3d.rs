@@ -8,7 +8,7 @@
 //! the CAS: directional derivatives of the arc formulas by hand, Rodrigues
 //! coefficients from `runtime::rodrigues::family`.
 //!
-//! Two uses: a second method for the generated kernels (tests/spatial.rs),
+//! Two uses: a second method for the generated kernels (tests/suite/spatial.rs),
 //! and what a kernel made of one element's code run in a loop costs
 //! (benches/interleaved.rs), against the unrolled kernels whose size puts
 //! them past the instruction caches (measured by benches/interleaved.rs and callgrind).

@@ -2,9 +2,7 @@
 //! central finite differences of the right-hand side, on random states of every bundled
 //! model (including states with angles exactly 0).
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use nalgebra::DMatrix;
 use runtime::{Dynamics, Workspace, accelerations, rhs_jacobian};
 use softarm::backend::{BackendChoice, load};
@@ -53,7 +51,7 @@ fn generated_jacobian_matches_central_differences() {
         let n = d.dof();
         // With joints the Jacobian is central differences of the
         // constrained solve itself: nothing generated to check here
-        // (tests/joints.rs runs every solver on it).
+        // (tests/suite/joints.rs runs every solver on it).
         if !d.info().constraints.is_empty() {
             continue;
         }

@@ -2,9 +2,7 @@
 //! (docs/design.md section 5), with joint springs and dampers, through the
 //! library (both backends) and through `softarm eom`.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use eomgen::load::load_model;
 use nalgebra::{DMatrix, DVector};
 use runtime::Dynamics;

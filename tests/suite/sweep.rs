@@ -4,9 +4,7 @@
 //! a grid is a row, and a run that fails is a row with its failure while
 //! the sweep goes on.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 fn read_csv(path: &std::path::Path) -> Vec<Vec<String>> {
     std::fs::read_to_string(path)

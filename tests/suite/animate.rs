@@ -3,9 +3,7 @@
 //! trajectory.csv's tip and its arm rows are shape.csv's. (The page itself
 //! is checked in a real browser by scripts/check_viewer.py, which CI runs.)
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use softarm::data::Csv;
 
 fn frames(path: &std::path::Path) -> (usize, (u16, u16)) {

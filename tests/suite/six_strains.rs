@@ -14,9 +14,7 @@
 //!   large skew tip load;
 //! * energy conserved by an undamped pcs arm swinging in all six strains.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use eomgen::model::Override;
 use nalgebra::{Rotation3, Vector3};
 use runtime::{SimOptions, StaticOptions, simulate, solve_static};
@@ -203,7 +201,7 @@ fn the_shear_factor_sets_timoshenkos_shear_deflection() {
 #[test]
 fn pcs_and_rom_converge_to_the_extensible_shearable_rod() {
     // P L^2 / E I = 10 along (0, -0.6, 0.8), as for the other methods
-    // (tests/spatial.rs); a soft stretch and shear (E A = 20 N, k G A = 10 N)
+    // (tests/suite/spatial.rs); a soft stretch and shear (E A = 20 N, k G A = 10 N)
     // so that they move the tip by centimetres.
     let p = 10.0 * ei() / (L * L);
     let keys = vec![

@@ -1,9 +1,7 @@
 //! Compiled and interpreted backends agree to round-off on random states
 //! for every bundled model, and the tape cache is hit on a second run.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use runtime::{Arm, Dynamics, Interpreted, KernelKind, output};
 use softarm::backend::{BackendChoice, load};
 use softarm::generated::MODELS;

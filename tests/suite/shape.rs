@@ -5,9 +5,7 @@
 //! inextensible arcs (the chords of a circle); a body's row is its
 //! coordinates; an obstacle's row its declared place.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use softarm::backend::{BackendChoice, Loaded, load};
 use softarm::shape::{Shape, ShapeRow};
 

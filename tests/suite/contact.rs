@@ -5,9 +5,7 @@
 //! or creeps at the regularised law's closed-form speed; the contact
 //! forces' analytic Jacobian against central differences.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use runtime::{SimOptions, Solver, simulate};
 
 /// |a - b| <= tol.

@@ -1,9 +1,7 @@
 //! When an integrator gives up, softarm says when, why and what to try,
 //! keeps the trajectory so far and exits non-zero.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 #[test]
 fn unstable_fixed_step_is_explained_and_the_trajectory_kept() {

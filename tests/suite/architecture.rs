@@ -326,7 +326,7 @@ fn each_crate_keeps_its_layer_order() {
                 continue;
             }
             let Some(at) = rank(&module) else {
-                panic!("{krate}: `{module}` has no place in LAYERS (tests/architecture.rs)")
+                panic!("{krate}: `{module}` has no place in LAYERS (tests/suite/architecture.rs)")
             };
             for used in uses
                 .iter()

@@ -1,0 +1,32 @@
+//! softarm's integration tests, one binary (one link of the compiled-in
+//! models, not one a file): a module per concern. Long checks beyond the
+//! default run are `#[ignore]`d and run by `.ci/run`'s own step
+//! (`cargo test --workspace -- --ignored`).
+
+mod common;
+
+mod actuation;
+mod animate;
+mod architecture;
+mod backends;
+mod bad_input;
+mod contact;
+mod cosserat_transient;
+mod double_pendulum;
+mod energy;
+mod events;
+mod failures;
+mod generated;
+mod integrators;
+mod jacobian;
+mod joints;
+mod linearize;
+mod long_arm;
+mod moving_base;
+mod pcc;
+mod rom_slices;
+mod shape;
+mod six_strains;
+mod spatial;
+mod sweep;
+mod unchanged;
