@@ -834,7 +834,7 @@ outer_radius = 0.02
     }
     x0[n + coordinate(&l, "base_rz")] = 1.0;
     let opts = SimOptions {
-        t_end: 3.0,
+        t_end: 1.0,
         output_dt: 0.01,
         rtol: 1e-11,
         atol: 1e-13,
