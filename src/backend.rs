@@ -51,6 +51,9 @@ pub struct Loaded {
     pub cache: CacheStatus,
     /// Time spent deriving (0 when compiled or cached).
     pub derive_s: f64,
+    /// Why the kernels are the ones they are (compiled in, linked cells,
+    /// or the interpreter and what a compiled route lacked).
+    pub route: String,
 }
 
 pub fn compiled_by_name(name: &str) -> Option<&'static CompiledModel> {
@@ -99,25 +102,39 @@ pub fn read_model(spec: &str, overrides: &[Override]) -> Result<(Model, String)>
 
 /// A 3D chain whose element count (or rom order) no compiled-in model
 /// has, on the compiled cells of its link shapes when every one is
-/// compiled in (found by key), with the seconds its layout took to derive.
-fn linked(structure: &Structure) -> Option<(Box<dyn Kernels>, f64)> {
+/// compiled in (found by key), with the seconds its layout took to derive;
+/// or why it cannot run so.
+fn linked(structure: &Structure) -> std::result::Result<(Box<dyn Kernels>, f64), String> {
     if !runtime::cpu::has_fma() {
-        return None;
+        return Err("this processor lacks the fused multiply-add compiled code needs".into());
     }
     let start = Instant::now();
-    let (info, links) = eomgen::derive::derive_links(structure)?;
-    let cells = (links.cells.iter().zip(&links.tangents).zip(&links.poses))
-        .map(|((cell, tangent), pose)| {
-            let key = eomgen::build::cell_key(cell, tangent, pose);
-            MODELS
-                .iter()
-                .flat_map(|m| m.cells)
-                .find(|c| c.key == key)
-                .copied()
-        })
-        .collect::<Option<Vec<_>>>()?;
+    let Some((info, links)) = eomgen::derive::derive_links(structure) else {
+        return Err(if structure.assembly.is_some() {
+            "link cells run single arms, and this is an assembly".into()
+        } else if structure.contact_points > 0 {
+            "link cells run arms without contact, and this one has obstacles".into()
+        } else if structure.dimensions != 3 {
+            "link cells run 3D arms, and this one is planar".into()
+        } else {
+            "not every one of its methods' elements is a link cell".into()
+        });
+    };
+    let keys: Vec<String> = (links.cells.iter().zip(&links.tangents).zip(&links.poses))
+        .map(|((cell, tangent), pose)| eomgen::build::cell_key(cell, tangent, pose))
+        .collect();
+    let found = |key: &String| MODELS.iter().flat_map(|m| m.cells).find(|c| c.key == *key);
+    let missing = keys.iter().filter(|k| found(k).is_none()).count();
+    if missing > 0 {
+        return Err(format!(
+            "{missing} of its {} link shapes {} in no compiled-in model",
+            keys.len(),
+            if missing == 1 { "is" } else { "are" }
+        ));
+    }
+    let cells = keys.iter().filter_map(found).copied().collect();
     let kernels = runtime::linked::LinkedKernels::new(info, links, cells);
-    Some((Box::new(kernels), start.elapsed().as_secs_f64()))
+    Ok((Box::new(kernels), start.elapsed().as_secs_f64()))
 }
 
 /// Load a model and bind its parameters to the chosen backend.
@@ -145,17 +162,28 @@ pub fn load(
         );
     }
     let compiled = compiled.filter(|_| runtime::cpu::has_fma());
+    let wanted_compiled = matches!(choice, BackendChoice::Auto | BackendChoice::Compiled);
+    let linked = match compiled {
+        None if wanted_compiled => Some(linked(&structure)),
+        _ => None,
+    };
+    let route = match (&compiled, &linked) {
+        (Some(c), _) if wanted_compiled => format!("compiled in as {}", c.name),
+        (_, Some(Ok(_))) => "compiled link cells of bundled models, linked to its layout".into(),
+        (_, Some(Err(why))) => format!(
+            "no compiled-in model has this structure and {why}: add the file to models/ and \
+             `cargo build --release` to compile it in"
+        ),
+        _ => "the interpreter, as asked".into(),
+    };
     let (kernels, cache, derive_s): (Box<dyn Kernels>, CacheStatus, f64) = match (choice, compiled)
     {
-        (BackendChoice::Auto | BackendChoice::Compiled, None)
-            if let Some((k, s)) = linked(&structure) =>
-        {
+        (BackendChoice::Auto | BackendChoice::Compiled, None) if let Some(Ok((k, s))) = linked => {
             (k, CacheStatus::Linked, s)
         }
-        (BackendChoice::Compiled, None) => bail!(
-            "{origin}: no compiled-in model has this structure (hash {hash}), nor every link shape of it; \
-             add the file to models/ and rebuild, or use --backend interpreted"
-        ),
+        (BackendChoice::Compiled, None) => {
+            bail!("{origin} (hash {hash}): {route}; or use --backend interpreted")
+        }
         (BackendChoice::Auto | BackendChoice::Compiled, Some(c)) => {
             ((c.kernels)(), CacheStatus::Unused, 0.0)
         }
@@ -204,5 +232,6 @@ pub fn load(
         base_dir,
         cache,
         derive_s,
+        route,
     })
 }

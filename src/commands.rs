@@ -454,6 +454,9 @@ fn report_run(
         stats.wall_s,
         out_dir.display()
     );
+    if arm.backend() == "interpreted" {
+        eprintln!("  why interpreted: {}", loaded.route);
+    }
     if let Some(e) = &tip_error {
         eprintln!(
             "tip error over {} to {} s ({} samples): mean {:.3} mm ({:.2} % of length), rms {:.3} mm, max {:.3} mm; plot in {}",

@@ -284,6 +284,7 @@ pub fn summary(
         "structural_hash": loaded.hash,
         "backend": arm.backend(),
         "cache": loaded.cache,
+        "route": loaded.route,
         "derive_s": loaded.derive_s,
         "solver": stats.solver,
         "rtol": opts.rtol,

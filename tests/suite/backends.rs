@@ -1051,3 +1051,81 @@ fn articulated_body_accelerations_equal_the_mass_matrix_solve() {
         None
     );
 }
+
+/// A run says which kernels it took and why: compiled in by name, linked
+/// cells for a new element count of a compiled-in chain, and for the
+/// interpreter what the compiled routes lacked, each as the structure
+/// makes it (planar, an assembly, contact, a link shape no model has).
+#[test]
+fn a_run_says_which_route_it_took_and_why() {
+    let route = |model: &str, set: &str, choice: BackendChoice| {
+        let sets: Vec<_> = (!set.is_empty())
+            .then(|| eomgen::model::Override::parse(set).unwrap())
+            .into_iter()
+            .collect();
+        let dir = tempfile::tempdir().unwrap();
+        let l = load(model, &sets, choice, Some(dir.path().to_path_buf())).unwrap();
+        (l.arm.backend(), l.route)
+    };
+    let auto = BackendChoice::Auto;
+    // Chambers in a 3D pcc arm: a link shape no bundled model has.
+    let dir = tempfile::tempdir().unwrap();
+    let tapered = dir.path().join("tapered.toml");
+    std::fs::write(
+        &tapered,
+        r#"
+name = "tapered"
+dimensions = 3
+gravity = [0.0, 0.0, -9.81]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.1
+elements = 2
+density = 1100.0
+outer_radius = 0.012
+youngs_modulus = 5e5
+[segment.chambers]
+count = 3
+radius = 0.002
+distance = 0.006
+inputs = ["p", "p", "p"]
+[[segment]]
+method = "pcc"
+length = 0.1
+elements = 2
+density = 1100.0
+outer_radius = 0.008
+youngs_modulus = 5e5
+[inputs.p]
+kind = "constant"
+value = 1000.0
+"#,
+    )
+    .unwrap();
+    let tapered = tapered.to_string_lossy().into_owned();
+    let (b, r) = route("soft_finger", "", auto);
+    assert_eq!((b, r.as_str()), ("compiled", "compiled in as soft_finger"));
+    let (b, r) = route("tentacle3d", "segment.0.elements=13", auto);
+    assert_eq!(b, "compiled");
+    assert!(r.contains("link cells"), "{r}");
+    for (model, set, why) in [
+        ("soft_finger", "segment.0.elements=7", "planar"),
+        ("falling_ball", "arm.left.segment.0.elements=3", "assembly"),
+        ("finger_tap", "segment.0.elements=5", "obstacles"),
+        (tapered.as_str(), "", "link shapes"),
+    ] {
+        let (b, r) = route(model, set, auto);
+        assert_eq!(b, "interpreted", "{model} {set}");
+        assert!(
+            r.contains(why) && r.contains("cargo build"),
+            "{model} {set}: {r}"
+        );
+    }
+    let (b, r) = route("soft_finger", "", BackendChoice::Interpreted);
+    assert_eq!(
+        (b, r.as_str()),
+        ("interpreted", "the interpreter, as asked")
+    );
+}
