@@ -113,3 +113,57 @@ fn cli_derive_check_detects_a_stale_file() {
     assert!(!stale.status.success());
     assert!(stderr(&stale).contains("stale: ") && stderr(&stale).contains("double_pendulum.rs"));
 }
+
+/// A bundled model's generated file may be at most this big (BENCHMARKS.md,
+/// build: generated/ under 2 MB for the bundled set).
+const FILE_BUDGET: u64 = 300_000;
+
+/// The models still over the budget (their assembly and contact kernels are
+/// flat expression code), each with the size it may not exceed: a file
+/// grows past its ceiling, or falls within the budget and is still listed,
+/// and the test fails, so the list only shrinks.
+const OVER_BUDGET: &[(&str, u64)] = &[
+    ("ball_drop", 1_371_209),
+    ("falling_ball", 762_305),
+    ("wrap", 702_233),
+    ("finger_tap", 560_302),
+    ("eba_arm", 405_867),
+];
+
+/// Generated sizes are deterministic, so the budget is a fair test: no
+/// model's file over 300 kB but the listed ones, and those no bigger.
+#[test]
+fn generated_files_keep_their_size_budget() {
+    let mut seen = Vec::new();
+    for e in std::fs::read_dir(root().join("generated")).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_stem().unwrap().to_string_lossy().into_owned();
+        if p.extension().is_none_or(|x| x != "rs") || matches!(name.as_str(), "mod" | "lib") {
+            continue;
+        }
+        let size = std::fs::metadata(&p).unwrap().len();
+        match OVER_BUDGET.iter().find(|(n, _)| *n == name) {
+            Some(&(_, ceiling)) => {
+                assert!(
+                    size <= ceiling,
+                    "generated/{name}.rs grew to {size} bytes (its ceiling: {ceiling})"
+                );
+                assert!(
+                    size > FILE_BUDGET,
+                    "generated/{name}.rs is within the budget now ({size} bytes): take it off OVER_BUDGET"
+                );
+                seen.push(name);
+            }
+            None => assert!(
+                size <= FILE_BUDGET,
+                "generated/{name}.rs is {size} bytes, over the {FILE_BUDGET}-byte budget"
+            ),
+        }
+    }
+    for (name, _) in OVER_BUDGET {
+        assert!(
+            seen.iter().any(|s| s == name),
+            "{name} is listed over budget but has no generated file"
+        );
+    }
+}
