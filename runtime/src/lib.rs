@@ -23,6 +23,7 @@ pub mod obstacle;
 pub mod output;
 pub mod parts;
 pub mod rodrigues;
+pub mod rotation;
 pub mod rows;
 pub mod solver;
 pub mod special;

@@ -252,24 +252,7 @@ impl Keys<'_> {
                 message: "a quaternion (w, x, y, z) of non-zero, finite length".into(),
             });
         }
-        let [w, x, y, z] = q.map(|c| c / len);
-        Ok([
-            [
-                1.0 - 2.0 * (y * y + z * z),
-                2.0 * (x * y - w * z),
-                2.0 * (x * z + w * y),
-            ],
-            [
-                2.0 * (x * y + w * z),
-                1.0 - 2.0 * (x * x + z * z),
-                2.0 * (y * z - w * x),
-            ],
-            [
-                2.0 * (x * z - w * y),
-                2.0 * (y * z + w * x),
-                1.0 - 2.0 * (x * x + y * y),
-            ],
-        ])
+        Ok(crate::rotation::from_unit_quaternion(q.map(|c| c / len)))
     }
 }
 

@@ -38,6 +38,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "special",
             "rodrigues",
             "output",
+            "rotation",
             "obstacle",
             "lanes",
             "tape",

@@ -31,24 +31,7 @@ impl SensorRotation {
                         "a quaternion [w, x, y, z] must have unit norm; this one has {n}"
                     ));
                 }
-                let (w, x, y, z) = (w / n, x / n, y / n, z / n);
-                [
-                    [
-                        1.0 - 2.0 * (y * y + z * z),
-                        2.0 * (x * y - w * z),
-                        2.0 * (x * z + w * y),
-                    ],
-                    [
-                        2.0 * (x * y + w * z),
-                        1.0 - 2.0 * (x * x + z * z),
-                        2.0 * (y * z - w * x),
-                    ],
-                    [
-                        2.0 * (x * z - w * y),
-                        2.0 * (y * z + w * x),
-                        1.0 - 2.0 * (x * x + y * y),
-                    ],
-                ]
+                runtime::rotation::from_unit_quaternion([w / n, x / n, y / n, z / n])
             }
             SensorRotation::Axes(names) => {
                 let mut r = [[0.0; 3]; 3];
