@@ -67,8 +67,8 @@ fn assert_backends_agree(
             compiled.eval_kernel(kind, t, &q, &qd, &mut a);
             interpreted.eval_kernel(kind, t, &q, &qd, &mut b);
             // Compiled chains take MassBias (3D) and Outputs from the
-            // link recursion (runtime/src/links/), eba from its parts
-            // (runtime/src/parts.rs), not the interpreter's flat tapes:
+            // link recursion (runtime/kernels/src/links/), eba from its parts
+            // (runtime/kernels/src/parts.rs), not the interpreter's flat tapes:
             // entries zero in closed form come out as different
             // round-off, so M and h are each held to 1e-12 of their
             // largest entry, and the outputs to 1e-12 of their kind's
@@ -99,7 +99,7 @@ fn assert_backends_agree(
         compiled.jacobian_parts(t, &q, &qd, &qdd, &mut a);
         interpreted.jacobian_parts(t, &q, &qd, &qdd, &mut b);
         // Compiled chains take the Jvp from the link recursion in dual
-        // numbers (runtime/src/links/tangent.rs), eba from its parts:
+        // numbers (runtime/kernels/src/links/tangent.rs), eba from its parts:
         // another order of the same sums, held to 1e-12 of each
         // block's largest entry.
         for k in 0..2 * n * n {
@@ -465,7 +465,7 @@ kind = "constant"
 value = 0.3
 "#;
 
-/// The link recursion (runtime/src/links/) with its cells interpreted
+/// The link recursion (runtime/kernels/src/links/) with its cells interpreted
 /// against the flat `MassBias` tape of the TMT sums, for every link shape
 /// and tip it covers: twist, stretch, thinning, vc modules, rom slices, a
 /// tip point mass, a tip cylinder, loads in the tip frame, a turned base;
@@ -809,7 +809,7 @@ fn recursion_matches_at(
     }
 }
 
-/// An eba arm as a sum of parts (runtime/src/parts.rs: bodies, beam
+/// An eba arm as a sum of parts (runtime/kernels/src/parts.rs: bodies, beam
 /// springs, the tip) against the flat `MassBias`, `Jvp` and `Outputs`
 /// tapes of the whole system at 1e-12 of their scale, with tip bodies and
 /// loads, extension and thinning.
@@ -972,7 +972,7 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
 #[test]
 fn articulated_body_accelerations_equal_the_mass_matrix_solve() {
     // Linked chains whose links own their coordinates take qdd by the
-    // articulated-body sweeps (runtime/src/links/articulated.rs), O(links)
+    // articulated-body sweeps (runtime/kernels/src/links/articulated.rs), O(links)
     // and without M; the reference is the interpreter's flat M and h and
     // a dense solve, -M^-1 h, at bent, moving states, with and without a
     // tip body and tip loads.

@@ -6,6 +6,7 @@
 //! forces' analytic Jacobian against central differences.
 
 use crate::common::*;
+use runtime::contact::Distance;
 use runtime::{SimOptions, Solver, simulate};
 
 /// |a - b| <= tol.

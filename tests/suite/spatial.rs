@@ -581,7 +581,7 @@ fn tentacle3d_tmt_mass_and_bias_match_a_numeric_composite_body_recursion() {
     let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
     let dir = std::env::temp_dir().join("softarm-test-cache");
     // The interpreter runs the flat tape of the TMT sums; the compiled
-    // model runs the link recursion of runtime/src/links/, which
+    // model runs the link recursion of runtime/kernels/src/links/, which
     // tests/suite/backends.rs holds to the interpreter.
     let l = load(
         "tentacle3d",

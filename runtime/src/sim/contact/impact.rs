@@ -12,6 +12,7 @@
 //! joints' in the accelerations' saddle-point solve, until its normal force
 //! would pull (the contact switch ends the leg there).
 
+use super::distance::Distance;
 use nalgebra::{DMatrix, DVector};
 use num_dual::Dual64;
 
@@ -96,7 +97,7 @@ pub fn rows<D: Dynamics + ?Sized>(
                 let (pb, vb) = (k.position(b), k.velocity(b));
                 let v_rel = [0, 1, 2].map(|c| v[c] - vb[c]);
                 let rel = [0, 1, 2].map(|c| Dual64::new(p[c] - pb[c], v_rel[c]));
-                let nd = crate::obstacle::unit(rel, [0.0, 0.0, 1.0]);
+                let nd = super::distance::unit(rel, [0.0, 0.0, 1.0]);
                 let jac = ja
                     .iter()
                     .zip(&jb)

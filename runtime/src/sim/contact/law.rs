@@ -5,7 +5,7 @@
 
 use num_dual::DualNum;
 
-use crate::obstacle::V;
+use super::distance::V;
 
 /// The normal law.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -13,6 +13,7 @@
 //! Its Jacobian is exact: the `ContactJvp` kernel's dJ and dv along each
 //! coordinate, and the laws' derivatives by dual numbers.
 
+pub mod distance;
 pub mod impact;
 pub mod law;
 
@@ -24,11 +25,12 @@ use crate::arm::Dynamics;
 use crate::kernels::{CONTACT_BOUND, KernelKind};
 use crate::signal::Signal;
 
-use crate::obstacle;
 pub use crate::obstacle::Shape;
+use distance as obstacle;
+pub use distance::Distance;
 pub use law::{Damping, Law, Normal, restitution_damping};
 
-use crate::obstacle::V;
+use distance::V;
 
 /// A sampled point: the radius of the tube (or body) around it, and where
 /// it is on the arms.

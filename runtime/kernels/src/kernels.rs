@@ -226,6 +226,25 @@ pub trait Kernels {
     }
 }
 
+/// A boxed set of kernels is one: the backends are chosen at run time.
+impl<K: Kernels + ?Sized> Kernels for Box<K> {
+    fn info(&self) -> &ModelInfo {
+        (**self).info()
+    }
+    fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
+        (**self).eval(kind, inp, out)
+    }
+    fn backend(&self) -> &'static str {
+        (**self).backend()
+    }
+    fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
+        (**self).solve_mass(packed, b, ws)
+    }
+    fn accelerations(&self, inp: &Inputs, qdd: &mut [f64]) -> Option<bool> {
+        (**self).accelerations(inp, qdd)
+    }
+}
+
 /// Derived tapes of one model: the interpreted backend, and what eomgen
 /// emits as Rust for the compiled one.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

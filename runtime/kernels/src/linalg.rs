@@ -146,7 +146,7 @@ impl Ldlt {
     }
 }
 
-#[cfg(all(test, feature = "simulate"))]
+#[cfg(test)]
 mod tests {
     use super::*;
     use nalgebra::{DMatrix, DVector};
