@@ -266,10 +266,10 @@ fn draw_gif(
     softarm::compare::register_font();
     let cam = Camera::new(view, scene.dimensions);
     let b = bounds(scene, &cam);
-    let delay = (1000.0 / fps).round() as u32;
-    let root = BitMapBackend::gif(path, size, delay)
-        .map_err(|e| anyhow!("{}: {e}", path.display()))?
-        .into_drawing_area();
+    // GIF delays are in hundredths of a second.
+    let delay = (((1000.0 / fps).round() as u32 + 5) / 10).min(u16::MAX as u32) as u16;
+    let mut gif = gif_file(path, size)?;
+    let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
     // The scene above, the input bars (if any) in a strip below it.
     let strip = BAR * scene.inputs.len().min(MAX_BARS) as f64;
     let (w, h) = (size.0 as f64, (size.1 as f64 - strip).max(32.0));
@@ -289,6 +289,7 @@ fn draw_gif(
         while k + 1 < scene.t.len() && (scene.t[k + 1] - t).abs() <= (scene.t[k] - t).abs() {
             k += 1;
         }
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
         for part in scene.parts.iter().filter(|p| matches!(p.look, Look::Plane)) {
             let r = part.frames[k][0];
@@ -334,8 +335,28 @@ fn draw_gif(
         .map_err(err)?;
         input_bars(&root, scene, k, size).map_err(err)?;
         root.present().map_err(err)?;
+        drop(root);
+        let mut frame = gif::Frame::from_rgb_speed(size.0 as u16, size.1 as u16, &rgb, 10);
+        frame.delay = delay;
+        gif.write_frame(&frame)
+            .map_err(|e| anyhow!("{}: {e}", path.display()))?;
     }
     Ok(())
+}
+
+/// An endlessly looping GIF at `path`, written frame by frame (our own
+/// encoder rather than plotters' GIF backend, which brings the `image`
+/// crate: ten seconds of every fresh build for one file format).
+fn gif_file(path: &std::path::Path, size: (u32, u32)) -> Result<gif::Encoder<std::fs::File>> {
+    let fail = |e: &dyn std::fmt::Display| anyhow!("{}: {e}", path.display());
+    let (w, h) = (u16::try_from(size.0), u16::try_from(size.1));
+    let (Ok(w), Ok(h)) = (w, h) else {
+        return Err(anyhow!("{}: a GIF is at most 65535 pixels a side", path.display()));
+    };
+    let file = std::fs::File::create(path).map_err(|e| fail(&e))?;
+    let mut gif = gif::Encoder::new(file, w, h, &[]).map_err(|e| fail(&e))?;
+    gif.set_repeat(gif::Repeat::Infinite).map_err(|e| fail(&e))?;
+    Ok(gif)
 }
 
 /// The shading layers of a piece: (width, offset toward the light, both
