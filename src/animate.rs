@@ -67,9 +67,11 @@ pub fn animate(a: AnimateArgs) -> Result<ExitCode> {
         .unwrap_or_else(|| PathBuf::from("out").join(model_stem(&sim.model.model)));
     let loaded = commands::load(&sim.model)?;
     let scene = Scene::read(&loaded, &out)?;
-    let gif = out.join("animation.gif");
+    // The animation joins the files of the run it shows.
+    let mut dir = softarm::output_dir::OutputDir::reopen(&out)?;
+    let gif = dir.file("animation.gif")?;
     draw_gif(&scene, a.view, a.fps, a.speed, size, &gif)?;
-    let html = out.join("viewer.html");
+    let html = dir.file("viewer.html")?;
     softarm::viewer::write(&scene, &html)?;
     if !sim.quiet {
         eprintln!("animation: {} and {}", gif.display(), html.display());
@@ -351,11 +353,15 @@ fn gif_file(path: &std::path::Path, size: (u32, u32)) -> Result<gif::Encoder<std
     let fail = |e: &dyn std::fmt::Display| anyhow!("{}: {e}", path.display());
     let (w, h) = (u16::try_from(size.0), u16::try_from(size.1));
     let (Ok(w), Ok(h)) = (w, h) else {
-        return Err(anyhow!("{}: a GIF is at most 65535 pixels a side", path.display()));
+        return Err(anyhow!(
+            "{}: a GIF is at most 65535 pixels a side",
+            path.display()
+        ));
     };
     let file = std::fs::File::create(path).map_err(|e| fail(&e))?;
     let mut gif = gif::Encoder::new(file, w, h, &[]).map_err(|e| fail(&e))?;
-    gif.set_repeat(gif::Repeat::Infinite).map_err(|e| fail(&e))?;
+    gif.set_repeat(gif::Repeat::Infinite)
+        .map_err(|e| fail(&e))?;
     Ok(gif)
 }
 

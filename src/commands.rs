@@ -262,7 +262,7 @@ fn compare_tip(
     loaded: &Loaded,
     m: &compare::Measured,
     traj: &Trajectory,
-    out_dir: &Path,
+    dir: &mut softarm::output_dir::OutputDir,
 ) -> Result<Option<compare::TipError>> {
     let tips = softarm::run::tips(loaded, traj);
     // A run that ends before the window has no statistics, but
@@ -279,7 +279,7 @@ fn compare_tip(
         ),
         None => format!("{}: simulated and measured tip", loaded.model.name),
     };
-    compare::plot(&out_dir.join("tip"), &title, &tips, m)?;
+    compare::plot(&dir.plot("tip")?, &title, &tips, m)?;
     Ok(err)
 }
 
@@ -305,8 +305,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&loaded.model.name));
-    std::fs::create_dir_all(&out_dir)
-        .with_context(|| format!("cannot create {}", out_dir.display()))?;
+    let mut dir = softarm::output_dir::OutputDir::claim(&out_dir)?;
 
     let progress = softarm::progress::Progress::start(&loaded.model.name, opts.t_end, a.quiet);
     opts.progress = progress.as_ref().map(|p| p.cell());
@@ -317,14 +316,14 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         Err(f) => explained(arm, *f),
     };
     let table = softarm::run::Table::of(arm, &traj);
-    write_atomic(&out_dir.join("trajectory.csv"), table.csv().as_bytes())?;
+    write_atomic(&dir.file("trajectory.csv")?, table.csv().as_bytes())?;
     if let Some(shape) = &shape {
         let csv = shape.csv(arm, &traj.t, &traj.x);
-        write_atomic(&out_dir.join("shape.csv"), csv.as_bytes())?;
+        write_atomic(&dir.file("shape.csv")?, csv.as_bytes())?;
     }
-    plot_paths_and_contact(&loaded, &traj, &out_dir)?;
+    plot_paths_and_contact(&loaded, &traj, &mut dir)?;
     let tip_error = match (&measured, &loaded.model.compare) {
-        (Some(m), Some(_)) => compare_tip(&loaded, m, &traj, &out_dir)?,
+        (Some(m), Some(_)) => compare_tip(&loaded, m, &traj, &mut dir)?,
         _ => None,
     };
     let mut summary = softarm::run::summary(
@@ -338,7 +337,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     summary["options"] = option_sources(&a, &loaded.model.simulate, &opts);
     summary["assembly_moved"] = json!(assembled_m);
     write_atomic(
-        &out_dir.join("summary.json"),
+        &dir.file("summary.json")?,
         serde_json::to_string_pretty(&summary)?.as_bytes(),
     )?;
     if !a.quiet {
@@ -387,7 +386,11 @@ fn explained(
 
 /// The free bodies' paths, and with contact the tip's path and the contact
 /// forces, as pictures in `out_dir`.
-fn plot_paths_and_contact(loaded: &Loaded, traj: &Trajectory, out_dir: &Path) -> Result<()> {
+fn plot_paths_and_contact(
+    loaded: &Loaded,
+    traj: &Trajectory,
+    dir: &mut softarm::output_dir::OutputDir,
+) -> Result<()> {
     let arm = &*loaded.arm;
     let n = arm.dof();
     let body_names: Vec<String> = loaded.model.bodies.iter().map(|b| b.name.clone()).collect();
@@ -399,7 +402,7 @@ fn plot_paths_and_contact(loaded: &Loaded, traj: &Trajectory, out_dir: &Path) ->
             .map(|(t, x)| (*t, x[ix], x[ix + 1]))
             .collect();
         let title = format!("{}: path of {body}", loaded.model.name);
-        softarm::joints::plot_path(&out_dir.join(&body), &title, &path)?;
+        softarm::joints::plot_path(&dir.plot(&body)?, &title, &path)?;
     }
     if let Some(set) = arm.contact() {
         // The tip's path and the contact forces.
@@ -413,7 +416,7 @@ fn plot_paths_and_contact(loaded: &Loaded, traj: &Trajectory, out_dir: &Path) ->
             })
             .collect();
         let name = &loaded.model.name;
-        softarm::joints::plot_path(&out_dir.join("tip"), &format!("{name}: tip path"), &tips)?;
+        softarm::joints::plot_path(&dir.plot("tip")?, &format!("{name}: tip path"), &tips)?;
         let forces: Vec<(f64, Vec<f64>)> = traj
             .t
             .iter()
@@ -421,7 +424,7 @@ fn plot_paths_and_contact(loaded: &Loaded, traj: &Trajectory, out_dir: &Path) ->
             .map(|(i, t)| (*t, softarm::contact::columns(arm, traj, i)))
             .collect();
         softarm::contact::plot_forces(
-            &out_dir.join("contact"),
+            &dir.plot("contact")?,
             &format!("{name}: contact forces"),
             &set.channels,
             &forces,

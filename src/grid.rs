@@ -5,6 +5,13 @@
 
 use anyhow::{Context, Result, bail};
 
+/// Values one `lin:`/`log:` range may give: a range is expanded in memory.
+pub const MAX_VALUES: usize = 100_000;
+/// Runs a sweep makes without being told `yes`: each writes a folder.
+pub const CONFIRM_RUNS: usize = 10_000;
+/// Runs no sweep makes: the grid itself is held in memory.
+pub const MAX_RUNS: usize = 10_000_000;
+
 /// One varied key and its values.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Vary {
@@ -37,6 +44,9 @@ impl Vary {
             let n: usize = parts[2].trim().parse().with_context(bad)?;
             if n < 2 || !a.is_finite() || !b.is_finite() {
                 bail!(bad());
+            }
+            if n > MAX_VALUES {
+                bail!("--vary {s}: {n} values; a range gives at most {MAX_VALUES}");
             }
             if kind == "log" && (a <= 0.0 || b <= 0.0) {
                 bail!("--vary {s}: a log range needs positive ends");
@@ -94,6 +104,31 @@ fn split_top_level(s: &str) -> Vec<String> {
     }
     out.push(cur.trim().to_string());
     out
+}
+
+/// The number of combinations, counted before any is made; an error past
+/// [`MAX_RUNS`], or past [`CONFIRM_RUNS`] unless `yes` (what to pass is
+/// `confirm`, the front end's spelling of it).
+pub fn checked_size(varies: &[Vary], yes: bool, confirm: &str) -> Result<usize> {
+    let size = varies
+        .iter()
+        .try_fold(1usize, |n, v| n.checked_mul(v.values.len()))
+        .filter(|&n| n <= MAX_RUNS);
+    let counts: Vec<String> = varies.iter().map(|v| v.values.len().to_string()).collect();
+    let Some(size) = size else {
+        bail!(
+            "the grid has {} runs, more than the {MAX_RUNS} a sweep makes: vary fewer values",
+            counts.join(" x ")
+        );
+    };
+    if size > CONFIRM_RUNS && !yes {
+        bail!(
+            "the grid has {} = {size} runs, each writing a folder of its own; \
+             over {CONFIRM_RUNS} runs a sweep starts only with {confirm}",
+            counts.join(" x ")
+        );
+    }
+    Ok(size)
 }
 
 /// Every combination, the last key fastest: value indices per key.

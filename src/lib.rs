@@ -16,6 +16,7 @@ pub mod grid;
 pub mod inputs;
 pub mod joints;
 pub mod linearize;
+pub mod output_dir;
 pub mod progress;
 pub mod run;
 pub mod scene;

@@ -5,7 +5,10 @@
 //! status, the chosen figures) and `sweep.png` one figure against the
 //! first varied value, a line per value of the second.
 //!
-//! A run that fails is a row with its failure; the sweep goes on.
+//! Before any run the grid is counted (a big one needs `--yes`) and every
+//! varied value is checked as `--set` checks it, so a typo fails at once.
+//! A run that fails is a row with its failure; the sweep goes on, and
+//! exits non-zero at its end.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -17,7 +20,7 @@ use rayon::prelude::*;
 use serde_json::Value;
 
 use crate::commands::{self, ModesArgs, SimulateArgs, StaticArgs};
-use softarm::grid::{Vary, grid};
+use softarm::grid::{Vary, checked_size, grid};
 
 #[derive(Args, Clone)]
 pub struct SweepArgs {
@@ -36,6 +39,9 @@ pub struct SweepArgs {
     /// Runs at once (default: every core).
     #[arg(long)]
     pub jobs: Option<usize>,
+    /// Start a sweep of more than 10,000 runs.
+    #[arg(long)]
+    pub yes: bool,
     /// The figure sweep.png plots (a column of sweep.csv; default tip_y,
     /// or f1_hz for modes).
     #[arg(long)]
@@ -63,6 +69,8 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         .iter()
         .map(|s| Vary::parse(s))
         .collect::<Result<_>>()?;
+    checked_size(&varies, a.yes, "--yes")?;
+    check_values(&a.simulate.model, &varies)?;
     let combos = grid(&varies);
     let name = model_name(&a.simulate.model.model);
     let out_dir = a
@@ -70,8 +78,7 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-sweep")));
-    std::fs::create_dir_all(&out_dir)
-        .with_context(|| format!("cannot create {}", out_dir.display()))?;
+    let mut dir = softarm::output_dir::OutputDir::claim(&out_dir)?;
     let jobs = a.jobs.unwrap_or_else(rayon::current_num_threads).max(1);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
@@ -93,19 +100,12 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
     });
     let wall = started.elapsed().as_secs_f64();
     let csv = sweep_csv(&varies, &combos, &rows);
-    std::fs::write(out_dir.join("sweep.csv"), csv).context("cannot write sweep.csv")?;
+    std::fs::write(dir.file("sweep.csv")?, csv).context("cannot write sweep.csv")?;
     let figure = a.plot.clone().unwrap_or_else(|| match a.run {
         Study::Modes => "f1_hz".into(),
         _ => "tip_y".into(),
     });
-    plot(
-        &out_dir.join("sweep"),
-        &name,
-        &figure,
-        &varies,
-        &combos,
-        &rows,
-    )?;
+    plot(&dir.plot("sweep")?, &name, &figure, &varies, &combos, &rows)?;
     let failed = rows.iter().filter(|r| r.status != "ok").count();
     let serial: f64 = rows.iter().map(|r| r.wall_s).sum();
     eprintln!(
@@ -113,7 +113,33 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         rows.len(),
         out_dir.join("sweep.csv").display()
     );
-    Ok(ExitCode::SUCCESS)
+    Ok(if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
+
+/// Every varied value as `--set` takes it, one at a time on the sweep's
+/// own overrides: the model must read and validate with it.
+fn check_values(model: &crate::ModelArgs, varies: &[Vary]) -> Result<()> {
+    let base = model
+        .set
+        .iter()
+        .map(|s| eomgen::model::Override::parse(s))
+        .collect::<Result<Vec<_>, _>>()?;
+    for v in varies {
+        for value in &v.values {
+            let set = format!("{}={value}", v.path);
+            let mut overrides = base.clone();
+            overrides.push(
+                eomgen::model::Override::parse(&set).with_context(|| format!("--vary {set}"))?,
+            );
+            softarm::backend::read_model(&model.model, &overrides)
+                .with_context(|| format!("--vary {set}"))?;
+        }
+    }
+    Ok(())
 }
 
 fn model_name(model: &str) -> String {

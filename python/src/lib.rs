@@ -458,12 +458,17 @@ fn load_with(spec: &str, overrides: &[String]) -> PyResult<Loaded> {
 /// `--set` takes them, and every combination as value indices.
 #[pyfunction]
 #[allow(clippy::type_complexity)]
-fn sweep_grid(specs: Vec<String>) -> PyResult<(Vec<String>, Vec<Vec<String>>, Vec<Vec<usize>>)> {
+#[pyo3(signature = (specs, yes = false))]
+fn sweep_grid(
+    specs: Vec<String>,
+    yes: bool,
+) -> PyResult<(Vec<String>, Vec<Vec<String>>, Vec<Vec<usize>>)> {
     let varies = specs
         .iter()
         .map(|s| softarm::grid::Vary::parse(s))
         .collect::<anyhow::Result<Vec<_>>>()
         .map_err(value_error)?;
+    softarm::grid::checked_size(&varies, yes, "yes=True").map_err(value_error)?;
     let combos = softarm::grid::grid(&varies);
     Ok((
         varies.iter().map(|v| v.path.clone()).collect(),

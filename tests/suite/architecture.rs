@@ -64,6 +64,7 @@ const LAYERS: &[(&str, &[&str])] = &[
         &[
             "data",
             "cache",
+            "output_dir",
             "continuum",
             "progress",
             "grid",

@@ -23,6 +23,7 @@ mod joints;
 mod linearize;
 mod long_arm;
 mod moving_base;
+mod output_dir;
 mod pcc;
 mod rom_slices;
 mod shape;

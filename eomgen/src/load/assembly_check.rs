@@ -71,12 +71,11 @@ fn names(ck: &Check) -> Result<(), ModelError> {
         .chain(m.bodies.iter().map(|b| ("body", &b.name)));
     for (kind, name) in named {
         let path = format!("{kind}.{name}.name");
-        if name.trim().is_empty() || name.contains('.') || name == "world" {
+        ck.file_name(&path, &format!("a {kind}"), name)?;
+        if name == "world" {
             return ck.err(
                 path,
-                format!(
-                    "\"{name}\" cannot name a {kind}: use a non-empty name without dots, not \"world\""
-                ),
+                format!("\"world\" is the ground and cannot name a {kind}"),
             );
         }
         if !frames.insert(name.as_str()) {

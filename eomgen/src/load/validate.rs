@@ -13,6 +13,7 @@ pub const MAX_ELEMENTS: usize = 500;
 /// first problem found is the error.
 pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
     let ck = Check { m, file };
+    ck.file_name("name", "a model", &m.name)?;
     if m.is_assembly() {
         super::assembly_check::check_assembly(&ck, |arm| validate_arm(arm, file))?;
         simulate_defaults(&ck)?;
@@ -72,9 +73,7 @@ fn simulate_defaults(ck: &Check) -> Result<(), ModelError> {
 /// Name, gravity, the base frame and the plane.
 fn frame(ck: &Check) -> Result<(), ModelError> {
     let m = ck.m;
-    if m.name.trim().is_empty() {
-        return ck.err("name".into(), "must not be empty".into());
-    }
+    ck.file_name("name", "a model", &m.name)?;
     ck.vec3("gravity", &m.gravity)?;
     ck.vec3("base.position", &m.base.position)?;
     ck.vec3("base.direction", &m.base.direction)?;

@@ -16,6 +16,22 @@ impl Check<'_> {
         Err(ModelError::new(self.file, path, msg))
     }
 
+    /// A name that becomes a file or folder name (a model's output folder,
+    /// a body's plot): letters, digits, `_` and `-`, so that nothing is
+    /// written outside the output folder.
+    pub fn file_name(&self, path: &str, what: &str, name: &str) -> Result<(), ModelError> {
+        let ok = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-';
+        if !name.is_empty() && name.len() <= 100 && name.chars().all(ok) {
+            return Ok(());
+        }
+        self.err(
+            path.into(),
+            format!(
+                "{name:?} cannot name {what}: it names files, so use 1 to 100 letters, digits, '_' and '-'"
+            ),
+        )
+    }
+
     pub fn finite(&self, path: &str, v: f64) -> Result<(), ModelError> {
         if v.is_finite() {
             return Ok(());

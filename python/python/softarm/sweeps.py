@@ -77,6 +77,7 @@ def sweep(
     client: Any = None,
     set: Optional[Mapping[str, Any]] = None,
     jobs: Optional[int] = None,
+    yes: bool = False,
     **options: Any,
 ):
     """Run `run` ("simulate", "static" or "modes") for every combination of
@@ -85,11 +86,12 @@ def sweep(
     (all, or those named in `figures`). `options` go to `Model.simulate`
     (t_end, solver, rtol, ...). With a `dask.distributed.Client` the runs
     are tasks on its cluster; else they run here on `jobs` processes
-    (default: every core)."""
+    (default: every core). A grid of more than 10,000 runs needs
+    `yes=True`."""
     import pandas as pd
 
     specs = [_spec(p, v) for p, v in vary.items()]
-    paths, values, combos = _softarm.sweep_grid(specs)
+    paths, values, combos = _softarm.sweep_grid(specs, yes)
     base = [f"{k}={v if isinstance(v, str) else json.dumps(v)}" for k, v in (set or {}).items()]
     tasks = [base + [f"{p}={values[i][c[i]]}" for i, p in enumerate(paths)] for c in combos]
     if client is not None:
