@@ -307,6 +307,8 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         .unwrap_or_else(|| PathBuf::from("out").join(&loaded.model.name));
     let mut dir = softarm::output_dir::OutputDir::claim(&out_dir)?;
 
+    // Ctrl-C or SIGTERM stops the run with what it computed written.
+    opts.interrupt = Some(softarm::interrupt::for_run());
     let progress = softarm::progress::Progress::start(&loaded.model.name, opts.t_end, a.quiet);
     opts.progress = progress.as_ref().map(|p| p.cell());
     let result = runtime::simulate(arm, x0.clone(), &opts);
@@ -343,15 +345,27 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     if !a.quiet {
         report_run(&loaded, &stats, &tip_error, &out_dir);
     }
-    if let Some((msg, _)) = failure {
-        if !a.quiet {
-            eprintln!("error: {msg}");
-            eprintln!(
-                "the trajectory up to then is in {}",
+    if let Some((msg, f)) = failure {
+        let stop = softarm::interrupt::requested().filter(|_| f["reason"] == runtime::INTERRUPTED);
+        // Said even when quiet: the folder holds an incomplete run.
+        match stop {
+            Some(s) => eprintln!(
+                "{}: stopped by {} at t = {} s; the trajectory up to then is in {}",
+                loaded.model.name,
+                s.name(),
+                f["t_reached"],
                 out_dir.join("trajectory.csv").display()
-            );
+            ),
+            None if !a.quiet => {
+                eprintln!("error: {msg}");
+                eprintln!(
+                    "the trajectory up to then is in {}",
+                    out_dir.join("trajectory.csv").display()
+                );
+            }
+            None => {}
         }
-        return Ok(ExitCode::FAILURE);
+        return Ok(stop.map_or(ExitCode::FAILURE, |s| ExitCode::from(s.exit_code())));
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -14,6 +14,7 @@ pub mod continuum;
 pub mod data;
 pub mod grid;
 pub mod inputs;
+pub mod interrupt;
 pub mod joints;
 pub mod linearize;
 pub mod output_dir;

@@ -297,7 +297,11 @@ pub fn summary(
         "jacobian_evaluations": stats.jacobian_evaluations,
         "solver_switch": stats.switched,
         "wall_s": stats.wall_s,
-        "status": if failure.is_some() { "failed" } else { "ok" },
+        "status": match &failure {
+            None => "ok",
+            Some(f) if f["reason"] == runtime::INTERRUPTED => "interrupted",
+            Some(_) => "failed",
+        },
         "tip_error": tip_error,
         "constraint_drift_max_m": stats.constraints.map(|c| c.drift_max_m),
         "constraints": stats.constraints,

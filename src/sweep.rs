@@ -90,6 +90,9 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         format!("{:?}", a.run).to_lowercase(),
         out_dir.display()
     );
+    // Ctrl-C or SIGTERM: the runs under way stop and keep what they
+    // computed, the others are not started; sweep.csv says which.
+    softarm::interrupt::catch();
     let started = Instant::now();
     let rows: Vec<Row> = pool.install(|| {
         combos
@@ -113,10 +116,16 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         rows.len(),
         out_dir.join("sweep.csv").display()
     );
-    Ok(if failed == 0 {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::FAILURE
+    Ok(match softarm::interrupt::requested() {
+        Some(stop) => {
+            eprintln!(
+                "sweep: stopped by {}; sweep.csv has every run's status",
+                stop.name()
+            );
+            ExitCode::from(stop.exit_code())
+        }
+        None if failed == 0 => ExitCode::SUCCESS,
+        None => ExitCode::FAILURE,
     })
 }
 
@@ -152,6 +161,13 @@ fn model_name(model: &str) -> String {
 /// its figures.
 fn run_one(a: &SweepArgs, varies: &[Vary], combo: &[usize], dir: &Path) -> Row {
     let started = Instant::now();
+    if let Some(stop) = softarm::interrupt::requested() {
+        return Row {
+            status: format!("not run: {} before it started", stop.name()),
+            wall_s: 0.0,
+            figures: Vec::new(),
+        };
+    }
     let mut model = a.simulate.model.clone();
     for (v, &i) in varies.iter().zip(combo) {
         model.set.push(format!("{}={}", v.path, v.values[i]));

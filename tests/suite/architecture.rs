@@ -65,6 +65,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "data",
             "cache",
             "output_dir",
+            "interrupt",
             "continuum",
             "progress",
             "grid",

@@ -18,6 +18,7 @@ mod events;
 mod failures;
 mod generated;
 mod integrators;
+mod interrupted;
 mod jacobian;
 mod joints;
 mod linearize;
