@@ -59,6 +59,17 @@ pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> 
     if !(output_dt > 0.0 && output_dt.is_finite()) {
         bail!("--output-dt must be positive, got {output_dt}");
     }
+    // Options against each other, before anything runs or is written.
+    if solver.fixed_step() && dt > t_end {
+        bail!(
+            "--dt {dt} s is longer than the run (--t-end {t_end} s): a fixed-step solver takes steps of --dt"
+        );
+    }
+    if output_dt > t_end {
+        bail!(
+            "--output-dt {output_dt} s is longer than the run (--t-end {t_end} s): the trajectory would hold its first row only"
+        );
+    }
     Ok(SimOptions {
         t_end,
         solver,

@@ -100,12 +100,16 @@ fn an_impossible_step_budget_is_explained_for_every_adaptive_solver() {
             .unwrap()
             .parse()
             .unwrap();
-        // Rows at every output time passed (t_end / 500 apart) are kept.
+        // Rows at every output time passed (t_end / 500 apart) are kept,
+        // and the last accepted state after them.
         let due = (t_reached / (2.0 / 500.0)).floor() as usize + 1;
         assert!(
-            rows == due && last_t <= t_reached + 1e-9,
-            "{solver}: {rows} rows kept, {due} due before t = {t_reached}"
+            rows == due + 1 && (last_t - t_reached).abs() <= 1e-8,
+            "{solver}: {rows} rows kept, {due} due before t = {t_reached}, last at {last_t}"
         );
+        // The steps are counted up to the failure, not reported as none.
+        let steps = summary["steps"].as_u64().unwrap();
+        assert!(steps > 0 && steps <= 200, "{solver}: {steps} steps");
     }
 }
 
@@ -155,4 +159,26 @@ fn summary_reports_the_run() {
         header,
         "t,theta_0_0,theta_1_0,theta_0_0_dot,theta_1_0_dot,tip_x,tip_y,tip_z,kinetic,potential,tip_qw,tip_qx,tip_qy,tip_qz"
     );
+}
+
+#[test]
+fn options_are_checked_against_each_other_before_anything_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, says) in [
+        (
+            vec!["--solver", "rk4", "--dt", "10", "--t-end", "0.2"],
+            "--dt 10 s is longer than the run (--t-end 0.2 s)",
+        ),
+        (
+            vec!["--output-dt", "1", "--t-end", "0.2"],
+            "--output-dt 1 s is longer than the run",
+        ),
+    ] {
+        let mut all = vec!["simulate", "double_pendulum", "--out", "o"];
+        all.extend(&args);
+        let out = softarm(&all, dir.path());
+        assert!(!out.status.success(), "{args:?}");
+        assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
+        assert!(!dir.path().join("o").exists(), "{args:?}: nothing written");
+    }
 }

@@ -52,6 +52,7 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
         last_step_s,
         contact,
         interrupted,
+        accepted,
     } = recorded;
     let hits = kept.events.clone();
     let wall_s = start.elapsed().as_secs_f64();
@@ -130,8 +131,13 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
                     t,
                     unpad(&y),
                     format!("the step budget of {} steps ran out", opts.max_steps),
-                    "shorten --t-end, relax --rtol/--atol, or use an implicit solver for stiff arms"
-                        .to_string(),
+                    if opts.solver.implicit() {
+                        "raise --max-steps, shorten --t-end or relax --rtol/--atol".to_string()
+                    } else {
+                        "raise --max-steps, shorten --t-end, relax --rtol/--atol, or use an \
+                         implicit solver (radau5) if the arm is stiff"
+                            .to_string()
+                    },
                 ),
                 Error::Stiffness { t, y } => (
                     t,
@@ -146,14 +152,22 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
                     "check the model and the solver options".to_string(),
                 ),
             };
+            // The last accepted state is what the run computed last: kept
+            // beside the samples, which a long output step may not reach.
+            let mut trajectory = kept;
+            if accepted > 0 && trajectory.t.last().is_none_or(|&t| t < t_reached) {
+                trajectory.t.push(t_reached);
+                trajectory.x.push(state.clone());
+            }
+            // The method's count of rejected steps dies with its error.
             Err(Box::new(SimFailure {
                 t_reached,
                 last_step_s,
                 reason,
                 suggestion,
                 state,
-                trajectory: kept,
-                stats: stats_of(0, 0),
+                trajectory,
+                stats: stats_of(accepted, 0),
             }))
         }
     }

@@ -39,7 +39,11 @@ pub(super) struct Recorder<'a> {
     /// and the last step; Some(reason) stops the run for a switch.
     watch: Option<&'a Watch<'a>>,
     switch: &'a RefCell<Option<(f64, Vec<f64>, String)>>,
-    accepted: usize,
+    /// The recorder's calls so far (the checks' cadence).
+    calls: usize,
+    /// Accepted steps so far (kept outside the crate's solution so that a
+    /// failed run still reports them).
+    accepted: &'a Cell<usize>,
     /// The contact switch (`integrate::touch`), when the arm has one.
     contact: Option<Box<super::events::SwitchFn<'a>>>,
     /// The contact meter's (power, depth) at (t, x), and its running sum.
@@ -90,7 +94,7 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
         }
         // Asked every 64 accepted steps: a check costs a host call.
         if let Some(stop) = &self.interrupt
-            && self.accepted.is_multiple_of(64)
+            && self.calls.is_multiple_of(64)
             && (stop.0)()
         {
             self.interrupted.set(Some(t_curr));
@@ -126,9 +130,13 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
             .sample(t_curr, t_prev, y_curr, y_prev, interpolator, solution);
         self.sampler.at_end(t_curr, y_curr, self.t_end, solution);
         self.keep(solution);
-        self.accepted += 1;
+        self.calls += 1;
+        // (A method's first call, at the start, is no step.)
+        if t_curr > t_prev {
+            self.accepted.set(self.accepted.get() + 1);
+        }
         if let Some(watch) = self.watch
-            && self.accepted.is_multiple_of(AUTO_CHECK_STEPS)
+            && self.calls.is_multiple_of(AUTO_CHECK_STEPS)
             && let Some(reason) = watch(y_curr.as_ref(), t_curr - t_prev)
         {
             *self.switch.borrow_mut() = Some((t_curr, y_curr.as_ref().to_vec(), reason));
@@ -239,6 +247,8 @@ pub(super) struct Recorded {
     pub(super) contact: Option<ContactMeter>,
     /// `SimOptions::interrupt` stopped the run at this time.
     pub(super) interrupted: Option<f64>,
+    /// The accepted steps the recorder saw.
+    pub(super) accepted: usize,
 }
 
 /// The shared state a run's `Recorder` writes to.
@@ -249,6 +259,7 @@ pub(super) struct RunLog {
     kept: RefCell<Trajectory>,
     last_step: Cell<Option<f64>>,
     metered: Cell<Option<ContactMeter>>,
+    accepted: Cell<usize>,
 }
 
 impl RunLog {
@@ -260,6 +271,7 @@ impl RunLog {
             kept: RefCell::new(Trajectory::default()),
             last_step: Cell::new(None),
             metered: Cell::new(None),
+            accepted: Cell::new(0),
         }
     }
 
@@ -283,7 +295,8 @@ impl RunLog {
             fixed_step,
             watch,
             switch,
-            accepted: 0,
+            calls: 0,
+            accepted: &self.accepted,
             contact: ode.contact_switch(),
             meter: ode.contact_meter(),
             metered: &self.metered,
@@ -302,6 +315,7 @@ impl RunLog {
             last_step_s: self.last_step.get(),
             contact: self.metered.get(),
             interrupted: self.interrupted.get(),
+            accepted: self.accepted.get(),
         }
     }
 }

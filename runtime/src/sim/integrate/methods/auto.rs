@@ -44,9 +44,14 @@ impl Integrator for Auto {
         if let Some(r) = analyse_at(t0, &x0)
             && r.stiffness_ratio > STIFF_RATIO
         {
-            let (traj, stats) = Own(radau5::integrate).run(arm, t0, x0, &implicit_opts)?;
             let reason = format!("stiff from the start: {}", r.reason);
-            return Ok((traj, as_auto(stats, t0, reason)));
+            return match Own(radau5::integrate).run(arm, t0, x0, &implicit_opts) {
+                Ok((traj, stats)) => Ok((traj, as_auto(stats, t0, reason))),
+                Err(mut f) => {
+                    f.stats = as_auto(f.stats, t0, reason);
+                    Err(f)
+                }
+            };
         }
         let watch = |x: &[f64], h: f64| -> Option<String> {
             let r = analyse_at(0.0, x)?;
@@ -68,7 +73,12 @@ impl Integrator for Auto {
         let Some((t_switch, x_switch, reason)) = switch.take() else {
             return Ok((traj, stats));
         };
-        let (rest, more) = Own(radau5::integrate).run(arm, t_switch, x_switch, &implicit_opts)?;
+        let (rest, more, failed) =
+            match Own(radau5::integrate).run(arm, t_switch, x_switch, &implicit_opts) {
+                Ok((rest, more)) => (rest, more, None),
+                // The radau5 leg failed: the failure reports both legs.
+                Err(mut f) => (std::mem::take(&mut f.trajectory), f.stats.clone(), Some(f)),
+            };
         traj.events.extend(rest.events);
         for (t, x) in rest.t.into_iter().zip(rest.x) {
             if traj.t.last().is_none_or(|&last| t > last) {
@@ -79,6 +89,14 @@ impl Integrator for Auto {
         stats.absorb(&more);
         stats.switched = None;
         stats.constraints = None;
-        Ok((traj, as_auto(stats, t_switch, reason)))
+        let stats = as_auto(stats, t_switch, reason);
+        match failed {
+            None => Ok((traj, stats)),
+            Some(mut f) => {
+                f.trajectory = traj;
+                f.stats = stats;
+                Err(f)
+            }
+        }
     }
 }
