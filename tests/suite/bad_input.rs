@@ -143,6 +143,14 @@ fn assembly_cases() -> Vec<(&'static str, String, Vec<&'static str>)> {
             ],
         ),
         (
+            "a turning compliant base without rotary inertia",
+            r(
+                "base = { position = [0.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0] }",
+                "base = { position = [0.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0], mass = 1.0, stiffness = 5.0, rotational_stiffness = 2.0, inertia = 0.0 }",
+            ),
+            vec!["arm.left.base.inertia", "needs its rotary inertia"],
+        ),
+        (
             "an arm's own error under its name",
             r("length = 0.2", "length = -0.2"),
             vec!["arm.left.segment[0].length", "must be positive"],

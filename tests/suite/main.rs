@@ -25,6 +25,7 @@ mod linearize;
 mod long_arm;
 mod moving_base;
 mod output_dir;
+mod parsers;
 mod pcc;
 mod rom_slices;
 mod shape;

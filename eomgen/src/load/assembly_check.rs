@@ -273,6 +273,22 @@ fn compliant_base(ck: &Check, base: &Base, key: &str, axes: usize) -> Result<(),
     ] {
         ck.non_negative(&k(name), v.unwrap_or(0.0))?;
     }
+    // Its turn is a coordinate of its own: without rotary inertia the
+    // mass matrix may be singular (an arm adds little about its own axis).
+    if base.turns_compliantly() {
+        match base.inertia {
+            Some(i) if i > 0.0 => {}
+            _ => {
+                return ck.err(
+                    k("inertia"),
+                    format!(
+                        "a base that turns on its rotational spring needs its rotary inertia (kg m^2, positive), got {}",
+                        base.inertia.map_or("none".into(), |i| i.to_string())
+                    ),
+                );
+            }
+        }
+    }
     if base.translation_inputs.is_some() || base.rotation_inputs.is_some() {
         return ck.err(
             k("follow"),
