@@ -186,9 +186,14 @@ pub struct SimulateArgs {
     /// Output directory (default out/<model name>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// No progress bar (it shows on a terminal for runs over a second).
+    /// No progress report (a bar on a terminal for runs over a second,
+    /// else a line every ten seconds).
     #[arg(long)]
     pub quiet: bool,
+    /// Stop the run after this many seconds of wall time, with what it
+    /// computed written, as Ctrl-C does.
+    #[arg(long, value_name = "SECONDS")]
+    pub max_wall: Option<f64>,
     /// Points per element of shape.csv's centreline (0: no shape.csv).
     #[arg(long, default_value_t = softarm::shape::DEFAULT_POINTS)]
     pub shape_points: usize,
@@ -287,6 +292,13 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     let mut loaded = load(&a.model)?;
     let req = request(&a, &loaded)?;
     let mut opts = softarm::run::options(&req, &loaded.model.simulate)?;
+    let deadline = match a.max_wall {
+        Some(s) if s > 0.0 && s.is_finite() => {
+            Some(std::time::Instant::now() + std::time::Duration::from_secs_f64(s))
+        }
+        Some(s) => bail!("--max-wall must be a positive number of seconds, got {s}"),
+        None => None,
+    };
     let (x0, assembled_m) = softarm::run::initial_state(&req, &mut loaded)?;
     report_assembly(&loaded, assembled_m);
     // Checked before the run: a bad option writes nothing.
@@ -307,8 +319,9 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         .unwrap_or_else(|| PathBuf::from("out").join(&loaded.model.name));
     let mut dir = softarm::output_dir::OutputDir::claim(&out_dir)?;
 
-    // Ctrl-C or SIGTERM stops the run with what it computed written.
-    opts.interrupt = Some(softarm::interrupt::for_run());
+    // Ctrl-C, SIGTERM or --max-wall stops the run with what it computed
+    // written.
+    opts.interrupt = Some(softarm::interrupt::for_run(deadline));
     let progress = softarm::progress::Progress::start(&loaded.model.name, opts.t_end, a.quiet);
     opts.progress = progress.as_ref().map(|p| p.cell());
     let result = runtime::simulate(arm, x0.clone(), &opts);
@@ -346,24 +359,23 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         report_run(&loaded, &stats, &tip_error, &out_dir);
     }
     if let Some((msg, f)) = failure {
-        let stop = softarm::interrupt::requested().filter(|_| f["reason"] == runtime::INTERRUPTED);
+        let stopped = f["reason"] == runtime::INTERRUPTED;
+        let stop = softarm::interrupt::requested().filter(|_| stopped);
         // Said even when quiet: the folder holds an incomplete run.
-        match stop {
-            Some(s) => eprintln!(
+        if stopped {
+            eprintln!(
                 "{}: stopped by {} at t = {} s; the trajectory up to then is in {}",
                 loaded.model.name,
-                s.name(),
+                stop.map_or("--max-wall", |s| s.name()),
                 f["t_reached"],
                 out_dir.join("trajectory.csv").display()
-            ),
-            None if !a.quiet => {
-                eprintln!("error: {msg}");
-                eprintln!(
-                    "the trajectory up to then is in {}",
-                    out_dir.join("trajectory.csv").display()
-                );
-            }
-            None => {}
+            );
+        } else if !a.quiet {
+            eprintln!("error: {msg}");
+            eprintln!(
+                "the trajectory up to then is in {}",
+                out_dir.join("trajectory.csv").display()
+            );
         }
         return Ok(stop.map_or(ExitCode::FAILURE, |s| ExitCode::from(s.exit_code())));
     }

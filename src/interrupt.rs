@@ -4,6 +4,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};
+use std::time::Instant;
 
 use signal_hook::consts::{SIGINT, SIGTERM};
 
@@ -76,8 +77,10 @@ pub fn requested() -> Option<Stop> {
 }
 
 /// A run's check for a stop request (`SimOptions::interrupt`), with the
-/// signals caught.
-pub fn for_run() -> runtime::Interrupt {
+/// signals caught: a signal, or the wall clock past `deadline`.
+pub fn for_run(deadline: Option<Instant>) -> runtime::Interrupt {
     catch();
-    runtime::Interrupt(Arc::new(|| requested().is_some()))
+    runtime::Interrupt(Arc::new(move || {
+        requested().is_some() || deadline.is_some_and(|d| Instant::now() >= d)
+    }))
 }

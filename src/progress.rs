@@ -3,8 +3,10 @@
 //! (`runtime::SimOptions::progress`); a thread polls it, so the
 //! integration loop never waits on the terminal.
 //!
-//! Shown only when stderr is a terminal, not under `--quiet`, and only
-//! after the run has taken a second: short runs print nothing extra.
+//! On a terminal a bar, after the run has taken a second; elsewhere (a
+//! log file, a cluster job) a plain line every ten seconds, so that a long
+//! run is never silent. Nothing under `--quiet`, and short runs print
+//! nothing extra.
 
 use std::io::IsTerminal;
 use std::sync::Arc;
@@ -16,6 +18,8 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// How long a run goes before its bar appears.
 const SHOW_AFTER: Duration = Duration::from_secs(1);
+/// How often a run without a terminal says where it is.
+const LINE_EVERY: Duration = Duration::from_secs(10);
 /// The bar's resolution: t_end is this many ticks.
 const TICKS: u64 = 1000;
 
@@ -27,16 +31,19 @@ pub struct Progress {
 }
 
 impl Progress {
-    /// A display for a run from 0 to `t_end` (s), or None when stderr is
-    /// not a terminal or `quiet`.
+    /// A display for a run from 0 to `t_end` (s), or None when `quiet`.
     pub fn start(label: &str, t_end: f64, quiet: bool) -> Option<Self> {
-        if quiet || !std::io::stderr().is_terminal() || t_end.is_nan() || t_end <= 0.0 {
+        if quiet || t_end.is_nan() || t_end <= 0.0 {
             return None;
         }
         let reached = Arc::new(AtomicU64::new(0f64.to_bits()));
         let done = Arc::new(AtomicBool::new(false));
         let (r, d, label) = (reached.clone(), done.clone(), label.to_string());
-        let thread = std::thread::spawn(move || show(&label, t_end, &r, &d));
+        let terminal = std::io::stderr().is_terminal();
+        let thread = std::thread::spawn(move || match terminal {
+            true => show(&label, t_end, &r, &d),
+            false => lines(&label, t_end, &r, &d),
+        });
         Some(Self {
             reached,
             done,
@@ -96,4 +103,26 @@ fn show(label: &str, t_end: f64, reached: &AtomicU64, done: &AtomicBool) {
         std::thread::sleep(tick);
     }
     bar.finish_and_clear();
+}
+
+/// Without a terminal: a line every `LINE_EVERY`, polled ten times a second
+/// so that the run's end is not held up.
+fn lines(label: &str, t_end: f64, reached: &AtomicU64, done: &AtomicBool) {
+    let start = Instant::now();
+    let mut next = LINE_EVERY;
+    while !done.load(Ordering::Relaxed) {
+        std::thread::sleep(Duration::from_millis(100));
+        let wall = start.elapsed();
+        if wall < next {
+            continue;
+        }
+        next += LINE_EVERY;
+        let t = f64::from_bits(reached.load(Ordering::Relaxed)).clamp(0.0, t_end);
+        let w = wall.as_secs_f64();
+        eprintln!(
+            "{label}: t = {t:.3} of {t_end} s ({:.1} %), {w:.0} s wall, {:.3} simulated s per s",
+            100.0 * t / t_end,
+            t / w
+        );
+    }
 }

@@ -94,3 +94,57 @@ fn ctrl_c_stops_a_run_with_its_trajectory_written() {
 fn sigterm_stops_a_run_with_its_trajectory_written() {
     stopped_by(libc::SIGTERM, "SIGTERM", 143);
 }
+
+/// `--max-wall` stops a run as a signal does, after that much wall time.
+fn stopped_by_the_wall_clock(seconds: &str) -> (std::process::Output, serde_json::Value) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = softarm(
+        &[
+            "simulate",
+            "soft_finger",
+            "--t-end",
+            "1e6",
+            "--output-dt",
+            "0.1",
+            "--max-wall",
+            seconds,
+            "--out",
+            "o",
+        ],
+        dir.path(),
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("o/summary.json")).unwrap())
+            .unwrap();
+    (out, summary)
+}
+
+#[test]
+fn max_wall_stops_a_run_with_its_trajectory_written() {
+    let (out, summary) = stopped_by_the_wall_clock("1");
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("stopped by --max-wall"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(summary["status"], "interrupted");
+    let reached = summary["failure"]["t_reached"].as_f64().unwrap();
+    assert!(reached > 0.0 && reached < 1e6, "{reached}");
+    let dir = tempfile::tempdir().unwrap();
+    let bad = softarm(&["simulate", "chain", "--max-wall", "0"], dir.path());
+    assert!(stderr(&bad).contains("--max-wall must be a positive number"));
+}
+
+/// A run without a terminal says where it is every ten seconds.
+#[test]
+#[ignore = "runs 11 s: the long checks"]
+fn a_long_run_without_a_terminal_reports_its_progress_on_plain_lines() {
+    let (out, _) = stopped_by_the_wall_clock("11");
+    let err = stderr(&out);
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("soft_finger: t = ") && l.contains("of 1000000 s"))
+        .unwrap_or_else(|| panic!("no progress line in {err}"));
+    assert!(line.contains("s wall"), "{line}");
+}
