@@ -8,7 +8,8 @@
 //! Before any run the grid is counted (a big one needs `--yes`) and every
 //! varied value is checked as `--set` checks it, so a typo fails at once.
 //! A run that fails is a row with its failure; the sweep goes on, and
-//! exits non-zero at its end.
+//! exits non-zero at its end. Each run that ended writes its row into its
+//! folder, so that `--resume` redoes only the runs that did not.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -42,6 +43,10 @@ pub struct SweepArgs {
     /// Start a sweep of more than 10,000 runs.
     #[arg(long)]
     pub yes: bool,
+    /// Keep the runs of an earlier sweep into the same folder that ended
+    /// (ok or failed) with the same overrides; run the others.
+    #[arg(long)]
+    pub resume: bool,
     /// The figure sweep.png plots (a column of sweep.csv; default tip_y,
     /// or f1_hz for modes).
     #[arg(long)]
@@ -56,7 +61,10 @@ pub enum Study {
     Modes,
 }
 
-/// One run's row: its figures by name, or its failure.
+/// One run's row: its figures by name, or its failure. Written into the
+/// run's folder last (`ROW`), so that `--resume` finds the runs that
+/// ended, with the overrides they ran with.
+#[derive(serde::Serialize, serde::Deserialize)]
 struct Row {
     status: String,
     wall_s: f64,
@@ -172,11 +180,19 @@ fn run_one(a: &SweepArgs, varies: &[Vary], combo: &[usize], dir: &Path) -> Row {
     for (v, &i) in varies.iter().zip(combo) {
         model.set.push(format!("{}={}", v.path, v.values[i]));
     }
+    let key = format!("{:?} {:?}", a.run, model.set);
+    if a.resume
+        && let Some(row) = ended(dir, &key)
+    {
+        return row;
+    }
+    // A run redone is not ended until its row is written again.
+    let _ = std::fs::remove_file(dir.join(ROW));
     let result = std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create {}", dir.display()))
         .and_then(|()| study(a, model, dir));
     let wall_s = started.elapsed().as_secs_f64();
-    match result {
+    let row = match result {
         Ok((status, figures)) => Row {
             status,
             wall_s,
@@ -191,7 +207,26 @@ fn run_one(a: &SweepArgs, varies: &[Vary], combo: &[usize], dir: &Path) -> Row {
                 figures: Vec::new(),
             }
         }
+    };
+    // An interrupted run is not an ended one: `--resume` runs it again.
+    if !row.status.contains(runtime::INTERRUPTED) && softarm::interrupt::requested().is_none() {
+        let text = serde_json::json!({"run": key, "row": &row}).to_string();
+        let _ = eomgen::atomic_write::write_atomic(&dir.join(ROW), text.as_bytes());
     }
+    row
+}
+
+/// The row a run writes into its folder when it has ended.
+const ROW: &str = "sweep-row.json";
+
+/// The row of the run in `dir` if it ended with the same study and
+/// overrides (`key`).
+fn ended(dir: &Path, key: &str) -> Option<Row> {
+    let text = std::fs::read_to_string(dir.join(ROW)).ok()?;
+    let v: Value = serde_json::from_str(&text).ok()?;
+    (v["run"] == key)
+        .then(|| serde_json::from_value(v["row"].clone()).ok())
+        .flatten()
 }
 
 /// Run the study with `model`'s overrides; (status, figures).

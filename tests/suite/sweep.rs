@@ -213,3 +213,68 @@ fn a_grid_is_counted_before_it_is_made() {
         assert!(!dir.path().join("s").exists());
     }
 }
+
+#[test]
+fn a_resumed_sweep_redoes_only_the_runs_that_did_not_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = |resume: bool| {
+        let mut args = vec![
+            "sweep",
+            "cantilever",
+            "--run",
+            "static",
+            "--vary",
+            "tip.mass=0,0.01,0.02",
+            "--out",
+            "s",
+        ];
+        if resume {
+            args.push("--resume");
+        }
+        let out = softarm(&args, dir.path());
+        assert!(out.status.success(), "{}", stderr(&out));
+        // Every column but the wall times.
+        let rows = read_csv(&dir.path().join("s/sweep.csv"));
+        let wall = rows[0].iter().position(|h| h == "wall_s").unwrap();
+        rows.into_iter()
+            .map(|mut r| {
+                r.remove(wall);
+                r
+            })
+            .collect::<Vec<_>>()
+    };
+    let whole = sweep(false);
+    let run = |i: usize, f: &str| dir.path().join(format!("s/run_{i:04}/{f}"));
+    // Run 1 as if stopped before it ended; run 0's result marked.
+    std::fs::remove_file(run(1, "sweep-row.json")).unwrap();
+    std::fs::remove_file(run(1, "static.json")).unwrap();
+    std::fs::write(run(0, "static.json"), "kept").unwrap();
+    let resumed = sweep(true);
+    assert_eq!(resumed, whole, "the same sweep.csv");
+    assert_eq!(
+        std::fs::read_to_string(run(0, "static.json")).unwrap(),
+        "kept"
+    );
+    assert!(run(1, "static.json").exists(), "run 1 redone");
+    // A sweep with other overrides in the folder runs everything again.
+    let again = softarm(
+        &[
+            "sweep",
+            "cantilever",
+            "--run",
+            "static",
+            "--set",
+            "gravity=[0,-1,0]",
+        ]
+        .iter()
+        .chain(&["--vary", "tip.mass=0,0.01,0.02", "--out", "s", "--resume"])
+        .copied()
+        .collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert!(again.status.success(), "{}", stderr(&again));
+    assert_ne!(
+        std::fs::read_to_string(run(0, "static.json")).unwrap(),
+        "kept"
+    );
+}
