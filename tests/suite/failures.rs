@@ -182,3 +182,26 @@ fn options_are_checked_against_each_other_before_anything_is_written() {
         assert!(!dir.path().join("o").exists(), "{args:?}: nothing written");
     }
 }
+
+#[test]
+fn a_run_that_cannot_start_says_why_in_its_own_terms() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = softarm(
+        &[
+            "simulate",
+            "double_pendulum",
+            "--qd0",
+            "1e150,1e150",
+            "--t-end",
+            "0.1",
+            "--out",
+            "o",
+        ],
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("the integrator could not start"), "{err}");
+    assert!(err.contains("check --q0 and --qd0"), "{err}");
+    assert!(!err.contains("Bad input"), "{err}");
+}

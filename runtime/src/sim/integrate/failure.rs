@@ -145,11 +145,26 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
                     explain("the method detected stiffness".into()),
                     "use an implicit solver: --solver radau5, bdf or esdirk".to_string(),
                 ),
+                // The ODE crate's own words, said as what they mean here.
+                Error::BadInput { msg } => (
+                    0.0,
+                    x0.to_vec(),
+                    explain(format!("the integrator could not start ({msg})")),
+                    start_hint(x0),
+                ),
+                Error::LinearAlgebra { t, y, msg } => (
+                    t,
+                    unpad(&y),
+                    explain(format!("a linear solve failed ({msg})")),
+                    "the arm may be singular here (a massless part, a locked joint): check the \
+                     model's masses and inertias"
+                        .to_string(),
+                ),
                 other => (
                     0.0,
                     x0.to_vec(),
-                    explain(format!("{other:?}")),
-                    "check the model and the solver options".to_string(),
+                    explain(format!("the integrator stopped ({other:?})")),
+                    start_hint(x0),
                 ),
             };
             // The last accepted state is what the run computed last: kept
@@ -170,5 +185,18 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
                 stats: stats_of(accepted, 0),
             }))
         }
+    }
+}
+
+/// What to check when a run cannot start: a state far out of scale, or
+/// the step options against the run.
+fn start_hint(x0: &[f64]) -> String {
+    let largest = x0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if !largest.is_finite() || largest > 1e6 {
+        format!(
+            "the initial state holds {largest:e}: check --q0 and --qd0 (or the model's [simulate] q0)"
+        )
+    } else {
+        "check --dt, --rtol and --atol against --t-end".to_string()
     }
 }
