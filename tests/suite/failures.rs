@@ -110,6 +110,18 @@ fn an_impossible_step_budget_is_explained_for_every_adaptive_solver() {
         // The steps are counted up to the failure, not reported as none.
         let steps = summary["steps"].as_u64().unwrap();
         assert!(steps > 0 && steps <= 200, "{solver}: {steps} steps");
+        let rejected = summary["rejected_steps"].as_u64().unwrap();
+        assert_eq!(steps + rejected, 200, "{solver}: the budget counts both");
+        if solver == "dopri5" {
+            // Counted independently: seven right-hand sides a step tried
+            // (accepted or not), and the initial step's estimate.
+            let rhs = summary["rhs_evaluations"].as_u64().unwrap();
+            let tried = steps + rejected;
+            assert!(
+                (7 * tried..=7 * tried + 4).contains(&rhs),
+                "{rhs} rhs, {tried} steps"
+            );
+        }
     }
 }
 

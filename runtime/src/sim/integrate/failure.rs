@@ -114,6 +114,7 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
             Ok((traj, stats))
         }
         Err(e) => {
+            let budget_spent = matches!(e, Error::MaxSteps { .. });
             let (t_reached, state, reason, suggestion) = match e {
                 Error::StepSize { t, y } => (
                     t,
@@ -174,7 +175,12 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
                 trajectory.t.push(t_reached);
                 trajectory.x.push(state.clone());
             }
-            // The method's count of rejected steps dies with its error.
+            // The method's count of rejected steps dies with its error, but
+            // a spent budget counts both kinds (ours and the crate's).
+            let rejected = match budget_spent {
+                true => opts.max_steps.saturating_sub(accepted),
+                false => 0,
+            };
             Err(Box::new(SimFailure {
                 t_reached,
                 last_step_s,
@@ -182,7 +188,7 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
                 suggestion,
                 state,
                 trajectory,
-                stats: stats_of(accepted, 0),
+                stats: stats_of(accepted, rejected),
             }))
         }
     }
