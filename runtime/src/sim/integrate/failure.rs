@@ -115,59 +115,8 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
         }
         Err(e) => {
             let budget_spent = matches!(e, Error::MaxSteps { .. });
-            let (t_reached, state, reason, suggestion) = match e {
-                Error::StepSize { t, y } => (
-                    t,
-                    unpad(&y),
-                    explain("the step size fell below the smallest allowed step".into()),
-                    if opts.solver.implicit() {
-                        "relax --rtol/--atol, or reduce the element count".to_string()
-                    } else {
-                        "the arm may be stiff: try --solver radau5 or bdf, relax --rtol/--atol, \
-                         or reduce the element count"
-                            .to_string()
-                    },
-                ),
-                Error::MaxSteps { t, y } => (
-                    t,
-                    unpad(&y),
-                    format!("the step budget of {} steps ran out", opts.max_steps),
-                    if opts.solver.implicit() {
-                        "raise --max-steps, shorten --t-end or relax --rtol/--atol".to_string()
-                    } else {
-                        "raise --max-steps, shorten --t-end, relax --rtol/--atol, or use an \
-                         implicit solver (radau5) if the arm is stiff"
-                            .to_string()
-                    },
-                ),
-                Error::Stiffness { t, y } => (
-                    t,
-                    unpad(&y),
-                    explain("the method detected stiffness".into()),
-                    "use an implicit solver: --solver radau5, bdf or esdirk".to_string(),
-                ),
-                // The ODE crate's own words, said as what they mean here.
-                Error::BadInput { msg } => (
-                    0.0,
-                    x0.to_vec(),
-                    explain(format!("the integrator could not start ({msg})")),
-                    start_hint(x0),
-                ),
-                Error::LinearAlgebra { t, y, msg } => (
-                    t,
-                    unpad(&y),
-                    explain(format!("a linear solve failed ({msg})")),
-                    "the arm may be singular here (a massless part, a locked joint): check the \
-                     model's masses and inertias"
-                        .to_string(),
-                ),
-                other => (
-                    0.0,
-                    x0.to_vec(),
-                    explain(format!("the integrator stopped ({other:?})")),
-                    start_hint(x0),
-                ),
-            };
+            let (t_reached, state, reason, suggestion) =
+                why(e, opts, x0, &explain, |y: &Y| unpad(y));
             // The last accepted state is what the run computed last: kept
             // beside the samples, which a long output step may not reach.
             let mut trajectory = kept;
@@ -191,6 +140,69 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
                 stats: stats_of(accepted, rejected),
             }))
         }
+    }
+}
+
+/// An error of the ODE crate as when, where, why and what to try.
+fn why<Y: StateVec>(
+    e: Error<f64, Y>,
+    opts: &SimOptions,
+    x0: &[f64],
+    explain: &dyn Fn(String) -> String,
+    unpad: impl Fn(&Y) -> Vec<f64>,
+) -> (f64, Vec<f64>, String, String) {
+    match e {
+        Error::StepSize { t, y } => (
+            t,
+            unpad(&y),
+            explain("the step size fell below the smallest allowed step".into()),
+            if opts.solver.implicit() {
+                "relax --rtol/--atol, or reduce the element count".to_string()
+            } else {
+                "the arm may be stiff: try --solver radau5 or bdf, relax --rtol/--atol, \
+                 or reduce the element count"
+                    .to_string()
+            },
+        ),
+        Error::MaxSteps { t, y } => (
+            t,
+            unpad(&y),
+            format!("the step budget of {} steps ran out", opts.max_steps),
+            if opts.solver.implicit() {
+                "raise --max-steps, shorten --t-end or relax --rtol/--atol".to_string()
+            } else {
+                "raise --max-steps, shorten --t-end, relax --rtol/--atol, or use an \
+                 implicit solver (radau5) if the arm is stiff"
+                    .to_string()
+            },
+        ),
+        Error::Stiffness { t, y } => (
+            t,
+            unpad(&y),
+            explain("the method detected stiffness".into()),
+            "use an implicit solver: --solver radau5, bdf or esdirk".to_string(),
+        ),
+        // The ODE crate's own words, said as what they mean here.
+        Error::BadInput { msg } => (
+            0.0,
+            x0.to_vec(),
+            explain(format!("the integrator could not start ({msg})")),
+            start_hint(x0),
+        ),
+        Error::LinearAlgebra { t, y, msg } => (
+            t,
+            unpad(&y),
+            explain(format!("a linear solve failed ({msg})")),
+            "the arm may be singular here (a massless part, a locked joint): check the \
+             model's masses and inertias"
+                .to_string(),
+        ),
+        other => (
+            0.0,
+            x0.to_vec(),
+            explain(format!("the integrator stopped ({other:?})")),
+            start_hint(x0),
+        ),
     }
 }
 
