@@ -3,8 +3,7 @@
 //! exit code; and that trajectory is the uninterrupted run's over the same
 //! span.
 
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use crate::common::*;
 
@@ -20,23 +19,9 @@ fn rows(path: &std::path::Path) -> Vec<Vec<f64>> {
 #[cfg(unix)]
 fn stopped_by(signal: i32, name: &str, code: i32) {
     let dir = tempfile::tempdir().unwrap();
-    let args = ["simulate", "soft_finger", "--output-dt", "0.01", "--quiet"];
-    let run = Command::new(env!("CARGO_BIN_EXE_softarm"))
-        .args(args)
-        .args(["--t-end", "1e6", "--out", "o"])
-        .current_dir(dir.path())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
     // Once the run holds its folder it is integrating; let it go on a
     // little (how far does not matter: any time reached is checked).
-    let held = dir.path().join("o/.softarm-files");
-    let start = Instant::now();
-    while !held.exists() && start.elapsed() < Duration::from_secs(120) {
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    assert!(held.exists(), "the run never started");
+    let run = long_run(dir.path(), &["--output-dt", "0.01"]);
     std::thread::sleep(Duration::from_millis(500));
     // SAFETY: a plain kill(2) of the child this test started.
     assert_eq!(unsafe { libc::kill(run.id() as i32, signal) }, 0);
@@ -60,7 +45,11 @@ fn stopped_by(signal: i32, name: &str, code: i32) {
     }
     let t_end = format!("{reached}");
     let whole = softarm(
-        &[&args[..], &["--t-end", &t_end, "--out", "p"]].concat(),
+        &["simulate", "soft_finger", "--output-dt", "0.01", "--quiet"]
+            .iter()
+            .chain(&["--t-end", t_end.as_str(), "--out", "p"])
+            .copied()
+            .collect::<Vec<_>>(),
         dir.path(),
     );
     assert!(whole.status.success(), "{}", stderr(&whole));

@@ -3,8 +3,6 @@
 //! at once, and no name in a model file reaches outside the folder.
 
 use std::path::Path;
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
 
 use crate::common::*;
 
@@ -74,21 +72,7 @@ fn two_runs_never_write_into_one_folder_at_once() {
     let dir = tempfile::tempdir().unwrap();
     // A run long enough to be caught writing: it holds the folder until
     // it is killed.
-    let mut first = Command::new(env!("CARGO_BIN_EXE_softarm"))
-        .args(["simulate", "soft_finger", "--t-end", "1e6", "--out", "o"])
-        .args(["--quiet"])
-        .current_dir(dir.path())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    // The folder is held once its list of files is started.
-    let held = dir.path().join("o/.softarm-files");
-    let start = Instant::now();
-    while !held.exists() && start.elapsed() < Duration::from_secs(120) {
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    assert!(held.exists(), "the first run never claimed its folder");
+    let mut first = long_run(dir.path(), &[]);
     let second = softarm(&["simulate", "chain", "--out", "o", "--quiet"], dir.path());
     first.kill().unwrap();
     first.wait().unwrap();

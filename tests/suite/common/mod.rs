@@ -71,6 +71,35 @@ pub fn softarm(args: &[&str], cwd: &Path) -> Output {
         .expect("the softarm binary runs")
 }
 
+/// A run of soft_finger for 1e6 s into `cwd/o` (with `args` besides),
+/// started in the background and returned once it holds its folder (its
+/// list of files begun): it is integrating, and runs until it is stopped.
+pub fn long_run(cwd: &Path, args: &[&str]) -> std::process::Child {
+    let run = Command::new(env!("CARGO_BIN_EXE_softarm"))
+        .args([
+            "simulate",
+            "soft_finger",
+            "--t-end",
+            "1e6",
+            "--out",
+            "o",
+            "--quiet",
+        ])
+        .args(args)
+        .current_dir(cwd)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the softarm binary runs");
+    let held = cwd.join("o/.softarm-files");
+    let start = std::time::Instant::now();
+    while !held.exists() && start.elapsed() < std::time::Duration::from_secs(120) {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert!(held.exists(), "the run never claimed its folder");
+    run
+}
+
 pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
