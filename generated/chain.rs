@@ -222,7 +222,7 @@ impl Kernels for Compiled {
         }
     }
 }
-/// Kernel `accel`: 1085 operations in 1 chunk(s).
+/// Kernel `accel`: the first 44 values of `eom` (1085 operations for all).
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
@@ -235,12 +235,11 @@ pub fn accel(
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
-    unsafe { accel_0(t, q, qd, qdd, dir, p, w, out) };
+    unsafe { accel_fma(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn accel_0(
+fn accel_fma(
     t: f64,
     q: &[f64; 8usize],
     qd: &[f64; 8usize],
@@ -249,6 +248,52 @@ fn accel_0(
     p: &[f64; 96usize],
     w: &mut [f64; 0usize],
     out: &mut [f64; 44usize],
+) {
+    let mut unused = [0.0f64; 44usize];
+    eom_0(t, q, qd, qdd, dir, p, w, out, &mut unused);
+}
+/// Kernel `mass_bias`: the last 44 values of `eom` (1085 operations for all).
+#[allow(unused_unsafe)]
+pub fn mass_bias(
+    t: f64,
+    q: &[f64; 8usize],
+    qd: &[f64; 8usize],
+    qdd: &[f64; 8usize],
+    dir: &[f64; 16usize],
+    p: &[f64; 96usize],
+    out: &mut [f64; 44usize],
+) {
+    runtime::cpu::require_fma();
+    let w = &mut [0.0f64; 0];
+    unsafe { mass_bias_fma(t, q, qd, qdd, dir, p, w, out) };
+}
+#[inline(never)]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+fn mass_bias_fma(
+    t: f64,
+    q: &[f64; 8usize],
+    qd: &[f64; 8usize],
+    qdd: &[f64; 8usize],
+    dir: &[f64; 16usize],
+    p: &[f64; 96usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 44usize],
+) {
+    let mut unused = [0.0f64; 44usize];
+    eom_0(t, q, qd, qdd, dir, p, w, &mut unused, out);
+}
+#[inline(always)]
+#[allow(unused_variables, clippy::all)]
+fn eom_0(
+    t: f64,
+    q: &[f64; 8usize],
+    qd: &[f64; 8usize],
+    qdd: &[f64; 8usize],
+    dir: &[f64; 16usize],
+    p: &[f64; 96usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 44usize],
+    out2: &mut [f64; 44usize],
 ) {
     let v13: f64 = p[6usize] + q[0usize];
     let (v60, v14): (f64, f64) = runtime::special::sin_cos(v13);
@@ -990,562 +1035,50 @@ fn accel_0(
     out[41usize] = v521;
     out[42usize] = v522;
     out[43usize] = v513;
-}
-/// Kernel `mass_bias`: 753 operations in 1 chunk(s).
-#[allow(unused_unsafe)]
-pub fn mass_bias(
-    t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    out: &mut [f64; 44usize],
-) {
-    runtime::cpu::require_fma();
-    let w = &mut [0.0f64; 0];
-    unsafe { mass_bias_0(t, q, qd, qdd, dir, p, w, out) };
-}
-#[inline(never)]
-#[allow(unused_variables, clippy::all)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn mass_bias_0(
-    t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 44usize],
-) {
-    let v13: f64 = p[6usize] + q[0usize];
-    let (v60, v14): (f64, f64) = runtime::special::sin_cos(v13);
-    let v15: f64 = p[7usize] * v14;
-    let v16: f64 = p[3usize] + v15;
-    let v19: f64 = q[1usize] + v13;
-    let (v63, v20): (f64, f64) = runtime::special::sin_cos(v19);
-    let v21: f64 = p[13usize] * v20;
-    let v22: f64 = v16 + v21;
-    let v25: f64 = q[2usize] + v19;
-    let (v66, v26): (f64, f64) = runtime::special::sin_cos(v25);
-    let v27: f64 = p[19usize] * v26;
-    let v28: f64 = v22 + v27;
-    let v31: f64 = q[3usize] + v25;
-    let (v69, v32): (f64, f64) = runtime::special::sin_cos(v31);
-    let v33: f64 = p[25usize] * v32;
-    let v34: f64 = v28 + v33;
-    let v37: f64 = q[4usize] + v31;
-    let (v72, v38): (f64, f64) = runtime::special::sin_cos(v37);
-    let v39: f64 = p[31usize] * v38;
-    let v40: f64 = v34 + v39;
-    let v43: f64 = q[5usize] + v37;
-    let (v75, v44): (f64, f64) = runtime::special::sin_cos(v43);
-    let v45: f64 = p[37usize] * v44;
-    let v46: f64 = v40 + v45;
-    let v49: f64 = q[6usize] + v43;
-    let (v78, v50): (f64, f64) = runtime::special::sin_cos(v49);
-    let v51: f64 = p[43usize] * v50;
-    let v52: f64 = v46 + v51;
-    let v55: f64 = q[7usize] + v49;
-    let (v81, v56): (f64, f64) = runtime::special::sin_cos(v55);
-    let v57: f64 = p[55usize] * v56;
-    let v58: f64 = v52 + v57;
-    let v61: f64 = p[7usize] * v60;
-    let v62: f64 = p[4usize] + v61;
-    let v64: f64 = p[13usize] * v63;
-    let v65: f64 = v62 + v64;
-    let v67: f64 = p[19usize] * v66;
-    let v68: f64 = v65 + v67;
-    let v70: f64 = p[25usize] * v69;
-    let v71: f64 = v68 + v70;
-    let v73: f64 = p[31usize] * v72;
-    let v74: f64 = v71 + v73;
-    let v76: f64 = p[37usize] * v75;
-    let v77: f64 = v74 + v76;
-    let v79: f64 = p[43usize] * v78;
-    let v80: f64 = v77 + v79;
-    let v82: f64 = p[55usize] * v81;
-    let v83: f64 = v80 + v82;
-    let v84: f64 = v83 * v83;
-    let v85: f64 = v58.mul_add(v58, v84);
-    let v86: f64 = p[50usize].mul_add(v85, p[51usize]);
-    let v89: f64 = p[56usize] * v50;
-    let v90: f64 = v46 + v89;
-    let v91: f64 = p[56usize] * v78;
-    let v92: f64 = v77 + v91;
-    let v93: f64 = v92 * v92;
-    let v94: f64 = v90.mul_add(v90, v93);
-    let v95: f64 = p[45usize] + v86;
-    let v96: f64 = p[44usize].mul_add(v94, v95);
-    let v99: f64 = p[57usize] * v44;
-    let v100: f64 = v40 + v99;
-    let v101: f64 = p[57usize] * v75;
-    let v102: f64 = v74 + v101;
-    let v103: f64 = v102 * v102;
-    let v104: f64 = v100.mul_add(v100, v103);
-    let v105: f64 = p[39usize] + v96;
-    let v106: f64 = p[38usize].mul_add(v104, v105);
-    let v109: f64 = p[58usize] * v38;
-    let v110: f64 = v34 + v109;
-    let v111: f64 = p[58usize] * v72;
-    let v112: f64 = v71 + v111;
-    let v113: f64 = v112 * v112;
-    let v114: f64 = v110.mul_add(v110, v113);
-    let v115: f64 = p[33usize] + v106;
-    let v116: f64 = p[32usize].mul_add(v114, v115);
-    let v119: f64 = p[59usize] * v32;
-    let v120: f64 = v28 + v119;
-    let v121: f64 = p[59usize] * v69;
-    let v122: f64 = v68 + v121;
-    let v123: f64 = v122 * v122;
-    let v124: f64 = v120.mul_add(v120, v123);
-    let v125: f64 = p[27usize] + v116;
-    let v126: f64 = p[26usize].mul_add(v124, v125);
-    let v129: f64 = p[60usize] * v26;
-    let v130: f64 = v22 + v129;
-    let v131: f64 = p[60usize] * v66;
-    let v132: f64 = v65 + v131;
-    let v133: f64 = v132 * v132;
-    let v134: f64 = v130.mul_add(v130, v133);
-    let v135: f64 = p[21usize] + v126;
-    let v136: f64 = p[20usize].mul_add(v134, v135);
-    let v139: f64 = p[61usize] * v20;
-    let v140: f64 = v16 + v139;
-    let v141: f64 = p[61usize] * v63;
-    let v142: f64 = v62 + v141;
-    let v143: f64 = v142 * v142;
-    let v144: f64 = v140.mul_add(v140, v143);
-    let v145: f64 = p[15usize] + v136;
-    let v146: f64 = p[14usize].mul_add(v144, v145);
-    let v149: f64 = p[62usize] * v14;
-    let v151: f64 = p[63usize] * v60;
-    let v152: f64 = v151 * v151;
-    let v153: f64 = v149.mul_add(v149, v152);
-    let v154: f64 = -v61;
-    let v155: f64 = v62 + v154;
-    let v156: f64 = p[50usize] * v83;
-    let v157: f64 = p[44usize].mul_add(v92, v156);
-    let v158: f64 = p[38usize].mul_add(v102, v157);
-    let v159: f64 = p[32usize].mul_add(v112, v158);
-    let v160: f64 = p[26usize].mul_add(v122, v159);
-    let v161: f64 = p[20usize].mul_add(v132, v160);
-    let v162: f64 = p[14usize].mul_add(v142, v161);
-    let v164: f64 = 2f64 * v162;
-    let v166: f64 = v155.mul_add(p[64usize], -v164);
-    let v167: f64 = v15 - v16;
-    let v168: f64 = p[50usize] * v58;
-    let v169: f64 = p[44usize].mul_add(v90, v168);
-    let v170: f64 = p[38usize].mul_add(v100, v169);
-    let v171: f64 = p[32usize].mul_add(v110, v170);
-    let v172: f64 = p[26usize].mul_add(v120, v171);
-    let v173: f64 = p[20usize].mul_add(v130, v172);
-    let v174: f64 = p[14usize].mul_add(v140, v173);
-    let v175: f64 = v167 * p[64usize];
-    let v176: f64 = 2f64.mul_add(v174, v175);
-    let v177: f64 = p[9usize] + v146;
-    let v178: f64 = p[8usize].mul_add(v153, v177);
-    let v179: f64 = v155.mul_add(v166, v178);
-    let v180: f64 = v167.mul_add(v176, v179);
-    let v181: f64 = v21 - v22;
-    let v182: f64 = -v64;
-    let v183: f64 = v65 + v182;
-    let v185: f64 = p[65usize] * v63;
-    let v186: f64 = v142 * v185;
-    let v187: f64 = v140.mul_add(v139, -v186);
-    let v188: f64 = v181.mul_add(v173, v145);
-    let v189: f64 = (-v183).mul_add(v161, v188);
-    let v190: f64 = p[14usize].mul_add(v187, v189);
-    let v192: f64 = v183 * p[66usize];
-    let v193: f64 = v192 - v161;
-    let v194: f64 = p[14usize].mul_add(v185, v193);
-    let v195: f64 = v181 * p[66usize];
-    let v196: f64 = v173 + v195;
-    let v197: f64 = p[14usize].mul_add(v139, v196);
-    let v198: f64 = v155.mul_add(v194, v190);
-    let v199: f64 = v167.mul_add(v197, v198);
-    let v200: f64 = v27 - v28;
-    let v201: f64 = -v67;
-    let v202: f64 = v68 + v201;
-    let v204: f64 = p[67usize] * v66;
-    let v205: f64 = v132 * v204;
-    let v206: f64 = v130.mul_add(v129, -v205);
-    let v207: f64 = v200.mul_add(v172, v135);
-    let v208: f64 = (-v202).mul_add(v160, v207);
-    let v209: f64 = p[20usize].mul_add(v206, v208);
-    let v211: f64 = v202 * p[68usize];
-    let v212: f64 = v211 - v160;
-    let v213: f64 = p[20usize].mul_add(v204, v212);
-    let v214: f64 = v200 * p[68usize];
-    let v215: f64 = v172 + v214;
-    let v216: f64 = p[20usize].mul_add(v129, v215);
-    let v217: f64 = v155.mul_add(v213, v209);
-    let v218: f64 = v167.mul_add(v216, v217);
-    let v219: f64 = v33 - v34;
-    let v220: f64 = -v70;
-    let v221: f64 = v71 + v220;
-    let v223: f64 = p[69usize] * v69;
-    let v224: f64 = v122 * v223;
-    let v225: f64 = v120.mul_add(v119, -v224);
-    let v226: f64 = v219.mul_add(v171, v125);
-    let v227: f64 = (-v221).mul_add(v159, v226);
-    let v228: f64 = p[26usize].mul_add(v225, v227);
-    let v230: f64 = v221 * p[70usize];
-    let v231: f64 = v230 - v159;
-    let v232: f64 = p[26usize].mul_add(v223, v231);
-    let v233: f64 = v219 * p[70usize];
-    let v234: f64 = v171 + v233;
-    let v235: f64 = p[26usize].mul_add(v119, v234);
-    let v236: f64 = v155.mul_add(v232, v228);
-    let v237: f64 = v167.mul_add(v235, v236);
-    let v238: f64 = v39 - v40;
-    let v239: f64 = -v73;
-    let v240: f64 = v74 + v239;
-    let v242: f64 = p[71usize] * v72;
-    let v243: f64 = v112 * v242;
-    let v244: f64 = v110.mul_add(v109, -v243);
-    let v245: f64 = v238.mul_add(v170, v115);
-    let v246: f64 = (-v240).mul_add(v158, v245);
-    let v247: f64 = p[32usize].mul_add(v244, v246);
-    let v249: f64 = v240 * p[72usize];
-    let v250: f64 = v249 - v158;
-    let v251: f64 = p[32usize].mul_add(v242, v250);
-    let v252: f64 = v238 * p[72usize];
-    let v253: f64 = v170 + v252;
-    let v254: f64 = p[32usize].mul_add(v109, v253);
-    let v255: f64 = v155.mul_add(v251, v247);
-    let v256: f64 = v167.mul_add(v254, v255);
-    let v257: f64 = v45 - v46;
-    let v258: f64 = -v76;
-    let v259: f64 = v77 + v258;
-    let v261: f64 = p[73usize] * v75;
-    let v262: f64 = v102 * v261;
-    let v263: f64 = v100.mul_add(v99, -v262);
-    let v264: f64 = v257.mul_add(v169, v105);
-    let v265: f64 = (-v259).mul_add(v157, v264);
-    let v266: f64 = p[38usize].mul_add(v263, v265);
-    let v268: f64 = v259 * p[74usize];
-    let v269: f64 = v268 - v157;
-    let v270: f64 = p[38usize].mul_add(v261, v269);
-    let v271: f64 = v257 * p[74usize];
-    let v272: f64 = v169 + v271;
-    let v273: f64 = p[38usize].mul_add(v99, v272);
-    let v274: f64 = v155.mul_add(v270, v266);
-    let v275: f64 = v167.mul_add(v273, v274);
-    let v276: f64 = v51 - v52;
-    let v277: f64 = -v79;
-    let v278: f64 = v80 + v277;
-    let v280: f64 = p[75usize] * v78;
-    let v281: f64 = v92 * v280;
-    let v282: f64 = v90.mul_add(v89, -v281);
-    let v283: f64 = v276.mul_add(v168, v95);
-    let v284: f64 = (-v278).mul_add(v156, v283);
-    let v285: f64 = p[44usize].mul_add(v282, v284);
-    let v286: f64 = p[50usize] * v278;
-    let v287: f64 = v286 - v156;
-    let v288: f64 = p[44usize].mul_add(v280, v287);
-    let v289: f64 = p[50usize] * v276;
-    let v290: f64 = v168 + v289;
-    let v291: f64 = p[44usize].mul_add(v89, v290);
-    let v292: f64 = v155.mul_add(v288, v285);
-    let v293: f64 = v167.mul_add(v291, v292);
-    let v295: f64 = p[76usize] * v81;
-    let v296: f64 = v83 * v295;
-    let v297: f64 = v58.mul_add(v57, -v296);
-    let v298: f64 = p[50usize].mul_add(v297, p[51usize]);
-    let v299: f64 = p[50usize] * v295;
-    let v300: f64 = p[50usize] * v57;
-    let v301: f64 = v155.mul_add(v299, v298);
-    let v302: f64 = v167.mul_add(v300, v301);
-    let v303: f64 = v139 * v139;
-    let v304: f64 = v185.mul_add(v185, v303);
-    let v305: f64 = (-2f64).mul_add(v161, v192);
-    let v306: f64 = 2f64.mul_add(v173, v195);
-    let v307: f64 = p[14usize].mul_add(v304, v145);
-    let v308: f64 = v183.mul_add(v305, v307);
-    let v309: f64 = v181.mul_add(v306, v308);
-    let v310: f64 = v183.mul_add(v213, v209);
-    let v311: f64 = v181.mul_add(v216, v310);
-    let v312: f64 = v183.mul_add(v232, v228);
-    let v313: f64 = v181.mul_add(v235, v312);
-    let v314: f64 = v183.mul_add(v251, v247);
-    let v315: f64 = v181.mul_add(v254, v314);
-    let v316: f64 = v183.mul_add(v270, v266);
-    let v317: f64 = v181.mul_add(v273, v316);
-    let v318: f64 = v183.mul_add(v288, v285);
-    let v319: f64 = v181.mul_add(v291, v318);
-    let v320: f64 = v183.mul_add(v299, v298);
-    let v321: f64 = v181.mul_add(v300, v320);
-    let v322: f64 = v129 * v129;
-    let v323: f64 = v204.mul_add(v204, v322);
-    let v324: f64 = (-2f64).mul_add(v160, v211);
-    let v325: f64 = 2f64.mul_add(v172, v214);
-    let v326: f64 = p[20usize].mul_add(v323, v135);
-    let v327: f64 = v202.mul_add(v324, v326);
-    let v328: f64 = v200.mul_add(v325, v327);
-    let v329: f64 = v202.mul_add(v232, v228);
-    let v330: f64 = v200.mul_add(v235, v329);
-    let v331: f64 = v202.mul_add(v251, v247);
-    let v332: f64 = v200.mul_add(v254, v331);
-    let v333: f64 = v202.mul_add(v270, v266);
-    let v334: f64 = v200.mul_add(v273, v333);
-    let v335: f64 = v202.mul_add(v288, v285);
-    let v336: f64 = v200.mul_add(v291, v335);
-    let v337: f64 = v202.mul_add(v299, v298);
-    let v338: f64 = v200.mul_add(v300, v337);
-    let v339: f64 = v119 * v119;
-    let v340: f64 = v223.mul_add(v223, v339);
-    let v341: f64 = (-2f64).mul_add(v159, v230);
-    let v342: f64 = 2f64.mul_add(v171, v233);
-    let v343: f64 = p[26usize].mul_add(v340, v125);
-    let v344: f64 = v221.mul_add(v341, v343);
-    let v345: f64 = v219.mul_add(v342, v344);
-    let v346: f64 = v221.mul_add(v251, v247);
-    let v347: f64 = v219.mul_add(v254, v346);
-    let v348: f64 = v221.mul_add(v270, v266);
-    let v349: f64 = v219.mul_add(v273, v348);
-    let v350: f64 = v221.mul_add(v288, v285);
-    let v351: f64 = v219.mul_add(v291, v350);
-    let v352: f64 = v221.mul_add(v299, v298);
-    let v353: f64 = v219.mul_add(v300, v352);
-    let v354: f64 = v109 * v109;
-    let v355: f64 = v242.mul_add(v242, v354);
-    let v356: f64 = (-2f64).mul_add(v158, v249);
-    let v357: f64 = 2f64.mul_add(v170, v252);
-    let v358: f64 = p[32usize].mul_add(v355, v115);
-    let v359: f64 = v240.mul_add(v356, v358);
-    let v360: f64 = v238.mul_add(v357, v359);
-    let v361: f64 = v240.mul_add(v270, v266);
-    let v362: f64 = v238.mul_add(v273, v361);
-    let v363: f64 = v240.mul_add(v288, v285);
-    let v364: f64 = v238.mul_add(v291, v363);
-    let v365: f64 = v240.mul_add(v299, v298);
-    let v366: f64 = v238.mul_add(v300, v365);
-    let v367: f64 = v99 * v99;
-    let v368: f64 = v261.mul_add(v261, v367);
-    let v369: f64 = (-2f64).mul_add(v157, v268);
-    let v370: f64 = 2f64.mul_add(v169, v271);
-    let v371: f64 = p[38usize].mul_add(v368, v105);
-    let v372: f64 = v259.mul_add(v369, v371);
-    let v373: f64 = v257.mul_add(v370, v372);
-    let v374: f64 = v259.mul_add(v288, v285);
-    let v375: f64 = v257.mul_add(v291, v374);
-    let v376: f64 = v259.mul_add(v299, v298);
-    let v377: f64 = v257.mul_add(v300, v376);
-    let v378: f64 = v89 * v89;
-    let v379: f64 = v280.mul_add(v280, v378);
-    let v380: f64 = (-2f64).mul_add(v156, v286);
-    let v381: f64 = 2f64.mul_add(v168, v289);
-    let v382: f64 = p[44usize].mul_add(v379, v95);
-    let v383: f64 = v278.mul_add(v380, v382);
-    let v384: f64 = v276.mul_add(v381, v383);
-    let v385: f64 = v278.mul_add(v299, v298);
-    let v386: f64 = v276.mul_add(v300, v385);
-    let v387: f64 = v57 * v57;
-    let v388: f64 = v295.mul_add(v295, v387);
-    let v389: f64 = p[50usize].mul_add(v388, p[51usize]);
-    let v392: f64 = qd[0usize] * qd[0usize];
-    let v393: f64 = v392 * v154;
-    let v395: f64 = qd[0usize] + qd[1usize];
-    let v396: f64 = v395 * v395;
-    let v397: f64 = (-v64).mul_add(v396, v393);
-    let v399: f64 = qd[2usize] + v395;
-    let v400: f64 = v399 * v399;
-    let v401: f64 = (-v67).mul_add(v400, v397);
-    let v403: f64 = qd[3usize] + v399;
-    let v404: f64 = v403 * v403;
-    let v405: f64 = (-v70).mul_add(v404, v401);
-    let v407: f64 = qd[4usize] + v403;
-    let v408: f64 = v407 * v407;
-    let v409: f64 = (-v73).mul_add(v408, v405);
-    let v411: f64 = qd[5usize] + v407;
-    let v412: f64 = v411 * v411;
-    let v413: f64 = (-v76).mul_add(v412, v409);
-    let v415: f64 = qd[6usize] + v411;
-    let v416: f64 = v415 * v415;
-    let v417: f64 = (-v79).mul_add(v416, v413);
-    let v419: f64 = qd[7usize] + v415;
-    let v420: f64 = v419 * v419;
-    let v421: f64 = (-v82).mul_add(v420, v417);
-    let v422: f64 = p[77usize] + v421;
-    let v424: f64 = -v15;
-    let v425: f64 = v392 * v424;
-    let v426: f64 = (-v21).mul_add(v396, v425);
-    let v427: f64 = (-v27).mul_add(v400, v426);
-    let v428: f64 = (-v33).mul_add(v404, v427);
-    let v429: f64 = (-v39).mul_add(v408, v428);
-    let v430: f64 = (-v45).mul_add(v412, v429);
-    let v431: f64 = (-v51).mul_add(v416, v430);
-    let v432: f64 = (-v57).mul_add(v420, v431);
-    let v433: f64 = p[78usize] + v432;
-    let v434: f64 = v83 * v433;
-    let v435: f64 = v58.mul_add(v422, -v434);
-    let v436: f64 = p[50usize] * v435;
-    let v437: f64 = (-v91).mul_add(v416, v413);
-    let v438: f64 = p[77usize] + v437;
-    let v439: f64 = (-v89).mul_add(v416, v430);
-    let v440: f64 = p[78usize] + v439;
-    let v441: f64 = v92 * v440;
-    let v442: f64 = v90.mul_add(v438, -v441);
-    let v443: f64 = p[44usize].mul_add(v442, v436);
-    let v444: f64 = (-v101).mul_add(v412, v409);
-    let v445: f64 = p[77usize] + v444;
-    let v446: f64 = (-v99).mul_add(v412, v429);
-    let v447: f64 = p[78usize] + v446;
-    let v448: f64 = v102 * v447;
-    let v449: f64 = v100.mul_add(v445, -v448);
-    let v450: f64 = p[38usize].mul_add(v449, v443);
-    let v451: f64 = (-v111).mul_add(v408, v405);
-    let v452: f64 = p[77usize] + v451;
-    let v453: f64 = (-v109).mul_add(v408, v428);
-    let v454: f64 = p[78usize] + v453;
-    let v455: f64 = v112 * v454;
-    let v456: f64 = v110.mul_add(v452, -v455);
-    let v457: f64 = p[32usize].mul_add(v456, v450);
-    let v458: f64 = (-v121).mul_add(v404, v401);
-    let v459: f64 = p[77usize] + v458;
-    let v460: f64 = (-v119).mul_add(v404, v427);
-    let v461: f64 = p[78usize] + v460;
-    let v462: f64 = v122 * v461;
-    let v463: f64 = v120.mul_add(v459, -v462);
-    let v464: f64 = p[26usize].mul_add(v463, v457);
-    let v465: f64 = (-v131).mul_add(v400, v397);
-    let v466: f64 = p[77usize] + v465;
-    let v467: f64 = (-v129).mul_add(v400, v426);
-    let v468: f64 = p[78usize] + v467;
-    let v469: f64 = v132 * v468;
-    let v470: f64 = v130.mul_add(v466, -v469);
-    let v471: f64 = p[20usize].mul_add(v470, v464);
-    let v472: f64 = (-v141).mul_add(v396, v393);
-    let v473: f64 = p[77usize] + v472;
-    let v474: f64 = (-v139).mul_add(v396, v425);
-    let v475: f64 = p[78usize] + v474;
-    let v476: f64 = v142 * v475;
-    let v477: f64 = v140.mul_add(v473, -v476);
-    let v478: f64 = p[14usize].mul_add(v477, v471);
-    let v479: f64 = p[50usize] * v433;
-    let v480: f64 = p[44usize].mul_add(v440, v479);
-    let v481: f64 = p[38usize].mul_add(v447, v480);
-    let v482: f64 = p[32usize].mul_add(v454, v481);
-    let v483: f64 = p[26usize].mul_add(v461, v482);
-    let v484: f64 = p[20usize].mul_add(v468, v483);
-    let v485: f64 = p[14usize].mul_add(v475, v484);
-    let v486: f64 = p[50usize] * v422;
-    let v487: f64 = p[44usize].mul_add(v438, v486);
-    let v488: f64 = p[38usize].mul_add(v445, v487);
-    let v489: f64 = p[32usize].mul_add(v452, v488);
-    let v490: f64 = p[26usize].mul_add(v459, v489);
-    let v491: f64 = p[20usize].mul_add(v466, v490);
-    let v492: f64 = p[14usize].mul_add(v473, v491);
-    let v495: f64 = p[79usize] + q[0usize];
-    let v497: f64 = p[63usize] * v14;
-    let v498: f64 = v392.mul_add(v497, p[78usize]);
-    let v499: f64 = v392.mul_add(v151, p[77usize]);
-    let v500: f64 = v149 * v499;
-    let v501: f64 = v151.mul_add(v498, v500);
-    let v502: f64 = v155.mul_add(v485, v478);
-    let v503: f64 = v167.mul_add(v492, v502);
-    let v504: f64 = p[10usize].mul_add(v495, v503);
-    let v505: f64 = p[11usize].mul_add(qd[0usize], v504);
-    let v506: f64 = p[8usize].mul_add(v501, v505);
-    let v509: f64 = p[80usize] + q[1usize];
-    let v511: f64 = v473 * v139;
-    let v512: f64 = v475.mul_add(v185, v511);
-    let v513: f64 = v183.mul_add(v484, v471);
-    let v514: f64 = v181.mul_add(v491, v513);
-    let v515: f64 = p[16usize].mul_add(v509, v514);
-    let v516: f64 = p[17usize].mul_add(qd[1usize], v515);
-    let v517: f64 = p[14usize].mul_add(v512, v516);
-    let v520: f64 = p[81usize] + q[2usize];
-    let v522: f64 = v466 * v129;
-    let v523: f64 = v468.mul_add(v204, v522);
-    let v524: f64 = v202.mul_add(v483, v464);
-    let v525: f64 = v200.mul_add(v490, v524);
-    let v526: f64 = p[22usize].mul_add(v520, v525);
-    let v527: f64 = p[23usize].mul_add(qd[2usize], v526);
-    let v528: f64 = p[20usize].mul_add(v523, v527);
-    let v531: f64 = p[82usize] + q[3usize];
-    let v533: f64 = v459 * v119;
-    let v534: f64 = v461.mul_add(v223, v533);
-    let v535: f64 = v221.mul_add(v482, v457);
-    let v536: f64 = v219.mul_add(v489, v535);
-    let v537: f64 = p[28usize].mul_add(v531, v536);
-    let v538: f64 = p[29usize].mul_add(qd[3usize], v537);
-    let v539: f64 = p[26usize].mul_add(v534, v538);
-    let v542: f64 = p[83usize] + q[4usize];
-    let v544: f64 = v452 * v109;
-    let v545: f64 = v454.mul_add(v242, v544);
-    let v546: f64 = v240.mul_add(v481, v450);
-    let v547: f64 = v238.mul_add(v488, v546);
-    let v548: f64 = p[34usize].mul_add(v542, v547);
-    let v549: f64 = p[35usize].mul_add(qd[4usize], v548);
-    let v550: f64 = p[32usize].mul_add(v545, v549);
-    let v553: f64 = p[84usize] + q[5usize];
-    let v555: f64 = v445 * v99;
-    let v556: f64 = v447.mul_add(v261, v555);
-    let v557: f64 = v259.mul_add(v480, v443);
-    let v558: f64 = v257.mul_add(v487, v557);
-    let v559: f64 = p[40usize].mul_add(v553, v558);
-    let v560: f64 = p[41usize].mul_add(qd[5usize], v559);
-    let v561: f64 = p[38usize].mul_add(v556, v560);
-    let v564: f64 = p[85usize] + q[6usize];
-    let v566: f64 = v438 * v89;
-    let v567: f64 = v440.mul_add(v280, v566);
-    let v568: f64 = v278.mul_add(v479, v436);
-    let v569: f64 = v276.mul_add(v486, v568);
-    let v570: f64 = p[46usize].mul_add(v564, v569);
-    let v571: f64 = p[47usize].mul_add(qd[6usize], v570);
-    let v572: f64 = p[44usize].mul_add(v567, v571);
-    let v575: f64 = p[86usize] + q[7usize];
-    let v577: f64 = p[53usize] * qd[7usize];
-    let v578: f64 = v422 * v57;
-    let v579: f64 = v433.mul_add(v295, v578);
-    let v580: f64 = p[52usize].mul_add(v575, v577);
-    let v581: f64 = p[50usize].mul_add(v579, v580);
-    out[0usize] = v180;
-    out[1usize] = v199;
-    out[2usize] = v218;
-    out[3usize] = v237;
-    out[4usize] = v256;
-    out[5usize] = v275;
-    out[6usize] = v293;
-    out[7usize] = v302;
-    out[8usize] = v309;
-    out[9usize] = v311;
-    out[10usize] = v313;
-    out[11usize] = v315;
-    out[12usize] = v317;
-    out[13usize] = v319;
-    out[14usize] = v321;
-    out[15usize] = v328;
-    out[16usize] = v330;
-    out[17usize] = v332;
-    out[18usize] = v334;
-    out[19usize] = v336;
-    out[20usize] = v338;
-    out[21usize] = v345;
-    out[22usize] = v347;
-    out[23usize] = v349;
-    out[24usize] = v351;
-    out[25usize] = v353;
-    out[26usize] = v360;
-    out[27usize] = v362;
-    out[28usize] = v364;
-    out[29usize] = v366;
-    out[30usize] = v373;
-    out[31usize] = v375;
-    out[32usize] = v377;
-    out[33usize] = v384;
-    out[34usize] = v386;
-    out[35usize] = v389;
-    out[36usize] = v506;
-    out[37usize] = v517;
-    out[38usize] = v528;
-    out[39usize] = v539;
-    out[40usize] = v550;
-    out[41usize] = v561;
-    out[42usize] = v572;
-    out[43usize] = v581;
+    out2[0usize] = v180;
+    out2[1usize] = v201;
+    out2[2usize] = v230;
+    out2[3usize] = v265;
+    out2[4usize] = v307;
+    out2[5usize] = v357;
+    out2[6usize] = v415;
+    out2[7usize] = v474;
+    out2[8usize] = v209;
+    out2[9usize] = v232;
+    out2[10usize] = v267;
+    out2[11usize] = v309;
+    out2[12usize] = v359;
+    out2[13usize] = v417;
+    out2[14usize] = v476;
+    out2[15usize] = v244;
+    out2[16usize] = v272;
+    out2[17usize] = v315;
+    out2[18usize] = v365;
+    out2[19usize] = v423;
+    out2[20usize] = v482;
+    out2[21usize] = v286;
+    out2[22usize] = v320;
+    out2[23usize] = v371;
+    out2[24usize] = v429;
+    out2[25usize] = v488;
+    out2[26usize] = v336;
+    out2[27usize] = v377;
+    out2[28usize] = v436;
+    out2[29usize] = v495;
+    out2[30usize] = v395;
+    out2[31usize] = v443;
+    out2[32usize] = v503;
+    out2[33usize] = v463;
+    out2[34usize] = v511;
+    out2[35usize] = v529;
+    out2[36usize] = v655;
+    out2[37usize] = v667;
+    out2[38usize] = v680;
+    out2[39usize] = v694;
+    out2[40usize] = v709;
+    out2[41usize] = v725;
+    out2[42usize] = v742;
+    out2[43usize] = v751;
 }
 /// Kernel `derived`: 41 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
@@ -1563,8 +1096,8 @@ pub fn derived(
     unsafe { derived_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
     q: &[f64; 8usize],
@@ -1674,8 +1207,8 @@ pub fn constraints(
     unsafe { constraints_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
     q: &[f64; 8usize],
@@ -1702,8 +1235,8 @@ pub fn contact(
     unsafe { contact_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
     q: &[f64; 8usize],
@@ -1742,8 +1275,8 @@ pub fn contact_jvp(
     unsafe { contact_jvp_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
     q: &[f64; 8usize],
@@ -1905,8 +1438,8 @@ pub fn cell_0_pose(
     unsafe { cell_0_pose_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
     q: &[f64; 1usize],
@@ -1992,8 +1525,8 @@ pub fn cell_0(
     unsafe { cell_0_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
     q: &[f64; 1usize],
@@ -2104,8 +1637,8 @@ pub fn cell_0_tangent(
     unsafe { cell_0_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
     q: &[f64; 1usize],

@@ -406,8 +406,8 @@ pub fn accel(
     unsafe { accel_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn accel_0(
     t: f64,
     q: &[f64; 32usize],
@@ -434,8 +434,8 @@ pub fn mass_bias(
     unsafe { mass_bias_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn mass_bias_0(
     t: f64,
     q: &[f64; 32usize],
@@ -3858,8 +3858,8 @@ pub fn derived(
     unsafe { derived_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
     q: &[f64; 32usize],
@@ -4209,8 +4209,8 @@ pub fn constraints(
     unsafe { constraints_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
     q: &[f64; 32usize],
@@ -4237,8 +4237,8 @@ pub fn contact(
     unsafe { contact_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
     q: &[f64; 32usize],
@@ -4277,8 +4277,8 @@ pub fn contact_jvp(
     unsafe { contact_jvp_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
     q: &[f64; 32usize],
@@ -4440,8 +4440,8 @@ pub fn cell_0_pose(
     unsafe { cell_0_pose_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
     q: &[f64; 1usize],
@@ -4527,8 +4527,8 @@ pub fn cell_0(
     unsafe { cell_0_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
     q: &[f64; 1usize],
@@ -4639,8 +4639,8 @@ pub fn cell_0_tangent(
     unsafe { cell_0_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
     q: &[f64; 1usize],

@@ -177,7 +177,7 @@ impl Kernels for Compiled {
         }
     }
 }
-/// Kernel `accel`: 118 operations in 1 chunk(s).
+/// Kernel `accel`: the first 5 values of `eom` (118 operations for all).
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
@@ -190,12 +190,11 @@ pub fn accel(
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
-    unsafe { accel_0(t, q, qd, qdd, dir, p, w, out) };
+    unsafe { accel_fma(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn accel_0(
+fn accel_fma(
     t: f64,
     q: &[f64; 2usize],
     qd: &[f64; 2usize],
@@ -204,6 +203,52 @@ fn accel_0(
     p: &[f64; 30usize],
     w: &mut [f64; 0usize],
     out: &mut [f64; 5usize],
+) {
+    let mut unused = [0.0f64; 5usize];
+    eom_0(t, q, qd, qdd, dir, p, w, out, &mut unused);
+}
+/// Kernel `mass_bias`: the last 5 values of `eom` (118 operations for all).
+#[allow(unused_unsafe)]
+pub fn mass_bias(
+    t: f64,
+    q: &[f64; 2usize],
+    qd: &[f64; 2usize],
+    qdd: &[f64; 2usize],
+    dir: &[f64; 4usize],
+    p: &[f64; 30usize],
+    out: &mut [f64; 5usize],
+) {
+    runtime::cpu::require_fma();
+    let w = &mut [0.0f64; 0];
+    unsafe { mass_bias_fma(t, q, qd, qdd, dir, p, w, out) };
+}
+#[inline(never)]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+fn mass_bias_fma(
+    t: f64,
+    q: &[f64; 2usize],
+    qd: &[f64; 2usize],
+    qdd: &[f64; 2usize],
+    dir: &[f64; 4usize],
+    p: &[f64; 30usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 5usize],
+) {
+    let mut unused = [0.0f64; 5usize];
+    eom_0(t, q, qd, qdd, dir, p, w, &mut unused, out);
+}
+#[inline(always)]
+#[allow(unused_variables, clippy::all)]
+fn eom_0(
+    t: f64,
+    q: &[f64; 2usize],
+    qd: &[f64; 2usize],
+    qdd: &[f64; 2usize],
+    dir: &[f64; 4usize],
+    p: &[f64; 30usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 5usize],
+    out2: &mut [f64; 5usize],
 ) {
     let v7: f64 = p[6usize] + q[0usize];
     let (v18, v8): (f64, f64) = runtime::special::sin_cos(v7);
@@ -295,115 +340,11 @@ fn accel_0(
     out[2usize] = v47;
     out[3usize] = v63;
     out[4usize] = v59;
-}
-/// Kernel `mass_bias`: 105 operations in 1 chunk(s).
-#[allow(unused_unsafe)]
-pub fn mass_bias(
-    t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    out: &mut [f64; 5usize],
-) {
-    runtime::cpu::require_fma();
-    let w = &mut [0.0f64; 0];
-    unsafe { mass_bias_0(t, q, qd, qdd, dir, p, w, out) };
-}
-#[inline(never)]
-#[allow(unused_variables, clippy::all)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn mass_bias_0(
-    t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 5usize],
-) {
-    let v7: f64 = p[6usize] + q[0usize];
-    let (v18, v8): (f64, f64) = runtime::special::sin_cos(v7);
-    let v9: f64 = p[7usize] * v8;
-    let v10: f64 = p[3usize] + v9;
-    let v13: f64 = q[1usize] + v7;
-    let (v21, v14): (f64, f64) = runtime::special::sin_cos(v13);
-    let v15: f64 = p[19usize] * v14;
-    let v16: f64 = v10 + v15;
-    let v19: f64 = p[7usize] * v18;
-    let v20: f64 = p[4usize] + v19;
-    let v22: f64 = p[19usize] * v21;
-    let v23: f64 = v20 + v22;
-    let v24: f64 = v23 * v23;
-    let v25: f64 = v16.mul_add(v16, v24);
-    let v26: f64 = p[14usize].mul_add(v25, p[15usize]);
-    let v29: f64 = p[20usize] * v8;
-    let v31: f64 = p[21usize] * v18;
-    let v32: f64 = v31 * v31;
-    let v33: f64 = v29.mul_add(v29, v32);
-    let v34: f64 = -v19;
-    let v35: f64 = v20 + v34;
-    let v36: f64 = p[14usize] * v23;
-    let v38: f64 = 2f64 * v36;
-    let v39: f64 = p[14usize].mul_add(v35, -v38);
-    let v40: f64 = v9 - v10;
-    let v41: f64 = p[14usize] * v16;
-    let v42: f64 = p[14usize] * v40;
-    let v43: f64 = 2f64.mul_add(v41, v42);
-    let v44: f64 = p[9usize] + v26;
-    let v45: f64 = p[8usize].mul_add(v33, v44);
-    let v46: f64 = v35.mul_add(v39, v45);
-    let v47: f64 = v40.mul_add(v43, v46);
-    let v49: f64 = p[22usize] * v21;
-    let v50: f64 = v23 * v49;
-    let v51: f64 = v16.mul_add(v15, -v50);
-    let v52: f64 = p[14usize].mul_add(v51, p[15usize]);
-    let v53: f64 = p[14usize] * v49;
-    let v54: f64 = p[14usize] * v15;
-    let v55: f64 = v35.mul_add(v53, v52);
-    let v56: f64 = v40.mul_add(v54, v55);
-    let v57: f64 = v15 * v15;
-    let v58: f64 = v49.mul_add(v49, v57);
-    let v59: f64 = p[14usize].mul_add(v58, p[15usize]);
-    let v62: f64 = qd[0usize] * qd[0usize];
-    let v64: f64 = qd[0usize] + qd[1usize];
-    let v65: f64 = v64 * v64;
-    let v66: f64 = v22 * v65;
-    let v67: f64 = v62.mul_add(v34, -v66);
-    let v68: f64 = p[23usize] + v67;
-    let v70: f64 = -v9;
-    let v71: f64 = v15 * v65;
-    let v72: f64 = v62.mul_add(v70, -v71);
-    let v73: f64 = p[24usize] + v72;
-    let v74: f64 = v23 * v73;
-    let v75: f64 = v16.mul_add(v68, -v74);
-    let v76: f64 = p[14usize] * v73;
-    let v77: f64 = v35 * v76;
-    let v78: f64 = p[14usize] * v68;
-    let v81: f64 = p[25usize] + q[0usize];
-    let v83: f64 = p[21usize] * v8;
-    let v84: f64 = v62.mul_add(v83, p[24usize]);
-    let v85: f64 = v62.mul_add(v31, p[23usize]);
-    let v86: f64 = v29 * v85;
-    let v87: f64 = v31.mul_add(v84, v86);
-    let v88: f64 = p[14usize].mul_add(v75, v77);
-    let v89: f64 = v40.mul_add(v78, v88);
-    let v90: f64 = p[10usize].mul_add(v81, v89);
-    let v91: f64 = p[11usize].mul_add(qd[0usize], v90);
-    let v92: f64 = p[8usize].mul_add(v87, v91);
-    let v95: f64 = p[26usize] + q[1usize];
-    let v97: f64 = p[17usize] * qd[1usize];
-    let v98: f64 = v68 * v15;
-    let v99: f64 = v73.mul_add(v49, v98);
-    let v100: f64 = p[16usize].mul_add(v95, v97);
-    let v101: f64 = p[14usize].mul_add(v99, v100);
-    out[0usize] = v47;
-    out[1usize] = v56;
-    out[2usize] = v59;
-    out[3usize] = v92;
-    out[4usize] = v101;
+    out2[0usize] = v47;
+    out2[1usize] = v58;
+    out2[2usize] = v62;
+    out2[3usize] = v104;
+    out2[4usize] = v107;
 }
 /// Kernel `derived`: 11 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
@@ -421,8 +362,8 @@ pub fn derived(
     unsafe { derived_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
     q: &[f64; 2usize],
@@ -472,8 +413,8 @@ pub fn constraints(
     unsafe { constraints_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
     q: &[f64; 2usize],
@@ -500,8 +441,8 @@ pub fn contact(
     unsafe { contact_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
     q: &[f64; 2usize],
@@ -540,8 +481,8 @@ pub fn contact_jvp(
     unsafe { contact_jvp_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
     q: &[f64; 2usize],
@@ -703,8 +644,8 @@ pub fn cell_0_pose(
     unsafe { cell_0_pose_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
     q: &[f64; 1usize],
@@ -790,8 +731,8 @@ pub fn cell_0(
     unsafe { cell_0_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
     q: &[f64; 1usize],
@@ -902,8 +843,8 @@ pub fn cell_0_tangent(
     unsafe { cell_0_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
     q: &[f64; 1usize],

@@ -265,7 +265,7 @@ fn contact_jacobian_framed(
         }
     }
 }
-/// Kernel `accel`: 2926 operations in 1 chunk(s).
+/// Kernel `accel`: the first 199 values of `eom` (2926 operations for all).
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
@@ -278,12 +278,11 @@ pub fn accel(
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
-    unsafe { accel_0(t, q, qd, qdd, dir, p, w, out) };
+    unsafe { accel_fma(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn accel_0(
+fn accel_fma(
     t: f64,
     q: &[f64; 10usize],
     qd: &[f64; 10usize],
@@ -292,6 +291,52 @@ fn accel_0(
     p: &[f64; 233usize],
     w: &mut [f64; 0usize],
     out: &mut [f64; 199usize],
+) {
+    let mut unused = [0.0f64; 65usize];
+    eom_0(t, q, qd, qdd, dir, p, w, out, &mut unused);
+}
+/// Kernel `mass_bias`: the last 65 values of `eom` (2926 operations for all).
+#[allow(unused_unsafe)]
+pub fn mass_bias(
+    t: f64,
+    q: &[f64; 10usize],
+    qd: &[f64; 10usize],
+    qdd: &[f64; 10usize],
+    dir: &[f64; 20usize],
+    p: &[f64; 233usize],
+    out: &mut [f64; 65usize],
+) {
+    runtime::cpu::require_fma();
+    let w = &mut [0.0f64; 0];
+    unsafe { mass_bias_fma(t, q, qd, qdd, dir, p, w, out) };
+}
+#[inline(never)]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+fn mass_bias_fma(
+    t: f64,
+    q: &[f64; 10usize],
+    qd: &[f64; 10usize],
+    qdd: &[f64; 10usize],
+    dir: &[f64; 20usize],
+    p: &[f64; 233usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 65usize],
+) {
+    let mut unused = [0.0f64; 199usize];
+    eom_0(t, q, qd, qdd, dir, p, w, &mut unused, out);
+}
+#[inline(always)]
+#[allow(unused_variables, clippy::all)]
+fn eom_0(
+    t: f64,
+    q: &[f64; 10usize],
+    qd: &[f64; 10usize],
+    qdd: &[f64; 10usize],
+    dir: &[f64; 20usize],
+    p: &[f64; 233usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 199usize],
+    out2: &mut [f64; 65usize],
 ) {
     let [v3, v397, v1723]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
         3usize,
@@ -2446,1657 +2491,71 @@ fn accel_0(
     out[196usize] = 0f64;
     out[197usize] = 0f64;
     out[198usize] = 1f64;
-}
-/// Kernel `mass_bias`: 2307 operations in 1 chunk(s).
-#[allow(unused_unsafe)]
-pub fn mass_bias(
-    t: f64,
-    q: &[f64; 10usize],
-    qd: &[f64; 10usize],
-    qdd: &[f64; 10usize],
-    dir: &[f64; 20usize],
-    p: &[f64; 233usize],
-    out: &mut [f64; 65usize],
-) {
-    runtime::cpu::require_fma();
-    let w = &mut [0.0f64; 0];
-    unsafe { mass_bias_0(t, q, qd, qdd, dir, p, w, out) };
-}
-#[inline(never)]
-#[allow(unused_variables, clippy::all)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn mass_bias_0(
-    t: f64,
-    q: &[f64; 10usize],
-    qd: &[f64; 10usize],
-    qdd: &[f64; 10usize],
-    dir: &[f64; 20usize],
-    p: &[f64; 233usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 65usize],
-) {
-    let [v3, v397, v1445]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[0usize]);
-    let v5: f64 = 2f64 * v3;
-    let v7: f64 = 0.5f64 * q[0usize];
-    let [v8, v394, v987]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v7);
-    let v9: f64 = v8.powi(4i32);
-    let v11: f64 = q[0usize] * q[0usize];
-    let v12: f64 = v3 * v3;
-    let v13: f64 = (-0.25f64).mul_add(v9, v5);
-    let v14: f64 = (-v11).mul_add(v12, v13);
-    let v15: f64 = p[79usize].mul_add(v14, p[9usize]);
-    let [v19, v450, v1396]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[1usize]);
-    let v20: f64 = 2f64 * v19;
-    let v21: f64 = 0.5f64 * q[1usize];
-    let [v22, v440, v997]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v21);
-    let v23: f64 = v22.powi(4i32);
-    let v24: f64 = q[1usize] * q[1usize];
-    let v25: f64 = v19 * v19;
-    let v26: f64 = (-0.25f64).mul_add(v23, v20);
-    let v27: f64 = (-v24).mul_add(v25, v26);
-    let [v31, v482, v1356]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[2usize]);
-    let v32: f64 = 2f64 * v31;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let [v34, v472, v1012]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v33);
-    let v35: f64 = v34.powi(4i32);
-    let v36: f64 = q[2usize] * q[2usize];
-    let v37: f64 = v31 * v31;
-    let v38: f64 = (-0.25f64).mul_add(v35, v32);
-    let v39: f64 = (-v36).mul_add(v37, v38);
-    let [v43, v514, v1327]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[3usize]);
-    let v44: f64 = 2f64 * v43;
-    let v45: f64 = 0.5f64 * q[3usize];
-    let [v46, v504, v1026]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v45);
-    let v47: f64 = v46.powi(4i32);
-    let v48: f64 = q[3usize] * q[3usize];
-    let v49: f64 = v43 * v43;
-    let v50: f64 = (-0.25f64).mul_add(v47, v44);
-    let v51: f64 = (-v48).mul_add(v49, v50);
-    let [v55, v546, v1298]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[4usize]);
-    let v56: f64 = 2f64 * v55;
-    let v57: f64 = 0.5f64 * q[4usize];
-    let [v58, v536, v1040]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v57);
-    let v59: f64 = v58.powi(4i32);
-    let v60: f64 = q[4usize] * q[4usize];
-    let v61: f64 = v55 * v55;
-    let v62: f64 = (-0.25f64).mul_add(v59, v56);
-    let v63: f64 = (-v60).mul_add(v61, v62);
-    let [v67, v578, v1269]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[5usize]);
-    let v68: f64 = 2f64 * v67;
-    let v69: f64 = 0.5f64 * q[5usize];
-    let [v70, v568, v1054]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v69);
-    let v71: f64 = v70.powi(4i32);
-    let v72: f64 = q[5usize] * q[5usize];
-    let v73: f64 = v67 * v67;
-    let v74: f64 = (-0.25f64).mul_add(v71, v68);
-    let v75: f64 = (-v72).mul_add(v73, v74);
-    let [v79, v610, v1240]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[6usize]);
-    let v80: f64 = 2f64 * v79;
-    let v81: f64 = 0.5f64 * q[6usize];
-    let [v82, v600, v1068]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v81);
-    let v83: f64 = v82.powi(4i32);
-    let v84: f64 = q[6usize] * q[6usize];
-    let v85: f64 = v79 * v79;
-    let v86: f64 = (-0.25f64).mul_add(v83, v80);
-    let v87: f64 = (-v84).mul_add(v85, v86);
-    let [v91, v642, v1211]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[7usize]);
-    let v92: f64 = 2f64 * v91;
-    let v93: f64 = 0.5f64 * q[7usize];
-    let [v94, v632, v1082]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v93);
-    let v95: f64 = v94.powi(4i32);
-    let v96: f64 = q[7usize] * q[7usize];
-    let v97: f64 = v91 * v91;
-    let v98: f64 = (-0.25f64).mul_add(v95, v92);
-    let v99: f64 = (-v96).mul_add(v97, v98);
-    let [v103, v674, v1182]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[8usize]);
-    let v104: f64 = 2f64 * v103;
-    let v105: f64 = 0.5f64 * q[8usize];
-    let [v106, v664, v1096]: [f64; 3usize] = runtime::special::sinc_orders::<
-        3usize,
-    >(v105);
-    let v107: f64 = v106.powi(4i32);
-    let v108: f64 = q[8usize] * q[8usize];
-    let v109: f64 = v103 * v103;
-    let v110: f64 = (-0.25f64).mul_add(v107, v104);
-    let v111: f64 = (-v108).mul_add(v109, v110);
-    let [v115, v699, v1105]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[9usize]);
-    let v116: f64 = 2f64 * v115;
-    let v117: f64 = 0.5f64 * q[9usize];
-    let [v118, v695, v1118]: [f64; 3usize] = runtime::special::sinc_orders::<
-        3usize,
-    >(v117);
-    let v119: f64 = v118.powi(4i32);
-    let v120: f64 = q[9usize] * q[9usize];
-    let v121: f64 = v115 * v115;
-    let v122: f64 = (-0.25f64).mul_add(v119, v116);
-    let v123: f64 = (-v120).mul_add(v121, v122);
-    let (v129, v130): (f64, f64) = runtime::special::sin_cos(v7);
-    let v131: f64 = p[89usize] * v129;
-    let v132: f64 = p[90usize].mul_add(v130, -v131);
-    let v133: f64 = p[7usize] * v8;
-    let v134: f64 = v133.mul_add(v132, p[3usize]);
-    let v136: f64 = p[90usize] * v129;
-    let v137: f64 = p[89usize].mul_add(v130, v136);
-    let v138: f64 = v132 * v129;
-    let v139: f64 = v137.mul_add(v130, v138);
-    let v140: f64 = v137 * v129;
-    let v141: f64 = v132.mul_add(v130, -v140);
-    let (v142, v143): (f64, f64) = runtime::special::sin_cos(v21);
-    let v144: f64 = v139 * v142;
-    let v145: f64 = v141.mul_add(v143, -v144);
-    let v146: f64 = p[13usize] * v22;
-    let v147: f64 = v146.mul_add(v145, v134);
-    let v149: f64 = v141 * v142;
-    let v150: f64 = v139.mul_add(v143, v149);
-    let v151: f64 = v145 * v142;
-    let v152: f64 = v150.mul_add(v143, v151);
-    let v153: f64 = v150 * v142;
-    let v154: f64 = v145.mul_add(v143, -v153);
-    let (v155, v156): (f64, f64) = runtime::special::sin_cos(v33);
-    let v157: f64 = v152 * v155;
-    let v158: f64 = v154.mul_add(v156, -v157);
-    let v159: f64 = p[19usize] * v34;
-    let v160: f64 = v159.mul_add(v158, v147);
-    let v162: f64 = v154 * v155;
-    let v163: f64 = v152.mul_add(v156, v162);
-    let v164: f64 = v158 * v155;
-    let v165: f64 = v163.mul_add(v156, v164);
-    let v166: f64 = v163 * v155;
-    let v167: f64 = v158.mul_add(v156, -v166);
-    let (v168, v169): (f64, f64) = runtime::special::sin_cos(v45);
-    let v170: f64 = v165 * v168;
-    let v171: f64 = v167.mul_add(v169, -v170);
-    let v172: f64 = p[25usize] * v46;
-    let v173: f64 = v172.mul_add(v171, v160);
-    let v175: f64 = v167 * v168;
-    let v176: f64 = v165.mul_add(v169, v175);
-    let v177: f64 = v171 * v168;
-    let v178: f64 = v176.mul_add(v169, v177);
-    let v179: f64 = v176 * v168;
-    let v180: f64 = v171.mul_add(v169, -v179);
-    let (v181, v182): (f64, f64) = runtime::special::sin_cos(v57);
-    let v183: f64 = v178 * v181;
-    let v184: f64 = v180.mul_add(v182, -v183);
-    let v185: f64 = p[31usize] * v58;
-    let v186: f64 = v185.mul_add(v184, v173);
-    let v188: f64 = v180 * v181;
-    let v189: f64 = v178.mul_add(v182, v188);
-    let v190: f64 = v184 * v181;
-    let v191: f64 = v189.mul_add(v182, v190);
-    let v192: f64 = v189 * v181;
-    let v193: f64 = v184.mul_add(v182, -v192);
-    let (v194, v195): (f64, f64) = runtime::special::sin_cos(v69);
-    let v196: f64 = v191 * v194;
-    let v197: f64 = v193.mul_add(v195, -v196);
-    let v198: f64 = p[37usize] * v70;
-    let v199: f64 = v198.mul_add(v197, v186);
-    let v201: f64 = v193 * v194;
-    let v202: f64 = v191.mul_add(v195, v201);
-    let v203: f64 = v197 * v194;
-    let v204: f64 = v202.mul_add(v195, v203);
-    let v205: f64 = v202 * v194;
-    let v206: f64 = v197.mul_add(v195, -v205);
-    let (v207, v208): (f64, f64) = runtime::special::sin_cos(v81);
-    let v209: f64 = v204 * v207;
-    let v210: f64 = v206.mul_add(v208, -v209);
-    let v211: f64 = p[43usize] * v82;
-    let v212: f64 = v211.mul_add(v210, v199);
-    let v214: f64 = v206 * v207;
-    let v215: f64 = v204.mul_add(v208, v214);
-    let v216: f64 = v210 * v207;
-    let v217: f64 = v215.mul_add(v208, v216);
-    let v218: f64 = v215 * v207;
-    let v219: f64 = v210.mul_add(v208, -v218);
-    let (v220, v221): (f64, f64) = runtime::special::sin_cos(v93);
-    let v222: f64 = v217 * v220;
-    let v223: f64 = v219.mul_add(v221, -v222);
-    let v224: f64 = p[49usize] * v94;
-    let v225: f64 = v224.mul_add(v223, v212);
-    let v227: f64 = v219 * v220;
-    let v228: f64 = v217.mul_add(v221, v227);
-    let v229: f64 = v223 * v220;
-    let v230: f64 = v228.mul_add(v221, v229);
-    let v231: f64 = v228 * v220;
-    let v232: f64 = v223.mul_add(v221, -v231);
-    let (v233, v234): (f64, f64) = runtime::special::sin_cos(v105);
-    let v235: f64 = v230 * v233;
-    let v236: f64 = v232.mul_add(v234, -v235);
-    let v237: f64 = p[55usize] * v106;
-    let v238: f64 = v237.mul_add(v236, v225);
-    let v239: f64 = v232 * v233;
-    let v240: f64 = v230.mul_add(v234, v239);
-    let v241: f64 = v240 * v233;
-    let v242: f64 = v236.mul_add(v234, -v241);
-    let v244: f64 = v118 * v118;
-    let v245: f64 = p[91usize] * v244;
-    let v246: f64 = v236 * v233;
-    let v247: f64 = v240.mul_add(v234, v246);
-    let v249: f64 = p[61usize] * q[9usize];
-    let v250: f64 = v249 * v115;
-    let v251: f64 = v242.mul_add(v245, v238);
-    let v252: f64 = (-v247).mul_add(v250, v251);
-    let v254: f64 = v133.mul_add(v137, p[4usize]);
-    let v255: f64 = v146.mul_add(v150, v254);
-    let v256: f64 = v159.mul_add(v163, v255);
-    let v257: f64 = v172.mul_add(v176, v256);
-    let v258: f64 = v185.mul_add(v189, v257);
-    let v259: f64 = v198.mul_add(v202, v258);
-    let v260: f64 = v211.mul_add(v215, v259);
-    let v261: f64 = v224.mul_add(v228, v260);
-    let v262: f64 = v237.mul_add(v240, v261);
-    let v263: f64 = v247.mul_add(v245, v262);
-    let v264: f64 = v242.mul_add(v250, v263);
-    let v265: f64 = v264 * v264;
-    let v266: f64 = v252.mul_add(v252, v265);
-    let v267: f64 = p[88usize].mul_add(v123, p[63usize]);
-    let v268: f64 = p[62usize].mul_add(v266, v267);
-    let v271: f64 = v106 * v106;
-    let v272: f64 = p[92usize] * v271;
-    let v273: f64 = p[55usize] * q[8usize];
-    let v274: f64 = v273 * v103;
-    let v275: f64 = v232.mul_add(v272, v225);
-    let v276: f64 = (-v230).mul_add(v274, v275);
-    let v277: f64 = v230.mul_add(v272, v261);
-    let v278: f64 = v232.mul_add(v274, v277);
-    let v279: f64 = v278 * v278;
-    let v280: f64 = v276.mul_add(v276, v279);
-    let v281: f64 = p[87usize].mul_add(v111, p[57usize]);
-    let v282: f64 = v281 + v268;
-    let v283: f64 = p[56usize].mul_add(v280, v282);
-    let v286: f64 = v94 * v94;
-    let v287: f64 = p[93usize] * v286;
-    let v288: f64 = p[49usize] * q[7usize];
-    let v289: f64 = v288 * v91;
-    let v290: f64 = v219.mul_add(v287, v212);
-    let v291: f64 = (-v217).mul_add(v289, v290);
-    let v292: f64 = v217.mul_add(v287, v260);
-    let v293: f64 = v219.mul_add(v289, v292);
-    let v294: f64 = v293 * v293;
-    let v295: f64 = v291.mul_add(v291, v294);
-    let v296: f64 = p[86usize].mul_add(v99, p[51usize]);
-    let v297: f64 = v296 + v283;
-    let v298: f64 = p[50usize].mul_add(v295, v297);
-    let v301: f64 = v82 * v82;
-    let v302: f64 = p[94usize] * v301;
-    let v303: f64 = p[43usize] * q[6usize];
-    let v304: f64 = v303 * v79;
-    let v305: f64 = v206.mul_add(v302, v199);
-    let v306: f64 = (-v204).mul_add(v304, v305);
-    let v307: f64 = v204.mul_add(v302, v259);
-    let v308: f64 = v206.mul_add(v304, v307);
-    let v309: f64 = v308 * v308;
-    let v310: f64 = v306.mul_add(v306, v309);
-    let v311: f64 = p[85usize].mul_add(v87, p[45usize]);
-    let v312: f64 = v311 + v298;
-    let v313: f64 = p[44usize].mul_add(v310, v312);
-    let v316: f64 = v70 * v70;
-    let v317: f64 = p[95usize] * v316;
-    let v318: f64 = p[37usize] * q[5usize];
-    let v319: f64 = v318 * v67;
-    let v320: f64 = v193.mul_add(v317, v186);
-    let v321: f64 = (-v191).mul_add(v319, v320);
-    let v322: f64 = v191.mul_add(v317, v258);
-    let v323: f64 = v193.mul_add(v319, v322);
-    let v324: f64 = v323 * v323;
-    let v325: f64 = v321.mul_add(v321, v324);
-    let v326: f64 = p[84usize].mul_add(v75, p[39usize]);
-    let v327: f64 = v326 + v313;
-    let v328: f64 = p[38usize].mul_add(v325, v327);
-    let v331: f64 = v58 * v58;
-    let v332: f64 = p[96usize] * v331;
-    let v333: f64 = p[31usize] * q[4usize];
-    let v334: f64 = v333 * v55;
-    let v335: f64 = v180.mul_add(v332, v173);
-    let v336: f64 = (-v178).mul_add(v334, v335);
-    let v337: f64 = v178.mul_add(v332, v257);
-    let v338: f64 = v180.mul_add(v334, v337);
-    let v339: f64 = v338 * v338;
-    let v340: f64 = v336.mul_add(v336, v339);
-    let v341: f64 = p[83usize].mul_add(v63, p[33usize]);
-    let v342: f64 = v341 + v328;
-    let v343: f64 = p[32usize].mul_add(v340, v342);
-    let v346: f64 = v46 * v46;
-    let v347: f64 = p[97usize] * v346;
-    let v348: f64 = p[25usize] * q[3usize];
-    let v349: f64 = v348 * v43;
-    let v350: f64 = v167.mul_add(v347, v160);
-    let v351: f64 = (-v165).mul_add(v349, v350);
-    let v352: f64 = v165.mul_add(v347, v256);
-    let v353: f64 = v167.mul_add(v349, v352);
-    let v354: f64 = v353 * v353;
-    let v355: f64 = v351.mul_add(v351, v354);
-    let v356: f64 = p[82usize].mul_add(v51, p[27usize]);
-    let v357: f64 = v356 + v343;
-    let v358: f64 = p[26usize].mul_add(v355, v357);
-    let v361: f64 = v34 * v34;
-    let v362: f64 = p[98usize] * v361;
-    let v363: f64 = p[19usize] * q[2usize];
-    let v364: f64 = v363 * v31;
-    let v365: f64 = v154.mul_add(v362, v147);
-    let v366: f64 = (-v152).mul_add(v364, v365);
-    let v367: f64 = v152.mul_add(v362, v255);
-    let v368: f64 = v154.mul_add(v364, v367);
-    let v369: f64 = v368 * v368;
-    let v370: f64 = v366.mul_add(v366, v369);
-    let v371: f64 = p[81usize].mul_add(v39, p[21usize]);
-    let v372: f64 = v371 + v358;
-    let v373: f64 = p[20usize].mul_add(v370, v372);
-    let v376: f64 = v22 * v22;
-    let v377: f64 = p[99usize] * v376;
-    let v378: f64 = v141 * v377;
-    let v379: f64 = p[13usize] * q[1usize];
-    let v380: f64 = v379 * v19;
-    let v381: f64 = v139 * v380;
-    let v382: f64 = v134 + v378;
-    let v383: f64 = v382 - v381;
-    let v384: f64 = v139 * v377;
-    let v385: f64 = v141 * v380;
-    let v386: f64 = v254 + v384;
-    let v387: f64 = v386 + v385;
-    let v388: f64 = v387 * v387;
-    let v389: f64 = v383.mul_add(v383, v388);
-    let v390: f64 = p[80usize].mul_add(v27, p[15usize]);
-    let v391: f64 = v390 + v373;
-    let v392: f64 = p[14usize].mul_add(v389, v391);
-    let v395: f64 = 0.5f64 * v394;
-    let v396: f64 = v133 * v395;
-    let v398: f64 = q[0usize].mul_add(v397, v3);
-    let v399: f64 = p[7usize] * v398;
-    let v400: f64 = p[90usize] * v399;
-    let v401: f64 = p[89usize].mul_add(v396, v400);
-    let v402: f64 = p[89usize] * v399;
-    let v403: f64 = p[90usize].mul_add(v396, -v402);
-    let v404: f64 = v403 * v403;
-    let v405: f64 = v401.mul_add(v401, v404);
-    let v406: f64 = v132 * v395;
-    let v407: f64 = 0.5f64 * v8;
-    let v408: f64 = (-v407).mul_add(v137, v406);
-    let v409: f64 = p[7usize].mul_add(v408, v254);
-    let v410: f64 = p[62usize] * v264;
-    let v411: f64 = p[56usize].mul_add(v278, v410);
-    let v412: f64 = p[50usize].mul_add(v293, v411);
-    let v413: f64 = p[44usize].mul_add(v308, v412);
-    let v414: f64 = p[38usize].mul_add(v323, v413);
-    let v415: f64 = p[32usize].mul_add(v338, v414);
-    let v416: f64 = p[26usize].mul_add(v353, v415);
-    let v417: f64 = p[20usize].mul_add(v368, v416);
-    let v418: f64 = p[14usize].mul_add(v387, v417);
-    let v419: f64 = 2f64 * v418;
-    let v421: f64 = v409.mul_add(p[100usize], -v419);
-    let v422: f64 = v137 * v395;
-    let v423: f64 = v407.mul_add(v132, v422);
-    let v424: f64 = p[7usize].mul_add(v423, -v134);
-    let v425: f64 = p[62usize] * v252;
-    let v426: f64 = p[56usize].mul_add(v276, v425);
-    let v427: f64 = p[50usize].mul_add(v291, v426);
-    let v428: f64 = p[44usize].mul_add(v306, v427);
-    let v429: f64 = p[38usize].mul_add(v321, v428);
-    let v430: f64 = p[32usize].mul_add(v336, v429);
-    let v431: f64 = p[26usize].mul_add(v351, v430);
-    let v432: f64 = p[20usize].mul_add(v366, v431);
-    let v433: f64 = p[14usize].mul_add(v383, v432);
-    let v434: f64 = v424 * p[100usize];
-    let v435: f64 = 2f64.mul_add(v433, v434);
-    let v436: f64 = 0.25f64.mul_add(v15, v392);
-    let v437: f64 = p[8usize].mul_add(v405, v436);
-    let v438: f64 = v409.mul_add(v421, v437);
-    let v439: f64 = v424.mul_add(v435, v438);
-    let v441: f64 = 0.5f64 * v440;
-    let v442: f64 = 0.5f64 * v22;
-    let v443: f64 = v442 * v145;
-    let v444: f64 = v150.mul_add(v441, v443);
-    let v445: f64 = p[13usize].mul_add(v444, -v147);
-    let v446: f64 = v442 * v150;
-    let v447: f64 = v145.mul_add(v441, -v446);
-    let v448: f64 = p[13usize].mul_add(v447, v255);
-    let v449: f64 = v146 * v441;
-    let v451: f64 = q[1usize].mul_add(v450, v19);
-    let v452: f64 = p[13usize] * v451;
-    let v453: f64 = v141 * v452;
-    let v454: f64 = v139.mul_add(v449, v453);
-    let v455: f64 = v139 * v452;
-    let v456: f64 = v141.mul_add(v449, -v455);
-    let v457: f64 = v387 * v456;
-    let v458: f64 = v383.mul_add(v454, -v457);
-    let v459: f64 = 0.5f64.mul_add(v390, v373);
-    let v460: f64 = v445.mul_add(v432, v459);
-    let v461: f64 = (-v448).mul_add(v417, v460);
-    let v462: f64 = p[14usize].mul_add(v458, v461);
-    let v464: f64 = v448 * p[101usize];
-    let v465: f64 = v464 - v417;
-    let v466: f64 = p[14usize].mul_add(v456, v465);
-    let v467: f64 = v445 * p[101usize];
-    let v468: f64 = v432 + v467;
-    let v469: f64 = p[14usize].mul_add(v454, v468);
-    let v470: f64 = v409.mul_add(v466, v462);
-    let v471: f64 = v424.mul_add(v469, v470);
-    let v473: f64 = 0.5f64 * v472;
-    let v474: f64 = 0.5f64 * v34;
-    let v475: f64 = v474 * v158;
-    let v476: f64 = v163.mul_add(v473, v475);
-    let v477: f64 = p[19usize].mul_add(v476, -v160);
-    let v478: f64 = v474 * v163;
-    let v479: f64 = v158.mul_add(v473, -v478);
-    let v480: f64 = p[19usize].mul_add(v479, v256);
-    let v481: f64 = v159 * v473;
-    let v483: f64 = q[2usize].mul_add(v482, v31);
-    let v484: f64 = p[19usize] * v483;
-    let v485: f64 = v154 * v484;
-    let v486: f64 = v152.mul_add(v481, v485);
-    let v487: f64 = v152 * v484;
-    let v488: f64 = v154.mul_add(v481, -v487);
-    let v489: f64 = v368 * v488;
-    let v490: f64 = v366.mul_add(v486, -v489);
-    let v491: f64 = 0.5f64.mul_add(v371, v358);
-    let v492: f64 = v477.mul_add(v431, v491);
-    let v493: f64 = (-v480).mul_add(v416, v492);
-    let v494: f64 = p[20usize].mul_add(v490, v493);
-    let v496: f64 = v480 * p[102usize];
-    let v497: f64 = v496 - v416;
-    let v498: f64 = p[20usize].mul_add(v488, v497);
-    let v499: f64 = v477 * p[102usize];
-    let v500: f64 = v431 + v499;
-    let v501: f64 = p[20usize].mul_add(v486, v500);
-    let v502: f64 = v409.mul_add(v498, v494);
-    let v503: f64 = v424.mul_add(v501, v502);
-    let v505: f64 = 0.5f64 * v504;
-    let v506: f64 = 0.5f64 * v46;
-    let v507: f64 = v506 * v171;
-    let v508: f64 = v176.mul_add(v505, v507);
-    let v509: f64 = p[25usize].mul_add(v508, -v173);
-    let v510: f64 = v506 * v176;
-    let v511: f64 = v171.mul_add(v505, -v510);
-    let v512: f64 = p[25usize].mul_add(v511, v257);
-    let v513: f64 = v172 * v505;
-    let v515: f64 = q[3usize].mul_add(v514, v43);
-    let v516: f64 = p[25usize] * v515;
-    let v517: f64 = v167 * v516;
-    let v518: f64 = v165.mul_add(v513, v517);
-    let v519: f64 = v165 * v516;
-    let v520: f64 = v167.mul_add(v513, -v519);
-    let v521: f64 = v353 * v520;
-    let v522: f64 = v351.mul_add(v518, -v521);
-    let v523: f64 = 0.5f64.mul_add(v356, v343);
-    let v524: f64 = v509.mul_add(v430, v523);
-    let v525: f64 = (-v512).mul_add(v415, v524);
-    let v526: f64 = p[26usize].mul_add(v522, v525);
-    let v528: f64 = v512 * p[103usize];
-    let v529: f64 = v528 - v415;
-    let v530: f64 = p[26usize].mul_add(v520, v529);
-    let v531: f64 = v509 * p[103usize];
-    let v532: f64 = v430 + v531;
-    let v533: f64 = p[26usize].mul_add(v518, v532);
-    let v534: f64 = v409.mul_add(v530, v526);
-    let v535: f64 = v424.mul_add(v533, v534);
-    let v537: f64 = 0.5f64 * v536;
-    let v538: f64 = 0.5f64 * v58;
-    let v539: f64 = v538 * v184;
-    let v540: f64 = v189.mul_add(v537, v539);
-    let v541: f64 = p[31usize].mul_add(v540, -v186);
-    let v542: f64 = v538 * v189;
-    let v543: f64 = v184.mul_add(v537, -v542);
-    let v544: f64 = p[31usize].mul_add(v543, v258);
-    let v545: f64 = v185 * v537;
-    let v547: f64 = q[4usize].mul_add(v546, v55);
-    let v548: f64 = p[31usize] * v547;
-    let v549: f64 = v180 * v548;
-    let v550: f64 = v178.mul_add(v545, v549);
-    let v551: f64 = v178 * v548;
-    let v552: f64 = v180.mul_add(v545, -v551);
-    let v553: f64 = v338 * v552;
-    let v554: f64 = v336.mul_add(v550, -v553);
-    let v555: f64 = 0.5f64.mul_add(v341, v328);
-    let v556: f64 = v541.mul_add(v429, v555);
-    let v557: f64 = (-v544).mul_add(v414, v556);
-    let v558: f64 = p[32usize].mul_add(v554, v557);
-    let v560: f64 = v544 * p[104usize];
-    let v561: f64 = v560 - v414;
-    let v562: f64 = p[32usize].mul_add(v552, v561);
-    let v563: f64 = v541 * p[104usize];
-    let v564: f64 = v429 + v563;
-    let v565: f64 = p[32usize].mul_add(v550, v564);
-    let v566: f64 = v409.mul_add(v562, v558);
-    let v567: f64 = v424.mul_add(v565, v566);
-    let v569: f64 = 0.5f64 * v568;
-    let v570: f64 = 0.5f64 * v70;
-    let v571: f64 = v570 * v197;
-    let v572: f64 = v202.mul_add(v569, v571);
-    let v573: f64 = p[37usize].mul_add(v572, -v199);
-    let v574: f64 = v570 * v202;
-    let v575: f64 = v197.mul_add(v569, -v574);
-    let v576: f64 = p[37usize].mul_add(v575, v259);
-    let v577: f64 = v198 * v569;
-    let v579: f64 = q[5usize].mul_add(v578, v67);
-    let v580: f64 = p[37usize] * v579;
-    let v581: f64 = v193 * v580;
-    let v582: f64 = v191.mul_add(v577, v581);
-    let v583: f64 = v191 * v580;
-    let v584: f64 = v193.mul_add(v577, -v583);
-    let v585: f64 = v323 * v584;
-    let v586: f64 = v321.mul_add(v582, -v585);
-    let v587: f64 = 0.5f64.mul_add(v326, v313);
-    let v588: f64 = v573.mul_add(v428, v587);
-    let v589: f64 = (-v576).mul_add(v413, v588);
-    let v590: f64 = p[38usize].mul_add(v586, v589);
-    let v592: f64 = v576 * p[105usize];
-    let v593: f64 = v592 - v413;
-    let v594: f64 = p[38usize].mul_add(v584, v593);
-    let v595: f64 = v573 * p[105usize];
-    let v596: f64 = v428 + v595;
-    let v597: f64 = p[38usize].mul_add(v582, v596);
-    let v598: f64 = v409.mul_add(v594, v590);
-    let v599: f64 = v424.mul_add(v597, v598);
-    let v601: f64 = 0.5f64 * v600;
-    let v602: f64 = 0.5f64 * v82;
-    let v603: f64 = v602 * v210;
-    let v604: f64 = v215.mul_add(v601, v603);
-    let v605: f64 = p[43usize].mul_add(v604, -v212);
-    let v606: f64 = v602 * v215;
-    let v607: f64 = v210.mul_add(v601, -v606);
-    let v608: f64 = p[43usize].mul_add(v607, v260);
-    let v609: f64 = v211 * v601;
-    let v611: f64 = q[6usize].mul_add(v610, v79);
-    let v612: f64 = p[43usize] * v611;
-    let v613: f64 = v206 * v612;
-    let v614: f64 = v204.mul_add(v609, v613);
-    let v615: f64 = v204 * v612;
-    let v616: f64 = v206.mul_add(v609, -v615);
-    let v617: f64 = v308 * v616;
-    let v618: f64 = v306.mul_add(v614, -v617);
-    let v619: f64 = 0.5f64.mul_add(v311, v298);
-    let v620: f64 = v605.mul_add(v427, v619);
-    let v621: f64 = (-v608).mul_add(v412, v620);
-    let v622: f64 = p[44usize].mul_add(v618, v621);
-    let v624: f64 = v608 * p[106usize];
-    let v625: f64 = v624 - v412;
-    let v626: f64 = p[44usize].mul_add(v616, v625);
-    let v627: f64 = v605 * p[106usize];
-    let v628: f64 = v427 + v627;
-    let v629: f64 = p[44usize].mul_add(v614, v628);
-    let v630: f64 = v409.mul_add(v626, v622);
-    let v631: f64 = v424.mul_add(v629, v630);
-    let v633: f64 = 0.5f64 * v632;
-    let v634: f64 = 0.5f64 * v94;
-    let v635: f64 = v634 * v223;
-    let v636: f64 = v228.mul_add(v633, v635);
-    let v637: f64 = p[49usize].mul_add(v636, -v225);
-    let v638: f64 = v634 * v228;
-    let v639: f64 = v223.mul_add(v633, -v638);
-    let v640: f64 = p[49usize].mul_add(v639, v261);
-    let v641: f64 = v224 * v633;
-    let v643: f64 = q[7usize].mul_add(v642, v91);
-    let v644: f64 = p[49usize] * v643;
-    let v645: f64 = v219 * v644;
-    let v646: f64 = v217.mul_add(v641, v645);
-    let v647: f64 = v217 * v644;
-    let v648: f64 = v219.mul_add(v641, -v647);
-    let v649: f64 = v293 * v648;
-    let v650: f64 = v291.mul_add(v646, -v649);
-    let v651: f64 = 0.5f64.mul_add(v296, v283);
-    let v652: f64 = v637.mul_add(v426, v651);
-    let v653: f64 = (-v640).mul_add(v411, v652);
-    let v654: f64 = p[50usize].mul_add(v650, v653);
-    let v656: f64 = v640 * p[107usize];
-    let v657: f64 = v656 - v411;
-    let v658: f64 = p[50usize].mul_add(v648, v657);
-    let v659: f64 = v637 * p[107usize];
-    let v660: f64 = v426 + v659;
-    let v661: f64 = p[50usize].mul_add(v646, v660);
-    let v662: f64 = v409.mul_add(v658, v654);
-    let v663: f64 = v424.mul_add(v661, v662);
-    let v665: f64 = 0.5f64 * v664;
-    let v666: f64 = 0.5f64 * v106;
-    let v667: f64 = v666 * v236;
-    let v668: f64 = v240.mul_add(v665, v667);
-    let v669: f64 = p[55usize].mul_add(v668, -v238);
-    let v670: f64 = v666 * v240;
-    let v671: f64 = v236.mul_add(v665, -v670);
-    let v672: f64 = p[55usize].mul_add(v671, v262);
-    let v673: f64 = v237 * v665;
-    let v675: f64 = q[8usize].mul_add(v674, v103);
-    let v676: f64 = p[55usize] * v675;
-    let v677: f64 = v232 * v676;
-    let v678: f64 = v230.mul_add(v673, v677);
-    let v679: f64 = v230 * v676;
-    let v680: f64 = v232.mul_add(v673, -v679);
-    let v681: f64 = v278 * v680;
-    let v682: f64 = v276.mul_add(v678, -v681);
-    let v683: f64 = 0.5f64.mul_add(v281, v268);
-    let v684: f64 = v669.mul_add(v425, v683);
-    let v685: f64 = (-v672).mul_add(v410, v684);
-    let v686: f64 = p[56usize].mul_add(v682, v685);
-    let v687: f64 = p[62usize] * v672;
-    let v688: f64 = v687 - v410;
-    let v689: f64 = p[56usize].mul_add(v680, v688);
-    let v690: f64 = p[62usize] * v669;
-    let v691: f64 = v425 + v690;
-    let v692: f64 = p[56usize].mul_add(v678, v691);
-    let v693: f64 = v409.mul_add(v689, v686);
-    let v694: f64 = v424.mul_add(v692, v693);
-    let v696: f64 = 0.5f64 * v695;
-    let v697: f64 = p[61usize] * v118;
-    let v698: f64 = v697 * v696;
-    let v700: f64 = q[9usize].mul_add(v699, v115);
-    let v701: f64 = p[61usize] * v700;
-    let v702: f64 = v242 * v701;
-    let v703: f64 = v247.mul_add(v698, v702);
-    let v704: f64 = v247 * v701;
-    let v705: f64 = v242.mul_add(v698, -v704);
-    let v706: f64 = v264 * v705;
-    let v707: f64 = v252.mul_add(v703, -v706);
-    let v708: f64 = p[62usize] * v707;
-    let v709: f64 = 0.5f64.mul_add(v267, v708);
-    let v710: f64 = p[62usize] * v705;
-    let v711: f64 = p[62usize] * v703;
-    let v712: f64 = v409.mul_add(v710, v709);
-    let v713: f64 = v424.mul_add(v711, v712);
-    let v714: f64 = v454 * v454;
-    let v715: f64 = v456.mul_add(v456, v714);
-    let v716: f64 = (-2f64).mul_add(v417, v464);
-    let v717: f64 = 2f64.mul_add(v432, v467);
-    let v718: f64 = 0.25f64.mul_add(v390, v373);
-    let v719: f64 = p[14usize].mul_add(v715, v718);
-    let v720: f64 = v448.mul_add(v716, v719);
-    let v721: f64 = v445.mul_add(v717, v720);
-    let v722: f64 = v448.mul_add(v498, v494);
-    let v723: f64 = v445.mul_add(v501, v722);
-    let v724: f64 = v448.mul_add(v530, v526);
-    let v725: f64 = v445.mul_add(v533, v724);
-    let v726: f64 = v448.mul_add(v562, v558);
-    let v727: f64 = v445.mul_add(v565, v726);
-    let v728: f64 = v448.mul_add(v594, v590);
-    let v729: f64 = v445.mul_add(v597, v728);
-    let v730: f64 = v448.mul_add(v626, v622);
-    let v731: f64 = v445.mul_add(v629, v730);
-    let v732: f64 = v448.mul_add(v658, v654);
-    let v733: f64 = v445.mul_add(v661, v732);
-    let v734: f64 = v448.mul_add(v689, v686);
-    let v735: f64 = v445.mul_add(v692, v734);
-    let v736: f64 = v448.mul_add(v710, v709);
-    let v737: f64 = v445.mul_add(v711, v736);
-    let v738: f64 = v486 * v486;
-    let v739: f64 = v488.mul_add(v488, v738);
-    let v740: f64 = (-2f64).mul_add(v416, v496);
-    let v741: f64 = 2f64.mul_add(v431, v499);
-    let v742: f64 = 0.25f64.mul_add(v371, v358);
-    let v743: f64 = p[20usize].mul_add(v739, v742);
-    let v744: f64 = v480.mul_add(v740, v743);
-    let v745: f64 = v477.mul_add(v741, v744);
-    let v746: f64 = v480.mul_add(v530, v526);
-    let v747: f64 = v477.mul_add(v533, v746);
-    let v748: f64 = v480.mul_add(v562, v558);
-    let v749: f64 = v477.mul_add(v565, v748);
-    let v750: f64 = v480.mul_add(v594, v590);
-    let v751: f64 = v477.mul_add(v597, v750);
-    let v752: f64 = v480.mul_add(v626, v622);
-    let v753: f64 = v477.mul_add(v629, v752);
-    let v754: f64 = v480.mul_add(v658, v654);
-    let v755: f64 = v477.mul_add(v661, v754);
-    let v756: f64 = v480.mul_add(v689, v686);
-    let v757: f64 = v477.mul_add(v692, v756);
-    let v758: f64 = v480.mul_add(v710, v709);
-    let v759: f64 = v477.mul_add(v711, v758);
-    let v760: f64 = v518 * v518;
-    let v761: f64 = v520.mul_add(v520, v760);
-    let v762: f64 = (-2f64).mul_add(v415, v528);
-    let v763: f64 = 2f64.mul_add(v430, v531);
-    let v764: f64 = 0.25f64.mul_add(v356, v343);
-    let v765: f64 = p[26usize].mul_add(v761, v764);
-    let v766: f64 = v512.mul_add(v762, v765);
-    let v767: f64 = v509.mul_add(v763, v766);
-    let v768: f64 = v512.mul_add(v562, v558);
-    let v769: f64 = v509.mul_add(v565, v768);
-    let v770: f64 = v512.mul_add(v594, v590);
-    let v771: f64 = v509.mul_add(v597, v770);
-    let v772: f64 = v512.mul_add(v626, v622);
-    let v773: f64 = v509.mul_add(v629, v772);
-    let v774: f64 = v512.mul_add(v658, v654);
-    let v775: f64 = v509.mul_add(v661, v774);
-    let v776: f64 = v512.mul_add(v689, v686);
-    let v777: f64 = v509.mul_add(v692, v776);
-    let v778: f64 = v512.mul_add(v710, v709);
-    let v779: f64 = v509.mul_add(v711, v778);
-    let v780: f64 = v550 * v550;
-    let v781: f64 = v552.mul_add(v552, v780);
-    let v782: f64 = (-2f64).mul_add(v414, v560);
-    let v783: f64 = 2f64.mul_add(v429, v563);
-    let v784: f64 = 0.25f64.mul_add(v341, v328);
-    let v785: f64 = p[32usize].mul_add(v781, v784);
-    let v786: f64 = v544.mul_add(v782, v785);
-    let v787: f64 = v541.mul_add(v783, v786);
-    let v788: f64 = v544.mul_add(v594, v590);
-    let v789: f64 = v541.mul_add(v597, v788);
-    let v790: f64 = v544.mul_add(v626, v622);
-    let v791: f64 = v541.mul_add(v629, v790);
-    let v792: f64 = v544.mul_add(v658, v654);
-    let v793: f64 = v541.mul_add(v661, v792);
-    let v794: f64 = v544.mul_add(v689, v686);
-    let v795: f64 = v541.mul_add(v692, v794);
-    let v796: f64 = v544.mul_add(v710, v709);
-    let v797: f64 = v541.mul_add(v711, v796);
-    let v798: f64 = v582 * v582;
-    let v799: f64 = v584.mul_add(v584, v798);
-    let v800: f64 = (-2f64).mul_add(v413, v592);
-    let v801: f64 = 2f64.mul_add(v428, v595);
-    let v802: f64 = 0.25f64.mul_add(v326, v313);
-    let v803: f64 = p[38usize].mul_add(v799, v802);
-    let v804: f64 = v576.mul_add(v800, v803);
-    let v805: f64 = v573.mul_add(v801, v804);
-    let v806: f64 = v576.mul_add(v626, v622);
-    let v807: f64 = v573.mul_add(v629, v806);
-    let v808: f64 = v576.mul_add(v658, v654);
-    let v809: f64 = v573.mul_add(v661, v808);
-    let v810: f64 = v576.mul_add(v689, v686);
-    let v811: f64 = v573.mul_add(v692, v810);
-    let v812: f64 = v576.mul_add(v710, v709);
-    let v813: f64 = v573.mul_add(v711, v812);
-    let v814: f64 = v614 * v614;
-    let v815: f64 = v616.mul_add(v616, v814);
-    let v816: f64 = (-2f64).mul_add(v412, v624);
-    let v817: f64 = 2f64.mul_add(v427, v627);
-    let v818: f64 = 0.25f64.mul_add(v311, v298);
-    let v819: f64 = p[44usize].mul_add(v815, v818);
-    let v820: f64 = v608.mul_add(v816, v819);
-    let v821: f64 = v605.mul_add(v817, v820);
-    let v822: f64 = v608.mul_add(v658, v654);
-    let v823: f64 = v605.mul_add(v661, v822);
-    let v824: f64 = v608.mul_add(v689, v686);
-    let v825: f64 = v605.mul_add(v692, v824);
-    let v826: f64 = v608.mul_add(v710, v709);
-    let v827: f64 = v605.mul_add(v711, v826);
-    let v828: f64 = v646 * v646;
-    let v829: f64 = v648.mul_add(v648, v828);
-    let v830: f64 = (-2f64).mul_add(v411, v656);
-    let v831: f64 = 2f64.mul_add(v426, v659);
-    let v832: f64 = 0.25f64.mul_add(v296, v283);
-    let v833: f64 = p[50usize].mul_add(v829, v832);
-    let v834: f64 = v640.mul_add(v830, v833);
-    let v835: f64 = v637.mul_add(v831, v834);
-    let v836: f64 = v640.mul_add(v689, v686);
-    let v837: f64 = v637.mul_add(v692, v836);
-    let v838: f64 = v640.mul_add(v710, v709);
-    let v839: f64 = v637.mul_add(v711, v838);
-    let v840: f64 = v678 * v678;
-    let v841: f64 = v680.mul_add(v680, v840);
-    let v842: f64 = (-2f64).mul_add(v410, v687);
-    let v843: f64 = 2f64.mul_add(v425, v690);
-    let v844: f64 = 0.25f64.mul_add(v281, v268);
-    let v845: f64 = p[56usize].mul_add(v841, v844);
-    let v846: f64 = v672.mul_add(v842, v845);
-    let v847: f64 = v669.mul_add(v843, v846);
-    let v848: f64 = v672.mul_add(v710, v709);
-    let v849: f64 = v669.mul_add(v711, v848);
-    let v850: f64 = v703 * v703;
-    let v851: f64 = v705.mul_add(v705, v850);
-    let v852: f64 = p[62usize] * v851;
-    let v853: f64 = 0.25f64.mul_add(v267, v852);
-    let v858: f64 = p[71usize] * p[74usize];
-    let v861: f64 = p[67usize].mul_add(p[70usize], v858);
-    let v862: f64 = p[75usize].mul_add(p[78usize], v861);
-    let v863: f64 = -v862;
-    let v866: f64 = 0.5f64 * qd[0usize];
-    let v867: f64 = v866 * v866;
-    let v869: f64 = (-0.5f64) * v867;
-    let v870: f64 = (-v5).mul_add(v11, 2f64);
-    let v871: f64 = v869 * v870;
-    let v872: f64 = p[108usize] * v871;
-    let v873: f64 = p[8usize] * v872;
-    let v875: f64 = v8.powi(3i32);
-    let v876: f64 = p[109usize] * v875;
-    let v877: f64 = v876 * v869;
-    let v879: f64 = 0.5f64 * qd[1usize];
-    let v880: f64 = v866 + v866;
-    let v881: f64 = v879 + v880;
-    let v882: f64 = v22.powi(3i32);
-    let v883: f64 = v441 * v882;
-    let v884: f64 = 2f64 * q[1usize];
-    let v885: f64 = (-v20).mul_add(v24, 2f64);
-    let v886: f64 = v450.mul_add(v885, -v883);
-    let v887: f64 = (-v884).mul_add(v25, v886);
-    let v888: f64 = p[80usize] * v887;
-    let v889: f64 = qd[1usize] * v881;
-    let v891: f64 = 0.5f64 * qd[2usize];
-    let v892: f64 = v879 + v881;
-    let v893: f64 = v891 + v892;
-    let v894: f64 = v34.powi(3i32);
-    let v895: f64 = v473 * v894;
-    let v896: f64 = 2f64 * q[2usize];
-    let v897: f64 = (-v32).mul_add(v36, 2f64);
-    let v898: f64 = v482.mul_add(v897, -v895);
-    let v899: f64 = (-v896).mul_add(v37, v898);
-    let v900: f64 = p[81usize] * v899;
-    let v901: f64 = qd[2usize] * v893;
-    let v903: f64 = 0.5f64 * qd[3usize];
-    let v904: f64 = v891 + v893;
-    let v905: f64 = v903 + v904;
-    let v906: f64 = v46.powi(3i32);
-    let v907: f64 = v505 * v906;
-    let v908: f64 = 2f64 * q[3usize];
-    let v909: f64 = (-v44).mul_add(v48, 2f64);
-    let v910: f64 = v514.mul_add(v909, -v907);
-    let v911: f64 = (-v908).mul_add(v49, v910);
-    let v912: f64 = p[82usize] * v911;
-    let v913: f64 = qd[3usize] * v905;
-    let v915: f64 = 0.5f64 * qd[4usize];
-    let v916: f64 = v903 + v905;
-    let v917: f64 = v915 + v916;
-    let v918: f64 = v58.powi(3i32);
-    let v919: f64 = v537 * v918;
-    let v920: f64 = 2f64 * q[4usize];
-    let v921: f64 = (-v56).mul_add(v60, 2f64);
-    let v922: f64 = v546.mul_add(v921, -v919);
-    let v923: f64 = (-v920).mul_add(v61, v922);
-    let v924: f64 = p[83usize] * v923;
-    let v925: f64 = qd[4usize] * v917;
-    let v927: f64 = 0.5f64 * qd[5usize];
-    let v928: f64 = v915 + v917;
-    let v929: f64 = v927 + v928;
-    let v930: f64 = v70.powi(3i32);
-    let v931: f64 = v569 * v930;
-    let v932: f64 = 2f64 * q[5usize];
-    let v933: f64 = (-v68).mul_add(v72, 2f64);
-    let v934: f64 = v578.mul_add(v933, -v931);
-    let v935: f64 = (-v932).mul_add(v73, v934);
-    let v936: f64 = p[84usize] * v935;
-    let v937: f64 = qd[5usize] * v929;
-    let v939: f64 = 0.5f64 * qd[6usize];
-    let v940: f64 = v927 + v929;
-    let v941: f64 = v939 + v940;
-    let v942: f64 = v82.powi(3i32);
-    let v943: f64 = v601 * v942;
-    let v944: f64 = 2f64 * q[6usize];
-    let v945: f64 = (-v80).mul_add(v84, 2f64);
-    let v946: f64 = v610.mul_add(v945, -v943);
-    let v947: f64 = (-v944).mul_add(v85, v946);
-    let v948: f64 = p[85usize] * v947;
-    let v949: f64 = qd[6usize] * v941;
-    let v951: f64 = 0.5f64 * qd[7usize];
-    let v952: f64 = v939 + v941;
-    let v953: f64 = v951 + v952;
-    let v954: f64 = v94.powi(3i32);
-    let v955: f64 = v633 * v954;
-    let v956: f64 = 2f64 * q[7usize];
-    let v957: f64 = (-v92).mul_add(v96, 2f64);
-    let v958: f64 = v642.mul_add(v957, -v955);
-    let v959: f64 = (-v956).mul_add(v97, v958);
-    let v960: f64 = p[86usize] * v959;
-    let v961: f64 = qd[7usize] * v953;
-    let v963: f64 = 0.5f64 * qd[8usize];
-    let v964: f64 = v951 + v953;
-    let v965: f64 = v963 + v964;
-    let v966: f64 = v106.powi(3i32);
-    let v967: f64 = v665 * v966;
-    let v968: f64 = 2f64 * q[8usize];
-    let v969: f64 = (-v104).mul_add(v108, 2f64);
-    let v970: f64 = v674.mul_add(v969, -v967);
-    let v971: f64 = (-v968).mul_add(v109, v970);
-    let v972: f64 = p[87usize] * v971;
-    let v973: f64 = qd[8usize] * v965;
-    let v975: f64 = v963 + v965;
-    let v976: f64 = 0.5f64.mul_add(qd[9usize], v975);
-    let v977: f64 = v118.powi(3i32);
-    let v978: f64 = v696 * v977;
-    let v979: f64 = 2f64 * q[9usize];
-    let v980: f64 = (-v116).mul_add(v120, 2f64);
-    let v981: f64 = v699.mul_add(v980, -v978);
-    let v982: f64 = (-v979).mul_add(v121, v981);
-    let v983: f64 = p[88usize] * v982;
-    let v984: f64 = qd[9usize] * v976;
-    let v986: f64 = qd[0usize] * qd[0usize];
-    let v988: f64 = 0.25f64 * v987;
-    let v989: f64 = (-0.25f64).mul_add(v8, v988);
-    let v990: f64 = v137.mul_add(v989, v406);
-    let v991: f64 = p[7usize] * v990;
-    let v992: f64 = qd[0usize] + v879;
-    let v993: f64 = 2f64 * qd[1usize];
-    let v994: f64 = v993 * v145;
-    let v995: f64 = v994 * v441;
-    let v996: f64 = qd[1usize] * qd[1usize];
-    let v998: f64 = 0.25f64 * v997;
-    let v999: f64 = v992 * v992;
-    let v1000: f64 = v22 * v999;
-    let v1001: f64 = v996.mul_add(v998, -v1000);
-    let v1002: f64 = v150 * v1001;
-    let v1003: f64 = v995.mul_add(v992, v1002);
-    let v1004: f64 = p[13usize] * v1003;
-    let v1005: f64 = v986.mul_add(v991, v1004);
-    let v1006: f64 = v879 + v992;
-    let v1007: f64 = v891 + v1006;
-    let v1008: f64 = 2f64 * qd[2usize];
-    let v1009: f64 = v1008 * v158;
-    let v1010: f64 = v1009 * v473;
-    let v1011: f64 = qd[2usize] * qd[2usize];
-    let v1013: f64 = 0.25f64 * v1012;
-    let v1014: f64 = v1007 * v1007;
-    let v1015: f64 = v34 * v1014;
-    let v1016: f64 = v1011.mul_add(v1013, -v1015);
-    let v1017: f64 = v163 * v1016;
-    let v1018: f64 = v1010.mul_add(v1007, v1017);
-    let v1019: f64 = p[19usize].mul_add(v1018, v1005);
-    let v1020: f64 = v891 + v1007;
-    let v1021: f64 = v903 + v1020;
-    let v1022: f64 = 2f64 * qd[3usize];
-    let v1023: f64 = v1022 * v171;
-    let v1024: f64 = v1023 * v505;
-    let v1025: f64 = qd[3usize] * qd[3usize];
-    let v1027: f64 = 0.25f64 * v1026;
-    let v1028: f64 = v1021 * v1021;
-    let v1029: f64 = v46 * v1028;
-    let v1030: f64 = v1025.mul_add(v1027, -v1029);
-    let v1031: f64 = v176 * v1030;
-    let v1032: f64 = v1024.mul_add(v1021, v1031);
-    let v1033: f64 = p[25usize].mul_add(v1032, v1019);
-    let v1034: f64 = v903 + v1021;
-    let v1035: f64 = v915 + v1034;
-    let v1036: f64 = 2f64 * qd[4usize];
-    let v1037: f64 = v1036 * v184;
-    let v1038: f64 = v1037 * v537;
-    let v1039: f64 = qd[4usize] * qd[4usize];
-    let v1041: f64 = 0.25f64 * v1040;
-    let v1042: f64 = v1035 * v1035;
-    let v1043: f64 = v58 * v1042;
-    let v1044: f64 = v1039.mul_add(v1041, -v1043);
-    let v1045: f64 = v189 * v1044;
-    let v1046: f64 = v1038.mul_add(v1035, v1045);
-    let v1047: f64 = p[31usize].mul_add(v1046, v1033);
-    let v1048: f64 = v915 + v1035;
-    let v1049: f64 = v927 + v1048;
-    let v1050: f64 = 2f64 * qd[5usize];
-    let v1051: f64 = v1050 * v197;
-    let v1052: f64 = v1051 * v569;
-    let v1053: f64 = qd[5usize] * qd[5usize];
-    let v1055: f64 = 0.25f64 * v1054;
-    let v1056: f64 = v1049 * v1049;
-    let v1057: f64 = v70 * v1056;
-    let v1058: f64 = v1053.mul_add(v1055, -v1057);
-    let v1059: f64 = v202 * v1058;
-    let v1060: f64 = v1052.mul_add(v1049, v1059);
-    let v1061: f64 = p[37usize].mul_add(v1060, v1047);
-    let v1062: f64 = v927 + v1049;
-    let v1063: f64 = v939 + v1062;
-    let v1064: f64 = 2f64 * qd[6usize];
-    let v1065: f64 = v1064 * v210;
-    let v1066: f64 = v1065 * v601;
-    let v1067: f64 = qd[6usize] * qd[6usize];
-    let v1069: f64 = 0.25f64 * v1068;
-    let v1070: f64 = v1063 * v1063;
-    let v1071: f64 = v82 * v1070;
-    let v1072: f64 = v1067.mul_add(v1069, -v1071);
-    let v1073: f64 = v215 * v1072;
-    let v1074: f64 = v1066.mul_add(v1063, v1073);
-    let v1075: f64 = p[43usize].mul_add(v1074, v1061);
-    let v1076: f64 = v939 + v1063;
-    let v1077: f64 = v951 + v1076;
-    let v1078: f64 = 2f64 * qd[7usize];
-    let v1079: f64 = v1078 * v223;
-    let v1080: f64 = v1079 * v633;
-    let v1081: f64 = qd[7usize] * qd[7usize];
-    let v1083: f64 = 0.25f64 * v1082;
-    let v1084: f64 = v1077 * v1077;
-    let v1085: f64 = v94 * v1084;
-    let v1086: f64 = v1081.mul_add(v1083, -v1085);
-    let v1087: f64 = v228 * v1086;
-    let v1088: f64 = v1080.mul_add(v1077, v1087);
-    let v1089: f64 = p[49usize].mul_add(v1088, v1075);
-    let v1090: f64 = v951 + v1077;
-    let v1091: f64 = v963 + v1090;
-    let v1092: f64 = 2f64 * qd[8usize];
-    let v1093: f64 = v1092 * v236;
-    let v1094: f64 = v1093 * v665;
-    let v1095: f64 = qd[8usize] * qd[8usize];
-    let v1097: f64 = 0.25f64 * v1096;
-    let v1098: f64 = v1091 * v1091;
-    let v1099: f64 = v106 * v1098;
-    let v1100: f64 = v1095.mul_add(v1097, -v1099);
-    let v1101: f64 = v240 * v1100;
-    let v1102: f64 = v1094.mul_add(v1091, v1101);
-    let v1103: f64 = p[55usize].mul_add(v1102, v1089);
-    let v1104: f64 = qd[9usize] * qd[9usize];
-    let v1106: f64 = q[9usize] * v1105;
-    let v1107: f64 = 2f64.mul_add(v699, v1106);
-    let v1108: f64 = p[61usize] * v1107;
-    let v1109: f64 = v1104 * v1108;
-    let v1110: f64 = v963 + v1091;
-    let v1111: f64 = 2f64 * qd[9usize];
-    let v1112: f64 = v1111 * v1110;
-    let v1113: f64 = v1112 * v698;
-    let v1114: f64 = v1110 * v1110;
-    let v1115: f64 = v250 * v1114;
-    let v1116: f64 = v1109 + v1113;
-    let v1117: f64 = v1116 - v1115;
-    let v1119: f64 = 0.25f64 * v1118;
-    let v1120: f64 = v118 * v1119;
-    let v1121: f64 = v696.mul_add(v696, v1120);
-    let v1122: f64 = p[61usize] * v1121;
-    let v1123: f64 = v245 * v1114;
-    let v1124: f64 = v1104.mul_add(v1122, -v1123);
-    let v1125: f64 = (-v1112).mul_add(v701, v1124);
-    let v1126: f64 = v242.mul_add(v1117, v1103);
-    let v1127: f64 = v247.mul_add(v1125, v1126);
-    let v1128: f64 = p[110usize] + v1127;
-    let v1130: f64 = v132.mul_add(v989, -v422);
-    let v1131: f64 = p[7usize] * v1130;
-    let v1132: f64 = v993 * v150;
-    let v1133: f64 = v1132 * v441;
-    let v1134: f64 = v1133 * v992;
-    let v1135: f64 = v145.mul_add(v1001, -v1134);
-    let v1136: f64 = p[13usize] * v1135;
-    let v1137: f64 = v986.mul_add(v1131, v1136);
-    let v1138: f64 = v1008 * v163;
-    let v1139: f64 = v1138 * v473;
-    let v1140: f64 = v1139 * v1007;
-    let v1141: f64 = v158.mul_add(v1016, -v1140);
-    let v1142: f64 = p[19usize].mul_add(v1141, v1137);
-    let v1143: f64 = v1022 * v176;
-    let v1144: f64 = v1143 * v505;
-    let v1145: f64 = v1144 * v1021;
-    let v1146: f64 = v171.mul_add(v1030, -v1145);
-    let v1147: f64 = p[25usize].mul_add(v1146, v1142);
-    let v1148: f64 = v1036 * v189;
-    let v1149: f64 = v1148 * v537;
-    let v1150: f64 = v1149 * v1035;
-    let v1151: f64 = v184.mul_add(v1044, -v1150);
-    let v1152: f64 = p[31usize].mul_add(v1151, v1147);
-    let v1153: f64 = v1050 * v202;
-    let v1154: f64 = v1153 * v569;
-    let v1155: f64 = v1154 * v1049;
-    let v1156: f64 = v197.mul_add(v1058, -v1155);
-    let v1157: f64 = p[37usize].mul_add(v1156, v1152);
-    let v1158: f64 = v1064 * v215;
-    let v1159: f64 = v1158 * v601;
-    let v1160: f64 = v1159 * v1063;
-    let v1161: f64 = v210.mul_add(v1072, -v1160);
-    let v1162: f64 = p[43usize].mul_add(v1161, v1157);
-    let v1163: f64 = v1078 * v228;
-    let v1164: f64 = v1163 * v633;
-    let v1165: f64 = v1164 * v1077;
-    let v1166: f64 = v223.mul_add(v1086, -v1165);
-    let v1167: f64 = p[49usize].mul_add(v1166, v1162);
-    let v1168: f64 = v1092 * v240;
-    let v1169: f64 = v1168 * v665;
-    let v1170: f64 = v1169 * v1091;
-    let v1171: f64 = v236.mul_add(v1100, -v1170);
-    let v1172: f64 = p[55usize].mul_add(v1171, v1167);
-    let v1173: f64 = v1115 - v1109;
-    let v1174: f64 = v1173 - v1113;
-    let v1175: f64 = v242.mul_add(v1125, v1172);
-    let v1176: f64 = v247.mul_add(v1174, v1175);
-    let v1177: f64 = p[111usize] + v1176;
-    let v1178: f64 = v264 * v1177;
-    let v1179: f64 = v252.mul_add(v1128, -v1178);
-    let v1180: f64 = p[62usize] * v1179;
-    let v1181: f64 = v984.mul_add(v983, v1180);
-    let v1183: f64 = q[8usize] * v1182;
-    let v1184: f64 = 2f64.mul_add(v674, v1183);
-    let v1185: f64 = p[55usize] * v1184;
-    let v1186: f64 = v1095 * v1185;
-    let v1187: f64 = v1092 * v1090;
-    let v1188: f64 = v1187 * v673;
-    let v1189: f64 = v1090 * v1090;
-    let v1190: f64 = v274 * v1189;
-    let v1191: f64 = v1186 + v1188;
-    let v1192: f64 = v1191 - v1190;
-    let v1193: f64 = v106 * v1097;
-    let v1194: f64 = v665.mul_add(v665, v1193);
-    let v1195: f64 = p[55usize] * v1194;
-    let v1196: f64 = v272 * v1189;
-    let v1197: f64 = v1095.mul_add(v1195, -v1196);
-    let v1198: f64 = (-v1187).mul_add(v676, v1197);
-    let v1199: f64 = v232.mul_add(v1192, v1089);
-    let v1200: f64 = v230.mul_add(v1198, v1199);
-    let v1201: f64 = p[110usize] + v1200;
-    let v1202: f64 = v1190 - v1186;
-    let v1203: f64 = v1202 - v1188;
-    let v1204: f64 = v232.mul_add(v1198, v1167);
-    let v1205: f64 = v230.mul_add(v1203, v1204);
-    let v1206: f64 = p[111usize] + v1205;
-    let v1207: f64 = v278 * v1206;
-    let v1208: f64 = v276.mul_add(v1201, -v1207);
-    let v1209: f64 = v973.mul_add(v972, v1181);
-    let v1210: f64 = p[56usize].mul_add(v1208, v1209);
-    let v1212: f64 = q[7usize] * v1211;
-    let v1213: f64 = 2f64.mul_add(v642, v1212);
-    let v1214: f64 = p[49usize] * v1213;
-    let v1215: f64 = v1081 * v1214;
-    let v1216: f64 = v1078 * v1076;
-    let v1217: f64 = v1216 * v641;
-    let v1218: f64 = v1076 * v1076;
-    let v1219: f64 = v289 * v1218;
-    let v1220: f64 = v1215 + v1217;
-    let v1221: f64 = v1220 - v1219;
-    let v1222: f64 = v94 * v1083;
-    let v1223: f64 = v633.mul_add(v633, v1222);
-    let v1224: f64 = p[49usize] * v1223;
-    let v1225: f64 = v287 * v1218;
-    let v1226: f64 = v1081.mul_add(v1224, -v1225);
-    let v1227: f64 = (-v1216).mul_add(v644, v1226);
-    let v1228: f64 = v219.mul_add(v1221, v1075);
-    let v1229: f64 = v217.mul_add(v1227, v1228);
-    let v1230: f64 = p[110usize] + v1229;
-    let v1231: f64 = v1219 - v1215;
-    let v1232: f64 = v1231 - v1217;
-    let v1233: f64 = v219.mul_add(v1227, v1162);
-    let v1234: f64 = v217.mul_add(v1232, v1233);
-    let v1235: f64 = p[111usize] + v1234;
-    let v1236: f64 = v293 * v1235;
-    let v1237: f64 = v291.mul_add(v1230, -v1236);
-    let v1238: f64 = v961.mul_add(v960, v1210);
-    let v1239: f64 = p[50usize].mul_add(v1237, v1238);
-    let v1241: f64 = q[6usize] * v1240;
-    let v1242: f64 = 2f64.mul_add(v610, v1241);
-    let v1243: f64 = p[43usize] * v1242;
-    let v1244: f64 = v1067 * v1243;
-    let v1245: f64 = v1064 * v1062;
-    let v1246: f64 = v1245 * v609;
-    let v1247: f64 = v1062 * v1062;
-    let v1248: f64 = v304 * v1247;
-    let v1249: f64 = v1244 + v1246;
-    let v1250: f64 = v1249 - v1248;
-    let v1251: f64 = v82 * v1069;
-    let v1252: f64 = v601.mul_add(v601, v1251);
-    let v1253: f64 = p[43usize] * v1252;
-    let v1254: f64 = v302 * v1247;
-    let v1255: f64 = v1067.mul_add(v1253, -v1254);
-    let v1256: f64 = (-v1245).mul_add(v612, v1255);
-    let v1257: f64 = v206.mul_add(v1250, v1061);
-    let v1258: f64 = v204.mul_add(v1256, v1257);
-    let v1259: f64 = p[110usize] + v1258;
-    let v1260: f64 = v1248 - v1244;
-    let v1261: f64 = v1260 - v1246;
-    let v1262: f64 = v206.mul_add(v1256, v1157);
-    let v1263: f64 = v204.mul_add(v1261, v1262);
-    let v1264: f64 = p[111usize] + v1263;
-    let v1265: f64 = v308 * v1264;
-    let v1266: f64 = v306.mul_add(v1259, -v1265);
-    let v1267: f64 = v949.mul_add(v948, v1239);
-    let v1268: f64 = p[44usize].mul_add(v1266, v1267);
-    let v1270: f64 = q[5usize] * v1269;
-    let v1271: f64 = 2f64.mul_add(v578, v1270);
-    let v1272: f64 = p[37usize] * v1271;
-    let v1273: f64 = v1053 * v1272;
-    let v1274: f64 = v1050 * v1048;
-    let v1275: f64 = v1274 * v577;
-    let v1276: f64 = v1048 * v1048;
-    let v1277: f64 = v319 * v1276;
-    let v1278: f64 = v1273 + v1275;
-    let v1279: f64 = v1278 - v1277;
-    let v1280: f64 = v70 * v1055;
-    let v1281: f64 = v569.mul_add(v569, v1280);
-    let v1282: f64 = p[37usize] * v1281;
-    let v1283: f64 = v317 * v1276;
-    let v1284: f64 = v1053.mul_add(v1282, -v1283);
-    let v1285: f64 = (-v1274).mul_add(v580, v1284);
-    let v1286: f64 = v193.mul_add(v1279, v1047);
-    let v1287: f64 = v191.mul_add(v1285, v1286);
-    let v1288: f64 = p[110usize] + v1287;
-    let v1289: f64 = v1277 - v1273;
-    let v1290: f64 = v1289 - v1275;
-    let v1291: f64 = v193.mul_add(v1285, v1152);
-    let v1292: f64 = v191.mul_add(v1290, v1291);
-    let v1293: f64 = p[111usize] + v1292;
-    let v1294: f64 = v323 * v1293;
-    let v1295: f64 = v321.mul_add(v1288, -v1294);
-    let v1296: f64 = v937.mul_add(v936, v1268);
-    let v1297: f64 = p[38usize].mul_add(v1295, v1296);
-    let v1299: f64 = q[4usize] * v1298;
-    let v1300: f64 = 2f64.mul_add(v546, v1299);
-    let v1301: f64 = p[31usize] * v1300;
-    let v1302: f64 = v1039 * v1301;
-    let v1303: f64 = v1036 * v1034;
-    let v1304: f64 = v1303 * v545;
-    let v1305: f64 = v1034 * v1034;
-    let v1306: f64 = v334 * v1305;
-    let v1307: f64 = v1302 + v1304;
-    let v1308: f64 = v1307 - v1306;
-    let v1309: f64 = v58 * v1041;
-    let v1310: f64 = v537.mul_add(v537, v1309);
-    let v1311: f64 = p[31usize] * v1310;
-    let v1312: f64 = v332 * v1305;
-    let v1313: f64 = v1039.mul_add(v1311, -v1312);
-    let v1314: f64 = (-v1303).mul_add(v548, v1313);
-    let v1315: f64 = v180.mul_add(v1308, v1033);
-    let v1316: f64 = v178.mul_add(v1314, v1315);
-    let v1317: f64 = p[110usize] + v1316;
-    let v1318: f64 = v1306 - v1302;
-    let v1319: f64 = v1318 - v1304;
-    let v1320: f64 = v180.mul_add(v1314, v1147);
-    let v1321: f64 = v178.mul_add(v1319, v1320);
-    let v1322: f64 = p[111usize] + v1321;
-    let v1323: f64 = v338 * v1322;
-    let v1324: f64 = v336.mul_add(v1317, -v1323);
-    let v1325: f64 = v925.mul_add(v924, v1297);
-    let v1326: f64 = p[32usize].mul_add(v1324, v1325);
-    let v1328: f64 = q[3usize] * v1327;
-    let v1329: f64 = 2f64.mul_add(v514, v1328);
-    let v1330: f64 = p[25usize] * v1329;
-    let v1331: f64 = v1025 * v1330;
-    let v1332: f64 = v1022 * v1020;
-    let v1333: f64 = v1332 * v513;
-    let v1334: f64 = v1020 * v1020;
-    let v1335: f64 = v349 * v1334;
-    let v1336: f64 = v1331 + v1333;
-    let v1337: f64 = v1336 - v1335;
-    let v1338: f64 = v46 * v1027;
-    let v1339: f64 = v505.mul_add(v505, v1338);
-    let v1340: f64 = p[25usize] * v1339;
-    let v1341: f64 = v347 * v1334;
-    let v1342: f64 = v1025.mul_add(v1340, -v1341);
-    let v1343: f64 = (-v1332).mul_add(v516, v1342);
-    let v1344: f64 = v167.mul_add(v1337, v1019);
-    let v1345: f64 = v165.mul_add(v1343, v1344);
-    let v1346: f64 = p[110usize] + v1345;
-    let v1347: f64 = v1335 - v1331;
-    let v1348: f64 = v1347 - v1333;
-    let v1349: f64 = v167.mul_add(v1343, v1142);
-    let v1350: f64 = v165.mul_add(v1348, v1349);
-    let v1351: f64 = p[111usize] + v1350;
-    let v1352: f64 = v353 * v1351;
-    let v1353: f64 = v351.mul_add(v1346, -v1352);
-    let v1354: f64 = v913.mul_add(v912, v1326);
-    let v1355: f64 = p[26usize].mul_add(v1353, v1354);
-    let v1357: f64 = q[2usize] * v1356;
-    let v1358: f64 = 2f64.mul_add(v482, v1357);
-    let v1359: f64 = p[19usize] * v1358;
-    let v1360: f64 = v1011 * v1359;
-    let v1361: f64 = v1008 * v1006;
-    let v1362: f64 = v1361 * v481;
-    let v1363: f64 = v1006 * v1006;
-    let v1364: f64 = v364 * v1363;
-    let v1365: f64 = v1360 + v1362;
-    let v1366: f64 = v1365 - v1364;
-    let v1367: f64 = v34 * v1013;
-    let v1368: f64 = v473.mul_add(v473, v1367);
-    let v1369: f64 = p[19usize] * v1368;
-    let v1370: f64 = v362 * v1363;
-    let v1371: f64 = v1011.mul_add(v1369, -v1370);
-    let v1372: f64 = (-v1361).mul_add(v484, v1371);
-    let v1373: f64 = v154.mul_add(v1366, v1005);
-    let v1374: f64 = v152.mul_add(v1372, v1373);
-    let v1375: f64 = p[110usize] + v1374;
-    let v1376: f64 = v1364 - v1360;
-    let v1377: f64 = v1376 - v1362;
-    let v1378: f64 = v154.mul_add(v1372, v1137);
-    let v1379: f64 = v152.mul_add(v1377, v1378);
-    let v1380: f64 = p[111usize] + v1379;
-    let v1381: f64 = v368 * v1380;
-    let v1382: f64 = v366.mul_add(v1375, -v1381);
-    let v1383: f64 = v901.mul_add(v900, v1355);
-    let v1384: f64 = p[20usize].mul_add(v1382, v1383);
-    let v1385: f64 = v991 - v384;
-    let v1386: f64 = v1385 - v385;
-    let v1387: f64 = 2f64 * v141;
-    let v1388: f64 = 2f64 * v139;
-    let v1389: f64 = v1388 * v452;
-    let v1390: f64 = v1387.mul_add(v449, -v1389);
-    let v1391: f64 = qd[1usize] * v1390;
-    let v1392: f64 = qd[0usize] * v1391;
-    let v1393: f64 = v22 * v998;
-    let v1394: f64 = v441.mul_add(v441, v1393);
-    let v1395: f64 = p[13usize] * v1394;
-    let v1397: f64 = q[1usize] * v1396;
-    let v1398: f64 = 2f64.mul_add(v450, v1397);
-    let v1399: f64 = p[13usize] * v1398;
-    let v1400: f64 = v141 * v1399;
-    let v1401: f64 = v139.mul_add(v1395, v1400);
-    let v1402: f64 = v986.mul_add(v1386, v1392);
-    let v1403: f64 = v996.mul_add(v1401, v1402);
-    let v1404: f64 = p[110usize] + v1403;
-    let v1405: f64 = v381 - v378;
-    let v1406: f64 = v1405 + v1131;
-    let v1407: f64 = v1387 * v452;
-    let v1408: f64 = v1388.mul_add(v449, v1407);
-    let v1409: f64 = -v1408;
-    let v1410: f64 = qd[1usize] * v1409;
-    let v1411: f64 = qd[0usize] * v1410;
-    let v1412: f64 = v139 * v1399;
-    let v1413: f64 = v141.mul_add(v1395, -v1412);
-    let v1414: f64 = v986.mul_add(v1406, v1411);
-    let v1415: f64 = v996.mul_add(v1413, v1414);
-    let v1416: f64 = p[111usize] + v1415;
-    let v1417: f64 = v387 * v1416;
-    let v1418: f64 = v383.mul_add(v1404, -v1417);
-    let v1419: f64 = v889.mul_add(v888, v1384);
-    let v1420: f64 = p[14usize].mul_add(v1418, v1419);
-    let v1421: f64 = p[62usize] * v1177;
-    let v1422: f64 = p[56usize].mul_add(v1206, v1421);
-    let v1423: f64 = p[50usize].mul_add(v1235, v1422);
-    let v1424: f64 = p[44usize].mul_add(v1264, v1423);
-    let v1425: f64 = p[38usize].mul_add(v1293, v1424);
-    let v1426: f64 = p[32usize].mul_add(v1322, v1425);
-    let v1427: f64 = p[26usize].mul_add(v1351, v1426);
-    let v1428: f64 = p[20usize].mul_add(v1380, v1427);
-    let v1429: f64 = p[14usize].mul_add(v1416, v1428);
-    let v1430: f64 = p[62usize] * v1128;
-    let v1431: f64 = p[56usize].mul_add(v1201, v1430);
-    let v1432: f64 = p[50usize].mul_add(v1230, v1431);
-    let v1433: f64 = p[44usize].mul_add(v1259, v1432);
-    let v1434: f64 = p[38usize].mul_add(v1288, v1433);
-    let v1435: f64 = p[32usize].mul_add(v1317, v1434);
-    let v1436: f64 = p[26usize].mul_add(v1346, v1435);
-    let v1437: f64 = p[20usize].mul_add(v1375, v1436);
-    let v1438: f64 = p[14usize].mul_add(v1404, v1437);
-    let v1441: f64 = p[112usize] + q[0usize];
-    let v1442: f64 = v8 * v988;
-    let v1443: f64 = v395.mul_add(v395, v1442);
-    let v1444: f64 = p[7usize] * v1443;
-    let v1446: f64 = q[0usize] * v1445;
-    let v1447: f64 = 2f64.mul_add(v397, v1446);
-    let v1448: f64 = p[7usize] * v1447;
-    let v1449: f64 = p[89usize] * v1448;
-    let v1450: f64 = p[90usize].mul_add(v1444, -v1449);
-    let v1451: f64 = v986.mul_add(v1450, p[111usize]);
-    let v1452: f64 = p[90usize] * v1448;
-    let v1453: f64 = p[89usize].mul_add(v1444, v1452);
-    let v1454: f64 = v986.mul_add(v1453, p[110usize]);
-    let v1455: f64 = v401 * v1454;
-    let v1457: f64 = p[113usize] * q[0usize];
-    let v1458: f64 = v1457 * v12;
-    let v1459: f64 = v403.mul_add(v1451, v1455);
-    let v1460: f64 = (-v1458).mul_add(v869, v1459);
-    let v1462: f64 = v395 * v875;
-    let v1463: f64 = 2f64 * q[0usize];
-    let v1464: f64 = v397.mul_add(v870, -v1462);
-    let v1465: f64 = (-v1463).mul_add(v12, v1464);
-    let v1466: f64 = p[79usize] * v1465;
-    let v1467: f64 = 0.5f64 * v866;
-    let v1468: f64 = v1467.mul_add(v1466, p[11usize]);
-    let v1469: f64 = v397.mul_add(v873, -v863);
-    let v1470: f64 = v395.mul_add(v877, v1469);
-    let v1471: f64 = v1470 + v1420;
-    let v1472: f64 = v409.mul_add(v1429, v1471);
-    let v1473: f64 = v424.mul_add(v1438, v1472);
-    let v1474: f64 = p[10usize].mul_add(v1441, v1473);
-    let v1475: f64 = p[8usize].mul_add(v1460, v1474);
-    let v1476: f64 = qd[0usize].mul_add(v1468, v1475);
-    let v1478: f64 = v881 * v881;
-    let v1479: f64 = (-0.5f64) * v1478;
-    let v1480: f64 = v1479 * v885;
-    let v1481: f64 = p[114usize] * v1480;
-    let v1482: f64 = p[14usize] * v1481;
-    let v1484: f64 = p[115usize] * v882;
-    let v1485: f64 = v1484 * v1479;
-    let v1488: f64 = p[116usize] + q[1usize];
-    let v1489: f64 = v1404 * v454;
-    let v1491: f64 = p[117usize] * q[1usize];
-    let v1492: f64 = v1491 * v25;
-    let v1493: f64 = v1416.mul_add(v456, v1489);
-    let v1494: f64 = (-v1492).mul_add(v1479, v1493);
-    let v1496: f64 = 0.5f64 * v881;
-    let v1497: f64 = v1496.mul_add(v888, p[17usize]);
-    let v1498: f64 = v450.mul_add(v1482, -v863);
-    let v1499: f64 = v441.mul_add(v1485, v1498);
-    let v1500: f64 = v1499 + v1384;
-    let v1501: f64 = v448.mul_add(v1428, v1500);
-    let v1502: f64 = v445.mul_add(v1437, v1501);
-    let v1503: f64 = p[16usize].mul_add(v1488, v1502);
-    let v1504: f64 = p[14usize].mul_add(v1494, v1503);
-    let v1505: f64 = qd[1usize].mul_add(v1497, v1504);
-    let v1507: f64 = v893 * v893;
-    let v1508: f64 = (-0.5f64) * v1507;
-    let v1509: f64 = v1508 * v897;
-    let v1510: f64 = p[118usize] * v1509;
-    let v1511: f64 = p[20usize] * v1510;
-    let v1513: f64 = p[119usize] * v894;
-    let v1514: f64 = v1513 * v1508;
-    let v1517: f64 = p[120usize] + q[2usize];
-    let v1518: f64 = v1375 * v486;
-    let v1520: f64 = p[121usize] * q[2usize];
-    let v1521: f64 = v1520 * v37;
-    let v1522: f64 = v1380.mul_add(v488, v1518);
-    let v1523: f64 = (-v1521).mul_add(v1508, v1522);
-    let v1525: f64 = 0.5f64 * v893;
-    let v1526: f64 = v1525.mul_add(v900, p[23usize]);
-    let v1527: f64 = v482.mul_add(v1511, -v863);
-    let v1528: f64 = v473.mul_add(v1514, v1527);
-    let v1529: f64 = v1528 + v1355;
-    let v1530: f64 = v480.mul_add(v1427, v1529);
-    let v1531: f64 = v477.mul_add(v1436, v1530);
-    let v1532: f64 = p[22usize].mul_add(v1517, v1531);
-    let v1533: f64 = p[20usize].mul_add(v1523, v1532);
-    let v1534: f64 = qd[2usize].mul_add(v1526, v1533);
-    let v1536: f64 = v905 * v905;
-    let v1537: f64 = (-0.5f64) * v1536;
-    let v1538: f64 = v1537 * v909;
-    let v1539: f64 = p[122usize] * v1538;
-    let v1540: f64 = p[26usize] * v1539;
-    let v1542: f64 = p[123usize] * v906;
-    let v1543: f64 = v1542 * v1537;
-    let v1546: f64 = p[124usize] + q[3usize];
-    let v1547: f64 = v1346 * v518;
-    let v1549: f64 = p[125usize] * q[3usize];
-    let v1550: f64 = v1549 * v49;
-    let v1551: f64 = v1351.mul_add(v520, v1547);
-    let v1552: f64 = (-v1550).mul_add(v1537, v1551);
-    let v1554: f64 = 0.5f64 * v905;
-    let v1555: f64 = v1554.mul_add(v912, p[29usize]);
-    let v1556: f64 = v514.mul_add(v1540, -v863);
-    let v1557: f64 = v505.mul_add(v1543, v1556);
-    let v1558: f64 = v1557 + v1326;
-    let v1559: f64 = v512.mul_add(v1426, v1558);
-    let v1560: f64 = v509.mul_add(v1435, v1559);
-    let v1561: f64 = p[28usize].mul_add(v1546, v1560);
-    let v1562: f64 = p[26usize].mul_add(v1552, v1561);
-    let v1563: f64 = qd[3usize].mul_add(v1555, v1562);
-    let v1565: f64 = v917 * v917;
-    let v1566: f64 = (-0.5f64) * v1565;
-    let v1567: f64 = v1566 * v921;
-    let v1568: f64 = p[126usize] * v1567;
-    let v1569: f64 = p[32usize] * v1568;
-    let v1571: f64 = p[127usize] * v918;
-    let v1572: f64 = v1571 * v1566;
-    let v1575: f64 = p[128usize] + q[4usize];
-    let v1576: f64 = v1317 * v550;
-    let v1578: f64 = p[129usize] * q[4usize];
-    let v1579: f64 = v1578 * v61;
-    let v1580: f64 = v1322.mul_add(v552, v1576);
-    let v1581: f64 = (-v1579).mul_add(v1566, v1580);
-    let v1583: f64 = 0.5f64 * v917;
-    let v1584: f64 = v1583.mul_add(v924, p[35usize]);
-    let v1585: f64 = v546.mul_add(v1569, -v863);
-    let v1586: f64 = v537.mul_add(v1572, v1585);
-    let v1587: f64 = v1586 + v1297;
-    let v1588: f64 = v544.mul_add(v1425, v1587);
-    let v1589: f64 = v541.mul_add(v1434, v1588);
-    let v1590: f64 = p[34usize].mul_add(v1575, v1589);
-    let v1591: f64 = p[32usize].mul_add(v1581, v1590);
-    let v1592: f64 = qd[4usize].mul_add(v1584, v1591);
-    let v1594: f64 = v929 * v929;
-    let v1595: f64 = (-0.5f64) * v1594;
-    let v1596: f64 = v1595 * v933;
-    let v1597: f64 = p[130usize] * v1596;
-    let v1598: f64 = p[38usize] * v1597;
-    let v1600: f64 = p[131usize] * v930;
-    let v1601: f64 = v1600 * v1595;
-    let v1604: f64 = p[132usize] + q[5usize];
-    let v1605: f64 = v1288 * v582;
-    let v1607: f64 = p[133usize] * q[5usize];
-    let v1608: f64 = v1607 * v73;
-    let v1609: f64 = v1293.mul_add(v584, v1605);
-    let v1610: f64 = (-v1608).mul_add(v1595, v1609);
-    let v1612: f64 = 0.5f64 * v929;
-    let v1613: f64 = v1612.mul_add(v936, p[41usize]);
-    let v1614: f64 = v578.mul_add(v1598, -v863);
-    let v1615: f64 = v569.mul_add(v1601, v1614);
-    let v1616: f64 = v1615 + v1268;
-    let v1617: f64 = v576.mul_add(v1424, v1616);
-    let v1618: f64 = v573.mul_add(v1433, v1617);
-    let v1619: f64 = p[40usize].mul_add(v1604, v1618);
-    let v1620: f64 = p[38usize].mul_add(v1610, v1619);
-    let v1621: f64 = qd[5usize].mul_add(v1613, v1620);
-    let v1623: f64 = v941 * v941;
-    let v1624: f64 = (-0.5f64) * v1623;
-    let v1625: f64 = v1624 * v945;
-    let v1626: f64 = p[134usize] * v1625;
-    let v1627: f64 = p[44usize] * v1626;
-    let v1629: f64 = p[135usize] * v942;
-    let v1630: f64 = v1629 * v1624;
-    let v1633: f64 = p[136usize] + q[6usize];
-    let v1634: f64 = v1259 * v614;
-    let v1636: f64 = p[137usize] * q[6usize];
-    let v1637: f64 = v1636 * v85;
-    let v1638: f64 = v1264.mul_add(v616, v1634);
-    let v1639: f64 = (-v1637).mul_add(v1624, v1638);
-    let v1641: f64 = 0.5f64 * v941;
-    let v1642: f64 = v1641.mul_add(v948, p[47usize]);
-    let v1643: f64 = v610.mul_add(v1627, -v863);
-    let v1644: f64 = v601.mul_add(v1630, v1643);
-    let v1645: f64 = v1644 + v1239;
-    let v1646: f64 = v608.mul_add(v1423, v1645);
-    let v1647: f64 = v605.mul_add(v1432, v1646);
-    let v1648: f64 = p[46usize].mul_add(v1633, v1647);
-    let v1649: f64 = p[44usize].mul_add(v1639, v1648);
-    let v1650: f64 = qd[6usize].mul_add(v1642, v1649);
-    let v1652: f64 = v953 * v953;
-    let v1653: f64 = (-0.5f64) * v1652;
-    let v1654: f64 = v1653 * v957;
-    let v1655: f64 = p[138usize] * v1654;
-    let v1656: f64 = p[50usize] * v1655;
-    let v1658: f64 = p[139usize] * v954;
-    let v1659: f64 = v1658 * v1653;
-    let v1662: f64 = p[140usize] + q[7usize];
-    let v1663: f64 = v1230 * v646;
-    let v1665: f64 = p[141usize] * q[7usize];
-    let v1666: f64 = v1665 * v97;
-    let v1667: f64 = v1235.mul_add(v648, v1663);
-    let v1668: f64 = (-v1666).mul_add(v1653, v1667);
-    let v1670: f64 = 0.5f64 * v953;
-    let v1671: f64 = v1670.mul_add(v960, p[53usize]);
-    let v1672: f64 = v642.mul_add(v1656, -v863);
-    let v1673: f64 = v633.mul_add(v1659, v1672);
-    let v1674: f64 = v1673 + v1210;
-    let v1675: f64 = v640.mul_add(v1422, v1674);
-    let v1676: f64 = v637.mul_add(v1431, v1675);
-    let v1677: f64 = p[52usize].mul_add(v1662, v1676);
-    let v1678: f64 = p[50usize].mul_add(v1668, v1677);
-    let v1679: f64 = qd[7usize].mul_add(v1671, v1678);
-    let v1681: f64 = v965 * v965;
-    let v1682: f64 = (-0.5f64) * v1681;
-    let v1683: f64 = v1682 * v969;
-    let v1684: f64 = p[142usize] * v1683;
-    let v1685: f64 = p[56usize] * v1684;
-    let v1687: f64 = p[143usize] * v966;
-    let v1688: f64 = v1687 * v1682;
-    let v1691: f64 = p[144usize] + q[8usize];
-    let v1692: f64 = v1201 * v678;
-    let v1694: f64 = p[145usize] * q[8usize];
-    let v1695: f64 = v1694 * v109;
-    let v1696: f64 = v1206.mul_add(v680, v1692);
-    let v1697: f64 = (-v1695).mul_add(v1682, v1696);
-    let v1699: f64 = 0.5f64 * v965;
-    let v1700: f64 = v1699.mul_add(v972, p[59usize]);
-    let v1701: f64 = v674.mul_add(v1685, -v863);
-    let v1702: f64 = v665.mul_add(v1688, v1701);
-    let v1703: f64 = v1702 + v1181;
-    let v1704: f64 = v672.mul_add(v1421, v1703);
-    let v1705: f64 = v669.mul_add(v1430, v1704);
-    let v1706: f64 = p[58usize].mul_add(v1691, v1705);
-    let v1707: f64 = p[56usize].mul_add(v1697, v1706);
-    let v1708: f64 = qd[8usize].mul_add(v1700, v1707);
-    let v1710: f64 = v976 * v976;
-    let v1711: f64 = (-0.5f64) * v1710;
-    let v1712: f64 = v1711 * v980;
-    let v1713: f64 = p[146usize] * v1712;
-    let v1714: f64 = p[62usize] * v1713;
-    let v1716: f64 = p[147usize] * v977;
-    let v1717: f64 = v1716 * v1711;
-    let v1720: f64 = p[148usize] + q[9usize];
-    let v1721: f64 = v1128 * v703;
-    let v1723: f64 = p[149usize] * q[9usize];
-    let v1724: f64 = v1723 * v121;
-    let v1725: f64 = v1177.mul_add(v705, v1721);
-    let v1726: f64 = (-v1724).mul_add(v1711, v1725);
-    let v1728: f64 = 0.5f64 * v976;
-    let v1729: f64 = v1728.mul_add(v983, p[65usize]);
-    let v1730: f64 = v699.mul_add(v1714, -v863);
-    let v1731: f64 = v696.mul_add(v1717, v1730);
-    let v1732: f64 = p[64usize].mul_add(v1720, v1731);
-    let v1733: f64 = p[62usize].mul_add(v1726, v1732);
-    let v1734: f64 = qd[9usize].mul_add(v1729, v1733);
-    out[0usize] = v439;
-    out[1usize] = v471;
-    out[2usize] = v503;
-    out[3usize] = v535;
-    out[4usize] = v567;
-    out[5usize] = v599;
-    out[6usize] = v631;
-    out[7usize] = v663;
-    out[8usize] = v694;
-    out[9usize] = v713;
-    out[10usize] = v721;
-    out[11usize] = v723;
-    out[12usize] = v725;
-    out[13usize] = v727;
-    out[14usize] = v729;
-    out[15usize] = v731;
-    out[16usize] = v733;
-    out[17usize] = v735;
-    out[18usize] = v737;
-    out[19usize] = v745;
-    out[20usize] = v747;
-    out[21usize] = v749;
-    out[22usize] = v751;
-    out[23usize] = v753;
-    out[24usize] = v755;
-    out[25usize] = v757;
-    out[26usize] = v759;
-    out[27usize] = v767;
-    out[28usize] = v769;
-    out[29usize] = v771;
-    out[30usize] = v773;
-    out[31usize] = v775;
-    out[32usize] = v777;
-    out[33usize] = v779;
-    out[34usize] = v787;
-    out[35usize] = v789;
-    out[36usize] = v791;
-    out[37usize] = v793;
-    out[38usize] = v795;
-    out[39usize] = v797;
-    out[40usize] = v805;
-    out[41usize] = v807;
-    out[42usize] = v809;
-    out[43usize] = v811;
-    out[44usize] = v813;
-    out[45usize] = v821;
-    out[46usize] = v823;
-    out[47usize] = v825;
-    out[48usize] = v827;
-    out[49usize] = v835;
-    out[50usize] = v837;
-    out[51usize] = v839;
-    out[52usize] = v847;
-    out[53usize] = v849;
-    out[54usize] = v853;
-    out[55usize] = v1476;
-    out[56usize] = v1505;
-    out[57usize] = v1534;
-    out[58usize] = v1563;
-    out[59usize] = v1592;
-    out[60usize] = v1621;
-    out[61usize] = v1650;
-    out[62usize] = v1679;
-    out[63usize] = v1708;
-    out[64usize] = v1734;
+    out2[0usize] = v439;
+    out2[1usize] = v473;
+    out2[2usize] = v516;
+    out2[3usize] = v565;
+    out2[4usize] = v621;
+    out2[5usize] = v685;
+    out2[6usize] = v758;
+    out2[7usize] = v841;
+    out2[8usize] = v934;
+    out2[9usize] = v1027;
+    out2[10usize] = v482;
+    out2[11usize] = v518;
+    out2[12usize] = v567;
+    out2[13usize] = v623;
+    out2[14usize] = v687;
+    out2[15usize] = v760;
+    out2[16usize] = v843;
+    out2[17usize] = v936;
+    out2[18usize] = v1029;
+    out2[19usize] = v531;
+    out2[20usize] = v572;
+    out2[21usize] = v629;
+    out2[22usize] = v693;
+    out2[23usize] = v766;
+    out2[24usize] = v849;
+    out2[25usize] = v942;
+    out2[26usize] = v1035;
+    out2[27usize] = v587;
+    out2[28usize] = v634;
+    out2[29usize] = v699;
+    out2[30usize] = v772;
+    out2[31usize] = v855;
+    out2[32usize] = v948;
+    out2[33usize] = v1041;
+    out2[34usize] = v651;
+    out2[35usize] = v705;
+    out2[36usize] = v779;
+    out2[37usize] = v862;
+    out2[38usize] = v955;
+    out2[39usize] = v1048;
+    out2[40usize] = v724;
+    out2[41usize] = v786;
+    out2[42usize] = v870;
+    out2[43usize] = v963;
+    out2[44usize] = v1056;
+    out2[45usize] = v807;
+    out2[46usize] = v878;
+    out2[47usize] = v972;
+    out2[48usize] = v1065;
+    out2[49usize] = v901;
+    out2[50usize] = v981;
+    out2[51usize] = v1075;
+    out2[52usize] = v1006;
+    out2[53usize] = v1085;
+    out2[54usize] = v1108;
+    out2[55usize] = v1754;
+    out2[56usize] = v1784;
+    out2[57usize] = v1815;
+    out2[58usize] = v1847;
+    out2[59usize] = v1880;
+    out2[60usize] = v1914;
+    out2[61usize] = v1949;
+    out2[62usize] = v1985;
+    out2[63usize] = v2022;
+    out2[64usize] = v2036;
 }
 /// Kernel `derived`: 189 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
@@ -4114,8 +2573,8 @@ pub fn derived(
     unsafe { derived_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
     q: &[f64; 10usize],
@@ -4467,8 +2926,8 @@ pub fn constraints(
     unsafe { constraints_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
     q: &[f64; 10usize],
@@ -4495,8 +2954,8 @@ pub fn contact(
     unsafe { contact_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
     q: &[f64; 10usize],
@@ -5375,8 +3834,8 @@ pub fn contact_jacobian_0(
     unsafe { contact_jacobian_0_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_0_0(
     t: f64,
     q: &[f64; 10usize],
@@ -5650,8 +4109,8 @@ pub fn contact_jacobian_1(
     unsafe { contact_jacobian_1_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_1_0(
     t: f64,
     q: &[f64; 10usize],
@@ -5939,8 +4398,8 @@ pub fn contact_jacobian_2(
     unsafe { contact_jacobian_2_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_2_0(
     t: f64,
     q: &[f64; 10usize],
@@ -6237,8 +4696,8 @@ pub fn contact_jacobian_3(
     unsafe { contact_jacobian_3_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_3_0(
     t: f64,
     q: &[f64; 10usize],
@@ -6544,8 +5003,8 @@ pub fn contact_jacobian_4(
     unsafe { contact_jacobian_4_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_4_0(
     t: f64,
     q: &[f64; 10usize],
@@ -6860,8 +5319,8 @@ pub fn contact_jacobian_5(
     unsafe { contact_jacobian_5_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_5_0(
     t: f64,
     q: &[f64; 10usize],
@@ -7185,8 +5644,8 @@ pub fn contact_jacobian_6(
     unsafe { contact_jacobian_6_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_6_0(
     t: f64,
     q: &[f64; 10usize],
@@ -7519,8 +5978,8 @@ pub fn contact_jacobian_7(
     unsafe { contact_jacobian_7_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_7_0(
     t: f64,
     q: &[f64; 10usize],
@@ -7862,8 +6321,8 @@ pub fn contact_jacobian_8(
     unsafe { contact_jacobian_8_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_8_0(
     t: f64,
     q: &[f64; 10usize],
@@ -8214,8 +6673,8 @@ pub fn contact_jacobian_9(
     unsafe { contact_jacobian_9_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_9_0(
     t: f64,
     q: &[f64; 10usize],
@@ -8585,8 +7044,8 @@ pub fn contact_jvp(
         });
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
     q: &[f64; 10usize],
@@ -11879,8 +10338,8 @@ fn contact_jvp_0(
     out[726usize] = v3047;
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jvp_1(
     t: f64,
     q: &[f64; 10usize],
@@ -14061,8 +12520,8 @@ pub fn cell_0_pose(
     unsafe { cell_0_pose_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
     q: &[f64; 1usize],
@@ -14177,8 +12636,8 @@ pub fn cell_0(
     unsafe { cell_0_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
     q: &[f64; 1usize],
@@ -14336,8 +12795,8 @@ pub fn cell_0_tangent(
     unsafe { cell_0_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
     q: &[f64; 1usize],
@@ -14632,8 +13091,8 @@ pub fn link_loads(
     unsafe { link_loads_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn link_loads_0(
     t: f64,
     q: &[f64; 10usize],

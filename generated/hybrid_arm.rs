@@ -216,7 +216,7 @@ impl Kernels for Compiled {
         }
     }
 }
-/// Kernel `accel`: 1709 operations in 1 chunk(s).
+/// Kernel `accel`: the first 35 values of `eom` (1709 operations for all).
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
@@ -229,12 +229,11 @@ pub fn accel(
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
-    unsafe { accel_0(t, q, qd, qdd, dir, p, w, out) };
+    unsafe { accel_fma(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn accel_0(
+fn accel_fma(
     t: f64,
     q: &[f64; 7usize],
     qd: &[f64; 7usize],
@@ -243,6 +242,52 @@ fn accel_0(
     p: &[f64; 118usize],
     w: &mut [f64; 0usize],
     out: &mut [f64; 35usize],
+) {
+    let mut unused = [0.0f64; 35usize];
+    eom_0(t, q, qd, qdd, dir, p, w, out, &mut unused);
+}
+/// Kernel `mass_bias`: the last 35 values of `eom` (1709 operations for all).
+#[allow(unused_unsafe)]
+pub fn mass_bias(
+    t: f64,
+    q: &[f64; 7usize],
+    qd: &[f64; 7usize],
+    qdd: &[f64; 7usize],
+    dir: &[f64; 14usize],
+    p: &[f64; 118usize],
+    out: &mut [f64; 35usize],
+) {
+    runtime::cpu::require_fma();
+    let w = &mut [0.0f64; 0];
+    unsafe { mass_bias_fma(t, q, qd, qdd, dir, p, w, out) };
+}
+#[inline(never)]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+fn mass_bias_fma(
+    t: f64,
+    q: &[f64; 7usize],
+    qd: &[f64; 7usize],
+    qdd: &[f64; 7usize],
+    dir: &[f64; 14usize],
+    p: &[f64; 118usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 35usize],
+) {
+    let mut unused = [0.0f64; 35usize];
+    eom_0(t, q, qd, qdd, dir, p, w, &mut unused, out);
+}
+#[inline(always)]
+#[allow(unused_variables, clippy::all)]
+fn eom_0(
+    t: f64,
+    q: &[f64; 7usize],
+    qd: &[f64; 7usize],
+    qdd: &[f64; 7usize],
+    dir: &[f64; 14usize],
+    p: &[f64; 118usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 35usize],
+    out2: &mut [f64; 35usize],
 ) {
     let [v4, v313, v1015]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
         3usize,
@@ -1428,1064 +1473,41 @@ fn accel_0(
     out[32usize] = v657;
     out[33usize] = v658;
     out[34usize] = v647;
-}
-/// Kernel `mass_bias`: 1471 operations in 1 chunk(s).
-#[allow(unused_unsafe)]
-pub fn mass_bias(
-    t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    out: &mut [f64; 35usize],
-) {
-    runtime::cpu::require_fma();
-    let w = &mut [0.0f64; 0];
-    unsafe { mass_bias_0(t, q, qd, qdd, dir, p, w, out) };
-}
-#[inline(never)]
-#[allow(unused_variables, clippy::all)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn mass_bias_0(
-    t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 35usize],
-) {
-    let [v4, v311, v891]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[1usize]);
-    let v6: f64 = 2f64 * v4;
-    let v8: f64 = 0.5f64 * q[1usize];
-    let [v9, v301, v646]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v8);
-    let v10: f64 = v9.powi(4i32);
-    let v12: f64 = q[1usize] * q[1usize];
-    let v13: f64 = v4 * v4;
-    let v14: f64 = (-0.25f64).mul_add(v10, v6);
-    let v15: f64 = (-v12).mul_add(v13, v14);
-    let [v19, v343, v862]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[2usize]);
-    let v20: f64 = 2f64 * v19;
-    let v21: f64 = 0.5f64 * q[2usize];
-    let [v22, v333, v658]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v21);
-    let v23: f64 = v22.powi(4i32);
-    let v24: f64 = q[2usize] * q[2usize];
-    let v25: f64 = v19 * v19;
-    let v26: f64 = (-0.25f64).mul_add(v23, v20);
-    let v27: f64 = (-v24).mul_add(v25, v26);
-    let [v31, v375, v833]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[3usize]);
-    let v32: f64 = 2f64 * v31;
-    let v33: f64 = 0.5f64 * q[3usize];
-    let [v34, v365, v670]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v33);
-    let v35: f64 = v34.powi(4i32);
-    let v36: f64 = q[3usize] * q[3usize];
-    let v37: f64 = v31 * v31;
-    let v38: f64 = (-0.25f64).mul_add(v35, v32);
-    let v39: f64 = (-v36).mul_add(v37, v38);
-    let [v43, v407, v804]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[4usize]);
-    let v44: f64 = 2f64 * v43;
-    let v45: f64 = 0.5f64 * q[4usize];
-    let [v46, v397, v682]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v45);
-    let v47: f64 = v46.powi(4i32);
-    let v48: f64 = q[4usize] * q[4usize];
-    let v49: f64 = v43 * v43;
-    let v50: f64 = (-0.25f64).mul_add(v47, v44);
-    let v51: f64 = (-v48).mul_add(v49, v50);
-    let [v55, v439, v775]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[5usize]);
-    let v56: f64 = 2f64 * v55;
-    let v57: f64 = 0.5f64 * q[5usize];
-    let [v58, v429, v694]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v57);
-    let v59: f64 = v58.powi(4i32);
-    let v60: f64 = q[5usize] * q[5usize];
-    let v61: f64 = v55 * v55;
-    let v62: f64 = (-0.25f64).mul_add(v59, v56);
-    let v63: f64 = (-v60).mul_add(v61, v62);
-    let [v67, v474, v746]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[6usize]);
-    let v68: f64 = 2f64 * v67;
-    let v69: f64 = 0.5f64 * q[6usize];
-    let [v70, v461, v706]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v69);
-    let v71: f64 = v70.powi(4i32);
-    let v72: f64 = q[6usize] * q[6usize];
-    let v73: f64 = v67 * v67;
-    let v74: f64 = (-0.25f64).mul_add(v71, v68);
-    let v75: f64 = (-v72).mul_add(v73, v74);
-    let v81: f64 = p[6usize] + q[0usize];
-    let (v86, v82): (f64, f64) = runtime::special::sin_cos(v81);
-    let v83: f64 = p[8usize] * v82;
-    let v84: f64 = p[3usize] + v83;
-    let (v87, v88): (f64, f64) = runtime::special::sin_cos(v8);
-    let v89: f64 = v86 * v87;
-    let v90: f64 = v82.mul_add(v88, -v89);
-    let v91: f64 = p[14usize] * v9;
-    let v92: f64 = v91.mul_add(v90, v84);
-    let v94: f64 = v82 * v87;
-    let v95: f64 = v86.mul_add(v88, v94);
-    let v96: f64 = v90 * v87;
-    let v97: f64 = v95.mul_add(v88, v96);
-    let v98: f64 = v95 * v87;
-    let v99: f64 = v90.mul_add(v88, -v98);
-    let (v100, v101): (f64, f64) = runtime::special::sin_cos(v21);
-    let v102: f64 = v97 * v100;
-    let v103: f64 = v99.mul_add(v101, -v102);
-    let v104: f64 = p[20usize] * v22;
-    let v105: f64 = v104.mul_add(v103, v92);
-    let v107: f64 = v99 * v100;
-    let v108: f64 = v97.mul_add(v101, v107);
-    let v109: f64 = v103 * v100;
-    let v110: f64 = v108.mul_add(v101, v109);
-    let v111: f64 = v108 * v100;
-    let v112: f64 = v103.mul_add(v101, -v111);
-    let (v113, v114): (f64, f64) = runtime::special::sin_cos(v33);
-    let v115: f64 = v110 * v113;
-    let v116: f64 = v112.mul_add(v114, -v115);
-    let v117: f64 = p[26usize] * v34;
-    let v118: f64 = v117.mul_add(v116, v105);
-    let v120: f64 = v112 * v113;
-    let v121: f64 = v110.mul_add(v114, v120);
-    let v122: f64 = v116 * v113;
-    let v123: f64 = v121.mul_add(v114, v122);
-    let v124: f64 = v121 * v113;
-    let v125: f64 = v116.mul_add(v114, -v124);
-    let (v126, v127): (f64, f64) = runtime::special::sin_cos(v45);
-    let v128: f64 = v123 * v126;
-    let v129: f64 = v125.mul_add(v127, -v128);
-    let v130: f64 = p[32usize] * v46;
-    let v131: f64 = v130.mul_add(v129, v118);
-    let v133: f64 = v125 * v126;
-    let v134: f64 = v123.mul_add(v127, v133);
-    let v135: f64 = v129 * v126;
-    let v136: f64 = v134.mul_add(v127, v135);
-    let v137: f64 = v134 * v126;
-    let v138: f64 = v129.mul_add(v127, -v137);
-    let (v139, v140): (f64, f64) = runtime::special::sin_cos(v57);
-    let v141: f64 = v136 * v139;
-    let v142: f64 = v138.mul_add(v140, -v141);
-    let v143: f64 = p[38usize] * v58;
-    let v144: f64 = v143.mul_add(v142, v131);
-    let v146: f64 = v70 * v70;
-    let v147: f64 = p[56usize] * v146;
-    let v148: f64 = v138 * v139;
-    let v149: f64 = v136.mul_add(v140, v148);
-    let v150: f64 = v149 * v139;
-    let v151: f64 = v142.mul_add(v140, -v150);
-    let v153: f64 = p[44usize] * q[6usize];
-    let v154: f64 = v153 * v67;
-    let v155: f64 = v142 * v139;
-    let v156: f64 = v149.mul_add(v140, v155);
-    let v157: f64 = v147.mul_add(v151, v144);
-    let v158: f64 = (-v154).mul_add(v156, v157);
-    let v160: f64 = p[8usize] * v86;
-    let v161: f64 = p[4usize] + v160;
-    let v162: f64 = v91.mul_add(v95, v161);
-    let v163: f64 = v104.mul_add(v108, v162);
-    let v164: f64 = v117.mul_add(v121, v163);
-    let v165: f64 = v130.mul_add(v134, v164);
-    let v166: f64 = v143.mul_add(v149, v165);
-    let v167: f64 = v147.mul_add(v156, v166);
-    let v168: f64 = v154.mul_add(v151, v167);
-    let v169: f64 = v168 * v168;
-    let v170: f64 = v158.mul_add(v158, v169);
-    let v172: f64 = v8 + v81;
-    let v173: f64 = v8 + v172;
-    let v174: f64 = v21 + v173;
-    let v175: f64 = v21 + v174;
-    let v176: f64 = v33 + v175;
-    let v177: f64 = v33 + v176;
-    let v178: f64 = v45 + v177;
-    let v179: f64 = v45 + v178;
-    let v180: f64 = v57 + v179;
-    let v181: f64 = v57 + v180;
-    let v182: f64 = v69 + v181;
-    let (v186, v183): (f64, f64) = runtime::special::sin_cos(v182);
-    let v184: f64 = p[44usize] * v70;
-    let v185: f64 = v184.mul_add(v183, v144);
-    let v187: f64 = v184.mul_add(v186, v166);
-    let v188: f64 = v187 * v187;
-    let v189: f64 = v185.mul_add(v185, v188);
-    let v190: f64 = p[55usize].mul_add(v75, p[46usize]);
-    let v191: f64 = p[45usize].mul_add(v170, v190);
-    let v192: f64 = p[7usize].mul_add(v189, v191);
-    let v195: f64 = v58 * v58;
-    let v196: f64 = p[57usize] * v195;
-    let v197: f64 = p[38usize] * q[5usize];
-    let v198: f64 = v197 * v55;
-    let v199: f64 = v196.mul_add(v138, v131);
-    let v200: f64 = (-v198).mul_add(v136, v199);
-    let v201: f64 = v196.mul_add(v136, v165);
-    let v202: f64 = v198.mul_add(v138, v201);
-    let v203: f64 = v202 * v202;
-    let v204: f64 = v200.mul_add(v200, v203);
-    let v205: f64 = p[54usize].mul_add(v63, p[40usize]);
-    let v206: f64 = v205 + v192;
-    let v207: f64 = p[39usize].mul_add(v204, v206);
-    let v210: f64 = v46 * v46;
-    let v211: f64 = p[58usize] * v210;
-    let v212: f64 = p[32usize] * q[4usize];
-    let v213: f64 = v212 * v43;
-    let v214: f64 = v211.mul_add(v125, v118);
-    let v215: f64 = (-v213).mul_add(v123, v214);
-    let v216: f64 = v211.mul_add(v123, v164);
-    let v217: f64 = v213.mul_add(v125, v216);
-    let v218: f64 = v217 * v217;
-    let v219: f64 = v215.mul_add(v215, v218);
-    let v220: f64 = p[53usize].mul_add(v51, p[34usize]);
-    let v221: f64 = v220 + v207;
-    let v222: f64 = p[33usize].mul_add(v219, v221);
-    let v225: f64 = v34 * v34;
-    let v226: f64 = p[59usize] * v225;
-    let v227: f64 = p[26usize] * q[3usize];
-    let v228: f64 = v227 * v31;
-    let v229: f64 = v226.mul_add(v112, v105);
-    let v230: f64 = (-v228).mul_add(v110, v229);
-    let v231: f64 = v226.mul_add(v110, v163);
-    let v232: f64 = v228.mul_add(v112, v231);
-    let v233: f64 = v232 * v232;
-    let v234: f64 = v230.mul_add(v230, v233);
-    let v235: f64 = p[52usize].mul_add(v39, p[28usize]);
-    let v236: f64 = v235 + v222;
-    let v237: f64 = p[27usize].mul_add(v234, v236);
-    let v240: f64 = v22 * v22;
-    let v241: f64 = p[60usize] * v240;
-    let v242: f64 = p[20usize] * q[2usize];
-    let v243: f64 = v242 * v19;
-    let v244: f64 = v241.mul_add(v99, v92);
-    let v245: f64 = (-v243).mul_add(v97, v244);
-    let v246: f64 = v241.mul_add(v97, v162);
-    let v247: f64 = v243.mul_add(v99, v246);
-    let v248: f64 = v247 * v247;
-    let v249: f64 = v245.mul_add(v245, v248);
-    let v250: f64 = p[51usize].mul_add(v27, p[22usize]);
-    let v251: f64 = v250 + v237;
-    let v252: f64 = p[21usize].mul_add(v249, v251);
-    let v255: f64 = v9 * v9;
-    let v256: f64 = p[61usize] * v255;
-    let v257: f64 = p[14usize] * q[1usize];
-    let v258: f64 = v257 * v4;
-    let v259: f64 = v82.mul_add(v256, v84);
-    let v260: f64 = (-v86).mul_add(v258, v259);
-    let v261: f64 = v86.mul_add(v256, v161);
-    let v262: f64 = v82.mul_add(v258, v261);
-    let v263: f64 = v262 * v262;
-    let v264: f64 = v260.mul_add(v260, v263);
-    let v265: f64 = p[50usize].mul_add(v15, p[16usize]);
-    let v266: f64 = v265 + v252;
-    let v267: f64 = p[15usize].mul_add(v264, v266);
-    let v270: f64 = p[62usize] * v82;
-    let v272: f64 = p[63usize] * v86;
-    let v273: f64 = v272 * v272;
-    let v274: f64 = v270.mul_add(v270, v273);
-    let v275: f64 = -v160;
-    let v276: f64 = v161 + v275;
-    let v277: f64 = p[7usize] * v187;
-    let v278: f64 = p[45usize].mul_add(v168, v277);
-    let v279: f64 = p[39usize].mul_add(v202, v278);
-    let v280: f64 = p[33usize].mul_add(v217, v279);
-    let v281: f64 = p[27usize].mul_add(v232, v280);
-    let v282: f64 = p[21usize].mul_add(v247, v281);
-    let v283: f64 = p[15usize].mul_add(v262, v282);
-    let v284: f64 = 2f64 * v283;
-    let v286: f64 = v276.mul_add(p[64usize], -v284);
-    let v287: f64 = v83 - v84;
-    let v288: f64 = p[7usize] * v185;
-    let v289: f64 = p[45usize].mul_add(v158, v288);
-    let v290: f64 = p[39usize].mul_add(v200, v289);
-    let v291: f64 = p[33usize].mul_add(v215, v290);
-    let v292: f64 = p[27usize].mul_add(v230, v291);
-    let v293: f64 = p[21usize].mul_add(v245, v292);
-    let v294: f64 = p[15usize].mul_add(v260, v293);
-    let v295: f64 = v287 * p[64usize];
-    let v296: f64 = 2f64.mul_add(v294, v295);
-    let v297: f64 = p[10usize] + v267;
-    let v298: f64 = p[9usize].mul_add(v274, v297);
-    let v299: f64 = v276.mul_add(v286, v298);
-    let v300: f64 = v287.mul_add(v296, v299);
-    let v302: f64 = 0.5f64 * v301;
-    let v303: f64 = 0.5f64 * v9;
-    let v304: f64 = v303 * v90;
-    let v305: f64 = v95.mul_add(v302, v304);
-    let v306: f64 = p[14usize].mul_add(v305, -v92);
-    let v307: f64 = v303 * v95;
-    let v308: f64 = v90.mul_add(v302, -v307);
-    let v309: f64 = p[14usize].mul_add(v308, v162);
-    let v310: f64 = v91 * v302;
-    let v312: f64 = q[1usize].mul_add(v311, v4);
-    let v313: f64 = p[14usize] * v312;
-    let v314: f64 = v82 * v313;
-    let v315: f64 = v86.mul_add(v310, v314);
-    let v316: f64 = v86 * v313;
-    let v317: f64 = v82.mul_add(v310, -v316);
-    let v318: f64 = v262 * v317;
-    let v319: f64 = v260.mul_add(v315, -v318);
-    let v320: f64 = 0.5f64.mul_add(v265, v252);
-    let v321: f64 = v306.mul_add(v293, v320);
-    let v322: f64 = (-v309).mul_add(v282, v321);
-    let v323: f64 = p[15usize].mul_add(v319, v322);
-    let v325: f64 = v309 * p[65usize];
-    let v326: f64 = v325 - v282;
-    let v327: f64 = p[15usize].mul_add(v317, v326);
-    let v328: f64 = v306 * p[65usize];
-    let v329: f64 = v293 + v328;
-    let v330: f64 = p[15usize].mul_add(v315, v329);
-    let v331: f64 = v276.mul_add(v327, v323);
-    let v332: f64 = v287.mul_add(v330, v331);
-    let v334: f64 = 0.5f64 * v333;
-    let v335: f64 = 0.5f64 * v22;
-    let v336: f64 = v335 * v103;
-    let v337: f64 = v108.mul_add(v334, v336);
-    let v338: f64 = p[20usize].mul_add(v337, -v105);
-    let v339: f64 = v335 * v108;
-    let v340: f64 = v103.mul_add(v334, -v339);
-    let v341: f64 = p[20usize].mul_add(v340, v163);
-    let v342: f64 = v104 * v334;
-    let v344: f64 = q[2usize].mul_add(v343, v19);
-    let v345: f64 = p[20usize] * v344;
-    let v346: f64 = v99 * v345;
-    let v347: f64 = v97.mul_add(v342, v346);
-    let v348: f64 = v97 * v345;
-    let v349: f64 = v99.mul_add(v342, -v348);
-    let v350: f64 = v247 * v349;
-    let v351: f64 = v245.mul_add(v347, -v350);
-    let v352: f64 = 0.5f64.mul_add(v250, v237);
-    let v353: f64 = v338.mul_add(v292, v352);
-    let v354: f64 = (-v341).mul_add(v281, v353);
-    let v355: f64 = p[21usize].mul_add(v351, v354);
-    let v357: f64 = v341 * p[66usize];
-    let v358: f64 = v357 - v281;
-    let v359: f64 = p[21usize].mul_add(v349, v358);
-    let v360: f64 = v338 * p[66usize];
-    let v361: f64 = v292 + v360;
-    let v362: f64 = p[21usize].mul_add(v347, v361);
-    let v363: f64 = v276.mul_add(v359, v355);
-    let v364: f64 = v287.mul_add(v362, v363);
-    let v366: f64 = 0.5f64 * v365;
-    let v367: f64 = 0.5f64 * v34;
-    let v368: f64 = v367 * v116;
-    let v369: f64 = v121.mul_add(v366, v368);
-    let v370: f64 = p[26usize].mul_add(v369, -v118);
-    let v371: f64 = v367 * v121;
-    let v372: f64 = v116.mul_add(v366, -v371);
-    let v373: f64 = p[26usize].mul_add(v372, v164);
-    let v374: f64 = v117 * v366;
-    let v376: f64 = q[3usize].mul_add(v375, v31);
-    let v377: f64 = p[26usize] * v376;
-    let v378: f64 = v112 * v377;
-    let v379: f64 = v110.mul_add(v374, v378);
-    let v380: f64 = v110 * v377;
-    let v381: f64 = v112.mul_add(v374, -v380);
-    let v382: f64 = v232 * v381;
-    let v383: f64 = v230.mul_add(v379, -v382);
-    let v384: f64 = 0.5f64.mul_add(v235, v222);
-    let v385: f64 = v370.mul_add(v291, v384);
-    let v386: f64 = (-v373).mul_add(v280, v385);
-    let v387: f64 = p[27usize].mul_add(v383, v386);
-    let v389: f64 = v373 * p[67usize];
-    let v390: f64 = v389 - v280;
-    let v391: f64 = p[27usize].mul_add(v381, v390);
-    let v392: f64 = v370 * p[67usize];
-    let v393: f64 = v291 + v392;
-    let v394: f64 = p[27usize].mul_add(v379, v393);
-    let v395: f64 = v276.mul_add(v391, v387);
-    let v396: f64 = v287.mul_add(v394, v395);
-    let v398: f64 = 0.5f64 * v397;
-    let v399: f64 = 0.5f64 * v46;
-    let v400: f64 = v399 * v129;
-    let v401: f64 = v134.mul_add(v398, v400);
-    let v402: f64 = p[32usize].mul_add(v401, -v131);
-    let v403: f64 = v399 * v134;
-    let v404: f64 = v129.mul_add(v398, -v403);
-    let v405: f64 = p[32usize].mul_add(v404, v165);
-    let v406: f64 = v130 * v398;
-    let v408: f64 = q[4usize].mul_add(v407, v43);
-    let v409: f64 = p[32usize] * v408;
-    let v410: f64 = v125 * v409;
-    let v411: f64 = v123.mul_add(v406, v410);
-    let v412: f64 = v123 * v409;
-    let v413: f64 = v125.mul_add(v406, -v412);
-    let v414: f64 = v217 * v413;
-    let v415: f64 = v215.mul_add(v411, -v414);
-    let v416: f64 = 0.5f64.mul_add(v220, v207);
-    let v417: f64 = v402.mul_add(v290, v416);
-    let v418: f64 = (-v405).mul_add(v279, v417);
-    let v419: f64 = p[33usize].mul_add(v415, v418);
-    let v421: f64 = v405 * p[68usize];
-    let v422: f64 = v421 - v279;
-    let v423: f64 = p[33usize].mul_add(v413, v422);
-    let v424: f64 = v402 * p[68usize];
-    let v425: f64 = v290 + v424;
-    let v426: f64 = p[33usize].mul_add(v411, v425);
-    let v427: f64 = v276.mul_add(v423, v419);
-    let v428: f64 = v287.mul_add(v426, v427);
-    let v430: f64 = 0.5f64 * v429;
-    let v431: f64 = 0.5f64 * v58;
-    let v432: f64 = v431 * v142;
-    let v433: f64 = v149.mul_add(v430, v432);
-    let v434: f64 = p[38usize].mul_add(v433, -v144);
-    let v435: f64 = v431 * v149;
-    let v436: f64 = v142.mul_add(v430, -v435);
-    let v437: f64 = p[38usize].mul_add(v436, v166);
-    let v438: f64 = v143 * v430;
-    let v440: f64 = q[5usize].mul_add(v439, v55);
-    let v441: f64 = p[38usize] * v440;
-    let v442: f64 = v138 * v441;
-    let v443: f64 = v136.mul_add(v438, v442);
-    let v444: f64 = v136 * v441;
-    let v445: f64 = v138.mul_add(v438, -v444);
-    let v446: f64 = v202 * v445;
-    let v447: f64 = v200.mul_add(v443, -v446);
-    let v448: f64 = 0.5f64.mul_add(v205, v192);
-    let v449: f64 = v434.mul_add(v289, v448);
-    let v450: f64 = (-v437).mul_add(v278, v449);
-    let v451: f64 = p[39usize].mul_add(v447, v450);
-    let v453: f64 = v437 * p[69usize];
-    let v454: f64 = v453 - v278;
-    let v455: f64 = p[39usize].mul_add(v445, v454);
-    let v456: f64 = v434 * p[69usize];
-    let v457: f64 = v289 + v456;
-    let v458: f64 = p[39usize].mul_add(v443, v457);
-    let v459: f64 = v276.mul_add(v455, v451);
-    let v460: f64 = v287.mul_add(v458, v459);
-    let v462: f64 = 0.5f64 * v461;
-    let v463: f64 = 0.5f64 * v70;
-    let v464: f64 = v463 * v183;
-    let v465: f64 = v186.mul_add(v462, v464);
-    let v466: f64 = p[44usize] * v465;
-    let v467: f64 = v463 * v186;
-    let v468: f64 = v183.mul_add(v462, -v467);
-    let v469: f64 = p[44usize] * v468;
-    let v470: f64 = v187 * v469;
-    let v471: f64 = v185.mul_add(v466, -v470);
-    let v472: f64 = p[7usize] * v471;
-    let v473: f64 = v184 * v462;
-    let v475: f64 = q[6usize].mul_add(v474, v67);
-    let v476: f64 = p[44usize] * v475;
-    let v477: f64 = v151 * v476;
-    let v478: f64 = v156.mul_add(v473, v477);
-    let v479: f64 = v156 * v476;
-    let v480: f64 = v151.mul_add(v473, -v479);
-    let v481: f64 = v168 * v480;
-    let v482: f64 = v158.mul_add(v478, -v481);
-    let v483: f64 = 0.5f64.mul_add(v190, v472);
-    let v484: f64 = p[45usize].mul_add(v482, v483);
-    let v485: f64 = p[7usize] * v469;
-    let v486: f64 = p[45usize].mul_add(v480, v485);
-    let v487: f64 = p[7usize] * v466;
-    let v488: f64 = p[45usize].mul_add(v478, v487);
-    let v489: f64 = v276.mul_add(v486, v484);
-    let v490: f64 = v287.mul_add(v488, v489);
-    let v491: f64 = v315 * v315;
-    let v492: f64 = v317.mul_add(v317, v491);
-    let v493: f64 = (-2f64).mul_add(v282, v325);
-    let v494: f64 = 2f64.mul_add(v293, v328);
-    let v495: f64 = 0.25f64.mul_add(v265, v252);
-    let v496: f64 = p[15usize].mul_add(v492, v495);
-    let v497: f64 = v309.mul_add(v493, v496);
-    let v498: f64 = v306.mul_add(v494, v497);
-    let v499: f64 = v309.mul_add(v359, v355);
-    let v500: f64 = v306.mul_add(v362, v499);
-    let v501: f64 = v309.mul_add(v391, v387);
-    let v502: f64 = v306.mul_add(v394, v501);
-    let v503: f64 = v309.mul_add(v423, v419);
-    let v504: f64 = v306.mul_add(v426, v503);
-    let v505: f64 = v309.mul_add(v455, v451);
-    let v506: f64 = v306.mul_add(v458, v505);
-    let v507: f64 = v309.mul_add(v486, v484);
-    let v508: f64 = v306.mul_add(v488, v507);
-    let v509: f64 = v347 * v347;
-    let v510: f64 = v349.mul_add(v349, v509);
-    let v511: f64 = (-2f64).mul_add(v281, v357);
-    let v512: f64 = 2f64.mul_add(v292, v360);
-    let v513: f64 = 0.25f64.mul_add(v250, v237);
-    let v514: f64 = p[21usize].mul_add(v510, v513);
-    let v515: f64 = v341.mul_add(v511, v514);
-    let v516: f64 = v338.mul_add(v512, v515);
-    let v517: f64 = v341.mul_add(v391, v387);
-    let v518: f64 = v338.mul_add(v394, v517);
-    let v519: f64 = v341.mul_add(v423, v419);
-    let v520: f64 = v338.mul_add(v426, v519);
-    let v521: f64 = v341.mul_add(v455, v451);
-    let v522: f64 = v338.mul_add(v458, v521);
-    let v523: f64 = v341.mul_add(v486, v484);
-    let v524: f64 = v338.mul_add(v488, v523);
-    let v525: f64 = v379 * v379;
-    let v526: f64 = v381.mul_add(v381, v525);
-    let v527: f64 = (-2f64).mul_add(v280, v389);
-    let v528: f64 = 2f64.mul_add(v291, v392);
-    let v529: f64 = 0.25f64.mul_add(v235, v222);
-    let v530: f64 = p[27usize].mul_add(v526, v529);
-    let v531: f64 = v373.mul_add(v527, v530);
-    let v532: f64 = v370.mul_add(v528, v531);
-    let v533: f64 = v373.mul_add(v423, v419);
-    let v534: f64 = v370.mul_add(v426, v533);
-    let v535: f64 = v373.mul_add(v455, v451);
-    let v536: f64 = v370.mul_add(v458, v535);
-    let v537: f64 = v373.mul_add(v486, v484);
-    let v538: f64 = v370.mul_add(v488, v537);
-    let v539: f64 = v411 * v411;
-    let v540: f64 = v413.mul_add(v413, v539);
-    let v541: f64 = (-2f64).mul_add(v279, v421);
-    let v542: f64 = 2f64.mul_add(v290, v424);
-    let v543: f64 = 0.25f64.mul_add(v220, v207);
-    let v544: f64 = p[33usize].mul_add(v540, v543);
-    let v545: f64 = v405.mul_add(v541, v544);
-    let v546: f64 = v402.mul_add(v542, v545);
-    let v547: f64 = v405.mul_add(v455, v451);
-    let v548: f64 = v402.mul_add(v458, v547);
-    let v549: f64 = v405.mul_add(v486, v484);
-    let v550: f64 = v402.mul_add(v488, v549);
-    let v551: f64 = v443 * v443;
-    let v552: f64 = v445.mul_add(v445, v551);
-    let v553: f64 = (-2f64).mul_add(v278, v453);
-    let v554: f64 = 2f64.mul_add(v289, v456);
-    let v555: f64 = 0.25f64.mul_add(v205, v192);
-    let v556: f64 = p[39usize].mul_add(v552, v555);
-    let v557: f64 = v437.mul_add(v553, v556);
-    let v558: f64 = v434.mul_add(v554, v557);
-    let v559: f64 = v437.mul_add(v486, v484);
-    let v560: f64 = v434.mul_add(v488, v559);
-    let v561: f64 = v478 * v478;
-    let v562: f64 = v480.mul_add(v480, v561);
-    let v563: f64 = p[45usize] * v562;
-    let v564: f64 = v466 * v466;
-    let v565: f64 = v469.mul_add(v469, v564);
-    let v566: f64 = 0.25f64.mul_add(v190, v563);
-    let v567: f64 = p[7usize].mul_add(v565, v566);
-    let v570: f64 = 0.5f64 * qd[1usize];
-    let v571: f64 = qd[0usize] + v570;
-    let v572: f64 = v9.powi(3i32);
-    let v573: f64 = v302 * v572;
-    let v574: f64 = 2f64 * q[1usize];
-    let v575: f64 = (-v6).mul_add(v12, 2f64);
-    let v576: f64 = v311.mul_add(v575, -v573);
-    let v577: f64 = (-v574).mul_add(v13, v576);
-    let v578: f64 = p[50usize] * v577;
-    let v579: f64 = qd[1usize] * v571;
-    let v581: f64 = 0.5f64 * qd[2usize];
-    let v582: f64 = v570 + v571;
-    let v583: f64 = v581 + v582;
-    let v584: f64 = v22.powi(3i32);
-    let v585: f64 = v334 * v584;
-    let v586: f64 = 2f64 * q[2usize];
-    let v587: f64 = (-v20).mul_add(v24, 2f64);
-    let v588: f64 = v343.mul_add(v587, -v585);
-    let v589: f64 = (-v586).mul_add(v25, v588);
-    let v590: f64 = p[51usize] * v589;
-    let v591: f64 = qd[2usize] * v583;
-    let v593: f64 = 0.5f64 * qd[3usize];
-    let v594: f64 = v581 + v583;
-    let v595: f64 = v593 + v594;
-    let v596: f64 = v34.powi(3i32);
-    let v597: f64 = v366 * v596;
-    let v598: f64 = 2f64 * q[3usize];
-    let v599: f64 = (-v32).mul_add(v36, 2f64);
-    let v600: f64 = v375.mul_add(v599, -v597);
-    let v601: f64 = (-v598).mul_add(v37, v600);
-    let v602: f64 = p[52usize] * v601;
-    let v603: f64 = qd[3usize] * v595;
-    let v605: f64 = 0.5f64 * qd[4usize];
-    let v606: f64 = v593 + v595;
-    let v607: f64 = v605 + v606;
-    let v608: f64 = v46.powi(3i32);
-    let v609: f64 = v398 * v608;
-    let v610: f64 = 2f64 * q[4usize];
-    let v611: f64 = (-v44).mul_add(v48, 2f64);
-    let v612: f64 = v407.mul_add(v611, -v609);
-    let v613: f64 = (-v610).mul_add(v49, v612);
-    let v614: f64 = p[53usize] * v613;
-    let v615: f64 = qd[4usize] * v607;
-    let v617: f64 = 0.5f64 * qd[5usize];
-    let v618: f64 = v605 + v607;
-    let v619: f64 = v617 + v618;
-    let v620: f64 = v58.powi(3i32);
-    let v621: f64 = v430 * v620;
-    let v622: f64 = 2f64 * q[5usize];
-    let v623: f64 = (-v56).mul_add(v60, 2f64);
-    let v624: f64 = v439.mul_add(v623, -v621);
-    let v625: f64 = (-v622).mul_add(v61, v624);
-    let v626: f64 = p[54usize] * v625;
-    let v627: f64 = qd[5usize] * v619;
-    let v629: f64 = v617 + v619;
-    let v630: f64 = 0.5f64.mul_add(qd[6usize], v629);
-    let v631: f64 = v70.powi(3i32);
-    let v632: f64 = v462 * v631;
-    let v633: f64 = 2f64 * q[6usize];
-    let v634: f64 = (-v68).mul_add(v72, 2f64);
-    let v635: f64 = v474.mul_add(v634, -v632);
-    let v636: f64 = (-v633).mul_add(v73, v635);
-    let v637: f64 = p[55usize] * v636;
-    let v638: f64 = qd[6usize] * v630;
-    let v640: f64 = qd[0usize] * qd[0usize];
-    let v641: f64 = v640 * v275;
-    let v642: f64 = 2f64 * qd[1usize];
-    let v643: f64 = v642 * v571;
-    let v644: f64 = v643 * v90;
-    let v645: f64 = qd[1usize] * qd[1usize];
-    let v647: f64 = 0.25f64 * v646;
-    let v648: f64 = v571 * v571;
-    let v649: f64 = v9 * v648;
-    let v650: f64 = v645.mul_add(v647, -v649);
-    let v651: f64 = v95 * v650;
-    let v652: f64 = v644.mul_add(v302, v651);
-    let v653: f64 = p[14usize].mul_add(v652, v641);
-    let v654: f64 = 2f64 * qd[2usize];
-    let v655: f64 = v654 * v583;
-    let v656: f64 = v655 * v103;
-    let v657: f64 = qd[2usize] * qd[2usize];
-    let v659: f64 = 0.25f64 * v658;
-    let v660: f64 = v583 * v583;
-    let v661: f64 = v22 * v660;
-    let v662: f64 = v657.mul_add(v659, -v661);
-    let v663: f64 = v108 * v662;
-    let v664: f64 = v656.mul_add(v334, v663);
-    let v665: f64 = p[20usize].mul_add(v664, v653);
-    let v666: f64 = 2f64 * qd[3usize];
-    let v667: f64 = v666 * v595;
-    let v668: f64 = v667 * v116;
-    let v669: f64 = qd[3usize] * qd[3usize];
-    let v671: f64 = 0.25f64 * v670;
-    let v672: f64 = v595 * v595;
-    let v673: f64 = v34 * v672;
-    let v674: f64 = v669.mul_add(v671, -v673);
-    let v675: f64 = v121 * v674;
-    let v676: f64 = v668.mul_add(v366, v675);
-    let v677: f64 = p[26usize].mul_add(v676, v665);
-    let v678: f64 = 2f64 * qd[4usize];
-    let v679: f64 = v678 * v607;
-    let v680: f64 = v679 * v129;
-    let v681: f64 = qd[4usize] * qd[4usize];
-    let v683: f64 = 0.25f64 * v682;
-    let v684: f64 = v607 * v607;
-    let v685: f64 = v46 * v684;
-    let v686: f64 = v681.mul_add(v683, -v685);
-    let v687: f64 = v134 * v686;
-    let v688: f64 = v680.mul_add(v398, v687);
-    let v689: f64 = p[32usize].mul_add(v688, v677);
-    let v690: f64 = 2f64 * qd[5usize];
-    let v691: f64 = v690 * v619;
-    let v692: f64 = v691 * v142;
-    let v693: f64 = qd[5usize] * qd[5usize];
-    let v695: f64 = 0.25f64 * v694;
-    let v696: f64 = v619 * v619;
-    let v697: f64 = v58 * v696;
-    let v698: f64 = v693.mul_add(v695, -v697);
-    let v699: f64 = v149 * v698;
-    let v700: f64 = v692.mul_add(v430, v699);
-    let v701: f64 = p[38usize].mul_add(v700, v689);
-    let v702: f64 = 2f64 * qd[6usize];
-    let v703: f64 = v702 * v630;
-    let v704: f64 = v703 * v183;
-    let v705: f64 = qd[6usize] * qd[6usize];
-    let v707: f64 = 0.25f64 * v706;
-    let v708: f64 = v630 * v630;
-    let v709: f64 = v70 * v708;
-    let v710: f64 = v705.mul_add(v707, -v709);
-    let v711: f64 = v186 * v710;
-    let v712: f64 = v704.mul_add(v462, v711);
-    let v713: f64 = p[44usize].mul_add(v712, v701);
-    let v714: f64 = p[70usize] + v713;
-    let v716: f64 = -v83;
-    let v717: f64 = v640 * v716;
-    let v718: f64 = v643 * v95;
-    let v719: f64 = v718 * v302;
-    let v720: f64 = v90.mul_add(v650, -v719);
-    let v721: f64 = p[14usize].mul_add(v720, v717);
-    let v722: f64 = v655 * v108;
-    let v723: f64 = v722 * v334;
-    let v724: f64 = v103.mul_add(v662, -v723);
-    let v725: f64 = p[20usize].mul_add(v724, v721);
-    let v726: f64 = v667 * v121;
-    let v727: f64 = v726 * v366;
-    let v728: f64 = v116.mul_add(v674, -v727);
-    let v729: f64 = p[26usize].mul_add(v728, v725);
-    let v730: f64 = v679 * v134;
-    let v731: f64 = v730 * v398;
-    let v732: f64 = v129.mul_add(v686, -v731);
-    let v733: f64 = p[32usize].mul_add(v732, v729);
-    let v734: f64 = v691 * v149;
-    let v735: f64 = v734 * v430;
-    let v736: f64 = v142.mul_add(v698, -v735);
-    let v737: f64 = p[38usize].mul_add(v736, v733);
-    let v738: f64 = v703 * v186;
-    let v739: f64 = v738 * v462;
-    let v740: f64 = v183.mul_add(v710, -v739);
-    let v741: f64 = p[44usize].mul_add(v740, v737);
-    let v742: f64 = p[71usize] + v741;
-    let v743: f64 = v187 * v742;
-    let v744: f64 = v185.mul_add(v714, -v743);
-    let v745: f64 = p[7usize] * v744;
-    let v747: f64 = q[6usize] * v746;
-    let v748: f64 = 2f64.mul_add(v474, v747);
-    let v749: f64 = p[44usize] * v748;
-    let v750: f64 = v705 * v749;
-    let v751: f64 = v702 * v629;
-    let v752: f64 = v751 * v473;
-    let v753: f64 = v629 * v629;
-    let v754: f64 = v154 * v753;
-    let v755: f64 = v750 + v752;
-    let v756: f64 = v755 - v754;
-    let v757: f64 = v70 * v707;
-    let v758: f64 = v462.mul_add(v462, v757);
-    let v759: f64 = p[44usize] * v758;
-    let v760: f64 = v147 * v753;
-    let v761: f64 = v705.mul_add(v759, -v760);
-    let v762: f64 = (-v751).mul_add(v476, v761);
-    let v763: f64 = v151.mul_add(v756, v701);
-    let v764: f64 = v156.mul_add(v762, v763);
-    let v765: f64 = p[70usize] + v764;
-    let v766: f64 = v754 - v750;
-    let v767: f64 = v766 - v752;
-    let v768: f64 = v151.mul_add(v762, v737);
-    let v769: f64 = v156.mul_add(v767, v768);
-    let v770: f64 = p[71usize] + v769;
-    let v771: f64 = v168 * v770;
-    let v772: f64 = v158.mul_add(v765, -v771);
-    let v773: f64 = v638.mul_add(v637, v745);
-    let v774: f64 = p[45usize].mul_add(v772, v773);
-    let v776: f64 = q[5usize] * v775;
-    let v777: f64 = 2f64.mul_add(v439, v776);
-    let v778: f64 = p[38usize] * v777;
-    let v779: f64 = v693 * v778;
-    let v780: f64 = v690 * v618;
-    let v781: f64 = v780 * v438;
-    let v782: f64 = v618 * v618;
-    let v783: f64 = v198 * v782;
-    let v784: f64 = v779 + v781;
-    let v785: f64 = v784 - v783;
-    let v786: f64 = v58 * v695;
-    let v787: f64 = v430.mul_add(v430, v786);
-    let v788: f64 = p[38usize] * v787;
-    let v789: f64 = v196 * v782;
-    let v790: f64 = v693.mul_add(v788, -v789);
-    let v791: f64 = (-v780).mul_add(v441, v790);
-    let v792: f64 = v138.mul_add(v785, v689);
-    let v793: f64 = v136.mul_add(v791, v792);
-    let v794: f64 = p[70usize] + v793;
-    let v795: f64 = v783 - v779;
-    let v796: f64 = v795 - v781;
-    let v797: f64 = v138.mul_add(v791, v733);
-    let v798: f64 = v136.mul_add(v796, v797);
-    let v799: f64 = p[71usize] + v798;
-    let v800: f64 = v202 * v799;
-    let v801: f64 = v200.mul_add(v794, -v800);
-    let v802: f64 = v627.mul_add(v626, v774);
-    let v803: f64 = p[39usize].mul_add(v801, v802);
-    let v805: f64 = q[4usize] * v804;
-    let v806: f64 = 2f64.mul_add(v407, v805);
-    let v807: f64 = p[32usize] * v806;
-    let v808: f64 = v681 * v807;
-    let v809: f64 = v678 * v606;
-    let v810: f64 = v809 * v406;
-    let v811: f64 = v606 * v606;
-    let v812: f64 = v213 * v811;
-    let v813: f64 = v808 + v810;
-    let v814: f64 = v813 - v812;
-    let v815: f64 = v46 * v683;
-    let v816: f64 = v398.mul_add(v398, v815);
-    let v817: f64 = p[32usize] * v816;
-    let v818: f64 = v211 * v811;
-    let v819: f64 = v681.mul_add(v817, -v818);
-    let v820: f64 = (-v809).mul_add(v409, v819);
-    let v821: f64 = v125.mul_add(v814, v677);
-    let v822: f64 = v123.mul_add(v820, v821);
-    let v823: f64 = p[70usize] + v822;
-    let v824: f64 = v812 - v808;
-    let v825: f64 = v824 - v810;
-    let v826: f64 = v125.mul_add(v820, v729);
-    let v827: f64 = v123.mul_add(v825, v826);
-    let v828: f64 = p[71usize] + v827;
-    let v829: f64 = v217 * v828;
-    let v830: f64 = v215.mul_add(v823, -v829);
-    let v831: f64 = v615.mul_add(v614, v803);
-    let v832: f64 = p[33usize].mul_add(v830, v831);
-    let v834: f64 = q[3usize] * v833;
-    let v835: f64 = 2f64.mul_add(v375, v834);
-    let v836: f64 = p[26usize] * v835;
-    let v837: f64 = v669 * v836;
-    let v838: f64 = v666 * v594;
-    let v839: f64 = v838 * v374;
-    let v840: f64 = v594 * v594;
-    let v841: f64 = v228 * v840;
-    let v842: f64 = v837 + v839;
-    let v843: f64 = v842 - v841;
-    let v844: f64 = v34 * v671;
-    let v845: f64 = v366.mul_add(v366, v844);
-    let v846: f64 = p[26usize] * v845;
-    let v847: f64 = v226 * v840;
-    let v848: f64 = v669.mul_add(v846, -v847);
-    let v849: f64 = (-v838).mul_add(v377, v848);
-    let v850: f64 = v112.mul_add(v843, v665);
-    let v851: f64 = v110.mul_add(v849, v850);
-    let v852: f64 = p[70usize] + v851;
-    let v853: f64 = v841 - v837;
-    let v854: f64 = v853 - v839;
-    let v855: f64 = v112.mul_add(v849, v725);
-    let v856: f64 = v110.mul_add(v854, v855);
-    let v857: f64 = p[71usize] + v856;
-    let v858: f64 = v232 * v857;
-    let v859: f64 = v230.mul_add(v852, -v858);
-    let v860: f64 = v603.mul_add(v602, v832);
-    let v861: f64 = p[27usize].mul_add(v859, v860);
-    let v863: f64 = q[2usize] * v862;
-    let v864: f64 = 2f64.mul_add(v343, v863);
-    let v865: f64 = p[20usize] * v864;
-    let v866: f64 = v657 * v865;
-    let v867: f64 = v654 * v582;
-    let v868: f64 = v867 * v342;
-    let v869: f64 = v582 * v582;
-    let v870: f64 = v243 * v869;
-    let v871: f64 = v866 + v868;
-    let v872: f64 = v871 - v870;
-    let v873: f64 = v22 * v659;
-    let v874: f64 = v334.mul_add(v334, v873);
-    let v875: f64 = p[20usize] * v874;
-    let v876: f64 = v241 * v869;
-    let v877: f64 = v657.mul_add(v875, -v876);
-    let v878: f64 = (-v867).mul_add(v345, v877);
-    let v879: f64 = v99.mul_add(v872, v653);
-    let v880: f64 = v97.mul_add(v878, v879);
-    let v881: f64 = p[70usize] + v880;
-    let v882: f64 = v870 - v866;
-    let v883: f64 = v882 - v868;
-    let v884: f64 = v99.mul_add(v878, v721);
-    let v885: f64 = v97.mul_add(v883, v884);
-    let v886: f64 = p[71usize] + v885;
-    let v887: f64 = v247 * v886;
-    let v888: f64 = v245.mul_add(v881, -v887);
-    let v889: f64 = v591.mul_add(v590, v861);
-    let v890: f64 = p[21usize].mul_add(v888, v889);
-    let v892: f64 = q[1usize] * v891;
-    let v893: f64 = 2f64.mul_add(v311, v892);
-    let v894: f64 = p[14usize] * v893;
-    let v895: f64 = v645 * v894;
-    let v896: f64 = 2f64 * qd[0usize];
-    let v897: f64 = v896 * qd[1usize];
-    let v898: f64 = v897 * v310;
-    let v899: f64 = v640 * v258;
-    let v900: f64 = v895 + v898;
-    let v901: f64 = v900 - v899;
-    let v902: f64 = v9 * v647;
-    let v903: f64 = v302.mul_add(v302, v902);
-    let v904: f64 = p[14usize] * v903;
-    let v905: f64 = v640 * v256;
-    let v906: f64 = v645.mul_add(v904, -v905);
-    let v907: f64 = (-v897).mul_add(v313, v906);
-    let v908: f64 = v82.mul_add(v901, v641);
-    let v909: f64 = v86.mul_add(v907, v908);
-    let v910: f64 = p[70usize] + v909;
-    let v911: f64 = v899 - v895;
-    let v912: f64 = v911 - v898;
-    let v913: f64 = v82.mul_add(v907, v717);
-    let v914: f64 = v86.mul_add(v912, v913);
-    let v915: f64 = p[71usize] + v914;
-    let v916: f64 = v262 * v915;
-    let v917: f64 = v260.mul_add(v910, -v916);
-    let v918: f64 = v579.mul_add(v578, v890);
-    let v919: f64 = p[15usize].mul_add(v917, v918);
-    let v920: f64 = p[7usize] * v742;
-    let v921: f64 = p[45usize].mul_add(v770, v920);
-    let v922: f64 = p[39usize].mul_add(v799, v921);
-    let v923: f64 = p[33usize].mul_add(v828, v922);
-    let v924: f64 = p[27usize].mul_add(v857, v923);
-    let v925: f64 = p[21usize].mul_add(v886, v924);
-    let v926: f64 = p[15usize].mul_add(v915, v925);
-    let v927: f64 = p[7usize] * v714;
-    let v928: f64 = p[45usize].mul_add(v765, v927);
-    let v929: f64 = p[39usize].mul_add(v794, v928);
-    let v930: f64 = p[33usize].mul_add(v823, v929);
-    let v931: f64 = p[27usize].mul_add(v852, v930);
-    let v932: f64 = p[21usize].mul_add(v881, v931);
-    let v933: f64 = p[15usize].mul_add(v910, v932);
-    let v936: f64 = p[72usize] + q[0usize];
-    let v938: f64 = p[63usize] * v82;
-    let v939: f64 = v640.mul_add(v938, p[71usize]);
-    let v940: f64 = v640.mul_add(v272, p[70usize]);
-    let v941: f64 = v270 * v940;
-    let v942: f64 = v272.mul_add(v939, v941);
-    let v943: f64 = v276.mul_add(v926, v919);
-    let v944: f64 = v287.mul_add(v933, v943);
-    let v945: f64 = p[11usize].mul_add(v936, v944);
-    let v946: f64 = p[12usize].mul_add(qd[0usize], v945);
-    let v947: f64 = p[9usize].mul_add(v942, v946);
-    let v950: f64 = (-0.5f64) * v648;
-    let v951: f64 = v950 * v575;
-    let v952: f64 = p[73usize] * v951;
-    let v953: f64 = p[15usize] * v952;
-    let v955: f64 = p[74usize] * v572;
-    let v956: f64 = v955 * v950;
-    let v957: f64 = v302 * v956;
-    let v960: f64 = p[75usize] + q[1usize];
-    let v961: f64 = v910 * v315;
-    let v963: f64 = p[76usize] * q[1usize];
-    let v964: f64 = v963 * v13;
-    let v965: f64 = v915.mul_add(v317, v961);
-    let v966: f64 = (-v964).mul_add(v950, v965);
-    let v968: f64 = 0.5f64 * v571;
-    let v969: f64 = v968.mul_add(v578, p[18usize]);
-    let v970: f64 = v311.mul_add(v953, v957);
-    let v971: f64 = v970 + v890;
-    let v972: f64 = v309.mul_add(v925, v971);
-    let v973: f64 = v306.mul_add(v932, v972);
-    let v974: f64 = p[17usize].mul_add(v960, v973);
-    let v975: f64 = p[15usize].mul_add(v966, v974);
-    let v976: f64 = qd[1usize].mul_add(v969, v975);
-    let v978: f64 = (-0.5f64) * v660;
-    let v979: f64 = v978 * v587;
-    let v980: f64 = p[77usize] * v979;
-    let v981: f64 = p[21usize] * v980;
-    let v983: f64 = p[78usize] * v584;
-    let v984: f64 = v983 * v978;
-    let v985: f64 = v334 * v984;
-    let v988: f64 = p[79usize] + q[2usize];
-    let v989: f64 = v881 * v347;
-    let v991: f64 = p[80usize] * q[2usize];
-    let v992: f64 = v991 * v25;
-    let v993: f64 = v886.mul_add(v349, v989);
-    let v994: f64 = (-v992).mul_add(v978, v993);
-    let v996: f64 = 0.5f64 * v583;
-    let v997: f64 = v996.mul_add(v590, p[24usize]);
-    let v998: f64 = v343.mul_add(v981, v985);
-    let v999: f64 = v998 + v861;
-    let v1000: f64 = v341.mul_add(v924, v999);
-    let v1001: f64 = v338.mul_add(v931, v1000);
-    let v1002: f64 = p[23usize].mul_add(v988, v1001);
-    let v1003: f64 = p[21usize].mul_add(v994, v1002);
-    let v1004: f64 = qd[2usize].mul_add(v997, v1003);
-    let v1006: f64 = (-0.5f64) * v672;
-    let v1007: f64 = v1006 * v599;
-    let v1008: f64 = p[81usize] * v1007;
-    let v1009: f64 = p[27usize] * v1008;
-    let v1011: f64 = p[82usize] * v596;
-    let v1012: f64 = v1011 * v1006;
-    let v1013: f64 = v366 * v1012;
-    let v1016: f64 = p[83usize] + q[3usize];
-    let v1017: f64 = v852 * v379;
-    let v1019: f64 = p[84usize] * q[3usize];
-    let v1020: f64 = v1019 * v37;
-    let v1021: f64 = v857.mul_add(v381, v1017);
-    let v1022: f64 = (-v1020).mul_add(v1006, v1021);
-    let v1024: f64 = 0.5f64 * v595;
-    let v1025: f64 = v1024.mul_add(v602, p[30usize]);
-    let v1026: f64 = v375.mul_add(v1009, v1013);
-    let v1027: f64 = v1026 + v832;
-    let v1028: f64 = v373.mul_add(v923, v1027);
-    let v1029: f64 = v370.mul_add(v930, v1028);
-    let v1030: f64 = p[29usize].mul_add(v1016, v1029);
-    let v1031: f64 = p[27usize].mul_add(v1022, v1030);
-    let v1032: f64 = qd[3usize].mul_add(v1025, v1031);
-    let v1034: f64 = (-0.5f64) * v684;
-    let v1035: f64 = v1034 * v611;
-    let v1036: f64 = p[85usize] * v1035;
-    let v1037: f64 = p[33usize] * v1036;
-    let v1039: f64 = p[86usize] * v608;
-    let v1040: f64 = v1039 * v1034;
-    let v1041: f64 = v398 * v1040;
-    let v1044: f64 = p[87usize] + q[4usize];
-    let v1045: f64 = v823 * v411;
-    let v1047: f64 = p[88usize] * q[4usize];
-    let v1048: f64 = v1047 * v49;
-    let v1049: f64 = v828.mul_add(v413, v1045);
-    let v1050: f64 = (-v1048).mul_add(v1034, v1049);
-    let v1052: f64 = 0.5f64 * v607;
-    let v1053: f64 = v1052.mul_add(v614, p[36usize]);
-    let v1054: f64 = v407.mul_add(v1037, v1041);
-    let v1055: f64 = v1054 + v803;
-    let v1056: f64 = v405.mul_add(v922, v1055);
-    let v1057: f64 = v402.mul_add(v929, v1056);
-    let v1058: f64 = p[35usize].mul_add(v1044, v1057);
-    let v1059: f64 = p[33usize].mul_add(v1050, v1058);
-    let v1060: f64 = qd[4usize].mul_add(v1053, v1059);
-    let v1062: f64 = (-0.5f64) * v696;
-    let v1063: f64 = v1062 * v623;
-    let v1064: f64 = p[89usize] * v1063;
-    let v1065: f64 = p[39usize] * v1064;
-    let v1067: f64 = p[90usize] * v620;
-    let v1068: f64 = v1067 * v1062;
-    let v1069: f64 = v430 * v1068;
-    let v1072: f64 = p[91usize] + q[5usize];
-    let v1073: f64 = v794 * v443;
-    let v1075: f64 = p[92usize] * q[5usize];
-    let v1076: f64 = v1075 * v61;
-    let v1077: f64 = v799.mul_add(v445, v1073);
-    let v1078: f64 = (-v1076).mul_add(v1062, v1077);
-    let v1080: f64 = 0.5f64 * v619;
-    let v1081: f64 = v1080.mul_add(v626, p[42usize]);
-    let v1082: f64 = v439.mul_add(v1065, v1069);
-    let v1083: f64 = v1082 + v774;
-    let v1084: f64 = v437.mul_add(v921, v1083);
-    let v1085: f64 = v434.mul_add(v928, v1084);
-    let v1086: f64 = p[41usize].mul_add(v1072, v1085);
-    let v1087: f64 = p[39usize].mul_add(v1078, v1086);
-    let v1088: f64 = qd[5usize].mul_add(v1081, v1087);
-    let v1090: f64 = (-0.5f64) * v708;
-    let v1091: f64 = v1090 * v634;
-    let v1092: f64 = p[93usize] * v1091;
-    let v1093: f64 = p[45usize] * v1092;
-    let v1095: f64 = p[94usize] * v631;
-    let v1096: f64 = v1095 * v1090;
-    let v1097: f64 = v462 * v1096;
-    let v1100: f64 = p[95usize] + q[6usize];
-    let v1101: f64 = v765 * v478;
-    let v1103: f64 = p[96usize] * q[6usize];
-    let v1104: f64 = v1103 * v73;
-    let v1105: f64 = v770.mul_add(v480, v1101);
-    let v1106: f64 = (-v1104).mul_add(v1090, v1105);
-    let v1107: f64 = v714 * v466;
-    let v1108: f64 = v742.mul_add(v469, v1107);
-    let v1110: f64 = 0.5f64 * v630;
-    let v1111: f64 = v1110.mul_add(v637, p[48usize]);
-    let v1112: f64 = v474.mul_add(v1093, v1097);
-    let v1113: f64 = p[47usize].mul_add(v1100, v1112);
-    let v1114: f64 = p[45usize].mul_add(v1106, v1113);
-    let v1115: f64 = p[7usize].mul_add(v1108, v1114);
-    let v1116: f64 = qd[6usize].mul_add(v1111, v1115);
-    out[0usize] = v300;
-    out[1usize] = v332;
-    out[2usize] = v364;
-    out[3usize] = v396;
-    out[4usize] = v428;
-    out[5usize] = v460;
-    out[6usize] = v490;
-    out[7usize] = v498;
-    out[8usize] = v500;
-    out[9usize] = v502;
-    out[10usize] = v504;
-    out[11usize] = v506;
-    out[12usize] = v508;
-    out[13usize] = v516;
-    out[14usize] = v518;
-    out[15usize] = v520;
-    out[16usize] = v522;
-    out[17usize] = v524;
-    out[18usize] = v532;
-    out[19usize] = v534;
-    out[20usize] = v536;
-    out[21usize] = v538;
-    out[22usize] = v546;
-    out[23usize] = v548;
-    out[24usize] = v550;
-    out[25usize] = v558;
-    out[26usize] = v560;
-    out[27usize] = v567;
-    out[28usize] = v947;
-    out[29usize] = v976;
-    out[30usize] = v1004;
-    out[31usize] = v1032;
-    out[32usize] = v1060;
-    out[33usize] = v1088;
-    out[34usize] = v1116;
+    out2[0usize] = v300;
+    out2[1usize] = v334;
+    out2[2usize] = v377;
+    out2[3usize] = v426;
+    out2[4usize] = v482;
+    out2[5usize] = v546;
+    out2[6usize] = v617;
+    out2[7usize] = v343;
+    out2[8usize] = v379;
+    out2[9usize] = v428;
+    out2[10usize] = v484;
+    out2[11usize] = v548;
+    out2[12usize] = v619;
+    out2[13usize] = v392;
+    out2[14usize] = v433;
+    out2[15usize] = v490;
+    out2[16usize] = v554;
+    out2[17usize] = v625;
+    out2[18usize] = v448;
+    out2[19usize] = v495;
+    out2[20usize] = v560;
+    out2[21usize] = v631;
+    out2[22usize] = v512;
+    out2[23usize] = v566;
+    out2[24usize] = v638;
+    out2[25usize] = v585;
+    out2[26usize] = v645;
+    out2[27usize] = v665;
+    out2[28usize] = v1071;
+    out2[29usize] = v1100;
+    out2[30usize] = v1130;
+    out2[31usize] = v1161;
+    out2[32usize] = v1193;
+    out2[33usize] = v1226;
+    out2[34usize] = v1237;
 }
 /// Kernel `derived`: 80 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
@@ -2503,8 +1525,8 @@ pub fn derived(
     unsafe { derived_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
     q: &[f64; 7usize],
@@ -2680,8 +1702,8 @@ pub fn constraints(
     unsafe { constraints_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
     q: &[f64; 7usize],
@@ -2708,8 +1730,8 @@ pub fn contact(
     unsafe { contact_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
     q: &[f64; 7usize],
@@ -2748,8 +1770,8 @@ pub fn contact_jvp(
     unsafe { contact_jvp_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
     q: &[f64; 7usize],
@@ -2947,8 +1969,8 @@ pub fn cell_0_pose(
     unsafe { cell_0_pose_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
     q: &[f64; 1usize],
@@ -3034,8 +2056,8 @@ pub fn cell_0(
     unsafe { cell_0_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
     q: &[f64; 1usize],
@@ -3146,8 +2168,8 @@ pub fn cell_0_tangent(
     unsafe { cell_0_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
     q: &[f64; 1usize],
@@ -3354,8 +2376,8 @@ pub fn cell_1_pose(
     unsafe { cell_1_pose_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_1_pose_0(
     t: f64,
     q: &[f64; 1usize],
@@ -3470,8 +2492,8 @@ pub fn cell_1(
     unsafe { cell_1_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_1_0(
     t: f64,
     q: &[f64; 1usize],
@@ -3629,8 +2651,8 @@ pub fn cell_1_tangent(
     unsafe { cell_1_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_1_tangent_0(
     t: f64,
     q: &[f64; 1usize],

@@ -229,7 +229,7 @@ impl Kernels for Compiled {
         }
     }
 }
-/// Kernel `accel`: 2483 operations in 1 chunk(s).
+/// Kernel `accel`: the first 54 values of `eom` (2483 operations for all).
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
@@ -242,12 +242,11 @@ pub fn accel(
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
-    unsafe { accel_0(t, q, qd, qdd, dir, p, w, out) };
+    unsafe { accel_fma(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn accel_0(
+fn accel_fma(
     t: f64,
     q: &[f64; 9usize],
     qd: &[f64; 9usize],
@@ -256,6 +255,52 @@ fn accel_0(
     p: &[f64; 155usize],
     w: &mut [f64; 0usize],
     out: &mut [f64; 54usize],
+) {
+    let mut unused = [0.0f64; 54usize];
+    eom_0(t, q, qd, qdd, dir, p, w, out, &mut unused);
+}
+/// Kernel `mass_bias`: the last 54 values of `eom` (2483 operations for all).
+#[allow(unused_unsafe)]
+pub fn mass_bias(
+    t: f64,
+    q: &[f64; 9usize],
+    qd: &[f64; 9usize],
+    qdd: &[f64; 9usize],
+    dir: &[f64; 18usize],
+    p: &[f64; 155usize],
+    out: &mut [f64; 54usize],
+) {
+    runtime::cpu::require_fma();
+    let w = &mut [0.0f64; 0];
+    unsafe { mass_bias_fma(t, q, qd, qdd, dir, p, w, out) };
+}
+#[inline(never)]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+fn mass_bias_fma(
+    t: f64,
+    q: &[f64; 9usize],
+    qd: &[f64; 9usize],
+    qdd: &[f64; 9usize],
+    dir: &[f64; 18usize],
+    p: &[f64; 155usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 54usize],
+) {
+    let mut unused = [0.0f64; 54usize];
+    eom_0(t, q, qd, qdd, dir, p, w, &mut unused, out);
+}
+#[inline(always)]
+#[allow(unused_variables, clippy::all)]
+fn eom_0(
+    t: f64,
+    q: &[f64; 9usize],
+    qd: &[f64; 9usize],
+    qdd: &[f64; 9usize],
+    dir: &[f64; 18usize],
+    p: &[f64; 155usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 54usize],
+    out2: &mut [f64; 54usize],
 ) {
     let [v3, v356, v1498]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
         3usize,
@@ -1979,1474 +2024,60 @@ fn accel_0(
     out[51usize] = v937;
     out[52usize] = v938;
     out[53usize] = v927;
-}
-/// Kernel `mass_bias`: 2036 operations in 1 chunk(s).
-#[allow(unused_unsafe)]
-pub fn mass_bias(
-    t: f64,
-    q: &[f64; 9usize],
-    qd: &[f64; 9usize],
-    qdd: &[f64; 9usize],
-    dir: &[f64; 18usize],
-    p: &[f64; 155usize],
-    out: &mut [f64; 54usize],
-) {
-    runtime::cpu::require_fma();
-    let w = &mut [0.0f64; 0];
-    unsafe { mass_bias_0(t, q, qd, qdd, dir, p, w, out) };
-}
-#[inline(never)]
-#[allow(unused_variables, clippy::all)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn mass_bias_0(
-    t: f64,
-    q: &[f64; 9usize],
-    qd: &[f64; 9usize],
-    qdd: &[f64; 9usize],
-    dir: &[f64; 18usize],
-    p: &[f64; 155usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 54usize],
-) {
-    let [v3, v356, v1282]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[0usize]);
-    let v5: f64 = 2f64 * v3;
-    let v7: f64 = 0.5f64 * q[0usize];
-    let [v8, v353, v867]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v7);
-    let v9: f64 = v8.powi(4i32);
-    let v11: f64 = q[0usize] * q[0usize];
-    let v12: f64 = v3 * v3;
-    let v13: f64 = (-0.25f64).mul_add(v9, v5);
-    let v14: f64 = (-v11).mul_add(v12, v13);
-    let v15: f64 = p[61usize].mul_add(v14, p[9usize]);
-    let [v19, v407, v1235]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[1usize]);
-    let v20: f64 = 2f64 * v19;
-    let v21: f64 = 0.5f64 * q[1usize];
-    let [v22, v397, v877]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v21);
-    let v23: f64 = v22.powi(4i32);
-    let v24: f64 = q[1usize] * q[1usize];
-    let v25: f64 = v19 * v19;
-    let v26: f64 = (-0.25f64).mul_add(v23, v20);
-    let v27: f64 = (-v24).mul_add(v25, v26);
-    let [v31, v439, v1194]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[2usize]);
-    let v32: f64 = 2f64 * v31;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let [v34, v429, v892]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v33);
-    let v35: f64 = v34.powi(4i32);
-    let v36: f64 = q[2usize] * q[2usize];
-    let v37: f64 = v31 * v31;
-    let v38: f64 = (-0.25f64).mul_add(v35, v32);
-    let v39: f64 = (-v36).mul_add(v37, v38);
-    let [v43, v471, v1164]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[3usize]);
-    let v44: f64 = 2f64 * v43;
-    let v45: f64 = 0.5f64 * q[3usize];
-    let [v46, v461, v906]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v45);
-    let v47: f64 = v46.powi(4i32);
-    let v48: f64 = q[3usize] * q[3usize];
-    let v49: f64 = v43 * v43;
-    let v50: f64 = (-0.25f64).mul_add(v47, v44);
-    let v51: f64 = (-v48).mul_add(v49, v50);
-    let [v55, v503, v1134]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[4usize]);
-    let v56: f64 = 2f64 * v55;
-    let v57: f64 = 0.5f64 * q[4usize];
-    let [v58, v493, v920]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v57);
-    let v59: f64 = v58.powi(4i32);
-    let v60: f64 = q[4usize] * q[4usize];
-    let v61: f64 = v55 * v55;
-    let v62: f64 = (-0.25f64).mul_add(v59, v56);
-    let v63: f64 = (-v60).mul_add(v61, v62);
-    let [v67, v535, v1104]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[5usize]);
-    let v68: f64 = 2f64 * v67;
-    let v69: f64 = 0.5f64 * q[5usize];
-    let [v70, v525, v934]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v69);
-    let v71: f64 = v70.powi(4i32);
-    let v72: f64 = q[5usize] * q[5usize];
-    let v73: f64 = v67 * v67;
-    let v74: f64 = (-0.25f64).mul_add(v71, v68);
-    let v75: f64 = (-v72).mul_add(v73, v74);
-    let [v79, v567, v1074]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[6usize]);
-    let v80: f64 = 2f64 * v79;
-    let v81: f64 = 0.5f64 * q[6usize];
-    let [v82, v557, v948]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v81);
-    let v83: f64 = v82.powi(4i32);
-    let v84: f64 = q[6usize] * q[6usize];
-    let v85: f64 = v79 * v79;
-    let v86: f64 = (-0.25f64).mul_add(v83, v80);
-    let v87: f64 = (-v84).mul_add(v85, v86);
-    let [v91, v599, v1044]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[7usize]);
-    let v92: f64 = 2f64 * v91;
-    let v93: f64 = 0.5f64 * q[7usize];
-    let [v94, v589, v962]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v93);
-    let v95: f64 = v94.powi(4i32);
-    let v96: f64 = q[7usize] * q[7usize];
-    let v97: f64 = v91 * v91;
-    let v98: f64 = (-0.25f64).mul_add(v95, v92);
-    let v99: f64 = (-v96).mul_add(v97, v98);
-    let [v103, v624, v971]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[8usize]);
-    let v104: f64 = 2f64 * v103;
-    let v105: f64 = 0.5f64 * q[8usize];
-    let [v106, v620, v984]: [f64; 3usize] = runtime::special::sinc_orders::<
-        3usize,
-    >(v105);
-    let v107: f64 = v106.powi(4i32);
-    let v108: f64 = q[8usize] * q[8usize];
-    let v109: f64 = v103 * v103;
-    let v110: f64 = (-0.25f64).mul_add(v107, v104);
-    let v111: f64 = (-v108).mul_add(v109, v110);
-    let (v117, v118): (f64, f64) = runtime::special::sin_cos(v7);
-    let v119: f64 = p[70usize] * v117;
-    let v120: f64 = p[71usize].mul_add(v118, -v119);
-    let v121: f64 = p[7usize] * v8;
-    let v122: f64 = v121.mul_add(v120, p[3usize]);
-    let v124: f64 = p[71usize] * v117;
-    let v125: f64 = p[70usize].mul_add(v118, v124);
-    let v126: f64 = v120 * v117;
-    let v127: f64 = v125.mul_add(v118, v126);
-    let v128: f64 = v125 * v117;
-    let v129: f64 = v120.mul_add(v118, -v128);
-    let (v130, v131): (f64, f64) = runtime::special::sin_cos(v21);
-    let v132: f64 = v127 * v130;
-    let v133: f64 = v129.mul_add(v131, -v132);
-    let v134: f64 = p[13usize] * v22;
-    let v135: f64 = v134.mul_add(v133, v122);
-    let v137: f64 = v129 * v130;
-    let v138: f64 = v127.mul_add(v131, v137);
-    let v139: f64 = v133 * v130;
-    let v140: f64 = v138.mul_add(v131, v139);
-    let v141: f64 = v138 * v130;
-    let v142: f64 = v133.mul_add(v131, -v141);
-    let (v143, v144): (f64, f64) = runtime::special::sin_cos(v33);
-    let v145: f64 = v140 * v143;
-    let v146: f64 = v142.mul_add(v144, -v145);
-    let v147: f64 = p[19usize] * v34;
-    let v148: f64 = v147.mul_add(v146, v135);
-    let v150: f64 = v142 * v143;
-    let v151: f64 = v140.mul_add(v144, v150);
-    let v152: f64 = v146 * v143;
-    let v153: f64 = v151.mul_add(v144, v152);
-    let v154: f64 = v151 * v143;
-    let v155: f64 = v146.mul_add(v144, -v154);
-    let (v156, v157): (f64, f64) = runtime::special::sin_cos(v45);
-    let v158: f64 = v153 * v156;
-    let v159: f64 = v155.mul_add(v157, -v158);
-    let v160: f64 = p[25usize] * v46;
-    let v161: f64 = v160.mul_add(v159, v148);
-    let v163: f64 = v155 * v156;
-    let v164: f64 = v153.mul_add(v157, v163);
-    let v165: f64 = v159 * v156;
-    let v166: f64 = v164.mul_add(v157, v165);
-    let v167: f64 = v164 * v156;
-    let v168: f64 = v159.mul_add(v157, -v167);
-    let (v169, v170): (f64, f64) = runtime::special::sin_cos(v57);
-    let v171: f64 = v166 * v169;
-    let v172: f64 = v168.mul_add(v170, -v171);
-    let v173: f64 = p[31usize] * v58;
-    let v174: f64 = v173.mul_add(v172, v161);
-    let v176: f64 = v168 * v169;
-    let v177: f64 = v166.mul_add(v170, v176);
-    let v178: f64 = v172 * v169;
-    let v179: f64 = v177.mul_add(v170, v178);
-    let v180: f64 = v177 * v169;
-    let v181: f64 = v172.mul_add(v170, -v180);
-    let (v182, v183): (f64, f64) = runtime::special::sin_cos(v69);
-    let v184: f64 = v179 * v182;
-    let v185: f64 = v181.mul_add(v183, -v184);
-    let v186: f64 = p[37usize] * v70;
-    let v187: f64 = v186.mul_add(v185, v174);
-    let v189: f64 = v181 * v182;
-    let v190: f64 = v179.mul_add(v183, v189);
-    let v191: f64 = v185 * v182;
-    let v192: f64 = v190.mul_add(v183, v191);
-    let v193: f64 = v190 * v182;
-    let v194: f64 = v185.mul_add(v183, -v193);
-    let (v195, v196): (f64, f64) = runtime::special::sin_cos(v81);
-    let v197: f64 = v192 * v195;
-    let v198: f64 = v194.mul_add(v196, -v197);
-    let v199: f64 = p[43usize] * v82;
-    let v200: f64 = v199.mul_add(v198, v187);
-    let v202: f64 = v194 * v195;
-    let v203: f64 = v192.mul_add(v196, v202);
-    let v204: f64 = v198 * v195;
-    let v205: f64 = v203.mul_add(v196, v204);
-    let v206: f64 = v203 * v195;
-    let v207: f64 = v198.mul_add(v196, -v206);
-    let (v208, v209): (f64, f64) = runtime::special::sin_cos(v93);
-    let v210: f64 = v205 * v208;
-    let v211: f64 = v207.mul_add(v209, -v210);
-    let v212: f64 = p[49usize] * v94;
-    let v213: f64 = v212.mul_add(v211, v200);
-    let v215: f64 = v106 * v106;
-    let v216: f64 = p[72usize] * v215;
-    let v217: f64 = v207 * v208;
-    let v218: f64 = v205.mul_add(v209, v217);
-    let v219: f64 = v218 * v208;
-    let v220: f64 = v211.mul_add(v209, -v219);
-    let v222: f64 = p[55usize] * q[8usize];
-    let v223: f64 = v222 * v103;
-    let v224: f64 = v211 * v208;
-    let v225: f64 = v218.mul_add(v209, v224);
-    let v226: f64 = v216.mul_add(v220, v213);
-    let v227: f64 = (-v223).mul_add(v225, v226);
-    let v229: f64 = v121.mul_add(v125, p[4usize]);
-    let v230: f64 = v134.mul_add(v138, v229);
-    let v231: f64 = v147.mul_add(v151, v230);
-    let v232: f64 = v160.mul_add(v164, v231);
-    let v233: f64 = v173.mul_add(v177, v232);
-    let v234: f64 = v186.mul_add(v190, v233);
-    let v235: f64 = v199.mul_add(v203, v234);
-    let v236: f64 = v212.mul_add(v218, v235);
-    let v237: f64 = v216.mul_add(v225, v236);
-    let v238: f64 = v223.mul_add(v220, v237);
-    let v239: f64 = v238 * v238;
-    let v240: f64 = v227.mul_add(v227, v239);
-    let v241: f64 = p[69usize].mul_add(v111, p[57usize]);
-    let v242: f64 = p[56usize].mul_add(v240, v241);
-    let v245: f64 = v94 * v94;
-    let v246: f64 = p[73usize] * v245;
-    let v247: f64 = p[49usize] * q[7usize];
-    let v248: f64 = v247 * v91;
-    let v249: f64 = v246.mul_add(v207, v200);
-    let v250: f64 = (-v248).mul_add(v205, v249);
-    let v251: f64 = v246.mul_add(v205, v235);
-    let v252: f64 = v248.mul_add(v207, v251);
-    let v253: f64 = v252 * v252;
-    let v254: f64 = v250.mul_add(v250, v253);
-    let v255: f64 = p[68usize].mul_add(v99, p[51usize]);
-    let v256: f64 = v255 + v242;
-    let v257: f64 = p[50usize].mul_add(v254, v256);
-    let v260: f64 = v82 * v82;
-    let v261: f64 = p[74usize] * v260;
-    let v262: f64 = p[43usize] * q[6usize];
-    let v263: f64 = v262 * v79;
-    let v264: f64 = v261.mul_add(v194, v187);
-    let v265: f64 = (-v263).mul_add(v192, v264);
-    let v266: f64 = v261.mul_add(v192, v234);
-    let v267: f64 = v263.mul_add(v194, v266);
-    let v268: f64 = v267 * v267;
-    let v269: f64 = v265.mul_add(v265, v268);
-    let v270: f64 = p[67usize].mul_add(v87, p[45usize]);
-    let v271: f64 = v270 + v257;
-    let v272: f64 = p[44usize].mul_add(v269, v271);
-    let v275: f64 = v70 * v70;
-    let v276: f64 = p[75usize] * v275;
-    let v277: f64 = p[37usize] * q[5usize];
-    let v278: f64 = v277 * v67;
-    let v279: f64 = v276.mul_add(v181, v174);
-    let v280: f64 = (-v278).mul_add(v179, v279);
-    let v281: f64 = v276.mul_add(v179, v233);
-    let v282: f64 = v278.mul_add(v181, v281);
-    let v283: f64 = v282 * v282;
-    let v284: f64 = v280.mul_add(v280, v283);
-    let v285: f64 = p[66usize].mul_add(v75, p[39usize]);
-    let v286: f64 = v285 + v272;
-    let v287: f64 = p[38usize].mul_add(v284, v286);
-    let v290: f64 = v58 * v58;
-    let v291: f64 = p[76usize] * v290;
-    let v292: f64 = p[31usize] * q[4usize];
-    let v293: f64 = v292 * v55;
-    let v294: f64 = v291.mul_add(v168, v161);
-    let v295: f64 = (-v293).mul_add(v166, v294);
-    let v296: f64 = v291.mul_add(v166, v232);
-    let v297: f64 = v293.mul_add(v168, v296);
-    let v298: f64 = v297 * v297;
-    let v299: f64 = v295.mul_add(v295, v298);
-    let v300: f64 = p[65usize].mul_add(v63, p[33usize]);
-    let v301: f64 = v300 + v287;
-    let v302: f64 = p[32usize].mul_add(v299, v301);
-    let v305: f64 = v46 * v46;
-    let v306: f64 = p[77usize] * v305;
-    let v307: f64 = p[25usize] * q[3usize];
-    let v308: f64 = v307 * v43;
-    let v309: f64 = v306.mul_add(v155, v148);
-    let v310: f64 = (-v308).mul_add(v153, v309);
-    let v311: f64 = v306.mul_add(v153, v231);
-    let v312: f64 = v308.mul_add(v155, v311);
-    let v313: f64 = v312 * v312;
-    let v314: f64 = v310.mul_add(v310, v313);
-    let v315: f64 = p[64usize].mul_add(v51, p[27usize]);
-    let v316: f64 = v315 + v302;
-    let v317: f64 = p[26usize].mul_add(v314, v316);
-    let v320: f64 = v34 * v34;
-    let v321: f64 = p[78usize] * v320;
-    let v322: f64 = p[19usize] * q[2usize];
-    let v323: f64 = v322 * v31;
-    let v324: f64 = v321.mul_add(v142, v135);
-    let v325: f64 = (-v323).mul_add(v140, v324);
-    let v326: f64 = v321.mul_add(v140, v230);
-    let v327: f64 = v323.mul_add(v142, v326);
-    let v328: f64 = v327 * v327;
-    let v329: f64 = v325.mul_add(v325, v328);
-    let v330: f64 = p[63usize].mul_add(v39, p[21usize]);
-    let v331: f64 = v330 + v317;
-    let v332: f64 = p[20usize].mul_add(v329, v331);
-    let v335: f64 = v22 * v22;
-    let v336: f64 = p[79usize] * v335;
-    let v337: f64 = v336 * v129;
-    let v338: f64 = p[13usize] * q[1usize];
-    let v339: f64 = v338 * v19;
-    let v340: f64 = v339 * v127;
-    let v341: f64 = v122 + v337;
-    let v342: f64 = v341 - v340;
-    let v343: f64 = v336 * v127;
-    let v344: f64 = v339 * v129;
-    let v345: f64 = v229 + v343;
-    let v346: f64 = v345 + v344;
-    let v347: f64 = v346 * v346;
-    let v348: f64 = v342.mul_add(v342, v347);
-    let v349: f64 = p[62usize].mul_add(v27, p[15usize]);
-    let v350: f64 = v349 + v332;
-    let v351: f64 = p[14usize].mul_add(v348, v350);
-    let v354: f64 = 0.5f64 * v353;
-    let v355: f64 = v121 * v354;
-    let v357: f64 = q[0usize].mul_add(v356, v3);
-    let v358: f64 = p[7usize] * v357;
-    let v359: f64 = p[71usize] * v358;
-    let v360: f64 = p[70usize].mul_add(v355, v359);
-    let v361: f64 = p[70usize] * v358;
-    let v362: f64 = p[71usize].mul_add(v355, -v361);
-    let v363: f64 = v362 * v362;
-    let v364: f64 = v360.mul_add(v360, v363);
-    let v365: f64 = v120 * v354;
-    let v366: f64 = 0.5f64 * v8;
-    let v367: f64 = (-v366).mul_add(v125, v365);
-    let v368: f64 = p[7usize].mul_add(v367, v229);
-    let v369: f64 = p[56usize] * v238;
-    let v370: f64 = p[50usize].mul_add(v252, v369);
-    let v371: f64 = p[44usize].mul_add(v267, v370);
-    let v372: f64 = p[38usize].mul_add(v282, v371);
-    let v373: f64 = p[32usize].mul_add(v297, v372);
-    let v374: f64 = p[26usize].mul_add(v312, v373);
-    let v375: f64 = p[20usize].mul_add(v327, v374);
-    let v376: f64 = p[14usize].mul_add(v346, v375);
-    let v377: f64 = 2f64 * v376;
-    let v379: f64 = v368.mul_add(p[80usize], -v377);
-    let v380: f64 = v125 * v354;
-    let v381: f64 = v366.mul_add(v120, v380);
-    let v382: f64 = p[7usize].mul_add(v381, -v122);
-    let v383: f64 = p[56usize] * v227;
-    let v384: f64 = p[50usize].mul_add(v250, v383);
-    let v385: f64 = p[44usize].mul_add(v265, v384);
-    let v386: f64 = p[38usize].mul_add(v280, v385);
-    let v387: f64 = p[32usize].mul_add(v295, v386);
-    let v388: f64 = p[26usize].mul_add(v310, v387);
-    let v389: f64 = p[20usize].mul_add(v325, v388);
-    let v390: f64 = p[14usize].mul_add(v342, v389);
-    let v391: f64 = v382 * p[80usize];
-    let v392: f64 = 2f64.mul_add(v390, v391);
-    let v393: f64 = 0.25f64.mul_add(v15, v351);
-    let v394: f64 = p[8usize].mul_add(v364, v393);
-    let v395: f64 = v368.mul_add(v379, v394);
-    let v396: f64 = v382.mul_add(v392, v395);
-    let v398: f64 = 0.5f64 * v397;
-    let v399: f64 = 0.5f64 * v22;
-    let v400: f64 = v399 * v133;
-    let v401: f64 = v138.mul_add(v398, v400);
-    let v402: f64 = p[13usize].mul_add(v401, -v135);
-    let v403: f64 = v399 * v138;
-    let v404: f64 = v133.mul_add(v398, -v403);
-    let v405: f64 = p[13usize].mul_add(v404, v230);
-    let v406: f64 = v134 * v398;
-    let v408: f64 = q[1usize].mul_add(v407, v19);
-    let v409: f64 = p[13usize] * v408;
-    let v410: f64 = v129 * v409;
-    let v411: f64 = v127.mul_add(v406, v410);
-    let v412: f64 = v127 * v409;
-    let v413: f64 = v129.mul_add(v406, -v412);
-    let v414: f64 = v346 * v413;
-    let v415: f64 = v342.mul_add(v411, -v414);
-    let v416: f64 = 0.5f64.mul_add(v349, v332);
-    let v417: f64 = v402.mul_add(v389, v416);
-    let v418: f64 = (-v405).mul_add(v375, v417);
-    let v419: f64 = p[14usize].mul_add(v415, v418);
-    let v421: f64 = v405 * p[81usize];
-    let v422: f64 = v421 - v375;
-    let v423: f64 = p[14usize].mul_add(v413, v422);
-    let v424: f64 = v402 * p[81usize];
-    let v425: f64 = v389 + v424;
-    let v426: f64 = p[14usize].mul_add(v411, v425);
-    let v427: f64 = v368.mul_add(v423, v419);
-    let v428: f64 = v382.mul_add(v426, v427);
-    let v430: f64 = 0.5f64 * v429;
-    let v431: f64 = 0.5f64 * v34;
-    let v432: f64 = v431 * v146;
-    let v433: f64 = v151.mul_add(v430, v432);
-    let v434: f64 = p[19usize].mul_add(v433, -v148);
-    let v435: f64 = v431 * v151;
-    let v436: f64 = v146.mul_add(v430, -v435);
-    let v437: f64 = p[19usize].mul_add(v436, v231);
-    let v438: f64 = v147 * v430;
-    let v440: f64 = q[2usize].mul_add(v439, v31);
-    let v441: f64 = p[19usize] * v440;
-    let v442: f64 = v142 * v441;
-    let v443: f64 = v140.mul_add(v438, v442);
-    let v444: f64 = v140 * v441;
-    let v445: f64 = v142.mul_add(v438, -v444);
-    let v446: f64 = v327 * v445;
-    let v447: f64 = v325.mul_add(v443, -v446);
-    let v448: f64 = 0.5f64.mul_add(v330, v317);
-    let v449: f64 = v434.mul_add(v388, v448);
-    let v450: f64 = (-v437).mul_add(v374, v449);
-    let v451: f64 = p[20usize].mul_add(v447, v450);
-    let v453: f64 = v437 * p[82usize];
-    let v454: f64 = v453 - v374;
-    let v455: f64 = p[20usize].mul_add(v445, v454);
-    let v456: f64 = v434 * p[82usize];
-    let v457: f64 = v388 + v456;
-    let v458: f64 = p[20usize].mul_add(v443, v457);
-    let v459: f64 = v368.mul_add(v455, v451);
-    let v460: f64 = v382.mul_add(v458, v459);
-    let v462: f64 = 0.5f64 * v461;
-    let v463: f64 = 0.5f64 * v46;
-    let v464: f64 = v463 * v159;
-    let v465: f64 = v164.mul_add(v462, v464);
-    let v466: f64 = p[25usize].mul_add(v465, -v161);
-    let v467: f64 = v463 * v164;
-    let v468: f64 = v159.mul_add(v462, -v467);
-    let v469: f64 = p[25usize].mul_add(v468, v232);
-    let v470: f64 = v160 * v462;
-    let v472: f64 = q[3usize].mul_add(v471, v43);
-    let v473: f64 = p[25usize] * v472;
-    let v474: f64 = v155 * v473;
-    let v475: f64 = v153.mul_add(v470, v474);
-    let v476: f64 = v153 * v473;
-    let v477: f64 = v155.mul_add(v470, -v476);
-    let v478: f64 = v312 * v477;
-    let v479: f64 = v310.mul_add(v475, -v478);
-    let v480: f64 = 0.5f64.mul_add(v315, v302);
-    let v481: f64 = v466.mul_add(v387, v480);
-    let v482: f64 = (-v469).mul_add(v373, v481);
-    let v483: f64 = p[26usize].mul_add(v479, v482);
-    let v485: f64 = v469 * p[83usize];
-    let v486: f64 = v485 - v373;
-    let v487: f64 = p[26usize].mul_add(v477, v486);
-    let v488: f64 = v466 * p[83usize];
-    let v489: f64 = v387 + v488;
-    let v490: f64 = p[26usize].mul_add(v475, v489);
-    let v491: f64 = v368.mul_add(v487, v483);
-    let v492: f64 = v382.mul_add(v490, v491);
-    let v494: f64 = 0.5f64 * v493;
-    let v495: f64 = 0.5f64 * v58;
-    let v496: f64 = v495 * v172;
-    let v497: f64 = v177.mul_add(v494, v496);
-    let v498: f64 = p[31usize].mul_add(v497, -v174);
-    let v499: f64 = v495 * v177;
-    let v500: f64 = v172.mul_add(v494, -v499);
-    let v501: f64 = p[31usize].mul_add(v500, v233);
-    let v502: f64 = v173 * v494;
-    let v504: f64 = q[4usize].mul_add(v503, v55);
-    let v505: f64 = p[31usize] * v504;
-    let v506: f64 = v168 * v505;
-    let v507: f64 = v166.mul_add(v502, v506);
-    let v508: f64 = v166 * v505;
-    let v509: f64 = v168.mul_add(v502, -v508);
-    let v510: f64 = v297 * v509;
-    let v511: f64 = v295.mul_add(v507, -v510);
-    let v512: f64 = 0.5f64.mul_add(v300, v287);
-    let v513: f64 = v498.mul_add(v386, v512);
-    let v514: f64 = (-v501).mul_add(v372, v513);
-    let v515: f64 = p[32usize].mul_add(v511, v514);
-    let v517: f64 = v501 * p[84usize];
-    let v518: f64 = v517 - v372;
-    let v519: f64 = p[32usize].mul_add(v509, v518);
-    let v520: f64 = v498 * p[84usize];
-    let v521: f64 = v386 + v520;
-    let v522: f64 = p[32usize].mul_add(v507, v521);
-    let v523: f64 = v368.mul_add(v519, v515);
-    let v524: f64 = v382.mul_add(v522, v523);
-    let v526: f64 = 0.5f64 * v525;
-    let v527: f64 = 0.5f64 * v70;
-    let v528: f64 = v527 * v185;
-    let v529: f64 = v190.mul_add(v526, v528);
-    let v530: f64 = p[37usize].mul_add(v529, -v187);
-    let v531: f64 = v527 * v190;
-    let v532: f64 = v185.mul_add(v526, -v531);
-    let v533: f64 = p[37usize].mul_add(v532, v234);
-    let v534: f64 = v186 * v526;
-    let v536: f64 = q[5usize].mul_add(v535, v67);
-    let v537: f64 = p[37usize] * v536;
-    let v538: f64 = v181 * v537;
-    let v539: f64 = v179.mul_add(v534, v538);
-    let v540: f64 = v179 * v537;
-    let v541: f64 = v181.mul_add(v534, -v540);
-    let v542: f64 = v282 * v541;
-    let v543: f64 = v280.mul_add(v539, -v542);
-    let v544: f64 = 0.5f64.mul_add(v285, v272);
-    let v545: f64 = v530.mul_add(v385, v544);
-    let v546: f64 = (-v533).mul_add(v371, v545);
-    let v547: f64 = p[38usize].mul_add(v543, v546);
-    let v549: f64 = v533 * p[85usize];
-    let v550: f64 = v549 - v371;
-    let v551: f64 = p[38usize].mul_add(v541, v550);
-    let v552: f64 = v530 * p[85usize];
-    let v553: f64 = v385 + v552;
-    let v554: f64 = p[38usize].mul_add(v539, v553);
-    let v555: f64 = v368.mul_add(v551, v547);
-    let v556: f64 = v382.mul_add(v554, v555);
-    let v558: f64 = 0.5f64 * v557;
-    let v559: f64 = 0.5f64 * v82;
-    let v560: f64 = v559 * v198;
-    let v561: f64 = v203.mul_add(v558, v560);
-    let v562: f64 = p[43usize].mul_add(v561, -v200);
-    let v563: f64 = v559 * v203;
-    let v564: f64 = v198.mul_add(v558, -v563);
-    let v565: f64 = p[43usize].mul_add(v564, v235);
-    let v566: f64 = v199 * v558;
-    let v568: f64 = q[6usize].mul_add(v567, v79);
-    let v569: f64 = p[43usize] * v568;
-    let v570: f64 = v194 * v569;
-    let v571: f64 = v192.mul_add(v566, v570);
-    let v572: f64 = v192 * v569;
-    let v573: f64 = v194.mul_add(v566, -v572);
-    let v574: f64 = v267 * v573;
-    let v575: f64 = v265.mul_add(v571, -v574);
-    let v576: f64 = 0.5f64.mul_add(v270, v257);
-    let v577: f64 = v562.mul_add(v384, v576);
-    let v578: f64 = (-v565).mul_add(v370, v577);
-    let v579: f64 = p[44usize].mul_add(v575, v578);
-    let v581: f64 = v565 * p[86usize];
-    let v582: f64 = v581 - v370;
-    let v583: f64 = p[44usize].mul_add(v573, v582);
-    let v584: f64 = v562 * p[86usize];
-    let v585: f64 = v384 + v584;
-    let v586: f64 = p[44usize].mul_add(v571, v585);
-    let v587: f64 = v368.mul_add(v583, v579);
-    let v588: f64 = v382.mul_add(v586, v587);
-    let v590: f64 = 0.5f64 * v589;
-    let v591: f64 = 0.5f64 * v94;
-    let v592: f64 = v591 * v211;
-    let v593: f64 = v218.mul_add(v590, v592);
-    let v594: f64 = p[49usize].mul_add(v593, -v213);
-    let v595: f64 = v591 * v218;
-    let v596: f64 = v211.mul_add(v590, -v595);
-    let v597: f64 = p[49usize].mul_add(v596, v236);
-    let v598: f64 = v212 * v590;
-    let v600: f64 = q[7usize].mul_add(v599, v91);
-    let v601: f64 = p[49usize] * v600;
-    let v602: f64 = v207 * v601;
-    let v603: f64 = v205.mul_add(v598, v602);
-    let v604: f64 = v205 * v601;
-    let v605: f64 = v207.mul_add(v598, -v604);
-    let v606: f64 = v252 * v605;
-    let v607: f64 = v250.mul_add(v603, -v606);
-    let v608: f64 = 0.5f64.mul_add(v255, v242);
-    let v609: f64 = v594.mul_add(v383, v608);
-    let v610: f64 = (-v597).mul_add(v369, v609);
-    let v611: f64 = p[50usize].mul_add(v607, v610);
-    let v612: f64 = p[56usize] * v597;
-    let v613: f64 = v612 - v369;
-    let v614: f64 = p[50usize].mul_add(v605, v613);
-    let v615: f64 = p[56usize] * v594;
-    let v616: f64 = v383 + v615;
-    let v617: f64 = p[50usize].mul_add(v603, v616);
-    let v618: f64 = v368.mul_add(v614, v611);
-    let v619: f64 = v382.mul_add(v617, v618);
-    let v621: f64 = 0.5f64 * v620;
-    let v622: f64 = p[55usize] * v106;
-    let v623: f64 = v622 * v621;
-    let v625: f64 = q[8usize].mul_add(v624, v103);
-    let v626: f64 = p[55usize] * v625;
-    let v627: f64 = v220 * v626;
-    let v628: f64 = v225.mul_add(v623, v627);
-    let v629: f64 = v225 * v626;
-    let v630: f64 = v220.mul_add(v623, -v629);
-    let v631: f64 = v238 * v630;
-    let v632: f64 = v227.mul_add(v628, -v631);
-    let v633: f64 = p[56usize] * v632;
-    let v634: f64 = 0.5f64.mul_add(v241, v633);
-    let v635: f64 = p[56usize] * v630;
-    let v636: f64 = p[56usize] * v628;
-    let v637: f64 = v368.mul_add(v635, v634);
-    let v638: f64 = v382.mul_add(v636, v637);
-    let v639: f64 = v411 * v411;
-    let v640: f64 = v413.mul_add(v413, v639);
-    let v641: f64 = (-2f64).mul_add(v375, v421);
-    let v642: f64 = 2f64.mul_add(v389, v424);
-    let v643: f64 = 0.25f64.mul_add(v349, v332);
-    let v644: f64 = p[14usize].mul_add(v640, v643);
-    let v645: f64 = v405.mul_add(v641, v644);
-    let v646: f64 = v402.mul_add(v642, v645);
-    let v647: f64 = v405.mul_add(v455, v451);
-    let v648: f64 = v402.mul_add(v458, v647);
-    let v649: f64 = v405.mul_add(v487, v483);
-    let v650: f64 = v402.mul_add(v490, v649);
-    let v651: f64 = v405.mul_add(v519, v515);
-    let v652: f64 = v402.mul_add(v522, v651);
-    let v653: f64 = v405.mul_add(v551, v547);
-    let v654: f64 = v402.mul_add(v554, v653);
-    let v655: f64 = v405.mul_add(v583, v579);
-    let v656: f64 = v402.mul_add(v586, v655);
-    let v657: f64 = v405.mul_add(v614, v611);
-    let v658: f64 = v402.mul_add(v617, v657);
-    let v659: f64 = v405.mul_add(v635, v634);
-    let v660: f64 = v402.mul_add(v636, v659);
-    let v661: f64 = v443 * v443;
-    let v662: f64 = v445.mul_add(v445, v661);
-    let v663: f64 = (-2f64).mul_add(v374, v453);
-    let v664: f64 = 2f64.mul_add(v388, v456);
-    let v665: f64 = 0.25f64.mul_add(v330, v317);
-    let v666: f64 = p[20usize].mul_add(v662, v665);
-    let v667: f64 = v437.mul_add(v663, v666);
-    let v668: f64 = v434.mul_add(v664, v667);
-    let v669: f64 = v437.mul_add(v487, v483);
-    let v670: f64 = v434.mul_add(v490, v669);
-    let v671: f64 = v437.mul_add(v519, v515);
-    let v672: f64 = v434.mul_add(v522, v671);
-    let v673: f64 = v437.mul_add(v551, v547);
-    let v674: f64 = v434.mul_add(v554, v673);
-    let v675: f64 = v437.mul_add(v583, v579);
-    let v676: f64 = v434.mul_add(v586, v675);
-    let v677: f64 = v437.mul_add(v614, v611);
-    let v678: f64 = v434.mul_add(v617, v677);
-    let v679: f64 = v437.mul_add(v635, v634);
-    let v680: f64 = v434.mul_add(v636, v679);
-    let v681: f64 = v475 * v475;
-    let v682: f64 = v477.mul_add(v477, v681);
-    let v683: f64 = (-2f64).mul_add(v373, v485);
-    let v684: f64 = 2f64.mul_add(v387, v488);
-    let v685: f64 = 0.25f64.mul_add(v315, v302);
-    let v686: f64 = p[26usize].mul_add(v682, v685);
-    let v687: f64 = v469.mul_add(v683, v686);
-    let v688: f64 = v466.mul_add(v684, v687);
-    let v689: f64 = v469.mul_add(v519, v515);
-    let v690: f64 = v466.mul_add(v522, v689);
-    let v691: f64 = v469.mul_add(v551, v547);
-    let v692: f64 = v466.mul_add(v554, v691);
-    let v693: f64 = v469.mul_add(v583, v579);
-    let v694: f64 = v466.mul_add(v586, v693);
-    let v695: f64 = v469.mul_add(v614, v611);
-    let v696: f64 = v466.mul_add(v617, v695);
-    let v697: f64 = v469.mul_add(v635, v634);
-    let v698: f64 = v466.mul_add(v636, v697);
-    let v699: f64 = v507 * v507;
-    let v700: f64 = v509.mul_add(v509, v699);
-    let v701: f64 = (-2f64).mul_add(v372, v517);
-    let v702: f64 = 2f64.mul_add(v386, v520);
-    let v703: f64 = 0.25f64.mul_add(v300, v287);
-    let v704: f64 = p[32usize].mul_add(v700, v703);
-    let v705: f64 = v501.mul_add(v701, v704);
-    let v706: f64 = v498.mul_add(v702, v705);
-    let v707: f64 = v501.mul_add(v551, v547);
-    let v708: f64 = v498.mul_add(v554, v707);
-    let v709: f64 = v501.mul_add(v583, v579);
-    let v710: f64 = v498.mul_add(v586, v709);
-    let v711: f64 = v501.mul_add(v614, v611);
-    let v712: f64 = v498.mul_add(v617, v711);
-    let v713: f64 = v501.mul_add(v635, v634);
-    let v714: f64 = v498.mul_add(v636, v713);
-    let v715: f64 = v539 * v539;
-    let v716: f64 = v541.mul_add(v541, v715);
-    let v717: f64 = (-2f64).mul_add(v371, v549);
-    let v718: f64 = 2f64.mul_add(v385, v552);
-    let v719: f64 = 0.25f64.mul_add(v285, v272);
-    let v720: f64 = p[38usize].mul_add(v716, v719);
-    let v721: f64 = v533.mul_add(v717, v720);
-    let v722: f64 = v530.mul_add(v718, v721);
-    let v723: f64 = v533.mul_add(v583, v579);
-    let v724: f64 = v530.mul_add(v586, v723);
-    let v725: f64 = v533.mul_add(v614, v611);
-    let v726: f64 = v530.mul_add(v617, v725);
-    let v727: f64 = v533.mul_add(v635, v634);
-    let v728: f64 = v530.mul_add(v636, v727);
-    let v729: f64 = v571 * v571;
-    let v730: f64 = v573.mul_add(v573, v729);
-    let v731: f64 = (-2f64).mul_add(v370, v581);
-    let v732: f64 = 2f64.mul_add(v384, v584);
-    let v733: f64 = 0.25f64.mul_add(v270, v257);
-    let v734: f64 = p[44usize].mul_add(v730, v733);
-    let v735: f64 = v565.mul_add(v731, v734);
-    let v736: f64 = v562.mul_add(v732, v735);
-    let v737: f64 = v565.mul_add(v614, v611);
-    let v738: f64 = v562.mul_add(v617, v737);
-    let v739: f64 = v565.mul_add(v635, v634);
-    let v740: f64 = v562.mul_add(v636, v739);
-    let v741: f64 = v603 * v603;
-    let v742: f64 = v605.mul_add(v605, v741);
-    let v743: f64 = (-2f64).mul_add(v369, v612);
-    let v744: f64 = 2f64.mul_add(v383, v615);
-    let v745: f64 = 0.25f64.mul_add(v255, v242);
-    let v746: f64 = p[50usize].mul_add(v742, v745);
-    let v747: f64 = v597.mul_add(v743, v746);
-    let v748: f64 = v594.mul_add(v744, v747);
-    let v749: f64 = v597.mul_add(v635, v634);
-    let v750: f64 = v594.mul_add(v636, v749);
-    let v751: f64 = v628 * v628;
-    let v752: f64 = v630.mul_add(v630, v751);
-    let v753: f64 = p[56usize] * v752;
-    let v754: f64 = 0.25f64.mul_add(v241, v753);
-    let v757: f64 = 0.5f64 * qd[0usize];
-    let v758: f64 = v757 * v757;
-    let v760: f64 = (-0.5f64) * v758;
-    let v761: f64 = (-v5).mul_add(v11, 2f64);
-    let v762: f64 = v760 * v761;
-    let v763: f64 = p[87usize] * v762;
-    let v764: f64 = p[8usize] * v763;
-    let v766: f64 = v8.powi(3i32);
-    let v767: f64 = p[88usize] * v766;
-    let v768: f64 = v767 * v760;
-    let v769: f64 = v354 * v768;
-    let v771: f64 = 0.5f64 * qd[1usize];
-    let v772: f64 = v757 + v757;
-    let v773: f64 = v771 + v772;
-    let v774: f64 = v22.powi(3i32);
-    let v775: f64 = v398 * v774;
-    let v776: f64 = 2f64 * q[1usize];
-    let v777: f64 = (-v20).mul_add(v24, 2f64);
-    let v778: f64 = v407.mul_add(v777, -v775);
-    let v779: f64 = (-v776).mul_add(v25, v778);
-    let v780: f64 = p[62usize] * v779;
-    let v781: f64 = qd[1usize] * v773;
-    let v783: f64 = 0.5f64 * qd[2usize];
-    let v784: f64 = v771 + v773;
-    let v785: f64 = v783 + v784;
-    let v786: f64 = v34.powi(3i32);
-    let v787: f64 = v430 * v786;
-    let v788: f64 = 2f64 * q[2usize];
-    let v789: f64 = (-v32).mul_add(v36, 2f64);
-    let v790: f64 = v439.mul_add(v789, -v787);
-    let v791: f64 = (-v788).mul_add(v37, v790);
-    let v792: f64 = p[63usize] * v791;
-    let v793: f64 = qd[2usize] * v785;
-    let v795: f64 = 0.5f64 * qd[3usize];
-    let v796: f64 = v783 + v785;
-    let v797: f64 = v795 + v796;
-    let v798: f64 = v46.powi(3i32);
-    let v799: f64 = v462 * v798;
-    let v800: f64 = 2f64 * q[3usize];
-    let v801: f64 = (-v44).mul_add(v48, 2f64);
-    let v802: f64 = v471.mul_add(v801, -v799);
-    let v803: f64 = (-v800).mul_add(v49, v802);
-    let v804: f64 = p[64usize] * v803;
-    let v805: f64 = qd[3usize] * v797;
-    let v807: f64 = 0.5f64 * qd[4usize];
-    let v808: f64 = v795 + v797;
-    let v809: f64 = v807 + v808;
-    let v810: f64 = v58.powi(3i32);
-    let v811: f64 = v494 * v810;
-    let v812: f64 = 2f64 * q[4usize];
-    let v813: f64 = (-v56).mul_add(v60, 2f64);
-    let v814: f64 = v503.mul_add(v813, -v811);
-    let v815: f64 = (-v812).mul_add(v61, v814);
-    let v816: f64 = p[65usize] * v815;
-    let v817: f64 = qd[4usize] * v809;
-    let v819: f64 = 0.5f64 * qd[5usize];
-    let v820: f64 = v807 + v809;
-    let v821: f64 = v819 + v820;
-    let v822: f64 = v70.powi(3i32);
-    let v823: f64 = v526 * v822;
-    let v824: f64 = 2f64 * q[5usize];
-    let v825: f64 = (-v68).mul_add(v72, 2f64);
-    let v826: f64 = v535.mul_add(v825, -v823);
-    let v827: f64 = (-v824).mul_add(v73, v826);
-    let v828: f64 = p[66usize] * v827;
-    let v829: f64 = qd[5usize] * v821;
-    let v831: f64 = 0.5f64 * qd[6usize];
-    let v832: f64 = v819 + v821;
-    let v833: f64 = v831 + v832;
-    let v834: f64 = v82.powi(3i32);
-    let v835: f64 = v558 * v834;
-    let v836: f64 = 2f64 * q[6usize];
-    let v837: f64 = (-v80).mul_add(v84, 2f64);
-    let v838: f64 = v567.mul_add(v837, -v835);
-    let v839: f64 = (-v836).mul_add(v85, v838);
-    let v840: f64 = p[67usize] * v839;
-    let v841: f64 = qd[6usize] * v833;
-    let v843: f64 = 0.5f64 * qd[7usize];
-    let v844: f64 = v831 + v833;
-    let v845: f64 = v843 + v844;
-    let v846: f64 = v94.powi(3i32);
-    let v847: f64 = v590 * v846;
-    let v848: f64 = 2f64 * q[7usize];
-    let v849: f64 = (-v92).mul_add(v96, 2f64);
-    let v850: f64 = v599.mul_add(v849, -v847);
-    let v851: f64 = (-v848).mul_add(v97, v850);
-    let v852: f64 = p[68usize] * v851;
-    let v853: f64 = qd[7usize] * v845;
-    let v855: f64 = v843 + v845;
-    let v856: f64 = 0.5f64.mul_add(qd[8usize], v855);
-    let v857: f64 = v106.powi(3i32);
-    let v858: f64 = v621 * v857;
-    let v859: f64 = 2f64 * q[8usize];
-    let v860: f64 = (-v104).mul_add(v108, 2f64);
-    let v861: f64 = v624.mul_add(v860, -v858);
-    let v862: f64 = (-v859).mul_add(v109, v861);
-    let v863: f64 = p[69usize] * v862;
-    let v864: f64 = qd[8usize] * v856;
-    let v866: f64 = qd[0usize] * qd[0usize];
-    let v868: f64 = 0.25f64 * v867;
-    let v869: f64 = (-0.25f64).mul_add(v8, v868);
-    let v870: f64 = v125.mul_add(v869, v365);
-    let v871: f64 = p[7usize] * v870;
-    let v872: f64 = qd[0usize] + v771;
-    let v873: f64 = 2f64 * qd[1usize];
-    let v874: f64 = v873 * v133;
-    let v875: f64 = v874 * v398;
-    let v876: f64 = qd[1usize] * qd[1usize];
-    let v878: f64 = 0.25f64 * v877;
-    let v879: f64 = v872 * v872;
-    let v880: f64 = v22 * v879;
-    let v881: f64 = v876.mul_add(v878, -v880);
-    let v882: f64 = v138 * v881;
-    let v883: f64 = v875.mul_add(v872, v882);
-    let v884: f64 = p[13usize] * v883;
-    let v885: f64 = v866.mul_add(v871, v884);
-    let v886: f64 = v771 + v872;
-    let v887: f64 = v783 + v886;
-    let v888: f64 = 2f64 * qd[2usize];
-    let v889: f64 = v888 * v146;
-    let v890: f64 = v889 * v430;
-    let v891: f64 = qd[2usize] * qd[2usize];
-    let v893: f64 = 0.25f64 * v892;
-    let v894: f64 = v887 * v887;
-    let v895: f64 = v34 * v894;
-    let v896: f64 = v891.mul_add(v893, -v895);
-    let v897: f64 = v151 * v896;
-    let v898: f64 = v890.mul_add(v887, v897);
-    let v899: f64 = p[19usize].mul_add(v898, v885);
-    let v900: f64 = v783 + v887;
-    let v901: f64 = v795 + v900;
-    let v902: f64 = 2f64 * qd[3usize];
-    let v903: f64 = v902 * v159;
-    let v904: f64 = v903 * v462;
-    let v905: f64 = qd[3usize] * qd[3usize];
-    let v907: f64 = 0.25f64 * v906;
-    let v908: f64 = v901 * v901;
-    let v909: f64 = v46 * v908;
-    let v910: f64 = v905.mul_add(v907, -v909);
-    let v911: f64 = v164 * v910;
-    let v912: f64 = v904.mul_add(v901, v911);
-    let v913: f64 = p[25usize].mul_add(v912, v899);
-    let v914: f64 = v795 + v901;
-    let v915: f64 = v807 + v914;
-    let v916: f64 = 2f64 * qd[4usize];
-    let v917: f64 = v916 * v172;
-    let v918: f64 = v917 * v494;
-    let v919: f64 = qd[4usize] * qd[4usize];
-    let v921: f64 = 0.25f64 * v920;
-    let v922: f64 = v915 * v915;
-    let v923: f64 = v58 * v922;
-    let v924: f64 = v919.mul_add(v921, -v923);
-    let v925: f64 = v177 * v924;
-    let v926: f64 = v918.mul_add(v915, v925);
-    let v927: f64 = p[31usize].mul_add(v926, v913);
-    let v928: f64 = v807 + v915;
-    let v929: f64 = v819 + v928;
-    let v930: f64 = 2f64 * qd[5usize];
-    let v931: f64 = v930 * v185;
-    let v932: f64 = v931 * v526;
-    let v933: f64 = qd[5usize] * qd[5usize];
-    let v935: f64 = 0.25f64 * v934;
-    let v936: f64 = v929 * v929;
-    let v937: f64 = v70 * v936;
-    let v938: f64 = v933.mul_add(v935, -v937);
-    let v939: f64 = v190 * v938;
-    let v940: f64 = v932.mul_add(v929, v939);
-    let v941: f64 = p[37usize].mul_add(v940, v927);
-    let v942: f64 = v819 + v929;
-    let v943: f64 = v831 + v942;
-    let v944: f64 = 2f64 * qd[6usize];
-    let v945: f64 = v944 * v198;
-    let v946: f64 = v945 * v558;
-    let v947: f64 = qd[6usize] * qd[6usize];
-    let v949: f64 = 0.25f64 * v948;
-    let v950: f64 = v943 * v943;
-    let v951: f64 = v82 * v950;
-    let v952: f64 = v947.mul_add(v949, -v951);
-    let v953: f64 = v203 * v952;
-    let v954: f64 = v946.mul_add(v943, v953);
-    let v955: f64 = p[43usize].mul_add(v954, v941);
-    let v956: f64 = v831 + v943;
-    let v957: f64 = v843 + v956;
-    let v958: f64 = 2f64 * qd[7usize];
-    let v959: f64 = v958 * v211;
-    let v960: f64 = v959 * v590;
-    let v961: f64 = qd[7usize] * qd[7usize];
-    let v963: f64 = 0.25f64 * v962;
-    let v964: f64 = v957 * v957;
-    let v965: f64 = v94 * v964;
-    let v966: f64 = v961.mul_add(v963, -v965);
-    let v967: f64 = v218 * v966;
-    let v968: f64 = v960.mul_add(v957, v967);
-    let v969: f64 = p[49usize].mul_add(v968, v955);
-    let v970: f64 = qd[8usize] * qd[8usize];
-    let v972: f64 = q[8usize] * v971;
-    let v973: f64 = 2f64.mul_add(v624, v972);
-    let v974: f64 = p[55usize] * v973;
-    let v975: f64 = v970 * v974;
-    let v976: f64 = v843 + v957;
-    let v977: f64 = 2f64 * qd[8usize];
-    let v978: f64 = v977 * v623;
-    let v979: f64 = v978 * v976;
-    let v980: f64 = v976 * v976;
-    let v981: f64 = v223 * v980;
-    let v982: f64 = v975 + v979;
-    let v983: f64 = v982 - v981;
-    let v985: f64 = 0.25f64 * v984;
-    let v986: f64 = v106 * v985;
-    let v987: f64 = v621.mul_add(v621, v986);
-    let v988: f64 = p[55usize] * v987;
-    let v989: f64 = v216 * v980;
-    let v990: f64 = v977 * v976;
-    let v991: f64 = v970.mul_add(v988, -v989);
-    let v992: f64 = (-v990).mul_add(v626, v991);
-    let v993: f64 = v220.mul_add(v983, v969);
-    let v994: f64 = v225.mul_add(v992, v993);
-    let v995: f64 = p[89usize] + v994;
-    let v997: f64 = v120.mul_add(v869, -v380);
-    let v998: f64 = p[7usize] * v997;
-    let v999: f64 = v873 * v138;
-    let v1000: f64 = v999 * v398;
-    let v1001: f64 = v1000 * v872;
-    let v1002: f64 = v133.mul_add(v881, -v1001);
-    let v1003: f64 = p[13usize] * v1002;
-    let v1004: f64 = v866.mul_add(v998, v1003);
-    let v1005: f64 = v888 * v151;
-    let v1006: f64 = v1005 * v430;
-    let v1007: f64 = v1006 * v887;
-    let v1008: f64 = v146.mul_add(v896, -v1007);
-    let v1009: f64 = p[19usize].mul_add(v1008, v1004);
-    let v1010: f64 = v902 * v164;
-    let v1011: f64 = v1010 * v462;
-    let v1012: f64 = v1011 * v901;
-    let v1013: f64 = v159.mul_add(v910, -v1012);
-    let v1014: f64 = p[25usize].mul_add(v1013, v1009);
-    let v1015: f64 = v916 * v177;
-    let v1016: f64 = v1015 * v494;
-    let v1017: f64 = v1016 * v915;
-    let v1018: f64 = v172.mul_add(v924, -v1017);
-    let v1019: f64 = p[31usize].mul_add(v1018, v1014);
-    let v1020: f64 = v930 * v190;
-    let v1021: f64 = v1020 * v526;
-    let v1022: f64 = v1021 * v929;
-    let v1023: f64 = v185.mul_add(v938, -v1022);
-    let v1024: f64 = p[37usize].mul_add(v1023, v1019);
-    let v1025: f64 = v944 * v203;
-    let v1026: f64 = v1025 * v558;
-    let v1027: f64 = v1026 * v943;
-    let v1028: f64 = v198.mul_add(v952, -v1027);
-    let v1029: f64 = p[43usize].mul_add(v1028, v1024);
-    let v1030: f64 = v958 * v218;
-    let v1031: f64 = v1030 * v590;
-    let v1032: f64 = v1031 * v957;
-    let v1033: f64 = v211.mul_add(v966, -v1032);
-    let v1034: f64 = p[49usize].mul_add(v1033, v1029);
-    let v1035: f64 = v981 - v975;
-    let v1036: f64 = v1035 - v979;
-    let v1037: f64 = v220.mul_add(v992, v1034);
-    let v1038: f64 = v225.mul_add(v1036, v1037);
-    let v1039: f64 = p[90usize] + v1038;
-    let v1040: f64 = v238 * v1039;
-    let v1041: f64 = v227.mul_add(v995, -v1040);
-    let v1042: f64 = p[56usize] * v1041;
-    let v1043: f64 = v864.mul_add(v863, v1042);
-    let v1045: f64 = q[7usize] * v1044;
-    let v1046: f64 = 2f64.mul_add(v599, v1045);
-    let v1047: f64 = p[49usize] * v1046;
-    let v1048: f64 = v961 * v1047;
-    let v1049: f64 = v958 * v598;
-    let v1050: f64 = v1049 * v956;
-    let v1051: f64 = v956 * v956;
-    let v1052: f64 = v248 * v1051;
-    let v1053: f64 = v1048 + v1050;
-    let v1054: f64 = v1053 - v1052;
-    let v1055: f64 = v94 * v963;
-    let v1056: f64 = v590.mul_add(v590, v1055);
-    let v1057: f64 = p[49usize] * v1056;
-    let v1058: f64 = v246 * v1051;
-    let v1059: f64 = v958 * v956;
-    let v1060: f64 = v961.mul_add(v1057, -v1058);
-    let v1061: f64 = (-v1059).mul_add(v601, v1060);
-    let v1062: f64 = v207.mul_add(v1054, v955);
-    let v1063: f64 = v205.mul_add(v1061, v1062);
-    let v1064: f64 = p[89usize] + v1063;
-    let v1065: f64 = v1052 - v1048;
-    let v1066: f64 = v1065 - v1050;
-    let v1067: f64 = v207.mul_add(v1061, v1029);
-    let v1068: f64 = v205.mul_add(v1066, v1067);
-    let v1069: f64 = p[90usize] + v1068;
-    let v1070: f64 = v252 * v1069;
-    let v1071: f64 = v250.mul_add(v1064, -v1070);
-    let v1072: f64 = v853.mul_add(v852, v1043);
-    let v1073: f64 = p[50usize].mul_add(v1071, v1072);
-    let v1075: f64 = q[6usize] * v1074;
-    let v1076: f64 = 2f64.mul_add(v567, v1075);
-    let v1077: f64 = p[43usize] * v1076;
-    let v1078: f64 = v947 * v1077;
-    let v1079: f64 = v944 * v566;
-    let v1080: f64 = v1079 * v942;
-    let v1081: f64 = v942 * v942;
-    let v1082: f64 = v263 * v1081;
-    let v1083: f64 = v1078 + v1080;
-    let v1084: f64 = v1083 - v1082;
-    let v1085: f64 = v82 * v949;
-    let v1086: f64 = v558.mul_add(v558, v1085);
-    let v1087: f64 = p[43usize] * v1086;
-    let v1088: f64 = v261 * v1081;
-    let v1089: f64 = v944 * v942;
-    let v1090: f64 = v947.mul_add(v1087, -v1088);
-    let v1091: f64 = (-v1089).mul_add(v569, v1090);
-    let v1092: f64 = v194.mul_add(v1084, v941);
-    let v1093: f64 = v192.mul_add(v1091, v1092);
-    let v1094: f64 = p[89usize] + v1093;
-    let v1095: f64 = v1082 - v1078;
-    let v1096: f64 = v1095 - v1080;
-    let v1097: f64 = v194.mul_add(v1091, v1024);
-    let v1098: f64 = v192.mul_add(v1096, v1097);
-    let v1099: f64 = p[90usize] + v1098;
-    let v1100: f64 = v267 * v1099;
-    let v1101: f64 = v265.mul_add(v1094, -v1100);
-    let v1102: f64 = v841.mul_add(v840, v1073);
-    let v1103: f64 = p[44usize].mul_add(v1101, v1102);
-    let v1105: f64 = q[5usize] * v1104;
-    let v1106: f64 = 2f64.mul_add(v535, v1105);
-    let v1107: f64 = p[37usize] * v1106;
-    let v1108: f64 = v933 * v1107;
-    let v1109: f64 = v930 * v534;
-    let v1110: f64 = v1109 * v928;
-    let v1111: f64 = v928 * v928;
-    let v1112: f64 = v278 * v1111;
-    let v1113: f64 = v1108 + v1110;
-    let v1114: f64 = v1113 - v1112;
-    let v1115: f64 = v70 * v935;
-    let v1116: f64 = v526.mul_add(v526, v1115);
-    let v1117: f64 = p[37usize] * v1116;
-    let v1118: f64 = v276 * v1111;
-    let v1119: f64 = v930 * v928;
-    let v1120: f64 = v933.mul_add(v1117, -v1118);
-    let v1121: f64 = (-v1119).mul_add(v537, v1120);
-    let v1122: f64 = v181.mul_add(v1114, v927);
-    let v1123: f64 = v179.mul_add(v1121, v1122);
-    let v1124: f64 = p[89usize] + v1123;
-    let v1125: f64 = v1112 - v1108;
-    let v1126: f64 = v1125 - v1110;
-    let v1127: f64 = v181.mul_add(v1121, v1019);
-    let v1128: f64 = v179.mul_add(v1126, v1127);
-    let v1129: f64 = p[90usize] + v1128;
-    let v1130: f64 = v282 * v1129;
-    let v1131: f64 = v280.mul_add(v1124, -v1130);
-    let v1132: f64 = v829.mul_add(v828, v1103);
-    let v1133: f64 = p[38usize].mul_add(v1131, v1132);
-    let v1135: f64 = q[4usize] * v1134;
-    let v1136: f64 = 2f64.mul_add(v503, v1135);
-    let v1137: f64 = p[31usize] * v1136;
-    let v1138: f64 = v919 * v1137;
-    let v1139: f64 = v916 * v502;
-    let v1140: f64 = v1139 * v914;
-    let v1141: f64 = v914 * v914;
-    let v1142: f64 = v293 * v1141;
-    let v1143: f64 = v1138 + v1140;
-    let v1144: f64 = v1143 - v1142;
-    let v1145: f64 = v58 * v921;
-    let v1146: f64 = v494.mul_add(v494, v1145);
-    let v1147: f64 = p[31usize] * v1146;
-    let v1148: f64 = v291 * v1141;
-    let v1149: f64 = v916 * v914;
-    let v1150: f64 = v919.mul_add(v1147, -v1148);
-    let v1151: f64 = (-v1149).mul_add(v505, v1150);
-    let v1152: f64 = v168.mul_add(v1144, v913);
-    let v1153: f64 = v166.mul_add(v1151, v1152);
-    let v1154: f64 = p[89usize] + v1153;
-    let v1155: f64 = v1142 - v1138;
-    let v1156: f64 = v1155 - v1140;
-    let v1157: f64 = v168.mul_add(v1151, v1014);
-    let v1158: f64 = v166.mul_add(v1156, v1157);
-    let v1159: f64 = p[90usize] + v1158;
-    let v1160: f64 = v297 * v1159;
-    let v1161: f64 = v295.mul_add(v1154, -v1160);
-    let v1162: f64 = v817.mul_add(v816, v1133);
-    let v1163: f64 = p[32usize].mul_add(v1161, v1162);
-    let v1165: f64 = q[3usize] * v1164;
-    let v1166: f64 = 2f64.mul_add(v471, v1165);
-    let v1167: f64 = p[25usize] * v1166;
-    let v1168: f64 = v905 * v1167;
-    let v1169: f64 = v902 * v470;
-    let v1170: f64 = v1169 * v900;
-    let v1171: f64 = v900 * v900;
-    let v1172: f64 = v308 * v1171;
-    let v1173: f64 = v1168 + v1170;
-    let v1174: f64 = v1173 - v1172;
-    let v1175: f64 = v46 * v907;
-    let v1176: f64 = v462.mul_add(v462, v1175);
-    let v1177: f64 = p[25usize] * v1176;
-    let v1178: f64 = v306 * v1171;
-    let v1179: f64 = v902 * v900;
-    let v1180: f64 = v905.mul_add(v1177, -v1178);
-    let v1181: f64 = (-v1179).mul_add(v473, v1180);
-    let v1182: f64 = v155.mul_add(v1174, v899);
-    let v1183: f64 = v153.mul_add(v1181, v1182);
-    let v1184: f64 = p[89usize] + v1183;
-    let v1185: f64 = v1172 - v1168;
-    let v1186: f64 = v1185 - v1170;
-    let v1187: f64 = v155.mul_add(v1181, v1009);
-    let v1188: f64 = v153.mul_add(v1186, v1187);
-    let v1189: f64 = p[90usize] + v1188;
-    let v1190: f64 = v312 * v1189;
-    let v1191: f64 = v310.mul_add(v1184, -v1190);
-    let v1192: f64 = v805.mul_add(v804, v1163);
-    let v1193: f64 = p[26usize].mul_add(v1191, v1192);
-    let v1195: f64 = q[2usize] * v1194;
-    let v1196: f64 = 2f64.mul_add(v439, v1195);
-    let v1197: f64 = p[19usize] * v1196;
-    let v1198: f64 = v891 * v1197;
-    let v1199: f64 = v888 * v438;
-    let v1200: f64 = v1199 * v886;
-    let v1201: f64 = v886 * v886;
-    let v1202: f64 = v323 * v1201;
-    let v1203: f64 = v1198 + v1200;
-    let v1204: f64 = v1203 - v1202;
-    let v1205: f64 = v34 * v893;
-    let v1206: f64 = v430.mul_add(v430, v1205);
-    let v1207: f64 = p[19usize] * v1206;
-    let v1208: f64 = v321 * v1201;
-    let v1209: f64 = v888 * v886;
-    let v1210: f64 = v891.mul_add(v1207, -v1208);
-    let v1211: f64 = (-v1209).mul_add(v441, v1210);
-    let v1212: f64 = v142.mul_add(v1204, v885);
-    let v1213: f64 = v140.mul_add(v1211, v1212);
-    let v1214: f64 = p[89usize] + v1213;
-    let v1215: f64 = v1202 - v1198;
-    let v1216: f64 = v1215 - v1200;
-    let v1217: f64 = v142.mul_add(v1211, v1004);
-    let v1218: f64 = v140.mul_add(v1216, v1217);
-    let v1219: f64 = p[90usize] + v1218;
-    let v1220: f64 = v327 * v1219;
-    let v1221: f64 = v325.mul_add(v1214, -v1220);
-    let v1222: f64 = v793.mul_add(v792, v1193);
-    let v1223: f64 = p[20usize].mul_add(v1221, v1222);
-    let v1224: f64 = v871 - v343;
-    let v1225: f64 = v1224 - v344;
-    let v1226: f64 = 2f64 * v129;
-    let v1227: f64 = 2f64 * v127;
-    let v1228: f64 = v1227 * v409;
-    let v1229: f64 = v1226.mul_add(v406, -v1228);
-    let v1230: f64 = qd[1usize] * v1229;
-    let v1231: f64 = qd[0usize] * v1230;
-    let v1232: f64 = v22 * v878;
-    let v1233: f64 = v398.mul_add(v398, v1232);
-    let v1234: f64 = p[13usize] * v1233;
-    let v1236: f64 = q[1usize] * v1235;
-    let v1237: f64 = 2f64.mul_add(v407, v1236);
-    let v1238: f64 = p[13usize] * v1237;
-    let v1239: f64 = v129 * v1238;
-    let v1240: f64 = v127.mul_add(v1234, v1239);
-    let v1241: f64 = v866.mul_add(v1225, v1231);
-    let v1242: f64 = v876.mul_add(v1240, v1241);
-    let v1243: f64 = p[89usize] + v1242;
-    let v1244: f64 = v340 - v337;
-    let v1245: f64 = v1244 + v998;
-    let v1246: f64 = v1226 * v409;
-    let v1247: f64 = v1227.mul_add(v406, v1246);
-    let v1248: f64 = -v1247;
-    let v1249: f64 = qd[1usize] * v1248;
-    let v1250: f64 = qd[0usize] * v1249;
-    let v1251: f64 = v127 * v1238;
-    let v1252: f64 = v129.mul_add(v1234, -v1251);
-    let v1253: f64 = v866.mul_add(v1245, v1250);
-    let v1254: f64 = v876.mul_add(v1252, v1253);
-    let v1255: f64 = p[90usize] + v1254;
-    let v1256: f64 = v346 * v1255;
-    let v1257: f64 = v342.mul_add(v1243, -v1256);
-    let v1258: f64 = v781.mul_add(v780, v1223);
-    let v1259: f64 = p[14usize].mul_add(v1257, v1258);
-    let v1260: f64 = p[56usize] * v1039;
-    let v1261: f64 = p[50usize].mul_add(v1069, v1260);
-    let v1262: f64 = p[44usize].mul_add(v1099, v1261);
-    let v1263: f64 = p[38usize].mul_add(v1129, v1262);
-    let v1264: f64 = p[32usize].mul_add(v1159, v1263);
-    let v1265: f64 = p[26usize].mul_add(v1189, v1264);
-    let v1266: f64 = p[20usize].mul_add(v1219, v1265);
-    let v1267: f64 = p[14usize].mul_add(v1255, v1266);
-    let v1268: f64 = p[56usize] * v995;
-    let v1269: f64 = p[50usize].mul_add(v1064, v1268);
-    let v1270: f64 = p[44usize].mul_add(v1094, v1269);
-    let v1271: f64 = p[38usize].mul_add(v1124, v1270);
-    let v1272: f64 = p[32usize].mul_add(v1154, v1271);
-    let v1273: f64 = p[26usize].mul_add(v1184, v1272);
-    let v1274: f64 = p[20usize].mul_add(v1214, v1273);
-    let v1275: f64 = p[14usize].mul_add(v1243, v1274);
-    let v1278: f64 = p[91usize] + q[0usize];
-    let v1279: f64 = v8 * v868;
-    let v1280: f64 = v354.mul_add(v354, v1279);
-    let v1281: f64 = p[7usize] * v1280;
-    let v1283: f64 = q[0usize] * v1282;
-    let v1284: f64 = 2f64.mul_add(v356, v1283);
-    let v1285: f64 = p[7usize] * v1284;
-    let v1286: f64 = p[70usize] * v1285;
-    let v1287: f64 = p[71usize].mul_add(v1281, -v1286);
-    let v1288: f64 = v866.mul_add(v1287, p[90usize]);
-    let v1289: f64 = p[71usize] * v1285;
-    let v1290: f64 = p[70usize].mul_add(v1281, v1289);
-    let v1291: f64 = v866.mul_add(v1290, p[89usize]);
-    let v1292: f64 = v360 * v1291;
-    let v1294: f64 = p[92usize] * q[0usize];
-    let v1295: f64 = v1294 * v12;
-    let v1296: f64 = v362.mul_add(v1288, v1292);
-    let v1297: f64 = (-v1295).mul_add(v760, v1296);
-    let v1299: f64 = v354 * v766;
-    let v1300: f64 = 2f64 * q[0usize];
-    let v1301: f64 = v356.mul_add(v761, -v1299);
-    let v1302: f64 = (-v1300).mul_add(v12, v1301);
-    let v1303: f64 = p[61usize] * v1302;
-    let v1304: f64 = 0.5f64 * v757;
-    let v1305: f64 = v1304.mul_add(v1303, p[11usize]);
-    let v1306: f64 = v356.mul_add(v764, v769);
-    let v1307: f64 = v1306 + v1259;
-    let v1308: f64 = v368.mul_add(v1267, v1307);
-    let v1309: f64 = v382.mul_add(v1275, v1308);
-    let v1310: f64 = p[10usize].mul_add(v1278, v1309);
-    let v1311: f64 = p[8usize].mul_add(v1297, v1310);
-    let v1312: f64 = qd[0usize].mul_add(v1305, v1311);
-    let v1314: f64 = v773 * v773;
-    let v1315: f64 = (-0.5f64) * v1314;
-    let v1316: f64 = v1315 * v777;
-    let v1317: f64 = p[93usize] * v1316;
-    let v1318: f64 = p[14usize] * v1317;
-    let v1320: f64 = p[94usize] * v774;
-    let v1321: f64 = v1320 * v1315;
-    let v1322: f64 = v398 * v1321;
-    let v1325: f64 = p[95usize] + q[1usize];
-    let v1326: f64 = v1243 * v411;
-    let v1328: f64 = p[96usize] * q[1usize];
-    let v1329: f64 = v1328 * v25;
-    let v1330: f64 = v1255.mul_add(v413, v1326);
-    let v1331: f64 = (-v1329).mul_add(v1315, v1330);
-    let v1333: f64 = 0.5f64 * v773;
-    let v1334: f64 = v1333.mul_add(v780, p[17usize]);
-    let v1335: f64 = v407.mul_add(v1318, v1322);
-    let v1336: f64 = v1335 + v1223;
-    let v1337: f64 = v405.mul_add(v1266, v1336);
-    let v1338: f64 = v402.mul_add(v1274, v1337);
-    let v1339: f64 = p[16usize].mul_add(v1325, v1338);
-    let v1340: f64 = p[14usize].mul_add(v1331, v1339);
-    let v1341: f64 = qd[1usize].mul_add(v1334, v1340);
-    let v1343: f64 = v785 * v785;
-    let v1344: f64 = (-0.5f64) * v1343;
-    let v1345: f64 = v1344 * v789;
-    let v1346: f64 = p[97usize] * v1345;
-    let v1347: f64 = p[20usize] * v1346;
-    let v1349: f64 = p[98usize] * v786;
-    let v1350: f64 = v1349 * v1344;
-    let v1351: f64 = v430 * v1350;
-    let v1354: f64 = p[99usize] + q[2usize];
-    let v1355: f64 = v1214 * v443;
-    let v1357: f64 = p[100usize] * q[2usize];
-    let v1358: f64 = v1357 * v37;
-    let v1359: f64 = v1219.mul_add(v445, v1355);
-    let v1360: f64 = (-v1358).mul_add(v1344, v1359);
-    let v1362: f64 = 0.5f64 * v785;
-    let v1363: f64 = v1362.mul_add(v792, p[23usize]);
-    let v1364: f64 = v439.mul_add(v1347, v1351);
-    let v1365: f64 = v1364 + v1193;
-    let v1366: f64 = v437.mul_add(v1265, v1365);
-    let v1367: f64 = v434.mul_add(v1273, v1366);
-    let v1368: f64 = p[22usize].mul_add(v1354, v1367);
-    let v1369: f64 = p[20usize].mul_add(v1360, v1368);
-    let v1370: f64 = qd[2usize].mul_add(v1363, v1369);
-    let v1372: f64 = v797 * v797;
-    let v1373: f64 = (-0.5f64) * v1372;
-    let v1374: f64 = v1373 * v801;
-    let v1375: f64 = p[101usize] * v1374;
-    let v1376: f64 = p[26usize] * v1375;
-    let v1378: f64 = p[102usize] * v798;
-    let v1379: f64 = v1378 * v1373;
-    let v1380: f64 = v462 * v1379;
-    let v1383: f64 = p[103usize] + q[3usize];
-    let v1384: f64 = v1184 * v475;
-    let v1386: f64 = p[104usize] * q[3usize];
-    let v1387: f64 = v1386 * v49;
-    let v1388: f64 = v1189.mul_add(v477, v1384);
-    let v1389: f64 = (-v1387).mul_add(v1373, v1388);
-    let v1391: f64 = 0.5f64 * v797;
-    let v1392: f64 = v1391.mul_add(v804, p[29usize]);
-    let v1393: f64 = v471.mul_add(v1376, v1380);
-    let v1394: f64 = v1393 + v1163;
-    let v1395: f64 = v469.mul_add(v1264, v1394);
-    let v1396: f64 = v466.mul_add(v1272, v1395);
-    let v1397: f64 = p[28usize].mul_add(v1383, v1396);
-    let v1398: f64 = p[26usize].mul_add(v1389, v1397);
-    let v1399: f64 = qd[3usize].mul_add(v1392, v1398);
-    let v1401: f64 = v809 * v809;
-    let v1402: f64 = (-0.5f64) * v1401;
-    let v1403: f64 = v1402 * v813;
-    let v1404: f64 = p[105usize] * v1403;
-    let v1405: f64 = p[32usize] * v1404;
-    let v1407: f64 = p[106usize] * v810;
-    let v1408: f64 = v1407 * v1402;
-    let v1409: f64 = v494 * v1408;
-    let v1412: f64 = p[107usize] + q[4usize];
-    let v1413: f64 = v1154 * v507;
-    let v1415: f64 = p[108usize] * q[4usize];
-    let v1416: f64 = v1415 * v61;
-    let v1417: f64 = v1159.mul_add(v509, v1413);
-    let v1418: f64 = (-v1416).mul_add(v1402, v1417);
-    let v1420: f64 = 0.5f64 * v809;
-    let v1421: f64 = v1420.mul_add(v816, p[35usize]);
-    let v1422: f64 = v503.mul_add(v1405, v1409);
-    let v1423: f64 = v1422 + v1133;
-    let v1424: f64 = v501.mul_add(v1263, v1423);
-    let v1425: f64 = v498.mul_add(v1271, v1424);
-    let v1426: f64 = p[34usize].mul_add(v1412, v1425);
-    let v1427: f64 = p[32usize].mul_add(v1418, v1426);
-    let v1428: f64 = qd[4usize].mul_add(v1421, v1427);
-    let v1430: f64 = v821 * v821;
-    let v1431: f64 = (-0.5f64) * v1430;
-    let v1432: f64 = v1431 * v825;
-    let v1433: f64 = p[109usize] * v1432;
-    let v1434: f64 = p[38usize] * v1433;
-    let v1436: f64 = p[110usize] * v822;
-    let v1437: f64 = v1436 * v1431;
-    let v1438: f64 = v526 * v1437;
-    let v1441: f64 = p[111usize] + q[5usize];
-    let v1442: f64 = v1124 * v539;
-    let v1444: f64 = p[112usize] * q[5usize];
-    let v1445: f64 = v1444 * v73;
-    let v1446: f64 = v1129.mul_add(v541, v1442);
-    let v1447: f64 = (-v1445).mul_add(v1431, v1446);
-    let v1449: f64 = 0.5f64 * v821;
-    let v1450: f64 = v1449.mul_add(v828, p[41usize]);
-    let v1451: f64 = v535.mul_add(v1434, v1438);
-    let v1452: f64 = v1451 + v1103;
-    let v1453: f64 = v533.mul_add(v1262, v1452);
-    let v1454: f64 = v530.mul_add(v1270, v1453);
-    let v1455: f64 = p[40usize].mul_add(v1441, v1454);
-    let v1456: f64 = p[38usize].mul_add(v1447, v1455);
-    let v1457: f64 = qd[5usize].mul_add(v1450, v1456);
-    let v1459: f64 = v833 * v833;
-    let v1460: f64 = (-0.5f64) * v1459;
-    let v1461: f64 = v1460 * v837;
-    let v1462: f64 = p[113usize] * v1461;
-    let v1463: f64 = p[44usize] * v1462;
-    let v1465: f64 = p[114usize] * v834;
-    let v1466: f64 = v1465 * v1460;
-    let v1467: f64 = v558 * v1466;
-    let v1470: f64 = p[115usize] + q[6usize];
-    let v1471: f64 = v1094 * v571;
-    let v1473: f64 = p[116usize] * q[6usize];
-    let v1474: f64 = v1473 * v85;
-    let v1475: f64 = v1099.mul_add(v573, v1471);
-    let v1476: f64 = (-v1474).mul_add(v1460, v1475);
-    let v1478: f64 = 0.5f64 * v833;
-    let v1479: f64 = v1478.mul_add(v840, p[47usize]);
-    let v1480: f64 = v567.mul_add(v1463, v1467);
-    let v1481: f64 = v1480 + v1073;
-    let v1482: f64 = v565.mul_add(v1261, v1481);
-    let v1483: f64 = v562.mul_add(v1269, v1482);
-    let v1484: f64 = p[46usize].mul_add(v1470, v1483);
-    let v1485: f64 = p[44usize].mul_add(v1476, v1484);
-    let v1486: f64 = qd[6usize].mul_add(v1479, v1485);
-    let v1488: f64 = v845 * v845;
-    let v1489: f64 = (-0.5f64) * v1488;
-    let v1490: f64 = v1489 * v849;
-    let v1491: f64 = p[117usize] * v1490;
-    let v1492: f64 = p[50usize] * v1491;
-    let v1494: f64 = p[118usize] * v846;
-    let v1495: f64 = v1494 * v1489;
-    let v1496: f64 = v590 * v1495;
-    let v1499: f64 = p[119usize] + q[7usize];
-    let v1500: f64 = v1064 * v603;
-    let v1502: f64 = p[120usize] * q[7usize];
-    let v1503: f64 = v1502 * v97;
-    let v1504: f64 = v1069.mul_add(v605, v1500);
-    let v1505: f64 = (-v1503).mul_add(v1489, v1504);
-    let v1507: f64 = 0.5f64 * v845;
-    let v1508: f64 = v1507.mul_add(v852, p[53usize]);
-    let v1509: f64 = v599.mul_add(v1492, v1496);
-    let v1510: f64 = v1509 + v1043;
-    let v1511: f64 = v597.mul_add(v1260, v1510);
-    let v1512: f64 = v594.mul_add(v1268, v1511);
-    let v1513: f64 = p[52usize].mul_add(v1499, v1512);
-    let v1514: f64 = p[50usize].mul_add(v1505, v1513);
-    let v1515: f64 = qd[7usize].mul_add(v1508, v1514);
-    let v1517: f64 = v856 * v856;
-    let v1518: f64 = (-0.5f64) * v1517;
-    let v1519: f64 = v1518 * v860;
-    let v1520: f64 = p[121usize] * v1519;
-    let v1521: f64 = p[56usize] * v1520;
-    let v1523: f64 = p[122usize] * v857;
-    let v1524: f64 = v1523 * v1518;
-    let v1525: f64 = v621 * v1524;
-    let v1528: f64 = p[123usize] + q[8usize];
-    let v1529: f64 = v995 * v628;
-    let v1531: f64 = p[124usize] * q[8usize];
-    let v1532: f64 = v1531 * v109;
-    let v1533: f64 = v1039.mul_add(v630, v1529);
-    let v1534: f64 = (-v1532).mul_add(v1518, v1533);
-    let v1536: f64 = 0.5f64 * v856;
-    let v1537: f64 = v1536.mul_add(v863, p[59usize]);
-    let v1538: f64 = v624.mul_add(v1521, v1525);
-    let v1539: f64 = p[58usize].mul_add(v1528, v1538);
-    let v1540: f64 = p[56usize].mul_add(v1534, v1539);
-    let v1541: f64 = qd[8usize].mul_add(v1537, v1540);
-    out[0usize] = v396;
-    out[1usize] = v428;
-    out[2usize] = v460;
-    out[3usize] = v492;
-    out[4usize] = v524;
-    out[5usize] = v556;
-    out[6usize] = v588;
-    out[7usize] = v619;
-    out[8usize] = v638;
-    out[9usize] = v646;
-    out[10usize] = v648;
-    out[11usize] = v650;
-    out[12usize] = v652;
-    out[13usize] = v654;
-    out[14usize] = v656;
-    out[15usize] = v658;
-    out[16usize] = v660;
-    out[17usize] = v668;
-    out[18usize] = v670;
-    out[19usize] = v672;
-    out[20usize] = v674;
-    out[21usize] = v676;
-    out[22usize] = v678;
-    out[23usize] = v680;
-    out[24usize] = v688;
-    out[25usize] = v690;
-    out[26usize] = v692;
-    out[27usize] = v694;
-    out[28usize] = v696;
-    out[29usize] = v698;
-    out[30usize] = v706;
-    out[31usize] = v708;
-    out[32usize] = v710;
-    out[33usize] = v712;
-    out[34usize] = v714;
-    out[35usize] = v722;
-    out[36usize] = v724;
-    out[37usize] = v726;
-    out[38usize] = v728;
-    out[39usize] = v736;
-    out[40usize] = v738;
-    out[41usize] = v740;
-    out[42usize] = v748;
-    out[43usize] = v750;
-    out[44usize] = v754;
-    out[45usize] = v1312;
-    out[46usize] = v1341;
-    out[47usize] = v1370;
-    out[48usize] = v1399;
-    out[49usize] = v1428;
-    out[50usize] = v1457;
-    out[51usize] = v1486;
-    out[52usize] = v1515;
-    out[53usize] = v1541;
+    out2[0usize] = v396;
+    out2[1usize] = v430;
+    out2[2usize] = v473;
+    out2[3usize] = v522;
+    out2[4usize] = v578;
+    out2[5usize] = v642;
+    out2[6usize] = v715;
+    out2[7usize] = v797;
+    out2[8usize] = v878;
+    out2[9usize] = v439;
+    out2[10usize] = v475;
+    out2[11usize] = v524;
+    out2[12usize] = v580;
+    out2[13usize] = v644;
+    out2[14usize] = v717;
+    out2[15usize] = v799;
+    out2[16usize] = v880;
+    out2[17usize] = v488;
+    out2[18usize] = v529;
+    out2[19usize] = v586;
+    out2[20usize] = v650;
+    out2[21usize] = v723;
+    out2[22usize] = v805;
+    out2[23usize] = v886;
+    out2[24usize] = v544;
+    out2[25usize] = v591;
+    out2[26usize] = v656;
+    out2[27usize] = v729;
+    out2[28usize] = v811;
+    out2[29usize] = v892;
+    out2[30usize] = v608;
+    out2[31usize] = v662;
+    out2[32usize] = v736;
+    out2[33usize] = v818;
+    out2[34usize] = v899;
+    out2[35usize] = v681;
+    out2[36usize] = v743;
+    out2[37usize] = v826;
+    out2[38usize] = v907;
+    out2[39usize] = v764;
+    out2[40usize] = v834;
+    out2[41usize] = v916;
+    out2[42usize] = v857;
+    out2[43usize] = v925;
+    out2[44usize] = v946;
+    out2[45usize] = v1528;
+    out2[46usize] = v1558;
+    out2[47usize] = v1589;
+    out2[48usize] = v1621;
+    out2[49usize] = v1654;
+    out2[50usize] = v1688;
+    out2[51usize] = v1723;
+    out2[52usize] = v1759;
+    out2[53usize] = v1771;
 }
 /// Kernel `derived`: 111 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
@@ -3464,8 +2095,8 @@ pub fn derived(
     unsafe { derived_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
     q: &[f64; 9usize],
@@ -3697,8 +2328,8 @@ pub fn constraints(
     unsafe { constraints_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
     q: &[f64; 9usize],
@@ -3725,8 +2356,8 @@ pub fn contact(
     unsafe { contact_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
     q: &[f64; 9usize],
@@ -3765,8 +2396,8 @@ pub fn contact_jvp(
     unsafe { contact_jvp_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
     q: &[f64; 9usize],
@@ -3928,8 +2559,8 @@ pub fn cell_0_pose(
     unsafe { cell_0_pose_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
     q: &[f64; 1usize],
@@ -4044,8 +2675,8 @@ pub fn cell_0(
     unsafe { cell_0_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
     q: &[f64; 1usize],
@@ -4203,8 +2834,8 @@ pub fn cell_0_tangent(
     unsafe { cell_0_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
     q: &[f64; 1usize],

@@ -326,8 +326,8 @@ pub fn accel(
     unsafe { accel_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn accel_0(
     t: f64,
     q: &[f64; 36usize],
@@ -354,8 +354,8 @@ pub fn derived(
     unsafe { derived_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
     q: &[f64; 36usize],
@@ -1213,8 +1213,8 @@ pub fn constraints(
     unsafe { constraints_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
     q: &[f64; 36usize],
@@ -1241,8 +1241,8 @@ pub fn contact(
     unsafe { contact_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
     q: &[f64; 36usize],
@@ -1281,8 +1281,8 @@ pub fn contact_jvp(
     unsafe { contact_jvp_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
     q: &[f64; 36usize],
@@ -1518,8 +1518,8 @@ pub fn cell_0_pose(
     unsafe { cell_0_pose_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
     q: &[f64; 6usize],
@@ -1801,8 +1801,8 @@ pub fn cell_0(
     unsafe { cell_0_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
     q: &[f64; 6usize],
@@ -3374,8 +3374,8 @@ pub fn cell_0_tangent(
     unsafe { cell_0_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
     q: &[f64; 6usize],
@@ -5083,8 +5083,8 @@ pub fn link_forces(
     unsafe { link_forces_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn link_forces_0(
     t: f64,
     q: &[f64; 36usize],
@@ -5282,8 +5282,8 @@ pub fn link_forces_tangent(
     unsafe { link_forces_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn link_forces_tangent_0(
     t: f64,
     q: &[f64; 36usize],
@@ -5607,8 +5607,8 @@ pub fn link_energy(
     unsafe { link_energy_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn link_energy_0(
     t: f64,
     q: &[f64; 36usize],

@@ -223,7 +223,7 @@ impl Kernels for Compiled {
         }
     }
 }
-/// Kernel `accel`: 2197 operations in 1 chunk(s).
+/// Kernel `accel`: the first 44 values of `eom` (2197 operations for all).
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
@@ -236,12 +236,11 @@ pub fn accel(
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
-    unsafe { accel_0(t, q, qd, qdd, dir, p, w, out) };
+    unsafe { accel_fma(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn accel_0(
+fn accel_fma(
     t: f64,
     q: &[f64; 8usize],
     qd: &[f64; 8usize],
@@ -250,6 +249,52 @@ fn accel_0(
     p: &[f64; 141usize],
     w: &mut [f64; 0usize],
     out: &mut [f64; 44usize],
+) {
+    let mut unused = [0.0f64; 44usize];
+    eom_0(t, q, qd, qdd, dir, p, w, out, &mut unused);
+}
+/// Kernel `mass_bias`: the last 44 values of `eom` (2197 operations for all).
+#[allow(unused_unsafe)]
+pub fn mass_bias(
+    t: f64,
+    q: &[f64; 8usize],
+    qd: &[f64; 8usize],
+    qdd: &[f64; 8usize],
+    dir: &[f64; 16usize],
+    p: &[f64; 141usize],
+    out: &mut [f64; 44usize],
+) {
+    runtime::cpu::require_fma();
+    let w = &mut [0.0f64; 0];
+    unsafe { mass_bias_fma(t, q, qd, qdd, dir, p, w, out) };
+}
+#[inline(never)]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+fn mass_bias_fma(
+    t: f64,
+    q: &[f64; 8usize],
+    qd: &[f64; 8usize],
+    qdd: &[f64; 8usize],
+    dir: &[f64; 16usize],
+    p: &[f64; 141usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 44usize],
+) {
+    let mut unused = [0.0f64; 44usize];
+    eom_0(t, q, qd, qdd, dir, p, w, &mut unused, out);
+}
+#[inline(always)]
+#[allow(unused_variables, clippy::all)]
+fn eom_0(
+    t: f64,
+    q: &[f64; 8usize],
+    qd: &[f64; 8usize],
+    qdd: &[f64; 8usize],
+    dir: &[f64; 16usize],
+    p: &[f64; 141usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 44usize],
+    out2: &mut [f64; 44usize],
 ) {
     let [v3, v340, v1352]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
         3usize,
@@ -1782,1353 +1827,50 @@ fn accel_0(
     out[41usize] = v830;
     out[42usize] = v831;
     out[43usize] = v819;
-}
-/// Kernel `mass_bias`: 1865 operations in 1 chunk(s).
-#[allow(unused_unsafe)]
-pub fn mass_bias(
-    t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    out: &mut [f64; 44usize],
-) {
-    runtime::cpu::require_fma();
-    let w = &mut [0.0f64; 0];
-    unsafe { mass_bias_0(t, q, qd, qdd, dir, p, w, out) };
-}
-#[inline(never)]
-#[allow(unused_variables, clippy::all)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn mass_bias_0(
-    t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 44usize],
-) {
-    let [v3, v340, v1186]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[0usize]);
-    let v5: f64 = 2f64 * v3;
-    let v7: f64 = 0.5f64 * q[0usize];
-    let [v8, v337, v801]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v7);
-    let v9: f64 = v8.powi(4i32);
-    let v11: f64 = q[0usize] * q[0usize];
-    let v12: f64 = v3 * v3;
-    let v13: f64 = (-0.25f64).mul_add(v9, v5);
-    let v14: f64 = (-v11).mul_add(v12, v13);
-    let v15: f64 = p[56usize].mul_add(v14, p[10usize]);
-    let [v19, v391, v1139]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[1usize]);
-    let v20: f64 = 2f64 * v19;
-    let v21: f64 = 0.5f64 * q[1usize];
-    let [v22, v381, v811]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v21);
-    let v23: f64 = v22.powi(4i32);
-    let v24: f64 = q[1usize] * q[1usize];
-    let v25: f64 = v19 * v19;
-    let v26: f64 = (-0.25f64).mul_add(v23, v20);
-    let v27: f64 = (-v24).mul_add(v25, v26);
-    let [v31, v423, v1098]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[2usize]);
-    let v32: f64 = 2f64 * v31;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let [v34, v413, v826]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v33);
-    let v35: f64 = v34.powi(4i32);
-    let v36: f64 = q[2usize] * q[2usize];
-    let v37: f64 = v31 * v31;
-    let v38: f64 = (-0.25f64).mul_add(v35, v32);
-    let v39: f64 = (-v36).mul_add(v37, v38);
-    let [v43, v455, v1068]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[3usize]);
-    let v44: f64 = 2f64 * v43;
-    let v45: f64 = 0.5f64 * q[3usize];
-    let [v46, v445, v840]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v45);
-    let v47: f64 = v46.powi(4i32);
-    let v48: f64 = q[3usize] * q[3usize];
-    let v49: f64 = v43 * v43;
-    let v50: f64 = (-0.25f64).mul_add(v47, v44);
-    let v51: f64 = (-v48).mul_add(v49, v50);
-    let [v55, v487, v1038]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[4usize]);
-    let v56: f64 = 2f64 * v55;
-    let v57: f64 = 0.5f64 * q[4usize];
-    let [v58, v477, v854]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v57);
-    let v59: f64 = v58.powi(4i32);
-    let v60: f64 = q[4usize] * q[4usize];
-    let v61: f64 = v55 * v55;
-    let v62: f64 = (-0.25f64).mul_add(v59, v56);
-    let v63: f64 = (-v60).mul_add(v61, v62);
-    let [v67, v519, v1008]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[5usize]);
-    let v68: f64 = 2f64 * v67;
-    let v69: f64 = 0.5f64 * q[5usize];
-    let [v70, v509, v868]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v69);
-    let v71: f64 = v70.powi(4i32);
-    let v72: f64 = q[5usize] * q[5usize];
-    let v73: f64 = v67 * v67;
-    let v74: f64 = (-0.25f64).mul_add(v71, v68);
-    let v75: f64 = (-v72).mul_add(v73, v74);
-    let [v79, v551, v978]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[6usize]);
-    let v80: f64 = 2f64 * v79;
-    let v81: f64 = 0.5f64 * q[6usize];
-    let [v82, v541, v882]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v81);
-    let v83: f64 = v82.powi(4i32);
-    let v84: f64 = q[6usize] * q[6usize];
-    let v85: f64 = v79 * v79;
-    let v86: f64 = (-0.25f64).mul_add(v83, v80);
-    let v87: f64 = (-v84).mul_add(v85, v86);
-    let [v91, v586, v948]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[7usize]);
-    let v92: f64 = 2f64 * v91;
-    let v93: f64 = 0.5f64 * q[7usize];
-    let [v94, v573, v896]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v93);
-    let v95: f64 = v94.powi(4i32);
-    let v96: f64 = q[7usize] * q[7usize];
-    let v97: f64 = v91 * v91;
-    let v98: f64 = (-0.25f64).mul_add(v95, v92);
-    let v99: f64 = (-v96).mul_add(v97, v98);
-    let (v105, v106): (f64, f64) = runtime::special::sin_cos(v7);
-    let v107: f64 = p[64usize] * v105;
-    let v108: f64 = p[65usize].mul_add(v106, -v107);
-    let v109: f64 = p[8usize] * v8;
-    let v110: f64 = v109.mul_add(v108, p[3usize]);
-    let v112: f64 = p[65usize] * v105;
-    let v113: f64 = p[64usize].mul_add(v106, v112);
-    let v114: f64 = v108 * v105;
-    let v115: f64 = v113.mul_add(v106, v114);
-    let v116: f64 = v113 * v105;
-    let v117: f64 = v108.mul_add(v106, -v116);
-    let (v118, v119): (f64, f64) = runtime::special::sin_cos(v21);
-    let v120: f64 = v115 * v118;
-    let v121: f64 = v117.mul_add(v119, -v120);
-    let v122: f64 = p[14usize] * v22;
-    let v123: f64 = v122.mul_add(v121, v110);
-    let v125: f64 = v117 * v118;
-    let v126: f64 = v115.mul_add(v119, v125);
-    let v127: f64 = v121 * v118;
-    let v128: f64 = v126.mul_add(v119, v127);
-    let v129: f64 = v126 * v118;
-    let v130: f64 = v121.mul_add(v119, -v129);
-    let (v131, v132): (f64, f64) = runtime::special::sin_cos(v33);
-    let v133: f64 = v128 * v131;
-    let v134: f64 = v130.mul_add(v132, -v133);
-    let v135: f64 = p[20usize] * v34;
-    let v136: f64 = v135.mul_add(v134, v123);
-    let v138: f64 = v130 * v131;
-    let v139: f64 = v128.mul_add(v132, v138);
-    let v140: f64 = v134 * v131;
-    let v141: f64 = v139.mul_add(v132, v140);
-    let v142: f64 = v139 * v131;
-    let v143: f64 = v134.mul_add(v132, -v142);
-    let (v144, v145): (f64, f64) = runtime::special::sin_cos(v45);
-    let v146: f64 = v141 * v144;
-    let v147: f64 = v143.mul_add(v145, -v146);
-    let v148: f64 = p[26usize] * v46;
-    let v149: f64 = v148.mul_add(v147, v136);
-    let v151: f64 = v143 * v144;
-    let v152: f64 = v141.mul_add(v145, v151);
-    let v153: f64 = v147 * v144;
-    let v154: f64 = v152.mul_add(v145, v153);
-    let v155: f64 = v152 * v144;
-    let v156: f64 = v147.mul_add(v145, -v155);
-    let (v157, v158): (f64, f64) = runtime::special::sin_cos(v57);
-    let v159: f64 = v154 * v157;
-    let v160: f64 = v156.mul_add(v158, -v159);
-    let v161: f64 = p[32usize] * v58;
-    let v162: f64 = v161.mul_add(v160, v149);
-    let v164: f64 = v156 * v157;
-    let v165: f64 = v154.mul_add(v158, v164);
-    let v166: f64 = v160 * v157;
-    let v167: f64 = v165.mul_add(v158, v166);
-    let v168: f64 = v165 * v157;
-    let v169: f64 = v160.mul_add(v158, -v168);
-    let (v170, v171): (f64, f64) = runtime::special::sin_cos(v69);
-    let v172: f64 = v167 * v170;
-    let v173: f64 = v169.mul_add(v171, -v172);
-    let v174: f64 = p[38usize] * v70;
-    let v175: f64 = v174.mul_add(v173, v162);
-    let v177: f64 = v169 * v170;
-    let v178: f64 = v167.mul_add(v171, v177);
-    let v179: f64 = v173 * v170;
-    let v180: f64 = v178.mul_add(v171, v179);
-    let v181: f64 = v178 * v170;
-    let v182: f64 = v173.mul_add(v171, -v181);
-    let (v183, v184): (f64, f64) = runtime::special::sin_cos(v81);
-    let v185: f64 = v180 * v183;
-    let v186: f64 = v182.mul_add(v184, -v185);
-    let v187: f64 = p[44usize] * v82;
-    let v188: f64 = v187.mul_add(v186, v175);
-    let v190: f64 = v94 * v94;
-    let v191: f64 = p[66usize] * v190;
-    let v192: f64 = v182 * v183;
-    let v193: f64 = v180.mul_add(v184, v192);
-    let v194: f64 = v193 * v183;
-    let v195: f64 = v186.mul_add(v184, -v194);
-    let v197: f64 = p[50usize] * q[7usize];
-    let v198: f64 = v197 * v91;
-    let v199: f64 = v186 * v183;
-    let v200: f64 = v193.mul_add(v184, v199);
-    let v201: f64 = v191.mul_add(v195, v188);
-    let v202: f64 = (-v198).mul_add(v200, v201);
-    let v204: f64 = v109.mul_add(v113, p[4usize]);
-    let v205: f64 = v122.mul_add(v126, v204);
-    let v206: f64 = v135.mul_add(v139, v205);
-    let v207: f64 = v148.mul_add(v152, v206);
-    let v208: f64 = v161.mul_add(v165, v207);
-    let v209: f64 = v174.mul_add(v178, v208);
-    let v210: f64 = v187.mul_add(v193, v209);
-    let v211: f64 = v191.mul_add(v200, v210);
-    let v212: f64 = v198.mul_add(v195, v211);
-    let v213: f64 = v212 * v212;
-    let v214: f64 = v202.mul_add(v202, v213);
-    let v217: f64 = p[6usize] + v7;
-    let v218: f64 = v7 + v217;
-    let v219: f64 = v21 + v218;
-    let v220: f64 = v21 + v219;
-    let v221: f64 = v33 + v220;
-    let v222: f64 = v33 + v221;
-    let v223: f64 = v45 + v222;
-    let v224: f64 = v45 + v223;
-    let v225: f64 = v57 + v224;
-    let v226: f64 = v57 + v225;
-    let v227: f64 = v69 + v226;
-    let v228: f64 = v69 + v227;
-    let v229: f64 = v81 + v228;
-    let v230: f64 = v81 + v229;
-    let v231: f64 = v93 + v230;
-    let (v235, v232): (f64, f64) = runtime::special::sin_cos(v231);
-    let v233: f64 = p[50usize] * v94;
-    let v234: f64 = v233.mul_add(v232, v188);
-    let v236: f64 = v233.mul_add(v235, v210);
-    let v237: f64 = v236 * v236;
-    let v238: f64 = v234.mul_add(v234, v237);
-    let v239: f64 = p[63usize].mul_add(v99, p[52usize]);
-    let v240: f64 = p[51usize].mul_add(v214, v239);
-    let v241: f64 = p[7usize].mul_add(v238, v240);
-    let v244: f64 = v82 * v82;
-    let v245: f64 = p[67usize] * v244;
-    let v246: f64 = p[44usize] * q[6usize];
-    let v247: f64 = v246 * v79;
-    let v248: f64 = v245.mul_add(v182, v175);
-    let v249: f64 = (-v247).mul_add(v180, v248);
-    let v250: f64 = v245.mul_add(v180, v209);
-    let v251: f64 = v247.mul_add(v182, v250);
-    let v252: f64 = v251 * v251;
-    let v253: f64 = v249.mul_add(v249, v252);
-    let v254: f64 = p[62usize].mul_add(v87, p[46usize]);
-    let v255: f64 = v254 + v241;
-    let v256: f64 = p[45usize].mul_add(v253, v255);
-    let v259: f64 = v70 * v70;
-    let v260: f64 = p[68usize] * v259;
-    let v261: f64 = p[38usize] * q[5usize];
-    let v262: f64 = v261 * v67;
-    let v263: f64 = v260.mul_add(v169, v162);
-    let v264: f64 = (-v262).mul_add(v167, v263);
-    let v265: f64 = v260.mul_add(v167, v208);
-    let v266: f64 = v262.mul_add(v169, v265);
-    let v267: f64 = v266 * v266;
-    let v268: f64 = v264.mul_add(v264, v267);
-    let v269: f64 = p[61usize].mul_add(v75, p[40usize]);
-    let v270: f64 = v269 + v256;
-    let v271: f64 = p[39usize].mul_add(v268, v270);
-    let v274: f64 = v58 * v58;
-    let v275: f64 = p[69usize] * v274;
-    let v276: f64 = p[32usize] * q[4usize];
-    let v277: f64 = v276 * v55;
-    let v278: f64 = v275.mul_add(v156, v149);
-    let v279: f64 = (-v277).mul_add(v154, v278);
-    let v280: f64 = v275.mul_add(v154, v207);
-    let v281: f64 = v277.mul_add(v156, v280);
-    let v282: f64 = v281 * v281;
-    let v283: f64 = v279.mul_add(v279, v282);
-    let v284: f64 = p[60usize].mul_add(v63, p[34usize]);
-    let v285: f64 = v284 + v271;
-    let v286: f64 = p[33usize].mul_add(v283, v285);
-    let v289: f64 = v46 * v46;
-    let v290: f64 = p[70usize] * v289;
-    let v291: f64 = p[26usize] * q[3usize];
-    let v292: f64 = v291 * v43;
-    let v293: f64 = v290.mul_add(v143, v136);
-    let v294: f64 = (-v292).mul_add(v141, v293);
-    let v295: f64 = v290.mul_add(v141, v206);
-    let v296: f64 = v292.mul_add(v143, v295);
-    let v297: f64 = v296 * v296;
-    let v298: f64 = v294.mul_add(v294, v297);
-    let v299: f64 = p[59usize].mul_add(v51, p[28usize]);
-    let v300: f64 = v299 + v286;
-    let v301: f64 = p[27usize].mul_add(v298, v300);
-    let v304: f64 = v34 * v34;
-    let v305: f64 = p[71usize] * v304;
-    let v306: f64 = p[20usize] * q[2usize];
-    let v307: f64 = v306 * v31;
-    let v308: f64 = v305.mul_add(v130, v123);
-    let v309: f64 = (-v307).mul_add(v128, v308);
-    let v310: f64 = v305.mul_add(v128, v205);
-    let v311: f64 = v307.mul_add(v130, v310);
-    let v312: f64 = v311 * v311;
-    let v313: f64 = v309.mul_add(v309, v312);
-    let v314: f64 = p[58usize].mul_add(v39, p[22usize]);
-    let v315: f64 = v314 + v301;
-    let v316: f64 = p[21usize].mul_add(v313, v315);
-    let v319: f64 = v22 * v22;
-    let v320: f64 = p[72usize] * v319;
-    let v321: f64 = v320 * v117;
-    let v322: f64 = p[14usize] * q[1usize];
-    let v323: f64 = v322 * v19;
-    let v324: f64 = v323 * v115;
-    let v325: f64 = v110 + v321;
-    let v326: f64 = v325 - v324;
-    let v327: f64 = v320 * v115;
-    let v328: f64 = v323 * v117;
-    let v329: f64 = v204 + v327;
-    let v330: f64 = v329 + v328;
-    let v331: f64 = v330 * v330;
-    let v332: f64 = v326.mul_add(v326, v331);
-    let v333: f64 = p[57usize].mul_add(v27, p[16usize]);
-    let v334: f64 = v333 + v316;
-    let v335: f64 = p[15usize].mul_add(v332, v334);
-    let v338: f64 = 0.5f64 * v337;
-    let v339: f64 = v109 * v338;
-    let v341: f64 = q[0usize].mul_add(v340, v3);
-    let v342: f64 = p[8usize] * v341;
-    let v343: f64 = p[65usize] * v342;
-    let v344: f64 = p[64usize].mul_add(v339, v343);
-    let v345: f64 = p[64usize] * v342;
-    let v346: f64 = p[65usize].mul_add(v339, -v345);
-    let v347: f64 = v346 * v346;
-    let v348: f64 = v344.mul_add(v344, v347);
-    let v349: f64 = v108 * v338;
-    let v350: f64 = 0.5f64 * v8;
-    let v351: f64 = (-v350).mul_add(v113, v349);
-    let v352: f64 = p[8usize].mul_add(v351, v204);
-    let v353: f64 = p[7usize] * v236;
-    let v354: f64 = p[51usize].mul_add(v212, v353);
-    let v355: f64 = p[45usize].mul_add(v251, v354);
-    let v356: f64 = p[39usize].mul_add(v266, v355);
-    let v357: f64 = p[33usize].mul_add(v281, v356);
-    let v358: f64 = p[27usize].mul_add(v296, v357);
-    let v359: f64 = p[21usize].mul_add(v311, v358);
-    let v360: f64 = p[15usize].mul_add(v330, v359);
-    let v361: f64 = 2f64 * v360;
-    let v363: f64 = v352.mul_add(p[73usize], -v361);
-    let v364: f64 = v113 * v338;
-    let v365: f64 = v350.mul_add(v108, v364);
-    let v366: f64 = p[8usize].mul_add(v365, -v110);
-    let v367: f64 = p[7usize] * v234;
-    let v368: f64 = p[51usize].mul_add(v202, v367);
-    let v369: f64 = p[45usize].mul_add(v249, v368);
-    let v370: f64 = p[39usize].mul_add(v264, v369);
-    let v371: f64 = p[33usize].mul_add(v279, v370);
-    let v372: f64 = p[27usize].mul_add(v294, v371);
-    let v373: f64 = p[21usize].mul_add(v309, v372);
-    let v374: f64 = p[15usize].mul_add(v326, v373);
-    let v375: f64 = v366 * p[73usize];
-    let v376: f64 = 2f64.mul_add(v374, v375);
-    let v377: f64 = 0.25f64.mul_add(v15, v335);
-    let v378: f64 = p[9usize].mul_add(v348, v377);
-    let v379: f64 = v352.mul_add(v363, v378);
-    let v380: f64 = v366.mul_add(v376, v379);
-    let v382: f64 = 0.5f64 * v381;
-    let v383: f64 = 0.5f64 * v22;
-    let v384: f64 = v383 * v121;
-    let v385: f64 = v126.mul_add(v382, v384);
-    let v386: f64 = p[14usize].mul_add(v385, -v123);
-    let v387: f64 = v383 * v126;
-    let v388: f64 = v121.mul_add(v382, -v387);
-    let v389: f64 = p[14usize].mul_add(v388, v205);
-    let v390: f64 = v122 * v382;
-    let v392: f64 = q[1usize].mul_add(v391, v19);
-    let v393: f64 = p[14usize] * v392;
-    let v394: f64 = v117 * v393;
-    let v395: f64 = v115.mul_add(v390, v394);
-    let v396: f64 = v115 * v393;
-    let v397: f64 = v117.mul_add(v390, -v396);
-    let v398: f64 = v330 * v397;
-    let v399: f64 = v326.mul_add(v395, -v398);
-    let v400: f64 = 0.5f64.mul_add(v333, v316);
-    let v401: f64 = v386.mul_add(v373, v400);
-    let v402: f64 = (-v389).mul_add(v359, v401);
-    let v403: f64 = p[15usize].mul_add(v399, v402);
-    let v405: f64 = v389 * p[74usize];
-    let v406: f64 = v405 - v359;
-    let v407: f64 = p[15usize].mul_add(v397, v406);
-    let v408: f64 = v386 * p[74usize];
-    let v409: f64 = v373 + v408;
-    let v410: f64 = p[15usize].mul_add(v395, v409);
-    let v411: f64 = v352.mul_add(v407, v403);
-    let v412: f64 = v366.mul_add(v410, v411);
-    let v414: f64 = 0.5f64 * v413;
-    let v415: f64 = 0.5f64 * v34;
-    let v416: f64 = v415 * v134;
-    let v417: f64 = v139.mul_add(v414, v416);
-    let v418: f64 = p[20usize].mul_add(v417, -v136);
-    let v419: f64 = v415 * v139;
-    let v420: f64 = v134.mul_add(v414, -v419);
-    let v421: f64 = p[20usize].mul_add(v420, v206);
-    let v422: f64 = v135 * v414;
-    let v424: f64 = q[2usize].mul_add(v423, v31);
-    let v425: f64 = p[20usize] * v424;
-    let v426: f64 = v130 * v425;
-    let v427: f64 = v128.mul_add(v422, v426);
-    let v428: f64 = v128 * v425;
-    let v429: f64 = v130.mul_add(v422, -v428);
-    let v430: f64 = v311 * v429;
-    let v431: f64 = v309.mul_add(v427, -v430);
-    let v432: f64 = 0.5f64.mul_add(v314, v301);
-    let v433: f64 = v418.mul_add(v372, v432);
-    let v434: f64 = (-v421).mul_add(v358, v433);
-    let v435: f64 = p[21usize].mul_add(v431, v434);
-    let v437: f64 = v421 * p[75usize];
-    let v438: f64 = v437 - v358;
-    let v439: f64 = p[21usize].mul_add(v429, v438);
-    let v440: f64 = v418 * p[75usize];
-    let v441: f64 = v372 + v440;
-    let v442: f64 = p[21usize].mul_add(v427, v441);
-    let v443: f64 = v352.mul_add(v439, v435);
-    let v444: f64 = v366.mul_add(v442, v443);
-    let v446: f64 = 0.5f64 * v445;
-    let v447: f64 = 0.5f64 * v46;
-    let v448: f64 = v447 * v147;
-    let v449: f64 = v152.mul_add(v446, v448);
-    let v450: f64 = p[26usize].mul_add(v449, -v149);
-    let v451: f64 = v447 * v152;
-    let v452: f64 = v147.mul_add(v446, -v451);
-    let v453: f64 = p[26usize].mul_add(v452, v207);
-    let v454: f64 = v148 * v446;
-    let v456: f64 = q[3usize].mul_add(v455, v43);
-    let v457: f64 = p[26usize] * v456;
-    let v458: f64 = v143 * v457;
-    let v459: f64 = v141.mul_add(v454, v458);
-    let v460: f64 = v141 * v457;
-    let v461: f64 = v143.mul_add(v454, -v460);
-    let v462: f64 = v296 * v461;
-    let v463: f64 = v294.mul_add(v459, -v462);
-    let v464: f64 = 0.5f64.mul_add(v299, v286);
-    let v465: f64 = v450.mul_add(v371, v464);
-    let v466: f64 = (-v453).mul_add(v357, v465);
-    let v467: f64 = p[27usize].mul_add(v463, v466);
-    let v469: f64 = v453 * p[76usize];
-    let v470: f64 = v469 - v357;
-    let v471: f64 = p[27usize].mul_add(v461, v470);
-    let v472: f64 = v450 * p[76usize];
-    let v473: f64 = v371 + v472;
-    let v474: f64 = p[27usize].mul_add(v459, v473);
-    let v475: f64 = v352.mul_add(v471, v467);
-    let v476: f64 = v366.mul_add(v474, v475);
-    let v478: f64 = 0.5f64 * v477;
-    let v479: f64 = 0.5f64 * v58;
-    let v480: f64 = v479 * v160;
-    let v481: f64 = v165.mul_add(v478, v480);
-    let v482: f64 = p[32usize].mul_add(v481, -v162);
-    let v483: f64 = v479 * v165;
-    let v484: f64 = v160.mul_add(v478, -v483);
-    let v485: f64 = p[32usize].mul_add(v484, v208);
-    let v486: f64 = v161 * v478;
-    let v488: f64 = q[4usize].mul_add(v487, v55);
-    let v489: f64 = p[32usize] * v488;
-    let v490: f64 = v156 * v489;
-    let v491: f64 = v154.mul_add(v486, v490);
-    let v492: f64 = v154 * v489;
-    let v493: f64 = v156.mul_add(v486, -v492);
-    let v494: f64 = v281 * v493;
-    let v495: f64 = v279.mul_add(v491, -v494);
-    let v496: f64 = 0.5f64.mul_add(v284, v271);
-    let v497: f64 = v482.mul_add(v370, v496);
-    let v498: f64 = (-v485).mul_add(v356, v497);
-    let v499: f64 = p[33usize].mul_add(v495, v498);
-    let v501: f64 = v485 * p[77usize];
-    let v502: f64 = v501 - v356;
-    let v503: f64 = p[33usize].mul_add(v493, v502);
-    let v504: f64 = v482 * p[77usize];
-    let v505: f64 = v370 + v504;
-    let v506: f64 = p[33usize].mul_add(v491, v505);
-    let v507: f64 = v352.mul_add(v503, v499);
-    let v508: f64 = v366.mul_add(v506, v507);
-    let v510: f64 = 0.5f64 * v509;
-    let v511: f64 = 0.5f64 * v70;
-    let v512: f64 = v511 * v173;
-    let v513: f64 = v178.mul_add(v510, v512);
-    let v514: f64 = p[38usize].mul_add(v513, -v175);
-    let v515: f64 = v511 * v178;
-    let v516: f64 = v173.mul_add(v510, -v515);
-    let v517: f64 = p[38usize].mul_add(v516, v209);
-    let v518: f64 = v174 * v510;
-    let v520: f64 = q[5usize].mul_add(v519, v67);
-    let v521: f64 = p[38usize] * v520;
-    let v522: f64 = v169 * v521;
-    let v523: f64 = v167.mul_add(v518, v522);
-    let v524: f64 = v167 * v521;
-    let v525: f64 = v169.mul_add(v518, -v524);
-    let v526: f64 = v266 * v525;
-    let v527: f64 = v264.mul_add(v523, -v526);
-    let v528: f64 = 0.5f64.mul_add(v269, v256);
-    let v529: f64 = v514.mul_add(v369, v528);
-    let v530: f64 = (-v517).mul_add(v355, v529);
-    let v531: f64 = p[39usize].mul_add(v527, v530);
-    let v533: f64 = v517 * p[78usize];
-    let v534: f64 = v533 - v355;
-    let v535: f64 = p[39usize].mul_add(v525, v534);
-    let v536: f64 = v514 * p[78usize];
-    let v537: f64 = v369 + v536;
-    let v538: f64 = p[39usize].mul_add(v523, v537);
-    let v539: f64 = v352.mul_add(v535, v531);
-    let v540: f64 = v366.mul_add(v538, v539);
-    let v542: f64 = 0.5f64 * v541;
-    let v543: f64 = 0.5f64 * v82;
-    let v544: f64 = v543 * v186;
-    let v545: f64 = v193.mul_add(v542, v544);
-    let v546: f64 = p[44usize].mul_add(v545, -v188);
-    let v547: f64 = v543 * v193;
-    let v548: f64 = v186.mul_add(v542, -v547);
-    let v549: f64 = p[44usize].mul_add(v548, v210);
-    let v550: f64 = v187 * v542;
-    let v552: f64 = q[6usize].mul_add(v551, v79);
-    let v553: f64 = p[44usize] * v552;
-    let v554: f64 = v182 * v553;
-    let v555: f64 = v180.mul_add(v550, v554);
-    let v556: f64 = v180 * v553;
-    let v557: f64 = v182.mul_add(v550, -v556);
-    let v558: f64 = v251 * v557;
-    let v559: f64 = v249.mul_add(v555, -v558);
-    let v560: f64 = 0.5f64.mul_add(v254, v241);
-    let v561: f64 = v546.mul_add(v368, v560);
-    let v562: f64 = (-v549).mul_add(v354, v561);
-    let v563: f64 = p[45usize].mul_add(v559, v562);
-    let v565: f64 = v549 * p[79usize];
-    let v566: f64 = v565 - v354;
-    let v567: f64 = p[45usize].mul_add(v557, v566);
-    let v568: f64 = v546 * p[79usize];
-    let v569: f64 = v368 + v568;
-    let v570: f64 = p[45usize].mul_add(v555, v569);
-    let v571: f64 = v352.mul_add(v567, v563);
-    let v572: f64 = v366.mul_add(v570, v571);
-    let v574: f64 = 0.5f64 * v573;
-    let v575: f64 = 0.5f64 * v94;
-    let v576: f64 = v575 * v232;
-    let v577: f64 = v235.mul_add(v574, v576);
-    let v578: f64 = p[50usize] * v577;
-    let v579: f64 = v575 * v235;
-    let v580: f64 = v232.mul_add(v574, -v579);
-    let v581: f64 = p[50usize] * v580;
-    let v582: f64 = v236 * v581;
-    let v583: f64 = v234.mul_add(v578, -v582);
-    let v584: f64 = p[7usize] * v583;
-    let v585: f64 = v233 * v574;
-    let v587: f64 = q[7usize].mul_add(v586, v91);
-    let v588: f64 = p[50usize] * v587;
-    let v589: f64 = v195 * v588;
-    let v590: f64 = v200.mul_add(v585, v589);
-    let v591: f64 = v200 * v588;
-    let v592: f64 = v195.mul_add(v585, -v591);
-    let v593: f64 = v212 * v592;
-    let v594: f64 = v202.mul_add(v590, -v593);
-    let v595: f64 = 0.5f64.mul_add(v239, v584);
-    let v596: f64 = p[51usize].mul_add(v594, v595);
-    let v597: f64 = p[7usize] * v581;
-    let v598: f64 = p[51usize].mul_add(v592, v597);
-    let v599: f64 = p[7usize] * v578;
-    let v600: f64 = p[51usize].mul_add(v590, v599);
-    let v601: f64 = v352.mul_add(v598, v596);
-    let v602: f64 = v366.mul_add(v600, v601);
-    let v603: f64 = v395 * v395;
-    let v604: f64 = v397.mul_add(v397, v603);
-    let v605: f64 = (-2f64).mul_add(v359, v405);
-    let v606: f64 = 2f64.mul_add(v373, v408);
-    let v607: f64 = 0.25f64.mul_add(v333, v316);
-    let v608: f64 = p[15usize].mul_add(v604, v607);
-    let v609: f64 = v389.mul_add(v605, v608);
-    let v610: f64 = v386.mul_add(v606, v609);
-    let v611: f64 = v389.mul_add(v439, v435);
-    let v612: f64 = v386.mul_add(v442, v611);
-    let v613: f64 = v389.mul_add(v471, v467);
-    let v614: f64 = v386.mul_add(v474, v613);
-    let v615: f64 = v389.mul_add(v503, v499);
-    let v616: f64 = v386.mul_add(v506, v615);
-    let v617: f64 = v389.mul_add(v535, v531);
-    let v618: f64 = v386.mul_add(v538, v617);
-    let v619: f64 = v389.mul_add(v567, v563);
-    let v620: f64 = v386.mul_add(v570, v619);
-    let v621: f64 = v389.mul_add(v598, v596);
-    let v622: f64 = v386.mul_add(v600, v621);
-    let v623: f64 = v427 * v427;
-    let v624: f64 = v429.mul_add(v429, v623);
-    let v625: f64 = (-2f64).mul_add(v358, v437);
-    let v626: f64 = 2f64.mul_add(v372, v440);
-    let v627: f64 = 0.25f64.mul_add(v314, v301);
-    let v628: f64 = p[21usize].mul_add(v624, v627);
-    let v629: f64 = v421.mul_add(v625, v628);
-    let v630: f64 = v418.mul_add(v626, v629);
-    let v631: f64 = v421.mul_add(v471, v467);
-    let v632: f64 = v418.mul_add(v474, v631);
-    let v633: f64 = v421.mul_add(v503, v499);
-    let v634: f64 = v418.mul_add(v506, v633);
-    let v635: f64 = v421.mul_add(v535, v531);
-    let v636: f64 = v418.mul_add(v538, v635);
-    let v637: f64 = v421.mul_add(v567, v563);
-    let v638: f64 = v418.mul_add(v570, v637);
-    let v639: f64 = v421.mul_add(v598, v596);
-    let v640: f64 = v418.mul_add(v600, v639);
-    let v641: f64 = v459 * v459;
-    let v642: f64 = v461.mul_add(v461, v641);
-    let v643: f64 = (-2f64).mul_add(v357, v469);
-    let v644: f64 = 2f64.mul_add(v371, v472);
-    let v645: f64 = 0.25f64.mul_add(v299, v286);
-    let v646: f64 = p[27usize].mul_add(v642, v645);
-    let v647: f64 = v453.mul_add(v643, v646);
-    let v648: f64 = v450.mul_add(v644, v647);
-    let v649: f64 = v453.mul_add(v503, v499);
-    let v650: f64 = v450.mul_add(v506, v649);
-    let v651: f64 = v453.mul_add(v535, v531);
-    let v652: f64 = v450.mul_add(v538, v651);
-    let v653: f64 = v453.mul_add(v567, v563);
-    let v654: f64 = v450.mul_add(v570, v653);
-    let v655: f64 = v453.mul_add(v598, v596);
-    let v656: f64 = v450.mul_add(v600, v655);
-    let v657: f64 = v491 * v491;
-    let v658: f64 = v493.mul_add(v493, v657);
-    let v659: f64 = (-2f64).mul_add(v356, v501);
-    let v660: f64 = 2f64.mul_add(v370, v504);
-    let v661: f64 = 0.25f64.mul_add(v284, v271);
-    let v662: f64 = p[33usize].mul_add(v658, v661);
-    let v663: f64 = v485.mul_add(v659, v662);
-    let v664: f64 = v482.mul_add(v660, v663);
-    let v665: f64 = v485.mul_add(v535, v531);
-    let v666: f64 = v482.mul_add(v538, v665);
-    let v667: f64 = v485.mul_add(v567, v563);
-    let v668: f64 = v482.mul_add(v570, v667);
-    let v669: f64 = v485.mul_add(v598, v596);
-    let v670: f64 = v482.mul_add(v600, v669);
-    let v671: f64 = v523 * v523;
-    let v672: f64 = v525.mul_add(v525, v671);
-    let v673: f64 = (-2f64).mul_add(v355, v533);
-    let v674: f64 = 2f64.mul_add(v369, v536);
-    let v675: f64 = 0.25f64.mul_add(v269, v256);
-    let v676: f64 = p[39usize].mul_add(v672, v675);
-    let v677: f64 = v517.mul_add(v673, v676);
-    let v678: f64 = v514.mul_add(v674, v677);
-    let v679: f64 = v517.mul_add(v567, v563);
-    let v680: f64 = v514.mul_add(v570, v679);
-    let v681: f64 = v517.mul_add(v598, v596);
-    let v682: f64 = v514.mul_add(v600, v681);
-    let v683: f64 = v555 * v555;
-    let v684: f64 = v557.mul_add(v557, v683);
-    let v685: f64 = (-2f64).mul_add(v354, v565);
-    let v686: f64 = 2f64.mul_add(v368, v568);
-    let v687: f64 = 0.25f64.mul_add(v254, v241);
-    let v688: f64 = p[45usize].mul_add(v684, v687);
-    let v689: f64 = v549.mul_add(v685, v688);
-    let v690: f64 = v546.mul_add(v686, v689);
-    let v691: f64 = v549.mul_add(v598, v596);
-    let v692: f64 = v546.mul_add(v600, v691);
-    let v693: f64 = v590 * v590;
-    let v694: f64 = v592.mul_add(v592, v693);
-    let v695: f64 = p[51usize] * v694;
-    let v696: f64 = v578 * v578;
-    let v697: f64 = v581.mul_add(v581, v696);
-    let v698: f64 = 0.25f64.mul_add(v239, v695);
-    let v699: f64 = p[7usize].mul_add(v697, v698);
-    let v702: f64 = 0.5f64 * qd[0usize];
-    let v703: f64 = v702 * v702;
-    let v705: f64 = (-0.5f64) * v703;
-    let v706: f64 = (-v5).mul_add(v11, 2f64);
-    let v707: f64 = v705 * v706;
-    let v708: f64 = p[80usize] * v707;
-    let v709: f64 = p[9usize] * v708;
-    let v711: f64 = v8.powi(3i32);
-    let v712: f64 = p[81usize] * v711;
-    let v713: f64 = v712 * v705;
-    let v714: f64 = v338 * v713;
-    let v716: f64 = 0.5f64 * qd[1usize];
-    let v717: f64 = v702 + v702;
-    let v718: f64 = v716 + v717;
-    let v719: f64 = v22.powi(3i32);
-    let v720: f64 = v382 * v719;
-    let v721: f64 = 2f64 * q[1usize];
-    let v722: f64 = (-v20).mul_add(v24, 2f64);
-    let v723: f64 = v391.mul_add(v722, -v720);
-    let v724: f64 = (-v721).mul_add(v25, v723);
-    let v725: f64 = p[57usize] * v724;
-    let v726: f64 = qd[1usize] * v718;
-    let v728: f64 = 0.5f64 * qd[2usize];
-    let v729: f64 = v716 + v718;
-    let v730: f64 = v728 + v729;
-    let v731: f64 = v34.powi(3i32);
-    let v732: f64 = v414 * v731;
-    let v733: f64 = 2f64 * q[2usize];
-    let v734: f64 = (-v32).mul_add(v36, 2f64);
-    let v735: f64 = v423.mul_add(v734, -v732);
-    let v736: f64 = (-v733).mul_add(v37, v735);
-    let v737: f64 = p[58usize] * v736;
-    let v738: f64 = qd[2usize] * v730;
-    let v740: f64 = 0.5f64 * qd[3usize];
-    let v741: f64 = v728 + v730;
-    let v742: f64 = v740 + v741;
-    let v743: f64 = v46.powi(3i32);
-    let v744: f64 = v446 * v743;
-    let v745: f64 = 2f64 * q[3usize];
-    let v746: f64 = (-v44).mul_add(v48, 2f64);
-    let v747: f64 = v455.mul_add(v746, -v744);
-    let v748: f64 = (-v745).mul_add(v49, v747);
-    let v749: f64 = p[59usize] * v748;
-    let v750: f64 = qd[3usize] * v742;
-    let v752: f64 = 0.5f64 * qd[4usize];
-    let v753: f64 = v740 + v742;
-    let v754: f64 = v752 + v753;
-    let v755: f64 = v58.powi(3i32);
-    let v756: f64 = v478 * v755;
-    let v757: f64 = 2f64 * q[4usize];
-    let v758: f64 = (-v56).mul_add(v60, 2f64);
-    let v759: f64 = v487.mul_add(v758, -v756);
-    let v760: f64 = (-v757).mul_add(v61, v759);
-    let v761: f64 = p[60usize] * v760;
-    let v762: f64 = qd[4usize] * v754;
-    let v764: f64 = 0.5f64 * qd[5usize];
-    let v765: f64 = v752 + v754;
-    let v766: f64 = v764 + v765;
-    let v767: f64 = v70.powi(3i32);
-    let v768: f64 = v510 * v767;
-    let v769: f64 = 2f64 * q[5usize];
-    let v770: f64 = (-v68).mul_add(v72, 2f64);
-    let v771: f64 = v519.mul_add(v770, -v768);
-    let v772: f64 = (-v769).mul_add(v73, v771);
-    let v773: f64 = p[61usize] * v772;
-    let v774: f64 = qd[5usize] * v766;
-    let v776: f64 = 0.5f64 * qd[6usize];
-    let v777: f64 = v764 + v766;
-    let v778: f64 = v776 + v777;
-    let v779: f64 = v82.powi(3i32);
-    let v780: f64 = v542 * v779;
-    let v781: f64 = 2f64 * q[6usize];
-    let v782: f64 = (-v80).mul_add(v84, 2f64);
-    let v783: f64 = v551.mul_add(v782, -v780);
-    let v784: f64 = (-v781).mul_add(v85, v783);
-    let v785: f64 = p[62usize] * v784;
-    let v786: f64 = qd[6usize] * v778;
-    let v788: f64 = 0.5f64 * qd[7usize];
-    let v789: f64 = v776 + v778;
-    let v790: f64 = v788 + v789;
-    let v791: f64 = v94.powi(3i32);
-    let v792: f64 = v574 * v791;
-    let v793: f64 = 2f64 * q[7usize];
-    let v794: f64 = (-v92).mul_add(v96, 2f64);
-    let v795: f64 = v586.mul_add(v794, -v792);
-    let v796: f64 = (-v793).mul_add(v97, v795);
-    let v797: f64 = p[63usize] * v796;
-    let v798: f64 = qd[7usize] * v790;
-    let v800: f64 = qd[0usize] * qd[0usize];
-    let v802: f64 = 0.25f64 * v801;
-    let v803: f64 = (-0.25f64).mul_add(v8, v802);
-    let v804: f64 = v113.mul_add(v803, v349);
-    let v805: f64 = p[8usize] * v804;
-    let v806: f64 = qd[0usize] + v716;
-    let v807: f64 = 2f64 * qd[1usize];
-    let v808: f64 = v807 * v121;
-    let v809: f64 = v808 * v382;
-    let v810: f64 = qd[1usize] * qd[1usize];
-    let v812: f64 = 0.25f64 * v811;
-    let v813: f64 = v806 * v806;
-    let v814: f64 = v22 * v813;
-    let v815: f64 = v810.mul_add(v812, -v814);
-    let v816: f64 = v126 * v815;
-    let v817: f64 = v809.mul_add(v806, v816);
-    let v818: f64 = p[14usize] * v817;
-    let v819: f64 = v800.mul_add(v805, v818);
-    let v820: f64 = v716 + v806;
-    let v821: f64 = v728 + v820;
-    let v822: f64 = 2f64 * qd[2usize];
-    let v823: f64 = v822 * v134;
-    let v824: f64 = v823 * v414;
-    let v825: f64 = qd[2usize] * qd[2usize];
-    let v827: f64 = 0.25f64 * v826;
-    let v828: f64 = v821 * v821;
-    let v829: f64 = v34 * v828;
-    let v830: f64 = v825.mul_add(v827, -v829);
-    let v831: f64 = v139 * v830;
-    let v832: f64 = v824.mul_add(v821, v831);
-    let v833: f64 = p[20usize].mul_add(v832, v819);
-    let v834: f64 = v728 + v821;
-    let v835: f64 = v740 + v834;
-    let v836: f64 = 2f64 * qd[3usize];
-    let v837: f64 = v836 * v147;
-    let v838: f64 = v837 * v446;
-    let v839: f64 = qd[3usize] * qd[3usize];
-    let v841: f64 = 0.25f64 * v840;
-    let v842: f64 = v835 * v835;
-    let v843: f64 = v46 * v842;
-    let v844: f64 = v839.mul_add(v841, -v843);
-    let v845: f64 = v152 * v844;
-    let v846: f64 = v838.mul_add(v835, v845);
-    let v847: f64 = p[26usize].mul_add(v846, v833);
-    let v848: f64 = v740 + v835;
-    let v849: f64 = v752 + v848;
-    let v850: f64 = 2f64 * qd[4usize];
-    let v851: f64 = v850 * v160;
-    let v852: f64 = v851 * v478;
-    let v853: f64 = qd[4usize] * qd[4usize];
-    let v855: f64 = 0.25f64 * v854;
-    let v856: f64 = v849 * v849;
-    let v857: f64 = v58 * v856;
-    let v858: f64 = v853.mul_add(v855, -v857);
-    let v859: f64 = v165 * v858;
-    let v860: f64 = v852.mul_add(v849, v859);
-    let v861: f64 = p[32usize].mul_add(v860, v847);
-    let v862: f64 = v752 + v849;
-    let v863: f64 = v764 + v862;
-    let v864: f64 = 2f64 * qd[5usize];
-    let v865: f64 = v864 * v173;
-    let v866: f64 = v865 * v510;
-    let v867: f64 = qd[5usize] * qd[5usize];
-    let v869: f64 = 0.25f64 * v868;
-    let v870: f64 = v863 * v863;
-    let v871: f64 = v70 * v870;
-    let v872: f64 = v867.mul_add(v869, -v871);
-    let v873: f64 = v178 * v872;
-    let v874: f64 = v866.mul_add(v863, v873);
-    let v875: f64 = p[38usize].mul_add(v874, v861);
-    let v876: f64 = v764 + v863;
-    let v877: f64 = v776 + v876;
-    let v878: f64 = 2f64 * qd[6usize];
-    let v879: f64 = v878 * v186;
-    let v880: f64 = v879 * v542;
-    let v881: f64 = qd[6usize] * qd[6usize];
-    let v883: f64 = 0.25f64 * v882;
-    let v884: f64 = v877 * v877;
-    let v885: f64 = v82 * v884;
-    let v886: f64 = v881.mul_add(v883, -v885);
-    let v887: f64 = v193 * v886;
-    let v888: f64 = v880.mul_add(v877, v887);
-    let v889: f64 = p[44usize].mul_add(v888, v875);
-    let v890: f64 = v776 + v877;
-    let v891: f64 = v788 + v890;
-    let v892: f64 = 2f64 * qd[7usize];
-    let v893: f64 = v892 * v232;
-    let v894: f64 = v893 * v574;
-    let v895: f64 = qd[7usize] * qd[7usize];
-    let v897: f64 = 0.25f64 * v896;
-    let v898: f64 = v891 * v891;
-    let v899: f64 = v94 * v898;
-    let v900: f64 = v895.mul_add(v897, -v899);
-    let v901: f64 = v235 * v900;
-    let v902: f64 = v894.mul_add(v891, v901);
-    let v903: f64 = p[50usize].mul_add(v902, v889);
-    let v904: f64 = p[82usize] + v903;
-    let v906: f64 = v108.mul_add(v803, -v364);
-    let v907: f64 = p[8usize] * v906;
-    let v908: f64 = v807 * v126;
-    let v909: f64 = v908 * v382;
-    let v910: f64 = v909 * v806;
-    let v911: f64 = v121.mul_add(v815, -v910);
-    let v912: f64 = p[14usize] * v911;
-    let v913: f64 = v800.mul_add(v907, v912);
-    let v914: f64 = v822 * v139;
-    let v915: f64 = v914 * v414;
-    let v916: f64 = v915 * v821;
-    let v917: f64 = v134.mul_add(v830, -v916);
-    let v918: f64 = p[20usize].mul_add(v917, v913);
-    let v919: f64 = v836 * v152;
-    let v920: f64 = v919 * v446;
-    let v921: f64 = v920 * v835;
-    let v922: f64 = v147.mul_add(v844, -v921);
-    let v923: f64 = p[26usize].mul_add(v922, v918);
-    let v924: f64 = v850 * v165;
-    let v925: f64 = v924 * v478;
-    let v926: f64 = v925 * v849;
-    let v927: f64 = v160.mul_add(v858, -v926);
-    let v928: f64 = p[32usize].mul_add(v927, v923);
-    let v929: f64 = v864 * v178;
-    let v930: f64 = v929 * v510;
-    let v931: f64 = v930 * v863;
-    let v932: f64 = v173.mul_add(v872, -v931);
-    let v933: f64 = p[38usize].mul_add(v932, v928);
-    let v934: f64 = v878 * v193;
-    let v935: f64 = v934 * v542;
-    let v936: f64 = v935 * v877;
-    let v937: f64 = v186.mul_add(v886, -v936);
-    let v938: f64 = p[44usize].mul_add(v937, v933);
-    let v939: f64 = v892 * v235;
-    let v940: f64 = v939 * v574;
-    let v941: f64 = v940 * v891;
-    let v942: f64 = v232.mul_add(v900, -v941);
-    let v943: f64 = p[50usize].mul_add(v942, v938);
-    let v944: f64 = p[83usize] + v943;
-    let v945: f64 = v236 * v944;
-    let v946: f64 = v234.mul_add(v904, -v945);
-    let v947: f64 = p[7usize] * v946;
-    let v949: f64 = q[7usize] * v948;
-    let v950: f64 = 2f64.mul_add(v586, v949);
-    let v951: f64 = p[50usize] * v950;
-    let v952: f64 = v895 * v951;
-    let v953: f64 = v892 * v585;
-    let v954: f64 = v953 * v890;
-    let v955: f64 = v890 * v890;
-    let v956: f64 = v198 * v955;
-    let v957: f64 = v952 + v954;
-    let v958: f64 = v957 - v956;
-    let v959: f64 = v94 * v897;
-    let v960: f64 = v574.mul_add(v574, v959);
-    let v961: f64 = p[50usize] * v960;
-    let v962: f64 = v191 * v955;
-    let v963: f64 = v892 * v890;
-    let v964: f64 = v895.mul_add(v961, -v962);
-    let v965: f64 = (-v963).mul_add(v588, v964);
-    let v966: f64 = v195.mul_add(v958, v889);
-    let v967: f64 = v200.mul_add(v965, v966);
-    let v968: f64 = p[82usize] + v967;
-    let v969: f64 = v956 - v952;
-    let v970: f64 = v969 - v954;
-    let v971: f64 = v195.mul_add(v965, v938);
-    let v972: f64 = v200.mul_add(v970, v971);
-    let v973: f64 = p[83usize] + v972;
-    let v974: f64 = v212 * v973;
-    let v975: f64 = v202.mul_add(v968, -v974);
-    let v976: f64 = v798.mul_add(v797, v947);
-    let v977: f64 = p[51usize].mul_add(v975, v976);
-    let v979: f64 = q[6usize] * v978;
-    let v980: f64 = 2f64.mul_add(v551, v979);
-    let v981: f64 = p[44usize] * v980;
-    let v982: f64 = v881 * v981;
-    let v983: f64 = v878 * v550;
-    let v984: f64 = v983 * v876;
-    let v985: f64 = v876 * v876;
-    let v986: f64 = v247 * v985;
-    let v987: f64 = v982 + v984;
-    let v988: f64 = v987 - v986;
-    let v989: f64 = v82 * v883;
-    let v990: f64 = v542.mul_add(v542, v989);
-    let v991: f64 = p[44usize] * v990;
-    let v992: f64 = v245 * v985;
-    let v993: f64 = v878 * v876;
-    let v994: f64 = v881.mul_add(v991, -v992);
-    let v995: f64 = (-v993).mul_add(v553, v994);
-    let v996: f64 = v182.mul_add(v988, v875);
-    let v997: f64 = v180.mul_add(v995, v996);
-    let v998: f64 = p[82usize] + v997;
-    let v999: f64 = v986 - v982;
-    let v1000: f64 = v999 - v984;
-    let v1001: f64 = v182.mul_add(v995, v933);
-    let v1002: f64 = v180.mul_add(v1000, v1001);
-    let v1003: f64 = p[83usize] + v1002;
-    let v1004: f64 = v251 * v1003;
-    let v1005: f64 = v249.mul_add(v998, -v1004);
-    let v1006: f64 = v786.mul_add(v785, v977);
-    let v1007: f64 = p[45usize].mul_add(v1005, v1006);
-    let v1009: f64 = q[5usize] * v1008;
-    let v1010: f64 = 2f64.mul_add(v519, v1009);
-    let v1011: f64 = p[38usize] * v1010;
-    let v1012: f64 = v867 * v1011;
-    let v1013: f64 = v864 * v518;
-    let v1014: f64 = v1013 * v862;
-    let v1015: f64 = v862 * v862;
-    let v1016: f64 = v262 * v1015;
-    let v1017: f64 = v1012 + v1014;
-    let v1018: f64 = v1017 - v1016;
-    let v1019: f64 = v70 * v869;
-    let v1020: f64 = v510.mul_add(v510, v1019);
-    let v1021: f64 = p[38usize] * v1020;
-    let v1022: f64 = v260 * v1015;
-    let v1023: f64 = v864 * v862;
-    let v1024: f64 = v867.mul_add(v1021, -v1022);
-    let v1025: f64 = (-v1023).mul_add(v521, v1024);
-    let v1026: f64 = v169.mul_add(v1018, v861);
-    let v1027: f64 = v167.mul_add(v1025, v1026);
-    let v1028: f64 = p[82usize] + v1027;
-    let v1029: f64 = v1016 - v1012;
-    let v1030: f64 = v1029 - v1014;
-    let v1031: f64 = v169.mul_add(v1025, v928);
-    let v1032: f64 = v167.mul_add(v1030, v1031);
-    let v1033: f64 = p[83usize] + v1032;
-    let v1034: f64 = v266 * v1033;
-    let v1035: f64 = v264.mul_add(v1028, -v1034);
-    let v1036: f64 = v774.mul_add(v773, v1007);
-    let v1037: f64 = p[39usize].mul_add(v1035, v1036);
-    let v1039: f64 = q[4usize] * v1038;
-    let v1040: f64 = 2f64.mul_add(v487, v1039);
-    let v1041: f64 = p[32usize] * v1040;
-    let v1042: f64 = v853 * v1041;
-    let v1043: f64 = v850 * v486;
-    let v1044: f64 = v1043 * v848;
-    let v1045: f64 = v848 * v848;
-    let v1046: f64 = v277 * v1045;
-    let v1047: f64 = v1042 + v1044;
-    let v1048: f64 = v1047 - v1046;
-    let v1049: f64 = v58 * v855;
-    let v1050: f64 = v478.mul_add(v478, v1049);
-    let v1051: f64 = p[32usize] * v1050;
-    let v1052: f64 = v275 * v1045;
-    let v1053: f64 = v850 * v848;
-    let v1054: f64 = v853.mul_add(v1051, -v1052);
-    let v1055: f64 = (-v1053).mul_add(v489, v1054);
-    let v1056: f64 = v156.mul_add(v1048, v847);
-    let v1057: f64 = v154.mul_add(v1055, v1056);
-    let v1058: f64 = p[82usize] + v1057;
-    let v1059: f64 = v1046 - v1042;
-    let v1060: f64 = v1059 - v1044;
-    let v1061: f64 = v156.mul_add(v1055, v923);
-    let v1062: f64 = v154.mul_add(v1060, v1061);
-    let v1063: f64 = p[83usize] + v1062;
-    let v1064: f64 = v281 * v1063;
-    let v1065: f64 = v279.mul_add(v1058, -v1064);
-    let v1066: f64 = v762.mul_add(v761, v1037);
-    let v1067: f64 = p[33usize].mul_add(v1065, v1066);
-    let v1069: f64 = q[3usize] * v1068;
-    let v1070: f64 = 2f64.mul_add(v455, v1069);
-    let v1071: f64 = p[26usize] * v1070;
-    let v1072: f64 = v839 * v1071;
-    let v1073: f64 = v836 * v454;
-    let v1074: f64 = v1073 * v834;
-    let v1075: f64 = v834 * v834;
-    let v1076: f64 = v292 * v1075;
-    let v1077: f64 = v1072 + v1074;
-    let v1078: f64 = v1077 - v1076;
-    let v1079: f64 = v46 * v841;
-    let v1080: f64 = v446.mul_add(v446, v1079);
-    let v1081: f64 = p[26usize] * v1080;
-    let v1082: f64 = v290 * v1075;
-    let v1083: f64 = v836 * v834;
-    let v1084: f64 = v839.mul_add(v1081, -v1082);
-    let v1085: f64 = (-v1083).mul_add(v457, v1084);
-    let v1086: f64 = v143.mul_add(v1078, v833);
-    let v1087: f64 = v141.mul_add(v1085, v1086);
-    let v1088: f64 = p[82usize] + v1087;
-    let v1089: f64 = v1076 - v1072;
-    let v1090: f64 = v1089 - v1074;
-    let v1091: f64 = v143.mul_add(v1085, v918);
-    let v1092: f64 = v141.mul_add(v1090, v1091);
-    let v1093: f64 = p[83usize] + v1092;
-    let v1094: f64 = v296 * v1093;
-    let v1095: f64 = v294.mul_add(v1088, -v1094);
-    let v1096: f64 = v750.mul_add(v749, v1067);
-    let v1097: f64 = p[27usize].mul_add(v1095, v1096);
-    let v1099: f64 = q[2usize] * v1098;
-    let v1100: f64 = 2f64.mul_add(v423, v1099);
-    let v1101: f64 = p[20usize] * v1100;
-    let v1102: f64 = v825 * v1101;
-    let v1103: f64 = v822 * v422;
-    let v1104: f64 = v1103 * v820;
-    let v1105: f64 = v820 * v820;
-    let v1106: f64 = v307 * v1105;
-    let v1107: f64 = v1102 + v1104;
-    let v1108: f64 = v1107 - v1106;
-    let v1109: f64 = v34 * v827;
-    let v1110: f64 = v414.mul_add(v414, v1109);
-    let v1111: f64 = p[20usize] * v1110;
-    let v1112: f64 = v305 * v1105;
-    let v1113: f64 = v822 * v820;
-    let v1114: f64 = v825.mul_add(v1111, -v1112);
-    let v1115: f64 = (-v1113).mul_add(v425, v1114);
-    let v1116: f64 = v130.mul_add(v1108, v819);
-    let v1117: f64 = v128.mul_add(v1115, v1116);
-    let v1118: f64 = p[82usize] + v1117;
-    let v1119: f64 = v1106 - v1102;
-    let v1120: f64 = v1119 - v1104;
-    let v1121: f64 = v130.mul_add(v1115, v913);
-    let v1122: f64 = v128.mul_add(v1120, v1121);
-    let v1123: f64 = p[83usize] + v1122;
-    let v1124: f64 = v311 * v1123;
-    let v1125: f64 = v309.mul_add(v1118, -v1124);
-    let v1126: f64 = v738.mul_add(v737, v1097);
-    let v1127: f64 = p[21usize].mul_add(v1125, v1126);
-    let v1128: f64 = v805 - v327;
-    let v1129: f64 = v1128 - v328;
-    let v1130: f64 = 2f64 * v117;
-    let v1131: f64 = 2f64 * v115;
-    let v1132: f64 = v1131 * v393;
-    let v1133: f64 = v1130.mul_add(v390, -v1132);
-    let v1134: f64 = qd[1usize] * v1133;
-    let v1135: f64 = qd[0usize] * v1134;
-    let v1136: f64 = v22 * v812;
-    let v1137: f64 = v382.mul_add(v382, v1136);
-    let v1138: f64 = p[14usize] * v1137;
-    let v1140: f64 = q[1usize] * v1139;
-    let v1141: f64 = 2f64.mul_add(v391, v1140);
-    let v1142: f64 = p[14usize] * v1141;
-    let v1143: f64 = v117 * v1142;
-    let v1144: f64 = v115.mul_add(v1138, v1143);
-    let v1145: f64 = v800.mul_add(v1129, v1135);
-    let v1146: f64 = v810.mul_add(v1144, v1145);
-    let v1147: f64 = p[82usize] + v1146;
-    let v1148: f64 = v324 - v321;
-    let v1149: f64 = v1148 + v907;
-    let v1150: f64 = v1130 * v393;
-    let v1151: f64 = v1131.mul_add(v390, v1150);
-    let v1152: f64 = -v1151;
-    let v1153: f64 = qd[1usize] * v1152;
-    let v1154: f64 = qd[0usize] * v1153;
-    let v1155: f64 = v115 * v1142;
-    let v1156: f64 = v117.mul_add(v1138, -v1155);
-    let v1157: f64 = v800.mul_add(v1149, v1154);
-    let v1158: f64 = v810.mul_add(v1156, v1157);
-    let v1159: f64 = p[83usize] + v1158;
-    let v1160: f64 = v330 * v1159;
-    let v1161: f64 = v326.mul_add(v1147, -v1160);
-    let v1162: f64 = v726.mul_add(v725, v1127);
-    let v1163: f64 = p[15usize].mul_add(v1161, v1162);
-    let v1164: f64 = p[7usize] * v944;
-    let v1165: f64 = p[51usize].mul_add(v973, v1164);
-    let v1166: f64 = p[45usize].mul_add(v1003, v1165);
-    let v1167: f64 = p[39usize].mul_add(v1033, v1166);
-    let v1168: f64 = p[33usize].mul_add(v1063, v1167);
-    let v1169: f64 = p[27usize].mul_add(v1093, v1168);
-    let v1170: f64 = p[21usize].mul_add(v1123, v1169);
-    let v1171: f64 = p[15usize].mul_add(v1159, v1170);
-    let v1172: f64 = p[7usize] * v904;
-    let v1173: f64 = p[51usize].mul_add(v968, v1172);
-    let v1174: f64 = p[45usize].mul_add(v998, v1173);
-    let v1175: f64 = p[39usize].mul_add(v1028, v1174);
-    let v1176: f64 = p[33usize].mul_add(v1058, v1175);
-    let v1177: f64 = p[27usize].mul_add(v1088, v1176);
-    let v1178: f64 = p[21usize].mul_add(v1118, v1177);
-    let v1179: f64 = p[15usize].mul_add(v1147, v1178);
-    let v1182: f64 = p[84usize] + q[0usize];
-    let v1183: f64 = v8 * v802;
-    let v1184: f64 = v338.mul_add(v338, v1183);
-    let v1185: f64 = p[8usize] * v1184;
-    let v1187: f64 = q[0usize] * v1186;
-    let v1188: f64 = 2f64.mul_add(v340, v1187);
-    let v1189: f64 = p[8usize] * v1188;
-    let v1190: f64 = p[64usize] * v1189;
-    let v1191: f64 = p[65usize].mul_add(v1185, -v1190);
-    let v1192: f64 = v800.mul_add(v1191, p[83usize]);
-    let v1193: f64 = p[65usize] * v1189;
-    let v1194: f64 = p[64usize].mul_add(v1185, v1193);
-    let v1195: f64 = v800.mul_add(v1194, p[82usize]);
-    let v1196: f64 = v344 * v1195;
-    let v1198: f64 = p[85usize] * q[0usize];
-    let v1199: f64 = v1198 * v12;
-    let v1200: f64 = v346.mul_add(v1192, v1196);
-    let v1201: f64 = (-v1199).mul_add(v705, v1200);
-    let v1203: f64 = v338 * v711;
-    let v1204: f64 = 2f64 * q[0usize];
-    let v1205: f64 = v340.mul_add(v706, -v1203);
-    let v1206: f64 = (-v1204).mul_add(v12, v1205);
-    let v1207: f64 = p[56usize] * v1206;
-    let v1208: f64 = 0.5f64 * v702;
-    let v1209: f64 = v1208.mul_add(v1207, p[12usize]);
-    let v1210: f64 = v340.mul_add(v709, v714);
-    let v1211: f64 = v1210 + v1163;
-    let v1212: f64 = v352.mul_add(v1171, v1211);
-    let v1213: f64 = v366.mul_add(v1179, v1212);
-    let v1214: f64 = p[11usize].mul_add(v1182, v1213);
-    let v1215: f64 = p[9usize].mul_add(v1201, v1214);
-    let v1216: f64 = qd[0usize].mul_add(v1209, v1215);
-    let v1218: f64 = v718 * v718;
-    let v1219: f64 = (-0.5f64) * v1218;
-    let v1220: f64 = v1219 * v722;
-    let v1221: f64 = p[86usize] * v1220;
-    let v1222: f64 = p[15usize] * v1221;
-    let v1224: f64 = p[87usize] * v719;
-    let v1225: f64 = v1224 * v1219;
-    let v1226: f64 = v382 * v1225;
-    let v1229: f64 = p[88usize] + q[1usize];
-    let v1230: f64 = v1147 * v395;
-    let v1232: f64 = p[89usize] * q[1usize];
-    let v1233: f64 = v1232 * v25;
-    let v1234: f64 = v1159.mul_add(v397, v1230);
-    let v1235: f64 = (-v1233).mul_add(v1219, v1234);
-    let v1237: f64 = 0.5f64 * v718;
-    let v1238: f64 = v1237.mul_add(v725, p[18usize]);
-    let v1239: f64 = v391.mul_add(v1222, v1226);
-    let v1240: f64 = v1239 + v1127;
-    let v1241: f64 = v389.mul_add(v1170, v1240);
-    let v1242: f64 = v386.mul_add(v1178, v1241);
-    let v1243: f64 = p[17usize].mul_add(v1229, v1242);
-    let v1244: f64 = p[15usize].mul_add(v1235, v1243);
-    let v1245: f64 = qd[1usize].mul_add(v1238, v1244);
-    let v1247: f64 = v730 * v730;
-    let v1248: f64 = (-0.5f64) * v1247;
-    let v1249: f64 = v1248 * v734;
-    let v1250: f64 = p[90usize] * v1249;
-    let v1251: f64 = p[21usize] * v1250;
-    let v1253: f64 = p[91usize] * v731;
-    let v1254: f64 = v1253 * v1248;
-    let v1255: f64 = v414 * v1254;
-    let v1258: f64 = p[92usize] + q[2usize];
-    let v1259: f64 = v1118 * v427;
-    let v1261: f64 = p[93usize] * q[2usize];
-    let v1262: f64 = v1261 * v37;
-    let v1263: f64 = v1123.mul_add(v429, v1259);
-    let v1264: f64 = (-v1262).mul_add(v1248, v1263);
-    let v1266: f64 = 0.5f64 * v730;
-    let v1267: f64 = v1266.mul_add(v737, p[24usize]);
-    let v1268: f64 = v423.mul_add(v1251, v1255);
-    let v1269: f64 = v1268 + v1097;
-    let v1270: f64 = v421.mul_add(v1169, v1269);
-    let v1271: f64 = v418.mul_add(v1177, v1270);
-    let v1272: f64 = p[23usize].mul_add(v1258, v1271);
-    let v1273: f64 = p[21usize].mul_add(v1264, v1272);
-    let v1274: f64 = qd[2usize].mul_add(v1267, v1273);
-    let v1276: f64 = v742 * v742;
-    let v1277: f64 = (-0.5f64) * v1276;
-    let v1278: f64 = v1277 * v746;
-    let v1279: f64 = p[94usize] * v1278;
-    let v1280: f64 = p[27usize] * v1279;
-    let v1282: f64 = p[95usize] * v743;
-    let v1283: f64 = v1282 * v1277;
-    let v1284: f64 = v446 * v1283;
-    let v1287: f64 = p[96usize] + q[3usize];
-    let v1288: f64 = v1088 * v459;
-    let v1290: f64 = p[97usize] * q[3usize];
-    let v1291: f64 = v1290 * v49;
-    let v1292: f64 = v1093.mul_add(v461, v1288);
-    let v1293: f64 = (-v1291).mul_add(v1277, v1292);
-    let v1295: f64 = 0.5f64 * v742;
-    let v1296: f64 = v1295.mul_add(v749, p[30usize]);
-    let v1297: f64 = v455.mul_add(v1280, v1284);
-    let v1298: f64 = v1297 + v1067;
-    let v1299: f64 = v453.mul_add(v1168, v1298);
-    let v1300: f64 = v450.mul_add(v1176, v1299);
-    let v1301: f64 = p[29usize].mul_add(v1287, v1300);
-    let v1302: f64 = p[27usize].mul_add(v1293, v1301);
-    let v1303: f64 = qd[3usize].mul_add(v1296, v1302);
-    let v1305: f64 = v754 * v754;
-    let v1306: f64 = (-0.5f64) * v1305;
-    let v1307: f64 = v1306 * v758;
-    let v1308: f64 = p[98usize] * v1307;
-    let v1309: f64 = p[33usize] * v1308;
-    let v1311: f64 = p[99usize] * v755;
-    let v1312: f64 = v1311 * v1306;
-    let v1313: f64 = v478 * v1312;
-    let v1316: f64 = p[100usize] + q[4usize];
-    let v1317: f64 = v1058 * v491;
-    let v1319: f64 = p[101usize] * q[4usize];
-    let v1320: f64 = v1319 * v61;
-    let v1321: f64 = v1063.mul_add(v493, v1317);
-    let v1322: f64 = (-v1320).mul_add(v1306, v1321);
-    let v1324: f64 = 0.5f64 * v754;
-    let v1325: f64 = v1324.mul_add(v761, p[36usize]);
-    let v1326: f64 = v487.mul_add(v1309, v1313);
-    let v1327: f64 = v1326 + v1037;
-    let v1328: f64 = v485.mul_add(v1167, v1327);
-    let v1329: f64 = v482.mul_add(v1175, v1328);
-    let v1330: f64 = p[35usize].mul_add(v1316, v1329);
-    let v1331: f64 = p[33usize].mul_add(v1322, v1330);
-    let v1332: f64 = qd[4usize].mul_add(v1325, v1331);
-    let v1334: f64 = v766 * v766;
-    let v1335: f64 = (-0.5f64) * v1334;
-    let v1336: f64 = v1335 * v770;
-    let v1337: f64 = p[102usize] * v1336;
-    let v1338: f64 = p[39usize] * v1337;
-    let v1340: f64 = p[103usize] * v767;
-    let v1341: f64 = v1340 * v1335;
-    let v1342: f64 = v510 * v1341;
-    let v1345: f64 = p[104usize] + q[5usize];
-    let v1346: f64 = v1028 * v523;
-    let v1348: f64 = p[105usize] * q[5usize];
-    let v1349: f64 = v1348 * v73;
-    let v1350: f64 = v1033.mul_add(v525, v1346);
-    let v1351: f64 = (-v1349).mul_add(v1335, v1350);
-    let v1353: f64 = 0.5f64 * v766;
-    let v1354: f64 = v1353.mul_add(v773, p[42usize]);
-    let v1355: f64 = v519.mul_add(v1338, v1342);
-    let v1356: f64 = v1355 + v1007;
-    let v1357: f64 = v517.mul_add(v1166, v1356);
-    let v1358: f64 = v514.mul_add(v1174, v1357);
-    let v1359: f64 = p[41usize].mul_add(v1345, v1358);
-    let v1360: f64 = p[39usize].mul_add(v1351, v1359);
-    let v1361: f64 = qd[5usize].mul_add(v1354, v1360);
-    let v1363: f64 = v778 * v778;
-    let v1364: f64 = (-0.5f64) * v1363;
-    let v1365: f64 = v1364 * v782;
-    let v1366: f64 = p[106usize] * v1365;
-    let v1367: f64 = p[45usize] * v1366;
-    let v1369: f64 = p[107usize] * v779;
-    let v1370: f64 = v1369 * v1364;
-    let v1371: f64 = v542 * v1370;
-    let v1374: f64 = p[108usize] + q[6usize];
-    let v1375: f64 = v998 * v555;
-    let v1377: f64 = p[109usize] * q[6usize];
-    let v1378: f64 = v1377 * v85;
-    let v1379: f64 = v1003.mul_add(v557, v1375);
-    let v1380: f64 = (-v1378).mul_add(v1364, v1379);
-    let v1382: f64 = 0.5f64 * v778;
-    let v1383: f64 = v1382.mul_add(v785, p[48usize]);
-    let v1384: f64 = v551.mul_add(v1367, v1371);
-    let v1385: f64 = v1384 + v977;
-    let v1386: f64 = v549.mul_add(v1165, v1385);
-    let v1387: f64 = v546.mul_add(v1173, v1386);
-    let v1388: f64 = p[47usize].mul_add(v1374, v1387);
-    let v1389: f64 = p[45usize].mul_add(v1380, v1388);
-    let v1390: f64 = qd[6usize].mul_add(v1383, v1389);
-    let v1392: f64 = v790 * v790;
-    let v1393: f64 = (-0.5f64) * v1392;
-    let v1394: f64 = v1393 * v794;
-    let v1395: f64 = p[110usize] * v1394;
-    let v1396: f64 = p[51usize] * v1395;
-    let v1398: f64 = p[111usize] * v791;
-    let v1399: f64 = v1398 * v1393;
-    let v1400: f64 = v574 * v1399;
-    let v1403: f64 = p[112usize] + q[7usize];
-    let v1404: f64 = v968 * v590;
-    let v1406: f64 = p[113usize] * q[7usize];
-    let v1407: f64 = v1406 * v97;
-    let v1408: f64 = v973.mul_add(v592, v1404);
-    let v1409: f64 = (-v1407).mul_add(v1393, v1408);
-    let v1410: f64 = v904 * v578;
-    let v1411: f64 = v944.mul_add(v581, v1410);
-    let v1413: f64 = 0.5f64 * v790;
-    let v1414: f64 = v1413.mul_add(v797, p[54usize]);
-    let v1415: f64 = v586.mul_add(v1396, v1400);
-    let v1416: f64 = p[53usize].mul_add(v1403, v1415);
-    let v1417: f64 = p[51usize].mul_add(v1409, v1416);
-    let v1418: f64 = p[7usize].mul_add(v1411, v1417);
-    let v1419: f64 = qd[7usize].mul_add(v1414, v1418);
-    out[0usize] = v380;
-    out[1usize] = v412;
-    out[2usize] = v444;
-    out[3usize] = v476;
-    out[4usize] = v508;
-    out[5usize] = v540;
-    out[6usize] = v572;
-    out[7usize] = v602;
-    out[8usize] = v610;
-    out[9usize] = v612;
-    out[10usize] = v614;
-    out[11usize] = v616;
-    out[12usize] = v618;
-    out[13usize] = v620;
-    out[14usize] = v622;
-    out[15usize] = v630;
-    out[16usize] = v632;
-    out[17usize] = v634;
-    out[18usize] = v636;
-    out[19usize] = v638;
-    out[20usize] = v640;
-    out[21usize] = v648;
-    out[22usize] = v650;
-    out[23usize] = v652;
-    out[24usize] = v654;
-    out[25usize] = v656;
-    out[26usize] = v664;
-    out[27usize] = v666;
-    out[28usize] = v668;
-    out[29usize] = v670;
-    out[30usize] = v678;
-    out[31usize] = v680;
-    out[32usize] = v682;
-    out[33usize] = v690;
-    out[34usize] = v692;
-    out[35usize] = v699;
-    out[36usize] = v1216;
-    out[37usize] = v1245;
-    out[38usize] = v1274;
-    out[39usize] = v1303;
-    out[40usize] = v1332;
-    out[41usize] = v1361;
-    out[42usize] = v1390;
-    out[43usize] = v1419;
+    out2[0usize] = v380;
+    out2[1usize] = v414;
+    out2[2usize] = v457;
+    out2[3usize] = v506;
+    out2[4usize] = v562;
+    out2[5usize] = v626;
+    out2[6usize] = v699;
+    out2[7usize] = v780;
+    out2[8usize] = v423;
+    out2[9usize] = v459;
+    out2[10usize] = v508;
+    out2[11usize] = v564;
+    out2[12usize] = v628;
+    out2[13usize] = v701;
+    out2[14usize] = v782;
+    out2[15usize] = v472;
+    out2[16usize] = v513;
+    out2[17usize] = v570;
+    out2[18usize] = v634;
+    out2[19usize] = v707;
+    out2[20usize] = v788;
+    out2[21usize] = v528;
+    out2[22usize] = v575;
+    out2[23usize] = v640;
+    out2[24usize] = v713;
+    out2[25usize] = v794;
+    out2[26usize] = v592;
+    out2[27usize] = v646;
+    out2[28usize] = v720;
+    out2[29usize] = v801;
+    out2[30usize] = v665;
+    out2[31usize] = v727;
+    out2[32usize] = v809;
+    out2[33usize] = v748;
+    out2[34usize] = v817;
+    out2[35usize] = v839;
+    out2[36usize] = v1382;
+    out2[37usize] = v1412;
+    out2[38usize] = v1443;
+    out2[39usize] = v1475;
+    out2[40usize] = v1508;
+    out2[41usize] = v1542;
+    out2[42usize] = v1577;
+    out2[43usize] = v1589;
 }
 /// Kernel `derived`: 100 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
@@ -3146,8 +1888,8 @@ pub fn derived(
     unsafe { derived_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
     q: &[f64; 8usize],
@@ -3359,8 +2101,8 @@ pub fn constraints(
     unsafe { constraints_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
     q: &[f64; 8usize],
@@ -3387,8 +2129,8 @@ pub fn contact(
     unsafe { contact_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
     q: &[f64; 8usize],
@@ -3427,8 +2169,8 @@ pub fn contact_jvp(
     unsafe { contact_jvp_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
     q: &[f64; 8usize],
@@ -3590,8 +2332,8 @@ pub fn cell_0_pose(
     unsafe { cell_0_pose_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
     q: &[f64; 1usize],
@@ -3706,8 +2448,8 @@ pub fn cell_0(
     unsafe { cell_0_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
     q: &[f64; 1usize],
@@ -3865,8 +2607,8 @@ pub fn cell_0_tangent(
     unsafe { cell_0_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
     q: &[f64; 1usize],

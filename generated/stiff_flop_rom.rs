@@ -426,8 +426,8 @@ pub fn accel(
     unsafe { accel_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn accel_0(
     t: f64,
     q: &[f64; 16usize],
@@ -454,8 +454,8 @@ pub fn derived(
     unsafe { derived_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
     q: &[f64; 16usize],
@@ -2296,8 +2296,8 @@ pub fn constraints(
     unsafe { constraints_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
     q: &[f64; 16usize],
@@ -2324,8 +2324,8 @@ pub fn contact(
     unsafe { contact_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
     q: &[f64; 16usize],
@@ -2364,8 +2364,8 @@ pub fn contact_jvp(
     unsafe { contact_jvp_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
     q: &[f64; 16usize],
@@ -2609,8 +2609,8 @@ pub fn cell_0_pose(
     unsafe { cell_0_pose_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
     q: &[f64; 4usize],
@@ -2864,8 +2864,8 @@ pub fn cell_0(
     unsafe { cell_0_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
     q: &[f64; 4usize],
@@ -4254,8 +4254,8 @@ pub fn cell_0_tangent(
     unsafe { cell_0_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
     q: &[f64; 4usize],
@@ -5817,8 +5817,8 @@ pub fn link_forces(
     unsafe { link_forces_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn link_forces_0(
     t: f64,
     q: &[f64; 16usize],
@@ -5903,8 +5903,8 @@ pub fn link_forces_tangent(
     unsafe { link_forces_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn link_forces_tangent_0(
     t: f64,
     q: &[f64; 16usize],
@@ -6029,8 +6029,8 @@ pub fn link_energy(
     unsafe { link_energy_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn link_energy_0(
     t: f64,
     q: &[f64; 16usize],
@@ -6070,8 +6070,8 @@ pub fn link_loads(
     unsafe { link_loads_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn link_loads_0(
     t: f64,
     q: &[f64; 16usize],

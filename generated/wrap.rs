@@ -271,7 +271,7 @@ fn contact_jacobian_framed(
         }
     }
 }
-/// Kernel `accel`: 3820 operations in 1 chunk(s).
+/// Kernel `accel`: the first 252 values of `eom` (3820 operations for all).
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
@@ -284,12 +284,11 @@ pub fn accel(
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
-    unsafe { accel_0(t, q, qd, qdd, dir, p, w, out) };
+    unsafe { accel_fma(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn accel_0(
+fn accel_fma(
     t: f64,
     q: &[f64; 12usize],
     qd: &[f64; 12usize],
@@ -298,6 +297,52 @@ fn accel_0(
     p: &[f64; 267usize],
     w: &mut [f64; 0usize],
     out: &mut [f64; 252usize],
+) {
+    let mut unused = [0.0f64; 90usize];
+    eom_0(t, q, qd, qdd, dir, p, w, out, &mut unused);
+}
+/// Kernel `mass_bias`: the last 90 values of `eom` (3820 operations for all).
+#[allow(unused_unsafe)]
+pub fn mass_bias(
+    t: f64,
+    q: &[f64; 12usize],
+    qd: &[f64; 12usize],
+    qdd: &[f64; 12usize],
+    dir: &[f64; 24usize],
+    p: &[f64; 267usize],
+    out: &mut [f64; 90usize],
+) {
+    runtime::cpu::require_fma();
+    let w = &mut [0.0f64; 0];
+    unsafe { mass_bias_fma(t, q, qd, qdd, dir, p, w, out) };
+}
+#[inline(never)]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+fn mass_bias_fma(
+    t: f64,
+    q: &[f64; 12usize],
+    qd: &[f64; 12usize],
+    qdd: &[f64; 12usize],
+    dir: &[f64; 24usize],
+    p: &[f64; 267usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 90usize],
+) {
+    let mut unused = [0.0f64; 252usize];
+    eom_0(t, q, qd, qdd, dir, p, w, &mut unused, out);
+}
+#[inline(always)]
+#[allow(unused_variables, clippy::all)]
+fn eom_0(
+    t: f64,
+    q: &[f64; 12usize],
+    qd: &[f64; 12usize],
+    qdd: &[f64; 12usize],
+    dir: &[f64; 24usize],
+    p: &[f64; 267usize],
+    w: &mut [f64; 0usize],
+    out: &mut [f64; 252usize],
+    out2: &mut [f64; 90usize],
 ) {
     let [v3, v479, v2209]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
         3usize,
@@ -3075,2037 +3120,96 @@ fn accel_0(
     out[249usize] = 0f64;
     out[250usize] = 0f64;
     out[251usize] = 1f64;
-}
-/// Kernel `mass_bias`: 2842 operations in 1 chunk(s).
-#[allow(unused_unsafe)]
-pub fn mass_bias(
-    t: f64,
-    q: &[f64; 12usize],
-    qd: &[f64; 12usize],
-    qdd: &[f64; 12usize],
-    dir: &[f64; 24usize],
-    p: &[f64; 267usize],
-    out: &mut [f64; 90usize],
-) {
-    runtime::cpu::require_fma();
-    let w = &mut [0.0f64; 0];
-    unsafe { mass_bias_0(t, q, qd, qdd, dir, p, w, out) };
-}
-#[inline(never)]
-#[allow(unused_variables, clippy::all)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-fn mass_bias_0(
-    t: f64,
-    q: &[f64; 12usize],
-    qd: &[f64; 12usize],
-    qdd: &[f64; 12usize],
-    dir: &[f64; 24usize],
-    p: &[f64; 267usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 90usize],
-) {
-    let [v3, v479, v1768]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[0usize]);
-    let v5: f64 = 2f64 * v3;
-    let v7: f64 = 0.5f64 * q[0usize];
-    let [v8, v476, v1210]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v7);
-    let v9: f64 = v8.powi(4i32);
-    let v11: f64 = q[0usize] * q[0usize];
-    let v12: f64 = v3 * v3;
-    let v13: f64 = (-0.25f64).mul_add(v9, v5);
-    let v14: f64 = (-v11).mul_add(v12, v13);
-    let v15: f64 = p[82usize].mul_add(v14, p[9usize]);
-    let [v19, v536, v1715]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[1usize]);
-    let v20: f64 = 2f64 * v19;
-    let v21: f64 = 0.5f64 * q[1usize];
-    let [v22, v526, v1220]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v21);
-    let v23: f64 = v22.powi(4i32);
-    let v24: f64 = q[1usize] * q[1usize];
-    let v25: f64 = v19 * v19;
-    let v26: f64 = (-0.25f64).mul_add(v23, v20);
-    let v27: f64 = (-v24).mul_add(v25, v26);
-    let [v31, v568, v1675]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[2usize]);
-    let v32: f64 = 2f64 * v31;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let [v34, v558, v1235]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v33);
-    let v35: f64 = v34.powi(4i32);
-    let v36: f64 = q[2usize] * q[2usize];
-    let v37: f64 = v31 * v31;
-    let v38: f64 = (-0.25f64).mul_add(v35, v32);
-    let v39: f64 = (-v36).mul_add(v37, v38);
-    let [v43, v600, v1646]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[3usize]);
-    let v44: f64 = 2f64 * v43;
-    let v45: f64 = 0.5f64 * q[3usize];
-    let [v46, v590, v1249]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v45);
-    let v47: f64 = v46.powi(4i32);
-    let v48: f64 = q[3usize] * q[3usize];
-    let v49: f64 = v43 * v43;
-    let v50: f64 = (-0.25f64).mul_add(v47, v44);
-    let v51: f64 = (-v48).mul_add(v49, v50);
-    let [v55, v632, v1617]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[4usize]);
-    let v56: f64 = 2f64 * v55;
-    let v57: f64 = 0.5f64 * q[4usize];
-    let [v58, v622, v1263]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v57);
-    let v59: f64 = v58.powi(4i32);
-    let v60: f64 = q[4usize] * q[4usize];
-    let v61: f64 = v55 * v55;
-    let v62: f64 = (-0.25f64).mul_add(v59, v56);
-    let v63: f64 = (-v60).mul_add(v61, v62);
-    let [v67, v664, v1588]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[5usize]);
-    let v68: f64 = 2f64 * v67;
-    let v69: f64 = 0.5f64 * q[5usize];
-    let [v70, v654, v1277]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v69);
-    let v71: f64 = v70.powi(4i32);
-    let v72: f64 = q[5usize] * q[5usize];
-    let v73: f64 = v67 * v67;
-    let v74: f64 = (-0.25f64).mul_add(v71, v68);
-    let v75: f64 = (-v72).mul_add(v73, v74);
-    let [v79, v696, v1559]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[6usize]);
-    let v80: f64 = 2f64 * v79;
-    let v81: f64 = 0.5f64 * q[6usize];
-    let [v82, v686, v1291]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v81);
-    let v83: f64 = v82.powi(4i32);
-    let v84: f64 = q[6usize] * q[6usize];
-    let v85: f64 = v79 * v79;
-    let v86: f64 = (-0.25f64).mul_add(v83, v80);
-    let v87: f64 = (-v84).mul_add(v85, v86);
-    let [v91, v728, v1530]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[7usize]);
-    let v92: f64 = 2f64 * v91;
-    let v93: f64 = 0.5f64 * q[7usize];
-    let [v94, v718, v1305]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v93);
-    let v95: f64 = v94.powi(4i32);
-    let v96: f64 = q[7usize] * q[7usize];
-    let v97: f64 = v91 * v91;
-    let v98: f64 = (-0.25f64).mul_add(v95, v92);
-    let v99: f64 = (-v96).mul_add(v97, v98);
-    let [v103, v760, v1501]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[8usize]);
-    let v104: f64 = 2f64 * v103;
-    let v105: f64 = 0.5f64 * q[8usize];
-    let [v106, v750, v1319]: [f64; 3usize] = runtime::special::sinc_orders::<
-        3usize,
-    >(v105);
-    let v107: f64 = v106.powi(4i32);
-    let v108: f64 = q[8usize] * q[8usize];
-    let v109: f64 = v103 * v103;
-    let v110: f64 = (-0.25f64).mul_add(v107, v104);
-    let v111: f64 = (-v108).mul_add(v109, v110);
-    let [v115, v792, v1472]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[9usize]);
-    let v116: f64 = 2f64 * v115;
-    let v117: f64 = 0.5f64 * q[9usize];
-    let [v118, v782, v1333]: [f64; 3usize] = runtime::special::sinc_orders::<
-        3usize,
-    >(v117);
-    let v119: f64 = v118.powi(4i32);
-    let v120: f64 = q[9usize] * q[9usize];
-    let v121: f64 = v115 * v115;
-    let v122: f64 = (-0.25f64).mul_add(v119, v116);
-    let v123: f64 = (-v120).mul_add(v121, v122);
-    let [v127, v824, v1443]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[10usize]);
-    let v128: f64 = 2f64 * v127;
-    let v129: f64 = 0.5f64 * q[10usize];
-    let [v130, v814, v1347]: [f64; 3usize] = runtime::special::sinc_orders::<
-        3usize,
-    >(v129);
-    let v131: f64 = v130.powi(4i32);
-    let v132: f64 = q[10usize] * q[10usize];
-    let v133: f64 = v127 * v127;
-    let v134: f64 = (-0.25f64).mul_add(v131, v128);
-    let v135: f64 = (-v132).mul_add(v133, v134);
-    let [v139, v849, v1356]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[11usize]);
-    let v140: f64 = 2f64 * v139;
-    let v141: f64 = 0.5f64 * q[11usize];
-    let [v142, v845, v1369]: [f64; 3usize] = runtime::special::sinc_orders::<
-        3usize,
-    >(v141);
-    let v143: f64 = v142.powi(4i32);
-    let v144: f64 = q[11usize] * q[11usize];
-    let v145: f64 = v139 * v139;
-    let v146: f64 = (-0.25f64).mul_add(v143, v140);
-    let v147: f64 = (-v144).mul_add(v145, v146);
-    let (v153, v154): (f64, f64) = runtime::special::sin_cos(v7);
-    let v155: f64 = p[94usize] * v153;
-    let v156: f64 = p[95usize].mul_add(v154, -v155);
-    let v157: f64 = p[7usize] * v8;
-    let v158: f64 = v157.mul_add(v156, p[3usize]);
-    let v160: f64 = p[95usize] * v153;
-    let v161: f64 = p[94usize].mul_add(v154, v160);
-    let v162: f64 = v156 * v153;
-    let v163: f64 = v161.mul_add(v154, v162);
-    let v164: f64 = v161 * v153;
-    let v165: f64 = v156.mul_add(v154, -v164);
-    let (v166, v167): (f64, f64) = runtime::special::sin_cos(v21);
-    let v168: f64 = v163 * v166;
-    let v169: f64 = v165.mul_add(v167, -v168);
-    let v170: f64 = p[13usize] * v22;
-    let v171: f64 = v170.mul_add(v169, v158);
-    let v173: f64 = v165 * v166;
-    let v174: f64 = v163.mul_add(v167, v173);
-    let v175: f64 = v169 * v166;
-    let v176: f64 = v174.mul_add(v167, v175);
-    let v177: f64 = v174 * v166;
-    let v178: f64 = v169.mul_add(v167, -v177);
-    let (v179, v180): (f64, f64) = runtime::special::sin_cos(v33);
-    let v181: f64 = v176 * v179;
-    let v182: f64 = v178.mul_add(v180, -v181);
-    let v183: f64 = p[19usize] * v34;
-    let v184: f64 = v183.mul_add(v182, v171);
-    let v186: f64 = v178 * v179;
-    let v187: f64 = v176.mul_add(v180, v186);
-    let v188: f64 = v182 * v179;
-    let v189: f64 = v187.mul_add(v180, v188);
-    let v190: f64 = v187 * v179;
-    let v191: f64 = v182.mul_add(v180, -v190);
-    let (v192, v193): (f64, f64) = runtime::special::sin_cos(v45);
-    let v194: f64 = v189 * v192;
-    let v195: f64 = v191.mul_add(v193, -v194);
-    let v196: f64 = p[25usize] * v46;
-    let v197: f64 = v196.mul_add(v195, v184);
-    let v199: f64 = v191 * v192;
-    let v200: f64 = v189.mul_add(v193, v199);
-    let v201: f64 = v195 * v192;
-    let v202: f64 = v200.mul_add(v193, v201);
-    let v203: f64 = v200 * v192;
-    let v204: f64 = v195.mul_add(v193, -v203);
-    let (v205, v206): (f64, f64) = runtime::special::sin_cos(v57);
-    let v207: f64 = v202 * v205;
-    let v208: f64 = v204.mul_add(v206, -v207);
-    let v209: f64 = p[31usize] * v58;
-    let v210: f64 = v209.mul_add(v208, v197);
-    let v212: f64 = v204 * v205;
-    let v213: f64 = v202.mul_add(v206, v212);
-    let v214: f64 = v208 * v205;
-    let v215: f64 = v213.mul_add(v206, v214);
-    let v216: f64 = v213 * v205;
-    let v217: f64 = v208.mul_add(v206, -v216);
-    let (v218, v219): (f64, f64) = runtime::special::sin_cos(v69);
-    let v220: f64 = v215 * v218;
-    let v221: f64 = v217.mul_add(v219, -v220);
-    let v222: f64 = p[37usize] * v70;
-    let v223: f64 = v222.mul_add(v221, v210);
-    let v225: f64 = v217 * v218;
-    let v226: f64 = v215.mul_add(v219, v225);
-    let v227: f64 = v221 * v218;
-    let v228: f64 = v226.mul_add(v219, v227);
-    let v229: f64 = v226 * v218;
-    let v230: f64 = v221.mul_add(v219, -v229);
-    let (v231, v232): (f64, f64) = runtime::special::sin_cos(v81);
-    let v233: f64 = v228 * v231;
-    let v234: f64 = v230.mul_add(v232, -v233);
-    let v235: f64 = p[43usize] * v82;
-    let v236: f64 = v235.mul_add(v234, v223);
-    let v238: f64 = v230 * v231;
-    let v239: f64 = v228.mul_add(v232, v238);
-    let v240: f64 = v234 * v231;
-    let v241: f64 = v239.mul_add(v232, v240);
-    let v242: f64 = v239 * v231;
-    let v243: f64 = v234.mul_add(v232, -v242);
-    let (v244, v245): (f64, f64) = runtime::special::sin_cos(v93);
-    let v246: f64 = v241 * v244;
-    let v247: f64 = v243.mul_add(v245, -v246);
-    let v248: f64 = p[49usize] * v94;
-    let v249: f64 = v248.mul_add(v247, v236);
-    let v251: f64 = v243 * v244;
-    let v252: f64 = v241.mul_add(v245, v251);
-    let v253: f64 = v247 * v244;
-    let v254: f64 = v252.mul_add(v245, v253);
-    let v255: f64 = v252 * v244;
-    let v256: f64 = v247.mul_add(v245, -v255);
-    let (v257, v258): (f64, f64) = runtime::special::sin_cos(v105);
-    let v259: f64 = v254 * v257;
-    let v260: f64 = v256.mul_add(v258, -v259);
-    let v261: f64 = p[55usize] * v106;
-    let v262: f64 = v261.mul_add(v260, v249);
-    let v264: f64 = v256 * v257;
-    let v265: f64 = v254.mul_add(v258, v264);
-    let v266: f64 = v260 * v257;
-    let v267: f64 = v265.mul_add(v258, v266);
-    let v268: f64 = v265 * v257;
-    let v269: f64 = v260.mul_add(v258, -v268);
-    let (v270, v271): (f64, f64) = runtime::special::sin_cos(v117);
-    let v272: f64 = v267 * v270;
-    let v273: f64 = v269.mul_add(v271, -v272);
-    let v274: f64 = p[61usize] * v118;
-    let v275: f64 = v274.mul_add(v273, v262);
-    let v277: f64 = v269 * v270;
-    let v278: f64 = v267.mul_add(v271, v277);
-    let v279: f64 = v273 * v270;
-    let v280: f64 = v278.mul_add(v271, v279);
-    let v281: f64 = v278 * v270;
-    let v282: f64 = v273.mul_add(v271, -v281);
-    let (v283, v284): (f64, f64) = runtime::special::sin_cos(v129);
-    let v285: f64 = v280 * v283;
-    let v286: f64 = v282.mul_add(v284, -v285);
-    let v287: f64 = p[67usize] * v130;
-    let v288: f64 = v287.mul_add(v286, v275);
-    let v289: f64 = v282 * v283;
-    let v290: f64 = v280.mul_add(v284, v289);
-    let v291: f64 = v290 * v283;
-    let v292: f64 = v286.mul_add(v284, -v291);
-    let v294: f64 = v142 * v142;
-    let v295: f64 = p[96usize] * v294;
-    let v296: f64 = v286 * v283;
-    let v297: f64 = v290.mul_add(v284, v296);
-    let v299: f64 = p[73usize] * q[11usize];
-    let v300: f64 = v299 * v139;
-    let v301: f64 = v292.mul_add(v295, v288);
-    let v302: f64 = (-v297).mul_add(v300, v301);
-    let v304: f64 = v157.mul_add(v161, p[4usize]);
-    let v305: f64 = v170.mul_add(v174, v304);
-    let v306: f64 = v183.mul_add(v187, v305);
-    let v307: f64 = v196.mul_add(v200, v306);
-    let v308: f64 = v209.mul_add(v213, v307);
-    let v309: f64 = v222.mul_add(v226, v308);
-    let v310: f64 = v235.mul_add(v239, v309);
-    let v311: f64 = v248.mul_add(v252, v310);
-    let v312: f64 = v261.mul_add(v265, v311);
-    let v313: f64 = v274.mul_add(v278, v312);
-    let v314: f64 = v287.mul_add(v290, v313);
-    let v315: f64 = v297.mul_add(v295, v314);
-    let v316: f64 = v292.mul_add(v300, v315);
-    let v317: f64 = v316 * v316;
-    let v318: f64 = v302.mul_add(v302, v317);
-    let v319: f64 = p[93usize].mul_add(v147, p[75usize]);
-    let v320: f64 = p[74usize].mul_add(v318, v319);
-    let v323: f64 = v130 * v130;
-    let v324: f64 = p[97usize] * v323;
-    let v325: f64 = p[67usize] * q[10usize];
-    let v326: f64 = v325 * v127;
-    let v327: f64 = v282.mul_add(v324, v275);
-    let v328: f64 = (-v280).mul_add(v326, v327);
-    let v329: f64 = v280.mul_add(v324, v313);
-    let v330: f64 = v282.mul_add(v326, v329);
-    let v331: f64 = v330 * v330;
-    let v332: f64 = v328.mul_add(v328, v331);
-    let v333: f64 = p[92usize].mul_add(v135, p[69usize]);
-    let v334: f64 = v333 + v320;
-    let v335: f64 = p[68usize].mul_add(v332, v334);
-    let v338: f64 = v118 * v118;
-    let v339: f64 = p[98usize] * v338;
-    let v340: f64 = p[61usize] * q[9usize];
-    let v341: f64 = v340 * v115;
-    let v342: f64 = v269.mul_add(v339, v262);
-    let v343: f64 = (-v267).mul_add(v341, v342);
-    let v344: f64 = v267.mul_add(v339, v312);
-    let v345: f64 = v269.mul_add(v341, v344);
-    let v346: f64 = v345 * v345;
-    let v347: f64 = v343.mul_add(v343, v346);
-    let v348: f64 = p[91usize].mul_add(v123, p[63usize]);
-    let v349: f64 = v348 + v335;
-    let v350: f64 = p[62usize].mul_add(v347, v349);
-    let v353: f64 = v106 * v106;
-    let v354: f64 = p[99usize] * v353;
-    let v355: f64 = p[55usize] * q[8usize];
-    let v356: f64 = v355 * v103;
-    let v357: f64 = v256.mul_add(v354, v249);
-    let v358: f64 = (-v254).mul_add(v356, v357);
-    let v359: f64 = v254.mul_add(v354, v311);
-    let v360: f64 = v256.mul_add(v356, v359);
-    let v361: f64 = v360 * v360;
-    let v362: f64 = v358.mul_add(v358, v361);
-    let v363: f64 = p[90usize].mul_add(v111, p[57usize]);
-    let v364: f64 = v363 + v350;
-    let v365: f64 = p[56usize].mul_add(v362, v364);
-    let v368: f64 = v94 * v94;
-    let v369: f64 = p[100usize] * v368;
-    let v370: f64 = p[49usize] * q[7usize];
-    let v371: f64 = v370 * v91;
-    let v372: f64 = v243.mul_add(v369, v236);
-    let v373: f64 = (-v241).mul_add(v371, v372);
-    let v374: f64 = v241.mul_add(v369, v310);
-    let v375: f64 = v243.mul_add(v371, v374);
-    let v376: f64 = v375 * v375;
-    let v377: f64 = v373.mul_add(v373, v376);
-    let v378: f64 = p[89usize].mul_add(v99, p[51usize]);
-    let v379: f64 = v378 + v365;
-    let v380: f64 = p[50usize].mul_add(v377, v379);
-    let v383: f64 = v82 * v82;
-    let v384: f64 = p[101usize] * v383;
-    let v385: f64 = p[43usize] * q[6usize];
-    let v386: f64 = v385 * v79;
-    let v387: f64 = v230.mul_add(v384, v223);
-    let v388: f64 = (-v228).mul_add(v386, v387);
-    let v389: f64 = v228.mul_add(v384, v309);
-    let v390: f64 = v230.mul_add(v386, v389);
-    let v391: f64 = v390 * v390;
-    let v392: f64 = v388.mul_add(v388, v391);
-    let v393: f64 = p[88usize].mul_add(v87, p[45usize]);
-    let v394: f64 = v393 + v380;
-    let v395: f64 = p[44usize].mul_add(v392, v394);
-    let v398: f64 = v70 * v70;
-    let v399: f64 = p[102usize] * v398;
-    let v400: f64 = p[37usize] * q[5usize];
-    let v401: f64 = v400 * v67;
-    let v402: f64 = v217.mul_add(v399, v210);
-    let v403: f64 = (-v215).mul_add(v401, v402);
-    let v404: f64 = v215.mul_add(v399, v308);
-    let v405: f64 = v217.mul_add(v401, v404);
-    let v406: f64 = v405 * v405;
-    let v407: f64 = v403.mul_add(v403, v406);
-    let v408: f64 = p[87usize].mul_add(v75, p[39usize]);
-    let v409: f64 = v408 + v395;
-    let v410: f64 = p[38usize].mul_add(v407, v409);
-    let v413: f64 = v58 * v58;
-    let v414: f64 = p[103usize] * v413;
-    let v415: f64 = p[31usize] * q[4usize];
-    let v416: f64 = v415 * v55;
-    let v417: f64 = v204.mul_add(v414, v197);
-    let v418: f64 = (-v202).mul_add(v416, v417);
-    let v419: f64 = v202.mul_add(v414, v307);
-    let v420: f64 = v204.mul_add(v416, v419);
-    let v421: f64 = v420 * v420;
-    let v422: f64 = v418.mul_add(v418, v421);
-    let v423: f64 = p[86usize].mul_add(v63, p[33usize]);
-    let v424: f64 = v423 + v410;
-    let v425: f64 = p[32usize].mul_add(v422, v424);
-    let v428: f64 = v46 * v46;
-    let v429: f64 = p[104usize] * v428;
-    let v430: f64 = p[25usize] * q[3usize];
-    let v431: f64 = v430 * v43;
-    let v432: f64 = v191.mul_add(v429, v184);
-    let v433: f64 = (-v189).mul_add(v431, v432);
-    let v434: f64 = v189.mul_add(v429, v306);
-    let v435: f64 = v191.mul_add(v431, v434);
-    let v436: f64 = v435 * v435;
-    let v437: f64 = v433.mul_add(v433, v436);
-    let v438: f64 = p[85usize].mul_add(v51, p[27usize]);
-    let v439: f64 = v438 + v425;
-    let v440: f64 = p[26usize].mul_add(v437, v439);
-    let v443: f64 = v34 * v34;
-    let v444: f64 = p[105usize] * v443;
-    let v445: f64 = p[19usize] * q[2usize];
-    let v446: f64 = v445 * v31;
-    let v447: f64 = v178.mul_add(v444, v171);
-    let v448: f64 = (-v176).mul_add(v446, v447);
-    let v449: f64 = v176.mul_add(v444, v305);
-    let v450: f64 = v178.mul_add(v446, v449);
-    let v451: f64 = v450 * v450;
-    let v452: f64 = v448.mul_add(v448, v451);
-    let v453: f64 = p[84usize].mul_add(v39, p[21usize]);
-    let v454: f64 = v453 + v440;
-    let v455: f64 = p[20usize].mul_add(v452, v454);
-    let v458: f64 = v22 * v22;
-    let v459: f64 = p[106usize] * v458;
-    let v460: f64 = v165 * v459;
-    let v461: f64 = p[13usize] * q[1usize];
-    let v462: f64 = v461 * v19;
-    let v463: f64 = v163 * v462;
-    let v464: f64 = v158 + v460;
-    let v465: f64 = v464 - v463;
-    let v466: f64 = v163 * v459;
-    let v467: f64 = v165 * v462;
-    let v468: f64 = v304 + v466;
-    let v469: f64 = v468 + v467;
-    let v470: f64 = v469 * v469;
-    let v471: f64 = v465.mul_add(v465, v470);
-    let v472: f64 = p[83usize].mul_add(v27, p[15usize]);
-    let v473: f64 = v472 + v455;
-    let v474: f64 = p[14usize].mul_add(v471, v473);
-    let v477: f64 = 0.5f64 * v476;
-    let v478: f64 = v157 * v477;
-    let v480: f64 = q[0usize].mul_add(v479, v3);
-    let v481: f64 = p[7usize] * v480;
-    let v482: f64 = p[95usize] * v481;
-    let v483: f64 = p[94usize].mul_add(v478, v482);
-    let v484: f64 = p[94usize] * v481;
-    let v485: f64 = p[95usize].mul_add(v478, -v484);
-    let v486: f64 = v485 * v485;
-    let v487: f64 = v483.mul_add(v483, v486);
-    let v488: f64 = v156 * v477;
-    let v489: f64 = 0.5f64 * v8;
-    let v490: f64 = (-v489).mul_add(v161, v488);
-    let v491: f64 = p[7usize].mul_add(v490, v304);
-    let v492: f64 = p[74usize] * v316;
-    let v493: f64 = p[68usize].mul_add(v330, v492);
-    let v494: f64 = p[62usize].mul_add(v345, v493);
-    let v495: f64 = p[56usize].mul_add(v360, v494);
-    let v496: f64 = p[50usize].mul_add(v375, v495);
-    let v497: f64 = p[44usize].mul_add(v390, v496);
-    let v498: f64 = p[38usize].mul_add(v405, v497);
-    let v499: f64 = p[32usize].mul_add(v420, v498);
-    let v500: f64 = p[26usize].mul_add(v435, v499);
-    let v501: f64 = p[20usize].mul_add(v450, v500);
-    let v502: f64 = p[14usize].mul_add(v469, v501);
-    let v503: f64 = 2f64 * v502;
-    let v505: f64 = v491.mul_add(p[107usize], -v503);
-    let v506: f64 = v161 * v477;
-    let v507: f64 = v489.mul_add(v156, v506);
-    let v508: f64 = p[7usize].mul_add(v507, -v158);
-    let v509: f64 = p[74usize] * v302;
-    let v510: f64 = p[68usize].mul_add(v328, v509);
-    let v511: f64 = p[62usize].mul_add(v343, v510);
-    let v512: f64 = p[56usize].mul_add(v358, v511);
-    let v513: f64 = p[50usize].mul_add(v373, v512);
-    let v514: f64 = p[44usize].mul_add(v388, v513);
-    let v515: f64 = p[38usize].mul_add(v403, v514);
-    let v516: f64 = p[32usize].mul_add(v418, v515);
-    let v517: f64 = p[26usize].mul_add(v433, v516);
-    let v518: f64 = p[20usize].mul_add(v448, v517);
-    let v519: f64 = p[14usize].mul_add(v465, v518);
-    let v520: f64 = v508 * p[107usize];
-    let v521: f64 = 2f64.mul_add(v519, v520);
-    let v522: f64 = 0.25f64.mul_add(v15, v474);
-    let v523: f64 = p[8usize].mul_add(v487, v522);
-    let v524: f64 = v491.mul_add(v505, v523);
-    let v525: f64 = v508.mul_add(v521, v524);
-    let v527: f64 = 0.5f64 * v526;
-    let v528: f64 = 0.5f64 * v22;
-    let v529: f64 = v528 * v169;
-    let v530: f64 = v174.mul_add(v527, v529);
-    let v531: f64 = p[13usize].mul_add(v530, -v171);
-    let v532: f64 = v528 * v174;
-    let v533: f64 = v169.mul_add(v527, -v532);
-    let v534: f64 = p[13usize].mul_add(v533, v305);
-    let v535: f64 = v170 * v527;
-    let v537: f64 = q[1usize].mul_add(v536, v19);
-    let v538: f64 = p[13usize] * v537;
-    let v539: f64 = v165 * v538;
-    let v540: f64 = v163.mul_add(v535, v539);
-    let v541: f64 = v163 * v538;
-    let v542: f64 = v165.mul_add(v535, -v541);
-    let v543: f64 = v469 * v542;
-    let v544: f64 = v465.mul_add(v540, -v543);
-    let v545: f64 = 0.5f64.mul_add(v472, v455);
-    let v546: f64 = v531.mul_add(v518, v545);
-    let v547: f64 = (-v534).mul_add(v501, v546);
-    let v548: f64 = p[14usize].mul_add(v544, v547);
-    let v550: f64 = v534 * p[108usize];
-    let v551: f64 = v550 - v501;
-    let v552: f64 = p[14usize].mul_add(v542, v551);
-    let v553: f64 = v531 * p[108usize];
-    let v554: f64 = v518 + v553;
-    let v555: f64 = p[14usize].mul_add(v540, v554);
-    let v556: f64 = v491.mul_add(v552, v548);
-    let v557: f64 = v508.mul_add(v555, v556);
-    let v559: f64 = 0.5f64 * v558;
-    let v560: f64 = 0.5f64 * v34;
-    let v561: f64 = v560 * v182;
-    let v562: f64 = v187.mul_add(v559, v561);
-    let v563: f64 = p[19usize].mul_add(v562, -v184);
-    let v564: f64 = v560 * v187;
-    let v565: f64 = v182.mul_add(v559, -v564);
-    let v566: f64 = p[19usize].mul_add(v565, v306);
-    let v567: f64 = v183 * v559;
-    let v569: f64 = q[2usize].mul_add(v568, v31);
-    let v570: f64 = p[19usize] * v569;
-    let v571: f64 = v178 * v570;
-    let v572: f64 = v176.mul_add(v567, v571);
-    let v573: f64 = v176 * v570;
-    let v574: f64 = v178.mul_add(v567, -v573);
-    let v575: f64 = v450 * v574;
-    let v576: f64 = v448.mul_add(v572, -v575);
-    let v577: f64 = 0.5f64.mul_add(v453, v440);
-    let v578: f64 = v563.mul_add(v517, v577);
-    let v579: f64 = (-v566).mul_add(v500, v578);
-    let v580: f64 = p[20usize].mul_add(v576, v579);
-    let v582: f64 = v566 * p[109usize];
-    let v583: f64 = v582 - v500;
-    let v584: f64 = p[20usize].mul_add(v574, v583);
-    let v585: f64 = v563 * p[109usize];
-    let v586: f64 = v517 + v585;
-    let v587: f64 = p[20usize].mul_add(v572, v586);
-    let v588: f64 = v491.mul_add(v584, v580);
-    let v589: f64 = v508.mul_add(v587, v588);
-    let v591: f64 = 0.5f64 * v590;
-    let v592: f64 = 0.5f64 * v46;
-    let v593: f64 = v592 * v195;
-    let v594: f64 = v200.mul_add(v591, v593);
-    let v595: f64 = p[25usize].mul_add(v594, -v197);
-    let v596: f64 = v592 * v200;
-    let v597: f64 = v195.mul_add(v591, -v596);
-    let v598: f64 = p[25usize].mul_add(v597, v307);
-    let v599: f64 = v196 * v591;
-    let v601: f64 = q[3usize].mul_add(v600, v43);
-    let v602: f64 = p[25usize] * v601;
-    let v603: f64 = v191 * v602;
-    let v604: f64 = v189.mul_add(v599, v603);
-    let v605: f64 = v189 * v602;
-    let v606: f64 = v191.mul_add(v599, -v605);
-    let v607: f64 = v435 * v606;
-    let v608: f64 = v433.mul_add(v604, -v607);
-    let v609: f64 = 0.5f64.mul_add(v438, v425);
-    let v610: f64 = v595.mul_add(v516, v609);
-    let v611: f64 = (-v598).mul_add(v499, v610);
-    let v612: f64 = p[26usize].mul_add(v608, v611);
-    let v614: f64 = v598 * p[110usize];
-    let v615: f64 = v614 - v499;
-    let v616: f64 = p[26usize].mul_add(v606, v615);
-    let v617: f64 = v595 * p[110usize];
-    let v618: f64 = v516 + v617;
-    let v619: f64 = p[26usize].mul_add(v604, v618);
-    let v620: f64 = v491.mul_add(v616, v612);
-    let v621: f64 = v508.mul_add(v619, v620);
-    let v623: f64 = 0.5f64 * v622;
-    let v624: f64 = 0.5f64 * v58;
-    let v625: f64 = v624 * v208;
-    let v626: f64 = v213.mul_add(v623, v625);
-    let v627: f64 = p[31usize].mul_add(v626, -v210);
-    let v628: f64 = v624 * v213;
-    let v629: f64 = v208.mul_add(v623, -v628);
-    let v630: f64 = p[31usize].mul_add(v629, v308);
-    let v631: f64 = v209 * v623;
-    let v633: f64 = q[4usize].mul_add(v632, v55);
-    let v634: f64 = p[31usize] * v633;
-    let v635: f64 = v204 * v634;
-    let v636: f64 = v202.mul_add(v631, v635);
-    let v637: f64 = v202 * v634;
-    let v638: f64 = v204.mul_add(v631, -v637);
-    let v639: f64 = v420 * v638;
-    let v640: f64 = v418.mul_add(v636, -v639);
-    let v641: f64 = 0.5f64.mul_add(v423, v410);
-    let v642: f64 = v627.mul_add(v515, v641);
-    let v643: f64 = (-v630).mul_add(v498, v642);
-    let v644: f64 = p[32usize].mul_add(v640, v643);
-    let v646: f64 = v630 * p[111usize];
-    let v647: f64 = v646 - v498;
-    let v648: f64 = p[32usize].mul_add(v638, v647);
-    let v649: f64 = v627 * p[111usize];
-    let v650: f64 = v515 + v649;
-    let v651: f64 = p[32usize].mul_add(v636, v650);
-    let v652: f64 = v491.mul_add(v648, v644);
-    let v653: f64 = v508.mul_add(v651, v652);
-    let v655: f64 = 0.5f64 * v654;
-    let v656: f64 = 0.5f64 * v70;
-    let v657: f64 = v656 * v221;
-    let v658: f64 = v226.mul_add(v655, v657);
-    let v659: f64 = p[37usize].mul_add(v658, -v223);
-    let v660: f64 = v656 * v226;
-    let v661: f64 = v221.mul_add(v655, -v660);
-    let v662: f64 = p[37usize].mul_add(v661, v309);
-    let v663: f64 = v222 * v655;
-    let v665: f64 = q[5usize].mul_add(v664, v67);
-    let v666: f64 = p[37usize] * v665;
-    let v667: f64 = v217 * v666;
-    let v668: f64 = v215.mul_add(v663, v667);
-    let v669: f64 = v215 * v666;
-    let v670: f64 = v217.mul_add(v663, -v669);
-    let v671: f64 = v405 * v670;
-    let v672: f64 = v403.mul_add(v668, -v671);
-    let v673: f64 = 0.5f64.mul_add(v408, v395);
-    let v674: f64 = v659.mul_add(v514, v673);
-    let v675: f64 = (-v662).mul_add(v497, v674);
-    let v676: f64 = p[38usize].mul_add(v672, v675);
-    let v678: f64 = v662 * p[112usize];
-    let v679: f64 = v678 - v497;
-    let v680: f64 = p[38usize].mul_add(v670, v679);
-    let v681: f64 = v659 * p[112usize];
-    let v682: f64 = v514 + v681;
-    let v683: f64 = p[38usize].mul_add(v668, v682);
-    let v684: f64 = v491.mul_add(v680, v676);
-    let v685: f64 = v508.mul_add(v683, v684);
-    let v687: f64 = 0.5f64 * v686;
-    let v688: f64 = 0.5f64 * v82;
-    let v689: f64 = v688 * v234;
-    let v690: f64 = v239.mul_add(v687, v689);
-    let v691: f64 = p[43usize].mul_add(v690, -v236);
-    let v692: f64 = v688 * v239;
-    let v693: f64 = v234.mul_add(v687, -v692);
-    let v694: f64 = p[43usize].mul_add(v693, v310);
-    let v695: f64 = v235 * v687;
-    let v697: f64 = q[6usize].mul_add(v696, v79);
-    let v698: f64 = p[43usize] * v697;
-    let v699: f64 = v230 * v698;
-    let v700: f64 = v228.mul_add(v695, v699);
-    let v701: f64 = v228 * v698;
-    let v702: f64 = v230.mul_add(v695, -v701);
-    let v703: f64 = v390 * v702;
-    let v704: f64 = v388.mul_add(v700, -v703);
-    let v705: f64 = 0.5f64.mul_add(v393, v380);
-    let v706: f64 = v691.mul_add(v513, v705);
-    let v707: f64 = (-v694).mul_add(v496, v706);
-    let v708: f64 = p[44usize].mul_add(v704, v707);
-    let v710: f64 = v694 * p[113usize];
-    let v711: f64 = v710 - v496;
-    let v712: f64 = p[44usize].mul_add(v702, v711);
-    let v713: f64 = v691 * p[113usize];
-    let v714: f64 = v513 + v713;
-    let v715: f64 = p[44usize].mul_add(v700, v714);
-    let v716: f64 = v491.mul_add(v712, v708);
-    let v717: f64 = v508.mul_add(v715, v716);
-    let v719: f64 = 0.5f64 * v718;
-    let v720: f64 = 0.5f64 * v94;
-    let v721: f64 = v720 * v247;
-    let v722: f64 = v252.mul_add(v719, v721);
-    let v723: f64 = p[49usize].mul_add(v722, -v249);
-    let v724: f64 = v720 * v252;
-    let v725: f64 = v247.mul_add(v719, -v724);
-    let v726: f64 = p[49usize].mul_add(v725, v311);
-    let v727: f64 = v248 * v719;
-    let v729: f64 = q[7usize].mul_add(v728, v91);
-    let v730: f64 = p[49usize] * v729;
-    let v731: f64 = v243 * v730;
-    let v732: f64 = v241.mul_add(v727, v731);
-    let v733: f64 = v241 * v730;
-    let v734: f64 = v243.mul_add(v727, -v733);
-    let v735: f64 = v375 * v734;
-    let v736: f64 = v373.mul_add(v732, -v735);
-    let v737: f64 = 0.5f64.mul_add(v378, v365);
-    let v738: f64 = v723.mul_add(v512, v737);
-    let v739: f64 = (-v726).mul_add(v495, v738);
-    let v740: f64 = p[50usize].mul_add(v736, v739);
-    let v742: f64 = v726 * p[114usize];
-    let v743: f64 = v742 - v495;
-    let v744: f64 = p[50usize].mul_add(v734, v743);
-    let v745: f64 = v723 * p[114usize];
-    let v746: f64 = v512 + v745;
-    let v747: f64 = p[50usize].mul_add(v732, v746);
-    let v748: f64 = v491.mul_add(v744, v740);
-    let v749: f64 = v508.mul_add(v747, v748);
-    let v751: f64 = 0.5f64 * v750;
-    let v752: f64 = 0.5f64 * v106;
-    let v753: f64 = v752 * v260;
-    let v754: f64 = v265.mul_add(v751, v753);
-    let v755: f64 = p[55usize].mul_add(v754, -v262);
-    let v756: f64 = v752 * v265;
-    let v757: f64 = v260.mul_add(v751, -v756);
-    let v758: f64 = p[55usize].mul_add(v757, v312);
-    let v759: f64 = v261 * v751;
-    let v761: f64 = q[8usize].mul_add(v760, v103);
-    let v762: f64 = p[55usize] * v761;
-    let v763: f64 = v256 * v762;
-    let v764: f64 = v254.mul_add(v759, v763);
-    let v765: f64 = v254 * v762;
-    let v766: f64 = v256.mul_add(v759, -v765);
-    let v767: f64 = v360 * v766;
-    let v768: f64 = v358.mul_add(v764, -v767);
-    let v769: f64 = 0.5f64.mul_add(v363, v350);
-    let v770: f64 = v755.mul_add(v511, v769);
-    let v771: f64 = (-v758).mul_add(v494, v770);
-    let v772: f64 = p[56usize].mul_add(v768, v771);
-    let v774: f64 = v758 * p[115usize];
-    let v775: f64 = v774 - v494;
-    let v776: f64 = p[56usize].mul_add(v766, v775);
-    let v777: f64 = v755 * p[115usize];
-    let v778: f64 = v511 + v777;
-    let v779: f64 = p[56usize].mul_add(v764, v778);
-    let v780: f64 = v491.mul_add(v776, v772);
-    let v781: f64 = v508.mul_add(v779, v780);
-    let v783: f64 = 0.5f64 * v782;
-    let v784: f64 = 0.5f64 * v118;
-    let v785: f64 = v784 * v273;
-    let v786: f64 = v278.mul_add(v783, v785);
-    let v787: f64 = p[61usize].mul_add(v786, -v275);
-    let v788: f64 = v784 * v278;
-    let v789: f64 = v273.mul_add(v783, -v788);
-    let v790: f64 = p[61usize].mul_add(v789, v313);
-    let v791: f64 = v274 * v783;
-    let v793: f64 = q[9usize].mul_add(v792, v115);
-    let v794: f64 = p[61usize] * v793;
-    let v795: f64 = v269 * v794;
-    let v796: f64 = v267.mul_add(v791, v795);
-    let v797: f64 = v267 * v794;
-    let v798: f64 = v269.mul_add(v791, -v797);
-    let v799: f64 = v345 * v798;
-    let v800: f64 = v343.mul_add(v796, -v799);
-    let v801: f64 = 0.5f64.mul_add(v348, v335);
-    let v802: f64 = v787.mul_add(v510, v801);
-    let v803: f64 = (-v790).mul_add(v493, v802);
-    let v804: f64 = p[62usize].mul_add(v800, v803);
-    let v806: f64 = v790 * p[116usize];
-    let v807: f64 = v806 - v493;
-    let v808: f64 = p[62usize].mul_add(v798, v807);
-    let v809: f64 = v787 * p[116usize];
-    let v810: f64 = v510 + v809;
-    let v811: f64 = p[62usize].mul_add(v796, v810);
-    let v812: f64 = v491.mul_add(v808, v804);
-    let v813: f64 = v508.mul_add(v811, v812);
-    let v815: f64 = 0.5f64 * v814;
-    let v816: f64 = 0.5f64 * v130;
-    let v817: f64 = v816 * v286;
-    let v818: f64 = v290.mul_add(v815, v817);
-    let v819: f64 = p[67usize].mul_add(v818, -v288);
-    let v820: f64 = v816 * v290;
-    let v821: f64 = v286.mul_add(v815, -v820);
-    let v822: f64 = p[67usize].mul_add(v821, v314);
-    let v823: f64 = v287 * v815;
-    let v825: f64 = q[10usize].mul_add(v824, v127);
-    let v826: f64 = p[67usize] * v825;
-    let v827: f64 = v282 * v826;
-    let v828: f64 = v280.mul_add(v823, v827);
-    let v829: f64 = v280 * v826;
-    let v830: f64 = v282.mul_add(v823, -v829);
-    let v831: f64 = v330 * v830;
-    let v832: f64 = v328.mul_add(v828, -v831);
-    let v833: f64 = 0.5f64.mul_add(v333, v320);
-    let v834: f64 = v819.mul_add(v509, v833);
-    let v835: f64 = (-v822).mul_add(v492, v834);
-    let v836: f64 = p[68usize].mul_add(v832, v835);
-    let v837: f64 = p[74usize] * v822;
-    let v838: f64 = v837 - v492;
-    let v839: f64 = p[68usize].mul_add(v830, v838);
-    let v840: f64 = p[74usize] * v819;
-    let v841: f64 = v509 + v840;
-    let v842: f64 = p[68usize].mul_add(v828, v841);
-    let v843: f64 = v491.mul_add(v839, v836);
-    let v844: f64 = v508.mul_add(v842, v843);
-    let v846: f64 = 0.5f64 * v845;
-    let v847: f64 = p[73usize] * v142;
-    let v848: f64 = v847 * v846;
-    let v850: f64 = q[11usize].mul_add(v849, v139);
-    let v851: f64 = p[73usize] * v850;
-    let v852: f64 = v292 * v851;
-    let v853: f64 = v297.mul_add(v848, v852);
-    let v854: f64 = v297 * v851;
-    let v855: f64 = v292.mul_add(v848, -v854);
-    let v856: f64 = v316 * v855;
-    let v857: f64 = v302.mul_add(v853, -v856);
-    let v858: f64 = p[74usize] * v857;
-    let v859: f64 = 0.5f64.mul_add(v319, v858);
-    let v860: f64 = p[74usize] * v855;
-    let v861: f64 = p[74usize] * v853;
-    let v862: f64 = v491.mul_add(v860, v859);
-    let v863: f64 = v508.mul_add(v861, v862);
-    let v864: f64 = v540 * v540;
-    let v865: f64 = v542.mul_add(v542, v864);
-    let v866: f64 = (-2f64).mul_add(v501, v550);
-    let v867: f64 = 2f64.mul_add(v518, v553);
-    let v868: f64 = 0.25f64.mul_add(v472, v455);
-    let v869: f64 = p[14usize].mul_add(v865, v868);
-    let v870: f64 = v534.mul_add(v866, v869);
-    let v871: f64 = v531.mul_add(v867, v870);
-    let v872: f64 = v534.mul_add(v584, v580);
-    let v873: f64 = v531.mul_add(v587, v872);
-    let v874: f64 = v534.mul_add(v616, v612);
-    let v875: f64 = v531.mul_add(v619, v874);
-    let v876: f64 = v534.mul_add(v648, v644);
-    let v877: f64 = v531.mul_add(v651, v876);
-    let v878: f64 = v534.mul_add(v680, v676);
-    let v879: f64 = v531.mul_add(v683, v878);
-    let v880: f64 = v534.mul_add(v712, v708);
-    let v881: f64 = v531.mul_add(v715, v880);
-    let v882: f64 = v534.mul_add(v744, v740);
-    let v883: f64 = v531.mul_add(v747, v882);
-    let v884: f64 = v534.mul_add(v776, v772);
-    let v885: f64 = v531.mul_add(v779, v884);
-    let v886: f64 = v534.mul_add(v808, v804);
-    let v887: f64 = v531.mul_add(v811, v886);
-    let v888: f64 = v534.mul_add(v839, v836);
-    let v889: f64 = v531.mul_add(v842, v888);
-    let v890: f64 = v534.mul_add(v860, v859);
-    let v891: f64 = v531.mul_add(v861, v890);
-    let v892: f64 = v572 * v572;
-    let v893: f64 = v574.mul_add(v574, v892);
-    let v894: f64 = (-2f64).mul_add(v500, v582);
-    let v895: f64 = 2f64.mul_add(v517, v585);
-    let v896: f64 = 0.25f64.mul_add(v453, v440);
-    let v897: f64 = p[20usize].mul_add(v893, v896);
-    let v898: f64 = v566.mul_add(v894, v897);
-    let v899: f64 = v563.mul_add(v895, v898);
-    let v900: f64 = v566.mul_add(v616, v612);
-    let v901: f64 = v563.mul_add(v619, v900);
-    let v902: f64 = v566.mul_add(v648, v644);
-    let v903: f64 = v563.mul_add(v651, v902);
-    let v904: f64 = v566.mul_add(v680, v676);
-    let v905: f64 = v563.mul_add(v683, v904);
-    let v906: f64 = v566.mul_add(v712, v708);
-    let v907: f64 = v563.mul_add(v715, v906);
-    let v908: f64 = v566.mul_add(v744, v740);
-    let v909: f64 = v563.mul_add(v747, v908);
-    let v910: f64 = v566.mul_add(v776, v772);
-    let v911: f64 = v563.mul_add(v779, v910);
-    let v912: f64 = v566.mul_add(v808, v804);
-    let v913: f64 = v563.mul_add(v811, v912);
-    let v914: f64 = v566.mul_add(v839, v836);
-    let v915: f64 = v563.mul_add(v842, v914);
-    let v916: f64 = v566.mul_add(v860, v859);
-    let v917: f64 = v563.mul_add(v861, v916);
-    let v918: f64 = v604 * v604;
-    let v919: f64 = v606.mul_add(v606, v918);
-    let v920: f64 = (-2f64).mul_add(v499, v614);
-    let v921: f64 = 2f64.mul_add(v516, v617);
-    let v922: f64 = 0.25f64.mul_add(v438, v425);
-    let v923: f64 = p[26usize].mul_add(v919, v922);
-    let v924: f64 = v598.mul_add(v920, v923);
-    let v925: f64 = v595.mul_add(v921, v924);
-    let v926: f64 = v598.mul_add(v648, v644);
-    let v927: f64 = v595.mul_add(v651, v926);
-    let v928: f64 = v598.mul_add(v680, v676);
-    let v929: f64 = v595.mul_add(v683, v928);
-    let v930: f64 = v598.mul_add(v712, v708);
-    let v931: f64 = v595.mul_add(v715, v930);
-    let v932: f64 = v598.mul_add(v744, v740);
-    let v933: f64 = v595.mul_add(v747, v932);
-    let v934: f64 = v598.mul_add(v776, v772);
-    let v935: f64 = v595.mul_add(v779, v934);
-    let v936: f64 = v598.mul_add(v808, v804);
-    let v937: f64 = v595.mul_add(v811, v936);
-    let v938: f64 = v598.mul_add(v839, v836);
-    let v939: f64 = v595.mul_add(v842, v938);
-    let v940: f64 = v598.mul_add(v860, v859);
-    let v941: f64 = v595.mul_add(v861, v940);
-    let v942: f64 = v636 * v636;
-    let v943: f64 = v638.mul_add(v638, v942);
-    let v944: f64 = (-2f64).mul_add(v498, v646);
-    let v945: f64 = 2f64.mul_add(v515, v649);
-    let v946: f64 = 0.25f64.mul_add(v423, v410);
-    let v947: f64 = p[32usize].mul_add(v943, v946);
-    let v948: f64 = v630.mul_add(v944, v947);
-    let v949: f64 = v627.mul_add(v945, v948);
-    let v950: f64 = v630.mul_add(v680, v676);
-    let v951: f64 = v627.mul_add(v683, v950);
-    let v952: f64 = v630.mul_add(v712, v708);
-    let v953: f64 = v627.mul_add(v715, v952);
-    let v954: f64 = v630.mul_add(v744, v740);
-    let v955: f64 = v627.mul_add(v747, v954);
-    let v956: f64 = v630.mul_add(v776, v772);
-    let v957: f64 = v627.mul_add(v779, v956);
-    let v958: f64 = v630.mul_add(v808, v804);
-    let v959: f64 = v627.mul_add(v811, v958);
-    let v960: f64 = v630.mul_add(v839, v836);
-    let v961: f64 = v627.mul_add(v842, v960);
-    let v962: f64 = v630.mul_add(v860, v859);
-    let v963: f64 = v627.mul_add(v861, v962);
-    let v964: f64 = v668 * v668;
-    let v965: f64 = v670.mul_add(v670, v964);
-    let v966: f64 = (-2f64).mul_add(v497, v678);
-    let v967: f64 = 2f64.mul_add(v514, v681);
-    let v968: f64 = 0.25f64.mul_add(v408, v395);
-    let v969: f64 = p[38usize].mul_add(v965, v968);
-    let v970: f64 = v662.mul_add(v966, v969);
-    let v971: f64 = v659.mul_add(v967, v970);
-    let v972: f64 = v662.mul_add(v712, v708);
-    let v973: f64 = v659.mul_add(v715, v972);
-    let v974: f64 = v662.mul_add(v744, v740);
-    let v975: f64 = v659.mul_add(v747, v974);
-    let v976: f64 = v662.mul_add(v776, v772);
-    let v977: f64 = v659.mul_add(v779, v976);
-    let v978: f64 = v662.mul_add(v808, v804);
-    let v979: f64 = v659.mul_add(v811, v978);
-    let v980: f64 = v662.mul_add(v839, v836);
-    let v981: f64 = v659.mul_add(v842, v980);
-    let v982: f64 = v662.mul_add(v860, v859);
-    let v983: f64 = v659.mul_add(v861, v982);
-    let v984: f64 = v700 * v700;
-    let v985: f64 = v702.mul_add(v702, v984);
-    let v986: f64 = (-2f64).mul_add(v496, v710);
-    let v987: f64 = 2f64.mul_add(v513, v713);
-    let v988: f64 = 0.25f64.mul_add(v393, v380);
-    let v989: f64 = p[44usize].mul_add(v985, v988);
-    let v990: f64 = v694.mul_add(v986, v989);
-    let v991: f64 = v691.mul_add(v987, v990);
-    let v992: f64 = v694.mul_add(v744, v740);
-    let v993: f64 = v691.mul_add(v747, v992);
-    let v994: f64 = v694.mul_add(v776, v772);
-    let v995: f64 = v691.mul_add(v779, v994);
-    let v996: f64 = v694.mul_add(v808, v804);
-    let v997: f64 = v691.mul_add(v811, v996);
-    let v998: f64 = v694.mul_add(v839, v836);
-    let v999: f64 = v691.mul_add(v842, v998);
-    let v1000: f64 = v694.mul_add(v860, v859);
-    let v1001: f64 = v691.mul_add(v861, v1000);
-    let v1002: f64 = v732 * v732;
-    let v1003: f64 = v734.mul_add(v734, v1002);
-    let v1004: f64 = (-2f64).mul_add(v495, v742);
-    let v1005: f64 = 2f64.mul_add(v512, v745);
-    let v1006: f64 = 0.25f64.mul_add(v378, v365);
-    let v1007: f64 = p[50usize].mul_add(v1003, v1006);
-    let v1008: f64 = v726.mul_add(v1004, v1007);
-    let v1009: f64 = v723.mul_add(v1005, v1008);
-    let v1010: f64 = v726.mul_add(v776, v772);
-    let v1011: f64 = v723.mul_add(v779, v1010);
-    let v1012: f64 = v726.mul_add(v808, v804);
-    let v1013: f64 = v723.mul_add(v811, v1012);
-    let v1014: f64 = v726.mul_add(v839, v836);
-    let v1015: f64 = v723.mul_add(v842, v1014);
-    let v1016: f64 = v726.mul_add(v860, v859);
-    let v1017: f64 = v723.mul_add(v861, v1016);
-    let v1018: f64 = v764 * v764;
-    let v1019: f64 = v766.mul_add(v766, v1018);
-    let v1020: f64 = (-2f64).mul_add(v494, v774);
-    let v1021: f64 = 2f64.mul_add(v511, v777);
-    let v1022: f64 = 0.25f64.mul_add(v363, v350);
-    let v1023: f64 = p[56usize].mul_add(v1019, v1022);
-    let v1024: f64 = v758.mul_add(v1020, v1023);
-    let v1025: f64 = v755.mul_add(v1021, v1024);
-    let v1026: f64 = v758.mul_add(v808, v804);
-    let v1027: f64 = v755.mul_add(v811, v1026);
-    let v1028: f64 = v758.mul_add(v839, v836);
-    let v1029: f64 = v755.mul_add(v842, v1028);
-    let v1030: f64 = v758.mul_add(v860, v859);
-    let v1031: f64 = v755.mul_add(v861, v1030);
-    let v1032: f64 = v796 * v796;
-    let v1033: f64 = v798.mul_add(v798, v1032);
-    let v1034: f64 = (-2f64).mul_add(v493, v806);
-    let v1035: f64 = 2f64.mul_add(v510, v809);
-    let v1036: f64 = 0.25f64.mul_add(v348, v335);
-    let v1037: f64 = p[62usize].mul_add(v1033, v1036);
-    let v1038: f64 = v790.mul_add(v1034, v1037);
-    let v1039: f64 = v787.mul_add(v1035, v1038);
-    let v1040: f64 = v790.mul_add(v839, v836);
-    let v1041: f64 = v787.mul_add(v842, v1040);
-    let v1042: f64 = v790.mul_add(v860, v859);
-    let v1043: f64 = v787.mul_add(v861, v1042);
-    let v1044: f64 = v828 * v828;
-    let v1045: f64 = v830.mul_add(v830, v1044);
-    let v1046: f64 = (-2f64).mul_add(v492, v837);
-    let v1047: f64 = 2f64.mul_add(v509, v840);
-    let v1048: f64 = 0.25f64.mul_add(v333, v320);
-    let v1049: f64 = p[68usize].mul_add(v1045, v1048);
-    let v1050: f64 = v822.mul_add(v1046, v1049);
-    let v1051: f64 = v819.mul_add(v1047, v1050);
-    let v1052: f64 = v822.mul_add(v860, v859);
-    let v1053: f64 = v819.mul_add(v861, v1052);
-    let v1054: f64 = v853 * v853;
-    let v1055: f64 = v855.mul_add(v855, v1054);
-    let v1056: f64 = p[74usize] * v1055;
-    let v1057: f64 = 0.25f64.mul_add(v319, v1056);
-    let v1060: f64 = p[79usize].abs();
-    let v1061: f64 = p[79usize] + v1060;
-    let v1062: f64 = p[117usize] * v1061;
-    let v1065: f64 = 0.5f64 * qd[0usize];
-    let v1066: f64 = v1065 * v1065;
-    let v1068: f64 = (-0.5f64) * v1066;
-    let v1069: f64 = (-v5).mul_add(v11, 2f64);
-    let v1070: f64 = v1068 * v1069;
-    let v1071: f64 = p[118usize] * v1070;
-    let v1072: f64 = p[8usize] * v1071;
-    let v1074: f64 = v8.powi(3i32);
-    let v1075: f64 = p[119usize] * v1074;
-    let v1076: f64 = v1075 * v1068;
-    let v1078: f64 = 0.5f64 * qd[1usize];
-    let v1079: f64 = v1065 + v1065;
-    let v1080: f64 = v1078 + v1079;
-    let v1081: f64 = v22.powi(3i32);
-    let v1082: f64 = v527 * v1081;
-    let v1083: f64 = 2f64 * q[1usize];
-    let v1084: f64 = (-v20).mul_add(v24, 2f64);
-    let v1085: f64 = v536.mul_add(v1084, -v1082);
-    let v1086: f64 = (-v1083).mul_add(v25, v1085);
-    let v1087: f64 = p[83usize] * v1086;
-    let v1088: f64 = qd[1usize] * v1080;
-    let v1090: f64 = 0.5f64 * qd[2usize];
-    let v1091: f64 = v1078 + v1080;
-    let v1092: f64 = v1090 + v1091;
-    let v1093: f64 = v34.powi(3i32);
-    let v1094: f64 = v559 * v1093;
-    let v1095: f64 = 2f64 * q[2usize];
-    let v1096: f64 = (-v32).mul_add(v36, 2f64);
-    let v1097: f64 = v568.mul_add(v1096, -v1094);
-    let v1098: f64 = (-v1095).mul_add(v37, v1097);
-    let v1099: f64 = p[84usize] * v1098;
-    let v1100: f64 = qd[2usize] * v1092;
-    let v1102: f64 = 0.5f64 * qd[3usize];
-    let v1103: f64 = v1090 + v1092;
-    let v1104: f64 = v1102 + v1103;
-    let v1105: f64 = v46.powi(3i32);
-    let v1106: f64 = v591 * v1105;
-    let v1107: f64 = 2f64 * q[3usize];
-    let v1108: f64 = (-v44).mul_add(v48, 2f64);
-    let v1109: f64 = v600.mul_add(v1108, -v1106);
-    let v1110: f64 = (-v1107).mul_add(v49, v1109);
-    let v1111: f64 = p[85usize] * v1110;
-    let v1112: f64 = qd[3usize] * v1104;
-    let v1114: f64 = 0.5f64 * qd[4usize];
-    let v1115: f64 = v1102 + v1104;
-    let v1116: f64 = v1114 + v1115;
-    let v1117: f64 = v58.powi(3i32);
-    let v1118: f64 = v623 * v1117;
-    let v1119: f64 = 2f64 * q[4usize];
-    let v1120: f64 = (-v56).mul_add(v60, 2f64);
-    let v1121: f64 = v632.mul_add(v1120, -v1118);
-    let v1122: f64 = (-v1119).mul_add(v61, v1121);
-    let v1123: f64 = p[86usize] * v1122;
-    let v1124: f64 = qd[4usize] * v1116;
-    let v1126: f64 = 0.5f64 * qd[5usize];
-    let v1127: f64 = v1114 + v1116;
-    let v1128: f64 = v1126 + v1127;
-    let v1129: f64 = v70.powi(3i32);
-    let v1130: f64 = v655 * v1129;
-    let v1131: f64 = 2f64 * q[5usize];
-    let v1132: f64 = (-v68).mul_add(v72, 2f64);
-    let v1133: f64 = v664.mul_add(v1132, -v1130);
-    let v1134: f64 = (-v1131).mul_add(v73, v1133);
-    let v1135: f64 = p[87usize] * v1134;
-    let v1136: f64 = qd[5usize] * v1128;
-    let v1138: f64 = 0.5f64 * qd[6usize];
-    let v1139: f64 = v1126 + v1128;
-    let v1140: f64 = v1138 + v1139;
-    let v1141: f64 = v82.powi(3i32);
-    let v1142: f64 = v687 * v1141;
-    let v1143: f64 = 2f64 * q[6usize];
-    let v1144: f64 = (-v80).mul_add(v84, 2f64);
-    let v1145: f64 = v696.mul_add(v1144, -v1142);
-    let v1146: f64 = (-v1143).mul_add(v85, v1145);
-    let v1147: f64 = p[88usize] * v1146;
-    let v1148: f64 = qd[6usize] * v1140;
-    let v1150: f64 = 0.5f64 * qd[7usize];
-    let v1151: f64 = v1138 + v1140;
-    let v1152: f64 = v1150 + v1151;
-    let v1153: f64 = v94.powi(3i32);
-    let v1154: f64 = v719 * v1153;
-    let v1155: f64 = 2f64 * q[7usize];
-    let v1156: f64 = (-v92).mul_add(v96, 2f64);
-    let v1157: f64 = v728.mul_add(v1156, -v1154);
-    let v1158: f64 = (-v1155).mul_add(v97, v1157);
-    let v1159: f64 = p[89usize] * v1158;
-    let v1160: f64 = qd[7usize] * v1152;
-    let v1162: f64 = 0.5f64 * qd[8usize];
-    let v1163: f64 = v1150 + v1152;
-    let v1164: f64 = v1162 + v1163;
-    let v1165: f64 = v106.powi(3i32);
-    let v1166: f64 = v751 * v1165;
-    let v1167: f64 = 2f64 * q[8usize];
-    let v1168: f64 = (-v104).mul_add(v108, 2f64);
-    let v1169: f64 = v760.mul_add(v1168, -v1166);
-    let v1170: f64 = (-v1167).mul_add(v109, v1169);
-    let v1171: f64 = p[90usize] * v1170;
-    let v1172: f64 = qd[8usize] * v1164;
-    let v1174: f64 = 0.5f64 * qd[9usize];
-    let v1175: f64 = v1162 + v1164;
-    let v1176: f64 = v1174 + v1175;
-    let v1177: f64 = v118.powi(3i32);
-    let v1178: f64 = v783 * v1177;
-    let v1179: f64 = 2f64 * q[9usize];
-    let v1180: f64 = (-v116).mul_add(v120, 2f64);
-    let v1181: f64 = v792.mul_add(v1180, -v1178);
-    let v1182: f64 = (-v1179).mul_add(v121, v1181);
-    let v1183: f64 = p[91usize] * v1182;
-    let v1184: f64 = qd[9usize] * v1176;
-    let v1186: f64 = 0.5f64 * qd[10usize];
-    let v1187: f64 = v1174 + v1176;
-    let v1188: f64 = v1186 + v1187;
-    let v1189: f64 = v130.powi(3i32);
-    let v1190: f64 = v815 * v1189;
-    let v1191: f64 = 2f64 * q[10usize];
-    let v1192: f64 = (-v128).mul_add(v132, 2f64);
-    let v1193: f64 = v824.mul_add(v1192, -v1190);
-    let v1194: f64 = (-v1191).mul_add(v133, v1193);
-    let v1195: f64 = p[92usize] * v1194;
-    let v1196: f64 = qd[10usize] * v1188;
-    let v1198: f64 = v1186 + v1188;
-    let v1199: f64 = 0.5f64.mul_add(qd[11usize], v1198);
-    let v1200: f64 = v142.powi(3i32);
-    let v1201: f64 = v846 * v1200;
-    let v1202: f64 = 2f64 * q[11usize];
-    let v1203: f64 = (-v140).mul_add(v144, 2f64);
-    let v1204: f64 = v849.mul_add(v1203, -v1201);
-    let v1205: f64 = (-v1202).mul_add(v145, v1204);
-    let v1206: f64 = p[93usize] * v1205;
-    let v1207: f64 = qd[11usize] * v1199;
-    let v1209: f64 = qd[0usize] * qd[0usize];
-    let v1211: f64 = 0.25f64 * v1210;
-    let v1212: f64 = (-0.25f64).mul_add(v8, v1211);
-    let v1213: f64 = v161.mul_add(v1212, v488);
-    let v1214: f64 = p[7usize] * v1213;
-    let v1215: f64 = qd[0usize] + v1078;
-    let v1216: f64 = 2f64 * qd[1usize];
-    let v1217: f64 = v1216 * v169;
-    let v1218: f64 = v1217 * v527;
-    let v1219: f64 = qd[1usize] * qd[1usize];
-    let v1221: f64 = 0.25f64 * v1220;
-    let v1222: f64 = v1215 * v1215;
-    let v1223: f64 = v22 * v1222;
-    let v1224: f64 = v1219.mul_add(v1221, -v1223);
-    let v1225: f64 = v174 * v1224;
-    let v1226: f64 = v1218.mul_add(v1215, v1225);
-    let v1227: f64 = p[13usize] * v1226;
-    let v1228: f64 = v1209.mul_add(v1214, v1227);
-    let v1229: f64 = v1078 + v1215;
-    let v1230: f64 = v1090 + v1229;
-    let v1231: f64 = 2f64 * qd[2usize];
-    let v1232: f64 = v1231 * v182;
-    let v1233: f64 = v1232 * v559;
-    let v1234: f64 = qd[2usize] * qd[2usize];
-    let v1236: f64 = 0.25f64 * v1235;
-    let v1237: f64 = v1230 * v1230;
-    let v1238: f64 = v34 * v1237;
-    let v1239: f64 = v1234.mul_add(v1236, -v1238);
-    let v1240: f64 = v187 * v1239;
-    let v1241: f64 = v1233.mul_add(v1230, v1240);
-    let v1242: f64 = p[19usize].mul_add(v1241, v1228);
-    let v1243: f64 = v1090 + v1230;
-    let v1244: f64 = v1102 + v1243;
-    let v1245: f64 = 2f64 * qd[3usize];
-    let v1246: f64 = v1245 * v195;
-    let v1247: f64 = v1246 * v591;
-    let v1248: f64 = qd[3usize] * qd[3usize];
-    let v1250: f64 = 0.25f64 * v1249;
-    let v1251: f64 = v1244 * v1244;
-    let v1252: f64 = v46 * v1251;
-    let v1253: f64 = v1248.mul_add(v1250, -v1252);
-    let v1254: f64 = v200 * v1253;
-    let v1255: f64 = v1247.mul_add(v1244, v1254);
-    let v1256: f64 = p[25usize].mul_add(v1255, v1242);
-    let v1257: f64 = v1102 + v1244;
-    let v1258: f64 = v1114 + v1257;
-    let v1259: f64 = 2f64 * qd[4usize];
-    let v1260: f64 = v1259 * v208;
-    let v1261: f64 = v1260 * v623;
-    let v1262: f64 = qd[4usize] * qd[4usize];
-    let v1264: f64 = 0.25f64 * v1263;
-    let v1265: f64 = v1258 * v1258;
-    let v1266: f64 = v58 * v1265;
-    let v1267: f64 = v1262.mul_add(v1264, -v1266);
-    let v1268: f64 = v213 * v1267;
-    let v1269: f64 = v1261.mul_add(v1258, v1268);
-    let v1270: f64 = p[31usize].mul_add(v1269, v1256);
-    let v1271: f64 = v1114 + v1258;
-    let v1272: f64 = v1126 + v1271;
-    let v1273: f64 = 2f64 * qd[5usize];
-    let v1274: f64 = v1273 * v221;
-    let v1275: f64 = v1274 * v655;
-    let v1276: f64 = qd[5usize] * qd[5usize];
-    let v1278: f64 = 0.25f64 * v1277;
-    let v1279: f64 = v1272 * v1272;
-    let v1280: f64 = v70 * v1279;
-    let v1281: f64 = v1276.mul_add(v1278, -v1280);
-    let v1282: f64 = v226 * v1281;
-    let v1283: f64 = v1275.mul_add(v1272, v1282);
-    let v1284: f64 = p[37usize].mul_add(v1283, v1270);
-    let v1285: f64 = v1126 + v1272;
-    let v1286: f64 = v1138 + v1285;
-    let v1287: f64 = 2f64 * qd[6usize];
-    let v1288: f64 = v1287 * v234;
-    let v1289: f64 = v1288 * v687;
-    let v1290: f64 = qd[6usize] * qd[6usize];
-    let v1292: f64 = 0.25f64 * v1291;
-    let v1293: f64 = v1286 * v1286;
-    let v1294: f64 = v82 * v1293;
-    let v1295: f64 = v1290.mul_add(v1292, -v1294);
-    let v1296: f64 = v239 * v1295;
-    let v1297: f64 = v1289.mul_add(v1286, v1296);
-    let v1298: f64 = p[43usize].mul_add(v1297, v1284);
-    let v1299: f64 = v1138 + v1286;
-    let v1300: f64 = v1150 + v1299;
-    let v1301: f64 = 2f64 * qd[7usize];
-    let v1302: f64 = v1301 * v247;
-    let v1303: f64 = v1302 * v719;
-    let v1304: f64 = qd[7usize] * qd[7usize];
-    let v1306: f64 = 0.25f64 * v1305;
-    let v1307: f64 = v1300 * v1300;
-    let v1308: f64 = v94 * v1307;
-    let v1309: f64 = v1304.mul_add(v1306, -v1308);
-    let v1310: f64 = v252 * v1309;
-    let v1311: f64 = v1303.mul_add(v1300, v1310);
-    let v1312: f64 = p[49usize].mul_add(v1311, v1298);
-    let v1313: f64 = v1150 + v1300;
-    let v1314: f64 = v1162 + v1313;
-    let v1315: f64 = 2f64 * qd[8usize];
-    let v1316: f64 = v1315 * v260;
-    let v1317: f64 = v1316 * v751;
-    let v1318: f64 = qd[8usize] * qd[8usize];
-    let v1320: f64 = 0.25f64 * v1319;
-    let v1321: f64 = v1314 * v1314;
-    let v1322: f64 = v106 * v1321;
-    let v1323: f64 = v1318.mul_add(v1320, -v1322);
-    let v1324: f64 = v265 * v1323;
-    let v1325: f64 = v1317.mul_add(v1314, v1324);
-    let v1326: f64 = p[55usize].mul_add(v1325, v1312);
-    let v1327: f64 = v1162 + v1314;
-    let v1328: f64 = v1174 + v1327;
-    let v1329: f64 = 2f64 * qd[9usize];
-    let v1330: f64 = v1329 * v273;
-    let v1331: f64 = v1330 * v783;
-    let v1332: f64 = qd[9usize] * qd[9usize];
-    let v1334: f64 = 0.25f64 * v1333;
-    let v1335: f64 = v1328 * v1328;
-    let v1336: f64 = v118 * v1335;
-    let v1337: f64 = v1332.mul_add(v1334, -v1336);
-    let v1338: f64 = v278 * v1337;
-    let v1339: f64 = v1331.mul_add(v1328, v1338);
-    let v1340: f64 = p[61usize].mul_add(v1339, v1326);
-    let v1341: f64 = v1174 + v1328;
-    let v1342: f64 = v1186 + v1341;
-    let v1343: f64 = 2f64 * qd[10usize];
-    let v1344: f64 = v1343 * v286;
-    let v1345: f64 = v1344 * v815;
-    let v1346: f64 = qd[10usize] * qd[10usize];
-    let v1348: f64 = 0.25f64 * v1347;
-    let v1349: f64 = v1342 * v1342;
-    let v1350: f64 = v130 * v1349;
-    let v1351: f64 = v1346.mul_add(v1348, -v1350);
-    let v1352: f64 = v290 * v1351;
-    let v1353: f64 = v1345.mul_add(v1342, v1352);
-    let v1354: f64 = p[67usize].mul_add(v1353, v1340);
-    let v1355: f64 = qd[11usize] * qd[11usize];
-    let v1357: f64 = q[11usize] * v1356;
-    let v1358: f64 = 2f64.mul_add(v849, v1357);
-    let v1359: f64 = p[73usize] * v1358;
-    let v1360: f64 = v1355 * v1359;
-    let v1361: f64 = v1186 + v1342;
-    let v1362: f64 = 2f64 * qd[11usize];
-    let v1363: f64 = v1362 * v1361;
-    let v1364: f64 = v1363 * v848;
-    let v1365: f64 = v1361 * v1361;
-    let v1366: f64 = v300 * v1365;
-    let v1367: f64 = v1360 + v1364;
-    let v1368: f64 = v1367 - v1366;
-    let v1370: f64 = 0.25f64 * v1369;
-    let v1371: f64 = v142 * v1370;
-    let v1372: f64 = v846.mul_add(v846, v1371);
-    let v1373: f64 = p[73usize] * v1372;
-    let v1374: f64 = v295 * v1365;
-    let v1375: f64 = v1355.mul_add(v1373, -v1374);
-    let v1376: f64 = (-v1363).mul_add(v851, v1375);
-    let v1377: f64 = v292.mul_add(v1368, v1354);
-    let v1378: f64 = v297.mul_add(v1376, v1377);
-    let v1379: f64 = p[120usize] + v1378;
-    let v1381: f64 = v156.mul_add(v1212, -v506);
-    let v1382: f64 = p[7usize] * v1381;
-    let v1383: f64 = v1216 * v174;
-    let v1384: f64 = v1383 * v527;
-    let v1385: f64 = v1384 * v1215;
-    let v1386: f64 = v169.mul_add(v1224, -v1385);
-    let v1387: f64 = p[13usize] * v1386;
-    let v1388: f64 = v1209.mul_add(v1382, v1387);
-    let v1389: f64 = v1231 * v187;
-    let v1390: f64 = v1389 * v559;
-    let v1391: f64 = v1390 * v1230;
-    let v1392: f64 = v182.mul_add(v1239, -v1391);
-    let v1393: f64 = p[19usize].mul_add(v1392, v1388);
-    let v1394: f64 = v1245 * v200;
-    let v1395: f64 = v1394 * v591;
-    let v1396: f64 = v1395 * v1244;
-    let v1397: f64 = v195.mul_add(v1253, -v1396);
-    let v1398: f64 = p[25usize].mul_add(v1397, v1393);
-    let v1399: f64 = v1259 * v213;
-    let v1400: f64 = v1399 * v623;
-    let v1401: f64 = v1400 * v1258;
-    let v1402: f64 = v208.mul_add(v1267, -v1401);
-    let v1403: f64 = p[31usize].mul_add(v1402, v1398);
-    let v1404: f64 = v1273 * v226;
-    let v1405: f64 = v1404 * v655;
-    let v1406: f64 = v1405 * v1272;
-    let v1407: f64 = v221.mul_add(v1281, -v1406);
-    let v1408: f64 = p[37usize].mul_add(v1407, v1403);
-    let v1409: f64 = v1287 * v239;
-    let v1410: f64 = v1409 * v687;
-    let v1411: f64 = v1410 * v1286;
-    let v1412: f64 = v234.mul_add(v1295, -v1411);
-    let v1413: f64 = p[43usize].mul_add(v1412, v1408);
-    let v1414: f64 = v1301 * v252;
-    let v1415: f64 = v1414 * v719;
-    let v1416: f64 = v1415 * v1300;
-    let v1417: f64 = v247.mul_add(v1309, -v1416);
-    let v1418: f64 = p[49usize].mul_add(v1417, v1413);
-    let v1419: f64 = v1315 * v265;
-    let v1420: f64 = v1419 * v751;
-    let v1421: f64 = v1420 * v1314;
-    let v1422: f64 = v260.mul_add(v1323, -v1421);
-    let v1423: f64 = p[55usize].mul_add(v1422, v1418);
-    let v1424: f64 = v1329 * v278;
-    let v1425: f64 = v1424 * v783;
-    let v1426: f64 = v1425 * v1328;
-    let v1427: f64 = v273.mul_add(v1337, -v1426);
-    let v1428: f64 = p[61usize].mul_add(v1427, v1423);
-    let v1429: f64 = v1343 * v290;
-    let v1430: f64 = v1429 * v815;
-    let v1431: f64 = v1430 * v1342;
-    let v1432: f64 = v286.mul_add(v1351, -v1431);
-    let v1433: f64 = p[67usize].mul_add(v1432, v1428);
-    let v1434: f64 = v1366 - v1360;
-    let v1435: f64 = v1434 - v1364;
-    let v1436: f64 = v292.mul_add(v1376, v1433);
-    let v1437: f64 = v297.mul_add(v1435, v1436);
-    let v1438: f64 = p[121usize] + v1437;
-    let v1439: f64 = v316 * v1438;
-    let v1440: f64 = v302.mul_add(v1379, -v1439);
-    let v1441: f64 = p[74usize] * v1440;
-    let v1442: f64 = v1207.mul_add(v1206, v1441);
-    let v1444: f64 = q[10usize] * v1443;
-    let v1445: f64 = 2f64.mul_add(v824, v1444);
-    let v1446: f64 = p[67usize] * v1445;
-    let v1447: f64 = v1346 * v1446;
-    let v1448: f64 = v1343 * v1341;
-    let v1449: f64 = v1448 * v823;
-    let v1450: f64 = v1341 * v1341;
-    let v1451: f64 = v326 * v1450;
-    let v1452: f64 = v1447 + v1449;
-    let v1453: f64 = v1452 - v1451;
-    let v1454: f64 = v130 * v1348;
-    let v1455: f64 = v815.mul_add(v815, v1454);
-    let v1456: f64 = p[67usize] * v1455;
-    let v1457: f64 = v324 * v1450;
-    let v1458: f64 = v1346.mul_add(v1456, -v1457);
-    let v1459: f64 = (-v1448).mul_add(v826, v1458);
-    let v1460: f64 = v282.mul_add(v1453, v1340);
-    let v1461: f64 = v280.mul_add(v1459, v1460);
-    let v1462: f64 = p[120usize] + v1461;
-    let v1463: f64 = v1451 - v1447;
-    let v1464: f64 = v1463 - v1449;
-    let v1465: f64 = v282.mul_add(v1459, v1428);
-    let v1466: f64 = v280.mul_add(v1464, v1465);
-    let v1467: f64 = p[121usize] + v1466;
-    let v1468: f64 = v330 * v1467;
-    let v1469: f64 = v328.mul_add(v1462, -v1468);
-    let v1470: f64 = v1196.mul_add(v1195, v1442);
-    let v1471: f64 = p[68usize].mul_add(v1469, v1470);
-    let v1473: f64 = q[9usize] * v1472;
-    let v1474: f64 = 2f64.mul_add(v792, v1473);
-    let v1475: f64 = p[61usize] * v1474;
-    let v1476: f64 = v1332 * v1475;
-    let v1477: f64 = v1329 * v1327;
-    let v1478: f64 = v1477 * v791;
-    let v1479: f64 = v1327 * v1327;
-    let v1480: f64 = v341 * v1479;
-    let v1481: f64 = v1476 + v1478;
-    let v1482: f64 = v1481 - v1480;
-    let v1483: f64 = v118 * v1334;
-    let v1484: f64 = v783.mul_add(v783, v1483);
-    let v1485: f64 = p[61usize] * v1484;
-    let v1486: f64 = v339 * v1479;
-    let v1487: f64 = v1332.mul_add(v1485, -v1486);
-    let v1488: f64 = (-v1477).mul_add(v794, v1487);
-    let v1489: f64 = v269.mul_add(v1482, v1326);
-    let v1490: f64 = v267.mul_add(v1488, v1489);
-    let v1491: f64 = p[120usize] + v1490;
-    let v1492: f64 = v1480 - v1476;
-    let v1493: f64 = v1492 - v1478;
-    let v1494: f64 = v269.mul_add(v1488, v1423);
-    let v1495: f64 = v267.mul_add(v1493, v1494);
-    let v1496: f64 = p[121usize] + v1495;
-    let v1497: f64 = v345 * v1496;
-    let v1498: f64 = v343.mul_add(v1491, -v1497);
-    let v1499: f64 = v1184.mul_add(v1183, v1471);
-    let v1500: f64 = p[62usize].mul_add(v1498, v1499);
-    let v1502: f64 = q[8usize] * v1501;
-    let v1503: f64 = 2f64.mul_add(v760, v1502);
-    let v1504: f64 = p[55usize] * v1503;
-    let v1505: f64 = v1318 * v1504;
-    let v1506: f64 = v1315 * v1313;
-    let v1507: f64 = v1506 * v759;
-    let v1508: f64 = v1313 * v1313;
-    let v1509: f64 = v356 * v1508;
-    let v1510: f64 = v1505 + v1507;
-    let v1511: f64 = v1510 - v1509;
-    let v1512: f64 = v106 * v1320;
-    let v1513: f64 = v751.mul_add(v751, v1512);
-    let v1514: f64 = p[55usize] * v1513;
-    let v1515: f64 = v354 * v1508;
-    let v1516: f64 = v1318.mul_add(v1514, -v1515);
-    let v1517: f64 = (-v1506).mul_add(v762, v1516);
-    let v1518: f64 = v256.mul_add(v1511, v1312);
-    let v1519: f64 = v254.mul_add(v1517, v1518);
-    let v1520: f64 = p[120usize] + v1519;
-    let v1521: f64 = v1509 - v1505;
-    let v1522: f64 = v1521 - v1507;
-    let v1523: f64 = v256.mul_add(v1517, v1418);
-    let v1524: f64 = v254.mul_add(v1522, v1523);
-    let v1525: f64 = p[121usize] + v1524;
-    let v1526: f64 = v360 * v1525;
-    let v1527: f64 = v358.mul_add(v1520, -v1526);
-    let v1528: f64 = v1172.mul_add(v1171, v1500);
-    let v1529: f64 = p[56usize].mul_add(v1527, v1528);
-    let v1531: f64 = q[7usize] * v1530;
-    let v1532: f64 = 2f64.mul_add(v728, v1531);
-    let v1533: f64 = p[49usize] * v1532;
-    let v1534: f64 = v1304 * v1533;
-    let v1535: f64 = v1301 * v1299;
-    let v1536: f64 = v1535 * v727;
-    let v1537: f64 = v1299 * v1299;
-    let v1538: f64 = v371 * v1537;
-    let v1539: f64 = v1534 + v1536;
-    let v1540: f64 = v1539 - v1538;
-    let v1541: f64 = v94 * v1306;
-    let v1542: f64 = v719.mul_add(v719, v1541);
-    let v1543: f64 = p[49usize] * v1542;
-    let v1544: f64 = v369 * v1537;
-    let v1545: f64 = v1304.mul_add(v1543, -v1544);
-    let v1546: f64 = (-v1535).mul_add(v730, v1545);
-    let v1547: f64 = v243.mul_add(v1540, v1298);
-    let v1548: f64 = v241.mul_add(v1546, v1547);
-    let v1549: f64 = p[120usize] + v1548;
-    let v1550: f64 = v1538 - v1534;
-    let v1551: f64 = v1550 - v1536;
-    let v1552: f64 = v243.mul_add(v1546, v1413);
-    let v1553: f64 = v241.mul_add(v1551, v1552);
-    let v1554: f64 = p[121usize] + v1553;
-    let v1555: f64 = v375 * v1554;
-    let v1556: f64 = v373.mul_add(v1549, -v1555);
-    let v1557: f64 = v1160.mul_add(v1159, v1529);
-    let v1558: f64 = p[50usize].mul_add(v1556, v1557);
-    let v1560: f64 = q[6usize] * v1559;
-    let v1561: f64 = 2f64.mul_add(v696, v1560);
-    let v1562: f64 = p[43usize] * v1561;
-    let v1563: f64 = v1290 * v1562;
-    let v1564: f64 = v1287 * v1285;
-    let v1565: f64 = v1564 * v695;
-    let v1566: f64 = v1285 * v1285;
-    let v1567: f64 = v386 * v1566;
-    let v1568: f64 = v1563 + v1565;
-    let v1569: f64 = v1568 - v1567;
-    let v1570: f64 = v82 * v1292;
-    let v1571: f64 = v687.mul_add(v687, v1570);
-    let v1572: f64 = p[43usize] * v1571;
-    let v1573: f64 = v384 * v1566;
-    let v1574: f64 = v1290.mul_add(v1572, -v1573);
-    let v1575: f64 = (-v1564).mul_add(v698, v1574);
-    let v1576: f64 = v230.mul_add(v1569, v1284);
-    let v1577: f64 = v228.mul_add(v1575, v1576);
-    let v1578: f64 = p[120usize] + v1577;
-    let v1579: f64 = v1567 - v1563;
-    let v1580: f64 = v1579 - v1565;
-    let v1581: f64 = v230.mul_add(v1575, v1408);
-    let v1582: f64 = v228.mul_add(v1580, v1581);
-    let v1583: f64 = p[121usize] + v1582;
-    let v1584: f64 = v390 * v1583;
-    let v1585: f64 = v388.mul_add(v1578, -v1584);
-    let v1586: f64 = v1148.mul_add(v1147, v1558);
-    let v1587: f64 = p[44usize].mul_add(v1585, v1586);
-    let v1589: f64 = q[5usize] * v1588;
-    let v1590: f64 = 2f64.mul_add(v664, v1589);
-    let v1591: f64 = p[37usize] * v1590;
-    let v1592: f64 = v1276 * v1591;
-    let v1593: f64 = v1273 * v1271;
-    let v1594: f64 = v1593 * v663;
-    let v1595: f64 = v1271 * v1271;
-    let v1596: f64 = v401 * v1595;
-    let v1597: f64 = v1592 + v1594;
-    let v1598: f64 = v1597 - v1596;
-    let v1599: f64 = v70 * v1278;
-    let v1600: f64 = v655.mul_add(v655, v1599);
-    let v1601: f64 = p[37usize] * v1600;
-    let v1602: f64 = v399 * v1595;
-    let v1603: f64 = v1276.mul_add(v1601, -v1602);
-    let v1604: f64 = (-v1593).mul_add(v666, v1603);
-    let v1605: f64 = v217.mul_add(v1598, v1270);
-    let v1606: f64 = v215.mul_add(v1604, v1605);
-    let v1607: f64 = p[120usize] + v1606;
-    let v1608: f64 = v1596 - v1592;
-    let v1609: f64 = v1608 - v1594;
-    let v1610: f64 = v217.mul_add(v1604, v1403);
-    let v1611: f64 = v215.mul_add(v1609, v1610);
-    let v1612: f64 = p[121usize] + v1611;
-    let v1613: f64 = v405 * v1612;
-    let v1614: f64 = v403.mul_add(v1607, -v1613);
-    let v1615: f64 = v1136.mul_add(v1135, v1587);
-    let v1616: f64 = p[38usize].mul_add(v1614, v1615);
-    let v1618: f64 = q[4usize] * v1617;
-    let v1619: f64 = 2f64.mul_add(v632, v1618);
-    let v1620: f64 = p[31usize] * v1619;
-    let v1621: f64 = v1262 * v1620;
-    let v1622: f64 = v1259 * v1257;
-    let v1623: f64 = v1622 * v631;
-    let v1624: f64 = v1257 * v1257;
-    let v1625: f64 = v416 * v1624;
-    let v1626: f64 = v1621 + v1623;
-    let v1627: f64 = v1626 - v1625;
-    let v1628: f64 = v58 * v1264;
-    let v1629: f64 = v623.mul_add(v623, v1628);
-    let v1630: f64 = p[31usize] * v1629;
-    let v1631: f64 = v414 * v1624;
-    let v1632: f64 = v1262.mul_add(v1630, -v1631);
-    let v1633: f64 = (-v1622).mul_add(v634, v1632);
-    let v1634: f64 = v204.mul_add(v1627, v1256);
-    let v1635: f64 = v202.mul_add(v1633, v1634);
-    let v1636: f64 = p[120usize] + v1635;
-    let v1637: f64 = v1625 - v1621;
-    let v1638: f64 = v1637 - v1623;
-    let v1639: f64 = v204.mul_add(v1633, v1398);
-    let v1640: f64 = v202.mul_add(v1638, v1639);
-    let v1641: f64 = p[121usize] + v1640;
-    let v1642: f64 = v420 * v1641;
-    let v1643: f64 = v418.mul_add(v1636, -v1642);
-    let v1644: f64 = v1124.mul_add(v1123, v1616);
-    let v1645: f64 = p[32usize].mul_add(v1643, v1644);
-    let v1647: f64 = q[3usize] * v1646;
-    let v1648: f64 = 2f64.mul_add(v600, v1647);
-    let v1649: f64 = p[25usize] * v1648;
-    let v1650: f64 = v1248 * v1649;
-    let v1651: f64 = v1245 * v1243;
-    let v1652: f64 = v1651 * v599;
-    let v1653: f64 = v1243 * v1243;
-    let v1654: f64 = v431 * v1653;
-    let v1655: f64 = v1650 + v1652;
-    let v1656: f64 = v1655 - v1654;
-    let v1657: f64 = v46 * v1250;
-    let v1658: f64 = v591.mul_add(v591, v1657);
-    let v1659: f64 = p[25usize] * v1658;
-    let v1660: f64 = v429 * v1653;
-    let v1661: f64 = v1248.mul_add(v1659, -v1660);
-    let v1662: f64 = (-v1651).mul_add(v602, v1661);
-    let v1663: f64 = v191.mul_add(v1656, v1242);
-    let v1664: f64 = v189.mul_add(v1662, v1663);
-    let v1665: f64 = p[120usize] + v1664;
-    let v1666: f64 = v1654 - v1650;
-    let v1667: f64 = v1666 - v1652;
-    let v1668: f64 = v191.mul_add(v1662, v1393);
-    let v1669: f64 = v189.mul_add(v1667, v1668);
-    let v1670: f64 = p[121usize] + v1669;
-    let v1671: f64 = v435 * v1670;
-    let v1672: f64 = v433.mul_add(v1665, -v1671);
-    let v1673: f64 = v1112.mul_add(v1111, v1645);
-    let v1674: f64 = p[26usize].mul_add(v1672, v1673);
-    let v1676: f64 = q[2usize] * v1675;
-    let v1677: f64 = 2f64.mul_add(v568, v1676);
-    let v1678: f64 = p[19usize] * v1677;
-    let v1679: f64 = v1234 * v1678;
-    let v1680: f64 = v1231 * v1229;
-    let v1681: f64 = v1680 * v567;
-    let v1682: f64 = v1229 * v1229;
-    let v1683: f64 = v446 * v1682;
-    let v1684: f64 = v1679 + v1681;
-    let v1685: f64 = v1684 - v1683;
-    let v1686: f64 = v34 * v1236;
-    let v1687: f64 = v559.mul_add(v559, v1686);
-    let v1688: f64 = p[19usize] * v1687;
-    let v1689: f64 = v444 * v1682;
-    let v1690: f64 = v1234.mul_add(v1688, -v1689);
-    let v1691: f64 = (-v1680).mul_add(v570, v1690);
-    let v1692: f64 = v178.mul_add(v1685, v1228);
-    let v1693: f64 = v176.mul_add(v1691, v1692);
-    let v1694: f64 = p[120usize] + v1693;
-    let v1695: f64 = v1683 - v1679;
-    let v1696: f64 = v1695 - v1681;
-    let v1697: f64 = v178.mul_add(v1691, v1388);
-    let v1698: f64 = v176.mul_add(v1696, v1697);
-    let v1699: f64 = p[121usize] + v1698;
-    let v1700: f64 = v450 * v1699;
-    let v1701: f64 = v448.mul_add(v1694, -v1700);
-    let v1702: f64 = v1100.mul_add(v1099, v1674);
-    let v1703: f64 = p[20usize].mul_add(v1701, v1702);
-    let v1704: f64 = v1214 - v466;
-    let v1705: f64 = v1704 - v467;
-    let v1706: f64 = 2f64 * v165;
-    let v1707: f64 = 2f64 * v163;
-    let v1708: f64 = v1707 * v538;
-    let v1709: f64 = v1706.mul_add(v535, -v1708);
-    let v1710: f64 = qd[1usize] * v1709;
-    let v1711: f64 = qd[0usize] * v1710;
-    let v1712: f64 = v22 * v1221;
-    let v1713: f64 = v527.mul_add(v527, v1712);
-    let v1714: f64 = p[13usize] * v1713;
-    let v1716: f64 = q[1usize] * v1715;
-    let v1717: f64 = 2f64.mul_add(v536, v1716);
-    let v1718: f64 = p[13usize] * v1717;
-    let v1719: f64 = v165 * v1718;
-    let v1720: f64 = v163.mul_add(v1714, v1719);
-    let v1721: f64 = v1209.mul_add(v1705, v1711);
-    let v1722: f64 = v1219.mul_add(v1720, v1721);
-    let v1723: f64 = p[120usize] + v1722;
-    let v1724: f64 = v463 - v460;
-    let v1725: f64 = v1724 + v1382;
-    let v1726: f64 = v1706 * v538;
-    let v1727: f64 = v1707.mul_add(v535, v1726);
-    let v1728: f64 = -v1727;
-    let v1729: f64 = qd[1usize] * v1728;
-    let v1730: f64 = qd[0usize] * v1729;
-    let v1731: f64 = v163 * v1718;
-    let v1732: f64 = v165.mul_add(v1714, -v1731);
-    let v1733: f64 = v1209.mul_add(v1725, v1730);
-    let v1734: f64 = v1219.mul_add(v1732, v1733);
-    let v1735: f64 = p[121usize] + v1734;
-    let v1736: f64 = v469 * v1735;
-    let v1737: f64 = v465.mul_add(v1723, -v1736);
-    let v1738: f64 = v1088.mul_add(v1087, v1703);
-    let v1739: f64 = p[14usize].mul_add(v1737, v1738);
-    let v1740: f64 = p[74usize] * v1438;
-    let v1741: f64 = p[68usize].mul_add(v1467, v1740);
-    let v1742: f64 = p[62usize].mul_add(v1496, v1741);
-    let v1743: f64 = p[56usize].mul_add(v1525, v1742);
-    let v1744: f64 = p[50usize].mul_add(v1554, v1743);
-    let v1745: f64 = p[44usize].mul_add(v1583, v1744);
-    let v1746: f64 = p[38usize].mul_add(v1612, v1745);
-    let v1747: f64 = p[32usize].mul_add(v1641, v1746);
-    let v1748: f64 = p[26usize].mul_add(v1670, v1747);
-    let v1749: f64 = p[20usize].mul_add(v1699, v1748);
-    let v1750: f64 = p[14usize].mul_add(v1735, v1749);
-    let v1751: f64 = p[74usize] * v1379;
-    let v1752: f64 = p[68usize].mul_add(v1462, v1751);
-    let v1753: f64 = p[62usize].mul_add(v1491, v1752);
-    let v1754: f64 = p[56usize].mul_add(v1520, v1753);
-    let v1755: f64 = p[50usize].mul_add(v1549, v1754);
-    let v1756: f64 = p[44usize].mul_add(v1578, v1755);
-    let v1757: f64 = p[38usize].mul_add(v1607, v1756);
-    let v1758: f64 = p[32usize].mul_add(v1636, v1757);
-    let v1759: f64 = p[26usize].mul_add(v1665, v1758);
-    let v1760: f64 = p[20usize].mul_add(v1694, v1759);
-    let v1761: f64 = p[14usize].mul_add(v1723, v1760);
-    let v1764: f64 = p[122usize] + q[0usize];
-    let v1765: f64 = v8 * v1211;
-    let v1766: f64 = v477.mul_add(v477, v1765);
-    let v1767: f64 = p[7usize] * v1766;
-    let v1769: f64 = q[0usize] * v1768;
-    let v1770: f64 = 2f64.mul_add(v479, v1769);
-    let v1771: f64 = p[7usize] * v1770;
-    let v1772: f64 = p[94usize] * v1771;
-    let v1773: f64 = p[95usize].mul_add(v1767, -v1772);
-    let v1774: f64 = v1209.mul_add(v1773, p[121usize]);
-    let v1775: f64 = p[95usize] * v1771;
-    let v1776: f64 = p[94usize].mul_add(v1767, v1775);
-    let v1777: f64 = v1209.mul_add(v1776, p[120usize]);
-    let v1778: f64 = v483 * v1777;
-    let v1780: f64 = p[123usize] * q[0usize];
-    let v1781: f64 = v1780 * v12;
-    let v1782: f64 = v485.mul_add(v1774, v1778);
-    let v1783: f64 = (-v1781).mul_add(v1068, v1782);
-    let v1785: f64 = v477 * v1074;
-    let v1786: f64 = 2f64 * q[0usize];
-    let v1787: f64 = v479.mul_add(v1069, -v1785);
-    let v1788: f64 = (-v1786).mul_add(v12, v1787);
-    let v1789: f64 = p[82usize] * v1788;
-    let v1790: f64 = 0.5f64 * v1065;
-    let v1791: f64 = v1790.mul_add(v1789, p[11usize]);
-    let v1792: f64 = v479.mul_add(v1072, -v1062);
-    let v1793: f64 = v477.mul_add(v1076, v1792);
-    let v1794: f64 = v1793 + v1739;
-    let v1795: f64 = v491.mul_add(v1750, v1794);
-    let v1796: f64 = v508.mul_add(v1761, v1795);
-    let v1797: f64 = p[10usize].mul_add(v1764, v1796);
-    let v1798: f64 = p[8usize].mul_add(v1783, v1797);
-    let v1799: f64 = qd[0usize].mul_add(v1791, v1798);
-    let v1801: f64 = v1080 * v1080;
-    let v1802: f64 = (-0.5f64) * v1801;
-    let v1803: f64 = v1802 * v1084;
-    let v1804: f64 = p[124usize] * v1803;
-    let v1805: f64 = p[14usize] * v1804;
-    let v1807: f64 = p[125usize] * v1081;
-    let v1808: f64 = v1807 * v1802;
-    let v1811: f64 = p[126usize] + q[1usize];
-    let v1812: f64 = v1723 * v540;
-    let v1814: f64 = p[127usize] * q[1usize];
-    let v1815: f64 = v1814 * v25;
-    let v1816: f64 = v1735.mul_add(v542, v1812);
-    let v1817: f64 = (-v1815).mul_add(v1802, v1816);
-    let v1819: f64 = 0.5f64 * v1080;
-    let v1820: f64 = v1819.mul_add(v1087, p[17usize]);
-    let v1821: f64 = v536.mul_add(v1805, -v1062);
-    let v1822: f64 = v527.mul_add(v1808, v1821);
-    let v1823: f64 = v1822 + v1703;
-    let v1824: f64 = v534.mul_add(v1749, v1823);
-    let v1825: f64 = v531.mul_add(v1760, v1824);
-    let v1826: f64 = p[16usize].mul_add(v1811, v1825);
-    let v1827: f64 = p[14usize].mul_add(v1817, v1826);
-    let v1828: f64 = qd[1usize].mul_add(v1820, v1827);
-    let v1830: f64 = v1092 * v1092;
-    let v1831: f64 = (-0.5f64) * v1830;
-    let v1832: f64 = v1831 * v1096;
-    let v1833: f64 = p[128usize] * v1832;
-    let v1834: f64 = p[20usize] * v1833;
-    let v1836: f64 = p[129usize] * v1093;
-    let v1837: f64 = v1836 * v1831;
-    let v1840: f64 = p[130usize] + q[2usize];
-    let v1841: f64 = v1694 * v572;
-    let v1843: f64 = p[131usize] * q[2usize];
-    let v1844: f64 = v1843 * v37;
-    let v1845: f64 = v1699.mul_add(v574, v1841);
-    let v1846: f64 = (-v1844).mul_add(v1831, v1845);
-    let v1848: f64 = 0.5f64 * v1092;
-    let v1849: f64 = v1848.mul_add(v1099, p[23usize]);
-    let v1850: f64 = v568.mul_add(v1834, -v1062);
-    let v1851: f64 = v559.mul_add(v1837, v1850);
-    let v1852: f64 = v1851 + v1674;
-    let v1853: f64 = v566.mul_add(v1748, v1852);
-    let v1854: f64 = v563.mul_add(v1759, v1853);
-    let v1855: f64 = p[22usize].mul_add(v1840, v1854);
-    let v1856: f64 = p[20usize].mul_add(v1846, v1855);
-    let v1857: f64 = qd[2usize].mul_add(v1849, v1856);
-    let v1859: f64 = v1104 * v1104;
-    let v1860: f64 = (-0.5f64) * v1859;
-    let v1861: f64 = v1860 * v1108;
-    let v1862: f64 = p[132usize] * v1861;
-    let v1863: f64 = p[26usize] * v1862;
-    let v1865: f64 = p[133usize] * v1105;
-    let v1866: f64 = v1865 * v1860;
-    let v1869: f64 = p[134usize] + q[3usize];
-    let v1870: f64 = v1665 * v604;
-    let v1872: f64 = p[135usize] * q[3usize];
-    let v1873: f64 = v1872 * v49;
-    let v1874: f64 = v1670.mul_add(v606, v1870);
-    let v1875: f64 = (-v1873).mul_add(v1860, v1874);
-    let v1877: f64 = 0.5f64 * v1104;
-    let v1878: f64 = v1877.mul_add(v1111, p[29usize]);
-    let v1879: f64 = v600.mul_add(v1863, -v1062);
-    let v1880: f64 = v591.mul_add(v1866, v1879);
-    let v1881: f64 = v1880 + v1645;
-    let v1882: f64 = v598.mul_add(v1747, v1881);
-    let v1883: f64 = v595.mul_add(v1758, v1882);
-    let v1884: f64 = p[28usize].mul_add(v1869, v1883);
-    let v1885: f64 = p[26usize].mul_add(v1875, v1884);
-    let v1886: f64 = qd[3usize].mul_add(v1878, v1885);
-    let v1888: f64 = v1116 * v1116;
-    let v1889: f64 = (-0.5f64) * v1888;
-    let v1890: f64 = v1889 * v1120;
-    let v1891: f64 = p[136usize] * v1890;
-    let v1892: f64 = p[32usize] * v1891;
-    let v1894: f64 = p[137usize] * v1117;
-    let v1895: f64 = v1894 * v1889;
-    let v1898: f64 = p[138usize] + q[4usize];
-    let v1899: f64 = v1636 * v636;
-    let v1901: f64 = p[139usize] * q[4usize];
-    let v1902: f64 = v1901 * v61;
-    let v1903: f64 = v1641.mul_add(v638, v1899);
-    let v1904: f64 = (-v1902).mul_add(v1889, v1903);
-    let v1906: f64 = 0.5f64 * v1116;
-    let v1907: f64 = v1906.mul_add(v1123, p[35usize]);
-    let v1908: f64 = v632.mul_add(v1892, -v1062);
-    let v1909: f64 = v623.mul_add(v1895, v1908);
-    let v1910: f64 = v1909 + v1616;
-    let v1911: f64 = v630.mul_add(v1746, v1910);
-    let v1912: f64 = v627.mul_add(v1757, v1911);
-    let v1913: f64 = p[34usize].mul_add(v1898, v1912);
-    let v1914: f64 = p[32usize].mul_add(v1904, v1913);
-    let v1915: f64 = qd[4usize].mul_add(v1907, v1914);
-    let v1917: f64 = v1128 * v1128;
-    let v1918: f64 = (-0.5f64) * v1917;
-    let v1919: f64 = v1918 * v1132;
-    let v1920: f64 = p[140usize] * v1919;
-    let v1921: f64 = p[38usize] * v1920;
-    let v1923: f64 = p[141usize] * v1129;
-    let v1924: f64 = v1923 * v1918;
-    let v1927: f64 = p[142usize] + q[5usize];
-    let v1928: f64 = v1607 * v668;
-    let v1930: f64 = p[143usize] * q[5usize];
-    let v1931: f64 = v1930 * v73;
-    let v1932: f64 = v1612.mul_add(v670, v1928);
-    let v1933: f64 = (-v1931).mul_add(v1918, v1932);
-    let v1935: f64 = 0.5f64 * v1128;
-    let v1936: f64 = v1935.mul_add(v1135, p[41usize]);
-    let v1937: f64 = v664.mul_add(v1921, -v1062);
-    let v1938: f64 = v655.mul_add(v1924, v1937);
-    let v1939: f64 = v1938 + v1587;
-    let v1940: f64 = v662.mul_add(v1745, v1939);
-    let v1941: f64 = v659.mul_add(v1756, v1940);
-    let v1942: f64 = p[40usize].mul_add(v1927, v1941);
-    let v1943: f64 = p[38usize].mul_add(v1933, v1942);
-    let v1944: f64 = qd[5usize].mul_add(v1936, v1943);
-    let v1946: f64 = v1140 * v1140;
-    let v1947: f64 = (-0.5f64) * v1946;
-    let v1948: f64 = v1947 * v1144;
-    let v1949: f64 = p[144usize] * v1948;
-    let v1950: f64 = p[44usize] * v1949;
-    let v1952: f64 = p[145usize] * v1141;
-    let v1953: f64 = v1952 * v1947;
-    let v1956: f64 = p[146usize] + q[6usize];
-    let v1957: f64 = v1578 * v700;
-    let v1959: f64 = p[147usize] * q[6usize];
-    let v1960: f64 = v1959 * v85;
-    let v1961: f64 = v1583.mul_add(v702, v1957);
-    let v1962: f64 = (-v1960).mul_add(v1947, v1961);
-    let v1964: f64 = 0.5f64 * v1140;
-    let v1965: f64 = v1964.mul_add(v1147, p[47usize]);
-    let v1966: f64 = v696.mul_add(v1950, -v1062);
-    let v1967: f64 = v687.mul_add(v1953, v1966);
-    let v1968: f64 = v1967 + v1558;
-    let v1969: f64 = v694.mul_add(v1744, v1968);
-    let v1970: f64 = v691.mul_add(v1755, v1969);
-    let v1971: f64 = p[46usize].mul_add(v1956, v1970);
-    let v1972: f64 = p[44usize].mul_add(v1962, v1971);
-    let v1973: f64 = qd[6usize].mul_add(v1965, v1972);
-    let v1975: f64 = v1152 * v1152;
-    let v1976: f64 = (-0.5f64) * v1975;
-    let v1977: f64 = v1976 * v1156;
-    let v1978: f64 = p[148usize] * v1977;
-    let v1979: f64 = p[50usize] * v1978;
-    let v1981: f64 = p[149usize] * v1153;
-    let v1982: f64 = v1981 * v1976;
-    let v1985: f64 = p[150usize] + q[7usize];
-    let v1986: f64 = v1549 * v732;
-    let v1988: f64 = p[151usize] * q[7usize];
-    let v1989: f64 = v1988 * v97;
-    let v1990: f64 = v1554.mul_add(v734, v1986);
-    let v1991: f64 = (-v1989).mul_add(v1976, v1990);
-    let v1993: f64 = 0.5f64 * v1152;
-    let v1994: f64 = v1993.mul_add(v1159, p[53usize]);
-    let v1995: f64 = v728.mul_add(v1979, -v1062);
-    let v1996: f64 = v719.mul_add(v1982, v1995);
-    let v1997: f64 = v1996 + v1529;
-    let v1998: f64 = v726.mul_add(v1743, v1997);
-    let v1999: f64 = v723.mul_add(v1754, v1998);
-    let v2000: f64 = p[52usize].mul_add(v1985, v1999);
-    let v2001: f64 = p[50usize].mul_add(v1991, v2000);
-    let v2002: f64 = qd[7usize].mul_add(v1994, v2001);
-    let v2004: f64 = v1164 * v1164;
-    let v2005: f64 = (-0.5f64) * v2004;
-    let v2006: f64 = v2005 * v1168;
-    let v2007: f64 = p[152usize] * v2006;
-    let v2008: f64 = p[56usize] * v2007;
-    let v2010: f64 = p[153usize] * v1165;
-    let v2011: f64 = v2010 * v2005;
-    let v2014: f64 = p[154usize] + q[8usize];
-    let v2015: f64 = v1520 * v764;
-    let v2017: f64 = p[155usize] * q[8usize];
-    let v2018: f64 = v2017 * v109;
-    let v2019: f64 = v1525.mul_add(v766, v2015);
-    let v2020: f64 = (-v2018).mul_add(v2005, v2019);
-    let v2022: f64 = 0.5f64 * v1164;
-    let v2023: f64 = v2022.mul_add(v1171, p[59usize]);
-    let v2024: f64 = v760.mul_add(v2008, -v1062);
-    let v2025: f64 = v751.mul_add(v2011, v2024);
-    let v2026: f64 = v2025 + v1500;
-    let v2027: f64 = v758.mul_add(v1742, v2026);
-    let v2028: f64 = v755.mul_add(v1753, v2027);
-    let v2029: f64 = p[58usize].mul_add(v2014, v2028);
-    let v2030: f64 = p[56usize].mul_add(v2020, v2029);
-    let v2031: f64 = qd[8usize].mul_add(v2023, v2030);
-    let v2033: f64 = v1176 * v1176;
-    let v2034: f64 = (-0.5f64) * v2033;
-    let v2035: f64 = v2034 * v1180;
-    let v2036: f64 = p[156usize] * v2035;
-    let v2037: f64 = p[62usize] * v2036;
-    let v2039: f64 = p[157usize] * v1177;
-    let v2040: f64 = v2039 * v2034;
-    let v2043: f64 = p[158usize] + q[9usize];
-    let v2044: f64 = v1491 * v796;
-    let v2046: f64 = p[159usize] * q[9usize];
-    let v2047: f64 = v2046 * v121;
-    let v2048: f64 = v1496.mul_add(v798, v2044);
-    let v2049: f64 = (-v2047).mul_add(v2034, v2048);
-    let v2051: f64 = 0.5f64 * v1176;
-    let v2052: f64 = v2051.mul_add(v1183, p[65usize]);
-    let v2053: f64 = v792.mul_add(v2037, -v1062);
-    let v2054: f64 = v783.mul_add(v2040, v2053);
-    let v2055: f64 = v2054 + v1471;
-    let v2056: f64 = v790.mul_add(v1741, v2055);
-    let v2057: f64 = v787.mul_add(v1752, v2056);
-    let v2058: f64 = p[64usize].mul_add(v2043, v2057);
-    let v2059: f64 = p[62usize].mul_add(v2049, v2058);
-    let v2060: f64 = qd[9usize].mul_add(v2052, v2059);
-    let v2062: f64 = v1188 * v1188;
-    let v2063: f64 = (-0.5f64) * v2062;
-    let v2064: f64 = v2063 * v1192;
-    let v2065: f64 = p[160usize] * v2064;
-    let v2066: f64 = p[68usize] * v2065;
-    let v2068: f64 = p[161usize] * v1189;
-    let v2069: f64 = v2068 * v2063;
-    let v2072: f64 = p[162usize] + q[10usize];
-    let v2073: f64 = v1462 * v828;
-    let v2075: f64 = p[163usize] * q[10usize];
-    let v2076: f64 = v2075 * v133;
-    let v2077: f64 = v1467.mul_add(v830, v2073);
-    let v2078: f64 = (-v2076).mul_add(v2063, v2077);
-    let v2080: f64 = 0.5f64 * v1188;
-    let v2081: f64 = v2080.mul_add(v1195, p[71usize]);
-    let v2082: f64 = v824.mul_add(v2066, -v1062);
-    let v2083: f64 = v815.mul_add(v2069, v2082);
-    let v2084: f64 = v2083 + v1442;
-    let v2085: f64 = v822.mul_add(v1740, v2084);
-    let v2086: f64 = v819.mul_add(v1751, v2085);
-    let v2087: f64 = p[70usize].mul_add(v2072, v2086);
-    let v2088: f64 = p[68usize].mul_add(v2078, v2087);
-    let v2089: f64 = qd[10usize].mul_add(v2081, v2088);
-    let v2091: f64 = v1199 * v1199;
-    let v2092: f64 = (-0.5f64) * v2091;
-    let v2093: f64 = v2092 * v1203;
-    let v2094: f64 = p[164usize] * v2093;
-    let v2095: f64 = p[74usize] * v2094;
-    let v2097: f64 = p[165usize] * v1200;
-    let v2098: f64 = v2097 * v2092;
-    let v2101: f64 = p[166usize] + q[11usize];
-    let v2102: f64 = v1379 * v853;
-    let v2104: f64 = p[167usize] * q[11usize];
-    let v2105: f64 = v2104 * v145;
-    let v2106: f64 = v1438.mul_add(v855, v2102);
-    let v2107: f64 = (-v2105).mul_add(v2092, v2106);
-    let v2109: f64 = 0.5f64 * v1199;
-    let v2110: f64 = v2109.mul_add(v1206, p[77usize]);
-    let v2111: f64 = v849.mul_add(v2095, -v1062);
-    let v2112: f64 = v846.mul_add(v2098, v2111);
-    let v2113: f64 = p[76usize].mul_add(v2101, v2112);
-    let v2114: f64 = p[74usize].mul_add(v2107, v2113);
-    let v2115: f64 = qd[11usize].mul_add(v2110, v2114);
-    out[0usize] = v525;
-    out[1usize] = v557;
-    out[2usize] = v589;
-    out[3usize] = v621;
-    out[4usize] = v653;
-    out[5usize] = v685;
-    out[6usize] = v717;
-    out[7usize] = v749;
-    out[8usize] = v781;
-    out[9usize] = v813;
-    out[10usize] = v844;
-    out[11usize] = v863;
-    out[12usize] = v871;
-    out[13usize] = v873;
-    out[14usize] = v875;
-    out[15usize] = v877;
-    out[16usize] = v879;
-    out[17usize] = v881;
-    out[18usize] = v883;
-    out[19usize] = v885;
-    out[20usize] = v887;
-    out[21usize] = v889;
-    out[22usize] = v891;
-    out[23usize] = v899;
-    out[24usize] = v901;
-    out[25usize] = v903;
-    out[26usize] = v905;
-    out[27usize] = v907;
-    out[28usize] = v909;
-    out[29usize] = v911;
-    out[30usize] = v913;
-    out[31usize] = v915;
-    out[32usize] = v917;
-    out[33usize] = v925;
-    out[34usize] = v927;
-    out[35usize] = v929;
-    out[36usize] = v931;
-    out[37usize] = v933;
-    out[38usize] = v935;
-    out[39usize] = v937;
-    out[40usize] = v939;
-    out[41usize] = v941;
-    out[42usize] = v949;
-    out[43usize] = v951;
-    out[44usize] = v953;
-    out[45usize] = v955;
-    out[46usize] = v957;
-    out[47usize] = v959;
-    out[48usize] = v961;
-    out[49usize] = v963;
-    out[50usize] = v971;
-    out[51usize] = v973;
-    out[52usize] = v975;
-    out[53usize] = v977;
-    out[54usize] = v979;
-    out[55usize] = v981;
-    out[56usize] = v983;
-    out[57usize] = v991;
-    out[58usize] = v993;
-    out[59usize] = v995;
-    out[60usize] = v997;
-    out[61usize] = v999;
-    out[62usize] = v1001;
-    out[63usize] = v1009;
-    out[64usize] = v1011;
-    out[65usize] = v1013;
-    out[66usize] = v1015;
-    out[67usize] = v1017;
-    out[68usize] = v1025;
-    out[69usize] = v1027;
-    out[70usize] = v1029;
-    out[71usize] = v1031;
-    out[72usize] = v1039;
-    out[73usize] = v1041;
-    out[74usize] = v1043;
-    out[75usize] = v1051;
-    out[76usize] = v1053;
-    out[77usize] = v1057;
-    out[78usize] = v1799;
-    out[79usize] = v1828;
-    out[80usize] = v1857;
-    out[81usize] = v1886;
-    out[82usize] = v1915;
-    out[83usize] = v1944;
-    out[84usize] = v1973;
-    out[85usize] = v2002;
-    out[86usize] = v2031;
-    out[87usize] = v2060;
-    out[88usize] = v2089;
-    out[89usize] = v2115;
+    out2[0usize] = v525;
+    out2[1usize] = v559;
+    out2[2usize] = v602;
+    out2[3usize] = v651;
+    out2[4usize] = v707;
+    out2[5usize] = v771;
+    out2[6usize] = v844;
+    out2[7usize] = v927;
+    out2[8usize] = v1021;
+    out2[9usize] = v1127;
+    out2[10usize] = v1245;
+    out2[11usize] = v1365;
+    out2[12usize] = v568;
+    out2[13usize] = v604;
+    out2[14usize] = v653;
+    out2[15usize] = v709;
+    out2[16usize] = v773;
+    out2[17usize] = v846;
+    out2[18usize] = v929;
+    out2[19usize] = v1023;
+    out2[20usize] = v1129;
+    out2[21usize] = v1247;
+    out2[22usize] = v1367;
+    out2[23usize] = v617;
+    out2[24usize] = v658;
+    out2[25usize] = v715;
+    out2[26usize] = v779;
+    out2[27usize] = v852;
+    out2[28usize] = v935;
+    out2[29usize] = v1029;
+    out2[30usize] = v1135;
+    out2[31usize] = v1253;
+    out2[32usize] = v1373;
+    out2[33usize] = v673;
+    out2[34usize] = v720;
+    out2[35usize] = v785;
+    out2[36usize] = v858;
+    out2[37usize] = v941;
+    out2[38usize] = v1035;
+    out2[39usize] = v1141;
+    out2[40usize] = v1259;
+    out2[41usize] = v1379;
+    out2[42usize] = v737;
+    out2[43usize] = v791;
+    out2[44usize] = v865;
+    out2[45usize] = v948;
+    out2[46usize] = v1042;
+    out2[47usize] = v1148;
+    out2[48usize] = v1266;
+    out2[49usize] = v1386;
+    out2[50usize] = v810;
+    out2[51usize] = v872;
+    out2[52usize] = v956;
+    out2[53usize] = v1050;
+    out2[54usize] = v1156;
+    out2[55usize] = v1274;
+    out2[56usize] = v1394;
+    out2[57usize] = v893;
+    out2[58usize] = v964;
+    out2[59usize] = v1059;
+    out2[60usize] = v1165;
+    out2[61usize] = v1283;
+    out2[62usize] = v1403;
+    out2[63usize] = v987;
+    out2[64usize] = v1068;
+    out2[65usize] = v1175;
+    out2[66usize] = v1293;
+    out2[67usize] = v1413;
+    out2[68usize] = v1093;
+    out2[69usize] = v1185;
+    out2[70usize] = v1304;
+    out2[71usize] = v1424;
+    out2[72usize] = v1212;
+    out2[73usize] = v1315;
+    out2[74usize] = v1436;
+    out2[75usize] = v1344;
+    out2[76usize] = v1448;
+    out2[77usize] = v1475;
+    out2[78usize] = v2240;
+    out2[79usize] = v2270;
+    out2[80usize] = v2301;
+    out2[81usize] = v2333;
+    out2[82usize] = v2366;
+    out2[83usize] = v2400;
+    out2[84usize] = v2435;
+    out2[85usize] = v2471;
+    out2[86usize] = v2508;
+    out2[87usize] = v2546;
+    out2[88usize] = v2585;
+    out2[89usize] = v2601;
 }
 /// Kernel `derived`: 228 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
@@ -5123,8 +3227,8 @@ pub fn derived(
     unsafe { derived_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
     q: &[f64; 12usize],
@@ -5542,8 +3646,8 @@ pub fn constraints(
     unsafe { constraints_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
     q: &[f64; 12usize],
@@ -5570,8 +3674,8 @@ pub fn contact(
     unsafe { contact_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
     q: &[f64; 12usize],
@@ -6622,8 +4726,8 @@ pub fn contact_jacobian_0(
     unsafe { contact_jacobian_0_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_0_0(
     t: f64,
     q: &[f64; 12usize],
@@ -6915,8 +5019,8 @@ pub fn contact_jacobian_1(
     unsafe { contact_jacobian_1_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_1_0(
     t: f64,
     q: &[f64; 12usize],
@@ -7222,8 +5326,8 @@ pub fn contact_jacobian_2(
     unsafe { contact_jacobian_2_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_2_0(
     t: f64,
     q: &[f64; 12usize],
@@ -7538,8 +5642,8 @@ pub fn contact_jacobian_3(
     unsafe { contact_jacobian_3_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_3_0(
     t: f64,
     q: &[f64; 12usize],
@@ -7863,8 +5967,8 @@ pub fn contact_jacobian_4(
     unsafe { contact_jacobian_4_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_4_0(
     t: f64,
     q: &[f64; 12usize],
@@ -8197,8 +6301,8 @@ pub fn contact_jacobian_5(
     unsafe { contact_jacobian_5_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_5_0(
     t: f64,
     q: &[f64; 12usize],
@@ -8540,8 +6644,8 @@ pub fn contact_jacobian_6(
     unsafe { contact_jacobian_6_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_6_0(
     t: f64,
     q: &[f64; 12usize],
@@ -8892,8 +6996,8 @@ pub fn contact_jacobian_7(
     unsafe { contact_jacobian_7_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_7_0(
     t: f64,
     q: &[f64; 12usize],
@@ -9253,8 +7357,8 @@ pub fn contact_jacobian_8(
     unsafe { contact_jacobian_8_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_8_0(
     t: f64,
     q: &[f64; 12usize],
@@ -9623,8 +7727,8 @@ pub fn contact_jacobian_9(
     unsafe { contact_jacobian_9_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_9_0(
     t: f64,
     q: &[f64; 12usize],
@@ -10002,8 +8106,8 @@ pub fn contact_jacobian_10(
     unsafe { contact_jacobian_10_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_10_0(
     t: f64,
     q: &[f64; 12usize],
@@ -10390,8 +8494,8 @@ pub fn contact_jacobian_11(
     unsafe { contact_jacobian_11_0(t, q, qd, qdd, dir, p, aux, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jacobian_11_0(
     t: f64,
     q: &[f64; 12usize],
@@ -10797,8 +8901,8 @@ pub fn contact_jvp(
         });
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
     q: &[f64; 12usize],
@@ -14091,8 +12195,8 @@ fn contact_jvp_0(
     out[858usize] = v3047;
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn contact_jvp_1(
     t: f64,
     q: &[f64; 12usize],
@@ -17741,8 +15845,8 @@ pub fn cell_0_pose(
     unsafe { cell_0_pose_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
     q: &[f64; 1usize],
@@ -17857,8 +15961,8 @@ pub fn cell_0(
     unsafe { cell_0_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
     q: &[f64; 1usize],
@@ -18016,8 +16120,8 @@ pub fn cell_0_tangent(
     unsafe { cell_0_tangent_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
     q: &[f64; 1usize],
@@ -18312,8 +16416,8 @@ pub fn link_loads(
     unsafe { link_loads_0(t, q, qd, qdd, dir, p, w, out) };
 }
 #[inline(never)]
-#[allow(unused_variables, clippy::all)]
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
 fn link_loads_0(
     t: f64,
     q: &[f64; 12usize],

@@ -68,10 +68,8 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
     let mass_bias = cas.to_tape_hoisted(&mass_bias, &mut hoist);
     let outputs = cas.to_tape_hoisted(&eq.outputs, &mut hoist);
     let n = eq.bias.len();
-    // Chains whose mass + bias the link recursion computes solve M qdd =
-    // -h at run time: their compiled mass + bias and an L D L^T solve beat
-    // a generated symbolic solve, whose unrolled code is past the
-    // instruction caches.
+    // Chains whose mass + bias the link recursion computes have no `Accel`
+    // kernel: the solve runs on the recursion's output.
     // An assembly is many chains and bodies: flat kernels.
     let single = structure.assembly.is_none();
     let links = if single {
@@ -86,19 +84,17 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
     let contact = (!sys.samples.is_empty()).then(|| contact_outputs(&mut cas, &sys));
     let accel_tape = if accel {
         // The contact frames ride along (else the points): they share the
-        // kinematics' trig with M and h, and a right-hand side that touches
-        // nothing needs nothing else.
+        // kinematics' trig with M and h, and a right-hand side that
+        // touches nothing needs nothing else. M and h follow, so that the
+        // tape gives `MassBias` too (`TapeSet::accel`).
         let s = solve_accelerations(&mut cas, &eq.mass_upper, &eq.bias);
         let points: Vec<ExprId> = match &contact {
             Some(c) if !c.frames.is_empty() => c.frames.clone(),
             _ => sys.samples.iter().flat_map(|s| s.point).collect(),
         };
-        let outs: Vec<_> = s
-            .qdd
-            .into_iter()
-            .chain(s.pivots)
-            .chain(s.lower)
+        let outs: Vec<_> = (s.qdd.into_iter().chain(s.pivots).chain(s.lower))
             .chain(points)
+            .chain(eq.mass_upper.iter().chain(&eq.bias).copied())
             .collect();
         cas.to_tape_hoisted(&outs, &mut hoist)
     } else {

@@ -36,6 +36,9 @@ struct KernelEmitter<'a> {
     n_spill: usize,
     /// Four evaluations at once in `runtime::lanes::X4` (`emit_lanes`).
     lanes: bool,
+    /// Outputs from this index on go to a second array, `out2` (one tape
+    /// for two kernels: `emit_accel`).
+    split: Option<usize>,
 }
 
 impl<'a> KernelEmitter<'a> {
@@ -81,6 +84,7 @@ impl<'a> KernelEmitter<'a> {
             spill,
             n_spill,
             lanes: false,
+            split: None,
         }
     }
 
@@ -368,31 +372,30 @@ impl<'a> KernelEmitter<'a> {
                 body.push(if self.lanes {
                     quote!(out[#k] = runtime::lanes::to_array(#val);)
                 } else {
-                    quote!(out[#k] = #val;)
+                    match self.split {
+                        Some(first) if k >= first => {
+                            let k = k - first;
+                            quote!(out2[#k] = #val;)
+                        }
+                        _ => quote!(out[#k] = #val;),
+                    }
                 });
             }
         }
         body
     }
 
-    /// The kernel function `name` and its chunks; a tape that reads `aux`
-    /// takes it after `p`, `n_aux` values.
-    fn emit(&self, name: &str, dof: usize, n_params: usize, n_aux: usize) -> TokenStream {
-        assert!(self.aux_len() <= n_aux, "{name} reads past its aux input");
-        let (aux_param, aux_arg) = match self.aux_len() {
-            0 => (quote!(), quote!()),
-            _ => (quote!(aux: &[f64; #n_aux],), quote!(aux,)),
-        };
-        let n_out = self.tape.outputs.len();
-        let n_chunks = self.n_chunks().max(1);
-        let n_spill = self.n_spill;
-        let n_dir = 2 * dof;
-        let mut chunks = Vec::new();
-        let mut calls = Vec::new();
-        // Members of one family at the same argument come from one call (in
-        // the chunk of the first, see `new`): sin and cos from `sin_cos`, the
-        // orders of a removable function from `*_orders`, the Rodrigues
-        // coefficients from `rodrigues::family`.
+    /// Members of one family at the same argument come from one call (in
+    /// the chunk of the first, see `new`): sin and cos from `sin_cos`, the
+    /// orders of a removable function from `*_orders`, the Rodrigues
+    /// coefficients from `rodrigues::family`.
+    #[allow(clippy::type_complexity)]
+    fn families(
+        &self,
+    ) -> (
+        HashMap<(Family, Slot), Vec<(Member, usize)>>,
+        HashMap<usize, (Family, Slot)>,
+    ) {
         let mut groups: HashMap<(Family, Slot), Vec<(Member, usize)>> = HashMap::new();
         for (i, op) in self.tape.ops.iter().enumerate() {
             if let Some((family, member, a)) = family_of(op) {
@@ -404,76 +407,124 @@ impl<'a> KernelEmitter<'a> {
             .iter()
             .flat_map(|(&(f, a), ms)| ms.iter().map(move |&(_, i)| (i, (f, a))))
             .collect();
+        (groups, group_of)
+    }
+
+    /// The chunk functions `name_0`, `name_1`, ... and their names. Built
+    /// for FMA and never inlined; with `inline`, always inlined into a
+    /// caller built for FMA instead (a kernel composed of others).
+    fn chunks(
+        &self,
+        name: &str,
+        dof: usize,
+        n_params: usize,
+        n_aux: usize,
+        inline: bool,
+    ) -> (Vec<TokenStream>, Vec<Ident>) {
+        assert!(self.aux_len() <= n_aux, "{name} reads past its aux input");
+        let aux_param = match self.aux_len() {
+            0 => quote!(),
+            _ => quote!(aux: &[f64; #n_aux],),
+        };
+        let n_all = self.tape.outputs.len();
+        let (n_out, out2) = match self.split {
+            Some(first) => {
+                let n2 = n_all - first;
+                (first, quote!(, out2: &mut [f64; #n2]))
+            }
+            None => (n_all, quote!()),
+        };
+        let n_chunks = self.n_chunks().max(1);
+        let n_spill = self.n_spill;
+        let n_dir = 2 * dof;
+        let (groups, group_of) = self.families();
+        let attributes = match inline {
+            true => quote!(#[inline(always)]),
+            false => quote! {
+                #[inline(never)]
+                #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+            },
+        };
+        let mut chunks = Vec::new();
+        let mut names = Vec::new();
         for c in 0..n_chunks {
             let body = self.chunk_body(c, n_chunks, &groups, &group_of);
-            if self.lanes {
-                assert!(n_chunks == 1 && n_spill == 0, "lane kernels are one chunk");
-                assert!(
-                    !self
-                        .tape
-                        .ops
-                        .iter()
-                        .any(|op| matches!(op, Op::Time | Op::Qdd(_) | Op::Dir(_) | Op::Aux(_))),
-                    "lane kernels read q, qd and p"
-                );
-                let f = format_ident!("{}", name);
-                let doc = format!(
-                    " Kernel `{name}`: {} operations, four evaluations in vector lanes.",
-                    self.tape.op_count()
-                );
-                return quote! {
-                    #[doc = #doc]
-                    #[cfg(target_arch = "x86_64")]
-                    #[inline(never)]
-                    #[allow(unused_variables, unused_parens, clippy::all)]
-                    #[target_feature(enable = "avx,fma")]
-                    fn #f(q: &[[f64; 4]; #dof], qd: &[[f64; 4]; #dof], p: &[[f64; 4]; #n_params],
-                          out: &mut [[f64; 4]; #n_out]) {
-                        use std::arch::x86_64::*;
-                        #(#body)*
-                    }
-                };
-            }
             let f = format_ident!("{}_{}", name, c);
             chunks.push(quote! {
-                #[inline(never)]
+                #attributes
                 #[allow(unused_variables, clippy::all)]
-                #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
                 fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir],
-                      p: &[f64; #n_params], #aux_param w: &mut [f64; #n_spill], out: &mut [f64; #n_out]) {
+                      p: &[f64; #n_params], #aux_param w: &mut [f64; #n_spill], out: &mut [f64; #n_out] #out2) {
                     #(#body)*
                 }
             });
-            calls.push(quote!(
-                // SAFETY: `require_fma` has checked that the processor has FMA.
-                unsafe { #f(t, q, qd, qdd, dir, p, #aux_arg w, out) };
-            ));
+            names.push(f);
         }
-        let f = Ident::new(name, Span::call_site());
+        (chunks, names)
+    }
+
+    /// The lane kernel `name`: four evaluations in vector lanes.
+    fn emit_lanes_kernel(&self, name: &str, dof: usize, n_params: usize) -> TokenStream {
+        let n_out = self.tape.outputs.len();
+        let (groups, group_of) = self.families();
+        assert!(
+            self.n_chunks() <= 1 && self.n_spill == 0,
+            "lane kernels are one chunk"
+        );
+        assert!(
+            !self
+                .tape
+                .ops
+                .iter()
+                .any(|op| matches!(op, Op::Time | Op::Qdd(_) | Op::Dir(_) | Op::Aux(_))),
+            "lane kernels read q, qd and p"
+        );
+        let body = self.chunk_body(0, 1, &groups, &group_of);
+        let f = format_ident!("{}", name);
         let doc = format!(
-            " Kernel `{name}`: {} operations in {n_chunks} chunk(s).",
+            " Kernel `{name}`: {} operations, four evaluations in vector lanes.",
             self.tape.op_count()
         );
-        // The workspace is a per-thread buffer, allocated on the first call:
-        // a fresh array would be zeroed on every call (a memset of several
-        // kilobytes for a 3D arm) and a large one would crowd the stack.
-        let body = if n_spill == 0 {
-            quote! {
-                let w = &mut [0.0f64; 0];
-                #(#calls)*
+        quote! {
+            #[doc = #doc]
+            #[cfg(target_arch = "x86_64")]
+            #[inline(never)]
+            #[allow(unused_variables, unused_parens, clippy::all)]
+            #[target_feature(enable = "avx,fma")]
+            fn #f(q: &[[f64; 4]; #dof], qd: &[[f64; 4]; #dof], p: &[[f64; 4]; #n_params],
+                  out: &mut [[f64; 4]; #n_out]) {
+                use std::arch::x86_64::*;
+                #(#body)*
             }
-        } else {
-            quote! {
-                thread_local! {
-                    static WORKSPACE: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
-                }
-                WORKSPACE.with_borrow_mut(|heap| {
-                    heap.resize(#n_spill, 0.0);
-                    let w: &mut [f64; #n_spill] = (&mut heap[..]).try_into().expect("workspace length");
-                    #(#calls)*
-                });
-            }
+        }
+    }
+
+    /// The kernel function `name` and its chunks; a tape that reads `aux`
+    /// takes it after `p`, `n_aux` values.
+    fn emit(&self, name: &str, dof: usize, n_params: usize, n_aux: usize) -> TokenStream {
+        if self.lanes {
+            return self.emit_lanes_kernel(name, dof, n_params);
+        }
+        let (aux_param, aux_arg) = match self.aux_len() {
+            0 => (quote!(), quote!()),
+            _ => (quote!(aux: &[f64; #n_aux],), quote!(aux,)),
         };
+        let n_out = self.tape.outputs.len();
+        let n_dir = 2 * dof;
+        let (chunks, names) = self.chunks(name, dof, n_params, n_aux, false);
+        let calls = names.iter().map(|f| {
+            quote!(
+                // SAFETY: `require_fma` has checked that the processor has FMA.
+                unsafe { #f(t, q, qd, qdd, dir, p, #aux_arg w, out) };
+            )
+        });
+        let f = Ident::new(name, Span::call_site());
+        let doc = format!(
+            " Kernel `{name}`: {} operations in {} chunk(s).",
+            self.tape.op_count(),
+            names.len()
+        );
+        let body = with_workspace(self.n_spill, quote!(#(#calls)*));
         quote! {
             #[doc = #doc]
             #[allow(unused_unsafe)]
@@ -483,6 +534,29 @@ impl<'a> KernelEmitter<'a> {
             }
             #(#chunks)*
         }
+    }
+}
+
+/// `calls` with `w`, the spill workspace of `n_spill` values: a per-thread
+/// buffer, allocated on the first call. A fresh array would be zeroed on
+/// every call (a memset of several kilobytes for a 3D arm) and a large one
+/// would crowd the stack.
+fn with_workspace(n_spill: usize, calls: TokenStream) -> TokenStream {
+    if n_spill == 0 {
+        return quote! {
+            let w = &mut [0.0f64; 0];
+            #calls
+        };
+    }
+    quote! {
+        thread_local! {
+            static WORKSPACE: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        WORKSPACE.with_borrow_mut(|heap| {
+            heap.resize(#n_spill, 0.0);
+            let w: &mut [f64; #n_spill] = (&mut heap[..]).try_into().expect("workspace length");
+            #calls
+        });
     }
 }
 
@@ -1176,6 +1250,11 @@ fn emit_kernels(
             // Emitted with the recursion, below.
             (Some(_), KernelKind::Jvp | KernelKind::Outputs) => {}
             (Some(links), KernelKind::MassBias) if links.mass_bias => {}
+            (_, KernelKind::Accel) if tapes.info.accel => {
+                kernels.push(emit_accel(tapes, dof, n_params))
+            }
+            // Emitted with `Accel`, on the same code.
+            (_, KernelKind::MassBias) if tapes.info.accel => {}
             (_, KernelKind::ContactJacobian) => kernels.push(emit_groups(tapes, dof, n_params)),
             _ => {
                 let tape = &tapes.tapes(kind)[0];
@@ -1200,6 +1279,67 @@ fn emit_kernels(
         });
     }
     (kernels, arms)
+}
+
+/// `Accel` and `MassBias` from one tape (`TapeSet::accel`: the solve's
+/// values, then M and h): its code is emitted once, always inlined, into
+/// two functions built for FMA. Each keeps its own values, and the
+/// compiler drops the code of the others (in `mass_bias` the solve, in
+/// `accel` nothing that M and h do not feed).
+fn emit_accel(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream {
+    let (n_mb, n_out) = (
+        KernelKind::MassBias.output_len(&tapes.info),
+        KernelKind::Accel.output_len(&tapes.info),
+    );
+    assert_eq!(
+        tapes.accel.outputs.len(),
+        n_out + n_mb,
+        "the accel tape gives Accel, then MassBias"
+    );
+    let n_dir = 2 * dof;
+    let all = KernelEmitter {
+        split: Some(n_out),
+        ..KernelEmitter::new(&tapes.accel)
+    };
+    let (chunks, names) = all.chunks("eom", dof, n_params, 0, true);
+    let n_spill = all.n_spill;
+    let inputs = quote!(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params]);
+    // `outs`: the chunks' two output arrays, the kernel's own and a local
+    // one whose values are never read.
+    let kernel = |name: &str, n: usize, n_unused: usize, outs: TokenStream, which: &str| {
+        let f = Ident::new(name, Span::call_site());
+        let fma = format_ident!("{}_fma", name);
+        let doc = format!(
+            " Kernel `{name}`: the {which} {n} values of `eom` ({} operations for all).",
+            tapes.accel.op_count()
+        );
+        let call = with_workspace(
+            n_spill,
+            quote!(unsafe { #fma(t, q, qd, qdd, dir, p, w, out) };),
+        );
+        quote! {
+            #[doc = #doc]
+            #[allow(unused_unsafe)]
+            pub fn #f(#inputs, out: &mut [f64; #n]) {
+                runtime::cpu::require_fma();
+                // SAFETY: `require_fma` has checked that the processor has FMA.
+                #call
+            }
+            #[inline(never)]
+            #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+            fn #fma(#inputs, w: &mut [f64; #n_spill], out: &mut [f64; #n]) {
+                let mut unused = [0.0f64; #n_unused];
+                #(#names(t, q, qd, qdd, dir, p, w, #outs);)*
+            }
+        }
+    };
+    let accel = kernel("accel", n_out, n_mb, quote!(out, &mut unused), "first");
+    let mass_bias = kernel("mass_bias", n_mb, n_out, quote!(&mut unused, out), "last");
+    quote! {
+        #accel
+        #mass_bias
+        #(#chunks)*
+    }
 }
 
 /// Rust source of one compiled-in model.

@@ -22,11 +22,10 @@ use crate::tape::{Inputs, Tape};
 ///   unit diagonal row by row (n (n - 1) / 2 values), then the contact
 ///   frames as `Contact` gives them (`ModelInfo::contact_frames`), or
 ///   where the chain has none the points' positions (3 per point): the
-///   mass solve generated as straight-line code, with what a contact
-///   force found after it needs (the broad phase or the gaps, and
-///   L D L^T to solve for it).
-///   Present only when `ModelInfo::accel` (small arms); otherwise the
-///   runtime solves `MassBias` output.
+///   mass solve generated as straight-line code ([`TapeSet::accel`]), with what a contact force found
+///   after it needs (the broad phase or the gaps, and L D L^T to solve
+///   for it). Present only when `ModelInfo::accel` (small arms);
+///   otherwise the runtime solves `MassBias` output.
 /// * `Jvp`: the directional derivative of the inverse dynamics
 ///   tau(q, qd, qdd) = M qdd + h along the input direction (dq, dqd), at
 ///   the input `qdd` (n values). The runtime assembles the right-hand
@@ -253,7 +252,9 @@ pub struct TapeSet {
     pub mass_bias: Tape,
     pub outputs: Tape,
     pub derived: Tape,
-    /// Empty unless `info.accel`.
+    /// The `Accel` kernel's values, then `MassBias`'s: one tape gives
+    /// both (compiled, each kernel's function keeps its values and the
+    /// compiler drops the code of the rest). Empty unless `info.accel`.
     pub accel: Tape,
     pub jvp: Tape,
     /// Empty unless `info.constraints > 0`.
@@ -374,6 +375,11 @@ impl Kernels for Interpreted {
         }
         if kind == KernelKind::Jvp {
             return self.jvp(inp, &mut slots, out);
+        }
+        if kind == KernelKind::Accel {
+            let mut all = vec![0.0; tape.outputs.len()];
+            tape.eval(inp, &mut slots, &mut all);
+            return out.copy_from_slice(&all[..out.len()]);
         }
         tape.eval(inp, &mut slots, out);
     }
