@@ -4,7 +4,7 @@
 use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
 /// Structural hash of the model this was derived from.
 pub const HASH: &str = "bc17844363980b6d";
-pub const DOF: usize = 8usize;
+pub const DOF: usize = 8;
 pub const COORDINATES: &[&str] = &[
     "theta_0_0",
     "theta_0_1",
@@ -73,21 +73,21 @@ pub const PARAMETERS: &[&str] = &[
     "joint[7].rest",
 ];
 /// Derived parameters, computed once per parameter set.
-pub const DERIVED: usize = 41usize;
+pub const DERIVED: usize = 41;
 /// Whether the mass solve is generated (the `accel` kernel).
 pub const ACCEL: bool = true;
 /// Base parameters that are loads (scaled by load continuation).
-pub const LOADS: &[usize] = &[0usize, 1usize, 2usize];
+pub const LOADS: &[usize] = &[0, 1, 2];
 /// The rows of the joints' constraint equations.
 pub const CONSTRAINTS: &[&str] = &[];
 /// Coordinates per independent subsystem (M block diagonal).
 pub const BLOCKS: &[usize] = &[];
 /// Contact points along the arms and at the bodies.
-pub const CONTACT_POINTS: usize = 0usize;
+pub const CONTACT_POINTS: usize = 0;
 /// Points per group of the `contact_jacobian` kernel.
 pub const CONTACT_GROUPS: &[usize] = &[];
 /// Length of the contact frames the `contact_jacobian` groups read.
-pub const CONTACT_FRAMES: usize = 0usize;
+pub const CONTACT_FRAMES: usize = 0;
 /// The compiled kernels of this structure.
 pub struct Compiled {
     info: ModelInfo,
@@ -119,17 +119,17 @@ impl Kernels for Compiled {
         "compiled"
     }
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
-        let q: &[f64; 8usize] = inp.q.try_into().expect("q has DOF entries");
-        let qd: &[f64; 8usize] = inp.qd.try_into().expect("qd has DOF entries");
-        let p: &[f64; 96usize] = inp.p.try_into().expect("parameter vector length");
-        let no_qdd = [0.0f64; 8usize];
-        let qdd: &[f64; 8usize] = if inp.qdd.is_empty() {
+        let q: &[f64; 8] = inp.q.try_into().expect("q has DOF entries");
+        let qd: &[f64; 8] = inp.qd.try_into().expect("qd has DOF entries");
+        let p: &[f64; 96] = inp.p.try_into().expect("parameter vector length");
+        let no_qdd = [0.0f64; 8];
+        let qdd: &[f64; 8] = if inp.qdd.is_empty() {
             &no_qdd
         } else {
             inp.qdd.try_into().expect("qdd has DOF entries")
         };
-        let no_dir = [0.0f64; 16usize];
-        let dir: &[f64; 16usize] = if inp.dir.is_empty() {
+        let no_dir = [0.0f64; 16];
+        let dir: &[f64; 16] = if inp.dir.is_empty() {
             &no_dir
         } else {
             inp.dir.try_into().expect("dir has 2 DOF entries")
@@ -226,12 +226,12 @@ impl Kernels for Compiled {
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    out: &mut [f64; 44usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    out: &mut [f64; 44],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -241,27 +241,27 @@ pub fn accel(
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
 fn accel_fma(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 44usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    w: &mut [f64; 0],
+    out: &mut [f64; 44],
 ) {
-    let mut unused = [0.0f64; 44usize];
+    let mut unused = [0.0f64; 44];
     eom_0(t, q, qd, qdd, dir, p, w, out, &mut unused);
 }
 /// Kernel `mass_bias`: the last 44 values of `eom` (1085 operations for all).
 #[allow(unused_unsafe)]
 pub fn mass_bias(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    out: &mut [f64; 44usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    out: &mut [f64; 44],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -271,825 +271,825 @@ pub fn mass_bias(
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
 fn mass_bias_fma(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 44usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    w: &mut [f64; 0],
+    out: &mut [f64; 44],
 ) {
-    let mut unused = [0.0f64; 44usize];
+    let mut unused = [0.0f64; 44];
     eom_0(t, q, qd, qdd, dir, p, w, &mut unused, out);
 }
 #[inline(always)]
 #[allow(unused_variables, clippy::all)]
 fn eom_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 44usize],
-    out2: &mut [f64; 44usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    w: &mut [f64; 0],
+    out: &mut [f64; 44],
+    out2: &mut [f64; 44],
 ) {
-    let v13: f64 = p[6usize] + q[0usize];
+    let v13 = p[6] + q[0];
     let (v60, v14): (f64, f64) = runtime::special::sin_cos(v13);
-    let v15: f64 = p[7usize] * v14;
-    let v16: f64 = p[3usize] + v15;
-    let v19: f64 = q[1usize] + v13;
+    let v15 = p[7] * v14;
+    let v16 = p[3] + v15;
+    let v19 = q[1] + v13;
     let (v63, v20): (f64, f64) = runtime::special::sin_cos(v19);
-    let v21: f64 = p[13usize] * v20;
-    let v22: f64 = v16 + v21;
-    let v25: f64 = q[2usize] + v19;
+    let v21 = p[13] * v20;
+    let v22 = v16 + v21;
+    let v25 = q[2] + v19;
     let (v66, v26): (f64, f64) = runtime::special::sin_cos(v25);
-    let v27: f64 = p[19usize] * v26;
-    let v28: f64 = v22 + v27;
-    let v31: f64 = q[3usize] + v25;
+    let v27 = p[19] * v26;
+    let v28 = v22 + v27;
+    let v31 = q[3] + v25;
     let (v69, v32): (f64, f64) = runtime::special::sin_cos(v31);
-    let v33: f64 = p[25usize] * v32;
-    let v34: f64 = v28 + v33;
-    let v37: f64 = q[4usize] + v31;
+    let v33 = p[25] * v32;
+    let v34 = v28 + v33;
+    let v37 = q[4] + v31;
     let (v72, v38): (f64, f64) = runtime::special::sin_cos(v37);
-    let v39: f64 = p[31usize] * v38;
-    let v40: f64 = v34 + v39;
-    let v43: f64 = q[5usize] + v37;
+    let v39 = p[31] * v38;
+    let v40 = v34 + v39;
+    let v43 = q[5] + v37;
     let (v75, v44): (f64, f64) = runtime::special::sin_cos(v43);
-    let v45: f64 = p[37usize] * v44;
-    let v46: f64 = v40 + v45;
-    let v49: f64 = q[6usize] + v43;
+    let v45 = p[37] * v44;
+    let v46 = v40 + v45;
+    let v49 = q[6] + v43;
     let (v78, v50): (f64, f64) = runtime::special::sin_cos(v49);
-    let v51: f64 = p[43usize] * v50;
-    let v52: f64 = v46 + v51;
-    let v55: f64 = q[7usize] + v49;
+    let v51 = p[43] * v50;
+    let v52 = v46 + v51;
+    let v55 = q[7] + v49;
     let (v81, v56): (f64, f64) = runtime::special::sin_cos(v55);
-    let v57: f64 = p[55usize] * v56;
-    let v58: f64 = v52 + v57;
-    let v61: f64 = p[7usize] * v60;
-    let v62: f64 = p[4usize] + v61;
-    let v64: f64 = p[13usize] * v63;
-    let v65: f64 = v62 + v64;
-    let v67: f64 = p[19usize] * v66;
-    let v68: f64 = v65 + v67;
-    let v70: f64 = p[25usize] * v69;
-    let v71: f64 = v68 + v70;
-    let v73: f64 = p[31usize] * v72;
-    let v74: f64 = v71 + v73;
-    let v76: f64 = p[37usize] * v75;
-    let v77: f64 = v74 + v76;
-    let v79: f64 = p[43usize] * v78;
-    let v80: f64 = v77 + v79;
-    let v82: f64 = p[55usize] * v81;
-    let v83: f64 = v80 + v82;
-    let v84: f64 = v83 * v83;
-    let v85: f64 = v58.mul_add(v58, v84);
-    let v86: f64 = p[50usize].mul_add(v85, p[51usize]);
-    let v89: f64 = p[56usize] * v50;
-    let v90: f64 = v46 + v89;
-    let v91: f64 = p[56usize] * v78;
-    let v92: f64 = v77 + v91;
-    let v93: f64 = v92 * v92;
-    let v94: f64 = v90.mul_add(v90, v93);
-    let v95: f64 = p[45usize] + v86;
-    let v96: f64 = p[44usize].mul_add(v94, v95);
-    let v99: f64 = p[57usize] * v44;
-    let v100: f64 = v40 + v99;
-    let v101: f64 = p[57usize] * v75;
-    let v102: f64 = v74 + v101;
-    let v103: f64 = v102 * v102;
-    let v104: f64 = v100.mul_add(v100, v103);
-    let v105: f64 = p[39usize] + v96;
-    let v106: f64 = p[38usize].mul_add(v104, v105);
-    let v109: f64 = p[58usize] * v38;
-    let v110: f64 = v34 + v109;
-    let v111: f64 = p[58usize] * v72;
-    let v112: f64 = v71 + v111;
-    let v113: f64 = v112 * v112;
-    let v114: f64 = v110.mul_add(v110, v113);
-    let v115: f64 = p[33usize] + v106;
-    let v116: f64 = p[32usize].mul_add(v114, v115);
-    let v119: f64 = p[59usize] * v32;
-    let v120: f64 = v28 + v119;
-    let v121: f64 = p[59usize] * v69;
-    let v122: f64 = v68 + v121;
-    let v123: f64 = v122 * v122;
-    let v124: f64 = v120.mul_add(v120, v123);
-    let v125: f64 = p[27usize] + v116;
-    let v126: f64 = p[26usize].mul_add(v124, v125);
-    let v129: f64 = p[60usize] * v26;
-    let v130: f64 = v22 + v129;
-    let v131: f64 = p[60usize] * v66;
-    let v132: f64 = v65 + v131;
-    let v133: f64 = v132 * v132;
-    let v134: f64 = v130.mul_add(v130, v133);
-    let v135: f64 = p[21usize] + v126;
-    let v136: f64 = p[20usize].mul_add(v134, v135);
-    let v139: f64 = p[61usize] * v20;
-    let v140: f64 = v16 + v139;
-    let v141: f64 = p[61usize] * v63;
-    let v142: f64 = v62 + v141;
-    let v143: f64 = v142 * v142;
-    let v144: f64 = v140.mul_add(v140, v143);
-    let v145: f64 = p[15usize] + v136;
-    let v146: f64 = p[14usize].mul_add(v144, v145);
-    let v149: f64 = p[62usize] * v14;
-    let v151: f64 = p[63usize] * v60;
-    let v152: f64 = v151 * v151;
-    let v153: f64 = v149.mul_add(v149, v152);
-    let v154: f64 = -v61;
-    let v155: f64 = v62 + v154;
-    let v156: f64 = p[50usize] * v83;
-    let v157: f64 = p[44usize].mul_add(v92, v156);
-    let v158: f64 = p[38usize].mul_add(v102, v157);
-    let v159: f64 = p[32usize].mul_add(v112, v158);
-    let v160: f64 = p[26usize].mul_add(v122, v159);
-    let v161: f64 = p[20usize].mul_add(v132, v160);
-    let v162: f64 = p[14usize].mul_add(v142, v161);
-    let v164: f64 = 2f64 * v162;
-    let v166: f64 = v155.mul_add(p[64usize], -v164);
-    let v167: f64 = v15 - v16;
-    let v168: f64 = p[50usize] * v58;
-    let v169: f64 = p[44usize].mul_add(v90, v168);
-    let v170: f64 = p[38usize].mul_add(v100, v169);
-    let v171: f64 = p[32usize].mul_add(v110, v170);
-    let v172: f64 = p[26usize].mul_add(v120, v171);
-    let v173: f64 = p[20usize].mul_add(v130, v172);
-    let v174: f64 = p[14usize].mul_add(v140, v173);
-    let v175: f64 = v167 * p[64usize];
-    let v176: f64 = 2f64.mul_add(v174, v175);
-    let v177: f64 = p[9usize] + v146;
-    let v178: f64 = p[8usize].mul_add(v153, v177);
-    let v179: f64 = v155.mul_add(v166, v178);
-    let v180: f64 = v167.mul_add(v176, v179);
-    let v182: f64 = 1f64 / v180;
-    let v183: f64 = v21 - v22;
-    let v184: f64 = -v64;
-    let v185: f64 = v65 + v184;
-    let v187: f64 = p[65usize] * v63;
-    let v188: f64 = v142 * v187;
-    let v189: f64 = v140.mul_add(v139, -v188);
-    let v190: f64 = v183.mul_add(v173, v145);
-    let v191: f64 = (-v185).mul_add(v161, v190);
-    let v192: f64 = p[14usize].mul_add(v189, v191);
-    let v194: f64 = v185 * p[66usize];
-    let v195: f64 = v194 - v161;
-    let v196: f64 = p[14usize].mul_add(v187, v195);
-    let v197: f64 = v183 * p[66usize];
-    let v198: f64 = v173 + v197;
-    let v199: f64 = p[14usize].mul_add(v139, v198);
-    let v200: f64 = v155.mul_add(v196, v192);
-    let v201: f64 = v167.mul_add(v199, v200);
-    let v202: f64 = v182 * v201;
-    let v203: f64 = v139 * v139;
-    let v204: f64 = v187.mul_add(v187, v203);
-    let v205: f64 = (-2f64).mul_add(v161, v194);
-    let v206: f64 = 2f64.mul_add(v173, v197);
-    let v207: f64 = p[14usize].mul_add(v204, v145);
-    let v208: f64 = v185.mul_add(v205, v207);
-    let v209: f64 = v183.mul_add(v206, v208);
-    let v210: f64 = (-v201).mul_add(v202, v209);
-    let v211: f64 = 1f64 / v210;
-    let v212: f64 = v27 - v28;
-    let v213: f64 = -v67;
-    let v214: f64 = v68 + v213;
-    let v216: f64 = p[67usize] * v66;
-    let v217: f64 = v132 * v216;
-    let v218: f64 = v130.mul_add(v129, -v217);
-    let v219: f64 = v212.mul_add(v172, v135);
-    let v220: f64 = (-v214).mul_add(v160, v219);
-    let v221: f64 = p[20usize].mul_add(v218, v220);
-    let v223: f64 = v214 * p[68usize];
-    let v224: f64 = v223 - v160;
-    let v225: f64 = p[20usize].mul_add(v216, v224);
-    let v226: f64 = v212 * p[68usize];
-    let v227: f64 = v172 + v226;
-    let v228: f64 = p[20usize].mul_add(v129, v227);
-    let v229: f64 = v155.mul_add(v225, v221);
-    let v230: f64 = v167.mul_add(v228, v229);
-    let v231: f64 = v185.mul_add(v225, v221);
-    let v232: f64 = v183.mul_add(v228, v231);
-    let v233: f64 = (-v202).mul_add(v230, v232);
-    let v234: f64 = v211 * v233;
-    let v235: f64 = v129 * v129;
-    let v236: f64 = v216.mul_add(v216, v235);
-    let v237: f64 = (-2f64).mul_add(v160, v223);
-    let v238: f64 = 2f64.mul_add(v172, v226);
-    let v239: f64 = v182 * v230;
-    let v240: f64 = v233 * v234;
-    let v241: f64 = v230.mul_add(v239, v240);
-    let v242: f64 = p[20usize].mul_add(v236, v135);
-    let v243: f64 = v214.mul_add(v237, v242);
-    let v244: f64 = v212.mul_add(v238, v243);
-    let v245: f64 = v244 - v241;
-    let v246: f64 = 1f64 / v245;
-    let v247: f64 = v33 - v34;
-    let v248: f64 = -v70;
-    let v249: f64 = v71 + v248;
-    let v251: f64 = p[69usize] * v69;
-    let v252: f64 = v122 * v251;
-    let v253: f64 = v120.mul_add(v119, -v252);
-    let v254: f64 = v247.mul_add(v171, v125);
-    let v255: f64 = (-v249).mul_add(v159, v254);
-    let v256: f64 = p[26usize].mul_add(v253, v255);
-    let v258: f64 = v249 * p[70usize];
-    let v259: f64 = v258 - v159;
-    let v260: f64 = p[26usize].mul_add(v251, v259);
-    let v261: f64 = v247 * p[70usize];
-    let v262: f64 = v171 + v261;
-    let v263: f64 = p[26usize].mul_add(v119, v262);
-    let v264: f64 = v155.mul_add(v260, v256);
-    let v265: f64 = v167.mul_add(v263, v264);
-    let v266: f64 = v185.mul_add(v260, v256);
-    let v267: f64 = v183.mul_add(v263, v266);
-    let v268: f64 = (-v202).mul_add(v265, v267);
-    let v269: f64 = v234 * v268;
-    let v270: f64 = v239.mul_add(v265, v269);
-    let v271: f64 = v214.mul_add(v260, v256);
-    let v272: f64 = v212.mul_add(v263, v271);
-    let v273: f64 = v272 - v270;
-    let v274: f64 = v246 * v273;
-    let v275: f64 = v119 * v119;
-    let v276: f64 = v251.mul_add(v251, v275);
-    let v277: f64 = (-2f64).mul_add(v159, v258);
-    let v278: f64 = 2f64.mul_add(v171, v261);
-    let v279: f64 = v182 * v265;
-    let v280: f64 = v211 * v268;
-    let v281: f64 = v268 * v280;
-    let v282: f64 = v265.mul_add(v279, v281);
-    let v283: f64 = v273.mul_add(v274, v282);
-    let v284: f64 = p[26usize].mul_add(v276, v125);
-    let v285: f64 = v249.mul_add(v277, v284);
-    let v286: f64 = v247.mul_add(v278, v285);
-    let v287: f64 = v286 - v283;
-    let v288: f64 = 1f64 / v287;
-    let v289: f64 = v39 - v40;
-    let v290: f64 = -v73;
-    let v291: f64 = v74 + v290;
-    let v293: f64 = p[71usize] * v72;
-    let v294: f64 = v112 * v293;
-    let v295: f64 = v110.mul_add(v109, -v294);
-    let v296: f64 = v289.mul_add(v170, v115);
-    let v297: f64 = (-v291).mul_add(v158, v296);
-    let v298: f64 = p[32usize].mul_add(v295, v297);
-    let v300: f64 = v291 * p[72usize];
-    let v301: f64 = v300 - v158;
-    let v302: f64 = p[32usize].mul_add(v293, v301);
-    let v303: f64 = v289 * p[72usize];
-    let v304: f64 = v170 + v303;
-    let v305: f64 = p[32usize].mul_add(v109, v304);
-    let v306: f64 = v155.mul_add(v302, v298);
-    let v307: f64 = v167.mul_add(v305, v306);
-    let v308: f64 = v185.mul_add(v302, v298);
-    let v309: f64 = v183.mul_add(v305, v308);
-    let v310: f64 = (-v202).mul_add(v307, v309);
-    let v311: f64 = v280 * v310;
-    let v312: f64 = v234 * v310;
-    let v313: f64 = v239.mul_add(v307, v312);
-    let v314: f64 = v214.mul_add(v302, v298);
-    let v315: f64 = v212.mul_add(v305, v314);
-    let v316: f64 = v315 - v313;
-    let v317: f64 = v279.mul_add(v307, v311);
-    let v318: f64 = v274.mul_add(v316, v317);
-    let v319: f64 = v249.mul_add(v302, v298);
-    let v320: f64 = v247.mul_add(v305, v319);
-    let v321: f64 = v320 - v318;
-    let v322: f64 = v288 * v321;
-    let v323: f64 = v109 * v109;
-    let v324: f64 = v293.mul_add(v293, v323);
-    let v325: f64 = (-2f64).mul_add(v158, v300);
-    let v326: f64 = 2f64.mul_add(v170, v303);
-    let v327: f64 = v182 * v307;
-    let v328: f64 = v211 * v310;
-    let v329: f64 = v310 * v328;
-    let v330: f64 = v246 * v316;
-    let v331: f64 = v307.mul_add(v327, v329);
-    let v332: f64 = v316.mul_add(v330, v331);
-    let v333: f64 = v321.mul_add(v322, v332);
-    let v334: f64 = p[32usize].mul_add(v324, v115);
-    let v335: f64 = v291.mul_add(v325, v334);
-    let v336: f64 = v289.mul_add(v326, v335);
-    let v337: f64 = v336 - v333;
-    let v338: f64 = 1f64 / v337;
-    let v339: f64 = v45 - v46;
-    let v340: f64 = -v76;
-    let v341: f64 = v77 + v340;
-    let v343: f64 = p[73usize] * v75;
-    let v344: f64 = v102 * v343;
-    let v345: f64 = v100.mul_add(v99, -v344);
-    let v346: f64 = v339.mul_add(v169, v105);
-    let v347: f64 = (-v341).mul_add(v157, v346);
-    let v348: f64 = p[38usize].mul_add(v345, v347);
-    let v350: f64 = v341 * p[74usize];
-    let v351: f64 = v350 - v157;
-    let v352: f64 = p[38usize].mul_add(v343, v351);
-    let v353: f64 = v339 * p[74usize];
-    let v354: f64 = v169 + v353;
-    let v355: f64 = p[38usize].mul_add(v99, v354);
-    let v356: f64 = v155.mul_add(v352, v348);
-    let v357: f64 = v167.mul_add(v355, v356);
-    let v358: f64 = v185.mul_add(v352, v348);
-    let v359: f64 = v183.mul_add(v355, v358);
-    let v360: f64 = (-v202).mul_add(v357, v359);
-    let v361: f64 = v328 * v360;
-    let v362: f64 = v234 * v360;
-    let v363: f64 = v239.mul_add(v357, v362);
-    let v364: f64 = v214.mul_add(v352, v348);
-    let v365: f64 = v212.mul_add(v355, v364);
-    let v366: f64 = v365 - v363;
-    let v367: f64 = v280 * v360;
-    let v368: f64 = v279.mul_add(v357, v367);
-    let v369: f64 = v274.mul_add(v366, v368);
-    let v370: f64 = v249.mul_add(v352, v348);
-    let v371: f64 = v247.mul_add(v355, v370);
-    let v372: f64 = v371 - v369;
-    let v373: f64 = v327.mul_add(v357, v361);
-    let v374: f64 = v330.mul_add(v366, v373);
-    let v375: f64 = v322.mul_add(v372, v374);
-    let v376: f64 = v291.mul_add(v352, v348);
-    let v377: f64 = v289.mul_add(v355, v376);
-    let v378: f64 = v377 - v375;
-    let v379: f64 = v338 * v378;
-    let v380: f64 = v99 * v99;
-    let v381: f64 = v343.mul_add(v343, v380);
-    let v382: f64 = (-2f64).mul_add(v157, v350);
-    let v383: f64 = 2f64.mul_add(v169, v353);
-    let v384: f64 = v182 * v357;
-    let v385: f64 = v211 * v360;
-    let v386: f64 = v360 * v385;
-    let v387: f64 = v246 * v366;
-    let v388: f64 = v288 * v372;
-    let v389: f64 = v357.mul_add(v384, v386);
-    let v390: f64 = v366.mul_add(v387, v389);
-    let v391: f64 = v372.mul_add(v388, v390);
-    let v392: f64 = v378.mul_add(v379, v391);
-    let v393: f64 = p[38usize].mul_add(v381, v105);
-    let v394: f64 = v341.mul_add(v382, v393);
-    let v395: f64 = v339.mul_add(v383, v394);
-    let v396: f64 = v395 - v392;
-    let v397: f64 = 1f64 / v396;
-    let v398: f64 = v51 - v52;
-    let v399: f64 = -v79;
-    let v400: f64 = v80 + v399;
-    let v402: f64 = p[75usize] * v78;
-    let v403: f64 = v92 * v402;
-    let v404: f64 = v90.mul_add(v89, -v403);
-    let v405: f64 = v398.mul_add(v168, v95);
-    let v406: f64 = (-v400).mul_add(v156, v405);
-    let v407: f64 = p[44usize].mul_add(v404, v406);
-    let v408: f64 = p[50usize] * v400;
-    let v409: f64 = v408 - v156;
-    let v410: f64 = p[44usize].mul_add(v402, v409);
-    let v411: f64 = p[50usize] * v398;
-    let v412: f64 = v168 + v411;
-    let v413: f64 = p[44usize].mul_add(v89, v412);
-    let v414: f64 = v155.mul_add(v410, v407);
-    let v415: f64 = v167.mul_add(v413, v414);
-    let v416: f64 = v185.mul_add(v410, v407);
-    let v417: f64 = v183.mul_add(v413, v416);
-    let v418: f64 = (-v202).mul_add(v415, v417);
-    let v419: f64 = v385 * v418;
-    let v420: f64 = v234 * v418;
-    let v421: f64 = v239.mul_add(v415, v420);
-    let v422: f64 = v214.mul_add(v410, v407);
-    let v423: f64 = v212.mul_add(v413, v422);
-    let v424: f64 = v423 - v421;
-    let v425: f64 = v280 * v418;
-    let v426: f64 = v279.mul_add(v415, v425);
-    let v427: f64 = v274.mul_add(v424, v426);
-    let v428: f64 = v249.mul_add(v410, v407);
-    let v429: f64 = v247.mul_add(v413, v428);
-    let v430: f64 = v429 - v427;
-    let v431: f64 = v328 * v418;
-    let v432: f64 = v327.mul_add(v415, v431);
-    let v433: f64 = v330.mul_add(v424, v432);
-    let v434: f64 = v322.mul_add(v430, v433);
-    let v435: f64 = v291.mul_add(v410, v407);
-    let v436: f64 = v289.mul_add(v413, v435);
-    let v437: f64 = v436 - v434;
-    let v438: f64 = v384.mul_add(v415, v419);
-    let v439: f64 = v387.mul_add(v424, v438);
-    let v440: f64 = v388.mul_add(v430, v439);
-    let v441: f64 = v379.mul_add(v437, v440);
-    let v442: f64 = v341.mul_add(v410, v407);
-    let v443: f64 = v339.mul_add(v413, v442);
-    let v444: f64 = v443 - v441;
-    let v445: f64 = v397 * v444;
-    let v446: f64 = v89 * v89;
-    let v447: f64 = v402.mul_add(v402, v446);
-    let v448: f64 = (-2f64).mul_add(v156, v408);
-    let v449: f64 = 2f64.mul_add(v168, v411);
-    let v450: f64 = v182 * v415;
-    let v451: f64 = v211 * v418;
-    let v452: f64 = v418 * v451;
-    let v453: f64 = v246 * v424;
-    let v454: f64 = v288 * v430;
-    let v455: f64 = v338 * v437;
-    let v456: f64 = v415.mul_add(v450, v452);
-    let v457: f64 = v424.mul_add(v453, v456);
-    let v458: f64 = v430.mul_add(v454, v457);
-    let v459: f64 = v437.mul_add(v455, v458);
-    let v460: f64 = v444.mul_add(v445, v459);
-    let v461: f64 = p[44usize].mul_add(v447, v95);
-    let v462: f64 = v400.mul_add(v448, v461);
-    let v463: f64 = v398.mul_add(v449, v462);
-    let v464: f64 = v463 - v460;
-    let v465: f64 = 1f64 / v464;
-    let v467: f64 = p[76usize] * v81;
-    let v468: f64 = v83 * v467;
-    let v469: f64 = v58.mul_add(v57, -v468);
-    let v470: f64 = p[50usize].mul_add(v469, p[51usize]);
-    let v471: f64 = p[50usize] * v467;
-    let v472: f64 = p[50usize] * v57;
-    let v473: f64 = v155.mul_add(v471, v470);
-    let v474: f64 = v167.mul_add(v472, v473);
-    let v475: f64 = v185.mul_add(v471, v470);
-    let v476: f64 = v183.mul_add(v472, v475);
-    let v477: f64 = (-v202).mul_add(v474, v476);
-    let v478: f64 = v451 * v477;
-    let v479: f64 = v234 * v477;
-    let v480: f64 = v239.mul_add(v474, v479);
-    let v481: f64 = v214.mul_add(v471, v470);
-    let v482: f64 = v212.mul_add(v472, v481);
-    let v483: f64 = v482 - v480;
-    let v484: f64 = v280 * v477;
-    let v485: f64 = v279.mul_add(v474, v484);
-    let v486: f64 = v274.mul_add(v483, v485);
-    let v487: f64 = v249.mul_add(v471, v470);
-    let v488: f64 = v247.mul_add(v472, v487);
-    let v489: f64 = v488 - v486;
-    let v490: f64 = v328 * v477;
-    let v491: f64 = v327.mul_add(v474, v490);
-    let v492: f64 = v330.mul_add(v483, v491);
-    let v493: f64 = v322.mul_add(v489, v492);
-    let v494: f64 = v291.mul_add(v471, v470);
-    let v495: f64 = v289.mul_add(v472, v494);
-    let v496: f64 = v495 - v493;
-    let v497: f64 = v385 * v477;
-    let v498: f64 = v384.mul_add(v474, v497);
-    let v499: f64 = v387.mul_add(v483, v498);
-    let v500: f64 = v388.mul_add(v489, v499);
-    let v501: f64 = v379.mul_add(v496, v500);
-    let v502: f64 = v341.mul_add(v471, v470);
-    let v503: f64 = v339.mul_add(v472, v502);
-    let v504: f64 = v503 - v501;
-    let v505: f64 = v450.mul_add(v474, v478);
-    let v506: f64 = v453.mul_add(v483, v505);
-    let v507: f64 = v454.mul_add(v489, v506);
-    let v508: f64 = v455.mul_add(v496, v507);
-    let v509: f64 = v445.mul_add(v504, v508);
-    let v510: f64 = v400.mul_add(v471, v470);
-    let v511: f64 = v398.mul_add(v472, v510);
-    let v512: f64 = v511 - v509;
-    let v513: f64 = v465 * v512;
-    let v514: f64 = v57 * v57;
-    let v515: f64 = v467.mul_add(v467, v514);
-    let v516: f64 = v182 * v474;
-    let v517: f64 = v211 * v477;
-    let v518: f64 = v477 * v517;
-    let v519: f64 = v246 * v483;
-    let v520: f64 = v288 * v489;
-    let v521: f64 = v338 * v496;
-    let v522: f64 = v397 * v504;
-    let v523: f64 = v474.mul_add(v516, v518);
-    let v524: f64 = v483.mul_add(v519, v523);
-    let v525: f64 = v489.mul_add(v520, v524);
-    let v526: f64 = v496.mul_add(v521, v525);
-    let v527: f64 = v504.mul_add(v522, v526);
-    let v528: f64 = v512.mul_add(v513, v527);
-    let v529: f64 = p[50usize].mul_add(v515, p[51usize]);
-    let v530: f64 = v529 - v528;
-    let v531: f64 = 1f64 / v530;
-    let v534: f64 = p[86usize] + q[7usize];
-    let v537: f64 = p[53usize] * qd[7usize];
-    let v540: f64 = qd[0usize] * qd[0usize];
-    let v541: f64 = -v15;
-    let v542: f64 = v540 * v541;
-    let v544: f64 = qd[0usize] + qd[1usize];
-    let v545: f64 = v544 * v544;
-    let v546: f64 = (-v21).mul_add(v545, v542);
-    let v548: f64 = qd[2usize] + v544;
-    let v549: f64 = v548 * v548;
-    let v550: f64 = (-v27).mul_add(v549, v546);
-    let v552: f64 = qd[3usize] + v548;
-    let v553: f64 = v552 * v552;
-    let v554: f64 = (-v33).mul_add(v553, v550);
-    let v556: f64 = qd[4usize] + v552;
-    let v557: f64 = v556 * v556;
-    let v558: f64 = (-v39).mul_add(v557, v554);
-    let v560: f64 = qd[5usize] + v556;
-    let v561: f64 = v560 * v560;
-    let v562: f64 = (-v45).mul_add(v561, v558);
-    let v564: f64 = qd[6usize] + v560;
-    let v565: f64 = v564 * v564;
-    let v566: f64 = (-v51).mul_add(v565, v562);
-    let v567: f64 = qd[7usize] + v564;
-    let v568: f64 = v567 * v567;
-    let v569: f64 = (-v57).mul_add(v568, v566);
-    let v570: f64 = p[78usize] + v569;
-    let v572: f64 = v540 * v154;
-    let v573: f64 = (-v64).mul_add(v545, v572);
-    let v574: f64 = (-v67).mul_add(v549, v573);
-    let v575: f64 = (-v70).mul_add(v553, v574);
-    let v576: f64 = (-v73).mul_add(v557, v575);
-    let v577: f64 = (-v76).mul_add(v561, v576);
-    let v578: f64 = (-v79).mul_add(v565, v577);
-    let v579: f64 = (-v82).mul_add(v568, v578);
-    let v580: f64 = p[77usize] + v579;
-    let v581: f64 = v580 * v57;
-    let v582: f64 = v570.mul_add(v467, v581);
-    let v583: f64 = v83 * v570;
-    let v584: f64 = v58.mul_add(v580, -v583);
-    let v585: f64 = p[50usize] * v584;
-    let v586: f64 = (-v91).mul_add(v565, v577);
-    let v587: f64 = p[77usize] + v586;
-    let v588: f64 = (-v89).mul_add(v565, v562);
-    let v589: f64 = p[78usize] + v588;
-    let v590: f64 = v92 * v589;
-    let v591: f64 = v90.mul_add(v587, -v590);
-    let v592: f64 = p[44usize].mul_add(v591, v585);
-    let v593: f64 = (-v101).mul_add(v561, v576);
-    let v594: f64 = p[77usize] + v593;
-    let v595: f64 = (-v99).mul_add(v561, v558);
-    let v596: f64 = p[78usize] + v595;
-    let v597: f64 = v102 * v596;
-    let v598: f64 = v100.mul_add(v594, -v597);
-    let v599: f64 = p[38usize].mul_add(v598, v592);
-    let v600: f64 = (-v111).mul_add(v557, v575);
-    let v601: f64 = p[77usize] + v600;
-    let v602: f64 = (-v109).mul_add(v557, v554);
-    let v603: f64 = p[78usize] + v602;
-    let v604: f64 = v112 * v603;
-    let v605: f64 = v110.mul_add(v601, -v604);
-    let v606: f64 = p[32usize].mul_add(v605, v599);
-    let v607: f64 = (-v121).mul_add(v553, v574);
-    let v608: f64 = p[77usize] + v607;
-    let v609: f64 = (-v119).mul_add(v553, v550);
-    let v610: f64 = p[78usize] + v609;
-    let v611: f64 = v122 * v610;
-    let v612: f64 = v120.mul_add(v608, -v611);
-    let v613: f64 = p[26usize].mul_add(v612, v606);
-    let v614: f64 = (-v131).mul_add(v549, v573);
-    let v615: f64 = p[77usize] + v614;
-    let v616: f64 = (-v129).mul_add(v549, v546);
-    let v617: f64 = p[78usize] + v616;
-    let v618: f64 = v132 * v617;
-    let v619: f64 = v130.mul_add(v615, -v618);
-    let v620: f64 = p[20usize].mul_add(v619, v613);
-    let v621: f64 = (-v141).mul_add(v545, v572);
-    let v622: f64 = p[77usize] + v621;
-    let v623: f64 = (-v139).mul_add(v545, v542);
-    let v624: f64 = p[78usize] + v623;
-    let v625: f64 = v142 * v624;
-    let v626: f64 = v140.mul_add(v622, -v625);
-    let v627: f64 = p[14usize].mul_add(v626, v620);
-    let v628: f64 = p[50usize] * v570;
-    let v629: f64 = p[44usize].mul_add(v589, v628);
-    let v630: f64 = p[38usize].mul_add(v596, v629);
-    let v631: f64 = p[32usize].mul_add(v603, v630);
-    let v632: f64 = p[26usize].mul_add(v610, v631);
-    let v633: f64 = p[20usize].mul_add(v617, v632);
-    let v634: f64 = p[14usize].mul_add(v624, v633);
-    let v635: f64 = p[50usize] * v580;
-    let v636: f64 = p[44usize].mul_add(v587, v635);
-    let v637: f64 = p[38usize].mul_add(v594, v636);
-    let v638: f64 = p[32usize].mul_add(v601, v637);
-    let v639: f64 = p[26usize].mul_add(v608, v638);
-    let v640: f64 = p[20usize].mul_add(v615, v639);
-    let v641: f64 = p[14usize].mul_add(v622, v640);
-    let v644: f64 = p[79usize] + q[0usize];
-    let v646: f64 = p[63usize] * v14;
-    let v647: f64 = v540.mul_add(v646, p[78usize]);
-    let v648: f64 = v540.mul_add(v151, p[77usize]);
-    let v649: f64 = v149 * v648;
-    let v650: f64 = v151.mul_add(v647, v649);
-    let v651: f64 = v155.mul_add(v634, v627);
-    let v652: f64 = v167.mul_add(v641, v651);
-    let v653: f64 = p[10usize].mul_add(v644, v652);
-    let v654: f64 = p[11usize].mul_add(qd[0usize], v653);
-    let v655: f64 = p[8usize].mul_add(v650, v654);
-    let v656: f64 = -v655;
-    let v659: f64 = p[80usize] + q[1usize];
-    let v661: f64 = v622 * v139;
-    let v662: f64 = v624.mul_add(v187, v661);
-    let v663: f64 = v185.mul_add(v633, v620);
-    let v664: f64 = v183.mul_add(v640, v663);
-    let v665: f64 = p[16usize].mul_add(v659, v664);
-    let v666: f64 = p[17usize].mul_add(qd[1usize], v665);
-    let v667: f64 = p[14usize].mul_add(v662, v666);
-    let v668: f64 = v202.mul_add(v656, v667);
-    let v669: f64 = -v668;
-    let v672: f64 = p[81usize] + q[2usize];
-    let v674: f64 = v615 * v129;
-    let v675: f64 = v617.mul_add(v216, v674);
-    let v676: f64 = v214.mul_add(v632, v613);
-    let v677: f64 = v212.mul_add(v639, v676);
-    let v678: f64 = p[22usize].mul_add(v672, v677);
-    let v679: f64 = p[23usize].mul_add(qd[2usize], v678);
-    let v680: f64 = p[20usize].mul_add(v675, v679);
-    let v681: f64 = v239.mul_add(v656, v680);
-    let v682: f64 = v234.mul_add(v669, v681);
-    let v683: f64 = -v682;
-    let v686: f64 = p[82usize] + q[3usize];
-    let v688: f64 = v608 * v119;
-    let v689: f64 = v610.mul_add(v251, v688);
-    let v690: f64 = v249.mul_add(v631, v606);
-    let v691: f64 = v247.mul_add(v638, v690);
-    let v692: f64 = p[28usize].mul_add(v686, v691);
-    let v693: f64 = p[29usize].mul_add(qd[3usize], v692);
-    let v694: f64 = p[26usize].mul_add(v689, v693);
-    let v695: f64 = v279.mul_add(v656, v694);
-    let v696: f64 = v280.mul_add(v669, v695);
-    let v697: f64 = v274.mul_add(v683, v696);
-    let v698: f64 = -v697;
-    let v701: f64 = p[83usize] + q[4usize];
-    let v703: f64 = v601 * v109;
-    let v704: f64 = v603.mul_add(v293, v703);
-    let v705: f64 = v291.mul_add(v630, v599);
-    let v706: f64 = v289.mul_add(v637, v705);
-    let v707: f64 = p[34usize].mul_add(v701, v706);
-    let v708: f64 = p[35usize].mul_add(qd[4usize], v707);
-    let v709: f64 = p[32usize].mul_add(v704, v708);
-    let v710: f64 = v327.mul_add(v656, v709);
-    let v711: f64 = v328.mul_add(v669, v710);
-    let v712: f64 = v330.mul_add(v683, v711);
-    let v713: f64 = v322.mul_add(v698, v712);
-    let v714: f64 = -v713;
-    let v717: f64 = p[84usize] + q[5usize];
-    let v719: f64 = v594 * v99;
-    let v720: f64 = v596.mul_add(v343, v719);
-    let v721: f64 = v341.mul_add(v629, v592);
-    let v722: f64 = v339.mul_add(v636, v721);
-    let v723: f64 = p[40usize].mul_add(v717, v722);
-    let v724: f64 = p[41usize].mul_add(qd[5usize], v723);
-    let v725: f64 = p[38usize].mul_add(v720, v724);
-    let v726: f64 = v384.mul_add(v656, v725);
-    let v727: f64 = v385.mul_add(v669, v726);
-    let v728: f64 = v387.mul_add(v683, v727);
-    let v729: f64 = v388.mul_add(v698, v728);
-    let v730: f64 = v379.mul_add(v714, v729);
-    let v731: f64 = -v730;
-    let v734: f64 = p[85usize] + q[6usize];
-    let v736: f64 = v587 * v89;
-    let v737: f64 = v589.mul_add(v402, v736);
-    let v738: f64 = v400.mul_add(v628, v585);
-    let v739: f64 = v398.mul_add(v635, v738);
-    let v740: f64 = p[46usize].mul_add(v734, v739);
-    let v741: f64 = p[47usize].mul_add(qd[6usize], v740);
-    let v742: f64 = p[44usize].mul_add(v737, v741);
-    let v743: f64 = v450.mul_add(v656, v742);
-    let v744: f64 = v451.mul_add(v669, v743);
-    let v745: f64 = v453.mul_add(v683, v744);
-    let v746: f64 = v454.mul_add(v698, v745);
-    let v747: f64 = v455.mul_add(v714, v746);
-    let v748: f64 = v445.mul_add(v731, v747);
-    let v749: f64 = -v748;
-    let v750: f64 = p[52usize].mul_add(v534, v537);
-    let v751: f64 = p[50usize].mul_add(v582, v750);
-    let v752: f64 = v516.mul_add(v656, v751);
-    let v753: f64 = v517.mul_add(v669, v752);
-    let v754: f64 = v519.mul_add(v683, v753);
-    let v755: f64 = v520.mul_add(v698, v754);
-    let v756: f64 = v521.mul_add(v714, v755);
-    let v757: f64 = v522.mul_add(v731, v756);
-    let v758: f64 = v513.mul_add(v749, v757);
-    let v759: f64 = -v758;
-    let v760: f64 = v531 * v759;
-    let v761: f64 = v513 * v760;
-    let v762: f64 = v465.mul_add(v749, -v761);
-    let v763: f64 = v522 * v760;
-    let v764: f64 = v445.mul_add(v762, v763);
-    let v765: f64 = v397.mul_add(v731, -v764);
-    let v766: f64 = v455 * v762;
-    let v767: f64 = v379.mul_add(v765, v766);
-    let v768: f64 = v521.mul_add(v760, v767);
-    let v769: f64 = v338.mul_add(v714, -v768);
-    let v770: f64 = v388 * v765;
-    let v771: f64 = v322.mul_add(v769, v770);
-    let v772: f64 = v454.mul_add(v762, v771);
-    let v773: f64 = v520.mul_add(v760, v772);
-    let v774: f64 = v288.mul_add(v698, -v773);
-    let v775: f64 = v330 * v769;
-    let v776: f64 = v274.mul_add(v774, v775);
-    let v777: f64 = v387.mul_add(v765, v776);
-    let v778: f64 = v453.mul_add(v762, v777);
-    let v779: f64 = v519.mul_add(v760, v778);
-    let v780: f64 = v246.mul_add(v683, -v779);
-    let v781: f64 = v280 * v774;
-    let v782: f64 = v234.mul_add(v780, v781);
-    let v783: f64 = v328.mul_add(v769, v782);
-    let v784: f64 = v385.mul_add(v765, v783);
-    let v785: f64 = v451.mul_add(v762, v784);
-    let v786: f64 = v517.mul_add(v760, v785);
-    let v787: f64 = v211.mul_add(v669, -v786);
-    let v788: f64 = v239 * v780;
-    let v789: f64 = v202.mul_add(v787, v788);
-    let v790: f64 = v279.mul_add(v774, v789);
-    let v791: f64 = v327.mul_add(v769, v790);
-    let v792: f64 = v384.mul_add(v765, v791);
-    let v793: f64 = v450.mul_add(v762, v792);
-    let v794: f64 = v516.mul_add(v760, v793);
-    let v795: f64 = v182.mul_add(v656, -v794);
-    out[0usize] = v795;
-    out[1usize] = v787;
-    out[2usize] = v780;
-    out[3usize] = v774;
-    out[4usize] = v769;
-    out[5usize] = v765;
-    out[6usize] = v762;
-    out[7usize] = v760;
-    out[8usize] = v180;
-    out[9usize] = v210;
-    out[10usize] = v245;
-    out[11usize] = v287;
-    out[12usize] = v337;
-    out[13usize] = v396;
-    out[14usize] = v464;
-    out[15usize] = v530;
-    out[16usize] = v202;
-    out[17usize] = v239;
-    out[18usize] = v234;
-    out[19usize] = v279;
-    out[20usize] = v280;
-    out[21usize] = v274;
-    out[22usize] = v327;
-    out[23usize] = v328;
-    out[24usize] = v330;
-    out[25usize] = v322;
-    out[26usize] = v384;
-    out[27usize] = v385;
-    out[28usize] = v387;
-    out[29usize] = v388;
-    out[30usize] = v379;
-    out[31usize] = v450;
-    out[32usize] = v451;
-    out[33usize] = v453;
-    out[34usize] = v454;
-    out[35usize] = v455;
-    out[36usize] = v445;
-    out[37usize] = v516;
-    out[38usize] = v517;
-    out[39usize] = v519;
-    out[40usize] = v520;
-    out[41usize] = v521;
-    out[42usize] = v522;
-    out[43usize] = v513;
-    out2[0usize] = v180;
-    out2[1usize] = v201;
-    out2[2usize] = v230;
-    out2[3usize] = v265;
-    out2[4usize] = v307;
-    out2[5usize] = v357;
-    out2[6usize] = v415;
-    out2[7usize] = v474;
-    out2[8usize] = v209;
-    out2[9usize] = v232;
-    out2[10usize] = v267;
-    out2[11usize] = v309;
-    out2[12usize] = v359;
-    out2[13usize] = v417;
-    out2[14usize] = v476;
-    out2[15usize] = v244;
-    out2[16usize] = v272;
-    out2[17usize] = v315;
-    out2[18usize] = v365;
-    out2[19usize] = v423;
-    out2[20usize] = v482;
-    out2[21usize] = v286;
-    out2[22usize] = v320;
-    out2[23usize] = v371;
-    out2[24usize] = v429;
-    out2[25usize] = v488;
-    out2[26usize] = v336;
-    out2[27usize] = v377;
-    out2[28usize] = v436;
-    out2[29usize] = v495;
-    out2[30usize] = v395;
-    out2[31usize] = v443;
-    out2[32usize] = v503;
-    out2[33usize] = v463;
-    out2[34usize] = v511;
-    out2[35usize] = v529;
-    out2[36usize] = v655;
-    out2[37usize] = v667;
-    out2[38usize] = v680;
-    out2[39usize] = v694;
-    out2[40usize] = v709;
-    out2[41usize] = v725;
-    out2[42usize] = v742;
-    out2[43usize] = v751;
+    let v57 = p[55] * v56;
+    let v58 = v52 + v57;
+    let v61 = p[7] * v60;
+    let v62 = p[4] + v61;
+    let v64 = p[13] * v63;
+    let v65 = v62 + v64;
+    let v67 = p[19] * v66;
+    let v68 = v65 + v67;
+    let v70 = p[25] * v69;
+    let v71 = v68 + v70;
+    let v73 = p[31] * v72;
+    let v74 = v71 + v73;
+    let v76 = p[37] * v75;
+    let v77 = v74 + v76;
+    let v79 = p[43] * v78;
+    let v80 = v77 + v79;
+    let v82 = p[55] * v81;
+    let v83 = v80 + v82;
+    let v84 = v83 * v83;
+    let v85 = v58.mul_add(v58, v84);
+    let v86 = p[50].mul_add(v85, p[51]);
+    let v89 = p[56] * v50;
+    let v90 = v46 + v89;
+    let v91 = p[56] * v78;
+    let v92 = v77 + v91;
+    let v93 = v92 * v92;
+    let v94 = v90.mul_add(v90, v93);
+    let v95 = p[45] + v86;
+    let v96 = p[44].mul_add(v94, v95);
+    let v99 = p[57] * v44;
+    let v100 = v40 + v99;
+    let v101 = p[57] * v75;
+    let v102 = v74 + v101;
+    let v103 = v102 * v102;
+    let v104 = v100.mul_add(v100, v103);
+    let v105 = p[39] + v96;
+    let v106 = p[38].mul_add(v104, v105);
+    let v109 = p[58] * v38;
+    let v110 = v34 + v109;
+    let v111 = p[58] * v72;
+    let v112 = v71 + v111;
+    let v113 = v112 * v112;
+    let v114 = v110.mul_add(v110, v113);
+    let v115 = p[33] + v106;
+    let v116 = p[32].mul_add(v114, v115);
+    let v119 = p[59] * v32;
+    let v120 = v28 + v119;
+    let v121 = p[59] * v69;
+    let v122 = v68 + v121;
+    let v123 = v122 * v122;
+    let v124 = v120.mul_add(v120, v123);
+    let v125 = p[27] + v116;
+    let v126 = p[26].mul_add(v124, v125);
+    let v129 = p[60] * v26;
+    let v130 = v22 + v129;
+    let v131 = p[60] * v66;
+    let v132 = v65 + v131;
+    let v133 = v132 * v132;
+    let v134 = v130.mul_add(v130, v133);
+    let v135 = p[21] + v126;
+    let v136 = p[20].mul_add(v134, v135);
+    let v139 = p[61] * v20;
+    let v140 = v16 + v139;
+    let v141 = p[61] * v63;
+    let v142 = v62 + v141;
+    let v143 = v142 * v142;
+    let v144 = v140.mul_add(v140, v143);
+    let v145 = p[15] + v136;
+    let v146 = p[14].mul_add(v144, v145);
+    let v149 = p[62] * v14;
+    let v151 = p[63] * v60;
+    let v152 = v151 * v151;
+    let v153 = v149.mul_add(v149, v152);
+    let v154 = -v61;
+    let v155 = v62 + v154;
+    let v156 = p[50] * v83;
+    let v157 = p[44].mul_add(v92, v156);
+    let v158 = p[38].mul_add(v102, v157);
+    let v159 = p[32].mul_add(v112, v158);
+    let v160 = p[26].mul_add(v122, v159);
+    let v161 = p[20].mul_add(v132, v160);
+    let v162 = p[14].mul_add(v142, v161);
+    let v164 = 2f64 * v162;
+    let v166 = v155.mul_add(p[64], -v164);
+    let v167 = v15 - v16;
+    let v168 = p[50] * v58;
+    let v169 = p[44].mul_add(v90, v168);
+    let v170 = p[38].mul_add(v100, v169);
+    let v171 = p[32].mul_add(v110, v170);
+    let v172 = p[26].mul_add(v120, v171);
+    let v173 = p[20].mul_add(v130, v172);
+    let v174 = p[14].mul_add(v140, v173);
+    let v175 = v167 * p[64];
+    let v176 = 2f64.mul_add(v174, v175);
+    let v177 = p[9] + v146;
+    let v178 = p[8].mul_add(v153, v177);
+    let v179 = v155.mul_add(v166, v178);
+    let v180 = v167.mul_add(v176, v179);
+    let v182 = 1f64 / v180;
+    let v183 = v21 - v22;
+    let v184 = -v64;
+    let v185 = v65 + v184;
+    let v187 = p[65] * v63;
+    let v188 = v142 * v187;
+    let v189 = v140.mul_add(v139, -v188);
+    let v190 = v183.mul_add(v173, v145);
+    let v191 = (-v185).mul_add(v161, v190);
+    let v192 = p[14].mul_add(v189, v191);
+    let v194 = v185 * p[66];
+    let v195 = v194 - v161;
+    let v196 = p[14].mul_add(v187, v195);
+    let v197 = v183 * p[66];
+    let v198 = v173 + v197;
+    let v199 = p[14].mul_add(v139, v198);
+    let v200 = v155.mul_add(v196, v192);
+    let v201 = v167.mul_add(v199, v200);
+    let v202 = v182 * v201;
+    let v203 = v139 * v139;
+    let v204 = v187.mul_add(v187, v203);
+    let v205 = (-2f64).mul_add(v161, v194);
+    let v206 = 2f64.mul_add(v173, v197);
+    let v207 = p[14].mul_add(v204, v145);
+    let v208 = v185.mul_add(v205, v207);
+    let v209 = v183.mul_add(v206, v208);
+    let v210 = (-v201).mul_add(v202, v209);
+    let v211 = 1f64 / v210;
+    let v212 = v27 - v28;
+    let v213 = -v67;
+    let v214 = v68 + v213;
+    let v216 = p[67] * v66;
+    let v217 = v132 * v216;
+    let v218 = v130.mul_add(v129, -v217);
+    let v219 = v212.mul_add(v172, v135);
+    let v220 = (-v214).mul_add(v160, v219);
+    let v221 = p[20].mul_add(v218, v220);
+    let v223 = v214 * p[68];
+    let v224 = v223 - v160;
+    let v225 = p[20].mul_add(v216, v224);
+    let v226 = v212 * p[68];
+    let v227 = v172 + v226;
+    let v228 = p[20].mul_add(v129, v227);
+    let v229 = v155.mul_add(v225, v221);
+    let v230 = v167.mul_add(v228, v229);
+    let v231 = v185.mul_add(v225, v221);
+    let v232 = v183.mul_add(v228, v231);
+    let v233 = (-v202).mul_add(v230, v232);
+    let v234 = v211 * v233;
+    let v235 = v129 * v129;
+    let v236 = v216.mul_add(v216, v235);
+    let v237 = (-2f64).mul_add(v160, v223);
+    let v238 = 2f64.mul_add(v172, v226);
+    let v239 = v182 * v230;
+    let v240 = v233 * v234;
+    let v241 = v230.mul_add(v239, v240);
+    let v242 = p[20].mul_add(v236, v135);
+    let v243 = v214.mul_add(v237, v242);
+    let v244 = v212.mul_add(v238, v243);
+    let v245 = v244 - v241;
+    let v246 = 1f64 / v245;
+    let v247 = v33 - v34;
+    let v248 = -v70;
+    let v249 = v71 + v248;
+    let v251 = p[69] * v69;
+    let v252 = v122 * v251;
+    let v253 = v120.mul_add(v119, -v252);
+    let v254 = v247.mul_add(v171, v125);
+    let v255 = (-v249).mul_add(v159, v254);
+    let v256 = p[26].mul_add(v253, v255);
+    let v258 = v249 * p[70];
+    let v259 = v258 - v159;
+    let v260 = p[26].mul_add(v251, v259);
+    let v261 = v247 * p[70];
+    let v262 = v171 + v261;
+    let v263 = p[26].mul_add(v119, v262);
+    let v264 = v155.mul_add(v260, v256);
+    let v265 = v167.mul_add(v263, v264);
+    let v266 = v185.mul_add(v260, v256);
+    let v267 = v183.mul_add(v263, v266);
+    let v268 = (-v202).mul_add(v265, v267);
+    let v269 = v234 * v268;
+    let v270 = v239.mul_add(v265, v269);
+    let v271 = v214.mul_add(v260, v256);
+    let v272 = v212.mul_add(v263, v271);
+    let v273 = v272 - v270;
+    let v274 = v246 * v273;
+    let v275 = v119 * v119;
+    let v276 = v251.mul_add(v251, v275);
+    let v277 = (-2f64).mul_add(v159, v258);
+    let v278 = 2f64.mul_add(v171, v261);
+    let v279 = v182 * v265;
+    let v280 = v211 * v268;
+    let v281 = v268 * v280;
+    let v282 = v265.mul_add(v279, v281);
+    let v283 = v273.mul_add(v274, v282);
+    let v284 = p[26].mul_add(v276, v125);
+    let v285 = v249.mul_add(v277, v284);
+    let v286 = v247.mul_add(v278, v285);
+    let v287 = v286 - v283;
+    let v288 = 1f64 / v287;
+    let v289 = v39 - v40;
+    let v290 = -v73;
+    let v291 = v74 + v290;
+    let v293 = p[71] * v72;
+    let v294 = v112 * v293;
+    let v295 = v110.mul_add(v109, -v294);
+    let v296 = v289.mul_add(v170, v115);
+    let v297 = (-v291).mul_add(v158, v296);
+    let v298 = p[32].mul_add(v295, v297);
+    let v300 = v291 * p[72];
+    let v301 = v300 - v158;
+    let v302 = p[32].mul_add(v293, v301);
+    let v303 = v289 * p[72];
+    let v304 = v170 + v303;
+    let v305 = p[32].mul_add(v109, v304);
+    let v306 = v155.mul_add(v302, v298);
+    let v307 = v167.mul_add(v305, v306);
+    let v308 = v185.mul_add(v302, v298);
+    let v309 = v183.mul_add(v305, v308);
+    let v310 = (-v202).mul_add(v307, v309);
+    let v311 = v280 * v310;
+    let v312 = v234 * v310;
+    let v313 = v239.mul_add(v307, v312);
+    let v314 = v214.mul_add(v302, v298);
+    let v315 = v212.mul_add(v305, v314);
+    let v316 = v315 - v313;
+    let v317 = v279.mul_add(v307, v311);
+    let v318 = v274.mul_add(v316, v317);
+    let v319 = v249.mul_add(v302, v298);
+    let v320 = v247.mul_add(v305, v319);
+    let v321 = v320 - v318;
+    let v322 = v288 * v321;
+    let v323 = v109 * v109;
+    let v324 = v293.mul_add(v293, v323);
+    let v325 = (-2f64).mul_add(v158, v300);
+    let v326 = 2f64.mul_add(v170, v303);
+    let v327 = v182 * v307;
+    let v328 = v211 * v310;
+    let v329 = v310 * v328;
+    let v330 = v246 * v316;
+    let v331 = v307.mul_add(v327, v329);
+    let v332 = v316.mul_add(v330, v331);
+    let v333 = v321.mul_add(v322, v332);
+    let v334 = p[32].mul_add(v324, v115);
+    let v335 = v291.mul_add(v325, v334);
+    let v336 = v289.mul_add(v326, v335);
+    let v337 = v336 - v333;
+    let v338 = 1f64 / v337;
+    let v339 = v45 - v46;
+    let v340 = -v76;
+    let v341 = v77 + v340;
+    let v343 = p[73] * v75;
+    let v344 = v102 * v343;
+    let v345 = v100.mul_add(v99, -v344);
+    let v346 = v339.mul_add(v169, v105);
+    let v347 = (-v341).mul_add(v157, v346);
+    let v348 = p[38].mul_add(v345, v347);
+    let v350 = v341 * p[74];
+    let v351 = v350 - v157;
+    let v352 = p[38].mul_add(v343, v351);
+    let v353 = v339 * p[74];
+    let v354 = v169 + v353;
+    let v355 = p[38].mul_add(v99, v354);
+    let v356 = v155.mul_add(v352, v348);
+    let v357 = v167.mul_add(v355, v356);
+    let v358 = v185.mul_add(v352, v348);
+    let v359 = v183.mul_add(v355, v358);
+    let v360 = (-v202).mul_add(v357, v359);
+    let v361 = v328 * v360;
+    let v362 = v234 * v360;
+    let v363 = v239.mul_add(v357, v362);
+    let v364 = v214.mul_add(v352, v348);
+    let v365 = v212.mul_add(v355, v364);
+    let v366 = v365 - v363;
+    let v367 = v280 * v360;
+    let v368 = v279.mul_add(v357, v367);
+    let v369 = v274.mul_add(v366, v368);
+    let v370 = v249.mul_add(v352, v348);
+    let v371 = v247.mul_add(v355, v370);
+    let v372 = v371 - v369;
+    let v373 = v327.mul_add(v357, v361);
+    let v374 = v330.mul_add(v366, v373);
+    let v375 = v322.mul_add(v372, v374);
+    let v376 = v291.mul_add(v352, v348);
+    let v377 = v289.mul_add(v355, v376);
+    let v378 = v377 - v375;
+    let v379 = v338 * v378;
+    let v380 = v99 * v99;
+    let v381 = v343.mul_add(v343, v380);
+    let v382 = (-2f64).mul_add(v157, v350);
+    let v383 = 2f64.mul_add(v169, v353);
+    let v384 = v182 * v357;
+    let v385 = v211 * v360;
+    let v386 = v360 * v385;
+    let v387 = v246 * v366;
+    let v388 = v288 * v372;
+    let v389 = v357.mul_add(v384, v386);
+    let v390 = v366.mul_add(v387, v389);
+    let v391 = v372.mul_add(v388, v390);
+    let v392 = v378.mul_add(v379, v391);
+    let v393 = p[38].mul_add(v381, v105);
+    let v394 = v341.mul_add(v382, v393);
+    let v395 = v339.mul_add(v383, v394);
+    let v396 = v395 - v392;
+    let v397 = 1f64 / v396;
+    let v398 = v51 - v52;
+    let v399 = -v79;
+    let v400 = v80 + v399;
+    let v402 = p[75] * v78;
+    let v403 = v92 * v402;
+    let v404 = v90.mul_add(v89, -v403);
+    let v405 = v398.mul_add(v168, v95);
+    let v406 = (-v400).mul_add(v156, v405);
+    let v407 = p[44].mul_add(v404, v406);
+    let v408 = p[50] * v400;
+    let v409 = v408 - v156;
+    let v410 = p[44].mul_add(v402, v409);
+    let v411 = p[50] * v398;
+    let v412 = v168 + v411;
+    let v413 = p[44].mul_add(v89, v412);
+    let v414 = v155.mul_add(v410, v407);
+    let v415 = v167.mul_add(v413, v414);
+    let v416 = v185.mul_add(v410, v407);
+    let v417 = v183.mul_add(v413, v416);
+    let v418 = (-v202).mul_add(v415, v417);
+    let v419 = v385 * v418;
+    let v420 = v234 * v418;
+    let v421 = v239.mul_add(v415, v420);
+    let v422 = v214.mul_add(v410, v407);
+    let v423 = v212.mul_add(v413, v422);
+    let v424 = v423 - v421;
+    let v425 = v280 * v418;
+    let v426 = v279.mul_add(v415, v425);
+    let v427 = v274.mul_add(v424, v426);
+    let v428 = v249.mul_add(v410, v407);
+    let v429 = v247.mul_add(v413, v428);
+    let v430 = v429 - v427;
+    let v431 = v328 * v418;
+    let v432 = v327.mul_add(v415, v431);
+    let v433 = v330.mul_add(v424, v432);
+    let v434 = v322.mul_add(v430, v433);
+    let v435 = v291.mul_add(v410, v407);
+    let v436 = v289.mul_add(v413, v435);
+    let v437 = v436 - v434;
+    let v438 = v384.mul_add(v415, v419);
+    let v439 = v387.mul_add(v424, v438);
+    let v440 = v388.mul_add(v430, v439);
+    let v441 = v379.mul_add(v437, v440);
+    let v442 = v341.mul_add(v410, v407);
+    let v443 = v339.mul_add(v413, v442);
+    let v444 = v443 - v441;
+    let v445 = v397 * v444;
+    let v446 = v89 * v89;
+    let v447 = v402.mul_add(v402, v446);
+    let v448 = (-2f64).mul_add(v156, v408);
+    let v449 = 2f64.mul_add(v168, v411);
+    let v450 = v182 * v415;
+    let v451 = v211 * v418;
+    let v452 = v418 * v451;
+    let v453 = v246 * v424;
+    let v454 = v288 * v430;
+    let v455 = v338 * v437;
+    let v456 = v415.mul_add(v450, v452);
+    let v457 = v424.mul_add(v453, v456);
+    let v458 = v430.mul_add(v454, v457);
+    let v459 = v437.mul_add(v455, v458);
+    let v460 = v444.mul_add(v445, v459);
+    let v461 = p[44].mul_add(v447, v95);
+    let v462 = v400.mul_add(v448, v461);
+    let v463 = v398.mul_add(v449, v462);
+    let v464 = v463 - v460;
+    let v465 = 1f64 / v464;
+    let v467 = p[76] * v81;
+    let v468 = v83 * v467;
+    let v469 = v58.mul_add(v57, -v468);
+    let v470 = p[50].mul_add(v469, p[51]);
+    let v471 = p[50] * v467;
+    let v472 = p[50] * v57;
+    let v473 = v155.mul_add(v471, v470);
+    let v474 = v167.mul_add(v472, v473);
+    let v475 = v185.mul_add(v471, v470);
+    let v476 = v183.mul_add(v472, v475);
+    let v477 = (-v202).mul_add(v474, v476);
+    let v478 = v451 * v477;
+    let v479 = v234 * v477;
+    let v480 = v239.mul_add(v474, v479);
+    let v481 = v214.mul_add(v471, v470);
+    let v482 = v212.mul_add(v472, v481);
+    let v483 = v482 - v480;
+    let v484 = v280 * v477;
+    let v485 = v279.mul_add(v474, v484);
+    let v486 = v274.mul_add(v483, v485);
+    let v487 = v249.mul_add(v471, v470);
+    let v488 = v247.mul_add(v472, v487);
+    let v489 = v488 - v486;
+    let v490 = v328 * v477;
+    let v491 = v327.mul_add(v474, v490);
+    let v492 = v330.mul_add(v483, v491);
+    let v493 = v322.mul_add(v489, v492);
+    let v494 = v291.mul_add(v471, v470);
+    let v495 = v289.mul_add(v472, v494);
+    let v496 = v495 - v493;
+    let v497 = v385 * v477;
+    let v498 = v384.mul_add(v474, v497);
+    let v499 = v387.mul_add(v483, v498);
+    let v500 = v388.mul_add(v489, v499);
+    let v501 = v379.mul_add(v496, v500);
+    let v502 = v341.mul_add(v471, v470);
+    let v503 = v339.mul_add(v472, v502);
+    let v504 = v503 - v501;
+    let v505 = v450.mul_add(v474, v478);
+    let v506 = v453.mul_add(v483, v505);
+    let v507 = v454.mul_add(v489, v506);
+    let v508 = v455.mul_add(v496, v507);
+    let v509 = v445.mul_add(v504, v508);
+    let v510 = v400.mul_add(v471, v470);
+    let v511 = v398.mul_add(v472, v510);
+    let v512 = v511 - v509;
+    let v513 = v465 * v512;
+    let v514 = v57 * v57;
+    let v515 = v467.mul_add(v467, v514);
+    let v516 = v182 * v474;
+    let v517 = v211 * v477;
+    let v518 = v477 * v517;
+    let v519 = v246 * v483;
+    let v520 = v288 * v489;
+    let v521 = v338 * v496;
+    let v522 = v397 * v504;
+    let v523 = v474.mul_add(v516, v518);
+    let v524 = v483.mul_add(v519, v523);
+    let v525 = v489.mul_add(v520, v524);
+    let v526 = v496.mul_add(v521, v525);
+    let v527 = v504.mul_add(v522, v526);
+    let v528 = v512.mul_add(v513, v527);
+    let v529 = p[50].mul_add(v515, p[51]);
+    let v530 = v529 - v528;
+    let v531 = 1f64 / v530;
+    let v534 = p[86] + q[7];
+    let v537 = p[53] * qd[7];
+    let v540 = qd[0] * qd[0];
+    let v541 = -v15;
+    let v542 = v540 * v541;
+    let v544 = qd[0] + qd[1];
+    let v545 = v544 * v544;
+    let v546 = (-v21).mul_add(v545, v542);
+    let v548 = qd[2] + v544;
+    let v549 = v548 * v548;
+    let v550 = (-v27).mul_add(v549, v546);
+    let v552 = qd[3] + v548;
+    let v553 = v552 * v552;
+    let v554 = (-v33).mul_add(v553, v550);
+    let v556 = qd[4] + v552;
+    let v557 = v556 * v556;
+    let v558 = (-v39).mul_add(v557, v554);
+    let v560 = qd[5] + v556;
+    let v561 = v560 * v560;
+    let v562 = (-v45).mul_add(v561, v558);
+    let v564 = qd[6] + v560;
+    let v565 = v564 * v564;
+    let v566 = (-v51).mul_add(v565, v562);
+    let v567 = qd[7] + v564;
+    let v568 = v567 * v567;
+    let v569 = (-v57).mul_add(v568, v566);
+    let v570 = p[78] + v569;
+    let v572 = v540 * v154;
+    let v573 = (-v64).mul_add(v545, v572);
+    let v574 = (-v67).mul_add(v549, v573);
+    let v575 = (-v70).mul_add(v553, v574);
+    let v576 = (-v73).mul_add(v557, v575);
+    let v577 = (-v76).mul_add(v561, v576);
+    let v578 = (-v79).mul_add(v565, v577);
+    let v579 = (-v82).mul_add(v568, v578);
+    let v580 = p[77] + v579;
+    let v581 = v580 * v57;
+    let v582 = v570.mul_add(v467, v581);
+    let v583 = v83 * v570;
+    let v584 = v58.mul_add(v580, -v583);
+    let v585 = p[50] * v584;
+    let v586 = (-v91).mul_add(v565, v577);
+    let v587 = p[77] + v586;
+    let v588 = (-v89).mul_add(v565, v562);
+    let v589 = p[78] + v588;
+    let v590 = v92 * v589;
+    let v591 = v90.mul_add(v587, -v590);
+    let v592 = p[44].mul_add(v591, v585);
+    let v593 = (-v101).mul_add(v561, v576);
+    let v594 = p[77] + v593;
+    let v595 = (-v99).mul_add(v561, v558);
+    let v596 = p[78] + v595;
+    let v597 = v102 * v596;
+    let v598 = v100.mul_add(v594, -v597);
+    let v599 = p[38].mul_add(v598, v592);
+    let v600 = (-v111).mul_add(v557, v575);
+    let v601 = p[77] + v600;
+    let v602 = (-v109).mul_add(v557, v554);
+    let v603 = p[78] + v602;
+    let v604 = v112 * v603;
+    let v605 = v110.mul_add(v601, -v604);
+    let v606 = p[32].mul_add(v605, v599);
+    let v607 = (-v121).mul_add(v553, v574);
+    let v608 = p[77] + v607;
+    let v609 = (-v119).mul_add(v553, v550);
+    let v610 = p[78] + v609;
+    let v611 = v122 * v610;
+    let v612 = v120.mul_add(v608, -v611);
+    let v613 = p[26].mul_add(v612, v606);
+    let v614 = (-v131).mul_add(v549, v573);
+    let v615 = p[77] + v614;
+    let v616 = (-v129).mul_add(v549, v546);
+    let v617 = p[78] + v616;
+    let v618 = v132 * v617;
+    let v619 = v130.mul_add(v615, -v618);
+    let v620 = p[20].mul_add(v619, v613);
+    let v621 = (-v141).mul_add(v545, v572);
+    let v622 = p[77] + v621;
+    let v623 = (-v139).mul_add(v545, v542);
+    let v624 = p[78] + v623;
+    let v625 = v142 * v624;
+    let v626 = v140.mul_add(v622, -v625);
+    let v627 = p[14].mul_add(v626, v620);
+    let v628 = p[50] * v570;
+    let v629 = p[44].mul_add(v589, v628);
+    let v630 = p[38].mul_add(v596, v629);
+    let v631 = p[32].mul_add(v603, v630);
+    let v632 = p[26].mul_add(v610, v631);
+    let v633 = p[20].mul_add(v617, v632);
+    let v634 = p[14].mul_add(v624, v633);
+    let v635 = p[50] * v580;
+    let v636 = p[44].mul_add(v587, v635);
+    let v637 = p[38].mul_add(v594, v636);
+    let v638 = p[32].mul_add(v601, v637);
+    let v639 = p[26].mul_add(v608, v638);
+    let v640 = p[20].mul_add(v615, v639);
+    let v641 = p[14].mul_add(v622, v640);
+    let v644 = p[79] + q[0];
+    let v646 = p[63] * v14;
+    let v647 = v540.mul_add(v646, p[78]);
+    let v648 = v540.mul_add(v151, p[77]);
+    let v649 = v149 * v648;
+    let v650 = v151.mul_add(v647, v649);
+    let v651 = v155.mul_add(v634, v627);
+    let v652 = v167.mul_add(v641, v651);
+    let v653 = p[10].mul_add(v644, v652);
+    let v654 = p[11].mul_add(qd[0], v653);
+    let v655 = p[8].mul_add(v650, v654);
+    let v656 = -v655;
+    let v659 = p[80] + q[1];
+    let v661 = v622 * v139;
+    let v662 = v624.mul_add(v187, v661);
+    let v663 = v185.mul_add(v633, v620);
+    let v664 = v183.mul_add(v640, v663);
+    let v665 = p[16].mul_add(v659, v664);
+    let v666 = p[17].mul_add(qd[1], v665);
+    let v667 = p[14].mul_add(v662, v666);
+    let v668 = v202.mul_add(v656, v667);
+    let v669 = -v668;
+    let v672 = p[81] + q[2];
+    let v674 = v615 * v129;
+    let v675 = v617.mul_add(v216, v674);
+    let v676 = v214.mul_add(v632, v613);
+    let v677 = v212.mul_add(v639, v676);
+    let v678 = p[22].mul_add(v672, v677);
+    let v679 = p[23].mul_add(qd[2], v678);
+    let v680 = p[20].mul_add(v675, v679);
+    let v681 = v239.mul_add(v656, v680);
+    let v682 = v234.mul_add(v669, v681);
+    let v683 = -v682;
+    let v686 = p[82] + q[3];
+    let v688 = v608 * v119;
+    let v689 = v610.mul_add(v251, v688);
+    let v690 = v249.mul_add(v631, v606);
+    let v691 = v247.mul_add(v638, v690);
+    let v692 = p[28].mul_add(v686, v691);
+    let v693 = p[29].mul_add(qd[3], v692);
+    let v694 = p[26].mul_add(v689, v693);
+    let v695 = v279.mul_add(v656, v694);
+    let v696 = v280.mul_add(v669, v695);
+    let v697 = v274.mul_add(v683, v696);
+    let v698 = -v697;
+    let v701 = p[83] + q[4];
+    let v703 = v601 * v109;
+    let v704 = v603.mul_add(v293, v703);
+    let v705 = v291.mul_add(v630, v599);
+    let v706 = v289.mul_add(v637, v705);
+    let v707 = p[34].mul_add(v701, v706);
+    let v708 = p[35].mul_add(qd[4], v707);
+    let v709 = p[32].mul_add(v704, v708);
+    let v710 = v327.mul_add(v656, v709);
+    let v711 = v328.mul_add(v669, v710);
+    let v712 = v330.mul_add(v683, v711);
+    let v713 = v322.mul_add(v698, v712);
+    let v714 = -v713;
+    let v717 = p[84] + q[5];
+    let v719 = v594 * v99;
+    let v720 = v596.mul_add(v343, v719);
+    let v721 = v341.mul_add(v629, v592);
+    let v722 = v339.mul_add(v636, v721);
+    let v723 = p[40].mul_add(v717, v722);
+    let v724 = p[41].mul_add(qd[5], v723);
+    let v725 = p[38].mul_add(v720, v724);
+    let v726 = v384.mul_add(v656, v725);
+    let v727 = v385.mul_add(v669, v726);
+    let v728 = v387.mul_add(v683, v727);
+    let v729 = v388.mul_add(v698, v728);
+    let v730 = v379.mul_add(v714, v729);
+    let v731 = -v730;
+    let v734 = p[85] + q[6];
+    let v736 = v587 * v89;
+    let v737 = v589.mul_add(v402, v736);
+    let v738 = v400.mul_add(v628, v585);
+    let v739 = v398.mul_add(v635, v738);
+    let v740 = p[46].mul_add(v734, v739);
+    let v741 = p[47].mul_add(qd[6], v740);
+    let v742 = p[44].mul_add(v737, v741);
+    let v743 = v450.mul_add(v656, v742);
+    let v744 = v451.mul_add(v669, v743);
+    let v745 = v453.mul_add(v683, v744);
+    let v746 = v454.mul_add(v698, v745);
+    let v747 = v455.mul_add(v714, v746);
+    let v748 = v445.mul_add(v731, v747);
+    let v749 = -v748;
+    let v750 = p[52].mul_add(v534, v537);
+    let v751 = p[50].mul_add(v582, v750);
+    let v752 = v516.mul_add(v656, v751);
+    let v753 = v517.mul_add(v669, v752);
+    let v754 = v519.mul_add(v683, v753);
+    let v755 = v520.mul_add(v698, v754);
+    let v756 = v521.mul_add(v714, v755);
+    let v757 = v522.mul_add(v731, v756);
+    let v758 = v513.mul_add(v749, v757);
+    let v759 = -v758;
+    let v760 = v531 * v759;
+    let v761 = v513 * v760;
+    let v762 = v465.mul_add(v749, -v761);
+    let v763 = v522 * v760;
+    let v764 = v445.mul_add(v762, v763);
+    let v765 = v397.mul_add(v731, -v764);
+    let v766 = v455 * v762;
+    let v767 = v379.mul_add(v765, v766);
+    let v768 = v521.mul_add(v760, v767);
+    let v769 = v338.mul_add(v714, -v768);
+    let v770 = v388 * v765;
+    let v771 = v322.mul_add(v769, v770);
+    let v772 = v454.mul_add(v762, v771);
+    let v773 = v520.mul_add(v760, v772);
+    let v774 = v288.mul_add(v698, -v773);
+    let v775 = v330 * v769;
+    let v776 = v274.mul_add(v774, v775);
+    let v777 = v387.mul_add(v765, v776);
+    let v778 = v453.mul_add(v762, v777);
+    let v779 = v519.mul_add(v760, v778);
+    let v780 = v246.mul_add(v683, -v779);
+    let v781 = v280 * v774;
+    let v782 = v234.mul_add(v780, v781);
+    let v783 = v328.mul_add(v769, v782);
+    let v784 = v385.mul_add(v765, v783);
+    let v785 = v451.mul_add(v762, v784);
+    let v786 = v517.mul_add(v760, v785);
+    let v787 = v211.mul_add(v669, -v786);
+    let v788 = v239 * v780;
+    let v789 = v202.mul_add(v787, v788);
+    let v790 = v279.mul_add(v774, v789);
+    let v791 = v327.mul_add(v769, v790);
+    let v792 = v384.mul_add(v765, v791);
+    let v793 = v450.mul_add(v762, v792);
+    let v794 = v516.mul_add(v760, v793);
+    let v795 = v182.mul_add(v656, -v794);
+    out[0] = v795;
+    out[1] = v787;
+    out[2] = v780;
+    out[3] = v774;
+    out[4] = v769;
+    out[5] = v765;
+    out[6] = v762;
+    out[7] = v760;
+    out[8] = v180;
+    out[9] = v210;
+    out[10] = v245;
+    out[11] = v287;
+    out[12] = v337;
+    out[13] = v396;
+    out[14] = v464;
+    out[15] = v530;
+    out[16] = v202;
+    out[17] = v239;
+    out[18] = v234;
+    out[19] = v279;
+    out[20] = v280;
+    out[21] = v274;
+    out[22] = v327;
+    out[23] = v328;
+    out[24] = v330;
+    out[25] = v322;
+    out[26] = v384;
+    out[27] = v385;
+    out[28] = v387;
+    out[29] = v388;
+    out[30] = v379;
+    out[31] = v450;
+    out[32] = v451;
+    out[33] = v453;
+    out[34] = v454;
+    out[35] = v455;
+    out[36] = v445;
+    out[37] = v516;
+    out[38] = v517;
+    out[39] = v519;
+    out[40] = v520;
+    out[41] = v521;
+    out[42] = v522;
+    out[43] = v513;
+    out2[0] = v180;
+    out2[1] = v201;
+    out2[2] = v230;
+    out2[3] = v265;
+    out2[4] = v307;
+    out2[5] = v357;
+    out2[6] = v415;
+    out2[7] = v474;
+    out2[8] = v209;
+    out2[9] = v232;
+    out2[10] = v267;
+    out2[11] = v309;
+    out2[12] = v359;
+    out2[13] = v417;
+    out2[14] = v476;
+    out2[15] = v244;
+    out2[16] = v272;
+    out2[17] = v315;
+    out2[18] = v365;
+    out2[19] = v423;
+    out2[20] = v482;
+    out2[21] = v286;
+    out2[22] = v320;
+    out2[23] = v371;
+    out2[24] = v429;
+    out2[25] = v488;
+    out2[26] = v336;
+    out2[27] = v377;
+    out2[28] = v436;
+    out2[29] = v495;
+    out2[30] = v395;
+    out2[31] = v443;
+    out2[32] = v503;
+    out2[33] = v463;
+    out2[34] = v511;
+    out2[35] = v529;
+    out2[36] = v655;
+    out2[37] = v667;
+    out2[38] = v680;
+    out2[39] = v694;
+    out2[40] = v709;
+    out2[41] = v725;
+    out2[42] = v742;
+    out2[43] = v751;
 }
 /// Kernel `derived`: 41 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn derived(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    out: &mut [f64; 41usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    out: &mut [f64; 41],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1100,107 +1100,107 @@ pub fn derived(
 #[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 41usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    w: &mut [f64; 0],
+    out: &mut [f64; 41],
 ) {
-    let v2: f64 = 0.5f64 * p[49usize];
-    let v4: f64 = 0.5f64 * p[43usize];
-    let v6: f64 = 0.5f64 * p[37usize];
-    let v8: f64 = 0.5f64 * p[31usize];
-    let v10: f64 = 0.5f64 * p[25usize];
-    let v12: f64 = 0.5f64 * p[19usize];
-    let v14: f64 = 0.5f64 * p[13usize];
-    let v16: f64 = 0.5f64 * p[7usize];
-    let v18: f64 = (-0.5f64) * p[7usize];
-    let v26: f64 = p[44usize] + p[50usize];
-    let v27: f64 = p[38usize] + v26;
-    let v28: f64 = p[32usize] + v27;
-    let v29: f64 = p[26usize] + v28;
-    let v30: f64 = p[20usize] + v29;
-    let v31: f64 = p[14usize] + v30;
-    let v32: f64 = (-0.5f64) * p[13usize];
-    let v33: f64 = (-0.5f64) * p[19usize];
-    let v34: f64 = (-0.5f64) * p[25usize];
-    let v35: f64 = (-0.5f64) * p[31usize];
-    let v36: f64 = (-0.5f64) * p[37usize];
-    let v37: f64 = (-0.5f64) * p[43usize];
-    let v38: f64 = (-0.5f64) * p[49usize];
-    let v40: f64 = -p[1usize];
-    let v42: f64 = -p[0usize];
-    let v44: f64 = -p[12usize];
-    let v46: f64 = -p[18usize];
-    let v48: f64 = -p[24usize];
-    let v50: f64 = -p[30usize];
-    let v52: f64 = -p[36usize];
-    let v54: f64 = -p[42usize];
-    let v56: f64 = -p[48usize];
-    let v58: f64 = -p[54usize];
-    let v60: f64 = 0.5f64 * p[10usize];
-    let v62: f64 = 0.5f64 * p[16usize];
-    let v64: f64 = 0.5f64 * p[22usize];
-    let v66: f64 = 0.5f64 * p[28usize];
-    let v68: f64 = 0.5f64 * p[34usize];
-    let v70: f64 = 0.5f64 * p[40usize];
-    let v72: f64 = 0.5f64 * p[46usize];
-    let v74: f64 = 0.5f64 * p[52usize];
-    let v77: f64 = p[2usize] * p[5usize];
-    out[0usize] = v2;
-    out[1usize] = v4;
-    out[2usize] = v6;
-    out[3usize] = v8;
-    out[4usize] = v10;
-    out[5usize] = v12;
-    out[6usize] = v14;
-    out[7usize] = v16;
-    out[8usize] = v18;
-    out[9usize] = v31;
-    out[10usize] = v32;
-    out[11usize] = v30;
-    out[12usize] = v33;
-    out[13usize] = v29;
-    out[14usize] = v34;
-    out[15usize] = v28;
-    out[16usize] = v35;
-    out[17usize] = v27;
-    out[18usize] = v36;
-    out[19usize] = v26;
-    out[20usize] = v37;
-    out[21usize] = v38;
-    out[22usize] = v40;
-    out[23usize] = v42;
-    out[24usize] = v44;
-    out[25usize] = v46;
-    out[26usize] = v48;
-    out[27usize] = v50;
-    out[28usize] = v52;
-    out[29usize] = v54;
-    out[30usize] = v56;
-    out[31usize] = v58;
-    out[32usize] = v60;
-    out[33usize] = v62;
-    out[34usize] = v64;
-    out[35usize] = v66;
-    out[36usize] = v68;
-    out[37usize] = v70;
-    out[38usize] = v72;
-    out[39usize] = v74;
-    out[40usize] = v77;
+    let v2 = 0.5f64 * p[49];
+    let v4 = 0.5f64 * p[43];
+    let v6 = 0.5f64 * p[37];
+    let v8 = 0.5f64 * p[31];
+    let v10 = 0.5f64 * p[25];
+    let v12 = 0.5f64 * p[19];
+    let v14 = 0.5f64 * p[13];
+    let v16 = 0.5f64 * p[7];
+    let v18 = (-0.5f64) * p[7];
+    let v26 = p[44] + p[50];
+    let v27 = p[38] + v26;
+    let v28 = p[32] + v27;
+    let v29 = p[26] + v28;
+    let v30 = p[20] + v29;
+    let v31 = p[14] + v30;
+    let v32 = (-0.5f64) * p[13];
+    let v33 = (-0.5f64) * p[19];
+    let v34 = (-0.5f64) * p[25];
+    let v35 = (-0.5f64) * p[31];
+    let v36 = (-0.5f64) * p[37];
+    let v37 = (-0.5f64) * p[43];
+    let v38 = (-0.5f64) * p[49];
+    let v40 = -p[1];
+    let v42 = -p[0];
+    let v44 = -p[12];
+    let v46 = -p[18];
+    let v48 = -p[24];
+    let v50 = -p[30];
+    let v52 = -p[36];
+    let v54 = -p[42];
+    let v56 = -p[48];
+    let v58 = -p[54];
+    let v60 = 0.5f64 * p[10];
+    let v62 = 0.5f64 * p[16];
+    let v64 = 0.5f64 * p[22];
+    let v66 = 0.5f64 * p[28];
+    let v68 = 0.5f64 * p[34];
+    let v70 = 0.5f64 * p[40];
+    let v72 = 0.5f64 * p[46];
+    let v74 = 0.5f64 * p[52];
+    let v77 = p[2] * p[5];
+    out[0] = v2;
+    out[1] = v4;
+    out[2] = v6;
+    out[3] = v8;
+    out[4] = v10;
+    out[5] = v12;
+    out[6] = v14;
+    out[7] = v16;
+    out[8] = v18;
+    out[9] = v31;
+    out[10] = v32;
+    out[11] = v30;
+    out[12] = v33;
+    out[13] = v29;
+    out[14] = v34;
+    out[15] = v28;
+    out[16] = v35;
+    out[17] = v27;
+    out[18] = v36;
+    out[19] = v26;
+    out[20] = v37;
+    out[21] = v38;
+    out[22] = v40;
+    out[23] = v42;
+    out[24] = v44;
+    out[25] = v46;
+    out[26] = v48;
+    out[27] = v50;
+    out[28] = v52;
+    out[29] = v54;
+    out[30] = v56;
+    out[31] = v58;
+    out[32] = v60;
+    out[33] = v62;
+    out[34] = v64;
+    out[35] = v66;
+    out[36] = v68;
+    out[37] = v70;
+    out[38] = v72;
+    out[39] = v74;
+    out[40] = v77;
 }
 /// Kernel `constraints`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn constraints(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1211,24 +1211,24 @@ pub fn constraints(
 #[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1239,36 +1239,36 @@ pub fn contact(
 #[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jacobian`: the points' positions, velocities and Jacobians in 0 groups; group g runs when `all` or `dir[g] != 0`.
 #[allow(unused_variables)]
 pub fn contact_jacobian(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
     all: bool,
-    p: &[f64; 96usize],
-    out: &mut [f64; 0usize],
+    p: &[f64; 96],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jvp`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact_jvp(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1279,13 +1279,13 @@ pub fn contact_jvp(
 #[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
@@ -1298,16 +1298,16 @@ static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyL
 #[allow(unused_variables)]
 pub fn jvp(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    out: &mut [f64; 8usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    out: &mut [f64; 8],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
-    let mut tau = [0.0; 8usize];
+    let mut tau = [0.0; 8];
     runtime::links::inverse_dynamics_tangent(
         &LINKS,
         &mut cells,
@@ -1324,12 +1324,12 @@ pub fn jvp(
 #[allow(unused_variables)]
 pub fn outputs(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 96usize],
-    out: &mut [f64; 9usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 96],
+    out: &mut [f64; 9],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
@@ -1338,21 +1338,21 @@ pub fn outputs(
 /// The compiled cells and forces the link recursion evaluates.
 #[allow(dead_code)]
 struct LinkCells<'a> {
-    q: &'a [f64; 8usize],
-    qd: &'a [f64; 8usize],
-    p: &'a [f64; 96usize],
+    q: &'a [f64; 8],
+    qd: &'a [f64; 8],
+    p: &'a [f64; 96],
 }
 impl runtime::links::Cells for LinkCells<'_> {
     #[inline(always)]
     fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
-                    &[0.0; 2usize],
+                    &[0.0; 1],
+                    &[0.0; 2],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs"),
                 )
@@ -1376,15 +1376,15 @@ impl runtime::links::Cells for LinkCells<'_> {
         out: &mut [f64],
     ) {
         match c {
-            0usize => {
-                let mut dir = [0.0; 2usize];
-                dir[..1usize].copy_from_slice(dx);
-                dir[1usize..].copy_from_slice(dxd);
+            0 => {
+                let mut dir = [0.0; 2];
+                dir[..1].copy_from_slice(dx);
+                dir[1..].copy_from_slice(dxd);
                 cell_0_tangent(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
+                    &[0.0; 1],
                     &dir,
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs and derivatives"),
@@ -1404,13 +1404,13 @@ impl runtime::links::Cells for LinkCells<'_> {
     }
     fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0_pose(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
-                    &[0.0; 2usize],
+                    &[0.0; 1],
+                    &[0.0; 2],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("pose outputs"),
                 )
@@ -1426,12 +1426,12 @@ impl runtime::links::Cells for LinkCells<'_> {
 #[allow(unused_unsafe)]
 pub fn cell_0_pose(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 38],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1442,83 +1442,83 @@ pub fn cell_0_pose(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 38],
 ) {
-    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0usize]);
-    let v3: f64 = -v2;
-    let v7: f64 = p[0usize] * v1;
-    let v8: f64 = p[0usize] * v2;
-    let v10: f64 = -v8;
-    let v11: f64 = qd[0usize] * v10;
-    let v12: f64 = qd[0usize] * v7;
-    let v14: f64 = 0.5f64 * p[0usize];
-    let v15: f64 = v14 * v1;
-    let v16: f64 = v14 * v2;
-    let v18: f64 = (-0.5f64) * p[0usize];
-    let v19: f64 = v18 * v2;
-    let v20: f64 = qd[0usize] * v19;
-    let v21: f64 = qd[0usize] * v15;
-    let v24: f64 = 0.5f64 * q[0usize];
+    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0]);
+    let v3 = -v2;
+    let v7 = p[0] * v1;
+    let v8 = p[0] * v2;
+    let v10 = -v8;
+    let v11 = qd[0] * v10;
+    let v12 = qd[0] * v7;
+    let v14 = 0.5f64 * p[0];
+    let v15 = v14 * v1;
+    let v16 = v14 * v2;
+    let v18 = (-0.5f64) * p[0];
+    let v19 = v18 * v2;
+    let v20 = qd[0] * v19;
+    let v21 = qd[0] * v15;
+    let v24 = 0.5f64 * q[0];
     let (v26, v25): (f64, f64) = runtime::special::sin_cos(v24);
-    let v29: f64 = q[0usize] - p[6usize];
-    let v30: f64 = v29 * v29;
-    let v31: f64 = 0.5f64 * p[4usize];
-    let v32: f64 = v31 * v30;
-    out[0usize] = v1;
-    out[1usize] = v3;
-    out[2usize] = 0f64;
-    out[3usize] = v2;
-    out[4usize] = v1;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v7;
-    out[10usize] = v8;
-    out[11usize] = 0f64;
-    out[12usize] = v11;
-    out[13usize] = v12;
-    out[14usize] = 0f64;
-    out[15usize] = 0f64;
-    out[16usize] = 0f64;
-    out[17usize] = qd[0usize];
-    out[18usize] = v15;
-    out[19usize] = v16;
-    out[20usize] = 0f64;
-    out[21usize] = v20;
-    out[22usize] = v21;
-    out[23usize] = 0f64;
-    out[24usize] = 0f64;
-    out[25usize] = 0f64;
-    out[26usize] = qd[0usize];
-    out[27usize] = 1f64;
-    out[28usize] = 0f64;
-    out[29usize] = 0f64;
-    out[30usize] = p[1usize];
-    out[31usize] = p[2usize];
-    out[32usize] = p[2usize];
-    out[33usize] = v25;
-    out[34usize] = 0f64;
-    out[35usize] = 0f64;
-    out[36usize] = v26;
-    out[37usize] = v32;
+    let v29 = q[0] - p[6];
+    let v30 = v29 * v29;
+    let v31 = 0.5f64 * p[4];
+    let v32 = v31 * v30;
+    out[0] = v1;
+    out[1] = v3;
+    out[2] = 0f64;
+    out[3] = v2;
+    out[4] = v1;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v7;
+    out[10] = v8;
+    out[11] = 0f64;
+    out[12] = v11;
+    out[13] = v12;
+    out[14] = 0f64;
+    out[15] = 0f64;
+    out[16] = 0f64;
+    out[17] = qd[0];
+    out[18] = v15;
+    out[19] = v16;
+    out[20] = 0f64;
+    out[21] = v20;
+    out[22] = v21;
+    out[23] = 0f64;
+    out[24] = 0f64;
+    out[25] = 0f64;
+    out[26] = qd[0];
+    out[27] = 1f64;
+    out[28] = 0f64;
+    out[29] = 0f64;
+    out[30] = p[1];
+    out[31] = p[2];
+    out[32] = p[2];
+    out[33] = v25;
+    out[34] = 0f64;
+    out[35] = 0f64;
+    out[36] = v26;
+    out[37] = v32;
 }
 /// Kernel `cell_0`: 26 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 59usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 59],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1529,108 +1529,108 @@ pub fn cell_0(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 59usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 59],
 ) {
-    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0usize]);
-    let v3: f64 = -v2;
-    let v7: f64 = p[0usize] * v1;
-    let v8: f64 = p[0usize] * v2;
-    let v10: f64 = -v8;
-    let v11: f64 = qd[0usize] * v10;
-    let v12: f64 = qd[0usize] * v7;
-    let v13: f64 = qd[0usize] * qd[0usize];
-    let v14: f64 = -v7;
-    let v15: f64 = v13 * v14;
-    let v16: f64 = v13 * v10;
-    let v18: f64 = 0.5f64 * p[0usize];
-    let v19: f64 = v18 * v1;
-    let v20: f64 = v18 * v2;
-    let v22: f64 = (-0.5f64) * p[0usize];
-    let v23: f64 = v22 * v2;
-    let v24: f64 = qd[0usize] * v23;
-    let v25: f64 = qd[0usize] * v19;
-    let v26: f64 = v22 * v1;
-    let v27: f64 = v13 * v26;
-    let v28: f64 = v13 * v23;
-    let v33: f64 = q[0usize] - p[6usize];
-    let v35: f64 = qd[0usize] * p[5usize];
-    let v36: f64 = p[4usize].mul_add(v33, v35);
-    out[0usize] = v1;
-    out[1usize] = v3;
-    out[2usize] = 0f64;
-    out[3usize] = v2;
-    out[4usize] = v1;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v7;
-    out[10usize] = v8;
-    out[11usize] = 0f64;
-    out[12usize] = v11;
-    out[13usize] = v12;
-    out[14usize] = 0f64;
-    out[15usize] = v15;
-    out[16usize] = v16;
-    out[17usize] = 0f64;
-    out[18usize] = 0f64;
-    out[19usize] = 0f64;
-    out[20usize] = qd[0usize];
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = v19;
-    out[25usize] = v20;
-    out[26usize] = 0f64;
-    out[27usize] = v24;
-    out[28usize] = v25;
-    out[29usize] = 0f64;
-    out[30usize] = v27;
-    out[31usize] = v28;
-    out[32usize] = 0f64;
-    out[33usize] = 0f64;
-    out[34usize] = 0f64;
-    out[35usize] = qd[0usize];
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
-    out[38usize] = 0f64;
-    out[39usize] = 1f64;
-    out[40usize] = 0f64;
-    out[41usize] = 0f64;
-    out[42usize] = p[1usize];
-    out[43usize] = p[2usize];
-    out[44usize] = p[2usize];
-    out[45usize] = 0f64;
-    out[46usize] = 0f64;
-    out[47usize] = 1f64;
-    out[48usize] = v10;
-    out[49usize] = v7;
-    out[50usize] = 0f64;
-    out[51usize] = 0f64;
-    out[52usize] = 0f64;
-    out[53usize] = 1f64;
-    out[54usize] = v23;
-    out[55usize] = v19;
-    out[56usize] = 0f64;
-    out[57usize] = v36;
-    out[58usize] = 0f64;
+    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0]);
+    let v3 = -v2;
+    let v7 = p[0] * v1;
+    let v8 = p[0] * v2;
+    let v10 = -v8;
+    let v11 = qd[0] * v10;
+    let v12 = qd[0] * v7;
+    let v13 = qd[0] * qd[0];
+    let v14 = -v7;
+    let v15 = v13 * v14;
+    let v16 = v13 * v10;
+    let v18 = 0.5f64 * p[0];
+    let v19 = v18 * v1;
+    let v20 = v18 * v2;
+    let v22 = (-0.5f64) * p[0];
+    let v23 = v22 * v2;
+    let v24 = qd[0] * v23;
+    let v25 = qd[0] * v19;
+    let v26 = v22 * v1;
+    let v27 = v13 * v26;
+    let v28 = v13 * v23;
+    let v33 = q[0] - p[6];
+    let v35 = qd[0] * p[5];
+    let v36 = p[4].mul_add(v33, v35);
+    out[0] = v1;
+    out[1] = v3;
+    out[2] = 0f64;
+    out[3] = v2;
+    out[4] = v1;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v7;
+    out[10] = v8;
+    out[11] = 0f64;
+    out[12] = v11;
+    out[13] = v12;
+    out[14] = 0f64;
+    out[15] = v15;
+    out[16] = v16;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = qd[0];
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = v19;
+    out[25] = v20;
+    out[26] = 0f64;
+    out[27] = v24;
+    out[28] = v25;
+    out[29] = 0f64;
+    out[30] = v27;
+    out[31] = v28;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = qd[0];
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 1f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = p[1];
+    out[43] = p[2];
+    out[44] = p[2];
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 1f64;
+    out[48] = v10;
+    out[49] = v7;
+    out[50] = 0f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 1f64;
+    out[54] = v23;
+    out[55] = v19;
+    out[56] = 0f64;
+    out[57] = v36;
+    out[58] = 0f64;
 }
 /// Kernel `cell_0_tangent`: 72 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0_tangent(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 118usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 118],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1641,193 +1641,193 @@ pub fn cell_0_tangent(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 118usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 118],
 ) {
-    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0usize]);
-    let v3: f64 = -v2;
-    let v7: f64 = p[0usize] * v1;
-    let v8: f64 = p[0usize] * v2;
-    let v10: f64 = -v8;
-    let v11: f64 = qd[0usize] * v10;
-    let v12: f64 = qd[0usize] * v7;
-    let v13: f64 = qd[0usize] * qd[0usize];
-    let v14: f64 = -v7;
-    let v15: f64 = v13 * v14;
-    let v16: f64 = v13 * v10;
-    let v18: f64 = 0.5f64 * p[0usize];
-    let v19: f64 = v18 * v1;
-    let v20: f64 = v18 * v2;
-    let v22: f64 = (-0.5f64) * p[0usize];
-    let v23: f64 = v22 * v2;
-    let v24: f64 = qd[0usize] * v23;
-    let v25: f64 = qd[0usize] * v19;
-    let v26: f64 = v22 * v1;
-    let v27: f64 = v13 * v26;
-    let v28: f64 = v13 * v23;
-    let v33: f64 = q[0usize] - p[6usize];
-    let v35: f64 = qd[0usize] * p[5usize];
-    let v36: f64 = p[4usize].mul_add(v33, v35);
-    let v38: f64 = v2 * dir[0usize];
-    let v39: f64 = -v38;
-    let v40: f64 = v1 * dir[0usize];
-    let v41: f64 = -v40;
-    let v42: f64 = v10 * dir[0usize];
-    let v43: f64 = v7 * dir[0usize];
-    let v45: f64 = qd[0usize] * v14;
-    let v46: f64 = v45 * dir[0usize];
-    let v47: f64 = v10.mul_add(dir[1usize], v46);
-    let v48: f64 = v11 * dir[0usize];
-    let v49: f64 = v7.mul_add(dir[1usize], v48);
-    let v50: f64 = v8 * v13;
-    let v52: f64 = 2f64 * qd[0usize];
-    let v53: f64 = v52 * v14;
-    let v54: f64 = v53 * dir[1usize];
-    let v55: f64 = v50.mul_add(dir[0usize], v54);
-    let v56: f64 = v52 * v10;
-    let v57: f64 = v56 * dir[1usize];
-    let v58: f64 = v15.mul_add(dir[0usize], v57);
-    let v59: f64 = v23 * dir[0usize];
-    let v60: f64 = v19 * dir[0usize];
-    let v61: f64 = qd[0usize] * v26;
-    let v62: f64 = v61 * dir[0usize];
-    let v63: f64 = v23.mul_add(dir[1usize], v62);
-    let v64: f64 = v24 * dir[0usize];
-    let v65: f64 = v19.mul_add(dir[1usize], v64);
-    let v66: f64 = v20 * v13;
-    let v67: f64 = v52 * v26;
-    let v68: f64 = v67 * dir[1usize];
-    let v69: f64 = v66.mul_add(dir[0usize], v68);
-    let v70: f64 = v52 * v23;
-    let v71: f64 = v70 * dir[1usize];
-    let v72: f64 = v27.mul_add(dir[0usize], v71);
-    let v73: f64 = v14 * dir[0usize];
-    let v74: f64 = v26 * dir[0usize];
-    let v75: f64 = p[5usize] * dir[1usize];
-    let v76: f64 = p[4usize].mul_add(dir[0usize], v75);
-    out[0usize] = v1;
-    out[1usize] = v3;
-    out[2usize] = 0f64;
-    out[3usize] = v2;
-    out[4usize] = v1;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v7;
-    out[10usize] = v8;
-    out[11usize] = 0f64;
-    out[12usize] = v11;
-    out[13usize] = v12;
-    out[14usize] = 0f64;
-    out[15usize] = v15;
-    out[16usize] = v16;
-    out[17usize] = 0f64;
-    out[18usize] = 0f64;
-    out[19usize] = 0f64;
-    out[20usize] = qd[0usize];
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = v19;
-    out[25usize] = v20;
-    out[26usize] = 0f64;
-    out[27usize] = v24;
-    out[28usize] = v25;
-    out[29usize] = 0f64;
-    out[30usize] = v27;
-    out[31usize] = v28;
-    out[32usize] = 0f64;
-    out[33usize] = 0f64;
-    out[34usize] = 0f64;
-    out[35usize] = qd[0usize];
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
-    out[38usize] = 0f64;
-    out[39usize] = 1f64;
-    out[40usize] = 0f64;
-    out[41usize] = 0f64;
-    out[42usize] = p[1usize];
-    out[43usize] = p[2usize];
-    out[44usize] = p[2usize];
-    out[45usize] = 0f64;
-    out[46usize] = 0f64;
-    out[47usize] = 1f64;
-    out[48usize] = v10;
-    out[49usize] = v7;
-    out[50usize] = 0f64;
-    out[51usize] = 0f64;
-    out[52usize] = 0f64;
-    out[53usize] = 1f64;
-    out[54usize] = v23;
-    out[55usize] = v19;
-    out[56usize] = 0f64;
-    out[57usize] = v36;
-    out[58usize] = 0f64;
-    out[59usize] = v39;
-    out[60usize] = v41;
-    out[61usize] = 0f64;
-    out[62usize] = v40;
-    out[63usize] = v39;
-    out[64usize] = 0f64;
-    out[65usize] = 0f64;
-    out[66usize] = 0f64;
-    out[67usize] = 0f64;
-    out[68usize] = v42;
-    out[69usize] = v43;
-    out[70usize] = 0f64;
-    out[71usize] = v47;
-    out[72usize] = v49;
-    out[73usize] = 0f64;
-    out[74usize] = v55;
-    out[75usize] = v58;
-    out[76usize] = 0f64;
-    out[77usize] = 0f64;
-    out[78usize] = 0f64;
-    out[79usize] = dir[1usize];
-    out[80usize] = 0f64;
-    out[81usize] = 0f64;
-    out[82usize] = 0f64;
-    out[83usize] = v59;
-    out[84usize] = v60;
-    out[85usize] = 0f64;
-    out[86usize] = v63;
-    out[87usize] = v65;
-    out[88usize] = 0f64;
-    out[89usize] = v69;
-    out[90usize] = v72;
-    out[91usize] = 0f64;
-    out[92usize] = 0f64;
-    out[93usize] = 0f64;
-    out[94usize] = dir[1usize];
-    out[95usize] = 0f64;
-    out[96usize] = 0f64;
-    out[97usize] = 0f64;
-    out[98usize] = 0f64;
-    out[99usize] = 0f64;
-    out[100usize] = 0f64;
-    out[101usize] = 0f64;
-    out[102usize] = 0f64;
-    out[103usize] = 0f64;
-    out[104usize] = 0f64;
-    out[105usize] = 0f64;
-    out[106usize] = 0f64;
-    out[107usize] = v73;
-    out[108usize] = v42;
-    out[109usize] = 0f64;
-    out[110usize] = 0f64;
-    out[111usize] = 0f64;
-    out[112usize] = 0f64;
-    out[113usize] = v74;
-    out[114usize] = v59;
-    out[115usize] = 0f64;
-    out[116usize] = v76;
-    out[117usize] = 0f64;
+    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0]);
+    let v3 = -v2;
+    let v7 = p[0] * v1;
+    let v8 = p[0] * v2;
+    let v10 = -v8;
+    let v11 = qd[0] * v10;
+    let v12 = qd[0] * v7;
+    let v13 = qd[0] * qd[0];
+    let v14 = -v7;
+    let v15 = v13 * v14;
+    let v16 = v13 * v10;
+    let v18 = 0.5f64 * p[0];
+    let v19 = v18 * v1;
+    let v20 = v18 * v2;
+    let v22 = (-0.5f64) * p[0];
+    let v23 = v22 * v2;
+    let v24 = qd[0] * v23;
+    let v25 = qd[0] * v19;
+    let v26 = v22 * v1;
+    let v27 = v13 * v26;
+    let v28 = v13 * v23;
+    let v33 = q[0] - p[6];
+    let v35 = qd[0] * p[5];
+    let v36 = p[4].mul_add(v33, v35);
+    let v38 = v2 * dir[0];
+    let v39 = -v38;
+    let v40 = v1 * dir[0];
+    let v41 = -v40;
+    let v42 = v10 * dir[0];
+    let v43 = v7 * dir[0];
+    let v45 = qd[0] * v14;
+    let v46 = v45 * dir[0];
+    let v47 = v10.mul_add(dir[1], v46);
+    let v48 = v11 * dir[0];
+    let v49 = v7.mul_add(dir[1], v48);
+    let v50 = v8 * v13;
+    let v52 = 2f64 * qd[0];
+    let v53 = v52 * v14;
+    let v54 = v53 * dir[1];
+    let v55 = v50.mul_add(dir[0], v54);
+    let v56 = v52 * v10;
+    let v57 = v56 * dir[1];
+    let v58 = v15.mul_add(dir[0], v57);
+    let v59 = v23 * dir[0];
+    let v60 = v19 * dir[0];
+    let v61 = qd[0] * v26;
+    let v62 = v61 * dir[0];
+    let v63 = v23.mul_add(dir[1], v62);
+    let v64 = v24 * dir[0];
+    let v65 = v19.mul_add(dir[1], v64);
+    let v66 = v20 * v13;
+    let v67 = v52 * v26;
+    let v68 = v67 * dir[1];
+    let v69 = v66.mul_add(dir[0], v68);
+    let v70 = v52 * v23;
+    let v71 = v70 * dir[1];
+    let v72 = v27.mul_add(dir[0], v71);
+    let v73 = v14 * dir[0];
+    let v74 = v26 * dir[0];
+    let v75 = p[5] * dir[1];
+    let v76 = p[4].mul_add(dir[0], v75);
+    out[0] = v1;
+    out[1] = v3;
+    out[2] = 0f64;
+    out[3] = v2;
+    out[4] = v1;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v7;
+    out[10] = v8;
+    out[11] = 0f64;
+    out[12] = v11;
+    out[13] = v12;
+    out[14] = 0f64;
+    out[15] = v15;
+    out[16] = v16;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = qd[0];
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = v19;
+    out[25] = v20;
+    out[26] = 0f64;
+    out[27] = v24;
+    out[28] = v25;
+    out[29] = 0f64;
+    out[30] = v27;
+    out[31] = v28;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = qd[0];
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 1f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = p[1];
+    out[43] = p[2];
+    out[44] = p[2];
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 1f64;
+    out[48] = v10;
+    out[49] = v7;
+    out[50] = 0f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 1f64;
+    out[54] = v23;
+    out[55] = v19;
+    out[56] = 0f64;
+    out[57] = v36;
+    out[58] = 0f64;
+    out[59] = v39;
+    out[60] = v41;
+    out[61] = 0f64;
+    out[62] = v40;
+    out[63] = v39;
+    out[64] = 0f64;
+    out[65] = 0f64;
+    out[66] = 0f64;
+    out[67] = 0f64;
+    out[68] = v42;
+    out[69] = v43;
+    out[70] = 0f64;
+    out[71] = v47;
+    out[72] = v49;
+    out[73] = 0f64;
+    out[74] = v55;
+    out[75] = v58;
+    out[76] = 0f64;
+    out[77] = 0f64;
+    out[78] = 0f64;
+    out[79] = dir[1];
+    out[80] = 0f64;
+    out[81] = 0f64;
+    out[82] = 0f64;
+    out[83] = v59;
+    out[84] = v60;
+    out[85] = 0f64;
+    out[86] = v63;
+    out[87] = v65;
+    out[88] = 0f64;
+    out[89] = v69;
+    out[90] = v72;
+    out[91] = 0f64;
+    out[92] = 0f64;
+    out[93] = 0f64;
+    out[94] = dir[1];
+    out[95] = 0f64;
+    out[96] = 0f64;
+    out[97] = 0f64;
+    out[98] = 0f64;
+    out[99] = 0f64;
+    out[100] = 0f64;
+    out[101] = 0f64;
+    out[102] = 0f64;
+    out[103] = 0f64;
+    out[104] = 0f64;
+    out[105] = 0f64;
+    out[106] = 0f64;
+    out[107] = v73;
+    out[108] = v42;
+    out[109] = 0f64;
+    out[110] = 0f64;
+    out[111] = 0f64;
+    out[112] = 0f64;
+    out[113] = v74;
+    out[114] = v59;
+    out[115] = 0f64;
+    out[116] = v76;
+    out[117] = 0f64;
 }
 /// This model's cells, for chains of other lengths to link.
 pub static CELLS: &[runtime::links::CompiledCell] = &[];

@@ -4,7 +4,7 @@
 use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
 /// Structural hash of the model this was derived from.
 pub const HASH: &str = "324284822e134557";
-pub const DOF: usize = 2usize;
+pub const DOF: usize = 2;
 pub const COORDINATES: &[&str] = &["theta_0_0", "theta_1_0"];
 pub const PARAMETERS: &[&str] = &[
     "gravity.x",
@@ -28,21 +28,21 @@ pub const PARAMETERS: &[&str] = &[
     "joint[1].rest",
 ];
 /// Derived parameters, computed once per parameter set.
-pub const DERIVED: usize = 11usize;
+pub const DERIVED: usize = 11;
 /// Whether the mass solve is generated (the `accel` kernel).
 pub const ACCEL: bool = true;
 /// Base parameters that are loads (scaled by load continuation).
-pub const LOADS: &[usize] = &[0usize, 1usize, 2usize];
+pub const LOADS: &[usize] = &[0, 1, 2];
 /// The rows of the joints' constraint equations.
 pub const CONSTRAINTS: &[&str] = &[];
 /// Coordinates per independent subsystem (M block diagonal).
 pub const BLOCKS: &[usize] = &[];
 /// Contact points along the arms and at the bodies.
-pub const CONTACT_POINTS: usize = 0usize;
+pub const CONTACT_POINTS: usize = 0;
 /// Points per group of the `contact_jacobian` kernel.
 pub const CONTACT_GROUPS: &[usize] = &[];
 /// Length of the contact frames the `contact_jacobian` groups read.
-pub const CONTACT_FRAMES: usize = 0usize;
+pub const CONTACT_FRAMES: usize = 0;
 /// The compiled kernels of this structure.
 pub struct Compiled {
     info: ModelInfo,
@@ -74,17 +74,17 @@ impl Kernels for Compiled {
         "compiled"
     }
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
-        let q: &[f64; 2usize] = inp.q.try_into().expect("q has DOF entries");
-        let qd: &[f64; 2usize] = inp.qd.try_into().expect("qd has DOF entries");
-        let p: &[f64; 30usize] = inp.p.try_into().expect("parameter vector length");
-        let no_qdd = [0.0f64; 2usize];
-        let qdd: &[f64; 2usize] = if inp.qdd.is_empty() {
+        let q: &[f64; 2] = inp.q.try_into().expect("q has DOF entries");
+        let qd: &[f64; 2] = inp.qd.try_into().expect("qd has DOF entries");
+        let p: &[f64; 30] = inp.p.try_into().expect("parameter vector length");
+        let no_qdd = [0.0f64; 2];
+        let qdd: &[f64; 2] = if inp.qdd.is_empty() {
             &no_qdd
         } else {
             inp.qdd.try_into().expect("qdd has DOF entries")
         };
-        let no_dir = [0.0f64; 4usize];
-        let dir: &[f64; 4usize] = if inp.dir.is_empty() {
+        let no_dir = [0.0f64; 4];
+        let dir: &[f64; 4] = if inp.dir.is_empty() {
             &no_dir
         } else {
             inp.dir.try_into().expect("dir has 2 DOF entries")
@@ -181,12 +181,12 @@ impl Kernels for Compiled {
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    out: &mut [f64; 5usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    out: &mut [f64; 5],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -196,27 +196,27 @@ pub fn accel(
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
 fn accel_fma(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 5usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    w: &mut [f64; 0],
+    out: &mut [f64; 5],
 ) {
-    let mut unused = [0.0f64; 5usize];
+    let mut unused = [0.0f64; 5];
     eom_0(t, q, qd, qdd, dir, p, w, out, &mut unused);
 }
 /// Kernel `mass_bias`: the last 5 values of `eom` (118 operations for all).
 #[allow(unused_unsafe)]
 pub fn mass_bias(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    out: &mut [f64; 5usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    out: &mut [f64; 5],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -226,136 +226,136 @@ pub fn mass_bias(
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
 fn mass_bias_fma(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 5usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    w: &mut [f64; 0],
+    out: &mut [f64; 5],
 ) {
-    let mut unused = [0.0f64; 5usize];
+    let mut unused = [0.0f64; 5];
     eom_0(t, q, qd, qdd, dir, p, w, &mut unused, out);
 }
 #[inline(always)]
 #[allow(unused_variables, clippy::all)]
 fn eom_0(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 5usize],
-    out2: &mut [f64; 5usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    w: &mut [f64; 0],
+    out: &mut [f64; 5],
+    out2: &mut [f64; 5],
 ) {
-    let v7: f64 = p[6usize] + q[0usize];
+    let v7 = p[6] + q[0];
     let (v18, v8): (f64, f64) = runtime::special::sin_cos(v7);
-    let v9: f64 = p[7usize] * v8;
-    let v10: f64 = p[3usize] + v9;
-    let v13: f64 = q[1usize] + v7;
+    let v9 = p[7] * v8;
+    let v10 = p[3] + v9;
+    let v13 = q[1] + v7;
     let (v21, v14): (f64, f64) = runtime::special::sin_cos(v13);
-    let v15: f64 = p[19usize] * v14;
-    let v16: f64 = v10 + v15;
-    let v19: f64 = p[7usize] * v18;
-    let v20: f64 = p[4usize] + v19;
-    let v22: f64 = p[19usize] * v21;
-    let v23: f64 = v20 + v22;
-    let v24: f64 = v23 * v23;
-    let v25: f64 = v16.mul_add(v16, v24);
-    let v26: f64 = p[14usize].mul_add(v25, p[15usize]);
-    let v29: f64 = p[20usize] * v8;
-    let v31: f64 = p[21usize] * v18;
-    let v32: f64 = v31 * v31;
-    let v33: f64 = v29.mul_add(v29, v32);
-    let v34: f64 = -v19;
-    let v35: f64 = v20 + v34;
-    let v36: f64 = p[14usize] * v23;
-    let v38: f64 = 2f64 * v36;
-    let v39: f64 = p[14usize].mul_add(v35, -v38);
-    let v40: f64 = v9 - v10;
-    let v41: f64 = p[14usize] * v16;
-    let v42: f64 = p[14usize] * v40;
-    let v43: f64 = 2f64.mul_add(v41, v42);
-    let v44: f64 = p[9usize] + v26;
-    let v45: f64 = p[8usize].mul_add(v33, v44);
-    let v46: f64 = v35.mul_add(v39, v45);
-    let v47: f64 = v40.mul_add(v43, v46);
-    let v49: f64 = 1f64 / v47;
-    let v51: f64 = p[22usize] * v21;
-    let v52: f64 = v23 * v51;
-    let v53: f64 = v16.mul_add(v15, -v52);
-    let v54: f64 = p[14usize].mul_add(v53, p[15usize]);
-    let v55: f64 = p[14usize] * v51;
-    let v56: f64 = p[14usize] * v15;
-    let v57: f64 = v35.mul_add(v55, v54);
-    let v58: f64 = v40.mul_add(v56, v57);
-    let v59: f64 = v49 * v58;
-    let v60: f64 = v15 * v15;
-    let v61: f64 = v51.mul_add(v51, v60);
-    let v62: f64 = p[14usize].mul_add(v61, p[15usize]);
-    let v63: f64 = (-v58).mul_add(v59, v62);
-    let v64: f64 = 1f64 / v63;
-    let v67: f64 = p[26usize] + q[1usize];
-    let v70: f64 = p[17usize] * qd[1usize];
-    let v73: f64 = qd[0usize] * qd[0usize];
-    let v74: f64 = -v9;
-    let v75: f64 = qd[0usize] + qd[1usize];
-    let v76: f64 = v75 * v75;
-    let v77: f64 = v15 * v76;
-    let v78: f64 = v73.mul_add(v74, -v77);
-    let v79: f64 = p[24usize] + v78;
-    let v81: f64 = v22 * v76;
-    let v82: f64 = v73.mul_add(v34, -v81);
-    let v83: f64 = p[23usize] + v82;
-    let v84: f64 = v83 * v15;
-    let v85: f64 = v79.mul_add(v51, v84);
-    let v86: f64 = v23 * v79;
-    let v87: f64 = v16.mul_add(v83, -v86);
-    let v88: f64 = p[14usize] * v79;
-    let v89: f64 = v35 * v88;
-    let v90: f64 = p[14usize] * v83;
-    let v93: f64 = p[25usize] + q[0usize];
-    let v95: f64 = p[21usize] * v8;
-    let v96: f64 = v73.mul_add(v95, p[24usize]);
-    let v97: f64 = v73.mul_add(v31, p[23usize]);
-    let v98: f64 = v29 * v97;
-    let v99: f64 = v31.mul_add(v96, v98);
-    let v100: f64 = p[14usize].mul_add(v87, v89);
-    let v101: f64 = v40.mul_add(v90, v100);
-    let v102: f64 = p[10usize].mul_add(v93, v101);
-    let v103: f64 = p[11usize].mul_add(qd[0usize], v102);
-    let v104: f64 = p[8usize].mul_add(v99, v103);
-    let v105: f64 = -v104;
-    let v106: f64 = p[16usize].mul_add(v67, v70);
-    let v107: f64 = p[14usize].mul_add(v85, v106);
-    let v108: f64 = v59.mul_add(v105, v107);
-    let v109: f64 = -v108;
-    let v110: f64 = v64 * v109;
-    let v111: f64 = v59 * v110;
-    let v112: f64 = v49.mul_add(v105, -v111);
-    out[0usize] = v112;
-    out[1usize] = v110;
-    out[2usize] = v47;
-    out[3usize] = v63;
-    out[4usize] = v59;
-    out2[0usize] = v47;
-    out2[1usize] = v58;
-    out2[2usize] = v62;
-    out2[3usize] = v104;
-    out2[4usize] = v107;
+    let v15 = p[19] * v14;
+    let v16 = v10 + v15;
+    let v19 = p[7] * v18;
+    let v20 = p[4] + v19;
+    let v22 = p[19] * v21;
+    let v23 = v20 + v22;
+    let v24 = v23 * v23;
+    let v25 = v16.mul_add(v16, v24);
+    let v26 = p[14].mul_add(v25, p[15]);
+    let v29 = p[20] * v8;
+    let v31 = p[21] * v18;
+    let v32 = v31 * v31;
+    let v33 = v29.mul_add(v29, v32);
+    let v34 = -v19;
+    let v35 = v20 + v34;
+    let v36 = p[14] * v23;
+    let v38 = 2f64 * v36;
+    let v39 = p[14].mul_add(v35, -v38);
+    let v40 = v9 - v10;
+    let v41 = p[14] * v16;
+    let v42 = p[14] * v40;
+    let v43 = 2f64.mul_add(v41, v42);
+    let v44 = p[9] + v26;
+    let v45 = p[8].mul_add(v33, v44);
+    let v46 = v35.mul_add(v39, v45);
+    let v47 = v40.mul_add(v43, v46);
+    let v49 = 1f64 / v47;
+    let v51 = p[22] * v21;
+    let v52 = v23 * v51;
+    let v53 = v16.mul_add(v15, -v52);
+    let v54 = p[14].mul_add(v53, p[15]);
+    let v55 = p[14] * v51;
+    let v56 = p[14] * v15;
+    let v57 = v35.mul_add(v55, v54);
+    let v58 = v40.mul_add(v56, v57);
+    let v59 = v49 * v58;
+    let v60 = v15 * v15;
+    let v61 = v51.mul_add(v51, v60);
+    let v62 = p[14].mul_add(v61, p[15]);
+    let v63 = (-v58).mul_add(v59, v62);
+    let v64 = 1f64 / v63;
+    let v67 = p[26] + q[1];
+    let v70 = p[17] * qd[1];
+    let v73 = qd[0] * qd[0];
+    let v74 = -v9;
+    let v75 = qd[0] + qd[1];
+    let v76 = v75 * v75;
+    let v77 = v15 * v76;
+    let v78 = v73.mul_add(v74, -v77);
+    let v79 = p[24] + v78;
+    let v81 = v22 * v76;
+    let v82 = v73.mul_add(v34, -v81);
+    let v83 = p[23] + v82;
+    let v84 = v83 * v15;
+    let v85 = v79.mul_add(v51, v84);
+    let v86 = v23 * v79;
+    let v87 = v16.mul_add(v83, -v86);
+    let v88 = p[14] * v79;
+    let v89 = v35 * v88;
+    let v90 = p[14] * v83;
+    let v93 = p[25] + q[0];
+    let v95 = p[21] * v8;
+    let v96 = v73.mul_add(v95, p[24]);
+    let v97 = v73.mul_add(v31, p[23]);
+    let v98 = v29 * v97;
+    let v99 = v31.mul_add(v96, v98);
+    let v100 = p[14].mul_add(v87, v89);
+    let v101 = v40.mul_add(v90, v100);
+    let v102 = p[10].mul_add(v93, v101);
+    let v103 = p[11].mul_add(qd[0], v102);
+    let v104 = p[8].mul_add(v99, v103);
+    let v105 = -v104;
+    let v106 = p[16].mul_add(v67, v70);
+    let v107 = p[14].mul_add(v85, v106);
+    let v108 = v59.mul_add(v105, v107);
+    let v109 = -v108;
+    let v110 = v64 * v109;
+    let v111 = v59 * v110;
+    let v112 = v49.mul_add(v105, -v111);
+    out[0] = v112;
+    out[1] = v110;
+    out[2] = v47;
+    out[3] = v63;
+    out[4] = v59;
+    out2[0] = v47;
+    out2[1] = v58;
+    out2[2] = v62;
+    out2[3] = v104;
+    out2[4] = v107;
 }
 /// Kernel `derived`: 11 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn derived(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    out: &mut [f64; 11usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    out: &mut [f64; 11],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -366,47 +366,47 @@ pub fn derived(
 #[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 11usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    w: &mut [f64; 0],
+    out: &mut [f64; 11],
 ) {
-    let v2: f64 = 0.5f64 * p[13usize];
-    let v4: f64 = 0.5f64 * p[7usize];
-    let v6: f64 = (-0.5f64) * p[7usize];
-    let v7: f64 = (-0.5f64) * p[13usize];
-    let v9: f64 = -p[1usize];
-    let v11: f64 = -p[0usize];
-    let v13: f64 = -p[12usize];
-    let v15: f64 = -p[18usize];
-    let v17: f64 = 0.5f64 * p[10usize];
-    let v19: f64 = 0.5f64 * p[16usize];
-    let v22: f64 = p[2usize] * p[5usize];
-    out[0usize] = v2;
-    out[1usize] = v4;
-    out[2usize] = v6;
-    out[3usize] = v7;
-    out[4usize] = v9;
-    out[5usize] = v11;
-    out[6usize] = v13;
-    out[7usize] = v15;
-    out[8usize] = v17;
-    out[9usize] = v19;
-    out[10usize] = v22;
+    let v2 = 0.5f64 * p[13];
+    let v4 = 0.5f64 * p[7];
+    let v6 = (-0.5f64) * p[7];
+    let v7 = (-0.5f64) * p[13];
+    let v9 = -p[1];
+    let v11 = -p[0];
+    let v13 = -p[12];
+    let v15 = -p[18];
+    let v17 = 0.5f64 * p[10];
+    let v19 = 0.5f64 * p[16];
+    let v22 = p[2] * p[5];
+    out[0] = v2;
+    out[1] = v4;
+    out[2] = v6;
+    out[3] = v7;
+    out[4] = v9;
+    out[5] = v11;
+    out[6] = v13;
+    out[7] = v15;
+    out[8] = v17;
+    out[9] = v19;
+    out[10] = v22;
 }
 /// Kernel `constraints`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn constraints(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -417,24 +417,24 @@ pub fn constraints(
 #[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -445,36 +445,36 @@ pub fn contact(
 #[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jacobian`: the points' positions, velocities and Jacobians in 0 groups; group g runs when `all` or `dir[g] != 0`.
 #[allow(unused_variables)]
 pub fn contact_jacobian(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
     all: bool,
-    p: &[f64; 30usize],
-    out: &mut [f64; 0usize],
+    p: &[f64; 30],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jvp`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact_jvp(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -485,13 +485,13 @@ pub fn contact_jvp(
 #[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
@@ -504,16 +504,16 @@ static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyL
 #[allow(unused_variables)]
 pub fn jvp(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    out: &mut [f64; 2usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    out: &mut [f64; 2],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
-    let mut tau = [0.0; 2usize];
+    let mut tau = [0.0; 2];
     runtime::links::inverse_dynamics_tangent(
         &LINKS,
         &mut cells,
@@ -530,12 +530,12 @@ pub fn jvp(
 #[allow(unused_variables)]
 pub fn outputs(
     t: f64,
-    q: &[f64; 2usize],
-    qd: &[f64; 2usize],
-    qdd: &[f64; 2usize],
-    dir: &[f64; 4usize],
-    p: &[f64; 30usize],
-    out: &mut [f64; 9usize],
+    q: &[f64; 2],
+    qd: &[f64; 2],
+    qdd: &[f64; 2],
+    dir: &[f64; 4],
+    p: &[f64; 30],
+    out: &mut [f64; 9],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
@@ -544,21 +544,21 @@ pub fn outputs(
 /// The compiled cells and forces the link recursion evaluates.
 #[allow(dead_code)]
 struct LinkCells<'a> {
-    q: &'a [f64; 2usize],
-    qd: &'a [f64; 2usize],
-    p: &'a [f64; 30usize],
+    q: &'a [f64; 2],
+    qd: &'a [f64; 2],
+    p: &'a [f64; 30],
 }
 impl runtime::links::Cells for LinkCells<'_> {
     #[inline(always)]
     fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
-                    &[0.0; 2usize],
+                    &[0.0; 1],
+                    &[0.0; 2],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs"),
                 )
@@ -582,15 +582,15 @@ impl runtime::links::Cells for LinkCells<'_> {
         out: &mut [f64],
     ) {
         match c {
-            0usize => {
-                let mut dir = [0.0; 2usize];
-                dir[..1usize].copy_from_slice(dx);
-                dir[1usize..].copy_from_slice(dxd);
+            0 => {
+                let mut dir = [0.0; 2];
+                dir[..1].copy_from_slice(dx);
+                dir[1..].copy_from_slice(dxd);
                 cell_0_tangent(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
+                    &[0.0; 1],
                     &dir,
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs and derivatives"),
@@ -610,13 +610,13 @@ impl runtime::links::Cells for LinkCells<'_> {
     }
     fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0_pose(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
-                    &[0.0; 2usize],
+                    &[0.0; 1],
+                    &[0.0; 2],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("pose outputs"),
                 )
@@ -632,12 +632,12 @@ impl runtime::links::Cells for LinkCells<'_> {
 #[allow(unused_unsafe)]
 pub fn cell_0_pose(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 38],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -648,83 +648,83 @@ pub fn cell_0_pose(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 38],
 ) {
-    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0usize]);
-    let v3: f64 = -v2;
-    let v7: f64 = p[0usize] * v1;
-    let v8: f64 = p[0usize] * v2;
-    let v10: f64 = -v8;
-    let v11: f64 = qd[0usize] * v10;
-    let v12: f64 = qd[0usize] * v7;
-    let v14: f64 = 0.5f64 * p[0usize];
-    let v15: f64 = v14 * v1;
-    let v16: f64 = v14 * v2;
-    let v18: f64 = (-0.5f64) * p[0usize];
-    let v19: f64 = v18 * v2;
-    let v20: f64 = qd[0usize] * v19;
-    let v21: f64 = qd[0usize] * v15;
-    let v24: f64 = 0.5f64 * q[0usize];
+    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0]);
+    let v3 = -v2;
+    let v7 = p[0] * v1;
+    let v8 = p[0] * v2;
+    let v10 = -v8;
+    let v11 = qd[0] * v10;
+    let v12 = qd[0] * v7;
+    let v14 = 0.5f64 * p[0];
+    let v15 = v14 * v1;
+    let v16 = v14 * v2;
+    let v18 = (-0.5f64) * p[0];
+    let v19 = v18 * v2;
+    let v20 = qd[0] * v19;
+    let v21 = qd[0] * v15;
+    let v24 = 0.5f64 * q[0];
     let (v26, v25): (f64, f64) = runtime::special::sin_cos(v24);
-    let v29: f64 = q[0usize] - p[6usize];
-    let v30: f64 = v29 * v29;
-    let v31: f64 = 0.5f64 * p[4usize];
-    let v32: f64 = v31 * v30;
-    out[0usize] = v1;
-    out[1usize] = v3;
-    out[2usize] = 0f64;
-    out[3usize] = v2;
-    out[4usize] = v1;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v7;
-    out[10usize] = v8;
-    out[11usize] = 0f64;
-    out[12usize] = v11;
-    out[13usize] = v12;
-    out[14usize] = 0f64;
-    out[15usize] = 0f64;
-    out[16usize] = 0f64;
-    out[17usize] = qd[0usize];
-    out[18usize] = v15;
-    out[19usize] = v16;
-    out[20usize] = 0f64;
-    out[21usize] = v20;
-    out[22usize] = v21;
-    out[23usize] = 0f64;
-    out[24usize] = 0f64;
-    out[25usize] = 0f64;
-    out[26usize] = qd[0usize];
-    out[27usize] = 1f64;
-    out[28usize] = 0f64;
-    out[29usize] = 0f64;
-    out[30usize] = p[1usize];
-    out[31usize] = p[2usize];
-    out[32usize] = p[2usize];
-    out[33usize] = v25;
-    out[34usize] = 0f64;
-    out[35usize] = 0f64;
-    out[36usize] = v26;
-    out[37usize] = v32;
+    let v29 = q[0] - p[6];
+    let v30 = v29 * v29;
+    let v31 = 0.5f64 * p[4];
+    let v32 = v31 * v30;
+    out[0] = v1;
+    out[1] = v3;
+    out[2] = 0f64;
+    out[3] = v2;
+    out[4] = v1;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v7;
+    out[10] = v8;
+    out[11] = 0f64;
+    out[12] = v11;
+    out[13] = v12;
+    out[14] = 0f64;
+    out[15] = 0f64;
+    out[16] = 0f64;
+    out[17] = qd[0];
+    out[18] = v15;
+    out[19] = v16;
+    out[20] = 0f64;
+    out[21] = v20;
+    out[22] = v21;
+    out[23] = 0f64;
+    out[24] = 0f64;
+    out[25] = 0f64;
+    out[26] = qd[0];
+    out[27] = 1f64;
+    out[28] = 0f64;
+    out[29] = 0f64;
+    out[30] = p[1];
+    out[31] = p[2];
+    out[32] = p[2];
+    out[33] = v25;
+    out[34] = 0f64;
+    out[35] = 0f64;
+    out[36] = v26;
+    out[37] = v32;
 }
 /// Kernel `cell_0`: 26 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 59usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 59],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -735,108 +735,108 @@ pub fn cell_0(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 59usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 59],
 ) {
-    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0usize]);
-    let v3: f64 = -v2;
-    let v7: f64 = p[0usize] * v1;
-    let v8: f64 = p[0usize] * v2;
-    let v10: f64 = -v8;
-    let v11: f64 = qd[0usize] * v10;
-    let v12: f64 = qd[0usize] * v7;
-    let v13: f64 = qd[0usize] * qd[0usize];
-    let v14: f64 = -v7;
-    let v15: f64 = v13 * v14;
-    let v16: f64 = v13 * v10;
-    let v18: f64 = 0.5f64 * p[0usize];
-    let v19: f64 = v18 * v1;
-    let v20: f64 = v18 * v2;
-    let v22: f64 = (-0.5f64) * p[0usize];
-    let v23: f64 = v22 * v2;
-    let v24: f64 = qd[0usize] * v23;
-    let v25: f64 = qd[0usize] * v19;
-    let v26: f64 = v22 * v1;
-    let v27: f64 = v13 * v26;
-    let v28: f64 = v13 * v23;
-    let v33: f64 = q[0usize] - p[6usize];
-    let v35: f64 = qd[0usize] * p[5usize];
-    let v36: f64 = p[4usize].mul_add(v33, v35);
-    out[0usize] = v1;
-    out[1usize] = v3;
-    out[2usize] = 0f64;
-    out[3usize] = v2;
-    out[4usize] = v1;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v7;
-    out[10usize] = v8;
-    out[11usize] = 0f64;
-    out[12usize] = v11;
-    out[13usize] = v12;
-    out[14usize] = 0f64;
-    out[15usize] = v15;
-    out[16usize] = v16;
-    out[17usize] = 0f64;
-    out[18usize] = 0f64;
-    out[19usize] = 0f64;
-    out[20usize] = qd[0usize];
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = v19;
-    out[25usize] = v20;
-    out[26usize] = 0f64;
-    out[27usize] = v24;
-    out[28usize] = v25;
-    out[29usize] = 0f64;
-    out[30usize] = v27;
-    out[31usize] = v28;
-    out[32usize] = 0f64;
-    out[33usize] = 0f64;
-    out[34usize] = 0f64;
-    out[35usize] = qd[0usize];
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
-    out[38usize] = 0f64;
-    out[39usize] = 1f64;
-    out[40usize] = 0f64;
-    out[41usize] = 0f64;
-    out[42usize] = p[1usize];
-    out[43usize] = p[2usize];
-    out[44usize] = p[2usize];
-    out[45usize] = 0f64;
-    out[46usize] = 0f64;
-    out[47usize] = 1f64;
-    out[48usize] = v10;
-    out[49usize] = v7;
-    out[50usize] = 0f64;
-    out[51usize] = 0f64;
-    out[52usize] = 0f64;
-    out[53usize] = 1f64;
-    out[54usize] = v23;
-    out[55usize] = v19;
-    out[56usize] = 0f64;
-    out[57usize] = v36;
-    out[58usize] = 0f64;
+    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0]);
+    let v3 = -v2;
+    let v7 = p[0] * v1;
+    let v8 = p[0] * v2;
+    let v10 = -v8;
+    let v11 = qd[0] * v10;
+    let v12 = qd[0] * v7;
+    let v13 = qd[0] * qd[0];
+    let v14 = -v7;
+    let v15 = v13 * v14;
+    let v16 = v13 * v10;
+    let v18 = 0.5f64 * p[0];
+    let v19 = v18 * v1;
+    let v20 = v18 * v2;
+    let v22 = (-0.5f64) * p[0];
+    let v23 = v22 * v2;
+    let v24 = qd[0] * v23;
+    let v25 = qd[0] * v19;
+    let v26 = v22 * v1;
+    let v27 = v13 * v26;
+    let v28 = v13 * v23;
+    let v33 = q[0] - p[6];
+    let v35 = qd[0] * p[5];
+    let v36 = p[4].mul_add(v33, v35);
+    out[0] = v1;
+    out[1] = v3;
+    out[2] = 0f64;
+    out[3] = v2;
+    out[4] = v1;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v7;
+    out[10] = v8;
+    out[11] = 0f64;
+    out[12] = v11;
+    out[13] = v12;
+    out[14] = 0f64;
+    out[15] = v15;
+    out[16] = v16;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = qd[0];
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = v19;
+    out[25] = v20;
+    out[26] = 0f64;
+    out[27] = v24;
+    out[28] = v25;
+    out[29] = 0f64;
+    out[30] = v27;
+    out[31] = v28;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = qd[0];
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 1f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = p[1];
+    out[43] = p[2];
+    out[44] = p[2];
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 1f64;
+    out[48] = v10;
+    out[49] = v7;
+    out[50] = 0f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 1f64;
+    out[54] = v23;
+    out[55] = v19;
+    out[56] = 0f64;
+    out[57] = v36;
+    out[58] = 0f64;
 }
 /// Kernel `cell_0_tangent`: 72 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0_tangent(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 118usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 118],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -847,193 +847,193 @@ pub fn cell_0_tangent(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 118usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 118],
 ) {
-    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0usize]);
-    let v3: f64 = -v2;
-    let v7: f64 = p[0usize] * v1;
-    let v8: f64 = p[0usize] * v2;
-    let v10: f64 = -v8;
-    let v11: f64 = qd[0usize] * v10;
-    let v12: f64 = qd[0usize] * v7;
-    let v13: f64 = qd[0usize] * qd[0usize];
-    let v14: f64 = -v7;
-    let v15: f64 = v13 * v14;
-    let v16: f64 = v13 * v10;
-    let v18: f64 = 0.5f64 * p[0usize];
-    let v19: f64 = v18 * v1;
-    let v20: f64 = v18 * v2;
-    let v22: f64 = (-0.5f64) * p[0usize];
-    let v23: f64 = v22 * v2;
-    let v24: f64 = qd[0usize] * v23;
-    let v25: f64 = qd[0usize] * v19;
-    let v26: f64 = v22 * v1;
-    let v27: f64 = v13 * v26;
-    let v28: f64 = v13 * v23;
-    let v33: f64 = q[0usize] - p[6usize];
-    let v35: f64 = qd[0usize] * p[5usize];
-    let v36: f64 = p[4usize].mul_add(v33, v35);
-    let v38: f64 = v2 * dir[0usize];
-    let v39: f64 = -v38;
-    let v40: f64 = v1 * dir[0usize];
-    let v41: f64 = -v40;
-    let v42: f64 = v10 * dir[0usize];
-    let v43: f64 = v7 * dir[0usize];
-    let v45: f64 = qd[0usize] * v14;
-    let v46: f64 = v45 * dir[0usize];
-    let v47: f64 = v10.mul_add(dir[1usize], v46);
-    let v48: f64 = v11 * dir[0usize];
-    let v49: f64 = v7.mul_add(dir[1usize], v48);
-    let v50: f64 = v8 * v13;
-    let v52: f64 = 2f64 * qd[0usize];
-    let v53: f64 = v52 * v14;
-    let v54: f64 = v53 * dir[1usize];
-    let v55: f64 = v50.mul_add(dir[0usize], v54);
-    let v56: f64 = v52 * v10;
-    let v57: f64 = v56 * dir[1usize];
-    let v58: f64 = v15.mul_add(dir[0usize], v57);
-    let v59: f64 = v23 * dir[0usize];
-    let v60: f64 = v19 * dir[0usize];
-    let v61: f64 = qd[0usize] * v26;
-    let v62: f64 = v61 * dir[0usize];
-    let v63: f64 = v23.mul_add(dir[1usize], v62);
-    let v64: f64 = v24 * dir[0usize];
-    let v65: f64 = v19.mul_add(dir[1usize], v64);
-    let v66: f64 = v20 * v13;
-    let v67: f64 = v52 * v26;
-    let v68: f64 = v67 * dir[1usize];
-    let v69: f64 = v66.mul_add(dir[0usize], v68);
-    let v70: f64 = v52 * v23;
-    let v71: f64 = v70 * dir[1usize];
-    let v72: f64 = v27.mul_add(dir[0usize], v71);
-    let v73: f64 = v14 * dir[0usize];
-    let v74: f64 = v26 * dir[0usize];
-    let v75: f64 = p[5usize] * dir[1usize];
-    let v76: f64 = p[4usize].mul_add(dir[0usize], v75);
-    out[0usize] = v1;
-    out[1usize] = v3;
-    out[2usize] = 0f64;
-    out[3usize] = v2;
-    out[4usize] = v1;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v7;
-    out[10usize] = v8;
-    out[11usize] = 0f64;
-    out[12usize] = v11;
-    out[13usize] = v12;
-    out[14usize] = 0f64;
-    out[15usize] = v15;
-    out[16usize] = v16;
-    out[17usize] = 0f64;
-    out[18usize] = 0f64;
-    out[19usize] = 0f64;
-    out[20usize] = qd[0usize];
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = v19;
-    out[25usize] = v20;
-    out[26usize] = 0f64;
-    out[27usize] = v24;
-    out[28usize] = v25;
-    out[29usize] = 0f64;
-    out[30usize] = v27;
-    out[31usize] = v28;
-    out[32usize] = 0f64;
-    out[33usize] = 0f64;
-    out[34usize] = 0f64;
-    out[35usize] = qd[0usize];
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
-    out[38usize] = 0f64;
-    out[39usize] = 1f64;
-    out[40usize] = 0f64;
-    out[41usize] = 0f64;
-    out[42usize] = p[1usize];
-    out[43usize] = p[2usize];
-    out[44usize] = p[2usize];
-    out[45usize] = 0f64;
-    out[46usize] = 0f64;
-    out[47usize] = 1f64;
-    out[48usize] = v10;
-    out[49usize] = v7;
-    out[50usize] = 0f64;
-    out[51usize] = 0f64;
-    out[52usize] = 0f64;
-    out[53usize] = 1f64;
-    out[54usize] = v23;
-    out[55usize] = v19;
-    out[56usize] = 0f64;
-    out[57usize] = v36;
-    out[58usize] = 0f64;
-    out[59usize] = v39;
-    out[60usize] = v41;
-    out[61usize] = 0f64;
-    out[62usize] = v40;
-    out[63usize] = v39;
-    out[64usize] = 0f64;
-    out[65usize] = 0f64;
-    out[66usize] = 0f64;
-    out[67usize] = 0f64;
-    out[68usize] = v42;
-    out[69usize] = v43;
-    out[70usize] = 0f64;
-    out[71usize] = v47;
-    out[72usize] = v49;
-    out[73usize] = 0f64;
-    out[74usize] = v55;
-    out[75usize] = v58;
-    out[76usize] = 0f64;
-    out[77usize] = 0f64;
-    out[78usize] = 0f64;
-    out[79usize] = dir[1usize];
-    out[80usize] = 0f64;
-    out[81usize] = 0f64;
-    out[82usize] = 0f64;
-    out[83usize] = v59;
-    out[84usize] = v60;
-    out[85usize] = 0f64;
-    out[86usize] = v63;
-    out[87usize] = v65;
-    out[88usize] = 0f64;
-    out[89usize] = v69;
-    out[90usize] = v72;
-    out[91usize] = 0f64;
-    out[92usize] = 0f64;
-    out[93usize] = 0f64;
-    out[94usize] = dir[1usize];
-    out[95usize] = 0f64;
-    out[96usize] = 0f64;
-    out[97usize] = 0f64;
-    out[98usize] = 0f64;
-    out[99usize] = 0f64;
-    out[100usize] = 0f64;
-    out[101usize] = 0f64;
-    out[102usize] = 0f64;
-    out[103usize] = 0f64;
-    out[104usize] = 0f64;
-    out[105usize] = 0f64;
-    out[106usize] = 0f64;
-    out[107usize] = v73;
-    out[108usize] = v42;
-    out[109usize] = 0f64;
-    out[110usize] = 0f64;
-    out[111usize] = 0f64;
-    out[112usize] = 0f64;
-    out[113usize] = v74;
-    out[114usize] = v59;
-    out[115usize] = 0f64;
-    out[116usize] = v76;
-    out[117usize] = 0f64;
+    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0]);
+    let v3 = -v2;
+    let v7 = p[0] * v1;
+    let v8 = p[0] * v2;
+    let v10 = -v8;
+    let v11 = qd[0] * v10;
+    let v12 = qd[0] * v7;
+    let v13 = qd[0] * qd[0];
+    let v14 = -v7;
+    let v15 = v13 * v14;
+    let v16 = v13 * v10;
+    let v18 = 0.5f64 * p[0];
+    let v19 = v18 * v1;
+    let v20 = v18 * v2;
+    let v22 = (-0.5f64) * p[0];
+    let v23 = v22 * v2;
+    let v24 = qd[0] * v23;
+    let v25 = qd[0] * v19;
+    let v26 = v22 * v1;
+    let v27 = v13 * v26;
+    let v28 = v13 * v23;
+    let v33 = q[0] - p[6];
+    let v35 = qd[0] * p[5];
+    let v36 = p[4].mul_add(v33, v35);
+    let v38 = v2 * dir[0];
+    let v39 = -v38;
+    let v40 = v1 * dir[0];
+    let v41 = -v40;
+    let v42 = v10 * dir[0];
+    let v43 = v7 * dir[0];
+    let v45 = qd[0] * v14;
+    let v46 = v45 * dir[0];
+    let v47 = v10.mul_add(dir[1], v46);
+    let v48 = v11 * dir[0];
+    let v49 = v7.mul_add(dir[1], v48);
+    let v50 = v8 * v13;
+    let v52 = 2f64 * qd[0];
+    let v53 = v52 * v14;
+    let v54 = v53 * dir[1];
+    let v55 = v50.mul_add(dir[0], v54);
+    let v56 = v52 * v10;
+    let v57 = v56 * dir[1];
+    let v58 = v15.mul_add(dir[0], v57);
+    let v59 = v23 * dir[0];
+    let v60 = v19 * dir[0];
+    let v61 = qd[0] * v26;
+    let v62 = v61 * dir[0];
+    let v63 = v23.mul_add(dir[1], v62);
+    let v64 = v24 * dir[0];
+    let v65 = v19.mul_add(dir[1], v64);
+    let v66 = v20 * v13;
+    let v67 = v52 * v26;
+    let v68 = v67 * dir[1];
+    let v69 = v66.mul_add(dir[0], v68);
+    let v70 = v52 * v23;
+    let v71 = v70 * dir[1];
+    let v72 = v27.mul_add(dir[0], v71);
+    let v73 = v14 * dir[0];
+    let v74 = v26 * dir[0];
+    let v75 = p[5] * dir[1];
+    let v76 = p[4].mul_add(dir[0], v75);
+    out[0] = v1;
+    out[1] = v3;
+    out[2] = 0f64;
+    out[3] = v2;
+    out[4] = v1;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v7;
+    out[10] = v8;
+    out[11] = 0f64;
+    out[12] = v11;
+    out[13] = v12;
+    out[14] = 0f64;
+    out[15] = v15;
+    out[16] = v16;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = qd[0];
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = v19;
+    out[25] = v20;
+    out[26] = 0f64;
+    out[27] = v24;
+    out[28] = v25;
+    out[29] = 0f64;
+    out[30] = v27;
+    out[31] = v28;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = qd[0];
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 1f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = p[1];
+    out[43] = p[2];
+    out[44] = p[2];
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 1f64;
+    out[48] = v10;
+    out[49] = v7;
+    out[50] = 0f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 1f64;
+    out[54] = v23;
+    out[55] = v19;
+    out[56] = 0f64;
+    out[57] = v36;
+    out[58] = 0f64;
+    out[59] = v39;
+    out[60] = v41;
+    out[61] = 0f64;
+    out[62] = v40;
+    out[63] = v39;
+    out[64] = 0f64;
+    out[65] = 0f64;
+    out[66] = 0f64;
+    out[67] = 0f64;
+    out[68] = v42;
+    out[69] = v43;
+    out[70] = 0f64;
+    out[71] = v47;
+    out[72] = v49;
+    out[73] = 0f64;
+    out[74] = v55;
+    out[75] = v58;
+    out[76] = 0f64;
+    out[77] = 0f64;
+    out[78] = 0f64;
+    out[79] = dir[1];
+    out[80] = 0f64;
+    out[81] = 0f64;
+    out[82] = 0f64;
+    out[83] = v59;
+    out[84] = v60;
+    out[85] = 0f64;
+    out[86] = v63;
+    out[87] = v65;
+    out[88] = 0f64;
+    out[89] = v69;
+    out[90] = v72;
+    out[91] = 0f64;
+    out[92] = 0f64;
+    out[93] = 0f64;
+    out[94] = dir[1];
+    out[95] = 0f64;
+    out[96] = 0f64;
+    out[97] = 0f64;
+    out[98] = 0f64;
+    out[99] = 0f64;
+    out[100] = 0f64;
+    out[101] = 0f64;
+    out[102] = 0f64;
+    out[103] = 0f64;
+    out[104] = 0f64;
+    out[105] = 0f64;
+    out[106] = 0f64;
+    out[107] = v73;
+    out[108] = v42;
+    out[109] = 0f64;
+    out[110] = 0f64;
+    out[111] = 0f64;
+    out[112] = 0f64;
+    out[113] = v74;
+    out[114] = v59;
+    out[115] = 0f64;
+    out[116] = v76;
+    out[117] = 0f64;
 }
 /// This model's cells, for chains of other lengths to link.
 pub static CELLS: &[runtime::links::CompiledCell] = &[];

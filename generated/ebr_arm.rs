@@ -4,7 +4,7 @@
 use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
 /// Structural hash of the model this was derived from.
 pub const HASH: &str = "e4a88e8f189e429d";
-pub const DOF: usize = 30usize;
+pub const DOF: usize = 30;
 pub const COORDINATES: &[&str] = &[
     "bend_y_0_0",
     "bend_z_0_0",
@@ -185,23 +185,21 @@ pub const PARAMETERS: &[&str] = &[
     "shear[9].stiffness",
 ];
 /// Derived parameters, computed once per parameter set.
-pub const DERIVED: usize = 122usize;
+pub const DERIVED: usize = 122;
 /// Whether the mass solve is generated (the `accel` kernel).
 pub const ACCEL: bool = false;
 /// Base parameters that are loads (scaled by load continuation).
-pub const LOADS: &[usize] = &[
-    0usize, 1usize, 2usize, 19usize, 20usize, 21usize, 22usize, 23usize, 24usize,
-];
+pub const LOADS: &[usize] = &[0, 1, 2, 19, 20, 21, 22, 23, 24];
 /// The rows of the joints' constraint equations.
 pub const CONSTRAINTS: &[&str] = &[];
 /// Coordinates per independent subsystem (M block diagonal).
 pub const BLOCKS: &[usize] = &[];
 /// Contact points along the arms and at the bodies.
-pub const CONTACT_POINTS: usize = 0usize;
+pub const CONTACT_POINTS: usize = 0;
 /// Points per group of the `contact_jacobian` kernel.
 pub const CONTACT_GROUPS: &[usize] = &[];
 /// Length of the contact frames the `contact_jacobian` groups read.
-pub const CONTACT_FRAMES: usize = 0usize;
+pub const CONTACT_FRAMES: usize = 0;
 /// The compiled kernels of this structure.
 pub struct Compiled {
     info: ModelInfo,
@@ -233,17 +231,17 @@ impl Kernels for Compiled {
         "compiled"
     }
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
-        let q: &[f64; 30usize] = inp.q.try_into().expect("q has DOF entries");
-        let qd: &[f64; 30usize] = inp.qd.try_into().expect("qd has DOF entries");
-        let p: &[f64; 267usize] = inp.p.try_into().expect("parameter vector length");
-        let no_qdd = [0.0f64; 30usize];
-        let qdd: &[f64; 30usize] = if inp.qdd.is_empty() {
+        let q: &[f64; 30] = inp.q.try_into().expect("q has DOF entries");
+        let qd: &[f64; 30] = inp.qd.try_into().expect("qd has DOF entries");
+        let p: &[f64; 267] = inp.p.try_into().expect("parameter vector length");
+        let no_qdd = [0.0f64; 30];
+        let qdd: &[f64; 30] = if inp.qdd.is_empty() {
             &no_qdd
         } else {
             inp.qdd.try_into().expect("qdd has DOF entries")
         };
-        let no_dir = [0.0f64; 60usize];
-        let dir: &[f64; 60usize] = if inp.dir.is_empty() {
+        let no_dir = [0.0f64; 60];
+        let dir: &[f64; 60] = if inp.dir.is_empty() {
             &no_dir
         } else {
             inp.dir.try_into().expect("dir has 2 DOF entries")
@@ -340,12 +338,12 @@ impl Kernels for Compiled {
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -356,24 +354,24 @@ pub fn accel(
 #[allow(unused_variables, clippy::all)]
 fn accel_0(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `derived`: 152 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn derived(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    out: &mut [f64; 122usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    out: &mut [f64; 122],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -384,291 +382,291 @@ pub fn derived(
 #[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 122usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    w: &mut [f64; 0],
+    out: &mut [f64; 122],
 ) {
-    let v2: f64 = 0.5f64 * p[25usize];
-    let v5: f64 = 0.5f64 * p[12usize];
-    let v6: f64 = v5.mul_add(p[25usize], p[5usize]);
-    let v9: f64 = 0.5f64 * p[9usize];
-    let v10: f64 = v9.mul_add(p[25usize], p[4usize]);
-    let v12: f64 = 0.5f64 * p[37usize];
-    let v14: f64 = 0.5f64 * p[49usize];
-    let v16: f64 = 0.5f64 * p[61usize];
-    let v18: f64 = 0.5f64 * p[73usize];
-    let v20: f64 = 0.5f64 * p[85usize];
-    let v22: f64 = 0.5f64 * p[97usize];
-    let v24: f64 = 0.5f64 * p[109usize];
-    let v26: f64 = 0.5f64 * p[121usize];
-    let v29: f64 = 0.25f64 * p[133usize];
-    let v30: f64 = 0.5f64 * p[133usize];
-    let v31: f64 = 0.25f64 * p[121usize];
-    let v32: f64 = 0.25f64 * p[109usize];
-    let v33: f64 = 0.25f64 * p[97usize];
-    let v34: f64 = 0.25f64 * p[85usize];
-    let v35: f64 = 0.25f64 * p[73usize];
-    let v36: f64 = 0.25f64 * p[61usize];
-    let v37: f64 = 0.25f64 * p[49usize];
-    let v38: f64 = 0.25f64 * p[37usize];
-    let v48: f64 = p[122usize] + p[134usize];
-    let v49: f64 = p[110usize] + v48;
-    let v50: f64 = p[98usize] + v49;
-    let v51: f64 = p[86usize] + v50;
-    let v52: f64 = p[74usize] + v51;
-    let v53: f64 = p[62usize] + v52;
-    let v54: f64 = p[50usize] + v53;
-    let v55: f64 = p[38usize] + v54;
-    let v58: f64 = 0.5f64 * p[6usize];
-    let v59: f64 = v58.mul_add(p[25usize], p[3usize]);
-    let v61: f64 = 0.5f64 * p[26usize];
-    let v62: f64 = 0.25f64 * p[25usize];
-    let v65: f64 = p[139usize] - p[135usize];
-    let v68: f64 = p[127usize] - p[123usize];
-    let v71: f64 = p[115usize] - p[111usize];
-    let v74: f64 = p[103usize] - p[99usize];
-    let v77: f64 = p[91usize] - p[87usize];
-    let v80: f64 = p[79usize] - p[75usize];
-    let v83: f64 = p[67usize] - p[63usize];
-    let v86: f64 = p[55usize] - p[51usize];
-    let v89: f64 = p[43usize] - p[39usize];
-    let v92: f64 = p[31usize] - p[27usize];
-    let v94: f64 = 2f64 * p[39usize];
-    let v95: f64 = 2f64 * p[51usize];
-    let v96: f64 = 2f64 * p[63usize];
-    let v97: f64 = 2f64 * p[75usize];
-    let v98: f64 = 2f64 * p[87usize];
-    let v99: f64 = 2f64 * p[99usize];
-    let v100: f64 = 2f64 * p[111usize];
-    let v101: f64 = 2f64 * p[123usize];
-    let v102: f64 = 2f64 * p[135usize];
-    let v103: f64 = 0.5f64 * p[38usize];
-    let v104: f64 = 0.5f64 * p[50usize];
-    let v105: f64 = 0.5f64 * p[62usize];
-    let v106: f64 = 0.5f64 * p[74usize];
-    let v107: f64 = 0.5f64 * p[86usize];
-    let v108: f64 = 0.5f64 * p[98usize];
-    let v109: f64 = 0.5f64 * p[110usize];
-    let v110: f64 = 0.5f64 * p[122usize];
-    let v111: f64 = 0.5f64 * p[134usize];
-    let v113: f64 = -p[19usize];
-    let v115: f64 = -p[0usize];
-    let v117: f64 = -p[20usize];
-    let v119: f64 = -p[1usize];
-    let v121: f64 = -p[21usize];
-    let v123: f64 = -p[2usize];
-    let v125: f64 = -p[22usize];
-    let v127: f64 = -p[23usize];
-    let v129: f64 = -p[24usize];
-    let v131: f64 = -p[30usize];
-    let v133: f64 = -p[42usize];
-    let v135: f64 = -p[54usize];
-    let v137: f64 = -p[66usize];
-    let v139: f64 = -p[78usize];
-    let v141: f64 = -p[90usize];
-    let v143: f64 = -p[102usize];
-    let v145: f64 = -p[114usize];
-    let v147: f64 = -p[126usize];
-    let v149: f64 = -p[138usize];
-    let v151: f64 = 0.5f64 * p[28usize];
-    let v153: f64 = 0.5f64 * p[32usize];
-    let v155: f64 = 0.5f64 * p[40usize];
-    let v157: f64 = 0.5f64 * p[44usize];
-    let v159: f64 = 0.5f64 * p[52usize];
-    let v161: f64 = 0.5f64 * p[56usize];
-    let v163: f64 = 0.5f64 * p[64usize];
-    let v165: f64 = 0.5f64 * p[68usize];
-    let v167: f64 = 0.5f64 * p[76usize];
-    let v169: f64 = 0.5f64 * p[80usize];
-    let v171: f64 = 0.5f64 * p[88usize];
-    let v173: f64 = 0.5f64 * p[92usize];
-    let v175: f64 = 0.5f64 * p[100usize];
-    let v177: f64 = 0.5f64 * p[104usize];
-    let v179: f64 = 0.5f64 * p[112usize];
-    let v181: f64 = 0.5f64 * p[116usize];
-    let v183: f64 = 0.5f64 * p[124usize];
-    let v185: f64 = 0.5f64 * p[128usize];
-    let v187: f64 = 0.5f64 * p[136usize];
-    let v189: f64 = 0.5f64 * p[140usize];
-    let v190: f64 = 0.25f64 * p[6usize];
-    let v191: f64 = v190.mul_add(p[25usize], p[3usize]);
-    let v192: f64 = 0.25f64 * p[9usize];
-    let v193: f64 = v192.mul_add(p[25usize], p[4usize]);
-    let v194: f64 = p[1usize] * v193;
-    let v195: f64 = 0.25f64 * p[12usize];
-    let v196: f64 = v195.mul_add(p[25usize], p[5usize]);
-    let v197: f64 = p[0usize].mul_add(v191, v194);
-    let v198: f64 = p[2usize].mul_add(v196, v197);
-    let v200: f64 = (-0.5f64) * p[26usize];
-    let v201: f64 = v200 * v198;
-    let v203: f64 = 0.5f64 * p[16usize];
-    let v205: f64 = 0.5f64 * p[17usize];
-    let v207: f64 = 0.5f64 * p[18usize];
-    let v209: f64 = 0.5f64 * p[15usize];
-    let v210: f64 = v68 - p[135usize];
-    let v211: f64 = v210 + p[139usize];
-    let v212: f64 = p[123usize] + p[135usize];
-    let v213: f64 = v71 - p[123usize];
-    let v214: f64 = v213 + p[127usize];
-    let v215: f64 = p[111usize] + p[123usize];
-    let v216: f64 = v74 - p[111usize];
-    let v217: f64 = v216 + p[115usize];
-    let v218: f64 = p[99usize] + p[111usize];
-    let v219: f64 = v77 - p[99usize];
-    let v220: f64 = v219 + p[103usize];
-    let v221: f64 = p[87usize] + p[99usize];
-    let v222: f64 = v80 - p[87usize];
-    let v223: f64 = v222 + p[91usize];
-    let v224: f64 = p[75usize] + p[87usize];
-    let v225: f64 = v83 - p[75usize];
-    let v226: f64 = v225 + p[79usize];
-    let v227: f64 = p[63usize] + p[75usize];
-    let v228: f64 = v86 - p[63usize];
-    let v229: f64 = v228 + p[67usize];
-    let v230: f64 = p[51usize] + p[63usize];
-    let v231: f64 = v89 - p[51usize];
-    let v232: f64 = v231 + p[55usize];
-    let v233: f64 = p[39usize] + p[51usize];
-    let v234: f64 = v92 - p[39usize];
-    let v235: f64 = v234 + p[43usize];
-    let v236: f64 = p[27usize] + p[39usize];
-    out[0usize] = v2;
-    out[1usize] = v6;
-    out[2usize] = v10;
-    out[3usize] = v12;
-    out[4usize] = v14;
-    out[5usize] = v16;
-    out[6usize] = v18;
-    out[7usize] = v20;
-    out[8usize] = v22;
-    out[9usize] = v24;
-    out[10usize] = v26;
-    out[11usize] = v29;
-    out[12usize] = v30;
-    out[13usize] = v31;
-    out[14usize] = v32;
-    out[15usize] = v33;
-    out[16usize] = v34;
-    out[17usize] = v35;
-    out[18usize] = v36;
-    out[19usize] = v37;
-    out[20usize] = v38;
-    out[21usize] = v55;
-    out[22usize] = v59;
-    out[23usize] = v61;
-    out[24usize] = v62;
-    out[25usize] = v65;
-    out[26usize] = v68;
-    out[27usize] = v71;
-    out[28usize] = v74;
-    out[29usize] = v77;
-    out[30usize] = v80;
-    out[31usize] = v83;
-    out[32usize] = v86;
-    out[33usize] = v89;
-    out[34usize] = v92;
-    out[35usize] = v94;
-    out[36usize] = v95;
-    out[37usize] = v96;
-    out[38usize] = v97;
-    out[39usize] = v98;
-    out[40usize] = v99;
-    out[41usize] = v100;
-    out[42usize] = v101;
-    out[43usize] = v102;
-    out[44usize] = v54;
-    out[45usize] = v103;
-    out[46usize] = v53;
-    out[47usize] = v104;
-    out[48usize] = v52;
-    out[49usize] = v105;
-    out[50usize] = v51;
-    out[51usize] = v106;
-    out[52usize] = v50;
-    out[53usize] = v107;
-    out[54usize] = v49;
-    out[55usize] = v108;
-    out[56usize] = v48;
-    out[57usize] = v109;
-    out[58usize] = v110;
-    out[59usize] = v111;
-    out[60usize] = v113;
-    out[61usize] = v115;
-    out[62usize] = v117;
-    out[63usize] = v119;
-    out[64usize] = v121;
-    out[65usize] = v123;
-    out[66usize] = v125;
-    out[67usize] = v127;
-    out[68usize] = v129;
-    out[69usize] = v131;
-    out[70usize] = v133;
-    out[71usize] = v135;
-    out[72usize] = v137;
-    out[73usize] = v139;
-    out[74usize] = v141;
-    out[75usize] = v143;
-    out[76usize] = v145;
-    out[77usize] = v147;
-    out[78usize] = v149;
-    out[79usize] = v151;
-    out[80usize] = v153;
-    out[81usize] = v155;
-    out[82usize] = v157;
-    out[83usize] = v159;
-    out[84usize] = v161;
-    out[85usize] = v163;
-    out[86usize] = v165;
-    out[87usize] = v167;
-    out[88usize] = v169;
-    out[89usize] = v171;
-    out[90usize] = v173;
-    out[91usize] = v175;
-    out[92usize] = v177;
-    out[93usize] = v179;
-    out[94usize] = v181;
-    out[95usize] = v183;
-    out[96usize] = v185;
-    out[97usize] = v187;
-    out[98usize] = v189;
-    out[99usize] = v201;
-    out[100usize] = v203;
-    out[101usize] = v205;
-    out[102usize] = v207;
-    out[103usize] = v209;
-    out[104usize] = v211;
-    out[105usize] = v212;
-    out[106usize] = v214;
-    out[107usize] = v215;
-    out[108usize] = v217;
-    out[109usize] = v218;
-    out[110usize] = v220;
-    out[111usize] = v221;
-    out[112usize] = v223;
-    out[113usize] = v224;
-    out[114usize] = v226;
-    out[115usize] = v227;
-    out[116usize] = v229;
-    out[117usize] = v230;
-    out[118usize] = v232;
-    out[119usize] = v233;
-    out[120usize] = v235;
-    out[121usize] = v236;
+    let v2 = 0.5f64 * p[25];
+    let v5 = 0.5f64 * p[12];
+    let v6 = v5.mul_add(p[25], p[5]);
+    let v9 = 0.5f64 * p[9];
+    let v10 = v9.mul_add(p[25], p[4]);
+    let v12 = 0.5f64 * p[37];
+    let v14 = 0.5f64 * p[49];
+    let v16 = 0.5f64 * p[61];
+    let v18 = 0.5f64 * p[73];
+    let v20 = 0.5f64 * p[85];
+    let v22 = 0.5f64 * p[97];
+    let v24 = 0.5f64 * p[109];
+    let v26 = 0.5f64 * p[121];
+    let v29 = 0.25f64 * p[133];
+    let v30 = 0.5f64 * p[133];
+    let v31 = 0.25f64 * p[121];
+    let v32 = 0.25f64 * p[109];
+    let v33 = 0.25f64 * p[97];
+    let v34 = 0.25f64 * p[85];
+    let v35 = 0.25f64 * p[73];
+    let v36 = 0.25f64 * p[61];
+    let v37 = 0.25f64 * p[49];
+    let v38 = 0.25f64 * p[37];
+    let v48 = p[122] + p[134];
+    let v49 = p[110] + v48;
+    let v50 = p[98] + v49;
+    let v51 = p[86] + v50;
+    let v52 = p[74] + v51;
+    let v53 = p[62] + v52;
+    let v54 = p[50] + v53;
+    let v55 = p[38] + v54;
+    let v58 = 0.5f64 * p[6];
+    let v59 = v58.mul_add(p[25], p[3]);
+    let v61 = 0.5f64 * p[26];
+    let v62 = 0.25f64 * p[25];
+    let v65 = p[139] - p[135];
+    let v68 = p[127] - p[123];
+    let v71 = p[115] - p[111];
+    let v74 = p[103] - p[99];
+    let v77 = p[91] - p[87];
+    let v80 = p[79] - p[75];
+    let v83 = p[67] - p[63];
+    let v86 = p[55] - p[51];
+    let v89 = p[43] - p[39];
+    let v92 = p[31] - p[27];
+    let v94 = 2f64 * p[39];
+    let v95 = 2f64 * p[51];
+    let v96 = 2f64 * p[63];
+    let v97 = 2f64 * p[75];
+    let v98 = 2f64 * p[87];
+    let v99 = 2f64 * p[99];
+    let v100 = 2f64 * p[111];
+    let v101 = 2f64 * p[123];
+    let v102 = 2f64 * p[135];
+    let v103 = 0.5f64 * p[38];
+    let v104 = 0.5f64 * p[50];
+    let v105 = 0.5f64 * p[62];
+    let v106 = 0.5f64 * p[74];
+    let v107 = 0.5f64 * p[86];
+    let v108 = 0.5f64 * p[98];
+    let v109 = 0.5f64 * p[110];
+    let v110 = 0.5f64 * p[122];
+    let v111 = 0.5f64 * p[134];
+    let v113 = -p[19];
+    let v115 = -p[0];
+    let v117 = -p[20];
+    let v119 = -p[1];
+    let v121 = -p[21];
+    let v123 = -p[2];
+    let v125 = -p[22];
+    let v127 = -p[23];
+    let v129 = -p[24];
+    let v131 = -p[30];
+    let v133 = -p[42];
+    let v135 = -p[54];
+    let v137 = -p[66];
+    let v139 = -p[78];
+    let v141 = -p[90];
+    let v143 = -p[102];
+    let v145 = -p[114];
+    let v147 = -p[126];
+    let v149 = -p[138];
+    let v151 = 0.5f64 * p[28];
+    let v153 = 0.5f64 * p[32];
+    let v155 = 0.5f64 * p[40];
+    let v157 = 0.5f64 * p[44];
+    let v159 = 0.5f64 * p[52];
+    let v161 = 0.5f64 * p[56];
+    let v163 = 0.5f64 * p[64];
+    let v165 = 0.5f64 * p[68];
+    let v167 = 0.5f64 * p[76];
+    let v169 = 0.5f64 * p[80];
+    let v171 = 0.5f64 * p[88];
+    let v173 = 0.5f64 * p[92];
+    let v175 = 0.5f64 * p[100];
+    let v177 = 0.5f64 * p[104];
+    let v179 = 0.5f64 * p[112];
+    let v181 = 0.5f64 * p[116];
+    let v183 = 0.5f64 * p[124];
+    let v185 = 0.5f64 * p[128];
+    let v187 = 0.5f64 * p[136];
+    let v189 = 0.5f64 * p[140];
+    let v190 = 0.25f64 * p[6];
+    let v191 = v190.mul_add(p[25], p[3]);
+    let v192 = 0.25f64 * p[9];
+    let v193 = v192.mul_add(p[25], p[4]);
+    let v194 = p[1] * v193;
+    let v195 = 0.25f64 * p[12];
+    let v196 = v195.mul_add(p[25], p[5]);
+    let v197 = p[0].mul_add(v191, v194);
+    let v198 = p[2].mul_add(v196, v197);
+    let v200 = (-0.5f64) * p[26];
+    let v201 = v200 * v198;
+    let v203 = 0.5f64 * p[16];
+    let v205 = 0.5f64 * p[17];
+    let v207 = 0.5f64 * p[18];
+    let v209 = 0.5f64 * p[15];
+    let v210 = v68 - p[135];
+    let v211 = v210 + p[139];
+    let v212 = p[123] + p[135];
+    let v213 = v71 - p[123];
+    let v214 = v213 + p[127];
+    let v215 = p[111] + p[123];
+    let v216 = v74 - p[111];
+    let v217 = v216 + p[115];
+    let v218 = p[99] + p[111];
+    let v219 = v77 - p[99];
+    let v220 = v219 + p[103];
+    let v221 = p[87] + p[99];
+    let v222 = v80 - p[87];
+    let v223 = v222 + p[91];
+    let v224 = p[75] + p[87];
+    let v225 = v83 - p[75];
+    let v226 = v225 + p[79];
+    let v227 = p[63] + p[75];
+    let v228 = v86 - p[63];
+    let v229 = v228 + p[67];
+    let v230 = p[51] + p[63];
+    let v231 = v89 - p[51];
+    let v232 = v231 + p[55];
+    let v233 = p[39] + p[51];
+    let v234 = v92 - p[39];
+    let v235 = v234 + p[43];
+    let v236 = p[27] + p[39];
+    out[0] = v2;
+    out[1] = v6;
+    out[2] = v10;
+    out[3] = v12;
+    out[4] = v14;
+    out[5] = v16;
+    out[6] = v18;
+    out[7] = v20;
+    out[8] = v22;
+    out[9] = v24;
+    out[10] = v26;
+    out[11] = v29;
+    out[12] = v30;
+    out[13] = v31;
+    out[14] = v32;
+    out[15] = v33;
+    out[16] = v34;
+    out[17] = v35;
+    out[18] = v36;
+    out[19] = v37;
+    out[20] = v38;
+    out[21] = v55;
+    out[22] = v59;
+    out[23] = v61;
+    out[24] = v62;
+    out[25] = v65;
+    out[26] = v68;
+    out[27] = v71;
+    out[28] = v74;
+    out[29] = v77;
+    out[30] = v80;
+    out[31] = v83;
+    out[32] = v86;
+    out[33] = v89;
+    out[34] = v92;
+    out[35] = v94;
+    out[36] = v95;
+    out[37] = v96;
+    out[38] = v97;
+    out[39] = v98;
+    out[40] = v99;
+    out[41] = v100;
+    out[42] = v101;
+    out[43] = v102;
+    out[44] = v54;
+    out[45] = v103;
+    out[46] = v53;
+    out[47] = v104;
+    out[48] = v52;
+    out[49] = v105;
+    out[50] = v51;
+    out[51] = v106;
+    out[52] = v50;
+    out[53] = v107;
+    out[54] = v49;
+    out[55] = v108;
+    out[56] = v48;
+    out[57] = v109;
+    out[58] = v110;
+    out[59] = v111;
+    out[60] = v113;
+    out[61] = v115;
+    out[62] = v117;
+    out[63] = v119;
+    out[64] = v121;
+    out[65] = v123;
+    out[66] = v125;
+    out[67] = v127;
+    out[68] = v129;
+    out[69] = v131;
+    out[70] = v133;
+    out[71] = v135;
+    out[72] = v137;
+    out[73] = v139;
+    out[74] = v141;
+    out[75] = v143;
+    out[76] = v145;
+    out[77] = v147;
+    out[78] = v149;
+    out[79] = v151;
+    out[80] = v153;
+    out[81] = v155;
+    out[82] = v157;
+    out[83] = v159;
+    out[84] = v161;
+    out[85] = v163;
+    out[86] = v165;
+    out[87] = v167;
+    out[88] = v169;
+    out[89] = v171;
+    out[90] = v173;
+    out[91] = v175;
+    out[92] = v177;
+    out[93] = v179;
+    out[94] = v181;
+    out[95] = v183;
+    out[96] = v185;
+    out[97] = v187;
+    out[98] = v189;
+    out[99] = v201;
+    out[100] = v203;
+    out[101] = v205;
+    out[102] = v207;
+    out[103] = v209;
+    out[104] = v211;
+    out[105] = v212;
+    out[106] = v214;
+    out[107] = v215;
+    out[108] = v217;
+    out[109] = v218;
+    out[110] = v220;
+    out[111] = v221;
+    out[112] = v223;
+    out[113] = v224;
+    out[114] = v226;
+    out[115] = v227;
+    out[116] = v229;
+    out[117] = v230;
+    out[118] = v232;
+    out[119] = v233;
+    out[120] = v235;
+    out[121] = v236;
 }
 /// Kernel `constraints`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn constraints(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -679,24 +677,24 @@ pub fn constraints(
 #[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -707,36 +705,36 @@ pub fn contact(
 #[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jacobian`: the points' positions, velocities and Jacobians in 0 groups; group g runs when `all` or `dir[g] != 0`.
 #[allow(unused_variables)]
 pub fn contact_jacobian(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
     all: bool,
-    p: &[f64; 267usize],
-    out: &mut [f64; 0usize],
+    p: &[f64; 267],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jvp`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact_jvp(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -747,13 +745,13 @@ pub fn contact_jvp(
 #[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
@@ -766,22 +764,22 @@ static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyL
 #[allow(unused_variables)]
 pub fn mass_bias(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    out: &mut [f64; 495usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    out: &mut [f64; 495],
 ) {
     runtime::cpu::require_fma();
     unsafe { mass_bias_links(q, qd, p, out) }
 }
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
 unsafe fn mass_bias_links(
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    p: &[f64; 267usize],
-    out: &mut [f64; 495usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    p: &[f64; 267],
+    out: &mut [f64; 495],
 ) {
     let mut cells = LinkCells { q, qd, p };
     runtime::links::mass_bias_owned(&LINKS, &mut cells, q, qd, p, out)
@@ -790,16 +788,16 @@ unsafe fn mass_bias_links(
 #[allow(unused_variables)]
 pub fn jvp(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    out: &mut [f64; 30usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    out: &mut [f64; 30],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
-    let mut tau = [0.0; 30usize];
+    let mut tau = [0.0; 30];
     runtime::links::inverse_dynamics_tangent(
         &LINKS,
         &mut cells,
@@ -816,12 +814,12 @@ pub fn jvp(
 #[allow(unused_variables)]
 pub fn outputs(
     t: f64,
-    q: &[f64; 30usize],
-    qd: &[f64; 30usize],
-    qdd: &[f64; 30usize],
-    dir: &[f64; 60usize],
-    p: &[f64; 267usize],
-    out: &mut [f64; 9usize],
+    q: &[f64; 30],
+    qd: &[f64; 30],
+    qdd: &[f64; 30],
+    dir: &[f64; 60],
+    p: &[f64; 267],
+    out: &mut [f64; 9],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
@@ -830,32 +828,32 @@ pub fn outputs(
 /// The compiled cells and forces the link recursion evaluates.
 #[allow(dead_code)]
 struct LinkCells<'a> {
-    q: &'a [f64; 30usize],
-    qd: &'a [f64; 30usize],
-    p: &'a [f64; 267usize],
+    q: &'a [f64; 30],
+    qd: &'a [f64; 30],
+    p: &'a [f64; 267],
 }
 impl runtime::links::Cells for LinkCells<'_> {
     #[inline(always)]
     fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 3usize],
-                    &[0.0; 6usize],
+                    &[0.0; 3],
+                    &[0.0; 6],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs"),
                 )
             }
-            1usize => {
+            1 => {
                 cell_1(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 0usize],
-                    &[0.0; 0usize],
+                    &[0.0; 0],
+                    &[0.0; 0],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs"),
                 )
@@ -874,7 +872,7 @@ impl runtime::links::Cells for LinkCells<'_> {
         out: &mut [[f64; 4]],
     ) {
         match c {
-            0usize => {
+            0 => {
                 unsafe {
                     cell_0_x4(
                         x.try_into().expect("link coordinates"),
@@ -884,7 +882,7 @@ impl runtime::links::Cells for LinkCells<'_> {
                     )
                 }
             }
-            1usize => {
+            1 => {
                 unsafe {
                     cell_1_x4(
                         x.try_into().expect("link coordinates"),
@@ -913,29 +911,29 @@ impl runtime::links::Cells for LinkCells<'_> {
         out: &mut [f64],
     ) {
         match c {
-            0usize => {
-                let mut dir = [0.0; 6usize];
-                dir[..3usize].copy_from_slice(dx);
-                dir[3usize..].copy_from_slice(dxd);
+            0 => {
+                let mut dir = [0.0; 6];
+                dir[..3].copy_from_slice(dx);
+                dir[3..].copy_from_slice(dxd);
                 cell_0_tangent(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 3usize],
+                    &[0.0; 3],
                     &dir,
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs and derivatives"),
                 )
             }
-            1usize => {
-                let mut dir = [0.0; 0usize];
-                dir[..0usize].copy_from_slice(dx);
-                dir[0usize..].copy_from_slice(dxd);
+            1 => {
+                let mut dir = [0.0; 0];
+                dir[..0].copy_from_slice(dx);
+                dir[0..].copy_from_slice(dxd);
                 cell_1_tangent(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 0usize],
+                    &[0.0; 0],
                     &dir,
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs and derivatives"),
@@ -955,24 +953,24 @@ impl runtime::links::Cells for LinkCells<'_> {
     }
     fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0_pose(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 3usize],
-                    &[0.0; 6usize],
+                    &[0.0; 3],
+                    &[0.0; 6],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("pose outputs"),
                 )
             }
-            1usize => {
+            1 => {
                 cell_1_pose(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 0usize],
-                    &[0.0; 0usize],
+                    &[0.0; 0],
+                    &[0.0; 0],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("pose outputs"),
                 )
@@ -988,12 +986,12 @@ impl runtime::links::Cells for LinkCells<'_> {
 #[allow(unused_unsafe)]
 pub fn cell_0_pose(
     t: f64,
-    q: &[f64; 3usize],
-    qd: &[f64; 3usize],
-    qdd: &[f64; 3usize],
-    dir: &[f64; 6usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 3],
+    qd: &[f64; 3],
+    qdd: &[f64; 3],
+    dir: &[f64; 6],
+    p: &[f64; 15],
+    out: &mut [f64; 38],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1004,154 +1002,154 @@ pub fn cell_0_pose(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
-    q: &[f64; 3usize],
-    qd: &[f64; 3usize],
-    qdd: &[f64; 3usize],
-    dir: &[f64; 6usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 3],
+    qd: &[f64; 3],
+    qdd: &[f64; 3],
+    dir: &[f64; 6],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 38],
 ) {
-    let v1: f64 = q[0usize] * q[0usize];
-    let v3: f64 = q[2usize] * q[2usize];
-    let v5: f64 = q[1usize] * q[1usize];
-    let v6: f64 = v1 + v3;
-    let v7: f64 = v6 + v5;
-    let c: [[f64; 1usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        1usize,
+    let v1 = q[0] * q[0];
+    let v3 = q[2] * q[2];
+    let v5 = q[1] * q[1];
+    let v6 = v1 + v3;
+    let v7 = v6 + v5;
+    let c: [[f64; 1]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        1,
     >(v7);
-    let v8: f64 = c[0usize][0usize];
-    let v9: f64 = c[2usize][0usize];
-    let v13: f64 = c[1usize][0usize];
-    let v41: f64 = c[3usize][0usize];
-    let v10: f64 = v3.mul_add(v9, v8);
-    let v11: f64 = q[0usize] * q[2usize];
-    let v12: f64 = v11 * v9;
-    let v14: f64 = q[1usize] * v13;
-    let v15: f64 = v12 - v14;
-    let v16: f64 = q[1usize] * q[2usize];
-    let v17: f64 = v16 * v9;
-    let v18: f64 = q[0usize] * v13;
-    let v19: f64 = v17 + v18;
-    let v20: f64 = v12 + v14;
-    let v21: f64 = v1.mul_add(v9, v8);
-    let v22: f64 = q[0usize] * q[1usize];
-    let v23: f64 = v22 * v9;
-    let v24: f64 = q[2usize] * v13;
-    let v25: f64 = v23 - v24;
-    let v26: f64 = v17 - v18;
-    let v27: f64 = v23 + v24;
-    let v28: f64 = v5.mul_add(v9, v8);
-    let v31: f64 = 0.5f64 * p[0usize];
-    let v32: f64 = v31 * v10;
-    let v33: f64 = v31 * v20;
-    let v34: f64 = v31 * v26;
-    let v38: f64 = q[2usize] * qd[1usize];
-    let v39: f64 = q[1usize].mul_add(qd[2usize], -v38);
-    let v40: f64 = v9 * v39;
-    let v42: f64 = q[0usize] * qd[0usize];
-    let v43: f64 = q[2usize].mul_add(qd[2usize], v42);
-    let v44: f64 = q[1usize].mul_add(qd[1usize], v43);
-    let v45: f64 = q[0usize] * v41;
-    let v46: f64 = qd[0usize].mul_add(v13, v40);
-    let v47: f64 = v45.mul_add(v44, v46);
-    let v48: f64 = q[0usize] * qd[2usize];
-    let v49: f64 = q[2usize].mul_add(qd[0usize], -v48);
-    let v50: f64 = v9 * v49;
-    let v51: f64 = q[1usize] * v41;
-    let v52: f64 = qd[1usize].mul_add(v13, v50);
-    let v53: f64 = v51.mul_add(v44, v52);
-    let v54: f64 = v53 * v33;
-    let v55: f64 = v47.mul_add(v34, -v54);
-    let v56: f64 = q[1usize] * qd[0usize];
-    let v57: f64 = q[0usize].mul_add(qd[1usize], -v56);
-    let v58: f64 = v9 * v57;
-    let v59: f64 = q[2usize] * v41;
-    let v60: f64 = qd[2usize].mul_add(v13, v58);
-    let v61: f64 = v59.mul_add(v44, v60);
-    let v62: f64 = v61 * v34;
-    let v63: f64 = v53.mul_add(v32, -v62);
-    let v64: f64 = v47 * v32;
-    let v65: f64 = v61.mul_add(v33, -v64);
-    let v67: f64 = 0.25f64 * p[0usize];
-    let v68: f64 = v67 * v10;
-    let v69: f64 = v67 * v20;
-    let v70: f64 = v67 * v26;
-    let v71: f64 = v53 * v69;
-    let v72: f64 = v47.mul_add(v70, -v71);
-    let v73: f64 = v61 * v70;
-    let v74: f64 = v53.mul_add(v68, -v73);
-    let v75: f64 = v47 * v68;
-    let v76: f64 = v61.mul_add(v69, -v75);
-    let v78: f64 = 0.5f64 * p[1usize];
-    let v81: f64 = 0.25f64 * v7;
-    let c: [[f64; 1usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        1usize,
+    let v8: f64 = c[0][0];
+    let v9: f64 = c[2][0];
+    let v13: f64 = c[1][0];
+    let v41: f64 = c[3][0];
+    let v10 = v3.mul_add(v9, v8);
+    let v11 = q[0] * q[2];
+    let v12 = v11 * v9;
+    let v14 = q[1] * v13;
+    let v15 = v12 - v14;
+    let v16 = q[1] * q[2];
+    let v17 = v16 * v9;
+    let v18 = q[0] * v13;
+    let v19 = v17 + v18;
+    let v20 = v12 + v14;
+    let v21 = v1.mul_add(v9, v8);
+    let v22 = q[0] * q[1];
+    let v23 = v22 * v9;
+    let v24 = q[2] * v13;
+    let v25 = v23 - v24;
+    let v26 = v17 - v18;
+    let v27 = v23 + v24;
+    let v28 = v5.mul_add(v9, v8);
+    let v31 = 0.5f64 * p[0];
+    let v32 = v31 * v10;
+    let v33 = v31 * v20;
+    let v34 = v31 * v26;
+    let v38 = q[2] * qd[1];
+    let v39 = q[1].mul_add(qd[2], -v38);
+    let v40 = v9 * v39;
+    let v42 = q[0] * qd[0];
+    let v43 = q[2].mul_add(qd[2], v42);
+    let v44 = q[1].mul_add(qd[1], v43);
+    let v45 = q[0] * v41;
+    let v46 = qd[0].mul_add(v13, v40);
+    let v47 = v45.mul_add(v44, v46);
+    let v48 = q[0] * qd[2];
+    let v49 = q[2].mul_add(qd[0], -v48);
+    let v50 = v9 * v49;
+    let v51 = q[1] * v41;
+    let v52 = qd[1].mul_add(v13, v50);
+    let v53 = v51.mul_add(v44, v52);
+    let v54 = v53 * v33;
+    let v55 = v47.mul_add(v34, -v54);
+    let v56 = q[1] * qd[0];
+    let v57 = q[0].mul_add(qd[1], -v56);
+    let v58 = v9 * v57;
+    let v59 = q[2] * v41;
+    let v60 = qd[2].mul_add(v13, v58);
+    let v61 = v59.mul_add(v44, v60);
+    let v62 = v61 * v34;
+    let v63 = v53.mul_add(v32, -v62);
+    let v64 = v47 * v32;
+    let v65 = v61.mul_add(v33, -v64);
+    let v67 = 0.25f64 * p[0];
+    let v68 = v67 * v10;
+    let v69 = v67 * v20;
+    let v70 = v67 * v26;
+    let v71 = v53 * v69;
+    let v72 = v47.mul_add(v70, -v71);
+    let v73 = v61 * v70;
+    let v74 = v53.mul_add(v68, -v73);
+    let v75 = v47 * v68;
+    let v76 = v61.mul_add(v69, -v75);
+    let v78 = 0.5f64 * p[1];
+    let v81 = 0.25f64 * v7;
+    let c: [[f64; 1]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        1,
     >(v81);
-    let v82: f64 = c[0usize][0usize];
-    let v83: f64 = c[1usize][0usize];
-    let v84: f64 = 0.5f64 * q[2usize];
-    let v85: f64 = v84 * v83;
-    let v86: f64 = 0.5f64 * q[0usize];
-    let v87: f64 = v86 * v83;
-    let v88: f64 = 0.5f64 * q[1usize];
-    let v89: f64 = v88 * v83;
-    let v91: f64 = 0.5f64 * p[7usize];
-    let v94: f64 = q[1usize] - p[6usize];
-    let v95: f64 = v94 * v94;
-    let v96: f64 = 0.5f64 * v95;
-    let v97: f64 = 0.5f64.mul_add(v1, v96);
-    let v98: f64 = p[4usize] * v97;
-    let v99: f64 = v91.mul_add(v3, v98);
-    out[0usize] = v10;
-    out[1usize] = v15;
-    out[2usize] = v19;
-    out[3usize] = v20;
-    out[4usize] = v21;
-    out[5usize] = v25;
-    out[6usize] = v26;
-    out[7usize] = v27;
-    out[8usize] = v28;
-    out[9usize] = v32;
-    out[10usize] = v33;
-    out[11usize] = v34;
-    out[12usize] = v55;
-    out[13usize] = v63;
-    out[14usize] = v65;
-    out[15usize] = v61;
-    out[16usize] = v47;
-    out[17usize] = v53;
-    out[18usize] = v68;
-    out[19usize] = v69;
-    out[20usize] = v70;
-    out[21usize] = v72;
-    out[22usize] = v74;
-    out[23usize] = v76;
-    out[24usize] = v61;
-    out[25usize] = v47;
-    out[26usize] = v53;
-    out[27usize] = v10;
-    out[28usize] = v20;
-    out[29usize] = v26;
-    out[30usize] = v78;
-    out[31usize] = p[2usize];
-    out[32usize] = p[3usize];
-    out[33usize] = v82;
-    out[34usize] = v85;
-    out[35usize] = v87;
-    out[36usize] = v89;
-    out[37usize] = v99;
+    let v82: f64 = c[0][0];
+    let v83: f64 = c[1][0];
+    let v84 = 0.5f64 * q[2];
+    let v85 = v84 * v83;
+    let v86 = 0.5f64 * q[0];
+    let v87 = v86 * v83;
+    let v88 = 0.5f64 * q[1];
+    let v89 = v88 * v83;
+    let v91 = 0.5f64 * p[7];
+    let v94 = q[1] - p[6];
+    let v95 = v94 * v94;
+    let v96 = 0.5f64 * v95;
+    let v97 = 0.5f64.mul_add(v1, v96);
+    let v98 = p[4] * v97;
+    let v99 = v91.mul_add(v3, v98);
+    out[0] = v10;
+    out[1] = v15;
+    out[2] = v19;
+    out[3] = v20;
+    out[4] = v21;
+    out[5] = v25;
+    out[6] = v26;
+    out[7] = v27;
+    out[8] = v28;
+    out[9] = v32;
+    out[10] = v33;
+    out[11] = v34;
+    out[12] = v55;
+    out[13] = v63;
+    out[14] = v65;
+    out[15] = v61;
+    out[16] = v47;
+    out[17] = v53;
+    out[18] = v68;
+    out[19] = v69;
+    out[20] = v70;
+    out[21] = v72;
+    out[22] = v74;
+    out[23] = v76;
+    out[24] = v61;
+    out[25] = v47;
+    out[26] = v53;
+    out[27] = v10;
+    out[28] = v20;
+    out[29] = v26;
+    out[30] = v78;
+    out[31] = p[2];
+    out[32] = p[3];
+    out[33] = v82;
+    out[34] = v85;
+    out[35] = v87;
+    out[36] = v89;
+    out[37] = v99;
 }
 /// Kernel `cell_0`: 252 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0(
     t: f64,
-    q: &[f64; 3usize],
-    qd: &[f64; 3usize],
-    qdd: &[f64; 3usize],
-    dir: &[f64; 6usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 87usize],
+    q: &[f64; 3],
+    qd: &[f64; 3],
+    qdd: &[f64; 3],
+    dir: &[f64; 6],
+    p: &[f64; 15],
+    out: &mut [f64; 87],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1162,282 +1160,282 @@ pub fn cell_0(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
-    q: &[f64; 3usize],
-    qd: &[f64; 3usize],
-    qdd: &[f64; 3usize],
-    dir: &[f64; 6usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 87usize],
+    q: &[f64; 3],
+    qd: &[f64; 3],
+    qdd: &[f64; 3],
+    dir: &[f64; 6],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 87],
 ) {
-    let v1: f64 = q[0usize] * q[0usize];
-    let v3: f64 = q[2usize] * q[2usize];
-    let v5: f64 = q[1usize] * q[1usize];
-    let v6: f64 = v1 + v3;
-    let v7: f64 = v6 + v5;
-    let c: [[f64; 2usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        2usize,
+    let v1 = q[0] * q[0];
+    let v3 = q[2] * q[2];
+    let v5 = q[1] * q[1];
+    let v6 = v1 + v3;
+    let v7 = v6 + v5;
+    let c: [[f64; 2]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        2,
     >(v7);
-    let v8: f64 = c[0usize][0usize];
-    let v9: f64 = c[2usize][0usize];
-    let v13: f64 = c[1usize][0usize];
-    let v41: f64 = c[3usize][0usize];
-    let v73: f64 = c[2usize][1usize];
-    let v75: f64 = c[3usize][1usize];
-    let v83: f64 = c[1usize][1usize];
-    let v10: f64 = v3.mul_add(v9, v8);
-    let v11: f64 = q[0usize] * q[2usize];
-    let v12: f64 = v11 * v9;
-    let v14: f64 = q[1usize] * v13;
-    let v15: f64 = v12 - v14;
-    let v16: f64 = q[1usize] * q[2usize];
-    let v17: f64 = v16 * v9;
-    let v18: f64 = q[0usize] * v13;
-    let v19: f64 = v17 + v18;
-    let v20: f64 = v12 + v14;
-    let v21: f64 = v1.mul_add(v9, v8);
-    let v22: f64 = q[0usize] * q[1usize];
-    let v23: f64 = v22 * v9;
-    let v24: f64 = q[2usize] * v13;
-    let v25: f64 = v23 - v24;
-    let v26: f64 = v17 - v18;
-    let v27: f64 = v23 + v24;
-    let v28: f64 = v5.mul_add(v9, v8);
-    let v31: f64 = 0.5f64 * p[0usize];
-    let v32: f64 = v31 * v10;
-    let v33: f64 = v31 * v20;
-    let v34: f64 = v31 * v26;
-    let v38: f64 = q[2usize] * qd[1usize];
-    let v39: f64 = q[1usize].mul_add(qd[2usize], -v38);
-    let v40: f64 = v9 * v39;
-    let v42: f64 = q[0usize] * qd[0usize];
-    let v43: f64 = q[2usize].mul_add(qd[2usize], v42);
-    let v44: f64 = q[1usize].mul_add(qd[1usize], v43);
-    let v45: f64 = q[0usize] * v41;
-    let v46: f64 = qd[0usize].mul_add(v13, v40);
-    let v47: f64 = v45.mul_add(v44, v46);
-    let v48: f64 = q[0usize] * qd[2usize];
-    let v49: f64 = q[2usize].mul_add(qd[0usize], -v48);
-    let v50: f64 = v9 * v49;
-    let v51: f64 = q[1usize] * v41;
-    let v52: f64 = qd[1usize].mul_add(v13, v50);
-    let v53: f64 = v51.mul_add(v44, v52);
-    let v54: f64 = v53 * v33;
-    let v55: f64 = v47.mul_add(v34, -v54);
-    let v56: f64 = q[1usize] * qd[0usize];
-    let v57: f64 = q[0usize].mul_add(qd[1usize], -v56);
-    let v58: f64 = v9 * v57;
-    let v59: f64 = q[2usize] * v41;
-    let v60: f64 = qd[2usize].mul_add(v13, v58);
-    let v61: f64 = v59.mul_add(v44, v60);
-    let v62: f64 = v61 * v34;
-    let v63: f64 = v53.mul_add(v32, -v62);
-    let v64: f64 = v47 * v32;
-    let v65: f64 = v61.mul_add(v33, -v64);
-    let v67: f64 = 2f64 * q[2usize];
-    let v68: f64 = 2f64 * q[0usize];
-    let v69: f64 = v68 * qd[0usize];
-    let v70: f64 = 2f64 * q[1usize];
-    let v71: f64 = v67.mul_add(qd[2usize], v69);
-    let v72: f64 = v70.mul_add(qd[1usize], v71);
-    let v74: f64 = v72 * v73;
-    let v76: f64 = v72 * v75;
-    let v77: f64 = qd[1usize] * qd[1usize];
-    let v78: f64 = qd[0usize].mul_add(qd[0usize], v77);
-    let v79: f64 = qd[2usize].mul_add(qd[2usize], v78);
-    let v80: f64 = v41 * v79;
-    let v81: f64 = v44.mul_add(v76, v80);
-    let v82: f64 = q[0usize] * v81;
-    let v84: f64 = v72 * v83;
-    let v85: f64 = v41.mul_add(v44, v84);
-    let v86: f64 = v39.mul_add(v74, v82);
-    let v87: f64 = qd[0usize].mul_add(v85, v86);
-    let v88: f64 = v47 * v65;
-    let v89: f64 = q[1usize] * v81;
-    let v90: f64 = v49.mul_add(v74, v89);
-    let v91: f64 = qd[1usize].mul_add(v85, v90);
-    let v92: f64 = v34.mul_add(v87, v88);
-    let v93: f64 = (-v33).mul_add(v91, v92);
-    let v94: f64 = (-v53).mul_add(v63, v93);
-    let v95: f64 = v53 * v55;
-    let v96: f64 = q[2usize] * v81;
-    let v97: f64 = v57.mul_add(v74, v96);
-    let v98: f64 = qd[2usize].mul_add(v85, v97);
-    let v99: f64 = v32.mul_add(v91, v95);
-    let v100: f64 = (-v34).mul_add(v98, v99);
-    let v101: f64 = (-v61).mul_add(v65, v100);
-    let v102: f64 = v61 * v63;
-    let v103: f64 = v33.mul_add(v98, v102);
-    let v104: f64 = (-v32).mul_add(v87, v103);
-    let v105: f64 = (-v47).mul_add(v55, v104);
-    let v107: f64 = 0.25f64 * p[0usize];
-    let v108: f64 = v107 * v10;
-    let v109: f64 = v107 * v20;
-    let v110: f64 = v107 * v26;
-    let v111: f64 = v53 * v109;
-    let v112: f64 = v47.mul_add(v110, -v111);
-    let v113: f64 = v61 * v110;
-    let v114: f64 = v53.mul_add(v108, -v113);
-    let v115: f64 = v47 * v108;
-    let v116: f64 = v61.mul_add(v109, -v115);
-    let v117: f64 = v47 * v116;
-    let v118: f64 = v110.mul_add(v87, v117);
-    let v119: f64 = (-v109).mul_add(v91, v118);
-    let v120: f64 = (-v53).mul_add(v114, v119);
-    let v121: f64 = v53 * v112;
-    let v122: f64 = v108.mul_add(v91, v121);
-    let v123: f64 = (-v110).mul_add(v98, v122);
-    let v124: f64 = (-v61).mul_add(v116, v123);
-    let v125: f64 = v61 * v114;
-    let v126: f64 = v109.mul_add(v98, v125);
-    let v127: f64 = (-v108).mul_add(v87, v126);
-    let v128: f64 = (-v47).mul_add(v112, v127);
-    let v130: f64 = 0.5f64 * p[1usize];
-    let v133: f64 = q[1usize] * v9;
-    let v134: f64 = v11 * v41;
-    let v135: f64 = v134 - v133;
-    let v136: f64 = v1.mul_add(v41, v13);
-    let v137: f64 = q[2usize] * v9;
-    let v138: f64 = v22 * v41;
-    let v139: f64 = v137 + v138;
-    let v140: f64 = v33 * v139;
-    let v141: f64 = v34.mul_add(v136, -v140);
-    let v142: f64 = v34 * v135;
-    let v143: f64 = v32.mul_add(v139, -v142);
-    let v144: f64 = v32 * v136;
-    let v145: f64 = v33.mul_add(v135, -v144);
-    let v146: f64 = v109 * v139;
-    let v147: f64 = v110.mul_add(v136, -v146);
-    let v148: f64 = v110 * v135;
-    let v149: f64 = v108.mul_add(v139, -v148);
-    let v150: f64 = v108 * v136;
-    let v151: f64 = v109.mul_add(v135, -v150);
-    let v152: f64 = q[0usize] * v9;
-    let v153: f64 = v16 * v41;
-    let v154: f64 = v152 + v153;
-    let v155: f64 = v138 - v137;
-    let v156: f64 = v5.mul_add(v41, v13);
-    let v157: f64 = v33 * v156;
-    let v158: f64 = v34.mul_add(v155, -v157);
-    let v159: f64 = v34 * v154;
-    let v160: f64 = v32.mul_add(v156, -v159);
-    let v161: f64 = v32 * v155;
-    let v162: f64 = v33.mul_add(v154, -v161);
-    let v163: f64 = v109 * v156;
-    let v164: f64 = v110.mul_add(v155, -v163);
-    let v165: f64 = v110 * v154;
-    let v166: f64 = v108.mul_add(v156, -v165);
-    let v167: f64 = v108 * v155;
-    let v168: f64 = v109.mul_add(v154, -v167);
-    let v169: f64 = v3.mul_add(v41, v13);
-    let v170: f64 = v133 + v134;
-    let v171: f64 = v153 - v152;
-    let v172: f64 = v33 * v171;
-    let v173: f64 = v34.mul_add(v170, -v172);
-    let v174: f64 = v34 * v169;
-    let v175: f64 = v32.mul_add(v171, -v174);
-    let v176: f64 = v32 * v170;
-    let v177: f64 = v33.mul_add(v169, -v176);
-    let v178: f64 = v109 * v171;
-    let v179: f64 = v110.mul_add(v170, -v178);
-    let v180: f64 = v110 * v169;
-    let v181: f64 = v108.mul_add(v171, -v180);
-    let v182: f64 = v108 * v170;
-    let v183: f64 = v109.mul_add(v169, -v182);
-    let v186: f64 = qd[0usize] * p[5usize];
-    let v187: f64 = q[0usize].mul_add(p[4usize], v186);
-    let v189: f64 = q[1usize] - p[6usize];
-    let v190: f64 = qd[1usize] * p[5usize];
-    let v191: f64 = p[4usize].mul_add(v189, v190);
-    let v194: f64 = qd[2usize] * p[8usize];
-    let v195: f64 = q[2usize].mul_add(p[7usize], v194);
-    out[0usize] = v10;
-    out[1usize] = v15;
-    out[2usize] = v19;
-    out[3usize] = v20;
-    out[4usize] = v21;
-    out[5usize] = v25;
-    out[6usize] = v26;
-    out[7usize] = v27;
-    out[8usize] = v28;
-    out[9usize] = v32;
-    out[10usize] = v33;
-    out[11usize] = v34;
-    out[12usize] = v55;
-    out[13usize] = v63;
-    out[14usize] = v65;
-    out[15usize] = v94;
-    out[16usize] = v101;
-    out[17usize] = v105;
-    out[18usize] = v61;
-    out[19usize] = v47;
-    out[20usize] = v53;
-    out[21usize] = v98;
-    out[22usize] = v87;
-    out[23usize] = v91;
-    out[24usize] = v108;
-    out[25usize] = v109;
-    out[26usize] = v110;
-    out[27usize] = v112;
-    out[28usize] = v114;
-    out[29usize] = v116;
-    out[30usize] = v120;
-    out[31usize] = v124;
-    out[32usize] = v128;
-    out[33usize] = v61;
-    out[34usize] = v47;
-    out[35usize] = v53;
-    out[36usize] = v98;
-    out[37usize] = v87;
-    out[38usize] = v91;
-    out[39usize] = v10;
-    out[40usize] = v20;
-    out[41usize] = v26;
-    out[42usize] = v130;
-    out[43usize] = p[2usize];
-    out[44usize] = p[3usize];
-    out[45usize] = v135;
-    out[46usize] = v136;
-    out[47usize] = v139;
-    out[48usize] = v141;
-    out[49usize] = v143;
-    out[50usize] = v145;
-    out[51usize] = v135;
-    out[52usize] = v136;
-    out[53usize] = v139;
-    out[54usize] = v147;
-    out[55usize] = v149;
-    out[56usize] = v151;
-    out[57usize] = v154;
-    out[58usize] = v155;
-    out[59usize] = v156;
-    out[60usize] = v158;
-    out[61usize] = v160;
-    out[62usize] = v162;
-    out[63usize] = v154;
-    out[64usize] = v155;
-    out[65usize] = v156;
-    out[66usize] = v164;
-    out[67usize] = v166;
-    out[68usize] = v168;
-    out[69usize] = v169;
-    out[70usize] = v170;
-    out[71usize] = v171;
-    out[72usize] = v173;
-    out[73usize] = v175;
-    out[74usize] = v177;
-    out[75usize] = v169;
-    out[76usize] = v170;
-    out[77usize] = v171;
-    out[78usize] = v179;
-    out[79usize] = v181;
-    out[80usize] = v183;
-    out[81usize] = v187;
-    out[82usize] = v191;
-    out[83usize] = v195;
-    out[84usize] = 0f64;
-    out[85usize] = 0f64;
-    out[86usize] = 0f64;
+    let v8: f64 = c[0][0];
+    let v9: f64 = c[2][0];
+    let v13: f64 = c[1][0];
+    let v41: f64 = c[3][0];
+    let v73: f64 = c[2][1];
+    let v75: f64 = c[3][1];
+    let v83: f64 = c[1][1];
+    let v10 = v3.mul_add(v9, v8);
+    let v11 = q[0] * q[2];
+    let v12 = v11 * v9;
+    let v14 = q[1] * v13;
+    let v15 = v12 - v14;
+    let v16 = q[1] * q[2];
+    let v17 = v16 * v9;
+    let v18 = q[0] * v13;
+    let v19 = v17 + v18;
+    let v20 = v12 + v14;
+    let v21 = v1.mul_add(v9, v8);
+    let v22 = q[0] * q[1];
+    let v23 = v22 * v9;
+    let v24 = q[2] * v13;
+    let v25 = v23 - v24;
+    let v26 = v17 - v18;
+    let v27 = v23 + v24;
+    let v28 = v5.mul_add(v9, v8);
+    let v31 = 0.5f64 * p[0];
+    let v32 = v31 * v10;
+    let v33 = v31 * v20;
+    let v34 = v31 * v26;
+    let v38 = q[2] * qd[1];
+    let v39 = q[1].mul_add(qd[2], -v38);
+    let v40 = v9 * v39;
+    let v42 = q[0] * qd[0];
+    let v43 = q[2].mul_add(qd[2], v42);
+    let v44 = q[1].mul_add(qd[1], v43);
+    let v45 = q[0] * v41;
+    let v46 = qd[0].mul_add(v13, v40);
+    let v47 = v45.mul_add(v44, v46);
+    let v48 = q[0] * qd[2];
+    let v49 = q[2].mul_add(qd[0], -v48);
+    let v50 = v9 * v49;
+    let v51 = q[1] * v41;
+    let v52 = qd[1].mul_add(v13, v50);
+    let v53 = v51.mul_add(v44, v52);
+    let v54 = v53 * v33;
+    let v55 = v47.mul_add(v34, -v54);
+    let v56 = q[1] * qd[0];
+    let v57 = q[0].mul_add(qd[1], -v56);
+    let v58 = v9 * v57;
+    let v59 = q[2] * v41;
+    let v60 = qd[2].mul_add(v13, v58);
+    let v61 = v59.mul_add(v44, v60);
+    let v62 = v61 * v34;
+    let v63 = v53.mul_add(v32, -v62);
+    let v64 = v47 * v32;
+    let v65 = v61.mul_add(v33, -v64);
+    let v67 = 2f64 * q[2];
+    let v68 = 2f64 * q[0];
+    let v69 = v68 * qd[0];
+    let v70 = 2f64 * q[1];
+    let v71 = v67.mul_add(qd[2], v69);
+    let v72 = v70.mul_add(qd[1], v71);
+    let v74 = v72 * v73;
+    let v76 = v72 * v75;
+    let v77 = qd[1] * qd[1];
+    let v78 = qd[0].mul_add(qd[0], v77);
+    let v79 = qd[2].mul_add(qd[2], v78);
+    let v80 = v41 * v79;
+    let v81 = v44.mul_add(v76, v80);
+    let v82 = q[0] * v81;
+    let v84 = v72 * v83;
+    let v85 = v41.mul_add(v44, v84);
+    let v86 = v39.mul_add(v74, v82);
+    let v87 = qd[0].mul_add(v85, v86);
+    let v88 = v47 * v65;
+    let v89 = q[1] * v81;
+    let v90 = v49.mul_add(v74, v89);
+    let v91 = qd[1].mul_add(v85, v90);
+    let v92 = v34.mul_add(v87, v88);
+    let v93 = (-v33).mul_add(v91, v92);
+    let v94 = (-v53).mul_add(v63, v93);
+    let v95 = v53 * v55;
+    let v96 = q[2] * v81;
+    let v97 = v57.mul_add(v74, v96);
+    let v98 = qd[2].mul_add(v85, v97);
+    let v99 = v32.mul_add(v91, v95);
+    let v100 = (-v34).mul_add(v98, v99);
+    let v101 = (-v61).mul_add(v65, v100);
+    let v102 = v61 * v63;
+    let v103 = v33.mul_add(v98, v102);
+    let v104 = (-v32).mul_add(v87, v103);
+    let v105 = (-v47).mul_add(v55, v104);
+    let v107 = 0.25f64 * p[0];
+    let v108 = v107 * v10;
+    let v109 = v107 * v20;
+    let v110 = v107 * v26;
+    let v111 = v53 * v109;
+    let v112 = v47.mul_add(v110, -v111);
+    let v113 = v61 * v110;
+    let v114 = v53.mul_add(v108, -v113);
+    let v115 = v47 * v108;
+    let v116 = v61.mul_add(v109, -v115);
+    let v117 = v47 * v116;
+    let v118 = v110.mul_add(v87, v117);
+    let v119 = (-v109).mul_add(v91, v118);
+    let v120 = (-v53).mul_add(v114, v119);
+    let v121 = v53 * v112;
+    let v122 = v108.mul_add(v91, v121);
+    let v123 = (-v110).mul_add(v98, v122);
+    let v124 = (-v61).mul_add(v116, v123);
+    let v125 = v61 * v114;
+    let v126 = v109.mul_add(v98, v125);
+    let v127 = (-v108).mul_add(v87, v126);
+    let v128 = (-v47).mul_add(v112, v127);
+    let v130 = 0.5f64 * p[1];
+    let v133 = q[1] * v9;
+    let v134 = v11 * v41;
+    let v135 = v134 - v133;
+    let v136 = v1.mul_add(v41, v13);
+    let v137 = q[2] * v9;
+    let v138 = v22 * v41;
+    let v139 = v137 + v138;
+    let v140 = v33 * v139;
+    let v141 = v34.mul_add(v136, -v140);
+    let v142 = v34 * v135;
+    let v143 = v32.mul_add(v139, -v142);
+    let v144 = v32 * v136;
+    let v145 = v33.mul_add(v135, -v144);
+    let v146 = v109 * v139;
+    let v147 = v110.mul_add(v136, -v146);
+    let v148 = v110 * v135;
+    let v149 = v108.mul_add(v139, -v148);
+    let v150 = v108 * v136;
+    let v151 = v109.mul_add(v135, -v150);
+    let v152 = q[0] * v9;
+    let v153 = v16 * v41;
+    let v154 = v152 + v153;
+    let v155 = v138 - v137;
+    let v156 = v5.mul_add(v41, v13);
+    let v157 = v33 * v156;
+    let v158 = v34.mul_add(v155, -v157);
+    let v159 = v34 * v154;
+    let v160 = v32.mul_add(v156, -v159);
+    let v161 = v32 * v155;
+    let v162 = v33.mul_add(v154, -v161);
+    let v163 = v109 * v156;
+    let v164 = v110.mul_add(v155, -v163);
+    let v165 = v110 * v154;
+    let v166 = v108.mul_add(v156, -v165);
+    let v167 = v108 * v155;
+    let v168 = v109.mul_add(v154, -v167);
+    let v169 = v3.mul_add(v41, v13);
+    let v170 = v133 + v134;
+    let v171 = v153 - v152;
+    let v172 = v33 * v171;
+    let v173 = v34.mul_add(v170, -v172);
+    let v174 = v34 * v169;
+    let v175 = v32.mul_add(v171, -v174);
+    let v176 = v32 * v170;
+    let v177 = v33.mul_add(v169, -v176);
+    let v178 = v109 * v171;
+    let v179 = v110.mul_add(v170, -v178);
+    let v180 = v110 * v169;
+    let v181 = v108.mul_add(v171, -v180);
+    let v182 = v108 * v170;
+    let v183 = v109.mul_add(v169, -v182);
+    let v186 = qd[0] * p[5];
+    let v187 = q[0].mul_add(p[4], v186);
+    let v189 = q[1] - p[6];
+    let v190 = qd[1] * p[5];
+    let v191 = p[4].mul_add(v189, v190);
+    let v194 = qd[2] * p[8];
+    let v195 = q[2].mul_add(p[7], v194);
+    out[0] = v10;
+    out[1] = v15;
+    out[2] = v19;
+    out[3] = v20;
+    out[4] = v21;
+    out[5] = v25;
+    out[6] = v26;
+    out[7] = v27;
+    out[8] = v28;
+    out[9] = v32;
+    out[10] = v33;
+    out[11] = v34;
+    out[12] = v55;
+    out[13] = v63;
+    out[14] = v65;
+    out[15] = v94;
+    out[16] = v101;
+    out[17] = v105;
+    out[18] = v61;
+    out[19] = v47;
+    out[20] = v53;
+    out[21] = v98;
+    out[22] = v87;
+    out[23] = v91;
+    out[24] = v108;
+    out[25] = v109;
+    out[26] = v110;
+    out[27] = v112;
+    out[28] = v114;
+    out[29] = v116;
+    out[30] = v120;
+    out[31] = v124;
+    out[32] = v128;
+    out[33] = v61;
+    out[34] = v47;
+    out[35] = v53;
+    out[36] = v98;
+    out[37] = v87;
+    out[38] = v91;
+    out[39] = v10;
+    out[40] = v20;
+    out[41] = v26;
+    out[42] = v130;
+    out[43] = p[2];
+    out[44] = p[3];
+    out[45] = v135;
+    out[46] = v136;
+    out[47] = v139;
+    out[48] = v141;
+    out[49] = v143;
+    out[50] = v145;
+    out[51] = v135;
+    out[52] = v136;
+    out[53] = v139;
+    out[54] = v147;
+    out[55] = v149;
+    out[56] = v151;
+    out[57] = v154;
+    out[58] = v155;
+    out[59] = v156;
+    out[60] = v158;
+    out[61] = v160;
+    out[62] = v162;
+    out[63] = v154;
+    out[64] = v155;
+    out[65] = v156;
+    out[66] = v164;
+    out[67] = v166;
+    out[68] = v168;
+    out[69] = v169;
+    out[70] = v170;
+    out[71] = v171;
+    out[72] = v173;
+    out[73] = v175;
+    out[74] = v177;
+    out[75] = v169;
+    out[76] = v170;
+    out[77] = v171;
+    out[78] = v179;
+    out[79] = v181;
+    out[80] = v183;
+    out[81] = v187;
+    out[82] = v191;
+    out[83] = v195;
+    out[84] = 0f64;
+    out[85] = 0f64;
+    out[86] = 0f64;
 }
 /// Kernel `cell_0_x4`: 252 operations, four evaluations in vector lanes.
 #[cfg(target_arch = "x86_64")]
@@ -1445,394 +1443,372 @@ fn cell_0_0(
 #[allow(unused_variables, unused_parens, clippy::all)]
 #[target_feature(enable = "avx,fma")]
 fn cell_0_x4(
-    q: &[[f64; 4]; 3usize],
-    qd: &[[f64; 4]; 3usize],
-    p: &[[f64; 4]; 15usize],
-    out: &mut [[f64; 4]; 87usize],
+    q: &[[f64; 4]; 3],
+    qd: &[[f64; 4]; 3],
+    p: &[[f64; 4]; 15],
+    out: &mut [[f64; 4]; 87],
 ) {
     use std::arch::x86_64::*;
-    let v1: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0usize]),
-        runtime::lanes::from_array(q[0usize]),
+    let v1 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[0]),
+        runtime::lanes::from_array(q[0]),
     );
-    let v3: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[2usize]),
-        runtime::lanes::from_array(q[2usize]),
+    let v3 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[2]),
+        runtime::lanes::from_array(q[2]),
     );
-    let v5: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1usize]),
-        runtime::lanes::from_array(q[1usize]),
+    let v5 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[1]),
+        runtime::lanes::from_array(q[1]),
     );
-    let v6: __m256d = _mm256_add_pd(v1, v3);
-    let v7: __m256d = _mm256_add_pd(v6, v5);
-    let c: [[__m256d; 2usize]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
-        2usize,
+    let v6 = _mm256_add_pd(v1, v3);
+    let v7 = _mm256_add_pd(v6, v5);
+    let c: [[__m256d; 2]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
+        2,
     >(v7);
-    let v8: __m256d = c[0usize][0usize];
-    let v9: __m256d = c[2usize][0usize];
-    let v13: __m256d = c[1usize][0usize];
-    let v41: __m256d = c[3usize][0usize];
-    let v73: __m256d = c[2usize][1usize];
-    let v75: __m256d = c[3usize][1usize];
-    let v83: __m256d = c[1usize][1usize];
-    let v10: __m256d = _mm256_fmadd_pd(v3, v9, v8);
-    let v11: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0usize]),
-        runtime::lanes::from_array(q[2usize]),
+    let v8: __m256d = c[0][0];
+    let v9: __m256d = c[2][0];
+    let v13: __m256d = c[1][0];
+    let v41: __m256d = c[3][0];
+    let v73: __m256d = c[2][1];
+    let v75: __m256d = c[3][1];
+    let v83: __m256d = c[1][1];
+    let v10 = _mm256_fmadd_pd(v3, v9, v8);
+    let v11 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[0]),
+        runtime::lanes::from_array(q[2]),
     );
-    let v12: __m256d = _mm256_mul_pd(v11, v9);
-    let v14: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[1usize]), v13);
-    let v15: __m256d = _mm256_sub_pd(v12, v14);
-    let v16: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1usize]),
-        runtime::lanes::from_array(q[2usize]),
+    let v12 = _mm256_mul_pd(v11, v9);
+    let v14 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v13);
+    let v15 = _mm256_sub_pd(v12, v14);
+    let v16 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[1]),
+        runtime::lanes::from_array(q[2]),
     );
-    let v17: __m256d = _mm256_mul_pd(v16, v9);
-    let v18: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[0usize]), v13);
-    let v19: __m256d = _mm256_add_pd(v17, v18);
-    let v20: __m256d = _mm256_add_pd(v12, v14);
-    let v21: __m256d = _mm256_fmadd_pd(v1, v9, v8);
-    let v22: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0usize]),
-        runtime::lanes::from_array(q[1usize]),
+    let v17 = _mm256_mul_pd(v16, v9);
+    let v18 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v13);
+    let v19 = _mm256_add_pd(v17, v18);
+    let v20 = _mm256_add_pd(v12, v14);
+    let v21 = _mm256_fmadd_pd(v1, v9, v8);
+    let v22 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[0]),
+        runtime::lanes::from_array(q[1]),
     );
-    let v23: __m256d = _mm256_mul_pd(v22, v9);
-    let v24: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[2usize]), v13);
-    let v25: __m256d = _mm256_sub_pd(v23, v24);
-    let v26: __m256d = _mm256_sub_pd(v17, v18);
-    let v27: __m256d = _mm256_add_pd(v23, v24);
-    let v28: __m256d = _mm256_fmadd_pd(v5, v9, v8);
-    let v31: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(p[0usize]),
+    let v23 = _mm256_mul_pd(v22, v9);
+    let v24 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v13);
+    let v25 = _mm256_sub_pd(v23, v24);
+    let v26 = _mm256_sub_pd(v17, v18);
+    let v27 = _mm256_add_pd(v23, v24);
+    let v28 = _mm256_fmadd_pd(v5, v9, v8);
+    let v31 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[0]));
+    let v32 = _mm256_mul_pd(v31, v10);
+    let v33 = _mm256_mul_pd(v31, v20);
+    let v34 = _mm256_mul_pd(v31, v26);
+    let v38 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[2]),
+        runtime::lanes::from_array(qd[1]),
     );
-    let v32: __m256d = _mm256_mul_pd(v31, v10);
-    let v33: __m256d = _mm256_mul_pd(v31, v20);
-    let v34: __m256d = _mm256_mul_pd(v31, v26);
-    let v38: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[2usize]),
-        runtime::lanes::from_array(qd[1usize]),
-    );
-    let v39: __m256d = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[1usize]),
-        runtime::lanes::from_array(qd[2usize]),
+    let v39 = _mm256_fmsub_pd(
+        runtime::lanes::from_array(q[1]),
+        runtime::lanes::from_array(qd[2]),
         v38,
     );
-    let v40: __m256d = _mm256_mul_pd(v9, v39);
-    let v42: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0usize]),
-        runtime::lanes::from_array(qd[0usize]),
+    let v40 = _mm256_mul_pd(v9, v39);
+    let v42 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[0]),
+        runtime::lanes::from_array(qd[0]),
     );
-    let v43: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[2usize]),
-        runtime::lanes::from_array(qd[2usize]),
+    let v43 = _mm256_fmadd_pd(
+        runtime::lanes::from_array(q[2]),
+        runtime::lanes::from_array(qd[2]),
         v42,
     );
-    let v44: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[1usize]),
-        runtime::lanes::from_array(qd[1usize]),
+    let v44 = _mm256_fmadd_pd(
+        runtime::lanes::from_array(q[1]),
+        runtime::lanes::from_array(qd[1]),
         v43,
     );
-    let v45: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[0usize]), v41);
-    let v46: __m256d = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0usize]), v13, v40);
-    let v47: __m256d = _mm256_fmadd_pd(v45, v44, v46);
-    let v48: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0usize]),
-        runtime::lanes::from_array(qd[2usize]),
+    let v45 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v41);
+    let v46 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v13, v40);
+    let v47 = _mm256_fmadd_pd(v45, v44, v46);
+    let v48 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[0]),
+        runtime::lanes::from_array(qd[2]),
     );
-    let v49: __m256d = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[2usize]),
-        runtime::lanes::from_array(qd[0usize]),
+    let v49 = _mm256_fmsub_pd(
+        runtime::lanes::from_array(q[2]),
+        runtime::lanes::from_array(qd[0]),
         v48,
     );
-    let v50: __m256d = _mm256_mul_pd(v9, v49);
-    let v51: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[1usize]), v41);
-    let v52: __m256d = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1usize]), v13, v50);
-    let v53: __m256d = _mm256_fmadd_pd(v51, v44, v52);
-    let v54: __m256d = _mm256_mul_pd(v53, v33);
-    let v55: __m256d = _mm256_fmsub_pd(v47, v34, v54);
-    let v56: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1usize]),
-        runtime::lanes::from_array(qd[0usize]),
+    let v50 = _mm256_mul_pd(v9, v49);
+    let v51 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v41);
+    let v52 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v13, v50);
+    let v53 = _mm256_fmadd_pd(v51, v44, v52);
+    let v54 = _mm256_mul_pd(v53, v33);
+    let v55 = _mm256_fmsub_pd(v47, v34, v54);
+    let v56 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[1]),
+        runtime::lanes::from_array(qd[0]),
     );
-    let v57: __m256d = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[0usize]),
-        runtime::lanes::from_array(qd[1usize]),
+    let v57 = _mm256_fmsub_pd(
+        runtime::lanes::from_array(q[0]),
+        runtime::lanes::from_array(qd[1]),
         v56,
     );
-    let v58: __m256d = _mm256_mul_pd(v9, v57);
-    let v59: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[2usize]), v41);
-    let v60: __m256d = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2usize]), v13, v58);
-    let v61: __m256d = _mm256_fmadd_pd(v59, v44, v60);
-    let v62: __m256d = _mm256_mul_pd(v61, v34);
-    let v63: __m256d = _mm256_fmsub_pd(v53, v32, v62);
-    let v64: __m256d = _mm256_mul_pd(v47, v32);
-    let v65: __m256d = _mm256_fmsub_pd(v61, v33, v64);
-    let v67: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(2f64),
-        runtime::lanes::from_array(q[2usize]),
+    let v58 = _mm256_mul_pd(v9, v57);
+    let v59 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v41);
+    let v60 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v13, v58);
+    let v61 = _mm256_fmadd_pd(v59, v44, v60);
+    let v62 = _mm256_mul_pd(v61, v34);
+    let v63 = _mm256_fmsub_pd(v53, v32, v62);
+    let v64 = _mm256_mul_pd(v47, v32);
+    let v65 = _mm256_fmsub_pd(v61, v33, v64);
+    let v67 = _mm256_mul_pd(_mm256_set1_pd(2f64), runtime::lanes::from_array(q[2]));
+    let v68 = _mm256_mul_pd(_mm256_set1_pd(2f64), runtime::lanes::from_array(q[0]));
+    let v69 = _mm256_mul_pd(v68, runtime::lanes::from_array(qd[0]));
+    let v70 = _mm256_mul_pd(_mm256_set1_pd(2f64), runtime::lanes::from_array(q[1]));
+    let v71 = _mm256_fmadd_pd(v67, runtime::lanes::from_array(qd[2]), v69);
+    let v72 = _mm256_fmadd_pd(v70, runtime::lanes::from_array(qd[1]), v71);
+    let v74 = _mm256_mul_pd(v72, v73);
+    let v76 = _mm256_mul_pd(v72, v75);
+    let v77 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[1]),
+        runtime::lanes::from_array(qd[1]),
     );
-    let v68: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(2f64),
-        runtime::lanes::from_array(q[0usize]),
-    );
-    let v69: __m256d = _mm256_mul_pd(v68, runtime::lanes::from_array(qd[0usize]));
-    let v70: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(2f64),
-        runtime::lanes::from_array(q[1usize]),
-    );
-    let v71: __m256d = _mm256_fmadd_pd(v67, runtime::lanes::from_array(qd[2usize]), v69);
-    let v72: __m256d = _mm256_fmadd_pd(v70, runtime::lanes::from_array(qd[1usize]), v71);
-    let v74: __m256d = _mm256_mul_pd(v72, v73);
-    let v76: __m256d = _mm256_mul_pd(v72, v75);
-    let v77: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        runtime::lanes::from_array(qd[1usize]),
-    );
-    let v78: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        runtime::lanes::from_array(qd[0usize]),
+    let v78 = _mm256_fmadd_pd(
+        runtime::lanes::from_array(qd[0]),
+        runtime::lanes::from_array(qd[0]),
         v77,
     );
-    let v79: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        runtime::lanes::from_array(qd[2usize]),
+    let v79 = _mm256_fmadd_pd(
+        runtime::lanes::from_array(qd[2]),
+        runtime::lanes::from_array(qd[2]),
         v78,
     );
-    let v80: __m256d = _mm256_mul_pd(v41, v79);
-    let v81: __m256d = _mm256_fmadd_pd(v44, v76, v80);
-    let v82: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[0usize]), v81);
-    let v84: __m256d = _mm256_mul_pd(v72, v83);
-    let v85: __m256d = _mm256_fmadd_pd(v41, v44, v84);
-    let v86: __m256d = _mm256_fmadd_pd(v39, v74, v82);
-    let v87: __m256d = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0usize]), v85, v86);
-    let v88: __m256d = _mm256_mul_pd(v47, v65);
-    let v89: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[1usize]), v81);
-    let v90: __m256d = _mm256_fmadd_pd(v49, v74, v89);
-    let v91: __m256d = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1usize]), v85, v90);
-    let v92: __m256d = _mm256_fmadd_pd(v34, v87, v88);
-    let v93: __m256d = _mm256_fnmadd_pd(v33, v91, v92);
-    let v94: __m256d = _mm256_fnmadd_pd(v53, v63, v93);
-    let v95: __m256d = _mm256_mul_pd(v53, v55);
-    let v96: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[2usize]), v81);
-    let v97: __m256d = _mm256_fmadd_pd(v57, v74, v96);
-    let v98: __m256d = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2usize]), v85, v97);
-    let v99: __m256d = _mm256_fmadd_pd(v32, v91, v95);
-    let v100: __m256d = _mm256_fnmadd_pd(v34, v98, v99);
-    let v101: __m256d = _mm256_fnmadd_pd(v61, v65, v100);
-    let v102: __m256d = _mm256_mul_pd(v61, v63);
-    let v103: __m256d = _mm256_fmadd_pd(v33, v98, v102);
-    let v104: __m256d = _mm256_fnmadd_pd(v32, v87, v103);
-    let v105: __m256d = _mm256_fnmadd_pd(v47, v55, v104);
-    let v107: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(p[0usize]),
+    let v80 = _mm256_mul_pd(v41, v79);
+    let v81 = _mm256_fmadd_pd(v44, v76, v80);
+    let v82 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v81);
+    let v84 = _mm256_mul_pd(v72, v83);
+    let v85 = _mm256_fmadd_pd(v41, v44, v84);
+    let v86 = _mm256_fmadd_pd(v39, v74, v82);
+    let v87 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v85, v86);
+    let v88 = _mm256_mul_pd(v47, v65);
+    let v89 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v81);
+    let v90 = _mm256_fmadd_pd(v49, v74, v89);
+    let v91 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v85, v90);
+    let v92 = _mm256_fmadd_pd(v34, v87, v88);
+    let v93 = _mm256_fnmadd_pd(v33, v91, v92);
+    let v94 = _mm256_fnmadd_pd(v53, v63, v93);
+    let v95 = _mm256_mul_pd(v53, v55);
+    let v96 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v81);
+    let v97 = _mm256_fmadd_pd(v57, v74, v96);
+    let v98 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v85, v97);
+    let v99 = _mm256_fmadd_pd(v32, v91, v95);
+    let v100 = _mm256_fnmadd_pd(v34, v98, v99);
+    let v101 = _mm256_fnmadd_pd(v61, v65, v100);
+    let v102 = _mm256_mul_pd(v61, v63);
+    let v103 = _mm256_fmadd_pd(v33, v98, v102);
+    let v104 = _mm256_fnmadd_pd(v32, v87, v103);
+    let v105 = _mm256_fnmadd_pd(v47, v55, v104);
+    let v107 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(p[0]));
+    let v108 = _mm256_mul_pd(v107, v10);
+    let v109 = _mm256_mul_pd(v107, v20);
+    let v110 = _mm256_mul_pd(v107, v26);
+    let v111 = _mm256_mul_pd(v53, v109);
+    let v112 = _mm256_fmsub_pd(v47, v110, v111);
+    let v113 = _mm256_mul_pd(v61, v110);
+    let v114 = _mm256_fmsub_pd(v53, v108, v113);
+    let v115 = _mm256_mul_pd(v47, v108);
+    let v116 = _mm256_fmsub_pd(v61, v109, v115);
+    let v117 = _mm256_mul_pd(v47, v116);
+    let v118 = _mm256_fmadd_pd(v110, v87, v117);
+    let v119 = _mm256_fnmadd_pd(v109, v91, v118);
+    let v120 = _mm256_fnmadd_pd(v53, v114, v119);
+    let v121 = _mm256_mul_pd(v53, v112);
+    let v122 = _mm256_fmadd_pd(v108, v91, v121);
+    let v123 = _mm256_fnmadd_pd(v110, v98, v122);
+    let v124 = _mm256_fnmadd_pd(v61, v116, v123);
+    let v125 = _mm256_mul_pd(v61, v114);
+    let v126 = _mm256_fmadd_pd(v109, v98, v125);
+    let v127 = _mm256_fnmadd_pd(v108, v87, v126);
+    let v128 = _mm256_fnmadd_pd(v47, v112, v127);
+    let v130 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[1]));
+    let v133 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v9);
+    let v134 = _mm256_mul_pd(v11, v41);
+    let v135 = _mm256_sub_pd(v134, v133);
+    let v136 = _mm256_fmadd_pd(v1, v41, v13);
+    let v137 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v9);
+    let v138 = _mm256_mul_pd(v22, v41);
+    let v139 = _mm256_add_pd(v137, v138);
+    let v140 = _mm256_mul_pd(v33, v139);
+    let v141 = _mm256_fmsub_pd(v34, v136, v140);
+    let v142 = _mm256_mul_pd(v34, v135);
+    let v143 = _mm256_fmsub_pd(v32, v139, v142);
+    let v144 = _mm256_mul_pd(v32, v136);
+    let v145 = _mm256_fmsub_pd(v33, v135, v144);
+    let v146 = _mm256_mul_pd(v109, v139);
+    let v147 = _mm256_fmsub_pd(v110, v136, v146);
+    let v148 = _mm256_mul_pd(v110, v135);
+    let v149 = _mm256_fmsub_pd(v108, v139, v148);
+    let v150 = _mm256_mul_pd(v108, v136);
+    let v151 = _mm256_fmsub_pd(v109, v135, v150);
+    let v152 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v9);
+    let v153 = _mm256_mul_pd(v16, v41);
+    let v154 = _mm256_add_pd(v152, v153);
+    let v155 = _mm256_sub_pd(v138, v137);
+    let v156 = _mm256_fmadd_pd(v5, v41, v13);
+    let v157 = _mm256_mul_pd(v33, v156);
+    let v158 = _mm256_fmsub_pd(v34, v155, v157);
+    let v159 = _mm256_mul_pd(v34, v154);
+    let v160 = _mm256_fmsub_pd(v32, v156, v159);
+    let v161 = _mm256_mul_pd(v32, v155);
+    let v162 = _mm256_fmsub_pd(v33, v154, v161);
+    let v163 = _mm256_mul_pd(v109, v156);
+    let v164 = _mm256_fmsub_pd(v110, v155, v163);
+    let v165 = _mm256_mul_pd(v110, v154);
+    let v166 = _mm256_fmsub_pd(v108, v156, v165);
+    let v167 = _mm256_mul_pd(v108, v155);
+    let v168 = _mm256_fmsub_pd(v109, v154, v167);
+    let v169 = _mm256_fmadd_pd(v3, v41, v13);
+    let v170 = _mm256_add_pd(v133, v134);
+    let v171 = _mm256_sub_pd(v153, v152);
+    let v172 = _mm256_mul_pd(v33, v171);
+    let v173 = _mm256_fmsub_pd(v34, v170, v172);
+    let v174 = _mm256_mul_pd(v34, v169);
+    let v175 = _mm256_fmsub_pd(v32, v171, v174);
+    let v176 = _mm256_mul_pd(v32, v170);
+    let v177 = _mm256_fmsub_pd(v33, v169, v176);
+    let v178 = _mm256_mul_pd(v109, v171);
+    let v179 = _mm256_fmsub_pd(v110, v170, v178);
+    let v180 = _mm256_mul_pd(v110, v169);
+    let v181 = _mm256_fmsub_pd(v108, v171, v180);
+    let v182 = _mm256_mul_pd(v108, v170);
+    let v183 = _mm256_fmsub_pd(v109, v169, v182);
+    let v186 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[0]),
+        runtime::lanes::from_array(p[5]),
     );
-    let v108: __m256d = _mm256_mul_pd(v107, v10);
-    let v109: __m256d = _mm256_mul_pd(v107, v20);
-    let v110: __m256d = _mm256_mul_pd(v107, v26);
-    let v111: __m256d = _mm256_mul_pd(v53, v109);
-    let v112: __m256d = _mm256_fmsub_pd(v47, v110, v111);
-    let v113: __m256d = _mm256_mul_pd(v61, v110);
-    let v114: __m256d = _mm256_fmsub_pd(v53, v108, v113);
-    let v115: __m256d = _mm256_mul_pd(v47, v108);
-    let v116: __m256d = _mm256_fmsub_pd(v61, v109, v115);
-    let v117: __m256d = _mm256_mul_pd(v47, v116);
-    let v118: __m256d = _mm256_fmadd_pd(v110, v87, v117);
-    let v119: __m256d = _mm256_fnmadd_pd(v109, v91, v118);
-    let v120: __m256d = _mm256_fnmadd_pd(v53, v114, v119);
-    let v121: __m256d = _mm256_mul_pd(v53, v112);
-    let v122: __m256d = _mm256_fmadd_pd(v108, v91, v121);
-    let v123: __m256d = _mm256_fnmadd_pd(v110, v98, v122);
-    let v124: __m256d = _mm256_fnmadd_pd(v61, v116, v123);
-    let v125: __m256d = _mm256_mul_pd(v61, v114);
-    let v126: __m256d = _mm256_fmadd_pd(v109, v98, v125);
-    let v127: __m256d = _mm256_fnmadd_pd(v108, v87, v126);
-    let v128: __m256d = _mm256_fnmadd_pd(v47, v112, v127);
-    let v130: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(p[1usize]),
-    );
-    let v133: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[1usize]), v9);
-    let v134: __m256d = _mm256_mul_pd(v11, v41);
-    let v135: __m256d = _mm256_sub_pd(v134, v133);
-    let v136: __m256d = _mm256_fmadd_pd(v1, v41, v13);
-    let v137: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[2usize]), v9);
-    let v138: __m256d = _mm256_mul_pd(v22, v41);
-    let v139: __m256d = _mm256_add_pd(v137, v138);
-    let v140: __m256d = _mm256_mul_pd(v33, v139);
-    let v141: __m256d = _mm256_fmsub_pd(v34, v136, v140);
-    let v142: __m256d = _mm256_mul_pd(v34, v135);
-    let v143: __m256d = _mm256_fmsub_pd(v32, v139, v142);
-    let v144: __m256d = _mm256_mul_pd(v32, v136);
-    let v145: __m256d = _mm256_fmsub_pd(v33, v135, v144);
-    let v146: __m256d = _mm256_mul_pd(v109, v139);
-    let v147: __m256d = _mm256_fmsub_pd(v110, v136, v146);
-    let v148: __m256d = _mm256_mul_pd(v110, v135);
-    let v149: __m256d = _mm256_fmsub_pd(v108, v139, v148);
-    let v150: __m256d = _mm256_mul_pd(v108, v136);
-    let v151: __m256d = _mm256_fmsub_pd(v109, v135, v150);
-    let v152: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[0usize]), v9);
-    let v153: __m256d = _mm256_mul_pd(v16, v41);
-    let v154: __m256d = _mm256_add_pd(v152, v153);
-    let v155: __m256d = _mm256_sub_pd(v138, v137);
-    let v156: __m256d = _mm256_fmadd_pd(v5, v41, v13);
-    let v157: __m256d = _mm256_mul_pd(v33, v156);
-    let v158: __m256d = _mm256_fmsub_pd(v34, v155, v157);
-    let v159: __m256d = _mm256_mul_pd(v34, v154);
-    let v160: __m256d = _mm256_fmsub_pd(v32, v156, v159);
-    let v161: __m256d = _mm256_mul_pd(v32, v155);
-    let v162: __m256d = _mm256_fmsub_pd(v33, v154, v161);
-    let v163: __m256d = _mm256_mul_pd(v109, v156);
-    let v164: __m256d = _mm256_fmsub_pd(v110, v155, v163);
-    let v165: __m256d = _mm256_mul_pd(v110, v154);
-    let v166: __m256d = _mm256_fmsub_pd(v108, v156, v165);
-    let v167: __m256d = _mm256_mul_pd(v108, v155);
-    let v168: __m256d = _mm256_fmsub_pd(v109, v154, v167);
-    let v169: __m256d = _mm256_fmadd_pd(v3, v41, v13);
-    let v170: __m256d = _mm256_add_pd(v133, v134);
-    let v171: __m256d = _mm256_sub_pd(v153, v152);
-    let v172: __m256d = _mm256_mul_pd(v33, v171);
-    let v173: __m256d = _mm256_fmsub_pd(v34, v170, v172);
-    let v174: __m256d = _mm256_mul_pd(v34, v169);
-    let v175: __m256d = _mm256_fmsub_pd(v32, v171, v174);
-    let v176: __m256d = _mm256_mul_pd(v32, v170);
-    let v177: __m256d = _mm256_fmsub_pd(v33, v169, v176);
-    let v178: __m256d = _mm256_mul_pd(v109, v171);
-    let v179: __m256d = _mm256_fmsub_pd(v110, v170, v178);
-    let v180: __m256d = _mm256_mul_pd(v110, v169);
-    let v181: __m256d = _mm256_fmsub_pd(v108, v171, v180);
-    let v182: __m256d = _mm256_mul_pd(v108, v170);
-    let v183: __m256d = _mm256_fmsub_pd(v109, v169, v182);
-    let v186: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        runtime::lanes::from_array(p[5usize]),
-    );
-    let v187: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[0usize]),
-        runtime::lanes::from_array(p[4usize]),
+    let v187 = _mm256_fmadd_pd(
+        runtime::lanes::from_array(q[0]),
+        runtime::lanes::from_array(p[4]),
         v186,
     );
-    let v189: __m256d = _mm256_sub_pd(
-        runtime::lanes::from_array(q[1usize]),
-        runtime::lanes::from_array(p[6usize]),
+    let v189 = _mm256_sub_pd(
+        runtime::lanes::from_array(q[1]),
+        runtime::lanes::from_array(p[6]),
     );
-    let v190: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        runtime::lanes::from_array(p[5usize]),
+    let v190 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[1]),
+        runtime::lanes::from_array(p[5]),
     );
-    let v191: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(p[4usize]),
-        v189,
-        v190,
+    let v191 = _mm256_fmadd_pd(runtime::lanes::from_array(p[4]), v189, v190);
+    let v194 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[2]),
+        runtime::lanes::from_array(p[8]),
     );
-    let v194: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        runtime::lanes::from_array(p[8usize]),
-    );
-    let v195: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[2usize]),
-        runtime::lanes::from_array(p[7usize]),
+    let v195 = _mm256_fmadd_pd(
+        runtime::lanes::from_array(q[2]),
+        runtime::lanes::from_array(p[7]),
         v194,
     );
-    out[0usize] = runtime::lanes::to_array(v10);
-    out[1usize] = runtime::lanes::to_array(v15);
-    out[2usize] = runtime::lanes::to_array(v19);
-    out[3usize] = runtime::lanes::to_array(v20);
-    out[4usize] = runtime::lanes::to_array(v21);
-    out[5usize] = runtime::lanes::to_array(v25);
-    out[6usize] = runtime::lanes::to_array(v26);
-    out[7usize] = runtime::lanes::to_array(v27);
-    out[8usize] = runtime::lanes::to_array(v28);
-    out[9usize] = runtime::lanes::to_array(v32);
-    out[10usize] = runtime::lanes::to_array(v33);
-    out[11usize] = runtime::lanes::to_array(v34);
-    out[12usize] = runtime::lanes::to_array(v55);
-    out[13usize] = runtime::lanes::to_array(v63);
-    out[14usize] = runtime::lanes::to_array(v65);
-    out[15usize] = runtime::lanes::to_array(v94);
-    out[16usize] = runtime::lanes::to_array(v101);
-    out[17usize] = runtime::lanes::to_array(v105);
-    out[18usize] = runtime::lanes::to_array(v61);
-    out[19usize] = runtime::lanes::to_array(v47);
-    out[20usize] = runtime::lanes::to_array(v53);
-    out[21usize] = runtime::lanes::to_array(v98);
-    out[22usize] = runtime::lanes::to_array(v87);
-    out[23usize] = runtime::lanes::to_array(v91);
-    out[24usize] = runtime::lanes::to_array(v108);
-    out[25usize] = runtime::lanes::to_array(v109);
-    out[26usize] = runtime::lanes::to_array(v110);
-    out[27usize] = runtime::lanes::to_array(v112);
-    out[28usize] = runtime::lanes::to_array(v114);
-    out[29usize] = runtime::lanes::to_array(v116);
-    out[30usize] = runtime::lanes::to_array(v120);
-    out[31usize] = runtime::lanes::to_array(v124);
-    out[32usize] = runtime::lanes::to_array(v128);
-    out[33usize] = runtime::lanes::to_array(v61);
-    out[34usize] = runtime::lanes::to_array(v47);
-    out[35usize] = runtime::lanes::to_array(v53);
-    out[36usize] = runtime::lanes::to_array(v98);
-    out[37usize] = runtime::lanes::to_array(v87);
-    out[38usize] = runtime::lanes::to_array(v91);
-    out[39usize] = runtime::lanes::to_array(v10);
-    out[40usize] = runtime::lanes::to_array(v20);
-    out[41usize] = runtime::lanes::to_array(v26);
-    out[42usize] = runtime::lanes::to_array(v130);
-    out[43usize] = runtime::lanes::to_array(runtime::lanes::from_array(p[2usize]));
-    out[44usize] = runtime::lanes::to_array(runtime::lanes::from_array(p[3usize]));
-    out[45usize] = runtime::lanes::to_array(v135);
-    out[46usize] = runtime::lanes::to_array(v136);
-    out[47usize] = runtime::lanes::to_array(v139);
-    out[48usize] = runtime::lanes::to_array(v141);
-    out[49usize] = runtime::lanes::to_array(v143);
-    out[50usize] = runtime::lanes::to_array(v145);
-    out[51usize] = runtime::lanes::to_array(v135);
-    out[52usize] = runtime::lanes::to_array(v136);
-    out[53usize] = runtime::lanes::to_array(v139);
-    out[54usize] = runtime::lanes::to_array(v147);
-    out[55usize] = runtime::lanes::to_array(v149);
-    out[56usize] = runtime::lanes::to_array(v151);
-    out[57usize] = runtime::lanes::to_array(v154);
-    out[58usize] = runtime::lanes::to_array(v155);
-    out[59usize] = runtime::lanes::to_array(v156);
-    out[60usize] = runtime::lanes::to_array(v158);
-    out[61usize] = runtime::lanes::to_array(v160);
-    out[62usize] = runtime::lanes::to_array(v162);
-    out[63usize] = runtime::lanes::to_array(v154);
-    out[64usize] = runtime::lanes::to_array(v155);
-    out[65usize] = runtime::lanes::to_array(v156);
-    out[66usize] = runtime::lanes::to_array(v164);
-    out[67usize] = runtime::lanes::to_array(v166);
-    out[68usize] = runtime::lanes::to_array(v168);
-    out[69usize] = runtime::lanes::to_array(v169);
-    out[70usize] = runtime::lanes::to_array(v170);
-    out[71usize] = runtime::lanes::to_array(v171);
-    out[72usize] = runtime::lanes::to_array(v173);
-    out[73usize] = runtime::lanes::to_array(v175);
-    out[74usize] = runtime::lanes::to_array(v177);
-    out[75usize] = runtime::lanes::to_array(v169);
-    out[76usize] = runtime::lanes::to_array(v170);
-    out[77usize] = runtime::lanes::to_array(v171);
-    out[78usize] = runtime::lanes::to_array(v179);
-    out[79usize] = runtime::lanes::to_array(v181);
-    out[80usize] = runtime::lanes::to_array(v183);
-    out[81usize] = runtime::lanes::to_array(v187);
-    out[82usize] = runtime::lanes::to_array(v191);
-    out[83usize] = runtime::lanes::to_array(v195);
-    out[84usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[85usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[86usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[0] = runtime::lanes::to_array(v10);
+    out[1] = runtime::lanes::to_array(v15);
+    out[2] = runtime::lanes::to_array(v19);
+    out[3] = runtime::lanes::to_array(v20);
+    out[4] = runtime::lanes::to_array(v21);
+    out[5] = runtime::lanes::to_array(v25);
+    out[6] = runtime::lanes::to_array(v26);
+    out[7] = runtime::lanes::to_array(v27);
+    out[8] = runtime::lanes::to_array(v28);
+    out[9] = runtime::lanes::to_array(v32);
+    out[10] = runtime::lanes::to_array(v33);
+    out[11] = runtime::lanes::to_array(v34);
+    out[12] = runtime::lanes::to_array(v55);
+    out[13] = runtime::lanes::to_array(v63);
+    out[14] = runtime::lanes::to_array(v65);
+    out[15] = runtime::lanes::to_array(v94);
+    out[16] = runtime::lanes::to_array(v101);
+    out[17] = runtime::lanes::to_array(v105);
+    out[18] = runtime::lanes::to_array(v61);
+    out[19] = runtime::lanes::to_array(v47);
+    out[20] = runtime::lanes::to_array(v53);
+    out[21] = runtime::lanes::to_array(v98);
+    out[22] = runtime::lanes::to_array(v87);
+    out[23] = runtime::lanes::to_array(v91);
+    out[24] = runtime::lanes::to_array(v108);
+    out[25] = runtime::lanes::to_array(v109);
+    out[26] = runtime::lanes::to_array(v110);
+    out[27] = runtime::lanes::to_array(v112);
+    out[28] = runtime::lanes::to_array(v114);
+    out[29] = runtime::lanes::to_array(v116);
+    out[30] = runtime::lanes::to_array(v120);
+    out[31] = runtime::lanes::to_array(v124);
+    out[32] = runtime::lanes::to_array(v128);
+    out[33] = runtime::lanes::to_array(v61);
+    out[34] = runtime::lanes::to_array(v47);
+    out[35] = runtime::lanes::to_array(v53);
+    out[36] = runtime::lanes::to_array(v98);
+    out[37] = runtime::lanes::to_array(v87);
+    out[38] = runtime::lanes::to_array(v91);
+    out[39] = runtime::lanes::to_array(v10);
+    out[40] = runtime::lanes::to_array(v20);
+    out[41] = runtime::lanes::to_array(v26);
+    out[42] = runtime::lanes::to_array(v130);
+    out[43] = runtime::lanes::to_array(runtime::lanes::from_array(p[2]));
+    out[44] = runtime::lanes::to_array(runtime::lanes::from_array(p[3]));
+    out[45] = runtime::lanes::to_array(v135);
+    out[46] = runtime::lanes::to_array(v136);
+    out[47] = runtime::lanes::to_array(v139);
+    out[48] = runtime::lanes::to_array(v141);
+    out[49] = runtime::lanes::to_array(v143);
+    out[50] = runtime::lanes::to_array(v145);
+    out[51] = runtime::lanes::to_array(v135);
+    out[52] = runtime::lanes::to_array(v136);
+    out[53] = runtime::lanes::to_array(v139);
+    out[54] = runtime::lanes::to_array(v147);
+    out[55] = runtime::lanes::to_array(v149);
+    out[56] = runtime::lanes::to_array(v151);
+    out[57] = runtime::lanes::to_array(v154);
+    out[58] = runtime::lanes::to_array(v155);
+    out[59] = runtime::lanes::to_array(v156);
+    out[60] = runtime::lanes::to_array(v158);
+    out[61] = runtime::lanes::to_array(v160);
+    out[62] = runtime::lanes::to_array(v162);
+    out[63] = runtime::lanes::to_array(v154);
+    out[64] = runtime::lanes::to_array(v155);
+    out[65] = runtime::lanes::to_array(v156);
+    out[66] = runtime::lanes::to_array(v164);
+    out[67] = runtime::lanes::to_array(v166);
+    out[68] = runtime::lanes::to_array(v168);
+    out[69] = runtime::lanes::to_array(v169);
+    out[70] = runtime::lanes::to_array(v170);
+    out[71] = runtime::lanes::to_array(v171);
+    out[72] = runtime::lanes::to_array(v173);
+    out[73] = runtime::lanes::to_array(v175);
+    out[74] = runtime::lanes::to_array(v177);
+    out[75] = runtime::lanes::to_array(v169);
+    out[76] = runtime::lanes::to_array(v170);
+    out[77] = runtime::lanes::to_array(v171);
+    out[78] = runtime::lanes::to_array(v179);
+    out[79] = runtime::lanes::to_array(v181);
+    out[80] = runtime::lanes::to_array(v183);
+    out[81] = runtime::lanes::to_array(v187);
+    out[82] = runtime::lanes::to_array(v191);
+    out[83] = runtime::lanes::to_array(v195);
+    out[84] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[85] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[86] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
 }
 /// Kernel `cell_0_tangent`: 788 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0_tangent(
     t: f64,
-    q: &[f64; 3usize],
-    qd: &[f64; 3usize],
-    qdd: &[f64; 3usize],
-    dir: &[f64; 6usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 174usize],
+    q: &[f64; 3],
+    qd: &[f64; 3],
+    qdd: &[f64; 3],
+    dir: &[f64; 6],
+    p: &[f64; 15],
+    out: &mut [f64; 174],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1843,721 +1819,721 @@ pub fn cell_0_tangent(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
-    q: &[f64; 3usize],
-    qd: &[f64; 3usize],
-    qdd: &[f64; 3usize],
-    dir: &[f64; 6usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 174usize],
+    q: &[f64; 3],
+    qd: &[f64; 3],
+    qdd: &[f64; 3],
+    dir: &[f64; 6],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 174],
 ) {
-    let v1: f64 = q[0usize] * q[0usize];
-    let v3: f64 = q[2usize] * q[2usize];
-    let v5: f64 = q[1usize] * q[1usize];
-    let v6: f64 = v1 + v3;
-    let v7: f64 = v6 + v5;
-    let c: [[f64; 3usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        3usize,
+    let v1 = q[0] * q[0];
+    let v3 = q[2] * q[2];
+    let v5 = q[1] * q[1];
+    let v6 = v1 + v3;
+    let v7 = v6 + v5;
+    let c: [[f64; 3]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        3,
     >(v7);
-    let v8: f64 = c[0usize][0usize];
-    let v9: f64 = c[2usize][0usize];
-    let v13: f64 = c[1usize][0usize];
-    let v41: f64 = c[3usize][0usize];
-    let v73: f64 = c[2usize][1usize];
-    let v75: f64 = c[3usize][1usize];
-    let v84: f64 = c[1usize][1usize];
-    let v204: f64 = c[0usize][1usize];
-    let v321: f64 = c[2usize][2usize];
-    let v325: f64 = c[3usize][2usize];
-    let v335: f64 = c[1usize][2usize];
-    let v10: f64 = v3.mul_add(v9, v8);
-    let v11: f64 = q[0usize] * q[2usize];
-    let v12: f64 = v11 * v9;
-    let v14: f64 = q[1usize] * v13;
-    let v15: f64 = v12 - v14;
-    let v16: f64 = q[1usize] * q[2usize];
-    let v17: f64 = v16 * v9;
-    let v18: f64 = q[0usize] * v13;
-    let v19: f64 = v17 + v18;
-    let v20: f64 = v12 + v14;
-    let v21: f64 = v1.mul_add(v9, v8);
-    let v22: f64 = q[0usize] * q[1usize];
-    let v23: f64 = v22 * v9;
-    let v24: f64 = q[2usize] * v13;
-    let v25: f64 = v23 - v24;
-    let v26: f64 = v17 - v18;
-    let v27: f64 = v23 + v24;
-    let v28: f64 = v5.mul_add(v9, v8);
-    let v31: f64 = 0.5f64 * p[0usize];
-    let v32: f64 = v31 * v10;
-    let v33: f64 = v31 * v20;
-    let v34: f64 = v31 * v26;
-    let v38: f64 = q[2usize] * qd[1usize];
-    let v39: f64 = q[1usize].mul_add(qd[2usize], -v38);
-    let v40: f64 = v9 * v39;
-    let v42: f64 = q[0usize] * qd[0usize];
-    let v43: f64 = q[2usize].mul_add(qd[2usize], v42);
-    let v44: f64 = q[1usize].mul_add(qd[1usize], v43);
-    let v45: f64 = q[0usize] * v41;
-    let v46: f64 = qd[0usize].mul_add(v13, v40);
-    let v47: f64 = v45.mul_add(v44, v46);
-    let v48: f64 = q[0usize] * qd[2usize];
-    let v49: f64 = q[2usize].mul_add(qd[0usize], -v48);
-    let v50: f64 = v9 * v49;
-    let v51: f64 = q[1usize] * v41;
-    let v52: f64 = qd[1usize].mul_add(v13, v50);
-    let v53: f64 = v51.mul_add(v44, v52);
-    let v54: f64 = v53 * v33;
-    let v55: f64 = v47.mul_add(v34, -v54);
-    let v56: f64 = q[1usize] * qd[0usize];
-    let v57: f64 = q[0usize].mul_add(qd[1usize], -v56);
-    let v58: f64 = v9 * v57;
-    let v59: f64 = q[2usize] * v41;
-    let v60: f64 = qd[2usize].mul_add(v13, v58);
-    let v61: f64 = v59.mul_add(v44, v60);
-    let v62: f64 = v61 * v34;
-    let v63: f64 = v53.mul_add(v32, -v62);
-    let v64: f64 = v47 * v32;
-    let v65: f64 = v61.mul_add(v33, -v64);
-    let v67: f64 = 2f64 * q[2usize];
-    let v68: f64 = 2f64 * q[0usize];
-    let v69: f64 = v68 * qd[0usize];
-    let v70: f64 = 2f64 * q[1usize];
-    let v71: f64 = v67.mul_add(qd[2usize], v69);
-    let v72: f64 = v70.mul_add(qd[1usize], v71);
-    let v74: f64 = v72 * v73;
-    let v76: f64 = v72 * v75;
-    let v77: f64 = v44 * v76;
-    let v78: f64 = qd[1usize] * qd[1usize];
-    let v79: f64 = qd[0usize].mul_add(qd[0usize], v78);
-    let v80: f64 = qd[2usize].mul_add(qd[2usize], v79);
-    let v81: f64 = v41.mul_add(v80, v77);
-    let v82: f64 = q[0usize] * v81;
-    let v83: f64 = v41 * v44;
-    let v85: f64 = v72 * v84;
-    let v86: f64 = v83 + v85;
-    let v87: f64 = v39.mul_add(v74, v82);
-    let v88: f64 = qd[0usize].mul_add(v86, v87);
-    let v89: f64 = v47 * v65;
-    let v90: f64 = q[1usize] * v81;
-    let v91: f64 = v49.mul_add(v74, v90);
-    let v92: f64 = qd[1usize].mul_add(v86, v91);
-    let v93: f64 = v34.mul_add(v88, v89);
-    let v94: f64 = (-v33).mul_add(v92, v93);
-    let v95: f64 = (-v53).mul_add(v63, v94);
-    let v96: f64 = v53 * v55;
-    let v97: f64 = q[2usize] * v81;
-    let v98: f64 = v57.mul_add(v74, v97);
-    let v99: f64 = qd[2usize].mul_add(v86, v98);
-    let v100: f64 = v32.mul_add(v92, v96);
-    let v101: f64 = (-v34).mul_add(v99, v100);
-    let v102: f64 = (-v61).mul_add(v65, v101);
-    let v103: f64 = v61 * v63;
-    let v104: f64 = v33.mul_add(v99, v103);
-    let v105: f64 = (-v32).mul_add(v88, v104);
-    let v106: f64 = (-v47).mul_add(v55, v105);
-    let v108: f64 = 0.25f64 * p[0usize];
-    let v109: f64 = v108 * v10;
-    let v110: f64 = v108 * v20;
-    let v111: f64 = v108 * v26;
-    let v112: f64 = v53 * v110;
-    let v113: f64 = v47.mul_add(v111, -v112);
-    let v114: f64 = v61 * v111;
-    let v115: f64 = v53.mul_add(v109, -v114);
-    let v116: f64 = v47 * v109;
-    let v117: f64 = v61.mul_add(v110, -v116);
-    let v118: f64 = v47 * v117;
-    let v119: f64 = v111.mul_add(v88, v118);
-    let v120: f64 = (-v110).mul_add(v92, v119);
-    let v121: f64 = (-v53).mul_add(v115, v120);
-    let v122: f64 = v53 * v113;
-    let v123: f64 = v109.mul_add(v92, v122);
-    let v124: f64 = (-v111).mul_add(v99, v123);
-    let v125: f64 = (-v61).mul_add(v117, v124);
-    let v126: f64 = v61 * v115;
-    let v127: f64 = v110.mul_add(v99, v126);
-    let v128: f64 = (-v109).mul_add(v88, v127);
-    let v129: f64 = (-v47).mul_add(v113, v128);
-    let v131: f64 = 0.5f64 * p[1usize];
-    let v134: f64 = q[1usize] * v9;
-    let v135: f64 = v11 * v41;
-    let v136: f64 = v135 - v134;
-    let v137: f64 = v1.mul_add(v41, v13);
-    let v138: f64 = q[2usize] * v9;
-    let v139: f64 = v22 * v41;
-    let v140: f64 = v138 + v139;
-    let v141: f64 = v33 * v140;
-    let v142: f64 = v34.mul_add(v137, -v141);
-    let v143: f64 = v34 * v136;
-    let v144: f64 = v32.mul_add(v140, -v143);
-    let v145: f64 = v32 * v137;
-    let v146: f64 = v33.mul_add(v136, -v145);
-    let v147: f64 = v110 * v140;
-    let v148: f64 = v111.mul_add(v137, -v147);
-    let v149: f64 = v111 * v136;
-    let v150: f64 = v109.mul_add(v140, -v149);
-    let v151: f64 = v109 * v137;
-    let v152: f64 = v110.mul_add(v136, -v151);
-    let v153: f64 = q[0usize] * v9;
-    let v154: f64 = v16 * v41;
-    let v155: f64 = v153 + v154;
-    let v156: f64 = v139 - v138;
-    let v157: f64 = v5.mul_add(v41, v13);
-    let v158: f64 = v33 * v157;
-    let v159: f64 = v34.mul_add(v156, -v158);
-    let v160: f64 = v34 * v155;
-    let v161: f64 = v32.mul_add(v157, -v160);
-    let v162: f64 = v32 * v156;
-    let v163: f64 = v33.mul_add(v155, -v162);
-    let v164: f64 = v110 * v157;
-    let v165: f64 = v111.mul_add(v156, -v164);
-    let v166: f64 = v111 * v155;
-    let v167: f64 = v109.mul_add(v157, -v166);
-    let v168: f64 = v109 * v156;
-    let v169: f64 = v110.mul_add(v155, -v168);
-    let v170: f64 = v3.mul_add(v41, v13);
-    let v171: f64 = v134 + v135;
-    let v172: f64 = v154 - v153;
-    let v173: f64 = v33 * v172;
-    let v174: f64 = v34.mul_add(v171, -v173);
-    let v175: f64 = v34 * v170;
-    let v176: f64 = v32.mul_add(v172, -v175);
-    let v177: f64 = v32 * v171;
-    let v178: f64 = v33.mul_add(v170, -v177);
-    let v179: f64 = v110 * v172;
-    let v180: f64 = v111.mul_add(v171, -v179);
-    let v181: f64 = v111 * v170;
-    let v182: f64 = v109.mul_add(v172, -v181);
-    let v183: f64 = v109 * v171;
-    let v184: f64 = v110.mul_add(v170, -v183);
-    let v187: f64 = qd[0usize] * p[5usize];
-    let v188: f64 = q[0usize].mul_add(p[4usize], v187);
-    let v190: f64 = q[1usize] - p[6usize];
-    let v191: f64 = qd[1usize] * p[5usize];
-    let v192: f64 = p[4usize].mul_add(v190, v191);
-    let v195: f64 = qd[2usize] * p[8usize];
-    let v196: f64 = q[2usize].mul_add(p[7usize], v195);
-    let v200: f64 = v67 * dir[2usize];
-    let v202: f64 = v68.mul_add(dir[0usize], v200);
-    let v203: f64 = v70.mul_add(dir[1usize], v202);
-    let v205: f64 = v203 * v204;
-    let v206: f64 = v73 * v203;
-    let v207: f64 = v67 * v9;
-    let v208: f64 = v3.mul_add(v206, v205);
-    let v209: f64 = v207.mul_add(dir[2usize], v208);
-    let v210: f64 = v138 * dir[0usize];
-    let v211: f64 = v13 * dir[1usize];
-    let v212: f64 = v84 * v203;
-    let v213: f64 = q[1usize] * v212;
-    let v214: f64 = v9 * dir[2usize];
-    let v215: f64 = q[2usize] * v206;
-    let v216: f64 = v214 + v215;
-    let v217: f64 = q[0usize] * v216;
-    let v218: f64 = v210 - v211;
-    let v219: f64 = v218 - v213;
-    let v220: f64 = v219 + v217;
-    let v221: f64 = v138 * dir[1usize];
-    let v222: f64 = v13 * dir[0usize];
-    let v223: f64 = q[0usize] * v212;
-    let v224: f64 = q[1usize] * v216;
-    let v225: f64 = v221 + v222;
-    let v226: f64 = v225 + v223;
-    let v227: f64 = v226 + v224;
-    let v228: f64 = v210 + v211;
-    let v229: f64 = v228 + v213;
-    let v230: f64 = v229 + v217;
-    let v231: f64 = v68 * v9;
-    let v232: f64 = v1.mul_add(v206, v205);
-    let v233: f64 = v231.mul_add(dir[0usize], v232);
-    let v234: f64 = v134 * dir[0usize];
-    let v235: f64 = v13 * dir[2usize];
-    let v236: f64 = q[2usize] * v212;
-    let v237: f64 = v9 * dir[1usize];
-    let v238: f64 = q[1usize] * v206;
-    let v239: f64 = v237 + v238;
-    let v240: f64 = q[0usize] * v239;
-    let v241: f64 = v234 - v235;
-    let v242: f64 = v241 - v236;
-    let v243: f64 = v242 + v240;
-    let v244: f64 = v221 - v222;
-    let v245: f64 = v244 - v223;
-    let v246: f64 = v245 + v224;
-    let v247: f64 = v234 + v235;
-    let v248: f64 = v247 + v236;
-    let v249: f64 = v248 + v240;
-    let v250: f64 = v70 * v9;
-    let v251: f64 = v5.mul_add(v206, v205);
-    let v252: f64 = v250.mul_add(dir[1usize], v251);
-    let v253: f64 = v31 * v209;
-    let v254: f64 = v31 * v230;
-    let v255: f64 = v31 * v246;
-    let v257: f64 = qd[0usize] * v212;
-    let v259: f64 = q[1usize] * dir[5usize];
-    let v261: f64 = qd[2usize].mul_add(dir[1usize], v259);
-    let v262: f64 = (-qd[1usize]).mul_add(dir[2usize], v261);
-    let v263: f64 = (-q[2usize]).mul_add(dir[4usize], v262);
-    let v264: f64 = v75 * v203;
-    let v265: f64 = v44 * v264;
-    let v266: f64 = q[2usize] * dir[5usize];
-    let v267: f64 = qd[2usize].mul_add(dir[2usize], v266);
-    let v268: f64 = qd[0usize].mul_add(dir[0usize], v267);
-    let v269: f64 = q[0usize].mul_add(dir[3usize], v268);
-    let v270: f64 = qd[1usize].mul_add(dir[1usize], v269);
-    let v271: f64 = q[1usize].mul_add(dir[4usize], v270);
-    let v272: f64 = v41 * v271;
-    let v273: f64 = v265 + v272;
-    let v274: f64 = v13.mul_add(dir[3usize], v257);
-    let v275: f64 = v39.mul_add(v206, v274);
-    let v276: f64 = v9.mul_add(v263, v275);
-    let v277: f64 = v83.mul_add(dir[0usize], v276);
-    let v278: f64 = q[0usize].mul_add(v273, v277);
-    let v279: f64 = v47 * v255;
-    let v280: f64 = qd[1usize] * v212;
-    let v281: f64 = q[2usize] * dir[3usize];
-    let v282: f64 = qd[0usize].mul_add(dir[2usize], v281);
-    let v283: f64 = (-qd[2usize]).mul_add(dir[0usize], v282);
-    let v284: f64 = (-q[0usize]).mul_add(dir[5usize], v283);
-    let v285: f64 = v13.mul_add(dir[4usize], v280);
-    let v286: f64 = v49.mul_add(v206, v285);
-    let v287: f64 = v9.mul_add(v284, v286);
-    let v288: f64 = v83.mul_add(dir[1usize], v287);
-    let v289: f64 = q[1usize].mul_add(v273, v288);
-    let v290: f64 = v34.mul_add(v278, v279);
-    let v291: f64 = (-v33).mul_add(v289, v290);
-    let v292: f64 = (-v53).mul_add(v254, v291);
-    let v293: f64 = v53 * v253;
-    let v294: f64 = qd[2usize] * v212;
-    let v295: f64 = q[0usize] * dir[4usize];
-    let v296: f64 = qd[1usize].mul_add(dir[0usize], v295);
-    let v297: f64 = (-qd[0usize]).mul_add(dir[1usize], v296);
-    let v298: f64 = (-q[1usize]).mul_add(dir[3usize], v297);
-    let v299: f64 = v13.mul_add(dir[5usize], v294);
-    let v300: f64 = v57.mul_add(v206, v299);
-    let v301: f64 = v9.mul_add(v298, v300);
-    let v302: f64 = v83.mul_add(dir[2usize], v301);
-    let v303: f64 = q[2usize].mul_add(v273, v302);
-    let v304: f64 = v32.mul_add(v289, v293);
-    let v305: f64 = (-v34).mul_add(v303, v304);
-    let v306: f64 = (-v61).mul_add(v255, v305);
-    let v307: f64 = v61 * v254;
-    let v308: f64 = v33.mul_add(v303, v307);
-    let v309: f64 = (-v32).mul_add(v278, v308);
-    let v310: f64 = (-v47).mul_add(v253, v309);
-    let v311: f64 = v74 * v263;
-    let v312: f64 = 2f64 * qd[2usize];
-    let v313: f64 = v67 * dir[5usize];
-    let v314: f64 = 2f64 * qd[0usize];
-    let v315: f64 = 2f64 * qd[1usize];
-    let v316: f64 = v312.mul_add(dir[2usize], v313);
-    let v317: f64 = v314.mul_add(dir[0usize], v316);
-    let v318: f64 = v68.mul_add(dir[3usize], v317);
-    let v319: f64 = v315.mul_add(dir[1usize], v318);
-    let v320: f64 = v70.mul_add(dir[4usize], v319);
-    let v322: f64 = v72 * v203;
-    let v323: f64 = v322 * v321;
-    let v324: f64 = v73.mul_add(v320, v323);
-    let v326: f64 = v322 * v325;
-    let v327: f64 = v75.mul_add(v320, v326);
-    let v328: f64 = v44 * v327;
-    let v329: f64 = v315 * dir[4usize];
-    let v330: f64 = v314.mul_add(dir[3usize], v329);
-    let v331: f64 = v312.mul_add(dir[5usize], v330);
-    let v332: f64 = v76.mul_add(v271, v328);
-    let v333: f64 = v80.mul_add(v264, v332);
-    let v334: f64 = v41.mul_add(v331, v333);
-    let v336: f64 = v322 * v335;
-    let v337: f64 = v84.mul_add(v320, v336);
-    let v338: f64 = v337 + v265;
-    let v339: f64 = v338 + v272;
-    let v340: f64 = v80 * dir[0usize];
-    let v341: f64 = v44.mul_add(dir[3usize], v340);
-    let v342: f64 = v85.mul_add(dir[3usize], v311);
-    let v343: f64 = v39.mul_add(v324, v342);
-    let v344: f64 = v77.mul_add(dir[0usize], v343);
-    let v345: f64 = q[0usize].mul_add(v334, v344);
-    let v346: f64 = qd[0usize].mul_add(v339, v345);
-    let v347: f64 = v41.mul_add(v341, v346);
-    let v348: f64 = v34 * v347;
-    let v349: f64 = v74 * v284;
-    let v350: f64 = v80 * dir[1usize];
-    let v351: f64 = v44.mul_add(dir[4usize], v350);
-    let v352: f64 = v85.mul_add(dir[4usize], v349);
-    let v353: f64 = v49.mul_add(v324, v352);
-    let v354: f64 = v77.mul_add(dir[1usize], v353);
-    let v355: f64 = q[1usize].mul_add(v334, v354);
-    let v356: f64 = qd[1usize].mul_add(v339, v355);
-    let v357: f64 = v41.mul_add(v351, v356);
-    let v358: f64 = v88.mul_add(v255, v348);
-    let v359: f64 = v65.mul_add(v278, v358);
-    let v360: f64 = v47.mul_add(v310, v359);
-    let v361: f64 = (-v92).mul_add(v254, v360);
-    let v362: f64 = (-v33).mul_add(v357, v361);
-    let v363: f64 = (-v63).mul_add(v289, v362);
-    let v364: f64 = (-v53).mul_add(v306, v363);
-    let v365: f64 = v32 * v357;
-    let v366: f64 = v74 * v298;
-    let v367: f64 = v80 * dir[2usize];
-    let v368: f64 = v44.mul_add(dir[5usize], v367);
-    let v369: f64 = v85.mul_add(dir[5usize], v366);
-    let v370: f64 = v57.mul_add(v324, v369);
-    let v371: f64 = v77.mul_add(dir[2usize], v370);
-    let v372: f64 = q[2usize].mul_add(v334, v371);
-    let v373: f64 = qd[2usize].mul_add(v339, v372);
-    let v374: f64 = v41.mul_add(v368, v373);
-    let v375: f64 = v92.mul_add(v253, v365);
-    let v376: f64 = v55.mul_add(v289, v375);
-    let v377: f64 = v53.mul_add(v292, v376);
-    let v378: f64 = (-v99).mul_add(v255, v377);
-    let v379: f64 = (-v34).mul_add(v374, v378);
-    let v380: f64 = (-v65).mul_add(v303, v379);
-    let v381: f64 = (-v61).mul_add(v310, v380);
-    let v382: f64 = v33 * v374;
-    let v383: f64 = v99.mul_add(v254, v382);
-    let v384: f64 = v63.mul_add(v303, v383);
-    let v385: f64 = v61.mul_add(v306, v384);
-    let v386: f64 = (-v88).mul_add(v253, v385);
-    let v387: f64 = (-v32).mul_add(v347, v386);
-    let v388: f64 = (-v55).mul_add(v278, v387);
-    let v389: f64 = (-v47).mul_add(v292, v388);
-    let v390: f64 = v108 * v209;
-    let v391: f64 = v108 * v230;
-    let v392: f64 = v108 * v246;
-    let v393: f64 = v47 * v392;
-    let v394: f64 = v111.mul_add(v278, v393);
-    let v395: f64 = (-v110).mul_add(v289, v394);
-    let v396: f64 = (-v53).mul_add(v391, v395);
-    let v397: f64 = v53 * v390;
-    let v398: f64 = v109.mul_add(v289, v397);
-    let v399: f64 = (-v111).mul_add(v303, v398);
-    let v400: f64 = (-v61).mul_add(v392, v399);
-    let v401: f64 = v61 * v391;
-    let v402: f64 = v110.mul_add(v303, v401);
-    let v403: f64 = (-v109).mul_add(v278, v402);
-    let v404: f64 = (-v47).mul_add(v390, v403);
-    let v405: f64 = v111 * v347;
-    let v406: f64 = v88.mul_add(v392, v405);
-    let v407: f64 = v117.mul_add(v278, v406);
-    let v408: f64 = v47.mul_add(v404, v407);
-    let v409: f64 = (-v92).mul_add(v391, v408);
-    let v410: f64 = (-v110).mul_add(v357, v409);
-    let v411: f64 = (-v115).mul_add(v289, v410);
-    let v412: f64 = (-v53).mul_add(v400, v411);
-    let v413: f64 = v109 * v357;
-    let v414: f64 = v92.mul_add(v390, v413);
-    let v415: f64 = v113.mul_add(v289, v414);
-    let v416: f64 = v53.mul_add(v396, v415);
-    let v417: f64 = (-v99).mul_add(v392, v416);
-    let v418: f64 = (-v111).mul_add(v374, v417);
-    let v419: f64 = (-v117).mul_add(v303, v418);
-    let v420: f64 = (-v61).mul_add(v404, v419);
-    let v421: f64 = v110 * v374;
-    let v422: f64 = v99.mul_add(v391, v421);
-    let v423: f64 = v115.mul_add(v303, v422);
-    let v424: f64 = v61.mul_add(v400, v423);
-    let v425: f64 = (-v88).mul_add(v390, v424);
-    let v426: f64 = (-v109).mul_add(v347, v425);
-    let v427: f64 = (-v113).mul_add(v278, v426);
-    let v428: f64 = (-v47).mul_add(v396, v427);
-    let v429: f64 = v59 * dir[0usize];
-    let v430: f64 = q[2usize] * v264;
-    let v431: f64 = v41.mul_add(dir[2usize], v430);
-    let v432: f64 = q[0usize] * v431;
-    let v433: f64 = v429 - v237;
-    let v434: f64 = v433 - v238;
-    let v435: f64 = v434 + v432;
-    let v436: f64 = v68 * v41;
-    let v437: f64 = v1.mul_add(v264, v212);
-    let v438: f64 = v436.mul_add(dir[0usize], v437);
-    let v439: f64 = v51 * dir[0usize];
-    let v440: f64 = q[1usize] * v264;
-    let v441: f64 = v41.mul_add(dir[1usize], v440);
-    let v442: f64 = q[0usize] * v441;
-    let v443: f64 = v216 + v439;
-    let v444: f64 = v443 + v442;
-    let v445: f64 = v34 * v438;
-    let v446: f64 = v137.mul_add(v255, v445);
-    let v447: f64 = (-v140).mul_add(v254, v446);
-    let v448: f64 = (-v33).mul_add(v444, v447);
-    let v449: f64 = v32 * v444;
-    let v450: f64 = v140.mul_add(v253, v449);
-    let v451: f64 = (-v136).mul_add(v255, v450);
-    let v452: f64 = (-v34).mul_add(v435, v451);
-    let v453: f64 = v33 * v435;
-    let v454: f64 = v136.mul_add(v254, v453);
-    let v455: f64 = (-v137).mul_add(v253, v454);
-    let v456: f64 = (-v32).mul_add(v438, v455);
-    let v457: f64 = v111 * v438;
-    let v458: f64 = v137.mul_add(v392, v457);
-    let v459: f64 = (-v140).mul_add(v391, v458);
-    let v460: f64 = (-v110).mul_add(v444, v459);
-    let v461: f64 = v109 * v444;
-    let v462: f64 = v140.mul_add(v390, v461);
-    let v463: f64 = (-v136).mul_add(v392, v462);
-    let v464: f64 = (-v111).mul_add(v435, v463);
-    let v465: f64 = v110 * v435;
-    let v466: f64 = v136.mul_add(v391, v465);
-    let v467: f64 = (-v137).mul_add(v390, v466);
-    let v468: f64 = (-v109).mul_add(v438, v467);
-    let v469: f64 = v9 * dir[0usize];
-    let v470: f64 = q[0usize] * v206;
-    let v471: f64 = v59 * dir[1usize];
-    let v472: f64 = q[1usize] * v431;
-    let v473: f64 = v469 + v470;
-    let v474: f64 = v473 + v471;
-    let v475: f64 = v474 + v472;
-    let v476: f64 = v439 - v214;
-    let v477: f64 = v476 - v215;
-    let v478: f64 = v477 + v442;
-    let v479: f64 = v70 * v41;
-    let v480: f64 = v5.mul_add(v264, v212);
-    let v481: f64 = v479.mul_add(dir[1usize], v480);
-    let v482: f64 = v34 * v478;
-    let v483: f64 = v156.mul_add(v255, v482);
-    let v484: f64 = (-v157).mul_add(v254, v483);
-    let v485: f64 = (-v33).mul_add(v481, v484);
-    let v486: f64 = v32 * v481;
-    let v487: f64 = v157.mul_add(v253, v486);
-    let v488: f64 = (-v155).mul_add(v255, v487);
-    let v489: f64 = (-v34).mul_add(v475, v488);
-    let v490: f64 = v33 * v475;
-    let v491: f64 = v155.mul_add(v254, v490);
-    let v492: f64 = (-v156).mul_add(v253, v491);
-    let v493: f64 = (-v32).mul_add(v478, v492);
-    let v494: f64 = v111 * v478;
-    let v495: f64 = v156.mul_add(v392, v494);
-    let v496: f64 = (-v157).mul_add(v391, v495);
-    let v497: f64 = (-v110).mul_add(v481, v496);
-    let v498: f64 = v109 * v481;
-    let v499: f64 = v157.mul_add(v390, v498);
-    let v500: f64 = (-v155).mul_add(v392, v499);
-    let v501: f64 = (-v111).mul_add(v475, v500);
-    let v502: f64 = v110 * v475;
-    let v503: f64 = v155.mul_add(v391, v502);
-    let v504: f64 = (-v156).mul_add(v390, v503);
-    let v505: f64 = (-v109).mul_add(v478, v504);
-    let v506: f64 = v67 * v41;
-    let v507: f64 = v3.mul_add(v264, v212);
-    let v508: f64 = v506.mul_add(dir[2usize], v507);
-    let v509: f64 = v239 + v429;
-    let v510: f64 = v509 + v432;
-    let v511: f64 = v471 - v469;
-    let v512: f64 = v511 - v470;
-    let v513: f64 = v512 + v472;
-    let v514: f64 = v34 * v510;
-    let v515: f64 = v171.mul_add(v255, v514);
-    let v516: f64 = (-v172).mul_add(v254, v515);
-    let v517: f64 = (-v33).mul_add(v513, v516);
-    let v518: f64 = v32 * v513;
-    let v519: f64 = v172.mul_add(v253, v518);
-    let v520: f64 = (-v170).mul_add(v255, v519);
-    let v521: f64 = (-v34).mul_add(v508, v520);
-    let v522: f64 = v33 * v508;
-    let v523: f64 = v170.mul_add(v254, v522);
-    let v524: f64 = (-v171).mul_add(v253, v523);
-    let v525: f64 = (-v32).mul_add(v510, v524);
-    let v526: f64 = v111 * v510;
-    let v527: f64 = v171.mul_add(v392, v526);
-    let v528: f64 = (-v172).mul_add(v391, v527);
-    let v529: f64 = (-v110).mul_add(v513, v528);
-    let v530: f64 = v109 * v513;
-    let v531: f64 = v172.mul_add(v390, v530);
-    let v532: f64 = (-v170).mul_add(v392, v531);
-    let v533: f64 = (-v111).mul_add(v508, v532);
-    let v534: f64 = v110 * v508;
-    let v535: f64 = v170.mul_add(v391, v534);
-    let v536: f64 = (-v171).mul_add(v390, v535);
-    let v537: f64 = (-v109).mul_add(v510, v536);
-    let v538: f64 = p[5usize] * dir[3usize];
-    let v539: f64 = p[4usize].mul_add(dir[0usize], v538);
-    let v540: f64 = p[5usize] * dir[4usize];
-    let v541: f64 = p[4usize].mul_add(dir[1usize], v540);
-    let v542: f64 = p[8usize] * dir[5usize];
-    let v543: f64 = p[7usize].mul_add(dir[2usize], v542);
-    out[0usize] = v10;
-    out[1usize] = v15;
-    out[2usize] = v19;
-    out[3usize] = v20;
-    out[4usize] = v21;
-    out[5usize] = v25;
-    out[6usize] = v26;
-    out[7usize] = v27;
-    out[8usize] = v28;
-    out[9usize] = v32;
-    out[10usize] = v33;
-    out[11usize] = v34;
-    out[12usize] = v55;
-    out[13usize] = v63;
-    out[14usize] = v65;
-    out[15usize] = v95;
-    out[16usize] = v102;
-    out[17usize] = v106;
-    out[18usize] = v61;
-    out[19usize] = v47;
-    out[20usize] = v53;
-    out[21usize] = v99;
-    out[22usize] = v88;
-    out[23usize] = v92;
-    out[24usize] = v109;
-    out[25usize] = v110;
-    out[26usize] = v111;
-    out[27usize] = v113;
-    out[28usize] = v115;
-    out[29usize] = v117;
-    out[30usize] = v121;
-    out[31usize] = v125;
-    out[32usize] = v129;
-    out[33usize] = v61;
-    out[34usize] = v47;
-    out[35usize] = v53;
-    out[36usize] = v99;
-    out[37usize] = v88;
-    out[38usize] = v92;
-    out[39usize] = v10;
-    out[40usize] = v20;
-    out[41usize] = v26;
-    out[42usize] = v131;
-    out[43usize] = p[2usize];
-    out[44usize] = p[3usize];
-    out[45usize] = v136;
-    out[46usize] = v137;
-    out[47usize] = v140;
-    out[48usize] = v142;
-    out[49usize] = v144;
-    out[50usize] = v146;
-    out[51usize] = v136;
-    out[52usize] = v137;
-    out[53usize] = v140;
-    out[54usize] = v148;
-    out[55usize] = v150;
-    out[56usize] = v152;
-    out[57usize] = v155;
-    out[58usize] = v156;
-    out[59usize] = v157;
-    out[60usize] = v159;
-    out[61usize] = v161;
-    out[62usize] = v163;
-    out[63usize] = v155;
-    out[64usize] = v156;
-    out[65usize] = v157;
-    out[66usize] = v165;
-    out[67usize] = v167;
-    out[68usize] = v169;
-    out[69usize] = v170;
-    out[70usize] = v171;
-    out[71usize] = v172;
-    out[72usize] = v174;
-    out[73usize] = v176;
-    out[74usize] = v178;
-    out[75usize] = v170;
-    out[76usize] = v171;
-    out[77usize] = v172;
-    out[78usize] = v180;
-    out[79usize] = v182;
-    out[80usize] = v184;
-    out[81usize] = v188;
-    out[82usize] = v192;
-    out[83usize] = v196;
-    out[84usize] = 0f64;
-    out[85usize] = 0f64;
-    out[86usize] = 0f64;
-    out[87usize] = v209;
-    out[88usize] = v220;
-    out[89usize] = v227;
-    out[90usize] = v230;
-    out[91usize] = v233;
-    out[92usize] = v243;
-    out[93usize] = v246;
-    out[94usize] = v249;
-    out[95usize] = v252;
-    out[96usize] = v253;
-    out[97usize] = v254;
-    out[98usize] = v255;
-    out[99usize] = v292;
-    out[100usize] = v306;
-    out[101usize] = v310;
-    out[102usize] = v364;
-    out[103usize] = v381;
-    out[104usize] = v389;
-    out[105usize] = v303;
-    out[106usize] = v278;
-    out[107usize] = v289;
-    out[108usize] = v374;
-    out[109usize] = v347;
-    out[110usize] = v357;
-    out[111usize] = v390;
-    out[112usize] = v391;
-    out[113usize] = v392;
-    out[114usize] = v396;
-    out[115usize] = v400;
-    out[116usize] = v404;
-    out[117usize] = v412;
-    out[118usize] = v420;
-    out[119usize] = v428;
-    out[120usize] = v303;
-    out[121usize] = v278;
-    out[122usize] = v289;
-    out[123usize] = v374;
-    out[124usize] = v347;
-    out[125usize] = v357;
-    out[126usize] = v209;
-    out[127usize] = v230;
-    out[128usize] = v246;
-    out[129usize] = 0f64;
-    out[130usize] = 0f64;
-    out[131usize] = 0f64;
-    out[132usize] = v435;
-    out[133usize] = v438;
-    out[134usize] = v444;
-    out[135usize] = v448;
-    out[136usize] = v452;
-    out[137usize] = v456;
-    out[138usize] = v435;
-    out[139usize] = v438;
-    out[140usize] = v444;
-    out[141usize] = v460;
-    out[142usize] = v464;
-    out[143usize] = v468;
-    out[144usize] = v475;
-    out[145usize] = v478;
-    out[146usize] = v481;
-    out[147usize] = v485;
-    out[148usize] = v489;
-    out[149usize] = v493;
-    out[150usize] = v475;
-    out[151usize] = v478;
-    out[152usize] = v481;
-    out[153usize] = v497;
-    out[154usize] = v501;
-    out[155usize] = v505;
-    out[156usize] = v508;
-    out[157usize] = v510;
-    out[158usize] = v513;
-    out[159usize] = v517;
-    out[160usize] = v521;
-    out[161usize] = v525;
-    out[162usize] = v508;
-    out[163usize] = v510;
-    out[164usize] = v513;
-    out[165usize] = v529;
-    out[166usize] = v533;
-    out[167usize] = v537;
-    out[168usize] = v539;
-    out[169usize] = v541;
-    out[170usize] = v543;
-    out[171usize] = 0f64;
-    out[172usize] = 0f64;
-    out[173usize] = 0f64;
+    let v8: f64 = c[0][0];
+    let v9: f64 = c[2][0];
+    let v13: f64 = c[1][0];
+    let v41: f64 = c[3][0];
+    let v73: f64 = c[2][1];
+    let v75: f64 = c[3][1];
+    let v84: f64 = c[1][1];
+    let v204: f64 = c[0][1];
+    let v321: f64 = c[2][2];
+    let v325: f64 = c[3][2];
+    let v335: f64 = c[1][2];
+    let v10 = v3.mul_add(v9, v8);
+    let v11 = q[0] * q[2];
+    let v12 = v11 * v9;
+    let v14 = q[1] * v13;
+    let v15 = v12 - v14;
+    let v16 = q[1] * q[2];
+    let v17 = v16 * v9;
+    let v18 = q[0] * v13;
+    let v19 = v17 + v18;
+    let v20 = v12 + v14;
+    let v21 = v1.mul_add(v9, v8);
+    let v22 = q[0] * q[1];
+    let v23 = v22 * v9;
+    let v24 = q[2] * v13;
+    let v25 = v23 - v24;
+    let v26 = v17 - v18;
+    let v27 = v23 + v24;
+    let v28 = v5.mul_add(v9, v8);
+    let v31 = 0.5f64 * p[0];
+    let v32 = v31 * v10;
+    let v33 = v31 * v20;
+    let v34 = v31 * v26;
+    let v38 = q[2] * qd[1];
+    let v39 = q[1].mul_add(qd[2], -v38);
+    let v40 = v9 * v39;
+    let v42 = q[0] * qd[0];
+    let v43 = q[2].mul_add(qd[2], v42);
+    let v44 = q[1].mul_add(qd[1], v43);
+    let v45 = q[0] * v41;
+    let v46 = qd[0].mul_add(v13, v40);
+    let v47 = v45.mul_add(v44, v46);
+    let v48 = q[0] * qd[2];
+    let v49 = q[2].mul_add(qd[0], -v48);
+    let v50 = v9 * v49;
+    let v51 = q[1] * v41;
+    let v52 = qd[1].mul_add(v13, v50);
+    let v53 = v51.mul_add(v44, v52);
+    let v54 = v53 * v33;
+    let v55 = v47.mul_add(v34, -v54);
+    let v56 = q[1] * qd[0];
+    let v57 = q[0].mul_add(qd[1], -v56);
+    let v58 = v9 * v57;
+    let v59 = q[2] * v41;
+    let v60 = qd[2].mul_add(v13, v58);
+    let v61 = v59.mul_add(v44, v60);
+    let v62 = v61 * v34;
+    let v63 = v53.mul_add(v32, -v62);
+    let v64 = v47 * v32;
+    let v65 = v61.mul_add(v33, -v64);
+    let v67 = 2f64 * q[2];
+    let v68 = 2f64 * q[0];
+    let v69 = v68 * qd[0];
+    let v70 = 2f64 * q[1];
+    let v71 = v67.mul_add(qd[2], v69);
+    let v72 = v70.mul_add(qd[1], v71);
+    let v74 = v72 * v73;
+    let v76 = v72 * v75;
+    let v77 = v44 * v76;
+    let v78 = qd[1] * qd[1];
+    let v79 = qd[0].mul_add(qd[0], v78);
+    let v80 = qd[2].mul_add(qd[2], v79);
+    let v81 = v41.mul_add(v80, v77);
+    let v82 = q[0] * v81;
+    let v83 = v41 * v44;
+    let v85 = v72 * v84;
+    let v86 = v83 + v85;
+    let v87 = v39.mul_add(v74, v82);
+    let v88 = qd[0].mul_add(v86, v87);
+    let v89 = v47 * v65;
+    let v90 = q[1] * v81;
+    let v91 = v49.mul_add(v74, v90);
+    let v92 = qd[1].mul_add(v86, v91);
+    let v93 = v34.mul_add(v88, v89);
+    let v94 = (-v33).mul_add(v92, v93);
+    let v95 = (-v53).mul_add(v63, v94);
+    let v96 = v53 * v55;
+    let v97 = q[2] * v81;
+    let v98 = v57.mul_add(v74, v97);
+    let v99 = qd[2].mul_add(v86, v98);
+    let v100 = v32.mul_add(v92, v96);
+    let v101 = (-v34).mul_add(v99, v100);
+    let v102 = (-v61).mul_add(v65, v101);
+    let v103 = v61 * v63;
+    let v104 = v33.mul_add(v99, v103);
+    let v105 = (-v32).mul_add(v88, v104);
+    let v106 = (-v47).mul_add(v55, v105);
+    let v108 = 0.25f64 * p[0];
+    let v109 = v108 * v10;
+    let v110 = v108 * v20;
+    let v111 = v108 * v26;
+    let v112 = v53 * v110;
+    let v113 = v47.mul_add(v111, -v112);
+    let v114 = v61 * v111;
+    let v115 = v53.mul_add(v109, -v114);
+    let v116 = v47 * v109;
+    let v117 = v61.mul_add(v110, -v116);
+    let v118 = v47 * v117;
+    let v119 = v111.mul_add(v88, v118);
+    let v120 = (-v110).mul_add(v92, v119);
+    let v121 = (-v53).mul_add(v115, v120);
+    let v122 = v53 * v113;
+    let v123 = v109.mul_add(v92, v122);
+    let v124 = (-v111).mul_add(v99, v123);
+    let v125 = (-v61).mul_add(v117, v124);
+    let v126 = v61 * v115;
+    let v127 = v110.mul_add(v99, v126);
+    let v128 = (-v109).mul_add(v88, v127);
+    let v129 = (-v47).mul_add(v113, v128);
+    let v131 = 0.5f64 * p[1];
+    let v134 = q[1] * v9;
+    let v135 = v11 * v41;
+    let v136 = v135 - v134;
+    let v137 = v1.mul_add(v41, v13);
+    let v138 = q[2] * v9;
+    let v139 = v22 * v41;
+    let v140 = v138 + v139;
+    let v141 = v33 * v140;
+    let v142 = v34.mul_add(v137, -v141);
+    let v143 = v34 * v136;
+    let v144 = v32.mul_add(v140, -v143);
+    let v145 = v32 * v137;
+    let v146 = v33.mul_add(v136, -v145);
+    let v147 = v110 * v140;
+    let v148 = v111.mul_add(v137, -v147);
+    let v149 = v111 * v136;
+    let v150 = v109.mul_add(v140, -v149);
+    let v151 = v109 * v137;
+    let v152 = v110.mul_add(v136, -v151);
+    let v153 = q[0] * v9;
+    let v154 = v16 * v41;
+    let v155 = v153 + v154;
+    let v156 = v139 - v138;
+    let v157 = v5.mul_add(v41, v13);
+    let v158 = v33 * v157;
+    let v159 = v34.mul_add(v156, -v158);
+    let v160 = v34 * v155;
+    let v161 = v32.mul_add(v157, -v160);
+    let v162 = v32 * v156;
+    let v163 = v33.mul_add(v155, -v162);
+    let v164 = v110 * v157;
+    let v165 = v111.mul_add(v156, -v164);
+    let v166 = v111 * v155;
+    let v167 = v109.mul_add(v157, -v166);
+    let v168 = v109 * v156;
+    let v169 = v110.mul_add(v155, -v168);
+    let v170 = v3.mul_add(v41, v13);
+    let v171 = v134 + v135;
+    let v172 = v154 - v153;
+    let v173 = v33 * v172;
+    let v174 = v34.mul_add(v171, -v173);
+    let v175 = v34 * v170;
+    let v176 = v32.mul_add(v172, -v175);
+    let v177 = v32 * v171;
+    let v178 = v33.mul_add(v170, -v177);
+    let v179 = v110 * v172;
+    let v180 = v111.mul_add(v171, -v179);
+    let v181 = v111 * v170;
+    let v182 = v109.mul_add(v172, -v181);
+    let v183 = v109 * v171;
+    let v184 = v110.mul_add(v170, -v183);
+    let v187 = qd[0] * p[5];
+    let v188 = q[0].mul_add(p[4], v187);
+    let v190 = q[1] - p[6];
+    let v191 = qd[1] * p[5];
+    let v192 = p[4].mul_add(v190, v191);
+    let v195 = qd[2] * p[8];
+    let v196 = q[2].mul_add(p[7], v195);
+    let v200 = v67 * dir[2];
+    let v202 = v68.mul_add(dir[0], v200);
+    let v203 = v70.mul_add(dir[1], v202);
+    let v205 = v203 * v204;
+    let v206 = v73 * v203;
+    let v207 = v67 * v9;
+    let v208 = v3.mul_add(v206, v205);
+    let v209 = v207.mul_add(dir[2], v208);
+    let v210 = v138 * dir[0];
+    let v211 = v13 * dir[1];
+    let v212 = v84 * v203;
+    let v213 = q[1] * v212;
+    let v214 = v9 * dir[2];
+    let v215 = q[2] * v206;
+    let v216 = v214 + v215;
+    let v217 = q[0] * v216;
+    let v218 = v210 - v211;
+    let v219 = v218 - v213;
+    let v220 = v219 + v217;
+    let v221 = v138 * dir[1];
+    let v222 = v13 * dir[0];
+    let v223 = q[0] * v212;
+    let v224 = q[1] * v216;
+    let v225 = v221 + v222;
+    let v226 = v225 + v223;
+    let v227 = v226 + v224;
+    let v228 = v210 + v211;
+    let v229 = v228 + v213;
+    let v230 = v229 + v217;
+    let v231 = v68 * v9;
+    let v232 = v1.mul_add(v206, v205);
+    let v233 = v231.mul_add(dir[0], v232);
+    let v234 = v134 * dir[0];
+    let v235 = v13 * dir[2];
+    let v236 = q[2] * v212;
+    let v237 = v9 * dir[1];
+    let v238 = q[1] * v206;
+    let v239 = v237 + v238;
+    let v240 = q[0] * v239;
+    let v241 = v234 - v235;
+    let v242 = v241 - v236;
+    let v243 = v242 + v240;
+    let v244 = v221 - v222;
+    let v245 = v244 - v223;
+    let v246 = v245 + v224;
+    let v247 = v234 + v235;
+    let v248 = v247 + v236;
+    let v249 = v248 + v240;
+    let v250 = v70 * v9;
+    let v251 = v5.mul_add(v206, v205);
+    let v252 = v250.mul_add(dir[1], v251);
+    let v253 = v31 * v209;
+    let v254 = v31 * v230;
+    let v255 = v31 * v246;
+    let v257 = qd[0] * v212;
+    let v259 = q[1] * dir[5];
+    let v261 = qd[2].mul_add(dir[1], v259);
+    let v262 = (-qd[1]).mul_add(dir[2], v261);
+    let v263 = (-q[2]).mul_add(dir[4], v262);
+    let v264 = v75 * v203;
+    let v265 = v44 * v264;
+    let v266 = q[2] * dir[5];
+    let v267 = qd[2].mul_add(dir[2], v266);
+    let v268 = qd[0].mul_add(dir[0], v267);
+    let v269 = q[0].mul_add(dir[3], v268);
+    let v270 = qd[1].mul_add(dir[1], v269);
+    let v271 = q[1].mul_add(dir[4], v270);
+    let v272 = v41 * v271;
+    let v273 = v265 + v272;
+    let v274 = v13.mul_add(dir[3], v257);
+    let v275 = v39.mul_add(v206, v274);
+    let v276 = v9.mul_add(v263, v275);
+    let v277 = v83.mul_add(dir[0], v276);
+    let v278 = q[0].mul_add(v273, v277);
+    let v279 = v47 * v255;
+    let v280 = qd[1] * v212;
+    let v281 = q[2] * dir[3];
+    let v282 = qd[0].mul_add(dir[2], v281);
+    let v283 = (-qd[2]).mul_add(dir[0], v282);
+    let v284 = (-q[0]).mul_add(dir[5], v283);
+    let v285 = v13.mul_add(dir[4], v280);
+    let v286 = v49.mul_add(v206, v285);
+    let v287 = v9.mul_add(v284, v286);
+    let v288 = v83.mul_add(dir[1], v287);
+    let v289 = q[1].mul_add(v273, v288);
+    let v290 = v34.mul_add(v278, v279);
+    let v291 = (-v33).mul_add(v289, v290);
+    let v292 = (-v53).mul_add(v254, v291);
+    let v293 = v53 * v253;
+    let v294 = qd[2] * v212;
+    let v295 = q[0] * dir[4];
+    let v296 = qd[1].mul_add(dir[0], v295);
+    let v297 = (-qd[0]).mul_add(dir[1], v296);
+    let v298 = (-q[1]).mul_add(dir[3], v297);
+    let v299 = v13.mul_add(dir[5], v294);
+    let v300 = v57.mul_add(v206, v299);
+    let v301 = v9.mul_add(v298, v300);
+    let v302 = v83.mul_add(dir[2], v301);
+    let v303 = q[2].mul_add(v273, v302);
+    let v304 = v32.mul_add(v289, v293);
+    let v305 = (-v34).mul_add(v303, v304);
+    let v306 = (-v61).mul_add(v255, v305);
+    let v307 = v61 * v254;
+    let v308 = v33.mul_add(v303, v307);
+    let v309 = (-v32).mul_add(v278, v308);
+    let v310 = (-v47).mul_add(v253, v309);
+    let v311 = v74 * v263;
+    let v312 = 2f64 * qd[2];
+    let v313 = v67 * dir[5];
+    let v314 = 2f64 * qd[0];
+    let v315 = 2f64 * qd[1];
+    let v316 = v312.mul_add(dir[2], v313);
+    let v317 = v314.mul_add(dir[0], v316);
+    let v318 = v68.mul_add(dir[3], v317);
+    let v319 = v315.mul_add(dir[1], v318);
+    let v320 = v70.mul_add(dir[4], v319);
+    let v322 = v72 * v203;
+    let v323 = v322 * v321;
+    let v324 = v73.mul_add(v320, v323);
+    let v326 = v322 * v325;
+    let v327 = v75.mul_add(v320, v326);
+    let v328 = v44 * v327;
+    let v329 = v315 * dir[4];
+    let v330 = v314.mul_add(dir[3], v329);
+    let v331 = v312.mul_add(dir[5], v330);
+    let v332 = v76.mul_add(v271, v328);
+    let v333 = v80.mul_add(v264, v332);
+    let v334 = v41.mul_add(v331, v333);
+    let v336 = v322 * v335;
+    let v337 = v84.mul_add(v320, v336);
+    let v338 = v337 + v265;
+    let v339 = v338 + v272;
+    let v340 = v80 * dir[0];
+    let v341 = v44.mul_add(dir[3], v340);
+    let v342 = v85.mul_add(dir[3], v311);
+    let v343 = v39.mul_add(v324, v342);
+    let v344 = v77.mul_add(dir[0], v343);
+    let v345 = q[0].mul_add(v334, v344);
+    let v346 = qd[0].mul_add(v339, v345);
+    let v347 = v41.mul_add(v341, v346);
+    let v348 = v34 * v347;
+    let v349 = v74 * v284;
+    let v350 = v80 * dir[1];
+    let v351 = v44.mul_add(dir[4], v350);
+    let v352 = v85.mul_add(dir[4], v349);
+    let v353 = v49.mul_add(v324, v352);
+    let v354 = v77.mul_add(dir[1], v353);
+    let v355 = q[1].mul_add(v334, v354);
+    let v356 = qd[1].mul_add(v339, v355);
+    let v357 = v41.mul_add(v351, v356);
+    let v358 = v88.mul_add(v255, v348);
+    let v359 = v65.mul_add(v278, v358);
+    let v360 = v47.mul_add(v310, v359);
+    let v361 = (-v92).mul_add(v254, v360);
+    let v362 = (-v33).mul_add(v357, v361);
+    let v363 = (-v63).mul_add(v289, v362);
+    let v364 = (-v53).mul_add(v306, v363);
+    let v365 = v32 * v357;
+    let v366 = v74 * v298;
+    let v367 = v80 * dir[2];
+    let v368 = v44.mul_add(dir[5], v367);
+    let v369 = v85.mul_add(dir[5], v366);
+    let v370 = v57.mul_add(v324, v369);
+    let v371 = v77.mul_add(dir[2], v370);
+    let v372 = q[2].mul_add(v334, v371);
+    let v373 = qd[2].mul_add(v339, v372);
+    let v374 = v41.mul_add(v368, v373);
+    let v375 = v92.mul_add(v253, v365);
+    let v376 = v55.mul_add(v289, v375);
+    let v377 = v53.mul_add(v292, v376);
+    let v378 = (-v99).mul_add(v255, v377);
+    let v379 = (-v34).mul_add(v374, v378);
+    let v380 = (-v65).mul_add(v303, v379);
+    let v381 = (-v61).mul_add(v310, v380);
+    let v382 = v33 * v374;
+    let v383 = v99.mul_add(v254, v382);
+    let v384 = v63.mul_add(v303, v383);
+    let v385 = v61.mul_add(v306, v384);
+    let v386 = (-v88).mul_add(v253, v385);
+    let v387 = (-v32).mul_add(v347, v386);
+    let v388 = (-v55).mul_add(v278, v387);
+    let v389 = (-v47).mul_add(v292, v388);
+    let v390 = v108 * v209;
+    let v391 = v108 * v230;
+    let v392 = v108 * v246;
+    let v393 = v47 * v392;
+    let v394 = v111.mul_add(v278, v393);
+    let v395 = (-v110).mul_add(v289, v394);
+    let v396 = (-v53).mul_add(v391, v395);
+    let v397 = v53 * v390;
+    let v398 = v109.mul_add(v289, v397);
+    let v399 = (-v111).mul_add(v303, v398);
+    let v400 = (-v61).mul_add(v392, v399);
+    let v401 = v61 * v391;
+    let v402 = v110.mul_add(v303, v401);
+    let v403 = (-v109).mul_add(v278, v402);
+    let v404 = (-v47).mul_add(v390, v403);
+    let v405 = v111 * v347;
+    let v406 = v88.mul_add(v392, v405);
+    let v407 = v117.mul_add(v278, v406);
+    let v408 = v47.mul_add(v404, v407);
+    let v409 = (-v92).mul_add(v391, v408);
+    let v410 = (-v110).mul_add(v357, v409);
+    let v411 = (-v115).mul_add(v289, v410);
+    let v412 = (-v53).mul_add(v400, v411);
+    let v413 = v109 * v357;
+    let v414 = v92.mul_add(v390, v413);
+    let v415 = v113.mul_add(v289, v414);
+    let v416 = v53.mul_add(v396, v415);
+    let v417 = (-v99).mul_add(v392, v416);
+    let v418 = (-v111).mul_add(v374, v417);
+    let v419 = (-v117).mul_add(v303, v418);
+    let v420 = (-v61).mul_add(v404, v419);
+    let v421 = v110 * v374;
+    let v422 = v99.mul_add(v391, v421);
+    let v423 = v115.mul_add(v303, v422);
+    let v424 = v61.mul_add(v400, v423);
+    let v425 = (-v88).mul_add(v390, v424);
+    let v426 = (-v109).mul_add(v347, v425);
+    let v427 = (-v113).mul_add(v278, v426);
+    let v428 = (-v47).mul_add(v396, v427);
+    let v429 = v59 * dir[0];
+    let v430 = q[2] * v264;
+    let v431 = v41.mul_add(dir[2], v430);
+    let v432 = q[0] * v431;
+    let v433 = v429 - v237;
+    let v434 = v433 - v238;
+    let v435 = v434 + v432;
+    let v436 = v68 * v41;
+    let v437 = v1.mul_add(v264, v212);
+    let v438 = v436.mul_add(dir[0], v437);
+    let v439 = v51 * dir[0];
+    let v440 = q[1] * v264;
+    let v441 = v41.mul_add(dir[1], v440);
+    let v442 = q[0] * v441;
+    let v443 = v216 + v439;
+    let v444 = v443 + v442;
+    let v445 = v34 * v438;
+    let v446 = v137.mul_add(v255, v445);
+    let v447 = (-v140).mul_add(v254, v446);
+    let v448 = (-v33).mul_add(v444, v447);
+    let v449 = v32 * v444;
+    let v450 = v140.mul_add(v253, v449);
+    let v451 = (-v136).mul_add(v255, v450);
+    let v452 = (-v34).mul_add(v435, v451);
+    let v453 = v33 * v435;
+    let v454 = v136.mul_add(v254, v453);
+    let v455 = (-v137).mul_add(v253, v454);
+    let v456 = (-v32).mul_add(v438, v455);
+    let v457 = v111 * v438;
+    let v458 = v137.mul_add(v392, v457);
+    let v459 = (-v140).mul_add(v391, v458);
+    let v460 = (-v110).mul_add(v444, v459);
+    let v461 = v109 * v444;
+    let v462 = v140.mul_add(v390, v461);
+    let v463 = (-v136).mul_add(v392, v462);
+    let v464 = (-v111).mul_add(v435, v463);
+    let v465 = v110 * v435;
+    let v466 = v136.mul_add(v391, v465);
+    let v467 = (-v137).mul_add(v390, v466);
+    let v468 = (-v109).mul_add(v438, v467);
+    let v469 = v9 * dir[0];
+    let v470 = q[0] * v206;
+    let v471 = v59 * dir[1];
+    let v472 = q[1] * v431;
+    let v473 = v469 + v470;
+    let v474 = v473 + v471;
+    let v475 = v474 + v472;
+    let v476 = v439 - v214;
+    let v477 = v476 - v215;
+    let v478 = v477 + v442;
+    let v479 = v70 * v41;
+    let v480 = v5.mul_add(v264, v212);
+    let v481 = v479.mul_add(dir[1], v480);
+    let v482 = v34 * v478;
+    let v483 = v156.mul_add(v255, v482);
+    let v484 = (-v157).mul_add(v254, v483);
+    let v485 = (-v33).mul_add(v481, v484);
+    let v486 = v32 * v481;
+    let v487 = v157.mul_add(v253, v486);
+    let v488 = (-v155).mul_add(v255, v487);
+    let v489 = (-v34).mul_add(v475, v488);
+    let v490 = v33 * v475;
+    let v491 = v155.mul_add(v254, v490);
+    let v492 = (-v156).mul_add(v253, v491);
+    let v493 = (-v32).mul_add(v478, v492);
+    let v494 = v111 * v478;
+    let v495 = v156.mul_add(v392, v494);
+    let v496 = (-v157).mul_add(v391, v495);
+    let v497 = (-v110).mul_add(v481, v496);
+    let v498 = v109 * v481;
+    let v499 = v157.mul_add(v390, v498);
+    let v500 = (-v155).mul_add(v392, v499);
+    let v501 = (-v111).mul_add(v475, v500);
+    let v502 = v110 * v475;
+    let v503 = v155.mul_add(v391, v502);
+    let v504 = (-v156).mul_add(v390, v503);
+    let v505 = (-v109).mul_add(v478, v504);
+    let v506 = v67 * v41;
+    let v507 = v3.mul_add(v264, v212);
+    let v508 = v506.mul_add(dir[2], v507);
+    let v509 = v239 + v429;
+    let v510 = v509 + v432;
+    let v511 = v471 - v469;
+    let v512 = v511 - v470;
+    let v513 = v512 + v472;
+    let v514 = v34 * v510;
+    let v515 = v171.mul_add(v255, v514);
+    let v516 = (-v172).mul_add(v254, v515);
+    let v517 = (-v33).mul_add(v513, v516);
+    let v518 = v32 * v513;
+    let v519 = v172.mul_add(v253, v518);
+    let v520 = (-v170).mul_add(v255, v519);
+    let v521 = (-v34).mul_add(v508, v520);
+    let v522 = v33 * v508;
+    let v523 = v170.mul_add(v254, v522);
+    let v524 = (-v171).mul_add(v253, v523);
+    let v525 = (-v32).mul_add(v510, v524);
+    let v526 = v111 * v510;
+    let v527 = v171.mul_add(v392, v526);
+    let v528 = (-v172).mul_add(v391, v527);
+    let v529 = (-v110).mul_add(v513, v528);
+    let v530 = v109 * v513;
+    let v531 = v172.mul_add(v390, v530);
+    let v532 = (-v170).mul_add(v392, v531);
+    let v533 = (-v111).mul_add(v508, v532);
+    let v534 = v110 * v508;
+    let v535 = v170.mul_add(v391, v534);
+    let v536 = (-v171).mul_add(v390, v535);
+    let v537 = (-v109).mul_add(v510, v536);
+    let v538 = p[5] * dir[3];
+    let v539 = p[4].mul_add(dir[0], v538);
+    let v540 = p[5] * dir[4];
+    let v541 = p[4].mul_add(dir[1], v540);
+    let v542 = p[8] * dir[5];
+    let v543 = p[7].mul_add(dir[2], v542);
+    out[0] = v10;
+    out[1] = v15;
+    out[2] = v19;
+    out[3] = v20;
+    out[4] = v21;
+    out[5] = v25;
+    out[6] = v26;
+    out[7] = v27;
+    out[8] = v28;
+    out[9] = v32;
+    out[10] = v33;
+    out[11] = v34;
+    out[12] = v55;
+    out[13] = v63;
+    out[14] = v65;
+    out[15] = v95;
+    out[16] = v102;
+    out[17] = v106;
+    out[18] = v61;
+    out[19] = v47;
+    out[20] = v53;
+    out[21] = v99;
+    out[22] = v88;
+    out[23] = v92;
+    out[24] = v109;
+    out[25] = v110;
+    out[26] = v111;
+    out[27] = v113;
+    out[28] = v115;
+    out[29] = v117;
+    out[30] = v121;
+    out[31] = v125;
+    out[32] = v129;
+    out[33] = v61;
+    out[34] = v47;
+    out[35] = v53;
+    out[36] = v99;
+    out[37] = v88;
+    out[38] = v92;
+    out[39] = v10;
+    out[40] = v20;
+    out[41] = v26;
+    out[42] = v131;
+    out[43] = p[2];
+    out[44] = p[3];
+    out[45] = v136;
+    out[46] = v137;
+    out[47] = v140;
+    out[48] = v142;
+    out[49] = v144;
+    out[50] = v146;
+    out[51] = v136;
+    out[52] = v137;
+    out[53] = v140;
+    out[54] = v148;
+    out[55] = v150;
+    out[56] = v152;
+    out[57] = v155;
+    out[58] = v156;
+    out[59] = v157;
+    out[60] = v159;
+    out[61] = v161;
+    out[62] = v163;
+    out[63] = v155;
+    out[64] = v156;
+    out[65] = v157;
+    out[66] = v165;
+    out[67] = v167;
+    out[68] = v169;
+    out[69] = v170;
+    out[70] = v171;
+    out[71] = v172;
+    out[72] = v174;
+    out[73] = v176;
+    out[74] = v178;
+    out[75] = v170;
+    out[76] = v171;
+    out[77] = v172;
+    out[78] = v180;
+    out[79] = v182;
+    out[80] = v184;
+    out[81] = v188;
+    out[82] = v192;
+    out[83] = v196;
+    out[84] = 0f64;
+    out[85] = 0f64;
+    out[86] = 0f64;
+    out[87] = v209;
+    out[88] = v220;
+    out[89] = v227;
+    out[90] = v230;
+    out[91] = v233;
+    out[92] = v243;
+    out[93] = v246;
+    out[94] = v249;
+    out[95] = v252;
+    out[96] = v253;
+    out[97] = v254;
+    out[98] = v255;
+    out[99] = v292;
+    out[100] = v306;
+    out[101] = v310;
+    out[102] = v364;
+    out[103] = v381;
+    out[104] = v389;
+    out[105] = v303;
+    out[106] = v278;
+    out[107] = v289;
+    out[108] = v374;
+    out[109] = v347;
+    out[110] = v357;
+    out[111] = v390;
+    out[112] = v391;
+    out[113] = v392;
+    out[114] = v396;
+    out[115] = v400;
+    out[116] = v404;
+    out[117] = v412;
+    out[118] = v420;
+    out[119] = v428;
+    out[120] = v303;
+    out[121] = v278;
+    out[122] = v289;
+    out[123] = v374;
+    out[124] = v347;
+    out[125] = v357;
+    out[126] = v209;
+    out[127] = v230;
+    out[128] = v246;
+    out[129] = 0f64;
+    out[130] = 0f64;
+    out[131] = 0f64;
+    out[132] = v435;
+    out[133] = v438;
+    out[134] = v444;
+    out[135] = v448;
+    out[136] = v452;
+    out[137] = v456;
+    out[138] = v435;
+    out[139] = v438;
+    out[140] = v444;
+    out[141] = v460;
+    out[142] = v464;
+    out[143] = v468;
+    out[144] = v475;
+    out[145] = v478;
+    out[146] = v481;
+    out[147] = v485;
+    out[148] = v489;
+    out[149] = v493;
+    out[150] = v475;
+    out[151] = v478;
+    out[152] = v481;
+    out[153] = v497;
+    out[154] = v501;
+    out[155] = v505;
+    out[156] = v508;
+    out[157] = v510;
+    out[158] = v513;
+    out[159] = v517;
+    out[160] = v521;
+    out[161] = v525;
+    out[162] = v508;
+    out[163] = v510;
+    out[164] = v513;
+    out[165] = v529;
+    out[166] = v533;
+    out[167] = v537;
+    out[168] = v539;
+    out[169] = v541;
+    out[170] = v543;
+    out[171] = 0f64;
+    out[172] = 0f64;
+    out[173] = 0f64;
 }
 /// Kernel `cell_1_pose`: 3 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_1_pose(
     t: f64,
-    q: &[f64; 0usize],
-    qd: &[f64; 0usize],
-    qdd: &[f64; 0usize],
-    dir: &[f64; 0usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 0],
+    qd: &[f64; 0],
+    qdd: &[f64; 0],
+    dir: &[f64; 0],
+    p: &[f64; 15],
+    out: &mut [f64; 38],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2568,66 +2544,66 @@ pub fn cell_1_pose(
 #[allow(unused_variables, clippy::all)]
 fn cell_1_pose_0(
     t: f64,
-    q: &[f64; 0usize],
-    qd: &[f64; 0usize],
-    qdd: &[f64; 0usize],
-    dir: &[f64; 0usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 0],
+    qd: &[f64; 0],
+    qdd: &[f64; 0],
+    dir: &[f64; 0],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 38],
 ) {
-    let v4: f64 = 0.5f64 * p[0usize];
-    let v6: f64 = 0.25f64 * p[0usize];
-    let v8: f64 = 0.5f64 * p[1usize];
-    out[0usize] = 1f64;
-    out[1usize] = 0f64;
-    out[2usize] = 0f64;
-    out[3usize] = 0f64;
-    out[4usize] = 1f64;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v4;
-    out[10usize] = 0f64;
-    out[11usize] = 0f64;
-    out[12usize] = 0f64;
-    out[13usize] = 0f64;
-    out[14usize] = 0f64;
-    out[15usize] = 0f64;
-    out[16usize] = 0f64;
-    out[17usize] = 0f64;
-    out[18usize] = v6;
-    out[19usize] = 0f64;
-    out[20usize] = 0f64;
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = 0f64;
-    out[25usize] = 0f64;
-    out[26usize] = 0f64;
-    out[27usize] = 1f64;
-    out[28usize] = 0f64;
-    out[29usize] = 0f64;
-    out[30usize] = v8;
-    out[31usize] = p[2usize];
-    out[32usize] = p[3usize];
-    out[33usize] = 1f64;
-    out[34usize] = 0f64;
-    out[35usize] = 0f64;
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
+    let v4 = 0.5f64 * p[0];
+    let v6 = 0.25f64 * p[0];
+    let v8 = 0.5f64 * p[1];
+    out[0] = 1f64;
+    out[1] = 0f64;
+    out[2] = 0f64;
+    out[3] = 0f64;
+    out[4] = 1f64;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v4;
+    out[10] = 0f64;
+    out[11] = 0f64;
+    out[12] = 0f64;
+    out[13] = 0f64;
+    out[14] = 0f64;
+    out[15] = 0f64;
+    out[16] = 0f64;
+    out[17] = 0f64;
+    out[18] = v6;
+    out[19] = 0f64;
+    out[20] = 0f64;
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = 0f64;
+    out[25] = 0f64;
+    out[26] = 0f64;
+    out[27] = 1f64;
+    out[28] = 0f64;
+    out[29] = 0f64;
+    out[30] = v8;
+    out[31] = p[2];
+    out[32] = p[3];
+    out[33] = 1f64;
+    out[34] = 0f64;
+    out[35] = 0f64;
+    out[36] = 0f64;
+    out[37] = 0f64;
 }
 /// Kernel `cell_1`: 3 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_1(
     t: f64,
-    q: &[f64; 0usize],
-    qd: &[f64; 0usize],
-    qdd: &[f64; 0usize],
-    dir: &[f64; 0usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 45usize],
+    q: &[f64; 0],
+    qd: &[f64; 0],
+    qdd: &[f64; 0],
+    dir: &[f64; 0],
+    p: &[f64; 15],
+    out: &mut [f64; 45],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2638,62 +2614,62 @@ pub fn cell_1(
 #[allow(unused_variables, clippy::all)]
 fn cell_1_0(
     t: f64,
-    q: &[f64; 0usize],
-    qd: &[f64; 0usize],
-    qdd: &[f64; 0usize],
-    dir: &[f64; 0usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 45usize],
+    q: &[f64; 0],
+    qd: &[f64; 0],
+    qdd: &[f64; 0],
+    dir: &[f64; 0],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 45],
 ) {
-    let v4: f64 = 0.5f64 * p[0usize];
-    let v6: f64 = 0.25f64 * p[0usize];
-    let v8: f64 = 0.5f64 * p[1usize];
-    out[0usize] = 1f64;
-    out[1usize] = 0f64;
-    out[2usize] = 0f64;
-    out[3usize] = 0f64;
-    out[4usize] = 1f64;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v4;
-    out[10usize] = 0f64;
-    out[11usize] = 0f64;
-    out[12usize] = 0f64;
-    out[13usize] = 0f64;
-    out[14usize] = 0f64;
-    out[15usize] = 0f64;
-    out[16usize] = 0f64;
-    out[17usize] = 0f64;
-    out[18usize] = 0f64;
-    out[19usize] = 0f64;
-    out[20usize] = 0f64;
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = v6;
-    out[25usize] = 0f64;
-    out[26usize] = 0f64;
-    out[27usize] = 0f64;
-    out[28usize] = 0f64;
-    out[29usize] = 0f64;
-    out[30usize] = 0f64;
-    out[31usize] = 0f64;
-    out[32usize] = 0f64;
-    out[33usize] = 0f64;
-    out[34usize] = 0f64;
-    out[35usize] = 0f64;
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
-    out[38usize] = 0f64;
-    out[39usize] = 1f64;
-    out[40usize] = 0f64;
-    out[41usize] = 0f64;
-    out[42usize] = v8;
-    out[43usize] = p[2usize];
-    out[44usize] = p[3usize];
+    let v4 = 0.5f64 * p[0];
+    let v6 = 0.25f64 * p[0];
+    let v8 = 0.5f64 * p[1];
+    out[0] = 1f64;
+    out[1] = 0f64;
+    out[2] = 0f64;
+    out[3] = 0f64;
+    out[4] = 1f64;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v4;
+    out[10] = 0f64;
+    out[11] = 0f64;
+    out[12] = 0f64;
+    out[13] = 0f64;
+    out[14] = 0f64;
+    out[15] = 0f64;
+    out[16] = 0f64;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = 0f64;
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = v6;
+    out[25] = 0f64;
+    out[26] = 0f64;
+    out[27] = 0f64;
+    out[28] = 0f64;
+    out[29] = 0f64;
+    out[30] = 0f64;
+    out[31] = 0f64;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = 0f64;
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 1f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = v8;
+    out[43] = p[2];
+    out[44] = p[3];
 }
 /// Kernel `cell_1_x4`: 3 operations, four evaluations in vector lanes.
 #[cfg(target_arch = "x86_64")]
@@ -2701,80 +2677,71 @@ fn cell_1_0(
 #[allow(unused_variables, unused_parens, clippy::all)]
 #[target_feature(enable = "avx,fma")]
 fn cell_1_x4(
-    q: &[[f64; 4]; 0usize],
-    qd: &[[f64; 4]; 0usize],
-    p: &[[f64; 4]; 15usize],
-    out: &mut [[f64; 4]; 45usize],
+    q: &[[f64; 4]; 0],
+    qd: &[[f64; 4]; 0],
+    p: &[[f64; 4]; 15],
+    out: &mut [[f64; 4]; 45],
 ) {
     use std::arch::x86_64::*;
-    let v4: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(p[0usize]),
-    );
-    let v6: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(p[0usize]),
-    );
-    let v8: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(p[1usize]),
-    );
-    out[0usize] = runtime::lanes::to_array(_mm256_set1_pd(1f64));
-    out[1usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[2usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[3usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[4usize] = runtime::lanes::to_array(_mm256_set1_pd(1f64));
-    out[5usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[6usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[7usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[8usize] = runtime::lanes::to_array(_mm256_set1_pd(1f64));
-    out[9usize] = runtime::lanes::to_array(v4);
-    out[10usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[11usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[12usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[13usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[14usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[15usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[16usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[17usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[18usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[19usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[20usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[21usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[22usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[23usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[24usize] = runtime::lanes::to_array(v6);
-    out[25usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[26usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[27usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[28usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[29usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[30usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[31usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[32usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[33usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[34usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[35usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[36usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[37usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[38usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[39usize] = runtime::lanes::to_array(_mm256_set1_pd(1f64));
-    out[40usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[41usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[42usize] = runtime::lanes::to_array(v8);
-    out[43usize] = runtime::lanes::to_array(runtime::lanes::from_array(p[2usize]));
-    out[44usize] = runtime::lanes::to_array(runtime::lanes::from_array(p[3usize]));
+    let v4 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[0]));
+    let v6 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(p[0]));
+    let v8 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[1]));
+    out[0] = runtime::lanes::to_array(_mm256_set1_pd(1f64));
+    out[1] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[2] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[3] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[4] = runtime::lanes::to_array(_mm256_set1_pd(1f64));
+    out[5] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[6] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[7] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[8] = runtime::lanes::to_array(_mm256_set1_pd(1f64));
+    out[9] = runtime::lanes::to_array(v4);
+    out[10] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[11] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[12] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[13] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[14] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[15] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[16] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[17] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[18] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[19] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[20] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[21] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[22] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[23] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[24] = runtime::lanes::to_array(v6);
+    out[25] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[26] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[27] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[28] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[29] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[30] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[31] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[32] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[33] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[34] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[35] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[36] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[37] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[38] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[39] = runtime::lanes::to_array(_mm256_set1_pd(1f64));
+    out[40] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[41] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[42] = runtime::lanes::to_array(v8);
+    out[43] = runtime::lanes::to_array(runtime::lanes::from_array(p[2]));
+    out[44] = runtime::lanes::to_array(runtime::lanes::from_array(p[3]));
 }
 /// Kernel `cell_1_tangent`: 3 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_1_tangent(
     t: f64,
-    q: &[f64; 0usize],
-    qd: &[f64; 0usize],
-    qdd: &[f64; 0usize],
-    dir: &[f64; 0usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 90usize],
+    q: &[f64; 0],
+    qd: &[f64; 0],
+    qdd: &[f64; 0],
+    dir: &[f64; 0],
+    p: &[f64; 15],
+    out: &mut [f64; 90],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2785,115 +2752,115 @@ pub fn cell_1_tangent(
 #[allow(unused_variables, clippy::all)]
 fn cell_1_tangent_0(
     t: f64,
-    q: &[f64; 0usize],
-    qd: &[f64; 0usize],
-    qdd: &[f64; 0usize],
-    dir: &[f64; 0usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 90usize],
+    q: &[f64; 0],
+    qd: &[f64; 0],
+    qdd: &[f64; 0],
+    dir: &[f64; 0],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 90],
 ) {
-    let v4: f64 = 0.5f64 * p[0usize];
-    let v6: f64 = 0.25f64 * p[0usize];
-    let v8: f64 = 0.5f64 * p[1usize];
-    out[0usize] = 1f64;
-    out[1usize] = 0f64;
-    out[2usize] = 0f64;
-    out[3usize] = 0f64;
-    out[4usize] = 1f64;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v4;
-    out[10usize] = 0f64;
-    out[11usize] = 0f64;
-    out[12usize] = 0f64;
-    out[13usize] = 0f64;
-    out[14usize] = 0f64;
-    out[15usize] = 0f64;
-    out[16usize] = 0f64;
-    out[17usize] = 0f64;
-    out[18usize] = 0f64;
-    out[19usize] = 0f64;
-    out[20usize] = 0f64;
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = v6;
-    out[25usize] = 0f64;
-    out[26usize] = 0f64;
-    out[27usize] = 0f64;
-    out[28usize] = 0f64;
-    out[29usize] = 0f64;
-    out[30usize] = 0f64;
-    out[31usize] = 0f64;
-    out[32usize] = 0f64;
-    out[33usize] = 0f64;
-    out[34usize] = 0f64;
-    out[35usize] = 0f64;
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
-    out[38usize] = 0f64;
-    out[39usize] = 1f64;
-    out[40usize] = 0f64;
-    out[41usize] = 0f64;
-    out[42usize] = v8;
-    out[43usize] = p[2usize];
-    out[44usize] = p[3usize];
-    out[45usize] = 0f64;
-    out[46usize] = 0f64;
-    out[47usize] = 0f64;
-    out[48usize] = 0f64;
-    out[49usize] = 0f64;
-    out[50usize] = 0f64;
-    out[51usize] = 0f64;
-    out[52usize] = 0f64;
-    out[53usize] = 0f64;
-    out[54usize] = 0f64;
-    out[55usize] = 0f64;
-    out[56usize] = 0f64;
-    out[57usize] = 0f64;
-    out[58usize] = 0f64;
-    out[59usize] = 0f64;
-    out[60usize] = 0f64;
-    out[61usize] = 0f64;
-    out[62usize] = 0f64;
-    out[63usize] = 0f64;
-    out[64usize] = 0f64;
-    out[65usize] = 0f64;
-    out[66usize] = 0f64;
-    out[67usize] = 0f64;
-    out[68usize] = 0f64;
-    out[69usize] = 0f64;
-    out[70usize] = 0f64;
-    out[71usize] = 0f64;
-    out[72usize] = 0f64;
-    out[73usize] = 0f64;
-    out[74usize] = 0f64;
-    out[75usize] = 0f64;
-    out[76usize] = 0f64;
-    out[77usize] = 0f64;
-    out[78usize] = 0f64;
-    out[79usize] = 0f64;
-    out[80usize] = 0f64;
-    out[81usize] = 0f64;
-    out[82usize] = 0f64;
-    out[83usize] = 0f64;
-    out[84usize] = 0f64;
-    out[85usize] = 0f64;
-    out[86usize] = 0f64;
-    out[87usize] = 0f64;
-    out[88usize] = 0f64;
-    out[89usize] = 0f64;
+    let v4 = 0.5f64 * p[0];
+    let v6 = 0.25f64 * p[0];
+    let v8 = 0.5f64 * p[1];
+    out[0] = 1f64;
+    out[1] = 0f64;
+    out[2] = 0f64;
+    out[3] = 0f64;
+    out[4] = 1f64;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v4;
+    out[10] = 0f64;
+    out[11] = 0f64;
+    out[12] = 0f64;
+    out[13] = 0f64;
+    out[14] = 0f64;
+    out[15] = 0f64;
+    out[16] = 0f64;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = 0f64;
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = v6;
+    out[25] = 0f64;
+    out[26] = 0f64;
+    out[27] = 0f64;
+    out[28] = 0f64;
+    out[29] = 0f64;
+    out[30] = 0f64;
+    out[31] = 0f64;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = 0f64;
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 1f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = v8;
+    out[43] = p[2];
+    out[44] = p[3];
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 0f64;
+    out[48] = 0f64;
+    out[49] = 0f64;
+    out[50] = 0f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 0f64;
+    out[54] = 0f64;
+    out[55] = 0f64;
+    out[56] = 0f64;
+    out[57] = 0f64;
+    out[58] = 0f64;
+    out[59] = 0f64;
+    out[60] = 0f64;
+    out[61] = 0f64;
+    out[62] = 0f64;
+    out[63] = 0f64;
+    out[64] = 0f64;
+    out[65] = 0f64;
+    out[66] = 0f64;
+    out[67] = 0f64;
+    out[68] = 0f64;
+    out[69] = 0f64;
+    out[70] = 0f64;
+    out[71] = 0f64;
+    out[72] = 0f64;
+    out[73] = 0f64;
+    out[74] = 0f64;
+    out[75] = 0f64;
+    out[76] = 0f64;
+    out[77] = 0f64;
+    out[78] = 0f64;
+    out[79] = 0f64;
+    out[80] = 0f64;
+    out[81] = 0f64;
+    out[82] = 0f64;
+    out[83] = 0f64;
+    out[84] = 0f64;
+    out[85] = 0f64;
+    out[86] = 0f64;
+    out[87] = 0f64;
+    out[88] = 0f64;
+    out[89] = 0f64;
 }
 fn cell_0_linked(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
     cell_0(
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 3usize],
-        &[0.0; 6usize],
+        &[0.0; 3],
+        &[0.0; 6],
         p.try_into().expect("cell parameters"),
         out.try_into().expect("cell outputs"),
     )
@@ -2927,14 +2894,14 @@ fn cell_0_tangent_linked(
     p: &[f64],
     out: &mut [f64],
 ) {
-    let mut dir = [0.0; 6usize];
-    dir[..3usize].copy_from_slice(dx);
-    dir[3usize..].copy_from_slice(dxd);
+    let mut dir = [0.0; 6];
+    dir[..3].copy_from_slice(dx);
+    dir[3..].copy_from_slice(dxd);
     cell_0_tangent(
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 3usize],
+        &[0.0; 3],
         &dir,
         p.try_into().expect("cell parameters"),
         out.try_into().expect("cell outputs and derivatives"),
@@ -2945,8 +2912,8 @@ fn cell_0_pose_linked(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 3usize],
-        &[0.0; 6usize],
+        &[0.0; 3],
+        &[0.0; 6],
         p.try_into().expect("cell parameters"),
         out.try_into().expect("pose outputs"),
     )
@@ -2956,8 +2923,8 @@ fn cell_1_linked(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 0usize],
-        &[0.0; 0usize],
+        &[0.0; 0],
+        &[0.0; 0],
         p.try_into().expect("cell parameters"),
         out.try_into().expect("cell outputs"),
     )
@@ -2991,14 +2958,14 @@ fn cell_1_tangent_linked(
     p: &[f64],
     out: &mut [f64],
 ) {
-    let mut dir = [0.0; 0usize];
-    dir[..0usize].copy_from_slice(dx);
-    dir[0usize..].copy_from_slice(dxd);
+    let mut dir = [0.0; 0];
+    dir[..0].copy_from_slice(dx);
+    dir[0..].copy_from_slice(dxd);
     cell_1_tangent(
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 0usize],
+        &[0.0; 0],
         &dir,
         p.try_into().expect("cell parameters"),
         out.try_into().expect("cell outputs and derivatives"),
@@ -3009,8 +2976,8 @@ fn cell_1_pose_linked(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 0usize],
-        &[0.0; 0usize],
+        &[0.0; 0],
+        &[0.0; 0],
         p.try_into().expect("cell parameters"),
         out.try_into().expect("pose outputs"),
     )

@@ -4,7 +4,7 @@
 use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
 /// Structural hash of the model this was derived from.
 pub const HASH: &str = "15f276d235aba863";
-pub const DOF: usize = 7usize;
+pub const DOF: usize = 7;
 pub const COORDINATES: &[&str] = &[
     "theta_0_0",
     "theta_1_0",
@@ -67,21 +67,21 @@ pub const PARAMETERS: &[&str] = &[
     "joint[6].rest",
 ];
 /// Derived parameters, computed once per parameter set.
-pub const DERIVED: usize = 68usize;
+pub const DERIVED: usize = 68;
 /// Whether the mass solve is generated (the `accel` kernel).
 pub const ACCEL: bool = true;
 /// Base parameters that are loads (scaled by load continuation).
-pub const LOADS: &[usize] = &[0usize, 1usize, 2usize];
+pub const LOADS: &[usize] = &[0, 1, 2];
 /// The rows of the joints' constraint equations.
 pub const CONSTRAINTS: &[&str] = &[];
 /// Coordinates per independent subsystem (M block diagonal).
 pub const BLOCKS: &[usize] = &[];
 /// Contact points along the arms and at the bodies.
-pub const CONTACT_POINTS: usize = 0usize;
+pub const CONTACT_POINTS: usize = 0;
 /// Points per group of the `contact_jacobian` kernel.
 pub const CONTACT_GROUPS: &[usize] = &[];
 /// Length of the contact frames the `contact_jacobian` groups read.
-pub const CONTACT_FRAMES: usize = 0usize;
+pub const CONTACT_FRAMES: usize = 0;
 /// The compiled kernels of this structure.
 pub struct Compiled {
     info: ModelInfo,
@@ -113,17 +113,17 @@ impl Kernels for Compiled {
         "compiled"
     }
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
-        let q: &[f64; 7usize] = inp.q.try_into().expect("q has DOF entries");
-        let qd: &[f64; 7usize] = inp.qd.try_into().expect("qd has DOF entries");
-        let p: &[f64; 118usize] = inp.p.try_into().expect("parameter vector length");
-        let no_qdd = [0.0f64; 7usize];
-        let qdd: &[f64; 7usize] = if inp.qdd.is_empty() {
+        let q: &[f64; 7] = inp.q.try_into().expect("q has DOF entries");
+        let qd: &[f64; 7] = inp.qd.try_into().expect("qd has DOF entries");
+        let p: &[f64; 118] = inp.p.try_into().expect("parameter vector length");
+        let no_qdd = [0.0f64; 7];
+        let qdd: &[f64; 7] = if inp.qdd.is_empty() {
             &no_qdd
         } else {
             inp.qdd.try_into().expect("qdd has DOF entries")
         };
-        let no_dir = [0.0f64; 14usize];
-        let dir: &[f64; 14usize] = if inp.dir.is_empty() {
+        let no_dir = [0.0f64; 14];
+        let dir: &[f64; 14] = if inp.dir.is_empty() {
             &no_dir
         } else {
             inp.dir.try_into().expect("dir has 2 DOF entries")
@@ -220,12 +220,12 @@ impl Kernels for Compiled {
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    out: &mut [f64; 35usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    out: &mut [f64; 35],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -235,27 +235,27 @@ pub fn accel(
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
 fn accel_fma(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 35usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    w: &mut [f64; 0],
+    out: &mut [f64; 35],
 ) {
-    let mut unused = [0.0f64; 35usize];
+    let mut unused = [0.0f64; 35];
     eom_0(t, q, qd, qdd, dir, p, w, out, &mut unused);
 }
 /// Kernel `mass_bias`: the last 35 values of `eom` (1709 operations for all).
 #[allow(unused_unsafe)]
 pub fn mass_bias(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    out: &mut [f64; 35usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    out: &mut [f64; 35],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -265,1260 +265,1248 @@ pub fn mass_bias(
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
 fn mass_bias_fma(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 35usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    w: &mut [f64; 0],
+    out: &mut [f64; 35],
 ) {
-    let mut unused = [0.0f64; 35usize];
+    let mut unused = [0.0f64; 35];
     eom_0(t, q, qd, qdd, dir, p, w, &mut unused, out);
 }
 #[inline(always)]
 #[allow(unused_variables, clippy::all)]
 fn eom_0(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 35usize],
-    out2: &mut [f64; 35usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    w: &mut [f64; 0],
+    out: &mut [f64; 35],
+    out2: &mut [f64; 35],
 ) {
-    let [v4, v313, v1015]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[1usize]);
-    let v6: f64 = 2f64 * v4;
-    let v8: f64 = 0.5f64 * q[1usize];
-    let [v9, v303, v716]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v8);
-    let v10: f64 = v9.powi(4i32);
-    let v12: f64 = q[1usize] * q[1usize];
-    let v13: f64 = v4 * v4;
-    let v14: f64 = (-0.25f64).mul_add(v10, v6);
-    let v15: f64 = (-v12).mul_add(v13, v14);
-    let [v19, v356, v986]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[2usize]);
-    let v20: f64 = 2f64 * v19;
-    let v21: f64 = 0.5f64 * q[2usize];
-    let [v22, v346, v728]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v21);
-    let v23: f64 = v22.powi(4i32);
-    let v24: f64 = q[2usize] * q[2usize];
-    let v25: f64 = v19 * v19;
-    let v26: f64 = (-0.25f64).mul_add(v23, v20);
-    let v27: f64 = (-v24).mul_add(v25, v26);
-    let [v31, v405, v957]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[3usize]);
-    let v32: f64 = 2f64 * v31;
-    let v33: f64 = 0.5f64 * q[3usize];
-    let [v34, v395, v740]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v33);
-    let v35: f64 = v34.powi(4i32);
-    let v36: f64 = q[3usize] * q[3usize];
-    let v37: f64 = v31 * v31;
-    let v38: f64 = (-0.25f64).mul_add(v35, v32);
-    let v39: f64 = (-v36).mul_add(v37, v38);
-    let [v43, v461, v928]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[4usize]);
-    let v44: f64 = 2f64 * v43;
-    let v45: f64 = 0.5f64 * q[4usize];
-    let [v46, v451, v752]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v45);
-    let v47: f64 = v46.powi(4i32);
-    let v48: f64 = q[4usize] * q[4usize];
-    let v49: f64 = v43 * v43;
-    let v50: f64 = (-0.25f64).mul_add(v47, v44);
-    let v51: f64 = (-v48).mul_add(v49, v50);
-    let [v55, v525, v899]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[5usize]);
-    let v56: f64 = 2f64 * v55;
-    let v57: f64 = 0.5f64 * q[5usize];
-    let [v58, v515, v764]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v57);
-    let v59: f64 = v58.powi(4i32);
-    let v60: f64 = q[5usize] * q[5usize];
-    let v61: f64 = v55 * v55;
-    let v62: f64 = (-0.25f64).mul_add(v59, v56);
-    let v63: f64 = (-v60).mul_add(v61, v62);
-    let [v67, v601, v783]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[6usize]);
-    let v68: f64 = 2f64 * v67;
-    let v69: f64 = 0.5f64 * q[6usize];
-    let [v70, v588, v772]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v69);
-    let v71: f64 = v70.powi(4i32);
-    let v72: f64 = q[6usize] * q[6usize];
-    let v73: f64 = v67 * v67;
-    let v74: f64 = (-0.25f64).mul_add(v71, v68);
-    let v75: f64 = (-v72).mul_add(v73, v74);
-    let v81: f64 = p[6usize] + q[0usize];
+    let [v4, v313, v1015]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[1]);
+    let v6 = 2f64 * v4;
+    let v8 = 0.5f64 * q[1];
+    let [v9, v303, v716]: [f64; 3] = runtime::special::sinc_orders::<3>(v8);
+    let v10 = v9.powi(4i32);
+    let v12 = q[1] * q[1];
+    let v13 = v4 * v4;
+    let v14 = (-0.25f64).mul_add(v10, v6);
+    let v15 = (-v12).mul_add(v13, v14);
+    let [v19, v356, v986]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[2]);
+    let v20 = 2f64 * v19;
+    let v21 = 0.5f64 * q[2];
+    let [v22, v346, v728]: [f64; 3] = runtime::special::sinc_orders::<3>(v21);
+    let v23 = v22.powi(4i32);
+    let v24 = q[2] * q[2];
+    let v25 = v19 * v19;
+    let v26 = (-0.25f64).mul_add(v23, v20);
+    let v27 = (-v24).mul_add(v25, v26);
+    let [v31, v405, v957]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[3]);
+    let v32 = 2f64 * v31;
+    let v33 = 0.5f64 * q[3];
+    let [v34, v395, v740]: [f64; 3] = runtime::special::sinc_orders::<3>(v33);
+    let v35 = v34.powi(4i32);
+    let v36 = q[3] * q[3];
+    let v37 = v31 * v31;
+    let v38 = (-0.25f64).mul_add(v35, v32);
+    let v39 = (-v36).mul_add(v37, v38);
+    let [v43, v461, v928]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[4]);
+    let v44 = 2f64 * v43;
+    let v45 = 0.5f64 * q[4];
+    let [v46, v451, v752]: [f64; 3] = runtime::special::sinc_orders::<3>(v45);
+    let v47 = v46.powi(4i32);
+    let v48 = q[4] * q[4];
+    let v49 = v43 * v43;
+    let v50 = (-0.25f64).mul_add(v47, v44);
+    let v51 = (-v48).mul_add(v49, v50);
+    let [v55, v525, v899]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[5]);
+    let v56 = 2f64 * v55;
+    let v57 = 0.5f64 * q[5];
+    let [v58, v515, v764]: [f64; 3] = runtime::special::sinc_orders::<3>(v57);
+    let v59 = v58.powi(4i32);
+    let v60 = q[5] * q[5];
+    let v61 = v55 * v55;
+    let v62 = (-0.25f64).mul_add(v59, v56);
+    let v63 = (-v60).mul_add(v61, v62);
+    let [v67, v601, v783]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[6]);
+    let v68 = 2f64 * v67;
+    let v69 = 0.5f64 * q[6];
+    let [v70, v588, v772]: [f64; 3] = runtime::special::sinc_orders::<3>(v69);
+    let v71 = v70.powi(4i32);
+    let v72 = q[6] * q[6];
+    let v73 = v67 * v67;
+    let v74 = (-0.25f64).mul_add(v71, v68);
+    let v75 = (-v72).mul_add(v73, v74);
+    let v81 = p[6] + q[0];
     let (v86, v82): (f64, f64) = runtime::special::sin_cos(v81);
-    let v83: f64 = p[8usize] * v82;
-    let v84: f64 = p[3usize] + v83;
+    let v83 = p[8] * v82;
+    let v84 = p[3] + v83;
     let (v87, v88): (f64, f64) = runtime::special::sin_cos(v8);
-    let v89: f64 = v86 * v87;
-    let v90: f64 = v82.mul_add(v88, -v89);
-    let v91: f64 = p[14usize] * v9;
-    let v92: f64 = v91.mul_add(v90, v84);
-    let v94: f64 = v82 * v87;
-    let v95: f64 = v86.mul_add(v88, v94);
-    let v96: f64 = v90 * v87;
-    let v97: f64 = v95.mul_add(v88, v96);
-    let v98: f64 = v95 * v87;
-    let v99: f64 = v90.mul_add(v88, -v98);
+    let v89 = v86 * v87;
+    let v90 = v82.mul_add(v88, -v89);
+    let v91 = p[14] * v9;
+    let v92 = v91.mul_add(v90, v84);
+    let v94 = v82 * v87;
+    let v95 = v86.mul_add(v88, v94);
+    let v96 = v90 * v87;
+    let v97 = v95.mul_add(v88, v96);
+    let v98 = v95 * v87;
+    let v99 = v90.mul_add(v88, -v98);
     let (v100, v101): (f64, f64) = runtime::special::sin_cos(v21);
-    let v102: f64 = v97 * v100;
-    let v103: f64 = v99.mul_add(v101, -v102);
-    let v104: f64 = p[20usize] * v22;
-    let v105: f64 = v104.mul_add(v103, v92);
-    let v107: f64 = v99 * v100;
-    let v108: f64 = v97.mul_add(v101, v107);
-    let v109: f64 = v103 * v100;
-    let v110: f64 = v108.mul_add(v101, v109);
-    let v111: f64 = v108 * v100;
-    let v112: f64 = v103.mul_add(v101, -v111);
+    let v102 = v97 * v100;
+    let v103 = v99.mul_add(v101, -v102);
+    let v104 = p[20] * v22;
+    let v105 = v104.mul_add(v103, v92);
+    let v107 = v99 * v100;
+    let v108 = v97.mul_add(v101, v107);
+    let v109 = v103 * v100;
+    let v110 = v108.mul_add(v101, v109);
+    let v111 = v108 * v100;
+    let v112 = v103.mul_add(v101, -v111);
     let (v113, v114): (f64, f64) = runtime::special::sin_cos(v33);
-    let v115: f64 = v110 * v113;
-    let v116: f64 = v112.mul_add(v114, -v115);
-    let v117: f64 = p[26usize] * v34;
-    let v118: f64 = v117.mul_add(v116, v105);
-    let v120: f64 = v112 * v113;
-    let v121: f64 = v110.mul_add(v114, v120);
-    let v122: f64 = v116 * v113;
-    let v123: f64 = v121.mul_add(v114, v122);
-    let v124: f64 = v121 * v113;
-    let v125: f64 = v116.mul_add(v114, -v124);
+    let v115 = v110 * v113;
+    let v116 = v112.mul_add(v114, -v115);
+    let v117 = p[26] * v34;
+    let v118 = v117.mul_add(v116, v105);
+    let v120 = v112 * v113;
+    let v121 = v110.mul_add(v114, v120);
+    let v122 = v116 * v113;
+    let v123 = v121.mul_add(v114, v122);
+    let v124 = v121 * v113;
+    let v125 = v116.mul_add(v114, -v124);
     let (v126, v127): (f64, f64) = runtime::special::sin_cos(v45);
-    let v128: f64 = v123 * v126;
-    let v129: f64 = v125.mul_add(v127, -v128);
-    let v130: f64 = p[32usize] * v46;
-    let v131: f64 = v130.mul_add(v129, v118);
-    let v133: f64 = v125 * v126;
-    let v134: f64 = v123.mul_add(v127, v133);
-    let v135: f64 = v129 * v126;
-    let v136: f64 = v134.mul_add(v127, v135);
-    let v137: f64 = v134 * v126;
-    let v138: f64 = v129.mul_add(v127, -v137);
+    let v128 = v123 * v126;
+    let v129 = v125.mul_add(v127, -v128);
+    let v130 = p[32] * v46;
+    let v131 = v130.mul_add(v129, v118);
+    let v133 = v125 * v126;
+    let v134 = v123.mul_add(v127, v133);
+    let v135 = v129 * v126;
+    let v136 = v134.mul_add(v127, v135);
+    let v137 = v134 * v126;
+    let v138 = v129.mul_add(v127, -v137);
     let (v139, v140): (f64, f64) = runtime::special::sin_cos(v57);
-    let v141: f64 = v136 * v139;
-    let v142: f64 = v138.mul_add(v140, -v141);
-    let v143: f64 = p[38usize] * v58;
-    let v144: f64 = v143.mul_add(v142, v131);
-    let v146: f64 = v70 * v70;
-    let v147: f64 = p[56usize] * v146;
-    let v148: f64 = v138 * v139;
-    let v149: f64 = v136.mul_add(v140, v148);
-    let v150: f64 = v149 * v139;
-    let v151: f64 = v142.mul_add(v140, -v150);
-    let v153: f64 = p[44usize] * q[6usize];
-    let v154: f64 = v153 * v67;
-    let v155: f64 = v142 * v139;
-    let v156: f64 = v149.mul_add(v140, v155);
-    let v157: f64 = v147.mul_add(v151, v144);
-    let v158: f64 = (-v154).mul_add(v156, v157);
-    let v160: f64 = p[8usize] * v86;
-    let v161: f64 = p[4usize] + v160;
-    let v162: f64 = v91.mul_add(v95, v161);
-    let v163: f64 = v104.mul_add(v108, v162);
-    let v164: f64 = v117.mul_add(v121, v163);
-    let v165: f64 = v130.mul_add(v134, v164);
-    let v166: f64 = v143.mul_add(v149, v165);
-    let v167: f64 = v147.mul_add(v156, v166);
-    let v168: f64 = v154.mul_add(v151, v167);
-    let v169: f64 = v168 * v168;
-    let v170: f64 = v158.mul_add(v158, v169);
-    let v172: f64 = v8 + v81;
-    let v173: f64 = v8 + v172;
-    let v174: f64 = v21 + v173;
-    let v175: f64 = v21 + v174;
-    let v176: f64 = v33 + v175;
-    let v177: f64 = v33 + v176;
-    let v178: f64 = v45 + v177;
-    let v179: f64 = v45 + v178;
-    let v180: f64 = v57 + v179;
-    let v181: f64 = v57 + v180;
-    let v182: f64 = v69 + v181;
+    let v141 = v136 * v139;
+    let v142 = v138.mul_add(v140, -v141);
+    let v143 = p[38] * v58;
+    let v144 = v143.mul_add(v142, v131);
+    let v146 = v70 * v70;
+    let v147 = p[56] * v146;
+    let v148 = v138 * v139;
+    let v149 = v136.mul_add(v140, v148);
+    let v150 = v149 * v139;
+    let v151 = v142.mul_add(v140, -v150);
+    let v153 = p[44] * q[6];
+    let v154 = v153 * v67;
+    let v155 = v142 * v139;
+    let v156 = v149.mul_add(v140, v155);
+    let v157 = v147.mul_add(v151, v144);
+    let v158 = (-v154).mul_add(v156, v157);
+    let v160 = p[8] * v86;
+    let v161 = p[4] + v160;
+    let v162 = v91.mul_add(v95, v161);
+    let v163 = v104.mul_add(v108, v162);
+    let v164 = v117.mul_add(v121, v163);
+    let v165 = v130.mul_add(v134, v164);
+    let v166 = v143.mul_add(v149, v165);
+    let v167 = v147.mul_add(v156, v166);
+    let v168 = v154.mul_add(v151, v167);
+    let v169 = v168 * v168;
+    let v170 = v158.mul_add(v158, v169);
+    let v172 = v8 + v81;
+    let v173 = v8 + v172;
+    let v174 = v21 + v173;
+    let v175 = v21 + v174;
+    let v176 = v33 + v175;
+    let v177 = v33 + v176;
+    let v178 = v45 + v177;
+    let v179 = v45 + v178;
+    let v180 = v57 + v179;
+    let v181 = v57 + v180;
+    let v182 = v69 + v181;
     let (v186, v183): (f64, f64) = runtime::special::sin_cos(v182);
-    let v184: f64 = p[44usize] * v70;
-    let v185: f64 = v184.mul_add(v183, v144);
-    let v187: f64 = v184.mul_add(v186, v166);
-    let v188: f64 = v187 * v187;
-    let v189: f64 = v185.mul_add(v185, v188);
-    let v190: f64 = p[55usize].mul_add(v75, p[46usize]);
-    let v191: f64 = p[45usize].mul_add(v170, v190);
-    let v192: f64 = p[7usize].mul_add(v189, v191);
-    let v195: f64 = v58 * v58;
-    let v196: f64 = p[57usize] * v195;
-    let v197: f64 = p[38usize] * q[5usize];
-    let v198: f64 = v197 * v55;
-    let v199: f64 = v196.mul_add(v138, v131);
-    let v200: f64 = (-v198).mul_add(v136, v199);
-    let v201: f64 = v196.mul_add(v136, v165);
-    let v202: f64 = v198.mul_add(v138, v201);
-    let v203: f64 = v202 * v202;
-    let v204: f64 = v200.mul_add(v200, v203);
-    let v205: f64 = p[54usize].mul_add(v63, p[40usize]);
-    let v206: f64 = v205 + v192;
-    let v207: f64 = p[39usize].mul_add(v204, v206);
-    let v210: f64 = v46 * v46;
-    let v211: f64 = p[58usize] * v210;
-    let v212: f64 = p[32usize] * q[4usize];
-    let v213: f64 = v212 * v43;
-    let v214: f64 = v211.mul_add(v125, v118);
-    let v215: f64 = (-v213).mul_add(v123, v214);
-    let v216: f64 = v211.mul_add(v123, v164);
-    let v217: f64 = v213.mul_add(v125, v216);
-    let v218: f64 = v217 * v217;
-    let v219: f64 = v215.mul_add(v215, v218);
-    let v220: f64 = p[53usize].mul_add(v51, p[34usize]);
-    let v221: f64 = v220 + v207;
-    let v222: f64 = p[33usize].mul_add(v219, v221);
-    let v225: f64 = v34 * v34;
-    let v226: f64 = p[59usize] * v225;
-    let v227: f64 = p[26usize] * q[3usize];
-    let v228: f64 = v227 * v31;
-    let v229: f64 = v226.mul_add(v112, v105);
-    let v230: f64 = (-v228).mul_add(v110, v229);
-    let v231: f64 = v226.mul_add(v110, v163);
-    let v232: f64 = v228.mul_add(v112, v231);
-    let v233: f64 = v232 * v232;
-    let v234: f64 = v230.mul_add(v230, v233);
-    let v235: f64 = p[52usize].mul_add(v39, p[28usize]);
-    let v236: f64 = v235 + v222;
-    let v237: f64 = p[27usize].mul_add(v234, v236);
-    let v240: f64 = v22 * v22;
-    let v241: f64 = p[60usize] * v240;
-    let v242: f64 = p[20usize] * q[2usize];
-    let v243: f64 = v242 * v19;
-    let v244: f64 = v241.mul_add(v99, v92);
-    let v245: f64 = (-v243).mul_add(v97, v244);
-    let v246: f64 = v241.mul_add(v97, v162);
-    let v247: f64 = v243.mul_add(v99, v246);
-    let v248: f64 = v247 * v247;
-    let v249: f64 = v245.mul_add(v245, v248);
-    let v250: f64 = p[51usize].mul_add(v27, p[22usize]);
-    let v251: f64 = v250 + v237;
-    let v252: f64 = p[21usize].mul_add(v249, v251);
-    let v255: f64 = v9 * v9;
-    let v256: f64 = p[61usize] * v255;
-    let v257: f64 = p[14usize] * q[1usize];
-    let v258: f64 = v257 * v4;
-    let v259: f64 = v82.mul_add(v256, v84);
-    let v260: f64 = (-v86).mul_add(v258, v259);
-    let v261: f64 = v86.mul_add(v256, v161);
-    let v262: f64 = v82.mul_add(v258, v261);
-    let v263: f64 = v262 * v262;
-    let v264: f64 = v260.mul_add(v260, v263);
-    let v265: f64 = p[50usize].mul_add(v15, p[16usize]);
-    let v266: f64 = v265 + v252;
-    let v267: f64 = p[15usize].mul_add(v264, v266);
-    let v270: f64 = p[62usize] * v82;
-    let v272: f64 = p[63usize] * v86;
-    let v273: f64 = v272 * v272;
-    let v274: f64 = v270.mul_add(v270, v273);
-    let v275: f64 = -v160;
-    let v276: f64 = v161 + v275;
-    let v277: f64 = p[7usize] * v187;
-    let v278: f64 = p[45usize].mul_add(v168, v277);
-    let v279: f64 = p[39usize].mul_add(v202, v278);
-    let v280: f64 = p[33usize].mul_add(v217, v279);
-    let v281: f64 = p[27usize].mul_add(v232, v280);
-    let v282: f64 = p[21usize].mul_add(v247, v281);
-    let v283: f64 = p[15usize].mul_add(v262, v282);
-    let v284: f64 = 2f64 * v283;
-    let v286: f64 = v276.mul_add(p[64usize], -v284);
-    let v287: f64 = v83 - v84;
-    let v288: f64 = p[7usize] * v185;
-    let v289: f64 = p[45usize].mul_add(v158, v288);
-    let v290: f64 = p[39usize].mul_add(v200, v289);
-    let v291: f64 = p[33usize].mul_add(v215, v290);
-    let v292: f64 = p[27usize].mul_add(v230, v291);
-    let v293: f64 = p[21usize].mul_add(v245, v292);
-    let v294: f64 = p[15usize].mul_add(v260, v293);
-    let v295: f64 = v287 * p[64usize];
-    let v296: f64 = 2f64.mul_add(v294, v295);
-    let v297: f64 = p[10usize] + v267;
-    let v298: f64 = p[9usize].mul_add(v274, v297);
-    let v299: f64 = v276.mul_add(v286, v298);
-    let v300: f64 = v287.mul_add(v296, v299);
-    let v302: f64 = 1f64 / v300;
-    let v304: f64 = 0.5f64 * v303;
-    let v305: f64 = 0.5f64 * v9;
-    let v306: f64 = v305 * v90;
-    let v307: f64 = v95.mul_add(v304, v306);
-    let v308: f64 = p[14usize].mul_add(v307, -v92);
-    let v309: f64 = v305 * v95;
-    let v310: f64 = v90.mul_add(v304, -v309);
-    let v311: f64 = p[14usize].mul_add(v310, v162);
-    let v312: f64 = v91 * v304;
-    let v314: f64 = q[1usize].mul_add(v313, v4);
-    let v315: f64 = p[14usize] * v314;
-    let v316: f64 = v82 * v315;
-    let v317: f64 = v86.mul_add(v312, v316);
-    let v318: f64 = v86 * v315;
-    let v319: f64 = v82.mul_add(v312, -v318);
-    let v320: f64 = v262 * v319;
-    let v321: f64 = v260.mul_add(v317, -v320);
-    let v322: f64 = 0.5f64.mul_add(v265, v252);
-    let v323: f64 = v308.mul_add(v293, v322);
-    let v324: f64 = (-v311).mul_add(v282, v323);
-    let v325: f64 = p[15usize].mul_add(v321, v324);
-    let v327: f64 = v311 * p[65usize];
-    let v328: f64 = v327 - v282;
-    let v329: f64 = p[15usize].mul_add(v319, v328);
-    let v330: f64 = v308 * p[65usize];
-    let v331: f64 = v293 + v330;
-    let v332: f64 = p[15usize].mul_add(v317, v331);
-    let v333: f64 = v276.mul_add(v329, v325);
-    let v334: f64 = v287.mul_add(v332, v333);
-    let v335: f64 = v302 * v334;
-    let v336: f64 = v317 * v317;
-    let v337: f64 = v319.mul_add(v319, v336);
-    let v338: f64 = (-2f64).mul_add(v282, v327);
-    let v339: f64 = 2f64.mul_add(v293, v330);
-    let v340: f64 = 0.25f64.mul_add(v265, v252);
-    let v341: f64 = p[15usize].mul_add(v337, v340);
-    let v342: f64 = v311.mul_add(v338, v341);
-    let v343: f64 = v308.mul_add(v339, v342);
-    let v344: f64 = (-v334).mul_add(v335, v343);
-    let v345: f64 = 1f64 / v344;
-    let v347: f64 = 0.5f64 * v346;
-    let v348: f64 = 0.5f64 * v22;
-    let v349: f64 = v348 * v103;
-    let v350: f64 = v108.mul_add(v347, v349);
-    let v351: f64 = p[20usize].mul_add(v350, -v105);
-    let v352: f64 = v348 * v108;
-    let v353: f64 = v103.mul_add(v347, -v352);
-    let v354: f64 = p[20usize].mul_add(v353, v163);
-    let v355: f64 = v104 * v347;
-    let v357: f64 = q[2usize].mul_add(v356, v19);
-    let v358: f64 = p[20usize] * v357;
-    let v359: f64 = v99 * v358;
-    let v360: f64 = v97.mul_add(v355, v359);
-    let v361: f64 = v97 * v358;
-    let v362: f64 = v99.mul_add(v355, -v361);
-    let v363: f64 = v247 * v362;
-    let v364: f64 = v245.mul_add(v360, -v363);
-    let v365: f64 = 0.5f64.mul_add(v250, v237);
-    let v366: f64 = v351.mul_add(v292, v365);
-    let v367: f64 = (-v354).mul_add(v281, v366);
-    let v368: f64 = p[21usize].mul_add(v364, v367);
-    let v370: f64 = v354 * p[66usize];
-    let v371: f64 = v370 - v281;
-    let v372: f64 = p[21usize].mul_add(v362, v371);
-    let v373: f64 = v351 * p[66usize];
-    let v374: f64 = v292 + v373;
-    let v375: f64 = p[21usize].mul_add(v360, v374);
-    let v376: f64 = v276.mul_add(v372, v368);
-    let v377: f64 = v287.mul_add(v375, v376);
-    let v378: f64 = v311.mul_add(v372, v368);
-    let v379: f64 = v308.mul_add(v375, v378);
-    let v380: f64 = (-v335).mul_add(v377, v379);
-    let v381: f64 = v345 * v380;
-    let v382: f64 = v360 * v360;
-    let v383: f64 = v362.mul_add(v362, v382);
-    let v384: f64 = (-2f64).mul_add(v281, v370);
-    let v385: f64 = 2f64.mul_add(v292, v373);
-    let v386: f64 = v302 * v377;
-    let v387: f64 = v380 * v381;
-    let v388: f64 = v377.mul_add(v386, v387);
-    let v389: f64 = 0.25f64.mul_add(v250, v237);
-    let v390: f64 = p[21usize].mul_add(v383, v389);
-    let v391: f64 = v354.mul_add(v384, v390);
-    let v392: f64 = v351.mul_add(v385, v391);
-    let v393: f64 = v392 - v388;
-    let v394: f64 = 1f64 / v393;
-    let v396: f64 = 0.5f64 * v395;
-    let v397: f64 = 0.5f64 * v34;
-    let v398: f64 = v397 * v116;
-    let v399: f64 = v121.mul_add(v396, v398);
-    let v400: f64 = p[26usize].mul_add(v399, -v118);
-    let v401: f64 = v397 * v121;
-    let v402: f64 = v116.mul_add(v396, -v401);
-    let v403: f64 = p[26usize].mul_add(v402, v164);
-    let v404: f64 = v117 * v396;
-    let v406: f64 = q[3usize].mul_add(v405, v31);
-    let v407: f64 = p[26usize] * v406;
-    let v408: f64 = v112 * v407;
-    let v409: f64 = v110.mul_add(v404, v408);
-    let v410: f64 = v110 * v407;
-    let v411: f64 = v112.mul_add(v404, -v410);
-    let v412: f64 = v232 * v411;
-    let v413: f64 = v230.mul_add(v409, -v412);
-    let v414: f64 = 0.5f64.mul_add(v235, v222);
-    let v415: f64 = v400.mul_add(v291, v414);
-    let v416: f64 = (-v403).mul_add(v280, v415);
-    let v417: f64 = p[27usize].mul_add(v413, v416);
-    let v419: f64 = v403 * p[67usize];
-    let v420: f64 = v419 - v280;
-    let v421: f64 = p[27usize].mul_add(v411, v420);
-    let v422: f64 = v400 * p[67usize];
-    let v423: f64 = v291 + v422;
-    let v424: f64 = p[27usize].mul_add(v409, v423);
-    let v425: f64 = v276.mul_add(v421, v417);
-    let v426: f64 = v287.mul_add(v424, v425);
-    let v427: f64 = v311.mul_add(v421, v417);
-    let v428: f64 = v308.mul_add(v424, v427);
-    let v429: f64 = (-v335).mul_add(v426, v428);
-    let v430: f64 = v381 * v429;
-    let v431: f64 = v386.mul_add(v426, v430);
-    let v432: f64 = v354.mul_add(v421, v417);
-    let v433: f64 = v351.mul_add(v424, v432);
-    let v434: f64 = v433 - v431;
-    let v435: f64 = v394 * v434;
-    let v436: f64 = v409 * v409;
-    let v437: f64 = v411.mul_add(v411, v436);
-    let v438: f64 = (-2f64).mul_add(v280, v419);
-    let v439: f64 = 2f64.mul_add(v291, v422);
-    let v440: f64 = v302 * v426;
-    let v441: f64 = v345 * v429;
-    let v442: f64 = v429 * v441;
-    let v443: f64 = v426.mul_add(v440, v442);
-    let v444: f64 = v434.mul_add(v435, v443);
-    let v445: f64 = 0.25f64.mul_add(v235, v222);
-    let v446: f64 = p[27usize].mul_add(v437, v445);
-    let v447: f64 = v403.mul_add(v438, v446);
-    let v448: f64 = v400.mul_add(v439, v447);
-    let v449: f64 = v448 - v444;
-    let v450: f64 = 1f64 / v449;
-    let v452: f64 = 0.5f64 * v451;
-    let v453: f64 = 0.5f64 * v46;
-    let v454: f64 = v453 * v129;
-    let v455: f64 = v134.mul_add(v452, v454);
-    let v456: f64 = p[32usize].mul_add(v455, -v131);
-    let v457: f64 = v453 * v134;
-    let v458: f64 = v129.mul_add(v452, -v457);
-    let v459: f64 = p[32usize].mul_add(v458, v165);
-    let v460: f64 = v130 * v452;
-    let v462: f64 = q[4usize].mul_add(v461, v43);
-    let v463: f64 = p[32usize] * v462;
-    let v464: f64 = v125 * v463;
-    let v465: f64 = v123.mul_add(v460, v464);
-    let v466: f64 = v123 * v463;
-    let v467: f64 = v125.mul_add(v460, -v466);
-    let v468: f64 = v217 * v467;
-    let v469: f64 = v215.mul_add(v465, -v468);
-    let v470: f64 = 0.5f64.mul_add(v220, v207);
-    let v471: f64 = v456.mul_add(v290, v470);
-    let v472: f64 = (-v459).mul_add(v279, v471);
-    let v473: f64 = p[33usize].mul_add(v469, v472);
-    let v475: f64 = v459 * p[68usize];
-    let v476: f64 = v475 - v279;
-    let v477: f64 = p[33usize].mul_add(v467, v476);
-    let v478: f64 = v456 * p[68usize];
-    let v479: f64 = v290 + v478;
-    let v480: f64 = p[33usize].mul_add(v465, v479);
-    let v481: f64 = v276.mul_add(v477, v473);
-    let v482: f64 = v287.mul_add(v480, v481);
-    let v483: f64 = v311.mul_add(v477, v473);
-    let v484: f64 = v308.mul_add(v480, v483);
-    let v485: f64 = (-v335).mul_add(v482, v484);
-    let v486: f64 = v441 * v485;
-    let v487: f64 = v381 * v485;
-    let v488: f64 = v386.mul_add(v482, v487);
-    let v489: f64 = v354.mul_add(v477, v473);
-    let v490: f64 = v351.mul_add(v480, v489);
-    let v491: f64 = v490 - v488;
-    let v492: f64 = v440.mul_add(v482, v486);
-    let v493: f64 = v435.mul_add(v491, v492);
-    let v494: f64 = v403.mul_add(v477, v473);
-    let v495: f64 = v400.mul_add(v480, v494);
-    let v496: f64 = v495 - v493;
-    let v497: f64 = v450 * v496;
-    let v498: f64 = v465 * v465;
-    let v499: f64 = v467.mul_add(v467, v498);
-    let v500: f64 = (-2f64).mul_add(v279, v475);
-    let v501: f64 = 2f64.mul_add(v290, v478);
-    let v502: f64 = v302 * v482;
-    let v503: f64 = v345 * v485;
-    let v504: f64 = v485 * v503;
-    let v505: f64 = v394 * v491;
-    let v506: f64 = v482.mul_add(v502, v504);
-    let v507: f64 = v491.mul_add(v505, v506);
-    let v508: f64 = v496.mul_add(v497, v507);
-    let v509: f64 = 0.25f64.mul_add(v220, v207);
-    let v510: f64 = p[33usize].mul_add(v499, v509);
-    let v511: f64 = v459.mul_add(v500, v510);
-    let v512: f64 = v456.mul_add(v501, v511);
-    let v513: f64 = v512 - v508;
-    let v514: f64 = 1f64 / v513;
-    let v516: f64 = 0.5f64 * v515;
-    let v517: f64 = 0.5f64 * v58;
-    let v518: f64 = v517 * v142;
-    let v519: f64 = v149.mul_add(v516, v518);
-    let v520: f64 = p[38usize].mul_add(v519, -v144);
-    let v521: f64 = v517 * v149;
-    let v522: f64 = v142.mul_add(v516, -v521);
-    let v523: f64 = p[38usize].mul_add(v522, v166);
-    let v524: f64 = v143 * v516;
-    let v526: f64 = q[5usize].mul_add(v525, v55);
-    let v527: f64 = p[38usize] * v526;
-    let v528: f64 = v138 * v527;
-    let v529: f64 = v136.mul_add(v524, v528);
-    let v530: f64 = v136 * v527;
-    let v531: f64 = v138.mul_add(v524, -v530);
-    let v532: f64 = v202 * v531;
-    let v533: f64 = v200.mul_add(v529, -v532);
-    let v534: f64 = 0.5f64.mul_add(v205, v192);
-    let v535: f64 = v520.mul_add(v289, v534);
-    let v536: f64 = (-v523).mul_add(v278, v535);
-    let v537: f64 = p[39usize].mul_add(v533, v536);
-    let v539: f64 = v523 * p[69usize];
-    let v540: f64 = v539 - v278;
-    let v541: f64 = p[39usize].mul_add(v531, v540);
-    let v542: f64 = v520 * p[69usize];
-    let v543: f64 = v289 + v542;
-    let v544: f64 = p[39usize].mul_add(v529, v543);
-    let v545: f64 = v276.mul_add(v541, v537);
-    let v546: f64 = v287.mul_add(v544, v545);
-    let v547: f64 = v311.mul_add(v541, v537);
-    let v548: f64 = v308.mul_add(v544, v547);
-    let v549: f64 = (-v335).mul_add(v546, v548);
-    let v550: f64 = v503 * v549;
-    let v551: f64 = v381 * v549;
-    let v552: f64 = v386.mul_add(v546, v551);
-    let v553: f64 = v354.mul_add(v541, v537);
-    let v554: f64 = v351.mul_add(v544, v553);
-    let v555: f64 = v554 - v552;
-    let v556: f64 = v441 * v549;
-    let v557: f64 = v440.mul_add(v546, v556);
-    let v558: f64 = v435.mul_add(v555, v557);
-    let v559: f64 = v403.mul_add(v541, v537);
-    let v560: f64 = v400.mul_add(v544, v559);
-    let v561: f64 = v560 - v558;
-    let v562: f64 = v502.mul_add(v546, v550);
-    let v563: f64 = v505.mul_add(v555, v562);
-    let v564: f64 = v497.mul_add(v561, v563);
-    let v565: f64 = v459.mul_add(v541, v537);
-    let v566: f64 = v456.mul_add(v544, v565);
-    let v567: f64 = v566 - v564;
-    let v568: f64 = v514 * v567;
-    let v569: f64 = v529 * v529;
-    let v570: f64 = v531.mul_add(v531, v569);
-    let v571: f64 = (-2f64).mul_add(v278, v539);
-    let v572: f64 = 2f64.mul_add(v289, v542);
-    let v573: f64 = v302 * v546;
-    let v574: f64 = v345 * v549;
-    let v575: f64 = v549 * v574;
-    let v576: f64 = v394 * v555;
-    let v577: f64 = v450 * v561;
-    let v578: f64 = v546.mul_add(v573, v575);
-    let v579: f64 = v555.mul_add(v576, v578);
-    let v580: f64 = v561.mul_add(v577, v579);
-    let v581: f64 = v567.mul_add(v568, v580);
-    let v582: f64 = 0.25f64.mul_add(v205, v192);
-    let v583: f64 = p[39usize].mul_add(v570, v582);
-    let v584: f64 = v523.mul_add(v571, v583);
-    let v585: f64 = v520.mul_add(v572, v584);
-    let v586: f64 = v585 - v581;
-    let v587: f64 = 1f64 / v586;
-    let v589: f64 = 0.5f64 * v588;
-    let v590: f64 = 0.5f64 * v70;
-    let v591: f64 = v590 * v183;
-    let v592: f64 = v186.mul_add(v589, v591);
-    let v593: f64 = p[44usize] * v592;
-    let v594: f64 = v590 * v186;
-    let v595: f64 = v183.mul_add(v589, -v594);
-    let v596: f64 = p[44usize] * v595;
-    let v597: f64 = v187 * v596;
-    let v598: f64 = v185.mul_add(v593, -v597);
-    let v599: f64 = p[7usize] * v598;
-    let v600: f64 = v184 * v589;
-    let v602: f64 = q[6usize].mul_add(v601, v67);
-    let v603: f64 = p[44usize] * v602;
-    let v604: f64 = v151 * v603;
-    let v605: f64 = v156.mul_add(v600, v604);
-    let v606: f64 = v156 * v603;
-    let v607: f64 = v151.mul_add(v600, -v606);
-    let v608: f64 = v168 * v607;
-    let v609: f64 = v158.mul_add(v605, -v608);
-    let v610: f64 = 0.5f64.mul_add(v190, v599);
-    let v611: f64 = p[45usize].mul_add(v609, v610);
-    let v612: f64 = p[7usize] * v596;
-    let v613: f64 = p[45usize].mul_add(v607, v612);
-    let v614: f64 = p[7usize] * v593;
-    let v615: f64 = p[45usize].mul_add(v605, v614);
-    let v616: f64 = v276.mul_add(v613, v611);
-    let v617: f64 = v287.mul_add(v615, v616);
-    let v618: f64 = v311.mul_add(v613, v611);
-    let v619: f64 = v308.mul_add(v615, v618);
-    let v620: f64 = (-v335).mul_add(v617, v619);
-    let v621: f64 = v574 * v620;
-    let v622: f64 = v381 * v620;
-    let v623: f64 = v386.mul_add(v617, v622);
-    let v624: f64 = v354.mul_add(v613, v611);
-    let v625: f64 = v351.mul_add(v615, v624);
-    let v626: f64 = v625 - v623;
-    let v627: f64 = v441 * v620;
-    let v628: f64 = v440.mul_add(v617, v627);
-    let v629: f64 = v435.mul_add(v626, v628);
-    let v630: f64 = v403.mul_add(v613, v611);
-    let v631: f64 = v400.mul_add(v615, v630);
-    let v632: f64 = v631 - v629;
-    let v633: f64 = v503 * v620;
-    let v634: f64 = v502.mul_add(v617, v633);
-    let v635: f64 = v505.mul_add(v626, v634);
-    let v636: f64 = v497.mul_add(v632, v635);
-    let v637: f64 = v459.mul_add(v613, v611);
-    let v638: f64 = v456.mul_add(v615, v637);
-    let v639: f64 = v638 - v636;
-    let v640: f64 = v573.mul_add(v617, v621);
-    let v641: f64 = v576.mul_add(v626, v640);
-    let v642: f64 = v577.mul_add(v632, v641);
-    let v643: f64 = v568.mul_add(v639, v642);
-    let v644: f64 = v523.mul_add(v613, v611);
-    let v645: f64 = v520.mul_add(v615, v644);
-    let v646: f64 = v645 - v643;
-    let v647: f64 = v587 * v646;
-    let v648: f64 = v605 * v605;
-    let v649: f64 = v607.mul_add(v607, v648);
-    let v650: f64 = p[45usize] * v649;
-    let v651: f64 = v593 * v593;
-    let v652: f64 = v596.mul_add(v596, v651);
-    let v653: f64 = v302 * v617;
-    let v654: f64 = v345 * v620;
-    let v655: f64 = v620 * v654;
-    let v656: f64 = v394 * v626;
-    let v657: f64 = v450 * v632;
-    let v658: f64 = v514 * v639;
-    let v659: f64 = v617.mul_add(v653, v655);
-    let v660: f64 = v626.mul_add(v656, v659);
-    let v661: f64 = v632.mul_add(v657, v660);
-    let v662: f64 = v639.mul_add(v658, v661);
-    let v663: f64 = v646.mul_add(v647, v662);
-    let v664: f64 = 0.25f64.mul_add(v190, v650);
-    let v665: f64 = p[7usize].mul_add(v652, v664);
-    let v666: f64 = v665 - v663;
-    let v667: f64 = 1f64 / v666;
-    let v671: f64 = 0.5f64 * qd[5usize];
-    let v673: f64 = 0.5f64 * qd[4usize];
-    let v675: f64 = 0.5f64 * qd[3usize];
-    let v677: f64 = 0.5f64 * qd[2usize];
-    let v679: f64 = 0.5f64 * qd[1usize];
-    let v681: f64 = qd[0usize] + v679;
-    let v682: f64 = v679 + v681;
-    let v683: f64 = v677 + v682;
-    let v684: f64 = v677 + v683;
-    let v685: f64 = v675 + v684;
-    let v686: f64 = v675 + v685;
-    let v687: f64 = v673 + v686;
-    let v688: f64 = v673 + v687;
-    let v689: f64 = v671 + v688;
-    let v690: f64 = v671 + v689;
-    let v691: f64 = 0.5f64.mul_add(qd[6usize], v690);
-    let v692: f64 = v691 * v691;
-    let v694: f64 = (-0.5f64) * v692;
-    let v695: f64 = (-v68).mul_add(v72, 2f64);
-    let v696: f64 = v694 * v695;
-    let v697: f64 = p[93usize] * v696;
-    let v698: f64 = p[45usize] * v697;
-    let v700: f64 = v70.powi(3i32);
-    let v701: f64 = p[94usize] * v700;
-    let v702: f64 = v701 * v694;
-    let v703: f64 = v589 * v702;
-    let v706: f64 = p[95usize] + q[6usize];
-    let v708: f64 = qd[0usize] * qd[0usize];
-    let v709: f64 = -v83;
-    let v710: f64 = v708 * v709;
-    let v711: f64 = 2f64 * qd[1usize];
-    let v712: f64 = v711 * v681;
-    let v713: f64 = v712 * v95;
-    let v714: f64 = v713 * v304;
-    let v715: f64 = qd[1usize] * qd[1usize];
-    let v717: f64 = 0.25f64 * v716;
-    let v718: f64 = v681 * v681;
-    let v719: f64 = v9 * v718;
-    let v720: f64 = v715.mul_add(v717, -v719);
-    let v721: f64 = v90.mul_add(v720, -v714);
-    let v722: f64 = p[14usize].mul_add(v721, v710);
-    let v723: f64 = 2f64 * qd[2usize];
-    let v724: f64 = v723 * v683;
-    let v725: f64 = v724 * v108;
-    let v726: f64 = v725 * v347;
-    let v727: f64 = qd[2usize] * qd[2usize];
-    let v729: f64 = 0.25f64 * v728;
-    let v730: f64 = v683 * v683;
-    let v731: f64 = v22 * v730;
-    let v732: f64 = v727.mul_add(v729, -v731);
-    let v733: f64 = v103.mul_add(v732, -v726);
-    let v734: f64 = p[20usize].mul_add(v733, v722);
-    let v735: f64 = 2f64 * qd[3usize];
-    let v736: f64 = v735 * v685;
-    let v737: f64 = v736 * v121;
-    let v738: f64 = v737 * v396;
-    let v739: f64 = qd[3usize] * qd[3usize];
-    let v741: f64 = 0.25f64 * v740;
-    let v742: f64 = v685 * v685;
-    let v743: f64 = v34 * v742;
-    let v744: f64 = v739.mul_add(v741, -v743);
-    let v745: f64 = v116.mul_add(v744, -v738);
-    let v746: f64 = p[26usize].mul_add(v745, v734);
-    let v747: f64 = 2f64 * qd[4usize];
-    let v748: f64 = v747 * v687;
-    let v749: f64 = v748 * v134;
-    let v750: f64 = v749 * v452;
-    let v751: f64 = qd[4usize] * qd[4usize];
-    let v753: f64 = 0.25f64 * v752;
-    let v754: f64 = v687 * v687;
-    let v755: f64 = v46 * v754;
-    let v756: f64 = v751.mul_add(v753, -v755);
-    let v757: f64 = v129.mul_add(v756, -v750);
-    let v758: f64 = p[32usize].mul_add(v757, v746);
-    let v759: f64 = 2f64 * qd[5usize];
-    let v760: f64 = v759 * v689;
-    let v761: f64 = v760 * v149;
-    let v762: f64 = v761 * v516;
-    let v763: f64 = qd[5usize] * qd[5usize];
-    let v765: f64 = 0.25f64 * v764;
-    let v766: f64 = v689 * v689;
-    let v767: f64 = v58 * v766;
-    let v768: f64 = v763.mul_add(v765, -v767);
-    let v769: f64 = v142.mul_add(v768, -v762);
-    let v770: f64 = p[38usize].mul_add(v769, v758);
-    let v771: f64 = qd[6usize] * qd[6usize];
-    let v773: f64 = 0.25f64 * v772;
-    let v774: f64 = v70 * v773;
-    let v775: f64 = v589.mul_add(v589, v774);
-    let v776: f64 = p[44usize] * v775;
-    let v777: f64 = v690 * v690;
-    let v778: f64 = v147 * v777;
-    let v779: f64 = 2f64 * qd[6usize];
-    let v780: f64 = v779 * v690;
-    let v781: f64 = v771.mul_add(v776, -v778);
-    let v782: f64 = (-v780).mul_add(v603, v781);
-    let v784: f64 = q[6usize] * v783;
-    let v785: f64 = 2f64.mul_add(v601, v784);
-    let v786: f64 = p[44usize] * v785;
-    let v787: f64 = v771 * v786;
-    let v788: f64 = v780 * v600;
-    let v789: f64 = v154 * v777;
-    let v790: f64 = v789 - v787;
-    let v791: f64 = v790 - v788;
-    let v792: f64 = v151.mul_add(v782, v770);
-    let v793: f64 = v156.mul_add(v791, v792);
-    let v794: f64 = p[71usize] + v793;
-    let v796: f64 = v708 * v275;
-    let v797: f64 = v712 * v90;
-    let v798: f64 = v95 * v720;
-    let v799: f64 = v797.mul_add(v304, v798);
-    let v800: f64 = p[14usize].mul_add(v799, v796);
-    let v801: f64 = v724 * v103;
-    let v802: f64 = v108 * v732;
-    let v803: f64 = v801.mul_add(v347, v802);
-    let v804: f64 = p[20usize].mul_add(v803, v800);
-    let v805: f64 = v736 * v116;
-    let v806: f64 = v121 * v744;
-    let v807: f64 = v805.mul_add(v396, v806);
-    let v808: f64 = p[26usize].mul_add(v807, v804);
-    let v809: f64 = v748 * v129;
-    let v810: f64 = v134 * v756;
-    let v811: f64 = v809.mul_add(v452, v810);
-    let v812: f64 = p[32usize].mul_add(v811, v808);
-    let v813: f64 = v760 * v142;
-    let v814: f64 = v149 * v768;
-    let v815: f64 = v813.mul_add(v516, v814);
-    let v816: f64 = p[38usize].mul_add(v815, v812);
-    let v817: f64 = v787 + v788;
-    let v818: f64 = v817 - v789;
-    let v819: f64 = v151.mul_add(v818, v816);
-    let v820: f64 = v156.mul_add(v782, v819);
-    let v821: f64 = p[70usize] + v820;
-    let v822: f64 = v821 * v605;
-    let v824: f64 = p[96usize] * q[6usize];
-    let v825: f64 = v824 * v73;
-    let v826: f64 = v794.mul_add(v607, v822);
-    let v827: f64 = (-v825).mul_add(v694, v826);
-    let v828: f64 = v779 * v691;
-    let v829: f64 = v828 * v186;
-    let v830: f64 = v829 * v589;
-    let v831: f64 = v70 * v692;
-    let v832: f64 = v771.mul_add(v773, -v831);
-    let v833: f64 = v183.mul_add(v832, -v830);
-    let v834: f64 = p[44usize].mul_add(v833, v770);
-    let v835: f64 = p[71usize] + v834;
-    let v836: f64 = v828 * v183;
-    let v837: f64 = v186 * v832;
-    let v838: f64 = v836.mul_add(v589, v837);
-    let v839: f64 = p[44usize].mul_add(v838, v816);
-    let v840: f64 = p[70usize] + v839;
-    let v841: f64 = v840 * v593;
-    let v842: f64 = v835.mul_add(v596, v841);
-    let v844: f64 = v589 * v700;
-    let v845: f64 = 2f64 * q[6usize];
-    let v846: f64 = v601.mul_add(v695, -v844);
-    let v847: f64 = (-v845).mul_add(v73, v846);
-    let v848: f64 = p[55usize] * v847;
-    let v849: f64 = 0.5f64 * v691;
-    let v850: f64 = v849.mul_add(v848, p[48usize]);
-    let v851: f64 = v9.powi(3i32);
-    let v852: f64 = v304 * v851;
-    let v853: f64 = 2f64 * q[1usize];
-    let v854: f64 = (-v6).mul_add(v12, 2f64);
-    let v855: f64 = v313.mul_add(v854, -v852);
-    let v856: f64 = (-v853).mul_add(v13, v855);
-    let v857: f64 = p[50usize] * v856;
-    let v858: f64 = qd[1usize] * v681;
-    let v859: f64 = v22.powi(3i32);
-    let v860: f64 = v347 * v859;
-    let v861: f64 = 2f64 * q[2usize];
-    let v862: f64 = (-v20).mul_add(v24, 2f64);
-    let v863: f64 = v356.mul_add(v862, -v860);
-    let v864: f64 = (-v861).mul_add(v25, v863);
-    let v865: f64 = p[51usize] * v864;
-    let v866: f64 = qd[2usize] * v683;
-    let v867: f64 = v34.powi(3i32);
-    let v868: f64 = v396 * v867;
-    let v869: f64 = 2f64 * q[3usize];
-    let v870: f64 = (-v32).mul_add(v36, 2f64);
-    let v871: f64 = v405.mul_add(v870, -v868);
-    let v872: f64 = (-v869).mul_add(v37, v871);
-    let v873: f64 = p[52usize] * v872;
-    let v874: f64 = qd[3usize] * v685;
-    let v875: f64 = v46.powi(3i32);
-    let v876: f64 = v452 * v875;
-    let v877: f64 = 2f64 * q[4usize];
-    let v878: f64 = (-v44).mul_add(v48, 2f64);
-    let v879: f64 = v461.mul_add(v878, -v876);
-    let v880: f64 = (-v877).mul_add(v49, v879);
-    let v881: f64 = p[53usize] * v880;
-    let v882: f64 = qd[4usize] * v687;
-    let v883: f64 = v58.powi(3i32);
-    let v884: f64 = v516 * v883;
-    let v885: f64 = 2f64 * q[5usize];
-    let v886: f64 = (-v56).mul_add(v60, 2f64);
-    let v887: f64 = v525.mul_add(v886, -v884);
-    let v888: f64 = (-v885).mul_add(v61, v887);
-    let v889: f64 = p[54usize] * v888;
-    let v890: f64 = qd[5usize] * v689;
-    let v891: f64 = qd[6usize] * v691;
-    let v892: f64 = v187 * v835;
-    let v893: f64 = v185.mul_add(v840, -v892);
-    let v894: f64 = p[7usize] * v893;
-    let v895: f64 = v168 * v794;
-    let v896: f64 = v158.mul_add(v821, -v895);
-    let v897: f64 = v891.mul_add(v848, v894);
-    let v898: f64 = p[45usize].mul_add(v896, v897);
-    let v900: f64 = q[5usize] * v899;
-    let v901: f64 = 2f64.mul_add(v525, v900);
-    let v902: f64 = p[38usize] * v901;
-    let v903: f64 = v763 * v902;
-    let v904: f64 = v759 * v688;
-    let v905: f64 = v904 * v524;
-    let v906: f64 = v688 * v688;
-    let v907: f64 = v198 * v906;
-    let v908: f64 = v903 + v905;
-    let v909: f64 = v908 - v907;
-    let v910: f64 = v58 * v765;
-    let v911: f64 = v516.mul_add(v516, v910);
-    let v912: f64 = p[38usize] * v911;
-    let v913: f64 = v196 * v906;
-    let v914: f64 = v763.mul_add(v912, -v913);
-    let v915: f64 = (-v904).mul_add(v527, v914);
-    let v916: f64 = v138.mul_add(v909, v812);
-    let v917: f64 = v136.mul_add(v915, v916);
-    let v918: f64 = p[70usize] + v917;
-    let v919: f64 = v907 - v903;
-    let v920: f64 = v919 - v905;
-    let v921: f64 = v138.mul_add(v915, v758);
-    let v922: f64 = v136.mul_add(v920, v921);
-    let v923: f64 = p[71usize] + v922;
-    let v924: f64 = v202 * v923;
-    let v925: f64 = v200.mul_add(v918, -v924);
-    let v926: f64 = v890.mul_add(v889, v898);
-    let v927: f64 = p[39usize].mul_add(v925, v926);
-    let v929: f64 = q[4usize] * v928;
-    let v930: f64 = 2f64.mul_add(v461, v929);
-    let v931: f64 = p[32usize] * v930;
-    let v932: f64 = v751 * v931;
-    let v933: f64 = v747 * v686;
-    let v934: f64 = v933 * v460;
-    let v935: f64 = v686 * v686;
-    let v936: f64 = v213 * v935;
-    let v937: f64 = v932 + v934;
-    let v938: f64 = v937 - v936;
-    let v939: f64 = v46 * v753;
-    let v940: f64 = v452.mul_add(v452, v939);
-    let v941: f64 = p[32usize] * v940;
-    let v942: f64 = v211 * v935;
-    let v943: f64 = v751.mul_add(v941, -v942);
-    let v944: f64 = (-v933).mul_add(v463, v943);
-    let v945: f64 = v125.mul_add(v938, v808);
-    let v946: f64 = v123.mul_add(v944, v945);
-    let v947: f64 = p[70usize] + v946;
-    let v948: f64 = v936 - v932;
-    let v949: f64 = v948 - v934;
-    let v950: f64 = v125.mul_add(v944, v746);
-    let v951: f64 = v123.mul_add(v949, v950);
-    let v952: f64 = p[71usize] + v951;
-    let v953: f64 = v217 * v952;
-    let v954: f64 = v215.mul_add(v947, -v953);
-    let v955: f64 = v882.mul_add(v881, v927);
-    let v956: f64 = p[33usize].mul_add(v954, v955);
-    let v958: f64 = q[3usize] * v957;
-    let v959: f64 = 2f64.mul_add(v405, v958);
-    let v960: f64 = p[26usize] * v959;
-    let v961: f64 = v739 * v960;
-    let v962: f64 = v735 * v684;
-    let v963: f64 = v962 * v404;
-    let v964: f64 = v684 * v684;
-    let v965: f64 = v228 * v964;
-    let v966: f64 = v961 + v963;
-    let v967: f64 = v966 - v965;
-    let v968: f64 = v34 * v741;
-    let v969: f64 = v396.mul_add(v396, v968);
-    let v970: f64 = p[26usize] * v969;
-    let v971: f64 = v226 * v964;
-    let v972: f64 = v739.mul_add(v970, -v971);
-    let v973: f64 = (-v962).mul_add(v407, v972);
-    let v974: f64 = v112.mul_add(v967, v804);
-    let v975: f64 = v110.mul_add(v973, v974);
-    let v976: f64 = p[70usize] + v975;
-    let v977: f64 = v965 - v961;
-    let v978: f64 = v977 - v963;
-    let v979: f64 = v112.mul_add(v973, v734);
-    let v980: f64 = v110.mul_add(v978, v979);
-    let v981: f64 = p[71usize] + v980;
-    let v982: f64 = v232 * v981;
-    let v983: f64 = v230.mul_add(v976, -v982);
-    let v984: f64 = v874.mul_add(v873, v956);
-    let v985: f64 = p[27usize].mul_add(v983, v984);
-    let v987: f64 = q[2usize] * v986;
-    let v988: f64 = 2f64.mul_add(v356, v987);
-    let v989: f64 = p[20usize] * v988;
-    let v990: f64 = v727 * v989;
-    let v991: f64 = v723 * v682;
-    let v992: f64 = v991 * v355;
-    let v993: f64 = v682 * v682;
-    let v994: f64 = v243 * v993;
-    let v995: f64 = v990 + v992;
-    let v996: f64 = v995 - v994;
-    let v997: f64 = v22 * v729;
-    let v998: f64 = v347.mul_add(v347, v997);
-    let v999: f64 = p[20usize] * v998;
-    let v1000: f64 = v241 * v993;
-    let v1001: f64 = v727.mul_add(v999, -v1000);
-    let v1002: f64 = (-v991).mul_add(v358, v1001);
-    let v1003: f64 = v99.mul_add(v996, v800);
-    let v1004: f64 = v97.mul_add(v1002, v1003);
-    let v1005: f64 = p[70usize] + v1004;
-    let v1006: f64 = v994 - v990;
-    let v1007: f64 = v1006 - v992;
-    let v1008: f64 = v99.mul_add(v1002, v722);
-    let v1009: f64 = v97.mul_add(v1007, v1008);
-    let v1010: f64 = p[71usize] + v1009;
-    let v1011: f64 = v247 * v1010;
-    let v1012: f64 = v245.mul_add(v1005, -v1011);
-    let v1013: f64 = v866.mul_add(v865, v985);
-    let v1014: f64 = p[21usize].mul_add(v1012, v1013);
-    let v1016: f64 = q[1usize] * v1015;
-    let v1017: f64 = 2f64.mul_add(v313, v1016);
-    let v1018: f64 = p[14usize] * v1017;
-    let v1019: f64 = v715 * v1018;
-    let v1020: f64 = 2f64 * qd[0usize];
-    let v1021: f64 = v1020 * qd[1usize];
-    let v1022: f64 = v1021 * v312;
-    let v1023: f64 = v708 * v258;
-    let v1024: f64 = v1019 + v1022;
-    let v1025: f64 = v1024 - v1023;
-    let v1026: f64 = v9 * v717;
-    let v1027: f64 = v304.mul_add(v304, v1026);
-    let v1028: f64 = p[14usize] * v1027;
-    let v1029: f64 = v708 * v256;
-    let v1030: f64 = v715.mul_add(v1028, -v1029);
-    let v1031: f64 = (-v1021).mul_add(v315, v1030);
-    let v1032: f64 = v82.mul_add(v1025, v796);
-    let v1033: f64 = v86.mul_add(v1031, v1032);
-    let v1034: f64 = p[70usize] + v1033;
-    let v1035: f64 = v1023 - v1019;
-    let v1036: f64 = v1035 - v1022;
-    let v1037: f64 = v82.mul_add(v1031, v710);
-    let v1038: f64 = v86.mul_add(v1036, v1037);
-    let v1039: f64 = p[71usize] + v1038;
-    let v1040: f64 = v262 * v1039;
-    let v1041: f64 = v260.mul_add(v1034, -v1040);
-    let v1042: f64 = v858.mul_add(v857, v1014);
-    let v1043: f64 = p[15usize].mul_add(v1041, v1042);
-    let v1044: f64 = p[7usize] * v835;
-    let v1045: f64 = p[45usize].mul_add(v794, v1044);
-    let v1046: f64 = p[39usize].mul_add(v923, v1045);
-    let v1047: f64 = p[33usize].mul_add(v952, v1046);
-    let v1048: f64 = p[27usize].mul_add(v981, v1047);
-    let v1049: f64 = p[21usize].mul_add(v1010, v1048);
-    let v1050: f64 = p[15usize].mul_add(v1039, v1049);
-    let v1051: f64 = p[7usize] * v840;
-    let v1052: f64 = p[45usize].mul_add(v821, v1051);
-    let v1053: f64 = p[39usize].mul_add(v918, v1052);
-    let v1054: f64 = p[33usize].mul_add(v947, v1053);
-    let v1055: f64 = p[27usize].mul_add(v976, v1054);
-    let v1056: f64 = p[21usize].mul_add(v1005, v1055);
-    let v1057: f64 = p[15usize].mul_add(v1034, v1056);
-    let v1060: f64 = p[72usize] + q[0usize];
-    let v1062: f64 = p[63usize] * v82;
-    let v1063: f64 = v708.mul_add(v1062, p[71usize]);
-    let v1064: f64 = v708.mul_add(v272, p[70usize]);
-    let v1065: f64 = v270 * v1064;
-    let v1066: f64 = v272.mul_add(v1063, v1065);
-    let v1067: f64 = v276.mul_add(v1050, v1043);
-    let v1068: f64 = v287.mul_add(v1057, v1067);
-    let v1069: f64 = p[11usize].mul_add(v1060, v1068);
-    let v1070: f64 = p[12usize].mul_add(qd[0usize], v1069);
-    let v1071: f64 = p[9usize].mul_add(v1066, v1070);
-    let v1072: f64 = -v1071;
-    let v1074: f64 = (-0.5f64) * v718;
-    let v1075: f64 = v1074 * v854;
-    let v1076: f64 = p[73usize] * v1075;
-    let v1077: f64 = p[15usize] * v1076;
-    let v1079: f64 = p[74usize] * v851;
-    let v1080: f64 = v1079 * v1074;
-    let v1081: f64 = v304 * v1080;
-    let v1084: f64 = p[75usize] + q[1usize];
-    let v1085: f64 = v1034 * v317;
-    let v1087: f64 = p[76usize] * q[1usize];
-    let v1088: f64 = v1087 * v13;
-    let v1089: f64 = v1039.mul_add(v319, v1085);
-    let v1090: f64 = (-v1088).mul_add(v1074, v1089);
-    let v1092: f64 = 0.5f64 * v681;
-    let v1093: f64 = v1092.mul_add(v857, p[18usize]);
-    let v1094: f64 = v313.mul_add(v1077, v1081);
-    let v1095: f64 = v1094 + v1014;
-    let v1096: f64 = v311.mul_add(v1049, v1095);
-    let v1097: f64 = v308.mul_add(v1056, v1096);
-    let v1098: f64 = p[17usize].mul_add(v1084, v1097);
-    let v1099: f64 = p[15usize].mul_add(v1090, v1098);
-    let v1100: f64 = qd[1usize].mul_add(v1093, v1099);
-    let v1101: f64 = v335.mul_add(v1072, v1100);
-    let v1102: f64 = -v1101;
-    let v1104: f64 = (-0.5f64) * v730;
-    let v1105: f64 = v1104 * v862;
-    let v1106: f64 = p[77usize] * v1105;
-    let v1107: f64 = p[21usize] * v1106;
-    let v1109: f64 = p[78usize] * v859;
-    let v1110: f64 = v1109 * v1104;
-    let v1111: f64 = v347 * v1110;
-    let v1114: f64 = p[79usize] + q[2usize];
-    let v1115: f64 = v1005 * v360;
-    let v1117: f64 = p[80usize] * q[2usize];
-    let v1118: f64 = v1117 * v25;
-    let v1119: f64 = v1010.mul_add(v362, v1115);
-    let v1120: f64 = (-v1118).mul_add(v1104, v1119);
-    let v1122: f64 = 0.5f64 * v683;
-    let v1123: f64 = v1122.mul_add(v865, p[24usize]);
-    let v1124: f64 = v356.mul_add(v1107, v1111);
-    let v1125: f64 = v1124 + v985;
-    let v1126: f64 = v354.mul_add(v1048, v1125);
-    let v1127: f64 = v351.mul_add(v1055, v1126);
-    let v1128: f64 = p[23usize].mul_add(v1114, v1127);
-    let v1129: f64 = p[21usize].mul_add(v1120, v1128);
-    let v1130: f64 = qd[2usize].mul_add(v1123, v1129);
-    let v1131: f64 = v386.mul_add(v1072, v1130);
-    let v1132: f64 = v381.mul_add(v1102, v1131);
-    let v1133: f64 = -v1132;
-    let v1135: f64 = (-0.5f64) * v742;
-    let v1136: f64 = v1135 * v870;
-    let v1137: f64 = p[81usize] * v1136;
-    let v1138: f64 = p[27usize] * v1137;
-    let v1140: f64 = p[82usize] * v867;
-    let v1141: f64 = v1140 * v1135;
-    let v1142: f64 = v396 * v1141;
-    let v1145: f64 = p[83usize] + q[3usize];
-    let v1146: f64 = v976 * v409;
-    let v1148: f64 = p[84usize] * q[3usize];
-    let v1149: f64 = v1148 * v37;
-    let v1150: f64 = v981.mul_add(v411, v1146);
-    let v1151: f64 = (-v1149).mul_add(v1135, v1150);
-    let v1153: f64 = 0.5f64 * v685;
-    let v1154: f64 = v1153.mul_add(v873, p[30usize]);
-    let v1155: f64 = v405.mul_add(v1138, v1142);
-    let v1156: f64 = v1155 + v956;
-    let v1157: f64 = v403.mul_add(v1047, v1156);
-    let v1158: f64 = v400.mul_add(v1054, v1157);
-    let v1159: f64 = p[29usize].mul_add(v1145, v1158);
-    let v1160: f64 = p[27usize].mul_add(v1151, v1159);
-    let v1161: f64 = qd[3usize].mul_add(v1154, v1160);
-    let v1162: f64 = v440.mul_add(v1072, v1161);
-    let v1163: f64 = v441.mul_add(v1102, v1162);
-    let v1164: f64 = v435.mul_add(v1133, v1163);
-    let v1165: f64 = -v1164;
-    let v1167: f64 = (-0.5f64) * v754;
-    let v1168: f64 = v1167 * v878;
-    let v1169: f64 = p[85usize] * v1168;
-    let v1170: f64 = p[33usize] * v1169;
-    let v1172: f64 = p[86usize] * v875;
-    let v1173: f64 = v1172 * v1167;
-    let v1174: f64 = v452 * v1173;
-    let v1177: f64 = p[87usize] + q[4usize];
-    let v1178: f64 = v947 * v465;
-    let v1180: f64 = p[88usize] * q[4usize];
-    let v1181: f64 = v1180 * v49;
-    let v1182: f64 = v952.mul_add(v467, v1178);
-    let v1183: f64 = (-v1181).mul_add(v1167, v1182);
-    let v1185: f64 = 0.5f64 * v687;
-    let v1186: f64 = v1185.mul_add(v881, p[36usize]);
-    let v1187: f64 = v461.mul_add(v1170, v1174);
-    let v1188: f64 = v1187 + v927;
-    let v1189: f64 = v459.mul_add(v1046, v1188);
-    let v1190: f64 = v456.mul_add(v1053, v1189);
-    let v1191: f64 = p[35usize].mul_add(v1177, v1190);
-    let v1192: f64 = p[33usize].mul_add(v1183, v1191);
-    let v1193: f64 = qd[4usize].mul_add(v1186, v1192);
-    let v1194: f64 = v502.mul_add(v1072, v1193);
-    let v1195: f64 = v503.mul_add(v1102, v1194);
-    let v1196: f64 = v505.mul_add(v1133, v1195);
-    let v1197: f64 = v497.mul_add(v1165, v1196);
-    let v1198: f64 = -v1197;
-    let v1200: f64 = (-0.5f64) * v766;
-    let v1201: f64 = v1200 * v886;
-    let v1202: f64 = p[89usize] * v1201;
-    let v1203: f64 = p[39usize] * v1202;
-    let v1205: f64 = p[90usize] * v883;
-    let v1206: f64 = v1205 * v1200;
-    let v1207: f64 = v516 * v1206;
-    let v1210: f64 = p[91usize] + q[5usize];
-    let v1211: f64 = v918 * v529;
-    let v1213: f64 = p[92usize] * q[5usize];
-    let v1214: f64 = v1213 * v61;
-    let v1215: f64 = v923.mul_add(v531, v1211);
-    let v1216: f64 = (-v1214).mul_add(v1200, v1215);
-    let v1218: f64 = 0.5f64 * v689;
-    let v1219: f64 = v1218.mul_add(v889, p[42usize]);
-    let v1220: f64 = v525.mul_add(v1203, v1207);
-    let v1221: f64 = v1220 + v898;
-    let v1222: f64 = v523.mul_add(v1045, v1221);
-    let v1223: f64 = v520.mul_add(v1052, v1222);
-    let v1224: f64 = p[41usize].mul_add(v1210, v1223);
-    let v1225: f64 = p[39usize].mul_add(v1216, v1224);
-    let v1226: f64 = qd[5usize].mul_add(v1219, v1225);
-    let v1227: f64 = v573.mul_add(v1072, v1226);
-    let v1228: f64 = v574.mul_add(v1102, v1227);
-    let v1229: f64 = v576.mul_add(v1133, v1228);
-    let v1230: f64 = v577.mul_add(v1165, v1229);
-    let v1231: f64 = v568.mul_add(v1198, v1230);
-    let v1232: f64 = -v1231;
-    let v1233: f64 = v601.mul_add(v698, v703);
-    let v1234: f64 = p[47usize].mul_add(v706, v1233);
-    let v1235: f64 = p[45usize].mul_add(v827, v1234);
-    let v1236: f64 = p[7usize].mul_add(v842, v1235);
-    let v1237: f64 = qd[6usize].mul_add(v850, v1236);
-    let v1238: f64 = v653.mul_add(v1072, v1237);
-    let v1239: f64 = v654.mul_add(v1102, v1238);
-    let v1240: f64 = v656.mul_add(v1133, v1239);
-    let v1241: f64 = v657.mul_add(v1165, v1240);
-    let v1242: f64 = v658.mul_add(v1198, v1241);
-    let v1243: f64 = v647.mul_add(v1232, v1242);
-    let v1244: f64 = -v1243;
-    let v1245: f64 = v667 * v1244;
-    let v1246: f64 = v647 * v1245;
-    let v1247: f64 = v587.mul_add(v1232, -v1246);
-    let v1248: f64 = v658 * v1245;
-    let v1249: f64 = v568.mul_add(v1247, v1248);
-    let v1250: f64 = v514.mul_add(v1198, -v1249);
-    let v1251: f64 = v577 * v1247;
-    let v1252: f64 = v497.mul_add(v1250, v1251);
-    let v1253: f64 = v657.mul_add(v1245, v1252);
-    let v1254: f64 = v450.mul_add(v1165, -v1253);
-    let v1255: f64 = v505 * v1250;
-    let v1256: f64 = v435.mul_add(v1254, v1255);
-    let v1257: f64 = v576.mul_add(v1247, v1256);
-    let v1258: f64 = v656.mul_add(v1245, v1257);
-    let v1259: f64 = v394.mul_add(v1133, -v1258);
-    let v1260: f64 = v441 * v1254;
-    let v1261: f64 = v381.mul_add(v1259, v1260);
-    let v1262: f64 = v503.mul_add(v1250, v1261);
-    let v1263: f64 = v574.mul_add(v1247, v1262);
-    let v1264: f64 = v654.mul_add(v1245, v1263);
-    let v1265: f64 = v345.mul_add(v1102, -v1264);
-    let v1266: f64 = v386 * v1259;
-    let v1267: f64 = v335.mul_add(v1265, v1266);
-    let v1268: f64 = v440.mul_add(v1254, v1267);
-    let v1269: f64 = v502.mul_add(v1250, v1268);
-    let v1270: f64 = v573.mul_add(v1247, v1269);
-    let v1271: f64 = v653.mul_add(v1245, v1270);
-    let v1272: f64 = v302.mul_add(v1072, -v1271);
-    out[0usize] = v1272;
-    out[1usize] = v1265;
-    out[2usize] = v1259;
-    out[3usize] = v1254;
-    out[4usize] = v1250;
-    out[5usize] = v1247;
-    out[6usize] = v1245;
-    out[7usize] = v300;
-    out[8usize] = v344;
-    out[9usize] = v393;
-    out[10usize] = v449;
-    out[11usize] = v513;
-    out[12usize] = v586;
-    out[13usize] = v666;
-    out[14usize] = v335;
-    out[15usize] = v386;
-    out[16usize] = v381;
-    out[17usize] = v440;
-    out[18usize] = v441;
-    out[19usize] = v435;
-    out[20usize] = v502;
-    out[21usize] = v503;
-    out[22usize] = v505;
-    out[23usize] = v497;
-    out[24usize] = v573;
-    out[25usize] = v574;
-    out[26usize] = v576;
-    out[27usize] = v577;
-    out[28usize] = v568;
-    out[29usize] = v653;
-    out[30usize] = v654;
-    out[31usize] = v656;
-    out[32usize] = v657;
-    out[33usize] = v658;
-    out[34usize] = v647;
-    out2[0usize] = v300;
-    out2[1usize] = v334;
-    out2[2usize] = v377;
-    out2[3usize] = v426;
-    out2[4usize] = v482;
-    out2[5usize] = v546;
-    out2[6usize] = v617;
-    out2[7usize] = v343;
-    out2[8usize] = v379;
-    out2[9usize] = v428;
-    out2[10usize] = v484;
-    out2[11usize] = v548;
-    out2[12usize] = v619;
-    out2[13usize] = v392;
-    out2[14usize] = v433;
-    out2[15usize] = v490;
-    out2[16usize] = v554;
-    out2[17usize] = v625;
-    out2[18usize] = v448;
-    out2[19usize] = v495;
-    out2[20usize] = v560;
-    out2[21usize] = v631;
-    out2[22usize] = v512;
-    out2[23usize] = v566;
-    out2[24usize] = v638;
-    out2[25usize] = v585;
-    out2[26usize] = v645;
-    out2[27usize] = v665;
-    out2[28usize] = v1071;
-    out2[29usize] = v1100;
-    out2[30usize] = v1130;
-    out2[31usize] = v1161;
-    out2[32usize] = v1193;
-    out2[33usize] = v1226;
-    out2[34usize] = v1237;
+    let v184 = p[44] * v70;
+    let v185 = v184.mul_add(v183, v144);
+    let v187 = v184.mul_add(v186, v166);
+    let v188 = v187 * v187;
+    let v189 = v185.mul_add(v185, v188);
+    let v190 = p[55].mul_add(v75, p[46]);
+    let v191 = p[45].mul_add(v170, v190);
+    let v192 = p[7].mul_add(v189, v191);
+    let v195 = v58 * v58;
+    let v196 = p[57] * v195;
+    let v197 = p[38] * q[5];
+    let v198 = v197 * v55;
+    let v199 = v196.mul_add(v138, v131);
+    let v200 = (-v198).mul_add(v136, v199);
+    let v201 = v196.mul_add(v136, v165);
+    let v202 = v198.mul_add(v138, v201);
+    let v203 = v202 * v202;
+    let v204 = v200.mul_add(v200, v203);
+    let v205 = p[54].mul_add(v63, p[40]);
+    let v206 = v205 + v192;
+    let v207 = p[39].mul_add(v204, v206);
+    let v210 = v46 * v46;
+    let v211 = p[58] * v210;
+    let v212 = p[32] * q[4];
+    let v213 = v212 * v43;
+    let v214 = v211.mul_add(v125, v118);
+    let v215 = (-v213).mul_add(v123, v214);
+    let v216 = v211.mul_add(v123, v164);
+    let v217 = v213.mul_add(v125, v216);
+    let v218 = v217 * v217;
+    let v219 = v215.mul_add(v215, v218);
+    let v220 = p[53].mul_add(v51, p[34]);
+    let v221 = v220 + v207;
+    let v222 = p[33].mul_add(v219, v221);
+    let v225 = v34 * v34;
+    let v226 = p[59] * v225;
+    let v227 = p[26] * q[3];
+    let v228 = v227 * v31;
+    let v229 = v226.mul_add(v112, v105);
+    let v230 = (-v228).mul_add(v110, v229);
+    let v231 = v226.mul_add(v110, v163);
+    let v232 = v228.mul_add(v112, v231);
+    let v233 = v232 * v232;
+    let v234 = v230.mul_add(v230, v233);
+    let v235 = p[52].mul_add(v39, p[28]);
+    let v236 = v235 + v222;
+    let v237 = p[27].mul_add(v234, v236);
+    let v240 = v22 * v22;
+    let v241 = p[60] * v240;
+    let v242 = p[20] * q[2];
+    let v243 = v242 * v19;
+    let v244 = v241.mul_add(v99, v92);
+    let v245 = (-v243).mul_add(v97, v244);
+    let v246 = v241.mul_add(v97, v162);
+    let v247 = v243.mul_add(v99, v246);
+    let v248 = v247 * v247;
+    let v249 = v245.mul_add(v245, v248);
+    let v250 = p[51].mul_add(v27, p[22]);
+    let v251 = v250 + v237;
+    let v252 = p[21].mul_add(v249, v251);
+    let v255 = v9 * v9;
+    let v256 = p[61] * v255;
+    let v257 = p[14] * q[1];
+    let v258 = v257 * v4;
+    let v259 = v82.mul_add(v256, v84);
+    let v260 = (-v86).mul_add(v258, v259);
+    let v261 = v86.mul_add(v256, v161);
+    let v262 = v82.mul_add(v258, v261);
+    let v263 = v262 * v262;
+    let v264 = v260.mul_add(v260, v263);
+    let v265 = p[50].mul_add(v15, p[16]);
+    let v266 = v265 + v252;
+    let v267 = p[15].mul_add(v264, v266);
+    let v270 = p[62] * v82;
+    let v272 = p[63] * v86;
+    let v273 = v272 * v272;
+    let v274 = v270.mul_add(v270, v273);
+    let v275 = -v160;
+    let v276 = v161 + v275;
+    let v277 = p[7] * v187;
+    let v278 = p[45].mul_add(v168, v277);
+    let v279 = p[39].mul_add(v202, v278);
+    let v280 = p[33].mul_add(v217, v279);
+    let v281 = p[27].mul_add(v232, v280);
+    let v282 = p[21].mul_add(v247, v281);
+    let v283 = p[15].mul_add(v262, v282);
+    let v284 = 2f64 * v283;
+    let v286 = v276.mul_add(p[64], -v284);
+    let v287 = v83 - v84;
+    let v288 = p[7] * v185;
+    let v289 = p[45].mul_add(v158, v288);
+    let v290 = p[39].mul_add(v200, v289);
+    let v291 = p[33].mul_add(v215, v290);
+    let v292 = p[27].mul_add(v230, v291);
+    let v293 = p[21].mul_add(v245, v292);
+    let v294 = p[15].mul_add(v260, v293);
+    let v295 = v287 * p[64];
+    let v296 = 2f64.mul_add(v294, v295);
+    let v297 = p[10] + v267;
+    let v298 = p[9].mul_add(v274, v297);
+    let v299 = v276.mul_add(v286, v298);
+    let v300 = v287.mul_add(v296, v299);
+    let v302 = 1f64 / v300;
+    let v304 = 0.5f64 * v303;
+    let v305 = 0.5f64 * v9;
+    let v306 = v305 * v90;
+    let v307 = v95.mul_add(v304, v306);
+    let v308 = p[14].mul_add(v307, -v92);
+    let v309 = v305 * v95;
+    let v310 = v90.mul_add(v304, -v309);
+    let v311 = p[14].mul_add(v310, v162);
+    let v312 = v91 * v304;
+    let v314 = q[1].mul_add(v313, v4);
+    let v315 = p[14] * v314;
+    let v316 = v82 * v315;
+    let v317 = v86.mul_add(v312, v316);
+    let v318 = v86 * v315;
+    let v319 = v82.mul_add(v312, -v318);
+    let v320 = v262 * v319;
+    let v321 = v260.mul_add(v317, -v320);
+    let v322 = 0.5f64.mul_add(v265, v252);
+    let v323 = v308.mul_add(v293, v322);
+    let v324 = (-v311).mul_add(v282, v323);
+    let v325 = p[15].mul_add(v321, v324);
+    let v327 = v311 * p[65];
+    let v328 = v327 - v282;
+    let v329 = p[15].mul_add(v319, v328);
+    let v330 = v308 * p[65];
+    let v331 = v293 + v330;
+    let v332 = p[15].mul_add(v317, v331);
+    let v333 = v276.mul_add(v329, v325);
+    let v334 = v287.mul_add(v332, v333);
+    let v335 = v302 * v334;
+    let v336 = v317 * v317;
+    let v337 = v319.mul_add(v319, v336);
+    let v338 = (-2f64).mul_add(v282, v327);
+    let v339 = 2f64.mul_add(v293, v330);
+    let v340 = 0.25f64.mul_add(v265, v252);
+    let v341 = p[15].mul_add(v337, v340);
+    let v342 = v311.mul_add(v338, v341);
+    let v343 = v308.mul_add(v339, v342);
+    let v344 = (-v334).mul_add(v335, v343);
+    let v345 = 1f64 / v344;
+    let v347 = 0.5f64 * v346;
+    let v348 = 0.5f64 * v22;
+    let v349 = v348 * v103;
+    let v350 = v108.mul_add(v347, v349);
+    let v351 = p[20].mul_add(v350, -v105);
+    let v352 = v348 * v108;
+    let v353 = v103.mul_add(v347, -v352);
+    let v354 = p[20].mul_add(v353, v163);
+    let v355 = v104 * v347;
+    let v357 = q[2].mul_add(v356, v19);
+    let v358 = p[20] * v357;
+    let v359 = v99 * v358;
+    let v360 = v97.mul_add(v355, v359);
+    let v361 = v97 * v358;
+    let v362 = v99.mul_add(v355, -v361);
+    let v363 = v247 * v362;
+    let v364 = v245.mul_add(v360, -v363);
+    let v365 = 0.5f64.mul_add(v250, v237);
+    let v366 = v351.mul_add(v292, v365);
+    let v367 = (-v354).mul_add(v281, v366);
+    let v368 = p[21].mul_add(v364, v367);
+    let v370 = v354 * p[66];
+    let v371 = v370 - v281;
+    let v372 = p[21].mul_add(v362, v371);
+    let v373 = v351 * p[66];
+    let v374 = v292 + v373;
+    let v375 = p[21].mul_add(v360, v374);
+    let v376 = v276.mul_add(v372, v368);
+    let v377 = v287.mul_add(v375, v376);
+    let v378 = v311.mul_add(v372, v368);
+    let v379 = v308.mul_add(v375, v378);
+    let v380 = (-v335).mul_add(v377, v379);
+    let v381 = v345 * v380;
+    let v382 = v360 * v360;
+    let v383 = v362.mul_add(v362, v382);
+    let v384 = (-2f64).mul_add(v281, v370);
+    let v385 = 2f64.mul_add(v292, v373);
+    let v386 = v302 * v377;
+    let v387 = v380 * v381;
+    let v388 = v377.mul_add(v386, v387);
+    let v389 = 0.25f64.mul_add(v250, v237);
+    let v390 = p[21].mul_add(v383, v389);
+    let v391 = v354.mul_add(v384, v390);
+    let v392 = v351.mul_add(v385, v391);
+    let v393 = v392 - v388;
+    let v394 = 1f64 / v393;
+    let v396 = 0.5f64 * v395;
+    let v397 = 0.5f64 * v34;
+    let v398 = v397 * v116;
+    let v399 = v121.mul_add(v396, v398);
+    let v400 = p[26].mul_add(v399, -v118);
+    let v401 = v397 * v121;
+    let v402 = v116.mul_add(v396, -v401);
+    let v403 = p[26].mul_add(v402, v164);
+    let v404 = v117 * v396;
+    let v406 = q[3].mul_add(v405, v31);
+    let v407 = p[26] * v406;
+    let v408 = v112 * v407;
+    let v409 = v110.mul_add(v404, v408);
+    let v410 = v110 * v407;
+    let v411 = v112.mul_add(v404, -v410);
+    let v412 = v232 * v411;
+    let v413 = v230.mul_add(v409, -v412);
+    let v414 = 0.5f64.mul_add(v235, v222);
+    let v415 = v400.mul_add(v291, v414);
+    let v416 = (-v403).mul_add(v280, v415);
+    let v417 = p[27].mul_add(v413, v416);
+    let v419 = v403 * p[67];
+    let v420 = v419 - v280;
+    let v421 = p[27].mul_add(v411, v420);
+    let v422 = v400 * p[67];
+    let v423 = v291 + v422;
+    let v424 = p[27].mul_add(v409, v423);
+    let v425 = v276.mul_add(v421, v417);
+    let v426 = v287.mul_add(v424, v425);
+    let v427 = v311.mul_add(v421, v417);
+    let v428 = v308.mul_add(v424, v427);
+    let v429 = (-v335).mul_add(v426, v428);
+    let v430 = v381 * v429;
+    let v431 = v386.mul_add(v426, v430);
+    let v432 = v354.mul_add(v421, v417);
+    let v433 = v351.mul_add(v424, v432);
+    let v434 = v433 - v431;
+    let v435 = v394 * v434;
+    let v436 = v409 * v409;
+    let v437 = v411.mul_add(v411, v436);
+    let v438 = (-2f64).mul_add(v280, v419);
+    let v439 = 2f64.mul_add(v291, v422);
+    let v440 = v302 * v426;
+    let v441 = v345 * v429;
+    let v442 = v429 * v441;
+    let v443 = v426.mul_add(v440, v442);
+    let v444 = v434.mul_add(v435, v443);
+    let v445 = 0.25f64.mul_add(v235, v222);
+    let v446 = p[27].mul_add(v437, v445);
+    let v447 = v403.mul_add(v438, v446);
+    let v448 = v400.mul_add(v439, v447);
+    let v449 = v448 - v444;
+    let v450 = 1f64 / v449;
+    let v452 = 0.5f64 * v451;
+    let v453 = 0.5f64 * v46;
+    let v454 = v453 * v129;
+    let v455 = v134.mul_add(v452, v454);
+    let v456 = p[32].mul_add(v455, -v131);
+    let v457 = v453 * v134;
+    let v458 = v129.mul_add(v452, -v457);
+    let v459 = p[32].mul_add(v458, v165);
+    let v460 = v130 * v452;
+    let v462 = q[4].mul_add(v461, v43);
+    let v463 = p[32] * v462;
+    let v464 = v125 * v463;
+    let v465 = v123.mul_add(v460, v464);
+    let v466 = v123 * v463;
+    let v467 = v125.mul_add(v460, -v466);
+    let v468 = v217 * v467;
+    let v469 = v215.mul_add(v465, -v468);
+    let v470 = 0.5f64.mul_add(v220, v207);
+    let v471 = v456.mul_add(v290, v470);
+    let v472 = (-v459).mul_add(v279, v471);
+    let v473 = p[33].mul_add(v469, v472);
+    let v475 = v459 * p[68];
+    let v476 = v475 - v279;
+    let v477 = p[33].mul_add(v467, v476);
+    let v478 = v456 * p[68];
+    let v479 = v290 + v478;
+    let v480 = p[33].mul_add(v465, v479);
+    let v481 = v276.mul_add(v477, v473);
+    let v482 = v287.mul_add(v480, v481);
+    let v483 = v311.mul_add(v477, v473);
+    let v484 = v308.mul_add(v480, v483);
+    let v485 = (-v335).mul_add(v482, v484);
+    let v486 = v441 * v485;
+    let v487 = v381 * v485;
+    let v488 = v386.mul_add(v482, v487);
+    let v489 = v354.mul_add(v477, v473);
+    let v490 = v351.mul_add(v480, v489);
+    let v491 = v490 - v488;
+    let v492 = v440.mul_add(v482, v486);
+    let v493 = v435.mul_add(v491, v492);
+    let v494 = v403.mul_add(v477, v473);
+    let v495 = v400.mul_add(v480, v494);
+    let v496 = v495 - v493;
+    let v497 = v450 * v496;
+    let v498 = v465 * v465;
+    let v499 = v467.mul_add(v467, v498);
+    let v500 = (-2f64).mul_add(v279, v475);
+    let v501 = 2f64.mul_add(v290, v478);
+    let v502 = v302 * v482;
+    let v503 = v345 * v485;
+    let v504 = v485 * v503;
+    let v505 = v394 * v491;
+    let v506 = v482.mul_add(v502, v504);
+    let v507 = v491.mul_add(v505, v506);
+    let v508 = v496.mul_add(v497, v507);
+    let v509 = 0.25f64.mul_add(v220, v207);
+    let v510 = p[33].mul_add(v499, v509);
+    let v511 = v459.mul_add(v500, v510);
+    let v512 = v456.mul_add(v501, v511);
+    let v513 = v512 - v508;
+    let v514 = 1f64 / v513;
+    let v516 = 0.5f64 * v515;
+    let v517 = 0.5f64 * v58;
+    let v518 = v517 * v142;
+    let v519 = v149.mul_add(v516, v518);
+    let v520 = p[38].mul_add(v519, -v144);
+    let v521 = v517 * v149;
+    let v522 = v142.mul_add(v516, -v521);
+    let v523 = p[38].mul_add(v522, v166);
+    let v524 = v143 * v516;
+    let v526 = q[5].mul_add(v525, v55);
+    let v527 = p[38] * v526;
+    let v528 = v138 * v527;
+    let v529 = v136.mul_add(v524, v528);
+    let v530 = v136 * v527;
+    let v531 = v138.mul_add(v524, -v530);
+    let v532 = v202 * v531;
+    let v533 = v200.mul_add(v529, -v532);
+    let v534 = 0.5f64.mul_add(v205, v192);
+    let v535 = v520.mul_add(v289, v534);
+    let v536 = (-v523).mul_add(v278, v535);
+    let v537 = p[39].mul_add(v533, v536);
+    let v539 = v523 * p[69];
+    let v540 = v539 - v278;
+    let v541 = p[39].mul_add(v531, v540);
+    let v542 = v520 * p[69];
+    let v543 = v289 + v542;
+    let v544 = p[39].mul_add(v529, v543);
+    let v545 = v276.mul_add(v541, v537);
+    let v546 = v287.mul_add(v544, v545);
+    let v547 = v311.mul_add(v541, v537);
+    let v548 = v308.mul_add(v544, v547);
+    let v549 = (-v335).mul_add(v546, v548);
+    let v550 = v503 * v549;
+    let v551 = v381 * v549;
+    let v552 = v386.mul_add(v546, v551);
+    let v553 = v354.mul_add(v541, v537);
+    let v554 = v351.mul_add(v544, v553);
+    let v555 = v554 - v552;
+    let v556 = v441 * v549;
+    let v557 = v440.mul_add(v546, v556);
+    let v558 = v435.mul_add(v555, v557);
+    let v559 = v403.mul_add(v541, v537);
+    let v560 = v400.mul_add(v544, v559);
+    let v561 = v560 - v558;
+    let v562 = v502.mul_add(v546, v550);
+    let v563 = v505.mul_add(v555, v562);
+    let v564 = v497.mul_add(v561, v563);
+    let v565 = v459.mul_add(v541, v537);
+    let v566 = v456.mul_add(v544, v565);
+    let v567 = v566 - v564;
+    let v568 = v514 * v567;
+    let v569 = v529 * v529;
+    let v570 = v531.mul_add(v531, v569);
+    let v571 = (-2f64).mul_add(v278, v539);
+    let v572 = 2f64.mul_add(v289, v542);
+    let v573 = v302 * v546;
+    let v574 = v345 * v549;
+    let v575 = v549 * v574;
+    let v576 = v394 * v555;
+    let v577 = v450 * v561;
+    let v578 = v546.mul_add(v573, v575);
+    let v579 = v555.mul_add(v576, v578);
+    let v580 = v561.mul_add(v577, v579);
+    let v581 = v567.mul_add(v568, v580);
+    let v582 = 0.25f64.mul_add(v205, v192);
+    let v583 = p[39].mul_add(v570, v582);
+    let v584 = v523.mul_add(v571, v583);
+    let v585 = v520.mul_add(v572, v584);
+    let v586 = v585 - v581;
+    let v587 = 1f64 / v586;
+    let v589 = 0.5f64 * v588;
+    let v590 = 0.5f64 * v70;
+    let v591 = v590 * v183;
+    let v592 = v186.mul_add(v589, v591);
+    let v593 = p[44] * v592;
+    let v594 = v590 * v186;
+    let v595 = v183.mul_add(v589, -v594);
+    let v596 = p[44] * v595;
+    let v597 = v187 * v596;
+    let v598 = v185.mul_add(v593, -v597);
+    let v599 = p[7] * v598;
+    let v600 = v184 * v589;
+    let v602 = q[6].mul_add(v601, v67);
+    let v603 = p[44] * v602;
+    let v604 = v151 * v603;
+    let v605 = v156.mul_add(v600, v604);
+    let v606 = v156 * v603;
+    let v607 = v151.mul_add(v600, -v606);
+    let v608 = v168 * v607;
+    let v609 = v158.mul_add(v605, -v608);
+    let v610 = 0.5f64.mul_add(v190, v599);
+    let v611 = p[45].mul_add(v609, v610);
+    let v612 = p[7] * v596;
+    let v613 = p[45].mul_add(v607, v612);
+    let v614 = p[7] * v593;
+    let v615 = p[45].mul_add(v605, v614);
+    let v616 = v276.mul_add(v613, v611);
+    let v617 = v287.mul_add(v615, v616);
+    let v618 = v311.mul_add(v613, v611);
+    let v619 = v308.mul_add(v615, v618);
+    let v620 = (-v335).mul_add(v617, v619);
+    let v621 = v574 * v620;
+    let v622 = v381 * v620;
+    let v623 = v386.mul_add(v617, v622);
+    let v624 = v354.mul_add(v613, v611);
+    let v625 = v351.mul_add(v615, v624);
+    let v626 = v625 - v623;
+    let v627 = v441 * v620;
+    let v628 = v440.mul_add(v617, v627);
+    let v629 = v435.mul_add(v626, v628);
+    let v630 = v403.mul_add(v613, v611);
+    let v631 = v400.mul_add(v615, v630);
+    let v632 = v631 - v629;
+    let v633 = v503 * v620;
+    let v634 = v502.mul_add(v617, v633);
+    let v635 = v505.mul_add(v626, v634);
+    let v636 = v497.mul_add(v632, v635);
+    let v637 = v459.mul_add(v613, v611);
+    let v638 = v456.mul_add(v615, v637);
+    let v639 = v638 - v636;
+    let v640 = v573.mul_add(v617, v621);
+    let v641 = v576.mul_add(v626, v640);
+    let v642 = v577.mul_add(v632, v641);
+    let v643 = v568.mul_add(v639, v642);
+    let v644 = v523.mul_add(v613, v611);
+    let v645 = v520.mul_add(v615, v644);
+    let v646 = v645 - v643;
+    let v647 = v587 * v646;
+    let v648 = v605 * v605;
+    let v649 = v607.mul_add(v607, v648);
+    let v650 = p[45] * v649;
+    let v651 = v593 * v593;
+    let v652 = v596.mul_add(v596, v651);
+    let v653 = v302 * v617;
+    let v654 = v345 * v620;
+    let v655 = v620 * v654;
+    let v656 = v394 * v626;
+    let v657 = v450 * v632;
+    let v658 = v514 * v639;
+    let v659 = v617.mul_add(v653, v655);
+    let v660 = v626.mul_add(v656, v659);
+    let v661 = v632.mul_add(v657, v660);
+    let v662 = v639.mul_add(v658, v661);
+    let v663 = v646.mul_add(v647, v662);
+    let v664 = 0.25f64.mul_add(v190, v650);
+    let v665 = p[7].mul_add(v652, v664);
+    let v666 = v665 - v663;
+    let v667 = 1f64 / v666;
+    let v671 = 0.5f64 * qd[5];
+    let v673 = 0.5f64 * qd[4];
+    let v675 = 0.5f64 * qd[3];
+    let v677 = 0.5f64 * qd[2];
+    let v679 = 0.5f64 * qd[1];
+    let v681 = qd[0] + v679;
+    let v682 = v679 + v681;
+    let v683 = v677 + v682;
+    let v684 = v677 + v683;
+    let v685 = v675 + v684;
+    let v686 = v675 + v685;
+    let v687 = v673 + v686;
+    let v688 = v673 + v687;
+    let v689 = v671 + v688;
+    let v690 = v671 + v689;
+    let v691 = 0.5f64.mul_add(qd[6], v690);
+    let v692 = v691 * v691;
+    let v694 = (-0.5f64) * v692;
+    let v695 = (-v68).mul_add(v72, 2f64);
+    let v696 = v694 * v695;
+    let v697 = p[93] * v696;
+    let v698 = p[45] * v697;
+    let v700 = v70.powi(3i32);
+    let v701 = p[94] * v700;
+    let v702 = v701 * v694;
+    let v703 = v589 * v702;
+    let v706 = p[95] + q[6];
+    let v708 = qd[0] * qd[0];
+    let v709 = -v83;
+    let v710 = v708 * v709;
+    let v711 = 2f64 * qd[1];
+    let v712 = v711 * v681;
+    let v713 = v712 * v95;
+    let v714 = v713 * v304;
+    let v715 = qd[1] * qd[1];
+    let v717 = 0.25f64 * v716;
+    let v718 = v681 * v681;
+    let v719 = v9 * v718;
+    let v720 = v715.mul_add(v717, -v719);
+    let v721 = v90.mul_add(v720, -v714);
+    let v722 = p[14].mul_add(v721, v710);
+    let v723 = 2f64 * qd[2];
+    let v724 = v723 * v683;
+    let v725 = v724 * v108;
+    let v726 = v725 * v347;
+    let v727 = qd[2] * qd[2];
+    let v729 = 0.25f64 * v728;
+    let v730 = v683 * v683;
+    let v731 = v22 * v730;
+    let v732 = v727.mul_add(v729, -v731);
+    let v733 = v103.mul_add(v732, -v726);
+    let v734 = p[20].mul_add(v733, v722);
+    let v735 = 2f64 * qd[3];
+    let v736 = v735 * v685;
+    let v737 = v736 * v121;
+    let v738 = v737 * v396;
+    let v739 = qd[3] * qd[3];
+    let v741 = 0.25f64 * v740;
+    let v742 = v685 * v685;
+    let v743 = v34 * v742;
+    let v744 = v739.mul_add(v741, -v743);
+    let v745 = v116.mul_add(v744, -v738);
+    let v746 = p[26].mul_add(v745, v734);
+    let v747 = 2f64 * qd[4];
+    let v748 = v747 * v687;
+    let v749 = v748 * v134;
+    let v750 = v749 * v452;
+    let v751 = qd[4] * qd[4];
+    let v753 = 0.25f64 * v752;
+    let v754 = v687 * v687;
+    let v755 = v46 * v754;
+    let v756 = v751.mul_add(v753, -v755);
+    let v757 = v129.mul_add(v756, -v750);
+    let v758 = p[32].mul_add(v757, v746);
+    let v759 = 2f64 * qd[5];
+    let v760 = v759 * v689;
+    let v761 = v760 * v149;
+    let v762 = v761 * v516;
+    let v763 = qd[5] * qd[5];
+    let v765 = 0.25f64 * v764;
+    let v766 = v689 * v689;
+    let v767 = v58 * v766;
+    let v768 = v763.mul_add(v765, -v767);
+    let v769 = v142.mul_add(v768, -v762);
+    let v770 = p[38].mul_add(v769, v758);
+    let v771 = qd[6] * qd[6];
+    let v773 = 0.25f64 * v772;
+    let v774 = v70 * v773;
+    let v775 = v589.mul_add(v589, v774);
+    let v776 = p[44] * v775;
+    let v777 = v690 * v690;
+    let v778 = v147 * v777;
+    let v779 = 2f64 * qd[6];
+    let v780 = v779 * v690;
+    let v781 = v771.mul_add(v776, -v778);
+    let v782 = (-v780).mul_add(v603, v781);
+    let v784 = q[6] * v783;
+    let v785 = 2f64.mul_add(v601, v784);
+    let v786 = p[44] * v785;
+    let v787 = v771 * v786;
+    let v788 = v780 * v600;
+    let v789 = v154 * v777;
+    let v790 = v789 - v787;
+    let v791 = v790 - v788;
+    let v792 = v151.mul_add(v782, v770);
+    let v793 = v156.mul_add(v791, v792);
+    let v794 = p[71] + v793;
+    let v796 = v708 * v275;
+    let v797 = v712 * v90;
+    let v798 = v95 * v720;
+    let v799 = v797.mul_add(v304, v798);
+    let v800 = p[14].mul_add(v799, v796);
+    let v801 = v724 * v103;
+    let v802 = v108 * v732;
+    let v803 = v801.mul_add(v347, v802);
+    let v804 = p[20].mul_add(v803, v800);
+    let v805 = v736 * v116;
+    let v806 = v121 * v744;
+    let v807 = v805.mul_add(v396, v806);
+    let v808 = p[26].mul_add(v807, v804);
+    let v809 = v748 * v129;
+    let v810 = v134 * v756;
+    let v811 = v809.mul_add(v452, v810);
+    let v812 = p[32].mul_add(v811, v808);
+    let v813 = v760 * v142;
+    let v814 = v149 * v768;
+    let v815 = v813.mul_add(v516, v814);
+    let v816 = p[38].mul_add(v815, v812);
+    let v817 = v787 + v788;
+    let v818 = v817 - v789;
+    let v819 = v151.mul_add(v818, v816);
+    let v820 = v156.mul_add(v782, v819);
+    let v821 = p[70] + v820;
+    let v822 = v821 * v605;
+    let v824 = p[96] * q[6];
+    let v825 = v824 * v73;
+    let v826 = v794.mul_add(v607, v822);
+    let v827 = (-v825).mul_add(v694, v826);
+    let v828 = v779 * v691;
+    let v829 = v828 * v186;
+    let v830 = v829 * v589;
+    let v831 = v70 * v692;
+    let v832 = v771.mul_add(v773, -v831);
+    let v833 = v183.mul_add(v832, -v830);
+    let v834 = p[44].mul_add(v833, v770);
+    let v835 = p[71] + v834;
+    let v836 = v828 * v183;
+    let v837 = v186 * v832;
+    let v838 = v836.mul_add(v589, v837);
+    let v839 = p[44].mul_add(v838, v816);
+    let v840 = p[70] + v839;
+    let v841 = v840 * v593;
+    let v842 = v835.mul_add(v596, v841);
+    let v844 = v589 * v700;
+    let v845 = 2f64 * q[6];
+    let v846 = v601.mul_add(v695, -v844);
+    let v847 = (-v845).mul_add(v73, v846);
+    let v848 = p[55] * v847;
+    let v849 = 0.5f64 * v691;
+    let v850 = v849.mul_add(v848, p[48]);
+    let v851 = v9.powi(3i32);
+    let v852 = v304 * v851;
+    let v853 = 2f64 * q[1];
+    let v854 = (-v6).mul_add(v12, 2f64);
+    let v855 = v313.mul_add(v854, -v852);
+    let v856 = (-v853).mul_add(v13, v855);
+    let v857 = p[50] * v856;
+    let v858 = qd[1] * v681;
+    let v859 = v22.powi(3i32);
+    let v860 = v347 * v859;
+    let v861 = 2f64 * q[2];
+    let v862 = (-v20).mul_add(v24, 2f64);
+    let v863 = v356.mul_add(v862, -v860);
+    let v864 = (-v861).mul_add(v25, v863);
+    let v865 = p[51] * v864;
+    let v866 = qd[2] * v683;
+    let v867 = v34.powi(3i32);
+    let v868 = v396 * v867;
+    let v869 = 2f64 * q[3];
+    let v870 = (-v32).mul_add(v36, 2f64);
+    let v871 = v405.mul_add(v870, -v868);
+    let v872 = (-v869).mul_add(v37, v871);
+    let v873 = p[52] * v872;
+    let v874 = qd[3] * v685;
+    let v875 = v46.powi(3i32);
+    let v876 = v452 * v875;
+    let v877 = 2f64 * q[4];
+    let v878 = (-v44).mul_add(v48, 2f64);
+    let v879 = v461.mul_add(v878, -v876);
+    let v880 = (-v877).mul_add(v49, v879);
+    let v881 = p[53] * v880;
+    let v882 = qd[4] * v687;
+    let v883 = v58.powi(3i32);
+    let v884 = v516 * v883;
+    let v885 = 2f64 * q[5];
+    let v886 = (-v56).mul_add(v60, 2f64);
+    let v887 = v525.mul_add(v886, -v884);
+    let v888 = (-v885).mul_add(v61, v887);
+    let v889 = p[54] * v888;
+    let v890 = qd[5] * v689;
+    let v891 = qd[6] * v691;
+    let v892 = v187 * v835;
+    let v893 = v185.mul_add(v840, -v892);
+    let v894 = p[7] * v893;
+    let v895 = v168 * v794;
+    let v896 = v158.mul_add(v821, -v895);
+    let v897 = v891.mul_add(v848, v894);
+    let v898 = p[45].mul_add(v896, v897);
+    let v900 = q[5] * v899;
+    let v901 = 2f64.mul_add(v525, v900);
+    let v902 = p[38] * v901;
+    let v903 = v763 * v902;
+    let v904 = v759 * v688;
+    let v905 = v904 * v524;
+    let v906 = v688 * v688;
+    let v907 = v198 * v906;
+    let v908 = v903 + v905;
+    let v909 = v908 - v907;
+    let v910 = v58 * v765;
+    let v911 = v516.mul_add(v516, v910);
+    let v912 = p[38] * v911;
+    let v913 = v196 * v906;
+    let v914 = v763.mul_add(v912, -v913);
+    let v915 = (-v904).mul_add(v527, v914);
+    let v916 = v138.mul_add(v909, v812);
+    let v917 = v136.mul_add(v915, v916);
+    let v918 = p[70] + v917;
+    let v919 = v907 - v903;
+    let v920 = v919 - v905;
+    let v921 = v138.mul_add(v915, v758);
+    let v922 = v136.mul_add(v920, v921);
+    let v923 = p[71] + v922;
+    let v924 = v202 * v923;
+    let v925 = v200.mul_add(v918, -v924);
+    let v926 = v890.mul_add(v889, v898);
+    let v927 = p[39].mul_add(v925, v926);
+    let v929 = q[4] * v928;
+    let v930 = 2f64.mul_add(v461, v929);
+    let v931 = p[32] * v930;
+    let v932 = v751 * v931;
+    let v933 = v747 * v686;
+    let v934 = v933 * v460;
+    let v935 = v686 * v686;
+    let v936 = v213 * v935;
+    let v937 = v932 + v934;
+    let v938 = v937 - v936;
+    let v939 = v46 * v753;
+    let v940 = v452.mul_add(v452, v939);
+    let v941 = p[32] * v940;
+    let v942 = v211 * v935;
+    let v943 = v751.mul_add(v941, -v942);
+    let v944 = (-v933).mul_add(v463, v943);
+    let v945 = v125.mul_add(v938, v808);
+    let v946 = v123.mul_add(v944, v945);
+    let v947 = p[70] + v946;
+    let v948 = v936 - v932;
+    let v949 = v948 - v934;
+    let v950 = v125.mul_add(v944, v746);
+    let v951 = v123.mul_add(v949, v950);
+    let v952 = p[71] + v951;
+    let v953 = v217 * v952;
+    let v954 = v215.mul_add(v947, -v953);
+    let v955 = v882.mul_add(v881, v927);
+    let v956 = p[33].mul_add(v954, v955);
+    let v958 = q[3] * v957;
+    let v959 = 2f64.mul_add(v405, v958);
+    let v960 = p[26] * v959;
+    let v961 = v739 * v960;
+    let v962 = v735 * v684;
+    let v963 = v962 * v404;
+    let v964 = v684 * v684;
+    let v965 = v228 * v964;
+    let v966 = v961 + v963;
+    let v967 = v966 - v965;
+    let v968 = v34 * v741;
+    let v969 = v396.mul_add(v396, v968);
+    let v970 = p[26] * v969;
+    let v971 = v226 * v964;
+    let v972 = v739.mul_add(v970, -v971);
+    let v973 = (-v962).mul_add(v407, v972);
+    let v974 = v112.mul_add(v967, v804);
+    let v975 = v110.mul_add(v973, v974);
+    let v976 = p[70] + v975;
+    let v977 = v965 - v961;
+    let v978 = v977 - v963;
+    let v979 = v112.mul_add(v973, v734);
+    let v980 = v110.mul_add(v978, v979);
+    let v981 = p[71] + v980;
+    let v982 = v232 * v981;
+    let v983 = v230.mul_add(v976, -v982);
+    let v984 = v874.mul_add(v873, v956);
+    let v985 = p[27].mul_add(v983, v984);
+    let v987 = q[2] * v986;
+    let v988 = 2f64.mul_add(v356, v987);
+    let v989 = p[20] * v988;
+    let v990 = v727 * v989;
+    let v991 = v723 * v682;
+    let v992 = v991 * v355;
+    let v993 = v682 * v682;
+    let v994 = v243 * v993;
+    let v995 = v990 + v992;
+    let v996 = v995 - v994;
+    let v997 = v22 * v729;
+    let v998 = v347.mul_add(v347, v997);
+    let v999 = p[20] * v998;
+    let v1000 = v241 * v993;
+    let v1001 = v727.mul_add(v999, -v1000);
+    let v1002 = (-v991).mul_add(v358, v1001);
+    let v1003 = v99.mul_add(v996, v800);
+    let v1004 = v97.mul_add(v1002, v1003);
+    let v1005 = p[70] + v1004;
+    let v1006 = v994 - v990;
+    let v1007 = v1006 - v992;
+    let v1008 = v99.mul_add(v1002, v722);
+    let v1009 = v97.mul_add(v1007, v1008);
+    let v1010 = p[71] + v1009;
+    let v1011 = v247 * v1010;
+    let v1012 = v245.mul_add(v1005, -v1011);
+    let v1013 = v866.mul_add(v865, v985);
+    let v1014 = p[21].mul_add(v1012, v1013);
+    let v1016 = q[1] * v1015;
+    let v1017 = 2f64.mul_add(v313, v1016);
+    let v1018 = p[14] * v1017;
+    let v1019 = v715 * v1018;
+    let v1020 = 2f64 * qd[0];
+    let v1021 = v1020 * qd[1];
+    let v1022 = v1021 * v312;
+    let v1023 = v708 * v258;
+    let v1024 = v1019 + v1022;
+    let v1025 = v1024 - v1023;
+    let v1026 = v9 * v717;
+    let v1027 = v304.mul_add(v304, v1026);
+    let v1028 = p[14] * v1027;
+    let v1029 = v708 * v256;
+    let v1030 = v715.mul_add(v1028, -v1029);
+    let v1031 = (-v1021).mul_add(v315, v1030);
+    let v1032 = v82.mul_add(v1025, v796);
+    let v1033 = v86.mul_add(v1031, v1032);
+    let v1034 = p[70] + v1033;
+    let v1035 = v1023 - v1019;
+    let v1036 = v1035 - v1022;
+    let v1037 = v82.mul_add(v1031, v710);
+    let v1038 = v86.mul_add(v1036, v1037);
+    let v1039 = p[71] + v1038;
+    let v1040 = v262 * v1039;
+    let v1041 = v260.mul_add(v1034, -v1040);
+    let v1042 = v858.mul_add(v857, v1014);
+    let v1043 = p[15].mul_add(v1041, v1042);
+    let v1044 = p[7] * v835;
+    let v1045 = p[45].mul_add(v794, v1044);
+    let v1046 = p[39].mul_add(v923, v1045);
+    let v1047 = p[33].mul_add(v952, v1046);
+    let v1048 = p[27].mul_add(v981, v1047);
+    let v1049 = p[21].mul_add(v1010, v1048);
+    let v1050 = p[15].mul_add(v1039, v1049);
+    let v1051 = p[7] * v840;
+    let v1052 = p[45].mul_add(v821, v1051);
+    let v1053 = p[39].mul_add(v918, v1052);
+    let v1054 = p[33].mul_add(v947, v1053);
+    let v1055 = p[27].mul_add(v976, v1054);
+    let v1056 = p[21].mul_add(v1005, v1055);
+    let v1057 = p[15].mul_add(v1034, v1056);
+    let v1060 = p[72] + q[0];
+    let v1062 = p[63] * v82;
+    let v1063 = v708.mul_add(v1062, p[71]);
+    let v1064 = v708.mul_add(v272, p[70]);
+    let v1065 = v270 * v1064;
+    let v1066 = v272.mul_add(v1063, v1065);
+    let v1067 = v276.mul_add(v1050, v1043);
+    let v1068 = v287.mul_add(v1057, v1067);
+    let v1069 = p[11].mul_add(v1060, v1068);
+    let v1070 = p[12].mul_add(qd[0], v1069);
+    let v1071 = p[9].mul_add(v1066, v1070);
+    let v1072 = -v1071;
+    let v1074 = (-0.5f64) * v718;
+    let v1075 = v1074 * v854;
+    let v1076 = p[73] * v1075;
+    let v1077 = p[15] * v1076;
+    let v1079 = p[74] * v851;
+    let v1080 = v1079 * v1074;
+    let v1081 = v304 * v1080;
+    let v1084 = p[75] + q[1];
+    let v1085 = v1034 * v317;
+    let v1087 = p[76] * q[1];
+    let v1088 = v1087 * v13;
+    let v1089 = v1039.mul_add(v319, v1085);
+    let v1090 = (-v1088).mul_add(v1074, v1089);
+    let v1092 = 0.5f64 * v681;
+    let v1093 = v1092.mul_add(v857, p[18]);
+    let v1094 = v313.mul_add(v1077, v1081);
+    let v1095 = v1094 + v1014;
+    let v1096 = v311.mul_add(v1049, v1095);
+    let v1097 = v308.mul_add(v1056, v1096);
+    let v1098 = p[17].mul_add(v1084, v1097);
+    let v1099 = p[15].mul_add(v1090, v1098);
+    let v1100 = qd[1].mul_add(v1093, v1099);
+    let v1101 = v335.mul_add(v1072, v1100);
+    let v1102 = -v1101;
+    let v1104 = (-0.5f64) * v730;
+    let v1105 = v1104 * v862;
+    let v1106 = p[77] * v1105;
+    let v1107 = p[21] * v1106;
+    let v1109 = p[78] * v859;
+    let v1110 = v1109 * v1104;
+    let v1111 = v347 * v1110;
+    let v1114 = p[79] + q[2];
+    let v1115 = v1005 * v360;
+    let v1117 = p[80] * q[2];
+    let v1118 = v1117 * v25;
+    let v1119 = v1010.mul_add(v362, v1115);
+    let v1120 = (-v1118).mul_add(v1104, v1119);
+    let v1122 = 0.5f64 * v683;
+    let v1123 = v1122.mul_add(v865, p[24]);
+    let v1124 = v356.mul_add(v1107, v1111);
+    let v1125 = v1124 + v985;
+    let v1126 = v354.mul_add(v1048, v1125);
+    let v1127 = v351.mul_add(v1055, v1126);
+    let v1128 = p[23].mul_add(v1114, v1127);
+    let v1129 = p[21].mul_add(v1120, v1128);
+    let v1130 = qd[2].mul_add(v1123, v1129);
+    let v1131 = v386.mul_add(v1072, v1130);
+    let v1132 = v381.mul_add(v1102, v1131);
+    let v1133 = -v1132;
+    let v1135 = (-0.5f64) * v742;
+    let v1136 = v1135 * v870;
+    let v1137 = p[81] * v1136;
+    let v1138 = p[27] * v1137;
+    let v1140 = p[82] * v867;
+    let v1141 = v1140 * v1135;
+    let v1142 = v396 * v1141;
+    let v1145 = p[83] + q[3];
+    let v1146 = v976 * v409;
+    let v1148 = p[84] * q[3];
+    let v1149 = v1148 * v37;
+    let v1150 = v981.mul_add(v411, v1146);
+    let v1151 = (-v1149).mul_add(v1135, v1150);
+    let v1153 = 0.5f64 * v685;
+    let v1154 = v1153.mul_add(v873, p[30]);
+    let v1155 = v405.mul_add(v1138, v1142);
+    let v1156 = v1155 + v956;
+    let v1157 = v403.mul_add(v1047, v1156);
+    let v1158 = v400.mul_add(v1054, v1157);
+    let v1159 = p[29].mul_add(v1145, v1158);
+    let v1160 = p[27].mul_add(v1151, v1159);
+    let v1161 = qd[3].mul_add(v1154, v1160);
+    let v1162 = v440.mul_add(v1072, v1161);
+    let v1163 = v441.mul_add(v1102, v1162);
+    let v1164 = v435.mul_add(v1133, v1163);
+    let v1165 = -v1164;
+    let v1167 = (-0.5f64) * v754;
+    let v1168 = v1167 * v878;
+    let v1169 = p[85] * v1168;
+    let v1170 = p[33] * v1169;
+    let v1172 = p[86] * v875;
+    let v1173 = v1172 * v1167;
+    let v1174 = v452 * v1173;
+    let v1177 = p[87] + q[4];
+    let v1178 = v947 * v465;
+    let v1180 = p[88] * q[4];
+    let v1181 = v1180 * v49;
+    let v1182 = v952.mul_add(v467, v1178);
+    let v1183 = (-v1181).mul_add(v1167, v1182);
+    let v1185 = 0.5f64 * v687;
+    let v1186 = v1185.mul_add(v881, p[36]);
+    let v1187 = v461.mul_add(v1170, v1174);
+    let v1188 = v1187 + v927;
+    let v1189 = v459.mul_add(v1046, v1188);
+    let v1190 = v456.mul_add(v1053, v1189);
+    let v1191 = p[35].mul_add(v1177, v1190);
+    let v1192 = p[33].mul_add(v1183, v1191);
+    let v1193 = qd[4].mul_add(v1186, v1192);
+    let v1194 = v502.mul_add(v1072, v1193);
+    let v1195 = v503.mul_add(v1102, v1194);
+    let v1196 = v505.mul_add(v1133, v1195);
+    let v1197 = v497.mul_add(v1165, v1196);
+    let v1198 = -v1197;
+    let v1200 = (-0.5f64) * v766;
+    let v1201 = v1200 * v886;
+    let v1202 = p[89] * v1201;
+    let v1203 = p[39] * v1202;
+    let v1205 = p[90] * v883;
+    let v1206 = v1205 * v1200;
+    let v1207 = v516 * v1206;
+    let v1210 = p[91] + q[5];
+    let v1211 = v918 * v529;
+    let v1213 = p[92] * q[5];
+    let v1214 = v1213 * v61;
+    let v1215 = v923.mul_add(v531, v1211);
+    let v1216 = (-v1214).mul_add(v1200, v1215);
+    let v1218 = 0.5f64 * v689;
+    let v1219 = v1218.mul_add(v889, p[42]);
+    let v1220 = v525.mul_add(v1203, v1207);
+    let v1221 = v1220 + v898;
+    let v1222 = v523.mul_add(v1045, v1221);
+    let v1223 = v520.mul_add(v1052, v1222);
+    let v1224 = p[41].mul_add(v1210, v1223);
+    let v1225 = p[39].mul_add(v1216, v1224);
+    let v1226 = qd[5].mul_add(v1219, v1225);
+    let v1227 = v573.mul_add(v1072, v1226);
+    let v1228 = v574.mul_add(v1102, v1227);
+    let v1229 = v576.mul_add(v1133, v1228);
+    let v1230 = v577.mul_add(v1165, v1229);
+    let v1231 = v568.mul_add(v1198, v1230);
+    let v1232 = -v1231;
+    let v1233 = v601.mul_add(v698, v703);
+    let v1234 = p[47].mul_add(v706, v1233);
+    let v1235 = p[45].mul_add(v827, v1234);
+    let v1236 = p[7].mul_add(v842, v1235);
+    let v1237 = qd[6].mul_add(v850, v1236);
+    let v1238 = v653.mul_add(v1072, v1237);
+    let v1239 = v654.mul_add(v1102, v1238);
+    let v1240 = v656.mul_add(v1133, v1239);
+    let v1241 = v657.mul_add(v1165, v1240);
+    let v1242 = v658.mul_add(v1198, v1241);
+    let v1243 = v647.mul_add(v1232, v1242);
+    let v1244 = -v1243;
+    let v1245 = v667 * v1244;
+    let v1246 = v647 * v1245;
+    let v1247 = v587.mul_add(v1232, -v1246);
+    let v1248 = v658 * v1245;
+    let v1249 = v568.mul_add(v1247, v1248);
+    let v1250 = v514.mul_add(v1198, -v1249);
+    let v1251 = v577 * v1247;
+    let v1252 = v497.mul_add(v1250, v1251);
+    let v1253 = v657.mul_add(v1245, v1252);
+    let v1254 = v450.mul_add(v1165, -v1253);
+    let v1255 = v505 * v1250;
+    let v1256 = v435.mul_add(v1254, v1255);
+    let v1257 = v576.mul_add(v1247, v1256);
+    let v1258 = v656.mul_add(v1245, v1257);
+    let v1259 = v394.mul_add(v1133, -v1258);
+    let v1260 = v441 * v1254;
+    let v1261 = v381.mul_add(v1259, v1260);
+    let v1262 = v503.mul_add(v1250, v1261);
+    let v1263 = v574.mul_add(v1247, v1262);
+    let v1264 = v654.mul_add(v1245, v1263);
+    let v1265 = v345.mul_add(v1102, -v1264);
+    let v1266 = v386 * v1259;
+    let v1267 = v335.mul_add(v1265, v1266);
+    let v1268 = v440.mul_add(v1254, v1267);
+    let v1269 = v502.mul_add(v1250, v1268);
+    let v1270 = v573.mul_add(v1247, v1269);
+    let v1271 = v653.mul_add(v1245, v1270);
+    let v1272 = v302.mul_add(v1072, -v1271);
+    out[0] = v1272;
+    out[1] = v1265;
+    out[2] = v1259;
+    out[3] = v1254;
+    out[4] = v1250;
+    out[5] = v1247;
+    out[6] = v1245;
+    out[7] = v300;
+    out[8] = v344;
+    out[9] = v393;
+    out[10] = v449;
+    out[11] = v513;
+    out[12] = v586;
+    out[13] = v666;
+    out[14] = v335;
+    out[15] = v386;
+    out[16] = v381;
+    out[17] = v440;
+    out[18] = v441;
+    out[19] = v435;
+    out[20] = v502;
+    out[21] = v503;
+    out[22] = v505;
+    out[23] = v497;
+    out[24] = v573;
+    out[25] = v574;
+    out[26] = v576;
+    out[27] = v577;
+    out[28] = v568;
+    out[29] = v653;
+    out[30] = v654;
+    out[31] = v656;
+    out[32] = v657;
+    out[33] = v658;
+    out[34] = v647;
+    out2[0] = v300;
+    out2[1] = v334;
+    out2[2] = v377;
+    out2[3] = v426;
+    out2[4] = v482;
+    out2[5] = v546;
+    out2[6] = v617;
+    out2[7] = v343;
+    out2[8] = v379;
+    out2[9] = v428;
+    out2[10] = v484;
+    out2[11] = v548;
+    out2[12] = v619;
+    out2[13] = v392;
+    out2[14] = v433;
+    out2[15] = v490;
+    out2[16] = v554;
+    out2[17] = v625;
+    out2[18] = v448;
+    out2[19] = v495;
+    out2[20] = v560;
+    out2[21] = v631;
+    out2[22] = v512;
+    out2[23] = v566;
+    out2[24] = v638;
+    out2[25] = v585;
+    out2[26] = v645;
+    out2[27] = v665;
+    out2[28] = v1071;
+    out2[29] = v1100;
+    out2[30] = v1130;
+    out2[31] = v1161;
+    out2[32] = v1193;
+    out2[33] = v1226;
+    out2[34] = v1237;
 }
 /// Kernel `derived`: 80 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn derived(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    out: &mut [f64; 68usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    out: &mut [f64; 68],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1529,173 +1517,173 @@ pub fn derived(
 #[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 68usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    w: &mut [f64; 0],
+    out: &mut [f64; 68],
 ) {
-    let v2: f64 = p[14usize] * p[14usize];
-    let v3: f64 = p[15usize] * v2;
-    let v6: f64 = p[20usize] * p[20usize];
-    let v7: f64 = p[21usize] * v6;
-    let v10: f64 = p[26usize] * p[26usize];
-    let v11: f64 = p[27usize] * v10;
-    let v14: f64 = p[32usize] * p[32usize];
-    let v15: f64 = p[33usize] * v14;
-    let v18: f64 = p[38usize] * p[38usize];
-    let v19: f64 = p[39usize] * v18;
-    let v22: f64 = p[44usize] * p[44usize];
-    let v23: f64 = p[45usize] * v22;
-    let v25: f64 = 0.5f64 * p[44usize];
-    let v26: f64 = 0.5f64 * p[38usize];
-    let v27: f64 = 0.5f64 * p[32usize];
-    let v28: f64 = 0.5f64 * p[26usize];
-    let v29: f64 = 0.5f64 * p[20usize];
-    let v30: f64 = 0.5f64 * p[14usize];
-    let v32: f64 = 0.5f64 * p[8usize];
-    let v34: f64 = (-0.5f64) * p[8usize];
-    let v36: f64 = p[7usize] + p[45usize];
-    let v37: f64 = p[39usize] + v36;
-    let v38: f64 = p[33usize] + v37;
-    let v39: f64 = p[27usize] + v38;
-    let v40: f64 = p[21usize] + v39;
-    let v41: f64 = p[15usize] + v40;
-    let v43: f64 = -p[1usize];
-    let v45: f64 = -p[0usize];
-    let v47: f64 = -p[13usize];
-    let v48: f64 = -v3;
-    let v50: f64 = -p[19usize];
-    let v52: f64 = 2f64 * v2;
-    let v53: f64 = -v7;
-    let v55: f64 = -p[25usize];
-    let v56: f64 = 2f64 * v6;
-    let v57: f64 = -v11;
-    let v59: f64 = -p[31usize];
-    let v60: f64 = 2f64 * v10;
-    let v61: f64 = -v15;
-    let v63: f64 = -p[37usize];
-    let v64: f64 = 2f64 * v14;
-    let v65: f64 = -v19;
-    let v67: f64 = -p[43usize];
-    let v68: f64 = 2f64 * v18;
-    let v69: f64 = -v23;
-    let v71: f64 = -p[49usize];
-    let v72: f64 = 2f64 * v22;
-    let v74: f64 = 0.5f64 * p[11usize];
-    let v76: f64 = 0.5f64 * p[17usize];
-    let v78: f64 = 0.5f64 * p[23usize];
-    let v80: f64 = 0.5f64 * p[29usize];
-    let v82: f64 = 0.5f64 * p[35usize];
-    let v84: f64 = 0.5f64 * p[41usize];
-    let v86: f64 = 0.5f64 * p[47usize];
-    let v89: f64 = p[2usize] * p[5usize];
-    let v91: f64 = 2f64 * p[9usize];
-    let v92: f64 = 2f64 * p[15usize];
-    let v93: f64 = v92 * v2;
-    let v95: f64 = 4f64 * p[15usize];
-    let v96: f64 = v95 * v2;
-    let v97: f64 = 2f64 * p[21usize];
-    let v98: f64 = v97 * v6;
-    let v99: f64 = 4f64 * p[21usize];
-    let v100: f64 = v99 * v6;
-    let v101: f64 = 2f64 * p[27usize];
-    let v102: f64 = v101 * v10;
-    let v103: f64 = 4f64 * p[27usize];
-    let v104: f64 = v103 * v10;
-    let v105: f64 = 2f64 * p[33usize];
-    let v106: f64 = v105 * v14;
-    let v107: f64 = 4f64 * p[33usize];
-    let v108: f64 = v107 * v14;
-    let v109: f64 = 2f64 * p[39usize];
-    let v110: f64 = v109 * v18;
-    let v111: f64 = 4f64 * p[39usize];
-    let v112: f64 = v111 * v18;
-    let v113: f64 = 2f64 * p[45usize];
-    let v114: f64 = v113 * v22;
-    let v115: f64 = 4f64 * p[45usize];
-    let v116: f64 = v115 * v22;
-    out[0usize] = v3;
-    out[1usize] = v7;
-    out[2usize] = v11;
-    out[3usize] = v15;
-    out[4usize] = v19;
-    out[5usize] = v23;
-    out[6usize] = v25;
-    out[7usize] = v26;
-    out[8usize] = v27;
-    out[9usize] = v28;
-    out[10usize] = v29;
-    out[11usize] = v30;
-    out[12usize] = v32;
-    out[13usize] = v34;
-    out[14usize] = v41;
-    out[15usize] = v40;
-    out[16usize] = v39;
-    out[17usize] = v38;
-    out[18usize] = v37;
-    out[19usize] = v36;
-    out[20usize] = v43;
-    out[21usize] = v45;
-    out[22usize] = v47;
-    out[23usize] = v2;
-    out[24usize] = v48;
-    out[25usize] = v50;
-    out[26usize] = v52;
-    out[27usize] = v6;
-    out[28usize] = v53;
-    out[29usize] = v55;
-    out[30usize] = v56;
-    out[31usize] = v10;
-    out[32usize] = v57;
-    out[33usize] = v59;
-    out[34usize] = v60;
-    out[35usize] = v14;
-    out[36usize] = v61;
-    out[37usize] = v63;
-    out[38usize] = v64;
-    out[39usize] = v18;
-    out[40usize] = v65;
-    out[41usize] = v67;
-    out[42usize] = v68;
-    out[43usize] = v22;
-    out[44usize] = v69;
-    out[45usize] = v71;
-    out[46usize] = v72;
-    out[47usize] = v74;
-    out[48usize] = v76;
-    out[49usize] = v78;
-    out[50usize] = v80;
-    out[51usize] = v82;
-    out[52usize] = v84;
-    out[53usize] = v86;
-    out[54usize] = v89;
-    out[55usize] = v91;
-    out[56usize] = v93;
-    out[57usize] = v96;
-    out[58usize] = v98;
-    out[59usize] = v100;
-    out[60usize] = v102;
-    out[61usize] = v104;
-    out[62usize] = v106;
-    out[63usize] = v108;
-    out[64usize] = v110;
-    out[65usize] = v112;
-    out[66usize] = v114;
-    out[67usize] = v116;
+    let v2 = p[14] * p[14];
+    let v3 = p[15] * v2;
+    let v6 = p[20] * p[20];
+    let v7 = p[21] * v6;
+    let v10 = p[26] * p[26];
+    let v11 = p[27] * v10;
+    let v14 = p[32] * p[32];
+    let v15 = p[33] * v14;
+    let v18 = p[38] * p[38];
+    let v19 = p[39] * v18;
+    let v22 = p[44] * p[44];
+    let v23 = p[45] * v22;
+    let v25 = 0.5f64 * p[44];
+    let v26 = 0.5f64 * p[38];
+    let v27 = 0.5f64 * p[32];
+    let v28 = 0.5f64 * p[26];
+    let v29 = 0.5f64 * p[20];
+    let v30 = 0.5f64 * p[14];
+    let v32 = 0.5f64 * p[8];
+    let v34 = (-0.5f64) * p[8];
+    let v36 = p[7] + p[45];
+    let v37 = p[39] + v36;
+    let v38 = p[33] + v37;
+    let v39 = p[27] + v38;
+    let v40 = p[21] + v39;
+    let v41 = p[15] + v40;
+    let v43 = -p[1];
+    let v45 = -p[0];
+    let v47 = -p[13];
+    let v48 = -v3;
+    let v50 = -p[19];
+    let v52 = 2f64 * v2;
+    let v53 = -v7;
+    let v55 = -p[25];
+    let v56 = 2f64 * v6;
+    let v57 = -v11;
+    let v59 = -p[31];
+    let v60 = 2f64 * v10;
+    let v61 = -v15;
+    let v63 = -p[37];
+    let v64 = 2f64 * v14;
+    let v65 = -v19;
+    let v67 = -p[43];
+    let v68 = 2f64 * v18;
+    let v69 = -v23;
+    let v71 = -p[49];
+    let v72 = 2f64 * v22;
+    let v74 = 0.5f64 * p[11];
+    let v76 = 0.5f64 * p[17];
+    let v78 = 0.5f64 * p[23];
+    let v80 = 0.5f64 * p[29];
+    let v82 = 0.5f64 * p[35];
+    let v84 = 0.5f64 * p[41];
+    let v86 = 0.5f64 * p[47];
+    let v89 = p[2] * p[5];
+    let v91 = 2f64 * p[9];
+    let v92 = 2f64 * p[15];
+    let v93 = v92 * v2;
+    let v95 = 4f64 * p[15];
+    let v96 = v95 * v2;
+    let v97 = 2f64 * p[21];
+    let v98 = v97 * v6;
+    let v99 = 4f64 * p[21];
+    let v100 = v99 * v6;
+    let v101 = 2f64 * p[27];
+    let v102 = v101 * v10;
+    let v103 = 4f64 * p[27];
+    let v104 = v103 * v10;
+    let v105 = 2f64 * p[33];
+    let v106 = v105 * v14;
+    let v107 = 4f64 * p[33];
+    let v108 = v107 * v14;
+    let v109 = 2f64 * p[39];
+    let v110 = v109 * v18;
+    let v111 = 4f64 * p[39];
+    let v112 = v111 * v18;
+    let v113 = 2f64 * p[45];
+    let v114 = v113 * v22;
+    let v115 = 4f64 * p[45];
+    let v116 = v115 * v22;
+    out[0] = v3;
+    out[1] = v7;
+    out[2] = v11;
+    out[3] = v15;
+    out[4] = v19;
+    out[5] = v23;
+    out[6] = v25;
+    out[7] = v26;
+    out[8] = v27;
+    out[9] = v28;
+    out[10] = v29;
+    out[11] = v30;
+    out[12] = v32;
+    out[13] = v34;
+    out[14] = v41;
+    out[15] = v40;
+    out[16] = v39;
+    out[17] = v38;
+    out[18] = v37;
+    out[19] = v36;
+    out[20] = v43;
+    out[21] = v45;
+    out[22] = v47;
+    out[23] = v2;
+    out[24] = v48;
+    out[25] = v50;
+    out[26] = v52;
+    out[27] = v6;
+    out[28] = v53;
+    out[29] = v55;
+    out[30] = v56;
+    out[31] = v10;
+    out[32] = v57;
+    out[33] = v59;
+    out[34] = v60;
+    out[35] = v14;
+    out[36] = v61;
+    out[37] = v63;
+    out[38] = v64;
+    out[39] = v18;
+    out[40] = v65;
+    out[41] = v67;
+    out[42] = v68;
+    out[43] = v22;
+    out[44] = v69;
+    out[45] = v71;
+    out[46] = v72;
+    out[47] = v74;
+    out[48] = v76;
+    out[49] = v78;
+    out[50] = v80;
+    out[51] = v82;
+    out[52] = v84;
+    out[53] = v86;
+    out[54] = v89;
+    out[55] = v91;
+    out[56] = v93;
+    out[57] = v96;
+    out[58] = v98;
+    out[59] = v100;
+    out[60] = v102;
+    out[61] = v104;
+    out[62] = v106;
+    out[63] = v108;
+    out[64] = v110;
+    out[65] = v112;
+    out[66] = v114;
+    out[67] = v116;
 }
 /// Kernel `constraints`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn constraints(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1706,24 +1694,24 @@ pub fn constraints(
 #[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1734,36 +1722,36 @@ pub fn contact(
 #[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jacobian`: the points' positions, velocities and Jacobians in 0 groups; group g runs when `all` or `dir[g] != 0`.
 #[allow(unused_variables)]
 pub fn contact_jacobian(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
     all: bool,
-    p: &[f64; 118usize],
-    out: &mut [f64; 0usize],
+    p: &[f64; 118],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jvp`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact_jvp(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1774,13 +1762,13 @@ pub fn contact_jvp(
 #[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
@@ -1793,16 +1781,16 @@ static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyL
 #[allow(unused_variables)]
 pub fn jvp(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    out: &mut [f64; 7usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    out: &mut [f64; 7],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
-    let mut tau = [0.0; 7usize];
+    let mut tau = [0.0; 7];
     runtime::links::inverse_dynamics_tangent(
         &LINKS,
         &mut cells,
@@ -1819,12 +1807,12 @@ pub fn jvp(
 #[allow(unused_variables)]
 pub fn outputs(
     t: f64,
-    q: &[f64; 7usize],
-    qd: &[f64; 7usize],
-    qdd: &[f64; 7usize],
-    dir: &[f64; 14usize],
-    p: &[f64; 118usize],
-    out: &mut [f64; 9usize],
+    q: &[f64; 7],
+    qd: &[f64; 7],
+    qdd: &[f64; 7],
+    dir: &[f64; 14],
+    p: &[f64; 118],
+    out: &mut [f64; 9],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
@@ -1833,32 +1821,32 @@ pub fn outputs(
 /// The compiled cells and forces the link recursion evaluates.
 #[allow(dead_code)]
 struct LinkCells<'a> {
-    q: &'a [f64; 7usize],
-    qd: &'a [f64; 7usize],
-    p: &'a [f64; 118usize],
+    q: &'a [f64; 7],
+    qd: &'a [f64; 7],
+    p: &'a [f64; 118],
 }
 impl runtime::links::Cells for LinkCells<'_> {
     #[inline(always)]
     fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
-                    &[0.0; 2usize],
+                    &[0.0; 1],
+                    &[0.0; 2],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs"),
                 )
             }
-            1usize => {
+            1 => {
                 cell_1(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
-                    &[0.0; 2usize],
+                    &[0.0; 1],
+                    &[0.0; 2],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs"),
                 )
@@ -1882,29 +1870,29 @@ impl runtime::links::Cells for LinkCells<'_> {
         out: &mut [f64],
     ) {
         match c {
-            0usize => {
-                let mut dir = [0.0; 2usize];
-                dir[..1usize].copy_from_slice(dx);
-                dir[1usize..].copy_from_slice(dxd);
+            0 => {
+                let mut dir = [0.0; 2];
+                dir[..1].copy_from_slice(dx);
+                dir[1..].copy_from_slice(dxd);
                 cell_0_tangent(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
+                    &[0.0; 1],
                     &dir,
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs and derivatives"),
                 )
             }
-            1usize => {
-                let mut dir = [0.0; 2usize];
-                dir[..1usize].copy_from_slice(dx);
-                dir[1usize..].copy_from_slice(dxd);
+            1 => {
+                let mut dir = [0.0; 2];
+                dir[..1].copy_from_slice(dx);
+                dir[1..].copy_from_slice(dxd);
                 cell_1_tangent(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
+                    &[0.0; 1],
                     &dir,
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs and derivatives"),
@@ -1924,24 +1912,24 @@ impl runtime::links::Cells for LinkCells<'_> {
     }
     fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0_pose(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
-                    &[0.0; 2usize],
+                    &[0.0; 1],
+                    &[0.0; 2],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("pose outputs"),
                 )
             }
-            1usize => {
+            1 => {
                 cell_1_pose(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
-                    &[0.0; 2usize],
+                    &[0.0; 1],
+                    &[0.0; 2],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("pose outputs"),
                 )
@@ -1957,12 +1945,12 @@ impl runtime::links::Cells for LinkCells<'_> {
 #[allow(unused_unsafe)]
 pub fn cell_0_pose(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 38],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1973,83 +1961,83 @@ pub fn cell_0_pose(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 38],
 ) {
-    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0usize]);
-    let v3: f64 = -v2;
-    let v7: f64 = p[0usize] * v1;
-    let v8: f64 = p[0usize] * v2;
-    let v10: f64 = -v8;
-    let v11: f64 = qd[0usize] * v10;
-    let v12: f64 = qd[0usize] * v7;
-    let v14: f64 = 0.5f64 * p[0usize];
-    let v15: f64 = v14 * v1;
-    let v16: f64 = v14 * v2;
-    let v18: f64 = (-0.5f64) * p[0usize];
-    let v19: f64 = v18 * v2;
-    let v20: f64 = qd[0usize] * v19;
-    let v21: f64 = qd[0usize] * v15;
-    let v24: f64 = 0.5f64 * q[0usize];
+    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0]);
+    let v3 = -v2;
+    let v7 = p[0] * v1;
+    let v8 = p[0] * v2;
+    let v10 = -v8;
+    let v11 = qd[0] * v10;
+    let v12 = qd[0] * v7;
+    let v14 = 0.5f64 * p[0];
+    let v15 = v14 * v1;
+    let v16 = v14 * v2;
+    let v18 = (-0.5f64) * p[0];
+    let v19 = v18 * v2;
+    let v20 = qd[0] * v19;
+    let v21 = qd[0] * v15;
+    let v24 = 0.5f64 * q[0];
     let (v26, v25): (f64, f64) = runtime::special::sin_cos(v24);
-    let v29: f64 = q[0usize] - p[6usize];
-    let v30: f64 = v29 * v29;
-    let v31: f64 = 0.5f64 * p[4usize];
-    let v32: f64 = v31 * v30;
-    out[0usize] = v1;
-    out[1usize] = v3;
-    out[2usize] = 0f64;
-    out[3usize] = v2;
-    out[4usize] = v1;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v7;
-    out[10usize] = v8;
-    out[11usize] = 0f64;
-    out[12usize] = v11;
-    out[13usize] = v12;
-    out[14usize] = 0f64;
-    out[15usize] = 0f64;
-    out[16usize] = 0f64;
-    out[17usize] = qd[0usize];
-    out[18usize] = v15;
-    out[19usize] = v16;
-    out[20usize] = 0f64;
-    out[21usize] = v20;
-    out[22usize] = v21;
-    out[23usize] = 0f64;
-    out[24usize] = 0f64;
-    out[25usize] = 0f64;
-    out[26usize] = qd[0usize];
-    out[27usize] = 1f64;
-    out[28usize] = 0f64;
-    out[29usize] = 0f64;
-    out[30usize] = p[1usize];
-    out[31usize] = p[2usize];
-    out[32usize] = p[2usize];
-    out[33usize] = v25;
-    out[34usize] = 0f64;
-    out[35usize] = 0f64;
-    out[36usize] = v26;
-    out[37usize] = v32;
+    let v29 = q[0] - p[6];
+    let v30 = v29 * v29;
+    let v31 = 0.5f64 * p[4];
+    let v32 = v31 * v30;
+    out[0] = v1;
+    out[1] = v3;
+    out[2] = 0f64;
+    out[3] = v2;
+    out[4] = v1;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v7;
+    out[10] = v8;
+    out[11] = 0f64;
+    out[12] = v11;
+    out[13] = v12;
+    out[14] = 0f64;
+    out[15] = 0f64;
+    out[16] = 0f64;
+    out[17] = qd[0];
+    out[18] = v15;
+    out[19] = v16;
+    out[20] = 0f64;
+    out[21] = v20;
+    out[22] = v21;
+    out[23] = 0f64;
+    out[24] = 0f64;
+    out[25] = 0f64;
+    out[26] = qd[0];
+    out[27] = 1f64;
+    out[28] = 0f64;
+    out[29] = 0f64;
+    out[30] = p[1];
+    out[31] = p[2];
+    out[32] = p[2];
+    out[33] = v25;
+    out[34] = 0f64;
+    out[35] = 0f64;
+    out[36] = v26;
+    out[37] = v32;
 }
 /// Kernel `cell_0`: 26 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 59usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 59],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2060,108 +2048,108 @@ pub fn cell_0(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 59usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 59],
 ) {
-    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0usize]);
-    let v3: f64 = -v2;
-    let v7: f64 = p[0usize] * v1;
-    let v8: f64 = p[0usize] * v2;
-    let v10: f64 = -v8;
-    let v11: f64 = qd[0usize] * v10;
-    let v12: f64 = qd[0usize] * v7;
-    let v13: f64 = qd[0usize] * qd[0usize];
-    let v14: f64 = -v7;
-    let v15: f64 = v13 * v14;
-    let v16: f64 = v13 * v10;
-    let v18: f64 = 0.5f64 * p[0usize];
-    let v19: f64 = v18 * v1;
-    let v20: f64 = v18 * v2;
-    let v22: f64 = (-0.5f64) * p[0usize];
-    let v23: f64 = v22 * v2;
-    let v24: f64 = qd[0usize] * v23;
-    let v25: f64 = qd[0usize] * v19;
-    let v26: f64 = v22 * v1;
-    let v27: f64 = v13 * v26;
-    let v28: f64 = v13 * v23;
-    let v33: f64 = q[0usize] - p[6usize];
-    let v35: f64 = qd[0usize] * p[5usize];
-    let v36: f64 = p[4usize].mul_add(v33, v35);
-    out[0usize] = v1;
-    out[1usize] = v3;
-    out[2usize] = 0f64;
-    out[3usize] = v2;
-    out[4usize] = v1;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v7;
-    out[10usize] = v8;
-    out[11usize] = 0f64;
-    out[12usize] = v11;
-    out[13usize] = v12;
-    out[14usize] = 0f64;
-    out[15usize] = v15;
-    out[16usize] = v16;
-    out[17usize] = 0f64;
-    out[18usize] = 0f64;
-    out[19usize] = 0f64;
-    out[20usize] = qd[0usize];
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = v19;
-    out[25usize] = v20;
-    out[26usize] = 0f64;
-    out[27usize] = v24;
-    out[28usize] = v25;
-    out[29usize] = 0f64;
-    out[30usize] = v27;
-    out[31usize] = v28;
-    out[32usize] = 0f64;
-    out[33usize] = 0f64;
-    out[34usize] = 0f64;
-    out[35usize] = qd[0usize];
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
-    out[38usize] = 0f64;
-    out[39usize] = 1f64;
-    out[40usize] = 0f64;
-    out[41usize] = 0f64;
-    out[42usize] = p[1usize];
-    out[43usize] = p[2usize];
-    out[44usize] = p[2usize];
-    out[45usize] = 0f64;
-    out[46usize] = 0f64;
-    out[47usize] = 1f64;
-    out[48usize] = v10;
-    out[49usize] = v7;
-    out[50usize] = 0f64;
-    out[51usize] = 0f64;
-    out[52usize] = 0f64;
-    out[53usize] = 1f64;
-    out[54usize] = v23;
-    out[55usize] = v19;
-    out[56usize] = 0f64;
-    out[57usize] = v36;
-    out[58usize] = 0f64;
+    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0]);
+    let v3 = -v2;
+    let v7 = p[0] * v1;
+    let v8 = p[0] * v2;
+    let v10 = -v8;
+    let v11 = qd[0] * v10;
+    let v12 = qd[0] * v7;
+    let v13 = qd[0] * qd[0];
+    let v14 = -v7;
+    let v15 = v13 * v14;
+    let v16 = v13 * v10;
+    let v18 = 0.5f64 * p[0];
+    let v19 = v18 * v1;
+    let v20 = v18 * v2;
+    let v22 = (-0.5f64) * p[0];
+    let v23 = v22 * v2;
+    let v24 = qd[0] * v23;
+    let v25 = qd[0] * v19;
+    let v26 = v22 * v1;
+    let v27 = v13 * v26;
+    let v28 = v13 * v23;
+    let v33 = q[0] - p[6];
+    let v35 = qd[0] * p[5];
+    let v36 = p[4].mul_add(v33, v35);
+    out[0] = v1;
+    out[1] = v3;
+    out[2] = 0f64;
+    out[3] = v2;
+    out[4] = v1;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v7;
+    out[10] = v8;
+    out[11] = 0f64;
+    out[12] = v11;
+    out[13] = v12;
+    out[14] = 0f64;
+    out[15] = v15;
+    out[16] = v16;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = qd[0];
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = v19;
+    out[25] = v20;
+    out[26] = 0f64;
+    out[27] = v24;
+    out[28] = v25;
+    out[29] = 0f64;
+    out[30] = v27;
+    out[31] = v28;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = qd[0];
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 1f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = p[1];
+    out[43] = p[2];
+    out[44] = p[2];
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 1f64;
+    out[48] = v10;
+    out[49] = v7;
+    out[50] = 0f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 1f64;
+    out[54] = v23;
+    out[55] = v19;
+    out[56] = 0f64;
+    out[57] = v36;
+    out[58] = 0f64;
 }
 /// Kernel `cell_0_tangent`: 72 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0_tangent(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 118usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 118],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2172,204 +2160,204 @@ pub fn cell_0_tangent(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 118usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 118],
 ) {
-    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0usize]);
-    let v3: f64 = -v2;
-    let v7: f64 = p[0usize] * v1;
-    let v8: f64 = p[0usize] * v2;
-    let v10: f64 = -v8;
-    let v11: f64 = qd[0usize] * v10;
-    let v12: f64 = qd[0usize] * v7;
-    let v13: f64 = qd[0usize] * qd[0usize];
-    let v14: f64 = -v7;
-    let v15: f64 = v13 * v14;
-    let v16: f64 = v13 * v10;
-    let v18: f64 = 0.5f64 * p[0usize];
-    let v19: f64 = v18 * v1;
-    let v20: f64 = v18 * v2;
-    let v22: f64 = (-0.5f64) * p[0usize];
-    let v23: f64 = v22 * v2;
-    let v24: f64 = qd[0usize] * v23;
-    let v25: f64 = qd[0usize] * v19;
-    let v26: f64 = v22 * v1;
-    let v27: f64 = v13 * v26;
-    let v28: f64 = v13 * v23;
-    let v33: f64 = q[0usize] - p[6usize];
-    let v35: f64 = qd[0usize] * p[5usize];
-    let v36: f64 = p[4usize].mul_add(v33, v35);
-    let v38: f64 = v2 * dir[0usize];
-    let v39: f64 = -v38;
-    let v40: f64 = v1 * dir[0usize];
-    let v41: f64 = -v40;
-    let v42: f64 = v10 * dir[0usize];
-    let v43: f64 = v7 * dir[0usize];
-    let v45: f64 = qd[0usize] * v14;
-    let v46: f64 = v45 * dir[0usize];
-    let v47: f64 = v10.mul_add(dir[1usize], v46);
-    let v48: f64 = v11 * dir[0usize];
-    let v49: f64 = v7.mul_add(dir[1usize], v48);
-    let v50: f64 = v8 * v13;
-    let v52: f64 = 2f64 * qd[0usize];
-    let v53: f64 = v52 * v14;
-    let v54: f64 = v53 * dir[1usize];
-    let v55: f64 = v50.mul_add(dir[0usize], v54);
-    let v56: f64 = v52 * v10;
-    let v57: f64 = v56 * dir[1usize];
-    let v58: f64 = v15.mul_add(dir[0usize], v57);
-    let v59: f64 = v23 * dir[0usize];
-    let v60: f64 = v19 * dir[0usize];
-    let v61: f64 = qd[0usize] * v26;
-    let v62: f64 = v61 * dir[0usize];
-    let v63: f64 = v23.mul_add(dir[1usize], v62);
-    let v64: f64 = v24 * dir[0usize];
-    let v65: f64 = v19.mul_add(dir[1usize], v64);
-    let v66: f64 = v20 * v13;
-    let v67: f64 = v52 * v26;
-    let v68: f64 = v67 * dir[1usize];
-    let v69: f64 = v66.mul_add(dir[0usize], v68);
-    let v70: f64 = v52 * v23;
-    let v71: f64 = v70 * dir[1usize];
-    let v72: f64 = v27.mul_add(dir[0usize], v71);
-    let v73: f64 = v14 * dir[0usize];
-    let v74: f64 = v26 * dir[0usize];
-    let v75: f64 = p[5usize] * dir[1usize];
-    let v76: f64 = p[4usize].mul_add(dir[0usize], v75);
-    out[0usize] = v1;
-    out[1usize] = v3;
-    out[2usize] = 0f64;
-    out[3usize] = v2;
-    out[4usize] = v1;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v7;
-    out[10usize] = v8;
-    out[11usize] = 0f64;
-    out[12usize] = v11;
-    out[13usize] = v12;
-    out[14usize] = 0f64;
-    out[15usize] = v15;
-    out[16usize] = v16;
-    out[17usize] = 0f64;
-    out[18usize] = 0f64;
-    out[19usize] = 0f64;
-    out[20usize] = qd[0usize];
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = v19;
-    out[25usize] = v20;
-    out[26usize] = 0f64;
-    out[27usize] = v24;
-    out[28usize] = v25;
-    out[29usize] = 0f64;
-    out[30usize] = v27;
-    out[31usize] = v28;
-    out[32usize] = 0f64;
-    out[33usize] = 0f64;
-    out[34usize] = 0f64;
-    out[35usize] = qd[0usize];
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
-    out[38usize] = 0f64;
-    out[39usize] = 1f64;
-    out[40usize] = 0f64;
-    out[41usize] = 0f64;
-    out[42usize] = p[1usize];
-    out[43usize] = p[2usize];
-    out[44usize] = p[2usize];
-    out[45usize] = 0f64;
-    out[46usize] = 0f64;
-    out[47usize] = 1f64;
-    out[48usize] = v10;
-    out[49usize] = v7;
-    out[50usize] = 0f64;
-    out[51usize] = 0f64;
-    out[52usize] = 0f64;
-    out[53usize] = 1f64;
-    out[54usize] = v23;
-    out[55usize] = v19;
-    out[56usize] = 0f64;
-    out[57usize] = v36;
-    out[58usize] = 0f64;
-    out[59usize] = v39;
-    out[60usize] = v41;
-    out[61usize] = 0f64;
-    out[62usize] = v40;
-    out[63usize] = v39;
-    out[64usize] = 0f64;
-    out[65usize] = 0f64;
-    out[66usize] = 0f64;
-    out[67usize] = 0f64;
-    out[68usize] = v42;
-    out[69usize] = v43;
-    out[70usize] = 0f64;
-    out[71usize] = v47;
-    out[72usize] = v49;
-    out[73usize] = 0f64;
-    out[74usize] = v55;
-    out[75usize] = v58;
-    out[76usize] = 0f64;
-    out[77usize] = 0f64;
-    out[78usize] = 0f64;
-    out[79usize] = dir[1usize];
-    out[80usize] = 0f64;
-    out[81usize] = 0f64;
-    out[82usize] = 0f64;
-    out[83usize] = v59;
-    out[84usize] = v60;
-    out[85usize] = 0f64;
-    out[86usize] = v63;
-    out[87usize] = v65;
-    out[88usize] = 0f64;
-    out[89usize] = v69;
-    out[90usize] = v72;
-    out[91usize] = 0f64;
-    out[92usize] = 0f64;
-    out[93usize] = 0f64;
-    out[94usize] = dir[1usize];
-    out[95usize] = 0f64;
-    out[96usize] = 0f64;
-    out[97usize] = 0f64;
-    out[98usize] = 0f64;
-    out[99usize] = 0f64;
-    out[100usize] = 0f64;
-    out[101usize] = 0f64;
-    out[102usize] = 0f64;
-    out[103usize] = 0f64;
-    out[104usize] = 0f64;
-    out[105usize] = 0f64;
-    out[106usize] = 0f64;
-    out[107usize] = v73;
-    out[108usize] = v42;
-    out[109usize] = 0f64;
-    out[110usize] = 0f64;
-    out[111usize] = 0f64;
-    out[112usize] = 0f64;
-    out[113usize] = v74;
-    out[114usize] = v59;
-    out[115usize] = 0f64;
-    out[116usize] = v76;
-    out[117usize] = 0f64;
+    let (v2, v1): (f64, f64) = runtime::special::sin_cos(q[0]);
+    let v3 = -v2;
+    let v7 = p[0] * v1;
+    let v8 = p[0] * v2;
+    let v10 = -v8;
+    let v11 = qd[0] * v10;
+    let v12 = qd[0] * v7;
+    let v13 = qd[0] * qd[0];
+    let v14 = -v7;
+    let v15 = v13 * v14;
+    let v16 = v13 * v10;
+    let v18 = 0.5f64 * p[0];
+    let v19 = v18 * v1;
+    let v20 = v18 * v2;
+    let v22 = (-0.5f64) * p[0];
+    let v23 = v22 * v2;
+    let v24 = qd[0] * v23;
+    let v25 = qd[0] * v19;
+    let v26 = v22 * v1;
+    let v27 = v13 * v26;
+    let v28 = v13 * v23;
+    let v33 = q[0] - p[6];
+    let v35 = qd[0] * p[5];
+    let v36 = p[4].mul_add(v33, v35);
+    let v38 = v2 * dir[0];
+    let v39 = -v38;
+    let v40 = v1 * dir[0];
+    let v41 = -v40;
+    let v42 = v10 * dir[0];
+    let v43 = v7 * dir[0];
+    let v45 = qd[0] * v14;
+    let v46 = v45 * dir[0];
+    let v47 = v10.mul_add(dir[1], v46);
+    let v48 = v11 * dir[0];
+    let v49 = v7.mul_add(dir[1], v48);
+    let v50 = v8 * v13;
+    let v52 = 2f64 * qd[0];
+    let v53 = v52 * v14;
+    let v54 = v53 * dir[1];
+    let v55 = v50.mul_add(dir[0], v54);
+    let v56 = v52 * v10;
+    let v57 = v56 * dir[1];
+    let v58 = v15.mul_add(dir[0], v57);
+    let v59 = v23 * dir[0];
+    let v60 = v19 * dir[0];
+    let v61 = qd[0] * v26;
+    let v62 = v61 * dir[0];
+    let v63 = v23.mul_add(dir[1], v62);
+    let v64 = v24 * dir[0];
+    let v65 = v19.mul_add(dir[1], v64);
+    let v66 = v20 * v13;
+    let v67 = v52 * v26;
+    let v68 = v67 * dir[1];
+    let v69 = v66.mul_add(dir[0], v68);
+    let v70 = v52 * v23;
+    let v71 = v70 * dir[1];
+    let v72 = v27.mul_add(dir[0], v71);
+    let v73 = v14 * dir[0];
+    let v74 = v26 * dir[0];
+    let v75 = p[5] * dir[1];
+    let v76 = p[4].mul_add(dir[0], v75);
+    out[0] = v1;
+    out[1] = v3;
+    out[2] = 0f64;
+    out[3] = v2;
+    out[4] = v1;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v7;
+    out[10] = v8;
+    out[11] = 0f64;
+    out[12] = v11;
+    out[13] = v12;
+    out[14] = 0f64;
+    out[15] = v15;
+    out[16] = v16;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = qd[0];
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = v19;
+    out[25] = v20;
+    out[26] = 0f64;
+    out[27] = v24;
+    out[28] = v25;
+    out[29] = 0f64;
+    out[30] = v27;
+    out[31] = v28;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = qd[0];
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 1f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = p[1];
+    out[43] = p[2];
+    out[44] = p[2];
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 1f64;
+    out[48] = v10;
+    out[49] = v7;
+    out[50] = 0f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 1f64;
+    out[54] = v23;
+    out[55] = v19;
+    out[56] = 0f64;
+    out[57] = v36;
+    out[58] = 0f64;
+    out[59] = v39;
+    out[60] = v41;
+    out[61] = 0f64;
+    out[62] = v40;
+    out[63] = v39;
+    out[64] = 0f64;
+    out[65] = 0f64;
+    out[66] = 0f64;
+    out[67] = 0f64;
+    out[68] = v42;
+    out[69] = v43;
+    out[70] = 0f64;
+    out[71] = v47;
+    out[72] = v49;
+    out[73] = 0f64;
+    out[74] = v55;
+    out[75] = v58;
+    out[76] = 0f64;
+    out[77] = 0f64;
+    out[78] = 0f64;
+    out[79] = dir[1];
+    out[80] = 0f64;
+    out[81] = 0f64;
+    out[82] = 0f64;
+    out[83] = v59;
+    out[84] = v60;
+    out[85] = 0f64;
+    out[86] = v63;
+    out[87] = v65;
+    out[88] = 0f64;
+    out[89] = v69;
+    out[90] = v72;
+    out[91] = 0f64;
+    out[92] = 0f64;
+    out[93] = 0f64;
+    out[94] = dir[1];
+    out[95] = 0f64;
+    out[96] = 0f64;
+    out[97] = 0f64;
+    out[98] = 0f64;
+    out[99] = 0f64;
+    out[100] = 0f64;
+    out[101] = 0f64;
+    out[102] = 0f64;
+    out[103] = 0f64;
+    out[104] = 0f64;
+    out[105] = 0f64;
+    out[106] = 0f64;
+    out[107] = v73;
+    out[108] = v42;
+    out[109] = 0f64;
+    out[110] = 0f64;
+    out[111] = 0f64;
+    out[112] = 0f64;
+    out[113] = v74;
+    out[114] = v59;
+    out[115] = 0f64;
+    out[116] = v76;
+    out[117] = 0f64;
 }
 /// Kernel `cell_1_pose`: 58 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_1_pose(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 38],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2380,112 +2368,110 @@ pub fn cell_1_pose(
 #[allow(unused_variables, clippy::all)]
 fn cell_1_pose_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 38],
 ) {
-    let v2: f64 = 0.5f64 * q[0usize];
-    let v3: f64 = v2 + v2;
+    let v2 = 0.5f64 * q[0];
+    let v3 = v2 + v2;
     let (v5, v4): (f64, f64) = runtime::special::sin_cos(v3);
-    let v6: f64 = -v5;
-    let [v10, v17]: [f64; 2usize] = runtime::special::sinc_orders::<2usize>(v2);
+    let v6 = -v5;
+    let [v10, v17]: [f64; 2] = runtime::special::sinc_orders::<2>(v2);
     let (v14, v11): (f64, f64) = runtime::special::sin_cos(v2);
-    let v12: f64 = p[0usize] * v10;
-    let v13: f64 = v12 * v11;
-    let v15: f64 = v12 * v14;
-    let v18: f64 = 0.5f64 * v17;
-    let v19: f64 = 0.5f64 * v10;
-    let v20: f64 = v19 * v14;
-    let v21: f64 = v11.mul_add(v18, -v20);
-    let v22: f64 = p[0usize] * v21;
-    let v23: f64 = qd[0usize] * v22;
-    let v24: f64 = v19 * v11;
-    let v25: f64 = v14.mul_add(v18, v24);
-    let v26: f64 = p[0usize] * v25;
-    let v27: f64 = qd[0usize] * v26;
-    let v28: f64 = 0.5f64 * qd[0usize];
-    let v29: f64 = v28 + v28;
-    let v30: f64 = v10 * v10;
-    let v31: f64 = 0.5f64 * p[0usize];
-    let v32: f64 = v31 * v30;
-    let [v33, v38]: [f64; 2usize] = runtime::special::sinc_rem_orders::<
-        2usize,
-    >(q[0usize]);
-    let v34: f64 = q[0usize] * p[0usize];
-    let v35: f64 = v34 * v33;
-    let v36: f64 = v12 * v18;
-    let v37: f64 = qd[0usize] * v36;
-    let v39: f64 = q[0usize].mul_add(v38, v33);
-    let v40: f64 = p[0usize] * v39;
-    let v41: f64 = qd[0usize] * v40;
-    let v45: f64 = v10.powi(4i32);
-    let v47: f64 = 0.25f64 * v45;
-    let v48: f64 = q[0usize] * q[0usize];
-    let v49: f64 = v33 * v33;
-    let v50: f64 = 2f64.mul_add(v33, -v47);
-    let v51: f64 = (-v48).mul_add(v49, v50);
-    let v52: f64 = p[0usize] * p[0usize];
-    let v53: f64 = p[1usize] * v51;
-    let v54: f64 = v53.mul_add(v52, p[2usize]);
-    let v55: f64 = 0.5f64 * v3;
+    let v12 = p[0] * v10;
+    let v13 = v12 * v11;
+    let v15 = v12 * v14;
+    let v18 = 0.5f64 * v17;
+    let v19 = 0.5f64 * v10;
+    let v20 = v19 * v14;
+    let v21 = v11.mul_add(v18, -v20);
+    let v22 = p[0] * v21;
+    let v23 = qd[0] * v22;
+    let v24 = v19 * v11;
+    let v25 = v14.mul_add(v18, v24);
+    let v26 = p[0] * v25;
+    let v27 = qd[0] * v26;
+    let v28 = 0.5f64 * qd[0];
+    let v29 = v28 + v28;
+    let v30 = v10 * v10;
+    let v31 = 0.5f64 * p[0];
+    let v32 = v31 * v30;
+    let [v33, v38]: [f64; 2] = runtime::special::sinc_rem_orders::<2>(q[0]);
+    let v34 = q[0] * p[0];
+    let v35 = v34 * v33;
+    let v36 = v12 * v18;
+    let v37 = qd[0] * v36;
+    let v39 = q[0].mul_add(v38, v33);
+    let v40 = p[0] * v39;
+    let v41 = qd[0] * v40;
+    let v45 = v10.powi(4i32);
+    let v47 = 0.25f64 * v45;
+    let v48 = q[0] * q[0];
+    let v49 = v33 * v33;
+    let v50 = 2f64.mul_add(v33, -v47);
+    let v51 = (-v48).mul_add(v49, v50);
+    let v52 = p[0] * p[0];
+    let v53 = p[1] * v51;
+    let v54 = v53.mul_add(v52, p[2]);
+    let v55 = 0.5f64 * v3;
     let (v57, v56): (f64, f64) = runtime::special::sin_cos(v55);
-    let v60: f64 = q[0usize] - p[6usize];
-    let v61: f64 = v60 * v60;
-    let v62: f64 = 0.5f64 * p[4usize];
-    let v63: f64 = v62 * v61;
-    out[0usize] = v4;
-    out[1usize] = v6;
-    out[2usize] = 0f64;
-    out[3usize] = v5;
-    out[4usize] = v4;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v13;
-    out[10usize] = v15;
-    out[11usize] = 0f64;
-    out[12usize] = v23;
-    out[13usize] = v27;
-    out[14usize] = 0f64;
-    out[15usize] = 0f64;
-    out[16usize] = 0f64;
-    out[17usize] = v29;
-    out[18usize] = v32;
-    out[19usize] = v35;
-    out[20usize] = 0f64;
-    out[21usize] = v37;
-    out[22usize] = v41;
-    out[23usize] = 0f64;
-    out[24usize] = 0f64;
-    out[25usize] = 0f64;
-    out[26usize] = v28;
-    out[27usize] = 1f64;
-    out[28usize] = 0f64;
-    out[29usize] = 0f64;
-    out[30usize] = p[1usize];
-    out[31usize] = v54;
-    out[32usize] = v54;
-    out[33usize] = v56;
-    out[34usize] = 0f64;
-    out[35usize] = 0f64;
-    out[36usize] = v57;
-    out[37usize] = v63;
+    let v60 = q[0] - p[6];
+    let v61 = v60 * v60;
+    let v62 = 0.5f64 * p[4];
+    let v63 = v62 * v61;
+    out[0] = v4;
+    out[1] = v6;
+    out[2] = 0f64;
+    out[3] = v5;
+    out[4] = v4;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v13;
+    out[10] = v15;
+    out[11] = 0f64;
+    out[12] = v23;
+    out[13] = v27;
+    out[14] = 0f64;
+    out[15] = 0f64;
+    out[16] = 0f64;
+    out[17] = v29;
+    out[18] = v32;
+    out[19] = v35;
+    out[20] = 0f64;
+    out[21] = v37;
+    out[22] = v41;
+    out[23] = 0f64;
+    out[24] = 0f64;
+    out[25] = 0f64;
+    out[26] = v28;
+    out[27] = 1f64;
+    out[28] = 0f64;
+    out[29] = 0f64;
+    out[30] = p[1];
+    out[31] = v54;
+    out[32] = v54;
+    out[33] = v56;
+    out[34] = 0f64;
+    out[35] = 0f64;
+    out[36] = v57;
+    out[37] = v63;
 }
 /// Kernel `cell_1`: 90 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_1(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 59usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 59],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2496,155 +2482,153 @@ pub fn cell_1(
 #[allow(unused_variables, clippy::all)]
 fn cell_1_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 59usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 59],
 ) {
-    let v2: f64 = 0.5f64 * q[0usize];
-    let v3: f64 = v2 + v2;
+    let v2 = 0.5f64 * q[0];
+    let v3 = v2 + v2;
     let (v5, v4): (f64, f64) = runtime::special::sin_cos(v3);
-    let v6: f64 = -v5;
-    let [v10, v17, v30]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v2);
+    let v6 = -v5;
+    let [v10, v17, v30]: [f64; 3] = runtime::special::sinc_orders::<3>(v2);
     let (v14, v11): (f64, f64) = runtime::special::sin_cos(v2);
-    let v12: f64 = p[0usize] * v10;
-    let v13: f64 = v12 * v11;
-    let v15: f64 = v12 * v14;
-    let v18: f64 = 0.5f64 * v17;
-    let v19: f64 = v11 * v18;
-    let v20: f64 = 0.5f64 * v10;
-    let v21: f64 = (-v20).mul_add(v14, v19);
-    let v22: f64 = p[0usize] * v21;
-    let v23: f64 = qd[0usize] * v22;
-    let v24: f64 = v14 * v18;
-    let v25: f64 = v20.mul_add(v11, v24);
-    let v26: f64 = p[0usize] * v25;
-    let v27: f64 = qd[0usize] * v26;
-    let v28: f64 = qd[0usize] * qd[0usize];
-    let v31: f64 = 0.25f64 * v30;
-    let v32: f64 = (-0.25f64).mul_add(v10, v31);
-    let v33: f64 = v11.mul_add(v32, -v24);
-    let v34: f64 = p[0usize] * v33;
-    let v35: f64 = v28 * v34;
-    let v36: f64 = v14.mul_add(v32, v19);
-    let v37: f64 = p[0usize] * v36;
-    let v38: f64 = v28 * v37;
-    let v39: f64 = 0.5f64 * qd[0usize];
-    let v40: f64 = v39 + v39;
-    let v41: f64 = v10 * v10;
-    let v42: f64 = 0.5f64 * p[0usize];
-    let v43: f64 = v42 * v41;
-    let [v44, v49, v58]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[0usize]);
-    let v45: f64 = q[0usize] * p[0usize];
-    let v46: f64 = v45 * v44;
-    let v47: f64 = v12 * v18;
-    let v48: f64 = qd[0usize] * v47;
-    let v50: f64 = q[0usize].mul_add(v49, v44);
-    let v51: f64 = p[0usize] * v50;
-    let v52: f64 = qd[0usize] * v51;
-    let v53: f64 = v10 * v31;
-    let v54: f64 = v18.mul_add(v18, v53);
-    let v55: f64 = p[0usize] * v54;
-    let v56: f64 = v28 * v55;
-    let v59: f64 = q[0usize] * v58;
-    let v60: f64 = 2f64.mul_add(v49, v59);
-    let v61: f64 = p[0usize] * v60;
-    let v62: f64 = v28 * v61;
-    let v65: f64 = 2f64 * v44;
-    let v66: f64 = v10.powi(4i32);
-    let v67: f64 = q[0usize] * q[0usize];
-    let v68: f64 = v44 * v44;
-    let v69: f64 = (-0.25f64).mul_add(v66, v65);
-    let v70: f64 = (-v67).mul_add(v68, v69);
-    let v71: f64 = p[0usize] * p[0usize];
-    let v72: f64 = p[1usize] * v70;
-    let v73: f64 = v72.mul_add(v71, p[2usize]);
-    let v76: f64 = q[0usize] - p[6usize];
-    let v78: f64 = qd[0usize] * p[5usize];
-    let v79: f64 = p[4usize].mul_add(v76, v78);
-    let v80: f64 = v10.powi(3i32);
-    let v81: f64 = v18 * v80;
-    let v82: f64 = 2f64 * q[0usize];
-    let v83: f64 = (-v65).mul_add(v67, 2f64);
-    let v84: f64 = v49.mul_add(v83, -v81);
-    let v85: f64 = (-v82).mul_add(v68, v84);
-    let v86: f64 = p[1usize] * v71;
-    let v87: f64 = v86 * v85;
-    out[0usize] = v4;
-    out[1usize] = v6;
-    out[2usize] = 0f64;
-    out[3usize] = v5;
-    out[4usize] = v4;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v13;
-    out[10usize] = v15;
-    out[11usize] = 0f64;
-    out[12usize] = v23;
-    out[13usize] = v27;
-    out[14usize] = 0f64;
-    out[15usize] = v35;
-    out[16usize] = v38;
-    out[17usize] = 0f64;
-    out[18usize] = 0f64;
-    out[19usize] = 0f64;
-    out[20usize] = v40;
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = v43;
-    out[25usize] = v46;
-    out[26usize] = 0f64;
-    out[27usize] = v48;
-    out[28usize] = v52;
-    out[29usize] = 0f64;
-    out[30usize] = v56;
-    out[31usize] = v62;
-    out[32usize] = 0f64;
-    out[33usize] = 0f64;
-    out[34usize] = 0f64;
-    out[35usize] = v39;
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
-    out[38usize] = 0f64;
-    out[39usize] = 1f64;
-    out[40usize] = 0f64;
-    out[41usize] = 0f64;
-    out[42usize] = p[1usize];
-    out[43usize] = v73;
-    out[44usize] = v73;
-    out[45usize] = 0f64;
-    out[46usize] = 0f64;
-    out[47usize] = 1f64;
-    out[48usize] = v22;
-    out[49usize] = v26;
-    out[50usize] = 0f64;
-    out[51usize] = 0f64;
-    out[52usize] = 0f64;
-    out[53usize] = 0.5f64;
-    out[54usize] = v47;
-    out[55usize] = v51;
-    out[56usize] = 0f64;
-    out[57usize] = v79;
-    out[58usize] = v87;
+    let v12 = p[0] * v10;
+    let v13 = v12 * v11;
+    let v15 = v12 * v14;
+    let v18 = 0.5f64 * v17;
+    let v19 = v11 * v18;
+    let v20 = 0.5f64 * v10;
+    let v21 = (-v20).mul_add(v14, v19);
+    let v22 = p[0] * v21;
+    let v23 = qd[0] * v22;
+    let v24 = v14 * v18;
+    let v25 = v20.mul_add(v11, v24);
+    let v26 = p[0] * v25;
+    let v27 = qd[0] * v26;
+    let v28 = qd[0] * qd[0];
+    let v31 = 0.25f64 * v30;
+    let v32 = (-0.25f64).mul_add(v10, v31);
+    let v33 = v11.mul_add(v32, -v24);
+    let v34 = p[0] * v33;
+    let v35 = v28 * v34;
+    let v36 = v14.mul_add(v32, v19);
+    let v37 = p[0] * v36;
+    let v38 = v28 * v37;
+    let v39 = 0.5f64 * qd[0];
+    let v40 = v39 + v39;
+    let v41 = v10 * v10;
+    let v42 = 0.5f64 * p[0];
+    let v43 = v42 * v41;
+    let [v44, v49, v58]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[0]);
+    let v45 = q[0] * p[0];
+    let v46 = v45 * v44;
+    let v47 = v12 * v18;
+    let v48 = qd[0] * v47;
+    let v50 = q[0].mul_add(v49, v44);
+    let v51 = p[0] * v50;
+    let v52 = qd[0] * v51;
+    let v53 = v10 * v31;
+    let v54 = v18.mul_add(v18, v53);
+    let v55 = p[0] * v54;
+    let v56 = v28 * v55;
+    let v59 = q[0] * v58;
+    let v60 = 2f64.mul_add(v49, v59);
+    let v61 = p[0] * v60;
+    let v62 = v28 * v61;
+    let v65 = 2f64 * v44;
+    let v66 = v10.powi(4i32);
+    let v67 = q[0] * q[0];
+    let v68 = v44 * v44;
+    let v69 = (-0.25f64).mul_add(v66, v65);
+    let v70 = (-v67).mul_add(v68, v69);
+    let v71 = p[0] * p[0];
+    let v72 = p[1] * v70;
+    let v73 = v72.mul_add(v71, p[2]);
+    let v76 = q[0] - p[6];
+    let v78 = qd[0] * p[5];
+    let v79 = p[4].mul_add(v76, v78);
+    let v80 = v10.powi(3i32);
+    let v81 = v18 * v80;
+    let v82 = 2f64 * q[0];
+    let v83 = (-v65).mul_add(v67, 2f64);
+    let v84 = v49.mul_add(v83, -v81);
+    let v85 = (-v82).mul_add(v68, v84);
+    let v86 = p[1] * v71;
+    let v87 = v86 * v85;
+    out[0] = v4;
+    out[1] = v6;
+    out[2] = 0f64;
+    out[3] = v5;
+    out[4] = v4;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v13;
+    out[10] = v15;
+    out[11] = 0f64;
+    out[12] = v23;
+    out[13] = v27;
+    out[14] = 0f64;
+    out[15] = v35;
+    out[16] = v38;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = v40;
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = v43;
+    out[25] = v46;
+    out[26] = 0f64;
+    out[27] = v48;
+    out[28] = v52;
+    out[29] = 0f64;
+    out[30] = v56;
+    out[31] = v62;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = v39;
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 1f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = p[1];
+    out[43] = v73;
+    out[44] = v73;
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 1f64;
+    out[48] = v22;
+    out[49] = v26;
+    out[50] = 0f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 0.5f64;
+    out[54] = v47;
+    out[55] = v51;
+    out[56] = 0f64;
+    out[57] = v79;
+    out[58] = v87;
 }
 /// Kernel `cell_1_tangent`: 188 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_1_tangent(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 118usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 118],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2655,281 +2639,277 @@ pub fn cell_1_tangent(
 #[allow(unused_variables, clippy::all)]
 fn cell_1_tangent_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 118usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 118],
 ) {
-    let v2: f64 = 0.5f64 * q[0usize];
-    let v3: f64 = v2 + v2;
+    let v2 = 0.5f64 * q[0];
+    let v3 = v2 + v2;
     let (v5, v4): (f64, f64) = runtime::special::sin_cos(v3);
-    let v6: f64 = -v5;
-    let [v10, v17, v30, v103]: [f64; 4usize] = runtime::special::sinc_orders::<
-        4usize,
-    >(v2);
+    let v6 = -v5;
+    let [v10, v17, v30, v103]: [f64; 4] = runtime::special::sinc_orders::<4>(v2);
     let (v14, v11): (f64, f64) = runtime::special::sin_cos(v2);
-    let v12: f64 = p[0usize] * v10;
-    let v13: f64 = v12 * v11;
-    let v15: f64 = v12 * v14;
-    let v18: f64 = 0.5f64 * v17;
-    let v19: f64 = v11 * v18;
-    let v20: f64 = 0.5f64 * v10;
-    let v21: f64 = (-v20).mul_add(v14, v19);
-    let v22: f64 = p[0usize] * v21;
-    let v23: f64 = qd[0usize] * v22;
-    let v24: f64 = v14 * v18;
-    let v25: f64 = v20.mul_add(v11, v24);
-    let v26: f64 = p[0usize] * v25;
-    let v27: f64 = qd[0usize] * v26;
-    let v28: f64 = qd[0usize] * qd[0usize];
-    let v31: f64 = 0.25f64 * v30;
-    let v32: f64 = (-0.25f64).mul_add(v10, v31);
-    let v33: f64 = v11.mul_add(v32, -v24);
-    let v34: f64 = p[0usize] * v33;
-    let v35: f64 = v28 * v34;
-    let v36: f64 = v14.mul_add(v32, v19);
-    let v37: f64 = p[0usize] * v36;
-    let v38: f64 = v28 * v37;
-    let v39: f64 = 0.5f64 * qd[0usize];
-    let v40: f64 = v39 + v39;
-    let v41: f64 = v10 * v10;
-    let v42: f64 = 0.5f64 * p[0usize];
-    let v43: f64 = v42 * v41;
-    let [v44, v49, v58, v142]: [f64; 4usize] = runtime::special::sinc_rem_orders::<
-        4usize,
-    >(q[0usize]);
-    let v45: f64 = q[0usize] * p[0usize];
-    let v46: f64 = v45 * v44;
-    let v47: f64 = v12 * v18;
-    let v48: f64 = qd[0usize] * v47;
-    let v50: f64 = q[0usize].mul_add(v49, v44);
-    let v51: f64 = p[0usize] * v50;
-    let v52: f64 = qd[0usize] * v51;
-    let v53: f64 = v18 * v18;
-    let v54: f64 = v10.mul_add(v31, v53);
-    let v55: f64 = p[0usize] * v54;
-    let v56: f64 = v28 * v55;
-    let v59: f64 = q[0usize] * v58;
-    let v60: f64 = 2f64.mul_add(v49, v59);
-    let v61: f64 = p[0usize] * v60;
-    let v62: f64 = v28 * v61;
-    let v65: f64 = 2f64 * v44;
-    let v66: f64 = v10.powi(4i32);
-    let v67: f64 = q[0usize] * q[0usize];
-    let v68: f64 = v44 * v44;
-    let v69: f64 = (-0.25f64).mul_add(v66, v65);
-    let v70: f64 = (-v67).mul_add(v68, v69);
-    let v71: f64 = p[0usize] * p[0usize];
-    let v72: f64 = p[1usize] * v70;
-    let v73: f64 = v72.mul_add(v71, p[2usize]);
-    let v76: f64 = q[0usize] - p[6usize];
-    let v78: f64 = qd[0usize] * p[5usize];
-    let v79: f64 = p[4usize].mul_add(v76, v78);
-    let v80: f64 = v10.powi(3i32);
-    let v81: f64 = v18 * v80;
-    let v82: f64 = 2f64 * q[0usize];
-    let v83: f64 = (-v65).mul_add(v67, 2f64);
-    let v84: f64 = v49.mul_add(v83, -v81);
-    let v85: f64 = (-v82).mul_add(v68, v84);
-    let v86: f64 = p[1usize] * v71;
-    let v87: f64 = v86 * v85;
-    let v89: f64 = v5 * dir[0usize];
-    let v90: f64 = -v89;
-    let v91: f64 = v4 * dir[0usize];
-    let v92: f64 = -v91;
-    let v93: f64 = v22 * dir[0usize];
-    let v94: f64 = v26 * dir[0usize];
-    let v96: f64 = qd[0usize] * v34;
-    let v97: f64 = v96 * dir[0usize];
-    let v98: f64 = v22.mul_add(dir[1usize], v97);
-    let v99: f64 = qd[0usize] * v37;
-    let v100: f64 = v99 * dir[0usize];
-    let v101: f64 = v26.mul_add(dir[1usize], v100);
-    let v105: f64 = 0.125f64 * v103;
-    let v106: f64 = (-0.75f64).mul_add(v18, v105);
-    let v107: f64 = 0.125f64 * v10;
-    let v109: f64 = 1.5f64 * v31;
-    let v110: f64 = v107 - v109;
-    let v111: f64 = v14 * v110;
-    let v112: f64 = v11.mul_add(v106, v111);
-    let v113: f64 = p[0usize] * v112;
-    let v114: f64 = v28 * dir[0usize];
-    let v115: f64 = 2f64 * qd[0usize];
-    let v116: f64 = v115 * v34;
-    let v117: f64 = v116 * dir[1usize];
-    let v118: f64 = v114.mul_add(v113, v117);
-    let v119: f64 = v109 - v107;
-    let v120: f64 = v14 * v106;
-    let v121: f64 = v11.mul_add(v119, v120);
-    let v122: f64 = p[0usize] * v121;
-    let v123: f64 = v115 * v37;
-    let v124: f64 = v123 * dir[1usize];
-    let v125: f64 = v114.mul_add(v122, v124);
-    let v126: f64 = v47 * dir[0usize];
-    let v127: f64 = v51 * dir[0usize];
-    let v128: f64 = qd[0usize] * v55;
-    let v129: f64 = v128 * dir[0usize];
-    let v130: f64 = v47.mul_add(dir[1usize], v129);
-    let v131: f64 = qd[0usize] * v61;
-    let v132: f64 = v131 * dir[0usize];
-    let v133: f64 = v51.mul_add(dir[1usize], v132);
-    let v135: f64 = 3f64 * v18;
-    let v136: f64 = v135 * v31;
-    let v137: f64 = v10.mul_add(v105, v136);
-    let v138: f64 = p[0usize] * v137;
-    let v139: f64 = v115 * v55;
-    let v140: f64 = v139 * dir[1usize];
-    let v141: f64 = v114.mul_add(v138, v140);
-    let v143: f64 = q[0usize] * v142;
-    let v144: f64 = 3f64.mul_add(v58, v143);
-    let v145: f64 = p[0usize] * v144;
-    let v146: f64 = v115 * v61;
-    let v147: f64 = v146 * dir[1usize];
-    let v148: f64 = v114.mul_add(v145, v147);
-    let v149: f64 = 0.5f64 * dir[1usize];
-    let v150: f64 = v87 * dir[0usize];
-    let v151: f64 = v34 * dir[0usize];
-    let v152: f64 = v37 * dir[0usize];
-    let v153: f64 = v55 * dir[0usize];
-    let v154: f64 = v61 * dir[0usize];
-    let v155: f64 = p[5usize] * dir[1usize];
-    let v156: f64 = p[4usize].mul_add(dir[0usize], v155);
-    let v157: f64 = 2f64 * v68;
-    let v158: f64 = 3f64 * v41;
-    let v159: f64 = v49 * v49;
-    let v160: f64 = 2f64 * v67;
-    let v162: f64 = 8f64 * q[0usize];
-    let v163: f64 = v160 * v58;
-    let v164: f64 = v162.mul_add(v49, v163);
-    let v165: f64 = -v164;
-    let v166: f64 = 2f64.mul_add(v58, -v157);
-    let v167: f64 = (-v31).mul_add(v80, v166);
-    let v168: f64 = (-v158).mul_add(v53, v167);
-    let v169: f64 = (-v160).mul_add(v159, v168);
-    let v170: f64 = v44.mul_add(v165, v169);
-    let v171: f64 = v86 * v170;
-    let v172: f64 = dir[0usize] * v171;
-    out[0usize] = v4;
-    out[1usize] = v6;
-    out[2usize] = 0f64;
-    out[3usize] = v5;
-    out[4usize] = v4;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v13;
-    out[10usize] = v15;
-    out[11usize] = 0f64;
-    out[12usize] = v23;
-    out[13usize] = v27;
-    out[14usize] = 0f64;
-    out[15usize] = v35;
-    out[16usize] = v38;
-    out[17usize] = 0f64;
-    out[18usize] = 0f64;
-    out[19usize] = 0f64;
-    out[20usize] = v40;
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = v43;
-    out[25usize] = v46;
-    out[26usize] = 0f64;
-    out[27usize] = v48;
-    out[28usize] = v52;
-    out[29usize] = 0f64;
-    out[30usize] = v56;
-    out[31usize] = v62;
-    out[32usize] = 0f64;
-    out[33usize] = 0f64;
-    out[34usize] = 0f64;
-    out[35usize] = v39;
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
-    out[38usize] = 0f64;
-    out[39usize] = 1f64;
-    out[40usize] = 0f64;
-    out[41usize] = 0f64;
-    out[42usize] = p[1usize];
-    out[43usize] = v73;
-    out[44usize] = v73;
-    out[45usize] = 0f64;
-    out[46usize] = 0f64;
-    out[47usize] = 1f64;
-    out[48usize] = v22;
-    out[49usize] = v26;
-    out[50usize] = 0f64;
-    out[51usize] = 0f64;
-    out[52usize] = 0f64;
-    out[53usize] = 0.5f64;
-    out[54usize] = v47;
-    out[55usize] = v51;
-    out[56usize] = 0f64;
-    out[57usize] = v79;
-    out[58usize] = v87;
-    out[59usize] = v90;
-    out[60usize] = v92;
-    out[61usize] = 0f64;
-    out[62usize] = v91;
-    out[63usize] = v90;
-    out[64usize] = 0f64;
-    out[65usize] = 0f64;
-    out[66usize] = 0f64;
-    out[67usize] = 0f64;
-    out[68usize] = v93;
-    out[69usize] = v94;
-    out[70usize] = 0f64;
-    out[71usize] = v98;
-    out[72usize] = v101;
-    out[73usize] = 0f64;
-    out[74usize] = v118;
-    out[75usize] = v125;
-    out[76usize] = 0f64;
-    out[77usize] = 0f64;
-    out[78usize] = 0f64;
-    out[79usize] = dir[1usize];
-    out[80usize] = 0f64;
-    out[81usize] = 0f64;
-    out[82usize] = 0f64;
-    out[83usize] = v126;
-    out[84usize] = v127;
-    out[85usize] = 0f64;
-    out[86usize] = v130;
-    out[87usize] = v133;
-    out[88usize] = 0f64;
-    out[89usize] = v141;
-    out[90usize] = v148;
-    out[91usize] = 0f64;
-    out[92usize] = 0f64;
-    out[93usize] = 0f64;
-    out[94usize] = v149;
-    out[95usize] = 0f64;
-    out[96usize] = 0f64;
-    out[97usize] = 0f64;
-    out[98usize] = 0f64;
-    out[99usize] = 0f64;
-    out[100usize] = 0f64;
-    out[101usize] = 0f64;
-    out[102usize] = v150;
-    out[103usize] = v150;
-    out[104usize] = 0f64;
-    out[105usize] = 0f64;
-    out[106usize] = 0f64;
-    out[107usize] = v151;
-    out[108usize] = v152;
-    out[109usize] = 0f64;
-    out[110usize] = 0f64;
-    out[111usize] = 0f64;
-    out[112usize] = 0f64;
-    out[113usize] = v153;
-    out[114usize] = v154;
-    out[115usize] = 0f64;
-    out[116usize] = v156;
-    out[117usize] = v172;
+    let v12 = p[0] * v10;
+    let v13 = v12 * v11;
+    let v15 = v12 * v14;
+    let v18 = 0.5f64 * v17;
+    let v19 = v11 * v18;
+    let v20 = 0.5f64 * v10;
+    let v21 = (-v20).mul_add(v14, v19);
+    let v22 = p[0] * v21;
+    let v23 = qd[0] * v22;
+    let v24 = v14 * v18;
+    let v25 = v20.mul_add(v11, v24);
+    let v26 = p[0] * v25;
+    let v27 = qd[0] * v26;
+    let v28 = qd[0] * qd[0];
+    let v31 = 0.25f64 * v30;
+    let v32 = (-0.25f64).mul_add(v10, v31);
+    let v33 = v11.mul_add(v32, -v24);
+    let v34 = p[0] * v33;
+    let v35 = v28 * v34;
+    let v36 = v14.mul_add(v32, v19);
+    let v37 = p[0] * v36;
+    let v38 = v28 * v37;
+    let v39 = 0.5f64 * qd[0];
+    let v40 = v39 + v39;
+    let v41 = v10 * v10;
+    let v42 = 0.5f64 * p[0];
+    let v43 = v42 * v41;
+    let [v44, v49, v58, v142]: [f64; 4] = runtime::special::sinc_rem_orders::<4>(q[0]);
+    let v45 = q[0] * p[0];
+    let v46 = v45 * v44;
+    let v47 = v12 * v18;
+    let v48 = qd[0] * v47;
+    let v50 = q[0].mul_add(v49, v44);
+    let v51 = p[0] * v50;
+    let v52 = qd[0] * v51;
+    let v53 = v18 * v18;
+    let v54 = v10.mul_add(v31, v53);
+    let v55 = p[0] * v54;
+    let v56 = v28 * v55;
+    let v59 = q[0] * v58;
+    let v60 = 2f64.mul_add(v49, v59);
+    let v61 = p[0] * v60;
+    let v62 = v28 * v61;
+    let v65 = 2f64 * v44;
+    let v66 = v10.powi(4i32);
+    let v67 = q[0] * q[0];
+    let v68 = v44 * v44;
+    let v69 = (-0.25f64).mul_add(v66, v65);
+    let v70 = (-v67).mul_add(v68, v69);
+    let v71 = p[0] * p[0];
+    let v72 = p[1] * v70;
+    let v73 = v72.mul_add(v71, p[2]);
+    let v76 = q[0] - p[6];
+    let v78 = qd[0] * p[5];
+    let v79 = p[4].mul_add(v76, v78);
+    let v80 = v10.powi(3i32);
+    let v81 = v18 * v80;
+    let v82 = 2f64 * q[0];
+    let v83 = (-v65).mul_add(v67, 2f64);
+    let v84 = v49.mul_add(v83, -v81);
+    let v85 = (-v82).mul_add(v68, v84);
+    let v86 = p[1] * v71;
+    let v87 = v86 * v85;
+    let v89 = v5 * dir[0];
+    let v90 = -v89;
+    let v91 = v4 * dir[0];
+    let v92 = -v91;
+    let v93 = v22 * dir[0];
+    let v94 = v26 * dir[0];
+    let v96 = qd[0] * v34;
+    let v97 = v96 * dir[0];
+    let v98 = v22.mul_add(dir[1], v97);
+    let v99 = qd[0] * v37;
+    let v100 = v99 * dir[0];
+    let v101 = v26.mul_add(dir[1], v100);
+    let v105 = 0.125f64 * v103;
+    let v106 = (-0.75f64).mul_add(v18, v105);
+    let v107 = 0.125f64 * v10;
+    let v109 = 1.5f64 * v31;
+    let v110 = v107 - v109;
+    let v111 = v14 * v110;
+    let v112 = v11.mul_add(v106, v111);
+    let v113 = p[0] * v112;
+    let v114 = v28 * dir[0];
+    let v115 = 2f64 * qd[0];
+    let v116 = v115 * v34;
+    let v117 = v116 * dir[1];
+    let v118 = v114.mul_add(v113, v117);
+    let v119 = v109 - v107;
+    let v120 = v14 * v106;
+    let v121 = v11.mul_add(v119, v120);
+    let v122 = p[0] * v121;
+    let v123 = v115 * v37;
+    let v124 = v123 * dir[1];
+    let v125 = v114.mul_add(v122, v124);
+    let v126 = v47 * dir[0];
+    let v127 = v51 * dir[0];
+    let v128 = qd[0] * v55;
+    let v129 = v128 * dir[0];
+    let v130 = v47.mul_add(dir[1], v129);
+    let v131 = qd[0] * v61;
+    let v132 = v131 * dir[0];
+    let v133 = v51.mul_add(dir[1], v132);
+    let v135 = 3f64 * v18;
+    let v136 = v135 * v31;
+    let v137 = v10.mul_add(v105, v136);
+    let v138 = p[0] * v137;
+    let v139 = v115 * v55;
+    let v140 = v139 * dir[1];
+    let v141 = v114.mul_add(v138, v140);
+    let v143 = q[0] * v142;
+    let v144 = 3f64.mul_add(v58, v143);
+    let v145 = p[0] * v144;
+    let v146 = v115 * v61;
+    let v147 = v146 * dir[1];
+    let v148 = v114.mul_add(v145, v147);
+    let v149 = 0.5f64 * dir[1];
+    let v150 = v87 * dir[0];
+    let v151 = v34 * dir[0];
+    let v152 = v37 * dir[0];
+    let v153 = v55 * dir[0];
+    let v154 = v61 * dir[0];
+    let v155 = p[5] * dir[1];
+    let v156 = p[4].mul_add(dir[0], v155);
+    let v157 = 2f64 * v68;
+    let v158 = 3f64 * v41;
+    let v159 = v49 * v49;
+    let v160 = 2f64 * v67;
+    let v162 = 8f64 * q[0];
+    let v163 = v160 * v58;
+    let v164 = v162.mul_add(v49, v163);
+    let v165 = -v164;
+    let v166 = 2f64.mul_add(v58, -v157);
+    let v167 = (-v31).mul_add(v80, v166);
+    let v168 = (-v158).mul_add(v53, v167);
+    let v169 = (-v160).mul_add(v159, v168);
+    let v170 = v44.mul_add(v165, v169);
+    let v171 = v86 * v170;
+    let v172 = dir[0] * v171;
+    out[0] = v4;
+    out[1] = v6;
+    out[2] = 0f64;
+    out[3] = v5;
+    out[4] = v4;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v13;
+    out[10] = v15;
+    out[11] = 0f64;
+    out[12] = v23;
+    out[13] = v27;
+    out[14] = 0f64;
+    out[15] = v35;
+    out[16] = v38;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = v40;
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = v43;
+    out[25] = v46;
+    out[26] = 0f64;
+    out[27] = v48;
+    out[28] = v52;
+    out[29] = 0f64;
+    out[30] = v56;
+    out[31] = v62;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = v39;
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 1f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = p[1];
+    out[43] = v73;
+    out[44] = v73;
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 1f64;
+    out[48] = v22;
+    out[49] = v26;
+    out[50] = 0f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 0.5f64;
+    out[54] = v47;
+    out[55] = v51;
+    out[56] = 0f64;
+    out[57] = v79;
+    out[58] = v87;
+    out[59] = v90;
+    out[60] = v92;
+    out[61] = 0f64;
+    out[62] = v91;
+    out[63] = v90;
+    out[64] = 0f64;
+    out[65] = 0f64;
+    out[66] = 0f64;
+    out[67] = 0f64;
+    out[68] = v93;
+    out[69] = v94;
+    out[70] = 0f64;
+    out[71] = v98;
+    out[72] = v101;
+    out[73] = 0f64;
+    out[74] = v118;
+    out[75] = v125;
+    out[76] = 0f64;
+    out[77] = 0f64;
+    out[78] = 0f64;
+    out[79] = dir[1];
+    out[80] = 0f64;
+    out[81] = 0f64;
+    out[82] = 0f64;
+    out[83] = v126;
+    out[84] = v127;
+    out[85] = 0f64;
+    out[86] = v130;
+    out[87] = v133;
+    out[88] = 0f64;
+    out[89] = v141;
+    out[90] = v148;
+    out[91] = 0f64;
+    out[92] = 0f64;
+    out[93] = 0f64;
+    out[94] = v149;
+    out[95] = 0f64;
+    out[96] = 0f64;
+    out[97] = 0f64;
+    out[98] = 0f64;
+    out[99] = 0f64;
+    out[100] = 0f64;
+    out[101] = 0f64;
+    out[102] = v150;
+    out[103] = v150;
+    out[104] = 0f64;
+    out[105] = 0f64;
+    out[106] = 0f64;
+    out[107] = v151;
+    out[108] = v152;
+    out[109] = 0f64;
+    out[110] = 0f64;
+    out[111] = 0f64;
+    out[112] = 0f64;
+    out[113] = v153;
+    out[114] = v154;
+    out[115] = 0f64;
+    out[116] = v156;
+    out[117] = v172;
 }
 /// This model's cells, for chains of other lengths to link.
 pub static CELLS: &[runtime::links::CompiledCell] = &[];

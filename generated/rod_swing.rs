@@ -4,7 +4,7 @@
 use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
 /// Structural hash of the model this was derived from.
 pub const HASH: &str = "6b97474479356c52";
-pub const DOF: usize = 60usize;
+pub const DOF: usize = 60;
 pub const COORDINATES: &[&str] = &[
     "bend_y_0_0",
     "bend_z_0_0",
@@ -209,21 +209,21 @@ pub const PARAMETERS: &[&str] = &[
     "shear[9].stiffness",
 ];
 /// Derived parameters, computed once per parameter set.
-pub const DERIVED: usize = 104usize;
+pub const DERIVED: usize = 104;
 /// Whether the mass solve is generated (the `accel` kernel).
 pub const ACCEL: bool = false;
 /// Base parameters that are loads (scaled by load continuation).
-pub const LOADS: &[usize] = &[0usize, 1usize, 2usize];
+pub const LOADS: &[usize] = &[0, 1, 2];
 /// The rows of the joints' constraint equations.
 pub const CONSTRAINTS: &[&str] = &[];
 /// Coordinates per independent subsystem (M block diagonal).
 pub const BLOCKS: &[usize] = &[];
 /// Contact points along the arms and at the bodies.
-pub const CONTACT_POINTS: usize = 0usize;
+pub const CONTACT_POINTS: usize = 0;
 /// Points per group of the `contact_jacobian` kernel.
 pub const CONTACT_GROUPS: &[usize] = &[];
 /// Length of the contact frames the `contact_jacobian` groups read.
-pub const CONTACT_FRAMES: usize = 0usize;
+pub const CONTACT_FRAMES: usize = 0;
 /// The compiled kernels of this structure.
 pub struct Compiled {
     info: ModelInfo,
@@ -255,17 +255,17 @@ impl Kernels for Compiled {
         "compiled"
     }
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
-        let q: &[f64; 60usize] = inp.q.try_into().expect("q has DOF entries");
-        let qd: &[f64; 60usize] = inp.qd.try_into().expect("qd has DOF entries");
-        let p: &[f64; 243usize] = inp.p.try_into().expect("parameter vector length");
-        let no_qdd = [0.0f64; 60usize];
-        let qdd: &[f64; 60usize] = if inp.qdd.is_empty() {
+        let q: &[f64; 60] = inp.q.try_into().expect("q has DOF entries");
+        let qd: &[f64; 60] = inp.qd.try_into().expect("qd has DOF entries");
+        let p: &[f64; 243] = inp.p.try_into().expect("parameter vector length");
+        let no_qdd = [0.0f64; 60];
+        let qdd: &[f64; 60] = if inp.qdd.is_empty() {
             &no_qdd
         } else {
             inp.qdd.try_into().expect("qdd has DOF entries")
         };
-        let no_dir = [0.0f64; 120usize];
-        let dir: &[f64; 120usize] = if inp.dir.is_empty() {
+        let no_dir = [0.0f64; 120];
+        let dir: &[f64; 120] = if inp.dir.is_empty() {
             &no_dir
         } else {
             inp.dir.try_into().expect("dir has 2 DOF entries")
@@ -362,12 +362,12 @@ impl Kernels for Compiled {
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -378,24 +378,24 @@ pub fn accel(
 #[allow(unused_variables, clippy::all)]
 fn accel_0(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `derived`: 153 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn derived(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    out: &mut [f64; 104usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    out: &mut [f64; 104],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -406,262 +406,262 @@ pub fn derived(
 #[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 104usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    w: &mut [f64; 0],
+    out: &mut [f64; 104],
 ) {
-    let v2: f64 = 0.5f64 * p[37usize];
-    let v5: f64 = 0.25f64 * p[37usize];
-    let v6: f64 = p[33usize] - v5;
-    let v7: f64 = 0.25f64.mul_add(v6, v2);
-    let v9: f64 = 0.5f64 * p[49usize];
-    let v11: f64 = 0.25f64 * p[49usize];
-    let v12: f64 = p[45usize] - v11;
-    let v13: f64 = 0.25f64.mul_add(v12, v9);
-    let v15: f64 = 0.5f64 * p[61usize];
-    let v17: f64 = 0.25f64 * p[61usize];
-    let v18: f64 = p[57usize] - v17;
-    let v19: f64 = 0.25f64.mul_add(v18, v15);
-    let v21: f64 = 0.5f64 * p[73usize];
-    let v23: f64 = 0.25f64 * p[73usize];
-    let v24: f64 = p[69usize] - v23;
-    let v25: f64 = 0.25f64.mul_add(v24, v21);
-    let v27: f64 = 0.5f64 * p[85usize];
-    let v29: f64 = 0.25f64 * p[85usize];
-    let v30: f64 = p[81usize] - v29;
-    let v31: f64 = 0.25f64.mul_add(v30, v27);
-    let v33: f64 = 0.5f64 * p[97usize];
-    let v35: f64 = 0.25f64 * p[97usize];
-    let v36: f64 = p[93usize] - v35;
-    let v37: f64 = 0.25f64.mul_add(v36, v33);
-    let v39: f64 = 0.5f64 * p[109usize];
-    let v41: f64 = 0.25f64 * p[109usize];
-    let v42: f64 = p[105usize] - v41;
-    let v43: f64 = 0.25f64.mul_add(v42, v39);
-    let v45: f64 = 0.5f64 * p[121usize];
-    let v47: f64 = 0.25f64 * p[121usize];
-    let v48: f64 = p[117usize] - v47;
-    let v49: f64 = 0.25f64.mul_add(v48, v45);
-    let v51: f64 = 0.5f64 * p[133usize];
-    let v53: f64 = 0.25f64 * p[133usize];
-    let v54: f64 = p[129usize] - v53;
-    let v55: f64 = 0.25f64.mul_add(v54, v51);
-    let v57: f64 = 0.125f64.mul_add(v54, v53);
-    let v58: f64 = v51 - v57;
-    let v59: f64 = 0.125f64.mul_add(v48, v47);
-    let v60: f64 = v45 - v59;
-    let v61: f64 = 0.125f64.mul_add(v42, v41);
-    let v62: f64 = v39 - v61;
-    let v63: f64 = 0.125f64.mul_add(v36, v35);
-    let v64: f64 = v33 - v63;
-    let v65: f64 = 0.125f64.mul_add(v30, v29);
-    let v66: f64 = v27 - v65;
-    let v67: f64 = 0.125f64.mul_add(v24, v23);
-    let v68: f64 = v21 - v67;
-    let v69: f64 = 0.125f64.mul_add(v18, v17);
-    let v70: f64 = v15 - v69;
-    let v71: f64 = 0.125f64.mul_add(v12, v11);
-    let v72: f64 = v9 - v71;
-    let v73: f64 = 0.125f64.mul_add(v6, v5);
-    let v74: f64 = v2 - v73;
-    let v84: f64 = p[116usize] + p[128usize];
-    let v85: f64 = p[104usize] + v84;
-    let v86: f64 = p[92usize] + v85;
-    let v87: f64 = p[80usize] + v86;
-    let v88: f64 = p[68usize] + v87;
-    let v89: f64 = p[56usize] + v88;
-    let v90: f64 = p[44usize] + v89;
-    let v91: f64 = p[32usize] + v90;
-    let v93: f64 = 0.25f64 * p[25usize];
-    let v95: f64 = p[21usize] - v93;
-    let v96: f64 = 0.125f64.mul_add(v95, v93);
-    let v97: f64 = 0.5f64.mul_add(p[25usize], -v96);
-    let v99: f64 = -p[2usize];
-    let v101: f64 = -p[1usize];
-    let v103: f64 = -p[0usize];
-    let v105: f64 = -p[24usize];
-    let v107: f64 = -p[36usize];
-    let v109: f64 = -p[48usize];
-    let v111: f64 = -p[60usize];
-    let v113: f64 = -p[72usize];
-    let v115: f64 = -p[84usize];
-    let v117: f64 = -p[96usize];
-    let v119: f64 = -p[108usize];
-    let v121: f64 = -p[120usize];
-    let v123: f64 = -p[132usize];
-    let v125: f64 = 0.5f64 * p[22usize];
-    let v127: f64 = 0.5f64 * p[26usize];
-    let v129: f64 = 0.5f64 * p[28usize];
-    let v131: f64 = 0.5f64 * p[30usize];
-    let v133: f64 = 0.5f64 * p[34usize];
-    let v135: f64 = 0.5f64 * p[38usize];
-    let v137: f64 = 0.5f64 * p[40usize];
-    let v139: f64 = 0.5f64 * p[42usize];
-    let v141: f64 = 0.5f64 * p[46usize];
-    let v143: f64 = 0.5f64 * p[50usize];
-    let v145: f64 = 0.5f64 * p[52usize];
-    let v147: f64 = 0.5f64 * p[54usize];
-    let v149: f64 = 0.5f64 * p[58usize];
-    let v151: f64 = 0.5f64 * p[62usize];
-    let v153: f64 = 0.5f64 * p[64usize];
-    let v155: f64 = 0.5f64 * p[66usize];
-    let v157: f64 = 0.5f64 * p[70usize];
-    let v159: f64 = 0.5f64 * p[74usize];
-    let v161: f64 = 0.5f64 * p[76usize];
-    let v163: f64 = 0.5f64 * p[78usize];
-    let v165: f64 = 0.5f64 * p[82usize];
-    let v167: f64 = 0.5f64 * p[86usize];
-    let v169: f64 = 0.5f64 * p[88usize];
-    let v171: f64 = 0.5f64 * p[90usize];
-    let v173: f64 = 0.5f64 * p[94usize];
-    let v175: f64 = 0.5f64 * p[98usize];
-    let v177: f64 = 0.5f64 * p[100usize];
-    let v179: f64 = 0.5f64 * p[102usize];
-    let v181: f64 = 0.5f64 * p[106usize];
-    let v183: f64 = 0.5f64 * p[110usize];
-    let v185: f64 = 0.5f64 * p[112usize];
-    let v187: f64 = 0.5f64 * p[114usize];
-    let v189: f64 = 0.5f64 * p[118usize];
-    let v191: f64 = 0.5f64 * p[122usize];
-    let v193: f64 = 0.5f64 * p[124usize];
-    let v195: f64 = 0.5f64 * p[126usize];
-    let v197: f64 = 0.5f64 * p[130usize];
-    let v199: f64 = 0.5f64 * p[134usize];
-    let v201: f64 = 0.5f64 * p[136usize];
-    let v203: f64 = 0.5f64 * p[138usize];
-    let v205: f64 = 0.5f64 * p[20usize];
-    let v206: f64 = 0.5f64 * p[32usize];
-    let v207: f64 = 0.5f64 * p[44usize];
-    let v208: f64 = 0.5f64 * p[56usize];
-    let v209: f64 = 0.5f64 * p[68usize];
-    let v210: f64 = 0.5f64 * p[80usize];
-    let v211: f64 = 0.5f64 * p[92usize];
-    let v212: f64 = 0.5f64 * p[104usize];
-    let v213: f64 = 0.5f64 * p[116usize];
-    let v214: f64 = 0.5f64 * p[128usize];
-    let v216: f64 = 0.25f64 * p[16usize];
-    let v218: f64 = 0.25f64 * p[17usize];
-    let v220: f64 = 0.25f64 * p[18usize];
-    let v222: f64 = 0.25f64 * p[15usize];
-    out[0usize] = v7;
-    out[1usize] = v13;
-    out[2usize] = v19;
-    out[3usize] = v25;
-    out[4usize] = v31;
-    out[5usize] = v37;
-    out[6usize] = v43;
-    out[7usize] = v49;
-    out[8usize] = v55;
-    out[9usize] = v58;
-    out[10usize] = v60;
-    out[11usize] = v62;
-    out[12usize] = v64;
-    out[13usize] = v66;
-    out[14usize] = v68;
-    out[15usize] = v70;
-    out[16usize] = v72;
-    out[17usize] = v74;
-    out[18usize] = v91;
-    out[19usize] = v96;
-    out[20usize] = v97;
-    out[21usize] = v73;
-    out[22usize] = v90;
-    out[23usize] = v71;
-    out[24usize] = v89;
-    out[25usize] = v69;
-    out[26usize] = v88;
-    out[27usize] = v67;
-    out[28usize] = v87;
-    out[29usize] = v65;
-    out[30usize] = v86;
-    out[31usize] = v63;
-    out[32usize] = v85;
-    out[33usize] = v61;
-    out[34usize] = v84;
-    out[35usize] = v59;
-    out[36usize] = v57;
-    out[37usize] = v99;
-    out[38usize] = v101;
-    out[39usize] = v103;
-    out[40usize] = v105;
-    out[41usize] = v107;
-    out[42usize] = v109;
-    out[43usize] = v111;
-    out[44usize] = v113;
-    out[45usize] = v115;
-    out[46usize] = v117;
-    out[47usize] = v119;
-    out[48usize] = v121;
-    out[49usize] = v123;
-    out[50usize] = v125;
-    out[51usize] = v127;
-    out[52usize] = v129;
-    out[53usize] = v131;
-    out[54usize] = v133;
-    out[55usize] = v135;
-    out[56usize] = v137;
-    out[57usize] = v139;
-    out[58usize] = v141;
-    out[59usize] = v143;
-    out[60usize] = v145;
-    out[61usize] = v147;
-    out[62usize] = v149;
-    out[63usize] = v151;
-    out[64usize] = v153;
-    out[65usize] = v155;
-    out[66usize] = v157;
-    out[67usize] = v159;
-    out[68usize] = v161;
-    out[69usize] = v163;
-    out[70usize] = v165;
-    out[71usize] = v167;
-    out[72usize] = v169;
-    out[73usize] = v171;
-    out[74usize] = v173;
-    out[75usize] = v175;
-    out[76usize] = v177;
-    out[77usize] = v179;
-    out[78usize] = v181;
-    out[79usize] = v183;
-    out[80usize] = v185;
-    out[81usize] = v187;
-    out[82usize] = v189;
-    out[83usize] = v191;
-    out[84usize] = v193;
-    out[85usize] = v195;
-    out[86usize] = v197;
-    out[87usize] = v199;
-    out[88usize] = v201;
-    out[89usize] = v203;
-    out[90usize] = v205;
-    out[91usize] = v206;
-    out[92usize] = v207;
-    out[93usize] = v208;
-    out[94usize] = v209;
-    out[95usize] = v210;
-    out[96usize] = v211;
-    out[97usize] = v212;
-    out[98usize] = v213;
-    out[99usize] = v214;
-    out[100usize] = v216;
-    out[101usize] = v218;
-    out[102usize] = v220;
-    out[103usize] = v222;
+    let v2 = 0.5f64 * p[37];
+    let v5 = 0.25f64 * p[37];
+    let v6 = p[33] - v5;
+    let v7 = 0.25f64.mul_add(v6, v2);
+    let v9 = 0.5f64 * p[49];
+    let v11 = 0.25f64 * p[49];
+    let v12 = p[45] - v11;
+    let v13 = 0.25f64.mul_add(v12, v9);
+    let v15 = 0.5f64 * p[61];
+    let v17 = 0.25f64 * p[61];
+    let v18 = p[57] - v17;
+    let v19 = 0.25f64.mul_add(v18, v15);
+    let v21 = 0.5f64 * p[73];
+    let v23 = 0.25f64 * p[73];
+    let v24 = p[69] - v23;
+    let v25 = 0.25f64.mul_add(v24, v21);
+    let v27 = 0.5f64 * p[85];
+    let v29 = 0.25f64 * p[85];
+    let v30 = p[81] - v29;
+    let v31 = 0.25f64.mul_add(v30, v27);
+    let v33 = 0.5f64 * p[97];
+    let v35 = 0.25f64 * p[97];
+    let v36 = p[93] - v35;
+    let v37 = 0.25f64.mul_add(v36, v33);
+    let v39 = 0.5f64 * p[109];
+    let v41 = 0.25f64 * p[109];
+    let v42 = p[105] - v41;
+    let v43 = 0.25f64.mul_add(v42, v39);
+    let v45 = 0.5f64 * p[121];
+    let v47 = 0.25f64 * p[121];
+    let v48 = p[117] - v47;
+    let v49 = 0.25f64.mul_add(v48, v45);
+    let v51 = 0.5f64 * p[133];
+    let v53 = 0.25f64 * p[133];
+    let v54 = p[129] - v53;
+    let v55 = 0.25f64.mul_add(v54, v51);
+    let v57 = 0.125f64.mul_add(v54, v53);
+    let v58 = v51 - v57;
+    let v59 = 0.125f64.mul_add(v48, v47);
+    let v60 = v45 - v59;
+    let v61 = 0.125f64.mul_add(v42, v41);
+    let v62 = v39 - v61;
+    let v63 = 0.125f64.mul_add(v36, v35);
+    let v64 = v33 - v63;
+    let v65 = 0.125f64.mul_add(v30, v29);
+    let v66 = v27 - v65;
+    let v67 = 0.125f64.mul_add(v24, v23);
+    let v68 = v21 - v67;
+    let v69 = 0.125f64.mul_add(v18, v17);
+    let v70 = v15 - v69;
+    let v71 = 0.125f64.mul_add(v12, v11);
+    let v72 = v9 - v71;
+    let v73 = 0.125f64.mul_add(v6, v5);
+    let v74 = v2 - v73;
+    let v84 = p[116] + p[128];
+    let v85 = p[104] + v84;
+    let v86 = p[92] + v85;
+    let v87 = p[80] + v86;
+    let v88 = p[68] + v87;
+    let v89 = p[56] + v88;
+    let v90 = p[44] + v89;
+    let v91 = p[32] + v90;
+    let v93 = 0.25f64 * p[25];
+    let v95 = p[21] - v93;
+    let v96 = 0.125f64.mul_add(v95, v93);
+    let v97 = 0.5f64.mul_add(p[25], -v96);
+    let v99 = -p[2];
+    let v101 = -p[1];
+    let v103 = -p[0];
+    let v105 = -p[24];
+    let v107 = -p[36];
+    let v109 = -p[48];
+    let v111 = -p[60];
+    let v113 = -p[72];
+    let v115 = -p[84];
+    let v117 = -p[96];
+    let v119 = -p[108];
+    let v121 = -p[120];
+    let v123 = -p[132];
+    let v125 = 0.5f64 * p[22];
+    let v127 = 0.5f64 * p[26];
+    let v129 = 0.5f64 * p[28];
+    let v131 = 0.5f64 * p[30];
+    let v133 = 0.5f64 * p[34];
+    let v135 = 0.5f64 * p[38];
+    let v137 = 0.5f64 * p[40];
+    let v139 = 0.5f64 * p[42];
+    let v141 = 0.5f64 * p[46];
+    let v143 = 0.5f64 * p[50];
+    let v145 = 0.5f64 * p[52];
+    let v147 = 0.5f64 * p[54];
+    let v149 = 0.5f64 * p[58];
+    let v151 = 0.5f64 * p[62];
+    let v153 = 0.5f64 * p[64];
+    let v155 = 0.5f64 * p[66];
+    let v157 = 0.5f64 * p[70];
+    let v159 = 0.5f64 * p[74];
+    let v161 = 0.5f64 * p[76];
+    let v163 = 0.5f64 * p[78];
+    let v165 = 0.5f64 * p[82];
+    let v167 = 0.5f64 * p[86];
+    let v169 = 0.5f64 * p[88];
+    let v171 = 0.5f64 * p[90];
+    let v173 = 0.5f64 * p[94];
+    let v175 = 0.5f64 * p[98];
+    let v177 = 0.5f64 * p[100];
+    let v179 = 0.5f64 * p[102];
+    let v181 = 0.5f64 * p[106];
+    let v183 = 0.5f64 * p[110];
+    let v185 = 0.5f64 * p[112];
+    let v187 = 0.5f64 * p[114];
+    let v189 = 0.5f64 * p[118];
+    let v191 = 0.5f64 * p[122];
+    let v193 = 0.5f64 * p[124];
+    let v195 = 0.5f64 * p[126];
+    let v197 = 0.5f64 * p[130];
+    let v199 = 0.5f64 * p[134];
+    let v201 = 0.5f64 * p[136];
+    let v203 = 0.5f64 * p[138];
+    let v205 = 0.5f64 * p[20];
+    let v206 = 0.5f64 * p[32];
+    let v207 = 0.5f64 * p[44];
+    let v208 = 0.5f64 * p[56];
+    let v209 = 0.5f64 * p[68];
+    let v210 = 0.5f64 * p[80];
+    let v211 = 0.5f64 * p[92];
+    let v212 = 0.5f64 * p[104];
+    let v213 = 0.5f64 * p[116];
+    let v214 = 0.5f64 * p[128];
+    let v216 = 0.25f64 * p[16];
+    let v218 = 0.25f64 * p[17];
+    let v220 = 0.25f64 * p[18];
+    let v222 = 0.25f64 * p[15];
+    out[0] = v7;
+    out[1] = v13;
+    out[2] = v19;
+    out[3] = v25;
+    out[4] = v31;
+    out[5] = v37;
+    out[6] = v43;
+    out[7] = v49;
+    out[8] = v55;
+    out[9] = v58;
+    out[10] = v60;
+    out[11] = v62;
+    out[12] = v64;
+    out[13] = v66;
+    out[14] = v68;
+    out[15] = v70;
+    out[16] = v72;
+    out[17] = v74;
+    out[18] = v91;
+    out[19] = v96;
+    out[20] = v97;
+    out[21] = v73;
+    out[22] = v90;
+    out[23] = v71;
+    out[24] = v89;
+    out[25] = v69;
+    out[26] = v88;
+    out[27] = v67;
+    out[28] = v87;
+    out[29] = v65;
+    out[30] = v86;
+    out[31] = v63;
+    out[32] = v85;
+    out[33] = v61;
+    out[34] = v84;
+    out[35] = v59;
+    out[36] = v57;
+    out[37] = v99;
+    out[38] = v101;
+    out[39] = v103;
+    out[40] = v105;
+    out[41] = v107;
+    out[42] = v109;
+    out[43] = v111;
+    out[44] = v113;
+    out[45] = v115;
+    out[46] = v117;
+    out[47] = v119;
+    out[48] = v121;
+    out[49] = v123;
+    out[50] = v125;
+    out[51] = v127;
+    out[52] = v129;
+    out[53] = v131;
+    out[54] = v133;
+    out[55] = v135;
+    out[56] = v137;
+    out[57] = v139;
+    out[58] = v141;
+    out[59] = v143;
+    out[60] = v145;
+    out[61] = v147;
+    out[62] = v149;
+    out[63] = v151;
+    out[64] = v153;
+    out[65] = v155;
+    out[66] = v157;
+    out[67] = v159;
+    out[68] = v161;
+    out[69] = v163;
+    out[70] = v165;
+    out[71] = v167;
+    out[72] = v169;
+    out[73] = v171;
+    out[74] = v173;
+    out[75] = v175;
+    out[76] = v177;
+    out[77] = v179;
+    out[78] = v181;
+    out[79] = v183;
+    out[80] = v185;
+    out[81] = v187;
+    out[82] = v189;
+    out[83] = v191;
+    out[84] = v193;
+    out[85] = v195;
+    out[86] = v197;
+    out[87] = v199;
+    out[88] = v201;
+    out[89] = v203;
+    out[90] = v205;
+    out[91] = v206;
+    out[92] = v207;
+    out[93] = v208;
+    out[94] = v209;
+    out[95] = v210;
+    out[96] = v211;
+    out[97] = v212;
+    out[98] = v213;
+    out[99] = v214;
+    out[100] = v216;
+    out[101] = v218;
+    out[102] = v220;
+    out[103] = v222;
 }
 /// Kernel `constraints`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn constraints(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -672,24 +672,24 @@ pub fn constraints(
 #[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -700,36 +700,36 @@ pub fn contact(
 #[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jacobian`: the points' positions, velocities and Jacobians in 0 groups; group g runs when `all` or `dir[g] != 0`.
 #[allow(unused_variables)]
 pub fn contact_jacobian(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
     all: bool,
-    p: &[f64; 243usize],
-    out: &mut [f64; 0usize],
+    p: &[f64; 243],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jvp`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact_jvp(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -740,13 +740,13 @@ pub fn contact_jvp(
 #[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
@@ -759,40 +759,40 @@ static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyL
 #[allow(unused_variables)]
 pub fn mass_bias(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    out: &mut [f64; 1890usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    out: &mut [f64; 1890],
 ) {
     runtime::cpu::require_fma();
     unsafe { mass_bias_links(q, qd, p, out) }
 }
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
 unsafe fn mass_bias_links(
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    p: &[f64; 243usize],
-    out: &mut [f64; 1890usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    p: &[f64; 243],
+    out: &mut [f64; 1890],
 ) {
     let mut cells = LinkCells { q, qd, p };
-    runtime::links::mass_bias_shared::<60usize, _>(&LINKS, &mut cells, q, qd, p, out)
+    runtime::links::mass_bias_shared::<60, _>(&LINKS, &mut cells, q, qd, p, out)
 }
 /// Kernel `jvp`: the inverse dynamics' tangent by the link recursion (`runtime::links::inverse_dynamics_tangent`) over 20 links.
 #[allow(unused_variables)]
 pub fn jvp(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    out: &mut [f64; 60usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    out: &mut [f64; 60],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
-    let mut tau = [0.0; 60usize];
+    let mut tau = [0.0; 60];
     runtime::links::inverse_dynamics_tangent(
         &LINKS,
         &mut cells,
@@ -809,12 +809,12 @@ pub fn jvp(
 #[allow(unused_variables)]
 pub fn outputs(
     t: f64,
-    q: &[f64; 60usize],
-    qd: &[f64; 60usize],
-    qdd: &[f64; 60usize],
-    dir: &[f64; 120usize],
-    p: &[f64; 243usize],
-    out: &mut [f64; 9usize],
+    q: &[f64; 60],
+    qd: &[f64; 60],
+    qdd: &[f64; 60],
+    dir: &[f64; 120],
+    p: &[f64; 243],
+    out: &mut [f64; 9],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
@@ -823,21 +823,21 @@ pub fn outputs(
 /// The compiled cells and forces the link recursion evaluates.
 #[allow(dead_code)]
 struct LinkCells<'a> {
-    q: &'a [f64; 60usize],
-    qd: &'a [f64; 60usize],
-    p: &'a [f64; 243usize],
+    q: &'a [f64; 60],
+    qd: &'a [f64; 60],
+    p: &'a [f64; 243],
 }
 impl runtime::links::Cells for LinkCells<'_> {
     #[inline(always)]
     fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 6usize],
-                    &[0.0; 12usize],
+                    &[0.0; 6],
+                    &[0.0; 12],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs"),
                 )
@@ -856,7 +856,7 @@ impl runtime::links::Cells for LinkCells<'_> {
         out: &mut [[f64; 4]],
     ) {
         match c {
-            0usize => {
+            0 => {
                 unsafe {
                     cell_0_x4(
                         x.try_into().expect("link coordinates"),
@@ -885,15 +885,15 @@ impl runtime::links::Cells for LinkCells<'_> {
         out: &mut [f64],
     ) {
         match c {
-            0usize => {
-                let mut dir = [0.0; 12usize];
-                dir[..6usize].copy_from_slice(dx);
-                dir[6usize..].copy_from_slice(dxd);
+            0 => {
+                let mut dir = [0.0; 12];
+                dir[..6].copy_from_slice(dx);
+                dir[6..].copy_from_slice(dxd);
                 cell_0_tangent(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 6usize],
+                    &[0.0; 6],
                     &dir,
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs and derivatives"),
@@ -913,13 +913,13 @@ impl runtime::links::Cells for LinkCells<'_> {
     }
     fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0_pose(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 6usize],
-                    &[0.0; 12usize],
+                    &[0.0; 6],
+                    &[0.0; 12],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("pose outputs"),
                 )
@@ -935,12 +935,12 @@ impl runtime::links::Cells for LinkCells<'_> {
 #[allow(unused_unsafe)]
 pub fn cell_0_pose(
     t: f64,
-    q: &[f64; 6usize],
-    qd: &[f64; 6usize],
-    qdd: &[f64; 6usize],
-    dir: &[f64; 12usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 6],
+    qd: &[f64; 6],
+    qdd: &[f64; 6],
+    dir: &[f64; 12],
+    p: &[f64; 15],
+    out: &mut [f64; 38],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -951,295 +951,295 @@ pub fn cell_0_pose(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
-    q: &[f64; 6usize],
-    qd: &[f64; 6usize],
-    qdd: &[f64; 6usize],
-    dir: &[f64; 12usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 6],
+    qd: &[f64; 6],
+    qdd: &[f64; 6],
+    dir: &[f64; 12],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 38],
 ) {
-    let v1: f64 = q[0usize] * q[0usize];
-    let v3: f64 = 0.25f64 * v1;
-    let v5: f64 = q[2usize] * q[2usize];
-    let v6: f64 = 0.25f64 * v5;
-    let v8: f64 = q[1usize] * q[1usize];
-    let v9: f64 = 0.25f64 * v8;
-    let v10: f64 = v3 + v6;
-    let v11: f64 = v10 + v9;
-    let c: [[f64; 2usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        2usize,
+    let v1 = q[0] * q[0];
+    let v3 = 0.25f64 * v1;
+    let v5 = q[2] * q[2];
+    let v6 = 0.25f64 * v5;
+    let v8 = q[1] * q[1];
+    let v9 = 0.25f64 * v8;
+    let v10 = v3 + v6;
+    let v11 = v10 + v9;
+    let c: [[f64; 2]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        2,
     >(v11);
-    let v12: f64 = c[0usize][0usize];
-    let v13: f64 = c[2usize][0usize];
-    let v18: f64 = c[1usize][0usize];
-    let v47: f64 = c[3usize][0usize];
-    let v78: f64 = c[2usize][1usize];
-    let v88: f64 = c[3usize][1usize];
-    let v158: f64 = c[4usize][0usize];
-    let v166: f64 = c[4usize][1usize];
-    let v14: f64 = v6.mul_add(v13, v12);
-    let v15: f64 = 0.25f64 * q[0usize];
-    let v16: f64 = v15 * q[2usize];
-    let v17: f64 = v16 * v13;
-    let v20: f64 = 0.5f64 * q[1usize];
-    let v21: f64 = v20 * v18;
-    let v22: f64 = v17 - v21;
-    let v23: f64 = 0.25f64 * q[1usize];
-    let v24: f64 = v23 * q[2usize];
-    let v25: f64 = v24 * v13;
-    let v26: f64 = 0.5f64 * q[0usize];
-    let v27: f64 = v26 * v18;
-    let v28: f64 = v25 + v27;
-    let v29: f64 = v17 + v21;
-    let v30: f64 = v3.mul_add(v13, v12);
-    let v31: f64 = v15 * q[1usize];
-    let v32: f64 = v31 * v13;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let v34: f64 = v33 * v18;
-    let v35: f64 = v32 - v34;
-    let v36: f64 = v25 - v27;
-    let v37: f64 = v32 + v34;
-    let v38: f64 = v9.mul_add(v13, v12);
-    let v41: f64 = q[3usize] + p[0usize];
-    let v42: f64 = 0.5f64 * v41;
-    let v45: f64 = v23 * q[4usize];
-    let v46: f64 = v15.mul_add(q[5usize], -v45);
-    let v48: f64 = 0.25f64 * q[2usize];
-    let v49: f64 = v15 * q[4usize];
-    let v50: f64 = v48.mul_add(v41, v49);
-    let v51: f64 = v23.mul_add(q[5usize], v50);
-    let v52: f64 = v42 * v11;
-    let v53: f64 = v33.mul_add(v51, -v52);
-    let v54: f64 = v13.mul_add(v46, v42);
-    let v55: f64 = v47.mul_add(v53, v54);
-    let v56: f64 = 0.5f64 * q[4usize];
-    let v57: f64 = v48 * q[5usize];
-    let v58: f64 = v23.mul_add(v41, -v57);
-    let v59: f64 = v56 * v11;
-    let v60: f64 = v26.mul_add(v51, -v59);
-    let v61: f64 = v13.mul_add(v58, v56);
-    let v62: f64 = v47.mul_add(v60, v61);
-    let v63: f64 = 0.5f64 * q[5usize];
-    let v64: f64 = v15 * v41;
-    let v65: f64 = v48.mul_add(q[4usize], -v64);
-    let v66: f64 = v63 * v11;
-    let v67: f64 = v20.mul_add(v51, -v66);
-    let v68: f64 = v13.mul_add(v65, v63);
-    let v69: f64 = v47.mul_add(v67, v68);
-    let v71: f64 = 0.5f64 * qd[3usize];
-    let v74: f64 = v26 * qd[0usize];
-    let v76: f64 = v33.mul_add(qd[2usize], v74);
-    let v77: f64 = v20.mul_add(qd[1usize], v76);
-    let v79: f64 = v77 * v78;
-    let v80: f64 = 0.25f64 * q[5usize];
-    let v82: f64 = v15 * qd[5usize];
-    let v83: f64 = 0.25f64 * q[4usize];
-    let v85: f64 = v80.mul_add(qd[0usize], v82);
-    let v86: f64 = (-v83).mul_add(qd[1usize], v85);
-    let v87: f64 = (-v23).mul_add(qd[4usize], v86);
-    let v89: f64 = v77 * v88;
-    let v90: f64 = 0.5f64 * qd[2usize];
-    let v91: f64 = 0.25f64 * qd[2usize];
-    let v92: f64 = v48 * qd[3usize];
-    let v93: f64 = v91.mul_add(v41, v92);
-    let v94: f64 = v83.mul_add(qd[0usize], v93);
-    let v95: f64 = v15.mul_add(qd[4usize], v94);
-    let v96: f64 = v80.mul_add(qd[1usize], v95);
-    let v97: f64 = v23.mul_add(qd[5usize], v96);
-    let v98: f64 = v33 * v97;
-    let v99: f64 = v90.mul_add(v51, v98);
-    let v100: f64 = (-v71).mul_add(v11, v99);
-    let v101: f64 = (-v42).mul_add(v77, v100);
-    let v102: f64 = v46.mul_add(v79, v71);
-    let v103: f64 = v13.mul_add(v87, v102);
-    let v104: f64 = v53.mul_add(v89, v103);
-    let v105: f64 = v47.mul_add(v101, v104);
-    let v106: f64 = 0.5f64 * qd[4usize];
-    let v107: f64 = 0.25f64 * qd[1usize];
-    let v108: f64 = v23 * qd[3usize];
-    let v109: f64 = v107.mul_add(v41, v108);
-    let v110: f64 = (-v80).mul_add(qd[2usize], v109);
-    let v111: f64 = (-v48).mul_add(qd[5usize], v110);
-    let v112: f64 = 0.5f64 * qd[0usize];
-    let v113: f64 = v26 * v97;
-    let v114: f64 = v112.mul_add(v51, v113);
-    let v115: f64 = (-v106).mul_add(v11, v114);
-    let v116: f64 = (-v56).mul_add(v77, v115);
-    let v117: f64 = v58.mul_add(v79, v106);
-    let v118: f64 = v13.mul_add(v111, v117);
-    let v119: f64 = v60.mul_add(v89, v118);
-    let v120: f64 = v47.mul_add(v116, v119);
-    let v121: f64 = 0.5f64 * qd[5usize];
-    let v122: f64 = v48 * qd[4usize];
-    let v123: f64 = 0.25f64 * qd[0usize];
-    let v124: f64 = v83.mul_add(qd[2usize], v122);
-    let v125: f64 = (-v123).mul_add(v41, v124);
-    let v126: f64 = (-v15).mul_add(qd[3usize], v125);
-    let v127: f64 = 0.5f64 * qd[1usize];
-    let v128: f64 = v20 * v97;
-    let v129: f64 = v127.mul_add(v51, v128);
-    let v130: f64 = (-v121).mul_add(v11, v129);
-    let v131: f64 = (-v63).mul_add(v77, v130);
-    let v132: f64 = v65.mul_add(v79, v121);
-    let v133: f64 = v13.mul_add(v126, v132);
-    let v134: f64 = v67.mul_add(v89, v133);
-    let v135: f64 = v47.mul_add(v131, v134);
-    let v136: f64 = v23 * qd[0usize];
-    let v137: f64 = v15.mul_add(qd[1usize], -v136);
-    let v138: f64 = v90 * v18;
-    let v139: f64 = v15 * qd[0usize];
-    let v140: f64 = v48.mul_add(qd[2usize], v139);
-    let v141: f64 = v23.mul_add(qd[1usize], v140);
-    let v142: f64 = v33 * v47;
-    let v143: f64 = v13.mul_add(v137, v138);
-    let v144: f64 = v142.mul_add(v141, v143);
-    let v145: f64 = v48 * qd[1usize];
-    let v146: f64 = v23.mul_add(qd[2usize], -v145);
-    let v147: f64 = v112 * v18;
-    let v148: f64 = v26 * v47;
-    let v149: f64 = v13.mul_add(v146, v147);
-    let v150: f64 = v148.mul_add(v141, v149);
-    let v151: f64 = v15 * qd[2usize];
-    let v152: f64 = v48.mul_add(qd[0usize], -v151);
-    let v153: f64 = v127 * v18;
-    let v154: f64 = v20 * v47;
-    let v155: f64 = v13.mul_add(v152, v153);
-    let v156: f64 = v154.mul_add(v141, v155);
-    let v157: f64 = v47 * v46;
-    let v159: f64 = 0.25f64.mul_add(v41, v157);
-    let v160: f64 = v158.mul_add(v53, v159);
-    let v161: f64 = v47.mul_add(v58, v83);
-    let v162: f64 = v158.mul_add(v60, v161);
-    let v163: f64 = v47.mul_add(v65, v80);
-    let v164: f64 = v158.mul_add(v67, v163);
-    let v165: f64 = v46 * v89;
-    let v167: f64 = v77 * v166;
-    let v168: f64 = 0.25f64.mul_add(qd[3usize], v165);
-    let v169: f64 = v47.mul_add(v87, v168);
-    let v170: f64 = v53.mul_add(v167, v169);
-    let v171: f64 = v158.mul_add(v101, v170);
-    let v172: f64 = v58 * v89;
-    let v173: f64 = 0.25f64.mul_add(qd[4usize], v172);
-    let v174: f64 = v47.mul_add(v111, v173);
-    let v175: f64 = v60.mul_add(v167, v174);
-    let v176: f64 = v158.mul_add(v116, v175);
-    let v177: f64 = v65 * v89;
-    let v178: f64 = 0.25f64.mul_add(qd[5usize], v177);
-    let v179: f64 = v47.mul_add(v126, v178);
-    let v180: f64 = v67.mul_add(v167, v179);
-    let v181: f64 = v158.mul_add(v131, v180);
-    let v182: f64 = 0.25f64 * v11;
-    let c: [[f64; 1usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        1usize,
+    let v12: f64 = c[0][0];
+    let v13: f64 = c[2][0];
+    let v18: f64 = c[1][0];
+    let v47: f64 = c[3][0];
+    let v78: f64 = c[2][1];
+    let v88: f64 = c[3][1];
+    let v158: f64 = c[4][0];
+    let v166: f64 = c[4][1];
+    let v14 = v6.mul_add(v13, v12);
+    let v15 = 0.25f64 * q[0];
+    let v16 = v15 * q[2];
+    let v17 = v16 * v13;
+    let v20 = 0.5f64 * q[1];
+    let v21 = v20 * v18;
+    let v22 = v17 - v21;
+    let v23 = 0.25f64 * q[1];
+    let v24 = v23 * q[2];
+    let v25 = v24 * v13;
+    let v26 = 0.5f64 * q[0];
+    let v27 = v26 * v18;
+    let v28 = v25 + v27;
+    let v29 = v17 + v21;
+    let v30 = v3.mul_add(v13, v12);
+    let v31 = v15 * q[1];
+    let v32 = v31 * v13;
+    let v33 = 0.5f64 * q[2];
+    let v34 = v33 * v18;
+    let v35 = v32 - v34;
+    let v36 = v25 - v27;
+    let v37 = v32 + v34;
+    let v38 = v9.mul_add(v13, v12);
+    let v41 = q[3] + p[0];
+    let v42 = 0.5f64 * v41;
+    let v45 = v23 * q[4];
+    let v46 = v15.mul_add(q[5], -v45);
+    let v48 = 0.25f64 * q[2];
+    let v49 = v15 * q[4];
+    let v50 = v48.mul_add(v41, v49);
+    let v51 = v23.mul_add(q[5], v50);
+    let v52 = v42 * v11;
+    let v53 = v33.mul_add(v51, -v52);
+    let v54 = v13.mul_add(v46, v42);
+    let v55 = v47.mul_add(v53, v54);
+    let v56 = 0.5f64 * q[4];
+    let v57 = v48 * q[5];
+    let v58 = v23.mul_add(v41, -v57);
+    let v59 = v56 * v11;
+    let v60 = v26.mul_add(v51, -v59);
+    let v61 = v13.mul_add(v58, v56);
+    let v62 = v47.mul_add(v60, v61);
+    let v63 = 0.5f64 * q[5];
+    let v64 = v15 * v41;
+    let v65 = v48.mul_add(q[4], -v64);
+    let v66 = v63 * v11;
+    let v67 = v20.mul_add(v51, -v66);
+    let v68 = v13.mul_add(v65, v63);
+    let v69 = v47.mul_add(v67, v68);
+    let v71 = 0.5f64 * qd[3];
+    let v74 = v26 * qd[0];
+    let v76 = v33.mul_add(qd[2], v74);
+    let v77 = v20.mul_add(qd[1], v76);
+    let v79 = v77 * v78;
+    let v80 = 0.25f64 * q[5];
+    let v82 = v15 * qd[5];
+    let v83 = 0.25f64 * q[4];
+    let v85 = v80.mul_add(qd[0], v82);
+    let v86 = (-v83).mul_add(qd[1], v85);
+    let v87 = (-v23).mul_add(qd[4], v86);
+    let v89 = v77 * v88;
+    let v90 = 0.5f64 * qd[2];
+    let v91 = 0.25f64 * qd[2];
+    let v92 = v48 * qd[3];
+    let v93 = v91.mul_add(v41, v92);
+    let v94 = v83.mul_add(qd[0], v93);
+    let v95 = v15.mul_add(qd[4], v94);
+    let v96 = v80.mul_add(qd[1], v95);
+    let v97 = v23.mul_add(qd[5], v96);
+    let v98 = v33 * v97;
+    let v99 = v90.mul_add(v51, v98);
+    let v100 = (-v71).mul_add(v11, v99);
+    let v101 = (-v42).mul_add(v77, v100);
+    let v102 = v46.mul_add(v79, v71);
+    let v103 = v13.mul_add(v87, v102);
+    let v104 = v53.mul_add(v89, v103);
+    let v105 = v47.mul_add(v101, v104);
+    let v106 = 0.5f64 * qd[4];
+    let v107 = 0.25f64 * qd[1];
+    let v108 = v23 * qd[3];
+    let v109 = v107.mul_add(v41, v108);
+    let v110 = (-v80).mul_add(qd[2], v109);
+    let v111 = (-v48).mul_add(qd[5], v110);
+    let v112 = 0.5f64 * qd[0];
+    let v113 = v26 * v97;
+    let v114 = v112.mul_add(v51, v113);
+    let v115 = (-v106).mul_add(v11, v114);
+    let v116 = (-v56).mul_add(v77, v115);
+    let v117 = v58.mul_add(v79, v106);
+    let v118 = v13.mul_add(v111, v117);
+    let v119 = v60.mul_add(v89, v118);
+    let v120 = v47.mul_add(v116, v119);
+    let v121 = 0.5f64 * qd[5];
+    let v122 = v48 * qd[4];
+    let v123 = 0.25f64 * qd[0];
+    let v124 = v83.mul_add(qd[2], v122);
+    let v125 = (-v123).mul_add(v41, v124);
+    let v126 = (-v15).mul_add(qd[3], v125);
+    let v127 = 0.5f64 * qd[1];
+    let v128 = v20 * v97;
+    let v129 = v127.mul_add(v51, v128);
+    let v130 = (-v121).mul_add(v11, v129);
+    let v131 = (-v63).mul_add(v77, v130);
+    let v132 = v65.mul_add(v79, v121);
+    let v133 = v13.mul_add(v126, v132);
+    let v134 = v67.mul_add(v89, v133);
+    let v135 = v47.mul_add(v131, v134);
+    let v136 = v23 * qd[0];
+    let v137 = v15.mul_add(qd[1], -v136);
+    let v138 = v90 * v18;
+    let v139 = v15 * qd[0];
+    let v140 = v48.mul_add(qd[2], v139);
+    let v141 = v23.mul_add(qd[1], v140);
+    let v142 = v33 * v47;
+    let v143 = v13.mul_add(v137, v138);
+    let v144 = v142.mul_add(v141, v143);
+    let v145 = v48 * qd[1];
+    let v146 = v23.mul_add(qd[2], -v145);
+    let v147 = v112 * v18;
+    let v148 = v26 * v47;
+    let v149 = v13.mul_add(v146, v147);
+    let v150 = v148.mul_add(v141, v149);
+    let v151 = v15 * qd[2];
+    let v152 = v48.mul_add(qd[0], -v151);
+    let v153 = v127 * v18;
+    let v154 = v20 * v47;
+    let v155 = v13.mul_add(v152, v153);
+    let v156 = v154.mul_add(v141, v155);
+    let v157 = v47 * v46;
+    let v159 = 0.25f64.mul_add(v41, v157);
+    let v160 = v158.mul_add(v53, v159);
+    let v161 = v47.mul_add(v58, v83);
+    let v162 = v158.mul_add(v60, v161);
+    let v163 = v47.mul_add(v65, v80);
+    let v164 = v158.mul_add(v67, v163);
+    let v165 = v46 * v89;
+    let v167 = v77 * v166;
+    let v168 = 0.25f64.mul_add(qd[3], v165);
+    let v169 = v47.mul_add(v87, v168);
+    let v170 = v53.mul_add(v167, v169);
+    let v171 = v158.mul_add(v101, v170);
+    let v172 = v58 * v89;
+    let v173 = 0.25f64.mul_add(qd[4], v172);
+    let v174 = v47.mul_add(v111, v173);
+    let v175 = v60.mul_add(v167, v174);
+    let v176 = v158.mul_add(v116, v175);
+    let v177 = v65 * v89;
+    let v178 = 0.25f64.mul_add(qd[5], v177);
+    let v179 = v47.mul_add(v126, v178);
+    let v180 = v67.mul_add(v167, v179);
+    let v181 = v158.mul_add(v131, v180);
+    let v182 = 0.25f64 * v11;
+    let c: [[f64; 1]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        1,
     >(v182);
-    let v183: f64 = c[2usize][0usize];
-    let v189: f64 = c[1usize][0usize];
-    let v191: f64 = c[3usize][0usize];
-    let v229: f64 = c[0usize][0usize];
-    let v185: f64 = 0.0625f64 * q[0usize];
-    let v186: f64 = 0.0625f64 * q[1usize];
-    let v187: f64 = v186 * qd[0usize];
-    let v188: f64 = v185.mul_add(qd[1usize], -v187);
-    let v190: f64 = v91 * v189;
-    let v192: f64 = 0.0625f64 * q[2usize];
-    let v193: f64 = v185 * qd[0usize];
-    let v194: f64 = v192.mul_add(qd[2usize], v193);
-    let v195: f64 = v186.mul_add(qd[1usize], v194);
-    let v196: f64 = v48 * v191;
-    let v197: f64 = v183.mul_add(v188, v190);
-    let v198: f64 = v196.mul_add(v195, v197);
-    let v199: f64 = v192 * qd[1usize];
-    let v200: f64 = v186.mul_add(qd[2usize], -v199);
-    let v201: f64 = v123 * v189;
-    let v202: f64 = v15 * v191;
-    let v203: f64 = v183.mul_add(v200, v201);
-    let v204: f64 = v202.mul_add(v195, v203);
-    let v205: f64 = v185 * qd[2usize];
-    let v206: f64 = v192.mul_add(qd[0usize], -v205);
-    let v207: f64 = v107 * v189;
-    let v208: f64 = v23 * v191;
-    let v209: f64 = v183.mul_add(v206, v207);
-    let v210: f64 = v208.mul_add(v195, v209);
-    let v212: f64 = 0.0625f64.mul_add(v5, -v182);
-    let v213: f64 = v183.mul_add(v212, 1f64);
-    let v214: f64 = v23 * v189;
-    let v215: f64 = v185 * q[2usize];
-    let v216: f64 = v215.mul_add(v183, v214);
-    let v217: f64 = v186 * q[2usize];
-    let v218: f64 = v15 * v189;
-    let v219: f64 = v217.mul_add(v183, -v218);
-    let v221: f64 = 0.5f64 * p[1usize];
-    let v223: f64 = 0.25f64 * p[3usize];
-    let v225: f64 = p[2usize] - v223;
-    let v227: f64 = 0.125f64.mul_add(v225, v223);
-    let v228: f64 = 0.5f64 * p[3usize];
-    let v230: f64 = v48 * v189;
-    let v232: f64 = 0.5f64 * p[7usize];
-    let v234: f64 = q[3usize] * q[3usize];
-    let v235: f64 = 0.5f64 * p[9usize];
-    let v236: f64 = v235 * v234;
-    let v239: f64 = q[1usize] - p[6usize];
-    let v240: f64 = v239 * v239;
-    let v241: f64 = 0.5f64 * v240;
-    let v242: f64 = 0.5f64.mul_add(v1, v241);
-    let v244: f64 = q[4usize] * q[4usize];
-    let v245: f64 = q[5usize] * q[5usize];
-    let v246: f64 = 0.5f64 * v245;
-    let v247: f64 = 0.5f64.mul_add(v244, v246);
-    let v248: f64 = v232.mul_add(v5, v236);
-    let v249: f64 = p[4usize].mul_add(v242, v248);
-    let v250: f64 = p[11usize].mul_add(v247, v249);
-    let v251: f64 = 0.5f64 * v250;
-    out[0usize] = v14;
-    out[1usize] = v22;
-    out[2usize] = v28;
-    out[3usize] = v29;
-    out[4usize] = v30;
-    out[5usize] = v35;
-    out[6usize] = v36;
-    out[7usize] = v37;
-    out[8usize] = v38;
-    out[9usize] = v55;
-    out[10usize] = v62;
-    out[11usize] = v69;
-    out[12usize] = v105;
-    out[13usize] = v120;
-    out[14usize] = v135;
-    out[15usize] = v144;
-    out[16usize] = v150;
-    out[17usize] = v156;
-    out[18usize] = v160;
-    out[19usize] = v162;
-    out[20usize] = v164;
-    out[21usize] = v171;
-    out[22usize] = v176;
-    out[23usize] = v181;
-    out[24usize] = v198;
-    out[25usize] = v204;
-    out[26usize] = v210;
-    out[27usize] = v213;
-    out[28usize] = v216;
-    out[29usize] = v219;
-    out[30usize] = v221;
-    out[31usize] = v227;
-    out[32usize] = v228;
-    out[33usize] = v229;
-    out[34usize] = v230;
-    out[35usize] = v218;
-    out[36usize] = v214;
-    out[37usize] = v251;
+    let v183: f64 = c[2][0];
+    let v189: f64 = c[1][0];
+    let v191: f64 = c[3][0];
+    let v229: f64 = c[0][0];
+    let v185 = 0.0625f64 * q[0];
+    let v186 = 0.0625f64 * q[1];
+    let v187 = v186 * qd[0];
+    let v188 = v185.mul_add(qd[1], -v187);
+    let v190 = v91 * v189;
+    let v192 = 0.0625f64 * q[2];
+    let v193 = v185 * qd[0];
+    let v194 = v192.mul_add(qd[2], v193);
+    let v195 = v186.mul_add(qd[1], v194);
+    let v196 = v48 * v191;
+    let v197 = v183.mul_add(v188, v190);
+    let v198 = v196.mul_add(v195, v197);
+    let v199 = v192 * qd[1];
+    let v200 = v186.mul_add(qd[2], -v199);
+    let v201 = v123 * v189;
+    let v202 = v15 * v191;
+    let v203 = v183.mul_add(v200, v201);
+    let v204 = v202.mul_add(v195, v203);
+    let v205 = v185 * qd[2];
+    let v206 = v192.mul_add(qd[0], -v205);
+    let v207 = v107 * v189;
+    let v208 = v23 * v191;
+    let v209 = v183.mul_add(v206, v207);
+    let v210 = v208.mul_add(v195, v209);
+    let v212 = 0.0625f64.mul_add(v5, -v182);
+    let v213 = v183.mul_add(v212, 1f64);
+    let v214 = v23 * v189;
+    let v215 = v185 * q[2];
+    let v216 = v215.mul_add(v183, v214);
+    let v217 = v186 * q[2];
+    let v218 = v15 * v189;
+    let v219 = v217.mul_add(v183, -v218);
+    let v221 = 0.5f64 * p[1];
+    let v223 = 0.25f64 * p[3];
+    let v225 = p[2] - v223;
+    let v227 = 0.125f64.mul_add(v225, v223);
+    let v228 = 0.5f64 * p[3];
+    let v230 = v48 * v189;
+    let v232 = 0.5f64 * p[7];
+    let v234 = q[3] * q[3];
+    let v235 = 0.5f64 * p[9];
+    let v236 = v235 * v234;
+    let v239 = q[1] - p[6];
+    let v240 = v239 * v239;
+    let v241 = 0.5f64 * v240;
+    let v242 = 0.5f64.mul_add(v1, v241);
+    let v244 = q[4] * q[4];
+    let v245 = q[5] * q[5];
+    let v246 = 0.5f64 * v245;
+    let v247 = 0.5f64.mul_add(v244, v246);
+    let v248 = v232.mul_add(v5, v236);
+    let v249 = p[4].mul_add(v242, v248);
+    let v250 = p[11].mul_add(v247, v249);
+    let v251 = 0.5f64 * v250;
+    out[0] = v14;
+    out[1] = v22;
+    out[2] = v28;
+    out[3] = v29;
+    out[4] = v30;
+    out[5] = v35;
+    out[6] = v36;
+    out[7] = v37;
+    out[8] = v38;
+    out[9] = v55;
+    out[10] = v62;
+    out[11] = v69;
+    out[12] = v105;
+    out[13] = v120;
+    out[14] = v135;
+    out[15] = v144;
+    out[16] = v150;
+    out[17] = v156;
+    out[18] = v160;
+    out[19] = v162;
+    out[20] = v164;
+    out[21] = v171;
+    out[22] = v176;
+    out[23] = v181;
+    out[24] = v198;
+    out[25] = v204;
+    out[26] = v210;
+    out[27] = v213;
+    out[28] = v216;
+    out[29] = v219;
+    out[30] = v221;
+    out[31] = v227;
+    out[32] = v228;
+    out[33] = v229;
+    out[34] = v230;
+    out[35] = v218;
+    out[36] = v214;
+    out[37] = v251;
 }
 /// Kernel `cell_0`: 752 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0(
     t: f64,
-    q: &[f64; 6usize],
-    qd: &[f64; 6usize],
-    qdd: &[f64; 6usize],
-    dir: &[f64; 12usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 129usize],
+    q: &[f64; 6],
+    qd: &[f64; 6],
+    qdd: &[f64; 6],
+    dir: &[f64; 12],
+    p: &[f64; 15],
+    out: &mut [f64; 129],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1250,655 +1250,655 @@ pub fn cell_0(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
-    q: &[f64; 6usize],
-    qd: &[f64; 6usize],
-    qdd: &[f64; 6usize],
-    dir: &[f64; 12usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 129usize],
+    q: &[f64; 6],
+    qd: &[f64; 6],
+    qdd: &[f64; 6],
+    dir: &[f64; 12],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 129],
 ) {
-    let v1: f64 = q[0usize] * q[0usize];
-    let v3: f64 = 0.25f64 * v1;
-    let v5: f64 = q[2usize] * q[2usize];
-    let v6: f64 = 0.25f64 * v5;
-    let v8: f64 = q[1usize] * q[1usize];
-    let v9: f64 = 0.25f64 * v8;
-    let v10: f64 = v3 + v6;
-    let v11: f64 = v10 + v9;
-    let c: [[f64; 3usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        3usize,
+    let v1 = q[0] * q[0];
+    let v3 = 0.25f64 * v1;
+    let v5 = q[2] * q[2];
+    let v6 = 0.25f64 * v5;
+    let v8 = q[1] * q[1];
+    let v9 = 0.25f64 * v8;
+    let v10 = v3 + v6;
+    let v11 = v10 + v9;
+    let c: [[f64; 3]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        3,
     >(v11);
-    let v12: f64 = c[0usize][0usize];
-    let v13: f64 = c[2usize][0usize];
-    let v18: f64 = c[1usize][0usize];
-    let v47: f64 = c[3usize][0usize];
-    let v78: f64 = c[2usize][1usize];
-    let v88: f64 = c[3usize][1usize];
-    let v144: f64 = c[2usize][2usize];
-    let v152: f64 = c[3usize][2usize];
-    let v220: f64 = c[1usize][1usize];
-    let v233: f64 = c[4usize][0usize];
-    let v241: f64 = c[4usize][1usize];
-    let v260: f64 = c[4usize][2usize];
-    let v14: f64 = v6.mul_add(v13, v12);
-    let v15: f64 = 0.25f64 * q[0usize];
-    let v16: f64 = v15 * q[2usize];
-    let v17: f64 = v16 * v13;
-    let v20: f64 = 0.5f64 * q[1usize];
-    let v21: f64 = v20 * v18;
-    let v22: f64 = v17 - v21;
-    let v23: f64 = 0.25f64 * q[1usize];
-    let v24: f64 = v23 * q[2usize];
-    let v25: f64 = v24 * v13;
-    let v26: f64 = 0.5f64 * q[0usize];
-    let v27: f64 = v26 * v18;
-    let v28: f64 = v25 + v27;
-    let v29: f64 = v17 + v21;
-    let v30: f64 = v3.mul_add(v13, v12);
-    let v31: f64 = v15 * q[1usize];
-    let v32: f64 = v31 * v13;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let v34: f64 = v33 * v18;
-    let v35: f64 = v32 - v34;
-    let v36: f64 = v25 - v27;
-    let v37: f64 = v32 + v34;
-    let v38: f64 = v9.mul_add(v13, v12);
-    let v41: f64 = q[3usize] + p[0usize];
-    let v42: f64 = 0.5f64 * v41;
-    let v45: f64 = v23 * q[4usize];
-    let v46: f64 = v15.mul_add(q[5usize], -v45);
-    let v48: f64 = 0.25f64 * q[2usize];
-    let v49: f64 = v15 * q[4usize];
-    let v50: f64 = v48.mul_add(v41, v49);
-    let v51: f64 = v23.mul_add(q[5usize], v50);
-    let v52: f64 = v42 * v11;
-    let v53: f64 = v33.mul_add(v51, -v52);
-    let v54: f64 = v13.mul_add(v46, v42);
-    let v55: f64 = v47.mul_add(v53, v54);
-    let v56: f64 = 0.5f64 * q[4usize];
-    let v57: f64 = v48 * q[5usize];
-    let v58: f64 = v23.mul_add(v41, -v57);
-    let v59: f64 = v56 * v11;
-    let v60: f64 = v26.mul_add(v51, -v59);
-    let v61: f64 = v13.mul_add(v58, v56);
-    let v62: f64 = v47.mul_add(v60, v61);
-    let v63: f64 = 0.5f64 * q[5usize];
-    let v64: f64 = v15 * v41;
-    let v65: f64 = v48.mul_add(q[4usize], -v64);
-    let v66: f64 = v63 * v11;
-    let v67: f64 = v20.mul_add(v51, -v66);
-    let v68: f64 = v13.mul_add(v65, v63);
-    let v69: f64 = v47.mul_add(v67, v68);
-    let v71: f64 = 0.5f64 * qd[3usize];
-    let v74: f64 = v26 * qd[0usize];
-    let v76: f64 = v33.mul_add(qd[2usize], v74);
-    let v77: f64 = v20.mul_add(qd[1usize], v76);
-    let v79: f64 = v77 * v78;
-    let v80: f64 = 0.25f64 * q[5usize];
-    let v82: f64 = v15 * qd[5usize];
-    let v83: f64 = 0.25f64 * q[4usize];
-    let v85: f64 = v80.mul_add(qd[0usize], v82);
-    let v86: f64 = (-v83).mul_add(qd[1usize], v85);
-    let v87: f64 = (-v23).mul_add(qd[4usize], v86);
-    let v89: f64 = v77 * v88;
-    let v90: f64 = 0.5f64 * qd[2usize];
-    let v91: f64 = 0.25f64 * qd[2usize];
-    let v92: f64 = v48 * qd[3usize];
-    let v93: f64 = v91.mul_add(v41, v92);
-    let v94: f64 = v83.mul_add(qd[0usize], v93);
-    let v95: f64 = v15.mul_add(qd[4usize], v94);
-    let v96: f64 = v80.mul_add(qd[1usize], v95);
-    let v97: f64 = v23.mul_add(qd[5usize], v96);
-    let v98: f64 = v33 * v97;
-    let v99: f64 = v90.mul_add(v51, v98);
-    let v100: f64 = (-v71).mul_add(v11, v99);
-    let v101: f64 = (-v42).mul_add(v77, v100);
-    let v102: f64 = v46.mul_add(v79, v71);
-    let v103: f64 = v13.mul_add(v87, v102);
-    let v104: f64 = v53.mul_add(v89, v103);
-    let v105: f64 = v47.mul_add(v101, v104);
-    let v106: f64 = 0.5f64 * qd[4usize];
-    let v107: f64 = 0.25f64 * qd[1usize];
-    let v108: f64 = v23 * qd[3usize];
-    let v109: f64 = v107.mul_add(v41, v108);
-    let v110: f64 = (-v80).mul_add(qd[2usize], v109);
-    let v111: f64 = (-v48).mul_add(qd[5usize], v110);
-    let v112: f64 = 0.5f64 * qd[0usize];
-    let v113: f64 = v26 * v97;
-    let v114: f64 = v112.mul_add(v51, v113);
-    let v115: f64 = (-v106).mul_add(v11, v114);
-    let v116: f64 = (-v56).mul_add(v77, v115);
-    let v117: f64 = v58.mul_add(v79, v106);
-    let v118: f64 = v13.mul_add(v111, v117);
-    let v119: f64 = v60.mul_add(v89, v118);
-    let v120: f64 = v47.mul_add(v116, v119);
-    let v121: f64 = 0.5f64 * qd[5usize];
-    let v122: f64 = v48 * qd[4usize];
-    let v123: f64 = 0.25f64 * qd[0usize];
-    let v124: f64 = v83.mul_add(qd[2usize], v122);
-    let v125: f64 = (-v123).mul_add(v41, v124);
-    let v126: f64 = (-v15).mul_add(qd[3usize], v125);
-    let v127: f64 = 0.5f64 * qd[1usize];
-    let v128: f64 = v20 * v97;
-    let v129: f64 = v127.mul_add(v51, v128);
-    let v130: f64 = (-v121).mul_add(v11, v129);
-    let v131: f64 = (-v63).mul_add(v77, v130);
-    let v132: f64 = v65.mul_add(v79, v121);
-    let v133: f64 = v13.mul_add(v126, v132);
-    let v134: f64 = v67.mul_add(v89, v133);
-    let v135: f64 = v47.mul_add(v131, v134);
-    let v137: f64 = 2f64 * v79;
-    let v138: f64 = qd[0usize] * qd[0usize];
-    let v139: f64 = qd[1usize] * qd[1usize];
-    let v140: f64 = 0.5f64 * v139;
-    let v141: f64 = qd[2usize] * qd[2usize];
-    let v142: f64 = 0.5f64.mul_add(v138, v140);
-    let v143: f64 = 0.5f64.mul_add(v141, v142);
-    let v145: f64 = v77 * v77;
-    let v146: f64 = v144 * v145;
-    let v147: f64 = v78.mul_add(v143, v146);
-    let v148: f64 = v46 * v147;
-    let v149: f64 = v127 * qd[4usize];
-    let v150: f64 = v112.mul_add(qd[5usize], -v149);
-    let v151: f64 = 2f64 * v89;
-    let v153: f64 = v145 * v152;
-    let v154: f64 = v88.mul_add(v143, v153);
-    let v155: f64 = v112 * qd[4usize];
-    let v156: f64 = v90.mul_add(qd[3usize], v155);
-    let v157: f64 = v127.mul_add(qd[5usize], v156);
-    let v158: f64 = v33 * v157;
-    let v159: f64 = qd[2usize].mul_add(v97, v158);
-    let v160: f64 = (-qd[3usize]).mul_add(v77, v159);
-    let v161: f64 = (-v42).mul_add(v143, v160);
-    let v162: f64 = v137.mul_add(v87, v148);
-    let v163: f64 = v13.mul_add(v150, v162);
-    let v164: f64 = v151.mul_add(v101, v163);
-    let v165: f64 = v53.mul_add(v154, v164);
-    let v166: f64 = v47.mul_add(v161, v165);
-    let v167: f64 = v58 * v147;
-    let v168: f64 = v90 * qd[5usize];
-    let v169: f64 = v127.mul_add(qd[3usize], -v168);
-    let v170: f64 = v26 * v157;
-    let v171: f64 = qd[0usize].mul_add(v97, v170);
-    let v172: f64 = (-qd[4usize]).mul_add(v77, v171);
-    let v173: f64 = (-v56).mul_add(v143, v172);
-    let v174: f64 = v137.mul_add(v111, v167);
-    let v175: f64 = v13.mul_add(v169, v174);
-    let v176: f64 = v151.mul_add(v116, v175);
-    let v177: f64 = v60.mul_add(v154, v176);
-    let v178: f64 = v47.mul_add(v173, v177);
-    let v179: f64 = v65 * v147;
-    let v180: f64 = v112 * qd[3usize];
-    let v181: f64 = v90.mul_add(qd[4usize], -v180);
-    let v182: f64 = v20 * v157;
-    let v183: f64 = qd[1usize].mul_add(v97, v182);
-    let v184: f64 = (-qd[5usize]).mul_add(v77, v183);
-    let v185: f64 = (-v63).mul_add(v143, v184);
-    let v186: f64 = v137.mul_add(v126, v179);
-    let v187: f64 = v13.mul_add(v181, v186);
-    let v188: f64 = v151.mul_add(v131, v187);
-    let v189: f64 = v67.mul_add(v154, v188);
-    let v190: f64 = v47.mul_add(v185, v189);
-    let v191: f64 = v23 * qd[0usize];
-    let v192: f64 = v15.mul_add(qd[1usize], -v191);
-    let v193: f64 = v90 * v18;
-    let v194: f64 = v15 * qd[0usize];
-    let v195: f64 = v48.mul_add(qd[2usize], v194);
-    let v196: f64 = v23.mul_add(qd[1usize], v195);
-    let v197: f64 = v33 * v47;
-    let v198: f64 = v13.mul_add(v192, v193);
-    let v199: f64 = v197.mul_add(v196, v198);
-    let v200: f64 = v48 * qd[1usize];
-    let v201: f64 = v23.mul_add(qd[2usize], -v200);
-    let v202: f64 = v112 * v18;
-    let v203: f64 = v26 * v47;
-    let v204: f64 = v13.mul_add(v201, v202);
-    let v205: f64 = v203.mul_add(v196, v204);
-    let v206: f64 = v15 * qd[2usize];
-    let v207: f64 = v48.mul_add(qd[0usize], -v206);
-    let v208: f64 = v127 * v18;
-    let v209: f64 = v20 * v47;
-    let v210: f64 = v13.mul_add(v207, v208);
-    let v211: f64 = v209.mul_add(v196, v210);
-    let v212: f64 = 0.5f64 * v196;
-    let v213: f64 = 0.25f64 * v139;
-    let v214: f64 = 0.25f64.mul_add(v138, v213);
-    let v215: f64 = 0.25f64.mul_add(v141, v214);
-    let v216: f64 = 0.5f64 * v47;
-    let v217: f64 = v216 * v215;
-    let v218: f64 = v212.mul_add(v89, v217);
-    let v219: f64 = q[2usize] * v218;
-    let v221: f64 = v77 * v220;
-    let v222: f64 = 0.5f64 * v221;
-    let v223: f64 = v216.mul_add(v196, v222);
-    let v224: f64 = v192.mul_add(v79, v219);
-    let v225: f64 = qd[2usize].mul_add(v223, v224);
-    let v226: f64 = q[0usize] * v218;
-    let v227: f64 = v201.mul_add(v79, v226);
-    let v228: f64 = qd[0usize].mul_add(v223, v227);
-    let v229: f64 = q[1usize] * v218;
-    let v230: f64 = v207.mul_add(v79, v229);
-    let v231: f64 = qd[1usize].mul_add(v223, v230);
-    let v232: f64 = 0.25f64 * v41;
-    let v234: f64 = v47.mul_add(v46, v232);
-    let v235: f64 = v233.mul_add(v53, v234);
-    let v236: f64 = v47.mul_add(v58, v83);
-    let v237: f64 = v233.mul_add(v60, v236);
-    let v238: f64 = v47.mul_add(v65, v80);
-    let v239: f64 = v233.mul_add(v67, v238);
-    let v240: f64 = v46 * v89;
-    let v242: f64 = v77 * v241;
-    let v243: f64 = 0.25f64.mul_add(qd[3usize], v240);
-    let v244: f64 = v47.mul_add(v87, v243);
-    let v245: f64 = v53.mul_add(v242, v244);
-    let v246: f64 = v233.mul_add(v101, v245);
-    let v247: f64 = v58 * v89;
-    let v248: f64 = 0.25f64.mul_add(qd[4usize], v247);
-    let v249: f64 = v47.mul_add(v111, v248);
-    let v250: f64 = v60.mul_add(v242, v249);
-    let v251: f64 = v233.mul_add(v116, v250);
-    let v252: f64 = v65 * v89;
-    let v253: f64 = 0.25f64.mul_add(qd[5usize], v252);
-    let v254: f64 = v47.mul_add(v126, v253);
-    let v255: f64 = v67.mul_add(v242, v254);
-    let v256: f64 = v233.mul_add(v131, v255);
-    let v257: f64 = 2f64 * v87;
-    let v258: f64 = v46 * v154;
-    let v259: f64 = 2f64 * v101;
-    let v261: f64 = v145 * v260;
-    let v262: f64 = v143.mul_add(v241, v261);
-    let v263: f64 = v257.mul_add(v89, v258);
-    let v264: f64 = v47.mul_add(v150, v263);
-    let v265: f64 = v259.mul_add(v242, v264);
-    let v266: f64 = v53.mul_add(v262, v265);
-    let v267: f64 = v233.mul_add(v161, v266);
-    let v268: f64 = v58 * v154;
-    let v269: f64 = 2f64 * v116;
-    let v270: f64 = v151.mul_add(v111, v268);
-    let v271: f64 = v47.mul_add(v169, v270);
-    let v272: f64 = v269.mul_add(v242, v271);
-    let v273: f64 = v60.mul_add(v262, v272);
-    let v274: f64 = v233.mul_add(v173, v273);
-    let v275: f64 = v65 * v154;
-    let v276: f64 = 2f64 * v131;
-    let v277: f64 = v151.mul_add(v126, v275);
-    let v278: f64 = v47.mul_add(v181, v277);
-    let v279: f64 = v276.mul_add(v242, v278);
-    let v280: f64 = v67.mul_add(v262, v279);
-    let v281: f64 = v233.mul_add(v185, v280);
-    let v282: f64 = 0.25f64 * v11;
-    let c: [[f64; 2usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        2usize,
+    let v12: f64 = c[0][0];
+    let v13: f64 = c[2][0];
+    let v18: f64 = c[1][0];
+    let v47: f64 = c[3][0];
+    let v78: f64 = c[2][1];
+    let v88: f64 = c[3][1];
+    let v144: f64 = c[2][2];
+    let v152: f64 = c[3][2];
+    let v220: f64 = c[1][1];
+    let v233: f64 = c[4][0];
+    let v241: f64 = c[4][1];
+    let v260: f64 = c[4][2];
+    let v14 = v6.mul_add(v13, v12);
+    let v15 = 0.25f64 * q[0];
+    let v16 = v15 * q[2];
+    let v17 = v16 * v13;
+    let v20 = 0.5f64 * q[1];
+    let v21 = v20 * v18;
+    let v22 = v17 - v21;
+    let v23 = 0.25f64 * q[1];
+    let v24 = v23 * q[2];
+    let v25 = v24 * v13;
+    let v26 = 0.5f64 * q[0];
+    let v27 = v26 * v18;
+    let v28 = v25 + v27;
+    let v29 = v17 + v21;
+    let v30 = v3.mul_add(v13, v12);
+    let v31 = v15 * q[1];
+    let v32 = v31 * v13;
+    let v33 = 0.5f64 * q[2];
+    let v34 = v33 * v18;
+    let v35 = v32 - v34;
+    let v36 = v25 - v27;
+    let v37 = v32 + v34;
+    let v38 = v9.mul_add(v13, v12);
+    let v41 = q[3] + p[0];
+    let v42 = 0.5f64 * v41;
+    let v45 = v23 * q[4];
+    let v46 = v15.mul_add(q[5], -v45);
+    let v48 = 0.25f64 * q[2];
+    let v49 = v15 * q[4];
+    let v50 = v48.mul_add(v41, v49);
+    let v51 = v23.mul_add(q[5], v50);
+    let v52 = v42 * v11;
+    let v53 = v33.mul_add(v51, -v52);
+    let v54 = v13.mul_add(v46, v42);
+    let v55 = v47.mul_add(v53, v54);
+    let v56 = 0.5f64 * q[4];
+    let v57 = v48 * q[5];
+    let v58 = v23.mul_add(v41, -v57);
+    let v59 = v56 * v11;
+    let v60 = v26.mul_add(v51, -v59);
+    let v61 = v13.mul_add(v58, v56);
+    let v62 = v47.mul_add(v60, v61);
+    let v63 = 0.5f64 * q[5];
+    let v64 = v15 * v41;
+    let v65 = v48.mul_add(q[4], -v64);
+    let v66 = v63 * v11;
+    let v67 = v20.mul_add(v51, -v66);
+    let v68 = v13.mul_add(v65, v63);
+    let v69 = v47.mul_add(v67, v68);
+    let v71 = 0.5f64 * qd[3];
+    let v74 = v26 * qd[0];
+    let v76 = v33.mul_add(qd[2], v74);
+    let v77 = v20.mul_add(qd[1], v76);
+    let v79 = v77 * v78;
+    let v80 = 0.25f64 * q[5];
+    let v82 = v15 * qd[5];
+    let v83 = 0.25f64 * q[4];
+    let v85 = v80.mul_add(qd[0], v82);
+    let v86 = (-v83).mul_add(qd[1], v85);
+    let v87 = (-v23).mul_add(qd[4], v86);
+    let v89 = v77 * v88;
+    let v90 = 0.5f64 * qd[2];
+    let v91 = 0.25f64 * qd[2];
+    let v92 = v48 * qd[3];
+    let v93 = v91.mul_add(v41, v92);
+    let v94 = v83.mul_add(qd[0], v93);
+    let v95 = v15.mul_add(qd[4], v94);
+    let v96 = v80.mul_add(qd[1], v95);
+    let v97 = v23.mul_add(qd[5], v96);
+    let v98 = v33 * v97;
+    let v99 = v90.mul_add(v51, v98);
+    let v100 = (-v71).mul_add(v11, v99);
+    let v101 = (-v42).mul_add(v77, v100);
+    let v102 = v46.mul_add(v79, v71);
+    let v103 = v13.mul_add(v87, v102);
+    let v104 = v53.mul_add(v89, v103);
+    let v105 = v47.mul_add(v101, v104);
+    let v106 = 0.5f64 * qd[4];
+    let v107 = 0.25f64 * qd[1];
+    let v108 = v23 * qd[3];
+    let v109 = v107.mul_add(v41, v108);
+    let v110 = (-v80).mul_add(qd[2], v109);
+    let v111 = (-v48).mul_add(qd[5], v110);
+    let v112 = 0.5f64 * qd[0];
+    let v113 = v26 * v97;
+    let v114 = v112.mul_add(v51, v113);
+    let v115 = (-v106).mul_add(v11, v114);
+    let v116 = (-v56).mul_add(v77, v115);
+    let v117 = v58.mul_add(v79, v106);
+    let v118 = v13.mul_add(v111, v117);
+    let v119 = v60.mul_add(v89, v118);
+    let v120 = v47.mul_add(v116, v119);
+    let v121 = 0.5f64 * qd[5];
+    let v122 = v48 * qd[4];
+    let v123 = 0.25f64 * qd[0];
+    let v124 = v83.mul_add(qd[2], v122);
+    let v125 = (-v123).mul_add(v41, v124);
+    let v126 = (-v15).mul_add(qd[3], v125);
+    let v127 = 0.5f64 * qd[1];
+    let v128 = v20 * v97;
+    let v129 = v127.mul_add(v51, v128);
+    let v130 = (-v121).mul_add(v11, v129);
+    let v131 = (-v63).mul_add(v77, v130);
+    let v132 = v65.mul_add(v79, v121);
+    let v133 = v13.mul_add(v126, v132);
+    let v134 = v67.mul_add(v89, v133);
+    let v135 = v47.mul_add(v131, v134);
+    let v137 = 2f64 * v79;
+    let v138 = qd[0] * qd[0];
+    let v139 = qd[1] * qd[1];
+    let v140 = 0.5f64 * v139;
+    let v141 = qd[2] * qd[2];
+    let v142 = 0.5f64.mul_add(v138, v140);
+    let v143 = 0.5f64.mul_add(v141, v142);
+    let v145 = v77 * v77;
+    let v146 = v144 * v145;
+    let v147 = v78.mul_add(v143, v146);
+    let v148 = v46 * v147;
+    let v149 = v127 * qd[4];
+    let v150 = v112.mul_add(qd[5], -v149);
+    let v151 = 2f64 * v89;
+    let v153 = v145 * v152;
+    let v154 = v88.mul_add(v143, v153);
+    let v155 = v112 * qd[4];
+    let v156 = v90.mul_add(qd[3], v155);
+    let v157 = v127.mul_add(qd[5], v156);
+    let v158 = v33 * v157;
+    let v159 = qd[2].mul_add(v97, v158);
+    let v160 = (-qd[3]).mul_add(v77, v159);
+    let v161 = (-v42).mul_add(v143, v160);
+    let v162 = v137.mul_add(v87, v148);
+    let v163 = v13.mul_add(v150, v162);
+    let v164 = v151.mul_add(v101, v163);
+    let v165 = v53.mul_add(v154, v164);
+    let v166 = v47.mul_add(v161, v165);
+    let v167 = v58 * v147;
+    let v168 = v90 * qd[5];
+    let v169 = v127.mul_add(qd[3], -v168);
+    let v170 = v26 * v157;
+    let v171 = qd[0].mul_add(v97, v170);
+    let v172 = (-qd[4]).mul_add(v77, v171);
+    let v173 = (-v56).mul_add(v143, v172);
+    let v174 = v137.mul_add(v111, v167);
+    let v175 = v13.mul_add(v169, v174);
+    let v176 = v151.mul_add(v116, v175);
+    let v177 = v60.mul_add(v154, v176);
+    let v178 = v47.mul_add(v173, v177);
+    let v179 = v65 * v147;
+    let v180 = v112 * qd[3];
+    let v181 = v90.mul_add(qd[4], -v180);
+    let v182 = v20 * v157;
+    let v183 = qd[1].mul_add(v97, v182);
+    let v184 = (-qd[5]).mul_add(v77, v183);
+    let v185 = (-v63).mul_add(v143, v184);
+    let v186 = v137.mul_add(v126, v179);
+    let v187 = v13.mul_add(v181, v186);
+    let v188 = v151.mul_add(v131, v187);
+    let v189 = v67.mul_add(v154, v188);
+    let v190 = v47.mul_add(v185, v189);
+    let v191 = v23 * qd[0];
+    let v192 = v15.mul_add(qd[1], -v191);
+    let v193 = v90 * v18;
+    let v194 = v15 * qd[0];
+    let v195 = v48.mul_add(qd[2], v194);
+    let v196 = v23.mul_add(qd[1], v195);
+    let v197 = v33 * v47;
+    let v198 = v13.mul_add(v192, v193);
+    let v199 = v197.mul_add(v196, v198);
+    let v200 = v48 * qd[1];
+    let v201 = v23.mul_add(qd[2], -v200);
+    let v202 = v112 * v18;
+    let v203 = v26 * v47;
+    let v204 = v13.mul_add(v201, v202);
+    let v205 = v203.mul_add(v196, v204);
+    let v206 = v15 * qd[2];
+    let v207 = v48.mul_add(qd[0], -v206);
+    let v208 = v127 * v18;
+    let v209 = v20 * v47;
+    let v210 = v13.mul_add(v207, v208);
+    let v211 = v209.mul_add(v196, v210);
+    let v212 = 0.5f64 * v196;
+    let v213 = 0.25f64 * v139;
+    let v214 = 0.25f64.mul_add(v138, v213);
+    let v215 = 0.25f64.mul_add(v141, v214);
+    let v216 = 0.5f64 * v47;
+    let v217 = v216 * v215;
+    let v218 = v212.mul_add(v89, v217);
+    let v219 = q[2] * v218;
+    let v221 = v77 * v220;
+    let v222 = 0.5f64 * v221;
+    let v223 = v216.mul_add(v196, v222);
+    let v224 = v192.mul_add(v79, v219);
+    let v225 = qd[2].mul_add(v223, v224);
+    let v226 = q[0] * v218;
+    let v227 = v201.mul_add(v79, v226);
+    let v228 = qd[0].mul_add(v223, v227);
+    let v229 = q[1] * v218;
+    let v230 = v207.mul_add(v79, v229);
+    let v231 = qd[1].mul_add(v223, v230);
+    let v232 = 0.25f64 * v41;
+    let v234 = v47.mul_add(v46, v232);
+    let v235 = v233.mul_add(v53, v234);
+    let v236 = v47.mul_add(v58, v83);
+    let v237 = v233.mul_add(v60, v236);
+    let v238 = v47.mul_add(v65, v80);
+    let v239 = v233.mul_add(v67, v238);
+    let v240 = v46 * v89;
+    let v242 = v77 * v241;
+    let v243 = 0.25f64.mul_add(qd[3], v240);
+    let v244 = v47.mul_add(v87, v243);
+    let v245 = v53.mul_add(v242, v244);
+    let v246 = v233.mul_add(v101, v245);
+    let v247 = v58 * v89;
+    let v248 = 0.25f64.mul_add(qd[4], v247);
+    let v249 = v47.mul_add(v111, v248);
+    let v250 = v60.mul_add(v242, v249);
+    let v251 = v233.mul_add(v116, v250);
+    let v252 = v65 * v89;
+    let v253 = 0.25f64.mul_add(qd[5], v252);
+    let v254 = v47.mul_add(v126, v253);
+    let v255 = v67.mul_add(v242, v254);
+    let v256 = v233.mul_add(v131, v255);
+    let v257 = 2f64 * v87;
+    let v258 = v46 * v154;
+    let v259 = 2f64 * v101;
+    let v261 = v145 * v260;
+    let v262 = v143.mul_add(v241, v261);
+    let v263 = v257.mul_add(v89, v258);
+    let v264 = v47.mul_add(v150, v263);
+    let v265 = v259.mul_add(v242, v264);
+    let v266 = v53.mul_add(v262, v265);
+    let v267 = v233.mul_add(v161, v266);
+    let v268 = v58 * v154;
+    let v269 = 2f64 * v116;
+    let v270 = v151.mul_add(v111, v268);
+    let v271 = v47.mul_add(v169, v270);
+    let v272 = v269.mul_add(v242, v271);
+    let v273 = v60.mul_add(v262, v272);
+    let v274 = v233.mul_add(v173, v273);
+    let v275 = v65 * v154;
+    let v276 = 2f64 * v131;
+    let v277 = v151.mul_add(v126, v275);
+    let v278 = v47.mul_add(v181, v277);
+    let v279 = v276.mul_add(v242, v278);
+    let v280 = v67.mul_add(v262, v279);
+    let v281 = v233.mul_add(v185, v280);
+    let v282 = 0.25f64 * v11;
+    let c: [[f64; 2]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        2,
     >(v282);
-    let v283: f64 = c[2usize][0usize];
-    let v289: f64 = c[1usize][0usize];
-    let v291: f64 = c[3usize][0usize];
-    let v312: f64 = c[2usize][1usize];
-    let v314: f64 = c[3usize][1usize];
-    let v324: f64 = c[1usize][1usize];
-    let v285: f64 = 0.0625f64 * q[0usize];
-    let v286: f64 = 0.0625f64 * q[1usize];
-    let v287: f64 = v286 * qd[0usize];
-    let v288: f64 = v285.mul_add(qd[1usize], -v287);
-    let v290: f64 = v91 * v289;
-    let v292: f64 = 0.0625f64 * q[2usize];
-    let v293: f64 = v285 * qd[0usize];
-    let v294: f64 = v292.mul_add(qd[2usize], v293);
-    let v295: f64 = v286.mul_add(qd[1usize], v294);
-    let v296: f64 = v48 * v291;
-    let v297: f64 = v283.mul_add(v288, v290);
-    let v298: f64 = v296.mul_add(v295, v297);
-    let v299: f64 = v292 * qd[1usize];
-    let v300: f64 = v286.mul_add(qd[2usize], -v299);
-    let v301: f64 = v123 * v289;
-    let v302: f64 = v15 * v291;
-    let v303: f64 = v283.mul_add(v300, v301);
-    let v304: f64 = v302.mul_add(v295, v303);
-    let v305: f64 = v285 * qd[2usize];
-    let v306: f64 = v292.mul_add(qd[0usize], -v305);
-    let v307: f64 = v107 * v289;
-    let v308: f64 = v23 * v291;
-    let v309: f64 = v283.mul_add(v306, v307);
-    let v310: f64 = v308.mul_add(v295, v309);
-    let v311: f64 = 0.25f64 * v77;
-    let v313: f64 = v311 * v312;
-    let v315: f64 = v311 * v314;
-    let v316: f64 = 0.25f64 * v295;
-    let v317: f64 = 0.0625f64 * v139;
-    let v318: f64 = 0.0625f64.mul_add(v138, v317);
-    let v319: f64 = 0.0625f64.mul_add(v141, v318);
-    let v320: f64 = 0.25f64 * v291;
-    let v321: f64 = v320 * v319;
-    let v322: f64 = v316.mul_add(v315, v321);
-    let v323: f64 = q[2usize] * v322;
-    let v325: f64 = v311 * v324;
-    let v326: f64 = 0.25f64 * v325;
-    let v327: f64 = v320.mul_add(v295, v326);
-    let v328: f64 = v288.mul_add(v313, v323);
-    let v329: f64 = qd[2usize].mul_add(v327, v328);
-    let v330: f64 = q[0usize] * v322;
-    let v331: f64 = v300.mul_add(v313, v330);
-    let v332: f64 = qd[0usize].mul_add(v327, v331);
-    let v333: f64 = q[1usize] * v322;
-    let v334: f64 = v306.mul_add(v313, v333);
-    let v335: f64 = qd[1usize].mul_add(v327, v334);
-    let v337: f64 = 0.0625f64.mul_add(v5, -v282);
-    let v338: f64 = v283.mul_add(v337, 1f64);
-    let v339: f64 = v285 * q[2usize];
-    let v340: f64 = v339 * v283;
-    let v341: f64 = v23.mul_add(v289, v340);
-    let v342: f64 = v286 * q[2usize];
-    let v343: f64 = v15 * v289;
-    let v344: f64 = v342.mul_add(v283, -v343);
-    let v346: f64 = 0.5f64 * p[1usize];
-    let v348: f64 = 0.25f64 * p[3usize];
-    let v350: f64 = p[2usize] - v348;
-    let v352: f64 = 0.125f64.mul_add(v350, v348);
-    let v353: f64 = 0.5f64 * p[3usize];
-    let v354: f64 = v23 * v13;
-    let v355: f64 = 0.125f64 * q[0usize];
-    let v356: f64 = v355 * q[2usize];
-    let v357: f64 = v356 * v47;
-    let v358: f64 = v357 - v354;
-    let v359: f64 = 0.5f64 * v18;
-    let v360: f64 = 0.125f64 * v1;
-    let v361: f64 = v360.mul_add(v47, v359);
-    let v362: f64 = v48 * v13;
-    let v363: f64 = v355 * q[1usize];
-    let v364: f64 = v363 * v47;
-    let v365: f64 = v362 + v364;
-    let v366: f64 = v78 * v26;
-    let v367: f64 = v80 * v13;
-    let v368: f64 = v88 * v26;
-    let v369: f64 = 0.125f64 * q[2usize];
-    let v370: f64 = v42 * v26;
-    let v371: f64 = v369.mul_add(q[4usize], -v370);
-    let v372: f64 = v46.mul_add(v366, v367);
-    let v373: f64 = v53.mul_add(v368, v372);
-    let v374: f64 = v47.mul_add(v371, v373);
-    let v375: f64 = v60 * v368;
-    let v376: f64 = 0.5f64 * v51;
-    let v377: f64 = (-0.5f64).mul_add(v26, v355);
-    let v378: f64 = q[4usize].mul_add(v377, v376);
-    let v379: f64 = v58.mul_add(v366, v375);
-    let v380: f64 = v47.mul_add(v378, v379);
-    let v381: f64 = v232 * v13;
-    let v382: f64 = 0.125f64 * q[1usize];
-    let v383: f64 = v63 * v26;
-    let v384: f64 = v382.mul_add(q[4usize], -v383);
-    let v385: f64 = v65.mul_add(v366, -v381);
-    let v386: f64 = v67.mul_add(v368, v385);
-    let v387: f64 = v47.mul_add(v384, v386);
-    let v388: f64 = v286 * v283;
-    let v390: f64 = 0.015625f64 * q[0usize];
-    let v391: f64 = v390 * q[2usize];
-    let v392: f64 = v391 * v291;
-    let v393: f64 = v392 - v388;
-    let v394: f64 = 0.25f64 * v289;
-    let v395: f64 = 0.015625f64 * v1;
-    let v396: f64 = v395.mul_add(v291, v394);
-    let v397: f64 = v292 * v283;
-    let v398: f64 = v390 * q[1usize];
-    let v399: f64 = v398 * v291;
-    let v400: f64 = v397 + v399;
-    let v401: f64 = v80 * v47;
-    let v402: f64 = v241 * v26;
-    let v403: f64 = v46.mul_add(v368, v401);
-    let v404: f64 = v53.mul_add(v402, v403);
-    let v405: f64 = v233.mul_add(v371, v404);
-    let v406: f64 = v60 * v402;
-    let v407: f64 = v58.mul_add(v368, v406);
-    let v408: f64 = v233.mul_add(v378, v407);
-    let v409: f64 = v232 * v47;
-    let v410: f64 = v65.mul_add(v368, -v409);
-    let v411: f64 = v67.mul_add(v402, v410);
-    let v412: f64 = v233.mul_add(v384, v411);
-    let v413: f64 = v15 * v13;
-    let v414: f64 = v382 * q[2usize];
-    let v415: f64 = v414 * v47;
-    let v416: f64 = v413 + v415;
-    let v417: f64 = v364 - v362;
-    let v418: f64 = 0.125f64 * v8;
-    let v419: f64 = v418.mul_add(v47, v359);
-    let v420: f64 = v78 * v20;
-    let v421: f64 = v83 * v13;
-    let v422: f64 = v88 * v20;
-    let v423: f64 = v42 * v20;
-    let v424: f64 = v369.mul_add(q[5usize], -v423);
-    let v425: f64 = v46.mul_add(v420, -v421);
-    let v426: f64 = v53.mul_add(v422, v425);
-    let v427: f64 = v47.mul_add(v424, v426);
-    let v428: f64 = v56 * v20;
-    let v429: f64 = v355.mul_add(q[5usize], -v428);
-    let v430: f64 = v58.mul_add(v420, v381);
-    let v431: f64 = v60.mul_add(v422, v430);
-    let v432: f64 = v47.mul_add(v429, v431);
-    let v433: f64 = v67 * v422;
-    let v434: f64 = (-0.5f64).mul_add(v20, v382);
-    let v435: f64 = q[5usize].mul_add(v434, v376);
-    let v436: f64 = v65.mul_add(v420, v433);
-    let v437: f64 = v47.mul_add(v435, v436);
-    let v438: f64 = v285 * v283;
-    let v439: f64 = 0.015625f64 * q[1usize];
-    let v440: f64 = v439 * q[2usize];
-    let v441: f64 = v440 * v291;
-    let v442: f64 = v438 + v441;
-    let v443: f64 = v399 - v397;
-    let v444: f64 = 0.015625f64 * v8;
-    let v445: f64 = v444.mul_add(v291, v394);
-    let v446: f64 = v83 * v47;
-    let v447: f64 = v241 * v20;
-    let v448: f64 = v46.mul_add(v422, -v446);
-    let v449: f64 = v53.mul_add(v447, v448);
-    let v450: f64 = v233.mul_add(v424, v449);
-    let v451: f64 = v58.mul_add(v422, v409);
-    let v452: f64 = v60.mul_add(v447, v451);
-    let v453: f64 = v233.mul_add(v429, v452);
-    let v454: f64 = v67 * v447;
-    let v455: f64 = v65.mul_add(v422, v454);
-    let v456: f64 = v233.mul_add(v435, v455);
-    let v457: f64 = 0.125f64 * v5;
-    let v458: f64 = v457.mul_add(v47, v359);
-    let v459: f64 = v354 + v357;
-    let v460: f64 = v415 - v413;
-    let v461: f64 = v78 * v33;
-    let v462: f64 = v88 * v33;
-    let v463: f64 = v53 * v462;
-    let v464: f64 = (-0.5f64).mul_add(v33, v369);
-    let v465: f64 = v41.mul_add(v464, v376);
-    let v466: f64 = v46.mul_add(v461, v463);
-    let v467: f64 = v47.mul_add(v465, v466);
-    let v468: f64 = v56 * v33;
-    let v469: f64 = v355.mul_add(v41, -v468);
-    let v470: f64 = v58.mul_add(v461, -v367);
-    let v471: f64 = v60.mul_add(v462, v470);
-    let v472: f64 = v47.mul_add(v469, v471);
-    let v473: f64 = v63 * v33;
-    let v474: f64 = v382.mul_add(v41, -v473);
-    let v475: f64 = v65.mul_add(v461, v421);
-    let v476: f64 = v67.mul_add(v462, v475);
-    let v477: f64 = v47.mul_add(v474, v476);
-    let v478: f64 = 0.015625f64 * v5;
-    let v479: f64 = v478.mul_add(v291, v394);
-    let v480: f64 = v388 + v392;
-    let v481: f64 = v441 - v438;
-    let v482: f64 = v241 * v33;
-    let v483: f64 = v53 * v482;
-    let v484: f64 = v46.mul_add(v462, v483);
-    let v485: f64 = v233.mul_add(v465, v484);
-    let v486: f64 = v58.mul_add(v462, -v401);
-    let v487: f64 = v60.mul_add(v482, v486);
-    let v488: f64 = v233.mul_add(v469, v487);
-    let v489: f64 = v65.mul_add(v462, v446);
-    let v490: f64 = v67.mul_add(v482, v489);
-    let v491: f64 = v233.mul_add(v474, v490);
-    let v493: f64 = 0.5f64 * v11;
-    let v494: f64 = v457 - v493;
-    let v495: f64 = v47.mul_add(v494, 0.5f64);
-    let v496: f64 = v233.mul_add(v494, 0.25f64);
-    let v497: f64 = v23 * v47;
-    let v498: f64 = v356 * v233;
-    let v499: f64 = v497 + v498;
-    let v500: f64 = v15 * v47;
-    let v501: f64 = v414 * v233;
-    let v502: f64 = v501 - v500;
-    let v503: f64 = v360 - v493;
-    let v504: f64 = v47.mul_add(v503, 0.5f64);
-    let v505: f64 = v498 - v497;
-    let v506: f64 = v233.mul_add(v503, 0.25f64);
-    let v507: f64 = v48 * v47;
-    let v508: f64 = v363 * v233;
-    let v509: f64 = v507 + v508;
-    let v510: f64 = v418 - v493;
-    let v511: f64 = v47.mul_add(v510, 0.5f64);
-    let v512: f64 = v500 + v501;
-    let v513: f64 = v508 - v507;
-    let v514: f64 = v233.mul_add(v510, 0.25f64);
-    let v517: f64 = v112 * p[5usize];
-    let v518: f64 = v26.mul_add(p[4usize], v517);
-    let v520: f64 = q[1usize] - p[6usize];
-    let v521: f64 = 0.5f64 * p[4usize];
-    let v522: f64 = v127 * p[5usize];
-    let v523: f64 = v521.mul_add(v520, v522);
-    let v526: f64 = v90 * p[8usize];
-    let v527: f64 = v33.mul_add(p[7usize], v526);
-    let v529: f64 = 0.5f64 * q[3usize];
-    let v531: f64 = v71 * p[10usize];
-    let v532: f64 = v529.mul_add(p[9usize], v531);
-    let v534: f64 = v106 * p[10usize];
-    let v535: f64 = v56.mul_add(p[11usize], v534);
-    let v536: f64 = v121 * p[10usize];
-    let v537: f64 = v63.mul_add(p[11usize], v536);
-    out[0usize] = v14;
-    out[1usize] = v22;
-    out[2usize] = v28;
-    out[3usize] = v29;
-    out[4usize] = v30;
-    out[5usize] = v35;
-    out[6usize] = v36;
-    out[7usize] = v37;
-    out[8usize] = v38;
-    out[9usize] = v55;
-    out[10usize] = v62;
-    out[11usize] = v69;
-    out[12usize] = v105;
-    out[13usize] = v120;
-    out[14usize] = v135;
-    out[15usize] = v166;
-    out[16usize] = v178;
-    out[17usize] = v190;
-    out[18usize] = v199;
-    out[19usize] = v205;
-    out[20usize] = v211;
-    out[21usize] = v225;
-    out[22usize] = v228;
-    out[23usize] = v231;
-    out[24usize] = v235;
-    out[25usize] = v237;
-    out[26usize] = v239;
-    out[27usize] = v246;
-    out[28usize] = v251;
-    out[29usize] = v256;
-    out[30usize] = v267;
-    out[31usize] = v274;
-    out[32usize] = v281;
-    out[33usize] = v298;
-    out[34usize] = v304;
-    out[35usize] = v310;
-    out[36usize] = v329;
-    out[37usize] = v332;
-    out[38usize] = v335;
-    out[39usize] = v338;
-    out[40usize] = v341;
-    out[41usize] = v344;
-    out[42usize] = v346;
-    out[43usize] = v352;
-    out[44usize] = v353;
-    out[45usize] = v358;
-    out[46usize] = v361;
-    out[47usize] = v365;
-    out[48usize] = v374;
-    out[49usize] = v380;
-    out[50usize] = v387;
-    out[51usize] = v393;
-    out[52usize] = v396;
-    out[53usize] = v400;
-    out[54usize] = v405;
-    out[55usize] = v408;
-    out[56usize] = v412;
-    out[57usize] = v416;
-    out[58usize] = v417;
-    out[59usize] = v419;
-    out[60usize] = v427;
-    out[61usize] = v432;
-    out[62usize] = v437;
-    out[63usize] = v442;
-    out[64usize] = v443;
-    out[65usize] = v445;
-    out[66usize] = v450;
-    out[67usize] = v453;
-    out[68usize] = v456;
-    out[69usize] = v458;
-    out[70usize] = v459;
-    out[71usize] = v460;
-    out[72usize] = v467;
-    out[73usize] = v472;
-    out[74usize] = v477;
-    out[75usize] = v479;
-    out[76usize] = v480;
-    out[77usize] = v481;
-    out[78usize] = v485;
-    out[79usize] = v488;
-    out[80usize] = v491;
-    out[81usize] = 0f64;
-    out[82usize] = 0f64;
-    out[83usize] = 0f64;
-    out[84usize] = v495;
-    out[85usize] = v459;
-    out[86usize] = v460;
-    out[87usize] = 0f64;
-    out[88usize] = 0f64;
-    out[89usize] = 0f64;
-    out[90usize] = v496;
-    out[91usize] = v499;
-    out[92usize] = v502;
-    out[93usize] = 0f64;
-    out[94usize] = 0f64;
-    out[95usize] = 0f64;
-    out[96usize] = v358;
-    out[97usize] = v504;
-    out[98usize] = v365;
-    out[99usize] = 0f64;
-    out[100usize] = 0f64;
-    out[101usize] = 0f64;
-    out[102usize] = v505;
-    out[103usize] = v506;
-    out[104usize] = v509;
-    out[105usize] = 0f64;
-    out[106usize] = 0f64;
-    out[107usize] = 0f64;
-    out[108usize] = v416;
-    out[109usize] = v417;
-    out[110usize] = v511;
-    out[111usize] = 0f64;
-    out[112usize] = 0f64;
-    out[113usize] = 0f64;
-    out[114usize] = v512;
-    out[115usize] = v513;
-    out[116usize] = v514;
-    out[117usize] = v518;
-    out[118usize] = v523;
-    out[119usize] = v527;
-    out[120usize] = v532;
-    out[121usize] = v535;
-    out[122usize] = v537;
-    out[123usize] = 0f64;
-    out[124usize] = 0f64;
-    out[125usize] = 0f64;
-    out[126usize] = 0f64;
-    out[127usize] = 0f64;
-    out[128usize] = 0f64;
+    let v283: f64 = c[2][0];
+    let v289: f64 = c[1][0];
+    let v291: f64 = c[3][0];
+    let v312: f64 = c[2][1];
+    let v314: f64 = c[3][1];
+    let v324: f64 = c[1][1];
+    let v285 = 0.0625f64 * q[0];
+    let v286 = 0.0625f64 * q[1];
+    let v287 = v286 * qd[0];
+    let v288 = v285.mul_add(qd[1], -v287);
+    let v290 = v91 * v289;
+    let v292 = 0.0625f64 * q[2];
+    let v293 = v285 * qd[0];
+    let v294 = v292.mul_add(qd[2], v293);
+    let v295 = v286.mul_add(qd[1], v294);
+    let v296 = v48 * v291;
+    let v297 = v283.mul_add(v288, v290);
+    let v298 = v296.mul_add(v295, v297);
+    let v299 = v292 * qd[1];
+    let v300 = v286.mul_add(qd[2], -v299);
+    let v301 = v123 * v289;
+    let v302 = v15 * v291;
+    let v303 = v283.mul_add(v300, v301);
+    let v304 = v302.mul_add(v295, v303);
+    let v305 = v285 * qd[2];
+    let v306 = v292.mul_add(qd[0], -v305);
+    let v307 = v107 * v289;
+    let v308 = v23 * v291;
+    let v309 = v283.mul_add(v306, v307);
+    let v310 = v308.mul_add(v295, v309);
+    let v311 = 0.25f64 * v77;
+    let v313 = v311 * v312;
+    let v315 = v311 * v314;
+    let v316 = 0.25f64 * v295;
+    let v317 = 0.0625f64 * v139;
+    let v318 = 0.0625f64.mul_add(v138, v317);
+    let v319 = 0.0625f64.mul_add(v141, v318);
+    let v320 = 0.25f64 * v291;
+    let v321 = v320 * v319;
+    let v322 = v316.mul_add(v315, v321);
+    let v323 = q[2] * v322;
+    let v325 = v311 * v324;
+    let v326 = 0.25f64 * v325;
+    let v327 = v320.mul_add(v295, v326);
+    let v328 = v288.mul_add(v313, v323);
+    let v329 = qd[2].mul_add(v327, v328);
+    let v330 = q[0] * v322;
+    let v331 = v300.mul_add(v313, v330);
+    let v332 = qd[0].mul_add(v327, v331);
+    let v333 = q[1] * v322;
+    let v334 = v306.mul_add(v313, v333);
+    let v335 = qd[1].mul_add(v327, v334);
+    let v337 = 0.0625f64.mul_add(v5, -v282);
+    let v338 = v283.mul_add(v337, 1f64);
+    let v339 = v285 * q[2];
+    let v340 = v339 * v283;
+    let v341 = v23.mul_add(v289, v340);
+    let v342 = v286 * q[2];
+    let v343 = v15 * v289;
+    let v344 = v342.mul_add(v283, -v343);
+    let v346 = 0.5f64 * p[1];
+    let v348 = 0.25f64 * p[3];
+    let v350 = p[2] - v348;
+    let v352 = 0.125f64.mul_add(v350, v348);
+    let v353 = 0.5f64 * p[3];
+    let v354 = v23 * v13;
+    let v355 = 0.125f64 * q[0];
+    let v356 = v355 * q[2];
+    let v357 = v356 * v47;
+    let v358 = v357 - v354;
+    let v359 = 0.5f64 * v18;
+    let v360 = 0.125f64 * v1;
+    let v361 = v360.mul_add(v47, v359);
+    let v362 = v48 * v13;
+    let v363 = v355 * q[1];
+    let v364 = v363 * v47;
+    let v365 = v362 + v364;
+    let v366 = v78 * v26;
+    let v367 = v80 * v13;
+    let v368 = v88 * v26;
+    let v369 = 0.125f64 * q[2];
+    let v370 = v42 * v26;
+    let v371 = v369.mul_add(q[4], -v370);
+    let v372 = v46.mul_add(v366, v367);
+    let v373 = v53.mul_add(v368, v372);
+    let v374 = v47.mul_add(v371, v373);
+    let v375 = v60 * v368;
+    let v376 = 0.5f64 * v51;
+    let v377 = (-0.5f64).mul_add(v26, v355);
+    let v378 = q[4].mul_add(v377, v376);
+    let v379 = v58.mul_add(v366, v375);
+    let v380 = v47.mul_add(v378, v379);
+    let v381 = v232 * v13;
+    let v382 = 0.125f64 * q[1];
+    let v383 = v63 * v26;
+    let v384 = v382.mul_add(q[4], -v383);
+    let v385 = v65.mul_add(v366, -v381);
+    let v386 = v67.mul_add(v368, v385);
+    let v387 = v47.mul_add(v384, v386);
+    let v388 = v286 * v283;
+    let v390 = 0.015625f64 * q[0];
+    let v391 = v390 * q[2];
+    let v392 = v391 * v291;
+    let v393 = v392 - v388;
+    let v394 = 0.25f64 * v289;
+    let v395 = 0.015625f64 * v1;
+    let v396 = v395.mul_add(v291, v394);
+    let v397 = v292 * v283;
+    let v398 = v390 * q[1];
+    let v399 = v398 * v291;
+    let v400 = v397 + v399;
+    let v401 = v80 * v47;
+    let v402 = v241 * v26;
+    let v403 = v46.mul_add(v368, v401);
+    let v404 = v53.mul_add(v402, v403);
+    let v405 = v233.mul_add(v371, v404);
+    let v406 = v60 * v402;
+    let v407 = v58.mul_add(v368, v406);
+    let v408 = v233.mul_add(v378, v407);
+    let v409 = v232 * v47;
+    let v410 = v65.mul_add(v368, -v409);
+    let v411 = v67.mul_add(v402, v410);
+    let v412 = v233.mul_add(v384, v411);
+    let v413 = v15 * v13;
+    let v414 = v382 * q[2];
+    let v415 = v414 * v47;
+    let v416 = v413 + v415;
+    let v417 = v364 - v362;
+    let v418 = 0.125f64 * v8;
+    let v419 = v418.mul_add(v47, v359);
+    let v420 = v78 * v20;
+    let v421 = v83 * v13;
+    let v422 = v88 * v20;
+    let v423 = v42 * v20;
+    let v424 = v369.mul_add(q[5], -v423);
+    let v425 = v46.mul_add(v420, -v421);
+    let v426 = v53.mul_add(v422, v425);
+    let v427 = v47.mul_add(v424, v426);
+    let v428 = v56 * v20;
+    let v429 = v355.mul_add(q[5], -v428);
+    let v430 = v58.mul_add(v420, v381);
+    let v431 = v60.mul_add(v422, v430);
+    let v432 = v47.mul_add(v429, v431);
+    let v433 = v67 * v422;
+    let v434 = (-0.5f64).mul_add(v20, v382);
+    let v435 = q[5].mul_add(v434, v376);
+    let v436 = v65.mul_add(v420, v433);
+    let v437 = v47.mul_add(v435, v436);
+    let v438 = v285 * v283;
+    let v439 = 0.015625f64 * q[1];
+    let v440 = v439 * q[2];
+    let v441 = v440 * v291;
+    let v442 = v438 + v441;
+    let v443 = v399 - v397;
+    let v444 = 0.015625f64 * v8;
+    let v445 = v444.mul_add(v291, v394);
+    let v446 = v83 * v47;
+    let v447 = v241 * v20;
+    let v448 = v46.mul_add(v422, -v446);
+    let v449 = v53.mul_add(v447, v448);
+    let v450 = v233.mul_add(v424, v449);
+    let v451 = v58.mul_add(v422, v409);
+    let v452 = v60.mul_add(v447, v451);
+    let v453 = v233.mul_add(v429, v452);
+    let v454 = v67 * v447;
+    let v455 = v65.mul_add(v422, v454);
+    let v456 = v233.mul_add(v435, v455);
+    let v457 = 0.125f64 * v5;
+    let v458 = v457.mul_add(v47, v359);
+    let v459 = v354 + v357;
+    let v460 = v415 - v413;
+    let v461 = v78 * v33;
+    let v462 = v88 * v33;
+    let v463 = v53 * v462;
+    let v464 = (-0.5f64).mul_add(v33, v369);
+    let v465 = v41.mul_add(v464, v376);
+    let v466 = v46.mul_add(v461, v463);
+    let v467 = v47.mul_add(v465, v466);
+    let v468 = v56 * v33;
+    let v469 = v355.mul_add(v41, -v468);
+    let v470 = v58.mul_add(v461, -v367);
+    let v471 = v60.mul_add(v462, v470);
+    let v472 = v47.mul_add(v469, v471);
+    let v473 = v63 * v33;
+    let v474 = v382.mul_add(v41, -v473);
+    let v475 = v65.mul_add(v461, v421);
+    let v476 = v67.mul_add(v462, v475);
+    let v477 = v47.mul_add(v474, v476);
+    let v478 = 0.015625f64 * v5;
+    let v479 = v478.mul_add(v291, v394);
+    let v480 = v388 + v392;
+    let v481 = v441 - v438;
+    let v482 = v241 * v33;
+    let v483 = v53 * v482;
+    let v484 = v46.mul_add(v462, v483);
+    let v485 = v233.mul_add(v465, v484);
+    let v486 = v58.mul_add(v462, -v401);
+    let v487 = v60.mul_add(v482, v486);
+    let v488 = v233.mul_add(v469, v487);
+    let v489 = v65.mul_add(v462, v446);
+    let v490 = v67.mul_add(v482, v489);
+    let v491 = v233.mul_add(v474, v490);
+    let v493 = 0.5f64 * v11;
+    let v494 = v457 - v493;
+    let v495 = v47.mul_add(v494, 0.5f64);
+    let v496 = v233.mul_add(v494, 0.25f64);
+    let v497 = v23 * v47;
+    let v498 = v356 * v233;
+    let v499 = v497 + v498;
+    let v500 = v15 * v47;
+    let v501 = v414 * v233;
+    let v502 = v501 - v500;
+    let v503 = v360 - v493;
+    let v504 = v47.mul_add(v503, 0.5f64);
+    let v505 = v498 - v497;
+    let v506 = v233.mul_add(v503, 0.25f64);
+    let v507 = v48 * v47;
+    let v508 = v363 * v233;
+    let v509 = v507 + v508;
+    let v510 = v418 - v493;
+    let v511 = v47.mul_add(v510, 0.5f64);
+    let v512 = v500 + v501;
+    let v513 = v508 - v507;
+    let v514 = v233.mul_add(v510, 0.25f64);
+    let v517 = v112 * p[5];
+    let v518 = v26.mul_add(p[4], v517);
+    let v520 = q[1] - p[6];
+    let v521 = 0.5f64 * p[4];
+    let v522 = v127 * p[5];
+    let v523 = v521.mul_add(v520, v522);
+    let v526 = v90 * p[8];
+    let v527 = v33.mul_add(p[7], v526);
+    let v529 = 0.5f64 * q[3];
+    let v531 = v71 * p[10];
+    let v532 = v529.mul_add(p[9], v531);
+    let v534 = v106 * p[10];
+    let v535 = v56.mul_add(p[11], v534);
+    let v536 = v121 * p[10];
+    let v537 = v63.mul_add(p[11], v536);
+    out[0] = v14;
+    out[1] = v22;
+    out[2] = v28;
+    out[3] = v29;
+    out[4] = v30;
+    out[5] = v35;
+    out[6] = v36;
+    out[7] = v37;
+    out[8] = v38;
+    out[9] = v55;
+    out[10] = v62;
+    out[11] = v69;
+    out[12] = v105;
+    out[13] = v120;
+    out[14] = v135;
+    out[15] = v166;
+    out[16] = v178;
+    out[17] = v190;
+    out[18] = v199;
+    out[19] = v205;
+    out[20] = v211;
+    out[21] = v225;
+    out[22] = v228;
+    out[23] = v231;
+    out[24] = v235;
+    out[25] = v237;
+    out[26] = v239;
+    out[27] = v246;
+    out[28] = v251;
+    out[29] = v256;
+    out[30] = v267;
+    out[31] = v274;
+    out[32] = v281;
+    out[33] = v298;
+    out[34] = v304;
+    out[35] = v310;
+    out[36] = v329;
+    out[37] = v332;
+    out[38] = v335;
+    out[39] = v338;
+    out[40] = v341;
+    out[41] = v344;
+    out[42] = v346;
+    out[43] = v352;
+    out[44] = v353;
+    out[45] = v358;
+    out[46] = v361;
+    out[47] = v365;
+    out[48] = v374;
+    out[49] = v380;
+    out[50] = v387;
+    out[51] = v393;
+    out[52] = v396;
+    out[53] = v400;
+    out[54] = v405;
+    out[55] = v408;
+    out[56] = v412;
+    out[57] = v416;
+    out[58] = v417;
+    out[59] = v419;
+    out[60] = v427;
+    out[61] = v432;
+    out[62] = v437;
+    out[63] = v442;
+    out[64] = v443;
+    out[65] = v445;
+    out[66] = v450;
+    out[67] = v453;
+    out[68] = v456;
+    out[69] = v458;
+    out[70] = v459;
+    out[71] = v460;
+    out[72] = v467;
+    out[73] = v472;
+    out[74] = v477;
+    out[75] = v479;
+    out[76] = v480;
+    out[77] = v481;
+    out[78] = v485;
+    out[79] = v488;
+    out[80] = v491;
+    out[81] = 0f64;
+    out[82] = 0f64;
+    out[83] = 0f64;
+    out[84] = v495;
+    out[85] = v459;
+    out[86] = v460;
+    out[87] = 0f64;
+    out[88] = 0f64;
+    out[89] = 0f64;
+    out[90] = v496;
+    out[91] = v499;
+    out[92] = v502;
+    out[93] = 0f64;
+    out[94] = 0f64;
+    out[95] = 0f64;
+    out[96] = v358;
+    out[97] = v504;
+    out[98] = v365;
+    out[99] = 0f64;
+    out[100] = 0f64;
+    out[101] = 0f64;
+    out[102] = v505;
+    out[103] = v506;
+    out[104] = v509;
+    out[105] = 0f64;
+    out[106] = 0f64;
+    out[107] = 0f64;
+    out[108] = v416;
+    out[109] = v417;
+    out[110] = v511;
+    out[111] = 0f64;
+    out[112] = 0f64;
+    out[113] = 0f64;
+    out[114] = v512;
+    out[115] = v513;
+    out[116] = v514;
+    out[117] = v518;
+    out[118] = v523;
+    out[119] = v527;
+    out[120] = v532;
+    out[121] = v535;
+    out[122] = v537;
+    out[123] = 0f64;
+    out[124] = 0f64;
+    out[125] = 0f64;
+    out[126] = 0f64;
+    out[127] = 0f64;
+    out[128] = 0f64;
 }
 /// Kernel `cell_0_x4`: 752 operations, four evaluations in vector lanes.
 #[cfg(target_arch = "x86_64")]
@@ -1906,972 +1906,715 @@ fn cell_0_0(
 #[allow(unused_variables, unused_parens, clippy::all)]
 #[target_feature(enable = "avx,fma")]
 fn cell_0_x4(
-    q: &[[f64; 4]; 6usize],
-    qd: &[[f64; 4]; 6usize],
-    p: &[[f64; 4]; 15usize],
-    out: &mut [[f64; 4]; 129usize],
+    q: &[[f64; 4]; 6],
+    qd: &[[f64; 4]; 6],
+    p: &[[f64; 4]; 15],
+    out: &mut [[f64; 4]; 129],
 ) {
     use std::arch::x86_64::*;
-    let v1: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0usize]),
-        runtime::lanes::from_array(q[0usize]),
+    let v1 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[0]),
+        runtime::lanes::from_array(q[0]),
     );
-    let v3: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v1);
-    let v5: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[2usize]),
-        runtime::lanes::from_array(q[2usize]),
+    let v3 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v1);
+    let v5 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[2]),
+        runtime::lanes::from_array(q[2]),
     );
-    let v6: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v5);
-    let v8: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1usize]),
-        runtime::lanes::from_array(q[1usize]),
+    let v6 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v5);
+    let v8 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[1]),
+        runtime::lanes::from_array(q[1]),
     );
-    let v9: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v8);
-    let v10: __m256d = _mm256_add_pd(v3, v6);
-    let v11: __m256d = _mm256_add_pd(v10, v9);
-    let c: [[__m256d; 3usize]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
-        3usize,
+    let v9 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v8);
+    let v10 = _mm256_add_pd(v3, v6);
+    let v11 = _mm256_add_pd(v10, v9);
+    let c: [[__m256d; 3]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
+        3,
     >(v11);
-    let v12: __m256d = c[0usize][0usize];
-    let v13: __m256d = c[2usize][0usize];
-    let v18: __m256d = c[1usize][0usize];
-    let v47: __m256d = c[3usize][0usize];
-    let v78: __m256d = c[2usize][1usize];
-    let v88: __m256d = c[3usize][1usize];
-    let v144: __m256d = c[2usize][2usize];
-    let v152: __m256d = c[3usize][2usize];
-    let v220: __m256d = c[1usize][1usize];
-    let v233: __m256d = c[4usize][0usize];
-    let v241: __m256d = c[4usize][1usize];
-    let v260: __m256d = c[4usize][2usize];
-    let v14: __m256d = _mm256_fmadd_pd(v6, v13, v12);
-    let v15: __m256d = _mm256_mul_pd(
+    let v12: __m256d = c[0][0];
+    let v13: __m256d = c[2][0];
+    let v18: __m256d = c[1][0];
+    let v47: __m256d = c[3][0];
+    let v78: __m256d = c[2][1];
+    let v88: __m256d = c[3][1];
+    let v144: __m256d = c[2][2];
+    let v152: __m256d = c[3][2];
+    let v220: __m256d = c[1][1];
+    let v233: __m256d = c[4][0];
+    let v241: __m256d = c[4][1];
+    let v260: __m256d = c[4][2];
+    let v14 = _mm256_fmadd_pd(v6, v13, v12);
+    let v15 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[0]));
+    let v16 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[2]));
+    let v17 = _mm256_mul_pd(v16, v13);
+    let v20 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[1]));
+    let v21 = _mm256_mul_pd(v20, v18);
+    let v22 = _mm256_sub_pd(v17, v21);
+    let v23 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[1]));
+    let v24 = _mm256_mul_pd(v23, runtime::lanes::from_array(q[2]));
+    let v25 = _mm256_mul_pd(v24, v13);
+    let v26 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[0]));
+    let v27 = _mm256_mul_pd(v26, v18);
+    let v28 = _mm256_add_pd(v25, v27);
+    let v29 = _mm256_add_pd(v17, v21);
+    let v30 = _mm256_fmadd_pd(v3, v13, v12);
+    let v31 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[1]));
+    let v32 = _mm256_mul_pd(v31, v13);
+    let v33 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[2]));
+    let v34 = _mm256_mul_pd(v33, v18);
+    let v35 = _mm256_sub_pd(v32, v34);
+    let v36 = _mm256_sub_pd(v25, v27);
+    let v37 = _mm256_add_pd(v32, v34);
+    let v38 = _mm256_fmadd_pd(v9, v13, v12);
+    let v41 = _mm256_add_pd(
+        runtime::lanes::from_array(q[3]),
+        runtime::lanes::from_array(p[0]),
+    );
+    let v42 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v41);
+    let v45 = _mm256_mul_pd(v23, runtime::lanes::from_array(q[4]));
+    let v46 = _mm256_fmsub_pd(v15, runtime::lanes::from_array(q[5]), v45);
+    let v48 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[2]));
+    let v49 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[4]));
+    let v50 = _mm256_fmadd_pd(v48, v41, v49);
+    let v51 = _mm256_fmadd_pd(v23, runtime::lanes::from_array(q[5]), v50);
+    let v52 = _mm256_mul_pd(v42, v11);
+    let v53 = _mm256_fmsub_pd(v33, v51, v52);
+    let v54 = _mm256_fmadd_pd(v13, v46, v42);
+    let v55 = _mm256_fmadd_pd(v47, v53, v54);
+    let v56 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[4]));
+    let v57 = _mm256_mul_pd(v48, runtime::lanes::from_array(q[5]));
+    let v58 = _mm256_fmsub_pd(v23, v41, v57);
+    let v59 = _mm256_mul_pd(v56, v11);
+    let v60 = _mm256_fmsub_pd(v26, v51, v59);
+    let v61 = _mm256_fmadd_pd(v13, v58, v56);
+    let v62 = _mm256_fmadd_pd(v47, v60, v61);
+    let v63 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[5]));
+    let v64 = _mm256_mul_pd(v15, v41);
+    let v65 = _mm256_fmsub_pd(v48, runtime::lanes::from_array(q[4]), v64);
+    let v66 = _mm256_mul_pd(v63, v11);
+    let v67 = _mm256_fmsub_pd(v20, v51, v66);
+    let v68 = _mm256_fmadd_pd(v13, v65, v63);
+    let v69 = _mm256_fmadd_pd(v47, v67, v68);
+    let v71 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[3]));
+    let v74 = _mm256_mul_pd(v26, runtime::lanes::from_array(qd[0]));
+    let v76 = _mm256_fmadd_pd(v33, runtime::lanes::from_array(qd[2]), v74);
+    let v77 = _mm256_fmadd_pd(v20, runtime::lanes::from_array(qd[1]), v76);
+    let v79 = _mm256_mul_pd(v77, v78);
+    let v80 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[5]));
+    let v82 = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[5]));
+    let v83 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[4]));
+    let v85 = _mm256_fmadd_pd(v80, runtime::lanes::from_array(qd[0]), v82);
+    let v86 = _mm256_fnmadd_pd(v83, runtime::lanes::from_array(qd[1]), v85);
+    let v87 = _mm256_fnmadd_pd(v23, runtime::lanes::from_array(qd[4]), v86);
+    let v89 = _mm256_mul_pd(v77, v88);
+    let v90 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[2]));
+    let v91 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[2]));
+    let v92 = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[3]));
+    let v93 = _mm256_fmadd_pd(v91, v41, v92);
+    let v94 = _mm256_fmadd_pd(v83, runtime::lanes::from_array(qd[0]), v93);
+    let v95 = _mm256_fmadd_pd(v15, runtime::lanes::from_array(qd[4]), v94);
+    let v96 = _mm256_fmadd_pd(v80, runtime::lanes::from_array(qd[1]), v95);
+    let v97 = _mm256_fmadd_pd(v23, runtime::lanes::from_array(qd[5]), v96);
+    let v98 = _mm256_mul_pd(v33, v97);
+    let v99 = _mm256_fmadd_pd(v90, v51, v98);
+    let v100 = _mm256_fnmadd_pd(v71, v11, v99);
+    let v101 = _mm256_fnmadd_pd(v42, v77, v100);
+    let v102 = _mm256_fmadd_pd(v46, v79, v71);
+    let v103 = _mm256_fmadd_pd(v13, v87, v102);
+    let v104 = _mm256_fmadd_pd(v53, v89, v103);
+    let v105 = _mm256_fmadd_pd(v47, v101, v104);
+    let v106 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[4]));
+    let v107 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[1]));
+    let v108 = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[3]));
+    let v109 = _mm256_fmadd_pd(v107, v41, v108);
+    let v110 = _mm256_fnmadd_pd(v80, runtime::lanes::from_array(qd[2]), v109);
+    let v111 = _mm256_fnmadd_pd(v48, runtime::lanes::from_array(qd[5]), v110);
+    let v112 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[0]));
+    let v113 = _mm256_mul_pd(v26, v97);
+    let v114 = _mm256_fmadd_pd(v112, v51, v113);
+    let v115 = _mm256_fnmadd_pd(v106, v11, v114);
+    let v116 = _mm256_fnmadd_pd(v56, v77, v115);
+    let v117 = _mm256_fmadd_pd(v58, v79, v106);
+    let v118 = _mm256_fmadd_pd(v13, v111, v117);
+    let v119 = _mm256_fmadd_pd(v60, v89, v118);
+    let v120 = _mm256_fmadd_pd(v47, v116, v119);
+    let v121 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[5]));
+    let v122 = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[4]));
+    let v123 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[0]));
+    let v124 = _mm256_fmadd_pd(v83, runtime::lanes::from_array(qd[2]), v122);
+    let v125 = _mm256_fnmadd_pd(v123, v41, v124);
+    let v126 = _mm256_fnmadd_pd(v15, runtime::lanes::from_array(qd[3]), v125);
+    let v127 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[1]));
+    let v128 = _mm256_mul_pd(v20, v97);
+    let v129 = _mm256_fmadd_pd(v127, v51, v128);
+    let v130 = _mm256_fnmadd_pd(v121, v11, v129);
+    let v131 = _mm256_fnmadd_pd(v63, v77, v130);
+    let v132 = _mm256_fmadd_pd(v65, v79, v121);
+    let v133 = _mm256_fmadd_pd(v13, v126, v132);
+    let v134 = _mm256_fmadd_pd(v67, v89, v133);
+    let v135 = _mm256_fmadd_pd(v47, v131, v134);
+    let v137 = _mm256_mul_pd(_mm256_set1_pd(2f64), v79);
+    let v138 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[0]),
+        runtime::lanes::from_array(qd[0]),
+    );
+    let v139 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[1]),
+        runtime::lanes::from_array(qd[1]),
+    );
+    let v140 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v139);
+    let v141 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[2]),
+        runtime::lanes::from_array(qd[2]),
+    );
+    let v142 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v138, v140);
+    let v143 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v141, v142);
+    let v145 = _mm256_mul_pd(v77, v77);
+    let v146 = _mm256_mul_pd(v144, v145);
+    let v147 = _mm256_fmadd_pd(v78, v143, v146);
+    let v148 = _mm256_mul_pd(v46, v147);
+    let v149 = _mm256_mul_pd(v127, runtime::lanes::from_array(qd[4]));
+    let v150 = _mm256_fmsub_pd(v112, runtime::lanes::from_array(qd[5]), v149);
+    let v151 = _mm256_mul_pd(_mm256_set1_pd(2f64), v89);
+    let v153 = _mm256_mul_pd(v145, v152);
+    let v154 = _mm256_fmadd_pd(v88, v143, v153);
+    let v155 = _mm256_mul_pd(v112, runtime::lanes::from_array(qd[4]));
+    let v156 = _mm256_fmadd_pd(v90, runtime::lanes::from_array(qd[3]), v155);
+    let v157 = _mm256_fmadd_pd(v127, runtime::lanes::from_array(qd[5]), v156);
+    let v158 = _mm256_mul_pd(v33, v157);
+    let v159 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v97, v158);
+    let v160 = _mm256_fnmadd_pd(runtime::lanes::from_array(qd[3]), v77, v159);
+    let v161 = _mm256_fnmadd_pd(v42, v143, v160);
+    let v162 = _mm256_fmadd_pd(v137, v87, v148);
+    let v163 = _mm256_fmadd_pd(v13, v150, v162);
+    let v164 = _mm256_fmadd_pd(v151, v101, v163);
+    let v165 = _mm256_fmadd_pd(v53, v154, v164);
+    let v166 = _mm256_fmadd_pd(v47, v161, v165);
+    let v167 = _mm256_mul_pd(v58, v147);
+    let v168 = _mm256_mul_pd(v90, runtime::lanes::from_array(qd[5]));
+    let v169 = _mm256_fmsub_pd(v127, runtime::lanes::from_array(qd[3]), v168);
+    let v170 = _mm256_mul_pd(v26, v157);
+    let v171 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v97, v170);
+    let v172 = _mm256_fnmadd_pd(runtime::lanes::from_array(qd[4]), v77, v171);
+    let v173 = _mm256_fnmadd_pd(v56, v143, v172);
+    let v174 = _mm256_fmadd_pd(v137, v111, v167);
+    let v175 = _mm256_fmadd_pd(v13, v169, v174);
+    let v176 = _mm256_fmadd_pd(v151, v116, v175);
+    let v177 = _mm256_fmadd_pd(v60, v154, v176);
+    let v178 = _mm256_fmadd_pd(v47, v173, v177);
+    let v179 = _mm256_mul_pd(v65, v147);
+    let v180 = _mm256_mul_pd(v112, runtime::lanes::from_array(qd[3]));
+    let v181 = _mm256_fmsub_pd(v90, runtime::lanes::from_array(qd[4]), v180);
+    let v182 = _mm256_mul_pd(v20, v157);
+    let v183 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v97, v182);
+    let v184 = _mm256_fnmadd_pd(runtime::lanes::from_array(qd[5]), v77, v183);
+    let v185 = _mm256_fnmadd_pd(v63, v143, v184);
+    let v186 = _mm256_fmadd_pd(v137, v126, v179);
+    let v187 = _mm256_fmadd_pd(v13, v181, v186);
+    let v188 = _mm256_fmadd_pd(v151, v131, v187);
+    let v189 = _mm256_fmadd_pd(v67, v154, v188);
+    let v190 = _mm256_fmadd_pd(v47, v185, v189);
+    let v191 = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[0]));
+    let v192 = _mm256_fmsub_pd(v15, runtime::lanes::from_array(qd[1]), v191);
+    let v193 = _mm256_mul_pd(v90, v18);
+    let v194 = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[0]));
+    let v195 = _mm256_fmadd_pd(v48, runtime::lanes::from_array(qd[2]), v194);
+    let v196 = _mm256_fmadd_pd(v23, runtime::lanes::from_array(qd[1]), v195);
+    let v197 = _mm256_mul_pd(v33, v47);
+    let v198 = _mm256_fmadd_pd(v13, v192, v193);
+    let v199 = _mm256_fmadd_pd(v197, v196, v198);
+    let v200 = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[1]));
+    let v201 = _mm256_fmsub_pd(v23, runtime::lanes::from_array(qd[2]), v200);
+    let v202 = _mm256_mul_pd(v112, v18);
+    let v203 = _mm256_mul_pd(v26, v47);
+    let v204 = _mm256_fmadd_pd(v13, v201, v202);
+    let v205 = _mm256_fmadd_pd(v203, v196, v204);
+    let v206 = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[2]));
+    let v207 = _mm256_fmsub_pd(v48, runtime::lanes::from_array(qd[0]), v206);
+    let v208 = _mm256_mul_pd(v127, v18);
+    let v209 = _mm256_mul_pd(v20, v47);
+    let v210 = _mm256_fmadd_pd(v13, v207, v208);
+    let v211 = _mm256_fmadd_pd(v209, v196, v210);
+    let v212 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v196);
+    let v213 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v139);
+    let v214 = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v138, v213);
+    let v215 = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v141, v214);
+    let v216 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v47);
+    let v217 = _mm256_mul_pd(v216, v215);
+    let v218 = _mm256_fmadd_pd(v212, v89, v217);
+    let v219 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v218);
+    let v221 = _mm256_mul_pd(v77, v220);
+    let v222 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v221);
+    let v223 = _mm256_fmadd_pd(v216, v196, v222);
+    let v224 = _mm256_fmadd_pd(v192, v79, v219);
+    let v225 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v223, v224);
+    let v226 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v218);
+    let v227 = _mm256_fmadd_pd(v201, v79, v226);
+    let v228 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v223, v227);
+    let v229 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v218);
+    let v230 = _mm256_fmadd_pd(v207, v79, v229);
+    let v231 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v223, v230);
+    let v232 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v41);
+    let v234 = _mm256_fmadd_pd(v47, v46, v232);
+    let v235 = _mm256_fmadd_pd(v233, v53, v234);
+    let v236 = _mm256_fmadd_pd(v47, v58, v83);
+    let v237 = _mm256_fmadd_pd(v233, v60, v236);
+    let v238 = _mm256_fmadd_pd(v47, v65, v80);
+    let v239 = _mm256_fmadd_pd(v233, v67, v238);
+    let v240 = _mm256_mul_pd(v46, v89);
+    let v242 = _mm256_mul_pd(v77, v241);
+    let v243 = _mm256_fmadd_pd(
         _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[0usize]),
-    );
-    let v16: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(q[2usize]));
-    let v17: __m256d = _mm256_mul_pd(v16, v13);
-    let v20: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[1usize]),
-    );
-    let v21: __m256d = _mm256_mul_pd(v20, v18);
-    let v22: __m256d = _mm256_sub_pd(v17, v21);
-    let v23: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[1usize]),
-    );
-    let v24: __m256d = _mm256_mul_pd(v23, runtime::lanes::from_array(q[2usize]));
-    let v25: __m256d = _mm256_mul_pd(v24, v13);
-    let v26: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[0usize]),
-    );
-    let v27: __m256d = _mm256_mul_pd(v26, v18);
-    let v28: __m256d = _mm256_add_pd(v25, v27);
-    let v29: __m256d = _mm256_add_pd(v17, v21);
-    let v30: __m256d = _mm256_fmadd_pd(v3, v13, v12);
-    let v31: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(q[1usize]));
-    let v32: __m256d = _mm256_mul_pd(v31, v13);
-    let v33: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[2usize]),
-    );
-    let v34: __m256d = _mm256_mul_pd(v33, v18);
-    let v35: __m256d = _mm256_sub_pd(v32, v34);
-    let v36: __m256d = _mm256_sub_pd(v25, v27);
-    let v37: __m256d = _mm256_add_pd(v32, v34);
-    let v38: __m256d = _mm256_fmadd_pd(v9, v13, v12);
-    let v41: __m256d = _mm256_add_pd(
-        runtime::lanes::from_array(q[3usize]),
-        runtime::lanes::from_array(p[0usize]),
-    );
-    let v42: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v41);
-    let v45: __m256d = _mm256_mul_pd(v23, runtime::lanes::from_array(q[4usize]));
-    let v46: __m256d = _mm256_fmsub_pd(v15, runtime::lanes::from_array(q[5usize]), v45);
-    let v48: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[2usize]),
-    );
-    let v49: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(q[4usize]));
-    let v50: __m256d = _mm256_fmadd_pd(v48, v41, v49);
-    let v51: __m256d = _mm256_fmadd_pd(v23, runtime::lanes::from_array(q[5usize]), v50);
-    let v52: __m256d = _mm256_mul_pd(v42, v11);
-    let v53: __m256d = _mm256_fmsub_pd(v33, v51, v52);
-    let v54: __m256d = _mm256_fmadd_pd(v13, v46, v42);
-    let v55: __m256d = _mm256_fmadd_pd(v47, v53, v54);
-    let v56: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[4usize]),
-    );
-    let v57: __m256d = _mm256_mul_pd(v48, runtime::lanes::from_array(q[5usize]));
-    let v58: __m256d = _mm256_fmsub_pd(v23, v41, v57);
-    let v59: __m256d = _mm256_mul_pd(v56, v11);
-    let v60: __m256d = _mm256_fmsub_pd(v26, v51, v59);
-    let v61: __m256d = _mm256_fmadd_pd(v13, v58, v56);
-    let v62: __m256d = _mm256_fmadd_pd(v47, v60, v61);
-    let v63: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[5usize]),
-    );
-    let v64: __m256d = _mm256_mul_pd(v15, v41);
-    let v65: __m256d = _mm256_fmsub_pd(v48, runtime::lanes::from_array(q[4usize]), v64);
-    let v66: __m256d = _mm256_mul_pd(v63, v11);
-    let v67: __m256d = _mm256_fmsub_pd(v20, v51, v66);
-    let v68: __m256d = _mm256_fmadd_pd(v13, v65, v63);
-    let v69: __m256d = _mm256_fmadd_pd(v47, v67, v68);
-    let v71: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[3usize]),
-    );
-    let v74: __m256d = _mm256_mul_pd(v26, runtime::lanes::from_array(qd[0usize]));
-    let v76: __m256d = _mm256_fmadd_pd(v33, runtime::lanes::from_array(qd[2usize]), v74);
-    let v77: __m256d = _mm256_fmadd_pd(v20, runtime::lanes::from_array(qd[1usize]), v76);
-    let v79: __m256d = _mm256_mul_pd(v77, v78);
-    let v80: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[5usize]),
-    );
-    let v82: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[5usize]));
-    let v83: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[4usize]),
-    );
-    let v85: __m256d = _mm256_fmadd_pd(v80, runtime::lanes::from_array(qd[0usize]), v82);
-    let v86: __m256d = _mm256_fnmadd_pd(
-        v83,
-        runtime::lanes::from_array(qd[1usize]),
-        v85,
-    );
-    let v87: __m256d = _mm256_fnmadd_pd(
-        v23,
-        runtime::lanes::from_array(qd[4usize]),
-        v86,
-    );
-    let v89: __m256d = _mm256_mul_pd(v77, v88);
-    let v90: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[2usize]),
-    );
-    let v91: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[2usize]),
-    );
-    let v92: __m256d = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[3usize]));
-    let v93: __m256d = _mm256_fmadd_pd(v91, v41, v92);
-    let v94: __m256d = _mm256_fmadd_pd(v83, runtime::lanes::from_array(qd[0usize]), v93);
-    let v95: __m256d = _mm256_fmadd_pd(v15, runtime::lanes::from_array(qd[4usize]), v94);
-    let v96: __m256d = _mm256_fmadd_pd(v80, runtime::lanes::from_array(qd[1usize]), v95);
-    let v97: __m256d = _mm256_fmadd_pd(v23, runtime::lanes::from_array(qd[5usize]), v96);
-    let v98: __m256d = _mm256_mul_pd(v33, v97);
-    let v99: __m256d = _mm256_fmadd_pd(v90, v51, v98);
-    let v100: __m256d = _mm256_fnmadd_pd(v71, v11, v99);
-    let v101: __m256d = _mm256_fnmadd_pd(v42, v77, v100);
-    let v102: __m256d = _mm256_fmadd_pd(v46, v79, v71);
-    let v103: __m256d = _mm256_fmadd_pd(v13, v87, v102);
-    let v104: __m256d = _mm256_fmadd_pd(v53, v89, v103);
-    let v105: __m256d = _mm256_fmadd_pd(v47, v101, v104);
-    let v106: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[4usize]),
-    );
-    let v107: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[1usize]),
-    );
-    let v108: __m256d = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[3usize]));
-    let v109: __m256d = _mm256_fmadd_pd(v107, v41, v108);
-    let v110: __m256d = _mm256_fnmadd_pd(
-        v80,
-        runtime::lanes::from_array(qd[2usize]),
-        v109,
-    );
-    let v111: __m256d = _mm256_fnmadd_pd(
-        v48,
-        runtime::lanes::from_array(qd[5usize]),
-        v110,
-    );
-    let v112: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[0usize]),
-    );
-    let v113: __m256d = _mm256_mul_pd(v26, v97);
-    let v114: __m256d = _mm256_fmadd_pd(v112, v51, v113);
-    let v115: __m256d = _mm256_fnmadd_pd(v106, v11, v114);
-    let v116: __m256d = _mm256_fnmadd_pd(v56, v77, v115);
-    let v117: __m256d = _mm256_fmadd_pd(v58, v79, v106);
-    let v118: __m256d = _mm256_fmadd_pd(v13, v111, v117);
-    let v119: __m256d = _mm256_fmadd_pd(v60, v89, v118);
-    let v120: __m256d = _mm256_fmadd_pd(v47, v116, v119);
-    let v121: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[5usize]),
-    );
-    let v122: __m256d = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[4usize]));
-    let v123: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[0usize]),
-    );
-    let v124: __m256d = _mm256_fmadd_pd(
-        v83,
-        runtime::lanes::from_array(qd[2usize]),
-        v122,
-    );
-    let v125: __m256d = _mm256_fnmadd_pd(v123, v41, v124);
-    let v126: __m256d = _mm256_fnmadd_pd(
-        v15,
-        runtime::lanes::from_array(qd[3usize]),
-        v125,
-    );
-    let v127: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[1usize]),
-    );
-    let v128: __m256d = _mm256_mul_pd(v20, v97);
-    let v129: __m256d = _mm256_fmadd_pd(v127, v51, v128);
-    let v130: __m256d = _mm256_fnmadd_pd(v121, v11, v129);
-    let v131: __m256d = _mm256_fnmadd_pd(v63, v77, v130);
-    let v132: __m256d = _mm256_fmadd_pd(v65, v79, v121);
-    let v133: __m256d = _mm256_fmadd_pd(v13, v126, v132);
-    let v134: __m256d = _mm256_fmadd_pd(v67, v89, v133);
-    let v135: __m256d = _mm256_fmadd_pd(v47, v131, v134);
-    let v137: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v79);
-    let v138: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        runtime::lanes::from_array(qd[0usize]),
-    );
-    let v139: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        runtime::lanes::from_array(qd[1usize]),
-    );
-    let v140: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v139);
-    let v141: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        runtime::lanes::from_array(qd[2usize]),
-    );
-    let v142: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v138, v140);
-    let v143: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v141, v142);
-    let v145: __m256d = _mm256_mul_pd(v77, v77);
-    let v146: __m256d = _mm256_mul_pd(v144, v145);
-    let v147: __m256d = _mm256_fmadd_pd(v78, v143, v146);
-    let v148: __m256d = _mm256_mul_pd(v46, v147);
-    let v149: __m256d = _mm256_mul_pd(v127, runtime::lanes::from_array(qd[4usize]));
-    let v150: __m256d = _mm256_fmsub_pd(
-        v112,
-        runtime::lanes::from_array(qd[5usize]),
-        v149,
-    );
-    let v151: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v89);
-    let v153: __m256d = _mm256_mul_pd(v145, v152);
-    let v154: __m256d = _mm256_fmadd_pd(v88, v143, v153);
-    let v155: __m256d = _mm256_mul_pd(v112, runtime::lanes::from_array(qd[4usize]));
-    let v156: __m256d = _mm256_fmadd_pd(
-        v90,
-        runtime::lanes::from_array(qd[3usize]),
-        v155,
-    );
-    let v157: __m256d = _mm256_fmadd_pd(
-        v127,
-        runtime::lanes::from_array(qd[5usize]),
-        v156,
-    );
-    let v158: __m256d = _mm256_mul_pd(v33, v157);
-    let v159: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        v97,
-        v158,
-    );
-    let v160: __m256d = _mm256_fnmadd_pd(
-        runtime::lanes::from_array(qd[3usize]),
-        v77,
-        v159,
-    );
-    let v161: __m256d = _mm256_fnmadd_pd(v42, v143, v160);
-    let v162: __m256d = _mm256_fmadd_pd(v137, v87, v148);
-    let v163: __m256d = _mm256_fmadd_pd(v13, v150, v162);
-    let v164: __m256d = _mm256_fmadd_pd(v151, v101, v163);
-    let v165: __m256d = _mm256_fmadd_pd(v53, v154, v164);
-    let v166: __m256d = _mm256_fmadd_pd(v47, v161, v165);
-    let v167: __m256d = _mm256_mul_pd(v58, v147);
-    let v168: __m256d = _mm256_mul_pd(v90, runtime::lanes::from_array(qd[5usize]));
-    let v169: __m256d = _mm256_fmsub_pd(
-        v127,
-        runtime::lanes::from_array(qd[3usize]),
-        v168,
-    );
-    let v170: __m256d = _mm256_mul_pd(v26, v157);
-    let v171: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        v97,
-        v170,
-    );
-    let v172: __m256d = _mm256_fnmadd_pd(
-        runtime::lanes::from_array(qd[4usize]),
-        v77,
-        v171,
-    );
-    let v173: __m256d = _mm256_fnmadd_pd(v56, v143, v172);
-    let v174: __m256d = _mm256_fmadd_pd(v137, v111, v167);
-    let v175: __m256d = _mm256_fmadd_pd(v13, v169, v174);
-    let v176: __m256d = _mm256_fmadd_pd(v151, v116, v175);
-    let v177: __m256d = _mm256_fmadd_pd(v60, v154, v176);
-    let v178: __m256d = _mm256_fmadd_pd(v47, v173, v177);
-    let v179: __m256d = _mm256_mul_pd(v65, v147);
-    let v180: __m256d = _mm256_mul_pd(v112, runtime::lanes::from_array(qd[3usize]));
-    let v181: __m256d = _mm256_fmsub_pd(
-        v90,
-        runtime::lanes::from_array(qd[4usize]),
-        v180,
-    );
-    let v182: __m256d = _mm256_mul_pd(v20, v157);
-    let v183: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        v97,
-        v182,
-    );
-    let v184: __m256d = _mm256_fnmadd_pd(
-        runtime::lanes::from_array(qd[5usize]),
-        v77,
-        v183,
-    );
-    let v185: __m256d = _mm256_fnmadd_pd(v63, v143, v184);
-    let v186: __m256d = _mm256_fmadd_pd(v137, v126, v179);
-    let v187: __m256d = _mm256_fmadd_pd(v13, v181, v186);
-    let v188: __m256d = _mm256_fmadd_pd(v151, v131, v187);
-    let v189: __m256d = _mm256_fmadd_pd(v67, v154, v188);
-    let v190: __m256d = _mm256_fmadd_pd(v47, v185, v189);
-    let v191: __m256d = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[0usize]));
-    let v192: __m256d = _mm256_fmsub_pd(
-        v15,
-        runtime::lanes::from_array(qd[1usize]),
-        v191,
-    );
-    let v193: __m256d = _mm256_mul_pd(v90, v18);
-    let v194: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[0usize]));
-    let v195: __m256d = _mm256_fmadd_pd(
-        v48,
-        runtime::lanes::from_array(qd[2usize]),
-        v194,
-    );
-    let v196: __m256d = _mm256_fmadd_pd(
-        v23,
-        runtime::lanes::from_array(qd[1usize]),
-        v195,
-    );
-    let v197: __m256d = _mm256_mul_pd(v33, v47);
-    let v198: __m256d = _mm256_fmadd_pd(v13, v192, v193);
-    let v199: __m256d = _mm256_fmadd_pd(v197, v196, v198);
-    let v200: __m256d = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[1usize]));
-    let v201: __m256d = _mm256_fmsub_pd(
-        v23,
-        runtime::lanes::from_array(qd[2usize]),
-        v200,
-    );
-    let v202: __m256d = _mm256_mul_pd(v112, v18);
-    let v203: __m256d = _mm256_mul_pd(v26, v47);
-    let v204: __m256d = _mm256_fmadd_pd(v13, v201, v202);
-    let v205: __m256d = _mm256_fmadd_pd(v203, v196, v204);
-    let v206: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[2usize]));
-    let v207: __m256d = _mm256_fmsub_pd(
-        v48,
-        runtime::lanes::from_array(qd[0usize]),
-        v206,
-    );
-    let v208: __m256d = _mm256_mul_pd(v127, v18);
-    let v209: __m256d = _mm256_mul_pd(v20, v47);
-    let v210: __m256d = _mm256_fmadd_pd(v13, v207, v208);
-    let v211: __m256d = _mm256_fmadd_pd(v209, v196, v210);
-    let v212: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v196);
-    let v213: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v139);
-    let v214: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v138, v213);
-    let v215: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v141, v214);
-    let v216: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v47);
-    let v217: __m256d = _mm256_mul_pd(v216, v215);
-    let v218: __m256d = _mm256_fmadd_pd(v212, v89, v217);
-    let v219: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[2usize]), v218);
-    let v221: __m256d = _mm256_mul_pd(v77, v220);
-    let v222: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v221);
-    let v223: __m256d = _mm256_fmadd_pd(v216, v196, v222);
-    let v224: __m256d = _mm256_fmadd_pd(v192, v79, v219);
-    let v225: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        v223,
-        v224,
-    );
-    let v226: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[0usize]), v218);
-    let v227: __m256d = _mm256_fmadd_pd(v201, v79, v226);
-    let v228: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        v223,
-        v227,
-    );
-    let v229: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[1usize]), v218);
-    let v230: __m256d = _mm256_fmadd_pd(v207, v79, v229);
-    let v231: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        v223,
-        v230,
-    );
-    let v232: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v41);
-    let v234: __m256d = _mm256_fmadd_pd(v47, v46, v232);
-    let v235: __m256d = _mm256_fmadd_pd(v233, v53, v234);
-    let v236: __m256d = _mm256_fmadd_pd(v47, v58, v83);
-    let v237: __m256d = _mm256_fmadd_pd(v233, v60, v236);
-    let v238: __m256d = _mm256_fmadd_pd(v47, v65, v80);
-    let v239: __m256d = _mm256_fmadd_pd(v233, v67, v238);
-    let v240: __m256d = _mm256_mul_pd(v46, v89);
-    let v242: __m256d = _mm256_mul_pd(v77, v241);
-    let v243: __m256d = _mm256_fmadd_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[3usize]),
+        runtime::lanes::from_array(qd[3]),
         v240,
     );
-    let v244: __m256d = _mm256_fmadd_pd(v47, v87, v243);
-    let v245: __m256d = _mm256_fmadd_pd(v53, v242, v244);
-    let v246: __m256d = _mm256_fmadd_pd(v233, v101, v245);
-    let v247: __m256d = _mm256_mul_pd(v58, v89);
-    let v248: __m256d = _mm256_fmadd_pd(
+    let v244 = _mm256_fmadd_pd(v47, v87, v243);
+    let v245 = _mm256_fmadd_pd(v53, v242, v244);
+    let v246 = _mm256_fmadd_pd(v233, v101, v245);
+    let v247 = _mm256_mul_pd(v58, v89);
+    let v248 = _mm256_fmadd_pd(
         _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[4usize]),
+        runtime::lanes::from_array(qd[4]),
         v247,
     );
-    let v249: __m256d = _mm256_fmadd_pd(v47, v111, v248);
-    let v250: __m256d = _mm256_fmadd_pd(v60, v242, v249);
-    let v251: __m256d = _mm256_fmadd_pd(v233, v116, v250);
-    let v252: __m256d = _mm256_mul_pd(v65, v89);
-    let v253: __m256d = _mm256_fmadd_pd(
+    let v249 = _mm256_fmadd_pd(v47, v111, v248);
+    let v250 = _mm256_fmadd_pd(v60, v242, v249);
+    let v251 = _mm256_fmadd_pd(v233, v116, v250);
+    let v252 = _mm256_mul_pd(v65, v89);
+    let v253 = _mm256_fmadd_pd(
         _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[5usize]),
+        runtime::lanes::from_array(qd[5]),
         v252,
     );
-    let v254: __m256d = _mm256_fmadd_pd(v47, v126, v253);
-    let v255: __m256d = _mm256_fmadd_pd(v67, v242, v254);
-    let v256: __m256d = _mm256_fmadd_pd(v233, v131, v255);
-    let v257: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v87);
-    let v258: __m256d = _mm256_mul_pd(v46, v154);
-    let v259: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v101);
-    let v261: __m256d = _mm256_mul_pd(v145, v260);
-    let v262: __m256d = _mm256_fmadd_pd(v143, v241, v261);
-    let v263: __m256d = _mm256_fmadd_pd(v257, v89, v258);
-    let v264: __m256d = _mm256_fmadd_pd(v47, v150, v263);
-    let v265: __m256d = _mm256_fmadd_pd(v259, v242, v264);
-    let v266: __m256d = _mm256_fmadd_pd(v53, v262, v265);
-    let v267: __m256d = _mm256_fmadd_pd(v233, v161, v266);
-    let v268: __m256d = _mm256_mul_pd(v58, v154);
-    let v269: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v116);
-    let v270: __m256d = _mm256_fmadd_pd(v151, v111, v268);
-    let v271: __m256d = _mm256_fmadd_pd(v47, v169, v270);
-    let v272: __m256d = _mm256_fmadd_pd(v269, v242, v271);
-    let v273: __m256d = _mm256_fmadd_pd(v60, v262, v272);
-    let v274: __m256d = _mm256_fmadd_pd(v233, v173, v273);
-    let v275: __m256d = _mm256_mul_pd(v65, v154);
-    let v276: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v131);
-    let v277: __m256d = _mm256_fmadd_pd(v151, v126, v275);
-    let v278: __m256d = _mm256_fmadd_pd(v47, v181, v277);
-    let v279: __m256d = _mm256_fmadd_pd(v276, v242, v278);
-    let v280: __m256d = _mm256_fmadd_pd(v67, v262, v279);
-    let v281: __m256d = _mm256_fmadd_pd(v233, v185, v280);
-    let v282: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v11);
-    let c: [[__m256d; 2usize]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
-        2usize,
+    let v254 = _mm256_fmadd_pd(v47, v126, v253);
+    let v255 = _mm256_fmadd_pd(v67, v242, v254);
+    let v256 = _mm256_fmadd_pd(v233, v131, v255);
+    let v257 = _mm256_mul_pd(_mm256_set1_pd(2f64), v87);
+    let v258 = _mm256_mul_pd(v46, v154);
+    let v259 = _mm256_mul_pd(_mm256_set1_pd(2f64), v101);
+    let v261 = _mm256_mul_pd(v145, v260);
+    let v262 = _mm256_fmadd_pd(v143, v241, v261);
+    let v263 = _mm256_fmadd_pd(v257, v89, v258);
+    let v264 = _mm256_fmadd_pd(v47, v150, v263);
+    let v265 = _mm256_fmadd_pd(v259, v242, v264);
+    let v266 = _mm256_fmadd_pd(v53, v262, v265);
+    let v267 = _mm256_fmadd_pd(v233, v161, v266);
+    let v268 = _mm256_mul_pd(v58, v154);
+    let v269 = _mm256_mul_pd(_mm256_set1_pd(2f64), v116);
+    let v270 = _mm256_fmadd_pd(v151, v111, v268);
+    let v271 = _mm256_fmadd_pd(v47, v169, v270);
+    let v272 = _mm256_fmadd_pd(v269, v242, v271);
+    let v273 = _mm256_fmadd_pd(v60, v262, v272);
+    let v274 = _mm256_fmadd_pd(v233, v173, v273);
+    let v275 = _mm256_mul_pd(v65, v154);
+    let v276 = _mm256_mul_pd(_mm256_set1_pd(2f64), v131);
+    let v277 = _mm256_fmadd_pd(v151, v126, v275);
+    let v278 = _mm256_fmadd_pd(v47, v181, v277);
+    let v279 = _mm256_fmadd_pd(v276, v242, v278);
+    let v280 = _mm256_fmadd_pd(v67, v262, v279);
+    let v281 = _mm256_fmadd_pd(v233, v185, v280);
+    let v282 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v11);
+    let c: [[__m256d; 2]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
+        2,
     >(v282);
-    let v283: __m256d = c[2usize][0usize];
-    let v289: __m256d = c[1usize][0usize];
-    let v291: __m256d = c[3usize][0usize];
-    let v312: __m256d = c[2usize][1usize];
-    let v314: __m256d = c[3usize][1usize];
-    let v324: __m256d = c[1usize][1usize];
-    let v285: __m256d = _mm256_mul_pd(
+    let v283: __m256d = c[2][0];
+    let v289: __m256d = c[1][0];
+    let v291: __m256d = c[3][0];
+    let v312: __m256d = c[2][1];
+    let v314: __m256d = c[3][1];
+    let v324: __m256d = c[1][1];
+    let v285 = _mm256_mul_pd(
         _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[0usize]),
+        runtime::lanes::from_array(q[0]),
     );
-    let v286: __m256d = _mm256_mul_pd(
+    let v286 = _mm256_mul_pd(
         _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[1usize]),
+        runtime::lanes::from_array(q[1]),
     );
-    let v287: __m256d = _mm256_mul_pd(v286, runtime::lanes::from_array(qd[0usize]));
-    let v288: __m256d = _mm256_fmsub_pd(
-        v285,
-        runtime::lanes::from_array(qd[1usize]),
-        v287,
-    );
-    let v290: __m256d = _mm256_mul_pd(v91, v289);
-    let v292: __m256d = _mm256_mul_pd(
+    let v287 = _mm256_mul_pd(v286, runtime::lanes::from_array(qd[0]));
+    let v288 = _mm256_fmsub_pd(v285, runtime::lanes::from_array(qd[1]), v287);
+    let v290 = _mm256_mul_pd(v91, v289);
+    let v292 = _mm256_mul_pd(
         _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[2usize]),
+        runtime::lanes::from_array(q[2]),
     );
-    let v293: __m256d = _mm256_mul_pd(v285, runtime::lanes::from_array(qd[0usize]));
-    let v294: __m256d = _mm256_fmadd_pd(
-        v292,
-        runtime::lanes::from_array(qd[2usize]),
-        v293,
-    );
-    let v295: __m256d = _mm256_fmadd_pd(
-        v286,
-        runtime::lanes::from_array(qd[1usize]),
-        v294,
-    );
-    let v296: __m256d = _mm256_mul_pd(v48, v291);
-    let v297: __m256d = _mm256_fmadd_pd(v283, v288, v290);
-    let v298: __m256d = _mm256_fmadd_pd(v296, v295, v297);
-    let v299: __m256d = _mm256_mul_pd(v292, runtime::lanes::from_array(qd[1usize]));
-    let v300: __m256d = _mm256_fmsub_pd(
-        v286,
-        runtime::lanes::from_array(qd[2usize]),
-        v299,
-    );
-    let v301: __m256d = _mm256_mul_pd(v123, v289);
-    let v302: __m256d = _mm256_mul_pd(v15, v291);
-    let v303: __m256d = _mm256_fmadd_pd(v283, v300, v301);
-    let v304: __m256d = _mm256_fmadd_pd(v302, v295, v303);
-    let v305: __m256d = _mm256_mul_pd(v285, runtime::lanes::from_array(qd[2usize]));
-    let v306: __m256d = _mm256_fmsub_pd(
-        v292,
-        runtime::lanes::from_array(qd[0usize]),
-        v305,
-    );
-    let v307: __m256d = _mm256_mul_pd(v107, v289);
-    let v308: __m256d = _mm256_mul_pd(v23, v291);
-    let v309: __m256d = _mm256_fmadd_pd(v283, v306, v307);
-    let v310: __m256d = _mm256_fmadd_pd(v308, v295, v309);
-    let v311: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v77);
-    let v313: __m256d = _mm256_mul_pd(v311, v312);
-    let v315: __m256d = _mm256_mul_pd(v311, v314);
-    let v316: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v295);
-    let v317: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.0625f64), v139);
-    let v318: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v138, v317);
-    let v319: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v141, v318);
-    let v320: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v291);
-    let v321: __m256d = _mm256_mul_pd(v320, v319);
-    let v322: __m256d = _mm256_fmadd_pd(v316, v315, v321);
-    let v323: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[2usize]), v322);
-    let v325: __m256d = _mm256_mul_pd(v311, v324);
-    let v326: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v325);
-    let v327: __m256d = _mm256_fmadd_pd(v320, v295, v326);
-    let v328: __m256d = _mm256_fmadd_pd(v288, v313, v323);
-    let v329: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        v327,
-        v328,
-    );
-    let v330: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[0usize]), v322);
-    let v331: __m256d = _mm256_fmadd_pd(v300, v313, v330);
-    let v332: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        v327,
-        v331,
-    );
-    let v333: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[1usize]), v322);
-    let v334: __m256d = _mm256_fmadd_pd(v306, v313, v333);
-    let v335: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        v327,
-        v334,
-    );
-    let v337: __m256d = _mm256_fmsub_pd(_mm256_set1_pd(0.0625f64), v5, v282);
-    let v338: __m256d = _mm256_fmadd_pd(v283, v337, _mm256_set1_pd(1f64));
-    let v339: __m256d = _mm256_mul_pd(v285, runtime::lanes::from_array(q[2usize]));
-    let v340: __m256d = _mm256_mul_pd(v339, v283);
-    let v341: __m256d = _mm256_fmadd_pd(v23, v289, v340);
-    let v342: __m256d = _mm256_mul_pd(v286, runtime::lanes::from_array(q[2usize]));
-    let v343: __m256d = _mm256_mul_pd(v15, v289);
-    let v344: __m256d = _mm256_fmsub_pd(v342, v283, v343);
-    let v346: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(p[1usize]),
-    );
-    let v348: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(p[3usize]),
-    );
-    let v350: __m256d = _mm256_sub_pd(runtime::lanes::from_array(p[2usize]), v348);
-    let v352: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.125f64), v350, v348);
-    let v353: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(p[3usize]),
-    );
-    let v354: __m256d = _mm256_mul_pd(v23, v13);
-    let v355: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.125f64),
-        runtime::lanes::from_array(q[0usize]),
-    );
-    let v356: __m256d = _mm256_mul_pd(v355, runtime::lanes::from_array(q[2usize]));
-    let v357: __m256d = _mm256_mul_pd(v356, v47);
-    let v358: __m256d = _mm256_sub_pd(v357, v354);
-    let v359: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v18);
-    let v360: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v1);
-    let v361: __m256d = _mm256_fmadd_pd(v360, v47, v359);
-    let v362: __m256d = _mm256_mul_pd(v48, v13);
-    let v363: __m256d = _mm256_mul_pd(v355, runtime::lanes::from_array(q[1usize]));
-    let v364: __m256d = _mm256_mul_pd(v363, v47);
-    let v365: __m256d = _mm256_add_pd(v362, v364);
-    let v366: __m256d = _mm256_mul_pd(v78, v26);
-    let v367: __m256d = _mm256_mul_pd(v80, v13);
-    let v368: __m256d = _mm256_mul_pd(v88, v26);
-    let v369: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.125f64),
-        runtime::lanes::from_array(q[2usize]),
-    );
-    let v370: __m256d = _mm256_mul_pd(v42, v26);
-    let v371: __m256d = _mm256_fmsub_pd(
-        v369,
-        runtime::lanes::from_array(q[4usize]),
-        v370,
-    );
-    let v372: __m256d = _mm256_fmadd_pd(v46, v366, v367);
-    let v373: __m256d = _mm256_fmadd_pd(v53, v368, v372);
-    let v374: __m256d = _mm256_fmadd_pd(v47, v371, v373);
-    let v375: __m256d = _mm256_mul_pd(v60, v368);
-    let v376: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v51);
-    let v377: __m256d = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v26, v355);
-    let v378: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[4usize]),
-        v377,
-        v376,
-    );
-    let v379: __m256d = _mm256_fmadd_pd(v58, v366, v375);
-    let v380: __m256d = _mm256_fmadd_pd(v47, v378, v379);
-    let v381: __m256d = _mm256_mul_pd(v232, v13);
-    let v382: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.125f64),
-        runtime::lanes::from_array(q[1usize]),
-    );
-    let v383: __m256d = _mm256_mul_pd(v63, v26);
-    let v384: __m256d = _mm256_fmsub_pd(
-        v382,
-        runtime::lanes::from_array(q[4usize]),
-        v383,
-    );
-    let v385: __m256d = _mm256_fmsub_pd(v65, v366, v381);
-    let v386: __m256d = _mm256_fmadd_pd(v67, v368, v385);
-    let v387: __m256d = _mm256_fmadd_pd(v47, v384, v386);
-    let v388: __m256d = _mm256_mul_pd(v286, v283);
-    let v390: __m256d = _mm256_mul_pd(
+    let v293 = _mm256_mul_pd(v285, runtime::lanes::from_array(qd[0]));
+    let v294 = _mm256_fmadd_pd(v292, runtime::lanes::from_array(qd[2]), v293);
+    let v295 = _mm256_fmadd_pd(v286, runtime::lanes::from_array(qd[1]), v294);
+    let v296 = _mm256_mul_pd(v48, v291);
+    let v297 = _mm256_fmadd_pd(v283, v288, v290);
+    let v298 = _mm256_fmadd_pd(v296, v295, v297);
+    let v299 = _mm256_mul_pd(v292, runtime::lanes::from_array(qd[1]));
+    let v300 = _mm256_fmsub_pd(v286, runtime::lanes::from_array(qd[2]), v299);
+    let v301 = _mm256_mul_pd(v123, v289);
+    let v302 = _mm256_mul_pd(v15, v291);
+    let v303 = _mm256_fmadd_pd(v283, v300, v301);
+    let v304 = _mm256_fmadd_pd(v302, v295, v303);
+    let v305 = _mm256_mul_pd(v285, runtime::lanes::from_array(qd[2]));
+    let v306 = _mm256_fmsub_pd(v292, runtime::lanes::from_array(qd[0]), v305);
+    let v307 = _mm256_mul_pd(v107, v289);
+    let v308 = _mm256_mul_pd(v23, v291);
+    let v309 = _mm256_fmadd_pd(v283, v306, v307);
+    let v310 = _mm256_fmadd_pd(v308, v295, v309);
+    let v311 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v77);
+    let v313 = _mm256_mul_pd(v311, v312);
+    let v315 = _mm256_mul_pd(v311, v314);
+    let v316 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v295);
+    let v317 = _mm256_mul_pd(_mm256_set1_pd(0.0625f64), v139);
+    let v318 = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v138, v317);
+    let v319 = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v141, v318);
+    let v320 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v291);
+    let v321 = _mm256_mul_pd(v320, v319);
+    let v322 = _mm256_fmadd_pd(v316, v315, v321);
+    let v323 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v322);
+    let v325 = _mm256_mul_pd(v311, v324);
+    let v326 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v325);
+    let v327 = _mm256_fmadd_pd(v320, v295, v326);
+    let v328 = _mm256_fmadd_pd(v288, v313, v323);
+    let v329 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v327, v328);
+    let v330 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v322);
+    let v331 = _mm256_fmadd_pd(v300, v313, v330);
+    let v332 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v327, v331);
+    let v333 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v322);
+    let v334 = _mm256_fmadd_pd(v306, v313, v333);
+    let v335 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v327, v334);
+    let v337 = _mm256_fmsub_pd(_mm256_set1_pd(0.0625f64), v5, v282);
+    let v338 = _mm256_fmadd_pd(v283, v337, _mm256_set1_pd(1f64));
+    let v339 = _mm256_mul_pd(v285, runtime::lanes::from_array(q[2]));
+    let v340 = _mm256_mul_pd(v339, v283);
+    let v341 = _mm256_fmadd_pd(v23, v289, v340);
+    let v342 = _mm256_mul_pd(v286, runtime::lanes::from_array(q[2]));
+    let v343 = _mm256_mul_pd(v15, v289);
+    let v344 = _mm256_fmsub_pd(v342, v283, v343);
+    let v346 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[1]));
+    let v348 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(p[3]));
+    let v350 = _mm256_sub_pd(runtime::lanes::from_array(p[2]), v348);
+    let v352 = _mm256_fmadd_pd(_mm256_set1_pd(0.125f64), v350, v348);
+    let v353 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[3]));
+    let v354 = _mm256_mul_pd(v23, v13);
+    let v355 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[0]));
+    let v356 = _mm256_mul_pd(v355, runtime::lanes::from_array(q[2]));
+    let v357 = _mm256_mul_pd(v356, v47);
+    let v358 = _mm256_sub_pd(v357, v354);
+    let v359 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v18);
+    let v360 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v1);
+    let v361 = _mm256_fmadd_pd(v360, v47, v359);
+    let v362 = _mm256_mul_pd(v48, v13);
+    let v363 = _mm256_mul_pd(v355, runtime::lanes::from_array(q[1]));
+    let v364 = _mm256_mul_pd(v363, v47);
+    let v365 = _mm256_add_pd(v362, v364);
+    let v366 = _mm256_mul_pd(v78, v26);
+    let v367 = _mm256_mul_pd(v80, v13);
+    let v368 = _mm256_mul_pd(v88, v26);
+    let v369 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[2]));
+    let v370 = _mm256_mul_pd(v42, v26);
+    let v371 = _mm256_fmsub_pd(v369, runtime::lanes::from_array(q[4]), v370);
+    let v372 = _mm256_fmadd_pd(v46, v366, v367);
+    let v373 = _mm256_fmadd_pd(v53, v368, v372);
+    let v374 = _mm256_fmadd_pd(v47, v371, v373);
+    let v375 = _mm256_mul_pd(v60, v368);
+    let v376 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v51);
+    let v377 = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v26, v355);
+    let v378 = _mm256_fmadd_pd(runtime::lanes::from_array(q[4]), v377, v376);
+    let v379 = _mm256_fmadd_pd(v58, v366, v375);
+    let v380 = _mm256_fmadd_pd(v47, v378, v379);
+    let v381 = _mm256_mul_pd(v232, v13);
+    let v382 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[1]));
+    let v383 = _mm256_mul_pd(v63, v26);
+    let v384 = _mm256_fmsub_pd(v382, runtime::lanes::from_array(q[4]), v383);
+    let v385 = _mm256_fmsub_pd(v65, v366, v381);
+    let v386 = _mm256_fmadd_pd(v67, v368, v385);
+    let v387 = _mm256_fmadd_pd(v47, v384, v386);
+    let v388 = _mm256_mul_pd(v286, v283);
+    let v390 = _mm256_mul_pd(
         _mm256_set1_pd(0.015625f64),
-        runtime::lanes::from_array(q[0usize]),
+        runtime::lanes::from_array(q[0]),
     );
-    let v391: __m256d = _mm256_mul_pd(v390, runtime::lanes::from_array(q[2usize]));
-    let v392: __m256d = _mm256_mul_pd(v391, v291);
-    let v393: __m256d = _mm256_sub_pd(v392, v388);
-    let v394: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v289);
-    let v395: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v1);
-    let v396: __m256d = _mm256_fmadd_pd(v395, v291, v394);
-    let v397: __m256d = _mm256_mul_pd(v292, v283);
-    let v398: __m256d = _mm256_mul_pd(v390, runtime::lanes::from_array(q[1usize]));
-    let v399: __m256d = _mm256_mul_pd(v398, v291);
-    let v400: __m256d = _mm256_add_pd(v397, v399);
-    let v401: __m256d = _mm256_mul_pd(v80, v47);
-    let v402: __m256d = _mm256_mul_pd(v241, v26);
-    let v403: __m256d = _mm256_fmadd_pd(v46, v368, v401);
-    let v404: __m256d = _mm256_fmadd_pd(v53, v402, v403);
-    let v405: __m256d = _mm256_fmadd_pd(v233, v371, v404);
-    let v406: __m256d = _mm256_mul_pd(v60, v402);
-    let v407: __m256d = _mm256_fmadd_pd(v58, v368, v406);
-    let v408: __m256d = _mm256_fmadd_pd(v233, v378, v407);
-    let v409: __m256d = _mm256_mul_pd(v232, v47);
-    let v410: __m256d = _mm256_fmsub_pd(v65, v368, v409);
-    let v411: __m256d = _mm256_fmadd_pd(v67, v402, v410);
-    let v412: __m256d = _mm256_fmadd_pd(v233, v384, v411);
-    let v413: __m256d = _mm256_mul_pd(v15, v13);
-    let v414: __m256d = _mm256_mul_pd(v382, runtime::lanes::from_array(q[2usize]));
-    let v415: __m256d = _mm256_mul_pd(v414, v47);
-    let v416: __m256d = _mm256_add_pd(v413, v415);
-    let v417: __m256d = _mm256_sub_pd(v364, v362);
-    let v418: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v8);
-    let v419: __m256d = _mm256_fmadd_pd(v418, v47, v359);
-    let v420: __m256d = _mm256_mul_pd(v78, v20);
-    let v421: __m256d = _mm256_mul_pd(v83, v13);
-    let v422: __m256d = _mm256_mul_pd(v88, v20);
-    let v423: __m256d = _mm256_mul_pd(v42, v20);
-    let v424: __m256d = _mm256_fmsub_pd(
-        v369,
-        runtime::lanes::from_array(q[5usize]),
-        v423,
-    );
-    let v425: __m256d = _mm256_fmsub_pd(v46, v420, v421);
-    let v426: __m256d = _mm256_fmadd_pd(v53, v422, v425);
-    let v427: __m256d = _mm256_fmadd_pd(v47, v424, v426);
-    let v428: __m256d = _mm256_mul_pd(v56, v20);
-    let v429: __m256d = _mm256_fmsub_pd(
-        v355,
-        runtime::lanes::from_array(q[5usize]),
-        v428,
-    );
-    let v430: __m256d = _mm256_fmadd_pd(v58, v420, v381);
-    let v431: __m256d = _mm256_fmadd_pd(v60, v422, v430);
-    let v432: __m256d = _mm256_fmadd_pd(v47, v429, v431);
-    let v433: __m256d = _mm256_mul_pd(v67, v422);
-    let v434: __m256d = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v20, v382);
-    let v435: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[5usize]),
-        v434,
-        v376,
-    );
-    let v436: __m256d = _mm256_fmadd_pd(v65, v420, v433);
-    let v437: __m256d = _mm256_fmadd_pd(v47, v435, v436);
-    let v438: __m256d = _mm256_mul_pd(v285, v283);
-    let v439: __m256d = _mm256_mul_pd(
+    let v391 = _mm256_mul_pd(v390, runtime::lanes::from_array(q[2]));
+    let v392 = _mm256_mul_pd(v391, v291);
+    let v393 = _mm256_sub_pd(v392, v388);
+    let v394 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v289);
+    let v395 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v1);
+    let v396 = _mm256_fmadd_pd(v395, v291, v394);
+    let v397 = _mm256_mul_pd(v292, v283);
+    let v398 = _mm256_mul_pd(v390, runtime::lanes::from_array(q[1]));
+    let v399 = _mm256_mul_pd(v398, v291);
+    let v400 = _mm256_add_pd(v397, v399);
+    let v401 = _mm256_mul_pd(v80, v47);
+    let v402 = _mm256_mul_pd(v241, v26);
+    let v403 = _mm256_fmadd_pd(v46, v368, v401);
+    let v404 = _mm256_fmadd_pd(v53, v402, v403);
+    let v405 = _mm256_fmadd_pd(v233, v371, v404);
+    let v406 = _mm256_mul_pd(v60, v402);
+    let v407 = _mm256_fmadd_pd(v58, v368, v406);
+    let v408 = _mm256_fmadd_pd(v233, v378, v407);
+    let v409 = _mm256_mul_pd(v232, v47);
+    let v410 = _mm256_fmsub_pd(v65, v368, v409);
+    let v411 = _mm256_fmadd_pd(v67, v402, v410);
+    let v412 = _mm256_fmadd_pd(v233, v384, v411);
+    let v413 = _mm256_mul_pd(v15, v13);
+    let v414 = _mm256_mul_pd(v382, runtime::lanes::from_array(q[2]));
+    let v415 = _mm256_mul_pd(v414, v47);
+    let v416 = _mm256_add_pd(v413, v415);
+    let v417 = _mm256_sub_pd(v364, v362);
+    let v418 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v8);
+    let v419 = _mm256_fmadd_pd(v418, v47, v359);
+    let v420 = _mm256_mul_pd(v78, v20);
+    let v421 = _mm256_mul_pd(v83, v13);
+    let v422 = _mm256_mul_pd(v88, v20);
+    let v423 = _mm256_mul_pd(v42, v20);
+    let v424 = _mm256_fmsub_pd(v369, runtime::lanes::from_array(q[5]), v423);
+    let v425 = _mm256_fmsub_pd(v46, v420, v421);
+    let v426 = _mm256_fmadd_pd(v53, v422, v425);
+    let v427 = _mm256_fmadd_pd(v47, v424, v426);
+    let v428 = _mm256_mul_pd(v56, v20);
+    let v429 = _mm256_fmsub_pd(v355, runtime::lanes::from_array(q[5]), v428);
+    let v430 = _mm256_fmadd_pd(v58, v420, v381);
+    let v431 = _mm256_fmadd_pd(v60, v422, v430);
+    let v432 = _mm256_fmadd_pd(v47, v429, v431);
+    let v433 = _mm256_mul_pd(v67, v422);
+    let v434 = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v20, v382);
+    let v435 = _mm256_fmadd_pd(runtime::lanes::from_array(q[5]), v434, v376);
+    let v436 = _mm256_fmadd_pd(v65, v420, v433);
+    let v437 = _mm256_fmadd_pd(v47, v435, v436);
+    let v438 = _mm256_mul_pd(v285, v283);
+    let v439 = _mm256_mul_pd(
         _mm256_set1_pd(0.015625f64),
-        runtime::lanes::from_array(q[1usize]),
+        runtime::lanes::from_array(q[1]),
     );
-    let v440: __m256d = _mm256_mul_pd(v439, runtime::lanes::from_array(q[2usize]));
-    let v441: __m256d = _mm256_mul_pd(v440, v291);
-    let v442: __m256d = _mm256_add_pd(v438, v441);
-    let v443: __m256d = _mm256_sub_pd(v399, v397);
-    let v444: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v8);
-    let v445: __m256d = _mm256_fmadd_pd(v444, v291, v394);
-    let v446: __m256d = _mm256_mul_pd(v83, v47);
-    let v447: __m256d = _mm256_mul_pd(v241, v20);
-    let v448: __m256d = _mm256_fmsub_pd(v46, v422, v446);
-    let v449: __m256d = _mm256_fmadd_pd(v53, v447, v448);
-    let v450: __m256d = _mm256_fmadd_pd(v233, v424, v449);
-    let v451: __m256d = _mm256_fmadd_pd(v58, v422, v409);
-    let v452: __m256d = _mm256_fmadd_pd(v60, v447, v451);
-    let v453: __m256d = _mm256_fmadd_pd(v233, v429, v452);
-    let v454: __m256d = _mm256_mul_pd(v67, v447);
-    let v455: __m256d = _mm256_fmadd_pd(v65, v422, v454);
-    let v456: __m256d = _mm256_fmadd_pd(v233, v435, v455);
-    let v457: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v5);
-    let v458: __m256d = _mm256_fmadd_pd(v457, v47, v359);
-    let v459: __m256d = _mm256_add_pd(v354, v357);
-    let v460: __m256d = _mm256_sub_pd(v415, v413);
-    let v461: __m256d = _mm256_mul_pd(v78, v33);
-    let v462: __m256d = _mm256_mul_pd(v88, v33);
-    let v463: __m256d = _mm256_mul_pd(v53, v462);
-    let v464: __m256d = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v33, v369);
-    let v465: __m256d = _mm256_fmadd_pd(v41, v464, v376);
-    let v466: __m256d = _mm256_fmadd_pd(v46, v461, v463);
-    let v467: __m256d = _mm256_fmadd_pd(v47, v465, v466);
-    let v468: __m256d = _mm256_mul_pd(v56, v33);
-    let v469: __m256d = _mm256_fmsub_pd(v355, v41, v468);
-    let v470: __m256d = _mm256_fmsub_pd(v58, v461, v367);
-    let v471: __m256d = _mm256_fmadd_pd(v60, v462, v470);
-    let v472: __m256d = _mm256_fmadd_pd(v47, v469, v471);
-    let v473: __m256d = _mm256_mul_pd(v63, v33);
-    let v474: __m256d = _mm256_fmsub_pd(v382, v41, v473);
-    let v475: __m256d = _mm256_fmadd_pd(v65, v461, v421);
-    let v476: __m256d = _mm256_fmadd_pd(v67, v462, v475);
-    let v477: __m256d = _mm256_fmadd_pd(v47, v474, v476);
-    let v478: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v5);
-    let v479: __m256d = _mm256_fmadd_pd(v478, v291, v394);
-    let v480: __m256d = _mm256_add_pd(v388, v392);
-    let v481: __m256d = _mm256_sub_pd(v441, v438);
-    let v482: __m256d = _mm256_mul_pd(v241, v33);
-    let v483: __m256d = _mm256_mul_pd(v53, v482);
-    let v484: __m256d = _mm256_fmadd_pd(v46, v462, v483);
-    let v485: __m256d = _mm256_fmadd_pd(v233, v465, v484);
-    let v486: __m256d = _mm256_fmsub_pd(v58, v462, v401);
-    let v487: __m256d = _mm256_fmadd_pd(v60, v482, v486);
-    let v488: __m256d = _mm256_fmadd_pd(v233, v469, v487);
-    let v489: __m256d = _mm256_fmadd_pd(v65, v462, v446);
-    let v490: __m256d = _mm256_fmadd_pd(v67, v482, v489);
-    let v491: __m256d = _mm256_fmadd_pd(v233, v474, v490);
-    let v493: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v11);
-    let v494: __m256d = _mm256_sub_pd(v457, v493);
-    let v495: __m256d = _mm256_fmadd_pd(v47, v494, _mm256_set1_pd(0.5f64));
-    let v496: __m256d = _mm256_fmadd_pd(v233, v494, _mm256_set1_pd(0.25f64));
-    let v497: __m256d = _mm256_mul_pd(v23, v47);
-    let v498: __m256d = _mm256_mul_pd(v356, v233);
-    let v499: __m256d = _mm256_add_pd(v497, v498);
-    let v500: __m256d = _mm256_mul_pd(v15, v47);
-    let v501: __m256d = _mm256_mul_pd(v414, v233);
-    let v502: __m256d = _mm256_sub_pd(v501, v500);
-    let v503: __m256d = _mm256_sub_pd(v360, v493);
-    let v504: __m256d = _mm256_fmadd_pd(v47, v503, _mm256_set1_pd(0.5f64));
-    let v505: __m256d = _mm256_sub_pd(v498, v497);
-    let v506: __m256d = _mm256_fmadd_pd(v233, v503, _mm256_set1_pd(0.25f64));
-    let v507: __m256d = _mm256_mul_pd(v48, v47);
-    let v508: __m256d = _mm256_mul_pd(v363, v233);
-    let v509: __m256d = _mm256_add_pd(v507, v508);
-    let v510: __m256d = _mm256_sub_pd(v418, v493);
-    let v511: __m256d = _mm256_fmadd_pd(v47, v510, _mm256_set1_pd(0.5f64));
-    let v512: __m256d = _mm256_add_pd(v500, v501);
-    let v513: __m256d = _mm256_sub_pd(v508, v507);
-    let v514: __m256d = _mm256_fmadd_pd(v233, v510, _mm256_set1_pd(0.25f64));
-    let v517: __m256d = _mm256_mul_pd(v112, runtime::lanes::from_array(p[5usize]));
-    let v518: __m256d = _mm256_fmadd_pd(
-        v26,
-        runtime::lanes::from_array(p[4usize]),
-        v517,
+    let v440 = _mm256_mul_pd(v439, runtime::lanes::from_array(q[2]));
+    let v441 = _mm256_mul_pd(v440, v291);
+    let v442 = _mm256_add_pd(v438, v441);
+    let v443 = _mm256_sub_pd(v399, v397);
+    let v444 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v8);
+    let v445 = _mm256_fmadd_pd(v444, v291, v394);
+    let v446 = _mm256_mul_pd(v83, v47);
+    let v447 = _mm256_mul_pd(v241, v20);
+    let v448 = _mm256_fmsub_pd(v46, v422, v446);
+    let v449 = _mm256_fmadd_pd(v53, v447, v448);
+    let v450 = _mm256_fmadd_pd(v233, v424, v449);
+    let v451 = _mm256_fmadd_pd(v58, v422, v409);
+    let v452 = _mm256_fmadd_pd(v60, v447, v451);
+    let v453 = _mm256_fmadd_pd(v233, v429, v452);
+    let v454 = _mm256_mul_pd(v67, v447);
+    let v455 = _mm256_fmadd_pd(v65, v422, v454);
+    let v456 = _mm256_fmadd_pd(v233, v435, v455);
+    let v457 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v5);
+    let v458 = _mm256_fmadd_pd(v457, v47, v359);
+    let v459 = _mm256_add_pd(v354, v357);
+    let v460 = _mm256_sub_pd(v415, v413);
+    let v461 = _mm256_mul_pd(v78, v33);
+    let v462 = _mm256_mul_pd(v88, v33);
+    let v463 = _mm256_mul_pd(v53, v462);
+    let v464 = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v33, v369);
+    let v465 = _mm256_fmadd_pd(v41, v464, v376);
+    let v466 = _mm256_fmadd_pd(v46, v461, v463);
+    let v467 = _mm256_fmadd_pd(v47, v465, v466);
+    let v468 = _mm256_mul_pd(v56, v33);
+    let v469 = _mm256_fmsub_pd(v355, v41, v468);
+    let v470 = _mm256_fmsub_pd(v58, v461, v367);
+    let v471 = _mm256_fmadd_pd(v60, v462, v470);
+    let v472 = _mm256_fmadd_pd(v47, v469, v471);
+    let v473 = _mm256_mul_pd(v63, v33);
+    let v474 = _mm256_fmsub_pd(v382, v41, v473);
+    let v475 = _mm256_fmadd_pd(v65, v461, v421);
+    let v476 = _mm256_fmadd_pd(v67, v462, v475);
+    let v477 = _mm256_fmadd_pd(v47, v474, v476);
+    let v478 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v5);
+    let v479 = _mm256_fmadd_pd(v478, v291, v394);
+    let v480 = _mm256_add_pd(v388, v392);
+    let v481 = _mm256_sub_pd(v441, v438);
+    let v482 = _mm256_mul_pd(v241, v33);
+    let v483 = _mm256_mul_pd(v53, v482);
+    let v484 = _mm256_fmadd_pd(v46, v462, v483);
+    let v485 = _mm256_fmadd_pd(v233, v465, v484);
+    let v486 = _mm256_fmsub_pd(v58, v462, v401);
+    let v487 = _mm256_fmadd_pd(v60, v482, v486);
+    let v488 = _mm256_fmadd_pd(v233, v469, v487);
+    let v489 = _mm256_fmadd_pd(v65, v462, v446);
+    let v490 = _mm256_fmadd_pd(v67, v482, v489);
+    let v491 = _mm256_fmadd_pd(v233, v474, v490);
+    let v493 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v11);
+    let v494 = _mm256_sub_pd(v457, v493);
+    let v495 = _mm256_fmadd_pd(v47, v494, _mm256_set1_pd(0.5f64));
+    let v496 = _mm256_fmadd_pd(v233, v494, _mm256_set1_pd(0.25f64));
+    let v497 = _mm256_mul_pd(v23, v47);
+    let v498 = _mm256_mul_pd(v356, v233);
+    let v499 = _mm256_add_pd(v497, v498);
+    let v500 = _mm256_mul_pd(v15, v47);
+    let v501 = _mm256_mul_pd(v414, v233);
+    let v502 = _mm256_sub_pd(v501, v500);
+    let v503 = _mm256_sub_pd(v360, v493);
+    let v504 = _mm256_fmadd_pd(v47, v503, _mm256_set1_pd(0.5f64));
+    let v505 = _mm256_sub_pd(v498, v497);
+    let v506 = _mm256_fmadd_pd(v233, v503, _mm256_set1_pd(0.25f64));
+    let v507 = _mm256_mul_pd(v48, v47);
+    let v508 = _mm256_mul_pd(v363, v233);
+    let v509 = _mm256_add_pd(v507, v508);
+    let v510 = _mm256_sub_pd(v418, v493);
+    let v511 = _mm256_fmadd_pd(v47, v510, _mm256_set1_pd(0.5f64));
+    let v512 = _mm256_add_pd(v500, v501);
+    let v513 = _mm256_sub_pd(v508, v507);
+    let v514 = _mm256_fmadd_pd(v233, v510, _mm256_set1_pd(0.25f64));
+    let v517 = _mm256_mul_pd(v112, runtime::lanes::from_array(p[5]));
+    let v518 = _mm256_fmadd_pd(v26, runtime::lanes::from_array(p[4]), v517);
+    let v520 = _mm256_sub_pd(
+        runtime::lanes::from_array(q[1]),
+        runtime::lanes::from_array(p[6]),
     );
-    let v520: __m256d = _mm256_sub_pd(
-        runtime::lanes::from_array(q[1usize]),
-        runtime::lanes::from_array(p[6usize]),
-    );
-    let v521: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(p[4usize]),
-    );
-    let v522: __m256d = _mm256_mul_pd(v127, runtime::lanes::from_array(p[5usize]));
-    let v523: __m256d = _mm256_fmadd_pd(v521, v520, v522);
-    let v526: __m256d = _mm256_mul_pd(v90, runtime::lanes::from_array(p[8usize]));
-    let v527: __m256d = _mm256_fmadd_pd(
-        v33,
-        runtime::lanes::from_array(p[7usize]),
-        v526,
-    );
-    let v529: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[3usize]),
-    );
-    let v531: __m256d = _mm256_mul_pd(v71, runtime::lanes::from_array(p[10usize]));
-    let v532: __m256d = _mm256_fmadd_pd(
-        v529,
-        runtime::lanes::from_array(p[9usize]),
-        v531,
-    );
-    let v534: __m256d = _mm256_mul_pd(v106, runtime::lanes::from_array(p[10usize]));
-    let v535: __m256d = _mm256_fmadd_pd(
-        v56,
-        runtime::lanes::from_array(p[11usize]),
-        v534,
-    );
-    let v536: __m256d = _mm256_mul_pd(v121, runtime::lanes::from_array(p[10usize]));
-    let v537: __m256d = _mm256_fmadd_pd(
-        v63,
-        runtime::lanes::from_array(p[11usize]),
-        v536,
-    );
-    out[0usize] = runtime::lanes::to_array(v14);
-    out[1usize] = runtime::lanes::to_array(v22);
-    out[2usize] = runtime::lanes::to_array(v28);
-    out[3usize] = runtime::lanes::to_array(v29);
-    out[4usize] = runtime::lanes::to_array(v30);
-    out[5usize] = runtime::lanes::to_array(v35);
-    out[6usize] = runtime::lanes::to_array(v36);
-    out[7usize] = runtime::lanes::to_array(v37);
-    out[8usize] = runtime::lanes::to_array(v38);
-    out[9usize] = runtime::lanes::to_array(v55);
-    out[10usize] = runtime::lanes::to_array(v62);
-    out[11usize] = runtime::lanes::to_array(v69);
-    out[12usize] = runtime::lanes::to_array(v105);
-    out[13usize] = runtime::lanes::to_array(v120);
-    out[14usize] = runtime::lanes::to_array(v135);
-    out[15usize] = runtime::lanes::to_array(v166);
-    out[16usize] = runtime::lanes::to_array(v178);
-    out[17usize] = runtime::lanes::to_array(v190);
-    out[18usize] = runtime::lanes::to_array(v199);
-    out[19usize] = runtime::lanes::to_array(v205);
-    out[20usize] = runtime::lanes::to_array(v211);
-    out[21usize] = runtime::lanes::to_array(v225);
-    out[22usize] = runtime::lanes::to_array(v228);
-    out[23usize] = runtime::lanes::to_array(v231);
-    out[24usize] = runtime::lanes::to_array(v235);
-    out[25usize] = runtime::lanes::to_array(v237);
-    out[26usize] = runtime::lanes::to_array(v239);
-    out[27usize] = runtime::lanes::to_array(v246);
-    out[28usize] = runtime::lanes::to_array(v251);
-    out[29usize] = runtime::lanes::to_array(v256);
-    out[30usize] = runtime::lanes::to_array(v267);
-    out[31usize] = runtime::lanes::to_array(v274);
-    out[32usize] = runtime::lanes::to_array(v281);
-    out[33usize] = runtime::lanes::to_array(v298);
-    out[34usize] = runtime::lanes::to_array(v304);
-    out[35usize] = runtime::lanes::to_array(v310);
-    out[36usize] = runtime::lanes::to_array(v329);
-    out[37usize] = runtime::lanes::to_array(v332);
-    out[38usize] = runtime::lanes::to_array(v335);
-    out[39usize] = runtime::lanes::to_array(v338);
-    out[40usize] = runtime::lanes::to_array(v341);
-    out[41usize] = runtime::lanes::to_array(v344);
-    out[42usize] = runtime::lanes::to_array(v346);
-    out[43usize] = runtime::lanes::to_array(v352);
-    out[44usize] = runtime::lanes::to_array(v353);
-    out[45usize] = runtime::lanes::to_array(v358);
-    out[46usize] = runtime::lanes::to_array(v361);
-    out[47usize] = runtime::lanes::to_array(v365);
-    out[48usize] = runtime::lanes::to_array(v374);
-    out[49usize] = runtime::lanes::to_array(v380);
-    out[50usize] = runtime::lanes::to_array(v387);
-    out[51usize] = runtime::lanes::to_array(v393);
-    out[52usize] = runtime::lanes::to_array(v396);
-    out[53usize] = runtime::lanes::to_array(v400);
-    out[54usize] = runtime::lanes::to_array(v405);
-    out[55usize] = runtime::lanes::to_array(v408);
-    out[56usize] = runtime::lanes::to_array(v412);
-    out[57usize] = runtime::lanes::to_array(v416);
-    out[58usize] = runtime::lanes::to_array(v417);
-    out[59usize] = runtime::lanes::to_array(v419);
-    out[60usize] = runtime::lanes::to_array(v427);
-    out[61usize] = runtime::lanes::to_array(v432);
-    out[62usize] = runtime::lanes::to_array(v437);
-    out[63usize] = runtime::lanes::to_array(v442);
-    out[64usize] = runtime::lanes::to_array(v443);
-    out[65usize] = runtime::lanes::to_array(v445);
-    out[66usize] = runtime::lanes::to_array(v450);
-    out[67usize] = runtime::lanes::to_array(v453);
-    out[68usize] = runtime::lanes::to_array(v456);
-    out[69usize] = runtime::lanes::to_array(v458);
-    out[70usize] = runtime::lanes::to_array(v459);
-    out[71usize] = runtime::lanes::to_array(v460);
-    out[72usize] = runtime::lanes::to_array(v467);
-    out[73usize] = runtime::lanes::to_array(v472);
-    out[74usize] = runtime::lanes::to_array(v477);
-    out[75usize] = runtime::lanes::to_array(v479);
-    out[76usize] = runtime::lanes::to_array(v480);
-    out[77usize] = runtime::lanes::to_array(v481);
-    out[78usize] = runtime::lanes::to_array(v485);
-    out[79usize] = runtime::lanes::to_array(v488);
-    out[80usize] = runtime::lanes::to_array(v491);
-    out[81usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[82usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[83usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[84usize] = runtime::lanes::to_array(v495);
-    out[85usize] = runtime::lanes::to_array(v459);
-    out[86usize] = runtime::lanes::to_array(v460);
-    out[87usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[88usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[89usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[90usize] = runtime::lanes::to_array(v496);
-    out[91usize] = runtime::lanes::to_array(v499);
-    out[92usize] = runtime::lanes::to_array(v502);
-    out[93usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[94usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[95usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[96usize] = runtime::lanes::to_array(v358);
-    out[97usize] = runtime::lanes::to_array(v504);
-    out[98usize] = runtime::lanes::to_array(v365);
-    out[99usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[100usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[101usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[102usize] = runtime::lanes::to_array(v505);
-    out[103usize] = runtime::lanes::to_array(v506);
-    out[104usize] = runtime::lanes::to_array(v509);
-    out[105usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[106usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[107usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[108usize] = runtime::lanes::to_array(v416);
-    out[109usize] = runtime::lanes::to_array(v417);
-    out[110usize] = runtime::lanes::to_array(v511);
-    out[111usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[112usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[113usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[114usize] = runtime::lanes::to_array(v512);
-    out[115usize] = runtime::lanes::to_array(v513);
-    out[116usize] = runtime::lanes::to_array(v514);
-    out[117usize] = runtime::lanes::to_array(v518);
-    out[118usize] = runtime::lanes::to_array(v523);
-    out[119usize] = runtime::lanes::to_array(v527);
-    out[120usize] = runtime::lanes::to_array(v532);
-    out[121usize] = runtime::lanes::to_array(v535);
-    out[122usize] = runtime::lanes::to_array(v537);
-    out[123usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[124usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[125usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[126usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[127usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[128usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    let v521 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[4]));
+    let v522 = _mm256_mul_pd(v127, runtime::lanes::from_array(p[5]));
+    let v523 = _mm256_fmadd_pd(v521, v520, v522);
+    let v526 = _mm256_mul_pd(v90, runtime::lanes::from_array(p[8]));
+    let v527 = _mm256_fmadd_pd(v33, runtime::lanes::from_array(p[7]), v526);
+    let v529 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[3]));
+    let v531 = _mm256_mul_pd(v71, runtime::lanes::from_array(p[10]));
+    let v532 = _mm256_fmadd_pd(v529, runtime::lanes::from_array(p[9]), v531);
+    let v534 = _mm256_mul_pd(v106, runtime::lanes::from_array(p[10]));
+    let v535 = _mm256_fmadd_pd(v56, runtime::lanes::from_array(p[11]), v534);
+    let v536 = _mm256_mul_pd(v121, runtime::lanes::from_array(p[10]));
+    let v537 = _mm256_fmadd_pd(v63, runtime::lanes::from_array(p[11]), v536);
+    out[0] = runtime::lanes::to_array(v14);
+    out[1] = runtime::lanes::to_array(v22);
+    out[2] = runtime::lanes::to_array(v28);
+    out[3] = runtime::lanes::to_array(v29);
+    out[4] = runtime::lanes::to_array(v30);
+    out[5] = runtime::lanes::to_array(v35);
+    out[6] = runtime::lanes::to_array(v36);
+    out[7] = runtime::lanes::to_array(v37);
+    out[8] = runtime::lanes::to_array(v38);
+    out[9] = runtime::lanes::to_array(v55);
+    out[10] = runtime::lanes::to_array(v62);
+    out[11] = runtime::lanes::to_array(v69);
+    out[12] = runtime::lanes::to_array(v105);
+    out[13] = runtime::lanes::to_array(v120);
+    out[14] = runtime::lanes::to_array(v135);
+    out[15] = runtime::lanes::to_array(v166);
+    out[16] = runtime::lanes::to_array(v178);
+    out[17] = runtime::lanes::to_array(v190);
+    out[18] = runtime::lanes::to_array(v199);
+    out[19] = runtime::lanes::to_array(v205);
+    out[20] = runtime::lanes::to_array(v211);
+    out[21] = runtime::lanes::to_array(v225);
+    out[22] = runtime::lanes::to_array(v228);
+    out[23] = runtime::lanes::to_array(v231);
+    out[24] = runtime::lanes::to_array(v235);
+    out[25] = runtime::lanes::to_array(v237);
+    out[26] = runtime::lanes::to_array(v239);
+    out[27] = runtime::lanes::to_array(v246);
+    out[28] = runtime::lanes::to_array(v251);
+    out[29] = runtime::lanes::to_array(v256);
+    out[30] = runtime::lanes::to_array(v267);
+    out[31] = runtime::lanes::to_array(v274);
+    out[32] = runtime::lanes::to_array(v281);
+    out[33] = runtime::lanes::to_array(v298);
+    out[34] = runtime::lanes::to_array(v304);
+    out[35] = runtime::lanes::to_array(v310);
+    out[36] = runtime::lanes::to_array(v329);
+    out[37] = runtime::lanes::to_array(v332);
+    out[38] = runtime::lanes::to_array(v335);
+    out[39] = runtime::lanes::to_array(v338);
+    out[40] = runtime::lanes::to_array(v341);
+    out[41] = runtime::lanes::to_array(v344);
+    out[42] = runtime::lanes::to_array(v346);
+    out[43] = runtime::lanes::to_array(v352);
+    out[44] = runtime::lanes::to_array(v353);
+    out[45] = runtime::lanes::to_array(v358);
+    out[46] = runtime::lanes::to_array(v361);
+    out[47] = runtime::lanes::to_array(v365);
+    out[48] = runtime::lanes::to_array(v374);
+    out[49] = runtime::lanes::to_array(v380);
+    out[50] = runtime::lanes::to_array(v387);
+    out[51] = runtime::lanes::to_array(v393);
+    out[52] = runtime::lanes::to_array(v396);
+    out[53] = runtime::lanes::to_array(v400);
+    out[54] = runtime::lanes::to_array(v405);
+    out[55] = runtime::lanes::to_array(v408);
+    out[56] = runtime::lanes::to_array(v412);
+    out[57] = runtime::lanes::to_array(v416);
+    out[58] = runtime::lanes::to_array(v417);
+    out[59] = runtime::lanes::to_array(v419);
+    out[60] = runtime::lanes::to_array(v427);
+    out[61] = runtime::lanes::to_array(v432);
+    out[62] = runtime::lanes::to_array(v437);
+    out[63] = runtime::lanes::to_array(v442);
+    out[64] = runtime::lanes::to_array(v443);
+    out[65] = runtime::lanes::to_array(v445);
+    out[66] = runtime::lanes::to_array(v450);
+    out[67] = runtime::lanes::to_array(v453);
+    out[68] = runtime::lanes::to_array(v456);
+    out[69] = runtime::lanes::to_array(v458);
+    out[70] = runtime::lanes::to_array(v459);
+    out[71] = runtime::lanes::to_array(v460);
+    out[72] = runtime::lanes::to_array(v467);
+    out[73] = runtime::lanes::to_array(v472);
+    out[74] = runtime::lanes::to_array(v477);
+    out[75] = runtime::lanes::to_array(v479);
+    out[76] = runtime::lanes::to_array(v480);
+    out[77] = runtime::lanes::to_array(v481);
+    out[78] = runtime::lanes::to_array(v485);
+    out[79] = runtime::lanes::to_array(v488);
+    out[80] = runtime::lanes::to_array(v491);
+    out[81] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[82] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[83] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[84] = runtime::lanes::to_array(v495);
+    out[85] = runtime::lanes::to_array(v459);
+    out[86] = runtime::lanes::to_array(v460);
+    out[87] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[88] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[89] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[90] = runtime::lanes::to_array(v496);
+    out[91] = runtime::lanes::to_array(v499);
+    out[92] = runtime::lanes::to_array(v502);
+    out[93] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[94] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[95] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[96] = runtime::lanes::to_array(v358);
+    out[97] = runtime::lanes::to_array(v504);
+    out[98] = runtime::lanes::to_array(v365);
+    out[99] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[100] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[101] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[102] = runtime::lanes::to_array(v505);
+    out[103] = runtime::lanes::to_array(v506);
+    out[104] = runtime::lanes::to_array(v509);
+    out[105] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[106] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[107] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[108] = runtime::lanes::to_array(v416);
+    out[109] = runtime::lanes::to_array(v417);
+    out[110] = runtime::lanes::to_array(v511);
+    out[111] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[112] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[113] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[114] = runtime::lanes::to_array(v512);
+    out[115] = runtime::lanes::to_array(v513);
+    out[116] = runtime::lanes::to_array(v514);
+    out[117] = runtime::lanes::to_array(v518);
+    out[118] = runtime::lanes::to_array(v523);
+    out[119] = runtime::lanes::to_array(v527);
+    out[120] = runtime::lanes::to_array(v532);
+    out[121] = runtime::lanes::to_array(v535);
+    out[122] = runtime::lanes::to_array(v537);
+    out[123] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[124] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[125] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[126] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[127] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[128] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
 }
 /// Kernel `cell_0_tangent`: 2244 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0_tangent(
     t: f64,
-    q: &[f64; 6usize],
-    qd: &[f64; 6usize],
-    qdd: &[f64; 6usize],
-    dir: &[f64; 12usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 258usize],
+    q: &[f64; 6],
+    qd: &[f64; 6],
+    qdd: &[f64; 6],
+    dir: &[f64; 12],
+    p: &[f64; 15],
+    out: &mut [f64; 258],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2882,1735 +2625,1735 @@ pub fn cell_0_tangent(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
-    q: &[f64; 6usize],
-    qd: &[f64; 6usize],
-    qdd: &[f64; 6usize],
-    dir: &[f64; 12usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 258usize],
+    q: &[f64; 6],
+    qd: &[f64; 6],
+    qdd: &[f64; 6],
+    dir: &[f64; 12],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 258],
 ) {
-    let v1: f64 = q[0usize] * q[0usize];
-    let v3: f64 = 0.25f64 * v1;
-    let v5: f64 = q[2usize] * q[2usize];
-    let v6: f64 = 0.25f64 * v5;
-    let v8: f64 = q[1usize] * q[1usize];
-    let v9: f64 = 0.25f64 * v8;
-    let v10: f64 = v3 + v6;
-    let v11: f64 = v10 + v9;
-    let c: [[f64; 4usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        4usize,
+    let v1 = q[0] * q[0];
+    let v3 = 0.25f64 * v1;
+    let v5 = q[2] * q[2];
+    let v6 = 0.25f64 * v5;
+    let v8 = q[1] * q[1];
+    let v9 = 0.25f64 * v8;
+    let v10 = v3 + v6;
+    let v11 = v10 + v9;
+    let c: [[f64; 4]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        4,
     >(v11);
-    let v12: f64 = c[0usize][0usize];
-    let v13: f64 = c[2usize][0usize];
-    let v18: f64 = c[1usize][0usize];
-    let v47: f64 = c[3usize][0usize];
-    let v78: f64 = c[2usize][1usize];
-    let v88: f64 = c[3usize][1usize];
-    let v144: f64 = c[2usize][2usize];
-    let v152: f64 = c[3usize][2usize];
-    let v221: f64 = c[1usize][1usize];
-    let v234: f64 = c[4usize][0usize];
-    let v242: f64 = c[4usize][1usize];
-    let v261: f64 = c[4usize][2usize];
-    let v549: f64 = c[0usize][1usize];
-    let v762: f64 = c[2usize][3usize];
-    let v774: f64 = c[3usize][3usize];
-    let v904: f64 = c[1usize][2usize];
-    let v984: f64 = c[4usize][3usize];
-    let v14: f64 = v6.mul_add(v13, v12);
-    let v15: f64 = 0.25f64 * q[0usize];
-    let v16: f64 = v15 * q[2usize];
-    let v17: f64 = v16 * v13;
-    let v20: f64 = 0.5f64 * q[1usize];
-    let v21: f64 = v20 * v18;
-    let v22: f64 = v17 - v21;
-    let v23: f64 = 0.25f64 * q[1usize];
-    let v24: f64 = v23 * q[2usize];
-    let v25: f64 = v24 * v13;
-    let v26: f64 = 0.5f64 * q[0usize];
-    let v27: f64 = v26 * v18;
-    let v28: f64 = v25 + v27;
-    let v29: f64 = v17 + v21;
-    let v30: f64 = v3.mul_add(v13, v12);
-    let v31: f64 = v15 * q[1usize];
-    let v32: f64 = v31 * v13;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let v34: f64 = v33 * v18;
-    let v35: f64 = v32 - v34;
-    let v36: f64 = v25 - v27;
-    let v37: f64 = v32 + v34;
-    let v38: f64 = v9.mul_add(v13, v12);
-    let v41: f64 = q[3usize] + p[0usize];
-    let v42: f64 = 0.5f64 * v41;
-    let v45: f64 = v23 * q[4usize];
-    let v46: f64 = v15.mul_add(q[5usize], -v45);
-    let v48: f64 = 0.25f64 * q[2usize];
-    let v49: f64 = v15 * q[4usize];
-    let v50: f64 = v48.mul_add(v41, v49);
-    let v51: f64 = v23.mul_add(q[5usize], v50);
-    let v52: f64 = v42 * v11;
-    let v53: f64 = v33.mul_add(v51, -v52);
-    let v54: f64 = v13.mul_add(v46, v42);
-    let v55: f64 = v47.mul_add(v53, v54);
-    let v56: f64 = 0.5f64 * q[4usize];
-    let v57: f64 = v48 * q[5usize];
-    let v58: f64 = v23.mul_add(v41, -v57);
-    let v59: f64 = v56 * v11;
-    let v60: f64 = v26.mul_add(v51, -v59);
-    let v61: f64 = v13.mul_add(v58, v56);
-    let v62: f64 = v47.mul_add(v60, v61);
-    let v63: f64 = 0.5f64 * q[5usize];
-    let v64: f64 = v15 * v41;
-    let v65: f64 = v48.mul_add(q[4usize], -v64);
-    let v66: f64 = v63 * v11;
-    let v67: f64 = v20.mul_add(v51, -v66);
-    let v68: f64 = v13.mul_add(v65, v63);
-    let v69: f64 = v47.mul_add(v67, v68);
-    let v71: f64 = 0.5f64 * qd[3usize];
-    let v74: f64 = v26 * qd[0usize];
-    let v76: f64 = v33.mul_add(qd[2usize], v74);
-    let v77: f64 = v20.mul_add(qd[1usize], v76);
-    let v79: f64 = v77 * v78;
-    let v80: f64 = 0.25f64 * q[5usize];
-    let v82: f64 = v15 * qd[5usize];
-    let v83: f64 = 0.25f64 * q[4usize];
-    let v85: f64 = v80.mul_add(qd[0usize], v82);
-    let v86: f64 = (-v83).mul_add(qd[1usize], v85);
-    let v87: f64 = (-v23).mul_add(qd[4usize], v86);
-    let v89: f64 = v77 * v88;
-    let v90: f64 = 0.5f64 * qd[2usize];
-    let v91: f64 = 0.25f64 * qd[2usize];
-    let v92: f64 = v48 * qd[3usize];
-    let v93: f64 = v91.mul_add(v41, v92);
-    let v94: f64 = v83.mul_add(qd[0usize], v93);
-    let v95: f64 = v15.mul_add(qd[4usize], v94);
-    let v96: f64 = v80.mul_add(qd[1usize], v95);
-    let v97: f64 = v23.mul_add(qd[5usize], v96);
-    let v98: f64 = v33 * v97;
-    let v99: f64 = v90.mul_add(v51, v98);
-    let v100: f64 = (-v71).mul_add(v11, v99);
-    let v101: f64 = (-v42).mul_add(v77, v100);
-    let v102: f64 = v46.mul_add(v79, v71);
-    let v103: f64 = v13.mul_add(v87, v102);
-    let v104: f64 = v53.mul_add(v89, v103);
-    let v105: f64 = v47.mul_add(v101, v104);
-    let v106: f64 = 0.5f64 * qd[4usize];
-    let v107: f64 = 0.25f64 * qd[1usize];
-    let v108: f64 = v23 * qd[3usize];
-    let v109: f64 = v107.mul_add(v41, v108);
-    let v110: f64 = (-v80).mul_add(qd[2usize], v109);
-    let v111: f64 = (-v48).mul_add(qd[5usize], v110);
-    let v112: f64 = 0.5f64 * qd[0usize];
-    let v113: f64 = v26 * v97;
-    let v114: f64 = v112.mul_add(v51, v113);
-    let v115: f64 = (-v106).mul_add(v11, v114);
-    let v116: f64 = (-v56).mul_add(v77, v115);
-    let v117: f64 = v58.mul_add(v79, v106);
-    let v118: f64 = v13.mul_add(v111, v117);
-    let v119: f64 = v60.mul_add(v89, v118);
-    let v120: f64 = v47.mul_add(v116, v119);
-    let v121: f64 = 0.5f64 * qd[5usize];
-    let v122: f64 = v48 * qd[4usize];
-    let v123: f64 = 0.25f64 * qd[0usize];
-    let v124: f64 = v83.mul_add(qd[2usize], v122);
-    let v125: f64 = (-v123).mul_add(v41, v124);
-    let v126: f64 = (-v15).mul_add(qd[3usize], v125);
-    let v127: f64 = 0.5f64 * qd[1usize];
-    let v128: f64 = v20 * v97;
-    let v129: f64 = v127.mul_add(v51, v128);
-    let v130: f64 = (-v121).mul_add(v11, v129);
-    let v131: f64 = (-v63).mul_add(v77, v130);
-    let v132: f64 = v65.mul_add(v79, v121);
-    let v133: f64 = v13.mul_add(v126, v132);
-    let v134: f64 = v67.mul_add(v89, v133);
-    let v135: f64 = v47.mul_add(v131, v134);
-    let v137: f64 = 2f64 * v79;
-    let v138: f64 = qd[0usize] * qd[0usize];
-    let v139: f64 = qd[1usize] * qd[1usize];
-    let v140: f64 = 0.5f64 * v139;
-    let v141: f64 = qd[2usize] * qd[2usize];
-    let v142: f64 = 0.5f64.mul_add(v138, v140);
-    let v143: f64 = 0.5f64.mul_add(v141, v142);
-    let v145: f64 = v77 * v77;
-    let v146: f64 = v144 * v145;
-    let v147: f64 = v78.mul_add(v143, v146);
-    let v148: f64 = v46 * v147;
-    let v149: f64 = v127 * qd[4usize];
-    let v150: f64 = v112.mul_add(qd[5usize], -v149);
-    let v151: f64 = 2f64 * v89;
-    let v153: f64 = v145 * v152;
-    let v154: f64 = v88.mul_add(v143, v153);
-    let v155: f64 = v112 * qd[4usize];
-    let v156: f64 = v90.mul_add(qd[3usize], v155);
-    let v157: f64 = v127.mul_add(qd[5usize], v156);
-    let v158: f64 = v33 * v157;
-    let v159: f64 = qd[2usize].mul_add(v97, v158);
-    let v160: f64 = (-qd[3usize]).mul_add(v77, v159);
-    let v161: f64 = (-v42).mul_add(v143, v160);
-    let v162: f64 = v137.mul_add(v87, v148);
-    let v163: f64 = v13.mul_add(v150, v162);
-    let v164: f64 = v151.mul_add(v101, v163);
-    let v165: f64 = v53.mul_add(v154, v164);
-    let v166: f64 = v47.mul_add(v161, v165);
-    let v167: f64 = v58 * v147;
-    let v168: f64 = v90 * qd[5usize];
-    let v169: f64 = v127.mul_add(qd[3usize], -v168);
-    let v170: f64 = v26 * v157;
-    let v171: f64 = qd[0usize].mul_add(v97, v170);
-    let v172: f64 = (-qd[4usize]).mul_add(v77, v171);
-    let v173: f64 = (-v56).mul_add(v143, v172);
-    let v174: f64 = v137.mul_add(v111, v167);
-    let v175: f64 = v13.mul_add(v169, v174);
-    let v176: f64 = v151.mul_add(v116, v175);
-    let v177: f64 = v60.mul_add(v154, v176);
-    let v178: f64 = v47.mul_add(v173, v177);
-    let v179: f64 = v65 * v147;
-    let v180: f64 = v112 * qd[3usize];
-    let v181: f64 = v90.mul_add(qd[4usize], -v180);
-    let v182: f64 = v20 * v157;
-    let v183: f64 = qd[1usize].mul_add(v97, v182);
-    let v184: f64 = (-qd[5usize]).mul_add(v77, v183);
-    let v185: f64 = (-v63).mul_add(v143, v184);
-    let v186: f64 = v137.mul_add(v126, v179);
-    let v187: f64 = v13.mul_add(v181, v186);
-    let v188: f64 = v151.mul_add(v131, v187);
-    let v189: f64 = v67.mul_add(v154, v188);
-    let v190: f64 = v47.mul_add(v185, v189);
-    let v191: f64 = v23 * qd[0usize];
-    let v192: f64 = v15.mul_add(qd[1usize], -v191);
-    let v193: f64 = v90 * v18;
-    let v194: f64 = v15 * qd[0usize];
-    let v195: f64 = v48.mul_add(qd[2usize], v194);
-    let v196: f64 = v23.mul_add(qd[1usize], v195);
-    let v197: f64 = v33 * v47;
-    let v198: f64 = v13.mul_add(v192, v193);
-    let v199: f64 = v197.mul_add(v196, v198);
-    let v200: f64 = v48 * qd[1usize];
-    let v201: f64 = v23.mul_add(qd[2usize], -v200);
-    let v202: f64 = v112 * v18;
-    let v203: f64 = v26 * v47;
-    let v204: f64 = v13.mul_add(v201, v202);
-    let v205: f64 = v203.mul_add(v196, v204);
-    let v206: f64 = v15 * qd[2usize];
-    let v207: f64 = v48.mul_add(qd[0usize], -v206);
-    let v208: f64 = v127 * v18;
-    let v209: f64 = v20 * v47;
-    let v210: f64 = v13.mul_add(v207, v208);
-    let v211: f64 = v209.mul_add(v196, v210);
-    let v212: f64 = 0.5f64 * v196;
-    let v213: f64 = v212 * v89;
-    let v214: f64 = 0.25f64 * v139;
-    let v215: f64 = 0.25f64.mul_add(v138, v214);
-    let v216: f64 = 0.25f64.mul_add(v141, v215);
-    let v217: f64 = 0.5f64 * v47;
-    let v218: f64 = v217.mul_add(v216, v213);
-    let v219: f64 = q[2usize] * v218;
-    let v220: f64 = v217 * v196;
-    let v222: f64 = v77 * v221;
-    let v223: f64 = 0.5f64 * v222;
-    let v224: f64 = v220 + v223;
-    let v225: f64 = v192.mul_add(v79, v219);
-    let v226: f64 = qd[2usize].mul_add(v224, v225);
-    let v227: f64 = q[0usize] * v218;
-    let v228: f64 = v201.mul_add(v79, v227);
-    let v229: f64 = qd[0usize].mul_add(v224, v228);
-    let v230: f64 = q[1usize] * v218;
-    let v231: f64 = v207.mul_add(v79, v230);
-    let v232: f64 = qd[1usize].mul_add(v224, v231);
-    let v233: f64 = 0.25f64 * v41;
-    let v235: f64 = v47.mul_add(v46, v233);
-    let v236: f64 = v234.mul_add(v53, v235);
-    let v237: f64 = v47.mul_add(v58, v83);
-    let v238: f64 = v234.mul_add(v60, v237);
-    let v239: f64 = v47.mul_add(v65, v80);
-    let v240: f64 = v234.mul_add(v67, v239);
-    let v241: f64 = 0.25f64 * qd[3usize];
-    let v243: f64 = v77 * v242;
-    let v244: f64 = v46.mul_add(v89, v241);
-    let v245: f64 = v47.mul_add(v87, v244);
-    let v246: f64 = v53.mul_add(v243, v245);
-    let v247: f64 = v234.mul_add(v101, v246);
-    let v248: f64 = 0.25f64 * qd[4usize];
-    let v249: f64 = v58.mul_add(v89, v248);
-    let v250: f64 = v47.mul_add(v111, v249);
-    let v251: f64 = v60.mul_add(v243, v250);
-    let v252: f64 = v234.mul_add(v116, v251);
-    let v253: f64 = 0.25f64 * qd[5usize];
-    let v254: f64 = v65.mul_add(v89, v253);
-    let v255: f64 = v47.mul_add(v126, v254);
-    let v256: f64 = v67.mul_add(v243, v255);
-    let v257: f64 = v234.mul_add(v131, v256);
-    let v258: f64 = 2f64 * v87;
-    let v259: f64 = v46 * v154;
-    let v260: f64 = 2f64 * v101;
-    let v262: f64 = v145 * v261;
-    let v263: f64 = v143.mul_add(v242, v262);
-    let v264: f64 = v258.mul_add(v89, v259);
-    let v265: f64 = v47.mul_add(v150, v264);
-    let v266: f64 = v260.mul_add(v243, v265);
-    let v267: f64 = v53.mul_add(v263, v266);
-    let v268: f64 = v234.mul_add(v161, v267);
-    let v269: f64 = v58 * v154;
-    let v270: f64 = 2f64 * v116;
-    let v271: f64 = v151.mul_add(v111, v269);
-    let v272: f64 = v47.mul_add(v169, v271);
-    let v273: f64 = v270.mul_add(v243, v272);
-    let v274: f64 = v60.mul_add(v263, v273);
-    let v275: f64 = v234.mul_add(v173, v274);
-    let v276: f64 = v65 * v154;
-    let v277: f64 = 2f64 * v131;
-    let v278: f64 = v151.mul_add(v126, v276);
-    let v279: f64 = v47.mul_add(v181, v278);
-    let v280: f64 = v277.mul_add(v243, v279);
-    let v281: f64 = v67.mul_add(v263, v280);
-    let v282: f64 = v234.mul_add(v185, v281);
-    let v283: f64 = 0.25f64 * v11;
-    let c: [[f64; 3usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        3usize,
+    let v12: f64 = c[0][0];
+    let v13: f64 = c[2][0];
+    let v18: f64 = c[1][0];
+    let v47: f64 = c[3][0];
+    let v78: f64 = c[2][1];
+    let v88: f64 = c[3][1];
+    let v144: f64 = c[2][2];
+    let v152: f64 = c[3][2];
+    let v221: f64 = c[1][1];
+    let v234: f64 = c[4][0];
+    let v242: f64 = c[4][1];
+    let v261: f64 = c[4][2];
+    let v549: f64 = c[0][1];
+    let v762: f64 = c[2][3];
+    let v774: f64 = c[3][3];
+    let v904: f64 = c[1][2];
+    let v984: f64 = c[4][3];
+    let v14 = v6.mul_add(v13, v12);
+    let v15 = 0.25f64 * q[0];
+    let v16 = v15 * q[2];
+    let v17 = v16 * v13;
+    let v20 = 0.5f64 * q[1];
+    let v21 = v20 * v18;
+    let v22 = v17 - v21;
+    let v23 = 0.25f64 * q[1];
+    let v24 = v23 * q[2];
+    let v25 = v24 * v13;
+    let v26 = 0.5f64 * q[0];
+    let v27 = v26 * v18;
+    let v28 = v25 + v27;
+    let v29 = v17 + v21;
+    let v30 = v3.mul_add(v13, v12);
+    let v31 = v15 * q[1];
+    let v32 = v31 * v13;
+    let v33 = 0.5f64 * q[2];
+    let v34 = v33 * v18;
+    let v35 = v32 - v34;
+    let v36 = v25 - v27;
+    let v37 = v32 + v34;
+    let v38 = v9.mul_add(v13, v12);
+    let v41 = q[3] + p[0];
+    let v42 = 0.5f64 * v41;
+    let v45 = v23 * q[4];
+    let v46 = v15.mul_add(q[5], -v45);
+    let v48 = 0.25f64 * q[2];
+    let v49 = v15 * q[4];
+    let v50 = v48.mul_add(v41, v49);
+    let v51 = v23.mul_add(q[5], v50);
+    let v52 = v42 * v11;
+    let v53 = v33.mul_add(v51, -v52);
+    let v54 = v13.mul_add(v46, v42);
+    let v55 = v47.mul_add(v53, v54);
+    let v56 = 0.5f64 * q[4];
+    let v57 = v48 * q[5];
+    let v58 = v23.mul_add(v41, -v57);
+    let v59 = v56 * v11;
+    let v60 = v26.mul_add(v51, -v59);
+    let v61 = v13.mul_add(v58, v56);
+    let v62 = v47.mul_add(v60, v61);
+    let v63 = 0.5f64 * q[5];
+    let v64 = v15 * v41;
+    let v65 = v48.mul_add(q[4], -v64);
+    let v66 = v63 * v11;
+    let v67 = v20.mul_add(v51, -v66);
+    let v68 = v13.mul_add(v65, v63);
+    let v69 = v47.mul_add(v67, v68);
+    let v71 = 0.5f64 * qd[3];
+    let v74 = v26 * qd[0];
+    let v76 = v33.mul_add(qd[2], v74);
+    let v77 = v20.mul_add(qd[1], v76);
+    let v79 = v77 * v78;
+    let v80 = 0.25f64 * q[5];
+    let v82 = v15 * qd[5];
+    let v83 = 0.25f64 * q[4];
+    let v85 = v80.mul_add(qd[0], v82);
+    let v86 = (-v83).mul_add(qd[1], v85);
+    let v87 = (-v23).mul_add(qd[4], v86);
+    let v89 = v77 * v88;
+    let v90 = 0.5f64 * qd[2];
+    let v91 = 0.25f64 * qd[2];
+    let v92 = v48 * qd[3];
+    let v93 = v91.mul_add(v41, v92);
+    let v94 = v83.mul_add(qd[0], v93);
+    let v95 = v15.mul_add(qd[4], v94);
+    let v96 = v80.mul_add(qd[1], v95);
+    let v97 = v23.mul_add(qd[5], v96);
+    let v98 = v33 * v97;
+    let v99 = v90.mul_add(v51, v98);
+    let v100 = (-v71).mul_add(v11, v99);
+    let v101 = (-v42).mul_add(v77, v100);
+    let v102 = v46.mul_add(v79, v71);
+    let v103 = v13.mul_add(v87, v102);
+    let v104 = v53.mul_add(v89, v103);
+    let v105 = v47.mul_add(v101, v104);
+    let v106 = 0.5f64 * qd[4];
+    let v107 = 0.25f64 * qd[1];
+    let v108 = v23 * qd[3];
+    let v109 = v107.mul_add(v41, v108);
+    let v110 = (-v80).mul_add(qd[2], v109);
+    let v111 = (-v48).mul_add(qd[5], v110);
+    let v112 = 0.5f64 * qd[0];
+    let v113 = v26 * v97;
+    let v114 = v112.mul_add(v51, v113);
+    let v115 = (-v106).mul_add(v11, v114);
+    let v116 = (-v56).mul_add(v77, v115);
+    let v117 = v58.mul_add(v79, v106);
+    let v118 = v13.mul_add(v111, v117);
+    let v119 = v60.mul_add(v89, v118);
+    let v120 = v47.mul_add(v116, v119);
+    let v121 = 0.5f64 * qd[5];
+    let v122 = v48 * qd[4];
+    let v123 = 0.25f64 * qd[0];
+    let v124 = v83.mul_add(qd[2], v122);
+    let v125 = (-v123).mul_add(v41, v124);
+    let v126 = (-v15).mul_add(qd[3], v125);
+    let v127 = 0.5f64 * qd[1];
+    let v128 = v20 * v97;
+    let v129 = v127.mul_add(v51, v128);
+    let v130 = (-v121).mul_add(v11, v129);
+    let v131 = (-v63).mul_add(v77, v130);
+    let v132 = v65.mul_add(v79, v121);
+    let v133 = v13.mul_add(v126, v132);
+    let v134 = v67.mul_add(v89, v133);
+    let v135 = v47.mul_add(v131, v134);
+    let v137 = 2f64 * v79;
+    let v138 = qd[0] * qd[0];
+    let v139 = qd[1] * qd[1];
+    let v140 = 0.5f64 * v139;
+    let v141 = qd[2] * qd[2];
+    let v142 = 0.5f64.mul_add(v138, v140);
+    let v143 = 0.5f64.mul_add(v141, v142);
+    let v145 = v77 * v77;
+    let v146 = v144 * v145;
+    let v147 = v78.mul_add(v143, v146);
+    let v148 = v46 * v147;
+    let v149 = v127 * qd[4];
+    let v150 = v112.mul_add(qd[5], -v149);
+    let v151 = 2f64 * v89;
+    let v153 = v145 * v152;
+    let v154 = v88.mul_add(v143, v153);
+    let v155 = v112 * qd[4];
+    let v156 = v90.mul_add(qd[3], v155);
+    let v157 = v127.mul_add(qd[5], v156);
+    let v158 = v33 * v157;
+    let v159 = qd[2].mul_add(v97, v158);
+    let v160 = (-qd[3]).mul_add(v77, v159);
+    let v161 = (-v42).mul_add(v143, v160);
+    let v162 = v137.mul_add(v87, v148);
+    let v163 = v13.mul_add(v150, v162);
+    let v164 = v151.mul_add(v101, v163);
+    let v165 = v53.mul_add(v154, v164);
+    let v166 = v47.mul_add(v161, v165);
+    let v167 = v58 * v147;
+    let v168 = v90 * qd[5];
+    let v169 = v127.mul_add(qd[3], -v168);
+    let v170 = v26 * v157;
+    let v171 = qd[0].mul_add(v97, v170);
+    let v172 = (-qd[4]).mul_add(v77, v171);
+    let v173 = (-v56).mul_add(v143, v172);
+    let v174 = v137.mul_add(v111, v167);
+    let v175 = v13.mul_add(v169, v174);
+    let v176 = v151.mul_add(v116, v175);
+    let v177 = v60.mul_add(v154, v176);
+    let v178 = v47.mul_add(v173, v177);
+    let v179 = v65 * v147;
+    let v180 = v112 * qd[3];
+    let v181 = v90.mul_add(qd[4], -v180);
+    let v182 = v20 * v157;
+    let v183 = qd[1].mul_add(v97, v182);
+    let v184 = (-qd[5]).mul_add(v77, v183);
+    let v185 = (-v63).mul_add(v143, v184);
+    let v186 = v137.mul_add(v126, v179);
+    let v187 = v13.mul_add(v181, v186);
+    let v188 = v151.mul_add(v131, v187);
+    let v189 = v67.mul_add(v154, v188);
+    let v190 = v47.mul_add(v185, v189);
+    let v191 = v23 * qd[0];
+    let v192 = v15.mul_add(qd[1], -v191);
+    let v193 = v90 * v18;
+    let v194 = v15 * qd[0];
+    let v195 = v48.mul_add(qd[2], v194);
+    let v196 = v23.mul_add(qd[1], v195);
+    let v197 = v33 * v47;
+    let v198 = v13.mul_add(v192, v193);
+    let v199 = v197.mul_add(v196, v198);
+    let v200 = v48 * qd[1];
+    let v201 = v23.mul_add(qd[2], -v200);
+    let v202 = v112 * v18;
+    let v203 = v26 * v47;
+    let v204 = v13.mul_add(v201, v202);
+    let v205 = v203.mul_add(v196, v204);
+    let v206 = v15 * qd[2];
+    let v207 = v48.mul_add(qd[0], -v206);
+    let v208 = v127 * v18;
+    let v209 = v20 * v47;
+    let v210 = v13.mul_add(v207, v208);
+    let v211 = v209.mul_add(v196, v210);
+    let v212 = 0.5f64 * v196;
+    let v213 = v212 * v89;
+    let v214 = 0.25f64 * v139;
+    let v215 = 0.25f64.mul_add(v138, v214);
+    let v216 = 0.25f64.mul_add(v141, v215);
+    let v217 = 0.5f64 * v47;
+    let v218 = v217.mul_add(v216, v213);
+    let v219 = q[2] * v218;
+    let v220 = v217 * v196;
+    let v222 = v77 * v221;
+    let v223 = 0.5f64 * v222;
+    let v224 = v220 + v223;
+    let v225 = v192.mul_add(v79, v219);
+    let v226 = qd[2].mul_add(v224, v225);
+    let v227 = q[0] * v218;
+    let v228 = v201.mul_add(v79, v227);
+    let v229 = qd[0].mul_add(v224, v228);
+    let v230 = q[1] * v218;
+    let v231 = v207.mul_add(v79, v230);
+    let v232 = qd[1].mul_add(v224, v231);
+    let v233 = 0.25f64 * v41;
+    let v235 = v47.mul_add(v46, v233);
+    let v236 = v234.mul_add(v53, v235);
+    let v237 = v47.mul_add(v58, v83);
+    let v238 = v234.mul_add(v60, v237);
+    let v239 = v47.mul_add(v65, v80);
+    let v240 = v234.mul_add(v67, v239);
+    let v241 = 0.25f64 * qd[3];
+    let v243 = v77 * v242;
+    let v244 = v46.mul_add(v89, v241);
+    let v245 = v47.mul_add(v87, v244);
+    let v246 = v53.mul_add(v243, v245);
+    let v247 = v234.mul_add(v101, v246);
+    let v248 = 0.25f64 * qd[4];
+    let v249 = v58.mul_add(v89, v248);
+    let v250 = v47.mul_add(v111, v249);
+    let v251 = v60.mul_add(v243, v250);
+    let v252 = v234.mul_add(v116, v251);
+    let v253 = 0.25f64 * qd[5];
+    let v254 = v65.mul_add(v89, v253);
+    let v255 = v47.mul_add(v126, v254);
+    let v256 = v67.mul_add(v243, v255);
+    let v257 = v234.mul_add(v131, v256);
+    let v258 = 2f64 * v87;
+    let v259 = v46 * v154;
+    let v260 = 2f64 * v101;
+    let v262 = v145 * v261;
+    let v263 = v143.mul_add(v242, v262);
+    let v264 = v258.mul_add(v89, v259);
+    let v265 = v47.mul_add(v150, v264);
+    let v266 = v260.mul_add(v243, v265);
+    let v267 = v53.mul_add(v263, v266);
+    let v268 = v234.mul_add(v161, v267);
+    let v269 = v58 * v154;
+    let v270 = 2f64 * v116;
+    let v271 = v151.mul_add(v111, v269);
+    let v272 = v47.mul_add(v169, v271);
+    let v273 = v270.mul_add(v243, v272);
+    let v274 = v60.mul_add(v263, v273);
+    let v275 = v234.mul_add(v173, v274);
+    let v276 = v65 * v154;
+    let v277 = 2f64 * v131;
+    let v278 = v151.mul_add(v126, v276);
+    let v279 = v47.mul_add(v181, v278);
+    let v280 = v277.mul_add(v243, v279);
+    let v281 = v67.mul_add(v263, v280);
+    let v282 = v234.mul_add(v185, v281);
+    let v283 = 0.25f64 * v11;
+    let c: [[f64; 3]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        3,
     >(v283);
-    let v284: f64 = c[2usize][0usize];
-    let v290: f64 = c[1usize][0usize];
-    let v292: f64 = c[3usize][0usize];
-    let v313: f64 = c[2usize][1usize];
-    let v315: f64 = c[3usize][1usize];
-    let v326: f64 = c[1usize][1usize];
-    let v1070: f64 = c[2usize][2usize];
-    let v1076: f64 = c[3usize][2usize];
-    let v1090: f64 = c[1usize][2usize];
-    let v286: f64 = 0.0625f64 * q[0usize];
-    let v287: f64 = 0.0625f64 * q[1usize];
-    let v288: f64 = v287 * qd[0usize];
-    let v289: f64 = v286.mul_add(qd[1usize], -v288);
-    let v291: f64 = v91 * v290;
-    let v293: f64 = 0.0625f64 * q[2usize];
-    let v294: f64 = v286 * qd[0usize];
-    let v295: f64 = v293.mul_add(qd[2usize], v294);
-    let v296: f64 = v287.mul_add(qd[1usize], v295);
-    let v297: f64 = v48 * v292;
-    let v298: f64 = v284.mul_add(v289, v291);
-    let v299: f64 = v297.mul_add(v296, v298);
-    let v300: f64 = v293 * qd[1usize];
-    let v301: f64 = v287.mul_add(qd[2usize], -v300);
-    let v302: f64 = v123 * v290;
-    let v303: f64 = v15 * v292;
-    let v304: f64 = v284.mul_add(v301, v302);
-    let v305: f64 = v303.mul_add(v296, v304);
-    let v306: f64 = v286 * qd[2usize];
-    let v307: f64 = v293.mul_add(qd[0usize], -v306);
-    let v308: f64 = v107 * v290;
-    let v309: f64 = v23 * v292;
-    let v310: f64 = v284.mul_add(v307, v308);
-    let v311: f64 = v309.mul_add(v296, v310);
-    let v312: f64 = 0.25f64 * v77;
-    let v314: f64 = v312 * v313;
-    let v316: f64 = v312 * v315;
-    let v317: f64 = 0.25f64 * v296;
-    let v318: f64 = v317 * v316;
-    let v319: f64 = 0.0625f64 * v139;
-    let v320: f64 = 0.0625f64.mul_add(v138, v319);
-    let v321: f64 = 0.0625f64.mul_add(v141, v320);
-    let v322: f64 = 0.25f64 * v292;
-    let v323: f64 = v322.mul_add(v321, v318);
-    let v324: f64 = q[2usize] * v323;
-    let v325: f64 = v322 * v296;
-    let v327: f64 = v312 * v326;
-    let v328: f64 = 0.25f64 * v327;
-    let v329: f64 = v325 + v328;
-    let v330: f64 = v289.mul_add(v314, v324);
-    let v331: f64 = qd[2usize].mul_add(v329, v330);
-    let v332: f64 = q[0usize] * v323;
-    let v333: f64 = v301.mul_add(v314, v332);
-    let v334: f64 = qd[0usize].mul_add(v329, v333);
-    let v335: f64 = q[1usize] * v323;
-    let v336: f64 = v307.mul_add(v314, v335);
-    let v337: f64 = qd[1usize].mul_add(v329, v336);
-    let v339: f64 = 0.0625f64.mul_add(v5, -v283);
-    let v340: f64 = v284.mul_add(v339, 1f64);
-    let v341: f64 = v286 * q[2usize];
-    let v342: f64 = v341 * v284;
-    let v343: f64 = v23.mul_add(v290, v342);
-    let v344: f64 = v287 * q[2usize];
-    let v345: f64 = v15 * v290;
-    let v346: f64 = v344.mul_add(v284, -v345);
-    let v348: f64 = 0.5f64 * p[1usize];
-    let v350: f64 = 0.25f64 * p[3usize];
-    let v352: f64 = p[2usize] - v350;
-    let v354: f64 = 0.125f64.mul_add(v352, v350);
-    let v355: f64 = 0.5f64 * p[3usize];
-    let v356: f64 = v23 * v13;
-    let v357: f64 = 0.125f64 * q[0usize];
-    let v358: f64 = v357 * q[2usize];
-    let v359: f64 = v358 * v47;
-    let v360: f64 = v359 - v356;
-    let v361: f64 = 0.5f64 * v18;
-    let v362: f64 = 0.125f64 * v1;
-    let v363: f64 = v362.mul_add(v47, v361);
-    let v364: f64 = v48 * v13;
-    let v365: f64 = v357 * q[1usize];
-    let v366: f64 = v365 * v47;
-    let v367: f64 = v364 + v366;
-    let v368: f64 = v78 * v26;
-    let v369: f64 = v80 * v13;
-    let v370: f64 = v88 * v26;
-    let v371: f64 = 0.125f64 * q[2usize];
-    let v372: f64 = v42 * v26;
-    let v373: f64 = v371.mul_add(q[4usize], -v372);
-    let v374: f64 = v46.mul_add(v368, v369);
-    let v375: f64 = v53.mul_add(v370, v374);
-    let v376: f64 = v47.mul_add(v373, v375);
-    let v377: f64 = v60 * v370;
-    let v378: f64 = 0.5f64 * v51;
-    let v379: f64 = 0.5f64 * v26;
-    let v380: f64 = v357 - v379;
-    let v381: f64 = q[4usize].mul_add(v380, v378);
-    let v382: f64 = v58.mul_add(v368, v377);
-    let v383: f64 = v47.mul_add(v381, v382);
-    let v384: f64 = v233 * v13;
-    let v385: f64 = 0.125f64 * q[1usize];
-    let v386: f64 = v63 * v26;
-    let v387: f64 = v385.mul_add(q[4usize], -v386);
-    let v388: f64 = v65.mul_add(v368, -v384);
-    let v389: f64 = v67.mul_add(v370, v388);
-    let v390: f64 = v47.mul_add(v387, v389);
-    let v391: f64 = v287 * v284;
-    let v393: f64 = 0.015625f64 * q[0usize];
-    let v394: f64 = v393 * q[2usize];
-    let v395: f64 = v394 * v292;
-    let v396: f64 = v395 - v391;
-    let v397: f64 = 0.25f64 * v290;
-    let v398: f64 = 0.015625f64 * v1;
-    let v399: f64 = v398.mul_add(v292, v397);
-    let v400: f64 = v293 * v284;
-    let v401: f64 = v393 * q[1usize];
-    let v402: f64 = v401 * v292;
-    let v403: f64 = v400 + v402;
-    let v404: f64 = v80 * v47;
-    let v405: f64 = v242 * v26;
-    let v406: f64 = v46.mul_add(v370, v404);
-    let v407: f64 = v53.mul_add(v405, v406);
-    let v408: f64 = v234.mul_add(v373, v407);
-    let v409: f64 = v60 * v405;
-    let v410: f64 = v58.mul_add(v370, v409);
-    let v411: f64 = v234.mul_add(v381, v410);
-    let v412: f64 = v233 * v47;
-    let v413: f64 = v65.mul_add(v370, -v412);
-    let v414: f64 = v67.mul_add(v405, v413);
-    let v415: f64 = v234.mul_add(v387, v414);
-    let v416: f64 = v15 * v13;
-    let v417: f64 = v385 * q[2usize];
-    let v418: f64 = v417 * v47;
-    let v419: f64 = v416 + v418;
-    let v420: f64 = v366 - v364;
-    let v421: f64 = 0.125f64 * v8;
-    let v422: f64 = v421.mul_add(v47, v361);
-    let v423: f64 = v78 * v20;
-    let v424: f64 = v83 * v13;
-    let v425: f64 = v88 * v20;
-    let v426: f64 = v42 * v20;
-    let v427: f64 = v371.mul_add(q[5usize], -v426);
-    let v428: f64 = v46.mul_add(v423, -v424);
-    let v429: f64 = v53.mul_add(v425, v428);
-    let v430: f64 = v47.mul_add(v427, v429);
-    let v431: f64 = v56 * v20;
-    let v432: f64 = v357.mul_add(q[5usize], -v431);
-    let v433: f64 = v58.mul_add(v423, v384);
-    let v434: f64 = v60.mul_add(v425, v433);
-    let v435: f64 = v47.mul_add(v432, v434);
-    let v436: f64 = v67 * v425;
-    let v437: f64 = 0.5f64 * v20;
-    let v438: f64 = v385 - v437;
-    let v439: f64 = q[5usize].mul_add(v438, v378);
-    let v440: f64 = v65.mul_add(v423, v436);
-    let v441: f64 = v47.mul_add(v439, v440);
-    let v442: f64 = v286 * v284;
-    let v443: f64 = 0.015625f64 * q[1usize];
-    let v444: f64 = v443 * q[2usize];
-    let v445: f64 = v444 * v292;
-    let v446: f64 = v442 + v445;
-    let v447: f64 = v402 - v400;
-    let v448: f64 = 0.015625f64 * v8;
-    let v449: f64 = v448.mul_add(v292, v397);
-    let v450: f64 = v83 * v47;
-    let v451: f64 = v242 * v20;
-    let v452: f64 = v46.mul_add(v425, -v450);
-    let v453: f64 = v53.mul_add(v451, v452);
-    let v454: f64 = v234.mul_add(v427, v453);
-    let v455: f64 = v58.mul_add(v425, v412);
-    let v456: f64 = v60.mul_add(v451, v455);
-    let v457: f64 = v234.mul_add(v432, v456);
-    let v458: f64 = v67 * v451;
-    let v459: f64 = v65.mul_add(v425, v458);
-    let v460: f64 = v234.mul_add(v439, v459);
-    let v461: f64 = 0.125f64 * v5;
-    let v462: f64 = v461.mul_add(v47, v361);
-    let v463: f64 = v356 + v359;
-    let v464: f64 = v418 - v416;
-    let v465: f64 = v78 * v33;
-    let v466: f64 = v88 * v33;
-    let v467: f64 = v53 * v466;
-    let v468: f64 = 0.5f64 * v33;
-    let v469: f64 = v371 - v468;
-    let v470: f64 = v41.mul_add(v469, v378);
-    let v471: f64 = v46.mul_add(v465, v467);
-    let v472: f64 = v47.mul_add(v470, v471);
-    let v473: f64 = v56 * v33;
-    let v474: f64 = v357.mul_add(v41, -v473);
-    let v475: f64 = v58.mul_add(v465, -v369);
-    let v476: f64 = v60.mul_add(v466, v475);
-    let v477: f64 = v47.mul_add(v474, v476);
-    let v478: f64 = v63 * v33;
-    let v479: f64 = v385.mul_add(v41, -v478);
-    let v480: f64 = v65.mul_add(v465, v424);
-    let v481: f64 = v67.mul_add(v466, v480);
-    let v482: f64 = v47.mul_add(v479, v481);
-    let v483: f64 = 0.015625f64 * v5;
-    let v484: f64 = v483.mul_add(v292, v397);
-    let v485: f64 = v391 + v395;
-    let v486: f64 = v445 - v442;
-    let v487: f64 = v242 * v33;
-    let v488: f64 = v53 * v487;
-    let v489: f64 = v46.mul_add(v466, v488);
-    let v490: f64 = v234.mul_add(v470, v489);
-    let v491: f64 = v58.mul_add(v466, -v404);
-    let v492: f64 = v60.mul_add(v487, v491);
-    let v493: f64 = v234.mul_add(v474, v492);
-    let v494: f64 = v65.mul_add(v466, v450);
-    let v495: f64 = v67.mul_add(v487, v494);
-    let v496: f64 = v234.mul_add(v479, v495);
-    let v498: f64 = 0.5f64 * v11;
-    let v499: f64 = v461 - v498;
-    let v500: f64 = v47.mul_add(v499, 0.5f64);
-    let v501: f64 = v234.mul_add(v499, 0.25f64);
-    let v502: f64 = v23 * v47;
-    let v503: f64 = v358 * v234;
-    let v504: f64 = v502 + v503;
-    let v505: f64 = v15 * v47;
-    let v506: f64 = v417 * v234;
-    let v507: f64 = v506 - v505;
-    let v508: f64 = v362 - v498;
-    let v509: f64 = v47.mul_add(v508, 0.5f64);
-    let v510: f64 = v503 - v502;
-    let v511: f64 = v234.mul_add(v508, 0.25f64);
-    let v512: f64 = v48 * v47;
-    let v513: f64 = v365 * v234;
-    let v514: f64 = v512 + v513;
-    let v515: f64 = v421 - v498;
-    let v516: f64 = v47.mul_add(v515, 0.5f64);
-    let v517: f64 = v505 + v506;
-    let v518: f64 = v513 - v512;
-    let v519: f64 = v234.mul_add(v515, 0.25f64);
-    let v522: f64 = v112 * p[5usize];
-    let v523: f64 = v26.mul_add(p[4usize], v522);
-    let v525: f64 = q[1usize] - p[6usize];
-    let v526: f64 = 0.5f64 * p[4usize];
-    let v527: f64 = v127 * p[5usize];
-    let v528: f64 = v526.mul_add(v525, v527);
-    let v531: f64 = v90 * p[8usize];
-    let v532: f64 = v33.mul_add(p[7usize], v531);
-    let v534: f64 = 0.5f64 * q[3usize];
-    let v536: f64 = v71 * p[10usize];
-    let v537: f64 = v534.mul_add(p[9usize], v536);
-    let v539: f64 = v106 * p[10usize];
-    let v540: f64 = v56.mul_add(p[11usize], v539);
-    let v541: f64 = v121 * p[10usize];
-    let v542: f64 = v63.mul_add(p[11usize], v541);
-    let v545: f64 = v33 * dir[2usize];
-    let v547: f64 = v26.mul_add(dir[0usize], v545);
-    let v548: f64 = v20.mul_add(dir[1usize], v547);
-    let v550: f64 = v548 * v549;
-    let v551: f64 = v33 * v13;
-    let v552: f64 = v78 * v548;
-    let v553: f64 = v551.mul_add(dir[2usize], v550);
-    let v554: f64 = v6.mul_add(v552, v553);
-    let v555: f64 = v364 * dir[0usize];
-    let v556: f64 = v361 * dir[1usize];
-    let v557: f64 = v221 * v548;
-    let v558: f64 = v20 * v557;
-    let v559: f64 = 0.25f64 * v13;
-    let v560: f64 = v559 * dir[2usize];
-    let v561: f64 = v48 * v552;
-    let v562: f64 = v560 + v561;
-    let v563: f64 = q[0usize] * v562;
-    let v564: f64 = v555 - v556;
-    let v565: f64 = v564 - v558;
-    let v566: f64 = v565 + v563;
-    let v567: f64 = v364 * dir[1usize];
-    let v568: f64 = v361 * dir[0usize];
-    let v569: f64 = v26 * v557;
-    let v570: f64 = q[1usize] * v562;
-    let v571: f64 = v567 + v568;
-    let v572: f64 = v571 + v569;
-    let v573: f64 = v572 + v570;
-    let v574: f64 = v555 + v556;
-    let v575: f64 = v574 + v558;
-    let v576: f64 = v575 + v563;
-    let v577: f64 = v26 * v13;
-    let v578: f64 = v577.mul_add(dir[0usize], v550);
-    let v579: f64 = v3.mul_add(v552, v578);
-    let v580: f64 = v356 * dir[0usize];
-    let v581: f64 = v361 * dir[2usize];
-    let v582: f64 = v33 * v557;
-    let v583: f64 = v559 * dir[1usize];
-    let v584: f64 = v23 * v552;
-    let v585: f64 = v583 + v584;
-    let v586: f64 = q[0usize] * v585;
-    let v587: f64 = v580 - v581;
-    let v588: f64 = v587 - v582;
-    let v589: f64 = v588 + v586;
-    let v590: f64 = v567 - v568;
-    let v591: f64 = v590 - v569;
-    let v592: f64 = v591 + v570;
-    let v593: f64 = v580 + v581;
-    let v594: f64 = v593 + v582;
-    let v595: f64 = v594 + v586;
-    let v596: f64 = v20 * v13;
-    let v597: f64 = v596.mul_add(dir[1usize], v550);
-    let v598: f64 = v9.mul_add(v552, v597);
-    let v600: f64 = v46 * v552;
-    let v601: f64 = v80 * dir[0usize];
-    let v603: f64 = v83 * dir[1usize];
-    let v605: f64 = v15.mul_add(dir[5usize], v601);
-    let v606: f64 = v605 - v603;
-    let v607: f64 = (-v23).mul_add(dir[4usize], v606);
-    let v608: f64 = v88 * v548;
-    let v609: f64 = v48 * dir[3usize];
-    let v610: f64 = v233.mul_add(dir[2usize], v609);
-    let v611: f64 = v83.mul_add(dir[0usize], v610);
-    let v612: f64 = v15.mul_add(dir[4usize], v611);
-    let v613: f64 = v80.mul_add(dir[1usize], v612);
-    let v614: f64 = v23.mul_add(dir[5usize], v613);
-    let v615: f64 = v33 * v614;
-    let v616: f64 = v378.mul_add(dir[2usize], v615);
-    let v617: f64 = (-v498).mul_add(dir[3usize], v616);
-    let v618: f64 = (-v42).mul_add(v548, v617);
-    let v619: f64 = 0.5f64.mul_add(dir[3usize], v600);
-    let v620: f64 = v13.mul_add(v607, v619);
-    let v621: f64 = v53.mul_add(v608, v620);
-    let v622: f64 = v47.mul_add(v618, v621);
-    let v623: f64 = v58 * v552;
-    let v624: f64 = v233 * dir[1usize];
-    let v625: f64 = v80 * dir[2usize];
-    let v626: f64 = v23.mul_add(dir[3usize], v624);
-    let v627: f64 = v626 - v625;
-    let v628: f64 = (-v48).mul_add(dir[5usize], v627);
-    let v629: f64 = v26 * v614;
-    let v630: f64 = v378.mul_add(dir[0usize], v629);
-    let v631: f64 = (-v498).mul_add(dir[4usize], v630);
-    let v632: f64 = (-v56).mul_add(v548, v631);
-    let v633: f64 = 0.5f64.mul_add(dir[4usize], v623);
-    let v634: f64 = v13.mul_add(v628, v633);
-    let v635: f64 = v60.mul_add(v608, v634);
-    let v636: f64 = v47.mul_add(v632, v635);
-    let v637: f64 = v65 * v552;
-    let v638: f64 = v83 * dir[2usize];
-    let v639: f64 = v233 * dir[0usize];
-    let v640: f64 = v48.mul_add(dir[4usize], v638);
-    let v641: f64 = v640 - v639;
-    let v642: f64 = (-v15).mul_add(dir[3usize], v641);
-    let v643: f64 = v20 * v614;
-    let v644: f64 = v378.mul_add(dir[1usize], v643);
-    let v645: f64 = (-v498).mul_add(dir[5usize], v644);
-    let v646: f64 = (-v63).mul_add(v548, v645);
-    let v647: f64 = 0.5f64.mul_add(dir[5usize], v637);
-    let v648: f64 = v13.mul_add(v642, v647);
-    let v649: f64 = v67.mul_add(v608, v648);
-    let v650: f64 = v47.mul_add(v646, v649);
-    let v652: f64 = v79 * v607;
-    let v654: f64 = v33 * dir[8usize];
-    let v657: f64 = v90.mul_add(dir[2usize], v654);
-    let v658: f64 = v112.mul_add(dir[0usize], v657);
-    let v659: f64 = v26.mul_add(dir[6usize], v658);
-    let v660: f64 = v127.mul_add(dir[1usize], v659);
-    let v661: f64 = v20.mul_add(dir[7usize], v660);
-    let v662: f64 = v77 * v144;
-    let v663: f64 = v662 * v548;
-    let v664: f64 = v78.mul_add(v661, v663);
-    let v665: f64 = v80 * dir[6usize];
-    let v668: f64 = v123.mul_add(dir[5usize], v665);
-    let v669: f64 = v253.mul_add(dir[0usize], v668);
-    let v670: f64 = v15.mul_add(dir[11usize], v669);
-    let v671: f64 = (-v107).mul_add(dir[4usize], v670);
-    let v672: f64 = (-v83).mul_add(dir[7usize], v671);
-    let v673: f64 = (-v248).mul_add(dir[1usize], v672);
-    let v674: f64 = (-v23).mul_add(dir[10usize], v673);
-    let v675: f64 = v77 * v152;
-    let v676: f64 = v675 * v548;
-    let v677: f64 = v88.mul_add(v661, v676);
-    let v678: f64 = v90 * v614;
-    let v679: f64 = 0.5f64 * v97;
-    let v680: f64 = v91 * dir[3usize];
-    let v681: f64 = v233.mul_add(dir[8usize], v680);
-    let v682: f64 = v241.mul_add(dir[2usize], v681);
-    let v683: f64 = v48.mul_add(dir[9usize], v682);
-    let v684: f64 = v123.mul_add(dir[4usize], v683);
-    let v685: f64 = v83.mul_add(dir[6usize], v684);
-    let v686: f64 = v248.mul_add(dir[0usize], v685);
-    let v687: f64 = v15.mul_add(dir[10usize], v686);
-    let v688: f64 = v107.mul_add(dir[5usize], v687);
-    let v689: f64 = v80.mul_add(dir[7usize], v688);
-    let v690: f64 = v253.mul_add(dir[1usize], v689);
-    let v691: f64 = v23.mul_add(dir[11usize], v690);
-    let v692: f64 = 0.5f64 * v77;
-    let v693: f64 = v378.mul_add(dir[8usize], v678);
-    let v694: f64 = v679.mul_add(dir[2usize], v693);
-    let v695: f64 = v33.mul_add(v691, v694);
-    let v696: f64 = (-v498).mul_add(dir[9usize], v695);
-    let v697: f64 = (-v71).mul_add(v548, v696);
-    let v698: f64 = (-v692).mul_add(dir[3usize], v697);
-    let v699: f64 = (-v42).mul_add(v661, v698);
-    let v700: f64 = 0.5f64.mul_add(dir[9usize], v652);
-    let v701: f64 = v46.mul_add(v664, v700);
-    let v702: f64 = v87.mul_add(v552, v701);
-    let v703: f64 = v13.mul_add(v674, v702);
-    let v704: f64 = v89.mul_add(v618, v703);
-    let v705: f64 = v53.mul_add(v677, v704);
-    let v706: f64 = v101.mul_add(v608, v705);
-    let v707: f64 = v47.mul_add(v699, v706);
-    let v708: f64 = v79 * v628;
-    let v709: f64 = v107 * dir[3usize];
-    let v710: f64 = v233.mul_add(dir[7usize], v709);
-    let v711: f64 = v241.mul_add(dir[1usize], v710);
-    let v712: f64 = v23.mul_add(dir[9usize], v711);
-    let v713: f64 = (-v91).mul_add(dir[5usize], v712);
-    let v714: f64 = (-v80).mul_add(dir[8usize], v713);
-    let v715: f64 = (-v253).mul_add(dir[2usize], v714);
-    let v716: f64 = (-v48).mul_add(dir[11usize], v715);
-    let v717: f64 = v112 * v614;
-    let v718: f64 = v378.mul_add(dir[6usize], v717);
-    let v719: f64 = v679.mul_add(dir[0usize], v718);
-    let v720: f64 = v26.mul_add(v691, v719);
-    let v721: f64 = (-v498).mul_add(dir[10usize], v720);
-    let v722: f64 = (-v106).mul_add(v548, v721);
-    let v723: f64 = (-v692).mul_add(dir[4usize], v722);
-    let v724: f64 = (-v56).mul_add(v661, v723);
-    let v725: f64 = 0.5f64.mul_add(dir[10usize], v708);
-    let v726: f64 = v58.mul_add(v664, v725);
-    let v727: f64 = v111.mul_add(v552, v726);
-    let v728: f64 = v13.mul_add(v716, v727);
-    let v729: f64 = v89.mul_add(v632, v728);
-    let v730: f64 = v60.mul_add(v677, v729);
-    let v731: f64 = v116.mul_add(v608, v730);
-    let v732: f64 = v47.mul_add(v724, v731);
-    let v733: f64 = v79 * v642;
-    let v734: f64 = v83 * dir[8usize];
-    let v735: f64 = v91.mul_add(dir[4usize], v734);
-    let v736: f64 = v248.mul_add(dir[2usize], v735);
-    let v737: f64 = v48.mul_add(dir[10usize], v736);
-    let v738: f64 = (-v233).mul_add(dir[6usize], v737);
-    let v739: f64 = (-v123).mul_add(dir[3usize], v738);
-    let v740: f64 = (-v241).mul_add(dir[0usize], v739);
-    let v741: f64 = (-v15).mul_add(dir[9usize], v740);
-    let v742: f64 = v127 * v614;
-    let v743: f64 = v378.mul_add(dir[7usize], v742);
-    let v744: f64 = v679.mul_add(dir[1usize], v743);
-    let v745: f64 = v20.mul_add(v691, v744);
-    let v746: f64 = (-v498).mul_add(dir[11usize], v745);
-    let v747: f64 = (-v121).mul_add(v548, v746);
-    let v748: f64 = (-v692).mul_add(dir[5usize], v747);
-    let v749: f64 = (-v63).mul_add(v661, v748);
-    let v750: f64 = 0.5f64.mul_add(dir[11usize], v733);
-    let v751: f64 = v65.mul_add(v664, v750);
-    let v752: f64 = v126.mul_add(v552, v751);
-    let v753: f64 = v13.mul_add(v741, v752);
-    let v754: f64 = v89.mul_add(v646, v753);
-    let v755: f64 = v67.mul_add(v677, v754);
-    let v756: f64 = v131.mul_add(v608, v755);
-    let v757: f64 = v47.mul_add(v749, v756);
-    let v758: f64 = v137 * v674;
-    let v759: f64 = qd[1usize] * dir[7usize];
-    let v760: f64 = qd[0usize].mul_add(dir[6usize], v759);
-    let v761: f64 = qd[2usize].mul_add(dir[8usize], v760);
-    let v763: f64 = v145 * v548;
-    let v764: f64 = v763 * v762;
-    let v765: f64 = 2f64 * v77;
-    let v766: f64 = v765 * v661;
-    let v767: f64 = v143.mul_add(v548, v766);
-    let v768: f64 = v78.mul_add(v761, v764);
-    let v769: f64 = v144.mul_add(v767, v768);
-    let v770: f64 = v112 * dir[11usize];
-    let v771: f64 = v121.mul_add(dir[6usize], v770);
-    let v772: f64 = (-v106).mul_add(dir[7usize], v771);
-    let v773: f64 = (-v127).mul_add(dir[10usize], v772);
-    let v775: f64 = v763 * v774;
-    let v776: f64 = v88.mul_add(v761, v775);
-    let v777: f64 = v152.mul_add(v767, v776);
-    let v778: f64 = qd[2usize] * v691;
-    let v779: f64 = 0.5f64 * v157;
-    let v780: f64 = v90 * dir[9usize];
-    let v781: f64 = v71.mul_add(dir[8usize], v780);
-    let v782: f64 = v106.mul_add(dir[6usize], v781);
-    let v783: f64 = v112.mul_add(dir[10usize], v782);
-    let v784: f64 = v121.mul_add(dir[7usize], v783);
-    let v785: f64 = v127.mul_add(dir[11usize], v784);
-    let v786: f64 = 0.5f64 * v143;
-    let v787: f64 = v97.mul_add(dir[8usize], v778);
-    let v788: f64 = v779.mul_add(dir[2usize], v787);
-    let v789: f64 = v33.mul_add(v785, v788);
-    let v790: f64 = (-v77).mul_add(dir[9usize], v789);
-    let v791: f64 = (-qd[3usize]).mul_add(v661, v790);
-    let v792: f64 = (-v786).mul_add(dir[3usize], v791);
-    let v793: f64 = (-v42).mul_add(v761, v792);
-    let v794: f64 = v258.mul_add(v664, v758);
-    let v795: f64 = v147.mul_add(v607, v794);
-    let v796: f64 = v46.mul_add(v769, v795);
-    let v797: f64 = v150.mul_add(v552, v796);
-    let v798: f64 = v13.mul_add(v773, v797);
-    let v799: f64 = v260.mul_add(v677, v798);
-    let v800: f64 = v151.mul_add(v699, v799);
-    let v801: f64 = v154.mul_add(v618, v800);
-    let v802: f64 = v53.mul_add(v777, v801);
-    let v803: f64 = v161.mul_add(v608, v802);
-    let v804: f64 = v47.mul_add(v793, v803);
-    let v805: f64 = 2f64 * v111;
-    let v806: f64 = v137 * v716;
-    let v807: f64 = v127 * dir[9usize];
-    let v808: f64 = v71.mul_add(dir[7usize], v807);
-    let v809: f64 = (-v121).mul_add(dir[8usize], v808);
-    let v810: f64 = (-v90).mul_add(dir[11usize], v809);
-    let v811: f64 = qd[0usize] * v691;
-    let v812: f64 = v97.mul_add(dir[6usize], v811);
-    let v813: f64 = v779.mul_add(dir[0usize], v812);
-    let v814: f64 = v26.mul_add(v785, v813);
-    let v815: f64 = (-v77).mul_add(dir[10usize], v814);
-    let v816: f64 = (-qd[4usize]).mul_add(v661, v815);
-    let v817: f64 = (-v786).mul_add(dir[4usize], v816);
-    let v818: f64 = (-v56).mul_add(v761, v817);
-    let v819: f64 = v805.mul_add(v664, v806);
-    let v820: f64 = v147.mul_add(v628, v819);
-    let v821: f64 = v58.mul_add(v769, v820);
-    let v822: f64 = v169.mul_add(v552, v821);
-    let v823: f64 = v13.mul_add(v810, v822);
-    let v824: f64 = v270.mul_add(v677, v823);
-    let v825: f64 = v151.mul_add(v724, v824);
-    let v826: f64 = v154.mul_add(v632, v825);
-    let v827: f64 = v60.mul_add(v777, v826);
-    let v828: f64 = v173.mul_add(v608, v827);
-    let v829: f64 = v47.mul_add(v818, v828);
-    let v830: f64 = 2f64 * v126;
-    let v831: f64 = v137 * v741;
-    let v832: f64 = v90 * dir[10usize];
-    let v833: f64 = v106.mul_add(dir[8usize], v832);
-    let v834: f64 = (-v71).mul_add(dir[6usize], v833);
-    let v835: f64 = (-v112).mul_add(dir[9usize], v834);
-    let v836: f64 = qd[1usize] * v691;
-    let v837: f64 = v97.mul_add(dir[7usize], v836);
-    let v838: f64 = v779.mul_add(dir[1usize], v837);
-    let v839: f64 = v20.mul_add(v785, v838);
-    let v840: f64 = (-v77).mul_add(dir[11usize], v839);
-    let v841: f64 = (-qd[5usize]).mul_add(v661, v840);
-    let v842: f64 = (-v786).mul_add(dir[5usize], v841);
-    let v843: f64 = (-v63).mul_add(v761, v842);
-    let v844: f64 = v830.mul_add(v664, v831);
-    let v845: f64 = v147.mul_add(v642, v844);
-    let v846: f64 = v65.mul_add(v769, v845);
-    let v847: f64 = v181.mul_add(v552, v846);
-    let v848: f64 = v13.mul_add(v835, v847);
-    let v849: f64 = v277.mul_add(v677, v848);
-    let v850: f64 = v151.mul_add(v749, v849);
-    let v851: f64 = v154.mul_add(v646, v850);
-    let v852: f64 = v67.mul_add(v777, v851);
-    let v853: f64 = v185.mul_add(v608, v852);
-    let v854: f64 = v47.mul_add(v843, v853);
-    let v855: f64 = v15 * dir[7usize];
-    let v856: f64 = v107.mul_add(dir[0usize], v855);
-    let v857: f64 = (-v123).mul_add(dir[1usize], v856);
-    let v858: f64 = (-v23).mul_add(dir[6usize], v857);
-    let v859: f64 = v13 * v858;
-    let v860: f64 = v212 * v608;
-    let v861: f64 = v48 * dir[8usize];
-    let v862: f64 = v91.mul_add(dir[2usize], v861);
-    let v863: f64 = v123.mul_add(dir[0usize], v862);
-    let v864: f64 = v15.mul_add(dir[6usize], v863);
-    let v865: f64 = v107.mul_add(dir[1usize], v864);
-    let v866: f64 = v23.mul_add(dir[7usize], v865);
-    let v867: f64 = v217 * v866;
-    let v868: f64 = v860 + v867;
-    let v869: f64 = v192.mul_add(v552, v859);
-    let v870: f64 = v361.mul_add(dir[8usize], v869);
-    let v871: f64 = v90.mul_add(v557, v870);
-    let v872: f64 = v220.mul_add(dir[2usize], v871);
-    let v873: f64 = q[2usize].mul_add(v868, v872);
-    let v874: f64 = v23 * dir[8usize];
-    let v875: f64 = v91.mul_add(dir[1usize], v874);
-    let v876: f64 = (-v107).mul_add(dir[2usize], v875);
-    let v877: f64 = (-v48).mul_add(dir[7usize], v876);
-    let v878: f64 = v13 * v877;
-    let v879: f64 = v201.mul_add(v552, v878);
-    let v880: f64 = v361.mul_add(dir[6usize], v879);
-    let v881: f64 = v112.mul_add(v557, v880);
-    let v882: f64 = v220.mul_add(dir[0usize], v881);
-    let v883: f64 = q[0usize].mul_add(v868, v882);
-    let v884: f64 = v48 * dir[6usize];
-    let v885: f64 = v123.mul_add(dir[2usize], v884);
-    let v886: f64 = (-v91).mul_add(dir[0usize], v885);
-    let v887: f64 = (-v15).mul_add(dir[8usize], v886);
-    let v888: f64 = v13 * v887;
-    let v889: f64 = v207.mul_add(v552, v888);
-    let v890: f64 = v361.mul_add(dir[7usize], v889);
-    let v891: f64 = v127.mul_add(v557, v890);
-    let v892: f64 = v220.mul_add(dir[1usize], v891);
-    let v893: f64 = q[1usize].mul_add(v868, v892);
-    let v894: f64 = v192 * v664;
-    let v895: f64 = 0.5f64 * v89;
-    let v896: f64 = v212 * v677;
-    let v897: f64 = 0.5f64 * v216;
-    let v898: f64 = v127 * dir[7usize];
-    let v899: f64 = v112.mul_add(dir[6usize], v898);
-    let v900: f64 = v90.mul_add(dir[8usize], v899);
-    let v901: f64 = v895.mul_add(v866, v896);
-    let v902: f64 = v897.mul_add(v608, v901);
-    let v903: f64 = v217.mul_add(v900, v902);
-    let v905: f64 = v77 * v548;
-    let v906: f64 = v905 * v904;
-    let v907: f64 = v221.mul_add(v661, v906);
-    let v908: f64 = 0.5f64.mul_add(v907, v860);
-    let v909: f64 = v908 + v867;
-    let v910: f64 = v897 * dir[2usize];
-    let v911: f64 = v212.mul_add(dir[8usize], v910);
-    let v912: f64 = v79.mul_add(v858, v894);
-    let v913: f64 = v223.mul_add(dir[8usize], v912);
-    let v914: f64 = v213.mul_add(dir[2usize], v913);
-    let v915: f64 = q[2usize].mul_add(v903, v914);
-    let v916: f64 = qd[2usize].mul_add(v909, v915);
-    let v917: f64 = v47.mul_add(v911, v916);
-    let v918: f64 = v201 * v664;
-    let v919: f64 = v897 * dir[0usize];
-    let v920: f64 = v212.mul_add(dir[6usize], v919);
-    let v921: f64 = v79.mul_add(v877, v918);
-    let v922: f64 = v223.mul_add(dir[6usize], v921);
-    let v923: f64 = v213.mul_add(dir[0usize], v922);
-    let v924: f64 = q[0usize].mul_add(v903, v923);
-    let v925: f64 = qd[0usize].mul_add(v909, v924);
-    let v926: f64 = v47.mul_add(v920, v925);
-    let v927: f64 = v207 * v664;
-    let v928: f64 = v897 * dir[1usize];
-    let v929: f64 = v212.mul_add(dir[7usize], v928);
-    let v930: f64 = v79.mul_add(v887, v927);
-    let v931: f64 = v223.mul_add(dir[7usize], v930);
-    let v932: f64 = v213.mul_add(dir[1usize], v931);
-    let v933: f64 = q[1usize].mul_add(v903, v932);
-    let v934: f64 = qd[1usize].mul_add(v909, v933);
-    let v935: f64 = v47.mul_add(v929, v934);
-    let v936: f64 = v46 * v608;
-    let v937: f64 = v242 * v548;
-    let v938: f64 = 0.25f64.mul_add(dir[3usize], v936);
-    let v939: f64 = v47.mul_add(v607, v938);
-    let v940: f64 = v53.mul_add(v937, v939);
-    let v941: f64 = v234.mul_add(v618, v940);
-    let v942: f64 = v58 * v608;
-    let v943: f64 = 0.25f64.mul_add(dir[4usize], v942);
-    let v944: f64 = v47.mul_add(v628, v943);
-    let v945: f64 = v60.mul_add(v937, v944);
-    let v946: f64 = v234.mul_add(v632, v945);
-    let v947: f64 = v65 * v608;
-    let v948: f64 = 0.25f64.mul_add(dir[5usize], v947);
-    let v949: f64 = v47.mul_add(v642, v948);
-    let v950: f64 = v67.mul_add(v937, v949);
-    let v951: f64 = v234.mul_add(v646, v950);
-    let v952: f64 = v89 * v607;
-    let v953: f64 = v77 * v261;
-    let v954: f64 = v953 * v548;
-    let v955: f64 = v242.mul_add(v661, v954);
-    let v956: f64 = 0.25f64.mul_add(dir[9usize], v952);
-    let v957: f64 = v46.mul_add(v677, v956);
-    let v958: f64 = v87.mul_add(v608, v957);
-    let v959: f64 = v47.mul_add(v674, v958);
-    let v960: f64 = v243.mul_add(v618, v959);
-    let v961: f64 = v53.mul_add(v955, v960);
-    let v962: f64 = v101.mul_add(v937, v961);
-    let v963: f64 = v234.mul_add(v699, v962);
-    let v964: f64 = v89 * v628;
-    let v965: f64 = 0.25f64.mul_add(dir[10usize], v964);
-    let v966: f64 = v58.mul_add(v677, v965);
-    let v967: f64 = v111.mul_add(v608, v966);
-    let v968: f64 = v47.mul_add(v716, v967);
-    let v969: f64 = v243.mul_add(v632, v968);
-    let v970: f64 = v60.mul_add(v955, v969);
-    let v971: f64 = v116.mul_add(v937, v970);
-    let v972: f64 = v234.mul_add(v724, v971);
-    let v973: f64 = v89 * v642;
-    let v974: f64 = 0.25f64.mul_add(dir[11usize], v973);
-    let v975: f64 = v65.mul_add(v677, v974);
-    let v976: f64 = v126.mul_add(v608, v975);
-    let v977: f64 = v47.mul_add(v741, v976);
-    let v978: f64 = v243.mul_add(v646, v977);
-    let v979: f64 = v67.mul_add(v955, v978);
-    let v980: f64 = v131.mul_add(v937, v979);
-    let v981: f64 = v234.mul_add(v749, v980);
-    let v982: f64 = v258 * v677;
-    let v983: f64 = 2f64 * v243;
-    let v985: f64 = v763 * v984;
-    let v986: f64 = v242.mul_add(v761, v985);
-    let v987: f64 = v261.mul_add(v767, v986);
-    let v988: f64 = v151.mul_add(v674, v982);
-    let v989: f64 = v154.mul_add(v607, v988);
-    let v990: f64 = v46.mul_add(v777, v989);
-    let v991: f64 = v150.mul_add(v608, v990);
-    let v992: f64 = v47.mul_add(v773, v991);
-    let v993: f64 = v983.mul_add(v699, v992);
-    let v994: f64 = v260.mul_add(v955, v993);
-    let v995: f64 = v263.mul_add(v618, v994);
-    let v996: f64 = v53.mul_add(v987, v995);
-    let v997: f64 = v161.mul_add(v937, v996);
-    let v998: f64 = v234.mul_add(v793, v997);
-    let v999: f64 = v151 * v716;
-    let v1000: f64 = v805.mul_add(v677, v999);
-    let v1001: f64 = v154.mul_add(v628, v1000);
-    let v1002: f64 = v58.mul_add(v777, v1001);
-    let v1003: f64 = v169.mul_add(v608, v1002);
-    let v1004: f64 = v47.mul_add(v810, v1003);
-    let v1005: f64 = v983.mul_add(v724, v1004);
-    let v1006: f64 = v270.mul_add(v955, v1005);
-    let v1007: f64 = v263.mul_add(v632, v1006);
-    let v1008: f64 = v60.mul_add(v987, v1007);
-    let v1009: f64 = v173.mul_add(v937, v1008);
-    let v1010: f64 = v234.mul_add(v818, v1009);
-    let v1011: f64 = v151 * v741;
-    let v1012: f64 = v830.mul_add(v677, v1011);
-    let v1013: f64 = v154.mul_add(v642, v1012);
-    let v1014: f64 = v65.mul_add(v777, v1013);
-    let v1015: f64 = v181.mul_add(v608, v1014);
-    let v1016: f64 = v47.mul_add(v835, v1015);
-    let v1017: f64 = v983.mul_add(v749, v1016);
-    let v1018: f64 = v277.mul_add(v955, v1017);
-    let v1019: f64 = v263.mul_add(v646, v1018);
-    let v1020: f64 = v67.mul_add(v987, v1019);
-    let v1021: f64 = v185.mul_add(v937, v1020);
-    let v1022: f64 = v234.mul_add(v843, v1021);
-    let v1023: f64 = 0.25f64 * v548;
-    let v1024: f64 = v313 * v1023;
-    let v1025: f64 = 0.0625f64 * qd[1usize];
-    let v1026: f64 = v286 * dir[7usize];
-    let v1027: f64 = 0.0625f64 * qd[0usize];
-    let v1028: f64 = v1025.mul_add(dir[0usize], v1026);
-    let v1029: f64 = (-v1027).mul_add(dir[1usize], v1028);
-    let v1030: f64 = (-v287).mul_add(dir[6usize], v1029);
-    let v1031: f64 = v284 * v1030;
-    let v1032: f64 = v326 * v1023;
-    let v1033: f64 = v315 * v1023;
-    let v1034: f64 = v317 * v1033;
-    let v1035: f64 = 0.0625f64 * qd[2usize];
-    let v1036: f64 = v293 * dir[8usize];
-    let v1037: f64 = v1035.mul_add(dir[2usize], v1036);
-    let v1038: f64 = v1027.mul_add(dir[0usize], v1037);
-    let v1039: f64 = v286.mul_add(dir[6usize], v1038);
-    let v1040: f64 = v1025.mul_add(dir[1usize], v1039);
-    let v1041: f64 = v287.mul_add(dir[7usize], v1040);
-    let v1042: f64 = v322 * v1041;
-    let v1043: f64 = v1034 + v1042;
-    let v1044: f64 = v289.mul_add(v1024, v1031);
-    let v1045: f64 = v397.mul_add(dir[8usize], v1044);
-    let v1046: f64 = v91.mul_add(v1032, v1045);
-    let v1047: f64 = v325.mul_add(dir[2usize], v1046);
-    let v1048: f64 = q[2usize].mul_add(v1043, v1047);
-    let v1049: f64 = v287 * dir[8usize];
-    let v1050: f64 = v1035.mul_add(dir[1usize], v1049);
-    let v1051: f64 = (-v1025).mul_add(dir[2usize], v1050);
-    let v1052: f64 = (-v293).mul_add(dir[7usize], v1051);
-    let v1053: f64 = v284 * v1052;
-    let v1054: f64 = v301.mul_add(v1024, v1053);
-    let v1055: f64 = v397.mul_add(dir[6usize], v1054);
-    let v1056: f64 = v123.mul_add(v1032, v1055);
-    let v1057: f64 = v325.mul_add(dir[0usize], v1056);
-    let v1058: f64 = q[0usize].mul_add(v1043, v1057);
-    let v1059: f64 = v293 * dir[6usize];
-    let v1060: f64 = v1027.mul_add(dir[2usize], v1059);
-    let v1061: f64 = (-v1035).mul_add(dir[0usize], v1060);
-    let v1062: f64 = (-v286).mul_add(dir[8usize], v1061);
-    let v1063: f64 = v284 * v1062;
-    let v1064: f64 = v307.mul_add(v1024, v1063);
-    let v1065: f64 = v397.mul_add(dir[7usize], v1064);
-    let v1066: f64 = v107.mul_add(v1032, v1065);
-    let v1067: f64 = v325.mul_add(dir[1usize], v1066);
-    let v1068: f64 = q[1usize].mul_add(v1043, v1067);
-    let v1069: f64 = 0.25f64 * v661;
-    let v1071: f64 = v312 * v1023;
-    let v1072: f64 = v1071 * v1070;
-    let v1073: f64 = v313.mul_add(v1069, v1072);
-    let v1074: f64 = v289 * v1073;
-    let v1075: f64 = 0.25f64 * v316;
-    let v1077: f64 = v1071 * v1076;
-    let v1078: f64 = v315.mul_add(v1069, v1077);
-    let v1079: f64 = v317 * v1078;
-    let v1080: f64 = 0.25f64 * v321;
-    let v1081: f64 = 0.125f64 * qd[0usize];
-    let v1082: f64 = 0.125f64 * qd[1usize];
-    let v1083: f64 = v1082 * dir[7usize];
-    let v1084: f64 = 0.125f64 * qd[2usize];
-    let v1085: f64 = v1081.mul_add(dir[6usize], v1083);
-    let v1086: f64 = v1084.mul_add(dir[8usize], v1085);
-    let v1087: f64 = v1075.mul_add(v1041, v1079);
-    let v1088: f64 = v1080.mul_add(v1033, v1087);
-    let v1089: f64 = v322.mul_add(v1086, v1088);
-    let v1091: f64 = v1071 * v1090;
-    let v1092: f64 = v326.mul_add(v1069, v1091);
-    let v1093: f64 = 0.25f64.mul_add(v1092, v1034);
-    let v1094: f64 = v1093 + v1042;
-    let v1095: f64 = v1080 * dir[2usize];
-    let v1096: f64 = v317.mul_add(dir[8usize], v1095);
-    let v1097: f64 = v314.mul_add(v1030, v1074);
-    let v1098: f64 = v328.mul_add(dir[8usize], v1097);
-    let v1099: f64 = v318.mul_add(dir[2usize], v1098);
-    let v1100: f64 = q[2usize].mul_add(v1089, v1099);
-    let v1101: f64 = qd[2usize].mul_add(v1094, v1100);
-    let v1102: f64 = v292.mul_add(v1096, v1101);
-    let v1103: f64 = v301 * v1073;
-    let v1104: f64 = v1080 * dir[0usize];
-    let v1105: f64 = v317.mul_add(dir[6usize], v1104);
-    let v1106: f64 = v314.mul_add(v1052, v1103);
-    let v1107: f64 = v328.mul_add(dir[6usize], v1106);
-    let v1108: f64 = v318.mul_add(dir[0usize], v1107);
-    let v1109: f64 = q[0usize].mul_add(v1089, v1108);
-    let v1110: f64 = qd[0usize].mul_add(v1094, v1109);
-    let v1111: f64 = v292.mul_add(v1105, v1110);
-    let v1112: f64 = v307 * v1073;
-    let v1113: f64 = v1080 * dir[1usize];
-    let v1114: f64 = v317.mul_add(dir[7usize], v1113);
-    let v1115: f64 = v314.mul_add(v1062, v1112);
-    let v1116: f64 = v328.mul_add(dir[7usize], v1115);
-    let v1117: f64 = v318.mul_add(dir[1usize], v1116);
-    let v1118: f64 = q[1usize].mul_add(v1089, v1117);
-    let v1119: f64 = qd[1usize].mul_add(v1094, v1118);
-    let v1120: f64 = v292.mul_add(v1114, v1119);
-    let v1121: f64 = v371.mul_add(dir[2usize], -v1023);
-    let v1122: f64 = v339 * v1024;
-    let v1123: f64 = v284.mul_add(v1121, v1122);
-    let v1124: f64 = v23 * v1032;
-    let v1125: f64 = 0.0625f64 * v284;
-    let v1126: f64 = v1125 * dir[2usize];
-    let v1127: f64 = v293 * v1024;
-    let v1128: f64 = v1126 + v1127;
-    let v1129: f64 = v397.mul_add(dir[1usize], v1124);
-    let v1130: f64 = v400.mul_add(dir[0usize], v1129);
-    let v1131: f64 = q[0usize].mul_add(v1128, v1130);
-    let v1132: f64 = v397 * dir[0usize];
-    let v1133: f64 = v400.mul_add(dir[1usize], -v1132);
-    let v1134: f64 = (-v15).mul_add(v1032, v1133);
-    let v1135: f64 = q[1usize].mul_add(v1128, v1134);
-    let v1136: f64 = v371 * v47;
-    let v1137: f64 = v1136 * dir[0usize];
-    let v1138: f64 = 0.125f64 * v47;
-    let v1139: f64 = v371 * v608;
-    let v1140: f64 = v1138.mul_add(dir[2usize], v1139);
-    let v1141: f64 = q[0usize] * v1140;
-    let v1142: f64 = v1137 - v583;
-    let v1143: f64 = v1142 - v584;
-    let v1144: f64 = v1143 + v1141;
-    let v1145: f64 = 0.5f64 * v557;
-    let v1146: f64 = v505.mul_add(dir[0usize], v1145);
-    let v1147: f64 = v362.mul_add(v608, v1146);
-    let v1148: f64 = v385 * v47;
-    let v1149: f64 = v1148 * dir[0usize];
-    let v1150: f64 = v385 * v608;
-    let v1151: f64 = v1138.mul_add(dir[1usize], v1150);
-    let v1152: f64 = q[0usize] * v1151;
-    let v1153: f64 = v562 + v1149;
-    let v1154: f64 = v1153 + v1152;
-    let v1155: f64 = v144 * v26;
-    let v1156: f64 = 0.5f64 * v78;
-    let v1157: f64 = v1156 * dir[0usize];
-    let v1158: f64 = v1155.mul_add(v548, v1157);
-    let v1159: f64 = v46 * v1158;
-    let v1160: f64 = v559 * dir[5usize];
-    let v1161: f64 = v80 * v552;
-    let v1162: f64 = v152 * v26;
-    let v1163: f64 = 0.5f64 * v88;
-    let v1164: f64 = v1163 * dir[0usize];
-    let v1165: f64 = v1162.mul_add(v548, v1164);
-    let v1166: f64 = 0.125f64 * q[4usize];
-    let v1167: f64 = v371 * dir[4usize];
-    let v1168: f64 = v1166.mul_add(dir[2usize], v1167);
-    let v1169: f64 = v1168 - v639;
-    let v1170: f64 = (-v379).mul_add(dir[3usize], v1169);
-    let v1171: f64 = v368.mul_add(v607, v1159);
-    let v1172: f64 = v1171 + v1160;
-    let v1173: f64 = v1172 + v1161;
-    let v1174: f64 = v370.mul_add(v618, v1173);
-    let v1175: f64 = v53.mul_add(v1165, v1174);
-    let v1176: f64 = v373.mul_add(v608, v1175);
-    let v1177: f64 = v47.mul_add(v1170, v1176);
-    let v1178: f64 = v58 * v1158;
-    let v1179: f64 = 0.5f64 * v614;
-    let v1180: f64 = (-v1166).mul_add(dir[0usize], v1179);
-    let v1181: f64 = v380.mul_add(dir[4usize], v1180);
-    let v1182: f64 = v368.mul_add(v628, v1178);
-    let v1183: f64 = v370.mul_add(v632, v1182);
-    let v1184: f64 = v60.mul_add(v1165, v1183);
-    let v1185: f64 = v381.mul_add(v608, v1184);
-    let v1186: f64 = v47.mul_add(v1181, v1185);
-    let v1187: f64 = v65 * v1158;
-    let v1188: f64 = v559 * dir[3usize];
-    let v1189: f64 = v233 * v552;
-    let v1190: f64 = v1166.mul_add(dir[1usize], -v601);
-    let v1191: f64 = v385.mul_add(dir[4usize], v1190);
-    let v1192: f64 = (-v379).mul_add(dir[5usize], v1191);
-    let v1193: f64 = v368.mul_add(v642, v1187);
-    let v1194: f64 = v1193 - v1188;
-    let v1195: f64 = v1194 - v1189;
-    let v1196: f64 = v370.mul_add(v646, v1195);
-    let v1197: f64 = v67.mul_add(v1165, v1196);
-    let v1198: f64 = v387.mul_add(v608, v1197);
-    let v1199: f64 = v47.mul_add(v1192, v1198);
-    let v1200: f64 = v1125 * dir[1usize];
-    let v1201: f64 = v287 * v1024;
-    let v1202: f64 = 0.015625f64 * q[2usize];
-    let v1203: f64 = v1202 * v292;
-    let v1204: f64 = v1203 * dir[0usize];
-    let v1205: f64 = 0.015625f64 * v292;
-    let v1206: f64 = v1202 * v1033;
-    let v1207: f64 = v1205.mul_add(dir[2usize], v1206);
-    let v1208: f64 = q[0usize] * v1207;
-    let v1209: f64 = v1204 - v1200;
-    let v1210: f64 = v1209 - v1201;
-    let v1211: f64 = v1210 + v1208;
-    let v1212: f64 = 0.25f64 * v1032;
-    let v1214: f64 = 0.03125f64 * q[0usize];
-    let v1215: f64 = v1214 * v292;
-    let v1216: f64 = v1215.mul_add(dir[0usize], v1212);
-    let v1217: f64 = v398.mul_add(v1033, v1216);
-    let v1218: f64 = v443 * v292;
-    let v1219: f64 = v1218 * dir[0usize];
-    let v1220: f64 = v443 * v1033;
-    let v1221: f64 = v1205.mul_add(dir[1usize], v1220);
-    let v1222: f64 = q[0usize] * v1221;
-    let v1223: f64 = v1128 + v1219;
-    let v1224: f64 = v1223 + v1222;
-    let v1225: f64 = v46 * v1165;
-    let v1226: f64 = 0.25f64 * v47;
-    let v1227: f64 = v1226 * dir[5usize];
-    let v1228: f64 = v80 * v608;
-    let v1229: f64 = v261 * v26;
-    let v1230: f64 = 0.5f64 * v242;
-    let v1231: f64 = v1230 * dir[0usize];
-    let v1232: f64 = v1229.mul_add(v548, v1231);
-    let v1233: f64 = v370.mul_add(v607, v1225);
-    let v1234: f64 = v1233 + v1227;
-    let v1235: f64 = v1234 + v1228;
-    let v1236: f64 = v405.mul_add(v618, v1235);
-    let v1237: f64 = v53.mul_add(v1232, v1236);
-    let v1238: f64 = v373.mul_add(v937, v1237);
-    let v1239: f64 = v234.mul_add(v1170, v1238);
-    let v1240: f64 = v58 * v1165;
-    let v1241: f64 = v370.mul_add(v628, v1240);
-    let v1242: f64 = v405.mul_add(v632, v1241);
-    let v1243: f64 = v60.mul_add(v1232, v1242);
-    let v1244: f64 = v381.mul_add(v937, v1243);
-    let v1245: f64 = v234.mul_add(v1181, v1244);
-    let v1246: f64 = v65 * v1165;
-    let v1247: f64 = v1226 * dir[3usize];
-    let v1248: f64 = v233 * v608;
-    let v1249: f64 = v370.mul_add(v642, v1246);
-    let v1250: f64 = v1249 - v1247;
-    let v1251: f64 = v1250 - v1248;
-    let v1252: f64 = v405.mul_add(v646, v1251);
-    let v1253: f64 = v67.mul_add(v1232, v1252);
-    let v1254: f64 = v387.mul_add(v937, v1253);
-    let v1255: f64 = v234.mul_add(v1192, v1254);
-    let v1256: f64 = v559 * dir[0usize];
-    let v1257: f64 = v15 * v552;
-    let v1258: f64 = v1136 * dir[1usize];
-    let v1259: f64 = q[1usize] * v1140;
-    let v1260: f64 = v1256 + v1257;
-    let v1261: f64 = v1260 + v1258;
-    let v1262: f64 = v1261 + v1259;
-    let v1263: f64 = v1149 - v560;
-    let v1264: f64 = v1263 - v561;
-    let v1265: f64 = v1264 + v1152;
-    let v1266: f64 = v502.mul_add(dir[1usize], v1145);
-    let v1267: f64 = v421.mul_add(v608, v1266);
-    let v1268: f64 = v144 * v20;
-    let v1269: f64 = v1156 * dir[1usize];
-    let v1270: f64 = v1268.mul_add(v548, v1269);
-    let v1271: f64 = v46 * v1270;
-    let v1272: f64 = v559 * dir[4usize];
-    let v1273: f64 = v83 * v552;
-    let v1274: f64 = v152 * v20;
-    let v1275: f64 = v1163 * dir[1usize];
-    let v1276: f64 = v1274.mul_add(v548, v1275);
-    let v1277: f64 = 0.125f64 * q[5usize];
-    let v1278: f64 = v1277.mul_add(dir[2usize], -v624);
-    let v1279: f64 = v371.mul_add(dir[5usize], v1278);
-    let v1280: f64 = (-v437).mul_add(dir[3usize], v1279);
-    let v1281: f64 = v423.mul_add(v607, v1271);
-    let v1282: f64 = v1281 - v1272;
-    let v1283: f64 = v1282 - v1273;
-    let v1284: f64 = v425.mul_add(v618, v1283);
-    let v1285: f64 = v53.mul_add(v1276, v1284);
-    let v1286: f64 = v427.mul_add(v608, v1285);
-    let v1287: f64 = v47.mul_add(v1280, v1286);
-    let v1288: f64 = v357 * dir[5usize];
-    let v1289: f64 = v1277.mul_add(dir[0usize], v1288);
-    let v1290: f64 = v1289 - v603;
-    let v1291: f64 = (-v437).mul_add(dir[4usize], v1290);
-    let v1292: f64 = v1188 + v1189;
-    let v1293: f64 = v423.mul_add(v628, v1292);
-    let v1294: f64 = v58.mul_add(v1270, v1293);
-    let v1295: f64 = v425.mul_add(v632, v1294);
-    let v1296: f64 = v60.mul_add(v1276, v1295);
-    let v1297: f64 = v432.mul_add(v608, v1296);
-    let v1298: f64 = v47.mul_add(v1291, v1297);
-    let v1299: f64 = v65 * v1270;
-    let v1300: f64 = (-v1277).mul_add(dir[1usize], v1179);
-    let v1301: f64 = v438.mul_add(dir[5usize], v1300);
-    let v1302: f64 = v423.mul_add(v642, v1299);
-    let v1303: f64 = v425.mul_add(v646, v1302);
-    let v1304: f64 = v67.mul_add(v1276, v1303);
-    let v1305: f64 = v439.mul_add(v608, v1304);
-    let v1306: f64 = v47.mul_add(v1301, v1305);
-    let v1307: f64 = v1125 * dir[0usize];
-    let v1308: f64 = v286 * v1024;
-    let v1309: f64 = v1203 * dir[1usize];
-    let v1310: f64 = q[1usize] * v1207;
-    let v1311: f64 = v1307 + v1308;
-    let v1312: f64 = v1311 + v1309;
-    let v1313: f64 = v1312 + v1310;
-    let v1314: f64 = v1219 - v1126;
-    let v1315: f64 = v1314 - v1127;
-    let v1316: f64 = v1315 + v1222;
-    let v1317: f64 = 0.03125f64 * q[1usize];
-    let v1318: f64 = v1317 * v292;
-    let v1319: f64 = v1318.mul_add(dir[1usize], v1212);
-    let v1320: f64 = v448.mul_add(v1033, v1319);
-    let v1321: f64 = v46 * v1276;
-    let v1322: f64 = v1226 * dir[4usize];
-    let v1323: f64 = v83 * v608;
-    let v1324: f64 = v261 * v20;
-    let v1325: f64 = v1230 * dir[1usize];
-    let v1326: f64 = v1324.mul_add(v548, v1325);
-    let v1327: f64 = v425.mul_add(v607, v1321);
-    let v1328: f64 = v1327 - v1322;
-    let v1329: f64 = v1328 - v1323;
-    let v1330: f64 = v451.mul_add(v618, v1329);
-    let v1331: f64 = v53.mul_add(v1326, v1330);
-    let v1332: f64 = v427.mul_add(v937, v1331);
-    let v1333: f64 = v234.mul_add(v1280, v1332);
-    let v1334: f64 = v1247 + v1248;
-    let v1335: f64 = v425.mul_add(v628, v1334);
-    let v1336: f64 = v58.mul_add(v1276, v1335);
-    let v1337: f64 = v451.mul_add(v632, v1336);
-    let v1338: f64 = v60.mul_add(v1326, v1337);
-    let v1339: f64 = v432.mul_add(v937, v1338);
-    let v1340: f64 = v234.mul_add(v1291, v1339);
-    let v1341: f64 = v65 * v1276;
-    let v1342: f64 = v425.mul_add(v642, v1341);
-    let v1343: f64 = v451.mul_add(v646, v1342);
-    let v1344: f64 = v67.mul_add(v1326, v1343);
-    let v1345: f64 = v439.mul_add(v937, v1344);
-    let v1346: f64 = v234.mul_add(v1301, v1345);
-    let v1347: f64 = v512.mul_add(dir[2usize], v1145);
-    let v1348: f64 = v461.mul_add(v608, v1347);
-    let v1349: f64 = v585 + v1137;
-    let v1350: f64 = v1349 + v1141;
-    let v1351: f64 = v1258 - v1256;
-    let v1352: f64 = v1351 - v1257;
-    let v1353: f64 = v1352 + v1259;
-    let v1354: f64 = v144 * v33;
-    let v1355: f64 = v1156 * dir[2usize];
-    let v1356: f64 = v1354.mul_add(v548, v1355);
-    let v1357: f64 = v46 * v1356;
-    let v1358: f64 = v152 * v33;
-    let v1359: f64 = v1163 * dir[2usize];
-    let v1360: f64 = v1358.mul_add(v548, v1359);
-    let v1361: f64 = 0.125f64 * v41;
-    let v1362: f64 = (-v1361).mul_add(dir[2usize], v1179);
-    let v1363: f64 = v469.mul_add(dir[3usize], v1362);
-    let v1364: f64 = v465.mul_add(v607, v1357);
-    let v1365: f64 = v466.mul_add(v618, v1364);
-    let v1366: f64 = v53.mul_add(v1360, v1365);
-    let v1367: f64 = v470.mul_add(v608, v1366);
-    let v1368: f64 = v47.mul_add(v1363, v1367);
-    let v1369: f64 = v1361.mul_add(dir[0usize], -v638);
-    let v1370: f64 = v357.mul_add(dir[3usize], v1369);
-    let v1371: f64 = (-v468).mul_add(dir[4usize], v1370);
-    let v1372: f64 = v465.mul_add(v628, -v1160);
-    let v1373: f64 = v1372 - v1161;
-    let v1374: f64 = v58.mul_add(v1356, v1373);
-    let v1375: f64 = v466.mul_add(v632, v1374);
-    let v1376: f64 = v60.mul_add(v1360, v1375);
-    let v1377: f64 = v474.mul_add(v608, v1376);
-    let v1378: f64 = v47.mul_add(v1371, v1377);
-    let v1379: f64 = v385 * dir[3usize];
-    let v1380: f64 = v1361.mul_add(dir[1usize], v1379);
-    let v1381: f64 = v1380 - v625;
-    let v1382: f64 = (-v468).mul_add(dir[5usize], v1381);
-    let v1383: f64 = v1272 + v1273;
-    let v1384: f64 = v465.mul_add(v642, v1383);
-    let v1385: f64 = v65.mul_add(v1356, v1384);
-    let v1386: f64 = v466.mul_add(v646, v1385);
-    let v1387: f64 = v67.mul_add(v1360, v1386);
-    let v1388: f64 = v479.mul_add(v608, v1387);
-    let v1389: f64 = v47.mul_add(v1382, v1388);
-    let v1390: f64 = 0.03125f64 * q[2usize];
-    let v1391: f64 = v1390 * v292;
-    let v1392: f64 = v1391.mul_add(dir[2usize], v1212);
-    let v1393: f64 = v483.mul_add(v1033, v1392);
-    let v1394: f64 = v1200 + v1201;
-    let v1395: f64 = v1394 + v1204;
-    let v1396: f64 = v1395 + v1208;
-    let v1397: f64 = v1309 - v1307;
-    let v1398: f64 = v1397 - v1308;
-    let v1399: f64 = v1398 + v1310;
-    let v1400: f64 = v46 * v1360;
-    let v1401: f64 = v261 * v33;
-    let v1402: f64 = v1230 * dir[2usize];
-    let v1403: f64 = v1401.mul_add(v548, v1402);
-    let v1404: f64 = v466.mul_add(v607, v1400);
-    let v1405: f64 = v487.mul_add(v618, v1404);
-    let v1406: f64 = v53.mul_add(v1403, v1405);
-    let v1407: f64 = v470.mul_add(v937, v1406);
-    let v1408: f64 = v234.mul_add(v1363, v1407);
-    let v1409: f64 = v466.mul_add(v628, -v1227);
-    let v1410: f64 = v1409 - v1228;
-    let v1411: f64 = v58.mul_add(v1360, v1410);
-    let v1412: f64 = v487.mul_add(v632, v1411);
-    let v1413: f64 = v60.mul_add(v1403, v1412);
-    let v1414: f64 = v474.mul_add(v937, v1413);
-    let v1415: f64 = v234.mul_add(v1371, v1414);
-    let v1416: f64 = v1322 + v1323;
-    let v1417: f64 = v466.mul_add(v642, v1416);
-    let v1418: f64 = v65.mul_add(v1360, v1417);
-    let v1419: f64 = v487.mul_add(v646, v1418);
-    let v1420: f64 = v67.mul_add(v1403, v1419);
-    let v1421: f64 = v479.mul_add(v937, v1420);
-    let v1422: f64 = v234.mul_add(v1382, v1421);
-    let v1423: f64 = 0.5f64 * v548;
-    let v1424: f64 = v48.mul_add(dir[2usize], -v1423);
-    let v1425: f64 = v47 * v1424;
-    let v1426: f64 = v499.mul_add(v608, v1425);
-    let v1427: f64 = v234 * v1424;
-    let v1428: f64 = v499.mul_add(v937, v1427);
-    let v1429: f64 = v1226 * dir[1usize];
-    let v1430: f64 = v23 * v608;
-    let v1431: f64 = v371 * v234;
-    let v1432: f64 = v1431 * dir[0usize];
-    let v1433: f64 = 0.125f64 * v234;
-    let v1434: f64 = v371 * v937;
-    let v1435: f64 = v1433.mul_add(dir[2usize], v1434);
-    let v1436: f64 = q[0usize] * v1435;
-    let v1437: f64 = v1429 + v1430;
-    let v1438: f64 = v1437 + v1432;
-    let v1439: f64 = v1438 + v1436;
-    let v1440: f64 = v1226 * dir[0usize];
-    let v1441: f64 = v15 * v608;
-    let v1442: f64 = v1431 * dir[1usize];
-    let v1443: f64 = q[1usize] * v1435;
-    let v1444: f64 = v1442 - v1440;
-    let v1445: f64 = v1444 - v1441;
-    let v1446: f64 = v1445 + v1443;
-    let v1447: f64 = v15.mul_add(dir[0usize], -v1423);
-    let v1448: f64 = v47 * v1447;
-    let v1449: f64 = v508.mul_add(v608, v1448);
-    let v1450: f64 = v1432 - v1429;
-    let v1451: f64 = v1450 - v1430;
-    let v1452: f64 = v1451 + v1436;
-    let v1453: f64 = v234 * v1447;
-    let v1454: f64 = v508.mul_add(v937, v1453);
-    let v1455: f64 = v1226 * dir[2usize];
-    let v1456: f64 = v48 * v608;
-    let v1457: f64 = v385 * v234;
-    let v1458: f64 = v1457 * dir[0usize];
-    let v1459: f64 = v385 * v937;
-    let v1460: f64 = v1433.mul_add(dir[1usize], v1459);
-    let v1461: f64 = q[0usize] * v1460;
-    let v1462: f64 = v1455 + v1456;
-    let v1463: f64 = v1462 + v1458;
-    let v1464: f64 = v1463 + v1461;
-    let v1465: f64 = v23.mul_add(dir[1usize], -v1423);
-    let v1466: f64 = v47 * v1465;
-    let v1467: f64 = v515.mul_add(v608, v1466);
-    let v1468: f64 = v1440 + v1441;
-    let v1469: f64 = v1468 + v1442;
-    let v1470: f64 = v1469 + v1443;
-    let v1471: f64 = v1458 - v1455;
-    let v1472: f64 = v1471 - v1456;
-    let v1473: f64 = v1472 + v1461;
-    let v1474: f64 = v234 * v1465;
-    let v1475: f64 = v515.mul_add(v937, v1474);
-    let v1476: f64 = 0.5f64 * p[5usize];
-    let v1477: f64 = v1476 * dir[6usize];
-    let v1478: f64 = v526.mul_add(dir[0usize], v1477);
-    let v1479: f64 = v1476 * dir[7usize];
-    let v1480: f64 = v526.mul_add(dir[1usize], v1479);
-    let v1481: f64 = 0.5f64 * p[7usize];
-    let v1482: f64 = 0.5f64 * p[8usize];
-    let v1483: f64 = v1482 * dir[8usize];
-    let v1484: f64 = v1481.mul_add(dir[2usize], v1483);
-    let v1485: f64 = 0.5f64 * p[9usize];
-    let v1486: f64 = 0.5f64 * p[10usize];
-    let v1487: f64 = v1486 * dir[9usize];
-    let v1488: f64 = v1485.mul_add(dir[3usize], v1487);
-    let v1489: f64 = 0.5f64 * p[11usize];
-    let v1490: f64 = v1486 * dir[10usize];
-    let v1491: f64 = v1489.mul_add(dir[4usize], v1490);
-    let v1492: f64 = v1486 * dir[11usize];
-    let v1493: f64 = v1489.mul_add(dir[5usize], v1492);
-    out[0usize] = v14;
-    out[1usize] = v22;
-    out[2usize] = v28;
-    out[3usize] = v29;
-    out[4usize] = v30;
-    out[5usize] = v35;
-    out[6usize] = v36;
-    out[7usize] = v37;
-    out[8usize] = v38;
-    out[9usize] = v55;
-    out[10usize] = v62;
-    out[11usize] = v69;
-    out[12usize] = v105;
-    out[13usize] = v120;
-    out[14usize] = v135;
-    out[15usize] = v166;
-    out[16usize] = v178;
-    out[17usize] = v190;
-    out[18usize] = v199;
-    out[19usize] = v205;
-    out[20usize] = v211;
-    out[21usize] = v226;
-    out[22usize] = v229;
-    out[23usize] = v232;
-    out[24usize] = v236;
-    out[25usize] = v238;
-    out[26usize] = v240;
-    out[27usize] = v247;
-    out[28usize] = v252;
-    out[29usize] = v257;
-    out[30usize] = v268;
-    out[31usize] = v275;
-    out[32usize] = v282;
-    out[33usize] = v299;
-    out[34usize] = v305;
-    out[35usize] = v311;
-    out[36usize] = v331;
-    out[37usize] = v334;
-    out[38usize] = v337;
-    out[39usize] = v340;
-    out[40usize] = v343;
-    out[41usize] = v346;
-    out[42usize] = v348;
-    out[43usize] = v354;
-    out[44usize] = v355;
-    out[45usize] = v360;
-    out[46usize] = v363;
-    out[47usize] = v367;
-    out[48usize] = v376;
-    out[49usize] = v383;
-    out[50usize] = v390;
-    out[51usize] = v396;
-    out[52usize] = v399;
-    out[53usize] = v403;
-    out[54usize] = v408;
-    out[55usize] = v411;
-    out[56usize] = v415;
-    out[57usize] = v419;
-    out[58usize] = v420;
-    out[59usize] = v422;
-    out[60usize] = v430;
-    out[61usize] = v435;
-    out[62usize] = v441;
-    out[63usize] = v446;
-    out[64usize] = v447;
-    out[65usize] = v449;
-    out[66usize] = v454;
-    out[67usize] = v457;
-    out[68usize] = v460;
-    out[69usize] = v462;
-    out[70usize] = v463;
-    out[71usize] = v464;
-    out[72usize] = v472;
-    out[73usize] = v477;
-    out[74usize] = v482;
-    out[75usize] = v484;
-    out[76usize] = v485;
-    out[77usize] = v486;
-    out[78usize] = v490;
-    out[79usize] = v493;
-    out[80usize] = v496;
-    out[81usize] = 0f64;
-    out[82usize] = 0f64;
-    out[83usize] = 0f64;
-    out[84usize] = v500;
-    out[85usize] = v463;
-    out[86usize] = v464;
-    out[87usize] = 0f64;
-    out[88usize] = 0f64;
-    out[89usize] = 0f64;
-    out[90usize] = v501;
-    out[91usize] = v504;
-    out[92usize] = v507;
-    out[93usize] = 0f64;
-    out[94usize] = 0f64;
-    out[95usize] = 0f64;
-    out[96usize] = v360;
-    out[97usize] = v509;
-    out[98usize] = v367;
-    out[99usize] = 0f64;
-    out[100usize] = 0f64;
-    out[101usize] = 0f64;
-    out[102usize] = v510;
-    out[103usize] = v511;
-    out[104usize] = v514;
-    out[105usize] = 0f64;
-    out[106usize] = 0f64;
-    out[107usize] = 0f64;
-    out[108usize] = v419;
-    out[109usize] = v420;
-    out[110usize] = v516;
-    out[111usize] = 0f64;
-    out[112usize] = 0f64;
-    out[113usize] = 0f64;
-    out[114usize] = v517;
-    out[115usize] = v518;
-    out[116usize] = v519;
-    out[117usize] = v523;
-    out[118usize] = v528;
-    out[119usize] = v532;
-    out[120usize] = v537;
-    out[121usize] = v540;
-    out[122usize] = v542;
-    out[123usize] = 0f64;
-    out[124usize] = 0f64;
-    out[125usize] = 0f64;
-    out[126usize] = 0f64;
-    out[127usize] = 0f64;
-    out[128usize] = 0f64;
-    out[129usize] = v554;
-    out[130usize] = v566;
-    out[131usize] = v573;
-    out[132usize] = v576;
-    out[133usize] = v579;
-    out[134usize] = v589;
-    out[135usize] = v592;
-    out[136usize] = v595;
-    out[137usize] = v598;
-    out[138usize] = v622;
-    out[139usize] = v636;
-    out[140usize] = v650;
-    out[141usize] = v707;
-    out[142usize] = v732;
-    out[143usize] = v757;
-    out[144usize] = v804;
-    out[145usize] = v829;
-    out[146usize] = v854;
-    out[147usize] = v873;
-    out[148usize] = v883;
-    out[149usize] = v893;
-    out[150usize] = v917;
-    out[151usize] = v926;
-    out[152usize] = v935;
-    out[153usize] = v941;
-    out[154usize] = v946;
-    out[155usize] = v951;
-    out[156usize] = v963;
-    out[157usize] = v972;
-    out[158usize] = v981;
-    out[159usize] = v998;
-    out[160usize] = v1010;
-    out[161usize] = v1022;
-    out[162usize] = v1048;
-    out[163usize] = v1058;
-    out[164usize] = v1068;
-    out[165usize] = v1102;
-    out[166usize] = v1111;
-    out[167usize] = v1120;
-    out[168usize] = v1123;
-    out[169usize] = v1131;
-    out[170usize] = v1135;
-    out[171usize] = 0f64;
-    out[172usize] = 0f64;
-    out[173usize] = 0f64;
-    out[174usize] = v1144;
-    out[175usize] = v1147;
-    out[176usize] = v1154;
-    out[177usize] = v1177;
-    out[178usize] = v1186;
-    out[179usize] = v1199;
-    out[180usize] = v1211;
-    out[181usize] = v1217;
-    out[182usize] = v1224;
-    out[183usize] = v1239;
-    out[184usize] = v1245;
-    out[185usize] = v1255;
-    out[186usize] = v1262;
-    out[187usize] = v1265;
-    out[188usize] = v1267;
-    out[189usize] = v1287;
-    out[190usize] = v1298;
-    out[191usize] = v1306;
-    out[192usize] = v1313;
-    out[193usize] = v1316;
-    out[194usize] = v1320;
-    out[195usize] = v1333;
-    out[196usize] = v1340;
-    out[197usize] = v1346;
-    out[198usize] = v1348;
-    out[199usize] = v1350;
-    out[200usize] = v1353;
-    out[201usize] = v1368;
-    out[202usize] = v1378;
-    out[203usize] = v1389;
-    out[204usize] = v1393;
-    out[205usize] = v1396;
-    out[206usize] = v1399;
-    out[207usize] = v1408;
-    out[208usize] = v1415;
-    out[209usize] = v1422;
-    out[210usize] = 0f64;
-    out[211usize] = 0f64;
-    out[212usize] = 0f64;
-    out[213usize] = v1426;
-    out[214usize] = v1350;
-    out[215usize] = v1353;
-    out[216usize] = 0f64;
-    out[217usize] = 0f64;
-    out[218usize] = 0f64;
-    out[219usize] = v1428;
-    out[220usize] = v1439;
-    out[221usize] = v1446;
-    out[222usize] = 0f64;
-    out[223usize] = 0f64;
-    out[224usize] = 0f64;
-    out[225usize] = v1144;
-    out[226usize] = v1449;
-    out[227usize] = v1154;
-    out[228usize] = 0f64;
-    out[229usize] = 0f64;
-    out[230usize] = 0f64;
-    out[231usize] = v1452;
-    out[232usize] = v1454;
-    out[233usize] = v1464;
-    out[234usize] = 0f64;
-    out[235usize] = 0f64;
-    out[236usize] = 0f64;
-    out[237usize] = v1262;
-    out[238usize] = v1265;
-    out[239usize] = v1467;
-    out[240usize] = 0f64;
-    out[241usize] = 0f64;
-    out[242usize] = 0f64;
-    out[243usize] = v1470;
-    out[244usize] = v1473;
-    out[245usize] = v1475;
-    out[246usize] = v1478;
-    out[247usize] = v1480;
-    out[248usize] = v1484;
-    out[249usize] = v1488;
-    out[250usize] = v1491;
-    out[251usize] = v1493;
-    out[252usize] = 0f64;
-    out[253usize] = 0f64;
-    out[254usize] = 0f64;
-    out[255usize] = 0f64;
-    out[256usize] = 0f64;
-    out[257usize] = 0f64;
+    let v284: f64 = c[2][0];
+    let v290: f64 = c[1][0];
+    let v292: f64 = c[3][0];
+    let v313: f64 = c[2][1];
+    let v315: f64 = c[3][1];
+    let v326: f64 = c[1][1];
+    let v1070: f64 = c[2][2];
+    let v1076: f64 = c[3][2];
+    let v1090: f64 = c[1][2];
+    let v286 = 0.0625f64 * q[0];
+    let v287 = 0.0625f64 * q[1];
+    let v288 = v287 * qd[0];
+    let v289 = v286.mul_add(qd[1], -v288);
+    let v291 = v91 * v290;
+    let v293 = 0.0625f64 * q[2];
+    let v294 = v286 * qd[0];
+    let v295 = v293.mul_add(qd[2], v294);
+    let v296 = v287.mul_add(qd[1], v295);
+    let v297 = v48 * v292;
+    let v298 = v284.mul_add(v289, v291);
+    let v299 = v297.mul_add(v296, v298);
+    let v300 = v293 * qd[1];
+    let v301 = v287.mul_add(qd[2], -v300);
+    let v302 = v123 * v290;
+    let v303 = v15 * v292;
+    let v304 = v284.mul_add(v301, v302);
+    let v305 = v303.mul_add(v296, v304);
+    let v306 = v286 * qd[2];
+    let v307 = v293.mul_add(qd[0], -v306);
+    let v308 = v107 * v290;
+    let v309 = v23 * v292;
+    let v310 = v284.mul_add(v307, v308);
+    let v311 = v309.mul_add(v296, v310);
+    let v312 = 0.25f64 * v77;
+    let v314 = v312 * v313;
+    let v316 = v312 * v315;
+    let v317 = 0.25f64 * v296;
+    let v318 = v317 * v316;
+    let v319 = 0.0625f64 * v139;
+    let v320 = 0.0625f64.mul_add(v138, v319);
+    let v321 = 0.0625f64.mul_add(v141, v320);
+    let v322 = 0.25f64 * v292;
+    let v323 = v322.mul_add(v321, v318);
+    let v324 = q[2] * v323;
+    let v325 = v322 * v296;
+    let v327 = v312 * v326;
+    let v328 = 0.25f64 * v327;
+    let v329 = v325 + v328;
+    let v330 = v289.mul_add(v314, v324);
+    let v331 = qd[2].mul_add(v329, v330);
+    let v332 = q[0] * v323;
+    let v333 = v301.mul_add(v314, v332);
+    let v334 = qd[0].mul_add(v329, v333);
+    let v335 = q[1] * v323;
+    let v336 = v307.mul_add(v314, v335);
+    let v337 = qd[1].mul_add(v329, v336);
+    let v339 = 0.0625f64.mul_add(v5, -v283);
+    let v340 = v284.mul_add(v339, 1f64);
+    let v341 = v286 * q[2];
+    let v342 = v341 * v284;
+    let v343 = v23.mul_add(v290, v342);
+    let v344 = v287 * q[2];
+    let v345 = v15 * v290;
+    let v346 = v344.mul_add(v284, -v345);
+    let v348 = 0.5f64 * p[1];
+    let v350 = 0.25f64 * p[3];
+    let v352 = p[2] - v350;
+    let v354 = 0.125f64.mul_add(v352, v350);
+    let v355 = 0.5f64 * p[3];
+    let v356 = v23 * v13;
+    let v357 = 0.125f64 * q[0];
+    let v358 = v357 * q[2];
+    let v359 = v358 * v47;
+    let v360 = v359 - v356;
+    let v361 = 0.5f64 * v18;
+    let v362 = 0.125f64 * v1;
+    let v363 = v362.mul_add(v47, v361);
+    let v364 = v48 * v13;
+    let v365 = v357 * q[1];
+    let v366 = v365 * v47;
+    let v367 = v364 + v366;
+    let v368 = v78 * v26;
+    let v369 = v80 * v13;
+    let v370 = v88 * v26;
+    let v371 = 0.125f64 * q[2];
+    let v372 = v42 * v26;
+    let v373 = v371.mul_add(q[4], -v372);
+    let v374 = v46.mul_add(v368, v369);
+    let v375 = v53.mul_add(v370, v374);
+    let v376 = v47.mul_add(v373, v375);
+    let v377 = v60 * v370;
+    let v378 = 0.5f64 * v51;
+    let v379 = 0.5f64 * v26;
+    let v380 = v357 - v379;
+    let v381 = q[4].mul_add(v380, v378);
+    let v382 = v58.mul_add(v368, v377);
+    let v383 = v47.mul_add(v381, v382);
+    let v384 = v233 * v13;
+    let v385 = 0.125f64 * q[1];
+    let v386 = v63 * v26;
+    let v387 = v385.mul_add(q[4], -v386);
+    let v388 = v65.mul_add(v368, -v384);
+    let v389 = v67.mul_add(v370, v388);
+    let v390 = v47.mul_add(v387, v389);
+    let v391 = v287 * v284;
+    let v393 = 0.015625f64 * q[0];
+    let v394 = v393 * q[2];
+    let v395 = v394 * v292;
+    let v396 = v395 - v391;
+    let v397 = 0.25f64 * v290;
+    let v398 = 0.015625f64 * v1;
+    let v399 = v398.mul_add(v292, v397);
+    let v400 = v293 * v284;
+    let v401 = v393 * q[1];
+    let v402 = v401 * v292;
+    let v403 = v400 + v402;
+    let v404 = v80 * v47;
+    let v405 = v242 * v26;
+    let v406 = v46.mul_add(v370, v404);
+    let v407 = v53.mul_add(v405, v406);
+    let v408 = v234.mul_add(v373, v407);
+    let v409 = v60 * v405;
+    let v410 = v58.mul_add(v370, v409);
+    let v411 = v234.mul_add(v381, v410);
+    let v412 = v233 * v47;
+    let v413 = v65.mul_add(v370, -v412);
+    let v414 = v67.mul_add(v405, v413);
+    let v415 = v234.mul_add(v387, v414);
+    let v416 = v15 * v13;
+    let v417 = v385 * q[2];
+    let v418 = v417 * v47;
+    let v419 = v416 + v418;
+    let v420 = v366 - v364;
+    let v421 = 0.125f64 * v8;
+    let v422 = v421.mul_add(v47, v361);
+    let v423 = v78 * v20;
+    let v424 = v83 * v13;
+    let v425 = v88 * v20;
+    let v426 = v42 * v20;
+    let v427 = v371.mul_add(q[5], -v426);
+    let v428 = v46.mul_add(v423, -v424);
+    let v429 = v53.mul_add(v425, v428);
+    let v430 = v47.mul_add(v427, v429);
+    let v431 = v56 * v20;
+    let v432 = v357.mul_add(q[5], -v431);
+    let v433 = v58.mul_add(v423, v384);
+    let v434 = v60.mul_add(v425, v433);
+    let v435 = v47.mul_add(v432, v434);
+    let v436 = v67 * v425;
+    let v437 = 0.5f64 * v20;
+    let v438 = v385 - v437;
+    let v439 = q[5].mul_add(v438, v378);
+    let v440 = v65.mul_add(v423, v436);
+    let v441 = v47.mul_add(v439, v440);
+    let v442 = v286 * v284;
+    let v443 = 0.015625f64 * q[1];
+    let v444 = v443 * q[2];
+    let v445 = v444 * v292;
+    let v446 = v442 + v445;
+    let v447 = v402 - v400;
+    let v448 = 0.015625f64 * v8;
+    let v449 = v448.mul_add(v292, v397);
+    let v450 = v83 * v47;
+    let v451 = v242 * v20;
+    let v452 = v46.mul_add(v425, -v450);
+    let v453 = v53.mul_add(v451, v452);
+    let v454 = v234.mul_add(v427, v453);
+    let v455 = v58.mul_add(v425, v412);
+    let v456 = v60.mul_add(v451, v455);
+    let v457 = v234.mul_add(v432, v456);
+    let v458 = v67 * v451;
+    let v459 = v65.mul_add(v425, v458);
+    let v460 = v234.mul_add(v439, v459);
+    let v461 = 0.125f64 * v5;
+    let v462 = v461.mul_add(v47, v361);
+    let v463 = v356 + v359;
+    let v464 = v418 - v416;
+    let v465 = v78 * v33;
+    let v466 = v88 * v33;
+    let v467 = v53 * v466;
+    let v468 = 0.5f64 * v33;
+    let v469 = v371 - v468;
+    let v470 = v41.mul_add(v469, v378);
+    let v471 = v46.mul_add(v465, v467);
+    let v472 = v47.mul_add(v470, v471);
+    let v473 = v56 * v33;
+    let v474 = v357.mul_add(v41, -v473);
+    let v475 = v58.mul_add(v465, -v369);
+    let v476 = v60.mul_add(v466, v475);
+    let v477 = v47.mul_add(v474, v476);
+    let v478 = v63 * v33;
+    let v479 = v385.mul_add(v41, -v478);
+    let v480 = v65.mul_add(v465, v424);
+    let v481 = v67.mul_add(v466, v480);
+    let v482 = v47.mul_add(v479, v481);
+    let v483 = 0.015625f64 * v5;
+    let v484 = v483.mul_add(v292, v397);
+    let v485 = v391 + v395;
+    let v486 = v445 - v442;
+    let v487 = v242 * v33;
+    let v488 = v53 * v487;
+    let v489 = v46.mul_add(v466, v488);
+    let v490 = v234.mul_add(v470, v489);
+    let v491 = v58.mul_add(v466, -v404);
+    let v492 = v60.mul_add(v487, v491);
+    let v493 = v234.mul_add(v474, v492);
+    let v494 = v65.mul_add(v466, v450);
+    let v495 = v67.mul_add(v487, v494);
+    let v496 = v234.mul_add(v479, v495);
+    let v498 = 0.5f64 * v11;
+    let v499 = v461 - v498;
+    let v500 = v47.mul_add(v499, 0.5f64);
+    let v501 = v234.mul_add(v499, 0.25f64);
+    let v502 = v23 * v47;
+    let v503 = v358 * v234;
+    let v504 = v502 + v503;
+    let v505 = v15 * v47;
+    let v506 = v417 * v234;
+    let v507 = v506 - v505;
+    let v508 = v362 - v498;
+    let v509 = v47.mul_add(v508, 0.5f64);
+    let v510 = v503 - v502;
+    let v511 = v234.mul_add(v508, 0.25f64);
+    let v512 = v48 * v47;
+    let v513 = v365 * v234;
+    let v514 = v512 + v513;
+    let v515 = v421 - v498;
+    let v516 = v47.mul_add(v515, 0.5f64);
+    let v517 = v505 + v506;
+    let v518 = v513 - v512;
+    let v519 = v234.mul_add(v515, 0.25f64);
+    let v522 = v112 * p[5];
+    let v523 = v26.mul_add(p[4], v522);
+    let v525 = q[1] - p[6];
+    let v526 = 0.5f64 * p[4];
+    let v527 = v127 * p[5];
+    let v528 = v526.mul_add(v525, v527);
+    let v531 = v90 * p[8];
+    let v532 = v33.mul_add(p[7], v531);
+    let v534 = 0.5f64 * q[3];
+    let v536 = v71 * p[10];
+    let v537 = v534.mul_add(p[9], v536);
+    let v539 = v106 * p[10];
+    let v540 = v56.mul_add(p[11], v539);
+    let v541 = v121 * p[10];
+    let v542 = v63.mul_add(p[11], v541);
+    let v545 = v33 * dir[2];
+    let v547 = v26.mul_add(dir[0], v545);
+    let v548 = v20.mul_add(dir[1], v547);
+    let v550 = v548 * v549;
+    let v551 = v33 * v13;
+    let v552 = v78 * v548;
+    let v553 = v551.mul_add(dir[2], v550);
+    let v554 = v6.mul_add(v552, v553);
+    let v555 = v364 * dir[0];
+    let v556 = v361 * dir[1];
+    let v557 = v221 * v548;
+    let v558 = v20 * v557;
+    let v559 = 0.25f64 * v13;
+    let v560 = v559 * dir[2];
+    let v561 = v48 * v552;
+    let v562 = v560 + v561;
+    let v563 = q[0] * v562;
+    let v564 = v555 - v556;
+    let v565 = v564 - v558;
+    let v566 = v565 + v563;
+    let v567 = v364 * dir[1];
+    let v568 = v361 * dir[0];
+    let v569 = v26 * v557;
+    let v570 = q[1] * v562;
+    let v571 = v567 + v568;
+    let v572 = v571 + v569;
+    let v573 = v572 + v570;
+    let v574 = v555 + v556;
+    let v575 = v574 + v558;
+    let v576 = v575 + v563;
+    let v577 = v26 * v13;
+    let v578 = v577.mul_add(dir[0], v550);
+    let v579 = v3.mul_add(v552, v578);
+    let v580 = v356 * dir[0];
+    let v581 = v361 * dir[2];
+    let v582 = v33 * v557;
+    let v583 = v559 * dir[1];
+    let v584 = v23 * v552;
+    let v585 = v583 + v584;
+    let v586 = q[0] * v585;
+    let v587 = v580 - v581;
+    let v588 = v587 - v582;
+    let v589 = v588 + v586;
+    let v590 = v567 - v568;
+    let v591 = v590 - v569;
+    let v592 = v591 + v570;
+    let v593 = v580 + v581;
+    let v594 = v593 + v582;
+    let v595 = v594 + v586;
+    let v596 = v20 * v13;
+    let v597 = v596.mul_add(dir[1], v550);
+    let v598 = v9.mul_add(v552, v597);
+    let v600 = v46 * v552;
+    let v601 = v80 * dir[0];
+    let v603 = v83 * dir[1];
+    let v605 = v15.mul_add(dir[5], v601);
+    let v606 = v605 - v603;
+    let v607 = (-v23).mul_add(dir[4], v606);
+    let v608 = v88 * v548;
+    let v609 = v48 * dir[3];
+    let v610 = v233.mul_add(dir[2], v609);
+    let v611 = v83.mul_add(dir[0], v610);
+    let v612 = v15.mul_add(dir[4], v611);
+    let v613 = v80.mul_add(dir[1], v612);
+    let v614 = v23.mul_add(dir[5], v613);
+    let v615 = v33 * v614;
+    let v616 = v378.mul_add(dir[2], v615);
+    let v617 = (-v498).mul_add(dir[3], v616);
+    let v618 = (-v42).mul_add(v548, v617);
+    let v619 = 0.5f64.mul_add(dir[3], v600);
+    let v620 = v13.mul_add(v607, v619);
+    let v621 = v53.mul_add(v608, v620);
+    let v622 = v47.mul_add(v618, v621);
+    let v623 = v58 * v552;
+    let v624 = v233 * dir[1];
+    let v625 = v80 * dir[2];
+    let v626 = v23.mul_add(dir[3], v624);
+    let v627 = v626 - v625;
+    let v628 = (-v48).mul_add(dir[5], v627);
+    let v629 = v26 * v614;
+    let v630 = v378.mul_add(dir[0], v629);
+    let v631 = (-v498).mul_add(dir[4], v630);
+    let v632 = (-v56).mul_add(v548, v631);
+    let v633 = 0.5f64.mul_add(dir[4], v623);
+    let v634 = v13.mul_add(v628, v633);
+    let v635 = v60.mul_add(v608, v634);
+    let v636 = v47.mul_add(v632, v635);
+    let v637 = v65 * v552;
+    let v638 = v83 * dir[2];
+    let v639 = v233 * dir[0];
+    let v640 = v48.mul_add(dir[4], v638);
+    let v641 = v640 - v639;
+    let v642 = (-v15).mul_add(dir[3], v641);
+    let v643 = v20 * v614;
+    let v644 = v378.mul_add(dir[1], v643);
+    let v645 = (-v498).mul_add(dir[5], v644);
+    let v646 = (-v63).mul_add(v548, v645);
+    let v647 = 0.5f64.mul_add(dir[5], v637);
+    let v648 = v13.mul_add(v642, v647);
+    let v649 = v67.mul_add(v608, v648);
+    let v650 = v47.mul_add(v646, v649);
+    let v652 = v79 * v607;
+    let v654 = v33 * dir[8];
+    let v657 = v90.mul_add(dir[2], v654);
+    let v658 = v112.mul_add(dir[0], v657);
+    let v659 = v26.mul_add(dir[6], v658);
+    let v660 = v127.mul_add(dir[1], v659);
+    let v661 = v20.mul_add(dir[7], v660);
+    let v662 = v77 * v144;
+    let v663 = v662 * v548;
+    let v664 = v78.mul_add(v661, v663);
+    let v665 = v80 * dir[6];
+    let v668 = v123.mul_add(dir[5], v665);
+    let v669 = v253.mul_add(dir[0], v668);
+    let v670 = v15.mul_add(dir[11], v669);
+    let v671 = (-v107).mul_add(dir[4], v670);
+    let v672 = (-v83).mul_add(dir[7], v671);
+    let v673 = (-v248).mul_add(dir[1], v672);
+    let v674 = (-v23).mul_add(dir[10], v673);
+    let v675 = v77 * v152;
+    let v676 = v675 * v548;
+    let v677 = v88.mul_add(v661, v676);
+    let v678 = v90 * v614;
+    let v679 = 0.5f64 * v97;
+    let v680 = v91 * dir[3];
+    let v681 = v233.mul_add(dir[8], v680);
+    let v682 = v241.mul_add(dir[2], v681);
+    let v683 = v48.mul_add(dir[9], v682);
+    let v684 = v123.mul_add(dir[4], v683);
+    let v685 = v83.mul_add(dir[6], v684);
+    let v686 = v248.mul_add(dir[0], v685);
+    let v687 = v15.mul_add(dir[10], v686);
+    let v688 = v107.mul_add(dir[5], v687);
+    let v689 = v80.mul_add(dir[7], v688);
+    let v690 = v253.mul_add(dir[1], v689);
+    let v691 = v23.mul_add(dir[11], v690);
+    let v692 = 0.5f64 * v77;
+    let v693 = v378.mul_add(dir[8], v678);
+    let v694 = v679.mul_add(dir[2], v693);
+    let v695 = v33.mul_add(v691, v694);
+    let v696 = (-v498).mul_add(dir[9], v695);
+    let v697 = (-v71).mul_add(v548, v696);
+    let v698 = (-v692).mul_add(dir[3], v697);
+    let v699 = (-v42).mul_add(v661, v698);
+    let v700 = 0.5f64.mul_add(dir[9], v652);
+    let v701 = v46.mul_add(v664, v700);
+    let v702 = v87.mul_add(v552, v701);
+    let v703 = v13.mul_add(v674, v702);
+    let v704 = v89.mul_add(v618, v703);
+    let v705 = v53.mul_add(v677, v704);
+    let v706 = v101.mul_add(v608, v705);
+    let v707 = v47.mul_add(v699, v706);
+    let v708 = v79 * v628;
+    let v709 = v107 * dir[3];
+    let v710 = v233.mul_add(dir[7], v709);
+    let v711 = v241.mul_add(dir[1], v710);
+    let v712 = v23.mul_add(dir[9], v711);
+    let v713 = (-v91).mul_add(dir[5], v712);
+    let v714 = (-v80).mul_add(dir[8], v713);
+    let v715 = (-v253).mul_add(dir[2], v714);
+    let v716 = (-v48).mul_add(dir[11], v715);
+    let v717 = v112 * v614;
+    let v718 = v378.mul_add(dir[6], v717);
+    let v719 = v679.mul_add(dir[0], v718);
+    let v720 = v26.mul_add(v691, v719);
+    let v721 = (-v498).mul_add(dir[10], v720);
+    let v722 = (-v106).mul_add(v548, v721);
+    let v723 = (-v692).mul_add(dir[4], v722);
+    let v724 = (-v56).mul_add(v661, v723);
+    let v725 = 0.5f64.mul_add(dir[10], v708);
+    let v726 = v58.mul_add(v664, v725);
+    let v727 = v111.mul_add(v552, v726);
+    let v728 = v13.mul_add(v716, v727);
+    let v729 = v89.mul_add(v632, v728);
+    let v730 = v60.mul_add(v677, v729);
+    let v731 = v116.mul_add(v608, v730);
+    let v732 = v47.mul_add(v724, v731);
+    let v733 = v79 * v642;
+    let v734 = v83 * dir[8];
+    let v735 = v91.mul_add(dir[4], v734);
+    let v736 = v248.mul_add(dir[2], v735);
+    let v737 = v48.mul_add(dir[10], v736);
+    let v738 = (-v233).mul_add(dir[6], v737);
+    let v739 = (-v123).mul_add(dir[3], v738);
+    let v740 = (-v241).mul_add(dir[0], v739);
+    let v741 = (-v15).mul_add(dir[9], v740);
+    let v742 = v127 * v614;
+    let v743 = v378.mul_add(dir[7], v742);
+    let v744 = v679.mul_add(dir[1], v743);
+    let v745 = v20.mul_add(v691, v744);
+    let v746 = (-v498).mul_add(dir[11], v745);
+    let v747 = (-v121).mul_add(v548, v746);
+    let v748 = (-v692).mul_add(dir[5], v747);
+    let v749 = (-v63).mul_add(v661, v748);
+    let v750 = 0.5f64.mul_add(dir[11], v733);
+    let v751 = v65.mul_add(v664, v750);
+    let v752 = v126.mul_add(v552, v751);
+    let v753 = v13.mul_add(v741, v752);
+    let v754 = v89.mul_add(v646, v753);
+    let v755 = v67.mul_add(v677, v754);
+    let v756 = v131.mul_add(v608, v755);
+    let v757 = v47.mul_add(v749, v756);
+    let v758 = v137 * v674;
+    let v759 = qd[1] * dir[7];
+    let v760 = qd[0].mul_add(dir[6], v759);
+    let v761 = qd[2].mul_add(dir[8], v760);
+    let v763 = v145 * v548;
+    let v764 = v763 * v762;
+    let v765 = 2f64 * v77;
+    let v766 = v765 * v661;
+    let v767 = v143.mul_add(v548, v766);
+    let v768 = v78.mul_add(v761, v764);
+    let v769 = v144.mul_add(v767, v768);
+    let v770 = v112 * dir[11];
+    let v771 = v121.mul_add(dir[6], v770);
+    let v772 = (-v106).mul_add(dir[7], v771);
+    let v773 = (-v127).mul_add(dir[10], v772);
+    let v775 = v763 * v774;
+    let v776 = v88.mul_add(v761, v775);
+    let v777 = v152.mul_add(v767, v776);
+    let v778 = qd[2] * v691;
+    let v779 = 0.5f64 * v157;
+    let v780 = v90 * dir[9];
+    let v781 = v71.mul_add(dir[8], v780);
+    let v782 = v106.mul_add(dir[6], v781);
+    let v783 = v112.mul_add(dir[10], v782);
+    let v784 = v121.mul_add(dir[7], v783);
+    let v785 = v127.mul_add(dir[11], v784);
+    let v786 = 0.5f64 * v143;
+    let v787 = v97.mul_add(dir[8], v778);
+    let v788 = v779.mul_add(dir[2], v787);
+    let v789 = v33.mul_add(v785, v788);
+    let v790 = (-v77).mul_add(dir[9], v789);
+    let v791 = (-qd[3]).mul_add(v661, v790);
+    let v792 = (-v786).mul_add(dir[3], v791);
+    let v793 = (-v42).mul_add(v761, v792);
+    let v794 = v258.mul_add(v664, v758);
+    let v795 = v147.mul_add(v607, v794);
+    let v796 = v46.mul_add(v769, v795);
+    let v797 = v150.mul_add(v552, v796);
+    let v798 = v13.mul_add(v773, v797);
+    let v799 = v260.mul_add(v677, v798);
+    let v800 = v151.mul_add(v699, v799);
+    let v801 = v154.mul_add(v618, v800);
+    let v802 = v53.mul_add(v777, v801);
+    let v803 = v161.mul_add(v608, v802);
+    let v804 = v47.mul_add(v793, v803);
+    let v805 = 2f64 * v111;
+    let v806 = v137 * v716;
+    let v807 = v127 * dir[9];
+    let v808 = v71.mul_add(dir[7], v807);
+    let v809 = (-v121).mul_add(dir[8], v808);
+    let v810 = (-v90).mul_add(dir[11], v809);
+    let v811 = qd[0] * v691;
+    let v812 = v97.mul_add(dir[6], v811);
+    let v813 = v779.mul_add(dir[0], v812);
+    let v814 = v26.mul_add(v785, v813);
+    let v815 = (-v77).mul_add(dir[10], v814);
+    let v816 = (-qd[4]).mul_add(v661, v815);
+    let v817 = (-v786).mul_add(dir[4], v816);
+    let v818 = (-v56).mul_add(v761, v817);
+    let v819 = v805.mul_add(v664, v806);
+    let v820 = v147.mul_add(v628, v819);
+    let v821 = v58.mul_add(v769, v820);
+    let v822 = v169.mul_add(v552, v821);
+    let v823 = v13.mul_add(v810, v822);
+    let v824 = v270.mul_add(v677, v823);
+    let v825 = v151.mul_add(v724, v824);
+    let v826 = v154.mul_add(v632, v825);
+    let v827 = v60.mul_add(v777, v826);
+    let v828 = v173.mul_add(v608, v827);
+    let v829 = v47.mul_add(v818, v828);
+    let v830 = 2f64 * v126;
+    let v831 = v137 * v741;
+    let v832 = v90 * dir[10];
+    let v833 = v106.mul_add(dir[8], v832);
+    let v834 = (-v71).mul_add(dir[6], v833);
+    let v835 = (-v112).mul_add(dir[9], v834);
+    let v836 = qd[1] * v691;
+    let v837 = v97.mul_add(dir[7], v836);
+    let v838 = v779.mul_add(dir[1], v837);
+    let v839 = v20.mul_add(v785, v838);
+    let v840 = (-v77).mul_add(dir[11], v839);
+    let v841 = (-qd[5]).mul_add(v661, v840);
+    let v842 = (-v786).mul_add(dir[5], v841);
+    let v843 = (-v63).mul_add(v761, v842);
+    let v844 = v830.mul_add(v664, v831);
+    let v845 = v147.mul_add(v642, v844);
+    let v846 = v65.mul_add(v769, v845);
+    let v847 = v181.mul_add(v552, v846);
+    let v848 = v13.mul_add(v835, v847);
+    let v849 = v277.mul_add(v677, v848);
+    let v850 = v151.mul_add(v749, v849);
+    let v851 = v154.mul_add(v646, v850);
+    let v852 = v67.mul_add(v777, v851);
+    let v853 = v185.mul_add(v608, v852);
+    let v854 = v47.mul_add(v843, v853);
+    let v855 = v15 * dir[7];
+    let v856 = v107.mul_add(dir[0], v855);
+    let v857 = (-v123).mul_add(dir[1], v856);
+    let v858 = (-v23).mul_add(dir[6], v857);
+    let v859 = v13 * v858;
+    let v860 = v212 * v608;
+    let v861 = v48 * dir[8];
+    let v862 = v91.mul_add(dir[2], v861);
+    let v863 = v123.mul_add(dir[0], v862);
+    let v864 = v15.mul_add(dir[6], v863);
+    let v865 = v107.mul_add(dir[1], v864);
+    let v866 = v23.mul_add(dir[7], v865);
+    let v867 = v217 * v866;
+    let v868 = v860 + v867;
+    let v869 = v192.mul_add(v552, v859);
+    let v870 = v361.mul_add(dir[8], v869);
+    let v871 = v90.mul_add(v557, v870);
+    let v872 = v220.mul_add(dir[2], v871);
+    let v873 = q[2].mul_add(v868, v872);
+    let v874 = v23 * dir[8];
+    let v875 = v91.mul_add(dir[1], v874);
+    let v876 = (-v107).mul_add(dir[2], v875);
+    let v877 = (-v48).mul_add(dir[7], v876);
+    let v878 = v13 * v877;
+    let v879 = v201.mul_add(v552, v878);
+    let v880 = v361.mul_add(dir[6], v879);
+    let v881 = v112.mul_add(v557, v880);
+    let v882 = v220.mul_add(dir[0], v881);
+    let v883 = q[0].mul_add(v868, v882);
+    let v884 = v48 * dir[6];
+    let v885 = v123.mul_add(dir[2], v884);
+    let v886 = (-v91).mul_add(dir[0], v885);
+    let v887 = (-v15).mul_add(dir[8], v886);
+    let v888 = v13 * v887;
+    let v889 = v207.mul_add(v552, v888);
+    let v890 = v361.mul_add(dir[7], v889);
+    let v891 = v127.mul_add(v557, v890);
+    let v892 = v220.mul_add(dir[1], v891);
+    let v893 = q[1].mul_add(v868, v892);
+    let v894 = v192 * v664;
+    let v895 = 0.5f64 * v89;
+    let v896 = v212 * v677;
+    let v897 = 0.5f64 * v216;
+    let v898 = v127 * dir[7];
+    let v899 = v112.mul_add(dir[6], v898);
+    let v900 = v90.mul_add(dir[8], v899);
+    let v901 = v895.mul_add(v866, v896);
+    let v902 = v897.mul_add(v608, v901);
+    let v903 = v217.mul_add(v900, v902);
+    let v905 = v77 * v548;
+    let v906 = v905 * v904;
+    let v907 = v221.mul_add(v661, v906);
+    let v908 = 0.5f64.mul_add(v907, v860);
+    let v909 = v908 + v867;
+    let v910 = v897 * dir[2];
+    let v911 = v212.mul_add(dir[8], v910);
+    let v912 = v79.mul_add(v858, v894);
+    let v913 = v223.mul_add(dir[8], v912);
+    let v914 = v213.mul_add(dir[2], v913);
+    let v915 = q[2].mul_add(v903, v914);
+    let v916 = qd[2].mul_add(v909, v915);
+    let v917 = v47.mul_add(v911, v916);
+    let v918 = v201 * v664;
+    let v919 = v897 * dir[0];
+    let v920 = v212.mul_add(dir[6], v919);
+    let v921 = v79.mul_add(v877, v918);
+    let v922 = v223.mul_add(dir[6], v921);
+    let v923 = v213.mul_add(dir[0], v922);
+    let v924 = q[0].mul_add(v903, v923);
+    let v925 = qd[0].mul_add(v909, v924);
+    let v926 = v47.mul_add(v920, v925);
+    let v927 = v207 * v664;
+    let v928 = v897 * dir[1];
+    let v929 = v212.mul_add(dir[7], v928);
+    let v930 = v79.mul_add(v887, v927);
+    let v931 = v223.mul_add(dir[7], v930);
+    let v932 = v213.mul_add(dir[1], v931);
+    let v933 = q[1].mul_add(v903, v932);
+    let v934 = qd[1].mul_add(v909, v933);
+    let v935 = v47.mul_add(v929, v934);
+    let v936 = v46 * v608;
+    let v937 = v242 * v548;
+    let v938 = 0.25f64.mul_add(dir[3], v936);
+    let v939 = v47.mul_add(v607, v938);
+    let v940 = v53.mul_add(v937, v939);
+    let v941 = v234.mul_add(v618, v940);
+    let v942 = v58 * v608;
+    let v943 = 0.25f64.mul_add(dir[4], v942);
+    let v944 = v47.mul_add(v628, v943);
+    let v945 = v60.mul_add(v937, v944);
+    let v946 = v234.mul_add(v632, v945);
+    let v947 = v65 * v608;
+    let v948 = 0.25f64.mul_add(dir[5], v947);
+    let v949 = v47.mul_add(v642, v948);
+    let v950 = v67.mul_add(v937, v949);
+    let v951 = v234.mul_add(v646, v950);
+    let v952 = v89 * v607;
+    let v953 = v77 * v261;
+    let v954 = v953 * v548;
+    let v955 = v242.mul_add(v661, v954);
+    let v956 = 0.25f64.mul_add(dir[9], v952);
+    let v957 = v46.mul_add(v677, v956);
+    let v958 = v87.mul_add(v608, v957);
+    let v959 = v47.mul_add(v674, v958);
+    let v960 = v243.mul_add(v618, v959);
+    let v961 = v53.mul_add(v955, v960);
+    let v962 = v101.mul_add(v937, v961);
+    let v963 = v234.mul_add(v699, v962);
+    let v964 = v89 * v628;
+    let v965 = 0.25f64.mul_add(dir[10], v964);
+    let v966 = v58.mul_add(v677, v965);
+    let v967 = v111.mul_add(v608, v966);
+    let v968 = v47.mul_add(v716, v967);
+    let v969 = v243.mul_add(v632, v968);
+    let v970 = v60.mul_add(v955, v969);
+    let v971 = v116.mul_add(v937, v970);
+    let v972 = v234.mul_add(v724, v971);
+    let v973 = v89 * v642;
+    let v974 = 0.25f64.mul_add(dir[11], v973);
+    let v975 = v65.mul_add(v677, v974);
+    let v976 = v126.mul_add(v608, v975);
+    let v977 = v47.mul_add(v741, v976);
+    let v978 = v243.mul_add(v646, v977);
+    let v979 = v67.mul_add(v955, v978);
+    let v980 = v131.mul_add(v937, v979);
+    let v981 = v234.mul_add(v749, v980);
+    let v982 = v258 * v677;
+    let v983 = 2f64 * v243;
+    let v985 = v763 * v984;
+    let v986 = v242.mul_add(v761, v985);
+    let v987 = v261.mul_add(v767, v986);
+    let v988 = v151.mul_add(v674, v982);
+    let v989 = v154.mul_add(v607, v988);
+    let v990 = v46.mul_add(v777, v989);
+    let v991 = v150.mul_add(v608, v990);
+    let v992 = v47.mul_add(v773, v991);
+    let v993 = v983.mul_add(v699, v992);
+    let v994 = v260.mul_add(v955, v993);
+    let v995 = v263.mul_add(v618, v994);
+    let v996 = v53.mul_add(v987, v995);
+    let v997 = v161.mul_add(v937, v996);
+    let v998 = v234.mul_add(v793, v997);
+    let v999 = v151 * v716;
+    let v1000 = v805.mul_add(v677, v999);
+    let v1001 = v154.mul_add(v628, v1000);
+    let v1002 = v58.mul_add(v777, v1001);
+    let v1003 = v169.mul_add(v608, v1002);
+    let v1004 = v47.mul_add(v810, v1003);
+    let v1005 = v983.mul_add(v724, v1004);
+    let v1006 = v270.mul_add(v955, v1005);
+    let v1007 = v263.mul_add(v632, v1006);
+    let v1008 = v60.mul_add(v987, v1007);
+    let v1009 = v173.mul_add(v937, v1008);
+    let v1010 = v234.mul_add(v818, v1009);
+    let v1011 = v151 * v741;
+    let v1012 = v830.mul_add(v677, v1011);
+    let v1013 = v154.mul_add(v642, v1012);
+    let v1014 = v65.mul_add(v777, v1013);
+    let v1015 = v181.mul_add(v608, v1014);
+    let v1016 = v47.mul_add(v835, v1015);
+    let v1017 = v983.mul_add(v749, v1016);
+    let v1018 = v277.mul_add(v955, v1017);
+    let v1019 = v263.mul_add(v646, v1018);
+    let v1020 = v67.mul_add(v987, v1019);
+    let v1021 = v185.mul_add(v937, v1020);
+    let v1022 = v234.mul_add(v843, v1021);
+    let v1023 = 0.25f64 * v548;
+    let v1024 = v313 * v1023;
+    let v1025 = 0.0625f64 * qd[1];
+    let v1026 = v286 * dir[7];
+    let v1027 = 0.0625f64 * qd[0];
+    let v1028 = v1025.mul_add(dir[0], v1026);
+    let v1029 = (-v1027).mul_add(dir[1], v1028);
+    let v1030 = (-v287).mul_add(dir[6], v1029);
+    let v1031 = v284 * v1030;
+    let v1032 = v326 * v1023;
+    let v1033 = v315 * v1023;
+    let v1034 = v317 * v1033;
+    let v1035 = 0.0625f64 * qd[2];
+    let v1036 = v293 * dir[8];
+    let v1037 = v1035.mul_add(dir[2], v1036);
+    let v1038 = v1027.mul_add(dir[0], v1037);
+    let v1039 = v286.mul_add(dir[6], v1038);
+    let v1040 = v1025.mul_add(dir[1], v1039);
+    let v1041 = v287.mul_add(dir[7], v1040);
+    let v1042 = v322 * v1041;
+    let v1043 = v1034 + v1042;
+    let v1044 = v289.mul_add(v1024, v1031);
+    let v1045 = v397.mul_add(dir[8], v1044);
+    let v1046 = v91.mul_add(v1032, v1045);
+    let v1047 = v325.mul_add(dir[2], v1046);
+    let v1048 = q[2].mul_add(v1043, v1047);
+    let v1049 = v287 * dir[8];
+    let v1050 = v1035.mul_add(dir[1], v1049);
+    let v1051 = (-v1025).mul_add(dir[2], v1050);
+    let v1052 = (-v293).mul_add(dir[7], v1051);
+    let v1053 = v284 * v1052;
+    let v1054 = v301.mul_add(v1024, v1053);
+    let v1055 = v397.mul_add(dir[6], v1054);
+    let v1056 = v123.mul_add(v1032, v1055);
+    let v1057 = v325.mul_add(dir[0], v1056);
+    let v1058 = q[0].mul_add(v1043, v1057);
+    let v1059 = v293 * dir[6];
+    let v1060 = v1027.mul_add(dir[2], v1059);
+    let v1061 = (-v1035).mul_add(dir[0], v1060);
+    let v1062 = (-v286).mul_add(dir[8], v1061);
+    let v1063 = v284 * v1062;
+    let v1064 = v307.mul_add(v1024, v1063);
+    let v1065 = v397.mul_add(dir[7], v1064);
+    let v1066 = v107.mul_add(v1032, v1065);
+    let v1067 = v325.mul_add(dir[1], v1066);
+    let v1068 = q[1].mul_add(v1043, v1067);
+    let v1069 = 0.25f64 * v661;
+    let v1071 = v312 * v1023;
+    let v1072 = v1071 * v1070;
+    let v1073 = v313.mul_add(v1069, v1072);
+    let v1074 = v289 * v1073;
+    let v1075 = 0.25f64 * v316;
+    let v1077 = v1071 * v1076;
+    let v1078 = v315.mul_add(v1069, v1077);
+    let v1079 = v317 * v1078;
+    let v1080 = 0.25f64 * v321;
+    let v1081 = 0.125f64 * qd[0];
+    let v1082 = 0.125f64 * qd[1];
+    let v1083 = v1082 * dir[7];
+    let v1084 = 0.125f64 * qd[2];
+    let v1085 = v1081.mul_add(dir[6], v1083);
+    let v1086 = v1084.mul_add(dir[8], v1085);
+    let v1087 = v1075.mul_add(v1041, v1079);
+    let v1088 = v1080.mul_add(v1033, v1087);
+    let v1089 = v322.mul_add(v1086, v1088);
+    let v1091 = v1071 * v1090;
+    let v1092 = v326.mul_add(v1069, v1091);
+    let v1093 = 0.25f64.mul_add(v1092, v1034);
+    let v1094 = v1093 + v1042;
+    let v1095 = v1080 * dir[2];
+    let v1096 = v317.mul_add(dir[8], v1095);
+    let v1097 = v314.mul_add(v1030, v1074);
+    let v1098 = v328.mul_add(dir[8], v1097);
+    let v1099 = v318.mul_add(dir[2], v1098);
+    let v1100 = q[2].mul_add(v1089, v1099);
+    let v1101 = qd[2].mul_add(v1094, v1100);
+    let v1102 = v292.mul_add(v1096, v1101);
+    let v1103 = v301 * v1073;
+    let v1104 = v1080 * dir[0];
+    let v1105 = v317.mul_add(dir[6], v1104);
+    let v1106 = v314.mul_add(v1052, v1103);
+    let v1107 = v328.mul_add(dir[6], v1106);
+    let v1108 = v318.mul_add(dir[0], v1107);
+    let v1109 = q[0].mul_add(v1089, v1108);
+    let v1110 = qd[0].mul_add(v1094, v1109);
+    let v1111 = v292.mul_add(v1105, v1110);
+    let v1112 = v307 * v1073;
+    let v1113 = v1080 * dir[1];
+    let v1114 = v317.mul_add(dir[7], v1113);
+    let v1115 = v314.mul_add(v1062, v1112);
+    let v1116 = v328.mul_add(dir[7], v1115);
+    let v1117 = v318.mul_add(dir[1], v1116);
+    let v1118 = q[1].mul_add(v1089, v1117);
+    let v1119 = qd[1].mul_add(v1094, v1118);
+    let v1120 = v292.mul_add(v1114, v1119);
+    let v1121 = v371.mul_add(dir[2], -v1023);
+    let v1122 = v339 * v1024;
+    let v1123 = v284.mul_add(v1121, v1122);
+    let v1124 = v23 * v1032;
+    let v1125 = 0.0625f64 * v284;
+    let v1126 = v1125 * dir[2];
+    let v1127 = v293 * v1024;
+    let v1128 = v1126 + v1127;
+    let v1129 = v397.mul_add(dir[1], v1124);
+    let v1130 = v400.mul_add(dir[0], v1129);
+    let v1131 = q[0].mul_add(v1128, v1130);
+    let v1132 = v397 * dir[0];
+    let v1133 = v400.mul_add(dir[1], -v1132);
+    let v1134 = (-v15).mul_add(v1032, v1133);
+    let v1135 = q[1].mul_add(v1128, v1134);
+    let v1136 = v371 * v47;
+    let v1137 = v1136 * dir[0];
+    let v1138 = 0.125f64 * v47;
+    let v1139 = v371 * v608;
+    let v1140 = v1138.mul_add(dir[2], v1139);
+    let v1141 = q[0] * v1140;
+    let v1142 = v1137 - v583;
+    let v1143 = v1142 - v584;
+    let v1144 = v1143 + v1141;
+    let v1145 = 0.5f64 * v557;
+    let v1146 = v505.mul_add(dir[0], v1145);
+    let v1147 = v362.mul_add(v608, v1146);
+    let v1148 = v385 * v47;
+    let v1149 = v1148 * dir[0];
+    let v1150 = v385 * v608;
+    let v1151 = v1138.mul_add(dir[1], v1150);
+    let v1152 = q[0] * v1151;
+    let v1153 = v562 + v1149;
+    let v1154 = v1153 + v1152;
+    let v1155 = v144 * v26;
+    let v1156 = 0.5f64 * v78;
+    let v1157 = v1156 * dir[0];
+    let v1158 = v1155.mul_add(v548, v1157);
+    let v1159 = v46 * v1158;
+    let v1160 = v559 * dir[5];
+    let v1161 = v80 * v552;
+    let v1162 = v152 * v26;
+    let v1163 = 0.5f64 * v88;
+    let v1164 = v1163 * dir[0];
+    let v1165 = v1162.mul_add(v548, v1164);
+    let v1166 = 0.125f64 * q[4];
+    let v1167 = v371 * dir[4];
+    let v1168 = v1166.mul_add(dir[2], v1167);
+    let v1169 = v1168 - v639;
+    let v1170 = (-v379).mul_add(dir[3], v1169);
+    let v1171 = v368.mul_add(v607, v1159);
+    let v1172 = v1171 + v1160;
+    let v1173 = v1172 + v1161;
+    let v1174 = v370.mul_add(v618, v1173);
+    let v1175 = v53.mul_add(v1165, v1174);
+    let v1176 = v373.mul_add(v608, v1175);
+    let v1177 = v47.mul_add(v1170, v1176);
+    let v1178 = v58 * v1158;
+    let v1179 = 0.5f64 * v614;
+    let v1180 = (-v1166).mul_add(dir[0], v1179);
+    let v1181 = v380.mul_add(dir[4], v1180);
+    let v1182 = v368.mul_add(v628, v1178);
+    let v1183 = v370.mul_add(v632, v1182);
+    let v1184 = v60.mul_add(v1165, v1183);
+    let v1185 = v381.mul_add(v608, v1184);
+    let v1186 = v47.mul_add(v1181, v1185);
+    let v1187 = v65 * v1158;
+    let v1188 = v559 * dir[3];
+    let v1189 = v233 * v552;
+    let v1190 = v1166.mul_add(dir[1], -v601);
+    let v1191 = v385.mul_add(dir[4], v1190);
+    let v1192 = (-v379).mul_add(dir[5], v1191);
+    let v1193 = v368.mul_add(v642, v1187);
+    let v1194 = v1193 - v1188;
+    let v1195 = v1194 - v1189;
+    let v1196 = v370.mul_add(v646, v1195);
+    let v1197 = v67.mul_add(v1165, v1196);
+    let v1198 = v387.mul_add(v608, v1197);
+    let v1199 = v47.mul_add(v1192, v1198);
+    let v1200 = v1125 * dir[1];
+    let v1201 = v287 * v1024;
+    let v1202 = 0.015625f64 * q[2];
+    let v1203 = v1202 * v292;
+    let v1204 = v1203 * dir[0];
+    let v1205 = 0.015625f64 * v292;
+    let v1206 = v1202 * v1033;
+    let v1207 = v1205.mul_add(dir[2], v1206);
+    let v1208 = q[0] * v1207;
+    let v1209 = v1204 - v1200;
+    let v1210 = v1209 - v1201;
+    let v1211 = v1210 + v1208;
+    let v1212 = 0.25f64 * v1032;
+    let v1214 = 0.03125f64 * q[0];
+    let v1215 = v1214 * v292;
+    let v1216 = v1215.mul_add(dir[0], v1212);
+    let v1217 = v398.mul_add(v1033, v1216);
+    let v1218 = v443 * v292;
+    let v1219 = v1218 * dir[0];
+    let v1220 = v443 * v1033;
+    let v1221 = v1205.mul_add(dir[1], v1220);
+    let v1222 = q[0] * v1221;
+    let v1223 = v1128 + v1219;
+    let v1224 = v1223 + v1222;
+    let v1225 = v46 * v1165;
+    let v1226 = 0.25f64 * v47;
+    let v1227 = v1226 * dir[5];
+    let v1228 = v80 * v608;
+    let v1229 = v261 * v26;
+    let v1230 = 0.5f64 * v242;
+    let v1231 = v1230 * dir[0];
+    let v1232 = v1229.mul_add(v548, v1231);
+    let v1233 = v370.mul_add(v607, v1225);
+    let v1234 = v1233 + v1227;
+    let v1235 = v1234 + v1228;
+    let v1236 = v405.mul_add(v618, v1235);
+    let v1237 = v53.mul_add(v1232, v1236);
+    let v1238 = v373.mul_add(v937, v1237);
+    let v1239 = v234.mul_add(v1170, v1238);
+    let v1240 = v58 * v1165;
+    let v1241 = v370.mul_add(v628, v1240);
+    let v1242 = v405.mul_add(v632, v1241);
+    let v1243 = v60.mul_add(v1232, v1242);
+    let v1244 = v381.mul_add(v937, v1243);
+    let v1245 = v234.mul_add(v1181, v1244);
+    let v1246 = v65 * v1165;
+    let v1247 = v1226 * dir[3];
+    let v1248 = v233 * v608;
+    let v1249 = v370.mul_add(v642, v1246);
+    let v1250 = v1249 - v1247;
+    let v1251 = v1250 - v1248;
+    let v1252 = v405.mul_add(v646, v1251);
+    let v1253 = v67.mul_add(v1232, v1252);
+    let v1254 = v387.mul_add(v937, v1253);
+    let v1255 = v234.mul_add(v1192, v1254);
+    let v1256 = v559 * dir[0];
+    let v1257 = v15 * v552;
+    let v1258 = v1136 * dir[1];
+    let v1259 = q[1] * v1140;
+    let v1260 = v1256 + v1257;
+    let v1261 = v1260 + v1258;
+    let v1262 = v1261 + v1259;
+    let v1263 = v1149 - v560;
+    let v1264 = v1263 - v561;
+    let v1265 = v1264 + v1152;
+    let v1266 = v502.mul_add(dir[1], v1145);
+    let v1267 = v421.mul_add(v608, v1266);
+    let v1268 = v144 * v20;
+    let v1269 = v1156 * dir[1];
+    let v1270 = v1268.mul_add(v548, v1269);
+    let v1271 = v46 * v1270;
+    let v1272 = v559 * dir[4];
+    let v1273 = v83 * v552;
+    let v1274 = v152 * v20;
+    let v1275 = v1163 * dir[1];
+    let v1276 = v1274.mul_add(v548, v1275);
+    let v1277 = 0.125f64 * q[5];
+    let v1278 = v1277.mul_add(dir[2], -v624);
+    let v1279 = v371.mul_add(dir[5], v1278);
+    let v1280 = (-v437).mul_add(dir[3], v1279);
+    let v1281 = v423.mul_add(v607, v1271);
+    let v1282 = v1281 - v1272;
+    let v1283 = v1282 - v1273;
+    let v1284 = v425.mul_add(v618, v1283);
+    let v1285 = v53.mul_add(v1276, v1284);
+    let v1286 = v427.mul_add(v608, v1285);
+    let v1287 = v47.mul_add(v1280, v1286);
+    let v1288 = v357 * dir[5];
+    let v1289 = v1277.mul_add(dir[0], v1288);
+    let v1290 = v1289 - v603;
+    let v1291 = (-v437).mul_add(dir[4], v1290);
+    let v1292 = v1188 + v1189;
+    let v1293 = v423.mul_add(v628, v1292);
+    let v1294 = v58.mul_add(v1270, v1293);
+    let v1295 = v425.mul_add(v632, v1294);
+    let v1296 = v60.mul_add(v1276, v1295);
+    let v1297 = v432.mul_add(v608, v1296);
+    let v1298 = v47.mul_add(v1291, v1297);
+    let v1299 = v65 * v1270;
+    let v1300 = (-v1277).mul_add(dir[1], v1179);
+    let v1301 = v438.mul_add(dir[5], v1300);
+    let v1302 = v423.mul_add(v642, v1299);
+    let v1303 = v425.mul_add(v646, v1302);
+    let v1304 = v67.mul_add(v1276, v1303);
+    let v1305 = v439.mul_add(v608, v1304);
+    let v1306 = v47.mul_add(v1301, v1305);
+    let v1307 = v1125 * dir[0];
+    let v1308 = v286 * v1024;
+    let v1309 = v1203 * dir[1];
+    let v1310 = q[1] * v1207;
+    let v1311 = v1307 + v1308;
+    let v1312 = v1311 + v1309;
+    let v1313 = v1312 + v1310;
+    let v1314 = v1219 - v1126;
+    let v1315 = v1314 - v1127;
+    let v1316 = v1315 + v1222;
+    let v1317 = 0.03125f64 * q[1];
+    let v1318 = v1317 * v292;
+    let v1319 = v1318.mul_add(dir[1], v1212);
+    let v1320 = v448.mul_add(v1033, v1319);
+    let v1321 = v46 * v1276;
+    let v1322 = v1226 * dir[4];
+    let v1323 = v83 * v608;
+    let v1324 = v261 * v20;
+    let v1325 = v1230 * dir[1];
+    let v1326 = v1324.mul_add(v548, v1325);
+    let v1327 = v425.mul_add(v607, v1321);
+    let v1328 = v1327 - v1322;
+    let v1329 = v1328 - v1323;
+    let v1330 = v451.mul_add(v618, v1329);
+    let v1331 = v53.mul_add(v1326, v1330);
+    let v1332 = v427.mul_add(v937, v1331);
+    let v1333 = v234.mul_add(v1280, v1332);
+    let v1334 = v1247 + v1248;
+    let v1335 = v425.mul_add(v628, v1334);
+    let v1336 = v58.mul_add(v1276, v1335);
+    let v1337 = v451.mul_add(v632, v1336);
+    let v1338 = v60.mul_add(v1326, v1337);
+    let v1339 = v432.mul_add(v937, v1338);
+    let v1340 = v234.mul_add(v1291, v1339);
+    let v1341 = v65 * v1276;
+    let v1342 = v425.mul_add(v642, v1341);
+    let v1343 = v451.mul_add(v646, v1342);
+    let v1344 = v67.mul_add(v1326, v1343);
+    let v1345 = v439.mul_add(v937, v1344);
+    let v1346 = v234.mul_add(v1301, v1345);
+    let v1347 = v512.mul_add(dir[2], v1145);
+    let v1348 = v461.mul_add(v608, v1347);
+    let v1349 = v585 + v1137;
+    let v1350 = v1349 + v1141;
+    let v1351 = v1258 - v1256;
+    let v1352 = v1351 - v1257;
+    let v1353 = v1352 + v1259;
+    let v1354 = v144 * v33;
+    let v1355 = v1156 * dir[2];
+    let v1356 = v1354.mul_add(v548, v1355);
+    let v1357 = v46 * v1356;
+    let v1358 = v152 * v33;
+    let v1359 = v1163 * dir[2];
+    let v1360 = v1358.mul_add(v548, v1359);
+    let v1361 = 0.125f64 * v41;
+    let v1362 = (-v1361).mul_add(dir[2], v1179);
+    let v1363 = v469.mul_add(dir[3], v1362);
+    let v1364 = v465.mul_add(v607, v1357);
+    let v1365 = v466.mul_add(v618, v1364);
+    let v1366 = v53.mul_add(v1360, v1365);
+    let v1367 = v470.mul_add(v608, v1366);
+    let v1368 = v47.mul_add(v1363, v1367);
+    let v1369 = v1361.mul_add(dir[0], -v638);
+    let v1370 = v357.mul_add(dir[3], v1369);
+    let v1371 = (-v468).mul_add(dir[4], v1370);
+    let v1372 = v465.mul_add(v628, -v1160);
+    let v1373 = v1372 - v1161;
+    let v1374 = v58.mul_add(v1356, v1373);
+    let v1375 = v466.mul_add(v632, v1374);
+    let v1376 = v60.mul_add(v1360, v1375);
+    let v1377 = v474.mul_add(v608, v1376);
+    let v1378 = v47.mul_add(v1371, v1377);
+    let v1379 = v385 * dir[3];
+    let v1380 = v1361.mul_add(dir[1], v1379);
+    let v1381 = v1380 - v625;
+    let v1382 = (-v468).mul_add(dir[5], v1381);
+    let v1383 = v1272 + v1273;
+    let v1384 = v465.mul_add(v642, v1383);
+    let v1385 = v65.mul_add(v1356, v1384);
+    let v1386 = v466.mul_add(v646, v1385);
+    let v1387 = v67.mul_add(v1360, v1386);
+    let v1388 = v479.mul_add(v608, v1387);
+    let v1389 = v47.mul_add(v1382, v1388);
+    let v1390 = 0.03125f64 * q[2];
+    let v1391 = v1390 * v292;
+    let v1392 = v1391.mul_add(dir[2], v1212);
+    let v1393 = v483.mul_add(v1033, v1392);
+    let v1394 = v1200 + v1201;
+    let v1395 = v1394 + v1204;
+    let v1396 = v1395 + v1208;
+    let v1397 = v1309 - v1307;
+    let v1398 = v1397 - v1308;
+    let v1399 = v1398 + v1310;
+    let v1400 = v46 * v1360;
+    let v1401 = v261 * v33;
+    let v1402 = v1230 * dir[2];
+    let v1403 = v1401.mul_add(v548, v1402);
+    let v1404 = v466.mul_add(v607, v1400);
+    let v1405 = v487.mul_add(v618, v1404);
+    let v1406 = v53.mul_add(v1403, v1405);
+    let v1407 = v470.mul_add(v937, v1406);
+    let v1408 = v234.mul_add(v1363, v1407);
+    let v1409 = v466.mul_add(v628, -v1227);
+    let v1410 = v1409 - v1228;
+    let v1411 = v58.mul_add(v1360, v1410);
+    let v1412 = v487.mul_add(v632, v1411);
+    let v1413 = v60.mul_add(v1403, v1412);
+    let v1414 = v474.mul_add(v937, v1413);
+    let v1415 = v234.mul_add(v1371, v1414);
+    let v1416 = v1322 + v1323;
+    let v1417 = v466.mul_add(v642, v1416);
+    let v1418 = v65.mul_add(v1360, v1417);
+    let v1419 = v487.mul_add(v646, v1418);
+    let v1420 = v67.mul_add(v1403, v1419);
+    let v1421 = v479.mul_add(v937, v1420);
+    let v1422 = v234.mul_add(v1382, v1421);
+    let v1423 = 0.5f64 * v548;
+    let v1424 = v48.mul_add(dir[2], -v1423);
+    let v1425 = v47 * v1424;
+    let v1426 = v499.mul_add(v608, v1425);
+    let v1427 = v234 * v1424;
+    let v1428 = v499.mul_add(v937, v1427);
+    let v1429 = v1226 * dir[1];
+    let v1430 = v23 * v608;
+    let v1431 = v371 * v234;
+    let v1432 = v1431 * dir[0];
+    let v1433 = 0.125f64 * v234;
+    let v1434 = v371 * v937;
+    let v1435 = v1433.mul_add(dir[2], v1434);
+    let v1436 = q[0] * v1435;
+    let v1437 = v1429 + v1430;
+    let v1438 = v1437 + v1432;
+    let v1439 = v1438 + v1436;
+    let v1440 = v1226 * dir[0];
+    let v1441 = v15 * v608;
+    let v1442 = v1431 * dir[1];
+    let v1443 = q[1] * v1435;
+    let v1444 = v1442 - v1440;
+    let v1445 = v1444 - v1441;
+    let v1446 = v1445 + v1443;
+    let v1447 = v15.mul_add(dir[0], -v1423);
+    let v1448 = v47 * v1447;
+    let v1449 = v508.mul_add(v608, v1448);
+    let v1450 = v1432 - v1429;
+    let v1451 = v1450 - v1430;
+    let v1452 = v1451 + v1436;
+    let v1453 = v234 * v1447;
+    let v1454 = v508.mul_add(v937, v1453);
+    let v1455 = v1226 * dir[2];
+    let v1456 = v48 * v608;
+    let v1457 = v385 * v234;
+    let v1458 = v1457 * dir[0];
+    let v1459 = v385 * v937;
+    let v1460 = v1433.mul_add(dir[1], v1459);
+    let v1461 = q[0] * v1460;
+    let v1462 = v1455 + v1456;
+    let v1463 = v1462 + v1458;
+    let v1464 = v1463 + v1461;
+    let v1465 = v23.mul_add(dir[1], -v1423);
+    let v1466 = v47 * v1465;
+    let v1467 = v515.mul_add(v608, v1466);
+    let v1468 = v1440 + v1441;
+    let v1469 = v1468 + v1442;
+    let v1470 = v1469 + v1443;
+    let v1471 = v1458 - v1455;
+    let v1472 = v1471 - v1456;
+    let v1473 = v1472 + v1461;
+    let v1474 = v234 * v1465;
+    let v1475 = v515.mul_add(v937, v1474);
+    let v1476 = 0.5f64 * p[5];
+    let v1477 = v1476 * dir[6];
+    let v1478 = v526.mul_add(dir[0], v1477);
+    let v1479 = v1476 * dir[7];
+    let v1480 = v526.mul_add(dir[1], v1479);
+    let v1481 = 0.5f64 * p[7];
+    let v1482 = 0.5f64 * p[8];
+    let v1483 = v1482 * dir[8];
+    let v1484 = v1481.mul_add(dir[2], v1483);
+    let v1485 = 0.5f64 * p[9];
+    let v1486 = 0.5f64 * p[10];
+    let v1487 = v1486 * dir[9];
+    let v1488 = v1485.mul_add(dir[3], v1487);
+    let v1489 = 0.5f64 * p[11];
+    let v1490 = v1486 * dir[10];
+    let v1491 = v1489.mul_add(dir[4], v1490);
+    let v1492 = v1486 * dir[11];
+    let v1493 = v1489.mul_add(dir[5], v1492);
+    out[0] = v14;
+    out[1] = v22;
+    out[2] = v28;
+    out[3] = v29;
+    out[4] = v30;
+    out[5] = v35;
+    out[6] = v36;
+    out[7] = v37;
+    out[8] = v38;
+    out[9] = v55;
+    out[10] = v62;
+    out[11] = v69;
+    out[12] = v105;
+    out[13] = v120;
+    out[14] = v135;
+    out[15] = v166;
+    out[16] = v178;
+    out[17] = v190;
+    out[18] = v199;
+    out[19] = v205;
+    out[20] = v211;
+    out[21] = v226;
+    out[22] = v229;
+    out[23] = v232;
+    out[24] = v236;
+    out[25] = v238;
+    out[26] = v240;
+    out[27] = v247;
+    out[28] = v252;
+    out[29] = v257;
+    out[30] = v268;
+    out[31] = v275;
+    out[32] = v282;
+    out[33] = v299;
+    out[34] = v305;
+    out[35] = v311;
+    out[36] = v331;
+    out[37] = v334;
+    out[38] = v337;
+    out[39] = v340;
+    out[40] = v343;
+    out[41] = v346;
+    out[42] = v348;
+    out[43] = v354;
+    out[44] = v355;
+    out[45] = v360;
+    out[46] = v363;
+    out[47] = v367;
+    out[48] = v376;
+    out[49] = v383;
+    out[50] = v390;
+    out[51] = v396;
+    out[52] = v399;
+    out[53] = v403;
+    out[54] = v408;
+    out[55] = v411;
+    out[56] = v415;
+    out[57] = v419;
+    out[58] = v420;
+    out[59] = v422;
+    out[60] = v430;
+    out[61] = v435;
+    out[62] = v441;
+    out[63] = v446;
+    out[64] = v447;
+    out[65] = v449;
+    out[66] = v454;
+    out[67] = v457;
+    out[68] = v460;
+    out[69] = v462;
+    out[70] = v463;
+    out[71] = v464;
+    out[72] = v472;
+    out[73] = v477;
+    out[74] = v482;
+    out[75] = v484;
+    out[76] = v485;
+    out[77] = v486;
+    out[78] = v490;
+    out[79] = v493;
+    out[80] = v496;
+    out[81] = 0f64;
+    out[82] = 0f64;
+    out[83] = 0f64;
+    out[84] = v500;
+    out[85] = v463;
+    out[86] = v464;
+    out[87] = 0f64;
+    out[88] = 0f64;
+    out[89] = 0f64;
+    out[90] = v501;
+    out[91] = v504;
+    out[92] = v507;
+    out[93] = 0f64;
+    out[94] = 0f64;
+    out[95] = 0f64;
+    out[96] = v360;
+    out[97] = v509;
+    out[98] = v367;
+    out[99] = 0f64;
+    out[100] = 0f64;
+    out[101] = 0f64;
+    out[102] = v510;
+    out[103] = v511;
+    out[104] = v514;
+    out[105] = 0f64;
+    out[106] = 0f64;
+    out[107] = 0f64;
+    out[108] = v419;
+    out[109] = v420;
+    out[110] = v516;
+    out[111] = 0f64;
+    out[112] = 0f64;
+    out[113] = 0f64;
+    out[114] = v517;
+    out[115] = v518;
+    out[116] = v519;
+    out[117] = v523;
+    out[118] = v528;
+    out[119] = v532;
+    out[120] = v537;
+    out[121] = v540;
+    out[122] = v542;
+    out[123] = 0f64;
+    out[124] = 0f64;
+    out[125] = 0f64;
+    out[126] = 0f64;
+    out[127] = 0f64;
+    out[128] = 0f64;
+    out[129] = v554;
+    out[130] = v566;
+    out[131] = v573;
+    out[132] = v576;
+    out[133] = v579;
+    out[134] = v589;
+    out[135] = v592;
+    out[136] = v595;
+    out[137] = v598;
+    out[138] = v622;
+    out[139] = v636;
+    out[140] = v650;
+    out[141] = v707;
+    out[142] = v732;
+    out[143] = v757;
+    out[144] = v804;
+    out[145] = v829;
+    out[146] = v854;
+    out[147] = v873;
+    out[148] = v883;
+    out[149] = v893;
+    out[150] = v917;
+    out[151] = v926;
+    out[152] = v935;
+    out[153] = v941;
+    out[154] = v946;
+    out[155] = v951;
+    out[156] = v963;
+    out[157] = v972;
+    out[158] = v981;
+    out[159] = v998;
+    out[160] = v1010;
+    out[161] = v1022;
+    out[162] = v1048;
+    out[163] = v1058;
+    out[164] = v1068;
+    out[165] = v1102;
+    out[166] = v1111;
+    out[167] = v1120;
+    out[168] = v1123;
+    out[169] = v1131;
+    out[170] = v1135;
+    out[171] = 0f64;
+    out[172] = 0f64;
+    out[173] = 0f64;
+    out[174] = v1144;
+    out[175] = v1147;
+    out[176] = v1154;
+    out[177] = v1177;
+    out[178] = v1186;
+    out[179] = v1199;
+    out[180] = v1211;
+    out[181] = v1217;
+    out[182] = v1224;
+    out[183] = v1239;
+    out[184] = v1245;
+    out[185] = v1255;
+    out[186] = v1262;
+    out[187] = v1265;
+    out[188] = v1267;
+    out[189] = v1287;
+    out[190] = v1298;
+    out[191] = v1306;
+    out[192] = v1313;
+    out[193] = v1316;
+    out[194] = v1320;
+    out[195] = v1333;
+    out[196] = v1340;
+    out[197] = v1346;
+    out[198] = v1348;
+    out[199] = v1350;
+    out[200] = v1353;
+    out[201] = v1368;
+    out[202] = v1378;
+    out[203] = v1389;
+    out[204] = v1393;
+    out[205] = v1396;
+    out[206] = v1399;
+    out[207] = v1408;
+    out[208] = v1415;
+    out[209] = v1422;
+    out[210] = 0f64;
+    out[211] = 0f64;
+    out[212] = 0f64;
+    out[213] = v1426;
+    out[214] = v1350;
+    out[215] = v1353;
+    out[216] = 0f64;
+    out[217] = 0f64;
+    out[218] = 0f64;
+    out[219] = v1428;
+    out[220] = v1439;
+    out[221] = v1446;
+    out[222] = 0f64;
+    out[223] = 0f64;
+    out[224] = 0f64;
+    out[225] = v1144;
+    out[226] = v1449;
+    out[227] = v1154;
+    out[228] = 0f64;
+    out[229] = 0f64;
+    out[230] = 0f64;
+    out[231] = v1452;
+    out[232] = v1454;
+    out[233] = v1464;
+    out[234] = 0f64;
+    out[235] = 0f64;
+    out[236] = 0f64;
+    out[237] = v1262;
+    out[238] = v1265;
+    out[239] = v1467;
+    out[240] = 0f64;
+    out[241] = 0f64;
+    out[242] = 0f64;
+    out[243] = v1470;
+    out[244] = v1473;
+    out[245] = v1475;
+    out[246] = v1478;
+    out[247] = v1480;
+    out[248] = v1484;
+    out[249] = v1488;
+    out[250] = v1491;
+    out[251] = v1493;
+    out[252] = 0f64;
+    out[253] = 0f64;
+    out[254] = 0f64;
+    out[255] = 0f64;
+    out[256] = 0f64;
+    out[257] = 0f64;
 }
 fn cell_0_linked(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
     cell_0(
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 6usize],
-        &[0.0; 12usize],
+        &[0.0; 6],
+        &[0.0; 12],
         p.try_into().expect("cell parameters"),
         out.try_into().expect("cell outputs"),
     )
@@ -4644,14 +4387,14 @@ fn cell_0_tangent_linked(
     p: &[f64],
     out: &mut [f64],
 ) {
-    let mut dir = [0.0; 12usize];
-    dir[..6usize].copy_from_slice(dx);
-    dir[6usize..].copy_from_slice(dxd);
+    let mut dir = [0.0; 12];
+    dir[..6].copy_from_slice(dx);
+    dir[6..].copy_from_slice(dxd);
     cell_0_tangent(
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 6usize],
+        &[0.0; 6],
         &dir,
         p.try_into().expect("cell parameters"),
         out.try_into().expect("cell outputs and derivatives"),
@@ -4662,8 +4405,8 @@ fn cell_0_pose_linked(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 6usize],
-        &[0.0; 12usize],
+        &[0.0; 6],
+        &[0.0; 12],
         p.try_into().expect("cell parameters"),
         out.try_into().expect("pose outputs"),
     )

@@ -4,7 +4,7 @@
 use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
 /// Structural hash of the model this was derived from.
 pub const HASH: &str = "097df576d0e23386";
-pub const DOF: usize = 36usize;
+pub const DOF: usize = 36;
 pub const COORDINATES: &[&str] = &[
     "bend_y_0_c0",
     "bend_y_0_c1",
@@ -161,21 +161,21 @@ pub const PARAMETERS: &[&str] = &[
     "shear[7].stiffness",
 ];
 /// Derived parameters, computed once per parameter set.
-pub const DERIVED: usize = 407usize;
+pub const DERIVED: usize = 407;
 /// Whether the mass solve is generated (the `accel` kernel).
 pub const ACCEL: bool = false;
 /// Base parameters that are loads (scaled by load continuation).
-pub const LOADS: &[usize] = &[0usize, 1usize, 2usize];
+pub const LOADS: &[usize] = &[0, 1, 2];
 /// The rows of the joints' constraint equations.
 pub const CONSTRAINTS: &[&str] = &[];
 /// Coordinates per independent subsystem (M block diagonal).
 pub const BLOCKS: &[usize] = &[];
 /// Contact points along the arms and at the bodies.
-pub const CONTACT_POINTS: usize = 0usize;
+pub const CONTACT_POINTS: usize = 0;
 /// Points per group of the `contact_jacobian` kernel.
 pub const CONTACT_GROUPS: &[usize] = &[];
 /// Length of the contact frames the `contact_jacobian` groups read.
-pub const CONTACT_FRAMES: usize = 0usize;
+pub const CONTACT_FRAMES: usize = 0;
 /// The compiled kernels of this structure.
 pub struct Compiled {
     info: ModelInfo,
@@ -207,17 +207,17 @@ impl Kernels for Compiled {
         "compiled"
     }
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
-        let q: &[f64; 36usize] = inp.q.try_into().expect("q has DOF entries");
-        let qd: &[f64; 36usize] = inp.qd.try_into().expect("qd has DOF entries");
-        let p: &[f64; 522usize] = inp.p.try_into().expect("parameter vector length");
-        let no_qdd = [0.0f64; 36usize];
-        let qdd: &[f64; 36usize] = if inp.qdd.is_empty() {
+        let q: &[f64; 36] = inp.q.try_into().expect("q has DOF entries");
+        let qd: &[f64; 36] = inp.qd.try_into().expect("qd has DOF entries");
+        let p: &[f64; 522] = inp.p.try_into().expect("parameter vector length");
+        let no_qdd = [0.0f64; 36];
+        let qdd: &[f64; 36] = if inp.qdd.is_empty() {
             &no_qdd
         } else {
             inp.qdd.try_into().expect("qdd has DOF entries")
         };
-        let no_dir = [0.0f64; 72usize];
-        let dir: &[f64; 72usize] = if inp.dir.is_empty() {
+        let no_dir = [0.0f64; 72];
+        let dir: &[f64; 72] = if inp.dir.is_empty() {
             &no_dir
         } else {
             inp.dir.try_into().expect("dir has 2 DOF entries")
@@ -314,12 +314,12 @@ impl Kernels for Compiled {
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -330,24 +330,24 @@ pub fn accel(
 #[allow(unused_variables, clippy::all)]
 fn accel_0(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `derived`: 439 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn derived(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    out: &mut [f64; 407usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    out: &mut [f64; 407],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -358,855 +358,855 @@ pub fn derived(
 #[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 407usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    w: &mut [f64; 0],
+    out: &mut [f64; 407],
 ) {
-    let v2: f64 = 0.25f64 * p[25usize];
-    let v4: f64 = p[21usize] - v2;
-    let v6: f64 = 0.125f64.mul_add(v4, v2);
-    let v8: f64 = 0.5f64.mul_add(p[25usize], -v6);
-    let v10: f64 = 0.25f64 * p[37usize];
-    let v12: f64 = p[33usize] - v10;
-    let v13: f64 = 0.125f64.mul_add(v12, v10);
-    let v14: f64 = 0.5f64.mul_add(p[37usize], -v13);
-    let v16: f64 = 0.25f64 * p[49usize];
-    let v18: f64 = p[45usize] - v16;
-    let v19: f64 = 0.125f64.mul_add(v18, v16);
-    let v20: f64 = 0.5f64.mul_add(p[49usize], -v19);
-    let v22: f64 = 0.25f64 * p[61usize];
-    let v24: f64 = p[57usize] - v22;
-    let v25: f64 = 0.125f64.mul_add(v24, v22);
-    let v26: f64 = 0.5f64.mul_add(p[61usize], -v25);
-    let v28: f64 = 0.25f64 * p[73usize];
-    let v30: f64 = p[69usize] - v28;
-    let v31: f64 = 0.125f64.mul_add(v30, v28);
-    let v32: f64 = 0.5f64.mul_add(p[73usize], -v31);
-    let v34: f64 = 0.25f64 * p[85usize];
-    let v36: f64 = p[81usize] - v34;
-    let v37: f64 = 0.125f64.mul_add(v36, v34);
-    let v38: f64 = 0.5f64.mul_add(p[85usize], -v37);
-    let v40: f64 = 0.25f64 * p[97usize];
-    let v42: f64 = p[93usize] - v40;
-    let v43: f64 = 0.125f64.mul_add(v42, v40);
-    let v44: f64 = 0.5f64.mul_add(p[97usize], -v43);
-    let v46: f64 = 0.25f64 * p[109usize];
-    let v48: f64 = p[105usize] - v46;
-    let v49: f64 = 0.125f64.mul_add(v48, v46);
-    let v50: f64 = 0.5f64.mul_add(p[109usize], -v49);
-    let v52: f64 = 0.5f64 * p[20usize];
-    let v54: f64 = 0.25f64 * p[19usize];
-    let v55: f64 = 0.125f64 * p[19usize];
-    let v57: f64 = 2f64 * p[19usize];
-    let v59: f64 = 4f64 * p[19usize];
-    let v61: f64 = 0.5f64 * p[32usize];
-    let v63: f64 = 0.25f64 * p[31usize];
-    let v64: f64 = 0.125f64 * p[31usize];
-    let v65: f64 = 2f64 * p[31usize];
-    let v66: f64 = 4f64 * p[31usize];
-    let v68: f64 = 0.5f64 * p[44usize];
-    let v70: f64 = 0.25f64 * p[43usize];
-    let v71: f64 = 0.125f64 * p[43usize];
-    let v72: f64 = 2f64 * p[43usize];
-    let v73: f64 = 4f64 * p[43usize];
-    let v75: f64 = 0.5f64 * p[56usize];
-    let v77: f64 = 0.25f64 * p[55usize];
-    let v78: f64 = 0.125f64 * p[55usize];
-    let v79: f64 = 2f64 * p[55usize];
-    let v80: f64 = 4f64 * p[55usize];
-    let v82: f64 = 0.5f64 * p[68usize];
-    let v84: f64 = 0.25f64 * p[67usize];
-    let v85: f64 = 0.125f64 * p[67usize];
-    let v86: f64 = 2f64 * p[67usize];
-    let v87: f64 = 4f64 * p[67usize];
-    let v89: f64 = 0.5f64 * p[80usize];
-    let v91: f64 = 0.25f64 * p[79usize];
-    let v92: f64 = 0.125f64 * p[79usize];
-    let v93: f64 = 2f64 * p[79usize];
-    let v94: f64 = 4f64 * p[79usize];
-    let v96: f64 = 0.5f64 * p[92usize];
-    let v98: f64 = 0.25f64 * p[91usize];
-    let v99: f64 = 0.125f64 * p[91usize];
-    let v100: f64 = 2f64 * p[91usize];
-    let v101: f64 = 4f64 * p[91usize];
-    let v103: f64 = 0.5f64 * p[104usize];
-    let v105: f64 = 0.25f64 * p[103usize];
-    let v106: f64 = 0.125f64 * p[103usize];
-    let v107: f64 = 2f64 * p[103usize];
-    let v108: f64 = 4f64 * p[103usize];
-    let v110: f64 = 0.23958333333333334f64 * p[19usize];
-    let v112: f64 = 0.11979166666666667f64 * p[19usize];
-    let v114: f64 = 0.19791666666666666f64 * p[19usize];
-    let v116: f64 = 0.09895833333333333f64 * p[19usize];
-    let v118: f64 = 0.17708333333333334f64 * p[31usize];
-    let v120: f64 = 0.08854166666666667f64 * p[31usize];
-    let v122: f64 = 0.13541666666666666f64 * p[31usize];
-    let v124: f64 = 0.06770833333333333f64 * p[31usize];
-    let v126: f64 = 0.11458333333333334f64 * p[43usize];
-    let v128: f64 = 0.05729166666666667f64 * p[43usize];
-    let v130: f64 = 0.07291666666666666f64 * p[43usize];
-    let v132: f64 = 0.03645833333333333f64 * p[43usize];
-    let v134: f64 = 0.05208333333333334f64 * p[55usize];
-    let v136: f64 = 0.02604166666666667f64 * p[55usize];
-    let v138: f64 = 0.010416666666666654f64 * p[55usize];
-    let v140: f64 = 0.005208333333333327f64 * p[55usize];
-    let v141: f64 = 0.010416666666666654f64 * p[67usize];
-    let v142: f64 = 0.005208333333333327f64 * p[67usize];
-    let v143: f64 = 0.05208333333333334f64 * p[67usize];
-    let v144: f64 = 0.02604166666666667f64 * p[67usize];
-    let v145: f64 = 0.07291666666666666f64 * p[79usize];
-    let v146: f64 = 0.03645833333333333f64 * p[79usize];
-    let v147: f64 = 0.11458333333333334f64 * p[79usize];
-    let v148: f64 = 0.05729166666666667f64 * p[79usize];
-    let v149: f64 = 0.13541666666666666f64 * p[91usize];
-    let v150: f64 = 0.06770833333333333f64 * p[91usize];
-    let v151: f64 = 0.17708333333333334f64 * p[91usize];
-    let v152: f64 = 0.08854166666666667f64 * p[91usize];
-    let v153: f64 = 0.19791666666666666f64 * p[103usize];
-    let v154: f64 = 0.09895833333333333f64 * p[103usize];
-    let v155: f64 = 0.23958333333333334f64 * p[103usize];
-    let v156: f64 = 0.11979166666666667f64 * p[103usize];
-    let v158: f64 = 0.21875000000000003f64 * p[19usize];
-    let v160: f64 = 0.10937500000000001f64 * p[19usize];
-    let v162: f64 = 0.10937499999999997f64 * p[19usize];
-    let v164: f64 = 0.054687499999999986f64 * p[19usize];
-    let v166: f64 = 0.06250000000000004f64 * p[31usize];
-    let v168: f64 = 0.03125000000000002f64 * p[31usize];
-    let v170: f64 = 0.015625000000000028f64 * p[31usize];
-    let v172: f64 = 0.007812500000000014f64 * p[31usize];
-    let v174: f64 = 0.04687499999999998f64 * p[43usize];
-    let v176: f64 = 0.02343749999999999f64 * p[43usize];
-    let v178: f64 = 0.09375000000000001f64 * p[43usize];
-    let v180: f64 = 0.04687500000000001f64 * p[43usize];
-    let v182: f64 = 0.109375f64 * p[55usize];
-    let v184: f64 = 0.0546875f64 * p[55usize];
-    let v186: f64 = 0.0625f64 * p[55usize];
-    let v187: f64 = 0.0625f64 * p[67usize];
-    let v188: f64 = 0.109375f64 * p[67usize];
-    let v189: f64 = 0.0546875f64 * p[67usize];
-    let v190: f64 = 0.09375000000000001f64 * p[79usize];
-    let v191: f64 = 0.04687500000000001f64 * p[79usize];
-    let v192: f64 = 0.04687499999999998f64 * p[79usize];
-    let v193: f64 = 0.02343749999999999f64 * p[79usize];
-    let v194: f64 = 0.015625000000000028f64 * p[91usize];
-    let v195: f64 = 0.007812500000000014f64 * p[91usize];
-    let v196: f64 = 0.06250000000000004f64 * p[91usize];
-    let v197: f64 = 0.03125000000000002f64 * p[91usize];
-    let v198: f64 = 0.10937499999999997f64 * p[103usize];
-    let v199: f64 = 0.054687499999999986f64 * p[103usize];
-    let v200: f64 = 0.21875000000000003f64 * p[103usize];
-    let v201: f64 = 0.10937500000000001f64 * p[103usize];
-    let v203: f64 = 0.18777126736111113f64 * p[19usize];
-    let v205: f64 = 0.09388563368055557f64 * p[19usize];
-    let v207: f64 = 0.010470920138888881f64 * p[19usize];
-    let v209: f64 = 0.005235460069444441f64 * p[19usize];
-    let v211: f64 = 0.045627170138888846f64 * p[31usize];
-    let v213: f64 = 0.022813585069444423f64 * p[31usize];
-    let v215: f64 = 0.10574001736111113f64 * p[31usize];
-    let v217: f64 = 0.052870008680555566f64 * p[31usize];
-    let v219: f64 = 0.1130099826388889f64 * p[43usize];
-    let v221: f64 = 0.05650499131944445f64 * p[43usize];
-    let v223: f64 = 0.09499782986111109f64 * p[43usize];
-    let v225: f64 = 0.047498914930555546f64 * p[43usize];
-    let v227: f64 = 0.07297092013888891f64 * p[55usize];
-    let v229: f64 = 0.036485460069444454f64 * p[55usize];
-    let v231: f64 = 0.01589626736111109f64 * p[55usize];
-    let v233: f64 = 0.007948133680555546f64 * p[55usize];
-    let v234: f64 = 0.01589626736111109f64 * p[67usize];
-    let v235: f64 = 0.007948133680555546f64 * p[67usize];
-    let v236: f64 = 0.07297092013888891f64 * p[67usize];
-    let v237: f64 = 0.036485460069444454f64 * p[67usize];
-    let v238: f64 = 0.09499782986111109f64 * p[79usize];
-    let v239: f64 = 0.047498914930555546f64 * p[79usize];
-    let v240: f64 = 0.1130099826388889f64 * p[79usize];
-    let v241: f64 = 0.05650499131944445f64 * p[79usize];
-    let v242: f64 = 0.10574001736111113f64 * p[91usize];
-    let v243: f64 = 0.052870008680555566f64 * p[91usize];
-    let v244: f64 = 0.045627170138888846f64 * p[91usize];
-    let v245: f64 = 0.022813585069444423f64 * p[91usize];
-    let v246: f64 = 0.010470920138888881f64 * p[103usize];
-    let v247: f64 = 0.005235460069444441f64 * p[103usize];
-    let v248: f64 = 0.18777126736111113f64 * p[103usize];
-    let v249: f64 = 0.09388563368055557f64 * p[103usize];
-    let v251: f64 = 0.14761352539062508f64 * p[19usize];
-    let v253: f64 = 0.07380676269531254f64 * p[19usize];
-    let v255: f64 = 0.07075670030381945f64 * p[19usize];
-    let v257: f64 = 0.035378350151909724f64 * p[19usize];
-    let v259: f64 = 0.10452948676215276f64 * p[31usize];
-    let v261: f64 = 0.05226474338107638f64 * p[31usize];
-    let v263: f64 = 0.08960978190104166f64 * p[31usize];
-    let v265: f64 = 0.04480489095052083f64 * p[31usize];
-    let v267: f64 = 0.055158827039930594f64 * p[43usize];
-    let v269: f64 = 0.027579413519965297f64 * p[43usize];
-    let v271: f64 = 0.02215237087673614f64 * p[43usize];
-    let v273: f64 = 0.01107618543836807f64 * p[43usize];
-    let v275: f64 = 0.056467692057291664f64 * p[55usize];
-    let v277: f64 = 0.028233846028645832f64 * p[55usize];
-    let v279: f64 = 0.09363132052951388f64 * p[55usize];
-    let v281: f64 = 0.04681566026475694f64 * p[55usize];
-    let v282: f64 = 0.09363132052951388f64 * p[67usize];
-    let v283: f64 = 0.04681566026475694f64 * p[67usize];
-    let v284: f64 = 0.056467692057291664f64 * p[67usize];
-    let v285: f64 = 0.028233846028645832f64 * p[67usize];
-    let v286: f64 = 0.02215237087673614f64 * p[79usize];
-    let v287: f64 = 0.01107618543836807f64 * p[79usize];
-    let v288: f64 = 0.055158827039930594f64 * p[79usize];
-    let v289: f64 = 0.027579413519965297f64 * p[79usize];
-    let v290: f64 = 0.08960978190104166f64 * p[91usize];
-    let v291: f64 = 0.04480489095052083f64 * p[91usize];
-    let v292: f64 = 0.10452948676215276f64 * p[91usize];
-    let v293: f64 = 0.05226474338107638f64 * p[91usize];
-    let v294: f64 = 0.07075670030381945f64 * p[103usize];
-    let v295: f64 = 0.035378350151909724f64 * p[103usize];
-    let v296: f64 = 0.14761352539062508f64 * p[103usize];
-    let v297: f64 = 0.07380676269531254f64 * p[103usize];
-    let v299: f64 = 0.10032187567816855f64 * p[19usize];
-    let v301: f64 = 0.05016093783908428f64 * p[19usize];
-    let v303: f64 = 0.11329947577582465f64 * p[19usize];
-    let v305: f64 = 0.056649737887912326f64 * p[19usize];
-    let v307: f64 = 0.09649361504448788f64 * p[31usize];
-    let v309: f64 = 0.04824680752224394f64 * p[31usize];
-    let v311: f64 = 0.0024977789984808813f64 * p[31usize];
-    let v313: f64 = 0.0012488894992404406f64 * p[31usize];
-    let v315: f64 = 0.04635153876410589f64 * p[43usize];
-    let v317: f64 = 0.023175769382052944f64 * p[43usize];
-    let v319: f64 = 0.08907784356011285f64 * p[43usize];
-    let v321: f64 = 0.044538921780056424f64 * p[43usize];
-    let v323: f64 = 0.08024893866644967f64 * p[55usize];
-    let v325: f64 = 0.04012446933322483f64 * p[55usize];
-    let v327: f64 = 0.020436180962456574f64 * p[55usize];
-    let v329: f64 = 0.010218090481228287f64 * p[55usize];
-    let v330: f64 = 0.020436180962456574f64 * p[67usize];
-    let v331: f64 = 0.010218090481228287f64 * p[67usize];
-    let v332: f64 = 0.08024893866644967f64 * p[67usize];
-    let v333: f64 = 0.04012446933322483f64 * p[67usize];
-    let v334: f64 = 0.08907784356011285f64 * p[79usize];
-    let v335: f64 = 0.044538921780056424f64 * p[79usize];
-    let v336: f64 = 0.04635153876410589f64 * p[79usize];
-    let v337: f64 = 0.023175769382052944f64 * p[79usize];
-    let v338: f64 = 0.0024977789984808813f64 * p[91usize];
-    let v339: f64 = 0.0012488894992404406f64 * p[91usize];
-    let v340: f64 = 0.09649361504448788f64 * p[91usize];
-    let v341: f64 = 0.04824680752224394f64 * p[91usize];
-    let v342: f64 = 0.11329947577582465f64 * p[103usize];
-    let v343: f64 = 0.056649737887912326f64 * p[103usize];
-    let v344: f64 = 0.10032187567816855f64 * p[103usize];
-    let v345: f64 = 0.05016093783908428f64 * p[103usize];
-    let v346: f64 = 0.5f64 * p[19usize];
-    let v347: f64 = 0.5f64 * p[31usize];
-    let v348: f64 = 0.5f64 * p[43usize];
-    let v349: f64 = 0.5f64 * p[55usize];
-    let v350: f64 = 0.5f64 * p[67usize];
-    let v351: f64 = 0.5f64 * p[79usize];
-    let v352: f64 = 0.5f64 * p[91usize];
-    let v353: f64 = 0.5f64 * p[103usize];
-    let v355: f64 = (-0.23958333333333334f64) * p[19usize];
-    let v357: f64 = (-0.4791666666666667f64) * p[19usize];
-    let v359: f64 = (-0.19791666666666666f64) * p[19usize];
-    let v361: f64 = (-0.3958333333333333f64) * p[19usize];
-    let v363: f64 = (-0.17708333333333334f64) * p[31usize];
-    let v365: f64 = (-0.3541666666666667f64) * p[31usize];
-    let v367: f64 = (-0.13541666666666666f64) * p[31usize];
-    let v369: f64 = (-0.2708333333333333f64) * p[31usize];
-    let v371: f64 = (-0.11458333333333334f64) * p[43usize];
-    let v373: f64 = (-0.22916666666666669f64) * p[43usize];
-    let v375: f64 = (-0.07291666666666666f64) * p[43usize];
-    let v377: f64 = (-0.14583333333333331f64) * p[43usize];
-    let v379: f64 = (-0.05208333333333334f64) * p[55usize];
-    let v381: f64 = (-0.10416666666666669f64) * p[55usize];
-    let v383: f64 = (-0.010416666666666654f64) * p[55usize];
-    let v385: f64 = (-0.020833333333333308f64) * p[55usize];
-    let v387: f64 = 0.020833333333333308f64 * p[67usize];
-    let v389: f64 = 0.10416666666666669f64 * p[67usize];
-    let v391: f64 = 0.14583333333333331f64 * p[79usize];
-    let v393: f64 = 0.22916666666666669f64 * p[79usize];
-    let v395: f64 = 0.2708333333333333f64 * p[91usize];
-    let v397: f64 = 0.3541666666666667f64 * p[91usize];
-    let v399: f64 = 0.3958333333333333f64 * p[103usize];
-    let v401: f64 = 0.43750000000000006f64 * p[19usize];
-    let v403: f64 = 0.21874999999999994f64 * p[19usize];
-    let v405: f64 = 0.12500000000000008f64 * p[31usize];
-    let v407: f64 = (-0.015625000000000028f64) * p[31usize];
-    let v409: f64 = (-0.031250000000000056f64) * p[31usize];
-    let v411: f64 = (-0.04687499999999998f64) * p[43usize];
-    let v413: f64 = (-0.09374999999999996f64) * p[43usize];
-    let v415: f64 = (-0.09375000000000001f64) * p[43usize];
-    let v417: f64 = (-0.18750000000000003f64) * p[43usize];
-    let v419: f64 = (-0.109375f64) * p[55usize];
-    let v421: f64 = (-0.21875f64) * p[55usize];
-    let v423: f64 = (-0.125f64) * p[55usize];
-    let v425: f64 = (-0.25f64) * p[55usize];
-    let v426: f64 = (-0.125f64) * p[67usize];
-    let v427: f64 = (-0.25f64) * p[67usize];
-    let v428: f64 = (-0.109375f64) * p[67usize];
-    let v429: f64 = (-0.21875f64) * p[67usize];
-    let v430: f64 = (-0.09375000000000001f64) * p[79usize];
-    let v431: f64 = (-0.18750000000000003f64) * p[79usize];
-    let v432: f64 = (-0.04687499999999998f64) * p[79usize];
-    let v433: f64 = (-0.09374999999999996f64) * p[79usize];
-    let v434: f64 = (-0.015625000000000028f64) * p[91usize];
-    let v435: f64 = (-0.031250000000000056f64) * p[91usize];
-    let v436: f64 = 0.12500000000000008f64 * p[91usize];
-    let v437: f64 = 0.21874999999999994f64 * p[103usize];
-    let v439: f64 = (-0.18777126736111113f64) * p[19usize];
-    let v441: f64 = (-0.37554253472222227f64) * p[19usize];
-    let v443: f64 = (-0.010470920138888881f64) * p[19usize];
-    let v445: f64 = (-0.020941840277777762f64) * p[19usize];
-    let v447: f64 = 0.09125434027777769f64 * p[31usize];
-    let v449: f64 = 0.21148003472222227f64 * p[31usize];
-    let v451: f64 = 0.2260199652777778f64 * p[43usize];
-    let v453: f64 = 0.18999565972222218f64 * p[43usize];
-    let v455: f64 = 0.14594184027777782f64 * p[55usize];
-    let v457: f64 = 0.03179253472222218f64 * p[55usize];
-    let v459: f64 = (-0.01589626736111109f64) * p[67usize];
-    let v461: f64 = (-0.03179253472222218f64) * p[67usize];
-    let v463: f64 = (-0.07297092013888891f64) * p[67usize];
-    let v465: f64 = (-0.14594184027777782f64) * p[67usize];
-    let v467: f64 = (-0.09499782986111109f64) * p[79usize];
-    let v469: f64 = (-0.18999565972222218f64) * p[79usize];
-    let v471: f64 = (-0.1130099826388889f64) * p[79usize];
-    let v473: f64 = (-0.2260199652777778f64) * p[79usize];
-    let v475: f64 = (-0.10574001736111113f64) * p[91usize];
-    let v477: f64 = (-0.21148003472222227f64) * p[91usize];
-    let v479: f64 = (-0.045627170138888846f64) * p[91usize];
-    let v481: f64 = (-0.09125434027777769f64) * p[91usize];
-    let v483: f64 = 0.020941840277777762f64 * p[103usize];
-    let v485: f64 = 0.29522705078125017f64 * p[19usize];
-    let v487: f64 = (-0.07075670030381945f64) * p[19usize];
-    let v489: f64 = (-0.1415134006076389f64) * p[19usize];
-    let v491: f64 = (-0.10452948676215276f64) * p[31usize];
-    let v493: f64 = (-0.20905897352430552f64) * p[31usize];
-    let v495: f64 = (-0.08960978190104166f64) * p[31usize];
-    let v497: f64 = (-0.17921956380208331f64) * p[31usize];
-    let v499: f64 = (-0.055158827039930594f64) * p[43usize];
-    let v501: f64 = (-0.11031765407986119f64) * p[43usize];
-    let v503: f64 = 0.04430474175347228f64 * p[43usize];
-    let v505: f64 = 0.11293538411458333f64 * p[55usize];
-    let v507: f64 = 0.18726264105902776f64 * p[55usize];
-    let v508: f64 = 0.18726264105902776f64 * p[67usize];
-    let v509: f64 = 0.11293538411458333f64 * p[67usize];
-    let v510: f64 = 0.04430474175347228f64 * p[79usize];
-    let v511: f64 = (-0.055158827039930594f64) * p[79usize];
-    let v512: f64 = (-0.11031765407986119f64) * p[79usize];
-    let v513: f64 = (-0.08960978190104166f64) * p[91usize];
-    let v514: f64 = (-0.17921956380208331f64) * p[91usize];
-    let v515: f64 = (-0.10452948676215276f64) * p[91usize];
-    let v516: f64 = (-0.20905897352430552f64) * p[91usize];
-    let v517: f64 = (-0.07075670030381945f64) * p[103usize];
-    let v518: f64 = (-0.1415134006076389f64) * p[103usize];
-    let v520: f64 = (-0.10032187567816855f64) * p[19usize];
-    let v522: f64 = (-0.2006437513563371f64) * p[19usize];
-    let v524: f64 = 0.2265989515516493f64 * p[19usize];
-    let v526: f64 = 0.19298723008897575f64 * p[31usize];
-    let v528: f64 = 0.004995557996961763f64 * p[31usize];
-    let v530: f64 = (-0.04635153876410589f64) * p[43usize];
-    let v532: f64 = (-0.09270307752821177f64) * p[43usize];
-    let v534: f64 = (-0.08907784356011285f64) * p[43usize];
-    let v536: f64 = (-0.1781556871202257f64) * p[43usize];
-    let v538: f64 = (-0.08024893866644967f64) * p[55usize];
-    let v540: f64 = (-0.16049787733289933f64) * p[55usize];
-    let v542: f64 = (-0.020436180962456574f64) * p[55usize];
-    let v544: f64 = (-0.04087236192491315f64) * p[55usize];
-    let v546: f64 = 0.04087236192491315f64 * p[67usize];
-    let v548: f64 = 0.16049787733289933f64 * p[67usize];
-    let v550: f64 = 0.1781556871202257f64 * p[79usize];
-    let v552: f64 = 0.09270307752821177f64 * p[79usize];
-    let v554: f64 = (-0.0024977789984808813f64) * p[91usize];
-    let v556: f64 = (-0.004995557996961763f64) * p[91usize];
-    let v558: f64 = (-0.09649361504448788f64) * p[91usize];
-    let v560: f64 = (-0.19298723008897575f64) * p[91usize];
-    let v562: f64 = (-0.11329947577582465f64) * p[103usize];
-    let v564: f64 = (-0.2265989515516493f64) * p[103usize];
-    let v566: f64 = -p[2usize];
-    let v568: f64 = 8f64 * p[19usize];
-    let v569: f64 = 8f64 * p[31usize];
-    let v570: f64 = 8f64 * p[43usize];
-    let v571: f64 = 8f64 * p[55usize];
-    let v572: f64 = 8f64 * p[67usize];
-    let v573: f64 = 8f64 * p[79usize];
-    let v574: f64 = 8f64 * p[91usize];
-    let v575: f64 = 8f64 * p[103usize];
-    let v577: f64 = -p[1usize];
-    let v579: f64 = -p[0usize];
-    let v581: f64 = 0.125f64 * p[22usize];
-    let v583: f64 = 0.125f64 * p[23usize];
-    let v585: f64 = 0.041666666666666664f64 * p[22usize];
-    let v586: f64 = 0.041666666666666664f64 * p[23usize];
-    let v588: f64 = 0.025f64 * p[22usize];
-    let v589: f64 = 0.025f64 * p[23usize];
-    let v591: f64 = 0.017857142857142856f64 * p[22usize];
-    let v592: f64 = 0.017857142857142856f64 * p[23usize];
-    let v594: f64 = 0.013888888888888888f64 * p[22usize];
-    let v595: f64 = 0.013888888888888888f64 * p[23usize];
-    let v597: f64 = 0.011363636363636364f64 * p[22usize];
-    let v598: f64 = 0.011363636363636364f64 * p[23usize];
-    let v601: f64 = (-8f64) * p[24usize];
-    let v603: f64 = 0.125f64 * p[26usize];
-    let v605: f64 = 0.125f64 * p[27usize];
-    let v606: f64 = 0.041666666666666664f64 * p[26usize];
-    let v607: f64 = 0.041666666666666664f64 * p[27usize];
-    let v608: f64 = 0.025f64 * p[26usize];
-    let v609: f64 = 0.025f64 * p[27usize];
-    let v610: f64 = 0.017857142857142856f64 * p[26usize];
-    let v611: f64 = 0.017857142857142856f64 * p[27usize];
-    let v612: f64 = 0.013888888888888888f64 * p[26usize];
-    let v613: f64 = 0.013888888888888888f64 * p[27usize];
-    let v614: f64 = 0.011363636363636364f64 * p[26usize];
-    let v615: f64 = 0.011363636363636364f64 * p[27usize];
-    let v616: f64 = p[19usize] * p[19usize];
-    let v618: f64 = 8f64 * p[28usize];
-    let v620: f64 = 8f64 * p[29usize];
-    let v622: f64 = 2.6666666666666665f64 * p[28usize];
-    let v623: f64 = 2.6666666666666665f64 * p[29usize];
-    let v625: f64 = 1.6f64 * p[28usize];
-    let v626: f64 = 1.6f64 * p[29usize];
-    let v628: f64 = 1.1428571428571428f64 * p[28usize];
-    let v629: f64 = 1.1428571428571428f64 * p[29usize];
-    let v631: f64 = 0.8888888888888888f64 * p[28usize];
-    let v632: f64 = 0.8888888888888888f64 * p[29usize];
-    let v634: f64 = 0.7272727272727273f64 * p[28usize];
-    let v635: f64 = 0.7272727272727273f64 * p[29usize];
-    let v637: f64 = 8f64 * p[30usize];
-    let v638: f64 = 2.6666666666666665f64 * p[30usize];
-    let v639: f64 = 1.6f64 * p[30usize];
-    let v640: f64 = 1.1428571428571428f64 * p[30usize];
-    let v641: f64 = 0.8888888888888888f64 * p[30usize];
-    let v642: f64 = 0.7272727272727273f64 * p[30usize];
-    let v644: f64 = 0.25f64 * p[16usize];
-    let v646: f64 = 0.25f64 * p[17usize];
-    let v648: f64 = 0.25f64 * p[18usize];
-    let v650: f64 = 0.25f64 * p[15usize];
-    let v651: f64 = v622 * v616;
-    let v652: f64 = v623 * v616;
-    let v653: f64 = v628 * v616;
-    let v654: f64 = v629 * v616;
-    let v655: f64 = v634 * v616;
-    let v656: f64 = v635 * v616;
-    let v657: f64 = v638 * v616;
-    let v658: f64 = v640 * v616;
-    let v659: f64 = v642 * v616;
-    out[0usize] = v6;
-    out[1usize] = v8;
-    out[2usize] = v13;
-    out[3usize] = v14;
-    out[4usize] = v19;
-    out[5usize] = v20;
-    out[6usize] = v25;
-    out[7usize] = v26;
-    out[8usize] = v31;
-    out[9usize] = v32;
-    out[10usize] = v37;
-    out[11usize] = v38;
-    out[12usize] = v43;
-    out[13usize] = v44;
-    out[14usize] = v49;
-    out[15usize] = v50;
-    out[16usize] = v52;
-    out[17usize] = v54;
-    out[18usize] = v55;
-    out[19usize] = v57;
-    out[20usize] = v59;
-    out[21usize] = v61;
-    out[22usize] = v63;
-    out[23usize] = v64;
-    out[24usize] = v65;
-    out[25usize] = v66;
-    out[26usize] = v68;
-    out[27usize] = v70;
-    out[28usize] = v71;
-    out[29usize] = v72;
-    out[30usize] = v73;
-    out[31usize] = v75;
-    out[32usize] = v77;
-    out[33usize] = v78;
-    out[34usize] = v79;
-    out[35usize] = v80;
-    out[36usize] = v82;
-    out[37usize] = v84;
-    out[38usize] = v85;
-    out[39usize] = v86;
-    out[40usize] = v87;
-    out[41usize] = v89;
-    out[42usize] = v91;
-    out[43usize] = v92;
-    out[44usize] = v93;
-    out[45usize] = v94;
-    out[46usize] = v96;
-    out[47usize] = v98;
-    out[48usize] = v99;
-    out[49usize] = v100;
-    out[50usize] = v101;
-    out[51usize] = v103;
-    out[52usize] = v105;
-    out[53usize] = v106;
-    out[54usize] = v107;
-    out[55usize] = v108;
-    out[56usize] = v110;
-    out[57usize] = v112;
-    out[58usize] = v114;
-    out[59usize] = v116;
-    out[60usize] = v118;
-    out[61usize] = v120;
-    out[62usize] = v122;
-    out[63usize] = v124;
-    out[64usize] = v126;
-    out[65usize] = v128;
-    out[66usize] = v130;
-    out[67usize] = v132;
-    out[68usize] = v134;
-    out[69usize] = v136;
-    out[70usize] = v138;
-    out[71usize] = v140;
-    out[72usize] = v141;
-    out[73usize] = v142;
-    out[74usize] = v143;
-    out[75usize] = v144;
-    out[76usize] = v145;
-    out[77usize] = v146;
-    out[78usize] = v147;
-    out[79usize] = v148;
-    out[80usize] = v149;
-    out[81usize] = v150;
-    out[82usize] = v151;
-    out[83usize] = v152;
-    out[84usize] = v153;
-    out[85usize] = v154;
-    out[86usize] = v155;
-    out[87usize] = v156;
-    out[88usize] = v158;
-    out[89usize] = v160;
-    out[90usize] = v162;
-    out[91usize] = v164;
-    out[92usize] = v166;
-    out[93usize] = v168;
-    out[94usize] = v170;
-    out[95usize] = v172;
-    out[96usize] = v174;
-    out[97usize] = v176;
-    out[98usize] = v178;
-    out[99usize] = v180;
-    out[100usize] = v182;
-    out[101usize] = v184;
-    out[102usize] = v186;
-    out[103usize] = v187;
-    out[104usize] = v188;
-    out[105usize] = v189;
-    out[106usize] = v190;
-    out[107usize] = v191;
-    out[108usize] = v192;
-    out[109usize] = v193;
-    out[110usize] = v194;
-    out[111usize] = v195;
-    out[112usize] = v196;
-    out[113usize] = v197;
-    out[114usize] = v198;
-    out[115usize] = v199;
-    out[116usize] = v200;
-    out[117usize] = v201;
-    out[118usize] = v203;
-    out[119usize] = v205;
-    out[120usize] = v207;
-    out[121usize] = v209;
-    out[122usize] = v211;
-    out[123usize] = v213;
-    out[124usize] = v215;
-    out[125usize] = v217;
-    out[126usize] = v219;
-    out[127usize] = v221;
-    out[128usize] = v223;
-    out[129usize] = v225;
-    out[130usize] = v227;
-    out[131usize] = v229;
-    out[132usize] = v231;
-    out[133usize] = v233;
-    out[134usize] = v234;
-    out[135usize] = v235;
-    out[136usize] = v236;
-    out[137usize] = v237;
-    out[138usize] = v238;
-    out[139usize] = v239;
-    out[140usize] = v240;
-    out[141usize] = v241;
-    out[142usize] = v242;
-    out[143usize] = v243;
-    out[144usize] = v244;
-    out[145usize] = v245;
-    out[146usize] = v246;
-    out[147usize] = v247;
-    out[148usize] = v248;
-    out[149usize] = v249;
-    out[150usize] = v251;
-    out[151usize] = v253;
-    out[152usize] = v255;
-    out[153usize] = v257;
-    out[154usize] = v259;
-    out[155usize] = v261;
-    out[156usize] = v263;
-    out[157usize] = v265;
-    out[158usize] = v267;
-    out[159usize] = v269;
-    out[160usize] = v271;
-    out[161usize] = v273;
-    out[162usize] = v275;
-    out[163usize] = v277;
-    out[164usize] = v279;
-    out[165usize] = v281;
-    out[166usize] = v282;
-    out[167usize] = v283;
-    out[168usize] = v284;
-    out[169usize] = v285;
-    out[170usize] = v286;
-    out[171usize] = v287;
-    out[172usize] = v288;
-    out[173usize] = v289;
-    out[174usize] = v290;
-    out[175usize] = v291;
-    out[176usize] = v292;
-    out[177usize] = v293;
-    out[178usize] = v294;
-    out[179usize] = v295;
-    out[180usize] = v296;
-    out[181usize] = v297;
-    out[182usize] = v299;
-    out[183usize] = v301;
-    out[184usize] = v303;
-    out[185usize] = v305;
-    out[186usize] = v307;
-    out[187usize] = v309;
-    out[188usize] = v311;
-    out[189usize] = v313;
-    out[190usize] = v315;
-    out[191usize] = v317;
-    out[192usize] = v319;
-    out[193usize] = v321;
-    out[194usize] = v323;
-    out[195usize] = v325;
-    out[196usize] = v327;
-    out[197usize] = v329;
-    out[198usize] = v330;
-    out[199usize] = v331;
-    out[200usize] = v332;
-    out[201usize] = v333;
-    out[202usize] = v334;
-    out[203usize] = v335;
-    out[204usize] = v336;
-    out[205usize] = v337;
-    out[206usize] = v338;
-    out[207usize] = v339;
-    out[208usize] = v340;
-    out[209usize] = v341;
-    out[210usize] = v342;
-    out[211usize] = v343;
-    out[212usize] = v344;
-    out[213usize] = v345;
-    out[214usize] = v346;
-    out[215usize] = v347;
-    out[216usize] = v348;
-    out[217usize] = v349;
-    out[218usize] = v350;
-    out[219usize] = v351;
-    out[220usize] = v352;
-    out[221usize] = v353;
-    out[222usize] = v355;
-    out[223usize] = v357;
-    out[224usize] = v359;
-    out[225usize] = v361;
-    out[226usize] = v363;
-    out[227usize] = v365;
-    out[228usize] = v367;
-    out[229usize] = v369;
-    out[230usize] = v371;
-    out[231usize] = v373;
-    out[232usize] = v375;
-    out[233usize] = v377;
-    out[234usize] = v379;
-    out[235usize] = v381;
-    out[236usize] = v383;
-    out[237usize] = v385;
-    out[238usize] = v387;
-    out[239usize] = v389;
-    out[240usize] = v391;
-    out[241usize] = v393;
-    out[242usize] = v395;
-    out[243usize] = v397;
-    out[244usize] = v399;
-    out[245usize] = v401;
-    out[246usize] = v403;
-    out[247usize] = v405;
-    out[248usize] = v407;
-    out[249usize] = v409;
-    out[250usize] = v411;
-    out[251usize] = v413;
-    out[252usize] = v415;
-    out[253usize] = v417;
-    out[254usize] = v419;
-    out[255usize] = v421;
-    out[256usize] = v423;
-    out[257usize] = v425;
-    out[258usize] = v426;
-    out[259usize] = v427;
-    out[260usize] = v428;
-    out[261usize] = v429;
-    out[262usize] = v430;
-    out[263usize] = v431;
-    out[264usize] = v432;
-    out[265usize] = v433;
-    out[266usize] = v434;
-    out[267usize] = v435;
-    out[268usize] = v436;
-    out[269usize] = v437;
-    out[270usize] = v439;
-    out[271usize] = v441;
-    out[272usize] = v443;
-    out[273usize] = v445;
-    out[274usize] = v447;
-    out[275usize] = v449;
-    out[276usize] = v451;
-    out[277usize] = v453;
-    out[278usize] = v455;
-    out[279usize] = v457;
-    out[280usize] = v459;
-    out[281usize] = v461;
-    out[282usize] = v463;
-    out[283usize] = v465;
-    out[284usize] = v467;
-    out[285usize] = v469;
-    out[286usize] = v471;
-    out[287usize] = v473;
-    out[288usize] = v475;
-    out[289usize] = v477;
-    out[290usize] = v479;
-    out[291usize] = v481;
-    out[292usize] = v483;
-    out[293usize] = v485;
-    out[294usize] = v487;
-    out[295usize] = v489;
-    out[296usize] = v491;
-    out[297usize] = v493;
-    out[298usize] = v495;
-    out[299usize] = v497;
-    out[300usize] = v499;
-    out[301usize] = v501;
-    out[302usize] = v503;
-    out[303usize] = v505;
-    out[304usize] = v507;
-    out[305usize] = v508;
-    out[306usize] = v509;
-    out[307usize] = v510;
-    out[308usize] = v511;
-    out[309usize] = v512;
-    out[310usize] = v513;
-    out[311usize] = v514;
-    out[312usize] = v515;
-    out[313usize] = v516;
-    out[314usize] = v517;
-    out[315usize] = v518;
-    out[316usize] = v520;
-    out[317usize] = v522;
-    out[318usize] = v524;
-    out[319usize] = v526;
-    out[320usize] = v528;
-    out[321usize] = v530;
-    out[322usize] = v532;
-    out[323usize] = v534;
-    out[324usize] = v536;
-    out[325usize] = v538;
-    out[326usize] = v540;
-    out[327usize] = v542;
-    out[328usize] = v544;
-    out[329usize] = v546;
-    out[330usize] = v548;
-    out[331usize] = v550;
-    out[332usize] = v552;
-    out[333usize] = v554;
-    out[334usize] = v556;
-    out[335usize] = v558;
-    out[336usize] = v560;
-    out[337usize] = v562;
-    out[338usize] = v564;
-    out[339usize] = v566;
-    out[340usize] = v568;
-    out[341usize] = v569;
-    out[342usize] = v570;
-    out[343usize] = v571;
-    out[344usize] = v572;
-    out[345usize] = v573;
-    out[346usize] = v574;
-    out[347usize] = v575;
-    out[348usize] = v577;
-    out[349usize] = v579;
-    out[350usize] = v581;
-    out[351usize] = v583;
-    out[352usize] = v585;
-    out[353usize] = v586;
-    out[354usize] = v588;
-    out[355usize] = v589;
-    out[356usize] = v591;
-    out[357usize] = v592;
-    out[358usize] = v594;
-    out[359usize] = v595;
-    out[360usize] = v597;
-    out[361usize] = v598;
-    out[362usize] = v601;
-    out[363usize] = v603;
-    out[364usize] = v605;
-    out[365usize] = v606;
-    out[366usize] = v607;
-    out[367usize] = v608;
-    out[368usize] = v609;
-    out[369usize] = v610;
-    out[370usize] = v611;
-    out[371usize] = v612;
-    out[372usize] = v613;
-    out[373usize] = v614;
-    out[374usize] = v615;
-    out[375usize] = v616;
-    out[376usize] = v618;
-    out[377usize] = v620;
-    out[378usize] = v622;
-    out[379usize] = v623;
-    out[380usize] = v625;
-    out[381usize] = v626;
-    out[382usize] = v628;
-    out[383usize] = v629;
-    out[384usize] = v631;
-    out[385usize] = v632;
-    out[386usize] = v634;
-    out[387usize] = v635;
-    out[388usize] = v637;
-    out[389usize] = v638;
-    out[390usize] = v639;
-    out[391usize] = v640;
-    out[392usize] = v641;
-    out[393usize] = v642;
-    out[394usize] = v644;
-    out[395usize] = v646;
-    out[396usize] = v648;
-    out[397usize] = v650;
-    out[398usize] = v651;
-    out[399usize] = v652;
-    out[400usize] = v653;
-    out[401usize] = v654;
-    out[402usize] = v655;
-    out[403usize] = v656;
-    out[404usize] = v657;
-    out[405usize] = v658;
-    out[406usize] = v659;
+    let v2 = 0.25f64 * p[25];
+    let v4 = p[21] - v2;
+    let v6 = 0.125f64.mul_add(v4, v2);
+    let v8 = 0.5f64.mul_add(p[25], -v6);
+    let v10 = 0.25f64 * p[37];
+    let v12 = p[33] - v10;
+    let v13 = 0.125f64.mul_add(v12, v10);
+    let v14 = 0.5f64.mul_add(p[37], -v13);
+    let v16 = 0.25f64 * p[49];
+    let v18 = p[45] - v16;
+    let v19 = 0.125f64.mul_add(v18, v16);
+    let v20 = 0.5f64.mul_add(p[49], -v19);
+    let v22 = 0.25f64 * p[61];
+    let v24 = p[57] - v22;
+    let v25 = 0.125f64.mul_add(v24, v22);
+    let v26 = 0.5f64.mul_add(p[61], -v25);
+    let v28 = 0.25f64 * p[73];
+    let v30 = p[69] - v28;
+    let v31 = 0.125f64.mul_add(v30, v28);
+    let v32 = 0.5f64.mul_add(p[73], -v31);
+    let v34 = 0.25f64 * p[85];
+    let v36 = p[81] - v34;
+    let v37 = 0.125f64.mul_add(v36, v34);
+    let v38 = 0.5f64.mul_add(p[85], -v37);
+    let v40 = 0.25f64 * p[97];
+    let v42 = p[93] - v40;
+    let v43 = 0.125f64.mul_add(v42, v40);
+    let v44 = 0.5f64.mul_add(p[97], -v43);
+    let v46 = 0.25f64 * p[109];
+    let v48 = p[105] - v46;
+    let v49 = 0.125f64.mul_add(v48, v46);
+    let v50 = 0.5f64.mul_add(p[109], -v49);
+    let v52 = 0.5f64 * p[20];
+    let v54 = 0.25f64 * p[19];
+    let v55 = 0.125f64 * p[19];
+    let v57 = 2f64 * p[19];
+    let v59 = 4f64 * p[19];
+    let v61 = 0.5f64 * p[32];
+    let v63 = 0.25f64 * p[31];
+    let v64 = 0.125f64 * p[31];
+    let v65 = 2f64 * p[31];
+    let v66 = 4f64 * p[31];
+    let v68 = 0.5f64 * p[44];
+    let v70 = 0.25f64 * p[43];
+    let v71 = 0.125f64 * p[43];
+    let v72 = 2f64 * p[43];
+    let v73 = 4f64 * p[43];
+    let v75 = 0.5f64 * p[56];
+    let v77 = 0.25f64 * p[55];
+    let v78 = 0.125f64 * p[55];
+    let v79 = 2f64 * p[55];
+    let v80 = 4f64 * p[55];
+    let v82 = 0.5f64 * p[68];
+    let v84 = 0.25f64 * p[67];
+    let v85 = 0.125f64 * p[67];
+    let v86 = 2f64 * p[67];
+    let v87 = 4f64 * p[67];
+    let v89 = 0.5f64 * p[80];
+    let v91 = 0.25f64 * p[79];
+    let v92 = 0.125f64 * p[79];
+    let v93 = 2f64 * p[79];
+    let v94 = 4f64 * p[79];
+    let v96 = 0.5f64 * p[92];
+    let v98 = 0.25f64 * p[91];
+    let v99 = 0.125f64 * p[91];
+    let v100 = 2f64 * p[91];
+    let v101 = 4f64 * p[91];
+    let v103 = 0.5f64 * p[104];
+    let v105 = 0.25f64 * p[103];
+    let v106 = 0.125f64 * p[103];
+    let v107 = 2f64 * p[103];
+    let v108 = 4f64 * p[103];
+    let v110 = 0.23958333333333334f64 * p[19];
+    let v112 = 0.11979166666666667f64 * p[19];
+    let v114 = 0.19791666666666666f64 * p[19];
+    let v116 = 0.09895833333333333f64 * p[19];
+    let v118 = 0.17708333333333334f64 * p[31];
+    let v120 = 0.08854166666666667f64 * p[31];
+    let v122 = 0.13541666666666666f64 * p[31];
+    let v124 = 0.06770833333333333f64 * p[31];
+    let v126 = 0.11458333333333334f64 * p[43];
+    let v128 = 0.05729166666666667f64 * p[43];
+    let v130 = 0.07291666666666666f64 * p[43];
+    let v132 = 0.03645833333333333f64 * p[43];
+    let v134 = 0.05208333333333334f64 * p[55];
+    let v136 = 0.02604166666666667f64 * p[55];
+    let v138 = 0.010416666666666654f64 * p[55];
+    let v140 = 0.005208333333333327f64 * p[55];
+    let v141 = 0.010416666666666654f64 * p[67];
+    let v142 = 0.005208333333333327f64 * p[67];
+    let v143 = 0.05208333333333334f64 * p[67];
+    let v144 = 0.02604166666666667f64 * p[67];
+    let v145 = 0.07291666666666666f64 * p[79];
+    let v146 = 0.03645833333333333f64 * p[79];
+    let v147 = 0.11458333333333334f64 * p[79];
+    let v148 = 0.05729166666666667f64 * p[79];
+    let v149 = 0.13541666666666666f64 * p[91];
+    let v150 = 0.06770833333333333f64 * p[91];
+    let v151 = 0.17708333333333334f64 * p[91];
+    let v152 = 0.08854166666666667f64 * p[91];
+    let v153 = 0.19791666666666666f64 * p[103];
+    let v154 = 0.09895833333333333f64 * p[103];
+    let v155 = 0.23958333333333334f64 * p[103];
+    let v156 = 0.11979166666666667f64 * p[103];
+    let v158 = 0.21875000000000003f64 * p[19];
+    let v160 = 0.10937500000000001f64 * p[19];
+    let v162 = 0.10937499999999997f64 * p[19];
+    let v164 = 0.054687499999999986f64 * p[19];
+    let v166 = 0.06250000000000004f64 * p[31];
+    let v168 = 0.03125000000000002f64 * p[31];
+    let v170 = 0.015625000000000028f64 * p[31];
+    let v172 = 0.007812500000000014f64 * p[31];
+    let v174 = 0.04687499999999998f64 * p[43];
+    let v176 = 0.02343749999999999f64 * p[43];
+    let v178 = 0.09375000000000001f64 * p[43];
+    let v180 = 0.04687500000000001f64 * p[43];
+    let v182 = 0.109375f64 * p[55];
+    let v184 = 0.0546875f64 * p[55];
+    let v186 = 0.0625f64 * p[55];
+    let v187 = 0.0625f64 * p[67];
+    let v188 = 0.109375f64 * p[67];
+    let v189 = 0.0546875f64 * p[67];
+    let v190 = 0.09375000000000001f64 * p[79];
+    let v191 = 0.04687500000000001f64 * p[79];
+    let v192 = 0.04687499999999998f64 * p[79];
+    let v193 = 0.02343749999999999f64 * p[79];
+    let v194 = 0.015625000000000028f64 * p[91];
+    let v195 = 0.007812500000000014f64 * p[91];
+    let v196 = 0.06250000000000004f64 * p[91];
+    let v197 = 0.03125000000000002f64 * p[91];
+    let v198 = 0.10937499999999997f64 * p[103];
+    let v199 = 0.054687499999999986f64 * p[103];
+    let v200 = 0.21875000000000003f64 * p[103];
+    let v201 = 0.10937500000000001f64 * p[103];
+    let v203 = 0.18777126736111113f64 * p[19];
+    let v205 = 0.09388563368055557f64 * p[19];
+    let v207 = 0.010470920138888881f64 * p[19];
+    let v209 = 0.005235460069444441f64 * p[19];
+    let v211 = 0.045627170138888846f64 * p[31];
+    let v213 = 0.022813585069444423f64 * p[31];
+    let v215 = 0.10574001736111113f64 * p[31];
+    let v217 = 0.052870008680555566f64 * p[31];
+    let v219 = 0.1130099826388889f64 * p[43];
+    let v221 = 0.05650499131944445f64 * p[43];
+    let v223 = 0.09499782986111109f64 * p[43];
+    let v225 = 0.047498914930555546f64 * p[43];
+    let v227 = 0.07297092013888891f64 * p[55];
+    let v229 = 0.036485460069444454f64 * p[55];
+    let v231 = 0.01589626736111109f64 * p[55];
+    let v233 = 0.007948133680555546f64 * p[55];
+    let v234 = 0.01589626736111109f64 * p[67];
+    let v235 = 0.007948133680555546f64 * p[67];
+    let v236 = 0.07297092013888891f64 * p[67];
+    let v237 = 0.036485460069444454f64 * p[67];
+    let v238 = 0.09499782986111109f64 * p[79];
+    let v239 = 0.047498914930555546f64 * p[79];
+    let v240 = 0.1130099826388889f64 * p[79];
+    let v241 = 0.05650499131944445f64 * p[79];
+    let v242 = 0.10574001736111113f64 * p[91];
+    let v243 = 0.052870008680555566f64 * p[91];
+    let v244 = 0.045627170138888846f64 * p[91];
+    let v245 = 0.022813585069444423f64 * p[91];
+    let v246 = 0.010470920138888881f64 * p[103];
+    let v247 = 0.005235460069444441f64 * p[103];
+    let v248 = 0.18777126736111113f64 * p[103];
+    let v249 = 0.09388563368055557f64 * p[103];
+    let v251 = 0.14761352539062508f64 * p[19];
+    let v253 = 0.07380676269531254f64 * p[19];
+    let v255 = 0.07075670030381945f64 * p[19];
+    let v257 = 0.035378350151909724f64 * p[19];
+    let v259 = 0.10452948676215276f64 * p[31];
+    let v261 = 0.05226474338107638f64 * p[31];
+    let v263 = 0.08960978190104166f64 * p[31];
+    let v265 = 0.04480489095052083f64 * p[31];
+    let v267 = 0.055158827039930594f64 * p[43];
+    let v269 = 0.027579413519965297f64 * p[43];
+    let v271 = 0.02215237087673614f64 * p[43];
+    let v273 = 0.01107618543836807f64 * p[43];
+    let v275 = 0.056467692057291664f64 * p[55];
+    let v277 = 0.028233846028645832f64 * p[55];
+    let v279 = 0.09363132052951388f64 * p[55];
+    let v281 = 0.04681566026475694f64 * p[55];
+    let v282 = 0.09363132052951388f64 * p[67];
+    let v283 = 0.04681566026475694f64 * p[67];
+    let v284 = 0.056467692057291664f64 * p[67];
+    let v285 = 0.028233846028645832f64 * p[67];
+    let v286 = 0.02215237087673614f64 * p[79];
+    let v287 = 0.01107618543836807f64 * p[79];
+    let v288 = 0.055158827039930594f64 * p[79];
+    let v289 = 0.027579413519965297f64 * p[79];
+    let v290 = 0.08960978190104166f64 * p[91];
+    let v291 = 0.04480489095052083f64 * p[91];
+    let v292 = 0.10452948676215276f64 * p[91];
+    let v293 = 0.05226474338107638f64 * p[91];
+    let v294 = 0.07075670030381945f64 * p[103];
+    let v295 = 0.035378350151909724f64 * p[103];
+    let v296 = 0.14761352539062508f64 * p[103];
+    let v297 = 0.07380676269531254f64 * p[103];
+    let v299 = 0.10032187567816855f64 * p[19];
+    let v301 = 0.05016093783908428f64 * p[19];
+    let v303 = 0.11329947577582465f64 * p[19];
+    let v305 = 0.056649737887912326f64 * p[19];
+    let v307 = 0.09649361504448788f64 * p[31];
+    let v309 = 0.04824680752224394f64 * p[31];
+    let v311 = 0.0024977789984808813f64 * p[31];
+    let v313 = 0.0012488894992404406f64 * p[31];
+    let v315 = 0.04635153876410589f64 * p[43];
+    let v317 = 0.023175769382052944f64 * p[43];
+    let v319 = 0.08907784356011285f64 * p[43];
+    let v321 = 0.044538921780056424f64 * p[43];
+    let v323 = 0.08024893866644967f64 * p[55];
+    let v325 = 0.04012446933322483f64 * p[55];
+    let v327 = 0.020436180962456574f64 * p[55];
+    let v329 = 0.010218090481228287f64 * p[55];
+    let v330 = 0.020436180962456574f64 * p[67];
+    let v331 = 0.010218090481228287f64 * p[67];
+    let v332 = 0.08024893866644967f64 * p[67];
+    let v333 = 0.04012446933322483f64 * p[67];
+    let v334 = 0.08907784356011285f64 * p[79];
+    let v335 = 0.044538921780056424f64 * p[79];
+    let v336 = 0.04635153876410589f64 * p[79];
+    let v337 = 0.023175769382052944f64 * p[79];
+    let v338 = 0.0024977789984808813f64 * p[91];
+    let v339 = 0.0012488894992404406f64 * p[91];
+    let v340 = 0.09649361504448788f64 * p[91];
+    let v341 = 0.04824680752224394f64 * p[91];
+    let v342 = 0.11329947577582465f64 * p[103];
+    let v343 = 0.056649737887912326f64 * p[103];
+    let v344 = 0.10032187567816855f64 * p[103];
+    let v345 = 0.05016093783908428f64 * p[103];
+    let v346 = 0.5f64 * p[19];
+    let v347 = 0.5f64 * p[31];
+    let v348 = 0.5f64 * p[43];
+    let v349 = 0.5f64 * p[55];
+    let v350 = 0.5f64 * p[67];
+    let v351 = 0.5f64 * p[79];
+    let v352 = 0.5f64 * p[91];
+    let v353 = 0.5f64 * p[103];
+    let v355 = (-0.23958333333333334f64) * p[19];
+    let v357 = (-0.4791666666666667f64) * p[19];
+    let v359 = (-0.19791666666666666f64) * p[19];
+    let v361 = (-0.3958333333333333f64) * p[19];
+    let v363 = (-0.17708333333333334f64) * p[31];
+    let v365 = (-0.3541666666666667f64) * p[31];
+    let v367 = (-0.13541666666666666f64) * p[31];
+    let v369 = (-0.2708333333333333f64) * p[31];
+    let v371 = (-0.11458333333333334f64) * p[43];
+    let v373 = (-0.22916666666666669f64) * p[43];
+    let v375 = (-0.07291666666666666f64) * p[43];
+    let v377 = (-0.14583333333333331f64) * p[43];
+    let v379 = (-0.05208333333333334f64) * p[55];
+    let v381 = (-0.10416666666666669f64) * p[55];
+    let v383 = (-0.010416666666666654f64) * p[55];
+    let v385 = (-0.020833333333333308f64) * p[55];
+    let v387 = 0.020833333333333308f64 * p[67];
+    let v389 = 0.10416666666666669f64 * p[67];
+    let v391 = 0.14583333333333331f64 * p[79];
+    let v393 = 0.22916666666666669f64 * p[79];
+    let v395 = 0.2708333333333333f64 * p[91];
+    let v397 = 0.3541666666666667f64 * p[91];
+    let v399 = 0.3958333333333333f64 * p[103];
+    let v401 = 0.43750000000000006f64 * p[19];
+    let v403 = 0.21874999999999994f64 * p[19];
+    let v405 = 0.12500000000000008f64 * p[31];
+    let v407 = (-0.015625000000000028f64) * p[31];
+    let v409 = (-0.031250000000000056f64) * p[31];
+    let v411 = (-0.04687499999999998f64) * p[43];
+    let v413 = (-0.09374999999999996f64) * p[43];
+    let v415 = (-0.09375000000000001f64) * p[43];
+    let v417 = (-0.18750000000000003f64) * p[43];
+    let v419 = (-0.109375f64) * p[55];
+    let v421 = (-0.21875f64) * p[55];
+    let v423 = (-0.125f64) * p[55];
+    let v425 = (-0.25f64) * p[55];
+    let v426 = (-0.125f64) * p[67];
+    let v427 = (-0.25f64) * p[67];
+    let v428 = (-0.109375f64) * p[67];
+    let v429 = (-0.21875f64) * p[67];
+    let v430 = (-0.09375000000000001f64) * p[79];
+    let v431 = (-0.18750000000000003f64) * p[79];
+    let v432 = (-0.04687499999999998f64) * p[79];
+    let v433 = (-0.09374999999999996f64) * p[79];
+    let v434 = (-0.015625000000000028f64) * p[91];
+    let v435 = (-0.031250000000000056f64) * p[91];
+    let v436 = 0.12500000000000008f64 * p[91];
+    let v437 = 0.21874999999999994f64 * p[103];
+    let v439 = (-0.18777126736111113f64) * p[19];
+    let v441 = (-0.37554253472222227f64) * p[19];
+    let v443 = (-0.010470920138888881f64) * p[19];
+    let v445 = (-0.020941840277777762f64) * p[19];
+    let v447 = 0.09125434027777769f64 * p[31];
+    let v449 = 0.21148003472222227f64 * p[31];
+    let v451 = 0.2260199652777778f64 * p[43];
+    let v453 = 0.18999565972222218f64 * p[43];
+    let v455 = 0.14594184027777782f64 * p[55];
+    let v457 = 0.03179253472222218f64 * p[55];
+    let v459 = (-0.01589626736111109f64) * p[67];
+    let v461 = (-0.03179253472222218f64) * p[67];
+    let v463 = (-0.07297092013888891f64) * p[67];
+    let v465 = (-0.14594184027777782f64) * p[67];
+    let v467 = (-0.09499782986111109f64) * p[79];
+    let v469 = (-0.18999565972222218f64) * p[79];
+    let v471 = (-0.1130099826388889f64) * p[79];
+    let v473 = (-0.2260199652777778f64) * p[79];
+    let v475 = (-0.10574001736111113f64) * p[91];
+    let v477 = (-0.21148003472222227f64) * p[91];
+    let v479 = (-0.045627170138888846f64) * p[91];
+    let v481 = (-0.09125434027777769f64) * p[91];
+    let v483 = 0.020941840277777762f64 * p[103];
+    let v485 = 0.29522705078125017f64 * p[19];
+    let v487 = (-0.07075670030381945f64) * p[19];
+    let v489 = (-0.1415134006076389f64) * p[19];
+    let v491 = (-0.10452948676215276f64) * p[31];
+    let v493 = (-0.20905897352430552f64) * p[31];
+    let v495 = (-0.08960978190104166f64) * p[31];
+    let v497 = (-0.17921956380208331f64) * p[31];
+    let v499 = (-0.055158827039930594f64) * p[43];
+    let v501 = (-0.11031765407986119f64) * p[43];
+    let v503 = 0.04430474175347228f64 * p[43];
+    let v505 = 0.11293538411458333f64 * p[55];
+    let v507 = 0.18726264105902776f64 * p[55];
+    let v508 = 0.18726264105902776f64 * p[67];
+    let v509 = 0.11293538411458333f64 * p[67];
+    let v510 = 0.04430474175347228f64 * p[79];
+    let v511 = (-0.055158827039930594f64) * p[79];
+    let v512 = (-0.11031765407986119f64) * p[79];
+    let v513 = (-0.08960978190104166f64) * p[91];
+    let v514 = (-0.17921956380208331f64) * p[91];
+    let v515 = (-0.10452948676215276f64) * p[91];
+    let v516 = (-0.20905897352430552f64) * p[91];
+    let v517 = (-0.07075670030381945f64) * p[103];
+    let v518 = (-0.1415134006076389f64) * p[103];
+    let v520 = (-0.10032187567816855f64) * p[19];
+    let v522 = (-0.2006437513563371f64) * p[19];
+    let v524 = 0.2265989515516493f64 * p[19];
+    let v526 = 0.19298723008897575f64 * p[31];
+    let v528 = 0.004995557996961763f64 * p[31];
+    let v530 = (-0.04635153876410589f64) * p[43];
+    let v532 = (-0.09270307752821177f64) * p[43];
+    let v534 = (-0.08907784356011285f64) * p[43];
+    let v536 = (-0.1781556871202257f64) * p[43];
+    let v538 = (-0.08024893866644967f64) * p[55];
+    let v540 = (-0.16049787733289933f64) * p[55];
+    let v542 = (-0.020436180962456574f64) * p[55];
+    let v544 = (-0.04087236192491315f64) * p[55];
+    let v546 = 0.04087236192491315f64 * p[67];
+    let v548 = 0.16049787733289933f64 * p[67];
+    let v550 = 0.1781556871202257f64 * p[79];
+    let v552 = 0.09270307752821177f64 * p[79];
+    let v554 = (-0.0024977789984808813f64) * p[91];
+    let v556 = (-0.004995557996961763f64) * p[91];
+    let v558 = (-0.09649361504448788f64) * p[91];
+    let v560 = (-0.19298723008897575f64) * p[91];
+    let v562 = (-0.11329947577582465f64) * p[103];
+    let v564 = (-0.2265989515516493f64) * p[103];
+    let v566 = -p[2];
+    let v568 = 8f64 * p[19];
+    let v569 = 8f64 * p[31];
+    let v570 = 8f64 * p[43];
+    let v571 = 8f64 * p[55];
+    let v572 = 8f64 * p[67];
+    let v573 = 8f64 * p[79];
+    let v574 = 8f64 * p[91];
+    let v575 = 8f64 * p[103];
+    let v577 = -p[1];
+    let v579 = -p[0];
+    let v581 = 0.125f64 * p[22];
+    let v583 = 0.125f64 * p[23];
+    let v585 = 0.041666666666666664f64 * p[22];
+    let v586 = 0.041666666666666664f64 * p[23];
+    let v588 = 0.025f64 * p[22];
+    let v589 = 0.025f64 * p[23];
+    let v591 = 0.017857142857142856f64 * p[22];
+    let v592 = 0.017857142857142856f64 * p[23];
+    let v594 = 0.013888888888888888f64 * p[22];
+    let v595 = 0.013888888888888888f64 * p[23];
+    let v597 = 0.011363636363636364f64 * p[22];
+    let v598 = 0.011363636363636364f64 * p[23];
+    let v601 = (-8f64) * p[24];
+    let v603 = 0.125f64 * p[26];
+    let v605 = 0.125f64 * p[27];
+    let v606 = 0.041666666666666664f64 * p[26];
+    let v607 = 0.041666666666666664f64 * p[27];
+    let v608 = 0.025f64 * p[26];
+    let v609 = 0.025f64 * p[27];
+    let v610 = 0.017857142857142856f64 * p[26];
+    let v611 = 0.017857142857142856f64 * p[27];
+    let v612 = 0.013888888888888888f64 * p[26];
+    let v613 = 0.013888888888888888f64 * p[27];
+    let v614 = 0.011363636363636364f64 * p[26];
+    let v615 = 0.011363636363636364f64 * p[27];
+    let v616 = p[19] * p[19];
+    let v618 = 8f64 * p[28];
+    let v620 = 8f64 * p[29];
+    let v622 = 2.6666666666666665f64 * p[28];
+    let v623 = 2.6666666666666665f64 * p[29];
+    let v625 = 1.6f64 * p[28];
+    let v626 = 1.6f64 * p[29];
+    let v628 = 1.1428571428571428f64 * p[28];
+    let v629 = 1.1428571428571428f64 * p[29];
+    let v631 = 0.8888888888888888f64 * p[28];
+    let v632 = 0.8888888888888888f64 * p[29];
+    let v634 = 0.7272727272727273f64 * p[28];
+    let v635 = 0.7272727272727273f64 * p[29];
+    let v637 = 8f64 * p[30];
+    let v638 = 2.6666666666666665f64 * p[30];
+    let v639 = 1.6f64 * p[30];
+    let v640 = 1.1428571428571428f64 * p[30];
+    let v641 = 0.8888888888888888f64 * p[30];
+    let v642 = 0.7272727272727273f64 * p[30];
+    let v644 = 0.25f64 * p[16];
+    let v646 = 0.25f64 * p[17];
+    let v648 = 0.25f64 * p[18];
+    let v650 = 0.25f64 * p[15];
+    let v651 = v622 * v616;
+    let v652 = v623 * v616;
+    let v653 = v628 * v616;
+    let v654 = v629 * v616;
+    let v655 = v634 * v616;
+    let v656 = v635 * v616;
+    let v657 = v638 * v616;
+    let v658 = v640 * v616;
+    let v659 = v642 * v616;
+    out[0] = v6;
+    out[1] = v8;
+    out[2] = v13;
+    out[3] = v14;
+    out[4] = v19;
+    out[5] = v20;
+    out[6] = v25;
+    out[7] = v26;
+    out[8] = v31;
+    out[9] = v32;
+    out[10] = v37;
+    out[11] = v38;
+    out[12] = v43;
+    out[13] = v44;
+    out[14] = v49;
+    out[15] = v50;
+    out[16] = v52;
+    out[17] = v54;
+    out[18] = v55;
+    out[19] = v57;
+    out[20] = v59;
+    out[21] = v61;
+    out[22] = v63;
+    out[23] = v64;
+    out[24] = v65;
+    out[25] = v66;
+    out[26] = v68;
+    out[27] = v70;
+    out[28] = v71;
+    out[29] = v72;
+    out[30] = v73;
+    out[31] = v75;
+    out[32] = v77;
+    out[33] = v78;
+    out[34] = v79;
+    out[35] = v80;
+    out[36] = v82;
+    out[37] = v84;
+    out[38] = v85;
+    out[39] = v86;
+    out[40] = v87;
+    out[41] = v89;
+    out[42] = v91;
+    out[43] = v92;
+    out[44] = v93;
+    out[45] = v94;
+    out[46] = v96;
+    out[47] = v98;
+    out[48] = v99;
+    out[49] = v100;
+    out[50] = v101;
+    out[51] = v103;
+    out[52] = v105;
+    out[53] = v106;
+    out[54] = v107;
+    out[55] = v108;
+    out[56] = v110;
+    out[57] = v112;
+    out[58] = v114;
+    out[59] = v116;
+    out[60] = v118;
+    out[61] = v120;
+    out[62] = v122;
+    out[63] = v124;
+    out[64] = v126;
+    out[65] = v128;
+    out[66] = v130;
+    out[67] = v132;
+    out[68] = v134;
+    out[69] = v136;
+    out[70] = v138;
+    out[71] = v140;
+    out[72] = v141;
+    out[73] = v142;
+    out[74] = v143;
+    out[75] = v144;
+    out[76] = v145;
+    out[77] = v146;
+    out[78] = v147;
+    out[79] = v148;
+    out[80] = v149;
+    out[81] = v150;
+    out[82] = v151;
+    out[83] = v152;
+    out[84] = v153;
+    out[85] = v154;
+    out[86] = v155;
+    out[87] = v156;
+    out[88] = v158;
+    out[89] = v160;
+    out[90] = v162;
+    out[91] = v164;
+    out[92] = v166;
+    out[93] = v168;
+    out[94] = v170;
+    out[95] = v172;
+    out[96] = v174;
+    out[97] = v176;
+    out[98] = v178;
+    out[99] = v180;
+    out[100] = v182;
+    out[101] = v184;
+    out[102] = v186;
+    out[103] = v187;
+    out[104] = v188;
+    out[105] = v189;
+    out[106] = v190;
+    out[107] = v191;
+    out[108] = v192;
+    out[109] = v193;
+    out[110] = v194;
+    out[111] = v195;
+    out[112] = v196;
+    out[113] = v197;
+    out[114] = v198;
+    out[115] = v199;
+    out[116] = v200;
+    out[117] = v201;
+    out[118] = v203;
+    out[119] = v205;
+    out[120] = v207;
+    out[121] = v209;
+    out[122] = v211;
+    out[123] = v213;
+    out[124] = v215;
+    out[125] = v217;
+    out[126] = v219;
+    out[127] = v221;
+    out[128] = v223;
+    out[129] = v225;
+    out[130] = v227;
+    out[131] = v229;
+    out[132] = v231;
+    out[133] = v233;
+    out[134] = v234;
+    out[135] = v235;
+    out[136] = v236;
+    out[137] = v237;
+    out[138] = v238;
+    out[139] = v239;
+    out[140] = v240;
+    out[141] = v241;
+    out[142] = v242;
+    out[143] = v243;
+    out[144] = v244;
+    out[145] = v245;
+    out[146] = v246;
+    out[147] = v247;
+    out[148] = v248;
+    out[149] = v249;
+    out[150] = v251;
+    out[151] = v253;
+    out[152] = v255;
+    out[153] = v257;
+    out[154] = v259;
+    out[155] = v261;
+    out[156] = v263;
+    out[157] = v265;
+    out[158] = v267;
+    out[159] = v269;
+    out[160] = v271;
+    out[161] = v273;
+    out[162] = v275;
+    out[163] = v277;
+    out[164] = v279;
+    out[165] = v281;
+    out[166] = v282;
+    out[167] = v283;
+    out[168] = v284;
+    out[169] = v285;
+    out[170] = v286;
+    out[171] = v287;
+    out[172] = v288;
+    out[173] = v289;
+    out[174] = v290;
+    out[175] = v291;
+    out[176] = v292;
+    out[177] = v293;
+    out[178] = v294;
+    out[179] = v295;
+    out[180] = v296;
+    out[181] = v297;
+    out[182] = v299;
+    out[183] = v301;
+    out[184] = v303;
+    out[185] = v305;
+    out[186] = v307;
+    out[187] = v309;
+    out[188] = v311;
+    out[189] = v313;
+    out[190] = v315;
+    out[191] = v317;
+    out[192] = v319;
+    out[193] = v321;
+    out[194] = v323;
+    out[195] = v325;
+    out[196] = v327;
+    out[197] = v329;
+    out[198] = v330;
+    out[199] = v331;
+    out[200] = v332;
+    out[201] = v333;
+    out[202] = v334;
+    out[203] = v335;
+    out[204] = v336;
+    out[205] = v337;
+    out[206] = v338;
+    out[207] = v339;
+    out[208] = v340;
+    out[209] = v341;
+    out[210] = v342;
+    out[211] = v343;
+    out[212] = v344;
+    out[213] = v345;
+    out[214] = v346;
+    out[215] = v347;
+    out[216] = v348;
+    out[217] = v349;
+    out[218] = v350;
+    out[219] = v351;
+    out[220] = v352;
+    out[221] = v353;
+    out[222] = v355;
+    out[223] = v357;
+    out[224] = v359;
+    out[225] = v361;
+    out[226] = v363;
+    out[227] = v365;
+    out[228] = v367;
+    out[229] = v369;
+    out[230] = v371;
+    out[231] = v373;
+    out[232] = v375;
+    out[233] = v377;
+    out[234] = v379;
+    out[235] = v381;
+    out[236] = v383;
+    out[237] = v385;
+    out[238] = v387;
+    out[239] = v389;
+    out[240] = v391;
+    out[241] = v393;
+    out[242] = v395;
+    out[243] = v397;
+    out[244] = v399;
+    out[245] = v401;
+    out[246] = v403;
+    out[247] = v405;
+    out[248] = v407;
+    out[249] = v409;
+    out[250] = v411;
+    out[251] = v413;
+    out[252] = v415;
+    out[253] = v417;
+    out[254] = v419;
+    out[255] = v421;
+    out[256] = v423;
+    out[257] = v425;
+    out[258] = v426;
+    out[259] = v427;
+    out[260] = v428;
+    out[261] = v429;
+    out[262] = v430;
+    out[263] = v431;
+    out[264] = v432;
+    out[265] = v433;
+    out[266] = v434;
+    out[267] = v435;
+    out[268] = v436;
+    out[269] = v437;
+    out[270] = v439;
+    out[271] = v441;
+    out[272] = v443;
+    out[273] = v445;
+    out[274] = v447;
+    out[275] = v449;
+    out[276] = v451;
+    out[277] = v453;
+    out[278] = v455;
+    out[279] = v457;
+    out[280] = v459;
+    out[281] = v461;
+    out[282] = v463;
+    out[283] = v465;
+    out[284] = v467;
+    out[285] = v469;
+    out[286] = v471;
+    out[287] = v473;
+    out[288] = v475;
+    out[289] = v477;
+    out[290] = v479;
+    out[291] = v481;
+    out[292] = v483;
+    out[293] = v485;
+    out[294] = v487;
+    out[295] = v489;
+    out[296] = v491;
+    out[297] = v493;
+    out[298] = v495;
+    out[299] = v497;
+    out[300] = v499;
+    out[301] = v501;
+    out[302] = v503;
+    out[303] = v505;
+    out[304] = v507;
+    out[305] = v508;
+    out[306] = v509;
+    out[307] = v510;
+    out[308] = v511;
+    out[309] = v512;
+    out[310] = v513;
+    out[311] = v514;
+    out[312] = v515;
+    out[313] = v516;
+    out[314] = v517;
+    out[315] = v518;
+    out[316] = v520;
+    out[317] = v522;
+    out[318] = v524;
+    out[319] = v526;
+    out[320] = v528;
+    out[321] = v530;
+    out[322] = v532;
+    out[323] = v534;
+    out[324] = v536;
+    out[325] = v538;
+    out[326] = v540;
+    out[327] = v542;
+    out[328] = v544;
+    out[329] = v546;
+    out[330] = v548;
+    out[331] = v550;
+    out[332] = v552;
+    out[333] = v554;
+    out[334] = v556;
+    out[335] = v558;
+    out[336] = v560;
+    out[337] = v562;
+    out[338] = v564;
+    out[339] = v566;
+    out[340] = v568;
+    out[341] = v569;
+    out[342] = v570;
+    out[343] = v571;
+    out[344] = v572;
+    out[345] = v573;
+    out[346] = v574;
+    out[347] = v575;
+    out[348] = v577;
+    out[349] = v579;
+    out[350] = v581;
+    out[351] = v583;
+    out[352] = v585;
+    out[353] = v586;
+    out[354] = v588;
+    out[355] = v589;
+    out[356] = v591;
+    out[357] = v592;
+    out[358] = v594;
+    out[359] = v595;
+    out[360] = v597;
+    out[361] = v598;
+    out[362] = v601;
+    out[363] = v603;
+    out[364] = v605;
+    out[365] = v606;
+    out[366] = v607;
+    out[367] = v608;
+    out[368] = v609;
+    out[369] = v610;
+    out[370] = v611;
+    out[371] = v612;
+    out[372] = v613;
+    out[373] = v614;
+    out[374] = v615;
+    out[375] = v616;
+    out[376] = v618;
+    out[377] = v620;
+    out[378] = v622;
+    out[379] = v623;
+    out[380] = v625;
+    out[381] = v626;
+    out[382] = v628;
+    out[383] = v629;
+    out[384] = v631;
+    out[385] = v632;
+    out[386] = v634;
+    out[387] = v635;
+    out[388] = v637;
+    out[389] = v638;
+    out[390] = v639;
+    out[391] = v640;
+    out[392] = v641;
+    out[393] = v642;
+    out[394] = v644;
+    out[395] = v646;
+    out[396] = v648;
+    out[397] = v650;
+    out[398] = v651;
+    out[399] = v652;
+    out[400] = v653;
+    out[401] = v654;
+    out[402] = v655;
+    out[403] = v656;
+    out[404] = v657;
+    out[405] = v658;
+    out[406] = v659;
 }
 /// Kernel `constraints`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn constraints(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1217,24 +1217,24 @@ pub fn constraints(
 #[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1245,36 +1245,36 @@ pub fn contact(
 #[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jacobian`: the points' positions, velocities and Jacobians in 0 groups; group g runs when `all` or `dir[g] != 0`.
 #[allow(unused_variables)]
 pub fn contact_jacobian(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
     all: bool,
-    p: &[f64; 522usize],
-    out: &mut [f64; 0usize],
+    p: &[f64; 522],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jvp`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact_jvp(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1285,13 +1285,13 @@ pub fn contact_jvp(
 #[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
@@ -1304,40 +1304,40 @@ static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyL
 #[allow(unused_variables)]
 pub fn mass_bias(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    out: &mut [f64; 702usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    out: &mut [f64; 702],
 ) {
     runtime::cpu::require_fma();
     unsafe { mass_bias_links(q, qd, p, out) }
 }
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
 unsafe fn mass_bias_links(
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    p: &[f64; 522usize],
-    out: &mut [f64; 702usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    p: &[f64; 522],
+    out: &mut [f64; 702],
 ) {
     let mut cells = LinkCells { q, qd, p };
-    runtime::links::mass_bias_shared::<36usize, _>(&LINKS, &mut cells, q, qd, p, out)
+    runtime::links::mass_bias_shared::<36, _>(&LINKS, &mut cells, q, qd, p, out)
 }
 /// Kernel `jvp`: the inverse dynamics' tangent by the link recursion (`runtime::links::inverse_dynamics_tangent`) over 16 links.
 #[allow(unused_variables)]
 pub fn jvp(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    out: &mut [f64; 36usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    out: &mut [f64; 36],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
-    let mut tau = [0.0; 36usize];
+    let mut tau = [0.0; 36];
     runtime::links::inverse_dynamics_tangent(
         &LINKS,
         &mut cells,
@@ -1354,12 +1354,12 @@ pub fn jvp(
 #[allow(unused_variables)]
 pub fn outputs(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    out: &mut [f64; 9usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    out: &mut [f64; 9],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
@@ -1368,21 +1368,21 @@ pub fn outputs(
 /// The compiled cells and forces the link recursion evaluates.
 #[allow(dead_code)]
 struct LinkCells<'a> {
-    q: &'a [f64; 36usize],
-    qd: &'a [f64; 36usize],
-    p: &'a [f64; 522usize],
+    q: &'a [f64; 36],
+    qd: &'a [f64; 36],
+    p: &'a [f64; 522],
 }
 impl runtime::links::Cells for LinkCells<'_> {
     #[inline(always)]
     fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 6usize],
-                    &[0.0; 12usize],
+                    &[0.0; 6],
+                    &[0.0; 12],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs"),
                 )
@@ -1401,7 +1401,7 @@ impl runtime::links::Cells for LinkCells<'_> {
         out: &mut [[f64; 4]],
     ) {
         match c {
-            0usize => {
+            0 => {
                 unsafe {
                     cell_0_x4(
                         x.try_into().expect("link coordinates"),
@@ -1421,8 +1421,8 @@ impl runtime::links::Cells for LinkCells<'_> {
             0.0,
             self.q,
             self.qd,
-            &[0.0; 36usize],
-            &[0.0; 72usize],
+            &[0.0; 36],
+            &[0.0; 72],
             self.p,
             out.try_into().expect("force outputs"),
         )
@@ -1438,15 +1438,15 @@ impl runtime::links::Cells for LinkCells<'_> {
         out: &mut [f64],
     ) {
         match c {
-            0usize => {
-                let mut dir = [0.0; 12usize];
-                dir[..6usize].copy_from_slice(dx);
-                dir[6usize..].copy_from_slice(dxd);
+            0 => {
+                let mut dir = [0.0; 12];
+                dir[..6].copy_from_slice(dx);
+                dir[6..].copy_from_slice(dxd);
                 cell_0_tangent(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 6usize],
+                    &[0.0; 6],
                     &dir,
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs and derivatives"),
@@ -1461,7 +1461,7 @@ impl runtime::links::Cells for LinkCells<'_> {
             0.0,
             self.q,
             self.qd,
-            &[0.0; 36usize],
+            &[0.0; 36],
             dir.try_into().expect("a direction of 2 DOF entries"),
             self.p,
             out.try_into().expect("force outputs and derivatives"),
@@ -1474,13 +1474,13 @@ impl runtime::links::Cells for LinkCells<'_> {
     }
     fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0_pose(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 6usize],
-                    &[0.0; 12usize],
+                    &[0.0; 6],
+                    &[0.0; 12],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("pose outputs"),
                 )
@@ -1490,15 +1490,7 @@ impl runtime::links::Cells for LinkCells<'_> {
     }
     fn energy(&mut self) -> f64 {
         let mut out = [0.0];
-        link_energy(
-            0.0,
-            self.q,
-            self.qd,
-            &[0.0; 36usize],
-            &[0.0; 72usize],
-            self.p,
-            &mut out,
-        );
+        link_energy(0.0, self.q, self.qd, &[0.0; 36], &[0.0; 72], self.p, &mut out);
         out[0]
     }
 }
@@ -1506,12 +1498,12 @@ impl runtime::links::Cells for LinkCells<'_> {
 #[allow(unused_unsafe)]
 pub fn cell_0_pose(
     t: f64,
-    q: &[f64; 6usize],
-    qd: &[f64; 6usize],
-    qdd: &[f64; 6usize],
-    dir: &[f64; 12usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 6],
+    qd: &[f64; 6],
+    qdd: &[f64; 6],
+    dir: &[f64; 12],
+    p: &[f64; 15],
+    out: &mut [f64; 38],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1522,279 +1514,279 @@ pub fn cell_0_pose(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
-    q: &[f64; 6usize],
-    qd: &[f64; 6usize],
-    qdd: &[f64; 6usize],
-    dir: &[f64; 12usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 6],
+    qd: &[f64; 6],
+    qdd: &[f64; 6],
+    dir: &[f64; 12],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 38],
 ) {
-    let v1: f64 = q[0usize] * q[0usize];
-    let v3: f64 = 0.25f64 * v1;
-    let v5: f64 = q[1usize] * q[1usize];
-    let v6: f64 = 0.25f64 * v5;
-    let v8: f64 = q[2usize] * q[2usize];
-    let v9: f64 = 0.25f64 * v8;
-    let v10: f64 = v3 + v6;
-    let v11: f64 = v10 + v9;
-    let c: [[f64; 2usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        2usize,
+    let v1 = q[0] * q[0];
+    let v3 = 0.25f64 * v1;
+    let v5 = q[1] * q[1];
+    let v6 = 0.25f64 * v5;
+    let v8 = q[2] * q[2];
+    let v9 = 0.25f64 * v8;
+    let v10 = v3 + v6;
+    let v11 = v10 + v9;
+    let c: [[f64; 2]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        2,
     >(v11);
-    let v12: f64 = c[0usize][0usize];
-    let v13: f64 = c[2usize][0usize];
-    let v18: f64 = c[1usize][0usize];
-    let v47: f64 = c[3usize][0usize];
-    let v78: f64 = c[2usize][1usize];
-    let v88: f64 = c[3usize][1usize];
-    let v158: f64 = c[4usize][0usize];
-    let v166: f64 = c[4usize][1usize];
-    let v14: f64 = v9.mul_add(v13, v12);
-    let v15: f64 = 0.25f64 * q[0usize];
-    let v16: f64 = v15 * q[2usize];
-    let v17: f64 = v16 * v13;
-    let v20: f64 = 0.5f64 * q[1usize];
-    let v21: f64 = v20 * v18;
-    let v22: f64 = v17 - v21;
-    let v23: f64 = 0.25f64 * q[1usize];
-    let v24: f64 = v23 * q[2usize];
-    let v25: f64 = v24 * v13;
-    let v26: f64 = 0.5f64 * q[0usize];
-    let v27: f64 = v26 * v18;
-    let v28: f64 = v25 + v27;
-    let v29: f64 = v17 + v21;
-    let v30: f64 = v3.mul_add(v13, v12);
-    let v31: f64 = v15 * q[1usize];
-    let v32: f64 = v31 * v13;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let v34: f64 = v33 * v18;
-    let v35: f64 = v32 - v34;
-    let v36: f64 = v25 - v27;
-    let v37: f64 = v32 + v34;
-    let v38: f64 = v6.mul_add(v13, v12);
-    let v41: f64 = q[3usize] + p[0usize];
-    let v42: f64 = 0.5f64 * v41;
-    let v45: f64 = v23 * q[4usize];
-    let v46: f64 = v15.mul_add(q[5usize], -v45);
-    let v48: f64 = 0.25f64 * q[2usize];
-    let v49: f64 = v15 * q[4usize];
-    let v50: f64 = v48.mul_add(v41, v49);
-    let v51: f64 = v23.mul_add(q[5usize], v50);
-    let v52: f64 = v42 * v11;
-    let v53: f64 = v33.mul_add(v51, -v52);
-    let v54: f64 = v13.mul_add(v46, v42);
-    let v55: f64 = v47.mul_add(v53, v54);
-    let v56: f64 = 0.5f64 * q[4usize];
-    let v57: f64 = v48 * q[5usize];
-    let v58: f64 = v23.mul_add(v41, -v57);
-    let v59: f64 = v56 * v11;
-    let v60: f64 = v26.mul_add(v51, -v59);
-    let v61: f64 = v13.mul_add(v58, v56);
-    let v62: f64 = v47.mul_add(v60, v61);
-    let v63: f64 = 0.5f64 * q[5usize];
-    let v64: f64 = v15 * v41;
-    let v65: f64 = v48.mul_add(q[4usize], -v64);
-    let v66: f64 = v63 * v11;
-    let v67: f64 = v20.mul_add(v51, -v66);
-    let v68: f64 = v13.mul_add(v65, v63);
-    let v69: f64 = v47.mul_add(v67, v68);
-    let v71: f64 = 0.5f64 * qd[3usize];
-    let v74: f64 = v26 * qd[0usize];
-    let v76: f64 = v33.mul_add(qd[2usize], v74);
-    let v77: f64 = v20.mul_add(qd[1usize], v76);
-    let v79: f64 = v77 * v78;
-    let v80: f64 = 0.25f64 * q[5usize];
-    let v82: f64 = v15 * qd[5usize];
-    let v83: f64 = 0.25f64 * q[4usize];
-    let v85: f64 = v80.mul_add(qd[0usize], v82);
-    let v86: f64 = (-v83).mul_add(qd[1usize], v85);
-    let v87: f64 = (-v23).mul_add(qd[4usize], v86);
-    let v89: f64 = v77 * v88;
-    let v90: f64 = 0.5f64 * qd[2usize];
-    let v91: f64 = 0.25f64 * qd[2usize];
-    let v92: f64 = v48 * qd[3usize];
-    let v93: f64 = v91.mul_add(v41, v92);
-    let v94: f64 = v83.mul_add(qd[0usize], v93);
-    let v95: f64 = v15.mul_add(qd[4usize], v94);
-    let v96: f64 = v80.mul_add(qd[1usize], v95);
-    let v97: f64 = v23.mul_add(qd[5usize], v96);
-    let v98: f64 = v33 * v97;
-    let v99: f64 = v90.mul_add(v51, v98);
-    let v100: f64 = (-v71).mul_add(v11, v99);
-    let v101: f64 = (-v42).mul_add(v77, v100);
-    let v102: f64 = v46.mul_add(v79, v71);
-    let v103: f64 = v13.mul_add(v87, v102);
-    let v104: f64 = v53.mul_add(v89, v103);
-    let v105: f64 = v47.mul_add(v101, v104);
-    let v106: f64 = 0.5f64 * qd[4usize];
-    let v107: f64 = 0.25f64 * qd[1usize];
-    let v108: f64 = v23 * qd[3usize];
-    let v109: f64 = v107.mul_add(v41, v108);
-    let v110: f64 = (-v80).mul_add(qd[2usize], v109);
-    let v111: f64 = (-v48).mul_add(qd[5usize], v110);
-    let v112: f64 = 0.5f64 * qd[0usize];
-    let v113: f64 = v26 * v97;
-    let v114: f64 = v112.mul_add(v51, v113);
-    let v115: f64 = (-v106).mul_add(v11, v114);
-    let v116: f64 = (-v56).mul_add(v77, v115);
-    let v117: f64 = v58.mul_add(v79, v106);
-    let v118: f64 = v13.mul_add(v111, v117);
-    let v119: f64 = v60.mul_add(v89, v118);
-    let v120: f64 = v47.mul_add(v116, v119);
-    let v121: f64 = 0.5f64 * qd[5usize];
-    let v122: f64 = v48 * qd[4usize];
-    let v123: f64 = 0.25f64 * qd[0usize];
-    let v124: f64 = v83.mul_add(qd[2usize], v122);
-    let v125: f64 = (-v123).mul_add(v41, v124);
-    let v126: f64 = (-v15).mul_add(qd[3usize], v125);
-    let v127: f64 = 0.5f64 * qd[1usize];
-    let v128: f64 = v20 * v97;
-    let v129: f64 = v127.mul_add(v51, v128);
-    let v130: f64 = (-v121).mul_add(v11, v129);
-    let v131: f64 = (-v63).mul_add(v77, v130);
-    let v132: f64 = v65.mul_add(v79, v121);
-    let v133: f64 = v13.mul_add(v126, v132);
-    let v134: f64 = v67.mul_add(v89, v133);
-    let v135: f64 = v47.mul_add(v131, v134);
-    let v136: f64 = v23 * qd[0usize];
-    let v137: f64 = v15.mul_add(qd[1usize], -v136);
-    let v138: f64 = v90 * v18;
-    let v139: f64 = v15 * qd[0usize];
-    let v140: f64 = v48.mul_add(qd[2usize], v139);
-    let v141: f64 = v23.mul_add(qd[1usize], v140);
-    let v142: f64 = v33 * v47;
-    let v143: f64 = v13.mul_add(v137, v138);
-    let v144: f64 = v142.mul_add(v141, v143);
-    let v145: f64 = v48 * qd[1usize];
-    let v146: f64 = v23.mul_add(qd[2usize], -v145);
-    let v147: f64 = v112 * v18;
-    let v148: f64 = v26 * v47;
-    let v149: f64 = v13.mul_add(v146, v147);
-    let v150: f64 = v148.mul_add(v141, v149);
-    let v151: f64 = v15 * qd[2usize];
-    let v152: f64 = v48.mul_add(qd[0usize], -v151);
-    let v153: f64 = v127 * v18;
-    let v154: f64 = v20 * v47;
-    let v155: f64 = v13.mul_add(v152, v153);
-    let v156: f64 = v154.mul_add(v141, v155);
-    let v157: f64 = v47 * v46;
-    let v159: f64 = 0.25f64.mul_add(v41, v157);
-    let v160: f64 = v158.mul_add(v53, v159);
-    let v161: f64 = v47.mul_add(v58, v83);
-    let v162: f64 = v158.mul_add(v60, v161);
-    let v163: f64 = v47.mul_add(v65, v80);
-    let v164: f64 = v158.mul_add(v67, v163);
-    let v165: f64 = v46 * v89;
-    let v167: f64 = v77 * v166;
-    let v168: f64 = 0.25f64.mul_add(qd[3usize], v165);
-    let v169: f64 = v47.mul_add(v87, v168);
-    let v170: f64 = v53.mul_add(v167, v169);
-    let v171: f64 = v158.mul_add(v101, v170);
-    let v172: f64 = v58 * v89;
-    let v173: f64 = 0.25f64.mul_add(qd[4usize], v172);
-    let v174: f64 = v47.mul_add(v111, v173);
-    let v175: f64 = v60.mul_add(v167, v174);
-    let v176: f64 = v158.mul_add(v116, v175);
-    let v177: f64 = v65 * v89;
-    let v178: f64 = 0.25f64.mul_add(qd[5usize], v177);
-    let v179: f64 = v47.mul_add(v126, v178);
-    let v180: f64 = v67.mul_add(v167, v179);
-    let v181: f64 = v158.mul_add(v131, v180);
-    let v182: f64 = 0.25f64 * v11;
-    let c: [[f64; 1usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        1usize,
+    let v12: f64 = c[0][0];
+    let v13: f64 = c[2][0];
+    let v18: f64 = c[1][0];
+    let v47: f64 = c[3][0];
+    let v78: f64 = c[2][1];
+    let v88: f64 = c[3][1];
+    let v158: f64 = c[4][0];
+    let v166: f64 = c[4][1];
+    let v14 = v9.mul_add(v13, v12);
+    let v15 = 0.25f64 * q[0];
+    let v16 = v15 * q[2];
+    let v17 = v16 * v13;
+    let v20 = 0.5f64 * q[1];
+    let v21 = v20 * v18;
+    let v22 = v17 - v21;
+    let v23 = 0.25f64 * q[1];
+    let v24 = v23 * q[2];
+    let v25 = v24 * v13;
+    let v26 = 0.5f64 * q[0];
+    let v27 = v26 * v18;
+    let v28 = v25 + v27;
+    let v29 = v17 + v21;
+    let v30 = v3.mul_add(v13, v12);
+    let v31 = v15 * q[1];
+    let v32 = v31 * v13;
+    let v33 = 0.5f64 * q[2];
+    let v34 = v33 * v18;
+    let v35 = v32 - v34;
+    let v36 = v25 - v27;
+    let v37 = v32 + v34;
+    let v38 = v6.mul_add(v13, v12);
+    let v41 = q[3] + p[0];
+    let v42 = 0.5f64 * v41;
+    let v45 = v23 * q[4];
+    let v46 = v15.mul_add(q[5], -v45);
+    let v48 = 0.25f64 * q[2];
+    let v49 = v15 * q[4];
+    let v50 = v48.mul_add(v41, v49);
+    let v51 = v23.mul_add(q[5], v50);
+    let v52 = v42 * v11;
+    let v53 = v33.mul_add(v51, -v52);
+    let v54 = v13.mul_add(v46, v42);
+    let v55 = v47.mul_add(v53, v54);
+    let v56 = 0.5f64 * q[4];
+    let v57 = v48 * q[5];
+    let v58 = v23.mul_add(v41, -v57);
+    let v59 = v56 * v11;
+    let v60 = v26.mul_add(v51, -v59);
+    let v61 = v13.mul_add(v58, v56);
+    let v62 = v47.mul_add(v60, v61);
+    let v63 = 0.5f64 * q[5];
+    let v64 = v15 * v41;
+    let v65 = v48.mul_add(q[4], -v64);
+    let v66 = v63 * v11;
+    let v67 = v20.mul_add(v51, -v66);
+    let v68 = v13.mul_add(v65, v63);
+    let v69 = v47.mul_add(v67, v68);
+    let v71 = 0.5f64 * qd[3];
+    let v74 = v26 * qd[0];
+    let v76 = v33.mul_add(qd[2], v74);
+    let v77 = v20.mul_add(qd[1], v76);
+    let v79 = v77 * v78;
+    let v80 = 0.25f64 * q[5];
+    let v82 = v15 * qd[5];
+    let v83 = 0.25f64 * q[4];
+    let v85 = v80.mul_add(qd[0], v82);
+    let v86 = (-v83).mul_add(qd[1], v85);
+    let v87 = (-v23).mul_add(qd[4], v86);
+    let v89 = v77 * v88;
+    let v90 = 0.5f64 * qd[2];
+    let v91 = 0.25f64 * qd[2];
+    let v92 = v48 * qd[3];
+    let v93 = v91.mul_add(v41, v92);
+    let v94 = v83.mul_add(qd[0], v93);
+    let v95 = v15.mul_add(qd[4], v94);
+    let v96 = v80.mul_add(qd[1], v95);
+    let v97 = v23.mul_add(qd[5], v96);
+    let v98 = v33 * v97;
+    let v99 = v90.mul_add(v51, v98);
+    let v100 = (-v71).mul_add(v11, v99);
+    let v101 = (-v42).mul_add(v77, v100);
+    let v102 = v46.mul_add(v79, v71);
+    let v103 = v13.mul_add(v87, v102);
+    let v104 = v53.mul_add(v89, v103);
+    let v105 = v47.mul_add(v101, v104);
+    let v106 = 0.5f64 * qd[4];
+    let v107 = 0.25f64 * qd[1];
+    let v108 = v23 * qd[3];
+    let v109 = v107.mul_add(v41, v108);
+    let v110 = (-v80).mul_add(qd[2], v109);
+    let v111 = (-v48).mul_add(qd[5], v110);
+    let v112 = 0.5f64 * qd[0];
+    let v113 = v26 * v97;
+    let v114 = v112.mul_add(v51, v113);
+    let v115 = (-v106).mul_add(v11, v114);
+    let v116 = (-v56).mul_add(v77, v115);
+    let v117 = v58.mul_add(v79, v106);
+    let v118 = v13.mul_add(v111, v117);
+    let v119 = v60.mul_add(v89, v118);
+    let v120 = v47.mul_add(v116, v119);
+    let v121 = 0.5f64 * qd[5];
+    let v122 = v48 * qd[4];
+    let v123 = 0.25f64 * qd[0];
+    let v124 = v83.mul_add(qd[2], v122);
+    let v125 = (-v123).mul_add(v41, v124);
+    let v126 = (-v15).mul_add(qd[3], v125);
+    let v127 = 0.5f64 * qd[1];
+    let v128 = v20 * v97;
+    let v129 = v127.mul_add(v51, v128);
+    let v130 = (-v121).mul_add(v11, v129);
+    let v131 = (-v63).mul_add(v77, v130);
+    let v132 = v65.mul_add(v79, v121);
+    let v133 = v13.mul_add(v126, v132);
+    let v134 = v67.mul_add(v89, v133);
+    let v135 = v47.mul_add(v131, v134);
+    let v136 = v23 * qd[0];
+    let v137 = v15.mul_add(qd[1], -v136);
+    let v138 = v90 * v18;
+    let v139 = v15 * qd[0];
+    let v140 = v48.mul_add(qd[2], v139);
+    let v141 = v23.mul_add(qd[1], v140);
+    let v142 = v33 * v47;
+    let v143 = v13.mul_add(v137, v138);
+    let v144 = v142.mul_add(v141, v143);
+    let v145 = v48 * qd[1];
+    let v146 = v23.mul_add(qd[2], -v145);
+    let v147 = v112 * v18;
+    let v148 = v26 * v47;
+    let v149 = v13.mul_add(v146, v147);
+    let v150 = v148.mul_add(v141, v149);
+    let v151 = v15 * qd[2];
+    let v152 = v48.mul_add(qd[0], -v151);
+    let v153 = v127 * v18;
+    let v154 = v20 * v47;
+    let v155 = v13.mul_add(v152, v153);
+    let v156 = v154.mul_add(v141, v155);
+    let v157 = v47 * v46;
+    let v159 = 0.25f64.mul_add(v41, v157);
+    let v160 = v158.mul_add(v53, v159);
+    let v161 = v47.mul_add(v58, v83);
+    let v162 = v158.mul_add(v60, v161);
+    let v163 = v47.mul_add(v65, v80);
+    let v164 = v158.mul_add(v67, v163);
+    let v165 = v46 * v89;
+    let v167 = v77 * v166;
+    let v168 = 0.25f64.mul_add(qd[3], v165);
+    let v169 = v47.mul_add(v87, v168);
+    let v170 = v53.mul_add(v167, v169);
+    let v171 = v158.mul_add(v101, v170);
+    let v172 = v58 * v89;
+    let v173 = 0.25f64.mul_add(qd[4], v172);
+    let v174 = v47.mul_add(v111, v173);
+    let v175 = v60.mul_add(v167, v174);
+    let v176 = v158.mul_add(v116, v175);
+    let v177 = v65 * v89;
+    let v178 = 0.25f64.mul_add(qd[5], v177);
+    let v179 = v47.mul_add(v126, v178);
+    let v180 = v67.mul_add(v167, v179);
+    let v181 = v158.mul_add(v131, v180);
+    let v182 = 0.25f64 * v11;
+    let c: [[f64; 1]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        1,
     >(v182);
-    let v183: f64 = c[2usize][0usize];
-    let v189: f64 = c[1usize][0usize];
-    let v191: f64 = c[3usize][0usize];
-    let v229: f64 = c[0usize][0usize];
-    let v185: f64 = 0.0625f64 * q[0usize];
-    let v186: f64 = 0.0625f64 * q[1usize];
-    let v187: f64 = v186 * qd[0usize];
-    let v188: f64 = v185.mul_add(qd[1usize], -v187);
-    let v190: f64 = v91 * v189;
-    let v192: f64 = 0.0625f64 * q[2usize];
-    let v193: f64 = v185 * qd[0usize];
-    let v194: f64 = v192.mul_add(qd[2usize], v193);
-    let v195: f64 = v186.mul_add(qd[1usize], v194);
-    let v196: f64 = v48 * v191;
-    let v197: f64 = v183.mul_add(v188, v190);
-    let v198: f64 = v196.mul_add(v195, v197);
-    let v199: f64 = v192 * qd[1usize];
-    let v200: f64 = v186.mul_add(qd[2usize], -v199);
-    let v201: f64 = v123 * v189;
-    let v202: f64 = v15 * v191;
-    let v203: f64 = v183.mul_add(v200, v201);
-    let v204: f64 = v202.mul_add(v195, v203);
-    let v205: f64 = v185 * qd[2usize];
-    let v206: f64 = v192.mul_add(qd[0usize], -v205);
-    let v207: f64 = v107 * v189;
-    let v208: f64 = v23 * v191;
-    let v209: f64 = v183.mul_add(v206, v207);
-    let v210: f64 = v208.mul_add(v195, v209);
-    let v212: f64 = 0.0625f64.mul_add(v8, -v182);
-    let v213: f64 = v183.mul_add(v212, 1f64);
-    let v214: f64 = v23 * v189;
-    let v215: f64 = v185 * q[2usize];
-    let v216: f64 = v215.mul_add(v183, v214);
-    let v217: f64 = v186 * q[2usize];
-    let v218: f64 = v15 * v189;
-    let v219: f64 = v217.mul_add(v183, -v218);
-    let v221: f64 = 0.5f64 * p[1usize];
-    let v223: f64 = 0.25f64 * p[3usize];
-    let v225: f64 = p[2usize] - v223;
-    let v227: f64 = 0.125f64.mul_add(v225, v223);
-    let v228: f64 = 0.5f64 * p[3usize];
-    let v230: f64 = v48 * v189;
-    out[0usize] = v14;
-    out[1usize] = v22;
-    out[2usize] = v28;
-    out[3usize] = v29;
-    out[4usize] = v30;
-    out[5usize] = v35;
-    out[6usize] = v36;
-    out[7usize] = v37;
-    out[8usize] = v38;
-    out[9usize] = v55;
-    out[10usize] = v62;
-    out[11usize] = v69;
-    out[12usize] = v105;
-    out[13usize] = v120;
-    out[14usize] = v135;
-    out[15usize] = v144;
-    out[16usize] = v150;
-    out[17usize] = v156;
-    out[18usize] = v160;
-    out[19usize] = v162;
-    out[20usize] = v164;
-    out[21usize] = v171;
-    out[22usize] = v176;
-    out[23usize] = v181;
-    out[24usize] = v198;
-    out[25usize] = v204;
-    out[26usize] = v210;
-    out[27usize] = v213;
-    out[28usize] = v216;
-    out[29usize] = v219;
-    out[30usize] = v221;
-    out[31usize] = v227;
-    out[32usize] = v228;
-    out[33usize] = v229;
-    out[34usize] = v230;
-    out[35usize] = v218;
-    out[36usize] = v214;
-    out[37usize] = 0f64;
+    let v183: f64 = c[2][0];
+    let v189: f64 = c[1][0];
+    let v191: f64 = c[3][0];
+    let v229: f64 = c[0][0];
+    let v185 = 0.0625f64 * q[0];
+    let v186 = 0.0625f64 * q[1];
+    let v187 = v186 * qd[0];
+    let v188 = v185.mul_add(qd[1], -v187);
+    let v190 = v91 * v189;
+    let v192 = 0.0625f64 * q[2];
+    let v193 = v185 * qd[0];
+    let v194 = v192.mul_add(qd[2], v193);
+    let v195 = v186.mul_add(qd[1], v194);
+    let v196 = v48 * v191;
+    let v197 = v183.mul_add(v188, v190);
+    let v198 = v196.mul_add(v195, v197);
+    let v199 = v192 * qd[1];
+    let v200 = v186.mul_add(qd[2], -v199);
+    let v201 = v123 * v189;
+    let v202 = v15 * v191;
+    let v203 = v183.mul_add(v200, v201);
+    let v204 = v202.mul_add(v195, v203);
+    let v205 = v185 * qd[2];
+    let v206 = v192.mul_add(qd[0], -v205);
+    let v207 = v107 * v189;
+    let v208 = v23 * v191;
+    let v209 = v183.mul_add(v206, v207);
+    let v210 = v208.mul_add(v195, v209);
+    let v212 = 0.0625f64.mul_add(v8, -v182);
+    let v213 = v183.mul_add(v212, 1f64);
+    let v214 = v23 * v189;
+    let v215 = v185 * q[2];
+    let v216 = v215.mul_add(v183, v214);
+    let v217 = v186 * q[2];
+    let v218 = v15 * v189;
+    let v219 = v217.mul_add(v183, -v218);
+    let v221 = 0.5f64 * p[1];
+    let v223 = 0.25f64 * p[3];
+    let v225 = p[2] - v223;
+    let v227 = 0.125f64.mul_add(v225, v223);
+    let v228 = 0.5f64 * p[3];
+    let v230 = v48 * v189;
+    out[0] = v14;
+    out[1] = v22;
+    out[2] = v28;
+    out[3] = v29;
+    out[4] = v30;
+    out[5] = v35;
+    out[6] = v36;
+    out[7] = v37;
+    out[8] = v38;
+    out[9] = v55;
+    out[10] = v62;
+    out[11] = v69;
+    out[12] = v105;
+    out[13] = v120;
+    out[14] = v135;
+    out[15] = v144;
+    out[16] = v150;
+    out[17] = v156;
+    out[18] = v160;
+    out[19] = v162;
+    out[20] = v164;
+    out[21] = v171;
+    out[22] = v176;
+    out[23] = v181;
+    out[24] = v198;
+    out[25] = v204;
+    out[26] = v210;
+    out[27] = v213;
+    out[28] = v216;
+    out[29] = v219;
+    out[30] = v221;
+    out[31] = v227;
+    out[32] = v228;
+    out[33] = v229;
+    out[34] = v230;
+    out[35] = v218;
+    out[36] = v214;
+    out[37] = 0f64;
 }
 /// Kernel `cell_0`: 731 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0(
     t: f64,
-    q: &[f64; 6usize],
-    qd: &[f64; 6usize],
-    qdd: &[f64; 6usize],
-    dir: &[f64; 12usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 129usize],
+    q: &[f64; 6],
+    qd: &[f64; 6],
+    qdd: &[f64; 6],
+    dir: &[f64; 12],
+    p: &[f64; 15],
+    out: &mut [f64; 129],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1805,640 +1797,640 @@ pub fn cell_0(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
-    q: &[f64; 6usize],
-    qd: &[f64; 6usize],
-    qdd: &[f64; 6usize],
-    dir: &[f64; 12usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 129usize],
+    q: &[f64; 6],
+    qd: &[f64; 6],
+    qdd: &[f64; 6],
+    dir: &[f64; 12],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 129],
 ) {
-    let v1: f64 = q[0usize] * q[0usize];
-    let v3: f64 = 0.25f64 * v1;
-    let v5: f64 = q[1usize] * q[1usize];
-    let v6: f64 = 0.25f64 * v5;
-    let v8: f64 = q[2usize] * q[2usize];
-    let v9: f64 = 0.25f64 * v8;
-    let v10: f64 = v3 + v6;
-    let v11: f64 = v10 + v9;
-    let c: [[f64; 3usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        3usize,
+    let v1 = q[0] * q[0];
+    let v3 = 0.25f64 * v1;
+    let v5 = q[1] * q[1];
+    let v6 = 0.25f64 * v5;
+    let v8 = q[2] * q[2];
+    let v9 = 0.25f64 * v8;
+    let v10 = v3 + v6;
+    let v11 = v10 + v9;
+    let c: [[f64; 3]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        3,
     >(v11);
-    let v12: f64 = c[0usize][0usize];
-    let v13: f64 = c[2usize][0usize];
-    let v18: f64 = c[1usize][0usize];
-    let v47: f64 = c[3usize][0usize];
-    let v78: f64 = c[2usize][1usize];
-    let v88: f64 = c[3usize][1usize];
-    let v144: f64 = c[2usize][2usize];
-    let v152: f64 = c[3usize][2usize];
-    let v220: f64 = c[1usize][1usize];
-    let v233: f64 = c[4usize][0usize];
-    let v241: f64 = c[4usize][1usize];
-    let v260: f64 = c[4usize][2usize];
-    let v14: f64 = v9.mul_add(v13, v12);
-    let v15: f64 = 0.25f64 * q[0usize];
-    let v16: f64 = v15 * q[2usize];
-    let v17: f64 = v16 * v13;
-    let v20: f64 = 0.5f64 * q[1usize];
-    let v21: f64 = v20 * v18;
-    let v22: f64 = v17 - v21;
-    let v23: f64 = 0.25f64 * q[1usize];
-    let v24: f64 = v23 * q[2usize];
-    let v25: f64 = v24 * v13;
-    let v26: f64 = 0.5f64 * q[0usize];
-    let v27: f64 = v26 * v18;
-    let v28: f64 = v25 + v27;
-    let v29: f64 = v17 + v21;
-    let v30: f64 = v3.mul_add(v13, v12);
-    let v31: f64 = v15 * q[1usize];
-    let v32: f64 = v31 * v13;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let v34: f64 = v33 * v18;
-    let v35: f64 = v32 - v34;
-    let v36: f64 = v25 - v27;
-    let v37: f64 = v32 + v34;
-    let v38: f64 = v6.mul_add(v13, v12);
-    let v41: f64 = q[3usize] + p[0usize];
-    let v42: f64 = 0.5f64 * v41;
-    let v45: f64 = v23 * q[4usize];
-    let v46: f64 = v15.mul_add(q[5usize], -v45);
-    let v48: f64 = 0.25f64 * q[2usize];
-    let v49: f64 = v15 * q[4usize];
-    let v50: f64 = v48.mul_add(v41, v49);
-    let v51: f64 = v23.mul_add(q[5usize], v50);
-    let v52: f64 = v42 * v11;
-    let v53: f64 = v33.mul_add(v51, -v52);
-    let v54: f64 = v13.mul_add(v46, v42);
-    let v55: f64 = v47.mul_add(v53, v54);
-    let v56: f64 = 0.5f64 * q[4usize];
-    let v57: f64 = v48 * q[5usize];
-    let v58: f64 = v23.mul_add(v41, -v57);
-    let v59: f64 = v56 * v11;
-    let v60: f64 = v26.mul_add(v51, -v59);
-    let v61: f64 = v13.mul_add(v58, v56);
-    let v62: f64 = v47.mul_add(v60, v61);
-    let v63: f64 = 0.5f64 * q[5usize];
-    let v64: f64 = v15 * v41;
-    let v65: f64 = v48.mul_add(q[4usize], -v64);
-    let v66: f64 = v63 * v11;
-    let v67: f64 = v20.mul_add(v51, -v66);
-    let v68: f64 = v13.mul_add(v65, v63);
-    let v69: f64 = v47.mul_add(v67, v68);
-    let v71: f64 = 0.5f64 * qd[3usize];
-    let v74: f64 = v26 * qd[0usize];
-    let v76: f64 = v33.mul_add(qd[2usize], v74);
-    let v77: f64 = v20.mul_add(qd[1usize], v76);
-    let v79: f64 = v77 * v78;
-    let v80: f64 = 0.25f64 * q[5usize];
-    let v82: f64 = v15 * qd[5usize];
-    let v83: f64 = 0.25f64 * q[4usize];
-    let v85: f64 = v80.mul_add(qd[0usize], v82);
-    let v86: f64 = (-v83).mul_add(qd[1usize], v85);
-    let v87: f64 = (-v23).mul_add(qd[4usize], v86);
-    let v89: f64 = v77 * v88;
-    let v90: f64 = 0.5f64 * qd[2usize];
-    let v91: f64 = 0.25f64 * qd[2usize];
-    let v92: f64 = v48 * qd[3usize];
-    let v93: f64 = v91.mul_add(v41, v92);
-    let v94: f64 = v83.mul_add(qd[0usize], v93);
-    let v95: f64 = v15.mul_add(qd[4usize], v94);
-    let v96: f64 = v80.mul_add(qd[1usize], v95);
-    let v97: f64 = v23.mul_add(qd[5usize], v96);
-    let v98: f64 = v33 * v97;
-    let v99: f64 = v90.mul_add(v51, v98);
-    let v100: f64 = (-v71).mul_add(v11, v99);
-    let v101: f64 = (-v42).mul_add(v77, v100);
-    let v102: f64 = v46.mul_add(v79, v71);
-    let v103: f64 = v13.mul_add(v87, v102);
-    let v104: f64 = v53.mul_add(v89, v103);
-    let v105: f64 = v47.mul_add(v101, v104);
-    let v106: f64 = 0.5f64 * qd[4usize];
-    let v107: f64 = 0.25f64 * qd[1usize];
-    let v108: f64 = v23 * qd[3usize];
-    let v109: f64 = v107.mul_add(v41, v108);
-    let v110: f64 = (-v80).mul_add(qd[2usize], v109);
-    let v111: f64 = (-v48).mul_add(qd[5usize], v110);
-    let v112: f64 = 0.5f64 * qd[0usize];
-    let v113: f64 = v26 * v97;
-    let v114: f64 = v112.mul_add(v51, v113);
-    let v115: f64 = (-v106).mul_add(v11, v114);
-    let v116: f64 = (-v56).mul_add(v77, v115);
-    let v117: f64 = v58.mul_add(v79, v106);
-    let v118: f64 = v13.mul_add(v111, v117);
-    let v119: f64 = v60.mul_add(v89, v118);
-    let v120: f64 = v47.mul_add(v116, v119);
-    let v121: f64 = 0.5f64 * qd[5usize];
-    let v122: f64 = v48 * qd[4usize];
-    let v123: f64 = 0.25f64 * qd[0usize];
-    let v124: f64 = v83.mul_add(qd[2usize], v122);
-    let v125: f64 = (-v123).mul_add(v41, v124);
-    let v126: f64 = (-v15).mul_add(qd[3usize], v125);
-    let v127: f64 = 0.5f64 * qd[1usize];
-    let v128: f64 = v20 * v97;
-    let v129: f64 = v127.mul_add(v51, v128);
-    let v130: f64 = (-v121).mul_add(v11, v129);
-    let v131: f64 = (-v63).mul_add(v77, v130);
-    let v132: f64 = v65.mul_add(v79, v121);
-    let v133: f64 = v13.mul_add(v126, v132);
-    let v134: f64 = v67.mul_add(v89, v133);
-    let v135: f64 = v47.mul_add(v131, v134);
-    let v137: f64 = 2f64 * v79;
-    let v138: f64 = qd[0usize] * qd[0usize];
-    let v139: f64 = qd[1usize] * qd[1usize];
-    let v140: f64 = 0.5f64 * v139;
-    let v141: f64 = qd[2usize] * qd[2usize];
-    let v142: f64 = 0.5f64.mul_add(v138, v140);
-    let v143: f64 = 0.5f64.mul_add(v141, v142);
-    let v145: f64 = v77 * v77;
-    let v146: f64 = v144 * v145;
-    let v147: f64 = v78.mul_add(v143, v146);
-    let v148: f64 = v46 * v147;
-    let v149: f64 = v127 * qd[4usize];
-    let v150: f64 = v112.mul_add(qd[5usize], -v149);
-    let v151: f64 = 2f64 * v89;
-    let v153: f64 = v145 * v152;
-    let v154: f64 = v88.mul_add(v143, v153);
-    let v155: f64 = v112 * qd[4usize];
-    let v156: f64 = v90.mul_add(qd[3usize], v155);
-    let v157: f64 = v127.mul_add(qd[5usize], v156);
-    let v158: f64 = v33 * v157;
-    let v159: f64 = qd[2usize].mul_add(v97, v158);
-    let v160: f64 = (-qd[3usize]).mul_add(v77, v159);
-    let v161: f64 = (-v42).mul_add(v143, v160);
-    let v162: f64 = v137.mul_add(v87, v148);
-    let v163: f64 = v13.mul_add(v150, v162);
-    let v164: f64 = v151.mul_add(v101, v163);
-    let v165: f64 = v53.mul_add(v154, v164);
-    let v166: f64 = v47.mul_add(v161, v165);
-    let v167: f64 = v58 * v147;
-    let v168: f64 = v90 * qd[5usize];
-    let v169: f64 = v127.mul_add(qd[3usize], -v168);
-    let v170: f64 = v26 * v157;
-    let v171: f64 = qd[0usize].mul_add(v97, v170);
-    let v172: f64 = (-qd[4usize]).mul_add(v77, v171);
-    let v173: f64 = (-v56).mul_add(v143, v172);
-    let v174: f64 = v137.mul_add(v111, v167);
-    let v175: f64 = v13.mul_add(v169, v174);
-    let v176: f64 = v151.mul_add(v116, v175);
-    let v177: f64 = v60.mul_add(v154, v176);
-    let v178: f64 = v47.mul_add(v173, v177);
-    let v179: f64 = v65 * v147;
-    let v180: f64 = v112 * qd[3usize];
-    let v181: f64 = v90.mul_add(qd[4usize], -v180);
-    let v182: f64 = v20 * v157;
-    let v183: f64 = qd[1usize].mul_add(v97, v182);
-    let v184: f64 = (-qd[5usize]).mul_add(v77, v183);
-    let v185: f64 = (-v63).mul_add(v143, v184);
-    let v186: f64 = v137.mul_add(v126, v179);
-    let v187: f64 = v13.mul_add(v181, v186);
-    let v188: f64 = v151.mul_add(v131, v187);
-    let v189: f64 = v67.mul_add(v154, v188);
-    let v190: f64 = v47.mul_add(v185, v189);
-    let v191: f64 = v23 * qd[0usize];
-    let v192: f64 = v15.mul_add(qd[1usize], -v191);
-    let v193: f64 = v90 * v18;
-    let v194: f64 = v15 * qd[0usize];
-    let v195: f64 = v48.mul_add(qd[2usize], v194);
-    let v196: f64 = v23.mul_add(qd[1usize], v195);
-    let v197: f64 = v33 * v47;
-    let v198: f64 = v13.mul_add(v192, v193);
-    let v199: f64 = v197.mul_add(v196, v198);
-    let v200: f64 = v48 * qd[1usize];
-    let v201: f64 = v23.mul_add(qd[2usize], -v200);
-    let v202: f64 = v112 * v18;
-    let v203: f64 = v26 * v47;
-    let v204: f64 = v13.mul_add(v201, v202);
-    let v205: f64 = v203.mul_add(v196, v204);
-    let v206: f64 = v15 * qd[2usize];
-    let v207: f64 = v48.mul_add(qd[0usize], -v206);
-    let v208: f64 = v127 * v18;
-    let v209: f64 = v20 * v47;
-    let v210: f64 = v13.mul_add(v207, v208);
-    let v211: f64 = v209.mul_add(v196, v210);
-    let v212: f64 = 0.5f64 * v196;
-    let v213: f64 = 0.25f64 * v139;
-    let v214: f64 = 0.25f64.mul_add(v138, v213);
-    let v215: f64 = 0.25f64.mul_add(v141, v214);
-    let v216: f64 = 0.5f64 * v47;
-    let v217: f64 = v216 * v215;
-    let v218: f64 = v212.mul_add(v89, v217);
-    let v219: f64 = q[2usize] * v218;
-    let v221: f64 = v77 * v220;
-    let v222: f64 = 0.5f64 * v221;
-    let v223: f64 = v216.mul_add(v196, v222);
-    let v224: f64 = v192.mul_add(v79, v219);
-    let v225: f64 = qd[2usize].mul_add(v223, v224);
-    let v226: f64 = q[0usize] * v218;
-    let v227: f64 = v201.mul_add(v79, v226);
-    let v228: f64 = qd[0usize].mul_add(v223, v227);
-    let v229: f64 = q[1usize] * v218;
-    let v230: f64 = v207.mul_add(v79, v229);
-    let v231: f64 = qd[1usize].mul_add(v223, v230);
-    let v232: f64 = 0.25f64 * v41;
-    let v234: f64 = v47.mul_add(v46, v232);
-    let v235: f64 = v233.mul_add(v53, v234);
-    let v236: f64 = v47.mul_add(v58, v83);
-    let v237: f64 = v233.mul_add(v60, v236);
-    let v238: f64 = v47.mul_add(v65, v80);
-    let v239: f64 = v233.mul_add(v67, v238);
-    let v240: f64 = v46 * v89;
-    let v242: f64 = v77 * v241;
-    let v243: f64 = 0.25f64.mul_add(qd[3usize], v240);
-    let v244: f64 = v47.mul_add(v87, v243);
-    let v245: f64 = v53.mul_add(v242, v244);
-    let v246: f64 = v233.mul_add(v101, v245);
-    let v247: f64 = v58 * v89;
-    let v248: f64 = 0.25f64.mul_add(qd[4usize], v247);
-    let v249: f64 = v47.mul_add(v111, v248);
-    let v250: f64 = v60.mul_add(v242, v249);
-    let v251: f64 = v233.mul_add(v116, v250);
-    let v252: f64 = v65 * v89;
-    let v253: f64 = 0.25f64.mul_add(qd[5usize], v252);
-    let v254: f64 = v47.mul_add(v126, v253);
-    let v255: f64 = v67.mul_add(v242, v254);
-    let v256: f64 = v233.mul_add(v131, v255);
-    let v257: f64 = 2f64 * v87;
-    let v258: f64 = v46 * v154;
-    let v259: f64 = 2f64 * v101;
-    let v261: f64 = v145 * v260;
-    let v262: f64 = v143.mul_add(v241, v261);
-    let v263: f64 = v257.mul_add(v89, v258);
-    let v264: f64 = v47.mul_add(v150, v263);
-    let v265: f64 = v259.mul_add(v242, v264);
-    let v266: f64 = v53.mul_add(v262, v265);
-    let v267: f64 = v233.mul_add(v161, v266);
-    let v268: f64 = v58 * v154;
-    let v269: f64 = 2f64 * v116;
-    let v270: f64 = v151.mul_add(v111, v268);
-    let v271: f64 = v47.mul_add(v169, v270);
-    let v272: f64 = v269.mul_add(v242, v271);
-    let v273: f64 = v60.mul_add(v262, v272);
-    let v274: f64 = v233.mul_add(v173, v273);
-    let v275: f64 = v65 * v154;
-    let v276: f64 = 2f64 * v131;
-    let v277: f64 = v151.mul_add(v126, v275);
-    let v278: f64 = v47.mul_add(v181, v277);
-    let v279: f64 = v276.mul_add(v242, v278);
-    let v280: f64 = v67.mul_add(v262, v279);
-    let v281: f64 = v233.mul_add(v185, v280);
-    let v282: f64 = 0.25f64 * v11;
-    let c: [[f64; 2usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        2usize,
+    let v12: f64 = c[0][0];
+    let v13: f64 = c[2][0];
+    let v18: f64 = c[1][0];
+    let v47: f64 = c[3][0];
+    let v78: f64 = c[2][1];
+    let v88: f64 = c[3][1];
+    let v144: f64 = c[2][2];
+    let v152: f64 = c[3][2];
+    let v220: f64 = c[1][1];
+    let v233: f64 = c[4][0];
+    let v241: f64 = c[4][1];
+    let v260: f64 = c[4][2];
+    let v14 = v9.mul_add(v13, v12);
+    let v15 = 0.25f64 * q[0];
+    let v16 = v15 * q[2];
+    let v17 = v16 * v13;
+    let v20 = 0.5f64 * q[1];
+    let v21 = v20 * v18;
+    let v22 = v17 - v21;
+    let v23 = 0.25f64 * q[1];
+    let v24 = v23 * q[2];
+    let v25 = v24 * v13;
+    let v26 = 0.5f64 * q[0];
+    let v27 = v26 * v18;
+    let v28 = v25 + v27;
+    let v29 = v17 + v21;
+    let v30 = v3.mul_add(v13, v12);
+    let v31 = v15 * q[1];
+    let v32 = v31 * v13;
+    let v33 = 0.5f64 * q[2];
+    let v34 = v33 * v18;
+    let v35 = v32 - v34;
+    let v36 = v25 - v27;
+    let v37 = v32 + v34;
+    let v38 = v6.mul_add(v13, v12);
+    let v41 = q[3] + p[0];
+    let v42 = 0.5f64 * v41;
+    let v45 = v23 * q[4];
+    let v46 = v15.mul_add(q[5], -v45);
+    let v48 = 0.25f64 * q[2];
+    let v49 = v15 * q[4];
+    let v50 = v48.mul_add(v41, v49);
+    let v51 = v23.mul_add(q[5], v50);
+    let v52 = v42 * v11;
+    let v53 = v33.mul_add(v51, -v52);
+    let v54 = v13.mul_add(v46, v42);
+    let v55 = v47.mul_add(v53, v54);
+    let v56 = 0.5f64 * q[4];
+    let v57 = v48 * q[5];
+    let v58 = v23.mul_add(v41, -v57);
+    let v59 = v56 * v11;
+    let v60 = v26.mul_add(v51, -v59);
+    let v61 = v13.mul_add(v58, v56);
+    let v62 = v47.mul_add(v60, v61);
+    let v63 = 0.5f64 * q[5];
+    let v64 = v15 * v41;
+    let v65 = v48.mul_add(q[4], -v64);
+    let v66 = v63 * v11;
+    let v67 = v20.mul_add(v51, -v66);
+    let v68 = v13.mul_add(v65, v63);
+    let v69 = v47.mul_add(v67, v68);
+    let v71 = 0.5f64 * qd[3];
+    let v74 = v26 * qd[0];
+    let v76 = v33.mul_add(qd[2], v74);
+    let v77 = v20.mul_add(qd[1], v76);
+    let v79 = v77 * v78;
+    let v80 = 0.25f64 * q[5];
+    let v82 = v15 * qd[5];
+    let v83 = 0.25f64 * q[4];
+    let v85 = v80.mul_add(qd[0], v82);
+    let v86 = (-v83).mul_add(qd[1], v85);
+    let v87 = (-v23).mul_add(qd[4], v86);
+    let v89 = v77 * v88;
+    let v90 = 0.5f64 * qd[2];
+    let v91 = 0.25f64 * qd[2];
+    let v92 = v48 * qd[3];
+    let v93 = v91.mul_add(v41, v92);
+    let v94 = v83.mul_add(qd[0], v93);
+    let v95 = v15.mul_add(qd[4], v94);
+    let v96 = v80.mul_add(qd[1], v95);
+    let v97 = v23.mul_add(qd[5], v96);
+    let v98 = v33 * v97;
+    let v99 = v90.mul_add(v51, v98);
+    let v100 = (-v71).mul_add(v11, v99);
+    let v101 = (-v42).mul_add(v77, v100);
+    let v102 = v46.mul_add(v79, v71);
+    let v103 = v13.mul_add(v87, v102);
+    let v104 = v53.mul_add(v89, v103);
+    let v105 = v47.mul_add(v101, v104);
+    let v106 = 0.5f64 * qd[4];
+    let v107 = 0.25f64 * qd[1];
+    let v108 = v23 * qd[3];
+    let v109 = v107.mul_add(v41, v108);
+    let v110 = (-v80).mul_add(qd[2], v109);
+    let v111 = (-v48).mul_add(qd[5], v110);
+    let v112 = 0.5f64 * qd[0];
+    let v113 = v26 * v97;
+    let v114 = v112.mul_add(v51, v113);
+    let v115 = (-v106).mul_add(v11, v114);
+    let v116 = (-v56).mul_add(v77, v115);
+    let v117 = v58.mul_add(v79, v106);
+    let v118 = v13.mul_add(v111, v117);
+    let v119 = v60.mul_add(v89, v118);
+    let v120 = v47.mul_add(v116, v119);
+    let v121 = 0.5f64 * qd[5];
+    let v122 = v48 * qd[4];
+    let v123 = 0.25f64 * qd[0];
+    let v124 = v83.mul_add(qd[2], v122);
+    let v125 = (-v123).mul_add(v41, v124);
+    let v126 = (-v15).mul_add(qd[3], v125);
+    let v127 = 0.5f64 * qd[1];
+    let v128 = v20 * v97;
+    let v129 = v127.mul_add(v51, v128);
+    let v130 = (-v121).mul_add(v11, v129);
+    let v131 = (-v63).mul_add(v77, v130);
+    let v132 = v65.mul_add(v79, v121);
+    let v133 = v13.mul_add(v126, v132);
+    let v134 = v67.mul_add(v89, v133);
+    let v135 = v47.mul_add(v131, v134);
+    let v137 = 2f64 * v79;
+    let v138 = qd[0] * qd[0];
+    let v139 = qd[1] * qd[1];
+    let v140 = 0.5f64 * v139;
+    let v141 = qd[2] * qd[2];
+    let v142 = 0.5f64.mul_add(v138, v140);
+    let v143 = 0.5f64.mul_add(v141, v142);
+    let v145 = v77 * v77;
+    let v146 = v144 * v145;
+    let v147 = v78.mul_add(v143, v146);
+    let v148 = v46 * v147;
+    let v149 = v127 * qd[4];
+    let v150 = v112.mul_add(qd[5], -v149);
+    let v151 = 2f64 * v89;
+    let v153 = v145 * v152;
+    let v154 = v88.mul_add(v143, v153);
+    let v155 = v112 * qd[4];
+    let v156 = v90.mul_add(qd[3], v155);
+    let v157 = v127.mul_add(qd[5], v156);
+    let v158 = v33 * v157;
+    let v159 = qd[2].mul_add(v97, v158);
+    let v160 = (-qd[3]).mul_add(v77, v159);
+    let v161 = (-v42).mul_add(v143, v160);
+    let v162 = v137.mul_add(v87, v148);
+    let v163 = v13.mul_add(v150, v162);
+    let v164 = v151.mul_add(v101, v163);
+    let v165 = v53.mul_add(v154, v164);
+    let v166 = v47.mul_add(v161, v165);
+    let v167 = v58 * v147;
+    let v168 = v90 * qd[5];
+    let v169 = v127.mul_add(qd[3], -v168);
+    let v170 = v26 * v157;
+    let v171 = qd[0].mul_add(v97, v170);
+    let v172 = (-qd[4]).mul_add(v77, v171);
+    let v173 = (-v56).mul_add(v143, v172);
+    let v174 = v137.mul_add(v111, v167);
+    let v175 = v13.mul_add(v169, v174);
+    let v176 = v151.mul_add(v116, v175);
+    let v177 = v60.mul_add(v154, v176);
+    let v178 = v47.mul_add(v173, v177);
+    let v179 = v65 * v147;
+    let v180 = v112 * qd[3];
+    let v181 = v90.mul_add(qd[4], -v180);
+    let v182 = v20 * v157;
+    let v183 = qd[1].mul_add(v97, v182);
+    let v184 = (-qd[5]).mul_add(v77, v183);
+    let v185 = (-v63).mul_add(v143, v184);
+    let v186 = v137.mul_add(v126, v179);
+    let v187 = v13.mul_add(v181, v186);
+    let v188 = v151.mul_add(v131, v187);
+    let v189 = v67.mul_add(v154, v188);
+    let v190 = v47.mul_add(v185, v189);
+    let v191 = v23 * qd[0];
+    let v192 = v15.mul_add(qd[1], -v191);
+    let v193 = v90 * v18;
+    let v194 = v15 * qd[0];
+    let v195 = v48.mul_add(qd[2], v194);
+    let v196 = v23.mul_add(qd[1], v195);
+    let v197 = v33 * v47;
+    let v198 = v13.mul_add(v192, v193);
+    let v199 = v197.mul_add(v196, v198);
+    let v200 = v48 * qd[1];
+    let v201 = v23.mul_add(qd[2], -v200);
+    let v202 = v112 * v18;
+    let v203 = v26 * v47;
+    let v204 = v13.mul_add(v201, v202);
+    let v205 = v203.mul_add(v196, v204);
+    let v206 = v15 * qd[2];
+    let v207 = v48.mul_add(qd[0], -v206);
+    let v208 = v127 * v18;
+    let v209 = v20 * v47;
+    let v210 = v13.mul_add(v207, v208);
+    let v211 = v209.mul_add(v196, v210);
+    let v212 = 0.5f64 * v196;
+    let v213 = 0.25f64 * v139;
+    let v214 = 0.25f64.mul_add(v138, v213);
+    let v215 = 0.25f64.mul_add(v141, v214);
+    let v216 = 0.5f64 * v47;
+    let v217 = v216 * v215;
+    let v218 = v212.mul_add(v89, v217);
+    let v219 = q[2] * v218;
+    let v221 = v77 * v220;
+    let v222 = 0.5f64 * v221;
+    let v223 = v216.mul_add(v196, v222);
+    let v224 = v192.mul_add(v79, v219);
+    let v225 = qd[2].mul_add(v223, v224);
+    let v226 = q[0] * v218;
+    let v227 = v201.mul_add(v79, v226);
+    let v228 = qd[0].mul_add(v223, v227);
+    let v229 = q[1] * v218;
+    let v230 = v207.mul_add(v79, v229);
+    let v231 = qd[1].mul_add(v223, v230);
+    let v232 = 0.25f64 * v41;
+    let v234 = v47.mul_add(v46, v232);
+    let v235 = v233.mul_add(v53, v234);
+    let v236 = v47.mul_add(v58, v83);
+    let v237 = v233.mul_add(v60, v236);
+    let v238 = v47.mul_add(v65, v80);
+    let v239 = v233.mul_add(v67, v238);
+    let v240 = v46 * v89;
+    let v242 = v77 * v241;
+    let v243 = 0.25f64.mul_add(qd[3], v240);
+    let v244 = v47.mul_add(v87, v243);
+    let v245 = v53.mul_add(v242, v244);
+    let v246 = v233.mul_add(v101, v245);
+    let v247 = v58 * v89;
+    let v248 = 0.25f64.mul_add(qd[4], v247);
+    let v249 = v47.mul_add(v111, v248);
+    let v250 = v60.mul_add(v242, v249);
+    let v251 = v233.mul_add(v116, v250);
+    let v252 = v65 * v89;
+    let v253 = 0.25f64.mul_add(qd[5], v252);
+    let v254 = v47.mul_add(v126, v253);
+    let v255 = v67.mul_add(v242, v254);
+    let v256 = v233.mul_add(v131, v255);
+    let v257 = 2f64 * v87;
+    let v258 = v46 * v154;
+    let v259 = 2f64 * v101;
+    let v261 = v145 * v260;
+    let v262 = v143.mul_add(v241, v261);
+    let v263 = v257.mul_add(v89, v258);
+    let v264 = v47.mul_add(v150, v263);
+    let v265 = v259.mul_add(v242, v264);
+    let v266 = v53.mul_add(v262, v265);
+    let v267 = v233.mul_add(v161, v266);
+    let v268 = v58 * v154;
+    let v269 = 2f64 * v116;
+    let v270 = v151.mul_add(v111, v268);
+    let v271 = v47.mul_add(v169, v270);
+    let v272 = v269.mul_add(v242, v271);
+    let v273 = v60.mul_add(v262, v272);
+    let v274 = v233.mul_add(v173, v273);
+    let v275 = v65 * v154;
+    let v276 = 2f64 * v131;
+    let v277 = v151.mul_add(v126, v275);
+    let v278 = v47.mul_add(v181, v277);
+    let v279 = v276.mul_add(v242, v278);
+    let v280 = v67.mul_add(v262, v279);
+    let v281 = v233.mul_add(v185, v280);
+    let v282 = 0.25f64 * v11;
+    let c: [[f64; 2]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        2,
     >(v282);
-    let v283: f64 = c[2usize][0usize];
-    let v289: f64 = c[1usize][0usize];
-    let v291: f64 = c[3usize][0usize];
-    let v312: f64 = c[2usize][1usize];
-    let v314: f64 = c[3usize][1usize];
-    let v324: f64 = c[1usize][1usize];
-    let v285: f64 = 0.0625f64 * q[0usize];
-    let v286: f64 = 0.0625f64 * q[1usize];
-    let v287: f64 = v286 * qd[0usize];
-    let v288: f64 = v285.mul_add(qd[1usize], -v287);
-    let v290: f64 = v91 * v289;
-    let v292: f64 = 0.0625f64 * q[2usize];
-    let v293: f64 = v285 * qd[0usize];
-    let v294: f64 = v292.mul_add(qd[2usize], v293);
-    let v295: f64 = v286.mul_add(qd[1usize], v294);
-    let v296: f64 = v48 * v291;
-    let v297: f64 = v283.mul_add(v288, v290);
-    let v298: f64 = v296.mul_add(v295, v297);
-    let v299: f64 = v292 * qd[1usize];
-    let v300: f64 = v286.mul_add(qd[2usize], -v299);
-    let v301: f64 = v123 * v289;
-    let v302: f64 = v15 * v291;
-    let v303: f64 = v283.mul_add(v300, v301);
-    let v304: f64 = v302.mul_add(v295, v303);
-    let v305: f64 = v285 * qd[2usize];
-    let v306: f64 = v292.mul_add(qd[0usize], -v305);
-    let v307: f64 = v107 * v289;
-    let v308: f64 = v23 * v291;
-    let v309: f64 = v283.mul_add(v306, v307);
-    let v310: f64 = v308.mul_add(v295, v309);
-    let v311: f64 = 0.25f64 * v77;
-    let v313: f64 = v311 * v312;
-    let v315: f64 = v311 * v314;
-    let v316: f64 = 0.25f64 * v295;
-    let v317: f64 = 0.0625f64 * v139;
-    let v318: f64 = 0.0625f64.mul_add(v138, v317);
-    let v319: f64 = 0.0625f64.mul_add(v141, v318);
-    let v320: f64 = 0.25f64 * v291;
-    let v321: f64 = v320 * v319;
-    let v322: f64 = v316.mul_add(v315, v321);
-    let v323: f64 = q[2usize] * v322;
-    let v325: f64 = v311 * v324;
-    let v326: f64 = 0.25f64 * v325;
-    let v327: f64 = v320.mul_add(v295, v326);
-    let v328: f64 = v288.mul_add(v313, v323);
-    let v329: f64 = qd[2usize].mul_add(v327, v328);
-    let v330: f64 = q[0usize] * v322;
-    let v331: f64 = v300.mul_add(v313, v330);
-    let v332: f64 = qd[0usize].mul_add(v327, v331);
-    let v333: f64 = q[1usize] * v322;
-    let v334: f64 = v306.mul_add(v313, v333);
-    let v335: f64 = qd[1usize].mul_add(v327, v334);
-    let v337: f64 = 0.0625f64.mul_add(v8, -v282);
-    let v338: f64 = v283.mul_add(v337, 1f64);
-    let v339: f64 = v285 * q[2usize];
-    let v340: f64 = v339 * v283;
-    let v341: f64 = v23.mul_add(v289, v340);
-    let v342: f64 = v286 * q[2usize];
-    let v343: f64 = v15 * v289;
-    let v344: f64 = v342.mul_add(v283, -v343);
-    let v346: f64 = 0.5f64 * p[1usize];
-    let v348: f64 = 0.25f64 * p[3usize];
-    let v350: f64 = p[2usize] - v348;
-    let v352: f64 = 0.125f64.mul_add(v350, v348);
-    let v353: f64 = 0.5f64 * p[3usize];
-    let v354: f64 = v23 * v13;
-    let v355: f64 = 0.125f64 * q[0usize];
-    let v356: f64 = v355 * q[2usize];
-    let v357: f64 = v356 * v47;
-    let v358: f64 = v357 - v354;
-    let v359: f64 = 0.5f64 * v18;
-    let v360: f64 = 0.125f64 * v1;
-    let v361: f64 = v360.mul_add(v47, v359);
-    let v362: f64 = v48 * v13;
-    let v363: f64 = v355 * q[1usize];
-    let v364: f64 = v363 * v47;
-    let v365: f64 = v362 + v364;
-    let v366: f64 = v78 * v26;
-    let v367: f64 = v80 * v13;
-    let v368: f64 = v88 * v26;
-    let v369: f64 = 0.125f64 * q[2usize];
-    let v370: f64 = v42 * v26;
-    let v371: f64 = v369.mul_add(q[4usize], -v370);
-    let v372: f64 = v46.mul_add(v366, v367);
-    let v373: f64 = v53.mul_add(v368, v372);
-    let v374: f64 = v47.mul_add(v371, v373);
-    let v375: f64 = v60 * v368;
-    let v376: f64 = 0.5f64 * v51;
-    let v377: f64 = (-0.5f64).mul_add(v26, v355);
-    let v378: f64 = q[4usize].mul_add(v377, v376);
-    let v379: f64 = v58.mul_add(v366, v375);
-    let v380: f64 = v47.mul_add(v378, v379);
-    let v381: f64 = v232 * v13;
-    let v382: f64 = 0.125f64 * q[1usize];
-    let v383: f64 = v63 * v26;
-    let v384: f64 = v382.mul_add(q[4usize], -v383);
-    let v385: f64 = v65.mul_add(v366, -v381);
-    let v386: f64 = v67.mul_add(v368, v385);
-    let v387: f64 = v47.mul_add(v384, v386);
-    let v388: f64 = v286 * v283;
-    let v390: f64 = 0.015625f64 * q[0usize];
-    let v391: f64 = v390 * q[2usize];
-    let v392: f64 = v391 * v291;
-    let v393: f64 = v392 - v388;
-    let v394: f64 = 0.25f64 * v289;
-    let v395: f64 = 0.015625f64 * v1;
-    let v396: f64 = v395.mul_add(v291, v394);
-    let v397: f64 = v292 * v283;
-    let v398: f64 = v390 * q[1usize];
-    let v399: f64 = v398 * v291;
-    let v400: f64 = v397 + v399;
-    let v401: f64 = v80 * v47;
-    let v402: f64 = v241 * v26;
-    let v403: f64 = v46.mul_add(v368, v401);
-    let v404: f64 = v53.mul_add(v402, v403);
-    let v405: f64 = v233.mul_add(v371, v404);
-    let v406: f64 = v60 * v402;
-    let v407: f64 = v58.mul_add(v368, v406);
-    let v408: f64 = v233.mul_add(v378, v407);
-    let v409: f64 = v232 * v47;
-    let v410: f64 = v65.mul_add(v368, -v409);
-    let v411: f64 = v67.mul_add(v402, v410);
-    let v412: f64 = v233.mul_add(v384, v411);
-    let v413: f64 = v15 * v13;
-    let v414: f64 = v382 * q[2usize];
-    let v415: f64 = v414 * v47;
-    let v416: f64 = v413 + v415;
-    let v417: f64 = v364 - v362;
-    let v418: f64 = 0.125f64 * v5;
-    let v419: f64 = v418.mul_add(v47, v359);
-    let v420: f64 = v78 * v20;
-    let v421: f64 = v83 * v13;
-    let v422: f64 = v88 * v20;
-    let v423: f64 = v42 * v20;
-    let v424: f64 = v369.mul_add(q[5usize], -v423);
-    let v425: f64 = v46.mul_add(v420, -v421);
-    let v426: f64 = v53.mul_add(v422, v425);
-    let v427: f64 = v47.mul_add(v424, v426);
-    let v428: f64 = v56 * v20;
-    let v429: f64 = v355.mul_add(q[5usize], -v428);
-    let v430: f64 = v58.mul_add(v420, v381);
-    let v431: f64 = v60.mul_add(v422, v430);
-    let v432: f64 = v47.mul_add(v429, v431);
-    let v433: f64 = v67 * v422;
-    let v434: f64 = (-0.5f64).mul_add(v20, v382);
-    let v435: f64 = q[5usize].mul_add(v434, v376);
-    let v436: f64 = v65.mul_add(v420, v433);
-    let v437: f64 = v47.mul_add(v435, v436);
-    let v438: f64 = v285 * v283;
-    let v439: f64 = 0.015625f64 * q[1usize];
-    let v440: f64 = v439 * q[2usize];
-    let v441: f64 = v440 * v291;
-    let v442: f64 = v438 + v441;
-    let v443: f64 = v399 - v397;
-    let v444: f64 = 0.015625f64 * v5;
-    let v445: f64 = v444.mul_add(v291, v394);
-    let v446: f64 = v83 * v47;
-    let v447: f64 = v241 * v20;
-    let v448: f64 = v46.mul_add(v422, -v446);
-    let v449: f64 = v53.mul_add(v447, v448);
-    let v450: f64 = v233.mul_add(v424, v449);
-    let v451: f64 = v58.mul_add(v422, v409);
-    let v452: f64 = v60.mul_add(v447, v451);
-    let v453: f64 = v233.mul_add(v429, v452);
-    let v454: f64 = v67 * v447;
-    let v455: f64 = v65.mul_add(v422, v454);
-    let v456: f64 = v233.mul_add(v435, v455);
-    let v457: f64 = 0.125f64 * v8;
-    let v458: f64 = v457.mul_add(v47, v359);
-    let v459: f64 = v354 + v357;
-    let v460: f64 = v415 - v413;
-    let v461: f64 = v78 * v33;
-    let v462: f64 = v88 * v33;
-    let v463: f64 = v53 * v462;
-    let v464: f64 = (-0.5f64).mul_add(v33, v369);
-    let v465: f64 = v41.mul_add(v464, v376);
-    let v466: f64 = v46.mul_add(v461, v463);
-    let v467: f64 = v47.mul_add(v465, v466);
-    let v468: f64 = v56 * v33;
-    let v469: f64 = v355.mul_add(v41, -v468);
-    let v470: f64 = v58.mul_add(v461, -v367);
-    let v471: f64 = v60.mul_add(v462, v470);
-    let v472: f64 = v47.mul_add(v469, v471);
-    let v473: f64 = v63 * v33;
-    let v474: f64 = v382.mul_add(v41, -v473);
-    let v475: f64 = v65.mul_add(v461, v421);
-    let v476: f64 = v67.mul_add(v462, v475);
-    let v477: f64 = v47.mul_add(v474, v476);
-    let v478: f64 = 0.015625f64 * v8;
-    let v479: f64 = v478.mul_add(v291, v394);
-    let v480: f64 = v388 + v392;
-    let v481: f64 = v441 - v438;
-    let v482: f64 = v241 * v33;
-    let v483: f64 = v53 * v482;
-    let v484: f64 = v46.mul_add(v462, v483);
-    let v485: f64 = v233.mul_add(v465, v484);
-    let v486: f64 = v58.mul_add(v462, -v401);
-    let v487: f64 = v60.mul_add(v482, v486);
-    let v488: f64 = v233.mul_add(v469, v487);
-    let v489: f64 = v65.mul_add(v462, v446);
-    let v490: f64 = v67.mul_add(v482, v489);
-    let v491: f64 = v233.mul_add(v474, v490);
-    let v493: f64 = 0.5f64 * v11;
-    let v494: f64 = v457 - v493;
-    let v495: f64 = v47.mul_add(v494, 0.5f64);
-    let v496: f64 = v233.mul_add(v494, 0.25f64);
-    let v497: f64 = v23 * v47;
-    let v498: f64 = v356 * v233;
-    let v499: f64 = v497 + v498;
-    let v500: f64 = v15 * v47;
-    let v501: f64 = v414 * v233;
-    let v502: f64 = v501 - v500;
-    let v503: f64 = v360 - v493;
-    let v504: f64 = v47.mul_add(v503, 0.5f64);
-    let v505: f64 = v498 - v497;
-    let v506: f64 = v233.mul_add(v503, 0.25f64);
-    let v507: f64 = v48 * v47;
-    let v508: f64 = v363 * v233;
-    let v509: f64 = v507 + v508;
-    let v510: f64 = v418 - v493;
-    let v511: f64 = v47.mul_add(v510, 0.5f64);
-    let v512: f64 = v500 + v501;
-    let v513: f64 = v508 - v507;
-    let v514: f64 = v233.mul_add(v510, 0.25f64);
-    out[0usize] = v14;
-    out[1usize] = v22;
-    out[2usize] = v28;
-    out[3usize] = v29;
-    out[4usize] = v30;
-    out[5usize] = v35;
-    out[6usize] = v36;
-    out[7usize] = v37;
-    out[8usize] = v38;
-    out[9usize] = v55;
-    out[10usize] = v62;
-    out[11usize] = v69;
-    out[12usize] = v105;
-    out[13usize] = v120;
-    out[14usize] = v135;
-    out[15usize] = v166;
-    out[16usize] = v178;
-    out[17usize] = v190;
-    out[18usize] = v199;
-    out[19usize] = v205;
-    out[20usize] = v211;
-    out[21usize] = v225;
-    out[22usize] = v228;
-    out[23usize] = v231;
-    out[24usize] = v235;
-    out[25usize] = v237;
-    out[26usize] = v239;
-    out[27usize] = v246;
-    out[28usize] = v251;
-    out[29usize] = v256;
-    out[30usize] = v267;
-    out[31usize] = v274;
-    out[32usize] = v281;
-    out[33usize] = v298;
-    out[34usize] = v304;
-    out[35usize] = v310;
-    out[36usize] = v329;
-    out[37usize] = v332;
-    out[38usize] = v335;
-    out[39usize] = v338;
-    out[40usize] = v341;
-    out[41usize] = v344;
-    out[42usize] = v346;
-    out[43usize] = v352;
-    out[44usize] = v353;
-    out[45usize] = v358;
-    out[46usize] = v361;
-    out[47usize] = v365;
-    out[48usize] = v374;
-    out[49usize] = v380;
-    out[50usize] = v387;
-    out[51usize] = v393;
-    out[52usize] = v396;
-    out[53usize] = v400;
-    out[54usize] = v405;
-    out[55usize] = v408;
-    out[56usize] = v412;
-    out[57usize] = v416;
-    out[58usize] = v417;
-    out[59usize] = v419;
-    out[60usize] = v427;
-    out[61usize] = v432;
-    out[62usize] = v437;
-    out[63usize] = v442;
-    out[64usize] = v443;
-    out[65usize] = v445;
-    out[66usize] = v450;
-    out[67usize] = v453;
-    out[68usize] = v456;
-    out[69usize] = v458;
-    out[70usize] = v459;
-    out[71usize] = v460;
-    out[72usize] = v467;
-    out[73usize] = v472;
-    out[74usize] = v477;
-    out[75usize] = v479;
-    out[76usize] = v480;
-    out[77usize] = v481;
-    out[78usize] = v485;
-    out[79usize] = v488;
-    out[80usize] = v491;
-    out[81usize] = 0f64;
-    out[82usize] = 0f64;
-    out[83usize] = 0f64;
-    out[84usize] = v495;
-    out[85usize] = v459;
-    out[86usize] = v460;
-    out[87usize] = 0f64;
-    out[88usize] = 0f64;
-    out[89usize] = 0f64;
-    out[90usize] = v496;
-    out[91usize] = v499;
-    out[92usize] = v502;
-    out[93usize] = 0f64;
-    out[94usize] = 0f64;
-    out[95usize] = 0f64;
-    out[96usize] = v358;
-    out[97usize] = v504;
-    out[98usize] = v365;
-    out[99usize] = 0f64;
-    out[100usize] = 0f64;
-    out[101usize] = 0f64;
-    out[102usize] = v505;
-    out[103usize] = v506;
-    out[104usize] = v509;
-    out[105usize] = 0f64;
-    out[106usize] = 0f64;
-    out[107usize] = 0f64;
-    out[108usize] = v416;
-    out[109usize] = v417;
-    out[110usize] = v511;
-    out[111usize] = 0f64;
-    out[112usize] = 0f64;
-    out[113usize] = 0f64;
-    out[114usize] = v512;
-    out[115usize] = v513;
-    out[116usize] = v514;
-    out[117usize] = 0f64;
-    out[118usize] = 0f64;
-    out[119usize] = 0f64;
-    out[120usize] = 0f64;
-    out[121usize] = 0f64;
-    out[122usize] = 0f64;
-    out[123usize] = 0f64;
-    out[124usize] = 0f64;
-    out[125usize] = 0f64;
-    out[126usize] = 0f64;
-    out[127usize] = 0f64;
-    out[128usize] = 0f64;
+    let v283: f64 = c[2][0];
+    let v289: f64 = c[1][0];
+    let v291: f64 = c[3][0];
+    let v312: f64 = c[2][1];
+    let v314: f64 = c[3][1];
+    let v324: f64 = c[1][1];
+    let v285 = 0.0625f64 * q[0];
+    let v286 = 0.0625f64 * q[1];
+    let v287 = v286 * qd[0];
+    let v288 = v285.mul_add(qd[1], -v287);
+    let v290 = v91 * v289;
+    let v292 = 0.0625f64 * q[2];
+    let v293 = v285 * qd[0];
+    let v294 = v292.mul_add(qd[2], v293);
+    let v295 = v286.mul_add(qd[1], v294);
+    let v296 = v48 * v291;
+    let v297 = v283.mul_add(v288, v290);
+    let v298 = v296.mul_add(v295, v297);
+    let v299 = v292 * qd[1];
+    let v300 = v286.mul_add(qd[2], -v299);
+    let v301 = v123 * v289;
+    let v302 = v15 * v291;
+    let v303 = v283.mul_add(v300, v301);
+    let v304 = v302.mul_add(v295, v303);
+    let v305 = v285 * qd[2];
+    let v306 = v292.mul_add(qd[0], -v305);
+    let v307 = v107 * v289;
+    let v308 = v23 * v291;
+    let v309 = v283.mul_add(v306, v307);
+    let v310 = v308.mul_add(v295, v309);
+    let v311 = 0.25f64 * v77;
+    let v313 = v311 * v312;
+    let v315 = v311 * v314;
+    let v316 = 0.25f64 * v295;
+    let v317 = 0.0625f64 * v139;
+    let v318 = 0.0625f64.mul_add(v138, v317);
+    let v319 = 0.0625f64.mul_add(v141, v318);
+    let v320 = 0.25f64 * v291;
+    let v321 = v320 * v319;
+    let v322 = v316.mul_add(v315, v321);
+    let v323 = q[2] * v322;
+    let v325 = v311 * v324;
+    let v326 = 0.25f64 * v325;
+    let v327 = v320.mul_add(v295, v326);
+    let v328 = v288.mul_add(v313, v323);
+    let v329 = qd[2].mul_add(v327, v328);
+    let v330 = q[0] * v322;
+    let v331 = v300.mul_add(v313, v330);
+    let v332 = qd[0].mul_add(v327, v331);
+    let v333 = q[1] * v322;
+    let v334 = v306.mul_add(v313, v333);
+    let v335 = qd[1].mul_add(v327, v334);
+    let v337 = 0.0625f64.mul_add(v8, -v282);
+    let v338 = v283.mul_add(v337, 1f64);
+    let v339 = v285 * q[2];
+    let v340 = v339 * v283;
+    let v341 = v23.mul_add(v289, v340);
+    let v342 = v286 * q[2];
+    let v343 = v15 * v289;
+    let v344 = v342.mul_add(v283, -v343);
+    let v346 = 0.5f64 * p[1];
+    let v348 = 0.25f64 * p[3];
+    let v350 = p[2] - v348;
+    let v352 = 0.125f64.mul_add(v350, v348);
+    let v353 = 0.5f64 * p[3];
+    let v354 = v23 * v13;
+    let v355 = 0.125f64 * q[0];
+    let v356 = v355 * q[2];
+    let v357 = v356 * v47;
+    let v358 = v357 - v354;
+    let v359 = 0.5f64 * v18;
+    let v360 = 0.125f64 * v1;
+    let v361 = v360.mul_add(v47, v359);
+    let v362 = v48 * v13;
+    let v363 = v355 * q[1];
+    let v364 = v363 * v47;
+    let v365 = v362 + v364;
+    let v366 = v78 * v26;
+    let v367 = v80 * v13;
+    let v368 = v88 * v26;
+    let v369 = 0.125f64 * q[2];
+    let v370 = v42 * v26;
+    let v371 = v369.mul_add(q[4], -v370);
+    let v372 = v46.mul_add(v366, v367);
+    let v373 = v53.mul_add(v368, v372);
+    let v374 = v47.mul_add(v371, v373);
+    let v375 = v60 * v368;
+    let v376 = 0.5f64 * v51;
+    let v377 = (-0.5f64).mul_add(v26, v355);
+    let v378 = q[4].mul_add(v377, v376);
+    let v379 = v58.mul_add(v366, v375);
+    let v380 = v47.mul_add(v378, v379);
+    let v381 = v232 * v13;
+    let v382 = 0.125f64 * q[1];
+    let v383 = v63 * v26;
+    let v384 = v382.mul_add(q[4], -v383);
+    let v385 = v65.mul_add(v366, -v381);
+    let v386 = v67.mul_add(v368, v385);
+    let v387 = v47.mul_add(v384, v386);
+    let v388 = v286 * v283;
+    let v390 = 0.015625f64 * q[0];
+    let v391 = v390 * q[2];
+    let v392 = v391 * v291;
+    let v393 = v392 - v388;
+    let v394 = 0.25f64 * v289;
+    let v395 = 0.015625f64 * v1;
+    let v396 = v395.mul_add(v291, v394);
+    let v397 = v292 * v283;
+    let v398 = v390 * q[1];
+    let v399 = v398 * v291;
+    let v400 = v397 + v399;
+    let v401 = v80 * v47;
+    let v402 = v241 * v26;
+    let v403 = v46.mul_add(v368, v401);
+    let v404 = v53.mul_add(v402, v403);
+    let v405 = v233.mul_add(v371, v404);
+    let v406 = v60 * v402;
+    let v407 = v58.mul_add(v368, v406);
+    let v408 = v233.mul_add(v378, v407);
+    let v409 = v232 * v47;
+    let v410 = v65.mul_add(v368, -v409);
+    let v411 = v67.mul_add(v402, v410);
+    let v412 = v233.mul_add(v384, v411);
+    let v413 = v15 * v13;
+    let v414 = v382 * q[2];
+    let v415 = v414 * v47;
+    let v416 = v413 + v415;
+    let v417 = v364 - v362;
+    let v418 = 0.125f64 * v5;
+    let v419 = v418.mul_add(v47, v359);
+    let v420 = v78 * v20;
+    let v421 = v83 * v13;
+    let v422 = v88 * v20;
+    let v423 = v42 * v20;
+    let v424 = v369.mul_add(q[5], -v423);
+    let v425 = v46.mul_add(v420, -v421);
+    let v426 = v53.mul_add(v422, v425);
+    let v427 = v47.mul_add(v424, v426);
+    let v428 = v56 * v20;
+    let v429 = v355.mul_add(q[5], -v428);
+    let v430 = v58.mul_add(v420, v381);
+    let v431 = v60.mul_add(v422, v430);
+    let v432 = v47.mul_add(v429, v431);
+    let v433 = v67 * v422;
+    let v434 = (-0.5f64).mul_add(v20, v382);
+    let v435 = q[5].mul_add(v434, v376);
+    let v436 = v65.mul_add(v420, v433);
+    let v437 = v47.mul_add(v435, v436);
+    let v438 = v285 * v283;
+    let v439 = 0.015625f64 * q[1];
+    let v440 = v439 * q[2];
+    let v441 = v440 * v291;
+    let v442 = v438 + v441;
+    let v443 = v399 - v397;
+    let v444 = 0.015625f64 * v5;
+    let v445 = v444.mul_add(v291, v394);
+    let v446 = v83 * v47;
+    let v447 = v241 * v20;
+    let v448 = v46.mul_add(v422, -v446);
+    let v449 = v53.mul_add(v447, v448);
+    let v450 = v233.mul_add(v424, v449);
+    let v451 = v58.mul_add(v422, v409);
+    let v452 = v60.mul_add(v447, v451);
+    let v453 = v233.mul_add(v429, v452);
+    let v454 = v67 * v447;
+    let v455 = v65.mul_add(v422, v454);
+    let v456 = v233.mul_add(v435, v455);
+    let v457 = 0.125f64 * v8;
+    let v458 = v457.mul_add(v47, v359);
+    let v459 = v354 + v357;
+    let v460 = v415 - v413;
+    let v461 = v78 * v33;
+    let v462 = v88 * v33;
+    let v463 = v53 * v462;
+    let v464 = (-0.5f64).mul_add(v33, v369);
+    let v465 = v41.mul_add(v464, v376);
+    let v466 = v46.mul_add(v461, v463);
+    let v467 = v47.mul_add(v465, v466);
+    let v468 = v56 * v33;
+    let v469 = v355.mul_add(v41, -v468);
+    let v470 = v58.mul_add(v461, -v367);
+    let v471 = v60.mul_add(v462, v470);
+    let v472 = v47.mul_add(v469, v471);
+    let v473 = v63 * v33;
+    let v474 = v382.mul_add(v41, -v473);
+    let v475 = v65.mul_add(v461, v421);
+    let v476 = v67.mul_add(v462, v475);
+    let v477 = v47.mul_add(v474, v476);
+    let v478 = 0.015625f64 * v8;
+    let v479 = v478.mul_add(v291, v394);
+    let v480 = v388 + v392;
+    let v481 = v441 - v438;
+    let v482 = v241 * v33;
+    let v483 = v53 * v482;
+    let v484 = v46.mul_add(v462, v483);
+    let v485 = v233.mul_add(v465, v484);
+    let v486 = v58.mul_add(v462, -v401);
+    let v487 = v60.mul_add(v482, v486);
+    let v488 = v233.mul_add(v469, v487);
+    let v489 = v65.mul_add(v462, v446);
+    let v490 = v67.mul_add(v482, v489);
+    let v491 = v233.mul_add(v474, v490);
+    let v493 = 0.5f64 * v11;
+    let v494 = v457 - v493;
+    let v495 = v47.mul_add(v494, 0.5f64);
+    let v496 = v233.mul_add(v494, 0.25f64);
+    let v497 = v23 * v47;
+    let v498 = v356 * v233;
+    let v499 = v497 + v498;
+    let v500 = v15 * v47;
+    let v501 = v414 * v233;
+    let v502 = v501 - v500;
+    let v503 = v360 - v493;
+    let v504 = v47.mul_add(v503, 0.5f64);
+    let v505 = v498 - v497;
+    let v506 = v233.mul_add(v503, 0.25f64);
+    let v507 = v48 * v47;
+    let v508 = v363 * v233;
+    let v509 = v507 + v508;
+    let v510 = v418 - v493;
+    let v511 = v47.mul_add(v510, 0.5f64);
+    let v512 = v500 + v501;
+    let v513 = v508 - v507;
+    let v514 = v233.mul_add(v510, 0.25f64);
+    out[0] = v14;
+    out[1] = v22;
+    out[2] = v28;
+    out[3] = v29;
+    out[4] = v30;
+    out[5] = v35;
+    out[6] = v36;
+    out[7] = v37;
+    out[8] = v38;
+    out[9] = v55;
+    out[10] = v62;
+    out[11] = v69;
+    out[12] = v105;
+    out[13] = v120;
+    out[14] = v135;
+    out[15] = v166;
+    out[16] = v178;
+    out[17] = v190;
+    out[18] = v199;
+    out[19] = v205;
+    out[20] = v211;
+    out[21] = v225;
+    out[22] = v228;
+    out[23] = v231;
+    out[24] = v235;
+    out[25] = v237;
+    out[26] = v239;
+    out[27] = v246;
+    out[28] = v251;
+    out[29] = v256;
+    out[30] = v267;
+    out[31] = v274;
+    out[32] = v281;
+    out[33] = v298;
+    out[34] = v304;
+    out[35] = v310;
+    out[36] = v329;
+    out[37] = v332;
+    out[38] = v335;
+    out[39] = v338;
+    out[40] = v341;
+    out[41] = v344;
+    out[42] = v346;
+    out[43] = v352;
+    out[44] = v353;
+    out[45] = v358;
+    out[46] = v361;
+    out[47] = v365;
+    out[48] = v374;
+    out[49] = v380;
+    out[50] = v387;
+    out[51] = v393;
+    out[52] = v396;
+    out[53] = v400;
+    out[54] = v405;
+    out[55] = v408;
+    out[56] = v412;
+    out[57] = v416;
+    out[58] = v417;
+    out[59] = v419;
+    out[60] = v427;
+    out[61] = v432;
+    out[62] = v437;
+    out[63] = v442;
+    out[64] = v443;
+    out[65] = v445;
+    out[66] = v450;
+    out[67] = v453;
+    out[68] = v456;
+    out[69] = v458;
+    out[70] = v459;
+    out[71] = v460;
+    out[72] = v467;
+    out[73] = v472;
+    out[74] = v477;
+    out[75] = v479;
+    out[76] = v480;
+    out[77] = v481;
+    out[78] = v485;
+    out[79] = v488;
+    out[80] = v491;
+    out[81] = 0f64;
+    out[82] = 0f64;
+    out[83] = 0f64;
+    out[84] = v495;
+    out[85] = v459;
+    out[86] = v460;
+    out[87] = 0f64;
+    out[88] = 0f64;
+    out[89] = 0f64;
+    out[90] = v496;
+    out[91] = v499;
+    out[92] = v502;
+    out[93] = 0f64;
+    out[94] = 0f64;
+    out[95] = 0f64;
+    out[96] = v358;
+    out[97] = v504;
+    out[98] = v365;
+    out[99] = 0f64;
+    out[100] = 0f64;
+    out[101] = 0f64;
+    out[102] = v505;
+    out[103] = v506;
+    out[104] = v509;
+    out[105] = 0f64;
+    out[106] = 0f64;
+    out[107] = 0f64;
+    out[108] = v416;
+    out[109] = v417;
+    out[110] = v511;
+    out[111] = 0f64;
+    out[112] = 0f64;
+    out[113] = 0f64;
+    out[114] = v512;
+    out[115] = v513;
+    out[116] = v514;
+    out[117] = 0f64;
+    out[118] = 0f64;
+    out[119] = 0f64;
+    out[120] = 0f64;
+    out[121] = 0f64;
+    out[122] = 0f64;
+    out[123] = 0f64;
+    out[124] = 0f64;
+    out[125] = 0f64;
+    out[126] = 0f64;
+    out[127] = 0f64;
+    out[128] = 0f64;
 }
 /// Kernel `cell_0_x4`: 731 operations, four evaluations in vector lanes.
 #[cfg(target_arch = "x86_64")]
@@ -2446,928 +2438,697 @@ fn cell_0_0(
 #[allow(unused_variables, unused_parens, clippy::all)]
 #[target_feature(enable = "avx,fma")]
 fn cell_0_x4(
-    q: &[[f64; 4]; 6usize],
-    qd: &[[f64; 4]; 6usize],
-    p: &[[f64; 4]; 15usize],
-    out: &mut [[f64; 4]; 129usize],
+    q: &[[f64; 4]; 6],
+    qd: &[[f64; 4]; 6],
+    p: &[[f64; 4]; 15],
+    out: &mut [[f64; 4]; 129],
 ) {
     use std::arch::x86_64::*;
-    let v1: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0usize]),
-        runtime::lanes::from_array(q[0usize]),
+    let v1 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[0]),
+        runtime::lanes::from_array(q[0]),
     );
-    let v3: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v1);
-    let v5: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1usize]),
-        runtime::lanes::from_array(q[1usize]),
+    let v3 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v1);
+    let v5 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[1]),
+        runtime::lanes::from_array(q[1]),
     );
-    let v6: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v5);
-    let v8: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[2usize]),
-        runtime::lanes::from_array(q[2usize]),
+    let v6 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v5);
+    let v8 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[2]),
+        runtime::lanes::from_array(q[2]),
     );
-    let v9: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v8);
-    let v10: __m256d = _mm256_add_pd(v3, v6);
-    let v11: __m256d = _mm256_add_pd(v10, v9);
-    let c: [[__m256d; 3usize]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
-        3usize,
+    let v9 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v8);
+    let v10 = _mm256_add_pd(v3, v6);
+    let v11 = _mm256_add_pd(v10, v9);
+    let c: [[__m256d; 3]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
+        3,
     >(v11);
-    let v12: __m256d = c[0usize][0usize];
-    let v13: __m256d = c[2usize][0usize];
-    let v18: __m256d = c[1usize][0usize];
-    let v47: __m256d = c[3usize][0usize];
-    let v78: __m256d = c[2usize][1usize];
-    let v88: __m256d = c[3usize][1usize];
-    let v144: __m256d = c[2usize][2usize];
-    let v152: __m256d = c[3usize][2usize];
-    let v220: __m256d = c[1usize][1usize];
-    let v233: __m256d = c[4usize][0usize];
-    let v241: __m256d = c[4usize][1usize];
-    let v260: __m256d = c[4usize][2usize];
-    let v14: __m256d = _mm256_fmadd_pd(v9, v13, v12);
-    let v15: __m256d = _mm256_mul_pd(
+    let v12: __m256d = c[0][0];
+    let v13: __m256d = c[2][0];
+    let v18: __m256d = c[1][0];
+    let v47: __m256d = c[3][0];
+    let v78: __m256d = c[2][1];
+    let v88: __m256d = c[3][1];
+    let v144: __m256d = c[2][2];
+    let v152: __m256d = c[3][2];
+    let v220: __m256d = c[1][1];
+    let v233: __m256d = c[4][0];
+    let v241: __m256d = c[4][1];
+    let v260: __m256d = c[4][2];
+    let v14 = _mm256_fmadd_pd(v9, v13, v12);
+    let v15 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[0]));
+    let v16 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[2]));
+    let v17 = _mm256_mul_pd(v16, v13);
+    let v20 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[1]));
+    let v21 = _mm256_mul_pd(v20, v18);
+    let v22 = _mm256_sub_pd(v17, v21);
+    let v23 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[1]));
+    let v24 = _mm256_mul_pd(v23, runtime::lanes::from_array(q[2]));
+    let v25 = _mm256_mul_pd(v24, v13);
+    let v26 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[0]));
+    let v27 = _mm256_mul_pd(v26, v18);
+    let v28 = _mm256_add_pd(v25, v27);
+    let v29 = _mm256_add_pd(v17, v21);
+    let v30 = _mm256_fmadd_pd(v3, v13, v12);
+    let v31 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[1]));
+    let v32 = _mm256_mul_pd(v31, v13);
+    let v33 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[2]));
+    let v34 = _mm256_mul_pd(v33, v18);
+    let v35 = _mm256_sub_pd(v32, v34);
+    let v36 = _mm256_sub_pd(v25, v27);
+    let v37 = _mm256_add_pd(v32, v34);
+    let v38 = _mm256_fmadd_pd(v6, v13, v12);
+    let v41 = _mm256_add_pd(
+        runtime::lanes::from_array(q[3]),
+        runtime::lanes::from_array(p[0]),
+    );
+    let v42 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v41);
+    let v45 = _mm256_mul_pd(v23, runtime::lanes::from_array(q[4]));
+    let v46 = _mm256_fmsub_pd(v15, runtime::lanes::from_array(q[5]), v45);
+    let v48 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[2]));
+    let v49 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[4]));
+    let v50 = _mm256_fmadd_pd(v48, v41, v49);
+    let v51 = _mm256_fmadd_pd(v23, runtime::lanes::from_array(q[5]), v50);
+    let v52 = _mm256_mul_pd(v42, v11);
+    let v53 = _mm256_fmsub_pd(v33, v51, v52);
+    let v54 = _mm256_fmadd_pd(v13, v46, v42);
+    let v55 = _mm256_fmadd_pd(v47, v53, v54);
+    let v56 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[4]));
+    let v57 = _mm256_mul_pd(v48, runtime::lanes::from_array(q[5]));
+    let v58 = _mm256_fmsub_pd(v23, v41, v57);
+    let v59 = _mm256_mul_pd(v56, v11);
+    let v60 = _mm256_fmsub_pd(v26, v51, v59);
+    let v61 = _mm256_fmadd_pd(v13, v58, v56);
+    let v62 = _mm256_fmadd_pd(v47, v60, v61);
+    let v63 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[5]));
+    let v64 = _mm256_mul_pd(v15, v41);
+    let v65 = _mm256_fmsub_pd(v48, runtime::lanes::from_array(q[4]), v64);
+    let v66 = _mm256_mul_pd(v63, v11);
+    let v67 = _mm256_fmsub_pd(v20, v51, v66);
+    let v68 = _mm256_fmadd_pd(v13, v65, v63);
+    let v69 = _mm256_fmadd_pd(v47, v67, v68);
+    let v71 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[3]));
+    let v74 = _mm256_mul_pd(v26, runtime::lanes::from_array(qd[0]));
+    let v76 = _mm256_fmadd_pd(v33, runtime::lanes::from_array(qd[2]), v74);
+    let v77 = _mm256_fmadd_pd(v20, runtime::lanes::from_array(qd[1]), v76);
+    let v79 = _mm256_mul_pd(v77, v78);
+    let v80 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[5]));
+    let v82 = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[5]));
+    let v83 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[4]));
+    let v85 = _mm256_fmadd_pd(v80, runtime::lanes::from_array(qd[0]), v82);
+    let v86 = _mm256_fnmadd_pd(v83, runtime::lanes::from_array(qd[1]), v85);
+    let v87 = _mm256_fnmadd_pd(v23, runtime::lanes::from_array(qd[4]), v86);
+    let v89 = _mm256_mul_pd(v77, v88);
+    let v90 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[2]));
+    let v91 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[2]));
+    let v92 = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[3]));
+    let v93 = _mm256_fmadd_pd(v91, v41, v92);
+    let v94 = _mm256_fmadd_pd(v83, runtime::lanes::from_array(qd[0]), v93);
+    let v95 = _mm256_fmadd_pd(v15, runtime::lanes::from_array(qd[4]), v94);
+    let v96 = _mm256_fmadd_pd(v80, runtime::lanes::from_array(qd[1]), v95);
+    let v97 = _mm256_fmadd_pd(v23, runtime::lanes::from_array(qd[5]), v96);
+    let v98 = _mm256_mul_pd(v33, v97);
+    let v99 = _mm256_fmadd_pd(v90, v51, v98);
+    let v100 = _mm256_fnmadd_pd(v71, v11, v99);
+    let v101 = _mm256_fnmadd_pd(v42, v77, v100);
+    let v102 = _mm256_fmadd_pd(v46, v79, v71);
+    let v103 = _mm256_fmadd_pd(v13, v87, v102);
+    let v104 = _mm256_fmadd_pd(v53, v89, v103);
+    let v105 = _mm256_fmadd_pd(v47, v101, v104);
+    let v106 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[4]));
+    let v107 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[1]));
+    let v108 = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[3]));
+    let v109 = _mm256_fmadd_pd(v107, v41, v108);
+    let v110 = _mm256_fnmadd_pd(v80, runtime::lanes::from_array(qd[2]), v109);
+    let v111 = _mm256_fnmadd_pd(v48, runtime::lanes::from_array(qd[5]), v110);
+    let v112 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[0]));
+    let v113 = _mm256_mul_pd(v26, v97);
+    let v114 = _mm256_fmadd_pd(v112, v51, v113);
+    let v115 = _mm256_fnmadd_pd(v106, v11, v114);
+    let v116 = _mm256_fnmadd_pd(v56, v77, v115);
+    let v117 = _mm256_fmadd_pd(v58, v79, v106);
+    let v118 = _mm256_fmadd_pd(v13, v111, v117);
+    let v119 = _mm256_fmadd_pd(v60, v89, v118);
+    let v120 = _mm256_fmadd_pd(v47, v116, v119);
+    let v121 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[5]));
+    let v122 = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[4]));
+    let v123 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[0]));
+    let v124 = _mm256_fmadd_pd(v83, runtime::lanes::from_array(qd[2]), v122);
+    let v125 = _mm256_fnmadd_pd(v123, v41, v124);
+    let v126 = _mm256_fnmadd_pd(v15, runtime::lanes::from_array(qd[3]), v125);
+    let v127 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[1]));
+    let v128 = _mm256_mul_pd(v20, v97);
+    let v129 = _mm256_fmadd_pd(v127, v51, v128);
+    let v130 = _mm256_fnmadd_pd(v121, v11, v129);
+    let v131 = _mm256_fnmadd_pd(v63, v77, v130);
+    let v132 = _mm256_fmadd_pd(v65, v79, v121);
+    let v133 = _mm256_fmadd_pd(v13, v126, v132);
+    let v134 = _mm256_fmadd_pd(v67, v89, v133);
+    let v135 = _mm256_fmadd_pd(v47, v131, v134);
+    let v137 = _mm256_mul_pd(_mm256_set1_pd(2f64), v79);
+    let v138 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[0]),
+        runtime::lanes::from_array(qd[0]),
+    );
+    let v139 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[1]),
+        runtime::lanes::from_array(qd[1]),
+    );
+    let v140 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v139);
+    let v141 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[2]),
+        runtime::lanes::from_array(qd[2]),
+    );
+    let v142 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v138, v140);
+    let v143 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v141, v142);
+    let v145 = _mm256_mul_pd(v77, v77);
+    let v146 = _mm256_mul_pd(v144, v145);
+    let v147 = _mm256_fmadd_pd(v78, v143, v146);
+    let v148 = _mm256_mul_pd(v46, v147);
+    let v149 = _mm256_mul_pd(v127, runtime::lanes::from_array(qd[4]));
+    let v150 = _mm256_fmsub_pd(v112, runtime::lanes::from_array(qd[5]), v149);
+    let v151 = _mm256_mul_pd(_mm256_set1_pd(2f64), v89);
+    let v153 = _mm256_mul_pd(v145, v152);
+    let v154 = _mm256_fmadd_pd(v88, v143, v153);
+    let v155 = _mm256_mul_pd(v112, runtime::lanes::from_array(qd[4]));
+    let v156 = _mm256_fmadd_pd(v90, runtime::lanes::from_array(qd[3]), v155);
+    let v157 = _mm256_fmadd_pd(v127, runtime::lanes::from_array(qd[5]), v156);
+    let v158 = _mm256_mul_pd(v33, v157);
+    let v159 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v97, v158);
+    let v160 = _mm256_fnmadd_pd(runtime::lanes::from_array(qd[3]), v77, v159);
+    let v161 = _mm256_fnmadd_pd(v42, v143, v160);
+    let v162 = _mm256_fmadd_pd(v137, v87, v148);
+    let v163 = _mm256_fmadd_pd(v13, v150, v162);
+    let v164 = _mm256_fmadd_pd(v151, v101, v163);
+    let v165 = _mm256_fmadd_pd(v53, v154, v164);
+    let v166 = _mm256_fmadd_pd(v47, v161, v165);
+    let v167 = _mm256_mul_pd(v58, v147);
+    let v168 = _mm256_mul_pd(v90, runtime::lanes::from_array(qd[5]));
+    let v169 = _mm256_fmsub_pd(v127, runtime::lanes::from_array(qd[3]), v168);
+    let v170 = _mm256_mul_pd(v26, v157);
+    let v171 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v97, v170);
+    let v172 = _mm256_fnmadd_pd(runtime::lanes::from_array(qd[4]), v77, v171);
+    let v173 = _mm256_fnmadd_pd(v56, v143, v172);
+    let v174 = _mm256_fmadd_pd(v137, v111, v167);
+    let v175 = _mm256_fmadd_pd(v13, v169, v174);
+    let v176 = _mm256_fmadd_pd(v151, v116, v175);
+    let v177 = _mm256_fmadd_pd(v60, v154, v176);
+    let v178 = _mm256_fmadd_pd(v47, v173, v177);
+    let v179 = _mm256_mul_pd(v65, v147);
+    let v180 = _mm256_mul_pd(v112, runtime::lanes::from_array(qd[3]));
+    let v181 = _mm256_fmsub_pd(v90, runtime::lanes::from_array(qd[4]), v180);
+    let v182 = _mm256_mul_pd(v20, v157);
+    let v183 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v97, v182);
+    let v184 = _mm256_fnmadd_pd(runtime::lanes::from_array(qd[5]), v77, v183);
+    let v185 = _mm256_fnmadd_pd(v63, v143, v184);
+    let v186 = _mm256_fmadd_pd(v137, v126, v179);
+    let v187 = _mm256_fmadd_pd(v13, v181, v186);
+    let v188 = _mm256_fmadd_pd(v151, v131, v187);
+    let v189 = _mm256_fmadd_pd(v67, v154, v188);
+    let v190 = _mm256_fmadd_pd(v47, v185, v189);
+    let v191 = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[0]));
+    let v192 = _mm256_fmsub_pd(v15, runtime::lanes::from_array(qd[1]), v191);
+    let v193 = _mm256_mul_pd(v90, v18);
+    let v194 = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[0]));
+    let v195 = _mm256_fmadd_pd(v48, runtime::lanes::from_array(qd[2]), v194);
+    let v196 = _mm256_fmadd_pd(v23, runtime::lanes::from_array(qd[1]), v195);
+    let v197 = _mm256_mul_pd(v33, v47);
+    let v198 = _mm256_fmadd_pd(v13, v192, v193);
+    let v199 = _mm256_fmadd_pd(v197, v196, v198);
+    let v200 = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[1]));
+    let v201 = _mm256_fmsub_pd(v23, runtime::lanes::from_array(qd[2]), v200);
+    let v202 = _mm256_mul_pd(v112, v18);
+    let v203 = _mm256_mul_pd(v26, v47);
+    let v204 = _mm256_fmadd_pd(v13, v201, v202);
+    let v205 = _mm256_fmadd_pd(v203, v196, v204);
+    let v206 = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[2]));
+    let v207 = _mm256_fmsub_pd(v48, runtime::lanes::from_array(qd[0]), v206);
+    let v208 = _mm256_mul_pd(v127, v18);
+    let v209 = _mm256_mul_pd(v20, v47);
+    let v210 = _mm256_fmadd_pd(v13, v207, v208);
+    let v211 = _mm256_fmadd_pd(v209, v196, v210);
+    let v212 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v196);
+    let v213 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v139);
+    let v214 = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v138, v213);
+    let v215 = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v141, v214);
+    let v216 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v47);
+    let v217 = _mm256_mul_pd(v216, v215);
+    let v218 = _mm256_fmadd_pd(v212, v89, v217);
+    let v219 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v218);
+    let v221 = _mm256_mul_pd(v77, v220);
+    let v222 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v221);
+    let v223 = _mm256_fmadd_pd(v216, v196, v222);
+    let v224 = _mm256_fmadd_pd(v192, v79, v219);
+    let v225 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v223, v224);
+    let v226 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v218);
+    let v227 = _mm256_fmadd_pd(v201, v79, v226);
+    let v228 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v223, v227);
+    let v229 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v218);
+    let v230 = _mm256_fmadd_pd(v207, v79, v229);
+    let v231 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v223, v230);
+    let v232 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v41);
+    let v234 = _mm256_fmadd_pd(v47, v46, v232);
+    let v235 = _mm256_fmadd_pd(v233, v53, v234);
+    let v236 = _mm256_fmadd_pd(v47, v58, v83);
+    let v237 = _mm256_fmadd_pd(v233, v60, v236);
+    let v238 = _mm256_fmadd_pd(v47, v65, v80);
+    let v239 = _mm256_fmadd_pd(v233, v67, v238);
+    let v240 = _mm256_mul_pd(v46, v89);
+    let v242 = _mm256_mul_pd(v77, v241);
+    let v243 = _mm256_fmadd_pd(
         _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[0usize]),
-    );
-    let v16: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(q[2usize]));
-    let v17: __m256d = _mm256_mul_pd(v16, v13);
-    let v20: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[1usize]),
-    );
-    let v21: __m256d = _mm256_mul_pd(v20, v18);
-    let v22: __m256d = _mm256_sub_pd(v17, v21);
-    let v23: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[1usize]),
-    );
-    let v24: __m256d = _mm256_mul_pd(v23, runtime::lanes::from_array(q[2usize]));
-    let v25: __m256d = _mm256_mul_pd(v24, v13);
-    let v26: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[0usize]),
-    );
-    let v27: __m256d = _mm256_mul_pd(v26, v18);
-    let v28: __m256d = _mm256_add_pd(v25, v27);
-    let v29: __m256d = _mm256_add_pd(v17, v21);
-    let v30: __m256d = _mm256_fmadd_pd(v3, v13, v12);
-    let v31: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(q[1usize]));
-    let v32: __m256d = _mm256_mul_pd(v31, v13);
-    let v33: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[2usize]),
-    );
-    let v34: __m256d = _mm256_mul_pd(v33, v18);
-    let v35: __m256d = _mm256_sub_pd(v32, v34);
-    let v36: __m256d = _mm256_sub_pd(v25, v27);
-    let v37: __m256d = _mm256_add_pd(v32, v34);
-    let v38: __m256d = _mm256_fmadd_pd(v6, v13, v12);
-    let v41: __m256d = _mm256_add_pd(
-        runtime::lanes::from_array(q[3usize]),
-        runtime::lanes::from_array(p[0usize]),
-    );
-    let v42: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v41);
-    let v45: __m256d = _mm256_mul_pd(v23, runtime::lanes::from_array(q[4usize]));
-    let v46: __m256d = _mm256_fmsub_pd(v15, runtime::lanes::from_array(q[5usize]), v45);
-    let v48: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[2usize]),
-    );
-    let v49: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(q[4usize]));
-    let v50: __m256d = _mm256_fmadd_pd(v48, v41, v49);
-    let v51: __m256d = _mm256_fmadd_pd(v23, runtime::lanes::from_array(q[5usize]), v50);
-    let v52: __m256d = _mm256_mul_pd(v42, v11);
-    let v53: __m256d = _mm256_fmsub_pd(v33, v51, v52);
-    let v54: __m256d = _mm256_fmadd_pd(v13, v46, v42);
-    let v55: __m256d = _mm256_fmadd_pd(v47, v53, v54);
-    let v56: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[4usize]),
-    );
-    let v57: __m256d = _mm256_mul_pd(v48, runtime::lanes::from_array(q[5usize]));
-    let v58: __m256d = _mm256_fmsub_pd(v23, v41, v57);
-    let v59: __m256d = _mm256_mul_pd(v56, v11);
-    let v60: __m256d = _mm256_fmsub_pd(v26, v51, v59);
-    let v61: __m256d = _mm256_fmadd_pd(v13, v58, v56);
-    let v62: __m256d = _mm256_fmadd_pd(v47, v60, v61);
-    let v63: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[5usize]),
-    );
-    let v64: __m256d = _mm256_mul_pd(v15, v41);
-    let v65: __m256d = _mm256_fmsub_pd(v48, runtime::lanes::from_array(q[4usize]), v64);
-    let v66: __m256d = _mm256_mul_pd(v63, v11);
-    let v67: __m256d = _mm256_fmsub_pd(v20, v51, v66);
-    let v68: __m256d = _mm256_fmadd_pd(v13, v65, v63);
-    let v69: __m256d = _mm256_fmadd_pd(v47, v67, v68);
-    let v71: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[3usize]),
-    );
-    let v74: __m256d = _mm256_mul_pd(v26, runtime::lanes::from_array(qd[0usize]));
-    let v76: __m256d = _mm256_fmadd_pd(v33, runtime::lanes::from_array(qd[2usize]), v74);
-    let v77: __m256d = _mm256_fmadd_pd(v20, runtime::lanes::from_array(qd[1usize]), v76);
-    let v79: __m256d = _mm256_mul_pd(v77, v78);
-    let v80: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[5usize]),
-    );
-    let v82: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[5usize]));
-    let v83: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[4usize]),
-    );
-    let v85: __m256d = _mm256_fmadd_pd(v80, runtime::lanes::from_array(qd[0usize]), v82);
-    let v86: __m256d = _mm256_fnmadd_pd(
-        v83,
-        runtime::lanes::from_array(qd[1usize]),
-        v85,
-    );
-    let v87: __m256d = _mm256_fnmadd_pd(
-        v23,
-        runtime::lanes::from_array(qd[4usize]),
-        v86,
-    );
-    let v89: __m256d = _mm256_mul_pd(v77, v88);
-    let v90: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[2usize]),
-    );
-    let v91: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[2usize]),
-    );
-    let v92: __m256d = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[3usize]));
-    let v93: __m256d = _mm256_fmadd_pd(v91, v41, v92);
-    let v94: __m256d = _mm256_fmadd_pd(v83, runtime::lanes::from_array(qd[0usize]), v93);
-    let v95: __m256d = _mm256_fmadd_pd(v15, runtime::lanes::from_array(qd[4usize]), v94);
-    let v96: __m256d = _mm256_fmadd_pd(v80, runtime::lanes::from_array(qd[1usize]), v95);
-    let v97: __m256d = _mm256_fmadd_pd(v23, runtime::lanes::from_array(qd[5usize]), v96);
-    let v98: __m256d = _mm256_mul_pd(v33, v97);
-    let v99: __m256d = _mm256_fmadd_pd(v90, v51, v98);
-    let v100: __m256d = _mm256_fnmadd_pd(v71, v11, v99);
-    let v101: __m256d = _mm256_fnmadd_pd(v42, v77, v100);
-    let v102: __m256d = _mm256_fmadd_pd(v46, v79, v71);
-    let v103: __m256d = _mm256_fmadd_pd(v13, v87, v102);
-    let v104: __m256d = _mm256_fmadd_pd(v53, v89, v103);
-    let v105: __m256d = _mm256_fmadd_pd(v47, v101, v104);
-    let v106: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[4usize]),
-    );
-    let v107: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[1usize]),
-    );
-    let v108: __m256d = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[3usize]));
-    let v109: __m256d = _mm256_fmadd_pd(v107, v41, v108);
-    let v110: __m256d = _mm256_fnmadd_pd(
-        v80,
-        runtime::lanes::from_array(qd[2usize]),
-        v109,
-    );
-    let v111: __m256d = _mm256_fnmadd_pd(
-        v48,
-        runtime::lanes::from_array(qd[5usize]),
-        v110,
-    );
-    let v112: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[0usize]),
-    );
-    let v113: __m256d = _mm256_mul_pd(v26, v97);
-    let v114: __m256d = _mm256_fmadd_pd(v112, v51, v113);
-    let v115: __m256d = _mm256_fnmadd_pd(v106, v11, v114);
-    let v116: __m256d = _mm256_fnmadd_pd(v56, v77, v115);
-    let v117: __m256d = _mm256_fmadd_pd(v58, v79, v106);
-    let v118: __m256d = _mm256_fmadd_pd(v13, v111, v117);
-    let v119: __m256d = _mm256_fmadd_pd(v60, v89, v118);
-    let v120: __m256d = _mm256_fmadd_pd(v47, v116, v119);
-    let v121: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[5usize]),
-    );
-    let v122: __m256d = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[4usize]));
-    let v123: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[0usize]),
-    );
-    let v124: __m256d = _mm256_fmadd_pd(
-        v83,
-        runtime::lanes::from_array(qd[2usize]),
-        v122,
-    );
-    let v125: __m256d = _mm256_fnmadd_pd(v123, v41, v124);
-    let v126: __m256d = _mm256_fnmadd_pd(
-        v15,
-        runtime::lanes::from_array(qd[3usize]),
-        v125,
-    );
-    let v127: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[1usize]),
-    );
-    let v128: __m256d = _mm256_mul_pd(v20, v97);
-    let v129: __m256d = _mm256_fmadd_pd(v127, v51, v128);
-    let v130: __m256d = _mm256_fnmadd_pd(v121, v11, v129);
-    let v131: __m256d = _mm256_fnmadd_pd(v63, v77, v130);
-    let v132: __m256d = _mm256_fmadd_pd(v65, v79, v121);
-    let v133: __m256d = _mm256_fmadd_pd(v13, v126, v132);
-    let v134: __m256d = _mm256_fmadd_pd(v67, v89, v133);
-    let v135: __m256d = _mm256_fmadd_pd(v47, v131, v134);
-    let v137: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v79);
-    let v138: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        runtime::lanes::from_array(qd[0usize]),
-    );
-    let v139: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        runtime::lanes::from_array(qd[1usize]),
-    );
-    let v140: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v139);
-    let v141: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        runtime::lanes::from_array(qd[2usize]),
-    );
-    let v142: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v138, v140);
-    let v143: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v141, v142);
-    let v145: __m256d = _mm256_mul_pd(v77, v77);
-    let v146: __m256d = _mm256_mul_pd(v144, v145);
-    let v147: __m256d = _mm256_fmadd_pd(v78, v143, v146);
-    let v148: __m256d = _mm256_mul_pd(v46, v147);
-    let v149: __m256d = _mm256_mul_pd(v127, runtime::lanes::from_array(qd[4usize]));
-    let v150: __m256d = _mm256_fmsub_pd(
-        v112,
-        runtime::lanes::from_array(qd[5usize]),
-        v149,
-    );
-    let v151: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v89);
-    let v153: __m256d = _mm256_mul_pd(v145, v152);
-    let v154: __m256d = _mm256_fmadd_pd(v88, v143, v153);
-    let v155: __m256d = _mm256_mul_pd(v112, runtime::lanes::from_array(qd[4usize]));
-    let v156: __m256d = _mm256_fmadd_pd(
-        v90,
-        runtime::lanes::from_array(qd[3usize]),
-        v155,
-    );
-    let v157: __m256d = _mm256_fmadd_pd(
-        v127,
-        runtime::lanes::from_array(qd[5usize]),
-        v156,
-    );
-    let v158: __m256d = _mm256_mul_pd(v33, v157);
-    let v159: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        v97,
-        v158,
-    );
-    let v160: __m256d = _mm256_fnmadd_pd(
-        runtime::lanes::from_array(qd[3usize]),
-        v77,
-        v159,
-    );
-    let v161: __m256d = _mm256_fnmadd_pd(v42, v143, v160);
-    let v162: __m256d = _mm256_fmadd_pd(v137, v87, v148);
-    let v163: __m256d = _mm256_fmadd_pd(v13, v150, v162);
-    let v164: __m256d = _mm256_fmadd_pd(v151, v101, v163);
-    let v165: __m256d = _mm256_fmadd_pd(v53, v154, v164);
-    let v166: __m256d = _mm256_fmadd_pd(v47, v161, v165);
-    let v167: __m256d = _mm256_mul_pd(v58, v147);
-    let v168: __m256d = _mm256_mul_pd(v90, runtime::lanes::from_array(qd[5usize]));
-    let v169: __m256d = _mm256_fmsub_pd(
-        v127,
-        runtime::lanes::from_array(qd[3usize]),
-        v168,
-    );
-    let v170: __m256d = _mm256_mul_pd(v26, v157);
-    let v171: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        v97,
-        v170,
-    );
-    let v172: __m256d = _mm256_fnmadd_pd(
-        runtime::lanes::from_array(qd[4usize]),
-        v77,
-        v171,
-    );
-    let v173: __m256d = _mm256_fnmadd_pd(v56, v143, v172);
-    let v174: __m256d = _mm256_fmadd_pd(v137, v111, v167);
-    let v175: __m256d = _mm256_fmadd_pd(v13, v169, v174);
-    let v176: __m256d = _mm256_fmadd_pd(v151, v116, v175);
-    let v177: __m256d = _mm256_fmadd_pd(v60, v154, v176);
-    let v178: __m256d = _mm256_fmadd_pd(v47, v173, v177);
-    let v179: __m256d = _mm256_mul_pd(v65, v147);
-    let v180: __m256d = _mm256_mul_pd(v112, runtime::lanes::from_array(qd[3usize]));
-    let v181: __m256d = _mm256_fmsub_pd(
-        v90,
-        runtime::lanes::from_array(qd[4usize]),
-        v180,
-    );
-    let v182: __m256d = _mm256_mul_pd(v20, v157);
-    let v183: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        v97,
-        v182,
-    );
-    let v184: __m256d = _mm256_fnmadd_pd(
-        runtime::lanes::from_array(qd[5usize]),
-        v77,
-        v183,
-    );
-    let v185: __m256d = _mm256_fnmadd_pd(v63, v143, v184);
-    let v186: __m256d = _mm256_fmadd_pd(v137, v126, v179);
-    let v187: __m256d = _mm256_fmadd_pd(v13, v181, v186);
-    let v188: __m256d = _mm256_fmadd_pd(v151, v131, v187);
-    let v189: __m256d = _mm256_fmadd_pd(v67, v154, v188);
-    let v190: __m256d = _mm256_fmadd_pd(v47, v185, v189);
-    let v191: __m256d = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[0usize]));
-    let v192: __m256d = _mm256_fmsub_pd(
-        v15,
-        runtime::lanes::from_array(qd[1usize]),
-        v191,
-    );
-    let v193: __m256d = _mm256_mul_pd(v90, v18);
-    let v194: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[0usize]));
-    let v195: __m256d = _mm256_fmadd_pd(
-        v48,
-        runtime::lanes::from_array(qd[2usize]),
-        v194,
-    );
-    let v196: __m256d = _mm256_fmadd_pd(
-        v23,
-        runtime::lanes::from_array(qd[1usize]),
-        v195,
-    );
-    let v197: __m256d = _mm256_mul_pd(v33, v47);
-    let v198: __m256d = _mm256_fmadd_pd(v13, v192, v193);
-    let v199: __m256d = _mm256_fmadd_pd(v197, v196, v198);
-    let v200: __m256d = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[1usize]));
-    let v201: __m256d = _mm256_fmsub_pd(
-        v23,
-        runtime::lanes::from_array(qd[2usize]),
-        v200,
-    );
-    let v202: __m256d = _mm256_mul_pd(v112, v18);
-    let v203: __m256d = _mm256_mul_pd(v26, v47);
-    let v204: __m256d = _mm256_fmadd_pd(v13, v201, v202);
-    let v205: __m256d = _mm256_fmadd_pd(v203, v196, v204);
-    let v206: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[2usize]));
-    let v207: __m256d = _mm256_fmsub_pd(
-        v48,
-        runtime::lanes::from_array(qd[0usize]),
-        v206,
-    );
-    let v208: __m256d = _mm256_mul_pd(v127, v18);
-    let v209: __m256d = _mm256_mul_pd(v20, v47);
-    let v210: __m256d = _mm256_fmadd_pd(v13, v207, v208);
-    let v211: __m256d = _mm256_fmadd_pd(v209, v196, v210);
-    let v212: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v196);
-    let v213: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v139);
-    let v214: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v138, v213);
-    let v215: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v141, v214);
-    let v216: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v47);
-    let v217: __m256d = _mm256_mul_pd(v216, v215);
-    let v218: __m256d = _mm256_fmadd_pd(v212, v89, v217);
-    let v219: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[2usize]), v218);
-    let v221: __m256d = _mm256_mul_pd(v77, v220);
-    let v222: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v221);
-    let v223: __m256d = _mm256_fmadd_pd(v216, v196, v222);
-    let v224: __m256d = _mm256_fmadd_pd(v192, v79, v219);
-    let v225: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        v223,
-        v224,
-    );
-    let v226: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[0usize]), v218);
-    let v227: __m256d = _mm256_fmadd_pd(v201, v79, v226);
-    let v228: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        v223,
-        v227,
-    );
-    let v229: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[1usize]), v218);
-    let v230: __m256d = _mm256_fmadd_pd(v207, v79, v229);
-    let v231: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        v223,
-        v230,
-    );
-    let v232: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v41);
-    let v234: __m256d = _mm256_fmadd_pd(v47, v46, v232);
-    let v235: __m256d = _mm256_fmadd_pd(v233, v53, v234);
-    let v236: __m256d = _mm256_fmadd_pd(v47, v58, v83);
-    let v237: __m256d = _mm256_fmadd_pd(v233, v60, v236);
-    let v238: __m256d = _mm256_fmadd_pd(v47, v65, v80);
-    let v239: __m256d = _mm256_fmadd_pd(v233, v67, v238);
-    let v240: __m256d = _mm256_mul_pd(v46, v89);
-    let v242: __m256d = _mm256_mul_pd(v77, v241);
-    let v243: __m256d = _mm256_fmadd_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[3usize]),
+        runtime::lanes::from_array(qd[3]),
         v240,
     );
-    let v244: __m256d = _mm256_fmadd_pd(v47, v87, v243);
-    let v245: __m256d = _mm256_fmadd_pd(v53, v242, v244);
-    let v246: __m256d = _mm256_fmadd_pd(v233, v101, v245);
-    let v247: __m256d = _mm256_mul_pd(v58, v89);
-    let v248: __m256d = _mm256_fmadd_pd(
+    let v244 = _mm256_fmadd_pd(v47, v87, v243);
+    let v245 = _mm256_fmadd_pd(v53, v242, v244);
+    let v246 = _mm256_fmadd_pd(v233, v101, v245);
+    let v247 = _mm256_mul_pd(v58, v89);
+    let v248 = _mm256_fmadd_pd(
         _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[4usize]),
+        runtime::lanes::from_array(qd[4]),
         v247,
     );
-    let v249: __m256d = _mm256_fmadd_pd(v47, v111, v248);
-    let v250: __m256d = _mm256_fmadd_pd(v60, v242, v249);
-    let v251: __m256d = _mm256_fmadd_pd(v233, v116, v250);
-    let v252: __m256d = _mm256_mul_pd(v65, v89);
-    let v253: __m256d = _mm256_fmadd_pd(
+    let v249 = _mm256_fmadd_pd(v47, v111, v248);
+    let v250 = _mm256_fmadd_pd(v60, v242, v249);
+    let v251 = _mm256_fmadd_pd(v233, v116, v250);
+    let v252 = _mm256_mul_pd(v65, v89);
+    let v253 = _mm256_fmadd_pd(
         _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[5usize]),
+        runtime::lanes::from_array(qd[5]),
         v252,
     );
-    let v254: __m256d = _mm256_fmadd_pd(v47, v126, v253);
-    let v255: __m256d = _mm256_fmadd_pd(v67, v242, v254);
-    let v256: __m256d = _mm256_fmadd_pd(v233, v131, v255);
-    let v257: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v87);
-    let v258: __m256d = _mm256_mul_pd(v46, v154);
-    let v259: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v101);
-    let v261: __m256d = _mm256_mul_pd(v145, v260);
-    let v262: __m256d = _mm256_fmadd_pd(v143, v241, v261);
-    let v263: __m256d = _mm256_fmadd_pd(v257, v89, v258);
-    let v264: __m256d = _mm256_fmadd_pd(v47, v150, v263);
-    let v265: __m256d = _mm256_fmadd_pd(v259, v242, v264);
-    let v266: __m256d = _mm256_fmadd_pd(v53, v262, v265);
-    let v267: __m256d = _mm256_fmadd_pd(v233, v161, v266);
-    let v268: __m256d = _mm256_mul_pd(v58, v154);
-    let v269: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v116);
-    let v270: __m256d = _mm256_fmadd_pd(v151, v111, v268);
-    let v271: __m256d = _mm256_fmadd_pd(v47, v169, v270);
-    let v272: __m256d = _mm256_fmadd_pd(v269, v242, v271);
-    let v273: __m256d = _mm256_fmadd_pd(v60, v262, v272);
-    let v274: __m256d = _mm256_fmadd_pd(v233, v173, v273);
-    let v275: __m256d = _mm256_mul_pd(v65, v154);
-    let v276: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v131);
-    let v277: __m256d = _mm256_fmadd_pd(v151, v126, v275);
-    let v278: __m256d = _mm256_fmadd_pd(v47, v181, v277);
-    let v279: __m256d = _mm256_fmadd_pd(v276, v242, v278);
-    let v280: __m256d = _mm256_fmadd_pd(v67, v262, v279);
-    let v281: __m256d = _mm256_fmadd_pd(v233, v185, v280);
-    let v282: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v11);
-    let c: [[__m256d; 2usize]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
-        2usize,
+    let v254 = _mm256_fmadd_pd(v47, v126, v253);
+    let v255 = _mm256_fmadd_pd(v67, v242, v254);
+    let v256 = _mm256_fmadd_pd(v233, v131, v255);
+    let v257 = _mm256_mul_pd(_mm256_set1_pd(2f64), v87);
+    let v258 = _mm256_mul_pd(v46, v154);
+    let v259 = _mm256_mul_pd(_mm256_set1_pd(2f64), v101);
+    let v261 = _mm256_mul_pd(v145, v260);
+    let v262 = _mm256_fmadd_pd(v143, v241, v261);
+    let v263 = _mm256_fmadd_pd(v257, v89, v258);
+    let v264 = _mm256_fmadd_pd(v47, v150, v263);
+    let v265 = _mm256_fmadd_pd(v259, v242, v264);
+    let v266 = _mm256_fmadd_pd(v53, v262, v265);
+    let v267 = _mm256_fmadd_pd(v233, v161, v266);
+    let v268 = _mm256_mul_pd(v58, v154);
+    let v269 = _mm256_mul_pd(_mm256_set1_pd(2f64), v116);
+    let v270 = _mm256_fmadd_pd(v151, v111, v268);
+    let v271 = _mm256_fmadd_pd(v47, v169, v270);
+    let v272 = _mm256_fmadd_pd(v269, v242, v271);
+    let v273 = _mm256_fmadd_pd(v60, v262, v272);
+    let v274 = _mm256_fmadd_pd(v233, v173, v273);
+    let v275 = _mm256_mul_pd(v65, v154);
+    let v276 = _mm256_mul_pd(_mm256_set1_pd(2f64), v131);
+    let v277 = _mm256_fmadd_pd(v151, v126, v275);
+    let v278 = _mm256_fmadd_pd(v47, v181, v277);
+    let v279 = _mm256_fmadd_pd(v276, v242, v278);
+    let v280 = _mm256_fmadd_pd(v67, v262, v279);
+    let v281 = _mm256_fmadd_pd(v233, v185, v280);
+    let v282 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v11);
+    let c: [[__m256d; 2]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
+        2,
     >(v282);
-    let v283: __m256d = c[2usize][0usize];
-    let v289: __m256d = c[1usize][0usize];
-    let v291: __m256d = c[3usize][0usize];
-    let v312: __m256d = c[2usize][1usize];
-    let v314: __m256d = c[3usize][1usize];
-    let v324: __m256d = c[1usize][1usize];
-    let v285: __m256d = _mm256_mul_pd(
+    let v283: __m256d = c[2][0];
+    let v289: __m256d = c[1][0];
+    let v291: __m256d = c[3][0];
+    let v312: __m256d = c[2][1];
+    let v314: __m256d = c[3][1];
+    let v324: __m256d = c[1][1];
+    let v285 = _mm256_mul_pd(
         _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[0usize]),
+        runtime::lanes::from_array(q[0]),
     );
-    let v286: __m256d = _mm256_mul_pd(
+    let v286 = _mm256_mul_pd(
         _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[1usize]),
+        runtime::lanes::from_array(q[1]),
     );
-    let v287: __m256d = _mm256_mul_pd(v286, runtime::lanes::from_array(qd[0usize]));
-    let v288: __m256d = _mm256_fmsub_pd(
-        v285,
-        runtime::lanes::from_array(qd[1usize]),
-        v287,
-    );
-    let v290: __m256d = _mm256_mul_pd(v91, v289);
-    let v292: __m256d = _mm256_mul_pd(
+    let v287 = _mm256_mul_pd(v286, runtime::lanes::from_array(qd[0]));
+    let v288 = _mm256_fmsub_pd(v285, runtime::lanes::from_array(qd[1]), v287);
+    let v290 = _mm256_mul_pd(v91, v289);
+    let v292 = _mm256_mul_pd(
         _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[2usize]),
+        runtime::lanes::from_array(q[2]),
     );
-    let v293: __m256d = _mm256_mul_pd(v285, runtime::lanes::from_array(qd[0usize]));
-    let v294: __m256d = _mm256_fmadd_pd(
-        v292,
-        runtime::lanes::from_array(qd[2usize]),
-        v293,
-    );
-    let v295: __m256d = _mm256_fmadd_pd(
-        v286,
-        runtime::lanes::from_array(qd[1usize]),
-        v294,
-    );
-    let v296: __m256d = _mm256_mul_pd(v48, v291);
-    let v297: __m256d = _mm256_fmadd_pd(v283, v288, v290);
-    let v298: __m256d = _mm256_fmadd_pd(v296, v295, v297);
-    let v299: __m256d = _mm256_mul_pd(v292, runtime::lanes::from_array(qd[1usize]));
-    let v300: __m256d = _mm256_fmsub_pd(
-        v286,
-        runtime::lanes::from_array(qd[2usize]),
-        v299,
-    );
-    let v301: __m256d = _mm256_mul_pd(v123, v289);
-    let v302: __m256d = _mm256_mul_pd(v15, v291);
-    let v303: __m256d = _mm256_fmadd_pd(v283, v300, v301);
-    let v304: __m256d = _mm256_fmadd_pd(v302, v295, v303);
-    let v305: __m256d = _mm256_mul_pd(v285, runtime::lanes::from_array(qd[2usize]));
-    let v306: __m256d = _mm256_fmsub_pd(
-        v292,
-        runtime::lanes::from_array(qd[0usize]),
-        v305,
-    );
-    let v307: __m256d = _mm256_mul_pd(v107, v289);
-    let v308: __m256d = _mm256_mul_pd(v23, v291);
-    let v309: __m256d = _mm256_fmadd_pd(v283, v306, v307);
-    let v310: __m256d = _mm256_fmadd_pd(v308, v295, v309);
-    let v311: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v77);
-    let v313: __m256d = _mm256_mul_pd(v311, v312);
-    let v315: __m256d = _mm256_mul_pd(v311, v314);
-    let v316: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v295);
-    let v317: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.0625f64), v139);
-    let v318: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v138, v317);
-    let v319: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v141, v318);
-    let v320: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v291);
-    let v321: __m256d = _mm256_mul_pd(v320, v319);
-    let v322: __m256d = _mm256_fmadd_pd(v316, v315, v321);
-    let v323: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[2usize]), v322);
-    let v325: __m256d = _mm256_mul_pd(v311, v324);
-    let v326: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v325);
-    let v327: __m256d = _mm256_fmadd_pd(v320, v295, v326);
-    let v328: __m256d = _mm256_fmadd_pd(v288, v313, v323);
-    let v329: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        v327,
-        v328,
-    );
-    let v330: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[0usize]), v322);
-    let v331: __m256d = _mm256_fmadd_pd(v300, v313, v330);
-    let v332: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        v327,
-        v331,
-    );
-    let v333: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[1usize]), v322);
-    let v334: __m256d = _mm256_fmadd_pd(v306, v313, v333);
-    let v335: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        v327,
-        v334,
-    );
-    let v337: __m256d = _mm256_fmsub_pd(_mm256_set1_pd(0.0625f64), v8, v282);
-    let v338: __m256d = _mm256_fmadd_pd(v283, v337, _mm256_set1_pd(1f64));
-    let v339: __m256d = _mm256_mul_pd(v285, runtime::lanes::from_array(q[2usize]));
-    let v340: __m256d = _mm256_mul_pd(v339, v283);
-    let v341: __m256d = _mm256_fmadd_pd(v23, v289, v340);
-    let v342: __m256d = _mm256_mul_pd(v286, runtime::lanes::from_array(q[2usize]));
-    let v343: __m256d = _mm256_mul_pd(v15, v289);
-    let v344: __m256d = _mm256_fmsub_pd(v342, v283, v343);
-    let v346: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(p[1usize]),
-    );
-    let v348: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(p[3usize]),
-    );
-    let v350: __m256d = _mm256_sub_pd(runtime::lanes::from_array(p[2usize]), v348);
-    let v352: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.125f64), v350, v348);
-    let v353: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(p[3usize]),
-    );
-    let v354: __m256d = _mm256_mul_pd(v23, v13);
-    let v355: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.125f64),
-        runtime::lanes::from_array(q[0usize]),
-    );
-    let v356: __m256d = _mm256_mul_pd(v355, runtime::lanes::from_array(q[2usize]));
-    let v357: __m256d = _mm256_mul_pd(v356, v47);
-    let v358: __m256d = _mm256_sub_pd(v357, v354);
-    let v359: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v18);
-    let v360: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v1);
-    let v361: __m256d = _mm256_fmadd_pd(v360, v47, v359);
-    let v362: __m256d = _mm256_mul_pd(v48, v13);
-    let v363: __m256d = _mm256_mul_pd(v355, runtime::lanes::from_array(q[1usize]));
-    let v364: __m256d = _mm256_mul_pd(v363, v47);
-    let v365: __m256d = _mm256_add_pd(v362, v364);
-    let v366: __m256d = _mm256_mul_pd(v78, v26);
-    let v367: __m256d = _mm256_mul_pd(v80, v13);
-    let v368: __m256d = _mm256_mul_pd(v88, v26);
-    let v369: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.125f64),
-        runtime::lanes::from_array(q[2usize]),
-    );
-    let v370: __m256d = _mm256_mul_pd(v42, v26);
-    let v371: __m256d = _mm256_fmsub_pd(
-        v369,
-        runtime::lanes::from_array(q[4usize]),
-        v370,
-    );
-    let v372: __m256d = _mm256_fmadd_pd(v46, v366, v367);
-    let v373: __m256d = _mm256_fmadd_pd(v53, v368, v372);
-    let v374: __m256d = _mm256_fmadd_pd(v47, v371, v373);
-    let v375: __m256d = _mm256_mul_pd(v60, v368);
-    let v376: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v51);
-    let v377: __m256d = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v26, v355);
-    let v378: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[4usize]),
-        v377,
-        v376,
-    );
-    let v379: __m256d = _mm256_fmadd_pd(v58, v366, v375);
-    let v380: __m256d = _mm256_fmadd_pd(v47, v378, v379);
-    let v381: __m256d = _mm256_mul_pd(v232, v13);
-    let v382: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.125f64),
-        runtime::lanes::from_array(q[1usize]),
-    );
-    let v383: __m256d = _mm256_mul_pd(v63, v26);
-    let v384: __m256d = _mm256_fmsub_pd(
-        v382,
-        runtime::lanes::from_array(q[4usize]),
-        v383,
-    );
-    let v385: __m256d = _mm256_fmsub_pd(v65, v366, v381);
-    let v386: __m256d = _mm256_fmadd_pd(v67, v368, v385);
-    let v387: __m256d = _mm256_fmadd_pd(v47, v384, v386);
-    let v388: __m256d = _mm256_mul_pd(v286, v283);
-    let v390: __m256d = _mm256_mul_pd(
+    let v293 = _mm256_mul_pd(v285, runtime::lanes::from_array(qd[0]));
+    let v294 = _mm256_fmadd_pd(v292, runtime::lanes::from_array(qd[2]), v293);
+    let v295 = _mm256_fmadd_pd(v286, runtime::lanes::from_array(qd[1]), v294);
+    let v296 = _mm256_mul_pd(v48, v291);
+    let v297 = _mm256_fmadd_pd(v283, v288, v290);
+    let v298 = _mm256_fmadd_pd(v296, v295, v297);
+    let v299 = _mm256_mul_pd(v292, runtime::lanes::from_array(qd[1]));
+    let v300 = _mm256_fmsub_pd(v286, runtime::lanes::from_array(qd[2]), v299);
+    let v301 = _mm256_mul_pd(v123, v289);
+    let v302 = _mm256_mul_pd(v15, v291);
+    let v303 = _mm256_fmadd_pd(v283, v300, v301);
+    let v304 = _mm256_fmadd_pd(v302, v295, v303);
+    let v305 = _mm256_mul_pd(v285, runtime::lanes::from_array(qd[2]));
+    let v306 = _mm256_fmsub_pd(v292, runtime::lanes::from_array(qd[0]), v305);
+    let v307 = _mm256_mul_pd(v107, v289);
+    let v308 = _mm256_mul_pd(v23, v291);
+    let v309 = _mm256_fmadd_pd(v283, v306, v307);
+    let v310 = _mm256_fmadd_pd(v308, v295, v309);
+    let v311 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v77);
+    let v313 = _mm256_mul_pd(v311, v312);
+    let v315 = _mm256_mul_pd(v311, v314);
+    let v316 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v295);
+    let v317 = _mm256_mul_pd(_mm256_set1_pd(0.0625f64), v139);
+    let v318 = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v138, v317);
+    let v319 = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v141, v318);
+    let v320 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v291);
+    let v321 = _mm256_mul_pd(v320, v319);
+    let v322 = _mm256_fmadd_pd(v316, v315, v321);
+    let v323 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v322);
+    let v325 = _mm256_mul_pd(v311, v324);
+    let v326 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v325);
+    let v327 = _mm256_fmadd_pd(v320, v295, v326);
+    let v328 = _mm256_fmadd_pd(v288, v313, v323);
+    let v329 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v327, v328);
+    let v330 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v322);
+    let v331 = _mm256_fmadd_pd(v300, v313, v330);
+    let v332 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v327, v331);
+    let v333 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v322);
+    let v334 = _mm256_fmadd_pd(v306, v313, v333);
+    let v335 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v327, v334);
+    let v337 = _mm256_fmsub_pd(_mm256_set1_pd(0.0625f64), v8, v282);
+    let v338 = _mm256_fmadd_pd(v283, v337, _mm256_set1_pd(1f64));
+    let v339 = _mm256_mul_pd(v285, runtime::lanes::from_array(q[2]));
+    let v340 = _mm256_mul_pd(v339, v283);
+    let v341 = _mm256_fmadd_pd(v23, v289, v340);
+    let v342 = _mm256_mul_pd(v286, runtime::lanes::from_array(q[2]));
+    let v343 = _mm256_mul_pd(v15, v289);
+    let v344 = _mm256_fmsub_pd(v342, v283, v343);
+    let v346 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[1]));
+    let v348 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(p[3]));
+    let v350 = _mm256_sub_pd(runtime::lanes::from_array(p[2]), v348);
+    let v352 = _mm256_fmadd_pd(_mm256_set1_pd(0.125f64), v350, v348);
+    let v353 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[3]));
+    let v354 = _mm256_mul_pd(v23, v13);
+    let v355 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[0]));
+    let v356 = _mm256_mul_pd(v355, runtime::lanes::from_array(q[2]));
+    let v357 = _mm256_mul_pd(v356, v47);
+    let v358 = _mm256_sub_pd(v357, v354);
+    let v359 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v18);
+    let v360 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v1);
+    let v361 = _mm256_fmadd_pd(v360, v47, v359);
+    let v362 = _mm256_mul_pd(v48, v13);
+    let v363 = _mm256_mul_pd(v355, runtime::lanes::from_array(q[1]));
+    let v364 = _mm256_mul_pd(v363, v47);
+    let v365 = _mm256_add_pd(v362, v364);
+    let v366 = _mm256_mul_pd(v78, v26);
+    let v367 = _mm256_mul_pd(v80, v13);
+    let v368 = _mm256_mul_pd(v88, v26);
+    let v369 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[2]));
+    let v370 = _mm256_mul_pd(v42, v26);
+    let v371 = _mm256_fmsub_pd(v369, runtime::lanes::from_array(q[4]), v370);
+    let v372 = _mm256_fmadd_pd(v46, v366, v367);
+    let v373 = _mm256_fmadd_pd(v53, v368, v372);
+    let v374 = _mm256_fmadd_pd(v47, v371, v373);
+    let v375 = _mm256_mul_pd(v60, v368);
+    let v376 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v51);
+    let v377 = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v26, v355);
+    let v378 = _mm256_fmadd_pd(runtime::lanes::from_array(q[4]), v377, v376);
+    let v379 = _mm256_fmadd_pd(v58, v366, v375);
+    let v380 = _mm256_fmadd_pd(v47, v378, v379);
+    let v381 = _mm256_mul_pd(v232, v13);
+    let v382 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[1]));
+    let v383 = _mm256_mul_pd(v63, v26);
+    let v384 = _mm256_fmsub_pd(v382, runtime::lanes::from_array(q[4]), v383);
+    let v385 = _mm256_fmsub_pd(v65, v366, v381);
+    let v386 = _mm256_fmadd_pd(v67, v368, v385);
+    let v387 = _mm256_fmadd_pd(v47, v384, v386);
+    let v388 = _mm256_mul_pd(v286, v283);
+    let v390 = _mm256_mul_pd(
         _mm256_set1_pd(0.015625f64),
-        runtime::lanes::from_array(q[0usize]),
+        runtime::lanes::from_array(q[0]),
     );
-    let v391: __m256d = _mm256_mul_pd(v390, runtime::lanes::from_array(q[2usize]));
-    let v392: __m256d = _mm256_mul_pd(v391, v291);
-    let v393: __m256d = _mm256_sub_pd(v392, v388);
-    let v394: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v289);
-    let v395: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v1);
-    let v396: __m256d = _mm256_fmadd_pd(v395, v291, v394);
-    let v397: __m256d = _mm256_mul_pd(v292, v283);
-    let v398: __m256d = _mm256_mul_pd(v390, runtime::lanes::from_array(q[1usize]));
-    let v399: __m256d = _mm256_mul_pd(v398, v291);
-    let v400: __m256d = _mm256_add_pd(v397, v399);
-    let v401: __m256d = _mm256_mul_pd(v80, v47);
-    let v402: __m256d = _mm256_mul_pd(v241, v26);
-    let v403: __m256d = _mm256_fmadd_pd(v46, v368, v401);
-    let v404: __m256d = _mm256_fmadd_pd(v53, v402, v403);
-    let v405: __m256d = _mm256_fmadd_pd(v233, v371, v404);
-    let v406: __m256d = _mm256_mul_pd(v60, v402);
-    let v407: __m256d = _mm256_fmadd_pd(v58, v368, v406);
-    let v408: __m256d = _mm256_fmadd_pd(v233, v378, v407);
-    let v409: __m256d = _mm256_mul_pd(v232, v47);
-    let v410: __m256d = _mm256_fmsub_pd(v65, v368, v409);
-    let v411: __m256d = _mm256_fmadd_pd(v67, v402, v410);
-    let v412: __m256d = _mm256_fmadd_pd(v233, v384, v411);
-    let v413: __m256d = _mm256_mul_pd(v15, v13);
-    let v414: __m256d = _mm256_mul_pd(v382, runtime::lanes::from_array(q[2usize]));
-    let v415: __m256d = _mm256_mul_pd(v414, v47);
-    let v416: __m256d = _mm256_add_pd(v413, v415);
-    let v417: __m256d = _mm256_sub_pd(v364, v362);
-    let v418: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v5);
-    let v419: __m256d = _mm256_fmadd_pd(v418, v47, v359);
-    let v420: __m256d = _mm256_mul_pd(v78, v20);
-    let v421: __m256d = _mm256_mul_pd(v83, v13);
-    let v422: __m256d = _mm256_mul_pd(v88, v20);
-    let v423: __m256d = _mm256_mul_pd(v42, v20);
-    let v424: __m256d = _mm256_fmsub_pd(
-        v369,
-        runtime::lanes::from_array(q[5usize]),
-        v423,
-    );
-    let v425: __m256d = _mm256_fmsub_pd(v46, v420, v421);
-    let v426: __m256d = _mm256_fmadd_pd(v53, v422, v425);
-    let v427: __m256d = _mm256_fmadd_pd(v47, v424, v426);
-    let v428: __m256d = _mm256_mul_pd(v56, v20);
-    let v429: __m256d = _mm256_fmsub_pd(
-        v355,
-        runtime::lanes::from_array(q[5usize]),
-        v428,
-    );
-    let v430: __m256d = _mm256_fmadd_pd(v58, v420, v381);
-    let v431: __m256d = _mm256_fmadd_pd(v60, v422, v430);
-    let v432: __m256d = _mm256_fmadd_pd(v47, v429, v431);
-    let v433: __m256d = _mm256_mul_pd(v67, v422);
-    let v434: __m256d = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v20, v382);
-    let v435: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[5usize]),
-        v434,
-        v376,
-    );
-    let v436: __m256d = _mm256_fmadd_pd(v65, v420, v433);
-    let v437: __m256d = _mm256_fmadd_pd(v47, v435, v436);
-    let v438: __m256d = _mm256_mul_pd(v285, v283);
-    let v439: __m256d = _mm256_mul_pd(
+    let v391 = _mm256_mul_pd(v390, runtime::lanes::from_array(q[2]));
+    let v392 = _mm256_mul_pd(v391, v291);
+    let v393 = _mm256_sub_pd(v392, v388);
+    let v394 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v289);
+    let v395 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v1);
+    let v396 = _mm256_fmadd_pd(v395, v291, v394);
+    let v397 = _mm256_mul_pd(v292, v283);
+    let v398 = _mm256_mul_pd(v390, runtime::lanes::from_array(q[1]));
+    let v399 = _mm256_mul_pd(v398, v291);
+    let v400 = _mm256_add_pd(v397, v399);
+    let v401 = _mm256_mul_pd(v80, v47);
+    let v402 = _mm256_mul_pd(v241, v26);
+    let v403 = _mm256_fmadd_pd(v46, v368, v401);
+    let v404 = _mm256_fmadd_pd(v53, v402, v403);
+    let v405 = _mm256_fmadd_pd(v233, v371, v404);
+    let v406 = _mm256_mul_pd(v60, v402);
+    let v407 = _mm256_fmadd_pd(v58, v368, v406);
+    let v408 = _mm256_fmadd_pd(v233, v378, v407);
+    let v409 = _mm256_mul_pd(v232, v47);
+    let v410 = _mm256_fmsub_pd(v65, v368, v409);
+    let v411 = _mm256_fmadd_pd(v67, v402, v410);
+    let v412 = _mm256_fmadd_pd(v233, v384, v411);
+    let v413 = _mm256_mul_pd(v15, v13);
+    let v414 = _mm256_mul_pd(v382, runtime::lanes::from_array(q[2]));
+    let v415 = _mm256_mul_pd(v414, v47);
+    let v416 = _mm256_add_pd(v413, v415);
+    let v417 = _mm256_sub_pd(v364, v362);
+    let v418 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v5);
+    let v419 = _mm256_fmadd_pd(v418, v47, v359);
+    let v420 = _mm256_mul_pd(v78, v20);
+    let v421 = _mm256_mul_pd(v83, v13);
+    let v422 = _mm256_mul_pd(v88, v20);
+    let v423 = _mm256_mul_pd(v42, v20);
+    let v424 = _mm256_fmsub_pd(v369, runtime::lanes::from_array(q[5]), v423);
+    let v425 = _mm256_fmsub_pd(v46, v420, v421);
+    let v426 = _mm256_fmadd_pd(v53, v422, v425);
+    let v427 = _mm256_fmadd_pd(v47, v424, v426);
+    let v428 = _mm256_mul_pd(v56, v20);
+    let v429 = _mm256_fmsub_pd(v355, runtime::lanes::from_array(q[5]), v428);
+    let v430 = _mm256_fmadd_pd(v58, v420, v381);
+    let v431 = _mm256_fmadd_pd(v60, v422, v430);
+    let v432 = _mm256_fmadd_pd(v47, v429, v431);
+    let v433 = _mm256_mul_pd(v67, v422);
+    let v434 = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v20, v382);
+    let v435 = _mm256_fmadd_pd(runtime::lanes::from_array(q[5]), v434, v376);
+    let v436 = _mm256_fmadd_pd(v65, v420, v433);
+    let v437 = _mm256_fmadd_pd(v47, v435, v436);
+    let v438 = _mm256_mul_pd(v285, v283);
+    let v439 = _mm256_mul_pd(
         _mm256_set1_pd(0.015625f64),
-        runtime::lanes::from_array(q[1usize]),
+        runtime::lanes::from_array(q[1]),
     );
-    let v440: __m256d = _mm256_mul_pd(v439, runtime::lanes::from_array(q[2usize]));
-    let v441: __m256d = _mm256_mul_pd(v440, v291);
-    let v442: __m256d = _mm256_add_pd(v438, v441);
-    let v443: __m256d = _mm256_sub_pd(v399, v397);
-    let v444: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v5);
-    let v445: __m256d = _mm256_fmadd_pd(v444, v291, v394);
-    let v446: __m256d = _mm256_mul_pd(v83, v47);
-    let v447: __m256d = _mm256_mul_pd(v241, v20);
-    let v448: __m256d = _mm256_fmsub_pd(v46, v422, v446);
-    let v449: __m256d = _mm256_fmadd_pd(v53, v447, v448);
-    let v450: __m256d = _mm256_fmadd_pd(v233, v424, v449);
-    let v451: __m256d = _mm256_fmadd_pd(v58, v422, v409);
-    let v452: __m256d = _mm256_fmadd_pd(v60, v447, v451);
-    let v453: __m256d = _mm256_fmadd_pd(v233, v429, v452);
-    let v454: __m256d = _mm256_mul_pd(v67, v447);
-    let v455: __m256d = _mm256_fmadd_pd(v65, v422, v454);
-    let v456: __m256d = _mm256_fmadd_pd(v233, v435, v455);
-    let v457: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v8);
-    let v458: __m256d = _mm256_fmadd_pd(v457, v47, v359);
-    let v459: __m256d = _mm256_add_pd(v354, v357);
-    let v460: __m256d = _mm256_sub_pd(v415, v413);
-    let v461: __m256d = _mm256_mul_pd(v78, v33);
-    let v462: __m256d = _mm256_mul_pd(v88, v33);
-    let v463: __m256d = _mm256_mul_pd(v53, v462);
-    let v464: __m256d = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v33, v369);
-    let v465: __m256d = _mm256_fmadd_pd(v41, v464, v376);
-    let v466: __m256d = _mm256_fmadd_pd(v46, v461, v463);
-    let v467: __m256d = _mm256_fmadd_pd(v47, v465, v466);
-    let v468: __m256d = _mm256_mul_pd(v56, v33);
-    let v469: __m256d = _mm256_fmsub_pd(v355, v41, v468);
-    let v470: __m256d = _mm256_fmsub_pd(v58, v461, v367);
-    let v471: __m256d = _mm256_fmadd_pd(v60, v462, v470);
-    let v472: __m256d = _mm256_fmadd_pd(v47, v469, v471);
-    let v473: __m256d = _mm256_mul_pd(v63, v33);
-    let v474: __m256d = _mm256_fmsub_pd(v382, v41, v473);
-    let v475: __m256d = _mm256_fmadd_pd(v65, v461, v421);
-    let v476: __m256d = _mm256_fmadd_pd(v67, v462, v475);
-    let v477: __m256d = _mm256_fmadd_pd(v47, v474, v476);
-    let v478: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v8);
-    let v479: __m256d = _mm256_fmadd_pd(v478, v291, v394);
-    let v480: __m256d = _mm256_add_pd(v388, v392);
-    let v481: __m256d = _mm256_sub_pd(v441, v438);
-    let v482: __m256d = _mm256_mul_pd(v241, v33);
-    let v483: __m256d = _mm256_mul_pd(v53, v482);
-    let v484: __m256d = _mm256_fmadd_pd(v46, v462, v483);
-    let v485: __m256d = _mm256_fmadd_pd(v233, v465, v484);
-    let v486: __m256d = _mm256_fmsub_pd(v58, v462, v401);
-    let v487: __m256d = _mm256_fmadd_pd(v60, v482, v486);
-    let v488: __m256d = _mm256_fmadd_pd(v233, v469, v487);
-    let v489: __m256d = _mm256_fmadd_pd(v65, v462, v446);
-    let v490: __m256d = _mm256_fmadd_pd(v67, v482, v489);
-    let v491: __m256d = _mm256_fmadd_pd(v233, v474, v490);
-    let v493: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v11);
-    let v494: __m256d = _mm256_sub_pd(v457, v493);
-    let v495: __m256d = _mm256_fmadd_pd(v47, v494, _mm256_set1_pd(0.5f64));
-    let v496: __m256d = _mm256_fmadd_pd(v233, v494, _mm256_set1_pd(0.25f64));
-    let v497: __m256d = _mm256_mul_pd(v23, v47);
-    let v498: __m256d = _mm256_mul_pd(v356, v233);
-    let v499: __m256d = _mm256_add_pd(v497, v498);
-    let v500: __m256d = _mm256_mul_pd(v15, v47);
-    let v501: __m256d = _mm256_mul_pd(v414, v233);
-    let v502: __m256d = _mm256_sub_pd(v501, v500);
-    let v503: __m256d = _mm256_sub_pd(v360, v493);
-    let v504: __m256d = _mm256_fmadd_pd(v47, v503, _mm256_set1_pd(0.5f64));
-    let v505: __m256d = _mm256_sub_pd(v498, v497);
-    let v506: __m256d = _mm256_fmadd_pd(v233, v503, _mm256_set1_pd(0.25f64));
-    let v507: __m256d = _mm256_mul_pd(v48, v47);
-    let v508: __m256d = _mm256_mul_pd(v363, v233);
-    let v509: __m256d = _mm256_add_pd(v507, v508);
-    let v510: __m256d = _mm256_sub_pd(v418, v493);
-    let v511: __m256d = _mm256_fmadd_pd(v47, v510, _mm256_set1_pd(0.5f64));
-    let v512: __m256d = _mm256_add_pd(v500, v501);
-    let v513: __m256d = _mm256_sub_pd(v508, v507);
-    let v514: __m256d = _mm256_fmadd_pd(v233, v510, _mm256_set1_pd(0.25f64));
-    out[0usize] = runtime::lanes::to_array(v14);
-    out[1usize] = runtime::lanes::to_array(v22);
-    out[2usize] = runtime::lanes::to_array(v28);
-    out[3usize] = runtime::lanes::to_array(v29);
-    out[4usize] = runtime::lanes::to_array(v30);
-    out[5usize] = runtime::lanes::to_array(v35);
-    out[6usize] = runtime::lanes::to_array(v36);
-    out[7usize] = runtime::lanes::to_array(v37);
-    out[8usize] = runtime::lanes::to_array(v38);
-    out[9usize] = runtime::lanes::to_array(v55);
-    out[10usize] = runtime::lanes::to_array(v62);
-    out[11usize] = runtime::lanes::to_array(v69);
-    out[12usize] = runtime::lanes::to_array(v105);
-    out[13usize] = runtime::lanes::to_array(v120);
-    out[14usize] = runtime::lanes::to_array(v135);
-    out[15usize] = runtime::lanes::to_array(v166);
-    out[16usize] = runtime::lanes::to_array(v178);
-    out[17usize] = runtime::lanes::to_array(v190);
-    out[18usize] = runtime::lanes::to_array(v199);
-    out[19usize] = runtime::lanes::to_array(v205);
-    out[20usize] = runtime::lanes::to_array(v211);
-    out[21usize] = runtime::lanes::to_array(v225);
-    out[22usize] = runtime::lanes::to_array(v228);
-    out[23usize] = runtime::lanes::to_array(v231);
-    out[24usize] = runtime::lanes::to_array(v235);
-    out[25usize] = runtime::lanes::to_array(v237);
-    out[26usize] = runtime::lanes::to_array(v239);
-    out[27usize] = runtime::lanes::to_array(v246);
-    out[28usize] = runtime::lanes::to_array(v251);
-    out[29usize] = runtime::lanes::to_array(v256);
-    out[30usize] = runtime::lanes::to_array(v267);
-    out[31usize] = runtime::lanes::to_array(v274);
-    out[32usize] = runtime::lanes::to_array(v281);
-    out[33usize] = runtime::lanes::to_array(v298);
-    out[34usize] = runtime::lanes::to_array(v304);
-    out[35usize] = runtime::lanes::to_array(v310);
-    out[36usize] = runtime::lanes::to_array(v329);
-    out[37usize] = runtime::lanes::to_array(v332);
-    out[38usize] = runtime::lanes::to_array(v335);
-    out[39usize] = runtime::lanes::to_array(v338);
-    out[40usize] = runtime::lanes::to_array(v341);
-    out[41usize] = runtime::lanes::to_array(v344);
-    out[42usize] = runtime::lanes::to_array(v346);
-    out[43usize] = runtime::lanes::to_array(v352);
-    out[44usize] = runtime::lanes::to_array(v353);
-    out[45usize] = runtime::lanes::to_array(v358);
-    out[46usize] = runtime::lanes::to_array(v361);
-    out[47usize] = runtime::lanes::to_array(v365);
-    out[48usize] = runtime::lanes::to_array(v374);
-    out[49usize] = runtime::lanes::to_array(v380);
-    out[50usize] = runtime::lanes::to_array(v387);
-    out[51usize] = runtime::lanes::to_array(v393);
-    out[52usize] = runtime::lanes::to_array(v396);
-    out[53usize] = runtime::lanes::to_array(v400);
-    out[54usize] = runtime::lanes::to_array(v405);
-    out[55usize] = runtime::lanes::to_array(v408);
-    out[56usize] = runtime::lanes::to_array(v412);
-    out[57usize] = runtime::lanes::to_array(v416);
-    out[58usize] = runtime::lanes::to_array(v417);
-    out[59usize] = runtime::lanes::to_array(v419);
-    out[60usize] = runtime::lanes::to_array(v427);
-    out[61usize] = runtime::lanes::to_array(v432);
-    out[62usize] = runtime::lanes::to_array(v437);
-    out[63usize] = runtime::lanes::to_array(v442);
-    out[64usize] = runtime::lanes::to_array(v443);
-    out[65usize] = runtime::lanes::to_array(v445);
-    out[66usize] = runtime::lanes::to_array(v450);
-    out[67usize] = runtime::lanes::to_array(v453);
-    out[68usize] = runtime::lanes::to_array(v456);
-    out[69usize] = runtime::lanes::to_array(v458);
-    out[70usize] = runtime::lanes::to_array(v459);
-    out[71usize] = runtime::lanes::to_array(v460);
-    out[72usize] = runtime::lanes::to_array(v467);
-    out[73usize] = runtime::lanes::to_array(v472);
-    out[74usize] = runtime::lanes::to_array(v477);
-    out[75usize] = runtime::lanes::to_array(v479);
-    out[76usize] = runtime::lanes::to_array(v480);
-    out[77usize] = runtime::lanes::to_array(v481);
-    out[78usize] = runtime::lanes::to_array(v485);
-    out[79usize] = runtime::lanes::to_array(v488);
-    out[80usize] = runtime::lanes::to_array(v491);
-    out[81usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[82usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[83usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[84usize] = runtime::lanes::to_array(v495);
-    out[85usize] = runtime::lanes::to_array(v459);
-    out[86usize] = runtime::lanes::to_array(v460);
-    out[87usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[88usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[89usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[90usize] = runtime::lanes::to_array(v496);
-    out[91usize] = runtime::lanes::to_array(v499);
-    out[92usize] = runtime::lanes::to_array(v502);
-    out[93usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[94usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[95usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[96usize] = runtime::lanes::to_array(v358);
-    out[97usize] = runtime::lanes::to_array(v504);
-    out[98usize] = runtime::lanes::to_array(v365);
-    out[99usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[100usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[101usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[102usize] = runtime::lanes::to_array(v505);
-    out[103usize] = runtime::lanes::to_array(v506);
-    out[104usize] = runtime::lanes::to_array(v509);
-    out[105usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[106usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[107usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[108usize] = runtime::lanes::to_array(v416);
-    out[109usize] = runtime::lanes::to_array(v417);
-    out[110usize] = runtime::lanes::to_array(v511);
-    out[111usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[112usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[113usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[114usize] = runtime::lanes::to_array(v512);
-    out[115usize] = runtime::lanes::to_array(v513);
-    out[116usize] = runtime::lanes::to_array(v514);
-    out[117usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[118usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[119usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[120usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[121usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[122usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[123usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[124usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[125usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[126usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[127usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[128usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    let v440 = _mm256_mul_pd(v439, runtime::lanes::from_array(q[2]));
+    let v441 = _mm256_mul_pd(v440, v291);
+    let v442 = _mm256_add_pd(v438, v441);
+    let v443 = _mm256_sub_pd(v399, v397);
+    let v444 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v5);
+    let v445 = _mm256_fmadd_pd(v444, v291, v394);
+    let v446 = _mm256_mul_pd(v83, v47);
+    let v447 = _mm256_mul_pd(v241, v20);
+    let v448 = _mm256_fmsub_pd(v46, v422, v446);
+    let v449 = _mm256_fmadd_pd(v53, v447, v448);
+    let v450 = _mm256_fmadd_pd(v233, v424, v449);
+    let v451 = _mm256_fmadd_pd(v58, v422, v409);
+    let v452 = _mm256_fmadd_pd(v60, v447, v451);
+    let v453 = _mm256_fmadd_pd(v233, v429, v452);
+    let v454 = _mm256_mul_pd(v67, v447);
+    let v455 = _mm256_fmadd_pd(v65, v422, v454);
+    let v456 = _mm256_fmadd_pd(v233, v435, v455);
+    let v457 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v8);
+    let v458 = _mm256_fmadd_pd(v457, v47, v359);
+    let v459 = _mm256_add_pd(v354, v357);
+    let v460 = _mm256_sub_pd(v415, v413);
+    let v461 = _mm256_mul_pd(v78, v33);
+    let v462 = _mm256_mul_pd(v88, v33);
+    let v463 = _mm256_mul_pd(v53, v462);
+    let v464 = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v33, v369);
+    let v465 = _mm256_fmadd_pd(v41, v464, v376);
+    let v466 = _mm256_fmadd_pd(v46, v461, v463);
+    let v467 = _mm256_fmadd_pd(v47, v465, v466);
+    let v468 = _mm256_mul_pd(v56, v33);
+    let v469 = _mm256_fmsub_pd(v355, v41, v468);
+    let v470 = _mm256_fmsub_pd(v58, v461, v367);
+    let v471 = _mm256_fmadd_pd(v60, v462, v470);
+    let v472 = _mm256_fmadd_pd(v47, v469, v471);
+    let v473 = _mm256_mul_pd(v63, v33);
+    let v474 = _mm256_fmsub_pd(v382, v41, v473);
+    let v475 = _mm256_fmadd_pd(v65, v461, v421);
+    let v476 = _mm256_fmadd_pd(v67, v462, v475);
+    let v477 = _mm256_fmadd_pd(v47, v474, v476);
+    let v478 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v8);
+    let v479 = _mm256_fmadd_pd(v478, v291, v394);
+    let v480 = _mm256_add_pd(v388, v392);
+    let v481 = _mm256_sub_pd(v441, v438);
+    let v482 = _mm256_mul_pd(v241, v33);
+    let v483 = _mm256_mul_pd(v53, v482);
+    let v484 = _mm256_fmadd_pd(v46, v462, v483);
+    let v485 = _mm256_fmadd_pd(v233, v465, v484);
+    let v486 = _mm256_fmsub_pd(v58, v462, v401);
+    let v487 = _mm256_fmadd_pd(v60, v482, v486);
+    let v488 = _mm256_fmadd_pd(v233, v469, v487);
+    let v489 = _mm256_fmadd_pd(v65, v462, v446);
+    let v490 = _mm256_fmadd_pd(v67, v482, v489);
+    let v491 = _mm256_fmadd_pd(v233, v474, v490);
+    let v493 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v11);
+    let v494 = _mm256_sub_pd(v457, v493);
+    let v495 = _mm256_fmadd_pd(v47, v494, _mm256_set1_pd(0.5f64));
+    let v496 = _mm256_fmadd_pd(v233, v494, _mm256_set1_pd(0.25f64));
+    let v497 = _mm256_mul_pd(v23, v47);
+    let v498 = _mm256_mul_pd(v356, v233);
+    let v499 = _mm256_add_pd(v497, v498);
+    let v500 = _mm256_mul_pd(v15, v47);
+    let v501 = _mm256_mul_pd(v414, v233);
+    let v502 = _mm256_sub_pd(v501, v500);
+    let v503 = _mm256_sub_pd(v360, v493);
+    let v504 = _mm256_fmadd_pd(v47, v503, _mm256_set1_pd(0.5f64));
+    let v505 = _mm256_sub_pd(v498, v497);
+    let v506 = _mm256_fmadd_pd(v233, v503, _mm256_set1_pd(0.25f64));
+    let v507 = _mm256_mul_pd(v48, v47);
+    let v508 = _mm256_mul_pd(v363, v233);
+    let v509 = _mm256_add_pd(v507, v508);
+    let v510 = _mm256_sub_pd(v418, v493);
+    let v511 = _mm256_fmadd_pd(v47, v510, _mm256_set1_pd(0.5f64));
+    let v512 = _mm256_add_pd(v500, v501);
+    let v513 = _mm256_sub_pd(v508, v507);
+    let v514 = _mm256_fmadd_pd(v233, v510, _mm256_set1_pd(0.25f64));
+    out[0] = runtime::lanes::to_array(v14);
+    out[1] = runtime::lanes::to_array(v22);
+    out[2] = runtime::lanes::to_array(v28);
+    out[3] = runtime::lanes::to_array(v29);
+    out[4] = runtime::lanes::to_array(v30);
+    out[5] = runtime::lanes::to_array(v35);
+    out[6] = runtime::lanes::to_array(v36);
+    out[7] = runtime::lanes::to_array(v37);
+    out[8] = runtime::lanes::to_array(v38);
+    out[9] = runtime::lanes::to_array(v55);
+    out[10] = runtime::lanes::to_array(v62);
+    out[11] = runtime::lanes::to_array(v69);
+    out[12] = runtime::lanes::to_array(v105);
+    out[13] = runtime::lanes::to_array(v120);
+    out[14] = runtime::lanes::to_array(v135);
+    out[15] = runtime::lanes::to_array(v166);
+    out[16] = runtime::lanes::to_array(v178);
+    out[17] = runtime::lanes::to_array(v190);
+    out[18] = runtime::lanes::to_array(v199);
+    out[19] = runtime::lanes::to_array(v205);
+    out[20] = runtime::lanes::to_array(v211);
+    out[21] = runtime::lanes::to_array(v225);
+    out[22] = runtime::lanes::to_array(v228);
+    out[23] = runtime::lanes::to_array(v231);
+    out[24] = runtime::lanes::to_array(v235);
+    out[25] = runtime::lanes::to_array(v237);
+    out[26] = runtime::lanes::to_array(v239);
+    out[27] = runtime::lanes::to_array(v246);
+    out[28] = runtime::lanes::to_array(v251);
+    out[29] = runtime::lanes::to_array(v256);
+    out[30] = runtime::lanes::to_array(v267);
+    out[31] = runtime::lanes::to_array(v274);
+    out[32] = runtime::lanes::to_array(v281);
+    out[33] = runtime::lanes::to_array(v298);
+    out[34] = runtime::lanes::to_array(v304);
+    out[35] = runtime::lanes::to_array(v310);
+    out[36] = runtime::lanes::to_array(v329);
+    out[37] = runtime::lanes::to_array(v332);
+    out[38] = runtime::lanes::to_array(v335);
+    out[39] = runtime::lanes::to_array(v338);
+    out[40] = runtime::lanes::to_array(v341);
+    out[41] = runtime::lanes::to_array(v344);
+    out[42] = runtime::lanes::to_array(v346);
+    out[43] = runtime::lanes::to_array(v352);
+    out[44] = runtime::lanes::to_array(v353);
+    out[45] = runtime::lanes::to_array(v358);
+    out[46] = runtime::lanes::to_array(v361);
+    out[47] = runtime::lanes::to_array(v365);
+    out[48] = runtime::lanes::to_array(v374);
+    out[49] = runtime::lanes::to_array(v380);
+    out[50] = runtime::lanes::to_array(v387);
+    out[51] = runtime::lanes::to_array(v393);
+    out[52] = runtime::lanes::to_array(v396);
+    out[53] = runtime::lanes::to_array(v400);
+    out[54] = runtime::lanes::to_array(v405);
+    out[55] = runtime::lanes::to_array(v408);
+    out[56] = runtime::lanes::to_array(v412);
+    out[57] = runtime::lanes::to_array(v416);
+    out[58] = runtime::lanes::to_array(v417);
+    out[59] = runtime::lanes::to_array(v419);
+    out[60] = runtime::lanes::to_array(v427);
+    out[61] = runtime::lanes::to_array(v432);
+    out[62] = runtime::lanes::to_array(v437);
+    out[63] = runtime::lanes::to_array(v442);
+    out[64] = runtime::lanes::to_array(v443);
+    out[65] = runtime::lanes::to_array(v445);
+    out[66] = runtime::lanes::to_array(v450);
+    out[67] = runtime::lanes::to_array(v453);
+    out[68] = runtime::lanes::to_array(v456);
+    out[69] = runtime::lanes::to_array(v458);
+    out[70] = runtime::lanes::to_array(v459);
+    out[71] = runtime::lanes::to_array(v460);
+    out[72] = runtime::lanes::to_array(v467);
+    out[73] = runtime::lanes::to_array(v472);
+    out[74] = runtime::lanes::to_array(v477);
+    out[75] = runtime::lanes::to_array(v479);
+    out[76] = runtime::lanes::to_array(v480);
+    out[77] = runtime::lanes::to_array(v481);
+    out[78] = runtime::lanes::to_array(v485);
+    out[79] = runtime::lanes::to_array(v488);
+    out[80] = runtime::lanes::to_array(v491);
+    out[81] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[82] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[83] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[84] = runtime::lanes::to_array(v495);
+    out[85] = runtime::lanes::to_array(v459);
+    out[86] = runtime::lanes::to_array(v460);
+    out[87] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[88] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[89] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[90] = runtime::lanes::to_array(v496);
+    out[91] = runtime::lanes::to_array(v499);
+    out[92] = runtime::lanes::to_array(v502);
+    out[93] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[94] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[95] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[96] = runtime::lanes::to_array(v358);
+    out[97] = runtime::lanes::to_array(v504);
+    out[98] = runtime::lanes::to_array(v365);
+    out[99] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[100] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[101] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[102] = runtime::lanes::to_array(v505);
+    out[103] = runtime::lanes::to_array(v506);
+    out[104] = runtime::lanes::to_array(v509);
+    out[105] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[106] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[107] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[108] = runtime::lanes::to_array(v416);
+    out[109] = runtime::lanes::to_array(v417);
+    out[110] = runtime::lanes::to_array(v511);
+    out[111] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[112] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[113] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[114] = runtime::lanes::to_array(v512);
+    out[115] = runtime::lanes::to_array(v513);
+    out[116] = runtime::lanes::to_array(v514);
+    out[117] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[118] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[119] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[120] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[121] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[122] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[123] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[124] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[125] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[126] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[127] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[128] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
 }
 /// Kernel `cell_0_tangent`: 2199 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0_tangent(
     t: f64,
-    q: &[f64; 6usize],
-    qd: &[f64; 6usize],
-    qdd: &[f64; 6usize],
-    dir: &[f64; 12usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 258usize],
+    q: &[f64; 6],
+    qd: &[f64; 6],
+    qdd: &[f64; 6],
+    dir: &[f64; 12],
+    p: &[f64; 15],
+    out: &mut [f64; 258],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -3378,1705 +3139,1705 @@ pub fn cell_0_tangent(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
-    q: &[f64; 6usize],
-    qd: &[f64; 6usize],
-    qdd: &[f64; 6usize],
-    dir: &[f64; 12usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 258usize],
+    q: &[f64; 6],
+    qd: &[f64; 6],
+    qdd: &[f64; 6],
+    dir: &[f64; 12],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 258],
 ) {
-    let v1: f64 = q[0usize] * q[0usize];
-    let v3: f64 = 0.25f64 * v1;
-    let v5: f64 = q[1usize] * q[1usize];
-    let v6: f64 = 0.25f64 * v5;
-    let v8: f64 = q[2usize] * q[2usize];
-    let v9: f64 = 0.25f64 * v8;
-    let v10: f64 = v3 + v6;
-    let v11: f64 = v10 + v9;
-    let c: [[f64; 4usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        4usize,
+    let v1 = q[0] * q[0];
+    let v3 = 0.25f64 * v1;
+    let v5 = q[1] * q[1];
+    let v6 = 0.25f64 * v5;
+    let v8 = q[2] * q[2];
+    let v9 = 0.25f64 * v8;
+    let v10 = v3 + v6;
+    let v11 = v10 + v9;
+    let c: [[f64; 4]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        4,
     >(v11);
-    let v12: f64 = c[0usize][0usize];
-    let v13: f64 = c[2usize][0usize];
-    let v18: f64 = c[1usize][0usize];
-    let v47: f64 = c[3usize][0usize];
-    let v78: f64 = c[2usize][1usize];
-    let v88: f64 = c[3usize][1usize];
-    let v144: f64 = c[2usize][2usize];
-    let v152: f64 = c[3usize][2usize];
-    let v221: f64 = c[1usize][1usize];
-    let v234: f64 = c[4usize][0usize];
-    let v242: f64 = c[4usize][1usize];
-    let v261: f64 = c[4usize][2usize];
-    let v526: f64 = c[0usize][1usize];
-    let v739: f64 = c[2usize][3usize];
-    let v751: f64 = c[3usize][3usize];
-    let v881: f64 = c[1usize][2usize];
-    let v961: f64 = c[4usize][3usize];
-    let v14: f64 = v9.mul_add(v13, v12);
-    let v15: f64 = 0.25f64 * q[0usize];
-    let v16: f64 = v15 * q[2usize];
-    let v17: f64 = v16 * v13;
-    let v20: f64 = 0.5f64 * q[1usize];
-    let v21: f64 = v20 * v18;
-    let v22: f64 = v17 - v21;
-    let v23: f64 = 0.25f64 * q[1usize];
-    let v24: f64 = v23 * q[2usize];
-    let v25: f64 = v24 * v13;
-    let v26: f64 = 0.5f64 * q[0usize];
-    let v27: f64 = v26 * v18;
-    let v28: f64 = v25 + v27;
-    let v29: f64 = v17 + v21;
-    let v30: f64 = v3.mul_add(v13, v12);
-    let v31: f64 = v15 * q[1usize];
-    let v32: f64 = v31 * v13;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let v34: f64 = v33 * v18;
-    let v35: f64 = v32 - v34;
-    let v36: f64 = v25 - v27;
-    let v37: f64 = v32 + v34;
-    let v38: f64 = v6.mul_add(v13, v12);
-    let v41: f64 = q[3usize] + p[0usize];
-    let v42: f64 = 0.5f64 * v41;
-    let v45: f64 = v23 * q[4usize];
-    let v46: f64 = v15.mul_add(q[5usize], -v45);
-    let v48: f64 = 0.25f64 * q[2usize];
-    let v49: f64 = v15 * q[4usize];
-    let v50: f64 = v48.mul_add(v41, v49);
-    let v51: f64 = v23.mul_add(q[5usize], v50);
-    let v52: f64 = v42 * v11;
-    let v53: f64 = v33.mul_add(v51, -v52);
-    let v54: f64 = v13.mul_add(v46, v42);
-    let v55: f64 = v47.mul_add(v53, v54);
-    let v56: f64 = 0.5f64 * q[4usize];
-    let v57: f64 = v48 * q[5usize];
-    let v58: f64 = v23.mul_add(v41, -v57);
-    let v59: f64 = v56 * v11;
-    let v60: f64 = v26.mul_add(v51, -v59);
-    let v61: f64 = v13.mul_add(v58, v56);
-    let v62: f64 = v47.mul_add(v60, v61);
-    let v63: f64 = 0.5f64 * q[5usize];
-    let v64: f64 = v15 * v41;
-    let v65: f64 = v48.mul_add(q[4usize], -v64);
-    let v66: f64 = v63 * v11;
-    let v67: f64 = v20.mul_add(v51, -v66);
-    let v68: f64 = v13.mul_add(v65, v63);
-    let v69: f64 = v47.mul_add(v67, v68);
-    let v71: f64 = 0.5f64 * qd[3usize];
-    let v74: f64 = v26 * qd[0usize];
-    let v76: f64 = v33.mul_add(qd[2usize], v74);
-    let v77: f64 = v20.mul_add(qd[1usize], v76);
-    let v79: f64 = v77 * v78;
-    let v80: f64 = 0.25f64 * q[5usize];
-    let v82: f64 = v15 * qd[5usize];
-    let v83: f64 = 0.25f64 * q[4usize];
-    let v85: f64 = v80.mul_add(qd[0usize], v82);
-    let v86: f64 = (-v83).mul_add(qd[1usize], v85);
-    let v87: f64 = (-v23).mul_add(qd[4usize], v86);
-    let v89: f64 = v77 * v88;
-    let v90: f64 = 0.5f64 * qd[2usize];
-    let v91: f64 = 0.25f64 * qd[2usize];
-    let v92: f64 = v48 * qd[3usize];
-    let v93: f64 = v91.mul_add(v41, v92);
-    let v94: f64 = v83.mul_add(qd[0usize], v93);
-    let v95: f64 = v15.mul_add(qd[4usize], v94);
-    let v96: f64 = v80.mul_add(qd[1usize], v95);
-    let v97: f64 = v23.mul_add(qd[5usize], v96);
-    let v98: f64 = v33 * v97;
-    let v99: f64 = v90.mul_add(v51, v98);
-    let v100: f64 = (-v71).mul_add(v11, v99);
-    let v101: f64 = (-v42).mul_add(v77, v100);
-    let v102: f64 = v46.mul_add(v79, v71);
-    let v103: f64 = v13.mul_add(v87, v102);
-    let v104: f64 = v53.mul_add(v89, v103);
-    let v105: f64 = v47.mul_add(v101, v104);
-    let v106: f64 = 0.5f64 * qd[4usize];
-    let v107: f64 = 0.25f64 * qd[1usize];
-    let v108: f64 = v23 * qd[3usize];
-    let v109: f64 = v107.mul_add(v41, v108);
-    let v110: f64 = (-v80).mul_add(qd[2usize], v109);
-    let v111: f64 = (-v48).mul_add(qd[5usize], v110);
-    let v112: f64 = 0.5f64 * qd[0usize];
-    let v113: f64 = v26 * v97;
-    let v114: f64 = v112.mul_add(v51, v113);
-    let v115: f64 = (-v106).mul_add(v11, v114);
-    let v116: f64 = (-v56).mul_add(v77, v115);
-    let v117: f64 = v58.mul_add(v79, v106);
-    let v118: f64 = v13.mul_add(v111, v117);
-    let v119: f64 = v60.mul_add(v89, v118);
-    let v120: f64 = v47.mul_add(v116, v119);
-    let v121: f64 = 0.5f64 * qd[5usize];
-    let v122: f64 = v48 * qd[4usize];
-    let v123: f64 = 0.25f64 * qd[0usize];
-    let v124: f64 = v83.mul_add(qd[2usize], v122);
-    let v125: f64 = (-v123).mul_add(v41, v124);
-    let v126: f64 = (-v15).mul_add(qd[3usize], v125);
-    let v127: f64 = 0.5f64 * qd[1usize];
-    let v128: f64 = v20 * v97;
-    let v129: f64 = v127.mul_add(v51, v128);
-    let v130: f64 = (-v121).mul_add(v11, v129);
-    let v131: f64 = (-v63).mul_add(v77, v130);
-    let v132: f64 = v65.mul_add(v79, v121);
-    let v133: f64 = v13.mul_add(v126, v132);
-    let v134: f64 = v67.mul_add(v89, v133);
-    let v135: f64 = v47.mul_add(v131, v134);
-    let v137: f64 = 2f64 * v79;
-    let v138: f64 = qd[0usize] * qd[0usize];
-    let v139: f64 = qd[1usize] * qd[1usize];
-    let v140: f64 = 0.5f64 * v139;
-    let v141: f64 = qd[2usize] * qd[2usize];
-    let v142: f64 = 0.5f64.mul_add(v138, v140);
-    let v143: f64 = 0.5f64.mul_add(v141, v142);
-    let v145: f64 = v77 * v77;
-    let v146: f64 = v144 * v145;
-    let v147: f64 = v78.mul_add(v143, v146);
-    let v148: f64 = v46 * v147;
-    let v149: f64 = v127 * qd[4usize];
-    let v150: f64 = v112.mul_add(qd[5usize], -v149);
-    let v151: f64 = 2f64 * v89;
-    let v153: f64 = v145 * v152;
-    let v154: f64 = v88.mul_add(v143, v153);
-    let v155: f64 = v112 * qd[4usize];
-    let v156: f64 = v90.mul_add(qd[3usize], v155);
-    let v157: f64 = v127.mul_add(qd[5usize], v156);
-    let v158: f64 = v33 * v157;
-    let v159: f64 = qd[2usize].mul_add(v97, v158);
-    let v160: f64 = (-qd[3usize]).mul_add(v77, v159);
-    let v161: f64 = (-v42).mul_add(v143, v160);
-    let v162: f64 = v137.mul_add(v87, v148);
-    let v163: f64 = v13.mul_add(v150, v162);
-    let v164: f64 = v151.mul_add(v101, v163);
-    let v165: f64 = v53.mul_add(v154, v164);
-    let v166: f64 = v47.mul_add(v161, v165);
-    let v167: f64 = v58 * v147;
-    let v168: f64 = v90 * qd[5usize];
-    let v169: f64 = v127.mul_add(qd[3usize], -v168);
-    let v170: f64 = v26 * v157;
-    let v171: f64 = qd[0usize].mul_add(v97, v170);
-    let v172: f64 = (-qd[4usize]).mul_add(v77, v171);
-    let v173: f64 = (-v56).mul_add(v143, v172);
-    let v174: f64 = v137.mul_add(v111, v167);
-    let v175: f64 = v13.mul_add(v169, v174);
-    let v176: f64 = v151.mul_add(v116, v175);
-    let v177: f64 = v60.mul_add(v154, v176);
-    let v178: f64 = v47.mul_add(v173, v177);
-    let v179: f64 = v65 * v147;
-    let v180: f64 = v112 * qd[3usize];
-    let v181: f64 = v90.mul_add(qd[4usize], -v180);
-    let v182: f64 = v20 * v157;
-    let v183: f64 = qd[1usize].mul_add(v97, v182);
-    let v184: f64 = (-qd[5usize]).mul_add(v77, v183);
-    let v185: f64 = (-v63).mul_add(v143, v184);
-    let v186: f64 = v137.mul_add(v126, v179);
-    let v187: f64 = v13.mul_add(v181, v186);
-    let v188: f64 = v151.mul_add(v131, v187);
-    let v189: f64 = v67.mul_add(v154, v188);
-    let v190: f64 = v47.mul_add(v185, v189);
-    let v191: f64 = v23 * qd[0usize];
-    let v192: f64 = v15.mul_add(qd[1usize], -v191);
-    let v193: f64 = v90 * v18;
-    let v194: f64 = v15 * qd[0usize];
-    let v195: f64 = v48.mul_add(qd[2usize], v194);
-    let v196: f64 = v23.mul_add(qd[1usize], v195);
-    let v197: f64 = v33 * v47;
-    let v198: f64 = v13.mul_add(v192, v193);
-    let v199: f64 = v197.mul_add(v196, v198);
-    let v200: f64 = v48 * qd[1usize];
-    let v201: f64 = v23.mul_add(qd[2usize], -v200);
-    let v202: f64 = v112 * v18;
-    let v203: f64 = v26 * v47;
-    let v204: f64 = v13.mul_add(v201, v202);
-    let v205: f64 = v203.mul_add(v196, v204);
-    let v206: f64 = v15 * qd[2usize];
-    let v207: f64 = v48.mul_add(qd[0usize], -v206);
-    let v208: f64 = v127 * v18;
-    let v209: f64 = v20 * v47;
-    let v210: f64 = v13.mul_add(v207, v208);
-    let v211: f64 = v209.mul_add(v196, v210);
-    let v212: f64 = 0.5f64 * v196;
-    let v213: f64 = v212 * v89;
-    let v214: f64 = 0.25f64 * v139;
-    let v215: f64 = 0.25f64.mul_add(v138, v214);
-    let v216: f64 = 0.25f64.mul_add(v141, v215);
-    let v217: f64 = 0.5f64 * v47;
-    let v218: f64 = v217.mul_add(v216, v213);
-    let v219: f64 = q[2usize] * v218;
-    let v220: f64 = v217 * v196;
-    let v222: f64 = v77 * v221;
-    let v223: f64 = 0.5f64 * v222;
-    let v224: f64 = v220 + v223;
-    let v225: f64 = v192.mul_add(v79, v219);
-    let v226: f64 = qd[2usize].mul_add(v224, v225);
-    let v227: f64 = q[0usize] * v218;
-    let v228: f64 = v201.mul_add(v79, v227);
-    let v229: f64 = qd[0usize].mul_add(v224, v228);
-    let v230: f64 = q[1usize] * v218;
-    let v231: f64 = v207.mul_add(v79, v230);
-    let v232: f64 = qd[1usize].mul_add(v224, v231);
-    let v233: f64 = 0.25f64 * v41;
-    let v235: f64 = v47.mul_add(v46, v233);
-    let v236: f64 = v234.mul_add(v53, v235);
-    let v237: f64 = v47.mul_add(v58, v83);
-    let v238: f64 = v234.mul_add(v60, v237);
-    let v239: f64 = v47.mul_add(v65, v80);
-    let v240: f64 = v234.mul_add(v67, v239);
-    let v241: f64 = 0.25f64 * qd[3usize];
-    let v243: f64 = v77 * v242;
-    let v244: f64 = v46.mul_add(v89, v241);
-    let v245: f64 = v47.mul_add(v87, v244);
-    let v246: f64 = v53.mul_add(v243, v245);
-    let v247: f64 = v234.mul_add(v101, v246);
-    let v248: f64 = 0.25f64 * qd[4usize];
-    let v249: f64 = v58.mul_add(v89, v248);
-    let v250: f64 = v47.mul_add(v111, v249);
-    let v251: f64 = v60.mul_add(v243, v250);
-    let v252: f64 = v234.mul_add(v116, v251);
-    let v253: f64 = 0.25f64 * qd[5usize];
-    let v254: f64 = v65.mul_add(v89, v253);
-    let v255: f64 = v47.mul_add(v126, v254);
-    let v256: f64 = v67.mul_add(v243, v255);
-    let v257: f64 = v234.mul_add(v131, v256);
-    let v258: f64 = 2f64 * v87;
-    let v259: f64 = v46 * v154;
-    let v260: f64 = 2f64 * v101;
-    let v262: f64 = v145 * v261;
-    let v263: f64 = v143.mul_add(v242, v262);
-    let v264: f64 = v258.mul_add(v89, v259);
-    let v265: f64 = v47.mul_add(v150, v264);
-    let v266: f64 = v260.mul_add(v243, v265);
-    let v267: f64 = v53.mul_add(v263, v266);
-    let v268: f64 = v234.mul_add(v161, v267);
-    let v269: f64 = v58 * v154;
-    let v270: f64 = 2f64 * v116;
-    let v271: f64 = v151.mul_add(v111, v269);
-    let v272: f64 = v47.mul_add(v169, v271);
-    let v273: f64 = v270.mul_add(v243, v272);
-    let v274: f64 = v60.mul_add(v263, v273);
-    let v275: f64 = v234.mul_add(v173, v274);
-    let v276: f64 = v65 * v154;
-    let v277: f64 = 2f64 * v131;
-    let v278: f64 = v151.mul_add(v126, v276);
-    let v279: f64 = v47.mul_add(v181, v278);
-    let v280: f64 = v277.mul_add(v243, v279);
-    let v281: f64 = v67.mul_add(v263, v280);
-    let v282: f64 = v234.mul_add(v185, v281);
-    let v283: f64 = 0.25f64 * v11;
-    let c: [[f64; 3usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        3usize,
+    let v12: f64 = c[0][0];
+    let v13: f64 = c[2][0];
+    let v18: f64 = c[1][0];
+    let v47: f64 = c[3][0];
+    let v78: f64 = c[2][1];
+    let v88: f64 = c[3][1];
+    let v144: f64 = c[2][2];
+    let v152: f64 = c[3][2];
+    let v221: f64 = c[1][1];
+    let v234: f64 = c[4][0];
+    let v242: f64 = c[4][1];
+    let v261: f64 = c[4][2];
+    let v526: f64 = c[0][1];
+    let v739: f64 = c[2][3];
+    let v751: f64 = c[3][3];
+    let v881: f64 = c[1][2];
+    let v961: f64 = c[4][3];
+    let v14 = v9.mul_add(v13, v12);
+    let v15 = 0.25f64 * q[0];
+    let v16 = v15 * q[2];
+    let v17 = v16 * v13;
+    let v20 = 0.5f64 * q[1];
+    let v21 = v20 * v18;
+    let v22 = v17 - v21;
+    let v23 = 0.25f64 * q[1];
+    let v24 = v23 * q[2];
+    let v25 = v24 * v13;
+    let v26 = 0.5f64 * q[0];
+    let v27 = v26 * v18;
+    let v28 = v25 + v27;
+    let v29 = v17 + v21;
+    let v30 = v3.mul_add(v13, v12);
+    let v31 = v15 * q[1];
+    let v32 = v31 * v13;
+    let v33 = 0.5f64 * q[2];
+    let v34 = v33 * v18;
+    let v35 = v32 - v34;
+    let v36 = v25 - v27;
+    let v37 = v32 + v34;
+    let v38 = v6.mul_add(v13, v12);
+    let v41 = q[3] + p[0];
+    let v42 = 0.5f64 * v41;
+    let v45 = v23 * q[4];
+    let v46 = v15.mul_add(q[5], -v45);
+    let v48 = 0.25f64 * q[2];
+    let v49 = v15 * q[4];
+    let v50 = v48.mul_add(v41, v49);
+    let v51 = v23.mul_add(q[5], v50);
+    let v52 = v42 * v11;
+    let v53 = v33.mul_add(v51, -v52);
+    let v54 = v13.mul_add(v46, v42);
+    let v55 = v47.mul_add(v53, v54);
+    let v56 = 0.5f64 * q[4];
+    let v57 = v48 * q[5];
+    let v58 = v23.mul_add(v41, -v57);
+    let v59 = v56 * v11;
+    let v60 = v26.mul_add(v51, -v59);
+    let v61 = v13.mul_add(v58, v56);
+    let v62 = v47.mul_add(v60, v61);
+    let v63 = 0.5f64 * q[5];
+    let v64 = v15 * v41;
+    let v65 = v48.mul_add(q[4], -v64);
+    let v66 = v63 * v11;
+    let v67 = v20.mul_add(v51, -v66);
+    let v68 = v13.mul_add(v65, v63);
+    let v69 = v47.mul_add(v67, v68);
+    let v71 = 0.5f64 * qd[3];
+    let v74 = v26 * qd[0];
+    let v76 = v33.mul_add(qd[2], v74);
+    let v77 = v20.mul_add(qd[1], v76);
+    let v79 = v77 * v78;
+    let v80 = 0.25f64 * q[5];
+    let v82 = v15 * qd[5];
+    let v83 = 0.25f64 * q[4];
+    let v85 = v80.mul_add(qd[0], v82);
+    let v86 = (-v83).mul_add(qd[1], v85);
+    let v87 = (-v23).mul_add(qd[4], v86);
+    let v89 = v77 * v88;
+    let v90 = 0.5f64 * qd[2];
+    let v91 = 0.25f64 * qd[2];
+    let v92 = v48 * qd[3];
+    let v93 = v91.mul_add(v41, v92);
+    let v94 = v83.mul_add(qd[0], v93);
+    let v95 = v15.mul_add(qd[4], v94);
+    let v96 = v80.mul_add(qd[1], v95);
+    let v97 = v23.mul_add(qd[5], v96);
+    let v98 = v33 * v97;
+    let v99 = v90.mul_add(v51, v98);
+    let v100 = (-v71).mul_add(v11, v99);
+    let v101 = (-v42).mul_add(v77, v100);
+    let v102 = v46.mul_add(v79, v71);
+    let v103 = v13.mul_add(v87, v102);
+    let v104 = v53.mul_add(v89, v103);
+    let v105 = v47.mul_add(v101, v104);
+    let v106 = 0.5f64 * qd[4];
+    let v107 = 0.25f64 * qd[1];
+    let v108 = v23 * qd[3];
+    let v109 = v107.mul_add(v41, v108);
+    let v110 = (-v80).mul_add(qd[2], v109);
+    let v111 = (-v48).mul_add(qd[5], v110);
+    let v112 = 0.5f64 * qd[0];
+    let v113 = v26 * v97;
+    let v114 = v112.mul_add(v51, v113);
+    let v115 = (-v106).mul_add(v11, v114);
+    let v116 = (-v56).mul_add(v77, v115);
+    let v117 = v58.mul_add(v79, v106);
+    let v118 = v13.mul_add(v111, v117);
+    let v119 = v60.mul_add(v89, v118);
+    let v120 = v47.mul_add(v116, v119);
+    let v121 = 0.5f64 * qd[5];
+    let v122 = v48 * qd[4];
+    let v123 = 0.25f64 * qd[0];
+    let v124 = v83.mul_add(qd[2], v122);
+    let v125 = (-v123).mul_add(v41, v124);
+    let v126 = (-v15).mul_add(qd[3], v125);
+    let v127 = 0.5f64 * qd[1];
+    let v128 = v20 * v97;
+    let v129 = v127.mul_add(v51, v128);
+    let v130 = (-v121).mul_add(v11, v129);
+    let v131 = (-v63).mul_add(v77, v130);
+    let v132 = v65.mul_add(v79, v121);
+    let v133 = v13.mul_add(v126, v132);
+    let v134 = v67.mul_add(v89, v133);
+    let v135 = v47.mul_add(v131, v134);
+    let v137 = 2f64 * v79;
+    let v138 = qd[0] * qd[0];
+    let v139 = qd[1] * qd[1];
+    let v140 = 0.5f64 * v139;
+    let v141 = qd[2] * qd[2];
+    let v142 = 0.5f64.mul_add(v138, v140);
+    let v143 = 0.5f64.mul_add(v141, v142);
+    let v145 = v77 * v77;
+    let v146 = v144 * v145;
+    let v147 = v78.mul_add(v143, v146);
+    let v148 = v46 * v147;
+    let v149 = v127 * qd[4];
+    let v150 = v112.mul_add(qd[5], -v149);
+    let v151 = 2f64 * v89;
+    let v153 = v145 * v152;
+    let v154 = v88.mul_add(v143, v153);
+    let v155 = v112 * qd[4];
+    let v156 = v90.mul_add(qd[3], v155);
+    let v157 = v127.mul_add(qd[5], v156);
+    let v158 = v33 * v157;
+    let v159 = qd[2].mul_add(v97, v158);
+    let v160 = (-qd[3]).mul_add(v77, v159);
+    let v161 = (-v42).mul_add(v143, v160);
+    let v162 = v137.mul_add(v87, v148);
+    let v163 = v13.mul_add(v150, v162);
+    let v164 = v151.mul_add(v101, v163);
+    let v165 = v53.mul_add(v154, v164);
+    let v166 = v47.mul_add(v161, v165);
+    let v167 = v58 * v147;
+    let v168 = v90 * qd[5];
+    let v169 = v127.mul_add(qd[3], -v168);
+    let v170 = v26 * v157;
+    let v171 = qd[0].mul_add(v97, v170);
+    let v172 = (-qd[4]).mul_add(v77, v171);
+    let v173 = (-v56).mul_add(v143, v172);
+    let v174 = v137.mul_add(v111, v167);
+    let v175 = v13.mul_add(v169, v174);
+    let v176 = v151.mul_add(v116, v175);
+    let v177 = v60.mul_add(v154, v176);
+    let v178 = v47.mul_add(v173, v177);
+    let v179 = v65 * v147;
+    let v180 = v112 * qd[3];
+    let v181 = v90.mul_add(qd[4], -v180);
+    let v182 = v20 * v157;
+    let v183 = qd[1].mul_add(v97, v182);
+    let v184 = (-qd[5]).mul_add(v77, v183);
+    let v185 = (-v63).mul_add(v143, v184);
+    let v186 = v137.mul_add(v126, v179);
+    let v187 = v13.mul_add(v181, v186);
+    let v188 = v151.mul_add(v131, v187);
+    let v189 = v67.mul_add(v154, v188);
+    let v190 = v47.mul_add(v185, v189);
+    let v191 = v23 * qd[0];
+    let v192 = v15.mul_add(qd[1], -v191);
+    let v193 = v90 * v18;
+    let v194 = v15 * qd[0];
+    let v195 = v48.mul_add(qd[2], v194);
+    let v196 = v23.mul_add(qd[1], v195);
+    let v197 = v33 * v47;
+    let v198 = v13.mul_add(v192, v193);
+    let v199 = v197.mul_add(v196, v198);
+    let v200 = v48 * qd[1];
+    let v201 = v23.mul_add(qd[2], -v200);
+    let v202 = v112 * v18;
+    let v203 = v26 * v47;
+    let v204 = v13.mul_add(v201, v202);
+    let v205 = v203.mul_add(v196, v204);
+    let v206 = v15 * qd[2];
+    let v207 = v48.mul_add(qd[0], -v206);
+    let v208 = v127 * v18;
+    let v209 = v20 * v47;
+    let v210 = v13.mul_add(v207, v208);
+    let v211 = v209.mul_add(v196, v210);
+    let v212 = 0.5f64 * v196;
+    let v213 = v212 * v89;
+    let v214 = 0.25f64 * v139;
+    let v215 = 0.25f64.mul_add(v138, v214);
+    let v216 = 0.25f64.mul_add(v141, v215);
+    let v217 = 0.5f64 * v47;
+    let v218 = v217.mul_add(v216, v213);
+    let v219 = q[2] * v218;
+    let v220 = v217 * v196;
+    let v222 = v77 * v221;
+    let v223 = 0.5f64 * v222;
+    let v224 = v220 + v223;
+    let v225 = v192.mul_add(v79, v219);
+    let v226 = qd[2].mul_add(v224, v225);
+    let v227 = q[0] * v218;
+    let v228 = v201.mul_add(v79, v227);
+    let v229 = qd[0].mul_add(v224, v228);
+    let v230 = q[1] * v218;
+    let v231 = v207.mul_add(v79, v230);
+    let v232 = qd[1].mul_add(v224, v231);
+    let v233 = 0.25f64 * v41;
+    let v235 = v47.mul_add(v46, v233);
+    let v236 = v234.mul_add(v53, v235);
+    let v237 = v47.mul_add(v58, v83);
+    let v238 = v234.mul_add(v60, v237);
+    let v239 = v47.mul_add(v65, v80);
+    let v240 = v234.mul_add(v67, v239);
+    let v241 = 0.25f64 * qd[3];
+    let v243 = v77 * v242;
+    let v244 = v46.mul_add(v89, v241);
+    let v245 = v47.mul_add(v87, v244);
+    let v246 = v53.mul_add(v243, v245);
+    let v247 = v234.mul_add(v101, v246);
+    let v248 = 0.25f64 * qd[4];
+    let v249 = v58.mul_add(v89, v248);
+    let v250 = v47.mul_add(v111, v249);
+    let v251 = v60.mul_add(v243, v250);
+    let v252 = v234.mul_add(v116, v251);
+    let v253 = 0.25f64 * qd[5];
+    let v254 = v65.mul_add(v89, v253);
+    let v255 = v47.mul_add(v126, v254);
+    let v256 = v67.mul_add(v243, v255);
+    let v257 = v234.mul_add(v131, v256);
+    let v258 = 2f64 * v87;
+    let v259 = v46 * v154;
+    let v260 = 2f64 * v101;
+    let v262 = v145 * v261;
+    let v263 = v143.mul_add(v242, v262);
+    let v264 = v258.mul_add(v89, v259);
+    let v265 = v47.mul_add(v150, v264);
+    let v266 = v260.mul_add(v243, v265);
+    let v267 = v53.mul_add(v263, v266);
+    let v268 = v234.mul_add(v161, v267);
+    let v269 = v58 * v154;
+    let v270 = 2f64 * v116;
+    let v271 = v151.mul_add(v111, v269);
+    let v272 = v47.mul_add(v169, v271);
+    let v273 = v270.mul_add(v243, v272);
+    let v274 = v60.mul_add(v263, v273);
+    let v275 = v234.mul_add(v173, v274);
+    let v276 = v65 * v154;
+    let v277 = 2f64 * v131;
+    let v278 = v151.mul_add(v126, v276);
+    let v279 = v47.mul_add(v181, v278);
+    let v280 = v277.mul_add(v243, v279);
+    let v281 = v67.mul_add(v263, v280);
+    let v282 = v234.mul_add(v185, v281);
+    let v283 = 0.25f64 * v11;
+    let c: [[f64; 3]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        3,
     >(v283);
-    let v284: f64 = c[2usize][0usize];
-    let v290: f64 = c[1usize][0usize];
-    let v292: f64 = c[3usize][0usize];
-    let v313: f64 = c[2usize][1usize];
-    let v315: f64 = c[3usize][1usize];
-    let v326: f64 = c[1usize][1usize];
-    let v1047: f64 = c[2usize][2usize];
-    let v1053: f64 = c[3usize][2usize];
-    let v1067: f64 = c[1usize][2usize];
-    let v286: f64 = 0.0625f64 * q[0usize];
-    let v287: f64 = 0.0625f64 * q[1usize];
-    let v288: f64 = v287 * qd[0usize];
-    let v289: f64 = v286.mul_add(qd[1usize], -v288);
-    let v291: f64 = v91 * v290;
-    let v293: f64 = 0.0625f64 * q[2usize];
-    let v294: f64 = v286 * qd[0usize];
-    let v295: f64 = v293.mul_add(qd[2usize], v294);
-    let v296: f64 = v287.mul_add(qd[1usize], v295);
-    let v297: f64 = v48 * v292;
-    let v298: f64 = v284.mul_add(v289, v291);
-    let v299: f64 = v297.mul_add(v296, v298);
-    let v300: f64 = v293 * qd[1usize];
-    let v301: f64 = v287.mul_add(qd[2usize], -v300);
-    let v302: f64 = v123 * v290;
-    let v303: f64 = v15 * v292;
-    let v304: f64 = v284.mul_add(v301, v302);
-    let v305: f64 = v303.mul_add(v296, v304);
-    let v306: f64 = v286 * qd[2usize];
-    let v307: f64 = v293.mul_add(qd[0usize], -v306);
-    let v308: f64 = v107 * v290;
-    let v309: f64 = v23 * v292;
-    let v310: f64 = v284.mul_add(v307, v308);
-    let v311: f64 = v309.mul_add(v296, v310);
-    let v312: f64 = 0.25f64 * v77;
-    let v314: f64 = v312 * v313;
-    let v316: f64 = v312 * v315;
-    let v317: f64 = 0.25f64 * v296;
-    let v318: f64 = v317 * v316;
-    let v319: f64 = 0.0625f64 * v139;
-    let v320: f64 = 0.0625f64.mul_add(v138, v319);
-    let v321: f64 = 0.0625f64.mul_add(v141, v320);
-    let v322: f64 = 0.25f64 * v292;
-    let v323: f64 = v322.mul_add(v321, v318);
-    let v324: f64 = q[2usize] * v323;
-    let v325: f64 = v322 * v296;
-    let v327: f64 = v312 * v326;
-    let v328: f64 = 0.25f64 * v327;
-    let v329: f64 = v325 + v328;
-    let v330: f64 = v289.mul_add(v314, v324);
-    let v331: f64 = qd[2usize].mul_add(v329, v330);
-    let v332: f64 = q[0usize] * v323;
-    let v333: f64 = v301.mul_add(v314, v332);
-    let v334: f64 = qd[0usize].mul_add(v329, v333);
-    let v335: f64 = q[1usize] * v323;
-    let v336: f64 = v307.mul_add(v314, v335);
-    let v337: f64 = qd[1usize].mul_add(v329, v336);
-    let v339: f64 = 0.0625f64.mul_add(v8, -v283);
-    let v340: f64 = v284.mul_add(v339, 1f64);
-    let v341: f64 = v286 * q[2usize];
-    let v342: f64 = v341 * v284;
-    let v343: f64 = v23.mul_add(v290, v342);
-    let v344: f64 = v287 * q[2usize];
-    let v345: f64 = v15 * v290;
-    let v346: f64 = v344.mul_add(v284, -v345);
-    let v348: f64 = 0.5f64 * p[1usize];
-    let v350: f64 = 0.25f64 * p[3usize];
-    let v352: f64 = p[2usize] - v350;
-    let v354: f64 = 0.125f64.mul_add(v352, v350);
-    let v355: f64 = 0.5f64 * p[3usize];
-    let v356: f64 = v23 * v13;
-    let v357: f64 = 0.125f64 * q[0usize];
-    let v358: f64 = v357 * q[2usize];
-    let v359: f64 = v358 * v47;
-    let v360: f64 = v359 - v356;
-    let v361: f64 = 0.5f64 * v18;
-    let v362: f64 = 0.125f64 * v1;
-    let v363: f64 = v362.mul_add(v47, v361);
-    let v364: f64 = v48 * v13;
-    let v365: f64 = v357 * q[1usize];
-    let v366: f64 = v365 * v47;
-    let v367: f64 = v364 + v366;
-    let v368: f64 = v78 * v26;
-    let v369: f64 = v80 * v13;
-    let v370: f64 = v88 * v26;
-    let v371: f64 = 0.125f64 * q[2usize];
-    let v372: f64 = v42 * v26;
-    let v373: f64 = v371.mul_add(q[4usize], -v372);
-    let v374: f64 = v46.mul_add(v368, v369);
-    let v375: f64 = v53.mul_add(v370, v374);
-    let v376: f64 = v47.mul_add(v373, v375);
-    let v377: f64 = v60 * v370;
-    let v378: f64 = 0.5f64 * v51;
-    let v379: f64 = 0.5f64 * v26;
-    let v380: f64 = v357 - v379;
-    let v381: f64 = q[4usize].mul_add(v380, v378);
-    let v382: f64 = v58.mul_add(v368, v377);
-    let v383: f64 = v47.mul_add(v381, v382);
-    let v384: f64 = v233 * v13;
-    let v385: f64 = 0.125f64 * q[1usize];
-    let v386: f64 = v63 * v26;
-    let v387: f64 = v385.mul_add(q[4usize], -v386);
-    let v388: f64 = v65.mul_add(v368, -v384);
-    let v389: f64 = v67.mul_add(v370, v388);
-    let v390: f64 = v47.mul_add(v387, v389);
-    let v391: f64 = v287 * v284;
-    let v393: f64 = 0.015625f64 * q[0usize];
-    let v394: f64 = v393 * q[2usize];
-    let v395: f64 = v394 * v292;
-    let v396: f64 = v395 - v391;
-    let v397: f64 = 0.25f64 * v290;
-    let v398: f64 = 0.015625f64 * v1;
-    let v399: f64 = v398.mul_add(v292, v397);
-    let v400: f64 = v293 * v284;
-    let v401: f64 = v393 * q[1usize];
-    let v402: f64 = v401 * v292;
-    let v403: f64 = v400 + v402;
-    let v404: f64 = v80 * v47;
-    let v405: f64 = v242 * v26;
-    let v406: f64 = v46.mul_add(v370, v404);
-    let v407: f64 = v53.mul_add(v405, v406);
-    let v408: f64 = v234.mul_add(v373, v407);
-    let v409: f64 = v60 * v405;
-    let v410: f64 = v58.mul_add(v370, v409);
-    let v411: f64 = v234.mul_add(v381, v410);
-    let v412: f64 = v233 * v47;
-    let v413: f64 = v65.mul_add(v370, -v412);
-    let v414: f64 = v67.mul_add(v405, v413);
-    let v415: f64 = v234.mul_add(v387, v414);
-    let v416: f64 = v15 * v13;
-    let v417: f64 = v385 * q[2usize];
-    let v418: f64 = v417 * v47;
-    let v419: f64 = v416 + v418;
-    let v420: f64 = v366 - v364;
-    let v421: f64 = 0.125f64 * v5;
-    let v422: f64 = v421.mul_add(v47, v361);
-    let v423: f64 = v78 * v20;
-    let v424: f64 = v83 * v13;
-    let v425: f64 = v88 * v20;
-    let v426: f64 = v42 * v20;
-    let v427: f64 = v371.mul_add(q[5usize], -v426);
-    let v428: f64 = v46.mul_add(v423, -v424);
-    let v429: f64 = v53.mul_add(v425, v428);
-    let v430: f64 = v47.mul_add(v427, v429);
-    let v431: f64 = v56 * v20;
-    let v432: f64 = v357.mul_add(q[5usize], -v431);
-    let v433: f64 = v58.mul_add(v423, v384);
-    let v434: f64 = v60.mul_add(v425, v433);
-    let v435: f64 = v47.mul_add(v432, v434);
-    let v436: f64 = v67 * v425;
-    let v437: f64 = 0.5f64 * v20;
-    let v438: f64 = v385 - v437;
-    let v439: f64 = q[5usize].mul_add(v438, v378);
-    let v440: f64 = v65.mul_add(v423, v436);
-    let v441: f64 = v47.mul_add(v439, v440);
-    let v442: f64 = v286 * v284;
-    let v443: f64 = 0.015625f64 * q[1usize];
-    let v444: f64 = v443 * q[2usize];
-    let v445: f64 = v444 * v292;
-    let v446: f64 = v442 + v445;
-    let v447: f64 = v402 - v400;
-    let v448: f64 = 0.015625f64 * v5;
-    let v449: f64 = v448.mul_add(v292, v397);
-    let v450: f64 = v83 * v47;
-    let v451: f64 = v242 * v20;
-    let v452: f64 = v46.mul_add(v425, -v450);
-    let v453: f64 = v53.mul_add(v451, v452);
-    let v454: f64 = v234.mul_add(v427, v453);
-    let v455: f64 = v58.mul_add(v425, v412);
-    let v456: f64 = v60.mul_add(v451, v455);
-    let v457: f64 = v234.mul_add(v432, v456);
-    let v458: f64 = v67 * v451;
-    let v459: f64 = v65.mul_add(v425, v458);
-    let v460: f64 = v234.mul_add(v439, v459);
-    let v461: f64 = 0.125f64 * v8;
-    let v462: f64 = v461.mul_add(v47, v361);
-    let v463: f64 = v356 + v359;
-    let v464: f64 = v418 - v416;
-    let v465: f64 = v78 * v33;
-    let v466: f64 = v88 * v33;
-    let v467: f64 = v53 * v466;
-    let v468: f64 = 0.5f64 * v33;
-    let v469: f64 = v371 - v468;
-    let v470: f64 = v41.mul_add(v469, v378);
-    let v471: f64 = v46.mul_add(v465, v467);
-    let v472: f64 = v47.mul_add(v470, v471);
-    let v473: f64 = v56 * v33;
-    let v474: f64 = v357.mul_add(v41, -v473);
-    let v475: f64 = v58.mul_add(v465, -v369);
-    let v476: f64 = v60.mul_add(v466, v475);
-    let v477: f64 = v47.mul_add(v474, v476);
-    let v478: f64 = v63 * v33;
-    let v479: f64 = v385.mul_add(v41, -v478);
-    let v480: f64 = v65.mul_add(v465, v424);
-    let v481: f64 = v67.mul_add(v466, v480);
-    let v482: f64 = v47.mul_add(v479, v481);
-    let v483: f64 = 0.015625f64 * v8;
-    let v484: f64 = v483.mul_add(v292, v397);
-    let v485: f64 = v391 + v395;
-    let v486: f64 = v445 - v442;
-    let v487: f64 = v242 * v33;
-    let v488: f64 = v53 * v487;
-    let v489: f64 = v46.mul_add(v466, v488);
-    let v490: f64 = v234.mul_add(v470, v489);
-    let v491: f64 = v58.mul_add(v466, -v404);
-    let v492: f64 = v60.mul_add(v487, v491);
-    let v493: f64 = v234.mul_add(v474, v492);
-    let v494: f64 = v65.mul_add(v466, v450);
-    let v495: f64 = v67.mul_add(v487, v494);
-    let v496: f64 = v234.mul_add(v479, v495);
-    let v498: f64 = 0.5f64 * v11;
-    let v499: f64 = v461 - v498;
-    let v500: f64 = v47.mul_add(v499, 0.5f64);
-    let v501: f64 = v234.mul_add(v499, 0.25f64);
-    let v502: f64 = v23 * v47;
-    let v503: f64 = v358 * v234;
-    let v504: f64 = v502 + v503;
-    let v505: f64 = v15 * v47;
-    let v506: f64 = v417 * v234;
-    let v507: f64 = v506 - v505;
-    let v508: f64 = v362 - v498;
-    let v509: f64 = v47.mul_add(v508, 0.5f64);
-    let v510: f64 = v503 - v502;
-    let v511: f64 = v234.mul_add(v508, 0.25f64);
-    let v512: f64 = v48 * v47;
-    let v513: f64 = v365 * v234;
-    let v514: f64 = v512 + v513;
-    let v515: f64 = v421 - v498;
-    let v516: f64 = v47.mul_add(v515, 0.5f64);
-    let v517: f64 = v505 + v506;
-    let v518: f64 = v513 - v512;
-    let v519: f64 = v234.mul_add(v515, 0.25f64);
-    let v522: f64 = v20 * dir[1usize];
-    let v524: f64 = v26.mul_add(dir[0usize], v522);
-    let v525: f64 = v33.mul_add(dir[2usize], v524);
-    let v527: f64 = v525 * v526;
-    let v528: f64 = v33 * v13;
-    let v529: f64 = v78 * v525;
-    let v530: f64 = v528.mul_add(dir[2usize], v527);
-    let v531: f64 = v9.mul_add(v529, v530);
-    let v532: f64 = v364 * dir[0usize];
-    let v533: f64 = v361 * dir[1usize];
-    let v534: f64 = v221 * v525;
-    let v535: f64 = v20 * v534;
-    let v536: f64 = 0.25f64 * v13;
-    let v537: f64 = v536 * dir[2usize];
-    let v538: f64 = v48 * v529;
-    let v539: f64 = v537 + v538;
-    let v540: f64 = q[0usize] * v539;
-    let v541: f64 = v532 - v533;
-    let v542: f64 = v541 - v535;
-    let v543: f64 = v542 + v540;
-    let v544: f64 = v364 * dir[1usize];
-    let v545: f64 = v361 * dir[0usize];
-    let v546: f64 = v26 * v534;
-    let v547: f64 = q[1usize] * v539;
-    let v548: f64 = v544 + v545;
-    let v549: f64 = v548 + v546;
-    let v550: f64 = v549 + v547;
-    let v551: f64 = v532 + v533;
-    let v552: f64 = v551 + v535;
-    let v553: f64 = v552 + v540;
-    let v554: f64 = v26 * v13;
-    let v555: f64 = v554.mul_add(dir[0usize], v527);
-    let v556: f64 = v3.mul_add(v529, v555);
-    let v557: f64 = v356 * dir[0usize];
-    let v558: f64 = v361 * dir[2usize];
-    let v559: f64 = v33 * v534;
-    let v560: f64 = v536 * dir[1usize];
-    let v561: f64 = v23 * v529;
-    let v562: f64 = v560 + v561;
-    let v563: f64 = q[0usize] * v562;
-    let v564: f64 = v557 - v558;
-    let v565: f64 = v564 - v559;
-    let v566: f64 = v565 + v563;
-    let v567: f64 = v544 - v545;
-    let v568: f64 = v567 - v546;
-    let v569: f64 = v568 + v547;
-    let v570: f64 = v557 + v558;
-    let v571: f64 = v570 + v559;
-    let v572: f64 = v571 + v563;
-    let v573: f64 = v20 * v13;
-    let v574: f64 = v573.mul_add(dir[1usize], v527);
-    let v575: f64 = v6.mul_add(v529, v574);
-    let v577: f64 = v46 * v529;
-    let v578: f64 = v80 * dir[0usize];
-    let v580: f64 = v83 * dir[1usize];
-    let v582: f64 = v15.mul_add(dir[5usize], v578);
-    let v583: f64 = v582 - v580;
-    let v584: f64 = (-v23).mul_add(dir[4usize], v583);
-    let v585: f64 = v88 * v525;
-    let v586: f64 = v48 * dir[3usize];
-    let v587: f64 = v233.mul_add(dir[2usize], v586);
-    let v588: f64 = v83.mul_add(dir[0usize], v587);
-    let v589: f64 = v15.mul_add(dir[4usize], v588);
-    let v590: f64 = v80.mul_add(dir[1usize], v589);
-    let v591: f64 = v23.mul_add(dir[5usize], v590);
-    let v592: f64 = v33 * v591;
-    let v593: f64 = v378.mul_add(dir[2usize], v592);
-    let v594: f64 = (-v498).mul_add(dir[3usize], v593);
-    let v595: f64 = (-v42).mul_add(v525, v594);
-    let v596: f64 = 0.5f64.mul_add(dir[3usize], v577);
-    let v597: f64 = v13.mul_add(v584, v596);
-    let v598: f64 = v53.mul_add(v585, v597);
-    let v599: f64 = v47.mul_add(v595, v598);
-    let v600: f64 = v58 * v529;
-    let v601: f64 = v233 * dir[1usize];
-    let v602: f64 = v80 * dir[2usize];
-    let v603: f64 = v23.mul_add(dir[3usize], v601);
-    let v604: f64 = v603 - v602;
-    let v605: f64 = (-v48).mul_add(dir[5usize], v604);
-    let v606: f64 = v26 * v591;
-    let v607: f64 = v378.mul_add(dir[0usize], v606);
-    let v608: f64 = (-v498).mul_add(dir[4usize], v607);
-    let v609: f64 = (-v56).mul_add(v525, v608);
-    let v610: f64 = 0.5f64.mul_add(dir[4usize], v600);
-    let v611: f64 = v13.mul_add(v605, v610);
-    let v612: f64 = v60.mul_add(v585, v611);
-    let v613: f64 = v47.mul_add(v609, v612);
-    let v614: f64 = v65 * v529;
-    let v615: f64 = v83 * dir[2usize];
-    let v616: f64 = v233 * dir[0usize];
-    let v617: f64 = v48.mul_add(dir[4usize], v615);
-    let v618: f64 = v617 - v616;
-    let v619: f64 = (-v15).mul_add(dir[3usize], v618);
-    let v620: f64 = v20 * v591;
-    let v621: f64 = v378.mul_add(dir[1usize], v620);
-    let v622: f64 = (-v498).mul_add(dir[5usize], v621);
-    let v623: f64 = (-v63).mul_add(v525, v622);
-    let v624: f64 = 0.5f64.mul_add(dir[5usize], v614);
-    let v625: f64 = v13.mul_add(v619, v624);
-    let v626: f64 = v67.mul_add(v585, v625);
-    let v627: f64 = v47.mul_add(v623, v626);
-    let v629: f64 = v79 * v584;
-    let v631: f64 = v33 * dir[8usize];
-    let v634: f64 = v90.mul_add(dir[2usize], v631);
-    let v635: f64 = v112.mul_add(dir[0usize], v634);
-    let v636: f64 = v26.mul_add(dir[6usize], v635);
-    let v637: f64 = v127.mul_add(dir[1usize], v636);
-    let v638: f64 = v20.mul_add(dir[7usize], v637);
-    let v639: f64 = v77 * v144;
-    let v640: f64 = v639 * v525;
-    let v641: f64 = v78.mul_add(v638, v640);
-    let v642: f64 = v80 * dir[6usize];
-    let v645: f64 = v123.mul_add(dir[5usize], v642);
-    let v646: f64 = v253.mul_add(dir[0usize], v645);
-    let v647: f64 = v15.mul_add(dir[11usize], v646);
-    let v648: f64 = (-v107).mul_add(dir[4usize], v647);
-    let v649: f64 = (-v83).mul_add(dir[7usize], v648);
-    let v650: f64 = (-v248).mul_add(dir[1usize], v649);
-    let v651: f64 = (-v23).mul_add(dir[10usize], v650);
-    let v652: f64 = v77 * v152;
-    let v653: f64 = v652 * v525;
-    let v654: f64 = v88.mul_add(v638, v653);
-    let v655: f64 = v90 * v591;
-    let v656: f64 = 0.5f64 * v97;
-    let v657: f64 = v91 * dir[3usize];
-    let v658: f64 = v233.mul_add(dir[8usize], v657);
-    let v659: f64 = v241.mul_add(dir[2usize], v658);
-    let v660: f64 = v48.mul_add(dir[9usize], v659);
-    let v661: f64 = v123.mul_add(dir[4usize], v660);
-    let v662: f64 = v83.mul_add(dir[6usize], v661);
-    let v663: f64 = v248.mul_add(dir[0usize], v662);
-    let v664: f64 = v15.mul_add(dir[10usize], v663);
-    let v665: f64 = v107.mul_add(dir[5usize], v664);
-    let v666: f64 = v80.mul_add(dir[7usize], v665);
-    let v667: f64 = v253.mul_add(dir[1usize], v666);
-    let v668: f64 = v23.mul_add(dir[11usize], v667);
-    let v669: f64 = 0.5f64 * v77;
-    let v670: f64 = v378.mul_add(dir[8usize], v655);
-    let v671: f64 = v656.mul_add(dir[2usize], v670);
-    let v672: f64 = v33.mul_add(v668, v671);
-    let v673: f64 = (-v498).mul_add(dir[9usize], v672);
-    let v674: f64 = (-v71).mul_add(v525, v673);
-    let v675: f64 = (-v669).mul_add(dir[3usize], v674);
-    let v676: f64 = (-v42).mul_add(v638, v675);
-    let v677: f64 = 0.5f64.mul_add(dir[9usize], v629);
-    let v678: f64 = v46.mul_add(v641, v677);
-    let v679: f64 = v87.mul_add(v529, v678);
-    let v680: f64 = v13.mul_add(v651, v679);
-    let v681: f64 = v89.mul_add(v595, v680);
-    let v682: f64 = v53.mul_add(v654, v681);
-    let v683: f64 = v101.mul_add(v585, v682);
-    let v684: f64 = v47.mul_add(v676, v683);
-    let v685: f64 = v79 * v605;
-    let v686: f64 = v107 * dir[3usize];
-    let v687: f64 = v233.mul_add(dir[7usize], v686);
-    let v688: f64 = v241.mul_add(dir[1usize], v687);
-    let v689: f64 = v23.mul_add(dir[9usize], v688);
-    let v690: f64 = (-v91).mul_add(dir[5usize], v689);
-    let v691: f64 = (-v80).mul_add(dir[8usize], v690);
-    let v692: f64 = (-v253).mul_add(dir[2usize], v691);
-    let v693: f64 = (-v48).mul_add(dir[11usize], v692);
-    let v694: f64 = v112 * v591;
-    let v695: f64 = v378.mul_add(dir[6usize], v694);
-    let v696: f64 = v656.mul_add(dir[0usize], v695);
-    let v697: f64 = v26.mul_add(v668, v696);
-    let v698: f64 = (-v498).mul_add(dir[10usize], v697);
-    let v699: f64 = (-v106).mul_add(v525, v698);
-    let v700: f64 = (-v669).mul_add(dir[4usize], v699);
-    let v701: f64 = (-v56).mul_add(v638, v700);
-    let v702: f64 = 0.5f64.mul_add(dir[10usize], v685);
-    let v703: f64 = v58.mul_add(v641, v702);
-    let v704: f64 = v111.mul_add(v529, v703);
-    let v705: f64 = v13.mul_add(v693, v704);
-    let v706: f64 = v89.mul_add(v609, v705);
-    let v707: f64 = v60.mul_add(v654, v706);
-    let v708: f64 = v116.mul_add(v585, v707);
-    let v709: f64 = v47.mul_add(v701, v708);
-    let v710: f64 = v79 * v619;
-    let v711: f64 = v83 * dir[8usize];
-    let v712: f64 = v91.mul_add(dir[4usize], v711);
-    let v713: f64 = v248.mul_add(dir[2usize], v712);
-    let v714: f64 = v48.mul_add(dir[10usize], v713);
-    let v715: f64 = (-v233).mul_add(dir[6usize], v714);
-    let v716: f64 = (-v123).mul_add(dir[3usize], v715);
-    let v717: f64 = (-v241).mul_add(dir[0usize], v716);
-    let v718: f64 = (-v15).mul_add(dir[9usize], v717);
-    let v719: f64 = v127 * v591;
-    let v720: f64 = v378.mul_add(dir[7usize], v719);
-    let v721: f64 = v656.mul_add(dir[1usize], v720);
-    let v722: f64 = v20.mul_add(v668, v721);
-    let v723: f64 = (-v498).mul_add(dir[11usize], v722);
-    let v724: f64 = (-v121).mul_add(v525, v723);
-    let v725: f64 = (-v669).mul_add(dir[5usize], v724);
-    let v726: f64 = (-v63).mul_add(v638, v725);
-    let v727: f64 = 0.5f64.mul_add(dir[11usize], v710);
-    let v728: f64 = v65.mul_add(v641, v727);
-    let v729: f64 = v126.mul_add(v529, v728);
-    let v730: f64 = v13.mul_add(v718, v729);
-    let v731: f64 = v89.mul_add(v623, v730);
-    let v732: f64 = v67.mul_add(v654, v731);
-    let v733: f64 = v131.mul_add(v585, v732);
-    let v734: f64 = v47.mul_add(v726, v733);
-    let v735: f64 = v137 * v651;
-    let v736: f64 = qd[1usize] * dir[7usize];
-    let v737: f64 = qd[0usize].mul_add(dir[6usize], v736);
-    let v738: f64 = qd[2usize].mul_add(dir[8usize], v737);
-    let v740: f64 = v145 * v525;
-    let v741: f64 = v740 * v739;
-    let v742: f64 = 2f64 * v77;
-    let v743: f64 = v742 * v638;
-    let v744: f64 = v143.mul_add(v525, v743);
-    let v745: f64 = v78.mul_add(v738, v741);
-    let v746: f64 = v144.mul_add(v744, v745);
-    let v747: f64 = v112 * dir[11usize];
-    let v748: f64 = v121.mul_add(dir[6usize], v747);
-    let v749: f64 = (-v106).mul_add(dir[7usize], v748);
-    let v750: f64 = (-v127).mul_add(dir[10usize], v749);
-    let v752: f64 = v740 * v751;
-    let v753: f64 = v88.mul_add(v738, v752);
-    let v754: f64 = v152.mul_add(v744, v753);
-    let v755: f64 = qd[2usize] * v668;
-    let v756: f64 = 0.5f64 * v157;
-    let v757: f64 = v90 * dir[9usize];
-    let v758: f64 = v71.mul_add(dir[8usize], v757);
-    let v759: f64 = v106.mul_add(dir[6usize], v758);
-    let v760: f64 = v112.mul_add(dir[10usize], v759);
-    let v761: f64 = v121.mul_add(dir[7usize], v760);
-    let v762: f64 = v127.mul_add(dir[11usize], v761);
-    let v763: f64 = 0.5f64 * v143;
-    let v764: f64 = v97.mul_add(dir[8usize], v755);
-    let v765: f64 = v756.mul_add(dir[2usize], v764);
-    let v766: f64 = v33.mul_add(v762, v765);
-    let v767: f64 = (-v77).mul_add(dir[9usize], v766);
-    let v768: f64 = (-qd[3usize]).mul_add(v638, v767);
-    let v769: f64 = (-v763).mul_add(dir[3usize], v768);
-    let v770: f64 = (-v42).mul_add(v738, v769);
-    let v771: f64 = v258.mul_add(v641, v735);
-    let v772: f64 = v147.mul_add(v584, v771);
-    let v773: f64 = v46.mul_add(v746, v772);
-    let v774: f64 = v150.mul_add(v529, v773);
-    let v775: f64 = v13.mul_add(v750, v774);
-    let v776: f64 = v260.mul_add(v654, v775);
-    let v777: f64 = v151.mul_add(v676, v776);
-    let v778: f64 = v154.mul_add(v595, v777);
-    let v779: f64 = v53.mul_add(v754, v778);
-    let v780: f64 = v161.mul_add(v585, v779);
-    let v781: f64 = v47.mul_add(v770, v780);
-    let v782: f64 = 2f64 * v111;
-    let v783: f64 = v137 * v693;
-    let v784: f64 = v127 * dir[9usize];
-    let v785: f64 = v71.mul_add(dir[7usize], v784);
-    let v786: f64 = (-v121).mul_add(dir[8usize], v785);
-    let v787: f64 = (-v90).mul_add(dir[11usize], v786);
-    let v788: f64 = qd[0usize] * v668;
-    let v789: f64 = v97.mul_add(dir[6usize], v788);
-    let v790: f64 = v756.mul_add(dir[0usize], v789);
-    let v791: f64 = v26.mul_add(v762, v790);
-    let v792: f64 = (-v77).mul_add(dir[10usize], v791);
-    let v793: f64 = (-qd[4usize]).mul_add(v638, v792);
-    let v794: f64 = (-v763).mul_add(dir[4usize], v793);
-    let v795: f64 = (-v56).mul_add(v738, v794);
-    let v796: f64 = v782.mul_add(v641, v783);
-    let v797: f64 = v147.mul_add(v605, v796);
-    let v798: f64 = v58.mul_add(v746, v797);
-    let v799: f64 = v169.mul_add(v529, v798);
-    let v800: f64 = v13.mul_add(v787, v799);
-    let v801: f64 = v270.mul_add(v654, v800);
-    let v802: f64 = v151.mul_add(v701, v801);
-    let v803: f64 = v154.mul_add(v609, v802);
-    let v804: f64 = v60.mul_add(v754, v803);
-    let v805: f64 = v173.mul_add(v585, v804);
-    let v806: f64 = v47.mul_add(v795, v805);
-    let v807: f64 = 2f64 * v126;
-    let v808: f64 = v137 * v718;
-    let v809: f64 = v90 * dir[10usize];
-    let v810: f64 = v106.mul_add(dir[8usize], v809);
-    let v811: f64 = (-v71).mul_add(dir[6usize], v810);
-    let v812: f64 = (-v112).mul_add(dir[9usize], v811);
-    let v813: f64 = qd[1usize] * v668;
-    let v814: f64 = v97.mul_add(dir[7usize], v813);
-    let v815: f64 = v756.mul_add(dir[1usize], v814);
-    let v816: f64 = v20.mul_add(v762, v815);
-    let v817: f64 = (-v77).mul_add(dir[11usize], v816);
-    let v818: f64 = (-qd[5usize]).mul_add(v638, v817);
-    let v819: f64 = (-v763).mul_add(dir[5usize], v818);
-    let v820: f64 = (-v63).mul_add(v738, v819);
-    let v821: f64 = v807.mul_add(v641, v808);
-    let v822: f64 = v147.mul_add(v619, v821);
-    let v823: f64 = v65.mul_add(v746, v822);
-    let v824: f64 = v181.mul_add(v529, v823);
-    let v825: f64 = v13.mul_add(v812, v824);
-    let v826: f64 = v277.mul_add(v654, v825);
-    let v827: f64 = v151.mul_add(v726, v826);
-    let v828: f64 = v154.mul_add(v623, v827);
-    let v829: f64 = v67.mul_add(v754, v828);
-    let v830: f64 = v185.mul_add(v585, v829);
-    let v831: f64 = v47.mul_add(v820, v830);
-    let v832: f64 = v15 * dir[7usize];
-    let v833: f64 = v107.mul_add(dir[0usize], v832);
-    let v834: f64 = (-v123).mul_add(dir[1usize], v833);
-    let v835: f64 = (-v23).mul_add(dir[6usize], v834);
-    let v836: f64 = v13 * v835;
-    let v837: f64 = v212 * v585;
-    let v838: f64 = v48 * dir[8usize];
-    let v839: f64 = v91.mul_add(dir[2usize], v838);
-    let v840: f64 = v123.mul_add(dir[0usize], v839);
-    let v841: f64 = v15.mul_add(dir[6usize], v840);
-    let v842: f64 = v107.mul_add(dir[1usize], v841);
-    let v843: f64 = v23.mul_add(dir[7usize], v842);
-    let v844: f64 = v217 * v843;
-    let v845: f64 = v837 + v844;
-    let v846: f64 = v192.mul_add(v529, v836);
-    let v847: f64 = v361.mul_add(dir[8usize], v846);
-    let v848: f64 = v90.mul_add(v534, v847);
-    let v849: f64 = v220.mul_add(dir[2usize], v848);
-    let v850: f64 = q[2usize].mul_add(v845, v849);
-    let v851: f64 = v23 * dir[8usize];
-    let v852: f64 = v91.mul_add(dir[1usize], v851);
-    let v853: f64 = (-v107).mul_add(dir[2usize], v852);
-    let v854: f64 = (-v48).mul_add(dir[7usize], v853);
-    let v855: f64 = v13 * v854;
-    let v856: f64 = v201.mul_add(v529, v855);
-    let v857: f64 = v361.mul_add(dir[6usize], v856);
-    let v858: f64 = v112.mul_add(v534, v857);
-    let v859: f64 = v220.mul_add(dir[0usize], v858);
-    let v860: f64 = q[0usize].mul_add(v845, v859);
-    let v861: f64 = v48 * dir[6usize];
-    let v862: f64 = v123.mul_add(dir[2usize], v861);
-    let v863: f64 = (-v91).mul_add(dir[0usize], v862);
-    let v864: f64 = (-v15).mul_add(dir[8usize], v863);
-    let v865: f64 = v13 * v864;
-    let v866: f64 = v207.mul_add(v529, v865);
-    let v867: f64 = v361.mul_add(dir[7usize], v866);
-    let v868: f64 = v127.mul_add(v534, v867);
-    let v869: f64 = v220.mul_add(dir[1usize], v868);
-    let v870: f64 = q[1usize].mul_add(v845, v869);
-    let v871: f64 = v192 * v641;
-    let v872: f64 = 0.5f64 * v89;
-    let v873: f64 = v212 * v654;
-    let v874: f64 = 0.5f64 * v216;
-    let v875: f64 = v127 * dir[7usize];
-    let v876: f64 = v112.mul_add(dir[6usize], v875);
-    let v877: f64 = v90.mul_add(dir[8usize], v876);
-    let v878: f64 = v872.mul_add(v843, v873);
-    let v879: f64 = v874.mul_add(v585, v878);
-    let v880: f64 = v217.mul_add(v877, v879);
-    let v882: f64 = v77 * v525;
-    let v883: f64 = v882 * v881;
-    let v884: f64 = v221.mul_add(v638, v883);
-    let v885: f64 = 0.5f64.mul_add(v884, v837);
-    let v886: f64 = v885 + v844;
-    let v887: f64 = v874 * dir[2usize];
-    let v888: f64 = v212.mul_add(dir[8usize], v887);
-    let v889: f64 = v79.mul_add(v835, v871);
-    let v890: f64 = v223.mul_add(dir[8usize], v889);
-    let v891: f64 = v213.mul_add(dir[2usize], v890);
-    let v892: f64 = q[2usize].mul_add(v880, v891);
-    let v893: f64 = qd[2usize].mul_add(v886, v892);
-    let v894: f64 = v47.mul_add(v888, v893);
-    let v895: f64 = v201 * v641;
-    let v896: f64 = v874 * dir[0usize];
-    let v897: f64 = v212.mul_add(dir[6usize], v896);
-    let v898: f64 = v79.mul_add(v854, v895);
-    let v899: f64 = v223.mul_add(dir[6usize], v898);
-    let v900: f64 = v213.mul_add(dir[0usize], v899);
-    let v901: f64 = q[0usize].mul_add(v880, v900);
-    let v902: f64 = qd[0usize].mul_add(v886, v901);
-    let v903: f64 = v47.mul_add(v897, v902);
-    let v904: f64 = v207 * v641;
-    let v905: f64 = v874 * dir[1usize];
-    let v906: f64 = v212.mul_add(dir[7usize], v905);
-    let v907: f64 = v79.mul_add(v864, v904);
-    let v908: f64 = v223.mul_add(dir[7usize], v907);
-    let v909: f64 = v213.mul_add(dir[1usize], v908);
-    let v910: f64 = q[1usize].mul_add(v880, v909);
-    let v911: f64 = qd[1usize].mul_add(v886, v910);
-    let v912: f64 = v47.mul_add(v906, v911);
-    let v913: f64 = v46 * v585;
-    let v914: f64 = v242 * v525;
-    let v915: f64 = 0.25f64.mul_add(dir[3usize], v913);
-    let v916: f64 = v47.mul_add(v584, v915);
-    let v917: f64 = v53.mul_add(v914, v916);
-    let v918: f64 = v234.mul_add(v595, v917);
-    let v919: f64 = v58 * v585;
-    let v920: f64 = 0.25f64.mul_add(dir[4usize], v919);
-    let v921: f64 = v47.mul_add(v605, v920);
-    let v922: f64 = v60.mul_add(v914, v921);
-    let v923: f64 = v234.mul_add(v609, v922);
-    let v924: f64 = v65 * v585;
-    let v925: f64 = 0.25f64.mul_add(dir[5usize], v924);
-    let v926: f64 = v47.mul_add(v619, v925);
-    let v927: f64 = v67.mul_add(v914, v926);
-    let v928: f64 = v234.mul_add(v623, v927);
-    let v929: f64 = v89 * v584;
-    let v930: f64 = v77 * v261;
-    let v931: f64 = v930 * v525;
-    let v932: f64 = v242.mul_add(v638, v931);
-    let v933: f64 = 0.25f64.mul_add(dir[9usize], v929);
-    let v934: f64 = v46.mul_add(v654, v933);
-    let v935: f64 = v87.mul_add(v585, v934);
-    let v936: f64 = v47.mul_add(v651, v935);
-    let v937: f64 = v243.mul_add(v595, v936);
-    let v938: f64 = v53.mul_add(v932, v937);
-    let v939: f64 = v101.mul_add(v914, v938);
-    let v940: f64 = v234.mul_add(v676, v939);
-    let v941: f64 = v89 * v605;
-    let v942: f64 = 0.25f64.mul_add(dir[10usize], v941);
-    let v943: f64 = v58.mul_add(v654, v942);
-    let v944: f64 = v111.mul_add(v585, v943);
-    let v945: f64 = v47.mul_add(v693, v944);
-    let v946: f64 = v243.mul_add(v609, v945);
-    let v947: f64 = v60.mul_add(v932, v946);
-    let v948: f64 = v116.mul_add(v914, v947);
-    let v949: f64 = v234.mul_add(v701, v948);
-    let v950: f64 = v89 * v619;
-    let v951: f64 = 0.25f64.mul_add(dir[11usize], v950);
-    let v952: f64 = v65.mul_add(v654, v951);
-    let v953: f64 = v126.mul_add(v585, v952);
-    let v954: f64 = v47.mul_add(v718, v953);
-    let v955: f64 = v243.mul_add(v623, v954);
-    let v956: f64 = v67.mul_add(v932, v955);
-    let v957: f64 = v131.mul_add(v914, v956);
-    let v958: f64 = v234.mul_add(v726, v957);
-    let v959: f64 = v258 * v654;
-    let v960: f64 = 2f64 * v243;
-    let v962: f64 = v740 * v961;
-    let v963: f64 = v242.mul_add(v738, v962);
-    let v964: f64 = v261.mul_add(v744, v963);
-    let v965: f64 = v151.mul_add(v651, v959);
-    let v966: f64 = v154.mul_add(v584, v965);
-    let v967: f64 = v46.mul_add(v754, v966);
-    let v968: f64 = v150.mul_add(v585, v967);
-    let v969: f64 = v47.mul_add(v750, v968);
-    let v970: f64 = v960.mul_add(v676, v969);
-    let v971: f64 = v260.mul_add(v932, v970);
-    let v972: f64 = v263.mul_add(v595, v971);
-    let v973: f64 = v53.mul_add(v964, v972);
-    let v974: f64 = v161.mul_add(v914, v973);
-    let v975: f64 = v234.mul_add(v770, v974);
-    let v976: f64 = v151 * v693;
-    let v977: f64 = v782.mul_add(v654, v976);
-    let v978: f64 = v154.mul_add(v605, v977);
-    let v979: f64 = v58.mul_add(v754, v978);
-    let v980: f64 = v169.mul_add(v585, v979);
-    let v981: f64 = v47.mul_add(v787, v980);
-    let v982: f64 = v960.mul_add(v701, v981);
-    let v983: f64 = v270.mul_add(v932, v982);
-    let v984: f64 = v263.mul_add(v609, v983);
-    let v985: f64 = v60.mul_add(v964, v984);
-    let v986: f64 = v173.mul_add(v914, v985);
-    let v987: f64 = v234.mul_add(v795, v986);
-    let v988: f64 = v151 * v718;
-    let v989: f64 = v807.mul_add(v654, v988);
-    let v990: f64 = v154.mul_add(v619, v989);
-    let v991: f64 = v65.mul_add(v754, v990);
-    let v992: f64 = v181.mul_add(v585, v991);
-    let v993: f64 = v47.mul_add(v812, v992);
-    let v994: f64 = v960.mul_add(v726, v993);
-    let v995: f64 = v277.mul_add(v932, v994);
-    let v996: f64 = v263.mul_add(v623, v995);
-    let v997: f64 = v67.mul_add(v964, v996);
-    let v998: f64 = v185.mul_add(v914, v997);
-    let v999: f64 = v234.mul_add(v820, v998);
-    let v1000: f64 = 0.25f64 * v525;
-    let v1001: f64 = v313 * v1000;
-    let v1002: f64 = 0.0625f64 * qd[1usize];
-    let v1003: f64 = v286 * dir[7usize];
-    let v1004: f64 = 0.0625f64 * qd[0usize];
-    let v1005: f64 = v1002.mul_add(dir[0usize], v1003);
-    let v1006: f64 = (-v1004).mul_add(dir[1usize], v1005);
-    let v1007: f64 = (-v287).mul_add(dir[6usize], v1006);
-    let v1008: f64 = v284 * v1007;
-    let v1009: f64 = v326 * v1000;
-    let v1010: f64 = v315 * v1000;
-    let v1011: f64 = v317 * v1010;
-    let v1012: f64 = 0.0625f64 * qd[2usize];
-    let v1013: f64 = v293 * dir[8usize];
-    let v1014: f64 = v1012.mul_add(dir[2usize], v1013);
-    let v1015: f64 = v1004.mul_add(dir[0usize], v1014);
-    let v1016: f64 = v286.mul_add(dir[6usize], v1015);
-    let v1017: f64 = v1002.mul_add(dir[1usize], v1016);
-    let v1018: f64 = v287.mul_add(dir[7usize], v1017);
-    let v1019: f64 = v322 * v1018;
-    let v1020: f64 = v1011 + v1019;
-    let v1021: f64 = v289.mul_add(v1001, v1008);
-    let v1022: f64 = v397.mul_add(dir[8usize], v1021);
-    let v1023: f64 = v91.mul_add(v1009, v1022);
-    let v1024: f64 = v325.mul_add(dir[2usize], v1023);
-    let v1025: f64 = q[2usize].mul_add(v1020, v1024);
-    let v1026: f64 = v287 * dir[8usize];
-    let v1027: f64 = v1012.mul_add(dir[1usize], v1026);
-    let v1028: f64 = (-v1002).mul_add(dir[2usize], v1027);
-    let v1029: f64 = (-v293).mul_add(dir[7usize], v1028);
-    let v1030: f64 = v284 * v1029;
-    let v1031: f64 = v301.mul_add(v1001, v1030);
-    let v1032: f64 = v397.mul_add(dir[6usize], v1031);
-    let v1033: f64 = v123.mul_add(v1009, v1032);
-    let v1034: f64 = v325.mul_add(dir[0usize], v1033);
-    let v1035: f64 = q[0usize].mul_add(v1020, v1034);
-    let v1036: f64 = v293 * dir[6usize];
-    let v1037: f64 = v1004.mul_add(dir[2usize], v1036);
-    let v1038: f64 = (-v1012).mul_add(dir[0usize], v1037);
-    let v1039: f64 = (-v286).mul_add(dir[8usize], v1038);
-    let v1040: f64 = v284 * v1039;
-    let v1041: f64 = v307.mul_add(v1001, v1040);
-    let v1042: f64 = v397.mul_add(dir[7usize], v1041);
-    let v1043: f64 = v107.mul_add(v1009, v1042);
-    let v1044: f64 = v325.mul_add(dir[1usize], v1043);
-    let v1045: f64 = q[1usize].mul_add(v1020, v1044);
-    let v1046: f64 = 0.25f64 * v638;
-    let v1048: f64 = v312 * v1000;
-    let v1049: f64 = v1048 * v1047;
-    let v1050: f64 = v313.mul_add(v1046, v1049);
-    let v1051: f64 = v289 * v1050;
-    let v1052: f64 = 0.25f64 * v316;
-    let v1054: f64 = v1048 * v1053;
-    let v1055: f64 = v315.mul_add(v1046, v1054);
-    let v1056: f64 = v317 * v1055;
-    let v1057: f64 = 0.25f64 * v321;
-    let v1058: f64 = 0.125f64 * qd[0usize];
-    let v1059: f64 = 0.125f64 * qd[1usize];
-    let v1060: f64 = v1059 * dir[7usize];
-    let v1061: f64 = 0.125f64 * qd[2usize];
-    let v1062: f64 = v1058.mul_add(dir[6usize], v1060);
-    let v1063: f64 = v1061.mul_add(dir[8usize], v1062);
-    let v1064: f64 = v1052.mul_add(v1018, v1056);
-    let v1065: f64 = v1057.mul_add(v1010, v1064);
-    let v1066: f64 = v322.mul_add(v1063, v1065);
-    let v1068: f64 = v1048 * v1067;
-    let v1069: f64 = v326.mul_add(v1046, v1068);
-    let v1070: f64 = 0.25f64.mul_add(v1069, v1011);
-    let v1071: f64 = v1070 + v1019;
-    let v1072: f64 = v1057 * dir[2usize];
-    let v1073: f64 = v317.mul_add(dir[8usize], v1072);
-    let v1074: f64 = v314.mul_add(v1007, v1051);
-    let v1075: f64 = v328.mul_add(dir[8usize], v1074);
-    let v1076: f64 = v318.mul_add(dir[2usize], v1075);
-    let v1077: f64 = q[2usize].mul_add(v1066, v1076);
-    let v1078: f64 = qd[2usize].mul_add(v1071, v1077);
-    let v1079: f64 = v292.mul_add(v1073, v1078);
-    let v1080: f64 = v301 * v1050;
-    let v1081: f64 = v1057 * dir[0usize];
-    let v1082: f64 = v317.mul_add(dir[6usize], v1081);
-    let v1083: f64 = v314.mul_add(v1029, v1080);
-    let v1084: f64 = v328.mul_add(dir[6usize], v1083);
-    let v1085: f64 = v318.mul_add(dir[0usize], v1084);
-    let v1086: f64 = q[0usize].mul_add(v1066, v1085);
-    let v1087: f64 = qd[0usize].mul_add(v1071, v1086);
-    let v1088: f64 = v292.mul_add(v1082, v1087);
-    let v1089: f64 = v307 * v1050;
-    let v1090: f64 = v1057 * dir[1usize];
-    let v1091: f64 = v317.mul_add(dir[7usize], v1090);
-    let v1092: f64 = v314.mul_add(v1039, v1089);
-    let v1093: f64 = v328.mul_add(dir[7usize], v1092);
-    let v1094: f64 = v318.mul_add(dir[1usize], v1093);
-    let v1095: f64 = q[1usize].mul_add(v1066, v1094);
-    let v1096: f64 = qd[1usize].mul_add(v1071, v1095);
-    let v1097: f64 = v292.mul_add(v1091, v1096);
-    let v1098: f64 = v371.mul_add(dir[2usize], -v1000);
-    let v1099: f64 = v339 * v1001;
-    let v1100: f64 = v284.mul_add(v1098, v1099);
-    let v1101: f64 = v23 * v1009;
-    let v1102: f64 = 0.0625f64 * v284;
-    let v1103: f64 = v1102 * dir[2usize];
-    let v1104: f64 = v293 * v1001;
-    let v1105: f64 = v1103 + v1104;
-    let v1106: f64 = v397.mul_add(dir[1usize], v1101);
-    let v1107: f64 = v400.mul_add(dir[0usize], v1106);
-    let v1108: f64 = q[0usize].mul_add(v1105, v1107);
-    let v1109: f64 = v397 * dir[0usize];
-    let v1110: f64 = v400.mul_add(dir[1usize], -v1109);
-    let v1111: f64 = (-v15).mul_add(v1009, v1110);
-    let v1112: f64 = q[1usize].mul_add(v1105, v1111);
-    let v1113: f64 = v371 * v47;
-    let v1114: f64 = v1113 * dir[0usize];
-    let v1115: f64 = 0.125f64 * v47;
-    let v1116: f64 = v371 * v585;
-    let v1117: f64 = v1115.mul_add(dir[2usize], v1116);
-    let v1118: f64 = q[0usize] * v1117;
-    let v1119: f64 = v1114 - v560;
-    let v1120: f64 = v1119 - v561;
-    let v1121: f64 = v1120 + v1118;
-    let v1122: f64 = 0.5f64 * v534;
-    let v1123: f64 = v505.mul_add(dir[0usize], v1122);
-    let v1124: f64 = v362.mul_add(v585, v1123);
-    let v1125: f64 = v385 * v47;
-    let v1126: f64 = v1125 * dir[0usize];
-    let v1127: f64 = v385 * v585;
-    let v1128: f64 = v1115.mul_add(dir[1usize], v1127);
-    let v1129: f64 = q[0usize] * v1128;
-    let v1130: f64 = v539 + v1126;
-    let v1131: f64 = v1130 + v1129;
-    let v1132: f64 = v144 * v26;
-    let v1133: f64 = 0.5f64 * v78;
-    let v1134: f64 = v1133 * dir[0usize];
-    let v1135: f64 = v1132.mul_add(v525, v1134);
-    let v1136: f64 = v46 * v1135;
-    let v1137: f64 = v536 * dir[5usize];
-    let v1138: f64 = v80 * v529;
-    let v1139: f64 = v152 * v26;
-    let v1140: f64 = 0.5f64 * v88;
-    let v1141: f64 = v1140 * dir[0usize];
-    let v1142: f64 = v1139.mul_add(v525, v1141);
-    let v1143: f64 = 0.125f64 * q[4usize];
-    let v1144: f64 = v371 * dir[4usize];
-    let v1145: f64 = v1143.mul_add(dir[2usize], v1144);
-    let v1146: f64 = v1145 - v616;
-    let v1147: f64 = (-v379).mul_add(dir[3usize], v1146);
-    let v1148: f64 = v368.mul_add(v584, v1136);
-    let v1149: f64 = v1148 + v1137;
-    let v1150: f64 = v1149 + v1138;
-    let v1151: f64 = v370.mul_add(v595, v1150);
-    let v1152: f64 = v53.mul_add(v1142, v1151);
-    let v1153: f64 = v373.mul_add(v585, v1152);
-    let v1154: f64 = v47.mul_add(v1147, v1153);
-    let v1155: f64 = v58 * v1135;
-    let v1156: f64 = 0.5f64 * v591;
-    let v1157: f64 = (-v1143).mul_add(dir[0usize], v1156);
-    let v1158: f64 = v380.mul_add(dir[4usize], v1157);
-    let v1159: f64 = v368.mul_add(v605, v1155);
-    let v1160: f64 = v370.mul_add(v609, v1159);
-    let v1161: f64 = v60.mul_add(v1142, v1160);
-    let v1162: f64 = v381.mul_add(v585, v1161);
-    let v1163: f64 = v47.mul_add(v1158, v1162);
-    let v1164: f64 = v65 * v1135;
-    let v1165: f64 = v536 * dir[3usize];
-    let v1166: f64 = v233 * v529;
-    let v1167: f64 = v1143.mul_add(dir[1usize], -v578);
-    let v1168: f64 = v385.mul_add(dir[4usize], v1167);
-    let v1169: f64 = (-v379).mul_add(dir[5usize], v1168);
-    let v1170: f64 = v368.mul_add(v619, v1164);
-    let v1171: f64 = v1170 - v1165;
-    let v1172: f64 = v1171 - v1166;
-    let v1173: f64 = v370.mul_add(v623, v1172);
-    let v1174: f64 = v67.mul_add(v1142, v1173);
-    let v1175: f64 = v387.mul_add(v585, v1174);
-    let v1176: f64 = v47.mul_add(v1169, v1175);
-    let v1177: f64 = v1102 * dir[1usize];
-    let v1178: f64 = v287 * v1001;
-    let v1179: f64 = 0.015625f64 * q[2usize];
-    let v1180: f64 = v1179 * v292;
-    let v1181: f64 = v1180 * dir[0usize];
-    let v1182: f64 = 0.015625f64 * v292;
-    let v1183: f64 = v1179 * v1010;
-    let v1184: f64 = v1182.mul_add(dir[2usize], v1183);
-    let v1185: f64 = q[0usize] * v1184;
-    let v1186: f64 = v1181 - v1177;
-    let v1187: f64 = v1186 - v1178;
-    let v1188: f64 = v1187 + v1185;
-    let v1189: f64 = 0.25f64 * v1009;
-    let v1191: f64 = 0.03125f64 * q[0usize];
-    let v1192: f64 = v1191 * v292;
-    let v1193: f64 = v1192.mul_add(dir[0usize], v1189);
-    let v1194: f64 = v398.mul_add(v1010, v1193);
-    let v1195: f64 = v443 * v292;
-    let v1196: f64 = v1195 * dir[0usize];
-    let v1197: f64 = v443 * v1010;
-    let v1198: f64 = v1182.mul_add(dir[1usize], v1197);
-    let v1199: f64 = q[0usize] * v1198;
-    let v1200: f64 = v1105 + v1196;
-    let v1201: f64 = v1200 + v1199;
-    let v1202: f64 = v46 * v1142;
-    let v1203: f64 = 0.25f64 * v47;
-    let v1204: f64 = v1203 * dir[5usize];
-    let v1205: f64 = v80 * v585;
-    let v1206: f64 = v261 * v26;
-    let v1207: f64 = 0.5f64 * v242;
-    let v1208: f64 = v1207 * dir[0usize];
-    let v1209: f64 = v1206.mul_add(v525, v1208);
-    let v1210: f64 = v370.mul_add(v584, v1202);
-    let v1211: f64 = v1210 + v1204;
-    let v1212: f64 = v1211 + v1205;
-    let v1213: f64 = v405.mul_add(v595, v1212);
-    let v1214: f64 = v53.mul_add(v1209, v1213);
-    let v1215: f64 = v373.mul_add(v914, v1214);
-    let v1216: f64 = v234.mul_add(v1147, v1215);
-    let v1217: f64 = v58 * v1142;
-    let v1218: f64 = v370.mul_add(v605, v1217);
-    let v1219: f64 = v405.mul_add(v609, v1218);
-    let v1220: f64 = v60.mul_add(v1209, v1219);
-    let v1221: f64 = v381.mul_add(v914, v1220);
-    let v1222: f64 = v234.mul_add(v1158, v1221);
-    let v1223: f64 = v65 * v1142;
-    let v1224: f64 = v1203 * dir[3usize];
-    let v1225: f64 = v233 * v585;
-    let v1226: f64 = v370.mul_add(v619, v1223);
-    let v1227: f64 = v1226 - v1224;
-    let v1228: f64 = v1227 - v1225;
-    let v1229: f64 = v405.mul_add(v623, v1228);
-    let v1230: f64 = v67.mul_add(v1209, v1229);
-    let v1231: f64 = v387.mul_add(v914, v1230);
-    let v1232: f64 = v234.mul_add(v1169, v1231);
-    let v1233: f64 = v536 * dir[0usize];
-    let v1234: f64 = v15 * v529;
-    let v1235: f64 = v1113 * dir[1usize];
-    let v1236: f64 = q[1usize] * v1117;
-    let v1237: f64 = v1233 + v1234;
-    let v1238: f64 = v1237 + v1235;
-    let v1239: f64 = v1238 + v1236;
-    let v1240: f64 = v1126 - v537;
-    let v1241: f64 = v1240 - v538;
-    let v1242: f64 = v1241 + v1129;
-    let v1243: f64 = v502.mul_add(dir[1usize], v1122);
-    let v1244: f64 = v421.mul_add(v585, v1243);
-    let v1245: f64 = v144 * v20;
-    let v1246: f64 = v1133 * dir[1usize];
-    let v1247: f64 = v1245.mul_add(v525, v1246);
-    let v1248: f64 = v46 * v1247;
-    let v1249: f64 = v536 * dir[4usize];
-    let v1250: f64 = v83 * v529;
-    let v1251: f64 = v152 * v20;
-    let v1252: f64 = v1140 * dir[1usize];
-    let v1253: f64 = v1251.mul_add(v525, v1252);
-    let v1254: f64 = 0.125f64 * q[5usize];
-    let v1255: f64 = v1254.mul_add(dir[2usize], -v601);
-    let v1256: f64 = v371.mul_add(dir[5usize], v1255);
-    let v1257: f64 = (-v437).mul_add(dir[3usize], v1256);
-    let v1258: f64 = v423.mul_add(v584, v1248);
-    let v1259: f64 = v1258 - v1249;
-    let v1260: f64 = v1259 - v1250;
-    let v1261: f64 = v425.mul_add(v595, v1260);
-    let v1262: f64 = v53.mul_add(v1253, v1261);
-    let v1263: f64 = v427.mul_add(v585, v1262);
-    let v1264: f64 = v47.mul_add(v1257, v1263);
-    let v1265: f64 = v357 * dir[5usize];
-    let v1266: f64 = v1254.mul_add(dir[0usize], v1265);
-    let v1267: f64 = v1266 - v580;
-    let v1268: f64 = (-v437).mul_add(dir[4usize], v1267);
-    let v1269: f64 = v1165 + v1166;
-    let v1270: f64 = v423.mul_add(v605, v1269);
-    let v1271: f64 = v58.mul_add(v1247, v1270);
-    let v1272: f64 = v425.mul_add(v609, v1271);
-    let v1273: f64 = v60.mul_add(v1253, v1272);
-    let v1274: f64 = v432.mul_add(v585, v1273);
-    let v1275: f64 = v47.mul_add(v1268, v1274);
-    let v1276: f64 = v65 * v1247;
-    let v1277: f64 = (-v1254).mul_add(dir[1usize], v1156);
-    let v1278: f64 = v438.mul_add(dir[5usize], v1277);
-    let v1279: f64 = v423.mul_add(v619, v1276);
-    let v1280: f64 = v425.mul_add(v623, v1279);
-    let v1281: f64 = v67.mul_add(v1253, v1280);
-    let v1282: f64 = v439.mul_add(v585, v1281);
-    let v1283: f64 = v47.mul_add(v1278, v1282);
-    let v1284: f64 = v1102 * dir[0usize];
-    let v1285: f64 = v286 * v1001;
-    let v1286: f64 = v1180 * dir[1usize];
-    let v1287: f64 = q[1usize] * v1184;
-    let v1288: f64 = v1284 + v1285;
-    let v1289: f64 = v1288 + v1286;
-    let v1290: f64 = v1289 + v1287;
-    let v1291: f64 = v1196 - v1103;
-    let v1292: f64 = v1291 - v1104;
-    let v1293: f64 = v1292 + v1199;
-    let v1294: f64 = 0.03125f64 * q[1usize];
-    let v1295: f64 = v1294 * v292;
-    let v1296: f64 = v1295.mul_add(dir[1usize], v1189);
-    let v1297: f64 = v448.mul_add(v1010, v1296);
-    let v1298: f64 = v46 * v1253;
-    let v1299: f64 = v1203 * dir[4usize];
-    let v1300: f64 = v83 * v585;
-    let v1301: f64 = v261 * v20;
-    let v1302: f64 = v1207 * dir[1usize];
-    let v1303: f64 = v1301.mul_add(v525, v1302);
-    let v1304: f64 = v425.mul_add(v584, v1298);
-    let v1305: f64 = v1304 - v1299;
-    let v1306: f64 = v1305 - v1300;
-    let v1307: f64 = v451.mul_add(v595, v1306);
-    let v1308: f64 = v53.mul_add(v1303, v1307);
-    let v1309: f64 = v427.mul_add(v914, v1308);
-    let v1310: f64 = v234.mul_add(v1257, v1309);
-    let v1311: f64 = v1224 + v1225;
-    let v1312: f64 = v425.mul_add(v605, v1311);
-    let v1313: f64 = v58.mul_add(v1253, v1312);
-    let v1314: f64 = v451.mul_add(v609, v1313);
-    let v1315: f64 = v60.mul_add(v1303, v1314);
-    let v1316: f64 = v432.mul_add(v914, v1315);
-    let v1317: f64 = v234.mul_add(v1268, v1316);
-    let v1318: f64 = v65 * v1253;
-    let v1319: f64 = v425.mul_add(v619, v1318);
-    let v1320: f64 = v451.mul_add(v623, v1319);
-    let v1321: f64 = v67.mul_add(v1303, v1320);
-    let v1322: f64 = v439.mul_add(v914, v1321);
-    let v1323: f64 = v234.mul_add(v1278, v1322);
-    let v1324: f64 = v512.mul_add(dir[2usize], v1122);
-    let v1325: f64 = v461.mul_add(v585, v1324);
-    let v1326: f64 = v562 + v1114;
-    let v1327: f64 = v1326 + v1118;
-    let v1328: f64 = v1235 - v1233;
-    let v1329: f64 = v1328 - v1234;
-    let v1330: f64 = v1329 + v1236;
-    let v1331: f64 = v144 * v33;
-    let v1332: f64 = v1133 * dir[2usize];
-    let v1333: f64 = v1331.mul_add(v525, v1332);
-    let v1334: f64 = v46 * v1333;
-    let v1335: f64 = v152 * v33;
-    let v1336: f64 = v1140 * dir[2usize];
-    let v1337: f64 = v1335.mul_add(v525, v1336);
-    let v1338: f64 = 0.125f64 * v41;
-    let v1339: f64 = (-v1338).mul_add(dir[2usize], v1156);
-    let v1340: f64 = v469.mul_add(dir[3usize], v1339);
-    let v1341: f64 = v465.mul_add(v584, v1334);
-    let v1342: f64 = v466.mul_add(v595, v1341);
-    let v1343: f64 = v53.mul_add(v1337, v1342);
-    let v1344: f64 = v470.mul_add(v585, v1343);
-    let v1345: f64 = v47.mul_add(v1340, v1344);
-    let v1346: f64 = v1338.mul_add(dir[0usize], -v615);
-    let v1347: f64 = v357.mul_add(dir[3usize], v1346);
-    let v1348: f64 = (-v468).mul_add(dir[4usize], v1347);
-    let v1349: f64 = v465.mul_add(v605, -v1137);
-    let v1350: f64 = v1349 - v1138;
-    let v1351: f64 = v58.mul_add(v1333, v1350);
-    let v1352: f64 = v466.mul_add(v609, v1351);
-    let v1353: f64 = v60.mul_add(v1337, v1352);
-    let v1354: f64 = v474.mul_add(v585, v1353);
-    let v1355: f64 = v47.mul_add(v1348, v1354);
-    let v1356: f64 = v385 * dir[3usize];
-    let v1357: f64 = v1338.mul_add(dir[1usize], v1356);
-    let v1358: f64 = v1357 - v602;
-    let v1359: f64 = (-v468).mul_add(dir[5usize], v1358);
-    let v1360: f64 = v1249 + v1250;
-    let v1361: f64 = v465.mul_add(v619, v1360);
-    let v1362: f64 = v65.mul_add(v1333, v1361);
-    let v1363: f64 = v466.mul_add(v623, v1362);
-    let v1364: f64 = v67.mul_add(v1337, v1363);
-    let v1365: f64 = v479.mul_add(v585, v1364);
-    let v1366: f64 = v47.mul_add(v1359, v1365);
-    let v1367: f64 = 0.03125f64 * q[2usize];
-    let v1368: f64 = v1367 * v292;
-    let v1369: f64 = v1368.mul_add(dir[2usize], v1189);
-    let v1370: f64 = v483.mul_add(v1010, v1369);
-    let v1371: f64 = v1177 + v1178;
-    let v1372: f64 = v1371 + v1181;
-    let v1373: f64 = v1372 + v1185;
-    let v1374: f64 = v1286 - v1284;
-    let v1375: f64 = v1374 - v1285;
-    let v1376: f64 = v1375 + v1287;
-    let v1377: f64 = v46 * v1337;
-    let v1378: f64 = v261 * v33;
-    let v1379: f64 = v1207 * dir[2usize];
-    let v1380: f64 = v1378.mul_add(v525, v1379);
-    let v1381: f64 = v466.mul_add(v584, v1377);
-    let v1382: f64 = v487.mul_add(v595, v1381);
-    let v1383: f64 = v53.mul_add(v1380, v1382);
-    let v1384: f64 = v470.mul_add(v914, v1383);
-    let v1385: f64 = v234.mul_add(v1340, v1384);
-    let v1386: f64 = v466.mul_add(v605, -v1204);
-    let v1387: f64 = v1386 - v1205;
-    let v1388: f64 = v58.mul_add(v1337, v1387);
-    let v1389: f64 = v487.mul_add(v609, v1388);
-    let v1390: f64 = v60.mul_add(v1380, v1389);
-    let v1391: f64 = v474.mul_add(v914, v1390);
-    let v1392: f64 = v234.mul_add(v1348, v1391);
-    let v1393: f64 = v1299 + v1300;
-    let v1394: f64 = v466.mul_add(v619, v1393);
-    let v1395: f64 = v65.mul_add(v1337, v1394);
-    let v1396: f64 = v487.mul_add(v623, v1395);
-    let v1397: f64 = v67.mul_add(v1380, v1396);
-    let v1398: f64 = v479.mul_add(v914, v1397);
-    let v1399: f64 = v234.mul_add(v1359, v1398);
-    let v1400: f64 = 0.5f64 * v525;
-    let v1401: f64 = v48.mul_add(dir[2usize], -v1400);
-    let v1402: f64 = v47 * v1401;
-    let v1403: f64 = v499.mul_add(v585, v1402);
-    let v1404: f64 = v234 * v1401;
-    let v1405: f64 = v499.mul_add(v914, v1404);
-    let v1406: f64 = v1203 * dir[1usize];
-    let v1407: f64 = v23 * v585;
-    let v1408: f64 = v371 * v234;
-    let v1409: f64 = v1408 * dir[0usize];
-    let v1410: f64 = 0.125f64 * v234;
-    let v1411: f64 = v371 * v914;
-    let v1412: f64 = v1410.mul_add(dir[2usize], v1411);
-    let v1413: f64 = q[0usize] * v1412;
-    let v1414: f64 = v1406 + v1407;
-    let v1415: f64 = v1414 + v1409;
-    let v1416: f64 = v1415 + v1413;
-    let v1417: f64 = v1203 * dir[0usize];
-    let v1418: f64 = v15 * v585;
-    let v1419: f64 = v1408 * dir[1usize];
-    let v1420: f64 = q[1usize] * v1412;
-    let v1421: f64 = v1419 - v1417;
-    let v1422: f64 = v1421 - v1418;
-    let v1423: f64 = v1422 + v1420;
-    let v1424: f64 = v15.mul_add(dir[0usize], -v1400);
-    let v1425: f64 = v47 * v1424;
-    let v1426: f64 = v508.mul_add(v585, v1425);
-    let v1427: f64 = v1409 - v1406;
-    let v1428: f64 = v1427 - v1407;
-    let v1429: f64 = v1428 + v1413;
-    let v1430: f64 = v234 * v1424;
-    let v1431: f64 = v508.mul_add(v914, v1430);
-    let v1432: f64 = v1203 * dir[2usize];
-    let v1433: f64 = v48 * v585;
-    let v1434: f64 = v385 * v234;
-    let v1435: f64 = v1434 * dir[0usize];
-    let v1436: f64 = v385 * v914;
-    let v1437: f64 = v1410.mul_add(dir[1usize], v1436);
-    let v1438: f64 = q[0usize] * v1437;
-    let v1439: f64 = v1432 + v1433;
-    let v1440: f64 = v1439 + v1435;
-    let v1441: f64 = v1440 + v1438;
-    let v1442: f64 = v23.mul_add(dir[1usize], -v1400);
-    let v1443: f64 = v47 * v1442;
-    let v1444: f64 = v515.mul_add(v585, v1443);
-    let v1445: f64 = v1417 + v1418;
-    let v1446: f64 = v1445 + v1419;
-    let v1447: f64 = v1446 + v1420;
-    let v1448: f64 = v1435 - v1432;
-    let v1449: f64 = v1448 - v1433;
-    let v1450: f64 = v1449 + v1438;
-    let v1451: f64 = v234 * v1442;
-    let v1452: f64 = v515.mul_add(v914, v1451);
-    out[0usize] = v14;
-    out[1usize] = v22;
-    out[2usize] = v28;
-    out[3usize] = v29;
-    out[4usize] = v30;
-    out[5usize] = v35;
-    out[6usize] = v36;
-    out[7usize] = v37;
-    out[8usize] = v38;
-    out[9usize] = v55;
-    out[10usize] = v62;
-    out[11usize] = v69;
-    out[12usize] = v105;
-    out[13usize] = v120;
-    out[14usize] = v135;
-    out[15usize] = v166;
-    out[16usize] = v178;
-    out[17usize] = v190;
-    out[18usize] = v199;
-    out[19usize] = v205;
-    out[20usize] = v211;
-    out[21usize] = v226;
-    out[22usize] = v229;
-    out[23usize] = v232;
-    out[24usize] = v236;
-    out[25usize] = v238;
-    out[26usize] = v240;
-    out[27usize] = v247;
-    out[28usize] = v252;
-    out[29usize] = v257;
-    out[30usize] = v268;
-    out[31usize] = v275;
-    out[32usize] = v282;
-    out[33usize] = v299;
-    out[34usize] = v305;
-    out[35usize] = v311;
-    out[36usize] = v331;
-    out[37usize] = v334;
-    out[38usize] = v337;
-    out[39usize] = v340;
-    out[40usize] = v343;
-    out[41usize] = v346;
-    out[42usize] = v348;
-    out[43usize] = v354;
-    out[44usize] = v355;
-    out[45usize] = v360;
-    out[46usize] = v363;
-    out[47usize] = v367;
-    out[48usize] = v376;
-    out[49usize] = v383;
-    out[50usize] = v390;
-    out[51usize] = v396;
-    out[52usize] = v399;
-    out[53usize] = v403;
-    out[54usize] = v408;
-    out[55usize] = v411;
-    out[56usize] = v415;
-    out[57usize] = v419;
-    out[58usize] = v420;
-    out[59usize] = v422;
-    out[60usize] = v430;
-    out[61usize] = v435;
-    out[62usize] = v441;
-    out[63usize] = v446;
-    out[64usize] = v447;
-    out[65usize] = v449;
-    out[66usize] = v454;
-    out[67usize] = v457;
-    out[68usize] = v460;
-    out[69usize] = v462;
-    out[70usize] = v463;
-    out[71usize] = v464;
-    out[72usize] = v472;
-    out[73usize] = v477;
-    out[74usize] = v482;
-    out[75usize] = v484;
-    out[76usize] = v485;
-    out[77usize] = v486;
-    out[78usize] = v490;
-    out[79usize] = v493;
-    out[80usize] = v496;
-    out[81usize] = 0f64;
-    out[82usize] = 0f64;
-    out[83usize] = 0f64;
-    out[84usize] = v500;
-    out[85usize] = v463;
-    out[86usize] = v464;
-    out[87usize] = 0f64;
-    out[88usize] = 0f64;
-    out[89usize] = 0f64;
-    out[90usize] = v501;
-    out[91usize] = v504;
-    out[92usize] = v507;
-    out[93usize] = 0f64;
-    out[94usize] = 0f64;
-    out[95usize] = 0f64;
-    out[96usize] = v360;
-    out[97usize] = v509;
-    out[98usize] = v367;
-    out[99usize] = 0f64;
-    out[100usize] = 0f64;
-    out[101usize] = 0f64;
-    out[102usize] = v510;
-    out[103usize] = v511;
-    out[104usize] = v514;
-    out[105usize] = 0f64;
-    out[106usize] = 0f64;
-    out[107usize] = 0f64;
-    out[108usize] = v419;
-    out[109usize] = v420;
-    out[110usize] = v516;
-    out[111usize] = 0f64;
-    out[112usize] = 0f64;
-    out[113usize] = 0f64;
-    out[114usize] = v517;
-    out[115usize] = v518;
-    out[116usize] = v519;
-    out[117usize] = 0f64;
-    out[118usize] = 0f64;
-    out[119usize] = 0f64;
-    out[120usize] = 0f64;
-    out[121usize] = 0f64;
-    out[122usize] = 0f64;
-    out[123usize] = 0f64;
-    out[124usize] = 0f64;
-    out[125usize] = 0f64;
-    out[126usize] = 0f64;
-    out[127usize] = 0f64;
-    out[128usize] = 0f64;
-    out[129usize] = v531;
-    out[130usize] = v543;
-    out[131usize] = v550;
-    out[132usize] = v553;
-    out[133usize] = v556;
-    out[134usize] = v566;
-    out[135usize] = v569;
-    out[136usize] = v572;
-    out[137usize] = v575;
-    out[138usize] = v599;
-    out[139usize] = v613;
-    out[140usize] = v627;
-    out[141usize] = v684;
-    out[142usize] = v709;
-    out[143usize] = v734;
-    out[144usize] = v781;
-    out[145usize] = v806;
-    out[146usize] = v831;
-    out[147usize] = v850;
-    out[148usize] = v860;
-    out[149usize] = v870;
-    out[150usize] = v894;
-    out[151usize] = v903;
-    out[152usize] = v912;
-    out[153usize] = v918;
-    out[154usize] = v923;
-    out[155usize] = v928;
-    out[156usize] = v940;
-    out[157usize] = v949;
-    out[158usize] = v958;
-    out[159usize] = v975;
-    out[160usize] = v987;
-    out[161usize] = v999;
-    out[162usize] = v1025;
-    out[163usize] = v1035;
-    out[164usize] = v1045;
-    out[165usize] = v1079;
-    out[166usize] = v1088;
-    out[167usize] = v1097;
-    out[168usize] = v1100;
-    out[169usize] = v1108;
-    out[170usize] = v1112;
-    out[171usize] = 0f64;
-    out[172usize] = 0f64;
-    out[173usize] = 0f64;
-    out[174usize] = v1121;
-    out[175usize] = v1124;
-    out[176usize] = v1131;
-    out[177usize] = v1154;
-    out[178usize] = v1163;
-    out[179usize] = v1176;
-    out[180usize] = v1188;
-    out[181usize] = v1194;
-    out[182usize] = v1201;
-    out[183usize] = v1216;
-    out[184usize] = v1222;
-    out[185usize] = v1232;
-    out[186usize] = v1239;
-    out[187usize] = v1242;
-    out[188usize] = v1244;
-    out[189usize] = v1264;
-    out[190usize] = v1275;
-    out[191usize] = v1283;
-    out[192usize] = v1290;
-    out[193usize] = v1293;
-    out[194usize] = v1297;
-    out[195usize] = v1310;
-    out[196usize] = v1317;
-    out[197usize] = v1323;
-    out[198usize] = v1325;
-    out[199usize] = v1327;
-    out[200usize] = v1330;
-    out[201usize] = v1345;
-    out[202usize] = v1355;
-    out[203usize] = v1366;
-    out[204usize] = v1370;
-    out[205usize] = v1373;
-    out[206usize] = v1376;
-    out[207usize] = v1385;
-    out[208usize] = v1392;
-    out[209usize] = v1399;
-    out[210usize] = 0f64;
-    out[211usize] = 0f64;
-    out[212usize] = 0f64;
-    out[213usize] = v1403;
-    out[214usize] = v1327;
-    out[215usize] = v1330;
-    out[216usize] = 0f64;
-    out[217usize] = 0f64;
-    out[218usize] = 0f64;
-    out[219usize] = v1405;
-    out[220usize] = v1416;
-    out[221usize] = v1423;
-    out[222usize] = 0f64;
-    out[223usize] = 0f64;
-    out[224usize] = 0f64;
-    out[225usize] = v1121;
-    out[226usize] = v1426;
-    out[227usize] = v1131;
-    out[228usize] = 0f64;
-    out[229usize] = 0f64;
-    out[230usize] = 0f64;
-    out[231usize] = v1429;
-    out[232usize] = v1431;
-    out[233usize] = v1441;
-    out[234usize] = 0f64;
-    out[235usize] = 0f64;
-    out[236usize] = 0f64;
-    out[237usize] = v1239;
-    out[238usize] = v1242;
-    out[239usize] = v1444;
-    out[240usize] = 0f64;
-    out[241usize] = 0f64;
-    out[242usize] = 0f64;
-    out[243usize] = v1447;
-    out[244usize] = v1450;
-    out[245usize] = v1452;
-    out[246usize] = 0f64;
-    out[247usize] = 0f64;
-    out[248usize] = 0f64;
-    out[249usize] = 0f64;
-    out[250usize] = 0f64;
-    out[251usize] = 0f64;
-    out[252usize] = 0f64;
-    out[253usize] = 0f64;
-    out[254usize] = 0f64;
-    out[255usize] = 0f64;
-    out[256usize] = 0f64;
-    out[257usize] = 0f64;
+    let v284: f64 = c[2][0];
+    let v290: f64 = c[1][0];
+    let v292: f64 = c[3][0];
+    let v313: f64 = c[2][1];
+    let v315: f64 = c[3][1];
+    let v326: f64 = c[1][1];
+    let v1047: f64 = c[2][2];
+    let v1053: f64 = c[3][2];
+    let v1067: f64 = c[1][2];
+    let v286 = 0.0625f64 * q[0];
+    let v287 = 0.0625f64 * q[1];
+    let v288 = v287 * qd[0];
+    let v289 = v286.mul_add(qd[1], -v288);
+    let v291 = v91 * v290;
+    let v293 = 0.0625f64 * q[2];
+    let v294 = v286 * qd[0];
+    let v295 = v293.mul_add(qd[2], v294);
+    let v296 = v287.mul_add(qd[1], v295);
+    let v297 = v48 * v292;
+    let v298 = v284.mul_add(v289, v291);
+    let v299 = v297.mul_add(v296, v298);
+    let v300 = v293 * qd[1];
+    let v301 = v287.mul_add(qd[2], -v300);
+    let v302 = v123 * v290;
+    let v303 = v15 * v292;
+    let v304 = v284.mul_add(v301, v302);
+    let v305 = v303.mul_add(v296, v304);
+    let v306 = v286 * qd[2];
+    let v307 = v293.mul_add(qd[0], -v306);
+    let v308 = v107 * v290;
+    let v309 = v23 * v292;
+    let v310 = v284.mul_add(v307, v308);
+    let v311 = v309.mul_add(v296, v310);
+    let v312 = 0.25f64 * v77;
+    let v314 = v312 * v313;
+    let v316 = v312 * v315;
+    let v317 = 0.25f64 * v296;
+    let v318 = v317 * v316;
+    let v319 = 0.0625f64 * v139;
+    let v320 = 0.0625f64.mul_add(v138, v319);
+    let v321 = 0.0625f64.mul_add(v141, v320);
+    let v322 = 0.25f64 * v292;
+    let v323 = v322.mul_add(v321, v318);
+    let v324 = q[2] * v323;
+    let v325 = v322 * v296;
+    let v327 = v312 * v326;
+    let v328 = 0.25f64 * v327;
+    let v329 = v325 + v328;
+    let v330 = v289.mul_add(v314, v324);
+    let v331 = qd[2].mul_add(v329, v330);
+    let v332 = q[0] * v323;
+    let v333 = v301.mul_add(v314, v332);
+    let v334 = qd[0].mul_add(v329, v333);
+    let v335 = q[1] * v323;
+    let v336 = v307.mul_add(v314, v335);
+    let v337 = qd[1].mul_add(v329, v336);
+    let v339 = 0.0625f64.mul_add(v8, -v283);
+    let v340 = v284.mul_add(v339, 1f64);
+    let v341 = v286 * q[2];
+    let v342 = v341 * v284;
+    let v343 = v23.mul_add(v290, v342);
+    let v344 = v287 * q[2];
+    let v345 = v15 * v290;
+    let v346 = v344.mul_add(v284, -v345);
+    let v348 = 0.5f64 * p[1];
+    let v350 = 0.25f64 * p[3];
+    let v352 = p[2] - v350;
+    let v354 = 0.125f64.mul_add(v352, v350);
+    let v355 = 0.5f64 * p[3];
+    let v356 = v23 * v13;
+    let v357 = 0.125f64 * q[0];
+    let v358 = v357 * q[2];
+    let v359 = v358 * v47;
+    let v360 = v359 - v356;
+    let v361 = 0.5f64 * v18;
+    let v362 = 0.125f64 * v1;
+    let v363 = v362.mul_add(v47, v361);
+    let v364 = v48 * v13;
+    let v365 = v357 * q[1];
+    let v366 = v365 * v47;
+    let v367 = v364 + v366;
+    let v368 = v78 * v26;
+    let v369 = v80 * v13;
+    let v370 = v88 * v26;
+    let v371 = 0.125f64 * q[2];
+    let v372 = v42 * v26;
+    let v373 = v371.mul_add(q[4], -v372);
+    let v374 = v46.mul_add(v368, v369);
+    let v375 = v53.mul_add(v370, v374);
+    let v376 = v47.mul_add(v373, v375);
+    let v377 = v60 * v370;
+    let v378 = 0.5f64 * v51;
+    let v379 = 0.5f64 * v26;
+    let v380 = v357 - v379;
+    let v381 = q[4].mul_add(v380, v378);
+    let v382 = v58.mul_add(v368, v377);
+    let v383 = v47.mul_add(v381, v382);
+    let v384 = v233 * v13;
+    let v385 = 0.125f64 * q[1];
+    let v386 = v63 * v26;
+    let v387 = v385.mul_add(q[4], -v386);
+    let v388 = v65.mul_add(v368, -v384);
+    let v389 = v67.mul_add(v370, v388);
+    let v390 = v47.mul_add(v387, v389);
+    let v391 = v287 * v284;
+    let v393 = 0.015625f64 * q[0];
+    let v394 = v393 * q[2];
+    let v395 = v394 * v292;
+    let v396 = v395 - v391;
+    let v397 = 0.25f64 * v290;
+    let v398 = 0.015625f64 * v1;
+    let v399 = v398.mul_add(v292, v397);
+    let v400 = v293 * v284;
+    let v401 = v393 * q[1];
+    let v402 = v401 * v292;
+    let v403 = v400 + v402;
+    let v404 = v80 * v47;
+    let v405 = v242 * v26;
+    let v406 = v46.mul_add(v370, v404);
+    let v407 = v53.mul_add(v405, v406);
+    let v408 = v234.mul_add(v373, v407);
+    let v409 = v60 * v405;
+    let v410 = v58.mul_add(v370, v409);
+    let v411 = v234.mul_add(v381, v410);
+    let v412 = v233 * v47;
+    let v413 = v65.mul_add(v370, -v412);
+    let v414 = v67.mul_add(v405, v413);
+    let v415 = v234.mul_add(v387, v414);
+    let v416 = v15 * v13;
+    let v417 = v385 * q[2];
+    let v418 = v417 * v47;
+    let v419 = v416 + v418;
+    let v420 = v366 - v364;
+    let v421 = 0.125f64 * v5;
+    let v422 = v421.mul_add(v47, v361);
+    let v423 = v78 * v20;
+    let v424 = v83 * v13;
+    let v425 = v88 * v20;
+    let v426 = v42 * v20;
+    let v427 = v371.mul_add(q[5], -v426);
+    let v428 = v46.mul_add(v423, -v424);
+    let v429 = v53.mul_add(v425, v428);
+    let v430 = v47.mul_add(v427, v429);
+    let v431 = v56 * v20;
+    let v432 = v357.mul_add(q[5], -v431);
+    let v433 = v58.mul_add(v423, v384);
+    let v434 = v60.mul_add(v425, v433);
+    let v435 = v47.mul_add(v432, v434);
+    let v436 = v67 * v425;
+    let v437 = 0.5f64 * v20;
+    let v438 = v385 - v437;
+    let v439 = q[5].mul_add(v438, v378);
+    let v440 = v65.mul_add(v423, v436);
+    let v441 = v47.mul_add(v439, v440);
+    let v442 = v286 * v284;
+    let v443 = 0.015625f64 * q[1];
+    let v444 = v443 * q[2];
+    let v445 = v444 * v292;
+    let v446 = v442 + v445;
+    let v447 = v402 - v400;
+    let v448 = 0.015625f64 * v5;
+    let v449 = v448.mul_add(v292, v397);
+    let v450 = v83 * v47;
+    let v451 = v242 * v20;
+    let v452 = v46.mul_add(v425, -v450);
+    let v453 = v53.mul_add(v451, v452);
+    let v454 = v234.mul_add(v427, v453);
+    let v455 = v58.mul_add(v425, v412);
+    let v456 = v60.mul_add(v451, v455);
+    let v457 = v234.mul_add(v432, v456);
+    let v458 = v67 * v451;
+    let v459 = v65.mul_add(v425, v458);
+    let v460 = v234.mul_add(v439, v459);
+    let v461 = 0.125f64 * v8;
+    let v462 = v461.mul_add(v47, v361);
+    let v463 = v356 + v359;
+    let v464 = v418 - v416;
+    let v465 = v78 * v33;
+    let v466 = v88 * v33;
+    let v467 = v53 * v466;
+    let v468 = 0.5f64 * v33;
+    let v469 = v371 - v468;
+    let v470 = v41.mul_add(v469, v378);
+    let v471 = v46.mul_add(v465, v467);
+    let v472 = v47.mul_add(v470, v471);
+    let v473 = v56 * v33;
+    let v474 = v357.mul_add(v41, -v473);
+    let v475 = v58.mul_add(v465, -v369);
+    let v476 = v60.mul_add(v466, v475);
+    let v477 = v47.mul_add(v474, v476);
+    let v478 = v63 * v33;
+    let v479 = v385.mul_add(v41, -v478);
+    let v480 = v65.mul_add(v465, v424);
+    let v481 = v67.mul_add(v466, v480);
+    let v482 = v47.mul_add(v479, v481);
+    let v483 = 0.015625f64 * v8;
+    let v484 = v483.mul_add(v292, v397);
+    let v485 = v391 + v395;
+    let v486 = v445 - v442;
+    let v487 = v242 * v33;
+    let v488 = v53 * v487;
+    let v489 = v46.mul_add(v466, v488);
+    let v490 = v234.mul_add(v470, v489);
+    let v491 = v58.mul_add(v466, -v404);
+    let v492 = v60.mul_add(v487, v491);
+    let v493 = v234.mul_add(v474, v492);
+    let v494 = v65.mul_add(v466, v450);
+    let v495 = v67.mul_add(v487, v494);
+    let v496 = v234.mul_add(v479, v495);
+    let v498 = 0.5f64 * v11;
+    let v499 = v461 - v498;
+    let v500 = v47.mul_add(v499, 0.5f64);
+    let v501 = v234.mul_add(v499, 0.25f64);
+    let v502 = v23 * v47;
+    let v503 = v358 * v234;
+    let v504 = v502 + v503;
+    let v505 = v15 * v47;
+    let v506 = v417 * v234;
+    let v507 = v506 - v505;
+    let v508 = v362 - v498;
+    let v509 = v47.mul_add(v508, 0.5f64);
+    let v510 = v503 - v502;
+    let v511 = v234.mul_add(v508, 0.25f64);
+    let v512 = v48 * v47;
+    let v513 = v365 * v234;
+    let v514 = v512 + v513;
+    let v515 = v421 - v498;
+    let v516 = v47.mul_add(v515, 0.5f64);
+    let v517 = v505 + v506;
+    let v518 = v513 - v512;
+    let v519 = v234.mul_add(v515, 0.25f64);
+    let v522 = v20 * dir[1];
+    let v524 = v26.mul_add(dir[0], v522);
+    let v525 = v33.mul_add(dir[2], v524);
+    let v527 = v525 * v526;
+    let v528 = v33 * v13;
+    let v529 = v78 * v525;
+    let v530 = v528.mul_add(dir[2], v527);
+    let v531 = v9.mul_add(v529, v530);
+    let v532 = v364 * dir[0];
+    let v533 = v361 * dir[1];
+    let v534 = v221 * v525;
+    let v535 = v20 * v534;
+    let v536 = 0.25f64 * v13;
+    let v537 = v536 * dir[2];
+    let v538 = v48 * v529;
+    let v539 = v537 + v538;
+    let v540 = q[0] * v539;
+    let v541 = v532 - v533;
+    let v542 = v541 - v535;
+    let v543 = v542 + v540;
+    let v544 = v364 * dir[1];
+    let v545 = v361 * dir[0];
+    let v546 = v26 * v534;
+    let v547 = q[1] * v539;
+    let v548 = v544 + v545;
+    let v549 = v548 + v546;
+    let v550 = v549 + v547;
+    let v551 = v532 + v533;
+    let v552 = v551 + v535;
+    let v553 = v552 + v540;
+    let v554 = v26 * v13;
+    let v555 = v554.mul_add(dir[0], v527);
+    let v556 = v3.mul_add(v529, v555);
+    let v557 = v356 * dir[0];
+    let v558 = v361 * dir[2];
+    let v559 = v33 * v534;
+    let v560 = v536 * dir[1];
+    let v561 = v23 * v529;
+    let v562 = v560 + v561;
+    let v563 = q[0] * v562;
+    let v564 = v557 - v558;
+    let v565 = v564 - v559;
+    let v566 = v565 + v563;
+    let v567 = v544 - v545;
+    let v568 = v567 - v546;
+    let v569 = v568 + v547;
+    let v570 = v557 + v558;
+    let v571 = v570 + v559;
+    let v572 = v571 + v563;
+    let v573 = v20 * v13;
+    let v574 = v573.mul_add(dir[1], v527);
+    let v575 = v6.mul_add(v529, v574);
+    let v577 = v46 * v529;
+    let v578 = v80 * dir[0];
+    let v580 = v83 * dir[1];
+    let v582 = v15.mul_add(dir[5], v578);
+    let v583 = v582 - v580;
+    let v584 = (-v23).mul_add(dir[4], v583);
+    let v585 = v88 * v525;
+    let v586 = v48 * dir[3];
+    let v587 = v233.mul_add(dir[2], v586);
+    let v588 = v83.mul_add(dir[0], v587);
+    let v589 = v15.mul_add(dir[4], v588);
+    let v590 = v80.mul_add(dir[1], v589);
+    let v591 = v23.mul_add(dir[5], v590);
+    let v592 = v33 * v591;
+    let v593 = v378.mul_add(dir[2], v592);
+    let v594 = (-v498).mul_add(dir[3], v593);
+    let v595 = (-v42).mul_add(v525, v594);
+    let v596 = 0.5f64.mul_add(dir[3], v577);
+    let v597 = v13.mul_add(v584, v596);
+    let v598 = v53.mul_add(v585, v597);
+    let v599 = v47.mul_add(v595, v598);
+    let v600 = v58 * v529;
+    let v601 = v233 * dir[1];
+    let v602 = v80 * dir[2];
+    let v603 = v23.mul_add(dir[3], v601);
+    let v604 = v603 - v602;
+    let v605 = (-v48).mul_add(dir[5], v604);
+    let v606 = v26 * v591;
+    let v607 = v378.mul_add(dir[0], v606);
+    let v608 = (-v498).mul_add(dir[4], v607);
+    let v609 = (-v56).mul_add(v525, v608);
+    let v610 = 0.5f64.mul_add(dir[4], v600);
+    let v611 = v13.mul_add(v605, v610);
+    let v612 = v60.mul_add(v585, v611);
+    let v613 = v47.mul_add(v609, v612);
+    let v614 = v65 * v529;
+    let v615 = v83 * dir[2];
+    let v616 = v233 * dir[0];
+    let v617 = v48.mul_add(dir[4], v615);
+    let v618 = v617 - v616;
+    let v619 = (-v15).mul_add(dir[3], v618);
+    let v620 = v20 * v591;
+    let v621 = v378.mul_add(dir[1], v620);
+    let v622 = (-v498).mul_add(dir[5], v621);
+    let v623 = (-v63).mul_add(v525, v622);
+    let v624 = 0.5f64.mul_add(dir[5], v614);
+    let v625 = v13.mul_add(v619, v624);
+    let v626 = v67.mul_add(v585, v625);
+    let v627 = v47.mul_add(v623, v626);
+    let v629 = v79 * v584;
+    let v631 = v33 * dir[8];
+    let v634 = v90.mul_add(dir[2], v631);
+    let v635 = v112.mul_add(dir[0], v634);
+    let v636 = v26.mul_add(dir[6], v635);
+    let v637 = v127.mul_add(dir[1], v636);
+    let v638 = v20.mul_add(dir[7], v637);
+    let v639 = v77 * v144;
+    let v640 = v639 * v525;
+    let v641 = v78.mul_add(v638, v640);
+    let v642 = v80 * dir[6];
+    let v645 = v123.mul_add(dir[5], v642);
+    let v646 = v253.mul_add(dir[0], v645);
+    let v647 = v15.mul_add(dir[11], v646);
+    let v648 = (-v107).mul_add(dir[4], v647);
+    let v649 = (-v83).mul_add(dir[7], v648);
+    let v650 = (-v248).mul_add(dir[1], v649);
+    let v651 = (-v23).mul_add(dir[10], v650);
+    let v652 = v77 * v152;
+    let v653 = v652 * v525;
+    let v654 = v88.mul_add(v638, v653);
+    let v655 = v90 * v591;
+    let v656 = 0.5f64 * v97;
+    let v657 = v91 * dir[3];
+    let v658 = v233.mul_add(dir[8], v657);
+    let v659 = v241.mul_add(dir[2], v658);
+    let v660 = v48.mul_add(dir[9], v659);
+    let v661 = v123.mul_add(dir[4], v660);
+    let v662 = v83.mul_add(dir[6], v661);
+    let v663 = v248.mul_add(dir[0], v662);
+    let v664 = v15.mul_add(dir[10], v663);
+    let v665 = v107.mul_add(dir[5], v664);
+    let v666 = v80.mul_add(dir[7], v665);
+    let v667 = v253.mul_add(dir[1], v666);
+    let v668 = v23.mul_add(dir[11], v667);
+    let v669 = 0.5f64 * v77;
+    let v670 = v378.mul_add(dir[8], v655);
+    let v671 = v656.mul_add(dir[2], v670);
+    let v672 = v33.mul_add(v668, v671);
+    let v673 = (-v498).mul_add(dir[9], v672);
+    let v674 = (-v71).mul_add(v525, v673);
+    let v675 = (-v669).mul_add(dir[3], v674);
+    let v676 = (-v42).mul_add(v638, v675);
+    let v677 = 0.5f64.mul_add(dir[9], v629);
+    let v678 = v46.mul_add(v641, v677);
+    let v679 = v87.mul_add(v529, v678);
+    let v680 = v13.mul_add(v651, v679);
+    let v681 = v89.mul_add(v595, v680);
+    let v682 = v53.mul_add(v654, v681);
+    let v683 = v101.mul_add(v585, v682);
+    let v684 = v47.mul_add(v676, v683);
+    let v685 = v79 * v605;
+    let v686 = v107 * dir[3];
+    let v687 = v233.mul_add(dir[7], v686);
+    let v688 = v241.mul_add(dir[1], v687);
+    let v689 = v23.mul_add(dir[9], v688);
+    let v690 = (-v91).mul_add(dir[5], v689);
+    let v691 = (-v80).mul_add(dir[8], v690);
+    let v692 = (-v253).mul_add(dir[2], v691);
+    let v693 = (-v48).mul_add(dir[11], v692);
+    let v694 = v112 * v591;
+    let v695 = v378.mul_add(dir[6], v694);
+    let v696 = v656.mul_add(dir[0], v695);
+    let v697 = v26.mul_add(v668, v696);
+    let v698 = (-v498).mul_add(dir[10], v697);
+    let v699 = (-v106).mul_add(v525, v698);
+    let v700 = (-v669).mul_add(dir[4], v699);
+    let v701 = (-v56).mul_add(v638, v700);
+    let v702 = 0.5f64.mul_add(dir[10], v685);
+    let v703 = v58.mul_add(v641, v702);
+    let v704 = v111.mul_add(v529, v703);
+    let v705 = v13.mul_add(v693, v704);
+    let v706 = v89.mul_add(v609, v705);
+    let v707 = v60.mul_add(v654, v706);
+    let v708 = v116.mul_add(v585, v707);
+    let v709 = v47.mul_add(v701, v708);
+    let v710 = v79 * v619;
+    let v711 = v83 * dir[8];
+    let v712 = v91.mul_add(dir[4], v711);
+    let v713 = v248.mul_add(dir[2], v712);
+    let v714 = v48.mul_add(dir[10], v713);
+    let v715 = (-v233).mul_add(dir[6], v714);
+    let v716 = (-v123).mul_add(dir[3], v715);
+    let v717 = (-v241).mul_add(dir[0], v716);
+    let v718 = (-v15).mul_add(dir[9], v717);
+    let v719 = v127 * v591;
+    let v720 = v378.mul_add(dir[7], v719);
+    let v721 = v656.mul_add(dir[1], v720);
+    let v722 = v20.mul_add(v668, v721);
+    let v723 = (-v498).mul_add(dir[11], v722);
+    let v724 = (-v121).mul_add(v525, v723);
+    let v725 = (-v669).mul_add(dir[5], v724);
+    let v726 = (-v63).mul_add(v638, v725);
+    let v727 = 0.5f64.mul_add(dir[11], v710);
+    let v728 = v65.mul_add(v641, v727);
+    let v729 = v126.mul_add(v529, v728);
+    let v730 = v13.mul_add(v718, v729);
+    let v731 = v89.mul_add(v623, v730);
+    let v732 = v67.mul_add(v654, v731);
+    let v733 = v131.mul_add(v585, v732);
+    let v734 = v47.mul_add(v726, v733);
+    let v735 = v137 * v651;
+    let v736 = qd[1] * dir[7];
+    let v737 = qd[0].mul_add(dir[6], v736);
+    let v738 = qd[2].mul_add(dir[8], v737);
+    let v740 = v145 * v525;
+    let v741 = v740 * v739;
+    let v742 = 2f64 * v77;
+    let v743 = v742 * v638;
+    let v744 = v143.mul_add(v525, v743);
+    let v745 = v78.mul_add(v738, v741);
+    let v746 = v144.mul_add(v744, v745);
+    let v747 = v112 * dir[11];
+    let v748 = v121.mul_add(dir[6], v747);
+    let v749 = (-v106).mul_add(dir[7], v748);
+    let v750 = (-v127).mul_add(dir[10], v749);
+    let v752 = v740 * v751;
+    let v753 = v88.mul_add(v738, v752);
+    let v754 = v152.mul_add(v744, v753);
+    let v755 = qd[2] * v668;
+    let v756 = 0.5f64 * v157;
+    let v757 = v90 * dir[9];
+    let v758 = v71.mul_add(dir[8], v757);
+    let v759 = v106.mul_add(dir[6], v758);
+    let v760 = v112.mul_add(dir[10], v759);
+    let v761 = v121.mul_add(dir[7], v760);
+    let v762 = v127.mul_add(dir[11], v761);
+    let v763 = 0.5f64 * v143;
+    let v764 = v97.mul_add(dir[8], v755);
+    let v765 = v756.mul_add(dir[2], v764);
+    let v766 = v33.mul_add(v762, v765);
+    let v767 = (-v77).mul_add(dir[9], v766);
+    let v768 = (-qd[3]).mul_add(v638, v767);
+    let v769 = (-v763).mul_add(dir[3], v768);
+    let v770 = (-v42).mul_add(v738, v769);
+    let v771 = v258.mul_add(v641, v735);
+    let v772 = v147.mul_add(v584, v771);
+    let v773 = v46.mul_add(v746, v772);
+    let v774 = v150.mul_add(v529, v773);
+    let v775 = v13.mul_add(v750, v774);
+    let v776 = v260.mul_add(v654, v775);
+    let v777 = v151.mul_add(v676, v776);
+    let v778 = v154.mul_add(v595, v777);
+    let v779 = v53.mul_add(v754, v778);
+    let v780 = v161.mul_add(v585, v779);
+    let v781 = v47.mul_add(v770, v780);
+    let v782 = 2f64 * v111;
+    let v783 = v137 * v693;
+    let v784 = v127 * dir[9];
+    let v785 = v71.mul_add(dir[7], v784);
+    let v786 = (-v121).mul_add(dir[8], v785);
+    let v787 = (-v90).mul_add(dir[11], v786);
+    let v788 = qd[0] * v668;
+    let v789 = v97.mul_add(dir[6], v788);
+    let v790 = v756.mul_add(dir[0], v789);
+    let v791 = v26.mul_add(v762, v790);
+    let v792 = (-v77).mul_add(dir[10], v791);
+    let v793 = (-qd[4]).mul_add(v638, v792);
+    let v794 = (-v763).mul_add(dir[4], v793);
+    let v795 = (-v56).mul_add(v738, v794);
+    let v796 = v782.mul_add(v641, v783);
+    let v797 = v147.mul_add(v605, v796);
+    let v798 = v58.mul_add(v746, v797);
+    let v799 = v169.mul_add(v529, v798);
+    let v800 = v13.mul_add(v787, v799);
+    let v801 = v270.mul_add(v654, v800);
+    let v802 = v151.mul_add(v701, v801);
+    let v803 = v154.mul_add(v609, v802);
+    let v804 = v60.mul_add(v754, v803);
+    let v805 = v173.mul_add(v585, v804);
+    let v806 = v47.mul_add(v795, v805);
+    let v807 = 2f64 * v126;
+    let v808 = v137 * v718;
+    let v809 = v90 * dir[10];
+    let v810 = v106.mul_add(dir[8], v809);
+    let v811 = (-v71).mul_add(dir[6], v810);
+    let v812 = (-v112).mul_add(dir[9], v811);
+    let v813 = qd[1] * v668;
+    let v814 = v97.mul_add(dir[7], v813);
+    let v815 = v756.mul_add(dir[1], v814);
+    let v816 = v20.mul_add(v762, v815);
+    let v817 = (-v77).mul_add(dir[11], v816);
+    let v818 = (-qd[5]).mul_add(v638, v817);
+    let v819 = (-v763).mul_add(dir[5], v818);
+    let v820 = (-v63).mul_add(v738, v819);
+    let v821 = v807.mul_add(v641, v808);
+    let v822 = v147.mul_add(v619, v821);
+    let v823 = v65.mul_add(v746, v822);
+    let v824 = v181.mul_add(v529, v823);
+    let v825 = v13.mul_add(v812, v824);
+    let v826 = v277.mul_add(v654, v825);
+    let v827 = v151.mul_add(v726, v826);
+    let v828 = v154.mul_add(v623, v827);
+    let v829 = v67.mul_add(v754, v828);
+    let v830 = v185.mul_add(v585, v829);
+    let v831 = v47.mul_add(v820, v830);
+    let v832 = v15 * dir[7];
+    let v833 = v107.mul_add(dir[0], v832);
+    let v834 = (-v123).mul_add(dir[1], v833);
+    let v835 = (-v23).mul_add(dir[6], v834);
+    let v836 = v13 * v835;
+    let v837 = v212 * v585;
+    let v838 = v48 * dir[8];
+    let v839 = v91.mul_add(dir[2], v838);
+    let v840 = v123.mul_add(dir[0], v839);
+    let v841 = v15.mul_add(dir[6], v840);
+    let v842 = v107.mul_add(dir[1], v841);
+    let v843 = v23.mul_add(dir[7], v842);
+    let v844 = v217 * v843;
+    let v845 = v837 + v844;
+    let v846 = v192.mul_add(v529, v836);
+    let v847 = v361.mul_add(dir[8], v846);
+    let v848 = v90.mul_add(v534, v847);
+    let v849 = v220.mul_add(dir[2], v848);
+    let v850 = q[2].mul_add(v845, v849);
+    let v851 = v23 * dir[8];
+    let v852 = v91.mul_add(dir[1], v851);
+    let v853 = (-v107).mul_add(dir[2], v852);
+    let v854 = (-v48).mul_add(dir[7], v853);
+    let v855 = v13 * v854;
+    let v856 = v201.mul_add(v529, v855);
+    let v857 = v361.mul_add(dir[6], v856);
+    let v858 = v112.mul_add(v534, v857);
+    let v859 = v220.mul_add(dir[0], v858);
+    let v860 = q[0].mul_add(v845, v859);
+    let v861 = v48 * dir[6];
+    let v862 = v123.mul_add(dir[2], v861);
+    let v863 = (-v91).mul_add(dir[0], v862);
+    let v864 = (-v15).mul_add(dir[8], v863);
+    let v865 = v13 * v864;
+    let v866 = v207.mul_add(v529, v865);
+    let v867 = v361.mul_add(dir[7], v866);
+    let v868 = v127.mul_add(v534, v867);
+    let v869 = v220.mul_add(dir[1], v868);
+    let v870 = q[1].mul_add(v845, v869);
+    let v871 = v192 * v641;
+    let v872 = 0.5f64 * v89;
+    let v873 = v212 * v654;
+    let v874 = 0.5f64 * v216;
+    let v875 = v127 * dir[7];
+    let v876 = v112.mul_add(dir[6], v875);
+    let v877 = v90.mul_add(dir[8], v876);
+    let v878 = v872.mul_add(v843, v873);
+    let v879 = v874.mul_add(v585, v878);
+    let v880 = v217.mul_add(v877, v879);
+    let v882 = v77 * v525;
+    let v883 = v882 * v881;
+    let v884 = v221.mul_add(v638, v883);
+    let v885 = 0.5f64.mul_add(v884, v837);
+    let v886 = v885 + v844;
+    let v887 = v874 * dir[2];
+    let v888 = v212.mul_add(dir[8], v887);
+    let v889 = v79.mul_add(v835, v871);
+    let v890 = v223.mul_add(dir[8], v889);
+    let v891 = v213.mul_add(dir[2], v890);
+    let v892 = q[2].mul_add(v880, v891);
+    let v893 = qd[2].mul_add(v886, v892);
+    let v894 = v47.mul_add(v888, v893);
+    let v895 = v201 * v641;
+    let v896 = v874 * dir[0];
+    let v897 = v212.mul_add(dir[6], v896);
+    let v898 = v79.mul_add(v854, v895);
+    let v899 = v223.mul_add(dir[6], v898);
+    let v900 = v213.mul_add(dir[0], v899);
+    let v901 = q[0].mul_add(v880, v900);
+    let v902 = qd[0].mul_add(v886, v901);
+    let v903 = v47.mul_add(v897, v902);
+    let v904 = v207 * v641;
+    let v905 = v874 * dir[1];
+    let v906 = v212.mul_add(dir[7], v905);
+    let v907 = v79.mul_add(v864, v904);
+    let v908 = v223.mul_add(dir[7], v907);
+    let v909 = v213.mul_add(dir[1], v908);
+    let v910 = q[1].mul_add(v880, v909);
+    let v911 = qd[1].mul_add(v886, v910);
+    let v912 = v47.mul_add(v906, v911);
+    let v913 = v46 * v585;
+    let v914 = v242 * v525;
+    let v915 = 0.25f64.mul_add(dir[3], v913);
+    let v916 = v47.mul_add(v584, v915);
+    let v917 = v53.mul_add(v914, v916);
+    let v918 = v234.mul_add(v595, v917);
+    let v919 = v58 * v585;
+    let v920 = 0.25f64.mul_add(dir[4], v919);
+    let v921 = v47.mul_add(v605, v920);
+    let v922 = v60.mul_add(v914, v921);
+    let v923 = v234.mul_add(v609, v922);
+    let v924 = v65 * v585;
+    let v925 = 0.25f64.mul_add(dir[5], v924);
+    let v926 = v47.mul_add(v619, v925);
+    let v927 = v67.mul_add(v914, v926);
+    let v928 = v234.mul_add(v623, v927);
+    let v929 = v89 * v584;
+    let v930 = v77 * v261;
+    let v931 = v930 * v525;
+    let v932 = v242.mul_add(v638, v931);
+    let v933 = 0.25f64.mul_add(dir[9], v929);
+    let v934 = v46.mul_add(v654, v933);
+    let v935 = v87.mul_add(v585, v934);
+    let v936 = v47.mul_add(v651, v935);
+    let v937 = v243.mul_add(v595, v936);
+    let v938 = v53.mul_add(v932, v937);
+    let v939 = v101.mul_add(v914, v938);
+    let v940 = v234.mul_add(v676, v939);
+    let v941 = v89 * v605;
+    let v942 = 0.25f64.mul_add(dir[10], v941);
+    let v943 = v58.mul_add(v654, v942);
+    let v944 = v111.mul_add(v585, v943);
+    let v945 = v47.mul_add(v693, v944);
+    let v946 = v243.mul_add(v609, v945);
+    let v947 = v60.mul_add(v932, v946);
+    let v948 = v116.mul_add(v914, v947);
+    let v949 = v234.mul_add(v701, v948);
+    let v950 = v89 * v619;
+    let v951 = 0.25f64.mul_add(dir[11], v950);
+    let v952 = v65.mul_add(v654, v951);
+    let v953 = v126.mul_add(v585, v952);
+    let v954 = v47.mul_add(v718, v953);
+    let v955 = v243.mul_add(v623, v954);
+    let v956 = v67.mul_add(v932, v955);
+    let v957 = v131.mul_add(v914, v956);
+    let v958 = v234.mul_add(v726, v957);
+    let v959 = v258 * v654;
+    let v960 = 2f64 * v243;
+    let v962 = v740 * v961;
+    let v963 = v242.mul_add(v738, v962);
+    let v964 = v261.mul_add(v744, v963);
+    let v965 = v151.mul_add(v651, v959);
+    let v966 = v154.mul_add(v584, v965);
+    let v967 = v46.mul_add(v754, v966);
+    let v968 = v150.mul_add(v585, v967);
+    let v969 = v47.mul_add(v750, v968);
+    let v970 = v960.mul_add(v676, v969);
+    let v971 = v260.mul_add(v932, v970);
+    let v972 = v263.mul_add(v595, v971);
+    let v973 = v53.mul_add(v964, v972);
+    let v974 = v161.mul_add(v914, v973);
+    let v975 = v234.mul_add(v770, v974);
+    let v976 = v151 * v693;
+    let v977 = v782.mul_add(v654, v976);
+    let v978 = v154.mul_add(v605, v977);
+    let v979 = v58.mul_add(v754, v978);
+    let v980 = v169.mul_add(v585, v979);
+    let v981 = v47.mul_add(v787, v980);
+    let v982 = v960.mul_add(v701, v981);
+    let v983 = v270.mul_add(v932, v982);
+    let v984 = v263.mul_add(v609, v983);
+    let v985 = v60.mul_add(v964, v984);
+    let v986 = v173.mul_add(v914, v985);
+    let v987 = v234.mul_add(v795, v986);
+    let v988 = v151 * v718;
+    let v989 = v807.mul_add(v654, v988);
+    let v990 = v154.mul_add(v619, v989);
+    let v991 = v65.mul_add(v754, v990);
+    let v992 = v181.mul_add(v585, v991);
+    let v993 = v47.mul_add(v812, v992);
+    let v994 = v960.mul_add(v726, v993);
+    let v995 = v277.mul_add(v932, v994);
+    let v996 = v263.mul_add(v623, v995);
+    let v997 = v67.mul_add(v964, v996);
+    let v998 = v185.mul_add(v914, v997);
+    let v999 = v234.mul_add(v820, v998);
+    let v1000 = 0.25f64 * v525;
+    let v1001 = v313 * v1000;
+    let v1002 = 0.0625f64 * qd[1];
+    let v1003 = v286 * dir[7];
+    let v1004 = 0.0625f64 * qd[0];
+    let v1005 = v1002.mul_add(dir[0], v1003);
+    let v1006 = (-v1004).mul_add(dir[1], v1005);
+    let v1007 = (-v287).mul_add(dir[6], v1006);
+    let v1008 = v284 * v1007;
+    let v1009 = v326 * v1000;
+    let v1010 = v315 * v1000;
+    let v1011 = v317 * v1010;
+    let v1012 = 0.0625f64 * qd[2];
+    let v1013 = v293 * dir[8];
+    let v1014 = v1012.mul_add(dir[2], v1013);
+    let v1015 = v1004.mul_add(dir[0], v1014);
+    let v1016 = v286.mul_add(dir[6], v1015);
+    let v1017 = v1002.mul_add(dir[1], v1016);
+    let v1018 = v287.mul_add(dir[7], v1017);
+    let v1019 = v322 * v1018;
+    let v1020 = v1011 + v1019;
+    let v1021 = v289.mul_add(v1001, v1008);
+    let v1022 = v397.mul_add(dir[8], v1021);
+    let v1023 = v91.mul_add(v1009, v1022);
+    let v1024 = v325.mul_add(dir[2], v1023);
+    let v1025 = q[2].mul_add(v1020, v1024);
+    let v1026 = v287 * dir[8];
+    let v1027 = v1012.mul_add(dir[1], v1026);
+    let v1028 = (-v1002).mul_add(dir[2], v1027);
+    let v1029 = (-v293).mul_add(dir[7], v1028);
+    let v1030 = v284 * v1029;
+    let v1031 = v301.mul_add(v1001, v1030);
+    let v1032 = v397.mul_add(dir[6], v1031);
+    let v1033 = v123.mul_add(v1009, v1032);
+    let v1034 = v325.mul_add(dir[0], v1033);
+    let v1035 = q[0].mul_add(v1020, v1034);
+    let v1036 = v293 * dir[6];
+    let v1037 = v1004.mul_add(dir[2], v1036);
+    let v1038 = (-v1012).mul_add(dir[0], v1037);
+    let v1039 = (-v286).mul_add(dir[8], v1038);
+    let v1040 = v284 * v1039;
+    let v1041 = v307.mul_add(v1001, v1040);
+    let v1042 = v397.mul_add(dir[7], v1041);
+    let v1043 = v107.mul_add(v1009, v1042);
+    let v1044 = v325.mul_add(dir[1], v1043);
+    let v1045 = q[1].mul_add(v1020, v1044);
+    let v1046 = 0.25f64 * v638;
+    let v1048 = v312 * v1000;
+    let v1049 = v1048 * v1047;
+    let v1050 = v313.mul_add(v1046, v1049);
+    let v1051 = v289 * v1050;
+    let v1052 = 0.25f64 * v316;
+    let v1054 = v1048 * v1053;
+    let v1055 = v315.mul_add(v1046, v1054);
+    let v1056 = v317 * v1055;
+    let v1057 = 0.25f64 * v321;
+    let v1058 = 0.125f64 * qd[0];
+    let v1059 = 0.125f64 * qd[1];
+    let v1060 = v1059 * dir[7];
+    let v1061 = 0.125f64 * qd[2];
+    let v1062 = v1058.mul_add(dir[6], v1060);
+    let v1063 = v1061.mul_add(dir[8], v1062);
+    let v1064 = v1052.mul_add(v1018, v1056);
+    let v1065 = v1057.mul_add(v1010, v1064);
+    let v1066 = v322.mul_add(v1063, v1065);
+    let v1068 = v1048 * v1067;
+    let v1069 = v326.mul_add(v1046, v1068);
+    let v1070 = 0.25f64.mul_add(v1069, v1011);
+    let v1071 = v1070 + v1019;
+    let v1072 = v1057 * dir[2];
+    let v1073 = v317.mul_add(dir[8], v1072);
+    let v1074 = v314.mul_add(v1007, v1051);
+    let v1075 = v328.mul_add(dir[8], v1074);
+    let v1076 = v318.mul_add(dir[2], v1075);
+    let v1077 = q[2].mul_add(v1066, v1076);
+    let v1078 = qd[2].mul_add(v1071, v1077);
+    let v1079 = v292.mul_add(v1073, v1078);
+    let v1080 = v301 * v1050;
+    let v1081 = v1057 * dir[0];
+    let v1082 = v317.mul_add(dir[6], v1081);
+    let v1083 = v314.mul_add(v1029, v1080);
+    let v1084 = v328.mul_add(dir[6], v1083);
+    let v1085 = v318.mul_add(dir[0], v1084);
+    let v1086 = q[0].mul_add(v1066, v1085);
+    let v1087 = qd[0].mul_add(v1071, v1086);
+    let v1088 = v292.mul_add(v1082, v1087);
+    let v1089 = v307 * v1050;
+    let v1090 = v1057 * dir[1];
+    let v1091 = v317.mul_add(dir[7], v1090);
+    let v1092 = v314.mul_add(v1039, v1089);
+    let v1093 = v328.mul_add(dir[7], v1092);
+    let v1094 = v318.mul_add(dir[1], v1093);
+    let v1095 = q[1].mul_add(v1066, v1094);
+    let v1096 = qd[1].mul_add(v1071, v1095);
+    let v1097 = v292.mul_add(v1091, v1096);
+    let v1098 = v371.mul_add(dir[2], -v1000);
+    let v1099 = v339 * v1001;
+    let v1100 = v284.mul_add(v1098, v1099);
+    let v1101 = v23 * v1009;
+    let v1102 = 0.0625f64 * v284;
+    let v1103 = v1102 * dir[2];
+    let v1104 = v293 * v1001;
+    let v1105 = v1103 + v1104;
+    let v1106 = v397.mul_add(dir[1], v1101);
+    let v1107 = v400.mul_add(dir[0], v1106);
+    let v1108 = q[0].mul_add(v1105, v1107);
+    let v1109 = v397 * dir[0];
+    let v1110 = v400.mul_add(dir[1], -v1109);
+    let v1111 = (-v15).mul_add(v1009, v1110);
+    let v1112 = q[1].mul_add(v1105, v1111);
+    let v1113 = v371 * v47;
+    let v1114 = v1113 * dir[0];
+    let v1115 = 0.125f64 * v47;
+    let v1116 = v371 * v585;
+    let v1117 = v1115.mul_add(dir[2], v1116);
+    let v1118 = q[0] * v1117;
+    let v1119 = v1114 - v560;
+    let v1120 = v1119 - v561;
+    let v1121 = v1120 + v1118;
+    let v1122 = 0.5f64 * v534;
+    let v1123 = v505.mul_add(dir[0], v1122);
+    let v1124 = v362.mul_add(v585, v1123);
+    let v1125 = v385 * v47;
+    let v1126 = v1125 * dir[0];
+    let v1127 = v385 * v585;
+    let v1128 = v1115.mul_add(dir[1], v1127);
+    let v1129 = q[0] * v1128;
+    let v1130 = v539 + v1126;
+    let v1131 = v1130 + v1129;
+    let v1132 = v144 * v26;
+    let v1133 = 0.5f64 * v78;
+    let v1134 = v1133 * dir[0];
+    let v1135 = v1132.mul_add(v525, v1134);
+    let v1136 = v46 * v1135;
+    let v1137 = v536 * dir[5];
+    let v1138 = v80 * v529;
+    let v1139 = v152 * v26;
+    let v1140 = 0.5f64 * v88;
+    let v1141 = v1140 * dir[0];
+    let v1142 = v1139.mul_add(v525, v1141);
+    let v1143 = 0.125f64 * q[4];
+    let v1144 = v371 * dir[4];
+    let v1145 = v1143.mul_add(dir[2], v1144);
+    let v1146 = v1145 - v616;
+    let v1147 = (-v379).mul_add(dir[3], v1146);
+    let v1148 = v368.mul_add(v584, v1136);
+    let v1149 = v1148 + v1137;
+    let v1150 = v1149 + v1138;
+    let v1151 = v370.mul_add(v595, v1150);
+    let v1152 = v53.mul_add(v1142, v1151);
+    let v1153 = v373.mul_add(v585, v1152);
+    let v1154 = v47.mul_add(v1147, v1153);
+    let v1155 = v58 * v1135;
+    let v1156 = 0.5f64 * v591;
+    let v1157 = (-v1143).mul_add(dir[0], v1156);
+    let v1158 = v380.mul_add(dir[4], v1157);
+    let v1159 = v368.mul_add(v605, v1155);
+    let v1160 = v370.mul_add(v609, v1159);
+    let v1161 = v60.mul_add(v1142, v1160);
+    let v1162 = v381.mul_add(v585, v1161);
+    let v1163 = v47.mul_add(v1158, v1162);
+    let v1164 = v65 * v1135;
+    let v1165 = v536 * dir[3];
+    let v1166 = v233 * v529;
+    let v1167 = v1143.mul_add(dir[1], -v578);
+    let v1168 = v385.mul_add(dir[4], v1167);
+    let v1169 = (-v379).mul_add(dir[5], v1168);
+    let v1170 = v368.mul_add(v619, v1164);
+    let v1171 = v1170 - v1165;
+    let v1172 = v1171 - v1166;
+    let v1173 = v370.mul_add(v623, v1172);
+    let v1174 = v67.mul_add(v1142, v1173);
+    let v1175 = v387.mul_add(v585, v1174);
+    let v1176 = v47.mul_add(v1169, v1175);
+    let v1177 = v1102 * dir[1];
+    let v1178 = v287 * v1001;
+    let v1179 = 0.015625f64 * q[2];
+    let v1180 = v1179 * v292;
+    let v1181 = v1180 * dir[0];
+    let v1182 = 0.015625f64 * v292;
+    let v1183 = v1179 * v1010;
+    let v1184 = v1182.mul_add(dir[2], v1183);
+    let v1185 = q[0] * v1184;
+    let v1186 = v1181 - v1177;
+    let v1187 = v1186 - v1178;
+    let v1188 = v1187 + v1185;
+    let v1189 = 0.25f64 * v1009;
+    let v1191 = 0.03125f64 * q[0];
+    let v1192 = v1191 * v292;
+    let v1193 = v1192.mul_add(dir[0], v1189);
+    let v1194 = v398.mul_add(v1010, v1193);
+    let v1195 = v443 * v292;
+    let v1196 = v1195 * dir[0];
+    let v1197 = v443 * v1010;
+    let v1198 = v1182.mul_add(dir[1], v1197);
+    let v1199 = q[0] * v1198;
+    let v1200 = v1105 + v1196;
+    let v1201 = v1200 + v1199;
+    let v1202 = v46 * v1142;
+    let v1203 = 0.25f64 * v47;
+    let v1204 = v1203 * dir[5];
+    let v1205 = v80 * v585;
+    let v1206 = v261 * v26;
+    let v1207 = 0.5f64 * v242;
+    let v1208 = v1207 * dir[0];
+    let v1209 = v1206.mul_add(v525, v1208);
+    let v1210 = v370.mul_add(v584, v1202);
+    let v1211 = v1210 + v1204;
+    let v1212 = v1211 + v1205;
+    let v1213 = v405.mul_add(v595, v1212);
+    let v1214 = v53.mul_add(v1209, v1213);
+    let v1215 = v373.mul_add(v914, v1214);
+    let v1216 = v234.mul_add(v1147, v1215);
+    let v1217 = v58 * v1142;
+    let v1218 = v370.mul_add(v605, v1217);
+    let v1219 = v405.mul_add(v609, v1218);
+    let v1220 = v60.mul_add(v1209, v1219);
+    let v1221 = v381.mul_add(v914, v1220);
+    let v1222 = v234.mul_add(v1158, v1221);
+    let v1223 = v65 * v1142;
+    let v1224 = v1203 * dir[3];
+    let v1225 = v233 * v585;
+    let v1226 = v370.mul_add(v619, v1223);
+    let v1227 = v1226 - v1224;
+    let v1228 = v1227 - v1225;
+    let v1229 = v405.mul_add(v623, v1228);
+    let v1230 = v67.mul_add(v1209, v1229);
+    let v1231 = v387.mul_add(v914, v1230);
+    let v1232 = v234.mul_add(v1169, v1231);
+    let v1233 = v536 * dir[0];
+    let v1234 = v15 * v529;
+    let v1235 = v1113 * dir[1];
+    let v1236 = q[1] * v1117;
+    let v1237 = v1233 + v1234;
+    let v1238 = v1237 + v1235;
+    let v1239 = v1238 + v1236;
+    let v1240 = v1126 - v537;
+    let v1241 = v1240 - v538;
+    let v1242 = v1241 + v1129;
+    let v1243 = v502.mul_add(dir[1], v1122);
+    let v1244 = v421.mul_add(v585, v1243);
+    let v1245 = v144 * v20;
+    let v1246 = v1133 * dir[1];
+    let v1247 = v1245.mul_add(v525, v1246);
+    let v1248 = v46 * v1247;
+    let v1249 = v536 * dir[4];
+    let v1250 = v83 * v529;
+    let v1251 = v152 * v20;
+    let v1252 = v1140 * dir[1];
+    let v1253 = v1251.mul_add(v525, v1252);
+    let v1254 = 0.125f64 * q[5];
+    let v1255 = v1254.mul_add(dir[2], -v601);
+    let v1256 = v371.mul_add(dir[5], v1255);
+    let v1257 = (-v437).mul_add(dir[3], v1256);
+    let v1258 = v423.mul_add(v584, v1248);
+    let v1259 = v1258 - v1249;
+    let v1260 = v1259 - v1250;
+    let v1261 = v425.mul_add(v595, v1260);
+    let v1262 = v53.mul_add(v1253, v1261);
+    let v1263 = v427.mul_add(v585, v1262);
+    let v1264 = v47.mul_add(v1257, v1263);
+    let v1265 = v357 * dir[5];
+    let v1266 = v1254.mul_add(dir[0], v1265);
+    let v1267 = v1266 - v580;
+    let v1268 = (-v437).mul_add(dir[4], v1267);
+    let v1269 = v1165 + v1166;
+    let v1270 = v423.mul_add(v605, v1269);
+    let v1271 = v58.mul_add(v1247, v1270);
+    let v1272 = v425.mul_add(v609, v1271);
+    let v1273 = v60.mul_add(v1253, v1272);
+    let v1274 = v432.mul_add(v585, v1273);
+    let v1275 = v47.mul_add(v1268, v1274);
+    let v1276 = v65 * v1247;
+    let v1277 = (-v1254).mul_add(dir[1], v1156);
+    let v1278 = v438.mul_add(dir[5], v1277);
+    let v1279 = v423.mul_add(v619, v1276);
+    let v1280 = v425.mul_add(v623, v1279);
+    let v1281 = v67.mul_add(v1253, v1280);
+    let v1282 = v439.mul_add(v585, v1281);
+    let v1283 = v47.mul_add(v1278, v1282);
+    let v1284 = v1102 * dir[0];
+    let v1285 = v286 * v1001;
+    let v1286 = v1180 * dir[1];
+    let v1287 = q[1] * v1184;
+    let v1288 = v1284 + v1285;
+    let v1289 = v1288 + v1286;
+    let v1290 = v1289 + v1287;
+    let v1291 = v1196 - v1103;
+    let v1292 = v1291 - v1104;
+    let v1293 = v1292 + v1199;
+    let v1294 = 0.03125f64 * q[1];
+    let v1295 = v1294 * v292;
+    let v1296 = v1295.mul_add(dir[1], v1189);
+    let v1297 = v448.mul_add(v1010, v1296);
+    let v1298 = v46 * v1253;
+    let v1299 = v1203 * dir[4];
+    let v1300 = v83 * v585;
+    let v1301 = v261 * v20;
+    let v1302 = v1207 * dir[1];
+    let v1303 = v1301.mul_add(v525, v1302);
+    let v1304 = v425.mul_add(v584, v1298);
+    let v1305 = v1304 - v1299;
+    let v1306 = v1305 - v1300;
+    let v1307 = v451.mul_add(v595, v1306);
+    let v1308 = v53.mul_add(v1303, v1307);
+    let v1309 = v427.mul_add(v914, v1308);
+    let v1310 = v234.mul_add(v1257, v1309);
+    let v1311 = v1224 + v1225;
+    let v1312 = v425.mul_add(v605, v1311);
+    let v1313 = v58.mul_add(v1253, v1312);
+    let v1314 = v451.mul_add(v609, v1313);
+    let v1315 = v60.mul_add(v1303, v1314);
+    let v1316 = v432.mul_add(v914, v1315);
+    let v1317 = v234.mul_add(v1268, v1316);
+    let v1318 = v65 * v1253;
+    let v1319 = v425.mul_add(v619, v1318);
+    let v1320 = v451.mul_add(v623, v1319);
+    let v1321 = v67.mul_add(v1303, v1320);
+    let v1322 = v439.mul_add(v914, v1321);
+    let v1323 = v234.mul_add(v1278, v1322);
+    let v1324 = v512.mul_add(dir[2], v1122);
+    let v1325 = v461.mul_add(v585, v1324);
+    let v1326 = v562 + v1114;
+    let v1327 = v1326 + v1118;
+    let v1328 = v1235 - v1233;
+    let v1329 = v1328 - v1234;
+    let v1330 = v1329 + v1236;
+    let v1331 = v144 * v33;
+    let v1332 = v1133 * dir[2];
+    let v1333 = v1331.mul_add(v525, v1332);
+    let v1334 = v46 * v1333;
+    let v1335 = v152 * v33;
+    let v1336 = v1140 * dir[2];
+    let v1337 = v1335.mul_add(v525, v1336);
+    let v1338 = 0.125f64 * v41;
+    let v1339 = (-v1338).mul_add(dir[2], v1156);
+    let v1340 = v469.mul_add(dir[3], v1339);
+    let v1341 = v465.mul_add(v584, v1334);
+    let v1342 = v466.mul_add(v595, v1341);
+    let v1343 = v53.mul_add(v1337, v1342);
+    let v1344 = v470.mul_add(v585, v1343);
+    let v1345 = v47.mul_add(v1340, v1344);
+    let v1346 = v1338.mul_add(dir[0], -v615);
+    let v1347 = v357.mul_add(dir[3], v1346);
+    let v1348 = (-v468).mul_add(dir[4], v1347);
+    let v1349 = v465.mul_add(v605, -v1137);
+    let v1350 = v1349 - v1138;
+    let v1351 = v58.mul_add(v1333, v1350);
+    let v1352 = v466.mul_add(v609, v1351);
+    let v1353 = v60.mul_add(v1337, v1352);
+    let v1354 = v474.mul_add(v585, v1353);
+    let v1355 = v47.mul_add(v1348, v1354);
+    let v1356 = v385 * dir[3];
+    let v1357 = v1338.mul_add(dir[1], v1356);
+    let v1358 = v1357 - v602;
+    let v1359 = (-v468).mul_add(dir[5], v1358);
+    let v1360 = v1249 + v1250;
+    let v1361 = v465.mul_add(v619, v1360);
+    let v1362 = v65.mul_add(v1333, v1361);
+    let v1363 = v466.mul_add(v623, v1362);
+    let v1364 = v67.mul_add(v1337, v1363);
+    let v1365 = v479.mul_add(v585, v1364);
+    let v1366 = v47.mul_add(v1359, v1365);
+    let v1367 = 0.03125f64 * q[2];
+    let v1368 = v1367 * v292;
+    let v1369 = v1368.mul_add(dir[2], v1189);
+    let v1370 = v483.mul_add(v1010, v1369);
+    let v1371 = v1177 + v1178;
+    let v1372 = v1371 + v1181;
+    let v1373 = v1372 + v1185;
+    let v1374 = v1286 - v1284;
+    let v1375 = v1374 - v1285;
+    let v1376 = v1375 + v1287;
+    let v1377 = v46 * v1337;
+    let v1378 = v261 * v33;
+    let v1379 = v1207 * dir[2];
+    let v1380 = v1378.mul_add(v525, v1379);
+    let v1381 = v466.mul_add(v584, v1377);
+    let v1382 = v487.mul_add(v595, v1381);
+    let v1383 = v53.mul_add(v1380, v1382);
+    let v1384 = v470.mul_add(v914, v1383);
+    let v1385 = v234.mul_add(v1340, v1384);
+    let v1386 = v466.mul_add(v605, -v1204);
+    let v1387 = v1386 - v1205;
+    let v1388 = v58.mul_add(v1337, v1387);
+    let v1389 = v487.mul_add(v609, v1388);
+    let v1390 = v60.mul_add(v1380, v1389);
+    let v1391 = v474.mul_add(v914, v1390);
+    let v1392 = v234.mul_add(v1348, v1391);
+    let v1393 = v1299 + v1300;
+    let v1394 = v466.mul_add(v619, v1393);
+    let v1395 = v65.mul_add(v1337, v1394);
+    let v1396 = v487.mul_add(v623, v1395);
+    let v1397 = v67.mul_add(v1380, v1396);
+    let v1398 = v479.mul_add(v914, v1397);
+    let v1399 = v234.mul_add(v1359, v1398);
+    let v1400 = 0.5f64 * v525;
+    let v1401 = v48.mul_add(dir[2], -v1400);
+    let v1402 = v47 * v1401;
+    let v1403 = v499.mul_add(v585, v1402);
+    let v1404 = v234 * v1401;
+    let v1405 = v499.mul_add(v914, v1404);
+    let v1406 = v1203 * dir[1];
+    let v1407 = v23 * v585;
+    let v1408 = v371 * v234;
+    let v1409 = v1408 * dir[0];
+    let v1410 = 0.125f64 * v234;
+    let v1411 = v371 * v914;
+    let v1412 = v1410.mul_add(dir[2], v1411);
+    let v1413 = q[0] * v1412;
+    let v1414 = v1406 + v1407;
+    let v1415 = v1414 + v1409;
+    let v1416 = v1415 + v1413;
+    let v1417 = v1203 * dir[0];
+    let v1418 = v15 * v585;
+    let v1419 = v1408 * dir[1];
+    let v1420 = q[1] * v1412;
+    let v1421 = v1419 - v1417;
+    let v1422 = v1421 - v1418;
+    let v1423 = v1422 + v1420;
+    let v1424 = v15.mul_add(dir[0], -v1400);
+    let v1425 = v47 * v1424;
+    let v1426 = v508.mul_add(v585, v1425);
+    let v1427 = v1409 - v1406;
+    let v1428 = v1427 - v1407;
+    let v1429 = v1428 + v1413;
+    let v1430 = v234 * v1424;
+    let v1431 = v508.mul_add(v914, v1430);
+    let v1432 = v1203 * dir[2];
+    let v1433 = v48 * v585;
+    let v1434 = v385 * v234;
+    let v1435 = v1434 * dir[0];
+    let v1436 = v385 * v914;
+    let v1437 = v1410.mul_add(dir[1], v1436);
+    let v1438 = q[0] * v1437;
+    let v1439 = v1432 + v1433;
+    let v1440 = v1439 + v1435;
+    let v1441 = v1440 + v1438;
+    let v1442 = v23.mul_add(dir[1], -v1400);
+    let v1443 = v47 * v1442;
+    let v1444 = v515.mul_add(v585, v1443);
+    let v1445 = v1417 + v1418;
+    let v1446 = v1445 + v1419;
+    let v1447 = v1446 + v1420;
+    let v1448 = v1435 - v1432;
+    let v1449 = v1448 - v1433;
+    let v1450 = v1449 + v1438;
+    let v1451 = v234 * v1442;
+    let v1452 = v515.mul_add(v914, v1451);
+    out[0] = v14;
+    out[1] = v22;
+    out[2] = v28;
+    out[3] = v29;
+    out[4] = v30;
+    out[5] = v35;
+    out[6] = v36;
+    out[7] = v37;
+    out[8] = v38;
+    out[9] = v55;
+    out[10] = v62;
+    out[11] = v69;
+    out[12] = v105;
+    out[13] = v120;
+    out[14] = v135;
+    out[15] = v166;
+    out[16] = v178;
+    out[17] = v190;
+    out[18] = v199;
+    out[19] = v205;
+    out[20] = v211;
+    out[21] = v226;
+    out[22] = v229;
+    out[23] = v232;
+    out[24] = v236;
+    out[25] = v238;
+    out[26] = v240;
+    out[27] = v247;
+    out[28] = v252;
+    out[29] = v257;
+    out[30] = v268;
+    out[31] = v275;
+    out[32] = v282;
+    out[33] = v299;
+    out[34] = v305;
+    out[35] = v311;
+    out[36] = v331;
+    out[37] = v334;
+    out[38] = v337;
+    out[39] = v340;
+    out[40] = v343;
+    out[41] = v346;
+    out[42] = v348;
+    out[43] = v354;
+    out[44] = v355;
+    out[45] = v360;
+    out[46] = v363;
+    out[47] = v367;
+    out[48] = v376;
+    out[49] = v383;
+    out[50] = v390;
+    out[51] = v396;
+    out[52] = v399;
+    out[53] = v403;
+    out[54] = v408;
+    out[55] = v411;
+    out[56] = v415;
+    out[57] = v419;
+    out[58] = v420;
+    out[59] = v422;
+    out[60] = v430;
+    out[61] = v435;
+    out[62] = v441;
+    out[63] = v446;
+    out[64] = v447;
+    out[65] = v449;
+    out[66] = v454;
+    out[67] = v457;
+    out[68] = v460;
+    out[69] = v462;
+    out[70] = v463;
+    out[71] = v464;
+    out[72] = v472;
+    out[73] = v477;
+    out[74] = v482;
+    out[75] = v484;
+    out[76] = v485;
+    out[77] = v486;
+    out[78] = v490;
+    out[79] = v493;
+    out[80] = v496;
+    out[81] = 0f64;
+    out[82] = 0f64;
+    out[83] = 0f64;
+    out[84] = v500;
+    out[85] = v463;
+    out[86] = v464;
+    out[87] = 0f64;
+    out[88] = 0f64;
+    out[89] = 0f64;
+    out[90] = v501;
+    out[91] = v504;
+    out[92] = v507;
+    out[93] = 0f64;
+    out[94] = 0f64;
+    out[95] = 0f64;
+    out[96] = v360;
+    out[97] = v509;
+    out[98] = v367;
+    out[99] = 0f64;
+    out[100] = 0f64;
+    out[101] = 0f64;
+    out[102] = v510;
+    out[103] = v511;
+    out[104] = v514;
+    out[105] = 0f64;
+    out[106] = 0f64;
+    out[107] = 0f64;
+    out[108] = v419;
+    out[109] = v420;
+    out[110] = v516;
+    out[111] = 0f64;
+    out[112] = 0f64;
+    out[113] = 0f64;
+    out[114] = v517;
+    out[115] = v518;
+    out[116] = v519;
+    out[117] = 0f64;
+    out[118] = 0f64;
+    out[119] = 0f64;
+    out[120] = 0f64;
+    out[121] = 0f64;
+    out[122] = 0f64;
+    out[123] = 0f64;
+    out[124] = 0f64;
+    out[125] = 0f64;
+    out[126] = 0f64;
+    out[127] = 0f64;
+    out[128] = 0f64;
+    out[129] = v531;
+    out[130] = v543;
+    out[131] = v550;
+    out[132] = v553;
+    out[133] = v556;
+    out[134] = v566;
+    out[135] = v569;
+    out[136] = v572;
+    out[137] = v575;
+    out[138] = v599;
+    out[139] = v613;
+    out[140] = v627;
+    out[141] = v684;
+    out[142] = v709;
+    out[143] = v734;
+    out[144] = v781;
+    out[145] = v806;
+    out[146] = v831;
+    out[147] = v850;
+    out[148] = v860;
+    out[149] = v870;
+    out[150] = v894;
+    out[151] = v903;
+    out[152] = v912;
+    out[153] = v918;
+    out[154] = v923;
+    out[155] = v928;
+    out[156] = v940;
+    out[157] = v949;
+    out[158] = v958;
+    out[159] = v975;
+    out[160] = v987;
+    out[161] = v999;
+    out[162] = v1025;
+    out[163] = v1035;
+    out[164] = v1045;
+    out[165] = v1079;
+    out[166] = v1088;
+    out[167] = v1097;
+    out[168] = v1100;
+    out[169] = v1108;
+    out[170] = v1112;
+    out[171] = 0f64;
+    out[172] = 0f64;
+    out[173] = 0f64;
+    out[174] = v1121;
+    out[175] = v1124;
+    out[176] = v1131;
+    out[177] = v1154;
+    out[178] = v1163;
+    out[179] = v1176;
+    out[180] = v1188;
+    out[181] = v1194;
+    out[182] = v1201;
+    out[183] = v1216;
+    out[184] = v1222;
+    out[185] = v1232;
+    out[186] = v1239;
+    out[187] = v1242;
+    out[188] = v1244;
+    out[189] = v1264;
+    out[190] = v1275;
+    out[191] = v1283;
+    out[192] = v1290;
+    out[193] = v1293;
+    out[194] = v1297;
+    out[195] = v1310;
+    out[196] = v1317;
+    out[197] = v1323;
+    out[198] = v1325;
+    out[199] = v1327;
+    out[200] = v1330;
+    out[201] = v1345;
+    out[202] = v1355;
+    out[203] = v1366;
+    out[204] = v1370;
+    out[205] = v1373;
+    out[206] = v1376;
+    out[207] = v1385;
+    out[208] = v1392;
+    out[209] = v1399;
+    out[210] = 0f64;
+    out[211] = 0f64;
+    out[212] = 0f64;
+    out[213] = v1403;
+    out[214] = v1327;
+    out[215] = v1330;
+    out[216] = 0f64;
+    out[217] = 0f64;
+    out[218] = 0f64;
+    out[219] = v1405;
+    out[220] = v1416;
+    out[221] = v1423;
+    out[222] = 0f64;
+    out[223] = 0f64;
+    out[224] = 0f64;
+    out[225] = v1121;
+    out[226] = v1426;
+    out[227] = v1131;
+    out[228] = 0f64;
+    out[229] = 0f64;
+    out[230] = 0f64;
+    out[231] = v1429;
+    out[232] = v1431;
+    out[233] = v1441;
+    out[234] = 0f64;
+    out[235] = 0f64;
+    out[236] = 0f64;
+    out[237] = v1239;
+    out[238] = v1242;
+    out[239] = v1444;
+    out[240] = 0f64;
+    out[241] = 0f64;
+    out[242] = 0f64;
+    out[243] = v1447;
+    out[244] = v1450;
+    out[245] = v1452;
+    out[246] = 0f64;
+    out[247] = 0f64;
+    out[248] = 0f64;
+    out[249] = 0f64;
+    out[250] = 0f64;
+    out[251] = 0f64;
+    out[252] = 0f64;
+    out[253] = 0f64;
+    out[254] = 0f64;
+    out[255] = 0f64;
+    out[256] = 0f64;
+    out[257] = 0f64;
 }
 /// Kernel `link_forces`: 171 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn link_forces(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    out: &mut [f64; 36usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    out: &mut [f64; 36],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -5087,195 +4848,195 @@ pub fn link_forces(
 #[allow(unused_variables, clippy::all)]
 fn link_forces_0(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 36usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    w: &mut [f64; 0],
+    out: &mut [f64; 36],
 ) {
-    let v3: f64 = 0.125f64 * p[22usize];
-    let v6: f64 = 0.125f64 * p[23usize];
-    let v7: f64 = v6 * qd[0usize];
-    let v8: f64 = v3.mul_add(q[0usize], v7);
-    let v11: f64 = 0.041666666666666664f64 * p[22usize];
-    let v13: f64 = 0.041666666666666664f64 * p[23usize];
-    let v14: f64 = v13 * qd[1usize];
-    let v15: f64 = v11.mul_add(q[1usize], v14);
-    let v18: f64 = 0.025f64 * p[22usize];
-    let v20: f64 = 0.025f64 * p[23usize];
-    let v21: f64 = v20 * qd[2usize];
-    let v22: f64 = v18.mul_add(q[2usize], v21);
-    let v25: f64 = 0.017857142857142856f64 * p[22usize];
-    let v27: f64 = 0.017857142857142856f64 * p[23usize];
-    let v28: f64 = v27 * qd[3usize];
-    let v29: f64 = v25.mul_add(q[3usize], v28);
-    let v32: f64 = 0.013888888888888888f64 * p[22usize];
-    let v34: f64 = 0.013888888888888888f64 * p[23usize];
-    let v35: f64 = v34 * qd[4usize];
-    let v36: f64 = v32.mul_add(q[4usize], v35);
-    let v39: f64 = 0.011363636363636364f64 * p[22usize];
-    let v41: f64 = 0.011363636363636364f64 * p[23usize];
-    let v42: f64 = v41 * qd[5usize];
-    let v43: f64 = v39.mul_add(q[5usize], v42);
-    let v47: f64 = (-8f64).mul_add(p[24usize], q[6usize]);
-    let v49: f64 = v6 * qd[6usize];
-    let v50: f64 = v3.mul_add(v47, v49);
-    let v53: f64 = v13 * qd[7usize];
-    let v54: f64 = v11.mul_add(q[7usize], v53);
-    let v57: f64 = v20 * qd[8usize];
-    let v58: f64 = v18.mul_add(q[8usize], v57);
-    let v61: f64 = v27 * qd[9usize];
-    let v62: f64 = v25.mul_add(q[9usize], v61);
-    let v65: f64 = v34 * qd[10usize];
-    let v66: f64 = v32.mul_add(q[10usize], v65);
-    let v69: f64 = v41 * qd[11usize];
-    let v70: f64 = v39.mul_add(q[11usize], v69);
-    let v73: f64 = 0.125f64 * p[26usize];
-    let v76: f64 = 0.125f64 * p[27usize];
-    let v77: f64 = v76 * qd[12usize];
-    let v78: f64 = v73.mul_add(q[12usize], v77);
-    let v80: f64 = 0.041666666666666664f64 * p[26usize];
-    let v82: f64 = 0.041666666666666664f64 * p[27usize];
-    let v83: f64 = v82 * qd[13usize];
-    let v84: f64 = v80.mul_add(q[13usize], v83);
-    let v86: f64 = 0.025f64 * p[26usize];
-    let v88: f64 = 0.025f64 * p[27usize];
-    let v89: f64 = v88 * qd[14usize];
-    let v90: f64 = v86.mul_add(q[14usize], v89);
-    let v92: f64 = 0.017857142857142856f64 * p[26usize];
-    let v94: f64 = 0.017857142857142856f64 * p[27usize];
-    let v95: f64 = v94 * qd[15usize];
-    let v96: f64 = v92.mul_add(q[15usize], v95);
-    let v98: f64 = 0.013888888888888888f64 * p[26usize];
-    let v100: f64 = 0.013888888888888888f64 * p[27usize];
-    let v101: f64 = v100 * qd[16usize];
-    let v102: f64 = v98.mul_add(q[16usize], v101);
-    let v104: f64 = 0.011363636363636364f64 * p[26usize];
-    let v106: f64 = 0.011363636363636364f64 * p[27usize];
-    let v107: f64 = v106 * qd[17usize];
-    let v108: f64 = v104.mul_add(q[17usize], v107);
-    let v110: f64 = p[19usize] * p[19usize];
-    let v113: f64 = 8f64 * p[28usize];
-    let v116: f64 = 8f64 * p[29usize];
-    let v117: f64 = v116 * qd[18usize];
-    let v118: f64 = v113.mul_add(q[18usize], v117);
-    let v119: f64 = v110 * v118;
-    let v122: f64 = 2.6666666666666665f64 * p[28usize];
-    let v124: f64 = 2.6666666666666665f64 * p[29usize];
-    let v125: f64 = v124 * qd[19usize];
-    let v126: f64 = v122.mul_add(q[19usize], v125);
-    let v127: f64 = v110 * v126;
-    let v130: f64 = 1.6f64 * p[28usize];
-    let v132: f64 = 1.6f64 * p[29usize];
-    let v133: f64 = v132 * qd[20usize];
-    let v134: f64 = v130.mul_add(q[20usize], v133);
-    let v135: f64 = v110 * v134;
-    let v138: f64 = 1.1428571428571428f64 * p[28usize];
-    let v140: f64 = 1.1428571428571428f64 * p[29usize];
-    let v141: f64 = v140 * qd[21usize];
-    let v142: f64 = v138.mul_add(q[21usize], v141);
-    let v143: f64 = v110 * v142;
-    let v146: f64 = 0.8888888888888888f64 * p[28usize];
-    let v148: f64 = 0.8888888888888888f64 * p[29usize];
-    let v149: f64 = v148 * qd[22usize];
-    let v150: f64 = v146.mul_add(q[22usize], v149);
-    let v151: f64 = v110 * v150;
-    let v154: f64 = 0.7272727272727273f64 * p[28usize];
-    let v156: f64 = 0.7272727272727273f64 * p[29usize];
-    let v157: f64 = v156 * qd[23usize];
-    let v158: f64 = v154.mul_add(q[23usize], v157);
-    let v159: f64 = v110 * v158;
-    let v162: f64 = 8f64 * p[30usize];
-    let v164: f64 = v116 * qd[24usize];
-    let v165: f64 = v162.mul_add(q[24usize], v164);
-    let v166: f64 = v110 * v165;
-    let v168: f64 = 2.6666666666666665f64 * p[30usize];
-    let v170: f64 = v124 * qd[25usize];
-    let v171: f64 = v168.mul_add(q[25usize], v170);
-    let v172: f64 = v110 * v171;
-    let v174: f64 = 1.6f64 * p[30usize];
-    let v176: f64 = v132 * qd[26usize];
-    let v177: f64 = v174.mul_add(q[26usize], v176);
-    let v178: f64 = v110 * v177;
-    let v180: f64 = 1.1428571428571428f64 * p[30usize];
-    let v182: f64 = v140 * qd[27usize];
-    let v183: f64 = v180.mul_add(q[27usize], v182);
-    let v184: f64 = v110 * v183;
-    let v186: f64 = 0.8888888888888888f64 * p[30usize];
-    let v188: f64 = v148 * qd[28usize];
-    let v189: f64 = v186.mul_add(q[28usize], v188);
-    let v190: f64 = v110 * v189;
-    let v192: f64 = 0.7272727272727273f64 * p[30usize];
-    let v194: f64 = v156 * qd[29usize];
-    let v195: f64 = v192.mul_add(q[29usize], v194);
-    let v196: f64 = v110 * v195;
-    let v199: f64 = v116 * qd[30usize];
-    let v200: f64 = v162.mul_add(q[30usize], v199);
-    let v201: f64 = v110 * v200;
-    let v204: f64 = v124 * qd[31usize];
-    let v205: f64 = v168.mul_add(q[31usize], v204);
-    let v206: f64 = v110 * v205;
-    let v209: f64 = v132 * qd[32usize];
-    let v210: f64 = v174.mul_add(q[32usize], v209);
-    let v211: f64 = v110 * v210;
-    let v214: f64 = v140 * qd[33usize];
-    let v215: f64 = v180.mul_add(q[33usize], v214);
-    let v216: f64 = v110 * v215;
-    let v219: f64 = v148 * qd[34usize];
-    let v220: f64 = v186.mul_add(q[34usize], v219);
-    let v221: f64 = v110 * v220;
-    let v224: f64 = v156 * qd[35usize];
-    let v225: f64 = v192.mul_add(q[35usize], v224);
-    let v226: f64 = v110 * v225;
-    out[0usize] = v8;
-    out[1usize] = v15;
-    out[2usize] = v22;
-    out[3usize] = v29;
-    out[4usize] = v36;
-    out[5usize] = v43;
-    out[6usize] = v50;
-    out[7usize] = v54;
-    out[8usize] = v58;
-    out[9usize] = v62;
-    out[10usize] = v66;
-    out[11usize] = v70;
-    out[12usize] = v78;
-    out[13usize] = v84;
-    out[14usize] = v90;
-    out[15usize] = v96;
-    out[16usize] = v102;
-    out[17usize] = v108;
-    out[18usize] = v119;
-    out[19usize] = v127;
-    out[20usize] = v135;
-    out[21usize] = v143;
-    out[22usize] = v151;
-    out[23usize] = v159;
-    out[24usize] = v166;
-    out[25usize] = v172;
-    out[26usize] = v178;
-    out[27usize] = v184;
-    out[28usize] = v190;
-    out[29usize] = v196;
-    out[30usize] = v201;
-    out[31usize] = v206;
-    out[32usize] = v211;
-    out[33usize] = v216;
-    out[34usize] = v221;
-    out[35usize] = v226;
+    let v3 = 0.125f64 * p[22];
+    let v6 = 0.125f64 * p[23];
+    let v7 = v6 * qd[0];
+    let v8 = v3.mul_add(q[0], v7);
+    let v11 = 0.041666666666666664f64 * p[22];
+    let v13 = 0.041666666666666664f64 * p[23];
+    let v14 = v13 * qd[1];
+    let v15 = v11.mul_add(q[1], v14);
+    let v18 = 0.025f64 * p[22];
+    let v20 = 0.025f64 * p[23];
+    let v21 = v20 * qd[2];
+    let v22 = v18.mul_add(q[2], v21);
+    let v25 = 0.017857142857142856f64 * p[22];
+    let v27 = 0.017857142857142856f64 * p[23];
+    let v28 = v27 * qd[3];
+    let v29 = v25.mul_add(q[3], v28);
+    let v32 = 0.013888888888888888f64 * p[22];
+    let v34 = 0.013888888888888888f64 * p[23];
+    let v35 = v34 * qd[4];
+    let v36 = v32.mul_add(q[4], v35);
+    let v39 = 0.011363636363636364f64 * p[22];
+    let v41 = 0.011363636363636364f64 * p[23];
+    let v42 = v41 * qd[5];
+    let v43 = v39.mul_add(q[5], v42);
+    let v47 = (-8f64).mul_add(p[24], q[6]);
+    let v49 = v6 * qd[6];
+    let v50 = v3.mul_add(v47, v49);
+    let v53 = v13 * qd[7];
+    let v54 = v11.mul_add(q[7], v53);
+    let v57 = v20 * qd[8];
+    let v58 = v18.mul_add(q[8], v57);
+    let v61 = v27 * qd[9];
+    let v62 = v25.mul_add(q[9], v61);
+    let v65 = v34 * qd[10];
+    let v66 = v32.mul_add(q[10], v65);
+    let v69 = v41 * qd[11];
+    let v70 = v39.mul_add(q[11], v69);
+    let v73 = 0.125f64 * p[26];
+    let v76 = 0.125f64 * p[27];
+    let v77 = v76 * qd[12];
+    let v78 = v73.mul_add(q[12], v77);
+    let v80 = 0.041666666666666664f64 * p[26];
+    let v82 = 0.041666666666666664f64 * p[27];
+    let v83 = v82 * qd[13];
+    let v84 = v80.mul_add(q[13], v83);
+    let v86 = 0.025f64 * p[26];
+    let v88 = 0.025f64 * p[27];
+    let v89 = v88 * qd[14];
+    let v90 = v86.mul_add(q[14], v89);
+    let v92 = 0.017857142857142856f64 * p[26];
+    let v94 = 0.017857142857142856f64 * p[27];
+    let v95 = v94 * qd[15];
+    let v96 = v92.mul_add(q[15], v95);
+    let v98 = 0.013888888888888888f64 * p[26];
+    let v100 = 0.013888888888888888f64 * p[27];
+    let v101 = v100 * qd[16];
+    let v102 = v98.mul_add(q[16], v101);
+    let v104 = 0.011363636363636364f64 * p[26];
+    let v106 = 0.011363636363636364f64 * p[27];
+    let v107 = v106 * qd[17];
+    let v108 = v104.mul_add(q[17], v107);
+    let v110 = p[19] * p[19];
+    let v113 = 8f64 * p[28];
+    let v116 = 8f64 * p[29];
+    let v117 = v116 * qd[18];
+    let v118 = v113.mul_add(q[18], v117);
+    let v119 = v110 * v118;
+    let v122 = 2.6666666666666665f64 * p[28];
+    let v124 = 2.6666666666666665f64 * p[29];
+    let v125 = v124 * qd[19];
+    let v126 = v122.mul_add(q[19], v125);
+    let v127 = v110 * v126;
+    let v130 = 1.6f64 * p[28];
+    let v132 = 1.6f64 * p[29];
+    let v133 = v132 * qd[20];
+    let v134 = v130.mul_add(q[20], v133);
+    let v135 = v110 * v134;
+    let v138 = 1.1428571428571428f64 * p[28];
+    let v140 = 1.1428571428571428f64 * p[29];
+    let v141 = v140 * qd[21];
+    let v142 = v138.mul_add(q[21], v141);
+    let v143 = v110 * v142;
+    let v146 = 0.8888888888888888f64 * p[28];
+    let v148 = 0.8888888888888888f64 * p[29];
+    let v149 = v148 * qd[22];
+    let v150 = v146.mul_add(q[22], v149);
+    let v151 = v110 * v150;
+    let v154 = 0.7272727272727273f64 * p[28];
+    let v156 = 0.7272727272727273f64 * p[29];
+    let v157 = v156 * qd[23];
+    let v158 = v154.mul_add(q[23], v157);
+    let v159 = v110 * v158;
+    let v162 = 8f64 * p[30];
+    let v164 = v116 * qd[24];
+    let v165 = v162.mul_add(q[24], v164);
+    let v166 = v110 * v165;
+    let v168 = 2.6666666666666665f64 * p[30];
+    let v170 = v124 * qd[25];
+    let v171 = v168.mul_add(q[25], v170);
+    let v172 = v110 * v171;
+    let v174 = 1.6f64 * p[30];
+    let v176 = v132 * qd[26];
+    let v177 = v174.mul_add(q[26], v176);
+    let v178 = v110 * v177;
+    let v180 = 1.1428571428571428f64 * p[30];
+    let v182 = v140 * qd[27];
+    let v183 = v180.mul_add(q[27], v182);
+    let v184 = v110 * v183;
+    let v186 = 0.8888888888888888f64 * p[30];
+    let v188 = v148 * qd[28];
+    let v189 = v186.mul_add(q[28], v188);
+    let v190 = v110 * v189;
+    let v192 = 0.7272727272727273f64 * p[30];
+    let v194 = v156 * qd[29];
+    let v195 = v192.mul_add(q[29], v194);
+    let v196 = v110 * v195;
+    let v199 = v116 * qd[30];
+    let v200 = v162.mul_add(q[30], v199);
+    let v201 = v110 * v200;
+    let v204 = v124 * qd[31];
+    let v205 = v168.mul_add(q[31], v204);
+    let v206 = v110 * v205;
+    let v209 = v132 * qd[32];
+    let v210 = v174.mul_add(q[32], v209);
+    let v211 = v110 * v210;
+    let v214 = v140 * qd[33];
+    let v215 = v180.mul_add(q[33], v214);
+    let v216 = v110 * v215;
+    let v219 = v148 * qd[34];
+    let v220 = v186.mul_add(q[34], v219);
+    let v221 = v110 * v220;
+    let v224 = v156 * qd[35];
+    let v225 = v192.mul_add(q[35], v224);
+    let v226 = v110 * v225;
+    out[0] = v8;
+    out[1] = v15;
+    out[2] = v22;
+    out[3] = v29;
+    out[4] = v36;
+    out[5] = v43;
+    out[6] = v50;
+    out[7] = v54;
+    out[8] = v58;
+    out[9] = v62;
+    out[10] = v66;
+    out[11] = v70;
+    out[12] = v78;
+    out[13] = v84;
+    out[14] = v90;
+    out[15] = v96;
+    out[16] = v102;
+    out[17] = v108;
+    out[18] = v119;
+    out[19] = v127;
+    out[20] = v135;
+    out[21] = v143;
+    out[22] = v151;
+    out[23] = v159;
+    out[24] = v166;
+    out[25] = v172;
+    out[26] = v178;
+    out[27] = v184;
+    out[28] = v190;
+    out[29] = v196;
+    out[30] = v201;
+    out[31] = v206;
+    out[32] = v211;
+    out[33] = v216;
+    out[34] = v221;
+    out[35] = v226;
 }
 /// Kernel `link_forces_tangent`: 297 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn link_forces_tangent(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    out: &mut [f64; 72usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    out: &mut [f64; 72],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -5286,321 +5047,321 @@ pub fn link_forces_tangent(
 #[allow(unused_variables, clippy::all)]
 fn link_forces_tangent_0(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 72usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    w: &mut [f64; 0],
+    out: &mut [f64; 72],
 ) {
-    let v3: f64 = 0.125f64 * p[22usize];
-    let v6: f64 = 0.125f64 * p[23usize];
-    let v7: f64 = v6 * qd[0usize];
-    let v8: f64 = v3.mul_add(q[0usize], v7);
-    let v11: f64 = 0.041666666666666664f64 * p[22usize];
-    let v13: f64 = 0.041666666666666664f64 * p[23usize];
-    let v14: f64 = v13 * qd[1usize];
-    let v15: f64 = v11.mul_add(q[1usize], v14);
-    let v18: f64 = 0.025f64 * p[22usize];
-    let v20: f64 = 0.025f64 * p[23usize];
-    let v21: f64 = v20 * qd[2usize];
-    let v22: f64 = v18.mul_add(q[2usize], v21);
-    let v25: f64 = 0.017857142857142856f64 * p[22usize];
-    let v27: f64 = 0.017857142857142856f64 * p[23usize];
-    let v28: f64 = v27 * qd[3usize];
-    let v29: f64 = v25.mul_add(q[3usize], v28);
-    let v32: f64 = 0.013888888888888888f64 * p[22usize];
-    let v34: f64 = 0.013888888888888888f64 * p[23usize];
-    let v35: f64 = v34 * qd[4usize];
-    let v36: f64 = v32.mul_add(q[4usize], v35);
-    let v39: f64 = 0.011363636363636364f64 * p[22usize];
-    let v41: f64 = 0.011363636363636364f64 * p[23usize];
-    let v42: f64 = v41 * qd[5usize];
-    let v43: f64 = v39.mul_add(q[5usize], v42);
-    let v47: f64 = (-8f64).mul_add(p[24usize], q[6usize]);
-    let v49: f64 = v6 * qd[6usize];
-    let v50: f64 = v3.mul_add(v47, v49);
-    let v53: f64 = v13 * qd[7usize];
-    let v54: f64 = v11.mul_add(q[7usize], v53);
-    let v57: f64 = v20 * qd[8usize];
-    let v58: f64 = v18.mul_add(q[8usize], v57);
-    let v61: f64 = v27 * qd[9usize];
-    let v62: f64 = v25.mul_add(q[9usize], v61);
-    let v65: f64 = v34 * qd[10usize];
-    let v66: f64 = v32.mul_add(q[10usize], v65);
-    let v69: f64 = v41 * qd[11usize];
-    let v70: f64 = v39.mul_add(q[11usize], v69);
-    let v73: f64 = 0.125f64 * p[26usize];
-    let v76: f64 = 0.125f64 * p[27usize];
-    let v77: f64 = v76 * qd[12usize];
-    let v78: f64 = v73.mul_add(q[12usize], v77);
-    let v80: f64 = 0.041666666666666664f64 * p[26usize];
-    let v82: f64 = 0.041666666666666664f64 * p[27usize];
-    let v83: f64 = v82 * qd[13usize];
-    let v84: f64 = v80.mul_add(q[13usize], v83);
-    let v86: f64 = 0.025f64 * p[26usize];
-    let v88: f64 = 0.025f64 * p[27usize];
-    let v89: f64 = v88 * qd[14usize];
-    let v90: f64 = v86.mul_add(q[14usize], v89);
-    let v92: f64 = 0.017857142857142856f64 * p[26usize];
-    let v94: f64 = 0.017857142857142856f64 * p[27usize];
-    let v95: f64 = v94 * qd[15usize];
-    let v96: f64 = v92.mul_add(q[15usize], v95);
-    let v98: f64 = 0.013888888888888888f64 * p[26usize];
-    let v100: f64 = 0.013888888888888888f64 * p[27usize];
-    let v101: f64 = v100 * qd[16usize];
-    let v102: f64 = v98.mul_add(q[16usize], v101);
-    let v104: f64 = 0.011363636363636364f64 * p[26usize];
-    let v106: f64 = 0.011363636363636364f64 * p[27usize];
-    let v107: f64 = v106 * qd[17usize];
-    let v108: f64 = v104.mul_add(q[17usize], v107);
-    let v110: f64 = p[19usize] * p[19usize];
-    let v113: f64 = 8f64 * p[28usize];
-    let v116: f64 = 8f64 * p[29usize];
-    let v117: f64 = v116 * qd[18usize];
-    let v118: f64 = v113.mul_add(q[18usize], v117);
-    let v119: f64 = v110 * v118;
-    let v122: f64 = 2.6666666666666665f64 * p[28usize];
-    let v124: f64 = 2.6666666666666665f64 * p[29usize];
-    let v125: f64 = v124 * qd[19usize];
-    let v126: f64 = v122.mul_add(q[19usize], v125);
-    let v127: f64 = v110 * v126;
-    let v130: f64 = 1.6f64 * p[28usize];
-    let v132: f64 = 1.6f64 * p[29usize];
-    let v133: f64 = v132 * qd[20usize];
-    let v134: f64 = v130.mul_add(q[20usize], v133);
-    let v135: f64 = v110 * v134;
-    let v138: f64 = 1.1428571428571428f64 * p[28usize];
-    let v140: f64 = 1.1428571428571428f64 * p[29usize];
-    let v141: f64 = v140 * qd[21usize];
-    let v142: f64 = v138.mul_add(q[21usize], v141);
-    let v143: f64 = v110 * v142;
-    let v146: f64 = 0.8888888888888888f64 * p[28usize];
-    let v148: f64 = 0.8888888888888888f64 * p[29usize];
-    let v149: f64 = v148 * qd[22usize];
-    let v150: f64 = v146.mul_add(q[22usize], v149);
-    let v151: f64 = v110 * v150;
-    let v154: f64 = 0.7272727272727273f64 * p[28usize];
-    let v156: f64 = 0.7272727272727273f64 * p[29usize];
-    let v157: f64 = v156 * qd[23usize];
-    let v158: f64 = v154.mul_add(q[23usize], v157);
-    let v159: f64 = v110 * v158;
-    let v162: f64 = 8f64 * p[30usize];
-    let v164: f64 = v116 * qd[24usize];
-    let v165: f64 = v162.mul_add(q[24usize], v164);
-    let v166: f64 = v110 * v165;
-    let v168: f64 = 2.6666666666666665f64 * p[30usize];
-    let v170: f64 = v124 * qd[25usize];
-    let v171: f64 = v168.mul_add(q[25usize], v170);
-    let v172: f64 = v110 * v171;
-    let v174: f64 = 1.6f64 * p[30usize];
-    let v176: f64 = v132 * qd[26usize];
-    let v177: f64 = v174.mul_add(q[26usize], v176);
-    let v178: f64 = v110 * v177;
-    let v180: f64 = 1.1428571428571428f64 * p[30usize];
-    let v182: f64 = v140 * qd[27usize];
-    let v183: f64 = v180.mul_add(q[27usize], v182);
-    let v184: f64 = v110 * v183;
-    let v186: f64 = 0.8888888888888888f64 * p[30usize];
-    let v188: f64 = v148 * qd[28usize];
-    let v189: f64 = v186.mul_add(q[28usize], v188);
-    let v190: f64 = v110 * v189;
-    let v192: f64 = 0.7272727272727273f64 * p[30usize];
-    let v194: f64 = v156 * qd[29usize];
-    let v195: f64 = v192.mul_add(q[29usize], v194);
-    let v196: f64 = v110 * v195;
-    let v199: f64 = v116 * qd[30usize];
-    let v200: f64 = v162.mul_add(q[30usize], v199);
-    let v201: f64 = v110 * v200;
-    let v204: f64 = v124 * qd[31usize];
-    let v205: f64 = v168.mul_add(q[31usize], v204);
-    let v206: f64 = v110 * v205;
-    let v209: f64 = v132 * qd[32usize];
-    let v210: f64 = v174.mul_add(q[32usize], v209);
-    let v211: f64 = v110 * v210;
-    let v214: f64 = v140 * qd[33usize];
-    let v215: f64 = v180.mul_add(q[33usize], v214);
-    let v216: f64 = v110 * v215;
-    let v219: f64 = v148 * qd[34usize];
-    let v220: f64 = v186.mul_add(q[34usize], v219);
-    let v221: f64 = v110 * v220;
-    let v224: f64 = v156 * qd[35usize];
-    let v225: f64 = v192.mul_add(q[35usize], v224);
-    let v226: f64 = v110 * v225;
-    let v229: f64 = v6 * dir[36usize];
-    let v230: f64 = v3.mul_add(dir[0usize], v229);
-    let v233: f64 = v13 * dir[37usize];
-    let v234: f64 = v11.mul_add(dir[1usize], v233);
-    let v237: f64 = v20 * dir[38usize];
-    let v238: f64 = v18.mul_add(dir[2usize], v237);
-    let v241: f64 = v27 * dir[39usize];
-    let v242: f64 = v25.mul_add(dir[3usize], v241);
-    let v245: f64 = v34 * dir[40usize];
-    let v246: f64 = v32.mul_add(dir[4usize], v245);
-    let v249: f64 = v41 * dir[41usize];
-    let v250: f64 = v39.mul_add(dir[5usize], v249);
-    let v253: f64 = v6 * dir[42usize];
-    let v254: f64 = v3.mul_add(dir[6usize], v253);
-    let v257: f64 = v13 * dir[43usize];
-    let v258: f64 = v11.mul_add(dir[7usize], v257);
-    let v261: f64 = v20 * dir[44usize];
-    let v262: f64 = v18.mul_add(dir[8usize], v261);
-    let v265: f64 = v27 * dir[45usize];
-    let v266: f64 = v25.mul_add(dir[9usize], v265);
-    let v269: f64 = v34 * dir[46usize];
-    let v270: f64 = v32.mul_add(dir[10usize], v269);
-    let v273: f64 = v41 * dir[47usize];
-    let v274: f64 = v39.mul_add(dir[11usize], v273);
-    let v277: f64 = v76 * dir[48usize];
-    let v278: f64 = v73.mul_add(dir[12usize], v277);
-    let v281: f64 = v82 * dir[49usize];
-    let v282: f64 = v80.mul_add(dir[13usize], v281);
-    let v285: f64 = v88 * dir[50usize];
-    let v286: f64 = v86.mul_add(dir[14usize], v285);
-    let v289: f64 = v94 * dir[51usize];
-    let v290: f64 = v92.mul_add(dir[15usize], v289);
-    let v293: f64 = v100 * dir[52usize];
-    let v294: f64 = v98.mul_add(dir[16usize], v293);
-    let v297: f64 = v106 * dir[53usize];
-    let v298: f64 = v104.mul_add(dir[17usize], v297);
-    let v301: f64 = v116 * dir[54usize];
-    let v302: f64 = v113.mul_add(dir[18usize], v301);
-    let v303: f64 = v110 * v302;
-    let v306: f64 = v124 * dir[55usize];
-    let v307: f64 = v122.mul_add(dir[19usize], v306);
-    let v308: f64 = v110 * v307;
-    let v311: f64 = v132 * dir[56usize];
-    let v312: f64 = v130.mul_add(dir[20usize], v311);
-    let v313: f64 = v110 * v312;
-    let v316: f64 = v140 * dir[57usize];
-    let v317: f64 = v138.mul_add(dir[21usize], v316);
-    let v318: f64 = v110 * v317;
-    let v321: f64 = v148 * dir[58usize];
-    let v322: f64 = v146.mul_add(dir[22usize], v321);
-    let v323: f64 = v110 * v322;
-    let v326: f64 = v156 * dir[59usize];
-    let v327: f64 = v154.mul_add(dir[23usize], v326);
-    let v328: f64 = v110 * v327;
-    let v331: f64 = v116 * dir[60usize];
-    let v332: f64 = v162.mul_add(dir[24usize], v331);
-    let v333: f64 = v110 * v332;
-    let v336: f64 = v124 * dir[61usize];
-    let v337: f64 = v168.mul_add(dir[25usize], v336);
-    let v338: f64 = v110 * v337;
-    let v341: f64 = v132 * dir[62usize];
-    let v342: f64 = v174.mul_add(dir[26usize], v341);
-    let v343: f64 = v110 * v342;
-    let v346: f64 = v140 * dir[63usize];
-    let v347: f64 = v180.mul_add(dir[27usize], v346);
-    let v348: f64 = v110 * v347;
-    let v351: f64 = v148 * dir[64usize];
-    let v352: f64 = v186.mul_add(dir[28usize], v351);
-    let v353: f64 = v110 * v352;
-    let v356: f64 = v156 * dir[65usize];
-    let v357: f64 = v192.mul_add(dir[29usize], v356);
-    let v358: f64 = v110 * v357;
-    let v361: f64 = v116 * dir[66usize];
-    let v362: f64 = v162.mul_add(dir[30usize], v361);
-    let v363: f64 = v110 * v362;
-    let v366: f64 = v124 * dir[67usize];
-    let v367: f64 = v168.mul_add(dir[31usize], v366);
-    let v368: f64 = v110 * v367;
-    let v371: f64 = v132 * dir[68usize];
-    let v372: f64 = v174.mul_add(dir[32usize], v371);
-    let v373: f64 = v110 * v372;
-    let v376: f64 = v140 * dir[69usize];
-    let v377: f64 = v180.mul_add(dir[33usize], v376);
-    let v378: f64 = v110 * v377;
-    let v381: f64 = v148 * dir[70usize];
-    let v382: f64 = v186.mul_add(dir[34usize], v381);
-    let v383: f64 = v110 * v382;
-    let v386: f64 = v156 * dir[71usize];
-    let v387: f64 = v192.mul_add(dir[35usize], v386);
-    let v388: f64 = v110 * v387;
-    out[0usize] = v8;
-    out[1usize] = v15;
-    out[2usize] = v22;
-    out[3usize] = v29;
-    out[4usize] = v36;
-    out[5usize] = v43;
-    out[6usize] = v50;
-    out[7usize] = v54;
-    out[8usize] = v58;
-    out[9usize] = v62;
-    out[10usize] = v66;
-    out[11usize] = v70;
-    out[12usize] = v78;
-    out[13usize] = v84;
-    out[14usize] = v90;
-    out[15usize] = v96;
-    out[16usize] = v102;
-    out[17usize] = v108;
-    out[18usize] = v119;
-    out[19usize] = v127;
-    out[20usize] = v135;
-    out[21usize] = v143;
-    out[22usize] = v151;
-    out[23usize] = v159;
-    out[24usize] = v166;
-    out[25usize] = v172;
-    out[26usize] = v178;
-    out[27usize] = v184;
-    out[28usize] = v190;
-    out[29usize] = v196;
-    out[30usize] = v201;
-    out[31usize] = v206;
-    out[32usize] = v211;
-    out[33usize] = v216;
-    out[34usize] = v221;
-    out[35usize] = v226;
-    out[36usize] = v230;
-    out[37usize] = v234;
-    out[38usize] = v238;
-    out[39usize] = v242;
-    out[40usize] = v246;
-    out[41usize] = v250;
-    out[42usize] = v254;
-    out[43usize] = v258;
-    out[44usize] = v262;
-    out[45usize] = v266;
-    out[46usize] = v270;
-    out[47usize] = v274;
-    out[48usize] = v278;
-    out[49usize] = v282;
-    out[50usize] = v286;
-    out[51usize] = v290;
-    out[52usize] = v294;
-    out[53usize] = v298;
-    out[54usize] = v303;
-    out[55usize] = v308;
-    out[56usize] = v313;
-    out[57usize] = v318;
-    out[58usize] = v323;
-    out[59usize] = v328;
-    out[60usize] = v333;
-    out[61usize] = v338;
-    out[62usize] = v343;
-    out[63usize] = v348;
-    out[64usize] = v353;
-    out[65usize] = v358;
-    out[66usize] = v363;
-    out[67usize] = v368;
-    out[68usize] = v373;
-    out[69usize] = v378;
-    out[70usize] = v383;
-    out[71usize] = v388;
+    let v3 = 0.125f64 * p[22];
+    let v6 = 0.125f64 * p[23];
+    let v7 = v6 * qd[0];
+    let v8 = v3.mul_add(q[0], v7);
+    let v11 = 0.041666666666666664f64 * p[22];
+    let v13 = 0.041666666666666664f64 * p[23];
+    let v14 = v13 * qd[1];
+    let v15 = v11.mul_add(q[1], v14);
+    let v18 = 0.025f64 * p[22];
+    let v20 = 0.025f64 * p[23];
+    let v21 = v20 * qd[2];
+    let v22 = v18.mul_add(q[2], v21);
+    let v25 = 0.017857142857142856f64 * p[22];
+    let v27 = 0.017857142857142856f64 * p[23];
+    let v28 = v27 * qd[3];
+    let v29 = v25.mul_add(q[3], v28);
+    let v32 = 0.013888888888888888f64 * p[22];
+    let v34 = 0.013888888888888888f64 * p[23];
+    let v35 = v34 * qd[4];
+    let v36 = v32.mul_add(q[4], v35);
+    let v39 = 0.011363636363636364f64 * p[22];
+    let v41 = 0.011363636363636364f64 * p[23];
+    let v42 = v41 * qd[5];
+    let v43 = v39.mul_add(q[5], v42);
+    let v47 = (-8f64).mul_add(p[24], q[6]);
+    let v49 = v6 * qd[6];
+    let v50 = v3.mul_add(v47, v49);
+    let v53 = v13 * qd[7];
+    let v54 = v11.mul_add(q[7], v53);
+    let v57 = v20 * qd[8];
+    let v58 = v18.mul_add(q[8], v57);
+    let v61 = v27 * qd[9];
+    let v62 = v25.mul_add(q[9], v61);
+    let v65 = v34 * qd[10];
+    let v66 = v32.mul_add(q[10], v65);
+    let v69 = v41 * qd[11];
+    let v70 = v39.mul_add(q[11], v69);
+    let v73 = 0.125f64 * p[26];
+    let v76 = 0.125f64 * p[27];
+    let v77 = v76 * qd[12];
+    let v78 = v73.mul_add(q[12], v77);
+    let v80 = 0.041666666666666664f64 * p[26];
+    let v82 = 0.041666666666666664f64 * p[27];
+    let v83 = v82 * qd[13];
+    let v84 = v80.mul_add(q[13], v83);
+    let v86 = 0.025f64 * p[26];
+    let v88 = 0.025f64 * p[27];
+    let v89 = v88 * qd[14];
+    let v90 = v86.mul_add(q[14], v89);
+    let v92 = 0.017857142857142856f64 * p[26];
+    let v94 = 0.017857142857142856f64 * p[27];
+    let v95 = v94 * qd[15];
+    let v96 = v92.mul_add(q[15], v95);
+    let v98 = 0.013888888888888888f64 * p[26];
+    let v100 = 0.013888888888888888f64 * p[27];
+    let v101 = v100 * qd[16];
+    let v102 = v98.mul_add(q[16], v101);
+    let v104 = 0.011363636363636364f64 * p[26];
+    let v106 = 0.011363636363636364f64 * p[27];
+    let v107 = v106 * qd[17];
+    let v108 = v104.mul_add(q[17], v107);
+    let v110 = p[19] * p[19];
+    let v113 = 8f64 * p[28];
+    let v116 = 8f64 * p[29];
+    let v117 = v116 * qd[18];
+    let v118 = v113.mul_add(q[18], v117);
+    let v119 = v110 * v118;
+    let v122 = 2.6666666666666665f64 * p[28];
+    let v124 = 2.6666666666666665f64 * p[29];
+    let v125 = v124 * qd[19];
+    let v126 = v122.mul_add(q[19], v125);
+    let v127 = v110 * v126;
+    let v130 = 1.6f64 * p[28];
+    let v132 = 1.6f64 * p[29];
+    let v133 = v132 * qd[20];
+    let v134 = v130.mul_add(q[20], v133);
+    let v135 = v110 * v134;
+    let v138 = 1.1428571428571428f64 * p[28];
+    let v140 = 1.1428571428571428f64 * p[29];
+    let v141 = v140 * qd[21];
+    let v142 = v138.mul_add(q[21], v141);
+    let v143 = v110 * v142;
+    let v146 = 0.8888888888888888f64 * p[28];
+    let v148 = 0.8888888888888888f64 * p[29];
+    let v149 = v148 * qd[22];
+    let v150 = v146.mul_add(q[22], v149);
+    let v151 = v110 * v150;
+    let v154 = 0.7272727272727273f64 * p[28];
+    let v156 = 0.7272727272727273f64 * p[29];
+    let v157 = v156 * qd[23];
+    let v158 = v154.mul_add(q[23], v157);
+    let v159 = v110 * v158;
+    let v162 = 8f64 * p[30];
+    let v164 = v116 * qd[24];
+    let v165 = v162.mul_add(q[24], v164);
+    let v166 = v110 * v165;
+    let v168 = 2.6666666666666665f64 * p[30];
+    let v170 = v124 * qd[25];
+    let v171 = v168.mul_add(q[25], v170);
+    let v172 = v110 * v171;
+    let v174 = 1.6f64 * p[30];
+    let v176 = v132 * qd[26];
+    let v177 = v174.mul_add(q[26], v176);
+    let v178 = v110 * v177;
+    let v180 = 1.1428571428571428f64 * p[30];
+    let v182 = v140 * qd[27];
+    let v183 = v180.mul_add(q[27], v182);
+    let v184 = v110 * v183;
+    let v186 = 0.8888888888888888f64 * p[30];
+    let v188 = v148 * qd[28];
+    let v189 = v186.mul_add(q[28], v188);
+    let v190 = v110 * v189;
+    let v192 = 0.7272727272727273f64 * p[30];
+    let v194 = v156 * qd[29];
+    let v195 = v192.mul_add(q[29], v194);
+    let v196 = v110 * v195;
+    let v199 = v116 * qd[30];
+    let v200 = v162.mul_add(q[30], v199);
+    let v201 = v110 * v200;
+    let v204 = v124 * qd[31];
+    let v205 = v168.mul_add(q[31], v204);
+    let v206 = v110 * v205;
+    let v209 = v132 * qd[32];
+    let v210 = v174.mul_add(q[32], v209);
+    let v211 = v110 * v210;
+    let v214 = v140 * qd[33];
+    let v215 = v180.mul_add(q[33], v214);
+    let v216 = v110 * v215;
+    let v219 = v148 * qd[34];
+    let v220 = v186.mul_add(q[34], v219);
+    let v221 = v110 * v220;
+    let v224 = v156 * qd[35];
+    let v225 = v192.mul_add(q[35], v224);
+    let v226 = v110 * v225;
+    let v229 = v6 * dir[36];
+    let v230 = v3.mul_add(dir[0], v229);
+    let v233 = v13 * dir[37];
+    let v234 = v11.mul_add(dir[1], v233);
+    let v237 = v20 * dir[38];
+    let v238 = v18.mul_add(dir[2], v237);
+    let v241 = v27 * dir[39];
+    let v242 = v25.mul_add(dir[3], v241);
+    let v245 = v34 * dir[40];
+    let v246 = v32.mul_add(dir[4], v245);
+    let v249 = v41 * dir[41];
+    let v250 = v39.mul_add(dir[5], v249);
+    let v253 = v6 * dir[42];
+    let v254 = v3.mul_add(dir[6], v253);
+    let v257 = v13 * dir[43];
+    let v258 = v11.mul_add(dir[7], v257);
+    let v261 = v20 * dir[44];
+    let v262 = v18.mul_add(dir[8], v261);
+    let v265 = v27 * dir[45];
+    let v266 = v25.mul_add(dir[9], v265);
+    let v269 = v34 * dir[46];
+    let v270 = v32.mul_add(dir[10], v269);
+    let v273 = v41 * dir[47];
+    let v274 = v39.mul_add(dir[11], v273);
+    let v277 = v76 * dir[48];
+    let v278 = v73.mul_add(dir[12], v277);
+    let v281 = v82 * dir[49];
+    let v282 = v80.mul_add(dir[13], v281);
+    let v285 = v88 * dir[50];
+    let v286 = v86.mul_add(dir[14], v285);
+    let v289 = v94 * dir[51];
+    let v290 = v92.mul_add(dir[15], v289);
+    let v293 = v100 * dir[52];
+    let v294 = v98.mul_add(dir[16], v293);
+    let v297 = v106 * dir[53];
+    let v298 = v104.mul_add(dir[17], v297);
+    let v301 = v116 * dir[54];
+    let v302 = v113.mul_add(dir[18], v301);
+    let v303 = v110 * v302;
+    let v306 = v124 * dir[55];
+    let v307 = v122.mul_add(dir[19], v306);
+    let v308 = v110 * v307;
+    let v311 = v132 * dir[56];
+    let v312 = v130.mul_add(dir[20], v311);
+    let v313 = v110 * v312;
+    let v316 = v140 * dir[57];
+    let v317 = v138.mul_add(dir[21], v316);
+    let v318 = v110 * v317;
+    let v321 = v148 * dir[58];
+    let v322 = v146.mul_add(dir[22], v321);
+    let v323 = v110 * v322;
+    let v326 = v156 * dir[59];
+    let v327 = v154.mul_add(dir[23], v326);
+    let v328 = v110 * v327;
+    let v331 = v116 * dir[60];
+    let v332 = v162.mul_add(dir[24], v331);
+    let v333 = v110 * v332;
+    let v336 = v124 * dir[61];
+    let v337 = v168.mul_add(dir[25], v336);
+    let v338 = v110 * v337;
+    let v341 = v132 * dir[62];
+    let v342 = v174.mul_add(dir[26], v341);
+    let v343 = v110 * v342;
+    let v346 = v140 * dir[63];
+    let v347 = v180.mul_add(dir[27], v346);
+    let v348 = v110 * v347;
+    let v351 = v148 * dir[64];
+    let v352 = v186.mul_add(dir[28], v351);
+    let v353 = v110 * v352;
+    let v356 = v156 * dir[65];
+    let v357 = v192.mul_add(dir[29], v356);
+    let v358 = v110 * v357;
+    let v361 = v116 * dir[66];
+    let v362 = v162.mul_add(dir[30], v361);
+    let v363 = v110 * v362;
+    let v366 = v124 * dir[67];
+    let v367 = v168.mul_add(dir[31], v366);
+    let v368 = v110 * v367;
+    let v371 = v132 * dir[68];
+    let v372 = v174.mul_add(dir[32], v371);
+    let v373 = v110 * v372;
+    let v376 = v140 * dir[69];
+    let v377 = v180.mul_add(dir[33], v376);
+    let v378 = v110 * v377;
+    let v381 = v148 * dir[70];
+    let v382 = v186.mul_add(dir[34], v381);
+    let v383 = v110 * v382;
+    let v386 = v156 * dir[71];
+    let v387 = v192.mul_add(dir[35], v386);
+    let v388 = v110 * v387;
+    out[0] = v8;
+    out[1] = v15;
+    out[2] = v22;
+    out[3] = v29;
+    out[4] = v36;
+    out[5] = v43;
+    out[6] = v50;
+    out[7] = v54;
+    out[8] = v58;
+    out[9] = v62;
+    out[10] = v66;
+    out[11] = v70;
+    out[12] = v78;
+    out[13] = v84;
+    out[14] = v90;
+    out[15] = v96;
+    out[16] = v102;
+    out[17] = v108;
+    out[18] = v119;
+    out[19] = v127;
+    out[20] = v135;
+    out[21] = v143;
+    out[22] = v151;
+    out[23] = v159;
+    out[24] = v166;
+    out[25] = v172;
+    out[26] = v178;
+    out[27] = v184;
+    out[28] = v190;
+    out[29] = v196;
+    out[30] = v201;
+    out[31] = v206;
+    out[32] = v211;
+    out[33] = v216;
+    out[34] = v221;
+    out[35] = v226;
+    out[36] = v230;
+    out[37] = v234;
+    out[38] = v238;
+    out[39] = v242;
+    out[40] = v246;
+    out[41] = v250;
+    out[42] = v254;
+    out[43] = v258;
+    out[44] = v262;
+    out[45] = v266;
+    out[46] = v270;
+    out[47] = v274;
+    out[48] = v278;
+    out[49] = v282;
+    out[50] = v286;
+    out[51] = v290;
+    out[52] = v294;
+    out[53] = v298;
+    out[54] = v303;
+    out[55] = v308;
+    out[56] = v313;
+    out[57] = v318;
+    out[58] = v323;
+    out[59] = v328;
+    out[60] = v333;
+    out[61] = v338;
+    out[62] = v343;
+    out[63] = v348;
+    out[64] = v353;
+    out[65] = v358;
+    out[66] = v363;
+    out[67] = v368;
+    out[68] = v373;
+    out[69] = v378;
+    out[70] = v383;
+    out[71] = v388;
 }
 /// Kernel `link_energy`: 116 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn link_energy(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    out: &mut [f64; 1usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    out: &mut [f64; 1],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -5611,103 +5372,103 @@ pub fn link_energy(
 #[allow(unused_variables, clippy::all)]
 fn link_energy_0(
     t: f64,
-    q: &[f64; 36usize],
-    qd: &[f64; 36usize],
-    qdd: &[f64; 36usize],
-    dir: &[f64; 72usize],
-    p: &[f64; 522usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 1usize],
+    q: &[f64; 36],
+    qd: &[f64; 36],
+    qdd: &[f64; 36],
+    dir: &[f64; 72],
+    p: &[f64; 522],
+    w: &mut [f64; 0],
+    out: &mut [f64; 1],
 ) {
-    let v3: f64 = q[13usize] * q[13usize];
-    let v5: f64 = 0.3333333333333333f64 * v3;
-    let v7: f64 = q[14usize] * q[14usize];
-    let v10: f64 = q[15usize] * q[15usize];
-    let v13: f64 = q[16usize] * q[16usize];
-    let v16: f64 = q[17usize] * q[17usize];
-    let v18: f64 = q[12usize].mul_add(q[12usize], v5);
-    let v19: f64 = 0.2f64.mul_add(v7, v18);
-    let v20: f64 = 0.14285714285714285f64.mul_add(v10, v19);
-    let v21: f64 = 0.1111111111111111f64.mul_add(v13, v20);
-    let v22: f64 = 0.09090909090909091f64.mul_add(v16, v21);
-    let v24: f64 = 0.125f64 * p[26usize];
-    let v26: f64 = p[19usize] * p[19usize];
-    let v30: f64 = q[19usize] * q[19usize];
-    let v31: f64 = 0.3333333333333333f64 * v30;
-    let v33: f64 = q[20usize] * q[20usize];
-    let v35: f64 = q[21usize] * q[21usize];
-    let v37: f64 = q[22usize] * q[22usize];
-    let v39: f64 = q[23usize] * q[23usize];
-    let v40: f64 = q[18usize].mul_add(q[18usize], v31);
-    let v41: f64 = 0.2f64.mul_add(v33, v40);
-    let v42: f64 = 0.14285714285714285f64.mul_add(v35, v41);
-    let v43: f64 = 0.1111111111111111f64.mul_add(v37, v42);
-    let v44: f64 = 0.09090909090909091f64.mul_add(v39, v43);
-    let v46: f64 = 8f64 * p[28usize];
-    let v50: f64 = q[25usize] * q[25usize];
-    let v51: f64 = 0.3333333333333333f64 * v50;
-    let v53: f64 = q[26usize] * q[26usize];
-    let v55: f64 = q[27usize] * q[27usize];
-    let v57: f64 = q[28usize] * q[28usize];
-    let v59: f64 = q[29usize] * q[29usize];
-    let v60: f64 = q[24usize].mul_add(q[24usize], v51);
-    let v61: f64 = 0.2f64.mul_add(v53, v60);
-    let v62: f64 = 0.14285714285714285f64.mul_add(v55, v61);
-    let v63: f64 = 0.1111111111111111f64.mul_add(v57, v62);
-    let v64: f64 = 0.09090909090909091f64.mul_add(v59, v63);
-    let v67: f64 = q[31usize] * q[31usize];
-    let v68: f64 = 0.3333333333333333f64 * v67;
-    let v70: f64 = q[32usize] * q[32usize];
-    let v72: f64 = q[33usize] * q[33usize];
-    let v74: f64 = q[34usize] * q[34usize];
-    let v76: f64 = q[35usize] * q[35usize];
-    let v77: f64 = q[30usize].mul_add(q[30usize], v68);
-    let v78: f64 = 0.2f64.mul_add(v70, v77);
-    let v79: f64 = 0.14285714285714285f64.mul_add(v72, v78);
-    let v80: f64 = 0.1111111111111111f64.mul_add(v74, v79);
-    let v81: f64 = 0.09090909090909091f64.mul_add(v76, v80);
-    let v82: f64 = 8f64 * v81;
-    let v83: f64 = 8f64.mul_add(v64, v82);
-    let v84: f64 = p[30usize] * v83;
-    let v85: f64 = v46.mul_add(v44, v84);
-    let v86: f64 = v26 * v85;
-    let v90: f64 = q[1usize] * q[1usize];
-    let v91: f64 = 0.3333333333333333f64 * v90;
-    let v93: f64 = q[2usize] * q[2usize];
-    let v95: f64 = q[3usize] * q[3usize];
-    let v97: f64 = q[4usize] * q[4usize];
-    let v99: f64 = q[5usize] * q[5usize];
-    let v100: f64 = q[0usize].mul_add(q[0usize], v91);
-    let v101: f64 = 0.2f64.mul_add(v93, v100);
-    let v102: f64 = 0.14285714285714285f64.mul_add(v95, v101);
-    let v103: f64 = 0.1111111111111111f64.mul_add(v97, v102);
-    let v104: f64 = 0.09090909090909091f64.mul_add(v99, v103);
-    let v107: f64 = (-8f64).mul_add(p[24usize], q[6usize]);
-    let v109: f64 = q[7usize] * q[7usize];
-    let v110: f64 = 0.3333333333333333f64 * v109;
-    let v112: f64 = q[8usize] * q[8usize];
-    let v114: f64 = q[9usize] * q[9usize];
-    let v116: f64 = q[10usize] * q[10usize];
-    let v118: f64 = q[11usize] * q[11usize];
-    let v119: f64 = v107.mul_add(v107, v110);
-    let v120: f64 = 0.2f64.mul_add(v112, v119);
-    let v121: f64 = 0.14285714285714285f64.mul_add(v114, v120);
-    let v122: f64 = 0.1111111111111111f64.mul_add(v116, v121);
-    let v123: f64 = 0.09090909090909091f64.mul_add(v118, v122);
-    let v124: f64 = 0.125f64 * v123;
-    let v125: f64 = 0.125f64.mul_add(v104, v124);
-    let v126: f64 = v24.mul_add(v22, v86);
-    let v127: f64 = p[22usize].mul_add(v125, v126);
-    let v129: f64 = 0.5f64 * v127;
-    out[0usize] = v129;
+    let v3 = q[13] * q[13];
+    let v5 = 0.3333333333333333f64 * v3;
+    let v7 = q[14] * q[14];
+    let v10 = q[15] * q[15];
+    let v13 = q[16] * q[16];
+    let v16 = q[17] * q[17];
+    let v18 = q[12].mul_add(q[12], v5);
+    let v19 = 0.2f64.mul_add(v7, v18);
+    let v20 = 0.14285714285714285f64.mul_add(v10, v19);
+    let v21 = 0.1111111111111111f64.mul_add(v13, v20);
+    let v22 = 0.09090909090909091f64.mul_add(v16, v21);
+    let v24 = 0.125f64 * p[26];
+    let v26 = p[19] * p[19];
+    let v30 = q[19] * q[19];
+    let v31 = 0.3333333333333333f64 * v30;
+    let v33 = q[20] * q[20];
+    let v35 = q[21] * q[21];
+    let v37 = q[22] * q[22];
+    let v39 = q[23] * q[23];
+    let v40 = q[18].mul_add(q[18], v31);
+    let v41 = 0.2f64.mul_add(v33, v40);
+    let v42 = 0.14285714285714285f64.mul_add(v35, v41);
+    let v43 = 0.1111111111111111f64.mul_add(v37, v42);
+    let v44 = 0.09090909090909091f64.mul_add(v39, v43);
+    let v46 = 8f64 * p[28];
+    let v50 = q[25] * q[25];
+    let v51 = 0.3333333333333333f64 * v50;
+    let v53 = q[26] * q[26];
+    let v55 = q[27] * q[27];
+    let v57 = q[28] * q[28];
+    let v59 = q[29] * q[29];
+    let v60 = q[24].mul_add(q[24], v51);
+    let v61 = 0.2f64.mul_add(v53, v60);
+    let v62 = 0.14285714285714285f64.mul_add(v55, v61);
+    let v63 = 0.1111111111111111f64.mul_add(v57, v62);
+    let v64 = 0.09090909090909091f64.mul_add(v59, v63);
+    let v67 = q[31] * q[31];
+    let v68 = 0.3333333333333333f64 * v67;
+    let v70 = q[32] * q[32];
+    let v72 = q[33] * q[33];
+    let v74 = q[34] * q[34];
+    let v76 = q[35] * q[35];
+    let v77 = q[30].mul_add(q[30], v68);
+    let v78 = 0.2f64.mul_add(v70, v77);
+    let v79 = 0.14285714285714285f64.mul_add(v72, v78);
+    let v80 = 0.1111111111111111f64.mul_add(v74, v79);
+    let v81 = 0.09090909090909091f64.mul_add(v76, v80);
+    let v82 = 8f64 * v81;
+    let v83 = 8f64.mul_add(v64, v82);
+    let v84 = p[30] * v83;
+    let v85 = v46.mul_add(v44, v84);
+    let v86 = v26 * v85;
+    let v90 = q[1] * q[1];
+    let v91 = 0.3333333333333333f64 * v90;
+    let v93 = q[2] * q[2];
+    let v95 = q[3] * q[3];
+    let v97 = q[4] * q[4];
+    let v99 = q[5] * q[5];
+    let v100 = q[0].mul_add(q[0], v91);
+    let v101 = 0.2f64.mul_add(v93, v100);
+    let v102 = 0.14285714285714285f64.mul_add(v95, v101);
+    let v103 = 0.1111111111111111f64.mul_add(v97, v102);
+    let v104 = 0.09090909090909091f64.mul_add(v99, v103);
+    let v107 = (-8f64).mul_add(p[24], q[6]);
+    let v109 = q[7] * q[7];
+    let v110 = 0.3333333333333333f64 * v109;
+    let v112 = q[8] * q[8];
+    let v114 = q[9] * q[9];
+    let v116 = q[10] * q[10];
+    let v118 = q[11] * q[11];
+    let v119 = v107.mul_add(v107, v110);
+    let v120 = 0.2f64.mul_add(v112, v119);
+    let v121 = 0.14285714285714285f64.mul_add(v114, v120);
+    let v122 = 0.1111111111111111f64.mul_add(v116, v121);
+    let v123 = 0.09090909090909091f64.mul_add(v118, v122);
+    let v124 = 0.125f64 * v123;
+    let v125 = 0.125f64.mul_add(v104, v124);
+    let v126 = v24.mul_add(v22, v86);
+    let v127 = p[22].mul_add(v125, v126);
+    let v129 = 0.5f64 * v127;
+    out[0] = v129;
 }
 fn cell_0_linked(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
     cell_0(
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 6usize],
-        &[0.0; 12usize],
+        &[0.0; 6],
+        &[0.0; 12],
         p.try_into().expect("cell parameters"),
         out.try_into().expect("cell outputs"),
     )
@@ -5741,14 +5502,14 @@ fn cell_0_tangent_linked(
     p: &[f64],
     out: &mut [f64],
 ) {
-    let mut dir = [0.0; 12usize];
-    dir[..6usize].copy_from_slice(dx);
-    dir[6usize..].copy_from_slice(dxd);
+    let mut dir = [0.0; 12];
+    dir[..6].copy_from_slice(dx);
+    dir[6..].copy_from_slice(dxd);
     cell_0_tangent(
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 6usize],
+        &[0.0; 6],
         &dir,
         p.try_into().expect("cell parameters"),
         out.try_into().expect("cell outputs and derivatives"),
@@ -5759,8 +5520,8 @@ fn cell_0_pose_linked(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 6usize],
-        &[0.0; 12usize],
+        &[0.0; 6],
+        &[0.0; 12],
         p.try_into().expect("cell parameters"),
         out.try_into().expect("pose outputs"),
     )

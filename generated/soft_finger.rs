@@ -4,7 +4,7 @@
 use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
 /// Structural hash of the model this was derived from.
 pub const HASH: &str = "4f39679bc37f54d7";
-pub const DOF: usize = 8usize;
+pub const DOF: usize = 8;
 pub const COORDINATES: &[&str] = &[
     "theta_0_0",
     "theta_0_1",
@@ -74,21 +74,21 @@ pub const PARAMETERS: &[&str] = &[
     "joint[7].rest",
 ];
 /// Derived parameters, computed once per parameter set.
-pub const DERIVED: usize = 85usize;
+pub const DERIVED: usize = 85;
 /// Whether the mass solve is generated (the `accel` kernel).
 pub const ACCEL: bool = true;
 /// Base parameters that are loads (scaled by load continuation).
-pub const LOADS: &[usize] = &[0usize, 1usize, 2usize];
+pub const LOADS: &[usize] = &[0, 1, 2];
 /// The rows of the joints' constraint equations.
 pub const CONSTRAINTS: &[&str] = &[];
 /// Coordinates per independent subsystem (M block diagonal).
 pub const BLOCKS: &[usize] = &[];
 /// Contact points along the arms and at the bodies.
-pub const CONTACT_POINTS: usize = 0usize;
+pub const CONTACT_POINTS: usize = 0;
 /// Points per group of the `contact_jacobian` kernel.
 pub const CONTACT_GROUPS: &[usize] = &[];
 /// Length of the contact frames the `contact_jacobian` groups read.
-pub const CONTACT_FRAMES: usize = 0usize;
+pub const CONTACT_FRAMES: usize = 0;
 /// The compiled kernels of this structure.
 pub struct Compiled {
     info: ModelInfo,
@@ -120,17 +120,17 @@ impl Kernels for Compiled {
         "compiled"
     }
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
-        let q: &[f64; 8usize] = inp.q.try_into().expect("q has DOF entries");
-        let qd: &[f64; 8usize] = inp.qd.try_into().expect("qd has DOF entries");
-        let p: &[f64; 141usize] = inp.p.try_into().expect("parameter vector length");
-        let no_qdd = [0.0f64; 8usize];
-        let qdd: &[f64; 8usize] = if inp.qdd.is_empty() {
+        let q: &[f64; 8] = inp.q.try_into().expect("q has DOF entries");
+        let qd: &[f64; 8] = inp.qd.try_into().expect("qd has DOF entries");
+        let p: &[f64; 141] = inp.p.try_into().expect("parameter vector length");
+        let no_qdd = [0.0f64; 8];
+        let qdd: &[f64; 8] = if inp.qdd.is_empty() {
             &no_qdd
         } else {
             inp.qdd.try_into().expect("qdd has DOF entries")
         };
-        let no_dir = [0.0f64; 16usize];
-        let dir: &[f64; 16usize] = if inp.dir.is_empty() {
+        let no_dir = [0.0f64; 16];
+        let dir: &[f64; 16] = if inp.dir.is_empty() {
             &no_dir
         } else {
             inp.dir.try_into().expect("dir has 2 DOF entries")
@@ -227,12 +227,12 @@ impl Kernels for Compiled {
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    out: &mut [f64; 44usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    out: &mut [f64; 44],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -242,27 +242,27 @@ pub fn accel(
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
 fn accel_fma(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 44usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    w: &mut [f64; 0],
+    out: &mut [f64; 44],
 ) {
-    let mut unused = [0.0f64; 44usize];
+    let mut unused = [0.0f64; 44];
     eom_0(t, q, qd, qdd, dir, p, w, out, &mut unused);
 }
 /// Kernel `mass_bias`: the last 44 values of `eom` (2197 operations for all).
 #[allow(unused_unsafe)]
 pub fn mass_bias(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    out: &mut [f64; 44usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    out: &mut [f64; 44],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -272,1616 +272,1600 @@ pub fn mass_bias(
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
 fn mass_bias_fma(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 44usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    w: &mut [f64; 0],
+    out: &mut [f64; 44],
 ) {
-    let mut unused = [0.0f64; 44usize];
+    let mut unused = [0.0f64; 44];
     eom_0(t, q, qd, qdd, dir, p, w, &mut unused, out);
 }
 #[inline(always)]
 #[allow(unused_variables, clippy::all)]
 fn eom_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 44usize],
-    out2: &mut [f64; 44usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    w: &mut [f64; 0],
+    out: &mut [f64; 44],
+    out2: &mut [f64; 44],
 ) {
-    let [v3, v340, v1352]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[0usize]);
-    let v5: f64 = 2f64 * v3;
-    let v7: f64 = 0.5f64 * q[0usize];
-    let [v8, v337, v890]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v7);
-    let v9: f64 = v8.powi(4i32);
-    let v11: f64 = q[0usize] * q[0usize];
-    let v12: f64 = v3 * v3;
-    let v13: f64 = (-0.25f64).mul_add(v9, v5);
-    let v14: f64 = (-v11).mul_add(v12, v13);
-    let v15: f64 = p[56usize].mul_add(v14, p[10usize]);
-    let [v19, v393, v1305]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[1usize]);
-    let v20: f64 = 2f64 * v19;
-    let v21: f64 = 0.5f64 * q[1usize];
-    let [v22, v383, v901]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v21);
-    let v23: f64 = v22.powi(4i32);
-    let v24: f64 = q[1usize] * q[1usize];
-    let v25: f64 = v19 * v19;
-    let v26: f64 = (-0.25f64).mul_add(v23, v20);
-    let v27: f64 = (-v24).mul_add(v25, v26);
-    let [v31, v436, v1264]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[2usize]);
-    let v32: f64 = 2f64 * v31;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let [v34, v426, v916]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v33);
-    let v35: f64 = v34.powi(4i32);
-    let v36: f64 = q[2usize] * q[2usize];
-    let v37: f64 = v31 * v31;
-    let v38: f64 = (-0.25f64).mul_add(v35, v32);
-    let v39: f64 = (-v36).mul_add(v37, v38);
-    let [v43, v485, v1234]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[3usize]);
-    let v44: f64 = 2f64 * v43;
-    let v45: f64 = 0.5f64 * q[3usize];
-    let [v46, v475, v930]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v45);
-    let v47: f64 = v46.powi(4i32);
-    let v48: f64 = q[3usize] * q[3usize];
-    let v49: f64 = v43 * v43;
-    let v50: f64 = (-0.25f64).mul_add(v47, v44);
-    let v51: f64 = (-v48).mul_add(v49, v50);
-    let [v55, v541, v1204]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[4usize]);
-    let v56: f64 = 2f64 * v55;
-    let v57: f64 = 0.5f64 * q[4usize];
-    let [v58, v531, v944]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v57);
-    let v59: f64 = v58.powi(4i32);
-    let v60: f64 = q[4usize] * q[4usize];
-    let v61: f64 = v55 * v55;
-    let v62: f64 = (-0.25f64).mul_add(v59, v56);
-    let v63: f64 = (-v60).mul_add(v61, v62);
-    let [v67, v605, v1174]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[5usize]);
-    let v68: f64 = 2f64 * v67;
-    let v69: f64 = 0.5f64 * q[5usize];
-    let [v70, v595, v958]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v69);
-    let v71: f64 = v70.powi(4i32);
-    let v72: f64 = q[5usize] * q[5usize];
-    let v73: f64 = v67 * v67;
-    let v74: f64 = (-0.25f64).mul_add(v71, v68);
-    let v75: f64 = (-v72).mul_add(v73, v74);
-    let [v79, v678, v1144]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[6usize]);
-    let v80: f64 = 2f64 * v79;
-    let v81: f64 = 0.5f64 * q[6usize];
-    let [v82, v668, v972]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v81);
-    let v83: f64 = v82.powi(4i32);
-    let v84: f64 = q[6usize] * q[6usize];
-    let v85: f64 = v79 * v79;
-    let v86: f64 = (-0.25f64).mul_add(v83, v80);
-    let v87: f64 = (-v84).mul_add(v85, v86);
-    let [v91, v764, v992]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[7usize]);
-    let v92: f64 = 2f64 * v91;
-    let v93: f64 = 0.5f64 * q[7usize];
-    let [v94, v751, v980]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v93);
-    let v95: f64 = v94.powi(4i32);
-    let v96: f64 = q[7usize] * q[7usize];
-    let v97: f64 = v91 * v91;
-    let v98: f64 = (-0.25f64).mul_add(v95, v92);
-    let v99: f64 = (-v96).mul_add(v97, v98);
+    let [v3, v340, v1352]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[0]);
+    let v5 = 2f64 * v3;
+    let v7 = 0.5f64 * q[0];
+    let [v8, v337, v890]: [f64; 3] = runtime::special::sinc_orders::<3>(v7);
+    let v9 = v8.powi(4i32);
+    let v11 = q[0] * q[0];
+    let v12 = v3 * v3;
+    let v13 = (-0.25f64).mul_add(v9, v5);
+    let v14 = (-v11).mul_add(v12, v13);
+    let v15 = p[56].mul_add(v14, p[10]);
+    let [v19, v393, v1305]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[1]);
+    let v20 = 2f64 * v19;
+    let v21 = 0.5f64 * q[1];
+    let [v22, v383, v901]: [f64; 3] = runtime::special::sinc_orders::<3>(v21);
+    let v23 = v22.powi(4i32);
+    let v24 = q[1] * q[1];
+    let v25 = v19 * v19;
+    let v26 = (-0.25f64).mul_add(v23, v20);
+    let v27 = (-v24).mul_add(v25, v26);
+    let [v31, v436, v1264]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[2]);
+    let v32 = 2f64 * v31;
+    let v33 = 0.5f64 * q[2];
+    let [v34, v426, v916]: [f64; 3] = runtime::special::sinc_orders::<3>(v33);
+    let v35 = v34.powi(4i32);
+    let v36 = q[2] * q[2];
+    let v37 = v31 * v31;
+    let v38 = (-0.25f64).mul_add(v35, v32);
+    let v39 = (-v36).mul_add(v37, v38);
+    let [v43, v485, v1234]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[3]);
+    let v44 = 2f64 * v43;
+    let v45 = 0.5f64 * q[3];
+    let [v46, v475, v930]: [f64; 3] = runtime::special::sinc_orders::<3>(v45);
+    let v47 = v46.powi(4i32);
+    let v48 = q[3] * q[3];
+    let v49 = v43 * v43;
+    let v50 = (-0.25f64).mul_add(v47, v44);
+    let v51 = (-v48).mul_add(v49, v50);
+    let [v55, v541, v1204]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[4]);
+    let v56 = 2f64 * v55;
+    let v57 = 0.5f64 * q[4];
+    let [v58, v531, v944]: [f64; 3] = runtime::special::sinc_orders::<3>(v57);
+    let v59 = v58.powi(4i32);
+    let v60 = q[4] * q[4];
+    let v61 = v55 * v55;
+    let v62 = (-0.25f64).mul_add(v59, v56);
+    let v63 = (-v60).mul_add(v61, v62);
+    let [v67, v605, v1174]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[5]);
+    let v68 = 2f64 * v67;
+    let v69 = 0.5f64 * q[5];
+    let [v70, v595, v958]: [f64; 3] = runtime::special::sinc_orders::<3>(v69);
+    let v71 = v70.powi(4i32);
+    let v72 = q[5] * q[5];
+    let v73 = v67 * v67;
+    let v74 = (-0.25f64).mul_add(v71, v68);
+    let v75 = (-v72).mul_add(v73, v74);
+    let [v79, v678, v1144]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[6]);
+    let v80 = 2f64 * v79;
+    let v81 = 0.5f64 * q[6];
+    let [v82, v668, v972]: [f64; 3] = runtime::special::sinc_orders::<3>(v81);
+    let v83 = v82.powi(4i32);
+    let v84 = q[6] * q[6];
+    let v85 = v79 * v79;
+    let v86 = (-0.25f64).mul_add(v83, v80);
+    let v87 = (-v84).mul_add(v85, v86);
+    let [v91, v764, v992]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[7]);
+    let v92 = 2f64 * v91;
+    let v93 = 0.5f64 * q[7];
+    let [v94, v751, v980]: [f64; 3] = runtime::special::sinc_orders::<3>(v93);
+    let v95 = v94.powi(4i32);
+    let v96 = q[7] * q[7];
+    let v97 = v91 * v91;
+    let v98 = (-0.25f64).mul_add(v95, v92);
+    let v99 = (-v96).mul_add(v97, v98);
     let (v105, v106): (f64, f64) = runtime::special::sin_cos(v7);
-    let v107: f64 = p[64usize] * v105;
-    let v108: f64 = p[65usize].mul_add(v106, -v107);
-    let v109: f64 = p[8usize] * v8;
-    let v110: f64 = v109.mul_add(v108, p[3usize]);
-    let v112: f64 = p[65usize] * v105;
-    let v113: f64 = p[64usize].mul_add(v106, v112);
-    let v114: f64 = v108 * v105;
-    let v115: f64 = v113.mul_add(v106, v114);
-    let v116: f64 = v113 * v105;
-    let v117: f64 = v108.mul_add(v106, -v116);
+    let v107 = p[64] * v105;
+    let v108 = p[65].mul_add(v106, -v107);
+    let v109 = p[8] * v8;
+    let v110 = v109.mul_add(v108, p[3]);
+    let v112 = p[65] * v105;
+    let v113 = p[64].mul_add(v106, v112);
+    let v114 = v108 * v105;
+    let v115 = v113.mul_add(v106, v114);
+    let v116 = v113 * v105;
+    let v117 = v108.mul_add(v106, -v116);
     let (v118, v119): (f64, f64) = runtime::special::sin_cos(v21);
-    let v120: f64 = v115 * v118;
-    let v121: f64 = v117.mul_add(v119, -v120);
-    let v122: f64 = p[14usize] * v22;
-    let v123: f64 = v122.mul_add(v121, v110);
-    let v125: f64 = v117 * v118;
-    let v126: f64 = v115.mul_add(v119, v125);
-    let v127: f64 = v121 * v118;
-    let v128: f64 = v126.mul_add(v119, v127);
-    let v129: f64 = v126 * v118;
-    let v130: f64 = v121.mul_add(v119, -v129);
+    let v120 = v115 * v118;
+    let v121 = v117.mul_add(v119, -v120);
+    let v122 = p[14] * v22;
+    let v123 = v122.mul_add(v121, v110);
+    let v125 = v117 * v118;
+    let v126 = v115.mul_add(v119, v125);
+    let v127 = v121 * v118;
+    let v128 = v126.mul_add(v119, v127);
+    let v129 = v126 * v118;
+    let v130 = v121.mul_add(v119, -v129);
     let (v131, v132): (f64, f64) = runtime::special::sin_cos(v33);
-    let v133: f64 = v128 * v131;
-    let v134: f64 = v130.mul_add(v132, -v133);
-    let v135: f64 = p[20usize] * v34;
-    let v136: f64 = v135.mul_add(v134, v123);
-    let v138: f64 = v130 * v131;
-    let v139: f64 = v128.mul_add(v132, v138);
-    let v140: f64 = v134 * v131;
-    let v141: f64 = v139.mul_add(v132, v140);
-    let v142: f64 = v139 * v131;
-    let v143: f64 = v134.mul_add(v132, -v142);
+    let v133 = v128 * v131;
+    let v134 = v130.mul_add(v132, -v133);
+    let v135 = p[20] * v34;
+    let v136 = v135.mul_add(v134, v123);
+    let v138 = v130 * v131;
+    let v139 = v128.mul_add(v132, v138);
+    let v140 = v134 * v131;
+    let v141 = v139.mul_add(v132, v140);
+    let v142 = v139 * v131;
+    let v143 = v134.mul_add(v132, -v142);
     let (v144, v145): (f64, f64) = runtime::special::sin_cos(v45);
-    let v146: f64 = v141 * v144;
-    let v147: f64 = v143.mul_add(v145, -v146);
-    let v148: f64 = p[26usize] * v46;
-    let v149: f64 = v148.mul_add(v147, v136);
-    let v151: f64 = v143 * v144;
-    let v152: f64 = v141.mul_add(v145, v151);
-    let v153: f64 = v147 * v144;
-    let v154: f64 = v152.mul_add(v145, v153);
-    let v155: f64 = v152 * v144;
-    let v156: f64 = v147.mul_add(v145, -v155);
+    let v146 = v141 * v144;
+    let v147 = v143.mul_add(v145, -v146);
+    let v148 = p[26] * v46;
+    let v149 = v148.mul_add(v147, v136);
+    let v151 = v143 * v144;
+    let v152 = v141.mul_add(v145, v151);
+    let v153 = v147 * v144;
+    let v154 = v152.mul_add(v145, v153);
+    let v155 = v152 * v144;
+    let v156 = v147.mul_add(v145, -v155);
     let (v157, v158): (f64, f64) = runtime::special::sin_cos(v57);
-    let v159: f64 = v154 * v157;
-    let v160: f64 = v156.mul_add(v158, -v159);
-    let v161: f64 = p[32usize] * v58;
-    let v162: f64 = v161.mul_add(v160, v149);
-    let v164: f64 = v156 * v157;
-    let v165: f64 = v154.mul_add(v158, v164);
-    let v166: f64 = v160 * v157;
-    let v167: f64 = v165.mul_add(v158, v166);
-    let v168: f64 = v165 * v157;
-    let v169: f64 = v160.mul_add(v158, -v168);
+    let v159 = v154 * v157;
+    let v160 = v156.mul_add(v158, -v159);
+    let v161 = p[32] * v58;
+    let v162 = v161.mul_add(v160, v149);
+    let v164 = v156 * v157;
+    let v165 = v154.mul_add(v158, v164);
+    let v166 = v160 * v157;
+    let v167 = v165.mul_add(v158, v166);
+    let v168 = v165 * v157;
+    let v169 = v160.mul_add(v158, -v168);
     let (v170, v171): (f64, f64) = runtime::special::sin_cos(v69);
-    let v172: f64 = v167 * v170;
-    let v173: f64 = v169.mul_add(v171, -v172);
-    let v174: f64 = p[38usize] * v70;
-    let v175: f64 = v174.mul_add(v173, v162);
-    let v177: f64 = v169 * v170;
-    let v178: f64 = v167.mul_add(v171, v177);
-    let v179: f64 = v173 * v170;
-    let v180: f64 = v178.mul_add(v171, v179);
-    let v181: f64 = v178 * v170;
-    let v182: f64 = v173.mul_add(v171, -v181);
+    let v172 = v167 * v170;
+    let v173 = v169.mul_add(v171, -v172);
+    let v174 = p[38] * v70;
+    let v175 = v174.mul_add(v173, v162);
+    let v177 = v169 * v170;
+    let v178 = v167.mul_add(v171, v177);
+    let v179 = v173 * v170;
+    let v180 = v178.mul_add(v171, v179);
+    let v181 = v178 * v170;
+    let v182 = v173.mul_add(v171, -v181);
     let (v183, v184): (f64, f64) = runtime::special::sin_cos(v81);
-    let v185: f64 = v180 * v183;
-    let v186: f64 = v182.mul_add(v184, -v185);
-    let v187: f64 = p[44usize] * v82;
-    let v188: f64 = v187.mul_add(v186, v175);
-    let v190: f64 = v94 * v94;
-    let v191: f64 = p[66usize] * v190;
-    let v192: f64 = v182 * v183;
-    let v193: f64 = v180.mul_add(v184, v192);
-    let v194: f64 = v193 * v183;
-    let v195: f64 = v186.mul_add(v184, -v194);
-    let v197: f64 = p[50usize] * q[7usize];
-    let v198: f64 = v197 * v91;
-    let v199: f64 = v186 * v183;
-    let v200: f64 = v193.mul_add(v184, v199);
-    let v201: f64 = v191.mul_add(v195, v188);
-    let v202: f64 = (-v198).mul_add(v200, v201);
-    let v204: f64 = v109.mul_add(v113, p[4usize]);
-    let v205: f64 = v122.mul_add(v126, v204);
-    let v206: f64 = v135.mul_add(v139, v205);
-    let v207: f64 = v148.mul_add(v152, v206);
-    let v208: f64 = v161.mul_add(v165, v207);
-    let v209: f64 = v174.mul_add(v178, v208);
-    let v210: f64 = v187.mul_add(v193, v209);
-    let v211: f64 = v191.mul_add(v200, v210);
-    let v212: f64 = v198.mul_add(v195, v211);
-    let v213: f64 = v212 * v212;
-    let v214: f64 = v202.mul_add(v202, v213);
-    let v217: f64 = p[6usize] + v7;
-    let v218: f64 = v7 + v217;
-    let v219: f64 = v21 + v218;
-    let v220: f64 = v21 + v219;
-    let v221: f64 = v33 + v220;
-    let v222: f64 = v33 + v221;
-    let v223: f64 = v45 + v222;
-    let v224: f64 = v45 + v223;
-    let v225: f64 = v57 + v224;
-    let v226: f64 = v57 + v225;
-    let v227: f64 = v69 + v226;
-    let v228: f64 = v69 + v227;
-    let v229: f64 = v81 + v228;
-    let v230: f64 = v81 + v229;
-    let v231: f64 = v93 + v230;
+    let v185 = v180 * v183;
+    let v186 = v182.mul_add(v184, -v185);
+    let v187 = p[44] * v82;
+    let v188 = v187.mul_add(v186, v175);
+    let v190 = v94 * v94;
+    let v191 = p[66] * v190;
+    let v192 = v182 * v183;
+    let v193 = v180.mul_add(v184, v192);
+    let v194 = v193 * v183;
+    let v195 = v186.mul_add(v184, -v194);
+    let v197 = p[50] * q[7];
+    let v198 = v197 * v91;
+    let v199 = v186 * v183;
+    let v200 = v193.mul_add(v184, v199);
+    let v201 = v191.mul_add(v195, v188);
+    let v202 = (-v198).mul_add(v200, v201);
+    let v204 = v109.mul_add(v113, p[4]);
+    let v205 = v122.mul_add(v126, v204);
+    let v206 = v135.mul_add(v139, v205);
+    let v207 = v148.mul_add(v152, v206);
+    let v208 = v161.mul_add(v165, v207);
+    let v209 = v174.mul_add(v178, v208);
+    let v210 = v187.mul_add(v193, v209);
+    let v211 = v191.mul_add(v200, v210);
+    let v212 = v198.mul_add(v195, v211);
+    let v213 = v212 * v212;
+    let v214 = v202.mul_add(v202, v213);
+    let v217 = p[6] + v7;
+    let v218 = v7 + v217;
+    let v219 = v21 + v218;
+    let v220 = v21 + v219;
+    let v221 = v33 + v220;
+    let v222 = v33 + v221;
+    let v223 = v45 + v222;
+    let v224 = v45 + v223;
+    let v225 = v57 + v224;
+    let v226 = v57 + v225;
+    let v227 = v69 + v226;
+    let v228 = v69 + v227;
+    let v229 = v81 + v228;
+    let v230 = v81 + v229;
+    let v231 = v93 + v230;
     let (v235, v232): (f64, f64) = runtime::special::sin_cos(v231);
-    let v233: f64 = p[50usize] * v94;
-    let v234: f64 = v233.mul_add(v232, v188);
-    let v236: f64 = v233.mul_add(v235, v210);
-    let v237: f64 = v236 * v236;
-    let v238: f64 = v234.mul_add(v234, v237);
-    let v239: f64 = p[63usize].mul_add(v99, p[52usize]);
-    let v240: f64 = p[51usize].mul_add(v214, v239);
-    let v241: f64 = p[7usize].mul_add(v238, v240);
-    let v244: f64 = v82 * v82;
-    let v245: f64 = p[67usize] * v244;
-    let v246: f64 = p[44usize] * q[6usize];
-    let v247: f64 = v246 * v79;
-    let v248: f64 = v245.mul_add(v182, v175);
-    let v249: f64 = (-v247).mul_add(v180, v248);
-    let v250: f64 = v245.mul_add(v180, v209);
-    let v251: f64 = v247.mul_add(v182, v250);
-    let v252: f64 = v251 * v251;
-    let v253: f64 = v249.mul_add(v249, v252);
-    let v254: f64 = p[62usize].mul_add(v87, p[46usize]);
-    let v255: f64 = v254 + v241;
-    let v256: f64 = p[45usize].mul_add(v253, v255);
-    let v259: f64 = v70 * v70;
-    let v260: f64 = p[68usize] * v259;
-    let v261: f64 = p[38usize] * q[5usize];
-    let v262: f64 = v261 * v67;
-    let v263: f64 = v260.mul_add(v169, v162);
-    let v264: f64 = (-v262).mul_add(v167, v263);
-    let v265: f64 = v260.mul_add(v167, v208);
-    let v266: f64 = v262.mul_add(v169, v265);
-    let v267: f64 = v266 * v266;
-    let v268: f64 = v264.mul_add(v264, v267);
-    let v269: f64 = p[61usize].mul_add(v75, p[40usize]);
-    let v270: f64 = v269 + v256;
-    let v271: f64 = p[39usize].mul_add(v268, v270);
-    let v274: f64 = v58 * v58;
-    let v275: f64 = p[69usize] * v274;
-    let v276: f64 = p[32usize] * q[4usize];
-    let v277: f64 = v276 * v55;
-    let v278: f64 = v275.mul_add(v156, v149);
-    let v279: f64 = (-v277).mul_add(v154, v278);
-    let v280: f64 = v275.mul_add(v154, v207);
-    let v281: f64 = v277.mul_add(v156, v280);
-    let v282: f64 = v281 * v281;
-    let v283: f64 = v279.mul_add(v279, v282);
-    let v284: f64 = p[60usize].mul_add(v63, p[34usize]);
-    let v285: f64 = v284 + v271;
-    let v286: f64 = p[33usize].mul_add(v283, v285);
-    let v289: f64 = v46 * v46;
-    let v290: f64 = p[70usize] * v289;
-    let v291: f64 = p[26usize] * q[3usize];
-    let v292: f64 = v291 * v43;
-    let v293: f64 = v290.mul_add(v143, v136);
-    let v294: f64 = (-v292).mul_add(v141, v293);
-    let v295: f64 = v290.mul_add(v141, v206);
-    let v296: f64 = v292.mul_add(v143, v295);
-    let v297: f64 = v296 * v296;
-    let v298: f64 = v294.mul_add(v294, v297);
-    let v299: f64 = p[59usize].mul_add(v51, p[28usize]);
-    let v300: f64 = v299 + v286;
-    let v301: f64 = p[27usize].mul_add(v298, v300);
-    let v304: f64 = v34 * v34;
-    let v305: f64 = p[71usize] * v304;
-    let v306: f64 = p[20usize] * q[2usize];
-    let v307: f64 = v306 * v31;
-    let v308: f64 = v305.mul_add(v130, v123);
-    let v309: f64 = (-v307).mul_add(v128, v308);
-    let v310: f64 = v305.mul_add(v128, v205);
-    let v311: f64 = v307.mul_add(v130, v310);
-    let v312: f64 = v311 * v311;
-    let v313: f64 = v309.mul_add(v309, v312);
-    let v314: f64 = p[58usize].mul_add(v39, p[22usize]);
-    let v315: f64 = v314 + v301;
-    let v316: f64 = p[21usize].mul_add(v313, v315);
-    let v319: f64 = v22 * v22;
-    let v320: f64 = p[72usize] * v319;
-    let v321: f64 = v320 * v117;
-    let v322: f64 = p[14usize] * q[1usize];
-    let v323: f64 = v322 * v19;
-    let v324: f64 = v323 * v115;
-    let v325: f64 = v110 + v321;
-    let v326: f64 = v325 - v324;
-    let v327: f64 = v320 * v115;
-    let v328: f64 = v323 * v117;
-    let v329: f64 = v204 + v327;
-    let v330: f64 = v329 + v328;
-    let v331: f64 = v330 * v330;
-    let v332: f64 = v326.mul_add(v326, v331);
-    let v333: f64 = p[57usize].mul_add(v27, p[16usize]);
-    let v334: f64 = v333 + v316;
-    let v335: f64 = p[15usize].mul_add(v332, v334);
-    let v338: f64 = 0.5f64 * v337;
-    let v339: f64 = v109 * v338;
-    let v341: f64 = q[0usize].mul_add(v340, v3);
-    let v342: f64 = p[8usize] * v341;
-    let v343: f64 = p[65usize] * v342;
-    let v344: f64 = p[64usize].mul_add(v339, v343);
-    let v345: f64 = p[64usize] * v342;
-    let v346: f64 = p[65usize].mul_add(v339, -v345);
-    let v347: f64 = v346 * v346;
-    let v348: f64 = v344.mul_add(v344, v347);
-    let v349: f64 = v108 * v338;
-    let v350: f64 = 0.5f64 * v8;
-    let v351: f64 = (-v350).mul_add(v113, v349);
-    let v352: f64 = p[8usize].mul_add(v351, v204);
-    let v353: f64 = p[7usize] * v236;
-    let v354: f64 = p[51usize].mul_add(v212, v353);
-    let v355: f64 = p[45usize].mul_add(v251, v354);
-    let v356: f64 = p[39usize].mul_add(v266, v355);
-    let v357: f64 = p[33usize].mul_add(v281, v356);
-    let v358: f64 = p[27usize].mul_add(v296, v357);
-    let v359: f64 = p[21usize].mul_add(v311, v358);
-    let v360: f64 = p[15usize].mul_add(v330, v359);
-    let v361: f64 = 2f64 * v360;
-    let v363: f64 = v352.mul_add(p[73usize], -v361);
-    let v364: f64 = v113 * v338;
-    let v365: f64 = v350.mul_add(v108, v364);
-    let v366: f64 = p[8usize].mul_add(v365, -v110);
-    let v367: f64 = p[7usize] * v234;
-    let v368: f64 = p[51usize].mul_add(v202, v367);
-    let v369: f64 = p[45usize].mul_add(v249, v368);
-    let v370: f64 = p[39usize].mul_add(v264, v369);
-    let v371: f64 = p[33usize].mul_add(v279, v370);
-    let v372: f64 = p[27usize].mul_add(v294, v371);
-    let v373: f64 = p[21usize].mul_add(v309, v372);
-    let v374: f64 = p[15usize].mul_add(v326, v373);
-    let v375: f64 = v366 * p[73usize];
-    let v376: f64 = 2f64.mul_add(v374, v375);
-    let v377: f64 = 0.25f64.mul_add(v15, v335);
-    let v378: f64 = p[9usize].mul_add(v348, v377);
-    let v379: f64 = v352.mul_add(v363, v378);
-    let v380: f64 = v366.mul_add(v376, v379);
-    let v382: f64 = 1f64 / v380;
-    let v384: f64 = 0.5f64 * v383;
-    let v385: f64 = 0.5f64 * v22;
-    let v386: f64 = v385 * v121;
-    let v387: f64 = v126.mul_add(v384, v386);
-    let v388: f64 = p[14usize].mul_add(v387, -v123);
-    let v389: f64 = v385 * v126;
-    let v390: f64 = v121.mul_add(v384, -v389);
-    let v391: f64 = p[14usize].mul_add(v390, v205);
-    let v392: f64 = v122 * v384;
-    let v394: f64 = q[1usize].mul_add(v393, v19);
-    let v395: f64 = p[14usize] * v394;
-    let v396: f64 = v117 * v395;
-    let v397: f64 = v115.mul_add(v392, v396);
-    let v398: f64 = v115 * v395;
-    let v399: f64 = v117.mul_add(v392, -v398);
-    let v400: f64 = v330 * v399;
-    let v401: f64 = v326.mul_add(v397, -v400);
-    let v402: f64 = 0.5f64.mul_add(v333, v316);
-    let v403: f64 = v388.mul_add(v373, v402);
-    let v404: f64 = (-v391).mul_add(v359, v403);
-    let v405: f64 = p[15usize].mul_add(v401, v404);
-    let v407: f64 = v391 * p[74usize];
-    let v408: f64 = v407 - v359;
-    let v409: f64 = p[15usize].mul_add(v399, v408);
-    let v410: f64 = v388 * p[74usize];
-    let v411: f64 = v373 + v410;
-    let v412: f64 = p[15usize].mul_add(v397, v411);
-    let v413: f64 = v352.mul_add(v409, v405);
-    let v414: f64 = v366.mul_add(v412, v413);
-    let v415: f64 = v382 * v414;
-    let v416: f64 = v397 * v397;
-    let v417: f64 = v399.mul_add(v399, v416);
-    let v418: f64 = (-2f64).mul_add(v359, v407);
-    let v419: f64 = 2f64.mul_add(v373, v410);
-    let v420: f64 = 0.25f64.mul_add(v333, v316);
-    let v421: f64 = p[15usize].mul_add(v417, v420);
-    let v422: f64 = v391.mul_add(v418, v421);
-    let v423: f64 = v388.mul_add(v419, v422);
-    let v424: f64 = (-v414).mul_add(v415, v423);
-    let v425: f64 = 1f64 / v424;
-    let v427: f64 = 0.5f64 * v426;
-    let v428: f64 = 0.5f64 * v34;
-    let v429: f64 = v428 * v134;
-    let v430: f64 = v139.mul_add(v427, v429);
-    let v431: f64 = p[20usize].mul_add(v430, -v136);
-    let v432: f64 = v428 * v139;
-    let v433: f64 = v134.mul_add(v427, -v432);
-    let v434: f64 = p[20usize].mul_add(v433, v206);
-    let v435: f64 = v135 * v427;
-    let v437: f64 = q[2usize].mul_add(v436, v31);
-    let v438: f64 = p[20usize] * v437;
-    let v439: f64 = v130 * v438;
-    let v440: f64 = v128.mul_add(v435, v439);
-    let v441: f64 = v128 * v438;
-    let v442: f64 = v130.mul_add(v435, -v441);
-    let v443: f64 = v311 * v442;
-    let v444: f64 = v309.mul_add(v440, -v443);
-    let v445: f64 = 0.5f64.mul_add(v314, v301);
-    let v446: f64 = v431.mul_add(v372, v445);
-    let v447: f64 = (-v434).mul_add(v358, v446);
-    let v448: f64 = p[21usize].mul_add(v444, v447);
-    let v450: f64 = v434 * p[75usize];
-    let v451: f64 = v450 - v358;
-    let v452: f64 = p[21usize].mul_add(v442, v451);
-    let v453: f64 = v431 * p[75usize];
-    let v454: f64 = v372 + v453;
-    let v455: f64 = p[21usize].mul_add(v440, v454);
-    let v456: f64 = v352.mul_add(v452, v448);
-    let v457: f64 = v366.mul_add(v455, v456);
-    let v458: f64 = v391.mul_add(v452, v448);
-    let v459: f64 = v388.mul_add(v455, v458);
-    let v460: f64 = (-v415).mul_add(v457, v459);
-    let v461: f64 = v425 * v460;
-    let v462: f64 = v440 * v440;
-    let v463: f64 = v442.mul_add(v442, v462);
-    let v464: f64 = (-2f64).mul_add(v358, v450);
-    let v465: f64 = 2f64.mul_add(v372, v453);
-    let v466: f64 = v382 * v457;
-    let v467: f64 = v460 * v461;
-    let v468: f64 = v457.mul_add(v466, v467);
-    let v469: f64 = 0.25f64.mul_add(v314, v301);
-    let v470: f64 = p[21usize].mul_add(v463, v469);
-    let v471: f64 = v434.mul_add(v464, v470);
-    let v472: f64 = v431.mul_add(v465, v471);
-    let v473: f64 = v472 - v468;
-    let v474: f64 = 1f64 / v473;
-    let v476: f64 = 0.5f64 * v475;
-    let v477: f64 = 0.5f64 * v46;
-    let v478: f64 = v477 * v147;
-    let v479: f64 = v152.mul_add(v476, v478);
-    let v480: f64 = p[26usize].mul_add(v479, -v149);
-    let v481: f64 = v477 * v152;
-    let v482: f64 = v147.mul_add(v476, -v481);
-    let v483: f64 = p[26usize].mul_add(v482, v207);
-    let v484: f64 = v148 * v476;
-    let v486: f64 = q[3usize].mul_add(v485, v43);
-    let v487: f64 = p[26usize] * v486;
-    let v488: f64 = v143 * v487;
-    let v489: f64 = v141.mul_add(v484, v488);
-    let v490: f64 = v141 * v487;
-    let v491: f64 = v143.mul_add(v484, -v490);
-    let v492: f64 = v296 * v491;
-    let v493: f64 = v294.mul_add(v489, -v492);
-    let v494: f64 = 0.5f64.mul_add(v299, v286);
-    let v495: f64 = v480.mul_add(v371, v494);
-    let v496: f64 = (-v483).mul_add(v357, v495);
-    let v497: f64 = p[27usize].mul_add(v493, v496);
-    let v499: f64 = v483 * p[76usize];
-    let v500: f64 = v499 - v357;
-    let v501: f64 = p[27usize].mul_add(v491, v500);
-    let v502: f64 = v480 * p[76usize];
-    let v503: f64 = v371 + v502;
-    let v504: f64 = p[27usize].mul_add(v489, v503);
-    let v505: f64 = v352.mul_add(v501, v497);
-    let v506: f64 = v366.mul_add(v504, v505);
-    let v507: f64 = v391.mul_add(v501, v497);
-    let v508: f64 = v388.mul_add(v504, v507);
-    let v509: f64 = (-v415).mul_add(v506, v508);
-    let v510: f64 = v461 * v509;
-    let v511: f64 = v466.mul_add(v506, v510);
-    let v512: f64 = v434.mul_add(v501, v497);
-    let v513: f64 = v431.mul_add(v504, v512);
-    let v514: f64 = v513 - v511;
-    let v515: f64 = v474 * v514;
-    let v516: f64 = v489 * v489;
-    let v517: f64 = v491.mul_add(v491, v516);
-    let v518: f64 = (-2f64).mul_add(v357, v499);
-    let v519: f64 = 2f64.mul_add(v371, v502);
-    let v520: f64 = v382 * v506;
-    let v521: f64 = v425 * v509;
-    let v522: f64 = v509 * v521;
-    let v523: f64 = v506.mul_add(v520, v522);
-    let v524: f64 = v514.mul_add(v515, v523);
-    let v525: f64 = 0.25f64.mul_add(v299, v286);
-    let v526: f64 = p[27usize].mul_add(v517, v525);
-    let v527: f64 = v483.mul_add(v518, v526);
-    let v528: f64 = v480.mul_add(v519, v527);
-    let v529: f64 = v528 - v524;
-    let v530: f64 = 1f64 / v529;
-    let v532: f64 = 0.5f64 * v531;
-    let v533: f64 = 0.5f64 * v58;
-    let v534: f64 = v533 * v160;
-    let v535: f64 = v165.mul_add(v532, v534);
-    let v536: f64 = p[32usize].mul_add(v535, -v162);
-    let v537: f64 = v533 * v165;
-    let v538: f64 = v160.mul_add(v532, -v537);
-    let v539: f64 = p[32usize].mul_add(v538, v208);
-    let v540: f64 = v161 * v532;
-    let v542: f64 = q[4usize].mul_add(v541, v55);
-    let v543: f64 = p[32usize] * v542;
-    let v544: f64 = v156 * v543;
-    let v545: f64 = v154.mul_add(v540, v544);
-    let v546: f64 = v154 * v543;
-    let v547: f64 = v156.mul_add(v540, -v546);
-    let v548: f64 = v281 * v547;
-    let v549: f64 = v279.mul_add(v545, -v548);
-    let v550: f64 = 0.5f64.mul_add(v284, v271);
-    let v551: f64 = v536.mul_add(v370, v550);
-    let v552: f64 = (-v539).mul_add(v356, v551);
-    let v553: f64 = p[33usize].mul_add(v549, v552);
-    let v555: f64 = v539 * p[77usize];
-    let v556: f64 = v555 - v356;
-    let v557: f64 = p[33usize].mul_add(v547, v556);
-    let v558: f64 = v536 * p[77usize];
-    let v559: f64 = v370 + v558;
-    let v560: f64 = p[33usize].mul_add(v545, v559);
-    let v561: f64 = v352.mul_add(v557, v553);
-    let v562: f64 = v366.mul_add(v560, v561);
-    let v563: f64 = v391.mul_add(v557, v553);
-    let v564: f64 = v388.mul_add(v560, v563);
-    let v565: f64 = (-v415).mul_add(v562, v564);
-    let v566: f64 = v521 * v565;
-    let v567: f64 = v461 * v565;
-    let v568: f64 = v466.mul_add(v562, v567);
-    let v569: f64 = v434.mul_add(v557, v553);
-    let v570: f64 = v431.mul_add(v560, v569);
-    let v571: f64 = v570 - v568;
-    let v572: f64 = v520.mul_add(v562, v566);
-    let v573: f64 = v515.mul_add(v571, v572);
-    let v574: f64 = v483.mul_add(v557, v553);
-    let v575: f64 = v480.mul_add(v560, v574);
-    let v576: f64 = v575 - v573;
-    let v577: f64 = v530 * v576;
-    let v578: f64 = v545 * v545;
-    let v579: f64 = v547.mul_add(v547, v578);
-    let v580: f64 = (-2f64).mul_add(v356, v555);
-    let v581: f64 = 2f64.mul_add(v370, v558);
-    let v582: f64 = v382 * v562;
-    let v583: f64 = v425 * v565;
-    let v584: f64 = v565 * v583;
-    let v585: f64 = v474 * v571;
-    let v586: f64 = v562.mul_add(v582, v584);
-    let v587: f64 = v571.mul_add(v585, v586);
-    let v588: f64 = v576.mul_add(v577, v587);
-    let v589: f64 = 0.25f64.mul_add(v284, v271);
-    let v590: f64 = p[33usize].mul_add(v579, v589);
-    let v591: f64 = v539.mul_add(v580, v590);
-    let v592: f64 = v536.mul_add(v581, v591);
-    let v593: f64 = v592 - v588;
-    let v594: f64 = 1f64 / v593;
-    let v596: f64 = 0.5f64 * v595;
-    let v597: f64 = 0.5f64 * v70;
-    let v598: f64 = v597 * v173;
-    let v599: f64 = v178.mul_add(v596, v598);
-    let v600: f64 = p[38usize].mul_add(v599, -v175);
-    let v601: f64 = v597 * v178;
-    let v602: f64 = v173.mul_add(v596, -v601);
-    let v603: f64 = p[38usize].mul_add(v602, v209);
-    let v604: f64 = v174 * v596;
-    let v606: f64 = q[5usize].mul_add(v605, v67);
-    let v607: f64 = p[38usize] * v606;
-    let v608: f64 = v169 * v607;
-    let v609: f64 = v167.mul_add(v604, v608);
-    let v610: f64 = v167 * v607;
-    let v611: f64 = v169.mul_add(v604, -v610);
-    let v612: f64 = v266 * v611;
-    let v613: f64 = v264.mul_add(v609, -v612);
-    let v614: f64 = 0.5f64.mul_add(v269, v256);
-    let v615: f64 = v600.mul_add(v369, v614);
-    let v616: f64 = (-v603).mul_add(v355, v615);
-    let v617: f64 = p[39usize].mul_add(v613, v616);
-    let v619: f64 = v603 * p[78usize];
-    let v620: f64 = v619 - v355;
-    let v621: f64 = p[39usize].mul_add(v611, v620);
-    let v622: f64 = v600 * p[78usize];
-    let v623: f64 = v369 + v622;
-    let v624: f64 = p[39usize].mul_add(v609, v623);
-    let v625: f64 = v352.mul_add(v621, v617);
-    let v626: f64 = v366.mul_add(v624, v625);
-    let v627: f64 = v391.mul_add(v621, v617);
-    let v628: f64 = v388.mul_add(v624, v627);
-    let v629: f64 = (-v415).mul_add(v626, v628);
-    let v630: f64 = v583 * v629;
-    let v631: f64 = v461 * v629;
-    let v632: f64 = v466.mul_add(v626, v631);
-    let v633: f64 = v434.mul_add(v621, v617);
-    let v634: f64 = v431.mul_add(v624, v633);
-    let v635: f64 = v634 - v632;
-    let v636: f64 = v521 * v629;
-    let v637: f64 = v520.mul_add(v626, v636);
-    let v638: f64 = v515.mul_add(v635, v637);
-    let v639: f64 = v483.mul_add(v621, v617);
-    let v640: f64 = v480.mul_add(v624, v639);
-    let v641: f64 = v640 - v638;
-    let v642: f64 = v582.mul_add(v626, v630);
-    let v643: f64 = v585.mul_add(v635, v642);
-    let v644: f64 = v577.mul_add(v641, v643);
-    let v645: f64 = v539.mul_add(v621, v617);
-    let v646: f64 = v536.mul_add(v624, v645);
-    let v647: f64 = v646 - v644;
-    let v648: f64 = v594 * v647;
-    let v649: f64 = v609 * v609;
-    let v650: f64 = v611.mul_add(v611, v649);
-    let v651: f64 = (-2f64).mul_add(v355, v619);
-    let v652: f64 = 2f64.mul_add(v369, v622);
-    let v653: f64 = v382 * v626;
-    let v654: f64 = v425 * v629;
-    let v655: f64 = v629 * v654;
-    let v656: f64 = v474 * v635;
-    let v657: f64 = v530 * v641;
-    let v658: f64 = v626.mul_add(v653, v655);
-    let v659: f64 = v635.mul_add(v656, v658);
-    let v660: f64 = v641.mul_add(v657, v659);
-    let v661: f64 = v647.mul_add(v648, v660);
-    let v662: f64 = 0.25f64.mul_add(v269, v256);
-    let v663: f64 = p[39usize].mul_add(v650, v662);
-    let v664: f64 = v603.mul_add(v651, v663);
-    let v665: f64 = v600.mul_add(v652, v664);
-    let v666: f64 = v665 - v661;
-    let v667: f64 = 1f64 / v666;
-    let v669: f64 = 0.5f64 * v668;
-    let v670: f64 = 0.5f64 * v82;
-    let v671: f64 = v670 * v186;
-    let v672: f64 = v193.mul_add(v669, v671);
-    let v673: f64 = p[44usize].mul_add(v672, -v188);
-    let v674: f64 = v670 * v193;
-    let v675: f64 = v186.mul_add(v669, -v674);
-    let v676: f64 = p[44usize].mul_add(v675, v210);
-    let v677: f64 = v187 * v669;
-    let v679: f64 = q[6usize].mul_add(v678, v79);
-    let v680: f64 = p[44usize] * v679;
-    let v681: f64 = v182 * v680;
-    let v682: f64 = v180.mul_add(v677, v681);
-    let v683: f64 = v180 * v680;
-    let v684: f64 = v182.mul_add(v677, -v683);
-    let v685: f64 = v251 * v684;
-    let v686: f64 = v249.mul_add(v682, -v685);
-    let v687: f64 = 0.5f64.mul_add(v254, v241);
-    let v688: f64 = v673.mul_add(v368, v687);
-    let v689: f64 = (-v676).mul_add(v354, v688);
-    let v690: f64 = p[45usize].mul_add(v686, v689);
-    let v692: f64 = v676 * p[79usize];
-    let v693: f64 = v692 - v354;
-    let v694: f64 = p[45usize].mul_add(v684, v693);
-    let v695: f64 = v673 * p[79usize];
-    let v696: f64 = v368 + v695;
-    let v697: f64 = p[45usize].mul_add(v682, v696);
-    let v698: f64 = v352.mul_add(v694, v690);
-    let v699: f64 = v366.mul_add(v697, v698);
-    let v700: f64 = v391.mul_add(v694, v690);
-    let v701: f64 = v388.mul_add(v697, v700);
-    let v702: f64 = (-v415).mul_add(v699, v701);
-    let v703: f64 = v654 * v702;
-    let v704: f64 = v461 * v702;
-    let v705: f64 = v466.mul_add(v699, v704);
-    let v706: f64 = v434.mul_add(v694, v690);
-    let v707: f64 = v431.mul_add(v697, v706);
-    let v708: f64 = v707 - v705;
-    let v709: f64 = v521 * v702;
-    let v710: f64 = v520.mul_add(v699, v709);
-    let v711: f64 = v515.mul_add(v708, v710);
-    let v712: f64 = v483.mul_add(v694, v690);
-    let v713: f64 = v480.mul_add(v697, v712);
-    let v714: f64 = v713 - v711;
-    let v715: f64 = v583 * v702;
-    let v716: f64 = v582.mul_add(v699, v715);
-    let v717: f64 = v585.mul_add(v708, v716);
-    let v718: f64 = v577.mul_add(v714, v717);
-    let v719: f64 = v539.mul_add(v694, v690);
-    let v720: f64 = v536.mul_add(v697, v719);
-    let v721: f64 = v720 - v718;
-    let v722: f64 = v653.mul_add(v699, v703);
-    let v723: f64 = v656.mul_add(v708, v722);
-    let v724: f64 = v657.mul_add(v714, v723);
-    let v725: f64 = v648.mul_add(v721, v724);
-    let v726: f64 = v603.mul_add(v694, v690);
-    let v727: f64 = v600.mul_add(v697, v726);
-    let v728: f64 = v727 - v725;
-    let v729: f64 = v667 * v728;
-    let v730: f64 = v682 * v682;
-    let v731: f64 = v684.mul_add(v684, v730);
-    let v732: f64 = (-2f64).mul_add(v354, v692);
-    let v733: f64 = 2f64.mul_add(v368, v695);
-    let v734: f64 = v382 * v699;
-    let v735: f64 = v425 * v702;
-    let v736: f64 = v702 * v735;
-    let v737: f64 = v474 * v708;
-    let v738: f64 = v530 * v714;
-    let v739: f64 = v594 * v721;
-    let v740: f64 = v699.mul_add(v734, v736);
-    let v741: f64 = v708.mul_add(v737, v740);
-    let v742: f64 = v714.mul_add(v738, v741);
-    let v743: f64 = v721.mul_add(v739, v742);
-    let v744: f64 = v728.mul_add(v729, v743);
-    let v745: f64 = 0.25f64.mul_add(v254, v241);
-    let v746: f64 = p[45usize].mul_add(v731, v745);
-    let v747: f64 = v676.mul_add(v732, v746);
-    let v748: f64 = v673.mul_add(v733, v747);
-    let v749: f64 = v748 - v744;
-    let v750: f64 = 1f64 / v749;
-    let v752: f64 = 0.5f64 * v751;
-    let v753: f64 = 0.5f64 * v94;
-    let v754: f64 = v753 * v232;
-    let v755: f64 = v235.mul_add(v752, v754);
-    let v756: f64 = p[50usize] * v755;
-    let v757: f64 = v753 * v235;
-    let v758: f64 = v232.mul_add(v752, -v757);
-    let v759: f64 = p[50usize] * v758;
-    let v760: f64 = v236 * v759;
-    let v761: f64 = v234.mul_add(v756, -v760);
-    let v762: f64 = p[7usize] * v761;
-    let v763: f64 = v233 * v752;
-    let v765: f64 = q[7usize].mul_add(v764, v91);
-    let v766: f64 = p[50usize] * v765;
-    let v767: f64 = v195 * v766;
-    let v768: f64 = v200.mul_add(v763, v767);
-    let v769: f64 = v200 * v766;
-    let v770: f64 = v195.mul_add(v763, -v769);
-    let v771: f64 = v212 * v770;
-    let v772: f64 = v202.mul_add(v768, -v771);
-    let v773: f64 = 0.5f64.mul_add(v239, v762);
-    let v774: f64 = p[51usize].mul_add(v772, v773);
-    let v775: f64 = p[7usize] * v759;
-    let v776: f64 = p[51usize].mul_add(v770, v775);
-    let v777: f64 = p[7usize] * v756;
-    let v778: f64 = p[51usize].mul_add(v768, v777);
-    let v779: f64 = v352.mul_add(v776, v774);
-    let v780: f64 = v366.mul_add(v778, v779);
-    let v781: f64 = v391.mul_add(v776, v774);
-    let v782: f64 = v388.mul_add(v778, v781);
-    let v783: f64 = (-v415).mul_add(v780, v782);
-    let v784: f64 = v735 * v783;
-    let v785: f64 = v461 * v783;
-    let v786: f64 = v466.mul_add(v780, v785);
-    let v787: f64 = v434.mul_add(v776, v774);
-    let v788: f64 = v431.mul_add(v778, v787);
-    let v789: f64 = v788 - v786;
-    let v790: f64 = v521 * v783;
-    let v791: f64 = v520.mul_add(v780, v790);
-    let v792: f64 = v515.mul_add(v789, v791);
-    let v793: f64 = v483.mul_add(v776, v774);
-    let v794: f64 = v480.mul_add(v778, v793);
-    let v795: f64 = v794 - v792;
-    let v796: f64 = v583 * v783;
-    let v797: f64 = v582.mul_add(v780, v796);
-    let v798: f64 = v585.mul_add(v789, v797);
-    let v799: f64 = v577.mul_add(v795, v798);
-    let v800: f64 = v539.mul_add(v776, v774);
-    let v801: f64 = v536.mul_add(v778, v800);
-    let v802: f64 = v801 - v799;
-    let v803: f64 = v654 * v783;
-    let v804: f64 = v653.mul_add(v780, v803);
-    let v805: f64 = v656.mul_add(v789, v804);
-    let v806: f64 = v657.mul_add(v795, v805);
-    let v807: f64 = v648.mul_add(v802, v806);
-    let v808: f64 = v603.mul_add(v776, v774);
-    let v809: f64 = v600.mul_add(v778, v808);
-    let v810: f64 = v809 - v807;
-    let v811: f64 = v734.mul_add(v780, v784);
-    let v812: f64 = v737.mul_add(v789, v811);
-    let v813: f64 = v738.mul_add(v795, v812);
-    let v814: f64 = v739.mul_add(v802, v813);
-    let v815: f64 = v729.mul_add(v810, v814);
-    let v816: f64 = v676.mul_add(v776, v774);
-    let v817: f64 = v673.mul_add(v778, v816);
-    let v818: f64 = v817 - v815;
-    let v819: f64 = v750 * v818;
-    let v820: f64 = v768 * v768;
-    let v821: f64 = v770.mul_add(v770, v820);
-    let v822: f64 = p[51usize] * v821;
-    let v823: f64 = v756 * v756;
-    let v824: f64 = v759.mul_add(v759, v823);
-    let v825: f64 = v382 * v780;
-    let v826: f64 = v425 * v783;
-    let v827: f64 = v783 * v826;
-    let v828: f64 = v474 * v789;
-    let v829: f64 = v530 * v795;
-    let v830: f64 = v594 * v802;
-    let v831: f64 = v667 * v810;
-    let v832: f64 = v780.mul_add(v825, v827);
-    let v833: f64 = v789.mul_add(v828, v832);
-    let v834: f64 = v795.mul_add(v829, v833);
-    let v835: f64 = v802.mul_add(v830, v834);
-    let v836: f64 = v810.mul_add(v831, v835);
-    let v837: f64 = v818.mul_add(v819, v836);
-    let v838: f64 = 0.25f64.mul_add(v239, v822);
-    let v839: f64 = p[7usize].mul_add(v824, v838);
-    let v840: f64 = v839 - v837;
-    let v841: f64 = 1f64 / v840;
-    let v844: f64 = 0.5f64 * qd[7usize];
-    let v846: f64 = 0.5f64 * qd[6usize];
-    let v848: f64 = 0.5f64 * qd[5usize];
-    let v850: f64 = 0.5f64 * qd[4usize];
-    let v852: f64 = 0.5f64 * qd[3usize];
-    let v854: f64 = 0.5f64 * qd[2usize];
-    let v856: f64 = 0.5f64 * qd[1usize];
-    let v858: f64 = 0.5f64 * qd[0usize];
-    let v859: f64 = v858 + v858;
-    let v860: f64 = v856 + v859;
-    let v861: f64 = v856 + v860;
-    let v862: f64 = v854 + v861;
-    let v863: f64 = v854 + v862;
-    let v864: f64 = v852 + v863;
-    let v865: f64 = v852 + v864;
-    let v866: f64 = v850 + v865;
-    let v867: f64 = v850 + v866;
-    let v868: f64 = v848 + v867;
-    let v869: f64 = v848 + v868;
-    let v870: f64 = v846 + v869;
-    let v871: f64 = v846 + v870;
-    let v872: f64 = v844 + v871;
-    let v873: f64 = v872 * v872;
-    let v875: f64 = (-0.5f64) * v873;
-    let v876: f64 = (-v92).mul_add(v96, 2f64);
-    let v877: f64 = v875 * v876;
-    let v878: f64 = p[110usize] * v877;
-    let v879: f64 = p[51usize] * v878;
-    let v881: f64 = v94.powi(3i32);
-    let v882: f64 = p[111usize] * v881;
-    let v883: f64 = v882 * v875;
-    let v884: f64 = v752 * v883;
-    let v887: f64 = p[112usize] + q[7usize];
-    let v889: f64 = qd[0usize] * qd[0usize];
-    let v891: f64 = 0.25f64 * v890;
-    let v892: f64 = (-0.25f64).mul_add(v8, v891);
-    let v893: f64 = v108.mul_add(v892, -v364);
-    let v894: f64 = p[8usize] * v893;
-    let v895: f64 = qd[0usize] + v856;
-    let v896: f64 = 2f64 * qd[1usize];
-    let v897: f64 = v896 * v126;
-    let v898: f64 = v897 * v384;
-    let v899: f64 = v898 * v895;
-    let v900: f64 = qd[1usize] * qd[1usize];
-    let v902: f64 = 0.25f64 * v901;
-    let v903: f64 = v895 * v895;
-    let v904: f64 = v22 * v903;
-    let v905: f64 = v900.mul_add(v902, -v904);
-    let v906: f64 = v121.mul_add(v905, -v899);
-    let v907: f64 = p[14usize] * v906;
-    let v908: f64 = v889.mul_add(v894, v907);
-    let v909: f64 = v856 + v895;
-    let v910: f64 = v854 + v909;
-    let v911: f64 = 2f64 * qd[2usize];
-    let v912: f64 = v911 * v139;
-    let v913: f64 = v912 * v427;
-    let v914: f64 = v913 * v910;
-    let v915: f64 = qd[2usize] * qd[2usize];
-    let v917: f64 = 0.25f64 * v916;
-    let v918: f64 = v910 * v910;
-    let v919: f64 = v34 * v918;
-    let v920: f64 = v915.mul_add(v917, -v919);
-    let v921: f64 = v134.mul_add(v920, -v914);
-    let v922: f64 = p[20usize].mul_add(v921, v908);
-    let v923: f64 = v854 + v910;
-    let v924: f64 = v852 + v923;
-    let v925: f64 = 2f64 * qd[3usize];
-    let v926: f64 = v925 * v152;
-    let v927: f64 = v926 * v476;
-    let v928: f64 = v927 * v924;
-    let v929: f64 = qd[3usize] * qd[3usize];
-    let v931: f64 = 0.25f64 * v930;
-    let v932: f64 = v924 * v924;
-    let v933: f64 = v46 * v932;
-    let v934: f64 = v929.mul_add(v931, -v933);
-    let v935: f64 = v147.mul_add(v934, -v928);
-    let v936: f64 = p[26usize].mul_add(v935, v922);
-    let v937: f64 = v852 + v924;
-    let v938: f64 = v850 + v937;
-    let v939: f64 = 2f64 * qd[4usize];
-    let v940: f64 = v939 * v165;
-    let v941: f64 = v940 * v532;
-    let v942: f64 = v941 * v938;
-    let v943: f64 = qd[4usize] * qd[4usize];
-    let v945: f64 = 0.25f64 * v944;
-    let v946: f64 = v938 * v938;
-    let v947: f64 = v58 * v946;
-    let v948: f64 = v943.mul_add(v945, -v947);
-    let v949: f64 = v160.mul_add(v948, -v942);
-    let v950: f64 = p[32usize].mul_add(v949, v936);
-    let v951: f64 = v850 + v938;
-    let v952: f64 = v848 + v951;
-    let v953: f64 = 2f64 * qd[5usize];
-    let v954: f64 = v953 * v178;
-    let v955: f64 = v954 * v596;
-    let v956: f64 = v955 * v952;
-    let v957: f64 = qd[5usize] * qd[5usize];
-    let v959: f64 = 0.25f64 * v958;
-    let v960: f64 = v952 * v952;
-    let v961: f64 = v70 * v960;
-    let v962: f64 = v957.mul_add(v959, -v961);
-    let v963: f64 = v173.mul_add(v962, -v956);
-    let v964: f64 = p[38usize].mul_add(v963, v950);
-    let v965: f64 = v848 + v952;
-    let v966: f64 = v846 + v965;
-    let v967: f64 = 2f64 * qd[6usize];
-    let v968: f64 = v967 * v193;
-    let v969: f64 = v968 * v669;
-    let v970: f64 = v969 * v966;
-    let v971: f64 = qd[6usize] * qd[6usize];
-    let v973: f64 = 0.25f64 * v972;
-    let v974: f64 = v966 * v966;
-    let v975: f64 = v82 * v974;
-    let v976: f64 = v971.mul_add(v973, -v975);
-    let v977: f64 = v186.mul_add(v976, -v970);
-    let v978: f64 = p[44usize].mul_add(v977, v964);
-    let v979: f64 = qd[7usize] * qd[7usize];
-    let v981: f64 = 0.25f64 * v980;
-    let v982: f64 = v94 * v981;
-    let v983: f64 = v752.mul_add(v752, v982);
-    let v984: f64 = p[50usize] * v983;
-    let v985: f64 = v846 + v966;
-    let v986: f64 = v985 * v985;
-    let v987: f64 = v191 * v986;
-    let v988: f64 = 2f64 * qd[7usize];
-    let v989: f64 = v988 * v985;
-    let v990: f64 = v979.mul_add(v984, -v987);
-    let v991: f64 = (-v989).mul_add(v766, v990);
-    let v993: f64 = q[7usize] * v992;
-    let v994: f64 = 2f64.mul_add(v764, v993);
-    let v995: f64 = p[50usize] * v994;
-    let v996: f64 = v979 * v995;
-    let v997: f64 = v988 * v763;
-    let v998: f64 = v997 * v985;
-    let v999: f64 = v198 * v986;
-    let v1000: f64 = v999 - v996;
-    let v1001: f64 = v1000 - v998;
-    let v1002: f64 = v195.mul_add(v991, v978);
-    let v1003: f64 = v200.mul_add(v1001, v1002);
-    let v1004: f64 = p[83usize] + v1003;
-    let v1006: f64 = v113.mul_add(v892, v349);
-    let v1007: f64 = p[8usize] * v1006;
-    let v1008: f64 = v896 * v121;
-    let v1009: f64 = v1008 * v384;
-    let v1010: f64 = v126 * v905;
-    let v1011: f64 = v1009.mul_add(v895, v1010);
-    let v1012: f64 = p[14usize] * v1011;
-    let v1013: f64 = v889.mul_add(v1007, v1012);
-    let v1014: f64 = v911 * v134;
-    let v1015: f64 = v1014 * v427;
-    let v1016: f64 = v139 * v920;
-    let v1017: f64 = v1015.mul_add(v910, v1016);
-    let v1018: f64 = p[20usize].mul_add(v1017, v1013);
-    let v1019: f64 = v925 * v147;
-    let v1020: f64 = v1019 * v476;
-    let v1021: f64 = v152 * v934;
-    let v1022: f64 = v1020.mul_add(v924, v1021);
-    let v1023: f64 = p[26usize].mul_add(v1022, v1018);
-    let v1024: f64 = v939 * v160;
-    let v1025: f64 = v1024 * v532;
-    let v1026: f64 = v165 * v948;
-    let v1027: f64 = v1025.mul_add(v938, v1026);
-    let v1028: f64 = p[32usize].mul_add(v1027, v1023);
-    let v1029: f64 = v953 * v173;
-    let v1030: f64 = v1029 * v596;
-    let v1031: f64 = v178 * v962;
-    let v1032: f64 = v1030.mul_add(v952, v1031);
-    let v1033: f64 = p[38usize].mul_add(v1032, v1028);
-    let v1034: f64 = v967 * v186;
-    let v1035: f64 = v1034 * v669;
-    let v1036: f64 = v193 * v976;
-    let v1037: f64 = v1035.mul_add(v966, v1036);
-    let v1038: f64 = p[44usize].mul_add(v1037, v1033);
-    let v1039: f64 = v996 + v998;
-    let v1040: f64 = v1039 - v999;
-    let v1041: f64 = v195.mul_add(v1040, v1038);
-    let v1042: f64 = v200.mul_add(v991, v1041);
-    let v1043: f64 = p[82usize] + v1042;
-    let v1044: f64 = v1043 * v768;
-    let v1046: f64 = p[113usize] * q[7usize];
-    let v1047: f64 = v1046 * v97;
-    let v1048: f64 = v1004.mul_add(v770, v1044);
-    let v1049: f64 = (-v1047).mul_add(v875, v1048);
-    let v1050: f64 = v844 + v985;
-    let v1051: f64 = v988 * v235;
-    let v1052: f64 = v1051 * v752;
-    let v1053: f64 = v1052 * v1050;
-    let v1054: f64 = v1050 * v1050;
-    let v1055: f64 = v94 * v1054;
-    let v1056: f64 = v979.mul_add(v981, -v1055);
-    let v1057: f64 = v232.mul_add(v1056, -v1053);
-    let v1058: f64 = p[50usize].mul_add(v1057, v978);
-    let v1059: f64 = p[83usize] + v1058;
-    let v1060: f64 = v988 * v232;
-    let v1061: f64 = v1060 * v752;
-    let v1062: f64 = v235 * v1056;
-    let v1063: f64 = v1061.mul_add(v1050, v1062);
-    let v1064: f64 = p[50usize].mul_add(v1063, v1038);
-    let v1065: f64 = p[82usize] + v1064;
-    let v1066: f64 = v1065 * v756;
-    let v1067: f64 = v1059.mul_add(v759, v1066);
-    let v1069: f64 = v752 * v881;
-    let v1070: f64 = 2f64 * q[7usize];
-    let v1071: f64 = v764.mul_add(v876, -v1069);
-    let v1072: f64 = (-v1070).mul_add(v97, v1071);
-    let v1073: f64 = p[63usize] * v1072;
-    let v1074: f64 = 0.5f64 * v872;
-    let v1075: f64 = v1074.mul_add(v1073, p[54usize]);
-    let v1077: f64 = v858 * v858;
-    let v1078: f64 = (-0.5f64) * v1077;
-    let v1079: f64 = (-v5).mul_add(v11, 2f64);
-    let v1080: f64 = v1078 * v1079;
-    let v1081: f64 = p[80usize] * v1080;
-    let v1082: f64 = p[9usize] * v1081;
-    let v1084: f64 = v8.powi(3i32);
-    let v1085: f64 = p[81usize] * v1084;
-    let v1086: f64 = v1085 * v1078;
-    let v1087: f64 = v338 * v1086;
-    let v1088: f64 = v22.powi(3i32);
-    let v1089: f64 = v384 * v1088;
-    let v1090: f64 = 2f64 * q[1usize];
-    let v1091: f64 = (-v20).mul_add(v24, 2f64);
-    let v1092: f64 = v393.mul_add(v1091, -v1089);
-    let v1093: f64 = (-v1090).mul_add(v25, v1092);
-    let v1094: f64 = p[57usize] * v1093;
-    let v1095: f64 = qd[1usize] * v860;
-    let v1096: f64 = v34.powi(3i32);
-    let v1097: f64 = v427 * v1096;
-    let v1098: f64 = 2f64 * q[2usize];
-    let v1099: f64 = (-v32).mul_add(v36, 2f64);
-    let v1100: f64 = v436.mul_add(v1099, -v1097);
-    let v1101: f64 = (-v1098).mul_add(v37, v1100);
-    let v1102: f64 = p[58usize] * v1101;
-    let v1103: f64 = qd[2usize] * v862;
-    let v1104: f64 = v46.powi(3i32);
-    let v1105: f64 = v476 * v1104;
-    let v1106: f64 = 2f64 * q[3usize];
-    let v1107: f64 = (-v44).mul_add(v48, 2f64);
-    let v1108: f64 = v485.mul_add(v1107, -v1105);
-    let v1109: f64 = (-v1106).mul_add(v49, v1108);
-    let v1110: f64 = p[59usize] * v1109;
-    let v1111: f64 = qd[3usize] * v864;
-    let v1112: f64 = v58.powi(3i32);
-    let v1113: f64 = v532 * v1112;
-    let v1114: f64 = 2f64 * q[4usize];
-    let v1115: f64 = (-v56).mul_add(v60, 2f64);
-    let v1116: f64 = v541.mul_add(v1115, -v1113);
-    let v1117: f64 = (-v1114).mul_add(v61, v1116);
-    let v1118: f64 = p[60usize] * v1117;
-    let v1119: f64 = qd[4usize] * v866;
-    let v1120: f64 = v70.powi(3i32);
-    let v1121: f64 = v596 * v1120;
-    let v1122: f64 = 2f64 * q[5usize];
-    let v1123: f64 = (-v68).mul_add(v72, 2f64);
-    let v1124: f64 = v605.mul_add(v1123, -v1121);
-    let v1125: f64 = (-v1122).mul_add(v73, v1124);
-    let v1126: f64 = p[61usize] * v1125;
-    let v1127: f64 = qd[5usize] * v868;
-    let v1128: f64 = v82.powi(3i32);
-    let v1129: f64 = v669 * v1128;
-    let v1130: f64 = 2f64 * q[6usize];
-    let v1131: f64 = (-v80).mul_add(v84, 2f64);
-    let v1132: f64 = v678.mul_add(v1131, -v1129);
-    let v1133: f64 = (-v1130).mul_add(v85, v1132);
-    let v1134: f64 = p[62usize] * v1133;
-    let v1135: f64 = qd[6usize] * v870;
-    let v1136: f64 = qd[7usize] * v872;
-    let v1137: f64 = v236 * v1059;
-    let v1138: f64 = v234.mul_add(v1065, -v1137);
-    let v1139: f64 = p[7usize] * v1138;
-    let v1140: f64 = v212 * v1004;
-    let v1141: f64 = v202.mul_add(v1043, -v1140);
-    let v1142: f64 = v1136.mul_add(v1073, v1139);
-    let v1143: f64 = p[51usize].mul_add(v1141, v1142);
-    let v1145: f64 = q[6usize] * v1144;
-    let v1146: f64 = 2f64.mul_add(v678, v1145);
-    let v1147: f64 = p[44usize] * v1146;
-    let v1148: f64 = v971 * v1147;
-    let v1149: f64 = v967 * v677;
-    let v1150: f64 = v1149 * v965;
-    let v1151: f64 = v965 * v965;
-    let v1152: f64 = v247 * v1151;
-    let v1153: f64 = v1148 + v1150;
-    let v1154: f64 = v1153 - v1152;
-    let v1155: f64 = v82 * v973;
-    let v1156: f64 = v669.mul_add(v669, v1155);
-    let v1157: f64 = p[44usize] * v1156;
-    let v1158: f64 = v245 * v1151;
-    let v1159: f64 = v967 * v965;
-    let v1160: f64 = v971.mul_add(v1157, -v1158);
-    let v1161: f64 = (-v1159).mul_add(v680, v1160);
-    let v1162: f64 = v182.mul_add(v1154, v1033);
-    let v1163: f64 = v180.mul_add(v1161, v1162);
-    let v1164: f64 = p[82usize] + v1163;
-    let v1165: f64 = v1152 - v1148;
-    let v1166: f64 = v1165 - v1150;
-    let v1167: f64 = v182.mul_add(v1161, v964);
-    let v1168: f64 = v180.mul_add(v1166, v1167);
-    let v1169: f64 = p[83usize] + v1168;
-    let v1170: f64 = v251 * v1169;
-    let v1171: f64 = v249.mul_add(v1164, -v1170);
-    let v1172: f64 = v1135.mul_add(v1134, v1143);
-    let v1173: f64 = p[45usize].mul_add(v1171, v1172);
-    let v1175: f64 = q[5usize] * v1174;
-    let v1176: f64 = 2f64.mul_add(v605, v1175);
-    let v1177: f64 = p[38usize] * v1176;
-    let v1178: f64 = v957 * v1177;
-    let v1179: f64 = v953 * v604;
-    let v1180: f64 = v1179 * v951;
-    let v1181: f64 = v951 * v951;
-    let v1182: f64 = v262 * v1181;
-    let v1183: f64 = v1178 + v1180;
-    let v1184: f64 = v1183 - v1182;
-    let v1185: f64 = v70 * v959;
-    let v1186: f64 = v596.mul_add(v596, v1185);
-    let v1187: f64 = p[38usize] * v1186;
-    let v1188: f64 = v260 * v1181;
-    let v1189: f64 = v953 * v951;
-    let v1190: f64 = v957.mul_add(v1187, -v1188);
-    let v1191: f64 = (-v1189).mul_add(v607, v1190);
-    let v1192: f64 = v169.mul_add(v1184, v1028);
-    let v1193: f64 = v167.mul_add(v1191, v1192);
-    let v1194: f64 = p[82usize] + v1193;
-    let v1195: f64 = v1182 - v1178;
-    let v1196: f64 = v1195 - v1180;
-    let v1197: f64 = v169.mul_add(v1191, v950);
-    let v1198: f64 = v167.mul_add(v1196, v1197);
-    let v1199: f64 = p[83usize] + v1198;
-    let v1200: f64 = v266 * v1199;
-    let v1201: f64 = v264.mul_add(v1194, -v1200);
-    let v1202: f64 = v1127.mul_add(v1126, v1173);
-    let v1203: f64 = p[39usize].mul_add(v1201, v1202);
-    let v1205: f64 = q[4usize] * v1204;
-    let v1206: f64 = 2f64.mul_add(v541, v1205);
-    let v1207: f64 = p[32usize] * v1206;
-    let v1208: f64 = v943 * v1207;
-    let v1209: f64 = v939 * v540;
-    let v1210: f64 = v1209 * v937;
-    let v1211: f64 = v937 * v937;
-    let v1212: f64 = v277 * v1211;
-    let v1213: f64 = v1208 + v1210;
-    let v1214: f64 = v1213 - v1212;
-    let v1215: f64 = v58 * v945;
-    let v1216: f64 = v532.mul_add(v532, v1215);
-    let v1217: f64 = p[32usize] * v1216;
-    let v1218: f64 = v275 * v1211;
-    let v1219: f64 = v939 * v937;
-    let v1220: f64 = v943.mul_add(v1217, -v1218);
-    let v1221: f64 = (-v1219).mul_add(v543, v1220);
-    let v1222: f64 = v156.mul_add(v1214, v1023);
-    let v1223: f64 = v154.mul_add(v1221, v1222);
-    let v1224: f64 = p[82usize] + v1223;
-    let v1225: f64 = v1212 - v1208;
-    let v1226: f64 = v1225 - v1210;
-    let v1227: f64 = v156.mul_add(v1221, v936);
-    let v1228: f64 = v154.mul_add(v1226, v1227);
-    let v1229: f64 = p[83usize] + v1228;
-    let v1230: f64 = v281 * v1229;
-    let v1231: f64 = v279.mul_add(v1224, -v1230);
-    let v1232: f64 = v1119.mul_add(v1118, v1203);
-    let v1233: f64 = p[33usize].mul_add(v1231, v1232);
-    let v1235: f64 = q[3usize] * v1234;
-    let v1236: f64 = 2f64.mul_add(v485, v1235);
-    let v1237: f64 = p[26usize] * v1236;
-    let v1238: f64 = v929 * v1237;
-    let v1239: f64 = v925 * v484;
-    let v1240: f64 = v1239 * v923;
-    let v1241: f64 = v923 * v923;
-    let v1242: f64 = v292 * v1241;
-    let v1243: f64 = v1238 + v1240;
-    let v1244: f64 = v1243 - v1242;
-    let v1245: f64 = v46 * v931;
-    let v1246: f64 = v476.mul_add(v476, v1245);
-    let v1247: f64 = p[26usize] * v1246;
-    let v1248: f64 = v290 * v1241;
-    let v1249: f64 = v925 * v923;
-    let v1250: f64 = v929.mul_add(v1247, -v1248);
-    let v1251: f64 = (-v1249).mul_add(v487, v1250);
-    let v1252: f64 = v143.mul_add(v1244, v1018);
-    let v1253: f64 = v141.mul_add(v1251, v1252);
-    let v1254: f64 = p[82usize] + v1253;
-    let v1255: f64 = v1242 - v1238;
-    let v1256: f64 = v1255 - v1240;
-    let v1257: f64 = v143.mul_add(v1251, v922);
-    let v1258: f64 = v141.mul_add(v1256, v1257);
-    let v1259: f64 = p[83usize] + v1258;
-    let v1260: f64 = v296 * v1259;
-    let v1261: f64 = v294.mul_add(v1254, -v1260);
-    let v1262: f64 = v1111.mul_add(v1110, v1233);
-    let v1263: f64 = p[27usize].mul_add(v1261, v1262);
-    let v1265: f64 = q[2usize] * v1264;
-    let v1266: f64 = 2f64.mul_add(v436, v1265);
-    let v1267: f64 = p[20usize] * v1266;
-    let v1268: f64 = v915 * v1267;
-    let v1269: f64 = v911 * v435;
-    let v1270: f64 = v1269 * v909;
-    let v1271: f64 = v909 * v909;
-    let v1272: f64 = v307 * v1271;
-    let v1273: f64 = v1268 + v1270;
-    let v1274: f64 = v1273 - v1272;
-    let v1275: f64 = v34 * v917;
-    let v1276: f64 = v427.mul_add(v427, v1275);
-    let v1277: f64 = p[20usize] * v1276;
-    let v1278: f64 = v305 * v1271;
-    let v1279: f64 = v911 * v909;
-    let v1280: f64 = v915.mul_add(v1277, -v1278);
-    let v1281: f64 = (-v1279).mul_add(v438, v1280);
-    let v1282: f64 = v130.mul_add(v1274, v1013);
-    let v1283: f64 = v128.mul_add(v1281, v1282);
-    let v1284: f64 = p[82usize] + v1283;
-    let v1285: f64 = v1272 - v1268;
-    let v1286: f64 = v1285 - v1270;
-    let v1287: f64 = v130.mul_add(v1281, v908);
-    let v1288: f64 = v128.mul_add(v1286, v1287);
-    let v1289: f64 = p[83usize] + v1288;
-    let v1290: f64 = v311 * v1289;
-    let v1291: f64 = v309.mul_add(v1284, -v1290);
-    let v1292: f64 = v1103.mul_add(v1102, v1263);
-    let v1293: f64 = p[21usize].mul_add(v1291, v1292);
-    let v1294: f64 = v1007 - v327;
-    let v1295: f64 = v1294 - v328;
-    let v1296: f64 = 2f64 * v117;
-    let v1297: f64 = 2f64 * v115;
-    let v1298: f64 = v1297 * v395;
-    let v1299: f64 = v1296.mul_add(v392, -v1298);
-    let v1300: f64 = qd[1usize] * v1299;
-    let v1301: f64 = qd[0usize] * v1300;
-    let v1302: f64 = v22 * v902;
-    let v1303: f64 = v384.mul_add(v384, v1302);
-    let v1304: f64 = p[14usize] * v1303;
-    let v1306: f64 = q[1usize] * v1305;
-    let v1307: f64 = 2f64.mul_add(v393, v1306);
-    let v1308: f64 = p[14usize] * v1307;
-    let v1309: f64 = v117 * v1308;
-    let v1310: f64 = v115.mul_add(v1304, v1309);
-    let v1311: f64 = v889.mul_add(v1295, v1301);
-    let v1312: f64 = v900.mul_add(v1310, v1311);
-    let v1313: f64 = p[82usize] + v1312;
-    let v1314: f64 = v324 - v321;
-    let v1315: f64 = v1314 + v894;
-    let v1316: f64 = v1296 * v395;
-    let v1317: f64 = v1297.mul_add(v392, v1316);
-    let v1318: f64 = -v1317;
-    let v1319: f64 = qd[1usize] * v1318;
-    let v1320: f64 = qd[0usize] * v1319;
-    let v1321: f64 = v115 * v1308;
-    let v1322: f64 = v117.mul_add(v1304, -v1321);
-    let v1323: f64 = v889.mul_add(v1315, v1320);
-    let v1324: f64 = v900.mul_add(v1322, v1323);
-    let v1325: f64 = p[83usize] + v1324;
-    let v1326: f64 = v330 * v1325;
-    let v1327: f64 = v326.mul_add(v1313, -v1326);
-    let v1328: f64 = v1095.mul_add(v1094, v1293);
-    let v1329: f64 = p[15usize].mul_add(v1327, v1328);
-    let v1330: f64 = p[7usize] * v1059;
-    let v1331: f64 = p[51usize].mul_add(v1004, v1330);
-    let v1332: f64 = p[45usize].mul_add(v1169, v1331);
-    let v1333: f64 = p[39usize].mul_add(v1199, v1332);
-    let v1334: f64 = p[33usize].mul_add(v1229, v1333);
-    let v1335: f64 = p[27usize].mul_add(v1259, v1334);
-    let v1336: f64 = p[21usize].mul_add(v1289, v1335);
-    let v1337: f64 = p[15usize].mul_add(v1325, v1336);
-    let v1338: f64 = p[7usize] * v1065;
-    let v1339: f64 = p[51usize].mul_add(v1043, v1338);
-    let v1340: f64 = p[45usize].mul_add(v1164, v1339);
-    let v1341: f64 = p[39usize].mul_add(v1194, v1340);
-    let v1342: f64 = p[33usize].mul_add(v1224, v1341);
-    let v1343: f64 = p[27usize].mul_add(v1254, v1342);
-    let v1344: f64 = p[21usize].mul_add(v1284, v1343);
-    let v1345: f64 = p[15usize].mul_add(v1313, v1344);
-    let v1348: f64 = p[84usize] + q[0usize];
-    let v1349: f64 = v8 * v891;
-    let v1350: f64 = v338.mul_add(v338, v1349);
-    let v1351: f64 = p[8usize] * v1350;
-    let v1353: f64 = q[0usize] * v1352;
-    let v1354: f64 = 2f64.mul_add(v340, v1353);
-    let v1355: f64 = p[8usize] * v1354;
-    let v1356: f64 = p[64usize] * v1355;
-    let v1357: f64 = p[65usize].mul_add(v1351, -v1356);
-    let v1358: f64 = v889.mul_add(v1357, p[83usize]);
-    let v1359: f64 = p[65usize] * v1355;
-    let v1360: f64 = p[64usize].mul_add(v1351, v1359);
-    let v1361: f64 = v889.mul_add(v1360, p[82usize]);
-    let v1362: f64 = v344 * v1361;
-    let v1364: f64 = p[85usize] * q[0usize];
-    let v1365: f64 = v1364 * v12;
-    let v1366: f64 = v346.mul_add(v1358, v1362);
-    let v1367: f64 = (-v1365).mul_add(v1078, v1366);
-    let v1369: f64 = v338 * v1084;
-    let v1370: f64 = 2f64 * q[0usize];
-    let v1371: f64 = v340.mul_add(v1079, -v1369);
-    let v1372: f64 = (-v1370).mul_add(v12, v1371);
-    let v1373: f64 = p[56usize] * v1372;
-    let v1374: f64 = 0.5f64 * v858;
-    let v1375: f64 = v1374.mul_add(v1373, p[12usize]);
-    let v1376: f64 = v340.mul_add(v1082, v1087);
-    let v1377: f64 = v1376 + v1329;
-    let v1378: f64 = v352.mul_add(v1337, v1377);
-    let v1379: f64 = v366.mul_add(v1345, v1378);
-    let v1380: f64 = p[11usize].mul_add(v1348, v1379);
-    let v1381: f64 = p[9usize].mul_add(v1367, v1380);
-    let v1382: f64 = qd[0usize].mul_add(v1375, v1381);
-    let v1383: f64 = -v1382;
-    let v1385: f64 = v860 * v860;
-    let v1386: f64 = (-0.5f64) * v1385;
-    let v1387: f64 = v1386 * v1091;
-    let v1388: f64 = p[86usize] * v1387;
-    let v1389: f64 = p[15usize] * v1388;
-    let v1391: f64 = p[87usize] * v1088;
-    let v1392: f64 = v1391 * v1386;
-    let v1393: f64 = v384 * v1392;
-    let v1396: f64 = p[88usize] + q[1usize];
-    let v1397: f64 = v1313 * v397;
-    let v1399: f64 = p[89usize] * q[1usize];
-    let v1400: f64 = v1399 * v25;
-    let v1401: f64 = v1325.mul_add(v399, v1397);
-    let v1402: f64 = (-v1400).mul_add(v1386, v1401);
-    let v1404: f64 = 0.5f64 * v860;
-    let v1405: f64 = v1404.mul_add(v1094, p[18usize]);
-    let v1406: f64 = v393.mul_add(v1389, v1393);
-    let v1407: f64 = v1406 + v1293;
-    let v1408: f64 = v391.mul_add(v1336, v1407);
-    let v1409: f64 = v388.mul_add(v1344, v1408);
-    let v1410: f64 = p[17usize].mul_add(v1396, v1409);
-    let v1411: f64 = p[15usize].mul_add(v1402, v1410);
-    let v1412: f64 = qd[1usize].mul_add(v1405, v1411);
-    let v1413: f64 = v415.mul_add(v1383, v1412);
-    let v1414: f64 = -v1413;
-    let v1416: f64 = v862 * v862;
-    let v1417: f64 = (-0.5f64) * v1416;
-    let v1418: f64 = v1417 * v1099;
-    let v1419: f64 = p[90usize] * v1418;
-    let v1420: f64 = p[21usize] * v1419;
-    let v1422: f64 = p[91usize] * v1096;
-    let v1423: f64 = v1422 * v1417;
-    let v1424: f64 = v427 * v1423;
-    let v1427: f64 = p[92usize] + q[2usize];
-    let v1428: f64 = v1284 * v440;
-    let v1430: f64 = p[93usize] * q[2usize];
-    let v1431: f64 = v1430 * v37;
-    let v1432: f64 = v1289.mul_add(v442, v1428);
-    let v1433: f64 = (-v1431).mul_add(v1417, v1432);
-    let v1435: f64 = 0.5f64 * v862;
-    let v1436: f64 = v1435.mul_add(v1102, p[24usize]);
-    let v1437: f64 = v436.mul_add(v1420, v1424);
-    let v1438: f64 = v1437 + v1263;
-    let v1439: f64 = v434.mul_add(v1335, v1438);
-    let v1440: f64 = v431.mul_add(v1343, v1439);
-    let v1441: f64 = p[23usize].mul_add(v1427, v1440);
-    let v1442: f64 = p[21usize].mul_add(v1433, v1441);
-    let v1443: f64 = qd[2usize].mul_add(v1436, v1442);
-    let v1444: f64 = v466.mul_add(v1383, v1443);
-    let v1445: f64 = v461.mul_add(v1414, v1444);
-    let v1446: f64 = -v1445;
-    let v1448: f64 = v864 * v864;
-    let v1449: f64 = (-0.5f64) * v1448;
-    let v1450: f64 = v1449 * v1107;
-    let v1451: f64 = p[94usize] * v1450;
-    let v1452: f64 = p[27usize] * v1451;
-    let v1454: f64 = p[95usize] * v1104;
-    let v1455: f64 = v1454 * v1449;
-    let v1456: f64 = v476 * v1455;
-    let v1459: f64 = p[96usize] + q[3usize];
-    let v1460: f64 = v1254 * v489;
-    let v1462: f64 = p[97usize] * q[3usize];
-    let v1463: f64 = v1462 * v49;
-    let v1464: f64 = v1259.mul_add(v491, v1460);
-    let v1465: f64 = (-v1463).mul_add(v1449, v1464);
-    let v1467: f64 = 0.5f64 * v864;
-    let v1468: f64 = v1467.mul_add(v1110, p[30usize]);
-    let v1469: f64 = v485.mul_add(v1452, v1456);
-    let v1470: f64 = v1469 + v1233;
-    let v1471: f64 = v483.mul_add(v1334, v1470);
-    let v1472: f64 = v480.mul_add(v1342, v1471);
-    let v1473: f64 = p[29usize].mul_add(v1459, v1472);
-    let v1474: f64 = p[27usize].mul_add(v1465, v1473);
-    let v1475: f64 = qd[3usize].mul_add(v1468, v1474);
-    let v1476: f64 = v520.mul_add(v1383, v1475);
-    let v1477: f64 = v521.mul_add(v1414, v1476);
-    let v1478: f64 = v515.mul_add(v1446, v1477);
-    let v1479: f64 = -v1478;
-    let v1481: f64 = v866 * v866;
-    let v1482: f64 = (-0.5f64) * v1481;
-    let v1483: f64 = v1482 * v1115;
-    let v1484: f64 = p[98usize] * v1483;
-    let v1485: f64 = p[33usize] * v1484;
-    let v1487: f64 = p[99usize] * v1112;
-    let v1488: f64 = v1487 * v1482;
-    let v1489: f64 = v532 * v1488;
-    let v1492: f64 = p[100usize] + q[4usize];
-    let v1493: f64 = v1224 * v545;
-    let v1495: f64 = p[101usize] * q[4usize];
-    let v1496: f64 = v1495 * v61;
-    let v1497: f64 = v1229.mul_add(v547, v1493);
-    let v1498: f64 = (-v1496).mul_add(v1482, v1497);
-    let v1500: f64 = 0.5f64 * v866;
-    let v1501: f64 = v1500.mul_add(v1118, p[36usize]);
-    let v1502: f64 = v541.mul_add(v1485, v1489);
-    let v1503: f64 = v1502 + v1203;
-    let v1504: f64 = v539.mul_add(v1333, v1503);
-    let v1505: f64 = v536.mul_add(v1341, v1504);
-    let v1506: f64 = p[35usize].mul_add(v1492, v1505);
-    let v1507: f64 = p[33usize].mul_add(v1498, v1506);
-    let v1508: f64 = qd[4usize].mul_add(v1501, v1507);
-    let v1509: f64 = v582.mul_add(v1383, v1508);
-    let v1510: f64 = v583.mul_add(v1414, v1509);
-    let v1511: f64 = v585.mul_add(v1446, v1510);
-    let v1512: f64 = v577.mul_add(v1479, v1511);
-    let v1513: f64 = -v1512;
-    let v1515: f64 = v868 * v868;
-    let v1516: f64 = (-0.5f64) * v1515;
-    let v1517: f64 = v1516 * v1123;
-    let v1518: f64 = p[102usize] * v1517;
-    let v1519: f64 = p[39usize] * v1518;
-    let v1521: f64 = p[103usize] * v1120;
-    let v1522: f64 = v1521 * v1516;
-    let v1523: f64 = v596 * v1522;
-    let v1526: f64 = p[104usize] + q[5usize];
-    let v1527: f64 = v1194 * v609;
-    let v1529: f64 = p[105usize] * q[5usize];
-    let v1530: f64 = v1529 * v73;
-    let v1531: f64 = v1199.mul_add(v611, v1527);
-    let v1532: f64 = (-v1530).mul_add(v1516, v1531);
-    let v1534: f64 = 0.5f64 * v868;
-    let v1535: f64 = v1534.mul_add(v1126, p[42usize]);
-    let v1536: f64 = v605.mul_add(v1519, v1523);
-    let v1537: f64 = v1536 + v1173;
-    let v1538: f64 = v603.mul_add(v1332, v1537);
-    let v1539: f64 = v600.mul_add(v1340, v1538);
-    let v1540: f64 = p[41usize].mul_add(v1526, v1539);
-    let v1541: f64 = p[39usize].mul_add(v1532, v1540);
-    let v1542: f64 = qd[5usize].mul_add(v1535, v1541);
-    let v1543: f64 = v653.mul_add(v1383, v1542);
-    let v1544: f64 = v654.mul_add(v1414, v1543);
-    let v1545: f64 = v656.mul_add(v1446, v1544);
-    let v1546: f64 = v657.mul_add(v1479, v1545);
-    let v1547: f64 = v648.mul_add(v1513, v1546);
-    let v1548: f64 = -v1547;
-    let v1550: f64 = v870 * v870;
-    let v1551: f64 = (-0.5f64) * v1550;
-    let v1552: f64 = v1551 * v1131;
-    let v1553: f64 = p[106usize] * v1552;
-    let v1554: f64 = p[45usize] * v1553;
-    let v1556: f64 = p[107usize] * v1128;
-    let v1557: f64 = v1556 * v1551;
-    let v1558: f64 = v669 * v1557;
-    let v1561: f64 = p[108usize] + q[6usize];
-    let v1562: f64 = v1164 * v682;
-    let v1564: f64 = p[109usize] * q[6usize];
-    let v1565: f64 = v1564 * v85;
-    let v1566: f64 = v1169.mul_add(v684, v1562);
-    let v1567: f64 = (-v1565).mul_add(v1551, v1566);
-    let v1569: f64 = 0.5f64 * v870;
-    let v1570: f64 = v1569.mul_add(v1134, p[48usize]);
-    let v1571: f64 = v678.mul_add(v1554, v1558);
-    let v1572: f64 = v1571 + v1143;
-    let v1573: f64 = v676.mul_add(v1331, v1572);
-    let v1574: f64 = v673.mul_add(v1339, v1573);
-    let v1575: f64 = p[47usize].mul_add(v1561, v1574);
-    let v1576: f64 = p[45usize].mul_add(v1567, v1575);
-    let v1577: f64 = qd[6usize].mul_add(v1570, v1576);
-    let v1578: f64 = v734.mul_add(v1383, v1577);
-    let v1579: f64 = v735.mul_add(v1414, v1578);
-    let v1580: f64 = v737.mul_add(v1446, v1579);
-    let v1581: f64 = v738.mul_add(v1479, v1580);
-    let v1582: f64 = v739.mul_add(v1513, v1581);
-    let v1583: f64 = v729.mul_add(v1548, v1582);
-    let v1584: f64 = -v1583;
-    let v1585: f64 = v764.mul_add(v879, v884);
-    let v1586: f64 = p[53usize].mul_add(v887, v1585);
-    let v1587: f64 = p[51usize].mul_add(v1049, v1586);
-    let v1588: f64 = p[7usize].mul_add(v1067, v1587);
-    let v1589: f64 = qd[7usize].mul_add(v1075, v1588);
-    let v1590: f64 = v825.mul_add(v1383, v1589);
-    let v1591: f64 = v826.mul_add(v1414, v1590);
-    let v1592: f64 = v828.mul_add(v1446, v1591);
-    let v1593: f64 = v829.mul_add(v1479, v1592);
-    let v1594: f64 = v830.mul_add(v1513, v1593);
-    let v1595: f64 = v831.mul_add(v1548, v1594);
-    let v1596: f64 = v819.mul_add(v1584, v1595);
-    let v1597: f64 = -v1596;
-    let v1598: f64 = v841 * v1597;
-    let v1599: f64 = v819 * v1598;
-    let v1600: f64 = v750.mul_add(v1584, -v1599);
-    let v1601: f64 = v831 * v1598;
-    let v1602: f64 = v729.mul_add(v1600, v1601);
-    let v1603: f64 = v667.mul_add(v1548, -v1602);
-    let v1604: f64 = v739 * v1600;
-    let v1605: f64 = v648.mul_add(v1603, v1604);
-    let v1606: f64 = v830.mul_add(v1598, v1605);
-    let v1607: f64 = v594.mul_add(v1513, -v1606);
-    let v1608: f64 = v657 * v1603;
-    let v1609: f64 = v577.mul_add(v1607, v1608);
-    let v1610: f64 = v738.mul_add(v1600, v1609);
-    let v1611: f64 = v829.mul_add(v1598, v1610);
-    let v1612: f64 = v530.mul_add(v1479, -v1611);
-    let v1613: f64 = v585 * v1607;
-    let v1614: f64 = v515.mul_add(v1612, v1613);
-    let v1615: f64 = v656.mul_add(v1603, v1614);
-    let v1616: f64 = v737.mul_add(v1600, v1615);
-    let v1617: f64 = v828.mul_add(v1598, v1616);
-    let v1618: f64 = v474.mul_add(v1446, -v1617);
-    let v1619: f64 = v521 * v1612;
-    let v1620: f64 = v461.mul_add(v1618, v1619);
-    let v1621: f64 = v583.mul_add(v1607, v1620);
-    let v1622: f64 = v654.mul_add(v1603, v1621);
-    let v1623: f64 = v735.mul_add(v1600, v1622);
-    let v1624: f64 = v826.mul_add(v1598, v1623);
-    let v1625: f64 = v425.mul_add(v1414, -v1624);
-    let v1626: f64 = v466 * v1618;
-    let v1627: f64 = v415.mul_add(v1625, v1626);
-    let v1628: f64 = v520.mul_add(v1612, v1627);
-    let v1629: f64 = v582.mul_add(v1607, v1628);
-    let v1630: f64 = v653.mul_add(v1603, v1629);
-    let v1631: f64 = v734.mul_add(v1600, v1630);
-    let v1632: f64 = v825.mul_add(v1598, v1631);
-    let v1633: f64 = v382.mul_add(v1383, -v1632);
-    out[0usize] = v1633;
-    out[1usize] = v1625;
-    out[2usize] = v1618;
-    out[3usize] = v1612;
-    out[4usize] = v1607;
-    out[5usize] = v1603;
-    out[6usize] = v1600;
-    out[7usize] = v1598;
-    out[8usize] = v380;
-    out[9usize] = v424;
-    out[10usize] = v473;
-    out[11usize] = v529;
-    out[12usize] = v593;
-    out[13usize] = v666;
-    out[14usize] = v749;
-    out[15usize] = v840;
-    out[16usize] = v415;
-    out[17usize] = v466;
-    out[18usize] = v461;
-    out[19usize] = v520;
-    out[20usize] = v521;
-    out[21usize] = v515;
-    out[22usize] = v582;
-    out[23usize] = v583;
-    out[24usize] = v585;
-    out[25usize] = v577;
-    out[26usize] = v653;
-    out[27usize] = v654;
-    out[28usize] = v656;
-    out[29usize] = v657;
-    out[30usize] = v648;
-    out[31usize] = v734;
-    out[32usize] = v735;
-    out[33usize] = v737;
-    out[34usize] = v738;
-    out[35usize] = v739;
-    out[36usize] = v729;
-    out[37usize] = v825;
-    out[38usize] = v826;
-    out[39usize] = v828;
-    out[40usize] = v829;
-    out[41usize] = v830;
-    out[42usize] = v831;
-    out[43usize] = v819;
-    out2[0usize] = v380;
-    out2[1usize] = v414;
-    out2[2usize] = v457;
-    out2[3usize] = v506;
-    out2[4usize] = v562;
-    out2[5usize] = v626;
-    out2[6usize] = v699;
-    out2[7usize] = v780;
-    out2[8usize] = v423;
-    out2[9usize] = v459;
-    out2[10usize] = v508;
-    out2[11usize] = v564;
-    out2[12usize] = v628;
-    out2[13usize] = v701;
-    out2[14usize] = v782;
-    out2[15usize] = v472;
-    out2[16usize] = v513;
-    out2[17usize] = v570;
-    out2[18usize] = v634;
-    out2[19usize] = v707;
-    out2[20usize] = v788;
-    out2[21usize] = v528;
-    out2[22usize] = v575;
-    out2[23usize] = v640;
-    out2[24usize] = v713;
-    out2[25usize] = v794;
-    out2[26usize] = v592;
-    out2[27usize] = v646;
-    out2[28usize] = v720;
-    out2[29usize] = v801;
-    out2[30usize] = v665;
-    out2[31usize] = v727;
-    out2[32usize] = v809;
-    out2[33usize] = v748;
-    out2[34usize] = v817;
-    out2[35usize] = v839;
-    out2[36usize] = v1382;
-    out2[37usize] = v1412;
-    out2[38usize] = v1443;
-    out2[39usize] = v1475;
-    out2[40usize] = v1508;
-    out2[41usize] = v1542;
-    out2[42usize] = v1577;
-    out2[43usize] = v1589;
+    let v233 = p[50] * v94;
+    let v234 = v233.mul_add(v232, v188);
+    let v236 = v233.mul_add(v235, v210);
+    let v237 = v236 * v236;
+    let v238 = v234.mul_add(v234, v237);
+    let v239 = p[63].mul_add(v99, p[52]);
+    let v240 = p[51].mul_add(v214, v239);
+    let v241 = p[7].mul_add(v238, v240);
+    let v244 = v82 * v82;
+    let v245 = p[67] * v244;
+    let v246 = p[44] * q[6];
+    let v247 = v246 * v79;
+    let v248 = v245.mul_add(v182, v175);
+    let v249 = (-v247).mul_add(v180, v248);
+    let v250 = v245.mul_add(v180, v209);
+    let v251 = v247.mul_add(v182, v250);
+    let v252 = v251 * v251;
+    let v253 = v249.mul_add(v249, v252);
+    let v254 = p[62].mul_add(v87, p[46]);
+    let v255 = v254 + v241;
+    let v256 = p[45].mul_add(v253, v255);
+    let v259 = v70 * v70;
+    let v260 = p[68] * v259;
+    let v261 = p[38] * q[5];
+    let v262 = v261 * v67;
+    let v263 = v260.mul_add(v169, v162);
+    let v264 = (-v262).mul_add(v167, v263);
+    let v265 = v260.mul_add(v167, v208);
+    let v266 = v262.mul_add(v169, v265);
+    let v267 = v266 * v266;
+    let v268 = v264.mul_add(v264, v267);
+    let v269 = p[61].mul_add(v75, p[40]);
+    let v270 = v269 + v256;
+    let v271 = p[39].mul_add(v268, v270);
+    let v274 = v58 * v58;
+    let v275 = p[69] * v274;
+    let v276 = p[32] * q[4];
+    let v277 = v276 * v55;
+    let v278 = v275.mul_add(v156, v149);
+    let v279 = (-v277).mul_add(v154, v278);
+    let v280 = v275.mul_add(v154, v207);
+    let v281 = v277.mul_add(v156, v280);
+    let v282 = v281 * v281;
+    let v283 = v279.mul_add(v279, v282);
+    let v284 = p[60].mul_add(v63, p[34]);
+    let v285 = v284 + v271;
+    let v286 = p[33].mul_add(v283, v285);
+    let v289 = v46 * v46;
+    let v290 = p[70] * v289;
+    let v291 = p[26] * q[3];
+    let v292 = v291 * v43;
+    let v293 = v290.mul_add(v143, v136);
+    let v294 = (-v292).mul_add(v141, v293);
+    let v295 = v290.mul_add(v141, v206);
+    let v296 = v292.mul_add(v143, v295);
+    let v297 = v296 * v296;
+    let v298 = v294.mul_add(v294, v297);
+    let v299 = p[59].mul_add(v51, p[28]);
+    let v300 = v299 + v286;
+    let v301 = p[27].mul_add(v298, v300);
+    let v304 = v34 * v34;
+    let v305 = p[71] * v304;
+    let v306 = p[20] * q[2];
+    let v307 = v306 * v31;
+    let v308 = v305.mul_add(v130, v123);
+    let v309 = (-v307).mul_add(v128, v308);
+    let v310 = v305.mul_add(v128, v205);
+    let v311 = v307.mul_add(v130, v310);
+    let v312 = v311 * v311;
+    let v313 = v309.mul_add(v309, v312);
+    let v314 = p[58].mul_add(v39, p[22]);
+    let v315 = v314 + v301;
+    let v316 = p[21].mul_add(v313, v315);
+    let v319 = v22 * v22;
+    let v320 = p[72] * v319;
+    let v321 = v320 * v117;
+    let v322 = p[14] * q[1];
+    let v323 = v322 * v19;
+    let v324 = v323 * v115;
+    let v325 = v110 + v321;
+    let v326 = v325 - v324;
+    let v327 = v320 * v115;
+    let v328 = v323 * v117;
+    let v329 = v204 + v327;
+    let v330 = v329 + v328;
+    let v331 = v330 * v330;
+    let v332 = v326.mul_add(v326, v331);
+    let v333 = p[57].mul_add(v27, p[16]);
+    let v334 = v333 + v316;
+    let v335 = p[15].mul_add(v332, v334);
+    let v338 = 0.5f64 * v337;
+    let v339 = v109 * v338;
+    let v341 = q[0].mul_add(v340, v3);
+    let v342 = p[8] * v341;
+    let v343 = p[65] * v342;
+    let v344 = p[64].mul_add(v339, v343);
+    let v345 = p[64] * v342;
+    let v346 = p[65].mul_add(v339, -v345);
+    let v347 = v346 * v346;
+    let v348 = v344.mul_add(v344, v347);
+    let v349 = v108 * v338;
+    let v350 = 0.5f64 * v8;
+    let v351 = (-v350).mul_add(v113, v349);
+    let v352 = p[8].mul_add(v351, v204);
+    let v353 = p[7] * v236;
+    let v354 = p[51].mul_add(v212, v353);
+    let v355 = p[45].mul_add(v251, v354);
+    let v356 = p[39].mul_add(v266, v355);
+    let v357 = p[33].mul_add(v281, v356);
+    let v358 = p[27].mul_add(v296, v357);
+    let v359 = p[21].mul_add(v311, v358);
+    let v360 = p[15].mul_add(v330, v359);
+    let v361 = 2f64 * v360;
+    let v363 = v352.mul_add(p[73], -v361);
+    let v364 = v113 * v338;
+    let v365 = v350.mul_add(v108, v364);
+    let v366 = p[8].mul_add(v365, -v110);
+    let v367 = p[7] * v234;
+    let v368 = p[51].mul_add(v202, v367);
+    let v369 = p[45].mul_add(v249, v368);
+    let v370 = p[39].mul_add(v264, v369);
+    let v371 = p[33].mul_add(v279, v370);
+    let v372 = p[27].mul_add(v294, v371);
+    let v373 = p[21].mul_add(v309, v372);
+    let v374 = p[15].mul_add(v326, v373);
+    let v375 = v366 * p[73];
+    let v376 = 2f64.mul_add(v374, v375);
+    let v377 = 0.25f64.mul_add(v15, v335);
+    let v378 = p[9].mul_add(v348, v377);
+    let v379 = v352.mul_add(v363, v378);
+    let v380 = v366.mul_add(v376, v379);
+    let v382 = 1f64 / v380;
+    let v384 = 0.5f64 * v383;
+    let v385 = 0.5f64 * v22;
+    let v386 = v385 * v121;
+    let v387 = v126.mul_add(v384, v386);
+    let v388 = p[14].mul_add(v387, -v123);
+    let v389 = v385 * v126;
+    let v390 = v121.mul_add(v384, -v389);
+    let v391 = p[14].mul_add(v390, v205);
+    let v392 = v122 * v384;
+    let v394 = q[1].mul_add(v393, v19);
+    let v395 = p[14] * v394;
+    let v396 = v117 * v395;
+    let v397 = v115.mul_add(v392, v396);
+    let v398 = v115 * v395;
+    let v399 = v117.mul_add(v392, -v398);
+    let v400 = v330 * v399;
+    let v401 = v326.mul_add(v397, -v400);
+    let v402 = 0.5f64.mul_add(v333, v316);
+    let v403 = v388.mul_add(v373, v402);
+    let v404 = (-v391).mul_add(v359, v403);
+    let v405 = p[15].mul_add(v401, v404);
+    let v407 = v391 * p[74];
+    let v408 = v407 - v359;
+    let v409 = p[15].mul_add(v399, v408);
+    let v410 = v388 * p[74];
+    let v411 = v373 + v410;
+    let v412 = p[15].mul_add(v397, v411);
+    let v413 = v352.mul_add(v409, v405);
+    let v414 = v366.mul_add(v412, v413);
+    let v415 = v382 * v414;
+    let v416 = v397 * v397;
+    let v417 = v399.mul_add(v399, v416);
+    let v418 = (-2f64).mul_add(v359, v407);
+    let v419 = 2f64.mul_add(v373, v410);
+    let v420 = 0.25f64.mul_add(v333, v316);
+    let v421 = p[15].mul_add(v417, v420);
+    let v422 = v391.mul_add(v418, v421);
+    let v423 = v388.mul_add(v419, v422);
+    let v424 = (-v414).mul_add(v415, v423);
+    let v425 = 1f64 / v424;
+    let v427 = 0.5f64 * v426;
+    let v428 = 0.5f64 * v34;
+    let v429 = v428 * v134;
+    let v430 = v139.mul_add(v427, v429);
+    let v431 = p[20].mul_add(v430, -v136);
+    let v432 = v428 * v139;
+    let v433 = v134.mul_add(v427, -v432);
+    let v434 = p[20].mul_add(v433, v206);
+    let v435 = v135 * v427;
+    let v437 = q[2].mul_add(v436, v31);
+    let v438 = p[20] * v437;
+    let v439 = v130 * v438;
+    let v440 = v128.mul_add(v435, v439);
+    let v441 = v128 * v438;
+    let v442 = v130.mul_add(v435, -v441);
+    let v443 = v311 * v442;
+    let v444 = v309.mul_add(v440, -v443);
+    let v445 = 0.5f64.mul_add(v314, v301);
+    let v446 = v431.mul_add(v372, v445);
+    let v447 = (-v434).mul_add(v358, v446);
+    let v448 = p[21].mul_add(v444, v447);
+    let v450 = v434 * p[75];
+    let v451 = v450 - v358;
+    let v452 = p[21].mul_add(v442, v451);
+    let v453 = v431 * p[75];
+    let v454 = v372 + v453;
+    let v455 = p[21].mul_add(v440, v454);
+    let v456 = v352.mul_add(v452, v448);
+    let v457 = v366.mul_add(v455, v456);
+    let v458 = v391.mul_add(v452, v448);
+    let v459 = v388.mul_add(v455, v458);
+    let v460 = (-v415).mul_add(v457, v459);
+    let v461 = v425 * v460;
+    let v462 = v440 * v440;
+    let v463 = v442.mul_add(v442, v462);
+    let v464 = (-2f64).mul_add(v358, v450);
+    let v465 = 2f64.mul_add(v372, v453);
+    let v466 = v382 * v457;
+    let v467 = v460 * v461;
+    let v468 = v457.mul_add(v466, v467);
+    let v469 = 0.25f64.mul_add(v314, v301);
+    let v470 = p[21].mul_add(v463, v469);
+    let v471 = v434.mul_add(v464, v470);
+    let v472 = v431.mul_add(v465, v471);
+    let v473 = v472 - v468;
+    let v474 = 1f64 / v473;
+    let v476 = 0.5f64 * v475;
+    let v477 = 0.5f64 * v46;
+    let v478 = v477 * v147;
+    let v479 = v152.mul_add(v476, v478);
+    let v480 = p[26].mul_add(v479, -v149);
+    let v481 = v477 * v152;
+    let v482 = v147.mul_add(v476, -v481);
+    let v483 = p[26].mul_add(v482, v207);
+    let v484 = v148 * v476;
+    let v486 = q[3].mul_add(v485, v43);
+    let v487 = p[26] * v486;
+    let v488 = v143 * v487;
+    let v489 = v141.mul_add(v484, v488);
+    let v490 = v141 * v487;
+    let v491 = v143.mul_add(v484, -v490);
+    let v492 = v296 * v491;
+    let v493 = v294.mul_add(v489, -v492);
+    let v494 = 0.5f64.mul_add(v299, v286);
+    let v495 = v480.mul_add(v371, v494);
+    let v496 = (-v483).mul_add(v357, v495);
+    let v497 = p[27].mul_add(v493, v496);
+    let v499 = v483 * p[76];
+    let v500 = v499 - v357;
+    let v501 = p[27].mul_add(v491, v500);
+    let v502 = v480 * p[76];
+    let v503 = v371 + v502;
+    let v504 = p[27].mul_add(v489, v503);
+    let v505 = v352.mul_add(v501, v497);
+    let v506 = v366.mul_add(v504, v505);
+    let v507 = v391.mul_add(v501, v497);
+    let v508 = v388.mul_add(v504, v507);
+    let v509 = (-v415).mul_add(v506, v508);
+    let v510 = v461 * v509;
+    let v511 = v466.mul_add(v506, v510);
+    let v512 = v434.mul_add(v501, v497);
+    let v513 = v431.mul_add(v504, v512);
+    let v514 = v513 - v511;
+    let v515 = v474 * v514;
+    let v516 = v489 * v489;
+    let v517 = v491.mul_add(v491, v516);
+    let v518 = (-2f64).mul_add(v357, v499);
+    let v519 = 2f64.mul_add(v371, v502);
+    let v520 = v382 * v506;
+    let v521 = v425 * v509;
+    let v522 = v509 * v521;
+    let v523 = v506.mul_add(v520, v522);
+    let v524 = v514.mul_add(v515, v523);
+    let v525 = 0.25f64.mul_add(v299, v286);
+    let v526 = p[27].mul_add(v517, v525);
+    let v527 = v483.mul_add(v518, v526);
+    let v528 = v480.mul_add(v519, v527);
+    let v529 = v528 - v524;
+    let v530 = 1f64 / v529;
+    let v532 = 0.5f64 * v531;
+    let v533 = 0.5f64 * v58;
+    let v534 = v533 * v160;
+    let v535 = v165.mul_add(v532, v534);
+    let v536 = p[32].mul_add(v535, -v162);
+    let v537 = v533 * v165;
+    let v538 = v160.mul_add(v532, -v537);
+    let v539 = p[32].mul_add(v538, v208);
+    let v540 = v161 * v532;
+    let v542 = q[4].mul_add(v541, v55);
+    let v543 = p[32] * v542;
+    let v544 = v156 * v543;
+    let v545 = v154.mul_add(v540, v544);
+    let v546 = v154 * v543;
+    let v547 = v156.mul_add(v540, -v546);
+    let v548 = v281 * v547;
+    let v549 = v279.mul_add(v545, -v548);
+    let v550 = 0.5f64.mul_add(v284, v271);
+    let v551 = v536.mul_add(v370, v550);
+    let v552 = (-v539).mul_add(v356, v551);
+    let v553 = p[33].mul_add(v549, v552);
+    let v555 = v539 * p[77];
+    let v556 = v555 - v356;
+    let v557 = p[33].mul_add(v547, v556);
+    let v558 = v536 * p[77];
+    let v559 = v370 + v558;
+    let v560 = p[33].mul_add(v545, v559);
+    let v561 = v352.mul_add(v557, v553);
+    let v562 = v366.mul_add(v560, v561);
+    let v563 = v391.mul_add(v557, v553);
+    let v564 = v388.mul_add(v560, v563);
+    let v565 = (-v415).mul_add(v562, v564);
+    let v566 = v521 * v565;
+    let v567 = v461 * v565;
+    let v568 = v466.mul_add(v562, v567);
+    let v569 = v434.mul_add(v557, v553);
+    let v570 = v431.mul_add(v560, v569);
+    let v571 = v570 - v568;
+    let v572 = v520.mul_add(v562, v566);
+    let v573 = v515.mul_add(v571, v572);
+    let v574 = v483.mul_add(v557, v553);
+    let v575 = v480.mul_add(v560, v574);
+    let v576 = v575 - v573;
+    let v577 = v530 * v576;
+    let v578 = v545 * v545;
+    let v579 = v547.mul_add(v547, v578);
+    let v580 = (-2f64).mul_add(v356, v555);
+    let v581 = 2f64.mul_add(v370, v558);
+    let v582 = v382 * v562;
+    let v583 = v425 * v565;
+    let v584 = v565 * v583;
+    let v585 = v474 * v571;
+    let v586 = v562.mul_add(v582, v584);
+    let v587 = v571.mul_add(v585, v586);
+    let v588 = v576.mul_add(v577, v587);
+    let v589 = 0.25f64.mul_add(v284, v271);
+    let v590 = p[33].mul_add(v579, v589);
+    let v591 = v539.mul_add(v580, v590);
+    let v592 = v536.mul_add(v581, v591);
+    let v593 = v592 - v588;
+    let v594 = 1f64 / v593;
+    let v596 = 0.5f64 * v595;
+    let v597 = 0.5f64 * v70;
+    let v598 = v597 * v173;
+    let v599 = v178.mul_add(v596, v598);
+    let v600 = p[38].mul_add(v599, -v175);
+    let v601 = v597 * v178;
+    let v602 = v173.mul_add(v596, -v601);
+    let v603 = p[38].mul_add(v602, v209);
+    let v604 = v174 * v596;
+    let v606 = q[5].mul_add(v605, v67);
+    let v607 = p[38] * v606;
+    let v608 = v169 * v607;
+    let v609 = v167.mul_add(v604, v608);
+    let v610 = v167 * v607;
+    let v611 = v169.mul_add(v604, -v610);
+    let v612 = v266 * v611;
+    let v613 = v264.mul_add(v609, -v612);
+    let v614 = 0.5f64.mul_add(v269, v256);
+    let v615 = v600.mul_add(v369, v614);
+    let v616 = (-v603).mul_add(v355, v615);
+    let v617 = p[39].mul_add(v613, v616);
+    let v619 = v603 * p[78];
+    let v620 = v619 - v355;
+    let v621 = p[39].mul_add(v611, v620);
+    let v622 = v600 * p[78];
+    let v623 = v369 + v622;
+    let v624 = p[39].mul_add(v609, v623);
+    let v625 = v352.mul_add(v621, v617);
+    let v626 = v366.mul_add(v624, v625);
+    let v627 = v391.mul_add(v621, v617);
+    let v628 = v388.mul_add(v624, v627);
+    let v629 = (-v415).mul_add(v626, v628);
+    let v630 = v583 * v629;
+    let v631 = v461 * v629;
+    let v632 = v466.mul_add(v626, v631);
+    let v633 = v434.mul_add(v621, v617);
+    let v634 = v431.mul_add(v624, v633);
+    let v635 = v634 - v632;
+    let v636 = v521 * v629;
+    let v637 = v520.mul_add(v626, v636);
+    let v638 = v515.mul_add(v635, v637);
+    let v639 = v483.mul_add(v621, v617);
+    let v640 = v480.mul_add(v624, v639);
+    let v641 = v640 - v638;
+    let v642 = v582.mul_add(v626, v630);
+    let v643 = v585.mul_add(v635, v642);
+    let v644 = v577.mul_add(v641, v643);
+    let v645 = v539.mul_add(v621, v617);
+    let v646 = v536.mul_add(v624, v645);
+    let v647 = v646 - v644;
+    let v648 = v594 * v647;
+    let v649 = v609 * v609;
+    let v650 = v611.mul_add(v611, v649);
+    let v651 = (-2f64).mul_add(v355, v619);
+    let v652 = 2f64.mul_add(v369, v622);
+    let v653 = v382 * v626;
+    let v654 = v425 * v629;
+    let v655 = v629 * v654;
+    let v656 = v474 * v635;
+    let v657 = v530 * v641;
+    let v658 = v626.mul_add(v653, v655);
+    let v659 = v635.mul_add(v656, v658);
+    let v660 = v641.mul_add(v657, v659);
+    let v661 = v647.mul_add(v648, v660);
+    let v662 = 0.25f64.mul_add(v269, v256);
+    let v663 = p[39].mul_add(v650, v662);
+    let v664 = v603.mul_add(v651, v663);
+    let v665 = v600.mul_add(v652, v664);
+    let v666 = v665 - v661;
+    let v667 = 1f64 / v666;
+    let v669 = 0.5f64 * v668;
+    let v670 = 0.5f64 * v82;
+    let v671 = v670 * v186;
+    let v672 = v193.mul_add(v669, v671);
+    let v673 = p[44].mul_add(v672, -v188);
+    let v674 = v670 * v193;
+    let v675 = v186.mul_add(v669, -v674);
+    let v676 = p[44].mul_add(v675, v210);
+    let v677 = v187 * v669;
+    let v679 = q[6].mul_add(v678, v79);
+    let v680 = p[44] * v679;
+    let v681 = v182 * v680;
+    let v682 = v180.mul_add(v677, v681);
+    let v683 = v180 * v680;
+    let v684 = v182.mul_add(v677, -v683);
+    let v685 = v251 * v684;
+    let v686 = v249.mul_add(v682, -v685);
+    let v687 = 0.5f64.mul_add(v254, v241);
+    let v688 = v673.mul_add(v368, v687);
+    let v689 = (-v676).mul_add(v354, v688);
+    let v690 = p[45].mul_add(v686, v689);
+    let v692 = v676 * p[79];
+    let v693 = v692 - v354;
+    let v694 = p[45].mul_add(v684, v693);
+    let v695 = v673 * p[79];
+    let v696 = v368 + v695;
+    let v697 = p[45].mul_add(v682, v696);
+    let v698 = v352.mul_add(v694, v690);
+    let v699 = v366.mul_add(v697, v698);
+    let v700 = v391.mul_add(v694, v690);
+    let v701 = v388.mul_add(v697, v700);
+    let v702 = (-v415).mul_add(v699, v701);
+    let v703 = v654 * v702;
+    let v704 = v461 * v702;
+    let v705 = v466.mul_add(v699, v704);
+    let v706 = v434.mul_add(v694, v690);
+    let v707 = v431.mul_add(v697, v706);
+    let v708 = v707 - v705;
+    let v709 = v521 * v702;
+    let v710 = v520.mul_add(v699, v709);
+    let v711 = v515.mul_add(v708, v710);
+    let v712 = v483.mul_add(v694, v690);
+    let v713 = v480.mul_add(v697, v712);
+    let v714 = v713 - v711;
+    let v715 = v583 * v702;
+    let v716 = v582.mul_add(v699, v715);
+    let v717 = v585.mul_add(v708, v716);
+    let v718 = v577.mul_add(v714, v717);
+    let v719 = v539.mul_add(v694, v690);
+    let v720 = v536.mul_add(v697, v719);
+    let v721 = v720 - v718;
+    let v722 = v653.mul_add(v699, v703);
+    let v723 = v656.mul_add(v708, v722);
+    let v724 = v657.mul_add(v714, v723);
+    let v725 = v648.mul_add(v721, v724);
+    let v726 = v603.mul_add(v694, v690);
+    let v727 = v600.mul_add(v697, v726);
+    let v728 = v727 - v725;
+    let v729 = v667 * v728;
+    let v730 = v682 * v682;
+    let v731 = v684.mul_add(v684, v730);
+    let v732 = (-2f64).mul_add(v354, v692);
+    let v733 = 2f64.mul_add(v368, v695);
+    let v734 = v382 * v699;
+    let v735 = v425 * v702;
+    let v736 = v702 * v735;
+    let v737 = v474 * v708;
+    let v738 = v530 * v714;
+    let v739 = v594 * v721;
+    let v740 = v699.mul_add(v734, v736);
+    let v741 = v708.mul_add(v737, v740);
+    let v742 = v714.mul_add(v738, v741);
+    let v743 = v721.mul_add(v739, v742);
+    let v744 = v728.mul_add(v729, v743);
+    let v745 = 0.25f64.mul_add(v254, v241);
+    let v746 = p[45].mul_add(v731, v745);
+    let v747 = v676.mul_add(v732, v746);
+    let v748 = v673.mul_add(v733, v747);
+    let v749 = v748 - v744;
+    let v750 = 1f64 / v749;
+    let v752 = 0.5f64 * v751;
+    let v753 = 0.5f64 * v94;
+    let v754 = v753 * v232;
+    let v755 = v235.mul_add(v752, v754);
+    let v756 = p[50] * v755;
+    let v757 = v753 * v235;
+    let v758 = v232.mul_add(v752, -v757);
+    let v759 = p[50] * v758;
+    let v760 = v236 * v759;
+    let v761 = v234.mul_add(v756, -v760);
+    let v762 = p[7] * v761;
+    let v763 = v233 * v752;
+    let v765 = q[7].mul_add(v764, v91);
+    let v766 = p[50] * v765;
+    let v767 = v195 * v766;
+    let v768 = v200.mul_add(v763, v767);
+    let v769 = v200 * v766;
+    let v770 = v195.mul_add(v763, -v769);
+    let v771 = v212 * v770;
+    let v772 = v202.mul_add(v768, -v771);
+    let v773 = 0.5f64.mul_add(v239, v762);
+    let v774 = p[51].mul_add(v772, v773);
+    let v775 = p[7] * v759;
+    let v776 = p[51].mul_add(v770, v775);
+    let v777 = p[7] * v756;
+    let v778 = p[51].mul_add(v768, v777);
+    let v779 = v352.mul_add(v776, v774);
+    let v780 = v366.mul_add(v778, v779);
+    let v781 = v391.mul_add(v776, v774);
+    let v782 = v388.mul_add(v778, v781);
+    let v783 = (-v415).mul_add(v780, v782);
+    let v784 = v735 * v783;
+    let v785 = v461 * v783;
+    let v786 = v466.mul_add(v780, v785);
+    let v787 = v434.mul_add(v776, v774);
+    let v788 = v431.mul_add(v778, v787);
+    let v789 = v788 - v786;
+    let v790 = v521 * v783;
+    let v791 = v520.mul_add(v780, v790);
+    let v792 = v515.mul_add(v789, v791);
+    let v793 = v483.mul_add(v776, v774);
+    let v794 = v480.mul_add(v778, v793);
+    let v795 = v794 - v792;
+    let v796 = v583 * v783;
+    let v797 = v582.mul_add(v780, v796);
+    let v798 = v585.mul_add(v789, v797);
+    let v799 = v577.mul_add(v795, v798);
+    let v800 = v539.mul_add(v776, v774);
+    let v801 = v536.mul_add(v778, v800);
+    let v802 = v801 - v799;
+    let v803 = v654 * v783;
+    let v804 = v653.mul_add(v780, v803);
+    let v805 = v656.mul_add(v789, v804);
+    let v806 = v657.mul_add(v795, v805);
+    let v807 = v648.mul_add(v802, v806);
+    let v808 = v603.mul_add(v776, v774);
+    let v809 = v600.mul_add(v778, v808);
+    let v810 = v809 - v807;
+    let v811 = v734.mul_add(v780, v784);
+    let v812 = v737.mul_add(v789, v811);
+    let v813 = v738.mul_add(v795, v812);
+    let v814 = v739.mul_add(v802, v813);
+    let v815 = v729.mul_add(v810, v814);
+    let v816 = v676.mul_add(v776, v774);
+    let v817 = v673.mul_add(v778, v816);
+    let v818 = v817 - v815;
+    let v819 = v750 * v818;
+    let v820 = v768 * v768;
+    let v821 = v770.mul_add(v770, v820);
+    let v822 = p[51] * v821;
+    let v823 = v756 * v756;
+    let v824 = v759.mul_add(v759, v823);
+    let v825 = v382 * v780;
+    let v826 = v425 * v783;
+    let v827 = v783 * v826;
+    let v828 = v474 * v789;
+    let v829 = v530 * v795;
+    let v830 = v594 * v802;
+    let v831 = v667 * v810;
+    let v832 = v780.mul_add(v825, v827);
+    let v833 = v789.mul_add(v828, v832);
+    let v834 = v795.mul_add(v829, v833);
+    let v835 = v802.mul_add(v830, v834);
+    let v836 = v810.mul_add(v831, v835);
+    let v837 = v818.mul_add(v819, v836);
+    let v838 = 0.25f64.mul_add(v239, v822);
+    let v839 = p[7].mul_add(v824, v838);
+    let v840 = v839 - v837;
+    let v841 = 1f64 / v840;
+    let v844 = 0.5f64 * qd[7];
+    let v846 = 0.5f64 * qd[6];
+    let v848 = 0.5f64 * qd[5];
+    let v850 = 0.5f64 * qd[4];
+    let v852 = 0.5f64 * qd[3];
+    let v854 = 0.5f64 * qd[2];
+    let v856 = 0.5f64 * qd[1];
+    let v858 = 0.5f64 * qd[0];
+    let v859 = v858 + v858;
+    let v860 = v856 + v859;
+    let v861 = v856 + v860;
+    let v862 = v854 + v861;
+    let v863 = v854 + v862;
+    let v864 = v852 + v863;
+    let v865 = v852 + v864;
+    let v866 = v850 + v865;
+    let v867 = v850 + v866;
+    let v868 = v848 + v867;
+    let v869 = v848 + v868;
+    let v870 = v846 + v869;
+    let v871 = v846 + v870;
+    let v872 = v844 + v871;
+    let v873 = v872 * v872;
+    let v875 = (-0.5f64) * v873;
+    let v876 = (-v92).mul_add(v96, 2f64);
+    let v877 = v875 * v876;
+    let v878 = p[110] * v877;
+    let v879 = p[51] * v878;
+    let v881 = v94.powi(3i32);
+    let v882 = p[111] * v881;
+    let v883 = v882 * v875;
+    let v884 = v752 * v883;
+    let v887 = p[112] + q[7];
+    let v889 = qd[0] * qd[0];
+    let v891 = 0.25f64 * v890;
+    let v892 = (-0.25f64).mul_add(v8, v891);
+    let v893 = v108.mul_add(v892, -v364);
+    let v894 = p[8] * v893;
+    let v895 = qd[0] + v856;
+    let v896 = 2f64 * qd[1];
+    let v897 = v896 * v126;
+    let v898 = v897 * v384;
+    let v899 = v898 * v895;
+    let v900 = qd[1] * qd[1];
+    let v902 = 0.25f64 * v901;
+    let v903 = v895 * v895;
+    let v904 = v22 * v903;
+    let v905 = v900.mul_add(v902, -v904);
+    let v906 = v121.mul_add(v905, -v899);
+    let v907 = p[14] * v906;
+    let v908 = v889.mul_add(v894, v907);
+    let v909 = v856 + v895;
+    let v910 = v854 + v909;
+    let v911 = 2f64 * qd[2];
+    let v912 = v911 * v139;
+    let v913 = v912 * v427;
+    let v914 = v913 * v910;
+    let v915 = qd[2] * qd[2];
+    let v917 = 0.25f64 * v916;
+    let v918 = v910 * v910;
+    let v919 = v34 * v918;
+    let v920 = v915.mul_add(v917, -v919);
+    let v921 = v134.mul_add(v920, -v914);
+    let v922 = p[20].mul_add(v921, v908);
+    let v923 = v854 + v910;
+    let v924 = v852 + v923;
+    let v925 = 2f64 * qd[3];
+    let v926 = v925 * v152;
+    let v927 = v926 * v476;
+    let v928 = v927 * v924;
+    let v929 = qd[3] * qd[3];
+    let v931 = 0.25f64 * v930;
+    let v932 = v924 * v924;
+    let v933 = v46 * v932;
+    let v934 = v929.mul_add(v931, -v933);
+    let v935 = v147.mul_add(v934, -v928);
+    let v936 = p[26].mul_add(v935, v922);
+    let v937 = v852 + v924;
+    let v938 = v850 + v937;
+    let v939 = 2f64 * qd[4];
+    let v940 = v939 * v165;
+    let v941 = v940 * v532;
+    let v942 = v941 * v938;
+    let v943 = qd[4] * qd[4];
+    let v945 = 0.25f64 * v944;
+    let v946 = v938 * v938;
+    let v947 = v58 * v946;
+    let v948 = v943.mul_add(v945, -v947);
+    let v949 = v160.mul_add(v948, -v942);
+    let v950 = p[32].mul_add(v949, v936);
+    let v951 = v850 + v938;
+    let v952 = v848 + v951;
+    let v953 = 2f64 * qd[5];
+    let v954 = v953 * v178;
+    let v955 = v954 * v596;
+    let v956 = v955 * v952;
+    let v957 = qd[5] * qd[5];
+    let v959 = 0.25f64 * v958;
+    let v960 = v952 * v952;
+    let v961 = v70 * v960;
+    let v962 = v957.mul_add(v959, -v961);
+    let v963 = v173.mul_add(v962, -v956);
+    let v964 = p[38].mul_add(v963, v950);
+    let v965 = v848 + v952;
+    let v966 = v846 + v965;
+    let v967 = 2f64 * qd[6];
+    let v968 = v967 * v193;
+    let v969 = v968 * v669;
+    let v970 = v969 * v966;
+    let v971 = qd[6] * qd[6];
+    let v973 = 0.25f64 * v972;
+    let v974 = v966 * v966;
+    let v975 = v82 * v974;
+    let v976 = v971.mul_add(v973, -v975);
+    let v977 = v186.mul_add(v976, -v970);
+    let v978 = p[44].mul_add(v977, v964);
+    let v979 = qd[7] * qd[7];
+    let v981 = 0.25f64 * v980;
+    let v982 = v94 * v981;
+    let v983 = v752.mul_add(v752, v982);
+    let v984 = p[50] * v983;
+    let v985 = v846 + v966;
+    let v986 = v985 * v985;
+    let v987 = v191 * v986;
+    let v988 = 2f64 * qd[7];
+    let v989 = v988 * v985;
+    let v990 = v979.mul_add(v984, -v987);
+    let v991 = (-v989).mul_add(v766, v990);
+    let v993 = q[7] * v992;
+    let v994 = 2f64.mul_add(v764, v993);
+    let v995 = p[50] * v994;
+    let v996 = v979 * v995;
+    let v997 = v988 * v763;
+    let v998 = v997 * v985;
+    let v999 = v198 * v986;
+    let v1000 = v999 - v996;
+    let v1001 = v1000 - v998;
+    let v1002 = v195.mul_add(v991, v978);
+    let v1003 = v200.mul_add(v1001, v1002);
+    let v1004 = p[83] + v1003;
+    let v1006 = v113.mul_add(v892, v349);
+    let v1007 = p[8] * v1006;
+    let v1008 = v896 * v121;
+    let v1009 = v1008 * v384;
+    let v1010 = v126 * v905;
+    let v1011 = v1009.mul_add(v895, v1010);
+    let v1012 = p[14] * v1011;
+    let v1013 = v889.mul_add(v1007, v1012);
+    let v1014 = v911 * v134;
+    let v1015 = v1014 * v427;
+    let v1016 = v139 * v920;
+    let v1017 = v1015.mul_add(v910, v1016);
+    let v1018 = p[20].mul_add(v1017, v1013);
+    let v1019 = v925 * v147;
+    let v1020 = v1019 * v476;
+    let v1021 = v152 * v934;
+    let v1022 = v1020.mul_add(v924, v1021);
+    let v1023 = p[26].mul_add(v1022, v1018);
+    let v1024 = v939 * v160;
+    let v1025 = v1024 * v532;
+    let v1026 = v165 * v948;
+    let v1027 = v1025.mul_add(v938, v1026);
+    let v1028 = p[32].mul_add(v1027, v1023);
+    let v1029 = v953 * v173;
+    let v1030 = v1029 * v596;
+    let v1031 = v178 * v962;
+    let v1032 = v1030.mul_add(v952, v1031);
+    let v1033 = p[38].mul_add(v1032, v1028);
+    let v1034 = v967 * v186;
+    let v1035 = v1034 * v669;
+    let v1036 = v193 * v976;
+    let v1037 = v1035.mul_add(v966, v1036);
+    let v1038 = p[44].mul_add(v1037, v1033);
+    let v1039 = v996 + v998;
+    let v1040 = v1039 - v999;
+    let v1041 = v195.mul_add(v1040, v1038);
+    let v1042 = v200.mul_add(v991, v1041);
+    let v1043 = p[82] + v1042;
+    let v1044 = v1043 * v768;
+    let v1046 = p[113] * q[7];
+    let v1047 = v1046 * v97;
+    let v1048 = v1004.mul_add(v770, v1044);
+    let v1049 = (-v1047).mul_add(v875, v1048);
+    let v1050 = v844 + v985;
+    let v1051 = v988 * v235;
+    let v1052 = v1051 * v752;
+    let v1053 = v1052 * v1050;
+    let v1054 = v1050 * v1050;
+    let v1055 = v94 * v1054;
+    let v1056 = v979.mul_add(v981, -v1055);
+    let v1057 = v232.mul_add(v1056, -v1053);
+    let v1058 = p[50].mul_add(v1057, v978);
+    let v1059 = p[83] + v1058;
+    let v1060 = v988 * v232;
+    let v1061 = v1060 * v752;
+    let v1062 = v235 * v1056;
+    let v1063 = v1061.mul_add(v1050, v1062);
+    let v1064 = p[50].mul_add(v1063, v1038);
+    let v1065 = p[82] + v1064;
+    let v1066 = v1065 * v756;
+    let v1067 = v1059.mul_add(v759, v1066);
+    let v1069 = v752 * v881;
+    let v1070 = 2f64 * q[7];
+    let v1071 = v764.mul_add(v876, -v1069);
+    let v1072 = (-v1070).mul_add(v97, v1071);
+    let v1073 = p[63] * v1072;
+    let v1074 = 0.5f64 * v872;
+    let v1075 = v1074.mul_add(v1073, p[54]);
+    let v1077 = v858 * v858;
+    let v1078 = (-0.5f64) * v1077;
+    let v1079 = (-v5).mul_add(v11, 2f64);
+    let v1080 = v1078 * v1079;
+    let v1081 = p[80] * v1080;
+    let v1082 = p[9] * v1081;
+    let v1084 = v8.powi(3i32);
+    let v1085 = p[81] * v1084;
+    let v1086 = v1085 * v1078;
+    let v1087 = v338 * v1086;
+    let v1088 = v22.powi(3i32);
+    let v1089 = v384 * v1088;
+    let v1090 = 2f64 * q[1];
+    let v1091 = (-v20).mul_add(v24, 2f64);
+    let v1092 = v393.mul_add(v1091, -v1089);
+    let v1093 = (-v1090).mul_add(v25, v1092);
+    let v1094 = p[57] * v1093;
+    let v1095 = qd[1] * v860;
+    let v1096 = v34.powi(3i32);
+    let v1097 = v427 * v1096;
+    let v1098 = 2f64 * q[2];
+    let v1099 = (-v32).mul_add(v36, 2f64);
+    let v1100 = v436.mul_add(v1099, -v1097);
+    let v1101 = (-v1098).mul_add(v37, v1100);
+    let v1102 = p[58] * v1101;
+    let v1103 = qd[2] * v862;
+    let v1104 = v46.powi(3i32);
+    let v1105 = v476 * v1104;
+    let v1106 = 2f64 * q[3];
+    let v1107 = (-v44).mul_add(v48, 2f64);
+    let v1108 = v485.mul_add(v1107, -v1105);
+    let v1109 = (-v1106).mul_add(v49, v1108);
+    let v1110 = p[59] * v1109;
+    let v1111 = qd[3] * v864;
+    let v1112 = v58.powi(3i32);
+    let v1113 = v532 * v1112;
+    let v1114 = 2f64 * q[4];
+    let v1115 = (-v56).mul_add(v60, 2f64);
+    let v1116 = v541.mul_add(v1115, -v1113);
+    let v1117 = (-v1114).mul_add(v61, v1116);
+    let v1118 = p[60] * v1117;
+    let v1119 = qd[4] * v866;
+    let v1120 = v70.powi(3i32);
+    let v1121 = v596 * v1120;
+    let v1122 = 2f64 * q[5];
+    let v1123 = (-v68).mul_add(v72, 2f64);
+    let v1124 = v605.mul_add(v1123, -v1121);
+    let v1125 = (-v1122).mul_add(v73, v1124);
+    let v1126 = p[61] * v1125;
+    let v1127 = qd[5] * v868;
+    let v1128 = v82.powi(3i32);
+    let v1129 = v669 * v1128;
+    let v1130 = 2f64 * q[6];
+    let v1131 = (-v80).mul_add(v84, 2f64);
+    let v1132 = v678.mul_add(v1131, -v1129);
+    let v1133 = (-v1130).mul_add(v85, v1132);
+    let v1134 = p[62] * v1133;
+    let v1135 = qd[6] * v870;
+    let v1136 = qd[7] * v872;
+    let v1137 = v236 * v1059;
+    let v1138 = v234.mul_add(v1065, -v1137);
+    let v1139 = p[7] * v1138;
+    let v1140 = v212 * v1004;
+    let v1141 = v202.mul_add(v1043, -v1140);
+    let v1142 = v1136.mul_add(v1073, v1139);
+    let v1143 = p[51].mul_add(v1141, v1142);
+    let v1145 = q[6] * v1144;
+    let v1146 = 2f64.mul_add(v678, v1145);
+    let v1147 = p[44] * v1146;
+    let v1148 = v971 * v1147;
+    let v1149 = v967 * v677;
+    let v1150 = v1149 * v965;
+    let v1151 = v965 * v965;
+    let v1152 = v247 * v1151;
+    let v1153 = v1148 + v1150;
+    let v1154 = v1153 - v1152;
+    let v1155 = v82 * v973;
+    let v1156 = v669.mul_add(v669, v1155);
+    let v1157 = p[44] * v1156;
+    let v1158 = v245 * v1151;
+    let v1159 = v967 * v965;
+    let v1160 = v971.mul_add(v1157, -v1158);
+    let v1161 = (-v1159).mul_add(v680, v1160);
+    let v1162 = v182.mul_add(v1154, v1033);
+    let v1163 = v180.mul_add(v1161, v1162);
+    let v1164 = p[82] + v1163;
+    let v1165 = v1152 - v1148;
+    let v1166 = v1165 - v1150;
+    let v1167 = v182.mul_add(v1161, v964);
+    let v1168 = v180.mul_add(v1166, v1167);
+    let v1169 = p[83] + v1168;
+    let v1170 = v251 * v1169;
+    let v1171 = v249.mul_add(v1164, -v1170);
+    let v1172 = v1135.mul_add(v1134, v1143);
+    let v1173 = p[45].mul_add(v1171, v1172);
+    let v1175 = q[5] * v1174;
+    let v1176 = 2f64.mul_add(v605, v1175);
+    let v1177 = p[38] * v1176;
+    let v1178 = v957 * v1177;
+    let v1179 = v953 * v604;
+    let v1180 = v1179 * v951;
+    let v1181 = v951 * v951;
+    let v1182 = v262 * v1181;
+    let v1183 = v1178 + v1180;
+    let v1184 = v1183 - v1182;
+    let v1185 = v70 * v959;
+    let v1186 = v596.mul_add(v596, v1185);
+    let v1187 = p[38] * v1186;
+    let v1188 = v260 * v1181;
+    let v1189 = v953 * v951;
+    let v1190 = v957.mul_add(v1187, -v1188);
+    let v1191 = (-v1189).mul_add(v607, v1190);
+    let v1192 = v169.mul_add(v1184, v1028);
+    let v1193 = v167.mul_add(v1191, v1192);
+    let v1194 = p[82] + v1193;
+    let v1195 = v1182 - v1178;
+    let v1196 = v1195 - v1180;
+    let v1197 = v169.mul_add(v1191, v950);
+    let v1198 = v167.mul_add(v1196, v1197);
+    let v1199 = p[83] + v1198;
+    let v1200 = v266 * v1199;
+    let v1201 = v264.mul_add(v1194, -v1200);
+    let v1202 = v1127.mul_add(v1126, v1173);
+    let v1203 = p[39].mul_add(v1201, v1202);
+    let v1205 = q[4] * v1204;
+    let v1206 = 2f64.mul_add(v541, v1205);
+    let v1207 = p[32] * v1206;
+    let v1208 = v943 * v1207;
+    let v1209 = v939 * v540;
+    let v1210 = v1209 * v937;
+    let v1211 = v937 * v937;
+    let v1212 = v277 * v1211;
+    let v1213 = v1208 + v1210;
+    let v1214 = v1213 - v1212;
+    let v1215 = v58 * v945;
+    let v1216 = v532.mul_add(v532, v1215);
+    let v1217 = p[32] * v1216;
+    let v1218 = v275 * v1211;
+    let v1219 = v939 * v937;
+    let v1220 = v943.mul_add(v1217, -v1218);
+    let v1221 = (-v1219).mul_add(v543, v1220);
+    let v1222 = v156.mul_add(v1214, v1023);
+    let v1223 = v154.mul_add(v1221, v1222);
+    let v1224 = p[82] + v1223;
+    let v1225 = v1212 - v1208;
+    let v1226 = v1225 - v1210;
+    let v1227 = v156.mul_add(v1221, v936);
+    let v1228 = v154.mul_add(v1226, v1227);
+    let v1229 = p[83] + v1228;
+    let v1230 = v281 * v1229;
+    let v1231 = v279.mul_add(v1224, -v1230);
+    let v1232 = v1119.mul_add(v1118, v1203);
+    let v1233 = p[33].mul_add(v1231, v1232);
+    let v1235 = q[3] * v1234;
+    let v1236 = 2f64.mul_add(v485, v1235);
+    let v1237 = p[26] * v1236;
+    let v1238 = v929 * v1237;
+    let v1239 = v925 * v484;
+    let v1240 = v1239 * v923;
+    let v1241 = v923 * v923;
+    let v1242 = v292 * v1241;
+    let v1243 = v1238 + v1240;
+    let v1244 = v1243 - v1242;
+    let v1245 = v46 * v931;
+    let v1246 = v476.mul_add(v476, v1245);
+    let v1247 = p[26] * v1246;
+    let v1248 = v290 * v1241;
+    let v1249 = v925 * v923;
+    let v1250 = v929.mul_add(v1247, -v1248);
+    let v1251 = (-v1249).mul_add(v487, v1250);
+    let v1252 = v143.mul_add(v1244, v1018);
+    let v1253 = v141.mul_add(v1251, v1252);
+    let v1254 = p[82] + v1253;
+    let v1255 = v1242 - v1238;
+    let v1256 = v1255 - v1240;
+    let v1257 = v143.mul_add(v1251, v922);
+    let v1258 = v141.mul_add(v1256, v1257);
+    let v1259 = p[83] + v1258;
+    let v1260 = v296 * v1259;
+    let v1261 = v294.mul_add(v1254, -v1260);
+    let v1262 = v1111.mul_add(v1110, v1233);
+    let v1263 = p[27].mul_add(v1261, v1262);
+    let v1265 = q[2] * v1264;
+    let v1266 = 2f64.mul_add(v436, v1265);
+    let v1267 = p[20] * v1266;
+    let v1268 = v915 * v1267;
+    let v1269 = v911 * v435;
+    let v1270 = v1269 * v909;
+    let v1271 = v909 * v909;
+    let v1272 = v307 * v1271;
+    let v1273 = v1268 + v1270;
+    let v1274 = v1273 - v1272;
+    let v1275 = v34 * v917;
+    let v1276 = v427.mul_add(v427, v1275);
+    let v1277 = p[20] * v1276;
+    let v1278 = v305 * v1271;
+    let v1279 = v911 * v909;
+    let v1280 = v915.mul_add(v1277, -v1278);
+    let v1281 = (-v1279).mul_add(v438, v1280);
+    let v1282 = v130.mul_add(v1274, v1013);
+    let v1283 = v128.mul_add(v1281, v1282);
+    let v1284 = p[82] + v1283;
+    let v1285 = v1272 - v1268;
+    let v1286 = v1285 - v1270;
+    let v1287 = v130.mul_add(v1281, v908);
+    let v1288 = v128.mul_add(v1286, v1287);
+    let v1289 = p[83] + v1288;
+    let v1290 = v311 * v1289;
+    let v1291 = v309.mul_add(v1284, -v1290);
+    let v1292 = v1103.mul_add(v1102, v1263);
+    let v1293 = p[21].mul_add(v1291, v1292);
+    let v1294 = v1007 - v327;
+    let v1295 = v1294 - v328;
+    let v1296 = 2f64 * v117;
+    let v1297 = 2f64 * v115;
+    let v1298 = v1297 * v395;
+    let v1299 = v1296.mul_add(v392, -v1298);
+    let v1300 = qd[1] * v1299;
+    let v1301 = qd[0] * v1300;
+    let v1302 = v22 * v902;
+    let v1303 = v384.mul_add(v384, v1302);
+    let v1304 = p[14] * v1303;
+    let v1306 = q[1] * v1305;
+    let v1307 = 2f64.mul_add(v393, v1306);
+    let v1308 = p[14] * v1307;
+    let v1309 = v117 * v1308;
+    let v1310 = v115.mul_add(v1304, v1309);
+    let v1311 = v889.mul_add(v1295, v1301);
+    let v1312 = v900.mul_add(v1310, v1311);
+    let v1313 = p[82] + v1312;
+    let v1314 = v324 - v321;
+    let v1315 = v1314 + v894;
+    let v1316 = v1296 * v395;
+    let v1317 = v1297.mul_add(v392, v1316);
+    let v1318 = -v1317;
+    let v1319 = qd[1] * v1318;
+    let v1320 = qd[0] * v1319;
+    let v1321 = v115 * v1308;
+    let v1322 = v117.mul_add(v1304, -v1321);
+    let v1323 = v889.mul_add(v1315, v1320);
+    let v1324 = v900.mul_add(v1322, v1323);
+    let v1325 = p[83] + v1324;
+    let v1326 = v330 * v1325;
+    let v1327 = v326.mul_add(v1313, -v1326);
+    let v1328 = v1095.mul_add(v1094, v1293);
+    let v1329 = p[15].mul_add(v1327, v1328);
+    let v1330 = p[7] * v1059;
+    let v1331 = p[51].mul_add(v1004, v1330);
+    let v1332 = p[45].mul_add(v1169, v1331);
+    let v1333 = p[39].mul_add(v1199, v1332);
+    let v1334 = p[33].mul_add(v1229, v1333);
+    let v1335 = p[27].mul_add(v1259, v1334);
+    let v1336 = p[21].mul_add(v1289, v1335);
+    let v1337 = p[15].mul_add(v1325, v1336);
+    let v1338 = p[7] * v1065;
+    let v1339 = p[51].mul_add(v1043, v1338);
+    let v1340 = p[45].mul_add(v1164, v1339);
+    let v1341 = p[39].mul_add(v1194, v1340);
+    let v1342 = p[33].mul_add(v1224, v1341);
+    let v1343 = p[27].mul_add(v1254, v1342);
+    let v1344 = p[21].mul_add(v1284, v1343);
+    let v1345 = p[15].mul_add(v1313, v1344);
+    let v1348 = p[84] + q[0];
+    let v1349 = v8 * v891;
+    let v1350 = v338.mul_add(v338, v1349);
+    let v1351 = p[8] * v1350;
+    let v1353 = q[0] * v1352;
+    let v1354 = 2f64.mul_add(v340, v1353);
+    let v1355 = p[8] * v1354;
+    let v1356 = p[64] * v1355;
+    let v1357 = p[65].mul_add(v1351, -v1356);
+    let v1358 = v889.mul_add(v1357, p[83]);
+    let v1359 = p[65] * v1355;
+    let v1360 = p[64].mul_add(v1351, v1359);
+    let v1361 = v889.mul_add(v1360, p[82]);
+    let v1362 = v344 * v1361;
+    let v1364 = p[85] * q[0];
+    let v1365 = v1364 * v12;
+    let v1366 = v346.mul_add(v1358, v1362);
+    let v1367 = (-v1365).mul_add(v1078, v1366);
+    let v1369 = v338 * v1084;
+    let v1370 = 2f64 * q[0];
+    let v1371 = v340.mul_add(v1079, -v1369);
+    let v1372 = (-v1370).mul_add(v12, v1371);
+    let v1373 = p[56] * v1372;
+    let v1374 = 0.5f64 * v858;
+    let v1375 = v1374.mul_add(v1373, p[12]);
+    let v1376 = v340.mul_add(v1082, v1087);
+    let v1377 = v1376 + v1329;
+    let v1378 = v352.mul_add(v1337, v1377);
+    let v1379 = v366.mul_add(v1345, v1378);
+    let v1380 = p[11].mul_add(v1348, v1379);
+    let v1381 = p[9].mul_add(v1367, v1380);
+    let v1382 = qd[0].mul_add(v1375, v1381);
+    let v1383 = -v1382;
+    let v1385 = v860 * v860;
+    let v1386 = (-0.5f64) * v1385;
+    let v1387 = v1386 * v1091;
+    let v1388 = p[86] * v1387;
+    let v1389 = p[15] * v1388;
+    let v1391 = p[87] * v1088;
+    let v1392 = v1391 * v1386;
+    let v1393 = v384 * v1392;
+    let v1396 = p[88] + q[1];
+    let v1397 = v1313 * v397;
+    let v1399 = p[89] * q[1];
+    let v1400 = v1399 * v25;
+    let v1401 = v1325.mul_add(v399, v1397);
+    let v1402 = (-v1400).mul_add(v1386, v1401);
+    let v1404 = 0.5f64 * v860;
+    let v1405 = v1404.mul_add(v1094, p[18]);
+    let v1406 = v393.mul_add(v1389, v1393);
+    let v1407 = v1406 + v1293;
+    let v1408 = v391.mul_add(v1336, v1407);
+    let v1409 = v388.mul_add(v1344, v1408);
+    let v1410 = p[17].mul_add(v1396, v1409);
+    let v1411 = p[15].mul_add(v1402, v1410);
+    let v1412 = qd[1].mul_add(v1405, v1411);
+    let v1413 = v415.mul_add(v1383, v1412);
+    let v1414 = -v1413;
+    let v1416 = v862 * v862;
+    let v1417 = (-0.5f64) * v1416;
+    let v1418 = v1417 * v1099;
+    let v1419 = p[90] * v1418;
+    let v1420 = p[21] * v1419;
+    let v1422 = p[91] * v1096;
+    let v1423 = v1422 * v1417;
+    let v1424 = v427 * v1423;
+    let v1427 = p[92] + q[2];
+    let v1428 = v1284 * v440;
+    let v1430 = p[93] * q[2];
+    let v1431 = v1430 * v37;
+    let v1432 = v1289.mul_add(v442, v1428);
+    let v1433 = (-v1431).mul_add(v1417, v1432);
+    let v1435 = 0.5f64 * v862;
+    let v1436 = v1435.mul_add(v1102, p[24]);
+    let v1437 = v436.mul_add(v1420, v1424);
+    let v1438 = v1437 + v1263;
+    let v1439 = v434.mul_add(v1335, v1438);
+    let v1440 = v431.mul_add(v1343, v1439);
+    let v1441 = p[23].mul_add(v1427, v1440);
+    let v1442 = p[21].mul_add(v1433, v1441);
+    let v1443 = qd[2].mul_add(v1436, v1442);
+    let v1444 = v466.mul_add(v1383, v1443);
+    let v1445 = v461.mul_add(v1414, v1444);
+    let v1446 = -v1445;
+    let v1448 = v864 * v864;
+    let v1449 = (-0.5f64) * v1448;
+    let v1450 = v1449 * v1107;
+    let v1451 = p[94] * v1450;
+    let v1452 = p[27] * v1451;
+    let v1454 = p[95] * v1104;
+    let v1455 = v1454 * v1449;
+    let v1456 = v476 * v1455;
+    let v1459 = p[96] + q[3];
+    let v1460 = v1254 * v489;
+    let v1462 = p[97] * q[3];
+    let v1463 = v1462 * v49;
+    let v1464 = v1259.mul_add(v491, v1460);
+    let v1465 = (-v1463).mul_add(v1449, v1464);
+    let v1467 = 0.5f64 * v864;
+    let v1468 = v1467.mul_add(v1110, p[30]);
+    let v1469 = v485.mul_add(v1452, v1456);
+    let v1470 = v1469 + v1233;
+    let v1471 = v483.mul_add(v1334, v1470);
+    let v1472 = v480.mul_add(v1342, v1471);
+    let v1473 = p[29].mul_add(v1459, v1472);
+    let v1474 = p[27].mul_add(v1465, v1473);
+    let v1475 = qd[3].mul_add(v1468, v1474);
+    let v1476 = v520.mul_add(v1383, v1475);
+    let v1477 = v521.mul_add(v1414, v1476);
+    let v1478 = v515.mul_add(v1446, v1477);
+    let v1479 = -v1478;
+    let v1481 = v866 * v866;
+    let v1482 = (-0.5f64) * v1481;
+    let v1483 = v1482 * v1115;
+    let v1484 = p[98] * v1483;
+    let v1485 = p[33] * v1484;
+    let v1487 = p[99] * v1112;
+    let v1488 = v1487 * v1482;
+    let v1489 = v532 * v1488;
+    let v1492 = p[100] + q[4];
+    let v1493 = v1224 * v545;
+    let v1495 = p[101] * q[4];
+    let v1496 = v1495 * v61;
+    let v1497 = v1229.mul_add(v547, v1493);
+    let v1498 = (-v1496).mul_add(v1482, v1497);
+    let v1500 = 0.5f64 * v866;
+    let v1501 = v1500.mul_add(v1118, p[36]);
+    let v1502 = v541.mul_add(v1485, v1489);
+    let v1503 = v1502 + v1203;
+    let v1504 = v539.mul_add(v1333, v1503);
+    let v1505 = v536.mul_add(v1341, v1504);
+    let v1506 = p[35].mul_add(v1492, v1505);
+    let v1507 = p[33].mul_add(v1498, v1506);
+    let v1508 = qd[4].mul_add(v1501, v1507);
+    let v1509 = v582.mul_add(v1383, v1508);
+    let v1510 = v583.mul_add(v1414, v1509);
+    let v1511 = v585.mul_add(v1446, v1510);
+    let v1512 = v577.mul_add(v1479, v1511);
+    let v1513 = -v1512;
+    let v1515 = v868 * v868;
+    let v1516 = (-0.5f64) * v1515;
+    let v1517 = v1516 * v1123;
+    let v1518 = p[102] * v1517;
+    let v1519 = p[39] * v1518;
+    let v1521 = p[103] * v1120;
+    let v1522 = v1521 * v1516;
+    let v1523 = v596 * v1522;
+    let v1526 = p[104] + q[5];
+    let v1527 = v1194 * v609;
+    let v1529 = p[105] * q[5];
+    let v1530 = v1529 * v73;
+    let v1531 = v1199.mul_add(v611, v1527);
+    let v1532 = (-v1530).mul_add(v1516, v1531);
+    let v1534 = 0.5f64 * v868;
+    let v1535 = v1534.mul_add(v1126, p[42]);
+    let v1536 = v605.mul_add(v1519, v1523);
+    let v1537 = v1536 + v1173;
+    let v1538 = v603.mul_add(v1332, v1537);
+    let v1539 = v600.mul_add(v1340, v1538);
+    let v1540 = p[41].mul_add(v1526, v1539);
+    let v1541 = p[39].mul_add(v1532, v1540);
+    let v1542 = qd[5].mul_add(v1535, v1541);
+    let v1543 = v653.mul_add(v1383, v1542);
+    let v1544 = v654.mul_add(v1414, v1543);
+    let v1545 = v656.mul_add(v1446, v1544);
+    let v1546 = v657.mul_add(v1479, v1545);
+    let v1547 = v648.mul_add(v1513, v1546);
+    let v1548 = -v1547;
+    let v1550 = v870 * v870;
+    let v1551 = (-0.5f64) * v1550;
+    let v1552 = v1551 * v1131;
+    let v1553 = p[106] * v1552;
+    let v1554 = p[45] * v1553;
+    let v1556 = p[107] * v1128;
+    let v1557 = v1556 * v1551;
+    let v1558 = v669 * v1557;
+    let v1561 = p[108] + q[6];
+    let v1562 = v1164 * v682;
+    let v1564 = p[109] * q[6];
+    let v1565 = v1564 * v85;
+    let v1566 = v1169.mul_add(v684, v1562);
+    let v1567 = (-v1565).mul_add(v1551, v1566);
+    let v1569 = 0.5f64 * v870;
+    let v1570 = v1569.mul_add(v1134, p[48]);
+    let v1571 = v678.mul_add(v1554, v1558);
+    let v1572 = v1571 + v1143;
+    let v1573 = v676.mul_add(v1331, v1572);
+    let v1574 = v673.mul_add(v1339, v1573);
+    let v1575 = p[47].mul_add(v1561, v1574);
+    let v1576 = p[45].mul_add(v1567, v1575);
+    let v1577 = qd[6].mul_add(v1570, v1576);
+    let v1578 = v734.mul_add(v1383, v1577);
+    let v1579 = v735.mul_add(v1414, v1578);
+    let v1580 = v737.mul_add(v1446, v1579);
+    let v1581 = v738.mul_add(v1479, v1580);
+    let v1582 = v739.mul_add(v1513, v1581);
+    let v1583 = v729.mul_add(v1548, v1582);
+    let v1584 = -v1583;
+    let v1585 = v764.mul_add(v879, v884);
+    let v1586 = p[53].mul_add(v887, v1585);
+    let v1587 = p[51].mul_add(v1049, v1586);
+    let v1588 = p[7].mul_add(v1067, v1587);
+    let v1589 = qd[7].mul_add(v1075, v1588);
+    let v1590 = v825.mul_add(v1383, v1589);
+    let v1591 = v826.mul_add(v1414, v1590);
+    let v1592 = v828.mul_add(v1446, v1591);
+    let v1593 = v829.mul_add(v1479, v1592);
+    let v1594 = v830.mul_add(v1513, v1593);
+    let v1595 = v831.mul_add(v1548, v1594);
+    let v1596 = v819.mul_add(v1584, v1595);
+    let v1597 = -v1596;
+    let v1598 = v841 * v1597;
+    let v1599 = v819 * v1598;
+    let v1600 = v750.mul_add(v1584, -v1599);
+    let v1601 = v831 * v1598;
+    let v1602 = v729.mul_add(v1600, v1601);
+    let v1603 = v667.mul_add(v1548, -v1602);
+    let v1604 = v739 * v1600;
+    let v1605 = v648.mul_add(v1603, v1604);
+    let v1606 = v830.mul_add(v1598, v1605);
+    let v1607 = v594.mul_add(v1513, -v1606);
+    let v1608 = v657 * v1603;
+    let v1609 = v577.mul_add(v1607, v1608);
+    let v1610 = v738.mul_add(v1600, v1609);
+    let v1611 = v829.mul_add(v1598, v1610);
+    let v1612 = v530.mul_add(v1479, -v1611);
+    let v1613 = v585 * v1607;
+    let v1614 = v515.mul_add(v1612, v1613);
+    let v1615 = v656.mul_add(v1603, v1614);
+    let v1616 = v737.mul_add(v1600, v1615);
+    let v1617 = v828.mul_add(v1598, v1616);
+    let v1618 = v474.mul_add(v1446, -v1617);
+    let v1619 = v521 * v1612;
+    let v1620 = v461.mul_add(v1618, v1619);
+    let v1621 = v583.mul_add(v1607, v1620);
+    let v1622 = v654.mul_add(v1603, v1621);
+    let v1623 = v735.mul_add(v1600, v1622);
+    let v1624 = v826.mul_add(v1598, v1623);
+    let v1625 = v425.mul_add(v1414, -v1624);
+    let v1626 = v466 * v1618;
+    let v1627 = v415.mul_add(v1625, v1626);
+    let v1628 = v520.mul_add(v1612, v1627);
+    let v1629 = v582.mul_add(v1607, v1628);
+    let v1630 = v653.mul_add(v1603, v1629);
+    let v1631 = v734.mul_add(v1600, v1630);
+    let v1632 = v825.mul_add(v1598, v1631);
+    let v1633 = v382.mul_add(v1383, -v1632);
+    out[0] = v1633;
+    out[1] = v1625;
+    out[2] = v1618;
+    out[3] = v1612;
+    out[4] = v1607;
+    out[5] = v1603;
+    out[6] = v1600;
+    out[7] = v1598;
+    out[8] = v380;
+    out[9] = v424;
+    out[10] = v473;
+    out[11] = v529;
+    out[12] = v593;
+    out[13] = v666;
+    out[14] = v749;
+    out[15] = v840;
+    out[16] = v415;
+    out[17] = v466;
+    out[18] = v461;
+    out[19] = v520;
+    out[20] = v521;
+    out[21] = v515;
+    out[22] = v582;
+    out[23] = v583;
+    out[24] = v585;
+    out[25] = v577;
+    out[26] = v653;
+    out[27] = v654;
+    out[28] = v656;
+    out[29] = v657;
+    out[30] = v648;
+    out[31] = v734;
+    out[32] = v735;
+    out[33] = v737;
+    out[34] = v738;
+    out[35] = v739;
+    out[36] = v729;
+    out[37] = v825;
+    out[38] = v826;
+    out[39] = v828;
+    out[40] = v829;
+    out[41] = v830;
+    out[42] = v831;
+    out[43] = v819;
+    out2[0] = v380;
+    out2[1] = v414;
+    out2[2] = v457;
+    out2[3] = v506;
+    out2[4] = v562;
+    out2[5] = v626;
+    out2[6] = v699;
+    out2[7] = v780;
+    out2[8] = v423;
+    out2[9] = v459;
+    out2[10] = v508;
+    out2[11] = v564;
+    out2[12] = v628;
+    out2[13] = v701;
+    out2[14] = v782;
+    out2[15] = v472;
+    out2[16] = v513;
+    out2[17] = v570;
+    out2[18] = v634;
+    out2[19] = v707;
+    out2[20] = v788;
+    out2[21] = v528;
+    out2[22] = v575;
+    out2[23] = v640;
+    out2[24] = v713;
+    out2[25] = v794;
+    out2[26] = v592;
+    out2[27] = v646;
+    out2[28] = v720;
+    out2[29] = v801;
+    out2[30] = v665;
+    out2[31] = v727;
+    out2[32] = v809;
+    out2[33] = v748;
+    out2[34] = v817;
+    out2[35] = v839;
+    out2[36] = v1382;
+    out2[37] = v1412;
+    out2[38] = v1443;
+    out2[39] = v1475;
+    out2[40] = v1508;
+    out2[41] = v1542;
+    out2[42] = v1577;
+    out2[43] = v1589;
 }
 /// Kernel `derived`: 100 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn derived(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    out: &mut [f64; 85usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    out: &mut [f64; 85],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -1892,209 +1876,209 @@ pub fn derived(
 #[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 85usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    w: &mut [f64; 0],
+    out: &mut [f64; 85],
 ) {
-    let v2: f64 = p[8usize] * p[8usize];
-    let v3: f64 = p[9usize] * v2;
-    let v6: f64 = p[14usize] * p[14usize];
-    let v7: f64 = p[15usize] * v6;
-    let v10: f64 = p[20usize] * p[20usize];
-    let v11: f64 = p[21usize] * v10;
-    let v14: f64 = p[26usize] * p[26usize];
-    let v15: f64 = p[27usize] * v14;
-    let v18: f64 = p[32usize] * p[32usize];
-    let v19: f64 = p[33usize] * v18;
-    let v22: f64 = p[38usize] * p[38usize];
-    let v23: f64 = p[39usize] * v22;
-    let v26: f64 = p[44usize] * p[44usize];
-    let v27: f64 = p[45usize] * v26;
-    let v30: f64 = p[50usize] * p[50usize];
-    let v31: f64 = p[51usize] * v30;
-    let (v33, v34): (f64, f64) = runtime::special::sin_cos(p[6usize]);
-    let v36: f64 = 0.5f64 * p[50usize];
-    let v37: f64 = 0.5f64 * p[44usize];
-    let v38: f64 = 0.5f64 * p[38usize];
-    let v39: f64 = 0.5f64 * p[32usize];
-    let v40: f64 = 0.5f64 * p[26usize];
-    let v41: f64 = 0.5f64 * p[20usize];
-    let v42: f64 = 0.5f64 * p[14usize];
-    let v44: f64 = p[7usize] + p[51usize];
-    let v45: f64 = p[45usize] + v44;
-    let v46: f64 = p[39usize] + v45;
-    let v47: f64 = p[33usize] + v46;
-    let v48: f64 = p[27usize] + v47;
-    let v49: f64 = p[21usize] + v48;
-    let v50: f64 = p[15usize] + v49;
-    let v51: f64 = -v3;
-    let v53: f64 = -p[1usize];
-    let v55: f64 = -p[0usize];
-    let v57: f64 = -p[13usize];
-    let v59: f64 = 2f64 * v2;
-    let v60: f64 = -v7;
-    let v62: f64 = -p[19usize];
-    let v63: f64 = 2f64 * v6;
-    let v64: f64 = -v11;
-    let v66: f64 = -p[25usize];
-    let v67: f64 = 2f64 * v10;
-    let v68: f64 = -v15;
-    let v70: f64 = -p[31usize];
-    let v71: f64 = 2f64 * v14;
-    let v72: f64 = -v19;
-    let v74: f64 = -p[37usize];
-    let v75: f64 = 2f64 * v18;
-    let v76: f64 = -v23;
-    let v78: f64 = -p[43usize];
-    let v79: f64 = 2f64 * v22;
-    let v80: f64 = -v27;
-    let v82: f64 = -p[49usize];
-    let v83: f64 = 2f64 * v26;
-    let v84: f64 = -v31;
-    let v86: f64 = -p[55usize];
-    let v87: f64 = 2f64 * v30;
-    let v89: f64 = 0.5f64 * p[11usize];
-    let v91: f64 = 0.5f64 * p[17usize];
-    let v93: f64 = 0.5f64 * p[23usize];
-    let v95: f64 = 0.5f64 * p[29usize];
-    let v97: f64 = 0.5f64 * p[35usize];
-    let v99: f64 = 0.5f64 * p[41usize];
-    let v101: f64 = 0.5f64 * p[47usize];
-    let v103: f64 = 0.5f64 * p[53usize];
-    let v104: f64 = 0.5f64 * p[8usize];
-    let v107: f64 = p[2usize] * p[5usize];
-    let v108: f64 = 2f64 * p[9usize];
-    let v109: f64 = v108 * v2;
-    let v111: f64 = 4f64 * p[9usize];
-    let v112: f64 = v111 * v2;
-    let v113: f64 = 2f64 * p[15usize];
-    let v114: f64 = v113 * v6;
-    let v115: f64 = 4f64 * p[15usize];
-    let v116: f64 = v115 * v6;
-    let v117: f64 = 2f64 * p[21usize];
-    let v118: f64 = v117 * v10;
-    let v119: f64 = 4f64 * p[21usize];
-    let v120: f64 = v119 * v10;
-    let v121: f64 = 2f64 * p[27usize];
-    let v122: f64 = v121 * v14;
-    let v123: f64 = 4f64 * p[27usize];
-    let v124: f64 = v123 * v14;
-    let v125: f64 = 2f64 * p[33usize];
-    let v126: f64 = v125 * v18;
-    let v127: f64 = 4f64 * p[33usize];
-    let v128: f64 = v127 * v18;
-    let v129: f64 = 2f64 * p[39usize];
-    let v130: f64 = v129 * v22;
-    let v131: f64 = 4f64 * p[39usize];
-    let v132: f64 = v131 * v22;
-    let v133: f64 = 2f64 * p[45usize];
-    let v134: f64 = v133 * v26;
-    let v135: f64 = 4f64 * p[45usize];
-    let v136: f64 = v135 * v26;
-    let v137: f64 = 2f64 * p[51usize];
-    let v138: f64 = v137 * v30;
-    let v139: f64 = 4f64 * p[51usize];
-    let v140: f64 = v139 * v30;
-    out[0usize] = v3;
-    out[1usize] = v7;
-    out[2usize] = v11;
-    out[3usize] = v15;
-    out[4usize] = v19;
-    out[5usize] = v23;
-    out[6usize] = v27;
-    out[7usize] = v31;
-    out[8usize] = v33;
-    out[9usize] = v34;
-    out[10usize] = v36;
-    out[11usize] = v37;
-    out[12usize] = v38;
-    out[13usize] = v39;
-    out[14usize] = v40;
-    out[15usize] = v41;
-    out[16usize] = v42;
-    out[17usize] = v50;
-    out[18usize] = v49;
-    out[19usize] = v48;
-    out[20usize] = v47;
-    out[21usize] = v46;
-    out[22usize] = v45;
-    out[23usize] = v44;
-    out[24usize] = v2;
-    out[25usize] = v51;
-    out[26usize] = v53;
-    out[27usize] = v55;
-    out[28usize] = v57;
-    out[29usize] = v59;
-    out[30usize] = v6;
-    out[31usize] = v60;
-    out[32usize] = v62;
-    out[33usize] = v63;
-    out[34usize] = v10;
-    out[35usize] = v64;
-    out[36usize] = v66;
-    out[37usize] = v67;
-    out[38usize] = v14;
-    out[39usize] = v68;
-    out[40usize] = v70;
-    out[41usize] = v71;
-    out[42usize] = v18;
-    out[43usize] = v72;
-    out[44usize] = v74;
-    out[45usize] = v75;
-    out[46usize] = v22;
-    out[47usize] = v76;
-    out[48usize] = v78;
-    out[49usize] = v79;
-    out[50usize] = v26;
-    out[51usize] = v80;
-    out[52usize] = v82;
-    out[53usize] = v83;
-    out[54usize] = v30;
-    out[55usize] = v84;
-    out[56usize] = v86;
-    out[57usize] = v87;
-    out[58usize] = v89;
-    out[59usize] = v91;
-    out[60usize] = v93;
-    out[61usize] = v95;
-    out[62usize] = v97;
-    out[63usize] = v99;
-    out[64usize] = v101;
-    out[65usize] = v103;
-    out[66usize] = v104;
-    out[67usize] = v107;
-    out[68usize] = v109;
-    out[69usize] = v112;
-    out[70usize] = v108;
-    out[71usize] = v114;
-    out[72usize] = v116;
-    out[73usize] = v118;
-    out[74usize] = v120;
-    out[75usize] = v122;
-    out[76usize] = v124;
-    out[77usize] = v126;
-    out[78usize] = v128;
-    out[79usize] = v130;
-    out[80usize] = v132;
-    out[81usize] = v134;
-    out[82usize] = v136;
-    out[83usize] = v138;
-    out[84usize] = v140;
+    let v2 = p[8] * p[8];
+    let v3 = p[9] * v2;
+    let v6 = p[14] * p[14];
+    let v7 = p[15] * v6;
+    let v10 = p[20] * p[20];
+    let v11 = p[21] * v10;
+    let v14 = p[26] * p[26];
+    let v15 = p[27] * v14;
+    let v18 = p[32] * p[32];
+    let v19 = p[33] * v18;
+    let v22 = p[38] * p[38];
+    let v23 = p[39] * v22;
+    let v26 = p[44] * p[44];
+    let v27 = p[45] * v26;
+    let v30 = p[50] * p[50];
+    let v31 = p[51] * v30;
+    let (v33, v34): (f64, f64) = runtime::special::sin_cos(p[6]);
+    let v36 = 0.5f64 * p[50];
+    let v37 = 0.5f64 * p[44];
+    let v38 = 0.5f64 * p[38];
+    let v39 = 0.5f64 * p[32];
+    let v40 = 0.5f64 * p[26];
+    let v41 = 0.5f64 * p[20];
+    let v42 = 0.5f64 * p[14];
+    let v44 = p[7] + p[51];
+    let v45 = p[45] + v44;
+    let v46 = p[39] + v45;
+    let v47 = p[33] + v46;
+    let v48 = p[27] + v47;
+    let v49 = p[21] + v48;
+    let v50 = p[15] + v49;
+    let v51 = -v3;
+    let v53 = -p[1];
+    let v55 = -p[0];
+    let v57 = -p[13];
+    let v59 = 2f64 * v2;
+    let v60 = -v7;
+    let v62 = -p[19];
+    let v63 = 2f64 * v6;
+    let v64 = -v11;
+    let v66 = -p[25];
+    let v67 = 2f64 * v10;
+    let v68 = -v15;
+    let v70 = -p[31];
+    let v71 = 2f64 * v14;
+    let v72 = -v19;
+    let v74 = -p[37];
+    let v75 = 2f64 * v18;
+    let v76 = -v23;
+    let v78 = -p[43];
+    let v79 = 2f64 * v22;
+    let v80 = -v27;
+    let v82 = -p[49];
+    let v83 = 2f64 * v26;
+    let v84 = -v31;
+    let v86 = -p[55];
+    let v87 = 2f64 * v30;
+    let v89 = 0.5f64 * p[11];
+    let v91 = 0.5f64 * p[17];
+    let v93 = 0.5f64 * p[23];
+    let v95 = 0.5f64 * p[29];
+    let v97 = 0.5f64 * p[35];
+    let v99 = 0.5f64 * p[41];
+    let v101 = 0.5f64 * p[47];
+    let v103 = 0.5f64 * p[53];
+    let v104 = 0.5f64 * p[8];
+    let v107 = p[2] * p[5];
+    let v108 = 2f64 * p[9];
+    let v109 = v108 * v2;
+    let v111 = 4f64 * p[9];
+    let v112 = v111 * v2;
+    let v113 = 2f64 * p[15];
+    let v114 = v113 * v6;
+    let v115 = 4f64 * p[15];
+    let v116 = v115 * v6;
+    let v117 = 2f64 * p[21];
+    let v118 = v117 * v10;
+    let v119 = 4f64 * p[21];
+    let v120 = v119 * v10;
+    let v121 = 2f64 * p[27];
+    let v122 = v121 * v14;
+    let v123 = 4f64 * p[27];
+    let v124 = v123 * v14;
+    let v125 = 2f64 * p[33];
+    let v126 = v125 * v18;
+    let v127 = 4f64 * p[33];
+    let v128 = v127 * v18;
+    let v129 = 2f64 * p[39];
+    let v130 = v129 * v22;
+    let v131 = 4f64 * p[39];
+    let v132 = v131 * v22;
+    let v133 = 2f64 * p[45];
+    let v134 = v133 * v26;
+    let v135 = 4f64 * p[45];
+    let v136 = v135 * v26;
+    let v137 = 2f64 * p[51];
+    let v138 = v137 * v30;
+    let v139 = 4f64 * p[51];
+    let v140 = v139 * v30;
+    out[0] = v3;
+    out[1] = v7;
+    out[2] = v11;
+    out[3] = v15;
+    out[4] = v19;
+    out[5] = v23;
+    out[6] = v27;
+    out[7] = v31;
+    out[8] = v33;
+    out[9] = v34;
+    out[10] = v36;
+    out[11] = v37;
+    out[12] = v38;
+    out[13] = v39;
+    out[14] = v40;
+    out[15] = v41;
+    out[16] = v42;
+    out[17] = v50;
+    out[18] = v49;
+    out[19] = v48;
+    out[20] = v47;
+    out[21] = v46;
+    out[22] = v45;
+    out[23] = v44;
+    out[24] = v2;
+    out[25] = v51;
+    out[26] = v53;
+    out[27] = v55;
+    out[28] = v57;
+    out[29] = v59;
+    out[30] = v6;
+    out[31] = v60;
+    out[32] = v62;
+    out[33] = v63;
+    out[34] = v10;
+    out[35] = v64;
+    out[36] = v66;
+    out[37] = v67;
+    out[38] = v14;
+    out[39] = v68;
+    out[40] = v70;
+    out[41] = v71;
+    out[42] = v18;
+    out[43] = v72;
+    out[44] = v74;
+    out[45] = v75;
+    out[46] = v22;
+    out[47] = v76;
+    out[48] = v78;
+    out[49] = v79;
+    out[50] = v26;
+    out[51] = v80;
+    out[52] = v82;
+    out[53] = v83;
+    out[54] = v30;
+    out[55] = v84;
+    out[56] = v86;
+    out[57] = v87;
+    out[58] = v89;
+    out[59] = v91;
+    out[60] = v93;
+    out[61] = v95;
+    out[62] = v97;
+    out[63] = v99;
+    out[64] = v101;
+    out[65] = v103;
+    out[66] = v104;
+    out[67] = v107;
+    out[68] = v109;
+    out[69] = v112;
+    out[70] = v108;
+    out[71] = v114;
+    out[72] = v116;
+    out[73] = v118;
+    out[74] = v120;
+    out[75] = v122;
+    out[76] = v124;
+    out[77] = v126;
+    out[78] = v128;
+    out[79] = v130;
+    out[80] = v132;
+    out[81] = v134;
+    out[82] = v136;
+    out[83] = v138;
+    out[84] = v140;
 }
 /// Kernel `constraints`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn constraints(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2105,24 +2089,24 @@ pub fn constraints(
 #[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2133,36 +2117,36 @@ pub fn contact(
 #[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jacobian`: the points' positions, velocities and Jacobians in 0 groups; group g runs when `all` or `dir[g] != 0`.
 #[allow(unused_variables)]
 pub fn contact_jacobian(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
     all: bool,
-    p: &[f64; 141usize],
-    out: &mut [f64; 0usize],
+    p: &[f64; 141],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jvp`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact_jvp(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2173,13 +2157,13 @@ pub fn contact_jvp(
 #[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
@@ -2192,16 +2176,16 @@ static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyL
 #[allow(unused_variables)]
 pub fn jvp(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    out: &mut [f64; 8usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    out: &mut [f64; 8],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
-    let mut tau = [0.0; 8usize];
+    let mut tau = [0.0; 8];
     runtime::links::inverse_dynamics_tangent(
         &LINKS,
         &mut cells,
@@ -2218,12 +2202,12 @@ pub fn jvp(
 #[allow(unused_variables)]
 pub fn outputs(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 141usize],
-    out: &mut [f64; 9usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 141],
+    out: &mut [f64; 9],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
@@ -2232,21 +2216,21 @@ pub fn outputs(
 /// The compiled cells and forces the link recursion evaluates.
 #[allow(dead_code)]
 struct LinkCells<'a> {
-    q: &'a [f64; 8usize],
-    qd: &'a [f64; 8usize],
-    p: &'a [f64; 141usize],
+    q: &'a [f64; 8],
+    qd: &'a [f64; 8],
+    p: &'a [f64; 141],
 }
 impl runtime::links::Cells for LinkCells<'_> {
     #[inline(always)]
     fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
-                    &[0.0; 2usize],
+                    &[0.0; 1],
+                    &[0.0; 2],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs"),
                 )
@@ -2270,15 +2254,15 @@ impl runtime::links::Cells for LinkCells<'_> {
         out: &mut [f64],
     ) {
         match c {
-            0usize => {
-                let mut dir = [0.0; 2usize];
-                dir[..1usize].copy_from_slice(dx);
-                dir[1usize..].copy_from_slice(dxd);
+            0 => {
+                let mut dir = [0.0; 2];
+                dir[..1].copy_from_slice(dx);
+                dir[1..].copy_from_slice(dxd);
                 cell_0_tangent(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
+                    &[0.0; 1],
                     &dir,
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs and derivatives"),
@@ -2298,13 +2282,13 @@ impl runtime::links::Cells for LinkCells<'_> {
     }
     fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0_pose(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 1usize],
-                    &[0.0; 2usize],
+                    &[0.0; 1],
+                    &[0.0; 2],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("pose outputs"),
                 )
@@ -2320,12 +2304,12 @@ impl runtime::links::Cells for LinkCells<'_> {
 #[allow(unused_unsafe)]
 pub fn cell_0_pose(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 38],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2336,112 +2320,110 @@ pub fn cell_0_pose(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 38],
 ) {
-    let v2: f64 = 0.5f64 * q[0usize];
-    let v3: f64 = v2 + v2;
+    let v2 = 0.5f64 * q[0];
+    let v3 = v2 + v2;
     let (v5, v4): (f64, f64) = runtime::special::sin_cos(v3);
-    let v6: f64 = -v5;
-    let [v10, v17]: [f64; 2usize] = runtime::special::sinc_orders::<2usize>(v2);
+    let v6 = -v5;
+    let [v10, v17]: [f64; 2] = runtime::special::sinc_orders::<2>(v2);
     let (v14, v11): (f64, f64) = runtime::special::sin_cos(v2);
-    let v12: f64 = p[0usize] * v10;
-    let v13: f64 = v12 * v11;
-    let v15: f64 = v12 * v14;
-    let v18: f64 = 0.5f64 * v17;
-    let v19: f64 = 0.5f64 * v10;
-    let v20: f64 = v19 * v14;
-    let v21: f64 = v11.mul_add(v18, -v20);
-    let v22: f64 = p[0usize] * v21;
-    let v23: f64 = qd[0usize] * v22;
-    let v24: f64 = v19 * v11;
-    let v25: f64 = v14.mul_add(v18, v24);
-    let v26: f64 = p[0usize] * v25;
-    let v27: f64 = qd[0usize] * v26;
-    let v28: f64 = 0.5f64 * qd[0usize];
-    let v29: f64 = v28 + v28;
-    let v30: f64 = v10 * v10;
-    let v31: f64 = 0.5f64 * p[0usize];
-    let v32: f64 = v31 * v30;
-    let [v33, v38]: [f64; 2usize] = runtime::special::sinc_rem_orders::<
-        2usize,
-    >(q[0usize]);
-    let v34: f64 = q[0usize] * p[0usize];
-    let v35: f64 = v34 * v33;
-    let v36: f64 = v12 * v18;
-    let v37: f64 = qd[0usize] * v36;
-    let v39: f64 = q[0usize].mul_add(v38, v33);
-    let v40: f64 = p[0usize] * v39;
-    let v41: f64 = qd[0usize] * v40;
-    let v45: f64 = v10.powi(4i32);
-    let v47: f64 = 0.25f64 * v45;
-    let v48: f64 = q[0usize] * q[0usize];
-    let v49: f64 = v33 * v33;
-    let v50: f64 = 2f64.mul_add(v33, -v47);
-    let v51: f64 = (-v48).mul_add(v49, v50);
-    let v52: f64 = p[0usize] * p[0usize];
-    let v53: f64 = p[1usize] * v51;
-    let v54: f64 = v53.mul_add(v52, p[2usize]);
-    let v55: f64 = 0.5f64 * v3;
+    let v12 = p[0] * v10;
+    let v13 = v12 * v11;
+    let v15 = v12 * v14;
+    let v18 = 0.5f64 * v17;
+    let v19 = 0.5f64 * v10;
+    let v20 = v19 * v14;
+    let v21 = v11.mul_add(v18, -v20);
+    let v22 = p[0] * v21;
+    let v23 = qd[0] * v22;
+    let v24 = v19 * v11;
+    let v25 = v14.mul_add(v18, v24);
+    let v26 = p[0] * v25;
+    let v27 = qd[0] * v26;
+    let v28 = 0.5f64 * qd[0];
+    let v29 = v28 + v28;
+    let v30 = v10 * v10;
+    let v31 = 0.5f64 * p[0];
+    let v32 = v31 * v30;
+    let [v33, v38]: [f64; 2] = runtime::special::sinc_rem_orders::<2>(q[0]);
+    let v34 = q[0] * p[0];
+    let v35 = v34 * v33;
+    let v36 = v12 * v18;
+    let v37 = qd[0] * v36;
+    let v39 = q[0].mul_add(v38, v33);
+    let v40 = p[0] * v39;
+    let v41 = qd[0] * v40;
+    let v45 = v10.powi(4i32);
+    let v47 = 0.25f64 * v45;
+    let v48 = q[0] * q[0];
+    let v49 = v33 * v33;
+    let v50 = 2f64.mul_add(v33, -v47);
+    let v51 = (-v48).mul_add(v49, v50);
+    let v52 = p[0] * p[0];
+    let v53 = p[1] * v51;
+    let v54 = v53.mul_add(v52, p[2]);
+    let v55 = 0.5f64 * v3;
     let (v57, v56): (f64, f64) = runtime::special::sin_cos(v55);
-    let v60: f64 = q[0usize] - p[6usize];
-    let v61: f64 = v60 * v60;
-    let v62: f64 = 0.5f64 * p[4usize];
-    let v63: f64 = v62 * v61;
-    out[0usize] = v4;
-    out[1usize] = v6;
-    out[2usize] = 0f64;
-    out[3usize] = v5;
-    out[4usize] = v4;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v13;
-    out[10usize] = v15;
-    out[11usize] = 0f64;
-    out[12usize] = v23;
-    out[13usize] = v27;
-    out[14usize] = 0f64;
-    out[15usize] = 0f64;
-    out[16usize] = 0f64;
-    out[17usize] = v29;
-    out[18usize] = v32;
-    out[19usize] = v35;
-    out[20usize] = 0f64;
-    out[21usize] = v37;
-    out[22usize] = v41;
-    out[23usize] = 0f64;
-    out[24usize] = 0f64;
-    out[25usize] = 0f64;
-    out[26usize] = v28;
-    out[27usize] = 1f64;
-    out[28usize] = 0f64;
-    out[29usize] = 0f64;
-    out[30usize] = p[1usize];
-    out[31usize] = v54;
-    out[32usize] = v54;
-    out[33usize] = v56;
-    out[34usize] = 0f64;
-    out[35usize] = 0f64;
-    out[36usize] = v57;
-    out[37usize] = v63;
+    let v60 = q[0] - p[6];
+    let v61 = v60 * v60;
+    let v62 = 0.5f64 * p[4];
+    let v63 = v62 * v61;
+    out[0] = v4;
+    out[1] = v6;
+    out[2] = 0f64;
+    out[3] = v5;
+    out[4] = v4;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v13;
+    out[10] = v15;
+    out[11] = 0f64;
+    out[12] = v23;
+    out[13] = v27;
+    out[14] = 0f64;
+    out[15] = 0f64;
+    out[16] = 0f64;
+    out[17] = v29;
+    out[18] = v32;
+    out[19] = v35;
+    out[20] = 0f64;
+    out[21] = v37;
+    out[22] = v41;
+    out[23] = 0f64;
+    out[24] = 0f64;
+    out[25] = 0f64;
+    out[26] = v28;
+    out[27] = 1f64;
+    out[28] = 0f64;
+    out[29] = 0f64;
+    out[30] = p[1];
+    out[31] = v54;
+    out[32] = v54;
+    out[33] = v56;
+    out[34] = 0f64;
+    out[35] = 0f64;
+    out[36] = v57;
+    out[37] = v63;
 }
 /// Kernel `cell_0`: 90 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 59usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 59],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2452,155 +2434,153 @@ pub fn cell_0(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 59usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 59],
 ) {
-    let v2: f64 = 0.5f64 * q[0usize];
-    let v3: f64 = v2 + v2;
+    let v2 = 0.5f64 * q[0];
+    let v3 = v2 + v2;
     let (v5, v4): (f64, f64) = runtime::special::sin_cos(v3);
-    let v6: f64 = -v5;
-    let [v10, v17, v30]: [f64; 3usize] = runtime::special::sinc_orders::<3usize>(v2);
+    let v6 = -v5;
+    let [v10, v17, v30]: [f64; 3] = runtime::special::sinc_orders::<3>(v2);
     let (v14, v11): (f64, f64) = runtime::special::sin_cos(v2);
-    let v12: f64 = p[0usize] * v10;
-    let v13: f64 = v12 * v11;
-    let v15: f64 = v12 * v14;
-    let v18: f64 = 0.5f64 * v17;
-    let v19: f64 = v11 * v18;
-    let v20: f64 = 0.5f64 * v10;
-    let v21: f64 = (-v20).mul_add(v14, v19);
-    let v22: f64 = p[0usize] * v21;
-    let v23: f64 = qd[0usize] * v22;
-    let v24: f64 = v14 * v18;
-    let v25: f64 = v20.mul_add(v11, v24);
-    let v26: f64 = p[0usize] * v25;
-    let v27: f64 = qd[0usize] * v26;
-    let v28: f64 = qd[0usize] * qd[0usize];
-    let v31: f64 = 0.25f64 * v30;
-    let v32: f64 = (-0.25f64).mul_add(v10, v31);
-    let v33: f64 = v11.mul_add(v32, -v24);
-    let v34: f64 = p[0usize] * v33;
-    let v35: f64 = v28 * v34;
-    let v36: f64 = v14.mul_add(v32, v19);
-    let v37: f64 = p[0usize] * v36;
-    let v38: f64 = v28 * v37;
-    let v39: f64 = 0.5f64 * qd[0usize];
-    let v40: f64 = v39 + v39;
-    let v41: f64 = v10 * v10;
-    let v42: f64 = 0.5f64 * p[0usize];
-    let v43: f64 = v42 * v41;
-    let [v44, v49, v58]: [f64; 3usize] = runtime::special::sinc_rem_orders::<
-        3usize,
-    >(q[0usize]);
-    let v45: f64 = q[0usize] * p[0usize];
-    let v46: f64 = v45 * v44;
-    let v47: f64 = v12 * v18;
-    let v48: f64 = qd[0usize] * v47;
-    let v50: f64 = q[0usize].mul_add(v49, v44);
-    let v51: f64 = p[0usize] * v50;
-    let v52: f64 = qd[0usize] * v51;
-    let v53: f64 = v10 * v31;
-    let v54: f64 = v18.mul_add(v18, v53);
-    let v55: f64 = p[0usize] * v54;
-    let v56: f64 = v28 * v55;
-    let v59: f64 = q[0usize] * v58;
-    let v60: f64 = 2f64.mul_add(v49, v59);
-    let v61: f64 = p[0usize] * v60;
-    let v62: f64 = v28 * v61;
-    let v65: f64 = 2f64 * v44;
-    let v66: f64 = v10.powi(4i32);
-    let v67: f64 = q[0usize] * q[0usize];
-    let v68: f64 = v44 * v44;
-    let v69: f64 = (-0.25f64).mul_add(v66, v65);
-    let v70: f64 = (-v67).mul_add(v68, v69);
-    let v71: f64 = p[0usize] * p[0usize];
-    let v72: f64 = p[1usize] * v70;
-    let v73: f64 = v72.mul_add(v71, p[2usize]);
-    let v76: f64 = q[0usize] - p[6usize];
-    let v78: f64 = qd[0usize] * p[5usize];
-    let v79: f64 = p[4usize].mul_add(v76, v78);
-    let v80: f64 = v10.powi(3i32);
-    let v81: f64 = v18 * v80;
-    let v82: f64 = 2f64 * q[0usize];
-    let v83: f64 = (-v65).mul_add(v67, 2f64);
-    let v84: f64 = v49.mul_add(v83, -v81);
-    let v85: f64 = (-v82).mul_add(v68, v84);
-    let v86: f64 = p[1usize] * v71;
-    let v87: f64 = v86 * v85;
-    out[0usize] = v4;
-    out[1usize] = v6;
-    out[2usize] = 0f64;
-    out[3usize] = v5;
-    out[4usize] = v4;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v13;
-    out[10usize] = v15;
-    out[11usize] = 0f64;
-    out[12usize] = v23;
-    out[13usize] = v27;
-    out[14usize] = 0f64;
-    out[15usize] = v35;
-    out[16usize] = v38;
-    out[17usize] = 0f64;
-    out[18usize] = 0f64;
-    out[19usize] = 0f64;
-    out[20usize] = v40;
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = v43;
-    out[25usize] = v46;
-    out[26usize] = 0f64;
-    out[27usize] = v48;
-    out[28usize] = v52;
-    out[29usize] = 0f64;
-    out[30usize] = v56;
-    out[31usize] = v62;
-    out[32usize] = 0f64;
-    out[33usize] = 0f64;
-    out[34usize] = 0f64;
-    out[35usize] = v39;
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
-    out[38usize] = 0f64;
-    out[39usize] = 1f64;
-    out[40usize] = 0f64;
-    out[41usize] = 0f64;
-    out[42usize] = p[1usize];
-    out[43usize] = v73;
-    out[44usize] = v73;
-    out[45usize] = 0f64;
-    out[46usize] = 0f64;
-    out[47usize] = 1f64;
-    out[48usize] = v22;
-    out[49usize] = v26;
-    out[50usize] = 0f64;
-    out[51usize] = 0f64;
-    out[52usize] = 0f64;
-    out[53usize] = 0.5f64;
-    out[54usize] = v47;
-    out[55usize] = v51;
-    out[56usize] = 0f64;
-    out[57usize] = v79;
-    out[58usize] = v87;
+    let v12 = p[0] * v10;
+    let v13 = v12 * v11;
+    let v15 = v12 * v14;
+    let v18 = 0.5f64 * v17;
+    let v19 = v11 * v18;
+    let v20 = 0.5f64 * v10;
+    let v21 = (-v20).mul_add(v14, v19);
+    let v22 = p[0] * v21;
+    let v23 = qd[0] * v22;
+    let v24 = v14 * v18;
+    let v25 = v20.mul_add(v11, v24);
+    let v26 = p[0] * v25;
+    let v27 = qd[0] * v26;
+    let v28 = qd[0] * qd[0];
+    let v31 = 0.25f64 * v30;
+    let v32 = (-0.25f64).mul_add(v10, v31);
+    let v33 = v11.mul_add(v32, -v24);
+    let v34 = p[0] * v33;
+    let v35 = v28 * v34;
+    let v36 = v14.mul_add(v32, v19);
+    let v37 = p[0] * v36;
+    let v38 = v28 * v37;
+    let v39 = 0.5f64 * qd[0];
+    let v40 = v39 + v39;
+    let v41 = v10 * v10;
+    let v42 = 0.5f64 * p[0];
+    let v43 = v42 * v41;
+    let [v44, v49, v58]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[0]);
+    let v45 = q[0] * p[0];
+    let v46 = v45 * v44;
+    let v47 = v12 * v18;
+    let v48 = qd[0] * v47;
+    let v50 = q[0].mul_add(v49, v44);
+    let v51 = p[0] * v50;
+    let v52 = qd[0] * v51;
+    let v53 = v10 * v31;
+    let v54 = v18.mul_add(v18, v53);
+    let v55 = p[0] * v54;
+    let v56 = v28 * v55;
+    let v59 = q[0] * v58;
+    let v60 = 2f64.mul_add(v49, v59);
+    let v61 = p[0] * v60;
+    let v62 = v28 * v61;
+    let v65 = 2f64 * v44;
+    let v66 = v10.powi(4i32);
+    let v67 = q[0] * q[0];
+    let v68 = v44 * v44;
+    let v69 = (-0.25f64).mul_add(v66, v65);
+    let v70 = (-v67).mul_add(v68, v69);
+    let v71 = p[0] * p[0];
+    let v72 = p[1] * v70;
+    let v73 = v72.mul_add(v71, p[2]);
+    let v76 = q[0] - p[6];
+    let v78 = qd[0] * p[5];
+    let v79 = p[4].mul_add(v76, v78);
+    let v80 = v10.powi(3i32);
+    let v81 = v18 * v80;
+    let v82 = 2f64 * q[0];
+    let v83 = (-v65).mul_add(v67, 2f64);
+    let v84 = v49.mul_add(v83, -v81);
+    let v85 = (-v82).mul_add(v68, v84);
+    let v86 = p[1] * v71;
+    let v87 = v86 * v85;
+    out[0] = v4;
+    out[1] = v6;
+    out[2] = 0f64;
+    out[3] = v5;
+    out[4] = v4;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v13;
+    out[10] = v15;
+    out[11] = 0f64;
+    out[12] = v23;
+    out[13] = v27;
+    out[14] = 0f64;
+    out[15] = v35;
+    out[16] = v38;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = v40;
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = v43;
+    out[25] = v46;
+    out[26] = 0f64;
+    out[27] = v48;
+    out[28] = v52;
+    out[29] = 0f64;
+    out[30] = v56;
+    out[31] = v62;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = v39;
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 1f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = p[1];
+    out[43] = v73;
+    out[44] = v73;
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 1f64;
+    out[48] = v22;
+    out[49] = v26;
+    out[50] = 0f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 0.5f64;
+    out[54] = v47;
+    out[55] = v51;
+    out[56] = 0f64;
+    out[57] = v79;
+    out[58] = v87;
 }
 /// Kernel `cell_0_tangent`: 188 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0_tangent(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 118usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    out: &mut [f64; 118],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2611,281 +2591,277 @@ pub fn cell_0_tangent(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
-    q: &[f64; 1usize],
-    qd: &[f64; 1usize],
-    qdd: &[f64; 1usize],
-    dir: &[f64; 2usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 118usize],
+    q: &[f64; 1],
+    qd: &[f64; 1],
+    qdd: &[f64; 1],
+    dir: &[f64; 2],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 118],
 ) {
-    let v2: f64 = 0.5f64 * q[0usize];
-    let v3: f64 = v2 + v2;
+    let v2 = 0.5f64 * q[0];
+    let v3 = v2 + v2;
     let (v5, v4): (f64, f64) = runtime::special::sin_cos(v3);
-    let v6: f64 = -v5;
-    let [v10, v17, v30, v103]: [f64; 4usize] = runtime::special::sinc_orders::<
-        4usize,
-    >(v2);
+    let v6 = -v5;
+    let [v10, v17, v30, v103]: [f64; 4] = runtime::special::sinc_orders::<4>(v2);
     let (v14, v11): (f64, f64) = runtime::special::sin_cos(v2);
-    let v12: f64 = p[0usize] * v10;
-    let v13: f64 = v12 * v11;
-    let v15: f64 = v12 * v14;
-    let v18: f64 = 0.5f64 * v17;
-    let v19: f64 = v11 * v18;
-    let v20: f64 = 0.5f64 * v10;
-    let v21: f64 = (-v20).mul_add(v14, v19);
-    let v22: f64 = p[0usize] * v21;
-    let v23: f64 = qd[0usize] * v22;
-    let v24: f64 = v14 * v18;
-    let v25: f64 = v20.mul_add(v11, v24);
-    let v26: f64 = p[0usize] * v25;
-    let v27: f64 = qd[0usize] * v26;
-    let v28: f64 = qd[0usize] * qd[0usize];
-    let v31: f64 = 0.25f64 * v30;
-    let v32: f64 = (-0.25f64).mul_add(v10, v31);
-    let v33: f64 = v11.mul_add(v32, -v24);
-    let v34: f64 = p[0usize] * v33;
-    let v35: f64 = v28 * v34;
-    let v36: f64 = v14.mul_add(v32, v19);
-    let v37: f64 = p[0usize] * v36;
-    let v38: f64 = v28 * v37;
-    let v39: f64 = 0.5f64 * qd[0usize];
-    let v40: f64 = v39 + v39;
-    let v41: f64 = v10 * v10;
-    let v42: f64 = 0.5f64 * p[0usize];
-    let v43: f64 = v42 * v41;
-    let [v44, v49, v58, v142]: [f64; 4usize] = runtime::special::sinc_rem_orders::<
-        4usize,
-    >(q[0usize]);
-    let v45: f64 = q[0usize] * p[0usize];
-    let v46: f64 = v45 * v44;
-    let v47: f64 = v12 * v18;
-    let v48: f64 = qd[0usize] * v47;
-    let v50: f64 = q[0usize].mul_add(v49, v44);
-    let v51: f64 = p[0usize] * v50;
-    let v52: f64 = qd[0usize] * v51;
-    let v53: f64 = v18 * v18;
-    let v54: f64 = v10.mul_add(v31, v53);
-    let v55: f64 = p[0usize] * v54;
-    let v56: f64 = v28 * v55;
-    let v59: f64 = q[0usize] * v58;
-    let v60: f64 = 2f64.mul_add(v49, v59);
-    let v61: f64 = p[0usize] * v60;
-    let v62: f64 = v28 * v61;
-    let v65: f64 = 2f64 * v44;
-    let v66: f64 = v10.powi(4i32);
-    let v67: f64 = q[0usize] * q[0usize];
-    let v68: f64 = v44 * v44;
-    let v69: f64 = (-0.25f64).mul_add(v66, v65);
-    let v70: f64 = (-v67).mul_add(v68, v69);
-    let v71: f64 = p[0usize] * p[0usize];
-    let v72: f64 = p[1usize] * v70;
-    let v73: f64 = v72.mul_add(v71, p[2usize]);
-    let v76: f64 = q[0usize] - p[6usize];
-    let v78: f64 = qd[0usize] * p[5usize];
-    let v79: f64 = p[4usize].mul_add(v76, v78);
-    let v80: f64 = v10.powi(3i32);
-    let v81: f64 = v18 * v80;
-    let v82: f64 = 2f64 * q[0usize];
-    let v83: f64 = (-v65).mul_add(v67, 2f64);
-    let v84: f64 = v49.mul_add(v83, -v81);
-    let v85: f64 = (-v82).mul_add(v68, v84);
-    let v86: f64 = p[1usize] * v71;
-    let v87: f64 = v86 * v85;
-    let v89: f64 = v5 * dir[0usize];
-    let v90: f64 = -v89;
-    let v91: f64 = v4 * dir[0usize];
-    let v92: f64 = -v91;
-    let v93: f64 = v22 * dir[0usize];
-    let v94: f64 = v26 * dir[0usize];
-    let v96: f64 = qd[0usize] * v34;
-    let v97: f64 = v96 * dir[0usize];
-    let v98: f64 = v22.mul_add(dir[1usize], v97);
-    let v99: f64 = qd[0usize] * v37;
-    let v100: f64 = v99 * dir[0usize];
-    let v101: f64 = v26.mul_add(dir[1usize], v100);
-    let v105: f64 = 0.125f64 * v103;
-    let v106: f64 = (-0.75f64).mul_add(v18, v105);
-    let v107: f64 = 0.125f64 * v10;
-    let v109: f64 = 1.5f64 * v31;
-    let v110: f64 = v107 - v109;
-    let v111: f64 = v14 * v110;
-    let v112: f64 = v11.mul_add(v106, v111);
-    let v113: f64 = p[0usize] * v112;
-    let v114: f64 = v28 * dir[0usize];
-    let v115: f64 = 2f64 * qd[0usize];
-    let v116: f64 = v115 * v34;
-    let v117: f64 = v116 * dir[1usize];
-    let v118: f64 = v114.mul_add(v113, v117);
-    let v119: f64 = v109 - v107;
-    let v120: f64 = v14 * v106;
-    let v121: f64 = v11.mul_add(v119, v120);
-    let v122: f64 = p[0usize] * v121;
-    let v123: f64 = v115 * v37;
-    let v124: f64 = v123 * dir[1usize];
-    let v125: f64 = v114.mul_add(v122, v124);
-    let v126: f64 = v47 * dir[0usize];
-    let v127: f64 = v51 * dir[0usize];
-    let v128: f64 = qd[0usize] * v55;
-    let v129: f64 = v128 * dir[0usize];
-    let v130: f64 = v47.mul_add(dir[1usize], v129);
-    let v131: f64 = qd[0usize] * v61;
-    let v132: f64 = v131 * dir[0usize];
-    let v133: f64 = v51.mul_add(dir[1usize], v132);
-    let v135: f64 = 3f64 * v18;
-    let v136: f64 = v135 * v31;
-    let v137: f64 = v10.mul_add(v105, v136);
-    let v138: f64 = p[0usize] * v137;
-    let v139: f64 = v115 * v55;
-    let v140: f64 = v139 * dir[1usize];
-    let v141: f64 = v114.mul_add(v138, v140);
-    let v143: f64 = q[0usize] * v142;
-    let v144: f64 = 3f64.mul_add(v58, v143);
-    let v145: f64 = p[0usize] * v144;
-    let v146: f64 = v115 * v61;
-    let v147: f64 = v146 * dir[1usize];
-    let v148: f64 = v114.mul_add(v145, v147);
-    let v149: f64 = 0.5f64 * dir[1usize];
-    let v150: f64 = v87 * dir[0usize];
-    let v151: f64 = v34 * dir[0usize];
-    let v152: f64 = v37 * dir[0usize];
-    let v153: f64 = v55 * dir[0usize];
-    let v154: f64 = v61 * dir[0usize];
-    let v155: f64 = p[5usize] * dir[1usize];
-    let v156: f64 = p[4usize].mul_add(dir[0usize], v155);
-    let v157: f64 = 2f64 * v68;
-    let v158: f64 = 3f64 * v41;
-    let v159: f64 = v49 * v49;
-    let v160: f64 = 2f64 * v67;
-    let v162: f64 = 8f64 * q[0usize];
-    let v163: f64 = v160 * v58;
-    let v164: f64 = v162.mul_add(v49, v163);
-    let v165: f64 = -v164;
-    let v166: f64 = 2f64.mul_add(v58, -v157);
-    let v167: f64 = (-v31).mul_add(v80, v166);
-    let v168: f64 = (-v158).mul_add(v53, v167);
-    let v169: f64 = (-v160).mul_add(v159, v168);
-    let v170: f64 = v44.mul_add(v165, v169);
-    let v171: f64 = v86 * v170;
-    let v172: f64 = dir[0usize] * v171;
-    out[0usize] = v4;
-    out[1usize] = v6;
-    out[2usize] = 0f64;
-    out[3usize] = v5;
-    out[4usize] = v4;
-    out[5usize] = 0f64;
-    out[6usize] = 0f64;
-    out[7usize] = 0f64;
-    out[8usize] = 1f64;
-    out[9usize] = v13;
-    out[10usize] = v15;
-    out[11usize] = 0f64;
-    out[12usize] = v23;
-    out[13usize] = v27;
-    out[14usize] = 0f64;
-    out[15usize] = v35;
-    out[16usize] = v38;
-    out[17usize] = 0f64;
-    out[18usize] = 0f64;
-    out[19usize] = 0f64;
-    out[20usize] = v40;
-    out[21usize] = 0f64;
-    out[22usize] = 0f64;
-    out[23usize] = 0f64;
-    out[24usize] = v43;
-    out[25usize] = v46;
-    out[26usize] = 0f64;
-    out[27usize] = v48;
-    out[28usize] = v52;
-    out[29usize] = 0f64;
-    out[30usize] = v56;
-    out[31usize] = v62;
-    out[32usize] = 0f64;
-    out[33usize] = 0f64;
-    out[34usize] = 0f64;
-    out[35usize] = v39;
-    out[36usize] = 0f64;
-    out[37usize] = 0f64;
-    out[38usize] = 0f64;
-    out[39usize] = 1f64;
-    out[40usize] = 0f64;
-    out[41usize] = 0f64;
-    out[42usize] = p[1usize];
-    out[43usize] = v73;
-    out[44usize] = v73;
-    out[45usize] = 0f64;
-    out[46usize] = 0f64;
-    out[47usize] = 1f64;
-    out[48usize] = v22;
-    out[49usize] = v26;
-    out[50usize] = 0f64;
-    out[51usize] = 0f64;
-    out[52usize] = 0f64;
-    out[53usize] = 0.5f64;
-    out[54usize] = v47;
-    out[55usize] = v51;
-    out[56usize] = 0f64;
-    out[57usize] = v79;
-    out[58usize] = v87;
-    out[59usize] = v90;
-    out[60usize] = v92;
-    out[61usize] = 0f64;
-    out[62usize] = v91;
-    out[63usize] = v90;
-    out[64usize] = 0f64;
-    out[65usize] = 0f64;
-    out[66usize] = 0f64;
-    out[67usize] = 0f64;
-    out[68usize] = v93;
-    out[69usize] = v94;
-    out[70usize] = 0f64;
-    out[71usize] = v98;
-    out[72usize] = v101;
-    out[73usize] = 0f64;
-    out[74usize] = v118;
-    out[75usize] = v125;
-    out[76usize] = 0f64;
-    out[77usize] = 0f64;
-    out[78usize] = 0f64;
-    out[79usize] = dir[1usize];
-    out[80usize] = 0f64;
-    out[81usize] = 0f64;
-    out[82usize] = 0f64;
-    out[83usize] = v126;
-    out[84usize] = v127;
-    out[85usize] = 0f64;
-    out[86usize] = v130;
-    out[87usize] = v133;
-    out[88usize] = 0f64;
-    out[89usize] = v141;
-    out[90usize] = v148;
-    out[91usize] = 0f64;
-    out[92usize] = 0f64;
-    out[93usize] = 0f64;
-    out[94usize] = v149;
-    out[95usize] = 0f64;
-    out[96usize] = 0f64;
-    out[97usize] = 0f64;
-    out[98usize] = 0f64;
-    out[99usize] = 0f64;
-    out[100usize] = 0f64;
-    out[101usize] = 0f64;
-    out[102usize] = v150;
-    out[103usize] = v150;
-    out[104usize] = 0f64;
-    out[105usize] = 0f64;
-    out[106usize] = 0f64;
-    out[107usize] = v151;
-    out[108usize] = v152;
-    out[109usize] = 0f64;
-    out[110usize] = 0f64;
-    out[111usize] = 0f64;
-    out[112usize] = 0f64;
-    out[113usize] = v153;
-    out[114usize] = v154;
-    out[115usize] = 0f64;
-    out[116usize] = v156;
-    out[117usize] = v172;
+    let v12 = p[0] * v10;
+    let v13 = v12 * v11;
+    let v15 = v12 * v14;
+    let v18 = 0.5f64 * v17;
+    let v19 = v11 * v18;
+    let v20 = 0.5f64 * v10;
+    let v21 = (-v20).mul_add(v14, v19);
+    let v22 = p[0] * v21;
+    let v23 = qd[0] * v22;
+    let v24 = v14 * v18;
+    let v25 = v20.mul_add(v11, v24);
+    let v26 = p[0] * v25;
+    let v27 = qd[0] * v26;
+    let v28 = qd[0] * qd[0];
+    let v31 = 0.25f64 * v30;
+    let v32 = (-0.25f64).mul_add(v10, v31);
+    let v33 = v11.mul_add(v32, -v24);
+    let v34 = p[0] * v33;
+    let v35 = v28 * v34;
+    let v36 = v14.mul_add(v32, v19);
+    let v37 = p[0] * v36;
+    let v38 = v28 * v37;
+    let v39 = 0.5f64 * qd[0];
+    let v40 = v39 + v39;
+    let v41 = v10 * v10;
+    let v42 = 0.5f64 * p[0];
+    let v43 = v42 * v41;
+    let [v44, v49, v58, v142]: [f64; 4] = runtime::special::sinc_rem_orders::<4>(q[0]);
+    let v45 = q[0] * p[0];
+    let v46 = v45 * v44;
+    let v47 = v12 * v18;
+    let v48 = qd[0] * v47;
+    let v50 = q[0].mul_add(v49, v44);
+    let v51 = p[0] * v50;
+    let v52 = qd[0] * v51;
+    let v53 = v18 * v18;
+    let v54 = v10.mul_add(v31, v53);
+    let v55 = p[0] * v54;
+    let v56 = v28 * v55;
+    let v59 = q[0] * v58;
+    let v60 = 2f64.mul_add(v49, v59);
+    let v61 = p[0] * v60;
+    let v62 = v28 * v61;
+    let v65 = 2f64 * v44;
+    let v66 = v10.powi(4i32);
+    let v67 = q[0] * q[0];
+    let v68 = v44 * v44;
+    let v69 = (-0.25f64).mul_add(v66, v65);
+    let v70 = (-v67).mul_add(v68, v69);
+    let v71 = p[0] * p[0];
+    let v72 = p[1] * v70;
+    let v73 = v72.mul_add(v71, p[2]);
+    let v76 = q[0] - p[6];
+    let v78 = qd[0] * p[5];
+    let v79 = p[4].mul_add(v76, v78);
+    let v80 = v10.powi(3i32);
+    let v81 = v18 * v80;
+    let v82 = 2f64 * q[0];
+    let v83 = (-v65).mul_add(v67, 2f64);
+    let v84 = v49.mul_add(v83, -v81);
+    let v85 = (-v82).mul_add(v68, v84);
+    let v86 = p[1] * v71;
+    let v87 = v86 * v85;
+    let v89 = v5 * dir[0];
+    let v90 = -v89;
+    let v91 = v4 * dir[0];
+    let v92 = -v91;
+    let v93 = v22 * dir[0];
+    let v94 = v26 * dir[0];
+    let v96 = qd[0] * v34;
+    let v97 = v96 * dir[0];
+    let v98 = v22.mul_add(dir[1], v97);
+    let v99 = qd[0] * v37;
+    let v100 = v99 * dir[0];
+    let v101 = v26.mul_add(dir[1], v100);
+    let v105 = 0.125f64 * v103;
+    let v106 = (-0.75f64).mul_add(v18, v105);
+    let v107 = 0.125f64 * v10;
+    let v109 = 1.5f64 * v31;
+    let v110 = v107 - v109;
+    let v111 = v14 * v110;
+    let v112 = v11.mul_add(v106, v111);
+    let v113 = p[0] * v112;
+    let v114 = v28 * dir[0];
+    let v115 = 2f64 * qd[0];
+    let v116 = v115 * v34;
+    let v117 = v116 * dir[1];
+    let v118 = v114.mul_add(v113, v117);
+    let v119 = v109 - v107;
+    let v120 = v14 * v106;
+    let v121 = v11.mul_add(v119, v120);
+    let v122 = p[0] * v121;
+    let v123 = v115 * v37;
+    let v124 = v123 * dir[1];
+    let v125 = v114.mul_add(v122, v124);
+    let v126 = v47 * dir[0];
+    let v127 = v51 * dir[0];
+    let v128 = qd[0] * v55;
+    let v129 = v128 * dir[0];
+    let v130 = v47.mul_add(dir[1], v129);
+    let v131 = qd[0] * v61;
+    let v132 = v131 * dir[0];
+    let v133 = v51.mul_add(dir[1], v132);
+    let v135 = 3f64 * v18;
+    let v136 = v135 * v31;
+    let v137 = v10.mul_add(v105, v136);
+    let v138 = p[0] * v137;
+    let v139 = v115 * v55;
+    let v140 = v139 * dir[1];
+    let v141 = v114.mul_add(v138, v140);
+    let v143 = q[0] * v142;
+    let v144 = 3f64.mul_add(v58, v143);
+    let v145 = p[0] * v144;
+    let v146 = v115 * v61;
+    let v147 = v146 * dir[1];
+    let v148 = v114.mul_add(v145, v147);
+    let v149 = 0.5f64 * dir[1];
+    let v150 = v87 * dir[0];
+    let v151 = v34 * dir[0];
+    let v152 = v37 * dir[0];
+    let v153 = v55 * dir[0];
+    let v154 = v61 * dir[0];
+    let v155 = p[5] * dir[1];
+    let v156 = p[4].mul_add(dir[0], v155);
+    let v157 = 2f64 * v68;
+    let v158 = 3f64 * v41;
+    let v159 = v49 * v49;
+    let v160 = 2f64 * v67;
+    let v162 = 8f64 * q[0];
+    let v163 = v160 * v58;
+    let v164 = v162.mul_add(v49, v163);
+    let v165 = -v164;
+    let v166 = 2f64.mul_add(v58, -v157);
+    let v167 = (-v31).mul_add(v80, v166);
+    let v168 = (-v158).mul_add(v53, v167);
+    let v169 = (-v160).mul_add(v159, v168);
+    let v170 = v44.mul_add(v165, v169);
+    let v171 = v86 * v170;
+    let v172 = dir[0] * v171;
+    out[0] = v4;
+    out[1] = v6;
+    out[2] = 0f64;
+    out[3] = v5;
+    out[4] = v4;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 1f64;
+    out[9] = v13;
+    out[10] = v15;
+    out[11] = 0f64;
+    out[12] = v23;
+    out[13] = v27;
+    out[14] = 0f64;
+    out[15] = v35;
+    out[16] = v38;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = v40;
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = v43;
+    out[25] = v46;
+    out[26] = 0f64;
+    out[27] = v48;
+    out[28] = v52;
+    out[29] = 0f64;
+    out[30] = v56;
+    out[31] = v62;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = v39;
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 1f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = p[1];
+    out[43] = v73;
+    out[44] = v73;
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 1f64;
+    out[48] = v22;
+    out[49] = v26;
+    out[50] = 0f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 0.5f64;
+    out[54] = v47;
+    out[55] = v51;
+    out[56] = 0f64;
+    out[57] = v79;
+    out[58] = v87;
+    out[59] = v90;
+    out[60] = v92;
+    out[61] = 0f64;
+    out[62] = v91;
+    out[63] = v90;
+    out[64] = 0f64;
+    out[65] = 0f64;
+    out[66] = 0f64;
+    out[67] = 0f64;
+    out[68] = v93;
+    out[69] = v94;
+    out[70] = 0f64;
+    out[71] = v98;
+    out[72] = v101;
+    out[73] = 0f64;
+    out[74] = v118;
+    out[75] = v125;
+    out[76] = 0f64;
+    out[77] = 0f64;
+    out[78] = 0f64;
+    out[79] = dir[1];
+    out[80] = 0f64;
+    out[81] = 0f64;
+    out[82] = 0f64;
+    out[83] = v126;
+    out[84] = v127;
+    out[85] = 0f64;
+    out[86] = v130;
+    out[87] = v133;
+    out[88] = 0f64;
+    out[89] = v141;
+    out[90] = v148;
+    out[91] = 0f64;
+    out[92] = 0f64;
+    out[93] = 0f64;
+    out[94] = v149;
+    out[95] = 0f64;
+    out[96] = 0f64;
+    out[97] = 0f64;
+    out[98] = 0f64;
+    out[99] = 0f64;
+    out[100] = 0f64;
+    out[101] = 0f64;
+    out[102] = v150;
+    out[103] = v150;
+    out[104] = 0f64;
+    out[105] = 0f64;
+    out[106] = 0f64;
+    out[107] = v151;
+    out[108] = v152;
+    out[109] = 0f64;
+    out[110] = 0f64;
+    out[111] = 0f64;
+    out[112] = 0f64;
+    out[113] = v153;
+    out[114] = v154;
+    out[115] = 0f64;
+    out[116] = v156;
+    out[117] = v172;
 }
 /// This model's cells, for chains of other lengths to link.
 pub static CELLS: &[runtime::links::CompiledCell] = &[];

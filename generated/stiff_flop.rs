@@ -4,7 +4,7 @@
 use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
 /// Structural hash of the model this was derived from.
 pub const HASH: &str = "d1f42f058088bdff";
-pub const DOF: usize = 8usize;
+pub const DOF: usize = 8;
 pub const COORDINATES: &[&str] = &[
     "bend_y_0_0",
     "bend_z_0_0",
@@ -83,23 +83,21 @@ pub const PARAMETERS: &[&str] = &[
     "chamber[0][2].arm_z",
 ];
 /// Derived parameters, computed once per parameter set.
-pub const DERIVED: usize = 36usize;
+pub const DERIVED: usize = 36;
 /// Whether the mass solve is generated (the `accel` kernel).
 pub const ACCEL: bool = false;
 /// Base parameters that are loads (scaled by load continuation).
-pub const LOADS: &[usize] = &[
-    0usize, 1usize, 2usize, 20usize, 21usize, 22usize, 23usize, 24usize, 25usize,
-];
+pub const LOADS: &[usize] = &[0, 1, 2, 20, 21, 22, 23, 24, 25];
 /// The rows of the joints' constraint equations.
 pub const CONSTRAINTS: &[&str] = &[];
 /// Coordinates per independent subsystem (M block diagonal).
 pub const BLOCKS: &[usize] = &[];
 /// Contact points along the arms and at the bodies.
-pub const CONTACT_POINTS: usize = 0usize;
+pub const CONTACT_POINTS: usize = 0;
 /// Points per group of the `contact_jacobian` kernel.
 pub const CONTACT_GROUPS: &[usize] = &[];
 /// Length of the contact frames the `contact_jacobian` groups read.
-pub const CONTACT_FRAMES: usize = 0usize;
+pub const CONTACT_FRAMES: usize = 0;
 /// The compiled kernels of this structure.
 pub struct Compiled {
     info: ModelInfo,
@@ -131,17 +129,17 @@ impl Kernels for Compiled {
         "compiled"
     }
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
-        let q: &[f64; 8usize] = inp.q.try_into().expect("q has DOF entries");
-        let qd: &[f64; 8usize] = inp.qd.try_into().expect("qd has DOF entries");
-        let p: &[f64; 101usize] = inp.p.try_into().expect("parameter vector length");
-        let no_qdd = [0.0f64; 8usize];
-        let qdd: &[f64; 8usize] = if inp.qdd.is_empty() {
+        let q: &[f64; 8] = inp.q.try_into().expect("q has DOF entries");
+        let qd: &[f64; 8] = inp.qd.try_into().expect("qd has DOF entries");
+        let p: &[f64; 101] = inp.p.try_into().expect("parameter vector length");
+        let no_qdd = [0.0f64; 8];
+        let qdd: &[f64; 8] = if inp.qdd.is_empty() {
             &no_qdd
         } else {
             inp.qdd.try_into().expect("qdd has DOF entries")
         };
-        let no_dir = [0.0f64; 16usize];
-        let dir: &[f64; 16usize] = if inp.dir.is_empty() {
+        let no_dir = [0.0f64; 16];
+        let dir: &[f64; 16] = if inp.dir.is_empty() {
             &no_dir
         } else {
             inp.dir.try_into().expect("dir has 2 DOF entries")
@@ -238,12 +236,12 @@ impl Kernels for Compiled {
 #[allow(unused_unsafe)]
 pub fn accel(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -254,24 +252,24 @@ pub fn accel(
 #[allow(unused_variables, clippy::all)]
 fn accel_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `derived`: 46 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn derived(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    out: &mut [f64; 36usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    out: &mut [f64; 36],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -282,103 +280,103 @@ pub fn derived(
 #[allow(unused_variables, clippy::all)]
 fn derived_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 36usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    w: &mut [f64; 0],
+    out: &mut [f64; 36],
 ) {
-    let v3: f64 = 0.5f64 * p[47usize];
-    let v6: f64 = 0.25f64 * p[47usize];
-    let v7: f64 = p[43usize] - v6;
-    let v8: f64 = p[27usize] + v3;
-    let v9: f64 = 0.25f64.mul_add(v7, v8);
-    let v11: f64 = p[28usize] - p[27usize];
-    let v13: f64 = 0.5f64 * p[9usize];
-    let v15: f64 = 0.5f64 * p[10usize];
-    let v17: f64 = 0.5f64 * p[11usize];
-    let v19: f64 = 0.5f64 * p[26usize];
-    let v21: f64 = 0.5f64 * p[12usize];
-    let v23: f64 = 0.5f64 * p[13usize];
-    let v25: f64 = 0.5f64 * p[14usize];
-    let v27: f64 = 0.125f64.mul_add(v7, v6);
-    let v28: f64 = v3 - v27;
-    let v30: f64 = 0.5f64 * p[6usize];
-    let v32: f64 = 0.5f64 * p[7usize];
-    let v34: f64 = 0.5f64 * p[8usize];
-    let v37: f64 = p[19usize] + p[42usize];
-    let v39: f64 = 0.25f64 * p[35usize];
-    let v41: f64 = p[31usize] - v39;
-    let v42: f64 = 0.125f64.mul_add(v41, v39);
-    let v43: f64 = 0.5f64.mul_add(p[35usize], -v42);
-    let v45: f64 = -p[2usize];
-    let v47: f64 = -p[1usize];
-    let v49: f64 = -p[0usize];
-    let v51: f64 = -p[34usize];
-    let v53: f64 = 0.5f64 * p[36usize];
-    let v54: f64 = 0.5f64 * p[42usize];
-    let v56: f64 = -p[46usize];
-    let v58: f64 = 0.5f64 * p[48usize];
-    let v60: f64 = 0.5f64 * p[38usize];
-    let v62: f64 = 0.5f64 * p[50usize];
-    let v64: f64 = 0.25f64 * p[16usize];
-    let v66: f64 = 0.25f64 * p[17usize];
-    let v68: f64 = 0.25f64 * p[18usize];
-    let v70: f64 = 0.25f64 * p[15usize];
-    let v72: f64 = 0.5f64 * p[30usize];
-    let v74: f64 = 0.5f64 * p[32usize];
-    let v77: f64 = 2f64 * p[29usize];
-    let v79: f64 = 0.5f64 * p[44usize];
-    let v81: f64 = 2f64 * p[41usize];
-    out[0usize] = v9;
-    out[1usize] = v11;
-    out[2usize] = v13;
-    out[3usize] = v15;
-    out[4usize] = v17;
-    out[5usize] = v19;
-    out[6usize] = v21;
-    out[7usize] = v23;
-    out[8usize] = v25;
-    out[9usize] = v28;
-    out[10usize] = v30;
-    out[11usize] = v32;
-    out[12usize] = v34;
-    out[13usize] = v37;
-    out[14usize] = v42;
-    out[15usize] = v43;
-    out[16usize] = v27;
-    out[17usize] = v45;
-    out[18usize] = v47;
-    out[19usize] = v49;
-    out[20usize] = v51;
-    out[21usize] = v53;
-    out[22usize] = v54;
-    out[23usize] = v56;
-    out[24usize] = v58;
-    out[25usize] = v60;
-    out[26usize] = v62;
-    out[27usize] = v64;
-    out[28usize] = v66;
-    out[29usize] = v68;
-    out[30usize] = v70;
-    out[31usize] = v72;
-    out[32usize] = v74;
-    out[33usize] = v77;
-    out[34usize] = v79;
-    out[35usize] = v81;
+    let v3 = 0.5f64 * p[47];
+    let v6 = 0.25f64 * p[47];
+    let v7 = p[43] - v6;
+    let v8 = p[27] + v3;
+    let v9 = 0.25f64.mul_add(v7, v8);
+    let v11 = p[28] - p[27];
+    let v13 = 0.5f64 * p[9];
+    let v15 = 0.5f64 * p[10];
+    let v17 = 0.5f64 * p[11];
+    let v19 = 0.5f64 * p[26];
+    let v21 = 0.5f64 * p[12];
+    let v23 = 0.5f64 * p[13];
+    let v25 = 0.5f64 * p[14];
+    let v27 = 0.125f64.mul_add(v7, v6);
+    let v28 = v3 - v27;
+    let v30 = 0.5f64 * p[6];
+    let v32 = 0.5f64 * p[7];
+    let v34 = 0.5f64 * p[8];
+    let v37 = p[19] + p[42];
+    let v39 = 0.25f64 * p[35];
+    let v41 = p[31] - v39;
+    let v42 = 0.125f64.mul_add(v41, v39);
+    let v43 = 0.5f64.mul_add(p[35], -v42);
+    let v45 = -p[2];
+    let v47 = -p[1];
+    let v49 = -p[0];
+    let v51 = -p[34];
+    let v53 = 0.5f64 * p[36];
+    let v54 = 0.5f64 * p[42];
+    let v56 = -p[46];
+    let v58 = 0.5f64 * p[48];
+    let v60 = 0.5f64 * p[38];
+    let v62 = 0.5f64 * p[50];
+    let v64 = 0.25f64 * p[16];
+    let v66 = 0.25f64 * p[17];
+    let v68 = 0.25f64 * p[18];
+    let v70 = 0.25f64 * p[15];
+    let v72 = 0.5f64 * p[30];
+    let v74 = 0.5f64 * p[32];
+    let v77 = 2f64 * p[29];
+    let v79 = 0.5f64 * p[44];
+    let v81 = 2f64 * p[41];
+    out[0] = v9;
+    out[1] = v11;
+    out[2] = v13;
+    out[3] = v15;
+    out[4] = v17;
+    out[5] = v19;
+    out[6] = v21;
+    out[7] = v23;
+    out[8] = v25;
+    out[9] = v28;
+    out[10] = v30;
+    out[11] = v32;
+    out[12] = v34;
+    out[13] = v37;
+    out[14] = v42;
+    out[15] = v43;
+    out[16] = v27;
+    out[17] = v45;
+    out[18] = v47;
+    out[19] = v49;
+    out[20] = v51;
+    out[21] = v53;
+    out[22] = v54;
+    out[23] = v56;
+    out[24] = v58;
+    out[25] = v60;
+    out[26] = v62;
+    out[27] = v64;
+    out[28] = v66;
+    out[29] = v68;
+    out[30] = v70;
+    out[31] = v72;
+    out[32] = v74;
+    out[33] = v77;
+    out[34] = v79;
+    out[35] = v81;
 }
 /// Kernel `constraints`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn constraints(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -389,24 +387,24 @@ pub fn constraints(
 #[allow(unused_variables, clippy::all)]
 fn constraints_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -417,36 +415,36 @@ pub fn contact(
 #[allow(unused_variables, clippy::all)]
 fn contact_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jacobian`: the points' positions, velocities and Jacobians in 0 groups; group g runs when `all` or `dir[g] != 0`.
 #[allow(unused_variables)]
 pub fn contact_jacobian(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
     all: bool,
-    p: &[f64; 101usize],
-    out: &mut [f64; 0usize],
+    p: &[f64; 101],
+    out: &mut [f64; 0],
 ) {}
 /// Kernel `contact_jvp`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn contact_jvp(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -457,13 +455,13 @@ pub fn contact_jvp(
 #[allow(unused_variables, clippy::all)]
 fn contact_jvp_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 0usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    w: &mut [f64; 0],
+    out: &mut [f64; 0],
 ) {}
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
@@ -476,40 +474,40 @@ static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyL
 #[allow(unused_variables)]
 pub fn mass_bias(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    out: &mut [f64; 44usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    out: &mut [f64; 44],
 ) {
     runtime::cpu::require_fma();
     unsafe { mass_bias_links(q, qd, p, out) }
 }
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
 unsafe fn mass_bias_links(
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    p: &[f64; 101usize],
-    out: &mut [f64; 44usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    p: &[f64; 101],
+    out: &mut [f64; 44],
 ) {
     let mut cells = LinkCells { q, qd, p };
-    runtime::links::mass_bias_shared::<8usize, _>(&LINKS, &mut cells, q, qd, p, out)
+    runtime::links::mass_bias_shared::<8, _>(&LINKS, &mut cells, q, qd, p, out)
 }
 /// Kernel `jvp`: the inverse dynamics' tangent by the link recursion (`runtime::links::inverse_dynamics_tangent`) over 4 links.
 #[allow(unused_variables)]
 pub fn jvp(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    out: &mut [f64; 8usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    out: &mut [f64; 8],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
-    let mut tau = [0.0; 8usize];
+    let mut tau = [0.0; 8];
     runtime::links::inverse_dynamics_tangent(
         &LINKS,
         &mut cells,
@@ -526,12 +524,12 @@ pub fn jvp(
 #[allow(unused_variables)]
 pub fn outputs(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    out: &mut [f64; 9usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    out: &mut [f64; 9],
 ) {
     runtime::cpu::require_fma();
     let mut cells = LinkCells { q, qd, p };
@@ -540,21 +538,21 @@ pub fn outputs(
 /// The compiled cells and forces the link recursion evaluates.
 #[allow(dead_code)]
 struct LinkCells<'a> {
-    q: &'a [f64; 8usize],
-    qd: &'a [f64; 8usize],
-    p: &'a [f64; 101usize],
+    q: &'a [f64; 8],
+    qd: &'a [f64; 8],
+    p: &'a [f64; 101],
 }
 impl runtime::links::Cells for LinkCells<'_> {
     #[inline(always)]
     fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 4usize],
-                    &[0.0; 8usize],
+                    &[0.0; 4],
+                    &[0.0; 8],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs"),
                 )
@@ -573,7 +571,7 @@ impl runtime::links::Cells for LinkCells<'_> {
         out: &mut [[f64; 4]],
     ) {
         match c {
-            0usize => {
+            0 => {
                 unsafe {
                     cell_0_x4(
                         x.try_into().expect("link coordinates"),
@@ -602,15 +600,15 @@ impl runtime::links::Cells for LinkCells<'_> {
         out: &mut [f64],
     ) {
         match c {
-            0usize => {
-                let mut dir = [0.0; 8usize];
-                dir[..4usize].copy_from_slice(dx);
-                dir[4usize..].copy_from_slice(dxd);
+            0 => {
+                let mut dir = [0.0; 8];
+                dir[..4].copy_from_slice(dx);
+                dir[4..].copy_from_slice(dxd);
                 cell_0_tangent(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 4usize],
+                    &[0.0; 4],
                     &dir,
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("cell outputs and derivatives"),
@@ -630,21 +628,21 @@ impl runtime::links::Cells for LinkCells<'_> {
             0.0,
             self.q,
             self.qd,
-            &[0.0; 8usize],
-            &[0.0; 16usize],
+            &[0.0; 8],
+            &[0.0; 16],
             self.p,
             out.try_into().expect("load outputs"),
         )
     }
     fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         match c {
-            0usize => {
+            0 => {
                 cell_0_pose(
                     0.0,
                     x.try_into().expect("link coordinates"),
                     xd.try_into().expect("link rates"),
-                    &[0.0; 4usize],
-                    &[0.0; 8usize],
+                    &[0.0; 4],
+                    &[0.0; 8],
                     p.try_into().expect("cell parameters"),
                     out.try_into().expect("pose outputs"),
                 )
@@ -660,12 +658,12 @@ impl runtime::links::Cells for LinkCells<'_> {
 #[allow(unused_unsafe)]
 pub fn cell_0_pose(
     t: f64,
-    q: &[f64; 4usize],
-    qd: &[f64; 4usize],
-    qdd: &[f64; 4usize],
-    dir: &[f64; 8usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 4],
+    qd: &[f64; 4],
+    qdd: &[f64; 4],
+    dir: &[f64; 8],
+    p: &[f64; 15],
+    out: &mut [f64; 38],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -676,254 +674,254 @@ pub fn cell_0_pose(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_pose_0(
     t: f64,
-    q: &[f64; 4usize],
-    qd: &[f64; 4usize],
-    qdd: &[f64; 4usize],
-    dir: &[f64; 8usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 38usize],
+    q: &[f64; 4],
+    qd: &[f64; 4],
+    qdd: &[f64; 4],
+    dir: &[f64; 8],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 38],
 ) {
-    let v1: f64 = q[0usize] * q[0usize];
-    let v3: f64 = 0.25f64 * v1;
-    let v5: f64 = q[2usize] * q[2usize];
-    let v6: f64 = 0.25f64 * v5;
-    let v8: f64 = q[1usize] * q[1usize];
-    let v9: f64 = 0.25f64 * v8;
-    let v10: f64 = v3 + v6;
-    let v11: f64 = v10 + v9;
-    let c: [[f64; 2usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        2usize,
+    let v1 = q[0] * q[0];
+    let v3 = 0.25f64 * v1;
+    let v5 = q[2] * q[2];
+    let v6 = 0.25f64 * v5;
+    let v8 = q[1] * q[1];
+    let v9 = 0.25f64 * v8;
+    let v10 = v3 + v6;
+    let v11 = v10 + v9;
+    let c: [[f64; 2]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        2,
     >(v11);
-    let v12: f64 = c[0usize][0usize];
-    let v13: f64 = c[2usize][0usize];
-    let v18: f64 = c[1usize][0usize];
-    let v43: f64 = c[3usize][0usize];
-    let v63: f64 = c[3usize][1usize];
-    let v70: f64 = c[2usize][1usize];
-    let v111: f64 = c[4usize][0usize];
-    let v118: f64 = c[4usize][1usize];
-    let v14: f64 = v6.mul_add(v13, v12);
-    let v15: f64 = 0.25f64 * q[0usize];
-    let v16: f64 = v15 * q[2usize];
-    let v17: f64 = v16 * v13;
-    let v20: f64 = 0.5f64 * q[1usize];
-    let v21: f64 = v20 * v18;
-    let v22: f64 = v17 - v21;
-    let v23: f64 = 0.25f64 * q[1usize];
-    let v24: f64 = v23 * q[2usize];
-    let v25: f64 = v24 * v13;
-    let v26: f64 = 0.5f64 * q[0usize];
-    let v27: f64 = v26 * v18;
-    let v28: f64 = v25 + v27;
-    let v29: f64 = v17 + v21;
-    let v30: f64 = v3.mul_add(v13, v12);
-    let v31: f64 = v15 * q[1usize];
-    let v32: f64 = v31 * v13;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let v34: f64 = v33 * v18;
-    let v35: f64 = v32 - v34;
-    let v36: f64 = v25 - v27;
-    let v37: f64 = v32 + v34;
-    let v38: f64 = v9.mul_add(v13, v12);
-    let v41: f64 = q[3usize] + p[0usize];
-    let v44: f64 = v6 - v11;
-    let v45: f64 = v43.mul_add(v44, 1f64);
-    let v46: f64 = 0.5f64 * v41;
-    let v47: f64 = v46 * v45;
-    let v48: f64 = v16 * v43;
-    let v49: f64 = v20.mul_add(v13, v48);
-    let v50: f64 = v46 * v49;
-    let v51: f64 = v26 * v13;
-    let v52: f64 = v24.mul_add(v43, -v51);
-    let v53: f64 = v46 * v52;
-    let v55: f64 = 0.5f64 * qd[3usize];
-    let v57: f64 = v33 * qd[2usize];
-    let v60: f64 = v26.mul_add(qd[0usize], v57);
-    let v61: f64 = v20.mul_add(qd[1usize], v60);
-    let v62: f64 = v57 - v61;
-    let v64: f64 = v61 * v63;
-    let v65: f64 = v64 * v44;
-    let v66: f64 = v43.mul_add(v62, v65);
-    let v67: f64 = v46 * v66;
-    let v68: f64 = v55.mul_add(v45, v67);
-    let v69: f64 = 0.5f64 * qd[1usize];
-    let v71: f64 = v61 * v70;
-    let v72: f64 = v20 * v71;
-    let v73: f64 = 0.25f64 * q[2usize];
-    let v74: f64 = v73 * qd[0usize];
-    let v75: f64 = 0.25f64 * qd[2usize];
-    let v76: f64 = v73 * v64;
-    let v77: f64 = v75.mul_add(v43, v76);
-    let v78: f64 = v69.mul_add(v13, v72);
-    let v79: f64 = v74.mul_add(v43, v78);
-    let v80: f64 = q[0usize].mul_add(v77, v79);
-    let v81: f64 = v46 * v80;
-    let v82: f64 = v55.mul_add(v49, v81);
-    let v83: f64 = v73 * qd[1usize];
-    let v84: f64 = 0.5f64 * qd[0usize];
-    let v85: f64 = v84 * v13;
-    let v86: f64 = v83.mul_add(v43, -v85);
-    let v87: f64 = (-v26).mul_add(v71, v86);
-    let v88: f64 = q[1usize].mul_add(v77, v87);
-    let v89: f64 = v46 * v88;
-    let v90: f64 = v55.mul_add(v52, v89);
-    let v91: f64 = v23 * qd[0usize];
-    let v92: f64 = v15.mul_add(qd[1usize], -v91);
-    let v93: f64 = 0.5f64 * qd[2usize];
-    let v94: f64 = v93 * v18;
-    let v95: f64 = v15 * qd[0usize];
-    let v96: f64 = v73.mul_add(qd[2usize], v95);
-    let v97: f64 = v23.mul_add(qd[1usize], v96);
-    let v98: f64 = v33 * v43;
-    let v99: f64 = v13.mul_add(v92, v94);
-    let v100: f64 = v98.mul_add(v97, v99);
-    let v101: f64 = v23.mul_add(qd[2usize], -v83);
-    let v102: f64 = v84 * v18;
-    let v103: f64 = v26 * v43;
-    let v104: f64 = v13.mul_add(v101, v102);
-    let v105: f64 = v103.mul_add(v97, v104);
-    let v106: f64 = (-v15).mul_add(qd[2usize], v74);
-    let v107: f64 = v69 * v18;
-    let v108: f64 = v20 * v43;
-    let v109: f64 = v13.mul_add(v106, v107);
-    let v110: f64 = v108.mul_add(v97, v109);
-    let v112: f64 = v111.mul_add(v44, 0.5f64);
-    let v113: f64 = v46 * v112;
-    let v114: f64 = v16.mul_add(v111, v108);
-    let v115: f64 = v46 * v114;
-    let v116: f64 = v24.mul_add(v111, -v103);
-    let v117: f64 = v46 * v116;
-    let v119: f64 = v61 * v118;
-    let v120: f64 = v119 * v44;
-    let v121: f64 = v111.mul_add(v62, v120);
-    let v122: f64 = v46 * v121;
-    let v123: f64 = v55.mul_add(v112, v122);
-    let v124: f64 = v20 * v64;
-    let v125: f64 = v73 * v119;
-    let v126: f64 = v75.mul_add(v111, v125);
-    let v127: f64 = v69.mul_add(v43, v124);
-    let v128: f64 = v74.mul_add(v111, v127);
-    let v129: f64 = q[0usize].mul_add(v126, v128);
-    let v130: f64 = v46 * v129;
-    let v131: f64 = v55.mul_add(v114, v130);
-    let v132: f64 = v84 * v43;
-    let v133: f64 = v83.mul_add(v111, -v132);
-    let v134: f64 = (-v26).mul_add(v64, v133);
-    let v135: f64 = q[1usize].mul_add(v126, v134);
-    let v136: f64 = v46 * v135;
-    let v137: f64 = v55.mul_add(v116, v136);
-    let v138: f64 = 0.25f64 * v11;
-    let c: [[f64; 1usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        1usize,
+    let v12: f64 = c[0][0];
+    let v13: f64 = c[2][0];
+    let v18: f64 = c[1][0];
+    let v43: f64 = c[3][0];
+    let v63: f64 = c[3][1];
+    let v70: f64 = c[2][1];
+    let v111: f64 = c[4][0];
+    let v118: f64 = c[4][1];
+    let v14 = v6.mul_add(v13, v12);
+    let v15 = 0.25f64 * q[0];
+    let v16 = v15 * q[2];
+    let v17 = v16 * v13;
+    let v20 = 0.5f64 * q[1];
+    let v21 = v20 * v18;
+    let v22 = v17 - v21;
+    let v23 = 0.25f64 * q[1];
+    let v24 = v23 * q[2];
+    let v25 = v24 * v13;
+    let v26 = 0.5f64 * q[0];
+    let v27 = v26 * v18;
+    let v28 = v25 + v27;
+    let v29 = v17 + v21;
+    let v30 = v3.mul_add(v13, v12);
+    let v31 = v15 * q[1];
+    let v32 = v31 * v13;
+    let v33 = 0.5f64 * q[2];
+    let v34 = v33 * v18;
+    let v35 = v32 - v34;
+    let v36 = v25 - v27;
+    let v37 = v32 + v34;
+    let v38 = v9.mul_add(v13, v12);
+    let v41 = q[3] + p[0];
+    let v44 = v6 - v11;
+    let v45 = v43.mul_add(v44, 1f64);
+    let v46 = 0.5f64 * v41;
+    let v47 = v46 * v45;
+    let v48 = v16 * v43;
+    let v49 = v20.mul_add(v13, v48);
+    let v50 = v46 * v49;
+    let v51 = v26 * v13;
+    let v52 = v24.mul_add(v43, -v51);
+    let v53 = v46 * v52;
+    let v55 = 0.5f64 * qd[3];
+    let v57 = v33 * qd[2];
+    let v60 = v26.mul_add(qd[0], v57);
+    let v61 = v20.mul_add(qd[1], v60);
+    let v62 = v57 - v61;
+    let v64 = v61 * v63;
+    let v65 = v64 * v44;
+    let v66 = v43.mul_add(v62, v65);
+    let v67 = v46 * v66;
+    let v68 = v55.mul_add(v45, v67);
+    let v69 = 0.5f64 * qd[1];
+    let v71 = v61 * v70;
+    let v72 = v20 * v71;
+    let v73 = 0.25f64 * q[2];
+    let v74 = v73 * qd[0];
+    let v75 = 0.25f64 * qd[2];
+    let v76 = v73 * v64;
+    let v77 = v75.mul_add(v43, v76);
+    let v78 = v69.mul_add(v13, v72);
+    let v79 = v74.mul_add(v43, v78);
+    let v80 = q[0].mul_add(v77, v79);
+    let v81 = v46 * v80;
+    let v82 = v55.mul_add(v49, v81);
+    let v83 = v73 * qd[1];
+    let v84 = 0.5f64 * qd[0];
+    let v85 = v84 * v13;
+    let v86 = v83.mul_add(v43, -v85);
+    let v87 = (-v26).mul_add(v71, v86);
+    let v88 = q[1].mul_add(v77, v87);
+    let v89 = v46 * v88;
+    let v90 = v55.mul_add(v52, v89);
+    let v91 = v23 * qd[0];
+    let v92 = v15.mul_add(qd[1], -v91);
+    let v93 = 0.5f64 * qd[2];
+    let v94 = v93 * v18;
+    let v95 = v15 * qd[0];
+    let v96 = v73.mul_add(qd[2], v95);
+    let v97 = v23.mul_add(qd[1], v96);
+    let v98 = v33 * v43;
+    let v99 = v13.mul_add(v92, v94);
+    let v100 = v98.mul_add(v97, v99);
+    let v101 = v23.mul_add(qd[2], -v83);
+    let v102 = v84 * v18;
+    let v103 = v26 * v43;
+    let v104 = v13.mul_add(v101, v102);
+    let v105 = v103.mul_add(v97, v104);
+    let v106 = (-v15).mul_add(qd[2], v74);
+    let v107 = v69 * v18;
+    let v108 = v20 * v43;
+    let v109 = v13.mul_add(v106, v107);
+    let v110 = v108.mul_add(v97, v109);
+    let v112 = v111.mul_add(v44, 0.5f64);
+    let v113 = v46 * v112;
+    let v114 = v16.mul_add(v111, v108);
+    let v115 = v46 * v114;
+    let v116 = v24.mul_add(v111, -v103);
+    let v117 = v46 * v116;
+    let v119 = v61 * v118;
+    let v120 = v119 * v44;
+    let v121 = v111.mul_add(v62, v120);
+    let v122 = v46 * v121;
+    let v123 = v55.mul_add(v112, v122);
+    let v124 = v20 * v64;
+    let v125 = v73 * v119;
+    let v126 = v75.mul_add(v111, v125);
+    let v127 = v69.mul_add(v43, v124);
+    let v128 = v74.mul_add(v111, v127);
+    let v129 = q[0].mul_add(v126, v128);
+    let v130 = v46 * v129;
+    let v131 = v55.mul_add(v114, v130);
+    let v132 = v84 * v43;
+    let v133 = v83.mul_add(v111, -v132);
+    let v134 = (-v26).mul_add(v64, v133);
+    let v135 = q[1].mul_add(v126, v134);
+    let v136 = v46 * v135;
+    let v137 = v55.mul_add(v116, v136);
+    let v138 = 0.25f64 * v11;
+    let c: [[f64; 1]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        1,
     >(v138);
-    let v139: f64 = c[2usize][0usize];
-    let v145: f64 = c[1usize][0usize];
-    let v147: f64 = c[3usize][0usize];
-    let v186: f64 = c[0usize][0usize];
-    let v141: f64 = 0.0625f64 * q[0usize];
-    let v142: f64 = 0.0625f64 * q[1usize];
-    let v143: f64 = v142 * qd[0usize];
-    let v144: f64 = v141.mul_add(qd[1usize], -v143);
-    let v146: f64 = v75 * v145;
-    let v148: f64 = 0.0625f64 * q[2usize];
-    let v149: f64 = v141 * qd[0usize];
-    let v150: f64 = v148.mul_add(qd[2usize], v149);
-    let v151: f64 = v142.mul_add(qd[1usize], v150);
-    let v152: f64 = v73 * v147;
-    let v153: f64 = v139.mul_add(v144, v146);
-    let v154: f64 = v152.mul_add(v151, v153);
-    let v155: f64 = v148 * qd[1usize];
-    let v156: f64 = v142.mul_add(qd[2usize], -v155);
-    let v157: f64 = 0.25f64 * qd[0usize];
-    let v158: f64 = v157 * v145;
-    let v159: f64 = v15 * v147;
-    let v160: f64 = v139.mul_add(v156, v158);
-    let v161: f64 = v159.mul_add(v151, v160);
-    let v162: f64 = v141 * qd[2usize];
-    let v163: f64 = v148.mul_add(qd[0usize], -v162);
-    let v164: f64 = 0.25f64 * qd[1usize];
-    let v165: f64 = v164 * v145;
-    let v166: f64 = v23 * v147;
-    let v167: f64 = v139.mul_add(v163, v165);
-    let v168: f64 = v166.mul_add(v151, v167);
-    let v169: f64 = 0.0625f64.mul_add(v5, -v138);
-    let v170: f64 = v139.mul_add(v169, 1f64);
-    let v171: f64 = v23 * v145;
-    let v172: f64 = v141 * q[2usize];
-    let v173: f64 = v172.mul_add(v139, v171);
-    let v174: f64 = v142 * q[2usize];
-    let v175: f64 = v15 * v145;
-    let v176: f64 = v174.mul_add(v139, -v175);
-    let v178: f64 = 0.5f64 * p[1usize];
-    let v180: f64 = 0.25f64 * p[3usize];
-    let v182: f64 = p[2usize] - v180;
-    let v184: f64 = 0.125f64.mul_add(v182, v180);
-    let v185: f64 = 0.5f64 * p[3usize];
-    let v187: f64 = v73 * v145;
-    let v189: f64 = q[3usize] * q[3usize];
-    let v190: f64 = 0.5f64 * p[9usize];
-    let v191: f64 = p[0usize] / v41;
-    let v192: f64 = v191.powi(3i32);
-    let v194: f64 = 0.5f64 * p[7usize];
-    let v197: f64 = q[1usize] - p[6usize];
-    let v198: f64 = v197 * v197;
-    let v199: f64 = 0.5f64 * v198;
-    let v200: f64 = 0.5f64.mul_add(v1, v199);
-    let v201: f64 = p[4usize] * v200;
-    let v202: f64 = v194.mul_add(v5, v201);
-    let v203: f64 = v192 * v202;
-    let v204: f64 = v190.mul_add(v189, v203);
-    let v205: f64 = 0.5f64 * v204;
-    out[0usize] = v14;
-    out[1usize] = v22;
-    out[2usize] = v28;
-    out[3usize] = v29;
-    out[4usize] = v30;
-    out[5usize] = v35;
-    out[6usize] = v36;
-    out[7usize] = v37;
-    out[8usize] = v38;
-    out[9usize] = v47;
-    out[10usize] = v50;
-    out[11usize] = v53;
-    out[12usize] = v68;
-    out[13usize] = v82;
-    out[14usize] = v90;
-    out[15usize] = v100;
-    out[16usize] = v105;
-    out[17usize] = v110;
-    out[18usize] = v113;
-    out[19usize] = v115;
-    out[20usize] = v117;
-    out[21usize] = v123;
-    out[22usize] = v131;
-    out[23usize] = v137;
-    out[24usize] = v154;
-    out[25usize] = v161;
-    out[26usize] = v168;
-    out[27usize] = v170;
-    out[28usize] = v173;
-    out[29usize] = v176;
-    out[30usize] = v178;
-    out[31usize] = v184;
-    out[32usize] = v185;
-    out[33usize] = v186;
-    out[34usize] = v187;
-    out[35usize] = v175;
-    out[36usize] = v171;
-    out[37usize] = v205;
+    let v139: f64 = c[2][0];
+    let v145: f64 = c[1][0];
+    let v147: f64 = c[3][0];
+    let v186: f64 = c[0][0];
+    let v141 = 0.0625f64 * q[0];
+    let v142 = 0.0625f64 * q[1];
+    let v143 = v142 * qd[0];
+    let v144 = v141.mul_add(qd[1], -v143);
+    let v146 = v75 * v145;
+    let v148 = 0.0625f64 * q[2];
+    let v149 = v141 * qd[0];
+    let v150 = v148.mul_add(qd[2], v149);
+    let v151 = v142.mul_add(qd[1], v150);
+    let v152 = v73 * v147;
+    let v153 = v139.mul_add(v144, v146);
+    let v154 = v152.mul_add(v151, v153);
+    let v155 = v148 * qd[1];
+    let v156 = v142.mul_add(qd[2], -v155);
+    let v157 = 0.25f64 * qd[0];
+    let v158 = v157 * v145;
+    let v159 = v15 * v147;
+    let v160 = v139.mul_add(v156, v158);
+    let v161 = v159.mul_add(v151, v160);
+    let v162 = v141 * qd[2];
+    let v163 = v148.mul_add(qd[0], -v162);
+    let v164 = 0.25f64 * qd[1];
+    let v165 = v164 * v145;
+    let v166 = v23 * v147;
+    let v167 = v139.mul_add(v163, v165);
+    let v168 = v166.mul_add(v151, v167);
+    let v169 = 0.0625f64.mul_add(v5, -v138);
+    let v170 = v139.mul_add(v169, 1f64);
+    let v171 = v23 * v145;
+    let v172 = v141 * q[2];
+    let v173 = v172.mul_add(v139, v171);
+    let v174 = v142 * q[2];
+    let v175 = v15 * v145;
+    let v176 = v174.mul_add(v139, -v175);
+    let v178 = 0.5f64 * p[1];
+    let v180 = 0.25f64 * p[3];
+    let v182 = p[2] - v180;
+    let v184 = 0.125f64.mul_add(v182, v180);
+    let v185 = 0.5f64 * p[3];
+    let v187 = v73 * v145;
+    let v189 = q[3] * q[3];
+    let v190 = 0.5f64 * p[9];
+    let v191 = p[0] / v41;
+    let v192 = v191.powi(3i32);
+    let v194 = 0.5f64 * p[7];
+    let v197 = q[1] - p[6];
+    let v198 = v197 * v197;
+    let v199 = 0.5f64 * v198;
+    let v200 = 0.5f64.mul_add(v1, v199);
+    let v201 = p[4] * v200;
+    let v202 = v194.mul_add(v5, v201);
+    let v203 = v192 * v202;
+    let v204 = v190.mul_add(v189, v203);
+    let v205 = 0.5f64 * v204;
+    out[0] = v14;
+    out[1] = v22;
+    out[2] = v28;
+    out[3] = v29;
+    out[4] = v30;
+    out[5] = v35;
+    out[6] = v36;
+    out[7] = v37;
+    out[8] = v38;
+    out[9] = v47;
+    out[10] = v50;
+    out[11] = v53;
+    out[12] = v68;
+    out[13] = v82;
+    out[14] = v90;
+    out[15] = v100;
+    out[16] = v105;
+    out[17] = v110;
+    out[18] = v113;
+    out[19] = v115;
+    out[20] = v117;
+    out[21] = v123;
+    out[22] = v131;
+    out[23] = v137;
+    out[24] = v154;
+    out[25] = v161;
+    out[26] = v168;
+    out[27] = v170;
+    out[28] = v173;
+    out[29] = v176;
+    out[30] = v178;
+    out[31] = v184;
+    out[32] = v185;
+    out[33] = v186;
+    out[34] = v187;
+    out[35] = v175;
+    out[36] = v171;
+    out[37] = v205;
 }
 /// Kernel `cell_0`: 596 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0(
     t: f64,
-    q: &[f64; 4usize],
-    qd: &[f64; 4usize],
-    qdd: &[f64; 4usize],
-    dir: &[f64; 8usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 101usize],
+    q: &[f64; 4],
+    qd: &[f64; 4],
+    qdd: &[f64; 4],
+    dir: &[f64; 8],
+    p: &[f64; 15],
+    out: &mut [f64; 101],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -934,560 +932,560 @@ pub fn cell_0(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0(
     t: f64,
-    q: &[f64; 4usize],
-    qd: &[f64; 4usize],
-    qdd: &[f64; 4usize],
-    dir: &[f64; 8usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 101usize],
+    q: &[f64; 4],
+    qd: &[f64; 4],
+    qdd: &[f64; 4],
+    dir: &[f64; 8],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 101],
 ) {
-    let v1: f64 = q[0usize] * q[0usize];
-    let v3: f64 = 0.25f64 * v1;
-    let v5: f64 = q[2usize] * q[2usize];
-    let v6: f64 = 0.25f64 * v5;
-    let v8: f64 = q[1usize] * q[1usize];
-    let v9: f64 = 0.25f64 * v8;
-    let v10: f64 = v3 + v6;
-    let v11: f64 = v10 + v9;
-    let c: [[f64; 3usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        3usize,
+    let v1 = q[0] * q[0];
+    let v3 = 0.25f64 * v1;
+    let v5 = q[2] * q[2];
+    let v6 = 0.25f64 * v5;
+    let v8 = q[1] * q[1];
+    let v9 = 0.25f64 * v8;
+    let v10 = v3 + v6;
+    let v11 = v10 + v9;
+    let c: [[f64; 3]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        3,
     >(v11);
-    let v12: f64 = c[0usize][0usize];
-    let v13: f64 = c[2usize][0usize];
-    let v18: f64 = c[1usize][0usize];
-    let v43: f64 = c[3usize][0usize];
-    let v63: f64 = c[3usize][1usize];
-    let v70: f64 = c[2usize][1usize];
-    let v103: f64 = c[3usize][2usize];
-    let v111: f64 = c[2usize][2usize];
-    let v158: f64 = c[1usize][1usize];
-    let v170: f64 = c[4usize][0usize];
-    let v177: f64 = c[4usize][1usize];
-    let v198: f64 = c[4usize][2usize];
-    let v14: f64 = v6.mul_add(v13, v12);
-    let v15: f64 = 0.25f64 * q[0usize];
-    let v16: f64 = v15 * q[2usize];
-    let v17: f64 = v16 * v13;
-    let v20: f64 = 0.5f64 * q[1usize];
-    let v21: f64 = v20 * v18;
-    let v22: f64 = v17 - v21;
-    let v23: f64 = 0.25f64 * q[1usize];
-    let v24: f64 = v23 * q[2usize];
-    let v25: f64 = v24 * v13;
-    let v26: f64 = 0.5f64 * q[0usize];
-    let v27: f64 = v26 * v18;
-    let v28: f64 = v25 + v27;
-    let v29: f64 = v17 + v21;
-    let v30: f64 = v3.mul_add(v13, v12);
-    let v31: f64 = v15 * q[1usize];
-    let v32: f64 = v31 * v13;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let v34: f64 = v33 * v18;
-    let v35: f64 = v32 - v34;
-    let v36: f64 = v25 - v27;
-    let v37: f64 = v32 + v34;
-    let v38: f64 = v9.mul_add(v13, v12);
-    let v41: f64 = q[3usize] + p[0usize];
-    let v44: f64 = v6 - v11;
-    let v45: f64 = v43.mul_add(v44, 1f64);
-    let v46: f64 = 0.5f64 * v41;
-    let v47: f64 = v46 * v45;
-    let v48: f64 = v16 * v43;
-    let v49: f64 = v20.mul_add(v13, v48);
-    let v50: f64 = v46 * v49;
-    let v51: f64 = v26 * v13;
-    let v52: f64 = v24.mul_add(v43, -v51);
-    let v53: f64 = v46 * v52;
-    let v55: f64 = 0.5f64 * qd[3usize];
-    let v57: f64 = v33 * qd[2usize];
-    let v60: f64 = v26.mul_add(qd[0usize], v57);
-    let v61: f64 = v20.mul_add(qd[1usize], v60);
-    let v62: f64 = v57 - v61;
-    let v64: f64 = v61 * v63;
-    let v65: f64 = v64 * v44;
-    let v66: f64 = v43.mul_add(v62, v65);
-    let v67: f64 = v46 * v66;
-    let v68: f64 = v55.mul_add(v45, v67);
-    let v69: f64 = 0.5f64 * qd[1usize];
-    let v71: f64 = v61 * v70;
-    let v72: f64 = v20 * v71;
-    let v73: f64 = 0.25f64 * q[2usize];
-    let v74: f64 = v73 * qd[0usize];
-    let v75: f64 = 0.25f64 * qd[2usize];
-    let v76: f64 = v73 * v64;
-    let v77: f64 = v75.mul_add(v43, v76);
-    let v78: f64 = v69.mul_add(v13, v72);
-    let v79: f64 = v74.mul_add(v43, v78);
-    let v80: f64 = q[0usize].mul_add(v77, v79);
-    let v81: f64 = v46 * v80;
-    let v82: f64 = v55.mul_add(v49, v81);
-    let v83: f64 = v73 * qd[1usize];
-    let v84: f64 = 0.5f64 * qd[0usize];
-    let v85: f64 = v84 * v13;
-    let v86: f64 = v83.mul_add(v43, -v85);
-    let v87: f64 = (-v26).mul_add(v71, v86);
-    let v88: f64 = q[1usize].mul_add(v77, v87);
-    let v89: f64 = v46 * v88;
-    let v90: f64 = v55.mul_add(v52, v89);
-    let v91: f64 = qd[2usize] * qd[2usize];
-    let v92: f64 = 0.5f64 * v91;
-    let v93: f64 = qd[0usize] * qd[0usize];
-    let v94: f64 = qd[1usize] * qd[1usize];
-    let v95: f64 = 0.5f64 * v94;
-    let v96: f64 = 0.5f64.mul_add(v93, v95);
-    let v97: f64 = v96 + v92;
-    let v98: f64 = v92 - v97;
-    let v100: f64 = 2f64 * v61;
-    let v101: f64 = q[2usize].mul_add(qd[2usize], -v100);
-    let v102: f64 = v64 * v101;
-    let v104: f64 = v61 * v61;
-    let v105: f64 = v103 * v104;
-    let v106: f64 = v63.mul_add(v97, v105);
-    let v107: f64 = v43.mul_add(v98, v102);
-    let v108: f64 = v106.mul_add(v44, v107);
-    let v109: f64 = v46 * v108;
-    let v110: f64 = qd[3usize].mul_add(v66, v109);
-    let v112: f64 = v104 * v111;
-    let v113: f64 = v70.mul_add(v97, v112);
-    let v114: f64 = v20 * v113;
-    let v115: f64 = 0.5f64 * qd[2usize];
-    let v116: f64 = v73 * v106;
-    let v117: f64 = v115.mul_add(v64, v116);
-    let v118: f64 = v33 * v64;
-    let v119: f64 = v115.mul_add(v43, v118);
-    let v120: f64 = qd[1usize].mul_add(v71, v114);
-    let v121: f64 = q[0usize].mul_add(v117, v120);
-    let v122: f64 = qd[0usize].mul_add(v119, v121);
-    let v123: f64 = v46 * v122;
-    let v124: f64 = qd[3usize].mul_add(v80, v123);
-    let v125: f64 = qd[0usize] * v71;
-    let v126: f64 = q[1usize].mul_add(v117, -v125);
-    let v127: f64 = (-v26).mul_add(v113, v126);
-    let v128: f64 = qd[1usize].mul_add(v119, v127);
-    let v129: f64 = v46 * v128;
-    let v130: f64 = qd[3usize].mul_add(v88, v129);
-    let v131: f64 = v23 * qd[0usize];
-    let v132: f64 = v15.mul_add(qd[1usize], -v131);
-    let v133: f64 = v115 * v18;
-    let v134: f64 = v15 * qd[0usize];
-    let v135: f64 = v73.mul_add(qd[2usize], v134);
-    let v136: f64 = v23.mul_add(qd[1usize], v135);
-    let v137: f64 = v33 * v43;
-    let v138: f64 = v13.mul_add(v132, v133);
-    let v139: f64 = v137.mul_add(v136, v138);
-    let v140: f64 = v23.mul_add(qd[2usize], -v83);
-    let v141: f64 = v84 * v18;
-    let v142: f64 = v26 * v43;
-    let v143: f64 = v13.mul_add(v140, v141);
-    let v144: f64 = v142.mul_add(v136, v143);
-    let v145: f64 = (-v15).mul_add(qd[2usize], v74);
-    let v146: f64 = v69 * v18;
-    let v147: f64 = v20 * v43;
-    let v148: f64 = v13.mul_add(v145, v146);
-    let v149: f64 = v147.mul_add(v136, v148);
-    let v150: f64 = 0.5f64 * v136;
-    let v151: f64 = 0.25f64 * v94;
-    let v152: f64 = 0.25f64.mul_add(v93, v151);
-    let v153: f64 = 0.25f64.mul_add(v91, v152);
-    let v154: f64 = 0.5f64 * v43;
-    let v155: f64 = v154 * v153;
-    let v156: f64 = v150.mul_add(v64, v155);
-    let v157: f64 = q[2usize] * v156;
-    let v159: f64 = v61 * v158;
-    let v160: f64 = 0.5f64 * v159;
-    let v161: f64 = v154.mul_add(v136, v160);
-    let v162: f64 = v132.mul_add(v71, v157);
-    let v163: f64 = qd[2usize].mul_add(v161, v162);
-    let v164: f64 = q[0usize] * v156;
-    let v165: f64 = v140.mul_add(v71, v164);
-    let v166: f64 = qd[0usize].mul_add(v161, v165);
-    let v167: f64 = q[1usize] * v156;
-    let v168: f64 = v145.mul_add(v71, v167);
-    let v169: f64 = qd[1usize].mul_add(v161, v168);
-    let v171: f64 = v170.mul_add(v44, 0.5f64);
-    let v172: f64 = v46 * v171;
-    let v173: f64 = v16.mul_add(v170, v147);
-    let v174: f64 = v46 * v173;
-    let v175: f64 = v24.mul_add(v170, -v142);
-    let v176: f64 = v46 * v175;
-    let v178: f64 = v61 * v177;
-    let v179: f64 = v178 * v44;
-    let v180: f64 = v170.mul_add(v62, v179);
-    let v181: f64 = v46 * v180;
-    let v182: f64 = v55.mul_add(v171, v181);
-    let v183: f64 = v20 * v64;
-    let v184: f64 = v73 * v178;
-    let v185: f64 = v75.mul_add(v170, v184);
-    let v186: f64 = v69.mul_add(v43, v183);
-    let v187: f64 = v74.mul_add(v170, v186);
-    let v188: f64 = q[0usize].mul_add(v185, v187);
-    let v189: f64 = v46 * v188;
-    let v190: f64 = v55.mul_add(v173, v189);
-    let v191: f64 = v84 * v43;
-    let v192: f64 = v83.mul_add(v170, -v191);
-    let v193: f64 = (-v26).mul_add(v64, v192);
-    let v194: f64 = q[1usize].mul_add(v185, v193);
-    let v195: f64 = v46 * v194;
-    let v196: f64 = v55.mul_add(v175, v195);
-    let v197: f64 = v178 * v101;
-    let v199: f64 = v104 * v198;
-    let v200: f64 = v97.mul_add(v177, v199);
-    let v201: f64 = v170.mul_add(v98, v197);
-    let v202: f64 = v200.mul_add(v44, v201);
-    let v203: f64 = v46 * v202;
-    let v204: f64 = qd[3usize].mul_add(v180, v203);
-    let v205: f64 = v20 * v106;
-    let v206: f64 = v73 * v200;
-    let v207: f64 = v115.mul_add(v178, v206);
-    let v208: f64 = v33 * v178;
-    let v209: f64 = v115.mul_add(v170, v208);
-    let v210: f64 = qd[1usize].mul_add(v64, v205);
-    let v211: f64 = q[0usize].mul_add(v207, v210);
-    let v212: f64 = qd[0usize].mul_add(v209, v211);
-    let v213: f64 = v46 * v212;
-    let v214: f64 = qd[3usize].mul_add(v188, v213);
-    let v215: f64 = qd[0usize] * v64;
-    let v216: f64 = q[1usize].mul_add(v207, -v215);
-    let v217: f64 = (-v26).mul_add(v106, v216);
-    let v218: f64 = qd[1usize].mul_add(v209, v217);
-    let v219: f64 = v46 * v218;
-    let v220: f64 = qd[3usize].mul_add(v194, v219);
-    let v221: f64 = 0.25f64 * v11;
-    let c: [[f64; 2usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        2usize,
+    let v12: f64 = c[0][0];
+    let v13: f64 = c[2][0];
+    let v18: f64 = c[1][0];
+    let v43: f64 = c[3][0];
+    let v63: f64 = c[3][1];
+    let v70: f64 = c[2][1];
+    let v103: f64 = c[3][2];
+    let v111: f64 = c[2][2];
+    let v158: f64 = c[1][1];
+    let v170: f64 = c[4][0];
+    let v177: f64 = c[4][1];
+    let v198: f64 = c[4][2];
+    let v14 = v6.mul_add(v13, v12);
+    let v15 = 0.25f64 * q[0];
+    let v16 = v15 * q[2];
+    let v17 = v16 * v13;
+    let v20 = 0.5f64 * q[1];
+    let v21 = v20 * v18;
+    let v22 = v17 - v21;
+    let v23 = 0.25f64 * q[1];
+    let v24 = v23 * q[2];
+    let v25 = v24 * v13;
+    let v26 = 0.5f64 * q[0];
+    let v27 = v26 * v18;
+    let v28 = v25 + v27;
+    let v29 = v17 + v21;
+    let v30 = v3.mul_add(v13, v12);
+    let v31 = v15 * q[1];
+    let v32 = v31 * v13;
+    let v33 = 0.5f64 * q[2];
+    let v34 = v33 * v18;
+    let v35 = v32 - v34;
+    let v36 = v25 - v27;
+    let v37 = v32 + v34;
+    let v38 = v9.mul_add(v13, v12);
+    let v41 = q[3] + p[0];
+    let v44 = v6 - v11;
+    let v45 = v43.mul_add(v44, 1f64);
+    let v46 = 0.5f64 * v41;
+    let v47 = v46 * v45;
+    let v48 = v16 * v43;
+    let v49 = v20.mul_add(v13, v48);
+    let v50 = v46 * v49;
+    let v51 = v26 * v13;
+    let v52 = v24.mul_add(v43, -v51);
+    let v53 = v46 * v52;
+    let v55 = 0.5f64 * qd[3];
+    let v57 = v33 * qd[2];
+    let v60 = v26.mul_add(qd[0], v57);
+    let v61 = v20.mul_add(qd[1], v60);
+    let v62 = v57 - v61;
+    let v64 = v61 * v63;
+    let v65 = v64 * v44;
+    let v66 = v43.mul_add(v62, v65);
+    let v67 = v46 * v66;
+    let v68 = v55.mul_add(v45, v67);
+    let v69 = 0.5f64 * qd[1];
+    let v71 = v61 * v70;
+    let v72 = v20 * v71;
+    let v73 = 0.25f64 * q[2];
+    let v74 = v73 * qd[0];
+    let v75 = 0.25f64 * qd[2];
+    let v76 = v73 * v64;
+    let v77 = v75.mul_add(v43, v76);
+    let v78 = v69.mul_add(v13, v72);
+    let v79 = v74.mul_add(v43, v78);
+    let v80 = q[0].mul_add(v77, v79);
+    let v81 = v46 * v80;
+    let v82 = v55.mul_add(v49, v81);
+    let v83 = v73 * qd[1];
+    let v84 = 0.5f64 * qd[0];
+    let v85 = v84 * v13;
+    let v86 = v83.mul_add(v43, -v85);
+    let v87 = (-v26).mul_add(v71, v86);
+    let v88 = q[1].mul_add(v77, v87);
+    let v89 = v46 * v88;
+    let v90 = v55.mul_add(v52, v89);
+    let v91 = qd[2] * qd[2];
+    let v92 = 0.5f64 * v91;
+    let v93 = qd[0] * qd[0];
+    let v94 = qd[1] * qd[1];
+    let v95 = 0.5f64 * v94;
+    let v96 = 0.5f64.mul_add(v93, v95);
+    let v97 = v96 + v92;
+    let v98 = v92 - v97;
+    let v100 = 2f64 * v61;
+    let v101 = q[2].mul_add(qd[2], -v100);
+    let v102 = v64 * v101;
+    let v104 = v61 * v61;
+    let v105 = v103 * v104;
+    let v106 = v63.mul_add(v97, v105);
+    let v107 = v43.mul_add(v98, v102);
+    let v108 = v106.mul_add(v44, v107);
+    let v109 = v46 * v108;
+    let v110 = qd[3].mul_add(v66, v109);
+    let v112 = v104 * v111;
+    let v113 = v70.mul_add(v97, v112);
+    let v114 = v20 * v113;
+    let v115 = 0.5f64 * qd[2];
+    let v116 = v73 * v106;
+    let v117 = v115.mul_add(v64, v116);
+    let v118 = v33 * v64;
+    let v119 = v115.mul_add(v43, v118);
+    let v120 = qd[1].mul_add(v71, v114);
+    let v121 = q[0].mul_add(v117, v120);
+    let v122 = qd[0].mul_add(v119, v121);
+    let v123 = v46 * v122;
+    let v124 = qd[3].mul_add(v80, v123);
+    let v125 = qd[0] * v71;
+    let v126 = q[1].mul_add(v117, -v125);
+    let v127 = (-v26).mul_add(v113, v126);
+    let v128 = qd[1].mul_add(v119, v127);
+    let v129 = v46 * v128;
+    let v130 = qd[3].mul_add(v88, v129);
+    let v131 = v23 * qd[0];
+    let v132 = v15.mul_add(qd[1], -v131);
+    let v133 = v115 * v18;
+    let v134 = v15 * qd[0];
+    let v135 = v73.mul_add(qd[2], v134);
+    let v136 = v23.mul_add(qd[1], v135);
+    let v137 = v33 * v43;
+    let v138 = v13.mul_add(v132, v133);
+    let v139 = v137.mul_add(v136, v138);
+    let v140 = v23.mul_add(qd[2], -v83);
+    let v141 = v84 * v18;
+    let v142 = v26 * v43;
+    let v143 = v13.mul_add(v140, v141);
+    let v144 = v142.mul_add(v136, v143);
+    let v145 = (-v15).mul_add(qd[2], v74);
+    let v146 = v69 * v18;
+    let v147 = v20 * v43;
+    let v148 = v13.mul_add(v145, v146);
+    let v149 = v147.mul_add(v136, v148);
+    let v150 = 0.5f64 * v136;
+    let v151 = 0.25f64 * v94;
+    let v152 = 0.25f64.mul_add(v93, v151);
+    let v153 = 0.25f64.mul_add(v91, v152);
+    let v154 = 0.5f64 * v43;
+    let v155 = v154 * v153;
+    let v156 = v150.mul_add(v64, v155);
+    let v157 = q[2] * v156;
+    let v159 = v61 * v158;
+    let v160 = 0.5f64 * v159;
+    let v161 = v154.mul_add(v136, v160);
+    let v162 = v132.mul_add(v71, v157);
+    let v163 = qd[2].mul_add(v161, v162);
+    let v164 = q[0] * v156;
+    let v165 = v140.mul_add(v71, v164);
+    let v166 = qd[0].mul_add(v161, v165);
+    let v167 = q[1] * v156;
+    let v168 = v145.mul_add(v71, v167);
+    let v169 = qd[1].mul_add(v161, v168);
+    let v171 = v170.mul_add(v44, 0.5f64);
+    let v172 = v46 * v171;
+    let v173 = v16.mul_add(v170, v147);
+    let v174 = v46 * v173;
+    let v175 = v24.mul_add(v170, -v142);
+    let v176 = v46 * v175;
+    let v178 = v61 * v177;
+    let v179 = v178 * v44;
+    let v180 = v170.mul_add(v62, v179);
+    let v181 = v46 * v180;
+    let v182 = v55.mul_add(v171, v181);
+    let v183 = v20 * v64;
+    let v184 = v73 * v178;
+    let v185 = v75.mul_add(v170, v184);
+    let v186 = v69.mul_add(v43, v183);
+    let v187 = v74.mul_add(v170, v186);
+    let v188 = q[0].mul_add(v185, v187);
+    let v189 = v46 * v188;
+    let v190 = v55.mul_add(v173, v189);
+    let v191 = v84 * v43;
+    let v192 = v83.mul_add(v170, -v191);
+    let v193 = (-v26).mul_add(v64, v192);
+    let v194 = q[1].mul_add(v185, v193);
+    let v195 = v46 * v194;
+    let v196 = v55.mul_add(v175, v195);
+    let v197 = v178 * v101;
+    let v199 = v104 * v198;
+    let v200 = v97.mul_add(v177, v199);
+    let v201 = v170.mul_add(v98, v197);
+    let v202 = v200.mul_add(v44, v201);
+    let v203 = v46 * v202;
+    let v204 = qd[3].mul_add(v180, v203);
+    let v205 = v20 * v106;
+    let v206 = v73 * v200;
+    let v207 = v115.mul_add(v178, v206);
+    let v208 = v33 * v178;
+    let v209 = v115.mul_add(v170, v208);
+    let v210 = qd[1].mul_add(v64, v205);
+    let v211 = q[0].mul_add(v207, v210);
+    let v212 = qd[0].mul_add(v209, v211);
+    let v213 = v46 * v212;
+    let v214 = qd[3].mul_add(v188, v213);
+    let v215 = qd[0] * v64;
+    let v216 = q[1].mul_add(v207, -v215);
+    let v217 = (-v26).mul_add(v106, v216);
+    let v218 = qd[1].mul_add(v209, v217);
+    let v219 = v46 * v218;
+    let v220 = qd[3].mul_add(v194, v219);
+    let v221 = 0.25f64 * v11;
+    let c: [[f64; 2]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        2,
     >(v221);
-    let v222: f64 = c[2usize][0usize];
-    let v228: f64 = c[1usize][0usize];
-    let v230: f64 = c[3usize][0usize];
-    let v253: f64 = c[2usize][1usize];
-    let v255: f64 = c[3usize][1usize];
-    let v265: f64 = c[1usize][1usize];
-    let v224: f64 = 0.0625f64 * q[0usize];
-    let v225: f64 = 0.0625f64 * q[1usize];
-    let v226: f64 = v225 * qd[0usize];
-    let v227: f64 = v224.mul_add(qd[1usize], -v226);
-    let v229: f64 = v75 * v228;
-    let v231: f64 = 0.0625f64 * q[2usize];
-    let v232: f64 = v224 * qd[0usize];
-    let v233: f64 = v231.mul_add(qd[2usize], v232);
-    let v234: f64 = v225.mul_add(qd[1usize], v233);
-    let v235: f64 = v73 * v230;
-    let v236: f64 = v222.mul_add(v227, v229);
-    let v237: f64 = v235.mul_add(v234, v236);
-    let v238: f64 = v231 * qd[1usize];
-    let v239: f64 = v225.mul_add(qd[2usize], -v238);
-    let v240: f64 = 0.25f64 * qd[0usize];
-    let v241: f64 = v240 * v228;
-    let v242: f64 = v15 * v230;
-    let v243: f64 = v222.mul_add(v239, v241);
-    let v244: f64 = v242.mul_add(v234, v243);
-    let v245: f64 = v224 * qd[2usize];
-    let v246: f64 = v231.mul_add(qd[0usize], -v245);
-    let v247: f64 = 0.25f64 * qd[1usize];
-    let v248: f64 = v247 * v228;
-    let v249: f64 = v23 * v230;
-    let v250: f64 = v222.mul_add(v246, v248);
-    let v251: f64 = v249.mul_add(v234, v250);
-    let v252: f64 = 0.25f64 * v61;
-    let v254: f64 = v252 * v253;
-    let v256: f64 = v252 * v255;
-    let v257: f64 = 0.25f64 * v234;
-    let v258: f64 = 0.0625f64 * v94;
-    let v259: f64 = 0.0625f64.mul_add(v93, v258);
-    let v260: f64 = 0.0625f64.mul_add(v91, v259);
-    let v261: f64 = 0.25f64 * v230;
-    let v262: f64 = v261 * v260;
-    let v263: f64 = v257.mul_add(v256, v262);
-    let v264: f64 = q[2usize] * v263;
-    let v266: f64 = v252 * v265;
-    let v267: f64 = 0.25f64 * v266;
-    let v268: f64 = v261.mul_add(v234, v267);
-    let v269: f64 = v227.mul_add(v254, v264);
-    let v270: f64 = qd[2usize].mul_add(v268, v269);
-    let v271: f64 = q[0usize] * v263;
-    let v272: f64 = v239.mul_add(v254, v271);
-    let v273: f64 = qd[0usize].mul_add(v268, v272);
-    let v274: f64 = q[1usize] * v263;
-    let v275: f64 = v246.mul_add(v254, v274);
-    let v276: f64 = qd[1usize].mul_add(v268, v275);
-    let v277: f64 = 0.0625f64.mul_add(v5, -v221);
-    let v278: f64 = v222.mul_add(v277, 1f64);
-    let v279: f64 = v224 * q[2usize];
-    let v280: f64 = v279 * v222;
-    let v281: f64 = v23.mul_add(v228, v280);
-    let v282: f64 = v225 * q[2usize];
-    let v283: f64 = v15 * v228;
-    let v284: f64 = v282.mul_add(v222, -v283);
-    let v286: f64 = 0.5f64 * p[1usize];
-    let v288: f64 = 0.25f64 * p[3usize];
-    let v290: f64 = p[2usize] - v288;
-    let v292: f64 = 0.125f64.mul_add(v290, v288);
-    let v293: f64 = 0.5f64 * p[3usize];
-    let v294: f64 = v23 * v13;
-    let v295: f64 = 0.125f64 * q[0usize];
-    let v296: f64 = v295 * q[2usize];
-    let v297: f64 = v296 * v43;
-    let v298: f64 = v297 - v294;
-    let v299: f64 = 0.5f64 * v18;
-    let v300: f64 = 0.125f64 * v1;
-    let v301: f64 = v300.mul_add(v43, v299);
-    let v302: f64 = v73 * v13;
-    let v303: f64 = v295 * q[1usize];
-    let v304: f64 = v303 * v43;
-    let v305: f64 = v302 + v304;
-    let v306: f64 = v63 * v26;
-    let v307: f64 = v306.mul_add(v44, -v142);
-    let v308: f64 = v46 * v307;
-    let v309: f64 = v70 * v26;
-    let v310: f64 = 0.25f64 * v43;
-    let v311: f64 = v15.mul_add(v306, v310);
-    let v312: f64 = q[2usize] * v311;
-    let v313: f64 = v20.mul_add(v309, v312);
-    let v314: f64 = v46 * v313;
-    let v315: f64 = 0.5f64 * v13;
-    let v316: f64 = v24.mul_add(v306, -v315);
-    let v317: f64 = (-v26).mul_add(v309, v316);
-    let v318: f64 = v46 * v317;
-    let v319: f64 = v225 * v222;
-    let v321: f64 = 0.015625f64 * q[0usize];
-    let v322: f64 = v321 * q[2usize];
-    let v323: f64 = v322 * v230;
-    let v324: f64 = v323 - v319;
-    let v325: f64 = 0.25f64 * v228;
-    let v326: f64 = 0.015625f64 * v1;
-    let v327: f64 = v326.mul_add(v230, v325);
-    let v328: f64 = v231 * v222;
-    let v329: f64 = v321 * q[1usize];
-    let v330: f64 = v329 * v230;
-    let v331: f64 = v328 + v330;
-    let v332: f64 = v170 * v26;
-    let v333: f64 = v177 * v26;
-    let v334: f64 = v333.mul_add(v44, -v332);
-    let v335: f64 = v46 * v334;
-    let v336: f64 = 0.25f64 * v170;
-    let v337: f64 = v15.mul_add(v333, v336);
-    let v338: f64 = q[2usize] * v337;
-    let v339: f64 = v20.mul_add(v306, v338);
-    let v340: f64 = v46 * v339;
-    let v341: f64 = v24.mul_add(v333, -v154);
-    let v342: f64 = (-v26).mul_add(v306, v341);
-    let v343: f64 = v46 * v342;
-    let v344: f64 = 0.125f64 * q[1usize];
-    let v345: f64 = v344 * q[2usize];
-    let v346: f64 = v345 * v43;
-    let v347: f64 = v15 * v13;
-    let v348: f64 = v346 + v347;
-    let v349: f64 = v304 - v302;
-    let v350: f64 = 0.125f64 * v8;
-    let v351: f64 = v350.mul_add(v43, v299);
-    let v352: f64 = v63 * v20;
-    let v353: f64 = v352.mul_add(v44, -v147);
-    let v354: f64 = v46 * v353;
-    let v355: f64 = v70 * v20;
-    let v356: f64 = v20.mul_add(v355, v315);
-    let v357: f64 = v16.mul_add(v352, v356);
-    let v358: f64 = v46 * v357;
-    let v359: f64 = v26 * v355;
-    let v360: f64 = v23.mul_add(v352, v310);
-    let v361: f64 = q[2usize].mul_add(v360, -v359);
-    let v362: f64 = v46 * v361;
-    let v363: f64 = v224 * v222;
-    let v364: f64 = 0.015625f64 * q[1usize];
-    let v365: f64 = v364 * q[2usize];
-    let v366: f64 = v365 * v230;
-    let v367: f64 = v363 + v366;
-    let v368: f64 = v330 - v328;
-    let v369: f64 = 0.015625f64 * v8;
-    let v370: f64 = v369.mul_add(v230, v325);
-    let v371: f64 = v170 * v20;
-    let v372: f64 = v177 * v20;
-    let v373: f64 = v372.mul_add(v44, -v371);
-    let v374: f64 = v46 * v373;
-    let v375: f64 = v20.mul_add(v352, v154);
-    let v376: f64 = v16.mul_add(v372, v375);
-    let v377: f64 = v46 * v376;
-    let v378: f64 = v26 * v352;
-    let v379: f64 = v23.mul_add(v372, v336);
-    let v380: f64 = q[2usize].mul_add(v379, -v378);
-    let v381: f64 = v46 * v380;
-    let v382: f64 = 0.125f64 * v5;
-    let v383: f64 = v382.mul_add(v43, v299);
-    let v384: f64 = v294 + v297;
-    let v385: f64 = v346 - v347;
-    let v386: f64 = v33 - v33;
-    let v387: f64 = v63 * v33;
-    let v388: f64 = v387 * v44;
-    let v389: f64 = v43.mul_add(v386, v388);
-    let v390: f64 = v46 * v389;
-    let v391: f64 = v70 * v33;
-    let v392: f64 = v73.mul_add(v387, v310);
-    let v393: f64 = q[0usize] * v392;
-    let v394: f64 = v20.mul_add(v391, v393);
-    let v395: f64 = v46 * v394;
-    let v396: f64 = v26 * v391;
-    let v397: f64 = q[1usize].mul_add(v392, -v396);
-    let v398: f64 = v46 * v397;
-    let v399: f64 = 0.015625f64 * v5;
-    let v400: f64 = v399.mul_add(v230, v325);
-    let v401: f64 = v319 + v323;
-    let v402: f64 = v366 - v363;
-    let v403: f64 = v177 * v33;
-    let v404: f64 = v403 * v44;
-    let v405: f64 = v170.mul_add(v386, v404);
-    let v406: f64 = v46 * v405;
-    let v407: f64 = v73.mul_add(v403, v336);
-    let v408: f64 = q[0usize] * v407;
-    let v409: f64 = v20.mul_add(v387, v408);
-    let v410: f64 = v46 * v409;
-    let v411: f64 = v26 * v387;
-    let v412: f64 = q[1usize].mul_add(v407, -v411);
-    let v413: f64 = v46 * v412;
-    let v415: f64 = 0.5f64 * v45;
-    let v416: f64 = 0.5f64 * v49;
-    let v417: f64 = 0.5f64 * v52;
-    let v418: f64 = 0.5f64 * v171;
-    let v419: f64 = 0.5f64 * v173;
-    let v420: f64 = 0.5f64 * v175;
-    let v422: f64 = p[0usize] / v41;
-    let v423: f64 = v422.powi(3i32);
-    let v424: f64 = q[0usize] * p[4usize];
-    let v426: f64 = v422.sqrt();
-    let v427: f64 = p[13usize] * v426;
-    let v428: f64 = v424.mul_add(v423, -v427);
-    let v430: f64 = v84 * p[5usize];
-    let v431: f64 = 0.5f64.mul_add(v428, v430);
-    let v433: f64 = q[1usize] - p[6usize];
-    let v434: f64 = p[4usize] * v423;
-    let v436: f64 = p[14usize] * v426;
-    let v437: f64 = v434.mul_add(v433, -v436);
-    let v438: f64 = v69 * p[5usize];
-    let v439: f64 = 0.5f64.mul_add(v437, v438);
-    let v441: f64 = v33 * p[7usize];
-    let v443: f64 = v115 * p[8usize];
-    let v444: f64 = v441.mul_add(v423, v443);
-    let v447: f64 = q[1usize] * p[14usize];
-    let v448: f64 = q[0usize].mul_add(p[13usize], v447);
-    let v449: f64 = v41 * v41;
-    let v450: f64 = p[0usize] / v449;
-    let v451: f64 = -v450;
-    let v452: f64 = 0.5f64 * v451;
-    let v453: f64 = v452 / v426;
-    let v454: f64 = v448.mul_add(v453, p[12usize]);
-    let v455: f64 = v422 * v422;
-    let v457: f64 = 3f64 * v451;
-    let v458: f64 = v457 * v455;
-    let v459: f64 = 0.5f64 * p[7usize];
-    let v460: f64 = v433 * v433;
-    let v461: f64 = 0.5f64 * v460;
-    let v462: f64 = 0.5f64.mul_add(v1, v461);
-    let v463: f64 = p[4usize] * v462;
-    let v464: f64 = v459.mul_add(v5, v463);
-    let v465: f64 = q[3usize].mul_add(p[9usize], -v454);
-    let v466: f64 = v458.mul_add(v464, v465);
-    let v468: f64 = v55 * p[10usize];
-    let v469: f64 = 0.5f64.mul_add(v466, v468);
-    out[0usize] = v14;
-    out[1usize] = v22;
-    out[2usize] = v28;
-    out[3usize] = v29;
-    out[4usize] = v30;
-    out[5usize] = v35;
-    out[6usize] = v36;
-    out[7usize] = v37;
-    out[8usize] = v38;
-    out[9usize] = v47;
-    out[10usize] = v50;
-    out[11usize] = v53;
-    out[12usize] = v68;
-    out[13usize] = v82;
-    out[14usize] = v90;
-    out[15usize] = v110;
-    out[16usize] = v124;
-    out[17usize] = v130;
-    out[18usize] = v139;
-    out[19usize] = v144;
-    out[20usize] = v149;
-    out[21usize] = v163;
-    out[22usize] = v166;
-    out[23usize] = v169;
-    out[24usize] = v172;
-    out[25usize] = v174;
-    out[26usize] = v176;
-    out[27usize] = v182;
-    out[28usize] = v190;
-    out[29usize] = v196;
-    out[30usize] = v204;
-    out[31usize] = v214;
-    out[32usize] = v220;
-    out[33usize] = v237;
-    out[34usize] = v244;
-    out[35usize] = v251;
-    out[36usize] = v270;
-    out[37usize] = v273;
-    out[38usize] = v276;
-    out[39usize] = v278;
-    out[40usize] = v281;
-    out[41usize] = v284;
-    out[42usize] = v286;
-    out[43usize] = v292;
-    out[44usize] = v293;
-    out[45usize] = v298;
-    out[46usize] = v301;
-    out[47usize] = v305;
-    out[48usize] = v308;
-    out[49usize] = v314;
-    out[50usize] = v318;
-    out[51usize] = v324;
-    out[52usize] = v327;
-    out[53usize] = v331;
-    out[54usize] = v335;
-    out[55usize] = v340;
-    out[56usize] = v343;
-    out[57usize] = v348;
-    out[58usize] = v349;
-    out[59usize] = v351;
-    out[60usize] = v354;
-    out[61usize] = v358;
-    out[62usize] = v362;
-    out[63usize] = v367;
-    out[64usize] = v368;
-    out[65usize] = v370;
-    out[66usize] = v374;
-    out[67usize] = v377;
-    out[68usize] = v381;
-    out[69usize] = v383;
-    out[70usize] = v384;
-    out[71usize] = v385;
-    out[72usize] = v390;
-    out[73usize] = v395;
-    out[74usize] = v398;
-    out[75usize] = v400;
-    out[76usize] = v401;
-    out[77usize] = v402;
-    out[78usize] = v406;
-    out[79usize] = v410;
-    out[80usize] = v413;
-    out[81usize] = 0f64;
-    out[82usize] = 0f64;
-    out[83usize] = 0f64;
-    out[84usize] = v415;
-    out[85usize] = v416;
-    out[86usize] = v417;
-    out[87usize] = 0f64;
-    out[88usize] = 0f64;
-    out[89usize] = 0f64;
-    out[90usize] = v418;
-    out[91usize] = v419;
-    out[92usize] = v420;
-    out[93usize] = v431;
-    out[94usize] = v439;
-    out[95usize] = v444;
-    out[96usize] = v469;
-    out[97usize] = 0f64;
-    out[98usize] = 0f64;
-    out[99usize] = 0f64;
-    out[100usize] = 0f64;
+    let v222: f64 = c[2][0];
+    let v228: f64 = c[1][0];
+    let v230: f64 = c[3][0];
+    let v253: f64 = c[2][1];
+    let v255: f64 = c[3][1];
+    let v265: f64 = c[1][1];
+    let v224 = 0.0625f64 * q[0];
+    let v225 = 0.0625f64 * q[1];
+    let v226 = v225 * qd[0];
+    let v227 = v224.mul_add(qd[1], -v226);
+    let v229 = v75 * v228;
+    let v231 = 0.0625f64 * q[2];
+    let v232 = v224 * qd[0];
+    let v233 = v231.mul_add(qd[2], v232);
+    let v234 = v225.mul_add(qd[1], v233);
+    let v235 = v73 * v230;
+    let v236 = v222.mul_add(v227, v229);
+    let v237 = v235.mul_add(v234, v236);
+    let v238 = v231 * qd[1];
+    let v239 = v225.mul_add(qd[2], -v238);
+    let v240 = 0.25f64 * qd[0];
+    let v241 = v240 * v228;
+    let v242 = v15 * v230;
+    let v243 = v222.mul_add(v239, v241);
+    let v244 = v242.mul_add(v234, v243);
+    let v245 = v224 * qd[2];
+    let v246 = v231.mul_add(qd[0], -v245);
+    let v247 = 0.25f64 * qd[1];
+    let v248 = v247 * v228;
+    let v249 = v23 * v230;
+    let v250 = v222.mul_add(v246, v248);
+    let v251 = v249.mul_add(v234, v250);
+    let v252 = 0.25f64 * v61;
+    let v254 = v252 * v253;
+    let v256 = v252 * v255;
+    let v257 = 0.25f64 * v234;
+    let v258 = 0.0625f64 * v94;
+    let v259 = 0.0625f64.mul_add(v93, v258);
+    let v260 = 0.0625f64.mul_add(v91, v259);
+    let v261 = 0.25f64 * v230;
+    let v262 = v261 * v260;
+    let v263 = v257.mul_add(v256, v262);
+    let v264 = q[2] * v263;
+    let v266 = v252 * v265;
+    let v267 = 0.25f64 * v266;
+    let v268 = v261.mul_add(v234, v267);
+    let v269 = v227.mul_add(v254, v264);
+    let v270 = qd[2].mul_add(v268, v269);
+    let v271 = q[0] * v263;
+    let v272 = v239.mul_add(v254, v271);
+    let v273 = qd[0].mul_add(v268, v272);
+    let v274 = q[1] * v263;
+    let v275 = v246.mul_add(v254, v274);
+    let v276 = qd[1].mul_add(v268, v275);
+    let v277 = 0.0625f64.mul_add(v5, -v221);
+    let v278 = v222.mul_add(v277, 1f64);
+    let v279 = v224 * q[2];
+    let v280 = v279 * v222;
+    let v281 = v23.mul_add(v228, v280);
+    let v282 = v225 * q[2];
+    let v283 = v15 * v228;
+    let v284 = v282.mul_add(v222, -v283);
+    let v286 = 0.5f64 * p[1];
+    let v288 = 0.25f64 * p[3];
+    let v290 = p[2] - v288;
+    let v292 = 0.125f64.mul_add(v290, v288);
+    let v293 = 0.5f64 * p[3];
+    let v294 = v23 * v13;
+    let v295 = 0.125f64 * q[0];
+    let v296 = v295 * q[2];
+    let v297 = v296 * v43;
+    let v298 = v297 - v294;
+    let v299 = 0.5f64 * v18;
+    let v300 = 0.125f64 * v1;
+    let v301 = v300.mul_add(v43, v299);
+    let v302 = v73 * v13;
+    let v303 = v295 * q[1];
+    let v304 = v303 * v43;
+    let v305 = v302 + v304;
+    let v306 = v63 * v26;
+    let v307 = v306.mul_add(v44, -v142);
+    let v308 = v46 * v307;
+    let v309 = v70 * v26;
+    let v310 = 0.25f64 * v43;
+    let v311 = v15.mul_add(v306, v310);
+    let v312 = q[2] * v311;
+    let v313 = v20.mul_add(v309, v312);
+    let v314 = v46 * v313;
+    let v315 = 0.5f64 * v13;
+    let v316 = v24.mul_add(v306, -v315);
+    let v317 = (-v26).mul_add(v309, v316);
+    let v318 = v46 * v317;
+    let v319 = v225 * v222;
+    let v321 = 0.015625f64 * q[0];
+    let v322 = v321 * q[2];
+    let v323 = v322 * v230;
+    let v324 = v323 - v319;
+    let v325 = 0.25f64 * v228;
+    let v326 = 0.015625f64 * v1;
+    let v327 = v326.mul_add(v230, v325);
+    let v328 = v231 * v222;
+    let v329 = v321 * q[1];
+    let v330 = v329 * v230;
+    let v331 = v328 + v330;
+    let v332 = v170 * v26;
+    let v333 = v177 * v26;
+    let v334 = v333.mul_add(v44, -v332);
+    let v335 = v46 * v334;
+    let v336 = 0.25f64 * v170;
+    let v337 = v15.mul_add(v333, v336);
+    let v338 = q[2] * v337;
+    let v339 = v20.mul_add(v306, v338);
+    let v340 = v46 * v339;
+    let v341 = v24.mul_add(v333, -v154);
+    let v342 = (-v26).mul_add(v306, v341);
+    let v343 = v46 * v342;
+    let v344 = 0.125f64 * q[1];
+    let v345 = v344 * q[2];
+    let v346 = v345 * v43;
+    let v347 = v15 * v13;
+    let v348 = v346 + v347;
+    let v349 = v304 - v302;
+    let v350 = 0.125f64 * v8;
+    let v351 = v350.mul_add(v43, v299);
+    let v352 = v63 * v20;
+    let v353 = v352.mul_add(v44, -v147);
+    let v354 = v46 * v353;
+    let v355 = v70 * v20;
+    let v356 = v20.mul_add(v355, v315);
+    let v357 = v16.mul_add(v352, v356);
+    let v358 = v46 * v357;
+    let v359 = v26 * v355;
+    let v360 = v23.mul_add(v352, v310);
+    let v361 = q[2].mul_add(v360, -v359);
+    let v362 = v46 * v361;
+    let v363 = v224 * v222;
+    let v364 = 0.015625f64 * q[1];
+    let v365 = v364 * q[2];
+    let v366 = v365 * v230;
+    let v367 = v363 + v366;
+    let v368 = v330 - v328;
+    let v369 = 0.015625f64 * v8;
+    let v370 = v369.mul_add(v230, v325);
+    let v371 = v170 * v20;
+    let v372 = v177 * v20;
+    let v373 = v372.mul_add(v44, -v371);
+    let v374 = v46 * v373;
+    let v375 = v20.mul_add(v352, v154);
+    let v376 = v16.mul_add(v372, v375);
+    let v377 = v46 * v376;
+    let v378 = v26 * v352;
+    let v379 = v23.mul_add(v372, v336);
+    let v380 = q[2].mul_add(v379, -v378);
+    let v381 = v46 * v380;
+    let v382 = 0.125f64 * v5;
+    let v383 = v382.mul_add(v43, v299);
+    let v384 = v294 + v297;
+    let v385 = v346 - v347;
+    let v386 = v33 - v33;
+    let v387 = v63 * v33;
+    let v388 = v387 * v44;
+    let v389 = v43.mul_add(v386, v388);
+    let v390 = v46 * v389;
+    let v391 = v70 * v33;
+    let v392 = v73.mul_add(v387, v310);
+    let v393 = q[0] * v392;
+    let v394 = v20.mul_add(v391, v393);
+    let v395 = v46 * v394;
+    let v396 = v26 * v391;
+    let v397 = q[1].mul_add(v392, -v396);
+    let v398 = v46 * v397;
+    let v399 = 0.015625f64 * v5;
+    let v400 = v399.mul_add(v230, v325);
+    let v401 = v319 + v323;
+    let v402 = v366 - v363;
+    let v403 = v177 * v33;
+    let v404 = v403 * v44;
+    let v405 = v170.mul_add(v386, v404);
+    let v406 = v46 * v405;
+    let v407 = v73.mul_add(v403, v336);
+    let v408 = q[0] * v407;
+    let v409 = v20.mul_add(v387, v408);
+    let v410 = v46 * v409;
+    let v411 = v26 * v387;
+    let v412 = q[1].mul_add(v407, -v411);
+    let v413 = v46 * v412;
+    let v415 = 0.5f64 * v45;
+    let v416 = 0.5f64 * v49;
+    let v417 = 0.5f64 * v52;
+    let v418 = 0.5f64 * v171;
+    let v419 = 0.5f64 * v173;
+    let v420 = 0.5f64 * v175;
+    let v422 = p[0] / v41;
+    let v423 = v422.powi(3i32);
+    let v424 = q[0] * p[4];
+    let v426 = v422.sqrt();
+    let v427 = p[13] * v426;
+    let v428 = v424.mul_add(v423, -v427);
+    let v430 = v84 * p[5];
+    let v431 = 0.5f64.mul_add(v428, v430);
+    let v433 = q[1] - p[6];
+    let v434 = p[4] * v423;
+    let v436 = p[14] * v426;
+    let v437 = v434.mul_add(v433, -v436);
+    let v438 = v69 * p[5];
+    let v439 = 0.5f64.mul_add(v437, v438);
+    let v441 = v33 * p[7];
+    let v443 = v115 * p[8];
+    let v444 = v441.mul_add(v423, v443);
+    let v447 = q[1] * p[14];
+    let v448 = q[0].mul_add(p[13], v447);
+    let v449 = v41 * v41;
+    let v450 = p[0] / v449;
+    let v451 = -v450;
+    let v452 = 0.5f64 * v451;
+    let v453 = v452 / v426;
+    let v454 = v448.mul_add(v453, p[12]);
+    let v455 = v422 * v422;
+    let v457 = 3f64 * v451;
+    let v458 = v457 * v455;
+    let v459 = 0.5f64 * p[7];
+    let v460 = v433 * v433;
+    let v461 = 0.5f64 * v460;
+    let v462 = 0.5f64.mul_add(v1, v461);
+    let v463 = p[4] * v462;
+    let v464 = v459.mul_add(v5, v463);
+    let v465 = q[3].mul_add(p[9], -v454);
+    let v466 = v458.mul_add(v464, v465);
+    let v468 = v55 * p[10];
+    let v469 = 0.5f64.mul_add(v466, v468);
+    out[0] = v14;
+    out[1] = v22;
+    out[2] = v28;
+    out[3] = v29;
+    out[4] = v30;
+    out[5] = v35;
+    out[6] = v36;
+    out[7] = v37;
+    out[8] = v38;
+    out[9] = v47;
+    out[10] = v50;
+    out[11] = v53;
+    out[12] = v68;
+    out[13] = v82;
+    out[14] = v90;
+    out[15] = v110;
+    out[16] = v124;
+    out[17] = v130;
+    out[18] = v139;
+    out[19] = v144;
+    out[20] = v149;
+    out[21] = v163;
+    out[22] = v166;
+    out[23] = v169;
+    out[24] = v172;
+    out[25] = v174;
+    out[26] = v176;
+    out[27] = v182;
+    out[28] = v190;
+    out[29] = v196;
+    out[30] = v204;
+    out[31] = v214;
+    out[32] = v220;
+    out[33] = v237;
+    out[34] = v244;
+    out[35] = v251;
+    out[36] = v270;
+    out[37] = v273;
+    out[38] = v276;
+    out[39] = v278;
+    out[40] = v281;
+    out[41] = v284;
+    out[42] = v286;
+    out[43] = v292;
+    out[44] = v293;
+    out[45] = v298;
+    out[46] = v301;
+    out[47] = v305;
+    out[48] = v308;
+    out[49] = v314;
+    out[50] = v318;
+    out[51] = v324;
+    out[52] = v327;
+    out[53] = v331;
+    out[54] = v335;
+    out[55] = v340;
+    out[56] = v343;
+    out[57] = v348;
+    out[58] = v349;
+    out[59] = v351;
+    out[60] = v354;
+    out[61] = v358;
+    out[62] = v362;
+    out[63] = v367;
+    out[64] = v368;
+    out[65] = v370;
+    out[66] = v374;
+    out[67] = v377;
+    out[68] = v381;
+    out[69] = v383;
+    out[70] = v384;
+    out[71] = v385;
+    out[72] = v390;
+    out[73] = v395;
+    out[74] = v398;
+    out[75] = v400;
+    out[76] = v401;
+    out[77] = v402;
+    out[78] = v406;
+    out[79] = v410;
+    out[80] = v413;
+    out[81] = 0f64;
+    out[82] = 0f64;
+    out[83] = 0f64;
+    out[84] = v415;
+    out[85] = v416;
+    out[86] = v417;
+    out[87] = 0f64;
+    out[88] = 0f64;
+    out[89] = 0f64;
+    out[90] = v418;
+    out[91] = v419;
+    out[92] = v420;
+    out[93] = v431;
+    out[94] = v439;
+    out[95] = v444;
+    out[96] = v469;
+    out[97] = 0f64;
+    out[98] = 0f64;
+    out[99] = 0f64;
+    out[100] = 0f64;
 }
 /// Kernel `cell_0_x4`: 596 operations, four evaluations in vector lanes.
 #[cfg(target_arch = "x86_64")]
@@ -1495,839 +1493,626 @@ fn cell_0_0(
 #[allow(unused_variables, unused_parens, clippy::all)]
 #[target_feature(enable = "avx,fma")]
 fn cell_0_x4(
-    q: &[[f64; 4]; 4usize],
-    qd: &[[f64; 4]; 4usize],
-    p: &[[f64; 4]; 15usize],
-    out: &mut [[f64; 4]; 101usize],
+    q: &[[f64; 4]; 4],
+    qd: &[[f64; 4]; 4],
+    p: &[[f64; 4]; 15],
+    out: &mut [[f64; 4]; 101],
 ) {
     use std::arch::x86_64::*;
-    let v1: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0usize]),
-        runtime::lanes::from_array(q[0usize]),
+    let v1 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[0]),
+        runtime::lanes::from_array(q[0]),
     );
-    let v3: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v1);
-    let v5: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[2usize]),
-        runtime::lanes::from_array(q[2usize]),
+    let v3 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v1);
+    let v5 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[2]),
+        runtime::lanes::from_array(q[2]),
     );
-    let v6: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v5);
-    let v8: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1usize]),
-        runtime::lanes::from_array(q[1usize]),
+    let v6 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v5);
+    let v8 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[1]),
+        runtime::lanes::from_array(q[1]),
     );
-    let v9: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v8);
-    let v10: __m256d = _mm256_add_pd(v3, v6);
-    let v11: __m256d = _mm256_add_pd(v10, v9);
-    let c: [[__m256d; 3usize]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
-        3usize,
+    let v9 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v8);
+    let v10 = _mm256_add_pd(v3, v6);
+    let v11 = _mm256_add_pd(v10, v9);
+    let c: [[__m256d; 3]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
+        3,
     >(v11);
-    let v12: __m256d = c[0usize][0usize];
-    let v13: __m256d = c[2usize][0usize];
-    let v18: __m256d = c[1usize][0usize];
-    let v43: __m256d = c[3usize][0usize];
-    let v63: __m256d = c[3usize][1usize];
-    let v70: __m256d = c[2usize][1usize];
-    let v103: __m256d = c[3usize][2usize];
-    let v111: __m256d = c[2usize][2usize];
-    let v158: __m256d = c[1usize][1usize];
-    let v170: __m256d = c[4usize][0usize];
-    let v177: __m256d = c[4usize][1usize];
-    let v198: __m256d = c[4usize][2usize];
-    let v14: __m256d = _mm256_fmadd_pd(v6, v13, v12);
-    let v15: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[0usize]),
+    let v12: __m256d = c[0][0];
+    let v13: __m256d = c[2][0];
+    let v18: __m256d = c[1][0];
+    let v43: __m256d = c[3][0];
+    let v63: __m256d = c[3][1];
+    let v70: __m256d = c[2][1];
+    let v103: __m256d = c[3][2];
+    let v111: __m256d = c[2][2];
+    let v158: __m256d = c[1][1];
+    let v170: __m256d = c[4][0];
+    let v177: __m256d = c[4][1];
+    let v198: __m256d = c[4][2];
+    let v14 = _mm256_fmadd_pd(v6, v13, v12);
+    let v15 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[0]));
+    let v16 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[2]));
+    let v17 = _mm256_mul_pd(v16, v13);
+    let v20 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[1]));
+    let v21 = _mm256_mul_pd(v20, v18);
+    let v22 = _mm256_sub_pd(v17, v21);
+    let v23 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[1]));
+    let v24 = _mm256_mul_pd(v23, runtime::lanes::from_array(q[2]));
+    let v25 = _mm256_mul_pd(v24, v13);
+    let v26 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[0]));
+    let v27 = _mm256_mul_pd(v26, v18);
+    let v28 = _mm256_add_pd(v25, v27);
+    let v29 = _mm256_add_pd(v17, v21);
+    let v30 = _mm256_fmadd_pd(v3, v13, v12);
+    let v31 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[1]));
+    let v32 = _mm256_mul_pd(v31, v13);
+    let v33 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[2]));
+    let v34 = _mm256_mul_pd(v33, v18);
+    let v35 = _mm256_sub_pd(v32, v34);
+    let v36 = _mm256_sub_pd(v25, v27);
+    let v37 = _mm256_add_pd(v32, v34);
+    let v38 = _mm256_fmadd_pd(v9, v13, v12);
+    let v41 = _mm256_add_pd(
+        runtime::lanes::from_array(q[3]),
+        runtime::lanes::from_array(p[0]),
     );
-    let v16: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(q[2usize]));
-    let v17: __m256d = _mm256_mul_pd(v16, v13);
-    let v20: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[1usize]),
+    let v44 = _mm256_sub_pd(v6, v11);
+    let v45 = _mm256_fmadd_pd(v43, v44, _mm256_set1_pd(1f64));
+    let v46 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v41);
+    let v47 = _mm256_mul_pd(v46, v45);
+    let v48 = _mm256_mul_pd(v16, v43);
+    let v49 = _mm256_fmadd_pd(v20, v13, v48);
+    let v50 = _mm256_mul_pd(v46, v49);
+    let v51 = _mm256_mul_pd(v26, v13);
+    let v52 = _mm256_fmsub_pd(v24, v43, v51);
+    let v53 = _mm256_mul_pd(v46, v52);
+    let v55 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[3]));
+    let v57 = _mm256_mul_pd(v33, runtime::lanes::from_array(qd[2]));
+    let v60 = _mm256_fmadd_pd(v26, runtime::lanes::from_array(qd[0]), v57);
+    let v61 = _mm256_fmadd_pd(v20, runtime::lanes::from_array(qd[1]), v60);
+    let v62 = _mm256_sub_pd(v57, v61);
+    let v64 = _mm256_mul_pd(v61, v63);
+    let v65 = _mm256_mul_pd(v64, v44);
+    let v66 = _mm256_fmadd_pd(v43, v62, v65);
+    let v67 = _mm256_mul_pd(v46, v66);
+    let v68 = _mm256_fmadd_pd(v55, v45, v67);
+    let v69 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[1]));
+    let v71 = _mm256_mul_pd(v61, v70);
+    let v72 = _mm256_mul_pd(v20, v71);
+    let v73 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[2]));
+    let v74 = _mm256_mul_pd(v73, runtime::lanes::from_array(qd[0]));
+    let v75 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[2]));
+    let v76 = _mm256_mul_pd(v73, v64);
+    let v77 = _mm256_fmadd_pd(v75, v43, v76);
+    let v78 = _mm256_fmadd_pd(v69, v13, v72);
+    let v79 = _mm256_fmadd_pd(v74, v43, v78);
+    let v80 = _mm256_fmadd_pd(runtime::lanes::from_array(q[0]), v77, v79);
+    let v81 = _mm256_mul_pd(v46, v80);
+    let v82 = _mm256_fmadd_pd(v55, v49, v81);
+    let v83 = _mm256_mul_pd(v73, runtime::lanes::from_array(qd[1]));
+    let v84 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[0]));
+    let v85 = _mm256_mul_pd(v84, v13);
+    let v86 = _mm256_fmsub_pd(v83, v43, v85);
+    let v87 = _mm256_fnmadd_pd(v26, v71, v86);
+    let v88 = _mm256_fmadd_pd(runtime::lanes::from_array(q[1]), v77, v87);
+    let v89 = _mm256_mul_pd(v46, v88);
+    let v90 = _mm256_fmadd_pd(v55, v52, v89);
+    let v91 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[2]),
+        runtime::lanes::from_array(qd[2]),
     );
-    let v21: __m256d = _mm256_mul_pd(v20, v18);
-    let v22: __m256d = _mm256_sub_pd(v17, v21);
-    let v23: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[1usize]),
+    let v92 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v91);
+    let v93 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[0]),
+        runtime::lanes::from_array(qd[0]),
     );
-    let v24: __m256d = _mm256_mul_pd(v23, runtime::lanes::from_array(q[2usize]));
-    let v25: __m256d = _mm256_mul_pd(v24, v13);
-    let v26: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[0usize]),
+    let v94 = _mm256_mul_pd(
+        runtime::lanes::from_array(qd[1]),
+        runtime::lanes::from_array(qd[1]),
     );
-    let v27: __m256d = _mm256_mul_pd(v26, v18);
-    let v28: __m256d = _mm256_add_pd(v25, v27);
-    let v29: __m256d = _mm256_add_pd(v17, v21);
-    let v30: __m256d = _mm256_fmadd_pd(v3, v13, v12);
-    let v31: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(q[1usize]));
-    let v32: __m256d = _mm256_mul_pd(v31, v13);
-    let v33: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(q[2usize]),
-    );
-    let v34: __m256d = _mm256_mul_pd(v33, v18);
-    let v35: __m256d = _mm256_sub_pd(v32, v34);
-    let v36: __m256d = _mm256_sub_pd(v25, v27);
-    let v37: __m256d = _mm256_add_pd(v32, v34);
-    let v38: __m256d = _mm256_fmadd_pd(v9, v13, v12);
-    let v41: __m256d = _mm256_add_pd(
-        runtime::lanes::from_array(q[3usize]),
-        runtime::lanes::from_array(p[0usize]),
-    );
-    let v44: __m256d = _mm256_sub_pd(v6, v11);
-    let v45: __m256d = _mm256_fmadd_pd(v43, v44, _mm256_set1_pd(1f64));
-    let v46: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v41);
-    let v47: __m256d = _mm256_mul_pd(v46, v45);
-    let v48: __m256d = _mm256_mul_pd(v16, v43);
-    let v49: __m256d = _mm256_fmadd_pd(v20, v13, v48);
-    let v50: __m256d = _mm256_mul_pd(v46, v49);
-    let v51: __m256d = _mm256_mul_pd(v26, v13);
-    let v52: __m256d = _mm256_fmsub_pd(v24, v43, v51);
-    let v53: __m256d = _mm256_mul_pd(v46, v52);
-    let v55: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[3usize]),
-    );
-    let v57: __m256d = _mm256_mul_pd(v33, runtime::lanes::from_array(qd[2usize]));
-    let v60: __m256d = _mm256_fmadd_pd(v26, runtime::lanes::from_array(qd[0usize]), v57);
-    let v61: __m256d = _mm256_fmadd_pd(v20, runtime::lanes::from_array(qd[1usize]), v60);
-    let v62: __m256d = _mm256_sub_pd(v57, v61);
-    let v64: __m256d = _mm256_mul_pd(v61, v63);
-    let v65: __m256d = _mm256_mul_pd(v64, v44);
-    let v66: __m256d = _mm256_fmadd_pd(v43, v62, v65);
-    let v67: __m256d = _mm256_mul_pd(v46, v66);
-    let v68: __m256d = _mm256_fmadd_pd(v55, v45, v67);
-    let v69: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[1usize]),
-    );
-    let v71: __m256d = _mm256_mul_pd(v61, v70);
-    let v72: __m256d = _mm256_mul_pd(v20, v71);
-    let v73: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(q[2usize]),
-    );
-    let v74: __m256d = _mm256_mul_pd(v73, runtime::lanes::from_array(qd[0usize]));
-    let v75: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[2usize]),
-    );
-    let v76: __m256d = _mm256_mul_pd(v73, v64);
-    let v77: __m256d = _mm256_fmadd_pd(v75, v43, v76);
-    let v78: __m256d = _mm256_fmadd_pd(v69, v13, v72);
-    let v79: __m256d = _mm256_fmadd_pd(v74, v43, v78);
-    let v80: __m256d = _mm256_fmadd_pd(runtime::lanes::from_array(q[0usize]), v77, v79);
-    let v81: __m256d = _mm256_mul_pd(v46, v80);
-    let v82: __m256d = _mm256_fmadd_pd(v55, v49, v81);
-    let v83: __m256d = _mm256_mul_pd(v73, runtime::lanes::from_array(qd[1usize]));
-    let v84: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[0usize]),
-    );
-    let v85: __m256d = _mm256_mul_pd(v84, v13);
-    let v86: __m256d = _mm256_fmsub_pd(v83, v43, v85);
-    let v87: __m256d = _mm256_fnmadd_pd(v26, v71, v86);
-    let v88: __m256d = _mm256_fmadd_pd(runtime::lanes::from_array(q[1usize]), v77, v87);
-    let v89: __m256d = _mm256_mul_pd(v46, v88);
-    let v90: __m256d = _mm256_fmadd_pd(v55, v52, v89);
-    let v91: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        runtime::lanes::from_array(qd[2usize]),
-    );
-    let v92: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v91);
-    let v93: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        runtime::lanes::from_array(qd[0usize]),
-    );
-    let v94: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        runtime::lanes::from_array(qd[1usize]),
-    );
-    let v95: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v94);
-    let v96: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v93, v95);
-    let v97: __m256d = _mm256_add_pd(v96, v92);
-    let v98: __m256d = _mm256_sub_pd(v92, v97);
-    let v100: __m256d = _mm256_mul_pd(_mm256_set1_pd(2f64), v61);
-    let v101: __m256d = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[2usize]),
-        runtime::lanes::from_array(qd[2usize]),
+    let v95 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v94);
+    let v96 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v93, v95);
+    let v97 = _mm256_add_pd(v96, v92);
+    let v98 = _mm256_sub_pd(v92, v97);
+    let v100 = _mm256_mul_pd(_mm256_set1_pd(2f64), v61);
+    let v101 = _mm256_fmsub_pd(
+        runtime::lanes::from_array(q[2]),
+        runtime::lanes::from_array(qd[2]),
         v100,
     );
-    let v102: __m256d = _mm256_mul_pd(v64, v101);
-    let v104: __m256d = _mm256_mul_pd(v61, v61);
-    let v105: __m256d = _mm256_mul_pd(v103, v104);
-    let v106: __m256d = _mm256_fmadd_pd(v63, v97, v105);
-    let v107: __m256d = _mm256_fmadd_pd(v43, v98, v102);
-    let v108: __m256d = _mm256_fmadd_pd(v106, v44, v107);
-    let v109: __m256d = _mm256_mul_pd(v46, v108);
-    let v110: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[3usize]),
-        v66,
-        v109,
-    );
-    let v112: __m256d = _mm256_mul_pd(v104, v111);
-    let v113: __m256d = _mm256_fmadd_pd(v70, v97, v112);
-    let v114: __m256d = _mm256_mul_pd(v20, v113);
-    let v115: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(qd[2usize]),
-    );
-    let v116: __m256d = _mm256_mul_pd(v73, v106);
-    let v117: __m256d = _mm256_fmadd_pd(v115, v64, v116);
-    let v118: __m256d = _mm256_mul_pd(v33, v64);
-    let v119: __m256d = _mm256_fmadd_pd(v115, v43, v118);
-    let v120: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        v71,
-        v114,
-    );
-    let v121: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[0usize]),
-        v117,
-        v120,
-    );
-    let v122: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        v119,
-        v121,
-    );
-    let v123: __m256d = _mm256_mul_pd(v46, v122);
-    let v124: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[3usize]),
-        v80,
-        v123,
-    );
-    let v125: __m256d = _mm256_mul_pd(runtime::lanes::from_array(qd[0usize]), v71);
-    let v126: __m256d = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[1usize]),
-        v117,
-        v125,
-    );
-    let v127: __m256d = _mm256_fnmadd_pd(v26, v113, v126);
-    let v128: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        v119,
-        v127,
-    );
-    let v129: __m256d = _mm256_mul_pd(v46, v128);
-    let v130: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[3usize]),
-        v88,
-        v129,
-    );
-    let v131: __m256d = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[0usize]));
-    let v132: __m256d = _mm256_fmsub_pd(
-        v15,
-        runtime::lanes::from_array(qd[1usize]),
-        v131,
-    );
-    let v133: __m256d = _mm256_mul_pd(v115, v18);
-    let v134: __m256d = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[0usize]));
-    let v135: __m256d = _mm256_fmadd_pd(
-        v73,
-        runtime::lanes::from_array(qd[2usize]),
-        v134,
-    );
-    let v136: __m256d = _mm256_fmadd_pd(
-        v23,
-        runtime::lanes::from_array(qd[1usize]),
-        v135,
-    );
-    let v137: __m256d = _mm256_mul_pd(v33, v43);
-    let v138: __m256d = _mm256_fmadd_pd(v13, v132, v133);
-    let v139: __m256d = _mm256_fmadd_pd(v137, v136, v138);
-    let v140: __m256d = _mm256_fmsub_pd(
-        v23,
-        runtime::lanes::from_array(qd[2usize]),
-        v83,
-    );
-    let v141: __m256d = _mm256_mul_pd(v84, v18);
-    let v142: __m256d = _mm256_mul_pd(v26, v43);
-    let v143: __m256d = _mm256_fmadd_pd(v13, v140, v141);
-    let v144: __m256d = _mm256_fmadd_pd(v142, v136, v143);
-    let v145: __m256d = _mm256_fnmadd_pd(
-        v15,
-        runtime::lanes::from_array(qd[2usize]),
-        v74,
-    );
-    let v146: __m256d = _mm256_mul_pd(v69, v18);
-    let v147: __m256d = _mm256_mul_pd(v20, v43);
-    let v148: __m256d = _mm256_fmadd_pd(v13, v145, v146);
-    let v149: __m256d = _mm256_fmadd_pd(v147, v136, v148);
-    let v150: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v136);
-    let v151: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v94);
-    let v152: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v93, v151);
-    let v153: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v91, v152);
-    let v154: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v43);
-    let v155: __m256d = _mm256_mul_pd(v154, v153);
-    let v156: __m256d = _mm256_fmadd_pd(v150, v64, v155);
-    let v157: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[2usize]), v156);
-    let v159: __m256d = _mm256_mul_pd(v61, v158);
-    let v160: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v159);
-    let v161: __m256d = _mm256_fmadd_pd(v154, v136, v160);
-    let v162: __m256d = _mm256_fmadd_pd(v132, v71, v157);
-    let v163: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        v161,
-        v162,
-    );
-    let v164: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[0usize]), v156);
-    let v165: __m256d = _mm256_fmadd_pd(v140, v71, v164);
-    let v166: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        v161,
-        v165,
-    );
-    let v167: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[1usize]), v156);
-    let v168: __m256d = _mm256_fmadd_pd(v145, v71, v167);
-    let v169: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        v161,
-        v168,
-    );
-    let v171: __m256d = _mm256_fmadd_pd(v170, v44, _mm256_set1_pd(0.5f64));
-    let v172: __m256d = _mm256_mul_pd(v46, v171);
-    let v173: __m256d = _mm256_fmadd_pd(v16, v170, v147);
-    let v174: __m256d = _mm256_mul_pd(v46, v173);
-    let v175: __m256d = _mm256_fmsub_pd(v24, v170, v142);
-    let v176: __m256d = _mm256_mul_pd(v46, v175);
-    let v178: __m256d = _mm256_mul_pd(v61, v177);
-    let v179: __m256d = _mm256_mul_pd(v178, v44);
-    let v180: __m256d = _mm256_fmadd_pd(v170, v62, v179);
-    let v181: __m256d = _mm256_mul_pd(v46, v180);
-    let v182: __m256d = _mm256_fmadd_pd(v55, v171, v181);
-    let v183: __m256d = _mm256_mul_pd(v20, v64);
-    let v184: __m256d = _mm256_mul_pd(v73, v178);
-    let v185: __m256d = _mm256_fmadd_pd(v75, v170, v184);
-    let v186: __m256d = _mm256_fmadd_pd(v69, v43, v183);
-    let v187: __m256d = _mm256_fmadd_pd(v74, v170, v186);
-    let v188: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[0usize]),
-        v185,
-        v187,
-    );
-    let v189: __m256d = _mm256_mul_pd(v46, v188);
-    let v190: __m256d = _mm256_fmadd_pd(v55, v173, v189);
-    let v191: __m256d = _mm256_mul_pd(v84, v43);
-    let v192: __m256d = _mm256_fmsub_pd(v83, v170, v191);
-    let v193: __m256d = _mm256_fnmadd_pd(v26, v64, v192);
-    let v194: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[1usize]),
-        v185,
-        v193,
-    );
-    let v195: __m256d = _mm256_mul_pd(v46, v194);
-    let v196: __m256d = _mm256_fmadd_pd(v55, v175, v195);
-    let v197: __m256d = _mm256_mul_pd(v178, v101);
-    let v199: __m256d = _mm256_mul_pd(v104, v198);
-    let v200: __m256d = _mm256_fmadd_pd(v97, v177, v199);
-    let v201: __m256d = _mm256_fmadd_pd(v170, v98, v197);
-    let v202: __m256d = _mm256_fmadd_pd(v200, v44, v201);
-    let v203: __m256d = _mm256_mul_pd(v46, v202);
-    let v204: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[3usize]),
-        v180,
-        v203,
-    );
-    let v205: __m256d = _mm256_mul_pd(v20, v106);
-    let v206: __m256d = _mm256_mul_pd(v73, v200);
-    let v207: __m256d = _mm256_fmadd_pd(v115, v178, v206);
-    let v208: __m256d = _mm256_mul_pd(v33, v178);
-    let v209: __m256d = _mm256_fmadd_pd(v115, v170, v208);
-    let v210: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        v64,
-        v205,
-    );
-    let v211: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[0usize]),
-        v207,
-        v210,
-    );
-    let v212: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        v209,
-        v211,
-    );
-    let v213: __m256d = _mm256_mul_pd(v46, v212);
-    let v214: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[3usize]),
-        v188,
-        v213,
-    );
-    let v215: __m256d = _mm256_mul_pd(runtime::lanes::from_array(qd[0usize]), v64);
-    let v216: __m256d = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[1usize]),
-        v207,
-        v215,
-    );
-    let v217: __m256d = _mm256_fnmadd_pd(v26, v106, v216);
-    let v218: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        v209,
-        v217,
-    );
-    let v219: __m256d = _mm256_mul_pd(v46, v218);
-    let v220: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[3usize]),
-        v194,
-        v219,
-    );
-    let v221: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v11);
-    let c: [[__m256d; 2usize]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
-        2usize,
+    let v102 = _mm256_mul_pd(v64, v101);
+    let v104 = _mm256_mul_pd(v61, v61);
+    let v105 = _mm256_mul_pd(v103, v104);
+    let v106 = _mm256_fmadd_pd(v63, v97, v105);
+    let v107 = _mm256_fmadd_pd(v43, v98, v102);
+    let v108 = _mm256_fmadd_pd(v106, v44, v107);
+    let v109 = _mm256_mul_pd(v46, v108);
+    let v110 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[3]), v66, v109);
+    let v112 = _mm256_mul_pd(v104, v111);
+    let v113 = _mm256_fmadd_pd(v70, v97, v112);
+    let v114 = _mm256_mul_pd(v20, v113);
+    let v115 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[2]));
+    let v116 = _mm256_mul_pd(v73, v106);
+    let v117 = _mm256_fmadd_pd(v115, v64, v116);
+    let v118 = _mm256_mul_pd(v33, v64);
+    let v119 = _mm256_fmadd_pd(v115, v43, v118);
+    let v120 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v71, v114);
+    let v121 = _mm256_fmadd_pd(runtime::lanes::from_array(q[0]), v117, v120);
+    let v122 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v119, v121);
+    let v123 = _mm256_mul_pd(v46, v122);
+    let v124 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[3]), v80, v123);
+    let v125 = _mm256_mul_pd(runtime::lanes::from_array(qd[0]), v71);
+    let v126 = _mm256_fmsub_pd(runtime::lanes::from_array(q[1]), v117, v125);
+    let v127 = _mm256_fnmadd_pd(v26, v113, v126);
+    let v128 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v119, v127);
+    let v129 = _mm256_mul_pd(v46, v128);
+    let v130 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[3]), v88, v129);
+    let v131 = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[0]));
+    let v132 = _mm256_fmsub_pd(v15, runtime::lanes::from_array(qd[1]), v131);
+    let v133 = _mm256_mul_pd(v115, v18);
+    let v134 = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[0]));
+    let v135 = _mm256_fmadd_pd(v73, runtime::lanes::from_array(qd[2]), v134);
+    let v136 = _mm256_fmadd_pd(v23, runtime::lanes::from_array(qd[1]), v135);
+    let v137 = _mm256_mul_pd(v33, v43);
+    let v138 = _mm256_fmadd_pd(v13, v132, v133);
+    let v139 = _mm256_fmadd_pd(v137, v136, v138);
+    let v140 = _mm256_fmsub_pd(v23, runtime::lanes::from_array(qd[2]), v83);
+    let v141 = _mm256_mul_pd(v84, v18);
+    let v142 = _mm256_mul_pd(v26, v43);
+    let v143 = _mm256_fmadd_pd(v13, v140, v141);
+    let v144 = _mm256_fmadd_pd(v142, v136, v143);
+    let v145 = _mm256_fnmadd_pd(v15, runtime::lanes::from_array(qd[2]), v74);
+    let v146 = _mm256_mul_pd(v69, v18);
+    let v147 = _mm256_mul_pd(v20, v43);
+    let v148 = _mm256_fmadd_pd(v13, v145, v146);
+    let v149 = _mm256_fmadd_pd(v147, v136, v148);
+    let v150 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v136);
+    let v151 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v94);
+    let v152 = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v93, v151);
+    let v153 = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v91, v152);
+    let v154 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v43);
+    let v155 = _mm256_mul_pd(v154, v153);
+    let v156 = _mm256_fmadd_pd(v150, v64, v155);
+    let v157 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v156);
+    let v159 = _mm256_mul_pd(v61, v158);
+    let v160 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v159);
+    let v161 = _mm256_fmadd_pd(v154, v136, v160);
+    let v162 = _mm256_fmadd_pd(v132, v71, v157);
+    let v163 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v161, v162);
+    let v164 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v156);
+    let v165 = _mm256_fmadd_pd(v140, v71, v164);
+    let v166 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v161, v165);
+    let v167 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v156);
+    let v168 = _mm256_fmadd_pd(v145, v71, v167);
+    let v169 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v161, v168);
+    let v171 = _mm256_fmadd_pd(v170, v44, _mm256_set1_pd(0.5f64));
+    let v172 = _mm256_mul_pd(v46, v171);
+    let v173 = _mm256_fmadd_pd(v16, v170, v147);
+    let v174 = _mm256_mul_pd(v46, v173);
+    let v175 = _mm256_fmsub_pd(v24, v170, v142);
+    let v176 = _mm256_mul_pd(v46, v175);
+    let v178 = _mm256_mul_pd(v61, v177);
+    let v179 = _mm256_mul_pd(v178, v44);
+    let v180 = _mm256_fmadd_pd(v170, v62, v179);
+    let v181 = _mm256_mul_pd(v46, v180);
+    let v182 = _mm256_fmadd_pd(v55, v171, v181);
+    let v183 = _mm256_mul_pd(v20, v64);
+    let v184 = _mm256_mul_pd(v73, v178);
+    let v185 = _mm256_fmadd_pd(v75, v170, v184);
+    let v186 = _mm256_fmadd_pd(v69, v43, v183);
+    let v187 = _mm256_fmadd_pd(v74, v170, v186);
+    let v188 = _mm256_fmadd_pd(runtime::lanes::from_array(q[0]), v185, v187);
+    let v189 = _mm256_mul_pd(v46, v188);
+    let v190 = _mm256_fmadd_pd(v55, v173, v189);
+    let v191 = _mm256_mul_pd(v84, v43);
+    let v192 = _mm256_fmsub_pd(v83, v170, v191);
+    let v193 = _mm256_fnmadd_pd(v26, v64, v192);
+    let v194 = _mm256_fmadd_pd(runtime::lanes::from_array(q[1]), v185, v193);
+    let v195 = _mm256_mul_pd(v46, v194);
+    let v196 = _mm256_fmadd_pd(v55, v175, v195);
+    let v197 = _mm256_mul_pd(v178, v101);
+    let v199 = _mm256_mul_pd(v104, v198);
+    let v200 = _mm256_fmadd_pd(v97, v177, v199);
+    let v201 = _mm256_fmadd_pd(v170, v98, v197);
+    let v202 = _mm256_fmadd_pd(v200, v44, v201);
+    let v203 = _mm256_mul_pd(v46, v202);
+    let v204 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[3]), v180, v203);
+    let v205 = _mm256_mul_pd(v20, v106);
+    let v206 = _mm256_mul_pd(v73, v200);
+    let v207 = _mm256_fmadd_pd(v115, v178, v206);
+    let v208 = _mm256_mul_pd(v33, v178);
+    let v209 = _mm256_fmadd_pd(v115, v170, v208);
+    let v210 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v64, v205);
+    let v211 = _mm256_fmadd_pd(runtime::lanes::from_array(q[0]), v207, v210);
+    let v212 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v209, v211);
+    let v213 = _mm256_mul_pd(v46, v212);
+    let v214 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[3]), v188, v213);
+    let v215 = _mm256_mul_pd(runtime::lanes::from_array(qd[0]), v64);
+    let v216 = _mm256_fmsub_pd(runtime::lanes::from_array(q[1]), v207, v215);
+    let v217 = _mm256_fnmadd_pd(v26, v106, v216);
+    let v218 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v209, v217);
+    let v219 = _mm256_mul_pd(v46, v218);
+    let v220 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[3]), v194, v219);
+    let v221 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v11);
+    let c: [[__m256d; 2]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
+        2,
     >(v221);
-    let v222: __m256d = c[2usize][0usize];
-    let v228: __m256d = c[1usize][0usize];
-    let v230: __m256d = c[3usize][0usize];
-    let v253: __m256d = c[2usize][1usize];
-    let v255: __m256d = c[3usize][1usize];
-    let v265: __m256d = c[1usize][1usize];
-    let v224: __m256d = _mm256_mul_pd(
+    let v222: __m256d = c[2][0];
+    let v228: __m256d = c[1][0];
+    let v230: __m256d = c[3][0];
+    let v253: __m256d = c[2][1];
+    let v255: __m256d = c[3][1];
+    let v265: __m256d = c[1][1];
+    let v224 = _mm256_mul_pd(
         _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[0usize]),
+        runtime::lanes::from_array(q[0]),
     );
-    let v225: __m256d = _mm256_mul_pd(
+    let v225 = _mm256_mul_pd(
         _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[1usize]),
+        runtime::lanes::from_array(q[1]),
     );
-    let v226: __m256d = _mm256_mul_pd(v225, runtime::lanes::from_array(qd[0usize]));
-    let v227: __m256d = _mm256_fmsub_pd(
-        v224,
-        runtime::lanes::from_array(qd[1usize]),
-        v226,
-    );
-    let v229: __m256d = _mm256_mul_pd(v75, v228);
-    let v231: __m256d = _mm256_mul_pd(
+    let v226 = _mm256_mul_pd(v225, runtime::lanes::from_array(qd[0]));
+    let v227 = _mm256_fmsub_pd(v224, runtime::lanes::from_array(qd[1]), v226);
+    let v229 = _mm256_mul_pd(v75, v228);
+    let v231 = _mm256_mul_pd(
         _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[2usize]),
+        runtime::lanes::from_array(q[2]),
     );
-    let v232: __m256d = _mm256_mul_pd(v224, runtime::lanes::from_array(qd[0usize]));
-    let v233: __m256d = _mm256_fmadd_pd(
-        v231,
-        runtime::lanes::from_array(qd[2usize]),
-        v232,
-    );
-    let v234: __m256d = _mm256_fmadd_pd(
-        v225,
-        runtime::lanes::from_array(qd[1usize]),
-        v233,
-    );
-    let v235: __m256d = _mm256_mul_pd(v73, v230);
-    let v236: __m256d = _mm256_fmadd_pd(v222, v227, v229);
-    let v237: __m256d = _mm256_fmadd_pd(v235, v234, v236);
-    let v238: __m256d = _mm256_mul_pd(v231, runtime::lanes::from_array(qd[1usize]));
-    let v239: __m256d = _mm256_fmsub_pd(
-        v225,
-        runtime::lanes::from_array(qd[2usize]),
-        v238,
-    );
-    let v240: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[0usize]),
-    );
-    let v241: __m256d = _mm256_mul_pd(v240, v228);
-    let v242: __m256d = _mm256_mul_pd(v15, v230);
-    let v243: __m256d = _mm256_fmadd_pd(v222, v239, v241);
-    let v244: __m256d = _mm256_fmadd_pd(v242, v234, v243);
-    let v245: __m256d = _mm256_mul_pd(v224, runtime::lanes::from_array(qd[2usize]));
-    let v246: __m256d = _mm256_fmsub_pd(
-        v231,
-        runtime::lanes::from_array(qd[0usize]),
-        v245,
-    );
-    let v247: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[1usize]),
-    );
-    let v248: __m256d = _mm256_mul_pd(v247, v228);
-    let v249: __m256d = _mm256_mul_pd(v23, v230);
-    let v250: __m256d = _mm256_fmadd_pd(v222, v246, v248);
-    let v251: __m256d = _mm256_fmadd_pd(v249, v234, v250);
-    let v252: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v61);
-    let v254: __m256d = _mm256_mul_pd(v252, v253);
-    let v256: __m256d = _mm256_mul_pd(v252, v255);
-    let v257: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v234);
-    let v258: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.0625f64), v94);
-    let v259: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v93, v258);
-    let v260: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v91, v259);
-    let v261: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v230);
-    let v262: __m256d = _mm256_mul_pd(v261, v260);
-    let v263: __m256d = _mm256_fmadd_pd(v257, v256, v262);
-    let v264: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[2usize]), v263);
-    let v266: __m256d = _mm256_mul_pd(v252, v265);
-    let v267: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v266);
-    let v268: __m256d = _mm256_fmadd_pd(v261, v234, v267);
-    let v269: __m256d = _mm256_fmadd_pd(v227, v254, v264);
-    let v270: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[2usize]),
-        v268,
-        v269,
-    );
-    let v271: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[0usize]), v263);
-    let v272: __m256d = _mm256_fmadd_pd(v239, v254, v271);
-    let v273: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[0usize]),
-        v268,
-        v272,
-    );
-    let v274: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[1usize]), v263);
-    let v275: __m256d = _mm256_fmadd_pd(v246, v254, v274);
-    let v276: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[1usize]),
-        v268,
-        v275,
-    );
-    let v277: __m256d = _mm256_fmsub_pd(_mm256_set1_pd(0.0625f64), v5, v221);
-    let v278: __m256d = _mm256_fmadd_pd(v222, v277, _mm256_set1_pd(1f64));
-    let v279: __m256d = _mm256_mul_pd(v224, runtime::lanes::from_array(q[2usize]));
-    let v280: __m256d = _mm256_mul_pd(v279, v222);
-    let v281: __m256d = _mm256_fmadd_pd(v23, v228, v280);
-    let v282: __m256d = _mm256_mul_pd(v225, runtime::lanes::from_array(q[2usize]));
-    let v283: __m256d = _mm256_mul_pd(v15, v228);
-    let v284: __m256d = _mm256_fmsub_pd(v282, v222, v283);
-    let v286: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(p[1usize]),
-    );
-    let v288: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(p[3usize]),
-    );
-    let v290: __m256d = _mm256_sub_pd(runtime::lanes::from_array(p[2usize]), v288);
-    let v292: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.125f64), v290, v288);
-    let v293: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(p[3usize]),
-    );
-    let v294: __m256d = _mm256_mul_pd(v23, v13);
-    let v295: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.125f64),
-        runtime::lanes::from_array(q[0usize]),
-    );
-    let v296: __m256d = _mm256_mul_pd(v295, runtime::lanes::from_array(q[2usize]));
-    let v297: __m256d = _mm256_mul_pd(v296, v43);
-    let v298: __m256d = _mm256_sub_pd(v297, v294);
-    let v299: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v18);
-    let v300: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v1);
-    let v301: __m256d = _mm256_fmadd_pd(v300, v43, v299);
-    let v302: __m256d = _mm256_mul_pd(v73, v13);
-    let v303: __m256d = _mm256_mul_pd(v295, runtime::lanes::from_array(q[1usize]));
-    let v304: __m256d = _mm256_mul_pd(v303, v43);
-    let v305: __m256d = _mm256_add_pd(v302, v304);
-    let v306: __m256d = _mm256_mul_pd(v63, v26);
-    let v307: __m256d = _mm256_fmsub_pd(v306, v44, v142);
-    let v308: __m256d = _mm256_mul_pd(v46, v307);
-    let v309: __m256d = _mm256_mul_pd(v70, v26);
-    let v310: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v43);
-    let v311: __m256d = _mm256_fmadd_pd(v15, v306, v310);
-    let v312: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[2usize]), v311);
-    let v313: __m256d = _mm256_fmadd_pd(v20, v309, v312);
-    let v314: __m256d = _mm256_mul_pd(v46, v313);
-    let v315: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v13);
-    let v316: __m256d = _mm256_fmsub_pd(v24, v306, v315);
-    let v317: __m256d = _mm256_fnmadd_pd(v26, v309, v316);
-    let v318: __m256d = _mm256_mul_pd(v46, v317);
-    let v319: __m256d = _mm256_mul_pd(v225, v222);
-    let v321: __m256d = _mm256_mul_pd(
+    let v232 = _mm256_mul_pd(v224, runtime::lanes::from_array(qd[0]));
+    let v233 = _mm256_fmadd_pd(v231, runtime::lanes::from_array(qd[2]), v232);
+    let v234 = _mm256_fmadd_pd(v225, runtime::lanes::from_array(qd[1]), v233);
+    let v235 = _mm256_mul_pd(v73, v230);
+    let v236 = _mm256_fmadd_pd(v222, v227, v229);
+    let v237 = _mm256_fmadd_pd(v235, v234, v236);
+    let v238 = _mm256_mul_pd(v231, runtime::lanes::from_array(qd[1]));
+    let v239 = _mm256_fmsub_pd(v225, runtime::lanes::from_array(qd[2]), v238);
+    let v240 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[0]));
+    let v241 = _mm256_mul_pd(v240, v228);
+    let v242 = _mm256_mul_pd(v15, v230);
+    let v243 = _mm256_fmadd_pd(v222, v239, v241);
+    let v244 = _mm256_fmadd_pd(v242, v234, v243);
+    let v245 = _mm256_mul_pd(v224, runtime::lanes::from_array(qd[2]));
+    let v246 = _mm256_fmsub_pd(v231, runtime::lanes::from_array(qd[0]), v245);
+    let v247 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[1]));
+    let v248 = _mm256_mul_pd(v247, v228);
+    let v249 = _mm256_mul_pd(v23, v230);
+    let v250 = _mm256_fmadd_pd(v222, v246, v248);
+    let v251 = _mm256_fmadd_pd(v249, v234, v250);
+    let v252 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v61);
+    let v254 = _mm256_mul_pd(v252, v253);
+    let v256 = _mm256_mul_pd(v252, v255);
+    let v257 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v234);
+    let v258 = _mm256_mul_pd(_mm256_set1_pd(0.0625f64), v94);
+    let v259 = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v93, v258);
+    let v260 = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v91, v259);
+    let v261 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v230);
+    let v262 = _mm256_mul_pd(v261, v260);
+    let v263 = _mm256_fmadd_pd(v257, v256, v262);
+    let v264 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v263);
+    let v266 = _mm256_mul_pd(v252, v265);
+    let v267 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v266);
+    let v268 = _mm256_fmadd_pd(v261, v234, v267);
+    let v269 = _mm256_fmadd_pd(v227, v254, v264);
+    let v270 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v268, v269);
+    let v271 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v263);
+    let v272 = _mm256_fmadd_pd(v239, v254, v271);
+    let v273 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v268, v272);
+    let v274 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v263);
+    let v275 = _mm256_fmadd_pd(v246, v254, v274);
+    let v276 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v268, v275);
+    let v277 = _mm256_fmsub_pd(_mm256_set1_pd(0.0625f64), v5, v221);
+    let v278 = _mm256_fmadd_pd(v222, v277, _mm256_set1_pd(1f64));
+    let v279 = _mm256_mul_pd(v224, runtime::lanes::from_array(q[2]));
+    let v280 = _mm256_mul_pd(v279, v222);
+    let v281 = _mm256_fmadd_pd(v23, v228, v280);
+    let v282 = _mm256_mul_pd(v225, runtime::lanes::from_array(q[2]));
+    let v283 = _mm256_mul_pd(v15, v228);
+    let v284 = _mm256_fmsub_pd(v282, v222, v283);
+    let v286 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[1]));
+    let v288 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(p[3]));
+    let v290 = _mm256_sub_pd(runtime::lanes::from_array(p[2]), v288);
+    let v292 = _mm256_fmadd_pd(_mm256_set1_pd(0.125f64), v290, v288);
+    let v293 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[3]));
+    let v294 = _mm256_mul_pd(v23, v13);
+    let v295 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[0]));
+    let v296 = _mm256_mul_pd(v295, runtime::lanes::from_array(q[2]));
+    let v297 = _mm256_mul_pd(v296, v43);
+    let v298 = _mm256_sub_pd(v297, v294);
+    let v299 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v18);
+    let v300 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v1);
+    let v301 = _mm256_fmadd_pd(v300, v43, v299);
+    let v302 = _mm256_mul_pd(v73, v13);
+    let v303 = _mm256_mul_pd(v295, runtime::lanes::from_array(q[1]));
+    let v304 = _mm256_mul_pd(v303, v43);
+    let v305 = _mm256_add_pd(v302, v304);
+    let v306 = _mm256_mul_pd(v63, v26);
+    let v307 = _mm256_fmsub_pd(v306, v44, v142);
+    let v308 = _mm256_mul_pd(v46, v307);
+    let v309 = _mm256_mul_pd(v70, v26);
+    let v310 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v43);
+    let v311 = _mm256_fmadd_pd(v15, v306, v310);
+    let v312 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v311);
+    let v313 = _mm256_fmadd_pd(v20, v309, v312);
+    let v314 = _mm256_mul_pd(v46, v313);
+    let v315 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v13);
+    let v316 = _mm256_fmsub_pd(v24, v306, v315);
+    let v317 = _mm256_fnmadd_pd(v26, v309, v316);
+    let v318 = _mm256_mul_pd(v46, v317);
+    let v319 = _mm256_mul_pd(v225, v222);
+    let v321 = _mm256_mul_pd(
         _mm256_set1_pd(0.015625f64),
-        runtime::lanes::from_array(q[0usize]),
+        runtime::lanes::from_array(q[0]),
     );
-    let v322: __m256d = _mm256_mul_pd(v321, runtime::lanes::from_array(q[2usize]));
-    let v323: __m256d = _mm256_mul_pd(v322, v230);
-    let v324: __m256d = _mm256_sub_pd(v323, v319);
-    let v325: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v228);
-    let v326: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v1);
-    let v327: __m256d = _mm256_fmadd_pd(v326, v230, v325);
-    let v328: __m256d = _mm256_mul_pd(v231, v222);
-    let v329: __m256d = _mm256_mul_pd(v321, runtime::lanes::from_array(q[1usize]));
-    let v330: __m256d = _mm256_mul_pd(v329, v230);
-    let v331: __m256d = _mm256_add_pd(v328, v330);
-    let v332: __m256d = _mm256_mul_pd(v170, v26);
-    let v333: __m256d = _mm256_mul_pd(v177, v26);
-    let v334: __m256d = _mm256_fmsub_pd(v333, v44, v332);
-    let v335: __m256d = _mm256_mul_pd(v46, v334);
-    let v336: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v170);
-    let v337: __m256d = _mm256_fmadd_pd(v15, v333, v336);
-    let v338: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[2usize]), v337);
-    let v339: __m256d = _mm256_fmadd_pd(v20, v306, v338);
-    let v340: __m256d = _mm256_mul_pd(v46, v339);
-    let v341: __m256d = _mm256_fmsub_pd(v24, v333, v154);
-    let v342: __m256d = _mm256_fnmadd_pd(v26, v306, v341);
-    let v343: __m256d = _mm256_mul_pd(v46, v342);
-    let v344: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.125f64),
-        runtime::lanes::from_array(q[1usize]),
-    );
-    let v345: __m256d = _mm256_mul_pd(v344, runtime::lanes::from_array(q[2usize]));
-    let v346: __m256d = _mm256_mul_pd(v345, v43);
-    let v347: __m256d = _mm256_mul_pd(v15, v13);
-    let v348: __m256d = _mm256_add_pd(v346, v347);
-    let v349: __m256d = _mm256_sub_pd(v304, v302);
-    let v350: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v8);
-    let v351: __m256d = _mm256_fmadd_pd(v350, v43, v299);
-    let v352: __m256d = _mm256_mul_pd(v63, v20);
-    let v353: __m256d = _mm256_fmsub_pd(v352, v44, v147);
-    let v354: __m256d = _mm256_mul_pd(v46, v353);
-    let v355: __m256d = _mm256_mul_pd(v70, v20);
-    let v356: __m256d = _mm256_fmadd_pd(v20, v355, v315);
-    let v357: __m256d = _mm256_fmadd_pd(v16, v352, v356);
-    let v358: __m256d = _mm256_mul_pd(v46, v357);
-    let v359: __m256d = _mm256_mul_pd(v26, v355);
-    let v360: __m256d = _mm256_fmadd_pd(v23, v352, v310);
-    let v361: __m256d = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[2usize]),
-        v360,
-        v359,
-    );
-    let v362: __m256d = _mm256_mul_pd(v46, v361);
-    let v363: __m256d = _mm256_mul_pd(v224, v222);
-    let v364: __m256d = _mm256_mul_pd(
+    let v322 = _mm256_mul_pd(v321, runtime::lanes::from_array(q[2]));
+    let v323 = _mm256_mul_pd(v322, v230);
+    let v324 = _mm256_sub_pd(v323, v319);
+    let v325 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v228);
+    let v326 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v1);
+    let v327 = _mm256_fmadd_pd(v326, v230, v325);
+    let v328 = _mm256_mul_pd(v231, v222);
+    let v329 = _mm256_mul_pd(v321, runtime::lanes::from_array(q[1]));
+    let v330 = _mm256_mul_pd(v329, v230);
+    let v331 = _mm256_add_pd(v328, v330);
+    let v332 = _mm256_mul_pd(v170, v26);
+    let v333 = _mm256_mul_pd(v177, v26);
+    let v334 = _mm256_fmsub_pd(v333, v44, v332);
+    let v335 = _mm256_mul_pd(v46, v334);
+    let v336 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v170);
+    let v337 = _mm256_fmadd_pd(v15, v333, v336);
+    let v338 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v337);
+    let v339 = _mm256_fmadd_pd(v20, v306, v338);
+    let v340 = _mm256_mul_pd(v46, v339);
+    let v341 = _mm256_fmsub_pd(v24, v333, v154);
+    let v342 = _mm256_fnmadd_pd(v26, v306, v341);
+    let v343 = _mm256_mul_pd(v46, v342);
+    let v344 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[1]));
+    let v345 = _mm256_mul_pd(v344, runtime::lanes::from_array(q[2]));
+    let v346 = _mm256_mul_pd(v345, v43);
+    let v347 = _mm256_mul_pd(v15, v13);
+    let v348 = _mm256_add_pd(v346, v347);
+    let v349 = _mm256_sub_pd(v304, v302);
+    let v350 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v8);
+    let v351 = _mm256_fmadd_pd(v350, v43, v299);
+    let v352 = _mm256_mul_pd(v63, v20);
+    let v353 = _mm256_fmsub_pd(v352, v44, v147);
+    let v354 = _mm256_mul_pd(v46, v353);
+    let v355 = _mm256_mul_pd(v70, v20);
+    let v356 = _mm256_fmadd_pd(v20, v355, v315);
+    let v357 = _mm256_fmadd_pd(v16, v352, v356);
+    let v358 = _mm256_mul_pd(v46, v357);
+    let v359 = _mm256_mul_pd(v26, v355);
+    let v360 = _mm256_fmadd_pd(v23, v352, v310);
+    let v361 = _mm256_fmsub_pd(runtime::lanes::from_array(q[2]), v360, v359);
+    let v362 = _mm256_mul_pd(v46, v361);
+    let v363 = _mm256_mul_pd(v224, v222);
+    let v364 = _mm256_mul_pd(
         _mm256_set1_pd(0.015625f64),
-        runtime::lanes::from_array(q[1usize]),
+        runtime::lanes::from_array(q[1]),
     );
-    let v365: __m256d = _mm256_mul_pd(v364, runtime::lanes::from_array(q[2usize]));
-    let v366: __m256d = _mm256_mul_pd(v365, v230);
-    let v367: __m256d = _mm256_add_pd(v363, v366);
-    let v368: __m256d = _mm256_sub_pd(v330, v328);
-    let v369: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v8);
-    let v370: __m256d = _mm256_fmadd_pd(v369, v230, v325);
-    let v371: __m256d = _mm256_mul_pd(v170, v20);
-    let v372: __m256d = _mm256_mul_pd(v177, v20);
-    let v373: __m256d = _mm256_fmsub_pd(v372, v44, v371);
-    let v374: __m256d = _mm256_mul_pd(v46, v373);
-    let v375: __m256d = _mm256_fmadd_pd(v20, v352, v154);
-    let v376: __m256d = _mm256_fmadd_pd(v16, v372, v375);
-    let v377: __m256d = _mm256_mul_pd(v46, v376);
-    let v378: __m256d = _mm256_mul_pd(v26, v352);
-    let v379: __m256d = _mm256_fmadd_pd(v23, v372, v336);
-    let v380: __m256d = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[2usize]),
-        v379,
-        v378,
+    let v365 = _mm256_mul_pd(v364, runtime::lanes::from_array(q[2]));
+    let v366 = _mm256_mul_pd(v365, v230);
+    let v367 = _mm256_add_pd(v363, v366);
+    let v368 = _mm256_sub_pd(v330, v328);
+    let v369 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v8);
+    let v370 = _mm256_fmadd_pd(v369, v230, v325);
+    let v371 = _mm256_mul_pd(v170, v20);
+    let v372 = _mm256_mul_pd(v177, v20);
+    let v373 = _mm256_fmsub_pd(v372, v44, v371);
+    let v374 = _mm256_mul_pd(v46, v373);
+    let v375 = _mm256_fmadd_pd(v20, v352, v154);
+    let v376 = _mm256_fmadd_pd(v16, v372, v375);
+    let v377 = _mm256_mul_pd(v46, v376);
+    let v378 = _mm256_mul_pd(v26, v352);
+    let v379 = _mm256_fmadd_pd(v23, v372, v336);
+    let v380 = _mm256_fmsub_pd(runtime::lanes::from_array(q[2]), v379, v378);
+    let v381 = _mm256_mul_pd(v46, v380);
+    let v382 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v5);
+    let v383 = _mm256_fmadd_pd(v382, v43, v299);
+    let v384 = _mm256_add_pd(v294, v297);
+    let v385 = _mm256_sub_pd(v346, v347);
+    let v386 = _mm256_sub_pd(v33, v33);
+    let v387 = _mm256_mul_pd(v63, v33);
+    let v388 = _mm256_mul_pd(v387, v44);
+    let v389 = _mm256_fmadd_pd(v43, v386, v388);
+    let v390 = _mm256_mul_pd(v46, v389);
+    let v391 = _mm256_mul_pd(v70, v33);
+    let v392 = _mm256_fmadd_pd(v73, v387, v310);
+    let v393 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v392);
+    let v394 = _mm256_fmadd_pd(v20, v391, v393);
+    let v395 = _mm256_mul_pd(v46, v394);
+    let v396 = _mm256_mul_pd(v26, v391);
+    let v397 = _mm256_fmsub_pd(runtime::lanes::from_array(q[1]), v392, v396);
+    let v398 = _mm256_mul_pd(v46, v397);
+    let v399 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v5);
+    let v400 = _mm256_fmadd_pd(v399, v230, v325);
+    let v401 = _mm256_add_pd(v319, v323);
+    let v402 = _mm256_sub_pd(v366, v363);
+    let v403 = _mm256_mul_pd(v177, v33);
+    let v404 = _mm256_mul_pd(v403, v44);
+    let v405 = _mm256_fmadd_pd(v170, v386, v404);
+    let v406 = _mm256_mul_pd(v46, v405);
+    let v407 = _mm256_fmadd_pd(v73, v403, v336);
+    let v408 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v407);
+    let v409 = _mm256_fmadd_pd(v20, v387, v408);
+    let v410 = _mm256_mul_pd(v46, v409);
+    let v411 = _mm256_mul_pd(v26, v387);
+    let v412 = _mm256_fmsub_pd(runtime::lanes::from_array(q[1]), v407, v411);
+    let v413 = _mm256_mul_pd(v46, v412);
+    let v415 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v45);
+    let v416 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v49);
+    let v417 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v52);
+    let v418 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v171);
+    let v419 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v173);
+    let v420 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v175);
+    let v422 = _mm256_div_pd(runtime::lanes::from_array(p[0]), v41);
+    let v423 = runtime::lanes::map(v422, |x| x.powi(3i32));
+    let v424 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[0]),
+        runtime::lanes::from_array(p[4]),
     );
-    let v381: __m256d = _mm256_mul_pd(v46, v380);
-    let v382: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v5);
-    let v383: __m256d = _mm256_fmadd_pd(v382, v43, v299);
-    let v384: __m256d = _mm256_add_pd(v294, v297);
-    let v385: __m256d = _mm256_sub_pd(v346, v347);
-    let v386: __m256d = _mm256_sub_pd(v33, v33);
-    let v387: __m256d = _mm256_mul_pd(v63, v33);
-    let v388: __m256d = _mm256_mul_pd(v387, v44);
-    let v389: __m256d = _mm256_fmadd_pd(v43, v386, v388);
-    let v390: __m256d = _mm256_mul_pd(v46, v389);
-    let v391: __m256d = _mm256_mul_pd(v70, v33);
-    let v392: __m256d = _mm256_fmadd_pd(v73, v387, v310);
-    let v393: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[0usize]), v392);
-    let v394: __m256d = _mm256_fmadd_pd(v20, v391, v393);
-    let v395: __m256d = _mm256_mul_pd(v46, v394);
-    let v396: __m256d = _mm256_mul_pd(v26, v391);
-    let v397: __m256d = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[1usize]),
-        v392,
-        v396,
+    let v426 = _mm256_sqrt_pd(v422);
+    let v427 = _mm256_mul_pd(runtime::lanes::from_array(p[13]), v426);
+    let v428 = _mm256_fmsub_pd(v424, v423, v427);
+    let v430 = _mm256_mul_pd(v84, runtime::lanes::from_array(p[5]));
+    let v431 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v428, v430);
+    let v433 = _mm256_sub_pd(
+        runtime::lanes::from_array(q[1]),
+        runtime::lanes::from_array(p[6]),
     );
-    let v398: __m256d = _mm256_mul_pd(v46, v397);
-    let v399: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v5);
-    let v400: __m256d = _mm256_fmadd_pd(v399, v230, v325);
-    let v401: __m256d = _mm256_add_pd(v319, v323);
-    let v402: __m256d = _mm256_sub_pd(v366, v363);
-    let v403: __m256d = _mm256_mul_pd(v177, v33);
-    let v404: __m256d = _mm256_mul_pd(v403, v44);
-    let v405: __m256d = _mm256_fmadd_pd(v170, v386, v404);
-    let v406: __m256d = _mm256_mul_pd(v46, v405);
-    let v407: __m256d = _mm256_fmadd_pd(v73, v403, v336);
-    let v408: __m256d = _mm256_mul_pd(runtime::lanes::from_array(q[0usize]), v407);
-    let v409: __m256d = _mm256_fmadd_pd(v20, v387, v408);
-    let v410: __m256d = _mm256_mul_pd(v46, v409);
-    let v411: __m256d = _mm256_mul_pd(v26, v387);
-    let v412: __m256d = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[1usize]),
-        v407,
-        v411,
+    let v434 = _mm256_mul_pd(runtime::lanes::from_array(p[4]), v423);
+    let v436 = _mm256_mul_pd(runtime::lanes::from_array(p[14]), v426);
+    let v437 = _mm256_fmsub_pd(v434, v433, v436);
+    let v438 = _mm256_mul_pd(v69, runtime::lanes::from_array(p[5]));
+    let v439 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v437, v438);
+    let v441 = _mm256_mul_pd(v33, runtime::lanes::from_array(p[7]));
+    let v443 = _mm256_mul_pd(v115, runtime::lanes::from_array(p[8]));
+    let v444 = _mm256_fmadd_pd(v441, v423, v443);
+    let v447 = _mm256_mul_pd(
+        runtime::lanes::from_array(q[1]),
+        runtime::lanes::from_array(p[14]),
     );
-    let v413: __m256d = _mm256_mul_pd(v46, v412);
-    let v415: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v45);
-    let v416: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v49);
-    let v417: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v52);
-    let v418: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v171);
-    let v419: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v173);
-    let v420: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v175);
-    let v422: __m256d = _mm256_div_pd(runtime::lanes::from_array(p[0usize]), v41);
-    let v423: __m256d = runtime::lanes::map(v422, |x| x.powi(3i32));
-    let v424: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0usize]),
-        runtime::lanes::from_array(p[4usize]),
-    );
-    let v426: __m256d = _mm256_sqrt_pd(v422);
-    let v427: __m256d = _mm256_mul_pd(runtime::lanes::from_array(p[13usize]), v426);
-    let v428: __m256d = _mm256_fmsub_pd(v424, v423, v427);
-    let v430: __m256d = _mm256_mul_pd(v84, runtime::lanes::from_array(p[5usize]));
-    let v431: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v428, v430);
-    let v433: __m256d = _mm256_sub_pd(
-        runtime::lanes::from_array(q[1usize]),
-        runtime::lanes::from_array(p[6usize]),
-    );
-    let v434: __m256d = _mm256_mul_pd(runtime::lanes::from_array(p[4usize]), v423);
-    let v436: __m256d = _mm256_mul_pd(runtime::lanes::from_array(p[14usize]), v426);
-    let v437: __m256d = _mm256_fmsub_pd(v434, v433, v436);
-    let v438: __m256d = _mm256_mul_pd(v69, runtime::lanes::from_array(p[5usize]));
-    let v439: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v437, v438);
-    let v441: __m256d = _mm256_mul_pd(v33, runtime::lanes::from_array(p[7usize]));
-    let v443: __m256d = _mm256_mul_pd(v115, runtime::lanes::from_array(p[8usize]));
-    let v444: __m256d = _mm256_fmadd_pd(v441, v423, v443);
-    let v447: __m256d = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1usize]),
-        runtime::lanes::from_array(p[14usize]),
-    );
-    let v448: __m256d = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[0usize]),
-        runtime::lanes::from_array(p[13usize]),
+    let v448 = _mm256_fmadd_pd(
+        runtime::lanes::from_array(q[0]),
+        runtime::lanes::from_array(p[13]),
         v447,
     );
-    let v449: __m256d = _mm256_mul_pd(v41, v41);
-    let v450: __m256d = _mm256_div_pd(runtime::lanes::from_array(p[0usize]), v449);
-    let v451: __m256d = _mm256_xor_pd(v450, _mm256_set1_pd(-0.0));
-    let v452: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v451);
-    let v453: __m256d = _mm256_div_pd(v452, v426);
-    let v454: __m256d = _mm256_fmadd_pd(
-        v448,
-        v453,
-        runtime::lanes::from_array(p[12usize]),
-    );
-    let v455: __m256d = _mm256_mul_pd(v422, v422);
-    let v457: __m256d = _mm256_mul_pd(_mm256_set1_pd(3f64), v451);
-    let v458: __m256d = _mm256_mul_pd(v457, v455);
-    let v459: __m256d = _mm256_mul_pd(
-        _mm256_set1_pd(0.5f64),
-        runtime::lanes::from_array(p[7usize]),
-    );
-    let v460: __m256d = _mm256_mul_pd(v433, v433);
-    let v461: __m256d = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v460);
-    let v462: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v1, v461);
-    let v463: __m256d = _mm256_mul_pd(runtime::lanes::from_array(p[4usize]), v462);
-    let v464: __m256d = _mm256_fmadd_pd(v459, v5, v463);
-    let v465: __m256d = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[3usize]),
-        runtime::lanes::from_array(p[9usize]),
+    let v449 = _mm256_mul_pd(v41, v41);
+    let v450 = _mm256_div_pd(runtime::lanes::from_array(p[0]), v449);
+    let v451 = _mm256_xor_pd(v450, _mm256_set1_pd(-0.0));
+    let v452 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v451);
+    let v453 = _mm256_div_pd(v452, v426);
+    let v454 = _mm256_fmadd_pd(v448, v453, runtime::lanes::from_array(p[12]));
+    let v455 = _mm256_mul_pd(v422, v422);
+    let v457 = _mm256_mul_pd(_mm256_set1_pd(3f64), v451);
+    let v458 = _mm256_mul_pd(v457, v455);
+    let v459 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[7]));
+    let v460 = _mm256_mul_pd(v433, v433);
+    let v461 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v460);
+    let v462 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v1, v461);
+    let v463 = _mm256_mul_pd(runtime::lanes::from_array(p[4]), v462);
+    let v464 = _mm256_fmadd_pd(v459, v5, v463);
+    let v465 = _mm256_fmsub_pd(
+        runtime::lanes::from_array(q[3]),
+        runtime::lanes::from_array(p[9]),
         v454,
     );
-    let v466: __m256d = _mm256_fmadd_pd(v458, v464, v465);
-    let v468: __m256d = _mm256_mul_pd(v55, runtime::lanes::from_array(p[10usize]));
-    let v469: __m256d = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v466, v468);
-    out[0usize] = runtime::lanes::to_array(v14);
-    out[1usize] = runtime::lanes::to_array(v22);
-    out[2usize] = runtime::lanes::to_array(v28);
-    out[3usize] = runtime::lanes::to_array(v29);
-    out[4usize] = runtime::lanes::to_array(v30);
-    out[5usize] = runtime::lanes::to_array(v35);
-    out[6usize] = runtime::lanes::to_array(v36);
-    out[7usize] = runtime::lanes::to_array(v37);
-    out[8usize] = runtime::lanes::to_array(v38);
-    out[9usize] = runtime::lanes::to_array(v47);
-    out[10usize] = runtime::lanes::to_array(v50);
-    out[11usize] = runtime::lanes::to_array(v53);
-    out[12usize] = runtime::lanes::to_array(v68);
-    out[13usize] = runtime::lanes::to_array(v82);
-    out[14usize] = runtime::lanes::to_array(v90);
-    out[15usize] = runtime::lanes::to_array(v110);
-    out[16usize] = runtime::lanes::to_array(v124);
-    out[17usize] = runtime::lanes::to_array(v130);
-    out[18usize] = runtime::lanes::to_array(v139);
-    out[19usize] = runtime::lanes::to_array(v144);
-    out[20usize] = runtime::lanes::to_array(v149);
-    out[21usize] = runtime::lanes::to_array(v163);
-    out[22usize] = runtime::lanes::to_array(v166);
-    out[23usize] = runtime::lanes::to_array(v169);
-    out[24usize] = runtime::lanes::to_array(v172);
-    out[25usize] = runtime::lanes::to_array(v174);
-    out[26usize] = runtime::lanes::to_array(v176);
-    out[27usize] = runtime::lanes::to_array(v182);
-    out[28usize] = runtime::lanes::to_array(v190);
-    out[29usize] = runtime::lanes::to_array(v196);
-    out[30usize] = runtime::lanes::to_array(v204);
-    out[31usize] = runtime::lanes::to_array(v214);
-    out[32usize] = runtime::lanes::to_array(v220);
-    out[33usize] = runtime::lanes::to_array(v237);
-    out[34usize] = runtime::lanes::to_array(v244);
-    out[35usize] = runtime::lanes::to_array(v251);
-    out[36usize] = runtime::lanes::to_array(v270);
-    out[37usize] = runtime::lanes::to_array(v273);
-    out[38usize] = runtime::lanes::to_array(v276);
-    out[39usize] = runtime::lanes::to_array(v278);
-    out[40usize] = runtime::lanes::to_array(v281);
-    out[41usize] = runtime::lanes::to_array(v284);
-    out[42usize] = runtime::lanes::to_array(v286);
-    out[43usize] = runtime::lanes::to_array(v292);
-    out[44usize] = runtime::lanes::to_array(v293);
-    out[45usize] = runtime::lanes::to_array(v298);
-    out[46usize] = runtime::lanes::to_array(v301);
-    out[47usize] = runtime::lanes::to_array(v305);
-    out[48usize] = runtime::lanes::to_array(v308);
-    out[49usize] = runtime::lanes::to_array(v314);
-    out[50usize] = runtime::lanes::to_array(v318);
-    out[51usize] = runtime::lanes::to_array(v324);
-    out[52usize] = runtime::lanes::to_array(v327);
-    out[53usize] = runtime::lanes::to_array(v331);
-    out[54usize] = runtime::lanes::to_array(v335);
-    out[55usize] = runtime::lanes::to_array(v340);
-    out[56usize] = runtime::lanes::to_array(v343);
-    out[57usize] = runtime::lanes::to_array(v348);
-    out[58usize] = runtime::lanes::to_array(v349);
-    out[59usize] = runtime::lanes::to_array(v351);
-    out[60usize] = runtime::lanes::to_array(v354);
-    out[61usize] = runtime::lanes::to_array(v358);
-    out[62usize] = runtime::lanes::to_array(v362);
-    out[63usize] = runtime::lanes::to_array(v367);
-    out[64usize] = runtime::lanes::to_array(v368);
-    out[65usize] = runtime::lanes::to_array(v370);
-    out[66usize] = runtime::lanes::to_array(v374);
-    out[67usize] = runtime::lanes::to_array(v377);
-    out[68usize] = runtime::lanes::to_array(v381);
-    out[69usize] = runtime::lanes::to_array(v383);
-    out[70usize] = runtime::lanes::to_array(v384);
-    out[71usize] = runtime::lanes::to_array(v385);
-    out[72usize] = runtime::lanes::to_array(v390);
-    out[73usize] = runtime::lanes::to_array(v395);
-    out[74usize] = runtime::lanes::to_array(v398);
-    out[75usize] = runtime::lanes::to_array(v400);
-    out[76usize] = runtime::lanes::to_array(v401);
-    out[77usize] = runtime::lanes::to_array(v402);
-    out[78usize] = runtime::lanes::to_array(v406);
-    out[79usize] = runtime::lanes::to_array(v410);
-    out[80usize] = runtime::lanes::to_array(v413);
-    out[81usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[82usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[83usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[84usize] = runtime::lanes::to_array(v415);
-    out[85usize] = runtime::lanes::to_array(v416);
-    out[86usize] = runtime::lanes::to_array(v417);
-    out[87usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[88usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[89usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[90usize] = runtime::lanes::to_array(v418);
-    out[91usize] = runtime::lanes::to_array(v419);
-    out[92usize] = runtime::lanes::to_array(v420);
-    out[93usize] = runtime::lanes::to_array(v431);
-    out[94usize] = runtime::lanes::to_array(v439);
-    out[95usize] = runtime::lanes::to_array(v444);
-    out[96usize] = runtime::lanes::to_array(v469);
-    out[97usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[98usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[99usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[100usize] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    let v466 = _mm256_fmadd_pd(v458, v464, v465);
+    let v468 = _mm256_mul_pd(v55, runtime::lanes::from_array(p[10]));
+    let v469 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v466, v468);
+    out[0] = runtime::lanes::to_array(v14);
+    out[1] = runtime::lanes::to_array(v22);
+    out[2] = runtime::lanes::to_array(v28);
+    out[3] = runtime::lanes::to_array(v29);
+    out[4] = runtime::lanes::to_array(v30);
+    out[5] = runtime::lanes::to_array(v35);
+    out[6] = runtime::lanes::to_array(v36);
+    out[7] = runtime::lanes::to_array(v37);
+    out[8] = runtime::lanes::to_array(v38);
+    out[9] = runtime::lanes::to_array(v47);
+    out[10] = runtime::lanes::to_array(v50);
+    out[11] = runtime::lanes::to_array(v53);
+    out[12] = runtime::lanes::to_array(v68);
+    out[13] = runtime::lanes::to_array(v82);
+    out[14] = runtime::lanes::to_array(v90);
+    out[15] = runtime::lanes::to_array(v110);
+    out[16] = runtime::lanes::to_array(v124);
+    out[17] = runtime::lanes::to_array(v130);
+    out[18] = runtime::lanes::to_array(v139);
+    out[19] = runtime::lanes::to_array(v144);
+    out[20] = runtime::lanes::to_array(v149);
+    out[21] = runtime::lanes::to_array(v163);
+    out[22] = runtime::lanes::to_array(v166);
+    out[23] = runtime::lanes::to_array(v169);
+    out[24] = runtime::lanes::to_array(v172);
+    out[25] = runtime::lanes::to_array(v174);
+    out[26] = runtime::lanes::to_array(v176);
+    out[27] = runtime::lanes::to_array(v182);
+    out[28] = runtime::lanes::to_array(v190);
+    out[29] = runtime::lanes::to_array(v196);
+    out[30] = runtime::lanes::to_array(v204);
+    out[31] = runtime::lanes::to_array(v214);
+    out[32] = runtime::lanes::to_array(v220);
+    out[33] = runtime::lanes::to_array(v237);
+    out[34] = runtime::lanes::to_array(v244);
+    out[35] = runtime::lanes::to_array(v251);
+    out[36] = runtime::lanes::to_array(v270);
+    out[37] = runtime::lanes::to_array(v273);
+    out[38] = runtime::lanes::to_array(v276);
+    out[39] = runtime::lanes::to_array(v278);
+    out[40] = runtime::lanes::to_array(v281);
+    out[41] = runtime::lanes::to_array(v284);
+    out[42] = runtime::lanes::to_array(v286);
+    out[43] = runtime::lanes::to_array(v292);
+    out[44] = runtime::lanes::to_array(v293);
+    out[45] = runtime::lanes::to_array(v298);
+    out[46] = runtime::lanes::to_array(v301);
+    out[47] = runtime::lanes::to_array(v305);
+    out[48] = runtime::lanes::to_array(v308);
+    out[49] = runtime::lanes::to_array(v314);
+    out[50] = runtime::lanes::to_array(v318);
+    out[51] = runtime::lanes::to_array(v324);
+    out[52] = runtime::lanes::to_array(v327);
+    out[53] = runtime::lanes::to_array(v331);
+    out[54] = runtime::lanes::to_array(v335);
+    out[55] = runtime::lanes::to_array(v340);
+    out[56] = runtime::lanes::to_array(v343);
+    out[57] = runtime::lanes::to_array(v348);
+    out[58] = runtime::lanes::to_array(v349);
+    out[59] = runtime::lanes::to_array(v351);
+    out[60] = runtime::lanes::to_array(v354);
+    out[61] = runtime::lanes::to_array(v358);
+    out[62] = runtime::lanes::to_array(v362);
+    out[63] = runtime::lanes::to_array(v367);
+    out[64] = runtime::lanes::to_array(v368);
+    out[65] = runtime::lanes::to_array(v370);
+    out[66] = runtime::lanes::to_array(v374);
+    out[67] = runtime::lanes::to_array(v377);
+    out[68] = runtime::lanes::to_array(v381);
+    out[69] = runtime::lanes::to_array(v383);
+    out[70] = runtime::lanes::to_array(v384);
+    out[71] = runtime::lanes::to_array(v385);
+    out[72] = runtime::lanes::to_array(v390);
+    out[73] = runtime::lanes::to_array(v395);
+    out[74] = runtime::lanes::to_array(v398);
+    out[75] = runtime::lanes::to_array(v400);
+    out[76] = runtime::lanes::to_array(v401);
+    out[77] = runtime::lanes::to_array(v402);
+    out[78] = runtime::lanes::to_array(v406);
+    out[79] = runtime::lanes::to_array(v410);
+    out[80] = runtime::lanes::to_array(v413);
+    out[81] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[82] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[83] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[84] = runtime::lanes::to_array(v415);
+    out[85] = runtime::lanes::to_array(v416);
+    out[86] = runtime::lanes::to_array(v417);
+    out[87] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[88] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[89] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[90] = runtime::lanes::to_array(v418);
+    out[91] = runtime::lanes::to_array(v419);
+    out[92] = runtime::lanes::to_array(v420);
+    out[93] = runtime::lanes::to_array(v431);
+    out[94] = runtime::lanes::to_array(v439);
+    out[95] = runtime::lanes::to_array(v444);
+    out[96] = runtime::lanes::to_array(v469);
+    out[97] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[98] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[99] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[100] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
 }
 /// Kernel `cell_0_tangent`: 1942 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn cell_0_tangent(
     t: f64,
-    q: &[f64; 4usize],
-    qd: &[f64; 4usize],
-    qdd: &[f64; 4usize],
-    dir: &[f64; 8usize],
-    p: &[f64; 15usize],
-    out: &mut [f64; 202usize],
+    q: &[f64; 4],
+    qd: &[f64; 4],
+    qdd: &[f64; 4],
+    dir: &[f64; 8],
+    p: &[f64; 15],
+    out: &mut [f64; 202],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -2338,1572 +2123,1572 @@ pub fn cell_0_tangent(
 #[allow(unused_variables, clippy::all)]
 fn cell_0_tangent_0(
     t: f64,
-    q: &[f64; 4usize],
-    qd: &[f64; 4usize],
-    qdd: &[f64; 4usize],
-    dir: &[f64; 8usize],
-    p: &[f64; 15usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 202usize],
+    q: &[f64; 4],
+    qd: &[f64; 4],
+    qdd: &[f64; 4],
+    dir: &[f64; 8],
+    p: &[f64; 15],
+    w: &mut [f64; 0],
+    out: &mut [f64; 202],
 ) {
-    let v1: f64 = q[0usize] * q[0usize];
-    let v3: f64 = 0.25f64 * v1;
-    let v5: f64 = q[2usize] * q[2usize];
-    let v6: f64 = 0.25f64 * v5;
-    let v8: f64 = q[1usize] * q[1usize];
-    let v9: f64 = 0.25f64 * v8;
-    let v10: f64 = v3 + v6;
-    let v11: f64 = v10 + v9;
-    let c: [[f64; 4usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        4usize,
+    let v1 = q[0] * q[0];
+    let v3 = 0.25f64 * v1;
+    let v5 = q[2] * q[2];
+    let v6 = 0.25f64 * v5;
+    let v8 = q[1] * q[1];
+    let v9 = 0.25f64 * v8;
+    let v10 = v3 + v6;
+    let v11 = v10 + v9;
+    let c: [[f64; 4]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        4,
     >(v11);
-    let v12: f64 = c[0usize][0usize];
-    let v13: f64 = c[2usize][0usize];
-    let v18: f64 = c[1usize][0usize];
-    let v43: f64 = c[3usize][0usize];
-    let v63: f64 = c[3usize][1usize];
-    let v70: f64 = c[2usize][1usize];
-    let v103: f64 = c[3usize][2usize];
-    let v111: f64 = c[2usize][2usize];
-    let v159: f64 = c[1usize][1usize];
-    let v171: f64 = c[4usize][0usize];
-    let v178: f64 = c[4usize][1usize];
-    let v199: f64 = c[4usize][2usize];
-    let v478: f64 = c[0usize][1usize];
-    let v634: f64 = c[3usize][3usize];
-    let v655: f64 = c[2usize][3usize];
-    let v744: f64 = c[1usize][2usize];
-    let v859: f64 = c[4usize][3usize];
-    let v14: f64 = v6.mul_add(v13, v12);
-    let v15: f64 = 0.25f64 * q[0usize];
-    let v16: f64 = v15 * q[2usize];
-    let v17: f64 = v16 * v13;
-    let v20: f64 = 0.5f64 * q[1usize];
-    let v21: f64 = v20 * v18;
-    let v22: f64 = v17 - v21;
-    let v23: f64 = 0.25f64 * q[1usize];
-    let v24: f64 = v23 * q[2usize];
-    let v25: f64 = v24 * v13;
-    let v26: f64 = 0.5f64 * q[0usize];
-    let v27: f64 = v26 * v18;
-    let v28: f64 = v25 + v27;
-    let v29: f64 = v17 + v21;
-    let v30: f64 = v3.mul_add(v13, v12);
-    let v31: f64 = v15 * q[1usize];
-    let v32: f64 = v31 * v13;
-    let v33: f64 = 0.5f64 * q[2usize];
-    let v34: f64 = v33 * v18;
-    let v35: f64 = v32 - v34;
-    let v36: f64 = v25 - v27;
-    let v37: f64 = v32 + v34;
-    let v38: f64 = v9.mul_add(v13, v12);
-    let v41: f64 = q[3usize] + p[0usize];
-    let v44: f64 = v6 - v11;
-    let v45: f64 = v43.mul_add(v44, 1f64);
-    let v46: f64 = 0.5f64 * v41;
-    let v47: f64 = v46 * v45;
-    let v48: f64 = v20 * v13;
-    let v49: f64 = v16.mul_add(v43, v48);
-    let v50: f64 = v46 * v49;
-    let v51: f64 = v26 * v13;
-    let v52: f64 = v24.mul_add(v43, -v51);
-    let v53: f64 = v46 * v52;
-    let v55: f64 = 0.5f64 * qd[3usize];
-    let v57: f64 = v33 * qd[2usize];
-    let v60: f64 = v26.mul_add(qd[0usize], v57);
-    let v61: f64 = v20.mul_add(qd[1usize], v60);
-    let v62: f64 = v57 - v61;
-    let v64: f64 = v61 * v63;
-    let v65: f64 = v64 * v44;
-    let v66: f64 = v43.mul_add(v62, v65);
-    let v67: f64 = v46 * v66;
-    let v68: f64 = v55.mul_add(v45, v67);
-    let v69: f64 = 0.5f64 * qd[1usize];
-    let v71: f64 = v61 * v70;
-    let v72: f64 = v20 * v71;
-    let v73: f64 = 0.25f64 * q[2usize];
-    let v74: f64 = v73 * qd[0usize];
-    let v75: f64 = 0.25f64 * qd[2usize];
-    let v76: f64 = v73 * v64;
-    let v77: f64 = v75.mul_add(v43, v76);
-    let v78: f64 = v69.mul_add(v13, v72);
-    let v79: f64 = v74.mul_add(v43, v78);
-    let v80: f64 = q[0usize].mul_add(v77, v79);
-    let v81: f64 = v46 * v80;
-    let v82: f64 = v55.mul_add(v49, v81);
-    let v83: f64 = v73 * qd[1usize];
-    let v84: f64 = 0.5f64 * qd[0usize];
-    let v85: f64 = v84 * v13;
-    let v86: f64 = v83.mul_add(v43, -v85);
-    let v87: f64 = (-v26).mul_add(v71, v86);
-    let v88: f64 = q[1usize].mul_add(v77, v87);
-    let v89: f64 = v46 * v88;
-    let v90: f64 = v55.mul_add(v52, v89);
-    let v91: f64 = qd[2usize] * qd[2usize];
-    let v92: f64 = 0.5f64 * v91;
-    let v93: f64 = qd[0usize] * qd[0usize];
-    let v94: f64 = qd[1usize] * qd[1usize];
-    let v95: f64 = 0.5f64 * v94;
-    let v96: f64 = 0.5f64.mul_add(v93, v95);
-    let v97: f64 = v96 + v92;
-    let v98: f64 = v92 - v97;
-    let v100: f64 = 2f64 * v61;
-    let v101: f64 = q[2usize].mul_add(qd[2usize], -v100);
-    let v102: f64 = v64 * v101;
-    let v104: f64 = v61 * v61;
-    let v105: f64 = v103 * v104;
-    let v106: f64 = v63.mul_add(v97, v105);
-    let v107: f64 = v43.mul_add(v98, v102);
-    let v108: f64 = v106.mul_add(v44, v107);
-    let v109: f64 = v46 * v108;
-    let v110: f64 = qd[3usize].mul_add(v66, v109);
-    let v112: f64 = v104 * v111;
-    let v113: f64 = v70.mul_add(v97, v112);
-    let v114: f64 = v20 * v113;
-    let v115: f64 = 0.5f64 * qd[2usize];
-    let v116: f64 = v73 * v106;
-    let v117: f64 = v115.mul_add(v64, v116);
-    let v118: f64 = v33 * v64;
-    let v119: f64 = v115.mul_add(v43, v118);
-    let v120: f64 = qd[1usize].mul_add(v71, v114);
-    let v121: f64 = q[0usize].mul_add(v117, v120);
-    let v122: f64 = qd[0usize].mul_add(v119, v121);
-    let v123: f64 = v46 * v122;
-    let v124: f64 = qd[3usize].mul_add(v80, v123);
-    let v125: f64 = qd[0usize] * v71;
-    let v126: f64 = q[1usize].mul_add(v117, -v125);
-    let v127: f64 = (-v26).mul_add(v113, v126);
-    let v128: f64 = qd[1usize].mul_add(v119, v127);
-    let v129: f64 = v46 * v128;
-    let v130: f64 = qd[3usize].mul_add(v88, v129);
-    let v131: f64 = v23 * qd[0usize];
-    let v132: f64 = v15.mul_add(qd[1usize], -v131);
-    let v133: f64 = v115 * v18;
-    let v134: f64 = v15 * qd[0usize];
-    let v135: f64 = v73.mul_add(qd[2usize], v134);
-    let v136: f64 = v23.mul_add(qd[1usize], v135);
-    let v137: f64 = v33 * v43;
-    let v138: f64 = v13.mul_add(v132, v133);
-    let v139: f64 = v137.mul_add(v136, v138);
-    let v140: f64 = v23.mul_add(qd[2usize], -v83);
-    let v141: f64 = v84 * v18;
-    let v142: f64 = v26 * v43;
-    let v143: f64 = v13.mul_add(v140, v141);
-    let v144: f64 = v142.mul_add(v136, v143);
-    let v145: f64 = (-v15).mul_add(qd[2usize], v74);
-    let v146: f64 = v69 * v18;
-    let v147: f64 = v20 * v43;
-    let v148: f64 = v13.mul_add(v145, v146);
-    let v149: f64 = v147.mul_add(v136, v148);
-    let v150: f64 = 0.5f64 * v136;
-    let v151: f64 = v150 * v64;
-    let v152: f64 = 0.25f64 * v94;
-    let v153: f64 = 0.25f64.mul_add(v93, v152);
-    let v154: f64 = 0.25f64.mul_add(v91, v153);
-    let v155: f64 = 0.5f64 * v43;
-    let v156: f64 = v155.mul_add(v154, v151);
-    let v157: f64 = q[2usize] * v156;
-    let v158: f64 = v155 * v136;
-    let v160: f64 = v61 * v159;
-    let v161: f64 = 0.5f64 * v160;
-    let v162: f64 = v158 + v161;
-    let v163: f64 = v132.mul_add(v71, v157);
-    let v164: f64 = qd[2usize].mul_add(v162, v163);
-    let v165: f64 = q[0usize] * v156;
-    let v166: f64 = v140.mul_add(v71, v165);
-    let v167: f64 = qd[0usize].mul_add(v162, v166);
-    let v168: f64 = q[1usize] * v156;
-    let v169: f64 = v145.mul_add(v71, v168);
-    let v170: f64 = qd[1usize].mul_add(v162, v169);
-    let v172: f64 = v171.mul_add(v44, 0.5f64);
-    let v173: f64 = v46 * v172;
-    let v174: f64 = v16.mul_add(v171, v147);
-    let v175: f64 = v46 * v174;
-    let v176: f64 = v24.mul_add(v171, -v142);
-    let v177: f64 = v46 * v176;
-    let v179: f64 = v61 * v178;
-    let v180: f64 = v179 * v44;
-    let v181: f64 = v171.mul_add(v62, v180);
-    let v182: f64 = v46 * v181;
-    let v183: f64 = v55.mul_add(v172, v182);
-    let v184: f64 = v20 * v64;
-    let v185: f64 = v73 * v179;
-    let v186: f64 = v75.mul_add(v171, v185);
-    let v187: f64 = v69.mul_add(v43, v184);
-    let v188: f64 = v74.mul_add(v171, v187);
-    let v189: f64 = q[0usize].mul_add(v186, v188);
-    let v190: f64 = v46 * v189;
-    let v191: f64 = v55.mul_add(v174, v190);
-    let v192: f64 = v84 * v43;
-    let v193: f64 = v83.mul_add(v171, -v192);
-    let v194: f64 = (-v26).mul_add(v64, v193);
-    let v195: f64 = q[1usize].mul_add(v186, v194);
-    let v196: f64 = v46 * v195;
-    let v197: f64 = v55.mul_add(v176, v196);
-    let v198: f64 = v179 * v101;
-    let v200: f64 = v104 * v199;
-    let v201: f64 = v97.mul_add(v178, v200);
-    let v202: f64 = v171.mul_add(v98, v198);
-    let v203: f64 = v201.mul_add(v44, v202);
-    let v204: f64 = v46 * v203;
-    let v205: f64 = qd[3usize].mul_add(v181, v204);
-    let v206: f64 = v20 * v106;
-    let v207: f64 = v73 * v201;
-    let v208: f64 = v115.mul_add(v179, v207);
-    let v209: f64 = v33 * v179;
-    let v210: f64 = v115.mul_add(v171, v209);
-    let v211: f64 = qd[1usize].mul_add(v64, v206);
-    let v212: f64 = q[0usize].mul_add(v208, v211);
-    let v213: f64 = qd[0usize].mul_add(v210, v212);
-    let v214: f64 = v46 * v213;
-    let v215: f64 = qd[3usize].mul_add(v189, v214);
-    let v216: f64 = qd[0usize] * v64;
-    let v217: f64 = q[1usize].mul_add(v208, -v216);
-    let v218: f64 = (-v26).mul_add(v106, v217);
-    let v219: f64 = qd[1usize].mul_add(v210, v218);
-    let v220: f64 = v46 * v219;
-    let v221: f64 = qd[3usize].mul_add(v195, v220);
-    let v222: f64 = 0.25f64 * v11;
-    let c: [[f64; 3usize]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
-        3usize,
+    let v12: f64 = c[0][0];
+    let v13: f64 = c[2][0];
+    let v18: f64 = c[1][0];
+    let v43: f64 = c[3][0];
+    let v63: f64 = c[3][1];
+    let v70: f64 = c[2][1];
+    let v103: f64 = c[3][2];
+    let v111: f64 = c[2][2];
+    let v159: f64 = c[1][1];
+    let v171: f64 = c[4][0];
+    let v178: f64 = c[4][1];
+    let v199: f64 = c[4][2];
+    let v478: f64 = c[0][1];
+    let v634: f64 = c[3][3];
+    let v655: f64 = c[2][3];
+    let v744: f64 = c[1][2];
+    let v859: f64 = c[4][3];
+    let v14 = v6.mul_add(v13, v12);
+    let v15 = 0.25f64 * q[0];
+    let v16 = v15 * q[2];
+    let v17 = v16 * v13;
+    let v20 = 0.5f64 * q[1];
+    let v21 = v20 * v18;
+    let v22 = v17 - v21;
+    let v23 = 0.25f64 * q[1];
+    let v24 = v23 * q[2];
+    let v25 = v24 * v13;
+    let v26 = 0.5f64 * q[0];
+    let v27 = v26 * v18;
+    let v28 = v25 + v27;
+    let v29 = v17 + v21;
+    let v30 = v3.mul_add(v13, v12);
+    let v31 = v15 * q[1];
+    let v32 = v31 * v13;
+    let v33 = 0.5f64 * q[2];
+    let v34 = v33 * v18;
+    let v35 = v32 - v34;
+    let v36 = v25 - v27;
+    let v37 = v32 + v34;
+    let v38 = v9.mul_add(v13, v12);
+    let v41 = q[3] + p[0];
+    let v44 = v6 - v11;
+    let v45 = v43.mul_add(v44, 1f64);
+    let v46 = 0.5f64 * v41;
+    let v47 = v46 * v45;
+    let v48 = v20 * v13;
+    let v49 = v16.mul_add(v43, v48);
+    let v50 = v46 * v49;
+    let v51 = v26 * v13;
+    let v52 = v24.mul_add(v43, -v51);
+    let v53 = v46 * v52;
+    let v55 = 0.5f64 * qd[3];
+    let v57 = v33 * qd[2];
+    let v60 = v26.mul_add(qd[0], v57);
+    let v61 = v20.mul_add(qd[1], v60);
+    let v62 = v57 - v61;
+    let v64 = v61 * v63;
+    let v65 = v64 * v44;
+    let v66 = v43.mul_add(v62, v65);
+    let v67 = v46 * v66;
+    let v68 = v55.mul_add(v45, v67);
+    let v69 = 0.5f64 * qd[1];
+    let v71 = v61 * v70;
+    let v72 = v20 * v71;
+    let v73 = 0.25f64 * q[2];
+    let v74 = v73 * qd[0];
+    let v75 = 0.25f64 * qd[2];
+    let v76 = v73 * v64;
+    let v77 = v75.mul_add(v43, v76);
+    let v78 = v69.mul_add(v13, v72);
+    let v79 = v74.mul_add(v43, v78);
+    let v80 = q[0].mul_add(v77, v79);
+    let v81 = v46 * v80;
+    let v82 = v55.mul_add(v49, v81);
+    let v83 = v73 * qd[1];
+    let v84 = 0.5f64 * qd[0];
+    let v85 = v84 * v13;
+    let v86 = v83.mul_add(v43, -v85);
+    let v87 = (-v26).mul_add(v71, v86);
+    let v88 = q[1].mul_add(v77, v87);
+    let v89 = v46 * v88;
+    let v90 = v55.mul_add(v52, v89);
+    let v91 = qd[2] * qd[2];
+    let v92 = 0.5f64 * v91;
+    let v93 = qd[0] * qd[0];
+    let v94 = qd[1] * qd[1];
+    let v95 = 0.5f64 * v94;
+    let v96 = 0.5f64.mul_add(v93, v95);
+    let v97 = v96 + v92;
+    let v98 = v92 - v97;
+    let v100 = 2f64 * v61;
+    let v101 = q[2].mul_add(qd[2], -v100);
+    let v102 = v64 * v101;
+    let v104 = v61 * v61;
+    let v105 = v103 * v104;
+    let v106 = v63.mul_add(v97, v105);
+    let v107 = v43.mul_add(v98, v102);
+    let v108 = v106.mul_add(v44, v107);
+    let v109 = v46 * v108;
+    let v110 = qd[3].mul_add(v66, v109);
+    let v112 = v104 * v111;
+    let v113 = v70.mul_add(v97, v112);
+    let v114 = v20 * v113;
+    let v115 = 0.5f64 * qd[2];
+    let v116 = v73 * v106;
+    let v117 = v115.mul_add(v64, v116);
+    let v118 = v33 * v64;
+    let v119 = v115.mul_add(v43, v118);
+    let v120 = qd[1].mul_add(v71, v114);
+    let v121 = q[0].mul_add(v117, v120);
+    let v122 = qd[0].mul_add(v119, v121);
+    let v123 = v46 * v122;
+    let v124 = qd[3].mul_add(v80, v123);
+    let v125 = qd[0] * v71;
+    let v126 = q[1].mul_add(v117, -v125);
+    let v127 = (-v26).mul_add(v113, v126);
+    let v128 = qd[1].mul_add(v119, v127);
+    let v129 = v46 * v128;
+    let v130 = qd[3].mul_add(v88, v129);
+    let v131 = v23 * qd[0];
+    let v132 = v15.mul_add(qd[1], -v131);
+    let v133 = v115 * v18;
+    let v134 = v15 * qd[0];
+    let v135 = v73.mul_add(qd[2], v134);
+    let v136 = v23.mul_add(qd[1], v135);
+    let v137 = v33 * v43;
+    let v138 = v13.mul_add(v132, v133);
+    let v139 = v137.mul_add(v136, v138);
+    let v140 = v23.mul_add(qd[2], -v83);
+    let v141 = v84 * v18;
+    let v142 = v26 * v43;
+    let v143 = v13.mul_add(v140, v141);
+    let v144 = v142.mul_add(v136, v143);
+    let v145 = (-v15).mul_add(qd[2], v74);
+    let v146 = v69 * v18;
+    let v147 = v20 * v43;
+    let v148 = v13.mul_add(v145, v146);
+    let v149 = v147.mul_add(v136, v148);
+    let v150 = 0.5f64 * v136;
+    let v151 = v150 * v64;
+    let v152 = 0.25f64 * v94;
+    let v153 = 0.25f64.mul_add(v93, v152);
+    let v154 = 0.25f64.mul_add(v91, v153);
+    let v155 = 0.5f64 * v43;
+    let v156 = v155.mul_add(v154, v151);
+    let v157 = q[2] * v156;
+    let v158 = v155 * v136;
+    let v160 = v61 * v159;
+    let v161 = 0.5f64 * v160;
+    let v162 = v158 + v161;
+    let v163 = v132.mul_add(v71, v157);
+    let v164 = qd[2].mul_add(v162, v163);
+    let v165 = q[0] * v156;
+    let v166 = v140.mul_add(v71, v165);
+    let v167 = qd[0].mul_add(v162, v166);
+    let v168 = q[1] * v156;
+    let v169 = v145.mul_add(v71, v168);
+    let v170 = qd[1].mul_add(v162, v169);
+    let v172 = v171.mul_add(v44, 0.5f64);
+    let v173 = v46 * v172;
+    let v174 = v16.mul_add(v171, v147);
+    let v175 = v46 * v174;
+    let v176 = v24.mul_add(v171, -v142);
+    let v177 = v46 * v176;
+    let v179 = v61 * v178;
+    let v180 = v179 * v44;
+    let v181 = v171.mul_add(v62, v180);
+    let v182 = v46 * v181;
+    let v183 = v55.mul_add(v172, v182);
+    let v184 = v20 * v64;
+    let v185 = v73 * v179;
+    let v186 = v75.mul_add(v171, v185);
+    let v187 = v69.mul_add(v43, v184);
+    let v188 = v74.mul_add(v171, v187);
+    let v189 = q[0].mul_add(v186, v188);
+    let v190 = v46 * v189;
+    let v191 = v55.mul_add(v174, v190);
+    let v192 = v84 * v43;
+    let v193 = v83.mul_add(v171, -v192);
+    let v194 = (-v26).mul_add(v64, v193);
+    let v195 = q[1].mul_add(v186, v194);
+    let v196 = v46 * v195;
+    let v197 = v55.mul_add(v176, v196);
+    let v198 = v179 * v101;
+    let v200 = v104 * v199;
+    let v201 = v97.mul_add(v178, v200);
+    let v202 = v171.mul_add(v98, v198);
+    let v203 = v201.mul_add(v44, v202);
+    let v204 = v46 * v203;
+    let v205 = qd[3].mul_add(v181, v204);
+    let v206 = v20 * v106;
+    let v207 = v73 * v201;
+    let v208 = v115.mul_add(v179, v207);
+    let v209 = v33 * v179;
+    let v210 = v115.mul_add(v171, v209);
+    let v211 = qd[1].mul_add(v64, v206);
+    let v212 = q[0].mul_add(v208, v211);
+    let v213 = qd[0].mul_add(v210, v212);
+    let v214 = v46 * v213;
+    let v215 = qd[3].mul_add(v189, v214);
+    let v216 = qd[0] * v64;
+    let v217 = q[1].mul_add(v208, -v216);
+    let v218 = (-v26).mul_add(v106, v217);
+    let v219 = qd[1].mul_add(v210, v218);
+    let v220 = v46 * v219;
+    let v221 = qd[3].mul_add(v195, v220);
+    let v222 = 0.25f64 * v11;
+    let c: [[f64; 3]; runtime::rodrigues::FAMILY_J] = runtime::rodrigues::family::<
+        3,
     >(v222);
-    let v223: f64 = c[2usize][0usize];
-    let v229: f64 = c[1usize][0usize];
-    let v231: f64 = c[3usize][0usize];
-    let v254: f64 = c[2usize][1usize];
-    let v256: f64 = c[3usize][1usize];
-    let v267: f64 = c[1usize][1usize];
-    let v960: f64 = c[2usize][2usize];
-    let v966: f64 = c[3usize][2usize];
-    let v980: f64 = c[1usize][2usize];
-    let v225: f64 = 0.0625f64 * q[0usize];
-    let v226: f64 = 0.0625f64 * q[1usize];
-    let v227: f64 = v226 * qd[0usize];
-    let v228: f64 = v225.mul_add(qd[1usize], -v227);
-    let v230: f64 = v75 * v229;
-    let v232: f64 = 0.0625f64 * q[2usize];
-    let v233: f64 = v225 * qd[0usize];
-    let v234: f64 = v232.mul_add(qd[2usize], v233);
-    let v235: f64 = v226.mul_add(qd[1usize], v234);
-    let v236: f64 = v73 * v231;
-    let v237: f64 = v223.mul_add(v228, v230);
-    let v238: f64 = v236.mul_add(v235, v237);
-    let v239: f64 = v232 * qd[1usize];
-    let v240: f64 = v226.mul_add(qd[2usize], -v239);
-    let v241: f64 = 0.25f64 * qd[0usize];
-    let v242: f64 = v241 * v229;
-    let v243: f64 = v15 * v231;
-    let v244: f64 = v223.mul_add(v240, v242);
-    let v245: f64 = v243.mul_add(v235, v244);
-    let v246: f64 = v225 * qd[2usize];
-    let v247: f64 = v232.mul_add(qd[0usize], -v246);
-    let v248: f64 = 0.25f64 * qd[1usize];
-    let v249: f64 = v248 * v229;
-    let v250: f64 = v23 * v231;
-    let v251: f64 = v223.mul_add(v247, v249);
-    let v252: f64 = v250.mul_add(v235, v251);
-    let v253: f64 = 0.25f64 * v61;
-    let v255: f64 = v253 * v254;
-    let v257: f64 = v253 * v256;
-    let v258: f64 = 0.25f64 * v235;
-    let v259: f64 = v258 * v257;
-    let v260: f64 = 0.0625f64 * v94;
-    let v261: f64 = 0.0625f64.mul_add(v93, v260);
-    let v262: f64 = 0.0625f64.mul_add(v91, v261);
-    let v263: f64 = 0.25f64 * v231;
-    let v264: f64 = v263.mul_add(v262, v259);
-    let v265: f64 = q[2usize] * v264;
-    let v266: f64 = v263 * v235;
-    let v268: f64 = v253 * v267;
-    let v269: f64 = 0.25f64 * v268;
-    let v270: f64 = v266 + v269;
-    let v271: f64 = v228.mul_add(v255, v265);
-    let v272: f64 = qd[2usize].mul_add(v270, v271);
-    let v273: f64 = q[0usize] * v264;
-    let v274: f64 = v240.mul_add(v255, v273);
-    let v275: f64 = qd[0usize].mul_add(v270, v274);
-    let v276: f64 = q[1usize] * v264;
-    let v277: f64 = v247.mul_add(v255, v276);
-    let v278: f64 = qd[1usize].mul_add(v270, v277);
-    let v279: f64 = 0.0625f64.mul_add(v5, -v222);
-    let v280: f64 = v223.mul_add(v279, 1f64);
-    let v281: f64 = v225 * q[2usize];
-    let v282: f64 = v281 * v223;
-    let v283: f64 = v23.mul_add(v229, v282);
-    let v284: f64 = v226 * q[2usize];
-    let v285: f64 = v15 * v229;
-    let v286: f64 = v284.mul_add(v223, -v285);
-    let v288: f64 = 0.5f64 * p[1usize];
-    let v290: f64 = 0.25f64 * p[3usize];
-    let v292: f64 = p[2usize] - v290;
-    let v294: f64 = 0.125f64.mul_add(v292, v290);
-    let v295: f64 = 0.5f64 * p[3usize];
-    let v296: f64 = v23 * v13;
-    let v297: f64 = 0.125f64 * q[0usize];
-    let v298: f64 = v297 * q[2usize];
-    let v299: f64 = v298 * v43;
-    let v300: f64 = v299 - v296;
-    let v301: f64 = 0.5f64 * v18;
-    let v302: f64 = 0.125f64 * v1;
-    let v303: f64 = v302.mul_add(v43, v301);
-    let v304: f64 = v73 * v13;
-    let v305: f64 = v297 * q[1usize];
-    let v306: f64 = v305 * v43;
-    let v307: f64 = v304 + v306;
-    let v308: f64 = v63 * v26;
-    let v309: f64 = v308.mul_add(v44, -v142);
-    let v310: f64 = v46 * v309;
-    let v311: f64 = v70 * v26;
-    let v312: f64 = 0.25f64 * v43;
-    let v313: f64 = v15.mul_add(v308, v312);
-    let v314: f64 = q[2usize] * v313;
-    let v315: f64 = v20.mul_add(v311, v314);
-    let v316: f64 = v46 * v315;
-    let v317: f64 = 0.5f64 * v13;
-    let v318: f64 = v24.mul_add(v308, -v317);
-    let v319: f64 = (-v26).mul_add(v311, v318);
-    let v320: f64 = v46 * v319;
-    let v321: f64 = v226 * v223;
-    let v323: f64 = 0.015625f64 * q[0usize];
-    let v324: f64 = v323 * q[2usize];
-    let v325: f64 = v324 * v231;
-    let v326: f64 = v325 - v321;
-    let v327: f64 = 0.25f64 * v229;
-    let v328: f64 = 0.015625f64 * v1;
-    let v329: f64 = v328.mul_add(v231, v327);
-    let v330: f64 = v232 * v223;
-    let v331: f64 = v323 * q[1usize];
-    let v332: f64 = v331 * v231;
-    let v333: f64 = v330 + v332;
-    let v334: f64 = v171 * v26;
-    let v335: f64 = v178 * v26;
-    let v336: f64 = v335.mul_add(v44, -v334);
-    let v337: f64 = v46 * v336;
-    let v338: f64 = 0.25f64 * v171;
-    let v339: f64 = v15.mul_add(v335, v338);
-    let v340: f64 = q[2usize] * v339;
-    let v341: f64 = v20.mul_add(v308, v340);
-    let v342: f64 = v46 * v341;
-    let v343: f64 = v24.mul_add(v335, -v155);
-    let v344: f64 = (-v26).mul_add(v308, v343);
-    let v345: f64 = v46 * v344;
-    let v346: f64 = 0.125f64 * q[1usize];
-    let v347: f64 = v346 * q[2usize];
-    let v348: f64 = v347 * v43;
-    let v349: f64 = v15 * v13;
-    let v350: f64 = v348 + v349;
-    let v351: f64 = v306 - v304;
-    let v352: f64 = 0.125f64 * v8;
-    let v353: f64 = v352.mul_add(v43, v301);
-    let v354: f64 = v63 * v20;
-    let v355: f64 = v354.mul_add(v44, -v147);
-    let v356: f64 = v46 * v355;
-    let v357: f64 = v70 * v20;
-    let v358: f64 = v20.mul_add(v357, v317);
-    let v359: f64 = v16.mul_add(v354, v358);
-    let v360: f64 = v46 * v359;
-    let v361: f64 = v26 * v357;
-    let v362: f64 = v23.mul_add(v354, v312);
-    let v363: f64 = q[2usize].mul_add(v362, -v361);
-    let v364: f64 = v46 * v363;
-    let v365: f64 = v225 * v223;
-    let v366: f64 = 0.015625f64 * q[1usize];
-    let v367: f64 = v366 * q[2usize];
-    let v368: f64 = v367 * v231;
-    let v369: f64 = v365 + v368;
-    let v370: f64 = v332 - v330;
-    let v371: f64 = 0.015625f64 * v8;
-    let v372: f64 = v371.mul_add(v231, v327);
-    let v373: f64 = v171 * v20;
-    let v374: f64 = v178 * v20;
-    let v375: f64 = v374.mul_add(v44, -v373);
-    let v376: f64 = v46 * v375;
-    let v377: f64 = v20.mul_add(v354, v155);
-    let v378: f64 = v16.mul_add(v374, v377);
-    let v379: f64 = v46 * v378;
-    let v380: f64 = v26 * v354;
-    let v381: f64 = v23.mul_add(v374, v338);
-    let v382: f64 = q[2usize].mul_add(v381, -v380);
-    let v383: f64 = v46 * v382;
-    let v384: f64 = 0.125f64 * v5;
-    let v385: f64 = v384.mul_add(v43, v301);
-    let v386: f64 = v296 + v299;
-    let v387: f64 = v348 - v349;
-    let v388: f64 = v33 - v33;
-    let v389: f64 = v63 * v33;
-    let v390: f64 = v389 * v44;
-    let v391: f64 = v43.mul_add(v388, v390);
-    let v392: f64 = v46 * v391;
-    let v393: f64 = v70 * v33;
-    let v394: f64 = v73.mul_add(v389, v312);
-    let v395: f64 = q[0usize] * v394;
-    let v396: f64 = v20.mul_add(v393, v395);
-    let v397: f64 = v46 * v396;
-    let v398: f64 = v26 * v393;
-    let v399: f64 = q[1usize].mul_add(v394, -v398);
-    let v400: f64 = v46 * v399;
-    let v401: f64 = 0.015625f64 * v5;
-    let v402: f64 = v401.mul_add(v231, v327);
-    let v403: f64 = v321 + v325;
-    let v404: f64 = v368 - v365;
-    let v405: f64 = v178 * v33;
-    let v406: f64 = v405 * v44;
-    let v407: f64 = v171.mul_add(v388, v406);
-    let v408: f64 = v46 * v407;
-    let v409: f64 = v73.mul_add(v405, v338);
-    let v410: f64 = q[0usize] * v409;
-    let v411: f64 = v20.mul_add(v389, v410);
-    let v412: f64 = v46 * v411;
-    let v413: f64 = v26 * v389;
-    let v414: f64 = q[1usize].mul_add(v409, -v413);
-    let v415: f64 = v46 * v414;
-    let v417: f64 = 0.5f64 * v45;
-    let v418: f64 = 0.5f64 * v49;
-    let v419: f64 = 0.5f64 * v52;
-    let v420: f64 = 0.5f64 * v172;
-    let v421: f64 = 0.5f64 * v174;
-    let v422: f64 = 0.5f64 * v176;
-    let v424: f64 = p[0usize] / v41;
-    let v425: f64 = v424.powi(3i32);
-    let v426: f64 = q[0usize] * p[4usize];
-    let v428: f64 = v424.sqrt();
-    let v429: f64 = p[13usize] * v428;
-    let v430: f64 = v426.mul_add(v425, -v429);
-    let v432: f64 = v84 * p[5usize];
-    let v433: f64 = 0.5f64.mul_add(v430, v432);
-    let v435: f64 = q[1usize] - p[6usize];
-    let v436: f64 = p[4usize] * v425;
-    let v438: f64 = p[14usize] * v428;
-    let v439: f64 = v436.mul_add(v435, -v438);
-    let v440: f64 = v69 * p[5usize];
-    let v441: f64 = 0.5f64.mul_add(v439, v440);
-    let v443: f64 = v33 * p[7usize];
-    let v445: f64 = v115 * p[8usize];
-    let v446: f64 = v443.mul_add(v425, v445);
-    let v449: f64 = q[1usize] * p[14usize];
-    let v450: f64 = q[0usize].mul_add(p[13usize], v449);
-    let v451: f64 = v41 * v41;
-    let v452: f64 = p[0usize] / v451;
-    let v453: f64 = -v452;
-    let v454: f64 = 0.5f64 * v453;
-    let v455: f64 = v454 / v428;
-    let v456: f64 = v450.mul_add(v455, p[12usize]);
-    let v457: f64 = v424 * v424;
-    let v459: f64 = 3f64 * v453;
-    let v460: f64 = v459 * v457;
-    let v461: f64 = 0.5f64 * p[7usize];
-    let v462: f64 = v435 * v435;
-    let v463: f64 = 0.5f64 * v462;
-    let v464: f64 = 0.5f64.mul_add(v1, v463);
-    let v465: f64 = p[4usize] * v464;
-    let v466: f64 = v461.mul_add(v5, v465);
-    let v467: f64 = q[3usize].mul_add(p[9usize], -v456);
-    let v468: f64 = v460.mul_add(v466, v467);
-    let v470: f64 = v55 * p[10usize];
-    let v471: f64 = 0.5f64.mul_add(v468, v470);
-    let v474: f64 = v33 * dir[2usize];
-    let v476: f64 = v26.mul_add(dir[0usize], v474);
-    let v477: f64 = v20.mul_add(dir[1usize], v476);
-    let v479: f64 = v477 * v478;
-    let v480: f64 = v33 * v13;
-    let v481: f64 = v70 * v477;
-    let v482: f64 = v480.mul_add(dir[2usize], v479);
-    let v483: f64 = v6.mul_add(v481, v482);
-    let v484: f64 = v304 * dir[0usize];
-    let v485: f64 = v301 * dir[1usize];
-    let v486: f64 = v159 * v477;
-    let v487: f64 = v20 * v486;
-    let v488: f64 = 0.25f64 * v13;
-    let v489: f64 = v488 * dir[2usize];
-    let v490: f64 = v73 * v481;
-    let v491: f64 = v489 + v490;
-    let v492: f64 = q[0usize] * v491;
-    let v493: f64 = v484 - v485;
-    let v494: f64 = v493 - v487;
-    let v495: f64 = v494 + v492;
-    let v496: f64 = v304 * dir[1usize];
-    let v497: f64 = v301 * dir[0usize];
-    let v498: f64 = v26 * v486;
-    let v499: f64 = q[1usize] * v491;
-    let v500: f64 = v496 + v497;
-    let v501: f64 = v500 + v498;
-    let v502: f64 = v501 + v499;
-    let v503: f64 = v484 + v485;
-    let v504: f64 = v503 + v487;
-    let v505: f64 = v504 + v492;
-    let v506: f64 = v51.mul_add(dir[0usize], v479);
-    let v507: f64 = v3.mul_add(v481, v506);
-    let v508: f64 = v296 * dir[0usize];
-    let v509: f64 = v301 * dir[2usize];
-    let v510: f64 = v33 * v486;
-    let v511: f64 = v488 * dir[1usize];
-    let v512: f64 = v23 * v481;
-    let v513: f64 = v511 + v512;
-    let v514: f64 = q[0usize] * v513;
-    let v515: f64 = v508 - v509;
-    let v516: f64 = v515 - v510;
-    let v517: f64 = v516 + v514;
-    let v518: f64 = v496 - v497;
-    let v519: f64 = v518 - v498;
-    let v520: f64 = v519 + v499;
-    let v521: f64 = v508 + v509;
-    let v522: f64 = v521 + v510;
-    let v523: f64 = v522 + v514;
-    let v524: f64 = v48.mul_add(dir[1usize], v479);
-    let v525: f64 = v9.mul_add(v481, v524);
-    let v527: f64 = v474 - v477;
-    let v528: f64 = v63 * v477;
-    let v529: f64 = v44 * v528;
-    let v530: f64 = v43.mul_add(v527, v529);
-    let v531: f64 = v46 * v530;
-    let v532: f64 = v417.mul_add(dir[3usize], v531);
-    let v533: f64 = v20 * v481;
-    let v534: f64 = v73 * v43;
-    let v535: f64 = v73 * v528;
-    let v536: f64 = v312.mul_add(dir[2usize], v535);
-    let v537: f64 = v317.mul_add(dir[1usize], v533);
-    let v538: f64 = v534.mul_add(dir[0usize], v537);
-    let v539: f64 = q[0usize].mul_add(v536, v538);
-    let v540: f64 = v46 * v539;
-    let v541: f64 = v418.mul_add(dir[3usize], v540);
-    let v542: f64 = v317 * dir[0usize];
-    let v543: f64 = v534.mul_add(dir[1usize], -v542);
-    let v544: f64 = (-v26).mul_add(v481, v543);
-    let v545: f64 = q[1usize].mul_add(v536, v544);
-    let v546: f64 = v46 * v545;
-    let v547: f64 = v419.mul_add(dir[3usize], v546);
-    let v549: f64 = v55 * v530;
-    let v550: f64 = 0.5f64 * v66;
-    let v551: f64 = v61 * v528;
-    let v553: f64 = v115 * v528;
-    let v554: f64 = 0.5f64 * v64;
-    let v555: f64 = v155.mul_add(dir[6usize], v553);
-    let v556: f64 = v554.mul_add(dir[2usize], v555);
-    let v557: f64 = v115 * dir[2usize];
-    let v560: f64 = v33.mul_add(dir[6usize], v557);
-    let v561: f64 = v84.mul_add(dir[0usize], v560);
-    let v562: f64 = v26.mul_add(dir[4usize], v561);
-    let v563: f64 = v69.mul_add(dir[1usize], v562);
-    let v564: f64 = v20.mul_add(dir[5usize], v563);
-    let v565: f64 = v557 - v564;
-    let v566: f64 = v61 * v103;
-    let v567: f64 = v566 * v477;
-    let v568: f64 = v63.mul_add(v564, v567);
-    let v569: f64 = q[2usize].mul_add(v556, -v551);
-    let v570: f64 = (-v64).mul_add(v477, v569);
-    let v571: f64 = v43.mul_add(v565, v570);
-    let v572: f64 = v44.mul_add(v568, v571);
-    let v573: f64 = v417.mul_add(dir[7usize], v549);
-    let v574: f64 = v550.mul_add(dir[3usize], v573);
-    let v575: f64 = v46.mul_add(v572, v574);
-    let v576: f64 = v55 * v539;
-    let v577: f64 = 0.5f64 * v80;
-    let v578: f64 = v69 * v481;
-    let v579: f64 = 0.5f64 * v71;
-    let v580: f64 = v61 * v111;
-    let v581: f64 = v580 * v477;
-    let v582: f64 = v70.mul_add(v564, v581);
-    let v583: f64 = v75 * v528;
-    let v584: f64 = 0.25f64 * v64;
-    let v585: f64 = v312.mul_add(dir[6usize], v583);
-    let v586: f64 = v584.mul_add(dir[2usize], v585);
-    let v587: f64 = v73.mul_add(v568, v586);
-    let v588: f64 = v241 * v528;
-    let v589: f64 = v312.mul_add(dir[4usize], v588);
-    let v590: f64 = v584.mul_add(dir[0usize], v589);
-    let v591: f64 = v241 * dir[2usize];
-    let v592: f64 = v75 * dir[0usize];
-    let v593: f64 = v591 + v592;
-    let v594: f64 = v317.mul_add(dir[5usize], v578);
-    let v595: f64 = v579.mul_add(dir[1usize], v594);
-    let v596: f64 = v20.mul_add(v582, v595);
-    let v597: f64 = q[0usize].mul_add(v587, v596);
-    let v598: f64 = q[2usize].mul_add(v590, v597);
-    let v599: f64 = v43.mul_add(v593, v598);
-    let v600: f64 = v418.mul_add(dir[7usize], v576);
-    let v601: f64 = v577.mul_add(dir[3usize], v600);
-    let v602: f64 = v46.mul_add(v599, v601);
-    let v603: f64 = v55 * v545;
-    let v604: f64 = 0.5f64 * v88;
-    let v605: f64 = v317 * dir[4usize];
-    let v606: f64 = v248 * v528;
-    let v607: f64 = v312.mul_add(dir[5usize], v606);
-    let v608: f64 = v584.mul_add(dir[1usize], v607);
-    let v609: f64 = v75 * dir[1usize];
-    let v610: f64 = v248 * dir[2usize];
-    let v611: f64 = v609 + v610;
-    let v612: f64 = q[1usize].mul_add(v587, -v605);
-    let v613: f64 = (-v84).mul_add(v481, v612);
-    let v614: f64 = (-v579).mul_add(dir[0usize], v613);
-    let v615: f64 = (-v26).mul_add(v582, v614);
-    let v616: f64 = q[2usize].mul_add(v608, v615);
-    let v617: f64 = v43.mul_add(v611, v616);
-    let v618: f64 = v419.mul_add(dir[7usize], v603);
-    let v619: f64 = v604.mul_add(dir[3usize], v618);
-    let v620: f64 = v46.mul_add(v617, v619);
-    let v621: f64 = qd[3usize] * v572;
-    let v622: f64 = 0.5f64 * v108;
-    let v623: f64 = 2f64 * v64;
-    let v624: f64 = v623 * v564;
-    let v625: f64 = qd[1usize] * dir[5usize];
-    let v626: f64 = qd[0usize].mul_add(dir[4usize], v625);
-    let v627: f64 = qd[2usize].mul_add(dir[6usize], v626);
-    let v628: f64 = qd[2usize] * v568;
-    let v629: f64 = 0.5f64 * v106;
-    let v630: f64 = v64.mul_add(dir[6usize], v628);
-    let v631: f64 = v629.mul_add(dir[2usize], v630);
-    let v632: f64 = v64 * dir[2usize];
-    let v633: f64 = v43.mul_add(dir[6usize], v632);
-    let v635: f64 = v104 * v477;
-    let v636: f64 = v635 * v634;
-    let v637: f64 = v100 * v564;
-    let v638: f64 = v97.mul_add(v477, v637);
-    let v639: f64 = v63.mul_add(v627, v636);
-    let v640: f64 = v103.mul_add(v638, v639);
-    let v641: f64 = q[2usize].mul_add(v631, -v624);
-    let v642: f64 = (-v100).mul_add(v568, v641);
-    let v643: f64 = (-v43).mul_add(v627, v642);
-    let v644: f64 = (-v106).mul_add(v477, v643);
-    let v645: f64 = qd[2usize].mul_add(v633, v644);
-    let v646: f64 = v98.mul_add(v528, v645);
-    let v647: f64 = v44.mul_add(v640, v646);
-    let v648: f64 = v66.mul_add(dir[7usize], v621);
-    let v649: f64 = v622.mul_add(dir[3usize], v648);
-    let v650: f64 = v46.mul_add(v647, v649);
-    let v651: f64 = qd[3usize] * v599;
-    let v652: f64 = 0.5f64 * v122;
-    let v653: f64 = qd[1usize] * v582;
-    let v654: f64 = 0.5f64 * v113;
-    let v656: f64 = v635 * v655;
-    let v657: f64 = v70.mul_add(v627, v656);
-    let v658: f64 = v111.mul_add(v638, v657);
-    let v659: f64 = v115 * v568;
-    let v660: f64 = 0.25f64 * v106;
-    let v661: f64 = v554.mul_add(dir[6usize], v659);
-    let v662: f64 = v660.mul_add(dir[2usize], v661);
-    let v663: f64 = v73.mul_add(v640, v662);
-    let v664: f64 = v33.mul_add(v568, v556);
-    let v665: f64 = v660 * dir[0usize];
-    let v666: f64 = v554.mul_add(dir[4usize], v665);
-    let v667: f64 = v155 * dir[4usize];
-    let v668: f64 = v554 * dir[0usize];
-    let v669: f64 = v667 + v668;
-    let v670: f64 = v71.mul_add(dir[5usize], v653);
-    let v671: f64 = v654.mul_add(dir[1usize], v670);
-    let v672: f64 = v20.mul_add(v658, v671);
-    let v673: f64 = q[0usize].mul_add(v663, v672);
-    let v674: f64 = qd[0usize].mul_add(v664, v673);
-    let v675: f64 = q[2usize].mul_add(v666, v674);
-    let v676: f64 = qd[2usize].mul_add(v669, v675);
-    let v677: f64 = v80.mul_add(dir[7usize], v651);
-    let v678: f64 = v652.mul_add(dir[3usize], v677);
-    let v679: f64 = v46.mul_add(v676, v678);
-    let v680: f64 = qd[3usize] * v617;
-    let v681: f64 = 0.5f64 * v128;
-    let v682: f64 = v71 * dir[4usize];
-    let v683: f64 = v660 * dir[1usize];
-    let v684: f64 = v554.mul_add(dir[5usize], v683);
-    let v685: f64 = v155 * dir[5usize];
-    let v686: f64 = v554 * dir[1usize];
-    let v687: f64 = v685 + v686;
-    let v688: f64 = q[1usize].mul_add(v663, -v682);
-    let v689: f64 = (-qd[0usize]).mul_add(v582, v688);
-    let v690: f64 = (-v654).mul_add(dir[0usize], v689);
-    let v691: f64 = (-v26).mul_add(v658, v690);
-    let v692: f64 = qd[1usize].mul_add(v664, v691);
-    let v693: f64 = q[2usize].mul_add(v684, v692);
-    let v694: f64 = qd[2usize].mul_add(v687, v693);
-    let v695: f64 = v88.mul_add(dir[7usize], v680);
-    let v696: f64 = v681.mul_add(dir[3usize], v695);
-    let v697: f64 = v46.mul_add(v694, v696);
-    let v698: f64 = v15 * dir[5usize];
-    let v699: f64 = v248.mul_add(dir[0usize], v698);
-    let v700: f64 = (-v241).mul_add(dir[1usize], v699);
-    let v701: f64 = (-v23).mul_add(dir[4usize], v700);
-    let v702: f64 = v13 * v701;
-    let v703: f64 = v150 * v528;
-    let v704: f64 = v73 * dir[6usize];
-    let v705: f64 = v75.mul_add(dir[2usize], v704);
-    let v706: f64 = v241.mul_add(dir[0usize], v705);
-    let v707: f64 = v15.mul_add(dir[4usize], v706);
-    let v708: f64 = v248.mul_add(dir[1usize], v707);
-    let v709: f64 = v23.mul_add(dir[5usize], v708);
-    let v710: f64 = v155 * v709;
-    let v711: f64 = v703 + v710;
-    let v712: f64 = v132.mul_add(v481, v702);
-    let v713: f64 = v301.mul_add(dir[6usize], v712);
-    let v714: f64 = v115.mul_add(v486, v713);
-    let v715: f64 = v158.mul_add(dir[2usize], v714);
-    let v716: f64 = q[2usize].mul_add(v711, v715);
-    let v717: f64 = v23.mul_add(dir[6usize], v609);
-    let v718: f64 = v717 - v610;
-    let v719: f64 = (-v73).mul_add(dir[5usize], v718);
-    let v720: f64 = v13 * v719;
-    let v721: f64 = v140.mul_add(v481, v720);
-    let v722: f64 = v301.mul_add(dir[4usize], v721);
-    let v723: f64 = v84.mul_add(v486, v722);
-    let v724: f64 = v158.mul_add(dir[0usize], v723);
-    let v725: f64 = q[0usize].mul_add(v711, v724);
-    let v726: f64 = v73.mul_add(dir[4usize], v591);
-    let v727: f64 = v726 - v592;
-    let v728: f64 = (-v15).mul_add(dir[6usize], v727);
-    let v729: f64 = v13 * v728;
-    let v730: f64 = v145.mul_add(v481, v729);
-    let v731: f64 = v301.mul_add(dir[5usize], v730);
-    let v732: f64 = v69.mul_add(v486, v731);
-    let v733: f64 = v158.mul_add(dir[1usize], v732);
-    let v734: f64 = q[1usize].mul_add(v711, v733);
-    let v735: f64 = v132 * v582;
-    let v736: f64 = v150 * v568;
-    let v737: f64 = 0.5f64 * v154;
-    let v738: f64 = v69 * dir[5usize];
-    let v739: f64 = v84.mul_add(dir[4usize], v738);
-    let v740: f64 = v115.mul_add(dir[6usize], v739);
-    let v741: f64 = v554.mul_add(v709, v736);
-    let v742: f64 = v737.mul_add(v528, v741);
-    let v743: f64 = v155.mul_add(v740, v742);
-    let v745: f64 = v61 * v477;
-    let v746: f64 = v745 * v744;
-    let v747: f64 = v159.mul_add(v564, v746);
-    let v748: f64 = 0.5f64.mul_add(v747, v703);
-    let v749: f64 = v748 + v710;
-    let v750: f64 = v737 * dir[2usize];
-    let v751: f64 = v150.mul_add(dir[6usize], v750);
-    let v752: f64 = v71.mul_add(v701, v735);
-    let v753: f64 = v161.mul_add(dir[6usize], v752);
-    let v754: f64 = v151.mul_add(dir[2usize], v753);
-    let v755: f64 = q[2usize].mul_add(v743, v754);
-    let v756: f64 = qd[2usize].mul_add(v749, v755);
-    let v757: f64 = v43.mul_add(v751, v756);
-    let v758: f64 = v140 * v582;
-    let v759: f64 = v737 * dir[0usize];
-    let v760: f64 = v150.mul_add(dir[4usize], v759);
-    let v761: f64 = v71.mul_add(v719, v758);
-    let v762: f64 = v161.mul_add(dir[4usize], v761);
-    let v763: f64 = v151.mul_add(dir[0usize], v762);
-    let v764: f64 = q[0usize].mul_add(v743, v763);
-    let v765: f64 = qd[0usize].mul_add(v749, v764);
-    let v766: f64 = v43.mul_add(v760, v765);
-    let v767: f64 = v145 * v582;
-    let v768: f64 = v737 * dir[1usize];
-    let v769: f64 = v150.mul_add(dir[5usize], v768);
-    let v770: f64 = v71.mul_add(v728, v767);
-    let v771: f64 = v161.mul_add(dir[5usize], v770);
-    let v772: f64 = v151.mul_add(dir[1usize], v771);
-    let v773: f64 = q[1usize].mul_add(v743, v772);
-    let v774: f64 = qd[1usize].mul_add(v749, v773);
-    let v775: f64 = v43.mul_add(v769, v774);
-    let v776: f64 = v178 * v477;
-    let v777: f64 = v44 * v776;
-    let v778: f64 = v171.mul_add(v527, v777);
-    let v779: f64 = v46 * v778;
-    let v780: f64 = v420.mul_add(dir[3usize], v779);
-    let v781: f64 = v155 * dir[1usize];
-    let v782: f64 = v20 * v528;
-    let v783: f64 = v73 * v171;
-    let v784: f64 = v73 * v776;
-    let v785: f64 = v338.mul_add(dir[2usize], v784);
-    let v786: f64 = v781 + v782;
-    let v787: f64 = v783.mul_add(dir[0usize], v786);
-    let v788: f64 = q[0usize].mul_add(v785, v787);
-    let v789: f64 = v46 * v788;
-    let v790: f64 = v421.mul_add(dir[3usize], v789);
-    let v791: f64 = v155 * dir[0usize];
-    let v792: f64 = v26 * v528;
-    let v793: f64 = v783.mul_add(dir[1usize], -v791);
-    let v794: f64 = v793 - v792;
-    let v795: f64 = q[1usize].mul_add(v785, v794);
-    let v796: f64 = v46 * v795;
-    let v797: f64 = v422.mul_add(dir[3usize], v796);
-    let v798: f64 = v55 * v778;
-    let v799: f64 = 0.5f64 * v181;
-    let v800: f64 = v61 * v776;
-    let v801: f64 = 0.5f64 * v171;
-    let v802: f64 = v115 * v776;
-    let v803: f64 = 0.5f64 * v179;
-    let v804: f64 = v801.mul_add(dir[6usize], v802);
-    let v805: f64 = v803.mul_add(dir[2usize], v804);
-    let v806: f64 = v61 * v199;
-    let v807: f64 = v806 * v477;
-    let v808: f64 = v178.mul_add(v564, v807);
-    let v809: f64 = q[2usize].mul_add(v805, -v800);
-    let v810: f64 = (-v179).mul_add(v477, v809);
-    let v811: f64 = v171.mul_add(v565, v810);
-    let v812: f64 = v44.mul_add(v808, v811);
-    let v813: f64 = v420.mul_add(dir[7usize], v798);
-    let v814: f64 = v799.mul_add(dir[3usize], v813);
-    let v815: f64 = v46.mul_add(v812, v814);
-    let v816: f64 = v55 * v788;
-    let v817: f64 = 0.5f64 * v189;
-    let v818: f64 = v75 * v776;
-    let v819: f64 = 0.25f64 * v179;
-    let v820: f64 = v338.mul_add(dir[6usize], v818);
-    let v821: f64 = v819.mul_add(dir[2usize], v820);
-    let v822: f64 = v73.mul_add(v808, v821);
-    let v823: f64 = v241 * v776;
-    let v824: f64 = v338.mul_add(dir[4usize], v823);
-    let v825: f64 = v819.mul_add(dir[0usize], v824);
-    let v826: f64 = v69.mul_add(v528, v685);
-    let v827: f64 = v826 + v686;
-    let v828: f64 = v20.mul_add(v568, v827);
-    let v829: f64 = q[0usize].mul_add(v822, v828);
-    let v830: f64 = q[2usize].mul_add(v825, v829);
-    let v831: f64 = v171.mul_add(v593, v830);
-    let v832: f64 = v421.mul_add(dir[7usize], v816);
-    let v833: f64 = v817.mul_add(dir[3usize], v832);
-    let v834: f64 = v46.mul_add(v831, v833);
-    let v835: f64 = v55 * v795;
-    let v836: f64 = 0.5f64 * v195;
-    let v837: f64 = v248 * v776;
-    let v838: f64 = v338.mul_add(dir[5usize], v837);
-    let v839: f64 = v819.mul_add(dir[1usize], v838);
-    let v840: f64 = q[1usize].mul_add(v822, -v667);
-    let v841: f64 = (-v84).mul_add(v528, v840);
-    let v842: f64 = v841 - v668;
-    let v843: f64 = (-v26).mul_add(v568, v842);
-    let v844: f64 = q[2usize].mul_add(v839, v843);
-    let v845: f64 = v171.mul_add(v611, v844);
-    let v846: f64 = v422.mul_add(dir[7usize], v835);
-    let v847: f64 = v836.mul_add(dir[3usize], v846);
-    let v848: f64 = v46.mul_add(v845, v847);
-    let v849: f64 = qd[3usize] * v812;
-    let v850: f64 = 0.5f64 * v203;
-    let v851: f64 = 2f64 * v179;
-    let v852: f64 = v851 * v564;
-    let v853: f64 = qd[2usize] * v808;
-    let v854: f64 = 0.5f64 * v201;
-    let v855: f64 = v179.mul_add(dir[6usize], v853);
-    let v856: f64 = v854.mul_add(dir[2usize], v855);
-    let v857: f64 = v179 * dir[2usize];
-    let v858: f64 = v171.mul_add(dir[6usize], v857);
-    let v860: f64 = v635 * v859;
-    let v861: f64 = v178.mul_add(v627, v860);
-    let v862: f64 = v199.mul_add(v638, v861);
-    let v863: f64 = q[2usize].mul_add(v856, -v852);
-    let v864: f64 = (-v100).mul_add(v808, v863);
-    let v865: f64 = (-v171).mul_add(v627, v864);
-    let v866: f64 = (-v201).mul_add(v477, v865);
-    let v867: f64 = qd[2usize].mul_add(v858, v866);
-    let v868: f64 = v98.mul_add(v776, v867);
-    let v869: f64 = v44.mul_add(v862, v868);
-    let v870: f64 = v181.mul_add(dir[7usize], v849);
-    let v871: f64 = v850.mul_add(dir[3usize], v870);
-    let v872: f64 = v46.mul_add(v869, v871);
-    let v873: f64 = qd[3usize] * v831;
-    let v874: f64 = 0.5f64 * v213;
-    let v875: f64 = qd[1usize] * v568;
-    let v876: f64 = v115 * v808;
-    let v877: f64 = 0.25f64 * v201;
-    let v878: f64 = v803.mul_add(dir[6usize], v876);
-    let v879: f64 = v877.mul_add(dir[2usize], v878);
-    let v880: f64 = v73.mul_add(v862, v879);
-    let v881: f64 = v33.mul_add(v808, v805);
-    let v882: f64 = v877 * dir[0usize];
-    let v883: f64 = v803.mul_add(dir[4usize], v882);
-    let v884: f64 = v803 * dir[0usize];
-    let v885: f64 = v801.mul_add(dir[4usize], v884);
-    let v886: f64 = v64.mul_add(dir[5usize], v875);
-    let v887: f64 = v629.mul_add(dir[1usize], v886);
-    let v888: f64 = v20.mul_add(v640, v887);
-    let v889: f64 = q[0usize].mul_add(v880, v888);
-    let v890: f64 = qd[0usize].mul_add(v881, v889);
-    let v891: f64 = q[2usize].mul_add(v883, v890);
-    let v892: f64 = qd[2usize].mul_add(v885, v891);
-    let v893: f64 = v189.mul_add(dir[7usize], v873);
-    let v894: f64 = v874.mul_add(dir[3usize], v893);
-    let v895: f64 = v46.mul_add(v892, v894);
-    let v896: f64 = qd[3usize] * v845;
-    let v897: f64 = 0.5f64 * v219;
-    let v898: f64 = v64 * dir[4usize];
-    let v899: f64 = v877 * dir[1usize];
-    let v900: f64 = v803.mul_add(dir[5usize], v899);
-    let v901: f64 = v803 * dir[1usize];
-    let v902: f64 = v801.mul_add(dir[5usize], v901);
-    let v903: f64 = q[1usize].mul_add(v880, -v898);
-    let v904: f64 = (-qd[0usize]).mul_add(v568, v903);
-    let v905: f64 = (-v629).mul_add(dir[0usize], v904);
-    let v906: f64 = (-v26).mul_add(v640, v905);
-    let v907: f64 = qd[1usize].mul_add(v881, v906);
-    let v908: f64 = q[2usize].mul_add(v900, v907);
-    let v909: f64 = qd[2usize].mul_add(v902, v908);
-    let v910: f64 = v195.mul_add(dir[7usize], v896);
-    let v911: f64 = v897.mul_add(dir[3usize], v910);
-    let v912: f64 = v46.mul_add(v909, v911);
-    let v913: f64 = 0.25f64 * v477;
-    let v914: f64 = v254 * v913;
-    let v915: f64 = 0.0625f64 * qd[1usize];
-    let v916: f64 = v225 * dir[5usize];
-    let v917: f64 = 0.0625f64 * qd[0usize];
-    let v918: f64 = v915.mul_add(dir[0usize], v916);
-    let v919: f64 = (-v917).mul_add(dir[1usize], v918);
-    let v920: f64 = (-v226).mul_add(dir[4usize], v919);
-    let v921: f64 = v223 * v920;
-    let v922: f64 = v267 * v913;
-    let v923: f64 = v256 * v913;
-    let v924: f64 = v258 * v923;
-    let v925: f64 = 0.0625f64 * qd[2usize];
-    let v926: f64 = v232 * dir[6usize];
-    let v927: f64 = v925.mul_add(dir[2usize], v926);
-    let v928: f64 = v917.mul_add(dir[0usize], v927);
-    let v929: f64 = v225.mul_add(dir[4usize], v928);
-    let v930: f64 = v915.mul_add(dir[1usize], v929);
-    let v931: f64 = v226.mul_add(dir[5usize], v930);
-    let v932: f64 = v263 * v931;
-    let v933: f64 = v924 + v932;
-    let v934: f64 = v228.mul_add(v914, v921);
-    let v935: f64 = v327.mul_add(dir[6usize], v934);
-    let v936: f64 = v75.mul_add(v922, v935);
-    let v937: f64 = v266.mul_add(dir[2usize], v936);
-    let v938: f64 = q[2usize].mul_add(v933, v937);
-    let v939: f64 = v226 * dir[6usize];
-    let v940: f64 = v925.mul_add(dir[1usize], v939);
-    let v941: f64 = (-v915).mul_add(dir[2usize], v940);
-    let v942: f64 = (-v232).mul_add(dir[5usize], v941);
-    let v943: f64 = v223 * v942;
-    let v944: f64 = v240.mul_add(v914, v943);
-    let v945: f64 = v327.mul_add(dir[4usize], v944);
-    let v946: f64 = v241.mul_add(v922, v945);
-    let v947: f64 = v266.mul_add(dir[0usize], v946);
-    let v948: f64 = q[0usize].mul_add(v933, v947);
-    let v949: f64 = v232 * dir[4usize];
-    let v950: f64 = v917.mul_add(dir[2usize], v949);
-    let v951: f64 = (-v925).mul_add(dir[0usize], v950);
-    let v952: f64 = (-v225).mul_add(dir[6usize], v951);
-    let v953: f64 = v223 * v952;
-    let v954: f64 = v247.mul_add(v914, v953);
-    let v955: f64 = v327.mul_add(dir[5usize], v954);
-    let v956: f64 = v248.mul_add(v922, v955);
-    let v957: f64 = v266.mul_add(dir[1usize], v956);
-    let v958: f64 = q[1usize].mul_add(v933, v957);
-    let v959: f64 = 0.25f64 * v564;
-    let v961: f64 = v253 * v913;
-    let v962: f64 = v961 * v960;
-    let v963: f64 = v254.mul_add(v959, v962);
-    let v964: f64 = v228 * v963;
-    let v965: f64 = 0.25f64 * v257;
-    let v967: f64 = v961 * v966;
-    let v968: f64 = v256.mul_add(v959, v967);
-    let v969: f64 = v258 * v968;
-    let v970: f64 = 0.25f64 * v262;
-    let v971: f64 = 0.125f64 * qd[0usize];
-    let v972: f64 = 0.125f64 * qd[1usize];
-    let v973: f64 = v972 * dir[5usize];
-    let v974: f64 = 0.125f64 * qd[2usize];
-    let v975: f64 = v971.mul_add(dir[4usize], v973);
-    let v976: f64 = v974.mul_add(dir[6usize], v975);
-    let v977: f64 = v965.mul_add(v931, v969);
-    let v978: f64 = v970.mul_add(v923, v977);
-    let v979: f64 = v263.mul_add(v976, v978);
-    let v981: f64 = v961 * v980;
-    let v982: f64 = v267.mul_add(v959, v981);
-    let v983: f64 = 0.25f64.mul_add(v982, v924);
-    let v984: f64 = v983 + v932;
-    let v985: f64 = v970 * dir[2usize];
-    let v986: f64 = v258.mul_add(dir[6usize], v985);
-    let v987: f64 = v255.mul_add(v920, v964);
-    let v988: f64 = v269.mul_add(dir[6usize], v987);
-    let v989: f64 = v259.mul_add(dir[2usize], v988);
-    let v990: f64 = q[2usize].mul_add(v979, v989);
-    let v991: f64 = qd[2usize].mul_add(v984, v990);
-    let v992: f64 = v231.mul_add(v986, v991);
-    let v993: f64 = v240 * v963;
-    let v994: f64 = v970 * dir[0usize];
-    let v995: f64 = v258.mul_add(dir[4usize], v994);
-    let v996: f64 = v255.mul_add(v942, v993);
-    let v997: f64 = v269.mul_add(dir[4usize], v996);
-    let v998: f64 = v259.mul_add(dir[0usize], v997);
-    let v999: f64 = q[0usize].mul_add(v979, v998);
-    let v1000: f64 = qd[0usize].mul_add(v984, v999);
-    let v1001: f64 = v231.mul_add(v995, v1000);
-    let v1002: f64 = v247 * v963;
-    let v1003: f64 = v970 * dir[1usize];
-    let v1004: f64 = v258.mul_add(dir[5usize], v1003);
-    let v1005: f64 = v255.mul_add(v952, v1002);
-    let v1006: f64 = v269.mul_add(dir[5usize], v1005);
-    let v1007: f64 = v259.mul_add(dir[1usize], v1006);
-    let v1008: f64 = q[1usize].mul_add(v979, v1007);
-    let v1009: f64 = qd[1usize].mul_add(v984, v1008);
-    let v1010: f64 = v231.mul_add(v1004, v1009);
-    let v1011: f64 = 0.125f64 * q[2usize];
-    let v1012: f64 = v1011.mul_add(dir[2usize], -v913);
-    let v1013: f64 = v279 * v914;
-    let v1014: f64 = v223.mul_add(v1012, v1013);
-    let v1015: f64 = v23 * v922;
-    let v1016: f64 = 0.0625f64 * v223;
-    let v1017: f64 = v1016 * dir[2usize];
-    let v1018: f64 = v232 * v914;
-    let v1019: f64 = v1017 + v1018;
-    let v1020: f64 = v327.mul_add(dir[1usize], v1015);
-    let v1021: f64 = v330.mul_add(dir[0usize], v1020);
-    let v1022: f64 = q[0usize].mul_add(v1019, v1021);
-    let v1023: f64 = v327 * dir[0usize];
-    let v1024: f64 = v330.mul_add(dir[1usize], -v1023);
-    let v1025: f64 = (-v15).mul_add(v922, v1024);
-    let v1026: f64 = q[1usize].mul_add(v1019, v1025);
-    let v1027: f64 = v1011 * v43;
-    let v1028: f64 = v1027 * dir[0usize];
-    let v1029: f64 = 0.125f64 * v43;
-    let v1030: f64 = v1011 * v528;
-    let v1031: f64 = v1029.mul_add(dir[2usize], v1030);
-    let v1032: f64 = q[0usize] * v1031;
-    let v1033: f64 = v1028 - v511;
-    let v1034: f64 = v1033 - v512;
-    let v1035: f64 = v1034 + v1032;
-    let v1036: f64 = 0.5f64 * v486;
-    let v1037: f64 = v15 * v43;
-    let v1038: f64 = v1037.mul_add(dir[0usize], v1036);
-    let v1039: f64 = v302.mul_add(v528, v1038);
-    let v1040: f64 = v346 * v43;
-    let v1041: f64 = v1040 * dir[0usize];
-    let v1042: f64 = v346 * v528;
-    let v1043: f64 = v1029.mul_add(dir[1usize], v1042);
-    let v1044: f64 = q[0usize] * v1043;
-    let v1045: f64 = v491 + v1041;
-    let v1046: f64 = v1045 + v1044;
-    let v1047: f64 = 0.5f64 * v309;
-    let v1048: f64 = v103 * v26;
-    let v1049: f64 = 0.5f64 * v63;
-    let v1050: f64 = v1049 * dir[0usize];
-    let v1051: f64 = v1048.mul_add(v477, v1050);
-    let v1052: f64 = v308.mul_add(v527, -v791);
-    let v1053: f64 = v1052 - v792;
-    let v1054: f64 = v44.mul_add(v1051, v1053);
-    let v1055: f64 = v46 * v1054;
-    let v1056: f64 = v1047.mul_add(dir[3usize], v1055);
-    let v1057: f64 = 0.5f64 * v315;
-    let v1058: f64 = 0.5f64 * v311;
-    let v1059: f64 = v111 * v26;
-    let v1060: f64 = 0.5f64 * v70;
-    let v1061: f64 = v1060 * dir[0usize];
-    let v1062: f64 = v1059.mul_add(v477, v1061);
-    let v1063: f64 = v20 * v1062;
-    let v1064: f64 = 0.25f64 * v528;
-    let v1065: f64 = 0.25f64 * v308;
-    let v1066: f64 = v1065.mul_add(dir[0usize], v1064);
-    let v1067: f64 = v15.mul_add(v1051, v1066);
-    let v1068: f64 = v1058.mul_add(dir[1usize], v1063);
-    let v1069: f64 = q[2usize].mul_add(v1067, v1068);
-    let v1070: f64 = v313.mul_add(dir[2usize], v1069);
-    let v1071: f64 = v46 * v1070;
-    let v1072: f64 = v1057.mul_add(dir[3usize], v1071);
-    let v1073: f64 = 0.5f64 * v319;
-    let v1074: f64 = 0.5f64 * v481;
-    let v1075: f64 = v73 * v308;
-    let v1076: f64 = v73 * v1051;
-    let v1077: f64 = v1065.mul_add(dir[2usize], v1076);
-    let v1078: f64 = v1075.mul_add(dir[1usize], -v1074);
-    let v1079: f64 = (-v1058).mul_add(dir[0usize], v1078);
-    let v1080: f64 = (-v26).mul_add(v1062, v1079);
-    let v1081: f64 = q[1usize].mul_add(v1077, v1080);
-    let v1082: f64 = v46 * v1081;
-    let v1083: f64 = v1073.mul_add(dir[3usize], v1082);
-    let v1084: f64 = v1016 * dir[1usize];
-    let v1085: f64 = v226 * v914;
-    let v1086: f64 = 0.015625f64 * q[2usize];
-    let v1087: f64 = v1086 * v231;
-    let v1088: f64 = v1087 * dir[0usize];
-    let v1089: f64 = 0.015625f64 * v231;
-    let v1090: f64 = v1086 * v923;
-    let v1091: f64 = v1089.mul_add(dir[2usize], v1090);
-    let v1092: f64 = q[0usize] * v1091;
-    let v1093: f64 = v1088 - v1084;
-    let v1094: f64 = v1093 - v1085;
-    let v1095: f64 = v1094 + v1092;
-    let v1096: f64 = 0.25f64 * v922;
-    let v1098: f64 = 0.03125f64 * q[0usize];
-    let v1099: f64 = v1098 * v231;
-    let v1100: f64 = v1099.mul_add(dir[0usize], v1096);
-    let v1101: f64 = v328.mul_add(v923, v1100);
-    let v1102: f64 = v366 * v231;
-    let v1103: f64 = v1102 * dir[0usize];
-    let v1104: f64 = v366 * v923;
-    let v1105: f64 = v1089.mul_add(dir[1usize], v1104);
-    let v1106: f64 = q[0usize] * v1105;
-    let v1107: f64 = v1019 + v1103;
-    let v1108: f64 = v1107 + v1106;
-    let v1109: f64 = 0.5f64 * v336;
-    let v1110: f64 = v26 * v776;
-    let v1111: f64 = v199 * v26;
-    let v1112: f64 = 0.5f64 * v178;
-    let v1113: f64 = v1112 * dir[0usize];
-    let v1114: f64 = v1111.mul_add(v477, v1113);
-    let v1115: f64 = v335.mul_add(v527, -v1110);
-    let v1116: f64 = (-v801).mul_add(dir[0usize], v1115);
-    let v1117: f64 = v44.mul_add(v1114, v1116);
-    let v1118: f64 = v46 * v1117;
-    let v1119: f64 = v1109.mul_add(dir[3usize], v1118);
-    let v1120: f64 = 0.5f64 * v341;
-    let v1121: f64 = 0.5f64 * v308;
-    let v1122: f64 = v20 * v1051;
-    let v1123: f64 = 0.25f64 * v776;
-    let v1124: f64 = 0.25f64 * v335;
-    let v1125: f64 = v1124.mul_add(dir[0usize], v1123);
-    let v1126: f64 = v15.mul_add(v1114, v1125);
-    let v1127: f64 = v1121.mul_add(dir[1usize], v1122);
-    let v1128: f64 = q[2usize].mul_add(v1126, v1127);
-    let v1129: f64 = v339.mul_add(dir[2usize], v1128);
-    let v1130: f64 = v46 * v1129;
-    let v1131: f64 = v1120.mul_add(dir[3usize], v1130);
-    let v1132: f64 = 0.5f64 * v344;
-    let v1133: f64 = 0.5f64 * v528;
-    let v1134: f64 = v73 * v335;
-    let v1135: f64 = v73 * v1114;
-    let v1136: f64 = v1124.mul_add(dir[2usize], v1135);
-    let v1137: f64 = v1134.mul_add(dir[1usize], -v1133);
-    let v1138: f64 = (-v1121).mul_add(dir[0usize], v1137);
-    let v1139: f64 = (-v26).mul_add(v1051, v1138);
-    let v1140: f64 = q[1usize].mul_add(v1136, v1139);
-    let v1141: f64 = v46 * v1140;
-    let v1142: f64 = v1132.mul_add(dir[3usize], v1141);
-    let v1143: f64 = v1027 * dir[1usize];
-    let v1144: f64 = v488 * dir[0usize];
-    let v1145: f64 = v15 * v481;
-    let v1146: f64 = q[1usize] * v1031;
-    let v1147: f64 = v1143 + v1144;
-    let v1148: f64 = v1147 + v1145;
-    let v1149: f64 = v1148 + v1146;
-    let v1150: f64 = v1041 - v489;
-    let v1151: f64 = v1150 - v490;
-    let v1152: f64 = v1151 + v1044;
-    let v1153: f64 = v23 * v43;
-    let v1154: f64 = v1153.mul_add(dir[1usize], v1036);
-    let v1155: f64 = v352.mul_add(v528, v1154);
-    let v1156: f64 = 0.5f64 * v355;
-    let v1157: f64 = v103 * v20;
-    let v1158: f64 = v1049 * dir[1usize];
-    let v1159: f64 = v1157.mul_add(v477, v1158);
-    let v1160: f64 = v354.mul_add(v527, -v781);
-    let v1161: f64 = v1160 - v782;
-    let v1162: f64 = v44.mul_add(v1159, v1161);
-    let v1163: f64 = v46 * v1162;
-    let v1164: f64 = v1156.mul_add(dir[3usize], v1163);
-    let v1165: f64 = 0.5f64 * v359;
-    let v1166: f64 = 0.5f64 * v357;
-    let v1167: f64 = v111 * v20;
-    let v1168: f64 = v1060 * dir[1usize];
-    let v1169: f64 = v1167.mul_add(v477, v1168);
-    let v1170: f64 = v73 * v354;
-    let v1171: f64 = 0.25f64 * v354;
-    let v1172: f64 = v73 * v1159;
-    let v1173: f64 = v1171.mul_add(dir[2usize], v1172);
-    let v1174: f64 = v1166.mul_add(dir[1usize], v1074);
-    let v1175: f64 = v20.mul_add(v1169, v1174);
-    let v1176: f64 = v1170.mul_add(dir[0usize], v1175);
-    let v1177: f64 = q[0usize].mul_add(v1173, v1176);
-    let v1178: f64 = v46 * v1177;
-    let v1179: f64 = v1165.mul_add(dir[3usize], v1178);
-    let v1180: f64 = 0.5f64 * v363;
-    let v1181: f64 = v1166 * dir[0usize];
-    let v1182: f64 = v1171.mul_add(dir[1usize], v1064);
-    let v1183: f64 = v23.mul_add(v1159, v1182);
-    let v1184: f64 = q[2usize].mul_add(v1183, -v1181);
-    let v1185: f64 = (-v26).mul_add(v1169, v1184);
-    let v1186: f64 = v362.mul_add(dir[2usize], v1185);
-    let v1187: f64 = v46 * v1186;
-    let v1188: f64 = v1180.mul_add(dir[3usize], v1187);
-    let v1189: f64 = v1016 * dir[0usize];
-    let v1190: f64 = v225 * v914;
-    let v1191: f64 = v1087 * dir[1usize];
-    let v1192: f64 = q[1usize] * v1091;
-    let v1193: f64 = v1189 + v1190;
-    let v1194: f64 = v1193 + v1191;
-    let v1195: f64 = v1194 + v1192;
-    let v1196: f64 = v1103 - v1017;
-    let v1197: f64 = v1196 - v1018;
-    let v1198: f64 = v1197 + v1106;
-    let v1199: f64 = 0.03125f64 * q[1usize];
-    let v1200: f64 = v1199 * v231;
-    let v1201: f64 = v1200.mul_add(dir[1usize], v1096);
-    let v1202: f64 = v371.mul_add(v923, v1201);
-    let v1203: f64 = 0.5f64 * v375;
-    let v1204: f64 = v20 * v776;
-    let v1205: f64 = v199 * v20;
-    let v1206: f64 = v1112 * dir[1usize];
-    let v1207: f64 = v1205.mul_add(v477, v1206);
-    let v1208: f64 = v374.mul_add(v527, -v1204);
-    let v1209: f64 = (-v801).mul_add(dir[1usize], v1208);
-    let v1210: f64 = v44.mul_add(v1207, v1209);
-    let v1211: f64 = v46 * v1210;
-    let v1212: f64 = v1203.mul_add(dir[3usize], v1211);
-    let v1213: f64 = 0.5f64 * v378;
-    let v1214: f64 = 0.5f64 * v354;
-    let v1215: f64 = v73 * v374;
-    let v1216: f64 = 0.25f64 * v374;
-    let v1217: f64 = v73 * v1207;
-    let v1218: f64 = v1216.mul_add(dir[2usize], v1217);
-    let v1219: f64 = v1214.mul_add(dir[1usize], v1133);
-    let v1220: f64 = v20.mul_add(v1159, v1219);
-    let v1221: f64 = v1215.mul_add(dir[0usize], v1220);
-    let v1222: f64 = q[0usize].mul_add(v1218, v1221);
-    let v1223: f64 = v46 * v1222;
-    let v1224: f64 = v1213.mul_add(dir[3usize], v1223);
-    let v1225: f64 = 0.5f64 * v382;
-    let v1226: f64 = v1214 * dir[0usize];
-    let v1227: f64 = v1216.mul_add(dir[1usize], v1123);
-    let v1228: f64 = v23.mul_add(v1207, v1227);
-    let v1229: f64 = q[2usize].mul_add(v1228, -v1226);
-    let v1230: f64 = (-v26).mul_add(v1159, v1229);
-    let v1231: f64 = v381.mul_add(dir[2usize], v1230);
-    let v1232: f64 = v46 * v1231;
-    let v1233: f64 = v1225.mul_add(dir[3usize], v1232);
-    let v1234: f64 = v534.mul_add(dir[2usize], v1036);
-    let v1235: f64 = v384.mul_add(v528, v1234);
-    let v1236: f64 = v513 + v1028;
-    let v1237: f64 = v1236 + v1032;
-    let v1238: f64 = v1143 - v1144;
-    let v1239: f64 = v1238 - v1145;
-    let v1240: f64 = v1239 + v1146;
-    let v1241: f64 = 0.5f64 * v391;
-    let v1242: f64 = v33 * v528;
-    let v1243: f64 = 0.5f64 * v389;
-    let v1244: f64 = v1243.mul_add(dir[2usize], v1133);
-    let v1245: f64 = v103 * v33;
-    let v1246: f64 = v1049 * dir[2usize];
-    let v1247: f64 = v1245.mul_add(v477, v1246);
-    let v1248: f64 = q[2usize].mul_add(v1244, -v1242);
-    let v1249: f64 = (-v389).mul_add(v477, v1248);
-    let v1250: f64 = v44.mul_add(v1247, v1249);
-    let v1251: f64 = v46 * v1250;
-    let v1252: f64 = v1241.mul_add(dir[3usize], v1251);
-    let v1253: f64 = 0.5f64 * v396;
-    let v1254: f64 = 0.5f64 * v393;
-    let v1255: f64 = v111 * v33;
-    let v1256: f64 = v1060 * dir[2usize];
-    let v1257: f64 = v1255.mul_add(v477, v1256);
-    let v1258: f64 = v20 * v1257;
-    let v1259: f64 = 0.25f64 * v389;
-    let v1260: f64 = v1259.mul_add(dir[2usize], v1064);
-    let v1261: f64 = v73.mul_add(v1247, v1260);
-    let v1262: f64 = v1254.mul_add(dir[1usize], v1258);
-    let v1263: f64 = q[0usize].mul_add(v1261, v1262);
-    let v1264: f64 = v394.mul_add(dir[0usize], v1263);
-    let v1265: f64 = v46 * v1264;
-    let v1266: f64 = v1253.mul_add(dir[3usize], v1265);
-    let v1267: f64 = 0.5f64 * v399;
-    let v1268: f64 = v1254 * dir[0usize];
-    let v1269: f64 = q[1usize].mul_add(v1261, -v1268);
-    let v1270: f64 = (-v26).mul_add(v1257, v1269);
-    let v1271: f64 = v394.mul_add(dir[1usize], v1270);
-    let v1272: f64 = v46 * v1271;
-    let v1273: f64 = v1267.mul_add(dir[3usize], v1272);
-    let v1274: f64 = 0.03125f64 * q[2usize];
-    let v1275: f64 = v1274 * v231;
-    let v1276: f64 = v1275.mul_add(dir[2usize], v1096);
-    let v1277: f64 = v401.mul_add(v923, v1276);
-    let v1278: f64 = v1084 + v1085;
-    let v1279: f64 = v1278 + v1088;
-    let v1280: f64 = v1279 + v1092;
-    let v1281: f64 = v1191 - v1189;
-    let v1282: f64 = v1281 - v1190;
-    let v1283: f64 = v1282 + v1192;
-    let v1284: f64 = 0.5f64 * v407;
-    let v1285: f64 = v33 * v776;
-    let v1286: f64 = 0.5f64 * v405;
-    let v1287: f64 = v1286 * dir[2usize];
-    let v1288: f64 = 0.5f64.mul_add(v776, v1287);
-    let v1289: f64 = v199 * v33;
-    let v1290: f64 = v1112 * dir[2usize];
-    let v1291: f64 = v1289.mul_add(v477, v1290);
-    let v1292: f64 = q[2usize].mul_add(v1288, -v1285);
-    let v1293: f64 = (-v405).mul_add(v477, v1292);
-    let v1294: f64 = v44.mul_add(v1291, v1293);
-    let v1295: f64 = v46 * v1294;
-    let v1296: f64 = v1284.mul_add(dir[3usize], v1295);
-    let v1297: f64 = 0.5f64 * v411;
-    let v1298: f64 = v20 * v1247;
-    let v1299: f64 = 0.25f64 * v405;
-    let v1300: f64 = v1299.mul_add(dir[2usize], v1123);
-    let v1301: f64 = v73.mul_add(v1291, v1300);
-    let v1302: f64 = v1243.mul_add(dir[1usize], v1298);
-    let v1303: f64 = q[0usize].mul_add(v1301, v1302);
-    let v1304: f64 = v409.mul_add(dir[0usize], v1303);
-    let v1305: f64 = v46 * v1304;
-    let v1306: f64 = v1297.mul_add(dir[3usize], v1305);
-    let v1307: f64 = 0.5f64 * v414;
-    let v1308: f64 = v1243 * dir[0usize];
-    let v1309: f64 = q[1usize].mul_add(v1301, -v1308);
-    let v1310: f64 = (-v26).mul_add(v1247, v1309);
-    let v1311: f64 = v409.mul_add(dir[1usize], v1310);
-    let v1312: f64 = v46 * v1311;
-    let v1313: f64 = v1307.mul_add(dir[3usize], v1312);
-    let v1314: f64 = 0.5f64 * v530;
-    let v1315: f64 = 0.5f64 * v539;
-    let v1316: f64 = 0.5f64 * v545;
-    let v1317: f64 = 0.5f64 * v778;
-    let v1318: f64 = 0.5f64 * v788;
-    let v1319: f64 = 0.5f64 * v795;
-    let v1320: f64 = p[13usize] * v455;
-    let v1321: f64 = v1320 * dir[3usize];
-    let v1322: f64 = q[0usize] * v460;
-    let v1323: f64 = v1322 * dir[3usize];
-    let v1324: f64 = v425.mul_add(dir[0usize], v1323);
-    let v1325: f64 = p[4usize].mul_add(v1324, -v1321);
-    let v1326: f64 = 0.5f64 * p[5usize];
-    let v1327: f64 = v1326 * dir[4usize];
-    let v1328: f64 = 0.5f64.mul_add(v1325, v1327);
-    let v1329: f64 = p[14usize] * v455;
-    let v1330: f64 = v1329 * dir[3usize];
-    let v1331: f64 = v435 * v460;
-    let v1332: f64 = v425 * dir[1usize];
-    let v1333: f64 = v1331.mul_add(dir[3usize], v1332);
-    let v1334: f64 = p[4usize].mul_add(v1333, -v1330);
-    let v1335: f64 = v1326 * dir[5usize];
-    let v1336: f64 = 0.5f64.mul_add(v1334, v1335);
-    let v1337: f64 = 0.5f64 * p[8usize];
-    let v1338: f64 = 0.5f64 * v425;
-    let v1339: f64 = v33 * v460;
-    let v1340: f64 = v1339 * dir[3usize];
-    let v1341: f64 = v1338.mul_add(dir[2usize], v1340);
-    let v1342: f64 = p[7usize] * v1341;
-    let v1343: f64 = v1337.mul_add(dir[6usize], v1342);
-    let v1344: f64 = p[14usize] * dir[1usize];
-    let v1345: f64 = p[13usize].mul_add(dir[0usize], v1344);
-    let v1346: f64 = v41.powi(3i32);
-    let v1347: f64 = 2f64 * p[0usize];
-    let v1348: f64 = v1347 / v1346;
-    let v1349: f64 = 0.5f64 * v1348;
-    let v1350: f64 = v1349 / v428;
-    let v1351: f64 = v453 * v453;
-    let v1353: f64 = v424.powf(1.5f64);
-    let v1354: f64 = 0.25f64 * v1351;
-    let v1355: f64 = v1354 / v1353;
-    let v1356: f64 = v1350 - v1355;
-    let v1357: f64 = v450 * dir[3usize];
-    let v1358: f64 = v1357 * v1356;
-    let v1359: f64 = v455.mul_add(v1345, v1358);
-    let v1360: f64 = v435 * dir[1usize];
-    let v1361: f64 = q[0usize].mul_add(dir[0usize], v1360);
-    let v1362: f64 = 3f64 * v457;
-    let v1364: f64 = 6f64 * v424;
-    let v1365: f64 = v1364 * v1351;
-    let v1366: f64 = v1362.mul_add(v1348, v1365);
-    let v1367: f64 = v464 * v1366;
-    let v1368: f64 = dir[3usize] * v1367;
-    let v1369: f64 = v460.mul_add(v1361, v1368);
-    let v1370: f64 = q[2usize] * v460;
-    let v1371: f64 = 0.5f64 * v5;
-    let v1372: f64 = v1371 * dir[3usize];
-    let v1373: f64 = v1372 * v1366;
-    let v1374: f64 = v1370.mul_add(dir[2usize], v1373);
-    let v1375: f64 = p[9usize].mul_add(dir[3usize], -v1359);
-    let v1376: f64 = p[4usize].mul_add(v1369, v1375);
-    let v1377: f64 = p[7usize].mul_add(v1374, v1376);
-    let v1378: f64 = 0.5f64 * p[10usize];
-    let v1379: f64 = v1378 * dir[7usize];
-    let v1380: f64 = 0.5f64.mul_add(v1377, v1379);
-    out[0usize] = v14;
-    out[1usize] = v22;
-    out[2usize] = v28;
-    out[3usize] = v29;
-    out[4usize] = v30;
-    out[5usize] = v35;
-    out[6usize] = v36;
-    out[7usize] = v37;
-    out[8usize] = v38;
-    out[9usize] = v47;
-    out[10usize] = v50;
-    out[11usize] = v53;
-    out[12usize] = v68;
-    out[13usize] = v82;
-    out[14usize] = v90;
-    out[15usize] = v110;
-    out[16usize] = v124;
-    out[17usize] = v130;
-    out[18usize] = v139;
-    out[19usize] = v144;
-    out[20usize] = v149;
-    out[21usize] = v164;
-    out[22usize] = v167;
-    out[23usize] = v170;
-    out[24usize] = v173;
-    out[25usize] = v175;
-    out[26usize] = v177;
-    out[27usize] = v183;
-    out[28usize] = v191;
-    out[29usize] = v197;
-    out[30usize] = v205;
-    out[31usize] = v215;
-    out[32usize] = v221;
-    out[33usize] = v238;
-    out[34usize] = v245;
-    out[35usize] = v252;
-    out[36usize] = v272;
-    out[37usize] = v275;
-    out[38usize] = v278;
-    out[39usize] = v280;
-    out[40usize] = v283;
-    out[41usize] = v286;
-    out[42usize] = v288;
-    out[43usize] = v294;
-    out[44usize] = v295;
-    out[45usize] = v300;
-    out[46usize] = v303;
-    out[47usize] = v307;
-    out[48usize] = v310;
-    out[49usize] = v316;
-    out[50usize] = v320;
-    out[51usize] = v326;
-    out[52usize] = v329;
-    out[53usize] = v333;
-    out[54usize] = v337;
-    out[55usize] = v342;
-    out[56usize] = v345;
-    out[57usize] = v350;
-    out[58usize] = v351;
-    out[59usize] = v353;
-    out[60usize] = v356;
-    out[61usize] = v360;
-    out[62usize] = v364;
-    out[63usize] = v369;
-    out[64usize] = v370;
-    out[65usize] = v372;
-    out[66usize] = v376;
-    out[67usize] = v379;
-    out[68usize] = v383;
-    out[69usize] = v385;
-    out[70usize] = v386;
-    out[71usize] = v387;
-    out[72usize] = v392;
-    out[73usize] = v397;
-    out[74usize] = v400;
-    out[75usize] = v402;
-    out[76usize] = v403;
-    out[77usize] = v404;
-    out[78usize] = v408;
-    out[79usize] = v412;
-    out[80usize] = v415;
-    out[81usize] = 0f64;
-    out[82usize] = 0f64;
-    out[83usize] = 0f64;
-    out[84usize] = v417;
-    out[85usize] = v418;
-    out[86usize] = v419;
-    out[87usize] = 0f64;
-    out[88usize] = 0f64;
-    out[89usize] = 0f64;
-    out[90usize] = v420;
-    out[91usize] = v421;
-    out[92usize] = v422;
-    out[93usize] = v433;
-    out[94usize] = v441;
-    out[95usize] = v446;
-    out[96usize] = v471;
-    out[97usize] = 0f64;
-    out[98usize] = 0f64;
-    out[99usize] = 0f64;
-    out[100usize] = 0f64;
-    out[101usize] = v483;
-    out[102usize] = v495;
-    out[103usize] = v502;
-    out[104usize] = v505;
-    out[105usize] = v507;
-    out[106usize] = v517;
-    out[107usize] = v520;
-    out[108usize] = v523;
-    out[109usize] = v525;
-    out[110usize] = v532;
-    out[111usize] = v541;
-    out[112usize] = v547;
-    out[113usize] = v575;
-    out[114usize] = v602;
-    out[115usize] = v620;
-    out[116usize] = v650;
-    out[117usize] = v679;
-    out[118usize] = v697;
-    out[119usize] = v716;
-    out[120usize] = v725;
-    out[121usize] = v734;
-    out[122usize] = v757;
-    out[123usize] = v766;
-    out[124usize] = v775;
-    out[125usize] = v780;
-    out[126usize] = v790;
-    out[127usize] = v797;
-    out[128usize] = v815;
-    out[129usize] = v834;
-    out[130usize] = v848;
-    out[131usize] = v872;
-    out[132usize] = v895;
-    out[133usize] = v912;
-    out[134usize] = v938;
-    out[135usize] = v948;
-    out[136usize] = v958;
-    out[137usize] = v992;
-    out[138usize] = v1001;
-    out[139usize] = v1010;
-    out[140usize] = v1014;
-    out[141usize] = v1022;
-    out[142usize] = v1026;
-    out[143usize] = 0f64;
-    out[144usize] = 0f64;
-    out[145usize] = 0f64;
-    out[146usize] = v1035;
-    out[147usize] = v1039;
-    out[148usize] = v1046;
-    out[149usize] = v1056;
-    out[150usize] = v1072;
-    out[151usize] = v1083;
-    out[152usize] = v1095;
-    out[153usize] = v1101;
-    out[154usize] = v1108;
-    out[155usize] = v1119;
-    out[156usize] = v1131;
-    out[157usize] = v1142;
-    out[158usize] = v1149;
-    out[159usize] = v1152;
-    out[160usize] = v1155;
-    out[161usize] = v1164;
-    out[162usize] = v1179;
-    out[163usize] = v1188;
-    out[164usize] = v1195;
-    out[165usize] = v1198;
-    out[166usize] = v1202;
-    out[167usize] = v1212;
-    out[168usize] = v1224;
-    out[169usize] = v1233;
-    out[170usize] = v1235;
-    out[171usize] = v1237;
-    out[172usize] = v1240;
-    out[173usize] = v1252;
-    out[174usize] = v1266;
-    out[175usize] = v1273;
-    out[176usize] = v1277;
-    out[177usize] = v1280;
-    out[178usize] = v1283;
-    out[179usize] = v1296;
-    out[180usize] = v1306;
-    out[181usize] = v1313;
-    out[182usize] = 0f64;
-    out[183usize] = 0f64;
-    out[184usize] = 0f64;
-    out[185usize] = v1314;
-    out[186usize] = v1315;
-    out[187usize] = v1316;
-    out[188usize] = 0f64;
-    out[189usize] = 0f64;
-    out[190usize] = 0f64;
-    out[191usize] = v1317;
-    out[192usize] = v1318;
-    out[193usize] = v1319;
-    out[194usize] = v1328;
-    out[195usize] = v1336;
-    out[196usize] = v1343;
-    out[197usize] = v1380;
-    out[198usize] = 0f64;
-    out[199usize] = 0f64;
-    out[200usize] = 0f64;
-    out[201usize] = 0f64;
+    let v223: f64 = c[2][0];
+    let v229: f64 = c[1][0];
+    let v231: f64 = c[3][0];
+    let v254: f64 = c[2][1];
+    let v256: f64 = c[3][1];
+    let v267: f64 = c[1][1];
+    let v960: f64 = c[2][2];
+    let v966: f64 = c[3][2];
+    let v980: f64 = c[1][2];
+    let v225 = 0.0625f64 * q[0];
+    let v226 = 0.0625f64 * q[1];
+    let v227 = v226 * qd[0];
+    let v228 = v225.mul_add(qd[1], -v227);
+    let v230 = v75 * v229;
+    let v232 = 0.0625f64 * q[2];
+    let v233 = v225 * qd[0];
+    let v234 = v232.mul_add(qd[2], v233);
+    let v235 = v226.mul_add(qd[1], v234);
+    let v236 = v73 * v231;
+    let v237 = v223.mul_add(v228, v230);
+    let v238 = v236.mul_add(v235, v237);
+    let v239 = v232 * qd[1];
+    let v240 = v226.mul_add(qd[2], -v239);
+    let v241 = 0.25f64 * qd[0];
+    let v242 = v241 * v229;
+    let v243 = v15 * v231;
+    let v244 = v223.mul_add(v240, v242);
+    let v245 = v243.mul_add(v235, v244);
+    let v246 = v225 * qd[2];
+    let v247 = v232.mul_add(qd[0], -v246);
+    let v248 = 0.25f64 * qd[1];
+    let v249 = v248 * v229;
+    let v250 = v23 * v231;
+    let v251 = v223.mul_add(v247, v249);
+    let v252 = v250.mul_add(v235, v251);
+    let v253 = 0.25f64 * v61;
+    let v255 = v253 * v254;
+    let v257 = v253 * v256;
+    let v258 = 0.25f64 * v235;
+    let v259 = v258 * v257;
+    let v260 = 0.0625f64 * v94;
+    let v261 = 0.0625f64.mul_add(v93, v260);
+    let v262 = 0.0625f64.mul_add(v91, v261);
+    let v263 = 0.25f64 * v231;
+    let v264 = v263.mul_add(v262, v259);
+    let v265 = q[2] * v264;
+    let v266 = v263 * v235;
+    let v268 = v253 * v267;
+    let v269 = 0.25f64 * v268;
+    let v270 = v266 + v269;
+    let v271 = v228.mul_add(v255, v265);
+    let v272 = qd[2].mul_add(v270, v271);
+    let v273 = q[0] * v264;
+    let v274 = v240.mul_add(v255, v273);
+    let v275 = qd[0].mul_add(v270, v274);
+    let v276 = q[1] * v264;
+    let v277 = v247.mul_add(v255, v276);
+    let v278 = qd[1].mul_add(v270, v277);
+    let v279 = 0.0625f64.mul_add(v5, -v222);
+    let v280 = v223.mul_add(v279, 1f64);
+    let v281 = v225 * q[2];
+    let v282 = v281 * v223;
+    let v283 = v23.mul_add(v229, v282);
+    let v284 = v226 * q[2];
+    let v285 = v15 * v229;
+    let v286 = v284.mul_add(v223, -v285);
+    let v288 = 0.5f64 * p[1];
+    let v290 = 0.25f64 * p[3];
+    let v292 = p[2] - v290;
+    let v294 = 0.125f64.mul_add(v292, v290);
+    let v295 = 0.5f64 * p[3];
+    let v296 = v23 * v13;
+    let v297 = 0.125f64 * q[0];
+    let v298 = v297 * q[2];
+    let v299 = v298 * v43;
+    let v300 = v299 - v296;
+    let v301 = 0.5f64 * v18;
+    let v302 = 0.125f64 * v1;
+    let v303 = v302.mul_add(v43, v301);
+    let v304 = v73 * v13;
+    let v305 = v297 * q[1];
+    let v306 = v305 * v43;
+    let v307 = v304 + v306;
+    let v308 = v63 * v26;
+    let v309 = v308.mul_add(v44, -v142);
+    let v310 = v46 * v309;
+    let v311 = v70 * v26;
+    let v312 = 0.25f64 * v43;
+    let v313 = v15.mul_add(v308, v312);
+    let v314 = q[2] * v313;
+    let v315 = v20.mul_add(v311, v314);
+    let v316 = v46 * v315;
+    let v317 = 0.5f64 * v13;
+    let v318 = v24.mul_add(v308, -v317);
+    let v319 = (-v26).mul_add(v311, v318);
+    let v320 = v46 * v319;
+    let v321 = v226 * v223;
+    let v323 = 0.015625f64 * q[0];
+    let v324 = v323 * q[2];
+    let v325 = v324 * v231;
+    let v326 = v325 - v321;
+    let v327 = 0.25f64 * v229;
+    let v328 = 0.015625f64 * v1;
+    let v329 = v328.mul_add(v231, v327);
+    let v330 = v232 * v223;
+    let v331 = v323 * q[1];
+    let v332 = v331 * v231;
+    let v333 = v330 + v332;
+    let v334 = v171 * v26;
+    let v335 = v178 * v26;
+    let v336 = v335.mul_add(v44, -v334);
+    let v337 = v46 * v336;
+    let v338 = 0.25f64 * v171;
+    let v339 = v15.mul_add(v335, v338);
+    let v340 = q[2] * v339;
+    let v341 = v20.mul_add(v308, v340);
+    let v342 = v46 * v341;
+    let v343 = v24.mul_add(v335, -v155);
+    let v344 = (-v26).mul_add(v308, v343);
+    let v345 = v46 * v344;
+    let v346 = 0.125f64 * q[1];
+    let v347 = v346 * q[2];
+    let v348 = v347 * v43;
+    let v349 = v15 * v13;
+    let v350 = v348 + v349;
+    let v351 = v306 - v304;
+    let v352 = 0.125f64 * v8;
+    let v353 = v352.mul_add(v43, v301);
+    let v354 = v63 * v20;
+    let v355 = v354.mul_add(v44, -v147);
+    let v356 = v46 * v355;
+    let v357 = v70 * v20;
+    let v358 = v20.mul_add(v357, v317);
+    let v359 = v16.mul_add(v354, v358);
+    let v360 = v46 * v359;
+    let v361 = v26 * v357;
+    let v362 = v23.mul_add(v354, v312);
+    let v363 = q[2].mul_add(v362, -v361);
+    let v364 = v46 * v363;
+    let v365 = v225 * v223;
+    let v366 = 0.015625f64 * q[1];
+    let v367 = v366 * q[2];
+    let v368 = v367 * v231;
+    let v369 = v365 + v368;
+    let v370 = v332 - v330;
+    let v371 = 0.015625f64 * v8;
+    let v372 = v371.mul_add(v231, v327);
+    let v373 = v171 * v20;
+    let v374 = v178 * v20;
+    let v375 = v374.mul_add(v44, -v373);
+    let v376 = v46 * v375;
+    let v377 = v20.mul_add(v354, v155);
+    let v378 = v16.mul_add(v374, v377);
+    let v379 = v46 * v378;
+    let v380 = v26 * v354;
+    let v381 = v23.mul_add(v374, v338);
+    let v382 = q[2].mul_add(v381, -v380);
+    let v383 = v46 * v382;
+    let v384 = 0.125f64 * v5;
+    let v385 = v384.mul_add(v43, v301);
+    let v386 = v296 + v299;
+    let v387 = v348 - v349;
+    let v388 = v33 - v33;
+    let v389 = v63 * v33;
+    let v390 = v389 * v44;
+    let v391 = v43.mul_add(v388, v390);
+    let v392 = v46 * v391;
+    let v393 = v70 * v33;
+    let v394 = v73.mul_add(v389, v312);
+    let v395 = q[0] * v394;
+    let v396 = v20.mul_add(v393, v395);
+    let v397 = v46 * v396;
+    let v398 = v26 * v393;
+    let v399 = q[1].mul_add(v394, -v398);
+    let v400 = v46 * v399;
+    let v401 = 0.015625f64 * v5;
+    let v402 = v401.mul_add(v231, v327);
+    let v403 = v321 + v325;
+    let v404 = v368 - v365;
+    let v405 = v178 * v33;
+    let v406 = v405 * v44;
+    let v407 = v171.mul_add(v388, v406);
+    let v408 = v46 * v407;
+    let v409 = v73.mul_add(v405, v338);
+    let v410 = q[0] * v409;
+    let v411 = v20.mul_add(v389, v410);
+    let v412 = v46 * v411;
+    let v413 = v26 * v389;
+    let v414 = q[1].mul_add(v409, -v413);
+    let v415 = v46 * v414;
+    let v417 = 0.5f64 * v45;
+    let v418 = 0.5f64 * v49;
+    let v419 = 0.5f64 * v52;
+    let v420 = 0.5f64 * v172;
+    let v421 = 0.5f64 * v174;
+    let v422 = 0.5f64 * v176;
+    let v424 = p[0] / v41;
+    let v425 = v424.powi(3i32);
+    let v426 = q[0] * p[4];
+    let v428 = v424.sqrt();
+    let v429 = p[13] * v428;
+    let v430 = v426.mul_add(v425, -v429);
+    let v432 = v84 * p[5];
+    let v433 = 0.5f64.mul_add(v430, v432);
+    let v435 = q[1] - p[6];
+    let v436 = p[4] * v425;
+    let v438 = p[14] * v428;
+    let v439 = v436.mul_add(v435, -v438);
+    let v440 = v69 * p[5];
+    let v441 = 0.5f64.mul_add(v439, v440);
+    let v443 = v33 * p[7];
+    let v445 = v115 * p[8];
+    let v446 = v443.mul_add(v425, v445);
+    let v449 = q[1] * p[14];
+    let v450 = q[0].mul_add(p[13], v449);
+    let v451 = v41 * v41;
+    let v452 = p[0] / v451;
+    let v453 = -v452;
+    let v454 = 0.5f64 * v453;
+    let v455 = v454 / v428;
+    let v456 = v450.mul_add(v455, p[12]);
+    let v457 = v424 * v424;
+    let v459 = 3f64 * v453;
+    let v460 = v459 * v457;
+    let v461 = 0.5f64 * p[7];
+    let v462 = v435 * v435;
+    let v463 = 0.5f64 * v462;
+    let v464 = 0.5f64.mul_add(v1, v463);
+    let v465 = p[4] * v464;
+    let v466 = v461.mul_add(v5, v465);
+    let v467 = q[3].mul_add(p[9], -v456);
+    let v468 = v460.mul_add(v466, v467);
+    let v470 = v55 * p[10];
+    let v471 = 0.5f64.mul_add(v468, v470);
+    let v474 = v33 * dir[2];
+    let v476 = v26.mul_add(dir[0], v474);
+    let v477 = v20.mul_add(dir[1], v476);
+    let v479 = v477 * v478;
+    let v480 = v33 * v13;
+    let v481 = v70 * v477;
+    let v482 = v480.mul_add(dir[2], v479);
+    let v483 = v6.mul_add(v481, v482);
+    let v484 = v304 * dir[0];
+    let v485 = v301 * dir[1];
+    let v486 = v159 * v477;
+    let v487 = v20 * v486;
+    let v488 = 0.25f64 * v13;
+    let v489 = v488 * dir[2];
+    let v490 = v73 * v481;
+    let v491 = v489 + v490;
+    let v492 = q[0] * v491;
+    let v493 = v484 - v485;
+    let v494 = v493 - v487;
+    let v495 = v494 + v492;
+    let v496 = v304 * dir[1];
+    let v497 = v301 * dir[0];
+    let v498 = v26 * v486;
+    let v499 = q[1] * v491;
+    let v500 = v496 + v497;
+    let v501 = v500 + v498;
+    let v502 = v501 + v499;
+    let v503 = v484 + v485;
+    let v504 = v503 + v487;
+    let v505 = v504 + v492;
+    let v506 = v51.mul_add(dir[0], v479);
+    let v507 = v3.mul_add(v481, v506);
+    let v508 = v296 * dir[0];
+    let v509 = v301 * dir[2];
+    let v510 = v33 * v486;
+    let v511 = v488 * dir[1];
+    let v512 = v23 * v481;
+    let v513 = v511 + v512;
+    let v514 = q[0] * v513;
+    let v515 = v508 - v509;
+    let v516 = v515 - v510;
+    let v517 = v516 + v514;
+    let v518 = v496 - v497;
+    let v519 = v518 - v498;
+    let v520 = v519 + v499;
+    let v521 = v508 + v509;
+    let v522 = v521 + v510;
+    let v523 = v522 + v514;
+    let v524 = v48.mul_add(dir[1], v479);
+    let v525 = v9.mul_add(v481, v524);
+    let v527 = v474 - v477;
+    let v528 = v63 * v477;
+    let v529 = v44 * v528;
+    let v530 = v43.mul_add(v527, v529);
+    let v531 = v46 * v530;
+    let v532 = v417.mul_add(dir[3], v531);
+    let v533 = v20 * v481;
+    let v534 = v73 * v43;
+    let v535 = v73 * v528;
+    let v536 = v312.mul_add(dir[2], v535);
+    let v537 = v317.mul_add(dir[1], v533);
+    let v538 = v534.mul_add(dir[0], v537);
+    let v539 = q[0].mul_add(v536, v538);
+    let v540 = v46 * v539;
+    let v541 = v418.mul_add(dir[3], v540);
+    let v542 = v317 * dir[0];
+    let v543 = v534.mul_add(dir[1], -v542);
+    let v544 = (-v26).mul_add(v481, v543);
+    let v545 = q[1].mul_add(v536, v544);
+    let v546 = v46 * v545;
+    let v547 = v419.mul_add(dir[3], v546);
+    let v549 = v55 * v530;
+    let v550 = 0.5f64 * v66;
+    let v551 = v61 * v528;
+    let v553 = v115 * v528;
+    let v554 = 0.5f64 * v64;
+    let v555 = v155.mul_add(dir[6], v553);
+    let v556 = v554.mul_add(dir[2], v555);
+    let v557 = v115 * dir[2];
+    let v560 = v33.mul_add(dir[6], v557);
+    let v561 = v84.mul_add(dir[0], v560);
+    let v562 = v26.mul_add(dir[4], v561);
+    let v563 = v69.mul_add(dir[1], v562);
+    let v564 = v20.mul_add(dir[5], v563);
+    let v565 = v557 - v564;
+    let v566 = v61 * v103;
+    let v567 = v566 * v477;
+    let v568 = v63.mul_add(v564, v567);
+    let v569 = q[2].mul_add(v556, -v551);
+    let v570 = (-v64).mul_add(v477, v569);
+    let v571 = v43.mul_add(v565, v570);
+    let v572 = v44.mul_add(v568, v571);
+    let v573 = v417.mul_add(dir[7], v549);
+    let v574 = v550.mul_add(dir[3], v573);
+    let v575 = v46.mul_add(v572, v574);
+    let v576 = v55 * v539;
+    let v577 = 0.5f64 * v80;
+    let v578 = v69 * v481;
+    let v579 = 0.5f64 * v71;
+    let v580 = v61 * v111;
+    let v581 = v580 * v477;
+    let v582 = v70.mul_add(v564, v581);
+    let v583 = v75 * v528;
+    let v584 = 0.25f64 * v64;
+    let v585 = v312.mul_add(dir[6], v583);
+    let v586 = v584.mul_add(dir[2], v585);
+    let v587 = v73.mul_add(v568, v586);
+    let v588 = v241 * v528;
+    let v589 = v312.mul_add(dir[4], v588);
+    let v590 = v584.mul_add(dir[0], v589);
+    let v591 = v241 * dir[2];
+    let v592 = v75 * dir[0];
+    let v593 = v591 + v592;
+    let v594 = v317.mul_add(dir[5], v578);
+    let v595 = v579.mul_add(dir[1], v594);
+    let v596 = v20.mul_add(v582, v595);
+    let v597 = q[0].mul_add(v587, v596);
+    let v598 = q[2].mul_add(v590, v597);
+    let v599 = v43.mul_add(v593, v598);
+    let v600 = v418.mul_add(dir[7], v576);
+    let v601 = v577.mul_add(dir[3], v600);
+    let v602 = v46.mul_add(v599, v601);
+    let v603 = v55 * v545;
+    let v604 = 0.5f64 * v88;
+    let v605 = v317 * dir[4];
+    let v606 = v248 * v528;
+    let v607 = v312.mul_add(dir[5], v606);
+    let v608 = v584.mul_add(dir[1], v607);
+    let v609 = v75 * dir[1];
+    let v610 = v248 * dir[2];
+    let v611 = v609 + v610;
+    let v612 = q[1].mul_add(v587, -v605);
+    let v613 = (-v84).mul_add(v481, v612);
+    let v614 = (-v579).mul_add(dir[0], v613);
+    let v615 = (-v26).mul_add(v582, v614);
+    let v616 = q[2].mul_add(v608, v615);
+    let v617 = v43.mul_add(v611, v616);
+    let v618 = v419.mul_add(dir[7], v603);
+    let v619 = v604.mul_add(dir[3], v618);
+    let v620 = v46.mul_add(v617, v619);
+    let v621 = qd[3] * v572;
+    let v622 = 0.5f64 * v108;
+    let v623 = 2f64 * v64;
+    let v624 = v623 * v564;
+    let v625 = qd[1] * dir[5];
+    let v626 = qd[0].mul_add(dir[4], v625);
+    let v627 = qd[2].mul_add(dir[6], v626);
+    let v628 = qd[2] * v568;
+    let v629 = 0.5f64 * v106;
+    let v630 = v64.mul_add(dir[6], v628);
+    let v631 = v629.mul_add(dir[2], v630);
+    let v632 = v64 * dir[2];
+    let v633 = v43.mul_add(dir[6], v632);
+    let v635 = v104 * v477;
+    let v636 = v635 * v634;
+    let v637 = v100 * v564;
+    let v638 = v97.mul_add(v477, v637);
+    let v639 = v63.mul_add(v627, v636);
+    let v640 = v103.mul_add(v638, v639);
+    let v641 = q[2].mul_add(v631, -v624);
+    let v642 = (-v100).mul_add(v568, v641);
+    let v643 = (-v43).mul_add(v627, v642);
+    let v644 = (-v106).mul_add(v477, v643);
+    let v645 = qd[2].mul_add(v633, v644);
+    let v646 = v98.mul_add(v528, v645);
+    let v647 = v44.mul_add(v640, v646);
+    let v648 = v66.mul_add(dir[7], v621);
+    let v649 = v622.mul_add(dir[3], v648);
+    let v650 = v46.mul_add(v647, v649);
+    let v651 = qd[3] * v599;
+    let v652 = 0.5f64 * v122;
+    let v653 = qd[1] * v582;
+    let v654 = 0.5f64 * v113;
+    let v656 = v635 * v655;
+    let v657 = v70.mul_add(v627, v656);
+    let v658 = v111.mul_add(v638, v657);
+    let v659 = v115 * v568;
+    let v660 = 0.25f64 * v106;
+    let v661 = v554.mul_add(dir[6], v659);
+    let v662 = v660.mul_add(dir[2], v661);
+    let v663 = v73.mul_add(v640, v662);
+    let v664 = v33.mul_add(v568, v556);
+    let v665 = v660 * dir[0];
+    let v666 = v554.mul_add(dir[4], v665);
+    let v667 = v155 * dir[4];
+    let v668 = v554 * dir[0];
+    let v669 = v667 + v668;
+    let v670 = v71.mul_add(dir[5], v653);
+    let v671 = v654.mul_add(dir[1], v670);
+    let v672 = v20.mul_add(v658, v671);
+    let v673 = q[0].mul_add(v663, v672);
+    let v674 = qd[0].mul_add(v664, v673);
+    let v675 = q[2].mul_add(v666, v674);
+    let v676 = qd[2].mul_add(v669, v675);
+    let v677 = v80.mul_add(dir[7], v651);
+    let v678 = v652.mul_add(dir[3], v677);
+    let v679 = v46.mul_add(v676, v678);
+    let v680 = qd[3] * v617;
+    let v681 = 0.5f64 * v128;
+    let v682 = v71 * dir[4];
+    let v683 = v660 * dir[1];
+    let v684 = v554.mul_add(dir[5], v683);
+    let v685 = v155 * dir[5];
+    let v686 = v554 * dir[1];
+    let v687 = v685 + v686;
+    let v688 = q[1].mul_add(v663, -v682);
+    let v689 = (-qd[0]).mul_add(v582, v688);
+    let v690 = (-v654).mul_add(dir[0], v689);
+    let v691 = (-v26).mul_add(v658, v690);
+    let v692 = qd[1].mul_add(v664, v691);
+    let v693 = q[2].mul_add(v684, v692);
+    let v694 = qd[2].mul_add(v687, v693);
+    let v695 = v88.mul_add(dir[7], v680);
+    let v696 = v681.mul_add(dir[3], v695);
+    let v697 = v46.mul_add(v694, v696);
+    let v698 = v15 * dir[5];
+    let v699 = v248.mul_add(dir[0], v698);
+    let v700 = (-v241).mul_add(dir[1], v699);
+    let v701 = (-v23).mul_add(dir[4], v700);
+    let v702 = v13 * v701;
+    let v703 = v150 * v528;
+    let v704 = v73 * dir[6];
+    let v705 = v75.mul_add(dir[2], v704);
+    let v706 = v241.mul_add(dir[0], v705);
+    let v707 = v15.mul_add(dir[4], v706);
+    let v708 = v248.mul_add(dir[1], v707);
+    let v709 = v23.mul_add(dir[5], v708);
+    let v710 = v155 * v709;
+    let v711 = v703 + v710;
+    let v712 = v132.mul_add(v481, v702);
+    let v713 = v301.mul_add(dir[6], v712);
+    let v714 = v115.mul_add(v486, v713);
+    let v715 = v158.mul_add(dir[2], v714);
+    let v716 = q[2].mul_add(v711, v715);
+    let v717 = v23.mul_add(dir[6], v609);
+    let v718 = v717 - v610;
+    let v719 = (-v73).mul_add(dir[5], v718);
+    let v720 = v13 * v719;
+    let v721 = v140.mul_add(v481, v720);
+    let v722 = v301.mul_add(dir[4], v721);
+    let v723 = v84.mul_add(v486, v722);
+    let v724 = v158.mul_add(dir[0], v723);
+    let v725 = q[0].mul_add(v711, v724);
+    let v726 = v73.mul_add(dir[4], v591);
+    let v727 = v726 - v592;
+    let v728 = (-v15).mul_add(dir[6], v727);
+    let v729 = v13 * v728;
+    let v730 = v145.mul_add(v481, v729);
+    let v731 = v301.mul_add(dir[5], v730);
+    let v732 = v69.mul_add(v486, v731);
+    let v733 = v158.mul_add(dir[1], v732);
+    let v734 = q[1].mul_add(v711, v733);
+    let v735 = v132 * v582;
+    let v736 = v150 * v568;
+    let v737 = 0.5f64 * v154;
+    let v738 = v69 * dir[5];
+    let v739 = v84.mul_add(dir[4], v738);
+    let v740 = v115.mul_add(dir[6], v739);
+    let v741 = v554.mul_add(v709, v736);
+    let v742 = v737.mul_add(v528, v741);
+    let v743 = v155.mul_add(v740, v742);
+    let v745 = v61 * v477;
+    let v746 = v745 * v744;
+    let v747 = v159.mul_add(v564, v746);
+    let v748 = 0.5f64.mul_add(v747, v703);
+    let v749 = v748 + v710;
+    let v750 = v737 * dir[2];
+    let v751 = v150.mul_add(dir[6], v750);
+    let v752 = v71.mul_add(v701, v735);
+    let v753 = v161.mul_add(dir[6], v752);
+    let v754 = v151.mul_add(dir[2], v753);
+    let v755 = q[2].mul_add(v743, v754);
+    let v756 = qd[2].mul_add(v749, v755);
+    let v757 = v43.mul_add(v751, v756);
+    let v758 = v140 * v582;
+    let v759 = v737 * dir[0];
+    let v760 = v150.mul_add(dir[4], v759);
+    let v761 = v71.mul_add(v719, v758);
+    let v762 = v161.mul_add(dir[4], v761);
+    let v763 = v151.mul_add(dir[0], v762);
+    let v764 = q[0].mul_add(v743, v763);
+    let v765 = qd[0].mul_add(v749, v764);
+    let v766 = v43.mul_add(v760, v765);
+    let v767 = v145 * v582;
+    let v768 = v737 * dir[1];
+    let v769 = v150.mul_add(dir[5], v768);
+    let v770 = v71.mul_add(v728, v767);
+    let v771 = v161.mul_add(dir[5], v770);
+    let v772 = v151.mul_add(dir[1], v771);
+    let v773 = q[1].mul_add(v743, v772);
+    let v774 = qd[1].mul_add(v749, v773);
+    let v775 = v43.mul_add(v769, v774);
+    let v776 = v178 * v477;
+    let v777 = v44 * v776;
+    let v778 = v171.mul_add(v527, v777);
+    let v779 = v46 * v778;
+    let v780 = v420.mul_add(dir[3], v779);
+    let v781 = v155 * dir[1];
+    let v782 = v20 * v528;
+    let v783 = v73 * v171;
+    let v784 = v73 * v776;
+    let v785 = v338.mul_add(dir[2], v784);
+    let v786 = v781 + v782;
+    let v787 = v783.mul_add(dir[0], v786);
+    let v788 = q[0].mul_add(v785, v787);
+    let v789 = v46 * v788;
+    let v790 = v421.mul_add(dir[3], v789);
+    let v791 = v155 * dir[0];
+    let v792 = v26 * v528;
+    let v793 = v783.mul_add(dir[1], -v791);
+    let v794 = v793 - v792;
+    let v795 = q[1].mul_add(v785, v794);
+    let v796 = v46 * v795;
+    let v797 = v422.mul_add(dir[3], v796);
+    let v798 = v55 * v778;
+    let v799 = 0.5f64 * v181;
+    let v800 = v61 * v776;
+    let v801 = 0.5f64 * v171;
+    let v802 = v115 * v776;
+    let v803 = 0.5f64 * v179;
+    let v804 = v801.mul_add(dir[6], v802);
+    let v805 = v803.mul_add(dir[2], v804);
+    let v806 = v61 * v199;
+    let v807 = v806 * v477;
+    let v808 = v178.mul_add(v564, v807);
+    let v809 = q[2].mul_add(v805, -v800);
+    let v810 = (-v179).mul_add(v477, v809);
+    let v811 = v171.mul_add(v565, v810);
+    let v812 = v44.mul_add(v808, v811);
+    let v813 = v420.mul_add(dir[7], v798);
+    let v814 = v799.mul_add(dir[3], v813);
+    let v815 = v46.mul_add(v812, v814);
+    let v816 = v55 * v788;
+    let v817 = 0.5f64 * v189;
+    let v818 = v75 * v776;
+    let v819 = 0.25f64 * v179;
+    let v820 = v338.mul_add(dir[6], v818);
+    let v821 = v819.mul_add(dir[2], v820);
+    let v822 = v73.mul_add(v808, v821);
+    let v823 = v241 * v776;
+    let v824 = v338.mul_add(dir[4], v823);
+    let v825 = v819.mul_add(dir[0], v824);
+    let v826 = v69.mul_add(v528, v685);
+    let v827 = v826 + v686;
+    let v828 = v20.mul_add(v568, v827);
+    let v829 = q[0].mul_add(v822, v828);
+    let v830 = q[2].mul_add(v825, v829);
+    let v831 = v171.mul_add(v593, v830);
+    let v832 = v421.mul_add(dir[7], v816);
+    let v833 = v817.mul_add(dir[3], v832);
+    let v834 = v46.mul_add(v831, v833);
+    let v835 = v55 * v795;
+    let v836 = 0.5f64 * v195;
+    let v837 = v248 * v776;
+    let v838 = v338.mul_add(dir[5], v837);
+    let v839 = v819.mul_add(dir[1], v838);
+    let v840 = q[1].mul_add(v822, -v667);
+    let v841 = (-v84).mul_add(v528, v840);
+    let v842 = v841 - v668;
+    let v843 = (-v26).mul_add(v568, v842);
+    let v844 = q[2].mul_add(v839, v843);
+    let v845 = v171.mul_add(v611, v844);
+    let v846 = v422.mul_add(dir[7], v835);
+    let v847 = v836.mul_add(dir[3], v846);
+    let v848 = v46.mul_add(v845, v847);
+    let v849 = qd[3] * v812;
+    let v850 = 0.5f64 * v203;
+    let v851 = 2f64 * v179;
+    let v852 = v851 * v564;
+    let v853 = qd[2] * v808;
+    let v854 = 0.5f64 * v201;
+    let v855 = v179.mul_add(dir[6], v853);
+    let v856 = v854.mul_add(dir[2], v855);
+    let v857 = v179 * dir[2];
+    let v858 = v171.mul_add(dir[6], v857);
+    let v860 = v635 * v859;
+    let v861 = v178.mul_add(v627, v860);
+    let v862 = v199.mul_add(v638, v861);
+    let v863 = q[2].mul_add(v856, -v852);
+    let v864 = (-v100).mul_add(v808, v863);
+    let v865 = (-v171).mul_add(v627, v864);
+    let v866 = (-v201).mul_add(v477, v865);
+    let v867 = qd[2].mul_add(v858, v866);
+    let v868 = v98.mul_add(v776, v867);
+    let v869 = v44.mul_add(v862, v868);
+    let v870 = v181.mul_add(dir[7], v849);
+    let v871 = v850.mul_add(dir[3], v870);
+    let v872 = v46.mul_add(v869, v871);
+    let v873 = qd[3] * v831;
+    let v874 = 0.5f64 * v213;
+    let v875 = qd[1] * v568;
+    let v876 = v115 * v808;
+    let v877 = 0.25f64 * v201;
+    let v878 = v803.mul_add(dir[6], v876);
+    let v879 = v877.mul_add(dir[2], v878);
+    let v880 = v73.mul_add(v862, v879);
+    let v881 = v33.mul_add(v808, v805);
+    let v882 = v877 * dir[0];
+    let v883 = v803.mul_add(dir[4], v882);
+    let v884 = v803 * dir[0];
+    let v885 = v801.mul_add(dir[4], v884);
+    let v886 = v64.mul_add(dir[5], v875);
+    let v887 = v629.mul_add(dir[1], v886);
+    let v888 = v20.mul_add(v640, v887);
+    let v889 = q[0].mul_add(v880, v888);
+    let v890 = qd[0].mul_add(v881, v889);
+    let v891 = q[2].mul_add(v883, v890);
+    let v892 = qd[2].mul_add(v885, v891);
+    let v893 = v189.mul_add(dir[7], v873);
+    let v894 = v874.mul_add(dir[3], v893);
+    let v895 = v46.mul_add(v892, v894);
+    let v896 = qd[3] * v845;
+    let v897 = 0.5f64 * v219;
+    let v898 = v64 * dir[4];
+    let v899 = v877 * dir[1];
+    let v900 = v803.mul_add(dir[5], v899);
+    let v901 = v803 * dir[1];
+    let v902 = v801.mul_add(dir[5], v901);
+    let v903 = q[1].mul_add(v880, -v898);
+    let v904 = (-qd[0]).mul_add(v568, v903);
+    let v905 = (-v629).mul_add(dir[0], v904);
+    let v906 = (-v26).mul_add(v640, v905);
+    let v907 = qd[1].mul_add(v881, v906);
+    let v908 = q[2].mul_add(v900, v907);
+    let v909 = qd[2].mul_add(v902, v908);
+    let v910 = v195.mul_add(dir[7], v896);
+    let v911 = v897.mul_add(dir[3], v910);
+    let v912 = v46.mul_add(v909, v911);
+    let v913 = 0.25f64 * v477;
+    let v914 = v254 * v913;
+    let v915 = 0.0625f64 * qd[1];
+    let v916 = v225 * dir[5];
+    let v917 = 0.0625f64 * qd[0];
+    let v918 = v915.mul_add(dir[0], v916);
+    let v919 = (-v917).mul_add(dir[1], v918);
+    let v920 = (-v226).mul_add(dir[4], v919);
+    let v921 = v223 * v920;
+    let v922 = v267 * v913;
+    let v923 = v256 * v913;
+    let v924 = v258 * v923;
+    let v925 = 0.0625f64 * qd[2];
+    let v926 = v232 * dir[6];
+    let v927 = v925.mul_add(dir[2], v926);
+    let v928 = v917.mul_add(dir[0], v927);
+    let v929 = v225.mul_add(dir[4], v928);
+    let v930 = v915.mul_add(dir[1], v929);
+    let v931 = v226.mul_add(dir[5], v930);
+    let v932 = v263 * v931;
+    let v933 = v924 + v932;
+    let v934 = v228.mul_add(v914, v921);
+    let v935 = v327.mul_add(dir[6], v934);
+    let v936 = v75.mul_add(v922, v935);
+    let v937 = v266.mul_add(dir[2], v936);
+    let v938 = q[2].mul_add(v933, v937);
+    let v939 = v226 * dir[6];
+    let v940 = v925.mul_add(dir[1], v939);
+    let v941 = (-v915).mul_add(dir[2], v940);
+    let v942 = (-v232).mul_add(dir[5], v941);
+    let v943 = v223 * v942;
+    let v944 = v240.mul_add(v914, v943);
+    let v945 = v327.mul_add(dir[4], v944);
+    let v946 = v241.mul_add(v922, v945);
+    let v947 = v266.mul_add(dir[0], v946);
+    let v948 = q[0].mul_add(v933, v947);
+    let v949 = v232 * dir[4];
+    let v950 = v917.mul_add(dir[2], v949);
+    let v951 = (-v925).mul_add(dir[0], v950);
+    let v952 = (-v225).mul_add(dir[6], v951);
+    let v953 = v223 * v952;
+    let v954 = v247.mul_add(v914, v953);
+    let v955 = v327.mul_add(dir[5], v954);
+    let v956 = v248.mul_add(v922, v955);
+    let v957 = v266.mul_add(dir[1], v956);
+    let v958 = q[1].mul_add(v933, v957);
+    let v959 = 0.25f64 * v564;
+    let v961 = v253 * v913;
+    let v962 = v961 * v960;
+    let v963 = v254.mul_add(v959, v962);
+    let v964 = v228 * v963;
+    let v965 = 0.25f64 * v257;
+    let v967 = v961 * v966;
+    let v968 = v256.mul_add(v959, v967);
+    let v969 = v258 * v968;
+    let v970 = 0.25f64 * v262;
+    let v971 = 0.125f64 * qd[0];
+    let v972 = 0.125f64 * qd[1];
+    let v973 = v972 * dir[5];
+    let v974 = 0.125f64 * qd[2];
+    let v975 = v971.mul_add(dir[4], v973);
+    let v976 = v974.mul_add(dir[6], v975);
+    let v977 = v965.mul_add(v931, v969);
+    let v978 = v970.mul_add(v923, v977);
+    let v979 = v263.mul_add(v976, v978);
+    let v981 = v961 * v980;
+    let v982 = v267.mul_add(v959, v981);
+    let v983 = 0.25f64.mul_add(v982, v924);
+    let v984 = v983 + v932;
+    let v985 = v970 * dir[2];
+    let v986 = v258.mul_add(dir[6], v985);
+    let v987 = v255.mul_add(v920, v964);
+    let v988 = v269.mul_add(dir[6], v987);
+    let v989 = v259.mul_add(dir[2], v988);
+    let v990 = q[2].mul_add(v979, v989);
+    let v991 = qd[2].mul_add(v984, v990);
+    let v992 = v231.mul_add(v986, v991);
+    let v993 = v240 * v963;
+    let v994 = v970 * dir[0];
+    let v995 = v258.mul_add(dir[4], v994);
+    let v996 = v255.mul_add(v942, v993);
+    let v997 = v269.mul_add(dir[4], v996);
+    let v998 = v259.mul_add(dir[0], v997);
+    let v999 = q[0].mul_add(v979, v998);
+    let v1000 = qd[0].mul_add(v984, v999);
+    let v1001 = v231.mul_add(v995, v1000);
+    let v1002 = v247 * v963;
+    let v1003 = v970 * dir[1];
+    let v1004 = v258.mul_add(dir[5], v1003);
+    let v1005 = v255.mul_add(v952, v1002);
+    let v1006 = v269.mul_add(dir[5], v1005);
+    let v1007 = v259.mul_add(dir[1], v1006);
+    let v1008 = q[1].mul_add(v979, v1007);
+    let v1009 = qd[1].mul_add(v984, v1008);
+    let v1010 = v231.mul_add(v1004, v1009);
+    let v1011 = 0.125f64 * q[2];
+    let v1012 = v1011.mul_add(dir[2], -v913);
+    let v1013 = v279 * v914;
+    let v1014 = v223.mul_add(v1012, v1013);
+    let v1015 = v23 * v922;
+    let v1016 = 0.0625f64 * v223;
+    let v1017 = v1016 * dir[2];
+    let v1018 = v232 * v914;
+    let v1019 = v1017 + v1018;
+    let v1020 = v327.mul_add(dir[1], v1015);
+    let v1021 = v330.mul_add(dir[0], v1020);
+    let v1022 = q[0].mul_add(v1019, v1021);
+    let v1023 = v327 * dir[0];
+    let v1024 = v330.mul_add(dir[1], -v1023);
+    let v1025 = (-v15).mul_add(v922, v1024);
+    let v1026 = q[1].mul_add(v1019, v1025);
+    let v1027 = v1011 * v43;
+    let v1028 = v1027 * dir[0];
+    let v1029 = 0.125f64 * v43;
+    let v1030 = v1011 * v528;
+    let v1031 = v1029.mul_add(dir[2], v1030);
+    let v1032 = q[0] * v1031;
+    let v1033 = v1028 - v511;
+    let v1034 = v1033 - v512;
+    let v1035 = v1034 + v1032;
+    let v1036 = 0.5f64 * v486;
+    let v1037 = v15 * v43;
+    let v1038 = v1037.mul_add(dir[0], v1036);
+    let v1039 = v302.mul_add(v528, v1038);
+    let v1040 = v346 * v43;
+    let v1041 = v1040 * dir[0];
+    let v1042 = v346 * v528;
+    let v1043 = v1029.mul_add(dir[1], v1042);
+    let v1044 = q[0] * v1043;
+    let v1045 = v491 + v1041;
+    let v1046 = v1045 + v1044;
+    let v1047 = 0.5f64 * v309;
+    let v1048 = v103 * v26;
+    let v1049 = 0.5f64 * v63;
+    let v1050 = v1049 * dir[0];
+    let v1051 = v1048.mul_add(v477, v1050);
+    let v1052 = v308.mul_add(v527, -v791);
+    let v1053 = v1052 - v792;
+    let v1054 = v44.mul_add(v1051, v1053);
+    let v1055 = v46 * v1054;
+    let v1056 = v1047.mul_add(dir[3], v1055);
+    let v1057 = 0.5f64 * v315;
+    let v1058 = 0.5f64 * v311;
+    let v1059 = v111 * v26;
+    let v1060 = 0.5f64 * v70;
+    let v1061 = v1060 * dir[0];
+    let v1062 = v1059.mul_add(v477, v1061);
+    let v1063 = v20 * v1062;
+    let v1064 = 0.25f64 * v528;
+    let v1065 = 0.25f64 * v308;
+    let v1066 = v1065.mul_add(dir[0], v1064);
+    let v1067 = v15.mul_add(v1051, v1066);
+    let v1068 = v1058.mul_add(dir[1], v1063);
+    let v1069 = q[2].mul_add(v1067, v1068);
+    let v1070 = v313.mul_add(dir[2], v1069);
+    let v1071 = v46 * v1070;
+    let v1072 = v1057.mul_add(dir[3], v1071);
+    let v1073 = 0.5f64 * v319;
+    let v1074 = 0.5f64 * v481;
+    let v1075 = v73 * v308;
+    let v1076 = v73 * v1051;
+    let v1077 = v1065.mul_add(dir[2], v1076);
+    let v1078 = v1075.mul_add(dir[1], -v1074);
+    let v1079 = (-v1058).mul_add(dir[0], v1078);
+    let v1080 = (-v26).mul_add(v1062, v1079);
+    let v1081 = q[1].mul_add(v1077, v1080);
+    let v1082 = v46 * v1081;
+    let v1083 = v1073.mul_add(dir[3], v1082);
+    let v1084 = v1016 * dir[1];
+    let v1085 = v226 * v914;
+    let v1086 = 0.015625f64 * q[2];
+    let v1087 = v1086 * v231;
+    let v1088 = v1087 * dir[0];
+    let v1089 = 0.015625f64 * v231;
+    let v1090 = v1086 * v923;
+    let v1091 = v1089.mul_add(dir[2], v1090);
+    let v1092 = q[0] * v1091;
+    let v1093 = v1088 - v1084;
+    let v1094 = v1093 - v1085;
+    let v1095 = v1094 + v1092;
+    let v1096 = 0.25f64 * v922;
+    let v1098 = 0.03125f64 * q[0];
+    let v1099 = v1098 * v231;
+    let v1100 = v1099.mul_add(dir[0], v1096);
+    let v1101 = v328.mul_add(v923, v1100);
+    let v1102 = v366 * v231;
+    let v1103 = v1102 * dir[0];
+    let v1104 = v366 * v923;
+    let v1105 = v1089.mul_add(dir[1], v1104);
+    let v1106 = q[0] * v1105;
+    let v1107 = v1019 + v1103;
+    let v1108 = v1107 + v1106;
+    let v1109 = 0.5f64 * v336;
+    let v1110 = v26 * v776;
+    let v1111 = v199 * v26;
+    let v1112 = 0.5f64 * v178;
+    let v1113 = v1112 * dir[0];
+    let v1114 = v1111.mul_add(v477, v1113);
+    let v1115 = v335.mul_add(v527, -v1110);
+    let v1116 = (-v801).mul_add(dir[0], v1115);
+    let v1117 = v44.mul_add(v1114, v1116);
+    let v1118 = v46 * v1117;
+    let v1119 = v1109.mul_add(dir[3], v1118);
+    let v1120 = 0.5f64 * v341;
+    let v1121 = 0.5f64 * v308;
+    let v1122 = v20 * v1051;
+    let v1123 = 0.25f64 * v776;
+    let v1124 = 0.25f64 * v335;
+    let v1125 = v1124.mul_add(dir[0], v1123);
+    let v1126 = v15.mul_add(v1114, v1125);
+    let v1127 = v1121.mul_add(dir[1], v1122);
+    let v1128 = q[2].mul_add(v1126, v1127);
+    let v1129 = v339.mul_add(dir[2], v1128);
+    let v1130 = v46 * v1129;
+    let v1131 = v1120.mul_add(dir[3], v1130);
+    let v1132 = 0.5f64 * v344;
+    let v1133 = 0.5f64 * v528;
+    let v1134 = v73 * v335;
+    let v1135 = v73 * v1114;
+    let v1136 = v1124.mul_add(dir[2], v1135);
+    let v1137 = v1134.mul_add(dir[1], -v1133);
+    let v1138 = (-v1121).mul_add(dir[0], v1137);
+    let v1139 = (-v26).mul_add(v1051, v1138);
+    let v1140 = q[1].mul_add(v1136, v1139);
+    let v1141 = v46 * v1140;
+    let v1142 = v1132.mul_add(dir[3], v1141);
+    let v1143 = v1027 * dir[1];
+    let v1144 = v488 * dir[0];
+    let v1145 = v15 * v481;
+    let v1146 = q[1] * v1031;
+    let v1147 = v1143 + v1144;
+    let v1148 = v1147 + v1145;
+    let v1149 = v1148 + v1146;
+    let v1150 = v1041 - v489;
+    let v1151 = v1150 - v490;
+    let v1152 = v1151 + v1044;
+    let v1153 = v23 * v43;
+    let v1154 = v1153.mul_add(dir[1], v1036);
+    let v1155 = v352.mul_add(v528, v1154);
+    let v1156 = 0.5f64 * v355;
+    let v1157 = v103 * v20;
+    let v1158 = v1049 * dir[1];
+    let v1159 = v1157.mul_add(v477, v1158);
+    let v1160 = v354.mul_add(v527, -v781);
+    let v1161 = v1160 - v782;
+    let v1162 = v44.mul_add(v1159, v1161);
+    let v1163 = v46 * v1162;
+    let v1164 = v1156.mul_add(dir[3], v1163);
+    let v1165 = 0.5f64 * v359;
+    let v1166 = 0.5f64 * v357;
+    let v1167 = v111 * v20;
+    let v1168 = v1060 * dir[1];
+    let v1169 = v1167.mul_add(v477, v1168);
+    let v1170 = v73 * v354;
+    let v1171 = 0.25f64 * v354;
+    let v1172 = v73 * v1159;
+    let v1173 = v1171.mul_add(dir[2], v1172);
+    let v1174 = v1166.mul_add(dir[1], v1074);
+    let v1175 = v20.mul_add(v1169, v1174);
+    let v1176 = v1170.mul_add(dir[0], v1175);
+    let v1177 = q[0].mul_add(v1173, v1176);
+    let v1178 = v46 * v1177;
+    let v1179 = v1165.mul_add(dir[3], v1178);
+    let v1180 = 0.5f64 * v363;
+    let v1181 = v1166 * dir[0];
+    let v1182 = v1171.mul_add(dir[1], v1064);
+    let v1183 = v23.mul_add(v1159, v1182);
+    let v1184 = q[2].mul_add(v1183, -v1181);
+    let v1185 = (-v26).mul_add(v1169, v1184);
+    let v1186 = v362.mul_add(dir[2], v1185);
+    let v1187 = v46 * v1186;
+    let v1188 = v1180.mul_add(dir[3], v1187);
+    let v1189 = v1016 * dir[0];
+    let v1190 = v225 * v914;
+    let v1191 = v1087 * dir[1];
+    let v1192 = q[1] * v1091;
+    let v1193 = v1189 + v1190;
+    let v1194 = v1193 + v1191;
+    let v1195 = v1194 + v1192;
+    let v1196 = v1103 - v1017;
+    let v1197 = v1196 - v1018;
+    let v1198 = v1197 + v1106;
+    let v1199 = 0.03125f64 * q[1];
+    let v1200 = v1199 * v231;
+    let v1201 = v1200.mul_add(dir[1], v1096);
+    let v1202 = v371.mul_add(v923, v1201);
+    let v1203 = 0.5f64 * v375;
+    let v1204 = v20 * v776;
+    let v1205 = v199 * v20;
+    let v1206 = v1112 * dir[1];
+    let v1207 = v1205.mul_add(v477, v1206);
+    let v1208 = v374.mul_add(v527, -v1204);
+    let v1209 = (-v801).mul_add(dir[1], v1208);
+    let v1210 = v44.mul_add(v1207, v1209);
+    let v1211 = v46 * v1210;
+    let v1212 = v1203.mul_add(dir[3], v1211);
+    let v1213 = 0.5f64 * v378;
+    let v1214 = 0.5f64 * v354;
+    let v1215 = v73 * v374;
+    let v1216 = 0.25f64 * v374;
+    let v1217 = v73 * v1207;
+    let v1218 = v1216.mul_add(dir[2], v1217);
+    let v1219 = v1214.mul_add(dir[1], v1133);
+    let v1220 = v20.mul_add(v1159, v1219);
+    let v1221 = v1215.mul_add(dir[0], v1220);
+    let v1222 = q[0].mul_add(v1218, v1221);
+    let v1223 = v46 * v1222;
+    let v1224 = v1213.mul_add(dir[3], v1223);
+    let v1225 = 0.5f64 * v382;
+    let v1226 = v1214 * dir[0];
+    let v1227 = v1216.mul_add(dir[1], v1123);
+    let v1228 = v23.mul_add(v1207, v1227);
+    let v1229 = q[2].mul_add(v1228, -v1226);
+    let v1230 = (-v26).mul_add(v1159, v1229);
+    let v1231 = v381.mul_add(dir[2], v1230);
+    let v1232 = v46 * v1231;
+    let v1233 = v1225.mul_add(dir[3], v1232);
+    let v1234 = v534.mul_add(dir[2], v1036);
+    let v1235 = v384.mul_add(v528, v1234);
+    let v1236 = v513 + v1028;
+    let v1237 = v1236 + v1032;
+    let v1238 = v1143 - v1144;
+    let v1239 = v1238 - v1145;
+    let v1240 = v1239 + v1146;
+    let v1241 = 0.5f64 * v391;
+    let v1242 = v33 * v528;
+    let v1243 = 0.5f64 * v389;
+    let v1244 = v1243.mul_add(dir[2], v1133);
+    let v1245 = v103 * v33;
+    let v1246 = v1049 * dir[2];
+    let v1247 = v1245.mul_add(v477, v1246);
+    let v1248 = q[2].mul_add(v1244, -v1242);
+    let v1249 = (-v389).mul_add(v477, v1248);
+    let v1250 = v44.mul_add(v1247, v1249);
+    let v1251 = v46 * v1250;
+    let v1252 = v1241.mul_add(dir[3], v1251);
+    let v1253 = 0.5f64 * v396;
+    let v1254 = 0.5f64 * v393;
+    let v1255 = v111 * v33;
+    let v1256 = v1060 * dir[2];
+    let v1257 = v1255.mul_add(v477, v1256);
+    let v1258 = v20 * v1257;
+    let v1259 = 0.25f64 * v389;
+    let v1260 = v1259.mul_add(dir[2], v1064);
+    let v1261 = v73.mul_add(v1247, v1260);
+    let v1262 = v1254.mul_add(dir[1], v1258);
+    let v1263 = q[0].mul_add(v1261, v1262);
+    let v1264 = v394.mul_add(dir[0], v1263);
+    let v1265 = v46 * v1264;
+    let v1266 = v1253.mul_add(dir[3], v1265);
+    let v1267 = 0.5f64 * v399;
+    let v1268 = v1254 * dir[0];
+    let v1269 = q[1].mul_add(v1261, -v1268);
+    let v1270 = (-v26).mul_add(v1257, v1269);
+    let v1271 = v394.mul_add(dir[1], v1270);
+    let v1272 = v46 * v1271;
+    let v1273 = v1267.mul_add(dir[3], v1272);
+    let v1274 = 0.03125f64 * q[2];
+    let v1275 = v1274 * v231;
+    let v1276 = v1275.mul_add(dir[2], v1096);
+    let v1277 = v401.mul_add(v923, v1276);
+    let v1278 = v1084 + v1085;
+    let v1279 = v1278 + v1088;
+    let v1280 = v1279 + v1092;
+    let v1281 = v1191 - v1189;
+    let v1282 = v1281 - v1190;
+    let v1283 = v1282 + v1192;
+    let v1284 = 0.5f64 * v407;
+    let v1285 = v33 * v776;
+    let v1286 = 0.5f64 * v405;
+    let v1287 = v1286 * dir[2];
+    let v1288 = 0.5f64.mul_add(v776, v1287);
+    let v1289 = v199 * v33;
+    let v1290 = v1112 * dir[2];
+    let v1291 = v1289.mul_add(v477, v1290);
+    let v1292 = q[2].mul_add(v1288, -v1285);
+    let v1293 = (-v405).mul_add(v477, v1292);
+    let v1294 = v44.mul_add(v1291, v1293);
+    let v1295 = v46 * v1294;
+    let v1296 = v1284.mul_add(dir[3], v1295);
+    let v1297 = 0.5f64 * v411;
+    let v1298 = v20 * v1247;
+    let v1299 = 0.25f64 * v405;
+    let v1300 = v1299.mul_add(dir[2], v1123);
+    let v1301 = v73.mul_add(v1291, v1300);
+    let v1302 = v1243.mul_add(dir[1], v1298);
+    let v1303 = q[0].mul_add(v1301, v1302);
+    let v1304 = v409.mul_add(dir[0], v1303);
+    let v1305 = v46 * v1304;
+    let v1306 = v1297.mul_add(dir[3], v1305);
+    let v1307 = 0.5f64 * v414;
+    let v1308 = v1243 * dir[0];
+    let v1309 = q[1].mul_add(v1301, -v1308);
+    let v1310 = (-v26).mul_add(v1247, v1309);
+    let v1311 = v409.mul_add(dir[1], v1310);
+    let v1312 = v46 * v1311;
+    let v1313 = v1307.mul_add(dir[3], v1312);
+    let v1314 = 0.5f64 * v530;
+    let v1315 = 0.5f64 * v539;
+    let v1316 = 0.5f64 * v545;
+    let v1317 = 0.5f64 * v778;
+    let v1318 = 0.5f64 * v788;
+    let v1319 = 0.5f64 * v795;
+    let v1320 = p[13] * v455;
+    let v1321 = v1320 * dir[3];
+    let v1322 = q[0] * v460;
+    let v1323 = v1322 * dir[3];
+    let v1324 = v425.mul_add(dir[0], v1323);
+    let v1325 = p[4].mul_add(v1324, -v1321);
+    let v1326 = 0.5f64 * p[5];
+    let v1327 = v1326 * dir[4];
+    let v1328 = 0.5f64.mul_add(v1325, v1327);
+    let v1329 = p[14] * v455;
+    let v1330 = v1329 * dir[3];
+    let v1331 = v435 * v460;
+    let v1332 = v425 * dir[1];
+    let v1333 = v1331.mul_add(dir[3], v1332);
+    let v1334 = p[4].mul_add(v1333, -v1330);
+    let v1335 = v1326 * dir[5];
+    let v1336 = 0.5f64.mul_add(v1334, v1335);
+    let v1337 = 0.5f64 * p[8];
+    let v1338 = 0.5f64 * v425;
+    let v1339 = v33 * v460;
+    let v1340 = v1339 * dir[3];
+    let v1341 = v1338.mul_add(dir[2], v1340);
+    let v1342 = p[7] * v1341;
+    let v1343 = v1337.mul_add(dir[6], v1342);
+    let v1344 = p[14] * dir[1];
+    let v1345 = p[13].mul_add(dir[0], v1344);
+    let v1346 = v41.powi(3i32);
+    let v1347 = 2f64 * p[0];
+    let v1348 = v1347 / v1346;
+    let v1349 = 0.5f64 * v1348;
+    let v1350 = v1349 / v428;
+    let v1351 = v453 * v453;
+    let v1353 = v424.powf(1.5f64);
+    let v1354 = 0.25f64 * v1351;
+    let v1355 = v1354 / v1353;
+    let v1356 = v1350 - v1355;
+    let v1357 = v450 * dir[3];
+    let v1358 = v1357 * v1356;
+    let v1359 = v455.mul_add(v1345, v1358);
+    let v1360 = v435 * dir[1];
+    let v1361 = q[0].mul_add(dir[0], v1360);
+    let v1362 = 3f64 * v457;
+    let v1364 = 6f64 * v424;
+    let v1365 = v1364 * v1351;
+    let v1366 = v1362.mul_add(v1348, v1365);
+    let v1367 = v464 * v1366;
+    let v1368 = dir[3] * v1367;
+    let v1369 = v460.mul_add(v1361, v1368);
+    let v1370 = q[2] * v460;
+    let v1371 = 0.5f64 * v5;
+    let v1372 = v1371 * dir[3];
+    let v1373 = v1372 * v1366;
+    let v1374 = v1370.mul_add(dir[2], v1373);
+    let v1375 = p[9].mul_add(dir[3], -v1359);
+    let v1376 = p[4].mul_add(v1369, v1375);
+    let v1377 = p[7].mul_add(v1374, v1376);
+    let v1378 = 0.5f64 * p[10];
+    let v1379 = v1378 * dir[7];
+    let v1380 = 0.5f64.mul_add(v1377, v1379);
+    out[0] = v14;
+    out[1] = v22;
+    out[2] = v28;
+    out[3] = v29;
+    out[4] = v30;
+    out[5] = v35;
+    out[6] = v36;
+    out[7] = v37;
+    out[8] = v38;
+    out[9] = v47;
+    out[10] = v50;
+    out[11] = v53;
+    out[12] = v68;
+    out[13] = v82;
+    out[14] = v90;
+    out[15] = v110;
+    out[16] = v124;
+    out[17] = v130;
+    out[18] = v139;
+    out[19] = v144;
+    out[20] = v149;
+    out[21] = v164;
+    out[22] = v167;
+    out[23] = v170;
+    out[24] = v173;
+    out[25] = v175;
+    out[26] = v177;
+    out[27] = v183;
+    out[28] = v191;
+    out[29] = v197;
+    out[30] = v205;
+    out[31] = v215;
+    out[32] = v221;
+    out[33] = v238;
+    out[34] = v245;
+    out[35] = v252;
+    out[36] = v272;
+    out[37] = v275;
+    out[38] = v278;
+    out[39] = v280;
+    out[40] = v283;
+    out[41] = v286;
+    out[42] = v288;
+    out[43] = v294;
+    out[44] = v295;
+    out[45] = v300;
+    out[46] = v303;
+    out[47] = v307;
+    out[48] = v310;
+    out[49] = v316;
+    out[50] = v320;
+    out[51] = v326;
+    out[52] = v329;
+    out[53] = v333;
+    out[54] = v337;
+    out[55] = v342;
+    out[56] = v345;
+    out[57] = v350;
+    out[58] = v351;
+    out[59] = v353;
+    out[60] = v356;
+    out[61] = v360;
+    out[62] = v364;
+    out[63] = v369;
+    out[64] = v370;
+    out[65] = v372;
+    out[66] = v376;
+    out[67] = v379;
+    out[68] = v383;
+    out[69] = v385;
+    out[70] = v386;
+    out[71] = v387;
+    out[72] = v392;
+    out[73] = v397;
+    out[74] = v400;
+    out[75] = v402;
+    out[76] = v403;
+    out[77] = v404;
+    out[78] = v408;
+    out[79] = v412;
+    out[80] = v415;
+    out[81] = 0f64;
+    out[82] = 0f64;
+    out[83] = 0f64;
+    out[84] = v417;
+    out[85] = v418;
+    out[86] = v419;
+    out[87] = 0f64;
+    out[88] = 0f64;
+    out[89] = 0f64;
+    out[90] = v420;
+    out[91] = v421;
+    out[92] = v422;
+    out[93] = v433;
+    out[94] = v441;
+    out[95] = v446;
+    out[96] = v471;
+    out[97] = 0f64;
+    out[98] = 0f64;
+    out[99] = 0f64;
+    out[100] = 0f64;
+    out[101] = v483;
+    out[102] = v495;
+    out[103] = v502;
+    out[104] = v505;
+    out[105] = v507;
+    out[106] = v517;
+    out[107] = v520;
+    out[108] = v523;
+    out[109] = v525;
+    out[110] = v532;
+    out[111] = v541;
+    out[112] = v547;
+    out[113] = v575;
+    out[114] = v602;
+    out[115] = v620;
+    out[116] = v650;
+    out[117] = v679;
+    out[118] = v697;
+    out[119] = v716;
+    out[120] = v725;
+    out[121] = v734;
+    out[122] = v757;
+    out[123] = v766;
+    out[124] = v775;
+    out[125] = v780;
+    out[126] = v790;
+    out[127] = v797;
+    out[128] = v815;
+    out[129] = v834;
+    out[130] = v848;
+    out[131] = v872;
+    out[132] = v895;
+    out[133] = v912;
+    out[134] = v938;
+    out[135] = v948;
+    out[136] = v958;
+    out[137] = v992;
+    out[138] = v1001;
+    out[139] = v1010;
+    out[140] = v1014;
+    out[141] = v1022;
+    out[142] = v1026;
+    out[143] = 0f64;
+    out[144] = 0f64;
+    out[145] = 0f64;
+    out[146] = v1035;
+    out[147] = v1039;
+    out[148] = v1046;
+    out[149] = v1056;
+    out[150] = v1072;
+    out[151] = v1083;
+    out[152] = v1095;
+    out[153] = v1101;
+    out[154] = v1108;
+    out[155] = v1119;
+    out[156] = v1131;
+    out[157] = v1142;
+    out[158] = v1149;
+    out[159] = v1152;
+    out[160] = v1155;
+    out[161] = v1164;
+    out[162] = v1179;
+    out[163] = v1188;
+    out[164] = v1195;
+    out[165] = v1198;
+    out[166] = v1202;
+    out[167] = v1212;
+    out[168] = v1224;
+    out[169] = v1233;
+    out[170] = v1235;
+    out[171] = v1237;
+    out[172] = v1240;
+    out[173] = v1252;
+    out[174] = v1266;
+    out[175] = v1273;
+    out[176] = v1277;
+    out[177] = v1280;
+    out[178] = v1283;
+    out[179] = v1296;
+    out[180] = v1306;
+    out[181] = v1313;
+    out[182] = 0f64;
+    out[183] = 0f64;
+    out[184] = 0f64;
+    out[185] = v1314;
+    out[186] = v1315;
+    out[187] = v1316;
+    out[188] = 0f64;
+    out[189] = 0f64;
+    out[190] = 0f64;
+    out[191] = v1317;
+    out[192] = v1318;
+    out[193] = v1319;
+    out[194] = v1328;
+    out[195] = v1336;
+    out[196] = v1343;
+    out[197] = v1380;
+    out[198] = 0f64;
+    out[199] = 0f64;
+    out[200] = 0f64;
+    out[201] = 0f64;
 }
 /// Kernel `link_loads`: 16 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn link_loads(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    out: &mut [f64; 3usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    out: &mut [f64; 3],
 ) {
     runtime::cpu::require_fma();
     let w = &mut [0.0f64; 0];
@@ -3914,35 +3699,35 @@ pub fn link_loads(
 #[allow(unused_variables, clippy::all)]
 fn link_loads_0(
     t: f64,
-    q: &[f64; 8usize],
-    qd: &[f64; 8usize],
-    qdd: &[f64; 8usize],
-    dir: &[f64; 16usize],
-    p: &[f64; 101usize],
-    w: &mut [f64; 0usize],
-    out: &mut [f64; 3usize],
+    q: &[f64; 8],
+    qd: &[f64; 8],
+    qdd: &[f64; 8],
+    dir: &[f64; 16],
+    p: &[f64; 101],
+    w: &mut [f64; 0],
+    out: &mut [f64; 3],
 ) {
-    let v4: f64 = p[57usize] * p[58usize];
-    let v7: f64 = p[53usize].mul_add(p[54usize], v4);
-    let v8: f64 = p[61usize].mul_add(p[62usize], v7);
-    let v11: f64 = p[57usize] * p[59usize];
-    let v13: f64 = p[53usize].mul_add(p[55usize], v11);
-    let v14: f64 = p[61usize].mul_add(p[63usize], v13);
-    let v17: f64 = p[57usize] * p[60usize];
-    let v19: f64 = p[53usize].mul_add(p[56usize], v17);
-    let v20: f64 = p[61usize].mul_add(p[64usize], v19);
-    let v21: f64 = -v20;
-    out[0usize] = v8;
-    out[1usize] = v14;
-    out[2usize] = v21;
+    let v4 = p[57] * p[58];
+    let v7 = p[53].mul_add(p[54], v4);
+    let v8 = p[61].mul_add(p[62], v7);
+    let v11 = p[57] * p[59];
+    let v13 = p[53].mul_add(p[55], v11);
+    let v14 = p[61].mul_add(p[63], v13);
+    let v17 = p[57] * p[60];
+    let v19 = p[53].mul_add(p[56], v17);
+    let v20 = p[61].mul_add(p[64], v19);
+    let v21 = -v20;
+    out[0] = v8;
+    out[1] = v14;
+    out[2] = v21;
 }
 fn cell_0_linked(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
     cell_0(
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 4usize],
-        &[0.0; 8usize],
+        &[0.0; 4],
+        &[0.0; 8],
         p.try_into().expect("cell parameters"),
         out.try_into().expect("cell outputs"),
     )
@@ -3976,14 +3761,14 @@ fn cell_0_tangent_linked(
     p: &[f64],
     out: &mut [f64],
 ) {
-    let mut dir = [0.0; 8usize];
-    dir[..4usize].copy_from_slice(dx);
-    dir[4usize..].copy_from_slice(dxd);
+    let mut dir = [0.0; 8];
+    dir[..4].copy_from_slice(dx);
+    dir[4..].copy_from_slice(dxd);
     cell_0_tangent(
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 4usize],
+        &[0.0; 4],
         &dir,
         p.try_into().expect("cell parameters"),
         out.try_into().expect("cell outputs and derivatives"),
@@ -3994,8 +3779,8 @@ fn cell_0_pose_linked(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
         0.0,
         x.try_into().expect("link coordinates"),
         xd.try_into().expect("link rates"),
-        &[0.0; 4usize],
-        &[0.0; 8usize],
+        &[0.0; 4],
+        &[0.0; 8],
         p.try_into().expect("cell parameters"),
         out.try_into().expect("pose outputs"),
     )
