@@ -1,11 +1,12 @@
 //! Model -> tapes: kinematics, TMT assembly, lowering.
 
+use runtime::kernels::{ArmBlocks, ArmInstance};
 use runtime::{ModelInfo, TapeSet};
 
-use crate::build::{assembly_system, link_chain, system};
+use crate::build::{ArmBlock, assembly_system, link_chain, system};
 use crate::cas::ExprId;
 use crate::cas::{Cas, Hoist, SymKind};
-use crate::model::{Model, ParamLayout, Structure};
+use crate::model::{AssemblyShape, Model, ParamLayout, Structure};
 use crate::tmt::contact_frames::{PointGroup, contact_frames};
 use crate::tmt::{SYMBOLIC_SOLVE_MAX_DOF, System, assemble, solve_accelerations};
 
@@ -47,9 +48,13 @@ pub fn derive_links(structure: &Structure) -> Option<(ModelInfo, runtime::links:
 pub fn derive_structure(structure: &Structure) -> TapeSet {
     let layout = ParamLayout::of(structure);
     let mut cas = Cas::new();
+    let mut by_arms = None;
     let (sys, phi, rows, blocks) = match &structure.assembly {
         Some(a) => {
             let assembled = assembly_system(&mut cas, a, &layout);
+            if arms_have_own_kernels(a) {
+                by_arms = Some((a, assembled.arms, assembled.rest));
+            }
             let blocks = assembled.blocks;
             (assembled.sys, assembled.constraints, assembled.rows, blocks)
         }
@@ -80,7 +85,8 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
     // Joints need M and h apart (the constrained solve is at run time).
     let accel = n <= SYMBOLIC_SOLVE_MAX_DOF
         && !links.as_ref().is_some_and(|l| l.mass_bias)
-        && phi.is_empty();
+        && phi.is_empty()
+        && by_arms.is_none();
     let contact = (!sys.samples.is_empty()).then(|| contact_outputs(&mut cas, &sys));
     let accel_tape = if accel {
         // The contact frames ride along (else the points): they share the
@@ -124,6 +130,8 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
             )
         }
     };
+    let arm_blocks =
+        by_arms.map(|(a, arms, rest)| arm_blocks(&mut cas, a, &arms, &rest, &mut hoist));
     let derived = hoist.finish(&mut cas);
     TapeSet {
         info: ModelInfo {
@@ -154,6 +162,65 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
             Some(_) => None,
         },
         links,
+        arm_blocks,
+    }
+}
+
+/// Whether an assembly's arms run on kernels of their own
+/// (`runtime::arm_blocks`): not an arm on a compliant base (its
+/// coordinates move the arm's base, which a single arm's kernels hold
+/// still) nor one with inputs (its parameters are copied once per
+/// parameter set).
+fn arms_have_own_kernels(a: &AssemblyShape) -> bool {
+    a.arms
+        .iter()
+        .all(|(_, st)| !st.base_compliant && ParamLayout::of(st).driven().is_empty())
+}
+
+/// The rest of an assembly's `MassBias` and `Jvp` (hoisted with its other
+/// kernels), and each distinct arm structure derived once as a single arm
+/// (without contact points: contact stays the assembly's).
+fn arm_blocks(
+    cas: &mut Cas,
+    a: &AssemblyShape,
+    arms: &[ArmBlock],
+    rest: &System,
+    hoist: &mut Hoist,
+) -> ArmBlocks {
+    let eq = assemble(cas, rest);
+    let mut mass_bias = eq.mass_upper.clone();
+    mass_bias.extend_from_slice(&eq.bias);
+    let mut kinds: Vec<(Structure, TapeSet)> = Vec::new();
+    let instances = a
+        .arms
+        .iter()
+        .zip(arms)
+        .map(|((_, st), b)| {
+            let st = Structure {
+                contact_points: 0,
+                ..st.clone()
+            };
+            let kind = match kinds.iter().position(|(s, _)| *s == st) {
+                Some(k) => k,
+                None => {
+                    let tapes = derive_structure(&st);
+                    kinds.push((st, tapes));
+                    kinds.len() - 1
+                }
+            };
+            ArmInstance {
+                kind,
+                first: b.first,
+                dof: b.dof,
+                params: b.params,
+            }
+        })
+        .collect();
+    ArmBlocks {
+        rest_mass_bias: cas.to_tape_hoisted(&mass_bias, hoist),
+        rest_jvp: cas.to_tape_hoisted(&eq.jvp, hoist),
+        kinds: kinds.into_iter().map(|(_, t)| t).collect(),
+        arms: instances,
     }
 }
 

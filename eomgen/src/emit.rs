@@ -9,6 +9,7 @@ use std::collections::HashMap;
 
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
+use runtime::kernels::ArmBlocks;
 use runtime::{KernelKind, Op, Slot, Tape, TapeSet};
 
 /// Operations per emitted function. A cut costs a store and a load per
@@ -922,6 +923,14 @@ fn emit_link_recursion(
         #[allow(unused_variables)]
         pub fn jvp(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #dof]) {
             runtime::cpu::require_fma();
+            // SAFETY: `require_fma` has checked that the processor has FMA.
+            unsafe { jvp_fma(q, qd, qdd, dir, p, out) }
+        }
+        /// The recursion inlined into a function built for FMA: its dual
+        /// numbers' fused products are instructions, not library calls.
+        #[inline(never)]
+        #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+        fn jvp_fma(q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #dof]) {
             let mut cells = LinkCells { q, qd, p };
             let mut tau = [0.0; #dof];
             runtime::links::inverse_dynamics_tangent(&LINKS, &mut cells, q, qd, qdd, dir, p, &mut tau, out)
@@ -1241,9 +1250,14 @@ fn emit_kernels(
                 kind,
                 KernelKind::MassBias | KernelKind::Jvp | KernelKind::Outputs
             );
+        let by_arms = tapes.arm_blocks.is_some()
+            && matches!(
+                kind,
+                KernelKind::MassBias | KernelKind::Jvp | KernelKind::Derived
+            );
         match (&tapes.links, kind) {
-            // Emitted with the parts, below.
-            _ if by_parts => {}
+            // Emitted with the parts or the arms, below.
+            _ if by_parts || by_arms => {}
             // Emitted with the recursion, below.
             (Some(_), KernelKind::Jvp | KernelKind::Outputs) => {}
             (Some(links), KernelKind::MassBias) if links.mass_bias => {}
@@ -1339,9 +1353,125 @@ fn emit_accel(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream {
     }
 }
 
+/// An assembly's `MassBias`, `Jvp` and `Derived` through its arms' own
+/// kernels (`runtime::arm_blocks`): each distinct arm structure's kernels
+/// in a module `arm_K`, called on each arm's slices of q, qd, qdd, the
+/// direction and the extended parameters, added to the rest of the
+/// system's flat kernels.
+fn emit_arm_blocks(
+    tapes: &TapeSet,
+    blocks: &ArmBlocks,
+    dof: usize,
+    n_params: usize,
+) -> TokenStream {
+    let n_dir = 2 * dof;
+    let n_base = tapes.info.parameters.len();
+    let own = tapes.info.derived;
+    let (starts, n_derived) = blocks.derived_layout(own);
+    let modules = blocks.kinds.iter().enumerate().map(|(k, kind)| {
+        let name = format_ident!("arm_{}", k);
+        let items = model_tokens(kind);
+        quote! {
+            /// The kernels of one arm structure of this assembly, as a single arm's.
+            #[allow(dead_code, unused_imports)]
+            pub mod #name {
+                #items
+            }
+        }
+    });
+    let flat = [
+        KernelEmitter::new(&blocks.rest_mass_bias).emit("rest_mass_bias", dof, n_params, 0),
+        KernelEmitter::new(&blocks.rest_jvp).emit("rest_jvp", dof, n_params, 0),
+        KernelEmitter::new(&tapes.derived).emit("own_derived", dof, n_params, 0),
+    ];
+    let (mut mass_bias, mut jvp, mut derived) = (Vec::new(), Vec::new(), Vec::new());
+    for (a, &start) in blocks.arms.iter().zip(&starts) {
+        let module = format_ident!("arm_{}", a.kind);
+        let kind = &blocks.kinds[a.kind];
+        let (first, m) = (a.first, a.dof);
+        let (nb, nd) = (kind.info.parameters.len(), kind.info.derived);
+        let (off, x) = (a.params, n_base + start);
+        let (m_mb, m_dir, m_ext) = (m * (m + 1) / 2 + m, 2 * m, nb + nd);
+        let slice = |v: TokenStream, from: usize, len: usize| quote!(#v[#from..#from + #len].try_into().expect("an arm's slice"));
+        let (aq, aqd, aqdd) = (
+            slice(quote!(q), first, m),
+            slice(quote!(qd), first, m),
+            slice(quote!(qdd), first, m),
+        );
+        let ap = slice(quote!(p), x, m_ext);
+        mass_bias.push(quote! {
+            let mut block = [0.0f64; #m_mb];
+            #module::mass_bias(t, #aq, #aqd, #aqdd, &[0.0; #m_dir], #ap, &mut block);
+            runtime::linalg::add_block(#dof, #first, #m, &block, out);
+        });
+        jvp.push(quote! {
+            let mut d = [0.0f64; #m_dir];
+            d[..#m].copy_from_slice(&dir[#first..#first + #m]);
+            d[#m..].copy_from_slice(&dir[#dof + #first..#dof + #first + #m]);
+            // A direction off the arm's block does not move it (a
+            // Jacobian's column touches one block).
+            if d.iter().any(|&x| x != 0.0) {
+                let mut tau = [0.0f64; #m];
+                #module::jvp(t, #aq, #aqd, #aqdd, &d, #ap, &mut tau);
+                for (o, x) in out[#first..#first + #m].iter_mut().zip(&tau) {
+                    *o += x;
+                }
+            }
+        });
+        derived.push(quote! {
+            let mut pe = [0.0f64; #m_ext];
+            pe[..#nb].copy_from_slice(&p[#off..#off + #nb]);
+            out[#start..#start + #nb].copy_from_slice(&p[#off..#off + #nb]);
+            #module::derived(t, &[0.0; #m], &[0.0; #m], &[0.0; #m], &[0.0; #m_dir], &pe,
+                (&mut out[#start + #nb..#start + #m_ext]).try_into().expect("an arm's derived parameters"));
+        });
+    }
+    let n_mb = dof * (dof + 1) / 2 + dof;
+    let inputs = quote!(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params]);
+    quote! {
+        #(#modules)*
+        #(#flat)*
+        /// Kernel `mass_bias`: the rest of the system's, then each arm's in its block.
+        pub fn mass_bias(#inputs, out: &mut [f64; #n_mb]) {
+            rest_mass_bias(t, q, qd, qdd, dir, p, out);
+            #({ #mass_bias })*
+        }
+        /// Kernel `jvp`: the rest of the system's, then each arm's in its block.
+        pub fn jvp(#inputs, out: &mut [f64; #dof]) {
+            rest_jvp(t, q, qd, qdd, dir, p, out);
+            #({ #jvp })*
+        }
+        /// Kernel `derived`: the assembly's own, then each arm's base
+        /// parameters and derived ones.
+        pub fn derived(#inputs, out: &mut [f64; #n_derived]) {
+            own_derived(t, q, qd, qdd, dir, p, (&mut out[..#own]).try_into().expect("own derived parameters"));
+            #({ #derived })*
+        }
+    }
+}
+
 /// Rust source of one compiled-in model.
 pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
-    let info = &tapes.info;
+    let tokens = unsuffixed(model_tokens(tapes));
+    let file: syn::File = syn::parse2(tokens).expect("emitted tokens parse as a Rust file");
+    format!(
+        "// @generated by eomgen from {source_path}: do not edit; `cargo build` or `softarm derive` rewrites it.\n\
+         {HASH_PREFIX}{}\n\n{}",
+        tapes.info.hash,
+        prettyplease::unparse(&file)
+    )
+}
+
+/// The items of one model's module: its constants, its `Compiled` kernels
+/// and their functions (an assembly's arms' in modules of their own).
+fn model_tokens(tapes: &TapeSet) -> TokenStream {
+    // An assembly on its arms' kernels has their parameters after its own
+    // derived ones.
+    let mut info = tapes.info.clone();
+    if let Some(b) = &tapes.arm_blocks {
+        info.derived = b.derived_layout(info.derived).1;
+    }
+    let info = &info;
     let dof = info.dof();
     let n_params = info.extended_params();
     let n_dir = 2 * dof;
@@ -1363,6 +1493,9 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
         let n_out = tapes.mass_bias.outputs.len();
         kernels.push(emit_parts(parts, dof, n_params, n_out));
     }
+    if let Some(blocks) = &tapes.arm_blocks {
+        kernels.push(emit_arm_blocks(tapes, blocks, dof, n_params));
+    }
     if let Some(links) = &tapes.links {
         let n_out = tapes.mass_bias.outputs.len();
         kernels.push(emit_link_recursion(links, dof, n_params, n_out));
@@ -1372,7 +1505,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
             pub static CELLS: &[runtime::links::CompiledCell] = &[];
         });
     }
-    let tokens = quote! {
+    quote! {
         use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
 
         /// Structural hash of the model this was derived from.
@@ -1454,14 +1587,7 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
 
         #frames_fn
         #(#kernels)*
-    };
-    let file: syn::File =
-        syn::parse2(unsuffixed(tokens)).expect("emitted tokens parse as a Rust file");
-    format!(
-        "// @generated by eomgen from {source_path}: do not edit; `cargo build` or `softarm derive` rewrites it.\n\
-         {HASH_PREFIX}{hash}\n\n{}",
-        prettyplease::unparse(&file)
-    )
+    }
 }
 
 /// `tokens` with every `usize` literal unsuffixed: quote writes `q[3usize]`,

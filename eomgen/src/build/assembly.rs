@@ -13,6 +13,7 @@
 //! and last each free 3D body its quaternion's unit norm (`unit`).
 
 use std::collections::HashMap;
+use std::ops::Range;
 
 use crate::cas::{Cas, ExprId, Scope, SymKind};
 use crate::model::assembly::{FrameRef, JointKind};
@@ -32,6 +33,46 @@ pub struct Assembled {
     /// Coordinates per independent subsystem (an arm with its compliant
     /// base, a free body), in order: M is block diagonal over them.
     pub blocks: Vec<usize>,
+    /// Where each arm's own system sits in the assembly's.
+    pub arms: Vec<ArmBlock>,
+    /// The system without the arms' own terms (their links, springs,
+    /// dampers, actuators and loads): the bodies, the compliant bases and
+    /// whatever joins the arms. The assembly's M, h and their tangent are
+    /// this system's plus each arm's, in its block.
+    pub rest: System,
+}
+
+/// An arm's place in the assembly: its coordinates `first..first + dof`
+/// (after its compliant base's, if any) and its parameters from `params`
+/// on, in its own layout's order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ArmBlock {
+    pub first: usize,
+    pub dof: usize,
+    pub params: usize,
+}
+
+/// The entries one arm's own system added to each of the builder's lists.
+#[derive(Clone)]
+struct ArmEntries {
+    bodies: Range<usize>,
+    elastic: Range<usize>,
+    rayleigh: Range<usize>,
+    actuation: Range<usize>,
+    point_forces: Range<usize>,
+    moments: Range<usize>,
+}
+
+/// `all` without the entries of every arm (`range` picks the list's).
+fn without_arms<T: Clone>(
+    all: &[T],
+    arms: &[ArmEntries],
+    range: impl Fn(&ArmEntries) -> &Range<usize>,
+) -> Vec<T> {
+    (all.iter().enumerate())
+        .filter(|(i, _)| !arms.iter().any(|a| range(a).contains(i)))
+        .map(|(_, x)| x.clone())
+        .collect()
 }
 
 /// A compliant base's coordinates: its displacement, and its turn (a
@@ -138,6 +179,8 @@ struct Builder {
     samples: Vec<Sample>,
     /// The arms' base frames.
     bases: Vec<Sample>,
+    arm_blocks: Vec<ArmBlock>,
+    arm_entries: Vec<ArmEntries>,
 }
 
 impl Builder {
@@ -177,6 +220,8 @@ impl Builder {
             units: Vec::new(),
             samples: Vec::new(),
             bases: Vec::new(),
+            arm_blocks: Vec::new(),
+            arm_entries: Vec::new(),
         }
     }
 
@@ -241,6 +286,11 @@ impl Builder {
             }
             super::arm_system(cas, st, &symbols)
         });
+        self.arm_blocks.push(ArmBlock {
+            first: self.names.len(),
+            dof: sys.coords.len(),
+            params: offset,
+        });
         self.names
             .extend(sys.coords.names.iter().map(|n| format!("{prefix}{n}")));
         self.q.extend(&sys.coords.q);
@@ -248,14 +298,30 @@ impl Builder {
         self.qdd.extend(&sys.coords.qdd);
         self.blocks.push(self.names.len() - first);
         self.bodies.extend(bodies);
+        let start = |v: usize| v..v;
+        let mut own = ArmEntries {
+            bodies: start(self.bodies.len()),
+            elastic: start(self.elastic.len()),
+            rayleigh: start(self.rayleigh.len()),
+            actuation: start(self.actuation.len()),
+            point_forces: start(self.point_forces.len()),
+            moments: start(self.moments.len()),
+        };
         self.bodies.extend(sys.bodies);
         self.elastic.push(sys.elastic);
         self.rayleigh.push(sys.rayleigh);
         self.actuation.push(sys.actuation);
         self.point_forces.extend(sys.point_forces);
+        own.bodies.end = self.bodies.len();
+        own.elastic.end = self.elastic.len();
+        own.rayleigh.end = self.rayleigh.len();
+        own.actuation.end = self.actuation.len();
+        own.point_forces.end = self.point_forces.len();
         self.samples.extend(sys.samples.iter().copied());
         self.bases.extend(sys.bases.iter().copied());
         self.moments.extend(sys.moments);
+        own.moments.end = self.moments.len();
+        self.arm_entries.push(own);
         self.seeds.extend(sys.seeds);
         match sys.planar {
             Some(planar) => {
@@ -495,6 +561,7 @@ impl Builder {
 
     fn finish(self, cas: &mut Cas, tip: [ExprId; 3], tip_orientation: [ExprId; 4]) -> Assembled {
         let gravity = Xyz::ALL.map(|c| self.get(Param::Gravity(c)));
+        let rest = self.rest(cas, gravity);
         let sys = System {
             coords: Coordinates {
                 names: self.names,
@@ -523,6 +590,41 @@ impl Builder {
             constraints: self.constraints,
             rows: self.rows,
             blocks: self.blocks,
+            arms: self.arm_blocks,
+            rest,
+        }
+    }
+
+    /// The system without the arms' own entries (`Assembled::rest`).
+    fn rest(&self, cas: &mut Cas, gravity: [ExprId; 3]) -> System {
+        let arms = &self.arm_entries;
+        let zero = self.zero;
+        let sum = |cas: &mut Cas, all: &[ExprId], range: fn(&ArmEntries) -> &Range<usize>| {
+            let kept = without_arms(all, arms, range);
+            cas.add_all(&kept)
+        };
+        System {
+            coords: Coordinates {
+                names: self.names.clone(),
+                q: self.q.clone(),
+                qd: self.qd.clone(),
+                qdd: self.qdd.clone(),
+            },
+            bodies: without_arms(&self.bodies, arms, |a| &a.bodies),
+            gravity,
+            elastic: sum(cas, &self.elastic, |a| &a.elastic),
+            rayleigh: sum(cas, &self.rayleigh, |a| &a.rayleigh),
+            actuation: sum(cas, &self.actuation, |a| &a.actuation),
+            point_forces: without_arms(&self.point_forces, arms, |a| &a.point_forces),
+            moments: without_arms(&self.moments, arms, |a| &a.moments),
+            tip: [zero; 3],
+            tip_orientation: [zero; 4],
+            chain: None,
+            seeds: self.seeds.clone(),
+            planar: None,
+            segment_ends: Vec::new(),
+            samples: Vec::new(),
+            bases: Vec::new(),
         }
     }
 }

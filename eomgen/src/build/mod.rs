@@ -13,7 +13,7 @@ use crate::tmt::planar::PlanarArm;
 use crate::tmt::spatial::SpatialArm;
 use crate::tmt::{ParamSymbols, System};
 
-pub use assembly::{Assembled, assembly_system};
+pub use assembly::{ArmBlock, Assembled, assembly_system};
 pub use cell::{cell_key, link_chain};
 
 /// The system of a structure: planar or spatial kinematics by

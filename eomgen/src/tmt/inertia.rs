@@ -13,6 +13,7 @@
 
 use crate::cas::{Cas, ExprId};
 
+#[derive(Clone)]
 pub enum Inertia {
     /// The same moment about every axis: planar bodies (whose angular
     /// velocity is along z) and point masses.

@@ -131,6 +131,7 @@ pub struct BaseMotion {
 }
 
 /// q, qd symbols and their names.
+#[derive(Clone)]
 pub struct Coordinates {
     pub names: Vec<String>,
     pub q: Vec<ExprId>,
@@ -178,6 +179,7 @@ impl Coordinates {
 }
 
 /// A lumped rigid body: Mbar = diag(m I3, J), all in the world frame.
+#[derive(Clone)]
 pub struct Body {
     pub mass: ExprId,
     /// Rotational inertia about the centre of mass.
@@ -189,12 +191,14 @@ pub struct Body {
 }
 
 /// A world-frame force applied at a point (a function of q).
+#[derive(Clone)]
 pub struct PointForce {
     pub point: [ExprId; 3],
     pub force: [ExprId; 3],
 }
 
 /// A constant world-frame moment on a frame turning at `omega`.
+#[derive(Clone)]
 pub struct AppliedMoment {
     pub omega: [ExprId; 3],
     pub moment: [ExprId; 3],

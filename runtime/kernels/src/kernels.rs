@@ -273,6 +273,11 @@ pub struct TapeSet {
     /// the interpreter keeps the flat tape.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub links: Option<crate::links::LinkKernels>,
+    /// An assembly's arms' own kernels ([`ArmBlocks`]), which
+    /// compiled models use for `MassBias`, `Jvp` and `Derived`; the
+    /// interpreter keeps the flat tapes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arm_blocks: Option<ArmBlocks>,
     /// The parts of a system that is a sum of small kernels (eba), which
     /// compiled models use for `MassBias` and `Jvp`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -301,6 +306,63 @@ impl TapeSet {
             KernelKind::ContactJvp => &self.contact_jvp,
             KernelKind::ContactJacobian => unreachable!("ContactJacobian is grouped: `tapes`"),
         }
+    }
+}
+
+/// An assembly's kernels through its arms' own (`TapeSet::arm_blocks`):
+/// each distinct arm
+/// structure is derived once as a single arm (its kernels, its link
+/// recursion, its derived parameters), and the assembly's `MassBias` and
+/// `Jvp` are the rest of the system's (bodies, compliant bases, what joins
+/// the arms: a small flat tape) plus each arm's in its block of
+/// coordinates. M is block diagonal over the arms and bodies, so nothing
+/// else couples them there; joints and contact stay in their own kernels.
+///
+/// Each arm reads its parameters as one slice of the extended parameter
+/// vector: the `Derived` kernel copies the arm's base parameters there and
+/// computes the arm's derived ones after them, once per parameter set (an
+/// arm with inputs, whose values change during a run, keeps the flat
+/// kernels: a copy would be stale).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ArmBlocks {
+    /// `MassBias` of the system without the arms' own terms (the
+    /// assembly's packed M and h).
+    pub rest_mass_bias: Tape,
+    /// `Jvp` of the same.
+    pub rest_jvp: Tape,
+    /// The kernels of each distinct arm structure, as a single arm's.
+    pub kinds: Vec<TapeSet>,
+    pub arms: Vec<ArmInstance>,
+}
+
+/// One arm of the assembly.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ArmInstance {
+    /// Its structure: an index into `ArmBlocks::kinds`.
+    pub kind: usize,
+    /// Its coordinates: `first..first + dof` of the assembly's.
+    pub first: usize,
+    pub dof: usize,
+    /// Its base parameters: from `params` on, in its own layout's order.
+    pub params: usize,
+}
+
+impl ArmBlocks {
+    /// Where each arm's parameters (its base ones, then its derived ones)
+    /// start among the assembly's derived parameters, after `own` of the
+    /// assembly's own; and the total.
+    pub fn derived_layout(&self, own: usize) -> (Vec<usize>, usize) {
+        let mut at = own;
+        let starts = self
+            .arms
+            .iter()
+            .map(|a| {
+                let start = at;
+                at += self.kinds[a.kind].info.extended_params();
+                start
+            })
+            .collect();
+        (starts, at)
     }
 }
 

@@ -161,7 +161,10 @@ struct Frame {
 /// values each): the `Jvp` kernel of compiled chains. Shared coordinates
 /// (rom slices) and the non-local forces are handled as
 /// `mass_bias_shared` handles them.
+/// Always inlined: a compiled model's kernel calls it from a function
+/// built for FMA (`mul_add` elsewhere is a library call).
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub fn inverse_dynamics_tangent<C: Cells>(
     layout: &LinkLayout,
     cells: &mut C,
@@ -267,11 +270,8 @@ fn link_forward(
     gravity: V3,
 ) -> LinkForces {
     let len = cell::len(nc);
-    let o = |i: usize| Dual {
-        v: out[i],
-        d: out[len + i],
-    };
-    let v3 = |i: usize| [o(i), o(i + 1), o(i + 2)];
+    let o = |i: usize| cell_dual(out, len, i);
+    let v3 = |i: usize| cell_v3(out, len, i);
     let rel: M3 = std::array::from_fn(|i| v3(cell::ROTATION + 3 * i));
     let Frame {
         r,
@@ -280,7 +280,7 @@ fn link_forward(
         alpha,
         acc,
     } = *frame;
-    let turn = |at: usize| mat_vec(&r, v3(at));
+    let turn = |at: usize| mat_vec(&r, cell_v3(out, len, at));
     let (d, dd) = (turn(cell::END), turn(cell::END_RATE));
     let (cen, cend) = (turn(cell::CENTROID), turn(cell::CENTROID_RATE));
     let (w_rel, w_b) = (turn(cell::OMEGA), turn(cell::BODY_OMEGA));
@@ -347,9 +347,27 @@ fn link_forward(
     forces
 }
 
+/// Output `i` of a cell's tangent kernel (`len` values, then their
+/// derivatives) as a dual number. Functions, not closures, so that they
+/// inline into the FMA-built caller.
+#[inline(always)]
+fn cell_dual(out: &[f64], len: usize, i: usize) -> Dual {
+    Dual {
+        v: out[i],
+        d: out[len + i],
+    }
+}
+
+/// Outputs `i..i + 3` of a cell's tangent kernel as a dual vector.
+#[inline(always)]
+fn cell_v3(out: &[f64], len: usize, i: usize) -> V3 {
+    [0, 1, 2].map(|k| cell_dual(out, len, i + k))
+}
+
 /// The wrench (about the world origin: moment, force) of what hangs on
 /// the end frame: the tip body's inertial and gravity forces and the tip
 /// loads, as forces of the opposite sign.
+#[inline(always)]
 fn tip_wrench(layout: &LinkLayout, frame: &Frame, p: &[f64], gravity: V3) -> (V3, V3) {
     let Frame {
         r,
