@@ -64,7 +64,7 @@ pub enum Study {
 /// One run's row: its figures by name, or its failure. Written into the
 /// run's folder last (`ROW`), so that `--resume` finds the runs that
 /// ended, with the overrides they ran with.
-#[derive(serde::Serialize, serde::Deserialize)]
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct Row {
     status: String,
     wall_s: f64,
@@ -102,16 +102,20 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
     // computed, the others are not started; sweep.csv says which.
     softarm::interrupt::catch();
     let started = Instant::now();
+    let table = Progress::new(dir.file("sweep.csv")?, combos.len());
     let rows: Vec<Row> = pool.install(|| {
         combos
             .par_iter()
             .enumerate()
-            .map(|(i, combo)| run_one(&a, &varies, combo, &out_dir.join(format!("run_{i:04}"))))
+            .map(|(i, combo)| {
+                let row = run_one(&a, &varies, combo, &out_dir.join(format!("run_{i:04}")));
+                table.finished(i, &row, &varies, &combos);
+                row
+            })
             .collect()
     });
     let wall = started.elapsed().as_secs_f64();
-    let csv = sweep_csv(&varies, &combos, &rows);
-    std::fs::write(dir.file("sweep.csv")?, csv).context("cannot write sweep.csv")?;
+    table.write(&varies, &combos, &rows.iter().map(Some).collect::<Vec<_>>())?;
     let figure = a.plot.clone().unwrap_or_else(|| match a.run {
         Study::Modes => "f1_hz".into(),
         _ => "tip_y".into(),
@@ -295,11 +299,49 @@ fn study(
     }
 }
 
+/// `sweep.csv` as runs finish: rewritten whole (atomically, in grid order,
+/// the runs not finished yet `pending`) at most once a second, so that a
+/// sweep killed outright still leaves the table of what it finished.
+struct Progress {
+    path: PathBuf,
+    state: std::sync::Mutex<(Vec<Option<Row>>, Instant)>,
+}
+
+impl Progress {
+    fn new(path: PathBuf, runs: usize) -> Self {
+        let mut rows = Vec::new();
+        rows.resize_with(runs, || None);
+        Self {
+            path,
+            state: std::sync::Mutex::new((rows, Instant::now())),
+        }
+    }
+
+    /// Run `i` finished with `row`.
+    fn finished(&self, i: usize, row: &Row, varies: &[Vary], combos: &[Vec<usize>]) {
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        state.0[i] = Some(row.clone());
+        if state.1.elapsed().as_secs_f64() >= 1.0 {
+            let rows: Vec<Option<&Row>> = state.0.iter().map(Option::as_ref).collect();
+            // A failed snapshot is not the sweep's failure: the last write says.
+            let _ = self.write(varies, combos, &rows);
+            state.1 = Instant::now();
+        }
+    }
+
+    fn write(&self, varies: &[Vary], combos: &[Vec<usize>], rows: &[Option<&Row>]) -> Result<()> {
+        let csv = sweep_csv(varies, combos, rows);
+        eomgen::atomic_write::write_atomic(&self.path, csv.as_bytes())
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+}
+
 /// `sweep.csv`: run, the varied values, status, wall time, then every
-/// figure any run reported (empty where a run has none).
-fn sweep_csv(varies: &[Vary], combos: &[Vec<usize>], rows: &[Row]) -> String {
+/// figure any run reported (empty where a run has none); a run not
+/// finished yet is `pending`.
+fn sweep_csv(varies: &[Vary], combos: &[Vec<usize>], rows: &[Option<&Row>]) -> String {
     let mut names: Vec<String> = Vec::new();
-    for r in rows {
+    for r in rows.iter().flatten() {
         for (n, _) in &r.figures {
             if !names.contains(n) {
                 names.push(n.clone());
@@ -318,7 +360,13 @@ fn sweep_csv(varies: &[Vary], combos: &[Vec<usize>], rows: &[Row]) -> String {
         out.push_str(n);
     }
     out.push('\n');
+    let pending = Row {
+        status: "pending".into(),
+        wall_s: 0.0,
+        figures: Vec::new(),
+    };
     for (i, (combo, r)) in combos.iter().zip(rows).enumerate() {
+        let r = r.unwrap_or(&pending);
         out.push_str(&i.to_string());
         for (v, &k) in varies.iter().zip(combo) {
             out.push(',');

@@ -278,3 +278,75 @@ fn a_resumed_sweep_redoes_only_the_runs_that_did_not_end() {
         "kept"
     );
 }
+
+/// sweep.csv grows as runs finish: a sweep killed outright (SIGKILL, no
+/// chance to write anything) leaves a table in grid order whose finished
+/// runs are `ok` with their figures and the rest `pending`, and `--resume`
+/// completes it keeping those rows.
+#[test]
+fn a_killed_sweep_leaves_the_table_of_what_it_finished() {
+    let dir = tempfile::tempdir().unwrap();
+    let runs = 300;
+    let args = |resume: bool| {
+        let mut a = vec![
+            "sweep".to_string(),
+            "cantilever".into(),
+            "--run".into(),
+            "static".into(),
+            "--vary".into(),
+            format!("tip.mass=lin:0:0.02:{runs}"),
+            "--jobs".into(),
+            "1".into(),
+            "--out".into(),
+            "s".into(),
+        ];
+        if resume {
+            a.push("--resume".into());
+        }
+        a
+    };
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_softarm"))
+        .args(args(false))
+        .current_dir(dir.path())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let table = dir.path().join("s/sweep.csv");
+    let start = std::time::Instant::now();
+    while !table.exists() && start.elapsed() < std::time::Duration::from_secs(60) {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let running = child.try_wait().unwrap().is_none();
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(running, "sweep.csv appeared only when the sweep had ended");
+    let rows = read_csv(&table);
+    assert_eq!(rows.len(), runs + 1, "a row a run and the header");
+    let status = rows[0].iter().position(|h| h == "status").unwrap();
+    let tip_x = rows[0].iter().position(|h| h == "tip_x").unwrap();
+    for (i, r) in rows[1..].iter().enumerate() {
+        assert_eq!(r[0], i.to_string(), "grid order");
+        match r[status].as_str() {
+            "ok" => assert!(r[tip_x].parse::<f64>().is_ok(), "run {i}: {r:?}"),
+            "pending" => assert!(r[tip_x].is_empty(), "run {i}: {r:?}"),
+            other => panic!("run {i}: status {other}"),
+        }
+    }
+    let done: Vec<&Vec<String>> = rows[1..].iter().filter(|r| r[status] == "ok").collect();
+    assert!(
+        !done.is_empty() && done.len() < runs,
+        "{} of {runs} ok",
+        done.len()
+    );
+    let resumed = softarm(
+        &args(true).iter().map(String::as_str).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert!(resumed.status.success(), "{}", stderr(&resumed));
+    let after = read_csv(&table);
+    assert!(after[1..].iter().all(|r| r[status] == "ok"));
+    for r in done {
+        let i: usize = r[0].parse().unwrap();
+        assert_eq!(&after[i + 1], r, "a finished run's row is kept as it was");
+    }
+}
