@@ -78,6 +78,8 @@ pub struct Ldlt {
     /// Per column j, one past the last row whose envelope reaches it: L
     /// is zero from there down.
     end: Vec<usize>,
+    /// Every row starts at column 0: the plain loops.
+    dense: bool,
 }
 
 impl Ldlt {
@@ -89,6 +91,7 @@ impl Ldlt {
             inv_d: vec![0.0; n],
             first: vec![0; n],
             end: vec![0; n],
+            dense: true,
         }
     }
 
@@ -109,10 +112,11 @@ impl Ldlt {
     /// a row (vector instructions; the dot-product form's short dots of
     /// dependent sums took three times as long at 40 coordinates).
     ///
-    /// Only within M's envelope (each row from its first nonzero on),
-    /// where L's nonzeros are: an assembly's M is block diagonal over its
-    /// arms and bodies, and its factorisation costs the blocks' (a dense
-    /// row's first nonzero is found at once).
+    /// A matrix with an envelope (rows that start late: an assembly's M,
+    /// block diagonal over its arms and bodies; eba's, banded) is factored
+    /// within it, where L's nonzeros are, at the cost of its blocks; a
+    /// dense one by the plain loops (their bounds constants: the envelope's
+    /// bounds cost a dense 20-coordinate arm 5 % of its right-hand side).
     #[inline(always)]
     fn factor_with<const FMA: bool>(&mut self, packed: &[f64]) -> bool {
         let n = self.n;
@@ -123,12 +127,32 @@ impl Ldlt {
                 a[i * n + k] = m;
             }
         }
+        // A dense row's first nonzero is found at once.
         for (i, first) in self.first.iter_mut().enumerate() {
             *first = (0..i).find(|&k| a[i * n + k] != 0.0).unwrap_or(i);
         }
         for j in 0..n {
             self.end[j] = 1 + (j..n).rev().find(|&i| self.first[i] <= j).unwrap_or(j);
         }
+        // The envelope's loops where they save a quarter of the work.
+        let (mut within, mut full) = (0, 0);
+        for (j, &end) in self.end.iter().enumerate() {
+            within += (end - j) * (end - j);
+            full += (n - j) * (n - j);
+        }
+        self.dense = 4 * within > 3 * full;
+        match self.dense {
+            true => self.factor_loops::<FMA, true>(),
+            false => self.factor_loops::<FMA, false>(),
+        }
+    }
+
+    /// The factorisation's loops, over each column's rows down to its
+    /// envelope's end (`DENSE`: n).
+    #[inline(always)]
+    fn factor_loops<const FMA: bool, const DENSE: bool>(&mut self) -> bool {
+        let n = self.n;
+        let a = &mut self.l;
         for j in 0..n {
             let d = a[j * n + j];
             if d.is_nan() || d <= 0.0 {
@@ -136,10 +160,11 @@ impl Ldlt {
             }
             let inv = 1.0 / d;
             self.inv_d[j] = inv;
-            for i in j + 1..self.end[j] {
+            let end = if DENSE { n } else { self.end[j] };
+            for i in j + 1..end {
                 self.col[i] = a[i * n + j];
             }
-            for i in j + 1..self.end[j] {
+            for i in j + 1..end {
                 let l = self.col[i] * inv;
                 let row = &mut a[i * n..i * n + i + 1];
                 row[j] = l;
@@ -170,9 +195,18 @@ impl Ldlt {
     #[allow(clippy::needless_range_loop)] // triangular index ranges read clearer
     #[inline(always)]
     fn solve_with<const FMA: bool>(&self, b: &mut [f64]) {
+        match self.dense {
+            true => self.solve_loops::<FMA, true>(b),
+            false => self.solve_loops::<FMA, false>(b),
+        }
+    }
+
+    #[allow(clippy::needless_range_loop)] // triangular index ranges read clearer
+    #[inline(always)]
+    fn solve_loops<const FMA: bool, const DENSE: bool>(&self, b: &mut [f64]) {
         let n = self.n;
         for i in 0..n {
-            let f = self.first[i];
+            let f = if DENSE { 0 } else { self.first[i] };
             b[i] -= dot::<FMA>(&self.l[i * n + f..i * n + i], &b[f..i]);
         }
         for (x, d) in b.iter_mut().zip(&self.inv_d) {
@@ -180,7 +214,8 @@ impl Ldlt {
         }
         for i in (0..n).rev() {
             let mut s = b[i];
-            for k in i + 1..self.end[i] {
+            let end = if DENSE { n } else { self.end[i] };
+            for k in i + 1..end {
                 s -= self.l[k * n + i] * b[k];
             }
             b[i] = s;
