@@ -49,3 +49,30 @@ def test_a_failed_run_is_a_row():
     df = softarm.sweep("soft_finger", {"segment.0.length": [0.12, -1.0]}, run="static", jobs=1)
     assert df["status"][0] == "ok"
     assert df["status"][1].startswith("failed:") and "length" in df["status"][1]
+
+
+def test_an_interrupted_sweep_returns_what_finished(monkeypatch):
+    """Ctrl-C (KeyboardInterrupt in the main thread) after two runs have
+    finished: their rows as an uninterrupted sweep has them, the others
+    `not run`, listed in attrs and warned about."""
+    import concurrent.futures
+
+    real = concurrent.futures.as_completed
+
+    def two_then_ctrl_c(futures, *a, **k):
+        for n, f in enumerate(real(futures, *a, **k)):
+            if n == 2:
+                raise KeyboardInterrupt
+            yield f
+
+    vary = {"tip.mass": [0, 0.005, 0.01, 0.015, 0.02, 0.025]}
+    whole = softarm.sweep("soft_finger", vary, run="static", jobs=1)
+    monkeypatch.setattr(concurrent.futures, "as_completed", two_then_ctrl_c)
+    with pytest.warns(UserWarning, match="4 of 6 runs did not finish"):
+        df = softarm.sweep("soft_finger", vary, run="static", jobs=1)
+    done = [k for k in range(6) if df["status"][k] == "ok"]
+    assert len(done) == 2 and sorted(df.attrs["unfinished"]) == [k for k in range(6) if k not in done]
+    for k in df.attrs["unfinished"]:
+        assert df["status"][k] == "not run: interrupted (Ctrl-C)"
+    for k in done:
+        assert df["tip_x"][k] == whole["tip_x"][k] and df["tip_y"][k] == whole["tip_y"][k]

@@ -18,6 +18,7 @@ from __future__ import annotations
 import json
 import os
 import time
+import warnings
 from typing import Any, Mapping, Optional, Sequence, Union
 
 from . import _softarm
@@ -87,22 +88,27 @@ def sweep(
     (t_end, solver, rtol, ...). With a `dask.distributed.Client` the runs
     are tasks on its cluster; else they run here on `jobs` processes
     (default: every core). A grid of more than 10,000 runs needs
-    `yes=True`."""
+    `yes=True`. Rows come in as runs finish: Ctrl-C (or a lost worker)
+    returns what finished, the other rows `not run: ...` (or `failed:
+    its worker was lost ...`), their indices in `df.attrs["unfinished"]`,
+    with a warning."""
     import pandas as pd
 
     specs = [_spec(p, v) for p, v in vary.items()]
     paths, values, combos = _softarm.sweep_grid(specs, yes)
     base = [f"{k}={v if isinstance(v, str) else json.dumps(v)}" for k, v in (set or {}).items()]
     tasks = [base + [f"{p}={values[i][c[i]]}" for i, p in enumerate(paths)] for c in combos]
-    if client is not None:
-        futures = [client.submit(run_one, model, t, run, options, pure=False) for t in tasks]
-        rows = client.gather(futures)
-    else:
-        from concurrent.futures import ProcessPoolExecutor
-
-        with ProcessPoolExecutor(max_workers=jobs or os.cpu_count()) as pool:
-            rows = list(pool.map(run_one, [model] * len(tasks), tasks, [run] * len(tasks),
-                                 [options] * len(tasks)))
+    rows: list = [None] * len(tasks)
+    stopped = _run_all(model, tasks, run, options, client, jobs, rows)
+    unfinished = [k for k, r in enumerate(rows) if r is None or r.get("lost")]
+    for k in unfinished:
+        if rows[k] is None:
+            rows[k] = {"status": f"not run: {stopped}", "wall_s": float("nan"), "figures": []}
+    if unfinished:
+        warnings.warn(f"softarm.sweep: {len(unfinished)} of {len(tasks)} runs did not finish "
+                      f"({stopped or 'workers lost'}); their rows say why "
+                      "(DataFrame.attrs['unfinished'])",
+                      stacklevel=2)
     names: list = []
     for r in rows:
         for n, _ in r["figures"]:
@@ -119,4 +125,50 @@ def sweep(
         got = dict(r["figures"])
         row.update({n: got.get(n, float("nan")) for n in names})
         table.append(row)
-    return pd.DataFrame(table, columns=["run", *paths, "status", "wall_s", *names])
+    df = pd.DataFrame(table, columns=["run", *paths, "status", "wall_s", *names])
+    df.attrs["unfinished"] = unfinished
+    return df
+
+
+def _lost(e: BaseException) -> dict:
+    """The row of a task that raised instead of returning its row: its
+    worker died or was lost (a run's own failure is a row, never raised)."""
+    return {"status": f"failed: its worker was lost ({type(e).__name__}: {e})",
+            "wall_s": float("nan"), "figures": [], "lost": True}
+
+
+def _run_all(model, tasks, run, options, client, jobs, rows) -> Optional[str]:
+    """Run every task into `rows` as each finishes (a Dask cluster's, or
+    local processes). Ctrl-C stops the sweep: the runs not finished are
+    cancelled and left None, and the reason is returned."""
+    args = [(model, t, run, options) for t in tasks]
+    if client is not None:
+        from distributed import as_completed
+
+        futures = [client.submit(run_one, *a, pure=False) for a in args]
+        index = {f.key: k for k, f in enumerate(futures)}
+        try:
+            for f in as_completed(futures):
+                try:
+                    rows[index[f.key]] = f.result()
+                except Exception as e:  # noqa: BLE001 - the row says what was lost
+                    rows[index[f.key]] = _lost(e)
+        except KeyboardInterrupt:
+            client.cancel([f for f in futures if not f.done()])
+            return "interrupted (Ctrl-C)"
+        return None
+    from concurrent.futures import ProcessPoolExecutor, as_completed as done
+
+    pool = ProcessPoolExecutor(max_workers=jobs or os.cpu_count())
+    try:
+        futures = {pool.submit(run_one, *a): k for k, a in enumerate(args)}
+        for f in done(futures):
+            try:
+                rows[futures[f]] = f.result()
+            except Exception as e:  # noqa: BLE001 - the row says what was lost
+                rows[futures[f]] = _lost(e)
+    except KeyboardInterrupt:
+        pool.shutdown(wait=False, cancel_futures=True)
+        return "interrupted (Ctrl-C)"
+    pool.shutdown()
+    return None
