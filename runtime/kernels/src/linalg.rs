@@ -127,7 +127,11 @@ impl Ldlt {
                 a[i * n + k] = m;
             }
         }
-        // A dense row's first nonzero is found at once.
+        // A corner that is not zero: dense (no envelope to find).
+        if n == 0 || packed[n - 1] != 0.0 {
+            self.dense = true;
+            return self.factor_loops::<FMA, true>();
+        }
         for (i, first) in self.first.iter_mut().enumerate() {
             *first = (0..i).find(|&k| a[i * n + k] != 0.0).unwrap_or(i);
         }
