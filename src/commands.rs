@@ -331,10 +331,11 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         Err(f) => explained(arm, *f),
     };
     let table = softarm::run::Table::of(arm, &traj);
-    write_atomic(&dir.file("trajectory.csv")?, table.csv().as_bytes())?;
+    eomgen::atomic_write::write_atomic_with(&dir.file("trajectory.csv")?, |w| table.write_csv(w))?;
     if let Some(shape) = &shape {
-        let csv = shape.csv(arm, &traj.t, &traj.x);
-        write_atomic(&dir.file("shape.csv")?, csv.as_bytes())?;
+        eomgen::atomic_write::write_atomic_with(&dir.file("shape.csv")?, |w| {
+            shape.write_csv(arm, &traj.t, &traj.x, w)
+        })?;
     }
     plot_paths_and_contact(&loaded, &traj, &mut dir)?;
     let tip_error = match (&measured, &loaded.model.compare) {

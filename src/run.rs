@@ -28,6 +28,10 @@ pub struct RunRequest {
 
 /// The run's options. Errors name the option as the command line spells
 /// it (`--rtol`), which Python's keyword (`rtol`) follows.
+///
+/// The trajectory's rows stay in memory for the figures and the summary:
+/// at most [`MAX_OUTPUT_ROWS`] of them (a 30-coordinate arm's million rows
+/// are about a gigabyte with their outputs).
 pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> {
     let defaults = SimOptions::default();
     let t_end = req.t_end.or(file.t_end).unwrap_or(defaults.t_end);
@@ -70,6 +74,13 @@ pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> 
             "--output-dt {output_dt} s is longer than the run (--t-end {t_end} s): the trajectory would hold its first row only"
         );
     }
+    let rows = (t_end / output_dt).floor() + 1.0;
+    if rows > MAX_OUTPUT_ROWS as f64 {
+        bail!(
+            "--output-dt {output_dt} s over --t-end {t_end} s is {rows:.0} trajectory rows; a run keeps at most {MAX_OUTPUT_ROWS} in memory: take --output-dt {} s or longer, or a shorter --t-end",
+            up_to_two_digits(t_end / (MAX_OUTPUT_ROWS - 1) as f64)
+        );
+    }
     Ok(SimOptions {
         t_end,
         solver,
@@ -80,6 +91,12 @@ pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> 
         max_steps,
         ..defaults
     })
+}
+
+/// x rounded up to two significant digits (a suggestion that holds).
+fn up_to_two_digits(x: f64) -> f64 {
+    let unit = 10f64.powf(x.log10().floor() - 1.0);
+    (x / unit).ceil() * unit
 }
 
 /// The coordinates to start from: `q0`, else the model's (`[simulate]
@@ -207,6 +224,9 @@ pub fn tip_error(
     })
 }
 
+/// The most trajectory rows a run keeps (`--output-dt` against `--t-end`).
+pub const MAX_OUTPUT_ROWS: usize = 1_000_000;
+
 /// A run's table, every column of `trajectory.csv` by name: t, the
 /// coordinates, their rates (`<name>_dot`), the outputs
 /// (`runtime::OUTPUT_NAMES`), the joints' forces and moments, the
@@ -251,19 +271,19 @@ impl Table {
         1 + 2 * dof + runtime::N_OUTPUTS
     }
 
-    /// As `trajectory.csv`: a header of the names, t to 9 decimals, the
-    /// rest to 13 significant digits.
-    pub fn csv(&self) -> String {
-        let mut s = self.names.join(",");
-        s.push('\n');
+    /// `trajectory.csv` streamed to `w`: a header of the names, t to 9
+    /// decimals, the rest to 13 significant digits (no copy of the text in
+    /// memory, which is twice the table's size).
+    pub fn write_csv(&self, w: &mut impl std::io::Write) -> std::io::Result<()> {
+        writeln!(w, "{}", self.names.join(","))?;
         for row in &self.rows {
-            s.push_str(&format!("{:.9}", row[0]));
+            write!(w, "{:.9}", row[0])?;
             for v in &row[1..] {
-                s.push_str(&format!(",{v:.12e}"));
+                write!(w, ",{v:.12e}")?;
             }
-            s.push('\n');
+            writeln!(w)?;
         }
-        s
+        Ok(())
     }
 }
 

@@ -107,20 +107,28 @@ impl Shape {
         rows
     }
 
-    /// `shape.csv` of a trajectory (times `t`, states `x`, q first).
-    pub fn csv(&self, arm: &dyn Dynamics, t: &[f64], x: &[Vec<f64>]) -> String {
+    /// `shape.csv` of a trajectory (times `t`, states `x`, q first),
+    /// streamed to `w` (the text is many times the trajectory's size, a row
+    /// per point: never held in memory).
+    pub fn write_csv(
+        &self,
+        arm: &dyn Dynamics,
+        t: &[f64],
+        x: &[Vec<f64>],
+        w: &mut impl std::io::Write,
+    ) -> std::io::Result<()> {
         let n = arm.dof();
-        let mut s = String::from("t,part,point,s,x,y,z,qw,qx,qy,qz\n");
+        writeln!(w, "t,part,point,s,x,y,z,qw,qx,qy,qz")?;
         for (t, x) in t.iter().zip(x) {
             for r in self.at(arm, *t, &x[..n]) {
-                s.push_str(&format!("{t:.9},{},{},{:.9}", r.part, r.point, r.s));
+                write!(w, "{t:.9},{},{},{:.9}", r.part, r.point, r.s)?;
                 for v in r.pose {
-                    s.push_str(&format!(",{v:.9e}"));
+                    write!(w, ",{v:.9e}")?;
                 }
-                s.push('\n');
+                writeln!(w)?;
             }
         }
-        s
+        Ok(())
     }
 }
 

@@ -185,6 +185,10 @@ fn options_are_checked_against_each_other_before_anything_is_written() {
             vec!["--output-dt", "1", "--t-end", "0.2"],
             "--output-dt 1 s is longer than the run",
         ),
+        (
+            vec!["--output-dt", "1e-6", "--t-end", "1"],
+            "is 1000001 trajectory rows; a run keeps at most 1000000 in memory",
+        ),
     ] {
         let mut all = vec!["simulate", "double_pendulum", "--out", "o"];
         all.extend(&args);
@@ -193,6 +197,45 @@ fn options_are_checked_against_each_other_before_anything_is_written() {
         assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
         assert!(!dir.path().join("o").exists(), "{args:?}: nothing written");
     }
+}
+
+/// Too dense an output is refused before the run with a spacing that
+/// fits, which the check then takes.
+#[test]
+fn too_many_trajectory_rows_are_refused_with_a_spacing_that_fits() {
+    let dir = tempfile::tempdir().unwrap();
+    let t_end = 3.7;
+    let args = |dt: &str| {
+        let t = t_end.to_string();
+        softarm(
+            &[
+                "simulate",
+                "double_pendulum",
+                "--t-end",
+                &t,
+                "--output-dt",
+                dt,
+                "--out",
+                "o",
+            ],
+            dir.path(),
+        )
+    };
+    let refused = args("1e-7");
+    let err = stderr(&refused);
+    assert!(!refused.status.success(), "{err}");
+    let fits: f64 = err
+        .split("take --output-dt ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no spacing suggested: {err}"));
+    let rows = (t_end / fits).floor() as usize + 1;
+    assert!(
+        rows <= softarm::run::MAX_OUTPUT_ROWS && rows > 900_000,
+        "{fits}: {rows} rows"
+    );
+    assert!(!dir.path().join("o").exists(), "nothing written");
 }
 
 #[test]

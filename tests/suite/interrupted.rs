@@ -92,7 +92,7 @@ fn stopped_by_the_wall_clock(seconds: &str) -> (std::process::Output, serde_json
             "simulate",
             "soft_finger",
             "--t-end",
-            "1e6",
+            "9000",
             "--output-dt",
             "0.1",
             "--max-wall",

@@ -79,8 +79,9 @@ pub fn long_run(cwd: &Path, args: &[&str]) -> std::process::Child {
         .args([
             "simulate",
             "soft_finger",
+            // Longer than any test waits, within the rows a run keeps.
             "--t-end",
-            "1e6",
+            "9000",
             "--out",
             "o",
             "--quiet",
