@@ -62,3 +62,32 @@ def test_any_model_wraps_by_naming_its_inputs():
     assert truncated
     with pytest.raises(ValueError, match="no channel"):
         SoftArmEnv(model="finger_free", inputs=["valve"], low=[0.0], high=[1.0])
+
+
+def test_a_step_that_cannot_be_integrated_ends_its_episode():
+    """An action the arm cannot follow (a pressure of 1e15 Pa) ends the
+    episode truncated, with the reason and the count in `info`; the state
+    is the step's start, and the next episode starts as the first."""
+    # rk4's fixed steps leave the finite numbers within a step or two.
+    env = SoftArmEnv(model="finger_free", inputs=["pressure"], low=[0.0], high=[1e15],
+                     control_dt=0.02, max_steps=5, settle_steps=0, solver="rk4")
+    first, _ = env.reset(seed=0)
+    obs, reward, terminated, truncated, info = env.step([1e15])
+    assert truncated and not terminated
+    assert "integration_failed" in info and info["integration_failures"] == 1
+    assert np.array_equal(obs, first) and np.isfinite(reward)
+    again, _ = env.reset(seed=0)
+    assert np.array_equal(again, first)
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_random_actions_never_raise(env_id):
+    """2000 seeded random steps, a new episode whenever one ends: no
+    exception (a step that cannot be integrated ends its episode)."""
+    env = gym.make(env_id)
+    env.reset(seed=1)
+    env.action_space.seed(1)
+    for _ in range(2000):
+        *_, terminated, truncated, _ = env.step(env.action_space.sample())
+        if terminated or truncated:
+            env.reset()

@@ -15,7 +15,10 @@
 
 `SoftArmEnv` wraps any bundled or user model by naming its input
 channels. Each step holds the action over `control_dt` seconds on
-softarm's compiled dynamics (`Model.simulator`).
+softarm's compiled dynamics (`Model.simulator`). A step whose integration
+cannot go on ends its episode (`truncated`, the reason in
+``info["integration_failed"]``, the count in `integration_failures`)
+instead of raising: an agent may try any action in the space.
 """
 
 from __future__ import annotations
@@ -67,16 +70,25 @@ class SoftArmEnv(gym.Env):
         self.settle_steps = int(settle_steps)
         self.target = np.zeros(3)
         self._steps = 0
+        # Steps whose integration could not go on (each ended its episode).
+        self.integration_failures = 0
 
     def _observation(self) -> np.ndarray:
         return np.concatenate([self.sim.state, self.sim.tip, self.target])
 
     def _draw_target(self) -> np.ndarray:
-        """A tip the arm reaches: hold a random action from the start."""
-        a = self.np_random.uniform(self.action_space.low, self.action_space.high)
+        """A tip the arm reaches: hold a random action from the start
+        (another one where the integration of one cannot go on)."""
+        for _ in range(10):
+            a = self.np_random.uniform(self.action_space.low, self.action_space.high)
+            self.sim.reset()
+            try:
+                for _ in range(self.settle_steps):
+                    self.sim.step(a)
+                return self.sim.tip.copy()
+            except softarm.IntegrationError:
+                self.integration_failures += 1
         self.sim.reset()
-        for _ in range(self.settle_steps):
-            self.sim.step(a)
         return self.sim.tip.copy()
 
     def target_at(self, step: int) -> np.ndarray:
@@ -93,7 +105,16 @@ class SoftArmEnv(gym.Env):
     def step(self, action):
         a = np.clip(np.asarray(action, dtype=np.float64), self.action_space.low,
                     self.action_space.high)
-        self.sim.step(a)
+        try:
+            self.sim.step(a)
+        except softarm.IntegrationError as e:
+            # The episode ends where the integration cannot go on (the state
+            # stays the step's start); the reason is in `info`.
+            self.integration_failures += 1
+            distance = float(np.linalg.norm(self.sim.tip - self.target))
+            return self._observation(), -distance, False, True, {
+                "distance": distance, "integration_failed": str(e),
+                "integration_failures": self.integration_failures}
         self._steps += 1
         self.target = self.target_at(self._steps)
         distance = float(np.linalg.norm(self.sim.tip - self.target))
