@@ -40,6 +40,10 @@ struct KernelEmitter<'a> {
     /// Outputs from this index on go to a second array, `out2` (one tape
     /// for two kernels: `emit_accel`).
     split: Option<usize>,
+    /// Written over `S: runtime::scalar::Scalar` (`emit_generic`): the
+    /// slots that move with q, qd or aux are `S`, the rest `f64`.
+    generic: bool,
+    moving: Vec<bool>,
 }
 
 impl<'a> KernelEmitter<'a> {
@@ -86,7 +90,31 @@ impl<'a> KernelEmitter<'a> {
             n_spill,
             lanes: false,
             split: None,
+            generic: false,
+            moving: Vec::new(),
         }
+    }
+
+    /// The emitter of `emit_generic`: one chunk, no spills.
+    fn new_generic(tape: &'a Tape) -> Self {
+        let mut moving = vec![false; tape.ops.len()];
+        for (i, op) in tape.ops.iter().enumerate() {
+            moving[i] = match op {
+                Op::Q(_) | Op::Qd(_) | Op::Aux(_) => true,
+                _ => op.operands().any(|a| moving[a as usize]),
+            };
+        }
+        Self {
+            generic: true,
+            moving,
+            ..Self::new(tape)
+        }
+    }
+
+    /// Whether `emit_generic` can write this tape: one chunk, so that no
+    /// value crosses an `f64` workspace.
+    fn fits_generic(tape: &Tape) -> bool {
+        KernelEmitter::new(tape).n_chunks() <= 1
     }
 
     /// The emitter of `emit_lanes`.
@@ -158,6 +186,9 @@ impl<'a> KernelEmitter<'a> {
 
     fn expr(&self, op: &Op, c: usize) -> TokenStream {
         let r = |s: Slot| self.read(s, c);
+        if self.generic && op.operands().any(|a| self.moving[a as usize]) {
+            return self.expr_moving(op, c);
+        }
         if self.lanes {
             // One instruction per operation, each lane the scalar one.
             match *op {
@@ -264,6 +295,95 @@ impl<'a> KernelEmitter<'a> {
         }
     }
 
+    /// An operation with a moving operand in a generic kernel: the moving
+    /// operand first where the operation commutes, `sub_from` and
+    /// `div_into` where it does not, constants lifted into fused and power
+    /// operations. The `f64` instance is the plain kernel's code.
+    fn expr_moving(&self, op: &Op, c: usize) -> TokenStream {
+        let m = |s: Slot| self.moving[s as usize];
+        let r = |s: Slot| self.read(s, c);
+        let lift = |s: Slot| match m(s) {
+            true => r(s),
+            false => {
+                let v = r(s);
+                quote!(S::c(#v))
+            }
+        };
+        let commuted = |a: Slot, b: Slot| match m(a) {
+            true => (r(a), r(b)),
+            false => (r(b), r(a)),
+        };
+        match *op {
+            Op::Add(a, b) => {
+                let (a, b) = commuted(a, b);
+                quote!(#a + #b)
+            }
+            Op::Mul(a, b) => {
+                let (a, b) = commuted(a, b);
+                quote!(#a * #b)
+            }
+            Op::Sub(a, b) if !m(a) => {
+                let (a, b) = (r(a), r(b));
+                quote!(#b.sub_from(#a))
+            }
+            Op::Div(a, b) if !m(a) => {
+                let (a, b) = (r(a), r(b));
+                quote!(#b.div_into(#a))
+            }
+            Op::Sub(a, b) => {
+                let (a, b) = (r(a), r(b));
+                quote!(#a - #b)
+            }
+            Op::Div(a, b) => {
+                let (a, b) = (r(a), r(b));
+                quote!(#a / #b)
+            }
+            Op::MulAdd(a, b, c) => {
+                let (a, b, c) = (lift(a), lift(b), lift(c));
+                quote!(#a.mul_add(#b, #c))
+            }
+            Op::MulSub(a, b, c) => {
+                let (a, b, c) = (lift(a), lift(b), lift(c));
+                quote!(#a.mul_add(#b, -#c))
+            }
+            Op::NegMulAdd(a, b, c) => {
+                let (a, b, c) = (lift(a), lift(b), lift(c));
+                quote!((-#a).mul_add(#b, #c))
+            }
+            Op::Powf(a, b) => {
+                let (a, b) = (lift(a), lift(b));
+                quote!(#a.powf(#b))
+            }
+            Op::Neg(a) => {
+                let a = r(a);
+                quote!(-#a)
+            }
+            Op::Powi(a, n) => {
+                let a = r(a);
+                quote!(#a.powi(#n))
+            }
+            _ => {
+                let a = r(op.operands().next().expect("a unary operation"));
+                let method = match *op {
+                    Op::Sqrt(_) => quote!(sqrt()),
+                    Op::Sin(_) => quote!(sin()),
+                    Op::Cos(_) => quote!(cos()),
+                    Op::Tan(_) => quote!(tan()),
+                    Op::Exp(_) => quote!(exp()),
+                    Op::Ln(_) => quote!(ln()),
+                    Op::Abs(_) => quote!(abs()),
+                    Op::Sign(_) => quote!(sign()),
+                    Op::Sinc(k, _) => quote!(sinc(#k)),
+                    Op::Cosc(k, _) => quote!(cosc(#k)),
+                    Op::SincRem(k, _) => quote!(sinc_rem(#k)),
+                    Op::Rodrigues(j, n, _) => quote!(rodrigues(#j, #n)),
+                    _ => unreachable!("every operation with operands is above"),
+                };
+                quote!(#a.#method)
+            }
+        }
+    }
+
     fn intrinsic(&self, f: TokenStream, args: &[TokenStream]) -> TokenStream {
         quote!(#f(#(#args),*))
     }
@@ -331,8 +451,12 @@ impl<'a> KernelEmitter<'a> {
                     if members.iter().map(|m| m.1).min() != Some(i) {
                         continue;
                     }
+                    let generic = self.generic && self.moving[a as usize];
                     let a = self.read(a, c);
-                    body.push(family.call(members, a, self.lanes));
+                    body.push(match generic {
+                        true => family.call_generic(members, a),
+                        false => family.call(members, a, self.lanes),
+                    });
                     members.iter().map(|m| m.1).collect()
                 }
                 None => {
@@ -369,6 +493,8 @@ impl<'a> KernelEmitter<'a> {
                 };
                 body.push(if self.lanes {
                     quote!(out[#k] = runtime::lanes::to_array(#val);)
+                } else if self.generic && !self.moving[s as usize] {
+                    quote!(out[#k] = S::c(#val);)
                 } else {
                     match self.split {
                         Some(first) if k >= first => {
@@ -420,9 +546,9 @@ impl<'a> KernelEmitter<'a> {
         inline: bool,
     ) -> (Vec<TokenStream>, Vec<Ident>) {
         assert!(self.aux_len() <= n_aux, "{name} reads past its aux input");
-        let aux_param = match self.aux_len() {
-            0 => quote!(),
-            _ => quote!(aux: &[f64; #n_aux],),
+        let (aux_param, aux_generic) = match self.aux_len() {
+            0 => (quote!(), quote!()),
+            _ => (quote!(aux: &[f64; #n_aux],), quote!(aux: &[S; #n_aux],)),
         };
         let n_all = self.tape.outputs.len();
         let (n_out, out2) = match self.split {
@@ -448,13 +574,23 @@ impl<'a> KernelEmitter<'a> {
         for c in 0..n_chunks {
             let body = self.chunk_body(c, n_chunks, &groups, &group_of);
             let f = format_ident!("{}_{}", name, c);
-            chunks.push(quote! {
-                #attributes
-                #[allow(unused_variables, clippy::all)]
-                fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir],
-                      p: &[f64; #n_params], #aux_param w: &mut [f64; #n_spill], out: &mut [f64; #n_out] #out2) {
-                    #(#body)*
-                }
+            chunks.push(match self.generic {
+                true => quote! {
+                    #attributes
+                    #[allow(unused_variables, clippy::all)]
+                    fn #f<S: runtime::scalar::Scalar>(t: f64, q: &[S; #dof], qd: &[S; #dof], qdd: &[f64; #dof],
+                          dir: &[f64; #n_dir], p: &[f64; #n_params], #aux_generic out: &mut [S; #n_out]) {
+                        #(#body)*
+                    }
+                },
+                false => quote! {
+                    #attributes
+                    #[allow(unused_variables, clippy::all)]
+                    fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir],
+                          p: &[f64; #n_params], #aux_param w: &mut [f64; #n_spill], out: &mut [f64; #n_out] #out2) {
+                        #(#body)*
+                    }
+                },
             });
             names.push(f);
         }
@@ -494,6 +630,68 @@ impl<'a> KernelEmitter<'a> {
                 use std::arch::x86_64::*;
                 #(#body)*
             }
+        }
+    }
+
+    /// A kernel written once over `S: runtime::scalar::Scalar` (its chunk
+    /// `name_0`) and its `f64` entry `name`; with `tangent` (for a tape
+    /// without `aux`) also `name_tangent`, its outputs and then their derivatives along (dq,
+    /// dqd) = `dir`, in dual numbers: what a symbolic tangent tape
+    /// (`tmt::cell_outputs::with_tangent`) gives, from the same source.
+    fn emit_generic(
+        &self,
+        name: &str,
+        dof: usize,
+        n_params: usize,
+        n_aux: usize,
+        tangent: bool,
+    ) -> TokenStream {
+        assert!(
+            self.generic && self.n_spill == 0 && self.n_chunks() <= 1,
+            "a generic kernel is one chunk"
+        );
+        let (chunks, names) = self.chunks(name, dof, n_params, n_aux, false);
+        let chunk = &names[0];
+        let n_out = self.tape.outputs.len();
+        let n_dir = 2 * dof;
+        let (aux_param, aux_arg) = match self.aux_len() {
+            0 => (quote!(), quote!()),
+            _ => (quote!(aux: &[f64; #n_aux],), quote!(aux,)),
+        };
+        let f = Ident::new(name, Span::call_site());
+        let doc = format!(
+            " Kernel `{name}`: {} operations, over f64 or dual numbers.",
+            self.tape.op_count()
+        );
+        let tangent = match self.aux_len() {
+            0 if tangent => {
+                let ft = format_ident!("{}_tangent", name);
+                let n2 = 2 * n_out;
+                let doc = format!(" `{name}` and its derivatives along `dir`, in dual numbers.");
+                quote! {
+                    #[doc = #doc]
+                    pub fn #ft(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n2]) {
+                        runtime::cpu::require_fma();
+                        let x = runtime::dual::seed(q, &dir[..#dof]);
+                        let xd = runtime::dual::seed(qd, &dir[#dof..]);
+                        let mut o = [runtime::dual::Dual::ZERO; #n_out];
+                        // SAFETY: `require_fma` has checked that the processor has FMA.
+                        unsafe { #chunk::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o) };
+                        runtime::dual::split(&o, out);
+                    }
+                }
+            }
+            _ => quote!(),
+        };
+        quote! {
+            #[doc = #doc]
+            pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], #aux_param out: &mut [f64; #n_out]) {
+                runtime::cpu::require_fma();
+                // SAFETY: `require_fma` has checked that the processor has FMA.
+                unsafe { #chunk::<f64>(t, q, qd, qdd, dir, p, #aux_arg out) };
+            }
+            #tangent
+            #(#chunks)*
         }
     }
 
@@ -556,6 +754,25 @@ fn with_workspace(n_spill: usize, calls: TokenStream) -> TokenStream {
             #calls
         });
     }
+}
+
+/// Kernel `name` and `name_tangent`, its outputs and their derivatives
+/// along `dir` (the symbolic `tangent` tape's outputs): written once over
+/// `runtime::scalar::Scalar` and run on dual numbers for the tangent where
+/// the kernel is one chunk, else both tapes as plain kernels.
+fn with_tangent(
+    tape: &Tape,
+    tangent: &Tape,
+    name: &str,
+    dof: usize,
+    n_params: usize,
+) -> TokenStream {
+    if KernelEmitter::fits_generic(tape) {
+        return KernelEmitter::new_generic(tape).emit_generic(name, dof, n_params, 0, true);
+    }
+    let plain = KernelEmitter::new(tape).emit(name, dof, n_params, 0);
+    let tangent = KernelEmitter::new(tangent).emit(&format!("{name}_tangent"), dof, n_params, 0);
+    quote!(#plain #tangent)
 }
 
 /// A cell as others link it (`runtime::links::CompiledCell`): its kernels
@@ -658,11 +875,10 @@ fn emit_cells(links: &runtime::links::LinkKernels) -> EmittedCells {
         let name_p = format!("cell_{c}_pose");
         defs.push(KernelEmitter::new(pose).emit(&name_p, n, CELL_PARAMS, 0));
         let fp = Ident::new(&name_p, Span::call_site());
-        defs.push(KernelEmitter::new(tape).emit(&name, n, CELL_PARAMS, 0));
+        defs.push(with_tangent(tape, tangent, &name, n, CELL_PARAMS));
         if links.mass_bias {
             defs.push(KernelEmitter::new_lanes(tape).emit(&name4, n, CELL_PARAMS, 0));
         }
-        defs.push(KernelEmitter::new(tangent).emit(&name_t, n, CELL_PARAMS, 0));
         let (f, f4, ft) = (
             Ident::new(&name, Span::call_site()),
             Ident::new(&name4, Span::call_site()),
@@ -725,8 +941,7 @@ fn emit_link_globals(
     let n_dir = 2 * dof;
     let (forces, forces_tangent) = match (&links.forces, &links.forces_tangent) {
         (Some(tape), Some(tangent)) => {
-            defs.push(KernelEmitter::new(tape).emit("link_forces", dof, n_params, 0));
-            defs.push(KernelEmitter::new(tangent).emit("link_forces_tangent", dof, n_params, 0));
+            defs.push(with_tangent(tape, tangent, "link_forces", dof, n_params));
             (
                 quote! {
                     link_forces(0.0, self.q, self.qd, &[0.0; #dof], &[0.0; #n_dir], self.p,
@@ -969,8 +1184,7 @@ fn emit_parts(
             .expect("every part kernel is used");
         let (m, np) = (spec.coords.len(), spec.params.len());
         let (name, name_t) = (format!("part_{k}"), format!("part_{k}_tangent"));
-        defs.push(KernelEmitter::new(tape).emit(&name, m, np, 0));
-        defs.push(KernelEmitter::new(tangent).emit(&name_t, m, np, 0));
+        defs.push(with_tangent(tape, tangent, &name, m, np));
         let (f, ft) = (
             Ident::new(&name, Span::call_site()),
             Ident::new(&name_t, Span::call_site()),
@@ -1092,6 +1306,50 @@ fn family_of(op: &Op) -> Option<(Family, Member, Slot)> {
 }
 
 impl Family {
+    /// `call` in a generic kernel, at a moving argument: the members as
+    /// `S`, from the `Scalar` methods.
+    fn call_generic(self, members: &[(Member, usize)], a: TokenStream) -> TokenStream {
+        let n = members
+            .iter()
+            .map(|m| usize::from(m.0.1))
+            .max()
+            .unwrap_or(0)
+            + 1;
+        if self == Family::Rodrigues {
+            let lets = members.iter().map(|&((j, k), i)| {
+                let (j, k) = (usize::from(j), usize::from(k));
+                let v = format_ident!("v{}", i);
+                quote!(let #v: S = c[#j][#k];)
+            });
+            return quote! {
+                let c: [[S; #n]; runtime::rodrigues::FAMILY_J] = #a.rodrigues_family::<#n>();
+                #(#lets)*
+            };
+        }
+        let names = Self::names(members, n);
+        let f = match self {
+            Family::SinCos => return quote!(let (#(#names),*): (S, S) = #a.sin_cos();),
+            Family::Sinc => quote!(sinc_orders),
+            Family::Cosc => quote!(cosc_orders),
+            Family::SincRem => quote!(sinc_rem_orders),
+            Family::Rodrigues => unreachable!("handled above"),
+        };
+        quote!(let [#(#names),*]: [S; #n] = #a.#f::<#n>();)
+    }
+
+    /// The binding of each order below `n`: its member's value, or `_`.
+    fn names(members: &[(Member, usize)], n: usize) -> Vec<TokenStream> {
+        (0..n)
+            .map(|k| match members.iter().find(|m| usize::from(m.0.1) == k) {
+                Some(&(_, i)) => {
+                    let v = format_ident!("v{}", i);
+                    quote!(#v)
+                }
+                None => quote!(_),
+            })
+            .collect()
+    }
+
     /// `let` binding the members (member, op index) from one call at `a`.
     fn call(self, members: &[(Member, usize)], a: TokenStream, lanes: bool) -> TokenStream {
         let ty = if lanes { quote!(__m256d) } else { quote!(f64) };
@@ -1117,15 +1375,7 @@ impl Family {
                 #(#lets)*
             };
         }
-        let names: Vec<TokenStream> = (0..n)
-            .map(|k| match members.iter().find(|m| usize::from(m.0.1) == k) {
-                Some(&(_, i)) => {
-                    let v = format_ident!("v{}", i);
-                    quote!(#v)
-                }
-                None => quote!(_),
-            })
-            .collect();
+        let names = Self::names(members, n);
         let f = match self {
             Family::SinCos if lanes => {
                 return quote!(let (#(#names),*): (#ty, #ty) = runtime::lanes::sin_cos(#a););
@@ -1148,7 +1398,7 @@ impl Family {
 
 /// The `contact_jacobian` kernel: one kernel per group of points, and the
 /// function that runs the groups `dir` selects (all of them when `all`).
-fn emit_groups(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream {
+fn emit_groups(tapes: &TapeSet, dof: usize, n_params: usize, generic: bool) -> TokenStream {
     let info = &tapes.info;
     let n_dir = 2 * dof;
     let width = 6 + 3 * dof;
@@ -1163,8 +1413,14 @@ fn emit_groups(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream {
     let groups = info.contact_group_ranges();
     for (g, ((first, len), tape)) in groups.zip(&tapes.contact_jacobian).enumerate() {
         let name = format!("contact_jacobian_{g}");
-        let emitter = KernelEmitter::new(tape);
-        kernels.push(emitter.emit(&name, dof, n_params, n_aux));
+        let emitter = match generic {
+            true => KernelEmitter::new_generic(tape),
+            false => KernelEmitter::new(tape),
+        };
+        kernels.push(match generic {
+            true => emitter.emit_generic(&name, dof, n_params, n_aux, false),
+            false => emitter.emit(&name, dof, n_params, n_aux),
+        });
         let f = Ident::new(&name, Span::call_site());
         let (a, b) = (first * width, (first + len) * width);
         let aux_arg = match emitter.aux_len() {
@@ -1189,6 +1445,60 @@ fn emit_groups(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream {
             #(#calls)*
         }
         #(#kernels)*
+    }
+}
+
+/// The `contact_jvp` kernel from the generic `contact` and
+/// `contact_jacobian` groups run on dual numbers moving along dq (the
+/// first n of `dir`): each point's dv and d(dp/dq), the tails of its
+/// group's rows; the contact frames' derivatives come from `contact`.
+fn emit_contact_jvp(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream {
+    let info = &tapes.info;
+    let n_dir = 2 * dof;
+    let width = 6 + 3 * dof;
+    let tail = 3 + 3 * dof;
+    let n_out = info.contact_points * tail;
+    let n_aux = info.contact_frames;
+    let frames = match n_aux {
+        0 => quote!(),
+        _ => {
+            let n_contact = 3 * info.contact_points + n_aux;
+            let first = 3 * info.contact_points;
+            quote! {
+                let mut c = [runtime::dual::Dual::ZERO; #n_contact];
+                // SAFETY: `require_fma` has checked that the processor has FMA.
+                unsafe { contact_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut c) };
+                let aux: &[runtime::dual::Dual; #n_aux] = c[#first..].try_into().expect("frames length");
+            }
+        }
+    };
+    let groups = info.contact_group_ranges().zip(&tapes.contact_jacobian);
+    let calls = groups.enumerate().map(|(g, ((first, len), tape))| {
+        let f = format_ident!("contact_jacobian_{}_0", g);
+        let n = len * width;
+        let (a, b) = (first * tail, (first + len) * tail);
+        let aux = match KernelEmitter::new(tape).aux_len() {
+            0 => quote!(),
+            _ => quote!(aux,),
+        };
+        quote! {
+            let mut o = [runtime::dual::Dual::ZERO; #n];
+            // SAFETY: `require_fma` has checked that the processor has FMA.
+            unsafe { #f::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, #aux &mut o) };
+            runtime::dual::row_tails(&o, #width, &mut out[#a..#b]);
+        }
+    });
+    quote! {
+        /// Kernel `contact_jvp`: the contact groups on dual numbers along dq.
+        #[allow(unused_variables)]
+        pub fn contact_jvp(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir],
+                           p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+            runtime::cpu::require_fma();
+            let x = runtime::dual::seed(q, &dir[..#dof]);
+            let xd = qd.map(runtime::dual::Dual::constant);
+            #frames
+            #(#calls)*
+        }
     }
 }
 
@@ -1243,6 +1553,12 @@ fn emit_kernels(
 ) -> (Vec<TokenStream>, Vec<TokenStream>) {
     let mut kernels = Vec::new();
     let mut arms = Vec::new();
+    let generic_contact = tapes.info.contact_points > 0
+        && KernelEmitter::fits_generic(&tapes.contact)
+        && tapes
+            .contact_jacobian
+            .iter()
+            .all(KernelEmitter::fits_generic);
     for kind in KernelKind::ALL {
         let name = kind.name();
         let by_parts = tapes.parts.is_some()
@@ -1266,7 +1582,16 @@ fn emit_kernels(
             }
             // Emitted with `Accel`, on the same code.
             (_, KernelKind::MassBias) if tapes.info.accel => {}
-            (_, KernelKind::ContactJacobian) => kernels.push(emit_groups(tapes, dof, n_params)),
+            (_, KernelKind::ContactJacobian) => {
+                kernels.push(emit_groups(tapes, dof, n_params, generic_contact))
+            }
+            (_, KernelKind::Contact) if generic_contact => kernels.push(
+                KernelEmitter::new_generic(&tapes.contact)
+                    .emit_generic(name, dof, n_params, n_aux, false),
+            ),
+            (_, KernelKind::ContactJvp) if generic_contact => {
+                kernels.push(emit_contact_jvp(tapes, dof, n_params))
+            }
             _ => {
                 let tape = &tapes.tapes(kind)[0];
                 kernels.push(KernelEmitter::new(tape).emit(name, dof, n_params, n_aux))

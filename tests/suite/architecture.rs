@@ -43,6 +43,8 @@ const LAYERS: &[(&str, &[&str])] = &[
             "cpu",
             "special",
             "rodrigues",
+            "dual",
+            "scalar",
             "output",
             "rotation",
             "obstacle",

@@ -10,6 +10,7 @@
 //! knows nothing of the CAS.
 
 pub mod cpu;
+pub mod dual;
 pub mod kernels;
 pub mod lanes;
 pub mod linalg;
@@ -21,6 +22,7 @@ pub mod parts;
 pub mod rodrigues;
 pub mod rotation;
 pub mod rows;
+pub mod scalar;
 pub mod solver;
 pub mod special;
 pub mod tape;

@@ -14,69 +14,8 @@
 //! an unrolled Jacobian of the whole arm (which grew with arm length times
 //! coordinates).
 
-use std::ops::{Add, Mul, Neg, Sub};
-
 use super::{Cells, LinkLayout, MAX_LINK_DOF, cell, local};
-
-/// A value and its directional derivative.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Dual {
-    pub v: f64,
-    pub d: f64,
-}
-
-impl Dual {
-    const ZERO: Dual = Dual { v: 0.0, d: 0.0 };
-
-    /// A number that does not move along the direction.
-    fn constant(v: f64) -> Self {
-        Dual { v, d: 0.0 }
-    }
-}
-
-impl Add for Dual {
-    type Output = Dual;
-    #[inline(always)]
-    fn add(self, b: Dual) -> Dual {
-        Dual {
-            v: self.v + b.v,
-            d: self.d + b.d,
-        }
-    }
-}
-
-impl Sub for Dual {
-    type Output = Dual;
-    #[inline(always)]
-    fn sub(self, b: Dual) -> Dual {
-        Dual {
-            v: self.v - b.v,
-            d: self.d - b.d,
-        }
-    }
-}
-
-impl Mul for Dual {
-    type Output = Dual;
-    #[inline(always)]
-    fn mul(self, b: Dual) -> Dual {
-        Dual {
-            v: self.v * b.v,
-            d: self.d.mul_add(b.v, self.v * b.d),
-        }
-    }
-}
-
-impl Neg for Dual {
-    type Output = Dual;
-    #[inline(always)]
-    fn neg(self) -> Dual {
-        Dual {
-            v: -self.v,
-            d: -self.d,
-        }
-    }
-}
+use crate::dual::Dual;
 
 type V3 = [Dual; 3];
 type M3 = [[Dual; 3]; 3];
