@@ -18,6 +18,10 @@
 //! `Contact` kernel alone (the points' positions); `straight:MODEL` the
 //! right-hand side at q = qd = 0 instead of the default state;
 //! `forces:MODEL` the contact forces alone (`generalised_force_at`);
+//! `jac:MODEL` the inverse dynamics' Jacobian (`Dynamics::jacobian_parts`,
+//! 2n `Jvp` directions: what an implicit step factors);
+//! `contactjac:MODEL` the contact forces' Jacobian (the `ContactJvp`
+//! kernel's columns with the forces);
 //! `Q=q0,q1,...` (env) times every model at that configuration, at rest;
 //! `recursion:tentacle3d` the numeric element-by-element
 //! recursion of tests/suite/common/pcc3d.rs.
@@ -49,6 +53,10 @@ enum What {
     Forces,
     /// `recursion:`: tests/suite/common/pcc3d.rs's numeric recursion.
     Recursion,
+    /// `jac:`: d tau/dq and d tau/dqd.
+    Jacobian,
+    /// `contactjac:`: the contact forces' Jacobian.
+    ContactJacobian,
 }
 
 /// A name's prefixes (any number, e.g. `rhs:straight:cantilever`): what
@@ -57,6 +65,8 @@ enum What {
 fn parse(name: &str) -> (What, bool, bool, &str) {
     let prefixes = [
         ("recursion:", What::Recursion),
+        ("jac:", What::Jacobian),
+        ("contactjac:", What::ContactJacobian),
         ("rhs:", What::Rhs),
         ("free:", What::Free),
         ("joints:", What::Joints),
@@ -74,6 +84,8 @@ fn parse(name: &str) -> (What, bool, bool, &str) {
     }
     // When several are asked, the first of this order is timed.
     let order = [
+        What::Jacobian,
+        What::ContactJacobian,
         What::Forces,
         What::Rhs,
         What::Joints,
@@ -141,6 +153,28 @@ fn timed(name: &str) -> Box<dyn FnMut()> {
                     &mut qc,
                 );
                 black_box(&qc);
+            })
+        }
+        What::Jacobian => {
+            let qdd = vec![0.1; dof];
+            let mut parts = vec![0.0; 2 * dof * dof];
+            Box::new(move || {
+                l.arm
+                    .jacobian_parts(0.0, black_box(&q), black_box(&qd), &qdd, &mut parts);
+                black_box(&parts);
+            })
+        }
+        What::ContactJacobian => {
+            let mut jac = vec![0.0; 2 * dof * dof];
+            Box::new(move || {
+                runtime::contact::subtract_from_jacobian(
+                    &*l.arm,
+                    0.0,
+                    black_box(&q),
+                    black_box(&qd),
+                    &mut jac,
+                );
+                black_box(&jac);
             })
         }
         What::Rhs => {

@@ -176,7 +176,7 @@ pub const PARAMETERS: &[&str] = &[
     "body[0].angle",
 ];
 /// Derived parameters, computed once per parameter set.
-pub const DERIVED: usize = 537;
+pub const DERIVED: usize = 617;
 /// Whether the mass solve is generated (the `accel` kernel).
 pub const ACCEL: bool = false;
 /// Base parameters that are loads (scaled by load continuation).
@@ -226,7 +226,7 @@ impl Kernels for Compiled {
     fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
         let q: &[f64; 23] = inp.q.try_into().expect("q has DOF entries");
         let qd: &[f64; 23] = inp.qd.try_into().expect("qd has DOF entries");
-        let p: &[f64; 680] = inp.p.try_into().expect("parameter vector length");
+        let p: &[f64; 760] = inp.p.try_into().expect("parameter vector length");
         let no_qdd = [0.0f64; 23];
         let qdd: &[f64; 23] = if inp.qdd.is_empty() {
             &no_qdd
@@ -335,7 +335,7 @@ pub fn accel(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
@@ -351,7 +351,7 @@ fn accel_0(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     w: &mut [f64; 0],
     out: &mut [f64; 0],
 ) {}
@@ -363,7 +363,7 @@ pub fn outputs(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     out: &mut [f64; 9],
 ) {
     runtime::cpu::require_fma();
@@ -379,7 +379,7 @@ fn outputs_0(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     w: &mut [f64; 0],
     out: &mut [f64; 9],
 ) {
@@ -1884,7 +1884,7 @@ pub fn constraints(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     out: &mut [f64; 0],
 ) {
     runtime::cpu::require_fma();
@@ -1900,6860 +1900,16 @@ fn constraints_0(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     w: &mut [f64; 0],
     out: &mut [f64; 0],
 ) {}
-/// Kernel `contact`: 428 operations, over f64 or dual numbers.
-pub fn contact(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 63],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 63],
-) {
-    let v3 = q[0] * 0.5f64;
-    let (v6, v4): (S, S) = v3.sin_cos();
-    let v8 = v6 * p[335];
-    let v9 = v4.mul_add(S::c(p[334]), -v8);
-    let v11 = v3.sinc(0u8);
-    let v12 = v11 * p[10];
-    let v13 = v9.mul_add(v12, S::c(p[6]));
-    let v15 = v4 * p[335];
-    let v16 = v6.mul_add(S::c(p[334]), v15);
-    let v17 = v16.mul_add(v12, S::c(p[7]));
-    let v21 = v6 * p[154];
-    let v22 = S::c(p[155]).mul_add(v4, -v21);
-    let v23 = v12.mul_add(v22, S::c(p[6]));
-    let v25 = q[1] * 0.5f64;
-    let (v31, v26): (S, S) = v25.sin_cos();
-    let v27 = v6 * p[155];
-    let v28 = S::c(p[154]).mul_add(v4, v27);
-    let v29 = v28 * v6;
-    let v30 = v22.mul_add(v4, -v29);
-    let v32 = v22 * v6;
-    let v33 = v28.mul_add(v4, v32);
-    let v34 = v31 * v33;
-    let v35 = v26.mul_add(v30, -v34);
-    let v37 = v25.sinc(0u8);
-    let v38 = v37 * p[16];
-    let v39 = v35.mul_add(v38, v23);
-    let v40 = v12.mul_add(v28, S::c(p[7]));
-    let v41 = v26 * v33;
-    let v42 = v31.mul_add(v30, v41);
-    let v43 = v42.mul_add(v38, v40);
-    let v45 = q[2] * 0.5f64;
-    let (v49, v46): (S, S) = v45.sin_cos();
-    let v47 = v42 * v31;
-    let v48 = v35.mul_add(v26, -v47);
-    let v50 = v35 * v31;
-    let v51 = v42.mul_add(v26, v50);
-    let v52 = v49 * v51;
-    let v53 = v46.mul_add(v48, -v52);
-    let v55 = v45.sinc(0u8);
-    let v56 = v55 * p[22];
-    let v57 = v53.mul_add(v56, v39);
-    let v58 = v46 * v51;
-    let v59 = v49.mul_add(v48, v58);
-    let v60 = v59.mul_add(v56, v43);
-    let v62 = q[3] * 0.5f64;
-    let (v66, v63): (S, S) = v62.sin_cos();
-    let v64 = v59 * v49;
-    let v65 = v53.mul_add(v46, -v64);
-    let v67 = v53 * v49;
-    let v68 = v59.mul_add(v46, v67);
-    let v69 = v66 * v68;
-    let v70 = v63.mul_add(v65, -v69);
-    let v72 = v62.sinc(0u8);
-    let v73 = v72 * p[28];
-    let v74 = v70.mul_add(v73, v57);
-    let v75 = v63 * v68;
-    let v76 = v66.mul_add(v65, v75);
-    let v77 = v76.mul_add(v73, v60);
-    let v79 = q[4] * 0.5f64;
-    let (v83, v80): (S, S) = v79.sin_cos();
-    let v81 = v76 * v66;
-    let v82 = v70.mul_add(v63, -v81);
-    let v84 = v70 * v66;
-    let v85 = v76.mul_add(v63, v84);
-    let v86 = v83 * v85;
-    let v87 = v80.mul_add(v82, -v86);
-    let v89 = v79.sinc(0u8);
-    let v90 = v89 * p[34];
-    let v91 = v87.mul_add(v90, v74);
-    let v92 = v80 * v85;
-    let v93 = v83.mul_add(v82, v92);
-    let v94 = v93.mul_add(v90, v77);
-    let v96 = q[5] * 0.5f64;
-    let (v100, v97): (S, S) = v96.sin_cos();
-    let v98 = v93 * v83;
-    let v99 = v87.mul_add(v80, -v98);
-    let v101 = v87 * v83;
-    let v102 = v93.mul_add(v80, v101);
-    let v103 = v100 * v102;
-    let v104 = v97.mul_add(v99, -v103);
-    let v106 = v96.sinc(0u8);
-    let v107 = v106 * p[40];
-    let v108 = v104.mul_add(v107, v91);
-    let v109 = v97 * v102;
-    let v110 = v100.mul_add(v99, v109);
-    let v111 = v110.mul_add(v107, v94);
-    let v113 = q[6] * 0.5f64;
-    let (v117, v114): (S, S) = v113.sin_cos();
-    let v115 = v110 * v100;
-    let v116 = v104.mul_add(v97, -v115);
-    let v118 = v104 * v100;
-    let v119 = v110.mul_add(v97, v118);
-    let v120 = v117 * v119;
-    let v121 = v114.mul_add(v116, -v120);
-    let v123 = v113.sinc(0u8);
-    let v124 = v123 * p[46];
-    let v125 = v121.mul_add(v124, v108);
-    let v126 = v114 * v119;
-    let v127 = v117.mul_add(v116, v126);
-    let v128 = v127.mul_add(v124, v111);
-    let v130 = q[7] * 0.5f64;
-    let (v134, v131): (S, S) = v130.sin_cos();
-    let v132 = v127 * v117;
-    let v133 = v121.mul_add(v114, -v132);
-    let v135 = v121 * v117;
-    let v136 = v127.mul_add(v114, v135);
-    let v137 = v134 * v136;
-    let v138 = v131.mul_add(v133, -v137);
-    let v140 = v130.sinc(0u8);
-    let v141 = v140 * p[52];
-    let v142 = v138.mul_add(v141, v125);
-    let v143 = v131 * v136;
-    let v144 = v134.mul_add(v133, v143);
-    let v145 = v144.mul_add(v141, v128);
-    let v147 = q[8] * 0.5f64;
-    let (v151, v148): (S, S) = v147.sin_cos();
-    let v149 = v144 * v134;
-    let v150 = v138.mul_add(v131, -v149);
-    let v152 = v138 * v134;
-    let v153 = v144.mul_add(v131, v152);
-    let v154 = v151 * v153;
-    let v155 = v148.mul_add(v150, -v154);
-    let v157 = v147.sinc(0u8);
-    let v158 = v157 * p[58];
-    let v159 = v155.mul_add(v158, v142);
-    let v160 = v148 * v153;
-    let v161 = v151.mul_add(v150, v160);
-    let v162 = v161.mul_add(v158, v145);
-    let v164 = q[9] * 0.5f64;
-    let (v168, v165): (S, S) = v164.sin_cos();
-    let v166 = v161 * v151;
-    let v167 = v155.mul_add(v148, -v166);
-    let v169 = v155 * v151;
-    let v170 = v161.mul_add(v148, v169);
-    let v171 = v168 * v170;
-    let v172 = v165.mul_add(v167, -v171);
-    let v174 = v164.sinc(0u8);
-    let v175 = v174 * p[64];
-    let v176 = v172.mul_add(v175, v159);
-    let v177 = v165 * v170;
-    let v178 = v168.mul_add(v167, v177);
-    let v179 = v178.mul_add(v175, v162);
-    let v182 = q[10] * 0.5f64;
-    let (v185, v183): (S, S) = v182.sin_cos();
-    let v187 = v185 * p[337];
-    let v188 = v183.mul_add(S::c(p[336]), -v187);
-    let v190 = v182.sinc(0u8);
-    let v191 = v190 * p[77];
-    let v192 = v188.mul_add(v191, S::c(p[73]));
-    let v194 = v183 * p[337];
-    let v195 = v185.mul_add(S::c(p[336]), v194);
-    let v196 = v195.mul_add(v191, S::c(p[74]));
-    let v200 = v185 * p[183];
-    let v201 = S::c(p[184]).mul_add(v183, -v200);
-    let v202 = v191.mul_add(v201, S::c(p[73]));
-    let v204 = q[11] * 0.5f64;
-    let (v210, v205): (S, S) = v204.sin_cos();
-    let v206 = v185 * p[184];
-    let v207 = S::c(p[183]).mul_add(v183, v206);
-    let v208 = v207 * v185;
-    let v209 = v201.mul_add(v183, -v208);
-    let v211 = v201 * v185;
-    let v212 = v207.mul_add(v183, v211);
-    let v213 = v210 * v212;
-    let v214 = v205.mul_add(v209, -v213);
-    let v216 = v204.sinc(0u8);
-    let v217 = v216 * p[83];
-    let v218 = v214.mul_add(v217, v202);
-    let v219 = v191.mul_add(v207, S::c(p[74]));
-    let v220 = v205 * v212;
-    let v221 = v210.mul_add(v209, v220);
-    let v222 = v221.mul_add(v217, v219);
-    let v224 = q[12] * 0.5f64;
-    let (v228, v225): (S, S) = v224.sin_cos();
-    let v226 = v221 * v210;
-    let v227 = v214.mul_add(v205, -v226);
-    let v229 = v214 * v210;
-    let v230 = v221.mul_add(v205, v229);
-    let v231 = v228 * v230;
-    let v232 = v225.mul_add(v227, -v231);
-    let v234 = v224.sinc(0u8);
-    let v235 = v234 * p[89];
-    let v236 = v232.mul_add(v235, v218);
-    let v237 = v225 * v230;
-    let v238 = v228.mul_add(v227, v237);
-    let v239 = v238.mul_add(v235, v222);
-    let v241 = q[13] * 0.5f64;
-    let (v245, v242): (S, S) = v241.sin_cos();
-    let v243 = v238 * v228;
-    let v244 = v232.mul_add(v225, -v243);
-    let v246 = v232 * v228;
-    let v247 = v238.mul_add(v225, v246);
-    let v248 = v245 * v247;
-    let v249 = v242.mul_add(v244, -v248);
-    let v251 = v241.sinc(0u8);
-    let v252 = v251 * p[95];
-    let v253 = v249.mul_add(v252, v236);
-    let v254 = v242 * v247;
-    let v255 = v245.mul_add(v244, v254);
-    let v256 = v255.mul_add(v252, v239);
-    let v258 = q[14] * 0.5f64;
-    let (v262, v259): (S, S) = v258.sin_cos();
-    let v260 = v255 * v245;
-    let v261 = v249.mul_add(v242, -v260);
-    let v263 = v249 * v245;
-    let v264 = v255.mul_add(v242, v263);
-    let v265 = v262 * v264;
-    let v266 = v259.mul_add(v261, -v265);
-    let v268 = v258.sinc(0u8);
-    let v269 = v268 * p[101];
-    let v270 = v266.mul_add(v269, v253);
-    let v271 = v259 * v264;
-    let v272 = v262.mul_add(v261, v271);
-    let v273 = v272.mul_add(v269, v256);
-    let v275 = q[15] * 0.5f64;
-    let (v279, v276): (S, S) = v275.sin_cos();
-    let v277 = v272 * v262;
-    let v278 = v266.mul_add(v259, -v277);
-    let v280 = v266 * v262;
-    let v281 = v272.mul_add(v259, v280);
-    let v282 = v279 * v281;
-    let v283 = v276.mul_add(v278, -v282);
-    let v285 = v275.sinc(0u8);
-    let v286 = v285 * p[107];
-    let v287 = v283.mul_add(v286, v270);
-    let v288 = v276 * v281;
-    let v289 = v279.mul_add(v278, v288);
-    let v290 = v289.mul_add(v286, v273);
-    let v292 = q[16] * 0.5f64;
-    let (v296, v293): (S, S) = v292.sin_cos();
-    let v294 = v289 * v279;
-    let v295 = v283.mul_add(v276, -v294);
-    let v297 = v283 * v279;
-    let v298 = v289.mul_add(v276, v297);
-    let v299 = v296 * v298;
-    let v300 = v293.mul_add(v295, -v299);
-    let v302 = v292.sinc(0u8);
-    let v303 = v302 * p[113];
-    let v304 = v300.mul_add(v303, v287);
-    let v305 = v293 * v298;
-    let v306 = v296.mul_add(v295, v305);
-    let v307 = v306.mul_add(v303, v290);
-    let v309 = q[17] * 0.5f64;
-    let (v313, v310): (S, S) = v309.sin_cos();
-    let v311 = v306 * v296;
-    let v312 = v300.mul_add(v293, -v311);
-    let v314 = v300 * v296;
-    let v315 = v306.mul_add(v293, v314);
-    let v316 = v313 * v315;
-    let v317 = v310.mul_add(v312, -v316);
-    let v319 = v309.sinc(0u8);
-    let v320 = v319 * p[119];
-    let v321 = v317.mul_add(v320, v304);
-    let v322 = v310 * v315;
-    let v323 = v313.mul_add(v312, v322);
-    let v324 = v323.mul_add(v320, v307);
-    let v326 = q[18] * 0.5f64;
-    let (v330, v327): (S, S) = v326.sin_cos();
-    let v328 = v323 * v313;
-    let v329 = v317.mul_add(v310, -v328);
-    let v331 = v317 * v313;
-    let v332 = v323.mul_add(v310, v331);
-    let v333 = v330 * v332;
-    let v334 = v327.mul_add(v329, -v333);
-    let v336 = v326.sinc(0u8);
-    let v337 = v336 * p[125];
-    let v338 = v334.mul_add(v337, v321);
-    let v339 = v327 * v332;
-    let v340 = v330.mul_add(v329, v339);
-    let v341 = v340.mul_add(v337, v324);
-    let v343 = q[19] * 0.5f64;
-    let (v347, v344): (S, S) = v343.sin_cos();
-    let v345 = v340 * v330;
-    let v346 = v334.mul_add(v327, -v345);
-    let v348 = v334 * v330;
-    let v349 = v340.mul_add(v327, v348);
-    let v350 = v347 * v349;
-    let v351 = v344.mul_add(v346, -v350);
-    let v353 = v343.sinc(0u8);
-    let v354 = v353 * p[131];
-    let v355 = v351.mul_add(v354, v338);
-    let v356 = v344 * v349;
-    let v357 = v347.mul_add(v346, v356);
-    let v358 = v357.mul_add(v354, v341);
-    out[0] = v13;
-    out[1] = v17;
-    out[2] = S::c(p[8]);
-    out[3] = v39;
-    out[4] = v43;
-    out[5] = S::c(p[8]);
-    out[6] = v57;
-    out[7] = v60;
-    out[8] = S::c(p[8]);
-    out[9] = v74;
-    out[10] = v77;
-    out[11] = S::c(p[8]);
-    out[12] = v91;
-    out[13] = v94;
-    out[14] = S::c(p[8]);
-    out[15] = v108;
-    out[16] = v111;
-    out[17] = S::c(p[8]);
-    out[18] = v125;
-    out[19] = v128;
-    out[20] = S::c(p[8]);
-    out[21] = v142;
-    out[22] = v145;
-    out[23] = S::c(p[8]);
-    out[24] = v159;
-    out[25] = v162;
-    out[26] = S::c(p[8]);
-    out[27] = v176;
-    out[28] = v179;
-    out[29] = S::c(p[8]);
-    out[30] = v192;
-    out[31] = v196;
-    out[32] = S::c(p[75]);
-    out[33] = v218;
-    out[34] = v222;
-    out[35] = S::c(p[75]);
-    out[36] = v236;
-    out[37] = v239;
-    out[38] = S::c(p[75]);
-    out[39] = v253;
-    out[40] = v256;
-    out[41] = S::c(p[75]);
-    out[42] = v270;
-    out[43] = v273;
-    out[44] = S::c(p[75]);
-    out[45] = v287;
-    out[46] = v290;
-    out[47] = S::c(p[75]);
-    out[48] = v304;
-    out[49] = v307;
-    out[50] = S::c(p[75]);
-    out[51] = v321;
-    out[52] = v324;
-    out[53] = S::c(p[75]);
-    out[54] = v338;
-    out[55] = v341;
-    out[56] = S::c(p[75]);
-    out[57] = v355;
-    out[58] = v358;
-    out[59] = S::c(p[75]);
-    out[60] = q[20];
-    out[61] = q[21];
-    out[62] = S::c(p[141]);
-}
-/// Kernel `contact_jacobian`: the points' positions, velocities and Jacobians in 21 groups; group g runs when `all` or `dir[g] != 0`.
-#[allow(unused_variables)]
-pub fn contact_jacobian(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    all: bool,
-    p: &[f64; 680],
-    out: &mut [f64; 1575],
-) {
-    if all || dir[0] != 0.0 {
-        contact_jacobian_0(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[0..75]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[1] != 0.0 {
-        contact_jacobian_1(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[75..150]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[2] != 0.0 {
-        contact_jacobian_2(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[150..225]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[3] != 0.0 {
-        contact_jacobian_3(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[225..300]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[4] != 0.0 {
-        contact_jacobian_4(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[300..375]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[5] != 0.0 {
-        contact_jacobian_5(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[375..450]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[6] != 0.0 {
-        contact_jacobian_6(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[450..525]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[7] != 0.0 {
-        contact_jacobian_7(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[525..600]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[8] != 0.0 {
-        contact_jacobian_8(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[600..675]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[9] != 0.0 {
-        contact_jacobian_9(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[675..750]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[10] != 0.0 {
-        contact_jacobian_10(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[750..825]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[11] != 0.0 {
-        contact_jacobian_11(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[825..900]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[12] != 0.0 {
-        contact_jacobian_12(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[900..975]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[13] != 0.0 {
-        contact_jacobian_13(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[975..1050]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[14] != 0.0 {
-        contact_jacobian_14(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[1050..1125]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[15] != 0.0 {
-        contact_jacobian_15(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[1125..1200]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[16] != 0.0 {
-        contact_jacobian_16(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[1200..1275]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[17] != 0.0 {
-        contact_jacobian_17(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[1275..1350]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[18] != 0.0 {
-        contact_jacobian_18(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[1350..1425]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[19] != 0.0 {
-        contact_jacobian_19(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[1425..1500]).try_into().expect("group output length"),
-        );
-    }
-    if all || dir[20] != 0.0 {
-        contact_jacobian_20(
-            t,
-            q,
-            qd,
-            qdd,
-            dir,
-            p,
-            (&mut out[1500..1575]).try_into().expect("group output length"),
-        );
-    }
-}
-/// Kernel `contact_jacobian_0`: 34 operations, over f64 or dual numbers.
-pub fn contact_jacobian_0(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_0_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_0_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v3 = q[0] * 0.5f64;
-    let (v6, v4): (S, S) = v3.sin_cos();
-    let v8 = v6 * p[335];
-    let v9 = v4.mul_add(S::c(p[334]), -v8);
-    let [v11, v25]: [S; 2] = v3.sinc_orders::<2>();
-    let v12 = v11 * p[10];
-    let v13 = v9.mul_add(v12, S::c(p[6]));
-    let v15 = v4 * p[335];
-    let v16 = v6.mul_add(S::c(p[334]), v15);
-    let v17 = v16.mul_add(v12, S::c(p[7]));
-    let v21 = v6 * (-0.5f64);
-    let v22 = v4 * 0.5f64;
-    let v23 = v22 * p[335];
-    let v24 = S::c(p[334]).mul_add(v21, -v23);
-    let v26 = v25 * 0.5f64;
-    let v27 = v26 * p[10];
-    let v28 = v9 * v27;
-    let v29 = v12.mul_add(v24, v28);
-    let v30 = qd[0] * v29;
-    let v31 = v21 * p[335];
-    let v32 = S::c(p[334]).mul_add(v22, v31);
-    let v33 = v16 * v27;
-    let v34 = v12.mul_add(v32, v33);
-    let v35 = qd[0] * v34;
-    out[0] = v13;
-    out[1] = v17;
-    out[2] = S::c(p[8]);
-    out[3] = v30;
-    out[4] = v35;
-    out[5] = S::c(0f64);
-    out[6] = v29;
-    out[7] = S::c(0f64);
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = S::c(0f64);
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = v34;
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = S::c(0f64);
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_1`: 91 operations, over f64 or dual numbers.
-pub fn contact_jacobian_1(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_1_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_1_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[0] * 0.5f64;
-    let [v5, v37]: [S; 2] = v4.sinc_orders::<2>();
-    let (v8, v9): (S, S) = v4.sin_cos();
-    let v10 = v8 * p[154];
-    let v11 = S::c(p[155]).mul_add(v9, -v10);
-    let v12 = v5 * p[10];
-    let v13 = v12.mul_add(v11, S::c(p[6]));
-    let v15 = q[1] * 0.5f64;
-    let (v22, v16): (S, S) = v15.sin_cos();
-    let v17 = v8 * p[155];
-    let v18 = S::c(p[154]).mul_add(v9, v17);
-    let v19 = v18 * v8;
-    let v20 = v11.mul_add(v9, -v19);
-    let v21 = v16 * v20;
-    let v23 = v11 * v8;
-    let v24 = v18.mul_add(v9, v23);
-    let v25 = (-v22).mul_add(v24, v21);
-    let [v27, v54]: [S; 2] = v15.sinc_orders::<2>();
-    let v28 = v27 * p[16];
-    let v29 = v25.mul_add(v28, v13);
-    let v31 = v12.mul_add(v18, S::c(p[7]));
-    let v32 = v22 * v20;
-    let v33 = v16.mul_add(v24, v32);
-    let v34 = v33.mul_add(v28, v31);
-    let v38 = v37 * 0.5f64;
-    let v39 = v5 * 0.5f64;
-    let v40 = v39 * v18;
-    let v41 = v11.mul_add(v38, -v40);
-    let v42 = v41 * p[10];
-    let v43 = -v24;
-    let v44 = v16.mul_add(v43, -v32);
-    let v47 = v22 * (-0.5f64);
-    let v48 = v16 * 0.5f64;
-    let v49 = v24 * v48;
-    let v50 = v20.mul_add(v47, -v49);
-    let v51 = qd[1] * v50;
-    let v52 = qd[0].mul_add(v44, v51);
-    let v53 = v28 * v52;
-    let v55 = v54 * 0.5f64;
-    let v56 = v55 * p[16];
-    let v57 = qd[1] * v25;
-    let v58 = qd[0].mul_add(v42, v53);
-    let v59 = v57.mul_add(v56, v58);
-    let v60 = v39 * v11;
-    let v61 = v18.mul_add(v38, v60);
-    let v62 = v61 * p[10];
-    let v63 = v22.mul_add(v43, v21);
-    let v64 = v24 * v47;
-    let v65 = v20.mul_add(v48, v64);
-    let v66 = qd[1] * v65;
-    let v67 = qd[0].mul_add(v63, v66);
-    let v68 = v28 * v67;
-    let v69 = qd[1] * v33;
-    let v70 = qd[0].mul_add(v62, v68);
-    let v71 = v69.mul_add(v56, v70);
-    let v73 = v28.mul_add(v44, v42);
-    let v74 = v25 * v56;
-    let v75 = v28.mul_add(v50, v74);
-    let v76 = v28.mul_add(v63, v62);
-    let v77 = v33 * v56;
-    let v78 = v28.mul_add(v65, v77);
-    out[0] = v29;
-    out[1] = v34;
-    out[2] = S::c(p[8]);
-    out[3] = v59;
-    out[4] = v71;
-    out[5] = S::c(0f64);
-    out[6] = v73;
-    out[7] = v75;
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = S::c(0f64);
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = v76;
-    out[30] = v78;
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = S::c(0f64);
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_2`: 143 operations, over f64 or dual numbers.
-pub fn contact_jacobian_2(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_2_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_2_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[0] * 0.5f64;
-    let [v5, v51]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[9];
-    let (v42, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[10];
-    let v10 = v9.mul_add(v8, S::c(p[6]));
-    let v13 = q[1] * 0.5f64;
-    let [v14, v58]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let (v16, v17): (S, S) = v15.sin_cos();
-    let (v18, v19): (S, S) = v13.sin_cos();
-    let v20 = v16 * v18;
-    let v21 = v17.mul_add(v19, -v20);
-    let v22 = v14 * p[16];
-    let v23 = v22 * v21;
-    let v24 = v10 + v23;
-    let v26 = q[2] * 0.5f64;
-    let (v33, v27): (S, S) = v26.sin_cos();
-    let v28 = v17 * v18;
-    let v29 = v16.mul_add(v19, v28);
-    let v30 = v29 * v18;
-    let v31 = v21.mul_add(v19, -v30);
-    let v32 = v27 * v31;
-    let v34 = v21 * v18;
-    let v35 = v29.mul_add(v19, v34);
-    let v36 = (-v33).mul_add(v35, v32);
-    let [v38, v81]: [S; 2] = v26.sinc_orders::<2>();
-    let v39 = v38 * p[22];
-    let v40 = v36.mul_add(v39, v24);
-    let v43 = v9.mul_add(v42, S::c(p[7]));
-    let v44 = v22 * v29;
-    let v45 = v43 + v44;
-    let v46 = v33 * v31;
-    let v47 = v27.mul_add(v35, v46);
-    let v48 = v47.mul_add(v39, v45);
-    let v52 = v51 * 0.5f64;
-    let v53 = v5 * 0.5f64;
-    let v54 = v53 * v42;
-    let v55 = v8.mul_add(v52, -v54);
-    let v56 = v55 * p[10];
-    let v59 = v58 * 0.5f64;
-    let v60 = qd[1] * v21;
-    let v61 = qd[1] * 0.5f64;
-    let v62 = qd[0] + v61;
-    let v63 = v14 * v29;
-    let v64 = v63 * v62;
-    let v65 = v60.mul_add(v59, -v64);
-    let v66 = v65 * p[16];
-    let v67 = qd[0].mul_add(v56, v66);
-    let v68 = v61 + v62;
-    let v69 = v35 * v68;
-    let v70 = -v69;
-    let v71 = v31 * v68;
-    let v72 = v33 * v71;
-    let v75 = v33 * (-0.5f64);
-    let v76 = v27 * 0.5f64;
-    let v77 = v35 * v76;
-    let v78 = v31.mul_add(v75, -v77);
-    let v79 = v27.mul_add(v70, -v72);
-    let v80 = qd[2].mul_add(v78, v79);
-    let v82 = v81 * 0.5f64;
-    let v83 = v82 * p[22];
-    let v84 = qd[2] * v36;
-    let v85 = v39.mul_add(v80, v67);
-    let v86 = v84.mul_add(v83, v85);
-    let v87 = v53 * v8;
-    let v88 = v42.mul_add(v52, v87);
-    let v89 = v88 * p[10];
-    let v90 = qd[1] * v29;
-    let v91 = v14 * v21;
-    let v92 = v91 * v62;
-    let v93 = v90.mul_add(v59, v92);
-    let v94 = v93 * p[16];
-    let v95 = qd[0].mul_add(v89, v94);
-    let v96 = v27 * v71;
-    let v97 = v35 * v75;
-    let v98 = v31.mul_add(v76, v97);
-    let v99 = v33.mul_add(v70, v96);
-    let v100 = qd[2].mul_add(v98, v99);
-    let v101 = qd[2] * v47;
-    let v102 = v39.mul_add(v100, v95);
-    let v103 = v101.mul_add(v83, v102);
-    let v105 = v56 - v44;
-    let v106 = -v35;
-    let v107 = v27.mul_add(v106, -v46);
-    let v108 = v39 * v107;
-    let v109 = v105 + v108;
-    let v110 = v14 * 0.5f64;
-    let v111 = v110 * v29;
-    let v112 = v21.mul_add(v59, -v111);
-    let v113 = S::c(p[16]).mul_add(v112, v108);
-    let v114 = v36 * v83;
-    let v115 = v39.mul_add(v78, v114);
-    let v116 = v23 + v89;
-    let v117 = v33.mul_add(v106, v32);
-    let v118 = v39 * v117;
-    let v119 = v116 + v118;
-    let v120 = v110 * v21;
-    let v121 = v29.mul_add(v59, v120);
-    let v122 = S::c(p[16]).mul_add(v121, v118);
-    let v123 = v47 * v83;
-    let v124 = v39.mul_add(v98, v123);
-    out[0] = v40;
-    out[1] = v48;
-    out[2] = S::c(p[8]);
-    out[3] = v86;
-    out[4] = v103;
-    out[5] = S::c(0f64);
-    out[6] = v109;
-    out[7] = v113;
-    out[8] = v115;
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = S::c(0f64);
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = v119;
-    out[30] = v122;
-    out[31] = v124;
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = S::c(0f64);
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_3`: 188 operations, over f64 or dual numbers.
-pub fn contact_jacobian_3(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_3_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_3_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[0] * 0.5f64;
-    let [v5, v64]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[9];
-    let (v52, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[10];
-    let v10 = v9.mul_add(v8, S::c(p[6]));
-    let v13 = q[1] * 0.5f64;
-    let [v14, v71]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v54, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[16];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[2] * 0.5f64;
-    let [v24, v82]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let (v26, v27): (S, S) = v25.sin_cos();
-    let (v28, v29): (S, S) = v23.sin_cos();
-    let v30 = v26 * v28;
-    let v31 = v27.mul_add(v29, -v30);
-    let v32 = v24 * p[22];
-    let v33 = v32 * v31;
-    let v34 = v20 + v33;
-    let v36 = q[3] * 0.5f64;
-    let (v43, v37): (S, S) = v36.sin_cos();
-    let v38 = v27 * v28;
-    let v39 = v26.mul_add(v29, v38);
-    let v40 = v39 * v28;
-    let v41 = v31.mul_add(v29, -v40);
-    let v42 = v37 * v41;
-    let v44 = v31 * v28;
-    let v45 = v39.mul_add(v29, v44);
-    let v46 = (-v43).mul_add(v45, v42);
-    let [v48, v105]: [S; 2] = v36.sinc_orders::<2>();
-    let v49 = v48 * p[28];
-    let v50 = v46.mul_add(v49, v34);
-    let v53 = v9.mul_add(v52, S::c(p[7]));
-    let v55 = v18 * v54;
-    let v56 = v53 + v55;
-    let v57 = v32 * v39;
-    let v58 = v56 + v57;
-    let v59 = v43 * v41;
-    let v60 = v37.mul_add(v45, v59);
-    let v61 = v60.mul_add(v49, v58);
-    let v65 = v64 * 0.5f64;
-    let v66 = v5 * 0.5f64;
-    let v67 = v66 * v52;
-    let v68 = v8.mul_add(v65, -v67);
-    let v69 = v68 * p[10];
-    let v72 = v71 * 0.5f64;
-    let v73 = qd[1] * v17;
-    let v74 = qd[1] * 0.5f64;
-    let v75 = qd[0] + v74;
-    let v76 = v14 * v54;
-    let v77 = v76 * v75;
-    let v78 = v73.mul_add(v72, -v77);
-    let v79 = v78 * p[16];
-    let v80 = qd[0].mul_add(v69, v79);
-    let v83 = v82 * 0.5f64;
-    let v84 = qd[2] * v31;
-    let v85 = qd[2] * 0.5f64;
-    let v86 = v74 + v75;
-    let v87 = v85 + v86;
-    let v88 = v24 * v39;
-    let v89 = v88 * v87;
-    let v90 = v84.mul_add(v83, -v89);
-    let v91 = S::c(p[22]).mul_add(v90, v80);
-    let v92 = v85 + v87;
-    let v93 = v45 * v92;
-    let v94 = -v93;
-    let v95 = v41 * v92;
-    let v96 = v43 * v95;
-    let v99 = v43 * (-0.5f64);
-    let v100 = v37 * 0.5f64;
-    let v101 = v45 * v100;
-    let v102 = v41.mul_add(v99, -v101);
-    let v103 = v37.mul_add(v94, -v96);
-    let v104 = qd[3].mul_add(v102, v103);
-    let v106 = v105 * 0.5f64;
-    let v107 = v106 * p[28];
-    let v108 = qd[3] * v46;
-    let v109 = v49.mul_add(v104, v91);
-    let v110 = v108.mul_add(v107, v109);
-    let v111 = v66 * v8;
-    let v112 = v52.mul_add(v65, v111);
-    let v113 = v112 * p[10];
-    let v114 = qd[1] * v54;
-    let v115 = v14 * v17;
-    let v116 = v115 * v75;
-    let v117 = v114.mul_add(v72, v116);
-    let v118 = v117 * p[16];
-    let v119 = qd[0].mul_add(v113, v118);
-    let v120 = qd[2] * v39;
-    let v121 = v24 * v31;
-    let v122 = v121 * v87;
-    let v123 = v120.mul_add(v83, v122);
-    let v124 = S::c(p[22]).mul_add(v123, v119);
-    let v125 = v37 * v95;
-    let v126 = v45 * v99;
-    let v127 = v41.mul_add(v100, v126);
-    let v128 = v43.mul_add(v94, v125);
-    let v129 = qd[3].mul_add(v127, v128);
-    let v130 = qd[3] * v60;
-    let v131 = v49.mul_add(v129, v124);
-    let v132 = v130.mul_add(v107, v131);
-    let v134 = v69 - v55;
-    let v135 = v134 - v57;
-    let v136 = -v45;
-    let v137 = v37.mul_add(v136, -v59);
-    let v138 = v49 * v137;
-    let v139 = v135 + v138;
-    let v140 = v14 * 0.5f64;
-    let v141 = v140 * v54;
-    let v142 = v17.mul_add(v72, -v141);
-    let v143 = S::c(p[16]).mul_add(v142, -v57);
-    let v144 = v143 + v138;
-    let v145 = v24 * 0.5f64;
-    let v146 = v145 * v39;
-    let v147 = v31.mul_add(v83, -v146);
-    let v148 = S::c(p[22]).mul_add(v147, v138);
-    let v149 = v46 * v107;
-    let v150 = v49.mul_add(v102, v149);
-    let v151 = v19 + v113;
-    let v152 = v33 + v151;
-    let v153 = v43.mul_add(v136, v42);
-    let v154 = v49 * v153;
-    let v155 = v152 + v154;
-    let v156 = v140 * v17;
-    let v157 = v54.mul_add(v72, v156);
-    let v158 = S::c(p[16]).mul_add(v157, v33);
-    let v159 = v158 + v154;
-    let v160 = v145 * v31;
-    let v161 = v39.mul_add(v83, v160);
-    let v162 = S::c(p[22]).mul_add(v161, v154);
-    let v163 = v60 * v107;
-    let v164 = v49.mul_add(v127, v163);
-    out[0] = v50;
-    out[1] = v61;
-    out[2] = S::c(p[8]);
-    out[3] = v110;
-    out[4] = v132;
-    out[5] = S::c(0f64);
-    out[6] = v139;
-    out[7] = v144;
-    out[8] = v148;
-    out[9] = v150;
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = S::c(0f64);
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = v155;
-    out[30] = v159;
-    out[31] = v162;
-    out[32] = v164;
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = S::c(0f64);
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_4`: 235 operations, over f64 or dual numbers.
-pub fn contact_jacobian_4(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_4_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_4_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[0] * 0.5f64;
-    let [v5, v77]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[9];
-    let (v62, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[10];
-    let v10 = v9.mul_add(v8, S::c(p[6]));
-    let v13 = q[1] * 0.5f64;
-    let [v14, v84]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v64, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[16];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[2] * 0.5f64;
-    let [v24, v95]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let v26 = v23 + v25;
-    let (v67, v27): (S, S) = v26.sin_cos();
-    let v28 = v24 * p[22];
-    let v29 = v28 * v27;
-    let v30 = v20 + v29;
-    let v33 = q[3] * 0.5f64;
-    let [v34, v106]: [S; 2] = v33.sinc_orders::<2>();
-    let v35 = v23 + v26;
-    let (v36, v37): (S, S) = v35.sin_cos();
-    let (v38, v39): (S, S) = v33.sin_cos();
-    let v40 = v36 * v38;
-    let v41 = v37.mul_add(v39, -v40);
-    let v42 = v34 * p[28];
-    let v43 = v42 * v41;
-    let v44 = v30 + v43;
-    let v46 = q[4] * 0.5f64;
-    let (v53, v47): (S, S) = v46.sin_cos();
-    let v48 = v37 * v38;
-    let v49 = v36.mul_add(v39, v48);
-    let v50 = v49 * v38;
-    let v51 = v41.mul_add(v39, -v50);
-    let v52 = v47 * v51;
-    let v54 = v41 * v38;
-    let v55 = v49.mul_add(v39, v54);
-    let v56 = (-v53).mul_add(v55, v52);
-    let [v58, v129]: [S; 2] = v46.sinc_orders::<2>();
-    let v59 = v58 * p[34];
-    let v60 = v56.mul_add(v59, v44);
-    let v63 = v9.mul_add(v62, S::c(p[7]));
-    let v65 = v18 * v64;
-    let v66 = v63 + v65;
-    let v68 = v28 * v67;
-    let v69 = v66 + v68;
-    let v70 = v42 * v49;
-    let v71 = v69 + v70;
-    let v72 = v53 * v51;
-    let v73 = v47.mul_add(v55, v72);
-    let v74 = v73.mul_add(v59, v71);
-    let v78 = v77 * 0.5f64;
-    let v79 = v5 * 0.5f64;
-    let v80 = v79 * v62;
-    let v81 = v8.mul_add(v78, -v80);
-    let v82 = v81 * p[10];
-    let v85 = v84 * 0.5f64;
-    let v86 = qd[1] * v17;
-    let v87 = qd[1] * 0.5f64;
-    let v88 = qd[0] + v87;
-    let v89 = v14 * v64;
-    let v90 = v89 * v88;
-    let v91 = v86.mul_add(v85, -v90);
-    let v92 = v91 * p[16];
-    let v93 = qd[0].mul_add(v82, v92);
-    let v96 = v95 * 0.5f64;
-    let v97 = qd[2] * v27;
-    let v98 = qd[2] * 0.5f64;
-    let v99 = v87 + v88;
-    let v100 = v98 + v99;
-    let v101 = v24 * v67;
-    let v102 = v101 * v100;
-    let v103 = v97.mul_add(v96, -v102);
-    let v104 = S::c(p[22]).mul_add(v103, v93);
-    let v107 = v106 * 0.5f64;
-    let v108 = qd[3] * v41;
-    let v109 = qd[3] * 0.5f64;
-    let v110 = v98 + v100;
-    let v111 = v109 + v110;
-    let v112 = v34 * v49;
-    let v113 = v112 * v111;
-    let v114 = v108.mul_add(v107, -v113);
-    let v115 = S::c(p[28]).mul_add(v114, v104);
-    let v116 = v109 + v111;
-    let v117 = v55 * v116;
-    let v118 = -v117;
-    let v119 = v51 * v116;
-    let v120 = v53 * v119;
-    let v123 = v53 * (-0.5f64);
-    let v124 = v47 * 0.5f64;
-    let v125 = v55 * v124;
-    let v126 = v51.mul_add(v123, -v125);
-    let v127 = v47.mul_add(v118, -v120);
-    let v128 = qd[4].mul_add(v126, v127);
-    let v130 = v129 * 0.5f64;
-    let v131 = v130 * p[34];
-    let v132 = qd[4] * v56;
-    let v133 = v59.mul_add(v128, v115);
-    let v134 = v132.mul_add(v131, v133);
-    let v135 = v79 * v8;
-    let v136 = v62.mul_add(v78, v135);
-    let v137 = v136 * p[10];
-    let v138 = qd[1] * v64;
-    let v139 = v14 * v17;
-    let v140 = v139 * v88;
-    let v141 = v138.mul_add(v85, v140);
-    let v142 = v141 * p[16];
-    let v143 = qd[0].mul_add(v137, v142);
-    let v144 = qd[2] * v67;
-    let v145 = v24 * v27;
-    let v146 = v145 * v100;
-    let v147 = v144.mul_add(v96, v146);
-    let v148 = S::c(p[22]).mul_add(v147, v143);
-    let v149 = qd[3] * v49;
-    let v150 = v34 * v41;
-    let v151 = v150 * v111;
-    let v152 = v149.mul_add(v107, v151);
-    let v153 = S::c(p[28]).mul_add(v152, v148);
-    let v154 = v47 * v119;
-    let v155 = v55 * v123;
-    let v156 = v51.mul_add(v124, v155);
-    let v157 = v53.mul_add(v118, v154);
-    let v158 = qd[4].mul_add(v156, v157);
-    let v159 = qd[4] * v73;
-    let v160 = v59.mul_add(v158, v153);
-    let v161 = v159.mul_add(v131, v160);
-    let v163 = v82 - v65;
-    let v164 = v163 - v68;
-    let v165 = v164 - v70;
-    let v166 = -v55;
-    let v167 = v47.mul_add(v166, -v72);
-    let v168 = v59 * v167;
-    let v169 = v165 + v168;
-    let v170 = v14 * 0.5f64;
-    let v171 = v170 * v64;
-    let v172 = v17.mul_add(v85, -v171);
-    let v173 = S::c(p[16]).mul_add(v172, -v68);
-    let v174 = v173 - v70;
-    let v175 = v174 + v168;
-    let v176 = v24 * 0.5f64;
-    let v177 = v176 * v67;
-    let v178 = v27.mul_add(v96, -v177);
-    let v179 = S::c(p[22]).mul_add(v178, -v70);
-    let v180 = v179 + v168;
-    let v181 = v34 * 0.5f64;
-    let v182 = v181 * v49;
-    let v183 = v41.mul_add(v107, -v182);
-    let v184 = S::c(p[28]).mul_add(v183, v168);
-    let v185 = v56 * v131;
-    let v186 = v59.mul_add(v126, v185);
-    let v187 = v19 + v137;
-    let v188 = v29 + v187;
-    let v189 = v43 + v188;
-    let v190 = v53.mul_add(v166, v52);
-    let v191 = v59 * v190;
-    let v192 = v189 + v191;
-    let v193 = v170 * v17;
-    let v194 = v64.mul_add(v85, v193);
-    let v195 = S::c(p[16]).mul_add(v194, v29);
-    let v196 = v43 + v195;
-    let v197 = v196 + v191;
-    let v198 = v176 * v27;
-    let v199 = v67.mul_add(v96, v198);
-    let v200 = S::c(p[22]).mul_add(v199, v43);
-    let v201 = v200 + v191;
-    let v202 = v181 * v41;
-    let v203 = v49.mul_add(v107, v202);
-    let v204 = S::c(p[28]).mul_add(v203, v191);
-    let v205 = v73 * v131;
-    let v206 = v59.mul_add(v156, v205);
-    out[0] = v60;
-    out[1] = v74;
-    out[2] = S::c(p[8]);
-    out[3] = v134;
-    out[4] = v161;
-    out[5] = S::c(0f64);
-    out[6] = v169;
-    out[7] = v175;
-    out[8] = v180;
-    out[9] = v184;
-    out[10] = v186;
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = S::c(0f64);
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = v192;
-    out[30] = v197;
-    out[31] = v201;
-    out[32] = v204;
-    out[33] = v206;
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = S::c(0f64);
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_5`: 284 operations, over f64 or dual numbers.
-pub fn contact_jacobian_5(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_5_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_5_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[0] * 0.5f64;
-    let [v5, v90]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[9];
-    let (v72, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[10];
-    let v10 = v9.mul_add(v8, S::c(p[6]));
-    let v13 = q[1] * 0.5f64;
-    let [v14, v97]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v74, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[16];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[2] * 0.5f64;
-    let [v24, v108]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let v26 = v23 + v25;
-    let (v77, v27): (S, S) = v26.sin_cos();
-    let v28 = v24 * p[22];
-    let v29 = v28 * v27;
-    let v30 = v20 + v29;
-    let v33 = q[3] * 0.5f64;
-    let [v34, v119]: [S; 2] = v33.sinc_orders::<2>();
-    let v35 = v23 + v26;
-    let v36 = v33 + v35;
-    let (v80, v37): (S, S) = v36.sin_cos();
-    let v38 = v34 * p[28];
-    let v39 = v38 * v37;
-    let v40 = v30 + v39;
-    let v43 = q[4] * 0.5f64;
-    let [v44, v130]: [S; 2] = v43.sinc_orders::<2>();
-    let v45 = v33 + v36;
-    let (v46, v47): (S, S) = v45.sin_cos();
-    let (v48, v49): (S, S) = v43.sin_cos();
-    let v50 = v46 * v48;
-    let v51 = v47.mul_add(v49, -v50);
-    let v52 = v44 * p[34];
-    let v53 = v52 * v51;
-    let v54 = v40 + v53;
-    let v56 = q[5] * 0.5f64;
-    let (v63, v57): (S, S) = v56.sin_cos();
-    let v58 = v47 * v48;
-    let v59 = v46.mul_add(v49, v58);
-    let v60 = v59 * v48;
-    let v61 = v51.mul_add(v49, -v60);
-    let v62 = v57 * v61;
-    let v64 = v51 * v48;
-    let v65 = v59.mul_add(v49, v64);
-    let v66 = (-v63).mul_add(v65, v62);
-    let [v68, v153]: [S; 2] = v56.sinc_orders::<2>();
-    let v69 = v68 * p[40];
-    let v70 = v66.mul_add(v69, v54);
-    let v73 = v9.mul_add(v72, S::c(p[7]));
-    let v75 = v18 * v74;
-    let v76 = v73 + v75;
-    let v78 = v28 * v77;
-    let v79 = v76 + v78;
-    let v81 = v38 * v80;
-    let v82 = v79 + v81;
-    let v83 = v52 * v59;
-    let v84 = v82 + v83;
-    let v85 = v63 * v61;
-    let v86 = v57.mul_add(v65, v85);
-    let v87 = v86.mul_add(v69, v84);
-    let v91 = v90 * 0.5f64;
-    let v92 = v5 * 0.5f64;
-    let v93 = v92 * v72;
-    let v94 = v8.mul_add(v91, -v93);
-    let v95 = v94 * p[10];
-    let v98 = v97 * 0.5f64;
-    let v99 = qd[1] * v17;
-    let v100 = qd[1] * 0.5f64;
-    let v101 = qd[0] + v100;
-    let v102 = v14 * v74;
-    let v103 = v102 * v101;
-    let v104 = v99.mul_add(v98, -v103);
-    let v105 = v104 * p[16];
-    let v106 = qd[0].mul_add(v95, v105);
-    let v109 = v108 * 0.5f64;
-    let v110 = qd[2] * v27;
-    let v111 = qd[2] * 0.5f64;
-    let v112 = v100 + v101;
-    let v113 = v111 + v112;
-    let v114 = v24 * v77;
-    let v115 = v114 * v113;
-    let v116 = v110.mul_add(v109, -v115);
-    let v117 = S::c(p[22]).mul_add(v116, v106);
-    let v120 = v119 * 0.5f64;
-    let v121 = qd[3] * v37;
-    let v122 = qd[3] * 0.5f64;
-    let v123 = v111 + v113;
-    let v124 = v122 + v123;
-    let v125 = v34 * v80;
-    let v126 = v125 * v124;
-    let v127 = v121.mul_add(v120, -v126);
-    let v128 = S::c(p[28]).mul_add(v127, v117);
-    let v131 = v130 * 0.5f64;
-    let v132 = qd[4] * v51;
-    let v133 = qd[4] * 0.5f64;
-    let v134 = v122 + v124;
-    let v135 = v133 + v134;
-    let v136 = v44 * v59;
-    let v137 = v136 * v135;
-    let v138 = v132.mul_add(v131, -v137);
-    let v139 = S::c(p[34]).mul_add(v138, v128);
-    let v140 = v133 + v135;
-    let v141 = v65 * v140;
-    let v142 = -v141;
-    let v143 = v61 * v140;
-    let v144 = v63 * v143;
-    let v147 = v63 * (-0.5f64);
-    let v148 = v57 * 0.5f64;
-    let v149 = v65 * v148;
-    let v150 = v61.mul_add(v147, -v149);
-    let v151 = v57.mul_add(v142, -v144);
-    let v152 = qd[5].mul_add(v150, v151);
-    let v154 = v153 * 0.5f64;
-    let v155 = v154 * p[40];
-    let v156 = qd[5] * v66;
-    let v157 = v69.mul_add(v152, v139);
-    let v158 = v156.mul_add(v155, v157);
-    let v159 = v92 * v8;
-    let v160 = v72.mul_add(v91, v159);
-    let v161 = v160 * p[10];
-    let v162 = qd[1] * v74;
-    let v163 = v14 * v17;
-    let v164 = v163 * v101;
-    let v165 = v162.mul_add(v98, v164);
-    let v166 = v165 * p[16];
-    let v167 = qd[0].mul_add(v161, v166);
-    let v168 = qd[2] * v77;
-    let v169 = v24 * v27;
-    let v170 = v169 * v113;
-    let v171 = v168.mul_add(v109, v170);
-    let v172 = S::c(p[22]).mul_add(v171, v167);
-    let v173 = qd[3] * v80;
-    let v174 = v34 * v37;
-    let v175 = v174 * v124;
-    let v176 = v173.mul_add(v120, v175);
-    let v177 = S::c(p[28]).mul_add(v176, v172);
-    let v178 = qd[4] * v59;
-    let v179 = v44 * v51;
-    let v180 = v179 * v135;
-    let v181 = v178.mul_add(v131, v180);
-    let v182 = S::c(p[34]).mul_add(v181, v177);
-    let v183 = v57 * v143;
-    let v184 = v65 * v147;
-    let v185 = v61.mul_add(v148, v184);
-    let v186 = v63.mul_add(v142, v183);
-    let v187 = qd[5].mul_add(v185, v186);
-    let v188 = qd[5] * v86;
-    let v189 = v69.mul_add(v187, v182);
-    let v190 = v188.mul_add(v155, v189);
-    let v192 = v95 - v75;
-    let v193 = v192 - v78;
-    let v194 = v193 - v81;
-    let v195 = v194 - v83;
-    let v196 = -v65;
-    let v197 = v57.mul_add(v196, -v85);
-    let v198 = v69 * v197;
-    let v199 = v195 + v198;
-    let v200 = v14 * 0.5f64;
-    let v201 = v200 * v74;
-    let v202 = v17.mul_add(v98, -v201);
-    let v203 = S::c(p[16]).mul_add(v202, -v78);
-    let v204 = v203 - v81;
-    let v205 = v204 - v83;
-    let v206 = v205 + v198;
-    let v207 = v24 * 0.5f64;
-    let v208 = v207 * v77;
-    let v209 = v27.mul_add(v109, -v208);
-    let v210 = S::c(p[22]).mul_add(v209, -v81);
-    let v211 = v210 - v83;
-    let v212 = v211 + v198;
-    let v213 = v34 * 0.5f64;
-    let v214 = v213 * v80;
-    let v215 = v37.mul_add(v120, -v214);
-    let v216 = S::c(p[28]).mul_add(v215, -v83);
-    let v217 = v216 + v198;
-    let v218 = v44 * 0.5f64;
-    let v219 = v218 * v59;
-    let v220 = v51.mul_add(v131, -v219);
-    let v221 = S::c(p[34]).mul_add(v220, v198);
-    let v222 = v66 * v155;
-    let v223 = v69.mul_add(v150, v222);
-    let v224 = v19 + v161;
-    let v225 = v29 + v224;
-    let v226 = v39 + v225;
-    let v227 = v53 + v226;
-    let v228 = v63.mul_add(v196, v62);
-    let v229 = v69 * v228;
-    let v230 = v227 + v229;
-    let v231 = v200 * v17;
-    let v232 = v74.mul_add(v98, v231);
-    let v233 = S::c(p[16]).mul_add(v232, v29);
-    let v234 = v39 + v233;
-    let v235 = v53 + v234;
-    let v236 = v235 + v229;
-    let v237 = v207 * v27;
-    let v238 = v77.mul_add(v109, v237);
-    let v239 = S::c(p[22]).mul_add(v238, v39);
-    let v240 = v53 + v239;
-    let v241 = v240 + v229;
-    let v242 = v213 * v37;
-    let v243 = v80.mul_add(v120, v242);
-    let v244 = S::c(p[28]).mul_add(v243, v53);
-    let v245 = v244 + v229;
-    let v246 = v218 * v51;
-    let v247 = v59.mul_add(v131, v246);
-    let v248 = S::c(p[34]).mul_add(v247, v229);
-    let v249 = v86 * v155;
-    let v250 = v69.mul_add(v185, v249);
-    out[0] = v70;
-    out[1] = v87;
-    out[2] = S::c(p[8]);
-    out[3] = v158;
-    out[4] = v190;
-    out[5] = S::c(0f64);
-    out[6] = v199;
-    out[7] = v206;
-    out[8] = v212;
-    out[9] = v217;
-    out[10] = v221;
-    out[11] = v223;
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = S::c(0f64);
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = v230;
-    out[30] = v236;
-    out[31] = v241;
-    out[32] = v245;
-    out[33] = v248;
-    out[34] = v250;
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = S::c(0f64);
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_6`: 335 operations, over f64 or dual numbers.
-pub fn contact_jacobian_6(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_6_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_6_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[0] * 0.5f64;
-    let [v5, v103]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[9];
-    let (v82, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[10];
-    let v10 = v9.mul_add(v8, S::c(p[6]));
-    let v13 = q[1] * 0.5f64;
-    let [v14, v110]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v84, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[16];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[2] * 0.5f64;
-    let [v24, v121]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let v26 = v23 + v25;
-    let (v87, v27): (S, S) = v26.sin_cos();
-    let v28 = v24 * p[22];
-    let v29 = v28 * v27;
-    let v30 = v20 + v29;
-    let v33 = q[3] * 0.5f64;
-    let [v34, v132]: [S; 2] = v33.sinc_orders::<2>();
-    let v35 = v23 + v26;
-    let v36 = v33 + v35;
-    let (v90, v37): (S, S) = v36.sin_cos();
-    let v38 = v34 * p[28];
-    let v39 = v38 * v37;
-    let v40 = v30 + v39;
-    let v43 = q[4] * 0.5f64;
-    let [v44, v143]: [S; 2] = v43.sinc_orders::<2>();
-    let v45 = v33 + v36;
-    let v46 = v43 + v45;
-    let (v93, v47): (S, S) = v46.sin_cos();
-    let v48 = v44 * p[34];
-    let v49 = v48 * v47;
-    let v50 = v40 + v49;
-    let v53 = q[5] * 0.5f64;
-    let [v54, v154]: [S; 2] = v53.sinc_orders::<2>();
-    let v55 = v43 + v46;
-    let (v56, v57): (S, S) = v55.sin_cos();
-    let (v58, v59): (S, S) = v53.sin_cos();
-    let v60 = v56 * v58;
-    let v61 = v57.mul_add(v59, -v60);
-    let v62 = v54 * p[40];
-    let v63 = v62 * v61;
-    let v64 = v50 + v63;
-    let v66 = q[6] * 0.5f64;
-    let (v73, v67): (S, S) = v66.sin_cos();
-    let v68 = v57 * v58;
-    let v69 = v56.mul_add(v59, v68);
-    let v70 = v69 * v58;
-    let v71 = v61.mul_add(v59, -v70);
-    let v72 = v67 * v71;
-    let v74 = v61 * v58;
-    let v75 = v69.mul_add(v59, v74);
-    let v76 = (-v73).mul_add(v75, v72);
-    let [v78, v177]: [S; 2] = v66.sinc_orders::<2>();
-    let v79 = v78 * p[46];
-    let v80 = v76.mul_add(v79, v64);
-    let v83 = v9.mul_add(v82, S::c(p[7]));
-    let v85 = v18 * v84;
-    let v86 = v83 + v85;
-    let v88 = v28 * v87;
-    let v89 = v86 + v88;
-    let v91 = v38 * v90;
-    let v92 = v89 + v91;
-    let v94 = v48 * v93;
-    let v95 = v92 + v94;
-    let v96 = v62 * v69;
-    let v97 = v95 + v96;
-    let v98 = v73 * v71;
-    let v99 = v67.mul_add(v75, v98);
-    let v100 = v99.mul_add(v79, v97);
-    let v104 = v103 * 0.5f64;
-    let v105 = v5 * 0.5f64;
-    let v106 = v105 * v82;
-    let v107 = v8.mul_add(v104, -v106);
-    let v108 = v107 * p[10];
-    let v111 = v110 * 0.5f64;
-    let v112 = qd[1] * v17;
-    let v113 = qd[1] * 0.5f64;
-    let v114 = qd[0] + v113;
-    let v115 = v14 * v84;
-    let v116 = v115 * v114;
-    let v117 = v112.mul_add(v111, -v116);
-    let v118 = v117 * p[16];
-    let v119 = qd[0].mul_add(v108, v118);
-    let v122 = v121 * 0.5f64;
-    let v123 = qd[2] * v27;
-    let v124 = qd[2] * 0.5f64;
-    let v125 = v113 + v114;
-    let v126 = v124 + v125;
-    let v127 = v24 * v87;
-    let v128 = v127 * v126;
-    let v129 = v123.mul_add(v122, -v128);
-    let v130 = S::c(p[22]).mul_add(v129, v119);
-    let v133 = v132 * 0.5f64;
-    let v134 = qd[3] * v37;
-    let v135 = qd[3] * 0.5f64;
-    let v136 = v124 + v126;
-    let v137 = v135 + v136;
-    let v138 = v34 * v90;
-    let v139 = v138 * v137;
-    let v140 = v134.mul_add(v133, -v139);
-    let v141 = S::c(p[28]).mul_add(v140, v130);
-    let v144 = v143 * 0.5f64;
-    let v145 = qd[4] * v47;
-    let v146 = qd[4] * 0.5f64;
-    let v147 = v135 + v137;
-    let v148 = v146 + v147;
-    let v149 = v44 * v93;
-    let v150 = v149 * v148;
-    let v151 = v145.mul_add(v144, -v150);
-    let v152 = S::c(p[34]).mul_add(v151, v141);
-    let v155 = v154 * 0.5f64;
-    let v156 = qd[5] * v61;
-    let v157 = qd[5] * 0.5f64;
-    let v158 = v146 + v148;
-    let v159 = v157 + v158;
-    let v160 = v54 * v69;
-    let v161 = v160 * v159;
-    let v162 = v156.mul_add(v155, -v161);
-    let v163 = S::c(p[40]).mul_add(v162, v152);
-    let v164 = v157 + v159;
-    let v165 = v75 * v164;
-    let v166 = -v165;
-    let v167 = v71 * v164;
-    let v168 = v73 * v167;
-    let v171 = v73 * (-0.5f64);
-    let v172 = v67 * 0.5f64;
-    let v173 = v75 * v172;
-    let v174 = v71.mul_add(v171, -v173);
-    let v175 = v67.mul_add(v166, -v168);
-    let v176 = qd[6].mul_add(v174, v175);
-    let v178 = v177 * 0.5f64;
-    let v179 = v178 * p[46];
-    let v180 = qd[6] * v76;
-    let v181 = v79.mul_add(v176, v163);
-    let v182 = v180.mul_add(v179, v181);
-    let v183 = v105 * v8;
-    let v184 = v82.mul_add(v104, v183);
-    let v185 = v184 * p[10];
-    let v186 = qd[1] * v84;
-    let v187 = v14 * v17;
-    let v188 = v187 * v114;
-    let v189 = v186.mul_add(v111, v188);
-    let v190 = v189 * p[16];
-    let v191 = qd[0].mul_add(v185, v190);
-    let v192 = qd[2] * v87;
-    let v193 = v24 * v27;
-    let v194 = v193 * v126;
-    let v195 = v192.mul_add(v122, v194);
-    let v196 = S::c(p[22]).mul_add(v195, v191);
-    let v197 = qd[3] * v90;
-    let v198 = v34 * v37;
-    let v199 = v198 * v137;
-    let v200 = v197.mul_add(v133, v199);
-    let v201 = S::c(p[28]).mul_add(v200, v196);
-    let v202 = qd[4] * v93;
-    let v203 = v44 * v47;
-    let v204 = v203 * v148;
-    let v205 = v202.mul_add(v144, v204);
-    let v206 = S::c(p[34]).mul_add(v205, v201);
-    let v207 = qd[5] * v69;
-    let v208 = v54 * v61;
-    let v209 = v208 * v159;
-    let v210 = v207.mul_add(v155, v209);
-    let v211 = S::c(p[40]).mul_add(v210, v206);
-    let v212 = v67 * v167;
-    let v213 = v75 * v171;
-    let v214 = v71.mul_add(v172, v213);
-    let v215 = v73.mul_add(v166, v212);
-    let v216 = qd[6].mul_add(v214, v215);
-    let v217 = qd[6] * v99;
-    let v218 = v79.mul_add(v216, v211);
-    let v219 = v217.mul_add(v179, v218);
-    let v221 = v108 - v85;
-    let v222 = v221 - v88;
-    let v223 = v222 - v91;
-    let v224 = v223 - v94;
-    let v225 = v224 - v96;
-    let v226 = -v75;
-    let v227 = v67.mul_add(v226, -v98);
-    let v228 = v79 * v227;
-    let v229 = v225 + v228;
-    let v230 = v14 * 0.5f64;
-    let v231 = v230 * v84;
-    let v232 = v17.mul_add(v111, -v231);
-    let v233 = S::c(p[16]).mul_add(v232, -v88);
-    let v234 = v233 - v91;
-    let v235 = v234 - v94;
-    let v236 = v235 - v96;
-    let v237 = v236 + v228;
-    let v238 = v24 * 0.5f64;
-    let v239 = v238 * v87;
-    let v240 = v27.mul_add(v122, -v239);
-    let v241 = S::c(p[22]).mul_add(v240, -v91);
-    let v242 = v241 - v94;
-    let v243 = v242 - v96;
-    let v244 = v243 + v228;
-    let v245 = v34 * 0.5f64;
-    let v246 = v245 * v90;
-    let v247 = v37.mul_add(v133, -v246);
-    let v248 = S::c(p[28]).mul_add(v247, -v94);
-    let v249 = v248 - v96;
-    let v250 = v249 + v228;
-    let v251 = v44 * 0.5f64;
-    let v252 = v251 * v93;
-    let v253 = v47.mul_add(v144, -v252);
-    let v254 = S::c(p[34]).mul_add(v253, -v96);
-    let v255 = v254 + v228;
-    let v256 = v54 * 0.5f64;
-    let v257 = v256 * v69;
-    let v258 = v61.mul_add(v155, -v257);
-    let v259 = S::c(p[40]).mul_add(v258, v228);
-    let v260 = v76 * v179;
-    let v261 = v79.mul_add(v174, v260);
-    let v262 = v19 + v185;
-    let v263 = v29 + v262;
-    let v264 = v39 + v263;
-    let v265 = v49 + v264;
-    let v266 = v63 + v265;
-    let v267 = v73.mul_add(v226, v72);
-    let v268 = v79 * v267;
-    let v269 = v266 + v268;
-    let v270 = v230 * v17;
-    let v271 = v84.mul_add(v111, v270);
-    let v272 = S::c(p[16]).mul_add(v271, v29);
-    let v273 = v39 + v272;
-    let v274 = v49 + v273;
-    let v275 = v63 + v274;
-    let v276 = v275 + v268;
-    let v277 = v238 * v27;
-    let v278 = v87.mul_add(v122, v277);
-    let v279 = S::c(p[22]).mul_add(v278, v39);
-    let v280 = v49 + v279;
-    let v281 = v63 + v280;
-    let v282 = v281 + v268;
-    let v283 = v245 * v37;
-    let v284 = v90.mul_add(v133, v283);
-    let v285 = S::c(p[28]).mul_add(v284, v49);
-    let v286 = v63 + v285;
-    let v287 = v286 + v268;
-    let v288 = v251 * v47;
-    let v289 = v93.mul_add(v144, v288);
-    let v290 = S::c(p[34]).mul_add(v289, v63);
-    let v291 = v290 + v268;
-    let v292 = v256 * v61;
-    let v293 = v69.mul_add(v155, v292);
-    let v294 = S::c(p[40]).mul_add(v293, v268);
-    let v295 = v99 * v179;
-    let v296 = v79.mul_add(v214, v295);
-    out[0] = v80;
-    out[1] = v100;
-    out[2] = S::c(p[8]);
-    out[3] = v182;
-    out[4] = v219;
-    out[5] = S::c(0f64);
-    out[6] = v229;
-    out[7] = v237;
-    out[8] = v244;
-    out[9] = v250;
-    out[10] = v255;
-    out[11] = v259;
-    out[12] = v261;
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = S::c(0f64);
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = v269;
-    out[30] = v276;
-    out[31] = v282;
-    out[32] = v287;
-    out[33] = v291;
-    out[34] = v294;
-    out[35] = v296;
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = S::c(0f64);
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_7`: 388 operations, over f64 or dual numbers.
-pub fn contact_jacobian_7(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_7_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_7_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[0] * 0.5f64;
-    let [v5, v116]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[9];
-    let (v92, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[10];
-    let v10 = v9.mul_add(v8, S::c(p[6]));
-    let v13 = q[1] * 0.5f64;
-    let [v14, v123]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v94, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[16];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[2] * 0.5f64;
-    let [v24, v134]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let v26 = v23 + v25;
-    let (v97, v27): (S, S) = v26.sin_cos();
-    let v28 = v24 * p[22];
-    let v29 = v28 * v27;
-    let v30 = v20 + v29;
-    let v33 = q[3] * 0.5f64;
-    let [v34, v145]: [S; 2] = v33.sinc_orders::<2>();
-    let v35 = v23 + v26;
-    let v36 = v33 + v35;
-    let (v100, v37): (S, S) = v36.sin_cos();
-    let v38 = v34 * p[28];
-    let v39 = v38 * v37;
-    let v40 = v30 + v39;
-    let v43 = q[4] * 0.5f64;
-    let [v44, v156]: [S; 2] = v43.sinc_orders::<2>();
-    let v45 = v33 + v36;
-    let v46 = v43 + v45;
-    let (v103, v47): (S, S) = v46.sin_cos();
-    let v48 = v44 * p[34];
-    let v49 = v48 * v47;
-    let v50 = v40 + v49;
-    let v53 = q[5] * 0.5f64;
-    let [v54, v167]: [S; 2] = v53.sinc_orders::<2>();
-    let v55 = v43 + v46;
-    let v56 = v53 + v55;
-    let (v106, v57): (S, S) = v56.sin_cos();
-    let v58 = v54 * p[40];
-    let v59 = v58 * v57;
-    let v60 = v50 + v59;
-    let v63 = q[6] * 0.5f64;
-    let [v64, v178]: [S; 2] = v63.sinc_orders::<2>();
-    let v65 = v53 + v56;
-    let (v66, v67): (S, S) = v65.sin_cos();
-    let (v68, v69): (S, S) = v63.sin_cos();
-    let v70 = v66 * v68;
-    let v71 = v67.mul_add(v69, -v70);
-    let v72 = v64 * p[46];
-    let v73 = v72 * v71;
-    let v74 = v60 + v73;
-    let v76 = q[7] * 0.5f64;
-    let (v83, v77): (S, S) = v76.sin_cos();
-    let v78 = v67 * v68;
-    let v79 = v66.mul_add(v69, v78);
-    let v80 = v79 * v68;
-    let v81 = v71.mul_add(v69, -v80);
-    let v82 = v77 * v81;
-    let v84 = v71 * v68;
-    let v85 = v79.mul_add(v69, v84);
-    let v86 = (-v83).mul_add(v85, v82);
-    let [v88, v201]: [S; 2] = v76.sinc_orders::<2>();
-    let v89 = v88 * p[52];
-    let v90 = v86.mul_add(v89, v74);
-    let v93 = v9.mul_add(v92, S::c(p[7]));
-    let v95 = v18 * v94;
-    let v96 = v93 + v95;
-    let v98 = v28 * v97;
-    let v99 = v96 + v98;
-    let v101 = v38 * v100;
-    let v102 = v99 + v101;
-    let v104 = v48 * v103;
-    let v105 = v102 + v104;
-    let v107 = v58 * v106;
-    let v108 = v105 + v107;
-    let v109 = v72 * v79;
-    let v110 = v108 + v109;
-    let v111 = v83 * v81;
-    let v112 = v77.mul_add(v85, v111);
-    let v113 = v112.mul_add(v89, v110);
-    let v117 = v116 * 0.5f64;
-    let v118 = v5 * 0.5f64;
-    let v119 = v118 * v92;
-    let v120 = v8.mul_add(v117, -v119);
-    let v121 = v120 * p[10];
-    let v124 = v123 * 0.5f64;
-    let v125 = qd[1] * v17;
-    let v126 = qd[1] * 0.5f64;
-    let v127 = qd[0] + v126;
-    let v128 = v14 * v94;
-    let v129 = v128 * v127;
-    let v130 = v125.mul_add(v124, -v129);
-    let v131 = v130 * p[16];
-    let v132 = qd[0].mul_add(v121, v131);
-    let v135 = v134 * 0.5f64;
-    let v136 = qd[2] * v27;
-    let v137 = qd[2] * 0.5f64;
-    let v138 = v126 + v127;
-    let v139 = v137 + v138;
-    let v140 = v24 * v97;
-    let v141 = v140 * v139;
-    let v142 = v136.mul_add(v135, -v141);
-    let v143 = S::c(p[22]).mul_add(v142, v132);
-    let v146 = v145 * 0.5f64;
-    let v147 = qd[3] * v37;
-    let v148 = qd[3] * 0.5f64;
-    let v149 = v137 + v139;
-    let v150 = v148 + v149;
-    let v151 = v34 * v100;
-    let v152 = v151 * v150;
-    let v153 = v147.mul_add(v146, -v152);
-    let v154 = S::c(p[28]).mul_add(v153, v143);
-    let v157 = v156 * 0.5f64;
-    let v158 = qd[4] * v47;
-    let v159 = qd[4] * 0.5f64;
-    let v160 = v148 + v150;
-    let v161 = v159 + v160;
-    let v162 = v44 * v103;
-    let v163 = v162 * v161;
-    let v164 = v158.mul_add(v157, -v163);
-    let v165 = S::c(p[34]).mul_add(v164, v154);
-    let v168 = v167 * 0.5f64;
-    let v169 = qd[5] * v57;
-    let v170 = qd[5] * 0.5f64;
-    let v171 = v159 + v161;
-    let v172 = v170 + v171;
-    let v173 = v54 * v106;
-    let v174 = v173 * v172;
-    let v175 = v169.mul_add(v168, -v174);
-    let v176 = S::c(p[40]).mul_add(v175, v165);
-    let v179 = v178 * 0.5f64;
-    let v180 = qd[6] * v71;
-    let v181 = qd[6] * 0.5f64;
-    let v182 = v170 + v172;
-    let v183 = v181 + v182;
-    let v184 = v64 * v79;
-    let v185 = v184 * v183;
-    let v186 = v180.mul_add(v179, -v185);
-    let v187 = S::c(p[46]).mul_add(v186, v176);
-    let v188 = v181 + v183;
-    let v189 = v85 * v188;
-    let v190 = -v189;
-    let v191 = v81 * v188;
-    let v192 = v83 * v191;
-    let v195 = v83 * (-0.5f64);
-    let v196 = v77 * 0.5f64;
-    let v197 = v85 * v196;
-    let v198 = v81.mul_add(v195, -v197);
-    let v199 = v77.mul_add(v190, -v192);
-    let v200 = qd[7].mul_add(v198, v199);
-    let v202 = v201 * 0.5f64;
-    let v203 = v202 * p[52];
-    let v204 = qd[7] * v86;
-    let v205 = v89.mul_add(v200, v187);
-    let v206 = v204.mul_add(v203, v205);
-    let v207 = v118 * v8;
-    let v208 = v92.mul_add(v117, v207);
-    let v209 = v208 * p[10];
-    let v210 = qd[1] * v94;
-    let v211 = v14 * v17;
-    let v212 = v211 * v127;
-    let v213 = v210.mul_add(v124, v212);
-    let v214 = v213 * p[16];
-    let v215 = qd[0].mul_add(v209, v214);
-    let v216 = qd[2] * v97;
-    let v217 = v24 * v27;
-    let v218 = v217 * v139;
-    let v219 = v216.mul_add(v135, v218);
-    let v220 = S::c(p[22]).mul_add(v219, v215);
-    let v221 = qd[3] * v100;
-    let v222 = v34 * v37;
-    let v223 = v222 * v150;
-    let v224 = v221.mul_add(v146, v223);
-    let v225 = S::c(p[28]).mul_add(v224, v220);
-    let v226 = qd[4] * v103;
-    let v227 = v44 * v47;
-    let v228 = v227 * v161;
-    let v229 = v226.mul_add(v157, v228);
-    let v230 = S::c(p[34]).mul_add(v229, v225);
-    let v231 = qd[5] * v106;
-    let v232 = v54 * v57;
-    let v233 = v232 * v172;
-    let v234 = v231.mul_add(v168, v233);
-    let v235 = S::c(p[40]).mul_add(v234, v230);
-    let v236 = qd[6] * v79;
-    let v237 = v64 * v71;
-    let v238 = v237 * v183;
-    let v239 = v236.mul_add(v179, v238);
-    let v240 = S::c(p[46]).mul_add(v239, v235);
-    let v241 = v77 * v191;
-    let v242 = v85 * v195;
-    let v243 = v81.mul_add(v196, v242);
-    let v244 = v83.mul_add(v190, v241);
-    let v245 = qd[7].mul_add(v243, v244);
-    let v246 = qd[7] * v112;
-    let v247 = v89.mul_add(v245, v240);
-    let v248 = v246.mul_add(v203, v247);
-    let v250 = v121 - v95;
-    let v251 = v250 - v98;
-    let v252 = v251 - v101;
-    let v253 = v252 - v104;
-    let v254 = v253 - v107;
-    let v255 = v254 - v109;
-    let v256 = -v85;
-    let v257 = v77.mul_add(v256, -v111);
-    let v258 = v89 * v257;
-    let v259 = v255 + v258;
-    let v260 = v14 * 0.5f64;
-    let v261 = v260 * v94;
-    let v262 = v17.mul_add(v124, -v261);
-    let v263 = S::c(p[16]).mul_add(v262, -v98);
-    let v264 = v263 - v101;
-    let v265 = v264 - v104;
-    let v266 = v265 - v107;
-    let v267 = v266 - v109;
-    let v268 = v267 + v258;
-    let v269 = v24 * 0.5f64;
-    let v270 = v269 * v97;
-    let v271 = v27.mul_add(v135, -v270);
-    let v272 = S::c(p[22]).mul_add(v271, -v101);
-    let v273 = v272 - v104;
-    let v274 = v273 - v107;
-    let v275 = v274 - v109;
-    let v276 = v275 + v258;
-    let v277 = v34 * 0.5f64;
-    let v278 = v277 * v100;
-    let v279 = v37.mul_add(v146, -v278);
-    let v280 = S::c(p[28]).mul_add(v279, -v104);
-    let v281 = v280 - v107;
-    let v282 = v281 - v109;
-    let v283 = v282 + v258;
-    let v284 = v44 * 0.5f64;
-    let v285 = v284 * v103;
-    let v286 = v47.mul_add(v157, -v285);
-    let v287 = S::c(p[34]).mul_add(v286, -v107);
-    let v288 = v287 - v109;
-    let v289 = v288 + v258;
-    let v290 = v54 * 0.5f64;
-    let v291 = v290 * v106;
-    let v292 = v57.mul_add(v168, -v291);
-    let v293 = S::c(p[40]).mul_add(v292, -v109);
-    let v294 = v293 + v258;
-    let v295 = v64 * 0.5f64;
-    let v296 = v295 * v79;
-    let v297 = v71.mul_add(v179, -v296);
-    let v298 = S::c(p[46]).mul_add(v297, v258);
-    let v299 = v86 * v203;
-    let v300 = v89.mul_add(v198, v299);
-    let v301 = v19 + v209;
-    let v302 = v29 + v301;
-    let v303 = v39 + v302;
-    let v304 = v49 + v303;
-    let v305 = v59 + v304;
-    let v306 = v73 + v305;
-    let v307 = v83.mul_add(v256, v82);
-    let v308 = v89 * v307;
-    let v309 = v306 + v308;
-    let v310 = v260 * v17;
-    let v311 = v94.mul_add(v124, v310);
-    let v312 = S::c(p[16]).mul_add(v311, v29);
-    let v313 = v39 + v312;
-    let v314 = v49 + v313;
-    let v315 = v59 + v314;
-    let v316 = v73 + v315;
-    let v317 = v316 + v308;
-    let v318 = v269 * v27;
-    let v319 = v97.mul_add(v135, v318);
-    let v320 = S::c(p[22]).mul_add(v319, v39);
-    let v321 = v49 + v320;
-    let v322 = v59 + v321;
-    let v323 = v73 + v322;
-    let v324 = v323 + v308;
-    let v325 = v277 * v37;
-    let v326 = v100.mul_add(v146, v325);
-    let v327 = S::c(p[28]).mul_add(v326, v49);
-    let v328 = v59 + v327;
-    let v329 = v73 + v328;
-    let v330 = v329 + v308;
-    let v331 = v284 * v47;
-    let v332 = v103.mul_add(v157, v331);
-    let v333 = S::c(p[34]).mul_add(v332, v59);
-    let v334 = v73 + v333;
-    let v335 = v334 + v308;
-    let v336 = v290 * v57;
-    let v337 = v106.mul_add(v168, v336);
-    let v338 = S::c(p[40]).mul_add(v337, v73);
-    let v339 = v338 + v308;
-    let v340 = v295 * v71;
-    let v341 = v79.mul_add(v179, v340);
-    let v342 = S::c(p[46]).mul_add(v341, v308);
-    let v343 = v112 * v203;
-    let v344 = v89.mul_add(v243, v343);
-    out[0] = v90;
-    out[1] = v113;
-    out[2] = S::c(p[8]);
-    out[3] = v206;
-    out[4] = v248;
-    out[5] = S::c(0f64);
-    out[6] = v259;
-    out[7] = v268;
-    out[8] = v276;
-    out[9] = v283;
-    out[10] = v289;
-    out[11] = v294;
-    out[12] = v298;
-    out[13] = v300;
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = S::c(0f64);
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = v309;
-    out[30] = v317;
-    out[31] = v324;
-    out[32] = v330;
-    out[33] = v335;
-    out[34] = v339;
-    out[35] = v342;
-    out[36] = v344;
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = S::c(0f64);
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_8`: 443 operations, over f64 or dual numbers.
-pub fn contact_jacobian_8(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_8_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_8_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[0] * 0.5f64;
-    let [v5, v129]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[9];
-    let (v102, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[10];
-    let v10 = v9.mul_add(v8, S::c(p[6]));
-    let v13 = q[1] * 0.5f64;
-    let [v14, v136]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v104, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[16];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[2] * 0.5f64;
-    let [v24, v147]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let v26 = v23 + v25;
-    let (v107, v27): (S, S) = v26.sin_cos();
-    let v28 = v24 * p[22];
-    let v29 = v28 * v27;
-    let v30 = v20 + v29;
-    let v33 = q[3] * 0.5f64;
-    let [v34, v158]: [S; 2] = v33.sinc_orders::<2>();
-    let v35 = v23 + v26;
-    let v36 = v33 + v35;
-    let (v110, v37): (S, S) = v36.sin_cos();
-    let v38 = v34 * p[28];
-    let v39 = v38 * v37;
-    let v40 = v30 + v39;
-    let v43 = q[4] * 0.5f64;
-    let [v44, v169]: [S; 2] = v43.sinc_orders::<2>();
-    let v45 = v33 + v36;
-    let v46 = v43 + v45;
-    let (v113, v47): (S, S) = v46.sin_cos();
-    let v48 = v44 * p[34];
-    let v49 = v48 * v47;
-    let v50 = v40 + v49;
-    let v53 = q[5] * 0.5f64;
-    let [v54, v180]: [S; 2] = v53.sinc_orders::<2>();
-    let v55 = v43 + v46;
-    let v56 = v53 + v55;
-    let (v116, v57): (S, S) = v56.sin_cos();
-    let v58 = v54 * p[40];
-    let v59 = v58 * v57;
-    let v60 = v50 + v59;
-    let v63 = q[6] * 0.5f64;
-    let [v64, v191]: [S; 2] = v63.sinc_orders::<2>();
-    let v65 = v53 + v56;
-    let v66 = v63 + v65;
-    let (v119, v67): (S, S) = v66.sin_cos();
-    let v68 = v64 * p[46];
-    let v69 = v68 * v67;
-    let v70 = v60 + v69;
-    let v73 = q[7] * 0.5f64;
-    let [v74, v202]: [S; 2] = v73.sinc_orders::<2>();
-    let v75 = v63 + v66;
-    let (v76, v77): (S, S) = v75.sin_cos();
-    let (v78, v79): (S, S) = v73.sin_cos();
-    let v80 = v76 * v78;
-    let v81 = v77.mul_add(v79, -v80);
-    let v82 = v74 * p[52];
-    let v83 = v82 * v81;
-    let v84 = v70 + v83;
-    let v86 = q[8] * 0.5f64;
-    let (v93, v87): (S, S) = v86.sin_cos();
-    let v88 = v77 * v78;
-    let v89 = v76.mul_add(v79, v88);
-    let v90 = v89 * v78;
-    let v91 = v81.mul_add(v79, -v90);
-    let v92 = v87 * v91;
-    let v94 = v81 * v78;
-    let v95 = v89.mul_add(v79, v94);
-    let v96 = (-v93).mul_add(v95, v92);
-    let [v98, v225]: [S; 2] = v86.sinc_orders::<2>();
-    let v99 = v98 * p[58];
-    let v100 = v96.mul_add(v99, v84);
-    let v103 = v9.mul_add(v102, S::c(p[7]));
-    let v105 = v18 * v104;
-    let v106 = v103 + v105;
-    let v108 = v28 * v107;
-    let v109 = v106 + v108;
-    let v111 = v38 * v110;
-    let v112 = v109 + v111;
-    let v114 = v48 * v113;
-    let v115 = v112 + v114;
-    let v117 = v58 * v116;
-    let v118 = v115 + v117;
-    let v120 = v68 * v119;
-    let v121 = v118 + v120;
-    let v122 = v82 * v89;
-    let v123 = v121 + v122;
-    let v124 = v93 * v91;
-    let v125 = v87.mul_add(v95, v124);
-    let v126 = v125.mul_add(v99, v123);
-    let v130 = v129 * 0.5f64;
-    let v131 = v5 * 0.5f64;
-    let v132 = v131 * v102;
-    let v133 = v8.mul_add(v130, -v132);
-    let v134 = v133 * p[10];
-    let v137 = v136 * 0.5f64;
-    let v138 = qd[1] * v17;
-    let v139 = qd[1] * 0.5f64;
-    let v140 = qd[0] + v139;
-    let v141 = v14 * v104;
-    let v142 = v141 * v140;
-    let v143 = v138.mul_add(v137, -v142);
-    let v144 = v143 * p[16];
-    let v145 = qd[0].mul_add(v134, v144);
-    let v148 = v147 * 0.5f64;
-    let v149 = qd[2] * v27;
-    let v150 = qd[2] * 0.5f64;
-    let v151 = v139 + v140;
-    let v152 = v150 + v151;
-    let v153 = v24 * v107;
-    let v154 = v153 * v152;
-    let v155 = v149.mul_add(v148, -v154);
-    let v156 = S::c(p[22]).mul_add(v155, v145);
-    let v159 = v158 * 0.5f64;
-    let v160 = qd[3] * v37;
-    let v161 = qd[3] * 0.5f64;
-    let v162 = v150 + v152;
-    let v163 = v161 + v162;
-    let v164 = v34 * v110;
-    let v165 = v164 * v163;
-    let v166 = v160.mul_add(v159, -v165);
-    let v167 = S::c(p[28]).mul_add(v166, v156);
-    let v170 = v169 * 0.5f64;
-    let v171 = qd[4] * v47;
-    let v172 = qd[4] * 0.5f64;
-    let v173 = v161 + v163;
-    let v174 = v172 + v173;
-    let v175 = v44 * v113;
-    let v176 = v175 * v174;
-    let v177 = v171.mul_add(v170, -v176);
-    let v178 = S::c(p[34]).mul_add(v177, v167);
-    let v181 = v180 * 0.5f64;
-    let v182 = qd[5] * v57;
-    let v183 = qd[5] * 0.5f64;
-    let v184 = v172 + v174;
-    let v185 = v183 + v184;
-    let v186 = v54 * v116;
-    let v187 = v186 * v185;
-    let v188 = v182.mul_add(v181, -v187);
-    let v189 = S::c(p[40]).mul_add(v188, v178);
-    let v192 = v191 * 0.5f64;
-    let v193 = qd[6] * v67;
-    let v194 = qd[6] * 0.5f64;
-    let v195 = v183 + v185;
-    let v196 = v194 + v195;
-    let v197 = v64 * v119;
-    let v198 = v197 * v196;
-    let v199 = v193.mul_add(v192, -v198);
-    let v200 = S::c(p[46]).mul_add(v199, v189);
-    let v203 = v202 * 0.5f64;
-    let v204 = qd[7] * v81;
-    let v205 = qd[7] * 0.5f64;
-    let v206 = v194 + v196;
-    let v207 = v205 + v206;
-    let v208 = v74 * v89;
-    let v209 = v208 * v207;
-    let v210 = v204.mul_add(v203, -v209);
-    let v211 = S::c(p[52]).mul_add(v210, v200);
-    let v212 = v205 + v207;
-    let v213 = v95 * v212;
-    let v214 = -v213;
-    let v215 = v91 * v212;
-    let v216 = v93 * v215;
-    let v219 = v93 * (-0.5f64);
-    let v220 = v87 * 0.5f64;
-    let v221 = v95 * v220;
-    let v222 = v91.mul_add(v219, -v221);
-    let v223 = v87.mul_add(v214, -v216);
-    let v224 = qd[8].mul_add(v222, v223);
-    let v226 = v225 * 0.5f64;
-    let v227 = v226 * p[58];
-    let v228 = qd[8] * v96;
-    let v229 = v99.mul_add(v224, v211);
-    let v230 = v228.mul_add(v227, v229);
-    let v231 = v131 * v8;
-    let v232 = v102.mul_add(v130, v231);
-    let v233 = v232 * p[10];
-    let v234 = qd[1] * v104;
-    let v235 = v14 * v17;
-    let v236 = v235 * v140;
-    let v237 = v234.mul_add(v137, v236);
-    let v238 = v237 * p[16];
-    let v239 = qd[0].mul_add(v233, v238);
-    let v240 = qd[2] * v107;
-    let v241 = v24 * v27;
-    let v242 = v241 * v152;
-    let v243 = v240.mul_add(v148, v242);
-    let v244 = S::c(p[22]).mul_add(v243, v239);
-    let v245 = qd[3] * v110;
-    let v246 = v34 * v37;
-    let v247 = v246 * v163;
-    let v248 = v245.mul_add(v159, v247);
-    let v249 = S::c(p[28]).mul_add(v248, v244);
-    let v250 = qd[4] * v113;
-    let v251 = v44 * v47;
-    let v252 = v251 * v174;
-    let v253 = v250.mul_add(v170, v252);
-    let v254 = S::c(p[34]).mul_add(v253, v249);
-    let v255 = qd[5] * v116;
-    let v256 = v54 * v57;
-    let v257 = v256 * v185;
-    let v258 = v255.mul_add(v181, v257);
-    let v259 = S::c(p[40]).mul_add(v258, v254);
-    let v260 = qd[6] * v119;
-    let v261 = v64 * v67;
-    let v262 = v261 * v196;
-    let v263 = v260.mul_add(v192, v262);
-    let v264 = S::c(p[46]).mul_add(v263, v259);
-    let v265 = qd[7] * v89;
-    let v266 = v74 * v81;
-    let v267 = v266 * v207;
-    let v268 = v265.mul_add(v203, v267);
-    let v269 = S::c(p[52]).mul_add(v268, v264);
-    let v270 = v87 * v215;
-    let v271 = v95 * v219;
-    let v272 = v91.mul_add(v220, v271);
-    let v273 = v93.mul_add(v214, v270);
-    let v274 = qd[8].mul_add(v272, v273);
-    let v275 = qd[8] * v125;
-    let v276 = v99.mul_add(v274, v269);
-    let v277 = v275.mul_add(v227, v276);
-    let v279 = v134 - v105;
-    let v280 = v279 - v108;
-    let v281 = v280 - v111;
-    let v282 = v281 - v114;
-    let v283 = v282 - v117;
-    let v284 = v283 - v120;
-    let v285 = v284 - v122;
-    let v286 = -v95;
-    let v287 = v87.mul_add(v286, -v124);
-    let v288 = v99 * v287;
-    let v289 = v285 + v288;
-    let v290 = v14 * 0.5f64;
-    let v291 = v290 * v104;
-    let v292 = v17.mul_add(v137, -v291);
-    let v293 = S::c(p[16]).mul_add(v292, -v108);
-    let v294 = v293 - v111;
-    let v295 = v294 - v114;
-    let v296 = v295 - v117;
-    let v297 = v296 - v120;
-    let v298 = v297 - v122;
-    let v299 = v298 + v288;
-    let v300 = v24 * 0.5f64;
-    let v301 = v300 * v107;
-    let v302 = v27.mul_add(v148, -v301);
-    let v303 = S::c(p[22]).mul_add(v302, -v111);
-    let v304 = v303 - v114;
-    let v305 = v304 - v117;
-    let v306 = v305 - v120;
-    let v307 = v306 - v122;
-    let v308 = v307 + v288;
-    let v309 = v34 * 0.5f64;
-    let v310 = v309 * v110;
-    let v311 = v37.mul_add(v159, -v310);
-    let v312 = S::c(p[28]).mul_add(v311, -v114);
-    let v313 = v312 - v117;
-    let v314 = v313 - v120;
-    let v315 = v314 - v122;
-    let v316 = v315 + v288;
-    let v317 = v44 * 0.5f64;
-    let v318 = v317 * v113;
-    let v319 = v47.mul_add(v170, -v318);
-    let v320 = S::c(p[34]).mul_add(v319, -v117);
-    let v321 = v320 - v120;
-    let v322 = v321 - v122;
-    let v323 = v322 + v288;
-    let v324 = v54 * 0.5f64;
-    let v325 = v324 * v116;
-    let v326 = v57.mul_add(v181, -v325);
-    let v327 = S::c(p[40]).mul_add(v326, -v120);
-    let v328 = v327 - v122;
-    let v329 = v328 + v288;
-    let v330 = v64 * 0.5f64;
-    let v331 = v330 * v119;
-    let v332 = v67.mul_add(v192, -v331);
-    let v333 = S::c(p[46]).mul_add(v332, -v122);
-    let v334 = v333 + v288;
-    let v335 = v74 * 0.5f64;
-    let v336 = v335 * v89;
-    let v337 = v81.mul_add(v203, -v336);
-    let v338 = S::c(p[52]).mul_add(v337, v288);
-    let v339 = v96 * v227;
-    let v340 = v99.mul_add(v222, v339);
-    let v341 = v19 + v233;
-    let v342 = v29 + v341;
-    let v343 = v39 + v342;
-    let v344 = v49 + v343;
-    let v345 = v59 + v344;
-    let v346 = v69 + v345;
-    let v347 = v83 + v346;
-    let v348 = v93.mul_add(v286, v92);
-    let v349 = v99 * v348;
-    let v350 = v347 + v349;
-    let v351 = v290 * v17;
-    let v352 = v104.mul_add(v137, v351);
-    let v353 = S::c(p[16]).mul_add(v352, v29);
-    let v354 = v39 + v353;
-    let v355 = v49 + v354;
-    let v356 = v59 + v355;
-    let v357 = v69 + v356;
-    let v358 = v83 + v357;
-    let v359 = v358 + v349;
-    let v360 = v300 * v27;
-    let v361 = v107.mul_add(v148, v360);
-    let v362 = S::c(p[22]).mul_add(v361, v39);
-    let v363 = v49 + v362;
-    let v364 = v59 + v363;
-    let v365 = v69 + v364;
-    let v366 = v83 + v365;
-    let v367 = v366 + v349;
-    let v368 = v309 * v37;
-    let v369 = v110.mul_add(v159, v368);
-    let v370 = S::c(p[28]).mul_add(v369, v49);
-    let v371 = v59 + v370;
-    let v372 = v69 + v371;
-    let v373 = v83 + v372;
-    let v374 = v373 + v349;
-    let v375 = v317 * v47;
-    let v376 = v113.mul_add(v170, v375);
-    let v377 = S::c(p[34]).mul_add(v376, v59);
-    let v378 = v69 + v377;
-    let v379 = v83 + v378;
-    let v380 = v379 + v349;
-    let v381 = v324 * v57;
-    let v382 = v116.mul_add(v181, v381);
-    let v383 = S::c(p[40]).mul_add(v382, v69);
-    let v384 = v83 + v383;
-    let v385 = v384 + v349;
-    let v386 = v330 * v67;
-    let v387 = v119.mul_add(v192, v386);
-    let v388 = S::c(p[46]).mul_add(v387, v83);
-    let v389 = v388 + v349;
-    let v390 = v335 * v81;
-    let v391 = v89.mul_add(v203, v390);
-    let v392 = S::c(p[52]).mul_add(v391, v349);
-    let v393 = v125 * v227;
-    let v394 = v99.mul_add(v272, v393);
-    out[0] = v100;
-    out[1] = v126;
-    out[2] = S::c(p[8]);
-    out[3] = v230;
-    out[4] = v277;
-    out[5] = S::c(0f64);
-    out[6] = v289;
-    out[7] = v299;
-    out[8] = v308;
-    out[9] = v316;
-    out[10] = v323;
-    out[11] = v329;
-    out[12] = v334;
-    out[13] = v338;
-    out[14] = v340;
-    out[15] = S::c(0f64);
-    out[16] = S::c(0f64);
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = v350;
-    out[30] = v359;
-    out[31] = v367;
-    out[32] = v374;
-    out[33] = v380;
-    out[34] = v385;
-    out[35] = v389;
-    out[36] = v392;
-    out[37] = v394;
-    out[38] = S::c(0f64);
-    out[39] = S::c(0f64);
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_9`: 500 operations, over f64 or dual numbers.
-pub fn contact_jacobian_9(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_9_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_9_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[0] * 0.5f64;
-    let [v5, v142]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[9];
-    let (v112, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[10];
-    let v10 = v9.mul_add(v8, S::c(p[6]));
-    let v13 = q[1] * 0.5f64;
-    let [v14, v149]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v114, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[16];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[2] * 0.5f64;
-    let [v24, v160]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let v26 = v23 + v25;
-    let (v117, v27): (S, S) = v26.sin_cos();
-    let v28 = v24 * p[22];
-    let v29 = v28 * v27;
-    let v30 = v20 + v29;
-    let v33 = q[3] * 0.5f64;
-    let [v34, v171]: [S; 2] = v33.sinc_orders::<2>();
-    let v35 = v23 + v26;
-    let v36 = v33 + v35;
-    let (v120, v37): (S, S) = v36.sin_cos();
-    let v38 = v34 * p[28];
-    let v39 = v38 * v37;
-    let v40 = v30 + v39;
-    let v43 = q[4] * 0.5f64;
-    let [v44, v182]: [S; 2] = v43.sinc_orders::<2>();
-    let v45 = v33 + v36;
-    let v46 = v43 + v45;
-    let (v123, v47): (S, S) = v46.sin_cos();
-    let v48 = v44 * p[34];
-    let v49 = v48 * v47;
-    let v50 = v40 + v49;
-    let v53 = q[5] * 0.5f64;
-    let [v54, v193]: [S; 2] = v53.sinc_orders::<2>();
-    let v55 = v43 + v46;
-    let v56 = v53 + v55;
-    let (v126, v57): (S, S) = v56.sin_cos();
-    let v58 = v54 * p[40];
-    let v59 = v58 * v57;
-    let v60 = v50 + v59;
-    let v63 = q[6] * 0.5f64;
-    let [v64, v204]: [S; 2] = v63.sinc_orders::<2>();
-    let v65 = v53 + v56;
-    let v66 = v63 + v65;
-    let (v129, v67): (S, S) = v66.sin_cos();
-    let v68 = v64 * p[46];
-    let v69 = v68 * v67;
-    let v70 = v60 + v69;
-    let v73 = q[7] * 0.5f64;
-    let [v74, v215]: [S; 2] = v73.sinc_orders::<2>();
-    let v75 = v63 + v66;
-    let v76 = v73 + v75;
-    let (v132, v77): (S, S) = v76.sin_cos();
-    let v78 = v74 * p[52];
-    let v79 = v78 * v77;
-    let v80 = v70 + v79;
-    let v83 = q[8] * 0.5f64;
-    let [v84, v226]: [S; 2] = v83.sinc_orders::<2>();
-    let v85 = v73 + v76;
-    let (v86, v87): (S, S) = v85.sin_cos();
-    let (v88, v89): (S, S) = v83.sin_cos();
-    let v90 = v86 * v88;
-    let v91 = v87.mul_add(v89, -v90);
-    let v92 = v84 * p[58];
-    let v93 = v92 * v91;
-    let v94 = v80 + v93;
-    let v96 = q[9] * 0.5f64;
-    let (v103, v97): (S, S) = v96.sin_cos();
-    let v98 = v87 * v88;
-    let v99 = v86.mul_add(v89, v98);
-    let v100 = v99 * v88;
-    let v101 = v91.mul_add(v89, -v100);
-    let v102 = v97 * v101;
-    let v104 = v91 * v88;
-    let v105 = v99.mul_add(v89, v104);
-    let v106 = (-v103).mul_add(v105, v102);
-    let [v108, v249]: [S; 2] = v96.sinc_orders::<2>();
-    let v109 = v108 * p[64];
-    let v110 = v106.mul_add(v109, v94);
-    let v113 = v9.mul_add(v112, S::c(p[7]));
-    let v115 = v18 * v114;
-    let v116 = v113 + v115;
-    let v118 = v28 * v117;
-    let v119 = v116 + v118;
-    let v121 = v38 * v120;
-    let v122 = v119 + v121;
-    let v124 = v48 * v123;
-    let v125 = v122 + v124;
-    let v127 = v58 * v126;
-    let v128 = v125 + v127;
-    let v130 = v68 * v129;
-    let v131 = v128 + v130;
-    let v133 = v78 * v132;
-    let v134 = v131 + v133;
-    let v135 = v92 * v99;
-    let v136 = v134 + v135;
-    let v137 = v103 * v101;
-    let v138 = v97.mul_add(v105, v137);
-    let v139 = v138.mul_add(v109, v136);
-    let v143 = v142 * 0.5f64;
-    let v144 = v5 * 0.5f64;
-    let v145 = v144 * v112;
-    let v146 = v8.mul_add(v143, -v145);
-    let v147 = v146 * p[10];
-    let v150 = v149 * 0.5f64;
-    let v151 = qd[1] * v17;
-    let v152 = qd[1] * 0.5f64;
-    let v153 = qd[0] + v152;
-    let v154 = v14 * v114;
-    let v155 = v154 * v153;
-    let v156 = v151.mul_add(v150, -v155);
-    let v157 = v156 * p[16];
-    let v158 = qd[0].mul_add(v147, v157);
-    let v161 = v160 * 0.5f64;
-    let v162 = qd[2] * v27;
-    let v163 = qd[2] * 0.5f64;
-    let v164 = v152 + v153;
-    let v165 = v163 + v164;
-    let v166 = v24 * v117;
-    let v167 = v166 * v165;
-    let v168 = v162.mul_add(v161, -v167);
-    let v169 = S::c(p[22]).mul_add(v168, v158);
-    let v172 = v171 * 0.5f64;
-    let v173 = qd[3] * v37;
-    let v174 = qd[3] * 0.5f64;
-    let v175 = v163 + v165;
-    let v176 = v174 + v175;
-    let v177 = v34 * v120;
-    let v178 = v177 * v176;
-    let v179 = v173.mul_add(v172, -v178);
-    let v180 = S::c(p[28]).mul_add(v179, v169);
-    let v183 = v182 * 0.5f64;
-    let v184 = qd[4] * v47;
-    let v185 = qd[4] * 0.5f64;
-    let v186 = v174 + v176;
-    let v187 = v185 + v186;
-    let v188 = v44 * v123;
-    let v189 = v188 * v187;
-    let v190 = v184.mul_add(v183, -v189);
-    let v191 = S::c(p[34]).mul_add(v190, v180);
-    let v194 = v193 * 0.5f64;
-    let v195 = qd[5] * v57;
-    let v196 = qd[5] * 0.5f64;
-    let v197 = v185 + v187;
-    let v198 = v196 + v197;
-    let v199 = v54 * v126;
-    let v200 = v199 * v198;
-    let v201 = v195.mul_add(v194, -v200);
-    let v202 = S::c(p[40]).mul_add(v201, v191);
-    let v205 = v204 * 0.5f64;
-    let v206 = qd[6] * v67;
-    let v207 = qd[6] * 0.5f64;
-    let v208 = v196 + v198;
-    let v209 = v207 + v208;
-    let v210 = v64 * v129;
-    let v211 = v210 * v209;
-    let v212 = v206.mul_add(v205, -v211);
-    let v213 = S::c(p[46]).mul_add(v212, v202);
-    let v216 = v215 * 0.5f64;
-    let v217 = qd[7] * v77;
-    let v218 = qd[7] * 0.5f64;
-    let v219 = v207 + v209;
-    let v220 = v218 + v219;
-    let v221 = v74 * v132;
-    let v222 = v221 * v220;
-    let v223 = v217.mul_add(v216, -v222);
-    let v224 = S::c(p[52]).mul_add(v223, v213);
-    let v227 = v226 * 0.5f64;
-    let v228 = qd[8] * v91;
-    let v229 = qd[8] * 0.5f64;
-    let v230 = v218 + v220;
-    let v231 = v229 + v230;
-    let v232 = v84 * v99;
-    let v233 = v232 * v231;
-    let v234 = v228.mul_add(v227, -v233);
-    let v235 = S::c(p[58]).mul_add(v234, v224);
-    let v236 = v229 + v231;
-    let v237 = v105 * v236;
-    let v238 = -v237;
-    let v239 = v101 * v236;
-    let v240 = v103 * v239;
-    let v243 = v103 * (-0.5f64);
-    let v244 = v97 * 0.5f64;
-    let v245 = v105 * v244;
-    let v246 = v101.mul_add(v243, -v245);
-    let v247 = v97.mul_add(v238, -v240);
-    let v248 = qd[9].mul_add(v246, v247);
-    let v250 = v249 * 0.5f64;
-    let v251 = v250 * p[64];
-    let v252 = qd[9] * v106;
-    let v253 = v109.mul_add(v248, v235);
-    let v254 = v252.mul_add(v251, v253);
-    let v255 = v144 * v8;
-    let v256 = v112.mul_add(v143, v255);
-    let v257 = v256 * p[10];
-    let v258 = qd[1] * v114;
-    let v259 = v14 * v17;
-    let v260 = v259 * v153;
-    let v261 = v258.mul_add(v150, v260);
-    let v262 = v261 * p[16];
-    let v263 = qd[0].mul_add(v257, v262);
-    let v264 = qd[2] * v117;
-    let v265 = v24 * v27;
-    let v266 = v265 * v165;
-    let v267 = v264.mul_add(v161, v266);
-    let v268 = S::c(p[22]).mul_add(v267, v263);
-    let v269 = qd[3] * v120;
-    let v270 = v34 * v37;
-    let v271 = v270 * v176;
-    let v272 = v269.mul_add(v172, v271);
-    let v273 = S::c(p[28]).mul_add(v272, v268);
-    let v274 = qd[4] * v123;
-    let v275 = v44 * v47;
-    let v276 = v275 * v187;
-    let v277 = v274.mul_add(v183, v276);
-    let v278 = S::c(p[34]).mul_add(v277, v273);
-    let v279 = qd[5] * v126;
-    let v280 = v54 * v57;
-    let v281 = v280 * v198;
-    let v282 = v279.mul_add(v194, v281);
-    let v283 = S::c(p[40]).mul_add(v282, v278);
-    let v284 = qd[6] * v129;
-    let v285 = v64 * v67;
-    let v286 = v285 * v209;
-    let v287 = v284.mul_add(v205, v286);
-    let v288 = S::c(p[46]).mul_add(v287, v283);
-    let v289 = qd[7] * v132;
-    let v290 = v74 * v77;
-    let v291 = v290 * v220;
-    let v292 = v289.mul_add(v216, v291);
-    let v293 = S::c(p[52]).mul_add(v292, v288);
-    let v294 = qd[8] * v99;
-    let v295 = v84 * v91;
-    let v296 = v295 * v231;
-    let v297 = v294.mul_add(v227, v296);
-    let v298 = S::c(p[58]).mul_add(v297, v293);
-    let v299 = v97 * v239;
-    let v300 = v105 * v243;
-    let v301 = v101.mul_add(v244, v300);
-    let v302 = v103.mul_add(v238, v299);
-    let v303 = qd[9].mul_add(v301, v302);
-    let v304 = qd[9] * v138;
-    let v305 = v109.mul_add(v303, v298);
-    let v306 = v304.mul_add(v251, v305);
-    let v308 = v147 - v115;
-    let v309 = v308 - v118;
-    let v310 = v309 - v121;
-    let v311 = v310 - v124;
-    let v312 = v311 - v127;
-    let v313 = v312 - v130;
-    let v314 = v313 - v133;
-    let v315 = v314 - v135;
-    let v316 = -v105;
-    let v317 = v97.mul_add(v316, -v137);
-    let v318 = v109 * v317;
-    let v319 = v315 + v318;
-    let v320 = v14 * 0.5f64;
-    let v321 = v320 * v114;
-    let v322 = v17.mul_add(v150, -v321);
-    let v323 = S::c(p[16]).mul_add(v322, -v118);
-    let v324 = v323 - v121;
-    let v325 = v324 - v124;
-    let v326 = v325 - v127;
-    let v327 = v326 - v130;
-    let v328 = v327 - v133;
-    let v329 = v328 - v135;
-    let v330 = v329 + v318;
-    let v331 = v24 * 0.5f64;
-    let v332 = v331 * v117;
-    let v333 = v27.mul_add(v161, -v332);
-    let v334 = S::c(p[22]).mul_add(v333, -v121);
-    let v335 = v334 - v124;
-    let v336 = v335 - v127;
-    let v337 = v336 - v130;
-    let v338 = v337 - v133;
-    let v339 = v338 - v135;
-    let v340 = v339 + v318;
-    let v341 = v34 * 0.5f64;
-    let v342 = v341 * v120;
-    let v343 = v37.mul_add(v172, -v342);
-    let v344 = S::c(p[28]).mul_add(v343, -v124);
-    let v345 = v344 - v127;
-    let v346 = v345 - v130;
-    let v347 = v346 - v133;
-    let v348 = v347 - v135;
-    let v349 = v348 + v318;
-    let v350 = v44 * 0.5f64;
-    let v351 = v350 * v123;
-    let v352 = v47.mul_add(v183, -v351);
-    let v353 = S::c(p[34]).mul_add(v352, -v127);
-    let v354 = v353 - v130;
-    let v355 = v354 - v133;
-    let v356 = v355 - v135;
-    let v357 = v356 + v318;
-    let v358 = v54 * 0.5f64;
-    let v359 = v358 * v126;
-    let v360 = v57.mul_add(v194, -v359);
-    let v361 = S::c(p[40]).mul_add(v360, -v130);
-    let v362 = v361 - v133;
-    let v363 = v362 - v135;
-    let v364 = v363 + v318;
-    let v365 = v64 * 0.5f64;
-    let v366 = v365 * v129;
-    let v367 = v67.mul_add(v205, -v366);
-    let v368 = S::c(p[46]).mul_add(v367, -v133);
-    let v369 = v368 - v135;
-    let v370 = v369 + v318;
-    let v371 = v74 * 0.5f64;
-    let v372 = v371 * v132;
-    let v373 = v77.mul_add(v216, -v372);
-    let v374 = S::c(p[52]).mul_add(v373, -v135);
-    let v375 = v374 + v318;
-    let v376 = v84 * 0.5f64;
-    let v377 = v376 * v99;
-    let v378 = v91.mul_add(v227, -v377);
-    let v379 = S::c(p[58]).mul_add(v378, v318);
-    let v380 = v106 * v251;
-    let v381 = v109.mul_add(v246, v380);
-    let v382 = v19 + v257;
-    let v383 = v29 + v382;
-    let v384 = v39 + v383;
-    let v385 = v49 + v384;
-    let v386 = v59 + v385;
-    let v387 = v69 + v386;
-    let v388 = v79 + v387;
-    let v389 = v93 + v388;
-    let v390 = v103.mul_add(v316, v102);
-    let v391 = v109 * v390;
-    let v392 = v389 + v391;
-    let v393 = v320 * v17;
-    let v394 = v114.mul_add(v150, v393);
-    let v395 = S::c(p[16]).mul_add(v394, v29);
-    let v396 = v39 + v395;
-    let v397 = v49 + v396;
-    let v398 = v59 + v397;
-    let v399 = v69 + v398;
-    let v400 = v79 + v399;
-    let v401 = v93 + v400;
-    let v402 = v401 + v391;
-    let v403 = v331 * v27;
-    let v404 = v117.mul_add(v161, v403);
-    let v405 = S::c(p[22]).mul_add(v404, v39);
-    let v406 = v49 + v405;
-    let v407 = v59 + v406;
-    let v408 = v69 + v407;
-    let v409 = v79 + v408;
-    let v410 = v93 + v409;
-    let v411 = v410 + v391;
-    let v412 = v341 * v37;
-    let v413 = v120.mul_add(v172, v412);
-    let v414 = S::c(p[28]).mul_add(v413, v49);
-    let v415 = v59 + v414;
-    let v416 = v69 + v415;
-    let v417 = v79 + v416;
-    let v418 = v93 + v417;
-    let v419 = v418 + v391;
-    let v420 = v350 * v47;
-    let v421 = v123.mul_add(v183, v420);
-    let v422 = S::c(p[34]).mul_add(v421, v59);
-    let v423 = v69 + v422;
-    let v424 = v79 + v423;
-    let v425 = v93 + v424;
-    let v426 = v425 + v391;
-    let v427 = v358 * v57;
-    let v428 = v126.mul_add(v194, v427);
-    let v429 = S::c(p[40]).mul_add(v428, v69);
-    let v430 = v79 + v429;
-    let v431 = v93 + v430;
-    let v432 = v431 + v391;
-    let v433 = v365 * v67;
-    let v434 = v129.mul_add(v205, v433);
-    let v435 = S::c(p[46]).mul_add(v434, v79);
-    let v436 = v93 + v435;
-    let v437 = v436 + v391;
-    let v438 = v371 * v77;
-    let v439 = v132.mul_add(v216, v438);
-    let v440 = S::c(p[52]).mul_add(v439, v93);
-    let v441 = v440 + v391;
-    let v442 = v376 * v91;
-    let v443 = v99.mul_add(v227, v442);
-    let v444 = S::c(p[58]).mul_add(v443, v391);
-    let v445 = v138 * v251;
-    let v446 = v109.mul_add(v301, v445);
-    out[0] = v110;
-    out[1] = v139;
-    out[2] = S::c(p[8]);
-    out[3] = v254;
-    out[4] = v306;
-    out[5] = S::c(0f64);
-    out[6] = v319;
-    out[7] = v330;
-    out[8] = v340;
-    out[9] = v349;
-    out[10] = v357;
-    out[11] = v364;
-    out[12] = v370;
-    out[13] = v375;
-    out[14] = v379;
-    out[15] = v381;
-    out[16] = S::c(0f64);
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = v392;
-    out[30] = v402;
-    out[31] = v411;
-    out[32] = v419;
-    out[33] = v426;
-    out[34] = v432;
-    out[35] = v437;
-    out[36] = v441;
-    out[37] = v444;
-    out[38] = v446;
-    out[39] = S::c(0f64);
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_10`: 34 operations, over f64 or dual numbers.
-pub fn contact_jacobian_10(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_10_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_10_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v3 = q[10] * 0.5f64;
-    let (v6, v4): (S, S) = v3.sin_cos();
-    let v8 = v6 * p[337];
-    let v9 = v4.mul_add(S::c(p[336]), -v8);
-    let [v11, v25]: [S; 2] = v3.sinc_orders::<2>();
-    let v12 = v11 * p[77];
-    let v13 = v9.mul_add(v12, S::c(p[73]));
-    let v15 = v4 * p[337];
-    let v16 = v6.mul_add(S::c(p[336]), v15);
-    let v17 = v16.mul_add(v12, S::c(p[74]));
-    let v21 = v6 * (-0.5f64);
-    let v22 = v4 * 0.5f64;
-    let v23 = v22 * p[337];
-    let v24 = S::c(p[336]).mul_add(v21, -v23);
-    let v26 = v25 * 0.5f64;
-    let v27 = v26 * p[77];
-    let v28 = v9 * v27;
-    let v29 = v12.mul_add(v24, v28);
-    let v30 = qd[10] * v29;
-    let v31 = v21 * p[337];
-    let v32 = S::c(p[336]).mul_add(v22, v31);
-    let v33 = v16 * v27;
-    let v34 = v12.mul_add(v32, v33);
-    let v35 = qd[10] * v34;
-    out[0] = v13;
-    out[1] = v17;
-    out[2] = S::c(p[75]);
-    out[3] = v30;
-    out[4] = v35;
-    out[5] = S::c(0f64);
-    out[6] = S::c(0f64);
-    out[7] = S::c(0f64);
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = v29;
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = S::c(0f64);
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = v34;
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_11`: 91 operations, over f64 or dual numbers.
-pub fn contact_jacobian_11(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_11_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_11_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[10] * 0.5f64;
-    let [v5, v37]: [S; 2] = v4.sinc_orders::<2>();
-    let (v8, v9): (S, S) = v4.sin_cos();
-    let v10 = v8 * p[183];
-    let v11 = S::c(p[184]).mul_add(v9, -v10);
-    let v12 = v5 * p[77];
-    let v13 = v12.mul_add(v11, S::c(p[73]));
-    let v15 = q[11] * 0.5f64;
-    let (v22, v16): (S, S) = v15.sin_cos();
-    let v17 = v8 * p[184];
-    let v18 = S::c(p[183]).mul_add(v9, v17);
-    let v19 = v18 * v8;
-    let v20 = v11.mul_add(v9, -v19);
-    let v21 = v16 * v20;
-    let v23 = v11 * v8;
-    let v24 = v18.mul_add(v9, v23);
-    let v25 = (-v22).mul_add(v24, v21);
-    let [v27, v54]: [S; 2] = v15.sinc_orders::<2>();
-    let v28 = v27 * p[83];
-    let v29 = v25.mul_add(v28, v13);
-    let v31 = v12.mul_add(v18, S::c(p[74]));
-    let v32 = v22 * v20;
-    let v33 = v16.mul_add(v24, v32);
-    let v34 = v33.mul_add(v28, v31);
-    let v38 = v37 * 0.5f64;
-    let v39 = v5 * 0.5f64;
-    let v40 = v39 * v18;
-    let v41 = v11.mul_add(v38, -v40);
-    let v42 = v41 * p[77];
-    let v43 = -v24;
-    let v44 = v16.mul_add(v43, -v32);
-    let v47 = v22 * (-0.5f64);
-    let v48 = v16 * 0.5f64;
-    let v49 = v24 * v48;
-    let v50 = v20.mul_add(v47, -v49);
-    let v51 = qd[11] * v50;
-    let v52 = qd[10].mul_add(v44, v51);
-    let v53 = v28 * v52;
-    let v55 = v54 * 0.5f64;
-    let v56 = v55 * p[83];
-    let v57 = qd[11] * v25;
-    let v58 = qd[10].mul_add(v42, v53);
-    let v59 = v57.mul_add(v56, v58);
-    let v60 = v39 * v11;
-    let v61 = v18.mul_add(v38, v60);
-    let v62 = v61 * p[77];
-    let v63 = v22.mul_add(v43, v21);
-    let v64 = v24 * v47;
-    let v65 = v20.mul_add(v48, v64);
-    let v66 = qd[11] * v65;
-    let v67 = qd[10].mul_add(v63, v66);
-    let v68 = v28 * v67;
-    let v69 = qd[11] * v33;
-    let v70 = qd[10].mul_add(v62, v68);
-    let v71 = v69.mul_add(v56, v70);
-    let v73 = v28.mul_add(v44, v42);
-    let v74 = v25 * v56;
-    let v75 = v28.mul_add(v50, v74);
-    let v76 = v28.mul_add(v63, v62);
-    let v77 = v33 * v56;
-    let v78 = v28.mul_add(v65, v77);
-    out[0] = v29;
-    out[1] = v34;
-    out[2] = S::c(p[75]);
-    out[3] = v59;
-    out[4] = v71;
-    out[5] = S::c(0f64);
-    out[6] = S::c(0f64);
-    out[7] = S::c(0f64);
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = v73;
-    out[17] = v75;
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = S::c(0f64);
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = v76;
-    out[40] = v78;
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_12`: 143 operations, over f64 or dual numbers.
-pub fn contact_jacobian_12(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_12_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_12_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[10] * 0.5f64;
-    let [v5, v51]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[76];
-    let (v42, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[77];
-    let v10 = v9.mul_add(v8, S::c(p[73]));
-    let v13 = q[11] * 0.5f64;
-    let [v14, v58]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let (v16, v17): (S, S) = v15.sin_cos();
-    let (v18, v19): (S, S) = v13.sin_cos();
-    let v20 = v16 * v18;
-    let v21 = v17.mul_add(v19, -v20);
-    let v22 = v14 * p[83];
-    let v23 = v22 * v21;
-    let v24 = v10 + v23;
-    let v26 = q[12] * 0.5f64;
-    let (v33, v27): (S, S) = v26.sin_cos();
-    let v28 = v17 * v18;
-    let v29 = v16.mul_add(v19, v28);
-    let v30 = v29 * v18;
-    let v31 = v21.mul_add(v19, -v30);
-    let v32 = v27 * v31;
-    let v34 = v21 * v18;
-    let v35 = v29.mul_add(v19, v34);
-    let v36 = (-v33).mul_add(v35, v32);
-    let [v38, v81]: [S; 2] = v26.sinc_orders::<2>();
-    let v39 = v38 * p[89];
-    let v40 = v36.mul_add(v39, v24);
-    let v43 = v9.mul_add(v42, S::c(p[74]));
-    let v44 = v22 * v29;
-    let v45 = v43 + v44;
-    let v46 = v33 * v31;
-    let v47 = v27.mul_add(v35, v46);
-    let v48 = v47.mul_add(v39, v45);
-    let v52 = v51 * 0.5f64;
-    let v53 = v5 * 0.5f64;
-    let v54 = v53 * v42;
-    let v55 = v8.mul_add(v52, -v54);
-    let v56 = v55 * p[77];
-    let v59 = v58 * 0.5f64;
-    let v60 = qd[11] * v21;
-    let v61 = qd[11] * 0.5f64;
-    let v62 = qd[10] + v61;
-    let v63 = v14 * v29;
-    let v64 = v63 * v62;
-    let v65 = v60.mul_add(v59, -v64);
-    let v66 = v65 * p[83];
-    let v67 = qd[10].mul_add(v56, v66);
-    let v68 = v61 + v62;
-    let v69 = v35 * v68;
-    let v70 = -v69;
-    let v71 = v31 * v68;
-    let v72 = v33 * v71;
-    let v75 = v33 * (-0.5f64);
-    let v76 = v27 * 0.5f64;
-    let v77 = v35 * v76;
-    let v78 = v31.mul_add(v75, -v77);
-    let v79 = v27.mul_add(v70, -v72);
-    let v80 = qd[12].mul_add(v78, v79);
-    let v82 = v81 * 0.5f64;
-    let v83 = v82 * p[89];
-    let v84 = qd[12] * v36;
-    let v85 = v39.mul_add(v80, v67);
-    let v86 = v84.mul_add(v83, v85);
-    let v87 = v53 * v8;
-    let v88 = v42.mul_add(v52, v87);
-    let v89 = v88 * p[77];
-    let v90 = qd[11] * v29;
-    let v91 = v14 * v21;
-    let v92 = v91 * v62;
-    let v93 = v90.mul_add(v59, v92);
-    let v94 = v93 * p[83];
-    let v95 = qd[10].mul_add(v89, v94);
-    let v96 = v27 * v71;
-    let v97 = v35 * v75;
-    let v98 = v31.mul_add(v76, v97);
-    let v99 = v33.mul_add(v70, v96);
-    let v100 = qd[12].mul_add(v98, v99);
-    let v101 = qd[12] * v47;
-    let v102 = v39.mul_add(v100, v95);
-    let v103 = v101.mul_add(v83, v102);
-    let v105 = v56 - v44;
-    let v106 = -v35;
-    let v107 = v27.mul_add(v106, -v46);
-    let v108 = v39 * v107;
-    let v109 = v105 + v108;
-    let v110 = v14 * 0.5f64;
-    let v111 = v110 * v29;
-    let v112 = v21.mul_add(v59, -v111);
-    let v113 = S::c(p[83]).mul_add(v112, v108);
-    let v114 = v36 * v83;
-    let v115 = v39.mul_add(v78, v114);
-    let v116 = v23 + v89;
-    let v117 = v33.mul_add(v106, v32);
-    let v118 = v39 * v117;
-    let v119 = v116 + v118;
-    let v120 = v110 * v21;
-    let v121 = v29.mul_add(v59, v120);
-    let v122 = S::c(p[83]).mul_add(v121, v118);
-    let v123 = v47 * v83;
-    let v124 = v39.mul_add(v98, v123);
-    out[0] = v40;
-    out[1] = v48;
-    out[2] = S::c(p[75]);
-    out[3] = v86;
-    out[4] = v103;
-    out[5] = S::c(0f64);
-    out[6] = S::c(0f64);
-    out[7] = S::c(0f64);
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = v109;
-    out[17] = v113;
-    out[18] = v115;
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = S::c(0f64);
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = v119;
-    out[40] = v122;
-    out[41] = v124;
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_13`: 188 operations, over f64 or dual numbers.
-pub fn contact_jacobian_13(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_13_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_13_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[10] * 0.5f64;
-    let [v5, v64]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[76];
-    let (v52, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[77];
-    let v10 = v9.mul_add(v8, S::c(p[73]));
-    let v13 = q[11] * 0.5f64;
-    let [v14, v71]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v54, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[83];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[12] * 0.5f64;
-    let [v24, v82]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let (v26, v27): (S, S) = v25.sin_cos();
-    let (v28, v29): (S, S) = v23.sin_cos();
-    let v30 = v26 * v28;
-    let v31 = v27.mul_add(v29, -v30);
-    let v32 = v24 * p[89];
-    let v33 = v32 * v31;
-    let v34 = v20 + v33;
-    let v36 = q[13] * 0.5f64;
-    let (v43, v37): (S, S) = v36.sin_cos();
-    let v38 = v27 * v28;
-    let v39 = v26.mul_add(v29, v38);
-    let v40 = v39 * v28;
-    let v41 = v31.mul_add(v29, -v40);
-    let v42 = v37 * v41;
-    let v44 = v31 * v28;
-    let v45 = v39.mul_add(v29, v44);
-    let v46 = (-v43).mul_add(v45, v42);
-    let [v48, v105]: [S; 2] = v36.sinc_orders::<2>();
-    let v49 = v48 * p[95];
-    let v50 = v46.mul_add(v49, v34);
-    let v53 = v9.mul_add(v52, S::c(p[74]));
-    let v55 = v18 * v54;
-    let v56 = v53 + v55;
-    let v57 = v32 * v39;
-    let v58 = v56 + v57;
-    let v59 = v43 * v41;
-    let v60 = v37.mul_add(v45, v59);
-    let v61 = v60.mul_add(v49, v58);
-    let v65 = v64 * 0.5f64;
-    let v66 = v5 * 0.5f64;
-    let v67 = v66 * v52;
-    let v68 = v8.mul_add(v65, -v67);
-    let v69 = v68 * p[77];
-    let v72 = v71 * 0.5f64;
-    let v73 = qd[11] * v17;
-    let v74 = qd[11] * 0.5f64;
-    let v75 = qd[10] + v74;
-    let v76 = v14 * v54;
-    let v77 = v76 * v75;
-    let v78 = v73.mul_add(v72, -v77);
-    let v79 = v78 * p[83];
-    let v80 = qd[10].mul_add(v69, v79);
-    let v83 = v82 * 0.5f64;
-    let v84 = qd[12] * v31;
-    let v85 = qd[12] * 0.5f64;
-    let v86 = v74 + v75;
-    let v87 = v85 + v86;
-    let v88 = v24 * v39;
-    let v89 = v88 * v87;
-    let v90 = v84.mul_add(v83, -v89);
-    let v91 = S::c(p[89]).mul_add(v90, v80);
-    let v92 = v85 + v87;
-    let v93 = v45 * v92;
-    let v94 = -v93;
-    let v95 = v41 * v92;
-    let v96 = v43 * v95;
-    let v99 = v43 * (-0.5f64);
-    let v100 = v37 * 0.5f64;
-    let v101 = v45 * v100;
-    let v102 = v41.mul_add(v99, -v101);
-    let v103 = v37.mul_add(v94, -v96);
-    let v104 = qd[13].mul_add(v102, v103);
-    let v106 = v105 * 0.5f64;
-    let v107 = v106 * p[95];
-    let v108 = qd[13] * v46;
-    let v109 = v49.mul_add(v104, v91);
-    let v110 = v108.mul_add(v107, v109);
-    let v111 = v66 * v8;
-    let v112 = v52.mul_add(v65, v111);
-    let v113 = v112 * p[77];
-    let v114 = qd[11] * v54;
-    let v115 = v14 * v17;
-    let v116 = v115 * v75;
-    let v117 = v114.mul_add(v72, v116);
-    let v118 = v117 * p[83];
-    let v119 = qd[10].mul_add(v113, v118);
-    let v120 = qd[12] * v39;
-    let v121 = v24 * v31;
-    let v122 = v121 * v87;
-    let v123 = v120.mul_add(v83, v122);
-    let v124 = S::c(p[89]).mul_add(v123, v119);
-    let v125 = v37 * v95;
-    let v126 = v45 * v99;
-    let v127 = v41.mul_add(v100, v126);
-    let v128 = v43.mul_add(v94, v125);
-    let v129 = qd[13].mul_add(v127, v128);
-    let v130 = qd[13] * v60;
-    let v131 = v49.mul_add(v129, v124);
-    let v132 = v130.mul_add(v107, v131);
-    let v134 = v69 - v55;
-    let v135 = v134 - v57;
-    let v136 = -v45;
-    let v137 = v37.mul_add(v136, -v59);
-    let v138 = v49 * v137;
-    let v139 = v135 + v138;
-    let v140 = v14 * 0.5f64;
-    let v141 = v140 * v54;
-    let v142 = v17.mul_add(v72, -v141);
-    let v143 = S::c(p[83]).mul_add(v142, -v57);
-    let v144 = v143 + v138;
-    let v145 = v24 * 0.5f64;
-    let v146 = v145 * v39;
-    let v147 = v31.mul_add(v83, -v146);
-    let v148 = S::c(p[89]).mul_add(v147, v138);
-    let v149 = v46 * v107;
-    let v150 = v49.mul_add(v102, v149);
-    let v151 = v19 + v113;
-    let v152 = v33 + v151;
-    let v153 = v43.mul_add(v136, v42);
-    let v154 = v49 * v153;
-    let v155 = v152 + v154;
-    let v156 = v140 * v17;
-    let v157 = v54.mul_add(v72, v156);
-    let v158 = S::c(p[83]).mul_add(v157, v33);
-    let v159 = v158 + v154;
-    let v160 = v145 * v31;
-    let v161 = v39.mul_add(v83, v160);
-    let v162 = S::c(p[89]).mul_add(v161, v154);
-    let v163 = v60 * v107;
-    let v164 = v49.mul_add(v127, v163);
-    out[0] = v50;
-    out[1] = v61;
-    out[2] = S::c(p[75]);
-    out[3] = v110;
-    out[4] = v132;
-    out[5] = S::c(0f64);
-    out[6] = S::c(0f64);
-    out[7] = S::c(0f64);
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = v139;
-    out[17] = v144;
-    out[18] = v148;
-    out[19] = v150;
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = S::c(0f64);
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = v155;
-    out[40] = v159;
-    out[41] = v162;
-    out[42] = v164;
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_14`: 235 operations, over f64 or dual numbers.
-pub fn contact_jacobian_14(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_14_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_14_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[10] * 0.5f64;
-    let [v5, v77]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[76];
-    let (v62, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[77];
-    let v10 = v9.mul_add(v8, S::c(p[73]));
-    let v13 = q[11] * 0.5f64;
-    let [v14, v84]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v64, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[83];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[12] * 0.5f64;
-    let [v24, v95]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let v26 = v23 + v25;
-    let (v67, v27): (S, S) = v26.sin_cos();
-    let v28 = v24 * p[89];
-    let v29 = v28 * v27;
-    let v30 = v20 + v29;
-    let v33 = q[13] * 0.5f64;
-    let [v34, v106]: [S; 2] = v33.sinc_orders::<2>();
-    let v35 = v23 + v26;
-    let (v36, v37): (S, S) = v35.sin_cos();
-    let (v38, v39): (S, S) = v33.sin_cos();
-    let v40 = v36 * v38;
-    let v41 = v37.mul_add(v39, -v40);
-    let v42 = v34 * p[95];
-    let v43 = v42 * v41;
-    let v44 = v30 + v43;
-    let v46 = q[14] * 0.5f64;
-    let (v53, v47): (S, S) = v46.sin_cos();
-    let v48 = v37 * v38;
-    let v49 = v36.mul_add(v39, v48);
-    let v50 = v49 * v38;
-    let v51 = v41.mul_add(v39, -v50);
-    let v52 = v47 * v51;
-    let v54 = v41 * v38;
-    let v55 = v49.mul_add(v39, v54);
-    let v56 = (-v53).mul_add(v55, v52);
-    let [v58, v129]: [S; 2] = v46.sinc_orders::<2>();
-    let v59 = v58 * p[101];
-    let v60 = v56.mul_add(v59, v44);
-    let v63 = v9.mul_add(v62, S::c(p[74]));
-    let v65 = v18 * v64;
-    let v66 = v63 + v65;
-    let v68 = v28 * v67;
-    let v69 = v66 + v68;
-    let v70 = v42 * v49;
-    let v71 = v69 + v70;
-    let v72 = v53 * v51;
-    let v73 = v47.mul_add(v55, v72);
-    let v74 = v73.mul_add(v59, v71);
-    let v78 = v77 * 0.5f64;
-    let v79 = v5 * 0.5f64;
-    let v80 = v79 * v62;
-    let v81 = v8.mul_add(v78, -v80);
-    let v82 = v81 * p[77];
-    let v85 = v84 * 0.5f64;
-    let v86 = qd[11] * v17;
-    let v87 = qd[11] * 0.5f64;
-    let v88 = qd[10] + v87;
-    let v89 = v14 * v64;
-    let v90 = v89 * v88;
-    let v91 = v86.mul_add(v85, -v90);
-    let v92 = v91 * p[83];
-    let v93 = qd[10].mul_add(v82, v92);
-    let v96 = v95 * 0.5f64;
-    let v97 = qd[12] * v27;
-    let v98 = qd[12] * 0.5f64;
-    let v99 = v87 + v88;
-    let v100 = v98 + v99;
-    let v101 = v24 * v67;
-    let v102 = v101 * v100;
-    let v103 = v97.mul_add(v96, -v102);
-    let v104 = S::c(p[89]).mul_add(v103, v93);
-    let v107 = v106 * 0.5f64;
-    let v108 = qd[13] * v41;
-    let v109 = qd[13] * 0.5f64;
-    let v110 = v98 + v100;
-    let v111 = v109 + v110;
-    let v112 = v34 * v49;
-    let v113 = v112 * v111;
-    let v114 = v108.mul_add(v107, -v113);
-    let v115 = S::c(p[95]).mul_add(v114, v104);
-    let v116 = v109 + v111;
-    let v117 = v55 * v116;
-    let v118 = -v117;
-    let v119 = v51 * v116;
-    let v120 = v53 * v119;
-    let v123 = v53 * (-0.5f64);
-    let v124 = v47 * 0.5f64;
-    let v125 = v55 * v124;
-    let v126 = v51.mul_add(v123, -v125);
-    let v127 = v47.mul_add(v118, -v120);
-    let v128 = qd[14].mul_add(v126, v127);
-    let v130 = v129 * 0.5f64;
-    let v131 = v130 * p[101];
-    let v132 = qd[14] * v56;
-    let v133 = v59.mul_add(v128, v115);
-    let v134 = v132.mul_add(v131, v133);
-    let v135 = v79 * v8;
-    let v136 = v62.mul_add(v78, v135);
-    let v137 = v136 * p[77];
-    let v138 = qd[11] * v64;
-    let v139 = v14 * v17;
-    let v140 = v139 * v88;
-    let v141 = v138.mul_add(v85, v140);
-    let v142 = v141 * p[83];
-    let v143 = qd[10].mul_add(v137, v142);
-    let v144 = qd[12] * v67;
-    let v145 = v24 * v27;
-    let v146 = v145 * v100;
-    let v147 = v144.mul_add(v96, v146);
-    let v148 = S::c(p[89]).mul_add(v147, v143);
-    let v149 = qd[13] * v49;
-    let v150 = v34 * v41;
-    let v151 = v150 * v111;
-    let v152 = v149.mul_add(v107, v151);
-    let v153 = S::c(p[95]).mul_add(v152, v148);
-    let v154 = v47 * v119;
-    let v155 = v55 * v123;
-    let v156 = v51.mul_add(v124, v155);
-    let v157 = v53.mul_add(v118, v154);
-    let v158 = qd[14].mul_add(v156, v157);
-    let v159 = qd[14] * v73;
-    let v160 = v59.mul_add(v158, v153);
-    let v161 = v159.mul_add(v131, v160);
-    let v163 = v82 - v65;
-    let v164 = v163 - v68;
-    let v165 = v164 - v70;
-    let v166 = -v55;
-    let v167 = v47.mul_add(v166, -v72);
-    let v168 = v59 * v167;
-    let v169 = v165 + v168;
-    let v170 = v14 * 0.5f64;
-    let v171 = v170 * v64;
-    let v172 = v17.mul_add(v85, -v171);
-    let v173 = S::c(p[83]).mul_add(v172, -v68);
-    let v174 = v173 - v70;
-    let v175 = v174 + v168;
-    let v176 = v24 * 0.5f64;
-    let v177 = v176 * v67;
-    let v178 = v27.mul_add(v96, -v177);
-    let v179 = S::c(p[89]).mul_add(v178, -v70);
-    let v180 = v179 + v168;
-    let v181 = v34 * 0.5f64;
-    let v182 = v181 * v49;
-    let v183 = v41.mul_add(v107, -v182);
-    let v184 = S::c(p[95]).mul_add(v183, v168);
-    let v185 = v56 * v131;
-    let v186 = v59.mul_add(v126, v185);
-    let v187 = v19 + v137;
-    let v188 = v29 + v187;
-    let v189 = v43 + v188;
-    let v190 = v53.mul_add(v166, v52);
-    let v191 = v59 * v190;
-    let v192 = v189 + v191;
-    let v193 = v170 * v17;
-    let v194 = v64.mul_add(v85, v193);
-    let v195 = S::c(p[83]).mul_add(v194, v29);
-    let v196 = v43 + v195;
-    let v197 = v196 + v191;
-    let v198 = v176 * v27;
-    let v199 = v67.mul_add(v96, v198);
-    let v200 = S::c(p[89]).mul_add(v199, v43);
-    let v201 = v200 + v191;
-    let v202 = v181 * v41;
-    let v203 = v49.mul_add(v107, v202);
-    let v204 = S::c(p[95]).mul_add(v203, v191);
-    let v205 = v73 * v131;
-    let v206 = v59.mul_add(v156, v205);
-    out[0] = v60;
-    out[1] = v74;
-    out[2] = S::c(p[75]);
-    out[3] = v134;
-    out[4] = v161;
-    out[5] = S::c(0f64);
-    out[6] = S::c(0f64);
-    out[7] = S::c(0f64);
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = v169;
-    out[17] = v175;
-    out[18] = v180;
-    out[19] = v184;
-    out[20] = v186;
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = S::c(0f64);
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = v192;
-    out[40] = v197;
-    out[41] = v201;
-    out[42] = v204;
-    out[43] = v206;
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_15`: 284 operations, over f64 or dual numbers.
-pub fn contact_jacobian_15(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_15_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_15_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[10] * 0.5f64;
-    let [v5, v90]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[76];
-    let (v72, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[77];
-    let v10 = v9.mul_add(v8, S::c(p[73]));
-    let v13 = q[11] * 0.5f64;
-    let [v14, v97]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v74, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[83];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[12] * 0.5f64;
-    let [v24, v108]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let v26 = v23 + v25;
-    let (v77, v27): (S, S) = v26.sin_cos();
-    let v28 = v24 * p[89];
-    let v29 = v28 * v27;
-    let v30 = v20 + v29;
-    let v33 = q[13] * 0.5f64;
-    let [v34, v119]: [S; 2] = v33.sinc_orders::<2>();
-    let v35 = v23 + v26;
-    let v36 = v33 + v35;
-    let (v80, v37): (S, S) = v36.sin_cos();
-    let v38 = v34 * p[95];
-    let v39 = v38 * v37;
-    let v40 = v30 + v39;
-    let v43 = q[14] * 0.5f64;
-    let [v44, v130]: [S; 2] = v43.sinc_orders::<2>();
-    let v45 = v33 + v36;
-    let (v46, v47): (S, S) = v45.sin_cos();
-    let (v48, v49): (S, S) = v43.sin_cos();
-    let v50 = v46 * v48;
-    let v51 = v47.mul_add(v49, -v50);
-    let v52 = v44 * p[101];
-    let v53 = v52 * v51;
-    let v54 = v40 + v53;
-    let v56 = q[15] * 0.5f64;
-    let (v63, v57): (S, S) = v56.sin_cos();
-    let v58 = v47 * v48;
-    let v59 = v46.mul_add(v49, v58);
-    let v60 = v59 * v48;
-    let v61 = v51.mul_add(v49, -v60);
-    let v62 = v57 * v61;
-    let v64 = v51 * v48;
-    let v65 = v59.mul_add(v49, v64);
-    let v66 = (-v63).mul_add(v65, v62);
-    let [v68, v153]: [S; 2] = v56.sinc_orders::<2>();
-    let v69 = v68 * p[107];
-    let v70 = v66.mul_add(v69, v54);
-    let v73 = v9.mul_add(v72, S::c(p[74]));
-    let v75 = v18 * v74;
-    let v76 = v73 + v75;
-    let v78 = v28 * v77;
-    let v79 = v76 + v78;
-    let v81 = v38 * v80;
-    let v82 = v79 + v81;
-    let v83 = v52 * v59;
-    let v84 = v82 + v83;
-    let v85 = v63 * v61;
-    let v86 = v57.mul_add(v65, v85);
-    let v87 = v86.mul_add(v69, v84);
-    let v91 = v90 * 0.5f64;
-    let v92 = v5 * 0.5f64;
-    let v93 = v92 * v72;
-    let v94 = v8.mul_add(v91, -v93);
-    let v95 = v94 * p[77];
-    let v98 = v97 * 0.5f64;
-    let v99 = qd[11] * v17;
-    let v100 = qd[11] * 0.5f64;
-    let v101 = qd[10] + v100;
-    let v102 = v14 * v74;
-    let v103 = v102 * v101;
-    let v104 = v99.mul_add(v98, -v103);
-    let v105 = v104 * p[83];
-    let v106 = qd[10].mul_add(v95, v105);
-    let v109 = v108 * 0.5f64;
-    let v110 = qd[12] * v27;
-    let v111 = qd[12] * 0.5f64;
-    let v112 = v100 + v101;
-    let v113 = v111 + v112;
-    let v114 = v24 * v77;
-    let v115 = v114 * v113;
-    let v116 = v110.mul_add(v109, -v115);
-    let v117 = S::c(p[89]).mul_add(v116, v106);
-    let v120 = v119 * 0.5f64;
-    let v121 = qd[13] * v37;
-    let v122 = qd[13] * 0.5f64;
-    let v123 = v111 + v113;
-    let v124 = v122 + v123;
-    let v125 = v34 * v80;
-    let v126 = v125 * v124;
-    let v127 = v121.mul_add(v120, -v126);
-    let v128 = S::c(p[95]).mul_add(v127, v117);
-    let v131 = v130 * 0.5f64;
-    let v132 = qd[14] * v51;
-    let v133 = qd[14] * 0.5f64;
-    let v134 = v122 + v124;
-    let v135 = v133 + v134;
-    let v136 = v44 * v59;
-    let v137 = v136 * v135;
-    let v138 = v132.mul_add(v131, -v137);
-    let v139 = S::c(p[101]).mul_add(v138, v128);
-    let v140 = v133 + v135;
-    let v141 = v65 * v140;
-    let v142 = -v141;
-    let v143 = v61 * v140;
-    let v144 = v63 * v143;
-    let v147 = v63 * (-0.5f64);
-    let v148 = v57 * 0.5f64;
-    let v149 = v65 * v148;
-    let v150 = v61.mul_add(v147, -v149);
-    let v151 = v57.mul_add(v142, -v144);
-    let v152 = qd[15].mul_add(v150, v151);
-    let v154 = v153 * 0.5f64;
-    let v155 = v154 * p[107];
-    let v156 = qd[15] * v66;
-    let v157 = v69.mul_add(v152, v139);
-    let v158 = v156.mul_add(v155, v157);
-    let v159 = v92 * v8;
-    let v160 = v72.mul_add(v91, v159);
-    let v161 = v160 * p[77];
-    let v162 = qd[11] * v74;
-    let v163 = v14 * v17;
-    let v164 = v163 * v101;
-    let v165 = v162.mul_add(v98, v164);
-    let v166 = v165 * p[83];
-    let v167 = qd[10].mul_add(v161, v166);
-    let v168 = qd[12] * v77;
-    let v169 = v24 * v27;
-    let v170 = v169 * v113;
-    let v171 = v168.mul_add(v109, v170);
-    let v172 = S::c(p[89]).mul_add(v171, v167);
-    let v173 = qd[13] * v80;
-    let v174 = v34 * v37;
-    let v175 = v174 * v124;
-    let v176 = v173.mul_add(v120, v175);
-    let v177 = S::c(p[95]).mul_add(v176, v172);
-    let v178 = qd[14] * v59;
-    let v179 = v44 * v51;
-    let v180 = v179 * v135;
-    let v181 = v178.mul_add(v131, v180);
-    let v182 = S::c(p[101]).mul_add(v181, v177);
-    let v183 = v57 * v143;
-    let v184 = v65 * v147;
-    let v185 = v61.mul_add(v148, v184);
-    let v186 = v63.mul_add(v142, v183);
-    let v187 = qd[15].mul_add(v185, v186);
-    let v188 = qd[15] * v86;
-    let v189 = v69.mul_add(v187, v182);
-    let v190 = v188.mul_add(v155, v189);
-    let v192 = v95 - v75;
-    let v193 = v192 - v78;
-    let v194 = v193 - v81;
-    let v195 = v194 - v83;
-    let v196 = -v65;
-    let v197 = v57.mul_add(v196, -v85);
-    let v198 = v69 * v197;
-    let v199 = v195 + v198;
-    let v200 = v14 * 0.5f64;
-    let v201 = v200 * v74;
-    let v202 = v17.mul_add(v98, -v201);
-    let v203 = S::c(p[83]).mul_add(v202, -v78);
-    let v204 = v203 - v81;
-    let v205 = v204 - v83;
-    let v206 = v205 + v198;
-    let v207 = v24 * 0.5f64;
-    let v208 = v207 * v77;
-    let v209 = v27.mul_add(v109, -v208);
-    let v210 = S::c(p[89]).mul_add(v209, -v81);
-    let v211 = v210 - v83;
-    let v212 = v211 + v198;
-    let v213 = v34 * 0.5f64;
-    let v214 = v213 * v80;
-    let v215 = v37.mul_add(v120, -v214);
-    let v216 = S::c(p[95]).mul_add(v215, -v83);
-    let v217 = v216 + v198;
-    let v218 = v44 * 0.5f64;
-    let v219 = v218 * v59;
-    let v220 = v51.mul_add(v131, -v219);
-    let v221 = S::c(p[101]).mul_add(v220, v198);
-    let v222 = v66 * v155;
-    let v223 = v69.mul_add(v150, v222);
-    let v224 = v19 + v161;
-    let v225 = v29 + v224;
-    let v226 = v39 + v225;
-    let v227 = v53 + v226;
-    let v228 = v63.mul_add(v196, v62);
-    let v229 = v69 * v228;
-    let v230 = v227 + v229;
-    let v231 = v200 * v17;
-    let v232 = v74.mul_add(v98, v231);
-    let v233 = S::c(p[83]).mul_add(v232, v29);
-    let v234 = v39 + v233;
-    let v235 = v53 + v234;
-    let v236 = v235 + v229;
-    let v237 = v207 * v27;
-    let v238 = v77.mul_add(v109, v237);
-    let v239 = S::c(p[89]).mul_add(v238, v39);
-    let v240 = v53 + v239;
-    let v241 = v240 + v229;
-    let v242 = v213 * v37;
-    let v243 = v80.mul_add(v120, v242);
-    let v244 = S::c(p[95]).mul_add(v243, v53);
-    let v245 = v244 + v229;
-    let v246 = v218 * v51;
-    let v247 = v59.mul_add(v131, v246);
-    let v248 = S::c(p[101]).mul_add(v247, v229);
-    let v249 = v86 * v155;
-    let v250 = v69.mul_add(v185, v249);
-    out[0] = v70;
-    out[1] = v87;
-    out[2] = S::c(p[75]);
-    out[3] = v158;
-    out[4] = v190;
-    out[5] = S::c(0f64);
-    out[6] = S::c(0f64);
-    out[7] = S::c(0f64);
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = v199;
-    out[17] = v206;
-    out[18] = v212;
-    out[19] = v217;
-    out[20] = v221;
-    out[21] = v223;
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = S::c(0f64);
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = v230;
-    out[40] = v236;
-    out[41] = v241;
-    out[42] = v245;
-    out[43] = v248;
-    out[44] = v250;
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_16`: 335 operations, over f64 or dual numbers.
-pub fn contact_jacobian_16(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_16_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_16_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[10] * 0.5f64;
-    let [v5, v103]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[76];
-    let (v82, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[77];
-    let v10 = v9.mul_add(v8, S::c(p[73]));
-    let v13 = q[11] * 0.5f64;
-    let [v14, v110]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v84, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[83];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[12] * 0.5f64;
-    let [v24, v121]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let v26 = v23 + v25;
-    let (v87, v27): (S, S) = v26.sin_cos();
-    let v28 = v24 * p[89];
-    let v29 = v28 * v27;
-    let v30 = v20 + v29;
-    let v33 = q[13] * 0.5f64;
-    let [v34, v132]: [S; 2] = v33.sinc_orders::<2>();
-    let v35 = v23 + v26;
-    let v36 = v33 + v35;
-    let (v90, v37): (S, S) = v36.sin_cos();
-    let v38 = v34 * p[95];
-    let v39 = v38 * v37;
-    let v40 = v30 + v39;
-    let v43 = q[14] * 0.5f64;
-    let [v44, v143]: [S; 2] = v43.sinc_orders::<2>();
-    let v45 = v33 + v36;
-    let v46 = v43 + v45;
-    let (v93, v47): (S, S) = v46.sin_cos();
-    let v48 = v44 * p[101];
-    let v49 = v48 * v47;
-    let v50 = v40 + v49;
-    let v53 = q[15] * 0.5f64;
-    let [v54, v154]: [S; 2] = v53.sinc_orders::<2>();
-    let v55 = v43 + v46;
-    let (v56, v57): (S, S) = v55.sin_cos();
-    let (v58, v59): (S, S) = v53.sin_cos();
-    let v60 = v56 * v58;
-    let v61 = v57.mul_add(v59, -v60);
-    let v62 = v54 * p[107];
-    let v63 = v62 * v61;
-    let v64 = v50 + v63;
-    let v66 = q[16] * 0.5f64;
-    let (v73, v67): (S, S) = v66.sin_cos();
-    let v68 = v57 * v58;
-    let v69 = v56.mul_add(v59, v68);
-    let v70 = v69 * v58;
-    let v71 = v61.mul_add(v59, -v70);
-    let v72 = v67 * v71;
-    let v74 = v61 * v58;
-    let v75 = v69.mul_add(v59, v74);
-    let v76 = (-v73).mul_add(v75, v72);
-    let [v78, v177]: [S; 2] = v66.sinc_orders::<2>();
-    let v79 = v78 * p[113];
-    let v80 = v76.mul_add(v79, v64);
-    let v83 = v9.mul_add(v82, S::c(p[74]));
-    let v85 = v18 * v84;
-    let v86 = v83 + v85;
-    let v88 = v28 * v87;
-    let v89 = v86 + v88;
-    let v91 = v38 * v90;
-    let v92 = v89 + v91;
-    let v94 = v48 * v93;
-    let v95 = v92 + v94;
-    let v96 = v62 * v69;
-    let v97 = v95 + v96;
-    let v98 = v73 * v71;
-    let v99 = v67.mul_add(v75, v98);
-    let v100 = v99.mul_add(v79, v97);
-    let v104 = v103 * 0.5f64;
-    let v105 = v5 * 0.5f64;
-    let v106 = v105 * v82;
-    let v107 = v8.mul_add(v104, -v106);
-    let v108 = v107 * p[77];
-    let v111 = v110 * 0.5f64;
-    let v112 = qd[11] * v17;
-    let v113 = qd[11] * 0.5f64;
-    let v114 = qd[10] + v113;
-    let v115 = v14 * v84;
-    let v116 = v115 * v114;
-    let v117 = v112.mul_add(v111, -v116);
-    let v118 = v117 * p[83];
-    let v119 = qd[10].mul_add(v108, v118);
-    let v122 = v121 * 0.5f64;
-    let v123 = qd[12] * v27;
-    let v124 = qd[12] * 0.5f64;
-    let v125 = v113 + v114;
-    let v126 = v124 + v125;
-    let v127 = v24 * v87;
-    let v128 = v127 * v126;
-    let v129 = v123.mul_add(v122, -v128);
-    let v130 = S::c(p[89]).mul_add(v129, v119);
-    let v133 = v132 * 0.5f64;
-    let v134 = qd[13] * v37;
-    let v135 = qd[13] * 0.5f64;
-    let v136 = v124 + v126;
-    let v137 = v135 + v136;
-    let v138 = v34 * v90;
-    let v139 = v138 * v137;
-    let v140 = v134.mul_add(v133, -v139);
-    let v141 = S::c(p[95]).mul_add(v140, v130);
-    let v144 = v143 * 0.5f64;
-    let v145 = qd[14] * v47;
-    let v146 = qd[14] * 0.5f64;
-    let v147 = v135 + v137;
-    let v148 = v146 + v147;
-    let v149 = v44 * v93;
-    let v150 = v149 * v148;
-    let v151 = v145.mul_add(v144, -v150);
-    let v152 = S::c(p[101]).mul_add(v151, v141);
-    let v155 = v154 * 0.5f64;
-    let v156 = qd[15] * v61;
-    let v157 = qd[15] * 0.5f64;
-    let v158 = v146 + v148;
-    let v159 = v157 + v158;
-    let v160 = v54 * v69;
-    let v161 = v160 * v159;
-    let v162 = v156.mul_add(v155, -v161);
-    let v163 = S::c(p[107]).mul_add(v162, v152);
-    let v164 = v157 + v159;
-    let v165 = v75 * v164;
-    let v166 = -v165;
-    let v167 = v71 * v164;
-    let v168 = v73 * v167;
-    let v171 = v73 * (-0.5f64);
-    let v172 = v67 * 0.5f64;
-    let v173 = v75 * v172;
-    let v174 = v71.mul_add(v171, -v173);
-    let v175 = v67.mul_add(v166, -v168);
-    let v176 = qd[16].mul_add(v174, v175);
-    let v178 = v177 * 0.5f64;
-    let v179 = v178 * p[113];
-    let v180 = qd[16] * v76;
-    let v181 = v79.mul_add(v176, v163);
-    let v182 = v180.mul_add(v179, v181);
-    let v183 = v105 * v8;
-    let v184 = v82.mul_add(v104, v183);
-    let v185 = v184 * p[77];
-    let v186 = qd[11] * v84;
-    let v187 = v14 * v17;
-    let v188 = v187 * v114;
-    let v189 = v186.mul_add(v111, v188);
-    let v190 = v189 * p[83];
-    let v191 = qd[10].mul_add(v185, v190);
-    let v192 = qd[12] * v87;
-    let v193 = v24 * v27;
-    let v194 = v193 * v126;
-    let v195 = v192.mul_add(v122, v194);
-    let v196 = S::c(p[89]).mul_add(v195, v191);
-    let v197 = qd[13] * v90;
-    let v198 = v34 * v37;
-    let v199 = v198 * v137;
-    let v200 = v197.mul_add(v133, v199);
-    let v201 = S::c(p[95]).mul_add(v200, v196);
-    let v202 = qd[14] * v93;
-    let v203 = v44 * v47;
-    let v204 = v203 * v148;
-    let v205 = v202.mul_add(v144, v204);
-    let v206 = S::c(p[101]).mul_add(v205, v201);
-    let v207 = qd[15] * v69;
-    let v208 = v54 * v61;
-    let v209 = v208 * v159;
-    let v210 = v207.mul_add(v155, v209);
-    let v211 = S::c(p[107]).mul_add(v210, v206);
-    let v212 = v67 * v167;
-    let v213 = v75 * v171;
-    let v214 = v71.mul_add(v172, v213);
-    let v215 = v73.mul_add(v166, v212);
-    let v216 = qd[16].mul_add(v214, v215);
-    let v217 = qd[16] * v99;
-    let v218 = v79.mul_add(v216, v211);
-    let v219 = v217.mul_add(v179, v218);
-    let v221 = v108 - v85;
-    let v222 = v221 - v88;
-    let v223 = v222 - v91;
-    let v224 = v223 - v94;
-    let v225 = v224 - v96;
-    let v226 = -v75;
-    let v227 = v67.mul_add(v226, -v98);
-    let v228 = v79 * v227;
-    let v229 = v225 + v228;
-    let v230 = v14 * 0.5f64;
-    let v231 = v230 * v84;
-    let v232 = v17.mul_add(v111, -v231);
-    let v233 = S::c(p[83]).mul_add(v232, -v88);
-    let v234 = v233 - v91;
-    let v235 = v234 - v94;
-    let v236 = v235 - v96;
-    let v237 = v236 + v228;
-    let v238 = v24 * 0.5f64;
-    let v239 = v238 * v87;
-    let v240 = v27.mul_add(v122, -v239);
-    let v241 = S::c(p[89]).mul_add(v240, -v91);
-    let v242 = v241 - v94;
-    let v243 = v242 - v96;
-    let v244 = v243 + v228;
-    let v245 = v34 * 0.5f64;
-    let v246 = v245 * v90;
-    let v247 = v37.mul_add(v133, -v246);
-    let v248 = S::c(p[95]).mul_add(v247, -v94);
-    let v249 = v248 - v96;
-    let v250 = v249 + v228;
-    let v251 = v44 * 0.5f64;
-    let v252 = v251 * v93;
-    let v253 = v47.mul_add(v144, -v252);
-    let v254 = S::c(p[101]).mul_add(v253, -v96);
-    let v255 = v254 + v228;
-    let v256 = v54 * 0.5f64;
-    let v257 = v256 * v69;
-    let v258 = v61.mul_add(v155, -v257);
-    let v259 = S::c(p[107]).mul_add(v258, v228);
-    let v260 = v76 * v179;
-    let v261 = v79.mul_add(v174, v260);
-    let v262 = v19 + v185;
-    let v263 = v29 + v262;
-    let v264 = v39 + v263;
-    let v265 = v49 + v264;
-    let v266 = v63 + v265;
-    let v267 = v73.mul_add(v226, v72);
-    let v268 = v79 * v267;
-    let v269 = v266 + v268;
-    let v270 = v230 * v17;
-    let v271 = v84.mul_add(v111, v270);
-    let v272 = S::c(p[83]).mul_add(v271, v29);
-    let v273 = v39 + v272;
-    let v274 = v49 + v273;
-    let v275 = v63 + v274;
-    let v276 = v275 + v268;
-    let v277 = v238 * v27;
-    let v278 = v87.mul_add(v122, v277);
-    let v279 = S::c(p[89]).mul_add(v278, v39);
-    let v280 = v49 + v279;
-    let v281 = v63 + v280;
-    let v282 = v281 + v268;
-    let v283 = v245 * v37;
-    let v284 = v90.mul_add(v133, v283);
-    let v285 = S::c(p[95]).mul_add(v284, v49);
-    let v286 = v63 + v285;
-    let v287 = v286 + v268;
-    let v288 = v251 * v47;
-    let v289 = v93.mul_add(v144, v288);
-    let v290 = S::c(p[101]).mul_add(v289, v63);
-    let v291 = v290 + v268;
-    let v292 = v256 * v61;
-    let v293 = v69.mul_add(v155, v292);
-    let v294 = S::c(p[107]).mul_add(v293, v268);
-    let v295 = v99 * v179;
-    let v296 = v79.mul_add(v214, v295);
-    out[0] = v80;
-    out[1] = v100;
-    out[2] = S::c(p[75]);
-    out[3] = v182;
-    out[4] = v219;
-    out[5] = S::c(0f64);
-    out[6] = S::c(0f64);
-    out[7] = S::c(0f64);
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = v229;
-    out[17] = v237;
-    out[18] = v244;
-    out[19] = v250;
-    out[20] = v255;
-    out[21] = v259;
-    out[22] = v261;
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = S::c(0f64);
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = v269;
-    out[40] = v276;
-    out[41] = v282;
-    out[42] = v287;
-    out[43] = v291;
-    out[44] = v294;
-    out[45] = v296;
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_17`: 388 operations, over f64 or dual numbers.
-pub fn contact_jacobian_17(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_17_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_17_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[10] * 0.5f64;
-    let [v5, v116]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[76];
-    let (v92, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[77];
-    let v10 = v9.mul_add(v8, S::c(p[73]));
-    let v13 = q[11] * 0.5f64;
-    let [v14, v123]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v94, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[83];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[12] * 0.5f64;
-    let [v24, v134]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let v26 = v23 + v25;
-    let (v97, v27): (S, S) = v26.sin_cos();
-    let v28 = v24 * p[89];
-    let v29 = v28 * v27;
-    let v30 = v20 + v29;
-    let v33 = q[13] * 0.5f64;
-    let [v34, v145]: [S; 2] = v33.sinc_orders::<2>();
-    let v35 = v23 + v26;
-    let v36 = v33 + v35;
-    let (v100, v37): (S, S) = v36.sin_cos();
-    let v38 = v34 * p[95];
-    let v39 = v38 * v37;
-    let v40 = v30 + v39;
-    let v43 = q[14] * 0.5f64;
-    let [v44, v156]: [S; 2] = v43.sinc_orders::<2>();
-    let v45 = v33 + v36;
-    let v46 = v43 + v45;
-    let (v103, v47): (S, S) = v46.sin_cos();
-    let v48 = v44 * p[101];
-    let v49 = v48 * v47;
-    let v50 = v40 + v49;
-    let v53 = q[15] * 0.5f64;
-    let [v54, v167]: [S; 2] = v53.sinc_orders::<2>();
-    let v55 = v43 + v46;
-    let v56 = v53 + v55;
-    let (v106, v57): (S, S) = v56.sin_cos();
-    let v58 = v54 * p[107];
-    let v59 = v58 * v57;
-    let v60 = v50 + v59;
-    let v63 = q[16] * 0.5f64;
-    let [v64, v178]: [S; 2] = v63.sinc_orders::<2>();
-    let v65 = v53 + v56;
-    let (v66, v67): (S, S) = v65.sin_cos();
-    let (v68, v69): (S, S) = v63.sin_cos();
-    let v70 = v66 * v68;
-    let v71 = v67.mul_add(v69, -v70);
-    let v72 = v64 * p[113];
-    let v73 = v72 * v71;
-    let v74 = v60 + v73;
-    let v76 = q[17] * 0.5f64;
-    let (v83, v77): (S, S) = v76.sin_cos();
-    let v78 = v67 * v68;
-    let v79 = v66.mul_add(v69, v78);
-    let v80 = v79 * v68;
-    let v81 = v71.mul_add(v69, -v80);
-    let v82 = v77 * v81;
-    let v84 = v71 * v68;
-    let v85 = v79.mul_add(v69, v84);
-    let v86 = (-v83).mul_add(v85, v82);
-    let [v88, v201]: [S; 2] = v76.sinc_orders::<2>();
-    let v89 = v88 * p[119];
-    let v90 = v86.mul_add(v89, v74);
-    let v93 = v9.mul_add(v92, S::c(p[74]));
-    let v95 = v18 * v94;
-    let v96 = v93 + v95;
-    let v98 = v28 * v97;
-    let v99 = v96 + v98;
-    let v101 = v38 * v100;
-    let v102 = v99 + v101;
-    let v104 = v48 * v103;
-    let v105 = v102 + v104;
-    let v107 = v58 * v106;
-    let v108 = v105 + v107;
-    let v109 = v72 * v79;
-    let v110 = v108 + v109;
-    let v111 = v83 * v81;
-    let v112 = v77.mul_add(v85, v111);
-    let v113 = v112.mul_add(v89, v110);
-    let v117 = v116 * 0.5f64;
-    let v118 = v5 * 0.5f64;
-    let v119 = v118 * v92;
-    let v120 = v8.mul_add(v117, -v119);
-    let v121 = v120 * p[77];
-    let v124 = v123 * 0.5f64;
-    let v125 = qd[11] * v17;
-    let v126 = qd[11] * 0.5f64;
-    let v127 = qd[10] + v126;
-    let v128 = v14 * v94;
-    let v129 = v128 * v127;
-    let v130 = v125.mul_add(v124, -v129);
-    let v131 = v130 * p[83];
-    let v132 = qd[10].mul_add(v121, v131);
-    let v135 = v134 * 0.5f64;
-    let v136 = qd[12] * v27;
-    let v137 = qd[12] * 0.5f64;
-    let v138 = v126 + v127;
-    let v139 = v137 + v138;
-    let v140 = v24 * v97;
-    let v141 = v140 * v139;
-    let v142 = v136.mul_add(v135, -v141);
-    let v143 = S::c(p[89]).mul_add(v142, v132);
-    let v146 = v145 * 0.5f64;
-    let v147 = qd[13] * v37;
-    let v148 = qd[13] * 0.5f64;
-    let v149 = v137 + v139;
-    let v150 = v148 + v149;
-    let v151 = v34 * v100;
-    let v152 = v151 * v150;
-    let v153 = v147.mul_add(v146, -v152);
-    let v154 = S::c(p[95]).mul_add(v153, v143);
-    let v157 = v156 * 0.5f64;
-    let v158 = qd[14] * v47;
-    let v159 = qd[14] * 0.5f64;
-    let v160 = v148 + v150;
-    let v161 = v159 + v160;
-    let v162 = v44 * v103;
-    let v163 = v162 * v161;
-    let v164 = v158.mul_add(v157, -v163);
-    let v165 = S::c(p[101]).mul_add(v164, v154);
-    let v168 = v167 * 0.5f64;
-    let v169 = qd[15] * v57;
-    let v170 = qd[15] * 0.5f64;
-    let v171 = v159 + v161;
-    let v172 = v170 + v171;
-    let v173 = v54 * v106;
-    let v174 = v173 * v172;
-    let v175 = v169.mul_add(v168, -v174);
-    let v176 = S::c(p[107]).mul_add(v175, v165);
-    let v179 = v178 * 0.5f64;
-    let v180 = qd[16] * v71;
-    let v181 = qd[16] * 0.5f64;
-    let v182 = v170 + v172;
-    let v183 = v181 + v182;
-    let v184 = v64 * v79;
-    let v185 = v184 * v183;
-    let v186 = v180.mul_add(v179, -v185);
-    let v187 = S::c(p[113]).mul_add(v186, v176);
-    let v188 = v181 + v183;
-    let v189 = v85 * v188;
-    let v190 = -v189;
-    let v191 = v81 * v188;
-    let v192 = v83 * v191;
-    let v195 = v83 * (-0.5f64);
-    let v196 = v77 * 0.5f64;
-    let v197 = v85 * v196;
-    let v198 = v81.mul_add(v195, -v197);
-    let v199 = v77.mul_add(v190, -v192);
-    let v200 = qd[17].mul_add(v198, v199);
-    let v202 = v201 * 0.5f64;
-    let v203 = v202 * p[119];
-    let v204 = qd[17] * v86;
-    let v205 = v89.mul_add(v200, v187);
-    let v206 = v204.mul_add(v203, v205);
-    let v207 = v118 * v8;
-    let v208 = v92.mul_add(v117, v207);
-    let v209 = v208 * p[77];
-    let v210 = qd[11] * v94;
-    let v211 = v14 * v17;
-    let v212 = v211 * v127;
-    let v213 = v210.mul_add(v124, v212);
-    let v214 = v213 * p[83];
-    let v215 = qd[10].mul_add(v209, v214);
-    let v216 = qd[12] * v97;
-    let v217 = v24 * v27;
-    let v218 = v217 * v139;
-    let v219 = v216.mul_add(v135, v218);
-    let v220 = S::c(p[89]).mul_add(v219, v215);
-    let v221 = qd[13] * v100;
-    let v222 = v34 * v37;
-    let v223 = v222 * v150;
-    let v224 = v221.mul_add(v146, v223);
-    let v225 = S::c(p[95]).mul_add(v224, v220);
-    let v226 = qd[14] * v103;
-    let v227 = v44 * v47;
-    let v228 = v227 * v161;
-    let v229 = v226.mul_add(v157, v228);
-    let v230 = S::c(p[101]).mul_add(v229, v225);
-    let v231 = qd[15] * v106;
-    let v232 = v54 * v57;
-    let v233 = v232 * v172;
-    let v234 = v231.mul_add(v168, v233);
-    let v235 = S::c(p[107]).mul_add(v234, v230);
-    let v236 = qd[16] * v79;
-    let v237 = v64 * v71;
-    let v238 = v237 * v183;
-    let v239 = v236.mul_add(v179, v238);
-    let v240 = S::c(p[113]).mul_add(v239, v235);
-    let v241 = v77 * v191;
-    let v242 = v85 * v195;
-    let v243 = v81.mul_add(v196, v242);
-    let v244 = v83.mul_add(v190, v241);
-    let v245 = qd[17].mul_add(v243, v244);
-    let v246 = qd[17] * v112;
-    let v247 = v89.mul_add(v245, v240);
-    let v248 = v246.mul_add(v203, v247);
-    let v250 = v121 - v95;
-    let v251 = v250 - v98;
-    let v252 = v251 - v101;
-    let v253 = v252 - v104;
-    let v254 = v253 - v107;
-    let v255 = v254 - v109;
-    let v256 = -v85;
-    let v257 = v77.mul_add(v256, -v111);
-    let v258 = v89 * v257;
-    let v259 = v255 + v258;
-    let v260 = v14 * 0.5f64;
-    let v261 = v260 * v94;
-    let v262 = v17.mul_add(v124, -v261);
-    let v263 = S::c(p[83]).mul_add(v262, -v98);
-    let v264 = v263 - v101;
-    let v265 = v264 - v104;
-    let v266 = v265 - v107;
-    let v267 = v266 - v109;
-    let v268 = v267 + v258;
-    let v269 = v24 * 0.5f64;
-    let v270 = v269 * v97;
-    let v271 = v27.mul_add(v135, -v270);
-    let v272 = S::c(p[89]).mul_add(v271, -v101);
-    let v273 = v272 - v104;
-    let v274 = v273 - v107;
-    let v275 = v274 - v109;
-    let v276 = v275 + v258;
-    let v277 = v34 * 0.5f64;
-    let v278 = v277 * v100;
-    let v279 = v37.mul_add(v146, -v278);
-    let v280 = S::c(p[95]).mul_add(v279, -v104);
-    let v281 = v280 - v107;
-    let v282 = v281 - v109;
-    let v283 = v282 + v258;
-    let v284 = v44 * 0.5f64;
-    let v285 = v284 * v103;
-    let v286 = v47.mul_add(v157, -v285);
-    let v287 = S::c(p[101]).mul_add(v286, -v107);
-    let v288 = v287 - v109;
-    let v289 = v288 + v258;
-    let v290 = v54 * 0.5f64;
-    let v291 = v290 * v106;
-    let v292 = v57.mul_add(v168, -v291);
-    let v293 = S::c(p[107]).mul_add(v292, -v109);
-    let v294 = v293 + v258;
-    let v295 = v64 * 0.5f64;
-    let v296 = v295 * v79;
-    let v297 = v71.mul_add(v179, -v296);
-    let v298 = S::c(p[113]).mul_add(v297, v258);
-    let v299 = v86 * v203;
-    let v300 = v89.mul_add(v198, v299);
-    let v301 = v19 + v209;
-    let v302 = v29 + v301;
-    let v303 = v39 + v302;
-    let v304 = v49 + v303;
-    let v305 = v59 + v304;
-    let v306 = v73 + v305;
-    let v307 = v83.mul_add(v256, v82);
-    let v308 = v89 * v307;
-    let v309 = v306 + v308;
-    let v310 = v260 * v17;
-    let v311 = v94.mul_add(v124, v310);
-    let v312 = S::c(p[83]).mul_add(v311, v29);
-    let v313 = v39 + v312;
-    let v314 = v49 + v313;
-    let v315 = v59 + v314;
-    let v316 = v73 + v315;
-    let v317 = v316 + v308;
-    let v318 = v269 * v27;
-    let v319 = v97.mul_add(v135, v318);
-    let v320 = S::c(p[89]).mul_add(v319, v39);
-    let v321 = v49 + v320;
-    let v322 = v59 + v321;
-    let v323 = v73 + v322;
-    let v324 = v323 + v308;
-    let v325 = v277 * v37;
-    let v326 = v100.mul_add(v146, v325);
-    let v327 = S::c(p[95]).mul_add(v326, v49);
-    let v328 = v59 + v327;
-    let v329 = v73 + v328;
-    let v330 = v329 + v308;
-    let v331 = v284 * v47;
-    let v332 = v103.mul_add(v157, v331);
-    let v333 = S::c(p[101]).mul_add(v332, v59);
-    let v334 = v73 + v333;
-    let v335 = v334 + v308;
-    let v336 = v290 * v57;
-    let v337 = v106.mul_add(v168, v336);
-    let v338 = S::c(p[107]).mul_add(v337, v73);
-    let v339 = v338 + v308;
-    let v340 = v295 * v71;
-    let v341 = v79.mul_add(v179, v340);
-    let v342 = S::c(p[113]).mul_add(v341, v308);
-    let v343 = v112 * v203;
-    let v344 = v89.mul_add(v243, v343);
-    out[0] = v90;
-    out[1] = v113;
-    out[2] = S::c(p[75]);
-    out[3] = v206;
-    out[4] = v248;
-    out[5] = S::c(0f64);
-    out[6] = S::c(0f64);
-    out[7] = S::c(0f64);
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = v259;
-    out[17] = v268;
-    out[18] = v276;
-    out[19] = v283;
-    out[20] = v289;
-    out[21] = v294;
-    out[22] = v298;
-    out[23] = v300;
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = S::c(0f64);
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = v309;
-    out[40] = v317;
-    out[41] = v324;
-    out[42] = v330;
-    out[43] = v335;
-    out[44] = v339;
-    out[45] = v342;
-    out[46] = v344;
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_18`: 443 operations, over f64 or dual numbers.
-pub fn contact_jacobian_18(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_18_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_18_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[10] * 0.5f64;
-    let [v5, v129]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[76];
-    let (v102, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[77];
-    let v10 = v9.mul_add(v8, S::c(p[73]));
-    let v13 = q[11] * 0.5f64;
-    let [v14, v136]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v104, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[83];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[12] * 0.5f64;
-    let [v24, v147]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let v26 = v23 + v25;
-    let (v107, v27): (S, S) = v26.sin_cos();
-    let v28 = v24 * p[89];
-    let v29 = v28 * v27;
-    let v30 = v20 + v29;
-    let v33 = q[13] * 0.5f64;
-    let [v34, v158]: [S; 2] = v33.sinc_orders::<2>();
-    let v35 = v23 + v26;
-    let v36 = v33 + v35;
-    let (v110, v37): (S, S) = v36.sin_cos();
-    let v38 = v34 * p[95];
-    let v39 = v38 * v37;
-    let v40 = v30 + v39;
-    let v43 = q[14] * 0.5f64;
-    let [v44, v169]: [S; 2] = v43.sinc_orders::<2>();
-    let v45 = v33 + v36;
-    let v46 = v43 + v45;
-    let (v113, v47): (S, S) = v46.sin_cos();
-    let v48 = v44 * p[101];
-    let v49 = v48 * v47;
-    let v50 = v40 + v49;
-    let v53 = q[15] * 0.5f64;
-    let [v54, v180]: [S; 2] = v53.sinc_orders::<2>();
-    let v55 = v43 + v46;
-    let v56 = v53 + v55;
-    let (v116, v57): (S, S) = v56.sin_cos();
-    let v58 = v54 * p[107];
-    let v59 = v58 * v57;
-    let v60 = v50 + v59;
-    let v63 = q[16] * 0.5f64;
-    let [v64, v191]: [S; 2] = v63.sinc_orders::<2>();
-    let v65 = v53 + v56;
-    let v66 = v63 + v65;
-    let (v119, v67): (S, S) = v66.sin_cos();
-    let v68 = v64 * p[113];
-    let v69 = v68 * v67;
-    let v70 = v60 + v69;
-    let v73 = q[17] * 0.5f64;
-    let [v74, v202]: [S; 2] = v73.sinc_orders::<2>();
-    let v75 = v63 + v66;
-    let (v76, v77): (S, S) = v75.sin_cos();
-    let (v78, v79): (S, S) = v73.sin_cos();
-    let v80 = v76 * v78;
-    let v81 = v77.mul_add(v79, -v80);
-    let v82 = v74 * p[119];
-    let v83 = v82 * v81;
-    let v84 = v70 + v83;
-    let v86 = q[18] * 0.5f64;
-    let (v93, v87): (S, S) = v86.sin_cos();
-    let v88 = v77 * v78;
-    let v89 = v76.mul_add(v79, v88);
-    let v90 = v89 * v78;
-    let v91 = v81.mul_add(v79, -v90);
-    let v92 = v87 * v91;
-    let v94 = v81 * v78;
-    let v95 = v89.mul_add(v79, v94);
-    let v96 = (-v93).mul_add(v95, v92);
-    let [v98, v225]: [S; 2] = v86.sinc_orders::<2>();
-    let v99 = v98 * p[125];
-    let v100 = v96.mul_add(v99, v84);
-    let v103 = v9.mul_add(v102, S::c(p[74]));
-    let v105 = v18 * v104;
-    let v106 = v103 + v105;
-    let v108 = v28 * v107;
-    let v109 = v106 + v108;
-    let v111 = v38 * v110;
-    let v112 = v109 + v111;
-    let v114 = v48 * v113;
-    let v115 = v112 + v114;
-    let v117 = v58 * v116;
-    let v118 = v115 + v117;
-    let v120 = v68 * v119;
-    let v121 = v118 + v120;
-    let v122 = v82 * v89;
-    let v123 = v121 + v122;
-    let v124 = v93 * v91;
-    let v125 = v87.mul_add(v95, v124);
-    let v126 = v125.mul_add(v99, v123);
-    let v130 = v129 * 0.5f64;
-    let v131 = v5 * 0.5f64;
-    let v132 = v131 * v102;
-    let v133 = v8.mul_add(v130, -v132);
-    let v134 = v133 * p[77];
-    let v137 = v136 * 0.5f64;
-    let v138 = qd[11] * v17;
-    let v139 = qd[11] * 0.5f64;
-    let v140 = qd[10] + v139;
-    let v141 = v14 * v104;
-    let v142 = v141 * v140;
-    let v143 = v138.mul_add(v137, -v142);
-    let v144 = v143 * p[83];
-    let v145 = qd[10].mul_add(v134, v144);
-    let v148 = v147 * 0.5f64;
-    let v149 = qd[12] * v27;
-    let v150 = qd[12] * 0.5f64;
-    let v151 = v139 + v140;
-    let v152 = v150 + v151;
-    let v153 = v24 * v107;
-    let v154 = v153 * v152;
-    let v155 = v149.mul_add(v148, -v154);
-    let v156 = S::c(p[89]).mul_add(v155, v145);
-    let v159 = v158 * 0.5f64;
-    let v160 = qd[13] * v37;
-    let v161 = qd[13] * 0.5f64;
-    let v162 = v150 + v152;
-    let v163 = v161 + v162;
-    let v164 = v34 * v110;
-    let v165 = v164 * v163;
-    let v166 = v160.mul_add(v159, -v165);
-    let v167 = S::c(p[95]).mul_add(v166, v156);
-    let v170 = v169 * 0.5f64;
-    let v171 = qd[14] * v47;
-    let v172 = qd[14] * 0.5f64;
-    let v173 = v161 + v163;
-    let v174 = v172 + v173;
-    let v175 = v44 * v113;
-    let v176 = v175 * v174;
-    let v177 = v171.mul_add(v170, -v176);
-    let v178 = S::c(p[101]).mul_add(v177, v167);
-    let v181 = v180 * 0.5f64;
-    let v182 = qd[15] * v57;
-    let v183 = qd[15] * 0.5f64;
-    let v184 = v172 + v174;
-    let v185 = v183 + v184;
-    let v186 = v54 * v116;
-    let v187 = v186 * v185;
-    let v188 = v182.mul_add(v181, -v187);
-    let v189 = S::c(p[107]).mul_add(v188, v178);
-    let v192 = v191 * 0.5f64;
-    let v193 = qd[16] * v67;
-    let v194 = qd[16] * 0.5f64;
-    let v195 = v183 + v185;
-    let v196 = v194 + v195;
-    let v197 = v64 * v119;
-    let v198 = v197 * v196;
-    let v199 = v193.mul_add(v192, -v198);
-    let v200 = S::c(p[113]).mul_add(v199, v189);
-    let v203 = v202 * 0.5f64;
-    let v204 = qd[17] * v81;
-    let v205 = qd[17] * 0.5f64;
-    let v206 = v194 + v196;
-    let v207 = v205 + v206;
-    let v208 = v74 * v89;
-    let v209 = v208 * v207;
-    let v210 = v204.mul_add(v203, -v209);
-    let v211 = S::c(p[119]).mul_add(v210, v200);
-    let v212 = v205 + v207;
-    let v213 = v95 * v212;
-    let v214 = -v213;
-    let v215 = v91 * v212;
-    let v216 = v93 * v215;
-    let v219 = v93 * (-0.5f64);
-    let v220 = v87 * 0.5f64;
-    let v221 = v95 * v220;
-    let v222 = v91.mul_add(v219, -v221);
-    let v223 = v87.mul_add(v214, -v216);
-    let v224 = qd[18].mul_add(v222, v223);
-    let v226 = v225 * 0.5f64;
-    let v227 = v226 * p[125];
-    let v228 = qd[18] * v96;
-    let v229 = v99.mul_add(v224, v211);
-    let v230 = v228.mul_add(v227, v229);
-    let v231 = v131 * v8;
-    let v232 = v102.mul_add(v130, v231);
-    let v233 = v232 * p[77];
-    let v234 = qd[11] * v104;
-    let v235 = v14 * v17;
-    let v236 = v235 * v140;
-    let v237 = v234.mul_add(v137, v236);
-    let v238 = v237 * p[83];
-    let v239 = qd[10].mul_add(v233, v238);
-    let v240 = qd[12] * v107;
-    let v241 = v24 * v27;
-    let v242 = v241 * v152;
-    let v243 = v240.mul_add(v148, v242);
-    let v244 = S::c(p[89]).mul_add(v243, v239);
-    let v245 = qd[13] * v110;
-    let v246 = v34 * v37;
-    let v247 = v246 * v163;
-    let v248 = v245.mul_add(v159, v247);
-    let v249 = S::c(p[95]).mul_add(v248, v244);
-    let v250 = qd[14] * v113;
-    let v251 = v44 * v47;
-    let v252 = v251 * v174;
-    let v253 = v250.mul_add(v170, v252);
-    let v254 = S::c(p[101]).mul_add(v253, v249);
-    let v255 = qd[15] * v116;
-    let v256 = v54 * v57;
-    let v257 = v256 * v185;
-    let v258 = v255.mul_add(v181, v257);
-    let v259 = S::c(p[107]).mul_add(v258, v254);
-    let v260 = qd[16] * v119;
-    let v261 = v64 * v67;
-    let v262 = v261 * v196;
-    let v263 = v260.mul_add(v192, v262);
-    let v264 = S::c(p[113]).mul_add(v263, v259);
-    let v265 = qd[17] * v89;
-    let v266 = v74 * v81;
-    let v267 = v266 * v207;
-    let v268 = v265.mul_add(v203, v267);
-    let v269 = S::c(p[119]).mul_add(v268, v264);
-    let v270 = v87 * v215;
-    let v271 = v95 * v219;
-    let v272 = v91.mul_add(v220, v271);
-    let v273 = v93.mul_add(v214, v270);
-    let v274 = qd[18].mul_add(v272, v273);
-    let v275 = qd[18] * v125;
-    let v276 = v99.mul_add(v274, v269);
-    let v277 = v275.mul_add(v227, v276);
-    let v279 = v134 - v105;
-    let v280 = v279 - v108;
-    let v281 = v280 - v111;
-    let v282 = v281 - v114;
-    let v283 = v282 - v117;
-    let v284 = v283 - v120;
-    let v285 = v284 - v122;
-    let v286 = -v95;
-    let v287 = v87.mul_add(v286, -v124);
-    let v288 = v99 * v287;
-    let v289 = v285 + v288;
-    let v290 = v14 * 0.5f64;
-    let v291 = v290 * v104;
-    let v292 = v17.mul_add(v137, -v291);
-    let v293 = S::c(p[83]).mul_add(v292, -v108);
-    let v294 = v293 - v111;
-    let v295 = v294 - v114;
-    let v296 = v295 - v117;
-    let v297 = v296 - v120;
-    let v298 = v297 - v122;
-    let v299 = v298 + v288;
-    let v300 = v24 * 0.5f64;
-    let v301 = v300 * v107;
-    let v302 = v27.mul_add(v148, -v301);
-    let v303 = S::c(p[89]).mul_add(v302, -v111);
-    let v304 = v303 - v114;
-    let v305 = v304 - v117;
-    let v306 = v305 - v120;
-    let v307 = v306 - v122;
-    let v308 = v307 + v288;
-    let v309 = v34 * 0.5f64;
-    let v310 = v309 * v110;
-    let v311 = v37.mul_add(v159, -v310);
-    let v312 = S::c(p[95]).mul_add(v311, -v114);
-    let v313 = v312 - v117;
-    let v314 = v313 - v120;
-    let v315 = v314 - v122;
-    let v316 = v315 + v288;
-    let v317 = v44 * 0.5f64;
-    let v318 = v317 * v113;
-    let v319 = v47.mul_add(v170, -v318);
-    let v320 = S::c(p[101]).mul_add(v319, -v117);
-    let v321 = v320 - v120;
-    let v322 = v321 - v122;
-    let v323 = v322 + v288;
-    let v324 = v54 * 0.5f64;
-    let v325 = v324 * v116;
-    let v326 = v57.mul_add(v181, -v325);
-    let v327 = S::c(p[107]).mul_add(v326, -v120);
-    let v328 = v327 - v122;
-    let v329 = v328 + v288;
-    let v330 = v64 * 0.5f64;
-    let v331 = v330 * v119;
-    let v332 = v67.mul_add(v192, -v331);
-    let v333 = S::c(p[113]).mul_add(v332, -v122);
-    let v334 = v333 + v288;
-    let v335 = v74 * 0.5f64;
-    let v336 = v335 * v89;
-    let v337 = v81.mul_add(v203, -v336);
-    let v338 = S::c(p[119]).mul_add(v337, v288);
-    let v339 = v96 * v227;
-    let v340 = v99.mul_add(v222, v339);
-    let v341 = v19 + v233;
-    let v342 = v29 + v341;
-    let v343 = v39 + v342;
-    let v344 = v49 + v343;
-    let v345 = v59 + v344;
-    let v346 = v69 + v345;
-    let v347 = v83 + v346;
-    let v348 = v93.mul_add(v286, v92);
-    let v349 = v99 * v348;
-    let v350 = v347 + v349;
-    let v351 = v290 * v17;
-    let v352 = v104.mul_add(v137, v351);
-    let v353 = S::c(p[83]).mul_add(v352, v29);
-    let v354 = v39 + v353;
-    let v355 = v49 + v354;
-    let v356 = v59 + v355;
-    let v357 = v69 + v356;
-    let v358 = v83 + v357;
-    let v359 = v358 + v349;
-    let v360 = v300 * v27;
-    let v361 = v107.mul_add(v148, v360);
-    let v362 = S::c(p[89]).mul_add(v361, v39);
-    let v363 = v49 + v362;
-    let v364 = v59 + v363;
-    let v365 = v69 + v364;
-    let v366 = v83 + v365;
-    let v367 = v366 + v349;
-    let v368 = v309 * v37;
-    let v369 = v110.mul_add(v159, v368);
-    let v370 = S::c(p[95]).mul_add(v369, v49);
-    let v371 = v59 + v370;
-    let v372 = v69 + v371;
-    let v373 = v83 + v372;
-    let v374 = v373 + v349;
-    let v375 = v317 * v47;
-    let v376 = v113.mul_add(v170, v375);
-    let v377 = S::c(p[101]).mul_add(v376, v59);
-    let v378 = v69 + v377;
-    let v379 = v83 + v378;
-    let v380 = v379 + v349;
-    let v381 = v324 * v57;
-    let v382 = v116.mul_add(v181, v381);
-    let v383 = S::c(p[107]).mul_add(v382, v69);
-    let v384 = v83 + v383;
-    let v385 = v384 + v349;
-    let v386 = v330 * v67;
-    let v387 = v119.mul_add(v192, v386);
-    let v388 = S::c(p[113]).mul_add(v387, v83);
-    let v389 = v388 + v349;
-    let v390 = v335 * v81;
-    let v391 = v89.mul_add(v203, v390);
-    let v392 = S::c(p[119]).mul_add(v391, v349);
-    let v393 = v125 * v227;
-    let v394 = v99.mul_add(v272, v393);
-    out[0] = v100;
-    out[1] = v126;
-    out[2] = S::c(p[75]);
-    out[3] = v230;
-    out[4] = v277;
-    out[5] = S::c(0f64);
-    out[6] = S::c(0f64);
-    out[7] = S::c(0f64);
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = v289;
-    out[17] = v299;
-    out[18] = v308;
-    out[19] = v316;
-    out[20] = v323;
-    out[21] = v329;
-    out[22] = v334;
-    out[23] = v338;
-    out[24] = v340;
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = S::c(0f64);
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = v350;
-    out[40] = v359;
-    out[41] = v367;
-    out[42] = v374;
-    out[43] = v380;
-    out[44] = v385;
-    out[45] = v389;
-    out[46] = v392;
-    out[47] = v394;
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_19`: 500 operations, over f64 or dual numbers.
-pub fn contact_jacobian_19(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_19_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_19_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    let v4 = q[10] * 0.5f64;
-    let [v5, v142]: [S; 2] = v4.sinc_orders::<2>();
-    let v7 = v4 + p[76];
-    let (v112, v8): (S, S) = v7.sin_cos();
-    let v9 = v5 * p[77];
-    let v10 = v9.mul_add(v8, S::c(p[73]));
-    let v13 = q[11] * 0.5f64;
-    let [v14, v149]: [S; 2] = v13.sinc_orders::<2>();
-    let v15 = v4 + v7;
-    let v16 = v13 + v15;
-    let (v114, v17): (S, S) = v16.sin_cos();
-    let v18 = v14 * p[83];
-    let v19 = v18 * v17;
-    let v20 = v10 + v19;
-    let v23 = q[12] * 0.5f64;
-    let [v24, v160]: [S; 2] = v23.sinc_orders::<2>();
-    let v25 = v13 + v16;
-    let v26 = v23 + v25;
-    let (v117, v27): (S, S) = v26.sin_cos();
-    let v28 = v24 * p[89];
-    let v29 = v28 * v27;
-    let v30 = v20 + v29;
-    let v33 = q[13] * 0.5f64;
-    let [v34, v171]: [S; 2] = v33.sinc_orders::<2>();
-    let v35 = v23 + v26;
-    let v36 = v33 + v35;
-    let (v120, v37): (S, S) = v36.sin_cos();
-    let v38 = v34 * p[95];
-    let v39 = v38 * v37;
-    let v40 = v30 + v39;
-    let v43 = q[14] * 0.5f64;
-    let [v44, v182]: [S; 2] = v43.sinc_orders::<2>();
-    let v45 = v33 + v36;
-    let v46 = v43 + v45;
-    let (v123, v47): (S, S) = v46.sin_cos();
-    let v48 = v44 * p[101];
-    let v49 = v48 * v47;
-    let v50 = v40 + v49;
-    let v53 = q[15] * 0.5f64;
-    let [v54, v193]: [S; 2] = v53.sinc_orders::<2>();
-    let v55 = v43 + v46;
-    let v56 = v53 + v55;
-    let (v126, v57): (S, S) = v56.sin_cos();
-    let v58 = v54 * p[107];
-    let v59 = v58 * v57;
-    let v60 = v50 + v59;
-    let v63 = q[16] * 0.5f64;
-    let [v64, v204]: [S; 2] = v63.sinc_orders::<2>();
-    let v65 = v53 + v56;
-    let v66 = v63 + v65;
-    let (v129, v67): (S, S) = v66.sin_cos();
-    let v68 = v64 * p[113];
-    let v69 = v68 * v67;
-    let v70 = v60 + v69;
-    let v73 = q[17] * 0.5f64;
-    let [v74, v215]: [S; 2] = v73.sinc_orders::<2>();
-    let v75 = v63 + v66;
-    let v76 = v73 + v75;
-    let (v132, v77): (S, S) = v76.sin_cos();
-    let v78 = v74 * p[119];
-    let v79 = v78 * v77;
-    let v80 = v70 + v79;
-    let v83 = q[18] * 0.5f64;
-    let [v84, v226]: [S; 2] = v83.sinc_orders::<2>();
-    let v85 = v73 + v76;
-    let (v86, v87): (S, S) = v85.sin_cos();
-    let (v88, v89): (S, S) = v83.sin_cos();
-    let v90 = v86 * v88;
-    let v91 = v87.mul_add(v89, -v90);
-    let v92 = v84 * p[125];
-    let v93 = v92 * v91;
-    let v94 = v80 + v93;
-    let v96 = q[19] * 0.5f64;
-    let (v103, v97): (S, S) = v96.sin_cos();
-    let v98 = v87 * v88;
-    let v99 = v86.mul_add(v89, v98);
-    let v100 = v99 * v88;
-    let v101 = v91.mul_add(v89, -v100);
-    let v102 = v97 * v101;
-    let v104 = v91 * v88;
-    let v105 = v99.mul_add(v89, v104);
-    let v106 = (-v103).mul_add(v105, v102);
-    let [v108, v249]: [S; 2] = v96.sinc_orders::<2>();
-    let v109 = v108 * p[131];
-    let v110 = v106.mul_add(v109, v94);
-    let v113 = v9.mul_add(v112, S::c(p[74]));
-    let v115 = v18 * v114;
-    let v116 = v113 + v115;
-    let v118 = v28 * v117;
-    let v119 = v116 + v118;
-    let v121 = v38 * v120;
-    let v122 = v119 + v121;
-    let v124 = v48 * v123;
-    let v125 = v122 + v124;
-    let v127 = v58 * v126;
-    let v128 = v125 + v127;
-    let v130 = v68 * v129;
-    let v131 = v128 + v130;
-    let v133 = v78 * v132;
-    let v134 = v131 + v133;
-    let v135 = v92 * v99;
-    let v136 = v134 + v135;
-    let v137 = v103 * v101;
-    let v138 = v97.mul_add(v105, v137);
-    let v139 = v138.mul_add(v109, v136);
-    let v143 = v142 * 0.5f64;
-    let v144 = v5 * 0.5f64;
-    let v145 = v144 * v112;
-    let v146 = v8.mul_add(v143, -v145);
-    let v147 = v146 * p[77];
-    let v150 = v149 * 0.5f64;
-    let v151 = qd[11] * v17;
-    let v152 = qd[11] * 0.5f64;
-    let v153 = qd[10] + v152;
-    let v154 = v14 * v114;
-    let v155 = v154 * v153;
-    let v156 = v151.mul_add(v150, -v155);
-    let v157 = v156 * p[83];
-    let v158 = qd[10].mul_add(v147, v157);
-    let v161 = v160 * 0.5f64;
-    let v162 = qd[12] * v27;
-    let v163 = qd[12] * 0.5f64;
-    let v164 = v152 + v153;
-    let v165 = v163 + v164;
-    let v166 = v24 * v117;
-    let v167 = v166 * v165;
-    let v168 = v162.mul_add(v161, -v167);
-    let v169 = S::c(p[89]).mul_add(v168, v158);
-    let v172 = v171 * 0.5f64;
-    let v173 = qd[13] * v37;
-    let v174 = qd[13] * 0.5f64;
-    let v175 = v163 + v165;
-    let v176 = v174 + v175;
-    let v177 = v34 * v120;
-    let v178 = v177 * v176;
-    let v179 = v173.mul_add(v172, -v178);
-    let v180 = S::c(p[95]).mul_add(v179, v169);
-    let v183 = v182 * 0.5f64;
-    let v184 = qd[14] * v47;
-    let v185 = qd[14] * 0.5f64;
-    let v186 = v174 + v176;
-    let v187 = v185 + v186;
-    let v188 = v44 * v123;
-    let v189 = v188 * v187;
-    let v190 = v184.mul_add(v183, -v189);
-    let v191 = S::c(p[101]).mul_add(v190, v180);
-    let v194 = v193 * 0.5f64;
-    let v195 = qd[15] * v57;
-    let v196 = qd[15] * 0.5f64;
-    let v197 = v185 + v187;
-    let v198 = v196 + v197;
-    let v199 = v54 * v126;
-    let v200 = v199 * v198;
-    let v201 = v195.mul_add(v194, -v200);
-    let v202 = S::c(p[107]).mul_add(v201, v191);
-    let v205 = v204 * 0.5f64;
-    let v206 = qd[16] * v67;
-    let v207 = qd[16] * 0.5f64;
-    let v208 = v196 + v198;
-    let v209 = v207 + v208;
-    let v210 = v64 * v129;
-    let v211 = v210 * v209;
-    let v212 = v206.mul_add(v205, -v211);
-    let v213 = S::c(p[113]).mul_add(v212, v202);
-    let v216 = v215 * 0.5f64;
-    let v217 = qd[17] * v77;
-    let v218 = qd[17] * 0.5f64;
-    let v219 = v207 + v209;
-    let v220 = v218 + v219;
-    let v221 = v74 * v132;
-    let v222 = v221 * v220;
-    let v223 = v217.mul_add(v216, -v222);
-    let v224 = S::c(p[119]).mul_add(v223, v213);
-    let v227 = v226 * 0.5f64;
-    let v228 = qd[18] * v91;
-    let v229 = qd[18] * 0.5f64;
-    let v230 = v218 + v220;
-    let v231 = v229 + v230;
-    let v232 = v84 * v99;
-    let v233 = v232 * v231;
-    let v234 = v228.mul_add(v227, -v233);
-    let v235 = S::c(p[125]).mul_add(v234, v224);
-    let v236 = v229 + v231;
-    let v237 = v105 * v236;
-    let v238 = -v237;
-    let v239 = v101 * v236;
-    let v240 = v103 * v239;
-    let v243 = v103 * (-0.5f64);
-    let v244 = v97 * 0.5f64;
-    let v245 = v105 * v244;
-    let v246 = v101.mul_add(v243, -v245);
-    let v247 = v97.mul_add(v238, -v240);
-    let v248 = qd[19].mul_add(v246, v247);
-    let v250 = v249 * 0.5f64;
-    let v251 = v250 * p[131];
-    let v252 = qd[19] * v106;
-    let v253 = v109.mul_add(v248, v235);
-    let v254 = v252.mul_add(v251, v253);
-    let v255 = v144 * v8;
-    let v256 = v112.mul_add(v143, v255);
-    let v257 = v256 * p[77];
-    let v258 = qd[11] * v114;
-    let v259 = v14 * v17;
-    let v260 = v259 * v153;
-    let v261 = v258.mul_add(v150, v260);
-    let v262 = v261 * p[83];
-    let v263 = qd[10].mul_add(v257, v262);
-    let v264 = qd[12] * v117;
-    let v265 = v24 * v27;
-    let v266 = v265 * v165;
-    let v267 = v264.mul_add(v161, v266);
-    let v268 = S::c(p[89]).mul_add(v267, v263);
-    let v269 = qd[13] * v120;
-    let v270 = v34 * v37;
-    let v271 = v270 * v176;
-    let v272 = v269.mul_add(v172, v271);
-    let v273 = S::c(p[95]).mul_add(v272, v268);
-    let v274 = qd[14] * v123;
-    let v275 = v44 * v47;
-    let v276 = v275 * v187;
-    let v277 = v274.mul_add(v183, v276);
-    let v278 = S::c(p[101]).mul_add(v277, v273);
-    let v279 = qd[15] * v126;
-    let v280 = v54 * v57;
-    let v281 = v280 * v198;
-    let v282 = v279.mul_add(v194, v281);
-    let v283 = S::c(p[107]).mul_add(v282, v278);
-    let v284 = qd[16] * v129;
-    let v285 = v64 * v67;
-    let v286 = v285 * v209;
-    let v287 = v284.mul_add(v205, v286);
-    let v288 = S::c(p[113]).mul_add(v287, v283);
-    let v289 = qd[17] * v132;
-    let v290 = v74 * v77;
-    let v291 = v290 * v220;
-    let v292 = v289.mul_add(v216, v291);
-    let v293 = S::c(p[119]).mul_add(v292, v288);
-    let v294 = qd[18] * v99;
-    let v295 = v84 * v91;
-    let v296 = v295 * v231;
-    let v297 = v294.mul_add(v227, v296);
-    let v298 = S::c(p[125]).mul_add(v297, v293);
-    let v299 = v97 * v239;
-    let v300 = v105 * v243;
-    let v301 = v101.mul_add(v244, v300);
-    let v302 = v103.mul_add(v238, v299);
-    let v303 = qd[19].mul_add(v301, v302);
-    let v304 = qd[19] * v138;
-    let v305 = v109.mul_add(v303, v298);
-    let v306 = v304.mul_add(v251, v305);
-    let v308 = v147 - v115;
-    let v309 = v308 - v118;
-    let v310 = v309 - v121;
-    let v311 = v310 - v124;
-    let v312 = v311 - v127;
-    let v313 = v312 - v130;
-    let v314 = v313 - v133;
-    let v315 = v314 - v135;
-    let v316 = -v105;
-    let v317 = v97.mul_add(v316, -v137);
-    let v318 = v109 * v317;
-    let v319 = v315 + v318;
-    let v320 = v14 * 0.5f64;
-    let v321 = v320 * v114;
-    let v322 = v17.mul_add(v150, -v321);
-    let v323 = S::c(p[83]).mul_add(v322, -v118);
-    let v324 = v323 - v121;
-    let v325 = v324 - v124;
-    let v326 = v325 - v127;
-    let v327 = v326 - v130;
-    let v328 = v327 - v133;
-    let v329 = v328 - v135;
-    let v330 = v329 + v318;
-    let v331 = v24 * 0.5f64;
-    let v332 = v331 * v117;
-    let v333 = v27.mul_add(v161, -v332);
-    let v334 = S::c(p[89]).mul_add(v333, -v121);
-    let v335 = v334 - v124;
-    let v336 = v335 - v127;
-    let v337 = v336 - v130;
-    let v338 = v337 - v133;
-    let v339 = v338 - v135;
-    let v340 = v339 + v318;
-    let v341 = v34 * 0.5f64;
-    let v342 = v341 * v120;
-    let v343 = v37.mul_add(v172, -v342);
-    let v344 = S::c(p[95]).mul_add(v343, -v124);
-    let v345 = v344 - v127;
-    let v346 = v345 - v130;
-    let v347 = v346 - v133;
-    let v348 = v347 - v135;
-    let v349 = v348 + v318;
-    let v350 = v44 * 0.5f64;
-    let v351 = v350 * v123;
-    let v352 = v47.mul_add(v183, -v351);
-    let v353 = S::c(p[101]).mul_add(v352, -v127);
-    let v354 = v353 - v130;
-    let v355 = v354 - v133;
-    let v356 = v355 - v135;
-    let v357 = v356 + v318;
-    let v358 = v54 * 0.5f64;
-    let v359 = v358 * v126;
-    let v360 = v57.mul_add(v194, -v359);
-    let v361 = S::c(p[107]).mul_add(v360, -v130);
-    let v362 = v361 - v133;
-    let v363 = v362 - v135;
-    let v364 = v363 + v318;
-    let v365 = v64 * 0.5f64;
-    let v366 = v365 * v129;
-    let v367 = v67.mul_add(v205, -v366);
-    let v368 = S::c(p[113]).mul_add(v367, -v133);
-    let v369 = v368 - v135;
-    let v370 = v369 + v318;
-    let v371 = v74 * 0.5f64;
-    let v372 = v371 * v132;
-    let v373 = v77.mul_add(v216, -v372);
-    let v374 = S::c(p[119]).mul_add(v373, -v135);
-    let v375 = v374 + v318;
-    let v376 = v84 * 0.5f64;
-    let v377 = v376 * v99;
-    let v378 = v91.mul_add(v227, -v377);
-    let v379 = S::c(p[125]).mul_add(v378, v318);
-    let v380 = v106 * v251;
-    let v381 = v109.mul_add(v246, v380);
-    let v382 = v19 + v257;
-    let v383 = v29 + v382;
-    let v384 = v39 + v383;
-    let v385 = v49 + v384;
-    let v386 = v59 + v385;
-    let v387 = v69 + v386;
-    let v388 = v79 + v387;
-    let v389 = v93 + v388;
-    let v390 = v103.mul_add(v316, v102);
-    let v391 = v109 * v390;
-    let v392 = v389 + v391;
-    let v393 = v320 * v17;
-    let v394 = v114.mul_add(v150, v393);
-    let v395 = S::c(p[83]).mul_add(v394, v29);
-    let v396 = v39 + v395;
-    let v397 = v49 + v396;
-    let v398 = v59 + v397;
-    let v399 = v69 + v398;
-    let v400 = v79 + v399;
-    let v401 = v93 + v400;
-    let v402 = v401 + v391;
-    let v403 = v331 * v27;
-    let v404 = v117.mul_add(v161, v403);
-    let v405 = S::c(p[89]).mul_add(v404, v39);
-    let v406 = v49 + v405;
-    let v407 = v59 + v406;
-    let v408 = v69 + v407;
-    let v409 = v79 + v408;
-    let v410 = v93 + v409;
-    let v411 = v410 + v391;
-    let v412 = v341 * v37;
-    let v413 = v120.mul_add(v172, v412);
-    let v414 = S::c(p[95]).mul_add(v413, v49);
-    let v415 = v59 + v414;
-    let v416 = v69 + v415;
-    let v417 = v79 + v416;
-    let v418 = v93 + v417;
-    let v419 = v418 + v391;
-    let v420 = v350 * v47;
-    let v421 = v123.mul_add(v183, v420);
-    let v422 = S::c(p[101]).mul_add(v421, v59);
-    let v423 = v69 + v422;
-    let v424 = v79 + v423;
-    let v425 = v93 + v424;
-    let v426 = v425 + v391;
-    let v427 = v358 * v57;
-    let v428 = v126.mul_add(v194, v427);
-    let v429 = S::c(p[107]).mul_add(v428, v69);
-    let v430 = v79 + v429;
-    let v431 = v93 + v430;
-    let v432 = v431 + v391;
-    let v433 = v365 * v67;
-    let v434 = v129.mul_add(v205, v433);
-    let v435 = S::c(p[113]).mul_add(v434, v79);
-    let v436 = v93 + v435;
-    let v437 = v436 + v391;
-    let v438 = v371 * v77;
-    let v439 = v132.mul_add(v216, v438);
-    let v440 = S::c(p[119]).mul_add(v439, v93);
-    let v441 = v440 + v391;
-    let v442 = v376 * v91;
-    let v443 = v99.mul_add(v227, v442);
-    let v444 = S::c(p[125]).mul_add(v443, v391);
-    let v445 = v138 * v251;
-    let v446 = v109.mul_add(v301, v445);
-    out[0] = v110;
-    out[1] = v139;
-    out[2] = S::c(p[75]);
-    out[3] = v254;
-    out[4] = v306;
-    out[5] = S::c(0f64);
-    out[6] = S::c(0f64);
-    out[7] = S::c(0f64);
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = v319;
-    out[17] = v330;
-    out[18] = v340;
-    out[19] = v349;
-    out[20] = v357;
-    out[21] = v364;
-    out[22] = v370;
-    out[23] = v375;
-    out[24] = v379;
-    out[25] = v381;
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = S::c(0f64);
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = v392;
-    out[40] = v402;
-    out[41] = v411;
-    out[42] = v419;
-    out[43] = v426;
-    out[44] = v432;
-    out[45] = v437;
-    out[46] = v441;
-    out[47] = v444;
-    out[48] = v446;
-    out[49] = S::c(0f64);
-    out[50] = S::c(0f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jacobian_20`: 0 operations, over f64 or dual numbers.
-pub fn contact_jacobian_20(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 75],
-) {
-    runtime::cpu::require_fma();
-    unsafe { contact_jacobian_20_0::<f64>(t, q, qd, qdd, dir, p, out) };
-}
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn contact_jacobian_20_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 23],
-    qd: &[S; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [S; 75],
-) {
-    out[0] = q[20];
-    out[1] = q[21];
-    out[2] = S::c(p[141]);
-    out[3] = qd[20];
-    out[4] = qd[21];
-    out[5] = S::c(0f64);
-    out[6] = S::c(0f64);
-    out[7] = S::c(0f64);
-    out[8] = S::c(0f64);
-    out[9] = S::c(0f64);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = S::c(0f64);
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(0f64);
-    out[25] = S::c(0f64);
-    out[26] = S::c(1f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = S::c(0f64);
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = S::c(0f64);
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(0f64);
-    out[43] = S::c(0f64);
-    out[44] = S::c(0f64);
-    out[45] = S::c(0f64);
-    out[46] = S::c(0f64);
-    out[47] = S::c(0f64);
-    out[48] = S::c(0f64);
-    out[49] = S::c(0f64);
-    out[50] = S::c(1f64);
-    out[51] = S::c(0f64);
-    out[52] = S::c(0f64);
-    out[53] = S::c(0f64);
-    out[54] = S::c(0f64);
-    out[55] = S::c(0f64);
-    out[56] = S::c(0f64);
-    out[57] = S::c(0f64);
-    out[58] = S::c(0f64);
-    out[59] = S::c(0f64);
-    out[60] = S::c(0f64);
-    out[61] = S::c(0f64);
-    out[62] = S::c(0f64);
-    out[63] = S::c(0f64);
-    out[64] = S::c(0f64);
-    out[65] = S::c(0f64);
-    out[66] = S::c(0f64);
-    out[67] = S::c(0f64);
-    out[68] = S::c(0f64);
-    out[69] = S::c(0f64);
-    out[70] = S::c(0f64);
-    out[71] = S::c(0f64);
-    out[72] = S::c(0f64);
-    out[73] = S::c(0f64);
-    out[74] = S::c(0f64);
-}
-/// Kernel `contact_jvp`: the contact groups on dual numbers along dq.
-#[allow(unused_variables)]
-pub fn contact_jvp(
-    t: f64,
-    q: &[f64; 23],
-    qd: &[f64; 23],
-    qdd: &[f64; 23],
-    dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 1512],
-) {
-    runtime::cpu::require_fma();
-    let x = runtime::dual::seed(q, &dir[..23]);
-    let xd = qd.map(runtime::dual::Dual::constant);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_0_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[0..72]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_1_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[72..144]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_2_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[144..216]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_3_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[216..288]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_4_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[288..360]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_5_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[360..432]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_6_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[432..504]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_7_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[504..576]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_8_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[576..648]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_9_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[648..720]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_10_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[720..792]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_11_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[792..864]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_12_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[864..936]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_13_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[936..1008]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_14_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[1008..1080]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_15_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[1080..1152]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_16_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[1152..1224]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_17_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[1224..1296]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_18_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[1296..1368]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_19_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[1368..1440]);
-    let mut o = [runtime::dual::Dual::ZERO; 75];
-    unsafe {
-        contact_jacobian_20_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o)
-    };
-    runtime::dual::row_tails(&o, 75, &mut out[1440..1512]);
-}
 /// The kernels of one arm structure of this assembly, as a single arm's.
 #[allow(dead_code, unused_imports)]
 pub mod arm_0 {
     use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
     /// Structural hash of the model this was derived from.
-    pub const HASH: &str = "bab70214226e4694";
+    pub const HASH: &str = "2518fb45402d89a7";
     pub const DOF: usize = 10;
     pub const COORDINATES: &[&str] = &[
         "theta_0_0",
@@ -8837,7 +1993,7 @@ pub mod arm_0 {
         "joint[9].rest",
     ];
     /// Derived parameters, computed once per parameter set.
-    pub const DERIVED: usize = 104;
+    pub const DERIVED: usize = 144;
     /// Whether the mass solve is generated (the `accel` kernel).
     pub const ACCEL: bool = true;
     /// Base parameters that are loads (scaled by load continuation).
@@ -8847,11 +2003,11 @@ pub mod arm_0 {
     /// Coordinates per independent subsystem (M block diagonal).
     pub const BLOCKS: &[usize] = &[];
     /// Contact points along the arms and at the bodies.
-    pub const CONTACT_POINTS: usize = 0;
+    pub const CONTACT_POINTS: usize = 10;
     /// Points per group of the `contact_jacobian` kernel.
-    pub const CONTACT_GROUPS: &[usize] = &[];
+    pub const CONTACT_GROUPS: &[usize] = &[1, 1, 1, 1, 1, 1, 1, 1, 1, 1];
     /// Length of the contact frames the `contact_jacobian` groups read.
-    pub const CONTACT_FRAMES: usize = 0;
+    pub const CONTACT_FRAMES: usize = 134;
     /// The compiled kernels of this structure.
     pub struct Compiled {
         info: ModelInfo,
@@ -8885,7 +2041,7 @@ pub mod arm_0 {
         fn eval(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
             let q: &[f64; 10] = inp.q.try_into().expect("q has DOF entries");
             let qd: &[f64; 10] = inp.qd.try_into().expect("qd has DOF entries");
-            let p: &[f64; 171] = inp.p.try_into().expect("parameter vector length");
+            let p: &[f64; 211] = inp.p.try_into().expect("parameter vector length");
             let no_qdd = [0.0f64; 10];
             let qdd: &[f64; 10] = if inp.qdd.is_empty() {
                 &no_qdd
@@ -8977,16 +2133,7 @@ pub mod arm_0 {
                     )
                 }
                 KernelKind::ContactJacobian => {
-                    contact_jacobian(
-                        inp.t,
-                        q,
-                        qd,
-                        qdd,
-                        dir,
-                        inp.dir.is_empty(),
-                        p,
-                        out.try_into().expect("output length"),
-                    )
+                    contact_jacobian_framed(inp, q, qd, qdd, dir, p, out)
                 }
                 KernelKind::ContactJvp => {
                     contact_jvp(
@@ -9002,7 +2149,31 @@ pub mod arm_0 {
             }
         }
     }
-    /// Kernel `accel`: the first 65 values of `eom` (2884 operations for all).
+    /// The `contact_jacobian` groups with the frames given, or else
+    /// from the `contact` kernel.
+    #[allow(clippy::too_many_arguments)]
+    fn contact_jacobian_framed(
+        inp: &Inputs,
+        q: &[f64; 10],
+        qd: &[f64; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        out: &mut [f64],
+    ) {
+        let out = out.try_into().expect("output length");
+        let all = inp.dir.is_empty();
+        match <&[f64; 134]>::try_from(inp.aux) {
+            Ok(aux) => contact_jacobian(inp.t, q, qd, qdd, dir, all, p, aux, out),
+            Err(_) => {
+                let mut own = [0.0f64; 164];
+                contact(inp.t, q, qd, qdd, dir, p, &mut own);
+                let aux = own[30..].try_into().expect("frames length");
+                contact_jacobian(inp.t, q, qd, qdd, dir, all, p, aux, out)
+            }
+        }
+    }
+    /// Kernel `accel`: the first 199 values of `eom` (2910 operations for all).
     #[allow(unused_unsafe)]
     pub fn accel(
         t: f64,
@@ -9010,8 +2181,8 @@ pub mod arm_0 {
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
-        out: &mut [f64; 65],
+        p: &[f64; 211],
+        out: &mut [f64; 199],
     ) {
         runtime::cpu::require_fma();
         let w = &mut [0.0f64; 0];
@@ -9025,14 +2196,14 @@ pub mod arm_0 {
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
+        p: &[f64; 211],
         w: &mut [f64; 0],
-        out: &mut [f64; 65],
+        out: &mut [f64; 199],
     ) {
         let mut unused = [0.0f64; 65];
         eom_0(t, q, qd, qdd, dir, p, w, out, &mut unused);
     }
-    /// Kernel `mass_bias`: the last 65 values of `eom` (2884 operations for all).
+    /// Kernel `mass_bias`: the last 65 values of `eom` (2910 operations for all).
     #[allow(unused_unsafe)]
     pub fn mass_bias(
         t: f64,
@@ -9040,7 +2211,7 @@ pub mod arm_0 {
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
+        p: &[f64; 211],
         out: &mut [f64; 65],
     ) {
         runtime::cpu::require_fma();
@@ -9055,11 +2226,11 @@ pub mod arm_0 {
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
+        p: &[f64; 211],
         w: &mut [f64; 0],
         out: &mut [f64; 65],
     ) {
-        let mut unused = [0.0f64; 65];
+        let mut unused = [0.0f64; 199];
         eom_0(t, q, qd, qdd, dir, p, w, &mut unused, out);
     }
     #[inline(always)]
@@ -9070,12 +2241,12 @@ pub mod arm_0 {
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
+        p: &[f64; 211],
         w: &mut [f64; 0],
-        out: &mut [f64; 65],
+        out: &mut [f64; 199],
         out2: &mut [f64; 65],
     ) {
-        let [v3, v397, v1723]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[0]);
+        let [v3, v397, v1715]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[0]);
         let v5 = 2f64 * v3;
         let v7 = 0.5f64 * q[0];
         let [v8, v394, v1166]: [f64; 3] = runtime::special::sinc_orders::<3>(v7);
@@ -9085,7 +2256,7 @@ pub mod arm_0 {
         let v13 = (-0.25f64).mul_add(v9, v5);
         let v14 = (-v11).mul_add(v12, v13);
         let v15 = p[67].mul_add(v14, p[9]);
-        let [v19, v452, v1674]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[1]);
+        let [v19, v452, v1666]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[1]);
         let v20 = 2f64 * v19;
         let v21 = 0.5f64 * q[1];
         let [v22, v442, v1177]: [f64; 3] = runtime::special::sinc_orders::<3>(v21);
@@ -9094,7 +2265,7 @@ pub mod arm_0 {
         let v25 = v19 * v19;
         let v26 = (-0.25f64).mul_add(v23, v20);
         let v27 = (-v24).mul_add(v25, v26);
-        let [v31, v495, v1633]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[2]);
+        let [v31, v495, v1626]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[2]);
         let v32 = 2f64 * v31;
         let v33 = 0.5f64 * q[2];
         let [v34, v485, v1192]: [f64; 3] = runtime::special::sinc_orders::<3>(v33);
@@ -9103,7 +2274,7 @@ pub mod arm_0 {
         let v37 = v31 * v31;
         let v38 = (-0.25f64).mul_add(v35, v32);
         let v39 = (-v36).mul_add(v37, v38);
-        let [v43, v544, v1603]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[3]);
+        let [v43, v544, v1597]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[3]);
         let v44 = 2f64 * v43;
         let v45 = 0.5f64 * q[3];
         let [v46, v534, v1206]: [f64; 3] = runtime::special::sinc_orders::<3>(v45);
@@ -9112,7 +2283,7 @@ pub mod arm_0 {
         let v49 = v43 * v43;
         let v50 = (-0.25f64).mul_add(v47, v44);
         let v51 = (-v48).mul_add(v49, v50);
-        let [v55, v600, v1573]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[4]);
+        let [v55, v600, v1568]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[4]);
         let v56 = 2f64 * v55;
         let v57 = 0.5f64 * q[4];
         let [v58, v590, v1220]: [f64; 3] = runtime::special::sinc_orders::<3>(v57);
@@ -9121,7 +2292,7 @@ pub mod arm_0 {
         let v61 = v55 * v55;
         let v62 = (-0.25f64).mul_add(v59, v56);
         let v63 = (-v60).mul_add(v61, v62);
-        let [v67, v664, v1543]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[5]);
+        let [v67, v664, v1539]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[5]);
         let v68 = 2f64 * v67;
         let v69 = 0.5f64 * q[5];
         let [v70, v654, v1234]: [f64; 3] = runtime::special::sinc_orders::<3>(v69);
@@ -9130,7 +2301,7 @@ pub mod arm_0 {
         let v73 = v67 * v67;
         let v74 = (-0.25f64).mul_add(v71, v68);
         let v75 = (-v72).mul_add(v73, v74);
-        let [v79, v737, v1513]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[6]);
+        let [v79, v737, v1510]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[6]);
         let v80 = 2f64 * v79;
         let v81 = 0.5f64 * q[6];
         let [v82, v727, v1248]: [f64; 3] = runtime::special::sinc_orders::<3>(v81);
@@ -9139,7 +2310,7 @@ pub mod arm_0 {
         let v85 = v79 * v79;
         let v86 = (-0.25f64).mul_add(v83, v80);
         let v87 = (-v84).mul_add(v85, v86);
-        let [v91, v820, v1483]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[7]);
+        let [v91, v820, v1481]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[7]);
         let v92 = 2f64 * v91;
         let v93 = 0.5f64 * q[7];
         let [v94, v810, v1262]: [f64; 3] = runtime::special::sinc_orders::<3>(v93);
@@ -9148,7 +2319,7 @@ pub mod arm_0 {
         let v97 = v91 * v91;
         let v98 = (-0.25f64).mul_add(v95, v92);
         let v99 = (-v96).mul_add(v97, v98);
-        let [v103, v914, v1453]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[8]);
+        let [v103, v914, v1452]: [f64; 3] = runtime::special::sinc_rem_orders::<3>(q[8]);
         let v104 = 2f64 * v103;
         let v105 = 0.5f64 * q[8];
         let [v106, v904, v1276]: [f64; 3] = runtime::special::sinc_orders::<3>(v105);
@@ -9261,18 +2432,18 @@ pub mod arm_0 {
         let v236 = v232.mul_add(v234, -v235);
         let v237 = p[55] * v106;
         let v238 = v237.mul_add(v236, v225);
-        let v240 = v118 * v118;
-        let v241 = p[79] * v240;
-        let v242 = v232 * v233;
-        let v243 = v230.mul_add(v234, v242);
-        let v244 = v243 * v233;
-        let v245 = v236.mul_add(v234, -v244);
-        let v247 = p[61] * q[9];
-        let v248 = v247 * v115;
-        let v249 = v236 * v233;
-        let v250 = v243.mul_add(v234, v249);
-        let v251 = v241.mul_add(v245, v238);
-        let v252 = (-v248).mul_add(v250, v251);
+        let v239 = v232 * v233;
+        let v240 = v230.mul_add(v234, v239);
+        let v241 = v240 * v233;
+        let v242 = v236.mul_add(v234, -v241);
+        let v244 = v118 * v118;
+        let v245 = p[79] * v244;
+        let v246 = v236 * v233;
+        let v247 = v240.mul_add(v234, v246);
+        let v249 = p[61] * q[9];
+        let v250 = v249 * v115;
+        let v251 = v242.mul_add(v245, v238);
+        let v252 = (-v247).mul_add(v250, v251);
         let v254 = v133.mul_add(v137, p[4]);
         let v255 = v146.mul_add(v150, v254);
         let v256 = v159.mul_add(v163, v255);
@@ -9281,9 +2452,9 @@ pub mod arm_0 {
         let v259 = v198.mul_add(v202, v258);
         let v260 = v211.mul_add(v215, v259);
         let v261 = v224.mul_add(v228, v260);
-        let v262 = v237.mul_add(v243, v261);
-        let v263 = v241.mul_add(v250, v262);
-        let v264 = v248.mul_add(v245, v263);
+        let v262 = v237.mul_add(v240, v261);
+        let v263 = v247.mul_add(v245, v262);
+        let v264 = v242.mul_add(v250, v263);
         let v265 = v264 * v264;
         let v266 = v252.mul_add(v252, v265);
         let v267 = p[76].mul_add(v123, p[63]);
@@ -9292,10 +2463,10 @@ pub mod arm_0 {
         let v272 = p[80] * v271;
         let v273 = p[55] * q[8];
         let v274 = v273 * v103;
-        let v275 = v272.mul_add(v232, v225);
-        let v276 = (-v274).mul_add(v230, v275);
-        let v277 = v272.mul_add(v230, v261);
-        let v278 = v274.mul_add(v232, v277);
+        let v275 = v232.mul_add(v272, v225);
+        let v276 = (-v230).mul_add(v274, v275);
+        let v277 = v230.mul_add(v272, v261);
+        let v278 = v232.mul_add(v274, v277);
         let v279 = v278 * v278;
         let v280 = v276.mul_add(v276, v279);
         let v281 = p[75].mul_add(v111, p[57]);
@@ -9305,10 +2476,10 @@ pub mod arm_0 {
         let v287 = p[81] * v286;
         let v288 = p[49] * q[7];
         let v289 = v288 * v91;
-        let v290 = v287.mul_add(v219, v212);
-        let v291 = (-v289).mul_add(v217, v290);
-        let v292 = v287.mul_add(v217, v260);
-        let v293 = v289.mul_add(v219, v292);
+        let v290 = v219.mul_add(v287, v212);
+        let v291 = (-v217).mul_add(v289, v290);
+        let v292 = v217.mul_add(v287, v260);
+        let v293 = v219.mul_add(v289, v292);
         let v294 = v293 * v293;
         let v295 = v291.mul_add(v291, v294);
         let v296 = p[74].mul_add(v99, p[51]);
@@ -9318,10 +2489,10 @@ pub mod arm_0 {
         let v302 = p[82] * v301;
         let v303 = p[43] * q[6];
         let v304 = v303 * v79;
-        let v305 = v302.mul_add(v206, v199);
-        let v306 = (-v304).mul_add(v204, v305);
-        let v307 = v302.mul_add(v204, v259);
-        let v308 = v304.mul_add(v206, v307);
+        let v305 = v206.mul_add(v302, v199);
+        let v306 = (-v204).mul_add(v304, v305);
+        let v307 = v204.mul_add(v302, v259);
+        let v308 = v206.mul_add(v304, v307);
         let v309 = v308 * v308;
         let v310 = v306.mul_add(v306, v309);
         let v311 = p[73].mul_add(v87, p[45]);
@@ -9331,10 +2502,10 @@ pub mod arm_0 {
         let v317 = p[83] * v316;
         let v318 = p[37] * q[5];
         let v319 = v318 * v67;
-        let v320 = v317.mul_add(v193, v186);
-        let v321 = (-v319).mul_add(v191, v320);
-        let v322 = v317.mul_add(v191, v258);
-        let v323 = v319.mul_add(v193, v322);
+        let v320 = v193.mul_add(v317, v186);
+        let v321 = (-v191).mul_add(v319, v320);
+        let v322 = v191.mul_add(v317, v258);
+        let v323 = v193.mul_add(v319, v322);
         let v324 = v323 * v323;
         let v325 = v321.mul_add(v321, v324);
         let v326 = p[72].mul_add(v75, p[39]);
@@ -9344,10 +2515,10 @@ pub mod arm_0 {
         let v332 = p[84] * v331;
         let v333 = p[31] * q[4];
         let v334 = v333 * v55;
-        let v335 = v332.mul_add(v180, v173);
-        let v336 = (-v334).mul_add(v178, v335);
-        let v337 = v332.mul_add(v178, v257);
-        let v338 = v334.mul_add(v180, v337);
+        let v335 = v180.mul_add(v332, v173);
+        let v336 = (-v178).mul_add(v334, v335);
+        let v337 = v178.mul_add(v332, v257);
+        let v338 = v180.mul_add(v334, v337);
         let v339 = v338 * v338;
         let v340 = v336.mul_add(v336, v339);
         let v341 = p[71].mul_add(v63, p[33]);
@@ -9357,10 +2528,10 @@ pub mod arm_0 {
         let v347 = p[85] * v346;
         let v348 = p[25] * q[3];
         let v349 = v348 * v43;
-        let v350 = v347.mul_add(v167, v160);
-        let v351 = (-v349).mul_add(v165, v350);
-        let v352 = v347.mul_add(v165, v256);
-        let v353 = v349.mul_add(v167, v352);
+        let v350 = v167.mul_add(v347, v160);
+        let v351 = (-v165).mul_add(v349, v350);
+        let v352 = v165.mul_add(v347, v256);
+        let v353 = v167.mul_add(v349, v352);
         let v354 = v353 * v353;
         let v355 = v351.mul_add(v351, v354);
         let v356 = p[70].mul_add(v51, p[27]);
@@ -9370,10 +2541,10 @@ pub mod arm_0 {
         let v362 = p[86] * v361;
         let v363 = p[19] * q[2];
         let v364 = v363 * v31;
-        let v365 = v362.mul_add(v154, v147);
-        let v366 = (-v364).mul_add(v152, v365);
-        let v367 = v362.mul_add(v152, v255);
-        let v368 = v364.mul_add(v154, v367);
+        let v365 = v154.mul_add(v362, v147);
+        let v366 = (-v152).mul_add(v364, v365);
+        let v367 = v152.mul_add(v362, v255);
+        let v368 = v154.mul_add(v364, v367);
         let v369 = v368 * v368;
         let v370 = v366.mul_add(v366, v369);
         let v371 = p[69].mul_add(v39, p[21]);
@@ -9381,14 +2552,14 @@ pub mod arm_0 {
         let v373 = p[20].mul_add(v370, v372);
         let v376 = v22 * v22;
         let v377 = p[87] * v376;
-        let v378 = v377 * v141;
+        let v378 = v141 * v377;
         let v379 = p[13] * q[1];
         let v380 = v379 * v19;
-        let v381 = v380 * v139;
+        let v381 = v139 * v380;
         let v382 = v134 + v378;
         let v383 = v382 - v381;
-        let v384 = v377 * v139;
-        let v385 = v380 * v141;
+        let v384 = v139 * v377;
+        let v385 = v141 * v380;
         let v386 = v254 + v384;
         let v387 = v386 + v385;
         let v388 = v387 * v387;
@@ -9884,9 +3055,9 @@ pub mod arm_0 {
         let v905 = 0.5f64 * v904;
         let v906 = 0.5f64 * v106;
         let v907 = v906 * v236;
-        let v908 = v243.mul_add(v905, v907);
+        let v908 = v240.mul_add(v905, v907);
         let v909 = p[55].mul_add(v908, -v238);
-        let v910 = v906 * v243;
+        let v910 = v906 * v240;
         let v911 = v236.mul_add(v905, -v910);
         let v912 = p[55].mul_add(v911, v262);
         let v913 = v237 * v905;
@@ -9989,10 +3160,10 @@ pub mod arm_0 {
         let v1012 = v1011 * v1010;
         let v1014 = q[9].mul_add(v1013, v115);
         let v1015 = p[61] * v1014;
-        let v1016 = v245 * v1015;
-        let v1017 = v250.mul_add(v1012, v1016);
-        let v1018 = v250 * v1015;
-        let v1019 = v245.mul_add(v1012, -v1018);
+        let v1016 = v242 * v1015;
+        let v1017 = v247.mul_add(v1012, v1016);
+        let v1018 = v247 * v1015;
+        let v1019 = v242.mul_add(v1012, -v1018);
         let v1020 = v264 * v1019;
         let v1021 = v252.mul_add(v1017, -v1020);
         let v1022 = p[62] * v1021;
@@ -10221,7 +3392,7 @@ pub mod arm_0 {
         let v1269 = v1116 + v1256;
         let v1270 = v1114 + v1269;
         let v1271 = 2f64 * qd[8];
-        let v1272 = v1271 * v243;
+        let v1272 = v1271 * v240;
         let v1273 = v1272 * v905;
         let v1274 = v1273 * v1270;
         let v1275 = qd[8] * qd[8];
@@ -10238,7 +3409,7 @@ pub mod arm_0 {
         let v1288 = p[61] * v1287;
         let v1289 = v1114 + v1270;
         let v1290 = v1289 * v1289;
-        let v1291 = v241 * v1290;
+        let v1291 = v245 * v1290;
         let v1292 = 2f64 * qd[9];
         let v1293 = v1292 * v1289;
         let v1294 = v1283.mul_add(v1288, -v1291);
@@ -10247,749 +3418,772 @@ pub mod arm_0 {
         let v1298 = 2f64.mul_add(v1013, v1297);
         let v1299 = p[61] * v1298;
         let v1300 = v1283 * v1299;
-        let v1301 = v1292 * v1012;
-        let v1302 = v1301 * v1289;
-        let v1303 = v248 * v1290;
-        let v1304 = v1303 - v1300;
-        let v1305 = v1304 - v1302;
-        let v1306 = v245.mul_add(v1295, v1282);
-        let v1307 = v250.mul_add(v1305, v1306);
-        let v1308 = p[99] + v1307;
-        let v1310 = v137.mul_add(v1168, v406);
-        let v1311 = p[7] * v1310;
-        let v1312 = v1172 * v145;
-        let v1313 = v1312 * v443;
-        let v1314 = v150 * v1181;
-        let v1315 = v1313.mul_add(v1171, v1314);
-        let v1316 = p[13] * v1315;
-        let v1317 = v1165.mul_add(v1311, v1316);
-        let v1318 = v1187 * v158;
-        let v1319 = v1318 * v486;
-        let v1320 = v163 * v1196;
-        let v1321 = v1319.mul_add(v1186, v1320);
-        let v1322 = p[19].mul_add(v1321, v1317);
-        let v1323 = v1201 * v171;
-        let v1324 = v1323 * v535;
-        let v1325 = v176 * v1210;
-        let v1326 = v1324.mul_add(v1200, v1325);
-        let v1327 = p[25].mul_add(v1326, v1322);
-        let v1328 = v1215 * v184;
-        let v1329 = v1328 * v591;
-        let v1330 = v189 * v1224;
-        let v1331 = v1329.mul_add(v1214, v1330);
-        let v1332 = p[31].mul_add(v1331, v1327);
-        let v1333 = v1229 * v197;
-        let v1334 = v1333 * v655;
-        let v1335 = v202 * v1238;
-        let v1336 = v1334.mul_add(v1228, v1335);
-        let v1337 = p[37].mul_add(v1336, v1332);
-        let v1338 = v1243 * v210;
-        let v1339 = v1338 * v728;
-        let v1340 = v215 * v1252;
-        let v1341 = v1339.mul_add(v1242, v1340);
-        let v1342 = p[43].mul_add(v1341, v1337);
-        let v1343 = v1257 * v223;
-        let v1344 = v1343 * v811;
-        let v1345 = v228 * v1266;
-        let v1346 = v1344.mul_add(v1256, v1345);
-        let v1347 = p[49].mul_add(v1346, v1342);
-        let v1348 = v1271 * v236;
-        let v1349 = v1348 * v905;
-        let v1350 = v243 * v1280;
-        let v1351 = v1349.mul_add(v1270, v1350);
-        let v1352 = p[55].mul_add(v1351, v1347);
-        let v1353 = v1300 + v1302;
-        let v1354 = v1353 - v1303;
-        let v1355 = v245.mul_add(v1354, v1352);
-        let v1356 = v250.mul_add(v1295, v1355);
-        let v1357 = p[98] + v1356;
-        let v1358 = v1357 * v1017;
-        let v1360 = p[137] * q[9];
-        let v1361 = v1360 * v121;
-        let v1362 = v1308.mul_add(v1019, v1358);
-        let v1363 = (-v1361).mul_add(v1151, v1362);
-        let v1365 = v1010 * v1157;
-        let v1366 = 2f64 * q[9];
-        let v1367 = v1013.mul_add(v1152, -v1365);
-        let v1368 = (-v1366).mul_add(v121, v1367);
-        let v1369 = p[76] * v1368;
-        let v1370 = 0.5f64 * v1148;
-        let v1371 = v1370.mul_add(v1369, p[65]);
-        let v1373 = v1130 * v1130;
-        let v1374 = (-0.5f64) * v1373;
-        let v1375 = (-v5).mul_add(v11, 2f64);
-        let v1376 = v1374 * v1375;
-        let v1377 = p[96] * v1376;
-        let v1378 = p[8] * v1377;
-        let v1380 = v8.powi(3i32);
-        let v1381 = p[97] * v1380;
-        let v1382 = v1381 * v1374;
-        let v1383 = v395 * v1382;
-        let v1384 = v22.powi(3i32);
-        let v1385 = v443 * v1384;
-        let v1386 = 2f64 * q[1];
-        let v1387 = (-v20).mul_add(v24, 2f64);
-        let v1388 = v452.mul_add(v1387, -v1385);
-        let v1389 = (-v1386).mul_add(v25, v1388);
-        let v1390 = p[68] * v1389;
-        let v1391 = qd[1] * v1132;
-        let v1392 = v34.powi(3i32);
-        let v1393 = v486 * v1392;
-        let v1394 = 2f64 * q[2];
-        let v1395 = (-v32).mul_add(v36, 2f64);
-        let v1396 = v495.mul_add(v1395, -v1393);
-        let v1397 = (-v1394).mul_add(v37, v1396);
-        let v1398 = p[69] * v1397;
-        let v1399 = qd[2] * v1134;
-        let v1400 = v46.powi(3i32);
-        let v1401 = v535 * v1400;
-        let v1402 = 2f64 * q[3];
-        let v1403 = (-v44).mul_add(v48, 2f64);
-        let v1404 = v544.mul_add(v1403, -v1401);
-        let v1405 = (-v1402).mul_add(v49, v1404);
-        let v1406 = p[70] * v1405;
-        let v1407 = qd[3] * v1136;
-        let v1408 = v58.powi(3i32);
-        let v1409 = v591 * v1408;
-        let v1410 = 2f64 * q[4];
-        let v1411 = (-v56).mul_add(v60, 2f64);
-        let v1412 = v600.mul_add(v1411, -v1409);
-        let v1413 = (-v1410).mul_add(v61, v1412);
-        let v1414 = p[71] * v1413;
-        let v1415 = qd[4] * v1138;
-        let v1416 = v70.powi(3i32);
-        let v1417 = v655 * v1416;
-        let v1418 = 2f64 * q[5];
-        let v1419 = (-v68).mul_add(v72, 2f64);
-        let v1420 = v664.mul_add(v1419, -v1417);
-        let v1421 = (-v1418).mul_add(v73, v1420);
-        let v1422 = p[72] * v1421;
-        let v1423 = qd[5] * v1140;
-        let v1424 = v82.powi(3i32);
-        let v1425 = v728 * v1424;
-        let v1426 = 2f64 * q[6];
-        let v1427 = (-v80).mul_add(v84, 2f64);
-        let v1428 = v737.mul_add(v1427, -v1425);
-        let v1429 = (-v1426).mul_add(v85, v1428);
-        let v1430 = p[73] * v1429;
-        let v1431 = qd[6] * v1142;
-        let v1432 = v94.powi(3i32);
-        let v1433 = v811 * v1432;
-        let v1434 = 2f64 * q[7];
-        let v1435 = (-v92).mul_add(v96, 2f64);
-        let v1436 = v820.mul_add(v1435, -v1433);
-        let v1437 = (-v1434).mul_add(v97, v1436);
-        let v1438 = p[74] * v1437;
-        let v1439 = qd[7] * v1144;
-        let v1440 = v106.powi(3i32);
-        let v1441 = v905 * v1440;
-        let v1442 = 2f64 * q[8];
-        let v1443 = (-v104).mul_add(v108, 2f64);
-        let v1444 = v914.mul_add(v1443, -v1441);
-        let v1445 = (-v1442).mul_add(v109, v1444);
-        let v1446 = p[75] * v1445;
-        let v1447 = qd[8] * v1146;
-        let v1448 = qd[9] * v1148;
-        let v1449 = v264 * v1308;
-        let v1450 = v252.mul_add(v1357, -v1449);
-        let v1451 = p[62] * v1450;
-        let v1452 = v1448.mul_add(v1369, v1451);
-        let v1454 = q[8] * v1453;
-        let v1455 = 2f64.mul_add(v914, v1454);
-        let v1456 = p[55] * v1455;
-        let v1457 = v1275 * v1456;
-        let v1458 = v1271 * v913;
-        let v1459 = v1458 * v1269;
-        let v1460 = v1269 * v1269;
-        let v1461 = v274 * v1460;
-        let v1462 = v1457 + v1459;
-        let v1463 = v1462 - v1461;
-        let v1464 = v106 * v1277;
-        let v1465 = v905.mul_add(v905, v1464);
-        let v1466 = p[55] * v1465;
-        let v1467 = v272 * v1460;
-        let v1468 = v1271 * v1269;
-        let v1469 = v1275.mul_add(v1466, -v1467);
-        let v1470 = (-v1468).mul_add(v916, v1469);
-        let v1471 = v232.mul_add(v1463, v1347);
-        let v1472 = v230.mul_add(v1470, v1471);
-        let v1473 = p[98] + v1472;
-        let v1474 = v1461 - v1457;
-        let v1475 = v1474 - v1459;
-        let v1476 = v232.mul_add(v1470, v1268);
-        let v1477 = v230.mul_add(v1475, v1476);
-        let v1478 = p[99] + v1477;
-        let v1479 = v278 * v1478;
-        let v1480 = v276.mul_add(v1473, -v1479);
-        let v1481 = v1447.mul_add(v1446, v1452);
-        let v1482 = p[56].mul_add(v1480, v1481);
-        let v1484 = q[7] * v1483;
-        let v1485 = 2f64.mul_add(v820, v1484);
-        let v1486 = p[49] * v1485;
-        let v1487 = v1261 * v1486;
-        let v1488 = v1257 * v819;
-        let v1489 = v1488 * v1255;
-        let v1490 = v1255 * v1255;
-        let v1491 = v289 * v1490;
-        let v1492 = v1487 + v1489;
-        let v1493 = v1492 - v1491;
-        let v1494 = v94 * v1263;
-        let v1495 = v811.mul_add(v811, v1494);
-        let v1496 = p[49] * v1495;
-        let v1497 = v287 * v1490;
-        let v1498 = v1257 * v1255;
-        let v1499 = v1261.mul_add(v1496, -v1497);
-        let v1500 = (-v1498).mul_add(v822, v1499);
-        let v1501 = v219.mul_add(v1493, v1342);
-        let v1502 = v217.mul_add(v1500, v1501);
-        let v1503 = p[98] + v1502;
-        let v1504 = v1491 - v1487;
-        let v1505 = v1504 - v1489;
-        let v1506 = v219.mul_add(v1500, v1254);
-        let v1507 = v217.mul_add(v1505, v1506);
-        let v1508 = p[99] + v1507;
-        let v1509 = v293 * v1508;
-        let v1510 = v291.mul_add(v1503, -v1509);
-        let v1511 = v1439.mul_add(v1438, v1482);
-        let v1512 = p[50].mul_add(v1510, v1511);
-        let v1514 = q[6] * v1513;
-        let v1515 = 2f64.mul_add(v737, v1514);
-        let v1516 = p[43] * v1515;
-        let v1517 = v1247 * v1516;
-        let v1518 = v1243 * v736;
-        let v1519 = v1518 * v1241;
-        let v1520 = v1241 * v1241;
-        let v1521 = v304 * v1520;
-        let v1522 = v1517 + v1519;
-        let v1523 = v1522 - v1521;
-        let v1524 = v82 * v1249;
-        let v1525 = v728.mul_add(v728, v1524);
-        let v1526 = p[43] * v1525;
-        let v1527 = v302 * v1520;
-        let v1528 = v1243 * v1241;
-        let v1529 = v1247.mul_add(v1526, -v1527);
-        let v1530 = (-v1528).mul_add(v739, v1529);
-        let v1531 = v206.mul_add(v1523, v1337);
-        let v1532 = v204.mul_add(v1530, v1531);
-        let v1533 = p[98] + v1532;
-        let v1534 = v1521 - v1517;
-        let v1535 = v1534 - v1519;
-        let v1536 = v206.mul_add(v1530, v1240);
-        let v1537 = v204.mul_add(v1535, v1536);
-        let v1538 = p[99] + v1537;
-        let v1539 = v308 * v1538;
-        let v1540 = v306.mul_add(v1533, -v1539);
-        let v1541 = v1431.mul_add(v1430, v1512);
-        let v1542 = p[44].mul_add(v1540, v1541);
-        let v1544 = q[5] * v1543;
-        let v1545 = 2f64.mul_add(v664, v1544);
-        let v1546 = p[37] * v1545;
-        let v1547 = v1233 * v1546;
-        let v1548 = v1229 * v663;
-        let v1549 = v1548 * v1227;
-        let v1550 = v1227 * v1227;
-        let v1551 = v319 * v1550;
-        let v1552 = v1547 + v1549;
-        let v1553 = v1552 - v1551;
-        let v1554 = v70 * v1235;
-        let v1555 = v655.mul_add(v655, v1554);
-        let v1556 = p[37] * v1555;
-        let v1557 = v317 * v1550;
-        let v1558 = v1229 * v1227;
-        let v1559 = v1233.mul_add(v1556, -v1557);
-        let v1560 = (-v1558).mul_add(v666, v1559);
-        let v1561 = v193.mul_add(v1553, v1332);
+        let v1301 = v1293 * v1012;
+        let v1302 = v250 * v1290;
+        let v1303 = v1302 - v1300;
+        let v1304 = v1303 - v1301;
+        let v1305 = v242.mul_add(v1295, v1282);
+        let v1306 = v247.mul_add(v1304, v1305);
+        let v1307 = p[99] + v1306;
+        let v1309 = v137.mul_add(v1168, v406);
+        let v1310 = p[7] * v1309;
+        let v1311 = v1172 * v145;
+        let v1312 = v1311 * v443;
+        let v1313 = v150 * v1181;
+        let v1314 = v1312.mul_add(v1171, v1313);
+        let v1315 = p[13] * v1314;
+        let v1316 = v1165.mul_add(v1310, v1315);
+        let v1317 = v1187 * v158;
+        let v1318 = v1317 * v486;
+        let v1319 = v163 * v1196;
+        let v1320 = v1318.mul_add(v1186, v1319);
+        let v1321 = p[19].mul_add(v1320, v1316);
+        let v1322 = v1201 * v171;
+        let v1323 = v1322 * v535;
+        let v1324 = v176 * v1210;
+        let v1325 = v1323.mul_add(v1200, v1324);
+        let v1326 = p[25].mul_add(v1325, v1321);
+        let v1327 = v1215 * v184;
+        let v1328 = v1327 * v591;
+        let v1329 = v189 * v1224;
+        let v1330 = v1328.mul_add(v1214, v1329);
+        let v1331 = p[31].mul_add(v1330, v1326);
+        let v1332 = v1229 * v197;
+        let v1333 = v1332 * v655;
+        let v1334 = v202 * v1238;
+        let v1335 = v1333.mul_add(v1228, v1334);
+        let v1336 = p[37].mul_add(v1335, v1331);
+        let v1337 = v1243 * v210;
+        let v1338 = v1337 * v728;
+        let v1339 = v215 * v1252;
+        let v1340 = v1338.mul_add(v1242, v1339);
+        let v1341 = p[43].mul_add(v1340, v1336);
+        let v1342 = v1257 * v223;
+        let v1343 = v1342 * v811;
+        let v1344 = v228 * v1266;
+        let v1345 = v1343.mul_add(v1256, v1344);
+        let v1346 = p[49].mul_add(v1345, v1341);
+        let v1347 = v1271 * v236;
+        let v1348 = v1347 * v905;
+        let v1349 = v240 * v1280;
+        let v1350 = v1348.mul_add(v1270, v1349);
+        let v1351 = p[55].mul_add(v1350, v1346);
+        let v1352 = v1300 + v1301;
+        let v1353 = v1352 - v1302;
+        let v1354 = v242.mul_add(v1353, v1351);
+        let v1355 = v247.mul_add(v1295, v1354);
+        let v1356 = p[98] + v1355;
+        let v1357 = v1356 * v1017;
+        let v1359 = p[137] * q[9];
+        let v1360 = v1359 * v121;
+        let v1361 = v1307.mul_add(v1019, v1357);
+        let v1362 = (-v1360).mul_add(v1151, v1361);
+        let v1364 = v1010 * v1157;
+        let v1365 = 2f64 * q[9];
+        let v1366 = v1013.mul_add(v1152, -v1364);
+        let v1367 = (-v1365).mul_add(v121, v1366);
+        let v1368 = p[76] * v1367;
+        let v1369 = 0.5f64 * v1148;
+        let v1370 = v1369.mul_add(v1368, p[65]);
+        let v1372 = v1130 * v1130;
+        let v1373 = (-0.5f64) * v1372;
+        let v1374 = (-v5).mul_add(v11, 2f64);
+        let v1375 = v1373 * v1374;
+        let v1376 = p[96] * v1375;
+        let v1377 = p[8] * v1376;
+        let v1379 = v8.powi(3i32);
+        let v1380 = p[97] * v1379;
+        let v1381 = v1380 * v1373;
+        let v1382 = v395 * v1381;
+        let v1383 = v22.powi(3i32);
+        let v1384 = v443 * v1383;
+        let v1385 = 2f64 * q[1];
+        let v1386 = (-v20).mul_add(v24, 2f64);
+        let v1387 = v452.mul_add(v1386, -v1384);
+        let v1388 = (-v1385).mul_add(v25, v1387);
+        let v1389 = p[68] * v1388;
+        let v1390 = qd[1] * v1132;
+        let v1391 = v34.powi(3i32);
+        let v1392 = v486 * v1391;
+        let v1393 = 2f64 * q[2];
+        let v1394 = (-v32).mul_add(v36, 2f64);
+        let v1395 = v495.mul_add(v1394, -v1392);
+        let v1396 = (-v1393).mul_add(v37, v1395);
+        let v1397 = p[69] * v1396;
+        let v1398 = qd[2] * v1134;
+        let v1399 = v46.powi(3i32);
+        let v1400 = v535 * v1399;
+        let v1401 = 2f64 * q[3];
+        let v1402 = (-v44).mul_add(v48, 2f64);
+        let v1403 = v544.mul_add(v1402, -v1400);
+        let v1404 = (-v1401).mul_add(v49, v1403);
+        let v1405 = p[70] * v1404;
+        let v1406 = qd[3] * v1136;
+        let v1407 = v58.powi(3i32);
+        let v1408 = v591 * v1407;
+        let v1409 = 2f64 * q[4];
+        let v1410 = (-v56).mul_add(v60, 2f64);
+        let v1411 = v600.mul_add(v1410, -v1408);
+        let v1412 = (-v1409).mul_add(v61, v1411);
+        let v1413 = p[71] * v1412;
+        let v1414 = qd[4] * v1138;
+        let v1415 = v70.powi(3i32);
+        let v1416 = v655 * v1415;
+        let v1417 = 2f64 * q[5];
+        let v1418 = (-v68).mul_add(v72, 2f64);
+        let v1419 = v664.mul_add(v1418, -v1416);
+        let v1420 = (-v1417).mul_add(v73, v1419);
+        let v1421 = p[72] * v1420;
+        let v1422 = qd[5] * v1140;
+        let v1423 = v82.powi(3i32);
+        let v1424 = v728 * v1423;
+        let v1425 = 2f64 * q[6];
+        let v1426 = (-v80).mul_add(v84, 2f64);
+        let v1427 = v737.mul_add(v1426, -v1424);
+        let v1428 = (-v1425).mul_add(v85, v1427);
+        let v1429 = p[73] * v1428;
+        let v1430 = qd[6] * v1142;
+        let v1431 = v94.powi(3i32);
+        let v1432 = v811 * v1431;
+        let v1433 = 2f64 * q[7];
+        let v1434 = (-v92).mul_add(v96, 2f64);
+        let v1435 = v820.mul_add(v1434, -v1432);
+        let v1436 = (-v1433).mul_add(v97, v1435);
+        let v1437 = p[74] * v1436;
+        let v1438 = qd[7] * v1144;
+        let v1439 = v106.powi(3i32);
+        let v1440 = v905 * v1439;
+        let v1441 = 2f64 * q[8];
+        let v1442 = (-v104).mul_add(v108, 2f64);
+        let v1443 = v914.mul_add(v1442, -v1440);
+        let v1444 = (-v1441).mul_add(v109, v1443);
+        let v1445 = p[75] * v1444;
+        let v1446 = qd[8] * v1146;
+        let v1447 = qd[9] * v1148;
+        let v1448 = v264 * v1307;
+        let v1449 = v252.mul_add(v1356, -v1448);
+        let v1450 = p[62] * v1449;
+        let v1451 = v1447.mul_add(v1368, v1450);
+        let v1453 = q[8] * v1452;
+        let v1454 = 2f64.mul_add(v914, v1453);
+        let v1455 = p[55] * v1454;
+        let v1456 = v1275 * v1455;
+        let v1457 = v1271 * v1269;
+        let v1458 = v1457 * v913;
+        let v1459 = v1269 * v1269;
+        let v1460 = v274 * v1459;
+        let v1461 = v1456 + v1458;
+        let v1462 = v1461 - v1460;
+        let v1463 = v106 * v1277;
+        let v1464 = v905.mul_add(v905, v1463);
+        let v1465 = p[55] * v1464;
+        let v1466 = v272 * v1459;
+        let v1467 = v1275.mul_add(v1465, -v1466);
+        let v1468 = (-v1457).mul_add(v916, v1467);
+        let v1469 = v232.mul_add(v1462, v1346);
+        let v1470 = v230.mul_add(v1468, v1469);
+        let v1471 = p[98] + v1470;
+        let v1472 = v1460 - v1456;
+        let v1473 = v1472 - v1458;
+        let v1474 = v232.mul_add(v1468, v1268);
+        let v1475 = v230.mul_add(v1473, v1474);
+        let v1476 = p[99] + v1475;
+        let v1477 = v278 * v1476;
+        let v1478 = v276.mul_add(v1471, -v1477);
+        let v1479 = v1446.mul_add(v1445, v1451);
+        let v1480 = p[56].mul_add(v1478, v1479);
+        let v1482 = q[7] * v1481;
+        let v1483 = 2f64.mul_add(v820, v1482);
+        let v1484 = p[49] * v1483;
+        let v1485 = v1261 * v1484;
+        let v1486 = v1257 * v1255;
+        let v1487 = v1486 * v819;
+        let v1488 = v1255 * v1255;
+        let v1489 = v289 * v1488;
+        let v1490 = v1485 + v1487;
+        let v1491 = v1490 - v1489;
+        let v1492 = v94 * v1263;
+        let v1493 = v811.mul_add(v811, v1492);
+        let v1494 = p[49] * v1493;
+        let v1495 = v287 * v1488;
+        let v1496 = v1261.mul_add(v1494, -v1495);
+        let v1497 = (-v1486).mul_add(v822, v1496);
+        let v1498 = v219.mul_add(v1491, v1341);
+        let v1499 = v217.mul_add(v1497, v1498);
+        let v1500 = p[98] + v1499;
+        let v1501 = v1489 - v1485;
+        let v1502 = v1501 - v1487;
+        let v1503 = v219.mul_add(v1497, v1254);
+        let v1504 = v217.mul_add(v1502, v1503);
+        let v1505 = p[99] + v1504;
+        let v1506 = v293 * v1505;
+        let v1507 = v291.mul_add(v1500, -v1506);
+        let v1508 = v1438.mul_add(v1437, v1480);
+        let v1509 = p[50].mul_add(v1507, v1508);
+        let v1511 = q[6] * v1510;
+        let v1512 = 2f64.mul_add(v737, v1511);
+        let v1513 = p[43] * v1512;
+        let v1514 = v1247 * v1513;
+        let v1515 = v1243 * v1241;
+        let v1516 = v1515 * v736;
+        let v1517 = v1241 * v1241;
+        let v1518 = v304 * v1517;
+        let v1519 = v1514 + v1516;
+        let v1520 = v1519 - v1518;
+        let v1521 = v82 * v1249;
+        let v1522 = v728.mul_add(v728, v1521);
+        let v1523 = p[43] * v1522;
+        let v1524 = v302 * v1517;
+        let v1525 = v1247.mul_add(v1523, -v1524);
+        let v1526 = (-v1515).mul_add(v739, v1525);
+        let v1527 = v206.mul_add(v1520, v1336);
+        let v1528 = v204.mul_add(v1526, v1527);
+        let v1529 = p[98] + v1528;
+        let v1530 = v1518 - v1514;
+        let v1531 = v1530 - v1516;
+        let v1532 = v206.mul_add(v1526, v1240);
+        let v1533 = v204.mul_add(v1531, v1532);
+        let v1534 = p[99] + v1533;
+        let v1535 = v308 * v1534;
+        let v1536 = v306.mul_add(v1529, -v1535);
+        let v1537 = v1430.mul_add(v1429, v1509);
+        let v1538 = p[44].mul_add(v1536, v1537);
+        let v1540 = q[5] * v1539;
+        let v1541 = 2f64.mul_add(v664, v1540);
+        let v1542 = p[37] * v1541;
+        let v1543 = v1233 * v1542;
+        let v1544 = v1229 * v1227;
+        let v1545 = v1544 * v663;
+        let v1546 = v1227 * v1227;
+        let v1547 = v319 * v1546;
+        let v1548 = v1543 + v1545;
+        let v1549 = v1548 - v1547;
+        let v1550 = v70 * v1235;
+        let v1551 = v655.mul_add(v655, v1550);
+        let v1552 = p[37] * v1551;
+        let v1553 = v317 * v1546;
+        let v1554 = v1233.mul_add(v1552, -v1553);
+        let v1555 = (-v1544).mul_add(v666, v1554);
+        let v1556 = v193.mul_add(v1549, v1331);
+        let v1557 = v191.mul_add(v1555, v1556);
+        let v1558 = p[98] + v1557;
+        let v1559 = v1547 - v1543;
+        let v1560 = v1559 - v1545;
+        let v1561 = v193.mul_add(v1555, v1226);
         let v1562 = v191.mul_add(v1560, v1561);
-        let v1563 = p[98] + v1562;
-        let v1564 = v1551 - v1547;
-        let v1565 = v1564 - v1549;
-        let v1566 = v193.mul_add(v1560, v1226);
-        let v1567 = v191.mul_add(v1565, v1566);
-        let v1568 = p[99] + v1567;
-        let v1569 = v323 * v1568;
-        let v1570 = v321.mul_add(v1563, -v1569);
-        let v1571 = v1423.mul_add(v1422, v1542);
-        let v1572 = p[38].mul_add(v1570, v1571);
-        let v1574 = q[4] * v1573;
-        let v1575 = 2f64.mul_add(v600, v1574);
-        let v1576 = p[31] * v1575;
-        let v1577 = v1219 * v1576;
-        let v1578 = v1215 * v599;
-        let v1579 = v1578 * v1213;
-        let v1580 = v1213 * v1213;
-        let v1581 = v334 * v1580;
-        let v1582 = v1577 + v1579;
-        let v1583 = v1582 - v1581;
-        let v1584 = v58 * v1221;
-        let v1585 = v591.mul_add(v591, v1584);
-        let v1586 = p[31] * v1585;
-        let v1587 = v332 * v1580;
-        let v1588 = v1215 * v1213;
-        let v1589 = v1219.mul_add(v1586, -v1587);
-        let v1590 = (-v1588).mul_add(v602, v1589);
-        let v1591 = v180.mul_add(v1583, v1327);
-        let v1592 = v178.mul_add(v1590, v1591);
-        let v1593 = p[98] + v1592;
-        let v1594 = v1581 - v1577;
-        let v1595 = v1594 - v1579;
-        let v1596 = v180.mul_add(v1590, v1212);
-        let v1597 = v178.mul_add(v1595, v1596);
-        let v1598 = p[99] + v1597;
-        let v1599 = v338 * v1598;
-        let v1600 = v336.mul_add(v1593, -v1599);
-        let v1601 = v1415.mul_add(v1414, v1572);
-        let v1602 = p[32].mul_add(v1600, v1601);
-        let v1604 = q[3] * v1603;
-        let v1605 = 2f64.mul_add(v544, v1604);
-        let v1606 = p[25] * v1605;
-        let v1607 = v1205 * v1606;
-        let v1608 = v1201 * v543;
-        let v1609 = v1608 * v1199;
-        let v1610 = v1199 * v1199;
-        let v1611 = v349 * v1610;
-        let v1612 = v1607 + v1609;
-        let v1613 = v1612 - v1611;
-        let v1614 = v46 * v1207;
-        let v1615 = v535.mul_add(v535, v1614);
-        let v1616 = p[25] * v1615;
-        let v1617 = v347 * v1610;
-        let v1618 = v1201 * v1199;
-        let v1619 = v1205.mul_add(v1616, -v1617);
-        let v1620 = (-v1618).mul_add(v546, v1619);
-        let v1621 = v167.mul_add(v1613, v1322);
-        let v1622 = v165.mul_add(v1620, v1621);
-        let v1623 = p[98] + v1622;
-        let v1624 = v1611 - v1607;
-        let v1625 = v1624 - v1609;
-        let v1626 = v167.mul_add(v1620, v1198);
-        let v1627 = v165.mul_add(v1625, v1626);
-        let v1628 = p[99] + v1627;
-        let v1629 = v353 * v1628;
-        let v1630 = v351.mul_add(v1623, -v1629);
-        let v1631 = v1407.mul_add(v1406, v1602);
-        let v1632 = p[26].mul_add(v1630, v1631);
-        let v1634 = q[2] * v1633;
-        let v1635 = 2f64.mul_add(v495, v1634);
-        let v1636 = p[19] * v1635;
-        let v1637 = v1191 * v1636;
-        let v1638 = v1187 * v494;
-        let v1639 = v1638 * v1185;
-        let v1640 = v1185 * v1185;
-        let v1641 = v364 * v1640;
-        let v1642 = v1637 + v1639;
-        let v1643 = v1642 - v1641;
-        let v1644 = v34 * v1193;
-        let v1645 = v486.mul_add(v486, v1644);
-        let v1646 = p[19] * v1645;
-        let v1647 = v362 * v1640;
-        let v1648 = v1187 * v1185;
-        let v1649 = v1191.mul_add(v1646, -v1647);
-        let v1650 = (-v1648).mul_add(v497, v1649);
-        let v1651 = v154.mul_add(v1643, v1317);
-        let v1652 = v152.mul_add(v1650, v1651);
-        let v1653 = p[98] + v1652;
-        let v1654 = v1641 - v1637;
-        let v1655 = v1654 - v1639;
-        let v1656 = v154.mul_add(v1650, v1184);
-        let v1657 = v152.mul_add(v1655, v1656);
-        let v1658 = p[99] + v1657;
-        let v1659 = v368 * v1658;
-        let v1660 = v366.mul_add(v1653, -v1659);
-        let v1661 = v1399.mul_add(v1398, v1632);
-        let v1662 = p[20].mul_add(v1660, v1661);
-        let v1663 = v1311 - v384;
-        let v1664 = v1663 - v385;
-        let v1665 = 2f64 * v141;
-        let v1666 = 2f64 * v139;
-        let v1667 = v1666 * v454;
-        let v1668 = v1665.mul_add(v451, -v1667);
-        let v1669 = qd[1] * v1668;
-        let v1670 = qd[0] * v1669;
-        let v1671 = v22 * v1178;
-        let v1672 = v443.mul_add(v443, v1671);
-        let v1673 = p[13] * v1672;
-        let v1675 = q[1] * v1674;
-        let v1676 = 2f64.mul_add(v452, v1675);
-        let v1677 = p[13] * v1676;
-        let v1678 = v141 * v1677;
-        let v1679 = v139.mul_add(v1673, v1678);
-        let v1680 = v1165.mul_add(v1664, v1670);
-        let v1681 = v1176.mul_add(v1679, v1680);
-        let v1682 = p[98] + v1681;
-        let v1683 = v381 - v378;
-        let v1684 = v1683 + v1170;
-        let v1685 = v1665 * v454;
-        let v1686 = v1666.mul_add(v451, v1685);
-        let v1687 = -v1686;
-        let v1688 = qd[1] * v1687;
-        let v1689 = qd[0] * v1688;
-        let v1690 = v139 * v1677;
-        let v1691 = v141.mul_add(v1673, -v1690);
-        let v1692 = v1165.mul_add(v1684, v1689);
-        let v1693 = v1176.mul_add(v1691, v1692);
-        let v1694 = p[99] + v1693;
-        let v1695 = v387 * v1694;
-        let v1696 = v383.mul_add(v1682, -v1695);
-        let v1697 = v1391.mul_add(v1390, v1662);
-        let v1698 = p[14].mul_add(v1696, v1697);
-        let v1699 = p[62] * v1308;
-        let v1700 = p[56].mul_add(v1478, v1699);
-        let v1701 = p[50].mul_add(v1508, v1700);
-        let v1702 = p[44].mul_add(v1538, v1701);
-        let v1703 = p[38].mul_add(v1568, v1702);
-        let v1704 = p[32].mul_add(v1598, v1703);
-        let v1705 = p[26].mul_add(v1628, v1704);
-        let v1706 = p[20].mul_add(v1658, v1705);
-        let v1707 = p[14].mul_add(v1694, v1706);
-        let v1708 = p[62] * v1357;
-        let v1709 = p[56].mul_add(v1473, v1708);
-        let v1710 = p[50].mul_add(v1503, v1709);
-        let v1711 = p[44].mul_add(v1533, v1710);
-        let v1712 = p[38].mul_add(v1563, v1711);
-        let v1713 = p[32].mul_add(v1593, v1712);
-        let v1714 = p[26].mul_add(v1623, v1713);
-        let v1715 = p[20].mul_add(v1653, v1714);
-        let v1716 = p[14].mul_add(v1682, v1715);
-        let v1719 = p[100] + q[0];
-        let v1720 = v8 * v1167;
-        let v1721 = v395.mul_add(v395, v1720);
-        let v1722 = p[7] * v1721;
-        let v1724 = q[0] * v1723;
-        let v1725 = 2f64.mul_add(v397, v1724);
-        let v1726 = p[7] * v1725;
-        let v1727 = p[77] * v1726;
-        let v1728 = p[78].mul_add(v1722, -v1727);
-        let v1729 = v1165.mul_add(v1728, p[99]);
-        let v1730 = p[78] * v1726;
-        let v1731 = p[77].mul_add(v1722, v1730);
-        let v1732 = v1165.mul_add(v1731, p[98]);
-        let v1733 = v401 * v1732;
-        let v1735 = p[101] * q[0];
-        let v1736 = v1735 * v12;
-        let v1737 = v403.mul_add(v1729, v1733);
-        let v1738 = (-v1736).mul_add(v1374, v1737);
-        let v1740 = v395 * v1380;
-        let v1741 = 2f64 * q[0];
-        let v1742 = v397.mul_add(v1375, -v1740);
-        let v1743 = (-v1741).mul_add(v12, v1742);
-        let v1744 = p[67] * v1743;
-        let v1745 = 0.5f64 * v1130;
-        let v1746 = v1745.mul_add(v1744, p[11]);
-        let v1747 = v397.mul_add(v1378, v1383);
-        let v1748 = v1747 + v1698;
-        let v1749 = v409.mul_add(v1707, v1748);
-        let v1750 = v424.mul_add(v1716, v1749);
-        let v1751 = p[10].mul_add(v1719, v1750);
-        let v1752 = p[8].mul_add(v1738, v1751);
-        let v1753 = qd[0].mul_add(v1746, v1752);
-        let v1754 = -v1753;
-        let v1756 = v1132 * v1132;
-        let v1757 = (-0.5f64) * v1756;
-        let v1758 = v1757 * v1387;
-        let v1759 = p[102] * v1758;
-        let v1760 = p[14] * v1759;
-        let v1762 = p[103] * v1384;
-        let v1763 = v1762 * v1757;
-        let v1764 = v443 * v1763;
-        let v1767 = p[104] + q[1];
-        let v1768 = v1682 * v456;
-        let v1770 = p[105] * q[1];
-        let v1771 = v1770 * v25;
-        let v1772 = v1694.mul_add(v458, v1768);
-        let v1773 = (-v1771).mul_add(v1757, v1772);
-        let v1775 = 0.5f64 * v1132;
-        let v1776 = v1775.mul_add(v1390, p[17]);
-        let v1777 = v452.mul_add(v1760, v1764);
-        let v1778 = v1777 + v1662;
-        let v1779 = v450.mul_add(v1706, v1778);
-        let v1780 = v447.mul_add(v1715, v1779);
-        let v1781 = p[16].mul_add(v1767, v1780);
-        let v1782 = p[14].mul_add(v1773, v1781);
-        let v1783 = qd[1].mul_add(v1776, v1782);
-        let v1784 = v474.mul_add(v1754, v1783);
-        let v1785 = -v1784;
-        let v1787 = v1134 * v1134;
-        let v1788 = (-0.5f64) * v1787;
-        let v1789 = v1788 * v1395;
-        let v1790 = p[106] * v1789;
-        let v1791 = p[20] * v1790;
-        let v1793 = p[107] * v1392;
-        let v1794 = v1793 * v1788;
-        let v1795 = v486 * v1794;
-        let v1798 = p[108] + q[2];
-        let v1799 = v1653 * v499;
-        let v1801 = p[109] * q[2];
-        let v1802 = v1801 * v37;
-        let v1803 = v1658.mul_add(v501, v1799);
-        let v1804 = (-v1802).mul_add(v1788, v1803);
-        let v1806 = 0.5f64 * v1134;
-        let v1807 = v1806.mul_add(v1398, p[23]);
-        let v1808 = v495.mul_add(v1791, v1795);
-        let v1809 = v1808 + v1632;
-        let v1810 = v493.mul_add(v1705, v1809);
-        let v1811 = v490.mul_add(v1714, v1810);
-        let v1812 = p[22].mul_add(v1798, v1811);
-        let v1813 = p[20].mul_add(v1804, v1812);
-        let v1814 = qd[2].mul_add(v1807, v1813);
-        let v1815 = v525.mul_add(v1754, v1814);
-        let v1816 = v520.mul_add(v1785, v1815);
-        let v1817 = -v1816;
-        let v1819 = v1136 * v1136;
-        let v1820 = (-0.5f64) * v1819;
-        let v1821 = v1820 * v1403;
-        let v1822 = p[110] * v1821;
-        let v1823 = p[26] * v1822;
-        let v1825 = p[111] * v1400;
-        let v1826 = v1825 * v1820;
-        let v1827 = v535 * v1826;
-        let v1830 = p[112] + q[3];
-        let v1831 = v1623 * v548;
-        let v1833 = p[113] * q[3];
-        let v1834 = v1833 * v49;
-        let v1835 = v1628.mul_add(v550, v1831);
-        let v1836 = (-v1834).mul_add(v1820, v1835);
-        let v1838 = 0.5f64 * v1136;
-        let v1839 = v1838.mul_add(v1406, p[29]);
-        let v1840 = v544.mul_add(v1823, v1827);
-        let v1841 = v1840 + v1602;
-        let v1842 = v542.mul_add(v1704, v1841);
-        let v1843 = v539.mul_add(v1713, v1842);
-        let v1844 = p[28].mul_add(v1830, v1843);
-        let v1845 = p[26].mul_add(v1836, v1844);
-        let v1846 = qd[3].mul_add(v1839, v1845);
-        let v1847 = v579.mul_add(v1754, v1846);
-        let v1848 = v580.mul_add(v1785, v1847);
-        let v1849 = v574.mul_add(v1817, v1848);
-        let v1850 = -v1849;
-        let v1852 = v1138 * v1138;
-        let v1853 = (-0.5f64) * v1852;
-        let v1854 = v1853 * v1411;
-        let v1855 = p[114] * v1854;
-        let v1856 = p[32] * v1855;
-        let v1858 = p[115] * v1408;
-        let v1859 = v1858 * v1853;
-        let v1860 = v591 * v1859;
-        let v1863 = p[116] + q[4];
-        let v1864 = v1593 * v604;
-        let v1866 = p[117] * q[4];
-        let v1867 = v1866 * v61;
-        let v1868 = v1598.mul_add(v606, v1864);
-        let v1869 = (-v1867).mul_add(v1853, v1868);
-        let v1871 = 0.5f64 * v1138;
-        let v1872 = v1871.mul_add(v1414, p[35]);
-        let v1873 = v600.mul_add(v1856, v1860);
-        let v1874 = v1873 + v1572;
-        let v1875 = v598.mul_add(v1703, v1874);
-        let v1876 = v595.mul_add(v1712, v1875);
-        let v1877 = p[34].mul_add(v1863, v1876);
-        let v1878 = p[32].mul_add(v1869, v1877);
-        let v1879 = qd[4].mul_add(v1872, v1878);
-        let v1880 = v641.mul_add(v1754, v1879);
-        let v1881 = v642.mul_add(v1785, v1880);
-        let v1882 = v644.mul_add(v1817, v1881);
-        let v1883 = v636.mul_add(v1850, v1882);
-        let v1884 = -v1883;
-        let v1886 = v1140 * v1140;
-        let v1887 = (-0.5f64) * v1886;
-        let v1888 = v1887 * v1419;
-        let v1889 = p[118] * v1888;
-        let v1890 = p[38] * v1889;
-        let v1892 = p[119] * v1416;
-        let v1893 = v1892 * v1887;
-        let v1894 = v655 * v1893;
-        let v1897 = p[120] + q[5];
-        let v1898 = v1563 * v668;
-        let v1900 = p[121] * q[5];
-        let v1901 = v1900 * v73;
-        let v1902 = v1568.mul_add(v670, v1898);
-        let v1903 = (-v1901).mul_add(v1887, v1902);
-        let v1905 = 0.5f64 * v1140;
-        let v1906 = v1905.mul_add(v1422, p[41]);
-        let v1907 = v664.mul_add(v1890, v1894);
-        let v1908 = v1907 + v1542;
-        let v1909 = v662.mul_add(v1702, v1908);
-        let v1910 = v659.mul_add(v1711, v1909);
-        let v1911 = p[40].mul_add(v1897, v1910);
-        let v1912 = p[38].mul_add(v1903, v1911);
-        let v1913 = qd[5].mul_add(v1906, v1912);
-        let v1914 = v712.mul_add(v1754, v1913);
-        let v1915 = v713.mul_add(v1785, v1914);
-        let v1916 = v715.mul_add(v1817, v1915);
-        let v1917 = v716.mul_add(v1850, v1916);
-        let v1918 = v707.mul_add(v1884, v1917);
-        let v1919 = -v1918;
-        let v1921 = v1142 * v1142;
-        let v1922 = (-0.5f64) * v1921;
-        let v1923 = v1922 * v1427;
-        let v1924 = p[122] * v1923;
-        let v1925 = p[44] * v1924;
-        let v1927 = p[123] * v1424;
-        let v1928 = v1927 * v1922;
-        let v1929 = v728 * v1928;
-        let v1932 = p[124] + q[6];
-        let v1933 = v1533 * v741;
-        let v1935 = p[125] * q[6];
-        let v1936 = v1935 * v85;
-        let v1937 = v1538.mul_add(v743, v1933);
-        let v1938 = (-v1936).mul_add(v1922, v1937);
-        let v1940 = 0.5f64 * v1142;
-        let v1941 = v1940.mul_add(v1430, p[47]);
-        let v1942 = v737.mul_add(v1925, v1929);
-        let v1943 = v1942 + v1512;
-        let v1944 = v735.mul_add(v1701, v1943);
-        let v1945 = v732.mul_add(v1710, v1944);
-        let v1946 = p[46].mul_add(v1932, v1945);
-        let v1947 = p[44].mul_add(v1938, v1946);
-        let v1948 = qd[6].mul_add(v1941, v1947);
-        let v1949 = v793.mul_add(v1754, v1948);
-        let v1950 = v794.mul_add(v1785, v1949);
-        let v1951 = v796.mul_add(v1817, v1950);
-        let v1952 = v797.mul_add(v1850, v1951);
-        let v1953 = v798.mul_add(v1884, v1952);
-        let v1954 = v788.mul_add(v1919, v1953);
-        let v1955 = -v1954;
-        let v1957 = v1144 * v1144;
-        let v1958 = (-0.5f64) * v1957;
-        let v1959 = v1958 * v1435;
-        let v1960 = p[126] * v1959;
-        let v1961 = p[50] * v1960;
-        let v1963 = p[127] * v1432;
-        let v1964 = v1963 * v1958;
-        let v1965 = v811 * v1964;
-        let v1968 = p[128] + q[7];
-        let v1969 = v1503 * v824;
-        let v1971 = p[129] * q[7];
-        let v1972 = v1971 * v97;
-        let v1973 = v1508.mul_add(v826, v1969);
-        let v1974 = (-v1972).mul_add(v1958, v1973);
-        let v1976 = 0.5f64 * v1144;
-        let v1977 = v1976.mul_add(v1438, p[53]);
-        let v1978 = v820.mul_add(v1961, v1965);
-        let v1979 = v1978 + v1482;
-        let v1980 = v818.mul_add(v1700, v1979);
-        let v1981 = v815.mul_add(v1709, v1980);
-        let v1982 = p[52].mul_add(v1968, v1981);
-        let v1983 = p[50].mul_add(v1974, v1982);
-        let v1984 = qd[7].mul_add(v1977, v1983);
-        let v1985 = v885.mul_add(v1754, v1984);
-        let v1986 = v886.mul_add(v1785, v1985);
-        let v1987 = v888.mul_add(v1817, v1986);
-        let v1988 = v889.mul_add(v1850, v1987);
-        let v1989 = v890.mul_add(v1884, v1988);
-        let v1990 = v891.mul_add(v1919, v1989);
-        let v1991 = v880.mul_add(v1955, v1990);
-        let v1992 = -v1991;
-        let v1994 = v1146 * v1146;
-        let v1995 = (-0.5f64) * v1994;
-        let v1996 = v1995 * v1443;
-        let v1997 = p[130] * v1996;
-        let v1998 = p[56] * v1997;
-        let v2000 = p[131] * v1440;
-        let v2001 = v2000 * v1995;
-        let v2002 = v905 * v2001;
-        let v2005 = p[132] + q[8];
-        let v2006 = v1473 * v918;
-        let v2008 = p[133] * q[8];
-        let v2009 = v2008 * v109;
-        let v2010 = v1478.mul_add(v920, v2006);
-        let v2011 = (-v2009).mul_add(v1995, v2010);
-        let v2013 = 0.5f64 * v1146;
-        let v2014 = v2013.mul_add(v1446, p[59]);
-        let v2015 = v914.mul_add(v1998, v2002);
-        let v2016 = v2015 + v1452;
-        let v2017 = v912.mul_add(v1699, v2016);
-        let v2018 = v909.mul_add(v1708, v2017);
-        let v2019 = p[58].mul_add(v2005, v2018);
-        let v2020 = p[56].mul_add(v2011, v2019);
-        let v2021 = qd[8].mul_add(v2014, v2020);
-        let v2022 = v988.mul_add(v1754, v2021);
-        let v2023 = v989.mul_add(v1785, v2022);
-        let v2024 = v991.mul_add(v1817, v2023);
-        let v2025 = v992.mul_add(v1850, v2024);
-        let v2026 = v993.mul_add(v1884, v2025);
-        let v2027 = v994.mul_add(v1919, v2026);
-        let v2028 = v995.mul_add(v1955, v2027);
-        let v2029 = v983.mul_add(v1992, v2028);
-        let v2030 = -v2029;
-        let v2031 = v1013.mul_add(v1155, v1160);
-        let v2032 = p[64].mul_add(v1163, v2031);
-        let v2033 = p[62].mul_add(v1363, v2032);
-        let v2034 = qd[9].mul_add(v1371, v2033);
-        let v2035 = v1091.mul_add(v1754, v2034);
-        let v2036 = v1092.mul_add(v1785, v2035);
-        let v2037 = v1094.mul_add(v1817, v2036);
-        let v2038 = v1095.mul_add(v1850, v2037);
-        let v2039 = v1096.mul_add(v1884, v2038);
-        let v2040 = v1097.mul_add(v1919, v2039);
-        let v2041 = v1098.mul_add(v1955, v2040);
-        let v2042 = v1099.mul_add(v1992, v2041);
-        let v2043 = v1087.mul_add(v2030, v2042);
-        let v2044 = -v2043;
-        let v2045 = v1110 * v2044;
-        let v2046 = v1087 * v2045;
-        let v2047 = v1008.mul_add(v2030, -v2046);
-        let v2048 = v1099 * v2045;
-        let v2049 = v983.mul_add(v2047, v2048);
-        let v2050 = v903.mul_add(v1992, -v2049);
-        let v2051 = v995 * v2047;
-        let v2052 = v880.mul_add(v2050, v2051);
-        let v2053 = v1098.mul_add(v2045, v2052);
-        let v2054 = v809.mul_add(v1955, -v2053);
-        let v2055 = v891 * v2050;
-        let v2056 = v788.mul_add(v2054, v2055);
-        let v2057 = v994.mul_add(v2047, v2056);
-        let v2058 = v1097.mul_add(v2045, v2057);
-        let v2059 = v726.mul_add(v1919, -v2058);
-        let v2060 = v798 * v2054;
-        let v2061 = v707.mul_add(v2059, v2060);
-        let v2062 = v890.mul_add(v2050, v2061);
-        let v2063 = v993.mul_add(v2047, v2062);
-        let v2064 = v1096.mul_add(v2045, v2063);
-        let v2065 = v653.mul_add(v1884, -v2064);
-        let v2066 = v716 * v2059;
-        let v2067 = v636.mul_add(v2065, v2066);
-        let v2068 = v797.mul_add(v2054, v2067);
-        let v2069 = v889.mul_add(v2050, v2068);
-        let v2070 = v992.mul_add(v2047, v2069);
-        let v2071 = v1095.mul_add(v2045, v2070);
-        let v2072 = v589.mul_add(v1850, -v2071);
-        let v2073 = v644 * v2065;
-        let v2074 = v574.mul_add(v2072, v2073);
-        let v2075 = v715.mul_add(v2059, v2074);
-        let v2076 = v796.mul_add(v2054, v2075);
-        let v2077 = v888.mul_add(v2050, v2076);
-        let v2078 = v991.mul_add(v2047, v2077);
-        let v2079 = v1094.mul_add(v2045, v2078);
-        let v2080 = v533.mul_add(v1817, -v2079);
-        let v2081 = v580 * v2072;
-        let v2082 = v520.mul_add(v2080, v2081);
-        let v2083 = v642.mul_add(v2065, v2082);
-        let v2084 = v713.mul_add(v2059, v2083);
-        let v2085 = v794.mul_add(v2054, v2084);
-        let v2086 = v886.mul_add(v2050, v2085);
-        let v2087 = v989.mul_add(v2047, v2086);
-        let v2088 = v1092.mul_add(v2045, v2087);
-        let v2089 = v484.mul_add(v1785, -v2088);
-        let v2090 = v525 * v2080;
-        let v2091 = v474.mul_add(v2089, v2090);
-        let v2092 = v579.mul_add(v2072, v2091);
-        let v2093 = v641.mul_add(v2065, v2092);
-        let v2094 = v712.mul_add(v2059, v2093);
-        let v2095 = v793.mul_add(v2054, v2094);
-        let v2096 = v885.mul_add(v2050, v2095);
-        let v2097 = v988.mul_add(v2047, v2096);
-        let v2098 = v1091.mul_add(v2045, v2097);
-        let v2099 = v441.mul_add(v1754, -v2098);
-        out[0] = v2099;
-        out[1] = v2089;
-        out[2] = v2080;
-        out[3] = v2072;
-        out[4] = v2065;
-        out[5] = v2059;
-        out[6] = v2054;
-        out[7] = v2050;
-        out[8] = v2047;
-        out[9] = v2045;
+        let v1563 = p[99] + v1562;
+        let v1564 = v323 * v1563;
+        let v1565 = v321.mul_add(v1558, -v1564);
+        let v1566 = v1422.mul_add(v1421, v1538);
+        let v1567 = p[38].mul_add(v1565, v1566);
+        let v1569 = q[4] * v1568;
+        let v1570 = 2f64.mul_add(v600, v1569);
+        let v1571 = p[31] * v1570;
+        let v1572 = v1219 * v1571;
+        let v1573 = v1215 * v1213;
+        let v1574 = v1573 * v599;
+        let v1575 = v1213 * v1213;
+        let v1576 = v334 * v1575;
+        let v1577 = v1572 + v1574;
+        let v1578 = v1577 - v1576;
+        let v1579 = v58 * v1221;
+        let v1580 = v591.mul_add(v591, v1579);
+        let v1581 = p[31] * v1580;
+        let v1582 = v332 * v1575;
+        let v1583 = v1219.mul_add(v1581, -v1582);
+        let v1584 = (-v1573).mul_add(v602, v1583);
+        let v1585 = v180.mul_add(v1578, v1326);
+        let v1586 = v178.mul_add(v1584, v1585);
+        let v1587 = p[98] + v1586;
+        let v1588 = v1576 - v1572;
+        let v1589 = v1588 - v1574;
+        let v1590 = v180.mul_add(v1584, v1212);
+        let v1591 = v178.mul_add(v1589, v1590);
+        let v1592 = p[99] + v1591;
+        let v1593 = v338 * v1592;
+        let v1594 = v336.mul_add(v1587, -v1593);
+        let v1595 = v1414.mul_add(v1413, v1567);
+        let v1596 = p[32].mul_add(v1594, v1595);
+        let v1598 = q[3] * v1597;
+        let v1599 = 2f64.mul_add(v544, v1598);
+        let v1600 = p[25] * v1599;
+        let v1601 = v1205 * v1600;
+        let v1602 = v1201 * v1199;
+        let v1603 = v1602 * v543;
+        let v1604 = v1199 * v1199;
+        let v1605 = v349 * v1604;
+        let v1606 = v1601 + v1603;
+        let v1607 = v1606 - v1605;
+        let v1608 = v46 * v1207;
+        let v1609 = v535.mul_add(v535, v1608);
+        let v1610 = p[25] * v1609;
+        let v1611 = v347 * v1604;
+        let v1612 = v1205.mul_add(v1610, -v1611);
+        let v1613 = (-v1602).mul_add(v546, v1612);
+        let v1614 = v167.mul_add(v1607, v1321);
+        let v1615 = v165.mul_add(v1613, v1614);
+        let v1616 = p[98] + v1615;
+        let v1617 = v1605 - v1601;
+        let v1618 = v1617 - v1603;
+        let v1619 = v167.mul_add(v1613, v1198);
+        let v1620 = v165.mul_add(v1618, v1619);
+        let v1621 = p[99] + v1620;
+        let v1622 = v353 * v1621;
+        let v1623 = v351.mul_add(v1616, -v1622);
+        let v1624 = v1406.mul_add(v1405, v1596);
+        let v1625 = p[26].mul_add(v1623, v1624);
+        let v1627 = q[2] * v1626;
+        let v1628 = 2f64.mul_add(v495, v1627);
+        let v1629 = p[19] * v1628;
+        let v1630 = v1191 * v1629;
+        let v1631 = v1187 * v1185;
+        let v1632 = v1631 * v494;
+        let v1633 = v1185 * v1185;
+        let v1634 = v364 * v1633;
+        let v1635 = v1630 + v1632;
+        let v1636 = v1635 - v1634;
+        let v1637 = v34 * v1193;
+        let v1638 = v486.mul_add(v486, v1637);
+        let v1639 = p[19] * v1638;
+        let v1640 = v362 * v1633;
+        let v1641 = v1191.mul_add(v1639, -v1640);
+        let v1642 = (-v1631).mul_add(v497, v1641);
+        let v1643 = v154.mul_add(v1636, v1316);
+        let v1644 = v152.mul_add(v1642, v1643);
+        let v1645 = p[98] + v1644;
+        let v1646 = v1634 - v1630;
+        let v1647 = v1646 - v1632;
+        let v1648 = v154.mul_add(v1642, v1184);
+        let v1649 = v152.mul_add(v1647, v1648);
+        let v1650 = p[99] + v1649;
+        let v1651 = v368 * v1650;
+        let v1652 = v366.mul_add(v1645, -v1651);
+        let v1653 = v1398.mul_add(v1397, v1625);
+        let v1654 = p[20].mul_add(v1652, v1653);
+        let v1655 = v1310 - v384;
+        let v1656 = v1655 - v385;
+        let v1657 = 2f64 * v141;
+        let v1658 = 2f64 * v139;
+        let v1659 = v1658 * v454;
+        let v1660 = v1657.mul_add(v451, -v1659);
+        let v1661 = qd[1] * v1660;
+        let v1662 = qd[0] * v1661;
+        let v1663 = v22 * v1178;
+        let v1664 = v443.mul_add(v443, v1663);
+        let v1665 = p[13] * v1664;
+        let v1667 = q[1] * v1666;
+        let v1668 = 2f64.mul_add(v452, v1667);
+        let v1669 = p[13] * v1668;
+        let v1670 = v141 * v1669;
+        let v1671 = v139.mul_add(v1665, v1670);
+        let v1672 = v1165.mul_add(v1656, v1662);
+        let v1673 = v1176.mul_add(v1671, v1672);
+        let v1674 = p[98] + v1673;
+        let v1675 = v381 - v378;
+        let v1676 = v1675 + v1170;
+        let v1677 = v1657 * v454;
+        let v1678 = v1658.mul_add(v451, v1677);
+        let v1679 = -v1678;
+        let v1680 = qd[1] * v1679;
+        let v1681 = qd[0] * v1680;
+        let v1682 = v139 * v1669;
+        let v1683 = v141.mul_add(v1665, -v1682);
+        let v1684 = v1165.mul_add(v1676, v1681);
+        let v1685 = v1176.mul_add(v1683, v1684);
+        let v1686 = p[99] + v1685;
+        let v1687 = v387 * v1686;
+        let v1688 = v383.mul_add(v1674, -v1687);
+        let v1689 = v1390.mul_add(v1389, v1654);
+        let v1690 = p[14].mul_add(v1688, v1689);
+        let v1691 = p[62] * v1307;
+        let v1692 = p[56].mul_add(v1476, v1691);
+        let v1693 = p[50].mul_add(v1505, v1692);
+        let v1694 = p[44].mul_add(v1534, v1693);
+        let v1695 = p[38].mul_add(v1563, v1694);
+        let v1696 = p[32].mul_add(v1592, v1695);
+        let v1697 = p[26].mul_add(v1621, v1696);
+        let v1698 = p[20].mul_add(v1650, v1697);
+        let v1699 = p[14].mul_add(v1686, v1698);
+        let v1700 = p[62] * v1356;
+        let v1701 = p[56].mul_add(v1471, v1700);
+        let v1702 = p[50].mul_add(v1500, v1701);
+        let v1703 = p[44].mul_add(v1529, v1702);
+        let v1704 = p[38].mul_add(v1558, v1703);
+        let v1705 = p[32].mul_add(v1587, v1704);
+        let v1706 = p[26].mul_add(v1616, v1705);
+        let v1707 = p[20].mul_add(v1645, v1706);
+        let v1708 = p[14].mul_add(v1674, v1707);
+        let v1711 = p[100] + q[0];
+        let v1712 = v8 * v1167;
+        let v1713 = v395.mul_add(v395, v1712);
+        let v1714 = p[7] * v1713;
+        let v1716 = q[0] * v1715;
+        let v1717 = 2f64.mul_add(v397, v1716);
+        let v1718 = p[7] * v1717;
+        let v1719 = p[77] * v1718;
+        let v1720 = p[78].mul_add(v1714, -v1719);
+        let v1721 = v1165.mul_add(v1720, p[99]);
+        let v1722 = p[78] * v1718;
+        let v1723 = p[77].mul_add(v1714, v1722);
+        let v1724 = v1165.mul_add(v1723, p[98]);
+        let v1725 = v401 * v1724;
+        let v1727 = p[101] * q[0];
+        let v1728 = v1727 * v12;
+        let v1729 = v403.mul_add(v1721, v1725);
+        let v1730 = (-v1728).mul_add(v1373, v1729);
+        let v1732 = v395 * v1379;
+        let v1733 = 2f64 * q[0];
+        let v1734 = v397.mul_add(v1374, -v1732);
+        let v1735 = (-v1733).mul_add(v12, v1734);
+        let v1736 = p[67] * v1735;
+        let v1737 = 0.5f64 * v1130;
+        let v1738 = v1737.mul_add(v1736, p[11]);
+        let v1739 = v397.mul_add(v1377, v1382);
+        let v1740 = v1739 + v1690;
+        let v1741 = v409.mul_add(v1699, v1740);
+        let v1742 = v424.mul_add(v1708, v1741);
+        let v1743 = p[10].mul_add(v1711, v1742);
+        let v1744 = p[8].mul_add(v1730, v1743);
+        let v1745 = qd[0].mul_add(v1738, v1744);
+        let v1746 = -v1745;
+        let v1748 = v1132 * v1132;
+        let v1749 = (-0.5f64) * v1748;
+        let v1750 = v1749 * v1386;
+        let v1751 = p[102] * v1750;
+        let v1752 = p[14] * v1751;
+        let v1754 = p[103] * v1383;
+        let v1755 = v1754 * v1749;
+        let v1756 = v443 * v1755;
+        let v1759 = p[104] + q[1];
+        let v1760 = v1674 * v456;
+        let v1762 = p[105] * q[1];
+        let v1763 = v1762 * v25;
+        let v1764 = v1686.mul_add(v458, v1760);
+        let v1765 = (-v1763).mul_add(v1749, v1764);
+        let v1767 = 0.5f64 * v1132;
+        let v1768 = v1767.mul_add(v1389, p[17]);
+        let v1769 = v452.mul_add(v1752, v1756);
+        let v1770 = v1769 + v1654;
+        let v1771 = v450.mul_add(v1698, v1770);
+        let v1772 = v447.mul_add(v1707, v1771);
+        let v1773 = p[16].mul_add(v1759, v1772);
+        let v1774 = p[14].mul_add(v1765, v1773);
+        let v1775 = qd[1].mul_add(v1768, v1774);
+        let v1776 = v474.mul_add(v1746, v1775);
+        let v1777 = -v1776;
+        let v1779 = v1134 * v1134;
+        let v1780 = (-0.5f64) * v1779;
+        let v1781 = v1780 * v1394;
+        let v1782 = p[106] * v1781;
+        let v1783 = p[20] * v1782;
+        let v1785 = p[107] * v1391;
+        let v1786 = v1785 * v1780;
+        let v1787 = v486 * v1786;
+        let v1790 = p[108] + q[2];
+        let v1791 = v1645 * v499;
+        let v1793 = p[109] * q[2];
+        let v1794 = v1793 * v37;
+        let v1795 = v1650.mul_add(v501, v1791);
+        let v1796 = (-v1794).mul_add(v1780, v1795);
+        let v1798 = 0.5f64 * v1134;
+        let v1799 = v1798.mul_add(v1397, p[23]);
+        let v1800 = v495.mul_add(v1783, v1787);
+        let v1801 = v1800 + v1625;
+        let v1802 = v493.mul_add(v1697, v1801);
+        let v1803 = v490.mul_add(v1706, v1802);
+        let v1804 = p[22].mul_add(v1790, v1803);
+        let v1805 = p[20].mul_add(v1796, v1804);
+        let v1806 = qd[2].mul_add(v1799, v1805);
+        let v1807 = v525.mul_add(v1746, v1806);
+        let v1808 = v520.mul_add(v1777, v1807);
+        let v1809 = -v1808;
+        let v1811 = v1136 * v1136;
+        let v1812 = (-0.5f64) * v1811;
+        let v1813 = v1812 * v1402;
+        let v1814 = p[110] * v1813;
+        let v1815 = p[26] * v1814;
+        let v1817 = p[111] * v1399;
+        let v1818 = v1817 * v1812;
+        let v1819 = v535 * v1818;
+        let v1822 = p[112] + q[3];
+        let v1823 = v1616 * v548;
+        let v1825 = p[113] * q[3];
+        let v1826 = v1825 * v49;
+        let v1827 = v1621.mul_add(v550, v1823);
+        let v1828 = (-v1826).mul_add(v1812, v1827);
+        let v1830 = 0.5f64 * v1136;
+        let v1831 = v1830.mul_add(v1405, p[29]);
+        let v1832 = v544.mul_add(v1815, v1819);
+        let v1833 = v1832 + v1596;
+        let v1834 = v542.mul_add(v1696, v1833);
+        let v1835 = v539.mul_add(v1705, v1834);
+        let v1836 = p[28].mul_add(v1822, v1835);
+        let v1837 = p[26].mul_add(v1828, v1836);
+        let v1838 = qd[3].mul_add(v1831, v1837);
+        let v1839 = v579.mul_add(v1746, v1838);
+        let v1840 = v580.mul_add(v1777, v1839);
+        let v1841 = v574.mul_add(v1809, v1840);
+        let v1842 = -v1841;
+        let v1844 = v1138 * v1138;
+        let v1845 = (-0.5f64) * v1844;
+        let v1846 = v1845 * v1410;
+        let v1847 = p[114] * v1846;
+        let v1848 = p[32] * v1847;
+        let v1850 = p[115] * v1407;
+        let v1851 = v1850 * v1845;
+        let v1852 = v591 * v1851;
+        let v1855 = p[116] + q[4];
+        let v1856 = v1587 * v604;
+        let v1858 = p[117] * q[4];
+        let v1859 = v1858 * v61;
+        let v1860 = v1592.mul_add(v606, v1856);
+        let v1861 = (-v1859).mul_add(v1845, v1860);
+        let v1863 = 0.5f64 * v1138;
+        let v1864 = v1863.mul_add(v1413, p[35]);
+        let v1865 = v600.mul_add(v1848, v1852);
+        let v1866 = v1865 + v1567;
+        let v1867 = v598.mul_add(v1695, v1866);
+        let v1868 = v595.mul_add(v1704, v1867);
+        let v1869 = p[34].mul_add(v1855, v1868);
+        let v1870 = p[32].mul_add(v1861, v1869);
+        let v1871 = qd[4].mul_add(v1864, v1870);
+        let v1872 = v641.mul_add(v1746, v1871);
+        let v1873 = v642.mul_add(v1777, v1872);
+        let v1874 = v644.mul_add(v1809, v1873);
+        let v1875 = v636.mul_add(v1842, v1874);
+        let v1876 = -v1875;
+        let v1878 = v1140 * v1140;
+        let v1879 = (-0.5f64) * v1878;
+        let v1880 = v1879 * v1418;
+        let v1881 = p[118] * v1880;
+        let v1882 = p[38] * v1881;
+        let v1884 = p[119] * v1415;
+        let v1885 = v1884 * v1879;
+        let v1886 = v655 * v1885;
+        let v1889 = p[120] + q[5];
+        let v1890 = v1558 * v668;
+        let v1892 = p[121] * q[5];
+        let v1893 = v1892 * v73;
+        let v1894 = v1563.mul_add(v670, v1890);
+        let v1895 = (-v1893).mul_add(v1879, v1894);
+        let v1897 = 0.5f64 * v1140;
+        let v1898 = v1897.mul_add(v1421, p[41]);
+        let v1899 = v664.mul_add(v1882, v1886);
+        let v1900 = v1899 + v1538;
+        let v1901 = v662.mul_add(v1694, v1900);
+        let v1902 = v659.mul_add(v1703, v1901);
+        let v1903 = p[40].mul_add(v1889, v1902);
+        let v1904 = p[38].mul_add(v1895, v1903);
+        let v1905 = qd[5].mul_add(v1898, v1904);
+        let v1906 = v712.mul_add(v1746, v1905);
+        let v1907 = v713.mul_add(v1777, v1906);
+        let v1908 = v715.mul_add(v1809, v1907);
+        let v1909 = v716.mul_add(v1842, v1908);
+        let v1910 = v707.mul_add(v1876, v1909);
+        let v1911 = -v1910;
+        let v1913 = v1142 * v1142;
+        let v1914 = (-0.5f64) * v1913;
+        let v1915 = v1914 * v1426;
+        let v1916 = p[122] * v1915;
+        let v1917 = p[44] * v1916;
+        let v1919 = p[123] * v1423;
+        let v1920 = v1919 * v1914;
+        let v1921 = v728 * v1920;
+        let v1924 = p[124] + q[6];
+        let v1925 = v1529 * v741;
+        let v1927 = p[125] * q[6];
+        let v1928 = v1927 * v85;
+        let v1929 = v1534.mul_add(v743, v1925);
+        let v1930 = (-v1928).mul_add(v1914, v1929);
+        let v1932 = 0.5f64 * v1142;
+        let v1933 = v1932.mul_add(v1429, p[47]);
+        let v1934 = v737.mul_add(v1917, v1921);
+        let v1935 = v1934 + v1509;
+        let v1936 = v735.mul_add(v1693, v1935);
+        let v1937 = v732.mul_add(v1702, v1936);
+        let v1938 = p[46].mul_add(v1924, v1937);
+        let v1939 = p[44].mul_add(v1930, v1938);
+        let v1940 = qd[6].mul_add(v1933, v1939);
+        let v1941 = v793.mul_add(v1746, v1940);
+        let v1942 = v794.mul_add(v1777, v1941);
+        let v1943 = v796.mul_add(v1809, v1942);
+        let v1944 = v797.mul_add(v1842, v1943);
+        let v1945 = v798.mul_add(v1876, v1944);
+        let v1946 = v788.mul_add(v1911, v1945);
+        let v1947 = -v1946;
+        let v1949 = v1144 * v1144;
+        let v1950 = (-0.5f64) * v1949;
+        let v1951 = v1950 * v1434;
+        let v1952 = p[126] * v1951;
+        let v1953 = p[50] * v1952;
+        let v1955 = p[127] * v1431;
+        let v1956 = v1955 * v1950;
+        let v1957 = v811 * v1956;
+        let v1960 = p[128] + q[7];
+        let v1961 = v1500 * v824;
+        let v1963 = p[129] * q[7];
+        let v1964 = v1963 * v97;
+        let v1965 = v1505.mul_add(v826, v1961);
+        let v1966 = (-v1964).mul_add(v1950, v1965);
+        let v1968 = 0.5f64 * v1144;
+        let v1969 = v1968.mul_add(v1437, p[53]);
+        let v1970 = v820.mul_add(v1953, v1957);
+        let v1971 = v1970 + v1480;
+        let v1972 = v818.mul_add(v1692, v1971);
+        let v1973 = v815.mul_add(v1701, v1972);
+        let v1974 = p[52].mul_add(v1960, v1973);
+        let v1975 = p[50].mul_add(v1966, v1974);
+        let v1976 = qd[7].mul_add(v1969, v1975);
+        let v1977 = v885.mul_add(v1746, v1976);
+        let v1978 = v886.mul_add(v1777, v1977);
+        let v1979 = v888.mul_add(v1809, v1978);
+        let v1980 = v889.mul_add(v1842, v1979);
+        let v1981 = v890.mul_add(v1876, v1980);
+        let v1982 = v891.mul_add(v1911, v1981);
+        let v1983 = v880.mul_add(v1947, v1982);
+        let v1984 = -v1983;
+        let v1986 = v1146 * v1146;
+        let v1987 = (-0.5f64) * v1986;
+        let v1988 = v1987 * v1442;
+        let v1989 = p[130] * v1988;
+        let v1990 = p[56] * v1989;
+        let v1992 = p[131] * v1439;
+        let v1993 = v1992 * v1987;
+        let v1994 = v905 * v1993;
+        let v1997 = p[132] + q[8];
+        let v1998 = v1471 * v918;
+        let v2000 = p[133] * q[8];
+        let v2001 = v2000 * v109;
+        let v2002 = v1476.mul_add(v920, v1998);
+        let v2003 = (-v2001).mul_add(v1987, v2002);
+        let v2005 = 0.5f64 * v1146;
+        let v2006 = v2005.mul_add(v1445, p[59]);
+        let v2007 = v914.mul_add(v1990, v1994);
+        let v2008 = v2007 + v1451;
+        let v2009 = v912.mul_add(v1691, v2008);
+        let v2010 = v909.mul_add(v1700, v2009);
+        let v2011 = p[58].mul_add(v1997, v2010);
+        let v2012 = p[56].mul_add(v2003, v2011);
+        let v2013 = qd[8].mul_add(v2006, v2012);
+        let v2014 = v988.mul_add(v1746, v2013);
+        let v2015 = v989.mul_add(v1777, v2014);
+        let v2016 = v991.mul_add(v1809, v2015);
+        let v2017 = v992.mul_add(v1842, v2016);
+        let v2018 = v993.mul_add(v1876, v2017);
+        let v2019 = v994.mul_add(v1911, v2018);
+        let v2020 = v995.mul_add(v1947, v2019);
+        let v2021 = v983.mul_add(v1984, v2020);
+        let v2022 = -v2021;
+        let v2023 = v1013.mul_add(v1155, v1160);
+        let v2024 = p[64].mul_add(v1163, v2023);
+        let v2025 = p[62].mul_add(v1362, v2024);
+        let v2026 = qd[9].mul_add(v1370, v2025);
+        let v2027 = v1091.mul_add(v1746, v2026);
+        let v2028 = v1092.mul_add(v1777, v2027);
+        let v2029 = v1094.mul_add(v1809, v2028);
+        let v2030 = v1095.mul_add(v1842, v2029);
+        let v2031 = v1096.mul_add(v1876, v2030);
+        let v2032 = v1097.mul_add(v1911, v2031);
+        let v2033 = v1098.mul_add(v1947, v2032);
+        let v2034 = v1099.mul_add(v1984, v2033);
+        let v2035 = v1087.mul_add(v2022, v2034);
+        let v2036 = -v2035;
+        let v2037 = v1110 * v2036;
+        let v2038 = v1087 * v2037;
+        let v2039 = v1008.mul_add(v2022, -v2038);
+        let v2040 = v1099 * v2037;
+        let v2041 = v983.mul_add(v2039, v2040);
+        let v2042 = v903.mul_add(v1984, -v2041);
+        let v2043 = v995 * v2039;
+        let v2044 = v880.mul_add(v2042, v2043);
+        let v2045 = v1098.mul_add(v2037, v2044);
+        let v2046 = v809.mul_add(v1947, -v2045);
+        let v2047 = v891 * v2042;
+        let v2048 = v788.mul_add(v2046, v2047);
+        let v2049 = v994.mul_add(v2039, v2048);
+        let v2050 = v1097.mul_add(v2037, v2049);
+        let v2051 = v726.mul_add(v1911, -v2050);
+        let v2052 = v798 * v2046;
+        let v2053 = v707.mul_add(v2051, v2052);
+        let v2054 = v890.mul_add(v2042, v2053);
+        let v2055 = v993.mul_add(v2039, v2054);
+        let v2056 = v1096.mul_add(v2037, v2055);
+        let v2057 = v653.mul_add(v1876, -v2056);
+        let v2058 = v716 * v2051;
+        let v2059 = v636.mul_add(v2057, v2058);
+        let v2060 = v797.mul_add(v2046, v2059);
+        let v2061 = v889.mul_add(v2042, v2060);
+        let v2062 = v992.mul_add(v2039, v2061);
+        let v2063 = v1095.mul_add(v2037, v2062);
+        let v2064 = v589.mul_add(v1842, -v2063);
+        let v2065 = v644 * v2057;
+        let v2066 = v574.mul_add(v2064, v2065);
+        let v2067 = v715.mul_add(v2051, v2066);
+        let v2068 = v796.mul_add(v2046, v2067);
+        let v2069 = v888.mul_add(v2042, v2068);
+        let v2070 = v991.mul_add(v2039, v2069);
+        let v2071 = v1094.mul_add(v2037, v2070);
+        let v2072 = v533.mul_add(v1809, -v2071);
+        let v2073 = v580 * v2064;
+        let v2074 = v520.mul_add(v2072, v2073);
+        let v2075 = v642.mul_add(v2057, v2074);
+        let v2076 = v713.mul_add(v2051, v2075);
+        let v2077 = v794.mul_add(v2046, v2076);
+        let v2078 = v886.mul_add(v2042, v2077);
+        let v2079 = v989.mul_add(v2039, v2078);
+        let v2080 = v1092.mul_add(v2037, v2079);
+        let v2081 = v484.mul_add(v1777, -v2080);
+        let v2082 = v525 * v2072;
+        let v2083 = v474.mul_add(v2081, v2082);
+        let v2084 = v579.mul_add(v2064, v2083);
+        let v2085 = v641.mul_add(v2057, v2084);
+        let v2086 = v712.mul_add(v2051, v2085);
+        let v2087 = v793.mul_add(v2046, v2086);
+        let v2088 = v885.mul_add(v2042, v2087);
+        let v2089 = v988.mul_add(v2039, v2088);
+        let v2090 = v1091.mul_add(v2037, v2089);
+        let v2091 = v441.mul_add(v1746, -v2090);
+        let v2094 = p[6] + v7;
+        let v2095 = v7 + v2094;
+        let v2096 = v21 + v2095;
+        let v2097 = v21 + v2096;
+        let v2098 = v33 + v2097;
+        let v2099 = v33 + v2098;
+        let v2100 = v45 + v2099;
+        let v2101 = v45 + v2100;
+        let v2102 = v57 + v2101;
+        let v2103 = v57 + v2102;
+        let v2104 = v69 + v2103;
+        let v2105 = v69 + v2104;
+        let v2106 = v81 + v2105;
+        let v2107 = v81 + v2106;
+        let v2108 = v93 + v2107;
+        let v2109 = v93 + v2108;
+        let v2110 = v105 + v2109;
+        let v2111 = v105 + v2110;
+        let v2112 = v117 + v2111;
+        let (v2115, v2113): (f64, f64) = runtime::special::sin_cos(v2112);
+        let v2114 = v1011.mul_add(v2113, v238);
+        let v2116 = v1011.mul_add(v2115, v262);
+        let v2117 = p[6] + q[0];
+        let v2118 = q[1] + v2095;
+        let v2119 = q[2] + v2097;
+        let v2120 = q[3] + v2099;
+        let v2121 = q[4] + v2101;
+        let v2122 = q[5] + v2103;
+        let v2123 = q[6] + v2105;
+        let v2124 = q[7] + v2107;
+        let v2125 = q[8] + v2109;
+        out[0] = v2091;
+        out[1] = v2081;
+        out[2] = v2072;
+        out[3] = v2064;
+        out[4] = v2057;
+        out[5] = v2051;
+        out[6] = v2046;
+        out[7] = v2042;
+        out[8] = v2039;
+        out[9] = v2037;
         out[10] = v439;
         out[11] = v483;
         out[12] = v532;
@@ -11045,6 +4239,140 @@ pub mod arm_0 {
         out[62] = v1098;
         out[63] = v1099;
         out[64] = v1087;
+        out[65] = p[3];
+        out[66] = p[4];
+        out[67] = p[5];
+        out[68] = v134;
+        out[69] = v254;
+        out[70] = p[5];
+        out[71] = p[7];
+        out[72] = v134;
+        out[73] = v254;
+        out[74] = p[5];
+        out[75] = v147;
+        out[76] = v255;
+        out[77] = p[5];
+        out[78] = p[13];
+        out[79] = v147;
+        out[80] = v255;
+        out[81] = p[5];
+        out[82] = v160;
+        out[83] = v256;
+        out[84] = p[5];
+        out[85] = p[19];
+        out[86] = v160;
+        out[87] = v256;
+        out[88] = p[5];
+        out[89] = v173;
+        out[90] = v257;
+        out[91] = p[5];
+        out[92] = p[25];
+        out[93] = v173;
+        out[94] = v257;
+        out[95] = p[5];
+        out[96] = v186;
+        out[97] = v258;
+        out[98] = p[5];
+        out[99] = p[31];
+        out[100] = v186;
+        out[101] = v258;
+        out[102] = p[5];
+        out[103] = v199;
+        out[104] = v259;
+        out[105] = p[5];
+        out[106] = p[37];
+        out[107] = v199;
+        out[108] = v259;
+        out[109] = p[5];
+        out[110] = v212;
+        out[111] = v260;
+        out[112] = p[5];
+        out[113] = p[43];
+        out[114] = v212;
+        out[115] = v260;
+        out[116] = p[5];
+        out[117] = v225;
+        out[118] = v261;
+        out[119] = p[5];
+        out[120] = p[49];
+        out[121] = v225;
+        out[122] = v261;
+        out[123] = p[5];
+        out[124] = v238;
+        out[125] = v262;
+        out[126] = p[5];
+        out[127] = p[55];
+        out[128] = v238;
+        out[129] = v262;
+        out[130] = p[5];
+        out[131] = v2114;
+        out[132] = v2116;
+        out[133] = p[5];
+        out[134] = p[61];
+        out[135] = p[6];
+        out[136] = v2117;
+        out[137] = v2118;
+        out[138] = v2119;
+        out[139] = v2120;
+        out[140] = v2121;
+        out[141] = v2122;
+        out[142] = v2123;
+        out[143] = v2124;
+        out[144] = v2125;
+        out[145] = v409;
+        out[146] = v424;
+        out[147] = 0f64;
+        out[148] = 0f64;
+        out[149] = 0f64;
+        out[150] = 1f64;
+        out[151] = v450;
+        out[152] = v447;
+        out[153] = 0f64;
+        out[154] = 0f64;
+        out[155] = 0f64;
+        out[156] = 1f64;
+        out[157] = v493;
+        out[158] = v490;
+        out[159] = 0f64;
+        out[160] = 0f64;
+        out[161] = 0f64;
+        out[162] = 1f64;
+        out[163] = v542;
+        out[164] = v539;
+        out[165] = 0f64;
+        out[166] = 0f64;
+        out[167] = 0f64;
+        out[168] = 1f64;
+        out[169] = v598;
+        out[170] = v595;
+        out[171] = 0f64;
+        out[172] = 0f64;
+        out[173] = 0f64;
+        out[174] = 1f64;
+        out[175] = v662;
+        out[176] = v659;
+        out[177] = 0f64;
+        out[178] = 0f64;
+        out[179] = 0f64;
+        out[180] = 1f64;
+        out[181] = v735;
+        out[182] = v732;
+        out[183] = 0f64;
+        out[184] = 0f64;
+        out[185] = 0f64;
+        out[186] = 1f64;
+        out[187] = v818;
+        out[188] = v815;
+        out[189] = 0f64;
+        out[190] = 0f64;
+        out[191] = 0f64;
+        out[192] = 1f64;
+        out[193] = v912;
+        out[194] = v909;
+        out[195] = 0f64;
+        out[196] = 0f64;
+        out[197] = 0f64;
+        out[198] = 1f64;
         out2[0] = v439;
         out2[1] = v473;
         out2[2] = v516;
@@ -11100,18 +4428,18 @@ pub mod arm_0 {
         out2[52] = v1006;
         out2[53] = v1085;
         out2[54] = v1108;
-        out2[55] = v1753;
-        out2[56] = v1783;
-        out2[57] = v1814;
-        out2[58] = v1846;
-        out2[59] = v1879;
-        out2[60] = v1913;
-        out2[61] = v1948;
-        out2[62] = v1984;
-        out2[63] = v2021;
-        out2[64] = v2034;
+        out2[55] = v1745;
+        out2[56] = v1775;
+        out2[57] = v1806;
+        out2[58] = v1838;
+        out2[59] = v1871;
+        out2[60] = v1905;
+        out2[61] = v1940;
+        out2[62] = v1976;
+        out2[63] = v2013;
+        out2[64] = v2026;
     }
-    /// Kernel `derived`: 123 operations in 1 chunk(s).
+    /// Kernel `derived`: 179 operations in 1 chunk(s).
     #[allow(unused_unsafe)]
     pub fn derived(
         t: f64,
@@ -11119,8 +4447,8 @@ pub mod arm_0 {
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
-        out: &mut [f64; 104],
+        p: &[f64; 211],
+        out: &mut [f64; 144],
     ) {
         runtime::cpu::require_fma();
         let w = &mut [0.0f64; 0];
@@ -11135,9 +4463,9 @@ pub mod arm_0 {
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
+        p: &[f64; 211],
         w: &mut [f64; 0],
-        out: &mut [f64; 104],
+        out: &mut [f64; 144],
     ) {
         let v2 = p[7] * p[7];
         let v3 = p[8] * v2;
@@ -11261,6 +4589,44 @@ pub mod arm_0 {
         let v168 = v167 * v38;
         let v169 = 4f64 * p[62];
         let v170 = v169 * v38;
+        let v172 = -p[3];
+        let v174 = -p[4];
+        let v175 = p[7].mul_add(v42, p[3]);
+        let v176 = -v175;
+        let v177 = p[7].mul_add(v41, p[4]);
+        let v178 = -v177;
+        let v179 = p[13].mul_add(v42, v175);
+        let v180 = -v179;
+        let v181 = p[13].mul_add(v41, v177);
+        let v182 = -v181;
+        let v183 = p[19].mul_add(v42, v179);
+        let v184 = -v183;
+        let v185 = p[19].mul_add(v41, v181);
+        let v186 = -v185;
+        let v187 = p[25].mul_add(v42, v183);
+        let v188 = -v187;
+        let v189 = p[25].mul_add(v41, v185);
+        let v190 = -v189;
+        let v191 = p[31].mul_add(v42, v187);
+        let v192 = -v191;
+        let v193 = p[31].mul_add(v41, v189);
+        let v194 = -v193;
+        let v195 = p[37].mul_add(v42, v191);
+        let v196 = -v195;
+        let v197 = p[37].mul_add(v41, v193);
+        let v198 = -v197;
+        let v199 = p[43].mul_add(v42, v195);
+        let v200 = -v199;
+        let v201 = p[43].mul_add(v41, v197);
+        let v202 = -v201;
+        let v203 = p[49].mul_add(v42, v199);
+        let v204 = -v203;
+        let v205 = p[49].mul_add(v41, v201);
+        let v206 = -v205;
+        let v207 = p[55].mul_add(v42, v203);
+        let v208 = -v207;
+        let v209 = p[55].mul_add(v41, v205);
+        let v210 = -v209;
         out[0] = v3;
         out[1] = v7;
         out[2] = v11;
@@ -11365,6 +4731,46 @@ pub mod arm_0 {
         out[101] = v166;
         out[102] = v168;
         out[103] = v170;
+        out[104] = v42;
+        out[105] = v41;
+        out[106] = v172;
+        out[107] = v174;
+        out[108] = v176;
+        out[109] = v175;
+        out[110] = v178;
+        out[111] = v177;
+        out[112] = v180;
+        out[113] = v179;
+        out[114] = v182;
+        out[115] = v181;
+        out[116] = v184;
+        out[117] = v183;
+        out[118] = v186;
+        out[119] = v185;
+        out[120] = v188;
+        out[121] = v187;
+        out[122] = v190;
+        out[123] = v189;
+        out[124] = v192;
+        out[125] = v191;
+        out[126] = v194;
+        out[127] = v193;
+        out[128] = v196;
+        out[129] = v195;
+        out[130] = v198;
+        out[131] = v197;
+        out[132] = v200;
+        out[133] = v199;
+        out[134] = v202;
+        out[135] = v201;
+        out[136] = v204;
+        out[137] = v203;
+        out[138] = v206;
+        out[139] = v205;
+        out[140] = v208;
+        out[141] = v207;
+        out[142] = v210;
+        out[143] = v209;
     }
     /// Kernel `constraints`: 0 operations in 1 chunk(s).
     #[allow(unused_unsafe)]
@@ -11374,7 +4780,7 @@ pub mod arm_0 {
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
+        p: &[f64; 211],
         out: &mut [f64; 0],
     ) {
         runtime::cpu::require_fma();
@@ -11390,39 +4796,446 @@ pub mod arm_0 {
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
+        p: &[f64; 211],
         w: &mut [f64; 0],
         out: &mut [f64; 0],
     ) {}
-    /// Kernel `contact`: 0 operations in 1 chunk(s).
-    #[allow(unused_unsafe)]
+    /// Kernel `contact`: 365 operations, over f64 or dual numbers.
     pub fn contact(
         t: f64,
         q: &[f64; 10],
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
-        out: &mut [f64; 0],
+        p: &[f64; 211],
+        out: &mut [f64; 164],
     ) {
         runtime::cpu::require_fma();
-        let w = &mut [0.0f64; 0];
-        unsafe { contact_0(t, q, qd, qdd, dir, p, w, out) };
+        unsafe { contact_0::<f64>(t, q, qd, qdd, dir, p, out) };
     }
     #[inline(never)]
     #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
     #[allow(unused_variables, clippy::all)]
-    fn contact_0(
+    fn contact_0<S: runtime::scalar::Scalar>(
         t: f64,
-        q: &[f64; 10],
-        qd: &[f64; 10],
+        q: &[S; 10],
+        qd: &[S; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
-        w: &mut [f64; 0],
-        out: &mut [f64; 0],
-    ) {}
-    /// Kernel `contact_jacobian`: the points' positions, velocities and Jacobians in 0 groups; group g runs when `all` or `dir[g] != 0`.
+        p: &[f64; 211],
+        out: &mut [S; 164],
+    ) {
+        let v3 = q[0] * 0.5f64;
+        let (v6, v4): (S, S) = v3.sin_cos();
+        let v8 = v6 * p[172];
+        let v9 = v4.mul_add(S::c(p[171]), -v8);
+        let [v11, v213]: [S; 2] = v3.sinc_orders::<2>();
+        let v12 = v11 * p[7];
+        let v13 = v9.mul_add(v12, S::c(p[3]));
+        let v15 = v4 * p[172];
+        let v16 = v6.mul_add(S::c(p[171]), v15);
+        let v17 = v16.mul_add(v12, S::c(p[4]));
+        let v21 = v6 * p[77];
+        let v22 = S::c(p[78]).mul_add(v4, -v21);
+        let v23 = v12.mul_add(v22, S::c(p[3]));
+        let v25 = q[1] * 0.5f64;
+        let (v31, v26): (S, S) = v25.sin_cos();
+        let v27 = v6 * p[78];
+        let v28 = S::c(p[77]).mul_add(v4, v27);
+        let v29 = v28 * v6;
+        let v30 = v22.mul_add(v4, -v29);
+        let v32 = v22 * v6;
+        let v33 = v28.mul_add(v4, v32);
+        let v34 = v31 * v33;
+        let v35 = v26.mul_add(v30, -v34);
+        let [v37, v224]: [S; 2] = v25.sinc_orders::<2>();
+        let v38 = v37 * p[13];
+        let v39 = v35.mul_add(v38, v23);
+        let v40 = v12.mul_add(v28, S::c(p[4]));
+        let v41 = v26 * v33;
+        let v42 = v31.mul_add(v30, v41);
+        let v43 = v42.mul_add(v38, v40);
+        let v45 = q[2] * 0.5f64;
+        let (v49, v46): (S, S) = v45.sin_cos();
+        let v47 = v42 * v31;
+        let v48 = v35.mul_add(v26, -v47);
+        let v50 = v35 * v31;
+        let v51 = v42.mul_add(v26, v50);
+        let v52 = v49 * v51;
+        let v53 = v46.mul_add(v48, -v52);
+        let [v55, v233]: [S; 2] = v45.sinc_orders::<2>();
+        let v56 = v55 * p[19];
+        let v57 = v53.mul_add(v56, v39);
+        let v58 = v46 * v51;
+        let v59 = v49.mul_add(v48, v58);
+        let v60 = v59.mul_add(v56, v43);
+        let v62 = q[3] * 0.5f64;
+        let (v66, v63): (S, S) = v62.sin_cos();
+        let v64 = v59 * v49;
+        let v65 = v53.mul_add(v46, -v64);
+        let v67 = v53 * v49;
+        let v68 = v59.mul_add(v46, v67);
+        let v69 = v66 * v68;
+        let v70 = v63.mul_add(v65, -v69);
+        let [v72, v242]: [S; 2] = v62.sinc_orders::<2>();
+        let v73 = v72 * p[25];
+        let v74 = v70.mul_add(v73, v57);
+        let v75 = v63 * v68;
+        let v76 = v66.mul_add(v65, v75);
+        let v77 = v76.mul_add(v73, v60);
+        let v79 = q[4] * 0.5f64;
+        let (v83, v80): (S, S) = v79.sin_cos();
+        let v81 = v76 * v66;
+        let v82 = v70.mul_add(v63, -v81);
+        let v84 = v70 * v66;
+        let v85 = v76.mul_add(v63, v84);
+        let v86 = v83 * v85;
+        let v87 = v80.mul_add(v82, -v86);
+        let [v89, v251]: [S; 2] = v79.sinc_orders::<2>();
+        let v90 = v89 * p[31];
+        let v91 = v87.mul_add(v90, v74);
+        let v92 = v80 * v85;
+        let v93 = v83.mul_add(v82, v92);
+        let v94 = v93.mul_add(v90, v77);
+        let v96 = q[5] * 0.5f64;
+        let (v100, v97): (S, S) = v96.sin_cos();
+        let v98 = v93 * v83;
+        let v99 = v87.mul_add(v80, -v98);
+        let v101 = v87 * v83;
+        let v102 = v93.mul_add(v80, v101);
+        let v103 = v100 * v102;
+        let v104 = v97.mul_add(v99, -v103);
+        let [v106, v260]: [S; 2] = v96.sinc_orders::<2>();
+        let v107 = v106 * p[37];
+        let v108 = v104.mul_add(v107, v91);
+        let v109 = v97 * v102;
+        let v110 = v100.mul_add(v99, v109);
+        let v111 = v110.mul_add(v107, v94);
+        let v113 = q[6] * 0.5f64;
+        let (v117, v114): (S, S) = v113.sin_cos();
+        let v115 = v110 * v100;
+        let v116 = v104.mul_add(v97, -v115);
+        let v118 = v104 * v100;
+        let v119 = v110.mul_add(v97, v118);
+        let v120 = v117 * v119;
+        let v121 = v114.mul_add(v116, -v120);
+        let [v123, v269]: [S; 2] = v113.sinc_orders::<2>();
+        let v124 = v123 * p[43];
+        let v125 = v121.mul_add(v124, v108);
+        let v126 = v114 * v119;
+        let v127 = v117.mul_add(v116, v126);
+        let v128 = v127.mul_add(v124, v111);
+        let v130 = q[7] * 0.5f64;
+        let (v134, v131): (S, S) = v130.sin_cos();
+        let v132 = v127 * v117;
+        let v133 = v121.mul_add(v114, -v132);
+        let v135 = v121 * v117;
+        let v136 = v127.mul_add(v114, v135);
+        let v137 = v134 * v136;
+        let v138 = v131.mul_add(v133, -v137);
+        let [v140, v278]: [S; 2] = v130.sinc_orders::<2>();
+        let v141 = v140 * p[49];
+        let v142 = v138.mul_add(v141, v125);
+        let v143 = v131 * v136;
+        let v144 = v134.mul_add(v133, v143);
+        let v145 = v144.mul_add(v141, v128);
+        let v147 = q[8] * 0.5f64;
+        let (v151, v148): (S, S) = v147.sin_cos();
+        let v149 = v144 * v134;
+        let v150 = v138.mul_add(v131, -v149);
+        let v152 = v138 * v134;
+        let v153 = v144.mul_add(v131, v152);
+        let v154 = v151 * v153;
+        let v155 = v148.mul_add(v150, -v154);
+        let [v157, v287]: [S; 2] = v147.sinc_orders::<2>();
+        let v158 = v157 * p[55];
+        let v159 = v155.mul_add(v158, v142);
+        let v160 = v148 * v153;
+        let v161 = v151.mul_add(v150, v160);
+        let v162 = v161.mul_add(v158, v145);
+        let v164 = q[9] * 0.5f64;
+        let (v168, v165): (S, S) = v164.sin_cos();
+        let v166 = v161 * v151;
+        let v167 = v155.mul_add(v148, -v166);
+        let v169 = v155 * v151;
+        let v170 = v161.mul_add(v148, v169);
+        let v171 = v168 * v170;
+        let v172 = v165.mul_add(v167, -v171);
+        let v174 = v164.sinc(0u8);
+        let v175 = v174 * p[61];
+        let v176 = v172.mul_add(v175, v159);
+        let v177 = v165 * v170;
+        let v178 = v168.mul_add(v167, v177);
+        let v179 = v178.mul_add(v175, v162);
+        let v181 = v3 + p[6];
+        let v182 = v3 + v181;
+        let v183 = v25 + v182;
+        let v184 = v25 + v183;
+        let v185 = v45 + v184;
+        let v186 = v45 + v185;
+        let v187 = v62 + v186;
+        let v188 = v62 + v187;
+        let v189 = v79 + v188;
+        let v190 = v79 + v189;
+        let v191 = v96 + v190;
+        let v192 = v96 + v191;
+        let v193 = v113 + v192;
+        let v194 = v113 + v193;
+        let v195 = v130 + v194;
+        let v196 = v130 + v195;
+        let v197 = v147 + v196;
+        let v198 = v147 + v197;
+        let v199 = v164 + v198;
+        let (v202, v200): (S, S) = v199.sin_cos();
+        let v201 = v175.mul_add(v200, v159);
+        let v203 = v175.mul_add(v202, v162);
+        let v204 = q[0] + p[6];
+        let v205 = q[1] + v182;
+        let v206 = q[2] + v184;
+        let v207 = q[3] + v186;
+        let v208 = q[4] + v188;
+        let v209 = q[5] + v190;
+        let v210 = q[6] + v192;
+        let v211 = q[7] + v194;
+        let v212 = q[8] + v196;
+        let v214 = v213 * 0.5f64;
+        let v215 = v11 * 0.5f64;
+        let v216 = v215 * v28;
+        let v217 = v22.mul_add(v214, -v216);
+        let v218 = S::c(p[7]).mul_add(v217, v40);
+        let v219 = v215 * v22;
+        let v220 = v28.mul_add(v214, v219);
+        let v221 = S::c(p[7]).mul_add(v220, -v23);
+        let v225 = v224 * 0.5f64;
+        let v226 = v37 * 0.5f64;
+        let v227 = v226 * v42;
+        let v228 = v35.mul_add(v225, -v227);
+        let v229 = S::c(p[13]).mul_add(v228, v43);
+        let v230 = v226 * v35;
+        let v231 = v42.mul_add(v225, v230);
+        let v232 = S::c(p[13]).mul_add(v231, -v39);
+        let v234 = v233 * 0.5f64;
+        let v235 = v55 * 0.5f64;
+        let v236 = v235 * v59;
+        let v237 = v53.mul_add(v234, -v236);
+        let v238 = S::c(p[19]).mul_add(v237, v60);
+        let v239 = v235 * v53;
+        let v240 = v59.mul_add(v234, v239);
+        let v241 = S::c(p[19]).mul_add(v240, -v57);
+        let v243 = v242 * 0.5f64;
+        let v244 = v72 * 0.5f64;
+        let v245 = v244 * v76;
+        let v246 = v70.mul_add(v243, -v245);
+        let v247 = S::c(p[25]).mul_add(v246, v77);
+        let v248 = v244 * v70;
+        let v249 = v76.mul_add(v243, v248);
+        let v250 = S::c(p[25]).mul_add(v249, -v74);
+        let v252 = v251 * 0.5f64;
+        let v253 = v89 * 0.5f64;
+        let v254 = v253 * v93;
+        let v255 = v87.mul_add(v252, -v254);
+        let v256 = S::c(p[31]).mul_add(v255, v94);
+        let v257 = v253 * v87;
+        let v258 = v93.mul_add(v252, v257);
+        let v259 = S::c(p[31]).mul_add(v258, -v91);
+        let v261 = v260 * 0.5f64;
+        let v262 = v106 * 0.5f64;
+        let v263 = v262 * v110;
+        let v264 = v104.mul_add(v261, -v263);
+        let v265 = S::c(p[37]).mul_add(v264, v111);
+        let v266 = v262 * v104;
+        let v267 = v110.mul_add(v261, v266);
+        let v268 = S::c(p[37]).mul_add(v267, -v108);
+        let v270 = v269 * 0.5f64;
+        let v271 = v123 * 0.5f64;
+        let v272 = v271 * v127;
+        let v273 = v121.mul_add(v270, -v272);
+        let v274 = S::c(p[43]).mul_add(v273, v128);
+        let v275 = v271 * v121;
+        let v276 = v127.mul_add(v270, v275);
+        let v277 = S::c(p[43]).mul_add(v276, -v125);
+        let v279 = v278 * 0.5f64;
+        let v280 = v140 * 0.5f64;
+        let v281 = v280 * v144;
+        let v282 = v138.mul_add(v279, -v281);
+        let v283 = S::c(p[49]).mul_add(v282, v145);
+        let v284 = v280 * v138;
+        let v285 = v144.mul_add(v279, v284);
+        let v286 = S::c(p[49]).mul_add(v285, -v142);
+        let v288 = v287 * 0.5f64;
+        let v289 = v157 * 0.5f64;
+        let v290 = v289 * v161;
+        let v291 = v155.mul_add(v288, -v290);
+        let v292 = S::c(p[55]).mul_add(v291, v162);
+        let v293 = v289 * v155;
+        let v294 = v161.mul_add(v288, v293);
+        let v295 = S::c(p[55]).mul_add(v294, -v159);
+        out[0] = v13;
+        out[1] = v17;
+        out[2] = S::c(p[5]);
+        out[3] = v39;
+        out[4] = v43;
+        out[5] = S::c(p[5]);
+        out[6] = v57;
+        out[7] = v60;
+        out[8] = S::c(p[5]);
+        out[9] = v74;
+        out[10] = v77;
+        out[11] = S::c(p[5]);
+        out[12] = v91;
+        out[13] = v94;
+        out[14] = S::c(p[5]);
+        out[15] = v108;
+        out[16] = v111;
+        out[17] = S::c(p[5]);
+        out[18] = v125;
+        out[19] = v128;
+        out[20] = S::c(p[5]);
+        out[21] = v142;
+        out[22] = v145;
+        out[23] = S::c(p[5]);
+        out[24] = v159;
+        out[25] = v162;
+        out[26] = S::c(p[5]);
+        out[27] = v176;
+        out[28] = v179;
+        out[29] = S::c(p[5]);
+        out[30] = S::c(p[3]);
+        out[31] = S::c(p[4]);
+        out[32] = S::c(p[5]);
+        out[33] = v23;
+        out[34] = v40;
+        out[35] = S::c(p[5]);
+        out[36] = S::c(p[7]);
+        out[37] = v23;
+        out[38] = v40;
+        out[39] = S::c(p[5]);
+        out[40] = v39;
+        out[41] = v43;
+        out[42] = S::c(p[5]);
+        out[43] = S::c(p[13]);
+        out[44] = v39;
+        out[45] = v43;
+        out[46] = S::c(p[5]);
+        out[47] = v57;
+        out[48] = v60;
+        out[49] = S::c(p[5]);
+        out[50] = S::c(p[19]);
+        out[51] = v57;
+        out[52] = v60;
+        out[53] = S::c(p[5]);
+        out[54] = v74;
+        out[55] = v77;
+        out[56] = S::c(p[5]);
+        out[57] = S::c(p[25]);
+        out[58] = v74;
+        out[59] = v77;
+        out[60] = S::c(p[5]);
+        out[61] = v91;
+        out[62] = v94;
+        out[63] = S::c(p[5]);
+        out[64] = S::c(p[31]);
+        out[65] = v91;
+        out[66] = v94;
+        out[67] = S::c(p[5]);
+        out[68] = v108;
+        out[69] = v111;
+        out[70] = S::c(p[5]);
+        out[71] = S::c(p[37]);
+        out[72] = v108;
+        out[73] = v111;
+        out[74] = S::c(p[5]);
+        out[75] = v125;
+        out[76] = v128;
+        out[77] = S::c(p[5]);
+        out[78] = S::c(p[43]);
+        out[79] = v125;
+        out[80] = v128;
+        out[81] = S::c(p[5]);
+        out[82] = v142;
+        out[83] = v145;
+        out[84] = S::c(p[5]);
+        out[85] = S::c(p[49]);
+        out[86] = v142;
+        out[87] = v145;
+        out[88] = S::c(p[5]);
+        out[89] = v159;
+        out[90] = v162;
+        out[91] = S::c(p[5]);
+        out[92] = S::c(p[55]);
+        out[93] = v159;
+        out[94] = v162;
+        out[95] = S::c(p[5]);
+        out[96] = v201;
+        out[97] = v203;
+        out[98] = S::c(p[5]);
+        out[99] = S::c(p[61]);
+        out[100] = S::c(p[6]);
+        out[101] = v204;
+        out[102] = v205;
+        out[103] = v206;
+        out[104] = v207;
+        out[105] = v208;
+        out[106] = v209;
+        out[107] = v210;
+        out[108] = v211;
+        out[109] = v212;
+        out[110] = v218;
+        out[111] = v221;
+        out[112] = S::c(0f64);
+        out[113] = S::c(0f64);
+        out[114] = S::c(0f64);
+        out[115] = S::c(1f64);
+        out[116] = v229;
+        out[117] = v232;
+        out[118] = S::c(0f64);
+        out[119] = S::c(0f64);
+        out[120] = S::c(0f64);
+        out[121] = S::c(1f64);
+        out[122] = v238;
+        out[123] = v241;
+        out[124] = S::c(0f64);
+        out[125] = S::c(0f64);
+        out[126] = S::c(0f64);
+        out[127] = S::c(1f64);
+        out[128] = v247;
+        out[129] = v250;
+        out[130] = S::c(0f64);
+        out[131] = S::c(0f64);
+        out[132] = S::c(0f64);
+        out[133] = S::c(1f64);
+        out[134] = v256;
+        out[135] = v259;
+        out[136] = S::c(0f64);
+        out[137] = S::c(0f64);
+        out[138] = S::c(0f64);
+        out[139] = S::c(1f64);
+        out[140] = v265;
+        out[141] = v268;
+        out[142] = S::c(0f64);
+        out[143] = S::c(0f64);
+        out[144] = S::c(0f64);
+        out[145] = S::c(1f64);
+        out[146] = v274;
+        out[147] = v277;
+        out[148] = S::c(0f64);
+        out[149] = S::c(0f64);
+        out[150] = S::c(0f64);
+        out[151] = S::c(1f64);
+        out[152] = v283;
+        out[153] = v286;
+        out[154] = S::c(0f64);
+        out[155] = S::c(0f64);
+        out[156] = S::c(0f64);
+        out[157] = S::c(1f64);
+        out[158] = v292;
+        out[159] = v295;
+        out[160] = S::c(0f64);
+        out[161] = S::c(0f64);
+        out[162] = S::c(0f64);
+        out[163] = S::c(1f64);
+    }
+    /// Kernel `contact_jacobian`: the points' positions, velocities and Jacobians in 10 groups; group g runs when `all` or `dir[g] != 0`.
     #[allow(unused_variables)]
     pub fn contact_jacobian(
         t: f64,
@@ -11431,37 +5244,1525 @@ pub mod arm_0 {
         qdd: &[f64; 10],
         dir: &[f64; 20],
         all: bool,
-        p: &[f64; 171],
-        out: &mut [f64; 0],
-    ) {}
-    /// Kernel `contact_jvp`: 0 operations in 1 chunk(s).
-    #[allow(unused_unsafe)]
+        p: &[f64; 211],
+        aux: &[f64; 134],
+        out: &mut [f64; 360],
+    ) {
+        if all || dir[0] != 0.0 {
+            contact_jacobian_0(
+                t,
+                q,
+                qd,
+                qdd,
+                dir,
+                p,
+                aux,
+                (&mut out[0..36]).try_into().expect("group output length"),
+            );
+        }
+        if all || dir[1] != 0.0 {
+            contact_jacobian_1(
+                t,
+                q,
+                qd,
+                qdd,
+                dir,
+                p,
+                aux,
+                (&mut out[36..72]).try_into().expect("group output length"),
+            );
+        }
+        if all || dir[2] != 0.0 {
+            contact_jacobian_2(
+                t,
+                q,
+                qd,
+                qdd,
+                dir,
+                p,
+                aux,
+                (&mut out[72..108]).try_into().expect("group output length"),
+            );
+        }
+        if all || dir[3] != 0.0 {
+            contact_jacobian_3(
+                t,
+                q,
+                qd,
+                qdd,
+                dir,
+                p,
+                aux,
+                (&mut out[108..144]).try_into().expect("group output length"),
+            );
+        }
+        if all || dir[4] != 0.0 {
+            contact_jacobian_4(
+                t,
+                q,
+                qd,
+                qdd,
+                dir,
+                p,
+                aux,
+                (&mut out[144..180]).try_into().expect("group output length"),
+            );
+        }
+        if all || dir[5] != 0.0 {
+            contact_jacobian_5(
+                t,
+                q,
+                qd,
+                qdd,
+                dir,
+                p,
+                aux,
+                (&mut out[180..216]).try_into().expect("group output length"),
+            );
+        }
+        if all || dir[6] != 0.0 {
+            contact_jacobian_6(
+                t,
+                q,
+                qd,
+                qdd,
+                dir,
+                p,
+                aux,
+                (&mut out[216..252]).try_into().expect("group output length"),
+            );
+        }
+        if all || dir[7] != 0.0 {
+            contact_jacobian_7(
+                t,
+                q,
+                qd,
+                qdd,
+                dir,
+                p,
+                aux,
+                (&mut out[252..288]).try_into().expect("group output length"),
+            );
+        }
+        if all || dir[8] != 0.0 {
+            contact_jacobian_8(
+                t,
+                q,
+                qd,
+                qdd,
+                dir,
+                p,
+                aux,
+                (&mut out[288..324]).try_into().expect("group output length"),
+            );
+        }
+        if all || dir[9] != 0.0 {
+            contact_jacobian_9(
+                t,
+                q,
+                qd,
+                qdd,
+                dir,
+                p,
+                aux,
+                (&mut out[324..360]).try_into().expect("group output length"),
+            );
+        }
+    }
+    /// Kernel `contact_jacobian_0`: 64 operations, over f64 or dual numbers.
+    pub fn contact_jacobian_0(
+        t: f64,
+        q: &[f64; 10],
+        qd: &[f64; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[f64; 134],
+        out: &mut [f64; 36],
+    ) {
+        runtime::cpu::require_fma();
+        unsafe { contact_jacobian_0_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
+    }
+    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[allow(unused_variables, clippy::all)]
+    fn contact_jacobian_0_0<S: runtime::scalar::Scalar>(
+        t: f64,
+        q: &[S; 10],
+        qd: &[S; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[S; 134],
+        out: &mut [S; 36],
+    ) {
+        let (v29, v2): (S, S) = aux[70].sin_cos();
+        let v8 = q[0] * 0.5f64;
+        let (v11, v9): (S, S) = v8.sin_cos();
+        let v13 = v11 * p[172];
+        let v14 = v9.mul_add(S::c(p[171]), -v13);
+        let [v16, v44]: [S; 2] = v8.sinc_orders::<2>();
+        let v17 = v16 * p[7];
+        let v18 = v14.mul_add(v17, S::c(p[3]));
+        let v19 = v18 + p[173];
+        let v23 = v9 * p[172];
+        let v24 = v11.mul_add(S::c(p[171]), v23);
+        let v25 = v24.mul_add(v17, S::c(p[4]));
+        let v26 = v25 + p[174];
+        let v27 = v26 * p[77];
+        let v28 = S::c(p[78]).mul_add(v19, v27);
+        let v30 = v19 * p[77];
+        let v31 = S::c(p[78]).mul_add(v26, -v30);
+        let v32 = v2.mul_add(v28, aux[0]);
+        let v33 = (-v29).mul_add(v31, v32);
+        let v35 = v29.mul_add(v28, aux[1]);
+        let v36 = v2.mul_add(v31, v35);
+        let v40 = v11 * (-0.5f64);
+        let v41 = v9 * 0.5f64;
+        let v42 = v41 * p[172];
+        let v43 = S::c(p[171]).mul_add(v40, -v42);
+        let v45 = v44 * 0.5f64;
+        let v46 = v45 * p[7];
+        let v47 = v14 * v46;
+        let v48 = v17.mul_add(v43, v47);
+        let v49 = v40 * p[172];
+        let v50 = S::c(p[171]).mul_add(v41, v49);
+        let v51 = v24 * v46;
+        let v52 = v17.mul_add(v50, v51);
+        let v53 = v52 * p[77];
+        let v54 = S::c(p[78]).mul_add(v48, v53);
+        let v55 = v48 * p[77];
+        let v56 = S::c(p[78]).mul_add(v52, -v55);
+        let v57 = v29 * v56;
+        let v58 = v2.mul_add(v54, -v57);
+        let v59 = qd[0] * v58;
+        let v60 = v2 * v56;
+        let v61 = v29.mul_add(v54, v60);
+        let v62 = qd[0] * v61;
+        out[0] = v33;
+        out[1] = v36;
+        out[2] = aux[2];
+        out[3] = v59;
+        out[4] = v62;
+        out[5] = S::c(0f64);
+        out[6] = v58;
+        out[7] = S::c(0f64);
+        out[8] = S::c(0f64);
+        out[9] = S::c(0f64);
+        out[10] = S::c(0f64);
+        out[11] = S::c(0f64);
+        out[12] = S::c(0f64);
+        out[13] = S::c(0f64);
+        out[14] = S::c(0f64);
+        out[15] = S::c(0f64);
+        out[16] = v61;
+        out[17] = S::c(0f64);
+        out[18] = S::c(0f64);
+        out[19] = S::c(0f64);
+        out[20] = S::c(0f64);
+        out[21] = S::c(0f64);
+        out[22] = S::c(0f64);
+        out[23] = S::c(0f64);
+        out[24] = S::c(0f64);
+        out[25] = S::c(0f64);
+        out[26] = S::c(0f64);
+        out[27] = S::c(0f64);
+        out[28] = S::c(0f64);
+        out[29] = S::c(0f64);
+        out[30] = S::c(0f64);
+        out[31] = S::c(0f64);
+        out[32] = S::c(0f64);
+        out[33] = S::c(0f64);
+        out[34] = S::c(0f64);
+        out[35] = S::c(0f64);
+    }
+    /// Kernel `contact_jacobian_1`: 74 operations, over f64 or dual numbers.
+    pub fn contact_jacobian_1(
+        t: f64,
+        q: &[f64; 10],
+        qd: &[f64; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[f64; 134],
+        out: &mut [f64; 36],
+    ) {
+        runtime::cpu::require_fma();
+        unsafe { contact_jacobian_1_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
+    }
+    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[allow(unused_variables, clippy::all)]
+    fn contact_jacobian_1_0<S: runtime::scalar::Scalar>(
+        t: f64,
+        q: &[S; 10],
+        qd: &[S; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[S; 134],
+        out: &mut [S; 36],
+    ) {
+        let (v29, v2): (S, S) = aux[71].sin_cos();
+        let v9 = q[1] * 0.5f64;
+        let [v10, v42]: [S; 2] = v9.sinc_orders::<2>();
+        let v11 = v10 * p[13];
+        let (v15, v13): (S, S) = v9.sin_cos();
+        let v16 = v15 * p[172];
+        let v17 = S::c(p[171]).mul_add(v13, -v16);
+        let v18 = v11.mul_add(v17, S::c(p[176]));
+        let v19 = v18 + p[175];
+        let v23 = v13 * p[172];
+        let v24 = S::c(p[171]).mul_add(v15, v23);
+        let v25 = v11.mul_add(v24, S::c(p[178]));
+        let v26 = v25 + p[177];
+        let v27 = v26 * p[77];
+        let v28 = S::c(p[78]).mul_add(v19, v27);
+        let v30 = v19 * p[77];
+        let v31 = S::c(p[78]).mul_add(v26, -v30);
+        let v32 = v2.mul_add(v28, aux[7]);
+        let v33 = (-v29).mul_add(v31, v32);
+        let v35 = v29.mul_add(v28, aux[8]);
+        let v36 = v2.mul_add(v31, v35);
+        let v40 = qd[0] * v36;
+        let v43 = v42 * 0.5f64;
+        let v44 = v43 * p[13];
+        let v46 = v15 * (-0.5f64);
+        let v47 = v13 * 0.5f64;
+        let v48 = v47 * p[172];
+        let v49 = S::c(p[171]).mul_add(v46, -v48);
+        let v50 = v11 * v49;
+        let v51 = v44.mul_add(v17, v50);
+        let v52 = v46 * p[172];
+        let v53 = S::c(p[171]).mul_add(v47, v52);
+        let v54 = v11 * v53;
+        let v55 = v44.mul_add(v24, v54);
+        let v56 = v55 * p[77];
+        let v57 = S::c(p[78]).mul_add(v51, v56);
+        let v58 = v51 * p[77];
+        let v59 = S::c(p[78]).mul_add(v55, -v58);
+        let v60 = v29 * v59;
+        let v61 = v2.mul_add(v57, -v60);
+        let v62 = qd[0].mul_add(aux[80], -v40);
+        let v63 = qd[1].mul_add(v61, v62);
+        let v65 = qd[0] * v33;
+        let v66 = v2 * v59;
+        let v67 = v29.mul_add(v57, v66);
+        let v68 = qd[0].mul_add(aux[81], v65);
+        let v69 = qd[1].mul_add(v67, v68);
+        let v71 = aux[80] - v36;
+        let v72 = aux[81] + v33;
+        out[0] = v33;
+        out[1] = v36;
+        out[2] = aux[9];
+        out[3] = v63;
+        out[4] = v69;
+        out[5] = S::c(0f64);
+        out[6] = v71;
+        out[7] = v61;
+        out[8] = S::c(0f64);
+        out[9] = S::c(0f64);
+        out[10] = S::c(0f64);
+        out[11] = S::c(0f64);
+        out[12] = S::c(0f64);
+        out[13] = S::c(0f64);
+        out[14] = S::c(0f64);
+        out[15] = S::c(0f64);
+        out[16] = v72;
+        out[17] = v67;
+        out[18] = S::c(0f64);
+        out[19] = S::c(0f64);
+        out[20] = S::c(0f64);
+        out[21] = S::c(0f64);
+        out[22] = S::c(0f64);
+        out[23] = S::c(0f64);
+        out[24] = S::c(0f64);
+        out[25] = S::c(0f64);
+        out[26] = S::c(0f64);
+        out[27] = S::c(0f64);
+        out[28] = S::c(0f64);
+        out[29] = S::c(0f64);
+        out[30] = S::c(0f64);
+        out[31] = S::c(0f64);
+        out[32] = S::c(0f64);
+        out[33] = S::c(0f64);
+        out[34] = S::c(0f64);
+        out[35] = S::c(0f64);
+    }
+    /// Kernel `contact_jacobian_2`: 81 operations, over f64 or dual numbers.
+    pub fn contact_jacobian_2(
+        t: f64,
+        q: &[f64; 10],
+        qd: &[f64; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[f64; 134],
+        out: &mut [f64; 36],
+    ) {
+        runtime::cpu::require_fma();
+        unsafe { contact_jacobian_2_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
+    }
+    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[allow(unused_variables, clippy::all)]
+    fn contact_jacobian_2_0<S: runtime::scalar::Scalar>(
+        t: f64,
+        q: &[S; 10],
+        qd: &[S; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[S; 134],
+        out: &mut [S; 36],
+    ) {
+        let (v29, v2): (S, S) = aux[72].sin_cos();
+        let v9 = q[2] * 0.5f64;
+        let [v10, v46]: [S; 2] = v9.sinc_orders::<2>();
+        let v11 = v10 * p[19];
+        let (v15, v13): (S, S) = v9.sin_cos();
+        let v16 = v15 * p[172];
+        let v17 = S::c(p[171]).mul_add(v13, -v16);
+        let v18 = v11.mul_add(v17, S::c(p[180]));
+        let v19 = v18 + p[179];
+        let v23 = v13 * p[172];
+        let v24 = S::c(p[171]).mul_add(v15, v23);
+        let v25 = v11.mul_add(v24, S::c(p[182]));
+        let v26 = v25 + p[181];
+        let v27 = v26 * p[77];
+        let v28 = S::c(p[78]).mul_add(v19, v27);
+        let v30 = v19 * p[77];
+        let v31 = S::c(p[78]).mul_add(v26, -v30);
+        let v32 = v2.mul_add(v28, aux[14]);
+        let v33 = (-v29).mul_add(v31, v32);
+        let v35 = v29.mul_add(v28, aux[15]);
+        let v36 = v2.mul_add(v31, v35);
+        let v42 = qd[1] * aux[86];
+        let v43 = qd[0].mul_add(aux[80], v42);
+        let v44 = qd[0] + qd[1];
+        let v47 = v46 * 0.5f64;
+        let v48 = v47 * p[19];
+        let v50 = v15 * (-0.5f64);
+        let v51 = v13 * 0.5f64;
+        let v52 = v51 * p[172];
+        let v53 = S::c(p[171]).mul_add(v50, -v52);
+        let v54 = v11 * v53;
+        let v55 = v48.mul_add(v17, v54);
+        let v56 = v50 * p[172];
+        let v57 = S::c(p[171]).mul_add(v51, v56);
+        let v58 = v11 * v57;
+        let v59 = v48.mul_add(v24, v58);
+        let v60 = v59 * p[77];
+        let v61 = S::c(p[78]).mul_add(v55, v60);
+        let v62 = v55 * p[77];
+        let v63 = S::c(p[78]).mul_add(v59, -v62);
+        let v64 = v29 * v63;
+        let v65 = v2.mul_add(v61, -v64);
+        let v66 = (-v44).mul_add(v36, v43);
+        let v67 = qd[2].mul_add(v65, v66);
+        let v70 = qd[1] * aux[87];
+        let v71 = qd[0].mul_add(aux[81], v70);
+        let v72 = v2 * v63;
+        let v73 = v29.mul_add(v61, v72);
+        let v74 = v44.mul_add(v33, v71);
+        let v75 = qd[2].mul_add(v73, v74);
+        let v77 = aux[80] - v36;
+        let v78 = aux[86] - v36;
+        let v79 = aux[81] + v33;
+        let v80 = aux[87] + v33;
+        out[0] = v33;
+        out[1] = v36;
+        out[2] = aux[16];
+        out[3] = v67;
+        out[4] = v75;
+        out[5] = S::c(0f64);
+        out[6] = v77;
+        out[7] = v78;
+        out[8] = v65;
+        out[9] = S::c(0f64);
+        out[10] = S::c(0f64);
+        out[11] = S::c(0f64);
+        out[12] = S::c(0f64);
+        out[13] = S::c(0f64);
+        out[14] = S::c(0f64);
+        out[15] = S::c(0f64);
+        out[16] = v79;
+        out[17] = v80;
+        out[18] = v73;
+        out[19] = S::c(0f64);
+        out[20] = S::c(0f64);
+        out[21] = S::c(0f64);
+        out[22] = S::c(0f64);
+        out[23] = S::c(0f64);
+        out[24] = S::c(0f64);
+        out[25] = S::c(0f64);
+        out[26] = S::c(0f64);
+        out[27] = S::c(0f64);
+        out[28] = S::c(0f64);
+        out[29] = S::c(0f64);
+        out[30] = S::c(0f64);
+        out[31] = S::c(0f64);
+        out[32] = S::c(0f64);
+        out[33] = S::c(0f64);
+        out[34] = S::c(0f64);
+        out[35] = S::c(0f64);
+    }
+    /// Kernel `contact_jacobian_3`: 88 operations, over f64 or dual numbers.
+    pub fn contact_jacobian_3(
+        t: f64,
+        q: &[f64; 10],
+        qd: &[f64; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[f64; 134],
+        out: &mut [f64; 36],
+    ) {
+        runtime::cpu::require_fma();
+        unsafe { contact_jacobian_3_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
+    }
+    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[allow(unused_variables, clippy::all)]
+    fn contact_jacobian_3_0<S: runtime::scalar::Scalar>(
+        t: f64,
+        q: &[S; 10],
+        qd: &[S; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[S; 134],
+        out: &mut [S; 36],
+    ) {
+        let (v29, v2): (S, S) = aux[73].sin_cos();
+        let v9 = q[3] * 0.5f64;
+        let [v10, v50]: [S; 2] = v9.sinc_orders::<2>();
+        let v11 = v10 * p[25];
+        let (v15, v13): (S, S) = v9.sin_cos();
+        let v16 = v15 * p[172];
+        let v17 = S::c(p[171]).mul_add(v13, -v16);
+        let v18 = v11.mul_add(v17, S::c(p[184]));
+        let v19 = v18 + p[183];
+        let v23 = v13 * p[172];
+        let v24 = S::c(p[171]).mul_add(v15, v23);
+        let v25 = v11.mul_add(v24, S::c(p[186]));
+        let v26 = v25 + p[185];
+        let v27 = v26 * p[77];
+        let v28 = S::c(p[78]).mul_add(v19, v27);
+        let v30 = v19 * p[77];
+        let v31 = S::c(p[78]).mul_add(v26, -v30);
+        let v32 = v2.mul_add(v28, aux[21]);
+        let v33 = (-v29).mul_add(v31, v32);
+        let v35 = v29.mul_add(v28, aux[22]);
+        let v36 = v2.mul_add(v31, v35);
+        let v42 = qd[1] * aux[86];
+        let v45 = qd[0].mul_add(aux[80], v42);
+        let v46 = qd[2].mul_add(aux[92], v45);
+        let v47 = qd[0] + qd[1];
+        let v48 = v47 + qd[2];
+        let v51 = v50 * 0.5f64;
+        let v52 = v51 * p[25];
+        let v54 = v15 * (-0.5f64);
+        let v55 = v13 * 0.5f64;
+        let v56 = v55 * p[172];
+        let v57 = S::c(p[171]).mul_add(v54, -v56);
+        let v58 = v11 * v57;
+        let v59 = v52.mul_add(v17, v58);
+        let v60 = v54 * p[172];
+        let v61 = S::c(p[171]).mul_add(v55, v60);
+        let v62 = v11 * v61;
+        let v63 = v52.mul_add(v24, v62);
+        let v64 = v63 * p[77];
+        let v65 = S::c(p[78]).mul_add(v59, v64);
+        let v66 = v59 * p[77];
+        let v67 = S::c(p[78]).mul_add(v63, -v66);
+        let v68 = v29 * v67;
+        let v69 = v2.mul_add(v65, -v68);
+        let v70 = (-v48).mul_add(v36, v46);
+        let v71 = qd[3].mul_add(v69, v70);
+        let v74 = qd[1] * aux[87];
+        let v76 = qd[0].mul_add(aux[81], v74);
+        let v77 = qd[2].mul_add(aux[93], v76);
+        let v78 = v2 * v67;
+        let v79 = v29.mul_add(v65, v78);
+        let v80 = v48.mul_add(v33, v77);
+        let v81 = qd[3].mul_add(v79, v80);
+        let v83 = aux[80] - v36;
+        let v84 = aux[86] - v36;
+        let v85 = aux[92] - v36;
+        let v86 = aux[81] + v33;
+        let v87 = aux[87] + v33;
+        let v88 = aux[93] + v33;
+        out[0] = v33;
+        out[1] = v36;
+        out[2] = aux[23];
+        out[3] = v71;
+        out[4] = v81;
+        out[5] = S::c(0f64);
+        out[6] = v83;
+        out[7] = v84;
+        out[8] = v85;
+        out[9] = v69;
+        out[10] = S::c(0f64);
+        out[11] = S::c(0f64);
+        out[12] = S::c(0f64);
+        out[13] = S::c(0f64);
+        out[14] = S::c(0f64);
+        out[15] = S::c(0f64);
+        out[16] = v86;
+        out[17] = v87;
+        out[18] = v88;
+        out[19] = v79;
+        out[20] = S::c(0f64);
+        out[21] = S::c(0f64);
+        out[22] = S::c(0f64);
+        out[23] = S::c(0f64);
+        out[24] = S::c(0f64);
+        out[25] = S::c(0f64);
+        out[26] = S::c(0f64);
+        out[27] = S::c(0f64);
+        out[28] = S::c(0f64);
+        out[29] = S::c(0f64);
+        out[30] = S::c(0f64);
+        out[31] = S::c(0f64);
+        out[32] = S::c(0f64);
+        out[33] = S::c(0f64);
+        out[34] = S::c(0f64);
+        out[35] = S::c(0f64);
+    }
+    /// Kernel `contact_jacobian_4`: 95 operations, over f64 or dual numbers.
+    pub fn contact_jacobian_4(
+        t: f64,
+        q: &[f64; 10],
+        qd: &[f64; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[f64; 134],
+        out: &mut [f64; 36],
+    ) {
+        runtime::cpu::require_fma();
+        unsafe { contact_jacobian_4_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
+    }
+    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[allow(unused_variables, clippy::all)]
+    fn contact_jacobian_4_0<S: runtime::scalar::Scalar>(
+        t: f64,
+        q: &[S; 10],
+        qd: &[S; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[S; 134],
+        out: &mut [S; 36],
+    ) {
+        let (v29, v2): (S, S) = aux[74].sin_cos();
+        let v9 = q[4] * 0.5f64;
+        let [v10, v54]: [S; 2] = v9.sinc_orders::<2>();
+        let v11 = v10 * p[31];
+        let (v15, v13): (S, S) = v9.sin_cos();
+        let v16 = v15 * p[172];
+        let v17 = S::c(p[171]).mul_add(v13, -v16);
+        let v18 = v11.mul_add(v17, S::c(p[188]));
+        let v19 = v18 + p[187];
+        let v23 = v13 * p[172];
+        let v24 = S::c(p[171]).mul_add(v15, v23);
+        let v25 = v11.mul_add(v24, S::c(p[190]));
+        let v26 = v25 + p[189];
+        let v27 = v26 * p[77];
+        let v28 = S::c(p[78]).mul_add(v19, v27);
+        let v30 = v19 * p[77];
+        let v31 = S::c(p[78]).mul_add(v26, -v30);
+        let v32 = v2.mul_add(v28, aux[28]);
+        let v33 = (-v29).mul_add(v31, v32);
+        let v35 = v29.mul_add(v28, aux[29]);
+        let v36 = v2.mul_add(v31, v35);
+        let v42 = qd[1] * aux[86];
+        let v47 = qd[0].mul_add(aux[80], v42);
+        let v48 = qd[2].mul_add(aux[92], v47);
+        let v49 = qd[3].mul_add(aux[98], v48);
+        let v50 = qd[0] + qd[1];
+        let v51 = v50 + qd[2];
+        let v52 = v51 + qd[3];
+        let v55 = v54 * 0.5f64;
+        let v56 = v55 * p[31];
+        let v58 = v15 * (-0.5f64);
+        let v59 = v13 * 0.5f64;
+        let v60 = v59 * p[172];
+        let v61 = S::c(p[171]).mul_add(v58, -v60);
+        let v62 = v11 * v61;
+        let v63 = v56.mul_add(v17, v62);
+        let v64 = v58 * p[172];
+        let v65 = S::c(p[171]).mul_add(v59, v64);
+        let v66 = v11 * v65;
+        let v67 = v56.mul_add(v24, v66);
+        let v68 = v67 * p[77];
+        let v69 = S::c(p[78]).mul_add(v63, v68);
+        let v70 = v63 * p[77];
+        let v71 = S::c(p[78]).mul_add(v67, -v70);
+        let v72 = v29 * v71;
+        let v73 = v2.mul_add(v69, -v72);
+        let v74 = (-v52).mul_add(v36, v49);
+        let v75 = qd[4].mul_add(v73, v74);
+        let v78 = qd[1] * aux[87];
+        let v81 = qd[0].mul_add(aux[81], v78);
+        let v82 = qd[2].mul_add(aux[93], v81);
+        let v83 = qd[3].mul_add(aux[99], v82);
+        let v84 = v2 * v71;
+        let v85 = v29.mul_add(v69, v84);
+        let v86 = v52.mul_add(v33, v83);
+        let v87 = qd[4].mul_add(v85, v86);
+        let v89 = aux[80] - v36;
+        let v90 = aux[86] - v36;
+        let v91 = aux[92] - v36;
+        let v92 = aux[98] - v36;
+        let v93 = aux[81] + v33;
+        let v94 = aux[87] + v33;
+        let v95 = aux[93] + v33;
+        let v96 = aux[99] + v33;
+        out[0] = v33;
+        out[1] = v36;
+        out[2] = aux[30];
+        out[3] = v75;
+        out[4] = v87;
+        out[5] = S::c(0f64);
+        out[6] = v89;
+        out[7] = v90;
+        out[8] = v91;
+        out[9] = v92;
+        out[10] = v73;
+        out[11] = S::c(0f64);
+        out[12] = S::c(0f64);
+        out[13] = S::c(0f64);
+        out[14] = S::c(0f64);
+        out[15] = S::c(0f64);
+        out[16] = v93;
+        out[17] = v94;
+        out[18] = v95;
+        out[19] = v96;
+        out[20] = v85;
+        out[21] = S::c(0f64);
+        out[22] = S::c(0f64);
+        out[23] = S::c(0f64);
+        out[24] = S::c(0f64);
+        out[25] = S::c(0f64);
+        out[26] = S::c(0f64);
+        out[27] = S::c(0f64);
+        out[28] = S::c(0f64);
+        out[29] = S::c(0f64);
+        out[30] = S::c(0f64);
+        out[31] = S::c(0f64);
+        out[32] = S::c(0f64);
+        out[33] = S::c(0f64);
+        out[34] = S::c(0f64);
+        out[35] = S::c(0f64);
+    }
+    /// Kernel `contact_jacobian_5`: 102 operations, over f64 or dual numbers.
+    pub fn contact_jacobian_5(
+        t: f64,
+        q: &[f64; 10],
+        qd: &[f64; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[f64; 134],
+        out: &mut [f64; 36],
+    ) {
+        runtime::cpu::require_fma();
+        unsafe { contact_jacobian_5_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
+    }
+    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[allow(unused_variables, clippy::all)]
+    fn contact_jacobian_5_0<S: runtime::scalar::Scalar>(
+        t: f64,
+        q: &[S; 10],
+        qd: &[S; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[S; 134],
+        out: &mut [S; 36],
+    ) {
+        let (v29, v2): (S, S) = aux[75].sin_cos();
+        let v9 = q[5] * 0.5f64;
+        let [v10, v58]: [S; 2] = v9.sinc_orders::<2>();
+        let v11 = v10 * p[37];
+        let (v15, v13): (S, S) = v9.sin_cos();
+        let v16 = v15 * p[172];
+        let v17 = S::c(p[171]).mul_add(v13, -v16);
+        let v18 = v11.mul_add(v17, S::c(p[192]));
+        let v19 = v18 + p[191];
+        let v23 = v13 * p[172];
+        let v24 = S::c(p[171]).mul_add(v15, v23);
+        let v25 = v11.mul_add(v24, S::c(p[194]));
+        let v26 = v25 + p[193];
+        let v27 = v26 * p[77];
+        let v28 = S::c(p[78]).mul_add(v19, v27);
+        let v30 = v19 * p[77];
+        let v31 = S::c(p[78]).mul_add(v26, -v30);
+        let v32 = v2.mul_add(v28, aux[35]);
+        let v33 = (-v29).mul_add(v31, v32);
+        let v35 = v29.mul_add(v28, aux[36]);
+        let v36 = v2.mul_add(v31, v35);
+        let v42 = qd[1] * aux[86];
+        let v49 = qd[0].mul_add(aux[80], v42);
+        let v50 = qd[2].mul_add(aux[92], v49);
+        let v51 = qd[3].mul_add(aux[98], v50);
+        let v52 = qd[4].mul_add(aux[104], v51);
+        let v53 = qd[0] + qd[1];
+        let v54 = v53 + qd[2];
+        let v55 = v54 + qd[3];
+        let v56 = v55 + qd[4];
+        let v59 = v58 * 0.5f64;
+        let v60 = v59 * p[37];
+        let v62 = v15 * (-0.5f64);
+        let v63 = v13 * 0.5f64;
+        let v64 = v63 * p[172];
+        let v65 = S::c(p[171]).mul_add(v62, -v64);
+        let v66 = v11 * v65;
+        let v67 = v60.mul_add(v17, v66);
+        let v68 = v62 * p[172];
+        let v69 = S::c(p[171]).mul_add(v63, v68);
+        let v70 = v11 * v69;
+        let v71 = v60.mul_add(v24, v70);
+        let v72 = v71 * p[77];
+        let v73 = S::c(p[78]).mul_add(v67, v72);
+        let v74 = v67 * p[77];
+        let v75 = S::c(p[78]).mul_add(v71, -v74);
+        let v76 = v29 * v75;
+        let v77 = v2.mul_add(v73, -v76);
+        let v78 = (-v56).mul_add(v36, v52);
+        let v79 = qd[5].mul_add(v77, v78);
+        let v82 = qd[1] * aux[87];
+        let v86 = qd[0].mul_add(aux[81], v82);
+        let v87 = qd[2].mul_add(aux[93], v86);
+        let v88 = qd[3].mul_add(aux[99], v87);
+        let v89 = qd[4].mul_add(aux[105], v88);
+        let v90 = v2 * v75;
+        let v91 = v29.mul_add(v73, v90);
+        let v92 = v56.mul_add(v33, v89);
+        let v93 = qd[5].mul_add(v91, v92);
+        let v95 = aux[80] - v36;
+        let v96 = aux[86] - v36;
+        let v97 = aux[92] - v36;
+        let v98 = aux[98] - v36;
+        let v99 = aux[104] - v36;
+        let v100 = aux[81] + v33;
+        let v101 = aux[87] + v33;
+        let v102 = aux[93] + v33;
+        let v103 = aux[99] + v33;
+        let v104 = aux[105] + v33;
+        out[0] = v33;
+        out[1] = v36;
+        out[2] = aux[37];
+        out[3] = v79;
+        out[4] = v93;
+        out[5] = S::c(0f64);
+        out[6] = v95;
+        out[7] = v96;
+        out[8] = v97;
+        out[9] = v98;
+        out[10] = v99;
+        out[11] = v77;
+        out[12] = S::c(0f64);
+        out[13] = S::c(0f64);
+        out[14] = S::c(0f64);
+        out[15] = S::c(0f64);
+        out[16] = v100;
+        out[17] = v101;
+        out[18] = v102;
+        out[19] = v103;
+        out[20] = v104;
+        out[21] = v91;
+        out[22] = S::c(0f64);
+        out[23] = S::c(0f64);
+        out[24] = S::c(0f64);
+        out[25] = S::c(0f64);
+        out[26] = S::c(0f64);
+        out[27] = S::c(0f64);
+        out[28] = S::c(0f64);
+        out[29] = S::c(0f64);
+        out[30] = S::c(0f64);
+        out[31] = S::c(0f64);
+        out[32] = S::c(0f64);
+        out[33] = S::c(0f64);
+        out[34] = S::c(0f64);
+        out[35] = S::c(0f64);
+    }
+    /// Kernel `contact_jacobian_6`: 109 operations, over f64 or dual numbers.
+    pub fn contact_jacobian_6(
+        t: f64,
+        q: &[f64; 10],
+        qd: &[f64; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[f64; 134],
+        out: &mut [f64; 36],
+    ) {
+        runtime::cpu::require_fma();
+        unsafe { contact_jacobian_6_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
+    }
+    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[allow(unused_variables, clippy::all)]
+    fn contact_jacobian_6_0<S: runtime::scalar::Scalar>(
+        t: f64,
+        q: &[S; 10],
+        qd: &[S; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[S; 134],
+        out: &mut [S; 36],
+    ) {
+        let (v29, v2): (S, S) = aux[76].sin_cos();
+        let v9 = q[6] * 0.5f64;
+        let [v10, v62]: [S; 2] = v9.sinc_orders::<2>();
+        let v11 = v10 * p[43];
+        let (v15, v13): (S, S) = v9.sin_cos();
+        let v16 = v15 * p[172];
+        let v17 = S::c(p[171]).mul_add(v13, -v16);
+        let v18 = v11.mul_add(v17, S::c(p[196]));
+        let v19 = v18 + p[195];
+        let v23 = v13 * p[172];
+        let v24 = S::c(p[171]).mul_add(v15, v23);
+        let v25 = v11.mul_add(v24, S::c(p[198]));
+        let v26 = v25 + p[197];
+        let v27 = v26 * p[77];
+        let v28 = S::c(p[78]).mul_add(v19, v27);
+        let v30 = v19 * p[77];
+        let v31 = S::c(p[78]).mul_add(v26, -v30);
+        let v32 = v2.mul_add(v28, aux[42]);
+        let v33 = (-v29).mul_add(v31, v32);
+        let v35 = v29.mul_add(v28, aux[43]);
+        let v36 = v2.mul_add(v31, v35);
+        let v42 = qd[1] * aux[86];
+        let v51 = qd[0].mul_add(aux[80], v42);
+        let v52 = qd[2].mul_add(aux[92], v51);
+        let v53 = qd[3].mul_add(aux[98], v52);
+        let v54 = qd[4].mul_add(aux[104], v53);
+        let v55 = qd[5].mul_add(aux[110], v54);
+        let v56 = qd[0] + qd[1];
+        let v57 = v56 + qd[2];
+        let v58 = v57 + qd[3];
+        let v59 = v58 + qd[4];
+        let v60 = v59 + qd[5];
+        let v63 = v62 * 0.5f64;
+        let v64 = v63 * p[43];
+        let v66 = v15 * (-0.5f64);
+        let v67 = v13 * 0.5f64;
+        let v68 = v67 * p[172];
+        let v69 = S::c(p[171]).mul_add(v66, -v68);
+        let v70 = v11 * v69;
+        let v71 = v64.mul_add(v17, v70);
+        let v72 = v66 * p[172];
+        let v73 = S::c(p[171]).mul_add(v67, v72);
+        let v74 = v11 * v73;
+        let v75 = v64.mul_add(v24, v74);
+        let v76 = v75 * p[77];
+        let v77 = S::c(p[78]).mul_add(v71, v76);
+        let v78 = v71 * p[77];
+        let v79 = S::c(p[78]).mul_add(v75, -v78);
+        let v80 = v29 * v79;
+        let v81 = v2.mul_add(v77, -v80);
+        let v82 = (-v60).mul_add(v36, v55);
+        let v83 = qd[6].mul_add(v81, v82);
+        let v86 = qd[1] * aux[87];
+        let v91 = qd[0].mul_add(aux[81], v86);
+        let v92 = qd[2].mul_add(aux[93], v91);
+        let v93 = qd[3].mul_add(aux[99], v92);
+        let v94 = qd[4].mul_add(aux[105], v93);
+        let v95 = qd[5].mul_add(aux[111], v94);
+        let v96 = v2 * v79;
+        let v97 = v29.mul_add(v77, v96);
+        let v98 = v60.mul_add(v33, v95);
+        let v99 = qd[6].mul_add(v97, v98);
+        let v101 = aux[80] - v36;
+        let v102 = aux[86] - v36;
+        let v103 = aux[92] - v36;
+        let v104 = aux[98] - v36;
+        let v105 = aux[104] - v36;
+        let v106 = aux[110] - v36;
+        let v107 = aux[81] + v33;
+        let v108 = aux[87] + v33;
+        let v109 = aux[93] + v33;
+        let v110 = aux[99] + v33;
+        let v111 = aux[105] + v33;
+        let v112 = aux[111] + v33;
+        out[0] = v33;
+        out[1] = v36;
+        out[2] = aux[44];
+        out[3] = v83;
+        out[4] = v99;
+        out[5] = S::c(0f64);
+        out[6] = v101;
+        out[7] = v102;
+        out[8] = v103;
+        out[9] = v104;
+        out[10] = v105;
+        out[11] = v106;
+        out[12] = v81;
+        out[13] = S::c(0f64);
+        out[14] = S::c(0f64);
+        out[15] = S::c(0f64);
+        out[16] = v107;
+        out[17] = v108;
+        out[18] = v109;
+        out[19] = v110;
+        out[20] = v111;
+        out[21] = v112;
+        out[22] = v97;
+        out[23] = S::c(0f64);
+        out[24] = S::c(0f64);
+        out[25] = S::c(0f64);
+        out[26] = S::c(0f64);
+        out[27] = S::c(0f64);
+        out[28] = S::c(0f64);
+        out[29] = S::c(0f64);
+        out[30] = S::c(0f64);
+        out[31] = S::c(0f64);
+        out[32] = S::c(0f64);
+        out[33] = S::c(0f64);
+        out[34] = S::c(0f64);
+        out[35] = S::c(0f64);
+    }
+    /// Kernel `contact_jacobian_7`: 116 operations, over f64 or dual numbers.
+    pub fn contact_jacobian_7(
+        t: f64,
+        q: &[f64; 10],
+        qd: &[f64; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[f64; 134],
+        out: &mut [f64; 36],
+    ) {
+        runtime::cpu::require_fma();
+        unsafe { contact_jacobian_7_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
+    }
+    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[allow(unused_variables, clippy::all)]
+    fn contact_jacobian_7_0<S: runtime::scalar::Scalar>(
+        t: f64,
+        q: &[S; 10],
+        qd: &[S; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[S; 134],
+        out: &mut [S; 36],
+    ) {
+        let (v29, v2): (S, S) = aux[77].sin_cos();
+        let v9 = q[7] * 0.5f64;
+        let [v10, v66]: [S; 2] = v9.sinc_orders::<2>();
+        let v11 = v10 * p[49];
+        let (v15, v13): (S, S) = v9.sin_cos();
+        let v16 = v15 * p[172];
+        let v17 = S::c(p[171]).mul_add(v13, -v16);
+        let v18 = v11.mul_add(v17, S::c(p[200]));
+        let v19 = v18 + p[199];
+        let v23 = v13 * p[172];
+        let v24 = S::c(p[171]).mul_add(v15, v23);
+        let v25 = v11.mul_add(v24, S::c(p[202]));
+        let v26 = v25 + p[201];
+        let v27 = v26 * p[77];
+        let v28 = S::c(p[78]).mul_add(v19, v27);
+        let v30 = v19 * p[77];
+        let v31 = S::c(p[78]).mul_add(v26, -v30);
+        let v32 = v2.mul_add(v28, aux[49]);
+        let v33 = (-v29).mul_add(v31, v32);
+        let v35 = v29.mul_add(v28, aux[50]);
+        let v36 = v2.mul_add(v31, v35);
+        let v42 = qd[1] * aux[86];
+        let v53 = qd[0].mul_add(aux[80], v42);
+        let v54 = qd[2].mul_add(aux[92], v53);
+        let v55 = qd[3].mul_add(aux[98], v54);
+        let v56 = qd[4].mul_add(aux[104], v55);
+        let v57 = qd[5].mul_add(aux[110], v56);
+        let v58 = qd[6].mul_add(aux[116], v57);
+        let v59 = qd[0] + qd[1];
+        let v60 = v59 + qd[2];
+        let v61 = v60 + qd[3];
+        let v62 = v61 + qd[4];
+        let v63 = v62 + qd[5];
+        let v64 = v63 + qd[6];
+        let v67 = v66 * 0.5f64;
+        let v68 = v67 * p[49];
+        let v70 = v15 * (-0.5f64);
+        let v71 = v13 * 0.5f64;
+        let v72 = v71 * p[172];
+        let v73 = S::c(p[171]).mul_add(v70, -v72);
+        let v74 = v11 * v73;
+        let v75 = v68.mul_add(v17, v74);
+        let v76 = v70 * p[172];
+        let v77 = S::c(p[171]).mul_add(v71, v76);
+        let v78 = v11 * v77;
+        let v79 = v68.mul_add(v24, v78);
+        let v80 = v79 * p[77];
+        let v81 = S::c(p[78]).mul_add(v75, v80);
+        let v82 = v75 * p[77];
+        let v83 = S::c(p[78]).mul_add(v79, -v82);
+        let v84 = v29 * v83;
+        let v85 = v2.mul_add(v81, -v84);
+        let v86 = (-v64).mul_add(v36, v58);
+        let v87 = qd[7].mul_add(v85, v86);
+        let v90 = qd[1] * aux[87];
+        let v96 = qd[0].mul_add(aux[81], v90);
+        let v97 = qd[2].mul_add(aux[93], v96);
+        let v98 = qd[3].mul_add(aux[99], v97);
+        let v99 = qd[4].mul_add(aux[105], v98);
+        let v100 = qd[5].mul_add(aux[111], v99);
+        let v101 = qd[6].mul_add(aux[117], v100);
+        let v102 = v2 * v83;
+        let v103 = v29.mul_add(v81, v102);
+        let v104 = v64.mul_add(v33, v101);
+        let v105 = qd[7].mul_add(v103, v104);
+        let v107 = aux[80] - v36;
+        let v108 = aux[86] - v36;
+        let v109 = aux[92] - v36;
+        let v110 = aux[98] - v36;
+        let v111 = aux[104] - v36;
+        let v112 = aux[110] - v36;
+        let v113 = aux[116] - v36;
+        let v114 = aux[81] + v33;
+        let v115 = aux[87] + v33;
+        let v116 = aux[93] + v33;
+        let v117 = aux[99] + v33;
+        let v118 = aux[105] + v33;
+        let v119 = aux[111] + v33;
+        let v120 = aux[117] + v33;
+        out[0] = v33;
+        out[1] = v36;
+        out[2] = aux[51];
+        out[3] = v87;
+        out[4] = v105;
+        out[5] = S::c(0f64);
+        out[6] = v107;
+        out[7] = v108;
+        out[8] = v109;
+        out[9] = v110;
+        out[10] = v111;
+        out[11] = v112;
+        out[12] = v113;
+        out[13] = v85;
+        out[14] = S::c(0f64);
+        out[15] = S::c(0f64);
+        out[16] = v114;
+        out[17] = v115;
+        out[18] = v116;
+        out[19] = v117;
+        out[20] = v118;
+        out[21] = v119;
+        out[22] = v120;
+        out[23] = v103;
+        out[24] = S::c(0f64);
+        out[25] = S::c(0f64);
+        out[26] = S::c(0f64);
+        out[27] = S::c(0f64);
+        out[28] = S::c(0f64);
+        out[29] = S::c(0f64);
+        out[30] = S::c(0f64);
+        out[31] = S::c(0f64);
+        out[32] = S::c(0f64);
+        out[33] = S::c(0f64);
+        out[34] = S::c(0f64);
+        out[35] = S::c(0f64);
+    }
+    /// Kernel `contact_jacobian_8`: 123 operations, over f64 or dual numbers.
+    pub fn contact_jacobian_8(
+        t: f64,
+        q: &[f64; 10],
+        qd: &[f64; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[f64; 134],
+        out: &mut [f64; 36],
+    ) {
+        runtime::cpu::require_fma();
+        unsafe { contact_jacobian_8_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
+    }
+    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[allow(unused_variables, clippy::all)]
+    fn contact_jacobian_8_0<S: runtime::scalar::Scalar>(
+        t: f64,
+        q: &[S; 10],
+        qd: &[S; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[S; 134],
+        out: &mut [S; 36],
+    ) {
+        let (v29, v2): (S, S) = aux[78].sin_cos();
+        let v9 = q[8] * 0.5f64;
+        let [v10, v70]: [S; 2] = v9.sinc_orders::<2>();
+        let v11 = v10 * p[55];
+        let (v15, v13): (S, S) = v9.sin_cos();
+        let v16 = v15 * p[172];
+        let v17 = S::c(p[171]).mul_add(v13, -v16);
+        let v18 = v11.mul_add(v17, S::c(p[204]));
+        let v19 = v18 + p[203];
+        let v23 = v13 * p[172];
+        let v24 = S::c(p[171]).mul_add(v15, v23);
+        let v25 = v11.mul_add(v24, S::c(p[206]));
+        let v26 = v25 + p[205];
+        let v27 = v26 * p[77];
+        let v28 = S::c(p[78]).mul_add(v19, v27);
+        let v30 = v19 * p[77];
+        let v31 = S::c(p[78]).mul_add(v26, -v30);
+        let v32 = v2.mul_add(v28, aux[56]);
+        let v33 = (-v29).mul_add(v31, v32);
+        let v35 = v29.mul_add(v28, aux[57]);
+        let v36 = v2.mul_add(v31, v35);
+        let v42 = qd[1] * aux[86];
+        let v55 = qd[0].mul_add(aux[80], v42);
+        let v56 = qd[2].mul_add(aux[92], v55);
+        let v57 = qd[3].mul_add(aux[98], v56);
+        let v58 = qd[4].mul_add(aux[104], v57);
+        let v59 = qd[5].mul_add(aux[110], v58);
+        let v60 = qd[6].mul_add(aux[116], v59);
+        let v61 = qd[7].mul_add(aux[122], v60);
+        let v62 = qd[0] + qd[1];
+        let v63 = v62 + qd[2];
+        let v64 = v63 + qd[3];
+        let v65 = v64 + qd[4];
+        let v66 = v65 + qd[5];
+        let v67 = v66 + qd[6];
+        let v68 = v67 + qd[7];
+        let v71 = v70 * 0.5f64;
+        let v72 = v71 * p[55];
+        let v74 = v15 * (-0.5f64);
+        let v75 = v13 * 0.5f64;
+        let v76 = v75 * p[172];
+        let v77 = S::c(p[171]).mul_add(v74, -v76);
+        let v78 = v11 * v77;
+        let v79 = v72.mul_add(v17, v78);
+        let v80 = v74 * p[172];
+        let v81 = S::c(p[171]).mul_add(v75, v80);
+        let v82 = v11 * v81;
+        let v83 = v72.mul_add(v24, v82);
+        let v84 = v83 * p[77];
+        let v85 = S::c(p[78]).mul_add(v79, v84);
+        let v86 = v79 * p[77];
+        let v87 = S::c(p[78]).mul_add(v83, -v86);
+        let v88 = v29 * v87;
+        let v89 = v2.mul_add(v85, -v88);
+        let v90 = (-v68).mul_add(v36, v61);
+        let v91 = qd[8].mul_add(v89, v90);
+        let v94 = qd[1] * aux[87];
+        let v101 = qd[0].mul_add(aux[81], v94);
+        let v102 = qd[2].mul_add(aux[93], v101);
+        let v103 = qd[3].mul_add(aux[99], v102);
+        let v104 = qd[4].mul_add(aux[105], v103);
+        let v105 = qd[5].mul_add(aux[111], v104);
+        let v106 = qd[6].mul_add(aux[117], v105);
+        let v107 = qd[7].mul_add(aux[123], v106);
+        let v108 = v2 * v87;
+        let v109 = v29.mul_add(v85, v108);
+        let v110 = v68.mul_add(v33, v107);
+        let v111 = qd[8].mul_add(v109, v110);
+        let v113 = aux[80] - v36;
+        let v114 = aux[86] - v36;
+        let v115 = aux[92] - v36;
+        let v116 = aux[98] - v36;
+        let v117 = aux[104] - v36;
+        let v118 = aux[110] - v36;
+        let v119 = aux[116] - v36;
+        let v120 = aux[122] - v36;
+        let v121 = aux[81] + v33;
+        let v122 = aux[87] + v33;
+        let v123 = aux[93] + v33;
+        let v124 = aux[99] + v33;
+        let v125 = aux[105] + v33;
+        let v126 = aux[111] + v33;
+        let v127 = aux[117] + v33;
+        let v128 = aux[123] + v33;
+        out[0] = v33;
+        out[1] = v36;
+        out[2] = aux[58];
+        out[3] = v91;
+        out[4] = v111;
+        out[5] = S::c(0f64);
+        out[6] = v113;
+        out[7] = v114;
+        out[8] = v115;
+        out[9] = v116;
+        out[10] = v117;
+        out[11] = v118;
+        out[12] = v119;
+        out[13] = v120;
+        out[14] = v89;
+        out[15] = S::c(0f64);
+        out[16] = v121;
+        out[17] = v122;
+        out[18] = v123;
+        out[19] = v124;
+        out[20] = v125;
+        out[21] = v126;
+        out[22] = v127;
+        out[23] = v128;
+        out[24] = v109;
+        out[25] = S::c(0f64);
+        out[26] = S::c(0f64);
+        out[27] = S::c(0f64);
+        out[28] = S::c(0f64);
+        out[29] = S::c(0f64);
+        out[30] = S::c(0f64);
+        out[31] = S::c(0f64);
+        out[32] = S::c(0f64);
+        out[33] = S::c(0f64);
+        out[34] = S::c(0f64);
+        out[35] = S::c(0f64);
+    }
+    /// Kernel `contact_jacobian_9`: 130 operations, over f64 or dual numbers.
+    pub fn contact_jacobian_9(
+        t: f64,
+        q: &[f64; 10],
+        qd: &[f64; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[f64; 134],
+        out: &mut [f64; 36],
+    ) {
+        runtime::cpu::require_fma();
+        unsafe { contact_jacobian_9_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
+    }
+    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[allow(unused_variables, clippy::all)]
+    fn contact_jacobian_9_0<S: runtime::scalar::Scalar>(
+        t: f64,
+        q: &[S; 10],
+        qd: &[S; 10],
+        qdd: &[f64; 10],
+        dir: &[f64; 20],
+        p: &[f64; 211],
+        aux: &[S; 134],
+        out: &mut [S; 36],
+    ) {
+        let (v29, v2): (S, S) = aux[79].sin_cos();
+        let v9 = q[9] * 0.5f64;
+        let [v10, v74]: [S; 2] = v9.sinc_orders::<2>();
+        let v11 = v10 * p[61];
+        let (v15, v13): (S, S) = v9.sin_cos();
+        let v16 = v15 * p[172];
+        let v17 = S::c(p[171]).mul_add(v13, -v16);
+        let v18 = v11.mul_add(v17, S::c(p[208]));
+        let v19 = v18 + p[207];
+        let v23 = v13 * p[172];
+        let v24 = S::c(p[171]).mul_add(v15, v23);
+        let v25 = v11.mul_add(v24, S::c(p[210]));
+        let v26 = v25 + p[209];
+        let v27 = v26 * p[77];
+        let v28 = S::c(p[78]).mul_add(v19, v27);
+        let v30 = v19 * p[77];
+        let v31 = S::c(p[78]).mul_add(v26, -v30);
+        let v32 = v2.mul_add(v28, aux[63]);
+        let v33 = (-v29).mul_add(v31, v32);
+        let v35 = v29.mul_add(v28, aux[64]);
+        let v36 = v2.mul_add(v31, v35);
+        let v42 = qd[1] * aux[86];
+        let v57 = qd[0].mul_add(aux[80], v42);
+        let v58 = qd[2].mul_add(aux[92], v57);
+        let v59 = qd[3].mul_add(aux[98], v58);
+        let v60 = qd[4].mul_add(aux[104], v59);
+        let v61 = qd[5].mul_add(aux[110], v60);
+        let v62 = qd[6].mul_add(aux[116], v61);
+        let v63 = qd[7].mul_add(aux[122], v62);
+        let v64 = qd[8].mul_add(aux[128], v63);
+        let v65 = qd[0] + qd[1];
+        let v66 = v65 + qd[2];
+        let v67 = v66 + qd[3];
+        let v68 = v67 + qd[4];
+        let v69 = v68 + qd[5];
+        let v70 = v69 + qd[6];
+        let v71 = v70 + qd[7];
+        let v72 = v71 + qd[8];
+        let v75 = v74 * 0.5f64;
+        let v76 = v75 * p[61];
+        let v78 = v15 * (-0.5f64);
+        let v79 = v13 * 0.5f64;
+        let v80 = v79 * p[172];
+        let v81 = S::c(p[171]).mul_add(v78, -v80);
+        let v82 = v11 * v81;
+        let v83 = v76.mul_add(v17, v82);
+        let v84 = v78 * p[172];
+        let v85 = S::c(p[171]).mul_add(v79, v84);
+        let v86 = v11 * v85;
+        let v87 = v76.mul_add(v24, v86);
+        let v88 = v87 * p[77];
+        let v89 = S::c(p[78]).mul_add(v83, v88);
+        let v90 = v83 * p[77];
+        let v91 = S::c(p[78]).mul_add(v87, -v90);
+        let v92 = v29 * v91;
+        let v93 = v2.mul_add(v89, -v92);
+        let v94 = (-v72).mul_add(v36, v64);
+        let v95 = qd[9].mul_add(v93, v94);
+        let v98 = qd[1] * aux[87];
+        let v106 = qd[0].mul_add(aux[81], v98);
+        let v107 = qd[2].mul_add(aux[93], v106);
+        let v108 = qd[3].mul_add(aux[99], v107);
+        let v109 = qd[4].mul_add(aux[105], v108);
+        let v110 = qd[5].mul_add(aux[111], v109);
+        let v111 = qd[6].mul_add(aux[117], v110);
+        let v112 = qd[7].mul_add(aux[123], v111);
+        let v113 = qd[8].mul_add(aux[129], v112);
+        let v114 = v2 * v91;
+        let v115 = v29.mul_add(v89, v114);
+        let v116 = v72.mul_add(v33, v113);
+        let v117 = qd[9].mul_add(v115, v116);
+        let v119 = aux[80] - v36;
+        let v120 = aux[86] - v36;
+        let v121 = aux[92] - v36;
+        let v122 = aux[98] - v36;
+        let v123 = aux[104] - v36;
+        let v124 = aux[110] - v36;
+        let v125 = aux[116] - v36;
+        let v126 = aux[122] - v36;
+        let v127 = aux[128] - v36;
+        let v128 = aux[81] + v33;
+        let v129 = aux[87] + v33;
+        let v130 = aux[93] + v33;
+        let v131 = aux[99] + v33;
+        let v132 = aux[105] + v33;
+        let v133 = aux[111] + v33;
+        let v134 = aux[117] + v33;
+        let v135 = aux[123] + v33;
+        let v136 = aux[129] + v33;
+        out[0] = v33;
+        out[1] = v36;
+        out[2] = aux[65];
+        out[3] = v95;
+        out[4] = v117;
+        out[5] = S::c(0f64);
+        out[6] = v119;
+        out[7] = v120;
+        out[8] = v121;
+        out[9] = v122;
+        out[10] = v123;
+        out[11] = v124;
+        out[12] = v125;
+        out[13] = v126;
+        out[14] = v127;
+        out[15] = v93;
+        out[16] = v128;
+        out[17] = v129;
+        out[18] = v130;
+        out[19] = v131;
+        out[20] = v132;
+        out[21] = v133;
+        out[22] = v134;
+        out[23] = v135;
+        out[24] = v136;
+        out[25] = v115;
+        out[26] = S::c(0f64);
+        out[27] = S::c(0f64);
+        out[28] = S::c(0f64);
+        out[29] = S::c(0f64);
+        out[30] = S::c(0f64);
+        out[31] = S::c(0f64);
+        out[32] = S::c(0f64);
+        out[33] = S::c(0f64);
+        out[34] = S::c(0f64);
+        out[35] = S::c(0f64);
+    }
+    /// Kernel `contact_jvp`: the contact groups on dual numbers along dq.
+    #[allow(unused_variables)]
     pub fn contact_jvp(
         t: f64,
         q: &[f64; 10],
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
-        out: &mut [f64; 0],
+        p: &[f64; 211],
+        out: &mut [f64; 330],
     ) {
         runtime::cpu::require_fma();
-        let w = &mut [0.0f64; 0];
-        unsafe { contact_jvp_0(t, q, qd, qdd, dir, p, w, out) };
+        let x = runtime::dual::seed(q, &dir[..10]);
+        let xd = qd.map(runtime::dual::Dual::constant);
+        let mut c = [runtime::dual::Dual::ZERO; 164];
+        unsafe { contact_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut c) };
+        let aux: &[runtime::dual::Dual; 134] = c[30..]
+            .try_into()
+            .expect("frames length");
+        let mut o = [runtime::dual::Dual::ZERO; 36];
+        unsafe {
+            contact_jacobian_0_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[0..33]);
+        let mut o = [runtime::dual::Dual::ZERO; 36];
+        unsafe {
+            contact_jacobian_1_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[33..66]);
+        let mut o = [runtime::dual::Dual::ZERO; 36];
+        unsafe {
+            contact_jacobian_2_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[66..99]);
+        let mut o = [runtime::dual::Dual::ZERO; 36];
+        unsafe {
+            contact_jacobian_3_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[99..132]);
+        let mut o = [runtime::dual::Dual::ZERO; 36];
+        unsafe {
+            contact_jacobian_4_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[132..165]);
+        let mut o = [runtime::dual::Dual::ZERO; 36];
+        unsafe {
+            contact_jacobian_5_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[165..198]);
+        let mut o = [runtime::dual::Dual::ZERO; 36];
+        unsafe {
+            contact_jacobian_6_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[198..231]);
+        let mut o = [runtime::dual::Dual::ZERO; 36];
+        unsafe {
+            contact_jacobian_7_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[231..264]);
+        let mut o = [runtime::dual::Dual::ZERO; 36];
+        unsafe {
+            contact_jacobian_8_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[264..297]);
+        let mut o = [runtime::dual::Dual::ZERO; 36];
+        unsafe {
+            contact_jacobian_9_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[297..330]);
     }
-    #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-    #[allow(unused_variables, clippy::all)]
-    fn contact_jvp_0(
-        t: f64,
-        q: &[f64; 10],
-        qd: &[f64; 10],
-        qdd: &[f64; 10],
-        dir: &[f64; 20],
-        p: &[f64; 171],
-        w: &mut [f64; 0],
-        out: &mut [f64; 0],
-    ) {}
     static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
     {
         serde_json::from_str(
@@ -11477,7 +6778,7 @@ pub mod arm_0 {
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
+        p: &[f64; 211],
         out: &mut [f64; 10],
     ) {
         runtime::cpu::require_fma();
@@ -11492,7 +6793,7 @@ pub mod arm_0 {
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
+        p: &[f64; 211],
         out: &mut [f64; 10],
     ) {
         let mut cells = LinkCells { q, qd, p };
@@ -11517,7 +6818,7 @@ pub mod arm_0 {
         qd: &[f64; 10],
         qdd: &[f64; 10],
         dir: &[f64; 20],
-        p: &[f64; 171],
+        p: &[f64; 211],
         out: &mut [f64; 9],
     ) {
         runtime::cpu::require_fma();
@@ -11529,7 +6830,7 @@ pub mod arm_0 {
     struct LinkCells<'a> {
         q: &'a [f64; 10],
         qd: &'a [f64; 10],
-        p: &'a [f64; 171],
+        p: &'a [f64; 211],
     }
     impl runtime::links::Cells for LinkCells<'_> {
         #[inline(always)]
@@ -11907,7 +7208,7 @@ pub fn rest_mass_bias(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     out: &mut [f64; 299],
 ) {
     runtime::cpu::require_fma();
@@ -11923,7 +7224,7 @@ fn rest_mass_bias_0(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     w: &mut [f64; 0],
     out: &mut [f64; 299],
 ) {
@@ -12235,7 +7536,7 @@ pub fn rest_jvp(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     out: &mut [f64; 23],
 ) {
     runtime::cpu::require_fma();
@@ -12251,7 +7552,7 @@ fn rest_jvp_0(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     w: &mut [f64; 0],
     out: &mut [f64; 23],
 ) {
@@ -12287,7 +7588,7 @@ pub fn own_derived(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     out: &mut [f64; 195],
 ) {
     runtime::cpu::require_fma();
@@ -12303,7 +7604,7 @@ fn own_derived_0(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     w: &mut [f64; 0],
     out: &mut [f64; 195],
 ) {
@@ -12788,6 +8089,461 @@ fn own_derived_0(
     out[193] = v157;
     out[194] = v156;
 }
+/// Kernel `rest_contact`: 0 operations in 1 chunk(s).
+#[allow(unused_unsafe)]
+pub fn rest_contact(
+    t: f64,
+    q: &[f64; 23],
+    qd: &[f64; 23],
+    qdd: &[f64; 23],
+    dir: &[f64; 46],
+    p: &[f64; 760],
+    out: &mut [f64; 3],
+) {
+    runtime::cpu::require_fma();
+    let w = &mut [0.0f64; 0];
+    unsafe { rest_contact_0(t, q, qd, qdd, dir, p, w, out) };
+}
+#[inline(never)]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
+fn rest_contact_0(
+    t: f64,
+    q: &[f64; 23],
+    qd: &[f64; 23],
+    qdd: &[f64; 23],
+    dir: &[f64; 46],
+    p: &[f64; 760],
+    w: &mut [f64; 0],
+    out: &mut [f64; 3],
+) {
+    out[0] = q[20];
+    out[1] = q[21];
+    out[2] = p[141];
+}
+/// Kernel `rest_contact_jvp`: 0 operations in 1 chunk(s).
+#[allow(unused_unsafe)]
+pub fn rest_contact_jvp(
+    t: f64,
+    q: &[f64; 23],
+    qd: &[f64; 23],
+    qdd: &[f64; 23],
+    dir: &[f64; 46],
+    p: &[f64; 760],
+    out: &mut [f64; 72],
+) {
+    runtime::cpu::require_fma();
+    let w = &mut [0.0f64; 0];
+    unsafe { rest_contact_jvp_0(t, q, qd, qdd, dir, p, w, out) };
+}
+#[inline(never)]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
+fn rest_contact_jvp_0(
+    t: f64,
+    q: &[f64; 23],
+    qd: &[f64; 23],
+    qdd: &[f64; 23],
+    dir: &[f64; 46],
+    p: &[f64; 760],
+    w: &mut [f64; 0],
+    out: &mut [f64; 72],
+) {
+    out[0] = 0f64;
+    out[1] = 0f64;
+    out[2] = 0f64;
+    out[3] = 0f64;
+    out[4] = 0f64;
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 0f64;
+    out[9] = 0f64;
+    out[10] = 0f64;
+    out[11] = 0f64;
+    out[12] = 0f64;
+    out[13] = 0f64;
+    out[14] = 0f64;
+    out[15] = 0f64;
+    out[16] = 0f64;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = 0f64;
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = 0f64;
+    out[25] = 0f64;
+    out[26] = 0f64;
+    out[27] = 0f64;
+    out[28] = 0f64;
+    out[29] = 0f64;
+    out[30] = 0f64;
+    out[31] = 0f64;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = 0f64;
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 0f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = 0f64;
+    out[43] = 0f64;
+    out[44] = 0f64;
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 0f64;
+    out[48] = 0f64;
+    out[49] = 0f64;
+    out[50] = 0f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 0f64;
+    out[54] = 0f64;
+    out[55] = 0f64;
+    out[56] = 0f64;
+    out[57] = 0f64;
+    out[58] = 0f64;
+    out[59] = 0f64;
+    out[60] = 0f64;
+    out[61] = 0f64;
+    out[62] = 0f64;
+    out[63] = 0f64;
+    out[64] = 0f64;
+    out[65] = 0f64;
+    out[66] = 0f64;
+    out[67] = 0f64;
+    out[68] = 0f64;
+    out[69] = 0f64;
+    out[70] = 0f64;
+    out[71] = 0f64;
+}
+/// Kernel `rest_contact_jacobian_0`: 0 operations in 1 chunk(s).
+#[allow(unused_unsafe)]
+pub fn rest_contact_jacobian_0(
+    t: f64,
+    q: &[f64; 23],
+    qd: &[f64; 23],
+    qdd: &[f64; 23],
+    dir: &[f64; 46],
+    p: &[f64; 760],
+    out: &mut [f64; 75],
+) {
+    runtime::cpu::require_fma();
+    let w = &mut [0.0f64; 0];
+    unsafe { rest_contact_jacobian_0_0(t, q, qd, qdd, dir, p, w, out) };
+}
+#[inline(never)]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
+fn rest_contact_jacobian_0_0(
+    t: f64,
+    q: &[f64; 23],
+    qd: &[f64; 23],
+    qdd: &[f64; 23],
+    dir: &[f64; 46],
+    p: &[f64; 760],
+    w: &mut [f64; 0],
+    out: &mut [f64; 75],
+) {
+    out[0] = q[20];
+    out[1] = q[21];
+    out[2] = p[141];
+    out[3] = qd[20];
+    out[4] = qd[21];
+    out[5] = 0f64;
+    out[6] = 0f64;
+    out[7] = 0f64;
+    out[8] = 0f64;
+    out[9] = 0f64;
+    out[10] = 0f64;
+    out[11] = 0f64;
+    out[12] = 0f64;
+    out[13] = 0f64;
+    out[14] = 0f64;
+    out[15] = 0f64;
+    out[16] = 0f64;
+    out[17] = 0f64;
+    out[18] = 0f64;
+    out[19] = 0f64;
+    out[20] = 0f64;
+    out[21] = 0f64;
+    out[22] = 0f64;
+    out[23] = 0f64;
+    out[24] = 0f64;
+    out[25] = 0f64;
+    out[26] = 1f64;
+    out[27] = 0f64;
+    out[28] = 0f64;
+    out[29] = 0f64;
+    out[30] = 0f64;
+    out[31] = 0f64;
+    out[32] = 0f64;
+    out[33] = 0f64;
+    out[34] = 0f64;
+    out[35] = 0f64;
+    out[36] = 0f64;
+    out[37] = 0f64;
+    out[38] = 0f64;
+    out[39] = 0f64;
+    out[40] = 0f64;
+    out[41] = 0f64;
+    out[42] = 0f64;
+    out[43] = 0f64;
+    out[44] = 0f64;
+    out[45] = 0f64;
+    out[46] = 0f64;
+    out[47] = 0f64;
+    out[48] = 0f64;
+    out[49] = 0f64;
+    out[50] = 1f64;
+    out[51] = 0f64;
+    out[52] = 0f64;
+    out[53] = 0f64;
+    out[54] = 0f64;
+    out[55] = 0f64;
+    out[56] = 0f64;
+    out[57] = 0f64;
+    out[58] = 0f64;
+    out[59] = 0f64;
+    out[60] = 0f64;
+    out[61] = 0f64;
+    out[62] = 0f64;
+    out[63] = 0f64;
+    out[64] = 0f64;
+    out[65] = 0f64;
+    out[66] = 0f64;
+    out[67] = 0f64;
+    out[68] = 0f64;
+    out[69] = 0f64;
+    out[70] = 0f64;
+    out[71] = 0f64;
+    out[72] = 0f64;
+    out[73] = 0f64;
+    out[74] = 0f64;
+}
+/// Kernel `contact`: each arm's points from its own kernels, then the rest's.
+#[allow(unused_variables)]
+pub fn contact(
+    t: f64,
+    q: &[f64; 23],
+    qd: &[f64; 23],
+    qdd: &[f64; 23],
+    dir: &[f64; 46],
+    p: &[f64; 760],
+    out: &mut [f64; 63],
+) {
+    {
+        let mut c = [0.0f64; 164];
+        arm_0::contact(
+            t,
+            q[0..0 + 10].try_into().expect("an arm's slice"),
+            qd[0..0 + 10].try_into().expect("an arm's slice"),
+            qdd[0..0 + 10].try_into().expect("an arm's slice"),
+            &[0.0; 20],
+            p[338..338 + 211].try_into().expect("an arm's slice"),
+            &mut c,
+        );
+        out[0..30].copy_from_slice(&c[..30]);
+    }
+    {
+        let mut c = [0.0f64; 164];
+        arm_0::contact(
+            t,
+            q[10..10 + 10].try_into().expect("an arm's slice"),
+            qd[10..10 + 10].try_into().expect("an arm's slice"),
+            qdd[10..10 + 10].try_into().expect("an arm's slice"),
+            &[0.0; 20],
+            p[549..549 + 211].try_into().expect("an arm's slice"),
+            &mut c,
+        );
+        out[30..60].copy_from_slice(&c[..30]);
+    }
+    {
+        rest_contact(
+            t,
+            q,
+            qd,
+            qdd,
+            dir,
+            p,
+            (&mut out[3 * 20..]).try_into().expect("the rest's points"),
+        );
+    }
+}
+/// Kernel `contact_jacobian`: each arm's groups from its own kernels,
+/// its columns in its block; then the rest's.
+#[allow(unused_variables)]
+pub fn contact_jacobian(
+    t: f64,
+    q: &[f64; 23],
+    qd: &[f64; 23],
+    qdd: &[f64; 23],
+    dir: &[f64; 46],
+    all: bool,
+    p: &[f64; 760],
+    out: &mut [f64; 1575],
+) {
+    {
+        let mut d = [0.0f64; 20];
+        d[..10].copy_from_slice(&dir[0..0 + 10]);
+        if all || d.iter().any(|&x| x != 0.0) {
+            let mut c = [0.0f64; 164];
+            arm_0::contact(
+                t,
+                q[0..0 + 10].try_into().expect("an arm's slice"),
+                qd[0..0 + 10].try_into().expect("an arm's slice"),
+                qdd[0..0 + 10].try_into().expect("an arm's slice"),
+                &[0.0; 20],
+                p[338..338 + 211].try_into().expect("an arm's slice"),
+                &mut c,
+            );
+            let aux: &[f64; 134] = c[30..].try_into().expect("the arm's contact frames");
+            let mut rows = [0.0f64; 360];
+            arm_0::contact_jacobian(
+                t,
+                q[0..0 + 10].try_into().expect("an arm's slice"),
+                qd[0..0 + 10].try_into().expect("an arm's slice"),
+                qdd[0..0 + 10].try_into().expect("an arm's slice"),
+                &d,
+                all,
+                p[338..338 + 211].try_into().expect("an arm's slice"),
+                aux,
+                &mut rows,
+            );
+            runtime::linalg::place_groups(
+                all,
+                &d,
+                arm_0::CONTACT_GROUPS,
+                23,
+                0,
+                10,
+                &rows,
+                &mut out[0..750],
+            );
+        }
+    }
+    {
+        let mut d = [0.0f64; 20];
+        d[..10].copy_from_slice(&dir[10..10 + 10]);
+        if all || d.iter().any(|&x| x != 0.0) {
+            let mut c = [0.0f64; 164];
+            arm_0::contact(
+                t,
+                q[10..10 + 10].try_into().expect("an arm's slice"),
+                qd[10..10 + 10].try_into().expect("an arm's slice"),
+                qdd[10..10 + 10].try_into().expect("an arm's slice"),
+                &[0.0; 20],
+                p[549..549 + 211].try_into().expect("an arm's slice"),
+                &mut c,
+            );
+            let aux: &[f64; 134] = c[30..].try_into().expect("the arm's contact frames");
+            let mut rows = [0.0f64; 360];
+            arm_0::contact_jacobian(
+                t,
+                q[10..10 + 10].try_into().expect("an arm's slice"),
+                qd[10..10 + 10].try_into().expect("an arm's slice"),
+                qdd[10..10 + 10].try_into().expect("an arm's slice"),
+                &d,
+                all,
+                p[549..549 + 211].try_into().expect("an arm's slice"),
+                aux,
+                &mut rows,
+            );
+            runtime::linalg::place_groups(
+                all,
+                &d,
+                arm_0::CONTACT_GROUPS,
+                23,
+                10,
+                10,
+                &rows,
+                &mut out[750..1500],
+            );
+        }
+    }
+    {
+        if all || dir[20] != 0.0 {
+            rest_contact_jacobian_0(
+                t,
+                q,
+                qd,
+                qdd,
+                dir,
+                p,
+                (&mut out[1500..1575]).try_into().expect("group output length"),
+            );
+        }
+    }
+}
+/// Kernel `contact_jvp`: each arm's from its own kernels along its
+/// block of dq; then the rest's.
+#[allow(unused_variables)]
+pub fn contact_jvp(
+    t: f64,
+    q: &[f64; 23],
+    qd: &[f64; 23],
+    qdd: &[f64; 23],
+    dir: &[f64; 46],
+    p: &[f64; 760],
+    out: &mut [f64; 1512],
+) {
+    {
+        let mut d = [0.0f64; 20];
+        d[..10].copy_from_slice(&dir[0..0 + 10]);
+        let o = &mut out[0..720];
+        if d.iter().any(|&x| x != 0.0) {
+            let mut rows = [0.0f64; 330];
+            arm_0::contact_jvp(
+                t,
+                q[0..0 + 10].try_into().expect("an arm's slice"),
+                qd[0..0 + 10].try_into().expect("an arm's slice"),
+                qdd[0..0 + 10].try_into().expect("an arm's slice"),
+                &d,
+                p[338..338 + 211].try_into().expect("an arm's slice"),
+                &mut rows,
+            );
+            runtime::linalg::place_point_rows(3, 23, 0, 10, &rows, o);
+        } else {
+            o.fill(0.0);
+        }
+    }
+    {
+        let mut d = [0.0f64; 20];
+        d[..10].copy_from_slice(&dir[10..10 + 10]);
+        let o = &mut out[720..1440];
+        if d.iter().any(|&x| x != 0.0) {
+            let mut rows = [0.0f64; 330];
+            arm_0::contact_jvp(
+                t,
+                q[10..10 + 10].try_into().expect("an arm's slice"),
+                qd[10..10 + 10].try_into().expect("an arm's slice"),
+                qdd[10..10 + 10].try_into().expect("an arm's slice"),
+                &d,
+                p[549..549 + 211].try_into().expect("an arm's slice"),
+                &mut rows,
+            );
+            runtime::linalg::place_point_rows(3, 23, 10, 10, &rows, o);
+        } else {
+            o.fill(0.0);
+        }
+    }
+    {
+        rest_contact_jvp(
+            t,
+            q,
+            qd,
+            qdd,
+            dir,
+            p,
+            (&mut out[20 * 72..]).try_into().expect("the rest's points"),
+        );
+    }
+}
 /// Kernel `mass_bias`: the rest of the system's, then each arm's in its block.
 pub fn mass_bias(
     t: f64,
@@ -12795,7 +8551,7 @@ pub fn mass_bias(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     out: &mut [f64; 299],
 ) {
     rest_mass_bias(t, q, qd, qdd, dir, p, out);
@@ -12807,7 +8563,7 @@ pub fn mass_bias(
             qd[0..0 + 10].try_into().expect("an arm's slice"),
             qdd[0..0 + 10].try_into().expect("an arm's slice"),
             &[0.0; 20],
-            p[338..338 + 171].try_into().expect("an arm's slice"),
+            p[338..338 + 211].try_into().expect("an arm's slice"),
             &mut block,
         );
         runtime::linalg::add_block(23, 0, 10, &block, out);
@@ -12820,7 +8576,7 @@ pub fn mass_bias(
             qd[10..10 + 10].try_into().expect("an arm's slice"),
             qdd[10..10 + 10].try_into().expect("an arm's slice"),
             &[0.0; 20],
-            p[509..509 + 171].try_into().expect("an arm's slice"),
+            p[549..549 + 211].try_into().expect("an arm's slice"),
             &mut block,
         );
         runtime::linalg::add_block(23, 10, 10, &block, out);
@@ -12833,7 +8589,7 @@ pub fn jvp(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
+    p: &[f64; 760],
     out: &mut [f64; 23],
 ) {
     rest_jvp(t, q, qd, qdd, dir, p, out);
@@ -12849,7 +8605,7 @@ pub fn jvp(
                 qd[0..0 + 10].try_into().expect("an arm's slice"),
                 qdd[0..0 + 10].try_into().expect("an arm's slice"),
                 &d,
-                p[338..338 + 171].try_into().expect("an arm's slice"),
+                p[338..338 + 211].try_into().expect("an arm's slice"),
                 &mut tau,
             );
             for (o, x) in out[0..0 + 10].iter_mut().zip(&tau) {
@@ -12869,7 +8625,7 @@ pub fn jvp(
                 qd[10..10 + 10].try_into().expect("an arm's slice"),
                 qdd[10..10 + 10].try_into().expect("an arm's slice"),
                 &d,
-                p[509..509 + 171].try_into().expect("an arm's slice"),
+                p[549..549 + 211].try_into().expect("an arm's slice"),
                 &mut tau,
             );
             for (o, x) in out[10..10 + 10].iter_mut().zip(&tau) {
@@ -12886,8 +8642,8 @@ pub fn derived(
     qd: &[f64; 23],
     qdd: &[f64; 23],
     dir: &[f64; 46],
-    p: &[f64; 680],
-    out: &mut [f64; 537],
+    p: &[f64; 760],
+    out: &mut [f64; 617],
 ) {
     own_derived(
         t,
@@ -12899,7 +8655,7 @@ pub fn derived(
         (&mut out[..195]).try_into().expect("own derived parameters"),
     );
     {
-        let mut pe = [0.0f64; 171];
+        let mut pe = [0.0f64; 211];
         pe[..67].copy_from_slice(&p[3..3 + 67]);
         out[195..195 + 67].copy_from_slice(&p[3..3 + 67]);
         arm_0::derived(
@@ -12909,15 +8665,15 @@ pub fn derived(
             &[0.0; 10],
             &[0.0; 20],
             &pe,
-            (&mut out[195 + 67..195 + 171])
+            (&mut out[195 + 67..195 + 211])
                 .try_into()
                 .expect("an arm's derived parameters"),
         );
     }
     {
-        let mut pe = [0.0f64; 171];
+        let mut pe = [0.0f64; 211];
         pe[..67].copy_from_slice(&p[70..70 + 67]);
-        out[366..366 + 67].copy_from_slice(&p[70..70 + 67]);
+        out[406..406 + 67].copy_from_slice(&p[70..70 + 67]);
         arm_0::derived(
             t,
             &[0.0; 10],
@@ -12925,7 +8681,7 @@ pub fn derived(
             &[0.0; 10],
             &[0.0; 20],
             &pe,
-            (&mut out[366 + 67..366 + 171])
+            (&mut out[406 + 67..406 + 211])
                 .try_into()
                 .expect("an arm's derived parameters"),
         );

@@ -1,6 +1,6 @@
 //! Model -> tapes: kinematics, TMT assembly, lowering.
 
-use runtime::kernels::{ArmBlocks, ArmInstance};
+use runtime::kernels::{ArmBlocks, ArmInstance, RestContact};
 use runtime::{ModelInfo, TapeSet};
 
 use crate::build::{ArmBlock, assembly_system, link_chain, system};
@@ -130,8 +130,8 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
             )
         }
     };
-    let arm_blocks =
-        by_arms.map(|(a, arms, rest)| arm_blocks(&mut cas, a, &arms, &rest, &mut hoist));
+    let arm_blocks = by_arms
+        .map(|(a, arms, rest)| arm_blocks(&mut cas, a, &arms, &rest, &contact_groups, &mut hoist));
     let derived = hoist.finish(&mut cas);
     TapeSet {
         info: ModelInfo {
@@ -178,26 +178,29 @@ fn arms_have_own_kernels(a: &AssemblyShape) -> bool {
 }
 
 /// The rest of an assembly's `MassBias` and `Jvp` (hoisted with its other
-/// kernels), and each distinct arm structure derived once as a single arm
-/// (without contact points: contact stays the assembly's).
+/// kernels), and each distinct arm structure derived once as a single arm,
+/// with its contact points when the assembly has contact (`groups`: the
+/// flat kernels' groups, which the arms' and the rest's must repeat).
 fn arm_blocks(
     cas: &mut Cas,
     a: &AssemblyShape,
     arms: &[ArmBlock],
     rest: &System,
+    groups: &[usize],
     hoist: &mut Hoist,
 ) -> ArmBlocks {
     let eq = assemble(cas, rest);
     let mut mass_bias = eq.mass_upper.clone();
     mass_bias.extend_from_slice(&eq.bias);
     let mut kinds: Vec<(Structure, TapeSet)> = Vec::new();
-    let instances = a
+    let contact = !groups.is_empty();
+    let instances: Vec<ArmInstance> = a
         .arms
         .iter()
         .zip(arms)
         .map(|((_, st), b)| {
             let st = Structure {
-                contact_points: 0,
+                contact_points: if contact { st.contact_points } else { 0 },
                 ..st.clone()
             };
             let kind = match kinds.iter().position(|(s, _)| *s == st) {
@@ -216,11 +219,35 @@ fn arm_blocks(
             }
         })
         .collect();
+    let kinds: Vec<TapeSet> = kinds.into_iter().map(|(_, t)| t).collect();
+    let rest_contact = contact.then(|| rest_contact(cas, rest, hoist)).filter(|r| {
+        // The arms' groups, then the rest's: the flat kernels' order.
+        let mut through_arms: Vec<usize> = (instances.iter())
+            .flat_map(|i| kinds[i.kind].info.contact_groups.iter().copied())
+            .collect();
+        through_arms.extend(&r.groups);
+        through_arms == groups
+    });
     ArmBlocks {
         rest_mass_bias: cas.to_tape_hoisted(&mass_bias, hoist),
         rest_jvp: cas.to_tape_hoisted(&eq.jvp, hoist),
-        kinds: kinds.into_iter().map(|(_, t)| t).collect(),
+        kinds,
         arms: instances,
+        rest_contact,
+    }
+}
+
+/// The contact kernels of the points no arm has (the bodies' centres).
+fn rest_contact(cas: &mut Cas, rest: &System, hoist: &mut Hoist) -> RestContact {
+    let c = contact_outputs(cas, rest);
+    assert!(c.frames.is_empty(), "no contact frames off the arms");
+    RestContact {
+        contact: cas.to_tape_hoisted(&c.points, hoist),
+        contact_jacobian: (c.groups.iter())
+            .map(|g| cas.to_tape_hoisted(g, hoist))
+            .collect(),
+        contact_jvp: cas.to_tape_hoisted(&c.tangent, hoist),
+        groups: c.groups.iter().map(|g| g.len() / c.width).collect(),
     }
 }
 

@@ -1566,11 +1566,13 @@ fn emit_kernels(
                 kind,
                 KernelKind::MassBias | KernelKind::Jvp | KernelKind::Outputs
             );
-        let by_arms = tapes.arm_blocks.is_some()
-            && matches!(
-                kind,
-                KernelKind::MassBias | KernelKind::Jvp | KernelKind::Derived
-            );
+        let by_arms = tapes.arm_blocks.as_ref().is_some_and(|b| match kind {
+            KernelKind::MassBias | KernelKind::Jvp | KernelKind::Derived => true,
+            KernelKind::Contact | KernelKind::ContactJacobian | KernelKind::ContactJvp => {
+                b.rest_contact.is_some()
+            }
+            _ => false,
+        });
         match (&tapes.links, kind) {
             // Emitted with the parts or the arms, below.
             _ if by_parts || by_arms => {}
@@ -1753,9 +1755,11 @@ fn emit_arm_blocks(
     }
     let n_mb = dof * (dof + 1) / 2 + dof;
     let inputs = quote!(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params]);
+    let contact = emit_arm_contact(tapes, blocks, dof, n_params);
     quote! {
         #(#modules)*
         #(#flat)*
+        #contact
         /// Kernel `mass_bias`: the rest of the system's, then each arm's in its block.
         pub fn mass_bias(#inputs, out: &mut [f64; #n_mb]) {
             rest_mass_bias(t, q, qd, qdd, dir, p, out);
@@ -1771,6 +1775,145 @@ fn emit_arm_blocks(
         pub fn derived(#inputs, out: &mut [f64; #n_derived]) {
             own_derived(t, q, qd, qdd, dir, p, (&mut out[..#own]).try_into().expect("own derived parameters"));
             #({ #derived })*
+        }
+    }
+}
+
+/// An arm's slices of the assembly's q, qd, qdd (coordinates `first..first
+/// + m`) and of the extended parameters (`x..x + len`).
+fn arm_slices(first: usize, m: usize, x: usize, len: usize) -> [TokenStream; 4] {
+    let slice = |v: TokenStream, from: usize, len: usize| quote!(#v[#from..#from + #len].try_into().expect("an arm's slice"));
+    [
+        slice(quote!(q), first, m),
+        slice(quote!(qd), first, m),
+        slice(quote!(qdd), first, m),
+        slice(quote!(p), x, len),
+    ]
+}
+
+/// The contact kernels through the arms' own (`ArmBlocks::rest_contact`):
+/// each arm's points and its groups from its kind's kernels (its contact
+/// frames from its `contact`), its Jacobian columns placed in its block;
+/// then the points no arm has, from the rest's tapes. Nothing without
+/// `rest_contact`.
+fn emit_arm_contact(
+    tapes: &TapeSet,
+    blocks: &ArmBlocks,
+    dof: usize,
+    n_params: usize,
+) -> TokenStream {
+    let Some(rest) = &blocks.rest_contact else {
+        return quote!();
+    };
+    let n_base = tapes.info.parameters.len();
+    let (starts, _) = blocks.derived_layout(tapes.info.derived);
+    let (width, tail) = (6 + 3 * dof, 3 + 3 * dof);
+    let (mut points, mut groups, mut tangents) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut pt, mut g0) = (0, 0);
+    for (a, &start) in blocks.arms.iter().zip(&starts) {
+        let module = format_ident!("arm_{}", a.kind);
+        let info = &blocks.kinds[a.kind].info;
+        let (first, m) = (a.first, a.dof);
+        let m_dir = 2 * m;
+        let [aq, aqd, aqdd, ap] = arm_slices(first, m, n_base + start, info.extended_params());
+        let (np, nf, ng) = (
+            info.contact_points,
+            info.contact_frames,
+            info.contact_groups.len(),
+        );
+        let nc = 3 * np + nf;
+        let (np3, nrows, njrows) = (3 * np, np * (6 + 3 * m), np * (3 + 3 * m));
+        let own_contact = quote! {
+            let mut c = [0.0f64; #nc];
+            #module::contact(t, #aq, #aqd, #aqdd, &[0.0; #m_dir], #ap, &mut c);
+        };
+        let (a3, b3) = (3 * pt, 3 * (pt + np));
+        points.push(quote! {
+            #own_contact
+            out[#a3..#b3].copy_from_slice(&c[..#np3]);
+        });
+        let (frames, aux) = match nf {
+            0 => (quote!(), quote!()),
+            _ => (
+                quote! {
+                    #own_contact
+                    let aux: &[f64; #nf] = c[#np3..].try_into().expect("the arm's contact frames");
+                },
+                quote!(aux,),
+            ),
+        };
+        let (ga, gb) = (pt * width, (pt + np) * width);
+        groups.push(quote! {
+            let mut d = [0.0f64; #m_dir];
+            d[..#ng].copy_from_slice(&dir[#g0..#g0 + #ng]);
+            if all || d.iter().any(|&x| x != 0.0) {
+                #frames
+                let mut rows = [0.0f64; #nrows];
+                #module::contact_jacobian(t, #aq, #aqd, #aqdd, &d, all, #ap, #aux &mut rows);
+                runtime::linalg::place_groups(all, &d, #module::CONTACT_GROUPS, #dof, #first, #m, &rows, &mut out[#ga..#gb]);
+            }
+        });
+        let (ja, jb) = (pt * tail, (pt + np) * tail);
+        tangents.push(quote! {
+            let mut d = [0.0f64; #m_dir];
+            d[..#m].copy_from_slice(&dir[#first..#first + #m]);
+            let o = &mut out[#ja..#jb];
+            // Along a direction off its block, an arm's points do not move.
+            if d.iter().any(|&x| x != 0.0) {
+                let mut rows = [0.0f64; #njrows];
+                #module::contact_jvp(t, #aq, #aqd, #aqdd, &d, #ap, &mut rows);
+                runtime::linalg::place_point_rows(3, #dof, #first, #m, &rows, o);
+            } else {
+                o.fill(0.0);
+            }
+        });
+        pt += np;
+        g0 += ng;
+    }
+    let n_rest: usize = rest.groups.iter().sum();
+    let mut defs = Vec::new();
+    if n_rest > 0 {
+        defs.push(KernelEmitter::new(&rest.contact).emit("rest_contact", dof, n_params, 0));
+        defs.push(KernelEmitter::new(&rest.contact_jvp).emit("rest_contact_jvp", dof, n_params, 0));
+        points.push(quote!(rest_contact(t, q, qd, qdd, dir, p, (&mut out[3 * #pt..]).try_into().expect("the rest's points"));));
+        tangents.push(quote!(rest_contact_jvp(t, q, qd, qdd, dir, p, (&mut out[#pt * #tail..]).try_into().expect("the rest's points"));));
+        let mut at = pt;
+        for (r, (tape, &len)) in rest.contact_jacobian.iter().zip(&rest.groups).enumerate() {
+            let name = format!("rest_contact_jacobian_{r}");
+            defs.push(KernelEmitter::new(tape).emit(&name, dof, n_params, 0));
+            let f = Ident::new(&name, Span::call_site());
+            let (a, b, g) = (at * width, (at + len) * width, g0 + r);
+            groups.push(quote! {
+                if all || dir[#g] != 0.0 {
+                    #f(t, q, qd, qdd, dir, p, (&mut out[#a..#b]).try_into().expect("group output length"));
+                }
+            });
+            at += len;
+        }
+    }
+    let n_dir = 2 * dof;
+    let n_points = tapes.info.contact_points;
+    let inputs =
+        quote!(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir]);
+    let (n_c, n_j, n_t) = (3 * n_points, n_points * width, n_points * tail);
+    quote! {
+        #(#defs)*
+        /// Kernel `contact`: each arm's points from its own kernels, then the rest's.
+        #[allow(unused_variables)]
+        pub fn contact(#inputs, p: &[f64; #n_params], out: &mut [f64; #n_c]) {
+            #({ #points })*
+        }
+        /// Kernel `contact_jacobian`: each arm's groups from its own kernels,
+        /// its columns in its block; then the rest's.
+        #[allow(unused_variables)]
+        pub fn contact_jacobian(#inputs, all: bool, p: &[f64; #n_params], out: &mut [f64; #n_j]) {
+            #({ #groups })*
+        }
+        /// Kernel `contact_jvp`: each arm's from its own kernels along its
+        /// block of dq; then the rest's.
+        #[allow(unused_variables)]
+        pub fn contact_jvp(#inputs, p: &[f64; #n_params], out: &mut [f64; #n_t]) {
+            #({ #tangents })*
         }
     }
 }

@@ -94,6 +94,7 @@ fn assert_backends_agree(
                 assert_close(a[k], b[k], rel, floor, &format!("{} {kind:?}[{k}]", what));
             }
         }
+        assert_contact_agrees(what, compiled, interpreted, rng, t, &q, &qd);
         // The Jacobian's parts, column by column from the Jvp kernel.
         let qdd = rng.vec(n, -5.0, 5.0);
         let (mut a, mut b) = (vec![0.0; 2 * n * n], vec![0.0; 2 * n * n]);
@@ -116,6 +117,59 @@ fn assert_backends_agree(
             );
         }
     }
+}
+
+/// The contact kernels agree: every point's position; every group's
+/// positions, velocities and dp/dq, all at once and each group alone (the
+/// others' rows left as they were); and dv, d(dp/dq) along a random dq.
+fn assert_contact_agrees(
+    what: &str,
+    compiled: &dyn Dynamics,
+    interpreted: &dyn Dynamics,
+    rng: &mut Rng,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+) {
+    let info = compiled.info();
+    let (n, points) = (q.len(), info.contact_points);
+    if points == 0 {
+        return;
+    }
+    let close = |a: &[f64], b: &[f64], label: &str| {
+        let scale = b.iter().fold(1e-300f64, |s, x| s.max(x.abs()));
+        for (k, (x, y)) in a.iter().zip(b).enumerate() {
+            assert!(x.is_finite(), "{what} {label}[{k}] not finite");
+            assert_close(*x, *y, 1e-12, scale, &format!("{what} {label}[{k}]"));
+        }
+    };
+    let eval = |d: &dyn Dynamics, kind: KernelKind, dir: &[f64], out: &mut Vec<f64>| {
+        out.resize(kind.output_len(d.info()), 0.0);
+        d.eval_direction(kind, t, q, qd, dir, &[], out);
+    };
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    eval(compiled, KernelKind::Contact, &[], &mut a);
+    eval(interpreted, KernelKind::Contact, &[], &mut b);
+    close(&a[..3 * points], &b[..3 * points], "contact point");
+    eval(compiled, KernelKind::ContactJacobian, &[], &mut a);
+    eval(interpreted, KernelKind::ContactJacobian, &[], &mut b);
+    close(&a, &b, "contact jacobian");
+    let width = 6 + 3 * n;
+    for (g, (first, len)) in info.contact_group_ranges().enumerate() {
+        let mut mask = vec![0.0; 2 * n];
+        mask[g] = 1.0;
+        let rows = first * width..(first + len) * width;
+        for (d, out) in [(compiled, &mut a), (interpreted, &mut b)] {
+            out.fill(f64::NAN);
+            d.eval_direction(KernelKind::ContactJacobian, t, q, qd, &mask, &[], out);
+        }
+        close(&a[rows.clone()], &b[rows], &format!("contact group {g}"));
+    }
+    let mut dir = rng.vec(n, -1.0, 1.0);
+    dir.resize(2 * n, 0.0);
+    eval(compiled, KernelKind::ContactJvp, &dir, &mut a);
+    eval(interpreted, KernelKind::ContactJvp, &dir, &mut b);
+    close(&a, &b, "contact jvp");
 }
 
 #[test]

@@ -118,48 +118,50 @@ fn cli_derive_check_detects_a_stale_file() {
 /// build: generated/ under 2 MB for the bundled set).
 const FILE_BUDGET: u64 = 300_000;
 
-/// The models still over the budget (their assembly and contact kernels are
-/// flat expression code), each with the size it may not exceed: a file
-/// grows past its ceiling, or falls within the budget and is still listed,
-/// and the test fails, so the list only shrinks.
-const OVER_BUDGET: &[(&str, u64)] = &[
-    ("ball_drop", 411_751),
-];
+/// generated/ as a whole (BENCHMARKS.md, build: under 2 MB for the
+/// bundled set).
+const TOTAL_BUDGET: u64 = 2_000_000;
+
+/// What the bundled set takes while it is still over [`TOTAL_BUDGET`] (the
+/// planar arms' flat mass + bias and symbolic solve are most of the
+/// excess): the total may not grow past it, and once within the budget the
+/// test asks for the ceiling to go, so that it only shrinks.
+const TOTAL_CEILING: Option<u64> = Some(TOTAL_NOW);
+const TOTAL_NOW: u64 = 2_780_272;
 
 /// Generated sizes are deterministic, so the budget is a fair test: no
-/// model's file over 300 kB but the listed ones, and those no bigger.
+/// model's file over 300 kB, and generated/ no bigger than its budget (or,
+/// while over it, its ceiling).
 #[test]
 fn generated_files_keep_their_size_budget() {
-    let mut seen = Vec::new();
+    let mut total = 0;
     for e in std::fs::read_dir(root().join("generated")).unwrap() {
         let p = e.unwrap().path();
+        let size = std::fs::metadata(&p).unwrap().len();
+        total += size;
         let name = p.file_stem().unwrap().to_string_lossy().into_owned();
         if p.extension().is_none_or(|x| x != "rs") || matches!(name.as_str(), "mod" | "lib") {
             continue;
         }
-        let size = std::fs::metadata(&p).unwrap().len();
-        match OVER_BUDGET.iter().find(|(n, _)| *n == name) {
-            Some(&(_, ceiling)) => {
-                assert!(
-                    size <= ceiling,
-                    "generated/{name}.rs grew to {size} bytes (its ceiling: {ceiling})"
-                );
-                assert!(
-                    size > FILE_BUDGET,
-                    "generated/{name}.rs is within the budget now ({size} bytes): take it off OVER_BUDGET"
-                );
-                seen.push(name);
-            }
-            None => assert!(
-                size <= FILE_BUDGET,
-                "generated/{name}.rs is {size} bytes, over the {FILE_BUDGET}-byte budget"
-            ),
-        }
-    }
-    for (name, _) in OVER_BUDGET {
         assert!(
-            seen.iter().any(|s| s == name),
-            "{name} is listed over budget but has no generated file"
+            size <= FILE_BUDGET,
+            "generated/{name}.rs is {size} bytes, over the {FILE_BUDGET}-byte budget"
         );
+    }
+    match TOTAL_CEILING {
+        Some(ceiling) => {
+            assert!(
+                total <= ceiling,
+                "generated/ grew to {total} bytes (its ceiling: {ceiling}; the budget: {TOTAL_BUDGET})"
+            );
+            assert!(
+                total > TOTAL_BUDGET,
+                "generated/ is within its budget now ({total} bytes): drop TOTAL_CEILING"
+            );
+        }
+        None => assert!(
+            total <= TOTAL_BUDGET,
+            "generated/ is {total} bytes, over its {TOTAL_BUDGET}-byte budget"
+        ),
     }
 }

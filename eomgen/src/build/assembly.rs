@@ -36,8 +36,8 @@ pub struct Assembled {
     /// Where each arm's own system sits in the assembly's.
     pub arms: Vec<ArmBlock>,
     /// The system without the arms' own terms (their links, springs,
-    /// dampers, actuators and loads): the bodies, the compliant bases and
-    /// whatever joins the arms. The assembly's M, h and their tangent are
+    /// dampers, actuators, loads and contact points): the bodies, the
+    /// compliant bases and whatever joins the arms. The assembly's M, h and their tangent are
     /// this system's plus each arm's, in its block.
     pub rest: System,
 }
@@ -61,6 +61,7 @@ struct ArmEntries {
     actuation: Range<usize>,
     point_forces: Range<usize>,
     moments: Range<usize>,
+    samples: Range<usize>,
 }
 
 /// `all` without the entries of every arm (`range` picks the list's).
@@ -306,6 +307,7 @@ impl Builder {
             actuation: start(self.actuation.len()),
             point_forces: start(self.point_forces.len()),
             moments: start(self.moments.len()),
+            samples: start(self.samples.len()),
         };
         self.bodies.extend(sys.bodies);
         self.elastic.push(sys.elastic);
@@ -318,6 +320,7 @@ impl Builder {
         own.actuation.end = self.actuation.len();
         own.point_forces.end = self.point_forces.len();
         self.samples.extend(sys.samples.iter().copied());
+        own.samples.end = self.samples.len();
         self.bases.extend(sys.bases.iter().copied());
         self.moments.extend(sys.moments);
         own.moments.end = self.moments.len();
@@ -623,7 +626,8 @@ impl Builder {
             seeds: self.seeds.clone(),
             planar: None,
             segment_ends: Vec::new(),
-            samples: Vec::new(),
+            // The points no arm has: the bodies' centres.
+            samples: without_arms(&self.samples, arms, |a| &a.samples),
             bases: Vec::new(),
         }
     }

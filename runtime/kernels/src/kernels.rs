@@ -333,6 +333,25 @@ pub struct ArmBlocks {
     /// The kernels of each distinct arm structure, as a single arm's.
     pub kinds: Vec<TapeSet>,
     pub arms: Vec<ArmInstance>,
+    /// The contact points through the arms' own contact kernels (each
+    /// arm's points, with its contact frames, from its kind's), and the
+    /// points no arm has (the bodies' centres) from these; `None`: the
+    /// assembly's flat contact kernels.
+    #[serde(default)]
+    pub rest_contact: Option<RestContact>,
+}
+
+/// The contact kernels of an assembly's points that are no arm's, which
+/// follow the arms' points and groups.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RestContact {
+    /// Their positions (3 each).
+    pub contact: Tape,
+    /// Their groups, as `TapeSet::contact_jacobian`'s.
+    pub contact_jacobian: Vec<Tape>,
+    pub contact_jvp: Tape,
+    /// Points per group.
+    pub groups: Vec<usize>,
 }
 
 /// One arm of the assembly.

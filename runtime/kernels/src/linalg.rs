@@ -39,6 +39,66 @@ fn dot<const FMA: bool>(a: &[f64], b: &[f64]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
+/// Rows of an arm's point kernels (`head` values, then a 3 x m Jacobian
+/// row-major over its `m` coordinates) into the assembly's rows (`head`,
+/// then 3 x n over its `n`): the arm's columns from `first`, the others
+/// zero (an arm on a fixed base moves with its own coordinates alone).
+#[inline(always)]
+pub fn place_point_rows(
+    head: usize,
+    n: usize,
+    first: usize,
+    m: usize,
+    rows: &[f64],
+    out: &mut [f64],
+) {
+    for (r, o) in rows
+        .chunks_exact(head + 3 * m)
+        .zip(out.chunks_exact_mut(head + 3 * n))
+    {
+        o[..head].copy_from_slice(&r[..head]);
+        for c in 0..3 {
+            let row = &mut o[head + c * n..head + (c + 1) * n];
+            row.fill(0.0);
+            row[first..first + m].copy_from_slice(&r[head + c * m..head + (c + 1) * m]);
+        }
+    }
+}
+
+/// [`place_point_rows`] for the `ContactJacobian` groups an arm's kernel
+/// evaluated (`groups`: points per group; group k when `all` or
+/// `dir[k] != 0`), rows of `6 + 3 m` into rows of `6 + 3 n`; the others'
+/// rows are left as they were.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn place_groups(
+    all: bool,
+    dir: &[f64],
+    groups: &[usize],
+    n: usize,
+    first: usize,
+    m: usize,
+    rows: &[f64],
+    out: &mut [f64],
+) {
+    let (wa, w) = (6 + 3 * m, 6 + 3 * n);
+    let mut point = 0;
+    for (k, &len) in groups.iter().enumerate() {
+        if all || dir[k] != 0.0 {
+            let (a, b) = (point, point + len);
+            place_point_rows(
+                6,
+                n,
+                first,
+                m,
+                &rows[a * wa..b * wa],
+                &mut out[a * w..b * w],
+            );
+        }
+        point += len;
+    }
+}
+
 /// Add an arm's packed M and h (`block`, `m` coordinates) into the
 /// assembly's (`out`, `n` coordinates), its coordinates from `first`.
 #[inline(always)]
