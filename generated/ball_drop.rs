@@ -4814,7 +4814,7 @@ pub mod arm_0 {
         unsafe { contact_0::<f64>(t, q, qd, qdd, dir, p, out) };
     }
     #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
     #[allow(unused_variables, clippy::all)]
     fn contact_0<S: runtime::scalar::Scalar>(
         t: f64,
@@ -5384,7 +5384,7 @@ pub mod arm_0 {
         unsafe { contact_jacobian_0_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
     }
     #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
     #[allow(unused_variables, clippy::all)]
     fn contact_jacobian_0_0<S: runtime::scalar::Scalar>(
         t: f64,
@@ -5491,7 +5491,7 @@ pub mod arm_0 {
         unsafe { contact_jacobian_1_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
     }
     #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
     #[allow(unused_variables, clippy::all)]
     fn contact_jacobian_1_0<S: runtime::scalar::Scalar>(
         t: f64,
@@ -5604,7 +5604,7 @@ pub mod arm_0 {
         unsafe { contact_jacobian_2_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
     }
     #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
     #[allow(unused_variables, clippy::all)]
     fn contact_jacobian_2_0<S: runtime::scalar::Scalar>(
         t: f64,
@@ -5722,7 +5722,7 @@ pub mod arm_0 {
         unsafe { contact_jacobian_3_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
     }
     #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
     #[allow(unused_variables, clippy::all)]
     fn contact_jacobian_3_0<S: runtime::scalar::Scalar>(
         t: f64,
@@ -5845,7 +5845,7 @@ pub mod arm_0 {
         unsafe { contact_jacobian_4_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
     }
     #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
     #[allow(unused_variables, clippy::all)]
     fn contact_jacobian_4_0<S: runtime::scalar::Scalar>(
         t: f64,
@@ -5973,7 +5973,7 @@ pub mod arm_0 {
         unsafe { contact_jacobian_5_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
     }
     #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
     #[allow(unused_variables, clippy::all)]
     fn contact_jacobian_5_0<S: runtime::scalar::Scalar>(
         t: f64,
@@ -6106,7 +6106,7 @@ pub mod arm_0 {
         unsafe { contact_jacobian_6_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
     }
     #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
     #[allow(unused_variables, clippy::all)]
     fn contact_jacobian_6_0<S: runtime::scalar::Scalar>(
         t: f64,
@@ -6244,7 +6244,7 @@ pub mod arm_0 {
         unsafe { contact_jacobian_7_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
     }
     #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
     #[allow(unused_variables, clippy::all)]
     fn contact_jacobian_7_0<S: runtime::scalar::Scalar>(
         t: f64,
@@ -6387,7 +6387,7 @@ pub mod arm_0 {
         unsafe { contact_jacobian_8_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
     }
     #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
     #[allow(unused_variables, clippy::all)]
     fn contact_jacobian_8_0<S: runtime::scalar::Scalar>(
         t: f64,
@@ -6535,7 +6535,7 @@ pub mod arm_0 {
         unsafe { contact_jacobian_9_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
     }
     #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
     #[allow(unused_variables, clippy::all)]
     fn contact_jacobian_9_0<S: runtime::scalar::Scalar>(
         t: f64,
@@ -7057,7 +7057,7 @@ pub mod arm_0 {
         runtime::dual::split(&o, out);
     }
     #[inline(never)]
-    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
     #[allow(unused_variables, clippy::all)]
     fn cell_0_0<S: runtime::scalar::Scalar>(
         t: f64,

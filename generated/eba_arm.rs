@@ -1153,7 +1153,7 @@ pub fn part_0_tangent(
     runtime::dual::split(&o, out);
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn part_0_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -1471,7 +1471,7 @@ pub fn part_1_tangent(
     runtime::dual::split(&o, out);
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn part_1_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -2152,7 +2152,7 @@ pub fn part_2_tangent(
     runtime::dual::split(&o, out);
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn part_2_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -3456,7 +3456,7 @@ pub fn part_3_tangent(
     runtime::dual::split(&o, out);
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn part_3_0<S: runtime::scalar::Scalar>(
     t: f64,

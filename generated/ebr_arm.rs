@@ -1184,8 +1184,25 @@ pub fn cell_0_tangent(
     unsafe { cell_0_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o) };
     runtime::dual::split(&o, out);
 }
+/// `cell_0` of four links at once, in vector lanes.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,fma")]
+fn cell_0_x4(
+    q: &[[f64; 4]; 3],
+    qd: &[[f64; 4]; 3],
+    p: &[[f64; 4]; 15],
+    out: &mut [[f64; 4]; 87],
+) {
+    use runtime::x4::X4;
+    let (x, xd, px) = (
+        q.map(X4::from_array),
+        qd.map(X4::from_array),
+        p.map(X4::from_array),
+    );
+    cell_0_0::<X4>(0.0, &x, &xd, &[0.0; 3], &[0.0; 6], &px, out);
+}
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -1193,9 +1210,11 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     qd: &[S; 3],
     qdd: &[f64; 3],
     dir: &[f64; 6],
-    p: &[f64; 15],
-    out: &mut [S; 87],
+    p: &[S::Param; 15],
+    out: &mut [S::Store; 87],
 ) {
+    #[allow(unused_imports)]
+    use runtime::scalar::Scalar as _;
     let v1 = q[0] * q[0];
     let v3 = q[2] * q[2];
     let v5 = q[1] * q[1];
@@ -1227,10 +1246,10 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     let v26 = v17 - v18;
     let v27 = v23 + v24;
     let v28 = v5.mul_add(v9, v8);
-    let v31 = 0.5f64 * p[0];
-    let v32 = v10 * v31;
-    let v33 = v20 * v31;
-    let v34 = v26 * v31;
+    let v31 = p[0] * 0.5f64;
+    let v32 = v10.mul_p(v31);
+    let v33 = v20.mul_p(v31);
+    let v34 = v26.mul_p(v31);
     let v38 = q[2] * qd[1];
     let v39 = q[1].mul_add(qd[2], -v38);
     let v40 = v9 * v39;
@@ -1294,10 +1313,10 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     let v103 = v33.mul_add(v98, v102);
     let v104 = (-v32).mul_add(v87, v103);
     let v105 = (-v47).mul_add(v55, v104);
-    let v107 = 0.25f64 * p[0];
-    let v108 = v10 * v107;
-    let v109 = v20 * v107;
-    let v110 = v26 * v107;
+    let v107 = p[0] * 0.25f64;
+    let v108 = v10.mul_p(v107);
+    let v109 = v20.mul_p(v107);
+    let v110 = v26.mul_p(v107);
     let v111 = v53 * v109;
     let v112 = v47.mul_add(v110, -v111);
     let v113 = v61 * v110;
@@ -1316,7 +1335,7 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     let v126 = v109.mul_add(v98, v125);
     let v127 = (-v108).mul_add(v87, v126);
     let v128 = (-v47).mul_add(v112, v127);
-    let v130 = 0.5f64 * p[1];
+    let v130 = p[1] * 0.5f64;
     let v133 = q[1] * v9;
     let v134 = v11 * v41;
     let v135 = v134 - v133;
@@ -1368,462 +1387,100 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     let v181 = v108.mul_add(v171, -v180);
     let v182 = v108 * v170;
     let v183 = v109.mul_add(v169, -v182);
-    let v186 = qd[0] * p[5];
-    let v187 = q[0].mul_add(S::c(p[4]), v186);
-    let v189 = q[1] - p[6];
-    let v190 = qd[1] * p[5];
-    let v191 = S::c(p[4]).mul_add(v189, v190);
-    let v194 = qd[2] * p[8];
-    let v195 = q[2].mul_add(S::c(p[7]), v194);
-    out[0] = v10;
-    out[1] = v15;
-    out[2] = v19;
-    out[3] = v20;
-    out[4] = v21;
-    out[5] = v25;
-    out[6] = v26;
-    out[7] = v27;
-    out[8] = v28;
-    out[9] = v32;
-    out[10] = v33;
-    out[11] = v34;
-    out[12] = v55;
-    out[13] = v63;
-    out[14] = v65;
-    out[15] = v94;
-    out[16] = v101;
-    out[17] = v105;
-    out[18] = v61;
-    out[19] = v47;
-    out[20] = v53;
-    out[21] = v98;
-    out[22] = v87;
-    out[23] = v91;
-    out[24] = v108;
-    out[25] = v109;
-    out[26] = v110;
-    out[27] = v112;
-    out[28] = v114;
-    out[29] = v116;
-    out[30] = v120;
-    out[31] = v124;
-    out[32] = v128;
-    out[33] = v61;
-    out[34] = v47;
-    out[35] = v53;
-    out[36] = v98;
-    out[37] = v87;
-    out[38] = v91;
-    out[39] = v10;
-    out[40] = v20;
-    out[41] = v26;
-    out[42] = S::c(v130);
-    out[43] = S::c(p[2]);
-    out[44] = S::c(p[3]);
-    out[45] = v135;
-    out[46] = v136;
-    out[47] = v139;
-    out[48] = v141;
-    out[49] = v143;
-    out[50] = v145;
-    out[51] = v135;
-    out[52] = v136;
-    out[53] = v139;
-    out[54] = v147;
-    out[55] = v149;
-    out[56] = v151;
-    out[57] = v154;
-    out[58] = v155;
-    out[59] = v156;
-    out[60] = v158;
-    out[61] = v160;
-    out[62] = v162;
-    out[63] = v154;
-    out[64] = v155;
-    out[65] = v156;
-    out[66] = v164;
-    out[67] = v166;
-    out[68] = v168;
-    out[69] = v169;
-    out[70] = v170;
-    out[71] = v171;
-    out[72] = v173;
-    out[73] = v175;
-    out[74] = v177;
-    out[75] = v169;
-    out[76] = v170;
-    out[77] = v171;
-    out[78] = v179;
-    out[79] = v181;
-    out[80] = v183;
-    out[81] = v187;
-    out[82] = v191;
-    out[83] = v195;
-    out[84] = S::c(0f64);
-    out[85] = S::c(0f64);
-    out[86] = S::c(0f64);
-}
-/// Kernel `cell_0_x4`: 252 operations, four evaluations in vector lanes.
-#[cfg(target_arch = "x86_64")]
-#[inline(never)]
-#[allow(unused_variables, unused_parens, clippy::all)]
-#[target_feature(enable = "avx,fma")]
-fn cell_0_x4(
-    q: &[[f64; 4]; 3],
-    qd: &[[f64; 4]; 3],
-    p: &[[f64; 4]; 15],
-    out: &mut [[f64; 4]; 87],
-) {
-    use std::arch::x86_64::*;
-    let v1 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0]),
-        runtime::lanes::from_array(q[0]),
-    );
-    let v3 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[2]),
-        runtime::lanes::from_array(q[2]),
-    );
-    let v5 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1]),
-        runtime::lanes::from_array(q[1]),
-    );
-    let v6 = _mm256_add_pd(v1, v3);
-    let v7 = _mm256_add_pd(v6, v5);
-    let c: [[__m256d; 2]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
-        2,
-    >(v7);
-    let v8: __m256d = c[0][0];
-    let v9: __m256d = c[2][0];
-    let v13: __m256d = c[1][0];
-    let v41: __m256d = c[3][0];
-    let v73: __m256d = c[2][1];
-    let v75: __m256d = c[3][1];
-    let v83: __m256d = c[1][1];
-    let v10 = _mm256_fmadd_pd(v3, v9, v8);
-    let v11 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0]),
-        runtime::lanes::from_array(q[2]),
-    );
-    let v12 = _mm256_mul_pd(v11, v9);
-    let v14 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v13);
-    let v15 = _mm256_sub_pd(v12, v14);
-    let v16 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1]),
-        runtime::lanes::from_array(q[2]),
-    );
-    let v17 = _mm256_mul_pd(v16, v9);
-    let v18 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v13);
-    let v19 = _mm256_add_pd(v17, v18);
-    let v20 = _mm256_add_pd(v12, v14);
-    let v21 = _mm256_fmadd_pd(v1, v9, v8);
-    let v22 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0]),
-        runtime::lanes::from_array(q[1]),
-    );
-    let v23 = _mm256_mul_pd(v22, v9);
-    let v24 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v13);
-    let v25 = _mm256_sub_pd(v23, v24);
-    let v26 = _mm256_sub_pd(v17, v18);
-    let v27 = _mm256_add_pd(v23, v24);
-    let v28 = _mm256_fmadd_pd(v5, v9, v8);
-    let v31 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[0]));
-    let v32 = _mm256_mul_pd(v31, v10);
-    let v33 = _mm256_mul_pd(v31, v20);
-    let v34 = _mm256_mul_pd(v31, v26);
-    let v38 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[2]),
-        runtime::lanes::from_array(qd[1]),
-    );
-    let v39 = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[1]),
-        runtime::lanes::from_array(qd[2]),
-        v38,
-    );
-    let v40 = _mm256_mul_pd(v9, v39);
-    let v42 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0]),
-        runtime::lanes::from_array(qd[0]),
-    );
-    let v43 = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[2]),
-        runtime::lanes::from_array(qd[2]),
-        v42,
-    );
-    let v44 = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[1]),
-        runtime::lanes::from_array(qd[1]),
-        v43,
-    );
-    let v45 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v41);
-    let v46 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v13, v40);
-    let v47 = _mm256_fmadd_pd(v45, v44, v46);
-    let v48 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0]),
-        runtime::lanes::from_array(qd[2]),
-    );
-    let v49 = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[2]),
-        runtime::lanes::from_array(qd[0]),
-        v48,
-    );
-    let v50 = _mm256_mul_pd(v9, v49);
-    let v51 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v41);
-    let v52 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v13, v50);
-    let v53 = _mm256_fmadd_pd(v51, v44, v52);
-    let v54 = _mm256_mul_pd(v53, v33);
-    let v55 = _mm256_fmsub_pd(v47, v34, v54);
-    let v56 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1]),
-        runtime::lanes::from_array(qd[0]),
-    );
-    let v57 = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[0]),
-        runtime::lanes::from_array(qd[1]),
-        v56,
-    );
-    let v58 = _mm256_mul_pd(v9, v57);
-    let v59 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v41);
-    let v60 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v13, v58);
-    let v61 = _mm256_fmadd_pd(v59, v44, v60);
-    let v62 = _mm256_mul_pd(v61, v34);
-    let v63 = _mm256_fmsub_pd(v53, v32, v62);
-    let v64 = _mm256_mul_pd(v47, v32);
-    let v65 = _mm256_fmsub_pd(v61, v33, v64);
-    let v67 = _mm256_mul_pd(_mm256_set1_pd(2f64), runtime::lanes::from_array(q[2]));
-    let v68 = _mm256_mul_pd(_mm256_set1_pd(2f64), runtime::lanes::from_array(q[0]));
-    let v69 = _mm256_mul_pd(v68, runtime::lanes::from_array(qd[0]));
-    let v70 = _mm256_mul_pd(_mm256_set1_pd(2f64), runtime::lanes::from_array(q[1]));
-    let v71 = _mm256_fmadd_pd(v67, runtime::lanes::from_array(qd[2]), v69);
-    let v72 = _mm256_fmadd_pd(v70, runtime::lanes::from_array(qd[1]), v71);
-    let v74 = _mm256_mul_pd(v72, v73);
-    let v76 = _mm256_mul_pd(v72, v75);
-    let v77 = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[1]),
-        runtime::lanes::from_array(qd[1]),
-    );
-    let v78 = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[0]),
-        runtime::lanes::from_array(qd[0]),
-        v77,
-    );
-    let v79 = _mm256_fmadd_pd(
-        runtime::lanes::from_array(qd[2]),
-        runtime::lanes::from_array(qd[2]),
-        v78,
-    );
-    let v80 = _mm256_mul_pd(v41, v79);
-    let v81 = _mm256_fmadd_pd(v44, v76, v80);
-    let v82 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v81);
-    let v84 = _mm256_mul_pd(v72, v83);
-    let v85 = _mm256_fmadd_pd(v41, v44, v84);
-    let v86 = _mm256_fmadd_pd(v39, v74, v82);
-    let v87 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v85, v86);
-    let v88 = _mm256_mul_pd(v47, v65);
-    let v89 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v81);
-    let v90 = _mm256_fmadd_pd(v49, v74, v89);
-    let v91 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v85, v90);
-    let v92 = _mm256_fmadd_pd(v34, v87, v88);
-    let v93 = _mm256_fnmadd_pd(v33, v91, v92);
-    let v94 = _mm256_fnmadd_pd(v53, v63, v93);
-    let v95 = _mm256_mul_pd(v53, v55);
-    let v96 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v81);
-    let v97 = _mm256_fmadd_pd(v57, v74, v96);
-    let v98 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v85, v97);
-    let v99 = _mm256_fmadd_pd(v32, v91, v95);
-    let v100 = _mm256_fnmadd_pd(v34, v98, v99);
-    let v101 = _mm256_fnmadd_pd(v61, v65, v100);
-    let v102 = _mm256_mul_pd(v61, v63);
-    let v103 = _mm256_fmadd_pd(v33, v98, v102);
-    let v104 = _mm256_fnmadd_pd(v32, v87, v103);
-    let v105 = _mm256_fnmadd_pd(v47, v55, v104);
-    let v107 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(p[0]));
-    let v108 = _mm256_mul_pd(v107, v10);
-    let v109 = _mm256_mul_pd(v107, v20);
-    let v110 = _mm256_mul_pd(v107, v26);
-    let v111 = _mm256_mul_pd(v53, v109);
-    let v112 = _mm256_fmsub_pd(v47, v110, v111);
-    let v113 = _mm256_mul_pd(v61, v110);
-    let v114 = _mm256_fmsub_pd(v53, v108, v113);
-    let v115 = _mm256_mul_pd(v47, v108);
-    let v116 = _mm256_fmsub_pd(v61, v109, v115);
-    let v117 = _mm256_mul_pd(v47, v116);
-    let v118 = _mm256_fmadd_pd(v110, v87, v117);
-    let v119 = _mm256_fnmadd_pd(v109, v91, v118);
-    let v120 = _mm256_fnmadd_pd(v53, v114, v119);
-    let v121 = _mm256_mul_pd(v53, v112);
-    let v122 = _mm256_fmadd_pd(v108, v91, v121);
-    let v123 = _mm256_fnmadd_pd(v110, v98, v122);
-    let v124 = _mm256_fnmadd_pd(v61, v116, v123);
-    let v125 = _mm256_mul_pd(v61, v114);
-    let v126 = _mm256_fmadd_pd(v109, v98, v125);
-    let v127 = _mm256_fnmadd_pd(v108, v87, v126);
-    let v128 = _mm256_fnmadd_pd(v47, v112, v127);
-    let v130 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[1]));
-    let v133 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v9);
-    let v134 = _mm256_mul_pd(v11, v41);
-    let v135 = _mm256_sub_pd(v134, v133);
-    let v136 = _mm256_fmadd_pd(v1, v41, v13);
-    let v137 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v9);
-    let v138 = _mm256_mul_pd(v22, v41);
-    let v139 = _mm256_add_pd(v137, v138);
-    let v140 = _mm256_mul_pd(v33, v139);
-    let v141 = _mm256_fmsub_pd(v34, v136, v140);
-    let v142 = _mm256_mul_pd(v34, v135);
-    let v143 = _mm256_fmsub_pd(v32, v139, v142);
-    let v144 = _mm256_mul_pd(v32, v136);
-    let v145 = _mm256_fmsub_pd(v33, v135, v144);
-    let v146 = _mm256_mul_pd(v109, v139);
-    let v147 = _mm256_fmsub_pd(v110, v136, v146);
-    let v148 = _mm256_mul_pd(v110, v135);
-    let v149 = _mm256_fmsub_pd(v108, v139, v148);
-    let v150 = _mm256_mul_pd(v108, v136);
-    let v151 = _mm256_fmsub_pd(v109, v135, v150);
-    let v152 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v9);
-    let v153 = _mm256_mul_pd(v16, v41);
-    let v154 = _mm256_add_pd(v152, v153);
-    let v155 = _mm256_sub_pd(v138, v137);
-    let v156 = _mm256_fmadd_pd(v5, v41, v13);
-    let v157 = _mm256_mul_pd(v33, v156);
-    let v158 = _mm256_fmsub_pd(v34, v155, v157);
-    let v159 = _mm256_mul_pd(v34, v154);
-    let v160 = _mm256_fmsub_pd(v32, v156, v159);
-    let v161 = _mm256_mul_pd(v32, v155);
-    let v162 = _mm256_fmsub_pd(v33, v154, v161);
-    let v163 = _mm256_mul_pd(v109, v156);
-    let v164 = _mm256_fmsub_pd(v110, v155, v163);
-    let v165 = _mm256_mul_pd(v110, v154);
-    let v166 = _mm256_fmsub_pd(v108, v156, v165);
-    let v167 = _mm256_mul_pd(v108, v155);
-    let v168 = _mm256_fmsub_pd(v109, v154, v167);
-    let v169 = _mm256_fmadd_pd(v3, v41, v13);
-    let v170 = _mm256_add_pd(v133, v134);
-    let v171 = _mm256_sub_pd(v153, v152);
-    let v172 = _mm256_mul_pd(v33, v171);
-    let v173 = _mm256_fmsub_pd(v34, v170, v172);
-    let v174 = _mm256_mul_pd(v34, v169);
-    let v175 = _mm256_fmsub_pd(v32, v171, v174);
-    let v176 = _mm256_mul_pd(v32, v170);
-    let v177 = _mm256_fmsub_pd(v33, v169, v176);
-    let v178 = _mm256_mul_pd(v109, v171);
-    let v179 = _mm256_fmsub_pd(v110, v170, v178);
-    let v180 = _mm256_mul_pd(v110, v169);
-    let v181 = _mm256_fmsub_pd(v108, v171, v180);
-    let v182 = _mm256_mul_pd(v108, v170);
-    let v183 = _mm256_fmsub_pd(v109, v169, v182);
-    let v186 = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[0]),
-        runtime::lanes::from_array(p[5]),
-    );
-    let v187 = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[0]),
-        runtime::lanes::from_array(p[4]),
-        v186,
-    );
-    let v189 = _mm256_sub_pd(
-        runtime::lanes::from_array(q[1]),
-        runtime::lanes::from_array(p[6]),
-    );
-    let v190 = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[1]),
-        runtime::lanes::from_array(p[5]),
-    );
-    let v191 = _mm256_fmadd_pd(runtime::lanes::from_array(p[4]), v189, v190);
-    let v194 = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[2]),
-        runtime::lanes::from_array(p[8]),
-    );
-    let v195 = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[2]),
-        runtime::lanes::from_array(p[7]),
-        v194,
-    );
-    out[0] = runtime::lanes::to_array(v10);
-    out[1] = runtime::lanes::to_array(v15);
-    out[2] = runtime::lanes::to_array(v19);
-    out[3] = runtime::lanes::to_array(v20);
-    out[4] = runtime::lanes::to_array(v21);
-    out[5] = runtime::lanes::to_array(v25);
-    out[6] = runtime::lanes::to_array(v26);
-    out[7] = runtime::lanes::to_array(v27);
-    out[8] = runtime::lanes::to_array(v28);
-    out[9] = runtime::lanes::to_array(v32);
-    out[10] = runtime::lanes::to_array(v33);
-    out[11] = runtime::lanes::to_array(v34);
-    out[12] = runtime::lanes::to_array(v55);
-    out[13] = runtime::lanes::to_array(v63);
-    out[14] = runtime::lanes::to_array(v65);
-    out[15] = runtime::lanes::to_array(v94);
-    out[16] = runtime::lanes::to_array(v101);
-    out[17] = runtime::lanes::to_array(v105);
-    out[18] = runtime::lanes::to_array(v61);
-    out[19] = runtime::lanes::to_array(v47);
-    out[20] = runtime::lanes::to_array(v53);
-    out[21] = runtime::lanes::to_array(v98);
-    out[22] = runtime::lanes::to_array(v87);
-    out[23] = runtime::lanes::to_array(v91);
-    out[24] = runtime::lanes::to_array(v108);
-    out[25] = runtime::lanes::to_array(v109);
-    out[26] = runtime::lanes::to_array(v110);
-    out[27] = runtime::lanes::to_array(v112);
-    out[28] = runtime::lanes::to_array(v114);
-    out[29] = runtime::lanes::to_array(v116);
-    out[30] = runtime::lanes::to_array(v120);
-    out[31] = runtime::lanes::to_array(v124);
-    out[32] = runtime::lanes::to_array(v128);
-    out[33] = runtime::lanes::to_array(v61);
-    out[34] = runtime::lanes::to_array(v47);
-    out[35] = runtime::lanes::to_array(v53);
-    out[36] = runtime::lanes::to_array(v98);
-    out[37] = runtime::lanes::to_array(v87);
-    out[38] = runtime::lanes::to_array(v91);
-    out[39] = runtime::lanes::to_array(v10);
-    out[40] = runtime::lanes::to_array(v20);
-    out[41] = runtime::lanes::to_array(v26);
-    out[42] = runtime::lanes::to_array(v130);
-    out[43] = runtime::lanes::to_array(runtime::lanes::from_array(p[2]));
-    out[44] = runtime::lanes::to_array(runtime::lanes::from_array(p[3]));
-    out[45] = runtime::lanes::to_array(v135);
-    out[46] = runtime::lanes::to_array(v136);
-    out[47] = runtime::lanes::to_array(v139);
-    out[48] = runtime::lanes::to_array(v141);
-    out[49] = runtime::lanes::to_array(v143);
-    out[50] = runtime::lanes::to_array(v145);
-    out[51] = runtime::lanes::to_array(v135);
-    out[52] = runtime::lanes::to_array(v136);
-    out[53] = runtime::lanes::to_array(v139);
-    out[54] = runtime::lanes::to_array(v147);
-    out[55] = runtime::lanes::to_array(v149);
-    out[56] = runtime::lanes::to_array(v151);
-    out[57] = runtime::lanes::to_array(v154);
-    out[58] = runtime::lanes::to_array(v155);
-    out[59] = runtime::lanes::to_array(v156);
-    out[60] = runtime::lanes::to_array(v158);
-    out[61] = runtime::lanes::to_array(v160);
-    out[62] = runtime::lanes::to_array(v162);
-    out[63] = runtime::lanes::to_array(v154);
-    out[64] = runtime::lanes::to_array(v155);
-    out[65] = runtime::lanes::to_array(v156);
-    out[66] = runtime::lanes::to_array(v164);
-    out[67] = runtime::lanes::to_array(v166);
-    out[68] = runtime::lanes::to_array(v168);
-    out[69] = runtime::lanes::to_array(v169);
-    out[70] = runtime::lanes::to_array(v170);
-    out[71] = runtime::lanes::to_array(v171);
-    out[72] = runtime::lanes::to_array(v173);
-    out[73] = runtime::lanes::to_array(v175);
-    out[74] = runtime::lanes::to_array(v177);
-    out[75] = runtime::lanes::to_array(v169);
-    out[76] = runtime::lanes::to_array(v170);
-    out[77] = runtime::lanes::to_array(v171);
-    out[78] = runtime::lanes::to_array(v179);
-    out[79] = runtime::lanes::to_array(v181);
-    out[80] = runtime::lanes::to_array(v183);
-    out[81] = runtime::lanes::to_array(v187);
-    out[82] = runtime::lanes::to_array(v191);
-    out[83] = runtime::lanes::to_array(v195);
-    out[84] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[85] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[86] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    let v186 = qd[0].mul_p(p[5]);
+    let v187 = q[0].mul_add(S::from_param(p[4]), v186);
+    let v189 = q[1].sub_p(p[6]);
+    let v190 = qd[1].mul_p(p[5]);
+    let v191 = S::from_param(p[4]).mul_add(v189, v190);
+    let v194 = qd[2].mul_p(p[8]);
+    let v195 = q[2].mul_add(S::from_param(p[7]), v194);
+    out[0] = v10.store();
+    out[1] = v15.store();
+    out[2] = v19.store();
+    out[3] = v20.store();
+    out[4] = v21.store();
+    out[5] = v25.store();
+    out[6] = v26.store();
+    out[7] = v27.store();
+    out[8] = v28.store();
+    out[9] = v32.store();
+    out[10] = v33.store();
+    out[11] = v34.store();
+    out[12] = v55.store();
+    out[13] = v63.store();
+    out[14] = v65.store();
+    out[15] = v94.store();
+    out[16] = v101.store();
+    out[17] = v105.store();
+    out[18] = v61.store();
+    out[19] = v47.store();
+    out[20] = v53.store();
+    out[21] = v98.store();
+    out[22] = v87.store();
+    out[23] = v91.store();
+    out[24] = v108.store();
+    out[25] = v109.store();
+    out[26] = v110.store();
+    out[27] = v112.store();
+    out[28] = v114.store();
+    out[29] = v116.store();
+    out[30] = v120.store();
+    out[31] = v124.store();
+    out[32] = v128.store();
+    out[33] = v61.store();
+    out[34] = v47.store();
+    out[35] = v53.store();
+    out[36] = v98.store();
+    out[37] = v87.store();
+    out[38] = v91.store();
+    out[39] = v10.store();
+    out[40] = v20.store();
+    out[41] = v26.store();
+    out[42] = S::from_param(v130).store();
+    out[43] = S::from_param(p[2]).store();
+    out[44] = S::from_param(p[3]).store();
+    out[45] = v135.store();
+    out[46] = v136.store();
+    out[47] = v139.store();
+    out[48] = v141.store();
+    out[49] = v143.store();
+    out[50] = v145.store();
+    out[51] = v135.store();
+    out[52] = v136.store();
+    out[53] = v139.store();
+    out[54] = v147.store();
+    out[55] = v149.store();
+    out[56] = v151.store();
+    out[57] = v154.store();
+    out[58] = v155.store();
+    out[59] = v156.store();
+    out[60] = v158.store();
+    out[61] = v160.store();
+    out[62] = v162.store();
+    out[63] = v154.store();
+    out[64] = v155.store();
+    out[65] = v156.store();
+    out[66] = v164.store();
+    out[67] = v166.store();
+    out[68] = v168.store();
+    out[69] = v169.store();
+    out[70] = v170.store();
+    out[71] = v171.store();
+    out[72] = v173.store();
+    out[73] = v175.store();
+    out[74] = v177.store();
+    out[75] = v169.store();
+    out[76] = v170.store();
+    out[77] = v171.store();
+    out[78] = v179.store();
+    out[79] = v181.store();
+    out[80] = v183.store();
+    out[81] = v187.store();
+    out[82] = v191.store();
+    out[83] = v195.store();
+    out[84] = S::c(0f64).store();
+    out[85] = S::c(0f64).store();
+    out[86] = S::c(0f64).store();
 }
 /// Kernel `cell_1_pose`: 3 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
@@ -1925,71 +1582,8 @@ pub fn cell_1_tangent(
     unsafe { cell_1_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o) };
     runtime::dual::split(&o, out);
 }
-#[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-#[allow(unused_variables, clippy::all)]
-fn cell_1_0<S: runtime::scalar::Scalar>(
-    t: f64,
-    q: &[S; 0],
-    qd: &[S; 0],
-    qdd: &[f64; 0],
-    dir: &[f64; 0],
-    p: &[f64; 15],
-    out: &mut [S; 45],
-) {
-    let v4 = 0.5f64 * p[0];
-    let v6 = 0.25f64 * p[0];
-    let v8 = 0.5f64 * p[1];
-    out[0] = S::c(1f64);
-    out[1] = S::c(0f64);
-    out[2] = S::c(0f64);
-    out[3] = S::c(0f64);
-    out[4] = S::c(1f64);
-    out[5] = S::c(0f64);
-    out[6] = S::c(0f64);
-    out[7] = S::c(0f64);
-    out[8] = S::c(1f64);
-    out[9] = S::c(v4);
-    out[10] = S::c(0f64);
-    out[11] = S::c(0f64);
-    out[12] = S::c(0f64);
-    out[13] = S::c(0f64);
-    out[14] = S::c(0f64);
-    out[15] = S::c(0f64);
-    out[16] = S::c(0f64);
-    out[17] = S::c(0f64);
-    out[18] = S::c(0f64);
-    out[19] = S::c(0f64);
-    out[20] = S::c(0f64);
-    out[21] = S::c(0f64);
-    out[22] = S::c(0f64);
-    out[23] = S::c(0f64);
-    out[24] = S::c(v6);
-    out[25] = S::c(0f64);
-    out[26] = S::c(0f64);
-    out[27] = S::c(0f64);
-    out[28] = S::c(0f64);
-    out[29] = S::c(0f64);
-    out[30] = S::c(0f64);
-    out[31] = S::c(0f64);
-    out[32] = S::c(0f64);
-    out[33] = S::c(0f64);
-    out[34] = S::c(0f64);
-    out[35] = S::c(0f64);
-    out[36] = S::c(0f64);
-    out[37] = S::c(0f64);
-    out[38] = S::c(0f64);
-    out[39] = S::c(1f64);
-    out[40] = S::c(0f64);
-    out[41] = S::c(0f64);
-    out[42] = S::c(v8);
-    out[43] = S::c(p[2]);
-    out[44] = S::c(p[3]);
-}
-/// Kernel `cell_1_x4`: 3 operations, four evaluations in vector lanes.
+/// `cell_1` of four links at once, in vector lanes.
 #[cfg(target_arch = "x86_64")]
-#[inline(never)]
-#[allow(unused_variables, unused_parens, clippy::all)]
 #[target_feature(enable = "avx,fma")]
 fn cell_1_x4(
     q: &[[f64; 4]; 0],
@@ -1997,55 +1591,76 @@ fn cell_1_x4(
     p: &[[f64; 4]; 15],
     out: &mut [[f64; 4]; 45],
 ) {
-    use std::arch::x86_64::*;
-    let v4 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[0]));
-    let v6 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(p[0]));
-    let v8 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[1]));
-    out[0] = runtime::lanes::to_array(_mm256_set1_pd(1f64));
-    out[1] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[2] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[3] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[4] = runtime::lanes::to_array(_mm256_set1_pd(1f64));
-    out[5] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[6] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[7] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[8] = runtime::lanes::to_array(_mm256_set1_pd(1f64));
-    out[9] = runtime::lanes::to_array(v4);
-    out[10] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[11] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[12] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[13] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[14] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[15] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[16] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[17] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[18] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[19] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[20] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[21] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[22] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[23] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[24] = runtime::lanes::to_array(v6);
-    out[25] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[26] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[27] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[28] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[29] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[30] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[31] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[32] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[33] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[34] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[35] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[36] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[37] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[38] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[39] = runtime::lanes::to_array(_mm256_set1_pd(1f64));
-    out[40] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[41] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[42] = runtime::lanes::to_array(v8);
-    out[43] = runtime::lanes::to_array(runtime::lanes::from_array(p[2]));
-    out[44] = runtime::lanes::to_array(runtime::lanes::from_array(p[3]));
+    use runtime::x4::X4;
+    let (x, xd, px) = (
+        q.map(X4::from_array),
+        qd.map(X4::from_array),
+        p.map(X4::from_array),
+    );
+    cell_1_0::<X4>(0.0, &x, &xd, &[0.0; 0], &[0.0; 0], &px, out);
+}
+#[inline(never)]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
+#[allow(unused_variables, clippy::all)]
+fn cell_1_0<S: runtime::scalar::Scalar>(
+    t: f64,
+    q: &[S; 0],
+    qd: &[S; 0],
+    qdd: &[f64; 0],
+    dir: &[f64; 0],
+    p: &[S::Param; 15],
+    out: &mut [S::Store; 45],
+) {
+    #[allow(unused_imports)]
+    use runtime::scalar::Scalar as _;
+    let v4 = p[0] * 0.5f64;
+    let v6 = p[0] * 0.25f64;
+    let v8 = p[1] * 0.5f64;
+    out[0] = S::c(1f64).store();
+    out[1] = S::c(0f64).store();
+    out[2] = S::c(0f64).store();
+    out[3] = S::c(0f64).store();
+    out[4] = S::c(1f64).store();
+    out[5] = S::c(0f64).store();
+    out[6] = S::c(0f64).store();
+    out[7] = S::c(0f64).store();
+    out[8] = S::c(1f64).store();
+    out[9] = S::from_param(v4).store();
+    out[10] = S::c(0f64).store();
+    out[11] = S::c(0f64).store();
+    out[12] = S::c(0f64).store();
+    out[13] = S::c(0f64).store();
+    out[14] = S::c(0f64).store();
+    out[15] = S::c(0f64).store();
+    out[16] = S::c(0f64).store();
+    out[17] = S::c(0f64).store();
+    out[18] = S::c(0f64).store();
+    out[19] = S::c(0f64).store();
+    out[20] = S::c(0f64).store();
+    out[21] = S::c(0f64).store();
+    out[22] = S::c(0f64).store();
+    out[23] = S::c(0f64).store();
+    out[24] = S::from_param(v6).store();
+    out[25] = S::c(0f64).store();
+    out[26] = S::c(0f64).store();
+    out[27] = S::c(0f64).store();
+    out[28] = S::c(0f64).store();
+    out[29] = S::c(0f64).store();
+    out[30] = S::c(0f64).store();
+    out[31] = S::c(0f64).store();
+    out[32] = S::c(0f64).store();
+    out[33] = S::c(0f64).store();
+    out[34] = S::c(0f64).store();
+    out[35] = S::c(0f64).store();
+    out[36] = S::c(0f64).store();
+    out[37] = S::c(0f64).store();
+    out[38] = S::c(0f64).store();
+    out[39] = S::c(1f64).store();
+    out[40] = S::c(0f64).store();
+    out[41] = S::c(0f64).store();
+    out[42] = S::from_param(v8).store();
+    out[43] = S::from_param(p[2]).store();
+    out[44] = S::from_param(p[3]).store();
 }
 fn cell_0_linked(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
     cell_0(

@@ -2926,7 +2926,7 @@ pub fn contact(
     unsafe { contact_0::<f64>(t, q, qd, qdd, dir, p, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -3803,7 +3803,7 @@ pub fn contact_jacobian_0(
     unsafe { contact_jacobian_0_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_0_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -4075,7 +4075,7 @@ pub fn contact_jacobian_1(
     unsafe { contact_jacobian_1_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_1_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -4361,7 +4361,7 @@ pub fn contact_jacobian_2(
     unsafe { contact_jacobian_2_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_2_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -4656,7 +4656,7 @@ pub fn contact_jacobian_3(
     unsafe { contact_jacobian_3_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_3_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -4960,7 +4960,7 @@ pub fn contact_jacobian_4(
     unsafe { contact_jacobian_4_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_4_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -5273,7 +5273,7 @@ pub fn contact_jacobian_5(
     unsafe { contact_jacobian_5_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_5_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -5595,7 +5595,7 @@ pub fn contact_jacobian_6(
     unsafe { contact_jacobian_6_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_6_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -5926,7 +5926,7 @@ pub fn contact_jacobian_7(
     unsafe { contact_jacobian_7_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_7_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -6266,7 +6266,7 @@ pub fn contact_jacobian_8(
     unsafe { contact_jacobian_8_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_8_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -6615,7 +6615,7 @@ pub fn contact_jacobian_9(
     unsafe { contact_jacobian_9_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_9_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -7328,7 +7328,7 @@ pub fn cell_0_tangent(
     runtime::dual::split(&o, out);
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0<S: runtime::scalar::Scalar>(
     t: f64,

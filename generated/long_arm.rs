@@ -2682,7 +2682,7 @@ pub fn cell_0_tangent(
     runtime::dual::split(&o, out);
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0<S: runtime::scalar::Scalar>(
     t: f64,

@@ -1821,8 +1821,25 @@ pub fn cell_0_tangent(
     unsafe { cell_0_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o) };
     runtime::dual::split(&o, out);
 }
+/// `cell_0` of four links at once, in vector lanes.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,fma")]
+fn cell_0_x4(
+    q: &[[f64; 4]; 6],
+    qd: &[[f64; 4]; 6],
+    p: &[[f64; 4]; 15],
+    out: &mut [[f64; 4]; 129],
+) {
+    use runtime::x4::X4;
+    let (x, xd, px) = (
+        q.map(X4::from_array),
+        qd.map(X4::from_array),
+        p.map(X4::from_array),
+    );
+    cell_0_0::<X4>(0.0, &x, &xd, &[0.0; 6], &[0.0; 12], &px, out);
+}
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -1830,9 +1847,11 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     qd: &[S; 6],
     qdd: &[f64; 6],
     dir: &[f64; 12],
-    p: &[f64; 15],
-    out: &mut [S; 129],
+    p: &[S::Param; 15],
+    out: &mut [S::Store; 129],
 ) {
+    #[allow(unused_imports)]
+    use runtime::scalar::Scalar as _;
     let v1 = q[0] * q[0];
     let v3 = v1 * 0.25f64;
     let v5 = q[1] * q[1];
@@ -1877,7 +1896,7 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     let v36 = v25 - v27;
     let v37 = v32 + v34;
     let v38 = v6.mul_add(v13, v12);
-    let v41 = q[3] + p[0];
+    let v41 = q[3].add_p(p[0]);
     let v42 = v41 * 0.5f64;
     let v45 = v23 * q[4];
     let v46 = v15.mul_add(q[5], -v45);
@@ -2162,11 +2181,11 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     let v342 = v286 * q[2];
     let v343 = v15 * v289;
     let v344 = v342.mul_add(v283, -v343);
-    let v346 = 0.5f64 * p[1];
-    let v348 = 0.25f64 * p[3];
+    let v346 = p[1] * 0.5f64;
+    let v348 = p[3] * 0.25f64;
     let v350 = p[2] - v348;
-    let v352 = 0.125f64.mul_add(v350, v348);
-    let v353 = 0.5f64 * p[3];
+    let v352 = S::pc(0.125f64).mul_add(v350, v348);
+    let v353 = p[3] * 0.5f64;
     let v354 = v23 * v13;
     let v355 = q[0] * 0.125f64;
     let v356 = v355 * q[2];
@@ -2326,822 +2345,135 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     let v512 = v500 + v501;
     let v513 = v508 - v507;
     let v514 = v233.mul_add(v510, S::c(0.25f64));
-    out[0] = v14;
-    out[1] = v22;
-    out[2] = v28;
-    out[3] = v29;
-    out[4] = v30;
-    out[5] = v35;
-    out[6] = v36;
-    out[7] = v37;
-    out[8] = v38;
-    out[9] = v55;
-    out[10] = v62;
-    out[11] = v69;
-    out[12] = v105;
-    out[13] = v120;
-    out[14] = v135;
-    out[15] = v166;
-    out[16] = v178;
-    out[17] = v190;
-    out[18] = v199;
-    out[19] = v205;
-    out[20] = v211;
-    out[21] = v225;
-    out[22] = v228;
-    out[23] = v231;
-    out[24] = v235;
-    out[25] = v237;
-    out[26] = v239;
-    out[27] = v246;
-    out[28] = v251;
-    out[29] = v256;
-    out[30] = v267;
-    out[31] = v274;
-    out[32] = v281;
-    out[33] = v298;
-    out[34] = v304;
-    out[35] = v310;
-    out[36] = v329;
-    out[37] = v332;
-    out[38] = v335;
-    out[39] = v338;
-    out[40] = v341;
-    out[41] = v344;
-    out[42] = S::c(v346);
-    out[43] = S::c(v352);
-    out[44] = S::c(v353);
-    out[45] = v358;
-    out[46] = v361;
-    out[47] = v365;
-    out[48] = v374;
-    out[49] = v380;
-    out[50] = v387;
-    out[51] = v393;
-    out[52] = v396;
-    out[53] = v400;
-    out[54] = v405;
-    out[55] = v408;
-    out[56] = v412;
-    out[57] = v416;
-    out[58] = v417;
-    out[59] = v419;
-    out[60] = v427;
-    out[61] = v432;
-    out[62] = v437;
-    out[63] = v442;
-    out[64] = v443;
-    out[65] = v445;
-    out[66] = v450;
-    out[67] = v453;
-    out[68] = v456;
-    out[69] = v458;
-    out[70] = v459;
-    out[71] = v460;
-    out[72] = v467;
-    out[73] = v472;
-    out[74] = v477;
-    out[75] = v479;
-    out[76] = v480;
-    out[77] = v481;
-    out[78] = v485;
-    out[79] = v488;
-    out[80] = v491;
-    out[81] = S::c(0f64);
-    out[82] = S::c(0f64);
-    out[83] = S::c(0f64);
-    out[84] = v495;
-    out[85] = v459;
-    out[86] = v460;
-    out[87] = S::c(0f64);
-    out[88] = S::c(0f64);
-    out[89] = S::c(0f64);
-    out[90] = v496;
-    out[91] = v499;
-    out[92] = v502;
-    out[93] = S::c(0f64);
-    out[94] = S::c(0f64);
-    out[95] = S::c(0f64);
-    out[96] = v358;
-    out[97] = v504;
-    out[98] = v365;
-    out[99] = S::c(0f64);
-    out[100] = S::c(0f64);
-    out[101] = S::c(0f64);
-    out[102] = v505;
-    out[103] = v506;
-    out[104] = v509;
-    out[105] = S::c(0f64);
-    out[106] = S::c(0f64);
-    out[107] = S::c(0f64);
-    out[108] = v416;
-    out[109] = v417;
-    out[110] = v511;
-    out[111] = S::c(0f64);
-    out[112] = S::c(0f64);
-    out[113] = S::c(0f64);
-    out[114] = v512;
-    out[115] = v513;
-    out[116] = v514;
-    out[117] = S::c(0f64);
-    out[118] = S::c(0f64);
-    out[119] = S::c(0f64);
-    out[120] = S::c(0f64);
-    out[121] = S::c(0f64);
-    out[122] = S::c(0f64);
-    out[123] = S::c(0f64);
-    out[124] = S::c(0f64);
-    out[125] = S::c(0f64);
-    out[126] = S::c(0f64);
-    out[127] = S::c(0f64);
-    out[128] = S::c(0f64);
-}
-/// Kernel `cell_0_x4`: 731 operations, four evaluations in vector lanes.
-#[cfg(target_arch = "x86_64")]
-#[inline(never)]
-#[allow(unused_variables, unused_parens, clippy::all)]
-#[target_feature(enable = "avx,fma")]
-fn cell_0_x4(
-    q: &[[f64; 4]; 6],
-    qd: &[[f64; 4]; 6],
-    p: &[[f64; 4]; 15],
-    out: &mut [[f64; 4]; 129],
-) {
-    use std::arch::x86_64::*;
-    let v1 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0]),
-        runtime::lanes::from_array(q[0]),
-    );
-    let v3 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v1);
-    let v5 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1]),
-        runtime::lanes::from_array(q[1]),
-    );
-    let v6 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v5);
-    let v8 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[2]),
-        runtime::lanes::from_array(q[2]),
-    );
-    let v9 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v8);
-    let v10 = _mm256_add_pd(v3, v6);
-    let v11 = _mm256_add_pd(v10, v9);
-    let c: [[__m256d; 3]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
-        3,
-    >(v11);
-    let v12: __m256d = c[0][0];
-    let v13: __m256d = c[2][0];
-    let v18: __m256d = c[1][0];
-    let v47: __m256d = c[3][0];
-    let v78: __m256d = c[2][1];
-    let v88: __m256d = c[3][1];
-    let v144: __m256d = c[2][2];
-    let v152: __m256d = c[3][2];
-    let v220: __m256d = c[1][1];
-    let v233: __m256d = c[4][0];
-    let v241: __m256d = c[4][1];
-    let v260: __m256d = c[4][2];
-    let v14 = _mm256_fmadd_pd(v9, v13, v12);
-    let v15 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[0]));
-    let v16 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[2]));
-    let v17 = _mm256_mul_pd(v16, v13);
-    let v20 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[1]));
-    let v21 = _mm256_mul_pd(v20, v18);
-    let v22 = _mm256_sub_pd(v17, v21);
-    let v23 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[1]));
-    let v24 = _mm256_mul_pd(v23, runtime::lanes::from_array(q[2]));
-    let v25 = _mm256_mul_pd(v24, v13);
-    let v26 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[0]));
-    let v27 = _mm256_mul_pd(v26, v18);
-    let v28 = _mm256_add_pd(v25, v27);
-    let v29 = _mm256_add_pd(v17, v21);
-    let v30 = _mm256_fmadd_pd(v3, v13, v12);
-    let v31 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[1]));
-    let v32 = _mm256_mul_pd(v31, v13);
-    let v33 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[2]));
-    let v34 = _mm256_mul_pd(v33, v18);
-    let v35 = _mm256_sub_pd(v32, v34);
-    let v36 = _mm256_sub_pd(v25, v27);
-    let v37 = _mm256_add_pd(v32, v34);
-    let v38 = _mm256_fmadd_pd(v6, v13, v12);
-    let v41 = _mm256_add_pd(
-        runtime::lanes::from_array(q[3]),
-        runtime::lanes::from_array(p[0]),
-    );
-    let v42 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v41);
-    let v45 = _mm256_mul_pd(v23, runtime::lanes::from_array(q[4]));
-    let v46 = _mm256_fmsub_pd(v15, runtime::lanes::from_array(q[5]), v45);
-    let v48 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[2]));
-    let v49 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[4]));
-    let v50 = _mm256_fmadd_pd(v48, v41, v49);
-    let v51 = _mm256_fmadd_pd(v23, runtime::lanes::from_array(q[5]), v50);
-    let v52 = _mm256_mul_pd(v42, v11);
-    let v53 = _mm256_fmsub_pd(v33, v51, v52);
-    let v54 = _mm256_fmadd_pd(v13, v46, v42);
-    let v55 = _mm256_fmadd_pd(v47, v53, v54);
-    let v56 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[4]));
-    let v57 = _mm256_mul_pd(v48, runtime::lanes::from_array(q[5]));
-    let v58 = _mm256_fmsub_pd(v23, v41, v57);
-    let v59 = _mm256_mul_pd(v56, v11);
-    let v60 = _mm256_fmsub_pd(v26, v51, v59);
-    let v61 = _mm256_fmadd_pd(v13, v58, v56);
-    let v62 = _mm256_fmadd_pd(v47, v60, v61);
-    let v63 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[5]));
-    let v64 = _mm256_mul_pd(v15, v41);
-    let v65 = _mm256_fmsub_pd(v48, runtime::lanes::from_array(q[4]), v64);
-    let v66 = _mm256_mul_pd(v63, v11);
-    let v67 = _mm256_fmsub_pd(v20, v51, v66);
-    let v68 = _mm256_fmadd_pd(v13, v65, v63);
-    let v69 = _mm256_fmadd_pd(v47, v67, v68);
-    let v71 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[3]));
-    let v74 = _mm256_mul_pd(v26, runtime::lanes::from_array(qd[0]));
-    let v76 = _mm256_fmadd_pd(v33, runtime::lanes::from_array(qd[2]), v74);
-    let v77 = _mm256_fmadd_pd(v20, runtime::lanes::from_array(qd[1]), v76);
-    let v79 = _mm256_mul_pd(v77, v78);
-    let v80 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[5]));
-    let v82 = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[5]));
-    let v83 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[4]));
-    let v85 = _mm256_fmadd_pd(v80, runtime::lanes::from_array(qd[0]), v82);
-    let v86 = _mm256_fnmadd_pd(v83, runtime::lanes::from_array(qd[1]), v85);
-    let v87 = _mm256_fnmadd_pd(v23, runtime::lanes::from_array(qd[4]), v86);
-    let v89 = _mm256_mul_pd(v77, v88);
-    let v90 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[2]));
-    let v91 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[2]));
-    let v92 = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[3]));
-    let v93 = _mm256_fmadd_pd(v91, v41, v92);
-    let v94 = _mm256_fmadd_pd(v83, runtime::lanes::from_array(qd[0]), v93);
-    let v95 = _mm256_fmadd_pd(v15, runtime::lanes::from_array(qd[4]), v94);
-    let v96 = _mm256_fmadd_pd(v80, runtime::lanes::from_array(qd[1]), v95);
-    let v97 = _mm256_fmadd_pd(v23, runtime::lanes::from_array(qd[5]), v96);
-    let v98 = _mm256_mul_pd(v33, v97);
-    let v99 = _mm256_fmadd_pd(v90, v51, v98);
-    let v100 = _mm256_fnmadd_pd(v71, v11, v99);
-    let v101 = _mm256_fnmadd_pd(v42, v77, v100);
-    let v102 = _mm256_fmadd_pd(v46, v79, v71);
-    let v103 = _mm256_fmadd_pd(v13, v87, v102);
-    let v104 = _mm256_fmadd_pd(v53, v89, v103);
-    let v105 = _mm256_fmadd_pd(v47, v101, v104);
-    let v106 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[4]));
-    let v107 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[1]));
-    let v108 = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[3]));
-    let v109 = _mm256_fmadd_pd(v107, v41, v108);
-    let v110 = _mm256_fnmadd_pd(v80, runtime::lanes::from_array(qd[2]), v109);
-    let v111 = _mm256_fnmadd_pd(v48, runtime::lanes::from_array(qd[5]), v110);
-    let v112 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[0]));
-    let v113 = _mm256_mul_pd(v26, v97);
-    let v114 = _mm256_fmadd_pd(v112, v51, v113);
-    let v115 = _mm256_fnmadd_pd(v106, v11, v114);
-    let v116 = _mm256_fnmadd_pd(v56, v77, v115);
-    let v117 = _mm256_fmadd_pd(v58, v79, v106);
-    let v118 = _mm256_fmadd_pd(v13, v111, v117);
-    let v119 = _mm256_fmadd_pd(v60, v89, v118);
-    let v120 = _mm256_fmadd_pd(v47, v116, v119);
-    let v121 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[5]));
-    let v122 = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[4]));
-    let v123 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[0]));
-    let v124 = _mm256_fmadd_pd(v83, runtime::lanes::from_array(qd[2]), v122);
-    let v125 = _mm256_fnmadd_pd(v123, v41, v124);
-    let v126 = _mm256_fnmadd_pd(v15, runtime::lanes::from_array(qd[3]), v125);
-    let v127 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[1]));
-    let v128 = _mm256_mul_pd(v20, v97);
-    let v129 = _mm256_fmadd_pd(v127, v51, v128);
-    let v130 = _mm256_fnmadd_pd(v121, v11, v129);
-    let v131 = _mm256_fnmadd_pd(v63, v77, v130);
-    let v132 = _mm256_fmadd_pd(v65, v79, v121);
-    let v133 = _mm256_fmadd_pd(v13, v126, v132);
-    let v134 = _mm256_fmadd_pd(v67, v89, v133);
-    let v135 = _mm256_fmadd_pd(v47, v131, v134);
-    let v137 = _mm256_mul_pd(_mm256_set1_pd(2f64), v79);
-    let v138 = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[0]),
-        runtime::lanes::from_array(qd[0]),
-    );
-    let v139 = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[1]),
-        runtime::lanes::from_array(qd[1]),
-    );
-    let v140 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v139);
-    let v141 = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[2]),
-        runtime::lanes::from_array(qd[2]),
-    );
-    let v142 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v138, v140);
-    let v143 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v141, v142);
-    let v145 = _mm256_mul_pd(v77, v77);
-    let v146 = _mm256_mul_pd(v144, v145);
-    let v147 = _mm256_fmadd_pd(v78, v143, v146);
-    let v148 = _mm256_mul_pd(v46, v147);
-    let v149 = _mm256_mul_pd(v127, runtime::lanes::from_array(qd[4]));
-    let v150 = _mm256_fmsub_pd(v112, runtime::lanes::from_array(qd[5]), v149);
-    let v151 = _mm256_mul_pd(_mm256_set1_pd(2f64), v89);
-    let v153 = _mm256_mul_pd(v145, v152);
-    let v154 = _mm256_fmadd_pd(v88, v143, v153);
-    let v155 = _mm256_mul_pd(v112, runtime::lanes::from_array(qd[4]));
-    let v156 = _mm256_fmadd_pd(v90, runtime::lanes::from_array(qd[3]), v155);
-    let v157 = _mm256_fmadd_pd(v127, runtime::lanes::from_array(qd[5]), v156);
-    let v158 = _mm256_mul_pd(v33, v157);
-    let v159 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v97, v158);
-    let v160 = _mm256_fnmadd_pd(runtime::lanes::from_array(qd[3]), v77, v159);
-    let v161 = _mm256_fnmadd_pd(v42, v143, v160);
-    let v162 = _mm256_fmadd_pd(v137, v87, v148);
-    let v163 = _mm256_fmadd_pd(v13, v150, v162);
-    let v164 = _mm256_fmadd_pd(v151, v101, v163);
-    let v165 = _mm256_fmadd_pd(v53, v154, v164);
-    let v166 = _mm256_fmadd_pd(v47, v161, v165);
-    let v167 = _mm256_mul_pd(v58, v147);
-    let v168 = _mm256_mul_pd(v90, runtime::lanes::from_array(qd[5]));
-    let v169 = _mm256_fmsub_pd(v127, runtime::lanes::from_array(qd[3]), v168);
-    let v170 = _mm256_mul_pd(v26, v157);
-    let v171 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v97, v170);
-    let v172 = _mm256_fnmadd_pd(runtime::lanes::from_array(qd[4]), v77, v171);
-    let v173 = _mm256_fnmadd_pd(v56, v143, v172);
-    let v174 = _mm256_fmadd_pd(v137, v111, v167);
-    let v175 = _mm256_fmadd_pd(v13, v169, v174);
-    let v176 = _mm256_fmadd_pd(v151, v116, v175);
-    let v177 = _mm256_fmadd_pd(v60, v154, v176);
-    let v178 = _mm256_fmadd_pd(v47, v173, v177);
-    let v179 = _mm256_mul_pd(v65, v147);
-    let v180 = _mm256_mul_pd(v112, runtime::lanes::from_array(qd[3]));
-    let v181 = _mm256_fmsub_pd(v90, runtime::lanes::from_array(qd[4]), v180);
-    let v182 = _mm256_mul_pd(v20, v157);
-    let v183 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v97, v182);
-    let v184 = _mm256_fnmadd_pd(runtime::lanes::from_array(qd[5]), v77, v183);
-    let v185 = _mm256_fnmadd_pd(v63, v143, v184);
-    let v186 = _mm256_fmadd_pd(v137, v126, v179);
-    let v187 = _mm256_fmadd_pd(v13, v181, v186);
-    let v188 = _mm256_fmadd_pd(v151, v131, v187);
-    let v189 = _mm256_fmadd_pd(v67, v154, v188);
-    let v190 = _mm256_fmadd_pd(v47, v185, v189);
-    let v191 = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[0]));
-    let v192 = _mm256_fmsub_pd(v15, runtime::lanes::from_array(qd[1]), v191);
-    let v193 = _mm256_mul_pd(v90, v18);
-    let v194 = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[0]));
-    let v195 = _mm256_fmadd_pd(v48, runtime::lanes::from_array(qd[2]), v194);
-    let v196 = _mm256_fmadd_pd(v23, runtime::lanes::from_array(qd[1]), v195);
-    let v197 = _mm256_mul_pd(v33, v47);
-    let v198 = _mm256_fmadd_pd(v13, v192, v193);
-    let v199 = _mm256_fmadd_pd(v197, v196, v198);
-    let v200 = _mm256_mul_pd(v48, runtime::lanes::from_array(qd[1]));
-    let v201 = _mm256_fmsub_pd(v23, runtime::lanes::from_array(qd[2]), v200);
-    let v202 = _mm256_mul_pd(v112, v18);
-    let v203 = _mm256_mul_pd(v26, v47);
-    let v204 = _mm256_fmadd_pd(v13, v201, v202);
-    let v205 = _mm256_fmadd_pd(v203, v196, v204);
-    let v206 = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[2]));
-    let v207 = _mm256_fmsub_pd(v48, runtime::lanes::from_array(qd[0]), v206);
-    let v208 = _mm256_mul_pd(v127, v18);
-    let v209 = _mm256_mul_pd(v20, v47);
-    let v210 = _mm256_fmadd_pd(v13, v207, v208);
-    let v211 = _mm256_fmadd_pd(v209, v196, v210);
-    let v212 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v196);
-    let v213 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v139);
-    let v214 = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v138, v213);
-    let v215 = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v141, v214);
-    let v216 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v47);
-    let v217 = _mm256_mul_pd(v216, v215);
-    let v218 = _mm256_fmadd_pd(v212, v89, v217);
-    let v219 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v218);
-    let v221 = _mm256_mul_pd(v77, v220);
-    let v222 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v221);
-    let v223 = _mm256_fmadd_pd(v216, v196, v222);
-    let v224 = _mm256_fmadd_pd(v192, v79, v219);
-    let v225 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v223, v224);
-    let v226 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v218);
-    let v227 = _mm256_fmadd_pd(v201, v79, v226);
-    let v228 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v223, v227);
-    let v229 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v218);
-    let v230 = _mm256_fmadd_pd(v207, v79, v229);
-    let v231 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v223, v230);
-    let v232 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v41);
-    let v234 = _mm256_fmadd_pd(v47, v46, v232);
-    let v235 = _mm256_fmadd_pd(v233, v53, v234);
-    let v236 = _mm256_fmadd_pd(v47, v58, v83);
-    let v237 = _mm256_fmadd_pd(v233, v60, v236);
-    let v238 = _mm256_fmadd_pd(v47, v65, v80);
-    let v239 = _mm256_fmadd_pd(v233, v67, v238);
-    let v240 = _mm256_mul_pd(v46, v89);
-    let v242 = _mm256_mul_pd(v77, v241);
-    let v243 = _mm256_fmadd_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[3]),
-        v240,
-    );
-    let v244 = _mm256_fmadd_pd(v47, v87, v243);
-    let v245 = _mm256_fmadd_pd(v53, v242, v244);
-    let v246 = _mm256_fmadd_pd(v233, v101, v245);
-    let v247 = _mm256_mul_pd(v58, v89);
-    let v248 = _mm256_fmadd_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[4]),
-        v247,
-    );
-    let v249 = _mm256_fmadd_pd(v47, v111, v248);
-    let v250 = _mm256_fmadd_pd(v60, v242, v249);
-    let v251 = _mm256_fmadd_pd(v233, v116, v250);
-    let v252 = _mm256_mul_pd(v65, v89);
-    let v253 = _mm256_fmadd_pd(
-        _mm256_set1_pd(0.25f64),
-        runtime::lanes::from_array(qd[5]),
-        v252,
-    );
-    let v254 = _mm256_fmadd_pd(v47, v126, v253);
-    let v255 = _mm256_fmadd_pd(v67, v242, v254);
-    let v256 = _mm256_fmadd_pd(v233, v131, v255);
-    let v257 = _mm256_mul_pd(_mm256_set1_pd(2f64), v87);
-    let v258 = _mm256_mul_pd(v46, v154);
-    let v259 = _mm256_mul_pd(_mm256_set1_pd(2f64), v101);
-    let v261 = _mm256_mul_pd(v145, v260);
-    let v262 = _mm256_fmadd_pd(v143, v241, v261);
-    let v263 = _mm256_fmadd_pd(v257, v89, v258);
-    let v264 = _mm256_fmadd_pd(v47, v150, v263);
-    let v265 = _mm256_fmadd_pd(v259, v242, v264);
-    let v266 = _mm256_fmadd_pd(v53, v262, v265);
-    let v267 = _mm256_fmadd_pd(v233, v161, v266);
-    let v268 = _mm256_mul_pd(v58, v154);
-    let v269 = _mm256_mul_pd(_mm256_set1_pd(2f64), v116);
-    let v270 = _mm256_fmadd_pd(v151, v111, v268);
-    let v271 = _mm256_fmadd_pd(v47, v169, v270);
-    let v272 = _mm256_fmadd_pd(v269, v242, v271);
-    let v273 = _mm256_fmadd_pd(v60, v262, v272);
-    let v274 = _mm256_fmadd_pd(v233, v173, v273);
-    let v275 = _mm256_mul_pd(v65, v154);
-    let v276 = _mm256_mul_pd(_mm256_set1_pd(2f64), v131);
-    let v277 = _mm256_fmadd_pd(v151, v126, v275);
-    let v278 = _mm256_fmadd_pd(v47, v181, v277);
-    let v279 = _mm256_fmadd_pd(v276, v242, v278);
-    let v280 = _mm256_fmadd_pd(v67, v262, v279);
-    let v281 = _mm256_fmadd_pd(v233, v185, v280);
-    let v282 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v11);
-    let c: [[__m256d; 2]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
-        2,
-    >(v282);
-    let v283: __m256d = c[2][0];
-    let v289: __m256d = c[1][0];
-    let v291: __m256d = c[3][0];
-    let v312: __m256d = c[2][1];
-    let v314: __m256d = c[3][1];
-    let v324: __m256d = c[1][1];
-    let v285 = _mm256_mul_pd(
-        _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[0]),
-    );
-    let v286 = _mm256_mul_pd(
-        _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[1]),
-    );
-    let v287 = _mm256_mul_pd(v286, runtime::lanes::from_array(qd[0]));
-    let v288 = _mm256_fmsub_pd(v285, runtime::lanes::from_array(qd[1]), v287);
-    let v290 = _mm256_mul_pd(v91, v289);
-    let v292 = _mm256_mul_pd(
-        _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[2]),
-    );
-    let v293 = _mm256_mul_pd(v285, runtime::lanes::from_array(qd[0]));
-    let v294 = _mm256_fmadd_pd(v292, runtime::lanes::from_array(qd[2]), v293);
-    let v295 = _mm256_fmadd_pd(v286, runtime::lanes::from_array(qd[1]), v294);
-    let v296 = _mm256_mul_pd(v48, v291);
-    let v297 = _mm256_fmadd_pd(v283, v288, v290);
-    let v298 = _mm256_fmadd_pd(v296, v295, v297);
-    let v299 = _mm256_mul_pd(v292, runtime::lanes::from_array(qd[1]));
-    let v300 = _mm256_fmsub_pd(v286, runtime::lanes::from_array(qd[2]), v299);
-    let v301 = _mm256_mul_pd(v123, v289);
-    let v302 = _mm256_mul_pd(v15, v291);
-    let v303 = _mm256_fmadd_pd(v283, v300, v301);
-    let v304 = _mm256_fmadd_pd(v302, v295, v303);
-    let v305 = _mm256_mul_pd(v285, runtime::lanes::from_array(qd[2]));
-    let v306 = _mm256_fmsub_pd(v292, runtime::lanes::from_array(qd[0]), v305);
-    let v307 = _mm256_mul_pd(v107, v289);
-    let v308 = _mm256_mul_pd(v23, v291);
-    let v309 = _mm256_fmadd_pd(v283, v306, v307);
-    let v310 = _mm256_fmadd_pd(v308, v295, v309);
-    let v311 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v77);
-    let v313 = _mm256_mul_pd(v311, v312);
-    let v315 = _mm256_mul_pd(v311, v314);
-    let v316 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v295);
-    let v317 = _mm256_mul_pd(_mm256_set1_pd(0.0625f64), v139);
-    let v318 = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v138, v317);
-    let v319 = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v141, v318);
-    let v320 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v291);
-    let v321 = _mm256_mul_pd(v320, v319);
-    let v322 = _mm256_fmadd_pd(v316, v315, v321);
-    let v323 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v322);
-    let v325 = _mm256_mul_pd(v311, v324);
-    let v326 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v325);
-    let v327 = _mm256_fmadd_pd(v320, v295, v326);
-    let v328 = _mm256_fmadd_pd(v288, v313, v323);
-    let v329 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v327, v328);
-    let v330 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v322);
-    let v331 = _mm256_fmadd_pd(v300, v313, v330);
-    let v332 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v327, v331);
-    let v333 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v322);
-    let v334 = _mm256_fmadd_pd(v306, v313, v333);
-    let v335 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v327, v334);
-    let v337 = _mm256_fmsub_pd(_mm256_set1_pd(0.0625f64), v8, v282);
-    let v338 = _mm256_fmadd_pd(v283, v337, _mm256_set1_pd(1f64));
-    let v339 = _mm256_mul_pd(v285, runtime::lanes::from_array(q[2]));
-    let v340 = _mm256_mul_pd(v339, v283);
-    let v341 = _mm256_fmadd_pd(v23, v289, v340);
-    let v342 = _mm256_mul_pd(v286, runtime::lanes::from_array(q[2]));
-    let v343 = _mm256_mul_pd(v15, v289);
-    let v344 = _mm256_fmsub_pd(v342, v283, v343);
-    let v346 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[1]));
-    let v348 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(p[3]));
-    let v350 = _mm256_sub_pd(runtime::lanes::from_array(p[2]), v348);
-    let v352 = _mm256_fmadd_pd(_mm256_set1_pd(0.125f64), v350, v348);
-    let v353 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[3]));
-    let v354 = _mm256_mul_pd(v23, v13);
-    let v355 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[0]));
-    let v356 = _mm256_mul_pd(v355, runtime::lanes::from_array(q[2]));
-    let v357 = _mm256_mul_pd(v356, v47);
-    let v358 = _mm256_sub_pd(v357, v354);
-    let v359 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v18);
-    let v360 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v1);
-    let v361 = _mm256_fmadd_pd(v360, v47, v359);
-    let v362 = _mm256_mul_pd(v48, v13);
-    let v363 = _mm256_mul_pd(v355, runtime::lanes::from_array(q[1]));
-    let v364 = _mm256_mul_pd(v363, v47);
-    let v365 = _mm256_add_pd(v362, v364);
-    let v366 = _mm256_mul_pd(v78, v26);
-    let v367 = _mm256_mul_pd(v80, v13);
-    let v368 = _mm256_mul_pd(v88, v26);
-    let v369 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[2]));
-    let v370 = _mm256_mul_pd(v42, v26);
-    let v371 = _mm256_fmsub_pd(v369, runtime::lanes::from_array(q[4]), v370);
-    let v372 = _mm256_fmadd_pd(v46, v366, v367);
-    let v373 = _mm256_fmadd_pd(v53, v368, v372);
-    let v374 = _mm256_fmadd_pd(v47, v371, v373);
-    let v375 = _mm256_mul_pd(v60, v368);
-    let v376 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v51);
-    let v377 = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v26, v355);
-    let v378 = _mm256_fmadd_pd(runtime::lanes::from_array(q[4]), v377, v376);
-    let v379 = _mm256_fmadd_pd(v58, v366, v375);
-    let v380 = _mm256_fmadd_pd(v47, v378, v379);
-    let v381 = _mm256_mul_pd(v232, v13);
-    let v382 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[1]));
-    let v383 = _mm256_mul_pd(v63, v26);
-    let v384 = _mm256_fmsub_pd(v382, runtime::lanes::from_array(q[4]), v383);
-    let v385 = _mm256_fmsub_pd(v65, v366, v381);
-    let v386 = _mm256_fmadd_pd(v67, v368, v385);
-    let v387 = _mm256_fmadd_pd(v47, v384, v386);
-    let v388 = _mm256_mul_pd(v286, v283);
-    let v390 = _mm256_mul_pd(
-        _mm256_set1_pd(0.015625f64),
-        runtime::lanes::from_array(q[0]),
-    );
-    let v391 = _mm256_mul_pd(v390, runtime::lanes::from_array(q[2]));
-    let v392 = _mm256_mul_pd(v391, v291);
-    let v393 = _mm256_sub_pd(v392, v388);
-    let v394 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v289);
-    let v395 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v1);
-    let v396 = _mm256_fmadd_pd(v395, v291, v394);
-    let v397 = _mm256_mul_pd(v292, v283);
-    let v398 = _mm256_mul_pd(v390, runtime::lanes::from_array(q[1]));
-    let v399 = _mm256_mul_pd(v398, v291);
-    let v400 = _mm256_add_pd(v397, v399);
-    let v401 = _mm256_mul_pd(v80, v47);
-    let v402 = _mm256_mul_pd(v241, v26);
-    let v403 = _mm256_fmadd_pd(v46, v368, v401);
-    let v404 = _mm256_fmadd_pd(v53, v402, v403);
-    let v405 = _mm256_fmadd_pd(v233, v371, v404);
-    let v406 = _mm256_mul_pd(v60, v402);
-    let v407 = _mm256_fmadd_pd(v58, v368, v406);
-    let v408 = _mm256_fmadd_pd(v233, v378, v407);
-    let v409 = _mm256_mul_pd(v232, v47);
-    let v410 = _mm256_fmsub_pd(v65, v368, v409);
-    let v411 = _mm256_fmadd_pd(v67, v402, v410);
-    let v412 = _mm256_fmadd_pd(v233, v384, v411);
-    let v413 = _mm256_mul_pd(v15, v13);
-    let v414 = _mm256_mul_pd(v382, runtime::lanes::from_array(q[2]));
-    let v415 = _mm256_mul_pd(v414, v47);
-    let v416 = _mm256_add_pd(v413, v415);
-    let v417 = _mm256_sub_pd(v364, v362);
-    let v418 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v5);
-    let v419 = _mm256_fmadd_pd(v418, v47, v359);
-    let v420 = _mm256_mul_pd(v78, v20);
-    let v421 = _mm256_mul_pd(v83, v13);
-    let v422 = _mm256_mul_pd(v88, v20);
-    let v423 = _mm256_mul_pd(v42, v20);
-    let v424 = _mm256_fmsub_pd(v369, runtime::lanes::from_array(q[5]), v423);
-    let v425 = _mm256_fmsub_pd(v46, v420, v421);
-    let v426 = _mm256_fmadd_pd(v53, v422, v425);
-    let v427 = _mm256_fmadd_pd(v47, v424, v426);
-    let v428 = _mm256_mul_pd(v56, v20);
-    let v429 = _mm256_fmsub_pd(v355, runtime::lanes::from_array(q[5]), v428);
-    let v430 = _mm256_fmadd_pd(v58, v420, v381);
-    let v431 = _mm256_fmadd_pd(v60, v422, v430);
-    let v432 = _mm256_fmadd_pd(v47, v429, v431);
-    let v433 = _mm256_mul_pd(v67, v422);
-    let v434 = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v20, v382);
-    let v435 = _mm256_fmadd_pd(runtime::lanes::from_array(q[5]), v434, v376);
-    let v436 = _mm256_fmadd_pd(v65, v420, v433);
-    let v437 = _mm256_fmadd_pd(v47, v435, v436);
-    let v438 = _mm256_mul_pd(v285, v283);
-    let v439 = _mm256_mul_pd(
-        _mm256_set1_pd(0.015625f64),
-        runtime::lanes::from_array(q[1]),
-    );
-    let v440 = _mm256_mul_pd(v439, runtime::lanes::from_array(q[2]));
-    let v441 = _mm256_mul_pd(v440, v291);
-    let v442 = _mm256_add_pd(v438, v441);
-    let v443 = _mm256_sub_pd(v399, v397);
-    let v444 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v5);
-    let v445 = _mm256_fmadd_pd(v444, v291, v394);
-    let v446 = _mm256_mul_pd(v83, v47);
-    let v447 = _mm256_mul_pd(v241, v20);
-    let v448 = _mm256_fmsub_pd(v46, v422, v446);
-    let v449 = _mm256_fmadd_pd(v53, v447, v448);
-    let v450 = _mm256_fmadd_pd(v233, v424, v449);
-    let v451 = _mm256_fmadd_pd(v58, v422, v409);
-    let v452 = _mm256_fmadd_pd(v60, v447, v451);
-    let v453 = _mm256_fmadd_pd(v233, v429, v452);
-    let v454 = _mm256_mul_pd(v67, v447);
-    let v455 = _mm256_fmadd_pd(v65, v422, v454);
-    let v456 = _mm256_fmadd_pd(v233, v435, v455);
-    let v457 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v8);
-    let v458 = _mm256_fmadd_pd(v457, v47, v359);
-    let v459 = _mm256_add_pd(v354, v357);
-    let v460 = _mm256_sub_pd(v415, v413);
-    let v461 = _mm256_mul_pd(v78, v33);
-    let v462 = _mm256_mul_pd(v88, v33);
-    let v463 = _mm256_mul_pd(v53, v462);
-    let v464 = _mm256_fnmadd_pd(_mm256_set1_pd(0.5f64), v33, v369);
-    let v465 = _mm256_fmadd_pd(v41, v464, v376);
-    let v466 = _mm256_fmadd_pd(v46, v461, v463);
-    let v467 = _mm256_fmadd_pd(v47, v465, v466);
-    let v468 = _mm256_mul_pd(v56, v33);
-    let v469 = _mm256_fmsub_pd(v355, v41, v468);
-    let v470 = _mm256_fmsub_pd(v58, v461, v367);
-    let v471 = _mm256_fmadd_pd(v60, v462, v470);
-    let v472 = _mm256_fmadd_pd(v47, v469, v471);
-    let v473 = _mm256_mul_pd(v63, v33);
-    let v474 = _mm256_fmsub_pd(v382, v41, v473);
-    let v475 = _mm256_fmadd_pd(v65, v461, v421);
-    let v476 = _mm256_fmadd_pd(v67, v462, v475);
-    let v477 = _mm256_fmadd_pd(v47, v474, v476);
-    let v478 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v8);
-    let v479 = _mm256_fmadd_pd(v478, v291, v394);
-    let v480 = _mm256_add_pd(v388, v392);
-    let v481 = _mm256_sub_pd(v441, v438);
-    let v482 = _mm256_mul_pd(v241, v33);
-    let v483 = _mm256_mul_pd(v53, v482);
-    let v484 = _mm256_fmadd_pd(v46, v462, v483);
-    let v485 = _mm256_fmadd_pd(v233, v465, v484);
-    let v486 = _mm256_fmsub_pd(v58, v462, v401);
-    let v487 = _mm256_fmadd_pd(v60, v482, v486);
-    let v488 = _mm256_fmadd_pd(v233, v469, v487);
-    let v489 = _mm256_fmadd_pd(v65, v462, v446);
-    let v490 = _mm256_fmadd_pd(v67, v482, v489);
-    let v491 = _mm256_fmadd_pd(v233, v474, v490);
-    let v493 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v11);
-    let v494 = _mm256_sub_pd(v457, v493);
-    let v495 = _mm256_fmadd_pd(v47, v494, _mm256_set1_pd(0.5f64));
-    let v496 = _mm256_fmadd_pd(v233, v494, _mm256_set1_pd(0.25f64));
-    let v497 = _mm256_mul_pd(v23, v47);
-    let v498 = _mm256_mul_pd(v356, v233);
-    let v499 = _mm256_add_pd(v497, v498);
-    let v500 = _mm256_mul_pd(v15, v47);
-    let v501 = _mm256_mul_pd(v414, v233);
-    let v502 = _mm256_sub_pd(v501, v500);
-    let v503 = _mm256_sub_pd(v360, v493);
-    let v504 = _mm256_fmadd_pd(v47, v503, _mm256_set1_pd(0.5f64));
-    let v505 = _mm256_sub_pd(v498, v497);
-    let v506 = _mm256_fmadd_pd(v233, v503, _mm256_set1_pd(0.25f64));
-    let v507 = _mm256_mul_pd(v48, v47);
-    let v508 = _mm256_mul_pd(v363, v233);
-    let v509 = _mm256_add_pd(v507, v508);
-    let v510 = _mm256_sub_pd(v418, v493);
-    let v511 = _mm256_fmadd_pd(v47, v510, _mm256_set1_pd(0.5f64));
-    let v512 = _mm256_add_pd(v500, v501);
-    let v513 = _mm256_sub_pd(v508, v507);
-    let v514 = _mm256_fmadd_pd(v233, v510, _mm256_set1_pd(0.25f64));
-    out[0] = runtime::lanes::to_array(v14);
-    out[1] = runtime::lanes::to_array(v22);
-    out[2] = runtime::lanes::to_array(v28);
-    out[3] = runtime::lanes::to_array(v29);
-    out[4] = runtime::lanes::to_array(v30);
-    out[5] = runtime::lanes::to_array(v35);
-    out[6] = runtime::lanes::to_array(v36);
-    out[7] = runtime::lanes::to_array(v37);
-    out[8] = runtime::lanes::to_array(v38);
-    out[9] = runtime::lanes::to_array(v55);
-    out[10] = runtime::lanes::to_array(v62);
-    out[11] = runtime::lanes::to_array(v69);
-    out[12] = runtime::lanes::to_array(v105);
-    out[13] = runtime::lanes::to_array(v120);
-    out[14] = runtime::lanes::to_array(v135);
-    out[15] = runtime::lanes::to_array(v166);
-    out[16] = runtime::lanes::to_array(v178);
-    out[17] = runtime::lanes::to_array(v190);
-    out[18] = runtime::lanes::to_array(v199);
-    out[19] = runtime::lanes::to_array(v205);
-    out[20] = runtime::lanes::to_array(v211);
-    out[21] = runtime::lanes::to_array(v225);
-    out[22] = runtime::lanes::to_array(v228);
-    out[23] = runtime::lanes::to_array(v231);
-    out[24] = runtime::lanes::to_array(v235);
-    out[25] = runtime::lanes::to_array(v237);
-    out[26] = runtime::lanes::to_array(v239);
-    out[27] = runtime::lanes::to_array(v246);
-    out[28] = runtime::lanes::to_array(v251);
-    out[29] = runtime::lanes::to_array(v256);
-    out[30] = runtime::lanes::to_array(v267);
-    out[31] = runtime::lanes::to_array(v274);
-    out[32] = runtime::lanes::to_array(v281);
-    out[33] = runtime::lanes::to_array(v298);
-    out[34] = runtime::lanes::to_array(v304);
-    out[35] = runtime::lanes::to_array(v310);
-    out[36] = runtime::lanes::to_array(v329);
-    out[37] = runtime::lanes::to_array(v332);
-    out[38] = runtime::lanes::to_array(v335);
-    out[39] = runtime::lanes::to_array(v338);
-    out[40] = runtime::lanes::to_array(v341);
-    out[41] = runtime::lanes::to_array(v344);
-    out[42] = runtime::lanes::to_array(v346);
-    out[43] = runtime::lanes::to_array(v352);
-    out[44] = runtime::lanes::to_array(v353);
-    out[45] = runtime::lanes::to_array(v358);
-    out[46] = runtime::lanes::to_array(v361);
-    out[47] = runtime::lanes::to_array(v365);
-    out[48] = runtime::lanes::to_array(v374);
-    out[49] = runtime::lanes::to_array(v380);
-    out[50] = runtime::lanes::to_array(v387);
-    out[51] = runtime::lanes::to_array(v393);
-    out[52] = runtime::lanes::to_array(v396);
-    out[53] = runtime::lanes::to_array(v400);
-    out[54] = runtime::lanes::to_array(v405);
-    out[55] = runtime::lanes::to_array(v408);
-    out[56] = runtime::lanes::to_array(v412);
-    out[57] = runtime::lanes::to_array(v416);
-    out[58] = runtime::lanes::to_array(v417);
-    out[59] = runtime::lanes::to_array(v419);
-    out[60] = runtime::lanes::to_array(v427);
-    out[61] = runtime::lanes::to_array(v432);
-    out[62] = runtime::lanes::to_array(v437);
-    out[63] = runtime::lanes::to_array(v442);
-    out[64] = runtime::lanes::to_array(v443);
-    out[65] = runtime::lanes::to_array(v445);
-    out[66] = runtime::lanes::to_array(v450);
-    out[67] = runtime::lanes::to_array(v453);
-    out[68] = runtime::lanes::to_array(v456);
-    out[69] = runtime::lanes::to_array(v458);
-    out[70] = runtime::lanes::to_array(v459);
-    out[71] = runtime::lanes::to_array(v460);
-    out[72] = runtime::lanes::to_array(v467);
-    out[73] = runtime::lanes::to_array(v472);
-    out[74] = runtime::lanes::to_array(v477);
-    out[75] = runtime::lanes::to_array(v479);
-    out[76] = runtime::lanes::to_array(v480);
-    out[77] = runtime::lanes::to_array(v481);
-    out[78] = runtime::lanes::to_array(v485);
-    out[79] = runtime::lanes::to_array(v488);
-    out[80] = runtime::lanes::to_array(v491);
-    out[81] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[82] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[83] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[84] = runtime::lanes::to_array(v495);
-    out[85] = runtime::lanes::to_array(v459);
-    out[86] = runtime::lanes::to_array(v460);
-    out[87] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[88] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[89] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[90] = runtime::lanes::to_array(v496);
-    out[91] = runtime::lanes::to_array(v499);
-    out[92] = runtime::lanes::to_array(v502);
-    out[93] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[94] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[95] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[96] = runtime::lanes::to_array(v358);
-    out[97] = runtime::lanes::to_array(v504);
-    out[98] = runtime::lanes::to_array(v365);
-    out[99] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[100] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[101] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[102] = runtime::lanes::to_array(v505);
-    out[103] = runtime::lanes::to_array(v506);
-    out[104] = runtime::lanes::to_array(v509);
-    out[105] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[106] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[107] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[108] = runtime::lanes::to_array(v416);
-    out[109] = runtime::lanes::to_array(v417);
-    out[110] = runtime::lanes::to_array(v511);
-    out[111] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[112] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[113] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[114] = runtime::lanes::to_array(v512);
-    out[115] = runtime::lanes::to_array(v513);
-    out[116] = runtime::lanes::to_array(v514);
-    out[117] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[118] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[119] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[120] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[121] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[122] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[123] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[124] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[125] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[126] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[127] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[128] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[0] = v14.store();
+    out[1] = v22.store();
+    out[2] = v28.store();
+    out[3] = v29.store();
+    out[4] = v30.store();
+    out[5] = v35.store();
+    out[6] = v36.store();
+    out[7] = v37.store();
+    out[8] = v38.store();
+    out[9] = v55.store();
+    out[10] = v62.store();
+    out[11] = v69.store();
+    out[12] = v105.store();
+    out[13] = v120.store();
+    out[14] = v135.store();
+    out[15] = v166.store();
+    out[16] = v178.store();
+    out[17] = v190.store();
+    out[18] = v199.store();
+    out[19] = v205.store();
+    out[20] = v211.store();
+    out[21] = v225.store();
+    out[22] = v228.store();
+    out[23] = v231.store();
+    out[24] = v235.store();
+    out[25] = v237.store();
+    out[26] = v239.store();
+    out[27] = v246.store();
+    out[28] = v251.store();
+    out[29] = v256.store();
+    out[30] = v267.store();
+    out[31] = v274.store();
+    out[32] = v281.store();
+    out[33] = v298.store();
+    out[34] = v304.store();
+    out[35] = v310.store();
+    out[36] = v329.store();
+    out[37] = v332.store();
+    out[38] = v335.store();
+    out[39] = v338.store();
+    out[40] = v341.store();
+    out[41] = v344.store();
+    out[42] = S::from_param(v346).store();
+    out[43] = S::from_param(v352).store();
+    out[44] = S::from_param(v353).store();
+    out[45] = v358.store();
+    out[46] = v361.store();
+    out[47] = v365.store();
+    out[48] = v374.store();
+    out[49] = v380.store();
+    out[50] = v387.store();
+    out[51] = v393.store();
+    out[52] = v396.store();
+    out[53] = v400.store();
+    out[54] = v405.store();
+    out[55] = v408.store();
+    out[56] = v412.store();
+    out[57] = v416.store();
+    out[58] = v417.store();
+    out[59] = v419.store();
+    out[60] = v427.store();
+    out[61] = v432.store();
+    out[62] = v437.store();
+    out[63] = v442.store();
+    out[64] = v443.store();
+    out[65] = v445.store();
+    out[66] = v450.store();
+    out[67] = v453.store();
+    out[68] = v456.store();
+    out[69] = v458.store();
+    out[70] = v459.store();
+    out[71] = v460.store();
+    out[72] = v467.store();
+    out[73] = v472.store();
+    out[74] = v477.store();
+    out[75] = v479.store();
+    out[76] = v480.store();
+    out[77] = v481.store();
+    out[78] = v485.store();
+    out[79] = v488.store();
+    out[80] = v491.store();
+    out[81] = S::c(0f64).store();
+    out[82] = S::c(0f64).store();
+    out[83] = S::c(0f64).store();
+    out[84] = v495.store();
+    out[85] = v459.store();
+    out[86] = v460.store();
+    out[87] = S::c(0f64).store();
+    out[88] = S::c(0f64).store();
+    out[89] = S::c(0f64).store();
+    out[90] = v496.store();
+    out[91] = v499.store();
+    out[92] = v502.store();
+    out[93] = S::c(0f64).store();
+    out[94] = S::c(0f64).store();
+    out[95] = S::c(0f64).store();
+    out[96] = v358.store();
+    out[97] = v504.store();
+    out[98] = v365.store();
+    out[99] = S::c(0f64).store();
+    out[100] = S::c(0f64).store();
+    out[101] = S::c(0f64).store();
+    out[102] = v505.store();
+    out[103] = v506.store();
+    out[104] = v509.store();
+    out[105] = S::c(0f64).store();
+    out[106] = S::c(0f64).store();
+    out[107] = S::c(0f64).store();
+    out[108] = v416.store();
+    out[109] = v417.store();
+    out[110] = v511.store();
+    out[111] = S::c(0f64).store();
+    out[112] = S::c(0f64).store();
+    out[113] = S::c(0f64).store();
+    out[114] = v512.store();
+    out[115] = v513.store();
+    out[116] = v514.store();
+    out[117] = S::c(0f64).store();
+    out[118] = S::c(0f64).store();
+    out[119] = S::c(0f64).store();
+    out[120] = S::c(0f64).store();
+    out[121] = S::c(0f64).store();
+    out[122] = S::c(0f64).store();
+    out[123] = S::c(0f64).store();
+    out[124] = S::c(0f64).store();
+    out[125] = S::c(0f64).store();
+    out[126] = S::c(0f64).store();
+    out[127] = S::c(0f64).store();
+    out[128] = S::c(0f64).store();
 }
 /// Kernel `link_forces`: 171 operations, over f64 or dual numbers.
 pub fn link_forces(
@@ -3174,7 +2506,7 @@ pub fn link_forces_tangent(
     runtime::dual::split(&o, out);
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn link_forces_0<S: runtime::scalar::Scalar>(
     t: f64,

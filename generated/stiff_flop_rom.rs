@@ -2882,8 +2882,25 @@ pub fn cell_0_tangent(
     unsafe { cell_0_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut o) };
     runtime::dual::split(&o, out);
 }
+/// `cell_0` of four links at once, in vector lanes.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,fma")]
+fn cell_0_x4(
+    q: &[[f64; 4]; 4],
+    qd: &[[f64; 4]; 4],
+    p: &[[f64; 4]; 15],
+    out: &mut [[f64; 4]; 101],
+) {
+    use runtime::x4::X4;
+    let (x, xd, px) = (
+        q.map(X4::from_array),
+        qd.map(X4::from_array),
+        p.map(X4::from_array),
+    );
+    cell_0_0::<X4>(0.0, &x, &xd, &[0.0; 4], &[0.0; 8], &px, out);
+}
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -2891,9 +2908,11 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     qd: &[S; 4],
     qdd: &[f64; 4],
     dir: &[f64; 8],
-    p: &[f64; 15],
-    out: &mut [S; 101],
+    p: &[S::Param; 15],
+    out: &mut [S::Store; 101],
 ) {
+    #[allow(unused_imports)]
+    use runtime::scalar::Scalar as _;
     let v1 = q[0] * q[0];
     let v3 = v1 * 0.25f64;
     let v5 = q[2] * q[2];
@@ -2938,7 +2957,7 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     let v36 = v25 - v27;
     let v37 = v32 + v34;
     let v38 = v9.mul_add(v13, v12);
-    let v41 = q[3] + p[0];
+    let v41 = q[3].add_p(p[0]);
     let v44 = v6 - v11;
     let v45 = v43.mul_add(v44, S::c(1f64));
     let v46 = v41 * 0.5f64;
@@ -3167,11 +3186,11 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     let v282 = v225 * q[2];
     let v283 = v15 * v228;
     let v284 = v282.mul_add(v222, -v283);
-    let v286 = 0.5f64 * p[1];
-    let v288 = 0.25f64 * p[3];
+    let v286 = p[1] * 0.5f64;
+    let v288 = p[3] * 0.25f64;
     let v290 = p[2] - v288;
-    let v292 = 0.125f64.mul_add(v290, v288);
-    let v293 = 0.5f64 * p[3];
+    let v292 = S::pc(0.125f64).mul_add(v290, v288);
+    let v293 = p[3] * 0.5f64;
     let v294 = v23 * v13;
     let v295 = q[0] * 0.125f64;
     let v296 = v295 * q[2];
@@ -3297,747 +3316,140 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     let v418 = v171 * 0.5f64;
     let v419 = v173 * 0.5f64;
     let v420 = v175 * 0.5f64;
-    let v422 = v41.div_into(p[0]);
+    let v422 = v41.rdiv_p(p[0]);
     let v423 = v422.powi(3i32);
-    let v424 = q[0] * p[4];
+    let v424 = q[0].mul_p(p[4]);
     let v426 = v422.sqrt();
-    let v427 = v426 * p[13];
+    let v427 = v426.mul_p(p[13]);
     let v428 = v424.mul_add(v423, -v427);
     let v429 = v428 * 0.5f64;
-    let v431 = q[1] - p[6];
-    let v432 = v423 * p[4];
-    let v434 = v426 * p[14];
+    let v431 = q[1].sub_p(p[6]);
+    let v432 = v423.mul_p(p[4]);
+    let v434 = v426.mul_p(p[14]);
     let v435 = v432.mul_add(v431, -v434);
     let v436 = v435 * 0.5f64;
-    let v438 = v33 * p[7];
+    let v438 = v33.mul_p(p[7]);
     let v439 = v438 * v423;
-    let v441 = q[1] * p[14];
-    let v442 = q[0].mul_add(S::c(p[13]), v441);
+    let v441 = q[1].mul_p(p[14]);
+    let v442 = q[0].mul_add(S::from_param(p[13]), v441);
     let v443 = v41 * v41;
-    let v444 = v443.div_into(p[0]);
+    let v444 = v443.rdiv_p(p[0]);
     let v445 = -v444;
     let v446 = v445 * 0.5f64;
     let v447 = v446 / v426;
-    let v448 = v442.mul_add(v447, S::c(p[12]));
+    let v448 = v442.mul_add(v447, S::from_param(p[12]));
     let v449 = v422 * v422;
     let v451 = v445 * 3f64;
     let v452 = v451 * v449;
-    let v453 = 0.5f64 * p[7];
+    let v453 = p[7] * 0.5f64;
     let v454 = v431 * v431;
     let v455 = v454 * 0.5f64;
     let v456 = S::c(0.5f64).mul_add(v1, v455);
-    let v457 = v456 * p[4];
-    let v458 = S::c(v453).mul_add(v5, v457);
+    let v457 = v456.mul_p(p[4]);
+    let v458 = S::from_param(v453).mul_add(v5, v457);
     let v459 = v452.mul_add(v458, -v448);
     let v460 = v459 * 0.5f64;
-    out[0] = v14;
-    out[1] = v22;
-    out[2] = v28;
-    out[3] = v29;
-    out[4] = v30;
-    out[5] = v35;
-    out[6] = v36;
-    out[7] = v37;
-    out[8] = v38;
-    out[9] = v47;
-    out[10] = v50;
-    out[11] = v53;
-    out[12] = v68;
-    out[13] = v82;
-    out[14] = v90;
-    out[15] = v110;
-    out[16] = v124;
-    out[17] = v130;
-    out[18] = v139;
-    out[19] = v144;
-    out[20] = v149;
-    out[21] = v163;
-    out[22] = v166;
-    out[23] = v169;
-    out[24] = v172;
-    out[25] = v174;
-    out[26] = v176;
-    out[27] = v182;
-    out[28] = v190;
-    out[29] = v196;
-    out[30] = v204;
-    out[31] = v214;
-    out[32] = v220;
-    out[33] = v237;
-    out[34] = v244;
-    out[35] = v251;
-    out[36] = v270;
-    out[37] = v273;
-    out[38] = v276;
-    out[39] = v278;
-    out[40] = v281;
-    out[41] = v284;
-    out[42] = S::c(v286);
-    out[43] = S::c(v292);
-    out[44] = S::c(v293);
-    out[45] = v298;
-    out[46] = v301;
-    out[47] = v305;
-    out[48] = v308;
-    out[49] = v314;
-    out[50] = v318;
-    out[51] = v324;
-    out[52] = v327;
-    out[53] = v331;
-    out[54] = v335;
-    out[55] = v340;
-    out[56] = v343;
-    out[57] = v348;
-    out[58] = v349;
-    out[59] = v351;
-    out[60] = v354;
-    out[61] = v358;
-    out[62] = v362;
-    out[63] = v367;
-    out[64] = v368;
-    out[65] = v370;
-    out[66] = v374;
-    out[67] = v377;
-    out[68] = v381;
-    out[69] = v383;
-    out[70] = v384;
-    out[71] = v385;
-    out[72] = v390;
-    out[73] = v395;
-    out[74] = v398;
-    out[75] = v400;
-    out[76] = v401;
-    out[77] = v402;
-    out[78] = v406;
-    out[79] = v410;
-    out[80] = v413;
-    out[81] = S::c(0f64);
-    out[82] = S::c(0f64);
-    out[83] = S::c(0f64);
-    out[84] = v415;
-    out[85] = v416;
-    out[86] = v417;
-    out[87] = S::c(0f64);
-    out[88] = S::c(0f64);
-    out[89] = S::c(0f64);
-    out[90] = v418;
-    out[91] = v419;
-    out[92] = v420;
-    out[93] = v429;
-    out[94] = v436;
-    out[95] = v439;
-    out[96] = v460;
-    out[97] = S::c(0f64);
-    out[98] = S::c(0f64);
-    out[99] = S::c(0f64);
-    out[100] = S::c(0f64);
-}
-/// Kernel `cell_0_x4`: 586 operations, four evaluations in vector lanes.
-#[cfg(target_arch = "x86_64")]
-#[inline(never)]
-#[allow(unused_variables, unused_parens, clippy::all)]
-#[target_feature(enable = "avx,fma")]
-fn cell_0_x4(
-    q: &[[f64; 4]; 4],
-    qd: &[[f64; 4]; 4],
-    p: &[[f64; 4]; 15],
-    out: &mut [[f64; 4]; 101],
-) {
-    use std::arch::x86_64::*;
-    let v1 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0]),
-        runtime::lanes::from_array(q[0]),
-    );
-    let v3 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v1);
-    let v5 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[2]),
-        runtime::lanes::from_array(q[2]),
-    );
-    let v6 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v5);
-    let v8 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1]),
-        runtime::lanes::from_array(q[1]),
-    );
-    let v9 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v8);
-    let v10 = _mm256_add_pd(v3, v6);
-    let v11 = _mm256_add_pd(v10, v9);
-    let c: [[__m256d; 3]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
-        3,
-    >(v11);
-    let v12: __m256d = c[0][0];
-    let v13: __m256d = c[2][0];
-    let v18: __m256d = c[1][0];
-    let v43: __m256d = c[3][0];
-    let v63: __m256d = c[3][1];
-    let v70: __m256d = c[2][1];
-    let v103: __m256d = c[3][2];
-    let v111: __m256d = c[2][2];
-    let v158: __m256d = c[1][1];
-    let v170: __m256d = c[4][0];
-    let v177: __m256d = c[4][1];
-    let v198: __m256d = c[4][2];
-    let v14 = _mm256_fmadd_pd(v6, v13, v12);
-    let v15 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[0]));
-    let v16 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[2]));
-    let v17 = _mm256_mul_pd(v16, v13);
-    let v20 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[1]));
-    let v21 = _mm256_mul_pd(v20, v18);
-    let v22 = _mm256_sub_pd(v17, v21);
-    let v23 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[1]));
-    let v24 = _mm256_mul_pd(v23, runtime::lanes::from_array(q[2]));
-    let v25 = _mm256_mul_pd(v24, v13);
-    let v26 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[0]));
-    let v27 = _mm256_mul_pd(v26, v18);
-    let v28 = _mm256_add_pd(v25, v27);
-    let v29 = _mm256_add_pd(v17, v21);
-    let v30 = _mm256_fmadd_pd(v3, v13, v12);
-    let v31 = _mm256_mul_pd(v15, runtime::lanes::from_array(q[1]));
-    let v32 = _mm256_mul_pd(v31, v13);
-    let v33 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(q[2]));
-    let v34 = _mm256_mul_pd(v33, v18);
-    let v35 = _mm256_sub_pd(v32, v34);
-    let v36 = _mm256_sub_pd(v25, v27);
-    let v37 = _mm256_add_pd(v32, v34);
-    let v38 = _mm256_fmadd_pd(v9, v13, v12);
-    let v41 = _mm256_add_pd(
-        runtime::lanes::from_array(q[3]),
-        runtime::lanes::from_array(p[0]),
-    );
-    let v44 = _mm256_sub_pd(v6, v11);
-    let v45 = _mm256_fmadd_pd(v43, v44, _mm256_set1_pd(1f64));
-    let v46 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v41);
-    let v47 = _mm256_mul_pd(v46, v45);
-    let v48 = _mm256_mul_pd(v16, v43);
-    let v49 = _mm256_fmadd_pd(v20, v13, v48);
-    let v50 = _mm256_mul_pd(v46, v49);
-    let v51 = _mm256_mul_pd(v26, v13);
-    let v52 = _mm256_fmsub_pd(v24, v43, v51);
-    let v53 = _mm256_mul_pd(v46, v52);
-    let v55 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[3]));
-    let v57 = _mm256_mul_pd(v33, runtime::lanes::from_array(qd[2]));
-    let v60 = _mm256_fmadd_pd(v26, runtime::lanes::from_array(qd[0]), v57);
-    let v61 = _mm256_fmadd_pd(v20, runtime::lanes::from_array(qd[1]), v60);
-    let v62 = _mm256_sub_pd(v57, v61);
-    let v64 = _mm256_mul_pd(v61, v63);
-    let v65 = _mm256_mul_pd(v64, v44);
-    let v66 = _mm256_fmadd_pd(v43, v62, v65);
-    let v67 = _mm256_mul_pd(v46, v66);
-    let v68 = _mm256_fmadd_pd(v55, v45, v67);
-    let v69 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[1]));
-    let v71 = _mm256_mul_pd(v61, v70);
-    let v72 = _mm256_mul_pd(v20, v71);
-    let v73 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(q[2]));
-    let v74 = _mm256_mul_pd(v73, runtime::lanes::from_array(qd[0]));
-    let v75 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[2]));
-    let v76 = _mm256_mul_pd(v73, v64);
-    let v77 = _mm256_fmadd_pd(v75, v43, v76);
-    let v78 = _mm256_fmadd_pd(v69, v13, v72);
-    let v79 = _mm256_fmadd_pd(v74, v43, v78);
-    let v80 = _mm256_fmadd_pd(runtime::lanes::from_array(q[0]), v77, v79);
-    let v81 = _mm256_mul_pd(v46, v80);
-    let v82 = _mm256_fmadd_pd(v55, v49, v81);
-    let v83 = _mm256_mul_pd(v73, runtime::lanes::from_array(qd[1]));
-    let v84 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[0]));
-    let v85 = _mm256_mul_pd(v84, v13);
-    let v86 = _mm256_fmsub_pd(v83, v43, v85);
-    let v87 = _mm256_fnmadd_pd(v26, v71, v86);
-    let v88 = _mm256_fmadd_pd(runtime::lanes::from_array(q[1]), v77, v87);
-    let v89 = _mm256_mul_pd(v46, v88);
-    let v90 = _mm256_fmadd_pd(v55, v52, v89);
-    let v91 = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[2]),
-        runtime::lanes::from_array(qd[2]),
-    );
-    let v92 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v91);
-    let v93 = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[0]),
-        runtime::lanes::from_array(qd[0]),
-    );
-    let v94 = _mm256_mul_pd(
-        runtime::lanes::from_array(qd[1]),
-        runtime::lanes::from_array(qd[1]),
-    );
-    let v95 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v94);
-    let v96 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v93, v95);
-    let v97 = _mm256_add_pd(v96, v92);
-    let v98 = _mm256_sub_pd(v92, v97);
-    let v100 = _mm256_mul_pd(_mm256_set1_pd(2f64), v61);
-    let v101 = _mm256_fmsub_pd(
-        runtime::lanes::from_array(q[2]),
-        runtime::lanes::from_array(qd[2]),
-        v100,
-    );
-    let v102 = _mm256_mul_pd(v64, v101);
-    let v104 = _mm256_mul_pd(v61, v61);
-    let v105 = _mm256_mul_pd(v103, v104);
-    let v106 = _mm256_fmadd_pd(v63, v97, v105);
-    let v107 = _mm256_fmadd_pd(v43, v98, v102);
-    let v108 = _mm256_fmadd_pd(v106, v44, v107);
-    let v109 = _mm256_mul_pd(v46, v108);
-    let v110 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[3]), v66, v109);
-    let v112 = _mm256_mul_pd(v104, v111);
-    let v113 = _mm256_fmadd_pd(v70, v97, v112);
-    let v114 = _mm256_mul_pd(v20, v113);
-    let v115 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(qd[2]));
-    let v116 = _mm256_mul_pd(v73, v106);
-    let v117 = _mm256_fmadd_pd(v115, v64, v116);
-    let v118 = _mm256_mul_pd(v33, v64);
-    let v119 = _mm256_fmadd_pd(v115, v43, v118);
-    let v120 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v71, v114);
-    let v121 = _mm256_fmadd_pd(runtime::lanes::from_array(q[0]), v117, v120);
-    let v122 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v119, v121);
-    let v123 = _mm256_mul_pd(v46, v122);
-    let v124 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[3]), v80, v123);
-    let v125 = _mm256_mul_pd(runtime::lanes::from_array(qd[0]), v71);
-    let v126 = _mm256_fmsub_pd(runtime::lanes::from_array(q[1]), v117, v125);
-    let v127 = _mm256_fnmadd_pd(v26, v113, v126);
-    let v128 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v119, v127);
-    let v129 = _mm256_mul_pd(v46, v128);
-    let v130 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[3]), v88, v129);
-    let v131 = _mm256_mul_pd(v23, runtime::lanes::from_array(qd[0]));
-    let v132 = _mm256_fmsub_pd(v15, runtime::lanes::from_array(qd[1]), v131);
-    let v133 = _mm256_mul_pd(v115, v18);
-    let v134 = _mm256_mul_pd(v15, runtime::lanes::from_array(qd[0]));
-    let v135 = _mm256_fmadd_pd(v73, runtime::lanes::from_array(qd[2]), v134);
-    let v136 = _mm256_fmadd_pd(v23, runtime::lanes::from_array(qd[1]), v135);
-    let v137 = _mm256_mul_pd(v33, v43);
-    let v138 = _mm256_fmadd_pd(v13, v132, v133);
-    let v139 = _mm256_fmadd_pd(v137, v136, v138);
-    let v140 = _mm256_fmsub_pd(v23, runtime::lanes::from_array(qd[2]), v83);
-    let v141 = _mm256_mul_pd(v84, v18);
-    let v142 = _mm256_mul_pd(v26, v43);
-    let v143 = _mm256_fmadd_pd(v13, v140, v141);
-    let v144 = _mm256_fmadd_pd(v142, v136, v143);
-    let v145 = _mm256_fnmadd_pd(v15, runtime::lanes::from_array(qd[2]), v74);
-    let v146 = _mm256_mul_pd(v69, v18);
-    let v147 = _mm256_mul_pd(v20, v43);
-    let v148 = _mm256_fmadd_pd(v13, v145, v146);
-    let v149 = _mm256_fmadd_pd(v147, v136, v148);
-    let v150 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v136);
-    let v151 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v94);
-    let v152 = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v93, v151);
-    let v153 = _mm256_fmadd_pd(_mm256_set1_pd(0.25f64), v91, v152);
-    let v154 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v43);
-    let v155 = _mm256_mul_pd(v154, v153);
-    let v156 = _mm256_fmadd_pd(v150, v64, v155);
-    let v157 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v156);
-    let v159 = _mm256_mul_pd(v61, v158);
-    let v160 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v159);
-    let v161 = _mm256_fmadd_pd(v154, v136, v160);
-    let v162 = _mm256_fmadd_pd(v132, v71, v157);
-    let v163 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v161, v162);
-    let v164 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v156);
-    let v165 = _mm256_fmadd_pd(v140, v71, v164);
-    let v166 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v161, v165);
-    let v167 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v156);
-    let v168 = _mm256_fmadd_pd(v145, v71, v167);
-    let v169 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v161, v168);
-    let v171 = _mm256_fmadd_pd(v170, v44, _mm256_set1_pd(0.5f64));
-    let v172 = _mm256_mul_pd(v46, v171);
-    let v173 = _mm256_fmadd_pd(v16, v170, v147);
-    let v174 = _mm256_mul_pd(v46, v173);
-    let v175 = _mm256_fmsub_pd(v24, v170, v142);
-    let v176 = _mm256_mul_pd(v46, v175);
-    let v178 = _mm256_mul_pd(v61, v177);
-    let v179 = _mm256_mul_pd(v178, v44);
-    let v180 = _mm256_fmadd_pd(v170, v62, v179);
-    let v181 = _mm256_mul_pd(v46, v180);
-    let v182 = _mm256_fmadd_pd(v55, v171, v181);
-    let v183 = _mm256_mul_pd(v20, v64);
-    let v184 = _mm256_mul_pd(v73, v178);
-    let v185 = _mm256_fmadd_pd(v75, v170, v184);
-    let v186 = _mm256_fmadd_pd(v69, v43, v183);
-    let v187 = _mm256_fmadd_pd(v74, v170, v186);
-    let v188 = _mm256_fmadd_pd(runtime::lanes::from_array(q[0]), v185, v187);
-    let v189 = _mm256_mul_pd(v46, v188);
-    let v190 = _mm256_fmadd_pd(v55, v173, v189);
-    let v191 = _mm256_mul_pd(v84, v43);
-    let v192 = _mm256_fmsub_pd(v83, v170, v191);
-    let v193 = _mm256_fnmadd_pd(v26, v64, v192);
-    let v194 = _mm256_fmadd_pd(runtime::lanes::from_array(q[1]), v185, v193);
-    let v195 = _mm256_mul_pd(v46, v194);
-    let v196 = _mm256_fmadd_pd(v55, v175, v195);
-    let v197 = _mm256_mul_pd(v178, v101);
-    let v199 = _mm256_mul_pd(v104, v198);
-    let v200 = _mm256_fmadd_pd(v97, v177, v199);
-    let v201 = _mm256_fmadd_pd(v170, v98, v197);
-    let v202 = _mm256_fmadd_pd(v200, v44, v201);
-    let v203 = _mm256_mul_pd(v46, v202);
-    let v204 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[3]), v180, v203);
-    let v205 = _mm256_mul_pd(v20, v106);
-    let v206 = _mm256_mul_pd(v73, v200);
-    let v207 = _mm256_fmadd_pd(v115, v178, v206);
-    let v208 = _mm256_mul_pd(v33, v178);
-    let v209 = _mm256_fmadd_pd(v115, v170, v208);
-    let v210 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v64, v205);
-    let v211 = _mm256_fmadd_pd(runtime::lanes::from_array(q[0]), v207, v210);
-    let v212 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v209, v211);
-    let v213 = _mm256_mul_pd(v46, v212);
-    let v214 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[3]), v188, v213);
-    let v215 = _mm256_mul_pd(runtime::lanes::from_array(qd[0]), v64);
-    let v216 = _mm256_fmsub_pd(runtime::lanes::from_array(q[1]), v207, v215);
-    let v217 = _mm256_fnmadd_pd(v26, v106, v216);
-    let v218 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v209, v217);
-    let v219 = _mm256_mul_pd(v46, v218);
-    let v220 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[3]), v194, v219);
-    let v221 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v11);
-    let c: [[__m256d; 2]; runtime::rodrigues::FAMILY_J] = runtime::lanes::family::<
-        2,
-    >(v221);
-    let v222: __m256d = c[2][0];
-    let v228: __m256d = c[1][0];
-    let v230: __m256d = c[3][0];
-    let v253: __m256d = c[2][1];
-    let v255: __m256d = c[3][1];
-    let v265: __m256d = c[1][1];
-    let v224 = _mm256_mul_pd(
-        _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[0]),
-    );
-    let v225 = _mm256_mul_pd(
-        _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[1]),
-    );
-    let v226 = _mm256_mul_pd(v225, runtime::lanes::from_array(qd[0]));
-    let v227 = _mm256_fmsub_pd(v224, runtime::lanes::from_array(qd[1]), v226);
-    let v229 = _mm256_mul_pd(v75, v228);
-    let v231 = _mm256_mul_pd(
-        _mm256_set1_pd(0.0625f64),
-        runtime::lanes::from_array(q[2]),
-    );
-    let v232 = _mm256_mul_pd(v224, runtime::lanes::from_array(qd[0]));
-    let v233 = _mm256_fmadd_pd(v231, runtime::lanes::from_array(qd[2]), v232);
-    let v234 = _mm256_fmadd_pd(v225, runtime::lanes::from_array(qd[1]), v233);
-    let v235 = _mm256_mul_pd(v73, v230);
-    let v236 = _mm256_fmadd_pd(v222, v227, v229);
-    let v237 = _mm256_fmadd_pd(v235, v234, v236);
-    let v238 = _mm256_mul_pd(v231, runtime::lanes::from_array(qd[1]));
-    let v239 = _mm256_fmsub_pd(v225, runtime::lanes::from_array(qd[2]), v238);
-    let v240 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[0]));
-    let v241 = _mm256_mul_pd(v240, v228);
-    let v242 = _mm256_mul_pd(v15, v230);
-    let v243 = _mm256_fmadd_pd(v222, v239, v241);
-    let v244 = _mm256_fmadd_pd(v242, v234, v243);
-    let v245 = _mm256_mul_pd(v224, runtime::lanes::from_array(qd[2]));
-    let v246 = _mm256_fmsub_pd(v231, runtime::lanes::from_array(qd[0]), v245);
-    let v247 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(qd[1]));
-    let v248 = _mm256_mul_pd(v247, v228);
-    let v249 = _mm256_mul_pd(v23, v230);
-    let v250 = _mm256_fmadd_pd(v222, v246, v248);
-    let v251 = _mm256_fmadd_pd(v249, v234, v250);
-    let v252 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v61);
-    let v254 = _mm256_mul_pd(v252, v253);
-    let v256 = _mm256_mul_pd(v252, v255);
-    let v257 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v234);
-    let v258 = _mm256_mul_pd(_mm256_set1_pd(0.0625f64), v94);
-    let v259 = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v93, v258);
-    let v260 = _mm256_fmadd_pd(_mm256_set1_pd(0.0625f64), v91, v259);
-    let v261 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v230);
-    let v262 = _mm256_mul_pd(v261, v260);
-    let v263 = _mm256_fmadd_pd(v257, v256, v262);
-    let v264 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v263);
-    let v266 = _mm256_mul_pd(v252, v265);
-    let v267 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v266);
-    let v268 = _mm256_fmadd_pd(v261, v234, v267);
-    let v269 = _mm256_fmadd_pd(v227, v254, v264);
-    let v270 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[2]), v268, v269);
-    let v271 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v263);
-    let v272 = _mm256_fmadd_pd(v239, v254, v271);
-    let v273 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[0]), v268, v272);
-    let v274 = _mm256_mul_pd(runtime::lanes::from_array(q[1]), v263);
-    let v275 = _mm256_fmadd_pd(v246, v254, v274);
-    let v276 = _mm256_fmadd_pd(runtime::lanes::from_array(qd[1]), v268, v275);
-    let v277 = _mm256_fmsub_pd(_mm256_set1_pd(0.0625f64), v5, v221);
-    let v278 = _mm256_fmadd_pd(v222, v277, _mm256_set1_pd(1f64));
-    let v279 = _mm256_mul_pd(v224, runtime::lanes::from_array(q[2]));
-    let v280 = _mm256_mul_pd(v279, v222);
-    let v281 = _mm256_fmadd_pd(v23, v228, v280);
-    let v282 = _mm256_mul_pd(v225, runtime::lanes::from_array(q[2]));
-    let v283 = _mm256_mul_pd(v15, v228);
-    let v284 = _mm256_fmsub_pd(v282, v222, v283);
-    let v286 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[1]));
-    let v288 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), runtime::lanes::from_array(p[3]));
-    let v290 = _mm256_sub_pd(runtime::lanes::from_array(p[2]), v288);
-    let v292 = _mm256_fmadd_pd(_mm256_set1_pd(0.125f64), v290, v288);
-    let v293 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[3]));
-    let v294 = _mm256_mul_pd(v23, v13);
-    let v295 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[0]));
-    let v296 = _mm256_mul_pd(v295, runtime::lanes::from_array(q[2]));
-    let v297 = _mm256_mul_pd(v296, v43);
-    let v298 = _mm256_sub_pd(v297, v294);
-    let v299 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v18);
-    let v300 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v1);
-    let v301 = _mm256_fmadd_pd(v300, v43, v299);
-    let v302 = _mm256_mul_pd(v73, v13);
-    let v303 = _mm256_mul_pd(v295, runtime::lanes::from_array(q[1]));
-    let v304 = _mm256_mul_pd(v303, v43);
-    let v305 = _mm256_add_pd(v302, v304);
-    let v306 = _mm256_mul_pd(v63, v26);
-    let v307 = _mm256_fmsub_pd(v306, v44, v142);
-    let v308 = _mm256_mul_pd(v46, v307);
-    let v309 = _mm256_mul_pd(v70, v26);
-    let v310 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v43);
-    let v311 = _mm256_fmadd_pd(v15, v306, v310);
-    let v312 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v311);
-    let v313 = _mm256_fmadd_pd(v20, v309, v312);
-    let v314 = _mm256_mul_pd(v46, v313);
-    let v315 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v13);
-    let v316 = _mm256_fmsub_pd(v24, v306, v315);
-    let v317 = _mm256_fnmadd_pd(v26, v309, v316);
-    let v318 = _mm256_mul_pd(v46, v317);
-    let v319 = _mm256_mul_pd(v225, v222);
-    let v321 = _mm256_mul_pd(
-        _mm256_set1_pd(0.015625f64),
-        runtime::lanes::from_array(q[0]),
-    );
-    let v322 = _mm256_mul_pd(v321, runtime::lanes::from_array(q[2]));
-    let v323 = _mm256_mul_pd(v322, v230);
-    let v324 = _mm256_sub_pd(v323, v319);
-    let v325 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v228);
-    let v326 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v1);
-    let v327 = _mm256_fmadd_pd(v326, v230, v325);
-    let v328 = _mm256_mul_pd(v231, v222);
-    let v329 = _mm256_mul_pd(v321, runtime::lanes::from_array(q[1]));
-    let v330 = _mm256_mul_pd(v329, v230);
-    let v331 = _mm256_add_pd(v328, v330);
-    let v332 = _mm256_mul_pd(v170, v26);
-    let v333 = _mm256_mul_pd(v177, v26);
-    let v334 = _mm256_fmsub_pd(v333, v44, v332);
-    let v335 = _mm256_mul_pd(v46, v334);
-    let v336 = _mm256_mul_pd(_mm256_set1_pd(0.25f64), v170);
-    let v337 = _mm256_fmadd_pd(v15, v333, v336);
-    let v338 = _mm256_mul_pd(runtime::lanes::from_array(q[2]), v337);
-    let v339 = _mm256_fmadd_pd(v20, v306, v338);
-    let v340 = _mm256_mul_pd(v46, v339);
-    let v341 = _mm256_fmsub_pd(v24, v333, v154);
-    let v342 = _mm256_fnmadd_pd(v26, v306, v341);
-    let v343 = _mm256_mul_pd(v46, v342);
-    let v344 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), runtime::lanes::from_array(q[1]));
-    let v345 = _mm256_mul_pd(v344, runtime::lanes::from_array(q[2]));
-    let v346 = _mm256_mul_pd(v345, v43);
-    let v347 = _mm256_mul_pd(v15, v13);
-    let v348 = _mm256_add_pd(v346, v347);
-    let v349 = _mm256_sub_pd(v304, v302);
-    let v350 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v8);
-    let v351 = _mm256_fmadd_pd(v350, v43, v299);
-    let v352 = _mm256_mul_pd(v63, v20);
-    let v353 = _mm256_fmsub_pd(v352, v44, v147);
-    let v354 = _mm256_mul_pd(v46, v353);
-    let v355 = _mm256_mul_pd(v70, v20);
-    let v356 = _mm256_fmadd_pd(v20, v355, v315);
-    let v357 = _mm256_fmadd_pd(v16, v352, v356);
-    let v358 = _mm256_mul_pd(v46, v357);
-    let v359 = _mm256_mul_pd(v26, v355);
-    let v360 = _mm256_fmadd_pd(v23, v352, v310);
-    let v361 = _mm256_fmsub_pd(runtime::lanes::from_array(q[2]), v360, v359);
-    let v362 = _mm256_mul_pd(v46, v361);
-    let v363 = _mm256_mul_pd(v224, v222);
-    let v364 = _mm256_mul_pd(
-        _mm256_set1_pd(0.015625f64),
-        runtime::lanes::from_array(q[1]),
-    );
-    let v365 = _mm256_mul_pd(v364, runtime::lanes::from_array(q[2]));
-    let v366 = _mm256_mul_pd(v365, v230);
-    let v367 = _mm256_add_pd(v363, v366);
-    let v368 = _mm256_sub_pd(v330, v328);
-    let v369 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v8);
-    let v370 = _mm256_fmadd_pd(v369, v230, v325);
-    let v371 = _mm256_mul_pd(v170, v20);
-    let v372 = _mm256_mul_pd(v177, v20);
-    let v373 = _mm256_fmsub_pd(v372, v44, v371);
-    let v374 = _mm256_mul_pd(v46, v373);
-    let v375 = _mm256_fmadd_pd(v20, v352, v154);
-    let v376 = _mm256_fmadd_pd(v16, v372, v375);
-    let v377 = _mm256_mul_pd(v46, v376);
-    let v378 = _mm256_mul_pd(v26, v352);
-    let v379 = _mm256_fmadd_pd(v23, v372, v336);
-    let v380 = _mm256_fmsub_pd(runtime::lanes::from_array(q[2]), v379, v378);
-    let v381 = _mm256_mul_pd(v46, v380);
-    let v382 = _mm256_mul_pd(_mm256_set1_pd(0.125f64), v5);
-    let v383 = _mm256_fmadd_pd(v382, v43, v299);
-    let v384 = _mm256_add_pd(v294, v297);
-    let v385 = _mm256_sub_pd(v346, v347);
-    let v386 = _mm256_sub_pd(v33, v33);
-    let v387 = _mm256_mul_pd(v63, v33);
-    let v388 = _mm256_mul_pd(v387, v44);
-    let v389 = _mm256_fmadd_pd(v43, v386, v388);
-    let v390 = _mm256_mul_pd(v46, v389);
-    let v391 = _mm256_mul_pd(v70, v33);
-    let v392 = _mm256_fmadd_pd(v73, v387, v310);
-    let v393 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v392);
-    let v394 = _mm256_fmadd_pd(v20, v391, v393);
-    let v395 = _mm256_mul_pd(v46, v394);
-    let v396 = _mm256_mul_pd(v26, v391);
-    let v397 = _mm256_fmsub_pd(runtime::lanes::from_array(q[1]), v392, v396);
-    let v398 = _mm256_mul_pd(v46, v397);
-    let v399 = _mm256_mul_pd(_mm256_set1_pd(0.015625f64), v5);
-    let v400 = _mm256_fmadd_pd(v399, v230, v325);
-    let v401 = _mm256_add_pd(v319, v323);
-    let v402 = _mm256_sub_pd(v366, v363);
-    let v403 = _mm256_mul_pd(v177, v33);
-    let v404 = _mm256_mul_pd(v403, v44);
-    let v405 = _mm256_fmadd_pd(v170, v386, v404);
-    let v406 = _mm256_mul_pd(v46, v405);
-    let v407 = _mm256_fmadd_pd(v73, v403, v336);
-    let v408 = _mm256_mul_pd(runtime::lanes::from_array(q[0]), v407);
-    let v409 = _mm256_fmadd_pd(v20, v387, v408);
-    let v410 = _mm256_mul_pd(v46, v409);
-    let v411 = _mm256_mul_pd(v26, v387);
-    let v412 = _mm256_fmsub_pd(runtime::lanes::from_array(q[1]), v407, v411);
-    let v413 = _mm256_mul_pd(v46, v412);
-    let v415 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v45);
-    let v416 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v49);
-    let v417 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v52);
-    let v418 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v171);
-    let v419 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v173);
-    let v420 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v175);
-    let v422 = _mm256_div_pd(runtime::lanes::from_array(p[0]), v41);
-    let v423 = runtime::lanes::map(v422, |x| x.powi(3i32));
-    let v424 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[0]),
-        runtime::lanes::from_array(p[4]),
-    );
-    let v426 = _mm256_sqrt_pd(v422);
-    let v427 = _mm256_mul_pd(runtime::lanes::from_array(p[13]), v426);
-    let v428 = _mm256_fmsub_pd(v424, v423, v427);
-    let v429 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v428);
-    let v431 = _mm256_sub_pd(
-        runtime::lanes::from_array(q[1]),
-        runtime::lanes::from_array(p[6]),
-    );
-    let v432 = _mm256_mul_pd(runtime::lanes::from_array(p[4]), v423);
-    let v434 = _mm256_mul_pd(runtime::lanes::from_array(p[14]), v426);
-    let v435 = _mm256_fmsub_pd(v432, v431, v434);
-    let v436 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v435);
-    let v438 = _mm256_mul_pd(v33, runtime::lanes::from_array(p[7]));
-    let v439 = _mm256_mul_pd(v438, v423);
-    let v441 = _mm256_mul_pd(
-        runtime::lanes::from_array(q[1]),
-        runtime::lanes::from_array(p[14]),
-    );
-    let v442 = _mm256_fmadd_pd(
-        runtime::lanes::from_array(q[0]),
-        runtime::lanes::from_array(p[13]),
-        v441,
-    );
-    let v443 = _mm256_mul_pd(v41, v41);
-    let v444 = _mm256_div_pd(runtime::lanes::from_array(p[0]), v443);
-    let v445 = _mm256_xor_pd(v444, _mm256_set1_pd(-0.0));
-    let v446 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v445);
-    let v447 = _mm256_div_pd(v446, v426);
-    let v448 = _mm256_fmadd_pd(v442, v447, runtime::lanes::from_array(p[12]));
-    let v449 = _mm256_mul_pd(v422, v422);
-    let v451 = _mm256_mul_pd(_mm256_set1_pd(3f64), v445);
-    let v452 = _mm256_mul_pd(v451, v449);
-    let v453 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), runtime::lanes::from_array(p[7]));
-    let v454 = _mm256_mul_pd(v431, v431);
-    let v455 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v454);
-    let v456 = _mm256_fmadd_pd(_mm256_set1_pd(0.5f64), v1, v455);
-    let v457 = _mm256_mul_pd(runtime::lanes::from_array(p[4]), v456);
-    let v458 = _mm256_fmadd_pd(v453, v5, v457);
-    let v459 = _mm256_fmsub_pd(v452, v458, v448);
-    let v460 = _mm256_mul_pd(_mm256_set1_pd(0.5f64), v459);
-    out[0] = runtime::lanes::to_array(v14);
-    out[1] = runtime::lanes::to_array(v22);
-    out[2] = runtime::lanes::to_array(v28);
-    out[3] = runtime::lanes::to_array(v29);
-    out[4] = runtime::lanes::to_array(v30);
-    out[5] = runtime::lanes::to_array(v35);
-    out[6] = runtime::lanes::to_array(v36);
-    out[7] = runtime::lanes::to_array(v37);
-    out[8] = runtime::lanes::to_array(v38);
-    out[9] = runtime::lanes::to_array(v47);
-    out[10] = runtime::lanes::to_array(v50);
-    out[11] = runtime::lanes::to_array(v53);
-    out[12] = runtime::lanes::to_array(v68);
-    out[13] = runtime::lanes::to_array(v82);
-    out[14] = runtime::lanes::to_array(v90);
-    out[15] = runtime::lanes::to_array(v110);
-    out[16] = runtime::lanes::to_array(v124);
-    out[17] = runtime::lanes::to_array(v130);
-    out[18] = runtime::lanes::to_array(v139);
-    out[19] = runtime::lanes::to_array(v144);
-    out[20] = runtime::lanes::to_array(v149);
-    out[21] = runtime::lanes::to_array(v163);
-    out[22] = runtime::lanes::to_array(v166);
-    out[23] = runtime::lanes::to_array(v169);
-    out[24] = runtime::lanes::to_array(v172);
-    out[25] = runtime::lanes::to_array(v174);
-    out[26] = runtime::lanes::to_array(v176);
-    out[27] = runtime::lanes::to_array(v182);
-    out[28] = runtime::lanes::to_array(v190);
-    out[29] = runtime::lanes::to_array(v196);
-    out[30] = runtime::lanes::to_array(v204);
-    out[31] = runtime::lanes::to_array(v214);
-    out[32] = runtime::lanes::to_array(v220);
-    out[33] = runtime::lanes::to_array(v237);
-    out[34] = runtime::lanes::to_array(v244);
-    out[35] = runtime::lanes::to_array(v251);
-    out[36] = runtime::lanes::to_array(v270);
-    out[37] = runtime::lanes::to_array(v273);
-    out[38] = runtime::lanes::to_array(v276);
-    out[39] = runtime::lanes::to_array(v278);
-    out[40] = runtime::lanes::to_array(v281);
-    out[41] = runtime::lanes::to_array(v284);
-    out[42] = runtime::lanes::to_array(v286);
-    out[43] = runtime::lanes::to_array(v292);
-    out[44] = runtime::lanes::to_array(v293);
-    out[45] = runtime::lanes::to_array(v298);
-    out[46] = runtime::lanes::to_array(v301);
-    out[47] = runtime::lanes::to_array(v305);
-    out[48] = runtime::lanes::to_array(v308);
-    out[49] = runtime::lanes::to_array(v314);
-    out[50] = runtime::lanes::to_array(v318);
-    out[51] = runtime::lanes::to_array(v324);
-    out[52] = runtime::lanes::to_array(v327);
-    out[53] = runtime::lanes::to_array(v331);
-    out[54] = runtime::lanes::to_array(v335);
-    out[55] = runtime::lanes::to_array(v340);
-    out[56] = runtime::lanes::to_array(v343);
-    out[57] = runtime::lanes::to_array(v348);
-    out[58] = runtime::lanes::to_array(v349);
-    out[59] = runtime::lanes::to_array(v351);
-    out[60] = runtime::lanes::to_array(v354);
-    out[61] = runtime::lanes::to_array(v358);
-    out[62] = runtime::lanes::to_array(v362);
-    out[63] = runtime::lanes::to_array(v367);
-    out[64] = runtime::lanes::to_array(v368);
-    out[65] = runtime::lanes::to_array(v370);
-    out[66] = runtime::lanes::to_array(v374);
-    out[67] = runtime::lanes::to_array(v377);
-    out[68] = runtime::lanes::to_array(v381);
-    out[69] = runtime::lanes::to_array(v383);
-    out[70] = runtime::lanes::to_array(v384);
-    out[71] = runtime::lanes::to_array(v385);
-    out[72] = runtime::lanes::to_array(v390);
-    out[73] = runtime::lanes::to_array(v395);
-    out[74] = runtime::lanes::to_array(v398);
-    out[75] = runtime::lanes::to_array(v400);
-    out[76] = runtime::lanes::to_array(v401);
-    out[77] = runtime::lanes::to_array(v402);
-    out[78] = runtime::lanes::to_array(v406);
-    out[79] = runtime::lanes::to_array(v410);
-    out[80] = runtime::lanes::to_array(v413);
-    out[81] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[82] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[83] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[84] = runtime::lanes::to_array(v415);
-    out[85] = runtime::lanes::to_array(v416);
-    out[86] = runtime::lanes::to_array(v417);
-    out[87] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[88] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[89] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[90] = runtime::lanes::to_array(v418);
-    out[91] = runtime::lanes::to_array(v419);
-    out[92] = runtime::lanes::to_array(v420);
-    out[93] = runtime::lanes::to_array(v429);
-    out[94] = runtime::lanes::to_array(v436);
-    out[95] = runtime::lanes::to_array(v439);
-    out[96] = runtime::lanes::to_array(v460);
-    out[97] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[98] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[99] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
-    out[100] = runtime::lanes::to_array(_mm256_set1_pd(0f64));
+    out[0] = v14.store();
+    out[1] = v22.store();
+    out[2] = v28.store();
+    out[3] = v29.store();
+    out[4] = v30.store();
+    out[5] = v35.store();
+    out[6] = v36.store();
+    out[7] = v37.store();
+    out[8] = v38.store();
+    out[9] = v47.store();
+    out[10] = v50.store();
+    out[11] = v53.store();
+    out[12] = v68.store();
+    out[13] = v82.store();
+    out[14] = v90.store();
+    out[15] = v110.store();
+    out[16] = v124.store();
+    out[17] = v130.store();
+    out[18] = v139.store();
+    out[19] = v144.store();
+    out[20] = v149.store();
+    out[21] = v163.store();
+    out[22] = v166.store();
+    out[23] = v169.store();
+    out[24] = v172.store();
+    out[25] = v174.store();
+    out[26] = v176.store();
+    out[27] = v182.store();
+    out[28] = v190.store();
+    out[29] = v196.store();
+    out[30] = v204.store();
+    out[31] = v214.store();
+    out[32] = v220.store();
+    out[33] = v237.store();
+    out[34] = v244.store();
+    out[35] = v251.store();
+    out[36] = v270.store();
+    out[37] = v273.store();
+    out[38] = v276.store();
+    out[39] = v278.store();
+    out[40] = v281.store();
+    out[41] = v284.store();
+    out[42] = S::from_param(v286).store();
+    out[43] = S::from_param(v292).store();
+    out[44] = S::from_param(v293).store();
+    out[45] = v298.store();
+    out[46] = v301.store();
+    out[47] = v305.store();
+    out[48] = v308.store();
+    out[49] = v314.store();
+    out[50] = v318.store();
+    out[51] = v324.store();
+    out[52] = v327.store();
+    out[53] = v331.store();
+    out[54] = v335.store();
+    out[55] = v340.store();
+    out[56] = v343.store();
+    out[57] = v348.store();
+    out[58] = v349.store();
+    out[59] = v351.store();
+    out[60] = v354.store();
+    out[61] = v358.store();
+    out[62] = v362.store();
+    out[63] = v367.store();
+    out[64] = v368.store();
+    out[65] = v370.store();
+    out[66] = v374.store();
+    out[67] = v377.store();
+    out[68] = v381.store();
+    out[69] = v383.store();
+    out[70] = v384.store();
+    out[71] = v385.store();
+    out[72] = v390.store();
+    out[73] = v395.store();
+    out[74] = v398.store();
+    out[75] = v400.store();
+    out[76] = v401.store();
+    out[77] = v402.store();
+    out[78] = v406.store();
+    out[79] = v410.store();
+    out[80] = v413.store();
+    out[81] = S::c(0f64).store();
+    out[82] = S::c(0f64).store();
+    out[83] = S::c(0f64).store();
+    out[84] = v415.store();
+    out[85] = v416.store();
+    out[86] = v417.store();
+    out[87] = S::c(0f64).store();
+    out[88] = S::c(0f64).store();
+    out[89] = S::c(0f64).store();
+    out[90] = v418.store();
+    out[91] = v419.store();
+    out[92] = v420.store();
+    out[93] = v429.store();
+    out[94] = v436.store();
+    out[95] = v439.store();
+    out[96] = v460.store();
+    out[97] = S::c(0f64).store();
+    out[98] = S::c(0f64).store();
+    out[99] = S::c(0f64).store();
+    out[100] = S::c(0f64).store();
 }
 /// Kernel `link_forces`: 45 operations, over f64 or dual numbers.
 pub fn link_forces(
@@ -4070,7 +3482,7 @@ pub fn link_forces_tangent(
     runtime::dual::split(&o, out);
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn link_forces_0<S: runtime::scalar::Scalar>(
     t: f64,

@@ -3637,7 +3637,7 @@ pub fn contact(
     unsafe { contact_0::<f64>(t, q, qd, qdd, dir, p, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -4686,7 +4686,7 @@ pub fn contact_jacobian_0(
     unsafe { contact_jacobian_0_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_0_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -4976,7 +4976,7 @@ pub fn contact_jacobian_1(
     unsafe { contact_jacobian_1_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_1_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -5280,7 +5280,7 @@ pub fn contact_jacobian_2(
     unsafe { contact_jacobian_2_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_2_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -5593,7 +5593,7 @@ pub fn contact_jacobian_3(
     unsafe { contact_jacobian_3_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_3_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -5915,7 +5915,7 @@ pub fn contact_jacobian_4(
     unsafe { contact_jacobian_4_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_4_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -6246,7 +6246,7 @@ pub fn contact_jacobian_5(
     unsafe { contact_jacobian_5_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_5_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -6586,7 +6586,7 @@ pub fn contact_jacobian_6(
     unsafe { contact_jacobian_6_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_6_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -6935,7 +6935,7 @@ pub fn contact_jacobian_7(
     unsafe { contact_jacobian_7_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_7_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -7293,7 +7293,7 @@ pub fn contact_jacobian_8(
     unsafe { contact_jacobian_8_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_8_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -7660,7 +7660,7 @@ pub fn contact_jacobian_9(
     unsafe { contact_jacobian_9_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_9_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -8036,7 +8036,7 @@ pub fn contact_jacobian_10(
     unsafe { contact_jacobian_10_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_10_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -8421,7 +8421,7 @@ pub fn contact_jacobian_11(
     unsafe { contact_jacobian_11_0::<f64>(t, q, qd, qdd, dir, p, aux, out) };
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn contact_jacobian_11_0<S: runtime::scalar::Scalar>(
     t: f64,
@@ -9184,7 +9184,7 @@ pub fn cell_0_tangent(
     runtime::dual::split(&o, out);
 }
 #[inline(never)]
-#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
 #[allow(unused_variables, clippy::all)]
 fn cell_0_0<S: runtime::scalar::Scalar>(
     t: f64,

@@ -28,6 +28,15 @@ fn lit(c: f64) -> TokenStream {
     }
 }
 
+/// What a slot of a generic kernel is (`emit_generic`): an `f64`
+/// (constants, time), a parameter (`S::Param`) or a moving value (`S`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Class {
+    Const,
+    Param,
+    Moving,
+}
+
 struct KernelEmitter<'a> {
     tape: &'a Tape,
     /// Chunk of each slot (leaves: none).
@@ -40,10 +49,12 @@ struct KernelEmitter<'a> {
     /// Outputs from this index on go to a second array, `out2` (one tape
     /// for two kernels: `emit_accel`).
     split: Option<usize>,
-    /// Written over `S: runtime::scalar::Scalar` (`emit_generic`): the
-    /// slots that move with q, qd or aux are `S`, the rest `f64`.
+    /// Written over `S: runtime::scalar::Scalar` (`emit_generic`), each
+    /// slot of its class.
     generic: bool,
-    moving: Vec<bool>,
+    class: Vec<Class>,
+    /// A generic kernel's parameters are `S::Param` (for its lane instance).
+    lane_params: bool,
 }
 
 impl<'a> KernelEmitter<'a> {
@@ -91,22 +102,29 @@ impl<'a> KernelEmitter<'a> {
             lanes: false,
             split: None,
             generic: false,
-            moving: Vec::new(),
+            class: Vec::new(),
+            lane_params: false,
         }
     }
 
-    /// The emitter of `emit_generic`: one chunk, no spills.
-    fn new_generic(tape: &'a Tape) -> Self {
-        let mut moving = vec![false; tape.ops.len()];
+    /// The emitter of `emit_generic`: one chunk, no spills. Parameters are
+    /// `S::Param` with `lanes` (a lane instance reads each link's own),
+    /// else `f64` like constants.
+    fn new_generic(tape: &'a Tape, lanes: bool) -> Self {
+        let mut class = vec![Class::Const; tape.ops.len()];
         for (i, op) in tape.ops.iter().enumerate() {
-            moving[i] = match op {
-                Op::Q(_) | Op::Qd(_) | Op::Aux(_) => true,
-                _ => op.operands().any(|a| moving[a as usize]),
+            class[i] = match op {
+                Op::Q(_) | Op::Qd(_) | Op::Aux(_) => Class::Moving,
+                Op::Param(_) if lanes => Class::Param,
+                _ => (op.operands().map(|a| class[a as usize]))
+                    .max()
+                    .unwrap_or(Class::Const),
             };
         }
         Self {
             generic: true,
-            moving,
+            class,
+            lane_params: lanes,
             ..Self::new(tape)
         }
     }
@@ -186,8 +204,11 @@ impl<'a> KernelEmitter<'a> {
 
     fn expr(&self, op: &Op, c: usize) -> TokenStream {
         let r = |s: Slot| self.read(s, c);
-        if self.generic && op.operands().any(|a| self.moving[a as usize]) {
-            return self.expr_moving(op, c);
+        if self.generic {
+            let class = (op.operands().map(|a| self.class[a as usize])).max();
+            if let Some(class @ (Class::Param | Class::Moving)) = class {
+                return self.expr_typed(op, c, class);
+            }
         }
         if self.lanes {
             // One instruction per operation, each lane the scalar one.
@@ -295,49 +316,57 @@ impl<'a> KernelEmitter<'a> {
         }
     }
 
-    /// An operation with a moving operand in a generic kernel: the moving
-    /// operand first where the operation commutes, `sub_from` and
-    /// `div_into` where it does not, constants lifted into fused and power
+    /// An operation of a generic kernel whose result is of `class` (a
+    /// parameter or a moving value): the higher operand first where the
+    /// operation commutes, `sub_from`, `div_into` and the `_p` methods
+    /// where it does not, lower operands lifted into fused and power
     /// operations. The `f64` instance is the plain kernel's code.
-    fn expr_moving(&self, op: &Op, c: usize) -> TokenStream {
-        let m = |s: Slot| self.moving[s as usize];
+    fn expr_typed(&self, op: &Op, c: usize, class: Class) -> TokenStream {
+        let k = |s: Slot| self.class[s as usize];
         let r = |s: Slot| self.read(s, c);
-        let lift = |s: Slot| match m(s) {
-            true => r(s),
-            false => {
-                let v = r(s);
-                quote!(S::c(#v))
+        let lift = |s: Slot| {
+            let v = r(s);
+            match (k(s), class) {
+                (a, b) if a == b => v,
+                (Class::Const, Class::Param) => quote!(S::pc(#v)),
+                (Class::Const, _) => quote!(S::c(#v)),
+                _ => quote!(S::from_param(#v)),
             }
         };
-        let commuted = |a: Slot, b: Slot| match m(a) {
-            true => (r(a), r(b)),
-            false => (r(b), r(a)),
+        // (higher, lower) operands of a commuting operation.
+        let ordered = |a: Slot, b: Slot| if k(a) >= k(b) { (a, b) } else { (b, a) };
+        // `a op b`, or `a.f_p(b)` for a moving a and a parameter b.
+        let mixed = |a: Slot, b: Slot, op: TokenStream, f: &str| {
+            let (x, y) = (r(a), r(b));
+            match (k(a), k(b)) {
+                (Class::Moving, Class::Param) => {
+                    let f = format_ident!("{}", f);
+                    quote!(#x.#f(#y))
+                }
+                _ => quote!(#x #op #y),
+            }
         };
         match *op {
             Op::Add(a, b) => {
-                let (a, b) = commuted(a, b);
-                quote!(#a + #b)
+                let (a, b) = ordered(a, b);
+                mixed(a, b, quote!(+), "add_p")
             }
             Op::Mul(a, b) => {
-                let (a, b) = commuted(a, b);
-                quote!(#a * #b)
+                let (a, b) = ordered(a, b);
+                mixed(a, b, quote!(*), "mul_p")
             }
-            Op::Sub(a, b) if !m(a) => {
-                let (a, b) = (r(a), r(b));
-                quote!(#b.sub_from(#a))
+            Op::Sub(a, b) | Op::Div(a, b) if k(a) < k(b) => {
+                let (x, y) = (r(a), r(b));
+                let f = match (op, k(a)) {
+                    (Op::Sub(..), Class::Const) => quote!(sub_from),
+                    (Op::Sub(..), _) => quote!(rsub_p),
+                    (_, Class::Const) => quote!(div_into),
+                    _ => quote!(rdiv_p),
+                };
+                quote!(#y.#f(#x))
             }
-            Op::Div(a, b) if !m(a) => {
-                let (a, b) = (r(a), r(b));
-                quote!(#b.div_into(#a))
-            }
-            Op::Sub(a, b) => {
-                let (a, b) = (r(a), r(b));
-                quote!(#a - #b)
-            }
-            Op::Div(a, b) => {
-                let (a, b) = (r(a), r(b));
-                quote!(#a / #b)
-            }
+            Op::Sub(a, b) => mixed(a, b, quote!(-), "sub_p"),
+            Op::Div(a, b) => mixed(a, b, quote!(/), "div_p"),
             Op::MulAdd(a, b, c) => {
                 let (a, b, c) = (lift(a), lift(b), lift(c));
                 quote!(#a.mul_add(#b, #c))
@@ -451,11 +480,12 @@ impl<'a> KernelEmitter<'a> {
                     if members.iter().map(|m| m.1).min() != Some(i) {
                         continue;
                     }
-                    let generic = self.generic && self.moving[a as usize];
+                    let class = self.class.get(a as usize).copied();
                     let a = self.read(a, c);
-                    body.push(match generic {
-                        true => family.call_generic(members, a),
-                        false => family.call(members, a, self.lanes),
+                    body.push(match class {
+                        Some(Class::Moving) => family.call_generic(members, a, quote!(S)),
+                        Some(Class::Param) => family.call_generic(members, a, quote!(S::Param)),
+                        _ => family.call(members, a, self.lanes),
                     });
                     members.iter().map(|m| m.1).collect()
                 }
@@ -493,8 +523,16 @@ impl<'a> KernelEmitter<'a> {
                 };
                 body.push(if self.lanes {
                     quote!(out[#k] = runtime::lanes::to_array(#val);)
-                } else if self.generic && !self.moving[s as usize] {
-                    quote!(out[#k] = S::c(#val);)
+                } else if self.generic {
+                    let val = match self.class[s as usize] {
+                        Class::Const => quote!(S::c(#val)),
+                        Class::Param => quote!(S::from_param(#val)),
+                        Class::Moving => val,
+                    };
+                    match self.lane_params {
+                        true => quote!(out[#k] = #val.store();),
+                        false => quote!(out[#k] = #val;),
+                    }
                 } else {
                     match self.split {
                         Some(first) if k >= first => {
@@ -562,11 +600,28 @@ impl<'a> KernelEmitter<'a> {
         let n_spill = self.n_spill;
         let n_dir = 2 * dof;
         let (groups, group_of) = self.families();
+        // A generic chunk's lane instance computes in 256-bit vectors.
+        let features = if self.generic { "avx,fma" } else { "fma" };
+        // A parameter's methods need the trait in scope.
+        let store = match self.lane_params {
+            true => quote!(S::Store),
+            false => quote!(S),
+        };
+        let (param, scope) = match self.lane_params {
+            true => (
+                quote!(S::Param),
+                quote!(
+                    #[allow(unused_imports)]
+                    use runtime::scalar::Scalar as _;
+                ),
+            ),
+            false => (quote!(f64), quote!()),
+        };
         let attributes = match inline {
             true => quote!(#[inline(always)]),
             false => quote! {
                 #[inline(never)]
-                #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+                #[cfg_attr(target_arch = "x86_64", target_feature(enable = #features))]
             },
         };
         let mut chunks = Vec::new();
@@ -579,7 +634,8 @@ impl<'a> KernelEmitter<'a> {
                     #attributes
                     #[allow(unused_variables, clippy::all)]
                     fn #f<S: runtime::scalar::Scalar>(t: f64, q: &[S; #dof], qd: &[S; #dof], qdd: &[f64; #dof],
-                          dir: &[f64; #n_dir], p: &[f64; #n_params], #aux_generic out: &mut [S; #n_out]) {
+                          dir: &[f64; #n_dir], p: &[#param; #n_params], #aux_generic out: &mut [#store; #n_out]) {
+                        #scope
                         #(#body)*
                     }
                 },
@@ -638,6 +694,7 @@ impl<'a> KernelEmitter<'a> {
     /// without `aux`) also `name_tangent`, its outputs and then their derivatives along (dq,
     /// dqd) = `dir`, in dual numbers: what a symbolic tangent tape
     /// (`tmt::cell_outputs::with_tangent`) gives, from the same source.
+    #[allow(clippy::too_many_arguments)]
     fn emit_generic(
         &self,
         name: &str,
@@ -645,6 +702,7 @@ impl<'a> KernelEmitter<'a> {
         n_params: usize,
         n_aux: usize,
         tangent: bool,
+        lanes: bool,
     ) -> TokenStream {
         assert!(
             self.generic && self.n_spill == 0 && self.n_chunks() <= 1,
@@ -683,6 +741,25 @@ impl<'a> KernelEmitter<'a> {
             }
             _ => quote!(),
         };
+        let four = match lanes {
+            true => {
+                assert_eq!(self.aux_len(), 0, "lane kernels read q, qd and p");
+                let f4 = format_ident!("{}_x4", name);
+                let doc = format!(" `{name}` of four links at once, in vector lanes.");
+                quote! {
+                    #[doc = #doc]
+                    #[cfg(target_arch = "x86_64")]
+                    #[target_feature(enable = "avx,fma")]
+                    fn #f4(q: &[[f64; 4]; #dof], qd: &[[f64; 4]; #dof], p: &[[f64; 4]; #n_params],
+                           out: &mut [[f64; 4]; #n_out]) {
+                        use runtime::x4::X4;
+                        let (x, xd, px) = (q.map(X4::from_array), qd.map(X4::from_array), p.map(X4::from_array));
+                        #chunk::<X4>(0.0, &x, &xd, &[0.0; #dof], &[0.0; #n_dir], &px, out);
+                    }
+                }
+            }
+            false => quote!(),
+        };
         quote! {
             #[doc = #doc]
             pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], #aux_param out: &mut [f64; #n_out]) {
@@ -691,6 +768,7 @@ impl<'a> KernelEmitter<'a> {
                 unsafe { #chunk::<f64>(t, q, qd, qdd, dir, p, #aux_arg out) };
             }
             #tangent
+            #four
             #(#chunks)*
         }
     }
@@ -766,13 +844,19 @@ fn with_tangent(
     name: &str,
     dof: usize,
     n_params: usize,
+    lanes: bool,
 ) -> TokenStream {
     if KernelEmitter::fits_generic(tape) {
-        return KernelEmitter::new_generic(tape).emit_generic(name, dof, n_params, 0, true);
+        return KernelEmitter::new_generic(tape, lanes)
+            .emit_generic(name, dof, n_params, 0, true, lanes);
     }
     let plain = KernelEmitter::new(tape).emit(name, dof, n_params, 0);
     let tangent = KernelEmitter::new(tangent).emit(&format!("{name}_tangent"), dof, n_params, 0);
-    quote!(#plain #tangent)
+    let four = match lanes {
+        true => KernelEmitter::new_lanes(tape).emit(&format!("{name}_x4"), dof, n_params, 0),
+        false => quote!(),
+    };
+    quote!(#plain #tangent #four)
 }
 
 /// A cell as others link it (`runtime::links::CompiledCell`): its kernels
@@ -875,10 +959,14 @@ fn emit_cells(links: &runtime::links::LinkKernels) -> EmittedCells {
         let name_p = format!("cell_{c}_pose");
         defs.push(KernelEmitter::new(pose).emit(&name_p, n, CELL_PARAMS, 0));
         let fp = Ident::new(&name_p, Span::call_site());
-        defs.push(with_tangent(tape, tangent, &name, n, CELL_PARAMS));
-        if links.mass_bias {
-            defs.push(KernelEmitter::new_lanes(tape).emit(&name4, n, CELL_PARAMS, 0));
-        }
+        defs.push(with_tangent(
+            tape,
+            tangent,
+            &name,
+            n,
+            CELL_PARAMS,
+            links.mass_bias,
+        ));
         let (f, f4, ft) = (
             Ident::new(&name, Span::call_site()),
             Ident::new(&name4, Span::call_site()),
@@ -941,7 +1029,14 @@ fn emit_link_globals(
     let n_dir = 2 * dof;
     let (forces, forces_tangent) = match (&links.forces, &links.forces_tangent) {
         (Some(tape), Some(tangent)) => {
-            defs.push(with_tangent(tape, tangent, "link_forces", dof, n_params));
+            defs.push(with_tangent(
+                tape,
+                tangent,
+                "link_forces",
+                dof,
+                n_params,
+                false,
+            ));
             (
                 quote! {
                     link_forces(0.0, self.q, self.qd, &[0.0; #dof], &[0.0; #n_dir], self.p,
@@ -1184,7 +1279,7 @@ fn emit_parts(
             .expect("every part kernel is used");
         let (m, np) = (spec.coords.len(), spec.params.len());
         let (name, name_t) = (format!("part_{k}"), format!("part_{k}_tangent"));
-        defs.push(with_tangent(tape, tangent, &name, m, np));
+        defs.push(with_tangent(tape, tangent, &name, m, np, false));
         let (f, ft) = (
             Ident::new(&name, Span::call_site()),
             Ident::new(&name_t, Span::call_site()),
@@ -1308,7 +1403,12 @@ fn family_of(op: &Op) -> Option<(Family, Member, Slot)> {
 impl Family {
     /// `call` in a generic kernel, at a moving argument: the members as
     /// `S`, from the `Scalar` methods.
-    fn call_generic(self, members: &[(Member, usize)], a: TokenStream) -> TokenStream {
+    fn call_generic(
+        self,
+        members: &[(Member, usize)],
+        a: TokenStream,
+        ty: TokenStream,
+    ) -> TokenStream {
         let n = members
             .iter()
             .map(|m| usize::from(m.0.1))
@@ -1319,22 +1419,22 @@ impl Family {
             let lets = members.iter().map(|&((j, k), i)| {
                 let (j, k) = (usize::from(j), usize::from(k));
                 let v = format_ident!("v{}", i);
-                quote!(let #v: S = c[#j][#k];)
+                quote!(let #v: #ty = c[#j][#k];)
             });
             return quote! {
-                let c: [[S; #n]; runtime::rodrigues::FAMILY_J] = #a.rodrigues_family::<#n>();
+                let c: [[#ty; #n]; runtime::rodrigues::FAMILY_J] = #a.rodrigues_family::<#n>();
                 #(#lets)*
             };
         }
         let names = Self::names(members, n);
         let f = match self {
-            Family::SinCos => return quote!(let (#(#names),*): (S, S) = #a.sin_cos();),
+            Family::SinCos => return quote!(let (#(#names),*): (#ty, #ty) = #a.sin_cos();),
             Family::Sinc => quote!(sinc_orders),
             Family::Cosc => quote!(cosc_orders),
             Family::SincRem => quote!(sinc_rem_orders),
             Family::Rodrigues => unreachable!("handled above"),
         };
-        quote!(let [#(#names),*]: [S; #n] = #a.#f::<#n>();)
+        quote!(let [#(#names),*]: [#ty; #n] = #a.#f::<#n>();)
     }
 
     /// The binding of each order below `n`: its member's value, or `_`.
@@ -1414,11 +1514,11 @@ fn emit_groups(tapes: &TapeSet, dof: usize, n_params: usize, generic: bool) -> T
     for (g, ((first, len), tape)) in groups.zip(&tapes.contact_jacobian).enumerate() {
         let name = format!("contact_jacobian_{g}");
         let emitter = match generic {
-            true => KernelEmitter::new_generic(tape),
+            true => KernelEmitter::new_generic(tape, false),
             false => KernelEmitter::new(tape),
         };
         kernels.push(match generic {
-            true => emitter.emit_generic(&name, dof, n_params, n_aux, false),
+            true => emitter.emit_generic(&name, dof, n_params, n_aux, false, false),
             false => emitter.emit(&name, dof, n_params, n_aux),
         });
         let f = Ident::new(&name, Span::call_site());
@@ -1588,8 +1688,8 @@ fn emit_kernels(
                 kernels.push(emit_groups(tapes, dof, n_params, generic_contact))
             }
             (_, KernelKind::Contact) if generic_contact => kernels.push(
-                KernelEmitter::new_generic(&tapes.contact)
-                    .emit_generic(name, dof, n_params, n_aux, false),
+                KernelEmitter::new_generic(&tapes.contact, false)
+                    .emit_generic(name, dof, n_params, n_aux, false, false),
             ),
             (_, KernelKind::ContactJvp) if generic_contact => {
                 kernels.push(emit_contact_jvp(tapes, dof, n_params))

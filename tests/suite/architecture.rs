@@ -49,6 +49,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "rotation",
             "obstacle",
             "lanes",
+            "x4",
             "tape",
             "rows",
             "linalg",

@@ -26,6 +26,7 @@ pub mod scalar;
 pub mod solver;
 pub mod special;
 pub mod tape;
+pub mod x4;
 
 pub use kernels::{
     CompiledModel, Interpreted, KernelKind, Kernels, ModelInfo, N_OUTPUTS, OUTPUT_NAMES, TapeSet,

@@ -1,5 +1,6 @@
 //! The numbers a generic kernel is written over: `f64` for its values,
-//! [`Dual`] for its values and their derivatives along a direction.
+//! [`Dual`] for its values and their derivatives along a direction, and
+//! (lanes.rs) `X4` for four evaluations in the lanes of a vector.
 //!
 //! The generator emits a kernel whose tangent is needed (a link cell, an
 //! eba part, the contact points) once, over `S: Scalar`, and instantiates
@@ -17,7 +18,10 @@ use crate::special;
 
 /// What the generated generic kernels call. `f64 op S` never appears: the
 /// generator writes commutative operations with the moving operand first
-/// and the others through [`Scalar::sub_from`] and [`Scalar::div_into`].
+/// and the others through [`Scalar::sub_from`] and [`Scalar::div_into`];
+/// an operation of a moving value and a parameter through the `_p`
+/// methods (for `f64` and `Dual`, whose parameters are `f64`, the mixed
+/// operators; for lanes, the lanes' own).
 pub trait Scalar:
     Copy
     + Add<Output = Self>
@@ -30,8 +34,29 @@ pub trait Scalar:
     + Div<f64, Output = Self>
     + Neg<Output = Self>
 {
+    /// What the parameters are: `f64`, or for the lane kernels (four
+    /// links at once, each with its own parameters) the lanes themselves.
+    type Param: Scalar;
+    /// How a lane kernel's outputs are stored: the value itself, or for
+    /// lanes an array, so that the kernel writes its caller's rows in place.
+    type Store: Copy;
+    fn store(self) -> Self::Store;
     /// A constant.
     fn c(v: f64) -> Self;
+    /// A constant as a parameter-typed value.
+    #[inline(always)]
+    fn pc(v: f64) -> Self::Param {
+        <Self::Param as Scalar>::c(v)
+    }
+    fn from_param(p: Self::Param) -> Self;
+    fn add_p(self, p: Self::Param) -> Self;
+    fn sub_p(self, p: Self::Param) -> Self;
+    /// p - self.
+    fn rsub_p(self, p: Self::Param) -> Self;
+    fn mul_p(self, p: Self::Param) -> Self;
+    fn div_p(self, p: Self::Param) -> Self;
+    /// p / self.
+    fn rdiv_p(self, p: Self::Param) -> Self;
     /// a - self.
     fn sub_from(self, a: f64) -> Self;
     /// a / self.
@@ -59,6 +84,40 @@ pub trait Scalar:
 }
 
 impl Scalar for f64 {
+    type Param = f64;
+    type Store = f64;
+    #[inline(always)]
+    fn store(self) -> Self {
+        self
+    }
+    #[inline(always)]
+    fn from_param(p: f64) -> Self {
+        Self::c(p)
+    }
+    #[inline(always)]
+    fn add_p(self, p: f64) -> Self {
+        self + p
+    }
+    #[inline(always)]
+    fn sub_p(self, p: f64) -> Self {
+        self - p
+    }
+    #[inline(always)]
+    fn rsub_p(self, p: f64) -> Self {
+        self.sub_from(p)
+    }
+    #[inline(always)]
+    fn mul_p(self, p: f64) -> Self {
+        self * p
+    }
+    #[inline(always)]
+    fn div_p(self, p: f64) -> Self {
+        self / p
+    }
+    #[inline(always)]
+    fn rdiv_p(self, p: f64) -> Self {
+        self.div_into(p)
+    }
     #[inline(always)]
     fn c(v: f64) -> Self {
         v
@@ -154,6 +213,40 @@ impl Scalar for f64 {
 }
 
 impl Scalar for Dual {
+    type Param = f64;
+    type Store = Dual;
+    #[inline(always)]
+    fn store(self) -> Self {
+        self
+    }
+    #[inline(always)]
+    fn from_param(p: f64) -> Self {
+        Self::c(p)
+    }
+    #[inline(always)]
+    fn add_p(self, p: f64) -> Self {
+        self + p
+    }
+    #[inline(always)]
+    fn sub_p(self, p: f64) -> Self {
+        self - p
+    }
+    #[inline(always)]
+    fn rsub_p(self, p: f64) -> Self {
+        self.sub_from(p)
+    }
+    #[inline(always)]
+    fn mul_p(self, p: f64) -> Self {
+        self * p
+    }
+    #[inline(always)]
+    fn div_p(self, p: f64) -> Self {
+        self / p
+    }
+    #[inline(always)]
+    fn rdiv_p(self, p: f64) -> Self {
+        self.div_into(p)
+    }
     #[inline(always)]
     fn c(v: f64) -> Self {
         Dual::constant(v)
