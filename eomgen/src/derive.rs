@@ -231,6 +231,7 @@ fn arm_blocks(
     ArmBlocks {
         rest_mass_bias: cas.to_tape_hoisted(&mass_bias, hoist),
         rest_jvp: cas.to_tape_hoisted(&eq.jvp, hoist),
+        rest_outputs: cas.to_tape_hoisted(&eq.outputs, hoist),
         kinds,
         arms: instances,
         rest_contact,

@@ -1668,6 +1668,7 @@ fn emit_kernels(
             );
         let by_arms = tapes.arm_blocks.as_ref().is_some_and(|b| match kind {
             KernelKind::MassBias | KernelKind::Jvp | KernelKind::Derived => true,
+            KernelKind::Outputs => !b.arms.is_empty(),
             KernelKind::Contact | KernelKind::ContactJacobian | KernelKind::ContactJvp => {
                 b.rest_contact.is_some()
             }
@@ -1809,10 +1810,12 @@ fn emit_arm_blocks(
     let flat = [
         KernelEmitter::new(&blocks.rest_mass_bias).emit("rest_mass_bias", dof, n_params, 0),
         KernelEmitter::new(&blocks.rest_jvp).emit("rest_jvp", dof, n_params, 0),
+        KernelEmitter::new(&blocks.rest_outputs).emit("rest_outputs", dof, n_params, 0),
         KernelEmitter::new(&tapes.derived).emit("own_derived", dof, n_params, 0),
     ];
     let (mut mass_bias, mut jvp, mut derived) = (Vec::new(), Vec::new(), Vec::new());
-    for (a, &start) in blocks.arms.iter().zip(&starts) {
+    let mut outputs = Vec::new();
+    for (i, (a, &start)) in blocks.arms.iter().zip(&starts).enumerate() {
         let module = format_ident!("arm_{}", a.kind);
         let kind = &blocks.kinds[a.kind];
         let (first, m) = (a.first, a.dof);
@@ -1845,6 +1848,21 @@ fn emit_arm_blocks(
                 }
             }
         });
+        // The energies add up; the tip is the first arm's.
+        let tip = match i {
+            0 => quote! {
+                out[runtime::output::TIP].copy_from_slice(&o[runtime::output::TIP]);
+                out[runtime::output::ORIENTATION].copy_from_slice(&o[runtime::output::ORIENTATION]);
+            },
+            _ => quote!(),
+        };
+        outputs.push(quote! {
+            let mut o = [0.0f64; runtime::N_OUTPUTS];
+            #module::outputs(t, #aq, #aqd, #aqdd, &[0.0; #m_dir], #ap, &mut o);
+            out[runtime::output::KINETIC] += o[runtime::output::KINETIC];
+            out[runtime::output::POTENTIAL] += o[runtime::output::POTENTIAL];
+            #tip
+        });
         derived.push(quote! {
             let mut pe = [0.0f64; #m_ext];
             pe[..#nb].copy_from_slice(&p[#off..#off + #nb]);
@@ -1869,6 +1887,12 @@ fn emit_arm_blocks(
         pub fn jvp(#inputs, out: &mut [f64; #dof]) {
             rest_jvp(t, q, qd, qdd, dir, p, out);
             #({ #jvp })*
+        }
+        /// Kernel `outputs`: the rest of the system's energies, each arm's
+        /// added, and the first arm's tip.
+        pub fn outputs(#inputs, out: &mut [f64; runtime::N_OUTPUTS]) {
+            rest_outputs(t, q, qd, qdd, dir, p, out);
+            #({ #outputs })*
         }
         /// Kernel `derived`: the assembly's own, then each arm's base
         /// parameters and derived ones.

@@ -330,6 +330,9 @@ pub struct ArmBlocks {
     pub rest_mass_bias: Tape,
     /// `Jvp` of the same.
     pub rest_jvp: Tape,
+    /// `Outputs` of the same (its energies; the tip is the first arm's).
+    #[serde(default)]
+    pub rest_outputs: Tape,
     /// The kernels of each distinct arm structure, as a single arm's.
     pub kinds: Vec<TapeSet>,
     pub arms: Vec<ArmInstance>,
