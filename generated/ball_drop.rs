@@ -6617,6 +6617,207 @@ fn own_derived_0(
     out[193] = v157;
     out[194] = v156;
 }
+/// Kernel `arm_points_0`: 214 operations in 1 chunk(s).
+#[allow(unused_unsafe)]
+pub fn arm_points_0(
+    t: f64,
+    q: &[f64; 10],
+    qd: &[f64; 10],
+    qdd: &[f64; 10],
+    dir: &[f64; 20],
+    p: &[f64; 211],
+    out: &mut [f64; 30],
+) {
+    runtime::cpu::require_fma();
+    let w = &mut [0.0f64; 0];
+    unsafe { arm_points_0_0(t, q, qd, qdd, dir, p, w, out) };
+}
+#[inline(never)]
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+#[allow(unused_variables, clippy::all)]
+fn arm_points_0_0(
+    t: f64,
+    q: &[f64; 10],
+    qd: &[f64; 10],
+    qdd: &[f64; 10],
+    dir: &[f64; 20],
+    p: &[f64; 211],
+    w: &mut [f64; 0],
+    out: &mut [f64; 30],
+) {
+    let v3 = 0.5f64 * q[0];
+    let (v6, v4): (f64, f64) = runtime::special::sin_cos(v3);
+    let v8 = v6 * p[172];
+    let v9 = v4.mul_add(p[171], -v8);
+    let v11 = runtime::special::sinc(0u8, v3);
+    let v12 = p[7] * v11;
+    let v13 = v9.mul_add(v12, p[3]);
+    let v15 = v4 * p[172];
+    let v16 = v6.mul_add(p[171], v15);
+    let v17 = v16.mul_add(v12, p[4]);
+    let v21 = p[77] * v6;
+    let v22 = p[78].mul_add(v4, -v21);
+    let v23 = v12.mul_add(v22, p[3]);
+    let v25 = 0.5f64 * q[1];
+    let (v31, v26): (f64, f64) = runtime::special::sin_cos(v25);
+    let v27 = p[78] * v6;
+    let v28 = p[77].mul_add(v4, v27);
+    let v29 = v28 * v6;
+    let v30 = v22.mul_add(v4, -v29);
+    let v32 = v22 * v6;
+    let v33 = v28.mul_add(v4, v32);
+    let v34 = v31 * v33;
+    let v35 = v26.mul_add(v30, -v34);
+    let v37 = runtime::special::sinc(0u8, v25);
+    let v38 = p[13] * v37;
+    let v39 = v35.mul_add(v38, v23);
+    let v40 = v12.mul_add(v28, p[4]);
+    let v41 = v26 * v33;
+    let v42 = v31.mul_add(v30, v41);
+    let v43 = v42.mul_add(v38, v40);
+    let v45 = 0.5f64 * q[2];
+    let (v49, v46): (f64, f64) = runtime::special::sin_cos(v45);
+    let v47 = v42 * v31;
+    let v48 = v35.mul_add(v26, -v47);
+    let v50 = v35 * v31;
+    let v51 = v42.mul_add(v26, v50);
+    let v52 = v49 * v51;
+    let v53 = v46.mul_add(v48, -v52);
+    let v55 = runtime::special::sinc(0u8, v45);
+    let v56 = p[19] * v55;
+    let v57 = v53.mul_add(v56, v39);
+    let v58 = v46 * v51;
+    let v59 = v49.mul_add(v48, v58);
+    let v60 = v59.mul_add(v56, v43);
+    let v62 = 0.5f64 * q[3];
+    let (v66, v63): (f64, f64) = runtime::special::sin_cos(v62);
+    let v64 = v59 * v49;
+    let v65 = v53.mul_add(v46, -v64);
+    let v67 = v53 * v49;
+    let v68 = v59.mul_add(v46, v67);
+    let v69 = v66 * v68;
+    let v70 = v63.mul_add(v65, -v69);
+    let v72 = runtime::special::sinc(0u8, v62);
+    let v73 = p[25] * v72;
+    let v74 = v70.mul_add(v73, v57);
+    let v75 = v63 * v68;
+    let v76 = v66.mul_add(v65, v75);
+    let v77 = v76.mul_add(v73, v60);
+    let v79 = 0.5f64 * q[4];
+    let (v83, v80): (f64, f64) = runtime::special::sin_cos(v79);
+    let v81 = v76 * v66;
+    let v82 = v70.mul_add(v63, -v81);
+    let v84 = v70 * v66;
+    let v85 = v76.mul_add(v63, v84);
+    let v86 = v83 * v85;
+    let v87 = v80.mul_add(v82, -v86);
+    let v89 = runtime::special::sinc(0u8, v79);
+    let v90 = p[31] * v89;
+    let v91 = v87.mul_add(v90, v74);
+    let v92 = v80 * v85;
+    let v93 = v83.mul_add(v82, v92);
+    let v94 = v93.mul_add(v90, v77);
+    let v96 = 0.5f64 * q[5];
+    let (v100, v97): (f64, f64) = runtime::special::sin_cos(v96);
+    let v98 = v93 * v83;
+    let v99 = v87.mul_add(v80, -v98);
+    let v101 = v87 * v83;
+    let v102 = v93.mul_add(v80, v101);
+    let v103 = v100 * v102;
+    let v104 = v97.mul_add(v99, -v103);
+    let v106 = runtime::special::sinc(0u8, v96);
+    let v107 = p[37] * v106;
+    let v108 = v104.mul_add(v107, v91);
+    let v109 = v97 * v102;
+    let v110 = v100.mul_add(v99, v109);
+    let v111 = v110.mul_add(v107, v94);
+    let v113 = 0.5f64 * q[6];
+    let (v117, v114): (f64, f64) = runtime::special::sin_cos(v113);
+    let v115 = v110 * v100;
+    let v116 = v104.mul_add(v97, -v115);
+    let v118 = v104 * v100;
+    let v119 = v110.mul_add(v97, v118);
+    let v120 = v117 * v119;
+    let v121 = v114.mul_add(v116, -v120);
+    let v123 = runtime::special::sinc(0u8, v113);
+    let v124 = p[43] * v123;
+    let v125 = v121.mul_add(v124, v108);
+    let v126 = v114 * v119;
+    let v127 = v117.mul_add(v116, v126);
+    let v128 = v127.mul_add(v124, v111);
+    let v130 = 0.5f64 * q[7];
+    let (v134, v131): (f64, f64) = runtime::special::sin_cos(v130);
+    let v132 = v127 * v117;
+    let v133 = v121.mul_add(v114, -v132);
+    let v135 = v121 * v117;
+    let v136 = v127.mul_add(v114, v135);
+    let v137 = v134 * v136;
+    let v138 = v131.mul_add(v133, -v137);
+    let v140 = runtime::special::sinc(0u8, v130);
+    let v141 = p[49] * v140;
+    let v142 = v138.mul_add(v141, v125);
+    let v143 = v131 * v136;
+    let v144 = v134.mul_add(v133, v143);
+    let v145 = v144.mul_add(v141, v128);
+    let v147 = 0.5f64 * q[8];
+    let (v151, v148): (f64, f64) = runtime::special::sin_cos(v147);
+    let v149 = v144 * v134;
+    let v150 = v138.mul_add(v131, -v149);
+    let v152 = v138 * v134;
+    let v153 = v144.mul_add(v131, v152);
+    let v154 = v151 * v153;
+    let v155 = v148.mul_add(v150, -v154);
+    let v157 = runtime::special::sinc(0u8, v147);
+    let v158 = p[55] * v157;
+    let v159 = v155.mul_add(v158, v142);
+    let v160 = v148 * v153;
+    let v161 = v151.mul_add(v150, v160);
+    let v162 = v161.mul_add(v158, v145);
+    let v164 = 0.5f64 * q[9];
+    let (v168, v165): (f64, f64) = runtime::special::sin_cos(v164);
+    let v166 = v161 * v151;
+    let v167 = v155.mul_add(v148, -v166);
+    let v169 = v155 * v151;
+    let v170 = v161.mul_add(v148, v169);
+    let v171 = v168 * v170;
+    let v172 = v165.mul_add(v167, -v171);
+    let v174 = runtime::special::sinc(0u8, v164);
+    let v175 = p[61] * v174;
+    let v176 = v172.mul_add(v175, v159);
+    let v177 = v165 * v170;
+    let v178 = v168.mul_add(v167, v177);
+    let v179 = v178.mul_add(v175, v162);
+    out[0] = v13;
+    out[1] = v17;
+    out[2] = p[5];
+    out[3] = v39;
+    out[4] = v43;
+    out[5] = p[5];
+    out[6] = v57;
+    out[7] = v60;
+    out[8] = p[5];
+    out[9] = v74;
+    out[10] = v77;
+    out[11] = p[5];
+    out[12] = v91;
+    out[13] = v94;
+    out[14] = p[5];
+    out[15] = v108;
+    out[16] = v111;
+    out[17] = p[5];
+    out[18] = v125;
+    out[19] = v128;
+    out[20] = p[5];
+    out[21] = v142;
+    out[22] = v145;
+    out[23] = p[5];
+    out[24] = v159;
+    out[25] = v162;
+    out[26] = p[5];
+    out[27] = v176;
+    out[28] = v179;
+    out[29] = p[5];
+}
 /// Kernel `rest_contact`: 0 operations in 1 chunk(s).
 #[allow(unused_unsafe)]
 pub fn rest_contact(
@@ -6866,30 +7067,26 @@ pub fn contact(
     out: &mut [f64; 63],
 ) {
     {
-        let mut c = [0.0f64; 164];
-        arm_0::contact(
+        arm_points_0(
             t,
             q[0..0 + 10].try_into().expect("an arm's slice"),
             qd[0..0 + 10].try_into().expect("an arm's slice"),
             qdd[0..0 + 10].try_into().expect("an arm's slice"),
             &[0.0; 20],
             p[338..338 + 211].try_into().expect("an arm's slice"),
-            &mut c,
+            (&mut out[0..30]).try_into().expect("an arm's points"),
         );
-        out[0..30].copy_from_slice(&c[..30]);
     }
     {
-        let mut c = [0.0f64; 164];
-        arm_0::contact(
+        arm_points_0(
             t,
             q[10..10 + 10].try_into().expect("an arm's slice"),
             qd[10..10 + 10].try_into().expect("an arm's slice"),
             qdd[10..10 + 10].try_into().expect("an arm's slice"),
             &[0.0; 20],
             p[549..549 + 211].try_into().expect("an arm's slice"),
-            &mut c,
+            (&mut out[30..60]).try_into().expect("an arm's points"),
         );
-        out[30..60].copy_from_slice(&c[..30]);
     }
     {
         rest_contact(

@@ -1933,6 +1933,7 @@ fn emit_arm_contact(
     let (starts, _) = blocks.derived_layout(tapes.info.derived);
     let (width, tail) = (6 + 3 * dof, 3 + 3 * dof);
     let (mut points, mut groups, mut tangents) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut defs, mut emitted_points) = (Vec::new(), Vec::new());
     let (mut pt, mut g0) = (0, 0);
     for (a, &start) in blocks.arms.iter().zip(&starts) {
         let module = format_ident!("arm_{}", a.kind);
@@ -1952,9 +1953,21 @@ fn emit_arm_contact(
             #module::contact(t, #aq, #aqd, #aqdd, &[0.0; #m_dir], #ap, &mut c);
         };
         let (a3, b3) = (3 * pt, 3 * (pt + np));
+        // The positions alone, without the frames (which only the groups
+        // read): the kind's `contact` tape sliced.
+        let points_fn = format_ident!("arm_points_{}", a.kind);
+        if nf > 0 && !emitted_points.contains(&a.kind) {
+            emitted_points.push(a.kind);
+            let tape = blocks.kinds[a.kind].contact.slice(0, np3);
+            let name = points_fn.to_string();
+            defs.push(KernelEmitter::new(&tape).emit(&name, m, info.extended_params(), 0));
+        }
+        let points_of = match nf {
+            0 => quote!(#module::contact),
+            _ => quote!(#points_fn),
+        };
         points.push(quote! {
-            #own_contact
-            out[#a3..#b3].copy_from_slice(&c[..#np3]);
+            #points_of(t, #aq, #aqd, #aqdd, &[0.0; #m_dir], #ap, (&mut out[#a3..#b3]).try_into().expect("an arm's points"));
         });
         let (frames, aux) = match nf {
             0 => (quote!(), quote!()),
@@ -1995,7 +2008,6 @@ fn emit_arm_contact(
         g0 += ng;
     }
     let n_rest: usize = rest.groups.iter().sum();
-    let mut defs = Vec::new();
     if n_rest > 0 {
         defs.push(KernelEmitter::new(&rest.contact).emit("rest_contact", dof, n_params, 0));
         defs.push(KernelEmitter::new(&rest.contact_jvp).emit("rest_contact_jvp", dof, n_params, 0));

@@ -264,6 +264,35 @@ impl Tape {
         }
     }
 
+    /// The tape of the outputs `first..first + len` alone, without the
+    /// operations only the others need.
+    pub fn slice(&self, first: usize, len: usize) -> Tape {
+        let outputs = &self.outputs[first..first + len];
+        let mut needed = vec![false; self.ops.len()];
+        for &s in outputs {
+            needed[s as usize] = true;
+        }
+        for i in (0..self.ops.len()).rev() {
+            if needed[i] {
+                for a in self.ops[i].operands() {
+                    needed[a as usize] = true;
+                }
+            }
+        }
+        let mut new_slot = vec![Slot::MAX; self.ops.len()];
+        let mut ops = Vec::new();
+        for (i, op) in self.ops.iter().enumerate() {
+            if needed[i] {
+                new_slot[i] = ops.len() as Slot;
+                ops.push(op.map_slots(|a| new_slot[a as usize]));
+            }
+        }
+        Tape {
+            ops,
+            outputs: outputs.iter().map(|&s| new_slot[s as usize]).collect(),
+        }
+    }
+
     /// Number of arithmetic operations (inputs and constants excluded; a
     /// fused multiply-add counts as the two it replaces).
     pub fn op_count(&self) -> usize {
@@ -275,5 +304,46 @@ impl Tape {
                 _ => 1,
             })
             .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A slice computes its outputs as the whole tape does, without the
+    /// operations only the others need.
+    #[test]
+    fn a_slice_keeps_what_its_outputs_need() {
+        // out = [q0 * q1, sin(q0) + p0, q1 + 2]
+        let tape = Tape {
+            ops: vec![
+                Op::Q(0),
+                Op::Q(1),
+                Op::Mul(0, 1),
+                Op::Sin(0),
+                Op::Param(0),
+                Op::Add(3, 4),
+                Op::Const(2.0),
+                Op::Add(1, 6),
+            ],
+            outputs: vec![2, 5, 7],
+        };
+        let inp = Inputs {
+            t: 0.0,
+            q: &[0.3, 1.7],
+            qd: &[0.0, 0.0],
+            qdd: &[],
+            dir: &[],
+            p: &[0.25],
+            aux: &[],
+        };
+        let (mut slots, mut all) = (Vec::new(), [0.0; 3]);
+        tape.eval(&inp, &mut slots, &mut all);
+        let part = tape.slice(1, 2);
+        assert_eq!(part.ops.len(), 7, "q0 * q1 is not needed");
+        let mut out = [0.0; 2];
+        part.eval(&inp, &mut slots, &mut out);
+        assert_eq!(out, [all[1], all[2]]);
     }
 }
