@@ -264,17 +264,8 @@ impl<'a> KernelEmitter<'a> {
                 let (a, b) = (r(a), r(b));
                 quote!(#a * #b)
             }
-            Op::MulAdd(a, b, c) => {
-                let (a, b, c) = (r(a), r(b), r(c));
-                quote!(#a.mul_add(#b, #c))
-            }
-            Op::MulSub(a, b, c) => {
-                let (a, b, c) = (r(a), r(b), r(c));
-                quote!(#a.mul_add(#b, -#c))
-            }
-            Op::NegMulAdd(a, b, c) => {
-                let (a, b, c) = (r(a), r(b), r(c));
-                quote!((-#a).mul_add(#b, #c))
+            Op::MulAdd(a, b, c) | Op::MulSub(a, b, c) | Op::NegMulAdd(a, b, c) => {
+                fused(op, [r(a), r(b), r(c)])
             }
             Op::Div(a, b) => {
                 let (a, b) = (r(a), r(b));
@@ -367,17 +358,8 @@ impl<'a> KernelEmitter<'a> {
             }
             Op::Sub(a, b) => mixed(a, b, quote!(-), "sub_p"),
             Op::Div(a, b) => mixed(a, b, quote!(/), "div_p"),
-            Op::MulAdd(a, b, c) => {
-                let (a, b, c) = (lift(a), lift(b), lift(c));
-                quote!(#a.mul_add(#b, #c))
-            }
-            Op::MulSub(a, b, c) => {
-                let (a, b, c) = (lift(a), lift(b), lift(c));
-                quote!(#a.mul_add(#b, -#c))
-            }
-            Op::NegMulAdd(a, b, c) => {
-                let (a, b, c) = (lift(a), lift(b), lift(c));
-                quote!((-#a).mul_add(#b, #c))
+            Op::MulAdd(a, b, c) | Op::MulSub(a, b, c) | Op::NegMulAdd(a, b, c) => {
+                fused(op, [lift(a), lift(b), lift(c)])
             }
             Op::Powf(a, b) => {
                 let (a, b) = (lift(a), lift(b));
@@ -808,6 +790,16 @@ impl<'a> KernelEmitter<'a> {
             }
             #(#chunks)*
         }
+    }
+}
+
+/// A fused operation on its operands' code: a * b + c, a * b - c, or
+/// c - a * b, each with one rounding.
+fn fused(op: &Op, [a, b, c]: [TokenStream; 3]) -> TokenStream {
+    match op {
+        Op::MulAdd(..) => quote!(#a.mul_add(#b, #c)),
+        Op::MulSub(..) => quote!(#a.mul_add(#b, -#c)),
+        _ => quote!((-#a).mul_add(#b, #c)),
     }
 }
 

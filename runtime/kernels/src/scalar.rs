@@ -83,41 +83,49 @@ pub trait Scalar:
     fn rodrigues_family<const N: usize>(self) -> [[Self; N]; FAMILY_J];
 }
 
+/// The parameter side of a `Scalar` whose parameters are `f64` (`f64`
+/// and `Dual`): the mixed operators, and outputs stored as they are.
+macro_rules! f64_parameters {
+    ($store:ty) => {
+        type Param = f64;
+        type Store = $store;
+        #[inline(always)]
+        fn store(self) -> Self {
+            self
+        }
+        #[inline(always)]
+        fn from_param(p: f64) -> Self {
+            Self::c(p)
+        }
+        #[inline(always)]
+        fn add_p(self, p: f64) -> Self {
+            self + p
+        }
+        #[inline(always)]
+        fn sub_p(self, p: f64) -> Self {
+            self - p
+        }
+        #[inline(always)]
+        fn rsub_p(self, p: f64) -> Self {
+            self.sub_from(p)
+        }
+        #[inline(always)]
+        fn mul_p(self, p: f64) -> Self {
+            self * p
+        }
+        #[inline(always)]
+        fn div_p(self, p: f64) -> Self {
+            self / p
+        }
+        #[inline(always)]
+        fn rdiv_p(self, p: f64) -> Self {
+            self.div_into(p)
+        }
+    };
+}
+
 impl Scalar for f64 {
-    type Param = f64;
-    type Store = f64;
-    #[inline(always)]
-    fn store(self) -> Self {
-        self
-    }
-    #[inline(always)]
-    fn from_param(p: f64) -> Self {
-        Self::c(p)
-    }
-    #[inline(always)]
-    fn add_p(self, p: f64) -> Self {
-        self + p
-    }
-    #[inline(always)]
-    fn sub_p(self, p: f64) -> Self {
-        self - p
-    }
-    #[inline(always)]
-    fn rsub_p(self, p: f64) -> Self {
-        self.sub_from(p)
-    }
-    #[inline(always)]
-    fn mul_p(self, p: f64) -> Self {
-        self * p
-    }
-    #[inline(always)]
-    fn div_p(self, p: f64) -> Self {
-        self / p
-    }
-    #[inline(always)]
-    fn rdiv_p(self, p: f64) -> Self {
-        self.div_into(p)
-    }
+    f64_parameters!(f64);
     #[inline(always)]
     fn c(v: f64) -> Self {
         v
@@ -213,40 +221,7 @@ impl Scalar for f64 {
 }
 
 impl Scalar for Dual {
-    type Param = f64;
-    type Store = Dual;
-    #[inline(always)]
-    fn store(self) -> Self {
-        self
-    }
-    #[inline(always)]
-    fn from_param(p: f64) -> Self {
-        Self::c(p)
-    }
-    #[inline(always)]
-    fn add_p(self, p: f64) -> Self {
-        self + p
-    }
-    #[inline(always)]
-    fn sub_p(self, p: f64) -> Self {
-        self - p
-    }
-    #[inline(always)]
-    fn rsub_p(self, p: f64) -> Self {
-        self.sub_from(p)
-    }
-    #[inline(always)]
-    fn mul_p(self, p: f64) -> Self {
-        self * p
-    }
-    #[inline(always)]
-    fn div_p(self, p: f64) -> Self {
-        self / p
-    }
-    #[inline(always)]
-    fn rdiv_p(self, p: f64) -> Self {
-        self.div_into(p)
-    }
+    f64_parameters!(Dual);
     #[inline(always)]
     fn c(v: f64) -> Self {
         Dual::constant(v)
