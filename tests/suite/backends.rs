@@ -994,12 +994,23 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
     // Structures no compiled-in model has, whose link shapes one has:
     // pcc without twist (tentacle3d's), with twist (cantilever3d's), pcs's
     // half-arcs (rod_swing's), rom slices of another order (rom_arm's).
+    // And arms with chambers on bare arms' cells: stiff_flop at another
+    // element count, and tentacle3d with chambers in it (its cells read
+    // their segment's actuation loads, zero where none act).
     let mut rng = Rng::new(11);
+    let dir = tempfile::tempdir().unwrap();
+    let chambered = dir.path().join("chambered.toml");
+    let text = std::fs::read_to_string(model_path("tentacle3d")).unwrap();
+    let chambers = "[segment.chambers]\ncount = 3\nradius = 0.002\ndistance = 0.006\ninputs = [\"p\", \"q\", \"q\"]\n\n[inputs.p]\nkind = \"constant\"\nvalue = 3000.0\n\n[inputs.q]\nkind = \"constant\"\nvalue = 0.0\n\n[tip]";
+    std::fs::write(&chambered, text.replace("[tip]", chambers)).unwrap();
+    let chambered = chambered.to_string_lossy().into_owned();
     for (model, set) in [
         ("tentacle3d", "segment.0.elements=13"),
         ("cantilever3d", "segment.0.elements=7"),
         ("rod_swing", "segment.0.elements=4"),
         ("rom_arm", "segment.0.order=5"),
+        ("stiff_flop", "segment.0.elements=5"),
+        (chambered.as_str(), "segment.0.elements=4"),
     ] {
         let what = format!("{model} {set}");
         let sets = [eomgen::model::Override::parse(set).unwrap()];
@@ -1009,18 +1020,21 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
             "{what}: not linked"
         );
         assert_eq!(l.arm.backend(), "compiled", "{what}");
-        let tapes = eomgen::derive::derive(&l.model);
-        let p: Vec<f64> = eomgen::load::parameters(&l.model)
-            .into_iter()
-            .map(|(_, v)| v)
-            .collect();
-        let interpreted = Arm::new(Interpreted::new(tapes), p);
+        // The interpreter's flat tapes, with the same inputs driving them.
+        let cache = tempfile::tempdir().unwrap();
+        let interpreted = load(
+            model,
+            &sets,
+            BackendChoice::Interpreted,
+            Some(cache.path().to_path_buf()),
+        )
+        .unwrap();
         assert_eq!(
             l.arm.info().coordinates,
-            interpreted.info().coordinates,
+            interpreted.arm.info().coordinates,
             "{what}"
         );
-        assert_backends_agree(&what, &*l.arm, &interpreted, &mut rng, 4);
+        assert_backends_agree(&what, &*l.arm, &*interpreted.arm, &mut rng, 4);
     }
 }
 
@@ -1123,7 +1137,9 @@ fn a_run_says_which_route_it_took_and_why() {
         (l.arm.backend(), l.route)
     };
     let auto = BackendChoice::Auto;
-    // Chambers in a 3D pcc arm: a link shape no bundled model has.
+    // A tapered 3D pcc arm with chambers: no bundled model has its
+    // structure, but every link shape (cells read their actuation loads,
+    // zero where none act: tentacle3d's bare cells serve it).
     let dir = tempfile::tempdir().unwrap();
     let tapered = dir.path().join("tapered.toml");
     std::fs::write(
@@ -1160,16 +1176,29 @@ value = 1000.0
     )
     .unwrap();
     let tapered = tapered.to_string_lossy().into_owned();
+    // A stretching pcc arm whose section keeps its area: a link shape no
+    // bundled model has (stiff_flop's stretch thins its section).
+    let stretching = dir.path().join("stretching.toml");
+    let text = std::fs::read_to_string(model_path("tentacle3d"))
+        .unwrap()
+        .replace("twist = false", "twist = false\nextension = true");
+    std::fs::write(&stretching, text).unwrap();
+    let stretching = stretching.to_string_lossy().into_owned();
     let (b, r) = route("soft_finger", "", auto);
     assert_eq!((b, r.as_str()), ("compiled", "compiled in as soft_finger"));
-    let (b, r) = route("tentacle3d", "segment.0.elements=13", auto);
-    assert_eq!(b, "compiled");
-    assert!(r.contains("link cells"), "{r}");
+    for (model, set) in [
+        ("tentacle3d", "segment.0.elements=13"),
+        (tapered.as_str(), ""),
+    ] {
+        let (b, r) = route(model, set, auto);
+        assert_eq!(b, "compiled", "{model} {set}");
+        assert!(r.contains("link cells"), "{model}: {r}");
+    }
     for (model, set, why) in [
         ("soft_finger", "segment.0.elements=7", "planar"),
         ("falling_ball", "arm.left.segment.0.elements=3", "assembly"),
         ("finger_tap", "segment.0.elements=5", "obstacles"),
-        (tapered.as_str(), "", "link shapes"),
+        (stretching.as_str(), "", "link shapes"),
     ] {
         let (b, r) = route(model, set, auto);
         assert_eq!(b, "interpreted", "{model} {set}");

@@ -12,7 +12,8 @@
 //! driven joint torques. Chambers and tendons load each element's strain
 //! by their segment's loads (`actuation::segment_loads`: linear in the
 //! strain), which a small kernel of the parameters gives and the cells
-//! read as parameters. A rom
+//! read as parameters: every cell reads them, zero where no actuator acts,
+//! so that an arm with chambers runs on a bare arm's cells. A rom
 //! segment's slices are links whose cell coordinates are fixed
 //! combinations of the segment's coefficients (`LocalCoordinate`); its
 //! strain energy, integrated exactly over the segment, is one more small
@@ -76,7 +77,6 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             shear: g.shear,
             incompressible: g.incompressible,
             rom: rom.is_some(),
-            actuated: load.is_some(),
             planar: (!spatial).then_some((g.method, g.joints)),
             kind: method.cell_kind(g, spatial),
         };
@@ -86,7 +86,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             }
             let kernels = match spatial {
                 true => derive_cell(shape),
-                false => derive_planar_cell(g, shape.actuated)?,
+                false => derive_planar_cell(g)?,
             };
             cells.push((shape, kernels));
             Some(cells.len() - 1)
@@ -98,7 +98,6 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             .then(|| {
                 cell_of(Shape {
                     kind: CellKind::BeforeJoint,
-                    actuated: false,
                     ..shape
                 })
             })
@@ -286,9 +285,6 @@ struct Shape {
     /// the whole segment (`derive_forces`), and its bending and twist too
     /// unless the section thins, when they go slice by slice as here.
     rom: bool,
-    /// Actuators load the link's strain (the last `ACTUATION_LOADS`
-    /// parameters).
-    actuated: bool,
     /// A planar element of this method and joint placement
     /// (`planar_cell`).
     planar: Option<(Method, Joints)>,
@@ -466,7 +462,6 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         shear,
         incompressible,
         rom,
-        actuated,
         kind,
         ..
     } = shape;
@@ -523,12 +518,10 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     // The actuators' potential on the link's strain, as the whole arm has
     // it (the outputs' potential energy is the strain energy alone).
     let stored = elastic;
-    let elastic = if actuated {
-        let work = strain_work(cas, loads, st, [tw, by, bz], thin.map(|t| t.1));
-        cas.sub(elastic, work)
-    } else {
-        elastic
-    };
+    // Every cell reads its segment's loads (zero where no actuator acts),
+    // so that an actuated arm and a bare one share their cells.
+    let work = strain_work(cas, loads, st, [tw, by, bz], thin.map(|t| t.1));
+    let elastic = cas.sub(elastic, work);
     // Each half of a half-arc element carries half its energies.
     let share = |cas: &mut Cas, e: ExprId| match kind {
         CellKind::HalfArc => cas.scaled(0.5, e),

@@ -21,9 +21,9 @@ use crate::tmt::planar::{Element2, PlanarArm, half_k_sq};
 use crate::tmt::system::{Coordinates, ParamSymbols};
 
 /// The cell, its tangent and its pose cell of one element of segment
-/// shape `g` (with its segment's actuation loads when `actuated`), or None
-/// when the element is not one body.
-pub(super) fn derive_planar_cell(g: &SegmentShape, actuated: bool) -> Option<[Tape; 3]> {
+/// shape `g` (with its segment's actuation loads, zero where no actuator
+/// acts), or None when the element is not one body.
+pub(super) fn derive_planar_cell(g: &SegmentShape) -> Option<[Tape; 3]> {
     let mut cas = Cas::new();
     let cas = &mut cas;
     let coords = Coordinates::new(cas, vec!["theta".into()]);
@@ -64,12 +64,8 @@ pub(super) fn derive_planar_cell(g: &SegmentShape, actuated: bool) -> Option<[Ta
     let bend = cas.sub(q, el.rest);
     let stored = half_k_sq(cas, el.stiff, bend);
     let rayleigh = half_k_sq(cas, el.damp, qd);
-    let elastic = if actuated {
-        let work = strain_work(cas, loads, zero, [zero, zero, q], None);
-        cas.sub(stored, work)
-    } else {
-        stored
-    };
+    let work = strain_work(cas, loads, zero, [zero, zero, q], None);
+    let elastic = cas.sub(stored, work);
 
     let (c, s) = (cas.cos(f.phi), cas.sin(f.phi));
     let ns = cas.neg(s);
