@@ -5171,76 +5171,114 @@ pub mod arm_0 {
         let aux: &[runtime::dual::Dual; 134] = c[30..]
             .try_into()
             .expect("frames length");
-        let mut o = [runtime::dual::Dual::ZERO; 36];
-        unsafe {
-            contact_jacobian_0_0::<
-                runtime::dual::Dual,
-            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
-        };
-        runtime::dual::row_tails(&o, 36, &mut out[0..33]);
-        let mut o = [runtime::dual::Dual::ZERO; 36];
-        unsafe {
-            contact_jacobian_1_0::<
-                runtime::dual::Dual,
-            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
-        };
-        runtime::dual::row_tails(&o, 36, &mut out[33..66]);
-        let mut o = [runtime::dual::Dual::ZERO; 36];
-        unsafe {
-            contact_jacobian_2_0::<
-                runtime::dual::Dual,
-            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
-        };
-        runtime::dual::row_tails(&o, 36, &mut out[66..99]);
-        let mut o = [runtime::dual::Dual::ZERO; 36];
-        unsafe {
-            contact_jacobian_3_0::<
-                runtime::dual::Dual,
-            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
-        };
-        runtime::dual::row_tails(&o, 36, &mut out[99..132]);
-        let mut o = [runtime::dual::Dual::ZERO; 36];
-        unsafe {
-            contact_jacobian_4_0::<
-                runtime::dual::Dual,
-            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
-        };
-        runtime::dual::row_tails(&o, 36, &mut out[132..165]);
-        let mut o = [runtime::dual::Dual::ZERO; 36];
-        unsafe {
-            contact_jacobian_5_0::<
-                runtime::dual::Dual,
-            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
-        };
-        runtime::dual::row_tails(&o, 36, &mut out[165..198]);
-        let mut o = [runtime::dual::Dual::ZERO; 36];
-        unsafe {
-            contact_jacobian_6_0::<
-                runtime::dual::Dual,
-            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
-        };
-        runtime::dual::row_tails(&o, 36, &mut out[198..231]);
-        let mut o = [runtime::dual::Dual::ZERO; 36];
-        unsafe {
-            contact_jacobian_7_0::<
-                runtime::dual::Dual,
-            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
-        };
-        runtime::dual::row_tails(&o, 36, &mut out[231..264]);
-        let mut o = [runtime::dual::Dual::ZERO; 36];
-        unsafe {
-            contact_jacobian_8_0::<
-                runtime::dual::Dual,
-            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
-        };
-        runtime::dual::row_tails(&o, 36, &mut out[264..297]);
-        let mut o = [runtime::dual::Dual::ZERO; 36];
-        unsafe {
-            contact_jacobian_9_0::<
-                runtime::dual::Dual,
-            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
-        };
-        runtime::dual::row_tails(&o, 36, &mut out[297..330]);
+        if dir[0] != 0.0 {
+            let mut o = [runtime::dual::Dual::ZERO; 36];
+            unsafe {
+                contact_jacobian_0_0::<
+                    runtime::dual::Dual,
+                >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+            };
+            runtime::dual::row_tails(&o, 36, &mut out[0..33]);
+        } else {
+            out[0..33].fill(0.0);
+        }
+        if dir[0..=1].iter().any(|&d| d != 0.0) {
+            let mut o = [runtime::dual::Dual::ZERO; 36];
+            unsafe {
+                contact_jacobian_1_0::<
+                    runtime::dual::Dual,
+                >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+            };
+            runtime::dual::row_tails(&o, 36, &mut out[33..66]);
+        } else {
+            out[33..66].fill(0.0);
+        }
+        if dir[0..=2].iter().any(|&d| d != 0.0) {
+            let mut o = [runtime::dual::Dual::ZERO; 36];
+            unsafe {
+                contact_jacobian_2_0::<
+                    runtime::dual::Dual,
+                >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+            };
+            runtime::dual::row_tails(&o, 36, &mut out[66..99]);
+        } else {
+            out[66..99].fill(0.0);
+        }
+        if dir[0..=3].iter().any(|&d| d != 0.0) {
+            let mut o = [runtime::dual::Dual::ZERO; 36];
+            unsafe {
+                contact_jacobian_3_0::<
+                    runtime::dual::Dual,
+                >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+            };
+            runtime::dual::row_tails(&o, 36, &mut out[99..132]);
+        } else {
+            out[99..132].fill(0.0);
+        }
+        if dir[0..=4].iter().any(|&d| d != 0.0) {
+            let mut o = [runtime::dual::Dual::ZERO; 36];
+            unsafe {
+                contact_jacobian_4_0::<
+                    runtime::dual::Dual,
+                >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+            };
+            runtime::dual::row_tails(&o, 36, &mut out[132..165]);
+        } else {
+            out[132..165].fill(0.0);
+        }
+        if dir[0..=5].iter().any(|&d| d != 0.0) {
+            let mut o = [runtime::dual::Dual::ZERO; 36];
+            unsafe {
+                contact_jacobian_5_0::<
+                    runtime::dual::Dual,
+                >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+            };
+            runtime::dual::row_tails(&o, 36, &mut out[165..198]);
+        } else {
+            out[165..198].fill(0.0);
+        }
+        if dir[0..=6].iter().any(|&d| d != 0.0) {
+            let mut o = [runtime::dual::Dual::ZERO; 36];
+            unsafe {
+                contact_jacobian_6_0::<
+                    runtime::dual::Dual,
+                >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+            };
+            runtime::dual::row_tails(&o, 36, &mut out[198..231]);
+        } else {
+            out[198..231].fill(0.0);
+        }
+        if dir[0..=7].iter().any(|&d| d != 0.0) {
+            let mut o = [runtime::dual::Dual::ZERO; 36];
+            unsafe {
+                contact_jacobian_7_0::<
+                    runtime::dual::Dual,
+                >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+            };
+            runtime::dual::row_tails(&o, 36, &mut out[231..264]);
+        } else {
+            out[231..264].fill(0.0);
+        }
+        if dir[0..=8].iter().any(|&d| d != 0.0) {
+            let mut o = [runtime::dual::Dual::ZERO; 36];
+            unsafe {
+                contact_jacobian_8_0::<
+                    runtime::dual::Dual,
+                >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+            };
+            runtime::dual::row_tails(&o, 36, &mut out[264..297]);
+        } else {
+            out[264..297].fill(0.0);
+        }
+        {
+            let mut o = [runtime::dual::Dual::ZERO; 36];
+            unsafe {
+                contact_jacobian_9_0::<
+                    runtime::dual::Dual,
+                >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+            };
+            runtime::dual::row_tails(&o, 36, &mut out[297..330]);
+        }
     }
     static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
     {

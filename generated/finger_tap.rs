@@ -6975,56 +6975,114 @@ pub fn contact_jvp(
     let mut c = [runtime::dual::Dual::ZERO; 224];
     unsafe { contact_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut c) };
     let aux: &[runtime::dual::Dual; 134] = c[90..].try_into().expect("frames length");
-    let mut o = [runtime::dual::Dual::ZERO; 108];
-    unsafe {
-        contact_jacobian_0_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 36, &mut out[0..99]);
-    let mut o = [runtime::dual::Dual::ZERO; 108];
-    unsafe {
-        contact_jacobian_1_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 36, &mut out[99..198]);
-    let mut o = [runtime::dual::Dual::ZERO; 108];
-    unsafe {
-        contact_jacobian_2_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 36, &mut out[198..297]);
-    let mut o = [runtime::dual::Dual::ZERO; 108];
-    unsafe {
-        contact_jacobian_3_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 36, &mut out[297..396]);
-    let mut o = [runtime::dual::Dual::ZERO; 108];
-    unsafe {
-        contact_jacobian_4_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 36, &mut out[396..495]);
-    let mut o = [runtime::dual::Dual::ZERO; 108];
-    unsafe {
-        contact_jacobian_5_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 36, &mut out[495..594]);
-    let mut o = [runtime::dual::Dual::ZERO; 108];
-    unsafe {
-        contact_jacobian_6_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 36, &mut out[594..693]);
-    let mut o = [runtime::dual::Dual::ZERO; 108];
-    unsafe {
-        contact_jacobian_7_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 36, &mut out[693..792]);
-    let mut o = [runtime::dual::Dual::ZERO; 108];
-    unsafe {
-        contact_jacobian_8_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 36, &mut out[792..891]);
-    let mut o = [runtime::dual::Dual::ZERO; 108];
-    unsafe {
-        contact_jacobian_9_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 36, &mut out[891..990]);
+    if dir[0] != 0.0 {
+        let mut o = [runtime::dual::Dual::ZERO; 108];
+        unsafe {
+            contact_jacobian_0_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[0..99]);
+    } else {
+        out[0..99].fill(0.0);
+    }
+    if dir[0..=1].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 108];
+        unsafe {
+            contact_jacobian_1_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[99..198]);
+    } else {
+        out[99..198].fill(0.0);
+    }
+    if dir[0..=2].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 108];
+        unsafe {
+            contact_jacobian_2_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[198..297]);
+    } else {
+        out[198..297].fill(0.0);
+    }
+    if dir[0..=3].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 108];
+        unsafe {
+            contact_jacobian_3_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[297..396]);
+    } else {
+        out[297..396].fill(0.0);
+    }
+    if dir[0..=4].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 108];
+        unsafe {
+            contact_jacobian_4_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[396..495]);
+    } else {
+        out[396..495].fill(0.0);
+    }
+    if dir[0..=5].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 108];
+        unsafe {
+            contact_jacobian_5_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[495..594]);
+    } else {
+        out[495..594].fill(0.0);
+    }
+    if dir[0..=6].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 108];
+        unsafe {
+            contact_jacobian_6_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[594..693]);
+    } else {
+        out[594..693].fill(0.0);
+    }
+    if dir[0..=7].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 108];
+        unsafe {
+            contact_jacobian_7_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[693..792]);
+    } else {
+        out[693..792].fill(0.0);
+    }
+    if dir[0..=8].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 108];
+        unsafe {
+            contact_jacobian_8_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[792..891]);
+    } else {
+        out[792..891].fill(0.0);
+    }
+    {
+        let mut o = [runtime::dual::Dual::ZERO; 108];
+        unsafe {
+            contact_jacobian_9_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 36, &mut out[891..990]);
+    }
 }
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {

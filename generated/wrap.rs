@@ -8817,70 +8817,136 @@ pub fn contact_jvp(
     let mut c = [runtime::dual::Dual::ZERO; 270];
     unsafe { contact_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, &mut c) };
     let aux: &[runtime::dual::Dual; 162] = c[108..].try_into().expect("frames length");
-    let mut o = [runtime::dual::Dual::ZERO; 126];
-    unsafe {
-        contact_jacobian_0_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 42, &mut out[0..117]);
-    let mut o = [runtime::dual::Dual::ZERO; 126];
-    unsafe {
-        contact_jacobian_1_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 42, &mut out[117..234]);
-    let mut o = [runtime::dual::Dual::ZERO; 126];
-    unsafe {
-        contact_jacobian_2_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 42, &mut out[234..351]);
-    let mut o = [runtime::dual::Dual::ZERO; 126];
-    unsafe {
-        contact_jacobian_3_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 42, &mut out[351..468]);
-    let mut o = [runtime::dual::Dual::ZERO; 126];
-    unsafe {
-        contact_jacobian_4_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 42, &mut out[468..585]);
-    let mut o = [runtime::dual::Dual::ZERO; 126];
-    unsafe {
-        contact_jacobian_5_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 42, &mut out[585..702]);
-    let mut o = [runtime::dual::Dual::ZERO; 126];
-    unsafe {
-        contact_jacobian_6_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 42, &mut out[702..819]);
-    let mut o = [runtime::dual::Dual::ZERO; 126];
-    unsafe {
-        contact_jacobian_7_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 42, &mut out[819..936]);
-    let mut o = [runtime::dual::Dual::ZERO; 126];
-    unsafe {
-        contact_jacobian_8_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 42, &mut out[936..1053]);
-    let mut o = [runtime::dual::Dual::ZERO; 126];
-    unsafe {
-        contact_jacobian_9_0::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 42, &mut out[1053..1170]);
-    let mut o = [runtime::dual::Dual::ZERO; 126];
-    unsafe {
-        contact_jacobian_10_0::<
-            runtime::dual::Dual,
-        >(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 42, &mut out[1170..1287]);
-    let mut o = [runtime::dual::Dual::ZERO; 126];
-    unsafe {
-        contact_jacobian_11_0::<
-            runtime::dual::Dual,
-        >(t, &x, &xd, qdd, dir, p, aux, &mut o)
-    };
-    runtime::dual::row_tails(&o, 42, &mut out[1287..1404]);
+    if dir[0] != 0.0 {
+        let mut o = [runtime::dual::Dual::ZERO; 126];
+        unsafe {
+            contact_jacobian_0_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 42, &mut out[0..117]);
+    } else {
+        out[0..117].fill(0.0);
+    }
+    if dir[0..=1].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 126];
+        unsafe {
+            contact_jacobian_1_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 42, &mut out[117..234]);
+    } else {
+        out[117..234].fill(0.0);
+    }
+    if dir[0..=2].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 126];
+        unsafe {
+            contact_jacobian_2_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 42, &mut out[234..351]);
+    } else {
+        out[234..351].fill(0.0);
+    }
+    if dir[0..=3].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 126];
+        unsafe {
+            contact_jacobian_3_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 42, &mut out[351..468]);
+    } else {
+        out[351..468].fill(0.0);
+    }
+    if dir[0..=4].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 126];
+        unsafe {
+            contact_jacobian_4_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 42, &mut out[468..585]);
+    } else {
+        out[468..585].fill(0.0);
+    }
+    if dir[0..=5].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 126];
+        unsafe {
+            contact_jacobian_5_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 42, &mut out[585..702]);
+    } else {
+        out[585..702].fill(0.0);
+    }
+    if dir[0..=6].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 126];
+        unsafe {
+            contact_jacobian_6_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 42, &mut out[702..819]);
+    } else {
+        out[702..819].fill(0.0);
+    }
+    if dir[0..=7].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 126];
+        unsafe {
+            contact_jacobian_7_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 42, &mut out[819..936]);
+    } else {
+        out[819..936].fill(0.0);
+    }
+    if dir[0..=8].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 126];
+        unsafe {
+            contact_jacobian_8_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 42, &mut out[936..1053]);
+    } else {
+        out[936..1053].fill(0.0);
+    }
+    if dir[0..=9].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 126];
+        unsafe {
+            contact_jacobian_9_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 42, &mut out[1053..1170]);
+    } else {
+        out[1053..1170].fill(0.0);
+    }
+    if dir[0..=10].iter().any(|&d| d != 0.0) {
+        let mut o = [runtime::dual::Dual::ZERO; 126];
+        unsafe {
+            contact_jacobian_10_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 42, &mut out[1170..1287]);
+    } else {
+        out[1170..1287].fill(0.0);
+    }
+    {
+        let mut o = [runtime::dual::Dual::ZERO; 126];
+        unsafe {
+            contact_jacobian_11_0::<
+                runtime::dual::Dual,
+            >(t, &x, &xd, qdd, dir, p, aux, &mut o)
+        };
+        runtime::dual::row_tails(&o, 42, &mut out[1287..1404]);
+    }
 }
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {

@@ -1564,6 +1564,10 @@ fn emit_contact_jvp(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream
             }
         }
     };
+    // A group whose points do not move with any coordinate dq moves is
+    // not evaluated: a chain's group reads the coordinates up to its link
+    // (through its frame), so a column of a later link skips it.
+    let frame_moved = moved_by(&tapes.contact, dof, &[]).split_off(3 * info.contact_points);
     let groups = info.contact_group_ranges().zip(&tapes.contact_jacobian);
     let calls = groups.enumerate().map(|(g, ((first, len), tape))| {
         let f = format_ident!("contact_jacobian_{}_0", g);
@@ -1573,11 +1577,40 @@ fn emit_contact_jvp(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream
             0 => quote!(),
             _ => quote!(aux,),
         };
-        quote! {
+        let moved =
+            moved_by(tape, dof, &frame_moved)
+                .into_iter()
+                .fold(vec![false; dof], |mut m, o| {
+                    m.iter_mut().zip(o).for_each(|(m, o)| *m |= o);
+                    m
+                });
+        let eval = quote! {
             let mut o = [runtime::dual::Dual::ZERO; #n];
             // SAFETY: `require_fma` has checked that the processor has FMA.
             unsafe { #f::<runtime::dual::Dual>(t, &x, &xd, qdd, dir, p, #aux &mut o) };
             runtime::dual::row_tails(&o, #width, &mut out[#a..#b]);
+        };
+        let moving: Vec<usize> = (0..dof).filter(|&k| moved[k]).collect();
+        // A chain's group moves with the coordinates up to its link: a range.
+        let test = match moving[..] {
+            [first, .., last] if last - first + 1 == moving.len() => {
+                quote!(dir[#first..=#last].iter().any(|&d| d != 0.0))
+            }
+            _ => {
+                let each = moving.iter().map(|k| quote!(dir[#k] != 0.0));
+                quote!(#(#each)||*)
+            }
+        };
+        match (moving.len(), moved.iter().all(|&m| m)) {
+            (_, true) => quote!({ #eval }),
+            (0, _) => quote!(out[#a..#b].fill(0.0);),
+            _ => quote! {
+                if #test {
+                    #eval
+                } else {
+                    out[#a..#b].fill(0.0);
+                }
+            },
         }
     });
     quote! {
@@ -1592,6 +1625,28 @@ fn emit_contact_jvp(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream
             #(#calls)*
         }
     }
+}
+
+/// Which of the `dof` coordinates each output of `tape` moves with: those
+/// it reads, and through `Aux(k)` those `aux[k]` moves with.
+fn moved_by(tape: &Tape, dof: usize, aux: &[Vec<bool>]) -> Vec<Vec<bool>> {
+    let mut moved: Vec<Vec<bool>> = Vec::with_capacity(tape.ops.len());
+    for op in &tape.ops {
+        let m = match *op {
+            Op::Q(k) => (0..dof).map(|i| i == k as usize).collect(),
+            Op::Aux(k) => aux[k as usize].clone(),
+            _ => op.operands().fold(vec![false; dof], |mut m, a| {
+                m.iter_mut()
+                    .zip(&moved[a as usize])
+                    .for_each(|(m, &o)| *m |= o);
+                m
+            }),
+        };
+        moved.push(m);
+    }
+    (tape.outputs.iter())
+        .map(|&s| moved[s as usize].clone())
+        .collect()
 }
 
 /// The header line that carries the structural hash.

@@ -165,11 +165,17 @@ fn assert_contact_agrees(
         }
         close(&a[rows.clone()], &b[rows], &format!("contact group {g}"));
     }
+    // Along a random dq, and along one coordinate (a Jacobian's column,
+    // where the groups that coordinate does not move are skipped).
     let mut dir = rng.vec(n, -1.0, 1.0);
     dir.resize(2 * n, 0.0);
-    eval(compiled, KernelKind::ContactJvp, &dir, &mut a);
-    eval(interpreted, KernelKind::ContactJvp, &dir, &mut b);
-    close(&a, &b, "contact jvp");
+    let mut column = vec![0.0; 2 * n];
+    column[(rng.uniform(0.0, n as f64) as usize).min(n - 1)] = 1.0;
+    for (dir, label) in [(dir, "contact jvp"), (column, "contact jvp column")] {
+        eval(compiled, KernelKind::ContactJvp, &dir, &mut a);
+        eval(interpreted, KernelKind::ContactJvp, &dir, &mut b);
+        close(&a, &b, label);
+    }
 }
 
 #[test]
