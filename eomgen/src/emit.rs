@@ -1401,18 +1401,9 @@ impl Family {
         a: TokenStream,
         ty: TokenStream,
     ) -> TokenStream {
-        let n = members
-            .iter()
-            .map(|m| usize::from(m.0.1))
-            .max()
-            .unwrap_or(0)
-            + 1;
+        let n = Self::orders(members);
         if self == Family::Rodrigues {
-            let lets = members.iter().map(|&((j, k), i)| {
-                let (j, k) = (usize::from(j), usize::from(k));
-                let v = format_ident!("v{}", i);
-                quote!(let #v: #ty = c[#j][#k];)
-            });
+            let lets = Self::rodrigues_members(members, &ty);
             return quote! {
                 let c: [[#ty; #n]; runtime::rodrigues::FAMILY_J] = #a.rodrigues_family::<#n>();
                 #(#lets)*
@@ -1427,6 +1418,28 @@ impl Family {
             Family::Rodrigues => unreachable!("handled above"),
         };
         quote!(let [#(#names),*]: [#ty; #n] = #a.#f::<#n>();)
+    }
+
+    /// How many orders one call gives: up to the highest member's.
+    fn orders(members: &[(Member, usize)]) -> usize {
+        members
+            .iter()
+            .map(|m| usize::from(m.0.1))
+            .max()
+            .unwrap_or(0)
+            + 1
+    }
+
+    /// Each Rodrigues member's `let`, of type `ty`, from the family `c`.
+    fn rodrigues_members(members: &[(Member, usize)], ty: &TokenStream) -> Vec<TokenStream> {
+        members
+            .iter()
+            .map(|&((j, k), i)| {
+                let (j, k) = (usize::from(j), usize::from(k));
+                let v = format_ident!("v{}", i);
+                quote!(let #v: #ty = c[#j][#k];)
+            })
+            .collect()
     }
 
     /// The binding of each order below `n`: its member's value, or `_`.
@@ -1445,18 +1458,9 @@ impl Family {
     /// `let` binding the members (member, op index) from one call at `a`.
     fn call(self, members: &[(Member, usize)], a: TokenStream, lanes: bool) -> TokenStream {
         let ty = if lanes { quote!(__m256d) } else { quote!(f64) };
-        let n = members
-            .iter()
-            .map(|m| usize::from(m.0.1))
-            .max()
-            .unwrap_or(0)
-            + 1;
+        let n = Self::orders(members);
         if self == Family::Rodrigues {
-            let lets = members.iter().map(|&((j, k), i)| {
-                let (j, k) = (usize::from(j), usize::from(k));
-                let v = format_ident!("v{}", i);
-                quote!(let #v: #ty = c[#j][#k];)
-            });
+            let lets = Self::rodrigues_members(members, &ty);
             let family = if lanes {
                 quote!(runtime::lanes::family)
             } else {
