@@ -100,8 +100,7 @@ pub fn read_model(spec: &str, overrides: &[Override]) -> Result<(Model, String)>
     )
 }
 
-/// A 3D chain whose element count (or rom order) no compiled-in model
-/// has, on the compiled cells of its link shapes when every one is
+/// A chain whose element count (or rom order) no compiled-in model has, on the compiled cells of its link shapes when every one is
 /// compiled in (found by key), with the seconds its layout took to derive;
 /// or why it cannot run so.
 fn linked(structure: &Structure) -> std::result::Result<(Box<dyn Kernels>, f64), String> {
@@ -114,8 +113,6 @@ fn linked(structure: &Structure) -> std::result::Result<(Box<dyn Kernels>, f64),
             "link cells run single arms, and this is an assembly".into()
         } else if structure.contact_points > 0 {
             "link cells run arms without contact, and this one has obstacles".into()
-        } else if structure.dimensions != 3 {
-            "link cells run 3D arms, and this one is planar".into()
         } else {
             "not every one of its methods' elements is a link cell".into()
         });

@@ -16,17 +16,17 @@ pub fn derive(model: &Model) -> TapeSet {
 }
 
 /// The link recursion's layout and kernels of a structure, with the model
-/// info that goes with them, and none of the flat kernels: all that a 3D
+/// info that goes with them, and none of the flat kernels: all that a
 /// chain of compiled-in link shapes needs to run on linked compiled cells
 /// (`runtime::linked::LinkedKernels`), derived in milliseconds at any
 /// element count. `None` where the recursion does not give every kernel:
-/// planar and short chains, assemblies, contact.
+/// assemblies, contact, elements that are no link cell.
 pub fn derive_links(structure: &Structure) -> Option<(ModelInfo, runtime::links::LinkKernels)> {
-    if structure.dimensions != 3 || structure.assembly.is_some() || structure.contact_points > 0 {
+    if structure.assembly.is_some() || structure.contact_points > 0 {
         return None;
     }
     let layout = ParamLayout::of(structure);
-    let links = link_chain(structure, &layout).filter(|l| l.mass_bias)?;
+    let links = link_chain(structure, &layout)?;
     let info = ModelInfo {
         hash: structure.hash(),
         coordinates: crate::method::coordinate_names(structure),

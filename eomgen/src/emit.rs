@@ -599,9 +599,16 @@ impl<'a> KernelEmitter<'a> {
             ),
             false => (quote!(f64), quote!()),
         };
-        let attributes = match inline {
-            true => quote!(#[inline(always)]),
-            false => quote! {
+        let attributes = match (inline, self.generic) {
+            (true, _) => quote!(#[inline(always)]),
+            // A generic kernel's f64 instance may be inlined into the link
+            // recursion (built for the same features): its outputs then
+            // stay in registers.
+            (false, true) => quote! {
+                #[inline]
+                #[cfg_attr(target_arch = "x86_64", target_feature(enable = #features))]
+            },
+            (false, false) => quote! {
                 #[inline(never)]
                 #[cfg_attr(target_arch = "x86_64", target_feature(enable = #features))]
             },
@@ -735,7 +742,7 @@ impl<'a> KernelEmitter<'a> {
                     fn #f4(q: &[[f64; 4]; #dof], qd: &[[f64; 4]; #dof], p: &[[f64; 4]; #n_params],
                            out: &mut [[f64; 4]; #n_out]) {
                         use runtime::x4::X4;
-                        let (x, xd, px) = (q.map(X4::from_array), qd.map(X4::from_array), p.map(X4::from_array));
+                        let (x, xd, px) = (X4::from_arrays(q), X4::from_arrays(qd), X4::from_arrays(p));
                         #chunk::<X4>(0.0, &x, &xd, &[0.0; #dof], &[0.0; #n_dir], &px, out);
                     }
                 }
@@ -851,58 +858,40 @@ fn with_tangent(
     quote!(#plain #tangent #four)
 }
 
-/// A cell as others link it (`runtime::links::CompiledCell`): its kernels
-/// behind slices, and its entry in `CELLS` under its key. `f`, `f4`, `ft`,
-/// `fp`: the cell's own kernel, lanes, tangent and pose functions.
+/// A cell's entry in the model's registry (`runtime::compiled_cell!`),
+/// with its lane kernel's glue where it has one.
 fn emit_linked_cell(
     c: usize,
     n: usize,
     (tape, tangent, pose): (&Tape, &Tape, &Tape),
-    (f, f4, ft, fp): (&Ident, &Ident, &Ident, &Ident),
+    (f, f4, ft, fp): (&Ident, Option<&Ident>, &Ident, &Ident),
 ) -> (TokenStream, TokenStream) {
-    let name = format!("cell_{c}");
-    let n2 = 2 * n;
     let key = crate::build::cell_key(tape, tangent, pose);
-    let (lo, l4, lt, lp, four) = (
-        Ident::new(&format!("{name}_linked"), Span::call_site()),
-        Ident::new(&format!("{name}_x4_linked"), Span::call_site()),
-        Ident::new(&format!("{name}_tangent_linked"), Span::call_site()),
-        Ident::new(&format!("{name}_pose_linked"), Span::call_site()),
-        Ident::new(&format!("CELL_{c}_FOUR"), Span::call_site()),
+    let (l4, four) = (
+        format_ident!("cell_{c}_x4_linked"),
+        format_ident!("CELL_{c}_FOUR"),
     );
-    let linked = quote! {
-        fn #lo(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
-            #f(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
-               &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
-               out.try_into().expect("cell outputs"))
-        }
-        #[cfg(target_arch = "x86_64")]
-        fn #l4(x: &[[f64; 4]], xd: &[[f64; 4]], p: &[[f64; 4]], out: &mut [[f64; 4]]) {
-            runtime::cpu::require_fma();
-            // SAFETY: `require_fma` has checked that the processor has FMA.
-            unsafe { #f4(x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
-                         p.try_into().expect("cell parameters"), out.try_into().expect("cell outputs")) }
-        }
-        #[cfg(target_arch = "x86_64")]
-        const #four: Option<runtime::links::CellLanesFn> = Some(#l4);
-        #[cfg(not(target_arch = "x86_64"))]
-        const #four: Option<runtime::links::CellLanesFn> = None;
-        fn #lt(x: &[f64], xd: &[f64], dx: &[f64], dxd: &[f64], p: &[f64], out: &mut [f64]) {
-            let mut dir = [0.0; #n2];
-            dir[..#n].copy_from_slice(dx);
-            dir[#n..].copy_from_slice(dxd);
-            #ft(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
-                &[0.0; #n], &dir, p.try_into().expect("cell parameters"),
-                out.try_into().expect("cell outputs and derivatives"))
-        }
-        fn #lp(x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
-            #fp(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
-                &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
-                out.try_into().expect("pose outputs"))
-        }
+    let linked = match f4 {
+        Some(f4) => quote! {
+            #[cfg(target_arch = "x86_64")]
+            fn #l4(x: &[[f64; 4]], xd: &[[f64; 4]], p: &[[f64; 4]], out: &mut [[f64; 4]]) {
+                runtime::cpu::require_fma();
+                // SAFETY: `require_fma` has checked that the processor has FMA.
+                unsafe { #f4(x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+                             p.try_into().expect("cell parameters"), out.try_into().expect("cell outputs")) }
+            }
+            #[cfg(target_arch = "x86_64")]
+            const #four: Option<runtime::links::CellLanesFn> = Some(#l4);
+            #[cfg(not(target_arch = "x86_64"))]
+            const #four: Option<runtime::links::CellLanesFn> = None;
+        },
+        None => quote! {
+            const #four: Option<runtime::links::CellLanesFn> = None;
+        },
     };
+    let n = proc_macro2::Literal::usize_unsuffixed(n);
     let registry = quote! {
-        runtime::links::CompiledCell { key: #key, one: #lo, four: #four, tangent: #lt, pose: #lp },
+        runtime::compiled_cell!(#key, #n, #f, #ft, #fp, #four),
     };
     (linked, registry)
 }
@@ -919,6 +908,13 @@ struct EmittedCells {
     poses: Vec<TokenStream>,
     linked: Vec<TokenStream>,
     registry: Vec<TokenStream>,
+}
+
+/// Whether a chain's cells get lane kernels: the 3D recursion's mass +
+/// bias evaluates four links at once; the planar one (`links::planar`)
+/// one at a time, inlined.
+fn lanes(links: &runtime::links::LinkKernels) -> bool {
+    links.mass_bias && links.layout.base_angle.is_none()
 }
 
 fn emit_cells(links: &runtime::links::LinkKernels) -> EmittedCells {
@@ -957,7 +953,7 @@ fn emit_cells(links: &runtime::links::LinkKernels) -> EmittedCells {
             &name,
             n,
             CELL_PARAMS,
-            links.mass_bias,
+            lanes(links),
         ));
         let (f, f4, ft) = (
             Ident::new(&name, Span::call_site()),
@@ -965,10 +961,14 @@ fn emit_cells(links: &runtime::links::LinkKernels) -> EmittedCells {
             Ident::new(&name_t, Span::call_site()),
         );
         let n2 = 2 * n;
+        let f0 = format_ident!("{}_0", name);
         ones.push(quote! {
-            #c => #f(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
+            // SAFETY: the kernel that made `LinkCells` has checked that the
+            // processor has FMA (and so AVX, as for `four`); called straight,
+            // the cell may be inlined into the recursion.
+            #c => unsafe { #f0::<f64>(0.0, x.try_into().expect("link coordinates"), xd.try_into().expect("link rates"),
                      &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
-                     out.try_into().expect("cell outputs")),
+                     out.try_into().expect("cell outputs")) },
         });
         fours.push(quote! {
             // SAFETY: `mass_bias` has checked that the processor has FMA
@@ -982,11 +982,11 @@ fn emit_cells(links: &runtime::links::LinkKernels) -> EmittedCells {
                       &[0.0; #n], &[0.0; #n2], p.try_into().expect("cell parameters"),
                       out.try_into().expect("pose outputs")),
         });
-        if links.mass_bias {
-            let (one, reg) = emit_linked_cell(c, n, (tape, tangent, pose), (&f, &f4, &ft, &fp));
-            linked.push(one);
-            registry.push(reg);
-        }
+        // Every chain's cells, for arms no compiled-in model has.
+        let f4 = lanes(links).then_some(&f4);
+        let (one, reg) = emit_linked_cell(c, n, (tape, tangent, pose), (&f, f4, &ft, &fp));
+        linked.push(one);
+        registry.push(reg);
         tangents.push(quote! {
             #c => {
                 let mut dir = [0.0; #n2];
@@ -1086,8 +1086,8 @@ fn emit_cells_impl(
         ..
     } = cells;
     let [forces, forces_tangent, loads, energy] = globals;
-    // Lane kernels serve the recursion's mass + bias alone.
-    let four = match links.mass_bias {
+    // Lane kernels serve the 3D recursion's mass + bias alone.
+    let four = match lanes(links) {
         true => quote! {
             #[cfg(target_arch = "x86_64")]
             #[inline(always)]
@@ -1203,7 +1203,7 @@ fn emit_link_recursion(
                 // SAFETY: `require_fma` has checked that the processor has FMA.
                 unsafe { mass_bias_links(q, qd, p, out) }
             }
-            #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+            #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
             unsafe fn mass_bias_links(q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
                 let mut cells = LinkCells { q, qd, p };
                 #call

@@ -191,7 +191,16 @@ fn second_interpreted_run_hits_the_disk_cache() {
     let mut seen = Vec::new();
     for run in 0..2 {
         let out = softarm(
-            &["simulate", m, "--t-end", "0.2", "--out", "run"],
+            &[
+                "simulate",
+                m,
+                "--t-end",
+                "0.2",
+                "--backend",
+                "interpreted",
+                "--out",
+                "run",
+            ],
             dir.path(),
         );
         assert!(out.status.success(), "run {run}: {}", stderr(&out));
@@ -241,7 +250,9 @@ fn structural_override_derives_anew_numeric_keeps_compiled() {
         dir.path(),
     );
     assert!(structural.status.success(), "{}", stderr(&structural));
-    assert!(stderr(&structural).contains("interpreted backend"));
+    // Another element count: not the compiled-in model's kernels, but its
+    // cells linked to the new layout.
+    assert!(stderr(&structural).contains("cells linked to this element count"));
 }
 
 #[test]
@@ -251,12 +262,13 @@ fn corrupt_cache_entry_is_rederived() {
         .unwrap()
         .replace("elements = 8", "elements = 2");
     std::fs::write(dir.path().join("two.toml"), text).unwrap();
-    let first = softarm(&["eom", "two.toml", "--json"], dir.path());
+    let args = ["eom", "two.toml", "--json", "--backend", "interpreted"];
+    let first = softarm(&args, dir.path());
     assert!(first.status.success());
     for e in std::fs::read_dir(dir.path().join("cache")).unwrap() {
         std::fs::write(e.unwrap().path(), "{ not json").unwrap();
     }
-    let second = softarm(&["eom", "two.toml", "--json"], dir.path());
+    let second = softarm(&args, dir.path());
     assert!(second.status.success(), "{}", stderr(&second));
     assert_eq!(stdout(&first), stdout(&second));
 }
@@ -1002,7 +1014,8 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
     // half-arcs (rod_swing's), rom slices of another order (rom_arm's).
     // And arms with chambers on bare arms' cells: stiff_flop at another
     // element count, and tentacle3d with chambers in it (its cells read
-    // their segment's actuation loads, zero where none act).
+    // their segment's actuation loads, zero where none act). And planar
+    // arms.
     let mut rng = Rng::new(11);
     let dir = tempfile::tempdir().unwrap();
     let chambered = dir.path().join("chambered.toml");
@@ -1017,6 +1030,13 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         ("rom_arm", "segment.0.order=5"),
         ("stiff_flop", "segment.0.elements=5"),
         (chambered.as_str(), "segment.0.elements=4"),
+        // Planar arms: the sums in the plane (`links::planar`) over
+        // cantilever's pcc cells, soft_finger's with its chambers'
+        // loads, chain's rigid links and hybrid_arm's two kinds.
+        ("cantilever", "segment.0.elements=7"),
+        ("soft_finger", "segment.0.elements=5"),
+        ("chain", "segment.0.elements=11"),
+        ("hybrid_arm", "segment.1.elements=3"),
     ] {
         let what = format!("{model} {set}");
         let sets = [eomgen::model::Override::parse(set).unwrap()];
@@ -1195,13 +1215,13 @@ value = 1000.0
     for (model, set) in [
         ("tentacle3d", "segment.0.elements=13"),
         (tapered.as_str(), ""),
+        ("soft_finger", "segment.0.elements=7"),
     ] {
         let (b, r) = route(model, set, auto);
         assert_eq!(b, "compiled", "{model} {set}");
         assert!(r.contains("link cells"), "{model}: {r}");
     }
     for (model, set, why) in [
-        ("soft_finger", "segment.0.elements=7", "planar"),
         ("falling_ball", "arm.left.segment.0.elements=3", "assembly"),
         ("finger_tap", "segment.0.elements=5", "obstacles"),
         (stretching.as_str(), "", "link shapes"),

@@ -122,12 +122,14 @@ const FILE_BUDGET: u64 = 300_000;
 /// bundled set).
 const TOTAL_BUDGET: u64 = 2_000_000;
 
-/// What the bundled set takes while it is still over [`TOTAL_BUDGET`] (the
-/// planar arms' flat mass + bias and symbolic solve are most of the
-/// excess): the total may not grow past it, and once within the budget the
-/// test asks for the ceiling to go, so that it only shrinks.
+/// What the bundled set takes while it is still over [`TOTAL_BUDGET`]:
+/// planar chains of fewer than 32 links keep their flat mass + bias and
+/// symbolic solve, quicker than the recursion in the plane (eomgen's
+/// `PLANAR_RECURSION_MIN_LINKS`), and that is most of the excess. The
+/// total may not grow past it, and once within the budget the test asks
+/// for the ceiling to go, so that it only shrinks.
 const TOTAL_CEILING: Option<u64> = Some(TOTAL_NOW);
-const TOTAL_NOW: u64 = 2_482_462;
+const TOTAL_NOW: u64 = 2_355_295;
 
 /// Generated sizes are deterministic, so the budget is a fair test: no
 /// model's file over 300 kB, and generated/ no bigger than its budget (or,

@@ -43,10 +43,22 @@ use crate::tmt::system::{Coordinates, ParamSymbols};
 /// side 757 ns flat against 1039 ns by the recursion (BENCHMARKS.md).
 const RECURSION_MIN_LINKS: usize = 4;
 
+/// A planar chain's flat `MassBias` and symbolic solve are quicker than
+/// its recursion (`runtime::links::planar`) below about thirty links: the
+/// mass and bias of 8 rigid links take 175 against 367 ns, of 10 pcc
+/// elements 457 against 757 ns, of 32 rigid links 1435 against 1444 ns
+/// (BENCHMARKS.md), while the flat code grows with the square of the
+/// links (chain32's: 125 kB). Compiled in, shorter planar chains keep it;
+/// any planar chain not compiled in runs on the recursion over compiled
+/// cells.
+const PLANAR_RECURSION_MIN_LINKS: usize = 32;
+
 /// The layout and kernels of a chain the link recursion covers, or `None`
-/// when its structure is outside it. Compiled 3D chains take every kernel
-/// from it; planar chains all but `MassBias` (and the symbolic solve on
-/// it), whose flat form is the quicker for their few coordinates.
+/// when its structure is outside it. Compiled chains take every kernel
+/// from it but, when shorter than [`RECURSION_MIN_LINKS`] (3D) or
+/// [`PLANAR_RECURSION_MIN_LINKS`] (planar), `MassBias` (and the symbolic
+/// solve on it), whose flat form is the quicker for their few links;
+/// chains not compiled in take every kernel from it (linked cells).
 pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     let spatial = st.dimensions == 3;
     // A planar element is covered when it is one body (`planar_cell`).
@@ -153,7 +165,11 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         Some(kernels) => kernels.map(Some),
         None => [None, None, None],
     };
-    let mass_bias = spatial && layout.links.len() >= RECURSION_MIN_LINKS;
+    let min_links = match spatial {
+        true => RECURSION_MIN_LINKS,
+        false => PLANAR_RECURSION_MIN_LINKS,
+    };
+    let mass_bias = layout.links.len() >= min_links;
     let mut kernels = LinkKernels {
         layout,
         mass_bias,

@@ -27,24 +27,18 @@ pub fn from_array(a: [f64; 4]) -> __m256d {
     unsafe { std::mem::transmute::<[f64; 4], __m256d>(a) }
 }
 
+// The helpers loop rather than call `array::map` or `from_fn`: those
+// stay out of line in a kernel built for `avx,fma` (they are not), and
+// cost a quarter of a planar arm's mass + bias.
+
 /// `f` lane by lane.
 #[inline(always)]
 pub fn map(v: __m256d, f: impl Fn(f64) -> f64) -> __m256d {
-    from_array(to_array(v).map(f))
-}
-
-/// A function of several orders (`special::sinc_orders`, ...) lane by lane.
-#[inline(always)]
-pub fn orders<const K: usize>(x: __m256d, f: impl Fn(f64) -> [f64; K]) -> [__m256d; K] {
-    let v = to_array(x).map(f);
-    std::array::from_fn(|k| from_array(std::array::from_fn(|l| v[l][k])))
-}
-
-/// `special::sin_cos` lane by lane.
-#[inline(always)]
-pub fn sin_cos(x: __m256d) -> (__m256d, __m256d) {
-    let v = to_array(x).map(crate::special::sin_cos);
-    (from_array(v.map(|p| p.0)), from_array(v.map(|p| p.1)))
+    let mut a = to_array(v);
+    for x in &mut a {
+        *x = f(*x);
+    }
+    from_array(a)
 }
 
 /// `rodrigues::family` of the four lanes (`rodrigues::family_x4`).

@@ -355,6 +355,121 @@ static COSC: Series = Series::new(1, alternating(1, 1));
 /// (x - sin x)/x^3 = sum_j (-1)^j x^(2j) / (2j + 3)!
 static SINC_REM: Series = Series::new(0, alternating(0, 3));
 
+/// Four arguments (the lanes of a vector kernel, `x4`), with the bits of
+/// four scalar calls: where every lane takes the series branch with the
+/// same number of terms, the same arithmetic runs on arrays of four, which
+/// a kernel built for AVX compiles to vector instructions; else lane by
+/// lane. The pcc cells of a bent arm spend most of their time here.
+pub type Lanes = [f64; 4];
+
+/// [`sinc_orders`] of four arguments.
+#[inline(always)]
+pub fn sinc_orders_x4<const K: usize>(x: Lanes) -> [Lanes; K] {
+    SINC.orders_x4(x, sinc_orders::<K>)
+}
+
+/// [`cosc_orders`] of four arguments.
+#[inline(always)]
+pub fn cosc_orders_x4<const K: usize>(x: Lanes) -> [Lanes; K] {
+    COSC.orders_x4(x, cosc_orders::<K>)
+}
+
+/// [`sinc_rem_orders`] of four arguments.
+#[inline(always)]
+pub fn sinc_rem_orders_x4<const K: usize>(x: Lanes) -> [Lanes; K] {
+    SINC_REM.orders_x4(x, sinc_rem_orders::<K>)
+}
+
+/// [`sin_cos`] of four arguments.
+#[inline(always)]
+pub fn sin_cos_x4(x: Lanes) -> (Lanes, Lanes) {
+    let (mut s, mut c) = ([0.0; 4], [0.0; 4]);
+    if x.iter().all(|x| x.abs() <= std::f64::consts::FRAC_PI_4) {
+        let x2 = mul4(x, x);
+        let sp = split_horner4(&SIN_TAYLOR, x2);
+        return (mul4(sp, x), split_horner4(&COS_TAYLOR, x2));
+    }
+    for l in 0..4 {
+        (s[l], c[l]) = sin_cos(x[l]);
+    }
+    (s, c)
+}
+
+#[inline(always)]
+fn mul4(a: Lanes, b: Lanes) -> Lanes {
+    let mut v = [0.0; 4];
+    for l in 0..4 {
+        v[l] = a[l] * b[l];
+    }
+    v
+}
+
+/// [`split_horner`] lane by lane, the same operations in the same order.
+#[inline(always)]
+fn split_horner4<const N: usize>(row: &[f64; N], x2: Lanes) -> Lanes {
+    let x4 = mul4(x2, x2);
+    let (mut even, mut odd) = ([0.0; 4], [0.0; 4]);
+    let mut i = N;
+    while i > 0 {
+        i -= 1;
+        let acc = if i.is_multiple_of(2) {
+            &mut even
+        } else {
+            &mut odd
+        };
+        for l in 0..4 {
+            acc[l] = acc[l] * x4[l] + row[i];
+        }
+    }
+    let mut v = [0.0; 4];
+    for l in 0..4 {
+        v[l] = even[l] + x2[l] * odd[l];
+    }
+    v
+}
+
+impl Series {
+    #[inline(always)]
+    fn orders_x4<const K: usize>(&self, x: Lanes, scalar: fn(f64) -> [f64; K]) -> [Lanes; K] {
+        let n = terms_for(x[0]);
+        let shared = K <= TABLE_ORDERS
+            && x.iter()
+                .all(|v| v.abs() < SERIES_BELOW && terms_for(*v) == n);
+        match (shared, n) {
+            (true, 6) => self.orders_n4::<K, 6>(x),
+            (true, 8) => self.orders_n4::<K, 8>(x),
+            (true, _) => self.orders_n4::<K, { TERMS as usize }>(x),
+            (false, _) => {
+                let mut out = [[0.0; 4]; K];
+                for l in 0..4 {
+                    for (o, v) in out.iter_mut().zip(scalar(x[l])) {
+                        o[l] = v;
+                    }
+                }
+                out
+            }
+        }
+    }
+
+    /// [`Series::eval_n`] of orders 0..K, four lanes at once.
+    #[inline(always)]
+    fn orders_n4<const K: usize, const N: usize>(&self, x: Lanes) -> [Lanes; K] {
+        let x2 = mul4(x, x);
+        let mut out = [[0.0; 4]; K];
+        for (k, o) in out.iter_mut().enumerate() {
+            let k32 = k as u32;
+            let mut m0 = self.first;
+            while m0 < k32 {
+                m0 += 2;
+            }
+            let head: &[f64; N] = self.table[k][..N].try_into().expect("N <= TERMS");
+            let sum = split_horner4(head, x2);
+            *o = if m0 > k32 { mul4(sum, x) } else { sum };
+        }
+        out
+    }
+}
+
 /// d^k/dx^k [g(x) / x^p] by Leibniz:
 /// sum_j C(k,j) g^(k-j)(x) (-1)^j (p + j - 1)! / (p - 1)! x^(-p-j).
 #[inline]
@@ -428,6 +543,41 @@ fn powi_u(x: f64, n: u32) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Four lanes give the bits of four scalar calls: lanes that share a
+    /// series length, lanes that do not, and lanes past the series.
+    #[test]
+    fn lanes_have_the_bits_of_scalar_calls() {
+        let groups = [
+            [0.0, 1e-9, -0.2, 0.24],
+            [0.3, -0.45, 0.26, 0.49],
+            [0.6, -0.9, 0.75, 0.99],
+            [0.1, 0.3, -0.7, 0.2],
+            [0.5, 1.5, -3.0, 0.7],
+        ];
+        let same = |a: Lanes, b: [f64; 4], what: &str| {
+            for l in 0..4 {
+                assert_eq!(a[l].to_bits(), b[l].to_bits(), "{what} lane {l}");
+            }
+        };
+        for x in groups {
+            let (s, c) = sin_cos_x4(x);
+            same(s, x.map(|x| sin_cos(x).0), "sin");
+            same(c, x.map(|x| sin_cos(x).1), "cos");
+            let lanes = [
+                sinc_orders_x4::<3>(x),
+                cosc_orders_x4(x),
+                sinc_rem_orders_x4(x),
+            ];
+            let scalar: [fn(f64) -> [f64; 3]; 3] =
+                [sinc_orders::<3>, cosc_orders::<3>, sinc_rem_orders::<3>];
+            for (lane, f) in lanes.iter().zip(scalar) {
+                for (k, order) in lane.iter().enumerate() {
+                    same(*order, x.map(|x| f(x)[k]), &format!("order {k} at {x:?}"));
+                }
+            }
+        }
+    }
 
     fn close(a: f64, b: f64, tol: f64) -> bool {
         (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))

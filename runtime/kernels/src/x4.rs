@@ -30,6 +30,17 @@ impl X4 {
         X4(lanes::from_array(a))
     }
 
+    /// Rows of lanes as vectors by a loop: `array::map`'s closure would
+    /// stay out of line, not built for the kernel's target features.
+    #[inline(always)]
+    pub fn from_arrays<const N: usize>(a: &[[f64; 4]; N]) -> [Self; N] {
+        let mut v = [<Self as Scalar>::c(0.0); N];
+        for (v, a) in v.iter_mut().zip(a) {
+            *v = X4::from_array(*a);
+        }
+        v
+    }
+
     #[inline(always)]
     pub fn to_array(self) -> [f64; 4] {
         lanes::to_array(self.0)
@@ -38,11 +49,6 @@ impl X4 {
     #[inline(always)]
     fn map(self, f: impl Fn(f64) -> f64) -> Self {
         X4(lanes::map(self.0, f))
-    }
-
-    #[inline(always)]
-    fn orders<const K: usize>(self, f: impl Fn(f64) -> [f64; K]) -> [Self; K] {
-        lanes::orders(self.0, f).map(X4)
     }
 }
 
@@ -152,8 +158,8 @@ impl Scalar for X4 {
     }
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
-        let (s, c) = lanes::sin_cos(self.0);
-        (X4(s), X4(c))
+        let (s, c) = special::sin_cos_x4(self.to_array());
+        (X4::from_array(s), X4::from_array(c))
     }
     #[inline(always)]
     fn sin(self) -> Self {
@@ -201,15 +207,15 @@ impl Scalar for X4 {
     }
     #[inline(always)]
     fn sinc_orders<const K: usize>(self) -> [Self; K] {
-        self.orders(special::sinc_orders::<K>)
+        X4::from_arrays(&special::sinc_orders_x4::<K>(self.to_array()))
     }
     #[inline(always)]
     fn cosc_orders<const K: usize>(self) -> [Self; K] {
-        self.orders(special::cosc_orders::<K>)
+        X4::from_arrays(&special::cosc_orders_x4::<K>(self.to_array()))
     }
     #[inline(always)]
     fn sinc_rem_orders<const K: usize>(self) -> [Self; K] {
-        self.orders(special::sinc_rem_orders::<K>)
+        X4::from_arrays(&special::sinc_rem_orders_x4::<K>(self.to_array()))
     }
     #[inline(always)]
     fn rodrigues_family<const N: usize>(self) -> [[Self; N]; FAMILY_J] {

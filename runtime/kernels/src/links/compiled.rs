@@ -24,3 +24,54 @@ pub struct CompiledCell {
     pub tangent: CellTangentFn,
     pub pose: CellFn,
 }
+
+/// A [`CompiledCell`] of a generated model's cell kernels (`name`,
+/// `name_tangent`, `name_pose` over `n` coordinates), the slices of the
+/// [`CellFn`] signatures turned into their arrays: the glue written once
+/// here rather than in every generated file. `four`: the cell's lane
+/// kernel behind a [`CellLanesFn`], or None.
+#[macro_export]
+macro_rules! compiled_cell {
+    ($key:expr, $n:literal, $one:path, $tangent:path, $pose:path, $four:expr) => {
+        $crate::links::CompiledCell {
+            key: $key,
+            one: |x, xd, p, out| {
+                $one(
+                    0.0,
+                    x.try_into().expect("link coordinates"),
+                    xd.try_into().expect("link rates"),
+                    &[0.0; $n],
+                    &[0.0; 2 * $n],
+                    p.try_into().expect("cell parameters"),
+                    out.try_into().expect("cell outputs"),
+                )
+            },
+            four: $four,
+            tangent: |x, xd, dx, dxd, p, out| {
+                let mut dir = [0.0; 2 * $n];
+                dir[..$n].copy_from_slice(dx);
+                dir[$n..].copy_from_slice(dxd);
+                $tangent(
+                    0.0,
+                    x.try_into().expect("link coordinates"),
+                    xd.try_into().expect("link rates"),
+                    &[0.0; $n],
+                    &dir,
+                    p.try_into().expect("cell parameters"),
+                    out.try_into().expect("cell outputs and derivatives"),
+                )
+            },
+            pose: |x, xd, p, out| {
+                $pose(
+                    0.0,
+                    x.try_into().expect("link coordinates"),
+                    xd.try_into().expect("link rates"),
+                    &[0.0; $n],
+                    &[0.0; 2 * $n],
+                    p.try_into().expect("cell parameters"),
+                    out.try_into().expect("pose outputs"),
+                )
+            },
+        }
+    };
+}

@@ -26,6 +26,7 @@ use crate::rows;
 mod articulated;
 mod compiled;
 mod outputs;
+mod planar;
 mod tangent;
 pub use articulated::accelerations_owned;
 pub use compiled::{CellFn, CellLanesFn, CellTangentFn, CompiledCell};
@@ -208,8 +209,9 @@ impl LinkLayout {
 pub struct LinkKernels {
     pub layout: LinkLayout,
     /// Whether compiled code takes `MassBias` from the recursion too (3D
-    /// chains); planar chains keep the flat kernel, quicker for their few
-    /// coordinates, and take the Jvp and outputs from here.
+    /// chains of four links or more, planar ones of 32 or more: eomgen's
+    /// `link_chain`); shorter chains keep the flat kernel, quicker for
+    /// their few coordinates, and take the Jvp and outputs from here.
     #[serde(default)]
     pub mass_bias: bool,
     pub cells: Vec<crate::Tape>,
@@ -807,6 +809,23 @@ pub fn mass_bias_owned<C: Cells>(
     out: &mut [f64],
 ) {
     debug_assert!(all_owned(layout));
+    match planar::covers(layout) {
+        true => planar::mass_bias(layout, cells, q, qd, p, out),
+        false => mass_bias_spatial(layout, cells, q, qd, p, out),
+    }
+}
+
+/// [`mass_bias_owned`] in 3D; a planar chain's cells run here too (a
+/// rotation about z), which the tests compare with `planar`'s sums.
+#[inline(always)]
+fn mass_bias_spatial<C: Cells>(
+    layout: &LinkLayout,
+    cells: &mut C,
+    q: &[f64],
+    qd: &[f64],
+    p: &[f64],
+    out: &mut [f64],
+) {
     let n = layout.dof;
     let mut scratch = take_scratch(layout, out);
     {
@@ -1205,7 +1224,18 @@ mod tests {
     /// accelerations fails it).
     #[test]
     fn the_recursion_gives_a_pendulum_chains_m_and_h() {
-        let (layout, p) = chain();
+        let (spatial, p) = chain();
+        // The same chain as a planar one (a base angle): the sums in the
+        // plane.
+        let mut planar = (spatial.clone(), p.clone());
+        planar.0.base_angle = Some(planar.1.len());
+        planar.1.push(0.0);
+        for (layout, p) in [(spatial, p), planar] {
+            pendulum_chain_matches_the_closed_form(&layout, &p);
+        }
+    }
+
+    fn pendulum_chain_matches_the_closed_form(layout: &LinkLayout, p: &[f64]) {
         let n = layout.dof;
         for (q, qd) in [
             ([0.0, 0.0, 0.0], [0.0, 0.0, 0.0]),
@@ -1213,7 +1243,7 @@ mod tests {
             ([-2.0, 0.3, -0.9], [-1.5, 0.7, 0.2]),
         ] {
             let mut out = vec![f64::NAN; n * (n + 1) / 2 + n];
-            mass_bias(&layout, &mut Pendulums, &q, &qd, &p, &mut out);
+            mass_bias(layout, &mut Pendulums, &q, &qd, p, &mut out);
             let (m, h) = (mass(&q), bias(&q, &qd));
             let upper = (0..n).flat_map(|i| (i..n).map(move |j| (i, j)));
             for ((i, j), got) in upper.zip(&out) {
@@ -1225,6 +1255,38 @@ mod tests {
                     "h[{i}] at {q:?}: {got} against {want}"
                 );
             }
+        }
+    }
+
+    /// A planar chain turned by its base angle: the sums in the plane
+    /// equal the 3D recursion's on the same cells under the same turn
+    /// (with a tip body and tip loads in the tip frame).
+    #[test]
+    fn planar_sums_equal_the_spatial_recursion() {
+        let (mut spatial, mut p) = chain();
+        let angle = 0.7;
+        let (s, c) = f64::sin_cos(angle);
+        p[6..15].copy_from_slice(&[c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0]);
+        let at = p.len();
+        // Tip mass, length, lateral and axial inertia, force, moment.
+        p.extend([0.3, 0.1, 2e-3, 1e-4, 0.4, -0.8, 0.0, 0.0, 0.0, 0.25]);
+        spatial.tip_mass = Some(at);
+        spatial.tip_length = Some(at + 1);
+        spatial.tip_inertia = Some([at + 2, at + 3]);
+        spatial.tip_force = Some([at + 4, at + 5, at + 6]);
+        spatial.tip_moment = Some([at + 7, at + 8, at + 9]);
+        spatial.tip_frame = true;
+        let mut planar = spatial.clone();
+        planar.base_angle = Some(p.len());
+        p.push(angle);
+        let n = spatial.dof;
+        let (q, qd) = ([0.4, -0.7, 1.1], [0.5, -1.2, 2.0]);
+        let mut want = vec![f64::NAN; n * (n + 1) / 2 + n];
+        mass_bias_spatial(&spatial, &mut Pendulums, &q, &qd, &p, &mut want);
+        let mut got = vec![f64::NAN; want.len()];
+        mass_bias(&planar, &mut Pendulums, &q, &qd, &p, &mut got);
+        for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+            assert!((g - w).abs() < 1e-12, "output {i}: {g} against {w}");
         }
     }
 }
