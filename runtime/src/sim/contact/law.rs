@@ -43,8 +43,9 @@ pub struct Law {
 }
 
 /// The slowest impact speed (m/s) that sets Hunt-Crossley's damping from
-/// the restitution: a contact that begins slower (a resting start, a
-/// creeping touch) is damped as if it hit at this speed, not infinitely.
+/// the restitution, so that alpha stays finite: a contact that begins at
+/// rest is damped at the scale of its load (`settle::settling_speed`),
+/// this where nothing presses it in.
 pub const SLOWEST_IMPACT: f64 = 1e-3;
 
 impl Law {

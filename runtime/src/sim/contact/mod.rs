@@ -16,6 +16,7 @@
 pub mod distance;
 pub mod impact;
 pub mod law;
+pub mod settle;
 
 use std::cell::RefCell;
 
@@ -291,6 +292,14 @@ impl ContactSet {
         }
         self.set_state(state);
         began
+    }
+
+    /// Pair `i` touches, damped as an impact at `speed` at least
+    /// (`settle::settling_speed`).
+    pub fn touch_as_impact_at(&self, i: usize, speed: f64) {
+        let mut state = self.state.borrow_mut();
+        state.touching[i] = true;
+        state.impact[i] = state.impact[i].max(speed);
     }
 
     /// A copy of the running state.

@@ -41,6 +41,7 @@ pub(super) fn run(
         };
         let forces = pair_forces(arm, set, t0, &x[..n], &x[n..], true);
         let began = set.update_records(&forces, &held_forces);
+        settle_records(arm, set, t0, &x, &forces, &began);
         let hits: Vec<usize> = began
             .into_iter()
             .filter(|&i| impact::restitution(set, i).is_some())
@@ -114,6 +115,31 @@ pub(super) fn run(
     let mut stats = stats.expect("at least one leg");
     stats.solver = opts.solver;
     Ok((traj, stats))
+}
+
+/// A Hunt-Crossley pair that began to touch slowly is damped at the scale
+/// of its load (`contact::settle`), and one resting on its surface (gap 0,
+/// not approaching: set down there at the start) while pressed in begins
+/// to touch so, rather than creep in unrecorded.
+fn settle_records(
+    arm: &dyn Dynamics,
+    set: &crate::contact::ContactSet,
+    t: f64,
+    x: &[f64],
+    forces: &[crate::contact::PairForce<f64>],
+    began: &[usize],
+) {
+    let (q, qd) = x.split_at(arm.dof());
+    let touching = set.state().touching;
+    for (i, f) in forces.iter().enumerate() {
+        let resting = !touching[i] && f.gap == 0.0 && f.approach <= 0.0;
+        if !(resting || began.contains(&i)) {
+            continue;
+        }
+        if let Some(v) = crate::contact::settle::settling_speed(arm, set, t, q, qd, i) {
+            set.touch_as_impact_at(i, v);
+        }
+    }
 }
 
 /// Append `seg`'s samples after `t0` (where the previous leg ended; all of
