@@ -318,6 +318,10 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&loaded.model.name));
     let mut dir = softarm::output_dir::OutputDir::claim(&out_dir)?;
+    let out_of_scale = softarm::scale::out_of_scale(&loaded.model, arm, t_end);
+    for line in &out_of_scale {
+        eprintln!("warning: {line}");
+    }
 
     // Ctrl-C, SIGTERM or --max-wall stops the run with what it computed
     // written.
@@ -328,7 +332,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     drop(progress);
     let (traj, stats, failure) = match result {
         Ok((traj, stats)) => (traj, stats, None),
-        Err(f) => explained(arm, *f),
+        Err(f) => explained(arm, *f, &out_of_scale),
     };
     let table = softarm::run::Table::of(arm, &traj);
     eomgen::atomic_write::write_atomic_with(&dir.file("trajectory.csv")?, |w| table.write_csv(w))?;
@@ -384,16 +388,25 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
 }
 
 /// A failed run's trajectory and counts, with its message (the joints
-/// that became dependent named) and its summary entry.
+/// that became dependent named) and its summary entry; inputs out of
+/// their model's scale (`softarm::scale`) come first in what to try.
 fn explained(
     arm: &dyn Dynamics,
-    f: runtime::SimFailure,
+    mut f: runtime::SimFailure,
+    out_of_scale: &[String],
 ) -> (
     Trajectory,
     runtime::SimStats,
     Option<(String, serde_json::Value)>,
 ) {
     let n = arm.dof();
+    if !out_of_scale.is_empty() {
+        f.suggestion = format!(
+            "bring the inputs into the model's scale: {}; then, if it still fails, {}",
+            out_of_scale.join("; "),
+            f.suggestion
+        );
+    }
     let mut msg = f.to_string();
     // Joints that became dependent during the run, by name.
     if f.state.len() == 2 * n {

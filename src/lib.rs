@@ -20,6 +20,7 @@ pub mod linearize;
 pub mod output_dir;
 pub mod progress;
 pub mod run;
+pub mod scale;
 pub mod scene;
 pub mod shape;
 pub mod viewer;

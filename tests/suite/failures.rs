@@ -260,3 +260,51 @@ fn a_run_that_cannot_start_says_why_in_its_own_terms() {
     assert!(err.contains("check --q0 and --qd0"), "{err}");
     assert!(!err.contains("Bad input"), "{err}");
 }
+
+/// A chamber pressure of 1e15 Pa (a unit slip) drives finger_free's
+/// silicone, E = 5e5 Pa, two billion times past its modulus: the run says
+/// so before it starts, naming the input's key, and when it fails, that is
+/// the first thing to try; the summary says it too. No bundled model, as
+/// given, is out of scale (no false alarm).
+#[test]
+fn an_input_far_out_of_scale_is_named_before_the_run_and_in_the_hint() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "simulate",
+        "finger_free",
+        "--set",
+        "inputs.pressure.to=1e15",
+        "--t-end",
+        "1",
+        "--max-steps",
+        "20000",
+        "--out",
+        "o",
+    ];
+    let out = softarm(&args, dir.path());
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    let warning = err.find("warning: inputs.pressure reaches 1.000e15 Pa");
+    let failure = err.find("integration stopped");
+    assert!(
+        warning.is_some() && warning < failure,
+        "named before the run: {err}"
+    );
+    assert!(
+        err.contains("what to try: bring the inputs into the model's scale: inputs.pressure"),
+        "{err}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("o/summary.json")).unwrap())
+            .unwrap();
+    let suggestion = summary["failure"]["suggestion"].as_str().unwrap();
+    assert!(suggestion.contains("inputs.pressure"), "{suggestion}");
+
+    for m in softarm::generated::MODELS {
+        let l = softarm::backend::load(m.name, &[], softarm::backend::BackendChoice::Auto, None)
+            .unwrap();
+        let t_end = l.model.simulate.t_end.unwrap_or(1.0);
+        let found = softarm::scale::out_of_scale(&l.model, &*l.arm, t_end);
+        assert!(found.is_empty(), "{}: {found:?}", m.name);
+    }
+}
