@@ -76,6 +76,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "inputs",
             "contact",
             "joints",
+            "scale",
             "backend",
             "run",
             "scene",
