@@ -110,6 +110,18 @@ fn split_top_level(s: &str) -> Vec<String> {
 /// [`MAX_RUNS`], or past [`CONFIRM_RUNS`] unless `yes` (what to pass is
 /// `confirm`, the front end's spelling of it).
 pub fn checked_size(varies: &[Vary], yes: bool, confirm: &str) -> Result<usize> {
+    checked_size_with(varies, yes, confirm, |_| None)
+}
+
+/// [`checked_size`], the refusal of a grid past [`CONFIRM_RUNS`] saying
+/// what `estimate` (of the run count) gives: the disk and time it would
+/// take.
+pub fn checked_size_with(
+    varies: &[Vary],
+    yes: bool,
+    confirm: &str,
+    estimate: impl FnOnce(usize) -> Option<String>,
+) -> Result<usize> {
     let size = varies
         .iter()
         .try_fold(1usize, |n, v| n.checked_mul(v.values.len()))
@@ -122,8 +134,9 @@ pub fn checked_size(varies: &[Vary], yes: bool, confirm: &str) -> Result<usize> 
         );
     };
     if size > CONFIRM_RUNS && !yes {
+        let estimate = estimate(size).map_or(String::new(), |e| format!(" ({e})"));
         bail!(
-            "the grid has {} = {size} runs, each writing a folder of its own; \
+            "the grid has {} = {size} runs, each writing a folder of its own{estimate}; \
              over {CONFIRM_RUNS} runs a sweep starts only with {confirm}",
             counts.join(" x ")
         );

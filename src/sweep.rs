@@ -5,8 +5,10 @@
 //! status, the chosen figures) and `sweep.png` one figure against the
 //! first varied value, a line per value of the second.
 //!
-//! Before any run the grid is counted (a big one needs `--yes`) and every
-//! varied value is checked as `--set` checks it, so a typo fails at once.
+//! Before any run every varied value is checked as `--set` checks it, so
+//! a typo fails at once, and the grid is counted: a big one needs
+//! `--yes`, and its refusal says the disk and time it would take, from a
+//! pilot of its first run.
 //! A run that fails is a row with its failure; the sweep goes on, and
 //! exits non-zero at its end. Each run that ended writes its row into its
 //! folder, so that `--resume` redoes only the runs that did not.
@@ -21,7 +23,7 @@ use rayon::prelude::*;
 use serde_json::Value;
 
 use crate::commands::{self, ModesArgs, SimulateArgs, StaticArgs};
-use softarm::grid::{Vary, checked_size, grid};
+use softarm::grid::{Vary, checked_size_with, grid};
 
 #[derive(Args, Clone)]
 pub struct SweepArgs {
@@ -77,8 +79,8 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         .iter()
         .map(|s| Vary::parse(s))
         .collect::<Result<_>>()?;
-    checked_size(&varies, a.yes, "--yes")?;
     check_values(&a.simulate.model, &varies)?;
+    checked_size_with(&varies, a.yes, "--yes", |runs| pilot(&a, &varies, runs))?;
     let combos = grid(&varies);
     let name = model_name(&a.simulate.model.model);
     let out_dir = a
@@ -218,6 +220,50 @@ fn run_one(a: &SweepArgs, varies: &[Vary], combo: &[usize], dir: &Path) -> Row {
         let _ = eomgen::atomic_write::write_atomic(&dir.join(ROW), text.as_bytes());
     }
     row
+}
+
+/// How long a pilot of the grid's first run may take (s).
+const PILOT_WALL_S: f64 = 2.0;
+
+/// The disk and time `runs` runs would take, from a pilot of the first
+/// run (stopped after [`PILOT_WALL_S`], scaled from the time it reached to
+/// the whole run), in a folder of the system's temporary one, removed.
+fn pilot(a: &SweepArgs, varies: &[Vary], runs: usize) -> Option<String> {
+    let dir = std::env::temp_dir().join(format!("softarm-sweep-pilot-{}", std::process::id()));
+    let mut pilot = a.clone();
+    pilot.simulate.max_wall = Some(PILOT_WALL_S);
+    let mut model = a.simulate.model.clone();
+    for v in varies {
+        model.set.push(format!("{}={}", v.path, v.values[0]));
+    }
+    let ran = std::fs::create_dir_all(&dir)
+        .ok()
+        .and_then(|()| study(&pilot, model, &dir).ok());
+    let summary: Option<Value> = std::fs::read_to_string(dir.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    let bytes: u64 = std::fs::read_dir(&dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter_map(|e| e.metadata().ok())
+        .map(|m| m.len())
+        .sum();
+    let _ = std::fs::remove_dir_all(&dir);
+    ran?;
+    let v = summary?;
+    let wall = v["wall_s"].as_f64()?;
+    // A study without time (static, modes) or a run that ended: as it is.
+    let scale = match (v["t_end"].as_f64(), v["failure"]["t_reached"].as_f64()) {
+        (Some(t_end), Some(t)) if t > 0.0 => t_end / t,
+        _ => 1.0,
+    };
+    let jobs = a.jobs.unwrap_or_else(rayon::current_num_threads).max(1);
+    let hours = wall * scale * runs as f64 / jobs as f64 / 3600.0;
+    let gb = bytes as f64 * scale * runs as f64 / 1e9;
+    Some(format!(
+        "about {gb:.3} GB and {hours:.2} h on {jobs} threads, from a pilot of the first run"
+    ))
 }
 
 /// The row a run writes into its folder when it has ended.

@@ -350,3 +350,76 @@ fn a_killed_sweep_leaves_the_table_of_what_it_finished() {
         assert_eq!(&after[i + 1], r, "a finished run's row is kept as it was");
     }
 }
+
+/// A grid past 10,000 runs is refused with the disk and time it would
+/// take, from a pilot of its first run (in the system's temporary folder,
+/// removed): the disk is the runs times what that run writes when run on
+/// its own (its run fits in the pilot's two seconds, so nothing is
+/// scaled).
+#[test]
+fn a_big_grid_is_refused_with_its_disk_and_time_from_a_pilot() {
+    let dir = tempfile::tempdir().unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let one = softarm(
+        &[
+            "simulate",
+            "soft_finger",
+            "--t-end",
+            "0.5",
+            "--set",
+            "tip.mass=0.01",
+            "--set",
+            "segment.0.length=0.1",
+            "--out",
+            "one",
+        ],
+        dir.path(),
+    );
+    assert!(one.status.success(), "{}", stderr(&one));
+    let bytes: u64 = std::fs::read_dir(dir.path().join("one"))
+        .unwrap()
+        .map(|e| e.unwrap().metadata().unwrap().len())
+        .sum();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_softarm"))
+        .args([
+            "sweep",
+            "soft_finger",
+            "--t-end",
+            "0.5",
+            "--jobs",
+            "2",
+            "--vary",
+            "tip.mass=lin:0.01:1:200",
+            "--vary",
+            "segment.0.length=lin:0.1:0.2:100",
+            "--out",
+            "s",
+        ])
+        .current_dir(dir.path())
+        .env("TMPDIR", tmp.path())
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    let figure = |before: &str| -> f64 {
+        let at = err
+            .find(before)
+            .unwrap_or_else(|| panic!("{before:?} in {err}"));
+        let head = &err[..at];
+        head[head.rfind(' ').unwrap() + 1..].parse().unwrap()
+    };
+    let (gb, hours) = (figure(" GB and"), figure(" h on 2 threads"));
+    let want = bytes as f64 * 20_000.0 / 1e9;
+    assert!(
+        (gb - want).abs() <= 0.02 * want,
+        "{gb} GB against {want}: {err}"
+    );
+    assert!(hours > 0.0 && hours.is_finite(), "{err}");
+    assert!(err.contains("only with --yes"), "{err}");
+    assert!(!dir.path().join("s").exists());
+    assert_eq!(
+        std::fs::read_dir(tmp.path()).unwrap().count(),
+        0,
+        "the pilot's folder removed"
+    );
+}
