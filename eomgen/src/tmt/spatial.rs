@@ -405,11 +405,14 @@ pub(crate) struct Element3 {
 
 impl Element3 {
     /// Half of this element (a half-arc, `in_halves`): half the mass and
-    /// axial inertia; laterally half the section's part (axial / 4) and an
-    /// eighth of the slice's m l^2 / 12.
+    /// axial inertia; laterally the element's lateral inertia is its
+    /// section's rotary inertia, axial / 2 (rho I l, J = 2 I), and its
+    /// slice's m l^2 / 12, of which a half of half the length carries half
+    /// and an eighth: axial / 4 and m l^2 / 96.
     pub fn half(&self, cas: &mut Cas) -> Element3 {
+        let whole_section = cas.scaled(0.5, self.axial);
         let section = cas.scaled(0.25, self.axial);
-        let slice = cas.sub(self.lateral, section);
+        let slice = cas.sub(self.lateral, whole_section);
         let slice = cas.scaled(0.125, slice);
         Element3 {
             l: cas.scaled(0.5, self.l),
