@@ -338,34 +338,67 @@ pub(crate) fn local(spec: &LinkSpec, p: &[f64], v: &[f64]) -> [f64; MAX_LINK_DOF
     x
 }
 
-/// Every link's cell parameters: its element parameters from `p`, then its
-/// segment's actuation loads (zero where none act).
+/// The actuation loads ([`Cells::loads`]: [`LinkLayout::loads`]
+/// triples), on the stack for up to eight actuated segments.
+pub(crate) struct Loads {
+    stack: [f64; 3 * 8],
+    heap: Vec<f64>,
+    len: usize,
+}
+
+impl Loads {
+    #[inline(always)]
+    pub(crate) fn of<C: Cells>(layout: &LinkLayout, cells: &mut C) -> Self {
+        let len = 3 * layout.loads;
+        let mut loads = Loads {
+            stack: [0.0; 3 * 8],
+            heap: Vec::new(),
+            len,
+        };
+        if len > loads.stack.len() {
+            loads.heap.resize(len, 0.0);
+            cells.loads(&mut loads.heap);
+        } else if len > 0 {
+            cells.loads(&mut loads.stack[..len]);
+        }
+        loads
+    }
+
+    #[inline(always)]
+    pub(crate) fn values(&self) -> &[f64] {
+        match self.len > self.stack.len() {
+            true => &self.heap,
+            false => &self.stack[..self.len],
+        }
+    }
+}
+
+/// A link's cell parameters into `v`: its element parameters from `p`,
+/// then its segment's actuation loads (`loads`: [`Loads::values`]; zero
+/// where none act).
+#[inline(always)]
+pub(crate) fn link_params(v: &mut [f64; CELL_PARAMS], spec: &LinkSpec, p: &[f64], loads: &[f64]) {
+    for (v, &i) in v.iter_mut().zip(&spec.params) {
+        *v = p[i];
+    }
+    let at = spec.load.map(|l| 3 * l);
+    for (f, v) in v[ELEMENT_PARAMS..].iter_mut().enumerate() {
+        *v = at.map_or(0.0, |at| loads[at + f]);
+    }
+}
+
+/// Every link's cell parameters ([`link_params`]).
 pub(crate) fn cell_params<C: Cells>(
     layout: &LinkLayout,
     cells: &mut C,
     p: &[f64],
     params: &mut Vec<[f64; CELL_PARAMS]>,
 ) {
-    let mut loads = [0.0; 3 * 8];
-    let mut heap = Vec::new();
-    let loads: &mut [f64] = if layout.loads <= 8 {
-        &mut loads[..3 * layout.loads]
-    } else {
-        heap.resize(3 * layout.loads, 0.0);
-        &mut heap
-    };
-    if layout.loads > 0 {
-        cells.loads(loads);
-    }
+    let loads = Loads::of(layout, cells);
+    let loads = loads.values();
     params.resize(layout.links.len(), [0.0; CELL_PARAMS]);
     for (v, spec) in params.iter_mut().zip(&layout.links) {
-        for (v, &i) in v.iter_mut().zip(&spec.params) {
-            *v = p[i];
-        }
-        let at = spec.load.map(|l| 3 * l);
-        for (f, v) in v[ELEMENT_PARAMS..].iter_mut().enumerate() {
-            *v = at.map_or(0.0, |at| loads[at + f]);
-        }
+        link_params(v, spec, p, loads);
     }
 }
 

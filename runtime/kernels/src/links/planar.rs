@@ -16,7 +16,7 @@
 
 use std::cell::RefCell;
 
-use super::{CELL_PARAMS, Cells, ELEMENT_PARAMS, LinkLayout, cell};
+use super::{CELL_PARAMS, Cells, LinkLayout, Loads, cell, link_params};
 
 type P2 = [f64; 2];
 /// A twist about the world origin, or a wrench: (w, vx, vy), (moment,
@@ -218,20 +218,6 @@ thread_local! {
     static SCRATCH: RefCell<Scratch> = RefCell::default();
 }
 
-/// Every link's cell parameters at `p`, then its segment's actuation
-/// loads (`loads`: the `loads` kernel's outputs).
-#[inline(always)]
-fn params_of(spec: &super::LinkSpec, p: &[f64], loads: &[f64]) -> [f64; CELL_PARAMS] {
-    let mut cp = [0.0; CELL_PARAMS];
-    for (v, &i) in cp.iter_mut().zip(&spec.params) {
-        *v = p[i];
-    }
-    if let Some(l) = spec.load {
-        cp[ELEMENT_PARAMS..].copy_from_slice(&loads[3 * l..3 * l + 3]);
-    }
-    cp
-}
-
 /// The forward sweep: every link's cell where the sweep reaches it, into
 /// a buffer of its own (the cell inlined, the buffer stays in registers),
 /// under the frame composed so far; then the tip.
@@ -244,17 +230,8 @@ fn forward<C: Cells>(
     p: &[f64],
     s: &mut Scratch,
 ) -> Tip {
-    let mut loads = [0.0; 3 * 8];
-    let mut heap = Vec::new();
-    let loads: &mut [f64] = if layout.loads <= 8 {
-        &mut loads[..3 * layout.loads]
-    } else {
-        heap.resize(3 * layout.loads, 0.0);
-        &mut heap
-    };
-    if layout.loads > 0 {
-        cells.loads(loads);
-    }
+    let loads = Loads::of(layout, cells);
+    let loads = loads.values();
     let gravity = [p[layout.gravity[0]], p[layout.gravity[1]]];
     let (sn, cs) = layout.base_angle.map_or(0.0, |i| p[i]).sin_cos();
     let mut frame = Frame {
@@ -267,7 +244,8 @@ fn forward<C: Cells>(
     s.links.clear();
     let mut at = 0;
     for spec in &layout.links {
-        let cp = params_of(spec, p, loads);
+        let mut cp = [0.0; CELL_PARAMS];
+        link_params(&mut cp, spec, p, loads);
         let mut out = [0.0; LEN];
         let xd = match spec.map.len() {
             1 => {
