@@ -308,3 +308,44 @@ fn an_input_far_out_of_scale_is_named_before_the_run_and_in_the_hint() {
         assert!(found.is_empty(), "{}: {found:?}", m.name);
     }
 }
+
+/// A run that fails for a cause other than its step budget reports the
+/// rejected steps its method counted up to the failure (our own methods
+/// keep the count: trbdf2 rejects steps as the right-hand side turns
+/// non-finite), and null rather than 0 where the ODE crate's method lost
+/// it with its error (bdf).
+#[test]
+fn a_failed_run_reports_its_rejected_steps_or_says_they_are_unknown() {
+    for (solver, counted) in [("trbdf2", true), ("bdf", false)] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = softarm(
+            &[
+                "simulate",
+                "finger_free",
+                "--set",
+                "inputs.pressure.to=1e308",
+                "--solver",
+                solver,
+                "--t-end",
+                "1",
+                "--out",
+                "o",
+            ],
+            dir.path(),
+        );
+        assert!(!out.status.success(), "{solver}");
+        let summary: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join("o/summary.json")).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(summary["status"], "failed", "{solver}");
+        let rejected = &summary["rejected_steps"];
+        match counted {
+            true => assert!(
+                rejected.as_u64().is_some_and(|r| r > 0),
+                "{solver}: {rejected}"
+            ),
+            false => assert!(rejected.is_null(), "{solver}: {rejected}"),
+        }
+    }
+}

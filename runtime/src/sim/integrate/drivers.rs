@@ -206,6 +206,7 @@ pub(super) fn run_own(
         },
         &mut counts,
     );
+    ode.rejected.set(Some(counts.rejected));
     let outcome: Outcome<Vec<f64>> = result.map(|_| {
         solution.steps.accepted = counts.accepted;
         solution.steps.rejected = counts.rejected;

@@ -57,7 +57,7 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
     let hits = kept.events.clone();
     let wall_s = start.elapsed().as_secs_f64();
     let m = 2 * ode.n;
-    let stats_of = |steps: usize, rejected: usize| SimStats {
+    let stats_of = |steps: usize, rejected: Option<usize>| SimStats {
         solver: opts.solver,
         steps,
         rejected_steps: rejected,
@@ -76,7 +76,7 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
     let unpad = |y: &Y| y.as_ref()[..m].to_vec();
     match result {
         Ok(sol) => {
-            let stats = stats_of(sol.steps.accepted, sol.steps.rejected);
+            let stats = stats_of(sol.steps.accepted, Some(sol.steps.rejected));
             let traj = Trajectory {
                 t: sol.t.clone(),
                 x: sol.y.iter().map(unpad).collect(),
@@ -124,11 +124,11 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
                 trajectory.t.push(t_reached);
                 trajectory.x.push(state.clone());
             }
-            // The method's count of rejected steps dies with its error, but
-            // a spent budget counts both kinds (ours and the crate's).
+            // A spent budget counts both kinds (ours and the crate's); our
+            // own methods keep their count; the crate's dies with its error.
             let rejected = match budget_spent {
-                true => opts.max_steps.saturating_sub(accepted),
-                false => 0,
+                true => Some(opts.max_steps.saturating_sub(accepted)),
+                false => ode.rejected.get(),
             };
             Err(Box::new(SimFailure {
                 t_reached,

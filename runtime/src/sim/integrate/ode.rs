@@ -23,6 +23,9 @@ pub(super) struct ArmOde<'a, D: ?Sized> {
     qdd: RefCell<Vec<f64>>,
     pub(super) evals: Cell<usize>,
     pub(super) jac_evals: Cell<usize>,
+    /// Rejected steps of our own methods (`drivers::run_own`), which keep
+    /// them past a failure; None for the ODE crate's.
+    pub(super) rejected: Cell<Option<usize>>,
     jac: RefCell<DMatrix<f64>>,
     pub(super) first_error: RefCell<Option<AccelError>>,
     /// Set when a right-hand side failed since the last accepted step.
@@ -39,6 +42,7 @@ impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
             qdd: RefCell::new(vec![0.0; n]),
             evals: Cell::new(0),
             jac_evals: Cell::new(0),
+            rejected: Cell::new(None),
             jac: RefCell::new(DMatrix::zeros(2 * n, 2 * n)),
             first_error: RefCell::new(None),
             failed_in_step: Cell::new(false),

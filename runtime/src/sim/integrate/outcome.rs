@@ -45,7 +45,9 @@ pub struct SwitchRecord {
 pub struct SimStats {
     pub solver: Solver,
     pub steps: usize,
-    pub rejected_steps: usize,
+    /// None where a failed method's count was lost with its error (the
+    /// ODE crate's methods, but for a spent budget).
+    pub rejected_steps: Option<usize>,
     pub rhs_evaluations: usize,
     pub jacobian_evaluations: usize,
     pub wall_s: f64,
@@ -63,7 +65,7 @@ impl SimStats {
         Self {
             solver,
             steps: 0,
-            rejected_steps: 0,
+            rejected_steps: Some(0),
             rhs_evaluations: 0,
             jacobian_evaluations: 0,
             wall_s: 0.0,
@@ -77,7 +79,10 @@ impl SimStats {
     /// (the constraints' figures are their runner's to merge).
     pub fn absorb(&mut self, more: &SimStats) {
         self.steps += more.steps;
-        self.rejected_steps += more.rejected_steps;
+        self.rejected_steps = self
+            .rejected_steps
+            .zip(more.rejected_steps)
+            .map(|(a, b)| a + b);
         self.rhs_evaluations += more.rhs_evaluations;
         self.jacobian_evaluations += more.jacobian_evaluations;
         self.wall_s += more.wall_s;
