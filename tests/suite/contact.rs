@@ -234,32 +234,10 @@ fn a_contact_that_begins_at_rest_settles_within_ten_periods() {
 fn an_arm_set_down_on_a_support_settles_where_the_static_solve_puts_it() {
     let (m, g, len, k, n_exp, k_joint): (f64, f64, f64, f64, f64, f64) =
         (0.3, 9.81, 0.4, 1e5, 1.5, 1.0);
-    let text = format!(
-        r#"
-name = "rod"
-gravity = [0.0, {gy}, 0.0]
-[base]
-direction = [1.0, 0.0, 0.0]
-[[segment]]
-method = "rigid"
-length = {len}
-mass = {m}
-elements = 1
-joint_stiffness = {k_joint}
-[[obstacle]]
-name = "support"
-shape = "plane"
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 1.0, 0.0]
-[contact]
-model = "hunt_crossley"
-restitution = 0.2
-stiffness = {k}
-exponent = {n_exp}
-points_per_element = 1
-"#,
-        gy = -g
+    let law = format!(
+        "model = \"hunt_crossley\"\nrestitution = 0.2\nstiffness = {k}\nexponent = {n_exp}"
     );
+    let text = rod_on_support(m, g, len, k_joint, &law);
     let dir = tempfile::tempdir().unwrap();
     let l = load_text(dir.path(), &text, &[]);
     // The closed form by bisection on the moment balance (theta < 0).
@@ -520,14 +498,11 @@ fn an_impulse_reverses_the_normal_velocity_by_e() {
     }
 }
 
-/// A rigid rod pinned at one end swings down onto a support under its
-/// tip: with e = 0 it stops dead at the impact (one freedom, so the whole
-/// velocity is normal at the tip) and rests held there, the support
-/// carrying half the rod's weight, m g / 2.
-#[test]
-fn a_rod_struck_on_its_support_stops_and_rests_on_it() {
-    let (m, g, len) = (0.3, 9.81, 0.4);
-    let text = format!(
+/// A rigid rod of mass `m` and length `len` pinned at the origin on a
+/// joint spring `k_joint`, pointing along x, gravity `g` down, its tip (one
+/// contact point) over a support plane y = 0 under the contact `law`.
+fn rod_on_support(m: f64, g: f64, len: f64, k_joint: f64, law: &str) -> String {
+    format!(
         r#"
 name = "rod"
 gravity = [0.0, {gy}, 0.0]
@@ -538,19 +513,28 @@ method = "rigid"
 length = {len}
 mass = {m}
 elements = 1
-joint_stiffness = 0.0
+joint_stiffness = {k_joint}
 [[obstacle]]
 name = "support"
 shape = "plane"
 point = [0.0, 0.0, 0.0]
 normal = [0.0, 1.0, 0.0]
 [contact]
-model = "impulse"
-restitution = 0.0
+{law}
 points_per_element = 1
 "#,
         gy = -g
-    );
+    )
+}
+
+/// A rigid rod pinned at one end swings down onto a support under its
+/// tip: with e = 0 it stops dead at the impact (one freedom, so the whole
+/// velocity is normal at the tip) and rests held there, the support
+/// carrying half the rod's weight, m g / 2.
+#[test]
+fn a_rod_struck_on_its_support_stops_and_rests_on_it() {
+    let (m, g, len) = (0.3, 9.81, 0.4);
+    let text = rod_on_support(m, g, len, 0.0, "model = \"impulse\"\nrestitution = 0.0");
     let dir = tempfile::tempdir().unwrap();
     let l = load_text(dir.path(), &text, &[]);
     let n = l.arm.dof();
