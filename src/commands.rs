@@ -17,6 +17,7 @@ use softarm::backend::{self, Loaded};
 use softarm::compare;
 use softarm::generated::MODELS;
 use softarm::run::RunRequest;
+use softarm::run_output::{Kept, RunOutput};
 
 use crate::ModelArgs;
 
@@ -266,13 +267,12 @@ fn option_sources(
 fn compare_tip(
     loaded: &Loaded,
     m: &compare::Measured,
-    traj: &Trajectory,
+    tips: &[(f64, [f64; 3])],
     dir: &mut softarm::output_dir::OutputDir,
 ) -> Result<Option<compare::TipError>> {
-    let tips = softarm::run::tips(loaded, traj);
     // A run that ends before the window has no statistics, but
     // still its plot.
-    let err = softarm::run::tip_error(loaded, m, &tips)
+    let err = softarm::run::tip_error(loaded, m, tips)
         .map_err(|e| eprintln!("warning: no tip error: {e}"))
         .ok();
     let title = match &err {
@@ -284,7 +284,7 @@ fn compare_tip(
         ),
         None => format!("{}: simulated and measured tip", loaded.model.name),
     };
-    compare::plot(&dir.plot("tip")?, &title, &tips, m)?;
+    compare::plot(&dir.plot("tip")?, &title, tips, m)?;
     Ok(err)
 }
 
@@ -323,6 +323,25 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         eprintln!("warning: {line}");
     }
 
+    let rows = match &opts.output_times {
+        Some(t) => t.len() as f64,
+        None => (t_end / opts.output_dt).floor() + 1.0,
+    };
+    if let Some(line) = softarm::run_output::size_warning(&loaded, &x0, shape.as_ref(), rows) {
+        eprintln!("warning: {line}");
+    }
+    // Rows go to disk as the run hands them over.
+    let shape_csv = match shape {
+        Some(s) => Some((s, dir.file("shape.csv")?)),
+        None => None,
+    };
+    let output = RunOutput::create(
+        &loaded,
+        &dir.file("trajectory.csv")?,
+        shape_csv,
+        measured.is_some(),
+    )?;
+    opts.rows = Some(output.sink());
     // Ctrl-C, SIGTERM or --max-wall stops the run with what it computed
     // written.
     opts.interrupt = Some(softarm::interrupt::for_run(deadline));
@@ -334,16 +353,10 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         Ok((traj, stats)) => (traj, stats, None),
         Err(f) => explained(arm, *f, &out_of_scale),
     };
-    let table = softarm::run::Table::of(arm, &traj);
-    eomgen::atomic_write::write_atomic_with(&dir.file("trajectory.csv")?, |w| table.write_csv(w))?;
-    if let Some(shape) = &shape {
-        eomgen::atomic_write::write_atomic_with(&dir.file("shape.csv")?, |w| {
-            shape.write_csv(arm, &traj.t, &traj.x, w)
-        })?;
-    }
-    plot_paths_and_contact(&loaded, &traj, &mut dir)?;
+    let kept = output.finish()?;
+    plot_paths_and_contact(&loaded, &kept, &mut dir)?;
     let tip_error = match (&measured, &loaded.model.compare) {
-        (Some(m), Some(_)) => compare_tip(&loaded, m, &traj, &mut dir)?,
+        (Some(m), Some(_)) => compare_tip(&loaded, m, &kept.tips, &mut dir)?,
         _ => None,
     };
     let mut summary = softarm::run::summary(
@@ -428,46 +441,25 @@ fn explained(
 /// forces, as pictures in `out_dir`.
 fn plot_paths_and_contact(
     loaded: &Loaded,
-    traj: &Trajectory,
+    kept: &Kept,
     dir: &mut softarm::output_dir::OutputDir,
 ) -> Result<()> {
-    let arm = &*loaded.arm;
-    let n = arm.dof();
-    let body_names: Vec<String> = loaded.model.bodies.iter().map(|b| b.name.clone()).collect();
-    for (body, ix) in softarm::joints::free_bodies(arm, &body_names) {
-        let path: Vec<(f64, f64, f64)> = traj
-            .t
-            .iter()
-            .zip(&traj.x)
-            .map(|(t, x)| (*t, x[ix], x[ix + 1]))
-            .collect();
+    for (body, path) in &kept.paths {
         let title = format!("{}: path of {body}", loaded.model.name);
-        softarm::joints::plot_path(&dir.plot(&body)?, &title, &path)?;
+        softarm::joints::plot_path(&dir.plot(body)?, &title, &path.points())?;
     }
-    if let Some(set) = arm.contact() {
+    if let Some(set) = loaded.arm.contact()
+        && !kept.tip_path.is_empty()
+    {
         // The tip's path and the contact forces.
-        let tips: Vec<(f64, f64, f64)> = traj
-            .t
-            .iter()
-            .zip(&traj.x)
-            .map(|(t, x)| {
-                let o = arm.outputs(*t, &x[..n], &x[n..]);
-                (*t, o[0], o[1])
-            })
-            .collect();
         let name = &loaded.model.name;
+        let tips = kept.tip_path.points();
         softarm::joints::plot_path(&dir.plot("tip")?, &format!("{name}: tip path"), &tips)?;
-        let forces: Vec<(f64, Vec<f64>)> = traj
-            .t
-            .iter()
-            .enumerate()
-            .map(|(i, t)| (*t, softarm::contact::columns(arm, traj, i)))
-            .collect();
         softarm::contact::plot_forces(
             &dir.plot("contact")?,
             &format!("{name}: contact forces"),
             &set.channels,
-            &forces,
+            &kept.forces.points(),
         )?;
     }
     Ok(())

@@ -20,6 +20,7 @@ pub mod linearize;
 pub mod output_dir;
 pub mod progress;
 pub mod run;
+pub mod run_output;
 pub mod scale;
 pub mod scene;
 pub mod shape;

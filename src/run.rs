@@ -28,10 +28,6 @@ pub struct RunRequest {
 
 /// The run's options. Errors name the option as the command line spells
 /// it (`--rtol`), which Python's keyword (`rtol`) follows.
-///
-/// The trajectory's rows stay in memory for the figures and the summary:
-/// at most [`MAX_OUTPUT_ROWS`] of them (a 30-coordinate arm's million rows
-/// are about a gigabyte with their outputs).
 pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> {
     let defaults = SimOptions::default();
     let t_end = req.t_end.or(file.t_end).unwrap_or(defaults.t_end);
@@ -74,13 +70,6 @@ pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> 
             "--output-dt {output_dt} s is longer than the run (--t-end {t_end} s): the trajectory would hold its first row only"
         );
     }
-    let rows = (t_end / output_dt).floor() + 1.0;
-    if rows > MAX_OUTPUT_ROWS as f64 {
-        bail!(
-            "--output-dt {output_dt} s over --t-end {t_end} s is {rows:.0} trajectory rows; a run keeps at most {MAX_OUTPUT_ROWS} in memory: take --output-dt {} s or longer, or a shorter --t-end",
-            up_to_two_digits(t_end / (MAX_OUTPUT_ROWS - 1) as f64)
-        );
-    }
     Ok(SimOptions {
         t_end,
         solver,
@@ -91,6 +80,20 @@ pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> 
         max_steps,
         ..defaults
     })
+}
+
+/// A run whose rows are returned in memory (Python's `simulate`) keeps at
+/// most [`MAX_OUTPUT_ROWS`]; the CLI writes them as they come, any number.
+pub fn rows_in_memory(opts: &SimOptions) -> Result<()> {
+    let (t_end, output_dt) = (opts.t_end, opts.output_dt);
+    let rows = (t_end / output_dt).floor() + 1.0;
+    if rows > MAX_OUTPUT_ROWS as f64 {
+        bail!(
+            "--output-dt {output_dt} s over --t-end {t_end} s is {rows:.0} trajectory rows; a run returned in memory keeps at most {MAX_OUTPUT_ROWS}: take --output-dt {} s or longer, a shorter --t-end, or `softarm simulate`, which writes its rows to disk as they come",
+            up_to_two_digits(t_end / (MAX_OUTPUT_ROWS - 1) as f64)
+        );
+    }
+    Ok(())
 }
 
 /// x rounded up to two significant digits (a suggestion that holds).
@@ -224,7 +227,9 @@ pub fn tip_error(
     })
 }
 
-/// The most trajectory rows a run keeps (`--output-dt` against `--t-end`).
+/// The most trajectory rows a run returned in memory keeps (a
+/// 30-coordinate arm's million rows are about a gigabyte with their
+/// outputs).
 pub const MAX_OUTPUT_ROWS: usize = 1_000_000;
 
 /// A run's table, every column of `trajectory.csv` by name: t, the
@@ -241,6 +246,22 @@ impl Table {
     /// The table of a run of `arm`.
     pub fn of(arm: &dyn runtime::Dynamics, traj: &runtime::Trajectory) -> Self {
         let n = arm.dof();
+        let joints = !arm.info().constraints.is_empty();
+        let rows = (traj.t.iter().zip(&traj.x).enumerate())
+            .map(|(i, (t, x))| {
+                let out = arm.outputs(*t, &x[..n], &x[n..]);
+                let contact = crate::contact::columns(arm, traj, i);
+                Self::row(arm, *t, x, &out, joints, &contact)
+            })
+            .collect();
+        Self {
+            names: Self::names(arm),
+            rows,
+        }
+    }
+
+    /// The columns' names.
+    pub fn names(arm: &dyn runtime::Dynamics) -> Vec<String> {
         let coords = &arm.info().coordinates;
         let mut names = vec!["t".to_string()];
         names.extend(coords.iter().cloned());
@@ -248,21 +269,28 @@ impl Table {
         names.extend(runtime::OUTPUT_NAMES.iter().map(|o| o.to_string()));
         names.extend(crate::joints::reaction_names(arm));
         names.extend(crate::contact::column_names(arm));
-        let joints = !arm.info().constraints.is_empty();
-        let rows = (traj.t.iter().zip(&traj.x).enumerate())
-            .map(|(i, (t, x))| {
-                let mut row = Vec::with_capacity(names.len());
-                row.push(*t);
-                row.extend_from_slice(x);
-                row.extend(arm.outputs(*t, &x[..n], &x[n..]));
-                if joints {
-                    row.extend(crate::joints::reactions(arm, *t, x));
-                }
-                row.extend(crate::contact::columns(arm, traj, i));
-                row
-            })
-            .collect();
-        Self { names, rows }
+        names
+    }
+
+    /// The row at (t, x): `outputs` the arm's there, `joints` whether it
+    /// has joints (their reactions), `contact` its contact columns.
+    pub fn row(
+        arm: &dyn runtime::Dynamics,
+        t: f64,
+        x: &[f64],
+        outputs: &[f64],
+        joints: bool,
+        contact: &[f64],
+    ) -> Vec<f64> {
+        let mut row = Vec::with_capacity(1 + x.len() + outputs.len() + contact.len());
+        row.push(t);
+        row.extend_from_slice(x);
+        row.extend_from_slice(outputs);
+        if joints {
+            row.extend(crate::joints::reactions(arm, t, x));
+        }
+        row.extend_from_slice(contact);
+        row
     }
 
     /// The first column of the forces (joints', then contacts'): after t,
@@ -277,13 +305,18 @@ impl Table {
     pub fn write_csv(&self, w: &mut impl std::io::Write) -> std::io::Result<()> {
         writeln!(w, "{}", self.names.join(","))?;
         for row in &self.rows {
-            write!(w, "{:.9}", row[0])?;
-            for v in &row[1..] {
-                write!(w, ",{v:.12e}")?;
-            }
-            writeln!(w)?;
+            Self::write_row(w, row)?;
         }
         Ok(())
+    }
+
+    /// One row of `trajectory.csv`.
+    pub fn write_row(w: &mut impl std::io::Write, row: &[f64]) -> std::io::Result<()> {
+        write!(w, "{:.9}", row[0])?;
+        for v in &row[1..] {
+            write!(w, ",{v:.12e}")?;
+        }
+        writeln!(w)
     }
 }
 

@@ -118,15 +118,32 @@ impl Shape {
         w: &mut impl std::io::Write,
     ) -> std::io::Result<()> {
         let n = arm.dof();
-        writeln!(w, "t,part,point,s,x,y,z,qw,qx,qy,qz")?;
+        Self::write_header(w)?;
         for (t, x) in t.iter().zip(x) {
-            for r in self.at(arm, *t, &x[..n]) {
-                write!(w, "{t:.9},{},{},{:.9}", r.part, r.point, r.s)?;
-                for v in r.pose {
-                    write!(w, ",{v:.9e}")?;
-                }
-                writeln!(w)?;
+            self.write_rows(arm, *t, &x[..n], w)?;
+        }
+        Ok(())
+    }
+
+    /// `shape.csv`'s header.
+    pub fn write_header(w: &mut impl std::io::Write) -> std::io::Result<()> {
+        writeln!(w, "t,part,point,s,x,y,z,qw,qx,qy,qz")
+    }
+
+    /// `shape.csv`'s rows at time t, coordinates q.
+    pub fn write_rows(
+        &self,
+        arm: &dyn Dynamics,
+        t: f64,
+        q: &[f64],
+        w: &mut impl std::io::Write,
+    ) -> std::io::Result<()> {
+        for r in self.at(arm, t, q) {
+            write!(w, "{t:.9},{},{},{:.9}", r.part, r.point, r.s)?;
+            for v in r.pose {
+                write!(w, ",{v:.9e}")?;
             }
+            writeln!(w)?;
         }
         Ok(())
     }

@@ -345,6 +345,7 @@ impl Model {
         };
         let mut opts =
             softarm::run::options(&req, &self.loaded.model.simulate).map_err(value_error)?;
+        softarm::run::rows_in_memory(&opts).map_err(value_error)?;
         let (x0, _) = softarm::run::initial_state(&req, &mut self.loaded).map_err(value_error)?;
         // A compared model samples at the measured times, as the CLI does.
         let measured = softarm::run::measured(&self.loaded, &x0).map_err(value_error)?;

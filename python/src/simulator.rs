@@ -62,6 +62,12 @@ impl Simulator {
     fn hold(&mut self, u: &[f64]) {
         self.controls.hold(&mut *self.loaded.arm, u);
     }
+
+    /// The next step begins a run of its own: how the contacts began is
+    /// the last run's, not this start's.
+    fn new_start(&mut self) {
+        self.opts.continues = false;
+    }
 }
 
 #[pymethods]
@@ -79,7 +85,10 @@ impl Simulator {
         self.opts.t_end = self.t + self.dt;
         self.opts.output_times = Some(vec![self.opts.t_end]);
         let arm = &*self.loaded.arm;
-        match runtime::simulate(arm, self.x.clone(), &self.opts) {
+        let run = runtime::simulate(arm, self.x.clone(), &self.opts);
+        // The next step goes on from this one.
+        self.opts.continues = true;
+        match run {
             Ok((traj, _)) => match (traj.t.last(), traj.x.last()) {
                 (Some(&t), Some(x)) if t == self.opts.t_end => {
                     self.x = x.clone();
@@ -106,6 +115,7 @@ impl Simulator {
     #[setter]
     fn set_state(&mut self, x: PyReadonlyArray1<f64>) -> PyResult<()> {
         self.x = vector("state", Some(x), self.x.len())?;
+        self.new_start();
         Ok(())
     }
 
@@ -146,6 +156,7 @@ impl Simulator {
         };
         self.t = 0.0;
         self.hold(&vec![0.0; self.controls.names.len()]);
+        self.new_start();
         Ok(self.x.clone().into_pyarray(py))
     }
 

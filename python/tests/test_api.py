@@ -118,6 +118,8 @@ def test_bad_input_raises_clear_exceptions():
         m.simulate(t_end=0.1, solver="ode45")
     with pytest.raises(ValueError, match="the starts are"):
         m.simulate(t_end=0.1, start="moving")
+    with pytest.raises(ValueError, match="a run returned in memory keeps at most 1000000"):
+        m.simulate(t_end=1.0, output_dt=1e-6)
 
 
 def test_a_run_that_gives_up_raises_with_its_report():
@@ -153,6 +155,21 @@ def test_stepping_reproduces_a_run_at_its_steps():
     for k in range(1, len(run["t"])):
         sim.step()
     assert np.allclose(sim.q, run["q"][-1], rtol=0, atol=1e-7)
+
+
+def test_a_new_run_begins_its_contacts_afresh():
+    # finger_tap touches its table at 0.13 s: a second run of the model,
+    # and the simulator after reset, are the first, with no record of how
+    # the last run's contacts began.
+    m = softarm.load("finger_tap")
+    a = m.simulate(t_end=0.3, output_dt=0.01)
+    b = m.simulate(t_end=0.3, output_dt=0.01)
+    assert np.array_equal(a["q"], b["q"])
+    sim = m.simulator(0.01)
+    first = np.array([sim.step() for _ in range(30)])
+    sim.reset()
+    again = np.array([sim.step() for _ in range(30)])
+    assert np.array_equal(first, again)
 
 
 def test_a_held_input_is_the_constant_channel():

@@ -82,6 +82,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "scene",
             "shape",
             "linearize",
+            "run_output",
             "viewer",
             "commands",
             "animate",

@@ -31,5 +31,6 @@ mod rom_slices;
 mod shape;
 mod six_strains;
 mod spatial;
+mod streamed;
 mod sweep;
 mod unchanged;

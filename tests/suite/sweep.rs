@@ -286,7 +286,7 @@ fn a_resumed_sweep_redoes_only_the_runs_that_did_not_end() {
 #[test]
 fn a_killed_sweep_leaves_the_table_of_what_it_finished() {
     let dir = tempfile::tempdir().unwrap();
-    let runs = 300;
+    let runs = 600;
     let args = |resume: bool| {
         let mut a = vec![
             "sweep".to_string(),

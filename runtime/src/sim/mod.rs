@@ -18,8 +18,8 @@ pub mod stiffness;
 pub use arm::{AccelError, Arm, Dynamics, Workspace, accelerations};
 pub use integrate::events::{CONTACT_EVENT, Crossing, Event, EventHit};
 pub use integrate::{
-    ContactMeter, DEFAULT_SAMPLES, DEFAULT_T_END, INTERRUPTED, Interrupt, MeterSample, SimFailure,
-    SimOptions, SimStats, SwitchRecord, Trajectory, simulate,
+    ContactMeter, DEFAULT_SAMPLES, DEFAULT_T_END, INTERRUPTED, Interrupt, MeterSample, Row,
+    RowSink, SimFailure, SimOptions, SimStats, SwitchRecord, Trajectory, simulate,
 };
 pub use jacobian::rhs_jacobian;
 pub use modes::{Modes, ModesError, modes};

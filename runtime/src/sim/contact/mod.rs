@@ -213,20 +213,17 @@ impl ContactSet {
         let holds = pairs
             .iter()
             .any(|p| matches!(p.law.normal, Normal::Impulse { .. }));
-        let state = ContactState {
-            touching: vec![false; pairs.len()],
-            impact: vec![0.0; pairs.len()],
-            held: vec![false; pairs.len()],
-        };
-        Self {
+        let set = Self {
             points,
             obstacles,
             pairs,
             channels,
             holds,
-            state: RefCell::new(state),
+            state: RefCell::new(ContactState::default()),
             scratch: RefCell::new(Scratch::default()),
-        }
+        };
+        set.clear_records();
+        set
     }
 
     /// A pair whose force depends on how it began (its impact speed), or
@@ -310,6 +307,19 @@ impl ContactSet {
     /// Replace the running state (the contact driver, between legs).
     pub fn set_state(&self, s: ContactState) {
         *self.state.borrow_mut() = s;
+    }
+
+    /// Forget how the contacts began: nothing touching, no impact speeds,
+    /// nothing held. A run continues the records the last run on this set
+    /// left (a control loop's steps are one run); a run from a new start
+    /// begins from these.
+    pub fn clear_records(&self) {
+        let n = self.pairs.len();
+        self.set_state(ContactState {
+            touching: vec![false; n],
+            impact: vec![0.0; n],
+            held: vec![false; n],
+        });
     }
 }
 

@@ -152,10 +152,10 @@ where
     let Start { t0, x0, y0 } = start;
     let ode = ArmOde::new(arm);
     let log = RunLog::new(opts, ode.n);
-    let mut recorder = log.recorder(opts, &ode, opts.solver.fixed_step(), watch, switch);
+    let mut recorder = log.recorder(opts, &ode, arm, opts.solver.fixed_step(), watch, switch);
     let clock = Instant::now();
     let result: Outcome<Y> = solve_ode(&mut method, &ode, t0, opts.t_end, &y0, &mut recorder);
-    finish(
+    let run = finish(
         result,
         &ode,
         log.blown_up.get(),
@@ -163,7 +163,22 @@ where
         opts,
         clock,
         log.finish(),
-    )
+    );
+    stream_tail(arm, opts, run)
+}
+
+/// A streamed run's end: its last sample (which the recorder holds back)
+/// and, after a failure, the last accepted state are handed over.
+fn stream_tail(arm: &dyn Dynamics, opts: &SimOptions, mut run: RunResult) -> RunResult {
+    if let Some(sink) = &opts.rows {
+        let traj = match &mut run {
+            Ok((traj, _)) => traj,
+            Err(f) => &mut f.trajectory,
+        };
+        (traj.t.iter().zip(&traj.x)).for_each(|(t, x)| sink.push(arm, *t, x));
+        super::rows::keep_last(traj);
+    }
+    run
 }
 
 /// An integrator of ours (`methods::bs23`, `radau5`, `trbdf2`), fed
@@ -178,7 +193,7 @@ pub(super) fn run_own(
     let ode = ArmOde::new(arm);
     let log = RunLog::new(opts, ode.n);
     let no_switch = RefCell::new(None);
-    let mut recorder = log.recorder(opts, &ode, false, None, &no_switch);
+    let mut recorder = log.recorder(opts, &ode, arm, false, None, &no_switch);
     let mut solution: Solution<f64, Vec<f64>> = Solution::new();
     let mut counts = Counts::default();
     let own_opts = stepper::Options {
@@ -212,7 +227,7 @@ pub(super) fn run_own(
         solution.steps.rejected = counts.rejected;
         solution
     });
-    finish(
+    let run = finish(
         outcome,
         &ode,
         log.blown_up.get(),
@@ -220,7 +235,8 @@ pub(super) fn run_own(
         opts,
         start,
         log.finish(),
-    )
+    );
+    stream_tail(arm, opts, run)
 }
 
 #[cfg(test)]

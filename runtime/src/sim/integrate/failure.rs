@@ -77,11 +77,19 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
     match result {
         Ok(sol) => {
             let stats = stats_of(sol.steps.accepted, Some(sol.steps.rejected));
-            let traj = Trajectory {
-                t: sol.t.clone(),
-                x: sol.y.iter().map(unpad).collect(),
-                events: hits,
-                ..Default::default()
+            // A streamed run's samples are gone from the solution: its
+            // last is kept.
+            let traj = match opts.rows {
+                Some(_) => Trajectory {
+                    events: hits,
+                    ..kept
+                },
+                None => Trajectory {
+                    t: sol.t.clone(),
+                    x: sol.y.iter().map(unpad).collect(),
+                    events: hits,
+                    ..Default::default()
+                },
             };
             if let Some(t_stop) = interrupted {
                 let state = traj.x.last().cloned().unwrap_or_else(|| x0.to_vec());

@@ -29,6 +29,7 @@ pub mod options;
 mod outcome;
 mod projected;
 mod record;
+mod rows;
 pub mod state;
 pub mod stepper;
 mod touch;
@@ -42,6 +43,7 @@ pub use outcome::{
     ConstraintStats, ContactMeter, MeterSample, SimStats, SolverSwitch, SwitchRecord, Trajectory,
 };
 pub use record::AUTO_CHECK_STEPS;
+pub use rows::{Row, RowFn, RowSink};
 pub use state::StateVec;
 
 use crate::arm::Dynamics;
@@ -74,11 +76,16 @@ pub fn simulate(
             },
         }));
     }
+    if let (Some(set), false) = (arm.contact(), opts.continues) {
+        set.clear_records();
+    }
     match arm.contact() {
         Some(set) if set.keeps_records() => touch::run(arm, x0, opts),
         Some(set) => {
             let (mut traj, stats) = run_leg(arm, t0, x0, opts)?;
-            crate::contact::record_columns(arm, set, &mut traj, 0);
+            if opts.rows.is_none() {
+                crate::contact::record_columns(arm, set, &mut traj, 0);
+            }
             Ok((traj, stats))
         }
         None => run_leg(arm, t0, x0, opts),

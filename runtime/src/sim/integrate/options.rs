@@ -37,6 +37,14 @@ pub struct SimOptions {
     /// language): true ends the run as a failure whose reason is
     /// `INTERRUPTED`, with the trajectory so far.
     pub interrupt: Option<Interrupt>,
+    /// Stream the samples: each is handed to this as soon as it is final
+    /// (`integrate::rows`), and the trajectory the run returns holds only
+    /// its last sample (with every event and contact switch).
+    pub rows: Option<super::rows::RowSink>,
+    /// The run goes on from where the last run on this arm ended (a
+    /// control loop's steps): its contacts keep the records of how they
+    /// began. Otherwise they begin afresh (`ContactSet::clear_records`).
+    pub continues: bool,
 }
 
 /// The reason of a run stopped by its `SimOptions::interrupt`.
@@ -67,6 +75,8 @@ impl Default for SimOptions {
             max_steps: 10_000_000,
             progress: None,
             interrupt: None,
+            rows: None,
+            continues: false,
         }
     }
 }

@@ -51,6 +51,10 @@ fn sample_times(opts: &SimOptions, t0: f64) -> Vec<f64> {
 /// drifts past the budget.
 const MAX_PIECES: usize = 64;
 
+/// Most sample intervals a leg spans: a leg's samples are held until it is
+/// accepted, so this bounds a streamed run's memory.
+const MAX_LEG_SAMPLES: usize = 4096;
+
 /// A leg's run: its samples (the last one projected), what it cost, and
 /// the largest drift seen at them before projection.
 struct Leg {
@@ -76,6 +80,11 @@ pub(super) fn run(
     };
     let times = sample_times(opts, t0);
     let budget = drift_budget(opts);
+    // The legs keep their samples until accepted; this run streams them.
+    let leg_opts = SimOptions {
+        rows: None,
+        ..opts.clone()
+    };
     // Legs span `leg_len` sample intervals; a single interval that drifts
     // too far is cut into `pieces`, projected after each.
     let (mut next, mut leg_len, mut pieces) = (0, 1, 1);
@@ -83,7 +92,7 @@ pub(super) fn run(
         let t0 = *traj.t.last().expect("the start is a sample");
         let x = traj.x.last().expect("as many states as times").clone();
         let leg_times = &times[next..(next + leg_len).min(times.len())];
-        let leg = match run_leg(arm, t0, x, leg_times, pieces, opts) {
+        let leg = match run_leg(arm, t0, x, leg_times, pieces, &leg_opts) {
             Ok(leg) => leg,
             Err(mut f) => {
                 stats.absorb(&f.stats);
@@ -92,6 +101,7 @@ pub(super) fn run(
                 before.t.extend(f.trajectory.t.drain(..).skip(skip));
                 before.x.extend(f.trajectory.x.drain(..).skip(skip));
                 before.events.append(&mut f.trajectory.events);
+                stream(arm, opts, &mut before);
                 f.trajectory = before;
                 f.stats = stats;
                 return Err(f);
@@ -117,6 +127,7 @@ pub(super) fn run(
         traj.events.extend(leg.traj.events);
         traj.t.extend(leg.traj.t);
         traj.x.extend(leg.traj.x);
+        stream(arm, opts, &mut traj);
         // A terminal event ended the leg early: the run ends there.
         if t_end < leg_times.last().copied() {
             break;
@@ -128,12 +139,21 @@ pub(super) fn run(
             if pieces > 1 {
                 pieces /= 2;
             } else {
-                leg_len *= 2;
+                leg_len = (2 * leg_len).min(MAX_LEG_SAMPLES);
             }
         }
     }
     stats.solver = opts.solver;
     Ok((traj, stats))
+}
+
+/// A streamed run hands over the samples of its accepted legs (the sink
+/// skips those it has) and keeps the last.
+fn stream(arm: &dyn Dynamics, opts: &SimOptions, traj: &mut Trajectory) {
+    if let Some(sink) = &opts.rows {
+        (traj.t.iter().zip(&traj.x)).for_each(|(t, x)| sink.push(arm, *t, x));
+        super::rows::keep_last(traj);
+    }
 }
 
 /// One leg from (t0, x) through `times`, in `pieces` runs when it is one

@@ -54,13 +54,33 @@ pub(super) struct Recorder<'a> {
     /// `SimOptions::interrupt`, and when it stopped the run.
     interrupt: Option<super::options::Interrupt>,
     interrupted: &'a Cell<Option<f64>>,
+    /// `SimOptions::rows`, with the run's arm: each sample is handed over
+    /// as it is taken, and only the last is kept (with the crate's
+    /// solution emptied), so memory stays bounded however long the run.
+    rows: Option<(super::rows::RowSink, &'a dyn crate::arm::Dynamics)>,
 }
 
 pub(super) type Watch<'a> = dyn Fn(&[f64], f64) -> Option<String> + 'a;
 
 impl Recorder<'_> {
-    fn keep<Y: StateVec>(&self, solution: &Solution<f64, Y>) {
+    fn keep<Y: StateVec>(&self, solution: &mut Solution<f64, Y>) {
         let mut kept = self.kept.borrow_mut();
+        // Streamed: every sample but the last goes; the last stays in the
+        // solution (the crate's even sampler replaces it when it lands
+        // within rounding of the end) and in `kept`, to go at the run's end.
+        if let Some((sink, arm)) = &self.rows {
+            let Some(last) = solution.t.len().checked_sub(1) else {
+                return;
+            };
+            for (t, y) in solution.t.iter().zip(&solution.y).take(last) {
+                sink.push(*arm, *t, &y.as_ref()[..self.m]);
+            }
+            solution.t.drain(..last);
+            solution.y.drain(..last);
+            kept.t = vec![solution.t[0]];
+            kept.x = vec![solution.y[0].as_ref()[..self.m].to_vec()];
+            return;
+        }
         for k in kept.t.len()..solution.t.len() {
             kept.t.push(solution.t[k]);
             kept.x.push(solution.y[k].as_ref()[..self.m].to_vec());
@@ -122,14 +142,14 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
             if solution.t.last() != Some(&t_event) {
                 solution.push(t_event, y_event);
             }
-            self.keep(solution);
+            self.keep(&mut *solution);
             return ControlFlag::Terminate;
         }
         let flag = self
             .sampler
             .sample(t_curr, t_prev, y_curr, y_prev, interpolator, solution);
         self.sampler.at_end(t_curr, y_curr, self.t_end, solution);
-        self.keep(solution);
+        self.keep(&mut *solution);
         self.calls += 1;
         // (A method's first call, at the start, is no step.)
         if t_curr > t_prev {
@@ -279,6 +299,7 @@ impl RunLog {
         &'a self,
         opts: &SimOptions,
         ode: &'a ArmOde<'_, D>,
+        arm: &'a dyn crate::arm::Dynamics,
         fixed_step: bool,
         watch: Option<&'a Watch<'a>>,
         switch: &'a RefCell<Option<(f64, Vec<f64>, String)>>,
@@ -303,6 +324,7 @@ impl RunLog {
             progress: opts.progress.clone(),
             interrupt: opts.interrupt.clone(),
             interrupted: &self.interrupted,
+            rows: opts.rows.clone().map(|s| (s, arm)),
         }
     }
 

@@ -87,8 +87,12 @@ pub(super) fn run(
         seg.x.push(x_end.clone());
         let from = traj.t.len();
         extend(&mut traj, seg, t0);
-        // While the records are still this leg's.
-        crate::contact::record_columns(arm, set, &mut traj, from);
+        // While the records are still this leg's (a streamed run's rows
+        // took theirs as they were handed over).
+        match opts.rows {
+            Some(_) => super::rows::keep_last(&mut traj),
+            None => crate::contact::record_columns(arm, set, &mut traj, from),
+        }
         if !switched || t_end >= opts.t_end {
             break;
         }
