@@ -44,6 +44,10 @@ pub enum View {
     Top,
 }
 
+/// Most frames of an animation (100 s of GIF at 20 frames a second): a
+/// longer run plays faster.
+pub const MAX_FRAMES: usize = 2000;
+
 pub fn animate(a: AnimateArgs) -> Result<ExitCode> {
     if !(a.fps > 0.0 && a.fps <= 100.0) {
         return Err(anyhow!(
@@ -59,18 +63,34 @@ pub fn animate(a: AnimateArgs) -> Result<ExitCode> {
     }
     let size = parse_size(&a.size)?;
     let mut sim = a.simulate.clone();
+    let loaded = commands::load(&sim.model)?;
+    let t_end = (sim.t_end)
+        .or(loaded.model.simulate.t_end)
+        .unwrap_or(runtime::DEFAULT_T_END);
+    // The whole run in at most MAX_FRAMES frames: faster playback if need be.
+    let mut speed = a.speed;
+    if t_end / speed * a.fps >= MAX_FRAMES as f64 {
+        speed = t_end * a.fps / (MAX_FRAMES - 1) as f64;
+        eprintln!(
+            "animation: {t_end} s at --speed {} and --fps {} would be {:.0} frames; played at --speed {speed:.4} to fit the whole run in {MAX_FRAMES}",
+            a.speed,
+            a.fps,
+            (t_end / a.speed * a.fps).floor() + 1.0
+        );
+    }
     // Rows four times a frame: the tip path follows what frames skip.
-    sim.output_dt = sim.output_dt.or(Some(a.speed / a.fps / 4.0));
+    let spacing = speed / a.fps / 4.0;
+    sim.output_dt = sim.output_dt.or(Some(spacing));
     sim.shape_points = sim.shape_points.max(1);
     let code = commands::simulate(sim.clone())?;
     let out = (sim.out.clone())
         .unwrap_or_else(|| PathBuf::from("out").join(model_stem(&sim.model.model)));
-    let loaded = commands::load(&sim.model)?;
-    let scene = Scene::read(&loaded, &out)?;
+    // Read at that spacing whatever rows the run wrote: a bounded scene.
+    let scene = Scene::read(&loaded, &out, spacing)?;
     // The animation joins the files of the run it shows.
     let mut dir = softarm::output_dir::OutputDir::reopen(&out)?;
     let gif = dir.file("animation.gif")?;
-    draw_gif(&scene, a.view, a.fps, a.speed, size, &gif)?;
+    draw_gif(&scene, a.view, a.fps, speed, size, &gif)?;
     let html = dir.file("viewer.html")?;
     softarm::viewer::write(&scene, &html)?;
     if !sim.quiet {
@@ -284,7 +304,7 @@ fn draw_gif(
     let err = |e: DrawingAreaErrorKind<_>| anyhow!("{}: {e}", path.display());
     // One GIF frame per 1 / fps s of playback: the nearest output row.
     let t_end = scene.t.last().copied().unwrap_or(0.0);
-    let frames = ((t_end / speed * fps).floor() as usize + 1).min(2000);
+    let frames = ((t_end / speed * fps + 1e-9).floor() as usize + 1).min(MAX_FRAMES);
     let mut k = 0;
     for f in 0..frames {
         let t = f as f64 * speed / fps;

@@ -12,7 +12,6 @@ use runtime::contact;
 use serde::Serialize;
 
 use crate::backend::Loaded;
-use crate::data::Csv;
 
 /// A part of the scene and how it is drawn.
 #[derive(Clone, Debug, Serialize)]
@@ -62,13 +61,12 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// The scene of the run in `dir` of the model `loaded`.
-    pub fn read(loaded: &Loaded, dir: &Path) -> Result<Self> {
-        let traj = Csv::read(&dir.join("trajectory.csv"))?;
-        let t = traj.column("t")?;
-        let [x, y, z] = ["tip_x", "tip_y", "tip_z"].map(|c| traj.column(c));
-        let (x, y, z) = (x?, y?, z?);
-        let tip = (0..t.len()).map(|i| [x[i], y[i], z[i]]).collect();
+    /// The scene of the run in `dir` of the model `loaded`, its rows at
+    /// least `spacing` s apart (and the last): read as a stream, so a run
+    /// of any length gives a scene of its length over `spacing`.
+    pub fn read(loaded: &Loaded, dir: &Path, spacing: f64) -> Result<Self> {
+        let (t, tip) = read_tips(&dir.join("trajectory.csv"), spacing)?;
+        let [x, y, z] = tip.first().copied().unwrap_or_default();
         let parts = read_shape(&dir.join("shape.csv"), &t)?
             .into_iter()
             .map(|(name, s, frames)| {
@@ -83,7 +81,7 @@ impl Scene {
         }
         let measured = match &loaded.model.compare {
             Some(spec) => {
-                let m = crate::compare::measured(spec, &loaded.base_dir, [x[0], y[0], z[0]])?;
+                let m = crate::compare::measured(spec, &loaded.base_dir, [x, y, z])?;
                 let end = t.last().copied().unwrap_or(0.0);
                 (m.t.iter().zip(&m.tip))
                     .filter(|(t, _)| **t <= end)
@@ -104,10 +102,56 @@ impl Scene {
     }
 }
 
+/// trajectory.csv's times and tips, the rows at least `spacing` apart
+/// from the first, and the last.
+type Tips = (Vec<f64>, Vec<[f64; 3]>);
+
+fn read_tips(path: &Path, spacing: f64) -> Result<Tips> {
+    let mut reader = csv::Reader::from_path(path)
+        .with_context(|| format!("{}: cannot read the CSV file", path.display()))?;
+    let header = reader.headers()?.clone();
+    let column = |name: &str| {
+        (header.iter().position(|h| h == name))
+            .with_context(|| format!("{}: no column {name}", path.display()))
+    };
+    let cols = [
+        column("t")?,
+        column("tip_x")?,
+        column("tip_y")?,
+        column("tip_z")?,
+    ];
+    let (mut t, mut tip) = (Vec::new(), Vec::new());
+    let mut last = None;
+    for (i, record) in reader.records().enumerate() {
+        let r =
+            record.with_context(|| format!("{}: row {}: not valid CSV", path.display(), i + 2))?;
+        let v = cols.map(|c| r.get(c).and_then(|s| s.parse::<f64>().ok()));
+        let [Some(time), Some(x), Some(y), Some(z)] = v else {
+            bail!("{}: row {}: not numbers", path.display(), i + 2);
+        };
+        // (Times are written to 9 decimals: equal spacings read within 1e-9.)
+        let due = t.last().is_none_or(|&l: &f64| time >= l + spacing - 1e-8);
+        if due {
+            t.push(time);
+            tip.push([x, y, z]);
+            last = None;
+        } else {
+            last = Some((time, [x, y, z]));
+        }
+    }
+    if let Some((time, p)) = last {
+        t.push(time);
+        tip.push(p);
+    }
+    Ok((t, tip))
+}
+
 /// `shape.csv`'s rows grouped by part, in order of first appearance: the
 /// material coordinate of each row, and the rows at each time of `t`.
 type Tracks = Vec<(String, Vec<f64>, Vec<Vec<[f64; 7]>>)>;
 
+/// The rows of `shape.csv` at the times `t` (trajectory.csv's, which print
+/// the same digits); the rows between them are skipped as they are read.
 fn read_shape(path: &Path, t: &[f64]) -> Result<Tracks> {
     let mut reader = csv::Reader::from_path(path).with_context(|| {
         format!(
@@ -117,7 +161,6 @@ fn read_shape(path: &Path, t: &[f64]) -> Result<Tracks> {
     })?;
     let mut tracks: Tracks = Vec::new();
     let mut frame = 0usize;
-    let mut last_t = f64::NAN;
     for record in reader.records() {
         let r = record.with_context(|| format!("{}: a bad row", path.display()))?;
         let num = |i: usize| -> Result<f64> {
@@ -126,11 +169,11 @@ fn read_shape(path: &Path, t: &[f64]) -> Result<Tracks> {
                 .with_context(|| format!("{}: column {i} is not a number", path.display()))
         };
         let time = num(0)?;
-        if time != last_t {
-            if !last_t.is_nan() {
-                frame += 1;
-            }
-            last_t = time;
+        while frame < t.len() && t[frame] < time {
+            frame += 1;
+        }
+        if t.get(frame) != Some(&time) {
+            continue;
         }
         let part = r.get(1).unwrap_or_default();
         let pose: [f64; 7] = [
@@ -156,11 +199,11 @@ fn read_shape(path: &Path, t: &[f64]) -> Result<Tracks> {
         frames.resize(frame + 1, Vec::new());
         frames[frame].push(pose);
     }
-    if frame + 1 != t.len() || tracks.is_empty() {
+    let frames = tracks.iter().map(|(_, _, f)| f.len()).min().unwrap_or(0);
+    if frames != t.len() {
         bail!(
-            "{}: {} times, trajectory.csv {}: not the same run",
+            "{}: {frames} of trajectory.csv's {} times: not the same run",
             path.display(),
-            frame + 1,
             t.len()
         );
     }

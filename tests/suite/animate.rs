@@ -87,3 +87,56 @@ fn bad_animation_options_are_named() {
         assert!(stderr(&o).contains(says), "{}", stderr(&o));
     }
 }
+
+/// A run longer than an animation holds plays faster: 400 s at 10 frames
+/// a second would be 4001 frames; the GIF has the most an animation
+/// holds, the last at the run's end, and the page's scene is read from
+/// trajectory.csv at four rows a frame however finely the run wrote it.
+#[test]
+fn a_long_run_plays_faster_in_a_bounded_animation() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = softarm(
+        &[
+            "animate",
+            "chain",
+            "--t-end",
+            "400",
+            "--fps",
+            "10",
+            "--size",
+            "64x64",
+            "--output-dt",
+            "0.01",
+            "--shape-points",
+            "1",
+            "--out",
+            "o",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("would be 4001 frames"),
+        "{}",
+        stderr(&o)
+    );
+    let run = dir.path().join("o");
+    let max = 2000;
+    assert_eq!(frames(&run.join("animation.gif")).0, max);
+    let written = Csv::read(&run.join("trajectory.csv")).unwrap();
+    assert_eq!(written.column("t").unwrap().len(), 40_001);
+    let page = std::fs::read_to_string(run.join("viewer.html")).unwrap();
+    let start = page.find(r#"type="application/json">"#).unwrap() + 24;
+    let end = start + page[start..].find("</script>").unwrap();
+    let scene: serde_json::Value = serde_json::from_str(&page[start..end]).unwrap();
+    let t: Vec<f64> = (scene["t"].as_array().unwrap().iter())
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    // A row every quarter frame of the faster playback, to the run's end.
+    let spacing = 400.0 / (max - 1) as f64 / 4.0;
+    assert!(t.len() <= 4 * max + 1, "{} rows", t.len());
+    assert!(t.windows(2).all(|w| w[1] - w[0] >= 0.5 * spacing - 1e-9));
+    assert_eq!(*t.last().unwrap(), 400.0);
+    let frames_of_arm = scene["parts"][0]["frames"].as_array().unwrap().len();
+    assert_eq!(frames_of_arm, t.len());
+}
