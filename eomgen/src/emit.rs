@@ -1746,6 +1746,9 @@ fn emit_kernels(
             (_, KernelKind::ContactJvp) if generic_contact => {
                 kernels.push(emit_contact_jvp(tapes, dof, n_params))
             }
+            (_, KernelKind::Derived) => {
+                kernels.push(emit_interpreted(&tapes.derived, name, dof, n_params))
+            }
             _ => {
                 let tape = &tapes.tapes(kind)[0];
                 kernels.push(KernelEmitter::new(tape).emit(name, dof, n_params, n_aux))
@@ -1769,6 +1772,35 @@ fn emit_kernels(
         });
     }
     (kernels, arms)
+}
+
+/// A kernel that runs once per parameter set (`Derived`), as its tape in
+/// text (`runtime::Tape::to_text`), read once and interpreted: compiled,
+/// it bought no time and cost the most source and build time of any
+/// kernel of many models. Same signature as an emitted kernel.
+fn emit_interpreted(tape: &Tape, name: &str, dof: usize, n_params: usize) -> TokenStream {
+    let n_out = tape.outputs.len();
+    let n_dir = 2 * dof;
+    let f = Ident::new(name, Span::call_site());
+    let doc = format!(
+        " Kernel `{name}`: {} operations, computed once per parameter set, so interpreted from its tape (below, as text) rather than compiled.",
+        tape.op_count()
+    );
+    // A raw string: the text's line breaks stay line breaks in the file.
+    let text: TokenStream = format!("r\"{}\"", tape.to_text())
+        .parse()
+        .expect("a tape's text is a raw string");
+    quote! {
+        #[doc = #doc]
+        #[allow(unused_variables)]
+        pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
+            static TAPE: std::sync::LazyLock<runtime::tape::Tape> = std::sync::LazyLock::new(|| {
+                runtime::tape::Tape::from_text(#text).expect("the generated tape reads")
+            });
+            let inp = runtime::Inputs { t, q, qd, qdd, dir, p, aux: &[] };
+            TAPE.eval(&inp, &mut Vec::new(), out);
+        }
+    }
 }
 
 /// `Accel` and `MassBias` from one tape (`TapeSet::accel`: the solve's
@@ -1862,7 +1894,7 @@ fn emit_arm_blocks(
         KernelEmitter::new(&blocks.rest_mass_bias).emit("rest_mass_bias", dof, n_params, 0),
         KernelEmitter::new(&blocks.rest_jvp).emit("rest_jvp", dof, n_params, 0),
         KernelEmitter::new(&blocks.rest_outputs).emit("rest_outputs", dof, n_params, 0),
-        KernelEmitter::new(&tapes.derived).emit("own_derived", dof, n_params, 0),
+        emit_interpreted(&tapes.derived, "own_derived", dof, n_params),
     ];
     let (mut mass_bias, mut jvp, mut derived) = (Vec::new(), Vec::new(), Vec::new());
     let mut outputs = Vec::new();

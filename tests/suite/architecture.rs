@@ -51,6 +51,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "lanes",
             "x4",
             "tape",
+            "tape_text",
             "rows",
             "linalg",
             "solver",

@@ -26,6 +26,7 @@ pub mod scalar;
 pub mod solver;
 pub mod special;
 pub mod tape;
+pub mod tape_text;
 pub mod x4;
 
 pub use kernels::{
