@@ -945,7 +945,9 @@ fn emit_cells(links: &runtime::links::LinkKernels) -> EmittedCells {
         let name4 = format!("cell_{c}_x4");
         let name_t = format!("cell_{c}_tangent");
         let name_p = format!("cell_{c}_pose");
-        defs.push(KernelEmitter::new(pose).emit(&name_p, n, CELL_PARAMS, 0));
+        // A pose serves the outputs (a row's tip, not the right-hand side):
+        // interpreted, as the derived parameters are.
+        defs.push(emit_interpreted(pose, &name_p, n, CELL_PARAMS));
         let fp = Ident::new(&name_p, Span::call_site());
         defs.push(with_tangent(
             tape,
@@ -1212,6 +1214,9 @@ fn emit_link_recursion(
         false => quote!(),
     };
     let json = serde_json::to_string(layout).expect("a link layout serialises");
+    // A raw string: JSON's quotes unescaped (it has no `#`).
+    assert!(!json.contains('#'), "a link layout's JSON has no #");
+    let json: TokenStream = format!("r#\"{json}\"#").parse().expect("a raw string");
     let doc_jvp = format!(
         " Kernel `jvp`: the inverse dynamics' tangent by the link recursion (`runtime::links::inverse_dynamics_tangent`) over {} links.",
         layout.links.len(),
@@ -1759,31 +1764,33 @@ fn emit_kernels(
         // A grouped kernel reads an empty direction as "every group", and
         // the contact frames as `aux`.
         let all = match kind {
-            KernelKind::ContactJacobian => quote!(inp.dir.is_empty(),),
+            KernelKind::ContactJacobian => quote!(inp.dir.is_empty()),
             _ => quote!(),
         };
+        // (`call!`, defined in `eval`, passes the inputs: one line an arm.)
         arms.push(match kind {
             KernelKind::ContactJacobian if n_aux > 0 => quote! {
                 KernelKind::#variant => contact_jacobian_framed(inp, q, qd, qdd, dir, p, out),
             },
             _ => quote! {
-                KernelKind::#variant => #f(inp.t, q, qd, qdd, dir, #all p, out.try_into().expect("output length")),
+                KernelKind::#variant => call!(#f, #all),
             },
         });
     }
     (kernels, arms)
 }
 
-/// A kernel that runs once per parameter set (`Derived`), as its tape in
-/// text (`runtime::Tape::to_text`), read once and interpreted: compiled,
-/// it bought no time and cost the most source and build time of any
-/// kernel of many models. Same signature as an emitted kernel.
+/// A kernel off the integration's path (the derived parameters, once per
+/// parameter set; a cell's pose, for a row's outputs), as its tape in
+/// text (`runtime::Tape::to_text`), read once and interpreted: compiled, it
+/// bought no time that counts and cost source and build time. Same
+/// signature as an emitted kernel.
 fn emit_interpreted(tape: &Tape, name: &str, dof: usize, n_params: usize) -> TokenStream {
     let n_out = tape.outputs.len();
     let n_dir = 2 * dof;
     let f = Ident::new(name, Span::call_site());
     let doc = format!(
-        " Kernel `{name}`: {} operations, computed once per parameter set, so interpreted from its tape (below, as text) rather than compiled.",
+        " Kernel `{name}`: {} operations off the integration's path, interpreted from its tape (below, as text) rather than compiled.",
         tape.op_count()
     );
     // A raw string: the text's line breaks stay line breaks in the file.
@@ -2172,8 +2179,7 @@ fn model_tokens(tapes: &TapeSet) -> TokenStream {
     let contact_frames = info.contact_frames;
     let n_aux = contact_frames;
     let hash = &info.hash;
-    let coords = &info.coordinates;
-    let params = &info.parameters;
+    let (coords, params) = (names(&info.coordinates), names(&info.parameters));
     let frames_fn = emit_framed_groups(dof, n_params, n_aux, contact_points);
     let (mut kernels, arms) = emit_kernels(tapes, dof, n_params, n_aux);
     if let Some(parts) = &tapes.parts {
@@ -2198,8 +2204,10 @@ fn model_tokens(tapes: &TapeSet) -> TokenStream {
         /// Structural hash of the model this was derived from.
         pub const HASH: &str = #hash;
         pub const DOF: usize = #dof;
-        pub const COORDINATES: &[&str] = &[#(#coords),*];
-        pub const PARAMETERS: &[&str] = &[#(#params),*];
+        /// The coordinates' names, separated by white space.
+        pub const COORDINATES: &str = #coords;
+        /// The parameters' names, separated by white space.
+        pub const PARAMETERS: &str = #params;
         /// Derived parameters, computed once per parameter set.
         pub const DERIVED: usize = #n_derived;
         /// Whether the mass solve is generated (the `accel` kernel).
@@ -2227,8 +2235,8 @@ fn model_tokens(tapes: &TapeSet) -> TokenStream {
                 Self {
                     info: ModelInfo {
                         hash: HASH.to_string(),
-                        coordinates: COORDINATES.iter().map(|s| s.to_string()).collect(),
-                        parameters: PARAMETERS.iter().map(|s| s.to_string()).collect(),
+                        coordinates: COORDINATES.split_whitespace().map(String::from).collect(),
+                        parameters: PARAMETERS.split_whitespace().map(String::from).collect(),
                         derived: DERIVED,
                         accel: ACCEL,
                         loads: LOADS.to_vec(),
@@ -2266,6 +2274,14 @@ fn model_tokens(tapes: &TapeSet) -> TokenStream {
                 } else {
                     inp.dir.try_into().expect("dir has 2 DOF entries")
                 };
+                // A kernel on the inputs (and, for the grouped one, whether
+                // every group is asked for).
+                #[allow(unused_macros)]
+                macro_rules! call {
+                    ($f:ident, $($all:expr)?) => {
+                        $f(inp.t, q, qd, qdd, dir, $($all,)? p, out.try_into().expect("output length"))
+                    };
+                }
                 match kind {
                     #(#arms)*
                 }
@@ -2275,6 +2291,21 @@ fn model_tokens(tapes: &TapeSet) -> TokenStream {
         #frames_fn
         #(#kernels)*
     }
+}
+
+/// Names as one raw string, eight a line: a list of string literals took
+/// three times the room.
+fn names(names: &[String]) -> TokenStream {
+    assert!(
+        names
+            .iter()
+            .all(|n| !n.is_empty() && !n.contains(char::is_whitespace) && !n.contains('"')),
+        "names are single words without quotes"
+    );
+    let lines: Vec<String> = names.chunks(8).map(|c| c.join(" ")).collect();
+    format!("r\"{}\"", lines.join("\n"))
+        .parse()
+        .expect("a raw string")
 }
 
 /// `tokens` with every `usize` literal unsuffixed: quote writes `q[3usize]`,

@@ -121,6 +121,7 @@ pub mod pose {
 pub struct LocalCoordinate {
     /// (arm coordinate, weight)
     pub terms: Vec<(usize, f64)>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale: Option<usize>,
 }
 
