@@ -428,6 +428,25 @@ impl<'a> KernelEmitter<'a> {
         }
     }
 
+    /// Whether slot `s` is the constant +0.
+    fn is_zero(&self, s: Slot) -> bool {
+        matches!(self.tape.ops[s as usize], Op::Const(v) if v.to_bits() == 0)
+    }
+
+    /// Whether the output is cleared first and its zeros not stored: at
+    /// least eight of them and a quarter of the outputs (a contact group's
+    /// Jacobian columns of the later coordinates), in a kernel writing one
+    /// plain array.
+    fn zero_filled(&self) -> bool {
+        let outs = &self.tape.outputs;
+        let zeros = outs.iter().filter(|&&s| self.is_zero(s)).count();
+        !self.lanes
+            && !self.lane_params
+            && self.split.is_none()
+            && zeros >= 8
+            && 4 * zeros >= outs.len()
+    }
+
     /// The length of the `aux` input this tape reads (0: none).
     fn aux_len(&self) -> usize {
         self.tape
@@ -452,6 +471,15 @@ impl<'a> KernelEmitter<'a> {
         group_of: &HashMap<usize, (Family, Slot)>,
     ) -> Vec<TokenStream> {
         let mut body = Vec::new();
+        // Many zero outputs: the first chunk clears the output, and no
+        // zero is stored one by one.
+        let zeros = self.zero_filled();
+        if zeros && c == 0 {
+            body.push(match self.generic {
+                true => quote!(out.fill(S::c(0f64));),
+                false => quote!(out.fill(0f64);),
+            });
+        }
         for (i, op) in self.tape.ops.iter().enumerate() {
             if self.chunk_of[i] != Some(c) {
                 continue;
@@ -491,6 +519,9 @@ impl<'a> KernelEmitter<'a> {
         // outputs (constants, inputs) by the last chunk.
         for (k, &s) in self.tape.outputs.iter().enumerate() {
             let owner = self.chunk_of[s as usize].unwrap_or(n_chunks - 1);
+            if zeros && self.is_zero(s) {
+                continue;
+            }
             if owner == c {
                 let val = match self.tape.ops[s as usize] {
                     // A constant output without lit's parentheses.
