@@ -55,6 +55,11 @@ struct KernelEmitter<'a> {
     class: Vec<Class>,
     /// A generic kernel's parameters are `S::Param` (for its lane instance).
     lane_params: bool,
+    /// Zero outputs stored one by one even when many (`zero_filled`): a
+    /// cell or a part is inlined into its sums, where the compiler drops
+    /// the stores no sum reads, and a clear of the whole output would
+    /// defeat that (soft_finger's mass + bias took 9 % longer).
+    keep_zeros: bool,
 }
 
 impl<'a> KernelEmitter<'a> {
@@ -104,6 +109,15 @@ impl<'a> KernelEmitter<'a> {
             generic: false,
             class: Vec::new(),
             lane_params: false,
+            keep_zeros: false,
+        }
+    }
+
+    /// Keep this kernel's zero stores (`keep_zeros`).
+    fn keeping_zeros(self) -> Self {
+        Self {
+            keep_zeros: true,
+            ..self
         }
     }
 
@@ -440,8 +454,7 @@ impl<'a> KernelEmitter<'a> {
     fn zero_filled(&self) -> bool {
         let outs = &self.tape.outputs;
         let zeros = outs.iter().filter(|&&s| self.is_zero(s)).count();
-        !self.lanes
-            && !self.lane_params
+        !(self.lanes || self.lane_params || self.keep_zeros)
             && self.split.is_none()
             && zeros >= 8
             && 4 * zeros >= outs.len()
@@ -652,7 +665,6 @@ impl<'a> KernelEmitter<'a> {
             chunks.push(match self.generic {
                 true => quote! {
                     #attributes
-                    #[allow(unused_variables, clippy::all)]
                     fn #f<S: runtime::scalar::Scalar>(t: f64, q: &[S; #dof], qd: &[S; #dof], qdd: &[f64; #dof],
                           dir: &[f64; #n_dir], p: &[#param; #n_params], #aux_generic out: &mut [#store; #n_out]) {
                         #scope
@@ -661,7 +673,6 @@ impl<'a> KernelEmitter<'a> {
                 },
                 false => quote! {
                     #attributes
-                    #[allow(unused_variables, clippy::all)]
                     fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir],
                           p: &[f64; #n_params], #aux_param w: &mut [f64; #n_spill], out: &mut [f64; #n_out] #out2) {
                         #(#body)*
@@ -699,7 +710,6 @@ impl<'a> KernelEmitter<'a> {
             #[doc = #doc]
             #[cfg(target_arch = "x86_64")]
             #[inline(never)]
-            #[allow(unused_variables, unused_parens, clippy::all)]
             #[target_feature(enable = "avx,fma")]
             fn #f(q: &[[f64; 4]; #dof], qd: &[[f64; 4]; #dof], p: &[[f64; 4]; #n_params],
                   out: &mut [[f64; 4]; #n_out]) {
@@ -821,7 +831,6 @@ impl<'a> KernelEmitter<'a> {
         let body = with_workspace(self.n_spill, quote!(#(#calls)*));
         quote! {
             #[doc = #doc]
-            #[allow(unused_unsafe)]
             pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], #aux_param out: &mut [f64; #n_out]) {
                 runtime::cpu::require_fma();
                 #body
@@ -878,10 +887,18 @@ fn with_tangent(
 ) -> TokenStream {
     if KernelEmitter::fits_generic(tape) {
         return KernelEmitter::new_generic(tape, lanes)
+            .keeping_zeros()
             .emit_generic(name, dof, n_params, 0, true, lanes);
     }
-    let plain = KernelEmitter::new(tape).emit(name, dof, n_params, 0);
-    let tangent = KernelEmitter::new(tangent).emit(&format!("{name}_tangent"), dof, n_params, 0);
+    let plain = KernelEmitter::new(tape)
+        .keeping_zeros()
+        .emit(name, dof, n_params, 0);
+    let tangent = KernelEmitter::new(tangent).keeping_zeros().emit(
+        &format!("{name}_tangent"),
+        dof,
+        n_params,
+        0,
+    );
     let four = match lanes {
         true => KernelEmitter::new_lanes(tape).emit(&format!("{name}_x4"), dof, n_params, 0),
         false => quote!(),
@@ -1151,7 +1168,6 @@ fn emit_cells_impl(
             }
             #four
             #[inline(always)]
-            #[allow(unused_variables)]
             fn forces(&mut self, out: &mut [f64]) {
                 #forces
             }
@@ -1161,12 +1177,10 @@ fn emit_cells_impl(
                     _ => unreachable!("cell index from the layout"),
                 }
             }
-            #[allow(unused_variables)]
             fn forces_tangent(&mut self, dir: &[f64], out: &mut [f64]) {
                 #forces_tangent
             }
             #[inline(always)]
-            #[allow(unused_variables)]
             fn loads(&mut self, out: &mut [f64]) {
                 #loads
             }
@@ -1230,7 +1244,6 @@ fn emit_link_recursion(
     let mass_bias = match links.mass_bias {
         true => quote! {
             #[doc = #doc]
-            #[allow(unused_variables)]
             pub fn mass_bias(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
                 runtime::cpu::require_fma();
                 // SAFETY: `require_fma` has checked that the processor has FMA.
@@ -1258,7 +1271,6 @@ fn emit_link_recursion(
         });
         #mass_bias
         #[doc = #doc_jvp]
-        #[allow(unused_variables)]
         pub fn jvp(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #dof]) {
             runtime::cpu::require_fma();
             // SAFETY: `require_fma` has checked that the processor has FMA.
@@ -1274,7 +1286,6 @@ fn emit_link_recursion(
             runtime::links::inverse_dynamics_tangent(&LINKS, &mut cells, q, qd, qdd, dir, p, &mut tau, out)
         }
         /// Kernel `outputs`: one sweep over the links' pose cells (`runtime::links::outputs`).
-        #[allow(unused_variables)]
         pub fn outputs(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_outputs]) {
             runtime::cpu::require_fma();
             let mut cells = LinkCells { q, qd, p };
@@ -1374,19 +1385,16 @@ fn emit_parts(
             }
         }
         /// Kernel `outputs`: the parts' energies, the pose and the offsets (`runtime::parts::outputs`).
-        #[allow(unused_variables)]
         pub fn outputs(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; runtime::N_OUTPUTS]) {
             runtime::cpu::require_fma();
             runtime::parts::outputs(&PARTS, &mut PartKernels, q, qd, p, out)
         }
         #[doc = #doc]
-        #[allow(unused_variables)]
         pub fn mass_bias(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
             runtime::cpu::require_fma();
             runtime::parts::mass_bias(&PARTS, &mut PartKernels, q, qd, p, out)
         }
         /// Kernel `jvp`: the inverse dynamics' tangent, over the parts the direction moves (`runtime::parts`).
-        #[allow(unused_variables)]
         pub fn jvp(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #dof]) {
             runtime::cpu::require_fma();
             runtime::parts::jvp(&PARTS, &mut PartKernels, q, qd, qdd, dir, p, out)
@@ -1571,7 +1579,6 @@ fn emit_groups(tapes: &TapeSet, dof: usize, n_params: usize, generic: bool) -> T
     );
     quote! {
         #[doc = #doc]
-        #[allow(unused_variables)]
         pub fn contact_jacobian(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir],
                                 all: bool, p: &[f64; #n_params], #aux_param out: &mut [f64; #n_out]) {
             #(#calls)*
@@ -1655,7 +1662,6 @@ fn emit_contact_jvp(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream
     });
     quote! {
         /// Kernel `contact_jvp`: the contact groups on dual numbers along dq.
-        #[allow(unused_variables)]
         pub fn contact_jvp(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir],
                            p: &[f64; #n_params], out: &mut [f64; #n_out]) {
             runtime::cpu::require_fma();
@@ -1710,7 +1716,6 @@ fn emit_framed_groups(
             quote! {
                 /// The `contact_jacobian` groups with the frames given, or else
                 /// from the `contact` kernel.
-                #[allow(clippy::too_many_arguments)]
                 fn contact_jacobian_framed(inp: &Inputs, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof],
                           dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64]) {
                     let out = out.try_into().expect("output length");
@@ -1830,13 +1835,8 @@ fn emit_interpreted(tape: &Tape, name: &str, dof: usize, n_params: usize) -> Tok
         .expect("a tape's text is a raw string");
     quote! {
         #[doc = #doc]
-        #[allow(unused_variables)]
         pub fn #f(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
-            static TAPE: std::sync::LazyLock<runtime::tape::Tape> = std::sync::LazyLock::new(|| {
-                runtime::tape::Tape::from_text(#text).expect("the generated tape reads")
-            });
-            let inp = runtime::Inputs { t, q, qd, qdd, dir, p, aux: &[] };
-            TAPE.eval(&inp, &mut Vec::new(), out);
+            runtime::interpreted!(#text, t, q, qd, qdd, dir, p, out);
         }
     }
 }
@@ -1879,7 +1879,6 @@ fn emit_accel(tapes: &TapeSet, dof: usize, n_params: usize) -> TokenStream {
         );
         quote! {
             #[doc = #doc]
-            #[allow(unused_unsafe)]
             pub fn #f(#inputs, out: &mut [f64; #n]) {
                 runtime::cpu::require_fma();
                 // SAFETY: `require_fma` has checked that the processor has FMA.
@@ -2156,19 +2155,16 @@ fn emit_arm_contact(
     quote! {
         #(#defs)*
         /// Kernel `contact`: each arm's points from its own kernels, then the rest's.
-        #[allow(unused_variables)]
         pub fn contact(#inputs, p: &[f64; #n_params], out: &mut [f64; #n_c]) {
             #({ #points })*
         }
         /// Kernel `contact_jacobian`: each arm's groups from its own kernels,
         /// its columns in its block; then the rest's.
-        #[allow(unused_variables)]
         pub fn contact_jacobian(#inputs, all: bool, p: &[f64; #n_params], out: &mut [f64; #n_j]) {
             #({ #groups })*
         }
         /// Kernel `contact_jvp`: each arm's from its own kernels along its
         /// block of dq; then the rest's.
-        #[allow(unused_variables)]
         pub fn contact_jvp(#inputs, p: &[f64; #n_params], out: &mut [f64; #n_t]) {
             #({ #tangents })*
         }
@@ -2230,6 +2226,9 @@ fn model_tokens(tapes: &TapeSet) -> TokenStream {
         });
     }
     quote! {
+        // Generated code: arguments every kernel takes though some read
+        // none, glue of every shape.
+        #![allow(unused_variables, unused_unsafe, unused_parens, unused_macros, dead_code, clippy::all)]
         use runtime::{Inputs, KernelKind, Kernels, ModelInfo};
 
         /// Structural hash of the model this was derived from.
@@ -2307,7 +2306,6 @@ fn model_tokens(tapes: &TapeSet) -> TokenStream {
                 };
                 // A kernel on the inputs (and, for the grouped one, whether
                 // every group is asked for).
-                #[allow(unused_macros)]
                 macro_rules! call {
                     ($f:ident, $($all:expr)?) => {
                         $f(inp.t, q, qd, qdd, dir, $($all,)? p, out.try_into().expect("output length"))

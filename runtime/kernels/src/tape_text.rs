@@ -86,6 +86,27 @@ impl Tape {
     }
 }
 
+/// A generated kernel carried as tape text (`eomgen`'s `emit_interpreted`):
+/// the text read once, at the first call, then interpreted on the inputs.
+#[macro_export]
+macro_rules! interpreted {
+    ($text:literal, $t:expr, $q:expr, $qd:expr, $qdd:expr, $dir:expr, $p:expr, $out:expr) => {{
+        static TAPE: std::sync::LazyLock<$crate::tape::Tape> = std::sync::LazyLock::new(|| {
+            $crate::tape::Tape::from_text($text).expect("the generated tape reads")
+        });
+        let inp = $crate::tape::Inputs {
+            t: $t,
+            q: $q,
+            qd: $qd,
+            qdd: $qdd,
+            dir: $dir,
+            p: $p,
+            aux: &[],
+        };
+        TAPE.eval(&inp, &mut Vec::new(), $out);
+    }};
+}
+
 /// Instruction `i` from its token; None if malformed or reading ahead.
 fn parse_op(i: usize, token: &str) -> Option<Op> {
     let mut chars = token.chars();
