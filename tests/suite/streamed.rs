@@ -216,3 +216,26 @@ fn the_cli_holds_no_rows_in_memory() {
     assert_eq!(t.len(), 200_001);
     assert!(t.windows(2).all(|w| w[0] < w[1]));
 }
+
+/// A figure's points from a run of any length: at most `MAX_PLOTTED`, at
+/// least half as many, evenly spaced (every k-th row) and ending on the
+/// last row.
+#[test]
+fn figures_keep_a_bounded_even_thinning_that_ends_on_the_last_row() {
+    use softarm::run_output::{MAX_PLOTTED, Thinned};
+    for rows in [10, MAX_PLOTTED, MAX_PLOTTED + 1, 123_457] {
+        let mut t = Thinned::default();
+        (0..rows).for_each(|i| t.push(i));
+        let p = t.points();
+        assert!(p.len() <= MAX_PLOTTED + 1, "{rows}: {} points", p.len());
+        assert!(
+            p.len() >= rows.min(MAX_PLOTTED / 2),
+            "{rows}: {} points",
+            p.len()
+        );
+        assert_eq!(*p.last().unwrap(), rows - 1, "{rows}: the last row");
+        let step = p[1] - p[0];
+        let body = &p[..p.len() - 1];
+        assert!(body.windows(2).all(|w| w[1] - w[0] == step), "{rows}: even");
+    }
+}
