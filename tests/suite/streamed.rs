@@ -223,7 +223,7 @@ fn the_cli_holds_no_rows_in_memory() {
 #[test]
 fn figures_keep_a_bounded_even_thinning_that_ends_on_the_last_row() {
     use softarm::run_output::{MAX_PLOTTED, Thinned};
-    for rows in [10, MAX_PLOTTED, MAX_PLOTTED + 1, 123_457] {
+    for rows in [10, MAX_PLOTTED, MAX_PLOTTED + 1, 123_457, 123_458] {
         let mut t = Thinned::default();
         (0..rows).for_each(|i| t.push(i));
         let p = t.points();
