@@ -5,7 +5,7 @@
 //! sequence (a universal or spherical joint).
 
 use super::{Carried, ModellingMethod, half_links_inertia};
-use crate::cas::Cas;
+use crate::cas::{Cas, ExprId};
 use crate::model::{Axis, Check, ElementParam, Joints, ModelError, Segment, SegmentShape};
 use crate::tmt::actuation::Strain;
 use crate::tmt::planar::{self, Element2, PlanarArm};
@@ -181,10 +181,36 @@ impl ModellingMethod for Rigid {
     }
 }
 
-/// The end frame turned by the element's joint: its angles about their
-/// axes in sequence, each with its spring (twist about x, bend about y and
-/// z, rest angle about z) and damper. The joint's lumped strain is its
-/// angles (exact for one axis, first order for several).
+/// The rotation vector of turns about coordinate axes in sequence, to
+/// second order in the angles: sum q_i e_i + 1/2 sum_{i<j} q_i q_j e_i x e_j.
+fn rotation_vector(cas: &mut Cas, turns: &[(usize, ExprId)], zero: ExprId) -> [ExprId; 3] {
+    let mut theta = [zero; 3];
+    for (i, &(a, q)) in turns.iter().enumerate() {
+        theta[a] = cas.add(theta[a], q);
+        for &(b, r) in &turns[i + 1..] {
+            // e_a x e_b = +-e_c for a != b (c the third axis), 0 for a == b.
+            if a == b {
+                continue;
+            }
+            let c = 3 - a - b;
+            let sign = if (a + 1) % 3 == b { 0.5 } else { -0.5 };
+            let qr = cas.mul(q, r);
+            let term = cas.scaled(sign, qr);
+            theta[c] = cas.add(theta[c], term);
+        }
+    }
+    theta
+}
+
+/// The end frame turned by the element's joint: first by its rest angle
+/// about z, then by its angles about their axes in sequence. Its springs
+/// (twist about x, bend about y and z) and dampers act on the rotation
+/// vector of the turn from rest, to second order (Baker-Campbell-Hausdorff:
+/// theta = sum q_i e_i + 1/2 sum_{i<j} q_i q_j e_i x e_j), about the axes
+/// the joint has. Springs on the angles themselves, with the rest angle
+/// taken from the angle about z, made the chain converge at first order,
+/// to an answer that depended on the order of the axes. The joint's lumped
+/// strain is its angles (exact for one axis, first order for several).
 fn joint(cas: &mut Cas, arm: &mut SpatialArm, g: &SegmentShape, s: usize) -> Frame {
     let e = |p| arm.symbols.element(arm.k, p);
     let (stiff, twist) = (
@@ -193,20 +219,28 @@ fn joint(cas: &mut Cas, arm: &mut SpatialArm, g: &SegmentShape, s: usize) -> Fra
     );
     let (damp, rest) = (e(ElementParam::BendDamping), e(ElementParam::Rest));
     let zero = arm.zero;
-    let mut f = arm.f;
+    // Half the rest turn before the joint and half after: its angles are
+    // then measured in the frame midway between its links, as a rod's
+    // strains are at that point (measured in the incoming link's frame,
+    // the twist and bend of a curved rod mixed at first order).
+    let half_rest = cas.scaled(0.5, rest);
+    let mut f = revolute(cas, &arm.f, 2, half_rest, zero);
     let mut rho = [zero; 3];
+    let mut turns: Vec<(usize, ExprId)> = Vec::new();
     for &a in &g.axes {
         let (q, qd) = arm.take();
         rho[a.index()] = cas.add(rho[a.index()], q);
         f = revolute(cas, &f, a.index(), q, qd);
-        let (kq, q_rest) = if a.index() == 0 {
-            (twist, zero)
-        } else {
-            (stiff, if a.index() == 2 { rest } else { zero })
-        };
-        let dq = cas.sub(q, q_rest);
-        arm.elastic.push(half_k_sq(cas, kq, dq));
         arm.rayleigh.push(half_k_sq(cas, damp, qd));
+        turns.push((a.index(), q));
+    }
+    f = revolute(cas, &f, 2, half_rest, zero);
+    let theta = rotation_vector(cas, &turns, zero);
+    for (k, &th) in theta.iter().enumerate() {
+        if turns.iter().any(|&(a, _)| a == k) {
+            let kq = if k == 0 { twist } else { stiff };
+            arm.elastic.push(half_k_sq(cas, kq, th));
+        }
     }
     arm.strains.push(Strain {
         segment: s,
