@@ -70,6 +70,14 @@ pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> 
             "--output-dt {output_dt} s is longer than the run (--t-end {t_end} s): the trajectory would hold its first row only"
         );
     }
+    let rows = (t_end / output_dt).floor() + 1.0;
+    if rows > MAX_WRITTEN_ROWS as f64 {
+        bail!(
+            "--output-dt {} s over --t-end {t_end} s is {rows:.3e} trajectory rows; a run writes at most {MAX_WRITTEN_ROWS} (tens of gigabytes): take --output-dt {} s or longer, or a shorter --t-end",
+            short(output_dt),
+            short(up_to_two_digits(t_end / (MAX_WRITTEN_ROWS - 1) as f64))
+        );
+    }
     Ok(SimOptions {
         t_end,
         solver,
@@ -82,6 +90,11 @@ pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> 
     })
 }
 
+/// The most trajectory rows a run writes to disk (its rows stream, but a
+/// hundred million are already tens of gigabytes, and a spacing far below
+/// the steps would spend the run interpolating).
+pub const MAX_WRITTEN_ROWS: usize = 100_000_000;
+
 /// A run whose rows are returned in memory (Python's `simulate`) keeps at
 /// most [`MAX_OUTPUT_ROWS`]; the CLI writes them as they come, any number.
 pub fn rows_in_memory(opts: &SimOptions) -> Result<()> {
@@ -89,11 +102,21 @@ pub fn rows_in_memory(opts: &SimOptions) -> Result<()> {
     let rows = (t_end / output_dt).floor() + 1.0;
     if rows > MAX_OUTPUT_ROWS as f64 {
         bail!(
-            "--output-dt {output_dt} s over --t-end {t_end} s is {rows:.0} trajectory rows; a run returned in memory keeps at most {MAX_OUTPUT_ROWS}: take --output-dt {} s or longer, a shorter --t-end, or `softarm simulate`, which writes its rows to disk as they come",
-            up_to_two_digits(t_end / (MAX_OUTPUT_ROWS - 1) as f64)
+            "--output-dt {} s over --t-end {t_end} s is {rows:.0} trajectory rows; a run returned in memory keeps at most {MAX_OUTPUT_ROWS}: take --output-dt {} s or longer, a shorter --t-end, or `softarm simulate`, which writes its rows to disk as they come",
+            short(output_dt),
+            short(up_to_two_digits(t_end / (MAX_OUTPUT_ROWS - 1) as f64))
         );
     }
     Ok(())
+}
+
+/// x as a person writes it: plain between 1e-4 and 1e6, else in
+/// exponent form to three digits.
+fn short(x: f64) -> String {
+    match x.abs() {
+        a if (1e-4..1e6).contains(&a) => format!("{}", (x * 1e12).round() / 1e12),
+        _ => format!("{x:.3e}"),
+    }
 }
 
 /// x rounded up to two significant digits (a suggestion that holds).

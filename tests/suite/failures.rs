@@ -185,6 +185,10 @@ fn options_are_checked_against_each_other_before_anything_is_written() {
             vec!["--output-dt", "1", "--t-end", "0.2"],
             "--output-dt 1 s is longer than the run",
         ),
+        (
+            vec!["--output-dt", "1e-300", "--t-end", "1"],
+            "trajectory rows; a run writes at most 100000000",
+        ),
     ] {
         let mut all = vec!["simulate", "double_pendulum", "--out", "o"];
         all.extend(&args);
