@@ -1,22 +1,35 @@
 //! `softarm animate`: the GIF has a frame per 1/fps s of playback at the
-//! requested size, and the viewer page carries the run: its tip path is
+//! requested size in the drawing's own colours, and the viewer page carries the run: its tip path is
 //! trajectory.csv's tip and its arm rows are shape.csv's. (The page itself
 //! is checked in a real browser by scripts/check_viewer.py, which CI runs.)
 
 use crate::common::*;
 use softarm::data::Csv;
+use std::collections::HashSet;
 
 fn frames(path: &std::path::Path) -> (usize, (u16, u16)) {
+    let (n, size, _) = decode(path);
+    (n, size)
+}
+
+/// The frame count, the size and the last frame's colours.
+fn decode(path: &std::path::Path) -> (usize, (u16, u16), HashSet<[u8; 3]>) {
     let file = std::fs::File::open(path).expect("animation.gif exists");
     let mut options = gif::DecodeOptions::new();
-    options.set_color_output(gif::ColorOutput::Indexed);
+    options.set_color_output(gif::ColorOutput::RGBA);
     let mut d = options.read_info(file).expect("a GIF");
     let size = (d.width(), d.height());
     let mut n = 0;
-    while d.read_next_frame().expect("frames decode").is_some() {
+    let mut colours = HashSet::new();
+    while let Some(frame) = d.read_next_frame().expect("frames decode") {
         n += 1;
+        colours = frame
+            .buffer
+            .chunks_exact(4)
+            .map(|p| [p[0], p[1], p[2]])
+            .collect();
     }
-    (n, size)
+    (n, size, colours)
 }
 
 #[test]
@@ -39,7 +52,13 @@ fn the_gif_has_a_frame_per_step_of_playback_and_the_page_the_runs_tip() {
     assert!(o.status.success(), "{}", stderr(&o));
     let run = out.join("soft_finger");
     // 1 s at half speed: 2 s of GIF at 10 frames a second, both ends.
-    assert_eq!(frames(&run.join("animation.gif")), (21, (480, 480)));
+    let (n, size, colours) = decode(&run.join("animation.gif"));
+    assert_eq!((n, size), (21, (480, 480)));
+    // The drawing's flat colours arrive exactly through the frame's
+    // palette: the white ground and the tip path's pure red.
+    for c in [[255, 255, 255], [255, 0, 0]] {
+        assert!(colours.contains(&c), "{c:?} is not in the last frame");
+    }
     let page = std::fs::read_to_string(run.join("viewer.html")).unwrap();
     let start = page.find(r#"type="application/json">"#).unwrap() + 24;
     let end = start + page[start..].find("</script>").unwrap();
