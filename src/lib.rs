@@ -8,6 +8,7 @@ pub use softarm_models as generated;
 
 pub mod backend;
 pub mod cache;
+pub mod cli;
 pub mod compare;
 pub mod contact;
 pub mod continuum;

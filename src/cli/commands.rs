@@ -6,6 +6,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use crate::backend::{self, BackendChoice, Loaded};
+use crate::compare;
+use crate::generated::MODELS;
+use crate::run::RunRequest;
+use crate::run_output::{Kept, RunOutput};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use eomgen::atomic_write::write_atomic;
@@ -13,14 +18,24 @@ use eomgen::model::{Override, SimulateDefaults, Start};
 use nalgebra::{DMatrix, DVector};
 use runtime::{Dynamics, KernelKind, SimOptions, Solver, Trajectory, Workspace, accelerations};
 use serde_json::json;
-use softarm::backend::{self, Loaded};
-use softarm::compare;
-use softarm::generated::MODELS;
-use softarm::run::RunRequest;
-use softarm::run_output::{Kept, RunOutput};
 
-use crate::ModelArgs;
+/// Options shared by every command that takes a model.
+#[derive(Args, Clone)]
+pub struct ModelArgs {
+    /// A model file (TOML or JSON) or the name of a compiled-in model.
+    pub model: String,
+    /// Override a model value: PATH=VALUE, e.g. segment.0.length=0.25 or tip.force=[0,-2,0].
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub set: Vec<String>,
+    /// Backend: compiled when available (auto), or force one.
+    #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
+    pub backend: BackendChoice,
+    /// Directory of the tape cache (default: $SOFTARM_CACHE_DIR or .softarm-cache).
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+}
 
+/// The model the arguments name, with their overrides, on its backend.
 pub fn load(a: &ModelArgs) -> Result<Loaded> {
     let overrides = a
         .set
@@ -101,7 +116,7 @@ pub fn derive(a: DeriveArgs) -> Result<ExitCode> {
             let start = Instant::now();
             let tapes = eomgen::derive::derive(&model);
             let s = start.elapsed().as_secs_f64();
-            softarm::cache::store(&softarm::cache::default_dir(), &tapes)
+            crate::cache::store(&crate::cache::default_dir(), &tapes)
                 .map_err(anyhow::Error::msg)?;
             println!(
                 "{origin}: dof {}, mass + bias {} ops, derived in {:.3} s (hash {})",
@@ -196,7 +211,7 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "SECONDS")]
     pub max_wall: Option<f64>,
     /// Points per element of shape.csv's centreline (0: no shape.csv).
-    #[arg(long, default_value_t = softarm::shape::DEFAULT_POINTS)]
+    #[arg(long, default_value_t = crate::shape::DEFAULT_POINTS)]
     pub shape_points: usize,
 }
 
@@ -268,11 +283,11 @@ fn compare_tip(
     loaded: &Loaded,
     m: &compare::Measured,
     tips: &[(f64, [f64; 3])],
-    dir: &mut softarm::output_dir::OutputDir,
+    dir: &mut crate::output_dir::OutputDir,
 ) -> Result<Option<compare::TipError>> {
     // A run that ends before the window has no statistics, but
     // still its plot.
-    let err = softarm::run::tip_error(loaded, m, tips)
+    let err = crate::run::tip_error(loaded, m, tips)
         .map_err(|e| eprintln!("warning: no tip error: {e}"))
         .ok();
     let title = match &err {
@@ -291,7 +306,7 @@ fn compare_tip(
 pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     let mut loaded = load(&a.model)?;
     let req = request(&a, &loaded)?;
-    let mut opts = softarm::run::options(&req, &loaded.model.simulate)?;
+    let mut opts = crate::run::options(&req, &loaded.model.simulate)?;
     let deadline = match a.max_wall {
         Some(s) if s > 0.0 && s.is_finite() => {
             Some(std::time::Instant::now() + std::time::Duration::from_secs_f64(s))
@@ -299,26 +314,26 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         Some(s) => bail!("--max-wall must be a positive number of seconds, got {s}"),
         None => None,
     };
-    let (x0, assembled_m) = softarm::run::initial_state(&req, &mut loaded)?;
+    let (x0, assembled_m) = crate::run::initial_state(&req, &mut loaded)?;
     report_assembly(&loaded, assembled_m);
     // Checked before the run: a bad option writes nothing.
     let shape = (a.shape_points > 0)
-        .then(|| softarm::shape::Shape::new(&loaded, a.shape_points))
+        .then(|| crate::shape::Shape::new(&loaded, a.shape_points))
         .transpose()?;
     let arm = &*loaded.arm;
     let t_end = opts.t_end;
     // Measured data to compare with: sampled at its own times.
-    let measured = softarm::run::measured(&loaded, &x0)?;
+    let measured = crate::run::measured(&loaded, &x0)?;
     let output_times = measured
         .as_ref()
-        .map(|m| softarm::run::compare_times(m, t_end));
+        .map(|m| crate::run::compare_times(m, t_end));
     opts.output_times = output_times;
     let out_dir = a
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&loaded.model.name));
-    let mut dir = softarm::output_dir::OutputDir::claim(&out_dir)?;
-    let out_of_scale = softarm::scale::out_of_scale(&loaded.model, arm, t_end);
+    let mut dir = crate::output_dir::OutputDir::claim(&out_dir)?;
+    let out_of_scale = crate::scale::out_of_scale(&loaded.model, arm, t_end);
     for line in &out_of_scale {
         eprintln!("warning: {line}");
     }
@@ -327,7 +342,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         Some(t) => t.len() as f64,
         None => (t_end / opts.output_dt).floor() + 1.0,
     };
-    if let Some(line) = softarm::run_output::size_warning(&loaded, &x0, shape.as_ref(), rows) {
+    if let Some(line) = crate::run_output::size_warning(&loaded, &x0, shape.as_ref(), rows) {
         eprintln!("warning: {line}");
     }
     // Rows go to disk as the run hands them over.
@@ -344,8 +359,8 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     opts.rows = Some(output.sink());
     // Ctrl-C, SIGTERM or --max-wall stops the run with what it computed
     // written.
-    opts.interrupt = Some(softarm::interrupt::for_run(deadline));
-    let progress = softarm::progress::Progress::start(&loaded.model.name, opts.t_end, a.quiet);
+    opts.interrupt = Some(crate::interrupt::for_run(deadline));
+    let progress = crate::progress::Progress::start(&loaded.model.name, opts.t_end, a.quiet);
     opts.progress = progress.as_ref().map(|p| p.cell());
     let result = runtime::simulate(arm, x0.clone(), &opts);
     drop(progress);
@@ -359,7 +374,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         (Some(m), Some(_)) => compare_tip(&loaded, m, &kept.tips, &mut dir)?,
         _ => None,
     };
-    let mut summary = softarm::run::summary(
+    let mut summary = crate::run::summary(
         &loaded,
         &opts,
         &stats,
@@ -378,7 +393,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     }
     if let Some((msg, f)) = failure {
         let stopped = f["reason"] == runtime::INTERRUPTED;
-        let stop = softarm::interrupt::requested().filter(|_| stopped);
+        let stop = crate::interrupt::requested().filter(|_| stopped);
         // Said even when quiet: the folder holds an incomplete run.
         if stopped {
             eprintln!(
@@ -402,7 +417,7 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
 
 /// A failed run's trajectory and counts, with its message (the joints
 /// that became dependent named) and its summary entry; inputs out of
-/// their model's scale (`softarm::scale`) come first in what to try.
+/// their model's scale (`crate::scale`) come first in what to try.
 fn explained(
     arm: &dyn Dynamics,
     mut f: runtime::SimFailure,
@@ -442,11 +457,11 @@ fn explained(
 fn plot_paths_and_contact(
     loaded: &Loaded,
     kept: &Kept,
-    dir: &mut softarm::output_dir::OutputDir,
+    dir: &mut crate::output_dir::OutputDir,
 ) -> Result<()> {
     for (body, path) in &kept.paths {
         let title = format!("{}: path of {body}", loaded.model.name);
-        softarm::joints::plot_path(&dir.plot(body)?, &title, &path.points())?;
+        crate::joints::plot_path(&dir.plot(body)?, &title, &path.points())?;
     }
     if let Some(set) = loaded.arm.contact()
         && !kept.tip_path.is_empty()
@@ -454,8 +469,8 @@ fn plot_paths_and_contact(
         // The tip's path and the contact forces.
         let name = &loaded.model.name;
         let tips = kept.tip_path.points();
-        softarm::joints::plot_path(&dir.plot("tip")?, &format!("{name}: tip path"), &tips)?;
-        softarm::contact::plot_forces(
+        crate::joints::plot_path(&dir.plot("tip")?, &format!("{name}: tip path"), &tips)?;
+        crate::contact::plot_forces(
             &dir.plot("contact")?,
             &format!("{name}: contact forces"),
             &set.channels,
@@ -649,7 +664,7 @@ pub struct StaticArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub q0: Option<String>,
     /// Points per element of the equilibrium's `shape` (0: none).
-    #[arg(long, default_value_t = softarm::shape::DEFAULT_POINTS)]
+    #[arg(long, default_value_t = crate::shape::DEFAULT_POINTS)]
     pub shape_points: usize,
     /// Print JSON (the only format; accepted for scripts).
     #[arg(long)]
@@ -665,7 +680,7 @@ fn start_coordinates(loaded: &Loaded, q0: &Option<String>) -> Result<(Vec<f64>, 
         .as_ref()
         .map(|s| parse_vector("--q0", s, n, coords))
         .transpose()?;
-    let (q, moved) = softarm::run::start_coordinates(loaded, q0.as_deref())?;
+    let (q, moved) = crate::run::start_coordinates(loaded, q0.as_deref())?;
     report_assembly(loaded, moved);
     Ok((q, moved))
 }
@@ -702,8 +717,8 @@ pub fn static_value(a: &StaticArgs) -> Result<serde_json::Value> {
         .map(|s| Override::parse(s))
         .collect::<Result<Vec<_>, _>>()?;
     let (model, origin) = backend::read_model(&a.model.model, &overrides)?;
-    if softarm::continuum::is_cosserat(&model) {
-        let sol = softarm::continuum::solve(&model, &origin)?;
+    if crate::continuum::is_cosserat(&model) {
+        let sol = crate::continuum::solve(&model, &origin)?;
         let v = json!({
             "model": model.name,
             "method": "cosserat",
@@ -723,7 +738,7 @@ pub fn static_value(a: &StaticArgs) -> Result<serde_json::Value> {
     let out = loaded.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
     let shape = match a.shape_points {
         0 => None,
-        p => Some(softarm::shape::Shape::new(&loaded, p)?.at(&*loaded.arm, 0.0, &sol.q)),
+        p => Some(crate::shape::Shape::new(&loaded, p)?.at(&*loaded.arm, 0.0, &sol.q)),
     };
     let v = json!({
         "model": loaded.model.name,
@@ -731,7 +746,7 @@ pub fn static_value(a: &StaticArgs) -> Result<serde_json::Value> {
         "coordinates": loaded.arm.info().coordinates,
         "q": sol.q,
         "tip_position": &out[..3],
-        "joint_forces": softarm::joints::static_forces(&*loaded.arm, &sol.lambda),
+        "joint_forces": crate::joints::static_forces(&*loaded.arm, &sol.lambda),
         "residual": sol.residual,
         "iterations": sol.iterations,
         "load_steps": sol.load_steps,
@@ -848,7 +863,7 @@ pub fn linearize(a: LinearizeArgs) -> Result<ExitCode> {
         a.u0.as_ref()
             .map(|s| parse_vector("--u0", s, a.inputs.len(), &a.inputs))
             .transpose()?;
-    let lin = softarm::linearize::linearize(&mut loaded, &a.inputs, u0.as_deref(), q0.as_deref())?;
+    let lin = crate::linearize::linearize(&mut loaded, &a.inputs, u0.as_deref(), q0.as_deref())?;
     let rows = |m: &DMatrix<f64>| -> Vec<Vec<f64>> {
         (0..m.nrows())
             .map(|i| m.row(i).iter().copied().collect())

@@ -22,8 +22,8 @@ use clap::Args;
 use rayon::prelude::*;
 use serde_json::Value;
 
-use crate::commands::{self, ModesArgs, SimulateArgs, StaticArgs};
-use softarm::grid::{Vary, checked_size_with, grid};
+use super::commands::{self, ModesArgs, SimulateArgs, StaticArgs};
+use crate::grid::{Vary, checked_size_with, grid};
 
 #[derive(Args, Clone)]
 pub struct SweepArgs {
@@ -88,7 +88,7 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-sweep")));
-    let mut dir = softarm::output_dir::OutputDir::claim(&out_dir)?;
+    let mut dir = crate::output_dir::OutputDir::claim(&out_dir)?;
     let jobs = a.jobs.unwrap_or_else(rayon::current_num_threads).max(1);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs)
@@ -102,7 +102,7 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
     );
     // Ctrl-C or SIGTERM: the runs under way stop and keep what they
     // computed, the others are not started; sweep.csv says which.
-    softarm::interrupt::catch();
+    crate::interrupt::catch();
     let started = Instant::now();
     let table = Progress::new(dir.file("sweep.csv")?, combos.len());
     let rows: Vec<Row> = pool.install(|| {
@@ -130,7 +130,7 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         rows.len(),
         out_dir.join("sweep.csv").display()
     );
-    Ok(match softarm::interrupt::requested() {
+    Ok(match crate::interrupt::requested() {
         Some(stop) => {
             eprintln!(
                 "sweep: stopped by {}; sweep.csv has every run's status",
@@ -145,7 +145,7 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
 
 /// Every varied value as `--set` takes it, one at a time on the sweep's
 /// own overrides: the model must read and validate with it.
-fn check_values(model: &crate::ModelArgs, varies: &[Vary]) -> Result<()> {
+fn check_values(model: &commands::ModelArgs, varies: &[Vary]) -> Result<()> {
     let base = model
         .set
         .iter()
@@ -158,7 +158,7 @@ fn check_values(model: &crate::ModelArgs, varies: &[Vary]) -> Result<()> {
             overrides.push(
                 eomgen::model::Override::parse(&set).with_context(|| format!("--vary {set}"))?,
             );
-            softarm::backend::read_model(&model.model, &overrides)
+            crate::backend::read_model(&model.model, &overrides)
                 .with_context(|| format!("--vary {set}"))?;
         }
     }
@@ -175,7 +175,7 @@ fn model_name(model: &str) -> String {
 /// its figures.
 fn run_one(a: &SweepArgs, varies: &[Vary], combo: &[usize], dir: &Path) -> Row {
     let started = Instant::now();
-    if let Some(stop) = softarm::interrupt::requested() {
+    if let Some(stop) = crate::interrupt::requested() {
         return Row {
             status: format!("not run: {} before it started", stop.name()),
             wall_s: 0.0,
@@ -215,7 +215,7 @@ fn run_one(a: &SweepArgs, varies: &[Vary], combo: &[usize], dir: &Path) -> Row {
         }
     };
     // An interrupted run is not an ended one: `--resume` runs it again.
-    if !row.status.contains(runtime::INTERRUPTED) && softarm::interrupt::requested().is_none() {
+    if !row.status.contains(runtime::INTERRUPTED) && crate::interrupt::requested().is_none() {
         let text = serde_json::json!({"run": key, "row": &row}).to_string();
         let _ = eomgen::atomic_write::write_atomic(&dir.join(ROW), text.as_bytes());
     }
@@ -282,7 +282,7 @@ fn ended(dir: &Path, key: &str) -> Option<Row> {
 /// Run the study with `model`'s overrides; (status, figures).
 fn study(
     a: &SweepArgs,
-    model: crate::ModelArgs,
+    model: commands::ModelArgs,
     dir: &Path,
 ) -> Result<(String, Vec<(String, f64)>)> {
     let tip = |v: &Value| -> Vec<(String, f64)> {
@@ -505,7 +505,7 @@ fn plot_lines(
         (a - 0.05 * d, b + 0.05 * d)
     };
     let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
-    softarm::compare::register_font();
+    crate::compare::register_font();
     let size = (900u32, 500u32);
     let mut rgb = vec![255u8; 3 * (size.0 * size.1) as usize];
     {
@@ -550,5 +550,5 @@ fn plot_lines(
             .map_err(|x| e(&x))?;
         root.present().map_err(|x| e(&x))?;
     }
-    softarm::compare::write_png(&stem.with_extension("png"), size, &rgb)
+    crate::compare::write_png(&stem.with_extension("png"), size, &rgb)
 }

@@ -10,8 +10,8 @@ use anyhow::{Result, anyhow};
 use clap::Args;
 use plotters::prelude::*;
 
-use crate::commands::{self, SimulateArgs};
-use softarm::scene::{Look, Scene};
+use super::commands::{self, SimulateArgs};
+use crate::scene::{Look, Scene};
 
 #[derive(Args, Clone)]
 pub struct AnimateArgs {
@@ -88,11 +88,11 @@ pub fn animate(a: AnimateArgs) -> Result<ExitCode> {
     // Read at that spacing whatever rows the run wrote: a bounded scene.
     let scene = Scene::read(&loaded, &out, spacing)?;
     // The animation joins the files of the run it shows.
-    let mut dir = softarm::output_dir::OutputDir::reopen(&out)?;
+    let mut dir = crate::output_dir::OutputDir::reopen(&out)?;
     let gif = dir.file("animation.gif")?;
     draw_gif(&scene, a.view, a.fps, speed, size, &gif)?;
     let html = dir.file("viewer.html")?;
-    softarm::viewer::write(&scene, &html)?;
+    crate::viewer::write(&scene, &html)?;
     if !sim.quiet {
         eprintln!("animation: {} and {}", gif.display(), html.display());
     }
@@ -285,7 +285,7 @@ fn draw_gif(
     size: (u32, u32),
     path: &std::path::Path,
 ) -> Result<()> {
-    softarm::compare::register_font();
+    crate::compare::register_font();
     let cam = Camera::new(view, scene.dimensions);
     let b = bounds(scene, &cam);
     // GIF delays are in hundredths of a second.
