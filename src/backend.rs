@@ -11,7 +11,9 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use eomgen::load::parse_model;
 use eomgen::model::{Model, Override, ParamLayout, Structure};
-use runtime::{Arm, CompiledModel, Dynamics, Interpreted, Kernels};
+use runtime::linked::LinkedKernels;
+use runtime::links::{CompiledCell, LinkKernels};
+use runtime::{Arm, CompiledModel, Dynamics, Interpreted, Kernels, TapeSet};
 use serde::Serialize;
 
 use crate::cache;
@@ -36,7 +38,9 @@ pub enum CacheStatus {
     Hit,
     Miss,
     /// Compiled link cells of another model's, linked to this chain's
-    /// layout (`runtime::linked::LinkedKernels`): no tape needed.
+    /// layout (`runtime::linked::LinkedKernels`): no tape needed but an
+    /// arm with contact's, for its contact kernels (from the cache or
+    /// derived into it).
     Linked,
 }
 
@@ -100,23 +104,39 @@ pub fn read_model(spec: &str, overrides: &[Override]) -> Result<(Model, String)>
     )
 }
 
-/// A chain whose element count (or rom order) no compiled-in model has, on the compiled cells of its link shapes when every one is
-/// compiled in (found by key), with the seconds its layout took to derive;
-/// or why it cannot run so.
-fn linked(structure: &Structure) -> std::result::Result<(Box<dyn Kernels>, f64), String> {
+/// A chain whose element count (or rom order) no compiled-in model has, on
+/// the compiled cells of its link shapes when every one is compiled in
+/// (found by key), with the seconds its layout took to derive; or why it
+/// cannot run so. An arm with contact takes its contact kernels from its
+/// tapes ([`tapes`]: the cache's, else derived and cached).
+fn linked(
+    model: &Model,
+    structure: &Structure,
+    cache_dir: &Path,
+) -> std::result::Result<(Box<dyn Kernels>, f64), String> {
     if !runtime::cpu::has_fma() {
         return Err("this processor lacks the fused multiply-add compiled code needs".into());
     }
+    if structure.assembly.is_some() {
+        return Err("link cells run single arms, and this is an assembly".into());
+    }
     let start = Instant::now();
-    let Some((info, links)) = eomgen::derive::derive_links(structure) else {
-        return Err(if structure.assembly.is_some() {
-            "link cells run single arms, and this is an assembly".into()
-        } else if structure.contact_points > 0 {
-            "link cells run arms without contact, and this one has obstacles".into()
-        } else {
-            "not every one of its methods' elements is a link cell".into()
-        });
+    let not_cells = || "not every one of its methods' elements is a link cell".to_string();
+    let kernels: Box<dyn Kernels> = if structure.contact_points > 0 {
+        let (tapes, _, _) = tapes(model, &structure.hash(), cache_dir);
+        let cells = compiled_cells(tapes.links.as_ref().ok_or_else(not_cells)?)?;
+        Box::new(LinkedKernels::with_tapes(tapes, cells).ok_or_else(not_cells)?)
+    } else {
+        let (info, links) = eomgen::derive::derive_links(structure).ok_or_else(not_cells)?;
+        let cells = compiled_cells(&links)?;
+        Box::new(LinkedKernels::new(info, links, cells))
     };
+    Ok((kernels, start.elapsed().as_secs_f64()))
+}
+
+/// The compiled cells of a chain's link shapes, found by key among the
+/// compiled-in models' cells; or how many no compiled-in model has.
+fn compiled_cells(links: &LinkKernels) -> std::result::Result<Vec<CompiledCell>, String> {
     let keys: Vec<String> = (links.cells.iter().zip(&links.tangents).zip(&links.poses))
         .map(|((cell, tangent), pose)| eomgen::build::cell_key(cell, tangent, pose))
         .collect();
@@ -129,9 +149,22 @@ fn linked(structure: &Structure) -> std::result::Result<(Box<dyn Kernels>, f64),
             if missing == 1 { "is" } else { "are" }
         ));
     }
-    let cells = keys.iter().filter_map(found).copied().collect();
-    let kernels = runtime::linked::LinkedKernels::new(info, links, cells);
-    Ok((Box::new(kernels), start.elapsed().as_secs_f64()))
+    Ok(keys.iter().filter_map(found).copied().collect())
+}
+
+/// A model's tapes: the cache's in `dir`, else derived and stored there;
+/// whether the cache had them, and the seconds the derivation took.
+fn tapes(model: &Model, hash: &str, dir: &Path) -> (TapeSet, CacheStatus, f64) {
+    if let Some(tapes) = cache::load(dir, hash) {
+        return (tapes, CacheStatus::Hit, 0.0);
+    }
+    let start = Instant::now();
+    let tapes = eomgen::derive::derive(model);
+    let derive_s = start.elapsed().as_secs_f64();
+    if let Err(e) = cache::store(dir, &tapes) {
+        eprintln!("warning: {e}");
+    }
+    (tapes, CacheStatus::Miss, derive_s)
 }
 
 /// Load a model and bind its parameters to the chosen backend.
@@ -160,12 +193,16 @@ pub fn load(
     }
     let compiled = compiled.filter(|_| runtime::cpu::has_fma());
     let wanted_compiled = matches!(choice, BackendChoice::Auto | BackendChoice::Compiled);
+    let dir = cache_dir.unwrap_or_else(cache::default_dir);
     let linked = match compiled {
-        None if wanted_compiled => Some(linked(&structure)),
+        None if wanted_compiled => Some(linked(&model, &structure, &dir)),
         _ => None,
     };
     let route = match (&compiled, &linked) {
         (Some(c), _) if wanted_compiled => format!("compiled in as {}", c.name),
+        (_, Some(Ok(_))) if structure.contact_points > 0 => "compiled link cells of bundled \
+             models, linked to its layout, its contact kernels interpreted"
+            .into(),
         (_, Some(Ok(_))) => "compiled link cells of bundled models, linked to its layout".into(),
         (_, Some(Err(why))) => format!(
             "no compiled-in model has this structure and {why}: add the file to models/ and \
@@ -185,23 +222,8 @@ pub fn load(
             ((c.kernels)(), CacheStatus::Unused, 0.0)
         }
         _ => {
-            let dir = cache_dir.unwrap_or_else(cache::default_dir);
-            match cache::load(&dir, &hash) {
-                Some(tapes) => (Box::new(Interpreted::new(tapes)), CacheStatus::Hit, 0.0),
-                None => {
-                    let start = Instant::now();
-                    let tapes = eomgen::derive::derive(&model);
-                    let derive_s = start.elapsed().as_secs_f64();
-                    if let Err(e) = cache::store(&dir, &tapes) {
-                        eprintln!("warning: {e}");
-                    }
-                    (
-                        Box::new(Interpreted::new(tapes)),
-                        CacheStatus::Miss,
-                        derive_s,
-                    )
-                }
-            }
+            let (tapes, cache, derive_s) = tapes(&model, &hash, &dir);
+            (Box::new(Interpreted::new(tapes)), cache, derive_s)
         }
     };
     // The kernels' metadata names their layout: it must be this one.

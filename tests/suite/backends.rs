@@ -1037,10 +1037,21 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         ("soft_finger", "segment.0.elements=5"),
         ("chain", "segment.0.elements=11"),
         ("hybrid_arm", "segment.1.elements=3"),
+        // Arms with contact: the recursion's M and h beside their tapes'
+        // contact kernels (3D, planar with friction).
+        ("finger_tap", "segment.0.elements=7"),
+        ("wrap", "segment.0.elements=9"),
     ] {
         let what = format!("{model} {set}");
         let sets = [eomgen::model::Override::parse(set).unwrap()];
-        let l = load(model, &sets, BackendChoice::Auto, None).unwrap();
+        let tapes = tempfile::tempdir().unwrap();
+        let l = load(
+            model,
+            &sets,
+            BackendChoice::Auto,
+            Some(tapes.path().to_path_buf()),
+        )
+        .unwrap();
         assert!(
             matches!(l.cache, softarm::backend::CacheStatus::Linked),
             "{what}: not linked"
@@ -1219,11 +1230,19 @@ value = 1000.0
     ] {
         let (b, r) = route(model, set, auto);
         assert_eq!(b, "compiled", "{model} {set}");
-        assert!(r.contains("link cells"), "{model}: {r}");
+        assert!(
+            r.contains("link cells") && !r.contains("contact"),
+            "{model}: {r}"
+        );
     }
+    let (b, r) = route("finger_tap", "segment.0.elements=5", auto);
+    assert_eq!(b, "compiled");
+    assert!(
+        r.contains("link cells") && r.contains("contact kernels interpreted"),
+        "{r}"
+    );
     for (model, set, why) in [
         ("falling_ball", "arm.left.segment.0.elements=3", "assembly"),
-        ("finger_tap", "segment.0.elements=5", "obstacles"),
         (stretching.as_str(), "", "link shapes"),
     ] {
         let (b, r) = route(model, set, auto);

@@ -3,11 +3,13 @@
 //! compiled cells (`links::CompiledCell`) of the same link shapes, found by
 //! their keys. The cell is what is compiled; the count is the layout's, a
 //! runtime value, so `--set segment.0.elements=20` on a bundled 10-element
-//! arm needs neither a rebuild nor the interpreter.
+//! arm needs neither a rebuild nor the interpreter. An arm with contact
+//! takes its contact kernels (and the derived parameters they read) from
+//! its tapes: the recursion covers M, h and their tangent, the costly part.
 
 use std::cell::RefCell;
 
-use crate::kernels::{KernelKind, Kernels, ModelInfo};
+use crate::kernels::{Interpreted, KernelKind, Kernels, ModelInfo, TapeSet};
 use crate::linalg::Ldlt;
 use crate::links::{
     Cells, CompiledCell, LinkKernels, accelerations_owned, all_owned, by_lanes,
@@ -18,12 +20,14 @@ use crate::tape::{Inputs, Tape};
 /// The kernels of a chain by the link recursion over linked compiled
 /// cells: `MassBias`, `Jvp` and `Outputs`; the few kernels of the
 /// parameters or of the whole arm's coordinates that a layout may have
-/// (a rom segment's forces, the actuation loads) by their tapes.
+/// (a rom segment's forces, the actuation loads) by their tapes, and the
+/// rest (contact, derived parameters) by the arm's interpreted tapes.
 pub struct LinkedKernels {
     info: ModelInfo,
     links: LinkKernels,
     cells: Vec<CompiledCell>,
     slots: RefCell<Vec<f64>>,
+    rest: Option<Interpreted>,
 }
 
 impl LinkedKernels {
@@ -35,7 +39,23 @@ impl LinkedKernels {
             links,
             cells,
             slots: RefCell::new(Vec::new()),
+            rest: None,
         }
+    }
+
+    /// The chain of `tapes` (its `links`) on `cells`, the kernels the
+    /// recursion does not give (contact, derived parameters) by `tapes`;
+    /// `None` when the tapes have no link recursion. M and h come from the
+    /// recursion and the mass solve, never the tapes' symbolic solve.
+    pub fn with_tapes(tapes: TapeSet, cells: Vec<CompiledCell>) -> Option<Self> {
+        let links = tapes.links.clone()?;
+        let info = ModelInfo {
+            accel: false,
+            ..tapes.info.clone()
+        };
+        let mut linked = Self::new(info, links, cells);
+        linked.rest = Some(Interpreted::new(tapes));
+        Some(linked)
     }
 }
 
@@ -216,16 +236,17 @@ impl LinkedKernels {
                     layout, &mut cells, inp.q, inp.qd, qdd, dir, inp.p, &mut tau, out,
                 )
             }
-            // No derived parameters, no symbolic solve, no joints, no
-            // contact: `LinkedKernels` is made only for such models.
+            // No symbolic solve (`with_tapes` says so); derived parameters
+            // and contact from the tapes when the chain has them.
             KernelKind::Derived
             | KernelKind::Accel
             | KernelKind::Constraints
             | KernelKind::Contact
             | KernelKind::ContactJacobian
-            | KernelKind::ContactJvp => {
-                debug_assert!(out.is_empty(), "{kind:?} of a linked chain");
-            }
+            | KernelKind::ContactJvp => match &self.rest {
+                Some(rest) => rest.eval(kind, inp, out),
+                None => debug_assert!(out.is_empty(), "{kind:?} of a linked chain"),
+            },
         }
     }
 }
