@@ -23,6 +23,9 @@
 //! `contactjac:MODEL` the contact forces' Jacobian (the `ContactJvp`
 //! kernel's columns with the forces);
 //! `Q=q0,q1,...` (env) times every model at that configuration, at rest;
+//! `interpreted:` before any of these runs the model on the tape
+//! interpreter instead (a model file not compiled in runs on its linked
+//! cells when it can, as `softarm simulate` would);
 //! `recursion:tentacle3d` the numeric element-by-element
 //! recursion of tests/suite/common/pcc3d.rs.
 
@@ -62,7 +65,12 @@ enum What {
 /// A name's prefixes (any number, e.g. `rhs:straight:cantilever`): what
 /// it times, at the straight state or not, with the model's contacts or
 /// not; and the model.
-fn parse(name: &str) -> (What, bool, bool, &str) {
+fn parse(name: &str) -> (What, bool, bool, bool, &str) {
+    // `interpreted:` picks the backend, not what is timed.
+    let (interpreted, name) = match name.strip_prefix("interpreted:") {
+        Some(rest) => (true, rest),
+        None => (false, name),
+    };
     let prefixes = [
         ("recursion:", What::Recursion),
         ("jac:", What::Jacobian),
@@ -96,7 +104,7 @@ fn parse(name: &str) -> (What, bool, bool, &str) {
     let what = (order.into_iter())
         .find(|w| asked.contains(w))
         .unwrap_or(What::MassBias);
-    (what, straight, nocontact, model)
+    (what, straight, nocontact, interpreted, model)
 }
 
 /// The state a model is timed at: angles of a few tenths of a radian and
@@ -131,9 +139,13 @@ fn state(coordinates: &[String], straight: bool) -> (Vec<f64>, Vec<f64>) {
 /// The callable a name times, on the criterion benches' state
 /// (benches/kernels.rs).
 fn timed(name: &str) -> Box<dyn FnMut()> {
-    let (what, straight, nocontact, model) = parse(name);
-    let mut l = load(model, &[], BackendChoice::Compiled, None)
-        .unwrap_or_else(|e| panic!("{model}: {e:#}"));
+    let (what, straight, nocontact, interpreted, model) = parse(name);
+    let choice = match interpreted {
+        true => BackendChoice::Interpreted,
+        false => BackendChoice::Compiled,
+    };
+    let cache = Some(std::env::temp_dir().join("softarm-bench-tapes"));
+    let mut l = load(model, &[], choice, cache).unwrap_or_else(|e| panic!("{model}: {e:#}"));
     if nocontact {
         l.arm.set_contact(None);
     }
