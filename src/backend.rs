@@ -11,6 +11,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use eomgen::load::parse_model;
 use eomgen::model::{Model, Override, ParamLayout, Structure};
+use runtime::assembled::BlockKernels;
 use runtime::linked::LinkedKernels;
 use runtime::links::{CompiledCell, LinkKernels};
 use runtime::{Arm, CompiledModel, Dynamics, Interpreted, Kernels, TapeSet};
@@ -108,7 +109,9 @@ pub fn read_model(spec: &str, overrides: &[Override]) -> Result<(Model, String)>
 /// the compiled cells of its link shapes when every one is compiled in
 /// (found by key), with the seconds its layout took to derive; or why it
 /// cannot run so. An arm with contact takes its contact kernels from its
-/// tapes ([`tapes`]: the cache's, else derived and cached).
+/// tapes ([`tapes`]: the cache's, else derived and cached); an assembly
+/// its arms' kernels so, and the rest, its joints and contact by its
+/// tapes (`runtime::assembled::BlockKernels`).
 fn linked(
     model: &Model,
     structure: &Structure,
@@ -117,12 +120,23 @@ fn linked(
     if !runtime::cpu::has_fma() {
         return Err("this processor lacks the fused multiply-add compiled code needs".into());
     }
-    if structure.assembly.is_some() {
-        return Err("link cells run single arms, and this is an assembly".into());
-    }
     let start = Instant::now();
     let not_cells = || "not every one of its methods' elements is a link cell".to_string();
-    let kernels: Box<dyn Kernels> = if structure.contact_points > 0 {
+    let kernels: Box<dyn Kernels> = if structure.assembly.is_some() {
+        let (tapes, _, _) = tapes(model, &structure.hash(), cache_dir);
+        let blocks = tapes.arm_blocks.as_ref().ok_or_else(|| {
+            "its arms run on the assembly's kernels (an arm has inputs or a compliant base)"
+                .to_string()
+        })?;
+        let kinds = (blocks.kinds.iter())
+            .map(|kind| {
+                let cells = compiled_cells(kind.links.as_ref().ok_or_else(not_cells)?)?;
+                let arm = LinkedKernels::with_tapes(kind.clone(), cells).ok_or_else(not_cells)?;
+                Ok(Box::new(arm) as Box<dyn Kernels>)
+            })
+            .collect::<std::result::Result<Vec<_>, String>>()?;
+        Box::new(BlockKernels::new(tapes, kinds).ok_or_else(not_cells)?)
+    } else if structure.contact_points > 0 {
         let (tapes, _, _) = tapes(model, &structure.hash(), cache_dir);
         let cells = compiled_cells(tapes.links.as_ref().ok_or_else(not_cells)?)?;
         Box::new(LinkedKernels::with_tapes(tapes, cells).ok_or_else(not_cells)?)
@@ -200,6 +214,9 @@ pub fn load(
     };
     let route = match (&compiled, &linked) {
         (Some(c), _) if wanted_compiled => format!("compiled in as {}", c.name),
+        (_, Some(Ok(_))) if structure.assembly.is_some() => "compiled link cells of bundled \
+             models, linked to each arm's layout, the rest of the assembly interpreted"
+            .into(),
         (_, Some(Ok(_))) if structure.contact_points > 0 => "compiled link cells of bundled \
              models, linked to its layout, its contact kernels interpreted"
             .into(),

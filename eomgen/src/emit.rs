@@ -2220,9 +2220,17 @@ fn model_tokens(tapes: &TapeSet) -> TokenStream {
         let n_out = tapes.mass_bias.outputs.len();
         kernels.push(emit_link_recursion(links, dof, n_params, n_out));
     } else {
+        // An assembly's are its arm kinds' (each module registers its own).
+        let arm_cells = (tapes.arm_blocks.iter())
+            .flat_map(|b| b.kinds.iter().enumerate())
+            .flat_map(|(k, kind)| {
+                let module = format_ident!("arm_{}", k);
+                let count = kind.links.as_ref().map_or(0, |l| l.cells.len());
+                (0..count).map(move |c| quote! { #module::CELLS[#c], })
+            });
         kernels.push(quote! {
-            /// This model's cells, for chains of other lengths to link: none.
-            pub static CELLS: &[runtime::links::CompiledCell] = &[];
+            /// This model's cells, for chains of other lengths to link.
+            pub static CELLS: &[runtime::links::CompiledCell] = &[#(#arm_cells)*];
         });
     }
     quote! {

@@ -59,6 +59,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "parts",
             "kernels",
             "linked",
+            "assembled",
         ],
     ),
     // The kernel layer's modules are re-exported at the runtime's root.

@@ -9,6 +9,7 @@
 //! build.rs's generator and the models share one compilation of it. It
 //! knows nothing of the CAS.
 
+pub mod assembled;
 pub mod cpu;
 pub mod dual;
 pub mod kernels;
