@@ -108,6 +108,52 @@ value = 0.0
     assert!(lateral < 0.0, "bends away from the chamber: {lateral}");
 }
 
+/// The standard bending actuator: a planar arm with two opposed chambers
+/// (no dummy holes), one pressurised, bends into the arc of curvature
+/// M / (E I_z) away from it, I_z less both holes about the bending axis
+/// (each at y = +-d: a d^2 each, where an isotropic pattern takes a d^2 / 2).
+#[test]
+fn two_opposed_chambers_bend_a_planar_arm_with_curvature_m_over_ei() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rc, d, p) = (0.002, 0.006, 1.0e5);
+    let text = format!(
+        r#"
+name = "bender"
+dimensions = 2
+gravity = [0.0, 0.0, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+{}
+[segment.chambers]
+count = 2
+radius = {rc}
+distance = {d}
+inputs = ["p", "none"]
+[inputs.p]
+kind = "constant"
+value = {p}
+[inputs.none]
+kind = "constant"
+value = 0.0
+"#,
+        segment(L, "")
+    );
+    let (tip, _) = static_tip(dir.path(), &text, &[]);
+    let a = PI * rc * rc;
+    let i = PI * R.powi(4) / 4.0 - 2.0 * (a * rc * rc / 4.0 + a * d * d);
+    let theta = p * a * d * L / (E * i);
+    // The pressurised hole at y = +d: the bend turns x about -z, away.
+    assert_tip(tip, arc(L, theta, [0.0, 0.0, -1.0]), "two opposed chambers");
+    // Three dimensions still ask for an isotropic section.
+    let spatial = text.replace("dimensions = 2", "dimensions = 3");
+    let path = dir.path().join("spatial.toml");
+    std::fs::write(&path, spatial).unwrap();
+    let err = load(path.to_str().unwrap(), &[], BackendChoice::Auto, None)
+        .err()
+        .expect("a 3D arm with two holes is refused");
+    assert!(format!("{err:#}").contains("at least 3 in 3D"), "{err:#}");
+}
+
 #[test]
 fn a_pulled_tendon_bends_its_segments_towards_it_and_a_slack_one_pulls_nothing() {
     let dir = tempfile::tempdir().unwrap();

@@ -374,7 +374,14 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
         return ck.err(p("inner_radius"), "needs `outer_radius`".into());
     }
     if let Some(c) = &s.chambers {
-        check_chambers(c, &p("chambers"), s.outer_radius, s.inner_radius, ck.file)?;
+        let planar = ck.m.dimensions == 2;
+        check_chambers(
+            c,
+            &p("chambers"),
+            (s.outer_radius, s.inner_radius),
+            planar,
+            ck.file,
+        )?;
     }
     if let (Some(_), Some(_)) = (s.youngs_modulus, s.bending_stiffness) {
         return ck.err(
@@ -535,12 +542,13 @@ fn shear_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
 }
 
 /// Chamber holes: one way to place them, inside the wall, not overlapping,
-/// in an isotropic pattern, with declared input channels.
+/// with declared input channels; in 3D in an isotropic pattern (a planar
+/// arm bends about one axis only: any holes, two opposed ones the usual).
 fn check_chambers(
     c: &crate::model::Chambers,
     path: &str,
-    outer: Option<f64>,
-    inner: Option<f64>,
+    (outer, inner): (Option<f64>, Option<f64>),
+    planar: bool,
     file: &str,
 ) -> Result<(), ModelError> {
     let err = |key: &str, msg: String| {
@@ -567,11 +575,11 @@ fn check_chambers(
                 "missing: give `count` (equally spaced positions) or `angles` (degrees)".into(),
             );
         }
-        (Some(n), None) if n < 3 && c.pair_spacing.is_none() => {
+        (Some(n), None) if n < 3 && c.pair_spacing.is_none() && !planar => {
             return err(
                 "count",
                 format!(
-                    "must be at least 3 (equally spaced holes keep the bending stiffness the same in every direction), got {n}"
+                    "must be at least 3 in 3D (equally spaced holes keep the bending stiffness the same in every direction; a planar arm takes any count), got {n}"
                 ),
             );
         }
@@ -633,16 +641,11 @@ fn check_chambers(
             }
         }
     }
-    // Isotropy: sum cos 2a = sum sin 2a = 0 makes I_y = I_z and I_yz = 0.
-    let (cs, sn) = holes.iter().fold((0.0, 0.0), |(x, y), a| {
-        let t = 2.0 * a.to_radians();
-        (x + t.cos(), y + t.sin())
-    });
-    if cs.hypot(sn) > 1e-6 * holes.len() as f64 {
+    if !planar && !c.isotropic() {
         return err(
             "",
             format!(
-                "the holes at {holes:?} degrees make the section stiffer in one direction than another; anisotropic sections are not supported yet: use 3 or more equally spaced positions, or pairs about them"
+                "the holes at {holes:?} degrees make the section stiffer in one direction than another; anisotropic sections are not supported in 3D yet (a planar arm takes any holes): use 3 or more equally spaced positions, or pairs about them"
             ),
         );
     }

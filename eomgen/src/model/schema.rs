@@ -254,17 +254,25 @@ impl Segment {
         )
     }
 
-    /// Second moment of area of the section (m^4), if it has a radius.
+    /// Second moment of area of the section (m^4) about its z axis, the
+    /// axis a planar arm bends about, if it has a radius. A hole at angle
+    /// a sits at y = d cos a. 3D arms have isotropic patterns (validated),
+    /// whose sum of cos^2 is n / 2: the same about every diameter.
     pub fn second_moment(&self) -> Option<f64> {
         let ro = self.outer_radius?;
         let ri = self.inner_radius.unwrap_or(0.0);
         let pi = std::f64::consts::PI;
-        // Holes at distance d in an isotropic pattern (validated): sum of
-        // d^2 sin^2 = n d^2 / 2 about any diameter.
         let holes = self.chambers.as_ref().map_or(0.0, |c| {
             let a = pi * c.radius * c.radius;
             let n = c.holes().len() as f64;
-            n * (a * c.radius * c.radius / 4.0 + a * c.distance * c.distance / 2.0)
+            let (r2, d2) = (c.radius * c.radius, c.distance * c.distance);
+            match c.isotropic() {
+                true => n * (a * r2 / 4.0 + a * d2 / 2.0),
+                false => {
+                    let cos2: f64 = c.holes().iter().map(|h| h.to_radians().cos().powi(2)).sum();
+                    n * a * r2 / 4.0 + a * d2 * cos2
+                }
+            }
         });
         Some(pi / 4.0 * (ro.powi(4) - ri.powi(4)) - holes)
     }
@@ -400,6 +408,17 @@ impl Chambers {
             Some(h) => pos.iter().flat_map(|&a| [a - h, a + h]).collect(),
             None => pos,
         }
+    }
+
+    /// Whether the holes bend alike about every diameter: sum cos 2a =
+    /// sum sin 2a = 0 makes I_y = I_z and I_yz = 0 (to round-off).
+    pub fn isotropic(&self) -> bool {
+        let holes = self.holes();
+        let (cs, sn) = holes.iter().fold((0.0, 0.0), |(x, y): (f64, f64), a| {
+            let t = 2.0 * a.to_radians();
+            (x + t.cos(), y + t.sin())
+        });
+        cs.hypot(sn) <= 1e-6 * holes.len() as f64
     }
 
     /// Holes per position.
