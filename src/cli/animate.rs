@@ -371,38 +371,56 @@ fn draw_gif(
 /// pixels) drawn in its nearest: the same picture as the gif crate's
 /// NeuQuant quantiser, which took two thirds of animate's time.
 fn gif_frame(w: u16, h: u16, rgb: &[u8]) -> gif::Frame<'static> {
-    use std::collections::HashMap;
-    let mut counts: HashMap<[u8; 3], u32> = HashMap::new();
-    for px in rgb.chunks_exact(3) {
-        *counts.entry([px[0], px[1], px[2]]).or_default() += 1;
+    // Colours as numbers, counted by sorting: no hashing per pixel.
+    let colour = |p: &[u8]| u32::from_be_bytes([0, p[0], p[1], p[2]]);
+    let mut sorted: Vec<u32> = rgb.chunks_exact(3).map(colour).collect();
+    sorted.sort_unstable();
+    let mut counted: Vec<(u32, u32)> = Vec::new();
+    for c in sorted {
+        match counted.last_mut() {
+            Some((k, n)) if *k == c => *n += 1,
+            _ => counted.push((c, 1)),
+        }
     }
-    let mut colours: Vec<([u8; 3], u32)> = counts.into_iter().collect();
     // Most frequent first, ties by colour: the same frame, the same file.
-    colours.sort_unstable_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
-    let palette: Vec<[u8; 3]> = colours.iter().take(256).map(|c| c.0).collect();
-    let distance = |a: [u8; 3], b: [u8; 3]| -> i32 {
-        (0..3)
-            .map(|k| (i32::from(a[k]) - i32::from(b[k])).pow(2))
-            .sum()
-    };
-    let index: HashMap<[u8; 3], u8> = colours
-        .iter()
+    let mut frequent = counted.clone();
+    frequent.sort_unstable_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    let palette: Vec<[u8; 3]> = (frequent.iter().take(256))
         .map(|&(c, _)| {
-            let nearest = (0..palette.len())
-                .min_by_key(|&i| distance(c, palette[i]))
-                .unwrap_or(0);
-            (c, nearest as u8)
+            let [_, r, g, b] = c.to_be_bytes();
+            [r, g, b]
         })
         .collect();
-    let mut last = ([0u8; 3], 0u8, false);
-    let pixels: Vec<u8> = rgb
-        .chunks_exact(3)
-        .map(|px| {
-            let c = [px[0], px[1], px[2]];
-            if !(last.2 && last.0 == c) {
-                last = (c, index[&c], true);
+    let distance = |c: u32, p: [u8; 3]| -> i32 {
+        let [_, r, g, b] = c.to_be_bytes();
+        let d = |x: u8, y: u8| (i32::from(x) - i32::from(y)).pow(2);
+        d(r, p[0]) + d(g, p[1]) + d(b, p[2])
+    };
+    // Each distinct colour's palette entry, in `counted`'s (sorted) order:
+    // its own for the palette's colours, the nearest for the rest.
+    let mut index = vec![0u8; counted.len()];
+    for (rank, &(c, _)) in frequent.iter().enumerate() {
+        let at = counted.partition_point(|&(k, _)| k < c);
+        index[at] = match rank < palette.len() {
+            true => rank as u8,
+            false => (0..palette.len())
+                .min_by_key(|&i| distance(c, palette[i]))
+                .unwrap_or(0) as u8,
+        };
+    }
+    let mut last: Option<(u32, u8)> = None;
+    let pixels: Vec<u8> = (rgb.chunks_exact(3))
+        .map(|p| {
+            let c = colour(p);
+            match last {
+                Some((l, i)) if l == c => i,
+                _ => {
+                    let at = counted.partition_point(|&(k, _)| k < c);
+                    let i = index[at];
+                    last = Some((c, i));
+                    i
+                }
             }
-            last.1
         })
         .collect();
     gif::Frame::from_palette_pixels(w, h, &pixels, palette.as_flattened(), None)
