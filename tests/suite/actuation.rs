@@ -111,7 +111,8 @@ value = 0.0
 /// The standard bending actuator: a planar arm with two opposed chambers
 /// (no dummy holes), one pressurised, bends into the arc of curvature
 /// M / (E I_z) away from it, I_z less both holes about the bending axis
-/// (each at y = +-d: a d^2 each, where an isotropic pattern takes a d^2 / 2).
+/// (each at y = +-d: a d^2 each, where an isotropic pattern takes a d^2 / 2);
+/// both at one pressure leave it straight.
 #[test]
 fn two_opposed_chambers_bend_a_planar_arm_with_curvature_m_over_ei() {
     let dir = tempfile::tempdir().unwrap();
@@ -144,6 +145,11 @@ value = 0.0
     let theta = p * a * d * L / (E * i);
     // The pressurised hole at y = +d: the bend turns x about -z, away.
     assert_tip(tip, arc(L, theta, [0.0, 0.0, -1.0]), "two opposed chambers");
+    // Both at the same pressure: their moments cancel, no bend (a planar
+    // pcc arm does not stretch).
+    let equal = text.replace("inputs = [\"p\", \"none\"]", "inputs = [\"p\", \"p\"]");
+    let (tip, _) = static_tip(dir.path(), &equal, &[]);
+    assert_tip(tip, [L, 0.0, 0.0], "two chambers at one pressure");
     // Three dimensions still ask for an isotropic section.
     let spatial = text.replace("dimensions = 2", "dimensions = 3");
     let path = dir.path().join("spatial.toml");
