@@ -48,14 +48,24 @@ impl BlockKernels {
         })
     }
 
-    /// Arm `i`'s kernels, first coordinate, coordinates and parameters
-    /// (its slice of the extended parameters `p`).
-    fn arm<'a>(&'a self, i: usize, p: &'a [f64]) -> (&'a dyn Kernels, usize, usize, &'a [f64]) {
+    /// Arm `i`'s kernels, first coordinate and inputs: its slices of the
+    /// coordinates and rates, its parameters among the extended ones, no
+    /// accelerations or direction (the Jvp sets its own).
+    fn arm<'a>(&'a self, i: usize, inp: &Inputs<'a>) -> (&'a dyn Kernels, usize, Inputs<'a>) {
         let a = &self.blocks.arms[i];
         let kernels = &*self.kinds[a.kind];
         let at = self.info.parameters.len() + self.starts[i];
         let len = kernels.info().extended_params();
-        (kernels, a.first, a.dof, &p[at..at + len])
+        let (first, dof) = (a.first, a.dof);
+        let arm = Inputs {
+            q: &inp.q[first..first + dof],
+            qd: &inp.qd[first..first + dof],
+            qdd: &[],
+            dir: &[],
+            p: &inp.p[at..at + len],
+            ..*inp
+        };
+        (kernels, first, arm)
     }
 
     fn rest(&self, tape: &Tape, inp: &Inputs, out: &mut [f64]) {
@@ -94,16 +104,9 @@ impl BlockKernels {
         self.rest(&self.blocks.rest_mass_bias, inp, out);
         let n = self.info.dof();
         for i in 0..self.blocks.arms.len() {
-            let (kernels, first, dof, p) = self.arm(i, inp.p);
+            let (kernels, first, arm) = self.arm(i, inp);
+            let dof = arm.q.len();
             let mut block = vec![0.0; dof * (dof + 1) / 2 + dof];
-            let arm = Inputs {
-                q: &inp.q[first..first + dof],
-                qd: &inp.qd[first..first + dof],
-                qdd: &[],
-                dir: &[],
-                p,
-                ..*inp
-            };
             kernels.eval(KernelKind::MassBias, &arm, &mut block);
             add_block(n, first, dof, &block, out);
         }
@@ -114,18 +117,11 @@ impl BlockKernels {
     fn jvp(&self, inp: &Inputs, out: &mut [f64]) {
         let n = self.info.dof();
         let zeros = vec![0.0; 2 * n];
-        let inp = Inputs {
-            qdd: if inp.qdd.is_empty() {
-                &zeros[..n]
-            } else {
-                inp.qdd
-            },
-            dir: if inp.dir.is_empty() { &zeros } else { inp.dir },
-            ..*inp
-        };
+        let inp = inp.zero_filled(&zeros);
         self.rest(&self.blocks.rest_jvp, &inp, out);
         for i in 0..self.blocks.arms.len() {
-            let (kernels, first, dof, p) = self.arm(i, inp.p);
+            let (kernels, first, arm) = self.arm(i, &inp);
+            let dof = arm.q.len();
             let mut d = vec![0.0; 2 * dof];
             d[..dof].copy_from_slice(&inp.dir[first..first + dof]);
             d[dof..].copy_from_slice(&inp.dir[n + first..n + first + dof]);
@@ -134,12 +130,9 @@ impl BlockKernels {
             }
             let mut tau = vec![0.0; dof];
             let arm = Inputs {
-                q: &inp.q[first..first + dof],
-                qd: &inp.qd[first..first + dof],
                 qdd: &inp.qdd[first..first + dof],
                 dir: &d,
-                p,
-                ..inp
+                ..arm
             };
             kernels.eval(KernelKind::Jvp, &arm, &mut tau);
             for (o, x) in out[first..first + dof].iter_mut().zip(&tau) {
@@ -153,16 +146,8 @@ impl BlockKernels {
     fn outputs(&self, inp: &Inputs, out: &mut [f64]) {
         self.rest(&self.blocks.rest_outputs, inp, out);
         for i in 0..self.blocks.arms.len() {
-            let (kernels, first, dof, p) = self.arm(i, inp.p);
+            let (kernels, _, arm) = self.arm(i, inp);
             let mut o = [0.0; output::N_OUTPUTS];
-            let arm = Inputs {
-                q: &inp.q[first..first + dof],
-                qd: &inp.qd[first..first + dof],
-                qdd: &[],
-                dir: &[],
-                p,
-                ..*inp
-            };
             kernels.eval(KernelKind::Outputs, &arm, &mut o);
             out[output::KINETIC] += o[output::KINETIC];
             out[output::POTENTIAL] += o[output::POTENTIAL];

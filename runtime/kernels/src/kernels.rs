@@ -444,18 +444,8 @@ impl Kernels for Interpreted {
         if kind == KernelKind::Jvp && (inp.qdd.is_empty() || inp.dir.is_empty()) {
             // As the compiled models do: absent accelerations and direction
             // read as zeros (only this kernel reads them).
-            let n = self.tapes.info.dof();
-            let zeros = vec![0.0; 2 * n];
-            let inp = Inputs {
-                qdd: if inp.qdd.is_empty() {
-                    &zeros[..n]
-                } else {
-                    inp.qdd
-                },
-                dir: if inp.dir.is_empty() { &zeros } else { inp.dir },
-                ..*inp
-            };
-            return self.jvp(&inp, &mut slots, out);
+            let zeros = vec![0.0; 2 * self.tapes.info.dof()];
+            return self.jvp(&inp.zero_filled(&zeros), &mut slots, out);
         }
         if kind == KernelKind::Jvp {
             return self.jvp(inp, &mut slots, out);

@@ -87,6 +87,23 @@ pub struct Inputs<'a> {
     pub aux: &'a [f64],
 }
 
+impl<'a> Inputs<'a> {
+    /// These inputs with absent accelerations and direction read from
+    /// `zeros` (2n zeros), as every backend's `Jvp` reads them.
+    pub fn zero_filled(&self, zeros: &'a [f64]) -> Inputs<'a> {
+        let n = zeros.len() / 2;
+        Inputs {
+            qdd: if self.qdd.is_empty() {
+                &zeros[..n]
+            } else {
+                self.qdd
+            },
+            dir: if self.dir.is_empty() { zeros } else { self.dir },
+            ..*self
+        }
+    }
+}
+
 impl Op {
     /// An input or a constant: read, not computed.
     pub fn is_leaf(&self) -> bool {
