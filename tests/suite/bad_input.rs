@@ -966,6 +966,29 @@ fn chamber_and_input_cases() -> Vec<FileCase> {
             vec!["segment[0].chambers", "anisotropic"],
         ),
         (
+            "holes off the axis in 3D",
+            r(
+                "angles = [0, 120, 240]",
+                "angles = [0, 90, 180, 270, 45, 135]",
+            )
+            .replace(
+                "[\"p\", \"p\", \"p\"]",
+                "[\"p\", \"p\", \"p\", \"p\", \"p\", \"p\"]",
+            ),
+            vec!["segment[0].chambers", "centroid off the arm's axis"],
+        ),
+        (
+            "one hole in a planar arm",
+            r("angles = [0, 120, 240]", "angles = [0]")
+                .replace("[\"p\", \"p\", \"p\"]", "[\"p\"]")
+                .replace("dimensions = 3", "dimensions = 2"),
+            vec![
+                "segment[0].chambers",
+                "centroid off the arm's axis",
+                "at 0 and 180 degrees",
+            ],
+        ),
+        (
             "count and angles",
             r(
                 "angles = [0, 120, 240]",

@@ -542,8 +542,9 @@ fn shear_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
 }
 
 /// Chamber holes: one way to place them, inside the wall, not overlapping,
-/// with declared input channels; in 3D in an isotropic pattern (a planar
-/// arm bends about one axis only: any holes, two opposed ones the usual).
+/// centred on the axis, with declared input channels; in 3D in an
+/// isotropic pattern (a planar arm bends about one axis only: two opposed
+/// holes, the usual bending actuator, or any other centred pattern).
 fn check_chambers(
     c: &crate::model::Chambers,
     path: &str,
@@ -579,7 +580,7 @@ fn check_chambers(
             return err(
                 "count",
                 format!(
-                    "must be at least 3 in 3D (equally spaced holes keep the bending stiffness the same in every direction; a planar arm takes any count), got {n}"
+                    "must be at least 3 in 3D (equally spaced holes keep the bending stiffness the same in every direction; a planar arm takes 2, two opposed chambers), got {n}"
                 ),
             );
         }
@@ -645,7 +646,16 @@ fn check_chambers(
         return err(
             "",
             format!(
-                "the holes at {holes:?} degrees make the section stiffer in one direction than another; anisotropic sections are not supported in 3D yet (a planar arm takes any holes): use 3 or more equally spaced positions, or pairs about them"
+                "the holes at {holes:?} degrees make the section stiffer in one direction than another; anisotropic sections are not supported in 3D yet (a planar arm takes any holes centred on its axis): use 3 or more equally spaced positions, or pairs about them"
+            ),
+        );
+    }
+    if !c.centred(planar) {
+        return err(
+            "",
+            format!(
+                "the holes at {holes:?} degrees move the section's centroid off the arm's axis, about which its stiffness and the pressure's lever are taken; sections whose centroid leaves the axis are not supported yet: place the holes symmetrically about the axis (two opposed, {}or 3 or more equally spaced)",
+                if planar { "at 0 and 180 degrees, " } else { "" }
             ),
         );
     }

@@ -256,8 +256,9 @@ impl Segment {
 
     /// Second moment of area of the section (m^4) about its z axis, the
     /// axis a planar arm bends about, if it has a radius. A hole at angle
-    /// a sits at y = d cos a. 3D arms have isotropic patterns (validated),
-    /// whose sum of cos^2 is n / 2: the same about every diameter.
+    /// a sits at y = d cos a; the holes leave the centroid on the axis
+    /// (validated). 3D arms have isotropic patterns (validated), whose sum
+    /// of cos^2 is n / 2: the same about every diameter.
     pub fn second_moment(&self) -> Option<f64> {
         let ro = self.outer_radius?;
         let ri = self.inner_radius.unwrap_or(0.0);
@@ -419,6 +420,19 @@ impl Chambers {
             (x + t.cos(), y + t.sin())
         });
         cs.hypot(sn) <= 1e-6 * holes.len() as f64
+    }
+
+    /// Whether the holes leave the section's centroid on the arm's axis:
+    /// sum cos a = 0 (the y offsets, all a planar arm bends by) and, in 3D,
+    /// sum sin a = 0 too (to round-off).
+    pub fn centred(&self, planar: bool) -> bool {
+        let holes = self.holes();
+        let (y, z) = holes.iter().fold((0.0, 0.0), |(y, z): (f64, f64), a| {
+            let a = a.to_radians();
+            (y + a.cos(), z + a.sin())
+        });
+        let off = if planar { y.abs() } else { y.hypot(z) };
+        off <= 1e-6 * holes.len() as f64
     }
 
     /// Holes per position.
