@@ -219,21 +219,11 @@ impl LinkedKernels {
             }
             KernelKind::Outputs => outputs(layout, &mut cells, inp.q, inp.qd, inp.p, out),
             KernelKind::Jvp => {
-                let n = layout.dof;
-                let zeros = vec![0.0; 2 * n];
-                let qdd = if inp.qdd.is_empty() {
-                    &zeros[..n]
-                } else {
-                    inp.qdd
-                };
-                let dir = if inp.dir.is_empty() {
-                    &zeros[..]
-                } else {
-                    inp.dir
-                };
-                let mut tau = vec![0.0; n];
+                let zeros = vec![0.0; 2 * layout.dof];
+                let inp = inp.zero_filled(&zeros);
+                let mut tau = vec![0.0; layout.dof];
                 inverse_dynamics_tangent(
-                    layout, &mut cells, inp.q, inp.qd, qdd, dir, inp.p, &mut tau, out,
+                    layout, &mut cells, inp.q, inp.qd, inp.qdd, inp.dir, inp.p, &mut tau, out,
                 )
             }
             // No symbolic solve (`with_tapes` says so); derived parameters
