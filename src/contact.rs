@@ -27,12 +27,15 @@ pub fn contact_set(model: &Model, base: &Path, points: usize) -> Result<Option<C
     for (arm, (_, am)) in model.arm_models().iter().enumerate() {
         let mut element = 0;
         for s in &am.segments {
-            let radius = s.outer_radius.unwrap_or(0.0);
-            // A rom segment's elements are its quadrature slices.
-            for _ in 0..s.slices() {
-                for _ in 0..per {
+            // A rom segment's elements are its quadrature slices; an
+            // element's points are evenly spaced along it, the last at its
+            // end, each as thick as the section there.
+            let n = s.slices();
+            for e in 0..n {
+                for j in 0..per {
+                    let at = (e as f64 + (j + 1) as f64 / per as f64) / n as f64;
                     sampled.push(ContactPoint {
-                        radius,
+                        radius: s.outer_radius.as_ref().map_or(0.0, |r| r.at(at)),
                         element: Some((arm, element)),
                     });
                 }

@@ -1,37 +1,66 @@
 //! `method = "cosserat"`: a model file as a Cosserat rod for
 //! `runtime::cosserat`, the continuum reference of the lumped methods.
 //!
-//! One uniform segment. Inextensible and unshearable unless it says
+//! One segment, uniform or tapered. Inextensible and unshearable unless it says
 //! otherwise: `extension = true` stretches it (E A), `shear = true` shears
 //! it (k G A, k the `shear_factor`), as the lumped methods' keys do.
 
 use anyhow::Result;
-use eomgen::model::{Model, base_rotation};
+use std::sync::Arc;
+
+use eomgen::model::{Model, Segment, base_rotation};
 use nalgebra::Matrix3;
-use runtime::cosserat::{Rod, RodLoads, RodOptions, RodSolution, solve_rod};
+use runtime::cosserat::{Rod, RodLoads, RodOptions, RodSolution, Section, solve_rod};
 
 /// True when the model asks for the Cosserat rod.
 pub fn is_cosserat(model: &Model) -> bool {
     model.segments.iter().any(|s| s.method.statics_only())
 }
 
+/// The rod's section at the fraction `x` of the segment `s`.
+fn section_at(s: &Segment, x: f64) -> Section {
+    let here = s.at(x);
+    let stiffness = |v: Option<f64>| v.expect("validated: the Cosserat rod's stiffness");
+    let ei = stiffness(here.ei());
+    Section {
+        ea: s.stretches().then(|| stiffness(here.ea())),
+        ga: s.shears().then(|| stiffness(here.ga())),
+        ei: [ei, ei],
+        gj: stiffness(here.gj()),
+        rho_a: s.mass_per_length(x).unwrap_or(0.0),
+    }
+}
+
+/// The rod of segment `s`: uniform, or tapered with its sections taken
+/// once at the points where the shooting reads them.
+fn rod_of(s: &Segment, opts: &RodOptions) -> Rod {
+    if !s.tapered() {
+        return Rod::uniform(s.length, section_at(s, 0.5));
+    }
+    let half = 0.5 / opts.steps as f64;
+    let table: Vec<Section> = (0..=2 * opts.steps)
+        .map(|k| section_at(s, k as f64 * half))
+        .collect();
+    let (seg, length) = (s.clone(), s.length);
+    Rod {
+        length,
+        section: Arc::new(move |at| {
+            let x = at / length;
+            let k = (x / half).round();
+            match (k * half - x).abs() < 1e-9 {
+                true => table[(k as usize).min(table.len() - 1)],
+                false => section_at(&seg, x),
+            }
+        }),
+    }
+}
+
 /// Solve the static rod of a model whose segment is `cosserat`
-/// (validation checked the model: one uniform segment, its stiffnesses).
+/// (validation checked the model: one segment, its stiffnesses).
 pub fn solve(model: &Model, origin: &str) -> Result<RodSolution> {
     let s = &model.segments[0];
-    let stiffness = |v: Option<f64>| v.expect("validated: the Cosserat rod's stiffness");
-    let ea = s.stretches().then(|| stiffness(s.ea()));
-    let ga = s.shears().then(|| stiffness(s.ga()));
-    let (ei, gj) = (stiffness(s.ei()), stiffness(s.gj()));
-    let mass = s.total_mass().unwrap_or(0.0);
-    let rod = Rod {
-        length: s.length,
-        ea,
-        ga,
-        ei: [ei, ei],
-        gj,
-        rho_a: mass / s.length,
-    };
+    let opts = RodOptions::default();
+    let rod = rod_of(s, &opts);
     // The rod's frame has its tangent third: (y, z, x) of the base frame.
     let r0 = base_rotation(model.base.direction);
     let col = |j: usize| [r0[0][j], r0[1][j], r0[2][j]];
@@ -47,12 +76,6 @@ pub fn solve(model: &Model, origin: &str) -> Result<RodSolution> {
         tip_force: model.tip.force.unwrap_or([0.0; 3]),
         tip_moment: model.tip.moment.unwrap_or([0.0; 3]),
     };
-    solve_rod(
-        &rod,
-        model.base.position,
-        frame,
-        &loads,
-        &RodOptions::default(),
-    )
-    .map_err(|e| anyhow::anyhow!("{origin}: {e}"))
+    solve_rod(&rod, model.base.position, frame, &loads, &opts)
+        .map_err(|e| anyhow::anyhow!("{origin}: {e}"))
 }

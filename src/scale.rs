@@ -23,7 +23,9 @@ pub fn out_of_scale(model: &Model, arm: &dyn Dynamics, t_end: f64) -> Vec<String
     let peak = |i: usize| samples.iter().map(|p| p[i].abs()).fold(0.0, f64::max);
     let mut found = Vec::new();
     for (s, seg) in model.segments.iter().enumerate() {
-        let (Some(e), Some(chambers)) = (seg.youngs_modulus, &seg.chambers) else {
+        let (Some(e), Some(chambers)) =
+            (seg.youngs_modulus.as_ref().map(|e| e.min()), &seg.chambers)
+        else {
             continue;
         };
         for (c, input) in chambers.inputs.iter().flatten().enumerate() {

@@ -219,14 +219,17 @@ fn look_of(loaded: &Loaded, name: &str, s: &[f64]) -> Look {
         let radius = s
             .iter()
             .map(|&s| {
-                let mut end = 0.0;
+                let mut start = 0.0;
                 for g in segments {
-                    end += g.length;
-                    if s <= end * (1.0 + 1e-9) {
-                        return g.outer_radius.unwrap_or(0.01);
+                    if s <= (start + g.length) * (1.0 + 1e-9) {
+                        let at = (s - start) / g.length;
+                        return g.outer_radius.as_ref().map_or(0.01, |r| r.at(at));
                     }
+                    start += g.length;
                 }
-                segments.last().and_then(|g| g.outer_radius).unwrap_or(0.01)
+                (segments.last())
+                    .and_then(|g| g.outer_radius.as_ref())
+                    .map_or(0.01, |r| r.at(1.0))
             })
             .collect();
         Look::Tube { radius }

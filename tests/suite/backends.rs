@@ -1239,12 +1239,15 @@ value = 1000.0
             "{model}: {r}"
         );
     }
-    // README's two-chamber finger, a file no build has seen.
-    let example = root().join("examples/two_chamber_finger.toml");
-    let example = example.to_string_lossy();
-    let (b, r) = route(&example, "", auto);
-    assert_eq!(b, "compiled", "{r}");
-    assert!(r.contains("link cells"), "{r}");
+    // README's two-chamber finger and continuously tapered tentacle,
+    // files no build has seen.
+    for file in ["two_chamber_finger", "tapered_tentacle"] {
+        let example = root().join(format!("examples/{file}.toml"));
+        let example = example.to_string_lossy();
+        let (b, r) = route(&example, "", auto);
+        assert_eq!(b, "compiled", "{file}: {r}");
+        assert!(r.contains("link cells"), "{file}: {r}");
+    }
     let (b, r) = route("finger_tap", "segment.0.elements=5", auto);
     assert_eq!(b, "compiled");
     assert!(

@@ -1017,6 +1017,49 @@ fn chamber_and_input_cases() -> Vec<FileCase> {
             ],
         ),
         (
+            "taper through zero",
+            r("outer_radius = 0.01", "outer_radius = [0.01, -0.002]"),
+            vec![
+                "segment[0].outer_radius",
+                "must be positive everywhere along the segment, got -0.002",
+            ],
+        ),
+        (
+            "taper of three numbers",
+            r("outer_radius = 0.01", "outer_radius = [0.01, 0.008, 0.006]"),
+            vec!["segment[0].outer_radius", "[start, end], two numbers"],
+        ),
+        (
+            "taper table not rising",
+            r(
+                "outer_radius = 0.01",
+                "outer_radius = { s = [0.0, 0.6, 0.5, 1.0], value = [0.01, 0.009, 0.008, 0.007] }",
+            ),
+            vec!["segment[0].outer_radius", "rising from 0 to 1"],
+        ),
+        (
+            "holes outside a tapered section",
+            r("outer_radius = 0.01", "outer_radius = [0.01, 0.007]"),
+            vec![
+                "segment[0].chambers",
+                "must lie in the wall",
+                "outer radius 0.007",
+                "at s/L = 1",
+            ],
+        ),
+        (
+            "tapered inner radius reaching the outer",
+            r(
+                "outer_radius = 0.01",
+                "outer_radius = [0.01, 0.006]\ninner_radius = [0.001, 0.007]",
+            ),
+            vec![
+                "segment[0].inner_radius",
+                "smaller than outer_radius",
+                "at s/L = 1",
+            ],
+        ),
+        (
             "pair spacing",
             r("distance = 0.006", "distance = 0.006\npair_spacing = 95"),
             vec!["segment[0].chambers.pair_spacing", "between 0 and 90"],

@@ -33,4 +33,5 @@ mod six_strains;
 mod spatial;
 mod streamed;
 mod sweep;
+mod taper;
 mod unchanged;

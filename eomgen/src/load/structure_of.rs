@@ -77,6 +77,7 @@ impl Structure {
                             0
                         },
                         joints: method.joints(s),
+                        varying: method.polynomial_fields() && s.tapered(),
                         twist: spatial && twist,
                         extension: spatial && extension,
                         shear: spatial && shear,

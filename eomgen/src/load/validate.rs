@@ -214,12 +214,20 @@ fn tendons(ck: &Check) -> Result<(), ModelError> {
         for s in 0..=end {
             let d = t.distance.at(s);
             ck.non_negative(&p("distance"), d)?;
-            if let Some(ro) = m.segments[s].outer_radius
+            let seg = &m.segments[s];
+            if let Some(ro) = seg.outer_radius.as_ref().map(|r| r.min())
                 && d > ro
             {
+                let least = if seg.tapered() {
+                    " at its thinnest"
+                } else {
+                    ""
+                };
                 return ck.err(
                     p("distance"),
-                    format!("{d} m lies outside segment {s}'s section (outer radius {ro} m)"),
+                    format!(
+                        "{d} m lies outside segment {s}'s section (outer radius {ro} m{least})"
+                    ),
                 );
             }
         }
@@ -335,7 +343,7 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
             format!("must be between 1 and {MAX_ELEMENTS}, got {}", s.elements),
         );
     }
-    match (s.mass, s.density) {
+    match (s.mass, &s.density) {
         (Some(_), Some(_)) => {
             return ck.err(
                 p("mass"),
@@ -350,7 +358,7 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
         }
         (Some(mass), None) => ck.positive(&p("mass"), mass)?,
         (None, Some(rho)) => {
-            ck.positive(&p("density"), rho)?;
+            ck.positive_along(&p("density"), rho)?;
             if s.outer_radius.is_none() {
                 return ck.err(
                     p("outer_radius"),
@@ -359,61 +367,56 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
             }
         }
     }
-    if let Some(ro) = s.outer_radius {
-        ck.positive(&p("outer_radius"), ro)?;
-        if let Some(ri) = s.inner_radius {
-            ck.non_negative(&p("inner_radius"), ri)?;
-            if ri >= ro {
-                return ck.err(
-                    p("inner_radius"),
-                    format!("must be smaller than outer_radius ({ro}), got {ri}"),
-                );
-            }
+    for (key, v) in s.profiles() {
+        if let Some(v) = v {
+            ck.positive_along(&p(key), v)?;
         }
-    } else if s.inner_radius.is_some() {
-        return ck.err(p("inner_radius"), "needs `outer_radius`".into());
     }
-    if let Some(c) = &s.chambers {
-        let planar = ck.m.dimensions == 2;
-        check_chambers(
-            c,
-            &p("chambers"),
-            (s.outer_radius, s.inner_radius),
-            planar,
-            ck.file,
-        )?;
+    if let Some(ri) = &s.inner_radius {
+        ck.non_negative_along(&p("inner_radius"), ri)?;
+        if s.outer_radius.is_none() {
+            return ck.err(p("inner_radius"), "needs `outer_radius`".into());
+        }
     }
-    if let (Some(_), Some(_)) = (s.youngs_modulus, s.bending_stiffness) {
+    // Every value is linear between the profiles' points: the section is
+    // checked where it is thinnest, at one of them.
+    for x in s.breaks() {
+        let here = s.at(x);
+        let (ro, ri) = (here.outer(), here.inner());
+        let at = match s.tapered() {
+            true => format!(" at s/L = {x}"),
+            false => String::new(),
+        };
+        if let (Some(ro), Some(ri)) = (ro, ri)
+            && ri >= ro
+        {
+            return ck.err(
+                p("inner_radius"),
+                format!("must be smaller than outer_radius ({ro}), got {ri}{at}"),
+            );
+        }
+        if let Some(c) = &s.chambers {
+            let planar = ck.m.dimensions == 2;
+            check_chambers(c, &p("chambers"), (ro, ri), planar, ck.file)
+                .map_err(|e| e.with_suffix(&at))?;
+        }
+    }
+    if let (Some(_), Some(_)) = (&s.youngs_modulus, &s.bending_stiffness) {
         return ck.err(
             p("bending_stiffness"),
             "give either `youngs_modulus` or `bending_stiffness`, not both".into(),
         );
     }
-    if let Some(e) = s.youngs_modulus {
-        ck.positive(&p("youngs_modulus"), e)?;
-        if s.outer_radius.is_none() {
-            return ck.err(
-                p("outer_radius"),
-                "missing: `youngs_modulus` needs the section's `outer_radius` (m)".into(),
-            );
-        }
-    }
-    if let Some(ei) = s.bending_stiffness {
-        ck.positive(&p("bending_stiffness"), ei)?;
+    if s.youngs_modulus.is_some() && s.outer_radius.is_none() {
+        return ck.err(
+            p("outer_radius"),
+            "missing: `youngs_modulus` needs the section's `outer_radius` (m)".into(),
+        );
     }
     if let Some(c) = s.bending_damping {
         ck.non_negative(&p("bending_damping"), c)?;
     }
     ck.finite(&p("rest_curvature"), s.rest_curvature)?;
-    for (key, v) in [
-        ("shear_modulus", s.shear_modulus),
-        ("torsional_stiffness", s.torsional_stiffness),
-        ("axial_stiffness", s.axial_stiffness),
-    ] {
-        if let Some(v) = v {
-            ck.positive(&p(key), v)?;
-        }
-    }
     if let Some(c) = s.axial_damping {
         ck.non_negative(&p("axial_damping"), c)?;
     }

@@ -4,8 +4,8 @@
 
 use crate::model::sensor::{Source, wrench_sources};
 use crate::model::{
-    BodyParam, ElementParam, JointParam, Model, Param, ParamLayout, SpringParam, Structure,
-    base_quaternion, base_rotation, base_turn_axis, chamber_value,
+    BodyParam, ElementParam, JointParam, Model, Param, ParamLayout, Segment, SpringParam,
+    Structure, base_quaternion, base_rotation, base_turn_axis, chamber_value,
 };
 
 impl ParamLayout {
@@ -192,62 +192,71 @@ impl ElementProps {
     }
 }
 
+/// Each element's values (a rom segment's: each slice's): a tapered
+/// segment's at the element's middle, so that its stiffness, mass and
+/// inertia converge at second order in the element length.
 pub fn element_props(m: &Model) -> Vec<ElementProps> {
     let mut out = Vec::new();
     for s in &m.segments {
-        let n = s.slices() as f64;
-        let l = s.length / n;
-        let ro = s.outer_radius.unwrap_or(0.0);
-        let ri = s.inner_radius.unwrap_or(0.0);
-        let mass = match (s.mass, s.density) {
-            (Some(mass), _) => mass / n,
-            (None, Some(rho)) => rho * s.area().unwrap_or(0.0) * l,
-            (None, None) => 0.0, // rejected by validation
-        };
-        // Uniform cylinders (hollow, solid, with chamber holes) about a
-        // diameter through the centre, m I / A ((r_o^2 + r_i^2) / 4 for a
-        // ring); slender rods when no radius is given.
-        let section = match (s.second_moment(), s.area()) {
-            (Some(i), Some(a)) if a > 0.0 => mass * i / a,
-            _ => mass * (ro * ro + ri * ri) / 4.0,
-        };
-        // Bodies: the whole link, or two half links (midpoint joints), or
-        // the section's part of an arc: the method's.
-        let (inertia, axial_inertia) =
-            crate::method::of(s.method).element_inertia(s, mass, l, section, m.dimensions);
-        let stiffness = match s.ei() {
-            Some(ei) => ei / l,
-            None => s.joint_stiffness.unwrap_or(0.0),
-        };
-        let damping = match s.bending_damping {
-            Some(eta) => eta / l,
-            None => s.joint_damping.unwrap_or(0.0),
-        };
-        let twist_stiffness = match s.gj() {
-            Some(gj) => gj / l,
-            None => s.joint_stiffness.unwrap_or(0.0),
-        };
-        let stretch_stiffness = s.ea().unwrap_or(0.0) / l;
-        let stretch_damping = s.axial_damping.unwrap_or(0.0) / l;
-        let shear_stiffness = s.ga().unwrap_or(0.0) / l;
-        for _ in 0..s.slices() {
-            out.push(ElementProps {
-                length: l,
-                mass,
-                inertia,
-                stiffness,
-                damping,
-                rest: s.rest_curvature * l,
-                axial_inertia,
-                twist_stiffness,
-                twist_damping: damping,
-                stretch_stiffness,
-                stretch_damping,
-                shear_stiffness,
-            });
+        let n = s.slices();
+        let method = crate::method::of(s.method);
+        for e in 0..n {
+            let at = |x: f64| s.at((e as f64 + x) / n as f64);
+            let (body, springs) = (at(0.5), at(method.spring_at(e)));
+            out.push(props_of(m, [&body, &springs], s.length / n as f64, n));
         }
     }
     out
+}
+
+/// The values of an element of length `l`, one of `n`: its body's from
+/// the uniform segment `s`, its springs' from `springs` (the section where
+/// they sit).
+fn props_of(m: &Model, [s, springs]: [&Segment; 2], l: f64, n: usize) -> ElementProps {
+    let ro = s.outer().unwrap_or(0.0);
+    let ri = s.inner().unwrap_or(0.0);
+    let mass = match (s.mass, s.density.as_ref()) {
+        (Some(mass), _) => mass / n as f64,
+        (None, Some(rho)) => rho.at(0.0) * s.area().unwrap_or(0.0) * l,
+        (None, None) => 0.0, // rejected by validation
+    };
+    // Uniform cylinders (hollow, solid, with chamber holes) about a
+    // diameter through the centre, m I / A ((r_o^2 + r_i^2) / 4 for a
+    // ring); slender rods when no radius is given.
+    let section = match (s.second_moment(), s.area()) {
+        (Some(i), Some(a)) if a > 0.0 => mass * i / a,
+        _ => mass * (ro * ro + ri * ri) / 4.0,
+    };
+    // Bodies: the whole link, or two half links (midpoint joints), or
+    // the section's part of an arc: the method's.
+    let (inertia, axial_inertia) =
+        crate::method::of(s.method).element_inertia(s, mass, l, section, m.dimensions);
+    let stiffness = match springs.ei() {
+        Some(ei) => ei / l,
+        None => s.joint_stiffness.unwrap_or(0.0),
+    };
+    let damping = match s.bending_damping {
+        Some(eta) => eta / l,
+        None => s.joint_damping.unwrap_or(0.0),
+    };
+    let twist_stiffness = match springs.gj() {
+        Some(gj) => gj / l,
+        None => s.joint_stiffness.unwrap_or(0.0),
+    };
+    ElementProps {
+        length: l,
+        mass,
+        inertia,
+        stiffness,
+        damping,
+        rest: s.rest_curvature * l,
+        axial_inertia,
+        twist_stiffness,
+        twist_damping: damping,
+        stretch_stiffness: springs.ea().unwrap_or(0.0) / l,
+        stretch_damping: s.axial_damping.unwrap_or(0.0) / l,
+        shear_stiffness: springs.ga().unwrap_or(0.0) / l,
+    }
 }
 
 #[cfg(test)]

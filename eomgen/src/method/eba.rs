@@ -57,6 +57,13 @@ impl ModellingMethod for Eba {
         false
     }
 
+    /// Element e's springs join it to element e - 1, from centre to centre:
+    /// they sit at its start (the first element's, from the base to its
+    /// centre, a quarter along it).
+    fn spring_at(&self, e: usize) -> f64 {
+        if e == 0 { 0.25 } else { 0.0 }
+    }
+
     fn spatial_only(&self) -> bool {
         true
     }

@@ -155,6 +155,13 @@ pub(crate) trait ModellingMethod: Sync {
         true
     }
 
+    /// Where along element `e` (as a fraction of its length) its springs
+    /// sit, which a varying section's stiffnesses are taken at: the
+    /// element's middle, unless its springs join it to its neighbour.
+    fn spring_at(&self, _e: usize) -> f64 {
+        0.5
+    }
+
     /// An element's rotational inertia about a diameter through its centre
     /// and about its axis, from its mass, length and the section's share
     /// (m I / A), in `dimensions`.

@@ -153,6 +153,7 @@ impl ModellingMethod for Rom {
 /// fields, but their Gram matrix (the Hilbert matrix) is ill-conditioned
 /// past order 5: the mass matrix inherits it and the step control stalls
 /// (docs/validation.md, the rom conditioning table).
+#[derive(Clone)]
 pub(crate) struct RomFields {
     pub first: usize,
     pub order: usize,
@@ -162,6 +163,10 @@ pub(crate) struct RomFields {
     pub shear: bool,
     /// Bending and twist energy by slices (see `Rom::build_spatial`), not here.
     pub incompressible: bool,
+    /// The section varies along the segment: each slice's stiffness over
+    /// its own part of the fields (`slice_gram`), not the first slice's
+    /// over the whole.
+    pub varying: bool,
 }
 
 impl RomFields {
@@ -175,7 +180,27 @@ impl RomFields {
             extension: g.extension,
             shear: g.shear,
             incompressible: g.incompressible,
+            varying: g.varying,
         }
+    }
+
+    /// Slice e's Gram matrix of the Legendre polynomials, int P_i P_j d
+    /// sigma over its part of [0, 1], by the Gauss rule of order + 1
+    /// points (exact for their degree 2 order): summed over the slices,
+    /// delta_ij / (2 i + 1).
+    pub(crate) fn slice_gram(&self, e: usize) -> Vec<Vec<f64>> {
+        let n = self.slices as f64;
+        let (a, b) = (e as f64 / n, (e + 1) as f64 / n);
+        let mut g = vec![vec![0.0; self.order + 1]; self.order + 1];
+        for (y, w) in gauss_legendre(self.order + 1) {
+            let p = legendre(self.order, 2.0 * (a + (b - a) * 0.5 * (y + 1.0)) - 1.0);
+            for i in 0..=self.order {
+                for j in 0..=self.order {
+                    g[i][j] += 0.5 * (b - a) * w * p[i] * p[j];
+                }
+            }
+        }
+        g
     }
 
     pub(crate) fn coordinates(&self) -> usize {
@@ -306,14 +331,40 @@ impl RomFields {
         k: usize,
     ) -> [ExprId; 2] {
         let n = self.slices as f64;
-        let quad = |cas: &mut Cas, x: &[ExprId]| {
-            let terms: Vec<ExprId> = (x.iter().enumerate())
-                .map(|(i, &a)| {
-                    let aa = cas.mul(a, a);
-                    cas.scaled(1.0 / (2 * i + 1) as f64, aa)
-                })
-                .collect();
-            cas.add_all(&terms)
+        // per x^T G x scale over the whole segment (G diagonal), or with each
+        // slice's parameter `per(e)` on its own part (a varying section).
+        let grams: Vec<Vec<Vec<f64>>> = match self.varying {
+            true => (0..self.slices).map(|e| self.slice_gram(e)).collect(),
+            false => Vec::new(),
+        };
+        let quad = |cas: &mut Cas, x: &[ExprId], per: &dyn Fn(usize) -> ExprId, scale: ExprId| {
+            if grams.is_empty() {
+                let terms: Vec<ExprId> = (x.iter().enumerate())
+                    .map(|(i, &a)| {
+                        let aa = cas.mul(a, a);
+                        cas.scaled(1.0 / (2 * i + 1) as f64, aa)
+                    })
+                    .collect();
+                let sum = cas.add_all(&terms);
+                return cas.mul_all(&[per(0), scale, sum]);
+            }
+            let mut slices = Vec::with_capacity(grams.len());
+            for (e, g) in grams.iter().enumerate() {
+                let mut terms = Vec::new();
+                for i in 0..x.len() {
+                    for j in i..x.len() {
+                        let c = if i == j { g[i][i] } else { 2.0 * g[i][j] };
+                        if c.abs() > 1e-15 * g[0][0] {
+                            let xx = cas.mul(x[i], x[j]);
+                            terms.push(cas.scaled(c, xx));
+                        }
+                    }
+                }
+                let sum = cas.add_all(&terms);
+                slices.push(cas.mul(per(e), sum));
+            }
+            let all = cas.add_all(&slices);
+            cas.mul(scale, all)
         };
         let (mut elastic, mut rayleigh) = (Vec::new(), Vec::new());
         let first_shear = 2 + usize::from(self.twist) + usize::from(self.extension);
@@ -331,9 +382,8 @@ impl RomFields {
                 let xd: Vec<ExprId> = (0..=self.order)
                     .map(|i| coords.qd[self.index(f, i)])
                     .collect();
-                let d = quad(cas, &xd);
                 let scale = cas.constant(1.0 / n);
-                rayleigh.push(cas.mul_all(&[ds, scale, d]));
+                rayleigh.push(quad(cas, &xd, &|_| ds, scale));
                 continue;
             }
             // Shear rates damped as the stretch's, as pcs has them.
@@ -345,8 +395,8 @@ impl RomFields {
                 0 | 1 => (ElementParam::BendStiffness, ElementParam::BendDamping),
                 _ => (ElementParam::TwistStiffness, ElementParam::TwistDamping),
             };
-            let ks = symbols.element(k, stiff);
-            let ds = symbols.element(k, damp);
+            let ks = |e: usize| symbols.element(k + e, stiff);
+            let ds = |e: usize| symbols.element(k + e, damp);
             // Bending, twist: (E I / L) c^T G c = (k_slice / n) ...; stretch
             // and shear: E A L e^T G e = k_slice n l^2 ....
             let scale = if stretch {
@@ -368,15 +418,35 @@ impl RomFields {
             let xd: Vec<ExprId> = (0..=self.order)
                 .map(|i| coords.qd[self.index(f, i)])
                 .collect();
-            let e = quad(cas, &x);
-            let d = quad(cas, &xd);
-            elastic.push(cas.mul_all(&[ks, scale, e]));
-            rayleigh.push(cas.mul_all(&[ds, scale, d]));
+            elastic.push(quad(cas, &x, &ks, scale));
+            rayleigh.push(quad(cas, &xd, &ds, scale));
         }
         let e = cas.add_all(&elastic);
         let d = cas.add_all(&rayleigh);
         [cas.scaled(0.5, e), cas.scaled(0.5, d)]
     }
+}
+
+/// The m-point Gauss-Legendre rule on [-1, 1]: nodes (roots of P_m, by
+/// Newton from Tricomi's estimate) and weights 2 / ((1 - y^2) P_m'(y)^2).
+fn gauss_legendre(m: usize) -> Vec<(f64, f64)> {
+    let mf = m as f64;
+    (0..m)
+        .map(|i| {
+            let mut y = (std::f64::consts::PI * (i as f64 + 0.75) / (mf + 0.5)).cos();
+            let mut dp = 1.0;
+            for _ in 0..100 {
+                let p = legendre(m, y);
+                dp = mf * (y * p[m] - p[m - 1]) / (y * y - 1.0);
+                let step = p[m] / dp;
+                y -= step;
+                if step.abs() < 1e-16 {
+                    break;
+                }
+            }
+            (y, 2.0 / ((1.0 - y * y) * dp * dp))
+        })
+        .collect()
 }
 
 /// P_0(y), ..., P_n(y), the Legendre polynomials on [-1, 1], by Bonnet's
@@ -423,7 +493,21 @@ mod tests {
             extension: false,
             shear: false,
             incompressible: false,
+            varying: false,
         };
+        // Slices' Gram matrices sum to the whole's.
+        let coarse = RomFields {
+            slices: 3,
+            ..rom.clone()
+        };
+        let grams: Vec<_> = (0..3).map(|e| coarse.slice_gram(e)).collect();
+        for i in 0..=6 {
+            for j in 0..=6 {
+                let sum: f64 = grams.iter().map(|g| g[i][j]).sum();
+                let exact = f64::from(u8::from(i == j)) / (2 * i + 1) as f64;
+                assert!((sum - exact).abs() < 1e-14, "Gram {i} {j}: {sum}");
+            }
+        }
         // A slice's two halves turn by half their weights each: together the
         // two-point Gauss rule of the slice.
         let w: Vec<Vec<f64>> = (0..rom.slices)

@@ -3,6 +3,7 @@
 //! keys with them too (`method/`).
 
 use super::error::ModelError;
+use super::profile::Profile;
 use super::schema::Model;
 
 /// The model under check and its file, with the checks every concern uses.
@@ -60,6 +61,36 @@ impl Check<'_> {
             return Ok(());
         }
         self.err(path.into(), format!("must be zero or positive, got {v}"))
+    }
+
+    /// A value along a segment is positive everywhere (it is linear
+    /// between its points, so at each of them).
+    pub fn positive_along(&self, path: &str, v: &Profile) -> Result<(), ModelError> {
+        self.along(path, v, |x| x > 0.0, "positive")
+    }
+
+    pub fn non_negative_along(&self, path: &str, v: &Profile) -> Result<(), ModelError> {
+        self.along(path, v, |x| x >= 0.0, "zero or positive")
+    }
+
+    fn along(
+        &self,
+        path: &str,
+        v: &Profile,
+        ok: fn(f64) -> bool,
+        what: &str,
+    ) -> Result<(), ModelError> {
+        for x in v.knots() {
+            self.finite(path, x)?;
+            if !ok(x) {
+                let msg = match v.uniform() {
+                    Some(_) => format!("must be {what}, got {x}"),
+                    None => format!("must be {what} everywhere along the segment, got {x}"),
+                };
+                return self.err(path.into(), msg);
+            }
+        }
+        Ok(())
     }
 
     /// `name` is a declared input channel.

@@ -29,4 +29,11 @@ impl ModelError {
             message: message.into(),
         }
     }
+
+    /// The same error with `suffix` after its message (where along a
+    /// segment it holds).
+    pub fn with_suffix(mut self, suffix: &str) -> Self {
+        self.message.push_str(suffix);
+        self
+    }
 }

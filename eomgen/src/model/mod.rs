@@ -11,6 +11,7 @@ mod error;
 mod methods;
 mod overrides;
 mod params;
+mod profile;
 mod schema;
 pub mod sensor;
 mod signals;
@@ -25,6 +26,7 @@ pub use params::{
     SpringParam, Xyz, base_rotation, base_turn_axis, channel,
 };
 pub(crate) use params::{base_quaternion, chamber_value};
+pub use profile::Profile;
 pub use schema::{
     Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, SimulateDefaults, Start,
     Tendon, Tip, Torque, WrenchFrame,

@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 pub use super::methods::Method;
+use super::profile::Profile;
 
 /// A declared arm (one `models/<arm>.toml`).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -157,15 +158,17 @@ pub struct Segment {
     /// Mass of the whole segment (kg); or give `density` and `outer_radius`.
     #[serde(default)]
     pub mass: Option<f64>,
-    /// Density (kg/m^3) of a circular section.
+    /// Density (kg/m^3) of a circular section. This and the section and
+    /// material values below are constant or vary along the segment
+    /// (`Profile`).
     #[serde(default)]
-    pub density: Option<f64>,
+    pub density: Option<Profile>,
     /// Outer radius of the section (m).
     #[serde(default)]
-    pub outer_radius: Option<f64>,
+    pub outer_radius: Option<Profile>,
     /// Inner radius of a hollow section (m).
     #[serde(default)]
-    pub inner_radius: Option<f64>,
+    pub inner_radius: Option<Profile>,
     /// Rotational stiffness of each joint (N m / rad); rigid segments.
     #[serde(default)]
     pub joint_stiffness: Option<f64>,
@@ -174,10 +177,10 @@ pub struct Segment {
     pub joint_damping: Option<f64>,
     /// Young's modulus (Pa): bending stiffness E I from the section.
     #[serde(default)]
-    pub youngs_modulus: Option<f64>,
+    pub youngs_modulus: Option<Profile>,
     /// Bending stiffness E I (N m^2), instead of `youngs_modulus`.
     #[serde(default)]
-    pub bending_stiffness: Option<f64>,
+    pub bending_stiffness: Option<Profile>,
     /// Bending damping (N m^2 s): Rayleigh function eta kappa_dot^2 / 2 per
     /// unit length, i.e. (eta / l_e) theta_dot^2 / 2 per element.
     #[serde(default)]
@@ -216,13 +219,13 @@ pub struct Segment {
     /// Shear modulus G (Pa) for the torsional stiffness G J; default E / 3
     /// (incompressible).
     #[serde(default)]
-    pub shear_modulus: Option<f64>,
+    pub shear_modulus: Option<Profile>,
     /// Torsional stiffness G J (N m^2), instead of the shear modulus.
     #[serde(default)]
-    pub torsional_stiffness: Option<f64>,
+    pub torsional_stiffness: Option<Profile>,
     /// Axial stiffness E A (N), instead of `youngs_modulus` times the area.
     #[serde(default)]
-    pub axial_stiffness: Option<f64>,
+    pub axial_stiffness: Option<Profile>,
     /// Axial damping (N s): Rayleigh function (c / l_e) stretch_dot^2 / 2
     /// per element.
     #[serde(default)]
@@ -254,14 +257,82 @@ impl Segment {
         )
     }
 
+    /// This segment as a uniform one with the values it has at the
+    /// fraction `x` of its length: what an element centred there reads.
+    pub fn at(&self, x: f64) -> Segment {
+        let here = |p: &Option<Profile>| p.as_ref().map(|p| Profile::Uniform(p.at(x)));
+        Segment {
+            density: here(&self.density),
+            outer_radius: here(&self.outer_radius),
+            inner_radius: here(&self.inner_radius),
+            youngs_modulus: here(&self.youngs_modulus),
+            bending_stiffness: here(&self.bending_stiffness),
+            shear_modulus: here(&self.shear_modulus),
+            torsional_stiffness: here(&self.torsional_stiffness),
+            axial_stiffness: here(&self.axial_stiffness),
+            ..self.clone()
+        }
+    }
+
+    /// Whether any value varies along the segment.
+    pub fn tapered(&self) -> bool {
+        self.profiles()
+            .iter()
+            .any(|(_, p)| p.is_some_and(|p| p.uniform().is_none()))
+    }
+
+    /// The keys that may vary along the segment, with their profiles.
+    pub fn profiles(&self) -> [(&'static str, Option<&Profile>); 8] {
+        [
+            ("density", self.density.as_ref()),
+            ("outer_radius", self.outer_radius.as_ref()),
+            ("inner_radius", self.inner_radius.as_ref()),
+            ("youngs_modulus", self.youngs_modulus.as_ref()),
+            ("bending_stiffness", self.bending_stiffness.as_ref()),
+            ("shear_modulus", self.shear_modulus.as_ref()),
+            ("torsional_stiffness", self.torsional_stiffness.as_ref()),
+            ("axial_stiffness", self.axial_stiffness.as_ref()),
+        ]
+    }
+
+    /// The fractions where some value's profile bends (0, 1 and the
+    /// tables' points), sorted: between two of them every value is linear.
+    pub fn breaks(&self) -> Vec<f64> {
+        let mut all: Vec<f64> = (self.profiles().iter())
+            .flat_map(|(_, p)| p.map(Profile::breaks).unwrap_or_default())
+            .chain([0.0, 1.0])
+            .collect();
+        all.sort_by(f64::total_cmp);
+        all.dedup();
+        all
+    }
+
+    /// A value of this section (a uniform segment's, or a tapered one's
+    /// at its middle: elements read theirs through [`Segment::at`]).
+    fn value(p: &Option<Profile>) -> Option<f64> {
+        p.as_ref().map(|p| p.uniform().unwrap_or_else(|| p.at(0.5)))
+    }
+
+    pub fn outer(&self) -> Option<f64> {
+        Self::value(&self.outer_radius)
+    }
+
+    pub fn inner(&self) -> Option<f64> {
+        Self::value(&self.inner_radius)
+    }
+
+    pub fn modulus(&self) -> Option<f64> {
+        Self::value(&self.youngs_modulus)
+    }
+
     /// Second moment of area of the section (m^4) about its z axis, the
     /// axis a planar arm bends about, if it has a radius. A hole at angle
     /// a sits at y = d cos a; the holes leave the centroid on the axis
     /// (validated). 3D arms have isotropic patterns (validated), whose sum
     /// of cos^2 is n / 2: the same about every diameter.
     pub fn second_moment(&self) -> Option<f64> {
-        let ro = self.outer_radius?;
-        let ri = self.inner_radius.unwrap_or(0.0);
+        let ro = self.outer()?;
+        let ri = self.inner().unwrap_or(0.0);
         let pi = std::f64::consts::PI;
         let holes = self.chambers.as_ref().map_or(0.0, |c| {
             let a = pi * c.radius * c.radius;
@@ -280,15 +351,15 @@ impl Segment {
 
     /// Bending stiffness E I (N m^2), if declared.
     pub fn ei(&self) -> Option<f64> {
-        self.bending_stiffness
-            .or_else(|| Some(self.youngs_modulus? * self.second_moment()?))
+        Self::value(&self.bending_stiffness)
+            .or_else(|| Some(self.modulus()? * self.second_moment()?))
     }
 
     /// Area of the section (m^2), if it has a radius: the ring less the
     /// chamber holes.
     pub fn area(&self) -> Option<f64> {
-        let ro = self.outer_radius?;
-        let ri = self.inner_radius.unwrap_or(0.0);
+        let ro = self.outer()?;
+        let ri = self.inner().unwrap_or(0.0);
         let holes = self
             .chambers
             .as_ref()
@@ -296,39 +367,60 @@ impl Segment {
         Some(std::f64::consts::PI * (ro * ro - ri * ri - holes))
     }
 
+    /// The shear modulus G, defaulting to E / 3 (incompressible).
+    fn shear(&self) -> Option<f64> {
+        Self::value(&self.shear_modulus).or_else(|| Some(self.modulus()? / 3.0))
+    }
+
     /// Torsional stiffness G J (N m^2): J = 2 I for circular sections, G
     /// defaulting to E / 3.
     pub fn gj(&self) -> Option<f64> {
-        self.torsional_stiffness.or_else(|| {
-            let g = self
-                .shear_modulus
-                .or_else(|| Some(self.youngs_modulus? / 3.0))?;
-            Some(g * 2.0 * self.second_moment()?)
-        })
+        Self::value(&self.torsional_stiffness)
+            .or_else(|| Some(self.shear()? * 2.0 * self.second_moment()?))
     }
 
     /// Shear stiffness k G A (N), k the `shear_factor` (default 1).
     pub fn ga(&self) -> Option<f64> {
-        let g = self
-            .shear_modulus
-            .or_else(|| Some(self.youngs_modulus? / 3.0))?;
-        Some(self.shear_factor.unwrap_or(1.0) * g * self.area()?)
+        Some(self.shear_factor.unwrap_or(1.0) * self.shear()? * self.area()?)
     }
 
     /// Axial stiffness E A (N).
     pub fn ea(&self) -> Option<f64> {
-        self.axial_stiffness
-            .or_else(|| Some(self.youngs_modulus? * self.area()?))
+        Self::value(&self.axial_stiffness).or_else(|| Some(self.modulus()? * self.area()?))
     }
 
-    /// The whole segment's mass (kg): `mass`, or `density` times the
-    /// section's area and the length.
-    pub fn total_mass(&self) -> Option<f64> {
-        match (self.mass, self.density) {
-            (Some(m), _) => Some(m),
-            (None, Some(rho)) => Some(rho * self.area()? * self.length),
-            (None, None) => None,
+    /// Mass per unit length (kg/m) at the fraction `x`: `density` times
+    /// the section's area there, or a `mass` spread evenly.
+    pub fn mass_per_length(&self, x: f64) -> Option<f64> {
+        match self.mass {
+            Some(m) => Some(m / self.length),
+            None => {
+                let here = self.at(x);
+                Some(here.density_value()? * here.area()?)
+            }
         }
+    }
+
+    fn density_value(&self) -> Option<f64> {
+        Self::value(&self.density)
+    }
+
+    /// The whole segment's mass (kg): `mass`, or the integral of density
+    /// times the section's area along it (Simpson's rule between the
+    /// profiles' points: exact while the radius and density are linear
+    /// there, a cubic).
+    pub fn total_mass(&self) -> Option<f64> {
+        if let Some(m) = self.mass {
+            return Some(m);
+        }
+        let breaks = self.breaks();
+        let mut total = 0.0;
+        for w in breaks.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let f = |x: f64| self.mass_per_length(x);
+            total += (b - a) * self.length / 6.0 * (f(a)? + 4.0 * f(0.5 * (a + b))? + f(b)?);
+        }
+        Some(total)
     }
 
     /// rom: the polynomial degree.

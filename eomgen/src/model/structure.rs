@@ -37,6 +37,10 @@ pub struct SegmentShape {
     /// of degree `order` (0 otherwise).
     pub polynomial: bool,
     pub order: usize,
+    /// The section varies along the segment where that shapes the
+    /// equations (rom: its energies slice by slice); elsewhere each
+    /// element's values are parameters, and this is false.
+    pub varying: bool,
 }
 
 /// Everything that shapes the equations; numbers are left out.
@@ -160,6 +164,9 @@ impl Structure {
             }
             if g.polynomial {
                 s.push_str(&format!(" order {}", g.order));
+            }
+            if g.varying {
+                s.push_str(" varying");
             }
             s.push('\n');
         }

@@ -16,12 +16,13 @@
 //! or unshearable rod is the limit of that stiffness to infinity: its
 //! strain stays v* (`Rod::ea`, `Rod::ga` as `None`).
 
+use std::sync::Arc;
+
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
-/// A uniform straight rod.
-#[derive(Clone, Debug)]
-pub struct Rod {
-    pub length: f64,
+/// A rod's section at one point: stiffnesses and mass per length.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Section {
     /// Axial stiffness E A (N); `None`: inextensible.
     pub ea: Option<f64>,
     /// Shear stiffness k G A (N); `None`: unshearable.
@@ -31,6 +32,34 @@ pub struct Rod {
     pub gj: f64,
     /// Mass per length (kg/m), for gravity.
     pub rho_a: f64,
+}
+
+/// A straight rod whose section may vary along it (a taper).
+#[derive(Clone)]
+pub struct Rod {
+    pub length: f64,
+    /// The section at arc length s in [0, length].
+    pub section: Arc<dyn Fn(f64) -> Section + Send + Sync>,
+}
+
+impl std::fmt::Debug for Rod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Rod")
+            .field("length", &self.length)
+            .field("base", &(self.section)(0.0))
+            .field("tip", &(self.section)(self.length))
+            .finish()
+    }
+}
+
+impl Rod {
+    /// A uniform rod.
+    pub fn uniform(length: f64, section: Section) -> Self {
+        Self {
+            length,
+            section: Arc::new(move |_| section),
+        }
+    }
 }
 
 /// Loads on a rod (world frame).
@@ -92,6 +121,22 @@ pub enum RodError {
     Invalid(String),
 }
 
+/// The distributed loads at one load factor: f(s) = gravity rho_a(s) +
+/// distributed.
+struct Loading {
+    gravity: Vector3<f64>,
+    distributed: Vector3<f64>,
+}
+
+impl Loading {
+    fn scaled(&self, c: f64) -> Loading {
+        Loading {
+            gravity: self.gravity * c,
+            distributed: self.distributed * c,
+        }
+    }
+}
+
 /// The integrated state along the rod.
 #[derive(Clone, Copy)]
 struct State {
@@ -106,19 +151,21 @@ fn hat(u: &Vector3<f64>) -> Matrix3<f64> {
 }
 
 impl Rod {
-    fn derivative(&self, x: &State, f: &Vector3<f64>) -> State {
+    fn derivative(&self, x: &State, s: f64, loads: &Loading) -> State {
+        let sec = (self.section)(s);
+        let f = loads.gravity * sec.rho_a + loads.distributed;
         let e3 = Vector3::z();
         let rt = x.r.transpose();
-        let v = if self.ea.is_none() && self.ga.is_none() {
+        let v = if sec.ea.is_none() && sec.ga.is_none() {
             e3
         } else {
             let local = rt * x.n;
             let compliance = |k: Option<f64>| k.map_or(0.0, |k| 1.0 / k);
-            let (shear, axial) = (compliance(self.ga), compliance(self.ea));
+            let (shear, axial) = (compliance(sec.ga), compliance(sec.ea));
             e3 + Vector3::new(local.x * shear, local.y * shear, local.z * axial)
         };
         let lm = rt * x.m;
-        let u = Vector3::new(lm.x / self.ei[0], lm.y / self.ei[1], lm.z / self.gj);
+        let u = Vector3::new(lm.x / sec.ei[0], lm.y / sec.ei[1], lm.z / sec.gj);
         let dp = x.r * v;
         State {
             p: dp,
@@ -133,7 +180,7 @@ impl Rod {
     fn shoot(
         &self,
         base: &(Vector3<f64>, Matrix3<f64>),
-        f: &Vector3<f64>,
+        f: &Loading,
         n0: Vector3<f64>,
         m0: Vector3<f64>,
         steps: usize,
@@ -153,11 +200,12 @@ impl Rod {
         };
         let mut out = Vec::with_capacity(steps + 1);
         out.push(x);
-        for _ in 0..steps {
-            let k1 = self.derivative(&x, f);
-            let k2 = self.derivative(&axpy(&x, &k1, h / 2.0), f);
-            let k3 = self.derivative(&axpy(&x, &k2, h / 2.0), f);
-            let k4 = self.derivative(&axpy(&x, &k3, h), f);
+        for k in 0..steps {
+            let s = k as f64 * h;
+            let k1 = self.derivative(&x, s, f);
+            let k2 = self.derivative(&axpy(&x, &k1, h / 2.0), s + h / 2.0, f);
+            let k3 = self.derivative(&axpy(&x, &k2, h / 2.0), s + h / 2.0, f);
+            let k4 = self.derivative(&axpy(&x, &k3, h), s + h, f);
             x = State {
                 p: x.p + (k1.p + k2.p * 2.0 + k3.p * 2.0 + k4.p) * (h / 6.0),
                 r: x.r + (k1.r + k2.r * 2.0 + k3.r * 2.0 + k4.r) * (h / 6.0),
@@ -184,11 +232,22 @@ pub fn solve_rod(
     loads: &RodLoads,
     opts: &RodOptions,
 ) -> Result<RodSolution, RodError> {
+    if opts.steps == 0 {
+        return Err(RodError::Invalid("steps must be at least 1".into()));
+    }
+    // The section where the integration reads it: the grid and its
+    // midpoints.
+    let h = rod.length / opts.steps as f64;
+    let sections: Vec<Section> = (0..=2 * opts.steps)
+        .map(|k| (rod.section)(k as f64 * h / 2.0))
+        .collect();
     let positive = |v: f64| v.is_finite() && v > 0.0;
     let stiff = positive(rod.length)
-        && rod.ei.iter().all(|&k| positive(k))
-        && positive(rod.gj)
-        && [rod.ea, rod.ga].iter().flatten().all(|&k| positive(k));
+        && sections.iter().all(|sec| {
+            sec.ei.iter().all(|&k| positive(k))
+                && positive(sec.gj)
+                && [sec.ea, sec.ga].iter().flatten().all(|&k| positive(k))
+        });
     if !stiff {
         return Err(RodError::Invalid(
             "length and stiffnesses must be finite and positive".into(),
@@ -203,8 +262,7 @@ pub fn solve_rod(
     ]
     .iter()
     .all(|v| v.iter().all(|x| x.is_finite()));
-    let valid = rod.rho_a.is_finite()
-        && rod.rho_a >= 0.0
+    let valid = (sections.iter()).all(|sec| sec.rho_a.is_finite() && sec.rho_a >= 0.0)
         && vectors_finite
         && frame.iter().all(|x| x.is_finite());
     if !valid {
@@ -212,15 +270,17 @@ pub fn solve_rod(
             "mass per length must be zero or positive, positions, frames and loads finite".into(),
         ));
     }
-    if opts.steps == 0 {
-        return Err(RodError::Invalid("steps must be at least 1".into()));
-    }
     let base = (Vector3::from(position), frame);
     let v3 = Vector3::from;
-    let f_full = v3(loads.gravity) * rod.rho_a + v3(loads.distributed_force);
+    let full = Loading {
+        gravity: v3(loads.gravity),
+        distributed: v3(loads.distributed_force),
+    };
     let (tip_f, tip_m) = (v3(loads.tip_force), v3(loads.tip_moment));
     // Scale of the residual: the largest force and moment the loads imply.
-    let force_scale = (f_full.norm() * rod.length + tip_f.norm()).max(1e-12);
+    let heaviest = sections.iter().map(|sec| sec.rho_a).fold(0.0, f64::max);
+    let f_max = full.gravity * heaviest + full.distributed;
+    let force_scale = (f_max.norm() * rod.length + tip_f.norm()).max(1e-12);
     let moment_scale = (tip_m.norm() + force_scale * rod.length).max(1e-12);
     let mut guess = Vector6::<f64>::zeros();
     let (mut fraction, mut step) = (0.0f64, 1.0f64);
@@ -231,7 +291,7 @@ pub fn solve_rod(
             return Err(RodError::NoConvergence { fraction });
         }
         let target = (fraction + step).min(1.0);
-        let f = f_full * target;
+        let f = full.scaled(target);
         let (ft, mt) = (tip_f * target, tip_m * target);
         let residual = |w: &Vector6<f64>| -> Vector6<f64> {
             let xs = rod.shoot(
@@ -289,7 +349,7 @@ pub fn solve_rod(
     }
     let xs = rod.shoot(
         &base,
-        &f_full,
+        &full,
         guess.fixed_rows::<3>(0).into(),
         guess.fixed_rows::<3>(3).into(),
         opts.steps,
@@ -317,12 +377,15 @@ mod tests {
 
     /// The bench rod of models/cantilever3d.toml: L 0.3 m, r 0.01 m, E 1 MPa, G = E/3.
     fn rod(inextensible: bool) -> Rod {
+        Rod::uniform(0.3, section(inextensible))
+    }
+
+    fn section(inextensible: bool) -> Section {
         let soft = |k: f64| (!inextensible).then_some(k);
         let (e, r) = (1e6, 0.01);
         let area = std::f64::consts::PI * r * r;
         let i = std::f64::consts::PI * r.powi(4) / 4.0;
-        Rod {
-            length: 0.3,
+        Section {
             ea: soft(e * area),
             ga: soft(e / 3.0 * area),
             ei: [e * i, e * i],
@@ -345,7 +408,7 @@ mod tests {
     fn small_lateral_tip_load_gives_the_beam_deflection() {
         let rod = rod(false);
         let l = rod.length;
-        let f = 0.005 * 3.0 * rod.ei[0] / l.powi(3) * l; // 0.5 % of L
+        let f = 0.005 * 3.0 * section(false).ei[0] / l.powi(3) * l; // 0.5 % of L
         let load = lateral() * f;
         let sol = solve_rod(
             &rod,
@@ -359,7 +422,7 @@ mod tests {
         )
         .unwrap();
         let tip = Vector3::from(sol.tip_position);
-        let beam = f * l.powi(3) / (3.0 * rod.ei[0]);
+        let beam = f * l.powi(3) / (3.0 * section(false).ei[0]);
         let along = tip.dot(&lateral());
         assert!((along - beam).abs() < 0.01 * beam, "{along} vs {beam}");
         // The base holds the load.
@@ -371,8 +434,14 @@ mod tests {
 
     #[test]
     fn invalid_rods_and_loads_are_errors_not_nans() {
-        let mut bad = rod(false);
-        bad.ei[1] = 0.0;
+        // Stiff at the base, not at the tip.
+        let bad = Rod {
+            section: Arc::new(|s| Section {
+                ei: [1.0, if s > 0.2 { 0.0 } else { 1.0 }],
+                ..section(false)
+            }),
+            ..rod(false)
+        };
         let none = RodLoads::default();
         let opts = RodOptions::default();
         assert!(solve_rod(&bad, [0.0; 3], along_x(), &none, &opts).is_err());
@@ -389,7 +458,7 @@ mod tests {
         // inextensible cantilever at 0.4450 L along and 0.8106 L across.
         let rod = rod(true);
         let l = rod.length;
-        let p = 10.0 * rod.ei[0] / (l * l);
+        let p = 10.0 * section(false).ei[0] / (l * l);
         let sol = solve_rod(
             &rod,
             [0.0; 3],
@@ -411,7 +480,7 @@ mod tests {
         // w L^4 / (8 E I) for a light load: scale gravity to 1 % of L.
         let rod = rod(false);
         let l = rod.length;
-        let g = 0.01 * l * 8.0 * rod.ei[0] / (rod.rho_a * l.powi(4));
+        let g = 0.01 * l * 8.0 * section(false).ei[0] / (section(false).rho_a * l.powi(4));
         let sol = solve_rod(
             &rod,
             [0.0; 3],
@@ -423,7 +492,7 @@ mod tests {
             &RodOptions::default(),
         )
         .unwrap();
-        let beam = rod.rho_a * g * l.powi(4) / (8.0 * rod.ei[0]);
+        let beam = section(false).rho_a * g * l.powi(4) / (8.0 * section(false).ei[0]);
         let dy = -sol.tip_position[1];
         assert!((dy - beam).abs() < 0.01 * beam, "{dy} vs {beam}");
     }
