@@ -950,8 +950,63 @@ fn malformed_3d_models_are_rejected_clearly() {
 /// The cases of `malformed_actuators_inputs_and_measurements_are_rejected_clearly`.
 fn actuator_input_and_measurement_cases() -> Vec<FileCase> {
     let mut all = chamber_and_input_cases();
+    all.extend(taper_cases());
     all.extend(tendon_torque_and_measurement_cases());
     all
+}
+
+/// Tapered sections: values through zero, malformed tapers, holes or an
+/// inner radius that leave the section where it thins.
+fn taper_cases() -> Vec<FileCase> {
+    let chambers = "[segment.chambers]\nangles = [0, 120, 240]\nradius = 0.002\ndistance = 0.006\ninputs = [\"p\", \"p\", \"p\"]\n";
+    let channel = "[inputs.p]\nkind = \"constant\"\nvalue = 1.0\n";
+    let base = format!("{GOOD3}{chambers}{channel}");
+    let r = |a: &str, b: &str| base.replacen(a, b, 1);
+    vec![
+        (
+            "taper through zero",
+            r("outer_radius = 0.01", "outer_radius = [0.01, -0.002]"),
+            vec![
+                "segment[0].outer_radius",
+                "must be positive everywhere along the segment, got -0.002",
+            ],
+        ),
+        (
+            "taper of three numbers",
+            r("outer_radius = 0.01", "outer_radius = [0.01, 0.008, 0.006]"),
+            vec!["segment[0].outer_radius", "[start, end], two numbers"],
+        ),
+        (
+            "taper table not rising",
+            r(
+                "outer_radius = 0.01",
+                "outer_radius = { s = [0.0, 0.6, 0.5, 1.0], value = [0.01, 0.009, 0.008, 0.007] }",
+            ),
+            vec!["segment[0].outer_radius", "rising from 0 to 1"],
+        ),
+        (
+            "holes outside a tapered section",
+            r("outer_radius = 0.01", "outer_radius = [0.01, 0.007]"),
+            vec![
+                "segment[0].chambers",
+                "must lie in the wall",
+                "outer radius 0.007",
+                "at s/L = 1",
+            ],
+        ),
+        (
+            "tapered inner radius reaching the outer",
+            r(
+                "outer_radius = 0.01",
+                "outer_radius = [0.01, 0.006]\ninner_radius = [0.001, 0.007]",
+            ),
+            vec![
+                "segment[0].inner_radius",
+                "smaller than outer_radius",
+                "at s/L = 1",
+            ],
+        ),
+    ]
 }
 
 fn chamber_and_input_cases() -> Vec<FileCase> {
@@ -1014,49 +1069,6 @@ fn chamber_and_input_cases() -> Vec<FileCase> {
                 "segment[0].chambers.inputs[1]",
                 "no input channel \"q\"",
                 "declared: p",
-            ],
-        ),
-        (
-            "taper through zero",
-            r("outer_radius = 0.01", "outer_radius = [0.01, -0.002]"),
-            vec![
-                "segment[0].outer_radius",
-                "must be positive everywhere along the segment, got -0.002",
-            ],
-        ),
-        (
-            "taper of three numbers",
-            r("outer_radius = 0.01", "outer_radius = [0.01, 0.008, 0.006]"),
-            vec!["segment[0].outer_radius", "[start, end], two numbers"],
-        ),
-        (
-            "taper table not rising",
-            r(
-                "outer_radius = 0.01",
-                "outer_radius = { s = [0.0, 0.6, 0.5, 1.0], value = [0.01, 0.009, 0.008, 0.007] }",
-            ),
-            vec!["segment[0].outer_radius", "rising from 0 to 1"],
-        ),
-        (
-            "holes outside a tapered section",
-            r("outer_radius = 0.01", "outer_radius = [0.01, 0.007]"),
-            vec![
-                "segment[0].chambers",
-                "must lie in the wall",
-                "outer radius 0.007",
-                "at s/L = 1",
-            ],
-        ),
-        (
-            "tapered inner radius reaching the outer",
-            r(
-                "outer_radius = 0.01",
-                "outer_radius = [0.01, 0.006]\ninner_radius = [0.001, 0.007]",
-            ),
-            vec![
-                "segment[0].inner_radius",
-                "smaller than outer_radius",
-                "at s/L = 1",
             ],
         ),
         (
