@@ -2363,7 +2363,7 @@ fn contact_jvp_0(
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
     serde_json::from_str(
-            r#"{"links":[{"cell":0,"map":[{"terms":[[0,1.0]]}],"params":[10,11,12,10,13,14,15,10,10,10,10,10]},{"cell":0,"map":[{"terms":[[1,1.0]]}],"params":[16,17,18,16,19,20,21,16,16,16,16,16]},{"cell":0,"map":[{"terms":[[2,1.0]]}],"params":[22,23,24,22,25,26,27,22,22,22,22,22]},{"cell":0,"map":[{"terms":[[3,1.0]]}],"params":[28,29,30,28,31,32,33,28,28,28,28,28]},{"cell":0,"map":[{"terms":[[4,1.0]]}],"params":[34,35,36,34,37,38,39,34,34,34,34,34]},{"cell":0,"map":[{"terms":[[5,1.0]]}],"params":[40,41,42,40,43,44,45,40,40,40,40,40]},{"cell":0,"map":[{"terms":[[6,1.0]]}],"params":[46,47,48,46,49,50,51,46,46,46,46,46]},{"cell":0,"map":[{"terms":[[7,1.0]]}],"params":[52,53,54,52,55,56,57,52,52,52,52,52]},{"cell":0,"map":[{"terms":[[8,1.0]]}],"params":[58,59,60,58,61,62,63,58,58,58,58,58]},{"cell":0,"map":[{"terms":[[9,1.0]]}],"params":[64,65,66,64,67,68,69,64,64,64,64,64]}],"dof":10,"forces":false,"loads":0,"gravity":[0,1,2],"base_position":[3,4,5],"base_rotation":[0,0,0,0,0,0,0,0,0],"base_angle":6,"variable_inertia":true,"base_quaternion":[0,0,0,0],"tip_force":[7,8,9],"tip_moment":null,"tip_frame":false,"tip_mass":null,"tip_length":null,"tip_inertia":null}"#,
+            r#"{"links":[{"cell":0,"map":[{"terms":[[0,1.0]]}],"params":[10,11,12,10,13,14,15,10,10,10,10,10,10,10,10]},{"cell":0,"map":[{"terms":[[1,1.0]]}],"params":[16,17,18,16,19,20,21,16,16,16,16,16,16,16,16]},{"cell":0,"map":[{"terms":[[2,1.0]]}],"params":[22,23,24,22,25,26,27,22,22,22,22,22,22,22,22]},{"cell":0,"map":[{"terms":[[3,1.0]]}],"params":[28,29,30,28,31,32,33,28,28,28,28,28,28,28,28]},{"cell":0,"map":[{"terms":[[4,1.0]]}],"params":[34,35,36,34,37,38,39,34,34,34,34,34,34,34,34]},{"cell":0,"map":[{"terms":[[5,1.0]]}],"params":[40,41,42,40,43,44,45,40,40,40,40,40,40,40,40]},{"cell":0,"map":[{"terms":[[6,1.0]]}],"params":[46,47,48,46,49,50,51,46,46,46,46,46,46,46,46]},{"cell":0,"map":[{"terms":[[7,1.0]]}],"params":[52,53,54,52,55,56,57,52,52,52,52,52,52,52,52]},{"cell":0,"map":[{"terms":[[8,1.0]]}],"params":[58,59,60,58,61,62,63,58,58,58,58,58,58,58,58]},{"cell":0,"map":[{"terms":[[9,1.0]]}],"params":[64,65,66,64,67,68,69,64,64,64,64,64,64,64,64]}],"dof":10,"forces":false,"loads":0,"gravity":[0,1,2],"base_position":[3,4,5],"base_rotation":[0,0,0,0,0,0,0,0,0],"base_angle":6,"variable_inertia":true,"base_quaternion":[0,0,0,0],"tip_force":[7,8,9],"tip_moment":null,"tip_frame":false,"tip_mass":null,"tip_length":null,"tip_inertia":null}"#,
         )
         .expect("the generated link layout parses")
 });
@@ -2515,7 +2515,7 @@ pub fn cell_0_pose(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 38],
 ) {
     runtime::interpreted!(
@@ -2534,7 +2534,7 @@ pub fn cell_0(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 59],
 ) {
     runtime::cpu::require_fma();
@@ -2547,7 +2547,7 @@ pub fn cell_0_tangent(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 118],
 ) {
     runtime::cpu::require_fma();
@@ -2565,7 +2565,7 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     qd: &[S; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [S; 59],
 ) {
     let v2 = q[0] * 0.5f64;

@@ -375,7 +375,7 @@ fn contact_jvp_0(
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
     serde_json::from_str(
-            r#"{"links":[{"cell":0,"map":[{"terms":[[0,1.0]]}],"params":[7,8,9,7,10,11,12,7,7,7,7,7]},{"cell":0,"map":[{"terms":[[1,1.0]]}],"params":[13,14,15,13,16,17,18,13,13,13,13,13]}],"dof":2,"forces":false,"loads":0,"gravity":[0,1,2],"base_position":[3,4,5],"base_rotation":[0,0,0,0,0,0,0,0,0],"base_angle":6,"variable_inertia":true,"base_quaternion":[0,0,0,0],"tip_force":null,"tip_moment":null,"tip_frame":false,"tip_mass":null,"tip_length":null,"tip_inertia":null}"#,
+            r#"{"links":[{"cell":0,"map":[{"terms":[[0,1.0]]}],"params":[7,8,9,7,10,11,12,7,7,7,7,7,7,7,7]},{"cell":0,"map":[{"terms":[[1,1.0]]}],"params":[13,14,15,13,16,17,18,13,13,13,13,13,13,13,13]}],"dof":2,"forces":false,"loads":0,"gravity":[0,1,2],"base_position":[3,4,5],"base_rotation":[0,0,0,0,0,0,0,0,0],"base_angle":6,"variable_inertia":true,"base_quaternion":[0,0,0,0],"tip_force":null,"tip_moment":null,"tip_frame":false,"tip_mass":null,"tip_length":null,"tip_inertia":null}"#,
         )
         .expect("the generated link layout parses")
 });
@@ -527,7 +527,7 @@ pub fn cell_0_pose(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 38],
 ) {
     runtime::interpreted!(
@@ -545,7 +545,7 @@ pub fn cell_0(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 59],
 ) {
     runtime::cpu::require_fma();
@@ -558,7 +558,7 @@ pub fn cell_0_tangent(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 118],
 ) {
     runtime::cpu::require_fma();
@@ -576,7 +576,7 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     qd: &[S; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [S; 59],
 ) {
     let (v2, v1): (S, S) = q[0].sin_cos();

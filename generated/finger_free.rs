@@ -2334,7 +2334,7 @@ fn contact_jvp_0(
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
     serde_json::from_str(
-            r#"{"links":[{"cell":0,"map":[{"terms":[[0,1.0]]}],"params":[7,8,9,7,10,11,12,7,7,7,7,7],"load":0},{"cell":0,"map":[{"terms":[[1,1.0]]}],"params":[13,14,15,13,16,17,18,13,13,13,13,13],"load":0},{"cell":0,"map":[{"terms":[[2,1.0]]}],"params":[19,20,21,19,22,23,24,19,19,19,19,19],"load":0},{"cell":0,"map":[{"terms":[[3,1.0]]}],"params":[25,26,27,25,28,29,30,25,25,25,25,25],"load":0},{"cell":0,"map":[{"terms":[[4,1.0]]}],"params":[31,32,33,31,34,35,36,31,31,31,31,31],"load":0},{"cell":0,"map":[{"terms":[[5,1.0]]}],"params":[37,38,39,37,40,41,42,37,37,37,37,37],"load":0},{"cell":0,"map":[{"terms":[[6,1.0]]}],"params":[43,44,45,43,46,47,48,43,43,43,43,43],"load":0},{"cell":0,"map":[{"terms":[[7,1.0]]}],"params":[49,50,51,49,52,53,54,49,49,49,49,49],"load":0},{"cell":0,"map":[{"terms":[[8,1.0]]}],"params":[55,56,57,55,58,59,60,55,55,55,55,55],"load":0},{"cell":0,"map":[{"terms":[[9,1.0]]}],"params":[61,62,63,61,64,65,66,61,61,61,61,61],"load":0}],"dof":10,"forces":false,"loads":1,"gravity":[0,1,2],"base_position":[3,4,5],"base_rotation":[0,0,0,0,0,0,0,0,0],"base_angle":6,"variable_inertia":true,"base_quaternion":[0,0,0,0],"tip_force":null,"tip_moment":null,"tip_frame":false,"tip_mass":null,"tip_length":null,"tip_inertia":null}"#,
+            r#"{"links":[{"cell":0,"map":[{"terms":[[0,1.0]]}],"params":[7,8,9,7,10,11,12,7,7,7,7,7,7,7,7],"load":0},{"cell":0,"map":[{"terms":[[1,1.0]]}],"params":[13,14,15,13,16,17,18,13,13,13,13,13,13,13,13],"load":0},{"cell":0,"map":[{"terms":[[2,1.0]]}],"params":[19,20,21,19,22,23,24,19,19,19,19,19,19,19,19],"load":0},{"cell":0,"map":[{"terms":[[3,1.0]]}],"params":[25,26,27,25,28,29,30,25,25,25,25,25,25,25,25],"load":0},{"cell":0,"map":[{"terms":[[4,1.0]]}],"params":[31,32,33,31,34,35,36,31,31,31,31,31,31,31,31],"load":0},{"cell":0,"map":[{"terms":[[5,1.0]]}],"params":[37,38,39,37,40,41,42,37,37,37,37,37,37,37,37],"load":0},{"cell":0,"map":[{"terms":[[6,1.0]]}],"params":[43,44,45,43,46,47,48,43,43,43,43,43,43,43,43],"load":0},{"cell":0,"map":[{"terms":[[7,1.0]]}],"params":[49,50,51,49,52,53,54,49,49,49,49,49,49,49,49],"load":0},{"cell":0,"map":[{"terms":[[8,1.0]]}],"params":[55,56,57,55,58,59,60,55,55,55,55,55,55,55,55],"load":0},{"cell":0,"map":[{"terms":[[9,1.0]]}],"params":[61,62,63,61,64,65,66,61,61,61,61,61,61,61,61],"load":0}],"dof":10,"forces":false,"loads":1,"gravity":[0,1,2],"base_position":[3,4,5],"base_rotation":[0,0,0,0,0,0,0,0,0],"base_angle":6,"variable_inertia":true,"base_quaternion":[0,0,0,0],"tip_force":null,"tip_moment":null,"tip_frame":false,"tip_mass":null,"tip_length":null,"tip_inertia":null}"#,
         )
         .expect("the generated link layout parses")
 });
@@ -2494,7 +2494,7 @@ pub fn cell_0_pose(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 38],
 ) {
     runtime::interpreted!(
@@ -2513,7 +2513,7 @@ pub fn cell_0(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 59],
 ) {
     runtime::cpu::require_fma();
@@ -2526,7 +2526,7 @@ pub fn cell_0_tangent(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 118],
 ) {
     runtime::cpu::require_fma();
@@ -2544,7 +2544,7 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     qd: &[S; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [S; 59],
 ) {
     let v2 = q[0] * 0.5f64;

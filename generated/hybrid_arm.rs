@@ -1497,7 +1497,7 @@ fn contact_jvp_0(
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
     serde_json::from_str(
-            r#"{"links":[{"cell":0,"map":[{"terms":[[0,1.0]]}],"params":[8,9,10,8,11,12,13,8,8,8,8,8]},{"cell":1,"map":[{"terms":[[1,1.0]]}],"params":[14,15,16,14,17,18,19,14,14,14,14,14]},{"cell":1,"map":[{"terms":[[2,1.0]]}],"params":[20,21,22,20,23,24,25,20,20,20,20,20]},{"cell":1,"map":[{"terms":[[3,1.0]]}],"params":[26,27,28,26,29,30,31,26,26,26,26,26]},{"cell":1,"map":[{"terms":[[4,1.0]]}],"params":[32,33,34,32,35,36,37,32,32,32,32,32]},{"cell":1,"map":[{"terms":[[5,1.0]]}],"params":[38,39,40,38,41,42,43,38,38,38,38,38]},{"cell":1,"map":[{"terms":[[6,1.0]]}],"params":[44,45,46,44,47,48,49,44,44,44,44,44]}],"dof":7,"forces":false,"loads":0,"gravity":[0,1,2],"base_position":[3,4,5],"base_rotation":[0,0,0,0,0,0,0,0,0],"base_angle":6,"variable_inertia":true,"base_quaternion":[0,0,0,0],"tip_force":null,"tip_moment":null,"tip_frame":false,"tip_mass":7,"tip_length":null,"tip_inertia":null}"#,
+            r#"{"links":[{"cell":0,"map":[{"terms":[[0,1.0]]}],"params":[8,9,10,8,11,12,13,8,8,8,8,8,8,8,8]},{"cell":1,"map":[{"terms":[[1,1.0]]}],"params":[14,15,16,14,17,18,19,14,14,14,14,14,14,14,14]},{"cell":1,"map":[{"terms":[[2,1.0]]}],"params":[20,21,22,20,23,24,25,20,20,20,20,20,20,20,20]},{"cell":1,"map":[{"terms":[[3,1.0]]}],"params":[26,27,28,26,29,30,31,26,26,26,26,26,26,26,26]},{"cell":1,"map":[{"terms":[[4,1.0]]}],"params":[32,33,34,32,35,36,37,32,32,32,32,32,32,32,32]},{"cell":1,"map":[{"terms":[[5,1.0]]}],"params":[38,39,40,38,41,42,43,38,38,38,38,38,38,38,38]},{"cell":1,"map":[{"terms":[[6,1.0]]}],"params":[44,45,46,44,47,48,49,44,44,44,44,44,44,44,44]}],"dof":7,"forces":false,"loads":0,"gravity":[0,1,2],"base_position":[3,4,5],"base_rotation":[0,0,0,0,0,0,0,0,0],"base_angle":6,"variable_inertia":true,"base_quaternion":[0,0,0,0],"tip_force":null,"tip_moment":null,"tip_frame":false,"tip_mass":7,"tip_length":null,"tip_inertia":null}"#,
         )
         .expect("the generated link layout parses")
 });
@@ -1689,7 +1689,7 @@ pub fn cell_0_pose(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 38],
 ) {
     runtime::interpreted!(
@@ -1707,7 +1707,7 @@ pub fn cell_0(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 59],
 ) {
     runtime::cpu::require_fma();
@@ -1720,7 +1720,7 @@ pub fn cell_0_tangent(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 118],
 ) {
     runtime::cpu::require_fma();
@@ -1738,7 +1738,7 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     qd: &[S; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [S; 59],
 ) {
     let (v2, v1): (S, S) = q[0].sin_cos();
@@ -1832,7 +1832,7 @@ pub fn cell_1_pose(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 38],
 ) {
     runtime::interpreted!(
@@ -1851,7 +1851,7 @@ pub fn cell_1(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 59],
 ) {
     runtime::cpu::require_fma();
@@ -1864,7 +1864,7 @@ pub fn cell_1_tangent(
     qd: &[f64; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 118],
 ) {
     runtime::cpu::require_fma();
@@ -1882,7 +1882,7 @@ fn cell_1_0<S: runtime::scalar::Scalar>(
     qd: &[S; 1],
     qdd: &[f64; 1],
     dir: &[f64; 2],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [S; 59],
 ) {
     let v2 = q[0] * 0.5f64;

@@ -245,7 +245,7 @@ fn contact_jvp_0(
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
     serde_json::from_str(
-            r#"{"links":[{"cell":0,"map":[{"terms":[[0,1.0]]},{"terms":[[1,1.0]]},{"terms":[[2,1.0]]},{"terms":[[3,1.0]]}],"params":[29,30,31,35,32,33,34,36,37,38,39,40],"load":0},{"cell":0,"map":[{"terms":[[0,1.0]]},{"terms":[[1,1.0]]},{"terms":[[2,1.0]]},{"terms":[[3,1.0]]}],"params":[29,30,31,35,32,33,34,36,37,38,39,40],"load":0},{"cell":0,"map":[{"terms":[[4,1.0]]},{"terms":[[5,1.0]]},{"terms":[[6,1.0]]},{"terms":[[7,1.0]]}],"params":[41,42,43,47,44,45,46,48,49,50,51,52],"load":0},{"cell":0,"map":[{"terms":[[4,1.0]]},{"terms":[[5,1.0]]},{"terms":[[6,1.0]]},{"terms":[[7,1.0]]}],"params":[41,42,43,47,44,45,46,48,49,50,51,52],"load":0}],"dof":8,"forces":false,"loads":1,"gravity":[0,1,2],"base_position":[3,4,5],"base_rotation":[6,7,8,9,10,11,12,13,14],"variable_inertia":false,"base_quaternion":[15,16,17,18],"tip_force":[20,21,22],"tip_moment":[23,24,25],"tip_frame":true,"tip_mass":19,"tip_length":26,"tip_inertia":[27,28]}"#,
+            r#"{"links":[{"cell":0,"map":[{"terms":[[0,1.0]]},{"terms":[[1,1.0]]},{"terms":[[2,1.0]]},{"terms":[[3,1.0]]}],"params":[29,30,31,35,32,33,34,36,37,38,39,40,29,29,29],"load":0},{"cell":0,"map":[{"terms":[[0,1.0]]},{"terms":[[1,1.0]]},{"terms":[[2,1.0]]},{"terms":[[3,1.0]]}],"params":[29,30,31,35,32,33,34,36,37,38,39,40,29,29,29],"load":0},{"cell":0,"map":[{"terms":[[4,1.0]]},{"terms":[[5,1.0]]},{"terms":[[6,1.0]]},{"terms":[[7,1.0]]}],"params":[41,42,43,47,44,45,46,48,49,50,51,52,41,41,41],"load":0},{"cell":0,"map":[{"terms":[[4,1.0]]},{"terms":[[5,1.0]]},{"terms":[[6,1.0]]},{"terms":[[7,1.0]]}],"params":[41,42,43,47,44,45,46,48,49,50,51,52,41,41,41],"load":0}],"dof":8,"forces":false,"loads":1,"gravity":[0,1,2],"base_position":[3,4,5],"base_rotation":[6,7,8,9,10,11,12,13,14],"variable_inertia":false,"base_quaternion":[15,16,17,18],"tip_force":[20,21,22],"tip_moment":[23,24,25],"tip_frame":true,"tip_mass":19,"tip_length":26,"tip_inertia":[27,28]}"#,
         )
         .expect("the generated link layout parses")
 });
@@ -452,7 +452,7 @@ pub fn cell_0_pose(
     qd: &[f64; 4],
     qdd: &[f64; 4],
     dir: &[f64; 8],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 38],
 ) {
     runtime::interpreted!(
@@ -480,7 +480,7 @@ pub fn cell_0(
     qd: &[f64; 4],
     qdd: &[f64; 4],
     dir: &[f64; 8],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 101],
 ) {
     runtime::cpu::require_fma();
@@ -493,7 +493,7 @@ pub fn cell_0_tangent(
     qd: &[f64; 4],
     qdd: &[f64; 4],
     dir: &[f64; 8],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 202],
 ) {
     runtime::cpu::require_fma();
@@ -509,7 +509,7 @@ pub fn cell_0_tangent(
 fn cell_0_x4(
     q: &[[f64; 4]; 4],
     qd: &[[f64; 4]; 4],
-    p: &[[f64; 4]; 15],
+    p: &[[f64; 4]; 18],
     out: &mut [[f64; 4]; 101],
 ) {
     use runtime::x4::X4;
@@ -524,7 +524,7 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     qd: &[S; 4],
     qdd: &[f64; 4],
     dir: &[f64; 8],
-    p: &[S::Param; 15],
+    p: &[S::Param; 18],
     out: &mut [S::Store; 101],
 ) {
     #[allow(unused_imports)]

@@ -2147,7 +2147,7 @@ fn contact_jvp_0(
 static LINKS: std::sync::LazyLock<runtime::links::LinkLayout> = std::sync::LazyLock::new(||
 {
     serde_json::from_str(
-            r#"{"links":[{"cell":0,"map":[{"terms":[[0,1.0]]},{"terms":[[1,1.0]]},{"terms":[[2,1.0]]}],"params":[20,21,22,26,23,24,25,27,28,29,30,31]},{"cell":0,"map":[{"terms":[[3,1.0]]},{"terms":[[4,1.0]]},{"terms":[[5,1.0]]}],"params":[32,33,34,38,35,36,37,39,40,41,42,43]}],"dof":6,"forces":false,"loads":0,"gravity":[0,1,2],"base_position":[3,4,5],"base_rotation":[6,7,8,9,10,11,12,13,14],"variable_inertia":false,"base_quaternion":[15,16,17,18],"tip_force":null,"tip_moment":null,"tip_frame":false,"tip_mass":19,"tip_length":null,"tip_inertia":null}"#,
+            r#"{"links":[{"cell":0,"map":[{"terms":[[0,1.0]]},{"terms":[[1,1.0]]},{"terms":[[2,1.0]]}],"params":[20,21,22,26,23,24,25,27,28,29,30,31,20,20,20]},{"cell":0,"map":[{"terms":[[3,1.0]]},{"terms":[[4,1.0]]},{"terms":[[5,1.0]]}],"params":[32,33,34,38,35,36,37,39,40,41,42,43,32,32,32]}],"dof":6,"forces":false,"loads":0,"gravity":[0,1,2],"base_position":[3,4,5],"base_rotation":[6,7,8,9,10,11,12,13,14],"variable_inertia":false,"base_quaternion":[15,16,17,18],"tip_force":null,"tip_moment":null,"tip_frame":false,"tip_mass":19,"tip_length":null,"tip_inertia":null}"#,
         )
         .expect("the generated link layout parses")
 });
@@ -2299,7 +2299,7 @@ pub fn cell_0_pose(
     qd: &[f64; 3],
     qdd: &[f64; 3],
     dir: &[f64; 6],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 38],
 ) {
     runtime::interpreted!(
@@ -2325,7 +2325,7 @@ pub fn cell_0(
     qd: &[f64; 3],
     qdd: &[f64; 3],
     dir: &[f64; 6],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 87],
 ) {
     runtime::cpu::require_fma();
@@ -2338,7 +2338,7 @@ pub fn cell_0_tangent(
     qd: &[f64; 3],
     qdd: &[f64; 3],
     dir: &[f64; 6],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [f64; 174],
 ) {
     runtime::cpu::require_fma();
@@ -2356,7 +2356,7 @@ fn cell_0_0<S: runtime::scalar::Scalar>(
     qd: &[S; 3],
     qdd: &[f64; 3],
     dir: &[f64; 6],
-    p: &[f64; 15],
+    p: &[f64; 18],
     out: &mut [S; 87],
 ) {
     let v1 = q[0] * q[0];

@@ -20,6 +20,7 @@ pub fn is_cosserat(model: &Model) -> bool {
 /// The rod's section at the fraction `x` of the segment `s`.
 fn section_at(s: &Segment, x: f64) -> Section {
     let here = s.at(x);
+    let [rest_y, rest_z, rest_twist, rest_stretch] = s.rest_at(x, 3);
     let stiffness = |v: Option<f64>| v.expect("validated: the Cosserat rod's stiffness");
     let ei = stiffness(here.ei());
     Section {
@@ -28,6 +29,9 @@ fn section_at(s: &Segment, x: f64) -> Section {
         ei: [ei, ei],
         gj: stiffness(here.gj()),
         rho_a: s.mass_per_length(x).unwrap_or(0.0),
+        // The rod's frame is (y, z, x) of the section's.
+        rest_u: [rest_y, rest_z, rest_twist],
+        rest_stretch,
     }
 }
 

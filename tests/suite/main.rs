@@ -27,6 +27,7 @@ mod moving_base;
 mod output_dir;
 mod parsers;
 mod pcc;
+mod rest_shape;
 mod rom_slices;
 mod shape;
 mod six_strains;

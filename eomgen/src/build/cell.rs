@@ -22,7 +22,7 @@
 use runtime::Tape;
 use runtime::links::{
     ACTUATION_LOADS, CELL_PARAMS, ELEMENT_PARAMS, LinkKernels, LinkLayout, LinkSpec,
-    LocalCoordinate,
+    LocalCoordinate, REST_PARAMS,
 };
 
 use crate::cas::{Cas, ExprId, SymKind};
@@ -84,6 +84,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         let rom = method.polynomial_fields().then(|| RomFields::of(g, first));
         let load = actuated.iter().position(|&a| a == s);
         let shape = Shape {
+            rest_3d: g.rest_3d,
             twist: g.twist,
             extension: g.extension,
             shear: g.shear,
@@ -119,9 +120,10 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             // A planar cell reads no spatial parameter: their slots repeat
             // the length's.
             let length = index(Param::Element(k, ElementParam::Length));
-            let params = ElementParam::CELL
-                .map(|e| params.get(Param::Element(k, e)).unwrap_or(length))
-                .to_vec();
+            let params: Vec<usize> = (ElementParam::CELL.iter())
+                .chain(&ElementParam::REST_3D)
+                .map(|&e| params.get(Param::Element(k, e)).unwrap_or(length))
+                .collect();
             let maps = coordinate_maps(rom.as_ref(), e, count, first, params[0], shape.kind);
             if let Some(b) = before {
                 links.push(LinkSpec {
@@ -293,6 +295,8 @@ fn globals(st: &Structure, params: &ParamLayout) -> LinkLayout {
 /// What a cell depends on besides its parameters' values.
 #[derive(Clone, Copy, PartialEq, Eq)]
 struct Shape {
+    /// It reads a rest bend about y, twist and stretch.
+    rest_3d: bool,
     twist: bool,
     extension: bool,
     shear: bool,
@@ -384,28 +388,38 @@ fn cell_coordinates(
 /// rest curvature, twist, its damping, stretch, its damping): a rom slice
 /// keeps only what thinning makes local, the rest is its segment's
 /// (`derive_forces`).
-fn cell_springs(rom: bool, incompressible: bool, zero: ExprId, k: [ExprId; 7]) -> Springs {
+fn cell_springs(
+    rom: bool,
+    incompressible: bool,
+    zero: ExprId,
+    k: [ExprId; 7],
+    [rest_y, rest_twist, rest_stretch]: [ExprId; REST_PARAMS],
+) -> Springs {
     let [kb, db, rest, kt, dt, ks, ds] = k;
     if rom {
         let local = |k: ExprId| if incompressible { k } else { zero };
         Springs {
             bend: local(kb),
             bend_damping: zero,
-            rest: local(rest),
+            rest: [local(rest_y), local(rest)],
             twist: local(kt),
             twist_damping: zero,
+            rest_twist: local(rest_twist),
             stretch: zero,
             stretch_damping: zero,
+            rest_stretch: zero,
         }
     } else {
         Springs {
             bend: kb,
             bend_damping: db,
-            rest,
+            rest: [rest_y, rest],
             twist: kt,
             twist_damping: dt,
+            rest_twist,
             stretch: ks,
             stretch_damping: ds,
+            rest_stretch,
         }
     }
 }
@@ -479,6 +493,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         incompressible,
         rom,
         kind,
+        rest_3d,
         ..
     } = shape;
     let mut cas = Cas::new();
@@ -497,6 +512,10 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     let [l, m, lateral, axial, kb, db, rest, kt, dt, ks, ds, kg] = std::array::from_fn(|i| p[i]);
     let loads: [ExprId; ACTUATION_LOADS] = std::array::from_fn(|i| p[ELEMENT_PARAMS + i]);
     let zero = cas.zero();
+    let rests: [ExprId; REST_PARAMS] = match rest_3d {
+        true => std::array::from_fn(|i| p[ELEMENT_PARAMS + ACTUATION_LOADS + i]),
+        false => [zero; REST_PARAMS],
+    };
     // Coordinates bend y, bend z, then twist and stretch where present.
     let mut strain = [zero; 4];
     let mut rates = [zero; 4];
@@ -517,7 +536,13 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     let len = cas.add(l, st);
     let thin = incompressible.then(|| thinning(cas, l, len));
     let soft = thin.map(|t| t.0);
-    let springs = cell_springs(rom, incompressible, zero, [kb, db, rest, kt, dt, ks, ds]);
+    let springs = cell_springs(
+        rom,
+        incompressible,
+        zero,
+        [kb, db, rest, kt, dt, ks, ds],
+        rests,
+    );
     let (mut elastic, mut rayleigh) = match kind {
         CellKind::BeforeJoint => (zero, zero),
         _ => springs.energies(cas, strain, rates, soft),

@@ -78,6 +78,7 @@ impl Structure {
                         },
                         joints: method.joints(s),
                         varying: method.polynomial_fields() && s.tapered(),
+                        rest_3d: s.rest_3d(m.dimensions),
                         twist: spatial && twist,
                         extension: spatial && extension,
                         shear: spatial && shear,

@@ -416,9 +416,42 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
     if let Some(c) = s.bending_damping {
         ck.non_negative(&p("bending_damping"), c)?;
     }
-    ck.finite(&p("rest_curvature"), s.rest_curvature)?;
+    rest_shape(ck, i, s)?;
     if let Some(c) = s.axial_damping {
         ck.non_negative(&p("axial_damping"), c)?;
+    }
+    Ok(())
+}
+
+/// The rest curvature, twist and stretch: finite, in the plane one
+/// curvature, a stretch only where the elements stretch.
+fn rest_shape(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
+    let p = |k: &str| format!("segment[{i}].{k}");
+    let planar = ck.m.dimensions == 2;
+    if planar && let Some(e) = s.rest_curvature.planar_error() {
+        return ck.err(p("rest_curvature"), e.into());
+    }
+    let ([y, z], _) = s.rest_curvature.axes(!planar);
+    for (key, v) in [
+        ("rest_curvature", Some(&y)),
+        ("rest_curvature", Some(&z)),
+        ("rest_twist", s.rest_twist.as_ref()),
+        ("rest_stretch", s.rest_stretch.as_ref()),
+    ] {
+        for x in v.map(|v| v.knots()).unwrap_or_default() {
+            ck.finite(&p(key), x)?;
+        }
+    }
+    if let Some(e) = &s.rest_stretch
+        && e.min() <= -1.0
+    {
+        return ck.err(
+            p("rest_stretch"),
+            format!(
+                "a strain above -1 (a positive rest length), got {}",
+                e.min()
+            ),
+        );
     }
     Ok(())
 }
@@ -440,6 +473,8 @@ fn segment_dimension_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), Model
             ("incompressible", s.incompressible.is_some()),
             ("shear", s.shear.is_some()),
             ("shear_factor", s.shear_factor.is_some()),
+            ("rest_twist", s.rest_twist.is_some()),
+            ("rest_stretch", s.rest_stretch.is_some()),
         ] {
             if given {
                 return ck.err(
@@ -483,6 +518,13 @@ fn segment_dimension_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), Model
             return ck.err(
                 p("axial_stiffness"),
                 "missing: `extension = true` needs `axial_stiffness` (E A), or `youngs_modulus` with the section".into(),
+            );
+        }
+        let stretches = method.stretch() != Carried::Never && s.stretches();
+        if s.rest_stretch.is_some() && !stretches {
+            return ck.err(
+                p("rest_stretch"),
+                "acts on stretching elements: set `extension = true` too".into(),
             );
         }
         shear_keys(ck, i, s)?;

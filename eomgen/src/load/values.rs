@@ -171,6 +171,11 @@ pub struct ElementProps {
     pub stretch_damping: f64,
     /// 3D, eba: G A / l_e (N/m).
     pub shear_stiffness: f64,
+    /// 3D rest shapes: bend about y and twist (rad), stretch (m), each the
+    /// rest strain times l_e.
+    pub rest_y: f64,
+    pub rest_twist: f64,
+    pub rest_stretch: f64,
 }
 
 impl ElementProps {
@@ -188,6 +193,9 @@ impl ElementProps {
             ElementParam::StretchStiffness => self.stretch_stiffness,
             ElementParam::StretchDamping => self.stretch_damping,
             ElementParam::ShearStiffness => self.shear_stiffness,
+            ElementParam::RestY => self.rest_y,
+            ElementParam::RestTwist => self.rest_twist,
+            ElementParam::RestStretch => self.rest_stretch,
         }
     }
 }
@@ -243,13 +251,17 @@ fn props_of(m: &Model, [s, springs]: [&Segment; 2], l: f64, n: usize) -> Element
         Some(gj) => gj / l,
         None => s.joint_stiffness.unwrap_or(0.0),
     };
+    let [rest_y, rest_z, rest_twist, rest_stretch] = s.rest_at(0.5, m.dimensions);
     ElementProps {
         length: l,
         mass,
         inertia,
         stiffness,
         damping,
-        rest: s.rest_curvature * l,
+        rest: rest_z * l,
+        rest_y: rest_y * l,
+        rest_twist: rest_twist * l,
+        rest_stretch: rest_stretch * l,
         axial_inertia,
         twist_stiffness,
         twist_damping: damping,

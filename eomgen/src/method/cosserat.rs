@@ -42,17 +42,11 @@ fn one_uniform_rod(ck: &Check) -> Result<(), ModelError> {
         return ck.err(
             "segment".into(),
             format!(
-                "the Cosserat statics take one uniform [[segment]], got {}",
+                "the Cosserat statics take one [[segment]], got {}",
                 m.segments.len()
             ),
         );
     };
-    if s.rest_curvature != 0.0 {
-        return ck.err(
-            "segment[0].rest_curvature".into(),
-            "the Cosserat rod is straight at rest; remove the key".into(),
-        );
-    }
     if m.tip.mass.is_some() {
         return ck.err(
             "tip.mass".into(),

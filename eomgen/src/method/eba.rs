@@ -78,10 +78,11 @@ impl ModellingMethod for Eba {
                     .into(),
             );
         }
-        if s.rest_curvature != 0.0 {
+        if let Some(key) = s.rest_key() {
             return ck.err(
-                p("rest_curvature"),
-                "eba elements are straight at rest: remove the key or use pcc, ebr or rom".into(),
+                p(key),
+                "eba elements are straight at rest: remove the key or use pcc, pcs, ebr or rom"
+                    .into(),
             );
         }
         if s.ea().is_none() || s.ga().is_none() {

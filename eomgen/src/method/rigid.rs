@@ -9,7 +9,7 @@ use crate::cas::{Cas, ExprId};
 use crate::model::{Axis, Check, ElementParam, Joints, ModelError, Segment, SegmentShape};
 use crate::tmt::actuation::Strain;
 use crate::tmt::planar::{self, Element2, PlanarArm};
-use crate::tmt::spatial::{Frame, SpatialArm, advance, half_k_sq, revolute};
+use crate::tmt::spatial::{Frame, SpatialArm, advance, compose, exp_turn, half_k_sq, revolute};
 
 pub(super) struct Rigid;
 
@@ -223,8 +223,21 @@ fn joint(cas: &mut Cas, arm: &mut SpatialArm, g: &SegmentShape, s: usize) -> Fra
     // then measured in the frame midway between its links, as a rod's
     // strains are at that point (measured in the incoming link's frame,
     // the twist and bend of a curved rod mixed at first order).
-    let half_rest = cas.scaled(0.5, rest);
-    let mut f = revolute(cas, &arm.f, 2, half_rest, zero);
+    // A 3D rest shape turns it by the rotation vector (twist, bend y, bend
+    // z) at rest, as a whole.
+    let rest_3d = g
+        .rest_3d
+        .then(|| [ElementParam::RestTwist, ElementParam::RestY, ElementParam::Rest].map(e));
+    let half_turn = |cas: &mut Cas, f: &Frame| -> Frame {
+        let Some(rho) = rest_3d else {
+            let half_rest = cas.scaled(0.5, rest);
+            return revolute(cas, f, 2, half_rest, zero);
+        };
+        let rho = rho.map(|r| cas.scaled(0.5, r));
+        let (r, q, _) = exp_turn(cas, &rho, &[zero; 3]);
+        compose(cas, f, Some((&r, &q)), None, None)
+    };
+    let mut f = half_turn(cas, &arm.f);
     let mut rho = [zero; 3];
     let mut turns: Vec<(usize, ExprId)> = Vec::new();
     for &a in &g.axes {
@@ -234,7 +247,7 @@ fn joint(cas: &mut Cas, arm: &mut SpatialArm, g: &SegmentShape, s: usize) -> Fra
         arm.rayleigh.push(half_k_sq(cas, damp, qd));
         turns.push((a.index(), q));
     }
-    f = revolute(cas, &f, 2, half_rest, zero);
+    f = half_turn(cas, &f);
     let theta = rotation_vector(cas, &turns, zero);
     for (k, &th) in theta.iter().enumerate() {
         if turns.iter().any(|&(a, _)| a == k) {

@@ -331,41 +331,11 @@ impl RomFields {
         k: usize,
     ) -> [ExprId; 2] {
         let n = self.slices as f64;
-        // per x^T G x scale over the whole segment (G diagonal), or with each
-        // slice's parameter `per(e)` on its own part (a varying section).
         let grams: Vec<Vec<Vec<f64>>> = match self.varying {
             true => (0..self.slices).map(|e| self.slice_gram(e)).collect(),
             false => Vec::new(),
         };
-        let quad = |cas: &mut Cas, x: &[ExprId], per: &dyn Fn(usize) -> ExprId, scale: ExprId| {
-            if grams.is_empty() {
-                let terms: Vec<ExprId> = (x.iter().enumerate())
-                    .map(|(i, &a)| {
-                        let aa = cas.mul(a, a);
-                        cas.scaled(1.0 / (2 * i + 1) as f64, aa)
-                    })
-                    .collect();
-                let sum = cas.add_all(&terms);
-                return cas.mul_all(&[per(0), scale, sum]);
-            }
-            let mut slices = Vec::with_capacity(grams.len());
-            for (e, g) in grams.iter().enumerate() {
-                let mut terms = Vec::new();
-                for i in 0..x.len() {
-                    for j in i..x.len() {
-                        let c = if i == j { g[i][i] } else { 2.0 * g[i][j] };
-                        if c.abs() > 1e-15 * g[0][0] {
-                            let xx = cas.mul(x[i], x[j]);
-                            terms.push(cas.scaled(c, xx));
-                        }
-                    }
-                }
-                let sum = cas.add_all(&terms);
-                slices.push(cas.mul(per(e), sum));
-            }
-            let all = cas.add_all(&slices);
-            cas.mul(scale, all)
-        };
+        let none = |_: usize| None;
         let (mut elastic, mut rayleigh) = (Vec::new(), Vec::new());
         let first_shear = 2 + usize::from(self.twist) + usize::from(self.extension);
         for f in 0..self.fields() {
@@ -383,7 +353,7 @@ impl RomFields {
                     .map(|i| coords.qd[self.index(f, i)])
                     .collect();
                 let scale = cas.constant(1.0 / n);
-                rayleigh.push(quad(cas, &xd, &|_| ds, scale));
+                rayleigh.push(quadratic(cas, &grams, &xd, &|_| ds, &none, scale));
                 continue;
             }
             // Shear rates damped as the stretch's, as pcs has them.
@@ -406,25 +376,97 @@ impl RomFields {
             } else {
                 cas.constant(1.0 / n)
             };
-            let mut x: Vec<ExprId> = (0..=self.order)
+            let x: Vec<ExprId> = (0..=self.order)
                 .map(|i| coords.q[self.index(f, i)])
                 .collect();
-            if f == 1 {
-                // Rest curvature about z, constant along s: kappa0 L = n rest.
-                let rest = symbols.element(k, ElementParam::Rest);
-                let r = cas.scaled(n, rest);
-                x[0] = cas.sub(x[0], r);
-            }
+            // The field's value at rest, constant over each slice: an angle
+            // field's kappa0 L = n rest, a translation field's the strain.
+            let extension_at = 2 + usize::from(self.twist);
+            let rest_param = match f {
+                0 => Some(ElementParam::RestY),
+                1 => Some(ElementParam::Rest),
+                _ if !stretch => Some(ElementParam::RestTwist),
+                _ if self.extension && f == extension_at => Some(ElementParam::RestStretch),
+                _ => None,
+            };
+            let zero = cas.zero();
+            let rests: Vec<Option<ExprId>> = (0..self.slices)
+                .map(|e| {
+                    let r = symbols.element_or(k + e, rest_param?, zero);
+                    if r == zero {
+                        return None;
+                    }
+                    Some(match stretch {
+                        true => {
+                            let l = symbols.element(k + e, ElementParam::Length);
+                            let inv = cas.powi(l, -1);
+                            cas.mul(r, inv)
+                        }
+                        false => cas.scaled(n, r),
+                    })
+                })
+                .collect();
             let xd: Vec<ExprId> = (0..=self.order)
                 .map(|i| coords.qd[self.index(f, i)])
                 .collect();
-            elastic.push(quad(cas, &x, &ks, scale));
-            rayleigh.push(quad(cas, &xd, &ds, scale));
+            let rest = |e: usize| rests[e];
+            elastic.push(quadratic(cas, &grams, &x, &ks, &rest, scale));
+            rayleigh.push(quadratic(cas, &grams, &xd, &ds, &none, scale));
         }
         let e = cas.add_all(&elastic);
         let d = cas.add_all(&rayleigh);
         [cas.scaled(0.5, e), cas.scaled(0.5, d)]
     }
+}
+
+/// per x^T G x scale over the whole segment (G diagonal: the Legendre
+/// polynomials' Gram matrix), or, given each slice's Gram matrix `grams`
+/// (a varying section), the sum of each slice's parameter `per(e)` on its
+/// own part; x's first coefficient less the slice's `rest(e)`.
+fn quadratic(
+    cas: &mut Cas,
+    grams: &[Vec<Vec<f64>>],
+    x: &[ExprId],
+    per: &dyn Fn(usize) -> ExprId,
+    rest: &dyn Fn(usize) -> Option<ExprId>,
+    scale: ExprId,
+) -> ExprId {
+    let less_rest = |cas: &mut Cas, e: usize| -> Vec<ExprId> {
+        let mut x = x.to_vec();
+        if let Some(r) = rest(e) {
+            x[0] = cas.sub(x[0], r);
+        }
+        x
+    };
+    if grams.is_empty() {
+        let x = less_rest(cas, 0);
+        let terms: Vec<ExprId> = (x.iter().enumerate())
+            .map(|(i, &a)| {
+                let aa = cas.mul(a, a);
+                cas.scaled(1.0 / (2 * i + 1) as f64, aa)
+            })
+            .collect();
+        let sum = cas.add_all(&terms);
+        return cas.mul_all(&[per(0), scale, sum]);
+    }
+    let mut slices = Vec::with_capacity(grams.len());
+    for (e, g) in grams.iter().enumerate() {
+        let x = less_rest(cas, e);
+        let mut terms = Vec::new();
+        for i in 0..x.len() {
+            for j in i..x.len() {
+                let c = if i == j { g[i][i] } else { 2.0 * g[i][j] };
+                if c.abs() > 1e-15 * g[0][0] {
+                    let xx = cas.mul(x[i], x[j]);
+                    terms.push(cas.scaled(c, xx));
+                }
+            }
+        }
+        let sum = cas.add_all(&terms);
+        slices.push(cas.mul(per(e), sum));
+    }
+    let all = cas.add_all(&slices);
+    cas.mul(scale, all)
 }
 
 /// The m-point Gauss-Legendre rule on [-1, 1]: nodes (roots of P_m, by

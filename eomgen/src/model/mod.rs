@@ -12,6 +12,7 @@ mod methods;
 mod overrides;
 mod params;
 mod profile;
+mod rest;
 mod schema;
 pub mod sensor;
 mod signals;
@@ -27,6 +28,7 @@ pub use params::{
 };
 pub(crate) use params::{base_quaternion, chamber_value};
 pub use profile::Profile;
+pub use rest::RestCurvature;
 pub use schema::{
     Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, SimulateDefaults, Start,
     Tendon, Tip, Torque, WrenchFrame,

@@ -79,6 +79,11 @@ pub enum ElementParam {
     StretchDamping,
     /// 3D, shearing elements (pcs, eba): k G A / l_e.
     ShearStiffness,
+    /// 3D rest shapes (`SegmentShape::rest_3d`): the bend about y, the
+    /// twist (rest strain times l_e, rad) and the stretch (m) at rest.
+    RestY,
+    RestTwist,
+    RestStretch,
 }
 
 impl ElementParam {
@@ -100,6 +105,11 @@ impl ElementParam {
         Self::StretchDamping,
         Self::ShearStiffness,
     ];
+    /// The parameters a 3D rest shape adds to its elements, in layout
+    /// order; a link cell reads them after its actuation loads
+    /// (`runtime::links::REST_PARAMS`).
+    pub const REST_3D: [ElementParam; runtime::links::REST_PARAMS] =
+        [Self::RestY, Self::RestTwist, Self::RestStretch];
     /// A link cell's parameters, in the order the cell tape reads them
     /// (`runtime::links::ELEMENT_PARAMS` of them).
     pub const CELL: [ElementParam; runtime::links::ELEMENT_PARAMS] = [
@@ -131,6 +141,9 @@ impl ElementParam {
             Self::StretchStiffness => ("stretch", "stiffness"),
             Self::StretchDamping => ("stretch", "damping"),
             Self::ShearStiffness => ("shear", "stiffness"),
+            Self::RestY => ("joint", "rest_y"),
+            Self::RestTwist => ("twist", "rest"),
+            Self::RestStretch => ("stretch", "rest"),
         };
         format!("{group}[{k}].{what}")
     }
@@ -425,10 +438,17 @@ impl ParamLayout {
         if st.tip_length {
             p.extend([Param::TipLength, Param::TipInertia, Param::TipAxialInertia]);
         }
-        for k in 0..st.elements() {
-            p.extend(ElementParam::PLANAR.map(|e| Param::Element(k, e)));
-            if spatial {
-                p.extend(ElementParam::SPATIAL.map(|e| Param::Element(k, e)));
+        let mut k = 0;
+        for g in &st.segments {
+            for _ in 0..g.elements {
+                p.extend(ElementParam::PLANAR.map(|e| Param::Element(k, e)));
+                if spatial {
+                    p.extend(ElementParam::SPATIAL.map(|e| Param::Element(k, e)));
+                }
+                if g.rest_3d {
+                    p.extend(ElementParam::REST_3D.map(|e| Param::Element(k, e)));
+                }
+                k += 1;
             }
         }
         for (segment, &count) in st.chambers.iter().enumerate() {

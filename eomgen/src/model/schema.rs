@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 pub use super::methods::Method;
 use super::profile::Profile;
+use super::rest::RestCurvature;
 
 /// A declared arm (one `models/<arm>.toml`).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -185,9 +186,18 @@ pub struct Segment {
     /// unit length, i.e. (eta / l_e) theta_dot^2 / 2 per element.
     #[serde(default)]
     pub bending_damping: Option<f64>,
-    /// Curvature at rest (1/m).
+    /// Curvature at rest (1/m): one value (in 3D about z), or in 3D
+    /// `[k_y, k_z]`; each constant or varying along the segment.
     #[serde(default)]
-    pub rest_curvature: f64,
+    pub rest_curvature: RestCurvature,
+    /// 3D: twist at rest (rad/m) about the arm's axis: with a rest
+    /// curvature, a helix.
+    #[serde(default)]
+    pub rest_twist: Option<Profile>,
+    /// 3D, stretching elements: strain at rest (dimensionless), the
+    /// elements' rest length (1 + strain) times their length.
+    #[serde(default)]
+    pub rest_stretch: Option<Profile>,
     /// Joint placement of a rigid segment (structural). Default: `midpoint`
     /// when the segment's stiffness comes from E I, else `base`.
     #[serde(default)]
@@ -270,15 +280,70 @@ impl Segment {
             shear_modulus: here(&self.shear_modulus),
             torsional_stiffness: here(&self.torsional_stiffness),
             axial_stiffness: here(&self.axial_stiffness),
+            rest_curvature: match &self.rest_curvature {
+                RestCurvature::One(p) => RestCurvature::One(Profile::Uniform(p.at(x))),
+                RestCurvature::Two(pair) => {
+                    RestCurvature::Two(pair.clone().map(|p| Profile::Uniform(p.at(x))))
+                }
+            },
+            rest_twist: here(&self.rest_twist),
+            rest_stretch: here(&self.rest_stretch),
             ..self.clone()
         }
     }
 
-    /// Whether any value varies along the segment.
+    /// The rest strains at the fraction `x` along the segment, in
+    /// `dimensions`: curvature about y and z (1/m), twist (rad/m), stretch.
+    pub fn rest_at(&self, x: f64, dimensions: u8) -> [f64; 4] {
+        let ([y, z], _) = self.rest_curvature.axes(dimensions == 3);
+        let or_zero = |p: &Option<Profile>| p.as_ref().map_or(0.0, |p| p.at(x));
+        [
+            y.at(x),
+            z.at(x),
+            or_zero(&self.rest_twist),
+            or_zero(&self.rest_stretch),
+        ]
+    }
+
+    /// The first rest key that makes the segment other than straight at
+    /// rest, if any.
+    pub fn rest_key(&self) -> Option<&'static str> {
+        let bent = |p: &Profile| p.knots().iter().any(|&v| v != 0.0);
+        let curved = match &self.rest_curvature {
+            RestCurvature::One(p) => bent(p),
+            RestCurvature::Two(pair) => pair.iter().any(bent),
+        };
+        [
+            ("rest_curvature", curved),
+            ("rest_twist", self.rest_twist.is_some()),
+            ("rest_stretch", self.rest_stretch.is_some()),
+        ]
+        .into_iter()
+        .find_map(|(key, given)| given.then_some(key))
+    }
+
+    /// 3D: the rest shape needs more than a curvature about z (a curvature
+    /// about y, a twist or a stretch is given): structural, so that the
+    /// values may change without a rebuild.
+    pub fn rest_3d(&self, dimensions: u8) -> bool {
+        dimensions == 3
+            && (self.rest_curvature.axes(true).1
+                || self.rest_twist.is_some()
+                || self.rest_stretch.is_some())
+    }
+
+    /// Whether any value varies along the segment (its section, material
+    /// or rest shape).
     pub fn tapered(&self) -> bool {
-        self.profiles()
-            .iter()
-            .any(|(_, p)| p.is_some_and(|p| p.uniform().is_none()))
+        let rest: Vec<&Profile> = match &self.rest_curvature {
+            RestCurvature::One(p) => vec![p],
+            RestCurvature::Two(pair) => pair.iter().collect(),
+        };
+        (self.profiles().iter().filter_map(|(_, p)| *p))
+            .chain(rest)
+            .chain(self.rest_twist.as_ref())
+            .chain(self.rest_stretch.as_ref())
+            .any(|p| p.uniform().is_none())
     }
 
     /// The keys that may vary along the segment, with their profiles.

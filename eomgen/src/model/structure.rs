@@ -41,6 +41,9 @@ pub struct SegmentShape {
     /// equations (rom: its energies slice by slice); elsewhere each
     /// element's values are parameters, and this is false.
     pub varying: bool,
+    /// 3D: its rest shape has a curvature about y, a twist or a stretch
+    /// (their parameters exist), not only a curvature about z.
+    pub rest_3d: bool,
 }
 
 /// Everything that shapes the equations; numbers are left out.
@@ -167,6 +170,9 @@ impl Structure {
             }
             if g.varying {
                 s.push_str(" varying");
+            }
+            if g.rest_3d {
+                s.push_str(" rest3d");
             }
             s.push('\n');
         }

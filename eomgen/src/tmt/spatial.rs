@@ -580,14 +580,17 @@ impl<'a> SpatialArm<'a> {
             offset_scale: thin.map(|t| t.1),
         });
         let e = |p| self.symbols.element(self.k, p);
+        let rest = |p| self.symbols.element_or(self.k, p, zero);
         let springs = Springs {
             bend: e(ElementParam::BendStiffness),
             bend_damping: e(ElementParam::BendDamping),
-            rest: e(ElementParam::Rest),
+            rest: [rest(ElementParam::RestY), e(ElementParam::Rest)],
             twist: e(ElementParam::TwistStiffness),
             twist_damping: e(ElementParam::TwistDamping),
+            rest_twist: rest(ElementParam::RestTwist),
             stretch: e(ElementParam::StretchStiffness),
             stretch_damping: e(ElementParam::StretchDamping),
+            rest_stretch: rest(ElementParam::RestStretch),
         };
         let (mut e, mut d) = springs.energies(
             cas,
@@ -721,12 +724,14 @@ pub(crate) fn base_frame(
 pub(crate) struct Springs {
     pub bend: ExprId,
     pub bend_damping: ExprId,
-    /// Rest bend about z.
-    pub rest: ExprId,
+    /// Rest bend about y and about z.
+    pub rest: [ExprId; 2],
     pub twist: ExprId,
     pub twist_damping: ExprId,
+    pub rest_twist: ExprId,
     pub stretch: ExprId,
     pub stretch_damping: ExprId,
+    pub rest_stretch: ExprId,
 }
 
 impl Springs {
@@ -744,12 +749,15 @@ impl Springs {
         let soften = |cas: &mut Cas, k: ExprId| soft.map_or(k, |s| cas.mul(k, s));
         let kb = soften(cas, self.bend);
         let kt = soften(cas, self.twist);
-        let bz_rel = cas.sub(bz, self.rest);
+        let by_rel = cas.sub(by, self.rest[0]);
+        let bz_rel = cas.sub(bz, self.rest[1]);
+        let tw_rel = cas.sub(tw, self.rest_twist);
+        let st_rel = cas.sub(st, self.rest_stretch);
         let elastic = [
-            half_k_sq(cas, kb, by),
+            half_k_sq(cas, kb, by_rel),
             half_k_sq(cas, kb, bz_rel),
-            half_k_sq(cas, kt, tw),
-            half_k_sq(cas, self.stretch, st),
+            half_k_sq(cas, kt, tw_rel),
+            half_k_sq(cas, self.stretch, st_rel),
         ];
         let rayleigh = [
             half_k_sq(cas, self.bend_damping, by_d),

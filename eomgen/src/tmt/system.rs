@@ -64,6 +64,12 @@ impl ParamSymbols {
         self.get(Param::Element(k, e))
     }
 
+    /// Element k's quantity `e` where its structure has it, else `or` (a
+    /// 3D rest shape's strains: zero where the segment has none).
+    pub fn element_or(&self, k: usize, e: ElementParam, or: ExprId) -> ExprId {
+        (self.layout.get(Param::Element(k, e))).map_or(or, |i| self.ids[i])
+    }
+
     /// A vector of three parameters.
     pub fn xyz(&self, p: impl Fn(Xyz) -> Param) -> [ExprId; 3] {
         Xyz::ALL.map(|c| self.get(p(c)))

@@ -32,9 +32,13 @@ pub struct Section {
     pub gj: f64,
     /// Mass per length (kg/m), for gravity.
     pub rho_a: f64,
+    /// The strains at rest: curvature u* about d1, d2 and twist about d3
+    /// (1/m), and the stretch (v* = (0, 0, 1 + stretch)).
+    pub rest_u: [f64; 3],
+    pub rest_stretch: f64,
 }
 
-/// A straight rod whose section may vary along it (a taper).
+/// A rod whose section may vary along it (a taper).
 #[derive(Clone)]
 pub struct Rod {
     pub length: f64,
@@ -156,16 +160,18 @@ impl Rod {
         let f = loads.gravity * sec.rho_a + loads.distributed;
         let e3 = Vector3::z();
         let rt = x.r.transpose();
+        let v_rest = e3 * (1.0 + sec.rest_stretch);
         let v = if sec.ea.is_none() && sec.ga.is_none() {
-            e3
+            v_rest
         } else {
             let local = rt * x.n;
             let compliance = |k: Option<f64>| k.map_or(0.0, |k| 1.0 / k);
             let (shear, axial) = (compliance(sec.ga), compliance(sec.ea));
-            e3 + Vector3::new(local.x * shear, local.y * shear, local.z * axial)
+            v_rest + Vector3::new(local.x * shear, local.y * shear, local.z * axial)
         };
         let lm = rt * x.m;
-        let u = Vector3::new(lm.x / sec.ei[0], lm.y / sec.ei[1], lm.z / sec.gj);
+        let u = Vector3::from(sec.rest_u)
+            + Vector3::new(lm.x / sec.ei[0], lm.y / sec.ei[1], lm.z / sec.gj);
         let dp = x.r * v;
         State {
             p: dp,
@@ -391,6 +397,8 @@ mod tests {
             ei: [e * i, e * i],
             gj: e / 3.0 * 2.0 * i,
             rho_a: 1000.0 * area,
+            rest_u: [0.0; 3],
+            rest_stretch: 0.0,
         }
     }
 

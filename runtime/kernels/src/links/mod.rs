@@ -41,8 +41,12 @@ pub const ELEMENT_PARAMS: usize = 12;
 /// Then the actuators' loads on the link's strain (c_st, c_by, c_bz: its
 /// segment's, from the `loads` kernel; zero where no actuator acts).
 pub const ACTUATION_LOADS: usize = 3;
+/// Then the element's rest strains besides its bend about z (bend about y,
+/// twist, stretch: `ElementParam::REST_3D`), which a cell of a 3D rest
+/// shape reads; other cells' slots repeat the length's.
+pub const REST_PARAMS: usize = 3;
 /// Everything a cell reads besides its coordinates.
-pub const CELL_PARAMS: usize = ELEMENT_PARAMS + ACTUATION_LOADS;
+pub const CELL_PARAMS: usize = ELEMENT_PARAMS + ACTUATION_LOADS + REST_PARAMS;
 
 /// Where a cell's outputs sit, for a link of `n` coordinates.
 pub mod cell {
@@ -131,7 +135,8 @@ pub struct LinkSpec {
     pub cell: usize,
     /// The cell's coordinates, in its order.
     pub map: Vec<LocalCoordinate>,
-    /// Indices into the parameter vector, [`ELEMENT_PARAMS`] of them.
+    /// Indices into the parameter vector: [`ELEMENT_PARAMS`], then
+    /// [`REST_PARAMS`].
     pub params: Vec<usize>,
     /// Which triple of the `loads` kernel's outputs the link's actuation
     /// loads are; None: none act on it.
@@ -379,12 +384,17 @@ impl Loads {
 /// where none act).
 #[inline(always)]
 pub(crate) fn link_params(v: &mut [f64; CELL_PARAMS], spec: &LinkSpec, p: &[f64], loads: &[f64]) {
-    for (v, &i) in v.iter_mut().zip(&spec.params) {
+    let (own, rest) = spec.params.split_at(ELEMENT_PARAMS);
+    for (v, &i) in v.iter_mut().zip(own) {
         *v = p[i];
     }
     let at = spec.load.map(|l| 3 * l);
-    for (f, v) in v[ELEMENT_PARAMS..].iter_mut().enumerate() {
+    let (actuation, rest_v) = v[ELEMENT_PARAMS..].split_at_mut(ACTUATION_LOADS);
+    for (f, v) in actuation.iter_mut().enumerate() {
         *v = at.map_or(0.0, |at| loads[at + f]);
+    }
+    for (v, &i) in rest_v.iter_mut().zip(rest) {
+        *v = p[i];
     }
 }
 
@@ -1163,7 +1173,7 @@ mod tests {
                     terms: vec![(k, 1.0)],
                     scale: None,
                 }],
-                params: (at..at + ELEMENT_PARAMS).collect(),
+                params: (at..at + ELEMENT_PARAMS).chain([at; REST_PARAMS]).collect(),
                 load: None,
             });
         }

@@ -1,0 +1,200 @@
+//! 3D rest shapes (`rest_curvature = [k_y, k_z]`, `rest_twist`,
+//! `rest_stretch`) against the closed form of a rod of constant strain and
+//! against the Cosserat rod:
+//!
+//! * unloaded, a rod curved about both axes and twisted at rest is a helix
+//!   whose tip is L (I + c2 K + c3 K^2) v, K = [L u]x, u = (twist, k_y,
+//!   k_z), v = (1 + stretch) e_x: exact for the constant-strain methods
+//!   (pcc, vc, pcs, rom) at any resolution, second order for ebr and the
+//!   rigid (Hencky) chain, and the Cosserat rod to its step error;
+//! * under a tip load, every method converges to the Cosserat rod;
+//! * at rest it stays at rest.
+
+use std::path::Path;
+
+use crate::common::*;
+use eomgen::model::Override;
+use runtime::{SimOptions, StaticOptions, simulate, solve_static};
+
+const L: f64 = 0.2;
+const KY: f64 = 4.0;
+const KZ: f64 = -6.0;
+const TWIST: f64 = 3.0;
+
+fn model(tip_force: [f64; 3]) -> String {
+    format!(
+        r#"
+name = "helix"
+dimensions = 3
+gravity = [0.0, 0.0, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = {L}
+elements = 8
+density = 1000.0
+outer_radius = 0.01
+youngs_modulus = 1e6
+rest_curvature = [{KY}, {KZ}]
+rest_twist = {TWIST}
+[tip]
+force = {tip_force:?}
+"#
+    )
+}
+
+/// The tip of a rod of constant strain: curvature and twist `u` (about x,
+/// y, z of the section), translation strain `v`, length `len`, from the
+/// origin along +x.
+fn constant_strain_tip(u: [f64; 3], v: [f64; 3], len: f64) -> [f64; 3] {
+    let rho = u.map(|c| c * len);
+    let t = (rho[0] * rho[0] + rho[1] * rho[1] + rho[2] * rho[2]).sqrt();
+    let (c2, c3) = ((1.0 - t.cos()) / (t * t), (t - t.sin()) / (t * t * t));
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let kv = cross(rho, v);
+    let kkv = cross(rho, kv);
+    std::array::from_fn(|i| len * (v[i] + c2 * kv[i] + c3 * kkv[i]))
+}
+
+fn static_tip(dir: &Path, text: &str, sets: &[String]) -> [f64; 3] {
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    if sets.contains(&"segment.0.method=cosserat") {
+        let path = dir.join("model.toml");
+        std::fs::write(&path, text).unwrap();
+        let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+        let spec = path.to_str().unwrap();
+        let (model, origin) = softarm::backend::read_model(spec, &overrides).unwrap();
+        return softarm::continuum::solve(&model, &origin)
+            .unwrap()
+            .tip_position;
+    }
+    let mut l = load_text(dir, text, &sets);
+    let n = l.arm.dof();
+    let sol = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
+    let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
+    [o[0], o[1], o[2]]
+}
+
+fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt()
+}
+
+fn sets(method: &str, n: usize) -> Vec<String> {
+    let key = if method == "rom" {
+        "quadrature"
+    } else {
+        "elements"
+    };
+    vec![
+        format!("segment.0.method={method}"),
+        format!("segment.0.{key}={n}"),
+    ]
+}
+
+#[test]
+fn an_unloaded_rod_curved_and_twisted_at_rest_is_its_helix() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = model([0.0; 3]);
+    let want = constant_strain_tip([TWIST, KY, KZ], [1.0, 0.0, 0.0], L);
+    // Far from straight: the helix turns by 1.5 rad.
+    assert!(distance(want, [L, 0.0, 0.0]) > 0.1 * L, "{want:?}");
+    for method in ["pcc", "vc", "pcs", "rom"] {
+        for n in [3, 8] {
+            let tip = static_tip(dir.path(), &text, &sets(method, n));
+            let err = distance(tip, want) / L;
+            assert!(err < 1e-9, "{method} at {n}: {err:e} of L off the helix");
+        }
+    }
+    for method in ["ebr", "rigid"] {
+        let err = |n| distance(static_tip(dir.path(), &text, &sets(method, n)), want) / L;
+        let (coarse, fine) = (err(8), err(16));
+        assert!(
+            fine < 2e-3 && fine * 3.5 < coarse,
+            "{method}: {coarse:e} of L at 8 elements, {fine:e} at 16"
+        );
+    }
+    let rod = static_tip(dir.path(), &text, &["segment.0.method=cosserat".into()]);
+    assert!(
+        distance(rod, want) / L < 1e-9,
+        "Cosserat: {rod:?} vs {want:?}"
+    );
+}
+
+#[test]
+fn a_rest_stretch_lengthens_the_helix() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = model([0.0; 3]);
+    let want = constant_strain_tip([TWIST, KY, KZ], [1.05, 0.0, 0.0], L);
+    for method in ["pcc", "pcs", "rom", "cosserat"] {
+        let mut s = sets(method, 4);
+        if method == "cosserat" {
+            s.truncate(1);
+        }
+        s.extend([
+            "segment.0.extension=true".into(),
+            "segment.0.rest_stretch=0.05".into(),
+        ]);
+        let tip = static_tip(dir.path(), &text, &s);
+        let err = distance(tip, want) / L;
+        assert!(err < 1e-9, "{method}: {err:e} of L off the stretched helix");
+    }
+}
+
+#[test]
+fn a_loaded_helix_converges_to_the_cosserat_rod() {
+    let dir = tempfile::tempdir().unwrap();
+    // A load across the helix that moves the tip by about a fifth of L.
+    let text = model([0.0, 0.1, -0.3]);
+    let rod = static_tip(dir.path(), &text, &["segment.0.method=cosserat".into()]);
+    let unloaded = constant_strain_tip([TWIST, KY, KZ], [1.0, 0.0, 0.0], L);
+    assert!(distance(rod, unloaded) > 0.1 * L, "{rod:?}");
+    let err = |sets: &[String]| distance(static_tip(dir.path(), &text, sets), rod) / L;
+    for method in ["pcc", "ebr", "rigid"] {
+        let (coarse, fine) = (err(&sets(method, 8)), err(&sets(method, 16)));
+        assert!(
+            fine < 2e-3 && fine * 3.0 < coarse,
+            "{method}: {coarse:e} of L from the Cosserat rod at 8, {fine:e} at 16"
+        );
+    }
+    // rom's error is its fields' degree's.
+    let rom = |order: usize| {
+        let mut s = sets("rom", 12);
+        s.push(format!("segment.0.order={order}"));
+        err(&s)
+    };
+    let (low, high) = (rom(2), rom(5));
+    assert!(
+        high < 1e-5 && high * 10.0 < low,
+        "rom: {low:e} of L from the Cosserat rod at order 2, {high:e} at 5"
+    );
+}
+
+#[test]
+fn a_helix_at_rest_stays_at_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = model([0.0; 3]).replace("youngs_modulus", "bending_damping = 1e-3\nyoungs_modulus");
+    assert!(text.contains("bending_damping"));
+    let mut l = load_text(dir.path(), &text, &[]);
+    let n = l.arm.dof();
+    let rest = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default())
+        .unwrap()
+        .q;
+    assert!(rest.iter().any(|q| q.abs() > 0.1), "{rest:?}");
+    let opts = SimOptions {
+        t_end: 0.2,
+        ..Default::default()
+    };
+    let x0 = [rest.clone(), vec![0.0; n]].concat();
+    let (traj, _) = simulate(&*l.arm, x0, &opts).unwrap();
+    let moved = (traj.x.iter())
+        .flat_map(|x| x[..n].iter().zip(&rest).map(|(q, r)| (q - r).abs()))
+        .fold(0.0, f64::max);
+    assert!(moved < 1e-12, "moved by {moved:e}");
+}
