@@ -766,6 +766,49 @@ fn three_d_key_cases() -> Vec<FileCase> {
             vec!["segment[0].twist", "a 3D key"],
         ),
         (
+            "rest twist in 2D",
+            r("dimensions = 3\n", "")
+                .replace("elements = 2", "elements = 2\nrest_twist = 1.0")
+                .replace("-9.81]", "0.0]"),
+            vec!["segment[0].rest_twist", "a 3D key"],
+        ),
+        (
+            "rest curvature vector in 2D",
+            r("dimensions = 3\n", "")
+                .replace(
+                    "elements = 2",
+                    "elements = 2\nrest_curvature = [0.0, [1.0, 2.0]]",
+                )
+                .replace("-9.81]", "0.0]"),
+            vec!["segment[0].rest_curvature", "one axis"],
+        ),
+        (
+            "rest stretch without extension",
+            r("elements = 2", "elements = 2\nrest_stretch = 0.1"),
+            vec!["segment[0].rest_stretch", "extension = true"],
+        ),
+        (
+            "rest stretch to nothing",
+            r(
+                "elements = 2",
+                "elements = 2\nextension = true\nrest_stretch = -1.5",
+            ),
+            vec!["segment[0].rest_stretch", "above -1"],
+        ),
+        (
+            "rest curvature of three",
+            r(
+                "elements = 2",
+                "elements = 2\nrest_curvature = [1.0, 2.0, 3.0]",
+            ),
+            vec!["segment[0].rest_curvature", "give two values"],
+        ),
+        (
+            "eba twisted at rest",
+            r("\"pcc\"", "\"eba\"").replace("elements = 2", "elements = 2\nrest_twist = 1.0"),
+            vec!["segment[0].rest_twist", "straight at rest"],
+        ),
+        (
             "shear in 2D",
             r("dimensions = 3\n", "")
                 .replace("elements = 2", "elements = 2\nshear = true")
@@ -894,14 +937,6 @@ fn three_d_method_cases() -> Vec<FileCase> {
             vec!["segment[0].incompressible", "keeps its section"],
         ),
         (
-            "curved Cosserat rod",
-            r(
-                "method = \"pcc\"",
-                "method = \"cosserat\"\nrest_curvature = 2.0",
-            ),
-            vec!["segment[0].rest_curvature", "straight at rest"],
-        ),
-        (
             "Cosserat rod without twist stiffness",
             r("method = \"pcc\"", "method = \"cosserat\"\ntwist = false")
                 .replace("youngs_modulus = 1e6", "bending_stiffness = 0.01"),
@@ -941,7 +976,7 @@ fn malformed_3d_models_are_rejected_clearly() {
     let out = softarm(&["static", "m.toml", "--json"], dir.path());
     assert!(!out.status.success());
     assert!(
-        stderr(&out).contains("segment: the Cosserat statics take one uniform [[segment]], got 2"),
+        stderr(&out).contains("segment: the Cosserat statics take one [[segment]], got 2"),
         "{}",
         stderr(&out)
     );
