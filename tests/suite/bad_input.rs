@@ -809,6 +809,30 @@ fn three_d_key_cases() -> Vec<FileCase> {
             vec!["segment[0].rest_twist", "straight at rest"],
         ),
         (
+            "turn of one angle in 3D",
+            r("elements = 2", "elements = 2\nturn = [90.0]"),
+            vec!["segment[0].turn", "[angle about y, angle about z] in 3D"],
+        ),
+        (
+            "turn of two angles in the plane",
+            r("dimensions = 3\n", "")
+                .replace("elements = 2", "elements = 2\nturn = [0.0, 90.0]")
+                .replace("-9.81]", "0.0]"),
+            vec!["segment[0].turn", "[angle about z] in the plane"],
+        ),
+        (
+            "offset out of the plane",
+            r("dimensions = 3\n", "")
+                .replace("elements = 2", "elements = 2\noffset = [0.0, 0.01, 0.01]")
+                .replace("-9.81]", "0.0]"),
+            vec!["segment[0].offset", "z must be 0"],
+        ),
+        (
+            "eba kinked",
+            r("\"pcc\"", "\"eba\"").replace("elements = 2", "elements = 2\nturn = [0.0, 90.0]"),
+            vec!["segment[0].turn", "meet tangent"],
+        ),
+        (
             "shear in 2D",
             r("dimensions = 3\n", "")
                 .replace("elements = 2", "elements = 2\nshear = true")
@@ -1363,6 +1387,11 @@ fn contact_mistakes_name_the_key() {
             "a plane without a direction",
             r("normal = [0.0, 1.0, 0.0]", "normal = [0.0, 0.0, 0.0]"),
             vec!["obstacle[0].normal", "zero vector"],
+        ),
+        (
+            "a kinked arm in contact",
+            r("elements = 3", "elements = 3\nturn = [30.0]"),
+            vec!["segment[0].turn", "not supported yet", "weld"],
         ),
         (
             "no points per element",

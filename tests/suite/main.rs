@@ -21,6 +21,7 @@ mod integrators;
 mod interrupted;
 mod jacobian;
 mod joints;
+mod kink;
 mod linearize;
 mod long_arm;
 mod moving_base;

@@ -69,7 +69,8 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             .all(|g| crate::method::of(g.method).link_cells()))
         && st.torques.is_empty()
         && !st.base_translates
-        && st.base_turns == 0;
+        && st.base_turns == 0
+        && st.segments.iter().all(|g| !g.kink);
     if !covered {
         return None;
     }

@@ -7,8 +7,9 @@ mod cell;
 mod planar_cell;
 
 use crate::cas::Cas;
+use crate::cas::ExprId;
 use crate::method;
-use crate::model::{Param, ParamLayout, Structure};
+use crate::model::{KinkParam, Param, ParamLayout, Structure};
 use crate::tmt::planar::PlanarArm;
 use crate::tmt::spatial::SpatialArm;
 use crate::tmt::{ParamSymbols, System};
@@ -54,6 +55,10 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
         let base = (arm.points > 0).then(|| arm.base_pose());
         let mut ends = Vec::new();
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
+            if g.kink {
+                let [turn, offset] = kink(symbols, s, true);
+                arm.kink(cas, &turn, &offset);
+            }
             m.build_spatial(cas, &mut arm, g, s);
             ends.push((arm.f.p, arm.f.quat));
         }
@@ -67,6 +72,10 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
         arm.points = structure.contact_points;
         let base = (arm.points > 0).then(|| arm.base_pose(cas));
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
+            if g.kink {
+                let [turn, offset] = kink(symbols, s, false);
+                arm.kink(cas, turn[2], &offset);
+            }
             for _ in 0..g.elements {
                 let el = arm.begin_element(s);
                 m.place_planar(cas, &mut arm, g, &el);
@@ -77,6 +86,18 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
         sys.bases = base.into_iter().collect();
         sys
     }
+}
+
+/// Segment s's kink: its turn as a rotation vector (0, y, z), about z
+/// alone in the plane, and its offset.
+fn kink(symbols: &ParamSymbols, s: usize, spatial: bool) -> [[ExprId; 3]; 2] {
+    let turn = |i| symbols.get(Param::Kink(s, KinkParam::Turn(i)));
+    let zero = symbols.zero();
+    let turn = match spatial {
+        true => [zero, turn(0), turn(1)],
+        false => [zero, zero, turn(0)],
+    };
+    [turn, symbols.xyz(|c| Param::Kink(s, KinkParam::Offset(c)))]
 }
 
 /// Driven generalised forces Q_k on named coordinates as the potential

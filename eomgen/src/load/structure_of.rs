@@ -79,6 +79,7 @@ impl Structure {
                         joints: method.joints(s),
                         varying: method.polynomial_fields() && s.tapered(),
                         rest_3d: s.rest_3d(m.dimensions),
+                        kink: s.kinked(),
                         twist: spatial && twist,
                         extension: spatial && extension,
                         shear: spatial && shear,

@@ -417,8 +417,50 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
         ck.non_negative(&p("bending_damping"), c)?;
     }
     rest_shape(ck, i, s)?;
+    kink(ck, i, s)?;
     if let Some(c) = s.axial_damping {
         ck.non_negative(&p("axial_damping"), c)?;
+    }
+    Ok(())
+}
+
+/// A kink: one turn in the plane (about z), two in 3D (about y and z),
+/// finite; an offset in the plane stays in it; no contact yet.
+fn kink(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
+    let p = |k: &str| format!("segment[{i}].{k}");
+    let planar = ck.m.dimensions == 2;
+    if let Some(turn) = &s.turn {
+        let want = if planar { 1 } else { 2 };
+        if turn.len() != want {
+            let form = if planar {
+                "[angle about z] in the plane"
+            } else {
+                "[angle about y, angle about z] in 3D"
+            };
+            return ck.err(
+                p("turn"),
+                format!("give {form}, in degrees (got {} values)", turn.len()),
+            );
+        }
+        for (k, &a) in turn.iter().enumerate() {
+            ck.finite(&format!("{}[{k}]", p("turn")), a)?;
+        }
+    }
+    if let Some(offset) = &s.offset {
+        ck.vec3(&p("offset"), offset)?;
+        if planar && offset[2] != 0.0 {
+            return ck.err(
+                p("offset"),
+                "a planar arm stays in its plane: the offset's z must be 0".into(),
+            );
+        }
+    }
+    if s.kinked() && ck.m.has_contact() {
+        return ck.err(
+            p(if s.turn.is_some() { "turn" } else { "offset" }),
+            "contact along an arm with kinks is not supported yet: use two arms joined by a weld"
+                .into(),
+        );
     }
     Ok(())
 }

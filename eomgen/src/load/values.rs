@@ -4,8 +4,8 @@
 
 use crate::model::sensor::{Source, wrench_sources};
 use crate::model::{
-    BodyParam, ElementParam, JointParam, Model, Param, ParamLayout, Segment, SpringParam,
-    Structure, base_quaternion, base_rotation, base_turn_axis, chamber_value,
+    BodyParam, ElementParam, JointParam, KinkParam, Model, Param, ParamLayout, Segment,
+    SpringParam, Structure, base_quaternion, base_rotation, base_turn_axis, chamber_value,
 };
 
 impl ParamLayout {
@@ -71,6 +71,13 @@ impl ParamLayout {
                     what,
                 } => chamber_value(m, segment, position, what),
                 Param::TendonTension(_) | Param::Torque(_) => 0.0,
+                Param::Kink(s, KinkParam::Turn(i)) => {
+                    let turn = m.segments[s].turn.as_deref().unwrap_or_default();
+                    turn.get(i as usize).copied().unwrap_or(0.0).to_radians()
+                }
+                Param::Kink(s, KinkParam::Offset(c)) => {
+                    m.segments[s].offset.map_or(0.0, |o| o[c.index()])
+                }
                 Param::TendonOffset { tendon, segment, z } => {
                     let t = &m.tendons[tendon];
                     let d = t.distance.at(segment);

@@ -47,6 +47,12 @@ fn one_uniform_rod(ck: &Check) -> Result<(), ModelError> {
             ),
         );
     };
+    if s.kinked() {
+        return ck.err(
+            "segment[0].turn".into(),
+            "the Cosserat rod starts at its base: set the base's direction instead of a kink".into(),
+        );
+    }
     if m.tip.mass.is_some() {
         return ck.err(
             "tip.mass".into(),

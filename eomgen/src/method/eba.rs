@@ -78,6 +78,12 @@ impl ModellingMethod for Eba {
                     .into(),
             );
         }
+        if s.kinked() {
+            return ck.err(
+                p(if s.turn.is_some() { "turn" } else { "offset" }),
+                "eba segments meet tangent: kinks are for the chain methods (pcc, vc, pcs, ebr, rom, rigid)".into(),
+            );
+        }
         if let Some(key) = s.rest_key() {
             return ck.err(
                 p(key),

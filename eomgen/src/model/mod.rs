@@ -23,7 +23,7 @@ pub use error::ModelError;
 pub(crate) use methods::methods;
 pub use overrides::Override;
 pub use params::{
-    BodyParam, ChamberParam, Driven, ElementParam, JointParam, Param, ParamLayout, Rate,
+    BodyParam, ChamberParam, Driven, ElementParam, JointParam, KinkParam, Param, ParamLayout, Rate,
     SpringParam, Xyz, base_rotation, base_turn_axis, channel,
 };
 pub(crate) use params::{base_quaternion, chamber_value};

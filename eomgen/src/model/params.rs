@@ -220,6 +220,16 @@ pub enum Param {
     Joint(u16, JointParam),
     /// Arm `0`'s compliant base.
     BaseSpring(u16, SpringParam),
+    /// Segment `0`'s kink: where it starts from the previous one's end.
+    Kink(usize, KinkParam),
+}
+
+/// A kink's turn (radians; planar: 0 about z; 3D: 0 about y, 1 about z)
+/// and its offset in the previous segment's end frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum KinkParam {
+    Turn(u8),
+    Offset(Xyz),
 }
 
 /// A rigid body's quantities: mass, planar inertia, and where a fixed body
@@ -314,6 +324,8 @@ impl Param {
                     format!("joint[{j}].q{}", ["w", "x", "y", "z"][i as usize])
                 }
             },
+            Self::Kink(s, KinkParam::Turn(i)) => format!("segment[{s}].turn[{i}]"),
+            Self::Kink(s, KinkParam::Offset(c)) => format!("segment[{s}].offset.{}", c.name()),
             Self::BaseSpring(a, what) => match what {
                 SpringParam::Mass => format!("arm[{a}].base.mass"),
                 SpringParam::Stiffness => format!("arm[{a}].base.stiffness"),
@@ -449,6 +461,13 @@ impl ParamLayout {
                     p.extend(ElementParam::REST_3D.map(|e| Param::Element(k, e)));
                 }
                 k += 1;
+            }
+        }
+        for (s, g) in st.segments.iter().enumerate() {
+            if g.kink {
+                let turns = if spatial { 2 } else { 1 };
+                p.extend((0..turns).map(|i| Param::Kink(s, KinkParam::Turn(i))));
+                p.extend(Xyz::ALL.map(|c| Param::Kink(s, KinkParam::Offset(c))));
             }
         }
         for (segment, &count) in st.chambers.iter().enumerate() {

@@ -221,6 +221,15 @@ pub struct Segment {
     /// Timoshenko's 0.9 or PyElastica's 27/28 for a solid circle).
     #[serde(default)]
     pub shear_factor: Option<f64>,
+    /// A kink: the segment starts turned from the previous one's end (the
+    /// base, for the first) by these angles (degrees): about z in the
+    /// plane; in 3D about y and z, the rotation vector (0, y, z).
+    #[serde(default)]
+    pub turn: Option<Vec<f64>>,
+    /// The segment starts this far (m) from the previous one's end, in that
+    /// end's frame (before the turn).
+    #[serde(default)]
+    pub offset: Option<[f64; 3]>,
     /// 3D, stretching elements (`extension`; eba always): the material
     /// keeps its volume, so a stretch lambda thins the section (structural;
     /// default false; no effect on rigid links).
@@ -320,6 +329,11 @@ impl Segment {
         ]
         .into_iter()
         .find_map(|(key, given)| given.then_some(key))
+    }
+
+    /// The segment starts turned or offset from the previous one's end.
+    pub fn kinked(&self) -> bool {
+        self.turn.is_some() || self.offset.is_some()
     }
 
     /// 3D: the rest shape needs more than a curvature about z (a curvature

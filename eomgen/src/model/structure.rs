@@ -44,6 +44,9 @@ pub struct SegmentShape {
     /// 3D: its rest shape has a curvature about y, a twist or a stretch
     /// (their parameters exist), not only a curvature about z.
     pub rest_3d: bool,
+    /// It starts turned or offset from the previous segment's end (its
+    /// `KinkParam`s exist).
+    pub kink: bool,
 }
 
 /// Everything that shapes the equations; numbers are left out.
@@ -173,6 +176,9 @@ impl Structure {
             }
             if g.rest_3d {
                 s.push_str(" rest3d");
+            }
+            if g.kink {
+                s.push_str(" kink");
             }
             s.push('\n');
         }

@@ -230,6 +230,19 @@ impl<'a> PlanarArm<'a> {
         Sample::planar(cas, [self.f.x, self.f.y, self.z], self.f.phi)
     }
 
+    /// A kink: the end frame moved by `offset` (x, y in itself) and turned
+    /// by `turn`, both constant.
+    pub fn kink(&mut self, cas: &mut Cas, turn: ExprId, offset: &[ExprId; 3]) {
+        let (c, s) = (cas.cos(self.f.phi), cas.sin(self.f.phi));
+        let dx = [cas.mul(c, offset[0]), cas.mul(s, offset[1])];
+        let dy = [cas.mul(s, offset[0]), cas.mul(c, offset[1])];
+        let dx = cas.sub(dx[0], dx[1]);
+        let dy = cas.add(dy[0], dy[1]);
+        self.f.x = cas.add(self.f.x, dx);
+        self.f.y = cas.add(self.f.y, dy);
+        self.f.phi = cas.add(self.f.phi, turn);
+    }
+
     /// The element ends at the end frame: its link, spring and damper.
     pub fn end_element(&mut self, cas: &mut Cas, el: &Element2) {
         let (zero, f) = (self.zero, self.f);

@@ -531,6 +531,14 @@ impl<'a> SpatialArm<'a> {
         Sample::spatial(self.f.p, self.f.quat)
     }
 
+    /// A kink: the end frame moved by `offset` (in itself) and turned by
+    /// the rotation vector `turn`, both constant.
+    pub fn kink(&mut self, cas: &mut Cas, turn: &V3, offset: &V3) {
+        let zero = cas.zero();
+        let (r, q, _) = exp_turn(cas, turn, &[zero; 3]);
+        self.f = compose(cas, &self.f, Some((&r, &q)), Some(offset), None);
+    }
+
     /// Move the end frame by `d` along its axis.
     pub fn advance(&mut self, cas: &mut Cas, d: ExprId) {
         self.f = advance(cas, &self.f, d);

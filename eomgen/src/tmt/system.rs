@@ -12,6 +12,7 @@ pub use super::inertia::Inertia;
 pub struct ParamSymbols {
     layout: ParamLayout,
     ids: Vec<ExprId>,
+    zero: ExprId,
     /// A compliant base's displacement: coordinates of the assembly.
     base_offset: Option<[ExprId; 3]>,
     /// A compliant base's turn: a rotation vector and its rate.
@@ -34,6 +35,7 @@ impl ParamSymbols {
         Self {
             layout: layout.clone(),
             ids,
+            zero: cas.zero(),
             base_offset: None,
             base_twist: None,
         }
@@ -62,6 +64,11 @@ impl ParamSymbols {
     /// Element k's quantity `e`.
     pub fn element(&self, k: usize, e: ElementParam) -> ExprId {
         self.get(Param::Element(k, e))
+    }
+
+    /// The constant zero (what a parameter the structure lacks stands for).
+    pub fn zero(&self) -> ExprId {
+        self.zero
     }
 
     /// Element k's quantity `e` where its structure has it, else `or` (a
