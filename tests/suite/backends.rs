@@ -1248,6 +1248,10 @@ value = 1000.0
         assert_eq!(b, "compiled", "{file}: {r}");
         assert!(r.contains("link cells"), "{file}: {r}");
     }
+    let example = root().join("examples/right_angle_frame.toml");
+    let (b, r) = route(&example.to_string_lossy(), "", auto);
+    assert_eq!(b, "interpreted");
+    assert!(r.contains("kinks are not link cells"), "{r}");
     let (b, r) = route("finger_tap", "segment.0.elements=5", auto);
     assert_eq!(b, "compiled");
     assert!(
