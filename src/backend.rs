@@ -124,6 +124,9 @@ fn linked(
     if structure.segments.iter().any(|g| g.kink) {
         return Err("its kinks are not link cells yet".into());
     }
+    if !structure.loads.is_empty() {
+        return Err("its loads along the arm are not link cells yet".into());
+    }
     let not_cells = || "not every one of its methods' elements is a link cell".to_string();
     let kernels: Box<dyn Kernels> = if structure.assembly.is_some() {
         let (tapes, _, _) = tapes(model, &structure.hash(), cache_dir);

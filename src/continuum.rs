@@ -76,7 +76,11 @@ pub fn solve(model: &Model, origin: &str) -> Result<RodSolution> {
     );
     let loads = RodLoads {
         gravity: model.gravity,
-        distributed_force: [0.0; 3],
+        // Validated: constant world-frame forces per unit length.
+        distributed_force: model.loads.iter().fold([0.0; 3], |acc, l| {
+            let f = l.force.unwrap_or([0.0; 3]);
+            [acc[0] + f[0], acc[1] + f[1], acc[2] + f[2]]
+        }),
         tip_force: model.tip.force.unwrap_or([0.0; 3]),
         tip_moment: model.tip.moment.unwrap_or([0.0; 3]),
     };

@@ -739,32 +739,15 @@ youngs_modulus = 1e6
 /// The cases of `malformed_3d_models_are_rejected_clearly`.
 fn three_d_cases() -> Vec<FileCase> {
     let mut all = three_d_key_cases();
+    all.extend(shape_and_load_cases());
     all.extend(three_d_method_cases());
     all
 }
 
-fn three_d_key_cases() -> Vec<FileCase> {
+/// Rest shapes, kinks and loads along the arm.
+fn shape_and_load_cases() -> Vec<FileCase> {
     let r = |a: &str, b: &str| GOOD3.replacen(a, b, 1);
     vec![
-        (
-            "dimensions 4",
-            r("dimensions = 3", "dimensions = 4"),
-            vec!["dimensions", "must be 2 (planar) or 3"],
-        ),
-        (
-            "ebr in 2D",
-            r("dimensions = 3\n", "")
-                .replace("\"pcc\"", "\"ebr\"")
-                .replace("-9.81]", "0.0]"),
-            vec!["segment[0].method", "ebr is a 3D method", "dimensions = 3"],
-        ),
-        (
-            "twist in 2D",
-            r("dimensions = 3\n", "")
-                .replace("elements = 2", "elements = 2\ntwist = false")
-                .replace("-9.81]", "0.0]"),
-            vec!["segment[0].twist", "a 3D key"],
-        ),
         (
             "rest twist in 2D",
             r("dimensions = 3\n", "")
@@ -831,6 +814,75 @@ fn three_d_key_cases() -> Vec<FileCase> {
             "eba kinked",
             r("\"pcc\"", "\"eba\"").replace("elements = 2", "elements = 2\nturn = [0.0, 90.0]"),
             vec!["segment[0].turn", "meet tangent"],
+        ),
+        (
+            "load off its segment",
+            format!(
+                "{}[[load]]\nsegment = 0\ns = 0.5\nforce = [0.0, 0.0, -1.0]\n",
+                GOOD3
+            ),
+            vec!["load[0].s", "between 0 and its length 0.3 m"],
+        ),
+        (
+            "load on no segment",
+            format!(
+                "{}[[load]]\nsegment = 3\ns = 0.1\nforce = [0.0, 0.0, -1.0]\n",
+                GOOD3
+            ),
+            vec!["load[0].segment", "no segment 3"],
+        ),
+        (
+            "load without force",
+            format!("{}[[load]]\nsegment = 0\ns = 0.1\n", GOOD3),
+            vec!["load[0].force", "missing"],
+        ),
+        (
+            "load on eba",
+            format!(
+                "{}[[load]]\nsegment = 0\ns = 0.1\nforce = [0.0, 0.0, -1.0]\n",
+                GOOD3
+            )
+            .replace("\"pcc\"", "\"eba\""),
+            vec!["load[0].segment", "eba segments are not supported yet"],
+        ),
+        (
+            "point load on the Cosserat rod",
+            format!(
+                "{}[[load]]\nsegment = 0\ns = 0.1\nforce = [0.0, 0.0, -1.0]\n",
+                GOOD3
+            )
+            .replace("\"pcc\"", "\"cosserat\""),
+            vec!["load[0].s", "constant distributed force"],
+        ),
+        (
+            "distributed moment",
+            format!("{}[[load]]\nsegment = 0\nmoment = [0.0, 0.0, 1.0]\n", GOOD3),
+            vec!["load[0].moment", "per unit length"],
+        ),
+    ]
+}
+
+fn three_d_key_cases() -> Vec<FileCase> {
+    let r = |a: &str, b: &str| GOOD3.replacen(a, b, 1);
+    vec![
+        (
+            "dimensions 4",
+            r("dimensions = 3", "dimensions = 4"),
+            vec!["dimensions", "must be 2 (planar) or 3"],
+        ),
+        (
+            "ebr in 2D",
+            r("dimensions = 3\n", "")
+                .replace("\"pcc\"", "\"ebr\"")
+                .replace("-9.81]", "0.0]"),
+            vec!["segment[0].method", "ebr is a 3D method", "dimensions = 3"],
+        ),
+        (
+            "twist in 2D",
+            r("dimensions = 3\n", "")
+                .replace("elements = 2", "elements = 2\ntwist = false")
+                .replace("-9.81]", "0.0]"),
+            vec!["segment[0].twist", "a 3D key"],
         ),
         (
             "shear in 2D",

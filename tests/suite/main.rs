@@ -23,6 +23,7 @@ mod jacobian;
 mod joints;
 mod kink;
 mod linearize;
+mod loads;
 mod long_arm;
 mod moving_base;
 mod output_dir;

@@ -70,7 +70,8 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         && st.torques.is_empty()
         && !st.base_translates
         && st.base_turns == 0
-        && st.segments.iter().all(|g| !g.kink);
+        && st.segments.iter().all(|g| !g.kink)
+        && st.loads.is_empty();
     if !covered {
         return None;
     }

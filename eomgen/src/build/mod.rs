@@ -10,6 +10,7 @@ use crate::cas::Cas;
 use crate::cas::ExprId;
 use crate::method;
 use crate::model::{KinkParam, Param, ParamLayout, Structure};
+use crate::tmt::along::along_loads;
 use crate::tmt::planar::PlanarArm;
 use crate::tmt::spatial::SpatialArm;
 use crate::tmt::{ParamSymbols, System};
@@ -52,6 +53,7 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
         let names = method::coordinate_names(structure);
         let mut arm = SpatialArm::new(cas, names, symbols);
         arm.points = structure.contact_points;
+        arm.loads = along_loads(cas, structure, symbols);
         let base = (arm.points > 0).then(|| arm.base_pose());
         let mut ends = Vec::new();
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
@@ -70,6 +72,7 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
         let names = method::coordinate_names(structure);
         let mut arm = PlanarArm::new(cas, names, symbols);
         arm.points = structure.contact_points;
+        arm.loads = along_loads(cas, structure, symbols);
         let base = (arm.points > 0).then(|| arm.base_pose(cas));
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
             if g.kink {

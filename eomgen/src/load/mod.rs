@@ -8,6 +8,7 @@
 
 mod assembly_check;
 mod contact_check;
+mod load_check;
 mod structure_of;
 mod validate;
 mod values;

@@ -2,7 +2,9 @@
 //! says, as the derivation sees it (`model::Structure`).
 
 use crate::model::assembly::FrameRef;
-use crate::model::{AssemblyShape, JointShape, Model, SegmentShape, Structure, WrenchFrame};
+use crate::model::{
+    AssemblyShape, JointShape, LoadShape, Model, SegmentShape, Structure, WrenchFrame,
+};
 
 impl Structure {
     pub fn of(m: &Model) -> Self {
@@ -49,6 +51,7 @@ impl Structure {
             base_follows: false,
             base_twists: false,
             contact_points: 0,
+            loads: Vec::new(),
             assembly: Some(Box::new(assembly)),
         }
     }
@@ -126,7 +129,32 @@ impl Structure {
             base_follows: m.base.is_compliant() && m.base.follow.is_some(),
             base_twists: m.base.turns_compliantly(),
             contact_points: m.contact_points(),
+            loads: load_shapes(m),
             assembly: None,
         }
     }
+}
+
+/// Where each `[[load]]` acts (validated: its segment exists, its point
+/// lies on it).
+fn load_shapes(m: &Model) -> Vec<LoadShape> {
+    m.loads
+        .iter()
+        .map(|l| {
+            let first: usize = m.segments[..l.segment].iter().map(|s| s.slices()).sum();
+            let g = &m.segments[l.segment];
+            LoadShape {
+                segment: l.segment,
+                at: l.s.map(|s| {
+                    let (e, f) = LoadShape::place(s, g.length, g.slices(), first);
+                    (e, f.to_bits())
+                }),
+                local: l.local(),
+                force: l.has_force(),
+                moment: l.has_moment(),
+                force_driven: l.force_inputs.is_some(),
+                moment_driven: l.moment_inputs.is_some(),
+            }
+        })
+        .collect()
 }

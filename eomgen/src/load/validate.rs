@@ -21,6 +21,7 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
     } else {
         validate_arm(m, file)?;
     }
+    super::load_check::check_loads(&ck)?;
     super::contact_check::check_contact(&ck)
 }
 

@@ -4,7 +4,7 @@
 
 use crate::model::sensor::{Source, wrench_sources};
 use crate::model::{
-    BodyParam, ElementParam, JointParam, KinkParam, Model, Param, ParamLayout, Segment,
+    BodyParam, ElementParam, JointParam, KinkParam, LoadParam, Model, Param, ParamLayout, Segment,
     SpringParam, Structure, base_quaternion, base_rotation, base_turn_axis, chamber_value,
 };
 
@@ -71,6 +71,13 @@ impl ParamLayout {
                     what,
                 } => chamber_value(m, segment, position, what),
                 Param::TendonTension(_) | Param::Torque(_) => 0.0,
+                // A driven component starts at 0: its input sets it.
+                Param::Load(i, LoadParam::Force(c)) => {
+                    m.loads[i].force.map_or(0.0, |f| f[c.index()])
+                }
+                Param::Load(i, LoadParam::Moment(c)) => {
+                    m.loads[i].moment.map_or(0.0, |f| f[c.index()])
+                }
                 Param::Kink(s, KinkParam::Turn(i)) => {
                     let turn = m.segments[s].turn.as_deref().unwrap_or_default();
                     turn.get(i as usize).copied().unwrap_or(0.0).to_radians()

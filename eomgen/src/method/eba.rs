@@ -57,6 +57,10 @@ impl ModellingMethod for Eba {
         false
     }
 
+    fn takes_point_loads(&self) -> bool {
+        false
+    }
+
     /// Element e's springs join it to element e - 1, from centre to centre:
     /// they sit at its start (the first element's, from the base to its
     /// centre, a quarter along it).

@@ -36,6 +36,8 @@ impl ModellingMethod for Pcc {
             let points = arc_points(cas, arm.f, el.l, el.q, arm.points);
             arm.sample_all(cas, Some(el.l), points);
         }
+        let (f, l, q, qd) = (arm.f, el.l, el.q, el.qd);
+        arm.apply_loads(cas, &|cas: &mut Cas, s: f64| arc_frame(cas, f, l, q, qd, s));
         let (c, chord_rate, arc_inertia, end) = pcc_element(cas, arm.f, el.l, el.m, el.q, el.qd);
         let total = cas.add(arc_inertia, el.inertia);
         arm.body(cas, c, chord_rate, el.m, total);
@@ -142,6 +144,27 @@ fn pcc_element(
 /// sinc(j a) = sinc(a) U_{j-1}(c) / j (Chebyshev's U: sin(j a) =
 /// sin(a) U_{j-1}(cos a)), so the P points cost one sin_cos of phi, one of
 /// a and one sinc, not P of each; theta = 0 is an ordinary point.
+/// The frame at the fraction s of an arc of length l turning by theta
+/// from frame f: at the chord s l sinc(s theta / 2) along the angle
+/// phi + s theta / 2, turned by s theta.
+fn arc_frame(cas: &mut Cas, f: Frame, l: ExprId, theta: ExprId, rate: ExprId, s: f64) -> Frame {
+    let half = cas.scaled(0.5 * s, theta);
+    let sinc = cas.sinc(half);
+    let chord = cas.mul_all(&[l, sinc]);
+    let chord = cas.scaled(s, chord);
+    let dir = cas.add(f.phi, half);
+    let (c, sn) = (cas.cos(dir), cas.sin(dir));
+    let (dx, dy) = (cas.mul(chord, c), cas.mul(chord, sn));
+    let turn = cas.scaled(s, theta);
+    let turn_rate = cas.scaled(s, rate);
+    Frame {
+        x: cas.add(f.x, dx),
+        y: cas.add(f.y, dy),
+        phi: cas.add(f.phi, turn),
+        w: cas.add(f.w, turn_rate),
+    }
+}
+
 fn arc_points(
     cas: &mut Cas,
     f: Frame,

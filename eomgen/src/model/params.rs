@@ -222,6 +222,15 @@ pub enum Param {
     BaseSpring(u16, SpringParam),
     /// Segment `0`'s kink: where it starts from the previous one's end.
     Kink(usize, KinkParam),
+    /// `[[load]]` `0`'s force and moment.
+    Load(usize, LoadParam),
+}
+
+/// A load's force (N, or N/m when distributed) and moment (N m).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum LoadParam {
+    Force(Xyz),
+    Moment(Xyz),
 }
 
 /// A kink's turn (radians; planar: 0 about z; 3D: 0 about y, 1 about z)
@@ -324,6 +333,8 @@ impl Param {
                     format!("joint[{j}].q{}", ["w", "x", "y", "z"][i as usize])
                 }
             },
+            Self::Load(i, LoadParam::Force(c)) => format!("load[{i}].force.{}", c.name()),
+            Self::Load(i, LoadParam::Moment(c)) => format!("load[{i}].moment.{}", c.name()),
             Self::Kink(s, KinkParam::Turn(i)) => format!("segment[{s}].turn[{i}]"),
             Self::Kink(s, KinkParam::Offset(c)) => format!("segment[{s}].offset.{}", c.name()),
             Self::BaseSpring(a, what) => match what {
@@ -350,7 +361,7 @@ impl Param {
     pub fn is_load(self) -> bool {
         matches!(
             self,
-            Self::Gravity(_) | Self::TipForce(_) | Self::TipMoment(_)
+            Self::Gravity(_) | Self::TipForce(_) | Self::TipMoment(_) | Self::Load(..)
         )
     }
 
@@ -461,6 +472,23 @@ impl ParamLayout {
                     p.extend(ElementParam::REST_3D.map(|e| Param::Element(k, e)));
                 }
                 k += 1;
+            }
+        }
+        for (i, l) in st.loads.iter().enumerate() {
+            for (given, driven, what) in [
+                (
+                    l.force,
+                    l.force_driven,
+                    LoadParam::Force as fn(Xyz) -> LoadParam,
+                ),
+                (l.moment, l.moment_driven, LoadParam::Moment),
+            ] {
+                for c in Xyz::ALL.iter().filter(|_| given) {
+                    match driven {
+                        true => drive(&mut p, Param::Load(i, what(*c)), 0),
+                        false => p.push(Param::Load(i, what(*c))),
+                    }
+                }
             }
         }
         for (s, g) in st.segments.iter().enumerate() {
@@ -603,6 +631,8 @@ pub fn channel(m: &Model, p: Param) -> Option<&str> {
             .as_ref()?
             .get(position),
         Param::TendonTension(i) => Some(&m.tendons[i].input),
+        Param::Load(i, LoadParam::Force(c)) => m.loads[i].force_inputs.as_ref()?.get(c.index()),
+        Param::Load(i, LoadParam::Moment(c)) => m.loads[i].moment_inputs.as_ref()?.get(c.index()),
         Param::Torque(i) => Some(&m.torques[i].input),
         _ => None,
     };

@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::load::Load;
 pub use super::methods::Method;
 use super::profile::Profile;
 use super::rest::RestCurvature;
@@ -34,6 +35,9 @@ pub struct Model {
     /// driven by an input channel.
     #[serde(default, rename = "torque")]
     pub torques: Vec<Torque>,
+    /// Loads along the arm: at a point, or per unit length.
+    #[serde(default, rename = "load")]
+    pub loads: Vec<Load>,
     /// Input channels by name: time signals that drive pressures, tensions
     /// and tip loads at run time (not structural: swapping a data file or a
     /// signal needs no rebuild).

@@ -87,6 +87,8 @@ pub struct Structure {
     pub base_twists: bool,
     /// Contact points sampled along each element (0: no contact).
     pub contact_points: usize,
+    /// The `[[load]]`s along the arm.
+    pub loads: Vec<super::load::LoadShape>,
     /// Several arms, bodies and joints: the arms' own structures and what
     /// joins them (the fields above are then empty).
     pub assembly: Option<Box<AssemblyShape>>,
@@ -220,6 +222,9 @@ impl Structure {
         }
         if self.contact_points > 0 {
             s.push_str(&format!("contact points {}\n", self.contact_points));
+        }
+        if !self.loads.is_empty() {
+            s.push_str(&format!("loads {:?}\n", self.loads));
         }
         if self.base_translates || self.base_turns > 0 {
             s.push_str(&format!(

@@ -4,6 +4,7 @@
 //! method places its elements with these; `build` asks the methods.
 
 pub(crate) mod actuation;
+pub(crate) mod along;
 pub(crate) mod cell_kind;
 pub(crate) mod cell_outputs;
 mod chain;

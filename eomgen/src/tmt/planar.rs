@@ -12,6 +12,7 @@ use crate::cas::{Cas, ExprId};
 use crate::model::{ElementParam, Param, Structure};
 
 use super::actuation::{Strain, actuation};
+use super::along::{AlongLoad, Applied, Placed};
 use super::system::{
     Body, Chain, Coordinates, Inertia, Link, ParamSymbols, PlanarFrames, PlanarPose, Sample,
     System, TipMount, tip_loads,
@@ -54,6 +55,9 @@ pub(crate) struct PlanarArm<'a> {
     /// Contact points per element, and the points sampled so far.
     pub points: usize,
     samples: Vec<Sample>,
+    /// The loads along the arm, and what they apply so far.
+    pub loads: Vec<AlongLoad>,
+    applied: Applied,
 }
 
 /// One planar element: its angle, rate and parameters.
@@ -106,6 +110,8 @@ impl<'a> PlanarArm<'a> {
             ends: Vec::new(),
             points: 0,
             samples: Vec::new(),
+            loads: Vec::new(),
+            applied: Applied::default(),
         }
     }
 
@@ -136,6 +142,8 @@ impl<'a> PlanarArm<'a> {
             ends: Vec::new(),
             points: 0,
             samples: Vec::new(),
+            loads: Vec::new(),
+            applied: Applied::default(),
         }
     }
 
@@ -204,6 +212,26 @@ impl<'a> PlanarArm<'a> {
             })
             .collect();
         self.sample_all(cas, length, points);
+        self.apply_loads(cas, &at);
+    }
+
+    /// The loads on the element being placed, at the frames `at` gives
+    /// along it (a method that samples by `sample_all` calls this too).
+    pub fn apply_loads(&mut self, cas: &mut Cas, at: &impl Fn(&mut Cas, f64) -> Frame) {
+        let (k, link, z, zero) = (self.k, self.links.len(), self.z, self.zero);
+        self.applied
+            .element(cas, &self.loads, (k, link), &mut |cas, s| {
+                let f = at(cas, s);
+                let (c, sn) = (cas.cos(f.phi), cas.sin(f.phi));
+                let (c, sn) = (cas.bind(c), cas.bind(sn));
+                let ns = cas.neg(sn);
+                let one = cas.one();
+                Placed {
+                    point: [f.x, f.y, z],
+                    rotation: [[c, ns, zero], [sn, c, zero], [zero, zero, one]],
+                    omega: [zero, zero, f.w],
+                }
+            });
     }
 
     /// Points along the element given all at once (P of them, at s = 1/P,
@@ -282,6 +310,7 @@ impl<'a> PlanarArm<'a> {
             seeds,
             ends,
             samples,
+            applied,
             ..
         } = self;
         let half_phi = cas.scaled(0.5, f.phi);
@@ -337,6 +366,7 @@ impl<'a> PlanarArm<'a> {
             omega: [zero, zero, f.w],
             rotation,
         };
+        applied.attach(&mut sys);
         let tip = tip_loads(cas, symbols, structure, &mount);
         sys.attach_tip(tip, last_link);
         sys

@@ -30,6 +30,7 @@ use crate::cas::{Cas, ExprId, Func};
 use crate::model::{ElementParam, Param, SegmentShape, Structure};
 
 use super::actuation::{Strain, actuation, thinning};
+use super::along::{AlongLoad, Applied, Placed};
 use super::system::{
     Body, Chain, Coordinates, Inertia, Link, ParamSymbols, Sample, System, TipMount, tip_loads,
 };
@@ -392,6 +393,9 @@ pub(crate) struct SpatialArm<'a> {
     /// Contact points per element, and the points sampled so far.
     pub points: usize,
     samples: Vec<Sample>,
+    /// The loads along the arm, and what they apply so far.
+    pub loads: Vec<AlongLoad>,
+    applied: Applied,
 }
 
 /// An element's lumped quantities (parameters).
@@ -486,6 +490,8 @@ impl<'a> SpatialArm<'a> {
             shared_coordinates: false,
             points: 0,
             samples: Vec::new(),
+            loads: Vec::new(),
+            applied: Applied::default(),
         }
     }
 
@@ -524,6 +530,17 @@ impl<'a> SpatialArm<'a> {
             self.samples
                 .push(Sample::spatial(point, f.quat).at_arc(arc));
         }
+        // The loads on this element, at the frames it places.
+        let (k, link) = (self.k, self.links.len());
+        self.applied
+            .element(cas, &self.loads, (k, link), &mut |cas, s| {
+                let f = at(cas, s);
+                Placed {
+                    point: f.p,
+                    rotation: f.r,
+                    omega: f.w,
+                }
+            });
     }
 
     /// The shape's first point: the frame the arm starts from.
@@ -642,6 +659,7 @@ impl<'a> SpatialArm<'a> {
             seeds,
             shared_coordinates,
             samples,
+            applied,
             ..
         } = self;
         let last_link = links.len().saturating_sub(1);
@@ -677,6 +695,7 @@ impl<'a> SpatialArm<'a> {
             omega: f.w,
             rotation: f.r,
         };
+        applied.attach(&mut sys);
         let tip = tip_loads(cas, symbols, structure, &mount);
         sys.attach_tip(tip, last_link);
         sys
