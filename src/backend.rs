@@ -124,7 +124,7 @@ fn linked(
     if structure.segments.iter().any(|g| g.kink) {
         return Err("its kinks are not link cells yet".into());
     }
-    if !structure.loads.is_empty() {
+    if !structure.loads.is_empty() || structure.fluid.is_some() {
         return Err("its loads along the arm are not link cells yet".into());
     }
     let not_cells = || "not every one of its methods' elements is a link cell".to_string();

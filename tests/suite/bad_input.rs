@@ -855,6 +855,21 @@ fn shape_and_load_cases() -> Vec<FileCase> {
             vec!["load[0].s", "constant distributed force"],
         ),
         (
+            "fluid of negative density",
+            format!("{}[fluid]\ndensity = -1.0\n", GOOD3),
+            vec!["fluid.density", "zero or positive"],
+        ),
+        (
+            "fluid around an arm without a radius",
+            format!("{}[fluid]\ndensity = 1000.0\n", GOOD3)
+                .replace(
+                    "density = 1000.0\nouter_radius = 0.01",
+                    "mass = 0.1\nbending_stiffness = 0.1\ntorsional_stiffness = 0.1",
+                )
+                .replace("youngs_modulus = 1e6\n", ""),
+            vec!["segment[0].outer_radius", "immersed"],
+        ),
+        (
             "distributed moment",
             format!("{}[[load]]\nsegment = 0\nmoment = [0.0, 0.0, 1.0]\n", GOOD3),
             vec!["load[0].moment", "per unit length"],

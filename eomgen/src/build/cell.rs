@@ -71,7 +71,8 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         && !st.base_translates
         && st.base_turns == 0
         && st.segments.iter().all(|g| !g.kink)
-        && st.loads.is_empty();
+        && st.loads.is_empty()
+        && st.fluid.is_none();
     if !covered {
         return None;
     }

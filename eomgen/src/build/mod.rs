@@ -9,8 +9,8 @@ mod planar_cell;
 use crate::cas::Cas;
 use crate::cas::ExprId;
 use crate::method;
-use crate::model::{KinkParam, Param, ParamLayout, Structure};
-use crate::tmt::along::along_loads;
+use crate::model::{FluidParam, KinkParam, Param, ParamLayout, Structure};
+use crate::tmt::along::{Drag, along_loads};
 use crate::tmt::planar::PlanarArm;
 use crate::tmt::spatial::SpatialArm;
 use crate::tmt::{ParamSymbols, System};
@@ -54,6 +54,7 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
         let mut arm = SpatialArm::new(cas, names, symbols);
         arm.points = structure.contact_points;
         arm.loads = along_loads(cas, structure, symbols);
+        arm.set_fluid(Drag::of(structure, symbols), buoyancy(structure, symbols));
         let base = (arm.points > 0).then(|| arm.base_pose());
         let mut ends = Vec::new();
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
@@ -73,6 +74,7 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
         let mut arm = PlanarArm::new(cas, names, symbols);
         arm.points = structure.contact_points;
         arm.loads = along_loads(cas, structure, symbols);
+        arm.set_fluid(Drag::of(structure, symbols), buoyancy(structure, symbols));
         let base = (arm.points > 0).then(|| arm.base_pose(cas));
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
             if g.kink {
@@ -89,6 +91,11 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
         sys.bases = base.into_iter().collect();
         sys
     }
+}
+
+/// The fluid's density, where the arm is immersed.
+fn buoyancy(structure: &Structure, symbols: &ParamSymbols) -> Option<ExprId> {
+    (structure.fluid.is_some()).then(|| symbols.get(Param::Fluid(FluidParam::Density)))
 }
 
 /// Segment s's kink: its turn as a rotation vector (0, y, z), about z

@@ -4,9 +4,10 @@
 
 use crate::model::{Check, Load, ModelError};
 
-/// Every `[[load]]` of a single-arm model.
+/// Every `[[load]]` of a single-arm model, and its `[fluid]`.
 pub(crate) fn check_loads(ck: &Check) -> Result<(), ModelError> {
     let m = ck.m;
+    check_fluid(ck)?;
     if m.is_assembly() && !m.loads.is_empty() {
         return ck.err(
             "load".into(),
@@ -104,6 +105,45 @@ fn check_load(ck: &Check, i: usize, l: &Load) -> Result<(), ModelError> {
                 seg.method.name()
             ),
         );
+    }
+    Ok(())
+}
+
+/// `[fluid]`: finite values, drag coefficients and density not negative;
+/// every segment a chain method's with an outer radius (its displaced
+/// volume and width); not on an assembly.
+fn check_fluid(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
+    let Some(f) = &m.fluid else {
+        return Ok(());
+    };
+    ck.non_negative("fluid.density", f.density)?;
+    ck.non_negative("fluid.drag_normal", f.drag_normal)?;
+    ck.non_negative("fluid.drag_tangential", f.drag_tangential)?;
+    ck.vec3("fluid.current", &f.current)?;
+    if m.is_assembly() {
+        return ck.err(
+            "fluid".into(),
+            "an immersed assembly is not supported yet: immerse a single arm".into(),
+        );
+    }
+    for (i, s) in m.segments.iter().enumerate() {
+        let method = crate::method::of(s.method);
+        if method.statics_only() || !method.takes_point_loads() {
+            return ck.err(
+                format!("segment[{i}].method"),
+                format!(
+                    "an immersed arm's segments are chain methods' (pcc, vc, pcs, ebr, rom, rigid), got {}",
+                    s.method.name()
+                ),
+            );
+        }
+        if s.outer_radius.is_none() {
+            return ck.err(
+                format!("segment[{i}].outer_radius"),
+                "missing: an immersed segment displaces and meets the fluid by its `outer_radius` (m)".into(),
+            );
+        }
     }
     Ok(())
 }

@@ -52,6 +52,7 @@ impl Structure {
             base_twists: false,
             contact_points: 0,
             loads: Vec::new(),
+            fluid: None,
             assembly: Some(Box::new(assembly)),
         }
     }
@@ -130,6 +131,7 @@ impl Structure {
             base_twists: m.base.turns_compliantly(),
             contact_points: m.contact_points(),
             loads: load_shapes(m),
+            fluid: m.fluid.as_ref().map(|f| f.drags()),
             assembly: None,
         }
     }

@@ -4,8 +4,9 @@
 
 use crate::model::sensor::{Source, wrench_sources};
 use crate::model::{
-    BodyParam, ElementParam, JointParam, KinkParam, LoadParam, Model, Param, ParamLayout, Segment,
-    SpringParam, Structure, base_quaternion, base_rotation, base_turn_axis, chamber_value,
+    BodyParam, ElementParam, FluidParam, JointParam, KinkParam, LoadParam, Model, Param,
+    ParamLayout, Segment, SpringParam, Structure, base_quaternion, base_rotation, base_turn_axis,
+    chamber_value,
 };
 
 impl ParamLayout {
@@ -77,6 +78,15 @@ impl ParamLayout {
                 }
                 Param::Load(i, LoadParam::Moment(c)) => {
                     m.loads[i].moment.map_or(0.0, |f| f[c.index()])
+                }
+                Param::Fluid(what) => {
+                    let f = m.fluid.as_ref().expect("the structure has the fluid");
+                    match what {
+                        FluidParam::Density => f.density,
+                        FluidParam::DragNormal => f.drag_normal,
+                        FluidParam::DragTangential => f.drag_tangential,
+                        FluidParam::Current(c) => f.current[c.index()],
+                    }
                 }
                 Param::Kink(s, KinkParam::Turn(i)) => {
                     let turn = m.segments[s].turn.as_deref().unwrap_or_default();
@@ -190,6 +200,10 @@ pub struct ElementProps {
     pub rest_y: f64,
     pub rest_twist: f64,
     pub rest_stretch: f64,
+    /// Immersed: the displaced volume (the outer section's) and the width
+    /// across the flow (the outer diameter).
+    pub volume: f64,
+    pub width: f64,
 }
 
 impl ElementProps {
@@ -210,6 +224,8 @@ impl ElementProps {
             ElementParam::RestY => self.rest_y,
             ElementParam::RestTwist => self.rest_twist,
             ElementParam::RestStretch => self.rest_stretch,
+            ElementParam::Volume => self.volume,
+            ElementParam::Width => self.width,
         }
     }
 }
@@ -276,6 +292,8 @@ fn props_of(m: &Model, [s, springs]: [&Segment; 2], l: f64, n: usize) -> Element
         rest_y: rest_y * l,
         rest_twist: rest_twist * l,
         rest_stretch: rest_stretch * l,
+        volume: std::f64::consts::PI * ro * ro * l,
+        width: 2.0 * ro,
         axial_inertia,
         twist_stiffness,
         twist_damping: damping,

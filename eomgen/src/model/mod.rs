@@ -8,6 +8,7 @@ mod assembly_params;
 mod check;
 pub mod contact;
 mod error;
+mod fluid;
 mod load;
 mod methods;
 mod overrides;
@@ -21,12 +22,13 @@ mod structure;
 
 pub(crate) use check::Check;
 pub use error::ModelError;
+pub use fluid::Fluid;
 pub use load::{Load, LoadFrame, LoadShape};
 pub(crate) use methods::methods;
 pub use overrides::Override;
 pub use params::{
-    BodyParam, ChamberParam, Driven, ElementParam, JointParam, KinkParam, LoadParam, Param,
-    ParamLayout, Rate, SpringParam, Xyz, base_rotation, base_turn_axis, channel,
+    BodyParam, ChamberParam, Driven, ElementParam, FluidParam, JointParam, KinkParam, LoadParam,
+    Param, ParamLayout, Rate, SpringParam, Xyz, base_rotation, base_turn_axis, channel,
 };
 pub(crate) use params::{base_quaternion, chamber_value};
 pub use profile::Profile;

@@ -84,6 +84,10 @@ pub enum ElementParam {
     RestY,
     RestTwist,
     RestStretch,
+    /// Immersed arms (`[fluid]`): the outer volume the element displaces
+    /// (m^3) and its width across the flow (m).
+    Volume,
+    Width,
 }
 
 impl ElementParam {
@@ -144,6 +148,8 @@ impl ElementParam {
             Self::RestY => ("joint", "rest_y"),
             Self::RestTwist => ("twist", "rest"),
             Self::RestStretch => ("stretch", "rest"),
+            Self::Volume => ("element", "volume"),
+            Self::Width => ("element", "width"),
         };
         format!("{group}[{k}].{what}")
     }
@@ -224,6 +230,17 @@ pub enum Param {
     Kink(usize, KinkParam),
     /// `[[load]]` `0`'s force and moment.
     Load(usize, LoadParam),
+    /// The fluid's density, drag coefficients and current.
+    Fluid(FluidParam),
+}
+
+/// The fluid's values (`[fluid]`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum FluidParam {
+    Density,
+    DragNormal,
+    DragTangential,
+    Current(Xyz),
 }
 
 /// A load's force (N, or N/m when distributed) and moment (N m).
@@ -333,6 +350,10 @@ impl Param {
                     format!("joint[{j}].q{}", ["w", "x", "y", "z"][i as usize])
                 }
             },
+            Self::Fluid(FluidParam::Density) => "fluid.density".into(),
+            Self::Fluid(FluidParam::DragNormal) => "fluid.drag_normal".into(),
+            Self::Fluid(FluidParam::DragTangential) => "fluid.drag_tangential".into(),
+            Self::Fluid(FluidParam::Current(c)) => format!("fluid.current.{}", c.name()),
             Self::Load(i, LoadParam::Force(c)) => format!("load[{i}].force.{}", c.name()),
             Self::Load(i, LoadParam::Moment(c)) => format!("load[{i}].moment.{}", c.name()),
             Self::Kink(s, KinkParam::Turn(i)) => format!("segment[{s}].turn[{i}]"),
@@ -471,8 +492,24 @@ impl ParamLayout {
                 if g.rest_3d {
                     p.extend(ElementParam::REST_3D.map(|e| Param::Element(k, e)));
                 }
+                if st.fluid.is_some() {
+                    p.extend(
+                        [ElementParam::Volume, ElementParam::Width].map(|e| Param::Element(k, e)),
+                    );
+                }
                 k += 1;
             }
+        }
+        if st.fluid.is_some() {
+            p.extend(
+                [
+                    FluidParam::Density,
+                    FluidParam::DragNormal,
+                    FluidParam::DragTangential,
+                ]
+                .map(Param::Fluid),
+            );
+            p.extend(Xyz::ALL.map(|c| Param::Fluid(FluidParam::Current(c))));
         }
         for (i, l) in st.loads.iter().enumerate() {
             for (given, driven, what) in [

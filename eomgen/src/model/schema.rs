@@ -62,6 +62,9 @@ pub struct Model {
     pub contact: Option<super::contact::ContactDecl>,
     #[serde(default, rename = "obstacle")]
     pub obstacles: Vec<super::contact::ObstacleDecl>,
+    /// The fluid the arm is immersed in: buoyancy and drag.
+    #[serde(default)]
+    pub fluid: Option<super::fluid::Fluid>,
 }
 
 /// `[simulate]`: how this arm is best simulated. Not structural.

@@ -89,6 +89,9 @@ pub struct Structure {
     pub contact_points: usize,
     /// The `[[load]]`s along the arm.
     pub loads: Vec<super::load::LoadShape>,
+    /// Immersed in a fluid (its parameters and the elements' displaced
+    /// volumes and widths exist), and whether it drags.
+    pub fluid: Option<bool>,
     /// Several arms, bodies and joints: the arms' own structures and what
     /// joins them (the fields above are then empty).
     pub assembly: Option<Box<AssemblyShape>>,
@@ -225,6 +228,9 @@ impl Structure {
         }
         if !self.loads.is_empty() {
             s.push_str(&format!("loads {:?}\n", self.loads));
+        }
+        if let Some(drags) = self.fluid {
+            s.push_str(&format!("fluid drag {drags}\n"));
         }
         if self.base_translates || self.base_turns > 0 {
             s.push_str(&format!(

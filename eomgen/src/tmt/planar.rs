@@ -12,7 +12,7 @@ use crate::cas::{Cas, ExprId};
 use crate::model::{ElementParam, Param, Structure};
 
 use super::actuation::{Strain, actuation};
-use super::along::{AlongLoad, Applied, Placed};
+use super::along::{AlongLoad, Applied, Drag, Placed};
 use super::system::{
     Body, Chain, Coordinates, Inertia, Link, ParamSymbols, PlanarFrames, PlanarPose, Sample,
     System, TipMount, tip_loads,
@@ -215,12 +215,28 @@ impl<'a> PlanarArm<'a> {
         self.apply_loads(cas, &at);
     }
 
+    /// The fluid the arm moves in: its drag, and its density for the
+    /// buoyancy.
+    pub fn set_fluid(&mut self, drag: Option<Drag>, buoyancy: Option<ExprId>) {
+        self.applied.drag = drag;
+        self.applied.buoyancy = buoyancy;
+    }
+
     /// The loads on the element being placed, at the frames `at` gives
     /// along it (a method that samples by `sample_all` calls this too).
     pub fn apply_loads(&mut self, cas: &mut Cas, at: &impl Fn(&mut Cas, f64) -> Frame) {
         let (k, link, z, zero) = (self.k, self.links.len(), self.z, self.zero);
-        self.applied
-            .element(cas, &self.loads, (k, link), &mut |cas, s| {
+        let mut pairs = self.coords.rate_pairs();
+        pairs.extend(&self.seeds);
+        let velocity = |cas: &mut Cas, p: &[ExprId; 3]| -> [ExprId; 3] {
+            let v = cas.time_derivatives(p, &pairs);
+            [v[0], v[1], v[2]]
+        };
+        self.applied.element(
+            cas,
+            &self.loads,
+            (k, link),
+            &mut |cas, s| {
                 let f = at(cas, s);
                 let (c, sn) = (cas.cos(f.phi), cas.sin(f.phi));
                 let (c, sn) = (cas.bind(c), cas.bind(sn));
@@ -231,7 +247,10 @@ impl<'a> PlanarArm<'a> {
                     rotation: [[c, ns, zero], [sn, c, zero], [zero, zero, one]],
                     omega: [zero, zero, f.w],
                 }
-            });
+            },
+            &velocity,
+            self.symbols,
+        );
     }
 
     /// Points along the element given all at once (P of them, at s = 1/P,
@@ -319,6 +338,7 @@ impl<'a> PlanarArm<'a> {
         let rayleigh = cas.add_all(&rayleigh);
         let actuation = actuation(cas, symbols, structure, &strains);
         let tip_orientation = [cas.cos(half_phi), zero, zero, cas.sin(half_phi)];
+        let element_of_body = body_link.clone();
         let mut sys = System {
             coords,
             bodies,
@@ -366,7 +386,7 @@ impl<'a> PlanarArm<'a> {
             omega: [zero, zero, f.w],
             rotation,
         };
-        applied.attach(&mut sys);
+        applied.attach(cas, &mut sys, symbols, &element_of_body);
         let tip = tip_loads(cas, symbols, structure, &mount);
         sys.attach_tip(tip, last_link);
         sys

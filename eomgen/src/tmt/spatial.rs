@@ -30,7 +30,7 @@ use crate::cas::{Cas, ExprId, Func};
 use crate::model::{ElementParam, Param, SegmentShape, Structure};
 
 use super::actuation::{Strain, actuation, thinning};
-use super::along::{AlongLoad, Applied, Placed};
+use super::along::{AlongLoad, Applied, Drag, Placed};
 use super::system::{
     Body, Chain, Coordinates, Inertia, Link, ParamSymbols, Sample, System, TipMount, tip_loads,
 };
@@ -532,15 +532,34 @@ impl<'a> SpatialArm<'a> {
         }
         // The loads on this element, at the frames it places.
         let (k, link) = (self.k, self.links.len());
-        self.applied
-            .element(cas, &self.loads, (k, link), &mut |cas, s| {
+        let mut pairs = self.coords.rate_pairs();
+        pairs.extend(&self.seeds);
+        let velocity = |cas: &mut Cas, p: &[ExprId; 3]| -> [ExprId; 3] {
+            let v = cas.time_derivatives(p, &pairs);
+            [v[0], v[1], v[2]]
+        };
+        self.applied.element(
+            cas,
+            &self.loads,
+            (k, link),
+            &mut |cas, s| {
                 let f = at(cas, s);
                 Placed {
                     point: f.p,
                     rotation: f.r,
                     omega: f.w,
                 }
-            });
+            },
+            &velocity,
+            self.symbols,
+        );
+    }
+
+    /// The fluid the arm moves in: its drag, and its density for the
+    /// buoyancy.
+    pub fn set_fluid(&mut self, drag: Option<Drag>, buoyancy: Option<ExprId>) {
+        self.applied.drag = drag;
+        self.applied.buoyancy = buoyancy;
     }
 
     /// The shape's first point: the frame the arm starts from.
@@ -666,6 +685,7 @@ impl<'a> SpatialArm<'a> {
         let elastic = cas.add_all(&elastic);
         let rayleigh = cas.add_all(&rayleigh);
         let actuation = actuation(cas, symbols, structure, &strains);
+        let element_of_body = body_link.clone();
         let mut sys = System {
             coords,
             bodies,
@@ -695,7 +715,7 @@ impl<'a> SpatialArm<'a> {
             omega: f.w,
             rotation: f.r,
         };
-        applied.attach(&mut sys);
+        applied.attach(cas, &mut sys, symbols, &element_of_body);
         let tip = tip_loads(cas, symbols, structure, &mount);
         sys.attach_tip(tip, last_link);
         sys

@@ -1,0 +1,143 @@
+//! An immersed arm (`[fluid]`) against closed forms and a conservation
+//! law, on a cantilever (L = 0.2 m, r = 10 mm, E = 1 MPa, rho = 1000):
+//!
+//! * in a fluid of its own density it floats straight under gravity; in
+//!   one of half its density it sags as beam theory says under half its
+//!   weight, q L^4 / (8 E I) with q = (rho - rho_f) A g;
+//! * a steady current U across it bends it as the distributed load
+//!   rho_f C_n d U^2 / 2 does;
+//! * moving, drag only dissipates: the energy of a released arm falls
+//!   from one sample to the next, where without the fluid it is kept.
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+use crate::common::*;
+use runtime::{SimOptions, StaticOptions, simulate, solve_static};
+
+const L: f64 = 0.2;
+const E: f64 = 1e6;
+const R: f64 = 0.01;
+const RHO: f64 = 1000.0;
+
+fn ei() -> f64 {
+    E * PI * R.powi(4) / 4.0
+}
+
+fn immersed(gravity: f64, fluid: &str, elements: usize) -> String {
+    format!(
+        r#"
+name = "immersed"
+dimensions = 3
+gravity = [0.0, 0.0, {gravity}]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = {L}
+elements = {elements}
+density = {RHO}
+outer_radius = {R}
+youngs_modulus = {E}
+{fluid}
+"#
+    )
+}
+
+fn static_tip(dir: &Path, text: &str) -> [f64; 3] {
+    let mut l = load_text(dir, text, &[]);
+    let n = l.arm.dof();
+    let sol = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
+    let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
+    [o[0], o[1], o[2]]
+}
+
+#[test]
+fn buoyancy_floats_a_neutral_arm_and_halves_a_denser_ones_sag() {
+    let dir = tempfile::tempdir().unwrap();
+    let g = -9.81e-3;
+    let neutral = static_tip(
+        dir.path(),
+        &immersed(g, &format!("[fluid]\ndensity = {RHO}"), 8),
+    );
+    assert!(
+        (neutral[0] - L).abs() < 1e-12 && neutral[2].abs() < 1e-12,
+        "{neutral:?}"
+    );
+    let q = (RHO - RHO / 2.0) * PI * R * R * g;
+    let want = q * L.powi(4) / (8.0 * ei());
+    let half = format!("[fluid]\ndensity = {}", RHO / 2.0);
+    let err = |n| (static_tip(dir.path(), &immersed(g, &half, n))[2] - want) / want;
+    let (coarse, fine) = (err(8), err(16));
+    assert!(
+        fine.abs() < 3e-3 && fine.abs() * 3.5 < coarse.abs(),
+        "sag in a fluid of half its density: {coarse:.2e} at 8 elements, {fine:.2e} at 16"
+    );
+}
+
+#[test]
+fn a_steady_current_bends_the_arm_by_its_drag() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rho_f, cn, u) = (1000.0, 1.2, 0.03);
+    let fluid =
+        format!("[fluid]\ndensity = {rho_f}\ndrag_normal = {cn}\ncurrent = [0.0, 0.0, {u}]");
+    let q = 0.5 * rho_f * cn * 2.0 * R * u * u;
+    let want = q * L.powi(4) / (8.0 * ei());
+    assert!(want < 2e-3 * L, "the linear range: {want}");
+    let err = |n| (static_tip(dir.path(), &immersed(0.0, &fluid, n))[2] - want) / want;
+    let (coarse, fine) = (err(8), err(16));
+    assert!(
+        fine.abs() < 3e-3 && fine.abs() * 3.0 < coarse.abs(),
+        "bent by the current: {coarse:.2e} at 8 elements, {fine:.2e} at 16"
+    );
+}
+
+#[test]
+fn drag_only_takes_energy_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let energies = |fluid: &str| -> Vec<f64> {
+        let l = load_text(dir.path(), &immersed(0.0, fluid, 4), &[]);
+        let n = l.arm.dof();
+        let mut x0 = vec![0.0; 2 * n];
+        x0[1] = 0.3; // the first element bent about z
+        let opts = SimOptions {
+            t_end: 0.5,
+            output_dt: 0.01,
+            rtol: 1e-9,
+            atol: 1e-12,
+            ..Default::default()
+        };
+        let (traj, _) = simulate(&*l.arm, x0, &opts).unwrap();
+        (traj.x.iter())
+            .map(|x| {
+                let o = l.arm.outputs(0.0, &x[..n], &x[n..]);
+                let names = runtime::OUTPUT_NAMES;
+                let at = |k: &str| o[names.iter().position(|n| *n == k).unwrap()];
+                at("kinetic") + at("potential")
+            })
+            .collect()
+    };
+    let kept = energies("");
+    let drift = kept.iter().map(|e| (e - kept[0]).abs()).fold(0.0, f64::max);
+    assert!(
+        drift < 1e-6 * kept[0],
+        "undamped and dry, drift {drift:e} of {}",
+        kept[0]
+    );
+    let dragged = energies("[fluid]\ndensity = 1000.0\ndrag_normal = 1.2");
+    for w in dragged.windows(2) {
+        assert!(
+            w[1] <= w[0] + 1e-12 * dragged[0],
+            "energy rose: {} to {}",
+            w[0],
+            w[1]
+        );
+    }
+    let last = dragged[dragged.len() - 1];
+    assert!(
+        last < 0.9 * dragged[0],
+        "dragged: {} of {}",
+        last,
+        dragged[0]
+    );
+}
