@@ -425,10 +425,6 @@ impl ParamLayout {
         let spatial = st.dimensions == 3;
         let mut p = Vec::new();
         let mut driven = Vec::new();
-        let mut drive = |p: &mut Vec<Param>, param: Param, derivative: u8| {
-            driven.push(Driven { param, derivative });
-            p.push(param);
-        };
         p.extend(Xyz::ALL.map(Param::Gravity));
         p.extend(Xyz::ALL.map(Param::BasePosition));
         if spatial {
@@ -446,7 +442,7 @@ impl ParamLayout {
                 for c in Xyz::ALL {
                     let param = Param::BaseTranslation(r, c);
                     match c.index() < moving {
-                        true => drive(&mut p, param, r.derivative()),
+                        true => drive(&mut p, &mut driven, param, r.derivative()),
                         false => p.push(param),
                     }
                 }
@@ -454,7 +450,7 @@ impl ParamLayout {
         }
         for i in 0..st.base_turns {
             for r in Rate::ALL {
-                drive(&mut p, Param::BaseTurn(r, i), r.derivative());
+                drive(&mut p, &mut driven, Param::BaseTurn(r, i), r.derivative());
             }
             if spatial {
                 p.extend(Xyz::ALL.map(|c| Param::BaseTurnAxis(i, c)));
@@ -466,7 +462,7 @@ impl ParamLayout {
         if st.tip_force {
             for c in Xyz::ALL {
                 match st.tip_force_driven {
-                    true => drive(&mut p, Param::TipForce(c), 0),
+                    true => drive(&mut p, &mut driven, Param::TipForce(c), 0),
                     false => p.push(Param::TipForce(c)),
                 }
             }
@@ -474,7 +470,7 @@ impl ParamLayout {
         if st.tip_moment {
             for c in Xyz::ALL {
                 match st.tip_moment_driven {
-                    true => drive(&mut p, Param::TipMoment(c), 0),
+                    true => drive(&mut p, &mut driven, Param::TipMoment(c), 0),
                     false => p.push(Param::TipMoment(c)),
                 }
             }
@@ -482,59 +478,7 @@ impl ParamLayout {
         if st.tip_length {
             p.extend([Param::TipLength, Param::TipInertia, Param::TipAxialInertia]);
         }
-        let mut k = 0;
-        for g in &st.segments {
-            for _ in 0..g.elements {
-                p.extend(ElementParam::PLANAR.map(|e| Param::Element(k, e)));
-                if spatial {
-                    p.extend(ElementParam::SPATIAL.map(|e| Param::Element(k, e)));
-                }
-                if g.rest_3d {
-                    p.extend(ElementParam::REST_3D.map(|e| Param::Element(k, e)));
-                }
-                if st.fluid.is_some() {
-                    p.extend(
-                        [ElementParam::Volume, ElementParam::Width].map(|e| Param::Element(k, e)),
-                    );
-                }
-                k += 1;
-            }
-        }
-        if st.fluid.is_some() {
-            p.extend(
-                [
-                    FluidParam::Density,
-                    FluidParam::DragNormal,
-                    FluidParam::DragTangential,
-                ]
-                .map(Param::Fluid),
-            );
-            p.extend(Xyz::ALL.map(|c| Param::Fluid(FluidParam::Current(c))));
-        }
-        for (i, l) in st.loads.iter().enumerate() {
-            for (given, driven, what) in [
-                (
-                    l.force,
-                    l.force_driven,
-                    LoadParam::Force as fn(Xyz) -> LoadParam,
-                ),
-                (l.moment, l.moment_driven, LoadParam::Moment),
-            ] {
-                for c in Xyz::ALL.iter().filter(|_| given) {
-                    match driven {
-                        true => drive(&mut p, Param::Load(i, what(*c)), 0),
-                        false => p.push(Param::Load(i, what(*c))),
-                    }
-                }
-            }
-        }
-        for (s, g) in st.segments.iter().enumerate() {
-            if g.kink {
-                let turns = if spatial { 2 } else { 1 };
-                p.extend((0..turns).map(|i| Param::Kink(s, KinkParam::Turn(i))));
-                p.extend(Xyz::ALL.map(|c| Param::Kink(s, KinkParam::Offset(c))));
-            }
-        }
+        along_arm(st, &mut p, &mut driven);
         for (segment, &count) in st.chambers.iter().enumerate() {
             for position in 0..count {
                 for what in ChamberParam::ALL {
@@ -544,14 +488,14 @@ impl ParamLayout {
                         what,
                     };
                     match what {
-                        ChamberParam::Pressure => drive(&mut p, param, 0),
+                        ChamberParam::Pressure => drive(&mut p, &mut driven, param, 0),
                         _ => p.push(param),
                     }
                 }
             }
         }
         for (tendon, &end) in st.tendons.iter().enumerate() {
-            drive(&mut p, Param::TendonTension(tendon), 0);
+            drive(&mut p, &mut driven, Param::TendonTension(tendon), 0);
             for segment in 0..=end {
                 for z in [false, true] {
                     p.push(Param::TendonOffset { tendon, segment, z });
@@ -559,7 +503,7 @@ impl ParamLayout {
             }
         }
         for i in 0..st.torques.len() {
-            drive(&mut p, Param::Torque(i), 0);
+            drive(&mut p, &mut driven, Param::Torque(i), 0);
         }
         // Drives in the order input channels are bound: base, tip, chambers,
         // tendons, torques (the layout's order).
@@ -744,4 +688,68 @@ pub fn base_rotation(d: [f64; 3]) -> [[f64; 3]; 3] {
         }
     }
     r
+}
+
+/// A driven parameter: in the layout, and an input sets it.
+fn drive(p: &mut Vec<Param>, driven: &mut Vec<Driven>, param: Param, derivative: u8) {
+    driven.push(Driven { param, derivative });
+    p.push(param);
+}
+
+/// What lies along a single arm: each element's parameters (a 3D rest
+/// shape's and an immersed arm's too), the fluid's, the loads' and the
+/// kinks'.
+fn along_arm(st: &Structure, p: &mut Vec<Param>, driven: &mut Vec<Driven>) {
+    let spatial = st.dimensions == 3;
+    let mut k = 0;
+    for g in &st.segments {
+        for _ in 0..g.elements {
+            p.extend(ElementParam::PLANAR.map(|e| Param::Element(k, e)));
+            if spatial {
+                p.extend(ElementParam::SPATIAL.map(|e| Param::Element(k, e)));
+            }
+            if g.rest_3d {
+                p.extend(ElementParam::REST_3D.map(|e| Param::Element(k, e)));
+            }
+            if st.fluid.is_some() {
+                p.extend([ElementParam::Volume, ElementParam::Width].map(|e| Param::Element(k, e)));
+            }
+            k += 1;
+        }
+    }
+    if st.fluid.is_some() {
+        p.extend(
+            [
+                FluidParam::Density,
+                FluidParam::DragNormal,
+                FluidParam::DragTangential,
+            ]
+            .map(Param::Fluid),
+        );
+        p.extend(Xyz::ALL.map(|c| Param::Fluid(FluidParam::Current(c))));
+    }
+    for (i, l) in st.loads.iter().enumerate() {
+        for (given, by_input, what) in [
+            (
+                l.force,
+                l.force_driven,
+                LoadParam::Force as fn(Xyz) -> LoadParam,
+            ),
+            (l.moment, l.moment_driven, LoadParam::Moment),
+        ] {
+            for c in Xyz::ALL.iter().filter(|_| given) {
+                match by_input {
+                    true => drive(p, driven, Param::Load(i, what(*c)), 0),
+                    false => p.push(Param::Load(i, what(*c))),
+                }
+            }
+        }
+    }
+    for (s, g) in st.segments.iter().enumerate() {
+        if g.kink {
+            let turns = if spatial { 2 } else { 1 };
+            p.extend((0..turns).map(|i| Param::Kink(s, KinkParam::Turn(i))));
+            p.extend(Xyz::ALL.map(|c| Param::Kink(s, KinkParam::Offset(c))));
+        }
+    }
 }
