@@ -24,6 +24,8 @@ pub struct RunRequest {
     pub q0: Option<Vec<f64>>,
     pub qd0: Option<Vec<f64>>,
     pub start: Option<Start>,
+    /// generalized-alpha's spectral radius at infinity.
+    pub rho_inf: Option<f64>,
 }
 
 /// The run's options. Errors name the option as the command line spells
@@ -50,6 +52,12 @@ pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> 
         if !(v > 0.0 && v.is_finite()) {
             bail!("{name} must be positive, got {v}");
         }
+    }
+    let rho_inf = req.rho_inf.or(file.rho_inf).unwrap_or(defaults.rho_inf);
+    if !(0.0..=1.0).contains(&rho_inf) {
+        bail!(
+            "--rho-inf must lie in [0, 1] (1: no numerical damping, 0: unresolved modes gone in a step), got {rho_inf}"
+        );
     }
     let max_steps = req.max_steps.unwrap_or(defaults.max_steps);
     if max_steps == 0 {
@@ -86,6 +94,7 @@ pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> 
         dt,
         output_dt,
         max_steps,
+        rho_inf,
         ..defaults
     })
 }

@@ -342,6 +342,7 @@ impl Model {
             q0: q0.map(|v| vector("q0", Some(v), n)).transpose()?,
             qd0: qd0.map(|v| vector("qd0", Some(v), n)).transpose()?,
             start,
+            rho_inf: None,
         };
         let mut opts =
             softarm::run::options(&req, &self.loaded.model.simulate).map_err(value_error)?;

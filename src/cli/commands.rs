@@ -186,6 +186,11 @@ pub struct SimulateArgs {
     /// Give up after this many steps (accepted and rejected).
     #[arg(long, default_value_t = SimOptions::default().max_steps)]
     pub max_steps: usize,
+    /// genalpha's spectral radius at infinity, in [0, 1]: how much of a
+    /// mode far above the step's resolution survives a step [default:
+    /// simulate.rho_inf, else 0.8].
+    #[arg(long)]
+    pub rho_inf: Option<f64>,
     /// Spacing of trajectory.csv rows (s); default t_end / 500.
     #[arg(long, allow_negative_numbers = true)]
     pub output_dt: Option<f64>,
@@ -234,6 +239,7 @@ fn request(a: &SimulateArgs, loaded: &Loaded) -> Result<RunRequest> {
         atol: a.atol,
         max_steps: Some(a.max_steps),
         output_dt: a.output_dt,
+        rho_inf: a.rho_inf,
         q0: a
             .q0
             .as_ref()

@@ -1121,6 +1121,11 @@ fn taper_cases() -> Vec<FileCase> {
             ],
         ),
         (
+            "inner radius below zero",
+            r("outer_radius = 0.01", "outer_radius = 0.01\ninner_radius = -0.001"),
+            vec!["segment[0].inner_radius", "zero or positive"],
+        ),
+        (
             "tapered inner radius reaching the outer",
             r(
                 "outer_radius = 0.01",

@@ -68,6 +68,14 @@ fn simulate_defaults(ck: &Check) -> Result<(), ModelError> {
             ck.positive(key, v)?;
         }
     }
+    if let Some(rho) = sim.rho_inf
+        && !(0.0..=1.0).contains(&rho)
+    {
+        return ck.err(
+            "simulate.rho_inf".into(),
+            format!("must lie in [0, 1] (1: no numerical damping), got {rho}"),
+        );
+    }
     Ok(())
 }
 
@@ -368,8 +376,9 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
             }
         }
     }
+    // Every value positive, the inner radius only not negative (below).
     for (key, v) in s.profiles() {
-        if let Some(v) = v {
+        if let Some(v) = v.filter(|_| key != "inner_radius") {
             ck.positive_along(&p(key), v)?;
         }
     }

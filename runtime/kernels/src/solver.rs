@@ -26,6 +26,10 @@ pub enum Solver {
     Trbdf2,
     /// ESDIRK 3(2) 4-stage, L-stable, adaptive (the crate's).
     Esdirk,
+    /// Generalized-alpha (Chung and Hulbert), second order, adaptive: the
+    /// structural dynamicist's method, damping unresolved high modes to
+    /// the spectral radius `rho_inf`.
+    GenAlpha,
     /// dopri5, switching to radau5 when the arm turns out stiff (checked
     /// from the Jacobian's eigenvalues at the start and every
     /// `AUTO_CHECK_STEPS` accepted steps).
@@ -34,7 +38,7 @@ pub enum Solver {
 
 /// Every solver with its name and the order of its global error (bdf's
 /// highest; auto's dopri5's), in the order `--solver` lists them.
-const TABLE: [(Solver, &str, u32); 10] = [
+const TABLE: [(Solver, &str, u32); 11] = [
     (Solver::Dopri5, "dopri5", 5),
     (Solver::Bs23, "bs23", 3),
     (Solver::Dop853, "dop853", 8),
@@ -44,6 +48,7 @@ const TABLE: [(Solver, &str, u32); 10] = [
     (Solver::Bdf, "bdf", 5),
     (Solver::Trbdf2, "trbdf2", 2),
     (Solver::Esdirk, "esdirk", 3),
+    (Solver::GenAlpha, "genalpha", 2),
     (Solver::Auto, "auto", 5),
 ];
 
@@ -101,7 +106,10 @@ impl Solver {
 
     /// Implicit methods (they use the analytic Jacobian).
     pub fn implicit(self) -> bool {
-        matches!(self, Self::Radau5 | Self::Bdf | Self::Trbdf2 | Self::Esdirk)
+        matches!(
+            self,
+            Self::Radau5 | Self::Bdf | Self::Trbdf2 | Self::Esdirk | Self::GenAlpha
+        )
     }
 }
 

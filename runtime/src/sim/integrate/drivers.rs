@@ -204,6 +204,7 @@ pub(super) fn run_own(
         rtol: opts.rtol,
         atol: opts.atol,
         max_steps: opts.max_steps,
+        rho_inf: opts.rho_inf,
     };
     let start = Instant::now();
     let result = integrate(

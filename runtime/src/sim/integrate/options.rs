@@ -45,7 +45,15 @@ pub struct SimOptions {
     /// control loop's steps): its contacts keep the records of how they
     /// began. Otherwise they begin afresh (`ContactSet::clear_records`).
     pub continues: bool,
+    /// generalized-alpha's spectral radius at infinity, in [0, 1]: how much
+    /// of a mode far above the step's resolution survives a step (1: all,
+    /// no numerical damping; 0: none).
+    pub rho_inf: f64,
 }
+
+/// The default spectral radius at infinity: modes the step does not resolve
+/// lose a fifth of their amplitude a step, those it resolves next to none.
+pub const DEFAULT_RHO_INF: f64 = 0.8;
 
 /// The reason of a run stopped by its `SimOptions::interrupt`.
 pub const INTERRUPTED: &str = "interrupted";
@@ -77,6 +85,7 @@ impl Default for SimOptions {
             interrupt: None,
             rows: None,
             continues: false,
+            rho_inf: DEFAULT_RHO_INF,
         }
     }
 }

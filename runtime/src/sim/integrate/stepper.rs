@@ -23,6 +23,8 @@ pub struct Options {
     pub rtol: f64,
     pub atol: f64,
     pub max_steps: usize,
+    /// generalized-alpha's spectral radius at infinity.
+    pub rho_inf: f64,
 }
 
 /// Sees every accepted step (t_prev, t, y_prev, y, dense output over the

@@ -11,6 +11,7 @@ mod dop853;
 mod dopri5;
 mod esdirk;
 mod euler;
+pub mod genalpha;
 pub mod radau5;
 mod rk4;
 pub mod trbdf2;
@@ -26,7 +27,7 @@ pub(super) trait Integrator: Sync {
     fn run(&self, arm: &dyn Dynamics, t0: f64, x0: Vec<f64>, opts: &SimOptions) -> RunResult;
 }
 
-/// A stepper written here (`bs23`, `radau5`, `trbdf2`), run through the
+/// A stepper written here (`bs23`, `radau5`, `trbdf2`, `genalpha`), run through the
 /// recorder by `drivers::run_own`.
 pub(super) struct Own(pub OwnIntegrator);
 
@@ -48,6 +49,7 @@ pub(super) fn of(solver: Solver) -> &'static dyn Integrator {
         Solver::Bdf => &bdf::Bdf,
         Solver::Trbdf2 => &Own(trbdf2::integrate),
         Solver::Esdirk => &esdirk::Esdirk,
+        Solver::GenAlpha => &Own(genalpha::integrate),
         Solver::Auto => &auto::Auto,
     }
 }
