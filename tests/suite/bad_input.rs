@@ -1122,7 +1122,10 @@ fn taper_cases() -> Vec<FileCase> {
         ),
         (
             "inner radius below zero",
-            r("outer_radius = 0.01", "outer_radius = 0.01\ninner_radius = -0.001"),
+            r(
+                "outer_radius = 0.01",
+                "outer_radius = 0.01\ninner_radius = -0.001",
+            ),
             vec!["segment[0].inner_radius", "zero or positive"],
         ),
         (

@@ -58,11 +58,36 @@ impl Alpha {
 }
 
 /// One step's state: positions and velocities (the ODE's state), the
-/// true acceleration there and the pseudo-acceleration.
+/// true acceleration there and the pseudo-acceleration, with the step
+/// that made it.
 struct Point {
     y: Vec<f64>,
     f: Vec<f64>,
     a: Vec<f64>,
+    h: Option<f64>,
+}
+
+/// The pseudo-acceleration a step of size h starts from. a_n tracks
+/// qdd(t_n + (alpha_m - alpha_f) h): second order in q and v only if it
+/// starts so, qdd_0 + (alpha_m - alpha_f) h qddd_0 (qddd from the
+/// Jacobian: J_q v + J_v qdd), and when the step changes its lead over
+/// qdd scales with it.
+fn started(al: &Alpha, p: &Point, h: f64, j: &DMatrix<f64>) -> Vec<f64> {
+    let n = p.a.len();
+    let acc = &p.f[n..];
+    match p.h {
+        Some(h0) => (0..n)
+            .map(|i| acc[i] + (p.a[i] - acc[i]) * h / h0)
+            .collect(),
+        None => (0..n)
+            .map(|i| {
+                let jerk: f64 = (0..n)
+                    .map(|k| j[(n + i, k)] * p.y[n + k] + j[(n + i, n + k)] * acc[k])
+                    .sum();
+                acc[i] + (al.alpha_m - al.alpha_f) * h * jerk
+            })
+            .collect(),
+    }
 }
 
 /// The step's end for the pseudo-acceleration `a1`, from `p`.
@@ -149,7 +174,12 @@ pub fn integrate(
     let mut f = vec![0.0; m];
     sys.rhs(t0, &y0, &mut f);
     let a = f[n..].to_vec();
-    let mut p = Point { y: y0, f, a };
+    let mut p = Point {
+        y: y0,
+        f,
+        a,
+        h: None,
+    };
     let mut t = t0;
     let (mut y1, mut f1, mut a1) = (vec![0.0; m], vec![0.0; m], vec![0.0; n]);
     let mut j = DMatrix::zeros(m, m);
@@ -176,6 +206,8 @@ pub fn integrate(
         let lu = s.lu();
         let scale: Vec<f64> = p.y[..n].iter().map(|v| atol + rtol * v.abs()).collect();
         let t1 = if last { t_end } else { t + h };
+        p.a = started(&al, &p, t1 - t, &j);
+        p.h = Some(t1 - t);
         a1.copy_from_slice(&p.a);
         let converged = newton(
             sys,
@@ -199,9 +231,7 @@ pub fn integrate(
         let hs = t1 - t;
         let raw = DVector::from_iterator(
             n,
-            (0..n).map(|i| {
-                (1.0 - al.alpha_m) * hs * hs * (al.beta - 1.0 / 6.0) * (a1[i] - p.a[i])
-            }),
+            (0..n).map(|i| (1.0 - al.alpha_m) * hs * hs * (al.beta - 1.0 / 6.0) * (a1[i] - p.a[i])),
         );
         let filtered: Vec<f64> = lu
             .solve(&raw)
@@ -237,4 +267,122 @@ pub fn integrate(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// x'' = -w^2 x - 2 zeta w x', as a first-order system (x, v).
+    struct Oscillator {
+        w: f64,
+        zeta: f64,
+    }
+
+    impl OdeSystem for Oscillator {
+        fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) {
+            dy[0] = y[1];
+            dy[1] = -self.w * self.w * y[0] - 2.0 * self.zeta * self.w * y[1];
+        }
+
+        fn jacobian(&mut self, _t: f64, _y: &[f64], j: &mut DMatrix<f64>) {
+            *j = DMatrix::from_row_slice(
+                2,
+                2,
+                &[0.0, 1.0, -self.w * self.w, -2.0 * self.zeta * self.w],
+            );
+        }
+    }
+
+    /// `steps` fixed steps of size h from x = 1, v = 0.
+    fn run(sys: &mut Oscillator, rho: f64, h: f64, steps: usize) -> Vec<f64> {
+        let al = Alpha::of(rho);
+        let mut f = vec![0.0; 2];
+        sys.rhs(0.0, &[1.0, 0.0], &mut f);
+        let mut p = Point {
+            y: vec![1.0, 0.0],
+            a: vec![f[1]],
+            f,
+            h: None,
+        };
+        let mut j = DMatrix::zeros(2, 2);
+        sys.jacobian(0.0, &p.y, &mut j);
+        p.a = started(&al, &p, h, &j);
+        p.h = Some(h);
+        let kq = (1.0 - al.alpha_f) * h * h * al.beta;
+        let kv = (1.0 - al.alpha_f) * h * al.gamma;
+        let s = DMatrix::from_element(1, 1, 1.0 - al.alpha_m - kq * j[(1, 0)] - kv * j[(1, 1)]);
+        let lu = s.lu();
+        let (mut y1, mut f1, mut a1) = (vec![0.0; 2], vec![0.0; 2], vec![0.0; 1]);
+        for k in 0..steps {
+            a1.copy_from_slice(&p.a);
+            let t1 = (k + 1) as f64 * h;
+            newton(
+                sys,
+                &al,
+                &lu,
+                (&p, t1, h),
+                &mut a1,
+                &mut y1,
+                &mut f1,
+                &[1.0],
+                1e-14,
+            )
+            .expect("a linear system converges");
+            std::mem::swap(&mut p.y, &mut y1);
+            std::mem::swap(&mut p.f, &mut f1);
+            std::mem::swap(&mut p.a, &mut a1);
+        }
+        p.y
+    }
+
+    #[test]
+    fn second_order_on_a_damped_oscillator() {
+        let (w, zeta, t): (f64, f64, f64) = (2.0 * std::f64::consts::PI, 0.05, 1.0);
+        let wd = w * (1.0 - zeta * zeta).sqrt();
+        let exact = (-zeta * w * t).exp() * ((wd * t).cos() + zeta * w / wd * (wd * t).sin());
+        for rho in [1.0, 0.8, 0.0] {
+            let err = |steps: usize| {
+                let h = t / steps as f64;
+                (run(&mut Oscillator { w, zeta }, rho, h, steps)[0] - exact).abs()
+            };
+            let (coarse, fine) = (err(800), err(1600));
+            let ratio = coarse / fine;
+            assert!(
+                (3.6..4.4).contains(&ratio),
+                "rho_inf {rho}: halving h divides the error by {ratio}, not 4 ({coarse:e}, {fine:e})"
+            );
+        }
+    }
+
+    #[test]
+    fn a_mode_far_above_the_step_loses_amplitude_by_rho_inf_a_step() {
+        // w h = 1e5: the step does not resolve the mode at all. Its
+        // position falls by the spectral radius a step (a double
+        // eigenvalue -rho_inf: about k rho^k, so measured between steps
+        // 100 and 200, where the factor 2 is a 100th root).
+        let (w, h) = (1e5, 1.0);
+        for rho in [0.5f64, 0.8] {
+            let q = |steps| run(&mut Oscillator { w, zeta: 0.0 }, rho, h, steps)[0].abs();
+            let measured = (q(200) / q(100) / 2.0).powf(1.0 / 100.0);
+            assert!(
+                (measured - rho).abs() < 1e-2,
+                "rho_inf {rho}: the mode falls by {measured} a step"
+            );
+        }
+        let gone = run(&mut Oscillator { w, zeta: 0.0 }, 0.0, h, 3)[0];
+        assert!(gone.abs() < 1e-9, "rho_inf 0 leaves {gone:e}");
+    }
+
+    #[test]
+    fn without_numerical_damping_an_oscillator_keeps_its_energy() {
+        // rho_inf = 1: the average-acceleration rule, which conserves a
+        // linear oscillator's energy exactly, at any step.
+        let w = 3.0;
+        for h in [1e-3, 0.1, 10.0] {
+            let y = run(&mut Oscillator { w, zeta: 0.0 }, 1.0, h, 1000);
+            let energy = y[0] * y[0] + (y[1] / w).powi(2);
+            assert!((energy - 1.0).abs() < 1e-10, "h {h}: energy {energy}");
+        }
+    }
 }
