@@ -13,11 +13,8 @@
 //!   constant does.
 
 use std::f64::consts::PI;
-use std::path::Path;
 
 use crate::common::*;
-use eomgen::model::Override;
-use runtime::{StaticOptions, solve_static};
 
 const L: f64 = 0.2;
 const E: f64 = 1e6;
@@ -45,25 +42,6 @@ youngs_modulus = {E}
 {extra}
 "#
     )
-}
-
-fn static_tip(dir: &Path, text: &str, sets: &[String]) -> [f64; 3] {
-    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
-    if sets.contains(&"segment.0.method=cosserat") {
-        let path = dir.join("model.toml");
-        std::fs::write(&path, text).unwrap();
-        let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
-        let spec = path.to_str().unwrap();
-        let (model, origin) = softarm::backend::read_model(spec, &overrides).unwrap();
-        return softarm::continuum::solve(&model, &origin)
-            .unwrap()
-            .tip_position;
-    }
-    let mut l = load_text(dir, text, &sets);
-    let n = l.arm.dof();
-    let sol = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
-    let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
-    [o[0], o[1], o[2]]
 }
 
 fn sets(method: &str, n: usize) -> Vec<String> {

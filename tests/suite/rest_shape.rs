@@ -10,10 +10,7 @@
 //! * under a tip load, every method converges to the Cosserat rod;
 //! * at rest it stays at rest.
 
-use std::path::Path;
-
 use crate::common::*;
-use eomgen::model::Override;
 use runtime::{SimOptions, StaticOptions, simulate, solve_static};
 
 const L: f64 = 0.2;
@@ -61,25 +58,6 @@ fn constant_strain_tip(u: [f64; 3], v: [f64; 3], len: f64) -> [f64; 3] {
     let kv = cross(rho, v);
     let kkv = cross(rho, kv);
     std::array::from_fn(|i| len * (v[i] + c2 * kv[i] + c3 * kkv[i]))
-}
-
-fn static_tip(dir: &Path, text: &str, sets: &[String]) -> [f64; 3] {
-    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
-    if sets.contains(&"segment.0.method=cosserat") {
-        let path = dir.join("model.toml");
-        std::fs::write(&path, text).unwrap();
-        let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
-        let spec = path.to_str().unwrap();
-        let (model, origin) = softarm::backend::read_model(spec, &overrides).unwrap();
-        return softarm::continuum::solve(&model, &origin)
-            .unwrap()
-            .tip_position;
-    }
-    let mut l = load_text(dir, text, &sets);
-    let n = l.arm.dof();
-    let sol = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
-    let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
-    [o[0], o[1], o[2]]
 }
 
 fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {

@@ -10,11 +10,8 @@
 //! * far from straight, pcc and the Cosserat rod agree.
 
 use std::f64::consts::PI;
-use std::path::Path;
 
 use crate::common::*;
-use eomgen::model::Override;
-use runtime::{StaticOptions, solve_static};
 
 const L: f64 = 0.2;
 const E: f64 = 1e6;
@@ -62,27 +59,6 @@ youngs_modulus = {E}
 force = [0.0, 0.0, {tip_force}]
 "#
     )
-}
-
-/// The static tip of `text` under `sets`: by a lumped method, or by the
-/// Cosserat rod when the sets make it one.
-fn static_tip(dir: &Path, text: &str, sets: &[String]) -> [f64; 3] {
-    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
-    if sets.contains(&"segment.0.method=cosserat") {
-        let path = dir.join("model.toml");
-        std::fs::write(&path, text).unwrap();
-        let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
-        let spec = path.to_str().unwrap();
-        let (model, origin) = softarm::backend::read_model(spec, &overrides).unwrap();
-        return softarm::continuum::solve(&model, &origin)
-            .unwrap()
-            .tip_position;
-    }
-    let mut l = load_text(dir, text, &sets);
-    let n = l.arm.dof();
-    let sol = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
-    let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
-    [o[0], o[1], o[2]]
 }
 
 /// Each method's sets at a coarse and a fine resolution, and whether it

@@ -152,3 +152,30 @@ pub fn energy_drift(arm: &dyn runtime::Dynamics, traj: &runtime::Trajectory) -> 
         .fold(0.0, f64::max)
         / e0.abs().max(ke_max)
 }
+
+/// The static tip of the model file `text` (written to `dir`) under
+/// `--set`-style `sets`: by its lumped method, from the straight state
+/// with the loads by continuation, or by the Cosserat rod when the sets
+/// make it one (`segment.0.method=cosserat`).
+pub fn static_tip(dir: &Path, text: &str, sets: &[String]) -> [f64; 3] {
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    if sets.contains(&"segment.0.method=cosserat") {
+        let path = dir.join("model.toml");
+        std::fs::write(&path, text).unwrap();
+        let overrides: Vec<eomgen::model::Override> = sets
+            .iter()
+            .map(|s| eomgen::model::Override::parse(s).unwrap())
+            .collect();
+        let spec = path.to_str().unwrap();
+        let (model, origin) = softarm::backend::read_model(spec, &overrides).unwrap();
+        return softarm::continuum::solve(&model, &origin)
+            .unwrap()
+            .tip_position;
+    }
+    let mut l = load_text(dir, text, &sets);
+    let n = l.arm.dof();
+    let opts = runtime::StaticOptions::default();
+    let sol = runtime::solve_static(&mut *l.arm, &vec![0.0; n], &opts).unwrap();
+    let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
+    [o[0], o[1], o[2]]
+}

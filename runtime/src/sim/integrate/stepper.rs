@@ -78,6 +78,51 @@ pub fn next_step(h: f64, err: f64, accepted: bool, rejected_last: bool) -> f64 {
     }
 }
 
+/// A simplified Newton iteration's convergence (Hairer and Wanner's test,
+/// as radau5 has it): the contraction rate between iterates, the
+/// slowest seen, and when the next iterate is within the tolerance.
+#[derive(Default)]
+pub struct Contraction {
+    previous: f64,
+    slowest: f64,
+    iterations: usize,
+}
+
+/// What an iterate's scaled norm says.
+pub enum Converging {
+    /// Go on iterating.
+    Continue,
+    /// Converged: the slowest contraction seen (the Jacobian is kept for
+    /// the next step below `REUSE_JACOBIAN_BELOW`).
+    Done(f64),
+    /// Diverging, or not a number: a smaller step or a new Jacobian.
+    Failed,
+}
+
+impl Contraction {
+    /// The iterate's update had scaled norm `norm`; `tol` the Newton
+    /// tolerance.
+    pub fn after(&mut self, norm: f64, tol: f64) -> Converging {
+        if !norm.is_finite() {
+            return Converging::Failed;
+        }
+        let first = self.iterations == 0;
+        self.iterations += 1;
+        let rate = if first { 0.5 } else { norm / self.previous };
+        if rate >= 0.9 {
+            return Converging::Failed;
+        }
+        if !first {
+            self.slowest = self.slowest.max(rate);
+        }
+        self.previous = norm;
+        if rate / (1.0 - rate) * norm <= tol || norm <= 1e-3 * tol {
+            return Converging::Done(self.slowest);
+        }
+        Converging::Continue
+    }
+}
+
 /// RMS of e_i / (atol + rtol max(|a_i|, |b_i|)).
 pub fn error_norm(e: &[f64], a: &[f64], b: &[f64], rtol: f64, atol: f64) -> f64 {
     let sum: f64 = e

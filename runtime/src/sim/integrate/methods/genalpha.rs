@@ -27,8 +27,8 @@ use differential_equations::error::Error;
 use nalgebra::{DMatrix, DVector};
 
 use super::super::stepper::{
-    Counts, Hermite, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, begin_step, error_norm,
-    next_step,
+    Contraction, Converging, Counts, Hermite, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn,
+    begin_step, error_norm, next_step,
 };
 
 const MAX_NEWTON: usize = 8;
@@ -116,8 +116,8 @@ fn newton(
     tol: f64,
 ) -> Option<f64> {
     let n = a1.len();
-    let (mut previous, mut slowest) = (f64::INFINITY, 0.0f64);
-    for it in 0..MAX_NEWTON {
+    let mut contraction = Contraction::default();
+    for _ in 0..MAX_NEWTON {
         advance(al, p, h, a1, y1);
         sys.rhs(t1, y1, f1);
         let r = DVector::from_iterator(
@@ -135,24 +135,17 @@ fn newton(
             .sum::<f64>()
             / n as f64)
             .sqrt();
-        if !norm.is_finite() {
-            return None;
-        }
         for i in 0..n {
             a1[i] += da[i];
         }
-        let rate = if it == 0 { 0.5 } else { norm / previous };
-        if rate >= 0.9 {
-            return None;
-        }
-        if it > 0 {
-            slowest = slowest.max(rate);
-        }
-        previous = norm;
-        if rate / (1.0 - rate) * norm <= tol || norm <= 1e-3 * tol {
-            advance(al, p, h, a1, y1);
-            sys.rhs(t1, y1, f1);
-            return Some(slowest);
+        match contraction.after(norm, tol) {
+            Converging::Continue => {}
+            Converging::Failed => return None,
+            Converging::Done(slowest) => {
+                advance(al, p, h, a1, y1);
+                sys.rhs(t1, y1, f1);
+                return Some(slowest);
+            }
         }
     }
     None

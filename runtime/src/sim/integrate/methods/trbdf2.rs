@@ -13,8 +13,8 @@ use differential_equations::error::Error;
 use nalgebra::{DMatrix, DVector};
 
 use super::super::stepper::{
-    Counts, Hermite, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, begin_step, error_norm,
-    next_step,
+    Contraction, Converging, Counts, Hermite, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn,
+    begin_step, error_norm, next_step,
 };
 
 const SQRT2: f64 = std::f64::consts::SQRT_2;
@@ -42,10 +42,8 @@ fn newton(
     tol: f64,
 ) -> Option<f64> {
     let m = x.len();
-    let mut previous = f64::INFINITY;
-    // The slowest contraction seen (none after a single iteration).
-    let mut slowest: f64 = 0.0;
-    for it in 0..MAX_NEWTON {
+    let mut contraction = Contraction::default();
+    for _ in 0..MAX_NEWTON {
         sys.rhs(t, x, k);
         let r = DVector::from_iterator(m, (0..m).map(|i| base[i] + dh * k[i] - x[i]));
         let dx = lu.solve(&r)?;
@@ -56,23 +54,18 @@ fn newton(
             .sum::<f64>()
             / m as f64)
             .sqrt();
-        if !norm.is_finite() {
-            return None;
+        if norm.is_finite() {
+            for i in 0..m {
+                x[i] += dx[i];
+            }
         }
-        for i in 0..m {
-            x[i] += dx[i];
-        }
-        let rate = if it == 0 { 0.5 } else { norm / previous };
-        if rate >= 0.9 {
-            return None;
-        }
-        if it > 0 {
-            slowest = slowest.max(rate);
-        }
-        previous = norm;
-        if rate / (1.0 - rate) * norm <= tol || norm <= 1e-3 * tol {
-            sys.rhs(t, x, k);
-            return Some(slowest);
+        match contraction.after(norm, tol) {
+            Converging::Continue => {}
+            Converging::Failed => return None,
+            Converging::Done(slowest) => {
+                sys.rhs(t, x, k);
+                return Some(slowest);
+            }
         }
     }
     None
