@@ -35,7 +35,10 @@ pub fn contact_set(model: &Model, base: &Path, points: usize) -> Result<Option<C
                 for j in 0..per {
                     let at = (e as f64 + (j + 1) as f64 / per as f64) / n as f64;
                     sampled.push(ContactPoint {
-                        radius: s.outer_radius.as_ref().map_or(0.0, |r| r.at(at)),
+                        radius: match &s.section {
+                            Some(sec) => sec.bounding_radius(),
+                            None => s.outer_radius.as_ref().map_or(0.0, |r| r.at(at)),
+                        },
                         element: Some((arm, element)),
                     });
                 }

@@ -223,6 +223,9 @@ fn look_of(loaded: &Loaded, name: &str, s: &[f64]) -> Look {
                 for g in segments {
                     if s <= (start + g.length) * (1.0 + 1e-9) {
                         let at = (s - start) / g.length;
+                        if let Some(sec) = &g.section {
+                            return sec.bounding_radius();
+                        }
                         return g.outer_radius.as_ref().map_or(0.01, |r| r.at(at));
                     }
                     start += g.length;

@@ -740,11 +740,105 @@ youngs_modulus = 1e6
 fn three_d_cases() -> Vec<FileCase> {
     let mut all = three_d_key_cases();
     all.extend(shape_and_load_cases());
+    all.extend(section_load_and_fluid_cases());
     all.extend(three_d_method_cases());
     all
 }
 
-/// Rest shapes, kinks and loads along the arm.
+/// Sections, loads along the arm and the fluid.
+fn section_load_and_fluid_cases() -> Vec<FileCase> {
+    let r = |a: &str, b: &str| GOOD3.replacen(a, b, 1);
+    vec![
+        (
+            "a flat section in 3D",
+            r(
+                "outer_radius = 0.01",
+                "section = { shape = \"rectangle\", width = 0.02, height = 0.005 }",
+            ),
+            vec![
+                "segment[0].section",
+                "anisotropic bending is not supported in 3D yet",
+            ],
+        ),
+        (
+            "a section and a radius",
+            r(
+                "outer_radius = 0.01",
+                "outer_radius = 0.01\nsection = { shape = \"ellipse\", width = 0.01, height = 0.01 }",
+            ),
+            vec!["segment[0].outer_radius", "takes no `outer_radius`"],
+        ),
+        (
+            "a section of no width",
+            r(
+                "outer_radius = 0.01",
+                "section = { shape = \"rectangle\", width = 0.0, height = 0.01 }",
+            ),
+            vec!["segment[0].section.width", "must be positive"],
+        ),
+        (
+            "load off its segment",
+            format!(
+                "{}[[load]]\nsegment = 0\ns = 0.5\nforce = [0.0, 0.0, -1.0]\n",
+                GOOD3
+            ),
+            vec!["load[0].s", "between 0 and its length 0.3 m"],
+        ),
+        (
+            "load on no segment",
+            format!(
+                "{}[[load]]\nsegment = 3\ns = 0.1\nforce = [0.0, 0.0, -1.0]\n",
+                GOOD3
+            ),
+            vec!["load[0].segment", "no segment 3"],
+        ),
+        (
+            "load without force",
+            format!("{}[[load]]\nsegment = 0\ns = 0.1\n", GOOD3),
+            vec!["load[0].force", "missing"],
+        ),
+        (
+            "load on eba",
+            format!(
+                "{}[[load]]\nsegment = 0\ns = 0.1\nforce = [0.0, 0.0, -1.0]\n",
+                GOOD3
+            )
+            .replace("\"pcc\"", "\"eba\""),
+            vec!["load[0].segment", "eba segments are not supported yet"],
+        ),
+        (
+            "point load on the Cosserat rod",
+            format!(
+                "{}[[load]]\nsegment = 0\ns = 0.1\nforce = [0.0, 0.0, -1.0]\n",
+                GOOD3
+            )
+            .replace("\"pcc\"", "\"cosserat\""),
+            vec!["load[0].s", "constant distributed force"],
+        ),
+        (
+            "fluid of negative density",
+            format!("{}[fluid]\ndensity = -1.0\n", GOOD3),
+            vec!["fluid.density", "zero or positive"],
+        ),
+        (
+            "fluid around an arm without a radius",
+            format!("{}[fluid]\ndensity = 1000.0\n", GOOD3)
+                .replace(
+                    "density = 1000.0\nouter_radius = 0.01",
+                    "mass = 0.1\nbending_stiffness = 0.1\ntorsional_stiffness = 0.1",
+                )
+                .replace("youngs_modulus = 1e6\n", ""),
+            vec!["segment[0].outer_radius", "immersed"],
+        ),
+        (
+            "distributed moment",
+            format!("{}[[load]]\nsegment = 0\nmoment = [0.0, 0.0, 1.0]\n", GOOD3),
+            vec!["load[0].moment", "per unit length"],
+        ),
+    ]
+}
+
+/// Rest shapes and kinks.
 fn shape_and_load_cases() -> Vec<FileCase> {
     let r = |a: &str, b: &str| GOOD3.replacen(a, b, 1);
     vec![
@@ -814,65 +908,6 @@ fn shape_and_load_cases() -> Vec<FileCase> {
             "eba kinked",
             r("\"pcc\"", "\"eba\"").replace("elements = 2", "elements = 2\nturn = [0.0, 90.0]"),
             vec!["segment[0].turn", "meet tangent"],
-        ),
-        (
-            "load off its segment",
-            format!(
-                "{}[[load]]\nsegment = 0\ns = 0.5\nforce = [0.0, 0.0, -1.0]\n",
-                GOOD3
-            ),
-            vec!["load[0].s", "between 0 and its length 0.3 m"],
-        ),
-        (
-            "load on no segment",
-            format!(
-                "{}[[load]]\nsegment = 3\ns = 0.1\nforce = [0.0, 0.0, -1.0]\n",
-                GOOD3
-            ),
-            vec!["load[0].segment", "no segment 3"],
-        ),
-        (
-            "load without force",
-            format!("{}[[load]]\nsegment = 0\ns = 0.1\n", GOOD3),
-            vec!["load[0].force", "missing"],
-        ),
-        (
-            "load on eba",
-            format!(
-                "{}[[load]]\nsegment = 0\ns = 0.1\nforce = [0.0, 0.0, -1.0]\n",
-                GOOD3
-            )
-            .replace("\"pcc\"", "\"eba\""),
-            vec!["load[0].segment", "eba segments are not supported yet"],
-        ),
-        (
-            "point load on the Cosserat rod",
-            format!(
-                "{}[[load]]\nsegment = 0\ns = 0.1\nforce = [0.0, 0.0, -1.0]\n",
-                GOOD3
-            )
-            .replace("\"pcc\"", "\"cosserat\""),
-            vec!["load[0].s", "constant distributed force"],
-        ),
-        (
-            "fluid of negative density",
-            format!("{}[fluid]\ndensity = -1.0\n", GOOD3),
-            vec!["fluid.density", "zero or positive"],
-        ),
-        (
-            "fluid around an arm without a radius",
-            format!("{}[fluid]\ndensity = 1000.0\n", GOOD3)
-                .replace(
-                    "density = 1000.0\nouter_radius = 0.01",
-                    "mass = 0.1\nbending_stiffness = 0.1\ntorsional_stiffness = 0.1",
-                )
-                .replace("youngs_modulus = 1e6\n", ""),
-            vec!["segment[0].outer_radius", "immersed"],
-        ),
-        (
-            "distributed moment",
-            format!("{}[[load]]\nsegment = 0\nmoment = [0.0, 0.0, 1.0]\n", GOOD3),
-            vec!["load[0].moment", "per unit length"],
         ),
     ]
 }

@@ -32,6 +32,7 @@ mod parsers;
 mod pcc;
 mod rest_shape;
 mod rom_slices;
+mod section;
 mod shape;
 mod six_strains;
 mod spatial;

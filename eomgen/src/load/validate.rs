@@ -368,14 +368,15 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
         (Some(mass), None) => ck.positive(&p("mass"), mass)?,
         (None, Some(rho)) => {
             ck.positive_along(&p("density"), rho)?;
-            if s.outer_radius.is_none() {
+            if !s.has_section() {
                 return ck.err(
                     p("outer_radius"),
-                    "missing: `density` needs `outer_radius` (m)".into(),
+                    "missing: `density` needs `outer_radius` (m) or a `section`".into(),
                 );
             }
         }
     }
+    section_shape(ck, i, s)?;
     // Every value positive, the inner radius only not negative (below).
     for (key, v) in s.profiles() {
         if let Some(v) = v.filter(|_| key != "inner_radius") {
@@ -417,10 +418,11 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
             "give either `youngs_modulus` or `bending_stiffness`, not both".into(),
         );
     }
-    if s.youngs_modulus.is_some() && s.outer_radius.is_none() {
+    if s.youngs_modulus.is_some() && !s.has_section() {
         return ck.err(
             p("outer_radius"),
-            "missing: `youngs_modulus` needs the section's `outer_radius` (m)".into(),
+            "missing: `youngs_modulus` needs the section's `outer_radius` (m) or a `section`"
+                .into(),
         );
     }
     if let Some(c) = s.bending_damping {
@@ -430,6 +432,44 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
     kink(ck, i, s)?;
     if let Some(c) = s.axial_damping {
         ck.non_negative(&p("axial_damping"), c)?;
+    }
+    Ok(())
+}
+
+/// `[segment.section]`: positive sides; instead of a radius, without
+/// chamber holes; in 3D the same bending stiffness about both axes (a
+/// square or a circle), since 3D elements bend isotropically.
+fn section_shape(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
+    let p = |k: &str| format!("segment[{i}].section.{k}");
+    let Some(sec) = &s.section else {
+        return Ok(());
+    };
+    let (w, h) = sec.sides();
+    ck.positive(&p("width"), w)?;
+    ck.positive(&p("height"), h)?;
+    for (key, given) in [
+        ("outer_radius", s.outer_radius.is_some()),
+        ("inner_radius", s.inner_radius.is_some()),
+        ("chambers", s.chambers.is_some()),
+    ] {
+        if given {
+            return ck.err(
+                format!("segment[{i}].{key}"),
+                format!(
+                    "a segment with a `section` takes no `{key}` (holes and radii are a circle's)"
+                ),
+            );
+        }
+    }
+    let [iy, iz] = sec.second_moments();
+    if ck.m.dimensions == 3 && (iy - iz).abs() > 1e-9 * iy.max(iz) {
+        return ck.err(
+            format!("segment[{i}].section"),
+            format!(
+                "a {w} x {h} section bends {:.3} times more stiffly about one axis than the other; anisotropic bending is not supported in 3D yet: a square or a circle, or a planar arm",
+                iy.max(iz) / iy.min(iz)
+            ),
+        );
     }
     Ok(())
 }

@@ -16,6 +16,7 @@ mod params;
 mod profile;
 mod rest;
 mod schema;
+mod section;
 pub mod sensor;
 mod signals;
 mod structure;
@@ -37,6 +38,7 @@ pub use schema::{
     Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, SimulateDefaults, Start,
     Tendon, Tip, Torque, WrenchFrame,
 };
+pub use section::SectionShape;
 pub use signals::{Compare, Input, Offset};
 pub(crate) use signals::{check_compare, check_input};
 pub use structure::{AssemblyShape, GENERATOR_VERSION, JointShape, SegmentShape, Structure};

@@ -179,6 +179,9 @@ pub struct Segment {
     /// Inner radius of a hollow section (m).
     #[serde(default)]
     pub inner_radius: Option<Profile>,
+    /// A rectangular or elliptic section instead of a circle.
+    #[serde(default)]
+    pub section: Option<super::section::SectionShape>,
     /// Rotational stiffness of each joint (N m / rad); rigid segments.
     #[serde(default)]
     pub joint_stiffness: Option<f64>,
@@ -419,6 +422,9 @@ impl Segment {
     /// (validated). 3D arms have isotropic patterns (validated), whose sum
     /// of cos^2 is n / 2: the same about every diameter.
     pub fn second_moment(&self) -> Option<f64> {
+        if let Some(sec) = &self.section {
+            return Some(sec.second_moments()[1]);
+        }
         let ro = self.outer()?;
         let ri = self.inner().unwrap_or(0.0);
         let pi = std::f64::consts::PI;
@@ -446,6 +452,9 @@ impl Segment {
     /// Area of the section (m^2), if it has a radius: the ring less the
     /// chamber holes.
     pub fn area(&self) -> Option<f64> {
+        if let Some(sec) = &self.section {
+            return Some(sec.area());
+        }
         let ro = self.outer()?;
         let ri = self.inner().unwrap_or(0.0);
         let holes = self
@@ -460,11 +469,21 @@ impl Segment {
         Self::value(&self.shear_modulus).or_else(|| Some(self.modulus()? / 3.0))
     }
 
-    /// Torsional stiffness G J (N m^2): J = 2 I for circular sections, G
-    /// defaulting to E / 3.
+    /// Torsional stiffness G J (N m^2): J = 2 I for circular sections,
+    /// St-Venant's for others, G defaulting to E / 3.
     pub fn gj(&self) -> Option<f64> {
-        Self::value(&self.torsional_stiffness)
-            .or_else(|| Some(self.shear()? * 2.0 * self.second_moment()?))
+        Self::value(&self.torsional_stiffness).or_else(|| {
+            let j = match &self.section {
+                Some(sec) => sec.torsion(),
+                None => 2.0 * self.second_moment()?,
+            };
+            Some(self.shear()? * j)
+        })
+    }
+
+    /// Whether the section's dimensions are given (a radius or a shape).
+    pub fn has_section(&self) -> bool {
+        self.outer_radius.is_some() || self.section.is_some()
     }
 
     /// Shear stiffness k G A (N), k the `shear_factor` (default 1).
