@@ -837,6 +837,42 @@ pub fn inspect(a: InspectArgs) -> Result<ExitCode> {
 }
 
 #[derive(Args)]
+pub struct FixedStepArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// The fixed-step solver.
+    #[arg(long, default_value = "rk4", value_parser = ["rk4", "euler"])]
+    pub solver: String,
+    /// The tip's largest allowed distance from the reference (m).
+    #[arg(long, default_value_t = 1e-3)]
+    pub tol: f64,
+    /// Simulated time (s) [default: simulate.t_end, else 5].
+    #[arg(long)]
+    pub t_end: Option<f64>,
+    /// Print JSON (the only format; accepted for scripts).
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `softarm fixed-step`: the chapter's step-size procedure.
+pub fn fixed_step(a: FixedStepArgs) -> Result<ExitCode> {
+    let mut loaded = load(&a.model)?;
+    let req = RunRequest {
+        t_end: a.t_end,
+        ..Default::default()
+    };
+    let opts = crate::run::options(&req, &loaded.model.simulate)?;
+    let (x0, _) = crate::run::initial_state(&req, &mut loaded)?;
+    let solver = runtime::Solver::parse(&a.solver).expect("clap checked the name");
+    let choice = crate::fixed_step::choose(&loaded, &x0, opts.t_end, solver, a.tol)?;
+    let mut v = serde_json::to_value(&choice)?;
+    v["model"] = json!(loaded.model.name);
+    v["t_end"] = json!(opts.t_end);
+    println!("{}", serde_json::to_string_pretty(&v)?);
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
 pub struct LinearizeArgs {
     #[command(flatten)]
     pub model: ModelArgs,

@@ -54,6 +54,9 @@ enum Command {
     /// controller design: x = (q, qd), u the named input channels, y the
     /// tip.
     Linearize(commands::LinearizeArgs),
+    /// The largest fixed step that keeps the tip within a tolerance of a
+    /// tight reference run, for fixed-step use (a controller's loop).
+    FixedStep(commands::FixedStepArgs),
 }
 
 /// Parses the command line and runs its command.
@@ -71,6 +74,7 @@ pub fn main() -> ExitCode {
         Command::Sweep(a) => sweep::sweep(a),
         Command::Animate(a) => animate::animate(a),
         Command::Linearize(a) => commands::linearize(a),
+        Command::FixedStep(a) => commands::fixed_step(a),
     };
     match result {
         Ok(code) => code,

@@ -84,6 +84,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "scene",
             "shape",
             "linearize",
+            "fixed_step",
             "run_output",
             "viewer",
             "cli",

@@ -286,3 +286,39 @@ fn a_fixed_step_run_records_its_end_and_restarts_at_t0() {
         assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0), "{a} vs {b}");
     }
 }
+
+/// `softarm fixed-step`: the step it picks keeps the tip within the
+/// tolerance of a tight run by another method (radau5 at rtol 1e-10), and
+/// the step twice as large does not.
+#[test]
+fn the_fixed_step_chosen_holds_the_tolerance_and_twice_it_does_not() {
+    let l = loaded("soft_finger", &[]);
+    let n = l.arm.dof();
+    let x0 = vec![0.0; 2 * n];
+    let (t_end, tol) = (0.5, 1e-4);
+    let choice = softarm::fixed_step::choose(&l, &x0, t_end, Solver::Rk4, tol).unwrap();
+    let tips = |solver: Solver, dt: f64, rtol: f64| {
+        let opts = SimOptions {
+            t_end,
+            solver,
+            dt,
+            rtol,
+            atol: rtol * 1e-3,
+            output_dt: t_end / 200.0,
+            ..Default::default()
+        };
+        let (traj, _) = simulate(&*l.arm, x0.clone(), &opts).unwrap();
+        softarm::run::tips(&l, &traj)
+    };
+    let reference = tips(Solver::Radau5, 0.0, 1e-10);
+    let distance = |dt: f64| {
+        (tips(Solver::Rk4, dt, 0.0).iter().zip(&reference))
+            .map(|((_, a), (_, b))| (0..3).map(|c| (a[c] - b[c]).powi(2)).sum::<f64>().sqrt())
+            .fold(0.0, f64::max)
+    };
+    assert!(distance(choice.dt) <= 1.01 * tol, "{choice:?}");
+    let coarser = choice.coarser_dt.expect("a larger step was tried");
+    assert!((coarser - 2.0 * choice.dt).abs() < 1e-15);
+    let e = choice.coarser_error_m.unwrap_or(f64::INFINITY);
+    assert!(e > tol, "{choice:?}");
+}
