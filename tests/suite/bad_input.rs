@@ -289,7 +289,11 @@ fn syntax_value_and_section_cases() -> Vec<CliCase> {
             "unknown segment key",
             r("length = 0.3", "lenght = 0.3"),
             vec![],
-            vec!["segment[0]", "unknown field `lenght`"],
+            vec![
+                "segment[0]",
+                "unknown field `lenght`",
+                "did you mean `length`?",
+            ],
         ),
         (
             "wrong type",

@@ -47,7 +47,8 @@ pub fn parse_model(
     let model: Model = serde_path_to_error::deserialize(tree).map_err(|e| {
         let path = e.path().to_string();
         let path = if path == "." { String::new() } else { path };
-        ModelError::new(file, path, e.into_inner().to_string())
+        let message = crate::model::with_suggestion(&e.into_inner().to_string());
+        ModelError::new(file, path, message)
     })?;
     let mut model = model;
     validate(&model, file)?;

@@ -20,6 +20,7 @@ mod section;
 pub mod sensor;
 mod signals;
 mod structure;
+mod suggest;
 
 pub(crate) use check::Check;
 pub use error::ModelError;
@@ -42,3 +43,4 @@ pub use section::SectionShape;
 pub use signals::{Compare, Input, Offset};
 pub(crate) use signals::{check_compare, check_input};
 pub use structure::{AssemblyShape, GENERATOR_VERSION, JointShape, SegmentShape, Structure};
+pub use suggest::with_suggestion;
