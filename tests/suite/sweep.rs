@@ -423,3 +423,32 @@ fn a_big_grid_is_refused_with_its_disk_and_time_from_a_pilot() {
         "the pilot's folder removed"
     );
 }
+
+/// `*` in a path is every item of a list: `segment.*.youngs_modulus` as a
+/// sweep's variable is the same value set on each segment one by one.
+#[test]
+fn a_star_sets_every_segment_as_setting_each_does() {
+    let model = root().join("benches/tapered_tentacle.toml");
+    let model = model.to_str().unwrap();
+    let tip = |sets: &[&str]| -> Vec<f64> {
+        let dir = tempfile::tempdir().unwrap();
+        let mut args = vec!["static", model, "--json"];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        let out = softarm(&args, dir.path());
+        assert!(out.status.success(), "{}", stderr(&out));
+        let v: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+        (v["tip_position"].as_array().unwrap().iter())
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let star = tip(&["segment.*.youngs_modulus=4e5"]);
+    let each = tip(&[
+        "segment.0.youngs_modulus=4e5",
+        "segment.1.youngs_modulus=4e5",
+        "segment.2.youngs_modulus=4e5",
+    ]);
+    assert_eq!(star, each);
+    assert_ne!(star, tip(&[]), "the value took effect");
+}

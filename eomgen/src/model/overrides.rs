@@ -64,9 +64,15 @@ impl Override {
     }
 
     pub(crate) fn apply(&self, root: &mut toml::Value) -> Result<(), ModelError> {
+        self.apply_from(root, 0)
+    }
+
+    /// The path from `from` on, below `root`; `*` in a list is every item
+    /// (`segment.*.youngs_modulus`: the same value on every segment).
+    fn apply_from(&self, root: &mut toml::Value, from: usize) -> Result<(), ModelError> {
         let err = |m: String| ModelError::new("--set", self.path.join("."), m);
         let mut cur = root;
-        for (depth, key) in self.path.iter().enumerate() {
+        for (depth, key) in self.path.iter().enumerate().skip(from) {
             let last = depth + 1 == self.path.len();
             cur = match cur {
                 toml::Value::Table(t) => {
@@ -91,6 +97,15 @@ impl Override {
                     t.entry(key.clone())
                         .or_insert_with(|| toml::Value::Table(toml::Table::new()))
                 }
+                toml::Value::Array(a) if key == "*" => {
+                    for item in a.iter_mut() {
+                        match last {
+                            true => *item = self.value.clone(),
+                            false => self.apply_from(item, depth + 1)?,
+                        }
+                    }
+                    return Ok(());
+                }
                 toml::Value::Array(a) => {
                     let n = a.len();
                     // An item by index, or by its `name` (`arm.left`).
@@ -102,7 +117,7 @@ impl Override {
                         (Err(_), Some(i)) => i,
                         (Err(_), None) => {
                             return Err(err(format!(
-                                "`{key}` is neither an index nor an item's name: this level is a list of {n} items, use 0 to {} or a name",
+                                "`{key}` is neither an index nor an item's name: this level is a list of {n} items, use 0 to {}, a name or * (every item)",
                                 n.saturating_sub(1)
                             )));
                         }
