@@ -21,7 +21,7 @@ def cli_sweep(tmp_path, study, *extra):
 def same(ours, ref):
     assert list(ours.columns) == list(ref.columns)
     for k in VARY:
-        assert list(ours[k]) == list(ref[k])
+        assert [float(v) for v in ours[k]] == [float(v) for v in ref[k]]
     assert list(ours["status"]) == list(ref["status"])
     for col in ref.columns:
         if col in ("run", "status", "wall_s", "run_wall_s", *VARY):
@@ -34,6 +34,14 @@ def test_a_local_sweep_is_the_clis(tmp_path):
     same(softarm.sweep("soft_finger", VARY, run="modes", jobs=2), cli_sweep(tmp_path, "modes"))
     same(softarm.sweep("soft_finger", VARY, run="simulate", t_end=0.2, jobs=2),
          cli_sweep(tmp_path, "simulate", "--t-end", "0.2", "--shape-points", "0"))
+
+
+def test_varied_values_are_numbers_that_sort_as_numbers():
+    df = softarm.sweep("soft_finger", {"segment.0.youngs_modulus": [1e6, 2e5]}, run="static",
+                       jobs=1)
+    column = df["segment.0.youngs_modulus"]
+    assert column.dtype.kind == "f"
+    assert list(column.sort_values()) == [2e5, 1e6]
 
 
 def test_a_dask_sweep_is_the_clis(tmp_path):

@@ -119,7 +119,7 @@ def sweep(
     table = []
     for k, (c, r) in enumerate(zip(combos, rows)):
         row = {"run": k}
-        row.update({p: values[i][c[i]] for i, p in enumerate(paths)})
+        row.update({p: _number(values[i][c[i]]) for i, p in enumerate(paths)})
         row["status"] = r["status"].splitlines()[0] if r["status"] else ""
         row["wall_s"] = r["wall_s"]
         got = dict(r["figures"])
@@ -128,6 +128,16 @@ def sweep(
     df = pd.DataFrame(table, columns=["run", *paths, "status", "wall_s", *names])
     df.attrs["unfinished"] = unfinished
     return df
+
+
+def _number(value: str) -> Any:
+    """A varied value as the table holds it: a number where it is one (so
+    that columns sort and pivot numerically: 200000 before 1000000), else
+    its text (an array, a word)."""
+    try:
+        return float(value)
+    except ValueError:
+        return value
 
 
 def _lost(e: BaseException) -> dict:
