@@ -527,7 +527,7 @@ fn plot_lines(
         chart
             .configure_mesh()
             .x_desc(x_desc)
-            .y_desc(y_name)
+            .y_desc(with_unit(y_name))
             .draw()
             .map_err(|x| e(&x))?;
         for (k, (label, pts)) in series.iter().enumerate() {
@@ -551,4 +551,14 @@ fn plot_lines(
         root.present().map_err(|x| e(&x))?;
     }
     crate::compare::write_png(&stem.with_extension("png"), size, &rgb)
+}
+
+/// A figure's name with its unit where the name does not already say it
+/// (tip coordinates are metres; `f1_hz`, `wall_s` and `_mm` say theirs).
+fn with_unit(name: &str) -> String {
+    let says = ["_hz", "_s", "_mm", "_m"].iter().any(|u| name.ends_with(u));
+    match name.starts_with("tip_") && !says {
+        true => format!("{name} (m)"),
+        false => name.to_string(),
+    }
 }
