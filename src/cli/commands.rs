@@ -788,16 +788,61 @@ pub fn modes_value(a: &ModesArgs) -> Result<serde_json::Value> {
     let sol = equilibrium(&mut loaded, &a.q0)?;
     let m = runtime::modes(&*loaded.arm, &sol.q)
         .map_err(|e| anyhow::anyhow!("{}: {e}", loaded.origin))?;
+    let kinds = mode_kinds(&loaded, &sol.q, &m.shapes);
     let mut v = json!({
         "model": loaded.model.name,
         "backend": loaded.arm.backend(),
         "frequencies_hz": m.frequencies_hz,
+        "kinds": kinds,
         "equilibrium_q": sol.q,
     });
     if a.shapes {
         v["shapes"] = json!(m.shapes);
     }
     Ok(v)
+}
+
+/// What each mode is: the family of coordinates (`bend_y`, `twist`,
+/// `stretch`, ...: a coordinate's name without its segment and element
+/// indices) that holds the largest share of its kinetic energy
+/// phi_i (M phi)_i / phi^T M phi, with that share.
+fn mode_kinds(loaded: &Loaded, q: &[f64], shapes: &[Vec<f64>]) -> Vec<serde_json::Value> {
+    let n = q.len();
+    let mut m = DMatrix::zeros(n, n);
+    loaded.arm.mass(0.0, q, &mut m);
+    let names = &loaded.arm.info().coordinates;
+    let family = |name: &str| -> String {
+        let kept: Vec<&str> = name
+            .split('_')
+            .take_while(|p| {
+                let digits = p.trim_start_matches('c');
+                digits.is_empty() || !digits.chars().all(|c| c.is_ascii_digit())
+            })
+            .collect();
+        kept.join("_")
+    };
+    shapes
+        .iter()
+        .map(|phi| {
+            let v = nalgebra::DVector::from_column_slice(phi);
+            let mv = &m * &v;
+            let total = v.dot(&mv);
+            let mut shares: Vec<(String, f64)> = Vec::new();
+            for i in 0..n {
+                let f = family(&names[i]);
+                let e = phi[i] * mv[i] / total;
+                match shares.iter_mut().find(|(g, _)| *g == f) {
+                    Some((_, s)) => *s += e,
+                    None => shares.push((f, e)),
+                }
+            }
+            let (kind, share) = shares
+                .into_iter()
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap_or_default();
+            json!({ "kind": kind, "share": share })
+        })
+        .collect()
 }
 
 #[derive(Args)]

@@ -811,3 +811,51 @@ fn a_curved_rigid_chain_at_rest_stays_at_its_rest_shape() {
         );
     }
 }
+
+/// `softarm modes` names each mode by the coordinates holding its kinetic
+/// energy: cantilever3d's first two are its bending pair, at the
+/// Euler-Bernoulli 1.875^2 / (2 pi L^2) sqrt(E I / rho A), and its first
+/// twist mode is at the torsion rod's closed form sqrt(G / rho) / (4 L),
+/// converging with the elements.
+#[test]
+fn modes_are_named_bending_or_twist_by_their_energy() {
+    let dir = tempfile::tempdir().unwrap();
+    let (l, r, e, rho): (f64, f64, f64, f64) = (0.3, 0.01, 1e6, 1000.0);
+    let modes = |elements: usize| -> Vec<(f64, String, f64)> {
+        let set = format!("segment.0.elements={elements}");
+        let out = softarm(
+            &["modes", "cantilever3d", "--set", &set, "--json"],
+            dir.path(),
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let v: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+        let f = v["frequencies_hz"].as_array().unwrap();
+        let k = v["kinds"].as_array().unwrap();
+        (f.iter().zip(k))
+            .map(|(f, k)| {
+                let kind = k["kind"].as_str().unwrap().to_string();
+                (f.as_f64().unwrap(), kind, k["share"].as_f64().unwrap())
+            })
+            .collect()
+    };
+    let bending =
+        1.875f64.powi(2) / (2.0 * std::f64::consts::PI * l * l) * (e * r * r / 4.0 / rho).sqrt();
+    let torsion = (e / 3.0 / rho).sqrt() / (4.0 * l);
+    let twist_error = |ms: &[(f64, String, f64)]| {
+        let (f, _, share) = ms.iter().find(|m| m.1 == "twist").expect("a twist mode");
+        assert!(*share > 0.99, "{share}");
+        (f - torsion).abs() / torsion
+    };
+    let coarse = modes(8);
+    let kinds: Vec<&str> = coarse[..2].iter().map(|m| m.1.as_str()).collect();
+    assert!(
+        kinds.contains(&"bend_y") && kinds.contains(&"bend_z"),
+        "{kinds:?}"
+    );
+    assert_close(coarse[0].0, bending, 5e-3, 0.0, "the first bending mode");
+    let (e8, e16) = (twist_error(&coarse), twist_error(&modes(16)));
+    assert!(
+        e16 < 2e-3 && e16 < e8,
+        "twist: {e8:e} at 8 elements, {e16:e} at 16"
+    );
+}
