@@ -121,10 +121,18 @@ fn linked(
         return Err("this processor lacks the fused multiply-add compiled code needs".into());
     }
     let start = Instant::now();
-    if structure.segments.iter().any(|g| g.kink) {
+    // The arm, or an assembly's arms.
+    let arms: Vec<&Structure> = match &structure.assembly {
+        Some(a) => a.arms.iter().map(|(_, s)| s).collect(),
+        None => vec![structure],
+    };
+    if arms.iter().any(|s| s.segments.iter().any(|g| g.kink)) {
         return Err("its kinks are not link cells yet".into());
     }
-    if !structure.loads.is_empty() || structure.fluid.is_some() {
+    if arms
+        .iter()
+        .any(|s| !s.loads.is_empty() || s.fluid.is_some())
+    {
         return Err("its loads along the arm are not link cells yet".into());
     }
     let not_cells = || "not every one of its methods' elements is a link cell".to_string();

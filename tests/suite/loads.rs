@@ -44,18 +44,6 @@ youngs_modulus = {E}
     )
 }
 
-fn sets(method: &str, n: usize) -> Vec<String> {
-    let key = if method == "rom" {
-        "quadrature"
-    } else {
-        "elements"
-    };
-    vec![
-        format!("segment.0.method={method}"),
-        format!("segment.0.{key}={n}"),
-    ]
-}
-
 /// Relative errors at two resolutions, the second twice the first.
 fn converges(errors: (f64, f64), what: &str) {
     let (coarse, fine) = errors;
@@ -88,8 +76,9 @@ fn a_force_at_mid_span_bends_the_tip_as_beam_theory_says() {
             };
             // 7 and 14 elements put the load inside an element, 8 and 16
             // on a boundary.
-            let err =
-                |n| (static_tip(dir.path(), &text, &sets(method, n))[1] - want - shear) / want;
+            let err = |n| {
+                (static_tip(dir.path(), &text, &method_sets(method, n))[1] - want - shear) / want
+            };
             converges((err(7), err(14)), &format!("{method} in {dims}D"));
             converges((err(8), err(16)), &format!("{method} in {dims}D"));
         }
@@ -104,14 +93,14 @@ fn a_moment_and_a_distributed_force_bend_it_as_beam_theory_says() {
     let want = m * a * (2.0 * L - a) / (2.0 * ei());
     for dims in [3, 2] {
         let text = cantilever(dims, &moment);
-        let err = |n| (static_tip(dir.path(), &text, &sets("pcc", n))[1] - want) / want;
+        let err = |n| (static_tip(dir.path(), &text, &method_sets("pcc", n))[1] - want) / want;
         converges((err(8), err(16)), &format!("a moment in {dims}D"));
     }
     let q = 1e-2;
     let spread = format!("[[load]]\nsegment = 0\nforce = [0.0, 0.0, {q}]");
     let text = cantilever(3, &spread);
     let want = q * L.powi(4) / (8.0 * ei());
-    let err = |n| (static_tip(dir.path(), &text, &sets("pcc", n))[2] - want) / want;
+    let err = |n| (static_tip(dir.path(), &text, &method_sets("pcc", n))[2] - want) / want;
     converges((err(8), err(16)), "a force per unit length");
     let rod = static_tip(dir.path(), &text, &["segment.0.method=cosserat".into()]);
     assert_close(rod[2], want, 1e-3, 0.0, "the Cosserat rod under it");

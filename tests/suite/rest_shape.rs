@@ -64,18 +64,6 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
     (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt()
 }
 
-fn sets(method: &str, n: usize) -> Vec<String> {
-    let key = if method == "rom" {
-        "quadrature"
-    } else {
-        "elements"
-    };
-    vec![
-        format!("segment.0.method={method}"),
-        format!("segment.0.{key}={n}"),
-    ]
-}
-
 #[test]
 fn an_unloaded_rod_curved_and_twisted_at_rest_is_its_helix() {
     let dir = tempfile::tempdir().unwrap();
@@ -85,13 +73,13 @@ fn an_unloaded_rod_curved_and_twisted_at_rest_is_its_helix() {
     assert!(distance(want, [L, 0.0, 0.0]) > 0.1 * L, "{want:?}");
     for method in ["pcc", "vc", "pcs", "rom"] {
         for n in [3, 8] {
-            let tip = static_tip(dir.path(), &text, &sets(method, n));
+            let tip = static_tip(dir.path(), &text, &method_sets(method, n));
             let err = distance(tip, want) / L;
             assert!(err < 1e-9, "{method} at {n}: {err:e} of L off the helix");
         }
     }
     for method in ["ebr", "rigid"] {
-        let err = |n| distance(static_tip(dir.path(), &text, &sets(method, n)), want) / L;
+        let err = |n| distance(static_tip(dir.path(), &text, &method_sets(method, n)), want) / L;
         let (coarse, fine) = (err(8), err(16));
         assert!(
             fine < 2e-3 && fine * 3.5 < coarse,
@@ -111,7 +99,7 @@ fn a_rest_stretch_lengthens_the_helix() {
     let text = model([0.0; 3]);
     let want = constant_strain_tip([TWIST, KY, KZ], [1.05, 0.0, 0.0], L);
     for method in ["pcc", "pcs", "rom", "cosserat"] {
-        let mut s = sets(method, 4);
+        let mut s = method_sets(method, 4);
         if method == "cosserat" {
             s.truncate(1);
         }
@@ -135,7 +123,7 @@ fn a_loaded_helix_converges_to_the_cosserat_rod() {
     assert!(distance(rod, unloaded) > 0.1 * L, "{rod:?}");
     let err = |sets: &[String]| distance(static_tip(dir.path(), &text, sets), rod) / L;
     for method in ["pcc", "ebr", "rigid"] {
-        let (coarse, fine) = (err(&sets(method, 8)), err(&sets(method, 16)));
+        let (coarse, fine) = (err(&method_sets(method, 8)), err(&method_sets(method, 16)));
         assert!(
             fine < 2e-3 && fine * 3.0 < coarse,
             "{method}: {coarse:e} of L from the Cosserat rod at 8, {fine:e} at 16"
@@ -143,7 +131,7 @@ fn a_loaded_helix_converges_to_the_cosserat_rod() {
     }
     // rom's error is its fields' degree's.
     let rom = |order: usize| {
-        let mut s = sets("rom", 12);
+        let mut s = method_sets("rom", 12);
         s.push(format!("segment.0.order={order}"));
         err(&s)
     };
@@ -219,7 +207,8 @@ force = [0.0, 0.0, 600.0]
         );
     }
     for method in ["pcc", "ebr"] {
-        let err = |n| distance(static_tip(dir.path(), &text, &sets(method, n)), rod) / radius;
+        let err =
+            |n| distance(static_tip(dir.path(), &text, &method_sets(method, n)), rod) / radius;
         let (coarse, fine) = (err(16), err(32));
         assert!(
             fine < 3e-4 && fine * 3.5 < coarse,

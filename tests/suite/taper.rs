@@ -64,14 +64,8 @@ force = [0.0, 0.0, {tip_force}]
 /// Each method's sets at a coarse and a fine resolution, and whether it
 /// shears (pcs, eba).
 fn methods() -> Vec<(&'static str, [Vec<String>; 2], bool)> {
-    let at = |method: &str, key: &str, n: usize| {
-        vec![
-            format!("segment.0.method={method}"),
-            format!("segment.0.{key}={n}"),
-        ]
-    };
-    let by_elements = |m| [at(m, "elements", 8), at(m, "elements", 16)];
-    let mut rom = [at("rom", "quadrature", 8), at("rom", "quadrature", 16)];
+    let by_elements = |m| [method_sets(m, 8), method_sets(m, 16)];
+    let mut rom = by_elements("rom");
     for r in &mut rom {
         r.push("segment.0.order=5".into());
     }

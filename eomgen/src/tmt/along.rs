@@ -207,20 +207,22 @@ impl Applied {
     }
 
     /// Apply the loads on element `k`, which moves with chain link `link`,
-    /// its points placed by `at`.
+    /// its points placed by `at`, their velocities by the time derivative
+    /// over the arm's (coordinate, rate) pairs.
     pub fn element(
         &mut self,
         cas: &mut Cas,
         loads: &[AlongLoad],
         (k, link): (usize, usize),
         at: &mut dyn FnMut(&mut Cas, f64) -> Placed,
-        velocity: &dyn Fn(&mut Cas, &[ExprId; 3]) -> [ExprId; 3],
+        rate_pairs: &[(ExprId, ExprId)],
         symbols: &ParamSymbols,
     ) {
         if let Some(drag) = self.drag {
             let middle = at(cas, 0.5);
             let axis = middle.rotation.map(|row| row[0]);
-            let v = velocity(cas, &middle.point);
+            let v = cas.time_derivatives(&middle.point, rate_pairs);
+            let v = [v[0], v[1], v[2]];
             let d = drag.dissipation(cas, symbols, k, axis, v);
             self.dissipation.push(d);
         }

@@ -228,10 +228,6 @@ impl<'a> PlanarArm<'a> {
         let (k, link, z, zero) = (self.k, self.links.len(), self.z, self.zero);
         let mut pairs = self.coords.rate_pairs();
         pairs.extend(&self.seeds);
-        let velocity = |cas: &mut Cas, p: &[ExprId; 3]| -> [ExprId; 3] {
-            let v = cas.time_derivatives(p, &pairs);
-            [v[0], v[1], v[2]]
-        };
         self.applied.element(
             cas,
             &self.loads,
@@ -248,7 +244,7 @@ impl<'a> PlanarArm<'a> {
                     omega: [zero, zero, f.w],
                 }
             },
-            &velocity,
+            &pairs,
             self.symbols,
         );
     }

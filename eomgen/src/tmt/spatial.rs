@@ -534,10 +534,6 @@ impl<'a> SpatialArm<'a> {
         let (k, link) = (self.k, self.links.len());
         let mut pairs = self.coords.rate_pairs();
         pairs.extend(&self.seeds);
-        let velocity = |cas: &mut Cas, p: &[ExprId; 3]| -> [ExprId; 3] {
-            let v = cas.time_derivatives(p, &pairs);
-            [v[0], v[1], v[2]]
-        };
         self.applied.element(
             cas,
             &self.loads,
@@ -550,7 +546,7 @@ impl<'a> SpatialArm<'a> {
                     omega: f.w,
                 }
             },
-            &velocity,
+            &pairs,
             self.symbols,
         );
     }

@@ -179,3 +179,17 @@ pub fn static_tip(dir: &Path, text: &str, sets: &[String]) -> [f64; 3] {
     let o = l.arm.outputs(0.0, &sol.q, &vec![0.0; n]);
     [o[0], o[1], o[2]]
 }
+
+/// `--set`s that make a model's first segment `method` at resolution `n`:
+/// its elements, or a rom segment's quadrature slices.
+pub fn method_sets(method: &str, n: usize) -> Vec<String> {
+    let key = if method == "rom" {
+        "quadrature"
+    } else {
+        "elements"
+    };
+    vec![
+        format!("segment.0.method={method}"),
+        format!("segment.0.{key}={n}"),
+    ]
+}
