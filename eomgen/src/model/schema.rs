@@ -512,24 +512,6 @@ impl Segment {
         Self::value(&self.density)
     }
 
-    /// The whole segment's mass (kg): `mass`, or the integral of density
-    /// times the section's area along it (Simpson's rule between the
-    /// profiles' points: exact while the radius and density are linear
-    /// there, a cubic).
-    pub fn total_mass(&self) -> Option<f64> {
-        if let Some(m) = self.mass {
-            return Some(m);
-        }
-        let breaks = self.breaks();
-        let mut total = 0.0;
-        for w in breaks.windows(2) {
-            let (a, b) = (w[0], w[1]);
-            let f = |x: f64| self.mass_per_length(x);
-            total += (b - a) * self.length / 6.0 * (f(a)? + 4.0 * f(0.5 * (a + b))? + f(b)?);
-        }
-        Some(total)
-    }
-
     /// rom: the polynomial degree.
     pub fn rom_order(&self) -> usize {
         self.order.unwrap_or(3)
