@@ -131,6 +131,14 @@ fn linked(
     }
     if arms
         .iter()
+        .any(|s| s.segments.iter().any(|g| g.anisotropic))
+    {
+        return Err(
+            "its sections bend unequally about y and z, which link cells do not carry yet".into(),
+        );
+    }
+    if arms
+        .iter()
         .any(|s| !s.loads.is_empty() || s.fluid.is_some())
     {
         return Err("its loads along the arm are not link cells yet".into());

@@ -22,11 +22,10 @@ fn section_at(s: &Segment, x: f64) -> Section {
     let here = s.at(x);
     let [rest_y, rest_z, rest_twist, rest_stretch] = s.rest_at(x, 3);
     let stiffness = |v: Option<f64>| v.expect("validated: the Cosserat rod's stiffness");
-    let ei = stiffness(here.ei());
     Section {
         ea: s.stretches().then(|| stiffness(here.ea())),
         ga: s.shears().then(|| stiffness(here.ga())),
-        ei: [ei, ei],
+        ei: [stiffness(here.ei_y()), stiffness(here.ei())],
         gj: stiffness(here.gj()),
         rho_a: s.mass_per_length(x).unwrap_or(0.0),
         // The rod's frame is (y, z, x) of the section's.

@@ -150,14 +150,108 @@ value = 0.0
     let equal = text.replace("inputs = [\"p\", \"none\"]", "inputs = [\"p\", \"p\"]");
     let (tip, _) = static_tip(dir.path(), &equal, &[]);
     assert_tip(tip, [L, 0.0, 0.0], "two chambers at one pressure");
-    // Three dimensions still ask for an isotropic section.
-    let spatial = text.replace("dimensions = 2", "dimensions = 3");
-    let path = dir.path().join("spatial.toml");
-    std::fs::write(&path, spatial).unwrap();
-    let err = load(path.to_str().unwrap(), &[], BackendChoice::Auto, None)
-        .err()
-        .expect("a 3D arm with two holes is refused");
-    assert!(format!("{err:#}").contains("at least 3 in 3D"), "{err:#}");
+}
+
+/// The same two opposed chambers in 3D: the section is anisotropic (the
+/// holes at y = +-d weaken the bend about z by 2 a d^2, about y not at
+/// all), one pressurised bends the arm by M / (E I_z) about z; both at
+/// one pressure stretch it by 2 p a L / (E A), without a bend; turned to
+/// z = +-d they bend it about y by I_y alike; and a tip moment about z
+/// meets I_z less the holes' a d^2 only where they sit at y = +-d.
+#[test]
+fn two_opposed_chambers_in_3d_bend_by_m_over_ei_and_stretch_straight_at_one_pressure() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rc, d, p) = (0.002, 0.006, 1.0e5);
+    let a = PI * rc * rc;
+    let ring = PI * R.powi(4) / 4.0;
+    let i_across = ring - 2.0 * (a * rc * rc / 4.0 + a * d * d);
+    let i_along = ring - 2.0 * (a * rc * rc / 4.0);
+    let area = PI * R * R - 2.0 * a;
+    for (angles, n, i) in [
+        ("[0.0, 180.0]", [0.0, 0.0, -1.0], i_across),
+        ("[90.0, 270.0]", [0.0, 1.0, 0.0], i_across),
+    ] {
+        let text = arm(&(segment(L, "twist = false\nextension = true")
+            + &format!(
+                r#"
+[segment.chambers]
+angles = {angles}
+radius = {rc}
+distance = {d}
+inputs = ["p", "none"]
+[inputs.p]
+kind = "constant"
+value = {p}
+[inputs.none]
+kind = "constant"
+value = 0.0
+"#
+            )));
+        // The bend alone (no stretch: the stretch stiffens to nothing).
+        let stiff = ["segment.0.axial_stiffness=1e12"];
+        let (tip, _) = static_tip(dir.path(), &text, &stiff);
+        let theta = p * a * d * L / (E * i);
+        assert_tip(
+            tip,
+            arc(L, theta, n),
+            &format!("one of {angles} pressurised"),
+        );
+        let equal = text.replace("inputs = [\"p\", \"none\"]", "inputs = [\"p\", \"p\"]");
+        let (tip, _) = static_tip(dir.path(), &equal, &[]);
+        let stretch = 2.0 * p * a * L / (E * area);
+        assert_tip(
+            tip,
+            [L + stretch, 0.0, 0.0],
+            &format!("both of {angles} at one pressure"),
+        );
+        // A moment about z: the holes at y weaken it, those at z do not.
+        let (bent, _) = static_tip(dir.path(), &equal, &["tip.moment=[0, 0, 1e-3]"]);
+        let theta = 1e-3 * L / (E * if angles.starts_with("[0") { i } else { i_along });
+        let want = arc(L + stretch, theta, [0.0, 0.0, 1.0]);
+        assert_close(
+            bent[1],
+            want[1],
+            1e-6,
+            L,
+            &format!("{angles}: a moment about z"),
+        );
+    }
+}
+
+/// One chamber alone (count = 1) moves the section's centroid away from
+/// it, by z_c = -a d / A; the arm bends about its centroid, where its
+/// second moment is I_y = (ring - a r^2 / 4 - a d^2) - A z_c^2 and the
+/// pressure's lever d - z_c.
+#[test]
+fn one_chamber_alone_bends_the_arm_about_its_shifted_centroid() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rc, d, p) = (0.003, 0.005, 1.0e5);
+    let text = arm(&(segment(L, "twist = false")
+        + &format!(
+            r#"
+[segment.chambers]
+angles = [90.0]
+radius = {rc}
+distance = {d}
+inputs = ["p"]
+[inputs.p]
+kind = "constant"
+value = {p}
+"#
+        )));
+    let (tip, _) = static_tip(dir.path(), &text, &[]);
+    let a = PI * rc * rc;
+    let area = PI * R * R - a;
+    let zc = -a * d / area;
+    let i_y = PI * R.powi(4) / 4.0 - (a * rc * rc / 4.0 + a * d * d) - area * zc * zc;
+    let theta = p * a * (d - zc) * L / (E * i_y);
+    // The hole at +z: the bend turns x about +y, towards -z.
+    assert_tip(tip, arc(L, theta, [0.0, 1.0, 0.0]), "one chamber");
+    assert!(tip[2] < 0.0, "bends away from the chamber: {tip:?}");
+    // Without the centroid's shift the lever and I_y differ by 6 % and
+    // 12 %: the test tells them apart.
+    let naive = p * a * d * L / (E * (PI * R.powi(4) / 4.0 - (a * rc * rc / 4.0 + a * d * d)));
+    assert!((naive - theta).abs() > 0.05 * theta, "{naive} {theta}");
 }
 
 #[test]

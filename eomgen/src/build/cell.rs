@@ -70,7 +70,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         && st.torques.is_empty()
         && !st.base_translates
         && st.base_turns == 0
-        && st.segments.iter().all(|g| !g.kink)
+        && st.segments.iter().all(|g| !g.kink && !g.anisotropic)
         && st.loads.is_empty()
         && st.fluid.is_none();
     if !covered {
@@ -403,6 +403,7 @@ fn cell_springs(
         let local = |k: ExprId| if incompressible { k } else { zero };
         Springs {
             bend: local(kb),
+            bend_y: local(kb),
             bend_damping: zero,
             rest: [local(rest_y), local(rest)],
             twist: local(kt),
@@ -415,6 +416,7 @@ fn cell_springs(
     } else {
         Springs {
             bend: kb,
+            bend_y: kb,
             bend_damping: db,
             rest: [rest_y, rest],
             twist: kt,
@@ -474,7 +476,8 @@ fn link_motion(
         }
         CellKind::PastJoint => {
             let half = cas.scaled(0.5, element.l);
-            let (c, a, w, end) = past_joint(cas, identity, &s.rho, &s.rate, half, s.st);
+            let (c, joint, end) = past_joint(cas, identity, &s.rho, &s.rate, half, s.st);
+            let (a, w) = (joint.axis(), joint.w);
             let body = Element3 {
                 m: half_m,
                 ..element
@@ -587,12 +590,8 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     let rho = [tw, by, bz];
     let rate = [tw_d, by_d, bz_d];
     let half_m = cas.scaled(0.5, m);
-    let element = Element3 {
-        l,
-        m,
-        lateral,
-        axial,
-    };
+    // Cells carry axisymmetric sections (anisotropic ones run interpreted).
+    let element = Element3::axisymmetric(l, m, lateral, axial);
     let shear = shear_at.map(|i| [q[i], q[i + 1]]);
     let (centroid, axis, omega, end, body) = link_motion(
         cas,

@@ -83,6 +83,7 @@ impl Structure {
                         joints: method.joints(s),
                         varying: method.polynomial_fields() && s.tapered(),
                         rest_3d: s.rest_3d(m.dimensions),
+                        anisotropic: s.anisotropic(m.dimensions),
                         kink: s.kinked(),
                         twist: spatial && twist,
                         extension: spatial && extension,

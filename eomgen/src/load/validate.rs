@@ -408,7 +408,7 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
         }
         if let Some(c) = &s.chambers {
             let planar = ck.m.dimensions == 2;
-            check_chambers(c, &p("chambers"), (ro, ri), planar, ck.file)
+            check_chambers(&here, c, &p("chambers"), planar, ck.file)
                 .map_err(|e| e.with_suffix(&at))?;
         }
     }
@@ -437,8 +437,8 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
 }
 
 /// `[segment.section]`: positive sides; instead of a radius, without
-/// chamber holes; in 3D the same bending stiffness about both axes (a
-/// square or a circle), since 3D elements bend isotropically.
+/// chamber holes. In 3D a section that bends more stiffly about one axis
+/// carries both stiffnesses (`Segment::anisotropic`).
 fn section_shape(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
     let p = |k: &str| format!("segment[{i}].section.{k}");
     let Some(sec) = &s.section else {
@@ -460,16 +460,6 @@ fn section_shape(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
                 ),
             );
         }
-    }
-    let [iy, iz] = sec.second_moments();
-    if ck.m.dimensions == 3 && (iy - iz).abs() > 1e-9 * iy.max(iz) {
-        return ck.err(
-            format!("segment[{i}].section"),
-            format!(
-                "a {w} x {h} section bends {:.3} times more stiffly about one axis than the other; anisotropic bending is not supported in 3D yet: a square or a circle, or a planar arm",
-                iy.max(iz) / iy.min(iz)
-            ),
-        );
     }
     Ok(())
 }
@@ -678,14 +668,13 @@ fn shear_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
     Ok(())
 }
 
-/// Chamber holes: one way to place them, inside the wall, not overlapping,
-/// centred on the axis, with declared input channels; in 3D in an
-/// isotropic pattern (a planar arm bends about one axis only: two opposed
-/// holes, the usual bending actuator, or any other centred pattern).
+/// Chamber holes of segment `s` (its section where they are checked): one
+/// way to place them, inside the wall, not overlapping, with declared
+/// input channels; in 3D with the principal axes y and z.
 fn check_chambers(
+    s: &Segment,
     c: &crate::model::Chambers,
     path: &str,
-    (outer, inner): (Option<f64>, Option<f64>),
     planar: bool,
     file: &str,
 ) -> Result<(), ModelError> {
@@ -697,6 +686,7 @@ fn check_chambers(
         };
         Err(ModelError::new(file, at, msg))
     };
+    let (outer, inner) = (s.outer(), s.inner());
     let Some(ro) = outer else {
         return err("", "needs the section's `outer_radius`".into());
     };
@@ -711,14 +701,6 @@ fn check_chambers(
             return err(
                 "count",
                 "missing: give `count` (equally spaced positions) or `angles` (degrees)".into(),
-            );
-        }
-        (Some(n), None) if n < 3 && c.pair_spacing.is_none() && !planar => {
-            return err(
-                "count",
-                format!(
-                    "must be at least 3 in 3D (equally spaced holes keep the bending stiffness the same in every direction; a planar arm takes 2, two opposed chambers), got {n}"
-                ),
             );
         }
         (Some(0), None) => return err("count", "must be at least 1".into()),
@@ -779,20 +761,16 @@ fn check_chambers(
             }
         }
     }
-    if !planar && !c.isotropic() {
+    // The centroid may leave the axis (the levers and stiffness are taken
+    // about it), but the principal axes must stay y and z: the elements
+    // bend about those two.
+    let [iy, iz] = s.second_moments().unwrap_or([1.0, 1.0]);
+    if !planar && s.product_moment().abs() > 1e-9 * iy.max(iz) {
         return err(
             "",
             format!(
-                "the holes at {holes:?} degrees make the section stiffer in one direction than another; anisotropic sections are not supported in 3D yet (a planar arm takes any holes centred on its axis): use 3 or more equally spaced positions, or pairs about them"
-            ),
-        );
-    }
-    if !c.centred(planar) {
-        return err(
-            "",
-            format!(
-                "the holes at {holes:?} degrees move the section's centroid off the arm's axis, about which its stiffness and the pressure's lever are taken; sections whose centroid leaves the axis are not supported yet: place the holes symmetrically about the axis (two opposed, {}or 3 or more equally spaced)",
-                if planar { "at 0 and 180 degrees, " } else { "" }
+                "the holes at {holes:?} degrees turn the section's principal axes away from y and z (I_yz = {:.3e} m^4); place them symmetrically about the y or the z axis (for example 0 and 180, or 90 and 270, degrees)",
+                s.product_moment()
             ),
         );
     }

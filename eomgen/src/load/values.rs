@@ -204,6 +204,10 @@ pub struct ElementProps {
     /// across the flow (the outer diameter).
     pub volume: f64,
     pub width: f64,
+    /// 3D anisotropic sections: E I_y / l_e and the bodies' rotary
+    /// inertia about their y axis.
+    pub stiffness_y: f64,
+    pub inertia_y: f64,
 }
 
 impl ElementProps {
@@ -226,6 +230,8 @@ impl ElementProps {
             ElementParam::RestStretch => self.rest_stretch,
             ElementParam::Volume => self.volume,
             ElementParam::Width => self.width,
+            ElementParam::BendStiffnessY => self.stiffness_y,
+            ElementParam::InertiaY => self.inertia_y,
         }
     }
 }
@@ -261,18 +267,29 @@ fn props_of(m: &Model, [s, springs]: [&Segment; 2], l: f64, n: usize) -> Element
     // Uniform cylinders (hollow, solid, with chamber holes) about a
     // diameter through the centre, m I / A ((r_o^2 + r_i^2) / 4 for a
     // ring); slender rods when no radius is given.
-    let section = match (s.second_moment(), s.area()) {
-        (Some(i), Some(a)) if a > 0.0 => mass * i / a,
-        _ => mass * (ro * ro + ri * ri) / 4.0,
+    // About z and about y.
+    let [section, section_y] = match (s.second_moments(), s.area()) {
+        (Some([iy, iz]), Some(a)) if a > 0.0 => [mass * iz / a, mass * iy / a],
+        _ => [mass * (ro * ro + ri * ri) / 4.0; 2],
     };
     // Bodies: the whole link, or two half links (midpoint joints), or
     // the section's part of an arc: the method's.
-    let (inertia, axial_inertia) =
-        crate::method::of(s.method).element_inertia(s, mass, l, section, m.dimensions);
-    let stiffness = match springs.ei() {
+    let method = crate::method::of(s.method);
+    let (inertia, mut axial_inertia) = method.element_inertia(s, mass, l, section, m.dimensions);
+    let inertia_y = match section_y == section {
+        true => inertia,
+        false => {
+            let (lateral, axial_y) = method.element_inertia(s, mass, l, section_y, m.dimensions);
+            // The polar moment is the sum of the two.
+            axial_inertia = 0.5 * (axial_inertia + axial_y);
+            lateral
+        }
+    };
+    let joint = |e: Option<f64>| match e {
         Some(ei) => ei / l,
         None => s.joint_stiffness.unwrap_or(0.0),
     };
+    let (stiffness, stiffness_y) = (joint(springs.ei()), joint(springs.ei_y()));
     let damping = match s.bending_damping {
         Some(eta) => eta / l,
         None => s.joint_damping.unwrap_or(0.0),
@@ -300,6 +317,8 @@ fn props_of(m: &Model, [s, springs]: [&Segment; 2], l: f64, n: usize) -> Element
         stretch_stiffness: springs.ea().unwrap_or(0.0) / l,
         stretch_damping: s.axial_damping.unwrap_or(0.0) / l,
         shear_stiffness: springs.ga().unwrap_or(0.0) / l,
+        stiffness_y,
+        inertia_y,
     }
 }
 

@@ -31,6 +31,7 @@ use crate::model::{
 use crate::tmt::actuation::{Strain, actuation, thinning};
 use crate::tmt::assemble;
 use crate::tmt::spatial::{
+    Element3,
     M3, V3, add3, base_frame, bind3, coefficients, half_k_sq, left_jacobian, quat_mul, rotation,
     rotation_quat,
 };
@@ -203,16 +204,16 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         omega = element_omega;
         let axis = [r[0][0], r[1][0], r[2][0]];
         slab_samples(cas, structure.contact_points, l, centre, axis, quat, &mut samples);
-        bodies.push(Body {
-            mass: symbols.element(k, ElementParam::Mass),
-            inertia: Inertia::Axisymmetric {
-                axis,
-                axial: symbols.element(k, ElementParam::AxialInertia),
-                lateral: symbols.element(k, ElementParam::Inertia),
-            },
-            position: centre,
-            omega,
-        });
+        let e = |p| symbols.element(k, p);
+        let lateral = e(ElementParam::Inertia);
+        let el = Element3 {
+            l,
+            m: e(ElementParam::Mass),
+            lateral,
+            lateral_y: symbols.element_or(k, ElementParam::InertiaY, lateral),
+            axial: e(ElementParam::AxialInertia),
+        };
+        bodies.push(el.body(cas, (axis, move |_: &mut Cas| r), centre, omega, el.m));
         let slab = Slab { r, centre, half };
 
         // Beam springs to the previous element (or the clamp), on centres
@@ -221,7 +222,8 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         // the whole arm (whose round-off grows with the arm's length), and
         // the same expression as the joint's part (`joint_part`).
         let incompressible = structure.segments[segment].incompressible;
-        let jp = JointParams::of(symbols, k);
+        let mut jp = JointParams::of(symbols, k);
+        jp.kb_y = symbols.element_or(k, ElementParam::BendStiffnessY, jp.kb);
         let prev_rel = Slab {
             r: prev.r,
             centre: if k == 0 {
@@ -358,6 +360,8 @@ struct JointParams {
     l: ExprId,
     kb: ExprId,
     kt: ExprId,
+    /// E I_y / l: `kb` but for anisotropic sections.
+    kb_y: ExprId,
     db: ExprId,
     dt: ExprId,
     ka: ExprId,
@@ -385,6 +389,7 @@ impl JointParams {
         Self {
             l,
             kb,
+            kb_y: kb,
             kt,
             db,
             dt,
@@ -408,6 +413,7 @@ fn beam_springs(
     let JointParams {
         l,
         kb,
+        kb_y,
         kt,
         db,
         dt,
@@ -456,7 +462,11 @@ fn beam_springs(
     let (mut elastic, mut rayleigh) = (Vec::new(), Vec::new());
     let v_d = cas.time_derivatives(&v, pairs);
     for (i, (&x, &xd)) in v.iter().zip(&v_d).enumerate() {
-        let (kk, dd) = if i == 0 { (kt, dt) } else { (kb, db) };
+        let (kk, dd) = match i {
+            0 => (kt, dt),
+            1 => (kb_y, db),
+            _ => (kb, db),
+        };
         let kk = cas.scaled(span, kk);
         let kk = match thin {
             Some((soft, _)) => cas.mul(kk, soft),
@@ -492,7 +502,8 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
         && st.base_turns == 0
         && st.torques.is_empty()
         && st.chambers.iter().all(|&c| c == 0)
-        && st.tendons.is_empty();
+        && st.tendons.is_empty()
+        && st.segments.iter().all(|g| !g.anisotropic);
     if !covered {
         return None;
     }

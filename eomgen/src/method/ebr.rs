@@ -80,10 +80,10 @@ impl ModellingMethod for Ebr {
                 advance(cas, &joint, d)
             });
             let (b, end) = before_joint(cas, &arm.f, quarter, half);
-            arm.bodies.push(el.body(arm.f.axis(), b, arm.f.w, half_m));
+            arm.bodies.push(el.body(cas, arm.f.orientation(), b, arm.f.w, half_m));
             arm.f = end;
-            let (b, axis, omega, end) = past_joint(cas, &arm.f, &rho, &rate, half, st.stretch);
-            arm.bodies.push(el.body(axis, b, omega, half_m));
+            let (b, joint, end) = past_joint(cas, &arm.f, &rho, &rate, half, st.stretch);
+            arm.bodies.push(el.body(cas, joint.orientation(), b, joint.w, half_m));
             arm.f = end;
             arm.close_link(first);
         }
@@ -99,8 +99,8 @@ pub(crate) fn before_joint(cas: &mut Cas, f: &Frame, quarter: ExprId, half: Expr
 
 /// The part of an ebr element past its joint, from the joint's frame `f`:
 /// the turn exp([rho]x), then the half element of length `half +
-/// stretch`: its body's centroid, axis and angular velocity, and the end
-/// frame (as `spatial::arc` gives them for a pcc element).
+/// stretch`: its body's centroid, the joint's frame (the body turns with
+/// it) and the end frame (as `spatial::arc` gives them for a pcc element).
 pub(crate) fn past_joint(
     cas: &mut Cas,
     f: &Frame,
@@ -108,12 +108,12 @@ pub(crate) fn past_joint(
     rate: &V3,
     half: ExprId,
     stretch: ExprId,
-) -> (V3, V3, V3, Frame) {
+) -> (V3, Frame, Frame) {
     let (r_rel, q_rel, w_rel) = exp_turn(cas, rho, rate);
     let joint = compose(cas, f, Some((&r_rel, &q_rel)), None, Some(&w_rel));
     let b_len = cas.add(half, stretch);
     let half_b = cas.scaled(0.5, b_len);
     let b = advance(cas, &joint, half_b);
     let end = advance(cas, &joint, b_len);
-    (b.p, joint.axis(), joint.w, end)
+    (b.p, joint, end)
 }

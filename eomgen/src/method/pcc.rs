@@ -9,7 +9,7 @@ use crate::cas::{Cas, ExprId, Func};
 use crate::model::{Check, ModelError, Segment, SegmentShape};
 use crate::tmt::cell_kind::CellKind;
 use crate::tmt::planar::{self, Element2, Frame, PlanarArm};
-use crate::tmt::spatial::{SpatialArm, arc, bind3, in_halves};
+use crate::tmt::spatial::{SpatialArm, arc, bind3, in_halves, mid_arc_rotation};
 
 pub(super) struct Pcc;
 
@@ -72,7 +72,8 @@ impl ModellingMethod for Pcc {
             for _ in 0..pieces {
                 let (centroid, axis, omega, end) = arc(cas, &arm.f, &part);
                 let centroid = bind3(cas, centroid);
-                arm.bodies.push(body.body(axis, centroid, omega, body.m));
+                let turn = (axis, mid_arc_rotation(&arm.f, &part));
+                arm.bodies.push(body.body(cas, turn, centroid, omega, body.m));
                 arm.f = end;
             }
             arm.close_link(first);

@@ -150,14 +150,14 @@ impl ModellingMethod for Rigid {
                     });
                     let half = cas.scaled(0.5, l);
                     let mid = advance(cas, &arm.f, half);
-                    arm.bodies.push(el.body(arm.f.axis(), mid.p, arm.f.w, m));
+                    arm.bodies.push(el.body(cas, arm.f.orientation(), mid.p, arm.f.w, m));
                     arm.advance(cas, l);
                 }
                 Joints::Midpoint => {
                     let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
                     let half_m = cas.scaled(0.5, m);
                     let b = advance(cas, &arm.f, quarter);
-                    arm.bodies.push(el.body(arm.f.axis(), b.p, arm.f.w, half_m));
+                    arm.bodies.push(el.body(cas, arm.f.orientation(), b.p, arm.f.w, half_m));
                     let f = arm.f;
                     arm.advance(cas, half);
                     arm.f = joint(cas, arm, g, s);
@@ -172,7 +172,7 @@ impl ModellingMethod for Rigid {
                         advance(cas, from, d)
                     });
                     let b = advance(cas, &arm.f, quarter);
-                    arm.bodies.push(el.body(arm.f.axis(), b.p, arm.f.w, half_m));
+                    arm.bodies.push(el.body(cas, arm.f.orientation(), b.p, arm.f.w, half_m));
                     arm.advance(cas, half);
                 }
             }
@@ -218,6 +218,7 @@ fn joint(cas: &mut Cas, arm: &mut SpatialArm, g: &SegmentShape, s: usize) -> Fra
         e(ElementParam::TwistStiffness),
     );
     let (damp, rest) = (e(ElementParam::BendDamping), e(ElementParam::Rest));
+    let stiff_y = (arm.symbols).element_or(arm.k, ElementParam::BendStiffnessY, stiff);
     let zero = arm.zero;
     // Half the rest turn before the joint and half after: its angles are
     // then measured in the frame midway between its links, as a rod's
@@ -251,7 +252,11 @@ fn joint(cas: &mut Cas, arm: &mut SpatialArm, g: &SegmentShape, s: usize) -> Fra
     let theta = rotation_vector(cas, &turns, zero);
     for (k, &th) in theta.iter().enumerate() {
         if turns.iter().any(|&(a, _)| a == k) {
-            let kq = if k == 0 { twist } else { stiff };
+            let kq = match k {
+                0 => twist,
+                1 => stiff_y,
+                _ => stiff,
+            };
             arm.elastic.push(half_k_sq(cas, kq, th));
         }
     }

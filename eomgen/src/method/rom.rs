@@ -9,7 +9,7 @@ use crate::cas::{Cas, ExprId};
 use crate::model::{Check, ElementParam, ModelError, Segment, SegmentShape};
 use crate::tmt::actuation::{Strain, thinning};
 use crate::tmt::cell_kind::CellKind;
-use crate::tmt::spatial::{ArcStrain, SpatialArm, V3, arc, bind3, half_k_sq};
+use crate::tmt::spatial::{ArcStrain, SpatialArm, V3, arc, bind3, half_k_sq, mid_arc_rotation};
 use crate::tmt::system::{Coordinates, ParamSymbols};
 
 pub(super) struct Rom;
@@ -78,6 +78,7 @@ impl ModellingMethod for Rom {
             let first = arm.c;
             let p = |q| arm.symbols.element(arm.k, q);
             let kb = p(ElementParam::BendStiffness);
+            let kb_y = (arm.symbols).element_or(arm.k, ElementParam::BendStiffnessY, kb);
             let kt = p(ElementParam::TwistStiffness);
             let rest = p(ElementParam::Rest);
             // The slice by its two half-arcs (`RomFields::halves`): each
@@ -93,7 +94,7 @@ impl ModellingMethod for Rom {
                 let thin = rom.incompressible.then(|| {
                     let (soft, off) = thinning(cas, el.l, len);
                     let bz = cas.sub(rho[2], rest);
-                    for (kk, x) in [(kb, rho[1]), (kb, bz), (kt, rho[0])] {
+                    for (kk, x) in [(kb_y, rho[1]), (kb, bz), (kt, rho[0])] {
                         let share = cas.constant(0.5);
                         let kk = cas.mul_all(&[kk, soft, share]);
                         arm.elastic.push(half_k_sq(cas, kk, x));
@@ -133,7 +134,8 @@ impl ModellingMethod for Rom {
             for part in [a, b] {
                 let (centroid, axis, omega, end) = arc(cas, &arm.f, &part);
                 let centroid = bind3(cas, centroid);
-                arm.bodies.push(body.body(axis, centroid, omega, body.m));
+                let turn = (axis, mid_arc_rotation(&arm.f, &part));
+                arm.bodies.push(body.body(cas, turn, centroid, omega, body.m));
                 arm.f = end;
             }
             arm.close_link(first);
@@ -365,7 +367,11 @@ impl RomFields {
                 0 | 1 => (ElementParam::BendStiffness, ElementParam::BendDamping),
                 _ => (ElementParam::TwistStiffness, ElementParam::TwistDamping),
             };
-            let ks = |e: usize| symbols.element(k + e, stiff);
+            // An anisotropic section's bend about y (field 0) its own.
+            let ks = |e: usize| match f {
+                0 => symbols.element_or(k + e, ElementParam::BendStiffnessY, symbols.element(k + e, stiff)),
+                _ => symbols.element(k + e, stiff),
+            };
             let ds = |e: usize| symbols.element(k + e, damp);
             // Bending, twist: (E I / L) c^T G c = (k_slice / n) ...; stretch
             // and shear: E A L e^T G e = k_slice n l^2 ....

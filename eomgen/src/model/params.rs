@@ -88,6 +88,11 @@ pub enum ElementParam {
     /// (m^3) and its width across the flow (m).
     Volume,
     Width,
+    /// 3D anisotropic sections (`SegmentShape::anisotropic`): E I_y / l_e,
+    /// the bend about y (`BendStiffness` is then about z), and each body's
+    /// rotary inertia about its y axis (`Inertia` about z).
+    BendStiffnessY,
+    InertiaY,
 }
 
 impl ElementParam {
@@ -114,6 +119,8 @@ impl ElementParam {
     /// (`runtime::links::REST_PARAMS`).
     pub const REST_3D: [ElementParam; runtime::links::REST_PARAMS] =
         [Self::RestY, Self::RestTwist, Self::RestStretch];
+    /// The parameters an anisotropic section adds, in layout order.
+    pub const ANISOTROPIC: [ElementParam; 2] = [Self::BendStiffnessY, Self::InertiaY];
     /// A link cell's parameters, in the order the cell tape reads them
     /// (`runtime::links::ELEMENT_PARAMS` of them).
     pub const CELL: [ElementParam; runtime::links::ELEMENT_PARAMS] = [
@@ -150,6 +157,8 @@ impl ElementParam {
             Self::RestStretch => ("stretch", "rest"),
             Self::Volume => ("element", "volume"),
             Self::Width => ("element", "width"),
+            Self::BendStiffnessY => ("joint", "stiffness_y"),
+            Self::InertiaY => ("element", "inertia_y"),
         };
         format!("{group}[{k}].{what}")
     }
@@ -621,9 +630,11 @@ pub fn channel(m: &Model, p: Param) -> Option<&str> {
 }
 
 /// A driven chamber position's pressure (0: its input sets it) and lever:
-/// the holes' total area and first moments a sum(z), a sum(y).
+/// the holes' total area and first moments a sum(z), a sum(y) about the
+/// section's centroid.
 pub(crate) fn chamber_value(m: &Model, segment: usize, position: usize, what: ChamberParam) -> f64 {
-    let c = m.segments[segment]
+    let seg = &m.segments[segment];
+    let c = seg
         .chambers
         .as_ref()
         .expect("the structure has this segment's chambers");
@@ -637,11 +648,14 @@ pub(crate) fn chamber_value(m: &Model, segment: usize, position: usize, what: Ch
         let h = h.to_radians();
         (y + c.distance * h.cos(), z + c.distance * h.sin())
     });
+    // Levers about the centroid, through which the centreline runs.
+    let n = holes.len() as f64;
+    let [yc, zc] = seg.centroid();
     match what {
         ChamberParam::Pressure => 0.0,
-        ChamberParam::Area => a * holes.len() as f64,
-        ChamberParam::ArmY => a * z,
-        ChamberParam::ArmZ => a * y,
+        ChamberParam::Area => a * n,
+        ChamberParam::ArmY => a * (z - n * zc),
+        ChamberParam::ArmZ => a * (y - n * yc),
     }
 }
 
@@ -710,6 +724,9 @@ fn along_arm(st: &Structure, p: &mut Vec<Param>, driven: &mut Vec<Driven>) {
             }
             if g.rest_3d {
                 p.extend(ElementParam::REST_3D.map(|e| Param::Element(k, e)));
+            }
+            if g.anisotropic {
+                p.extend(ElementParam::ANISOTROPIC.map(|e| Param::Element(k, e)));
             }
             if st.fluid.is_some() {
                 p.extend([ElementParam::Volume, ElementParam::Width].map(|e| Param::Element(k, e)));

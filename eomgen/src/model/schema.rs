@@ -417,36 +417,121 @@ impl Segment {
     }
 
     /// Second moment of area of the section (m^4) about its z axis, the
-    /// axis a planar arm bends about, if it has a radius. A hole at angle
-    /// a sits at y = d cos a; the holes leave the centroid on the axis
-    /// (validated). 3D arms have isotropic patterns (validated), whose sum
-    /// of cos^2 is n / 2: the same about every diameter.
+    /// axis a planar arm bends about, if it has a radius or a shape.
     pub fn second_moment(&self) -> Option<f64> {
+        Some(self.second_moments()?[1])
+    }
+
+    /// Second moments of area (m^4) about the section's y and z axes
+    /// through its centroid: the bends about y (int z^2) and about z (int
+    /// y^2). A hole at angle a sits at (y, z) = d (cos a, sin a); isotropic
+    /// patterns (sum cos 2a = sum sin 2a = 0) have n / 2 of cos^2 and of
+    /// sin^2, the same about every diameter. Holes off the axis move the
+    /// centroid (`centroid`), about which the arm bends: the parallel-axis
+    /// term takes it there.
+    pub fn second_moments(&self) -> Option<[f64; 2]> {
         if let Some(sec) = &self.section {
-            return Some(sec.second_moments()[1]);
+            return Some(sec.second_moments());
         }
         let ro = self.outer()?;
         let ri = self.inner().unwrap_or(0.0);
         let pi = std::f64::consts::PI;
-        let holes = self.chambers.as_ref().map_or(0.0, |c| {
-            let a = pi * c.radius * c.radius;
-            let n = c.holes().len() as f64;
-            let (r2, d2) = (c.radius * c.radius, c.distance * c.distance);
-            match c.isotropic() {
-                true => n * (a * r2 / 4.0 + a * d2 / 2.0),
-                false => {
-                    let cos2: f64 = c.holes().iter().map(|h| h.to_radians().cos().powi(2)).sum();
-                    n * a * r2 / 4.0 + a * d2 * cos2
-                }
-            }
-        });
-        Some(pi / 4.0 * (ro.powi(4) - ri.powi(4)) - holes)
+        let ring = pi / 4.0 * (ro.powi(4) - ri.powi(4));
+        let Some(c) = &self.chambers else {
+            return Some([ring, ring]);
+        };
+        let a = pi * c.radius * c.radius;
+        let holes = c.holes();
+        let n = holes.len() as f64;
+        let (r2, d2) = (c.radius * c.radius, c.distance * c.distance);
+        if c.isotropic() {
+            let i = ring - n * (a * r2 / 4.0 + a * d2 / 2.0);
+            return Some([i, i]);
+        }
+        let sum = |f: fn(f64) -> f64| -> f64 { holes.iter().map(|h| f(h.to_radians())).sum() };
+        let cos2 = sum(|t| t.cos().powi(2));
+        let sin2 = sum(|t| t.sin().powi(2));
+        let about_axis = [
+            ring - (n * a * r2 / 4.0 + a * d2 * sin2),
+            ring - (n * a * r2 / 4.0 + a * d2 * cos2),
+        ];
+        if c.centred(false) {
+            return Some(about_axis);
+        }
+        let [yc, zc] = self.centroid();
+        let area = self.area()?;
+        Some([
+            about_axis[0] - area * zc * zc,
+            about_axis[1] - area * yc * yc,
+        ])
     }
 
-    /// Bending stiffness E I (N m^2), if declared.
+    /// Where the section's centroid sits (y, z, m) from the centre of its
+    /// outer circle: off it when chamber holes are not balanced about it.
+    /// The arm's centreline runs through the centroid (its stiffness and
+    /// the chambers' levers are taken about it).
+    pub fn centroid(&self) -> [f64; 2] {
+        let (Some(c), Some(area)) = (&self.chambers, self.area()) else {
+            return [0.0, 0.0];
+        };
+        if c.centred(false) {
+            return [0.0, 0.0];
+        }
+        let a = std::f64::consts::PI * c.radius * c.radius;
+        let first = |f: fn(f64) -> f64| -> f64 {
+            c.holes()
+                .iter()
+                .map(|h| a * c.distance * f(h.to_radians()))
+                .sum()
+        };
+        // The holes' material is missing: the centroid moves away from them.
+        [-first(f64::cos) / area, -first(f64::sin) / area]
+    }
+
+    /// The product of inertia I_yz (m^4) about the centroid: nonzero when
+    /// the holes turn the section's principal axes away from y and z.
+    pub fn product_moment(&self) -> f64 {
+        let (Some(c), Some(area)) = (&self.chambers, self.area()) else {
+            return 0.0;
+        };
+        let a = std::f64::consts::PI * c.radius * c.radius;
+        let d2 = c.distance * c.distance;
+        let about_axis: f64 = -c
+            .holes()
+            .iter()
+            .map(|h| {
+                let t = h.to_radians();
+                a * d2 * t.cos() * t.sin()
+            })
+            .sum::<f64>();
+        let [yc, zc] = self.centroid();
+        about_axis - area * yc * zc
+    }
+
+    /// Whether the section bends more stiffly about one of its axes than
+    /// the other (3D: an anisotropic section's elements carry both).
+    pub fn anisotropic(&self, dimensions: u8) -> bool {
+        if dimensions != 3 || self.bending_stiffness.is_some() {
+            return false;
+        }
+        let differ = |p: &Segment| {
+            p.second_moments()
+                .is_some_and(|[iy, iz]| (iy - iz).abs() > 1e-12 * iy.abs().max(iz.abs()))
+        };
+        differ(self) || self.tapered() && self.breaks().iter().any(|&x| differ(&self.at(x)))
+    }
+
+    /// Bending stiffness E I (N m^2) about z, if declared.
     pub fn ei(&self) -> Option<f64> {
         Self::value(&self.bending_stiffness)
             .or_else(|| Some(self.modulus()? * self.second_moment()?))
+    }
+
+    /// Bending stiffness E I (N m^2) about y: E I about z where the section
+    /// is isotropic or E I is given.
+    pub fn ei_y(&self) -> Option<f64> {
+        Self::value(&self.bending_stiffness)
+            .or_else(|| Some(self.modulus()? * self.second_moments()?[0]))
     }
 
     /// Area of the section (m^2), if it has a radius: the ring less the
@@ -475,7 +560,10 @@ impl Segment {
         Self::value(&self.torsional_stiffness).or_else(|| {
             let j = match &self.section {
                 Some(sec) => sec.torsion(),
-                None => 2.0 * self.second_moment()?,
+                None => {
+                    let [iy, iz] = self.second_moments()?;
+                    iy + iz
+                }
             };
             Some(self.shear()? * j)
         })

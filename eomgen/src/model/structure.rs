@@ -44,6 +44,9 @@ pub struct SegmentShape {
     /// 3D: its rest shape has a curvature about y, a twist or a stretch
     /// (their parameters exist), not only a curvature about z.
     pub rest_3d: bool,
+    /// 3D: its section bends more stiffly about one axis than the other
+    /// (its elements' `ElementParam::ANISOTROPIC` exist).
+    pub anisotropic: bool,
     /// It starts turned or offset from the previous segment's end (its
     /// `KinkParam`s exist).
     pub kink: bool,
@@ -181,6 +184,9 @@ impl Structure {
             }
             if g.rest_3d {
                 s.push_str(" rest3d");
+            }
+            if g.anisotropic {
+                s.push_str(" anisotropic");
             }
             if g.kink {
                 s.push_str(" kink");

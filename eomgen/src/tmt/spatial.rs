@@ -91,6 +91,13 @@ impl Frame {
     pub fn axis(&self) -> V3 {
         [self.r[0][0], self.r[1][0], self.r[2][0]]
     }
+
+    /// A body turned as this frame: its axis and its rotation
+    /// (`Element3::body`).
+    pub fn orientation(&self) -> (V3, impl FnOnce(&mut Cas) -> M3 + use<>) {
+        let r = self.r;
+        (self.axis(), move |_: &mut Cas| r)
+    }
 }
 
 pub(crate) fn add3(cas: &mut Cas, a: &V3, b: &V3) -> V3 {
@@ -325,6 +332,26 @@ pub(crate) fn arc(cas: &mut Cas, f: &Frame, a: &ArcStrain) -> (V3, V3, V3, Frame
     (centroid, axis, omega, end)
 }
 
+/// The rotation of an arc's body, its frame midway along (exp([rho/2]x)
+/// after `f`): asked for by anisotropic sections only (`Element3::body`).
+pub(crate) fn mid_arc_rotation(f: &Frame, a: &ArcStrain) -> impl FnOnce(&mut Cas) -> M3 + use<> {
+    let (r, rho) = (f.r, a.rho);
+    move |cas: &mut Cas| {
+        let rho_h = rho.map(|e| cas.scaled(0.5, e));
+        let w = cas.dot(&rho_h, &rho_h);
+        let w = cas.bind(w);
+        let c = coefficients(cas, w, [0, 1, 2]);
+        let turn = rotation(cas, &rho_h, c);
+        std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                let col = [turn[0][j], turn[1][j], turn[2][j]];
+                let e = cas.dot(&r[i], &col);
+                cas.bind(e)
+            })
+        })
+    }
+}
+
 /// The turn exp([rho]x): its rotation, quaternion and angular velocity
 /// (the left Jacobian applied to the rate) in the frame it turns from.
 pub(crate) fn exp_turn(cas: &mut Cas, rho: &V3, rate: &V3) -> (M3, Quat, V3) {
@@ -403,38 +430,98 @@ pub(crate) struct SpatialArm<'a> {
 pub(crate) struct Element3 {
     pub l: ExprId,
     pub m: ExprId,
+    /// Each body's rotary inertia about its z axis, about its y axis (the
+    /// same expression unless the section is anisotropic) and about its
+    /// own axis.
     pub lateral: ExprId,
+    pub lateral_y: ExprId,
     pub axial: ExprId,
 }
 
 impl Element3 {
+    /// An element whose section bends alike about y and z.
+    pub fn axisymmetric(l: ExprId, m: ExprId, lateral: ExprId, axial: ExprId) -> Self {
+        Self {
+            l,
+            m,
+            lateral,
+            lateral_y: lateral,
+            axial,
+        }
+    }
+
+    fn anisotropic(&self) -> bool {
+        self.lateral_y != self.lateral
+    }
+
     /// Half of this element (a half-arc, `in_halves`): half the mass and
     /// axial inertia; laterally the element's lateral inertia is its
-    /// section's rotary inertia, axial / 2 (rho I l, J = 2 I), and its
+    /// section's rotary inertia (rho I l; axial / 2 when J = 2 I) and its
     /// slice's m l^2 / 12, of which a half of half the length carries half
-    /// and an eighth: axial / 4 and m l^2 / 96.
+    /// and an eighth: the section's half and m l^2 / 96.
     pub fn half(&self, cas: &mut Cas) -> Element3 {
+        let axial = cas.scaled(0.5, self.axial);
+        if self.anisotropic() {
+            // The slice's part from the two laterals and the polar sum:
+            // (lateral + lateral_y - axial) / 2.
+            let both = cas.add(self.lateral, self.lateral_y);
+            let both = cas.sub(both, self.axial);
+            let slice = cas.scaled(0.5, both);
+            let half = |cas: &mut Cas, lateral: ExprId| {
+                let section = cas.sub(lateral, slice);
+                let section = cas.scaled(0.5, section);
+                let part = cas.scaled(0.125, slice);
+                cas.add(section, part)
+            };
+            return Element3 {
+                l: cas.scaled(0.5, self.l),
+                m: cas.scaled(0.5, self.m),
+                lateral: half(cas, self.lateral),
+                lateral_y: half(cas, self.lateral_y),
+                axial,
+            };
+        }
         let whole_section = cas.scaled(0.5, self.axial);
         let section = cas.scaled(0.25, self.axial);
         let slice = cas.sub(self.lateral, whole_section);
         let slice = cas.scaled(0.125, slice);
-        Element3 {
-            l: cas.scaled(0.5, self.l),
-            m: cas.scaled(0.5, self.m),
-            lateral: cas.add(section, slice),
-            axial: cas.scaled(0.5, self.axial),
-        }
+        let lateral = cas.add(section, slice);
+        Element3::axisymmetric(
+            cas.scaled(0.5, self.l),
+            cas.scaled(0.5, self.m),
+            lateral,
+            axial,
+        )
     }
 
-    /// A body of this element's section: axisymmetric about `axis`.
-    pub fn body(&self, axis: V3, position: V3, omega: V3, mass: ExprId) -> Body {
-        Body {
-            mass,
-            inertia: Inertia::Axisymmetric {
+    /// A body of this element's section, its own axis `axis`; an
+    /// anisotropic section's principal axes are the columns of the body's
+    /// rotation, `turn`, asked for only then.
+    pub fn body(
+        &self,
+        cas: &mut Cas,
+        (axis, turn): (V3, impl FnOnce(&mut Cas) -> M3),
+        position: V3,
+        omega: V3,
+        mass: ExprId,
+    ) -> Body {
+        let inertia = match self.anisotropic() {
+            false => Inertia::Axisymmetric {
                 axis,
                 axial: self.axial,
                 lateral: self.lateral,
             },
+            true => {
+                let r = turn(cas);
+                Inertia::Principal {
+                    axes: std::array::from_fn(|k| [r[0][k], r[1][k], r[2][k]]),
+                    moments: [self.axial, self.lateral_y, self.lateral],
+                }
+            }
+        };
+        Body {
+            mass,
+            inertia,
             position,
             omega,
         }
@@ -498,10 +585,12 @@ impl<'a> SpatialArm<'a> {
     /// The current element's parameters.
     pub fn element(&self) -> Element3 {
         let e = |p| self.symbols.element(self.k, p);
+        let lateral = e(ElementParam::Inertia);
         Element3 {
             l: e(ElementParam::Length),
             m: e(ElementParam::Mass),
-            lateral: e(ElementParam::Inertia),
+            lateral,
+            lateral_y: (self.symbols).element_or(self.k, ElementParam::InertiaY, lateral),
             axial: e(ElementParam::AxialInertia),
         }
     }
@@ -621,8 +710,12 @@ impl<'a> SpatialArm<'a> {
         });
         let e = |p| self.symbols.element(self.k, p);
         let rest = |p| self.symbols.element_or(self.k, p, zero);
+        let bend = e(ElementParam::BendStiffness);
         let springs = Springs {
-            bend: e(ElementParam::BendStiffness),
+            bend,
+            bend_y: self
+                .symbols
+                .element_or(self.k, ElementParam::BendStiffnessY, bend),
             bend_damping: e(ElementParam::BendDamping),
             rest: [rest(ElementParam::RestY), e(ElementParam::Rest)],
             twist: e(ElementParam::TwistStiffness),
@@ -765,7 +858,10 @@ pub(crate) fn base_frame(
 
 /// An element's springs and dampers (pcc, vc, ebr; a link cell's too).
 pub(crate) struct Springs {
+    /// E I / l about z, and about y (the same but for anisotropic
+    /// sections).
     pub bend: ExprId,
+    pub bend_y: ExprId,
     pub bend_damping: ExprId,
     /// Rest bend about y and about z.
     pub rest: [ExprId; 2],
@@ -791,13 +887,14 @@ impl Springs {
     ) -> (ExprId, ExprId) {
         let soften = |cas: &mut Cas, k: ExprId| soft.map_or(k, |s| cas.mul(k, s));
         let kb = soften(cas, self.bend);
+        let kb_y = soften(cas, self.bend_y);
         let kt = soften(cas, self.twist);
         let by_rel = cas.sub(by, self.rest[0]);
         let bz_rel = cas.sub(bz, self.rest[1]);
         let tw_rel = cas.sub(tw, self.rest_twist);
         let st_rel = cas.sub(st, self.rest_stretch);
         let elastic = [
-            half_k_sq(cas, kb, by_rel),
+            half_k_sq(cas, kb_y, by_rel),
             half_k_sq(cas, kb, bz_rel),
             half_k_sq(cas, kt, tw_rel),
             half_k_sq(cas, self.stretch, st_rel),
