@@ -754,17 +754,6 @@ fn section_load_and_fluid_cases() -> Vec<FileCase> {
     let r = |a: &str, b: &str| GOOD3.replacen(a, b, 1);
     vec![
         (
-            "a flat section in 3D",
-            r(
-                "outer_radius = 0.01",
-                "section = { shape = \"rectangle\", width = 0.02, height = 0.005 }",
-            ),
-            vec![
-                "segment[0].section",
-                "anisotropic bending is not supported in 3D yet",
-            ],
-        ),
-        (
             "a section and a radius",
             r(
                 "outer_radius = 0.01",
@@ -1043,12 +1032,12 @@ fn three_d_method_cases() -> Vec<FileCase> {
             vec!["segment[0].method", "unknown variant `fem`", "rom"],
         ),
         (
-            "two chambers",
+            "chambers that turn the principal axes",
             r(
                 "elements = 2",
-                "chambers = { count = 2, radius = 0.002, distance = 0.005 }",
+                "chambers = { angles = [0, 90], radius = 0.002, distance = 0.005 }",
             ),
-            vec!["segment[0].chambers.count", "at least 3"],
+            vec!["segment[0].chambers", "principal axes", "0 and 180"],
         ),
         (
             "overlapping chambers",
@@ -1191,30 +1180,7 @@ fn chamber_and_input_cases() -> Vec<FileCase> {
         (
             "anisotropic holes",
             r("angles = [0, 120, 240]", "angles = [0, 90, 240]"),
-            vec!["segment[0].chambers", "anisotropic"],
-        ),
-        (
-            "holes off the axis in 3D",
-            r(
-                "angles = [0, 120, 240]",
-                "angles = [0, 90, 180, 270, 45, 135]",
-            )
-            .replace(
-                "[\"p\", \"p\", \"p\"]",
-                "[\"p\", \"p\", \"p\", \"p\", \"p\", \"p\"]",
-            ),
-            vec!["segment[0].chambers", "centroid off the arm's axis"],
-        ),
-        (
-            "one hole in a planar arm",
-            r("angles = [0, 120, 240]", "angles = [0]")
-                .replace("[\"p\", \"p\", \"p\"]", "[\"p\"]")
-                .replace("dimensions = 3", "dimensions = 2"),
-            vec![
-                "segment[0].chambers",
-                "centroid off the arm's axis",
-                "at 0 and 180 degrees",
-            ],
+            vec!["segment[0].chambers", "principal axes"],
         ),
         (
             "count and angles",

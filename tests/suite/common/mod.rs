@@ -193,3 +193,45 @@ pub fn method_sets(method: &str, n: usize) -> Vec<String> {
         format!("segment.0.{key}={n}"),
     ]
 }
+
+/// The first N bending frequencies (Hz) of a clamped-free Rayleigh beam
+/// (Euler-Bernoulli with the section's rotary inertia rho I), from its
+/// characteristic equation: EI W'''' + rho I w^2 W'' - rho A w^2 W = 0,
+/// W = C1 cosh ax + C2 sinh ax + C3 cos bx + C4 sin bx, clamped at 0,
+/// with EI W'' = 0 and EI W''' + rho I w^2 W' = 0 at L; the roots of the
+/// 2 x 2 determinant left by the clamp, bracketed on a scan and bisected.
+pub fn rayleigh_beam_hz<const N: usize>(ei: f64, rho_a: f64, rho_i: f64, len: f64) -> [f64; N] {
+    let det = |w: f64| {
+        let w2 = w * w;
+        let d = (rho_i * rho_i * w2 * w2 + 4.0 * ei * rho_a * w2).sqrt();
+        let a = ((d - rho_i * w2) / (2.0 * ei)).sqrt();
+        let b = ((d + rho_i * w2) / (2.0 * ei)).sqrt();
+        let (ch, sh) = ((a * len).cosh(), (a * len).sinh());
+        let (s, c) = (b * len).sin_cos();
+        let m11 = a * a * ch + b * b * c;
+        let m12 = a * a * sh + a * b * s;
+        let m21 = ei * (a.powi(3) * sh - b.powi(3) * s) + rho_i * w2 * (a * sh + b * s);
+        let m22 = ei * (a.powi(3) * ch + a * b * b * c) + rho_i * w2 * a * (ch - c);
+        m11 * m22 - m12 * m21
+    };
+    let mut roots = Vec::new();
+    // Steps of 1e-3 of the first root's Euler-Bernoulli estimate.
+    let step = 1e-3 * (ei / (rho_a * len.powi(4))).sqrt();
+    let mut w = step;
+    while roots.len() < N {
+        if det(w).signum() != det(w + step).signum() {
+            let (mut lo, mut hi) = (w, w + step);
+            for _ in 0..100 {
+                let mid = 0.5 * (lo + hi);
+                if det(mid).signum() == det(lo).signum() {
+                    lo = mid
+                } else {
+                    hi = mid
+                }
+            }
+            roots.push(0.5 * (lo + hi) / (2.0 * std::f64::consts::PI));
+        }
+        w += step;
+    }
+    std::array::from_fn(|k| roots[k])
+}
