@@ -740,6 +740,9 @@ outer_radius = 0.01
 youngs_modulus = 1e6
 "#;
 
+/// A section given by its properties, all valid.
+const PROPERTIES: &str = "{ shape = \"properties\", axial_stiffness = 300.0, bending_stiffness = [1e-3, 2e-3], torsional_stiffness = 1e-3, mass_per_length = 0.3, rotary_inertia = [1e-6, 1e-6] }";
+
 /// The cases of `malformed_3d_models_are_rejected_clearly`.
 fn three_d_cases() -> Vec<FileCase> {
     let mut all = three_d_key_cases();
@@ -768,6 +771,30 @@ fn section_load_and_fluid_cases() -> Vec<FileCase> {
                 "section = { shape = \"rectangle\", width = 0.0, height = 0.01 }",
             ),
             vec!["segment[0].section.width", "must be positive"],
+        ),
+        (
+            "properties and a density",
+            r("outer_radius = 0.01", &format!("section = {PROPERTIES}")),
+            vec!["segment[0].density", "takes no `density`"],
+        ),
+        (
+            "properties with a zero rotary inertia",
+            r(
+                "density = 1000.0\nouter_radius = 0.01\nyoungs_modulus = 1e6",
+                &format!(
+                    "section = {}",
+                    PROPERTIES.replace("[1e-6, 1e-6]", "[0.0, 1e-6]")
+                ),
+            ),
+            vec!["segment[0].section.rotary_inertia[0]", "must be positive"],
+        ),
+        (
+            "properties of a shearing segment without its shear stiffness",
+            r(
+                "density = 1000.0\nouter_radius = 0.01\nyoungs_modulus = 1e6",
+                &format!("section = {PROPERTIES}\nshear = true"),
+            ),
+            vec!["segment[0].section.shear_stiffness", "missing"],
         ),
         (
             "load off its segment",

@@ -184,3 +184,76 @@ fn a_rectangular_rod_deflects_under_a_tip_force_by_each_axis_stiffness() {
         assert_close(pcc[axis], bend, 1e-3, 0.0, &format!("pcc along {axis}"));
     }
 }
+
+/// A section given by its properties (E A, k G A, E I_y, E I_z, G J, rho A,
+/// rho I_y, rho I_z) moves as the rectangle whose values they are: the same
+/// frequencies to 1e-9. Given a polar inertia rho J twice I_y + I_z, its
+/// twist modes (and only they) drop by sqrt(2), as sqrt(G J / rho J) says.
+#[test]
+fn a_section_given_by_its_properties_moves_as_the_shape_it_describes() {
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h): (f64, f64) = (0.02, 0.006);
+    let shape = SectionShapeValues::rectangle(w, h);
+    let rect = format!("{{ shape = \"rectangle\", width = {w}, height = {h} }}");
+    let frequencies = |text: &str| {
+        let l = load_text(dir.path(), text, &["segment.0.elements=6"]);
+        let dof = l.arm.dof();
+        runtime::modes(&*l.arm, &vec![0.0; dof])
+            .unwrap()
+            .frequencies_hz
+    };
+    let want = frequencies(&arm(3, &rect, 1, ""));
+    let given = |rho_j: f64| {
+        let section = format!(
+            "{{ shape = \"properties\", axial_stiffness = {}, bending_stiffness = [{}, {}], torsional_stiffness = {}, mass_per_length = {}, rotary_inertia = [{}, {}], polar_inertia = {rho_j} }}",
+            E * w * h,
+            E * shape.i[0],
+            E * shape.i[1],
+            E / 3.0 * shape.j,
+            RHO * w * h,
+            RHO * shape.i[0],
+            RHO * shape.i[1],
+        );
+        arm(3, &section, 1, "")
+            .replace(&format!("density = {RHO}\n"), "")
+            .replace(&format!("youngs_modulus = {E}\n"), "")
+    };
+    let polar = RHO * (shape.i[0] + shape.i[1]);
+    let got = frequencies(&given(polar));
+    assert_eq!(got.len(), want.len());
+    for (g, f) in got.iter().zip(&want) {
+        assert_close(*g, *f, 1e-9, 0.0, "the properties of the rectangle");
+    }
+    let heavier = frequencies(&given(2.0 * polar));
+    let (mut same, mut slower) = (0, 0);
+    for f in &want {
+        let near = |x: f64| heavier.iter().any(|g| (g - x).abs() < 1e-9 * x);
+        if near(*f) {
+            same += 1
+        } else if near(f / 2f64.sqrt()) {
+            slower += 1
+        } else {
+            panic!("{f} Hz is neither kept nor slowed by sqrt(2): {heavier:?}");
+        }
+    }
+    // Six elements: six twist modes.
+    assert_eq!((same, slower), (want.len() - 6, 6), "{want:?}\n{heavier:?}");
+}
+
+/// A rectangle's second moments [I_y, I_z] and St-Venant J by Roark's
+/// formula, as the model's section computes them.
+struct SectionShapeValues {
+    i: [f64; 2],
+    j: f64,
+}
+
+impl SectionShapeValues {
+    fn rectangle(w: f64, h: f64) -> Self {
+        let (a, b) = (w.max(h), w.min(h));
+        let r = b / a;
+        Self {
+            i: [h * w.powi(3) / 12.0, w * h.powi(3) / 12.0],
+            j: a * b.powi(3) * (1.0 / 3.0 - 0.21 * r * (1.0 - r.powi(4) / 12.0)),
+        }
+    }
+}

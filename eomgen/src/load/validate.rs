@@ -353,6 +353,8 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
         );
     }
     match (s.mass, &s.density) {
+        // Its mass per length given.
+        _ if s.given().is_some() => {}
         (Some(_), Some(_)) => {
             return ck.err(
                 p("mass"),
@@ -444,7 +446,9 @@ fn section_shape(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
     let Some(sec) = &s.section else {
         return Ok(());
     };
-    let (w, h) = sec.sides();
+    let Some((w, h)) = sec.sides() else {
+        return section_properties(ck, i, s);
+    };
     ck.positive(&p("width"), w)?;
     ck.positive(&p("height"), h)?;
     for (key, given) in [
@@ -460,6 +464,58 @@ fn section_shape(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
                 ),
             );
         }
+    }
+    Ok(())
+}
+
+/// A section given by its properties: each value positive, and none of
+/// what it replaces (the mass, the material, the shape's sizes) given too.
+fn section_properties(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
+    let p = |k: &str| format!("segment[{i}].section.{k}");
+    let g = s
+        .given()
+        .expect("a section without sides is given by its properties");
+    for (key, v) in [
+        ("axial_stiffness", g.ea),
+        ("bending_stiffness[0]", g.ei[0]),
+        ("bending_stiffness[1]", g.ei[1]),
+        ("torsional_stiffness", g.gj),
+        ("mass_per_length", g.rho_a),
+        ("rotary_inertia[0]", g.rho_i[0]),
+        ("rotary_inertia[1]", g.rho_i[1]),
+        ("polar_inertia", g.rho_j),
+    ] {
+        ck.positive(&p(key), v)?;
+    }
+    if let Some(ga) = g.ga {
+        ck.positive(&p("shear_stiffness"), ga)?;
+    }
+    let replaced = [
+        ("mass", s.mass.is_some()),
+        ("density", s.density.is_some()),
+        ("outer_radius", s.outer_radius.is_some()),
+        ("inner_radius", s.inner_radius.is_some()),
+        ("chambers", s.chambers.is_some()),
+        ("youngs_modulus", s.youngs_modulus.is_some()),
+        ("bending_stiffness", s.bending_stiffness.is_some()),
+        ("torsional_stiffness", s.torsional_stiffness.is_some()),
+        ("axial_stiffness", s.axial_stiffness.is_some()),
+        ("shear_modulus", s.shear_modulus.is_some()),
+        ("shear_factor", s.shear_factor.is_some()),
+    ];
+    if let Some((key, _)) = replaced.iter().find(|(_, given)| *given) {
+        return ck.err(
+            format!("segment[{i}].{key}"),
+            format!(
+                "a segment whose section is given by its `properties` takes no `{key}`: the section's keys give its mass, stiffnesses and inertias"
+            ),
+        );
+    }
+    if s.shears() && g.ga.is_none() {
+        return ck.err(
+            p("shear_stiffness"),
+            "missing: a shearing segment needs the section's `shear_stiffness` (k G A, N)".into(),
+        );
     }
     Ok(())
 }

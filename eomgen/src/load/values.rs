@@ -259,7 +259,9 @@ pub fn element_props(m: &Model) -> Vec<ElementProps> {
 fn props_of(m: &Model, [s, springs]: [&Segment; 2], l: f64, n: usize) -> ElementProps {
     let ro = s.outer().unwrap_or(0.0);
     let ri = s.inner().unwrap_or(0.0);
+    let given = s.given();
     let mass = match (s.mass, s.density.as_ref()) {
+        _ if given.is_some() => s.mass_per_length(0.5).unwrap_or(0.0) * l,
         (Some(mass), _) => mass / n as f64,
         (None, Some(rho)) => rho.at(0.0) * s.area().unwrap_or(0.0) * l,
         (None, None) => 0.0, // rejected by validation
@@ -268,8 +270,9 @@ fn props_of(m: &Model, [s, springs]: [&Segment; 2], l: f64, n: usize) -> Element
     // diameter through the centre, m I / A ((r_o^2 + r_i^2) / 4 for a
     // ring); slender rods when no radius is given.
     // About z and about y.
-    let [section, section_y] = match (s.second_moments(), s.area()) {
-        (Some([iy, iz]), Some(a)) if a > 0.0 => [mass * iz / a, mass * iy / a],
+    let [section, section_y] = match (s.second_moments(), s.area(), given) {
+        (_, _, Some(g)) => [g.rho_i[1] * l, g.rho_i[0] * l],
+        (Some([iy, iz]), Some(a), _) if a > 0.0 => [mass * iz / a, mass * iy / a],
         _ => [mass * (ro * ro + ri * ri) / 4.0; 2],
     };
     // Bodies: the whole link, or two half links (midpoint joints), or
@@ -290,6 +293,10 @@ fn props_of(m: &Model, [s, springs]: [&Segment; 2], l: f64, n: usize) -> Element
         None => s.joint_stiffness.unwrap_or(0.0),
     };
     let (stiffness, stiffness_y) = (joint(springs.ei()), joint(springs.ei_y()));
+    // A polar moment given apart from I_y + I_z: the method's share of it.
+    if let Some(g) = given {
+        axial_inertia *= g.rho_j / (g.rho_i[0] + g.rho_i[1]);
+    }
     let damping = match s.bending_damping {
         Some(eta) => eta / l,
         None => s.joint_damping.unwrap_or(0.0),

@@ -431,7 +431,7 @@ impl Segment {
     /// term takes it there.
     pub fn second_moments(&self) -> Option<[f64; 2]> {
         if let Some(sec) = &self.section {
-            return Some(sec.second_moments());
+            return sec.second_moments();
         }
         let ro = self.outer()?;
         let ri = self.inner().unwrap_or(0.0);
@@ -514,16 +514,23 @@ impl Segment {
         if dimensions != 3 || self.bending_stiffness.is_some() {
             return false;
         }
+        let unequal = |[y, z]: [f64; 2]| (y - z).abs() > 1e-12 * y.abs().max(z.abs());
         let differ = |p: &Segment| {
-            p.second_moments()
-                .is_some_and(|[iy, iz]| (iy - iz).abs() > 1e-12 * iy.abs().max(iz.abs()))
+            let given = p.given().is_some_and(|g| unequal(g.ei) || unequal(g.rho_i));
+            given || p.second_moments().is_some_and(unequal)
         };
         differ(self) || self.tapered() && self.breaks().iter().any(|&x| differ(&self.at(x)))
+    }
+
+    /// The section's values given directly (`shape = "properties"`).
+    pub fn given(&self) -> Option<super::section::Given> {
+        self.section.as_ref()?.given()
     }
 
     /// Bending stiffness E I (N m^2) about z, if declared.
     pub fn ei(&self) -> Option<f64> {
         Self::value(&self.bending_stiffness)
+            .or_else(|| Some(self.given()?.ei[1]))
             .or_else(|| Some(self.modulus()? * self.second_moment()?))
     }
 
@@ -531,6 +538,7 @@ impl Segment {
     /// is isotropic or E I is given.
     pub fn ei_y(&self) -> Option<f64> {
         Self::value(&self.bending_stiffness)
+            .or_else(|| Some(self.given()?.ei[0]))
             .or_else(|| Some(self.modulus()? * self.second_moments()?[0]))
     }
 
@@ -538,7 +546,7 @@ impl Segment {
     /// chamber holes.
     pub fn area(&self) -> Option<f64> {
         if let Some(sec) = &self.section {
-            return Some(sec.area());
+            return sec.area();
         }
         let ro = self.outer()?;
         let ri = self.inner().unwrap_or(0.0);
@@ -558,8 +566,11 @@ impl Segment {
     /// St-Venant's for others, G defaulting to E / 3.
     pub fn gj(&self) -> Option<f64> {
         Self::value(&self.torsional_stiffness).or_else(|| {
+            if let Some(g) = self.given() {
+                return Some(g.gj);
+            }
             let j = match &self.section {
-                Some(sec) => sec.torsion(),
+                Some(sec) => sec.torsion()?,
                 None => {
                     let [iy, iz] = self.second_moments()?;
                     iy + iz
@@ -576,17 +587,25 @@ impl Segment {
 
     /// Shear stiffness k G A (N), k the `shear_factor` (default 1).
     pub fn ga(&self) -> Option<f64> {
+        if let Some(g) = self.given() {
+            return g.ga;
+        }
         Some(self.shear_factor.unwrap_or(1.0) * self.shear()? * self.area()?)
     }
 
     /// Axial stiffness E A (N).
     pub fn ea(&self) -> Option<f64> {
-        Self::value(&self.axial_stiffness).or_else(|| Some(self.modulus()? * self.area()?))
+        Self::value(&self.axial_stiffness)
+            .or_else(|| Some(self.given()?.ea))
+            .or_else(|| Some(self.modulus()? * self.area()?))
     }
 
     /// Mass per unit length (kg/m) at the fraction `x`: `density` times
     /// the section's area there, or a `mass` spread evenly.
     pub fn mass_per_length(&self, x: f64) -> Option<f64> {
+        if let Some(g) = self.given() {
+            return Some(g.rho_a);
+        }
         match self.mass {
             Some(m) => Some(m / self.length),
             None => {
