@@ -171,7 +171,7 @@ pub struct SimulateArgs {
     /// End time (s) [default: the model's simulate.t_end, else 5].
     #[arg(long, allow_negative_numbers = true)]
     pub t_end: Option<f64>,
-    /// Integrator [default: the model's simulate.solver, else dopri5].
+    /// Integrator [default: the model's simulate.solver, else auto].
     #[arg(long, value_parser = Solver::NAMES)]
     pub solver: Option<String>,
     /// Step of fixed-step solvers (s) [default: simulate.dt, else 1e-3].

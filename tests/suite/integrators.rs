@@ -8,6 +8,8 @@ use eomgen::model::Override;
 use runtime::{Dynamics, SimOptions, Solver, simulate};
 use softarm::backend::{BackendChoice, load};
 
+use crate::common::root;
+
 fn final_state(
     arm: &dyn Dynamics,
     x0: &[f64],
@@ -180,6 +182,7 @@ fn stiffness_analysis_predicts_the_explicit_step() {
     let opts = SimOptions {
         t_end,
         output_dt: t_end,
+        solver: Solver::Dopri5,
         ..Default::default()
     };
     let (_, stats) = simulate(&*l.arm, x, &opts).unwrap();
@@ -205,6 +208,58 @@ fn stiffness_analysis_predicts_the_explicit_step() {
         runtime::analyse_stiffness(&jac).recommended_solver,
         "dopri5"
     );
+}
+
+/// The steel rod (undamped, modes from 35 to 1.5e5 rad/s, every real part
+/// zero) is stiff by the spread of its time scales, which a ratio of decay
+/// rates missed: `auto` takes generalized-alpha from the start at an
+/// engineer's tolerance (rtol 1e-3), radau5 at a tight one, and radau5
+/// once its bending is damped (the fast modes' damping ratio past 0.05).
+/// Each puts the tip where dopri5 run alone does, to its tolerance (the
+/// modes generalized-alpha damps are those the step does not resolve).
+#[test]
+fn auto_takes_generalized_alpha_for_a_lightly_damped_stiff_structure() {
+    let example = root().join("examples/steel_rod.toml");
+    let example = example.to_string_lossy();
+    let run = |sets: &[&str], rtol: f64, solver: Solver| {
+        let l = loaded(&example, sets);
+        let n = l.arm.dof();
+        let mut x0 = vec![0.0; 2 * n];
+        x0[0] = 0.05; // a uniform bend: the rod swings
+        let opts = SimOptions {
+            t_end: 0.02,
+            solver,
+            rtol,
+            atol: 1e-9,
+            output_dt: 0.02,
+            ..Default::default()
+        };
+        let (traj, stats) = simulate(&*l.arm, x0, &opts).unwrap();
+        let x = traj.x.last().unwrap();
+        let o = l.arm.outputs(0.02, &x[..n], &x[n..]);
+        // The tip's deflection from the straight rod.
+        (vec![o[0] - 0.5, o[1], o[2]], stats)
+    };
+    let damped = "segment.0.bending_damping=1e-2";
+    for (sets, rtol, want) in [
+        (&[][..], 1e-3, Solver::GenAlpha),
+        (&[][..], 1e-6, Solver::Radau5),
+        (&[damped][..], 1e-3, Solver::Radau5),
+    ] {
+        let (q, stats) = run(sets, rtol, Solver::Auto);
+        let switch = stats.switched.expect("the steel rod is stiff");
+        assert_eq!(
+            (switch.to, switch.at_s),
+            (want, 0.0),
+            "{sets:?} at rtol {rtol}: {}",
+            switch.reason
+        );
+        let (reference, _) = run(sets, 1e-9, Solver::Dopri5);
+        let err = relative_error(&q, &reference);
+        eprintln!("{sets:?} at rtol {rtol}: the tip {err:.2e} from dopri5's");
+        let what = format!("{sets:?} at rtol {rtol}: the tip {err:.2e} from dopri5's");
+        assert!(err < 10.0 * rtol, "{what}");
+    }
 }
 
 #[test]

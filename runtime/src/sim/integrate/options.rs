@@ -73,7 +73,7 @@ impl Default for SimOptions {
         Self {
             t0: 0.0,
             t_end: DEFAULT_T_END,
-            solver: Solver::Dopri5,
+            solver: Solver::Auto,
             rtol: 1e-6,
             atol: 1e-9,
             dt: 1e-3,
