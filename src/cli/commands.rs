@@ -873,7 +873,12 @@ pub fn inspect(a: InspectArgs) -> Result<ExitCode> {
     let mut jac = DMatrix::zeros(2 * n, 2 * n);
     runtime::rhs_jacobian(&*loaded.arm, &mut Workspace::new(n), 0.0, &x, &mut jac)
         .map_err(|e| anyhow::anyhow!("{}: {e}", loaded.origin))?;
-    let report = runtime::analyse_stiffness(&jac);
+    let report = runtime::analyse_stiffness(&jac).ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: the Jacobian at this state is not finite or its eigenvalues do not converge: no stiffness to report",
+            loaded.origin
+        )
+    })?;
     let mut v = serde_json::to_value(&report)?;
     v["model"] = json!(loaded.model.name);
     v["q"] = json!(q);

@@ -156,7 +156,11 @@ fn summary_reports_the_run() {
         assert!(!s[key].is_null(), "summary.json lacks {key}");
     }
     assert_eq!(s["backend"], "compiled");
-    assert_eq!(s["solver"], "dopri5");
+    // The default solver is auto; the double pendulum is not stiff, so it
+    // stays explicit (dopri5's seven right-hand sides a step, below).
+    assert_eq!(s["solver"], "auto");
+    assert!(s["solver_switch"].is_null(), "{}", s["solver_switch"]);
+    assert_eq!(s["options"]["solver"]["from"], "default");
     // The effective options and where each came from.
     let o = &s["options"];
     assert_eq!(o["t_end"]["value"], 1.0);

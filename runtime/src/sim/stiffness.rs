@@ -38,9 +38,16 @@ pub struct StiffnessReport {
     pub reason: String,
 }
 
-/// Analyse the Jacobian `jac` of x' = f(x).
-pub fn analyse(jac: &DMatrix<f64>) -> StiffnessReport {
-    let mut eig: Vec<[f64; 2]> = jac
+/// Analyse the Jacobian `jac` of x' = f(x); None when it is not finite
+/// or its eigenvalues do not converge (a state blowing up: nalgebra's
+/// unbounded iteration would never return).
+pub fn analyse(jac: &DMatrix<f64>) -> Option<StiffnessReport> {
+    if jac.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let schur =
+        nalgebra::linalg::Schur::try_new(jac.clone(), f64::EPSILON, 100 * jac.nrows().max(10))?;
+    let mut eig: Vec<[f64; 2]> = schur
         .complex_eigenvalues()
         .iter()
         .map(|c| [c.re, c.im])
@@ -117,7 +124,7 @@ pub fn analyse(jac: &DMatrix<f64>) -> StiffnessReport {
             false => ("radau5", format!("{spread} > 1000: {held}")),
         }
     };
-    StiffnessReport {
+    Some(StiffnessReport {
         eigenvalues: eig,
         stiffness_ratio: ratio,
         class,
@@ -126,7 +133,7 @@ pub fn analyse(jac: &DMatrix<f64>) -> StiffnessReport {
         fastest_damping_ratio: zeta,
         recommended_solver,
         reason,
-    }
+    })
 }
 
 #[cfg(test)]
@@ -138,7 +145,7 @@ mod tests {
         // y1' = -1000 y1, y2' = -0.001 y2: ratio 1e6, stiff (the chapter's
         // section on stiffness).
         let j = DMatrix::from_row_slice(2, 2, &[-1000.0, 0.0, 0.0, -0.001]);
-        let r = analyse(&j);
+        let r = analyse(&j).unwrap();
         assert!((r.stiffness_ratio - 1e6).abs() < 1e-3);
         assert_eq!(r.class, "stiff");
         assert_eq!(r.recommended_solver, "radau5");
@@ -149,7 +156,7 @@ mod tests {
     fn a_lightly_damped_oscillator_is_not_stiff() {
         // x'' + 0.2 x' + x = 0: eigenvalues -0.1 +- 0.995i, ratio 1.
         let j = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -1.0, -0.2]);
-        let r = analyse(&j);
+        let r = analyse(&j).unwrap();
         assert!((r.stiffness_ratio - 1.0).abs() < 1e-9);
         assert_eq!(r.class, "not stiff");
         assert!((r.eigenvalues[0][0] + 0.1).abs() < 1e-12);
@@ -169,7 +176,7 @@ mod tests {
                 j[(2 * k + 1, 2 * k)] = -w * w;
                 j[(2 * k + 1, 2 * k + 1)] = -c;
             }
-            analyse(&j)
+            analyse(&j).unwrap()
         };
         let r = oscillators(0.0);
         assert!(
@@ -184,5 +191,15 @@ mod tests {
         let r = oscillators(0.5);
         assert!((r.fastest_damping_ratio - 0.5).abs() < 1e-9);
         assert_eq!(r.recommended_solver, "radau5");
+    }
+
+    /// A Jacobian that is not finite (a state blowing up) has no report,
+    /// at once: nalgebra's unbounded eigenvalue iteration never returned.
+    #[test]
+    fn a_jacobian_that_is_not_finite_has_no_report() {
+        let j = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, f64::NAN, 1e300]);
+        assert!(analyse(&j).is_none());
+        let j = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, f64::INFINITY, 0.0]);
+        assert!(analyse(&j).is_none());
     }
 }

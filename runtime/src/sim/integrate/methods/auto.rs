@@ -33,7 +33,7 @@ impl Integrator for Auto {
             let mut jac = DMatrix::zeros(2 * n, 2 * n);
             rhs_jacobian(arm, &mut Workspace::new(n), t, &x[..2 * n], &mut jac)
                 .ok()
-                .map(|_| crate::stiffness::analyse(&jac))
+                .and_then(|_| crate::stiffness::analyse(&jac))
         };
         // The implicit method a stiffness report recommends; generalized-
         // alpha, second order, only at an engineer's tolerance (rtol 1e-4
