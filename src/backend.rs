@@ -81,8 +81,17 @@ pub fn base_dir(spec: &str) -> PathBuf {
     }
 }
 
-/// Read the model named by `spec`: a file path, or a compiled-in model's name.
-pub fn read_model(spec: &str, overrides: &[Override]) -> Result<(Model, String)> {
+/// A model's text as written: the file named by `spec`, or a compiled-in
+/// model's source; whether it is JSON, and its label for messages.
+pub struct Source {
+    pub text: String,
+    pub json: bool,
+    pub label: String,
+}
+
+/// The text of the model named by `spec`: a file path, or a compiled-in
+/// model's name.
+pub fn model_source(spec: &str) -> Result<Source> {
     let path = Path::new(spec);
     if path.exists() {
         let text = std::fs::read_to_string(path)
@@ -90,19 +99,31 @@ pub fn read_model(spec: &str, overrides: &[Override]) -> Result<(Model, String)>
         let json = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-        let model = parse_model(&text, spec, json, overrides)?;
-        return Ok((model, spec.to_string()));
+        return Ok(Source {
+            text,
+            json,
+            label: spec.to_string(),
+        });
     }
     if let Some(m) = compiled_by_name(spec) {
-        let label = format!("compiled-in:{}", m.name);
-        let model = parse_model(m.source, &label, false, overrides)?;
-        return Ok((model, label));
+        return Ok(Source {
+            text: m.source.to_string(),
+            json: false,
+            label: format!("compiled-in:{}", m.name),
+        });
     }
     let names: Vec<&str> = MODELS.iter().map(|m| m.name).collect();
     bail!(
         "{spec}: no such model file, and no compiled-in model of that name (compiled in: {})",
         names.join(", ")
     )
+}
+
+/// Read the model named by `spec`: a file path, or a compiled-in model's name.
+pub fn read_model(spec: &str, overrides: &[Override]) -> Result<(Model, String)> {
+    let src = model_source(spec)?;
+    let model = parse_model(&src.text, &src.label, src.json, overrides)?;
+    Ok((model, src.label))
 }
 
 /// A chain whose element count (or rom order) no compiled-in model has, on

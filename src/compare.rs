@@ -157,30 +157,56 @@ pub fn plot(
     simulated: &[(f64, [f64; 3])],
     measured: &Measured,
 ) -> Result<()> {
+    let curve = Curve {
+        label: "simulated",
+        color: plotters::style::RED,
+        points: simulated,
+    };
+    plot_curves(stem, title, &[curve], measured, None)
+}
+
+/// A simulated tip path on a plot against the record.
+pub struct Curve<'a> {
+    pub label: &'a str,
+    pub color: plotters::style::RGBColor,
+    pub points: &'a [(f64, [f64; 3])],
+}
+
+/// Simulated tips (`curves`) against the measured one, x, y and z over
+/// time, one panel each, with the time span `shaded` (a validation
+/// window) shaded; as `<stem>.png` and `<stem>.svg`.
+pub fn plot_curves(
+    stem: &Path,
+    title: &str,
+    curves: &[Curve],
+    measured: &Measured,
+    shaded: Option<[f64; 2]>,
+) -> Result<()> {
     use plotters::prelude::*;
     register_font();
+    fn e(e: impl std::fmt::Display) -> anyhow::Error {
+        anyhow::anyhow!("{e}")
+    }
     fn draw<DB: DrawingBackend>(
         root: DrawingArea<DB, plotters::coord::Shift>,
         title: &str,
-        simulated: &[(f64, [f64; 3])],
+        curves: &[Curve],
         measured: &Measured,
+        shaded: Option<[f64; 2]>,
     ) -> Result<()>
     where
         DB::ErrorType: 'static,
     {
-        root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let root = root
-            .titled(title, ("sans-serif", 20))
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        root.fill(&WHITE).map_err(e)?;
+        let root = root.titled(title, ("sans-serif", 20)).map_err(e)?;
         let panels = root.split_evenly((3, 1));
-        let t_max = simulated
-            .iter()
+        let points = || curves.iter().flat_map(|c| c.points.iter());
+        let t_max = points()
             .map(|s| s.0)
             .chain(measured.t.iter().copied())
             .fold(0.0, f64::max);
         for (k, panel) in panels.iter().enumerate() {
-            let values = simulated
-                .iter()
+            let values = points()
                 .map(|s| s.1[k])
                 .chain(measured.tip.iter().map(|m| m[k]))
                 .map(|v| 1e3 * v);
@@ -188,70 +214,68 @@ pub fn plot(
                 (a.min(v), b.max(v))
             });
             let pad = 0.05 * (hi - lo).max(1.0);
+            let (y0, y1) = (lo - pad, hi + pad);
             let mut chart = ChartBuilder::on(panel)
                 .margin(8)
                 .x_label_area_size(30)
                 .y_label_area_size(60)
-                .build_cartesian_2d(0.0..t_max, (lo - pad)..(hi + pad))
-                .map_err(|e| anyhow::anyhow!("{e}"))?;
+                .build_cartesian_2d(0.0..t_max, y0..y1)
+                .map_err(e)?;
             chart
                 .configure_mesh()
                 .x_desc("t (s)")
                 .y_desc(format!("tip {} (mm)", ["x", "y", "z"][k]))
                 .light_line_style(WHITE)
                 .draw()
-                .map_err(|e| anyhow::anyhow!("{e}"))?;
+                .map_err(e)?;
+            if let Some([a, b]) = shaded {
+                let fill = RGBColor(220, 230, 245).filled();
+                chart
+                    .draw_series([Rectangle::new([(a, y0), (b.min(t_max), y1)], fill)])
+                    .map_err(e)?
+                    .label("validation window")
+                    .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], fill));
+            }
             chart
                 .draw_series(LineSeries::new(
-                    measured
-                        .t
-                        .iter()
-                        .zip(&measured.tip)
-                        .map(|(t, m)| (*t, 1e3 * m[k])),
+                    (measured.t.iter().zip(&measured.tip)).map(|(t, m)| (*t, 1e3 * m[k])),
                     BLACK.stroke_width(1),
                 ))
-                .map_err(|e| anyhow::anyhow!("{e}"))?
+                .map_err(e)?
                 .label("measured")
                 .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK));
-            chart
-                .draw_series(LineSeries::new(
-                    simulated.iter().map(|(t, s)| (*t, 1e3 * s[k])),
-                    RED.stroke_width(2),
-                ))
-                .map_err(|e| anyhow::anyhow!("{e}"))?
-                .label("simulated")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
+            for c in curves {
+                let color = c.color;
+                chart
+                    .draw_series(LineSeries::new(
+                        c.points.iter().map(|(t, s)| (*t, 1e3 * s[k])),
+                        color.stroke_width(2),
+                    ))
+                    .map_err(e)?
+                    .label(c.label)
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color));
+            }
             chart
                 .configure_series_labels()
                 .background_style(WHITE.mix(0.8))
                 .border_style(BLACK)
                 .draw()
-                .map_err(|e| anyhow::anyhow!("{e}"))?;
+                .map_err(e)?;
         }
-        root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
+        root.present().map_err(e)?;
         Ok(())
     }
     let size = (1000u32, 900u32);
-    let png = stem.with_extension("png");
-    let svg = stem.with_extension("svg");
     // Drawn into a buffer and encoded by the `png` crate: plotters' own
     // encoder would pull in the whole `image` crate.
     let mut rgb = vec![255u8; 3 * (size.0 * size.1) as usize];
-    draw(
-        BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area(),
-        title,
-        simulated,
-        measured,
-    )?;
-    write_png(&png, size, &rgb)?;
+    let area = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+    draw(area, title, curves, measured, shaded)?;
+    write_png(&stem.with_extension("png"), size, &rgb)?;
     let mut text = String::new();
-    draw(
-        SVGBackend::with_string(&mut text, size).into_drawing_area(),
-        title,
-        simulated,
-        measured,
-    )?;
-    Ok(write_atomic(&svg, text.as_bytes())?)
+    let area = SVGBackend::with_string(&mut text, size).into_drawing_area();
+    draw(area, title, curves, measured, shaded)?;
+    Ok(write_atomic(&stem.with_extension("svg"), text.as_bytes())?)
 }
 
 /// Encode 8-bit RGB pixels as a PNG file.

@@ -55,6 +55,7 @@ pub fn signal(name: &str, input: &Input, base: &Path) -> Result<Signal> {
             scale,
             offset,
             smooth,
+            delay,
         } => {
             let path = resolve(base, file);
             let csv = Csv::read(&path).with_context(|| format!("inputs.{name}.file"))?;
@@ -71,6 +72,7 @@ pub fn signal(name: &str, input: &Input, base: &Path) -> Result<Signal> {
             };
             let values: Vec<f64> = raw.iter().map(|v| scale * (v - shift)).collect();
             let values = moving_average(&values, *smooth);
+            let times = times.iter().map(|t| t + delay).collect();
             Signal::Table(
                 Table::new(times, values)
                     .with_context(|| format!("inputs.{name}: {}", path.display()))?,

@@ -5,6 +5,7 @@
 
 mod animate;
 mod commands;
+mod fit;
 mod sweep;
 
 use std::process::ExitCode;
@@ -57,6 +58,10 @@ enum Command {
     /// The largest fixed step that keeps the tip within a tolerance of a
     /// tight reference run, for fixed-step use (a controller's loop).
     FixedStep(commands::FixedStepArgs),
+    /// Fit model values to the model's [compare] record (least squares on
+    /// the tip, exact-Jacobian sensitivities); writes fit.json,
+    /// fitted.toml and fit.png.
+    Fit(fit::FitArgs),
 }
 
 /// Parses the command line and runs its command.
@@ -75,6 +80,7 @@ pub fn main() -> ExitCode {
         Command::Animate(a) => animate::animate(a),
         Command::Linearize(a) => commands::linearize(a),
         Command::FixedStep(a) => commands::fixed_step(a),
+        Command::Fit(a) => fit::fit(a),
     };
     match result {
         Ok(code) => code,

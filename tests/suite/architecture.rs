@@ -81,6 +81,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "scale",
             "backend",
             "run",
+            "fit",
             "scene",
             "shape",
             "linearize",

@@ -28,6 +28,29 @@ pub fn parse_model(
     json: bool,
     overrides: &[Override],
 ) -> Result<Model, ModelError> {
+    let tree = model_tree(text, file, json, overrides)?;
+    let model: Model = serde_path_to_error::deserialize(tree).map_err(|e| {
+        let path = e.path().to_string();
+        let path = if path == "." { String::new() } else { path };
+        let message = crate::model::with_suggestion(&e.into_inner().to_string());
+        ModelError::new(file, path, message)
+    })?;
+    let mut model = model;
+    validate(&model, file)?;
+    // Checked, then cut.
+    model.joints.retain(|j| j.active);
+    Ok(model)
+}
+
+/// A model file's tree of keys with `overrides` applied, before the
+/// typed reading: what `softarm fit` reads start values from and writes
+/// fitted values into.
+pub fn model_tree(
+    text: &str,
+    file: &str,
+    json: bool,
+    overrides: &[Override],
+) -> Result<toml::Value, ModelError> {
     let mut tree: toml::Value = if json {
         serde_json::from_str(text)
             .map_err(|e| ModelError::new(file, "", format!("invalid JSON: {e}")))?
@@ -44,17 +67,7 @@ pub fn parse_model(
     for o in overrides {
         o.apply(&mut tree)?;
     }
-    let model: Model = serde_path_to_error::deserialize(tree).map_err(|e| {
-        let path = e.path().to_string();
-        let path = if path == "." { String::new() } else { path };
-        let message = crate::model::with_suggestion(&e.into_inner().to_string());
-        ModelError::new(file, path, message)
-    })?;
-    let mut model = model;
-    validate(&model, file)?;
-    // Checked, then cut.
-    model.joints.retain(|j| j.active);
-    Ok(model)
+    Ok(tree)
 }
 
 /// Read a model file (`.json` is read as JSON, anything else as TOML).

@@ -63,8 +63,24 @@ impl Override {
         })
     }
 
-    pub(crate) fn apply(&self, root: &mut toml::Value) -> Result<(), ModelError> {
+    /// Apply to a model's tree of keys (`load::model_tree`).
+    pub fn apply(&self, root: &mut toml::Value) -> Result<(), ModelError> {
         self.apply_from(root, 0)
+    }
+
+    /// The value at `path` below `root`, items of a list by index or by
+    /// their `name` as `--set` finds them; None where nothing is there.
+    pub fn value_at<'v>(root: &'v toml::Value, path: &str) -> Option<&'v toml::Value> {
+        path.split('.').try_fold(root, |cur, key| match cur {
+            toml::Value::Table(t) => t.get(key),
+            toml::Value::Array(a) => match key.parse::<usize>() {
+                Ok(i) => a.get(i),
+                Err(_) => a
+                    .iter()
+                    .find(|item| item.get("name").and_then(toml::Value::as_str) == Some(key)),
+            },
+            _ => None,
+        })
     }
 
     /// The path from `from` on, below `root`; `*` in a list is every item

@@ -62,6 +62,11 @@ pub enum Input {
         /// uses one fewer, as MATLAB's `smooth` does): no lag.
         #[serde(default = "one")]
         smooth: usize,
+        /// The channel arrives this many seconds after its time column
+        /// says (s): u(t) is the record's value at t - delay. A sensor's
+        /// or a valve's lag, and a value `softarm fit` can find.
+        #[serde(default)]
+        delay: f64,
     },
 }
 
@@ -207,6 +212,7 @@ pub(crate) fn check_input(
             scale,
             offset,
             smooth,
+            delay,
         } => {
             if f.trim().is_empty() {
                 return bad(
@@ -220,6 +226,7 @@ pub(crate) fn check_input(
                 }
             }
             finite("scale", *scale)?;
+            finite("delay", *delay)?;
             match offset {
                 Some(Offset::Value(v)) => finite("offset", *v)?,
                 Some(Offset::Named(s)) if s != "first" => {

@@ -16,7 +16,8 @@
 //! through the recorder), `record` (samples, events, counts), `outcome`
 //! (what a run gives back), `failure` (the explained failure), `ode` (the
 //! arm as x' = f(t, x)), [`stepper`] (the interface of our own steppers),
-//! [`events`] (zero crossings); `projected` (joints held) and `touch`
+//! [`events`] (zero crossings), [`sensitivity`] (a run's derivatives
+//! in its parameters); `projected` (joints held) and `touch`
 //! (legs between contact switches) run the methods in legs. The solver
 //! names are `crate::solver`'s.
 
@@ -30,6 +31,7 @@ mod outcome;
 mod projected;
 mod record;
 mod rows;
+pub mod sensitivity;
 pub mod state;
 pub mod stepper;
 mod touch;

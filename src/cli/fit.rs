@@ -1,0 +1,180 @@
+//! `softarm fit`: the command line of `crate::fit`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Result, bail};
+use clap::Args;
+use eomgen::model::Override;
+
+use crate::fit::{self, Free, Problem, Validation, lm};
+use crate::run::RunRequest;
+
+#[derive(Args, Clone)]
+pub struct FitArgs {
+    /// A model file with a [compare] record, or a compiled-in model's name.
+    pub model: String,
+    /// A value to fit, as --set names it, with optional bounds:
+    /// PATH or PATH=LO:HI (either bound may be empty). Repeat for each.
+    #[arg(long = "free", value_name = "PATH[=LO:HI]", required = true)]
+    pub free: Vec<String>,
+    /// Fit on the samples between A and B seconds [default: [compare]
+    /// window, else the whole record].
+    #[arg(long, value_name = "A:B")]
+    pub window: Option<String>,
+    /// Report the error on data the fit did not see: a window A:B of the
+    /// same record, or another model file (another record of the arm).
+    #[arg(long, value_name = "A:B|MODEL")]
+    pub validate: Option<String>,
+    /// Override a model value first: PATH=VALUE.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub set: Vec<String>,
+    /// Relative tolerance of the runs [default: simulate.rtol, else 1e-6].
+    #[arg(long)]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance of the runs [default: simulate.atol, else 1e-9].
+    #[arg(long)]
+    pub atol: Option<f64>,
+    /// Most Levenberg-Marquardt iterations.
+    #[arg(long, default_value_t = lm::Options::default().max_iterations)]
+    pub max_iterations: usize,
+    /// Output directory (default out/<model name>-fit).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Directory of the tape cache (default: $SOFTARM_CACHE_DIR or .softarm-cache).
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+    /// No line per iteration.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// `A:B` in seconds, A < B.
+fn window(flag: &str, s: &str) -> Result<[f64; 2]> {
+    let parsed = s
+        .split_once(':')
+        .and_then(|(a, b)| Some([a.trim().parse::<f64>().ok()?, b.trim().parse::<f64>().ok()?]));
+    match parsed {
+        Some([a, b]) if a < b && a >= 0.0 && b.is_finite() => Ok([a, b]),
+        _ => bail!("{flag} {s}: expected A:B in seconds with 0 <= A < B, e.g. 7:30"),
+    }
+}
+
+pub fn fit(a: FitArgs) -> Result<ExitCode> {
+    let overrides = (a.set.iter())
+        .map(|s| Override::parse(s))
+        .collect::<Result<Vec<_>, _>>()?;
+    let free = (a.free.iter())
+        .map(|s| Free::parse(s))
+        .collect::<Result<Vec<_>>>()?;
+    let run = RunRequest {
+        rtol: a.rtol,
+        atol: a.atol,
+        ..RunRequest::default()
+    };
+    let problem = Problem::new(
+        &a.model,
+        overrides.clone(),
+        free.clone(),
+        run.clone(),
+        a.cache_dir.clone(),
+    )?;
+    let record = problem.record_window();
+    let fit_window = match &a.window {
+        Some(s) => window("--window", s)?,
+        None => record,
+    };
+    let validation = match &a.validate {
+        None => None,
+        Some(s) if s.contains(':') && !std::path::Path::new(s).exists() => {
+            Some(Validation::Window(window("--validate", s)?))
+        }
+        Some(s) => Some(Validation::Model(s.clone())),
+    };
+    let other = match &validation {
+        Some(Validation::Model(spec)) => {
+            let p = Problem::new(spec, overrides, free, run, a.cache_dir.clone())?;
+            let w = p.record_window();
+            Some((p, w))
+        }
+        _ => None,
+    };
+    let same_window = match &validation {
+        Some(Validation::Window(w)) => Some(*w),
+        _ => None,
+    };
+    let out_dir = (a.out.clone())
+        .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-fit", model_name(&a.model))));
+    let mut dir = crate::output_dir::OutputDir::claim(&out_dir)?;
+    let opts = lm::Options {
+        max_iterations: a.max_iterations,
+        ..lm::Options::default()
+    };
+    let quiet = a.quiet;
+    let mut progress = |k: usize, mean: f64| {
+        if !quiet {
+            eprintln!("fit: iteration {k}: mean tip error {:.4} mm", 1e3 * mean);
+        }
+    };
+    let validation_pair = match (&other, same_window) {
+        (Some((p, w)), _) => Some((p, *w)),
+        (None, Some(w)) => Some((&problem, w)),
+        (None, None) => None,
+    };
+    let f = fit::fit(&problem, fit_window, validation_pair, &opts, &mut progress)?;
+    fit::report::write(&mut dir, &problem, &f, same_window)?;
+    if !quiet {
+        print_table(&f);
+        println!("wrote {}", out_dir.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The model's name for the default folder: a file's stem, or the name.
+fn model_name(spec: &str) -> String {
+    std::path::Path::new(spec)
+        .file_stem()
+        .map_or_else(|| spec.to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+fn print_table(f: &fit::Fitted) {
+    println!(
+        "{:<40} {:>14} {:>14} {:>12}",
+        "value", "start", "fitted", "std error"
+    );
+    for (k, n) in f.names.iter().enumerate() {
+        println!(
+            "{n:<40} {:>14.6e} {:>14.6e} {:>12.3e}",
+            f.initial[k], f.values[k], f.std_error[k]
+        );
+    }
+    let c = &f.fit_cost;
+    println!(
+        "mean tip error on {}..{} s ({} samples): {:.3} mm -> {:.3} mm",
+        c.window_s[0],
+        c.window_s[1],
+        c.samples,
+        1e3 * c.initial,
+        1e3 * c.fitted
+    );
+    if let Some(v) = &f.validation_cost {
+        println!(
+            "validation on {}..{} s ({} samples): {:.3} mm -> {:.3} mm",
+            v.window_s[0],
+            v.window_s[1],
+            v.samples,
+            1e3 * v.initial,
+            1e3 * v.fitted
+        );
+    }
+    println!(
+        "{} iterations, {} evaluations, {:.1} s: {}",
+        f.iterations, f.evaluations, f.wall_s, f.status
+    );
+    for n in &f.at_bound {
+        println!("warning: {n} ended on a bound");
+    }
+    for (a, b, c) in &f.inseparable {
+        println!("warning: {a} and {b}: correlation {c:.4}: the data cannot separate them");
+    }
+}

@@ -1,0 +1,233 @@
+//! `softarm fit`: a model's numeric values fitted to its `[compare]`
+//! record, least squares on the tip over the samples of a window.
+//!
+//! Each value is named by the path `--set` takes. An evaluation loads the
+//! model with the values set (the same structure, so the same kernels),
+//! and one perturbed pair per value, and runs the staggered forward
+//! sensitivities (`runtime::sensitivity`): the tip's derivatives in every
+//! value come with the run, at the cost of the Jacobians along it, not of
+//! a run per value. The search is `lm`'s bounded Levenberg-Marquardt;
+//! `report` writes what it found.
+
+pub mod lm;
+mod problem;
+pub mod report;
+mod uncertainty;
+
+use std::cell::RefCell;
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use nalgebra::DMatrix;
+
+pub use problem::{Evaluation, Problem};
+pub use uncertainty::uncertainty;
+
+/// One value to fit: `PATH` or `PATH=LO:HI`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Free {
+    pub path: String,
+    pub lo: f64,
+    pub hi: f64,
+}
+
+impl Free {
+    pub fn parse(s: &str) -> Result<Self> {
+        let (path, bounds) = match s.split_once('=') {
+            Some((p, b)) => (p.trim(), Some(b.trim())),
+            None => (s.trim(), None),
+        };
+        if path.is_empty() || path.split('.').any(|k| k.trim().is_empty()) {
+            bail!("--free {s}: expected PATH or PATH=LO:HI, e.g. segment.0.youngs_modulus=5e4:5e5");
+        }
+        let (lo, hi) = match bounds {
+            None => (f64::NEG_INFINITY, f64::INFINITY),
+            Some(b) => {
+                let bound = |v: &str, inf: f64| -> Result<f64> {
+                    match v.trim() {
+                        "" => Ok(inf),
+                        v => v.parse::<f64>().map_err(|_| {
+                            anyhow::anyhow!("--free {s}: the bound `{v}` is not a number (LO:HI, either may be empty)")
+                        }),
+                    }
+                };
+                let Some((lo, hi)) = b.split_once(':') else {
+                    bail!(
+                        "--free {s}: bounds are LO:HI, e.g. {path}=1e4:1e6 (either may be empty)"
+                    );
+                };
+                (bound(lo, f64::NEG_INFINITY)?, bound(hi, f64::INFINITY)?)
+            }
+        };
+        if lo.is_nan() || hi.is_nan() || lo >= hi {
+            bail!("--free {s}: LO must be below HI, got {lo} and {hi}");
+        }
+        Ok(Self {
+            path: path.to_string(),
+            lo,
+            hi,
+        })
+    }
+}
+
+/// Where the fit is checked on data it did not see.
+#[derive(Clone, Debug)]
+pub enum Validation {
+    /// Another window of the same record.
+    Window([f64; 2]),
+    /// Another model file (another record of the same arm), with the
+    /// fitted values set on it.
+    Model(String),
+}
+
+/// Mean tip error (m) before and after.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct Costs {
+    pub initial: f64,
+    #[serde(rename = "final")]
+    pub fitted: f64,
+    pub window_s: [f64; 2],
+    pub samples: usize,
+}
+
+/// What a fit found.
+pub struct Fitted {
+    pub names: Vec<String>,
+    pub initial: Vec<f64>,
+    pub values: Vec<f64>,
+    pub std_error: Vec<f64>,
+    pub correlation: DMatrix<f64>,
+    pub fit_cost: Costs,
+    pub validation_cost: Option<Costs>,
+    pub iterations: usize,
+    pub evaluations: usize,
+    pub wall_s: f64,
+    pub status: String,
+    pub converged: bool,
+    /// Values that ended on a bound.
+    pub at_bound: Vec<String>,
+    /// Pairs the data cannot separate: |correlation| above 0.99.
+    pub inseparable: Vec<(String, String, f64)>,
+    /// The runs at the start and at the fitted values, for the plot.
+    pub start_run: Evaluation,
+    pub fitted_run: Evaluation,
+}
+
+/// Correlation above which two values are reported as inseparable.
+pub const INSEPARABLE: f64 = 0.99;
+
+/// Fit `problem`'s free values to its record over `window`, checking on
+/// `validation` (`problem` itself for another window of its record, or
+/// another model's); `progress(iteration, mean tip error in window)`.
+pub fn fit(
+    problem: &Problem,
+    window: [f64; 2],
+    validation: Option<(&Problem, [f64; 2])>,
+    opts: &lm::Options,
+    progress: &mut dyn FnMut(usize, f64),
+) -> Result<Fitted> {
+    let start = Instant::now();
+    let theta0 = problem.start_values();
+    let (lo, hi) = problem.bounds();
+    // Every run is kept: the start's and the optimum's are reported.
+    let runs: RefCell<Vec<(Vec<f64>, Evaluation)>> = RefCell::new(Vec::new());
+    let mut evaluate = |theta: &[f64]| {
+        let e = problem
+            .evaluate(theta, true, window[1])
+            .map_err(|e| format!("{e:#}"))?;
+        let out = e.residuals(window);
+        runs.borrow_mut().push((theta.to_vec(), e));
+        Ok(out)
+    };
+    let run_at = |theta: &[f64]| {
+        (runs.borrow().iter())
+            .find(|(t, _)| t == theta)
+            .map(|(_, e)| e.clone())
+    };
+    let mut report = |k: usize, theta: &[f64]| {
+        if let Some(e) = run_at(theta) {
+            progress(k, e.mean_error(window));
+        }
+    };
+    let out = lm::minimise(&mut evaluate, &theta0, &lo, &hi, opts, &mut report)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", problem.label()))?;
+    // The start and the optimum again, without derivatives, as far as
+    // the validation window reaches.
+    let end = match validation {
+        Some((p, w)) if std::ptr::eq(p, problem) => window[1].max(w[1]),
+        _ => window[1],
+    };
+    let start_run = problem.evaluate(&theta0, false, end)?;
+    let fitted_run = problem.evaluate(&out.theta, false, end)?;
+    let fit_cost = Costs {
+        initial: start_run.mean_error(window),
+        fitted: fitted_run.mean_error(window),
+        window_s: window,
+        samples: fitted_run.samples(window),
+    };
+    let validation_cost = match validation {
+        None => None,
+        Some((p, w)) => {
+            let (a, b) = match std::ptr::eq(p, problem) {
+                true => (start_run.clone(), fitted_run.clone()),
+                false => (
+                    p.evaluate(&theta0, false, w[1])?,
+                    p.evaluate(&out.theta, false, w[1])?,
+                ),
+            };
+            Some(Costs {
+                initial: a.mean_error(w),
+                fitted: b.mean_error(w),
+                window_s: w,
+                samples: b.samples(w),
+            })
+        }
+    };
+    let (std_error, correlation) = uncertainty(&out.residuals, &out.jacobian);
+    let names = problem.names();
+    let m = names.len();
+    let at_bound = (0..m)
+        .filter(|&j| out.theta[j] <= lo[j] || out.theta[j] >= hi[j])
+        .map(|j| names[j].clone())
+        .collect();
+    let mut inseparable = Vec::new();
+    for a in 0..m {
+        for b in a + 1..m {
+            let c = correlation[(a, b)];
+            if c.abs() > INSEPARABLE || c.is_nan() {
+                inseparable.push((names[a].clone(), names[b].clone(), c));
+            }
+        }
+    }
+    Ok(Fitted {
+        names,
+        initial: theta0,
+        values: out.theta,
+        std_error,
+        correlation,
+        fit_cost,
+        validation_cost,
+        iterations: out.iterations,
+        evaluations: out.evaluations,
+        wall_s: start.elapsed().as_secs_f64(),
+        status: out.status,
+        converged: out.converged,
+        at_bound,
+        inseparable,
+        start_run,
+        fitted_run,
+    })
+}
+
+/// The window of a record: the given one, else `[compare] window`, else
+/// the whole record.
+pub fn window_of(problem: &Problem, given: Option<[f64; 2]>) -> [f64; 2] {
+    given.unwrap_or_else(|| problem.record_window())
+}
+
+/// The residual rows of the samples in `window`: 3 a sample (x, y, z).
+pub fn rows_in(times: &[f64], window: [f64; 2]) -> Vec<usize> {
+    (0..times.len())
+        .filter(|&i| times[i] >= window[0] && times[i] <= window[1])
+        .collect()
+}
