@@ -26,18 +26,14 @@ pub struct Options {
     /// Stop when every parameter moves by less than this fraction of its
     /// value (or of its scale).
     pub xtol: f64,
-    /// Stop when every value moves by less than this fraction of its
-    /// standard error.
-    pub sigma_tol: f64,
 }
 
 impl Default for Options {
     fn default() -> Self {
         Self {
             max_iterations: 40,
-            ftol: 1e-8,
+            ftol: 1e-6,
             xtol: 1e-8,
-            sigma_tol: 0.1,
         }
     }
 }
@@ -148,19 +144,6 @@ pub fn minimise(
                 }
                 if small {
                     status = format!("the parameters moved by less than {:e}", opts.xtol);
-                    converged = true;
-                    break;
-                }
-                // Moves far inside the values' own uncertainty change
-                // nothing the data can tell.
-                let (sigma, _) = super::uncertainty::uncertainty(&r, &jac);
-                let within = (free.iter().enumerate())
-                    .all(|(k, &j)| moved[k].abs() <= opts.sigma_tol * sigma[j]);
-                if within {
-                    status = format!(
-                        "the last step moved every value by less than {} of its standard error",
-                        opts.sigma_tol
-                    );
                     converged = true;
                     break;
                 }

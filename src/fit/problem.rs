@@ -118,7 +118,7 @@ impl Problem {
                 bail!("--free {}: given twice", f.path);
             }
             start.push(start_value(&tree, f, &label)?);
-            check_numeric(spec, &overrides, f, start[k], &base)?;
+            check_numeric(spec, &overrides, f, &tree, &base)?;
         }
         let m = crate::compare::measured(compare, &base.base_dir, [0.0; 3])
             .map_err(|e| anyhow!("{label}: [compare]: {e:#}"))?;
@@ -378,16 +378,17 @@ fn check_numeric(
     spec: &str,
     overrides: &[Override],
     f: &Free,
-    start: f64,
+    tree: &toml::Value,
     base: &Loaded,
 ) -> Result<()> {
-    let near = if start == 0.0 {
-        1e-3
-    } else {
-        start * (1.0 + 1e-3)
+    // A whole number may be a count (elements, order): the next one.
+    let near = match Override::value_at(tree, &f.path) {
+        Some(toml::Value::Integer(v)) => format!("{}", v + 1),
+        Some(toml::Value::Float(v)) if *v != 0.0 => format!("{:e}", v * (1.0 + 1e-3)),
+        _ => "1e-3".to_string(),
     };
     let mut all = overrides.to_vec();
-    all.push(Override::parse(&format!("{}={near:e}", f.path))?);
+    all.push(Override::parse(&format!("{}={near}", f.path))?);
     let (model, _) = crate::backend::read_model(spec, &all)
         .with_context(|| format!("--free {}: the model does not take a nearby value", f.path))?;
     let hash = eomgen::model::Structure::of(&model).hash();

@@ -16,6 +16,7 @@ mod double_pendulum;
 mod energy;
 mod events;
 mod failures;
+mod fit;
 mod fluid;
 mod generated;
 mod integrators;
