@@ -93,6 +93,58 @@ pub(crate) fn vector(name: &str, v: Option<PyReadonlyArray1<f64>>, n: usize) -> 
 
 #[pymethods]
 impl Model {
+    /// `softarm fit` on this model: fit.json's content as JSON text.
+    /// `free` as the command line's `--free` ("PATH" or "PATH=LO:HI"),
+    /// `validate` as its `--validate` ("A:B" or a model).
+    #[pyo3(signature = (free, window=None, validate=None, rtol=None, atol=None, max_iterations=40))]
+    #[allow(clippy::too_many_arguments)]
+    fn fit(
+        &self,
+        py: Python<'_>,
+        free: Vec<String>,
+        window: Option<(f64, f64)>,
+        validate: Option<String>,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        max_iterations: usize,
+    ) -> PyResult<String> {
+        use softarm::fit;
+        let overrides = (self.overrides.iter())
+            .map(|s| eomgen::model::Override::parse(s))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let free = (free.iter())
+            .map(|s| fit::Free::parse(s))
+            .collect::<anyhow::Result<Vec<_>>>()
+            .map_err(value_error)?;
+        let validate = (validate.as_deref())
+            .map(fit::Validation::parse)
+            .transpose()
+            .map_err(value_error)?;
+        let req = fit::Request {
+            model: self.spec.clone(),
+            overrides,
+            free,
+            window: window.map(|(a, b)| [a, b]),
+            validate,
+            run: RunRequest {
+                rtol,
+                atol,
+                ..Default::default()
+            },
+            cache_dir: None,
+            lm: fit::lm::Options {
+                max_iterations,
+                ..Default::default()
+            },
+        };
+        let prepared = fit::prepare(&req).map_err(value_error)?;
+        let fitted = py
+            .detach(|| prepared.fit(&req.lm, &mut |_, _| {}))
+            .map_err(value_error)?;
+        Ok(fit::report::json(&fitted).to_string())
+    }
+
     /// A stepping simulator of its own copy of the model (see
     /// `simulator.rs`).
     #[pyo3(signature = (dt, inputs=Vec::new(), solver=None, rtol=None, atol=None, step=None))]

@@ -347,3 +347,22 @@ def test_a_long_run_releases_the_gil_and_stops_on_ctrl_c():
         assert time.perf_counter() - started < 5.0
     finally:
         signal.signal(signal.SIGINT, previous)
+
+
+def test_a_fit_is_the_clis(tmp_path):
+    """`Model.fit` returns fit.json's content: the same values, errors and
+    costs as `softarm fit`, to the bit."""
+    free = {"segment.0.youngs_modulus": (5e4, 5e5), "segment.0.bending_damping": (1e-7, None)}
+    args = ["--window", "1:4", "--validate", "4:6", "--rtol", "1e-5", "--max-iterations", "3"]
+    for path, (lo, hi) in free.items():
+        args += ["--free", f"{path}={lo!r}:{'' if hi is None else repr(hi)}"]
+    subprocess.run([cli(), "fit", "stiff_flop", *args, "--out", str(tmp_path / "f"), "--quiet"],
+                   check=True)
+    expected = json.loads((tmp_path / "f" / "fit.json").read_text())
+    got = softarm.load("stiff_flop").fit(free, window=(1, 4), validate=(4, 6), rtol=1e-5,
+                                         max_iterations=3)
+    for key in ["parameters", "initial", "std_error", "correlation", "cost", "iterations",
+                "evaluations", "status", "at_bound"]:
+        assert got[key] == expected[key], key
+    with pytest.raises(ValueError, match="structural"):
+        softarm.load("stiff_flop").fit({"segment.0.elements": None})

@@ -3,11 +3,11 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use clap::Args;
 use eomgen::model::Override;
 
-use crate::fit::{self, Free, Problem, Validation, lm};
+use crate::fit::{self, Free, Validation, lm};
 use crate::run::RunRequest;
 
 #[derive(Args, Clone)]
@@ -49,80 +49,45 @@ pub struct FitArgs {
     pub quiet: bool,
 }
 
-/// `A:B` in seconds, A < B.
-fn window(flag: &str, s: &str) -> Result<[f64; 2]> {
-    let parsed = s
-        .split_once(':')
-        .and_then(|(a, b)| Some([a.trim().parse::<f64>().ok()?, b.trim().parse::<f64>().ok()?]));
-    match parsed {
-        Some([a, b]) if a < b && a >= 0.0 && b.is_finite() => Ok([a, b]),
-        _ => bail!("{flag} {s}: expected A:B in seconds with 0 <= A < B, e.g. 7:30"),
-    }
-}
-
 pub fn fit(a: FitArgs) -> Result<ExitCode> {
-    let overrides = (a.set.iter())
-        .map(|s| Override::parse(s))
-        .collect::<Result<Vec<_>, _>>()?;
-    let free = (a.free.iter())
-        .map(|s| Free::parse(s))
-        .collect::<Result<Vec<_>>>()?;
-    let run = RunRequest {
-        rtol: a.rtol,
-        atol: a.atol,
-        ..RunRequest::default()
+    let req = fit::Request {
+        model: a.model.clone(),
+        overrides: (a.set.iter())
+            .map(|s| Override::parse(s))
+            .collect::<Result<Vec<_>, _>>()?,
+        free: (a.free.iter())
+            .map(|s| Free::parse(s))
+            .collect::<Result<Vec<_>>>()?,
+        window: a
+            .window
+            .as_deref()
+            .map(|s| fit::parse_window("--window", s))
+            .transpose()?,
+        validate: a.validate.as_deref().map(Validation::parse).transpose()?,
+        run: RunRequest {
+            rtol: a.rtol,
+            atol: a.atol,
+            ..RunRequest::default()
+        },
+        cache_dir: a.cache_dir.clone(),
+        lm: lm::Options {
+            max_iterations: a.max_iterations,
+            ..lm::Options::default()
+        },
     };
-    let problem = Problem::new(
-        &a.model,
-        overrides.clone(),
-        free.clone(),
-        run.clone(),
-        a.cache_dir.clone(),
-    )?;
-    let record = problem.record_window();
-    let fit_window = match &a.window {
-        Some(s) => window("--window", s)?,
-        None => record,
-    };
-    let validation = match &a.validate {
-        None => None,
-        Some(s) if s.contains(':') && !std::path::Path::new(s).exists() => {
-            Some(Validation::Window(window("--validate", s)?))
-        }
-        Some(s) => Some(Validation::Model(s.clone())),
-    };
-    let other = match &validation {
-        Some(Validation::Model(spec)) => {
-            let p = Problem::new(spec, overrides, free, run, a.cache_dir.clone())?;
-            let w = p.record_window();
-            Some((p, w))
-        }
-        _ => None,
-    };
-    let same_window = match &validation {
-        Some(Validation::Window(w)) => Some(*w),
-        _ => None,
-    };
+    // Checked before anything is written.
+    let prepared = fit::prepare(&req)?;
     let out_dir = (a.out.clone())
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-fit", model_name(&a.model))));
     let mut dir = crate::output_dir::OutputDir::claim(&out_dir)?;
-    let opts = lm::Options {
-        max_iterations: a.max_iterations,
-        ..lm::Options::default()
-    };
     let quiet = a.quiet;
     let mut progress = |k: usize, mean: f64| {
         if !quiet {
             eprintln!("fit: iteration {k}: mean tip error {:.4} mm", 1e3 * mean);
         }
     };
-    let validation_pair = match (&other, same_window) {
-        (Some((p, w)), _) => Some((p, *w)),
-        (None, Some(w)) => Some((&problem, w)),
-        (None, None) => None,
-    };
-    let f = fit::fit(&problem, fit_window, validation_pair, &opts, &mut progress)?;
-    fit::report::write(&mut dir, &problem, &f, same_window)?;
+    let f = prepared.fit(&req.lm, &mut progress)?;
+    fit::report::write(&mut dir, &prepared.problem, &f, prepared.shaded())?;
     if !quiet {
         print_table(&f);
         println!("wrote {}", out_dir.display());

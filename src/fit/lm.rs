@@ -71,7 +71,14 @@ pub fn minimise(
     let mut cost = initial_cost;
     let mut lambda = 1e-3;
     let mut nu = 2.0;
-    let scale: Vec<f64> = theta0.iter().map(|v| v.abs().max(1e-300)).collect();
+    // A value's size for the step test: its start, else its bounds' width.
+    let scale: Vec<f64> = (0..m)
+        .map(|j| match (theta0[j].abs(), hi[j] - lo[j]) {
+            (v, _) if v > 0.0 => v,
+            (_, w) if w.is_finite() => w,
+            _ => 1.0,
+        })
+        .collect();
     let mut status = format!("stopped after {} iterations", opts.max_iterations);
     let mut converged = false;
     let mut iterations = 0;

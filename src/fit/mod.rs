@@ -17,8 +17,13 @@ mod uncertainty;
 use std::cell::RefCell;
 use std::time::Instant;
 
+use std::path::PathBuf;
+
 use anyhow::{Result, bail};
+use eomgen::model::Override;
 use nalgebra::DMatrix;
+
+use crate::run::RunRequest;
 
 pub use problem::{Evaluation, Problem};
 pub use uncertainty::uncertainty;
@@ -78,6 +83,100 @@ pub enum Validation {
     /// Another model file (another record of the same arm), with the
     /// fitted values set on it.
     Model(String),
+}
+
+impl Validation {
+    /// `A:B` (seconds), or a model file or name.
+    pub fn parse(s: &str) -> Result<Self> {
+        let is_file = std::path::Path::new(s).exists();
+        match s.contains(':') && !is_file {
+            true => Ok(Self::Window(parse_window("--validate", s)?)),
+            false => Ok(Self::Model(s.to_string())),
+        }
+    }
+}
+
+/// `A:B` in seconds, 0 <= A < B; `flag` names it in the error.
+pub fn parse_window(flag: &str, s: &str) -> Result<[f64; 2]> {
+    let parsed = s
+        .split_once(':')
+        .and_then(|(a, b)| Some([a.trim().parse::<f64>().ok()?, b.trim().parse::<f64>().ok()?]));
+    match parsed {
+        Some([a, b]) if a < b && a >= 0.0 && b.is_finite() => Ok([a, b]),
+        _ => bail!("{flag} {s}: expected A:B in seconds with 0 <= A < B, e.g. 7:30"),
+    }
+}
+
+/// A fit as asked, by the command line or Python.
+pub struct Request {
+    pub model: String,
+    pub overrides: Vec<Override>,
+    pub free: Vec<Free>,
+    /// The fit window [default: the record's].
+    pub window: Option<[f64; 2]>,
+    pub validate: Option<Validation>,
+    pub run: RunRequest,
+    pub cache_dir: Option<PathBuf>,
+    pub lm: lm::Options,
+}
+
+/// A request checked: its problems and windows, nothing run yet.
+pub struct Prepared {
+    pub problem: Problem,
+    pub window: [f64; 2],
+    /// Another model's problem and its window, for `Validation::Model`.
+    other: Option<(Problem, [f64; 2])>,
+    /// A validation window of the same record.
+    same: Option<[f64; 2]>,
+}
+
+/// Check a request: the model, its record, every free value.
+pub fn prepare(req: &Request) -> Result<Prepared> {
+    let problem = Problem::new(
+        &req.model,
+        req.overrides.clone(),
+        req.free.clone(),
+        req.run.clone(),
+        req.cache_dir.clone(),
+    )?;
+    let window = req.window.unwrap_or_else(|| problem.record_window());
+    let (other, same) = match &req.validate {
+        None => (None, None),
+        Some(Validation::Window(w)) => (None, Some(*w)),
+        Some(Validation::Model(spec)) => {
+            let p = Problem::new(
+                spec,
+                req.overrides.clone(),
+                req.free.clone(),
+                req.run.clone(),
+                req.cache_dir.clone(),
+            )?;
+            let w = p.record_window();
+            (Some((p, w)), None)
+        }
+    };
+    Ok(Prepared {
+        problem,
+        window,
+        other,
+        same,
+    })
+}
+
+impl Prepared {
+    /// A validation window of the fitted record itself, to shade.
+    pub fn shaded(&self) -> Option<[f64; 2]> {
+        self.same
+    }
+
+    pub fn fit(&self, opts: &lm::Options, progress: &mut dyn FnMut(usize, f64)) -> Result<Fitted> {
+        let validation = match (&self.other, self.same) {
+            (Some((p, w)), _) => Some((p, *w)),
+            (None, Some(w)) => Some((&self.problem, w)),
+            (None, None) => None,
+        };
+        fit(&self.problem, self.window, validation, opts, progress)
+    }
 }
 
 /// Mean tip error (m) before and after.
@@ -217,12 +316,6 @@ pub fn fit(
         start_run,
         fitted_run,
     })
-}
-
-/// The window of a record: the given one, else `[compare] window`, else
-/// the whole record.
-pub fn window_of(problem: &Problem, given: Option<[f64; 2]>) -> [f64; 2] {
-    given.unwrap_or_else(|| problem.record_window())
 }
 
 /// The residual rows of the samples in `window`: 3 a sample (x, y, z).

@@ -155,6 +155,17 @@ impl Problem {
         )
     }
 
+    /// The size of value j: its start, else the width of its bounds, else
+    /// 1 (a delay or an offset that starts at zero).
+    pub fn typical(&self, j: usize) -> f64 {
+        let f = &self.free[j];
+        match (self.start[j], f.hi - f.lo) {
+            (v, _) if v != 0.0 => v.abs(),
+            (_, w) if w.is_finite() => w,
+            _ => 1.0,
+        }
+    }
+
     /// `[compare] window`, else the whole record.
     pub fn record_window(&self) -> [f64; 2] {
         self.record
@@ -195,7 +206,7 @@ impl Problem {
         let m = if derivatives { theta.len() } else { 0 };
         let mut pairs = Vec::with_capacity(m);
         for j in 0..m {
-            let delta = DELTA * theta[j].abs().max(DELTA * self.start[j].abs()).max(1e-300);
+            let delta = DELTA * theta[j].abs().max(1e-3 * self.typical(j));
             let at = |sign: f64| {
                 let mut t = theta.to_vec();
                 t[j] += sign * delta;

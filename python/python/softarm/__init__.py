@@ -140,6 +140,42 @@ class Model:
         q, residual, iterations = self._core.equilibrium(_vector(q0))
         return {"q": q, "tip": self.tip(q), "residual": residual, "iterations": iterations}
 
+    def fit(
+        self,
+        free: Mapping[str, Any],
+        window: Optional[Sequence[float]] = None,
+        validate: Any = None,
+        rtol: Optional[float] = None,
+        atol: Optional[float] = None,
+        max_iterations: int = 40,
+    ) -> dict:
+        """Fit model values to the model's [compare] record, as `softarm
+        fit` does; returns fit.json's content.
+
+        `free` maps each value's key path to its bounds ``(lo, hi)`` (either
+        may be None) or to None (unbounded):
+        ``{"segment.0.youngs_modulus": (5e4, 5e5), "tip.mass": None}``.
+        `window` is the fit's (a, b) in seconds; `validate` another window
+        (a, b) or another model file with its own record.
+        """
+        def spec(path: str, bounds: Any) -> str:
+            if bounds is None:
+                return path
+            lo, hi = bounds
+            return f"{path}={'' if lo is None else repr(float(lo))}:{'' if hi is None else repr(float(hi))}"
+
+        if isinstance(validate, (tuple, list)):
+            validate = f"{float(validate[0])!r}:{float(validate[1])!r}"
+        text = self._core.fit(
+            [spec(k, v) for k, v in free.items()],
+            None if window is None else (float(window[0]), float(window[1])),
+            None if validate is None else str(validate),
+            rtol,
+            atol,
+            max_iterations,
+        )
+        return json.loads(text)
+
     def modes(self, q0=None) -> dict:
         """Natural frequencies (Hz, ascending) and mode shapes (columns)
         about the static equilibrium."""

@@ -25,6 +25,15 @@ class Model:
     ) -> tuple[Vector, Vector, Vector, Vector, Vector, Vector]: ...
     def equilibrium(self, q0: Optional[Vector] = None) -> tuple[Vector, float, int]: ...
     def modes(self, q: Vector) -> tuple[Vector, Vector]: ...  # shapes (n, k), frequencies (k,)
+    def fit(
+        self,
+        free: list[str],
+        window: Optional[tuple[float, float]] = None,
+        validate: Optional[str] = None,
+        rtol: Optional[float] = None,
+        atol: Optional[float] = None,
+        max_iterations: int = 40,
+    ) -> str: ...  # fit.json's content
     def simulate(
         self,
         t_end: Optional[float] = None,
