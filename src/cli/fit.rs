@@ -72,9 +72,13 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
         cache_dir: a.cache_dir.clone(),
         lm: lm::Options {
             max_iterations: a.max_iterations,
+            stop: Some(|| crate::interrupt::requested().is_some()),
             ..lm::Options::default()
         },
     };
+    // Ctrl-C or SIGTERM ends the search with the best values so far
+    // written.
+    crate::interrupt::catch();
     // Checked before anything is written.
     let prepared = fit::prepare(&req)?;
     let out_dir = (a.out.clone())
@@ -91,6 +95,15 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
     if !quiet {
         print_table(&f);
         println!("wrote {}", out_dir.display());
+    }
+    if let Some(stop) = crate::interrupt::requested().filter(|_| f.interrupted) {
+        eprintln!(
+            "fit: stopped by {} after {} iterations; the best values so far are in {}",
+            stop.name(),
+            f.iterations,
+            out_dir.join("fit.json").display()
+        );
+        return Ok(ExitCode::from(stop.exit_code()));
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -18,6 +18,7 @@ use nalgebra::{DMatrix, DVector};
 /// theta, or why they could not be computed there (a run that failed).
 pub type Evaluate<'a> = dyn FnMut(&[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String> + 'a;
 
+#[derive(Clone, Copy)]
 pub struct Options {
     pub max_iterations: usize,
     /// Stop when an accepted step lowers the cost by less than this
@@ -26,6 +27,9 @@ pub struct Options {
     /// Stop when every parameter moves by less than this fraction of its
     /// value (or of its scale).
     pub xtol: f64,
+    /// Asked before each evaluation: true stops the search where it is
+    /// (Ctrl-C), with the best values so far.
+    pub stop: Option<fn() -> bool>,
 }
 
 impl Default for Options {
@@ -34,6 +38,7 @@ impl Default for Options {
             max_iterations: 40,
             ftol: 1e-6,
             xtol: 1e-8,
+            stop: None,
         }
     }
 }
@@ -50,6 +55,8 @@ pub struct Outcome {
     /// Why it stopped.
     pub status: String,
     pub converged: bool,
+    /// Stopped by `Options::stop`.
+    pub interrupted: bool,
 }
 
 /// Minimise from `theta0` within [lo, hi]; `progress(iteration, theta)`
@@ -82,7 +89,13 @@ pub fn minimise(
     let mut status = format!("stopped after {} iterations", opts.max_iterations);
     let mut converged = false;
     let mut iterations = 0;
+    let mut interrupted = false;
     while iterations < opts.max_iterations {
+        if opts.stop.is_some_and(|stop| stop()) {
+            status = format!("interrupted after {iterations} iterations");
+            interrupted = true;
+            break;
+        }
         let g = jac.transpose() * &r;
         // Held: at a bound with the descent direction -g pointing out.
         let free: Vec<usize> = (0..m)
@@ -176,5 +189,6 @@ pub fn minimise(
         evaluations,
         status,
         converged,
+        interrupted,
     })
 }

@@ -203,6 +203,8 @@ pub struct Fitted {
     pub wall_s: f64,
     pub status: String,
     pub converged: bool,
+    /// Stopped by a signal: the values are the best so far.
+    pub interrupted: bool,
     /// Values that ended on a bound.
     pub at_bound: Vec<String>,
     /// Pairs the data cannot separate: |correlation| above 0.99.
@@ -311,6 +313,7 @@ pub fn fit(
         wall_s: start.elapsed().as_secs_f64(),
         status: out.status,
         converged: out.converged,
+        interrupted: out.interrupted,
         at_bound,
         inseparable,
         start_run,

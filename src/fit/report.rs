@@ -47,7 +47,11 @@ pub fn json(f: &Fitted) -> Value {
         "iterations": f.iterations,
         "evaluations": f.evaluations,
         "wall_s": f.wall_s,
-        "status": if f.converged { "converged" } else { "not converged" },
+        "status": match (f.interrupted, f.converged) {
+            (true, _) => "interrupted",
+            (false, true) => "converged",
+            (false, false) => "not converged",
+        },
         "reason": f.status,
         "at_bound": f.at_bound,
         "warnings": warnings,

@@ -116,6 +116,11 @@ fn model(text: &str, values: &[(&str, f64)]) -> String {
 /// noise of `sigma` on each coordinate but the first sample's (the
 /// registration's anchor: `[compare]` subtracts it).
 fn record(dir: &Path, text: &str, truth: &[(&str, f64)], sigma: f64) {
+    record_seeded(dir, text, truth, sigma, 7);
+}
+
+/// `record` with its noise from `seed`.
+fn record_seeded(dir: &Path, text: &str, truth: &[(&str, f64)], sigma: f64, seed: u64) {
     // Without its [compare], a run samples at --output-dt.
     let truth_model = model(text, truth).replace(COMPARE, "");
     std::fs::write(dir.join("truth.toml"), truth_model).unwrap();
@@ -147,7 +152,7 @@ fn record(dir: &Path, text: &str, truth: &[(&str, f64)], sigma: f64) {
     let names: Vec<&str> = lines.next().unwrap().split(',').collect();
     let col = |n: &str| names.iter().position(|c| *c == n).unwrap();
     let (t, x, y, z) = (col("t"), col("tip_x"), col("tip_y"), col("tip_z"));
-    let mut rng = Rng::new(7);
+    let mut rng = Rng::new(seed);
     let mut gauss = || {
         let (u, v) = (rng.next_f64().max(1e-300), rng.next_f64());
         (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
@@ -233,6 +238,46 @@ fn recovers_a_planar_fingers_stiffness_damping_and_tip_mass() {
         ],
     );
     assert_recovered(&fit, &truth, sigma);
+    // Checked on another record of the same arm (other noise), which the
+    // fit did not see: its error is that record's noise.
+    std::fs::rename(dir.path().join("record.csv"), dir.path().join("first.csv")).unwrap();
+    record_seeded(dir.path(), PLANAR, &truth, sigma, 11);
+    std::fs::rename(dir.path().join("record.csv"), dir.path().join("second.csv")).unwrap();
+    let text = model(PLANAR, &start);
+    std::fs::write(
+        dir.path().join("model.toml"),
+        text.replace("record.csv", "first.csv"),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("other.toml"),
+        text.replace("record.csv", "second.csv"),
+    )
+    .unwrap();
+    let fit = fit_json(
+        dir.path(),
+        &[
+            "--free",
+            "segment.0.youngs_modulus=1e5:1e8",
+            "--free",
+            "segment.0.bending_damping=1e-7:1e-3",
+            "--free",
+            "tip.mass=1e-3:0.1",
+            "--validate",
+            "other.toml",
+        ],
+    );
+    let v = &fit["cost"]["validation"];
+    assert_eq!(v["samples"], 151, "{v}");
+    let noise = sigma * (8.0 / std::f64::consts::PI).sqrt();
+    assert_close(
+        v["final"].as_f64().unwrap(),
+        noise,
+        0.15,
+        0.0,
+        "validation error",
+    );
+    assert!(v["initial"].as_f64().unwrap() > 3.0 * noise, "{v}");
     // The fitted model runs as it is.
     let out = softarm(
         &[
