@@ -149,13 +149,13 @@ pub fn tip_error(
     })
 }
 
-/// Simulated against measured tip x, y, z over time, one panel each, as
-/// `<stem>.png` and `<stem>.svg`.
+/// The simulated tip x, y, z over time, one panel each, against the
+/// measured one when there is a record, as `<stem>.png` and `<stem>.svg`.
 pub fn plot(
     stem: &Path,
     title: &str,
     simulated: &[(f64, [f64; 3])],
-    measured: &Measured,
+    measured: Option<&Measured>,
 ) -> Result<()> {
     let curve = Curve {
         label: "simulated",
@@ -172,16 +172,29 @@ pub struct Curve<'a> {
     pub points: &'a [(f64, [f64; 3])],
 }
 
-/// Simulated tips (`curves`) against the measured one, x, y and z over
-/// time, one panel each, with the time span `shaded` (a validation
-/// window) shaded; as `<stem>.png` and `<stem>.svg`.
+/// Simulated tips (`curves`) against the measured one (if any), x, y and
+/// z over time, one panel each, with the time span `shaded` (a validation
+/// window) shaded; as `<stem>.png` and `<stem>.svg`. Nothing is drawn for
+/// a run that never left t = 0: it has no time axis.
 pub fn plot_curves(
     stem: &Path,
     title: &str,
     curves: &[Curve],
-    measured: &Measured,
+    measured: Option<&Measured>,
     shaded: Option<[f64; 2]>,
 ) -> Result<()> {
+    let none = Measured {
+        t: Vec::new(),
+        tip: Vec::new(),
+    };
+    let record = measured.unwrap_or(&none);
+    let t_max = (curves.iter().flat_map(|c| c.points.iter().map(|p| p.0)))
+        .chain(record.t.iter().copied())
+        .filter(|t| t.is_finite())
+        .fold(0.0, f64::max);
+    if t_max <= 0.0 {
+        return Ok(());
+    }
     use plotters::prelude::*;
     register_font();
     fn e(e: impl std::fmt::Display) -> anyhow::Error {
@@ -191,7 +204,8 @@ pub fn plot_curves(
         root: DrawingArea<DB, plotters::coord::Shift>,
         title: &str,
         curves: &[Curve],
-        measured: &Measured,
+        measured: Option<&Measured>,
+        t_max: f64,
         shaded: Option<[f64; 2]>,
     ) -> Result<()>
     where
@@ -201,18 +215,17 @@ pub fn plot_curves(
         let root = root.titled(title, ("sans-serif", 20)).map_err(e)?;
         let panels = root.split_evenly((3, 1));
         let points = || curves.iter().flat_map(|c| c.points.iter());
-        let t_max = points()
-            .map(|s| s.0)
-            .chain(measured.t.iter().copied())
-            .fold(0.0, f64::max);
+        let measured_tips = || measured.iter().flat_map(|m| m.tip.iter());
         for (k, panel) in panels.iter().enumerate() {
             let values = points()
                 .map(|s| s.1[k])
-                .chain(measured.tip.iter().map(|m| m[k]))
-                .map(|v| 1e3 * v);
+                .chain(measured_tips().map(|m| m[k]))
+                .map(|v| 1e3 * v)
+                .filter(|v| v.is_finite());
             let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
                 (a.min(v), b.max(v))
             });
+            let (lo, hi) = if lo <= hi { (lo, hi) } else { (0.0, 0.0) };
             let pad = 0.05 * (hi - lo).max(1.0);
             let (y0, y1) = (lo - pad, hi + pad);
             let mut chart = ChartBuilder::on(panel)
@@ -236,14 +249,16 @@ pub fn plot_curves(
                     .label("validation window")
                     .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], fill));
             }
-            chart
-                .draw_series(LineSeries::new(
-                    (measured.t.iter().zip(&measured.tip)).map(|(t, m)| (*t, 1e3 * m[k])),
-                    BLACK.stroke_width(1),
-                ))
-                .map_err(e)?
-                .label("measured")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK));
+            if let Some(m) = measured {
+                chart
+                    .draw_series(LineSeries::new(
+                        (m.t.iter().zip(&m.tip)).map(|(t, m)| (*t, 1e3 * m[k])),
+                        BLACK.stroke_width(1),
+                    ))
+                    .map_err(e)?
+                    .label("measured")
+                    .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK));
+            }
             for c in curves {
                 let color = c.color;
                 chart
@@ -270,11 +285,11 @@ pub fn plot_curves(
     // encoder would pull in the whole `image` crate.
     let mut rgb = vec![255u8; 3 * (size.0 * size.1) as usize];
     let area = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
-    draw(area, title, curves, measured, shaded)?;
+    draw(area, title, curves, measured, t_max, shaded)?;
     write_png(&stem.with_extension("png"), size, &rgb)?;
     let mut text = String::new();
     let area = SVGBackend::with_string(&mut text, size).into_drawing_area();
-    draw(area, title, curves, measured, shaded)?;
+    draw(area, title, curves, measured, t_max, shaded)?;
     Ok(write_atomic(&stem.with_extension("svg"), text.as_bytes())?)
 }
 

@@ -63,7 +63,7 @@ pub fn options(req: &RunRequest, file: &SimulateDefaults) -> Result<SimOptions> 
     if max_steps == 0 {
         bail!("--max-steps must be at least 1");
     }
-    let output_dt = req.output_dt.unwrap_or(t_end / runtime::DEFAULT_SAMPLES);
+    let output_dt = (req.output_dt.or(file.output_dt)).unwrap_or(t_end / runtime::DEFAULT_SAMPLES);
     if !(output_dt > 0.0 && output_dt.is_finite()) {
         bail!("--output-dt must be positive, got {output_dt}");
     }
@@ -259,6 +259,54 @@ pub fn tip_error(
     })
 }
 
+/// Each arm's tip (x, y, z) in a model of several arms, as trajectory.csv's
+/// last columns (`ARM.tip_x`, ...): the `Outputs` kernel's tip is the
+/// first arm's. From the shape's tape at one point per element.
+pub struct ArmTips {
+    tape: eomgen::shape::ShapeTape,
+}
+
+impl ArmTips {
+    /// None for a model of one arm (its tip is `tip_x`, ...).
+    pub fn of(loaded: &Loaded) -> Option<Self> {
+        let structure = eomgen::model::Structure::of(&loaded.model);
+        let arms = structure.assembly.as_ref().map_or(1, |a| a.arms.len());
+        (arms > 1).then(|| Self {
+            tape: eomgen::shape::shape_tape(&structure, 1),
+        })
+    }
+
+    pub fn names(&self) -> Vec<String> {
+        (self.tape.arms.iter())
+            .flat_map(|a| ["x", "y", "z"].map(|c| format!("{}.tip_{c}", a.name)))
+            .collect()
+    }
+
+    /// The tips at time t, coordinates q: 3 values an arm.
+    pub fn at(&self, arm: &dyn runtime::Dynamics, t: f64, q: &[f64]) -> Vec<f64> {
+        let p = arm.params_at(t);
+        let mut out = vec![0.0; self.tape.tape.outputs.len()];
+        let inp = runtime::Inputs {
+            t,
+            q,
+            qd: &[],
+            qdd: &[],
+            dir: &[],
+            p: &p,
+            aux: &[],
+        };
+        self.tape.tape.eval(&inp, &mut Vec::new(), &mut out);
+        let mut first = 0;
+        let mut tips = Vec::with_capacity(3 * self.tape.arms.len());
+        for a in &self.tape.arms {
+            let last = first + a.rows() - 1;
+            tips.extend_from_slice(&out[last * eomgen::shape::ROW..last * eomgen::shape::ROW + 3]);
+            first += a.rows();
+        }
+        tips
+    }
+}
+
 /// The most trajectory rows a run returned in memory keeps (a
 /// 30-coordinate arm's million rows are about a gigabyte with their
 /// outputs).
@@ -275,25 +323,31 @@ pub struct Table {
 }
 
 impl Table {
-    /// The table of a run of `arm`.
-    pub fn of(arm: &dyn runtime::Dynamics, traj: &runtime::Trajectory) -> Self {
+    /// The table of a run of `arm` (`tips`: each arm's, for a model of
+    /// several).
+    pub fn of(
+        arm: &dyn runtime::Dynamics,
+        tips: Option<&ArmTips>,
+        traj: &runtime::Trajectory,
+    ) -> Self {
         let n = arm.dof();
         let joints = !arm.info().constraints.is_empty();
         let rows = (traj.t.iter().zip(&traj.x).enumerate())
             .map(|(i, (t, x))| {
                 let out = arm.outputs(*t, &x[..n], &x[n..]);
                 let contact = crate::contact::columns(arm, traj, i);
-                Self::row(arm, *t, x, &out, joints, &contact)
+                let tips = tips.map_or(Vec::new(), |a| a.at(arm, *t, &x[..n]));
+                Self::row(arm, *t, x, &out, joints, &contact, &tips)
             })
             .collect();
         Self {
-            names: Self::names(arm),
+            names: Self::names(arm, tips),
             rows,
         }
     }
 
     /// The columns' names.
-    pub fn names(arm: &dyn runtime::Dynamics) -> Vec<String> {
+    pub fn names(arm: &dyn runtime::Dynamics, tips: Option<&ArmTips>) -> Vec<String> {
         let coords = &arm.info().coordinates;
         let mut names = vec!["t".to_string()];
         names.extend(coords.iter().cloned());
@@ -301,11 +355,13 @@ impl Table {
         names.extend(runtime::OUTPUT_NAMES.iter().map(|o| o.to_string()));
         names.extend(crate::joints::reaction_names(arm));
         names.extend(crate::contact::column_names(arm));
+        names.extend(tips.map_or(Vec::new(), ArmTips::names));
         names
     }
 
     /// The row at (t, x): `outputs` the arm's there, `joints` whether it
-    /// has joints (their reactions), `contact` its contact columns.
+    /// has joints (their reactions), `contact` its contact columns, `tips`
+    /// each arm's tip (`ArmTips::at`; empty for one arm).
     pub fn row(
         arm: &dyn runtime::Dynamics,
         t: f64,
@@ -313,6 +369,7 @@ impl Table {
         outputs: &[f64],
         joints: bool,
         contact: &[f64],
+        tips: &[f64],
     ) -> Vec<f64> {
         let mut row = Vec::with_capacity(1 + x.len() + outputs.len() + contact.len());
         row.push(t);
@@ -322,6 +379,7 @@ impl Table {
             row.extend(crate::joints::reactions(arm, t, x));
         }
         row.extend_from_slice(contact);
+        row.extend_from_slice(tips);
         row
     }
 

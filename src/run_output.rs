@@ -17,7 +17,7 @@ use anyhow::{Context, Result};
 use runtime::{Dynamics, RowSink};
 
 use crate::backend::Loaded;
-use crate::run::Table;
+use crate::run::{ArmTips, Table};
 use crate::shape::Shape;
 
 /// Most points a figure keeps: far more than its pixels across.
@@ -38,6 +38,8 @@ pub struct Kept {
     pub tips: Vec<(f64, [f64; 3])>,
     /// Each free body's path (t, x, y), by name.
     pub paths: Vec<(String, Thinned<PathPoint>)>,
+    /// The tip (x, y, z) over the run, thinned, for its plot.
+    pub tip: Thinned<(f64, [f64; 3])>,
     /// With contact: the tip's path (t, x, y) and the contact columns.
     pub tip_path: Thinned<PathPoint>,
     pub forces: Thinned<(f64, Vec<f64>)>,
@@ -48,6 +50,8 @@ struct Writer {
     trajectory: BufWriter<File>,
     shape: Option<(Shape, BufWriter<File>)>,
     joints: bool,
+    /// Each arm's tip, for a model of several arms.
+    tips: Option<ArmTips>,
     compare: bool,
     /// Free bodies: name and the index of x in the state.
     bodies: Vec<(String, usize)>,
@@ -84,7 +88,8 @@ pub fn size_warning(
     let out = arm.outputs(0.0, &x0[..n], &x0[n..]);
     let contact = crate::contact::column_names(arm).len();
     let joints = !arm.info().constraints.is_empty();
-    let row = Table::row(arm, 0.0, x0, &out, joints, &vec![0.0; contact]);
+    let tips = ArmTips::of(loaded).map_or(Vec::new(), |a| a.at(arm, 0.0, &x0[..n]));
+    let row = Table::row(arm, 0.0, x0, &out, joints, &vec![0.0; contact], &tips);
     let mut buf = Vec::new();
     Table::write_row(&mut buf, &row).ok()?;
     let trajectory = rows * buf.len() as f64;
@@ -119,7 +124,8 @@ impl RunOutput {
             Ok(BufWriter::new(f))
         };
         let mut t = open(trajectory)?;
-        writeln!(t, "{}", Table::names(arm).join(","))?;
+        let tips = ArmTips::of(loaded);
+        writeln!(t, "{}", Table::names(arm, tips.as_ref()).join(","))?;
         let shape = match shape {
             Some((s, p)) => {
                 let mut w = open(&p)?;
@@ -141,6 +147,7 @@ impl RunOutput {
                 trajectory: t,
                 shape,
                 joints: !arm.info().constraints.is_empty(),
+                tips,
                 compare,
                 bodies,
                 kept,
@@ -187,7 +194,8 @@ impl Writer {
         let (t, x) = (row.t, row.x);
         let out = arm.outputs(t, &x[..n], &x[n..]);
         if self.error.is_none() {
-            let values = Table::row(arm, t, x, &out, self.joints, row.contact);
+            let tips = (self.tips.as_ref()).map_or(Vec::new(), |a| a.at(arm, t, &x[..n]));
+            let values = Table::row(arm, t, x, &out, self.joints, row.contact, &tips);
             let written = Table::write_row(&mut self.trajectory, &values).and_then(|_| {
                 match &mut self.shape {
                     Some((s, w)) => s.write_rows(arm, t, &x[..n], w),
@@ -206,6 +214,7 @@ impl Writer {
         if self.compare {
             k.tips.push((t, [out[0], out[1], out[2]]));
         }
+        k.tip.push((t, [out[0], out[1], out[2]]));
         for ((_, ix), (_, path)) in self.bodies.iter().zip(&mut k.paths) {
             path.push((t, x[*ix], x[ix + 1]));
         }

@@ -432,7 +432,8 @@ impl Model {
         // trajectory.csv's table, built as the CLI builds it: the states,
         // the outputs, and every column after them (the joints' and the
         // contacts' forces) by name.
-        let table = softarm::run::Table::of(arm, &traj);
+        let tips = softarm::run::ArmTips::of(&self.loaded);
+        let table = softarm::run::Table::of(arm, tips.as_ref(), &traj);
         let rows = table.rows.len();
         let outs_at = 1 + 2 * n;
         let forces_at = softarm::run::Table::forces_from(n);

@@ -191,7 +191,8 @@ pub struct SimulateArgs {
     /// simulate.rho_inf, else 0.8].
     #[arg(long)]
     pub rho_inf: Option<f64>,
-    /// Spacing of trajectory.csv rows (s); default t_end / 500.
+    /// Spacing of trajectory.csv rows (s) [default: simulate.output_dt,
+    /// else t_end / 500].
     #[arg(long, allow_negative_numbers = true)]
     pub output_dt: Option<f64>,
     /// Initial coordinates, comma-separated (default 0).
@@ -277,7 +278,11 @@ fn option_sources(
         "dt": {"value": opts.dt, "from": from(a.dt.is_some(), file.dt.is_some()),
                "used": opts.solver.fixed_step()},
         "output_dt": {"value": opts.output_dt,
-                      "from": if a.output_dt.is_some() { "command line" } else { "default (t_end / 500)" }},
+                      "from": match (a.output_dt.is_some(), file.output_dt.is_some()) {
+                          (true, _) => "command line",
+                          (false, true) => "model",
+                          (false, false) => "default (t_end / 500)",
+                      }},
         "max_steps": {"value": opts.max_steps,
                       "from": if a.max_steps == SimOptions::default().max_steps { "default" } else { "command line" }},
     })
@@ -305,7 +310,7 @@ fn compare_tip(
         ),
         None => format!("{}: simulated and measured tip", loaded.model.name),
     };
-    compare::plot(&dir.plot("tip")?, &title, tips, m)?;
+    compare::plot(&dir.plot("tip")?, &title, tips, Some(m))?;
     Ok(err)
 }
 
@@ -378,6 +383,12 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     plot_paths_and_contact(&loaded, &kept, &mut dir)?;
     let tip_error = match (&measured, &loaded.model.compare) {
         (Some(m), Some(_)) => compare_tip(&loaded, m, &kept.tips, &mut dir)?,
+        // Every run's tip over time (a run with contact plots its path).
+        _ if arm.contact().is_none() => {
+            let title = format!("{}: tip", loaded.model.name);
+            compare::plot(&dir.plot("tip")?, &title, &kept.tip.points(), None)?;
+            None
+        }
         _ => None,
     };
     let mut summary = crate::run::summary(
@@ -672,7 +683,7 @@ pub struct StaticArgs {
     /// Points per element of the equilibrium's `shape` (0: none).
     #[arg(long, default_value_t = crate::shape::DEFAULT_POINTS)]
     pub shape_points: usize,
-    /// Print JSON (the only format; accepted for scripts).
+    /// Print JSON (every value, for scripts) instead of a table.
     #[arg(long)]
     pub json: bool,
 }
@@ -710,7 +721,10 @@ fn equilibrium(loaded: &mut Loaded, q0: &Option<String>) -> Result<runtime::Stat
 
 pub fn statics(a: StaticArgs) -> Result<ExitCode> {
     let v = static_value(&a)?;
-    println!("{}", serde_json::to_string_pretty(&v)?);
+    match a.json {
+        true => println!("{}", serde_json::to_string_pretty(&v)?),
+        false => super::tables::statics(&v),
+    }
     Ok(ExitCode::SUCCESS)
 }
 
@@ -771,14 +785,17 @@ pub struct ModesArgs {
     /// Also print the mode shapes (generalised coordinates).
     #[arg(long)]
     pub shapes: bool,
-    /// Print JSON (the only format; accepted for scripts).
+    /// Print JSON (every value, for scripts) instead of a table.
     #[arg(long)]
     pub json: bool,
 }
 
 pub fn modes(a: ModesArgs) -> Result<ExitCode> {
     let v = modes_value(&a)?;
-    println!("{}", serde_json::to_string_pretty(&v)?);
+    match a.json {
+        true => println!("{}", serde_json::to_string_pretty(&v)?),
+        false => super::tables::modes(&v),
+    }
     Ok(ExitCode::SUCCESS)
 }
 
@@ -855,7 +872,7 @@ pub struct InspectArgs {
     /// Rates at that configuration (default 0).
     #[arg(long, allow_hyphen_values = true)]
     pub qd: Option<String>,
-    /// Print JSON (the only format; accepted for scripts).
+    /// Print JSON (every value, for scripts) instead of a table.
     #[arg(long)]
     pub json: bool,
 }
@@ -882,7 +899,10 @@ pub fn inspect(a: InspectArgs) -> Result<ExitCode> {
     let mut v = serde_json::to_value(&report)?;
     v["model"] = json!(loaded.model.name);
     v["q"] = json!(q);
-    println!("{}", serde_json::to_string_pretty(&v)?);
+    match a.json {
+        true => println!("{}", serde_json::to_string_pretty(&v)?),
+        false => super::tables::inspect(&v),
+    }
     Ok(ExitCode::SUCCESS)
 }
 

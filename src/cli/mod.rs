@@ -7,6 +7,7 @@ mod animate;
 mod commands;
 mod fit;
 mod sweep;
+mod tables;
 
 use std::process::ExitCode;
 

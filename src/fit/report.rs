@@ -113,7 +113,7 @@ pub fn write(
         &dir.plot("fit")?,
         &title,
         &curves,
-        &measured,
+        Some(&measured),
         validation_window,
     )
 }

@@ -343,3 +343,72 @@ fn a_failed_run_reports_its_rejected_steps_or_says_they_are_unknown() {
         }
     }
 }
+
+/// `[simulate] output_dt` spaces the rows as `--output-dt` does, and the
+/// command line's wins.
+#[test]
+fn the_model_file_sets_the_row_spacing() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows = |extra: &[&str]| {
+        let mut args = vec!["simulate", "double_pendulum", "--t-end", "1", "--set"];
+        args.extend_from_slice(&["simulate.output_dt=0.05", "--out", "o", "--quiet"]);
+        args.extend_from_slice(extra);
+        let out = softarm(&args, dir.path());
+        assert!(out.status.success(), "{}", stderr(&out));
+        let s: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join("o/summary.json")).unwrap(),
+        )
+        .unwrap();
+        let csv = std::fs::read_to_string(dir.path().join("o/trajectory.csv")).unwrap();
+        (
+            csv.lines().count() - 1,
+            s["options"]["output_dt"]["from"].clone(),
+        )
+    };
+    assert_eq!(rows(&[]), (21, serde_json::json!("model")));
+    assert_eq!(
+        rows(&["--output-dt", "0.1"]),
+        (11, serde_json::json!("command line"))
+    );
+}
+
+/// Every run plots its tip against time; a run stopped before its first
+/// step has no time axis and no plot, and still ends.
+#[test]
+fn every_run_plots_its_tip() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = softarm(
+        &[
+            "simulate",
+            "soft_finger",
+            "--t-end",
+            "0.1",
+            "--out",
+            "o",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let png = std::fs::read(dir.path().join("o/tip.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    assert!(dir.path().join("o/tip.svg").exists());
+    let out = softarm(
+        &[
+            "simulate",
+            "soft_finger",
+            "--max-wall",
+            "1e-9",
+            "--out",
+            "s",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert!(!out.status.success(), "a run stopped at once");
+    assert!(
+        dir.path().join("s/summary.json").exists(),
+        "{}",
+        stderr(&out)
+    );
+}

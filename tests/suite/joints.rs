@@ -861,3 +861,86 @@ outer_radius = 0.02
         "energy drift {worst:.3e} J of {scale:.3e} J"
     );
 }
+
+/// In a model of several arms every arm's tip is in trajectory.csv: the
+/// first arm's equals the `Outputs` kernel's tip (a second computation),
+/// and each sits where its weld holds it on the ball, 5 cm to either side
+/// of the ball's centre (falling_ball's arms mirror each other).
+#[test]
+fn every_arms_tip_is_in_the_trajectory() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = softarm(
+        &[
+            "simulate",
+            "falling_ball",
+            "--t-end",
+            "0.3",
+            "--out",
+            "o",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(dir.path().join("o/trajectory.csv")).unwrap();
+    let mut lines = text.lines();
+    let names: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| {
+        names
+            .iter()
+            .position(|c| *c == n)
+            .unwrap_or_else(|| panic!("no column {n} in {names:?}"))
+    };
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert!(rows.len() > 10);
+    for r in &rows {
+        let (bx, by, a) = (r[col("ball.x")], r[col("ball.y")], r[col("ball.angle")]);
+        // The welds' points on the ball: -+5 cm along its turned x axis.
+        let (cx, cy) = (0.05 * a.cos(), 0.05 * a.sin());
+        assert_close(
+            r[col("left.tip_x")],
+            r[col("tip_x")],
+            1e-9,
+            1.0,
+            "left tip x",
+        );
+        assert_close(
+            r[col("left.tip_y")],
+            r[col("tip_y")],
+            1e-9,
+            1.0,
+            "left tip y",
+        );
+        assert_close(
+            r[col("left.tip_x")],
+            bx - cx,
+            1e-5,
+            1.0,
+            "left tip on the ball",
+        );
+        assert_close(
+            r[col("left.tip_y")],
+            by - cy,
+            1e-5,
+            1.0,
+            "left tip on the ball",
+        );
+        assert_close(
+            r[col("right.tip_x")],
+            bx + cx,
+            1e-5,
+            1.0,
+            "right tip on the ball",
+        );
+        assert_close(
+            r[col("right.tip_y")],
+            by + cy,
+            1e-5,
+            1.0,
+            "right tip on the ball",
+        );
+        assert_close(r[col("right.tip_z")], 0.0, 1e-12, 1.0, "in the plane");
+    }
+}

@@ -305,6 +305,47 @@ fn cli_static_and_modes_report_json() {
     assert_eq!(v["shapes"].as_array().unwrap().len(), 10);
 }
 
+/// Without `--json`, `static`, `modes` and `inspect` print tables a person
+/// reads, with the JSON's own values.
+#[test]
+fn cli_static_modes_and_inspect_print_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |args: &[&str]| {
+        let out = softarm(args, dir.path());
+        assert!(out.status.success(), "{}", stderr(&out));
+        stdout(&out)
+    };
+    let table = run(&["static", "cantilever", "--set", "tip.force=[0,-0.05,0]"]);
+    let v: serde_json::Value = serde_json::from_str(&run(&[
+        "static",
+        "cantilever",
+        "--set",
+        "tip.force=[0,-0.05,0]",
+        "--json",
+    ]))
+    .unwrap();
+    let y = format!("y {:.3} mm", 1e3 * v["tip_position"][1].as_f64().unwrap());
+    assert!(table.contains(&y), "{y} in\n{table}");
+    assert!(table.contains("largest coordinates"), "{table}");
+    let table = run(&["modes", "cantilever"]);
+    let v: serde_json::Value =
+        serde_json::from_str(&run(&["modes", "cantilever", "--json"])).unwrap();
+    let f1 = format!("{:>9.3} Hz", v["frequencies_hz"][0].as_f64().unwrap());
+    assert!(table.contains(&f1), "{f1} in\n{table}");
+    assert!(
+        table.lines().filter(|l| l.contains(" Hz ")).count() == 10,
+        "{table}"
+    );
+    let table = run(&["inspect", "stiff_flop"]);
+    let v: serde_json::Value =
+        serde_json::from_str(&run(&["inspect", "stiff_flop", "--json"])).unwrap();
+    let ratio = format!("{:.3e}", v["stiffness_ratio"].as_f64().unwrap());
+    assert!(
+        table.contains(&ratio) && table.contains("recommended solver"),
+        "{table}"
+    );
+}
+
 #[test]
 fn static_failure_names_the_last_converged_load_fraction() {
     // A chain without joint springs has no stiffness: Newton cannot start.

@@ -63,6 +63,7 @@ fn simulate_defaults(ck: &Check) -> Result<(), ModelError> {
         ("simulate.rtol", sim.rtol),
         ("simulate.atol", sim.atol),
         ("simulate.dt", sim.dt),
+        ("simulate.output_dt", sim.output_dt),
     ] {
         if let Some(v) = v {
             ck.positive(key, v)?;

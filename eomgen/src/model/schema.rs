@@ -80,6 +80,8 @@ pub struct SimulateDefaults {
     pub dt: Option<f64>,
     /// generalized-alpha's spectral radius at infinity, in [0, 1].
     pub rho_inf: Option<f64>,
+    /// Spacing of trajectory.csv's rows (s) [default: t_end / 500].
+    pub output_dt: Option<f64>,
     /// Initial state: "rest" (default) or "static" (the equilibrium at t = 0).
     pub start: Option<Start>,
     /// Initial coordinates by name (the rest 0, a free body's from its
