@@ -58,6 +58,8 @@ pub struct Scene {
     pub inputs: BTreeMap<String, Vec<f64>>,
     /// The measured tip (t, x, y, z), if the model has `[compare]`.
     pub measured: Vec<[f64; 4]>,
+    /// Gravity (m/s^2), drawn as an arrow.
+    pub gravity: [f64; 3],
 }
 
 impl Scene {
@@ -98,6 +100,7 @@ impl Scene {
             tip,
             inputs,
             measured,
+            gravity: loaded.model.gravity,
         })
     }
 }

@@ -355,6 +355,9 @@ fn draw_gif(
             label.clone(),
         ))
         .map_err(err)?;
+        clamps(&root, scene, &cam, s, &px).map_err(err)?;
+        let screen = (size.0 as i32, h as i32);
+        scale_and_gravity(&root, scene, &cam, s, screen).map_err(err)?;
         input_bars(&root, scene, k, size).map_err(err)?;
         root.present().map_err(err)?;
         drop(root);
@@ -494,6 +497,93 @@ fn draw_piece<DB: DrawingBackend>(
 /// Input bars: at most this many, each this tall (px).
 const MAX_BARS: usize = 4;
 const BAR: f64 = 22.0;
+
+/// Each arm's clamp: a dark block behind its base (the base frame's -x),
+/// as wide as three tube radii either side.
+fn clamps<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    scene: &Scene,
+    cam: &Camera,
+    scale: f64,
+    px: &dyn Fn([f64; 3]) -> (i32, i32),
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    for part in &scene.parts {
+        let (Look::Tube { radius }, Some(base)) = (&part.look, part.frames.first()) else {
+            continue;
+        };
+        let (r, b) = (radius.first().copied().unwrap_or(0.0), base[0]);
+        let q = [b[3], b[4], b[5], b[6]];
+        let (along, across) = (rotate(q, [1.0, 0.0, 0.0]), rotate(q, [0.0, 1.0, 0.0]));
+        // Across the arm on screen: its y axis, or z where y is edge-on.
+        let across = match cam.project(across) {
+            a if a[0].hypot(a[1]) > 0.3 => across,
+            _ => rotate(q, [0.0, 0.0, 1.0]),
+        };
+        let (d, w) = ((4.0 * r).max(6.0 / scale), (3.0 * r).max(8.0 / scale));
+        let at = |u: f64, v: f64| {
+            let p = [0, 1, 2].map(|c| b[c] + u * along[c] + v * across[c]);
+            px(cam.project(p))
+        };
+        let block = vec![at(0.0, -w), at(0.0, w), at(-d, w), at(-d, -w)];
+        root.draw(&Polygon::new(block, RGBColor(90, 90, 90).filled()))?;
+    }
+    Ok(())
+}
+
+/// A scale bar (a round length near a fifth of the view) at the bottom
+/// right of the scene, and gravity's direction as an arrow at the top
+/// right.
+fn scale_and_gravity<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    scene: &Scene,
+    cam: &Camera,
+    scale: f64,
+    (w, h): (i32, i32),
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let font = ("sans-serif", 14).into_font();
+    let target = 0.2 * w as f64 / scale;
+    let unit = 10f64.powf(target.log10().floor());
+    let length = [5.0, 2.0, 1.0]
+        .map(|m| m * unit)
+        .into_iter()
+        .find(|l| *l <= target)
+        .unwrap_or(unit);
+    let pixels = (length * scale).round() as i32;
+    let (x1, y) = (w - 16, h - 16);
+    let bar = vec![(x1 - pixels, y), (x1, y)];
+    root.draw(&PathElement::new(bar, BLACK.stroke_width(3)))?;
+    for x in [x1 - pixels, x1] {
+        root.draw(&PathElement::new(
+            vec![(x, y - 6), (x, y + 6)],
+            BLACK.stroke_width(2),
+        ))?;
+    }
+    let text = match length {
+        l if l >= 1.0 => format!("{l} m"),
+        l => format!("{} mm", (l * 1e3 * 1e6).round() / 1e6),
+    };
+    root.draw(&Text::new(text, (x1 - pixels, y - 22), font.clone()))?;
+    let g = cam.project(scene.gravity);
+    let norm = g[0].hypot(g[1]);
+    if norm > 1e-9 {
+        let (cx, cy, len) = (w - 40, 40, 24.0);
+        let (dx, dy) = (len * g[0] / norm, -len * g[1] / norm);
+        let tip = (cx + dx as i32, cy + dy as i32);
+        let back = |turn: f64| {
+            let (c, s) = (turn.cos(), turn.sin());
+            let (bx, by) = (-(dx * c - dy * s) * 0.35, -(dx * s + dy * c) * 0.35);
+            (tip.0 + bx as i32, tip.1 + by as i32)
+        };
+        let (from, to) = ((cx - dx as i32, cy - dy as i32), tip);
+        root.draw(&PathElement::new(vec![from, to], BLACK.stroke_width(2)))?;
+        root.draw(&Polygon::new(
+            vec![tip, back(0.5), back(-0.5)],
+            BLACK.filled(),
+        ))?;
+        root.draw(&Text::new("g", (cx + 10, cy - 30), font))?;
+    }
+    Ok(())
+}
 
 /// The inputs at frame k as bars along the bottom, each scaled by its
 /// largest magnitude over the run.

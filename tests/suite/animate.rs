@@ -55,14 +55,16 @@ fn the_gif_has_a_frame_per_step_of_playback_and_the_page_the_runs_tip() {
     let (n, size, colours) = decode(&run.join("animation.gif"));
     assert_eq!((n, size), (21, (480, 480)));
     // The drawing's flat colours arrive exactly through the frame's
-    // palette: the white ground and the tip path's pure red.
-    for c in [[255, 255, 255], [255, 0, 0]] {
+    // palette: the white ground, the tip path's pure red, the clamp's grey
+    // and the black of the scale bar and the gravity arrow.
+    for c in [[255, 255, 255], [255, 0, 0], [90, 90, 90], [0, 0, 0]] {
         assert!(colours.contains(&c), "{c:?} is not in the last frame");
     }
     let page = std::fs::read_to_string(run.join("viewer.html")).unwrap();
     let start = page.find(r#"type="application/json">"#).unwrap() + 24;
     let end = start + page[start..].find("</script>").unwrap();
     let scene: serde_json::Value = serde_json::from_str(&page[start..end]).unwrap();
+    assert_eq!(scene["gravity"], serde_json::json!([0.0, -9.81, 0.0]));
     let traj = Csv::read(&run.join("trajectory.csv")).unwrap();
     let t = traj.column("t").unwrap();
     let tip_x = traj.column("tip_x").unwrap();
