@@ -284,18 +284,7 @@ impl ArmTips {
 
     /// The tips at time t, coordinates q: 3 values an arm.
     pub fn at(&self, arm: &dyn runtime::Dynamics, t: f64, q: &[f64]) -> Vec<f64> {
-        let p = arm.params_at(t);
-        let mut out = vec![0.0; self.tape.tape.outputs.len()];
-        let inp = runtime::Inputs {
-            t,
-            q,
-            qd: &[],
-            qdd: &[],
-            dir: &[],
-            p: &p,
-            aux: &[],
-        };
-        self.tape.tape.eval(&inp, &mut Vec::new(), &mut out);
+        let out = self.tape.eval(t, q, &arm.params_at(t));
         let mut first = 0;
         let mut tips = Vec::with_capacity(3 * self.tape.arms.len());
         for a in &self.tape.arms {

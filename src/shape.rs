@@ -7,8 +7,8 @@
 use anyhow::{Result, bail};
 use eomgen::model::{ParamLayout, Structure};
 use eomgen::shape::{ROW, ShapeTape, shape_tape};
+use runtime::Dynamics;
 use runtime::contact::{self, Obstacle};
-use runtime::{Dynamics, Inputs};
 
 use crate::backend::Loaded;
 
@@ -61,17 +61,7 @@ impl Shape {
     /// The rows at time t, coordinates q.
     pub fn at(&self, arm: &dyn Dynamics, t: f64, q: &[f64]) -> Vec<ShapeRow> {
         let p = arm.params_at(t);
-        let mut out = vec![0.0; self.tape.tape.outputs.len()];
-        let inp = Inputs {
-            t,
-            q,
-            qd: &[],
-            qdd: &[],
-            dir: &[],
-            p: &p,
-            aux: &[],
-        };
-        self.tape.tape.eval(&inp, &mut Vec::new(), &mut out);
+        let out = self.tape.eval(t, q, &p);
         let pose = |k: usize| -> [f64; ROW] { std::array::from_fn(|i| out[k * ROW + i]) };
         let mut rows = Vec::new();
         let mut k = 0;

@@ -42,6 +42,25 @@ pub struct ArmShape {
     pub lengths: Vec<usize>,
 }
 
+impl ShapeTape {
+    /// Its rows at time t, coordinates q, parameters p (`ROW` values a
+    /// row, in `arms` then `bodies` order).
+    pub fn eval(&self, t: f64, q: &[f64], p: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.tape.outputs.len()];
+        let inp = runtime::Inputs {
+            t,
+            q,
+            qd: &[],
+            qdd: &[],
+            dir: &[],
+            p,
+            aux: &[],
+        };
+        self.tape.eval(&inp, &mut Vec::new(), &mut out);
+        out
+    }
+}
+
 impl ArmShape {
     pub fn rows(&self) -> usize {
         1 + self.points * self.lengths.len()

@@ -383,8 +383,9 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
     plot_paths_and_contact(&loaded, &kept, &mut dir)?;
     let tip_error = match (&measured, &loaded.model.compare) {
         (Some(m), Some(_)) => compare_tip(&loaded, m, &kept.tips, &mut dir)?,
-        // Every run's tip over time (a run with contact plots its path).
-        _ if arm.contact().is_none() => {
+        // Every arm's run plots its tip over time (a run with contact
+        // plots its path; bodies alone have their own plots).
+        _ if arm.contact().is_none() && !no_arm(&loaded.model) => {
             let title = format!("{}: tip", loaded.model.name);
             compare::plot(&dir.plot("tip")?, &title, &kept.tip.points(), None)?;
             None
@@ -430,6 +431,11 @@ pub fn simulate(a: SimulateArgs) -> Result<ExitCode> {
         return Ok(stop.map_or(ExitCode::FAILURE, |s| ExitCode::from(s.exit_code())));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// A model of free bodies alone (no tip to plot).
+fn no_arm(model: &eomgen::model::Model) -> bool {
+    model.segments.is_empty() && model.arms.is_empty()
 }
 
 /// A failed run's trajectory and counts, with its message (the joints

@@ -94,6 +94,23 @@ position = ["x", "y", "z"]
 t_end = 1.5
 "#;
 
+/// The finger's true values in the records the tests make.
+const FINGER: [(&str, f64); 3] = [
+    ("segment.0.youngs_modulus", 5.0e6),
+    ("segment.0.bending_damping", 2.0e-5),
+    ("tip.mass", 0.01),
+];
+
+/// The finger's three values free, with bounds.
+const FINGER_FREE: [&str; 6] = [
+    "--free",
+    "segment.0.youngs_modulus=1e5:1e8",
+    "--free",
+    "segment.0.bending_damping=1e-7:1e-3",
+    "--free",
+    "tip.mass=1e-3:0.1",
+];
+
 /// Both models' [compare] section.
 const COMPARE: &str = "[compare]\nfile = \"record.csv\"\nposition = [\"x\", \"y\", \"z\"]\n";
 
@@ -214,11 +231,7 @@ fn assert_recovered(fit: &serde_json::Value, truth: &[(&str, f64)], sigma: f64) 
 #[test]
 fn recovers_a_planar_fingers_stiffness_damping_and_tip_mass() {
     let dir = tempfile::tempdir().unwrap();
-    let truth = [
-        ("segment.0.youngs_modulus", 5.0e6),
-        ("segment.0.bending_damping", 2.0e-5),
-        ("tip.mass", 0.01),
-    ];
+    let truth = FINGER;
     let sigma = 2e-4;
     record(dir.path(), PLANAR, &truth, sigma);
     let start = [truth[0].0, truth[1].0, truth[2].0]
@@ -226,17 +239,7 @@ fn recovers_a_planar_fingers_stiffness_damping_and_tip_mass() {
         .zip([5.25e6, 3.0e-5, 0.011])
         .collect::<Vec<_>>();
     std::fs::write(dir.path().join("model.toml"), model(PLANAR, &start)).unwrap();
-    let fit = fit_json(
-        dir.path(),
-        &[
-            "--free",
-            "segment.0.youngs_modulus=1e5:1e8",
-            "--free",
-            "segment.0.bending_damping=1e-7:1e-3",
-            "--free",
-            "tip.mass=1e-3:0.1",
-        ],
-    );
+    let fit = fit_json(dir.path(), &FINGER_FREE);
     assert_recovered(&fit, &truth, sigma);
     // Checked on another record of the same arm (other noise), which the
     // fit did not see: its error is that record's noise.
@@ -256,16 +259,7 @@ fn recovers_a_planar_fingers_stiffness_damping_and_tip_mass() {
     .unwrap();
     let fit = fit_json(
         dir.path(),
-        &[
-            "--free",
-            "segment.0.youngs_modulus=1e5:1e8",
-            "--free",
-            "segment.0.bending_damping=1e-7:1e-3",
-            "--free",
-            "tip.mass=1e-3:0.1",
-            "--validate",
-            "other.toml",
-        ],
+        &[&FINGER_FREE[..], &["--validate", "other.toml"]].concat(),
     );
     let v = &fit["cost"]["validation"];
     assert_eq!(v["samples"], 151, "{v}");
@@ -330,11 +324,7 @@ fn recovers_a_3d_rods_stiffness_damping_and_load() {
 #[test]
 fn keeps_its_bounds_and_names_a_pair_the_data_cannot_separate() {
     let dir = tempfile::tempdir().unwrap();
-    let truth = [
-        ("segment.0.youngs_modulus", 5.0e6),
-        ("segment.0.bending_damping", 2.0e-5),
-        ("tip.mass", 0.01),
-    ];
+    let truth = FINGER;
     record(dir.path(), PLANAR, &truth, 2e-4);
     let start = [("segment.0.youngs_modulus", 2.0e6), truth[1], truth[2]];
     std::fs::write(dir.path().join("model.toml"), model(PLANAR, &start)).unwrap();
@@ -416,11 +406,7 @@ fn tight() -> RunRequest {
 #[test]
 fn sensitivities_match_central_differences_of_whole_runs() {
     let dir = tempfile::tempdir().unwrap();
-    let truth = [
-        ("segment.0.youngs_modulus", 5.0e6),
-        ("segment.0.bending_damping", 2.0e-5),
-        ("tip.mass", 0.01),
-    ];
+    let truth = FINGER;
     record(dir.path(), PLANAR, &truth, 0.0);
     let file = dir.path().join("model.toml");
     std::fs::write(&file, model(PLANAR, &truth)).unwrap();
@@ -459,11 +445,7 @@ fn sensitivities_on_a_measured_input_match_central_differences() {
 #[test]
 fn refuses_bad_input_and_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let truth = [
-        ("segment.0.youngs_modulus", 5.0e6),
-        ("segment.0.bending_damping", 2.0e-5),
-        ("tip.mass", 0.01),
-    ];
+    let truth = FINGER;
     std::fs::write(dir.path().join("model.toml"), model(PLANAR, &truth)).unwrap();
     std::fs::write(
         dir.path().join("record.csv"),
