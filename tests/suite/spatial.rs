@@ -300,6 +300,7 @@ fn undamped_rom_arm_swinging_with_twist_conserves_energy() {
 }
 
 #[test]
+#[ignore = "long (14 to 24 s, the machine's speed varies): run by .ci/run's long checks"]
 fn undamped_eba_arm_swinging_with_twist_conserves_energy() {
     conserves_energy_swinging_with_twist("eba");
 }
@@ -455,6 +456,7 @@ fn rom_slices_converge_at_fourth_order_to_the_cubic_fields_own_error() {
 }
 
 #[test]
+#[ignore = "long (19 to 33 s, the machine's speed varies): run by .ci/run's long checks"]
 fn eba_converges_to_the_extensible_cosserat_rod_under_a_large_load() {
     // Absolute states with axial and shear springs: the extensible,
     // shearable rod is its limit.
