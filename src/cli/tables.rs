@@ -8,14 +8,15 @@ fn num(v: &Value) -> f64 {
     v.as_f64().unwrap_or(f64::NAN)
 }
 
-/// A coordinate's value with its unit: stretches and a free body's x, y
-/// are lengths, the rest angles.
-fn with_unit(name: &str, v: f64) -> String {
-    let length = name.starts_with("stretch") || name.ends_with(".x") || name.ends_with(".y");
-    match length {
-        true => format!("{:>10.3} mm", 1e3 * v),
-        false => format!("{v:>10.4} rad ({:.2} deg)", v.to_degrees()),
-    }
+/// A coordinate's family: its name without its segment, element or
+/// coefficient indices (`bend_y_0_3` and `bend_y_1_c2` are `bend_y`).
+fn family(name: &str) -> String {
+    let index = |p: &str| {
+        let digits = p.strip_prefix('c').unwrap_or(p);
+        !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit())
+    };
+    let kept: Vec<&str> = name.split('_').filter(|p| !index(p)).collect();
+    kept.join("_")
 }
 
 /// The equilibrium: the tip, how well it holds, the largest coordinates.
@@ -55,13 +56,24 @@ pub fn statics(v: &Value) {
     let (Some(names), Some(q)) = (v["coordinates"].as_array(), v["q"].as_array()) else {
         return;
     };
-    let mut largest: Vec<(&str, f64)> = (names.iter().zip(q))
-        .map(|(n, q)| (n.as_str().unwrap_or("?"), num(q)))
-        .collect();
-    largest.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
-    println!("  largest coordinates (of {}):", largest.len());
-    for (name, q) in largest.iter().take(6) {
-        println!("    {name:<24} {}", with_unit(name, *q));
+    // The largest of each family of coordinates (bend, twist, stretch,
+    // ...): magnitudes compare within a family, whose unit is one.
+    let mut largest: Vec<(String, &str, f64)> = Vec::new();
+    for (n, q) in names.iter().zip(q) {
+        let (name, q) = (n.as_str().unwrap_or("?"), num(q));
+        let f = family(name);
+        match largest.iter_mut().find(|(g, ..)| *g == f) {
+            Some(e) if q.abs() > e.2.abs() => *e = (f, name, q),
+            Some(_) => {}
+            None => largest.push((f, name, q)),
+        }
+    }
+    println!(
+        "  largest coordinate of each kind (of {}; in trajectory.csv's units):",
+        names.len()
+    );
+    for (_, name, q) in &largest {
+        println!("    {name:<24} {q:>12.5e}");
     }
     println!("  (--json: every coordinate, the joints' forces and the shape)");
 }

@@ -140,6 +140,8 @@ pub fn prepare(req: &Request) -> Result<Prepared> {
         req.cache_dir.clone(),
     )?;
     let window = req.window.unwrap_or_else(|| problem.record_window());
+    let m = req.free.len();
+    check_window(&problem, "--window", window, (m + 2).div_ceil(3).max(2))?;
     let (other, same) = match &req.validate {
         None => (None, None),
         Some(Validation::Window(w)) => (None, Some(*w)),
@@ -152,15 +154,37 @@ pub fn prepare(req: &Request) -> Result<Prepared> {
                 req.cache_dir.clone(),
             )?;
             let w = p.record_window();
+            check_window(&p, "--validate", w, 1)?;
             (Some((p, w)), None)
         }
     };
+    if let Some(w) = same {
+        check_window(&problem, "--validate", w, 1)?;
+    }
     Ok(Prepared {
         problem,
         window,
         other,
         same,
     })
+}
+
+/// A window must hold `least` of the record's samples: an empty one
+/// would be fitted trivially, or report an error of nothing.
+fn check_window(p: &Problem, flag: &str, w: [f64; 2], least: usize) -> Result<()> {
+    let n = p.samples_in(w);
+    if n < least {
+        let r = p.record_window();
+        bail!(
+            "{flag} {}:{}: {} has {n} samples there, and needs at least {least}; its record spans {} to {} s",
+            w[0],
+            w[1],
+            p.label(),
+            r[0],
+            r[1]
+        );
+    }
+    Ok(())
 }
 
 impl Prepared {
@@ -255,8 +279,8 @@ pub fn fit(
     // The start and the optimum again, without derivatives, as far as
     // the validation window reaches.
     let end = match validation {
-        Some((p, w)) if std::ptr::eq(p, problem) => window[1].max(w[1]),
-        _ => window[1],
+        Some((p, w)) if std::ptr::eq(p, problem) => problem.end_of(window).max(p.end_of(w)),
+        _ => problem.end_of(window),
     };
     let start_run = problem.evaluate(&theta0, false, end)?;
     let fitted_run = problem.evaluate(&out.theta, false, end)?;
@@ -272,8 +296,8 @@ pub fn fit(
             let (a, b) = match std::ptr::eq(p, problem) {
                 true => (start_run.clone(), fitted_run.clone()),
                 false => (
-                    p.evaluate(&theta0, false, w[1])?,
-                    p.evaluate(&out.theta, false, w[1])?,
+                    p.evaluate(&theta0, false, p.end_of(w))?,
+                    p.evaluate(&out.theta, false, p.end_of(w))?,
                 ),
             };
             Some(Costs {

@@ -42,6 +42,8 @@ pub struct Problem {
     run: RunRequest,
     cache_dir: Option<PathBuf>,
     record: [f64; 2],
+    /// The record's sample times (s).
+    times: Vec<f64>,
 }
 
 /// A run at some values: the simulated and measured tip at the record's
@@ -117,6 +119,12 @@ impl Problem {
             if free[..k].iter().any(|g| g.path == f.path) {
                 bail!("--free {}: given twice", f.path);
             }
+            not_a_value(f)?;
+            // A key the file does not set: an unknown one fails here with
+            // the schema's message (and its suggestion).
+            if Override::value_at(&tree, &f.path).is_none() {
+                check_numeric(spec, &overrides, f, &tree, &base)?;
+            }
             start.push(start_value(&tree, f, &label)?);
             check_numeric(spec, &overrides, f, &tree, &base)?;
         }
@@ -133,6 +141,7 @@ impl Problem {
             run,
             cache_dir,
             record,
+            times: m.t,
         })
     }
 
@@ -164,6 +173,18 @@ impl Problem {
             (_, w) if w.is_finite() => w,
             _ => 1.0,
         }
+    }
+
+    /// The record's samples within `window`.
+    pub fn samples_in(&self, window: [f64; 2]) -> usize {
+        rows_in(&self.times, window).len()
+    }
+
+    /// Where a run for `window` ends: its last sample (a window may reach
+    /// past the record).
+    pub fn end_of(&self, window: [f64; 2]) -> f64 {
+        let last = rows_in(&self.times, window).last().map(|&i| self.times[i]);
+        last.unwrap_or(window[1]).max(0.0)
     }
 
     /// `[compare] window`, else the whole record.
@@ -350,9 +371,8 @@ fn absolute_files(v: &mut toml::Value, base: &std::path::Path) {
     }
 }
 
-/// The start value of a free value: the model's, as written (after the
-/// user's --set), within its bounds.
-fn start_value(tree: &toml::Value, f: &Free, label: &str) -> Result<f64> {
+/// Keys that are not values of the arm or its record are refused.
+fn not_a_value(f: &Free) -> Result<()> {
     let path = &f.path;
     if let Some(key) = NOT_VALUES
         .iter()
@@ -362,6 +382,13 @@ fn start_value(tree: &toml::Value, f: &Free, label: &str) -> Result<f64> {
             "--free {path}: `{key}` is not a value of the arm or its record; fit values such as segment.0.youngs_modulus, segment.0.bending_damping, tip.mass, compare.sensor_offset.0 or inputs.NAME.delay"
         );
     }
+    Ok(())
+}
+
+/// The start value of a free value: the model's, as written (after the
+/// user's --set), within its bounds.
+fn start_value(tree: &toml::Value, f: &Free, label: &str) -> Result<f64> {
+    let path = &f.path;
     let v = match Override::value_at(tree, path) {
         Some(toml::Value::Float(v)) => *v,
         Some(toml::Value::Integer(v)) => *v as f64,
@@ -401,7 +428,7 @@ fn check_numeric(
     let mut all = overrides.to_vec();
     all.push(Override::parse(&format!("{}={near}", f.path))?);
     let (model, _) = crate::backend::read_model(spec, &all)
-        .with_context(|| format!("--free {}: the model does not take a nearby value", f.path))?;
+        .with_context(|| format!("--free {}: the model does not take a value there", f.path))?;
     let hash = eomgen::model::Structure::of(&model).hash();
     if hash != base.hash {
         bail!(

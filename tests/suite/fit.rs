@@ -456,8 +456,8 @@ fn refuses_bad_input_and_writes_nothing() {
     std::fs::write(dir.path().join("plain.toml"), no_compare).unwrap();
     let cases: &[(&[&str], &str)] = &[
         (
-            &["model.toml", "--free", "segment.0.stiffness"],
-            "segment.0.stiffness",
+            &["model.toml", "--free", "segment.0.youngs_modulu"],
+            "did you mean `youngs_modulus`",
         ),
         (
             &["model.toml", "--free", "segment.0.elements"],
@@ -476,10 +476,30 @@ fn refuses_bad_input_and_writes_nothing() {
             "not a value of the arm",
         ),
         (
+            &["model.toml", "--free", "tendon.0.angle"],
+            "--set tendon.0.angle",
+        ),
+        (
             &["model.toml", "--free", "inputs.pull.delay"],
-            "--set inputs.pull.delay",
+            "unknown field `delay`",
         ),
         (&["plain.toml", "--free", "tip.mass"], "no [compare]"),
+        (
+            &["model.toml", "--free", "segment.0.method"],
+            "not a number",
+        ),
+        (
+            &["model.toml", "--free", "tip.mass", "--window", "2:3"],
+            "has 0 samples there",
+        ),
+        (
+            &["model.toml", "--free", "tip.mass", "--validate", "5:9"],
+            "has 0 samples there",
+        ),
+        (
+            &["model.toml", "--free", "tip.mass", "--window", "3:1"],
+            "expected A:B",
+        ),
     ];
     for (args, expected) in cases {
         let mut all = vec!["fit"];
