@@ -224,6 +224,24 @@ fn tapes(model: &Model, hash: &str, dir: &Path) -> (TapeSet, CacheStatus, f64) {
     (tapes, CacheStatus::Miss, derive_s)
 }
 
+/// A viscoelastic model's relaxing groups: each segment with a Prony
+/// series, by its elements' stiffness parameters.
+fn relaxation(model: &Model, layout: &ParamLayout) -> Option<runtime::relaxation::Relaxation> {
+    let groups: Vec<_> = (model.segments.iter().enumerate())
+        .filter(|(_, s)| !s.relaxation.is_empty())
+        .map(|(i, s)| runtime::relaxation::Group {
+            stiffness: eomgen::load::segment_stiffness(layout, model, i),
+            branches: (s.relaxation.iter())
+                .map(|r| runtime::relaxation::Branch {
+                    ratio: r.ratio,
+                    time: r.time,
+                })
+                .collect(),
+        })
+        .collect();
+    (!groups.is_empty()).then_some(runtime::relaxation::Relaxation { groups })
+}
+
 /// Load a model and bind its parameters to the chosen backend.
 pub fn load(
     spec: &str,
@@ -303,6 +321,7 @@ pub fn load(
     let contact = crate::contact::contact_set(&model, &base_dir, arm.info().contact_points)
         .with_context(|| format!("{origin}: contact"))?;
     arm.set_contact(contact);
+    arm.set_relaxation(relaxation(&model, &layout));
     Ok(Loaded {
         model,
         origin,

@@ -180,7 +180,7 @@ fn forces_at(
         set,
         t,
         &x[..n],
-        &x[n..],
+        &x[n..2 * n],
         true,
     ))
 }
@@ -197,7 +197,7 @@ pub fn columns(arm: &dyn runtime::Dynamics, traj: &runtime::Trajectory, i: usize
     }
     let n = arm.dof();
     let x = &traj.x[i];
-    runtime::contact::channel_columns(arm, set, traj.t[i], &x[..n], &x[n..])
+    runtime::contact::channel_columns(arm, set, traj.t[i], &x[..n], &x[n..2 * n])
 }
 
 /// The run's contacts for summary.json: the energy they dissipated, the

@@ -89,7 +89,8 @@ pub fn static_forces(
 pub fn reactions(arm: &dyn Dynamics, t: f64, x: &[f64]) -> Vec<f64> {
     let n = arm.dof();
     let rows = &arm.info().constraints;
-    let lambda = forces(arm, t, &x[..n], &x[n..]).unwrap_or_else(|_| vec![f64::NAN; rows.len()]);
+    let lambda =
+        forces(arm, t, &x[..n], &x[n..2 * n]).unwrap_or_else(|_| vec![f64::NAN; rows.len()]);
     rows.iter()
         .zip(lambda)
         .filter(|(r, _)| column(r).is_some())

@@ -1,9 +1,10 @@
 //! The state-space model of an arm about an equilibrium, for controller
-//! design: with x = (q, qd), u the held input channels and y the tip,
+//! design: with x = (q, qd) (and a viscoelastic arm's relaxed forces,
+//! relaxed at the equilibrium), u the held input channels and y the tip,
 //!
 //!   dx/dt = A dx + B du,   dy = C dx + D du.
 //!
-//! A is the right-hand side's analytic Jacobian (`runtime::rhs_jacobian`,
+//! A is the right-hand side's analytic Jacobian (`runtime::state_jacobian`,
 //! the generated `Jvp` kernel: what the implicit solvers use). B, C and D
 //! are central differences: inputs enter through parameters, which the
 //! kernels take no derivatives in, and the tip's derivative in q is three
@@ -67,20 +68,22 @@ pub fn linearize(
         }
     };
     let n = q0.len();
-    let x0: Vec<f64> = q0
-        .iter()
-        .copied()
+    let z0 = runtime::relaxed_forces::relaxed(&*loaded.arm, 0.0, &q0);
+    let x0: Vec<f64> = (q0.iter().copied())
         .chain(std::iter::repeat_n(0.0, n))
+        .chain(z0)
         .collect();
     let mut ws = Workspace::new(n);
-    let mut a = DMatrix::zeros(2 * n, 2 * n);
-    runtime::rhs_jacobian(&*loaded.arm, &mut ws, 0.0, &x0, &mut a)
+    let mut a = DMatrix::zeros(x0.len(), x0.len());
+    runtime::state_jacobian(&*loaded.arm, &mut ws, 0.0, &x0, &mut a)
         .map_err(|e| anyhow!("{}: {e}", loaded.origin))?;
     let (b, d) = input_columns(loaded, &controls, &u0, &x0, &mut ws)?;
     let c = tip_rows(&*loaded.arm, &x0);
-    let coords = loaded.arm.info().coordinates.clone();
-    let states = (coords.iter().cloned())
-        .chain(coords.iter().map(|c| format!("{c}_dot")))
+    let states = crate::run::Table::names(&*loaded.arm, None)
+        .into_iter()
+        .skip(1)
+        .take(2 * n)
+        .chain(crate::run::relaxed_names(&*loaded.arm))
         .collect();
     Ok(Linearization {
         a,
@@ -100,8 +103,9 @@ fn step_for(v: f64) -> f64 {
     f64::EPSILON.cbrt() * v.abs().max(1.0)
 }
 
-/// B (2n x m) and D (3 x m) by central differences in each input, the
-/// others held at u0; the channels are left at u0.
+/// B (states x m) and D (3 x m) by central differences in each input,
+/// the others held at u0; the channels are left at u0. The relaxed
+/// forces' rates do not depend on the inputs (they enter no stiffness).
 fn input_columns(
     loaded: &mut Loaded,
     controls: &Controls,
@@ -109,9 +113,10 @@ fn input_columns(
     x0: &[f64],
     ws: &mut Workspace,
 ) -> Result<(DMatrix<f64>, DMatrix<f64>)> {
-    let n = x0.len() / 2;
+    let n = loaded.arm.dof();
     let m = u0.len();
-    let (mut b, mut d) = (DMatrix::zeros(2 * n, m), DMatrix::zeros(3, m));
+    let (mut b, mut d) = (DMatrix::zeros(x0.len(), m), DMatrix::zeros(3, m));
+    loaded.arm.set_internal(&x0[2 * n..]);
     let mut qdd = [vec![0.0; n], vec![0.0; n]];
     let mut tip = [[0.0; 3]; 2];
     for j in 0..m {
@@ -120,9 +125,9 @@ fn input_columns(
             let mut u = u0.to_vec();
             u[j] += sign * h;
             controls.hold(&mut *loaded.arm, &u);
-            runtime::accelerations(&*loaded.arm, ws, 0.0, &x0[..n], &x0[n..], &mut qdd[s])
+            runtime::accelerations(&*loaded.arm, ws, 0.0, &x0[..n], &x0[n..2 * n], &mut qdd[s])
                 .map_err(|e| anyhow!("{}: {e}", loaded.origin))?;
-            let o = loaded.arm.outputs(0.0, &x0[..n], &x0[n..]);
+            let o = loaded.arm.outputs(0.0, &x0[..n], &x0[n..2 * n]);
             tip[s] = [o[0], o[1], o[2]];
         }
         for i in 0..n {
@@ -136,19 +141,19 @@ fn input_columns(
     Ok((b, d))
 }
 
-/// C (3 x 2n): the tip's derivative in q (central differences); the tip
-/// does not depend on the rates.
+/// C (3 x states): the tip's derivative in q (central differences); the
+/// tip does not depend on the rates or the relaxed forces.
 fn tip_rows(arm: &dyn Dynamics, x0: &[f64]) -> DMatrix<f64> {
-    let n = x0.len() / 2;
-    let mut c = DMatrix::zeros(3, 2 * n);
+    let n = arm.dof();
+    let mut c = DMatrix::zeros(3, x0.len());
     let mut q = x0[..n].to_vec();
     for j in 0..n {
         let h = step_for(q[j]);
         let q0 = q[j];
         q[j] = q0 + h;
-        let plus = arm.outputs(0.0, &q, &x0[n..]);
+        let plus = arm.outputs(0.0, &q, &x0[n..2 * n]);
         q[j] = q0 - h;
-        let minus = arm.outputs(0.0, &q, &x0[n..]);
+        let minus = arm.outputs(0.0, &q, &x0[n..2 * n]);
         q[j] = q0;
         for i in 0..3 {
             c[(i, j)] = (plus[i] - minus[i]) / (2.0 * h);

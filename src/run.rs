@@ -200,7 +200,13 @@ pub fn initial_state(req: &RunRequest, loaded: &mut Loaded) -> Result<(Vec<f64>,
     }
     // The rates onto the joints too (the coordinates already are).
     crate::joints::assemble(&*loaded.arm, &loaded.origin, &mut q0, &mut qd0)?;
-    Ok((q0.into_iter().chain(qd0).collect(), moved))
+    // A viscoelastic arm's relaxed forces: in equilibrium with q0 (it has
+    // rested there), or none (it was deformed just before t = 0).
+    let z0 = match loaded.model.simulate.start_relaxed.unwrap_or(true) {
+        true => runtime::relaxed_forces::relaxed(&*loaded.arm, 0.0, &q0),
+        false => vec![0.0; loaded.arm.internal_len()],
+    };
+    Ok((q0.into_iter().chain(qd0).chain(z0).collect(), moved))
 }
 
 /// The measured tip of the model's `[compare]` in the model frame (its
@@ -210,7 +216,7 @@ pub fn measured(loaded: &Loaded, x0: &[f64]) -> Result<Option<crate::compare::Me
         return Ok(None);
     };
     let n = loaded.arm.dof();
-    let start = loaded.arm.outputs(0.0, &x0[..n], &x0[n..]);
+    let start = loaded.arm.outputs(0.0, &x0[..n], &x0[n..2 * n]);
     let m = crate::compare::measured(spec, &loaded.base_dir, [start[0], start[1], start[2]])
         .map_err(|e| anyhow!("{}: [compare]: {e:#}", loaded.origin))?;
     Ok(Some(m))
@@ -230,7 +236,7 @@ pub fn tips(loaded: &Loaded, traj: &runtime::Trajectory) -> Vec<(f64, [f64; 3])>
     let n = loaded.arm.dof();
     (traj.t.iter().zip(&traj.x))
         .map(|(t, x)| {
-            let o = loaded.arm.outputs(*t, &x[..n], &x[n..]);
+            let o = loaded.arm.outputs(*t, &x[..n], &x[n..2 * n]);
             (*t, [o[0], o[1], o[2]])
         })
         .collect()
@@ -304,7 +310,8 @@ pub const MAX_OUTPUT_ROWS: usize = 1_000_000;
 /// A run's table, every column of `trajectory.csv` by name: t, the
 /// coordinates, their rates (`<name>_dot`), the outputs
 /// (`runtime::OUTPUT_NAMES`), the joints' forces and moments, the
-/// contacts' forces. Built once for the CLI and Python, so that both have
+/// contacts' forces, each arm's tip, a viscoelastic arm's relaxed forces
+/// (`relaxed<k>.<coordinate>`, branch k: the state a run continues from). Built once for the CLI and Python, so that both have
 /// every column.
 pub struct Table {
     pub names: Vec<String>,
@@ -323,7 +330,7 @@ impl Table {
         let joints = !arm.info().constraints.is_empty();
         let rows = (traj.t.iter().zip(&traj.x).enumerate())
             .map(|(i, (t, x))| {
-                let out = arm.outputs(*t, &x[..n], &x[n..]);
+                let out = arm.outputs(*t, &x[..n], &x[n..2 * n]);
                 let contact = crate::contact::columns(arm, traj, i);
                 let tips = tips.map_or(Vec::new(), |a| a.at(arm, *t, &x[..n]));
                 Self::row(arm, *t, x, &out, joints, &contact, &tips)
@@ -345,6 +352,7 @@ impl Table {
         names.extend(crate::joints::reaction_names(arm));
         names.extend(crate::contact::column_names(arm));
         names.extend(tips.map_or(Vec::new(), ArmTips::names));
+        names.extend(relaxed_names(arm));
         names
     }
 
@@ -361,14 +369,16 @@ impl Table {
         tips: &[f64],
     ) -> Vec<f64> {
         let mut row = Vec::with_capacity(1 + x.len() + outputs.len() + contact.len());
+        let n = arm.dof();
         row.push(t);
-        row.extend_from_slice(x);
+        row.extend_from_slice(&x[..2 * n]);
         row.extend_from_slice(outputs);
         if joints {
             row.extend(crate::joints::reactions(arm, t, x));
         }
         row.extend_from_slice(contact);
         row.extend_from_slice(tips);
+        row.extend_from_slice(&x[2 * n..]);
         row
     }
 
@@ -399,6 +409,17 @@ impl Table {
     }
 }
 
+/// The relaxed forces' columns: `relaxed<k>.<coordinate>` for branch k.
+pub fn relaxed_names(arm: &dyn runtime::Dynamics) -> Vec<String> {
+    let Some(relax) = arm.relaxation() else {
+        return Vec::new();
+    };
+    let coords = &arm.info().coordinates;
+    (0..relax.branches().count())
+        .flat_map(|k| coords.iter().map(move |c| format!("relaxed{k}.{c}")))
+        .collect()
+}
+
 /// What `summary.json` says of a run, for the CLI and Python alike: the
 /// model and its backend, the options, what the solver counted, the tip
 /// error, the joints' drift, the contacts, the failure (if any) and the
@@ -416,8 +437,8 @@ pub fn summary(
     let n = arm.dof();
     let final_state = traj.x.last().cloned().unwrap_or_default();
     let t_final = traj.t.last().copied().unwrap_or(0.0);
-    let tip = if final_state.len() == 2 * n {
-        arm.outputs(t_final, &final_state[..n], &final_state[n..])
+    let tip = if final_state.len() >= 2 * n {
+        arm.outputs(t_final, &final_state[..n], &final_state[n..2 * n])
     } else {
         [f64::NAN; runtime::N_OUTPUTS]
     };

@@ -85,7 +85,7 @@ pub fn size_warning(
 ) -> Option<String> {
     let arm = &*loaded.arm;
     let n = arm.dof();
-    let out = arm.outputs(0.0, &x0[..n], &x0[n..]);
+    let out = arm.outputs(0.0, &x0[..n], &x0[n..2 * n]);
     let contact = crate::contact::column_names(arm).len();
     let joints = !arm.info().constraints.is_empty();
     let tips = ArmTips::of(loaded).map_or(Vec::new(), |a| a.at(arm, 0.0, &x0[..n]));
@@ -192,7 +192,7 @@ impl Writer {
     fn row(&mut self, arm: &dyn Dynamics, row: &runtime::Row<'_>) {
         let n = arm.dof();
         let (t, x) = (row.t, row.x);
-        let out = arm.outputs(t, &x[..n], &x[n..]);
+        let out = arm.outputs(t, &x[..n], &x[n..2 * n]);
         if self.error.is_none() {
             let tips = (self.tips.as_ref()).map_or(Vec::new(), |a| a.at(arm, t, &x[..n]));
             let values = Table::row(arm, t, x, &out, self.joints, row.contact, &tips);

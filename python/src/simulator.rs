@@ -162,8 +162,11 @@ impl Simulator {
 
     /// The outputs (tip, energies, tip orientation) at the current state.
     fn outputs<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        let n = self.x.len() / 2;
-        let o = self.loaded.arm.outputs(self.t, &self.x[..n], &self.x[n..]);
+        let n = self.loaded.arm.dof();
+        let o = self
+            .loaded
+            .arm
+            .outputs(self.t, &self.x[..n], &self.x[n..2 * n]);
         o.to_vec().into_pyarray(py)
     }
 }

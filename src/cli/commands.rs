@@ -460,7 +460,7 @@ fn explained(
     }
     let mut msg = f.to_string();
     // Joints that became dependent during the run, by name.
-    if f.state.len() == 2 * n {
+    if f.state.len() >= 2 * n {
         let rows = runtime::constraints::dependent_rows(arm, f.t_reached, &f.state[..n]);
         for group in rows {
             msg.push_str(&format!(

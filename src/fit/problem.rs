@@ -235,6 +235,13 @@ impl Problem {
             };
             pairs.push((at(1.0)?, at(-1.0)?, delta));
         }
+        let (x0, _) = crate::run::initial_state(&self.run, &mut loaded)?;
+        // A viscoelastic start moves its relaxed forces with the values:
+        // the centred quotient of the perturbed starts.
+        let differenced = match loaded.arm.internal_len() {
+            0 => None,
+            _ => Some(self.start_differences(&mut pairs, &x0)?),
+        };
         let perturbed: Vec<Perturbed> = (pairs.iter())
             .map(|(p, q, d)| Perturbed {
                 plus: &*p.arm,
@@ -242,12 +249,12 @@ impl Problem {
                 delta: *d,
             })
             .collect();
-        let (x0, _) = crate::run::initial_state(&self.run, &mut loaded)?;
         let arm = &*loaded.arm;
         let n = arm.dof();
         let start = self.run.start.or(loaded.model.simulate.start);
-        let s0 = match start {
-            Some(Start::Static) => static_sensitivities(arm, &perturbed, 0.0, &x0[..n])
+        let s0 = match (differenced, start) {
+            (Some(s0), _) => s0,
+            (None, Some(Start::Static)) => static_sensitivities(arm, &perturbed, 0.0, &x0[..n])
                 .map_err(|e| anyhow!("{}: the start's sensitivities: {e}", self.label))?,
             _ => vec![vec![0.0; 2 * n]; m],
         };
@@ -268,7 +275,7 @@ impl Problem {
             forward_sensitivities(arm, &perturbed, 0.0, x0.clone(), s0.clone(), &times, &opts)
                 .map_err(|f| anyhow!("{}: {f}", self.label))?;
         let tip = |a: &dyn Dynamics, t: f64, x: &[f64]| {
-            let o = a.outputs(t, &x[..n], &x[n..]);
+            let o = a.outputs(t, &x[..n], &x[n..2 * n]);
             [o[0], o[1], o[2]]
         };
         // d tip/d value by the centred quotient along (x +- delta s).
@@ -321,6 +328,26 @@ impl Problem {
         })
     }
 
+    /// dx0/d value of each pair (value + delta, value - delta) by the
+    /// centred quotient of their start states.
+    fn start_differences(
+        &self,
+        pairs: &mut [(Loaded, Loaded, f64)],
+        x0: &[f64],
+    ) -> Result<Vec<Vec<f64>>> {
+        (pairs.iter_mut())
+            .map(|(plus, minus, delta)| {
+                let (a, _) = crate::run::initial_state(&self.run, plus)?;
+                let (b, _) = crate::run::initial_state(&self.run, minus)?;
+                debug_assert_eq!(a.len(), x0.len());
+                Ok(a.iter()
+                    .zip(&b)
+                    .map(|(a, b)| (a - b) / (2.0 * *delta))
+                    .collect())
+            })
+            .collect()
+    }
+
     /// d measured/d value at the samples, for values of `[compare]` (the
     /// registration: sensor offset, rotation, scale); zero for the rest.
     fn record_derivatives(
@@ -331,7 +358,7 @@ impl Problem {
         samples: &[usize],
     ) -> Result<Vec<Vec<[f64; 3]>>> {
         let n = loaded.arm.dof();
-        let o = loaded.arm.outputs(0.0, &x0[..n], &x0[n..]);
+        let o = loaded.arm.outputs(0.0, &x0[..n], &x0[n..2 * n]);
         let initial = [o[0], o[1], o[2]];
         let mut d = vec![vec![[0.0; 3]; pairs.len()]; samples.len()];
         for (j, (plus, minus, delta)) in pairs.iter().enumerate() {

@@ -929,6 +929,46 @@ fn shape_and_load_cases() -> Vec<FileCase> {
             r("\"pcc\"", "\"eba\"").replace("elements = 2", "elements = 2\nturn = [0.0, 90.0]"),
             vec!["segment[0].turn", "meet tangent"],
         ),
+        (
+            "relaxation ratio of one",
+            r(
+                "elements = 2",
+                "elements = 2\nrelaxation = [{ ratio = 1.0, time = 0.5 }]",
+            ),
+            vec!["segment[0].relaxation[0].ratio", "between 0 and 1"],
+        ),
+        (
+            "relaxation ratios summing to one",
+            r(
+                "elements = 2",
+                "elements = 2\nrelaxation = [{ ratio = 0.6, time = 0.5 }, { ratio = 0.4, time = 2.0 }]",
+            ),
+            vec!["segment[0].relaxation", "sum below 1"],
+        ),
+        (
+            "relaxation time of zero",
+            r(
+                "elements = 2",
+                "elements = 2\nrelaxation = [{ ratio = 0.3, time = 0.0 }]",
+            ),
+            vec!["segment[0].relaxation[0].time", "positive"],
+        ),
+        (
+            "relaxation without a time",
+            r(
+                "elements = 2",
+                "elements = 2\nrelaxation = [{ ratio = 0.3 }]",
+            ),
+            vec!["time"],
+        ),
+        (
+            "relaxation with contact",
+            r(
+                "elements = 2",
+                "elements = 2\nrelaxation = [{ ratio = 0.3, time = 0.5 }]",
+            ) + "[[obstacle]]\nname = \"floor\"\nshape = \"plane\"\npoint = [0.0, 0.0, -0.5]\nnormal = [0.0, 0.0, 1.0]\n",
+            vec!["segment[0].relaxation", "contact"],
+        ),
     ]
 }
 

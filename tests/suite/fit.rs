@@ -418,6 +418,32 @@ fn sensitivities_match_central_differences_of_whole_runs() {
     }
 }
 
+/// A viscoelastic finger: its relaxation's ratio and time are values like
+/// any other, the relaxed forces states like any other (1e-3, as above).
+#[test]
+fn sensitivities_to_a_relaxation_match_central_differences() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = PLANAR.replace(
+        "bending_damping = B\n",
+        "bending_damping = B\nrelaxation = [{ ratio = 0.3, time = 0.25 }]\n",
+    );
+    let truth = FINGER;
+    record(dir.path(), &text, &truth, 0.0);
+    let file = dir.path().join("model.toml");
+    std::fs::write(&file, model(&text, &truth)).unwrap();
+    let paths = [
+        "segment.0.relaxation.0.ratio",
+        "segment.0.relaxation.0.time",
+        truth[0].0,
+    ];
+    let free = paths.iter().map(|p| Free::parse(p).unwrap()).collect();
+    let p = Problem::new(file.to_str().unwrap(), vec![], free, tight(), None).unwrap();
+    for (path, err) in paths.iter().zip(sensitivity_errors(&p, 1.0)) {
+        eprintln!("{path}: {err:.2e} of the largest derivative");
+        assert!(err < 1e-3, "{path}: {err:e} of the largest derivative");
+    }
+}
+
 /// On STIFF-FLOP's record over 1 s: modulus, damping, tip mass, a
 /// pressure channel's delay and the sensor offset (a value of the record,
 /// not of the arm). The recorded pressures are linear between their

@@ -31,6 +31,7 @@ mod moving_base;
 mod output_dir;
 mod parsers;
 mod pcc;
+mod relaxation;
 mod rest_shape;
 mod rom_slices;
 mod section;

@@ -19,7 +19,7 @@ use crate::model::{Model, ModelError, Override};
 use validate::validate;
 
 pub use validate::MAX_ELEMENTS;
-pub use values::{ElementProps, element_props, parameters};
+pub use values::{ElementProps, element_props, parameters, segment_stiffness};
 
 /// Parse model text (TOML, or JSON when `json`), apply overrides, check.
 pub fn parse_model(

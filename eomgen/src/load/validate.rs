@@ -16,6 +16,7 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
     ck.file_name("name", "a model", &m.name)?;
     if m.is_assembly() {
         super::assembly_check::check_assembly(&ck, |arm| validate_arm(arm, file))?;
+        relaxing_assembly(&ck)?;
         simulate_defaults(&ck)?;
         signals(&ck)?;
     } else {
@@ -23,6 +24,59 @@ pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
     }
     super::load_check::check_loads(&ck)?;
     super::contact_check::check_contact(&ck)
+}
+
+/// A segment's relaxation: each ratio in (0, 1), their sum below 1 (a
+/// positive long-term modulus), each time positive; no contact around
+/// them yet (its runs switch, which carries the coordinates only).
+fn relaxation(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
+    let p = |k: usize, key: &str| format!("segment[{i}].relaxation[{k}].{key}");
+    for (k, r) in s.relaxation.iter().enumerate() {
+        ck.finite(&p(k, "ratio"), r.ratio)?;
+        if !(r.ratio > 0.0 && r.ratio < 1.0) {
+            return ck.err(
+                p(k, "ratio"),
+                format!(
+                    "the share of the modulus that relaxes lies between 0 and 1, got {}",
+                    r.ratio
+                ),
+            );
+        }
+        ck.positive(&p(k, "time"), r.time)?;
+    }
+    let sum: f64 = s.relaxation.iter().map(|r| r.ratio).sum();
+    if sum >= 1.0 {
+        return ck.err(
+            format!("segment[{i}].relaxation"),
+            format!(
+                "the ratios sum to {sum}: they must sum below 1, so that a long-term modulus remains"
+            ),
+        );
+    }
+    if !s.relaxation.is_empty() && ck.m.has_contact() {
+        return ck.err(
+            format!("segment[{i}].relaxation"),
+            "a relaxing arm with contact is not supported yet: the contact's runs carry the \
+             coordinates alone"
+                .into(),
+        );
+    }
+    Ok(())
+}
+
+/// An assembly's arms are elastic: its runs hold joints by projection,
+/// which carries the coordinates alone.
+fn relaxing_assembly(ck: &Check) -> Result<(), ModelError> {
+    for (name, arm) in ck.m.arm_models() {
+        if let Some(i) = arm.segments.iter().position(|s| !s.relaxation.is_empty()) {
+            return ck.err(
+                format!("arm.{name}.segment[{i}].relaxation"),
+                "viscoelastic arms in an assembly are not supported yet: declare the arm alone"
+                    .into(),
+            );
+        }
+    }
+    Ok(())
 }
 
 /// The checks of one arm (a single-arm file, or an assembly's arm).
@@ -34,6 +88,7 @@ fn validate_arm(m: &Model, file: &str) -> Result<(), ModelError> {
         segment_section(&ck, i, s)?;
         segment_dimension_keys(&ck, i, s)?;
         crate::method::check_segment(&ck, i, s)?;
+        relaxation(&ck, i, s)?;
     }
     tip(&ck)?;
     driven_loads_and_chambers(&ck)?;

@@ -168,6 +168,30 @@ pub fn parameters(m: &Model) -> Vec<(String, f64)> {
     layout.names().into_iter().zip(layout.values(m)).collect()
 }
 
+/// The slots of segment `segment`'s stiffnesses (bending, twist,
+/// stretch, shear): what a viscoelastic segment relaxes.
+pub fn segment_stiffness(layout: &ParamLayout, m: &Model, segment: usize) -> Vec<usize> {
+    let first: usize = m.segments[..segment].iter().map(|s| s.slices()).sum();
+    let elements = first..first + m.segments[segment].slices();
+    (layout.params().iter().enumerate())
+        .filter(|(_, p)| match p {
+            Param::Element(k, e) => {
+                elements.contains(k)
+                    && matches!(
+                        e,
+                        ElementParam::BendStiffness
+                            | ElementParam::BendStiffnessY
+                            | ElementParam::TwistStiffness
+                            | ElementParam::StretchStiffness
+                            | ElementParam::ShearStiffness
+                    )
+            }
+            _ => false,
+        })
+        .map(|(i, _)| i)
+        .collect()
+}
+
 /// Per-element physical quantities, from the declared segment.
 #[derive(Clone, Copy, Debug)]
 pub struct ElementProps {

@@ -14,6 +14,7 @@ mod methods;
 mod overrides;
 mod params;
 mod profile;
+mod relaxation;
 mod rest;
 mod schema;
 mod section;
@@ -34,6 +35,7 @@ pub use params::{
 };
 pub(crate) use params::{base_quaternion, chamber_value};
 pub use profile::Profile;
+pub use relaxation::Relaxation;
 pub use rest::RestCurvature;
 pub use schema::{
     Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, SimulateDefaults, Start,

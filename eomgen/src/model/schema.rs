@@ -84,6 +84,9 @@ pub struct SimulateDefaults {
     pub output_dt: Option<f64>,
     /// Initial state: "rest" (default) or "static" (the equilibrium at t = 0).
     pub start: Option<Start>,
+    /// Whether a viscoelastic arm starts relaxed at its start shape (it has
+    /// rested there; default) or not (it was deformed just before t = 0).
+    pub start_relaxed: Option<bool>,
     /// Initial coordinates by name (the rest 0, a free body's from its
     /// `position` and `angle`); `--q0` replaces them all.
     #[serde(default)]
@@ -274,6 +277,10 @@ pub struct Segment {
     /// default 4 (order + 1)).
     #[serde(default)]
     pub quadrature: Option<usize>,
+    /// A viscoelastic material: its Prony series (`model::relaxation`);
+    /// empty: elastic.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub relaxation: Vec<super::relaxation::Relaxation>,
 }
 
 /// A segment's answers from its keys alone; those its method decides

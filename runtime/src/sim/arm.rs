@@ -93,6 +93,28 @@ pub trait Dynamics {
     }
     /// Give the system its contacts (replacing any).
     fn set_contact(&mut self, _contact: Option<crate::contact::ContactSet>) {}
+    /// Its viscoelastic groups (none by default: elastic).
+    fn relaxation(&self) -> Option<&crate::relaxation::Relaxation> {
+        None
+    }
+    /// Give the system its viscoelastic groups (replacing any).
+    fn set_relaxation(&mut self, _relaxation: Option<crate::relaxation::Relaxation>) {}
+    /// Extra first-order states after [q, qd]: the relaxed forces.
+    fn internal_len(&self) -> usize {
+        self.relaxation().map_or(0, |r| r.states(self.dof()))
+    }
+    /// The relaxed forces the next accelerations take (`internal_len`
+    /// values; ignored by an elastic system).
+    fn set_internal(&self, _z: &[f64]) {}
+    /// Add the relaxed forces' sum to the generalised force `out`; false
+    /// (and `out` untouched) for an elastic system.
+    fn add_internal_force(&self, _out: &mut [f64]) -> bool {
+        false
+    }
+    /// The elastic force of relaxing group g alone at (t, q).
+    fn group_force(&self, _t: f64, _q: &[f64], _g: usize, _out: &mut [f64]) {}
+    /// Its tangent stiffness (row-major n x n).
+    fn group_stiffness(&self, _t: f64, _q: &[f64], _g: usize, _out: &mut [f64]) {}
 }
 
 /// Why the accelerations could not be computed.
@@ -125,6 +147,11 @@ pub struct Arm<K> {
     live: RefCell<Vec<f64>>,
     /// Contact forces on the right-hand side (`crate::contact`).
     contact: Option<crate::contact::ContactSet>,
+    /// Viscoelastic groups, each with its parameters (base then derived)
+    /// without the group's stiffnesses.
+    relax: Option<(crate::relaxation::Relaxation, Vec<Vec<f64>>)>,
+    /// The relaxed forces of the last `set_internal`.
+    internal: RefCell<Vec<f64>>,
 }
 
 impl<K: Kernels> Arm<K> {
@@ -147,6 +174,78 @@ impl<K: Kernels> Arm<K> {
             drives: Vec::new(),
             live: RefCell::new(Vec::new()),
             contact: None,
+            relax: None,
+            internal: RefCell::new(Vec::new()),
+        }
+    }
+
+    /// Each relaxing group's parameters without its stiffnesses.
+    fn group_params(&self) -> Option<(crate::relaxation::Relaxation, Vec<Vec<f64>>)> {
+        let (relax, _) = self.relax.as_ref()?;
+        let n = self.kernels.info().parameters.len();
+        let without = (0..relax.groups.len())
+            .map(|g| {
+                let base = relax.without(g, &self.params[..n]);
+                let derived = derived_params(&self.kernels, &base);
+                base.into_iter().chain(derived).collect()
+            })
+            .collect();
+        Some((relax.clone(), without))
+    }
+
+    /// `f` on group g's parameters without its stiffnesses at time t
+    /// (driven ones from their signals).
+    fn with_group_params<R>(&self, g: usize, t: f64, f: impl FnOnce(&[f64]) -> R) -> R {
+        let (_, without) = self.relax.as_ref().expect("a relaxing group");
+        if self.drives.is_empty() {
+            return f(&without[g]);
+        }
+        let mut p = without[g].clone();
+        for d in &self.drives {
+            p[d.param] = d.signal.at(t);
+        }
+        f(&p)
+    }
+
+    /// h(q, 0) at parameters `p` into `out`.
+    fn static_bias_at(&self, p: &[f64], t: f64, q: &[f64], out: &mut [f64]) {
+        let n = q.len();
+        let zeros = vec![0.0; n];
+        let mut packed = vec![0.0; KernelKind::MassBias.output_len(self.kernels.info())];
+        let inp = Inputs {
+            t,
+            q,
+            qd: &zeros,
+            qdd: &[],
+            dir: &[],
+            p,
+            aux: &[],
+        };
+        self.kernels.eval(KernelKind::MassBias, &inp, &mut packed);
+        out.copy_from_slice(&packed[n * (n + 1) / 2..]);
+    }
+
+    /// d h(q, 0)/dq at parameters `p` (row-major) into `out`.
+    fn stiffness_at(&self, p: &[f64], t: f64, q: &[f64], out: &mut [f64]) {
+        let n = q.len();
+        let zeros = vec![0.0; n];
+        let (mut dir, mut col) = (vec![0.0; 2 * n], vec![0.0; n]);
+        for j in 0..n {
+            dir[j] = 1.0;
+            let inp = Inputs {
+                t,
+                q,
+                qd: &zeros,
+                qdd: &zeros,
+                dir: &dir,
+                p,
+                aux: &[],
+            };
+            self.kernels.eval(KernelKind::Jvp, &inp, &mut col);
+            dir[j] = 0.0;
+            for i in 0..n {
+                out[i * n + j] = col[i];
+            }
         }
     }
 
@@ -349,6 +448,47 @@ impl<K: Kernels> Dynamics for Arm<K> {
     fn set_contact(&mut self, contact: Option<crate::contact::ContactSet>) {
         self.contact = contact;
     }
+    fn relaxation(&self) -> Option<&crate::relaxation::Relaxation> {
+        self.relax.as_ref().map(|(r, _)| r)
+    }
+    fn set_relaxation(&mut self, relaxation: Option<crate::relaxation::Relaxation>) {
+        self.relax = relaxation.map(|r| (r, Vec::new()));
+        self.relax = self.group_params();
+        self.internal.borrow_mut().clear();
+    }
+    fn set_internal(&self, z: &[f64]) {
+        let mut internal = self.internal.borrow_mut();
+        internal.clear();
+        internal.extend_from_slice(z);
+    }
+    fn add_internal_force(&self, out: &mut [f64]) -> bool {
+        let internal = self.internal.borrow();
+        if self.relax.is_none() || internal.is_empty() {
+            return false;
+        }
+        for branch in internal.chunks(out.len()) {
+            for (o, r) in out.iter_mut().zip(branch) {
+                *o += r;
+            }
+        }
+        true
+    }
+    fn group_force(&self, t: f64, q: &[f64], g: usize, out: &mut [f64]) {
+        let mut without = vec![0.0; q.len()];
+        self.with_params(t, |p| self.static_bias_at(p, t, q, out));
+        self.with_group_params(g, t, |p| self.static_bias_at(p, t, q, &mut without));
+        for (o, w) in out.iter_mut().zip(&without) {
+            *o -= w;
+        }
+    }
+    fn group_stiffness(&self, t: f64, q: &[f64], g: usize, out: &mut [f64]) {
+        let mut without = vec![0.0; out.len()];
+        self.with_params(t, |p| self.stiffness_at(p, t, q, out));
+        self.with_group_params(g, t, |p| self.stiffness_at(p, t, q, &mut without));
+        for (o, w) in out.iter_mut().zip(&without) {
+            *o -= w;
+        }
+    }
     fn base_params(&self) -> &[f64] {
         &self.params[..self.kernels.info().parameters.len()]
     }
@@ -361,6 +501,7 @@ impl<K: Kernels> Dynamics for Arm<K> {
         self.params[..n].copy_from_slice(params);
         self.params[n..].copy_from_slice(&derived);
         self.live.borrow_mut().clear();
+        self.relax = self.group_params();
     }
     fn set_drive_signal(&mut self, k: usize, signal: crate::signal::Signal) {
         self.drives[k].signal = signal;
@@ -440,7 +581,7 @@ pub fn accelerations<D: Dynamics + ?Sized>(
         qdd.copy_from_slice(&ws.accel[..n]);
         let (pivots, rest) = ws.accel[n..].split_at(n);
         let (lower, points) = rest.split_at(n * n.saturating_sub(1) / 2);
-        if crate::contact::generalised_force_at(d, t, q, qd, Some(points), &mut ws.contact) {
+        if applied_force(d, t, q, qd, Some(points), &mut ws.contact) {
             solve_unit_ldl(lower, pivots, &mut ws.contact);
             for (a, x) in qdd.iter_mut().zip(&ws.contact) {
                 *a += x;
@@ -450,7 +591,7 @@ pub fn accelerations<D: Dynamics + ?Sized>(
         pivots.iter().all(|&p| p > 0.0)
     } else {
         // Contact forces that push make the right-hand side M^-1 (Q_c - h).
-        let contact = crate::contact::generalised_force_at(d, t, q, qd, None, &mut ws.contact);
+        let contact = applied_force(d, t, q, qd, None, &mut ws.contact);
         let direct = match contact || rows > 0 {
             true => None,
             false => d.direct_accelerations(t, q, qd, qdd),
@@ -485,6 +626,27 @@ pub fn accelerations<D: Dynamics + ?Sized>(
         return Err(diagnose(d, t, q, qd));
     }
     Ok(())
+}
+
+/// The generalised forces beyond h into `out`: contact forces that push
+/// and a viscoelastic arm's relaxed forces; false when there are none
+/// (`out` then unspecified).
+fn applied_force<D: Dynamics + ?Sized>(
+    d: &D,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    points: Option<&[f64]>,
+    out: &mut [f64],
+) -> bool {
+    let contact = crate::contact::generalised_force_at(d, t, q, qd, points, out);
+    if d.internal_len() == 0 {
+        return contact;
+    }
+    if !contact {
+        out.fill(0.0);
+    }
+    d.add_internal_force(out) || contact
 }
 
 /// Solve L D L^T x = b in place, L unit lower triangular given below its

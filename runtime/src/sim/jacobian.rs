@@ -12,7 +12,38 @@ use nalgebra::DMatrix;
 
 use crate::arm::{AccelError, Dynamics, Workspace, accelerations};
 
-/// J (2n x 2n) at t, x = [q, qd]; also returns qdd.
+/// J of the whole state at t, x = [q, qd] and a viscoelastic arm's
+/// relaxed forces z (`crate::relaxation`, whose rows and columns it adds);
+/// also returns qdd.
+pub fn state_jacobian<D: Dynamics + ?Sized>(
+    d: &D,
+    ws: &mut Workspace,
+    t: f64,
+    x: &[f64],
+    jac: &mut DMatrix<f64>,
+) -> Result<Vec<f64>, AccelError> {
+    let n = d.dof();
+    if d.internal_len() == 0 {
+        return rhs_jacobian(d, ws, t, x, jac);
+    }
+    d.set_internal(&x[2 * n..2 * n + d.internal_len()]);
+    let mut top = DMatrix::zeros(2 * n, 2 * n);
+    let qdd = rhs_jacobian(d, ws, t, &x[..2 * n], &mut top)?;
+    jac.fill(0.0);
+    jac.view_mut((0, 0), (2 * n, 2 * n)).copy_from(&top);
+    let mut m = DMatrix::zeros(n, n);
+    d.mass(t, &x[..n], &mut m);
+    let m_inv = m.cholesky().ok_or(AccelError::SingularMass {
+        t,
+        condition: f64::INFINITY,
+    })?;
+    let m_inv = m_inv.inverse();
+    crate::relaxed_forces::fill_jacobian(d, t, &x[..n], &m_inv, jac);
+    Ok(qdd)
+}
+
+/// J (2n x 2n) at t, x = [q, qd] (a viscoelastic arm's relaxed forces as
+/// last set); also returns qdd.
 pub fn rhs_jacobian<D: Dynamics + ?Sized>(
     d: &D,
     ws: &mut Workspace,

@@ -11,6 +11,8 @@ pub mod cosserat;
 pub mod integrate;
 pub mod jacobian;
 pub mod modes;
+pub mod relaxation;
+pub mod relaxed_forces;
 pub mod signal;
 pub mod statics;
 pub mod stiffness;
@@ -21,7 +23,7 @@ pub use integrate::{
     ContactMeter, DEFAULT_SAMPLES, DEFAULT_T_END, INTERRUPTED, Interrupt, MeterSample, Row,
     RowSink, SimFailure, SimOptions, SimStats, SwitchRecord, Trajectory, simulate,
 };
-pub use jacobian::rhs_jacobian;
+pub use jacobian::{rhs_jacobian, state_jacobian};
 pub use modes::{Modes, ModesError, modes};
 pub use signal::{Drive, Signal, Table};
 pub use statics::{StaticError, StaticOptions, StaticSolution, solve_static};

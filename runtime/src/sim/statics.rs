@@ -164,17 +164,22 @@ fn newton(d: &dyn Dynamics, z: &mut [f64], opts: &StaticOptions) -> Result<(usiz
     ))
 }
 
-/// Static equilibrium at the model's full load, from `q0`. The model's
-/// parameters are left as they were.
+/// Static equilibrium at the model's full load, from `q0` (a viscoelastic
+/// arm's at its long-term moduli). The model's parameters are left as
+/// they were.
 pub fn solve_static(
     d: &mut dyn Dynamics,
     q0: &[f64],
     opts: &StaticOptions,
 ) -> Result<StaticSolution, StaticError> {
     let base = d.base_params().to_vec();
+    // A viscoelastic arm held at rest has relaxed: its long-term moduli.
+    let long_term = d
+        .relaxation()
+        .map_or_else(|| base.clone(), |r| r.long_term(&base));
     let loads = d.info().loads.clone();
     let scaled = |lambda: f64| {
-        let mut p = base.clone();
+        let mut p = long_term.clone();
         for &i in &loads {
             p[i] *= lambda;
         }
@@ -230,10 +235,13 @@ pub fn solve_static(
         let _ = last_reason;
         Ok(())
     })();
+    let mut g = vec![0.0; q.len()];
+    if result.is_ok() {
+        d.set_base_params(&long_term);
+        residual(d, &q, &mut g);
+    }
     d.set_base_params(&base);
     result?;
-    let mut g = vec![0.0; q.len()];
-    residual(d, &q, &mut g);
     let lambda = q.split_off(n);
     Ok(StaticSolution {
         residual: inf_norm(&g),

@@ -141,7 +141,7 @@ pub fn accelerations(l: &softarm::backend::Loaded, t: f64, q: &[f64], qd: &[f64]
 pub fn energy_drift(arm: &dyn runtime::Dynamics, traj: &runtime::Trajectory) -> f64 {
     let n = arm.dof();
     let energy = |x: &[f64]| {
-        let o = arm.outputs(0.0, &x[..n], &x[n..]);
+        let o = arm.outputs(0.0, &x[..n], &x[n..2 * n]);
         (o[3], o[3] + o[4])
     };
     let e0 = energy(&traj.x[0]).1;

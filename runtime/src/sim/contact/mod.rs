@@ -1095,7 +1095,7 @@ pub fn record_columns<D: Dynamics + ?Sized>(
     let n = d.dof();
     traj.contact.truncate(from);
     for (t, x) in traj.t[from..].iter().zip(&traj.x[from..]) {
-        let c = channel_columns(d, set, *t, &x[..n], &x[n..]);
+        let c = channel_columns(d, set, *t, &x[..n], &x[n..2 * n]);
         traj.contact.push(c);
     }
 }

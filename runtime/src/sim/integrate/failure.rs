@@ -56,7 +56,7 @@ pub(super) fn finish<D: Dynamics + ?Sized, Y: StateVec>(
     } = recorded;
     let hits = kept.events.clone();
     let wall_s = start.elapsed().as_secs_f64();
-    let m = 2 * ode.n;
+    let m = ode.len;
     let stats_of = |steps: usize, rejected: Option<usize>| SimStats {
         solver: opts.solver,
         steps,

@@ -57,13 +57,37 @@ pub fn simulate(
     opts: &SimOptions,
 ) -> Result<(Trajectory, SimStats), Box<SimFailure>> {
     let n = arm.dof();
-    assert_eq!(x0.len(), 2 * n, "state must be [q, qd]");
+    let internal = arm.internal_len();
+    assert!(
+        x0.len() == 2 * n || x0.len() == 2 * n + internal,
+        "state must be [q, qd], or with a viscoelastic arm's relaxed forces"
+    );
+    // A viscoelastic arm given [q, qd] starts relaxed at q0.
+    let mut x0 = x0;
+    if x0.len() < 2 * n + internal {
+        let z0 = crate::relaxed_forces::relaxed(arm, opts.t0, &x0[..n]);
+        x0.extend(z0);
+    }
+    arm.set_internal(&x0[2 * n..]);
+    if internal > 0 && opts.solver == Solver::GenAlpha {
+        return Err(Box::new(SimFailure {
+            t_reached: opts.t0,
+            last_step_s: None,
+            reason: "generalized-alpha integrates the second-order form M qdd + h = 0; a \
+                     viscoelastic arm's relaxing forces are first-order states"
+                .into(),
+            suggestion: "use --solver radau5 (or auto, which takes it for stiff arms)".into(),
+            state: x0,
+            trajectory: Trajectory::default(),
+            stats: SimStats::none(opts.solver),
+        }));
+    }
     // A start whose accelerations cannot be computed fails now, with the
     // reason, rather than after a solver has shrunk its step to nothing.
     let mut qdd = vec![0.0; n];
     let mut ws = crate::arm::Workspace::new(n);
     let t0 = opts.t0;
-    if let Err(e) = crate::arm::accelerations(arm, &mut ws, t0, &x0[..n], &x0[n..], &mut qdd) {
+    if let Err(e) = crate::arm::accelerations(arm, &mut ws, t0, &x0[..n], &x0[n..2 * n], &mut qdd) {
         return Err(Box::new(SimFailure {
             t_reached: t0,
             last_step_s: None,

@@ -1,5 +1,7 @@
-//! An arm as the first-order system x' = f(t, x), x = [q, qd], with its
-//! analytic Jacobian; the first failure of either is kept for the report.
+//! An arm as the first-order system x' = f(t, x), x = [q, qd] (and a
+//! viscoelastic arm's relaxed forces z after them, `crate::relaxation`),
+//! with its analytic Jacobian; the first failure of either is kept for
+//! the report.
 
 use std::cell::{Cell, RefCell};
 
@@ -9,16 +11,18 @@ use nalgebra::DMatrix;
 use super::state::StateVec;
 use super::stepper::OdeSystem;
 use crate::arm::{AccelError, Dynamics, Workspace, accelerations};
-use crate::jacobian::rhs_jacobian;
+use crate::jacobian::state_jacobian;
 
 /// (power, depth) of the contacts at (t, x).
 pub(super) type MeterFn<'a> = dyn Fn(f64, &[f64]) -> super::outcome::MeterSample + 'a;
 
-/// The first-order system x' = f(t, x) of an arm; components past 2 n are
-/// padding.
+/// The first-order system x' = f(t, x) of an arm; components past `len`
+/// are padding.
 pub(super) struct ArmOde<'a, D: ?Sized> {
     arm: &'a D,
     pub(super) n: usize,
+    /// The state's length: 2 n, and the relaxed forces.
+    pub(super) len: usize,
     ws: RefCell<Workspace>,
     qdd: RefCell<Vec<f64>>,
     pub(super) evals: Cell<usize>,
@@ -35,15 +39,17 @@ pub(super) struct ArmOde<'a, D: ?Sized> {
 impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
     pub(super) fn new(arm: &'a D) -> Self {
         let n = arm.dof();
+        let len = 2 * n + arm.internal_len();
         Self {
             arm,
             n,
+            len,
             ws: RefCell::new(Workspace::new(n)),
             qdd: RefCell::new(vec![0.0; n]),
             evals: Cell::new(0),
             jac_evals: Cell::new(0),
             rejected: Cell::new(None),
-            jac: RefCell::new(DMatrix::zeros(2 * n, 2 * n)),
+            jac: RefCell::new(DMatrix::zeros(len, len)),
             first_error: RefCell::new(None),
             failed_in_step: Cell::new(false),
         }
@@ -73,11 +79,15 @@ impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
 
     fn rhs(&self, t: f64, x: &[f64], dx: &mut [f64]) {
         self.evals.set(self.evals.get() + 1);
-        let n = self.n;
+        let (n, len) = (self.n, self.len);
         let (q, rest) = x.split_at(n);
-        let qd = &rest[..n];
+        let (qd, z) = (&rest[..n], &rest[n..len - n]);
         dx[..n].copy_from_slice(qd);
         dx[2 * n..].fill(0.0);
+        if len > 2 * n {
+            self.arm.set_internal(z);
+            crate::relaxed_forces::rates(self.arm, t, q, z, &mut dx[2 * n..len]);
+        }
         let mut qdd = self.qdd.borrow_mut();
         match accelerations(self.arm, &mut self.ws.borrow_mut(), t, q, qd, &mut qdd) {
             Ok(()) => dx[n..2 * n].copy_from_slice(&qdd),
@@ -94,7 +104,7 @@ impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
     /// The Jacobian of the unpadded system into `j` (NaN if it fails).
     fn jacobian_dense(&self, t: f64, x: &[f64], j: &mut DMatrix<f64>) {
         self.jac_evals.set(self.jac_evals.get() + 1);
-        if let Err(e) = rhs_jacobian(self.arm, &mut self.ws.borrow_mut(), t, x, j) {
+        if let Err(e) = state_jacobian(self.arm, &mut self.ws.borrow_mut(), t, x, j) {
             self.first_error.borrow_mut().get_or_insert(e);
             j.fill(f64::NAN);
         }
@@ -102,9 +112,9 @@ impl<'a, D: Dynamics + ?Sized> ArmOde<'a, D> {
 
     fn jacobian_into(&self, t: f64, x: &[f64], j: &mut Matrix<f64>) {
         self.jac_evals.set(self.jac_evals.get() + 1);
-        let m = 2 * self.n;
+        let m = self.len;
         let mut jac = self.jac.borrow_mut();
-        let ok = match rhs_jacobian(self.arm, &mut self.ws.borrow_mut(), t, &x[..m], &mut jac) {
+        let ok = match state_jacobian(self.arm, &mut self.ws.borrow_mut(), t, &x[..m], &mut jac) {
             Ok(_) => true,
             Err(e) => {
                 self.first_error.borrow_mut().get_or_insert(e);

@@ -61,28 +61,46 @@ pub(super) struct Recorder<'a> {
 
 pub(super) type Watch<'a> = dyn Fn(&[f64], f64) -> Option<String> + 'a;
 
+/// Samples a streamed run hands over at once at most: a long step over
+/// many output times (radau5 takes a second at a time on a damped arm)
+/// does not gather them all first.
+const STREAM_BATCH: usize = 256;
+
 impl Recorder<'_> {
     fn keep<Y: StateVec>(&self, solution: &mut Solution<f64, Y>) {
-        let mut kept = self.kept.borrow_mut();
+        keep(&self.kept, &self.rows, self.m, solution);
+    }
+}
+
+/// The new samples of `solution` into `kept`, or handed over to the row
+/// sink of a streamed run.
+fn keep<Y: StateVec>(
+    kept: &RefCell<Trajectory>,
+    rows: &Option<(super::rows::RowSink, &dyn crate::arm::Dynamics)>,
+    m: usize,
+    solution: &mut Solution<f64, Y>,
+) {
+    {
+        let mut kept = kept.borrow_mut();
         // Streamed: every sample but the last goes; the last stays in the
         // solution (the crate's even sampler replaces it when it lands
         // within rounding of the end) and in `kept`, to go at the run's end.
-        if let Some((sink, arm)) = &self.rows {
+        if let Some((sink, arm)) = rows {
             let Some(last) = solution.t.len().checked_sub(1) else {
                 return;
             };
             for (t, y) in solution.t.iter().zip(&solution.y).take(last) {
-                sink.push(*arm, *t, &y.as_ref()[..self.m]);
+                sink.push(*arm, *t, &y.as_ref()[..m]);
             }
             solution.t.drain(..last);
             solution.y.drain(..last);
             kept.t = vec![solution.t[0]];
-            kept.x = vec![solution.y[0].as_ref()[..self.m].to_vec()];
+            kept.x = vec![solution.y[0].as_ref()[..m].to_vec()];
             return;
         }
         for k in kept.t.len()..solution.t.len() {
             kept.t.push(solution.t[k]);
-            kept.x.push(solution.y[k].as_ref()[..self.m].to_vec());
+            kept.x.push(solution.y[k].as_ref()[..m].to_vec());
         }
     }
 }
@@ -135,18 +153,37 @@ impl<Y: StateVec> Solout<f64, Y> for Recorder<'_> {
             interpolator,
             self.contact.as_deref(),
         );
+        let (kept, rows, m) = (self.kept, &self.rows, self.m);
+        let mut flush = |s: &mut Solution<f64, Y>| {
+            if rows.is_some() && s.t.len() >= STREAM_BATCH {
+                keep(kept, rows, m, s);
+            }
+        };
         if let Some((t_event, y_event)) = hit {
-            self.sampler
-                .sample(t_event, t_prev, &y_event, y_prev, interpolator, solution);
+            self.sampler.sample(
+                t_event,
+                t_prev,
+                &y_event,
+                y_prev,
+                interpolator,
+                solution,
+                &mut flush,
+            );
             if solution.t.last() != Some(&t_event) {
                 solution.push(t_event, y_event);
             }
             self.keep(&mut *solution);
             return ControlFlag::Terminate;
         }
-        let flag = self
-            .sampler
-            .sample(t_curr, t_prev, y_curr, y_prev, interpolator, solution);
+        let flag = self.sampler.sample(
+            t_curr,
+            t_prev,
+            y_curr,
+            y_prev,
+            interpolator,
+            solution,
+            &mut flush,
+        );
         self.sampler.at_end(t_curr, y_curr, self.t_end, solution);
         self.keep(&mut *solution);
         self.calls += 1;
@@ -197,7 +234,9 @@ impl Sampler {
         }
     }
 
-    /// The samples in [t_prev, t_curr] not taken yet, into `solution`.
+    /// The samples in [t_prev, t_curr] not taken yet, into `solution`,
+    /// `flush`ed after each (a streamed run hands them over in batches).
+    #[allow(clippy::too_many_arguments)]
     fn sample<Y: StateVec, I: Interpolation<f64, Y> + ?Sized>(
         &mut self,
         t_curr: f64,
@@ -206,6 +245,7 @@ impl Sampler {
         y_prev: &Y,
         interpolator: &mut I,
         solution: &mut Solution<f64, Y>,
+        flush: &mut dyn FnMut(&mut Solution<f64, Y>),
     ) -> ControlFlag<f64, Y> {
         let mut at = |t: f64, solution: &mut Solution<f64, Y>| {
             let y = if t == t_curr {
@@ -219,6 +259,7 @@ impl Sampler {
                 }
             };
             solution.push(t, y);
+            flush(solution);
         };
         match self {
             Self::Even { dt, t_end, next } => {
@@ -341,7 +382,7 @@ impl RunLog {
             sampler: Sampler::new(opts),
             t_end: opts.t_end,
             kept: &self.kept,
-            m: 2 * ode.n,
+            m: ode.len,
             last_step: &self.last_step,
             events: &self.events,
             blown_up: &self.blown_up,

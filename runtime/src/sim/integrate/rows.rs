@@ -60,7 +60,7 @@ impl RowSink {
         };
         let row = Row {
             t,
-            x: &x[..2 * n],
+            x: &x[..2 * n + arm.internal_len()],
             contact: &contact,
         };
         (r.f)(arm, &row);

@@ -16,8 +16,9 @@
 //! accelerations of two arms whose parameters differ by +-delta_j along
 //! theta_j (CVODES' default for the parameter part): a parameter reaches
 //! the kernels through the parameter vector, inputs and derived values,
-//! which the caller builds for each perturbed value. A model with joints
-//! or contact is not covered: its runs switch and project.
+//! which the caller builds for each perturbed value. A viscoelastic arm's
+//! relaxed forces are states like any other. A model with joints or
+//! contact is not covered: its runs switch and project.
 
 use differential_equations::error::Error;
 use differential_equations::interpolate::Interpolation;
@@ -26,8 +27,9 @@ use nalgebra::{DMatrix, DVector};
 use super::methods::radau5;
 use super::ode::ArmOde;
 use super::stepper::{Counts, Options};
-use crate::arm::{AccelError, Dynamics, Workspace, accelerations};
-use crate::jacobian::rhs_jacobian;
+use crate::arm::{AccelError, Dynamics, Workspace};
+use crate::jacobian::state_jacobian;
+use crate::relaxed_forces::state_rate;
 
 /// A parameter's two perturbed arms: the same model at theta_j + delta
 /// and theta_j - delta, every other value alike.
@@ -92,21 +94,22 @@ struct Linearised {
 impl Carried<'_> {
     /// J and the parameter columns df/dtheta_j at (t, x).
     fn linearised(&mut self, t: f64, x: &[f64]) -> Result<Linearised, AccelError> {
-        let n = self.arm.dof();
-        let mut j = DMatrix::zeros(2 * n, 2 * n);
-        rhs_jacobian(self.arm, &mut self.ws, t, x, &mut j)?;
-        let (q, qd) = x.split_at(n);
-        let (mut up, mut down) = (vec![0.0; n], vec![0.0; n]);
+        let len = x.len();
+        let mut j = DMatrix::zeros(len, len);
+        state_jacobian(self.arm, &mut self.ws, t, x, &mut j)?;
+        let (mut up, mut down) = (vec![0.0; len], vec![0.0; len]);
         let mut b = Vec::with_capacity(self.params.len());
         for p in self.params {
-            accelerations(p.plus, &mut self.ws, t, q, qd, &mut up)?;
-            accelerations(p.minus, &mut self.ws, t, q, qd, &mut down)?;
-            let mut col = DVector::zeros(2 * n);
-            for k in 0..n {
-                col[n + k] = (up[k] - down[k]) / (2.0 * p.delta);
-            }
-            b.push(col);
+            state_rate(p.plus, &mut self.ws, t, x, &mut up)?;
+            state_rate(p.minus, &mut self.ws, t, x, &mut down)?;
+            b.push(DVector::from_iterator(
+                len,
+                (up.iter().zip(&down)).map(|(a, b)| (a - b) / (2.0 * p.delta)),
+            ));
         }
+        // The arm's own relaxed forces again (the perturbed arms' calls
+        // set theirs).
+        self.arm.set_internal(&x[2 * self.arm.dof()..]);
         Ok(Linearised { t, j, b })
     }
 
@@ -265,7 +268,8 @@ pub fn forward_sensitivities(
 
 /// dx0/dtheta_j of a start in equilibrium at time t (h(q0, 0) = 0): the
 /// tangent stiffness K = dh/dq gives dq0/dtheta_j = -K^-1 dh/dtheta_j,
-/// the rates stay zero.
+/// the rates stay zero. An elastic arm's (a viscoelastic arm's start
+/// moves its relaxed forces too: the caller differences its starts).
 pub fn static_sensitivities(
     arm: &dyn Dynamics,
     params: &[Perturbed<'_>],

@@ -38,8 +38,9 @@ impl Integrator for Auto {
         // The implicit method a stiffness report recommends; generalized-
         // alpha, second order, only at an engineer's tolerance (rtol 1e-4
         // or looser): tighter, radau5's fifth order takes the larger steps.
+        let second_order = arm.internal_len() == 0;
         let implicit = |r: &crate::stiffness::StiffnessReport| match r.recommended_solver {
-            "genalpha" if opts.rtol >= GENALPHA_RTOL => Solver::GenAlpha,
+            "genalpha" if opts.rtol >= GENALPHA_RTOL && second_order => Solver::GenAlpha,
             _ => Solver::Radau5,
         };
         let as_auto = |mut stats: SimStats, at_s: f64, to: Solver, reason: String| {
