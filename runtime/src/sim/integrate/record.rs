@@ -68,7 +68,7 @@ const STREAM_BATCH: usize = 256;
 
 impl Recorder<'_> {
     fn keep<Y: StateVec>(&self, solution: &mut Solution<f64, Y>) {
-        keep(&self.kept, &self.rows, self.m, solution);
+        keep(self.kept, &self.rows, self.m, solution);
     }
 }
 
