@@ -17,11 +17,14 @@ pub fn is_cosserat(model: &Model) -> bool {
     model.segments.iter().any(|s| s.method.statics_only())
 }
 
-/// The rod's section at the fraction `x` of the segment `s`.
+/// The rod's section at the fraction `x` of the segment `s` (a
+/// viscoelastic segment's at its long-term moduli).
 fn section_at(s: &Segment, x: f64) -> Section {
     let here = s.at(x);
     let [rest_y, rest_z, rest_twist, rest_stretch] = s.rest_at(x, 3);
-    let stiffness = |v: Option<f64>| v.expect("validated: the Cosserat rod's stiffness");
+    // A viscoelastic rod in equilibrium has relaxed: its long-term moduli.
+    let share = 1.0 - s.relaxation.iter().map(|r| r.ratio).sum::<f64>();
+    let stiffness = |v: Option<f64>| share * v.expect("validated: the Cosserat rod's stiffness");
     Section {
         ea: s.stretches().then(|| stiffness(here.ea())),
         ga: s.shears().then(|| stiffness(here.ga())),

@@ -343,6 +343,30 @@ fn statics_takes_the_long_term_modulus_and_linearize_the_retardation_rate() {
         0.0,
         "the static tip at the long-term modulus",
     );
+    // The Cosserat rod too, under the same force held constant.
+    let rod = vec!["segment.0.method=cosserat".to_string()];
+    let constant = |text: &str| {
+        let head = text.split("[inputs.zero]").next().unwrap();
+        head.replace(
+            "force_inputs = [\"zero\", \"f\", \"zero\"]",
+            &format!("force = [0.0, {}, 0.0]", -P),
+        )
+    };
+    let (a, b) = (
+        static_tip(dir.path(), &constant(&relaxing), &rod),
+        static_tip(dir.path(), &constant(&long_term), &rod),
+    );
+    eprintln!(
+        "Cosserat rod: relaxing {:.9e}, long-term modulus {:.9e}",
+        a[1], b[1]
+    );
+    assert_close(
+        a[1],
+        b[1],
+        1e-9,
+        0.0,
+        "the Cosserat rod at the long-term modulus",
+    );
     // The slow eigenvalues of A: each coordinate creeps at its material
     // law's slow rate, the smaller root of
     // (l + 1 / c)(l + 1 / tau) = g / (c tau), with c = eta / E I for the
