@@ -270,6 +270,7 @@ impl Problem {
             atol: sim.atol,
             max_steps: sim.max_steps,
             rho_inf: sim.rho_inf,
+            dt: sim.dt,
         };
         let run =
             forward_sensitivities(arm, &perturbed, 0.0, x0.clone(), s0.clone(), &times, &opts)

@@ -30,6 +30,10 @@ pub enum Solver {
     /// structural dynamicist's method, damping unresolved high modes to
     /// the spectral radius `rho_inf`.
     GenAlpha,
+    /// Gauss-Legendre, two stages, fourth order, at a fixed step: implicit,
+    /// A-stable and symplectic (no numerical damping), for lightly damped
+    /// structures over many periods.
+    Gauss,
     /// dopri5, switching to radau5 when the arm turns out stiff (checked
     /// from the Jacobian's eigenvalues at the start and every
     /// `AUTO_CHECK_STEPS` accepted steps).
@@ -38,7 +42,7 @@ pub enum Solver {
 
 /// Every solver with its name and the order of its global error (bdf's
 /// highest; auto's dopri5's), in the order `--solver` lists them.
-const TABLE: [(Solver, &str, u32); 11] = [
+const TABLE: [(Solver, &str, u32); 12] = [
     (Solver::Dopri5, "dopri5", 5),
     (Solver::Bs23, "bs23", 3),
     (Solver::Dop853, "dop853", 8),
@@ -49,6 +53,7 @@ const TABLE: [(Solver, &str, u32); 11] = [
     (Solver::Trbdf2, "trbdf2", 2),
     (Solver::Esdirk, "esdirk", 3),
     (Solver::GenAlpha, "genalpha", 2),
+    (Solver::Gauss, "gauss", 4),
     (Solver::Auto, "auto", 5),
 ];
 
@@ -101,14 +106,14 @@ impl Solver {
 
     /// Fixed-step methods (no error estimate: `dt` sets the step).
     pub fn fixed_step(self) -> bool {
-        matches!(self, Self::Rk4 | Self::Euler)
+        matches!(self, Self::Rk4 | Self::Euler | Self::Gauss)
     }
 
     /// Implicit methods (they use the analytic Jacobian).
     pub fn implicit(self) -> bool {
         matches!(
             self,
-            Self::Radau5 | Self::Bdf | Self::Trbdf2 | Self::Esdirk | Self::GenAlpha
+            Self::Radau5 | Self::Bdf | Self::Trbdf2 | Self::Esdirk | Self::GenAlpha | Self::Gauss
         )
     }
 }

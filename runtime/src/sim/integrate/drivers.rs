@@ -205,6 +205,7 @@ pub(super) fn run_own(
         atol: opts.atol,
         max_steps: opts.max_steps,
         rho_inf: opts.rho_inf,
+        dt: opts.dt,
     };
     let start = Instant::now();
     let result = integrate(

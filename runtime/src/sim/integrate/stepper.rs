@@ -25,6 +25,8 @@ pub struct Options {
     pub max_steps: usize,
     /// generalized-alpha's spectral radius at infinity.
     pub rho_inf: f64,
+    /// The step of a fixed-step method (s).
+    pub dt: f64,
 }
 
 /// Sees every accepted step (t_prev, t, y_prev, y, dense output over the

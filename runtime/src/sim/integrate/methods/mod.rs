@@ -11,6 +11,7 @@ mod dop853;
 mod dopri5;
 mod esdirk;
 mod euler;
+pub mod gauss;
 pub mod genalpha;
 pub mod radau5;
 mod rk4;
@@ -50,6 +51,7 @@ pub(super) fn of(solver: Solver) -> &'static dyn Integrator {
         Solver::Trbdf2 => &Own(trbdf2::integrate),
         Solver::Esdirk => &esdirk::Esdirk,
         Solver::GenAlpha => &Own(genalpha::integrate),
+        Solver::Gauss => &Own(gauss::integrate),
         Solver::Auto => &auto::Auto,
     }
 }
