@@ -244,9 +244,10 @@ mod tests {
     }
 
     /// A mode far above the step (w h = 50) keeps its amplitude and turns
-    /// by the method's own phase a step, arg R(i w h) with R(z) = (1 + z/2
-    /// + z^2/12) / (1 - z/2 + z^2/12): no numerical damping, where
-    /// generalized-alpha takes rho_inf of it a step.
+    /// by the method's own phase a step, arg R(i w h), with the stability
+    /// function R(z) = (1 + z/2 + z^2/12) / (1 - z/2 + z^2/12): no
+    /// numerical damping, where generalized-alpha takes rho_inf of it a
+    /// step.
     #[test]
     fn a_mode_far_above_the_step_keeps_its_amplitude() {
         let (w, h, steps) = (1.0e4, 5e-3, 7);
