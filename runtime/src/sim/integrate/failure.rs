@@ -160,6 +160,17 @@ fn why<Y: StateVec>(
     unpad: impl Fn(&Y) -> Vec<f64>,
 ) -> (f64, Vec<f64>, String, String) {
     match e {
+        // A fixed step is not shrunk: an implicit one whose stages do
+        // not converge stops there.
+        Error::StepSize { t, y } if opts.solver.fixed_step() => (
+            t,
+            unpad(&y),
+            explain(format!(
+                "the implicit stages did not converge at the fixed step dt = {:e} s",
+                opts.dt
+            )),
+            "reduce --dt, or use an adaptive implicit solver (radau5)".to_string(),
+        ),
         Error::StepSize { t, y } => (
             t,
             unpad(&y),

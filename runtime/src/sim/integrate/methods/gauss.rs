@@ -58,10 +58,7 @@ fn stages(
     z: &mut [f64],
 ) -> Option<f64> {
     let m = y.len();
-    let size = y
-        .iter()
-        .fold(0.0f64, |s, v| s.max(v.abs()))
-        .max(f64::MIN_POSITIVE);
+    let largest = |v: &[f64]| v.iter().fold(0.0f64, |s, x| s.max(x.abs()));
     let mut f = [vec![0.0; m], vec![0.0; m]];
     let mut at = vec![0.0; m];
     let mut contraction = Contraction::default();
@@ -80,7 +77,10 @@ fn stages(
             }),
         );
         let dz = lu.solve(&r)?;
-        let norm = dz.iter().fold(0.0f64, |s, v| s.max(v.abs())) / size;
+        // Relative to the state, or to the step's change where the state
+        // is zero (a start at rest in the rest shape).
+        let size = largest(y).max(largest(z)).max(f64::MIN_POSITIVE);
+        let norm = largest(dz.as_slice()) / size;
         if norm.is_finite() {
             for (zp, d) in z.iter_mut().zip(dz.iter()) {
                 *zp += d;
