@@ -166,23 +166,48 @@ pub fn plot_path(stem: &Path, title: &str, path: &[(f64, f64, f64)]) -> Result<(
         chart
             .draw_series([Circle::new((1e3 * fx, 1e3 * fy), 5, BLACK.filled())])
             .map_err(|x| e(&x))?;
+        // Each coordinate's displacement from the start against time, on
+        // its own scale: a path that is a short line above still shows
+        // how it moves.
+        let (dx, dy) = (
+            (x0 - 1e3 * fx, x1 - 1e3 * fx),
+            (y0 - 1e3 * fy, y1 - 1e3 * fy),
+        );
+        let (lo, hi) = (dx.0.min(dy.0), dx.1.max(dy.1));
+        let margin = 0.05 * (hi - lo).max(1e-6);
         let mut chart = ChartBuilder::on(&bottom)
             .margin(10)
             .x_label_area_size(35)
             .y_label_area_size(60)
-            .build_cartesian_2d(0.0..t1, (y0 - pad)..(y1 + pad))
+            .build_cartesian_2d(0.0..t1, (lo - margin)..(hi + margin))
             .map_err(|x| e(&x))?;
         chart
             .configure_mesh()
             .x_desc("t (s)")
-            .y_desc("y (mm)")
+            .y_desc("displacement from the start (mm)")
             .draw()
             .map_err(|x| e(&x))?;
         chart
             .draw_series(LineSeries::new(
-                finite.iter().map(|p| (p.0, 1e3 * p.2)),
+                finite.iter().map(|p| (p.0, 1e3 * (p.1 - fx))),
+                BLUE.stroke_width(2),
+            ))
+            .map_err(|x| e(&x))?
+            .label("x")
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE));
+        chart
+            .draw_series(LineSeries::new(
+                finite.iter().map(|p| (p.0, 1e3 * (p.2 - fy))),
                 RED.stroke_width(2),
             ))
+            .map_err(|x| e(&x))?
+            .label("y")
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED));
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
             .map_err(|x| e(&x))?;
         root.present().map_err(|x| e(&x))?;
     }
