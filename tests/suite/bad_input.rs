@@ -901,11 +901,6 @@ fn shape_and_load_cases() -> Vec<FileCase> {
             vec!["segment[0].rest_curvature", "give two values"],
         ),
         (
-            "eba twisted at rest",
-            r("\"pcc\"", "\"eba\"").replace("elements = 2", "elements = 2\nrest_twist = 1.0"),
-            vec!["segment[0].rest_twist", "straight at rest"],
-        ),
-        (
             "turn of one angle in 3D",
             r("elements = 2", "elements = 2\nturn = [90.0]"),
             vec!["segment[0].turn", "[angle about y, angle about z] in 3D"],

@@ -78,7 +78,7 @@ fn an_unloaded_rod_curved_and_twisted_at_rest_is_its_helix() {
             assert!(err < 1e-9, "{method} at {n}: {err:e} of L off the helix");
         }
     }
-    for method in ["ebr", "rigid"] {
+    for method in ["ebr", "rigid", "eba"] {
         let err = |n| distance(static_tip(dir.path(), &text, &method_sets(method, n)), want) / L;
         let (coarse, fine) = (err(8), err(16));
         assert!(
@@ -142,17 +142,59 @@ fn a_loaded_helix_converges_to_the_cosserat_rod() {
     );
 }
 
+/// eba's beam springs stretch and shear: it converges to the extensible,
+/// shearable rod, which the load moves measurably from the other.
+#[test]
+fn a_loaded_eba_helix_converges_to_the_shearing_cosserat_rod() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = model([0.0, 0.1, -0.3]);
+    let cosserat = |more: &[&str]| {
+        let mut sets = vec!["segment.0.method=cosserat".to_string()];
+        sets.extend(more.iter().map(|s| s.to_string()));
+        static_tip(dir.path(), &text, &sets)
+    };
+    let rod = cosserat(&[]);
+    let shearing = cosserat(&["segment.0.extension=true", "segment.0.shear=true"]);
+    assert!(
+        distance(shearing, rod) > 1e-3 * L,
+        "{shearing:?} vs {rod:?}"
+    );
+    let err = |n| {
+        distance(
+            static_tip(dir.path(), &text, &method_sets("eba", n)),
+            shearing,
+        ) / L
+    };
+    let (coarse, fine) = (err(6), err(12));
+    assert!(
+        fine < 3e-3 && fine * 3.0 < coarse,
+        "eba: {coarse:e} of L from the shearing Cosserat rod at 6, {fine:e} at 12"
+    );
+}
+
 #[test]
 fn a_helix_at_rest_stays_at_rest() {
     let dir = tempfile::tempdir().unwrap();
     let text = model([0.0; 3]).replace("youngs_modulus", "bending_damping = 1e-3\nyoungs_modulus");
     assert!(text.contains("bending_damping"));
-    let mut l = load_text(dir.path(), &text, &[]);
+    for method in ["pcc", "eba"] {
+        stays_at_rest(dir.path(), &text, &method_sets(method, 8));
+    }
+}
+
+fn stays_at_rest(dir: &std::path::Path, text: &str, sets: &[String]) {
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    let mut l = load_text(dir, text, &sets);
     let n = l.arm.dof();
     let rest = solve_static(&mut *l.arm, &vec![0.0; n], &StaticOptions::default())
         .unwrap()
         .q;
-    assert!(rest.iter().any(|q| q.abs() > 0.1), "{rest:?}");
+    // Curved: its coordinates (pcc's strains) or its placement (eba's).
+    let tip = l.arm.outputs(0.0, &rest, &vec![0.0; n]);
+    assert!(
+        distance([tip[0], tip[1], tip[2]], [L, 0.0, 0.0]) > 0.1 * L,
+        "{tip:?}"
+    );
     let opts = SimOptions {
         t_end: 0.2,
         ..Default::default()
@@ -215,4 +257,68 @@ force = [0.0, 0.0, 600.0]
             "{method}: {coarse:e} of the radius from the rod at 16 elements, {fine:e} at 32"
         );
     }
+}
+
+/// A rest shape that varies along the rod (bend about y ramping from 0 to
+/// 8 1/m, twist from 0 to 5 rad/m, bend about z constant): unloaded, every
+/// method places it. Reference: the rest shape's own equations, R' = R
+/// [u(s)]x and r' = R e_x, integrated by RK4 on nalgebra's rotations. The
+/// lumped methods take each element's strain at its middle and converge at
+/// second order (pcc's arcs, ebr's and the rigid chain's joints, eba's
+/// placed slabs and rom's quadrature slices alike); the Cosserat rod
+/// integrates it along s.
+#[test]
+fn a_rest_shape_varying_along_the_rod_is_placed_by_every_method() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = model([0.0; 3])
+        .replace(
+            &format!("rest_curvature = [{KY}, {KZ}]"),
+            "rest_curvature = [[0.0, 8.0], -4.0]",
+        )
+        .replace(&format!("rest_twist = {TWIST}"), "rest_twist = [0.0, 5.0]");
+    assert!(text.contains("[[0.0, 8.0], -4.0]") && text.contains("[0.0, 5.0]"));
+    let strain = |s: f64| {
+        let x = s / L;
+        nalgebra::Vector3::new(5.0 * x, 8.0 * x, -4.0)
+    };
+    let steps = 4000;
+    let h = L / steps as f64;
+    let (mut r, mut p) = (nalgebra::Rotation3::identity(), nalgebra::Vector3::zeros());
+    for i in 0..steps {
+        // RK4 on (r, R): the rotation advanced by the averaged rate (exact
+        // to fourth order for a rate linear in s), the position by Simpson.
+        let s = i as f64 * h;
+        let k = (strain(s) + 4.0 * strain(s + h / 2.0) + strain(s + h)) / 6.0;
+        let mid =
+            r * nalgebra::Rotation3::new(strain(s) * (h / 4.0) + strain(s + h / 2.0) * (h / 4.0));
+        let end = r * nalgebra::Rotation3::new(k * h);
+        let ex = nalgebra::Vector3::x();
+        p += h / 6.0 * (r * ex + 4.0 * (mid * ex) + end * ex);
+        r = end;
+    }
+    let want = [p.x, p.y, p.z];
+    assert!(distance(want, [L, 0.0, 0.0]) > 0.1 * L, "{want:?}");
+    for method in ["pcc", "ebr", "rigid", "eba"] {
+        let err = |n| distance(static_tip(dir.path(), &text, &method_sets(method, n)), want) / L;
+        let (coarse, fine) = (err(6), err(12));
+        assert!(
+            fine < 2e-3 && fine * 3.5 < coarse,
+            "{method}: {coarse:e} of L off the rest shape at 6 elements, {fine:e} at 12"
+        );
+    }
+    // rom's rest field is constant over each quadrature slice (as its
+    // varying sections are): second order in its slices.
+    let rom = |n| {
+        let mut s = method_sets("rom", n);
+        s.push("segment.0.order=2".into());
+        distance(static_tip(dir.path(), &text, &s), want) / L
+    };
+    let (coarse, fine) = (rom(6), rom(12));
+    assert!(
+        fine < 2e-3 && fine * 3.5 < coarse,
+        "rom: {coarse:e} of L off the rest shape at 6 slices, {fine:e} at 12"
+    );
+    let rod = static_tip(dir.path(), &text, &["segment.0.method=cosserat".into()]);
+    let rod = distance(rod, want) / L;
+    assert!(rod < 1e-8, "Cosserat: {rod:e} of L off");
 }

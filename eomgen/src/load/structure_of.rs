@@ -82,7 +82,8 @@ impl Structure {
                         },
                         joints: method.joints(s),
                         varying: method.polynomial_fields() && s.tapered(),
-                        rest_3d: s.rest_3d(m.dimensions),
+                        rest_3d: s.rest_3d(m.dimensions)
+                            || (spatial && method.rest_always_3d() && s.rest_key().is_some()),
                         anisotropic: s.anisotropic(m.dimensions),
                         kink: s.kinked(),
                         twist: spatial && twist,

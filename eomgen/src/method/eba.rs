@@ -18,6 +18,15 @@
 //!
 //! A finite-difference rod (strains between element centres) that converges
 //! to the extensible, shearable Cosserat rod as l_e -> 0.
+//!
+//! A rest shape (curvature, twist, stretch) is placed rather than measured:
+//! element k sits turned by A_k = A_{k-1} exp(rho_{k-1} / 2) exp(rho_k / 2)
+//! (rho_k its rest turn, the rest strains times l_e), R_k = R0 A_k
+//! exp([psi_k]x), its centre at the rest centre plus u_k, so q = 0 is the
+//! rest shape still. The springs measure the turn from rest in the frame
+//! midway between two elements, exp(-rho_a / 2) R_a^T R_b exp(-rho_b / 2)
+//! (the clamp turning by nothing), and the gap from its rest length
+//! (rho_a's and rho_b's half stretches) along the previous axis.
 
 use runtime::Tape;
 use runtime::parts::{PartKernels, PartLayout, PartSpec};
@@ -32,8 +41,8 @@ use crate::tmt::actuation::{Strain, actuation, thinning};
 use crate::tmt::assemble;
 use crate::tmt::spatial::{
     Element3,
-    M3, V3, add3, base_frame, bind3, coefficients, half_k_sq, left_jacobian, quat_mul, rotation,
-    rotation_quat,
+    M3, Quat, V3, add3, base_frame, bind3, coefficients, exp_turn, half_k_sq, left_jacobian,
+    quat_mul, rotation, rotation_quat,
 };
 use crate::tmt::system::{
     Body, Coordinates, Inertia, ParamSymbols, Sample, System, TipMount, tip_loads,
@@ -73,6 +82,11 @@ impl ModellingMethod for Eba {
         true
     }
 
+    /// Its coordinates are measured from the placed rest shape.
+    fn rest_always_3d(&self) -> bool {
+        true
+    }
+
     fn check_keys(&self, ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> {
         let p = |k: &str| format!("segment[{i}].{k}");
         needs_bending_stiffness(ck, i, s)?;
@@ -87,13 +101,6 @@ impl ModellingMethod for Eba {
             return ck.err(
                 p(if s.turn.is_some() { "turn" } else { "offset" }),
                 "eba segments meet tangent: kinks are for the chain methods (pcc, vc, pcs, ebr, rom, rigid)".into(),
-            );
-        }
-        if let Some(key) = s.rest_key() {
-            return ck.err(
-                p(key),
-                "eba elements are straight at rest: remove the key or use pcc, pcs, ebr or rom"
-                    .into(),
             );
         }
         if s.ea().is_none() || s.ga().is_none() {
@@ -151,6 +158,152 @@ fn transpose_mul(cas: &mut Cas, a: &M3, b: &M3) -> M3 {
     })
 }
 
+/// a b.
+fn mul3(cas: &mut Cas, a: &M3, b: &M3) -> M3 {
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            let bj = [b[0][j], b[1][j], b[2][j]];
+            let e = cas.dot(&a[i], &bj);
+            cas.bind(e)
+        })
+    })
+}
+
+/// a b^T.
+fn mul3_t(cas: &mut Cas, a: &M3, b: &M3) -> M3 {
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            let e = cas.dot(&a[i], &b[j]);
+            cas.bind(e)
+        })
+    })
+}
+
+/// Half an element's rest turn, exp(rho / 2) (rho its rest twist and bends
+/// times its length), and half its rest stretch (times its length).
+#[derive(Clone, Copy)]
+struct HalfRest {
+    r: M3,
+    quat: Quat,
+    stretch: ExprId,
+}
+
+impl HalfRest {
+    fn of(cas: &mut Cas, symbols: &ParamSymbols, k: usize, shaped: bool) -> Self {
+        if !shaped {
+            return Self::none(cas);
+        }
+        let e = |p| symbols.element(k, p);
+        let rho = [
+            ElementParam::RestTwist,
+            ElementParam::RestY,
+            ElementParam::Rest,
+        ]
+        .map(|p| cas.scaled(0.5, e(p)));
+        let zero = cas.zero();
+        let (r, quat, _) = exp_turn(cas, &rho, &[zero; 3]);
+        let stretch = cas.scaled(0.5, e(ElementParam::RestStretch));
+        Self { r, quat, stretch }
+    }
+
+    /// A straight element's (and the clamp's).
+    fn none(cas: &mut Cas) -> Self {
+        let (zero, one) = (cas.zero(), cas.one());
+        let r = std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one } else { zero }));
+        Self {
+            r,
+            quat: [one, zero, zero, zero],
+            stretch: zero,
+        }
+    }
+}
+
+/// The rest shape placed element by element, in the base frame.
+struct RestPlacement {
+    /// The rest frame at the previous joint (A_{k-1} exp(rho_{k-1} / 2);
+    /// the clamp's: I), and its quaternion.
+    joint: M3,
+    joint_quat: Quat,
+    /// The previous element's axis, half length and half rest turn.
+    axis: V3,
+    half: ExprId,
+    turn: Option<HalfRest>,
+    /// The previous element's rest centre (the clamp point first).
+    centre: V3,
+}
+
+/// Element k's rest placement.
+struct Placed {
+    /// Its rest orientation A_k and its quaternion.
+    a: M3,
+    quat: Quat,
+    /// Its rest centre, and the offset from the previous one.
+    centre: V3,
+    step: V3,
+    /// What its springs to the previous element measure from.
+    joint: RestJoint,
+}
+
+/// The rest of the springs between two elements: the previous element's
+/// half turn (none at the clamp), this one's, and the gap's rest length.
+struct RestJoint {
+    before: Option<M3>,
+    after: M3,
+    gap: ExprId,
+}
+
+impl RestPlacement {
+    fn new(cas: &mut Cas) -> Self {
+        let (zero, one) = (cas.zero(), cas.one());
+        let none = HalfRest::none(cas);
+        Self {
+            joint: none.r,
+            joint_quat: none.quat,
+            axis: [one, zero, zero],
+            half: zero,
+            turn: None,
+            centre: [zero; 3],
+        }
+    }
+
+    /// Places the next element, of half length `half`, turned `turn`.
+    fn next(&mut self, cas: &mut Cas, turn: HalfRest, half: ExprId) -> Placed {
+        let a = mul3(cas, &self.joint, &turn.r);
+        let quat = quat_mul(cas, &self.joint_quat, &turn.quat);
+        let gap = match self.turn {
+            Some(t) => cas.add(t.stretch, turn.stretch),
+            None => turn.stretch,
+        };
+        let reach = cas.add(self.half, gap);
+        let step: V3 = std::array::from_fn(|i| {
+            let before = cas.mul(reach, self.axis[i]);
+            let after = cas.mul(half, a[i][0]);
+            cas.add(before, after)
+        });
+        let step = bind3(cas, step);
+        let centre = add3(cas, &self.centre, &step);
+        let centre = bind3(cas, centre);
+        let joint = RestJoint {
+            before: self.turn.map(|t| t.r),
+            after: turn.r,
+            gap,
+        };
+        self.joint = mul3(cas, &a, &turn.r);
+        self.joint_quat = quat_mul(cas, &quat, &turn.quat);
+        self.axis = [a[0][0], a[1][0], a[2][0]];
+        self.half = half;
+        self.turn = Some(turn);
+        self.centre = centre;
+        Placed {
+            a,
+            quat,
+            centre,
+            step,
+            joint,
+        }
+    }
+}
+
 fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
     let coords = Coordinates::new(cas, super::coordinate_names(structure));
     let zero = cas.zero();
@@ -184,6 +337,8 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         .collect();
     let mut strains = Vec::new();
     let mut samples = Vec::new();
+    let curved = structure.segments.iter().any(|g| g.rest_3d);
+    let mut placed = curved.then(|| RestPlacement::new(cas));
     for (k, &segment) in segment_of.iter().enumerate() {
         let c = 6 * k;
         let u: V3 = std::array::from_fn(|i| coords.q[c + i]);
@@ -191,16 +346,51 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         let psi_d: V3 = std::array::from_fn(|i| coords.qd[c + 3 + i]);
         let l = symbols.element(k, ElementParam::Length);
         let half = cas.scaled(0.5, l);
-        // Centre of the straight arm plus the displacement.
-        let s_mid = cas.add(along, half);
-        let centre: V3 = std::array::from_fn(|i| {
-            let straight = cas.mul(s_mid, base_axis[i]);
-            cas.add_all(&[p0[i], straight, u[i]])
+        // The rest centre's offset from the previous one (from the clamp
+        // point for the first), in the base frame: straight, or placed.
+        let rest = placed.as_mut().map(|p| {
+            let turn = HalfRest::of(cas, symbols, k, structure.segments[segment].rest_3d);
+            p.next(cas, turn, half)
         });
+        let step: V3 = match &rest {
+            None => {
+                let gap = cas.add(prev.half, half);
+                base_axis.map(|a| cas.mul(gap, a))
+            }
+            Some(r) => {
+                let step = std::array::from_fn(|i| cas.dot(&r0[i], &r.step));
+                bind3(cas, step)
+            }
+        };
+        let centre: V3 = match &rest {
+            None => {
+                let s_mid = cas.add(along, half);
+                std::array::from_fn(|i| {
+                    let straight = cas.mul(s_mid, base_axis[i]);
+                    cas.add_all(&[p0[i], straight, u[i]])
+                })
+            }
+            Some(r) => std::array::from_fn(|i| {
+                let placed = cas.dot(&r0[i], &r.centre);
+                cas.add_all(&[p0[i], placed, u[i]])
+            }),
+        };
         let centre = bind3(cas, centre);
         along = cas.add(along, l);
-        let (r, element_omega, q_rel) = element_frame(cas, &r0, &w0, &psi, &psi_d);
-        quat = quat_mul(cas, &q0, &q_rel);
+        // The element's rest orientation turns the frame its rotation
+        // vector is measured from.
+        let r_rest = match &rest {
+            None => r0,
+            Some(r) => mul3(cas, &r0, &r.a),
+        };
+        let (r, element_omega, q_rel) = element_frame(cas, &r_rest, &w0, &psi, &psi_d);
+        quat = match &rest {
+            None => quat_mul(cas, &q0, &q_rel),
+            Some(rr) => {
+                let q_rest = quat_mul(cas, &q0, &rr.quat);
+                quat_mul(cas, &q_rest, &q_rel)
+            }
+        };
         omega = element_omega;
         let axis = [r[0][0], r[1][0], r[2][0]];
         slab_samples(cas, structure.contact_points, l, centre, axis, quat, &mut samples);
@@ -217,10 +407,10 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         let slab = Slab { r, centre, half };
 
         // Beam springs to the previous element (or the clamp), on centres
-        // relative to the previous element's straight-arm centre: the gap
-        // between element ends is then no difference of positions along
-        // the whole arm (whose round-off grows with the arm's length), and
-        // the same expression as the joint's part (`joint_part`).
+        // relative to the previous element's rest centre: the gap between
+        // element ends is then no difference of positions along the whole
+        // arm (whose round-off grows with the arm's length), and the same
+        // expression as the joint's part (`joint_part`).
         let incompressible = structure.segments[segment].incompressible;
         let mut jp = JointParams::of(symbols, k);
         jp.kb_y = symbols.element_or(k, ElementParam::BendStiffnessY, jp.kb);
@@ -233,11 +423,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
             },
             half: prev.half,
         };
-        let gap = cas.add(prev.half, half);
-        let rel_centre: V3 = std::array::from_fn(|i| {
-            let straight = cas.mul(gap, base_axis[i]);
-            cas.add(straight, u[i])
-        });
+        let rel_centre: V3 = std::array::from_fn(|i| cas.add(step[i], u[i]));
         let slab_rel = Slab {
             r: slab.r,
             centre: bind3(cas, rel_centre),
@@ -247,8 +433,8 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
             cas,
             &jp,
             k == 0,
-            &prev_rel,
-            &slab_rel,
+            (&prev_rel, &slab_rel),
+            rest.as_ref().map(|r| &r.joint),
             incompressible,
             &pairs,
         );
@@ -404,8 +590,8 @@ fn beam_springs(
     cas: &mut Cas,
     jp: &JointParams,
     first: bool,
-    prev: &Slab,
-    slab: &Slab,
+    (prev, slab): (&Slab, &Slab),
+    rest: Option<&RestJoint>,
     incompressible: bool,
     pairs: &[(ExprId, ExprId)],
 ) -> BeamJoint {
@@ -421,7 +607,14 @@ fn beam_springs(
         da,
         ks,
     } = *jp;
-    let r_rel = transpose_mul(cas, &prev.r, &slab.r);
+    let mut r_rel = transpose_mul(cas, &prev.r, &slab.r);
+    // From rest: in the frame midway between the two elements.
+    if let Some(rest) = rest {
+        if let Some(before) = &rest.before {
+            r_rel = transpose_mul(cas, before, &r_rel);
+        }
+        r_rel = mul3_t(cas, &r_rel, &rest.after);
+    }
     // 2 tan(theta / 2) n = 2 vee(R - R^T) / (1 + tr R): the relative
     // rotation to second order, and stiffening up to a half turn, so
     // that equilibria exist under any load.
@@ -440,11 +633,15 @@ fn beam_springs(
     let start_b = slab.end(cas, -1.0);
     let gap: V3 = std::array::from_fn(|i| cas.sub(start_b[i], end_a[i]));
     // In the previous frame: R_a^T gap.
-    let local: V3 = std::array::from_fn(|i| {
+    let mut local: V3 = std::array::from_fn(|i| {
         let col = [prev.r[0][i], prev.r[1][i], prev.r[2][i]];
         let e = cas.dot(&col, &gap);
         cas.bind(e)
     });
+    if let Some(rest) = rest {
+        let e = cas.sub(local[0], rest.gap);
+        local[0] = cas.bind(e);
+    }
     // Incompressible: a stretch lambda = (l + gap) / l thins the section
     // (as in `SpatialArm::strain_element`).
     let thin = incompressible.then(|| {
@@ -503,7 +700,7 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
         && st.torques.is_empty()
         && st.chambers.iter().all(|&c| c == 0)
         && st.tendons.is_empty()
-        && st.segments.iter().all(|g| !g.anisotropic);
+        && st.segments.iter().all(|g| !g.anisotropic && !g.rest_3d);
     if !covered {
         return None;
     }
@@ -724,7 +921,7 @@ fn joint_part(first: bool, incompressible: bool) -> [Tape; 2] {
         half: half_b,
     };
     let pairs = coords.rate_pairs();
-    let joint = beam_springs(cas, &jp, first, &prev, &slab, incompressible, &pairs);
+    let joint = beam_springs(cas, &jp, first, (&prev, &slab), None, incompressible, &pairs);
     let mut sys = empty_system(cas, coords, [zero; 3]);
     sys.elastic = cas.add_all(&joint.elastic);
     sys.rayleigh = cas.add_all(&joint.rayleigh);

@@ -189,6 +189,13 @@ pub(crate) trait ModellingMethod: Sync {
         (section + slice, 2.0 * section)
     }
 
+    /// 3D: any rest shape, a curvature about z alone included, is
+    /// structural (its elements read every rest parameter: an absolute
+    /// method places its rest shape rather than measuring strains from it).
+    fn rest_always_3d(&self) -> bool {
+        false
+    }
+
     /// A segment's end is a frame a joint may hold.
     fn segment_end_frames(&self) -> bool {
         true

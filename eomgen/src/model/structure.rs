@@ -42,7 +42,8 @@ pub struct SegmentShape {
     /// element's values are parameters, and this is false.
     pub varying: bool,
     /// 3D: its rest shape has a curvature about y, a twist or a stretch
-    /// (their parameters exist), not only a curvature about z.
+    /// (their parameters exist), not only a curvature about z; for a
+    /// method that places its rest shape (eba), any rest shape.
     pub rest_3d: bool,
     /// 3D: its section bends more stiffly about one axis than the other
     /// (its elements' `ElementParam::ANISOTROPIC` exist).
