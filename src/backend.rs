@@ -155,7 +155,8 @@ fn linked(
         .any(|s| s.segments.iter().any(|g| g.anisotropic))
     {
         return Err(
-            "its sections bend unequally about y and z, which link cells do not carry yet".into(),
+            "its sections bend or shear unequally along y and z, which link cells do not carry yet"
+                .into(),
         );
     }
     if arms

@@ -27,7 +27,12 @@ fn section_at(s: &Segment, x: f64) -> Section {
     let stiffness = |v: Option<f64>| share * v.expect("validated: the Cosserat rod's stiffness");
     Section {
         ea: s.stretches().then(|| stiffness(here.ea())),
-        ga: s.shears().then(|| stiffness(here.ga())),
+        ga: s.shears().then(|| {
+            let pair = here
+                .ga_pair()
+                .expect("validated: the Cosserat rod's shear stiffness");
+            pair.map(|k| stiffness(Some(k)))
+        }),
         ei: [stiffness(here.ei_y()), stiffness(here.ei())],
         gj: stiffness(here.gj()),
         rho_a: s.mass_per_length(x).unwrap_or(0.0),

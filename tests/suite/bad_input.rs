@@ -789,6 +789,20 @@ fn section_load_and_fluid_cases() -> Vec<FileCase> {
             vec!["segment[0].section.rotary_inertia[0]", "must be positive"],
         ),
         (
+            "properties with a negative shear stiffness along z",
+            r(
+                "density = 1000.0\nouter_radius = 0.01\nyoungs_modulus = 1e6",
+                &format!(
+                    "section = {}\nshear = true",
+                    PROPERTIES.replace(
+                        "axial_stiffness",
+                        "shear_stiffness = [5.0, -5.0], axial_stiffness"
+                    )
+                ),
+            ),
+            vec!["segment[0].section.shear_stiffness", "must be positive"],
+        ),
+        (
             "properties of a shearing segment without its shear stiffness",
             r(
                 "density = 1000.0\nouter_radius = 0.01\nyoungs_modulus = 1e6",

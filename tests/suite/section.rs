@@ -257,3 +257,57 @@ impl SectionShapeValues {
         }
     }
 }
+
+/// A section given by its properties may shear more stiffly along one axis
+/// (`shear_stiffness = [k G A_y, k G A_z]`). A small tip force along y, then
+/// along z: the tip moves by bending plus Timoshenko's F L / (k G A) along
+/// the force, so swapping the two shear stiffnesses moves it by
+/// F L (1 / a - 1 / b) along y and the opposite along z, exactly for every
+/// shearing method (the bending part cancels), to the small load's
+/// nonlinearity.
+#[test]
+fn a_properties_section_shears_by_its_own_stiffness_along_each_axis() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (4.0, 12.0);
+    let ei = E * PI * 0.01f64.powi(4) / 4.0;
+    let f = 1e-4;
+    let section = |ga: [f64; 2]| {
+        format!(
+            "{{ shape = \"properties\", axial_stiffness = 300.0, shear_stiffness = {ga:?}, bending_stiffness = [{ei}, {ei}], torsional_stiffness = {}, mass_per_length = 0.3, rotary_inertia = [1e-5, 1e-5] }}",
+            ei / 1.5
+        )
+    };
+    let text = |ga: [f64; 2], force: [f64; 3]| {
+        arm(3, &section(ga), 4, &format!("[tip]\nforce = {force:?}"))
+            .replace(&format!("density = {RHO}\n"), "")
+            .replace(&format!("youngs_modulus = {E}\n"), "")
+    };
+    let want = f * L * (1.0 / a - 1.0 / b);
+    let cases: [(&str, &[&str]); 5] = [
+        ("pcs", &[]),
+        ("pcc", &["segment.0.shear=true"]),
+        ("rom", &["segment.0.shear=true", "segment.0.extension=true"]),
+        ("eba", &[]),
+        (
+            "cosserat",
+            &["segment.0.shear=true", "segment.0.extension=true"],
+        ),
+    ];
+    for (method, keys) in cases {
+        let mut sets = vec![format!("segment.0.method={method}")];
+        sets.extend(keys.iter().map(|k| k.to_string()));
+        for (axis, sign) in [(1, 1.0), (2, -1.0)] {
+            let mut force = [0.0; 3];
+            force[axis] = f;
+            let tip = |ga| static_tip(dir.path(), &text(ga, force), &sets)[axis];
+            let got = tip([a, b]) - tip([b, a]);
+            assert_close(
+                got,
+                sign * want,
+                1e-4,
+                0.0,
+                &format!("{method} along {axis}"),
+            );
+        }
+    }
+}

@@ -543,8 +543,8 @@ fn section_properties(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelErro
     ] {
         ck.positive(&p(key), v)?;
     }
-    if let Some(ga) = g.ga {
-        ck.positive(&p("shear_stiffness"), ga)?;
+    for ga in g.ga.iter().flatten() {
+        ck.positive(&p("shear_stiffness"), *ga)?;
     }
     let replaced = [
         ("mass", s.mass.is_some()),

@@ -217,8 +217,9 @@ pub struct ElementProps {
     /// 3D: E A / l_e (N/m) and c / l_e (N s/m).
     pub stretch_stiffness: f64,
     pub stretch_damping: f64,
-    /// 3D, eba: G A / l_e (N/m).
+    /// 3D, shearing elements: k G A / l_e (N/m) along y, and along z.
     pub shear_stiffness: f64,
+    pub shear_stiffness_z: f64,
     /// 3D rest shapes: bend about y and twist (rad), stretch (m), each the
     /// rest strain times l_e.
     pub rest_y: f64,
@@ -256,6 +257,7 @@ impl ElementProps {
             ElementParam::Width => self.width,
             ElementParam::BendStiffnessY => self.stiffness_y,
             ElementParam::InertiaY => self.inertia_y,
+            ElementParam::ShearStiffnessZ => self.shear_stiffness_z,
         }
     }
 }
@@ -347,7 +349,8 @@ fn props_of(m: &Model, [s, springs]: [&Segment; 2], l: f64, n: usize) -> Element
         twist_damping: damping,
         stretch_stiffness: springs.ea().unwrap_or(0.0) / l,
         stretch_damping: s.axial_damping.unwrap_or(0.0) / l,
-        shear_stiffness: springs.ga().unwrap_or(0.0) / l,
+        shear_stiffness: springs.ga_pair().map_or(0.0, |g| g[0]) / l,
+        shear_stiffness_z: springs.ga_pair().map_or(0.0, |g| g[1]) / l,
         stiffness_y,
         inertia_y,
     }

@@ -414,6 +414,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         let incompressible = structure.segments[segment].incompressible;
         let mut jp = JointParams::of(symbols, k);
         jp.kb_y = symbols.element_or(k, ElementParam::BendStiffnessY, jp.kb);
+        jp.ks_z = symbols.element_or(k, ElementParam::ShearStiffnessZ, jp.ks);
         let prev_rel = Slab {
             r: prev.r,
             centre: if k == 0 {
@@ -546,8 +547,10 @@ struct JointParams {
     l: ExprId,
     kb: ExprId,
     kt: ExprId,
-    /// E I_y / l: `kb` but for anisotropic sections.
+    /// E I_y / l and k G A_z / l: `kb` and `ks` but for anisotropic
+    /// sections.
     kb_y: ExprId,
+    ks_z: ExprId,
     db: ExprId,
     dt: ExprId,
     ka: ExprId,
@@ -576,6 +579,7 @@ impl JointParams {
             l,
             kb,
             kb_y: kb,
+            ks_z: ks,
             kt,
             db,
             dt,
@@ -606,6 +610,7 @@ fn beam_springs(
         ka,
         da,
         ks,
+        ks_z,
     } = *jp;
     let mut r_rel = transpose_mul(cas, &prev.r, &slab.r);
     // From rest: in the frame midway between the two elements.
@@ -676,8 +681,8 @@ fn beam_springs(
     let local_d = cas.time_derivatives(&local[..1], pairs);
     elastic.push(half_k_sq(cas, ka, local[0]));
     rayleigh.push(half_k_sq(cas, da, local_d[0]));
-    for &x in &local[1..] {
-        elastic.push(half_k_sq(cas, ks, x));
+    for (&x, k) in local[1..].iter().zip([ks, ks_z]) {
+        elastic.push(half_k_sq(cas, k, x));
     }
     BeamJoint {
         strain,

@@ -367,10 +367,15 @@ impl RomFields {
                 0 | 1 => (ElementParam::BendStiffness, ElementParam::BendDamping),
                 _ => (ElementParam::TwistStiffness, ElementParam::TwistDamping),
             };
-            // An anisotropic section's bend about y (field 0) its own.
-            let ks = |e: usize| match f {
-                0 => symbols.element_or(k + e, ElementParam::BendStiffnessY, symbols.element(k + e, stiff)),
-                _ => symbols.element(k + e, stiff),
+            // An anisotropic section's bend about y (field 0) and shear
+            // along z (the second shear field) its own.
+            let ks = |e: usize| {
+                let own = match f {
+                    0 => ElementParam::BendStiffnessY,
+                    _ if stretch && f == first_shear + 1 => ElementParam::ShearStiffnessZ,
+                    _ => return symbols.element(k + e, stiff),
+                };
+                symbols.element_or(k + e, own, symbols.element(k + e, stiff))
             };
             let ds = |e: usize| symbols.element(k + e, damp);
             // Bending, twist: (E I / L) c^T G c = (k_slice / n) ...; stretch

@@ -93,6 +93,9 @@ pub enum ElementParam {
     /// rotary inertia about its y axis (`Inertia` about z).
     BendStiffnessY,
     InertiaY,
+    /// 3D anisotropic sections: k G A_z / l_e, the shear along z
+    /// (`ShearStiffness` is then along y).
+    ShearStiffnessZ,
 }
 
 impl ElementParam {
@@ -120,7 +123,8 @@ impl ElementParam {
     pub const REST_3D: [ElementParam; runtime::links::REST_PARAMS] =
         [Self::RestY, Self::RestTwist, Self::RestStretch];
     /// The parameters an anisotropic section adds, in layout order.
-    pub const ANISOTROPIC: [ElementParam; 2] = [Self::BendStiffnessY, Self::InertiaY];
+    pub const ANISOTROPIC: [ElementParam; 3] =
+        [Self::BendStiffnessY, Self::InertiaY, Self::ShearStiffnessZ];
     /// A link cell's parameters, in the order the cell tape reads them
     /// (`runtime::links::ELEMENT_PARAMS` of them).
     pub const CELL: [ElementParam; runtime::links::ELEMENT_PARAMS] = [
@@ -159,6 +163,7 @@ impl ElementParam {
             Self::Width => ("element", "width"),
             Self::BendStiffnessY => ("joint", "stiffness_y"),
             Self::InertiaY => ("element", "inertia_y"),
+            Self::ShearStiffnessZ => ("shear", "stiffness_z"),
         };
         format!("{group}[{k}].{what}")
     }

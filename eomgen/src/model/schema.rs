@@ -525,7 +525,9 @@ impl Segment {
         }
         let unequal = |[y, z]: [f64; 2]| (y - z).abs() > 1e-12 * y.abs().max(z.abs());
         let differ = |p: &Segment| {
-            let given = p.given().is_some_and(|g| unequal(g.ei) || unequal(g.rho_i));
+            let given = p
+                .given()
+                .is_some_and(|g| unequal(g.ei) || unequal(g.rho_i) || g.ga.is_some_and(unequal));
             given || p.second_moments().is_some_and(unequal)
         };
         differ(self) || self.tapered() && self.breaks().iter().any(|&x| differ(&self.at(x)))
@@ -594,12 +596,19 @@ impl Segment {
         self.outer_radius.is_some() || self.section.is_some()
     }
 
-    /// Shear stiffness k G A (N), k the `shear_factor` (default 1).
+    /// Shear stiffness k G A (N) along the section's y, k the
+    /// `shear_factor` (default 1).
     pub fn ga(&self) -> Option<f64> {
+        Some(self.ga_pair()?[0])
+    }
+
+    /// Shear stiffness k G A (N) along y and along z: a `properties`
+    /// section may give them apart; a shape's are alike.
+    pub fn ga_pair(&self) -> Option<[f64; 2]> {
         if let Some(g) = self.given() {
             return g.ga;
         }
-        Some(self.shear_factor.unwrap_or(1.0) * self.shear()? * self.area()?)
+        Some([self.shear_factor.unwrap_or(1.0) * self.shear()? * self.area()?; 2])
     }
 
     /// Axial stiffness E A (N).

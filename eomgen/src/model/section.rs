@@ -8,6 +8,23 @@
 
 use serde::{Deserialize, Serialize};
 
+/// A value alike along both section axes, or one along each (y, z).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum OneOrTwo {
+    One(f64),
+    Two([f64; 2]),
+}
+
+impl OneOrTwo {
+    pub fn pair(self) -> [f64; 2] {
+        match self {
+            Self::One(v) => [v; 2],
+            Self::Two(p) => p,
+        }
+    }
+}
+
 /// A rectangle or an ellipse (full axes, m).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields, tag = "shape", rename_all = "lowercase")]
@@ -20,13 +37,14 @@ pub enum SectionShape {
         width: f64,
         height: f64,
     },
-    /// Given directly: E A (N), k G A (N, alike along y and z), [E I_y,
+    /// Given directly: E A (N), k G A (N: one value, or along y and
+    /// along z), [E I_y,
     /// E I_z] and G J (N m^2), rho A (kg/m), [rho I_y, rho I_z] and rho J
     /// (kg m, J defaulting to I_y + I_z), and the radius that holds the
     /// section (m, for contact and drawing).
     Properties {
         axial_stiffness: f64,
-        shear_stiffness: Option<f64>,
+        shear_stiffness: Option<OneOrTwo>,
         bending_stiffness: [f64; 2],
         torsional_stiffness: f64,
         mass_per_length: f64,
@@ -41,7 +59,8 @@ pub enum SectionShape {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Given {
     pub ea: f64,
-    pub ga: Option<f64>,
+    /// k G A along y, along z.
+    pub ga: Option<[f64; 2]>,
     /// About y, about z.
     pub ei: [f64; 2],
     pub gj: f64,
@@ -66,7 +85,7 @@ impl SectionShape {
                 ..
             } => Some(Given {
                 ea: axial_stiffness,
-                ga: shear_stiffness,
+                ga: shear_stiffness.map(OneOrTwo::pair),
                 ei: bending_stiffness,
                 gj: torsional_stiffness,
                 rho_a: mass_per_length,

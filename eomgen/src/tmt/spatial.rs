@@ -733,9 +733,13 @@ impl<'a> SpatialArm<'a> {
         );
         if let Some(pairs) = shear {
             let k = self.symbols.element(self.k, ElementParam::ShearStiffness);
+            // Along z an anisotropic section's own.
+            let k_z = (self.symbols).element_or(self.k, ElementParam::ShearStiffnessZ, k);
             // Shear rates damped as the stretch's (`axial_damping`).
             let c = self.symbols.element(self.k, ElementParam::StretchDamping);
-            let terms: Vec<ExprId> = pairs.iter().map(|&(x, _)| half_k_sq(cas, k, x)).collect();
+            let terms: Vec<ExprId> = (pairs.iter().zip([k, k_z]))
+                .map(|(&(x, _), k)| half_k_sq(cas, k, x))
+                .collect();
             let damped: Vec<ExprId> = pairs.iter().map(|&(_, xd)| half_k_sq(cas, c, xd)).collect();
             e = cas.add_all(&[&[e][..], &terms].concat());
             d = cas.add_all(&[&[d][..], &damped].concat());

@@ -25,8 +25,8 @@ use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 pub struct Section {
     /// Axial stiffness E A (N); `None`: inextensible.
     pub ea: Option<f64>,
-    /// Shear stiffness k G A (N); `None`: unshearable.
-    pub ga: Option<f64>,
+    /// Shear stiffness k G A (N) along d1 and d2; `None`: unshearable.
+    pub ga: Option<[f64; 2]>,
     /// Bending stiffness about the section's two axes and torsion G J (N m^2).
     pub ei: [f64; 2],
     pub gj: f64,
@@ -166,8 +166,9 @@ impl Rod {
         } else {
             let local = rt * x.n;
             let compliance = |k: Option<f64>| k.map_or(0.0, |k| 1.0 / k);
-            let (shear, axial) = (compliance(sec.ga), compliance(sec.ea));
-            v_rest + Vector3::new(local.x * shear, local.y * shear, local.z * axial)
+            let shear = [0, 1].map(|i| compliance(sec.ga.map(|g| g[i])));
+            let axial = compliance(sec.ea);
+            v_rest + Vector3::new(local.x * shear[0], local.y * shear[1], local.z * axial)
         };
         let lm = rt * x.m;
         let u = Vector3::from(sec.rest_u)
@@ -252,7 +253,11 @@ pub fn solve_rod(
         && sections.iter().all(|sec| {
             sec.ei.iter().all(|&k| positive(k))
                 && positive(sec.gj)
-                && [sec.ea, sec.ga].iter().flatten().all(|&k| positive(k))
+                && sec
+                    .ea
+                    .iter()
+                    .chain(sec.ga.iter().flatten())
+                    .all(|&k| positive(k))
         });
     if !stiff {
         return Err(RodError::Invalid(
@@ -393,7 +398,7 @@ mod tests {
         let i = std::f64::consts::PI * r.powi(4) / 4.0;
         Section {
             ea: soft(e * area),
-            ga: soft(e / 3.0 * area),
+            ga: soft(e / 3.0 * area).map(|g| [g; 2]),
             ei: [e * i, e * i],
             gj: e / 3.0 * 2.0 * i,
             rho_a: 1000.0 * area,
