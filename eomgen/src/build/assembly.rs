@@ -81,6 +81,9 @@ fn without_arms<T: Clone>(
 /// turns.
 struct Sway {
     offset: [ExprId; 3],
+    /// Its coordinates' (q, qd) pairs: what moves the arm's points besides
+    /// the arm's own coordinates (drag sees them).
+    seeds: Vec<(ExprId, ExprId)>,
     twist: Option<([ExprId; 3], [ExprId; 3])>,
     inertia: Option<ExprId>,
     omega: Option<[ExprId; 3]>,
@@ -274,7 +277,7 @@ impl Builder {
         let sys = cas.scoped(scope, |cas| {
             let mut symbols = ParamSymbols::new(cas, arm_layout);
             if let (Some(base), Some(&mass)) = (&base, base_mass) {
-                symbols = symbols.with_base_offset(base.offset);
+                symbols = symbols.with_base_offset(base.offset, &base.seeds);
                 if let Some((rho, rate)) = base.twist {
                     symbols = symbols.with_base_twist(rho, rate);
                 }
@@ -362,8 +365,10 @@ impl Builder {
         let spring = |w| Param::BaseSpring(k as u16, w);
         let axes = if self.spatial { 3 } else { 2 };
         let mut offset = [self.zero; 3];
+        let mut seeds = Vec::new();
         for (c, axis) in Xyz::ALL.iter().take(axes).enumerate() {
             let (s, v) = self.coordinate(cas, format!("{prefix}base_{}", ["x", "y", "z"][c]));
+            seeds.push((s, v));
             offset[c] = s;
             let gap = cas.sub(s, self.get(spring(SpringParam::Follow(Rate::Value, *axis))));
             let k_s = self.get(spring(SpringParam::Stiffness));
@@ -374,6 +379,7 @@ impl Builder {
         }
         let mut sway = Sway {
             offset,
+            seeds,
             twist: None,
             inertia: None,
             omega: None,
@@ -405,6 +411,7 @@ impl Builder {
                 format!("{prefix}base_angle")
             };
             (rho[c], rate[c]) = self.coordinate(cas, name);
+            sway.seeds.push((rho[c], rate[c]));
         }
         let omega = if self.spatial {
             crate::tmt::spatial::exp_turn(cas, &rho, &rate).2

@@ -121,10 +121,10 @@ fn check_fluid(ck: &Check) -> Result<(), ModelError> {
     ck.non_negative("fluid.drag_normal", f.drag_normal)?;
     ck.non_negative("fluid.drag_tangential", f.drag_tangential)?;
     ck.vec3("fluid.current", &f.current)?;
-    if m.is_assembly() {
+    if m.is_assembly() && !m.arms.is_empty() {
         return ck.err(
             "fluid".into(),
-            "an immersed assembly is not supported yet: immerse a single arm".into(),
+            "an immersed assembly of several arms is not supported yet: immerse a single arm (on a compliant base or not)".into(),
         );
     }
     for (i, s) in m.segments.iter().enumerate() {

@@ -47,6 +47,8 @@ pub(crate) struct PlanarArm<'a> {
     body_link: Vec<usize>,
     strains: Vec<Strain>,
     seeds: Vec<(ExprId, ExprId)>,
+    /// What else moves its points: a compliant base's coordinates.
+    moved_by: Vec<(ExprId, ExprId)>,
     /// The next element.
     k: usize,
     /// The segment of the element being placed, and each segment's end.
@@ -105,6 +107,7 @@ impl<'a> PlanarArm<'a> {
             body_link: Vec::new(),
             strains: Vec::new(),
             seeds: base.seeds,
+            moved_by: base.moved_by,
             k: 0,
             segment: 0,
             ends: Vec::new(),
@@ -137,6 +140,7 @@ impl<'a> PlanarArm<'a> {
             body_link: Vec::new(),
             strains: Vec::new(),
             seeds: Vec::new(),
+            moved_by: Vec::new(),
             k: 0,
             segment: 0,
             ends: Vec::new(),
@@ -228,6 +232,7 @@ impl<'a> PlanarArm<'a> {
         let (k, link, z, zero) = (self.k, self.links.len(), self.z, self.zero);
         let mut pairs = self.coords.rate_pairs();
         pairs.extend(&self.seeds);
+        pairs.extend(&self.moved_by);
         self.applied.element(
             cas,
             &self.loads,

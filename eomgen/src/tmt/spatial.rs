@@ -410,6 +410,8 @@ pub(crate) struct SpatialArm<'a> {
     links: Vec<Link>,
     body_link: Vec<usize>,
     seeds: Vec<(ExprId, ExprId)>,
+    /// What else moves its points: a compliant base's coordinates.
+    moved_by: Vec<(ExprId, ExprId)>,
     /// The next coordinate.
     pub c: usize,
     /// The next element (slice, link).
@@ -572,6 +574,7 @@ impl<'a> SpatialArm<'a> {
             links: Vec::new(),
             body_link: Vec::new(),
             seeds: base.seeds,
+            moved_by: base.moved_by,
             c: 0,
             k: 0,
             shared_coordinates: false,
@@ -623,6 +626,7 @@ impl<'a> SpatialArm<'a> {
         let (k, link) = (self.k, self.links.len());
         let mut pairs = self.coords.rate_pairs();
         pairs.extend(&self.seeds);
+        pairs.extend(&self.moved_by);
         self.applied.element(
             cas,
             &self.loads,

@@ -15,6 +15,7 @@ pub struct ParamSymbols {
     zero: ExprId,
     /// A compliant base's displacement: coordinates of the assembly.
     base_offset: Option<[ExprId; 3]>,
+    base_seeds: Vec<(ExprId, ExprId)>,
     /// A compliant base's turn: a rotation vector and its rate.
     base_twist: Option<([ExprId; 3], [ExprId; 3])>,
 }
@@ -37,14 +38,18 @@ impl ParamSymbols {
             ids,
             zero: cas.zero(),
             base_offset: None,
+            base_seeds: Vec::new(),
             base_twist: None,
         }
     }
 
     /// The base rides on coordinates (a compliant base of an assembly):
     /// its displacement from the declared position.
-    pub fn with_base_offset(mut self, offset: [ExprId; 3]) -> Self {
+    /// A compliant base: its offset (coordinates) and the (coordinate,
+    /// rate) pairs that move it, `seeds` of the base's motion.
+    pub fn with_base_offset(mut self, offset: [ExprId; 3], seeds: &[(ExprId, ExprId)]) -> Self {
         self.base_offset = Some(offset);
+        self.base_seeds = seeds.to_vec();
         self
     }
 
@@ -118,6 +123,7 @@ impl ParamSymbols {
             turns,
             twist: self.base_twist,
             seeds,
+            moved_by: self.base_seeds.clone(),
         }
     }
 
@@ -141,6 +147,10 @@ pub struct BaseMotion {
     pub twist: Option<([ExprId; 3], [ExprId; 3])>,
     /// (parameter, its rate) pairs for the kinematic time derivatives.
     pub seeds: Vec<(ExprId, ExprId)>,
+    /// A compliant base's (coordinate, rate) pairs: an assembly's
+    /// coordinates (its equations take their rates from its own list), which
+    /// the arm's own velocities (drag) add to `seeds`.
+    pub moved_by: Vec<(ExprId, ExprId)>,
 }
 
 /// q, qd symbols and their names.
