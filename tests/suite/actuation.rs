@@ -254,6 +254,39 @@ value = {p}
     assert!((naive - theta).abs() > 0.05 * theta, "{naive} {theta}");
 }
 
+/// Two opposed chambers of unequal radii (`radius = [r1, r2]`) at one
+/// pressure: the larger pushes harder and the section's centroid moves
+/// away from it, z_c = -(a1 - a2) d / A; the arm bends about the centroid
+/// by the net lever p (a1 (d - z_c) - a2 (d + z_c)) over E I_y, I_y the
+/// ring less each hole's own and parallel-axis moments, less A z_c^2.
+#[test]
+fn two_opposed_chambers_of_unequal_radii_bend_the_arm_away_from_the_larger() {
+    let dir = tempfile::tempdir().unwrap();
+    let (r1, r2, d, p) = (0.003, 0.002, 0.005, 1.0e5);
+    let text = arm(&(segment(L, "twist = false")
+        + &format!(
+            r#"
+[segment.chambers]
+angles = [90.0, 270.0]
+radius = [{r1}, {r2}]
+distance = {d}
+inputs = ["p", "p"]
+[inputs.p]
+kind = "constant"
+value = {p}
+"#
+        )));
+    let (tip, _) = static_tip(dir.path(), &text, &[]);
+    let (a1, a2) = (PI * r1 * r1, PI * r2 * r2);
+    let area = PI * R * R - a1 - a2;
+    let zc = -(a1 - a2) * d / area;
+    let own = a1 * r1 * r1 / 4.0 + a2 * r2 * r2 / 4.0;
+    let i_y = PI * R.powi(4) / 4.0 - own - (a1 + a2) * d * d - area * zc * zc;
+    let theta = p * (a1 * (d - zc) - a2 * (d + zc)) * L / (E * i_y);
+    assert_tip(tip, arc(L, theta, [0.0, 1.0, 0.0]), "unequal chambers");
+    assert!(tip[2] < 0.0, "bends away from the larger chamber: {tip:?}");
+}
+
 #[test]
 fn a_pulled_tendon_bends_its_segments_towards_it_and_a_slack_one_pulls_nothing() {
     let dir = tempfile::tempdir().unwrap();

@@ -1259,6 +1259,24 @@ fn chamber_and_input_cases() -> Vec<FileCase> {
             vec!["segment[0].chambers", "principal axes"],
         ),
         (
+            "radii not one per position",
+            r("radius = 0.002", "radius = [0.002, 0.001]"),
+            vec!["segment[0].chambers.radius", "one per position (3), got 2"],
+        ),
+        (
+            "a radius of zero",
+            r("radius = 0.002", "radius = [0.002, 0.0, 0.002]"),
+            vec!["segment[0].chambers.radius", "must be positive, got 0"],
+        ),
+        (
+            "holes of unequal radii overlapping",
+            r(
+                "angles = [0, 120, 240]\nradius = 0.002",
+                "angles = [0, 60, 240]\nradius = [0.0035, 0.0035, 0.002]",
+            ),
+            vec!["segment[0].chambers", "overlap"],
+        ),
+        (
             "count and angles",
             r(
                 "angles = [0, 120, 240]",

@@ -834,40 +834,56 @@ fn check_chambers(
             format!("must be an angle between 0 and 90 degrees, got {h}"),
         );
     }
-    for (key, v) in [("radius", c.radius), ("distance", c.distance)] {
-        if !(v.is_finite() && v > 0.0) {
-            return err(key, format!("must be positive, got {v}"));
+    let positions = c.positions().len();
+    let per_position = [("radius", Some(&c.radius)), ("area", c.area.as_ref())];
+    for (key, v) in per_position {
+        let Some(v) = v else { continue };
+        let given = v.given();
+        if let crate::model::OneOrMany::Many(list) = v
+            && list.len() != positions
+        {
+            return err(
+                key,
+                format!(
+                    "give one value or one per position ({positions}), got {}",
+                    list.len()
+                ),
+            );
+        }
+        if let Some(x) = given.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
+            return err(key, format!("must be positive, got {x}"));
         }
     }
-    if let Some(a) = c.area
-        && !(a.is_finite() && a > 0.0)
-    {
-        return err("area", format!("must be positive, got {a}"));
+    if !(c.distance.is_finite() && c.distance > 0.0) {
+        return err("distance", format!("must be positive, got {}", c.distance));
     }
     let ri = inner.unwrap_or(0.0);
-    if c.distance - c.radius < ri || c.distance + c.radius > ro {
+    let holes = c.hole_list();
+    if let Some(h) = holes
+        .iter()
+        .find(|h| c.distance - h.radius < ri || c.distance + h.radius > ro)
+    {
         return err(
             "",
             format!(
                 "holes of radius {} at distance {} must lie in the wall between inner radius {ri} and outer radius {ro}",
-                c.radius, c.distance
+                h.radius, c.distance
             ),
         );
     }
-    let holes = c.holes();
-    let centre = |a: f64| {
-        let a = a.to_radians();
+    let centre = |h: &crate::model::Hole| {
+        let a = h.angle.to_radians();
         (c.distance * a.cos(), c.distance * a.sin())
     };
-    for (i, &a) in holes.iter().enumerate() {
-        for &b in &holes[i + 1..] {
+    for (i, a) in holes.iter().enumerate() {
+        for b in &holes[i + 1..] {
             let ((ya, za), (yb, zb)) = (centre(a), centre(b));
-            if (ya - yb).hypot(za - zb) <= 2.0 * c.radius {
+            if (ya - yb).hypot(za - zb) <= a.radius + b.radius {
                 return err(
                     "",
                     format!(
-                        "holes of radius {} at distance {} and angles {a} and {b} degrees overlap",
-                        c.radius, c.distance
+                        "holes of radius {} and {} at distance {} and angles {} and {} degrees overlap",
+                        a.radius, b.radius, c.distance, a.angle, b.angle
                     ),
                 );
             }

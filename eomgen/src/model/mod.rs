@@ -38,7 +38,7 @@ pub use profile::Profile;
 pub use relaxation::Relaxation;
 pub use rest::RestCurvature;
 pub use schema::{
-    Axis, Base, Chambers, Joints, Method, Model, OneOrMany, Segment, SimulateDefaults, Start,
+    Axis, Base, Chambers, Hole, Joints, Method, Model, OneOrMany, Segment, SimulateDefaults, Start,
     Tendon, Tip, Torque, WrenchFrame,
 };
 pub use section::SectionShape;

@@ -643,7 +643,7 @@ pub(crate) fn chamber_value(m: &Model, segment: usize, position: usize, what: Ch
         .chambers
         .as_ref()
         .expect("the structure has this segment's chambers");
-    let a = c.hole_area();
+    let a = c.hole_area(position);
     let angle = c.positions()[position];
     let holes: Vec<f64> = match c.pair_spacing {
         Some(spacing) => vec![angle - spacing, angle + spacing],

@@ -449,21 +449,26 @@ impl Segment {
         let Some(c) = &self.chambers else {
             return Some([ring, ring]);
         };
-        let a = pi * c.radius * c.radius;
-        let holes = c.holes();
-        let n = holes.len() as f64;
-        let (r2, d2) = (c.radius * c.radius, c.distance * c.distance);
+        let holes = c.hole_list();
+        let d2 = c.distance * c.distance;
+        // Each hole's own moment (pi r^4 / 4) and its parallel-axis term
+        // about the circle's centre.
+        let own: f64 = holes.iter().map(|h| pi * h.radius.powi(4) / 4.0).sum();
+        let area_of = |h: &Hole| pi * h.radius * h.radius;
         if c.isotropic() {
-            let i = ring - n * (a * r2 / 4.0 + a * d2 / 2.0);
+            let total: f64 = holes.iter().map(area_of).sum();
+            let i = ring - (own + total * d2 / 2.0);
             return Some([i, i]);
         }
-        let sum = |f: fn(f64) -> f64| -> f64 { holes.iter().map(|h| f(h.to_radians())).sum() };
+        let sum = |f: fn(f64) -> f64| -> f64 {
+            holes
+                .iter()
+                .map(|h| area_of(h) * f(h.angle.to_radians()))
+                .sum()
+        };
         let cos2 = sum(|t| t.cos().powi(2));
         let sin2 = sum(|t| t.sin().powi(2));
-        let about_axis = [
-            ring - (n * a * r2 / 4.0 + a * d2 * sin2),
-            ring - (n * a * r2 / 4.0 + a * d2 * cos2),
-        ];
+        let about_axis = [ring - (own + d2 * sin2), ring - (own + d2 * cos2)];
         if c.centred(false) {
             return Some(about_axis);
         }
@@ -486,11 +491,10 @@ impl Segment {
         if c.centred(false) {
             return [0.0, 0.0];
         }
-        let a = std::f64::consts::PI * c.radius * c.radius;
+        let pi = std::f64::consts::PI;
         let first = |f: fn(f64) -> f64| -> f64 {
-            c.holes()
-                .iter()
-                .map(|h| a * c.distance * f(h.to_radians()))
+            (c.hole_list().iter())
+                .map(|h| pi * h.radius * h.radius * c.distance * f(h.angle.to_radians()))
                 .sum()
         };
         // The holes' material is missing: the centroid moves away from them.
@@ -503,13 +507,13 @@ impl Segment {
         let (Some(c), Some(area)) = (&self.chambers, self.area()) else {
             return 0.0;
         };
-        let a = std::f64::consts::PI * c.radius * c.radius;
         let d2 = c.distance * c.distance;
-        let about_axis: f64 = -c
-            .holes()
-            .iter()
+        let about_axis: f64 = -(c.hole_list().iter())
             .map(|h| {
-                let t = h.to_radians();
+                let (t, a) = (
+                    h.angle.to_radians(),
+                    std::f64::consts::PI * h.radius * h.radius,
+                );
                 a * d2 * t.cos() * t.sin()
             })
             .sum::<f64>();
@@ -561,10 +565,9 @@ impl Segment {
         }
         let ro = self.outer()?;
         let ri = self.inner().unwrap_or(0.0);
-        let holes = self
-            .chambers
-            .as_ref()
-            .map_or(0.0, |c| c.holes().len() as f64 * c.radius * c.radius);
+        let holes = self.chambers.as_ref().map_or(0.0, |c| {
+            c.hole_list().iter().map(|h| h.radius * h.radius).sum()
+        });
         Some(std::f64::consts::PI * (ro * ro - ri * ri - holes))
     }
 
@@ -667,13 +670,21 @@ fn two() -> u8 {
     2
 }
 
+/// One chamber hole: its angle (degrees) and radius (m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hole {
+    pub angle: f64,
+    pub radius: f64,
+}
+
 /// Circular chamber holes along a segment, in the wall of its section:
 /// pneumatic actuators when `inputs` drive them, passive holes otherwise.
 ///
 /// Holes sit at `positions()` (degrees in the section, from the element
 /// frame's y axis towards its z axis), each position a single hole or,
 /// with `pair_spacing`, a pair at +- that angle (STIFF-FLOP's braided
-/// pairs). The hole pattern must leave the section isotropic in bending.
+/// pairs), of one radius or each position its own. In 3D the pattern must
+/// keep the section's principal axes on y and z.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Chambers {
@@ -686,13 +697,14 @@ pub struct Chambers {
     /// Each position a pair of holes at +- this angle (degrees).
     #[serde(default)]
     pub pair_spacing: Option<f64>,
-    /// Hole radius (m).
-    pub radius: f64,
+    /// Hole radius (m): one for every position, or one per position.
+    pub radius: OneOrMany,
     /// Distance of the hole centres from the axis (m).
     pub distance: f64,
-    /// Area the pressure acts on, per hole (m^2); default pi radius^2.
+    /// Area the pressure acts on, per hole (m^2; one, or one per
+    /// position); default pi radius^2.
     #[serde(default)]
-    pub area: Option<f64>,
+    pub area: Option<OneOrMany>,
     /// Input channel (pressure, Pa, gauge) of each position: structural.
     #[serde(default)]
     pub inputs: Option<Vec<String>>,
@@ -717,28 +729,49 @@ impl Chambers {
         }
     }
 
-    /// Whether the holes bend alike about every diameter: sum cos 2a =
-    /// sum sin 2a = 0 makes I_y = I_z and I_yz = 0 (to round-off).
+    /// Every hole: its angle (degrees) and radius (m), its position's.
+    pub fn hole_list(&self) -> Vec<Hole> {
+        let radii = self.radius.values(self.positions().len());
+        let pos = self.positions();
+        pos.iter()
+            .zip(radii)
+            .flat_map(|(&a, radius)| match self.pair_spacing {
+                Some(h) => vec![(a - h, radius), (a + h, radius)],
+                None => vec![(a, radius)],
+            })
+            .map(|(angle, radius)| Hole { angle, radius })
+            .collect()
+    }
+
+    /// The holes all of one radius.
+    pub fn equal_radii(&self) -> bool {
+        let r = self.radius.values(self.positions().len());
+        r.windows(2).all(|w| w[0] == w[1])
+    }
+
+    /// Whether the holes bend alike about every diameter: sum a cos 2t =
+    /// sum a sin 2t = 0 (a each hole's area) makes I_y = I_z and I_yz = 0
+    /// (to round-off).
     pub fn isotropic(&self) -> bool {
-        let holes = self.holes();
-        let (cs, sn) = holes.iter().fold((0.0, 0.0), |(x, y): (f64, f64), a| {
-            let t = 2.0 * a.to_radians();
-            (x + t.cos(), y + t.sin())
+        let holes = self.hole_list();
+        let (cs, sn, total) = holes.iter().fold((0.0, 0.0, 0.0), |(x, y, s), h| {
+            let (t, a) = (2.0 * h.angle.to_radians(), h.radius * h.radius);
+            (x + a * t.cos(), y + a * t.sin(), s + a)
         });
-        cs.hypot(sn) <= 1e-6 * holes.len() as f64
+        cs.hypot(sn) <= 1e-6 * total
     }
 
     /// Whether the holes leave the section's centroid on the arm's axis:
     /// sum cos a = 0 (the y offsets, all a planar arm bends by) and, in 3D,
     /// sum sin a = 0 too (to round-off).
     pub fn centred(&self, planar: bool) -> bool {
-        let holes = self.holes();
-        let (y, z) = holes.iter().fold((0.0, 0.0), |(y, z): (f64, f64), a| {
-            let a = a.to_radians();
-            (y + a.cos(), z + a.sin())
+        let holes = self.hole_list();
+        let (y, z, total) = holes.iter().fold((0.0, 0.0, 0.0), |(y, z, s), h| {
+            let (t, a) = (h.angle.to_radians(), h.radius * h.radius);
+            (y + a * t.cos(), z + a * t.sin(), s + a)
         });
         let off = if planar { y.abs() } else { y.hypot(z) };
-        off <= 1e-6 * holes.len() as f64
+        off <= 1e-6 * total
     }
 
     /// Holes per position.
@@ -746,10 +779,13 @@ impl Chambers {
         if self.pair_spacing.is_some() { 2 } else { 1 }
     }
 
-    /// Pressure area of one hole (m^2).
-    pub fn hole_area(&self) -> f64 {
-        self.area
-            .unwrap_or(std::f64::consts::PI * self.radius * self.radius)
+    /// Pressure area of one hole at `position` (m^2).
+    pub fn hole_area(&self, position: usize) -> f64 {
+        let n = self.positions().len();
+        match &self.area {
+            Some(a) => a.values(n)[position],
+            None => std::f64::consts::PI * self.radius.values(n)[position].powi(2),
+        }
     }
 }
 
@@ -783,7 +819,7 @@ pub struct Torque {
     pub input: String,
 }
 
-/// A number, or one per segment.
+/// A number, or one per item (a tendon's segments, a chamber's positions).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum OneOrMany {
@@ -792,11 +828,24 @@ pub enum OneOrMany {
 }
 
 impl OneOrMany {
-    /// The value for segment `s`.
+    /// The value for item `s`.
     pub fn at(&self, s: usize) -> f64 {
         match self {
             OneOrMany::One(v) => *v,
             OneOrMany::Many(v) => v.get(s).copied().unwrap_or(f64::NAN),
+        }
+    }
+
+    /// The values of `n` items.
+    pub fn values(&self, n: usize) -> Vec<f64> {
+        (0..n).map(|i| self.at(i)).collect()
+    }
+
+    /// Every value given.
+    pub fn given(&self) -> Vec<f64> {
+        match self {
+            OneOrMany::One(v) => vec![*v],
+            OneOrMany::Many(v) => v.clone(),
         }
     }
 }
@@ -1012,6 +1061,71 @@ fn active() -> bool {
 mod tests {
     use super::*;
 
+    /// Holes of unequal radii: the area, the centroid (off the axis), the
+    /// second moments and the product moment about it, against a grid
+    /// integral of the section.
+    #[test]
+    fn chambers_of_unequal_radii_shape_the_section_as_a_grid_integral_says() {
+        for chambers in [
+            "chambers = { angles = [90, 270], radius = [0.003, 0.0015], distance = 0.007 }",
+            "chambers = { angles = [0, 120, 240], radius = [0.002, 0.003, 0.0025], distance = 0.0075 }",
+        ] {
+            let seg: Segment = toml::from_str(&format!(
+                r#"
+                method = "pcc"
+                length = 0.1
+                outer_radius = 0.0125
+                inner_radius = 0.003
+                {chambers}
+                "#
+            ))
+            .unwrap();
+            let c = seg.chambers.clone().unwrap();
+            let (ro, ri) = (0.0125f64, 0.003f64);
+            let n = 2000;
+            let h = 2.0 * ro / n as f64;
+            // Sums of 1, y, z, y^2, z^2, y z over the material.
+            let mut m = [0.0f64; 6];
+            for a in 0..n {
+                for b in 0..n {
+                    let (y, z) = (-ro + (a as f64 + 0.5) * h, -ro + (b as f64 + 0.5) * h);
+                    let r2 = y * y + z * z;
+                    if r2 > ro * ro || r2 < ri * ri {
+                        continue;
+                    }
+                    let hole = c.hole_list().iter().any(|hole| {
+                        let phi = hole.angle.to_radians();
+                        let (cy, cz) = (c.distance * phi.cos(), c.distance * phi.sin());
+                        (y - cy).powi(2) + (z - cz).powi(2) < hole.radius * hole.radius
+                    });
+                    if !hole {
+                        for (k, v) in [1.0, y, z, y * y, z * z, y * z].iter().enumerate() {
+                            m[k] += v * h * h;
+                        }
+                    }
+                }
+            }
+            let area = m[0];
+            let (yc, zc) = (m[1] / area, m[2] / area);
+            let iy = m[4] - area * zc * zc;
+            let iz = m[3] - area * yc * yc;
+            let iyz = m[5] - area * yc * zc;
+            let a = seg.area().unwrap();
+            assert!((a - area).abs() < 2e-3 * a, "area {a} vs grid {area}");
+            let [cy, cz] = seg.centroid();
+            let scale = 2e-3 * (yc.abs() + zc.abs());
+            assert!(
+                (cy - yc).abs() + (cz - zc).abs() < scale,
+                "centroid {cy} {cz} vs {yc} {zc}"
+            );
+            let [sy, sz] = seg.second_moments().unwrap();
+            assert!((sy - iy).abs() < 2e-3 * sy, "I_y {sy} vs grid {iy}");
+            assert!((sz - iz).abs() < 2e-3 * sz, "I_z {sz} vs grid {iz}");
+            let p = seg.product_moment();
+            assert!((p - iyz).abs() < 2e-3 * sy, "I_yz {p} vs grid {iyz}");
+        }
+    }
+
     #[test]
     fn chamber_holes_reduce_area_and_second_moment_as_a_grid_integral_says() {
         // Six equally spaced holes, and STIFF-FLOP's three pairs at +-20.33
@@ -1046,7 +1160,7 @@ mod tests {
                     let hole = c.holes().iter().any(|deg| {
                         let phi = deg.to_radians() + 0.3;
                         let (cy, cz) = (c.distance * phi.cos(), c.distance * phi.sin());
-                        (y - cy).powi(2) + (z - cz).powi(2) < c.radius * c.radius
+                        (y - cy).powi(2) + (z - cz).powi(2) < c.radius.at(0).powi(2)
                     });
                     if !hole {
                         area += h * h;
