@@ -289,7 +289,10 @@ impl Segment {
     /// Joint placement actually used (rigid segments).
     pub fn joint_placement(&self) -> Joints {
         self.joints.unwrap_or(
-            if self.youngs_modulus.is_some() || self.bending_stiffness.is_some() {
+            if self.youngs_modulus.is_some()
+                || self.bending_stiffness.is_some()
+                || self.given().is_some()
+            {
                 Joints::Midpoint
             } else {
                 Joints::Base
