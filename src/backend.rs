@@ -161,6 +161,14 @@ fn linked(
     }
     if arms
         .iter()
+        .any(|s| s.segments.iter().any(|g| g.chambers_vary))
+    {
+        return Err(
+            "its chambers' levers vary along a segment, which link cells do not carry yet".into(),
+        );
+    }
+    if arms
+        .iter()
         .any(|s| !s.loads.is_empty() || s.fluid.is_some())
     {
         return Err("its loads along the arm are not link cells yet".into());

@@ -287,6 +287,93 @@ value = {p}
     assert!(tip[2] < 0.0, "bends away from the larger chamber: {tip:?}");
 }
 
+/// A chamber whose distance from the axis varies along the segment
+/// (`distance = [d0, d1]`): at each s the section loses the hole there, so
+/// the centroid sits at z_c(s) = -a d(s) / A, I_y(s) about it, and the arm
+/// bends by kappa(s) = p a (d(s) - z_c(s)) / (E I_y(s)). Reference: the
+/// plane curve of that curvature, theta(s) = int kappa, x = int cos theta,
+/// z = -int sin theta, by Simpson's rule in the test. Each element reads
+/// its section and lever at its middle: pcc and ebr converge to it at
+/// second order, and rom by its slices.
+#[test]
+fn a_chamber_whose_offset_tapers_bends_the_arm_by_its_local_lever() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rc, d0, d1, p) = (0.002, 0.007, 0.004, 1.0e5);
+    let text = arm(&(segment(L, "twist = false")
+        + &format!(
+            r#"
+[segment.chambers]
+angles = [90.0]
+radius = {rc}
+distance = [{d0}, {d1}]
+inputs = ["p"]
+[inputs.p]
+kind = "constant"
+value = {p}
+"#
+        )));
+    let a = PI * rc * rc;
+    let area = PI * R * R - a;
+    let kappa = |s: f64| {
+        let d = d0 + (d1 - d0) * s / L;
+        let zc = -a * d / area;
+        let i_y = PI * R.powi(4) / 4.0 - (a * rc * rc / 4.0 + a * d * d) - area * zc * zc;
+        p * a * (d - zc) / (E * i_y)
+    };
+    // theta(s) is a cubic-free integral: Simpson on a fine grid, then the
+    // position by Simpson again.
+    let steps = 2000;
+    let h = L / steps as f64;
+    let mut theta = vec![0.0; steps + 1];
+    for i in 0..steps {
+        let s = i as f64 * h;
+        theta[i + 1] = theta[i] + h / 6.0 * (kappa(s) + 4.0 * kappa(s + h / 2.0) + kappa(s + h));
+    }
+    let simpson = |f: &dyn Fn(f64) -> f64| {
+        (0..=steps)
+            .map(|i| {
+                let w = if i == 0 || i == steps {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * f(theta[i])
+            })
+            .sum::<f64>()
+            * h
+            / 3.0
+    };
+    let want = [simpson(&|t: f64| t.cos()), 0.0, -simpson(&|t: f64| t.sin())];
+    // The lever and stiffness differ by half from base to tip.
+    assert!(kappa(0.0) > 1.5 * kappa(L), "{} {}", kappa(0.0), kappa(L));
+    let err = |method: &str, key: &str, n: usize| {
+        let sets = [
+            format!("segment.0.method={method}"),
+            format!("segment.0.{key}={n}"),
+        ];
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let (tip, _) = static_tip(dir.path(), &text, &sets);
+        (0..3)
+            .map(|k| (tip[k] - want[k]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+            / L
+    };
+    for (method, key) in [
+        ("pcc", "elements"),
+        ("ebr", "elements"),
+        ("rom", "quadrature"),
+    ] {
+        let (coarse, fine) = (err(method, key, 4), err(method, key, 8));
+        assert!(
+            fine < 1e-4 && fine * 3.5 < coarse,
+            "{method}: {coarse:e} of L off at 4, {fine:e} at 8"
+        );
+    }
+}
+
 #[test]
 fn a_pulled_tendon_bends_its_segments_towards_it_and_a_slack_one_pulls_nothing() {
     let dir = tempfile::tempdir().unwrap();

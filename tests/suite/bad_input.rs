@@ -1259,6 +1259,11 @@ fn chamber_and_input_cases() -> Vec<FileCase> {
             vec!["segment[0].chambers", "principal axes"],
         ),
         (
+            "a chamber offset tapering out of the wall",
+            r("distance = 0.006", "distance = [0.006, 0.02]"),
+            vec!["segment[0].chambers", "must lie in the wall", "at s/L = 1"],
+        ),
+        (
             "radii not one per position",
             r("radius = 0.002", "radius = [0.002, 0.001]"),
             vec!["segment[0].chambers.radius", "one per position (3), got 2"],

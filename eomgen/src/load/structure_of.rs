@@ -86,6 +86,11 @@ impl Structure {
                             || (spatial && method.rest_always_3d() && s.rest_key().is_some()),
                         anisotropic: s.anisotropic(m.dimensions),
                         kink: s.kinked(),
+                        chambers_vary: s.chambers.as_ref().is_some_and(|c| {
+                            c.inputs.is_some()
+                                && (c.distance.uniform().is_none()
+                                    || s.tapered() && !c.centred(m.dimensions == 2))
+                        }),
                         twist: spatial && twist,
                         extension: spatial && extension,
                         shear: spatial && shear,

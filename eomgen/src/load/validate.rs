@@ -464,7 +464,7 @@ fn segment_section(ck: &Check, i: usize, s: &Segment) -> Result<(), ModelError> 
                 format!("must be smaller than outer_radius ({ro}), got {ri}{at}"),
             );
         }
-        if let Some(c) = &s.chambers {
+        if let Some(c) = &here.chambers {
             let planar = ck.m.dimensions == 2;
             check_chambers(&here, c, &p("chambers"), planar, ck.file)
                 .map_err(|e| e.with_suffix(&at))?;
@@ -854,26 +854,27 @@ fn check_chambers(
             return err(key, format!("must be positive, got {x}"));
         }
     }
-    if !(c.distance.is_finite() && c.distance > 0.0) {
-        return err("distance", format!("must be positive, got {}", c.distance));
+    let d = c.offset();
+    if !(d.is_finite() && d > 0.0) {
+        return err("distance", format!("must be positive, got {d}"));
     }
     let ri = inner.unwrap_or(0.0);
     let holes = c.hole_list();
     if let Some(h) = holes
         .iter()
-        .find(|h| c.distance - h.radius < ri || c.distance + h.radius > ro)
+        .find(|h| d - h.radius < ri || d + h.radius > ro)
     {
         return err(
             "",
             format!(
                 "holes of radius {} at distance {} must lie in the wall between inner radius {ri} and outer radius {ro}",
-                h.radius, c.distance
+                h.radius, d
             ),
         );
     }
     let centre = |h: &crate::model::Hole| {
         let a = h.angle.to_radians();
-        (c.distance * a.cos(), c.distance * a.sin())
+        (d * a.cos(), d * a.sin())
     };
     for (i, a) in holes.iter().enumerate() {
         for b in &holes[i + 1..] {
@@ -883,7 +884,7 @@ fn check_chambers(
                     "",
                     format!(
                         "holes of radius {} and {} at distance {} and angles {} and {} degrees overlap",
-                        a.radius, b.radius, c.distance, a.angle, b.angle
+                        a.radius, b.radius, d, a.angle, b.angle
                     ),
                 );
             }

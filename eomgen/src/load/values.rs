@@ -4,9 +4,9 @@
 
 use crate::model::sensor::{Source, wrench_sources};
 use crate::model::{
-    BodyParam, ElementParam, FluidParam, JointParam, KinkParam, LoadParam, Model, Param,
-    ParamLayout, Segment, SpringParam, Structure, base_quaternion, base_rotation, base_turn_axis,
-    chamber_value,
+    BodyParam, ChamberParam, ElementParam, FluidParam, JointParam, KinkParam, LoadParam, Model,
+    Param, ParamLayout, Segment, SpringParam, Structure, base_quaternion, base_rotation,
+    base_turn_axis, chamber_value, chamber_value_of,
 };
 
 impl ParamLayout {
@@ -71,6 +71,11 @@ impl ParamLayout {
                     position,
                     what,
                 } => chamber_value(m, segment, position, what),
+                Param::ChamberArm {
+                    element,
+                    position,
+                    z,
+                } => chamber_arm(m, element, position, z),
                 Param::TendonTension(_) | Param::Torque(_) => 0.0,
                 // A driven component starts at 0: its input sets it.
                 Param::Load(i, LoadParam::Force(c)) => {
@@ -260,6 +265,25 @@ impl ElementProps {
             ElementParam::ShearStiffnessZ => self.shear_stiffness_z,
         }
     }
+}
+
+/// Element `element`'s lever of a chamber position (y's, or z's): its
+/// segment's section and holes at the element's middle.
+fn chamber_arm(m: &Model, element: usize, position: usize, z: bool) -> f64 {
+    let mut k = element;
+    for s in &m.segments {
+        let n = s.slices();
+        if k < n {
+            let what = if z {
+                ChamberParam::ArmZ
+            } else {
+                ChamberParam::ArmY
+            };
+            return chamber_value_of(&s.at((k as f64 + 0.5) / n as f64), position, what);
+        }
+        k -= n;
+    }
+    unreachable!("the layout's element {element} is one of the model's")
 }
 
 /// Each element's values (a rom segment's: each slice's): a tapered

@@ -441,6 +441,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         );
         strains.push(Strain {
             segment,
+            element: k,
             ..joint.strain
         });
         elastic.extend(joint.elastic);
@@ -657,6 +658,7 @@ fn beam_springs(
     // the relative rotation measure.
     let strain = Strain {
         segment: 0,
+        element: 0,
         stretch: local[0],
         rho: v,
         offset_scale: thin.map(|t| t.1),

@@ -262,6 +262,7 @@ fn joint(cas: &mut Cas, arm: &mut SpatialArm, g: &SegmentShape, s: usize) -> Fra
     }
     arm.strains.push(Strain {
         segment: s,
+        element: arm.k,
         stretch: zero,
         rho,
         offset_scale: None,

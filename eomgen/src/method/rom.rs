@@ -105,6 +105,7 @@ impl ModellingMethod for Rom {
                 // on each half's coordinates.
                 arm.strains.push(Strain {
                     segment: s,
+                    element: arm.k,
                     stretch: cas.scaled(0.5, st),
                     rho: rho.map(|x| cas.scaled(0.5, x)),
                     offset_scale: thin,

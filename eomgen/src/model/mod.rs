@@ -33,7 +33,7 @@ pub use params::{
     BodyParam, ChamberParam, Driven, ElementParam, FluidParam, JointParam, KinkParam, LoadParam,
     Param, ParamLayout, Rate, SpringParam, Xyz, base_rotation, base_turn_axis, channel,
 };
-pub(crate) use params::{base_quaternion, chamber_value};
+pub(crate) use params::{base_quaternion, chamber_value, chamber_value_of};
 pub use profile::Profile;
 pub use relaxation::Relaxation;
 pub use rest::RestCurvature;

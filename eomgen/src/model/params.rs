@@ -14,7 +14,7 @@
 
 use std::collections::HashMap;
 
-use super::schema::Model;
+use super::schema::{Model, Segment};
 use super::structure::Structure;
 
 /// A component of a vector in the world frame.
@@ -219,6 +219,14 @@ pub enum Param {
         position: usize,
         what: ChamberParam,
     },
+    /// Element `element`'s lever of chamber position `position` (a sum of
+    /// hole area times offset, y's then z's, as `ChamberParam::ArmY` and
+    /// `ArmZ`), where the levers vary along the segment.
+    ChamberArm {
+        element: usize,
+        position: usize,
+        z: bool,
+    },
     /// Tendon i's tension (an input).
     TendonTension(usize),
     /// Tendon i's offset in the section of a segment it spans: y, z.
@@ -340,6 +348,14 @@ impl Param {
                 let w = ["pressure", "area", "arm_y", "arm_z"][what as usize];
                 format!("chamber[{segment}][{position}].{w}")
             }
+            Self::ChamberArm {
+                element,
+                position,
+                z,
+            } => format!(
+                "element[{element}].chamber[{position}].{}",
+                if z { "arm_z" } else { "arm_y" }
+            ),
             Self::TendonTension(i) => format!("tendon[{i}].tension"),
             Self::TendonOffset { tendon, segment, z } => {
                 format!("tendon[{tendon}][{segment}].{}", if z { "z" } else { "y" })
@@ -508,6 +524,23 @@ impl ParamLayout {
                 }
             }
         }
+        let mut first = 0;
+        for (g, &count) in st.segments.iter().zip(&st.chambers) {
+            if g.chambers_vary {
+                for element in first..first + g.elements {
+                    for position in 0..count {
+                        for z in [false, true] {
+                            p.push(Param::ChamberArm {
+                                element,
+                                position,
+                                z,
+                            });
+                        }
+                    }
+                }
+            }
+            first += g.elements;
+        }
         for (tendon, &end) in st.tendons.iter().enumerate() {
             drive(&mut p, &mut driven, Param::TendonTension(tendon), 0);
             for segment in 0..=end {
@@ -638,7 +671,11 @@ pub fn channel(m: &Model, p: Param) -> Option<&str> {
 /// the holes' total area and first moments a sum(z), a sum(y) about the
 /// section's centroid.
 pub(crate) fn chamber_value(m: &Model, segment: usize, position: usize, what: ChamberParam) -> f64 {
-    let seg = &m.segments[segment];
+    chamber_value_of(&m.segments[segment], position, what)
+}
+
+/// [`chamber_value`] of a segment (an element's: `Segment::at`).
+pub(crate) fn chamber_value_of(seg: &Segment, position: usize, what: ChamberParam) -> f64 {
     let c = seg
         .chambers
         .as_ref()
@@ -651,7 +688,7 @@ pub(crate) fn chamber_value(m: &Model, segment: usize, position: usize, what: Ch
     };
     let (y, z) = holes.iter().fold((0.0, 0.0), |(y, z), h| {
         let h = h.to_radians();
-        (y + c.distance * h.cos(), z + c.distance * h.sin())
+        (y + c.offset() * h.cos(), z + c.offset() * h.sin())
     });
     // Levers about the centroid, through which the centreline runs.
     let n = holes.len() as f64;

@@ -321,6 +321,10 @@ impl Segment {
             },
             rest_twist: here(&self.rest_twist),
             rest_stretch: here(&self.rest_stretch),
+            chambers: self.chambers.as_ref().map(|c| Chambers {
+                distance: Profile::Uniform(c.distance.at(x)),
+                ..c.clone()
+            }),
             ..self.clone()
         }
     }
@@ -385,7 +389,7 @@ impl Segment {
     }
 
     /// The keys that may vary along the segment, with their profiles.
-    pub fn profiles(&self) -> [(&'static str, Option<&Profile>); 8] {
+    pub fn profiles(&self) -> [(&'static str, Option<&Profile>); 9] {
         [
             ("density", self.density.as_ref()),
             ("outer_radius", self.outer_radius.as_ref()),
@@ -395,6 +399,10 @@ impl Segment {
             ("shear_modulus", self.shear_modulus.as_ref()),
             ("torsional_stiffness", self.torsional_stiffness.as_ref()),
             ("axial_stiffness", self.axial_stiffness.as_ref()),
+            (
+                "chambers.distance",
+                self.chambers.as_ref().map(|c| &c.distance),
+            ),
         ]
     }
 
@@ -453,25 +461,42 @@ impl Segment {
             return Some([ring, ring]);
         };
         let holes = c.hole_list();
-        let d2 = c.distance * c.distance;
-        // Each hole's own moment (pi r^4 / 4) and its parallel-axis term
-        // about the circle's centre.
-        let own: f64 = holes.iter().map(|h| pi * h.radius.powi(4) / 4.0).sum();
-        let area_of = |h: &Hole| pi * h.radius * h.radius;
-        if c.isotropic() {
-            let total: f64 = holes.iter().map(area_of).sum();
-            let i = ring - (own + total * d2 / 2.0);
-            return Some([i, i]);
-        }
-        let sum = |f: fn(f64) -> f64| -> f64 {
-            holes
+        let d2 = c.offset() * c.offset();
+        let about_axis = if c.equal_radii() {
+            // One radius: n (a r^2 / 4 + a d^2 / 2) when isotropic.
+            let r = holes[0].radius;
+            let (a, n, r2) = (pi * r * r, holes.len() as f64, r * r);
+            if c.isotropic() {
+                let i = ring - n * (a * r2 / 4.0 + a * d2 / 2.0);
+                return Some([i, i]);
+            }
+            let sum =
+                |f: fn(f64) -> f64| -> f64 { holes.iter().map(|h| f(h.angle.to_radians())).sum() };
+            let (cos2, sin2) = (sum(|t| t.cos().powi(2)), sum(|t| t.sin().powi(2)));
+            [
+                ring - (n * a * r2 / 4.0 + a * d2 * sin2),
+                ring - (n * a * r2 / 4.0 + a * d2 * cos2),
+            ]
+        } else {
+            // Each hole's own moment (a r^2 / 4) and its parallel-axis term
+            // about the circle's centre.
+            let area_of = |h: &Hole| pi * h.radius * h.radius;
+            let own: f64 = holes
                 .iter()
-                .map(|h| area_of(h) * f(h.angle.to_radians()))
-                .sum()
+                .map(|h| area_of(h) * h.radius * h.radius / 4.0)
+                .sum();
+            let sum = |f: fn(f64) -> f64| -> f64 {
+                (holes.iter())
+                    .map(|h| area_of(h) * f(h.angle.to_radians()))
+                    .sum()
+            };
+            let (cos2, sin2) = (sum(|t| t.cos().powi(2)), sum(|t| t.sin().powi(2)));
+            if c.isotropic() {
+                let i = ring - (own + d2 * (cos2 + sin2) / 2.0);
+                return Some([i, i]);
+            }
+            [ring - (own + d2 * sin2), ring - (own + d2 * cos2)]
         };
-        let cos2 = sum(|t| t.cos().powi(2));
-        let sin2 = sum(|t| t.sin().powi(2));
-        let about_axis = [ring - (own + d2 * sin2), ring - (own + d2 * cos2)];
         if c.centred(false) {
             return Some(about_axis);
         }
@@ -497,7 +522,7 @@ impl Segment {
         let pi = std::f64::consts::PI;
         let first = |f: fn(f64) -> f64| -> f64 {
             (c.hole_list().iter())
-                .map(|h| pi * h.radius * h.radius * c.distance * f(h.angle.to_radians()))
+                .map(|h| pi * h.radius * h.radius * c.offset() * f(h.angle.to_radians()))
                 .sum()
         };
         // The holes' material is missing: the centroid moves away from them.
@@ -510,7 +535,7 @@ impl Segment {
         let (Some(c), Some(area)) = (&self.chambers, self.area()) else {
             return 0.0;
         };
-        let d2 = c.distance * c.distance;
+        let d2 = c.offset().powi(2);
         let about_axis: f64 = -(c.hole_list().iter())
             .map(|h| {
                 let (t, a) = (
@@ -569,7 +594,11 @@ impl Segment {
         let ro = self.outer()?;
         let ri = self.inner().unwrap_or(0.0);
         let holes = self.chambers.as_ref().map_or(0.0, |c| {
-            c.hole_list().iter().map(|h| h.radius * h.radius).sum()
+            let holes = c.hole_list();
+            match c.equal_radii() {
+                true => holes.len() as f64 * holes[0].radius * holes[0].radius,
+                false => holes.iter().map(|h| h.radius * h.radius).sum(),
+            }
         });
         Some(std::f64::consts::PI * (ro * ro - ri * ri - holes))
     }
@@ -702,8 +731,9 @@ pub struct Chambers {
     pub pair_spacing: Option<f64>,
     /// Hole radius (m): one for every position, or one per position.
     pub radius: OneOrMany,
-    /// Distance of the hole centres from the axis (m).
-    pub distance: f64,
+    /// Distance of the hole centres from the axis (m): constant, or
+    /// varying along the segment (`[base, tip]` or a table over s/L).
+    pub distance: Profile,
     /// Area the pressure acts on, per hole (m^2; one, or one per
     /// position); default pi radius^2.
     #[serde(default)]
@@ -744,6 +774,12 @@ impl Chambers {
             })
             .map(|(angle, radius)| Hole { angle, radius })
             .collect()
+    }
+
+    /// The holes' distance from the axis: a uniform segment's (an
+    /// element's segment, `Segment::at`), else at the segment's middle.
+    pub fn offset(&self) -> f64 {
+        self.distance.at(0.5)
     }
 
     /// The holes all of one radius.
@@ -787,7 +823,10 @@ impl Chambers {
         let n = self.positions().len();
         match &self.area {
             Some(a) => a.values(n)[position],
-            None => std::f64::consts::PI * self.radius.values(n)[position].powi(2),
+            None => {
+                let r = self.radius.values(n)[position];
+                std::f64::consts::PI * r * r
+            }
         }
     }
 }
@@ -1098,7 +1137,7 @@ mod tests {
                     }
                     let hole = c.hole_list().iter().any(|hole| {
                         let phi = hole.angle.to_radians();
-                        let (cy, cz) = (c.distance * phi.cos(), c.distance * phi.sin());
+                        let (cy, cz) = (c.offset() * phi.cos(), c.offset() * phi.sin());
                         (y - cy).powi(2) + (z - cz).powi(2) < hole.radius * hole.radius
                     });
                     if !hole {
@@ -1162,7 +1201,7 @@ mod tests {
                     }
                     let hole = c.holes().iter().any(|deg| {
                         let phi = deg.to_radians() + 0.3;
-                        let (cy, cz) = (c.distance * phi.cos(), c.distance * phi.sin());
+                        let (cy, cz) = (c.offset() * phi.cos(), c.offset() * phi.sin());
                         (y - cy).powi(2) + (z - cz).powi(2) < c.radius.at(0).powi(2)
                     });
                     if !hole {

@@ -51,6 +51,10 @@ pub struct SegmentShape {
     /// It starts turned or offset from the previous segment's end (its
     /// `KinkParam`s exist).
     pub kink: bool,
+    /// Its driven chambers' levers vary along it (their distance from the
+    /// axis does, or the section does under holes off its centre): each
+    /// element reads its own (`Param::ChamberArm`).
+    pub chambers_vary: bool,
 }
 
 /// Everything that shapes the equations; numbers are left out.
@@ -191,6 +195,9 @@ impl Structure {
             }
             if g.kink {
                 s.push_str(" kink");
+            }
+            if g.chambers_vary {
+                s.push_str(" chambers_vary");
             }
             s.push('\n');
         }

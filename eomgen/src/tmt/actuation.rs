@@ -24,6 +24,8 @@ use super::system::ParamSymbols;
 /// The lumped strain of one element, slice or joint.
 pub struct Strain {
     pub segment: usize,
+    /// The element (slice, link) whose parameters it reads.
+    pub element: usize,
     /// Length change (m).
     pub stretch: ExprId,
     /// Rotation vector across it in its base frame (twist, bend about y,
@@ -65,53 +67,70 @@ pub fn segment_loads(
     symbols: &ParamSymbols,
     structure: &Structure,
 ) -> Vec<Option<[ExprId; 3]>> {
-    let n = structure.segments.len();
-    let mut terms = vec![[Vec::new(), Vec::new(), Vec::new()]; n];
-    for (s, &count) in structure.chambers.iter().enumerate() {
-        for j in 0..count {
-            let key = |what| {
-                symbols.get(Param::Chamber {
-                    segment: s,
-                    position: j,
-                    what,
-                })
-            };
-            let p = key(ChamberParam::Pressure);
-            // The position's holes together: area a, first moments a sum z
-            // (lever of bend y) and a sum y (of bend z).
-            let area = cas.mul(p, key(ChamberParam::Area));
-            let arm_y = cas.mul(p, key(ChamberParam::ArmY));
-            let arm_z = cas.mul(p, key(ChamberParam::ArmZ));
-            terms[s][0].push(area);
-            terms[s][1].push(arm_y);
-            terms[s][2].push(cas.neg(arm_z));
-        }
+    (0..structure.segments.len())
+        .map(|s| loads_on(cas, symbols, structure, s, None))
+        .collect()
+}
+
+/// The loads on segment `s`'s strains ([`segment_loads`]), with element
+/// `element`'s own chamber levers where they vary along the segment.
+fn loads_on(
+    cas: &mut Cas,
+    symbols: &ParamSymbols,
+    structure: &Structure,
+    s: usize,
+    element: Option<usize>,
+) -> Option<[ExprId; 3]> {
+    let mut parts = [Vec::new(), Vec::new(), Vec::new()];
+    for position in 0..structure.chambers[s] {
+        let key = |what| {
+            symbols.get(Param::Chamber {
+                segment: s,
+                position,
+                what,
+            })
+        };
+        let lever = |what, z| match element {
+            Some(element) => symbols.get(Param::ChamberArm {
+                element,
+                position,
+                z,
+            }),
+            None => key(what),
+        };
+        let p = key(ChamberParam::Pressure);
+        // The position's holes together: area a, first moments a sum z
+        // (lever of bend y) and a sum y (of bend z).
+        let area = cas.mul(p, key(ChamberParam::Area));
+        let arm_y = cas.mul(p, lever(ChamberParam::ArmY, false));
+        let arm_z = cas.mul(p, lever(ChamberParam::ArmZ, true));
+        parts[0].push(area);
+        parts[1].push(arm_y);
+        parts[2].push(cas.neg(arm_z));
     }
     for (i, &end) in structure.tendons.iter().enumerate() {
+        if s > end {
+            continue;
+        }
         let t = symbols.get(Param::TendonTension(i));
         // Tension only: (T + |T|) / 2.
         let abs = cas.func(Func::Abs, t);
         let sum = cas.add(t, abs);
         let pull = cas.scaled(0.5, sum);
-        for (s, parts) in terms.iter_mut().enumerate().take(end + 1) {
-            let offset = |z| {
-                symbols.get(Param::TendonOffset {
-                    tendon: i,
-                    segment: s,
-                    z,
-                })
-            };
-            let (y, z) = (offset(false), offset(true));
-            parts[0].push(cas.neg(pull));
-            let pz = cas.mul(pull, z);
-            parts[1].push(cas.neg(pz));
-            parts[2].push(cas.mul(pull, y));
-        }
+        let offset = |z| {
+            symbols.get(Param::TendonOffset {
+                tendon: i,
+                segment: s,
+                z,
+            })
+        };
+        let (y, z) = (offset(false), offset(true));
+        parts[0].push(cas.neg(pull));
+        let pz = cas.mul(pull, z);
+        parts[1].push(cas.neg(pz));
+        parts[2].push(cas.mul(pull, y));
     }
-    terms
-        .into_iter()
-        .map(|parts| (!parts[0].is_empty()).then(|| parts.map(|p| cas.add_all(&p))))
-        .collect()
+    (!parts[0].is_empty()).then(|| parts.map(|p| cas.add_all(&p)))
 }
 
 /// The virtual work of a segment's loads ([`segment_loads`]) on one
@@ -146,7 +165,11 @@ pub fn actuation(
     let loads = segment_loads(cas, symbols, structure);
     let mut work = Vec::new();
     for s in strains {
-        if let Some(load) = loads[s.segment] {
+        let load = match structure.segments[s.segment].chambers_vary {
+            true => loads_on(cas, symbols, structure, s.segment, Some(s.element)),
+            false => loads[s.segment],
+        };
+        if let Some(load) = load {
             work.push(strain_work(cas, load, s.stretch, s.rho, s.offset_scale));
         }
     }

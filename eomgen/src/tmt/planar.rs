@@ -165,6 +165,7 @@ impl<'a> PlanarArm<'a> {
         let zero = self.zero;
         self.strains.push(Strain {
             segment: s,
+            element: k,
             stretch: zero,
             rho: [zero, zero, q],
             offset_scale: None,

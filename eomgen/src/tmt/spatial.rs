@@ -708,6 +708,7 @@ impl<'a> SpatialArm<'a> {
         let thin = g.incompressible.then(|| thinning(cas, el.l, len));
         self.strains.push(Strain {
             segment: s,
+            element: self.k,
             stretch: st,
             rho,
             offset_scale: thin.map(|t| t.1),
