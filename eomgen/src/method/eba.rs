@@ -304,6 +304,52 @@ impl RestPlacement {
     }
 }
 
+/// Where element k rests, from the base frame (rotation `r0`, quaternion
+/// `q0`): its centre's offset from the previous one's (from the clamp
+/// point for the first) and from the clamp point, and the frame its
+/// rotation vector turns (R0 A_k) with its quaternion. Straight, or placed
+/// on the rest shape.
+struct RestPose {
+    step: V3,
+    centre: V3,
+    r: M3,
+    quat: Quat,
+}
+
+impl RestPose {
+    fn of(
+        cas: &mut Cas,
+        (r0, q0): (&M3, &Quat),
+        placed: Option<&Placed>,
+        [prev_half, half]: [ExprId; 2],
+        along: ExprId,
+    ) -> Self {
+        let base_axis = [r0[0][0], r0[1][0], r0[2][0]];
+        let Some(p) = placed else {
+            let gap = cas.add(prev_half, half);
+            let step = base_axis.map(|a| cas.mul(gap, a));
+            let s_mid = cas.add(along, half);
+            let centre = base_axis.map(|a| cas.mul(s_mid, a));
+            return Self {
+                step,
+                centre,
+                r: *r0,
+                quat: *q0,
+            };
+        };
+        let turned = |cas: &mut Cas, v: &V3| {
+            let w = std::array::from_fn(|i| cas.dot(&r0[i], v));
+            bind3(cas, w)
+        };
+        Self {
+            step: turned(cas, &p.step),
+            centre: turned(cas, &p.centre),
+            r: mul3(cas, r0, &p.a),
+            quat: quat_mul(cas, q0, &p.quat),
+        }
+    }
+}
+
 fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> System {
     let coords = Coordinates::new(cas, super::coordinate_names(structure));
     let zero = cas.zero();
@@ -312,7 +358,6 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
     let base = symbols.base_motion(cas);
     let frame = base_frame(cas, symbols, &base);
     let (r0, p0, w0) = (frame.r, frame.p, frame.w);
-    let base_axis = [r0[0][0], r0[1][0], r0[2][0]];
     // Rates (of the damping) relative to a moving base, too.
     let mut pairs = coords.rate_pairs();
     pairs.extend(&base.seeds);
@@ -352,45 +397,13 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
             let turn = HalfRest::of(cas, symbols, k, structure.segments[segment].rest_3d);
             p.next(cas, turn, half)
         });
-        let step: V3 = match &rest {
-            None => {
-                let gap = cas.add(prev.half, half);
-                base_axis.map(|a| cas.mul(gap, a))
-            }
-            Some(r) => {
-                let step = std::array::from_fn(|i| cas.dot(&r0[i], &r.step));
-                bind3(cas, step)
-            }
-        };
-        let centre: V3 = match &rest {
-            None => {
-                let s_mid = cas.add(along, half);
-                std::array::from_fn(|i| {
-                    let straight = cas.mul(s_mid, base_axis[i]);
-                    cas.add_all(&[p0[i], straight, u[i]])
-                })
-            }
-            Some(r) => std::array::from_fn(|i| {
-                let placed = cas.dot(&r0[i], &r.centre);
-                cas.add_all(&[p0[i], placed, u[i]])
-            }),
-        };
+        let at = RestPose::of(cas, (&r0, &q0), rest.as_ref(), [prev.half, half], along);
+        let centre: V3 = std::array::from_fn(|i| cas.add_all(&[p0[i], at.centre[i], u[i]]));
         let centre = bind3(cas, centre);
         along = cas.add(along, l);
-        // The element's rest orientation turns the frame its rotation
-        // vector is measured from.
-        let r_rest = match &rest {
-            None => r0,
-            Some(r) => mul3(cas, &r0, &r.a),
-        };
+        let (step, r_rest) = (at.step, at.r);
         let (r, element_omega, q_rel) = element_frame(cas, &r_rest, &w0, &psi, &psi_d);
-        quat = match &rest {
-            None => quat_mul(cas, &q0, &q_rel),
-            Some(rr) => {
-                let q_rest = quat_mul(cas, &q0, &rr.quat);
-                quat_mul(cas, &q_rest, &q_rel)
-            }
-        };
+        quat = quat_mul(cas, &at.quat, &q_rel);
         omega = element_omega;
         let axis = [r[0][0], r[1][0], r[2][0]];
         slab_samples(cas, structure.contact_points, l, centre, axis, quat, &mut samples);
