@@ -55,7 +55,11 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
             if arms_have_own_kernels(a) {
                 by_arms = Some((a, assembled.arms, assembled.rest));
             }
-            let blocks = assembled.blocks;
+            // Arms on other arms' frames move with them: one block of M.
+            let blocks = match a.tree() {
+                true => vec![assembled.blocks.iter().sum()],
+                false => assembled.blocks,
+            };
             (assembled.sys, assembled.constraints, assembled.rows, blocks)
         }
         None => (
@@ -169,12 +173,13 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
 /// Whether an assembly's arms run on kernels of their own
 /// (`runtime::arm_blocks`): not an arm on a compliant base (its
 /// coordinates move the arm's base, which a single arm's kernels hold
-/// still) nor one with inputs (its parameters are copied once per
-/// parameter set).
+/// still), nor one on another arm's frame (the other's coordinates move
+/// it), nor one with inputs (its parameters are copied once per parameter
+/// set).
 fn arms_have_own_kernels(a: &AssemblyShape) -> bool {
-    a.arms
-        .iter()
-        .all(|(_, st)| !st.base_compliant && ParamLayout::of(st).driven().is_empty())
+    !a.tree()
+        && (a.arms.iter())
+            .all(|(_, st)| !st.base_compliant && ParamLayout::of(st).driven().is_empty())
 }
 
 /// The rest of an assembly's `MassBias` and `Jvp` (hoisted with its other

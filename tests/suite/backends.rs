@@ -1256,6 +1256,10 @@ value = 1000.0
     let (b, r) = route(&example.to_string_lossy(), "", auto);
     assert_eq!(b, "interpreted");
     assert!(r.contains("bend or shear unequally along y and z"), "{r}");
+    let example = root().join("examples/palm.toml");
+    let (b, r) = route(&example.to_string_lossy(), "", auto);
+    assert_eq!(b, "interpreted");
+    assert!(r.contains("sits on another arm"), "{r}");
     let (b, r) = route("finger_tap", "segment.0.elements=5", auto);
     assert_eq!(b, "compiled");
     assert!(

@@ -41,4 +41,5 @@ mod spatial;
 mod streamed;
 mod sweep;
 mod taper;
+mod tree;
 mod unchanged;

@@ -21,7 +21,9 @@ use crate::model::{
     AssemblyShape, BodyParam, JointParam, JointShape, Param, ParamLayout, Rate, SpringParam, Xyz,
 };
 
-use crate::tmt::system::{Body, Coordinates, Inertia, ParamSymbols, PointForce, Sample, System};
+use crate::tmt::system::{
+    Body, Coordinates, Inertia, MountFrame, ParamSymbols, PointForce, Sample, System,
+};
 
 /// The assembled system and its constraint equations.
 pub struct Assembled {
@@ -102,6 +104,20 @@ struct Pose {
 struct ArmFrames {
     segment_ends: Vec<Pose>,
     tip: Pose,
+    /// 3D: each segment end's whole frame (the last the tip's), for arms
+    /// that sit on it.
+    end_frames: Vec<MountFrame>,
+}
+
+impl ArmFrames {
+    /// The frame `f` (this arm's tip or segment end) names.
+    fn mount(&self, f: FrameRef) -> Option<MountFrame> {
+        match f {
+            FrameRef::Tip(_) => self.end_frames.last().copied(),
+            FrameRef::SegmentEnd { segment, .. } => self.end_frames.get(segment).copied(),
+            _ => None,
+        }
+    }
 }
 
 /// The system of an assembly structure.
@@ -110,7 +126,14 @@ pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -
     let mut tips = Vec::new();
     let mut arm_frames = Vec::new();
     for (k, ((name, st), (_, offset, arm_layout))) in a.arms.iter().zip(layout.arms()).enumerate() {
-        let frames = b.arm(cas, k, name, st, *offset, arm_layout);
+        // An arm on an earlier arm's frame (validated: a chain's, in 3D).
+        let mount = a.mounts.get(k).copied().flatten().and_then(|f| match f {
+            FrameRef::Tip(j) | FrameRef::SegmentEnd { arm: j, .. } => {
+                arm_frames.get(j).and_then(|p: &ArmFrames| p.mount(f))
+            }
+            _ => None,
+        });
+        let frames = b.arm(cas, k, name, st, (*offset, arm_layout), mount);
         tips.push((frames.tip.point, frames.tip.quat));
         arm_frames.push(frames);
     }
@@ -253,8 +276,8 @@ impl Builder {
         k: usize,
         name: &str,
         st: &crate::model::Structure,
-        offset: usize,
-        arm_layout: &ParamLayout,
+        (offset, arm_layout): (usize, &ParamLayout),
+        mount: Option<MountFrame>,
     ) -> ArmFrames {
         let prefix = if name.is_empty() {
             String::new()
@@ -276,6 +299,9 @@ impl Builder {
         let (zero, mut bodies) = (self.zero, Vec::new());
         let sys = cas.scoped(scope, |cas| {
             let mut symbols = ParamSymbols::new(cas, arm_layout);
+            if let Some(m) = mount {
+                symbols = symbols.with_mount(m);
+            }
             if let (Some(base), Some(&mass)) = (&base, base_mass) {
                 symbols = symbols.with_base_offset(base.offset, &base.seeds);
                 if let Some((rho, rate)) = base.twist {
@@ -337,6 +363,7 @@ impl Builder {
                     quat: [zero; 4],
                 };
                 ArmFrames {
+                    end_frames: Vec::new(),
                     segment_ends: planar.segment_ends.into_iter().map(pose).collect(),
                     tip: Pose {
                         point: sys.tip,
@@ -354,6 +381,7 @@ impl Builder {
                 ArmFrames {
                     segment_ends: sys.segment_ends.into_iter().map(pose).collect(),
                     tip: pose((sys.tip, sys.tip_orientation)),
+                    end_frames: sys.end_frames,
                 }
             }
         }
@@ -592,6 +620,7 @@ impl Builder {
             seeds: self.seeds,
             planar: None,
             segment_ends: Vec::new(),
+            end_frames: Vec::new(),
             samples: self.samples,
             bases: self.bases,
         };
@@ -633,6 +662,7 @@ impl Builder {
             seeds: self.seeds.clone(),
             planar: None,
             segment_ends: Vec::new(),
+            end_frames: Vec::new(),
             // The points no arm has: the bodies' centres.
             samples: without_arms(&self.samples, arms, |a| &a.samples),
             bases: Vec::new(),

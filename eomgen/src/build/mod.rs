@@ -13,6 +13,7 @@ use crate::model::{FluidParam, KinkParam, Param, ParamLayout, Structure};
 use crate::tmt::along::{Drag, along_loads};
 use crate::tmt::planar::PlanarArm;
 use crate::tmt::spatial::SpatialArm;
+use crate::tmt::system::MountFrame;
 use crate::tmt::{ParamSymbols, System};
 
 pub use assembly::{ArmBlock, Assembled, assembly_system};
@@ -56,7 +57,7 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
         arm.loads = along_loads(cas, structure, symbols);
         arm.set_fluid(Drag::of(structure, symbols), buoyancy(structure, symbols));
         let base = (arm.points > 0).then(|| arm.base_pose());
-        let mut ends = Vec::new();
+        let (mut ends, mut frames) = (Vec::new(), Vec::new());
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
             if g.kink {
                 let [turn, offset] = kink(symbols, s, true);
@@ -64,9 +65,17 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
             }
             m.build_spatial(cas, &mut arm, g, s);
             ends.push((arm.f.p, arm.f.quat));
+            let f = arm.f;
+            frames.push(MountFrame {
+                r: f.r,
+                p: f.p,
+                w: f.w,
+                quat: f.quat,
+            });
         }
         let mut sys = arm.finish(cas, structure);
         sys.segment_ends = ends;
+        sys.end_frames = frames;
         sys.bases = base.into_iter().collect();
         sys
     } else {

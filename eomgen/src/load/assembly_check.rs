@@ -59,6 +59,61 @@ pub(super) fn check_assembly(
     joints(ck)
 }
 
+/// An arm based on another's frame: an earlier arm's tip or segment end
+/// (its coordinates then carry this one), in 3D, the base itself held
+/// still there (neither compliant nor driven).
+pub(super) fn mounts(ck: &Check) -> Result<(), ModelError> {
+    let m = ck.m;
+    if m.arms.is_empty() {
+        if m.base.on.is_some() {
+            return ck.err(
+                "base.on".into(),
+                "a base on another frame is an [[arm]]'s in an assembly: declare the arms as [[arm]]s"
+                    .into(),
+            );
+        }
+        return Ok(());
+    }
+    let arms = m.arm_models();
+    for (i, a) in m.arms.iter().enumerate() {
+        let Some(on) = &a.base.on else { continue };
+        let key = format!("arm.{}.base.on", a.name);
+        let err = |msg: String| ck.err(key.clone(), msg);
+        if m.dimensions != 3 {
+            return err("an arm on another's frame is 3D only for now".into());
+        }
+        let parent = match FrameRef::parse(on, m) {
+            Ok(FrameRef::Tip(j)) | Ok(FrameRef::SegmentEnd { arm: j, .. }) => j,
+            Ok(_) => {
+                return err(format!(
+                    "\"{on}\": an arm sits on another arm's `ARM.tip` or `ARM.segment.K.end` (bodies and the world: use a joint or the arm's own base)"
+                ));
+            }
+            Err(e) => return err(e),
+        };
+        if parent >= i {
+            return err(format!(
+                "\"{on}\" is not an arm declared before this one: declare the arm it sits on first"
+            ));
+        }
+        if let Some(s) = (arms[parent].1.segments.iter())
+            .find(|s| !crate::method::of(s.method).segment_end_frames())
+        {
+            return err(format!(
+                "an {} arm's frames do not carry other arms yet",
+                s.method.name()
+            ));
+        }
+        let b = &a.base;
+        if b.is_compliant() || b.translation_inputs.is_some() || b.rotation_inputs.is_some() {
+            return err(
+                "an arm on another's frame is held there: no compliant base, translation_inputs or rotation_inputs".into(),
+            );
+        }
+    }
+    Ok(())
+}
+
 /// Arms and bodies share one namespace (joints name them); joints have
 /// their own; `world` is the ground.
 fn names(ck: &Check) -> Result<(), ModelError> {

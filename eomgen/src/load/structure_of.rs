@@ -21,6 +21,9 @@ impl Structure {
                 .collect(),
             bodies: m.bodies.iter().map(|b| (b.name.clone(), b.free)).collect(),
             contact: m.has_contact(),
+            mounts: (m.arms.iter())
+                .map(|a| a.base.on.as_deref().map(frame))
+                .collect(),
             joints: m
                 .joints
                 .iter()

@@ -14,6 +14,7 @@ pub const MAX_ELEMENTS: usize = 500;
 pub fn validate(m: &Model, file: &str) -> Result<(), ModelError> {
     let ck = Check { m, file };
     ck.file_name("name", "a model", &m.name)?;
+    super::assembly_check::mounts(&ck)?;
     if m.is_assembly() {
         super::assembly_check::check_assembly(&ck, |arm| validate_arm(arm, file))?;
         relaxing_assembly(&ck)?;

@@ -481,6 +481,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         chain: None,
         seeds: base.seeds,
         segment_ends: Vec::new(),
+        end_frames: Vec::new(),
         samples,
         bases: match structure.contact_points {
             0 => Vec::new(),
@@ -853,6 +854,7 @@ fn empty_system(cas: &mut Cas, coords: Coordinates, gravity: V3) -> System {
         chain: None,
         seeds: Vec::new(),
         segment_ends: Vec::new(),
+        end_frames: Vec::new(),
         samples: Vec::new(),
         bases: Vec::new(),
         planar: None,

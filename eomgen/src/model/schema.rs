@@ -148,6 +148,12 @@ pub struct Base {
     pub rotational_damping: Option<f64>,
     #[serde(default)]
     pub inertia: Option<f64>,
+    /// An assembly's arm based on another frame (`ARM.tip`,
+    /// `ARM.segment.K.end` of an arm declared before it): carried by that
+    /// arm's coordinates, its `position` and `direction` in that frame.
+    /// Structural.
+    #[serde(default)]
+    pub on: Option<String>,
 }
 
 /// Where the joints of a rigid segment sit. Structural.

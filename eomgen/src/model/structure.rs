@@ -118,6 +118,16 @@ pub struct AssemblyShape {
     pub joints: Vec<JointShape>,
     /// Contact: every body's centre is a contact point, after the arms'.
     pub contact: bool,
+    /// Per arm: the frame its base sits on (an earlier arm's), if any.
+    pub mounts: Vec<Option<FrameRef>>,
+}
+
+impl AssemblyShape {
+    /// Some arm sits on another's frame: the arms' coordinates then move
+    /// one another (one block of M, flat kernels).
+    pub fn tree(&self) -> bool {
+        self.mounts.iter().any(Option::is_some)
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -137,7 +147,10 @@ impl Structure {
                 a.arms.len(),
                 a.dimensions
             );
-            for (name, arm) in &a.arms {
+            for (k, (name, arm)) in a.arms.iter().enumerate() {
+                if let Some(Some(on)) = a.mounts.get(k) {
+                    s.push_str(&format!("arm {name:?} on {on:?}\n"));
+                }
                 s.push_str(&format!("arm {name:?}\n{}", arm.canonical()));
             }
             s.push_str(&format!("bodies {:?}\n", a.bodies));

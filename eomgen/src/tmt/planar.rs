@@ -360,6 +360,7 @@ impl<'a> PlanarArm<'a> {
             }),
             seeds,
             segment_ends: Vec::new(),
+            end_frames: Vec::new(),
             samples,
             bases: Vec::new(),
             planar: Some(PlanarFrames {

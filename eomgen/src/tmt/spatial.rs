@@ -803,6 +803,7 @@ impl<'a> SpatialArm<'a> {
             }),
             seeds,
             segment_ends: Vec::new(),
+            end_frames: Vec::new(),
             samples,
             bases: Vec::new(),
             planar: None,
@@ -830,6 +831,21 @@ pub(crate) fn base_frame(
     base: &super::system::BaseMotion,
 ) -> Frame {
     let (position, turns) = (base.position, &base.turns);
+    let r: M3 = std::array::from_fn(|i| {
+        std::array::from_fn(|j| symbols.get(Param::BaseRotation(i as u8, j as u8)))
+    });
+    let q = std::array::from_fn(|c| symbols.get(Param::BaseQuaternion(c as u8)));
+    if let Some(m) = symbols.mount() {
+        // On another arm's frame: the position, then the direction, in it.
+        let f = Frame {
+            r: m.r,
+            p: m.p,
+            w: m.w,
+            quat: m.quat,
+        };
+        let f = compose(cas, &f, None, Some(&position), None);
+        return compose(cas, &f, Some((&r, &q)), None, None);
+    }
     let (zero, one) = (cas.zero(), cas.one());
     let mut f = Frame {
         r: std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one } else { zero })),
@@ -854,10 +870,6 @@ pub(crate) fn base_frame(
         let (r, q, w) = exp_turn(cas, rho, rate);
         f = compose(cas, &f, Some((&r, &q)), None, Some(&w));
     }
-    let r: M3 = std::array::from_fn(|i| {
-        std::array::from_fn(|j| symbols.get(Param::BaseRotation(i as u8, j as u8)))
-    });
-    let q = std::array::from_fn(|c| symbols.get(Param::BaseQuaternion(c as u8)));
     if still {
         // The identity folds away, but say so: a still base is its parameters.
         return Frame { r, quat: q, ..f };

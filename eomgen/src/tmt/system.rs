@@ -18,6 +18,8 @@ pub struct ParamSymbols {
     base_seeds: Vec<(ExprId, ExprId)>,
     /// A compliant base's turn: a rotation vector and its rate.
     base_twist: Option<([ExprId; 3], [ExprId; 3])>,
+    /// The frame the base sits on (another arm's), if any.
+    mount: Option<MountFrame>,
 }
 
 impl ParamSymbols {
@@ -40,6 +42,7 @@ impl ParamSymbols {
             base_offset: None,
             base_seeds: Vec::new(),
             base_twist: None,
+            mount: None,
         }
     }
 
@@ -58,6 +61,18 @@ impl ParamSymbols {
     pub fn with_base_twist(mut self, rho: [ExprId; 3], rate: [ExprId; 3]) -> Self {
         self.base_twist = Some((rho, rate));
         self
+    }
+
+    /// The base sits on `frame` (another arm's, in an assembly): its
+    /// `position` and `direction` are in that frame.
+    pub fn with_mount(mut self, frame: MountFrame) -> Self {
+        self.mount = Some(frame);
+        self
+    }
+
+    /// The frame the base sits on, if any.
+    pub fn mount(&self) -> Option<MountFrame> {
+        self.mount
     }
 
     /// The symbol of `p`; kinematics only ask for parameters their
@@ -227,6 +242,16 @@ pub struct AppliedMoment {
     pub moment: [ExprId; 3],
 }
 
+/// A frame another arm may sit on: rotation (rows), origin, world angular
+/// velocity and orientation quaternion (w, x, y, z).
+#[derive(Clone, Copy, Debug)]
+pub struct MountFrame {
+    pub r: [[ExprId; 3]; 3],
+    pub p: [ExprId; 3],
+    pub w: [ExprId; 3],
+    pub quat: [ExprId; 4],
+}
+
 pub struct System {
     pub coords: Coordinates,
     pub bodies: Vec<Body>,
@@ -256,6 +281,9 @@ pub struct System {
     pub planar: Option<PlanarFrames>,
     /// 3D chains: each segment's end frame, origin and orientation (w, x,
     /// y, z), for joints (empty for a method that builds the whole arm).
+    /// 3D chain arms: each segment end's whole frame (the last the tip's),
+    /// which another arm may sit on.
+    pub end_frames: Vec<MountFrame>,
     pub segment_ends: Vec<([ExprId; 3], [ExprId; 4])>,
     /// Points along the arm's centreline with their cross-section frames,
     /// element by element (`Structure::contact_points` each, the last at

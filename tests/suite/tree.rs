@@ -1,0 +1,219 @@
+//! Arms on other arms' frames (`[arm.base] on = "ARM.tip"`): carried by
+//! the structure in minimal coordinates, no constraint. An arm on another's
+//! tip is the same mechanism as one arm of two segments, so against that
+//! arm (a second derivation: one chain), coordinate by coordinate, in
+//! statics and in motion; turned on the tip, against the same arm with a
+//! kink (`turn`); two arms on one tip (a palm's fingers) keep the energy of
+//! an undamped swing.
+
+use crate::common::*;
+use runtime::{SimOptions, StaticOptions, simulate, solve_static};
+
+const SEGMENT: &str = "method = \"pcc\"\ndensity = 1000.0\nouter_radius = 0.01\nyoungs_modulus = 1e5\nbending_damping = 1e-4";
+
+fn tree(direction: &str, more: &str) -> String {
+    format!(
+        r#"
+name = "tree"
+dimensions = 3
+gravity = [0.0, -4.0, -9.81]
+[[arm]]
+name = "upper"
+[arm.base]
+direction = [1.0, 0.0, 0.0]
+[[arm.segment]]
+length = 0.2
+elements = 4
+{SEGMENT}
+[[arm]]
+name = "lower"
+[arm.base]
+on = "upper.tip"
+direction = {direction}
+[[arm.segment]]
+length = 0.15
+elements = 3
+{SEGMENT}
+{more}
+"#
+    )
+}
+
+fn chain(turn: &str) -> String {
+    format!(
+        r#"
+name = "chain"
+dimensions = 3
+gravity = [0.0, -4.0, -9.81]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+length = 0.2
+elements = 4
+{SEGMENT}
+[[segment]]
+length = 0.15
+elements = 3
+{SEGMENT}
+{turn}
+"#
+    )
+}
+
+/// The largest difference of the coordinates, statically and over 0.3 s
+/// of motion from straight.
+fn differences(a: &str, b: &str) -> (f64, f64, f64) {
+    let dir = tempfile::tempdir().unwrap();
+    let (da, db) = (dir.path().join("a"), dir.path().join("b"));
+    std::fs::create_dir_all(&da).unwrap();
+    std::fs::create_dir_all(&db).unwrap();
+    let (mut la, mut lb) = (load_text(&da, a, &[]), load_text(&db, b, &[]));
+    let n = la.arm.dof();
+    assert_eq!(n, lb.arm.dof());
+    let sa = solve_static(&mut *la.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
+    let sb = solve_static(&mut *lb.arm, &vec![0.0; n], &StaticOptions::default()).unwrap();
+    let statics =
+        sa.q.iter()
+            .zip(&sb.q)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+    let scale = sb.q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let opts = SimOptions {
+        t_end: 0.3,
+        output_dt: 0.01,
+        rtol: 1e-10,
+        atol: 1e-12,
+        ..Default::default()
+    };
+    let (ta, _) = simulate(&*la.arm, vec![0.0; 2 * n], &opts).unwrap();
+    let (tb, _) = simulate(&*lb.arm, vec![0.0; 2 * n], &opts).unwrap();
+    assert_eq!(ta.t.len(), tb.t.len());
+    let motion = (ta.x.iter().zip(&tb.x))
+        .flat_map(|(x, y)| x[..n].iter().zip(&y[..n]).map(|(p, q)| (p - q).abs()))
+        .fold(0.0, f64::max);
+    (statics, motion, scale)
+}
+
+#[test]
+fn an_arm_on_anothers_tip_moves_as_one_arm_of_two_segments() {
+    let (statics, motion, scale) = differences(&tree("[1.0, 0.0, 0.0]", ""), &chain(""));
+    assert!(scale > 0.1, "the arm sags: {scale}");
+    assert!(statics < 1e-9 * scale, "statics differ by {statics:e}");
+    assert!(motion < 1e-7 * scale, "motion differs by {motion:e}");
+}
+
+#[test]
+fn an_arm_turned_on_anothers_tip_moves_as_one_arm_with_a_kink() {
+    let (statics, motion, scale) =
+        differences(&tree("[0.0, 1.0, 0.0]", ""), &chain("turn = [0.0, 90.0]"));
+    assert!(scale > 0.1, "the arm sags: {scale}");
+    assert!(statics < 1e-9 * scale, "statics differ by {statics:e}");
+    assert!(motion < 1e-7 * scale, "motion differs by {motion:e}");
+}
+
+/// A palm with two fingers: both on the upper arm's tip, turned 45 degrees
+/// either way; undamped, released straight under gravity, the whole keeps
+/// its energy (kinetic plus potential) while the fingers swing.
+#[test]
+fn two_arms_on_one_tip_keep_the_energy_of_an_undamped_swing() {
+    let finger = |name: &str, y: f64| {
+        format!(
+            "[[arm]]\nname = \"{name}\"\n[arm.base]\non = \"upper.tip\"\ndirection = [1.0, {y}, 0.0]\n[[arm.segment]]\nlength = 0.1\nelements = 2\n{SEGMENT}\n"
+        )
+    };
+    let text = tree("[1.0, 0.0, 0.0]", "")
+        .replace("name = \"lower\"", "name = \"thumb\"")
+        .replace(
+            "direction = [1.0, 0.0, 0.0]\n[[arm.segment]]\nlength = 0.15",
+            "direction = [1.0, 0.0, 0.5]\n[[arm.segment]]\nlength = 0.15",
+        )
+        + &finger("index", 1.0)
+        + &finger("ring", -1.0);
+    let text = text.replace("bending_damping = 1e-4", "");
+    let dir = tempfile::tempdir().unwrap();
+    let l = load_text(dir.path(), &text, &[]);
+    let n = l.arm.dof();
+    assert_eq!(n, 3 * (4 + 3 + 2 + 2), "{:?}", l.arm.info().coordinates);
+    let opts = SimOptions {
+        t_end: 0.3,
+        output_dt: 0.01,
+        rtol: 1e-10,
+        atol: 1e-12,
+        ..Default::default()
+    };
+    let (traj, _) = simulate(&*l.arm, vec![0.0; 2 * n], &opts).unwrap();
+    let names = runtime::OUTPUT_NAMES;
+    let at = |k: &str| names.iter().position(|n| *n == k).unwrap();
+    let energy: Vec<(f64, f64)> = (traj.x.iter())
+        .map(|x| {
+            let o = l.arm.outputs(0.0, &x[..n], &x[n..]);
+            (o[at("kinetic")], o[at("potential")])
+        })
+        .collect();
+    let total: Vec<f64> = energy.iter().map(|(k, p)| k + p).collect();
+    let swing = energy.iter().map(|e| e.0).fold(0.0, f64::max);
+    let drift = total
+        .iter()
+        .map(|e| (e - total[0]).abs())
+        .fold(0.0, f64::max);
+    assert!(swing > 1e-4, "it swings: {swing}");
+    assert!(
+        drift < 1e-6 * swing,
+        "energy drifts by {drift:e} of a swing of {swing:e}"
+    );
+}
+
+/// Bad bases on frames: clear errors naming the key, nothing printed.
+#[test]
+fn bases_on_frames_that_cannot_carry_them_are_refused_with_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = tree("[1.0, 0.0, 0.0]", "");
+    let r = |a: &str, b: &str| {
+        assert!(good.contains(a), "{a}");
+        good.replacen(a, b, 1)
+    };
+    let single = chain("").replace("[base]\n", "[base]\non = \"tip\"\n");
+    let cases = [
+        (
+            "a single arm on a frame",
+            single,
+            vec!["base.on", "[[arm]]"],
+        ),
+        (
+            "on the world",
+            r("on = \"upper.tip\"", "on = \"world\""),
+            vec!["arm.lower.base.on", "another arm's"],
+        ),
+        (
+            "on an unknown arm",
+            r("on = \"upper.tip\"", "on = \"middle.tip\""),
+            vec!["arm.lower.base.on", "no frame \"middle.tip\""],
+        ),
+        (
+            "on itself",
+            r("on = \"upper.tip\"", "on = \"lower.tip\""),
+            vec!["arm.lower.base.on", "declare the arm it sits on first"],
+        ),
+        (
+            "in the plane",
+            r("dimensions = 3", "dimensions = 2"),
+            vec!["arm.lower.base.on", "3D only"],
+        ),
+        (
+            "on a compliant base",
+            r("on = \"upper.tip\"", "on = \"upper.tip\"\nmass = 0.1"),
+            vec!["arm.lower.base.on", "no compliant base"],
+        ),
+    ];
+    for (label, text, expect) in cases {
+        std::fs::write(dir.path().join("m.toml"), &text).unwrap();
+        let out = softarm(&["eom", "m.toml", "--json"], dir.path());
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{label}: accepted");
+        assert!(!err.contains("panicked"), "{label}: panic: {err}");
+        assert!(stdout(&out).is_empty(), "{label}: printed output");
+        for e in expect {
+            assert!(err.contains(e), "{label}: expected `{e}` in: {err}");
+        }
+    }
+}
