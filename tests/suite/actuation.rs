@@ -46,6 +46,18 @@ youngs_modulus = {E}
     )
 }
 
+/// An untwisting one-segment arm with chambers at `angles` (degrees) of
+/// `radius` (a TOML number or list) at `distance`, every position at the
+/// constant pressure `p`.
+fn chambered(angles: &str, radius: &str, distance: &str, p: f64) -> String {
+    let n = angles.split(',').count();
+    let inputs = vec!["\"p\""; n].join(", ");
+    arm(&(segment(L, "twist = false")
+        + &format!(
+            "[segment.chambers]\nangles = [{angles}]\nradius = {radius}\ndistance = {distance}\ninputs = [{inputs}]\n[inputs.p]\nkind = \"constant\"\nvalue = {p}\n"
+        )))
+}
+
 /// Static tip and coordinates of a model file written to `dir`.
 fn static_tip(dir: &Path, text: &str, sets: &[&str]) -> ([f64; 3], Vec<f64>) {
     let mut l = load_text(dir, text, sets);
@@ -226,19 +238,7 @@ value = 0.0
 fn one_chamber_alone_bends_the_arm_about_its_shifted_centroid() {
     let dir = tempfile::tempdir().unwrap();
     let (rc, d, p) = (0.003, 0.005, 1.0e5);
-    let text = arm(&(segment(L, "twist = false")
-        + &format!(
-            r#"
-[segment.chambers]
-angles = [90.0]
-radius = {rc}
-distance = {d}
-inputs = ["p"]
-[inputs.p]
-kind = "constant"
-value = {p}
-"#
-        )));
+    let text = chambered("90.0", &rc.to_string(), &d.to_string(), p);
     let (tip, _) = static_tip(dir.path(), &text, &[]);
     let a = PI * rc * rc;
     let area = PI * R * R - a;
@@ -263,19 +263,7 @@ value = {p}
 fn two_opposed_chambers_of_unequal_radii_bend_the_arm_away_from_the_larger() {
     let dir = tempfile::tempdir().unwrap();
     let (r1, r2, d, p) = (0.003, 0.002, 0.005, 1.0e5);
-    let text = arm(&(segment(L, "twist = false")
-        + &format!(
-            r#"
-[segment.chambers]
-angles = [90.0, 270.0]
-radius = [{r1}, {r2}]
-distance = {d}
-inputs = ["p", "p"]
-[inputs.p]
-kind = "constant"
-value = {p}
-"#
-        )));
+    let text = chambered("90.0, 270.0", &format!("[{r1}, {r2}]"), &d.to_string(), p);
     let (tip, _) = static_tip(dir.path(), &text, &[]);
     let (a1, a2) = (PI * r1 * r1, PI * r2 * r2);
     let area = PI * R * R - a1 - a2;
@@ -299,19 +287,7 @@ value = {p}
 fn a_chamber_whose_offset_tapers_bends_the_arm_by_its_local_lever() {
     let dir = tempfile::tempdir().unwrap();
     let (rc, d0, d1, p) = (0.002, 0.007, 0.004, 1.0e5);
-    let text = arm(&(segment(L, "twist = false")
-        + &format!(
-            r#"
-[segment.chambers]
-angles = [90.0]
-radius = {rc}
-distance = [{d0}, {d1}]
-inputs = ["p"]
-[inputs.p]
-kind = "constant"
-value = {p}
-"#
-        )));
+    let text = chambered("90.0", &rc.to_string(), &format!("[{d0}, {d1}]"), p);
     let a = PI * rc * rc;
     let area = PI * R * R - a;
     let kappa = |s: f64| {

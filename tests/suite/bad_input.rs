@@ -201,7 +201,7 @@ fn assembly_cases() -> Vec<(&'static str, String, Vec<&'static str>)> {
 #[test]
 fn assembly_mistakes_name_the_key() {
     let dir = tempfile::tempdir().unwrap();
-    for (label, text, expect) in assembly_cases() {
+    for (label, text, expect) in assembly_cases().into_iter().chain(crate::tree::bad_cases()) {
         std::fs::write(dir.path().join("m.toml"), &text).unwrap();
         let out = softarm(&["eom", "m.toml", "--json"], dir.path());
         let err = stderr(&out);
@@ -787,6 +787,20 @@ fn section_load_and_fluid_cases() -> Vec<FileCase> {
                 ),
             ),
             vec!["segment[0].section.rotary_inertia[0]", "must be positive"],
+        ),
+        (
+            "properties with three shear stiffnesses",
+            r(
+                "density = 1000.0\nouter_radius = 0.01\nyoungs_modulus = 1e6",
+                &format!(
+                    "section = {}",
+                    PROPERTIES.replace(
+                        "axial_stiffness",
+                        "shear_stiffness = [5.0, 5.0, 5.0], axial_stiffness"
+                    )
+                ),
+            ),
+            vec!["segment[0].section", "`shear_stiffness`: a number, or two"],
         ),
         (
             "properties with a negative shear stiffness along z",

@@ -470,7 +470,7 @@ impl Segment {
         let d2 = c.offset() * c.offset();
         let about_axis = if c.equal_radii() {
             // One radius: n (a r^2 / 4 + a d^2 / 2) when isotropic.
-            let r = holes[0].radius;
+            let r = holes.first().map_or(0.0, |h| h.radius);
             let (a, n, r2) = (pi * r * r, holes.len() as f64, r * r);
             if c.isotropic() {
                 let i = ring - n * (a * r2 / 4.0 + a * d2 / 2.0);
@@ -602,7 +602,9 @@ impl Segment {
         let holes = self.chambers.as_ref().map_or(0.0, |c| {
             let holes = c.hole_list();
             match c.equal_radii() {
-                true => holes.len() as f64 * holes[0].radius * holes[0].radius,
+                true => holes
+                    .first()
+                    .map_or(0.0, |h| holes.len() as f64 * h.radius * h.radius),
                 false => holes.iter().map(|h| h.radius * h.radius).sum(),
             }
         });
@@ -869,7 +871,7 @@ pub struct Torque {
 
 /// A number, or one per item (a tendon's segments, a chamber's positions).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "a number, or a list of numbers (one per item)")]
 pub enum OneOrMany {
     One(f64),
     Many(Vec<f64>),

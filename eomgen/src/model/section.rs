@@ -10,7 +10,10 @@ use serde::{Deserialize, Serialize};
 
 /// A value alike along both section axes, or one along each (y, z).
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "`shear_stiffness`: a number, or two: [along y, along z] (N)"
+)]
 pub enum OneOrTwo {
     One(f64),
     Two([f64; 2]),
