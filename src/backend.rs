@@ -220,7 +220,8 @@ fn compiled_cells(links: &LinkKernels) -> std::result::Result<Vec<CompiledCell>,
 
 /// A model's tapes: the cache's in `dir`, else derived and stored there;
 /// whether the cache had them, and the seconds the derivation took.
-fn tapes(model: &Model, hash: &str, dir: &Path) -> (TapeSet, CacheStatus, f64) {
+/// The model's tapes: from the cache in `dir`, or derived into it.
+pub fn tapes(model: &Model, hash: &str, dir: &Path) -> (TapeSet, CacheStatus, f64) {
     if let Some(tapes) = cache::load(dir, hash) {
         return (tapes, CacheStatus::Hit, 0.0);
     }

@@ -13,6 +13,7 @@ pub mod compare;
 pub mod contact;
 pub mod continuum;
 pub mod data;
+pub mod export;
 pub mod fit;
 pub mod fixed_step;
 pub mod grid;

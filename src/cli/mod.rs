@@ -5,6 +5,7 @@
 
 mod animate;
 mod commands;
+mod export;
 mod fit;
 mod sweep;
 mod tables;
@@ -63,6 +64,10 @@ enum Command {
     /// the tip, exact-Jacobian sensitivities); writes fit.json,
     /// fitted.toml and fit.png.
     Fit(fit::FitArgs),
+    /// Export the equations: a C99 library (one header, one source, libm
+    /// alone) with the state derivative, its Jacobian, M and h, the
+    /// outputs and the shape.
+    Export(export::ExportArgs),
 }
 
 /// Parses the command line and runs its command.
@@ -82,6 +87,7 @@ pub fn main() -> ExitCode {
         Command::Linearize(a) => commands::linearize(a),
         Command::FixedStep(a) => commands::fixed_step(a),
         Command::Fit(a) => fit::fit(a),
+        Command::Export(a) => export::export(a),
     };
     match result {
         Ok(code) => code,

@@ -85,6 +85,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "scene",
             "shape",
             "linearize",
+            "export",
             "fixed_step",
             "run_output",
             "viewer",

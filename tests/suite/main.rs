@@ -15,6 +15,7 @@ mod cosserat_transient;
 mod double_pendulum;
 mod energy;
 mod events;
+mod export_c;
 mod failures;
 mod fit;
 mod fluid;

@@ -1,0 +1,46 @@
+//! `softarm export`: a model's equations for use outside softarm.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Result;
+use clap::Args;
+use eomgen::model::Override;
+
+#[derive(Args)]
+pub struct ExportArgs {
+    /// A model file (TOML or JSON) or the name of a compiled-in model.
+    pub model: String,
+    /// Override a model value: PATH=VALUE (the exported defaults).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub set: Vec<String>,
+    /// Write a C99 library (DIR/<model>.h and DIR/<model>.c) into DIR.
+    #[arg(long = "c", value_name = "DIR")]
+    pub c: PathBuf,
+    /// Directory of the tape cache (default: $SOFTARM_CACHE_DIR or .softarm-cache).
+    #[arg(long, value_name = "DIR")]
+    pub cache_dir: Option<PathBuf>,
+}
+
+/// `softarm export MODEL --c DIR`.
+pub fn export(a: ExportArgs) -> Result<ExitCode> {
+    let overrides = (a.set.iter())
+        .map(|s| Override::parse(s))
+        .collect::<Result<Vec<_>, _>>()?;
+    let out = crate::export::export_c(&a.model, &overrides, &a.c, a.cache_dir)?;
+    println!(
+        "wrote {} and {}: {} coordinates, {} joint rows; prefix {}_",
+        out.header.display(),
+        out.source.display(),
+        out.dof,
+        out.constraints,
+        out.prefix
+    );
+    for (i, name) in &out.inputs {
+        println!(
+            "  input-driven parameter {i} ({name}): set it each step with {}_set_parameter",
+            out.prefix
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}

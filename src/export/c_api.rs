@@ -1,0 +1,464 @@
+//! The exported library's header and source: named parameters with the
+//! model's values as defaults, the kernels, and the functions a caller
+//! uses (docs/export.md).
+
+use std::collections::HashSet;
+use std::fmt::Write;
+
+use runtime::{N_OUTPUTS, OUTPUT_NAMES, Tape, TapeSet};
+
+use super::c_tape::{self, literal};
+
+/// The support code every export carries (special functions, L D L^T).
+const SUPPORT: &str = include_str!("support.c");
+
+/// Values a shape row holds: the point, then the section's quaternion.
+const SHAPE_ROW: usize = eomgen::shape::ROW;
+
+/// One model's library.
+pub struct Library<'a> {
+    pub prefix: &'a str,
+    pub model: &'a str,
+    pub hash: &'a str,
+    pub tapes: &'a TapeSet,
+    /// The base parameters' values (the defaults).
+    pub values: &'a [f64],
+    /// Parameters that inputs drive.
+    pub inputs: &'a [(usize, String)],
+    /// The arm's shape, one point per element (`eomgen::shape`).
+    pub shape: &'a Tape,
+}
+
+/// A C identifier from any name: other characters become `_`, runs of
+/// them one, and a leading digit gets a `_` before it.
+pub fn identifier(name: &str) -> String {
+    let mut out = String::new();
+    for ch in name.chars() {
+        let c = if ch.is_ascii_alphanumeric() { ch } else { '_' };
+        if !(c == '_' && out.ends_with('_')) {
+            out.push(c);
+        }
+    }
+    let out = out.trim_matches('_').to_string();
+    match out.chars().next() {
+        None => "model".into(),
+        Some(c) if c.is_ascii_digit() => format!("_{out}"),
+        Some(_) => out,
+    }
+}
+
+/// Each parameter's field name in the struct: its identifier, made
+/// unique by a suffix where two names meet.
+fn field_names(names: &[String]) -> Vec<String> {
+    let mut seen = HashSet::new();
+    names
+        .iter()
+        .map(|n| {
+            let base = identifier(n);
+            let mut f = base.clone();
+            let mut k = 2;
+            while !seen.insert(f.clone()) {
+                f = format!("{base}_{k}");
+                k += 1;
+            }
+            f
+        })
+        .collect()
+}
+
+/// `text` with every identifier that starts with `from` starting with
+/// `to` instead: the support functions are external (a model need not
+/// call all of them, and -Wall warns of an unused static one), named for
+/// the model so that two exports link together.
+fn with_prefix(text: &str, from: &str, to: &str) -> String {
+    let mut out = String::with_capacity(text.len() + text.len() / 8);
+    let mut rest = text;
+    while let Some(k) = rest.find(from) {
+        let (before, after) = rest.split_at(k);
+        out.push_str(before);
+        let starts = !(out.chars().last()).is_some_and(|c| c.is_ascii_alphanumeric() || c == '_');
+        out.push_str(if starts { to } else { from });
+        rest = &after[from.len()..];
+    }
+    out.push_str(rest);
+    out
+}
+
+impl Library<'_> {
+    fn n(&self) -> usize {
+        self.tapes.info.dof()
+    }
+    fn m(&self) -> usize {
+        self.tapes.info.constraints.len()
+    }
+    fn upper(&self) -> String {
+        self.prefix.to_ascii_uppercase()
+    }
+
+    /// `<prefix>.h`.
+    pub fn header(&self) -> String {
+        let (p, up) = (self.prefix, self.upper());
+        let info = &self.tapes.info;
+        let mut h = String::new();
+        let _ = write!(
+            h,
+            "/* {p}.h: the equations of motion of the softarm model \"{model}\" (structure \
+             {hash}), exported by softarm {version}. Generated: do not edit; export again.\n \
+             * C99 and libm alone. The state is x = (q, qd); docs/export.md in softarm \
+             explains every function. */\n#ifndef {up}_H\n#define {up}_H\n\n#include <stddef.h>\n\n",
+            model = self.model,
+            hash = self.hash,
+            version = env!("CARGO_PKG_VERSION"),
+        );
+        let defines = [
+            ("NQ", self.n(), "generalised coordinates"),
+            ("NX", 2 * self.n(), "states: q, then qd"),
+            ("NPARAMS", info.parameters.len(), "base parameters"),
+            (
+                "NOUTPUTS",
+                N_OUTPUTS,
+                "outputs (tip, energies, tip orientation)",
+            ),
+            ("NCONSTRAINTS", self.m(), "joint rows (0: no joints)"),
+            ("NSHAPE", self.shape.outputs.len() / SHAPE_ROW, "shape rows"),
+            ("NINPUTS", self.inputs.len(), "parameters driven by inputs"),
+        ];
+        for (name, v, what) in defines {
+            let _ = writeln!(h, "#define {up}_{name} {v} /* {what} */");
+        }
+        h.push_str("\n/* The model's parameters, named; ");
+        let _ = writeln!(h, "{p}_default_params gives the model file's values. */");
+        h.push_str("typedef struct {\n");
+        let fields = field_names(&info.parameters);
+        for (f, name) in fields.iter().zip(&info.parameters) {
+            let _ = writeln!(h, "    double {f}; /* {name} */");
+        }
+        let _ = writeln!(h, "}} {p}_params;\n");
+        let work = self.work_len();
+        let _ = writeln!(
+            h,
+            "/* Parameters (base, then derived) and workspace: one per thread. */\n\
+             typedef struct {{\n    double p[{}];\n    double work[{work}];\n}} {p}_model;\n",
+            info.extended_params().max(1),
+        );
+        h.push_str(&self.prototypes());
+        let _ = writeln!(h, "\n#endif /* {up}_H */");
+        h
+    }
+
+    /// Length of the model struct's workspace.
+    fn work_len(&self) -> usize {
+        let (n, m) = (self.n(), self.m());
+        let tri = n * (n + 1) / 2;
+        // packed M and h, L, D, the state derivative, a direction, d tau;
+        // with joints the constraint rows, X, S, its factors and lambda.
+        let base = tri + n + n * n + n + 2 * n + 2 * n + n;
+        let joints = m * (n + 2) + m * n + m * (m + 1) / 2 + m * m + m + m;
+        base + joints + self.scratch_len()
+    }
+
+    fn prototypes(&self) -> String {
+        let p = self.prefix;
+        let mut h = String::new();
+        let _ = writeln!(
+            h,
+            "extern const char *const {p}_coordinate_names[];\n\
+             extern const char *const {p}_parameter_names[];\n\
+             extern const char *const {p}_output_names[];\n\
+             /* Indices in the parameters of those that inputs drive (set them each step\n \
+             * with {p}_set_parameter); none when NINPUTS is 0. */\n\
+             extern const size_t {p}_input_parameters[];\n\n\
+             /* The model file's values. */\n\
+             void {p}_default_params({p}_params *params);\n\
+             /* Bind parameter values: copies them and computes the derived ones. */\n\
+             void {p}_init({p}_model *model, const {p}_params *params);\n\
+             /* Change parameter i (in {p}_parameter_names' order), an input's at each step. */\n\
+             void {p}_set_parameter({p}_model *model, size_t i, double value);\n\
+             /* M(q) (NQ x NQ, row-major) and h(t, q, qd), M qdd + h = 0 the equations. */\n\
+             void {p}_mass_bias({p}_model *model, double t, const double *q, const double *qd,\n    \
+             double *mass, double *bias);\n\
+             /* The outputs ({p}_output_names). */\n\
+             void {p}_outputs({p}_model *model, double t, const double *q, const double *qd, double *out);\n\
+             /* The arm's shape: NSHAPE rows of (x, y, z, qw, qx, qy, qz), each arm's base then\n \
+             * its element ends. */\n\
+             void {p}_shape({p}_model *model, double t, const double *q, double *out);\n\
+             /* The directional derivative of tau = M qdd + h along (dq, dqd) at qdd. */\n\
+             void {p}_inverse_dynamics_jvp({p}_model *model, double t, const double *q,\n    \
+             const double *qd, const double *qdd, const double *dq, const double *dqd, double *dtau);\n\
+             /* dx = f(t, x). Returns 0, 1 when M is not positive definite, 2 when the joints\n \
+             * are dependent. */\n\
+             int {p}_state_derivative({p}_model *model, double t, const double *x, double *dx);"
+        );
+        if self.m() == 0 {
+            let _ = writeln!(
+                h,
+                "/* df/dx (NX x NX, row-major); returns as {p}_state_derivative. */\n\
+                 int {p}_state_jacobian({p}_model *model, double t, const double *x, double *jac);"
+            );
+        } else {
+            let _ = writeln!(
+                h,
+                "/* The joints phi(q) = 0: phi (NCONSTRAINTS), J = dphi/dq (NCONSTRAINTS x NQ,\n \
+                 * row-major), gamma = (dJ/dt) qd (NCONSTRAINTS). */\n\
+                 void {p}_constraints({p}_model *model, double t, const double *q, const double *qd,\n    \
+                 double *phi, double *jac, double *gamma);"
+            );
+        }
+        h
+    }
+
+    /// The kernels by their C names.
+    fn kernels(&self) -> Vec<(&'static str, &Tape)> {
+        let t = self.tapes;
+        let mut kernels = vec![
+            ("k_derived", &t.derived),
+            ("k_mass_bias", &t.mass_bias),
+            ("k_outputs", &t.outputs),
+            ("k_jvp", &t.jvp),
+            ("k_shape", self.shape),
+        ];
+        if self.m() > 0 {
+            kernels.push(("k_constraints", &t.constraints));
+        }
+        kernels
+    }
+
+    /// Scratch values the table kernels need (the largest one's).
+    fn scratch_len(&self) -> usize {
+        let sizes = self
+            .kernels()
+            .into_iter()
+            .map(|(_, tape)| c_tape::scratch(tape));
+        sizes.max().unwrap_or(0).max(1)
+    }
+
+    /// `<prefix>.c`.
+    pub fn source(&self) -> String {
+        let p = self.prefix;
+        let mut c = format!(
+            "/* {p}.c: the equations of motion of the softarm model \"{}\" (structure {}).\n \
+             * Generated by `softarm export`: do not edit. C99 and libm alone. */\n\
+             #include \"{p}.h\"\n\n#include <math.h>\n#include <stddef.h>\n#include <string.h>\n\n",
+            self.model, self.hash
+        );
+        // 1/n! as literals: the series' coefficients, exact to the last bit.
+        let mut f = 1.0_f64;
+        let inv: Vec<String> = (0..48)
+            .map(|n| {
+                if n > 0 {
+                    f *= n as f64;
+                }
+                literal(1.0 / f)
+            })
+            .collect();
+        c.push_str(&SUPPORT.replace("/*INV_FACTORIALS*/", &inv.join(", ")));
+        c.push('\n');
+        for (name, tape) in self.kernels() {
+            c.push_str(&c_tape::kernel(name, tape));
+            c.push('\n');
+        }
+        c.push_str(&self.workspace_macros());
+        c.push_str(&self.names());
+        c.push_str(&self.parameter_functions());
+        c.push_str(&self.dynamics_functions());
+        with_prefix(&c, "sa_", &format!("{p}_sa_"))
+    }
+
+    /// The name tables.
+    fn names(&self) -> String {
+        let p = self.prefix;
+        let info = &self.tapes.info;
+        let quoted = |v: &[String]| {
+            let items: Vec<String> = v
+                .iter()
+                .map(|s| format!("\"{}\"", s.escape_default()))
+                .collect();
+            if items.is_empty() {
+                "\"\"".to_string()
+            } else {
+                items.join(", ")
+            }
+        };
+        let outputs: Vec<String> = OUTPUT_NAMES.iter().map(|s| s.to_string()).collect();
+        let inputs: Vec<String> = self.inputs.iter().map(|(i, _)| i.to_string()).collect();
+        format!(
+            "const char *const {p}_coordinate_names[] = {{{}}};\n\
+             const char *const {p}_parameter_names[] = {{{}}};\n\
+             const char *const {p}_output_names[] = {{{}}};\n\
+             const size_t {p}_input_parameters[] = {{{}}};\n\n",
+            quoted(&info.coordinates),
+            quoted(&info.parameters),
+            quoted(&outputs),
+            if inputs.is_empty() {
+                "0".into()
+            } else {
+                inputs.join(", ")
+            },
+        )
+    }
+
+    /// Defaults, binding and changing parameters.
+    fn parameter_functions(&self) -> String {
+        let p = self.prefix;
+        let info = &self.tapes.info;
+        let fields = field_names(&info.parameters);
+        let mut c = format!("void {p}_default_params({p}_params *v)\n{{\n");
+        for (f, &v) in fields.iter().zip(self.values) {
+            let _ = writeln!(c, "    v->{f} = {};", literal(v));
+        }
+        c.push_str("}\n\n");
+        let _ = writeln!(
+            c,
+            "/* The derived parameters after the base ones. */\n\
+             static void derive_params({p}_model *m)\n{{\n    \
+             k_derived(0.0, NULL, NULL, NULL, NULL, m->p, NULL, m->p + {}, SCRATCH);\n}}\n",
+            info.parameters.len()
+        );
+        let _ = writeln!(c, "void {p}_init({p}_model *m, const {p}_params *v)\n{{");
+        c.push_str("    memset(m, 0, sizeof *m);\n");
+        for (i, f) in fields.iter().enumerate() {
+            let _ = writeln!(c, "    m->p[{i}] = v->{f};");
+        }
+        c.push_str("    derive_params(m);\n}\n\n");
+        let _ = writeln!(
+            c,
+            "void {p}_set_parameter({p}_model *m, size_t i, double value)\n{{\n    \
+             if (i < {}) {{\n        m->p[i] = value;\n        derive_params(m);\n    }}\n}}\n",
+            info.parameters.len()
+        );
+        c
+    }
+
+    /// Mass and bias, outputs, shape, the state derivative and its
+    /// Jacobian (or the joints' rows).
+    fn dynamics_functions(&self) -> String {
+        let (p, n, m) = (self.prefix, self.n(), self.m());
+        let tri = n * (n + 1) / 2;
+        let mut c = String::new();
+        let _ = writeln!(
+            c,
+            "void {p}_mass_bias({p}_model *m, double t, const double *q, const double *qd,\n    \
+             double *mass, double *bias)\n{{\n    size_t i, j;\n    \
+             k_mass_bias(t, q, qd, NULL, NULL, m->p, NULL, PACKED, SCRATCH);\n    \
+             for (i = 0; i < {n}; i++) {{\n        bias[i] = PACKED[{tri} + i];\n        \
+             for (j = i; j < {n}; j++)\n            \
+             mass[i * {n} + j] = mass[j * {n} + i] = PACKED[sa_packed({n}, i, j)];\n    }}\n}}\n\n\
+             void {p}_outputs({p}_model *m, double t, const double *q, const double *qd, double *out)\n{{\n    \
+             k_outputs(t, q, qd, NULL, NULL, m->p, NULL, out, SCRATCH);\n}}\n\n\
+             void {p}_shape({p}_model *m, double t, const double *q, double *out)\n{{\n    \
+             k_shape(t, q, NULL, NULL, NULL, m->p, NULL, out, SCRATCH);\n}}\n\n\
+             void {p}_inverse_dynamics_jvp({p}_model *m, double t, const double *q,\n    \
+             const double *qd, const double *qdd, const double *dq, const double *dqd, double *dtau)\n{{\n    \
+             memcpy(DIR, dq, {n} * sizeof(double));\n    \
+             memcpy(DIR + {n}, dqd, {n} * sizeof(double));\n    \
+             k_jvp(t, q, qd, qdd, DIR, m->p, NULL, dtau, SCRATCH);\n}}\n"
+        );
+        c.push_str(&self.state_derivative());
+        if m == 0 {
+            c.push_str(&self.state_jacobian());
+        } else {
+            let _ = writeln!(
+                c,
+                "void {p}_constraints({p}_model *m, double t, const double *q, const double *qd,\n    \
+                 double *phi, double *jac, double *gamma)\n{{\n    \
+                 k_constraints(t, q, qd, NULL, NULL, m->p, NULL, ROWS, SCRATCH);\n    \
+                 memcpy(phi, ROWS, {m} * sizeof(double));\n    \
+                 memcpy(jac, ROWS + {m}, {mn} * sizeof(double));\n    \
+                 memcpy(gamma, ROWS + {m} + {mn}, {m} * sizeof(double));\n}}\n",
+                mn = m * n
+            );
+        }
+        c
+    }
+
+    /// Names for the workspace's pieces (laid out as `work_len` counts).
+    fn workspace_macros(&self) -> String {
+        let (n, m) = (self.n(), self.m());
+        let tri = n * (n + 1) / 2;
+        let pieces = [
+            ("PACKED", tri + n),
+            ("LOWER", n * n),
+            ("PIVOTS", n),
+            ("DX", 2 * n),
+            ("DIR", 2 * n),
+            ("DTAU", n),
+            ("ROWS", m * (n + 2)),
+            ("XCOLS", m * n),
+            ("SCHUR", m * (m + 1) / 2),
+            ("SLOWER", m * m),
+            ("SPIVOTS", m),
+            ("LAMBDA", m),
+            ("SCRATCH", self.scratch_len()),
+        ];
+        let mut c = String::new();
+        let mut at = 0;
+        for (name, len) in pieces {
+            let _ = writeln!(c, "#define {name} (m->work + {at})");
+            at += len;
+        }
+        debug_assert_eq!(at, self.work_len());
+        c.push('\n');
+        c
+    }
+
+    /// dx = (qd, qdd): L D L^T of M, then the joints' Schur complement.
+    fn state_derivative(&self) -> String {
+        let (p, n, m) = (self.prefix, self.n(), self.m());
+        let tri = n * (n + 1) / 2;
+        let mut c = format!(
+            "int {p}_state_derivative({p}_model *m, double t, const double *x, double *dx)\n{{\n    \
+             const double *q = x, *qd = x + {n};\n    size_t i;\n    \
+             k_mass_bias(t, q, qd, NULL, NULL, m->p, NULL, PACKED, SCRATCH);\n    \
+             if (sa_ldlt_factor({n}, PACKED, LOWER, PIVOTS)) return 1;\n    \
+             for (i = 0; i < {n}; i++) {{\n        dx[i] = qd[i];\n        \
+             dx[{n} + i] = -PACKED[{tri} + i];\n    }}\n    \
+             sa_ldlt_solve({n}, LOWER, PIVOTS, dx + {n});\n"
+        );
+        if m > 0 {
+            let _ = write!(
+                c,
+                "    {{\n        /* qdd = a0 - X lambda, X = M^-1 J^T, (J X) lambda = J a0 + gamma. */\n        \
+                 const double *jac = ROWS + {m}, *gamma = ROWS + {m} + {mn};\n        \
+                 size_t r, s, k = 0;\n        \
+                 k_constraints(t, q, qd, NULL, NULL, m->p, NULL, ROWS, SCRATCH);\n        \
+                 for (r = 0; r < {m}; r++) {{\n            \
+                 memcpy(XCOLS + r * {n}, jac + r * {n}, {n} * sizeof(double));\n            \
+                 sa_ldlt_solve({n}, LOWER, PIVOTS, XCOLS + r * {n});\n        }}\n        \
+                 for (r = 0; r < {m}; r++) {{\n            double v = gamma[r];\n            \
+                 for (s = r; s < {m}; s++) {{\n                double d = 0.0;\n                \
+                 for (i = 0; i < {n}; i++) d += jac[r * {n} + i] * XCOLS[s * {n} + i];\n                \
+                 SCHUR[k++] = d;\n            }}\n            \
+                 for (i = 0; i < {n}; i++) v += jac[r * {n} + i] * dx[{n} + i];\n            \
+                 LAMBDA[r] = v;\n        }}\n        \
+                 if (sa_ldlt_factor({m}, SCHUR, SLOWER, SPIVOTS)) return 2;\n        \
+                 sa_ldlt_solve({m}, SLOWER, SPIVOTS, LAMBDA);\n        \
+                 for (r = 0; r < {m}; r++)\n            \
+                 for (i = 0; i < {n}; i++) dx[{n} + i] -= LAMBDA[r] * XCOLS[r * {n} + i];\n    }}\n",
+                mn = m * n
+            );
+        }
+        c.push_str("    return 0;\n}\n\n");
+        c
+    }
+
+    /// df/dx: [0 I; dqdd/dq dqdd/dqd], dqdd = -M^-1 d tau column by column.
+    fn state_jacobian(&self) -> String {
+        let (p, n) = (self.prefix, self.n());
+        format!(
+            "int {p}_state_jacobian({p}_model *m, double t, const double *x, double *jac)\n{{\n    \
+             const double *q = x, *qd = x + {n};\n    size_t i, col;\n    \
+             int status = {p}_state_derivative(m, t, x, DX);\n    \
+             if (status) return status;\n    \
+             memset(jac, 0, {nx} * {nx} * sizeof(double));\n    \
+             for (i = 0; i < {n}; i++) jac[i * {nx} + {n} + i] = 1.0;\n    \
+             for (col = 0; col < {nx}; col++) {{\n        \
+             memset(DIR, 0, {nx} * sizeof(double));\n        DIR[col] = 1.0;\n        \
+             k_jvp(t, q, qd, DX + {n}, DIR, m->p, NULL, DTAU, SCRATCH);\n        \
+             for (i = 0; i < {n}; i++) DTAU[i] = -DTAU[i];\n        \
+             sa_ldlt_solve({n}, LOWER, PIVOTS, DTAU);\n        \
+             for (i = 0; i < {n}; i++) jac[({n} + i) * {nx} + col] = DTAU[i];\n    }}\n    \
+             return 0;\n}}\n",
+            nx = 2 * n
+        )
+    }
+}

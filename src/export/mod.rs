@@ -1,0 +1,108 @@
+//! `softarm export MODEL --c DIR`: a model's equations as a self-contained
+//! C99 library (one header, one source, libm alone), for controllers,
+//! Simulink S-functions and anything else that links C.
+//!
+//! The kernels are the model's tapes, each a C function running the
+//! interpreter's operations in its order (`c_tape`); the state derivative
+//! solves M qdd = -h by L D L^T (and the joints' rows by their Schur
+//! complement, as `runtime::constraints`), its Jacobian comes column by
+//! column from the inverse dynamics' directional derivative, as the
+//! runtime's. docs/export.md is the user's guide.
+
+mod c_api;
+mod c_tape;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use eomgen::model::{Override, ParamLayout, Structure};
+
+use crate::backend;
+
+/// What an export wrote.
+#[derive(Debug)]
+pub struct CExport {
+    /// The C identifier prefix of every name the library declares.
+    pub prefix: String,
+    pub header: PathBuf,
+    pub source: PathBuf,
+    pub dof: usize,
+    pub constraints: usize,
+    /// The parameters that inputs drive: (index, name), set by the caller
+    /// at each step.
+    pub inputs: Vec<(usize, String)>,
+}
+
+/// Export the model `spec` (a name or file, with `--set` overrides) as C
+/// into `dir` (created if missing; nothing else in it is touched).
+pub fn export_c(
+    spec: &str,
+    overrides: &[Override],
+    dir: &Path,
+    cache_dir: Option<PathBuf>,
+) -> Result<CExport> {
+    let (model, origin) = backend::read_model(spec, overrides)?;
+    if crate::continuum::is_cosserat(&model) {
+        bail!(
+            "{origin}: segment.method: \"cosserat\" is solved as a boundary value problem, which \
+             has no equations of motion to export; choose pcc, vc, ebr, eba, rom, pcs or rigid"
+        );
+    }
+    let structure = Structure::of(&model);
+    if structure.contact_points > 0 {
+        bail!(
+            "{origin}: [contact]: the contact laws are not exported to C yet (only the \
+             equations without contact); remove [contact] and [[obstacle]] to export the rest"
+        );
+    }
+    if model.segments.iter().any(|s| !s.relaxation.is_empty()) {
+        bail!(
+            "{origin}: segment.relaxation: viscoelastic materials carry relaxed forces as extra \
+             states, which the C export does not have yet; export the elastic model (remove \
+             relaxation)"
+        );
+    }
+    let hash = structure.hash();
+    let layout = ParamLayout::of(&structure);
+    let (tapes, _, _) = backend::tapes(
+        &model,
+        &hash,
+        &cache_dir.unwrap_or_else(crate::cache::default_dir),
+    );
+    if tapes.info.parameters != layout.names() {
+        bail!("{origin}: the cached kernels do not match this generator's parameter layout");
+    }
+    let values = layout.values(&model);
+    let base = backend::base_dir(spec);
+    let drives = crate::inputs::model_drives(&model, &layout, &base)
+        .with_context(|| format!("{origin}: reading the input channels"))?;
+    let inputs: Vec<(usize, String)> = (drives.iter())
+        .map(|d| (d.param, tapes.info.parameters[d.param].clone()))
+        .collect();
+    let shape = eomgen::shape::shape_tape(&structure, 1);
+    let prefix = c_api::identifier(&model.name);
+    let library = c_api::Library {
+        prefix: &prefix,
+        model: &model.name,
+        hash: &hash,
+        tapes: &tapes,
+        values: &values,
+        inputs: &inputs,
+        shape: &shape.tape,
+    };
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let header = dir.join(format!("{prefix}.h"));
+    let source = dir.join(format!("{prefix}.c"));
+    eomgen::atomic_write::write_atomic(&header, library.header().as_bytes())
+        .with_context(|| format!("writing {}", header.display()))?;
+    eomgen::atomic_write::write_atomic(&source, library.source().as_bytes())
+        .with_context(|| format!("writing {}", source.display()))?;
+    Ok(CExport {
+        prefix,
+        header,
+        source,
+        dof: tapes.info.dof(),
+        constraints: tapes.info.constraints.len(),
+        inputs,
+    })
+}

@@ -1,0 +1,296 @@
+//! `softarm export --c`: the library, compiled by the system's C compiler
+//! at `-std=c99 -Wall -Werror -O2`, gives what the Rust kernels give at
+//! random states: M, h, the outputs, the shape, the state derivative and
+//! its Jacobian (or the joints' rows), to 1e-12 of each block's largest
+//! entry.
+
+use std::fmt::Write;
+use std::path::Path;
+use std::process::Command;
+
+use nalgebra::{DMatrix, DVector};
+use runtime::Dynamics;
+use softarm::backend::{BackendChoice, load};
+
+use crate::common::{Rng, root};
+
+/// Relative agreement asked of every kernel's block.
+const TOL: f64 = 1e-12;
+/// Of what comes through a solve with M (the accelerations and the
+/// Jacobian's lower half): two solves in different orders agree to about
+/// cond(M) times round-off, and random states of a soft finger give
+/// cond(M) near 1e4. The C solve's own backward error is held to `TOL`
+/// (the residual of M qdd + h, below).
+const SOLVED_TOL: f64 = 1e-9;
+/// Random states a model.
+const STATES: usize = 3;
+
+/// One block of values: its name and the Rust side's numbers.
+struct Block {
+    name: String,
+    values: Vec<f64>,
+    tol: f64,
+}
+
+fn block(name: &str, values: Vec<f64>) -> Block {
+    Block {
+        name: name.into(),
+        values,
+        tol: TOL,
+    }
+}
+
+/// What the Rust kernels give at (t, q, qd), in the driver's print order.
+fn rust_blocks(
+    arm: &dyn Dynamics,
+    shape: &eomgen::shape::ShapeTape,
+    t: f64,
+    x: &[f64],
+) -> Vec<Block> {
+    let n = arm.dof();
+    let (q, qd) = x.split_at(n);
+    let mut m = DMatrix::zeros(n, n);
+    let mut h = DVector::zeros(n);
+    arm.mass_bias(t, q, qd, &mut m, &mut h);
+    let mut blocks = vec![
+        block("mass", m.transpose().iter().copied().collect()),
+        block("bias", h.iter().copied().collect()),
+        block("outputs", arm.outputs(t, q, qd).to_vec()),
+        block("shape", shape.eval(t, q, &arm.params_at(t))),
+    ];
+    let mut ws = runtime::Workspace::new(n);
+    let mut qdd = vec![0.0; n];
+    runtime::accelerations(arm, &mut ws, t, q, qd, &mut qdd).expect("the Rust accelerations");
+    blocks.push(Block {
+        name: "qdd".into(),
+        values: qdd,
+        tol: SOLVED_TOL,
+    });
+    if arm.info().constraints.is_empty() {
+        let mut jac = DMatrix::zeros(2 * n, 2 * n);
+        runtime::state_jacobian(arm, &mut ws, t, x, &mut jac).expect("the Rust Jacobian");
+        let values = jac.transpose().iter().copied().collect();
+        blocks.push(Block {
+            name: "jacobian".into(),
+            values,
+            tol: SOLVED_TOL,
+        });
+    } else {
+        let c = runtime::constraints::evaluate(arm, t, q, qd);
+        let jac: Vec<f64> = c.jac.transpose().iter().copied().collect();
+        blocks.push(block("phi", c.phi));
+        blocks.push(block("constraint jacobian", jac));
+        blocks.push(block("gamma", c.gamma));
+    }
+    blocks
+}
+
+/// A C driver that binds the given base parameters, evaluates every
+/// function at each state and prints the values one a line.
+fn driver(prefix: &str, params: &[f64], states: &[Vec<f64>], joints: bool, t: f64) -> String {
+    let p = prefix;
+    let up = p.to_ascii_uppercase();
+    let (n, no) = (states[0].len() / 2, runtime::N_OUTPUTS);
+    let mut c = format!(
+        "#include <stdio.h>\n#include \"{p}.h\"\n\
+         static void put(const double *v, size_t k) {{ size_t i; for (i = 0; i < k; i++) printf(\"%.17g\\n\", v[i]); }}\n\
+         int main(void) {{\n  static {p}_params v; static {p}_model m;\n  \
+         static double mass[{nn}], bias[{n}], out[{no}], shape[{up}_NSHAPE * 7], dx[{nx}], jac[{nxx}];\n  \
+         static double phi[{up}_NCONSTRAINTS + 1], cj[({up}_NCONSTRAINTS + 1) * {n}], gamma[{up}_NCONSTRAINTS + 1];\n  \
+         size_t i;\n  {p}_default_params(&v);\n  {p}_init(&m, &v);\n",
+        nn = n * n,
+        nx = 2 * n,
+        nxx = 4 * n * n,
+    );
+    // The parameters as the Rust side has them at t (inputs included).
+    let _ = write!(c, "  {{ static const double base[] = {{");
+    for v in params {
+        let _ = write!(c, "{v:?}, ");
+    }
+    let _ = writeln!(
+        c,
+        "0.0 }};\n    for (i = 0; i < {}; i++) {p}_set_parameter(&m, i, base[i]);\n  }}",
+        params.len()
+    );
+    for x in states {
+        let _ = write!(c, "  {{ static const double x[] = {{");
+        for v in x {
+            let _ = write!(c, "{v:?}, ");
+        }
+        let _ = writeln!(
+            c,
+            "0.0 }};\n    {p}_mass_bias(&m, {t:?}, x, x + {n}, mass, bias); put(mass, {nn}); put(bias, {n});\n    \
+             {p}_outputs(&m, {t:?}, x, x + {n}, out); put(out, {no});\n    \
+             {p}_shape(&m, {t:?}, x, shape); put(shape, {up}_NSHAPE * 7);\n    \
+             if ({p}_state_derivative(&m, {t:?}, x, dx)) return 3;\n    put(dx + {n}, {n});",
+            nn = n * n,
+        );
+        if joints {
+            let _ = writeln!(
+                c,
+                "    {p}_constraints(&m, {t:?}, x, x + {n}, phi, cj, gamma);\n    \
+                 put(phi, {up}_NCONSTRAINTS); put(cj, {up}_NCONSTRAINTS * {n}); put(gamma, {up}_NCONSTRAINTS);"
+            );
+        } else {
+            let _ = writeln!(
+                c,
+                "    if ({p}_state_jacobian(&m, {t:?}, x, jac)) return 4;\n    put(jac, {});",
+                4 * n * n
+            );
+        }
+        c.push_str("  }\n");
+    }
+    c.push_str("  (void)phi; (void)cj; (void)gamma; (void)jac;\n  return 0;\n}\n");
+    c
+}
+
+/// The C accelerations solve M qdd = -h to round-off: each row's residual
+/// within `TOL` of the row's own magnitudes (|M| |qdd| + |h|).
+fn backward_error_is_round_off(arm: &dyn Dynamics, t: f64, x: &[f64], qdd: &[f64], model: &str) {
+    let n = arm.dof();
+    let (q, qd) = x.split_at(n);
+    let mut m = DMatrix::zeros(n, n);
+    let mut h = DVector::zeros(n);
+    arm.mass_bias(t, q, qd, &mut m, &mut h);
+    for i in 0..n {
+        let r: f64 = (0..n).map(|j| m[(i, j)] * qdd[j]).sum::<f64>() + h[i];
+        let size: f64 = (0..n).map(|j| (m[(i, j)] * qdd[j]).abs()).sum::<f64>() + h[i].abs();
+        assert!(
+            r.abs() <= TOL * size,
+            "{model}: row {i} of M qdd + h is {r:e} of {size:e}"
+        );
+    }
+}
+
+/// Export `model`, compile it with a driver, and compare every block at
+/// random states with the Rust kernels.
+fn check_export(model: &str, dir: &Path) {
+    let cache = dir.join("cache");
+    let out = dir.join("c");
+    let spec = root().join("models").join(format!("{model}.toml"));
+    let spec = spec.to_str().unwrap();
+    let export = softarm::export::export_c(spec, &[], &out, Some(cache.clone())).unwrap();
+    let loaded = load(spec, &[], BackendChoice::Auto, Some(cache)).unwrap();
+    let arm = &*loaded.arm;
+    let n = arm.dof();
+    let structure = eomgen::model::Structure::of(&loaded.model);
+    let shape = eomgen::shape::shape_tape(&structure, 1);
+    let t = 0.25;
+    let mut rng = Rng::new(0x5eed ^ model.len() as u64);
+    let states: Vec<Vec<f64>> = (0..STATES)
+        .map(|_| {
+            let mut x = rng.coordinates(&arm.info().coordinates, -0.3, 0.3);
+            x.extend(rng.vec(n, -1.0, 1.0));
+            x
+        })
+        .collect();
+    let params = arm.params_at(t)[..arm.info().parameters.len()].to_vec();
+    let joints = !arm.info().constraints.is_empty();
+    let main = out.join("driver.c");
+    std::fs::write(&main, driver(&export.prefix, &params, &states, joints, t)).unwrap();
+    let exe = out.join("driver");
+    let cc = Command::new("cc")
+        .args(["-std=c99", "-Wall", "-Werror", "-O2", "-o"])
+        .arg(&exe)
+        .arg(&main)
+        .arg(&export.source)
+        .arg("-lm")
+        .output()
+        .expect("a C compiler (cc) on the PATH");
+    assert!(
+        cc.status.success(),
+        "{model}: cc failed:\n{}",
+        String::from_utf8_lossy(&cc.stderr)
+    );
+    let run = Command::new(&exe).output().unwrap();
+    assert!(
+        run.status.success(),
+        "{model}: the driver failed ({:?})",
+        run.status
+    );
+    let text = String::from_utf8(run.stdout).unwrap();
+    let mut got = text.lines().map(|l| l.parse::<f64>().unwrap());
+    for (k, x) in states.iter().enumerate() {
+        for b in rust_blocks(arm, &shape, t, x) {
+            let c: Vec<f64> = got.by_ref().take(b.values.len()).collect();
+            assert_eq!(c.len(), b.values.len(), "{model}: {} too short", b.name);
+            let scale = b.values.iter().fold(1e-300_f64, |m, v| m.max(v.abs()));
+            let worst = c
+                .iter()
+                .zip(&b.values)
+                .map(|(a, r)| (a - r).abs())
+                .fold(0.0, f64::max);
+            if b.name == "qdd" && !joints {
+                backward_error_is_round_off(arm, t, x, &c, model);
+            }
+            assert!(
+                worst <= b.tol * scale,
+                "{model}, state {k}, {}: C and Rust differ by {worst:e} of a largest entry {scale:e}",
+                b.name
+            );
+        }
+    }
+    assert!(
+        got.next().is_none(),
+        "{model}: the driver printed more than asked"
+    );
+}
+
+/// A planar pcc arm, a 3D rom arm (kernels large enough to go as
+/// tables) and an assembly closed by joints: the default run's check.
+#[test]
+fn the_c_library_of_a_pcc_arm_a_rom_arm_and_joints_agrees_with_the_rust_kernels() {
+    for model in ["soft_finger", "rom_arm", "falling_ball"] {
+        let dir = tempfile::tempdir().unwrap();
+        check_export(model, dir.path());
+    }
+}
+
+/// Every bundled model the export takes (contact and viscoelastic ones
+/// are refused with a reason, checked below).
+#[test]
+#[ignore = "long (every bundled model compiled at -O2): run by .ci/run's long checks"]
+fn every_bundled_model_exports_c_that_agrees_with_the_rust_kernels() {
+    for e in std::fs::read_dir(root().join("models")).unwrap() {
+        let path = e.unwrap().path();
+        let name = path.file_stem().unwrap().to_str().unwrap().to_string();
+        let dir = tempfile::tempdir().unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        if text.contains("[contact]") || text.contains("relaxation") {
+            continue;
+        }
+        check_export(&name, dir.path());
+    }
+}
+
+/// What the export cannot carry yet is refused with the key and the
+/// reason, and nothing is written.
+#[test]
+fn contact_and_viscoelastic_models_are_refused_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let relaxing = dir.path().join("relaxing.toml");
+    let finger = std::fs::read_to_string(root().join("models/soft_finger.toml")).unwrap();
+    let relaxing_text = finger.replace(
+        "youngs_modulus = 1.0e6",
+        "youngs_modulus = 1.0e6\nrelaxation = [{ ratio = 0.3, time = 0.5 }]",
+    );
+    assert_ne!(relaxing_text, finger);
+    std::fs::write(&relaxing, relaxing_text).unwrap();
+    let contact = root().join("models/finger_tap.toml");
+    for (spec, key) in [
+        (contact.as_path(), "[contact]"),
+        (relaxing.as_path(), "segment.relaxation"),
+    ] {
+        let out = dir.path().join("c");
+        let err = softarm::export::export_c(
+            spec.to_str().unwrap(),
+            &[],
+            &out,
+            Some(dir.path().join("cache")),
+        )
+        .unwrap_err();
+        let text = format!("{err:#}");
+        assert!(text.contains(key) && text.contains("not"), "{text}");
+        assert!(!out.exists(), "{} was written", out.display());
+    }
+}
