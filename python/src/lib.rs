@@ -268,6 +268,25 @@ impl Model {
         Ok((m.into_pyarray(py), h.as_slice().to_vec().into_pyarray(py)))
     }
 
+    /// The base parameters at times `t`, a row a time (`parameters`'
+    /// order): the model's values with its inputs applied, what the
+    /// kernels read then (and what an exported C library or FMU is given).
+    fn parameters_at<'py>(
+        &self,
+        py: Python<'py>,
+        t: PyReadonlyArray1<f64>,
+    ) -> Bound<'py, PyArray2<f64>> {
+        let t = t
+            .as_slice()
+            .map(<[f64]>::to_vec)
+            .unwrap_or_else(|_| t.as_array().to_vec());
+        let nb = self.loaded.arm.info().parameters.len();
+        let rows: Vec<Vec<f64>> = (t.iter())
+            .map(|&t| self.loaded.arm.params_at(t)[..nb].to_vec())
+            .collect();
+        Array2::from_shape_fn((rows.len(), nb), |(i, j)| rows[i][j]).into_pyarray(py)
+    }
+
     /// The outputs at (q, qd, t): tip x, y, z, kinetic and potential
     /// energy, tip orientation w, x, y, z.
     #[pyo3(signature = (q, qd=None, t=0.0))]

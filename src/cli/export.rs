@@ -16,7 +16,11 @@ pub struct ExportArgs {
     pub set: Vec<String>,
     /// Write a C99 library (DIR/<model>.h and DIR/<model>.c) into DIR.
     #[arg(long = "c", value_name = "DIR")]
-    pub c: PathBuf,
+    pub c: Option<PathBuf>,
+    /// Write an FMI 2.0 model-exchange FMU (sources and a binary for this
+    /// platform, built by the C compiler `cc` or $CC).
+    #[arg(long, value_name = "FILE.fmu")]
+    pub fmu: Option<PathBuf>,
     /// Directory of the tape cache (default: $SOFTARM_CACHE_DIR or .softarm-cache).
     #[arg(long, value_name = "DIR")]
     pub cache_dir: Option<PathBuf>,
@@ -27,14 +31,14 @@ pub fn export(a: ExportArgs) -> Result<ExitCode> {
     let overrides = (a.set.iter())
         .map(|s| Override::parse(s))
         .collect::<Result<Vec<_>, _>>()?;
-    let out = crate::export::export_c(&a.model, &overrides, &a.c, a.cache_dir)?;
+    let targets = crate::export::Targets { c: a.c, fmu: a.fmu };
+    let out = crate::export::export(&a.model, &overrides, &targets, a.cache_dir)?;
+    for f in &out.files {
+        println!("wrote {}", f.display());
+    }
     println!(
-        "wrote {} and {}: {} coordinates, {} joint rows; prefix {}_",
-        out.header.display(),
-        out.source.display(),
-        out.dof,
-        out.constraints,
-        out.prefix
+        "{} coordinates, {} joint rows; C names start with {}_",
+        out.dof, out.constraints, out.prefix
     );
     for (i, name) in &out.inputs {
         println!(

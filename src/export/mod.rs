@@ -11,6 +11,7 @@
 
 mod c_api;
 mod c_tape;
+mod fmu;
 
 use std::path::{Path, PathBuf};
 
@@ -19,13 +20,21 @@ use eomgen::model::{Override, ParamLayout, Structure};
 
 use crate::backend;
 
+/// What an export writes: the C library into a folder, an FMU file, or
+/// both.
+#[derive(Debug, Default)]
+pub struct Targets {
+    pub c: Option<PathBuf>,
+    pub fmu: Option<PathBuf>,
+}
+
 /// What an export wrote.
 #[derive(Debug)]
 pub struct CExport {
     /// The C identifier prefix of every name the library declares.
     pub prefix: String,
-    pub header: PathBuf,
-    pub source: PathBuf,
+    /// The files written, in order.
+    pub files: Vec<PathBuf>,
     pub dof: usize,
     pub constraints: usize,
     /// The parameters that inputs drive: (index, name), set by the caller
@@ -41,6 +50,24 @@ pub fn export_c(
     dir: &Path,
     cache_dir: Option<PathBuf>,
 ) -> Result<CExport> {
+    let targets = Targets {
+        c: Some(dir.to_path_buf()),
+        fmu: None,
+    };
+    export(spec, overrides, &targets, cache_dir)
+}
+
+/// Export the model `spec` to `targets`; a model the export cannot carry
+/// is refused before anything is written.
+pub fn export(
+    spec: &str,
+    overrides: &[Override],
+    targets: &Targets,
+    cache_dir: Option<PathBuf>,
+) -> Result<CExport> {
+    if targets.c.is_none() && targets.fmu.is_none() {
+        bail!("export: say what to write: --c DIR (a C library) or --fmu FILE.fmu (an FMU)");
+    }
     let (model, origin) = backend::read_model(spec, overrides)?;
     if crate::continuum::is_cosserat(&model) {
         bail!(
@@ -90,17 +117,32 @@ pub fn export_c(
         inputs: &inputs,
         shape: &shape.tape,
     };
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let header = dir.join(format!("{prefix}.h"));
-    let source = dir.join(format!("{prefix}.c"));
-    eomgen::atomic_write::write_atomic(&header, library.header().as_bytes())
-        .with_context(|| format!("writing {}", header.display()))?;
-    eomgen::atomic_write::write_atomic(&source, library.source().as_bytes())
-        .with_context(|| format!("writing {}", source.display()))?;
+    let mut files = Vec::new();
+    if let Some(dir) = &targets.c {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let header = dir.join(format!("{prefix}.h"));
+        let source = dir.join(format!("{prefix}.c"));
+        eomgen::atomic_write::write_atomic(&header, library.header().as_bytes())
+            .with_context(|| format!("writing {}", header.display()))?;
+        eomgen::atomic_write::write_atomic(&source, library.source().as_bytes())
+            .with_context(|| format!("writing {}", source.display()))?;
+        files.extend([header, source]);
+    }
+    if let Some(path) = &targets.fmu {
+        // The build folder sits beside the FMU and goes, success or not.
+        let name = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("model.fmu");
+        let build = path.with_file_name(format!(".{name}.build-{}", std::process::id()));
+        let written = fmu::write(&library, path, &build);
+        let _ = std::fs::remove_dir_all(&build);
+        written?;
+        files.push(path.clone());
+    }
     Ok(CExport {
         prefix,
-        header,
-        source,
+        files,
         dof: tapes.info.dof(),
         constraints: tapes.info.constraints.len(),
         inputs,

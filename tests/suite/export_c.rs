@@ -193,7 +193,7 @@ fn check_export(model: &str, dir: &Path) {
         .args(["-std=c99", "-Wall", "-Werror", "-O2", "-o"])
         .arg(&exe)
         .arg(&main)
-        .arg(&export.source)
+        .arg(&export.files[1])
         .arg("-lm")
         .output()
         .expect("a C compiler (cc) on the PATH");

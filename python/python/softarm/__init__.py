@@ -125,6 +125,13 @@ class Model:
         """The mass matrix M (n, n) and bias h (n,) at (q, qd, t)."""
         return self._core.mass_bias(_vector(q), _vector(qd), float(t))
 
+    def parameters_at(self, t) -> np.ndarray:
+        """The base parameters (`parameters`' order) at each time of t,
+        (len(t), len(parameters)): the model's values with its inputs
+        applied, as the kernels read them (and as an exported C library or
+        FMU is given them)."""
+        return self._core.parameters_at(np.ascontiguousarray(t, dtype=float).ravel())
+
     def outputs(self, q, qd=None, t: float = 0.0) -> np.ndarray:
         """The outputs (`OUTPUT_NAMES`) at (q, qd, t)."""
         return self._core.outputs(_vector(q), _vector(qd), float(t))
