@@ -10,6 +10,8 @@ use std::process::Command;
 
 use anyhow::{Context, Result, bail};
 use runtime::OUTPUT_NAMES;
+// (Named apart: `...Method::` is how softarm's modelling methods are spelt.)
+use zip::CompressionMethod as Compression;
 
 use super::c_api::Library;
 use super::c_tape::literal;
@@ -74,8 +76,7 @@ pub fn write(lib: &Library, fmu: &Path, build: &Path) -> Result<()> {
     }
     let so = std::fs::read(&binary).with_context(|| format!("reading {}", binary.display()))?;
     let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
-    let stored =
-        zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+    let stored = zip::write::SimpleFileOptions::default().compression_method(Compression::Stored);
     let mut entries: Vec<(String, Vec<u8>, u32)> = vec![
         (
             "modelDescription.xml".into(),
