@@ -10,7 +10,7 @@ use std::process::Command;
 
 use anyhow::{Context, Result, bail};
 use runtime::OUTPUT_NAMES;
-// (Named apart: `...Method::` is how softarm's modelling methods are spelt.)
+// Named apart: the architecture test keeps the modelling methods' enum path to eomgen/src/method.
 use zip::CompressionMethod as Compression;
 
 use super::c_api::Library;
