@@ -582,12 +582,30 @@ pub fn eom(a: EomArgs) -> Result<ExitCode> {
     arm.mass_bias(a.t, &q, &qd, &mut m, &mut h);
     let out = arm.outputs(a.t, &q, &qd);
     let rows: Vec<Vec<f64>> = (0..n).map(|i| m.row(i).iter().copied().collect()).collect();
+    // The state derivative's Jacobian, with the accelerations; null where
+    // they fail (M not positive definite, dependent joints).
+    let x: Vec<f64> = q.iter().chain(&qd).copied().collect();
+    let mut jac = DMatrix::zeros(2 * n, 2 * n);
+    let mut ws = runtime::Workspace::new(n);
+    let (qdd, jacobian) = match runtime::state_jacobian(arm, &mut ws, a.t, &x, &mut jac) {
+        Ok(qdd) => {
+            let rows: Vec<Vec<f64>> = (0..2 * n)
+                .map(|i| jac.row(i).iter().copied().collect())
+                .collect();
+            (json!(qdd), json!(rows))
+        }
+        Err(_) => (serde_json::Value::Null, serde_json::Value::Null),
+    };
     let v = json!({
         "model": loaded.model.name,
         "backend": arm.backend(),
         "coordinates": coords,
         "mass": rows,
         "bias": h.as_slice(),
+        "accelerations": qdd,
+        "jacobian": jacobian,
+        "outputs": out.as_slice(),
+        "output_names": runtime::OUTPUT_NAMES,
         "tip_position": &out[..3],
         "kinetic_energy": out[3],
         "potential_energy": out[4],

@@ -21,6 +21,10 @@ pub struct ExportArgs {
     /// platform, built by the C compiler `cc` or $CC).
     #[arg(long, value_name = "FILE.fmu")]
     pub fmu: Option<PathBuf>,
+    /// Write a MATLAB/Octave MEX function's sources and `.m` wrappers into
+    /// DIR (compile them with DIR/<model>_build.m).
+    #[arg(long, value_name = "DIR")]
+    pub mex: Option<PathBuf>,
     /// Directory of the tape cache (default: $SOFTARM_CACHE_DIR or .softarm-cache).
     #[arg(long, value_name = "DIR")]
     pub cache_dir: Option<PathBuf>,
@@ -31,7 +35,11 @@ pub fn export(a: ExportArgs) -> Result<ExitCode> {
     let overrides = (a.set.iter())
         .map(|s| Override::parse(s))
         .collect::<Result<Vec<_>, _>>()?;
-    let targets = crate::export::Targets { c: a.c, fmu: a.fmu };
+    let targets = crate::export::Targets {
+        c: a.c,
+        fmu: a.fmu,
+        mex: a.mex,
+    };
     let out = crate::export::export(&a.model, &overrides, &targets, a.cache_dir)?;
     for f in &out.files {
         println!("wrote {}", f.display());

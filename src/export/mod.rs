@@ -12,6 +12,7 @@
 mod c_api;
 mod c_tape;
 mod fmu;
+mod mex;
 
 use std::path::{Path, PathBuf};
 
@@ -26,6 +27,8 @@ use crate::backend;
 pub struct Targets {
     pub c: Option<PathBuf>,
     pub fmu: Option<PathBuf>,
+    /// A folder for the MATLAB/Octave MEX sources and `.m` wrappers.
+    pub mex: Option<PathBuf>,
 }
 
 /// What an export wrote.
@@ -52,7 +55,7 @@ pub fn export_c(
 ) -> Result<CExport> {
     let targets = Targets {
         c: Some(dir.to_path_buf()),
-        fmu: None,
+        ..Default::default()
     };
     export(spec, overrides, &targets, cache_dir)
 }
@@ -65,8 +68,11 @@ pub fn export(
     targets: &Targets,
     cache_dir: Option<PathBuf>,
 ) -> Result<CExport> {
-    if targets.c.is_none() && targets.fmu.is_none() {
-        bail!("export: say what to write: --c DIR (a C library) or --fmu FILE.fmu (an FMU)");
+    if targets.c.is_none() && targets.fmu.is_none() && targets.mex.is_none() {
+        bail!(
+            "export: say what to write: --c DIR (a C library), --fmu FILE.fmu (an FMU) or \
+             --mex DIR (a MATLAB/Octave MEX function)"
+        );
     }
     let (model, origin) = backend::read_model(spec, overrides)?;
     if crate::continuum::is_cosserat(&model) {
@@ -127,6 +133,9 @@ pub fn export(
         eomgen::atomic_write::write_atomic(&source, library.source().as_bytes())
             .with_context(|| format!("writing {}", source.display()))?;
         files.extend([header, source]);
+    }
+    if let Some(dir) = &targets.mex {
+        files.extend(mex::write(&library, dir)?);
     }
     if let Some(path) = &targets.fmu {
         // The build folder sits beside the FMU and goes, success or not.

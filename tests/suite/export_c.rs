@@ -266,7 +266,7 @@ fn every_bundled_model_exports_c_that_agrees_with_the_rust_kernels() {
 /// What the export cannot carry yet is refused with the key and the
 /// reason, and nothing is written.
 #[test]
-fn contact_and_viscoelastic_models_are_refused_and_nothing_is_written() {
+fn what_the_export_cannot_carry_is_refused_and_nothing_is_written() {
     let dir = tempfile::tempdir().unwrap();
     let relaxing = dir.path().join("relaxing.toml");
     let finger = std::fs::read_to_string(root().join("models/soft_finger.toml")).unwrap();
@@ -293,4 +293,14 @@ fn contact_and_viscoelastic_models_are_refused_and_nothing_is_written() {
         assert!(text.contains(key) && text.contains("not"), "{text}");
         assert!(!out.exists(), "{} was written", out.display());
     }
+    // Nothing asked: the three targets named.
+    let none = softarm::export::Targets::default();
+    let err = softarm::export::export("soft_finger", &[], &none, None).unwrap_err();
+    let text = format!("{err:#}");
+    assert!(
+        ["--c DIR", "--fmu", "--mex"]
+            .iter()
+            .all(|k| text.contains(k)),
+        "{text}"
+    );
 }

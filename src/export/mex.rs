@@ -1,0 +1,85 @@
+//! `softarm export MODEL --mex DIR`: the C library with a MATLAB/Octave
+//! gateway (one MEX function named by its first argument), an `.m`
+//! wrapper a function and `<model>_build.m`, which compiles it with
+//! MATLAB's `mex` or Octave's `mkoctfile --mex`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+
+use super::c_api::Library;
+
+/// The gateway, the same for every model but its names.
+const GATEWAY: &str = include_str!("mex.c");
+
+/// The wrappers: (function, arguments, what it returns).
+const WRAPPERS: [(&str, &str, &str); 5] = [
+    ("state_derivative", "t, x", "dx = f(t, x), x = [q; qd]"),
+    ("jacobian", "t, x", "df/dx, 2n x 2n (models without joints)"),
+    ("mass", "t, q", "the mass matrix M(q), n x n"),
+    ("bias", "t, q, qd", "the bias h(t, q, qd): M qdd + h = 0"),
+    (
+        "outputs",
+        "t, q, qd",
+        "tip x, y, z (m), kinetic and potential energy (J), tip quaternion",
+    ),
+];
+
+/// Write the library, the gateway and the `.m` files into `dir`; the
+/// files written.
+pub fn write(lib: &Library, dir: &Path) -> Result<Vec<PathBuf>> {
+    let p = lib.prefix;
+    let up = p.to_ascii_uppercase();
+    let jacobian = match lib.tapes.info.constraints.is_empty() {
+        true => format!("{p}_state_jacobian(&model, t, x, jac)"),
+        false => "3".into(),
+    };
+    let gateway = GATEWAY
+        .replace("/*JACOBIAN*/", &jacobian)
+        .replace("PFXU_", &format!("{up}_"))
+        .replace("PFX_", &format!("{p}_"))
+        .replace("PFX", p);
+    let mut files = vec![
+        (format!("{p}.h"), lib.header()),
+        (format!("{p}.c"), lib.source()),
+        (format!("{p}_mex.c"), gateway),
+        (format!("{p}_build.m"), build_script(p)),
+    ];
+    for (name, args, what) in WRAPPERS {
+        let text = format!(
+            "function out = {p}_{name}({args})\n\
+             %{upn}  {what}: softarm model {model}.\n\
+             %   Compile once with {p}_build. See docs/export.md in softarm.\n\
+             out = {p}_mex('{name}', {args});\nend\n",
+            upn = format!("{p}_{name}").to_ascii_uppercase(),
+            model = lib.model,
+        );
+        files.push((format!("{p}_{name}.m"), text));
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let mut written = Vec::new();
+    for (name, text) in files {
+        let path = dir.join(name);
+        eomgen::atomic_write::write_atomic(&path, text.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// `<model>_build.m`: the MEX function from its two sources, by Octave's
+/// mkoctfile or MATLAB's mex (the separate-complex API, which both read).
+fn build_script(p: &str) -> String {
+    format!(
+        "function {p}_build()\n\
+         %{up}_BUILD  Compile {p}_mex from {p}_mex.c and {p}.c (Octave or MATLAB).\n\
+         here = fileparts(mfilename('fullpath'));\n\
+         sources = {{fullfile(here, '{p}_mex.c'), fullfile(here, '{p}.c')}};\n\
+         if exist('OCTAVE_VERSION', 'builtin')\n  \
+         mkoctfile('--mex', '-O2', '-o', fullfile(here, '{p}_mex'), sources{{:}});\n\
+         else\n  \
+         mex('-R2017b', '-O', '-outdir', here, '-output', '{p}_mex', sources{{:}});\n\
+         end\nend\n",
+        up = p.to_ascii_uppercase()
+    )
+}
