@@ -25,7 +25,7 @@ static const double *values(int nrhs, const mxArray *prhs[], int k, size_t n, co
     static char message[160];
     if (k >= nrhs || !mxIsDouble(prhs[k]) || mxIsComplex(prhs[k]) ||
         mxGetNumberOfElements(prhs[k]) != n) {
-        sprintf(message, "PFX_mex: %s must be %lu real values", what, (unsigned long)n);
+        sprintf(message, "%s must be %lu real values", what, (unsigned long)n);
         fail(message);
     }
     return mxGetPr(prhs[k]);
@@ -63,9 +63,8 @@ static void names(mxArray **out, const char *const *list, size_t n)
 
 static void status_check(int status)
 {
-    if (status == 1) fail("PFX_mex: the mass matrix is not positive definite at this state");
-    if (status == 2) fail("PFX_mex: the joints are dependent at this state");
-    if (status == 3) fail("PFX_mex: no state Jacobian for a model with joints");
+    if (status == 1) fail("the mass matrix is not positive definite at this state");
+    if (status == 2) fail("the joints are dependent at this state");
 }
 
 void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[])
@@ -87,7 +86,7 @@ void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[])
     } else if (!strcmp(name, "jacobian")) {
         double t = scalar(nrhs, prhs, 1, "t");
         const double *x = values(nrhs, prhs, 2, PFXU_NX, "x");
-        status_check(/*JACOBIAN*/);
+        status_check(PFX_state_jacobian(&model, t, x, jac));
         matrix(&plhs[0], jac, PFXU_NX, PFXU_NX);
     } else if (!strcmp(name, "mass")) {
         double t = scalar(nrhs, prhs, 1, "t");
@@ -110,7 +109,7 @@ void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[])
         double i = scalar(nrhs, prhs, 1, "i");
         double v = scalar(nrhs, prhs, 2, "value");
         if (!(i >= 1 && i <= PFXU_NPARAMS) || i != (double)(size_t)i)
-            fail("PFX_mex: set_parameter's i is 1 to NPARAMS (parameter_names' order)");
+            fail("set_parameter's i is 1 to NPARAMS (parameter_names' order)");
         PFX_set_parameter(&model, (size_t)i - 1, v);
     } else if (!strcmp(name, "reset")) {
         PFX_init(&model, &params);

@@ -15,7 +15,11 @@ const GATEWAY: &str = include_str!("mex.c");
 /// The wrappers: (function, arguments, what it returns).
 const WRAPPERS: [(&str, &str, &str); 5] = [
     ("state_derivative", "t, x", "dx = f(t, x), x = [q; qd]"),
-    ("jacobian", "t, x", "df/dx, 2n x 2n (models without joints)"),
+    (
+        "jacobian",
+        "t, x",
+        "df/dx, 2n x 2n (with joints by central differences)",
+    ),
     ("mass", "t, q", "the mass matrix M(q), n x n"),
     ("bias", "t, q, qd", "the bias h(t, q, qd): M qdd + h = 0"),
     (
@@ -30,12 +34,7 @@ const WRAPPERS: [(&str, &str, &str); 5] = [
 pub fn write(lib: &Library, dir: &Path) -> Result<Vec<PathBuf>> {
     let p = lib.prefix;
     let up = p.to_ascii_uppercase();
-    let jacobian = match lib.tapes.info.constraints.is_empty() {
-        true => format!("{p}_state_jacobian(&model, t, x, jac)"),
-        false => "3".into(),
-    };
     let gateway = GATEWAY
-        .replace("/*JACOBIAN*/", &jacobian)
         .replace("PFXU_", &format!("{up}_"))
         .replace("PFX_", &format!("{p}_"))
         .replace("PFX", p);
