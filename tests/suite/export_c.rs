@@ -307,3 +307,88 @@ fn what_the_export_cannot_carry_is_refused_and_nothing_is_written() {
         "{text}"
     );
 }
+
+/// The FMU's archive and model description hang together (FMPy's own
+/// validation and simulation run in python/tests/test_fmu.py): the
+/// description, the sources and this platform's binary are there; every
+/// variable has its own value reference, in order; each derivative names
+/// its state; the inputs are the parameters that inputs drive.
+#[test]
+fn the_fmu_holds_its_description_sources_and_binary() {
+    let dir = tempfile::tempdir().unwrap();
+    let fmu = dir.path().join("stiff_flop.fmu");
+    let targets = softarm::export::Targets {
+        fmu: Some(fmu.clone()),
+        ..Default::default()
+    };
+    let spec = root().join("models/stiff_flop.toml");
+    let out = softarm::export::export(
+        spec.to_str().unwrap(),
+        &[],
+        &targets,
+        Some(dir.path().join("cache")),
+    )
+    .unwrap();
+    let mut archive = zip::ZipArchive::new(std::fs::File::open(&fmu).unwrap()).unwrap();
+    let names: Vec<String> = archive
+        .file_names()
+        .map(|n| n.unwrap().to_string())
+        .collect();
+    for want in [
+        "modelDescription.xml",
+        "sources/stiff_flop.c",
+        "sources/stiff_flop.h",
+        "sources/fmi2.c",
+        "binaries/linux64/stiff_flop.so",
+    ] {
+        assert!(
+            names.iter().any(|n| n == want),
+            "{want} missing from {names:?}"
+        );
+    }
+    let mut xml = String::new();
+    std::io::Read::read_to_string(
+        &mut archive.by_name("modelDescription.xml").unwrap(),
+        &mut xml,
+    )
+    .unwrap();
+    let n = out.dof;
+    let vars: Vec<&str> = xml.split("<ScalarVariable ").skip(1).collect();
+    let attr = |v: &str, key: &str| -> Option<String> {
+        let at = v.find(&format!("{key}=\""))? + key.len() + 2;
+        Some(v[at..at + v[at..].find('"')?].to_string())
+    };
+    for (k, v) in vars.iter().enumerate() {
+        assert_eq!(
+            attr(v, "valueReference"),
+            Some(k.to_string()),
+            "variable {k}"
+        );
+    }
+    for k in 0..2 * n {
+        let v = vars[2 * n + k];
+        assert_eq!(attr(v, "derivative"), Some((k + 1).to_string()));
+        let state = attr(vars[k], "name").unwrap();
+        assert_eq!(attr(v, "name"), Some(format!("der({state})")));
+    }
+    let inputs: Vec<String> = (vars.iter())
+        .filter(|v| attr(v, "causality").as_deref() == Some("input"))
+        .map(|v| attr(v, "name").unwrap())
+        .collect();
+    let driven: Vec<String> = out.inputs.iter().map(|(_, name)| name.clone()).collect();
+    assert_eq!(inputs, driven);
+    assert!(
+        inputs.iter().any(|i| i == "chamber[0][0].pressure"),
+        "{inputs:?}"
+    );
+    assert_eq!(
+        vars.len(),
+        4 * n + runtime::N_OUTPUTS + out_parameters(&xml)
+    );
+}
+
+/// Parameters and inputs in a model description (after the states, their
+/// derivatives and the outputs).
+fn out_parameters(xml: &str) -> usize {
+    xml.matches("causality=\"parameter\"").count() + xml.matches("causality=\"input\"").count()
+}
