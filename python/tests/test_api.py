@@ -17,17 +17,10 @@ import numpy as np
 import pytest
 
 import softarm
+from cli import cli
 
 ROOT = Path(__file__).resolve().parents[2]
 MODELS = ["double_pendulum", "soft_finger"]
-
-
-def cli():
-    for p in [os.environ.get("SOFTARM_BIN"), ROOT / "target/debug/softarm",
-              ROOT / "target/release/softarm"]:
-        if p and Path(p).exists():
-            return str(p)
-    pytest.skip("no softarm binary: run cargo build first")
 
 
 def run(*args, cwd=None):

@@ -12,9 +12,7 @@ The CLI binary is $SOFTARM_BIN, else target/debug/softarm, else
 target/release/softarm.
 """
 
-import os
 import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,18 +20,10 @@ import pytest
 fmpy = pytest.importorskip("fmpy", reason="FMPy (pip install fmpy) runs the FMU")
 from fmpy.validation import validate_fmu  # noqa: E402
 
+from cli import cli  # noqa: E402
 import softarm  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[2]
 DT = 0.01
-
-
-def cli():
-    for p in [os.environ.get("SOFTARM_BIN"), ROOT / "target/debug/softarm",
-              ROOT / "target/release/softarm"]:
-        if p and Path(p).exists():
-            return str(p)
-    pytest.skip("no softarm binary: run cargo build first")
 
 
 def export(name, tmp_path):

@@ -253,17 +253,33 @@ impl Library<'_> {
                 literal(1.0 / f)
             })
             .collect();
-        c.push_str(&SUPPORT.replace("/*INV_FACTORIALS*/", &inv.join(", ")));
-        c.push('\n');
+        // The support functions' names get the model's prefix in the code
+        // alone: the name tables and the parameters' fields are the
+        // model's own words, which no rewrite may touch.
+        let own = |code: &str| with_prefix(code, "sa_", &format!("{p}_sa_"));
+        let mut code = SUPPORT.replace("/*INV_FACTORIALS*/", &inv.join(", "));
+        code.push('\n');
         for (name, tape) in self.kernels() {
-            c.push_str(&c_tape::kernel(name, tape));
-            c.push('\n');
+            code.push_str(&c_tape::kernel(name, tape));
+            code.push('\n');
         }
-        c.push_str(&self.workspace_macros());
+        code.push_str(&self.workspace_macros());
+        c.push_str(&own(&code));
         c.push_str(&self.names());
         c.push_str(&self.parameter_functions());
-        c.push_str(&self.dynamics_functions());
-        with_prefix(&c, "sa_", &format!("{p}_sa_"))
+        c.push_str(&own(&self.dynamics_functions()));
+        c
+    }
+
+    /// A template of the support code (`fmi2.c`, `mex.c`) with this
+    /// model's names: `PFXU_` its macros' prefix, `PFX_` its functions',
+    /// `PFX` its file and identifier.
+    pub fn named(&self, template: &str) -> String {
+        let p = self.prefix;
+        template
+            .replace("PFXU_", &format!("{}_", p.to_ascii_uppercase()))
+            .replace("PFX_", &format!("{p}_"))
+            .replace("PFX", p)
     }
 
     /// The name tables.

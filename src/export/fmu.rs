@@ -43,11 +43,7 @@ fn xml(s: &str) -> String {
 pub fn write(lib: &Library, fmu: &Path, build: &Path) -> Result<()> {
     let (folder, suffix) = platform()?;
     let id = lib.prefix;
-    let up = id.to_ascii_uppercase();
-    let wrapper = FMI2
-        .replace("PFXU_", &format!("{up}_"))
-        .replace("PFX_", &format!("{id}_"))
-        .replace("PFX", id);
+    let wrapper = lib.named(FMI2);
     let files = [
         (format!("{id}.h"), lib.header()),
         (format!("{id}.c"), lib.source()),

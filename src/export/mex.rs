@@ -33,11 +33,7 @@ const WRAPPERS: [(&str, &str, &str); 5] = [
 /// files written.
 pub fn write(lib: &Library, dir: &Path) -> Result<Vec<PathBuf>> {
     let p = lib.prefix;
-    let up = p.to_ascii_uppercase();
-    let gateway = GATEWAY
-        .replace("PFXU_", &format!("{up}_"))
-        .replace("PFX_", &format!("{p}_"))
-        .replace("PFX", p);
+    let gateway = lib.named(GATEWAY);
     let mut files = vec![
         (format!("{p}.h"), lib.header()),
         (format!("{p}.c"), lib.source()),
