@@ -70,14 +70,15 @@ pub fn compiled_by_hash(hash: &str) -> Option<&'static CompiledModel> {
 }
 
 /// The folder paths in a model are relative to: the model file's, or for
-/// a compiled-in model the `models/` folder it was built from.
+/// a compiled-in model the files compiled in with it (`data::read_text`),
+/// never the checkout it was built in.
 pub fn base_dir(spec: &str) -> PathBuf {
     let path = Path::new(spec);
     if path.exists() {
         path.parent()
             .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
     } else {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("models")
+        crate::data::compiled_in_base(spec)
     }
 }
 

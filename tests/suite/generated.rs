@@ -145,3 +145,42 @@ fn generated_files_keep_their_size_budget() {
         "generated/ is {total} bytes, over its {TOTAL_BUDGET}-byte budget"
     );
 }
+
+/// A compiled-in model reads its data from the binary, not from the
+/// checkout it was built in: a copy of softarm (a wheel, a binary moved
+/// elsewhere) runs its bundled models with their records. The reference is
+/// each file on disk; the licence notice beside each data set travels too.
+#[test]
+fn compiled_in_models_carry_their_data_files_and_notices() {
+    let mut carried = 0;
+    for m in softarm::generated::MODELS {
+        let base = softarm::backend::base_dir(m.name);
+        assert!(
+            !base.is_absolute() && !base.exists(),
+            "{}: its files resolve against {}, a place on disk",
+            m.name,
+            base.display()
+        );
+        let model = eomgen::load::load_model(&model_path(m.name), &[]).unwrap();
+        let files = model
+            .inputs
+            .values()
+            .filter_map(|i| match i {
+                eomgen::model::Input::Csv { file, .. } => Some(file.clone()),
+                _ => None,
+            })
+            .chain(model.compare.iter().map(|c| c.file.clone()));
+        for file in files {
+            let notice = Path::new(&file).with_file_name("README.md");
+            for f in [Path::new(&file), notice.as_path()] {
+                let on_disk = std::fs::read_to_string(root().join("models").join(f)).unwrap();
+                let path = softarm::data::resolve(&base, f.to_str().unwrap());
+                let text = softarm::data::read_text(&path)
+                    .unwrap_or_else(|e| panic!("{}: {f:?}: {e:#}", m.name));
+                assert_eq!(text, on_disk, "{}: {f:?} differs from the file", m.name);
+                carried += 1;
+            }
+        }
+    }
+    assert!(carried >= 2, "no bundled model reads a data file any more");
+}

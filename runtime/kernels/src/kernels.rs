@@ -498,6 +498,10 @@ pub struct CompiledModel {
     pub dof: usize,
     /// The model file as it was when compiled in.
     pub source: &'static str,
+    /// The data files it reads (paths as written in it, and their text),
+    /// carried inside the binary: a copy of softarm runs its bundled
+    /// models with no checkout beside it.
+    pub files: &'static [(&'static str, &'static str)],
     pub kernels: fn() -> Box<dyn Kernels>,
     /// Its link cells, which chains of the same link shapes and other
     /// lengths link (`linked::LinkedKernels`).
