@@ -237,7 +237,11 @@ fn registry_source(stems: &[Entry], absolute: Option<&Path>) -> String {
             .iter()
             .map(|f| format!("\n            ({f:?}, include_str!({})),", include(f)))
             .collect();
-        let files = if files.is_empty() { files } else { format!("{files}\n        ") };
+        let files = if files.is_empty() {
+            files
+        } else {
+            format!("{files}\n        ")
+        };
         s.push_str(&format!(
             "    CompiledModel {{\n        name: \"{stem}\",\n        hash: {stem}::HASH,\n        dof: {stem}::DOF,\n        source: include_str!({source}),\n        files: &[{files}],\n        kernels: || Box::new({stem}::Compiled::default()),\n        cells: {stem}::CELLS,\n    }},\n"
         ));
