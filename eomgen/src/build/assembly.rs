@@ -104,8 +104,8 @@ struct Pose {
 struct ArmFrames {
     segment_ends: Vec<Pose>,
     tip: Pose,
-    /// 3D: each segment end's whole frame (the last the tip's), for arms
-    /// that sit on it.
+    /// Each segment end's whole frame (the last the tip's), for arms that
+    /// sit on it.
     end_frames: Vec<MountFrame>,
 }
 
@@ -363,7 +363,7 @@ impl Builder {
                     quat: [zero; 4],
                 };
                 ArmFrames {
-                    end_frames: Vec::new(),
+                    end_frames: sys.end_frames,
                     segment_ends: planar.segment_ends.into_iter().map(pose).collect(),
                     tip: Pose {
                         point: sys.tip,

@@ -66,7 +66,7 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
             m.build_spatial(cas, &mut arm, g, s);
             ends.push((arm.f.p, arm.f.quat));
             let f = arm.f;
-            frames.push(MountFrame {
+            frames.push(MountFrame::Spatial {
                 r: f.r,
                 p: f.p,
                 w: f.w,
@@ -85,6 +85,7 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
         arm.loads = along_loads(cas, structure, symbols);
         arm.set_fluid(Drag::of(structure, symbols), buoyancy(structure, symbols));
         let base = (arm.points > 0).then(|| arm.base_pose(cas));
+        let mut frames = Vec::new();
         for (s, (g, m)) in structure.segments.iter().zip(&methods).enumerate() {
             if g.kink {
                 let [turn, offset] = kink(symbols, s, false);
@@ -95,8 +96,10 @@ fn kinematics(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> S
                 m.place_planar(cas, &mut arm, g, &el);
                 arm.end_element(cas, &el);
             }
+            frames.push(arm.mount_frame());
         }
         let mut sys = arm.finish(cas, structure);
+        sys.end_frames = frames;
         sys.bases = base.into_iter().collect();
         sys
     }

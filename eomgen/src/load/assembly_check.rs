@@ -79,9 +79,6 @@ pub(super) fn mounts(ck: &Check) -> Result<(), ModelError> {
         let Some(on) = &a.base.on else { continue };
         let key = format!("arm.{}.base.on", a.name);
         let err = |msg: String| ck.err(key.clone(), msg);
-        if m.dimensions != 3 {
-            return err("an arm on another's frame is 3D only for now".into());
-        }
         let parent = match FrameRef::parse(on, m) {
             Ok(FrameRef::Tip(j)) | Ok(FrameRef::SegmentEnd { arm: j, .. }) => j,
             Ok(_) => {

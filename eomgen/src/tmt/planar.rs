@@ -88,12 +88,28 @@ impl<'a> PlanarArm<'a> {
             phi = cas.add(phi, rho[2]);
             w = cas.add(w, rate[2]);
         }
-        let f = Frame {
+        let mut f = Frame {
             x: base.position[0],
             y: base.position[1],
             phi,
             w,
         };
+        if let Some(super::system::MountFrame::Planar { p, angle, w: rate }) = symbols.mount() {
+            // On another planar arm's frame: the position and the angle in
+            // it (validation leaves such a base no motion of its own).
+            let (c, s) = (cas.cos(angle), cas.sin(angle));
+            let [px, py] = [base.position[0], base.position[1]];
+            let (cx, sy) = (cas.mul(c, px), cas.mul(s, py));
+            let (sx, cy) = (cas.mul(s, px), cas.mul(c, py));
+            let dx = cas.sub(cx, sy);
+            let dy = cas.add(sx, cy);
+            f = Frame {
+                x: cas.add(p[0], dx),
+                y: cas.add(p[1], dy),
+                phi: cas.add(angle, phi),
+                w: cas.add(rate, w),
+            };
+        }
         Self {
             symbols,
             coords,
@@ -271,6 +287,15 @@ impl<'a> PlanarArm<'a> {
             let arc = length.map(|l| cas.scaled((j + 1) as f64 / count, l));
             let sample = Sample::planar(cas, point, angle).at_arc(arc);
             self.samples.push(sample);
+        }
+    }
+
+    /// The end frame as another arm sits on it.
+    pub fn mount_frame(&self) -> super::system::MountFrame {
+        super::system::MountFrame::Planar {
+            p: [self.f.x, self.f.y, self.z],
+            angle: self.f.phi,
+            w: self.f.w,
         }
     }
 

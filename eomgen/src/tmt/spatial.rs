@@ -835,14 +835,9 @@ pub(crate) fn base_frame(
         std::array::from_fn(|j| symbols.get(Param::BaseRotation(i as u8, j as u8)))
     });
     let q = std::array::from_fn(|c| symbols.get(Param::BaseQuaternion(c as u8)));
-    if let Some(m) = symbols.mount() {
+    if let Some(super::system::MountFrame::Spatial { r: mr, p, w, quat }) = symbols.mount() {
         // On another arm's frame: the position, then the direction, in it.
-        let f = Frame {
-            r: m.r,
-            p: m.p,
-            w: m.w,
-            quat: m.quat,
-        };
+        let f = Frame { r: mr, p, w, quat };
         let f = compose(cas, &f, None, Some(&position), None);
         return compose(cas, &f, Some((&r, &q)), None, None);
     }

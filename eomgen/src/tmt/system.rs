@@ -242,14 +242,22 @@ pub struct AppliedMoment {
     pub moment: [ExprId; 3],
 }
 
-/// A frame another arm may sit on: rotation (rows), origin, world angular
-/// velocity and orientation quaternion (w, x, y, z).
+/// A frame another arm may sit on. In 3D: rotation (rows), origin, world
+/// angular velocity and orientation quaternion (w, x, y, z). In the plane:
+/// origin, angle and its rate, as a planar arm's frames are.
 #[derive(Clone, Copy, Debug)]
-pub struct MountFrame {
-    pub r: [[ExprId; 3]; 3],
-    pub p: [ExprId; 3],
-    pub w: [ExprId; 3],
-    pub quat: [ExprId; 4],
+pub enum MountFrame {
+    Spatial {
+        r: [[ExprId; 3]; 3],
+        p: [ExprId; 3],
+        w: [ExprId; 3],
+        quat: [ExprId; 4],
+    },
+    Planar {
+        p: [ExprId; 3],
+        angle: ExprId,
+        w: ExprId,
+    },
 }
 
 pub struct System {
