@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use super::c_api::Library;
 
@@ -51,15 +51,7 @@ pub fn write(lib: &Library, dir: &Path) -> Result<Vec<PathBuf>> {
         );
         files.push((format!("{p}_{name}.m"), text));
     }
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let mut written = Vec::new();
-    for (name, text) in files {
-        let path = dir.join(name);
-        eomgen::atomic_write::write_atomic(&path, text.as_bytes())
-            .with_context(|| format!("writing {}", path.display()))?;
-        written.push(path);
-    }
-    Ok(written)
+    super::write_set(dir, &files)
 }
 
 /// `<model>_build.m`: the MEX function from its two sources, by Octave's

@@ -125,14 +125,11 @@ pub fn export(
     };
     let mut files = Vec::new();
     if let Some(dir) = &targets.c {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        let header = dir.join(format!("{prefix}.h"));
-        let source = dir.join(format!("{prefix}.c"));
-        eomgen::atomic_write::write_atomic(&header, library.header().as_bytes())
-            .with_context(|| format!("writing {}", header.display()))?;
-        eomgen::atomic_write::write_atomic(&source, library.source().as_bytes())
-            .with_context(|| format!("writing {}", source.display()))?;
-        files.extend([header, source]);
+        let set = [
+            (format!("{prefix}.h"), library.header()),
+            (format!("{prefix}.c"), library.source()),
+        ];
+        files.extend(write_set(dir, &set)?);
     }
     if let Some(dir) = &targets.mex {
         files.extend(mex::write(&library, dir)?);
@@ -156,4 +153,47 @@ pub fn export(
         constraints: tapes.info.constraints.len(),
         inputs,
     })
+}
+
+/// Write a set of files that belong together (a header and its source, a
+/// MEX function's sources and wrappers) into `dir`, all or none: each is
+/// written beside its target first, then all are moved in. A failure
+/// takes back what this call put in place and leaves the folder's earlier
+/// files as they were, except one it had already replaced.
+fn write_set(dir: &Path, files: &[(String, String)]) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let staged: Vec<(PathBuf, PathBuf)> = files
+        .iter()
+        .map(|(name, _)| {
+            let target = dir.join(name);
+            let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
+            (tmp, target)
+        })
+        .collect();
+    let clean = |from: usize| {
+        for (tmp, _) in &staged[from..] {
+            let _ = std::fs::remove_file(tmp);
+        }
+    };
+    for ((tmp, target), (_, text)) in staged.iter().zip(files) {
+        if let Err(e) = std::fs::write(tmp, text) {
+            clean(0);
+            return Err(e).with_context(|| format!("writing {}", target.display()));
+        }
+    }
+    for (k, (tmp, target)) in staged.iter().enumerate() {
+        if let Err(e) = std::fs::rename(tmp, target) {
+            for (_, done) in &staged[..k] {
+                let _ = std::fs::remove_file(done);
+            }
+            clean(k);
+            return Err(e).with_context(|| {
+                format!(
+                    "writing {} (nothing of this export is left)",
+                    target.display()
+                )
+            });
+        }
+    }
+    Ok(staged.into_iter().map(|(_, target)| target).collect())
 }

@@ -296,6 +296,18 @@ fn what_the_export_cannot_carry_is_refused_and_nothing_is_written() {
         assert!(text.contains(key) && text.contains("not"), "{text}");
         assert!(!out.exists(), "{} was written", out.display());
     }
+    // A file that cannot be put in place (a folder in the way of the
+    // source): the header written before it is taken back, no temporary
+    // is left, and the folder holds what it held.
+    let out = dir.path().join("blocked");
+    std::fs::create_dir_all(out.join("soft_finger.c").join("inside")).unwrap();
+    let err = softarm::export::export_c("soft_finger", &[], &out, None).unwrap_err();
+    assert!(format!("{err:#}").contains("soft_finger.c"), "{err:#}");
+    let left: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(left, ["soft_finger.c"], "left behind: {left:?}");
     // Nothing asked: the three targets named.
     let none = softarm::export::Targets::default();
     let err = softarm::export::export("soft_finger", &[], &none, None).unwrap_err();
