@@ -173,7 +173,7 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
 /// Whether an assembly's arms run on kernels of their own
 /// (`runtime::arm_blocks`): not an arm on a compliant base (its
 /// coordinates move the arm's base, which a single arm's kernels hold
-/// still), nor one on another arm's frame (the other's coordinates move
+/// still), nor one on another arm's frame or a body (their coordinates move
 /// it), nor one with inputs (its parameters are copied once per parameter
 /// set).
 fn arms_have_own_kernels(a: &AssemblyShape) -> bool {

@@ -232,3 +232,117 @@ pub fn bad_cases() -> Vec<(&'static str, String, Vec<&'static str>)> {
         ),
     ]
 }
+
+/// An arm on a free body (a cart, a palm): the body carries it in minimal
+/// coordinates. The same mechanism is an arm whose compliant base has the
+/// body's mass and inertia and no springs (a second derivation: the base
+/// coordinates move the arm as the body's do), coordinate by coordinate,
+/// released bent in the plane with no gravity: the arm rings and the body
+/// recoils and turns.
+#[test]
+fn an_arm_on_a_free_planar_body_moves_as_an_arm_on_a_free_base() {
+    let arm = |base: &str, name: &str| {
+        format!("{base}\n[[{name}segment]]\nlength = 0.2\nelements = 4\n{SEGMENT}\n")
+    };
+    let on_body = format!(
+        "name = \"cart\"\ngravity = [0.0, 0.0, 0.0]\n\
+         [[body]]\nname = \"cart\"\nshape = \"sphere\"\nradius = 0.05\nmass = 0.3\ninertia = 2e-4\n\
+         [[arm]]\nname = \"arm\"\n{}",
+        arm(
+            "[arm.base]\non = \"cart\"\ndirection = [1.0, 0.0, 0.0]",
+            "arm."
+        )
+    );
+    let on_base = format!(
+        "name = \"free\"\ngravity = [0.0, 0.0, 0.0]\n{}",
+        arm(
+            "[base]\ndirection = [1.0, 0.0, 0.0]\nmass = 0.3\nstiffness = 0.0\n\
+             rotational_stiffness = 0.0\ninertia = 2e-4",
+            ""
+        )
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let (da, db) = (dir.path().join("a"), dir.path().join("b"));
+    std::fs::create_dir_all(&da).unwrap();
+    std::fs::create_dir_all(&db).unwrap();
+    let (la, lb) = (load_text(&da, &on_body, &[]), load_text(&db, &on_base, &[]));
+    let n = la.arm.dof();
+    assert_eq!(n, 3 + 4);
+    assert_eq!(lb.arm.dof(), n);
+    // Bent: 0.3 rad an element.
+    let mut x0 = vec![0.0; 2 * n];
+    x0[3..7].fill(0.3);
+    let (ta, _) = simulate(&*la.arm, x0.clone(), &tight()).unwrap();
+    let (tb, _) = simulate(&*lb.arm, x0, &tight()).unwrap();
+    let worst = |range: std::ops::Range<usize>| {
+        (ta.x.iter().zip(&tb.x))
+            .flat_map(|(x, y)| range.clone().map(move |i| (x[i] - y[i]).abs()))
+            .fold(0.0, f64::max)
+    };
+    let moved = (ta.x.iter()).map(|x| x[2].abs()).fold(0.0, f64::max);
+    eprintln!(
+        "body turned {moved:.3} rad; the two differ by {:.1e}",
+        worst(0..2 * n)
+    );
+    assert!(moved > 0.05, "the body barely turns: {moved}");
+    assert!(worst(0..2 * n) < 1e-8, "differ by {:e}", worst(0..2 * n));
+}
+
+/// In 3D: an arm on a free body (quaternion coordinates held to unit norm)
+/// against an arm on a free base (a rotation vector), the body's inertia
+/// the same about every axis as the base's is: the tips agree over the
+/// motion of an arm released bent about both axes, with no gravity.
+#[test]
+fn an_arm_on_a_free_body_in_3d_moves_as_an_arm_on_a_free_base() {
+    let segment = format!("length = 0.2\nelements = 4\n{SEGMENT}\n");
+    let on_body = format!(
+        "name = \"palm\"\ndimensions = 3\ngravity = [0.0, 0.0, 0.0]\n\
+         [[body]]\nname = \"palm\"\nshape = \"sphere\"\nradius = 0.05\nmass = 0.3\n\
+         principal_inertia = [2e-4, 2e-4, 2e-4]\n\
+         [[arm]]\nname = \"arm\"\n[arm.base]\non = \"palm\"\ndirection = [1.0, 0.0, 0.0]\n\
+         [[arm.segment]]\n{segment}"
+    );
+    let on_base = format!(
+        "name = \"free\"\ndimensions = 3\ngravity = [0.0, 0.0, 0.0]\n\
+         [base]\ndirection = [1.0, 0.0, 0.0]\nmass = 0.3\nstiffness = 0.0\n\
+         rotational_stiffness = 0.0\ninertia = 2e-4\n[[segment]]\n{segment}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let (da, db) = (dir.path().join("a"), dir.path().join("b"));
+    std::fs::create_dir_all(&da).unwrap();
+    std::fs::create_dir_all(&db).unwrap();
+    let (la, lb) = (load_text(&da, &on_body, &[]), load_text(&db, &on_base, &[]));
+    let (na, nb) = (la.arm.dof(), lb.arm.dof());
+    assert_eq!((na, nb), (7 + 12, 6 + 12));
+    // The arm's bends: 0.3 rad about y and 0.2 about z an element (each
+    // element's coordinates: bend_y, bend_z, twist).
+    let bent = |n: usize, first: usize, qw: Option<usize>| {
+        let mut x = vec![0.0; 2 * n];
+        for e in 0..4 {
+            x[first + 3 * e] = 0.3;
+            x[first + 3 * e + 1] = 0.2;
+        }
+        if let Some(i) = qw {
+            x[i] = 1.0;
+        }
+        x
+    };
+    let names = la.arm.info().coordinates.clone();
+    assert_eq!(names[7], "arm.bend_y_0_0", "{names:?}");
+    let (ta, _) = simulate(&*la.arm, bent(na, 7, Some(3)), &tight()).unwrap();
+    let (tb, _) = simulate(&*lb.arm, bent(nb, 6, None), &tight()).unwrap();
+    assert_eq!(ta.t.len(), tb.t.len());
+    let tip = |l: &softarm::backend::Loaded, n: usize, x: &[f64]| {
+        let o = l.arm.outputs(0.0, &x[..n], &x[n..2 * n]);
+        [o[0], o[1], o[2]]
+    };
+    let (mut worst, mut turned) = (0.0f64, 0.0f64);
+    for (xa, xb) in ta.x.iter().zip(&tb.x) {
+        let (a, b) = (tip(&la, na, xa), tip(&lb, nb, xb));
+        worst = worst.max((0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f64::max));
+        turned = turned.max(xa[4].abs().max(xa[5].abs()).max(xa[6].abs()));
+    }
+    eprintln!("the palm's quaternion reaches {turned:.3}; the tips differ by {worst:.1e} m");
+    assert!(turned > 0.02, "the palm barely turns: {turned}");
+    assert!(worst < 1e-8, "the tips differ by {worst:e} m");
+}

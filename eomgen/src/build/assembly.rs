@@ -125,23 +125,35 @@ pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -
     let mut b = Builder::new(cas, layout, a.dimensions == 3);
     let mut tips = Vec::new();
     let mut arm_frames = Vec::new();
+    // Bodies that carry arms come first (their coordinates too), the rest
+    // after the arms, as an assembly without carriers has always had them.
+    let carries = |k: usize| a.mounts.contains(&Some(FrameRef::Body(k)));
+    let mut body_frames: Vec<Option<(Pose, MountFrame)>> = vec![None; a.bodies.len()];
+    for (k, (name, free)) in a.bodies.iter().enumerate() {
+        if carries(k) {
+            let (pose, omega) = b.body(cas, k, name, *free);
+            body_frames[k] = Some((pose, b.carrier(cas, pose, omega)));
+        }
+    }
     for (k, ((name, st), (_, offset, arm_layout))) in a.arms.iter().zip(layout.arms()).enumerate() {
-        // An arm on an earlier arm's frame (validated: a chain's, in 3D).
+        // An arm on an earlier arm's frame (validated: a chain's) or on a
+        // body.
         let mount = a.mounts.get(k).copied().flatten().and_then(|f| match f {
             FrameRef::Tip(j) | FrameRef::SegmentEnd { arm: j, .. } => {
                 arm_frames.get(j).and_then(|p: &ArmFrames| p.mount(f))
             }
-            _ => None,
+            FrameRef::Body(j) => body_frames[j].map(|(_, m)| m),
+            FrameRef::World => None,
         });
         let frames = b.arm(cas, k, name, st, (*offset, arm_layout), mount);
         tips.push((frames.tip.point, frames.tip.quat));
         arm_frames.push(frames);
     }
-    let body_frames: Vec<Pose> = a
-        .bodies
-        .iter()
-        .enumerate()
-        .map(|(k, (name, free))| b.body(cas, k, name, *free))
+    let body_frames: Vec<Pose> = (a.bodies.iter().enumerate())
+        .map(|(k, (name, free))| match body_frames[k] {
+            Some((pose, _)) => pose,
+            None => b.body(cas, k, name, *free).0,
+        })
         .collect();
     if a.contact {
         let spatial = b.spatial;
@@ -457,11 +469,12 @@ impl Builder {
     }
 
     /// Body k: free (coordinates of its own) or fixed (parameters).
-    fn body(&mut self, cas: &mut Cas, k: usize, name: &str, free: bool) -> Pose {
+    /// Body k's frame for joints, and its angular velocity.
+    fn body(&mut self, cas: &mut Cas, k: usize, name: &str, free: bool) -> (Pose, [ExprId; 3]) {
         let p = |w| Param::Body(k as u16, w);
         let zero = self.zero;
         if !free {
-            return Pose {
+            let pose = Pose {
                 point: Xyz::ALL.map(|c| self.get(p(BodyParam::Position(c)))),
                 angle: self.get(p(BodyParam::Angle)),
                 quat: if self.spatial {
@@ -470,41 +483,68 @@ impl Builder {
                     [zero; 4]
                 },
             };
+            return (pose, [zero; 3]);
         }
         let first = self.names.len();
         let mass = self.get(p(BodyParam::Mass));
-        let pose = if self.spatial {
+        let (pose, omega) = if self.spatial {
             let point = ["x", "y", "z"].map(|c| self.coordinate(cas, format!("{name}.{c}")).0);
             let both =
                 ["qw", "qx", "qy", "qz"].map(|c| self.coordinate(cas, format!("{name}.{c}")));
             let (quat, rate) = (both.map(|b| b.0), both.map(|b| b.1));
             let moments = Xyz::ALL.map(|c| self.get(p(BodyParam::Moment(c))));
-            self.spatial_body(cas, mass, point, quat, rate, moments);
+            let omega = self.spatial_body(cas, mass, point, quat, rate, moments);
             self.units.push((name.to_string(), quat));
-            Pose {
+            let pose = Pose {
                 point,
                 angle: zero,
                 quat,
-            }
+            };
+            (pose, omega)
         } else {
             let (x, _) = self.coordinate(cas, format!("{name}.x"));
             let (y, _) = self.coordinate(cas, format!("{name}.y"));
             let (angle, rate) = self.coordinate(cas, format!("{name}.angle"));
             let point = [x, y, self.get(p(BodyParam::Position(Xyz::Z)))];
+            let omega = [zero, zero, rate];
             self.bodies.push(Body {
                 mass,
                 inertia: Inertia::Isotropic(self.get(p(BodyParam::Inertia))),
                 position: point,
-                omega: [zero, zero, rate],
+                omega,
             });
-            Pose {
+            let pose = Pose {
                 point,
                 angle,
                 quat: [zero; 4],
-            }
+            };
+            (pose, omega)
         };
         self.blocks.push(self.names.len() - first);
-        pose
+        (pose, omega)
+    }
+
+    /// A body's frame as an arm sits on it: its pose and angular velocity.
+    fn carrier(&self, cas: &mut Cas, pose: Pose, omega: [ExprId; 3]) -> MountFrame {
+        if !self.spatial {
+            return MountFrame::Planar {
+                p: pose.point,
+                angle: pose.angle,
+                w: omega[2],
+            };
+        }
+        let zero = self.zero;
+        let columns = [0, 1, 2].map(|k| {
+            let mut e = [zero; 3];
+            e[k] = cas.one();
+            rotate(cas, pose.quat, e)
+        });
+        MountFrame::Spatial {
+            r: std::array::from_fn(|i| std::array::from_fn(|j| columns[j][i])),
+            p: pose.point,
+            w: omega,
+            quat: pose.quat,
+        }
     }
 
     /// A free 3D body on quaternion coordinates: world angular velocity
@@ -521,7 +561,7 @@ impl Builder {
         quat: [ExprId; 4],
         rate: [ExprId; 4],
         moments: [ExprId; 3],
-    ) {
+    ) -> [ExprId; 3] {
         let zero = self.zero;
         let (u, du) = ([quat[1], quat[2], quat[3]], [rate[1], rate[2], rate[3]]);
         let cross = cas.cross(&u, &du);
@@ -553,6 +593,7 @@ impl Builder {
             position: [zero; 3],
             omega: [radial, zero, zero],
         });
+        omega
     }
 
     /// Joint k's rows: the gap between its two points, then a weld's angle

@@ -81,9 +81,13 @@ pub(super) fn mounts(ck: &Check) -> Result<(), ModelError> {
         let err = |msg: String| ck.err(key.clone(), msg);
         let parent = match FrameRef::parse(on, m) {
             Ok(FrameRef::Tip(j)) | Ok(FrameRef::SegmentEnd { arm: j, .. }) => j,
-            Ok(_) => {
+            Ok(FrameRef::Body(_)) => {
+                held_base(ck, &key, &a.base)?;
+                continue;
+            }
+            Ok(FrameRef::World) => {
                 return err(format!(
-                    "\"{on}\": an arm sits on another arm's `ARM.tip` or `ARM.segment.K.end` (bodies and the world: use a joint or the arm's own base)"
+                    "\"{on}\": an arm sits on a body or on another arm's `ARM.tip` or `ARM.segment.K.end` (on the world: the arm's own base)"
                 ));
             }
             Err(e) => return err(e),
@@ -101,12 +105,19 @@ pub(super) fn mounts(ck: &Check) -> Result<(), ModelError> {
                 s.method.name()
             ));
         }
-        let b = &a.base;
-        if b.is_compliant() || b.translation_inputs.is_some() || b.rotation_inputs.is_some() {
-            return err(
-                "an arm on another's frame is held there: no compliant base, translation_inputs or rotation_inputs".into(),
-            );
-        }
+        held_base(ck, &key, &a.base)?;
+    }
+    Ok(())
+}
+
+/// An arm on another frame is held there: its base moves with the frame
+/// alone.
+fn held_base(ck: &Check, key: &str, b: &crate::model::Base) -> Result<(), ModelError> {
+    if b.is_compliant() || b.translation_inputs.is_some() || b.rotation_inputs.is_some() {
+        return ck.err(
+            key.to_string(),
+            "an arm on another's frame is held there: no compliant base, translation_inputs or rotation_inputs".into(),
+        );
     }
     Ok(())
 }
