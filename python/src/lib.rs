@@ -339,7 +339,7 @@ impl Model {
     /// JSON); states (N, 2n) are q then qd, outputs (N, 9).
     #[pyo3(signature = (t_end=None, solver=None, rtol=None, atol=None, dt=None,
                         output_dt=None, max_steps=None, q0=None, qd0=None, start=None,
-                        inputs=Vec::new()))]
+                        inputs=Vec::new(), rho_inf=None))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &mut self,
@@ -355,6 +355,7 @@ impl Model {
         qd0: Option<PyReadonlyArray1<f64>>,
         start: Option<String>,
         inputs: Vec<(String, Vec<f64>, Vec<f64>)>,
+        rho_inf: Option<f64>,
     ) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
         // Channels given as samples in time (linear between them) replace
         // the model's for this run, on a copy of the model.
@@ -389,6 +390,7 @@ impl Model {
                 qd0,
                 start,
                 Vec::new(),
+                rho_inf,
             );
         }
         let n = self.dof();
@@ -413,7 +415,7 @@ impl Model {
             q0: q0.map(|v| vector("q0", Some(v), n)).transpose()?,
             qd0: qd0.map(|v| vector("qd0", Some(v), n)).transpose()?,
             start,
-            rho_inf: None,
+            rho_inf,
         };
         let mut opts =
             softarm::run::options(&req, &self.loaded.model.simulate).map_err(value_error)?;

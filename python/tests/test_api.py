@@ -57,6 +57,25 @@ def test_the_static_tip_is_the_clis(name):
     assert np.array_equal(sol["tip"], np.array(ref["tip_position"]))
 
 
+def test_rho_inf_reaches_generalized_alpha_as_the_clis(tmp_path):
+    # The same run as `--solver genalpha --rho-inf 0.5`, to the bit; and a
+    # different rho_inf takes other steps (the value is not dropped).
+    run("simulate", "soft_finger", "--t-end", "1", "--solver", "genalpha", "--rho-inf", "0.5",
+        "--shape-points", "0", "--quiet", "--out", str(tmp_path))
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    m = softarm.load("soft_finger")
+    half = m.simulate(t_end=1.0, solver="genalpha", rho_inf=0.5)
+    assert half["summary"]["steps"] == summary["steps"]
+    with open(tmp_path / "trajectory.csv") as f:
+        last = list(csv.DictReader(f))[-1]
+    ref = np.array([float(last[c]) for c in m.coordinates])
+    assert np.max(np.abs(half["q"][-1] - ref)) <= 1e-12 * np.max(np.abs(ref))
+    other = m.simulate(t_end=1.0, solver="genalpha", rho_inf=1.0)
+    assert other["summary"]["steps"] != summary["steps"]
+    with pytest.raises(ValueError, match="rho_inf"):
+        m.simulate(t_end=0.1, rho_inf=0.5, inputs={"p": lambda t, s: 0.0})
+
+
 @pytest.mark.parametrize("name", MODELS)
 def test_a_trajectory_is_the_clis(name, tmp_path):
     run("simulate", name, "--t-end", "1", "--shape-points", "0", "--quiet",

@@ -205,10 +205,13 @@ class Model:
         start: Optional[str] = None,
         inputs: Optional[Mapping[str, Any]] = None,
         control_dt: Optional[float] = None,
+        rho_inf: Optional[float] = None,
     ) -> dict:
         """Integrate as ``softarm simulate`` does. Options left out come from
-        the model's ``[simulate]``, else the defaults (5 s, dopri5, rtol 1e-6,
-        atol 1e-9, a row every t_end / 500).
+        the model's ``[simulate]``, else the defaults (5 s, auto, rtol 1e-6,
+        atol 1e-9, a row every t_end / 500). `rho_inf` is generalized-alpha's
+        spectral radius at infinity (``--rho-inf``; 1 none, 0 the most
+        numerical damping of unresolved modes); not with a callable input.
 
         `inputs` replaces input channels for this run, by name: a pair of
         arrays ``(t, values)`` (linear between samples, held beyond them),
@@ -227,6 +230,9 @@ class Model:
         """
         inputs = dict(inputs or {})
         if any(callable(f) for f in inputs.values()):
+            if rho_inf is not None:
+                raise ValueError("rho_inf: a run with a controller in the loop steps with the "
+                                 "Simulator, which takes the solver's defaults; leave rho_inf out")
             return self._simulate_closed_loop(inputs, t_end, solver, rtol, atol, dt, output_dt,
                                               control_dt, q0, qd0)
         sampled = []
@@ -241,7 +247,7 @@ class Model:
         try:
             t, x, out, summary, names, columns, channels, values = self._core.simulate(
                 t_end, solver, rtol, atol, dt, output_dt, max_steps,
-                _vector(q0), _vector(qd0), start, sampled,
+                _vector(q0), _vector(qd0), start, sampled, rho_inf,
             )
         except IntegrationError as e:
             message, report = e.args

@@ -47,6 +47,7 @@ class Model:
         qd0: Optional[Vector] = None,
         start: Optional[str] = None,
         inputs: list[tuple[str, list[float], list[float]]] = ...,
+        rho_inf: Optional[float] = None,
     ) -> tuple[Vector, Vector, Vector, str, list[str], Vector, list[str], Vector]: ...
 
     def simulator(
