@@ -346,3 +346,57 @@ fn an_arm_on_a_free_body_in_3d_moves_as_an_arm_on_a_free_base() {
     assert!(turned > 0.02, "the palm barely turns: {turned}");
     assert!(worst < 1e-8, "the tips differ by {worst:e} m");
 }
+
+/// The tree's arm on the upper arm's tip against the same system welded:
+/// the lower arm on a hub that a weld joint holds to the upper arm's tip,
+/// a constraint solved at every step where the tree has none. The hub is
+/// a 10 g ball of 1 mm radius, the tree's upper arm carries 10 g at its
+/// tip: they differ by the ball's rotary inertia (4e-9 kg m^2, 6e-5 of
+/// the lower arm's about the tip).
+#[test]
+fn an_arm_on_anothers_tip_moves_as_the_same_arms_welded() {
+    let welded = format!(
+        "name = \"welded\"\n{SPACE}\n\
+         [[arm]]\nname = \"upper\"\n[arm.base]\ndirection = [1.0, 0.0, 0.0]\n\
+         [[arm.segment]]\nlength = 0.2\nelements = 4\n{SEGMENT}\n\
+         [[body]]\nname = \"hub\"\nshape = \"sphere\"\nradius = 0.001\nmass = 0.01\nposition = [0.2, 0.0, 0.0]\n\
+         [[joint]]\nname = \"weld\"\nkind = \"weld\"\na = \"upper.tip\"\nb = \"hub\"\n\
+         [[arm]]\nname = \"lower\"\n[arm.base]\non = \"hub\"\ndirection = [1.0, 0.0, 0.0]\n\
+         [[arm.segment]]\nlength = 0.15\nelements = 3\n{SEGMENT}\n"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let (da, db) = (dir.path().join("a"), dir.path().join("b"));
+    std::fs::create_dir_all(&da).unwrap();
+    std::fs::create_dir_all(&db).unwrap();
+    let (la, lb) = (
+        load_text(
+            &da,
+            &tree("[1.0, 0.0, 0.0]", "").replacen(
+                "[[arm]]\nname = \"lower\"",
+                "[arm.tip]\nmass = 0.01\n[[arm]]\nname = \"lower\"",
+                1,
+            ),
+            &[],
+        ),
+        load_text(&db, &welded, &[]),
+    );
+    let (na, nb) = (la.arm.dof(), lb.arm.dof());
+    assert_eq!(nb, na + 7, "{:?}", lb.arm.info().coordinates);
+    // The hub where the straight upper arm ends, unturned.
+    let mut xb = vec![0.0; 2 * nb];
+    xb[0] = 0.2;
+    xb[3] = 1.0;
+    let (ta, _) = simulate(&*la.arm, vec![0.0; 2 * na], &tight()).unwrap();
+    let (tb, _) = simulate(&*lb.arm, xb, &tight()).unwrap();
+    assert_eq!(ta.t.len(), tb.t.len());
+    let (mut worst, mut scale) = (0.0f64, 0.0f64);
+    for (a, b) in ta.x.iter().zip(&tb.x) {
+        for i in 0..na {
+            worst = worst.max((a[i] - b[7 + i]).abs());
+            scale = scale.max(a[i].abs());
+        }
+    }
+    eprintln!("welded against the tree: {worst:.1e} of {scale:.2}");
+    assert!(scale > 0.1, "the arms sag: {scale}");
+    assert!(worst < 2e-5 * scale, "differ by {worst:e}");
+}
