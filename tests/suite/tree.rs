@@ -226,6 +226,12 @@ pub fn bad_cases() -> Vec<(&'static str, String, Vec<&'static str>)> {
             vec!["arm.lower.base.on", "declare the arm it sits on first"],
         ),
         (
+            "on a body, on a compliant base",
+            r("on = \"upper.tip\"", "on = \"hub\"\nmass = 0.1")
+                + "[[body]]\nname = \"hub\"\nshape = \"sphere\"\nradius = 0.01\nmass = 0.1\n",
+            vec!["arm.lower.base.on", "no compliant base"],
+        ),
+        (
             "on a compliant base",
             r("on = \"upper.tip\"", "on = \"upper.tip\"\nmass = 0.1"),
             vec!["arm.lower.base.on", "no compliant base"],
