@@ -184,3 +184,23 @@ fn compiled_in_models_carry_their_data_files_and_notices() {
     }
     assert!(carried >= 2, "no bundled model reads a data file any more");
 }
+
+/// A compiled-in model has no folder: a record it carries resolves inside
+/// it, one it does not (a `--set` of another file) from the current folder,
+/// and a compiled-in path it does not carry is an error naming the file.
+#[test]
+fn a_compiled_in_models_other_files_resolve_from_the_current_folder() {
+    use softarm::data::{compiled_in_base, read_text, resolve};
+    let base = compiled_in_base("stiff_flop");
+    let carried = resolve(&base, "../data/stiff-flop/noload.csv");
+    assert_eq!(carried, base.join("../data/stiff-flop/noload.csv"));
+    assert_eq!(resolve(&base, "mine.csv"), Path::new("mine.csv"));
+    assert_eq!(resolve(&base, "/tmp/mine.csv"), Path::new("/tmp/mine.csv"));
+    // Written again into a fitted model's file, the carried path stays.
+    assert_eq!(
+        resolve(Path::new("elsewhere"), carried.to_str().unwrap()),
+        carried
+    );
+    let err = read_text(&base.join("other.csv")).unwrap_err();
+    assert!(format!("{err:#}").contains("other.csv"), "{err:#}");
+}

@@ -27,6 +27,24 @@ pub(crate) struct Frame {
     pub w: ExprId,
 }
 
+impl Frame {
+    /// Moved by `offset` (x, y in itself), then turned by `turn`, its rate
+    /// kept: a kink, or an arm's base on another frame.
+    fn moved(self, cas: &mut Cas, offset: [ExprId; 2], turn: ExprId) -> Frame {
+        let (c, s) = (cas.cos(self.phi), cas.sin(self.phi));
+        let dx = [cas.mul(c, offset[0]), cas.mul(s, offset[1])];
+        let dy = [cas.mul(s, offset[0]), cas.mul(c, offset[1])];
+        let dx = cas.sub(dx[0], dx[1]);
+        let dy = cas.add(dy[0], dy[1]);
+        Frame {
+            x: cas.add(self.x, dx),
+            y: cas.add(self.y, dy),
+            phi: cas.add(self.phi, turn),
+            w: self.w,
+        }
+    }
+}
+
 /// A planar arm under construction: the chain's state every method's
 /// elements extend, and what is common to every method (the base, one
 /// angle an element, its spring and damper, gravity, actuation, the tip
@@ -95,20 +113,16 @@ impl<'a> PlanarArm<'a> {
             w,
         };
         if let Some(super::system::MountFrame::Planar { p, angle, w: rate }) = symbols.mount() {
-            // On another planar arm's frame: the position and the angle in
-            // it (validation leaves such a base no motion of its own).
-            let (c, s) = (cas.cos(angle), cas.sin(angle));
-            let [px, py] = [base.position[0], base.position[1]];
-            let (cx, sy) = (cas.mul(c, px), cas.mul(s, py));
-            let (sx, cy) = (cas.mul(s, px), cas.mul(c, py));
-            let dx = cas.sub(cx, sy);
-            let dy = cas.add(sx, cy);
-            f = Frame {
-                x: cas.add(p[0], dx),
-                y: cas.add(p[1], dy),
-                phi: cas.add(angle, phi),
+            // On another planar frame (an arm's end, a body): the position
+            // and the angle in it (validation leaves such a base no motion
+            // of its own).
+            let on = Frame {
+                x: p[0],
+                y: p[1],
+                phi: angle,
                 w: cas.add(rate, w),
             };
+            f = on.moved(cas, [base.position[0], base.position[1]], phi);
         }
         Self {
             symbols,
@@ -307,14 +321,7 @@ impl<'a> PlanarArm<'a> {
     /// A kink: the end frame moved by `offset` (x, y in itself) and turned
     /// by `turn`, both constant.
     pub fn kink(&mut self, cas: &mut Cas, turn: ExprId, offset: &[ExprId; 3]) {
-        let (c, s) = (cas.cos(self.f.phi), cas.sin(self.f.phi));
-        let dx = [cas.mul(c, offset[0]), cas.mul(s, offset[1])];
-        let dy = [cas.mul(s, offset[0]), cas.mul(c, offset[1])];
-        let dx = cas.sub(dx[0], dx[1]);
-        let dy = cas.add(dy[0], dy[1]);
-        self.f.x = cas.add(self.f.x, dx);
-        self.f.y = cas.add(self.f.y, dy);
-        self.f.phi = cas.add(self.f.phi, turn);
+        self.f = self.f.moved(cas, [offset[0], offset[1]], turn);
     }
 
     /// The element ends at the end frame: its link, spring and damper.
