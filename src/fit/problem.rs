@@ -271,6 +271,8 @@ impl Problem {
             max_steps: sim.max_steps,
             rho_inf: sim.rho_inf,
             dt: sim.dt,
+            // radau5 integrates the state and its sensitivities together.
+            positions: 0,
         };
         let run =
             forward_sensitivities(arm, &perturbed, 0.0, x0.clone(), s0.clone(), &times, &opts)

@@ -206,6 +206,7 @@ pub(super) fn run_own(
         max_steps: opts.max_steps,
         rho_inf: opts.rho_inf,
         dt: opts.dt,
+        positions: ode.n,
     };
     let start = Instant::now();
     let result = integrate(

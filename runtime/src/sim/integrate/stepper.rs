@@ -27,6 +27,9 @@ pub struct Options {
     pub rho_inf: f64,
     /// The step of a fixed-step method (s).
     pub dt: f64,
+    /// The state starts with this many positions followed by their rates
+    /// (an arm's [q, qd, ...]); 0 when the state has no such split.
+    pub positions: usize,
 }
 
 /// Sees every accepted step (t_prev, t, y_prev, y, dense output over the
