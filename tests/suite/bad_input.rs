@@ -846,15 +846,6 @@ fn section_load_and_fluid_cases() -> Vec<FileCase> {
             vec!["load[0].force", "missing"],
         ),
         (
-            "load on eba",
-            format!(
-                "{}[[load]]\nsegment = 0\ns = 0.1\nforce = [0.0, 0.0, -1.0]\n",
-                GOOD3
-            )
-            .replace("\"pcc\"", "\"eba\""),
-            vec!["load[0].segment", "eba segments are not supported yet"],
-        ),
-        (
             "point load on the Cosserat rod",
             format!(
                 "{}[[load]]\nsegment = 0\ns = 0.1\nforce = [0.0, 0.0, -1.0]\n",

@@ -85,6 +85,24 @@ fn a_force_at_mid_span_bends_the_tip_as_beam_theory_says() {
     }
 }
 
+/// The same force on eba's absolute elements, which shear as pcs does;
+/// its finite differences converge at second order from further, so at
+/// twice the elements.
+#[test]
+fn a_force_at_mid_span_bends_an_eba_arm_as_beam_theory_says() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = 1e-3;
+    let point = format!(
+        "[[load]]\nsegment = 0\ns = {}\nforce = [0.0, {p}, 0.0]",
+        L / 2.0
+    );
+    let want = 5.0 * p * L.powi(3) / (48.0 * ei()) + p * L / 2.0 / (E / 3.0 * PI * R * R);
+    let text = cantilever(3, &point);
+    let err = |n| (static_tip(dir.path(), &text, &method_sets("eba", n))[1] - want) / want;
+    converges((err(14), err(28)), "eba, the load inside an element");
+    converges((err(16), err(32)), "eba, the load on a boundary");
+}
+
 #[test]
 fn a_moment_and_a_distributed_force_bend_it_as_beam_theory_says() {
     let dir = tempfile::tempdir().unwrap();

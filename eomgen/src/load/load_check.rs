@@ -1,6 +1,7 @@
 //! `[[load]]`: on a segment that exists, a point on it, a force or a
 //! moment (not both constant and driven), declared input channels, in the
-//! plane only what stays in it, on methods that place points.
+//! plane only what stays in it; the Cosserat statics take a constant
+//! distributed force alone.
 
 use crate::model::{Check, Load, ModelError};
 
@@ -97,15 +98,6 @@ fn check_load(ck: &Check, i: usize, l: &Load) -> Result<(), ModelError> {
             "the Cosserat statics take a constant distributed force in the world frame (no `s`, no inputs, no local frame)".into(),
         );
     }
-    if !method.statics_only() && !method.takes_point_loads() {
-        return ck.err(
-            p("segment"),
-            format!(
-                "loads along {} segments are not supported yet: use pcc, pcs, ebr or rom",
-                seg.method.name()
-            ),
-        );
-    }
     Ok(())
 }
 
@@ -129,11 +121,11 @@ fn check_fluid(ck: &Check) -> Result<(), ModelError> {
     }
     for (i, s) in m.segments.iter().enumerate() {
         let method = crate::method::of(s.method);
-        if method.statics_only() || !method.takes_point_loads() {
+        if method.statics_only() {
             return ck.err(
                 format!("segment[{i}].method"),
                 format!(
-                    "an immersed arm's segments are chain methods' (pcc, vc, pcs, ebr, rom, rigid), got {}",
+                    "an immersed arm's segments are lumped (pcc, vc, pcs, ebr, eba, rom, rigid), got {}",
                     s.method.name()
                 ),
             );

@@ -34,10 +34,11 @@ use runtime::parts::{PartKernels, PartLayout, PartSpec};
 use super::{Carried, Method, ModellingMethod, needs_bending_stiffness};
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{
-    Check, ElementParam, ModelError, Param, ParamLayout, Segment, SegmentShape, Structure,
-    Xyz,
+    Check, ElementParam, FluidParam, ModelError, Param, ParamLayout, Segment, SegmentShape,
+    Structure, Xyz,
 };
 use crate::tmt::actuation::{Strain, actuation, thinning};
+use crate::tmt::along::{self, Applied, Drag, along_loads};
 use crate::tmt::assemble;
 use crate::tmt::spatial::{
     Element3,
@@ -64,10 +65,6 @@ impl ModellingMethod for Eba {
     }
 
     fn segment_end_frames(&self) -> bool {
-        false
-    }
-
-    fn takes_point_loads(&self) -> bool {
         false
     }
 
@@ -384,6 +381,15 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
     let mut samples = Vec::new();
     let curved = structure.segments.iter().any(|g| g.rest_3d);
     let mut placed = curved.then(|| RestPlacement::new(cas));
+    // Loads along the arm act on the element's slab, as its contact
+    // points sit; the fluid drags each slab's centre.
+    let loads = along_loads(cas, structure, symbols);
+    let mut applied = Applied::default();
+    applied.drag = Drag::of(structure, symbols);
+    applied.buoyancy = structure
+        .fluid
+        .is_some()
+        .then(|| symbols.get(Param::Fluid(FluidParam::Density)));
     for (k, &segment) in segment_of.iter().enumerate() {
         let c = 6 * k;
         let u: V3 = std::array::from_fn(|i| coords.q[c + i]);
@@ -418,6 +424,18 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         };
         bodies.push(el.body(cas, (axis, move |_: &mut Cas| r), centre, omega, el.m));
         let slab = Slab { r, centre, half };
+        applied.element(
+            cas,
+            &loads,
+            (k, k),
+            &mut |cas, fraction| along::Placed {
+                point: slab.end(cas, 2.0 * fraction - 1.0),
+                rotation: r,
+                omega,
+            },
+            &pairs,
+            symbols,
+        );
 
         // Beam springs to the previous element (or the clamp), on centres
         // relative to the previous element's rest centre: the gap between
@@ -489,6 +507,10 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         },
         planar: None,
     };
+    // Element k's body is body k (the tip's, attached next, displaces
+    // nothing).
+    let body_link: Vec<usize> = (0..sys.bodies.len()).collect();
+    applied.attach(cas, &mut sys, symbols, &body_link);
     let mount = TipMount {
         point: tip,
         axis: [prev.r[0][0], prev.r[1][0], prev.r[2][0]],
@@ -713,7 +735,8 @@ fn beam_springs(
 /// (one, reading the model's parameters). Centres are taken relative to a
 /// common point, which changes neither M nor h, so a part does not depend
 /// on the arc length to its element. None for an arm with actuators, a
-/// moving base or joint torques (terms not split into parts yet).
+/// moving base, joint torques, loads along it or a fluid (terms not split
+/// into parts yet).
 pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartKernels> {
     let covered = st.segments.iter().all(|g| g.method == Method::Eba)
         && !st.base_translates
@@ -721,7 +744,9 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
         && st.torques.is_empty()
         && st.chambers.iter().all(|&c| c == 0)
         && st.tendons.is_empty()
-        && st.segments.iter().all(|g| !g.anisotropic && !g.rest_3d);
+        && st.segments.iter().all(|g| !g.anisotropic && !g.rest_3d)
+        && st.loads.is_empty()
+        && st.fluid.is_none();
     if !covered {
         return None;
     }

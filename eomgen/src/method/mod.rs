@@ -155,12 +155,6 @@ pub(crate) trait ModellingMethod: Sync {
         true
     }
 
-    /// Whether its elements place points a `[[load]]` can act at (every
-    /// chain method; not a method that builds the whole arm).
-    fn takes_point_loads(&self) -> bool {
-        true
-    }
-
     /// Where along element `e` (as a fraction of its length) its springs
     /// sit, which a varying section's stiffnesses are taken at: the
     /// element's middle, unless its springs join it to its neighbour.
