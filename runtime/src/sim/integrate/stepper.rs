@@ -128,6 +128,43 @@ impl Contraction {
     }
 }
 
+/// The first step of an adaptive method of order `order` from (t0, y0),
+/// whose rate is `f0`: Hairer, Norsett and Wanner's estimate (Solving
+/// ODEs I, II.4), from the sizes of the state and its rate and, by one
+/// trial Euler step, of its second derivative. A start at rest in
+/// equilibrium has no rate to measure; the trial step then sees what
+/// moves it (a load ramped on over 0.1 ms), where a step from the rate
+/// alone leapt the whole span and, its error measured from accelerations
+/// equal at both ends, was accepted.
+pub fn initial_step(
+    sys: &mut dyn OdeSystem,
+    (t0, y0, f0): (f64, &[f64], &[f64]),
+    order: u32,
+    opts: &Options,
+) -> f64 {
+    let (rtol, atol) = (opts.rtol, opts.atol);
+    let span = opts.t_end - t0;
+    let d0 = error_norm(y0, y0, y0, rtol, atol);
+    let d1 = error_norm(f0, y0, y0, rtol, atol);
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    }
+    .min(span);
+    let y1: Vec<f64> = y0.iter().zip(f0).map(|(y, f)| y + h0 * f).collect();
+    let mut f1 = vec![0.0; y0.len()];
+    sys.rhs(t0 + h0, &y1, &mut f1);
+    let df: Vec<f64> = f1.iter().zip(f0).map(|(a, b)| (a - b) / h0).collect();
+    let d2 = error_norm(&df, y0, y0, rtol, atol);
+    let h1 = if d1.max(d2) <= 1e-15 {
+        (h0 * 1e-3).max(1e-6)
+    } else {
+        (0.01 / d1.max(d2)).powf(1.0 / (order as f64 + 1.0))
+    };
+    (100.0 * h0).min(h1).clamp(1e-10 * span, span)
+}
+
 /// RMS of e_i / (atol + rtol max(|a_i|, |b_i|)).
 pub fn error_norm(e: &[f64], a: &[f64], b: &[f64], rtol: f64, atol: f64) -> f64 {
     let sum: f64 = e

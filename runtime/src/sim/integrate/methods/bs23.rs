@@ -8,7 +8,7 @@
 use differential_equations::error::Error;
 
 use super::super::stepper::{
-    Counts, Hermite, OdeSystem, Options, StepFn, begin_step, error_norm, next_step,
+    Counts, Hermite, OdeSystem, Options, StepFn, begin_step, error_norm, initial_step, next_step,
 };
 
 /// Integrate from (t0, y0) to `opts.t_end`.
@@ -27,17 +27,7 @@ pub fn integrate(
     sys.rhs(t, &y, &mut k1);
     let (mut k2, mut k3, mut k4) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
     let (mut stage, mut y_new, mut err) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
-    // Initial step from the size of the state and of its rate (Hairer's
-    // simple estimate), within the span.
-    let d0 = error_norm(&y, &y, &y, opts.rtol, opts.atol);
-    let d1 = error_norm(&k1, &y, &y, opts.rtol, opts.atol);
-    let span = t_end - t0;
-    let mut h = if d0 > 1e-5 && d1 > 1e-5 {
-        0.01 * d0 / d1
-    } else {
-        1e-6
-    }
-    .min(span);
+    let mut h = initial_step(sys, (t0, &y, &k1), 3, opts);
     let mut rejected_last = false;
     while t < t_end {
         let last = begin_step(counts, opts, t, &mut h, &y)?;

@@ -28,7 +28,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::super::stepper::{
     Contraction, Converging, Counts, Hermite, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn,
-    begin_step, error_norm, next_step,
+    begin_step, error_norm, initial_step, next_step,
 };
 
 const MAX_NEWTON: usize = 8;
@@ -177,9 +177,7 @@ pub fn integrate(
     let (mut y1, mut f1, mut a1) = (vec![0.0; m], vec![0.0; m], vec![0.0; n]);
     let mut j = DMatrix::zeros(m, m);
     let (mut need_jacobian, mut fresh) = (true, false);
-    let span = t_end - t0;
-    let d1 = error_norm(&p.f, &p.y, &p.y, rtol, atol);
-    let mut h = if d1 > 1e-5 { 0.01 / d1 } else { 1e-6 * span }.clamp(1e-10 * span, span);
+    let mut h = initial_step(sys, (t0, &p.y, &p.f), 2, opts);
     let mut rejected_last = false;
     while t < t_end {
         let last = begin_step(counts, opts, t, &mut h, &p.y)?;

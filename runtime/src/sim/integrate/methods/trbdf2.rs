@@ -14,7 +14,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::super::stepper::{
     Contraction, Converging, Counts, Hermite, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn,
-    begin_step, error_norm, next_step,
+    begin_step, error_norm, initial_step, next_step,
 };
 
 const SQRT2: f64 = std::f64::consts::SQRT_2;
@@ -94,9 +94,7 @@ pub fn integrate(
     // in hand was evaluated at the current point (kept while Newton
     // contracts fast, as radau5 does).
     let (mut need_jacobian, mut fresh) = (true, false);
-    let span = t_end - t0;
-    let d1 = error_norm(&k1, &y, &y, rtol, atol);
-    let mut h = if d1 > 1e-5 { 0.01 / d1 } else { 1e-6 * span }.clamp(1e-10 * span, span);
+    let mut h = initial_step(sys, (t0, &y, &k1), 2, opts);
     let mut rejected_last = false;
     while t < t_end {
         let last = begin_step(counts, opts, t, &mut h, &y)?;
