@@ -381,9 +381,10 @@ fn the_fixed_step_chosen_holds_the_tolerance_and_twice_it_does_not() {
 /// Gauss-Legendre on the undamped steel rod (examples/steel_rod.toml),
 /// released from its static bend, at a 2 ms step for 2 s (90 steps of its
 /// first period): symplectic, without numerical damping, it keeps the
-/// rod's energy after the release to 1e-4 of the largest kinetic energy
-/// (2e-5 measured), the unexcited modes far above the step (twist, the
-/// basis' highest bends) bounded.
+/// rod's energy after the release, the unexcited modes far above the step
+/// (twist, the basis' highest bends) bounded: to 1e-4 of the largest
+/// kinetic energy with its stages solved to rtol 1e-6 (2.1e-5 measured),
+/// to 1e-3 at the file's rtol 1e-3 (1.8e-4).
 #[test]
 fn gauss_keeps_an_undamped_rods_energy_at_a_large_step() {
     let example = root().join("examples/steel_rod.toml");
@@ -396,12 +397,12 @@ fn gauss_keeps_an_undamped_rods_energy_at_a_large_step() {
     )
     .unwrap()
     .q;
-    let drift = |solver: Solver| {
+    let drift = |solver: Solver, rtol: f64| {
         let opts = SimOptions {
             t_end: 2.0,
             solver,
             dt: 2e-3,
-            rtol: 1e-4,
+            rtol,
             atol: 1e-7,
             output_dt: 0.01,
             ..Default::default()
@@ -420,9 +421,15 @@ fn gauss_keeps_an_undamped_rods_energy_at_a_large_step() {
         let e0 = energy[0].1;
         energy.iter().fold(0.0f64, |m, e| m.max((e.1 - e0).abs())) / ke
     };
-    let gauss = drift(Solver::Gauss);
-    eprintln!("energy drift after the release: {gauss:.2e} of the largest kinetic energy");
-    assert!(gauss < 1e-4, "gauss: {gauss:e}");
+    // The stages solved to rtol (Newton's tolerance at a fixed step): the
+    // energy is kept to about the tolerance it is solved to.
+    for (rtol, bound) in [(1e-6, 1e-4), (1e-3, 1e-3)] {
+        let gauss = drift(Solver::Gauss, rtol);
+        eprintln!(
+            "rtol {rtol}: energy drift after the release {gauss:.2e} of the largest kinetic energy"
+        );
+        assert!(gauss < bound, "gauss at rtol {rtol}: {gauss:e}");
+    }
 }
 
 /// The steel rod of Till, Aloi and Rucker (examples/steel_rod.toml) as
