@@ -237,7 +237,10 @@ pub fn tapes(model: &Model, hash: &str, dir: &Path) -> (TapeSet, CacheStatus, f6
 
 /// A viscoelastic model's relaxing groups: each segment with a Prony
 /// series, by its elements' stiffness parameters.
-fn relaxation(model: &Model, layout: &ParamLayout) -> Option<runtime::relaxation::Relaxation> {
+pub(crate) fn relaxation(
+    model: &Model,
+    layout: &ParamLayout,
+) -> Option<runtime::relaxation::Relaxation> {
     let groups: Vec<_> = (model.segments.iter().enumerate())
         .filter(|(_, s)| !s.relaxation.is_empty())
         .map(|(i, s)| runtime::relaxation::Group {

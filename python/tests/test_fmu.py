@@ -99,3 +99,42 @@ def test_the_stiff_flop_fmu_follows_softarm_under_the_recorded_pressures(tmp_pat
     ours = softarm_run(m, x0, ["p0", "p1", "p2"], values, t_end)
     theirs = fmpy_run(fmu, m, x0, chambers, values, t_end)
     assert np.max(np.abs(theirs - ours)) < 1e-6 * 0.044
+
+
+def test_a_viscoelastic_fmu_creeps_as_softarm(tmp_path):
+    """The soft finger (models/soft_finger.toml) of a relaxing material,
+    two Prony branches: its relaxed forces are the FMU's states after q and
+    qd, named as trajectory.csv names them, and it sags and creeps as
+    softarm's run does."""
+    spec = tmp_path / "relaxing_finger.toml"
+    spec.write_text(RELAXING_FINGER)
+    fmu = export(str(spec), tmp_path)
+    names = [v.name for v in fmpy.read_model_description(str(fmu)).modelVariables]
+    m = softarm.load(str(spec))
+    assert f"relaxed1.{m.coordinates[-1]}" in names
+    # At rest in the rest shape, relaxed: the relaxed forces zero too.
+    x0 = np.zeros(2 * m.dof)
+    # A second: both branches (0.05 and 0.5 s) relax within it.
+    ours = softarm_run(m, np.zeros(4 * m.dof), [], [], 1.0)
+    theirs = fmpy_run(fmu, m, x0, [], [], 1.0)
+    assert theirs.shape == ours.shape
+    assert np.max(np.abs(theirs - ours)) < 1e-6 * 0.12
+
+
+RELAXING_FINGER = """
+name = "relaxing_finger"
+gravity = [0.0, -9.81, 0.0]
+[base]
+position = [0.0, 0.0, 0.0]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.12
+elements = 8
+density = 1070.0
+outer_radius = 0.006
+youngs_modulus = 1.0e6
+relaxation = [{ ratio = 0.3, time = 0.5 }, { ratio = 0.2, time = 0.05 }]
+[tip]
+mass = 0.02
+"""

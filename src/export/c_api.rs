@@ -5,6 +5,7 @@
 use std::collections::HashSet;
 use std::fmt::Write;
 
+use runtime::relaxation::Relaxation;
 use runtime::{N_OUTPUTS, OUTPUT_NAMES, Tape, TapeSet};
 
 use super::c_tape::{self, literal};
@@ -27,6 +28,9 @@ pub struct Library<'a> {
     pub inputs: &'a [(usize, String)],
     /// The arm's shape, one point per element (`eomgen::shape`).
     pub shape: &'a Tape,
+    /// A viscoelastic model's relaxing groups: their relaxed forces are
+    /// states after q and qd.
+    pub relax: Option<&'a Relaxation>,
 }
 
 /// A C identifier from any name: other characters become `_`, runs of
@@ -94,6 +98,17 @@ impl Library<'_> {
     fn upper(&self) -> String {
         self.prefix.to_ascii_uppercase()
     }
+    /// Relaxed forces: n per Prony branch.
+    fn nz(&self) -> usize {
+        self.relax.map_or(0, |r| r.states(self.n()))
+    }
+    /// States: q, qd, then the relaxed forces.
+    pub fn nx(&self) -> usize {
+        2 * self.n() + self.nz()
+    }
+    fn groups(&self) -> usize {
+        self.relax.map_or(0, |r| r.groups.len())
+    }
 
     /// `<prefix>.h`.
     pub fn header(&self) -> String {
@@ -104,15 +119,20 @@ impl Library<'_> {
             h,
             "/* {p}.h: the equations of motion of the softarm model \"{model}\" (structure \
              {hash}), exported by softarm {version}. Generated: do not edit; export again.\n \
-             * C99 and libm alone. The state is x = (q, qd); docs/export.md in softarm \
-             explains every function. */\n#ifndef {up}_H\n#define {up}_H\n\n#include <stddef.h>\n\n",
+             * C99 and libm alone. The state is x = (q, qd), then a viscoelastic model's \
+             relaxed forces; docs/export.md in softarm explains every function. */\n#ifndef {up}_H\n#define {up}_H\n\n#include <stddef.h>\n\n",
             model = self.model,
             hash = self.hash,
             version = env!("CARGO_PKG_VERSION"),
         );
         let defines = [
             ("NQ", self.n(), "generalised coordinates"),
-            ("NX", 2 * self.n(), "states: q, then qd"),
+            ("NX", self.nx(), "states: q, qd, then NRELAXED"),
+            (
+                "NRELAXED",
+                self.nz(),
+                "relaxed forces: NQ per Prony branch (0: elastic)",
+            ),
             ("NPARAMS", info.parameters.len(), "base parameters"),
             (
                 "NOUTPUTS",
@@ -135,11 +155,18 @@ impl Library<'_> {
         }
         let _ = writeln!(h, "}} {p}_params;\n");
         let work = self.work_len();
+        let ext = info.extended_params().max(1);
+        let relaxing = match self.groups() {
+            0 => String::new(),
+            g => format!(
+                "    /* Each relaxing group's parameters with its stiffnesses zeroed. */\n    \
+                 double zeroed[{g}][{ext}];\n"
+            ),
+        };
         let _ = writeln!(
             h,
             "/* Parameters (base, then derived) and workspace: one per thread. */\n\
-             typedef struct {{\n    double p[{}];\n    double work[{work}];\n}} {p}_model;\n",
-            info.extended_params().max(1),
+             typedef struct {{\n    double p[{ext}];\n{relaxing}    double work[{work}];\n}} {p}_model;\n",
         );
         h.push_str(&self.prototypes());
         let _ = writeln!(h, "\n#endif /* {up}_H */");
@@ -154,8 +181,23 @@ impl Library<'_> {
         // with joints the constraint rows, X, S, its factors, lambda and
         // the differenced Jacobian's shifted state and its two slopes.
         let base = tri + n + n * n + n + 2 * n + 2 * n + n;
-        let joints = m * (n + 2) + m * n + m * (m + 1) / 2 + m * m + m + m + 6 * n * m.min(1);
-        base + joints + self.scratch_len()
+        let joints = m * (n + 2) + m * n + m * (m + 1) / 2 + m * m + m + m;
+        base + joints + self.relax_work() + 3 * self.nx() * self.differenced() + self.scratch_len()
+    }
+
+    /// The Jacobian by central differences: with joints or relaxed forces.
+    fn differenced(&self) -> usize {
+        usize::from(self.m() > 0 || self.nz() > 0)
+    }
+
+    /// Workspace of the relaxed forces' rates: zero rates, the packed M
+    /// and h twice, the group's force.
+    fn relax_work(&self) -> usize {
+        let (n, tri) = (self.n(), self.n() * (self.n() + 1) / 2);
+        match self.nz() {
+            0 => 0,
+            _ => n + 2 * (tri + n) + n,
+        }
     }
 
     fn prototypes(&self) -> String {
@@ -193,8 +235,8 @@ impl Library<'_> {
         let _ = writeln!(
             h,
             "/* df/dx (NX x NX, row-major); returns as {p}_state_derivative. Exact without\n \
-             * joints; with joints by central differences of the state derivative, as\n \
-             * softarm's own. */\n\
+             * joints or relaxed forces; with them by central differences of the state\n \
+             * derivative. */\n\
              int {p}_state_jacobian({p}_model *model, double t, const double *x, double *jac);"
         );
         if self.m() > 0 {
@@ -325,12 +367,27 @@ impl Library<'_> {
             let _ = writeln!(c, "    v->{f} = {};", literal(v));
         }
         c.push_str("}\n\n");
+        let np = info.parameters.len();
+        let mut zeroed = String::new();
+        for (g, group) in self.relax.iter().flat_map(|r| r.groups.iter()).enumerate() {
+            let _ = writeln!(
+                zeroed,
+                "    memcpy(m->zeroed[{g}], m->p, {np} * sizeof(double));"
+            );
+            for &i in &group.stiffness {
+                let _ = writeln!(zeroed, "    m->zeroed[{g}][{i}] = 0.0;");
+            }
+            let _ = writeln!(
+                zeroed,
+                "    k_derived(0.0, NULL, NULL, NULL, NULL, m->zeroed[{g}], NULL, m->zeroed[{g}] + {np}, SCRATCH);"
+            );
+        }
         let _ = writeln!(
             c,
-            "/* The derived parameters after the base ones. */\n\
+            "/* The derived parameters after the base ones (and each relaxing group's\n \
+             * parameters without its stiffnesses). */\n\
              static void derive_params({p}_model *m)\n{{\n    \
-             k_derived(0.0, NULL, NULL, NULL, NULL, m->p, NULL, m->p + {}, SCRATCH);\n}}\n",
-            info.parameters.len()
+             k_derived(0.0, NULL, NULL, NULL, NULL, m->p, NULL, m->p + {np}, SCRATCH);\n{zeroed}}}\n"
         );
         let _ = writeln!(c, "void {p}_init({p}_model *m, const {p}_params *v)\n{{");
         c.push_str("    memset(m, 0, sizeof *m);\n");
@@ -371,11 +428,14 @@ impl Library<'_> {
              memcpy(DIR + {n}, dqd, {n} * sizeof(double));\n    \
              k_jvp(t, q, qd, qdd, DIR, m->p, NULL, dtau, SCRATCH);\n}}\n"
         );
+        c.push_str(&self.relaxed_rates());
         c.push_str(&self.state_derivative());
-        if m == 0 {
+        if self.differenced() == 0 {
             c.push_str(&self.state_jacobian());
         } else {
             c.push_str(&self.differenced_jacobian());
+        }
+        if m > 0 {
             let _ = writeln!(
                 c,
                 "void {p}_constraints({p}_model *m, double t, const double *q, const double *qd,\n    \
@@ -407,9 +467,13 @@ impl Library<'_> {
             ("SLOWER", m * m),
             ("SPIVOTS", m),
             ("LAMBDA", m),
-            ("SHIFTED", 2 * n * m.min(1)),
-            ("PLUS", 2 * n * m.min(1)),
-            ("MINUS", 2 * n * m.min(1)),
+            ("ZEROS", n * self.nz().min(1)),
+            ("GWITH", (tri + n) * self.nz().min(1)),
+            ("GWITHOUT", (tri + n) * self.nz().min(1)),
+            ("GFORCE", n * self.nz().min(1)),
+            ("SHIFTED", self.nx() * self.differenced()),
+            ("PLUS", self.nx() * self.differenced()),
+            ("MINUS", self.nx() * self.differenced()),
             ("SCRATCH", self.scratch_len()),
         ];
         let mut c = String::new();
@@ -433,8 +497,17 @@ impl Library<'_> {
              k_mass_bias(t, q, qd, NULL, NULL, m->p, NULL, PACKED, SCRATCH);\n    \
              if (sa_ldlt_factor({n}, PACKED, LOWER, PIVOTS)) return 1;\n    \
              for (i = 0; i < {n}; i++) {{\n        dx[i] = qd[i];\n        \
-             dx[{n} + i] = -PACKED[{tri} + i];\n    }}\n    \
-             sa_ldlt_solve({n}, LOWER, PIVOTS, dx + {n});\n"
+             dx[{n} + i] = -PACKED[{tri} + i];\n    }}\n{relaxed}    \
+             sa_ldlt_solve({n}, LOWER, PIVOTS, dx + {n});\n",
+            relaxed = match self.nz() {
+                0 => String::new(),
+                nz => format!(
+                    "    /* M qdd + h = the relaxed forces' sum; their rates. */\n    \
+                     for (i = 0; i < {nz}; i++) dx[{n} + i % {n}] += x[{x0} + i];\n    \
+                     relaxed_rates(m, t, q, x + {x0}, dx + {x0});\n",
+                    x0 = 2 * n
+                ),
+            }
         );
         if m > 0 {
             let _ = write!(
@@ -463,8 +536,9 @@ impl Library<'_> {
         c
     }
 
-    /// With joints, df/dx by central differences of the state derivative,
-    /// with softarm's steps (`runtime::jacobian`): cbrt(eps) max(|x_j|, 1).
+    /// With joints or relaxed forces, df/dx by central differences of the
+    /// state derivative, with softarm's steps (`runtime::jacobian`):
+    /// cbrt(eps) max(|x_j|, 1); the rows of q' = qd exact.
     fn differenced_jacobian(&self) -> String {
         let (p, n) = (self.prefix, self.n());
         format!(
@@ -481,11 +555,49 @@ impl Library<'_> {
              SHIFTED[j] = x[j] - step;\n        \
              if ((status = {p}_state_derivative(m, t, SHIFTED, MINUS))) return status;\n        \
              SHIFTED[j] = x[j];\n        \
-             for (i = 0; i < {n}; i++)\n            \
-             jac[({n} + i) * {nx} + j] = (PLUS[{n} + i] - MINUS[{n} + i]) / (2.0 * step);\n    }}\n    \
+             for (i = {n}; i < {nx}; i++)\n            \
+             jac[i * {nx} + j] = (PLUS[i] - MINUS[i]) / (2.0 * step);\n    }}\n    \
              return 0;\n}}\n",
-            nx = 2 * n
+            nx = self.nx()
         )
+    }
+
+    /// A viscoelastic model's relaxed forces' rates (`runtime::relaxation`):
+    /// each group's elastic force f_g = h(q, 0) less h(q, 0) with its
+    /// stiffnesses zeroed, then time_k z_k' = ratio_k f_g - z_k for each of
+    /// its branches, in the groups' order.
+    fn relaxed_rates(&self) -> String {
+        let Some(relax) = self.relax else {
+            return String::new();
+        };
+        let (n, tri) = (self.n(), self.n() * (self.n() + 1) / 2);
+        let mut c = format!(
+            "static void relaxed_rates({p}_model *m, double t, const double *q, const double *z,\n    \
+             double *dz)\n{{\n    size_t i;\n    \
+             k_mass_bias(t, q, ZEROS, NULL, NULL, m->p, NULL, GWITH, SCRATCH);\n",
+            p = self.prefix
+        );
+        let mut k = 0;
+        for (g, group) in relax.groups.iter().enumerate() {
+            let _ = writeln!(
+                c,
+                "    k_mass_bias(t, q, ZEROS, NULL, NULL, m->zeroed[{g}], NULL, GWITHOUT, SCRATCH);\n    \
+                 for (i = 0; i < {n}; i++) GFORCE[i] = GWITH[{tri} + i] - GWITHOUT[{tri} + i];"
+            );
+            for b in &group.branches {
+                let _ = writeln!(
+                    c,
+                    "    for (i = 0; i < {n}; i++)\n        \
+                     dz[{at} + i] = ({ratio} * GFORCE[i] - z[{at} + i]) / {time};",
+                    at = k * n,
+                    ratio = literal(b.ratio),
+                    time = literal(b.time),
+                );
+                k += 1;
+            }
+        }
+        c.push_str("}\n\n");
+        c
     }
 
     /// df/dx: [0 I; dqdd/dq dqdd/dqd], dqdd = -M^-1 d tau column by column.

@@ -97,7 +97,7 @@ pub fn write(lib: &Library, fmu: &Path, build: &Path) -> Result<()> {
 /// the parameters (inputs among them), in value-reference order.
 fn model_description(lib: &Library) -> String {
     let info = &lib.tapes.info;
-    let (n, nout) = (info.dof(), OUTPUT_NAMES.len());
+    let (n, nx, nout) = (info.dof(), lib.nx(), OUTPUT_NAMES.len());
     let mut vars = String::new();
     let mut var = |name: &str, vr: usize, attrs: &str, real: &str| {
         let _ = writeln!(
@@ -106,11 +106,17 @@ fn model_description(lib: &Library) -> String {
             xml(name)
         );
     };
-    let state = |k: usize| match k < n {
-        true => format!("q.{}", info.coordinates[k]),
-        false => format!("qd.{}", info.coordinates[k - n]),
+    // A viscoelastic model's relaxed forces as trajectory.csv names them.
+    let state = |k: usize| match k {
+        k if k < n => format!("q.{}", info.coordinates[k]),
+        k if k < 2 * n => format!("qd.{}", info.coordinates[k - n]),
+        k => format!(
+            "relaxed{}.{}",
+            (k - 2 * n) / n,
+            info.coordinates[(k - 2 * n) % n]
+        ),
     };
-    for k in 0..2 * n {
+    for k in 0..nx {
         var(
             &state(k),
             k,
@@ -118,11 +124,11 @@ fn model_description(lib: &Library) -> String {
             " start=\"0\"",
         );
     }
-    for k in 0..2 * n {
+    for k in 0..nx {
         let derivative = format!(" derivative=\"{}\"", k + 1);
         var(
             &format!("der({})", state(k)),
-            2 * n + k,
+            nx + k,
             "causality=\"local\" variability=\"continuous\"",
             &derivative,
         );
@@ -130,7 +136,7 @@ fn model_description(lib: &Library) -> String {
     for (k, name) in OUTPUT_NAMES.iter().enumerate() {
         var(
             name,
-            4 * n + k,
+            2 * nx + k,
             "causality=\"output\" variability=\"continuous\"",
             "",
         );
@@ -144,14 +150,14 @@ fn model_description(lib: &Library) -> String {
             true => "causality=\"input\" variability=\"continuous\"",
             false => "causality=\"parameter\" variability=\"fixed\" initial=\"exact\"",
         };
-        var(name, 4 * n + nout + k, attrs, &start);
+        var(name, 2 * nx + nout + k, attrs, &start);
     }
     let unknowns = |range: std::ops::Range<usize>| -> String {
         range
             .map(|i| format!("      <Unknown index=\"{}\"/>\n", i + 1))
             .collect()
     };
-    let (derivatives, outputs) = (unknowns(2 * n..4 * n), unknowns(4 * n..4 * n + nout));
+    let (derivatives, outputs) = (unknowns(nx..2 * nx), unknowns(2 * nx..2 * nx + nout));
     format!(
         "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n\
          <fmiModelDescription fmiVersion=\"2.0\" modelName=\"{model}\" guid=\"{{{hash}}}\" \

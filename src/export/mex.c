@@ -69,7 +69,7 @@ static void status_check(int status)
 
 void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[])
 {
-    static double mass[PFXU_NQ * PFXU_NQ + 1], bias[PFXU_NQ + 1], jac[4 * PFXU_NQ * PFXU_NQ + 1];
+    static double mass[PFXU_NQ * PFXU_NQ + 1], bias[PFXU_NQ + 1], jac[PFXU_NX * PFXU_NX + 1];
     static const double zeros[PFXU_NQ + 1];
     char name[40];
     (void)nlhs;

@@ -88,13 +88,6 @@ pub fn export(
              equations without contact); remove [contact] and [[obstacle]] to export the rest"
         );
     }
-    if model.segments.iter().any(|s| !s.relaxation.is_empty()) {
-        bail!(
-            "{origin}: segment.relaxation: viscoelastic materials carry relaxed forces as extra \
-             states, which the C export does not have yet; export the elastic model (remove \
-             relaxation)"
-        );
-    }
     let hash = structure.hash();
     let layout = ParamLayout::of(&structure);
     let (tapes, _, _) = backend::tapes(
@@ -113,6 +106,7 @@ pub fn export(
         .map(|d| (d.param, tapes.info.parameters[d.param].clone()))
         .collect();
     let shape = eomgen::shape::shape_tape(&structure, 1);
+    let relax = backend::relaxation(&model, &layout);
     let prefix = c_api::identifier(&model.name);
     let library = c_api::Library {
         prefix: &prefix,
@@ -122,6 +116,7 @@ pub fn export(
         values: &values,
         inputs: &inputs,
         shape: &shape.tape,
+        relax: relax.as_ref(),
     };
     let mut files = Vec::new();
     if let Some(dir) = &targets.c {

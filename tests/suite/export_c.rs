@@ -52,7 +52,7 @@ fn rust_blocks(
     x: &[f64],
 ) -> Vec<Block> {
     let n = arm.dof();
-    let (q, qd) = x.split_at(n);
+    let (q, qd) = (&x[..n], &x[n..2 * n]);
     let mut m = DMatrix::zeros(n, n);
     let mut h = DVector::zeros(n);
     arm.mass_bias(t, q, qd, &mut m, &mut h);
@@ -63,21 +63,30 @@ fn rust_blocks(
         block("shape", shape.eval(t, q, &arm.params_at(t))),
     ];
     let mut ws = runtime::Workspace::new(n);
-    let mut qdd = vec![0.0; n];
-    runtime::accelerations(arm, &mut ws, t, q, qd, &mut qdd).expect("the Rust accelerations");
+    // qdd, then a viscoelastic arm's relaxed forces' rates.
+    let mut dx = vec![0.0; x.len()];
+    runtime::relaxed_forces::state_rate(arm, &mut ws, t, x, &mut dx)
+        .expect("the Rust state derivative");
     blocks.push(Block {
         name: "qdd".into(),
-        values: qdd,
+        values: dx[n..2 * n].to_vec(),
         tol: SOLVED_TOL,
     });
-    let mut jac = DMatrix::zeros(2 * n, 2 * n);
+    if x.len() > 2 * n {
+        blocks.push(block("relaxed forces' rates", dx[2 * n..].to_vec()));
+    }
+    let mut jac = DMatrix::zeros(x.len(), x.len());
     runtime::state_jacobian(arm, &mut ws, t, x, &mut jac).expect("the Rust Jacobian");
     let values = jac.transpose().iter().copied().collect();
     let joints = !arm.info().constraints.is_empty();
     blocks.push(Block {
         name: "jacobian".into(),
         values,
-        tol: if joints { DIFFERENCED_TOL } else { SOLVED_TOL },
+        tol: if joints || arm.internal_len() > 0 {
+            DIFFERENCED_TOL
+        } else {
+            SOLVED_TOL
+        },
     });
     if joints {
         let c = runtime::constraints::evaluate(arm, t, q, qd);
@@ -91,10 +100,16 @@ fn rust_blocks(
 
 /// A C driver that binds the given base parameters, evaluates every
 /// function at each state and prints the values one a line.
-fn driver(prefix: &str, params: &[f64], states: &[Vec<f64>], joints: bool, t: f64) -> String {
+fn driver(
+    prefix: &str,
+    params: &[f64],
+    (n, states): (usize, &[Vec<f64>]),
+    joints: bool,
+    t: f64,
+) -> String {
     let p = prefix;
     let up = p.to_ascii_uppercase();
-    let (n, no) = (states[0].len() / 2, runtime::N_OUTPUTS);
+    let (nx, no) = (states[0].len(), runtime::N_OUTPUTS);
     let mut c = format!(
         "#include <stdio.h>\n#include \"{p}.h\"\n\
          static void put(const double *v, size_t k) {{ size_t i; for (i = 0; i < k; i++) printf(\"%.17g\\n\", v[i]); }}\n\
@@ -103,8 +118,7 @@ fn driver(prefix: &str, params: &[f64], states: &[Vec<f64>], joints: bool, t: f6
          static double phi[{up}_NCONSTRAINTS + 1], cj[({up}_NCONSTRAINTS + 1) * {n}], gamma[{up}_NCONSTRAINTS + 1];\n  \
          size_t i;\n  {p}_default_params(&v);\n  {p}_init(&m, &v);\n",
         nn = n * n,
-        nx = 2 * n,
-        nxx = 4 * n * n,
+        nxx = nx * nx,
     );
     // The parameters as the Rust side has them at t (inputs included).
     let _ = write!(c, "  {{ static const double base[] = {{");
@@ -126,13 +140,14 @@ fn driver(prefix: &str, params: &[f64], states: &[Vec<f64>], joints: bool, t: f6
             "0.0 }};\n    {p}_mass_bias(&m, {t:?}, x, x + {n}, mass, bias); put(mass, {nn}); put(bias, {n});\n    \
              {p}_outputs(&m, {t:?}, x, x + {n}, out); put(out, {no});\n    \
              {p}_shape(&m, {t:?}, x, shape); put(shape, {up}_NSHAPE * 7);\n    \
-             if ({p}_state_derivative(&m, {t:?}, x, dx)) return 3;\n    put(dx + {n}, {n});",
+             if ({p}_state_derivative(&m, {t:?}, x, dx)) return 3;\n    put(dx + {n}, {});",
+            nx - n,
             nn = n * n,
         );
         let _ = writeln!(
             c,
             "    if ({p}_state_jacobian(&m, {t:?}, x, jac)) return 4;\n    put(jac, {});",
-            4 * n * n
+            nx * nx
         );
         if joints {
             let _ = writeln!(
@@ -151,10 +166,14 @@ fn driver(prefix: &str, params: &[f64], states: &[Vec<f64>], joints: bool, t: f6
 /// within `TOL` of the row's own magnitudes (|M| |qdd| + |h|).
 fn backward_error_is_round_off(arm: &dyn Dynamics, t: f64, x: &[f64], qdd: &[f64], model: &str) {
     let n = arm.dof();
-    let (q, qd) = x.split_at(n);
+    let (q, qd) = (&x[..n], &x[n..2 * n]);
     let mut m = DMatrix::zeros(n, n);
     let mut h = DVector::zeros(n);
     arm.mass_bias(t, q, qd, &mut m, &mut h);
+    // M qdd + h = the relaxed forces' sum.
+    for (k, z) in x[2 * n..].iter().enumerate() {
+        h[k % n] -= z;
+    }
     for i in 0..n {
         let r: f64 = (0..n).map(|j| m[(i, j)] * qdd[j]).sum::<f64>() + h[i];
         let size: f64 = (0..n).map(|j| (m[(i, j)] * qdd[j]).abs()).sum::<f64>() + h[i].abs();
@@ -168,9 +187,14 @@ fn backward_error_is_round_off(arm: &dyn Dynamics, t: f64, x: &[f64], qdd: &[f64
 /// Export `model`, compile it with a driver, and compare every block at
 /// random states with the Rust kernels.
 fn check_export(model: &str, dir: &Path) {
+    let spec = root().join("models").join(format!("{model}.toml"));
+    check_export_of(model, &spec, dir);
+}
+
+/// [`check_export`] of the model file `spec`.
+fn check_export_of(model: &str, spec: &Path, dir: &Path) {
     let cache = dir.join("cache");
     let out = dir.join("c");
-    let spec = root().join("models").join(format!("{model}.toml"));
     let spec = spec.to_str().unwrap();
     let export = softarm::export::export_c(spec, &[], &out, Some(cache.clone())).unwrap();
     let loaded = load(spec, &[], BackendChoice::Auto, Some(cache)).unwrap();
@@ -184,13 +208,18 @@ fn check_export(model: &str, dir: &Path) {
         .map(|_| {
             let mut x = rng.coordinates(&arm.info().coordinates, -0.3, 0.3);
             x.extend(rng.vec(n, -1.0, 1.0));
+            x.extend(rng.vec(arm.internal_len(), -1e-3, 1e-3));
             x
         })
         .collect();
     let params = arm.params_at(t)[..arm.info().parameters.len()].to_vec();
     let joints = !arm.info().constraints.is_empty();
     let main = out.join("driver.c");
-    std::fs::write(&main, driver(&export.prefix, &params, &states, joints, t)).unwrap();
+    std::fs::write(
+        &main,
+        driver(&export.prefix, &params, (n, &states), joints, t),
+    )
+    .unwrap();
     let exe = out.join("driver");
     let cc = Command::new("cc")
         .args(["-std=c99", "-Wall", "-Werror", "-O2", "-o"])
@@ -249,8 +278,8 @@ fn the_c_library_of_a_pcc_arm_a_rom_arm_and_joints_agrees_with_the_rust_kernels(
     }
 }
 
-/// Every bundled model the export takes (contact and viscoelastic ones
-/// are refused with a reason, checked below).
+/// Every bundled model the export takes (contact is refused with a
+/// reason, checked below).
 #[test]
 #[ignore = "long (every bundled model compiled at -O2): run by .ci/run's long checks"]
 fn every_bundled_model_exports_c_that_agrees_with_the_rust_kernels() {
@@ -259,11 +288,29 @@ fn every_bundled_model_exports_c_that_agrees_with_the_rust_kernels() {
         let name = path.file_stem().unwrap().to_str().unwrap().to_string();
         let dir = tempfile::tempdir().unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
-        if text.contains("[contact]") || text.contains("relaxation") {
+        if text.contains("[contact]") {
             continue;
         }
         check_export(&name, dir.path());
     }
+}
+
+/// A viscoelastic soft finger (two Prony branches): its relaxed forces
+/// are states after q and qd, M qdd + h their sum and each branch's rate
+/// (ratio f_g - z) / time with f_g the finger's elastic force, as
+/// `runtime::relaxed_forces` has them.
+#[test]
+fn a_viscoelastic_arms_relaxed_forces_are_exported_as_states() {
+    let dir = tempfile::tempdir().unwrap();
+    let relaxing = dir.path().join("relaxing_finger.toml");
+    let finger = std::fs::read_to_string(root().join("models/soft_finger.toml")).unwrap();
+    let relaxing_text = finger.replace(
+        "youngs_modulus = 1.0e6",
+        "youngs_modulus = 1.0e6\nrelaxation = [{ ratio = 0.3, time = 0.5 }, { ratio = 0.2, time = 0.05 }]",
+    );
+    assert_ne!(relaxing_text, finger);
+    std::fs::write(&relaxing, relaxing_text).unwrap();
+    check_export_of("relaxing_finger", &relaxing, dir.path());
 }
 
 /// What the export cannot carry yet is refused with the key and the
@@ -271,19 +318,9 @@ fn every_bundled_model_exports_c_that_agrees_with_the_rust_kernels() {
 #[test]
 fn what_the_export_cannot_carry_is_refused_and_nothing_is_written() {
     let dir = tempfile::tempdir().unwrap();
-    let relaxing = dir.path().join("relaxing.toml");
-    let finger = std::fs::read_to_string(root().join("models/soft_finger.toml")).unwrap();
-    let relaxing_text = finger.replace(
-        "youngs_modulus = 1.0e6",
-        "youngs_modulus = 1.0e6\nrelaxation = [{ ratio = 0.3, time = 0.5 }]",
-    );
-    assert_ne!(relaxing_text, finger);
-    std::fs::write(&relaxing, relaxing_text).unwrap();
     let contact = root().join("models/finger_tap.toml");
-    for (spec, key) in [
-        (contact.as_path(), "[contact]"),
-        (relaxing.as_path(), "segment.relaxation"),
-    ] {
+    {
+        let (spec, key) = (contact.as_path(), "[contact]");
         let out = dir.path().join("c");
         let err = softarm::export::export_c(
             spec.to_str().unwrap(),
