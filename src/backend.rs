@@ -138,7 +138,7 @@ fn linked(
     model: &Model,
     structure: &Structure,
     cache_dir: &Path,
-) -> std::result::Result<(Box<dyn Kernels>, f64), String> {
+) -> std::result::Result<(Box<dyn Kernels>, f64, String), String> {
     if !runtime::cpu::has_fma() {
         return Err("this processor lacks the fused multiply-add compiled code needs".into());
     }
@@ -175,48 +175,73 @@ fn linked(
         return Err("its loads along the arm are not link cells yet".into());
     }
     let not_cells = || "not every one of its methods' elements is a link cell".to_string();
-    let kernels: Box<dyn Kernels> = if structure.assembly.is_some() {
+    let kernels: (Box<dyn Kernels>, String) = if structure.assembly.is_some() {
         let (tapes, _, _) = tapes(model, &structure.hash(), cache_dir);
         let blocks = tapes.arm_blocks.as_ref().ok_or_else(|| {
             "its arms run on the assembly's kernels (an arm has inputs, a compliant base or sits on another arm or a body)"
                 .to_string()
         })?;
-        let kinds = (blocks.kinds.iter())
-            .map(|kind| {
-                let cells = compiled_cells(kind.links.as_ref().ok_or_else(not_cells)?)?;
+        let cells = (blocks.kinds.iter())
+            .map(|kind| Ok(compiled_cells(kind.links.as_ref().ok_or_else(not_cells)?)))
+            .collect::<std::result::Result<Vec<_>, String>>()?;
+        let note = taped(cells.iter().flatten());
+        let kinds = (blocks.kinds.iter().zip(cells))
+            .map(|(kind, cells)| {
                 let arm = LinkedKernels::with_tapes(kind.clone(), cells).ok_or_else(not_cells)?;
                 Ok(Box::new(arm) as Box<dyn Kernels>)
             })
             .collect::<std::result::Result<Vec<_>, String>>()?;
-        Box::new(BlockKernels::new(tapes, kinds).ok_or_else(not_cells)?)
+        (
+            Box::new(BlockKernels::new(tapes, kinds).ok_or_else(not_cells)?),
+            note,
+        )
     } else if structure.contact_points > 0 {
         let (tapes, _, _) = tapes(model, &structure.hash(), cache_dir);
-        let cells = compiled_cells(tapes.links.as_ref().ok_or_else(not_cells)?)?;
-        Box::new(LinkedKernels::with_tapes(tapes, cells).ok_or_else(not_cells)?)
+        let cells = compiled_cells(tapes.links.as_ref().ok_or_else(not_cells)?);
+        let note = taped(&cells);
+        (
+            Box::new(LinkedKernels::with_tapes(tapes, cells).ok_or_else(not_cells)?),
+            note,
+        )
     } else {
         let (info, links) = eomgen::derive::derive_links(structure).ok_or_else(not_cells)?;
-        let cells = compiled_cells(&links)?;
-        Box::new(LinkedKernels::new(info, links, cells))
+        let cells = compiled_cells(&links);
+        let note = taped(&cells);
+        (Box::new(LinkedKernels::new(info, links, cells)), note)
     };
-    Ok((kernels, start.elapsed().as_secs_f64()))
+    let (kernels, note) = kernels;
+    Ok((kernels, start.elapsed().as_secs_f64(), note))
 }
 
 /// The compiled cells of a chain's link shapes, found by key among the
-/// compiled-in models' cells; or how many no compiled-in model has.
-fn compiled_cells(links: &LinkKernels) -> std::result::Result<Vec<CompiledCell>, String> {
-    let keys: Vec<String> = (links.cells.iter().zip(&links.tangents).zip(&links.poses))
-        .map(|((cell, tangent), pose)| eomgen::build::cell_key(cell, tangent, pose))
-        .collect();
-    let found = |key: &String| MODELS.iter().flat_map(|m| m.cells).find(|c| c.key == *key);
-    let missing = keys.iter().filter(|k| found(k).is_none()).count();
-    if missing > 0 {
-        return Err(format!(
-            "{missing} of its {} link shapes {} in no compiled-in model",
-            keys.len(),
-            if missing == 1 { "is" } else { "are" }
-        ));
+/// compiled-in models' cells; None for a shape no compiled-in model has,
+/// whose tapes then run.
+fn compiled_cells(links: &LinkKernels) -> Vec<Option<CompiledCell>> {
+    let found = |key: String| MODELS.iter().flat_map(|m| m.cells).find(|c| c.key == key);
+    (links.cells.iter().zip(&links.tangents).zip(&links.poses))
+        .map(|((cell, tangent), pose)| found(eomgen::build::cell_key(cell, tangent, pose)).copied())
+        .collect()
+}
+
+/// What of a chain's cells (or an assembly's arms' cells) runs on tapes,
+/// for the route: empty when all are compiled in.
+fn taped<'a>(cells: impl IntoIterator<Item = &'a Option<CompiledCell>>) -> String {
+    let (mut k, mut total) = (0, 0);
+    for c in cells {
+        total += 1;
+        k += usize::from(c.is_none());
     }
-    Ok(keys.iter().filter_map(found).copied().collect())
+    match k {
+        0 => String::new(),
+        _ => format!(
+            "; {k} of its {total} link shapes {} in no compiled-in model and {} on {} tapes \
+             (add the file to models/ and `cargo build --release` to compile {})",
+            if k == 1 { "is" } else { "are" },
+            if k == 1 { "runs" } else { "run" },
+            if k == 1 { "its" } else { "their" },
+            if k == 1 { "it" } else { "them" },
+        ),
+    }
 }
 
 /// A model's tapes: the cache's in `dir`, else derived and stored there;
@@ -289,13 +314,17 @@ pub fn load(
     };
     let route = match (&compiled, &linked) {
         (Some(c), _) if wanted_compiled => format!("compiled in as {}", c.name),
-        (_, Some(Ok(_))) if structure.assembly.is_some() => "compiled link cells of bundled \
-             models, linked to each arm's layout, the rest of the assembly interpreted"
-            .into(),
-        (_, Some(Ok(_))) if structure.contact_points > 0 => "compiled link cells of bundled \
-             models, linked to its layout, its contact kernels interpreted"
-            .into(),
-        (_, Some(Ok(_))) => "compiled link cells of bundled models, linked to its layout".into(),
+        (_, Some(Ok((_, _, note)))) if structure.assembly.is_some() => format!(
+            "compiled link cells of bundled models, linked to each arm's layout, the rest of \
+             the assembly interpreted{note}"
+        ),
+        (_, Some(Ok((_, _, note)))) if structure.contact_points > 0 => format!(
+            "compiled link cells of bundled models, linked to its layout, its contact kernels \
+             interpreted{note}"
+        ),
+        (_, Some(Ok((_, _, note)))) => {
+            format!("compiled link cells of bundled models, linked to its layout{note}")
+        }
         (_, Some(Err(why))) => format!(
             "no compiled-in model has this structure and {why}: add the file to models/ and \
              `cargo build --release` to compile it in"
@@ -304,7 +333,9 @@ pub fn load(
     };
     let (kernels, cache, derive_s): (Box<dyn Kernels>, CacheStatus, f64) = match (choice, compiled)
     {
-        (BackendChoice::Auto | BackendChoice::Compiled, None) if let Some(Ok((k, s))) = linked => {
+        (BackendChoice::Auto | BackendChoice::Compiled, None)
+            if let Some(Ok((k, s, _))) = linked =>
+        {
             (k, CacheStatus::Linked, s)
         }
         (BackendChoice::Compiled, None) => {

@@ -1023,7 +1023,15 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
     let chambers = "[segment.chambers]\ncount = 3\nradius = 0.002\ndistance = 0.006\ninputs = [\"p\", \"q\", \"q\"]\n\n[inputs.p]\nkind = \"constant\"\nvalue = 3000.0\n\n[inputs.q]\nkind = \"constant\"\nvalue = 0.0\n\n[tip]";
     std::fs::write(&chambered, text.replace("[tip]", chambers)).unwrap();
     let chambered = chambered.to_string_lossy().into_owned();
+    // A link shape no compiled-in model has (a stretching pcc arc): its
+    // cell runs on its tapes, the rest of the recursion compiled.
+    let stretching = dir.path().join("stretching.toml");
+    let text = text.replace("twist = false", "twist = false\nextension = true");
+    assert!(text.contains("extension = true"));
+    std::fs::write(&stretching, text).unwrap();
+    let stretching = stretching.to_string_lossy().into_owned();
     for (model, set) in [
+        (stretching.as_str(), "segment.0.elements=6"),
         ("tentacle3d", "segment.0.elements=13"),
         ("cantilever3d", "segment.0.elements=7"),
         ("rod_swing", "segment.0.elements=4"),
@@ -1273,9 +1281,10 @@ value = 1000.0
         "{r}"
     );
     let (b, r) = route(&stretching, "", auto);
-    assert_eq!(b, "interpreted");
+    assert_eq!(b, "compiled");
     assert!(
-        r.contains("link shapes") && r.contains("cargo build"),
+        r.contains("1 of its 1 link shapes is in no compiled-in model and runs on its tapes")
+            && r.contains("cargo build"),
         "{r}"
     );
     let (b, r) = route("soft_finger", "", BackendChoice::Interpreted);

@@ -6,6 +6,8 @@
 //! arm needs neither a rebuild nor the interpreter. An arm with contact
 //! takes its contact kernels (and the derived parameters they read) from
 //! its tapes: the recursion covers M, h and their tangent, the costly part.
+//! A link shape no compiled-in model has (a pre-curved rod's, a kink's)
+//! runs on its cell's tapes, the rest of the chain compiled.
 
 use std::cell::RefCell;
 
@@ -25,14 +27,15 @@ use crate::tape::{Inputs, Tape};
 pub struct LinkedKernels {
     info: ModelInfo,
     links: LinkKernels,
-    cells: Vec<CompiledCell>,
+    cells: Vec<Option<CompiledCell>>,
     slots: RefCell<Vec<f64>>,
     rest: Option<Interpreted>,
 }
 
 impl LinkedKernels {
-    /// `cells[c]` is the compiled cell of `links.cells[c]`.
-    pub fn new(info: ModelInfo, links: LinkKernels, cells: Vec<CompiledCell>) -> Self {
+    /// `cells[c]` is the compiled cell of `links.cells[c]`, or None where
+    /// no compiled-in model has it: its tapes then run.
+    pub fn new(info: ModelInfo, links: LinkKernels, cells: Vec<Option<CompiledCell>>) -> Self {
         assert_eq!(cells.len(), links.cells.len(), "one compiled cell a cell");
         Self {
             info,
@@ -47,7 +50,7 @@ impl LinkedKernels {
     /// recursion does not give (contact, derived parameters) by `tapes`;
     /// `None` when the tapes have no link recursion. M and h come from the
     /// recursion and the mass solve, never the tapes' symbolic solve.
-    pub fn with_tapes(tapes: TapeSet, cells: Vec<CompiledCell>) -> Option<Self> {
+    pub fn with_tapes(tapes: TapeSet, cells: Vec<Option<CompiledCell>>) -> Option<Self> {
         let links = tapes.links.clone()?;
         let info = ModelInfo {
             accel: false,
@@ -61,9 +64,29 @@ impl LinkedKernels {
 
 struct Linked<'a> {
     links: &'a LinkKernels,
-    cells: &'a [CompiledCell],
+    cells: &'a [Option<CompiledCell>],
     inp: Inputs<'a>,
     slots: &'a mut Vec<f64>,
+}
+
+/// A cell's tape at its coordinates `x`, rates `xd`, parameters `p` and
+/// direction `dir` (the tangent's).
+fn cell_by_tape(
+    tape: &Tape,
+    (x, xd, dir, p): (&[f64], &[f64], &[f64], &[f64]),
+    slots: &mut Vec<f64>,
+    out: &mut [f64],
+) {
+    let inp = Inputs {
+        t: 0.0,
+        q: x,
+        qd: xd,
+        qdd: &[],
+        dir,
+        p,
+        aux: &[],
+    };
+    tape.eval(&inp, slots, out)
 }
 
 /// A kernel of the layout's own by its tape.
@@ -76,7 +99,10 @@ fn by_tape(tape: &Option<Tape>, what: &str, inp: &Inputs, slots: &mut Vec<f64>, 
 
 impl Cells for Linked<'_> {
     fn one(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
-        (self.cells[c].one)(x, xd, p, out)
+        match &self.cells[c] {
+            Some(cell) => (cell.one)(x, xd, p, out),
+            None => cell_by_tape(&self.links.cells[c], (x, xd, &[], p), self.slots, out),
+        }
     }
 
     fn four(
@@ -87,9 +113,21 @@ impl Cells for Linked<'_> {
         p: &[[f64; 4]],
         out: &mut [[f64; 4]],
     ) {
-        match self.cells[c].four {
-            Some(four) => four(x, xd, p, out),
-            None => by_lanes(self.cells[c].one, x, xd, p, out),
+        match &self.cells[c] {
+            Some(CompiledCell {
+                four: Some(four), ..
+            }) => four(x, xd, p, out),
+            Some(cell) => by_lanes(cell.one, x, xd, p, out),
+            None => {
+                let (tape, slots) = (&self.links.cells[c], &mut *self.slots);
+                by_lanes(
+                    |x, xd, p, out| cell_by_tape(tape, (x, xd, &[], p), slots, out),
+                    x,
+                    xd,
+                    p,
+                    out,
+                )
+            }
         }
     }
 
@@ -107,7 +145,13 @@ impl Cells for Linked<'_> {
         p: &[f64],
         out: &mut [f64],
     ) {
-        (self.cells[c].tangent)(x, xd, dx, dxd, p, out)
+        match &self.cells[c] {
+            Some(cell) => (cell.tangent)(x, xd, dx, dxd, p, out),
+            None => {
+                let dir: Vec<f64> = dx.iter().chain(dxd).copied().collect();
+                cell_by_tape(&self.links.tangents[c], (x, xd, &dir, p), self.slots, out)
+            }
+        }
     }
 
     fn forces_tangent(&mut self, dir: &[f64], out: &mut [f64]) {
@@ -126,7 +170,10 @@ impl Cells for Linked<'_> {
     }
 
     fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
-        (self.cells[c].pose)(x, xd, p, out)
+        match &self.cells[c] {
+            Some(cell) => (cell.pose)(x, xd, p, out),
+            None => cell_by_tape(&self.links.poses[c], (x, xd, &[], p), self.slots, out),
+        }
     }
 
     fn energy(&mut self) -> f64 {
