@@ -148,8 +148,11 @@ fn linked(
         Some(a) => a.arms.iter().map(|(_, s)| s).collect(),
         None => vec![structure],
     };
-    if arms.iter().any(|s| s.segments.iter().any(|g| g.kink)) {
-        return Err("its kinks are not link cells yet".into());
+    if arms
+        .iter()
+        .any(|s| s.dimensions == 2 && s.segments.iter().any(|g| g.kink))
+    {
+        return Err("its kinks in the plane are not link cells yet".into());
     }
     if arms
         .iter()

@@ -1030,8 +1030,13 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
     assert!(text.contains("extension = true"));
     std::fs::write(&stretching, text).unwrap();
     let stretching = stretching.to_string_lossy().into_owned();
+    // A right-angle frame of one arm: its kink a link of no coordinates
+    // whose cell (the constant turn and offset) runs on its tapes.
+    let frame = root().join("examples/right_angle_frame.toml");
+    let frame = frame.to_string_lossy().into_owned();
     for (model, set) in [
         (stretching.as_str(), "segment.0.elements=6"),
+        (frame.as_str(), "segment.1.offset=[0.01, -0.02, 0.005]"),
         ("tentacle3d", "segment.0.elements=13"),
         ("cantilever3d", "segment.0.elements=7"),
         ("rod_swing", "segment.0.elements=4"),
@@ -1258,8 +1263,11 @@ value = 1000.0
     }
     let example = root().join("examples/right_angle_frame.toml");
     let (b, r) = route(&example.to_string_lossy(), "", auto);
-    assert_eq!(b, "interpreted");
-    assert!(r.contains("kinks are not link cells"), "{r}");
+    assert_eq!(b, "compiled");
+    assert!(
+        r.contains("link cells") && r.contains("runs on its tapes"),
+        "{r}"
+    );
     let example = root().join("examples/two_chamber_finger_3d.toml");
     let (b, r) = route(&example.to_string_lossy(), "", auto);
     assert_eq!(b, "interpreted");

@@ -26,7 +26,7 @@ use runtime::links::{
 };
 
 use crate::cas::{Cas, ExprId, SymKind};
-use crate::model::{ElementParam, Joints, Method, Param, ParamLayout, Structure, Xyz};
+use crate::model::{ElementParam, Joints, KinkParam, Method, Param, ParamLayout, Structure, Xyz};
 
 use super::planar_cell::derive_planar_cell;
 use crate::method::ebr::{before_joint, past_joint};
@@ -34,7 +34,9 @@ use crate::method::rom::RomFields;
 use crate::tmt::actuation::{segment_loads, strain_work, thinning};
 use crate::tmt::cell_kind::CellKind;
 use crate::tmt::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
-use crate::tmt::spatial::{ArcStrain, Element3, Frame, Springs, V3, arc, half_k_sq};
+use crate::tmt::spatial::{
+    ArcStrain, Element3, Frame, Springs, V3, arc, compose, exp_turn, half_k_sq,
+};
 use crate::tmt::system::{Coordinates, ParamSymbols};
 
 /// Chains of fewer links keep the flat `MassBias` and its symbolic solve:
@@ -53,6 +55,23 @@ const RECURSION_MIN_LINKS: usize = 4;
 /// cells.
 const PLANAR_RECURSION_MIN_LINKS: usize = 32;
 
+impl Shape {
+    /// No strain beyond bending, no rest shape: a kink's (whose cell reads
+    /// none of it).
+    fn bare() -> Self {
+        Shape {
+            rest_3d: false,
+            twist: false,
+            extension: false,
+            shear: false,
+            incompressible: false,
+            rom: false,
+            planar: None,
+            kind: CellKind::Arc,
+        }
+    }
+}
+
 /// The layout and kernels of a chain the link recursion covers, or `None`
 /// when its structure is outside it. Compiled chains take every kernel
 /// from it but, when shorter than [`RECURSION_MIN_LINKS`] (3D) or
@@ -70,7 +89,8 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         && st.torques.is_empty()
         && !st.base_translates
         && st.base_turns == 0
-        && (st.segments.iter()).all(|g| !g.kink && !g.anisotropic && !g.chambers_vary)
+        && (st.segments.iter())
+            .all(|g| !(g.kink && !spatial) && !g.anisotropic && !g.chambers_vary)
         && st.loads.is_empty()
         && st.fluid.is_none();
     if !covered {
@@ -107,6 +127,26 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             cells.push((shape, kernels));
             Some(cells.len() - 1)
         };
+        if g.kink {
+            // A link of no coordinates before the segment: the kink's
+            // constant turn (about y, z) and offset, in its cell's first
+            // parameter slots.
+            let kink = cell_of(Shape {
+                kind: CellKind::Kink,
+                ..Shape::bare()
+            })?;
+            let turn = [0, 1].map(|i| index(Param::Kink(s, KinkParam::Turn(i))));
+            let offset = Xyz::ALL.map(|c| index(Param::Kink(s, KinkParam::Offset(c))));
+            let slots = ElementParam::CELL.len() + ElementParam::REST_3D.len();
+            let mut params: Vec<usize> = turn.into_iter().chain(offset).collect();
+            params.resize(slots, turn[0]);
+            links.push(LinkSpec {
+                cell: kink,
+                map: Vec::new(),
+                params,
+                load: None,
+            });
+        }
         let c = cell_of(shape)?;
         // An ebr element's first half is a link of its own, before the
         // joint's.
@@ -484,6 +524,7 @@ fn link_motion(
             };
             (c, a, w, end, body)
         }
+        CellKind::Kink => unreachable!("a kink's cell is `derive_kink_cell`"),
     }
 }
 
@@ -492,6 +533,9 @@ fn link_motion(
 /// the cell [`with_tangent`]; and its pose cell (`runtime::links::pose`:
 /// what the `Outputs` need of the link).
 fn derive_cell(shape: Shape) -> [Tape; 3] {
+    if shape.kind == CellKind::Kink {
+        return derive_kink_cell();
+    }
     let Shape {
         twist,
         extension,
@@ -628,6 +672,51 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     [
         cas.to_tape(&out),
         with_tangent(cas, &out, &q, &qd),
+        cas.to_tape(&pose_out),
+    ]
+}
+
+/// A kink's cell: no coordinates, no body, the frame moved by its offset
+/// (parameter slots 2 to 4, in the frame) and turned by the rotation
+/// vector (0, slot 0, slot 1), as `SpatialArm::kink` moves the arm's.
+fn derive_kink_cell() -> [Tape; 3] {
+    let mut cas = Cas::new();
+    let cas = &mut cas;
+    let p: Vec<ExprId> = (0..CELL_PARAMS)
+        .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
+        .collect();
+    let (zero, one) = (cas.zero(), cas.one());
+    let identity = Frame {
+        r: std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one } else { zero })),
+        p: [zero; 3],
+        w: [zero; 3],
+        quat: [one, zero, zero, zero],
+    };
+    let turn = [zero, p[0], p[1]];
+    let offset = [p[2], p[3], p[4]];
+    let (r, quat, _) = exp_turn(cas, &turn, &[zero; 3]);
+    let end = compose(cas, &identity, Some((&r, &quat)), Some(&offset), None);
+    let kin = LinkKinematics::new(
+        cas,
+        Motion {
+            rotation: end.r,
+            end: end.p,
+            omega: end.w,
+            quat: end.quat,
+            centroid: [zero; 3],
+            body_omega: [zero; 3],
+            axis: [one, zero, zero],
+        },
+        [zero; 4],
+        &[],
+        &[],
+        Rates::Turned,
+    );
+    let out = kin.cell(cas, &[], &[], zero, zero);
+    let pose_out = kin.pose(cas);
+    [
+        cas.to_tape(&out),
+        with_tangent(cas, &out, &[], &[]),
         cas.to_tape(&pose_out),
     ]
 }

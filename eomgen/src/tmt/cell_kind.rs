@@ -13,4 +13,7 @@ pub(crate) enum CellKind {
     BeforeJoint,
     /// An ebr element's joint and the half past it.
     PastJoint,
+    /// A kink before a segment: its constant turn and offset, no
+    /// coordinates, no body.
+    Kink,
 }
