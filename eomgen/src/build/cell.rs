@@ -89,8 +89,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         && st.torques.is_empty()
         && !st.base_translates
         && st.base_turns == 0
-        && (st.segments.iter())
-            .all(|g| !(g.kink && !spatial) && !g.anisotropic && !g.chambers_vary)
+        && (st.segments.iter()).all(|g| (!g.kink || spatial) && !g.anisotropic && !g.chambers_vary)
         && st.loads.is_empty()
         && st.fluid.is_none();
     if !covered {
