@@ -623,13 +623,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         share(cas, rayleigh),
     );
 
-    let one = cas.one();
-    let identity = Frame {
-        r: std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one } else { zero })),
-        p: [zero; 3],
-        w: [zero; 3],
-        quat: [one, zero, zero, zero],
-    };
+    let identity = Frame::at_rest(cas, [zero; 3]);
     let rho = [tw, by, bz];
     let rate = [tw_d, by_d, bz_d];
     let half_m = cas.scaled(0.5, m);
@@ -685,12 +679,7 @@ fn derive_kink_cell() -> [Tape; 3] {
         .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
         .collect();
     let (zero, one) = (cas.zero(), cas.one());
-    let identity = Frame {
-        r: std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one } else { zero })),
-        p: [zero; 3],
-        w: [zero; 3],
-        quat: [one, zero, zero, zero],
-    };
+    let identity = Frame::at_rest(cas, [zero; 3]);
     let turn = [zero, p[0], p[1]];
     let offset = [p[2], p[3], p[4]];
     let (r, quat, _) = exp_turn(cas, &turn, &[zero; 3]);

@@ -87,6 +87,17 @@ pub(crate) struct Frame {
 }
 
 impl Frame {
+    /// The world frame at rest at `p`.
+    pub fn at_rest(cas: &mut Cas, p: V3) -> Self {
+        let (zero, one) = (cas.zero(), cas.one());
+        Frame {
+            r: std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one } else { zero })),
+            p,
+            w: [zero; 3],
+            quat: [one, zero, zero, zero],
+        }
+    }
+
     /// The frame's x axis in the world.
     pub fn axis(&self) -> V3 {
         [self.r[0][0], self.r[1][0], self.r[2][0]]
@@ -841,13 +852,8 @@ pub(crate) fn base_frame(
         let f = compose(cas, &f, None, Some(&position), None);
         return compose(cas, &f, Some((&r, &q)), None, None);
     }
-    let (zero, one) = (cas.zero(), cas.one());
-    let mut f = Frame {
-        r: std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one } else { zero })),
-        p: position,
-        w: [zero; 3],
-        quat: [one, zero, zero, zero],
-    };
+    let one = cas.one();
+    let mut f = Frame::at_rest(cas, position);
     for (i, &(angle, rate)) in turns.iter().enumerate() {
         let n = symbols.xyz(|c| Param::BaseTurnAxis(i, c));
         // exp(angle [n]x) = cos I + sin [n]x + (1 - cos) n n^T, n a unit vector.
