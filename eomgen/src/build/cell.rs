@@ -127,24 +127,11 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             Some(cells.len() - 1)
         };
         if g.kink {
-            // A link of no coordinates before the segment: the kink's
-            // constant turn (about y, z) and offset, in its cell's first
-            // parameter slots.
             let kink = cell_of(Shape {
                 kind: CellKind::Kink,
                 ..Shape::bare()
             })?;
-            let turn = [0, 1].map(|i| index(Param::Kink(s, KinkParam::Turn(i))));
-            let offset = Xyz::ALL.map(|c| index(Param::Kink(s, KinkParam::Offset(c))));
-            let slots = ElementParam::CELL.len() + ElementParam::REST_3D.len();
-            let mut params: Vec<usize> = turn.into_iter().chain(offset).collect();
-            params.resize(slots, turn[0]);
-            links.push(LinkSpec {
-                cell: kink,
-                map: Vec::new(),
-                params,
-                load: None,
-            });
+            links.push(kink_link(params, s, kink));
         }
         let c = cell_of(shape)?;
         // An ebr element's first half is a link of its own, before the
@@ -229,6 +216,24 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         kernels.poses.push(pose);
     }
     Some(kernels)
+}
+
+/// Segment s's kink as a link of no coordinates before it, of cell
+/// `cell`: the kink's constant turn (about y, z) and offset in the cell's
+/// first parameter slots.
+fn kink_link(params: &ParamLayout, s: usize, cell: usize) -> LinkSpec {
+    let index = |p: Param| params.index(p);
+    let turn = [0, 1].map(|i| index(Param::Kink(s, KinkParam::Turn(i))));
+    let offset = Xyz::ALL.map(|c| index(Param::Kink(s, KinkParam::Offset(c))));
+    let slots = ElementParam::CELL.len() + ElementParam::REST_3D.len();
+    let mut params: Vec<usize> = turn.into_iter().chain(offset).collect();
+    params.resize(slots, turn[0]);
+    LinkSpec {
+        cell,
+        map: Vec::new(),
+        params,
+        load: None,
+    }
 }
 
 /// The arm's coordinates each link of element `e` reads, as its cell's

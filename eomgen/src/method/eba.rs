@@ -359,9 +359,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
     let mut pairs = coords.rate_pairs();
     pairs.extend(&base.seeds);
 
-    let mut bodies = Vec::new();
-    let mut elastic = Vec::new();
-    let mut rayleigh = Vec::new();
+    let (mut bodies, mut elastic, mut rayleigh) = (Vec::new(), Vec::new(), Vec::new());
     let mut prev = Slab {
         r: r0,
         centre: p0,
@@ -377,19 +375,10 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         .enumerate()
         .flat_map(|(s, g)| std::iter::repeat_n(s, g.elements))
         .collect();
-    let mut strains = Vec::new();
-    let mut samples = Vec::new();
+    let (mut strains, mut samples) = (Vec::new(), Vec::new());
     let curved = structure.segments.iter().any(|g| g.rest_3d);
     let mut placed = curved.then(|| RestPlacement::new(cas));
-    // Loads along the arm act on the element's slab, as its contact
-    // points sit; the fluid drags each slab's centre.
-    let loads = along_loads(cas, structure, symbols);
-    let mut applied = Applied::default();
-    applied.drag = Drag::of(structure, symbols);
-    applied.buoyancy = structure
-        .fluid
-        .is_some()
-        .then(|| symbols.get(Param::Fluid(FluidParam::Density)));
+    let mut slab_loads = SlabLoads::of(cas, structure, symbols);
     for (k, &segment) in segment_of.iter().enumerate() {
         let c = 6 * k;
         let u: V3 = std::array::from_fn(|i| coords.q[c + i]);
@@ -424,18 +413,7 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         };
         bodies.push(el.body(cas, (axis, move |_: &mut Cas| r), centre, omega, el.m));
         let slab = Slab { r, centre, half };
-        applied.element(
-            cas,
-            &loads,
-            (k, k),
-            &mut |cas, fraction| along::Placed {
-                point: slab.end(cas, 2.0 * fraction - 1.0),
-                rotation: r,
-                omega,
-            },
-            &pairs,
-            symbols,
-        );
+        slab_loads.on(cas, (k, &slab, omega), &pairs, symbols);
 
         // Beam springs to the previous element (or the clamp), on centres
         // relative to the previous element's rest centre: the gap between
@@ -501,25 +479,72 @@ fn absolute_system(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols)
         segment_ends: Vec::new(),
         end_frames: Vec::new(),
         samples,
-        bases: match structure.contact_points {
-            0 => Vec::new(),
-            _ => vec![Sample::spatial(p0, q0)],
-        },
+        bases: (structure.contact_points > 0)
+            .then(|| Sample::spatial(p0, q0))
+            .into_iter()
+            .collect(),
         planar: None,
     };
-    // Element k's body is body k (the tip's, attached next, displaces
-    // nothing).
-    let body_link: Vec<usize> = (0..sys.bodies.len()).collect();
-    applied.attach(cas, &mut sys, symbols, &body_link);
+    slab_loads.attach(cas, &mut sys, symbols);
     let mount = TipMount {
         point: tip,
-        axis: [prev.r[0][0], prev.r[1][0], prev.r[2][0]],
+        axis: prev.r.map(|row| row[0]),
         omega,
         rotation: prev.r,
     };
     let loads = tip_loads(cas, symbols, structure, &mount);
     sys.attach_tip(loads, 0);
     sys
+}
+
+/// Loads along the arm (`[[load]]`, `[fluid]`) on eba's elements: each
+/// acts on its element's rigid slab, where the slab's contact points sit;
+/// the fluid drags each slab's centre.
+struct SlabLoads {
+    loads: Vec<along::AlongLoad>,
+    applied: Applied,
+}
+
+impl SlabLoads {
+    fn of(cas: &mut Cas, structure: &Structure, symbols: &ParamSymbols) -> Self {
+        let mut applied = Applied::default();
+        applied.drag = Drag::of(structure, symbols);
+        applied.buoyancy = (structure.fluid.is_some())
+            .then(|| symbols.get(Param::Fluid(FluidParam::Density)));
+        Self {
+            loads: along_loads(cas, structure, symbols),
+            applied,
+        }
+    }
+
+    /// The loads on element k, its slab turning at `omega`.
+    fn on(
+        &mut self,
+        cas: &mut Cas,
+        (k, slab, omega): (usize, &Slab, V3),
+        pairs: &[(ExprId, ExprId)],
+        symbols: &ParamSymbols,
+    ) {
+        self.applied.element(
+            cas,
+            &self.loads,
+            (k, k),
+            &mut |cas, fraction| along::Placed {
+                point: slab.end(cas, 2.0 * fraction - 1.0),
+                rotation: slab.r,
+                omega,
+            },
+            pairs,
+            symbols,
+        );
+    }
+
+    /// Into `sys`, whose body k is element k's (the tip's, attached
+    /// after, displaces nothing).
+    fn attach(self, cas: &mut Cas, sys: &mut System, symbols: &ParamSymbols) {
+        let body_link: Vec<usize> = (0..sys.bodies.len()).collect();
+        self.applied.attach(cas, sys, symbols, &body_link);
+    }
 }
 
 /// A slab's `points` contact points, on its centreline straight through
