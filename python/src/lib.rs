@@ -78,7 +78,7 @@ pub(crate) fn vector(name: &str, v: Option<PyReadonlyArray1<f64>>, n: usize) -> 
     let v = v.as_slice()?.to_vec();
     if v.len() != n {
         return Err(PyValueError::new_err(format!(
-            "{name} has {} values, where {n} are expected",
+            "{name} has {} values; the model has {n}",
             v.len()
         )));
     }
