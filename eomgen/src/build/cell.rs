@@ -651,15 +651,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     );
     let kin = LinkKinematics::new(
         cas,
-        Motion {
-            rotation: end.r,
-            end: end.p,
-            omega: end.w,
-            quat: end.quat,
-            centroid,
-            body_omega: omega,
-            axis,
-        },
+        Motion::ending(&end, centroid, omega, axis),
         [body.m, body.lateral, body.axial, stored],
         &q,
         &qd,
@@ -691,15 +683,7 @@ fn derive_kink_cell() -> [Tape; 3] {
     let end = compose(cas, &identity, Some((&r, &quat)), Some(&offset), None);
     let kin = LinkKinematics::new(
         cas,
-        Motion {
-            rotation: end.r,
-            end: end.p,
-            omega: end.w,
-            quat: end.quat,
-            centroid: [zero; 3],
-            body_omega: [zero; 3],
-            axis: [one, zero, zero],
-        },
+        Motion::ending(&end, [zero; 3], [zero; 3], [one, zero, zero]),
         [zero; 4],
         &[],
         &[],

@@ -9,7 +9,7 @@ use runtime::links::{cell, pose};
 
 use crate::cas::{Cas, ExprId, SymKind};
 
-use super::spatial::V3;
+use super::spatial::{Frame, V3};
 
 /// The tape of `out` followed by its directional derivative along (dx,
 /// dxd) of the coordinates `x` and rates `xd` (`SymKind::Dir` symbols:
@@ -49,6 +49,22 @@ pub(crate) struct Motion {
     pub body_omega: V3,
     /// The body's axis (its inertia is axisymmetric about it).
     pub axis: V3,
+}
+
+impl Motion {
+    /// A link ending on the frame `end`, its body's centroid, angular
+    /// velocity and axis.
+    pub fn ending(end: &Frame, centroid: V3, body_omega: V3, axis: V3) -> Self {
+        Motion {
+            rotation: end.r,
+            end: end.p,
+            omega: end.w,
+            quat: end.quat,
+            centroid,
+            body_omega,
+            axis,
+        }
+    }
 }
 
 /// A link's motion with the rates and convective accelerations a cell
