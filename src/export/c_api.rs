@@ -8,6 +8,7 @@ use std::fmt::Write;
 use runtime::relaxation::Relaxation;
 use runtime::{N_OUTPUTS, OUTPUT_NAMES, Tape, TapeSet};
 
+use super::c_contact::Contact;
 use super::c_tape::{self, literal};
 
 /// The support code every export carries (special functions, L D L^T).
@@ -31,6 +32,8 @@ pub struct Library<'a> {
     /// A viscoelastic model's relaxing groups: their relaxed forces are
     /// states after q and qd.
     pub relax: Option<&'a Relaxation>,
+    /// Obstacles, laws and pairs: the contact forces are applied forces.
+    pub contact: Option<Contact<'a>>,
 }
 
 /// A C identifier from any name: other characters become `_`, runs of
@@ -106,6 +109,10 @@ impl Library<'_> {
     pub fn nx(&self) -> usize {
         2 * self.n() + self.nz()
     }
+    /// Contact pairs: the FMU's event indicators are their gaps.
+    pub fn contact_pairs(&self) -> usize {
+        self.contact.as_ref().map_or(0, |c| c.set.pairs.len())
+    }
     fn groups(&self) -> usize {
         self.relax.map_or(0, |r| r.groups.len())
     }
@@ -143,7 +150,8 @@ impl Library<'_> {
             ("NSHAPE", self.shape.outputs.len() / SHAPE_ROW, "shape rows"),
             ("NINPUTS", self.inputs.len(), "parameters driven by inputs"),
         ];
-        for (name, v, what) in defines {
+        let contact = self.contact.iter().flat_map(|c| c.defines());
+        for (name, v, what) in defines.into_iter().chain(contact) {
             let _ = writeln!(h, "#define {up}_{name} {v} /* {what} */");
         }
         h.push_str("\n/* The model's parameters, named; ");
@@ -166,7 +174,8 @@ impl Library<'_> {
         let _ = writeln!(
             h,
             "/* Parameters (base, then derived) and workspace: one per thread. */\n\
-             typedef struct {{\n    double p[{ext}];\n{relaxing}    double work[{work}];\n}} {p}_model;\n",
+             typedef struct {{\n    double p[{ext}];\n{relaxing}{contact}    double work[{work}];\n}} {p}_model;\n",
+            contact = self.contact.as_ref().map_or(String::new(), |c| c.fields()),
         );
         h.push_str(&self.prototypes());
         let _ = writeln!(h, "\n#endif /* {up}_H */");
@@ -182,12 +191,23 @@ impl Library<'_> {
         // the differenced Jacobian's shifted state and its two slopes.
         let base = tri + n + n * n + n + 2 * n + 2 * n + n;
         let joints = m * (n + 2) + m * n + m * (m + 1) / 2 + m * m + m + m;
-        base + joints + self.relax_work() + 3 * self.nx() * self.differenced() + self.scratch_len()
+        let contact: usize = self.contact_work().iter().map(|(_, len)| len).sum();
+        base + joints
+            + self.relax_work()
+            + 3 * self.nx() * self.differenced()
+            + contact
+            + self.scratch_len()
     }
 
-    /// The Jacobian by central differences: with joints or relaxed forces.
+    /// The contact forces' workspace pieces (none without contact).
+    fn contact_work(&self) -> Vec<(&'static str, usize)> {
+        self.contact.iter().flat_map(|c| c.work()).collect()
+    }
+
+    /// The Jacobian by central differences: with joints, relaxed forces
+    /// or contact.
     fn differenced(&self) -> usize {
-        usize::from(self.m() > 0 || self.nz() > 0)
+        usize::from(self.m() > 0 || self.nz() > 0 || self.contact.is_some())
     }
 
     /// Workspace of the relaxed forces' rates: zero rates, the packed M
@@ -248,21 +268,38 @@ impl Library<'_> {
                  double *phi, double *jac, double *gamma);"
             );
         }
+        if let Some(c) = &self.contact {
+            h.push_str(&c.prototypes(p));
+        }
         h
     }
 
+    /// After `k_mass_bias` into PACKED: h less the contact forces.
+    fn contact_bias(&self) -> String {
+        let tri = self.n() * (self.n() + 1) / 2;
+        match self.contact {
+            Some(_) => format!("    contact_bias(m, t, q, qd, PACKED + {tri});\n"),
+            None => String::new(),
+        }
+    }
+
     /// The kernels by their C names.
-    fn kernels(&self) -> Vec<(&'static str, &Tape)> {
+    fn kernels(&self) -> Vec<(String, &Tape)> {
         let t = self.tapes;
-        let mut kernels = vec![
+        let mut kernels: Vec<(String, &Tape)> = [
             ("k_derived", &t.derived),
             ("k_mass_bias", &t.mass_bias),
             ("k_outputs", &t.outputs),
             ("k_jvp", &t.jvp),
             ("k_shape", self.shape),
-        ];
+        ]
+        .map(|(name, tape)| (name.to_string(), tape))
+        .into();
         if self.m() > 0 {
-            kernels.push(("k_constraints", &t.constraints));
+            kernels.push(("k_constraints".into(), &t.constraints));
+        }
+        if let Some(c) = &self.contact {
+            kernels.extend(c.kernels(t));
         }
         kernels
     }
@@ -302,10 +339,14 @@ impl Library<'_> {
         let mut code = SUPPORT.replace("/*INV_FACTORIALS*/", &inv.join(", "));
         code.push('\n');
         for (name, tape) in self.kernels() {
-            code.push_str(&c_tape::kernel(name, tape));
+            code.push_str(&c_tape::kernel(&name, tape));
             code.push('\n');
         }
         code.push_str(&self.workspace_macros());
+        if let Some(contact) = &self.contact {
+            let _ = writeln!(code, "#define MODEL {p}_model\n");
+            code.push_str(&contact.source(p));
+        }
         c.push_str(&own(&code));
         c.push_str(&self.names());
         c.push_str(&self.parameter_functions());
@@ -391,6 +432,9 @@ impl Library<'_> {
         );
         let _ = writeln!(c, "void {p}_init({p}_model *m, const {p}_params *v)\n{{");
         c.push_str("    memset(m, 0, sizeof *m);\n");
+        if self.contact.is_some() {
+            c.push_str("    contact_defaults(m);\n");
+        }
         for (i, f) in fields.iter().enumerate() {
             let _ = writeln!(c, "    m->p[{i}] = v->{f};");
         }
@@ -414,7 +458,7 @@ impl Library<'_> {
             c,
             "void {p}_mass_bias({p}_model *m, double t, const double *q, const double *qd,\n    \
              double *mass, double *bias)\n{{\n    size_t i, j;\n    \
-             k_mass_bias(t, q, qd, NULL, NULL, m->p, NULL, PACKED, SCRATCH);\n    \
+             k_mass_bias(t, q, qd, NULL, NULL, m->p, NULL, PACKED, SCRATCH);\n{contact}    \
              for (i = 0; i < {n}; i++) {{\n        bias[i] = PACKED[{tri} + i];\n        \
              for (j = i; j < {n}; j++)\n            \
              mass[i * {n} + j] = mass[j * {n} + i] = PACKED[sa_packed({n}, i, j)];\n    }}\n}}\n\n\
@@ -426,7 +470,8 @@ impl Library<'_> {
              const double *qd, const double *qdd, const double *dq, const double *dqd, double *dtau)\n{{\n    \
              memcpy(DIR, dq, {n} * sizeof(double));\n    \
              memcpy(DIR + {n}, dqd, {n} * sizeof(double));\n    \
-             k_jvp(t, q, qd, qdd, DIR, m->p, NULL, dtau, SCRATCH);\n}}\n"
+             k_jvp(t, q, qd, qdd, DIR, m->p, NULL, dtau, SCRATCH);\n}}\n",
+            contact = self.contact_bias(),
         );
         c.push_str(&self.relaxed_rates());
         c.push_str(&self.state_derivative());
@@ -478,7 +523,7 @@ impl Library<'_> {
         ];
         let mut c = String::new();
         let mut at = 0;
-        for (name, len) in pieces {
+        for (name, len) in pieces.into_iter().chain(self.contact_work()) {
             let _ = writeln!(c, "#define {name} (m->work + {at})");
             at += len;
         }
@@ -494,11 +539,12 @@ impl Library<'_> {
         let mut c = format!(
             "int {p}_state_derivative({p}_model *m, double t, const double *x, double *dx)\n{{\n    \
              const double *q = x, *qd = x + {n};\n    size_t i;\n    \
-             k_mass_bias(t, q, qd, NULL, NULL, m->p, NULL, PACKED, SCRATCH);\n    \
+             k_mass_bias(t, q, qd, NULL, NULL, m->p, NULL, PACKED, SCRATCH);\n{contact}    \
              if (sa_ldlt_factor({n}, PACKED, LOWER, PIVOTS)) return 1;\n    \
              for (i = 0; i < {n}; i++) {{\n        dx[i] = qd[i];\n        \
              dx[{n} + i] = -PACKED[{tri} + i];\n    }}\n{relaxed}    \
              sa_ldlt_solve({n}, LOWER, PIVOTS, dx + {n});\n",
+            contact = self.contact_bias(),
             relaxed = match self.nz() {
                 0 => String::new(),
                 nz => format!(

@@ -62,6 +62,9 @@ typedef struct {
     double out[NOUT];
     /* dx and out are those of (time, x, the parameters). */
     int fresh;
+#ifdef PFXU_NPAIRS
+    double normal[PFXU_NPAIRS + 1]; /* the pairs' normal forces, beside their gaps */
+#endif
 } Instance;
 
 static void say(Instance *c, fmi2Status status, const char *message)
@@ -137,7 +140,16 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tolerance_defined, f
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) { (void)c; return fmi2OK; }
-fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return update((Instance *)c); }
+fmi2Status fmi2ExitInitializationMode(fmi2Component c)
+{
+#ifdef PFXU_NPAIRS
+    /* The contact records of the initial state. */
+    Instance *i = (Instance *)c;
+    PFX_contact_update(&i->model, i->time, i->x);
+    i->fresh = 0;
+#endif
+    return update((Instance *)c);
+}
 fmi2Status fmi2Terminate(fmi2Component c) { (void)c; return fmi2OK; }
 fmi2Status fmi2Reset(fmi2Component c) { reset((Instance *)c); return fmi2OK; }
 
@@ -242,13 +254,24 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
     return fmi2Error;
 }
 
-/* Model exchange: continuous states, no events. */
+/* Model exchange: continuous states; with contact, a state event where a
+ * pair's gap changes sign, at which the pairs' records (the speed at
+ * which each began to touch) are brought up to date, as softarm does
+ * between its legs. */
 fmi2Status fmi2EnterEventMode(fmi2Component c) { (void)c; return fmi2OK; }
 
 fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info)
 {
-    (void)c;
     memset(info, 0, sizeof *info);
+#ifdef PFXU_NPAIRS
+    {
+        Instance *i = (Instance *)c;
+        PFX_contact_update(&i->model, i->time, i->x);
+        i->fresh = 0;
+    }
+#else
+    (void)c;
+#endif
     return fmi2OK;
 }
 
@@ -289,8 +312,15 @@ fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real dx[], size_t nx)
 
 fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real z[], size_t nz)
 {
+#ifdef PFXU_NPAIRS
+    Instance *i = (Instance *)c;
+    if (nz != PFXU_NPAIRS) return fmi2Error;
+    PFX_contact(&i->model, i->time, i->x, z, i->normal);
+    return fmi2OK;
+#else
     (void)c; (void)z;
     return nz ? fmi2Error : fmi2OK;
+#endif
 }
 
 fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx)

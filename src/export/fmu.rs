@@ -162,7 +162,7 @@ fn model_description(lib: &Library) -> String {
         "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n\
          <fmiModelDescription fmiVersion=\"2.0\" modelName=\"{model}\" guid=\"{{{hash}}}\" \
          description=\"softarm model {model}: the equations of motion by the TMT method\" \
-         generationTool=\"softarm {version}\" variableNamingConvention=\"flat\" numberOfEventIndicators=\"0\">\n  \
+         generationTool=\"softarm {version}\" variableNamingConvention=\"flat\" numberOfEventIndicators=\"{events}\">\n  \
          <ModelExchange modelIdentifier=\"{id}\" canGetAndSetFMUstate=\"false\" \
          canSerializeFMUstate=\"false\" providesDirectionalDerivative=\"false\">\n    \
          <SourceFiles>\n      <File name=\"{id}.c\"/>\n      <File name=\"fmi2.c\"/>\n    </SourceFiles>\n  \
@@ -173,6 +173,7 @@ fn model_description(lib: &Library) -> String {
          </fmiModelDescription>\n",
         model = xml(lib.model),
         hash = lib.hash,
+        events = lib.contact_pairs(),
         version = env!("CARGO_PKG_VERSION"),
         id = lib.prefix,
     )

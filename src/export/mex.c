@@ -15,7 +15,11 @@ static int ready = 0;
 static const char *USAGE =
     "PFX_mex(NAME, ...): NAME is state_derivative (t, x), jacobian (t, x), mass (t, q), "
     "bias (t, q, qd), outputs (t, q, qd), parameters (), set_parameter (i, value), "
-    "reset (), coordinate_names (), parameter_names (), output_names ()";
+    "reset (), coordinate_names (), parameter_names (), output_names ()"
+#ifdef PFXU_NPAIRS
+    ", contact (t, x), contact_update (t, x)"
+#endif
+    ;
 
 static void fail(const char *message) { mexErrMsgIdAndTxt("softarm:PFX", "%s", message); }
 
@@ -103,6 +107,25 @@ void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[])
         const double *q = values(nrhs, prhs, 2, PFXU_NQ, "q");
         const double *qd = values(nrhs, prhs, 3, PFXU_NQ, "qd");
         PFX_outputs(&model, t, q, qd, column(&plhs[0], PFXU_NOUTPUTS));
+#ifdef PFXU_NPAIRS
+    } else if (!strcmp(name, "contact")) {
+        /* Each pair's gap and normal force. */
+        double t = scalar(nrhs, prhs, 1, "t");
+        const double *x = values(nrhs, prhs, 2, PFXU_NX, "x");
+        double *gap = column(&plhs[0], PFXU_NPAIRS), *normal;
+        if (nlhs > 1) {
+            normal = column(&plhs[1], PFXU_NPAIRS);
+        } else {
+            static double unused[PFXU_NPAIRS + 1];
+            normal = unused;
+        }
+        PFX_contact(&model, t, x, gap, normal);
+    } else if (!strcmp(name, "contact_update")) {
+        /* The pairs' records, kept in this MEX function: call after each step. */
+        double t = scalar(nrhs, prhs, 1, "t");
+        const double *x = values(nrhs, prhs, 2, PFXU_NX, "x");
+        PFX_contact_update(&model, t, x);
+#endif
     } else if (!strcmp(name, "parameters")) {
         memcpy(column(&plhs[0], PFXU_NPARAMS), model.p, PFXU_NPARAMS * sizeof(double));
     } else if (!strcmp(name, "set_parameter")) {

@@ -40,12 +40,31 @@ pub fn write(lib: &Library, dir: &Path) -> Result<Vec<PathBuf>> {
         (format!("{p}_mex.c"), gateway),
         (format!("{p}_build.m"), build_script(p)),
     ];
-    for (name, args, what) in WRAPPERS {
+    let contact = [
+        (
+            "contact",
+            "t, x",
+            "each contact pair's gap (m); [gap, normal] also its normal force (N)",
+        ),
+        (
+            "contact_update",
+            "t, x",
+            "bring the contact records up to x: call it after each accepted step",
+        ),
+    ];
+    let contact = &contact[..2 * usize::from(lib.contact_pairs() > 0)];
+    for &(name, args, what) in WRAPPERS.iter().chain(contact) {
+        // One output, two (contact's) or none (contact_update's).
+        let (returns, call) = match name {
+            "contact_update" => ("", ""),
+            "contact" => ("[gap, normal] = ", "[gap, normal] = "),
+            _ => ("out = ", "out = "),
+        };
         let text = format!(
-            "function out = {p}_{name}({args})\n\
+            "function {returns}{p}_{name}({args})\n\
              %{upn}  {what}: softarm model {model}.\n\
              %   Compile once with {p}_build. See docs/export.md in softarm.\n\
-             out = {p}_mex('{name}', {args});\nend\n",
+             {call}{p}_mex('{name}', {args});\nend\n",
             upn = format!("{p}_{name}").to_ascii_uppercase(),
             model = lib.model,
         );

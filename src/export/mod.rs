@@ -7,9 +7,11 @@
 //! solves M qdd = -h by L D L^T (and the joints' rows by their Schur
 //! complement, as `runtime::constraints`), its Jacobian comes column by
 //! column from the inverse dynamics' directional derivative, as the
-//! runtime's. docs/export.md is the user's guide.
+//! runtime's. Contact (`c_contact`) subtracts J^T f from h as the runtime
+//! does. docs/export.md is the user's guide.
 
 mod c_api;
+mod c_contact;
 mod c_tape;
 mod fmu;
 mod mex;
@@ -82,12 +84,7 @@ pub fn export(
         );
     }
     let structure = Structure::of(&model);
-    if structure.contact_points > 0 {
-        bail!(
-            "{origin}: [contact]: the contact laws are not exported to C yet (only the \
-             equations without contact); remove [contact] and [[obstacle]] to export the rest"
-        );
-    }
+    let base = backend::base_dir(spec);
     let hash = structure.hash();
     let layout = ParamLayout::of(&structure);
     let (tapes, _, _) = backend::tapes(
@@ -99,7 +96,11 @@ pub fn export(
         bail!("{origin}: the cached kernels do not match this generator's parameter layout");
     }
     let values = layout.values(&model);
-    let base = backend::base_dir(spec);
+    let contact = crate::contact::contact_set(&model, &base, tapes.info.contact_points)
+        .with_context(|| format!("{origin}: contact"))?;
+    if let Some(why) = contact.as_ref().and_then(c_contact::refusal) {
+        bail!("{origin}: {why}");
+    }
     let drives = crate::inputs::model_drives(&model, &layout, &base)
         .with_context(|| format!("{origin}: reading the input channels"))?;
     let inputs: Vec<(usize, String)> = (drives.iter())
@@ -117,6 +118,7 @@ pub fn export(
         inputs: &inputs,
         shape: &shape.tape,
         relax: relax.as_ref(),
+        contact: (contact.as_ref()).map(|set| c_contact::Contact::new(set, &tapes.info)),
     };
     let mut files = Vec::new();
     if let Some(dir) = &targets.c {

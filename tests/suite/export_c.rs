@@ -82,12 +82,24 @@ fn rust_blocks(
     blocks.push(Block {
         name: "jacobian".into(),
         values,
-        tol: if joints || arm.internal_len() > 0 {
+        tol: if joints || arm.internal_len() > 0 || arm.contact().is_some() {
             DIFFERENCED_TOL
         } else {
             SOLVED_TOL
         },
     });
+    if let Some(set) = arm.contact() {
+        let forces = runtime::contact::pair_forces(arm, set, t, q, qd, true);
+        blocks.push(block("gaps", forces.iter().map(|f| f.gap).collect()));
+        blocks.push(Block {
+            name: "normal forces".into(),
+            values: forces.iter().map(|f| f.normal).collect(),
+            // From the velocities, which come through no solve: 1e-12 of
+            // the largest, but a pair at the surface may have no force on
+            // one side and round-off on the other.
+            tol: TOL,
+        });
+    }
     if joints {
         let c = runtime::constraints::evaluate(arm, t, q, qd);
         let jac: Vec<f64> = c.jac.transpose().iter().copied().collect();
@@ -104,7 +116,7 @@ fn driver(
     prefix: &str,
     params: &[f64],
     (n, states): (usize, &[Vec<f64>]),
-    joints: bool,
+    (joints, impact): (bool, Option<&[f64]>),
     t: f64,
 ) -> String {
     let p = prefix;
@@ -130,6 +142,13 @@ fn driver(
         "0.0 }};\n    for (i = 0; i < {}; i++) {p}_set_parameter(&m, i, base[i]);\n  }}",
         params.len()
     );
+    if let Some(impact) = impact {
+        // The pairs' records, as the Rust side has them.
+        for (i, v) in impact.iter().enumerate() {
+            let _ = writeln!(c, "  m.impact[{i}] = {v:?};");
+        }
+        let _ = writeln!(c, "  static double gap[{up}_NPAIRS], normal[{up}_NPAIRS];");
+    }
     for x in states {
         let _ = write!(c, "  {{ static const double x[] = {{");
         for v in x {
@@ -149,6 +168,12 @@ fn driver(
             "    if ({p}_state_jacobian(&m, {t:?}, x, jac)) return 4;\n    put(jac, {});",
             nx * nx
         );
+        if impact.is_some() {
+            let _ = writeln!(
+                c,
+                "    {p}_contact(&m, {t:?}, x, gap, normal); put(gap, {up}_NPAIRS); put(normal, {up}_NPAIRS);"
+            );
+        }
         if joints {
             let _ = writeln!(
                 c,
@@ -157,6 +182,20 @@ fn driver(
             );
         }
         c.push_str("  }\n");
+    }
+    if impact.is_some() {
+        // The records from none, brought up to the first state.
+        let _ = writeln!(
+            c,
+            "  {{\n    static const double x[] = {{{}0.0 }};\n    \
+             for (i = 0; i < {up}_NPAIRS; i++) {{ m.impact[i] = 0.0; m.touching[i] = 0; }}\n    \
+             {p}_contact_update(&m, {t:?}, x);\n    put(m.impact, {up}_NPAIRS);\n    \
+             for (i = 0; i < {up}_NPAIRS; i++) printf(\"%d\\n\", m.touching[i]);\n  }}",
+            states[0]
+                .iter()
+                .map(|v| format!("{v:?}, "))
+                .collect::<String>()
+        );
     }
     c.push_str("  (void)phi; (void)cj; (void)gamma; (void)jac;\n  return 0;\n}\n");
     c
@@ -193,6 +232,12 @@ fn check_export(model: &str, dir: &Path) {
 
 /// [`check_export`] of the model file `spec`.
 fn check_export_of(model: &str, spec: &Path, dir: &Path) {
+    check_export_spread(model, spec, dir, 0.3, false);
+}
+
+/// [`check_export_of`] at states whose coordinates lie within `spread`;
+/// `touching`: every obstacle, self contact and body pushes at some state.
+fn check_export_spread(model: &str, spec: &Path, dir: &Path, spread: f64, touching: bool) {
     let cache = dir.join("cache");
     let out = dir.join("c");
     let spec = spec.to_str().unwrap();
@@ -206,18 +251,36 @@ fn check_export_of(model: &str, spec: &Path, dir: &Path) {
     let mut rng = Rng::new(0x5eed ^ model.len() as u64);
     let states: Vec<Vec<f64>> = (0..STATES)
         .map(|_| {
-            let mut x = rng.coordinates(&arm.info().coordinates, -0.3, 0.3);
-            x.extend(rng.vec(n, -1.0, 1.0));
+            let mut x = rng.coordinates(&arm.info().coordinates, -spread, spread);
+            x.extend(rng.vec(n, -spread / 0.3, spread / 0.3));
             x.extend(rng.vec(arm.internal_len(), -1e-3, 1e-3));
             x
         })
         .collect();
     let params = arm.params_at(t)[..arm.info().parameters.len()].to_vec();
     let joints = !arm.info().constraints.is_empty();
+    // Each pair's impact speed, a record Hunt-Crossley from a restitution
+    // damps by (below the floor speed for some, which then holds).
+    let impact: Option<Vec<f64>> = arm.contact().map(|set| {
+        let pairs = set.pairs.len();
+        let impact = rng.vec(pairs, 0.0, 0.5);
+        set.set_state(runtime::contact::ContactState {
+            touching: vec![true; pairs],
+            impact: impact.clone(),
+            held: vec![false; pairs],
+        });
+        impact
+    });
     let main = out.join("driver.c");
     std::fs::write(
         &main,
-        driver(&export.prefix, &params, (n, &states), joints, t),
+        driver(
+            &export.prefix,
+            &params,
+            (n, &states),
+            (joints, impact.as_deref()),
+            t,
+        ),
     )
     .unwrap();
     let exe = out.join("driver");
@@ -241,6 +304,22 @@ fn check_export_of(model: &str, spec: &Path, dir: &Path) {
         run.status
     );
     let text = String::from_utf8(run.stdout).unwrap();
+    if let Some(set) = arm.contact().filter(|_| touching) {
+        // Every obstacle, self contact and body pushes at some state, so
+        // that each shape's and law's forces are compared.
+        let pushes = |channel: usize| {
+            states.iter().any(|x| {
+                let f = runtime::contact::pair_forces(arm, set, t, &x[..n], &x[n..2 * n], true);
+                (set.pairs.iter().zip(&f)).any(|(p, f)| p.channel == channel && f.normal > 0.0)
+            })
+        };
+        for (c, name) in set.channels.iter().enumerate() {
+            assert!(
+                pushes(c),
+                "{model}: nothing touches {name} at the test's states"
+            );
+        }
+    }
     let mut got = text.lines().map(|l| l.parse::<f64>().unwrap());
     for (k, x) in states.iter().enumerate() {
         for b in rust_blocks(arm, &shape, t, x) {
@@ -262,6 +341,30 @@ fn check_export_of(model: &str, spec: &Path, dir: &Path) {
             );
         }
     }
+    if let Some(set) = arm.contact() {
+        // `contact_update` from no records: a pair that touches records its
+        // speed of approach, as `ContactSet::update_records`.
+        let x = &states[0];
+        set.clear_records();
+        let forces = runtime::contact::pair_forces(arm, set, t, &x[..n], &x[n..2 * n], true);
+        set.update_records(&forces, &[]);
+        let state = set.state();
+        let flags = state.touching.iter().map(|&b| f64::from(u8::from(b)));
+        let rust: Vec<f64> = state.impact.iter().copied().chain(flags).collect();
+        let c: Vec<f64> = got.by_ref().take(rust.len()).collect();
+        assert!(
+            !touching || state.touching.iter().any(|&b| b),
+            "{model}: no pair touches"
+        );
+        let scale = rust.iter().fold(1e-300_f64, |m, v| m.max(v.abs()));
+        for (a, r) in c.iter().zip(&rust) {
+            assert!(
+                (a - r).abs() <= TOL * scale,
+                "{model}: records {c:?} against {rust:?}"
+            );
+        }
+        assert_eq!(c.len(), rust.len(), "{model}: records too short");
+    }
     assert!(
         got.next().is_none(),
         "{model}: the driver printed more than asked"
@@ -278,8 +381,7 @@ fn the_c_library_of_a_pcc_arm_a_rom_arm_and_joints_agrees_with_the_rust_kernels(
     }
 }
 
-/// Every bundled model the export takes (contact is refused with a
-/// reason, checked below).
+/// Every bundled model, contact included.
 #[test]
 #[ignore = "long (every bundled model compiled at -O2): run by .ci/run's long checks"]
 fn every_bundled_model_exports_c_that_agrees_with_the_rust_kernels() {
@@ -287,10 +389,6 @@ fn every_bundled_model_exports_c_that_agrees_with_the_rust_kernels() {
         let path = e.unwrap().path();
         let name = path.file_stem().unwrap().to_str().unwrap().to_string();
         let dir = tempfile::tempdir().unwrap();
-        let text = std::fs::read_to_string(&path).unwrap();
-        if text.contains("[contact]") {
-            continue;
-        }
         check_export(&name, dir.path());
     }
 }
@@ -313,14 +411,101 @@ fn a_viscoelastic_arms_relaxed_forces_are_exported_as_states() {
     check_export_of("relaxing_finger", &relaxing, dir.path());
 }
 
+/// A 3D arm among obstacles of every shape (a plane, a sphere, a capped
+/// cylinder and a turned box, each crossing the arm's reach) with self
+/// contact, and two arms and a ball on a floor (point-on-body pairs):
+/// each pair's gap and normal force, h less J^T f and the accelerations
+/// equal the Rust contact forces' at random states, with random impact
+/// records (Hunt-Crossley from a restitution damps by them).
+#[test]
+fn contact_is_exported_for_every_shape_self_contact_and_bodies() {
+    let dir = tempfile::tempdir().unwrap();
+    let among = dir.path().join("among_obstacles.toml");
+    std::fs::write(&among, AMONG_OBSTACLES).unwrap();
+    check_export_spread("among_obstacles", &among, dir.path(), 0.3, true);
+    // ball_drop's floor raised into the arms' reach.
+    let dir = tempfile::tempdir().unwrap();
+    let drop = std::fs::read_to_string(root().join("models/ball_drop.toml")).unwrap();
+    let raised = drop.replace("point = [0.0, -0.7, 0.0]", "point = [0.0, -0.05, 0.0]");
+    assert_ne!(raised, drop);
+    let spec = dir.path().join("ball_drop.toml");
+    std::fs::write(&spec, raised).unwrap();
+    // Near its straight arms, the ball by their bases (its coordinates are
+    // its place), slowly: a Hunt-Crossley contact leaving fast pushes not.
+    check_export_spread("ball_drop", &spec, dir.path(), 0.05, true);
+}
+
+/// A 3D pcc arm along x reaching through four obstacles, with self
+/// contact and friction.
+const AMONG_OBSTACLES: &str = r#"
+name = "among_obstacles"
+dimensions = 3
+gravity = [0.0, 0.0, -9.81]
+
+[base]
+direction = [1.0, 0.0, 0.0]
+
+[[segment]]
+method = "pcc"
+length = 0.2
+elements = 8
+outer_radius = 0.02
+density = 1100.0
+youngs_modulus = 1.0e6
+bending_damping = 1.0e-4
+
+[[obstacle]]
+name = "floor"
+shape = "plane"
+point = [0.0, 0.0, -0.004]
+normal = [0.1, 0.0, 1.0]
+
+[[obstacle]]
+name = "ball"
+shape = "sphere"
+center = [0.1, 0.01, 0.0]
+radius = 0.03
+
+[[obstacle]]
+name = "post"
+shape = "cylinder"
+center = [0.15, 0.0, 0.0]
+axis = [0.0, 0.6, 0.8]
+radius = 0.012
+length = 0.05
+
+[[obstacle]]
+name = "block"
+shape = "box"
+center = [0.19, 0.0, 0.01]
+size = [0.03, 0.04, 0.02]
+orientation = [0.9238795325112867, 0.0, 0.0, 0.3826834323650898]
+contact = { model = "hertz", stiffness = 3.0e4 }
+
+[contact]
+model = "hunt_crossley"
+stiffness = 2.0e4
+exponent = 1.5
+restitution = 0.3
+friction = 0.6
+slip_velocity = 1.0e-3
+points_per_element = 2
+self_contact = true
+"#;
+
 /// What the export cannot carry yet is refused with the key and the
 /// reason, and nothing is written.
 #[test]
 fn what_the_export_cannot_carry_is_refused_and_nothing_is_written() {
     let dir = tempfile::tempdir().unwrap();
-    let contact = root().join("models/finger_tap.toml");
+    // The impulse law: a velocity jump, then a held constraint.
+    let impulse = dir.path().join("impulse.toml");
+    let tap = std::fs::read_to_string(root().join("models/finger_tap.toml")).unwrap();
+    let impulse_text = tap.replace("model = \"hunt_crossley\"", "model = \"impulse\"");
+    assert_ne!(impulse_text, tap);
+    std::fs::write(&impulse, impulse_text).unwrap();
     {
-        let (spec, key) = (contact.as_path(), "[contact]");
+        let (spec, key) = (impulse.as_path(), "[contact]");
         let out = dir.path().join("c");
         let err = softarm::export::export_c(
             spec.to_str().unwrap(),
