@@ -9,6 +9,7 @@ use runtime::relaxation::Relaxation;
 use runtime::{N_OUTPUTS, OUTPUT_NAMES, Tape, TapeSet};
 
 use super::c_contact::Contact;
+use super::c_links::Links;
 use super::c_tape::{self, literal};
 
 /// The support code every export carries (special functions, L D L^T).
@@ -34,6 +35,9 @@ pub struct Library<'a> {
     pub relax: Option<&'a Relaxation>,
     /// Obstacles, laws and pairs: the contact forces are applied forces.
     pub contact: Option<Contact<'a>>,
+    /// A chain the link recursion covers: its cells and the recursion give
+    /// M and h, their tangent and the outputs.
+    pub links: Option<Links<'a>>,
 }
 
 /// A C identifier from any name: other characters become `_`, runs of
@@ -286,15 +290,19 @@ impl Library<'_> {
     /// The kernels by their C names.
     fn kernels(&self) -> Vec<(String, &Tape)> {
         let t = self.tapes;
-        let mut kernels: Vec<(String, &Tape)> = [
-            ("k_derived", &t.derived),
-            ("k_mass_bias", &t.mass_bias),
-            ("k_outputs", &t.outputs),
-            ("k_jvp", &t.jvp),
-            ("k_shape", self.shape),
-        ]
-        .map(|(name, tape)| (name.to_string(), tape))
-        .into();
+        let mut kernels: Vec<(String, &Tape)> = vec![("k_derived".into(), &t.derived)];
+        match &self.links {
+            Some(links) => kernels.extend(links.kernels()),
+            None => kernels.extend(
+                [
+                    ("k_mass_bias", &t.mass_bias),
+                    ("k_outputs", &t.outputs),
+                    ("k_jvp", &t.jvp),
+                ]
+                .map(|(name, tape)| (name.to_string(), tape)),
+            ),
+        }
+        kernels.push(("k_shape".into(), self.shape));
         if self.m() > 0 {
             kernels.push(("k_constraints".into(), &t.constraints));
         }
@@ -310,7 +318,9 @@ impl Library<'_> {
             .kernels()
             .into_iter()
             .map(|(_, tape)| c_tape::scratch(tape));
-        sizes.max().unwrap_or(0).max(1)
+        let tapes = sizes.max().unwrap_or(0);
+        let recursion = (self.links.as_ref()).map_or(0, |l| l.scratch(l.cells_scratch()));
+        tapes.max(recursion).max(1)
     }
 
     /// `<prefix>.c`.
@@ -341,6 +351,9 @@ impl Library<'_> {
         for (name, tape) in self.kernels() {
             code.push_str(&c_tape::kernel(&name, tape));
             code.push('\n');
+        }
+        if let Some(links) = &self.links {
+            code.push_str(&links.source());
         }
         code.push_str(&self.workspace_macros());
         if let Some(contact) = &self.contact {

@@ -12,6 +12,7 @@
 
 mod c_api;
 mod c_contact;
+mod c_links;
 mod c_tape;
 mod fmu;
 mod mex;
@@ -108,6 +109,17 @@ pub fn export(
         .collect();
     let shape = eomgen::shape::shape_tape(&structure, 1);
     let relax = backend::relaxation(&model, &layout);
+    // A chain whose full derivation keeps flat kernels but whose every
+    // element is a link cell (a kink, say) still exports as its cells: the
+    // linked route's own derivation, on the same base parameters.
+    let derived_links = match (&tapes.links, contact.is_some()) {
+        (None, false) => eomgen::derive::derive_links(&structure)
+            .filter(|(info, _)| info.parameters == tapes.info.parameters)
+            .map(|(_, links)| links),
+        _ => None,
+    };
+    let links = c_links::Links::of(&tapes)
+        .or_else(|| (derived_links.as_ref()).map(|l| c_links::Links::new(l, tapes.info.dof())));
     let prefix = c_api::identifier(&model.name);
     let library = c_api::Library {
         prefix: &prefix,
@@ -119,6 +131,7 @@ pub fn export(
         shape: &shape.tape,
         relax: relax.as_ref(),
         contact: (contact.as_ref()).map(|set| c_contact::Contact::new(set, &tapes.info)),
+        links,
     };
     let mut files = Vec::new();
     if let Some(dir) = &targets.c {

@@ -1,0 +1,496 @@
+/* The link recursion (softarm's runtime_kernels::links): a chain's world
+ * frame composed link by link from each link's cell, the bodies' inertial
+ * and gravity forces, and the wrench past each link projected on its
+ * coordinates' twists. One sweep gives tau = M qdd + h and, in dual
+ * numbers through the cells' tangents, its directional derivative along
+ * (dq, dqd) (links/tangent.rs); M column by column from the inertial
+ * part alone; the outputs by a sweep over the pose cells (links/outputs.rs).
+ * The layout (LINK_*, TERM_*, the base, the tip) is the model's, above. */
+
+typedef struct {
+    double v, d;
+} sa_dual;
+typedef struct {
+    sa_dual c[3];
+} sa_d3;
+
+static sa_dual sa_dc(double v) { sa_dual r; r.v = v; r.d = 0.0; return r; }
+static sa_dual sa_dadd(sa_dual a, sa_dual b) { a.v += b.v; a.d += b.d; return a; }
+static sa_dual sa_dsub(sa_dual a, sa_dual b) { a.v -= b.v; a.d -= b.d; return a; }
+static sa_dual sa_dmul(sa_dual a, sa_dual b)
+{
+    sa_dual r;
+    r.v = a.v * b.v;
+    r.d = a.d * b.v + a.v * b.d;
+    return r;
+}
+static sa_d3 sa_zero3(void) { sa_d3 r; memset(&r, 0, sizeof r); return r; }
+static sa_d3 sa_add3(sa_d3 a, sa_d3 b)
+{
+    int k;
+    for (k = 0; k < 3; k++) a.c[k] = sa_dadd(a.c[k], b.c[k]);
+    return a;
+}
+static sa_d3 sa_sub3(sa_d3 a, sa_d3 b)
+{
+    int k;
+    for (k = 0; k < 3; k++) a.c[k] = sa_dsub(a.c[k], b.c[k]);
+    return a;
+}
+static sa_d3 sa_scale3(sa_dual s, sa_d3 a)
+{
+    int k;
+    for (k = 0; k < 3; k++) a.c[k] = sa_dmul(s, a.c[k]);
+    return a;
+}
+static sa_dual sa_ddot(sa_d3 a, sa_d3 b)
+{
+    return sa_dadd(sa_dadd(sa_dmul(a.c[0], b.c[0]), sa_dmul(a.c[1], b.c[1])), sa_dmul(a.c[2], b.c[2]));
+}
+static sa_d3 sa_dcross(sa_d3 a, sa_d3 b)
+{
+    sa_d3 r;
+    r.c[0] = sa_dsub(sa_dmul(a.c[1], b.c[2]), sa_dmul(a.c[2], b.c[1]));
+    r.c[1] = sa_dsub(sa_dmul(a.c[2], b.c[0]), sa_dmul(a.c[0], b.c[2]));
+    r.c[2] = sa_dsub(sa_dmul(a.c[0], b.c[1]), sa_dmul(a.c[1], b.c[0]));
+    return r;
+}
+/* r (rows r[0..3]) times v. */
+static sa_d3 sa_dmatvec(const sa_d3 *r, sa_d3 v)
+{
+    sa_d3 o;
+    int k;
+    for (k = 0; k < 3; k++) o.c[k] = sa_ddot(r[k], v);
+    return o;
+}
+/* Axisymmetric inertia applied to w. */
+static sa_d3 sa_apply_body(sa_dual lateral, sa_dual axial, sa_d3 axis, sa_d3 w)
+{
+    return sa_add3(sa_scale3(lateral, w), sa_scale3(sa_dmul(sa_dsub(axial, lateral), sa_ddot(axis, w)), axis));
+}
+/* a + alpha x r + w x (w x r) + 2 w x rate + accel. */
+static sa_d3 sa_point_accel(sa_d3 a, sa_d3 alpha, sa_d3 w, sa_d3 r, sa_d3 rate, sa_d3 accel)
+{
+    return sa_add3(sa_add3(sa_add3(a, sa_dcross(alpha, r)), sa_dcross(w, sa_dcross(w, r))),
+                   sa_add3(sa_scale3(sa_dc(2.0), sa_dcross(w, rate)), accel));
+}
+
+/* Output i of a cell's tangent (len values, then their derivatives). */
+static sa_dual sa_cell_dual(const double *out, size_t len, size_t i)
+{
+    sa_dual r;
+    r.v = out[i];
+    r.d = out[len + i];
+    return r;
+}
+static sa_d3 sa_cell_v3(const double *out, size_t len, size_t i)
+{
+    sa_d3 r;
+    int k;
+    for (k = 0; k < 3; k++) r.c[k] = sa_cell_dual(out, len, i + (size_t)k);
+    return r;
+}
+
+/* What the sweep back needs of a link (links/tangent.rs' LinkForces). */
+typedef struct {
+    sa_d3 centroid, force, torque;
+    sa_d3 twist_w[LINK_MAX_DOF], twist_v[LINK_MAX_DOF], own_w[LINK_MAX_DOF], own_v[LINK_MAX_DOF];
+    sa_dual local_force[LINK_MAX_DOF];
+} sa_link;
+
+/* Doubles a link's record takes in the workspace. */
+#define SA_LINK_DOUBLES ((sizeof(sa_link) + sizeof(double) - 1) / sizeof(double))
+
+/* The workspace LINK_RECORD counts for a record must hold it. */
+typedef char sa_link_record_fits[SA_LINK_DOUBLES <= LINK_RECORD ? 1 : -1];
+
+/* The frame a link starts from. */
+typedef struct {
+    sa_d3 r[3], pos, omega, alpha, acc;
+} sa_frame;
+
+/* A link's cell coordinates from the arm's v (each its terms' combination,
+ * scaled). */
+static void sa_local(size_t k, const double *p, const double *v, double *x)
+{
+    size_t f, i;
+    for (f = 0; f < LINK_MAX_DOF; f++) x[f] = 0.0;
+    for (f = 0; f < LINK_DOF[k]; f++) {
+        size_t at = LINK_TERMS[k][f];
+        double s = 0.0, sc = LINK_SCALE[k][f] < 0 ? 1.0 : p[LINK_SCALE[k][f]];
+        for (i = TERM_START[at]; i < TERM_START[at + 1]; i++) s += TERM_WEIGHT[i] * v[TERM_COORD[i]];
+        x[f] = sc * s;
+    }
+}
+
+/* Link k's cell parameters: its element parameters, its segment's
+ * actuation loads (zero where none act), its rest strains. */
+static void sa_link_params(size_t k, const double *p, const double *loads, double *v)
+{
+    size_t i;
+    for (i = 0; i < LINK_ELEMENT_PARAMS; i++) v[i] = p[LINK_PARAM[k][i]];
+    for (i = 0; i < LINK_ACTUATION; i++)
+        v[LINK_ELEMENT_PARAMS + i] = LINK_LOAD[k] < 0 ? 0.0 : loads[3 * LINK_LOAD[k] + i];
+    for (i = 0; i < LINK_REST_PARAMS; i++)
+        v[LINK_ELEMENT_PARAMS + LINK_ACTUATION + i] = p[LINK_PARAM[k][LINK_ELEMENT_PARAMS + i]];
+}
+
+/* The base frame's rotation (rows) and quaternion. */
+static void sa_base(const double *p, double r[3][3], double quat[4])
+{
+    int i, j;
+    if (BASE_ANGLE >= 0) {
+        double a = p[BASE_ANGLE], s = sin(a), c = cos(a);
+        double rows[3][3] = {{c, -s, 0.0}, {s, c, 0.0}, {0.0, 0.0, 1.0}};
+        memcpy(r, rows, sizeof rows);
+        quat[0] = cos(0.5 * a);
+        quat[1] = quat[2] = 0.0;
+        quat[3] = sin(0.5 * a);
+        return;
+    }
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) r[i][j] = p[BASE_ROTATION[3 * i + j]];
+    for (i = 0; i < 4; i++) quat[i] = p[BASE_QUATERNION[i]];
+}
+
+/* One link of the sweep out (links/tangent.rs' link_forward). */
+static void sa_link_forward(sa_frame *frame, const double *out, size_t nc, const double *xdd,
+                            const sa_dual *inertia_rates, sa_d3 gravity, sa_link *l)
+{
+    size_t len = LINK_CELL_LEN(nc), f;
+    sa_d3 rel[3], d, dd, cen, cend, w_rel, w_b, axis, ddd, w_rel_d, cendd, w_b_d, end, body_a, body_w,
+        body_alpha, iw, torque;
+    sa_dual m = sa_cell_dual(out, len, LINK_MASS), lateral = sa_cell_dual(out, len, LINK_MASS + 1),
+            axial = sa_cell_dual(out, len, LINK_MASS + 2);
+    sa_frame f0 = *frame;
+    int i;
+    for (i = 0; i < 3; i++) rel[i] = sa_cell_v3(out, len, LINK_ROTATION + 3 * (size_t)i);
+#define TURN(at) sa_dmatvec(f0.r, sa_cell_v3(out, len, (at)))
+    d = TURN(LINK_END);
+    dd = TURN(LINK_END + 3);
+    cen = TURN(LINK_CENTROID);
+    cend = TURN(LINK_CENTROID + 3);
+    w_rel = TURN(LINK_OMEGA);
+    w_b = TURN(LINK_BODY_OMEGA);
+    axis = TURN(LINK_AXIS);
+    ddd = TURN(LINK_END + 6);
+    w_rel_d = TURN(LINK_OMEGA + 3);
+    cendd = TURN(LINK_CENTROID + 6);
+    w_b_d = TURN(LINK_BODY_OMEGA + 3);
+    end = sa_add3(f0.pos, d);
+    for (f = 0; f < LINK_MAX_DOF; f++) {
+        l->twist_w[f] = l->twist_v[f] = l->own_w[f] = l->own_v[f] = sa_zero3();
+        l->local_force[f] = sa_dc(0.0);
+    }
+    for (f = 0; f < nc; f++) {
+        size_t col = LINK_COLUMNS + 12 * f;
+        sa_d3 s_w = TURN(col), v_end = TURN(col + 3);
+        sa_dual a = sa_dc(xdd[f]);
+        ddd = sa_add3(ddd, sa_scale3(a, v_end));
+        w_rel_d = sa_add3(w_rel_d, sa_scale3(a, s_w));
+        cendd = sa_add3(cendd, sa_scale3(a, TURN(col + 9)));
+        w_b_d = sa_add3(w_b_d, sa_scale3(a, TURN(col + 6)));
+        l->twist_w[f] = s_w;
+        l->twist_v[f] = sa_sub3(v_end, sa_dcross(s_w, end));
+        l->own_w[f] = TURN(col + 6);
+        l->own_v[f] = TURN(col + 9);
+        l->local_force[f] = sa_cell_dual(out, len, LINK_COLUMNS + 12 * nc + f);
+    }
+#undef TURN
+    body_a = sa_point_accel(f0.acc, f0.alpha, f0.omega, cen, cend, cendd);
+    body_w = sa_add3(f0.omega, w_b);
+    body_alpha = sa_add3(sa_add3(f0.alpha, sa_dcross(f0.omega, w_b)), w_b_d);
+    iw = sa_apply_body(lateral, axial, axis, body_w);
+    torque = sa_add3(sa_apply_body(lateral, axial, axis, body_alpha), sa_dcross(body_w, iw));
+    if (inertia_rates) {
+        /* The torque I' w and -|w|^2 dI/dx / 2 of an inertia that changes. */
+        sa_dual i_dot = sa_dc(0.0), half_w2 = sa_dmul(sa_dc(0.5), sa_ddot(body_w, body_w));
+        size_t rates = LINK_COLUMNS + 13 * nc;
+        for (f = 0; f < nc; f++) i_dot = sa_dadd(i_dot, sa_dmul(sa_cell_dual(out, len, rates + f), inertia_rates[f]));
+        torque = sa_add3(torque, sa_scale3(i_dot, body_w));
+        for (f = 0; f < nc; f++)
+            l->local_force[f] = sa_dsub(l->local_force[f], sa_dmul(half_w2, sa_cell_dual(out, len, rates + f)));
+    }
+    l->centroid = sa_add3(f0.pos, cen);
+    l->force = sa_scale3(m, sa_sub3(body_a, gravity));
+    l->torque = torque;
+    for (i = 0; i < 3; i++) {
+        sa_d3 col;
+        int j;
+        for (j = 0; j < 3; j++) col.c[j] = rel[j].c[i];
+        for (j = 0; j < 3; j++) frame->r[j].c[i] = sa_ddot(f0.r[j], col);
+    }
+    frame->pos = end;
+    frame->omega = sa_add3(f0.omega, w_rel);
+    frame->alpha = sa_add3(sa_add3(f0.alpha, sa_dcross(f0.omega, w_rel)), w_rel_d);
+    frame->acc = sa_point_accel(f0.acc, f0.alpha, f0.omega, d, dd, ddd);
+}
+
+/* The wrench (moment about the world origin, force) of what hangs on the
+ * end frame: the tip body's inertial and gravity forces and the tip loads,
+ * as forces of the opposite sign (links/tangent.rs' tip_wrench). */
+static void sa_tip_wrench(const sa_frame *fr, const double *p, sa_d3 gravity, int inertial, sa_d3 *moment,
+                          sa_d3 *force)
+{
+    sa_d3 axis, point, tip_f = sa_zero3(), tip_m = sa_zero3();
+    sa_dual length = sa_dc(TIP_LENGTH < 0 ? 0.0 : p[TIP_LENGTH]);
+    int k;
+    for (k = 0; k < 3; k++) axis.c[k] = fr->r[k].c[0];
+    point = sa_add3(fr->pos, sa_scale3(length, axis));
+    *moment = *force = sa_zero3();
+    if (TIP_MASS >= 0) {
+        sa_dual m = sa_dc(p[TIP_MASS]);
+        sa_d3 offset = sa_scale3(sa_dmul(sa_dc(0.5), length), axis), centre = sa_add3(fr->pos, offset);
+        sa_dual lateral = sa_dc(TIP_LATERAL < 0 ? 0.0 : p[TIP_LATERAL]);
+        sa_dual axial = sa_dc(TIP_AXIAL < 0 ? 0.0 : p[TIP_AXIAL]);
+        sa_d3 a_c = sa_point_accel(fr->acc, fr->alpha, fr->omega, offset, sa_zero3(), sa_zero3());
+        sa_d3 iw = sa_apply_body(lateral, axial, axis, fr->omega), torque;
+        *force = sa_scale3(m, sa_sub3(a_c, gravity));
+        torque = sa_add3(sa_apply_body(lateral, axial, axis, fr->alpha), sa_dcross(fr->omega, iw));
+        *moment = sa_add3(torque, sa_dcross(centre, *force));
+    }
+    if (inertial) return;
+    for (k = 0; k < 3; k++) {
+        if (TIP_FORCE[k] >= 0) tip_f.c[k] = sa_dc(-p[TIP_FORCE[k]]);
+        if (TIP_MOMENT[k] >= 0) tip_m.c[k] = sa_dc(-p[TIP_MOMENT[k]]);
+    }
+    if (TIP_FRAME) {
+        tip_f = sa_dmatvec(fr->r, tip_f);
+        tip_m = sa_dmatvec(fr->r, tip_m);
+    }
+    *moment = sa_add3(*moment, sa_add3(sa_dcross(point, tip_f), tip_m));
+    *force = sa_add3(*force, tip_f);
+}
+
+/* tau = M qdd + h into tau and its derivative along dir = (dq, dqd) into
+ * dtau (links/tangent.rs' inverse_dynamics_tangent); `inertial`: M qdd
+ * alone (no gravity, springs, dampers or loads: at qd = 0, a column of M
+ * for a unit qdd). w: LINKS_WORK values, then the cells' scratch. */
+static void links_inverse_dynamics(double t, const double *q, const double *qd, const double *qdd,
+                                   const double *dir, const double *p, int inertial, double *tau,
+                                   double *dtau, double *w)
+{
+    /* Each link's record, copied in and out (the workspace is doubles). */
+    double *links = w, *loads = links + LINK_COUNT * SA_LINK_DOUBLES, *out = loads + 3 * LINK_LOADS + 1;
+    double *f = out + 2 * LINK_CELL_LEN(LINK_MAX_DOF), *scratch = f + 2 * NQ_LINKS;
+    double cp[LINK_CELL_PARAMS], x[LINK_MAX_DOF], xd[LINK_MAX_DOF], xdd[LINK_MAX_DOF];
+    double dx[2 * LINK_MAX_DOF];
+    double base[3][3], quat[4];
+    sa_frame frame;
+    sa_d3 gravity, moment, force;
+    sa_dual t_acc[NQ_LINKS];
+    size_t k, i, c;
+    for (i = 0; i < 3; i++) gravity.c[i] = sa_dc(inertial ? 0.0 : p[GRAVITY[i]]);
+    sa_base(p, base, quat);
+    for (i = 0; i < 3; i++) {
+        for (c = 0; c < 3; c++) frame.r[i].c[c] = sa_dc(base[i][c]);
+        frame.pos.c[i] = sa_dc(p[BASE_POSITION[i]]);
+    }
+    frame.omega = frame.alpha = frame.acc = sa_zero3();
+    links_loads(t, q, qd, p, loads, scratch);
+    for (k = 0; k < LINK_COUNT; k++) {
+        size_t nc = LINK_DOF[k];
+        sa_dual rates[LINK_MAX_DOF];
+        sa_link l;
+        sa_link_params(k, p, loads, cp);
+        sa_local(k, p, q, x);
+        sa_local(k, p, qd, xd);
+        sa_local(k, p, qdd, xdd);
+        /* The cell's direction: the coordinates' then the rates'. */
+        {
+            double dq_local[LINK_MAX_DOF], dqd_local[LINK_MAX_DOF];
+            sa_local(k, p, dir, dq_local);
+            sa_local(k, p, dir + NQ_LINKS, dqd_local);
+            for (i = 0; i < nc; i++) {
+                dx[i] = dq_local[i];
+                dx[nc + i] = dqd_local[i];
+            }
+            for (i = 0; i < nc; i++) {
+                rates[i].v = xd[i];
+                rates[i].d = dqd_local[i];
+            }
+        }
+        cell_tangent(LINK_CELL[k], x, xd, dx, cp, out, scratch);
+        sa_link_forward(&frame, out, nc, xdd, VARIABLE_INERTIA ? rates : NULL, gravity, &l);
+        if (inertial)
+            for (i = 0; i < nc; i++) l.local_force[i] = sa_dc(0.0);
+        memcpy(links + k * SA_LINK_DOUBLES, &l, sizeof l);
+    }
+    sa_tip_wrench(&frame, p, gravity, inertial, &moment, &force);
+    for (i = 0; i < NQ_LINKS; i++) t_acc[i] = sa_dc(0.0);
+    for (k = LINK_COUNT; k-- > 0;) {
+        sa_link link;
+        const sa_link *l = &link;
+        size_t fi;
+        memcpy(&link, links + k * SA_LINK_DOUBLES, sizeof link);
+        for (fi = 0; fi < LINK_DOF[k]; fi++) {
+            size_t at = LINK_TERMS[k][fi];
+            sa_dual g = sa_dadd(sa_dadd(sa_dadd(sa_dadd(sa_ddot(l->twist_w[fi], moment), sa_ddot(l->twist_v[fi], force)),
+                                                sa_ddot(l->own_v[fi], l->force)),
+                                        sa_ddot(l->own_w[fi], l->torque)),
+                                l->local_force[fi]);
+            double sc = LINK_SCALE[k][fi] < 0 ? 1.0 : p[LINK_SCALE[k][fi]];
+            for (i = TERM_START[at]; i < TERM_START[at + 1]; i++)
+                t_acc[TERM_COORD[i]] = sa_dadd(t_acc[TERM_COORD[i]], sa_dmul(sa_dc(sc * TERM_WEIGHT[i]), g));
+        }
+        moment = sa_add3(moment, sa_add3(l->torque, sa_dcross(l->centroid, l->force)));
+        force = sa_add3(force, l->force);
+    }
+    for (i = 0; i < NQ_LINKS; i++) {
+        tau[i] = t_acc[i].v;
+        dtau[i] = t_acc[i].d;
+    }
+    if (LINK_FORCES && !inertial) {
+        links_forces_tangent(t, q, qd, qdd, dir, p, f, scratch);
+        for (i = 0; i < NQ_LINKS; i++) {
+            tau[i] += f[i];
+            dtau[i] += f[NQ_LINKS + i];
+        }
+    }
+}
+
+/* The Hamilton product a b (w, x, y, z) into o. */
+static void sa_quat_mul(const double *a, const double *b, double *o)
+{
+    o[0] = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
+    o[1] = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2];
+    o[2] = a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1];
+    o[3] = a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0];
+}
+static double sa_dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void sa_cross(const double *a, const double *b, double *o)
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+/* r (rows) times v into o. */
+static void sa_turn(double r[3][3], const double *v, double *o)
+{
+    int i;
+    for (i = 0; i < 3; i++) o[i] = sa_dot(r[i], v);
+}
+/* Kinetic energy of a body of mass m, axisymmetric inertia about axis,
+ * moving at (v, w). */
+static double sa_kinetic(double m, double lateral, double axial, const double *axis, const double *v,
+                         const double *w)
+{
+    double aw = sa_dot(axis, w), iw[3];
+    int k;
+    for (k = 0; k < 3; k++) iw[k] = lateral * w[k] + (axial - lateral) * aw * axis[k];
+    return 0.5 * (m * sa_dot(v, v) + sa_dot(w, iw));
+}
+
+/* Tip position, kinetic and potential energy, tip quaternion by a sweep
+ * over the pose cells (links/outputs.rs). */
+static void links_outputs(double t, const double *q, const double *qd, const double *p, double *out,
+                          double *w)
+{
+    double *loads = w, *o = loads + 3 * LINK_LOADS + 1, *scratch = o + LINK_POSE_LEN;
+    double r[3][3], quat[4], pos[3], v[3] = {0.0, 0.0, 0.0}, omega[3] = {0.0, 0.0, 0.0}, ke = 0.0, pe = 0.0;
+    double gravity[3], cp[LINK_CELL_PARAMS], x[LINK_MAX_DOF], xd[LINK_MAX_DOF], axis[3], point[3], length;
+    size_t k;
+    int i, j;
+    for (i = 0; i < 3; i++) {
+        gravity[i] = p[GRAVITY[i]];
+        pos[i] = p[BASE_POSITION[i]];
+    }
+    sa_base(p, r, quat);
+    links_loads(t, q, qd, p, loads, scratch);
+    for (k = 0; k < LINK_COUNT; k++) {
+        double rel[3][3], d[3], dd[3], w_rel[3], cen[3], cend[3], w_b[3], ax[3], body_v[3], body_w[3], c1[3],
+            next[3][3], q2[4], m;
+        sa_link_params(k, p, loads, cp);
+        sa_local(k, p, q, x);
+        sa_local(k, p, qd, xd);
+        cell_pose(LINK_CELL[k], x, xd, cp, o, scratch);
+        for (i = 0; i < 3; i++)
+            for (j = 0; j < 3; j++) rel[i][j] = o[POSE_ROTATION + 3 * i + j];
+        sa_turn(r, o + POSE_END, d);
+        sa_turn(r, o + POSE_END + 3, dd);
+        sa_turn(r, o + POSE_OMEGA, w_rel);
+        sa_turn(r, o + POSE_CENTROID, cen);
+        sa_turn(r, o + POSE_CENTROID + 3, cend);
+        sa_turn(r, o + POSE_BODY_OMEGA, w_b);
+        sa_turn(r, o + POSE_AXIS, ax);
+        m = o[POSE_MASS];
+        sa_cross(omega, cen, c1);
+        for (i = 0; i < 3; i++) {
+            body_v[i] = v[i] + c1[i] + cend[i];
+            body_w[i] = omega[i] + w_b[i];
+            c1[i] = pos[i] + cen[i];
+        }
+        ke += sa_kinetic(m, o[POSE_MASS + 1], o[POSE_MASS + 2], ax, body_v, body_w);
+        pe += o[POSE_ENERGY] - m * sa_dot(gravity, c1);
+        sa_cross(omega, d, c1);
+        for (i = 0; i < 3; i++) {
+            v[i] = v[i] + c1[i] + dd[i];
+            omega[i] += w_rel[i];
+            pos[i] += d[i];
+        }
+        for (i = 0; i < 3; i++)
+            for (j = 0; j < 3; j++) next[i][j] = r[i][0] * rel[0][j] + r[i][1] * rel[1][j] + r[i][2] * rel[2][j];
+        memcpy(r, next, sizeof next);
+        sa_quat_mul(quat, o + POSE_QUAT, q2);
+        memcpy(quat, q2, sizeof q2);
+    }
+    for (i = 0; i < 3; i++) axis[i] = r[i][0];
+    length = TIP_LENGTH < 0 ? 0.0 : p[TIP_LENGTH];
+    if (TIP_MASS >= 0) {
+        double m = p[TIP_MASS], offset[3], v_c[3], c1[3], at[3];
+        double lateral = TIP_LATERAL < 0 ? 0.0 : p[TIP_LATERAL], axial = TIP_AXIAL < 0 ? 0.0 : p[TIP_AXIAL];
+        for (i = 0; i < 3; i++) offset[i] = 0.5 * length * axis[i];
+        sa_cross(omega, offset, c1);
+        for (i = 0; i < 3; i++) {
+            v_c[i] = v[i] + c1[i];
+            at[i] = pos[i] + offset[i];
+        }
+        ke += sa_kinetic(m, lateral, axial, axis, v_c, omega);
+        pe -= m * sa_dot(gravity, at);
+    }
+    for (i = 0; i < 3; i++) point[i] = pos[i] + length * axis[i];
+    if (TIP_FORCE[0] >= 0 && !TIP_FRAME) {
+        double f[3];
+        for (i = 0; i < 3; i++) f[i] = p[TIP_FORCE[i]];
+        pe -= sa_dot(f, point);
+    }
+    if (LINK_FORCES) pe += links_energy(t, q, qd, p, scratch);
+    for (i = 0; i < 3; i++) out[i] = point[i];
+    out[3] = ke;
+    out[4] = pe;
+    for (i = 0; i < 4; i++) out[5 + i] = quat[i];
+}
+
+/* The kernels the library calls, on the recursion. M qdd + h packed:
+ * h at qdd = 0, then column j of M as the inertial tau of a unit qdd_j. */
+static void k_mass_bias(double t, const double *q, const double *qd, const double *qdd, const double *dir,
+                        const double *p, const double *aux, double *out, double *scratch)
+{
+    double *zero = scratch, *unit = zero + 2 * NQ_LINKS, *tau = unit + NQ_LINKS, *dtau = tau + NQ_LINKS;
+    double *w = dtau + NQ_LINKS;
+    size_t i, j;
+    (void)qdd; (void)dir; (void)aux;
+    memset(zero, 0, 3 * NQ_LINKS * sizeof(double));
+    links_inverse_dynamics(t, q, qd, zero, zero, p, 0, out + NQ_LINKS * (NQ_LINKS + 1) / 2, dtau, w);
+    for (j = 0; j < NQ_LINKS; j++) {
+        unit[j] = 1.0;
+        links_inverse_dynamics(t, q, zero, unit, zero, p, 1, tau, dtau, w);
+        unit[j] = 0.0;
+        for (i = 0; i <= j; i++) out[sa_packed(NQ_LINKS, i, j)] = tau[i];
+    }
+}
+
+/* The directional derivative of tau = M qdd + h along dir = (dq, dqd). */
+static void k_jvp(double t, const double *q, const double *qd, const double *qdd, const double *dir,
+                  const double *p, const double *aux, double *out, double *scratch)
+{
+    (void)aux;
+    links_inverse_dynamics(t, q, qd, qdd, dir, p, 0, scratch, out, scratch + NQ_LINKS);
+}
+
+static void k_outputs(double t, const double *q, const double *qd, const double *qdd, const double *dir,
+                      const double *p, const double *aux, double *out, double *scratch)
+{
+    (void)qdd; (void)dir; (void)aux;
+    links_outputs(t, q, qd, p, out, scratch);
+}
