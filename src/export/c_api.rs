@@ -302,7 +302,9 @@ impl Library<'_> {
                 .map(|(name, tape)| (name.to_string(), tape)),
             ),
         }
-        kernels.push(("k_shape".into(), self.shape));
+        if !self.links.as_ref().is_some_and(|l| l.draws_shape()) {
+            kernels.push(("k_shape".into(), self.shape));
+        }
         if self.m() > 0 {
             kernels.push(("k_constraints".into(), &t.constraints));
         }

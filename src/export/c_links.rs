@@ -11,7 +11,8 @@
 use std::fmt::Write;
 
 use runtime::links::{
-    ACTUATION_LOADS, CELL_PARAMS, ELEMENT_PARAMS, LinkKernels, MAX_LINK_DOF, REST_PARAMS, cell, pose,
+    ACTUATION_LOADS, CELL_PARAMS, ELEMENT_PARAMS, LinkKernels, MAX_LINK_DOF, REST_PARAMS, cell,
+    pose,
 };
 use runtime::{Tape, TapeSet};
 
@@ -27,6 +28,9 @@ const LINK_RECORD: usize = 2 * (9 + 12 * MAX_LINK_DOF + MAX_LINK_DOF);
 pub struct Links<'a> {
     links: &'a LinkKernels,
     dof: usize,
+    /// Where each shape row's links end, when the links' ends are the
+    /// shape's rows (`shape_rows`).
+    rows: Option<Vec<usize>>,
 }
 
 impl<'a> Links<'a> {
@@ -37,7 +41,31 @@ impl<'a> Links<'a> {
 
     /// A chain of `dof` coordinates by `links`.
     pub fn new(links: &'a LinkKernels, dof: usize) -> Self {
-        Self { links, dof }
+        Self {
+            links,
+            dof,
+            rows: None,
+        }
+    }
+
+    /// Draw the shape's `rows` (the base and each element's end) by the
+    /// recursion, if each element is one link with coordinates, after any
+    /// links without (a kink's turn); else the shape stays its own kernel.
+    pub fn with_shape(mut self, rows: usize) -> Self {
+        let mut ends = vec![0];
+        for (k, spec) in self.links.layout.links.iter().enumerate() {
+            if !spec.map.is_empty() {
+                ends.push(k + 1);
+            }
+        }
+        let covered = ends.last() == Some(&self.links.layout.links.len());
+        self.rows = (covered && ends.len() == rows).then_some(ends);
+        self
+    }
+
+    /// Whether the recursion draws the shape.
+    pub fn draws_shape(&self) -> bool {
+        self.rows.is_some()
     }
 
     /// The cells' kernels and the chain's own (actuation loads, the
@@ -45,7 +73,9 @@ impl<'a> Links<'a> {
     pub fn kernels(&self) -> Vec<(String, &'a Tape)> {
         let l = self.links;
         let mut k = Vec::new();
-        for (c, (tangent, pose)) in l.tangents.iter().zip(&l.poses).enumerate() {
+        let cells = l.cells.iter().zip(&l.tangents).zip(&l.poses);
+        for (c, ((one, tangent), pose)) in cells.enumerate() {
+            k.push((format!("k_cell_{c}"), one));
             k.push((format!("k_cell_tangent_{c}"), tangent));
             k.push((format!("k_cell_pose_{c}"), pose));
         }
@@ -65,17 +95,22 @@ impl<'a> Links<'a> {
     /// Scratch the recursion's kernels take beyond the cells' own:
     /// `k_mass_bias`'s vectors, the links' records, the loads, a cell's
     /// tangent and the non-local forces with their derivatives.
-    pub fn scratch(&self, cells: usize) -> usize {
+    pub fn scratch(&self, kernels: usize) -> usize {
         let n = self.dof;
         let layout = &self.links.layout;
-        5 * n
+        let cells = 2 * cell::len(MAX_LINK_DOF) * layout.links.len();
+        // `links_mass`: each link's geometry and its force and torque for
+        // each column, the frames' accelerations, wrenches and M.
+        let mass = layout.links.len() * (6 + 12 * MAX_LINK_DOF + 6 * n) + 12 * n + n * n;
+        mass + 5 * n
+            + cells
             + layout.links.len() * LINK_RECORD
             + 3 * layout.loads
             + 1
             + 2 * cell::len(MAX_LINK_DOF)
             + 2 * n
             + pose::LEN
-            + cells
+            + kernels
     }
 
     /// The layout's macros and tables, the kernels' dispatch and the
@@ -91,7 +126,8 @@ impl<'a> Links<'a> {
         let layout = &self.links.layout;
         let flag = |b: bool| usize::from(b);
         let index = |i: Option<usize>| i.map_or("-1".to_string(), |i| i.to_string());
-        let mut c = String::from("/* The chain's layout (runtime_kernels::links::LinkLayout). */\n");
+        let mut c =
+            String::from("/* The chain's layout (runtime_kernels::links::LinkLayout). */\n");
         let defines = [
             ("NQ_LINKS", self.dof.to_string()),
             ("LINK_COUNT", layout.links.len().to_string()),
@@ -103,7 +139,10 @@ impl<'a> Links<'a> {
             ("LINK_RECORD", LINK_RECORD.to_string()),
             ("LINK_LOADS", layout.loads.to_string()),
             ("LINK_FORCES", flag(layout.forces).to_string()),
-            ("VARIABLE_INERTIA", flag(layout.variable_inertia).to_string()),
+            (
+                "VARIABLE_INERTIA",
+                flag(layout.variable_inertia).to_string(),
+            ),
             (
                 "LINK_CELL_LEN(n)",
                 format!("({} + 14 * (n))", cell::COLUMNS),
@@ -141,7 +180,23 @@ impl<'a> Links<'a> {
             false => v.join(", "),
         };
         let ints = |v: &[usize]| list(&v.iter().map(|i| i.to_string()).collect::<Vec<_>>());
-        let three = |t: Option<[usize; 3]>| list(&t.map_or([-1i64; 3], |t| t.map(|i| i as i64)).map(|i| i.to_string()));
+        let three = |t: Option<[usize; 3]>| {
+            list(
+                &t.map_or([-1i64; 3], |t| t.map(|i| i as i64))
+                    .map(|i| i.to_string()),
+            )
+        };
+        match &self.rows {
+            Some(rows) => {
+                let _ = writeln!(
+                    c,
+                    "#define LINK_SHAPE 1\n#define LINK_ROWS {}\nstatic const size_t LINK_ROW_FROM[] = {{{}}};",
+                    rows.len(),
+                    ints(rows)
+                );
+            }
+            None => c.push_str("#define LINK_SHAPE 0\n"),
+        }
         let _ = writeln!(
             c,
             "static const int TIP_FORCE[3] = {{{}}};\nstatic const int TIP_MOMENT[3] = {{{}}};\n\
@@ -213,9 +268,12 @@ impl<'a> Links<'a> {
     /// chain has none).
     fn dispatch(&self) -> String {
         let l = self.links;
-        let mut tangent = String::new();
-        let mut pose = String::new();
+        let (mut one, mut tangent, mut pose) = (String::new(), String::new(), String::new());
         for c in 0..l.tangents.len() {
+            let _ = writeln!(
+                one,
+                "    case {c}: k_cell_{c}(0.0, x, xd, NULL, NULL, p, NULL, out, scratch); break;"
+            );
             let _ = writeln!(
                 tangent,
                 "    case {c}: k_cell_tangent_{c}(0.0, x, xd, NULL, dir, p, NULL, out, scratch); break;"
@@ -230,11 +288,16 @@ impl<'a> Links<'a> {
             None => String::new(),
         };
         let energy = match &l.energy {
-            Some(_) => "    double e;\n    k_links_energy(t, q, qd, NULL, NULL, p, NULL, &e, scratch);\n    return e;\n",
+            Some(_) => {
+                "    double e;\n    k_links_energy(t, q, qd, NULL, NULL, p, NULL, &e, scratch);\n    return e;\n"
+            }
             None => "    (void)t; (void)q; (void)qd; (void)p; (void)scratch;\n    return 0.0;\n",
         };
         format!(
-            "/* Cell c's outputs and their derivatives along dir (the cell coordinates'\n \
+            "/* Cell c's outputs. */\n\
+             static void cell_one(size_t c, const double *x, const double *xd, const double *p,\n    \
+             double *out, double *scratch)\n{{\n    switch (c) {{\n{one}    default: break;\n    }}\n}}\n\n\
+             /* Cell c's outputs and their derivatives along dir (the cell coordinates'\n \
              * then their rates'). */\n\
              static void cell_tangent(size_t c, const double *x, const double *xd, const double *dir,\n    \
              const double *p, double *out, double *scratch)\n{{\n    switch (c) {{\n{tangent}    \

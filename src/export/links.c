@@ -229,8 +229,7 @@ static void sa_link_forward(sa_frame *frame, const double *out, size_t nc, const
 /* The wrench (moment about the world origin, force) of what hangs on the
  * end frame: the tip body's inertial and gravity forces and the tip loads,
  * as forces of the opposite sign (links/tangent.rs' tip_wrench). */
-static void sa_tip_wrench(const sa_frame *fr, const double *p, sa_d3 gravity, int inertial, sa_d3 *moment,
-                          sa_d3 *force)
+static void sa_tip_wrench(const sa_frame *fr, const double *p, sa_d3 gravity, sa_d3 *moment, sa_d3 *force)
 {
     sa_d3 axis, point, tip_f = sa_zero3(), tip_m = sa_zero3();
     sa_dual length = sa_dc(TIP_LENGTH < 0 ? 0.0 : p[TIP_LENGTH]);
@@ -249,7 +248,6 @@ static void sa_tip_wrench(const sa_frame *fr, const double *p, sa_d3 gravity, in
         torque = sa_add3(sa_apply_body(lateral, axial, axis, fr->alpha), sa_dcross(fr->omega, iw));
         *moment = sa_add3(torque, sa_dcross(centre, *force));
     }
-    if (inertial) return;
     for (k = 0; k < 3; k++) {
         if (TIP_FORCE[k] >= 0) tip_f.c[k] = sa_dc(-p[TIP_FORCE[k]]);
         if (TIP_MOMENT[k] >= 0) tip_m.c[k] = sa_dc(-p[TIP_MOMENT[k]]);
@@ -262,61 +260,81 @@ static void sa_tip_wrench(const sa_frame *fr, const double *p, sa_d3 gravity, in
     *force = sa_add3(*force, tip_f);
 }
 
-/* tau = M qdd + h into tau and its derivative along dir = (dq, dqd) into
- * dtau (links/tangent.rs' inverse_dynamics_tangent); `inertial`: M qdd
- * alone (no gravity, springs, dampers or loads: at qd = 0, a column of M
- * for a unit qdd). w: LINKS_WORK values, then the cells' scratch. */
-static void links_inverse_dynamics(double t, const double *q, const double *qd, const double *qdd,
-                                   const double *dir, const double *p, int inertial, double *tau,
-                                   double *dtau, double *w)
+/* Every link's cell at (q, qd) with its derivatives along dir = (dq, dqd)
+ * into cells (2 LINK_CELL_LEN(LINK_MAX_DOF) values a link): a link the
+ * direction does not move takes its value cell and zero derivatives.
+ * w: the loads, then the cells' scratch. */
+static void links_cells(double t, const double *q, const double *qd, const double *dir, const double *p,
+                        double *cells, double *w)
+{
+    double *loads = w, *scratch = loads + 3 * LINK_LOADS + 1;
+    double cp[LINK_CELL_PARAMS], x[LINK_MAX_DOF], xd[LINK_MAX_DOF], dq[LINK_MAX_DOF], dqd[LINK_MAX_DOF];
+    double dx[2 * LINK_MAX_DOF];
+    size_t k, i;
+    links_loads(t, q, qd, p, loads, scratch);
+    for (k = 0; k < LINK_COUNT; k++) {
+        size_t nc = LINK_DOF[k], len = LINK_CELL_LEN(nc);
+        double *out = cells + k * 2 * LINK_CELL_LEN(LINK_MAX_DOF);
+        int moves = 0;
+        sa_link_params(k, p, loads, cp);
+        sa_local(k, p, q, x);
+        sa_local(k, p, qd, xd);
+        sa_local(k, p, dir, dq);
+        sa_local(k, p, dir + NQ_LINKS, dqd);
+        for (i = 0; i < nc; i++) {
+            dx[i] = dq[i];
+            dx[nc + i] = dqd[i];
+            moves |= dq[i] != 0.0 || dqd[i] != 0.0;
+        }
+        if (moves) {
+            cell_tangent(LINK_CELL[k], x, xd, dx, cp, out, scratch);
+        } else {
+            cell_one(LINK_CELL[k], x, xd, cp, out, scratch);
+            memset(out + len, 0, len * sizeof(double));
+        }
+    }
+}
+
+/* tau = M qdd + h into tau and its derivative along dir into dtau from
+ * the cells `links_cells` gave at (q, qd, dir) (links/tangent.rs'
+ * inverse_dynamics_tangent). w: the links' records, then the non-local
+ * forces and the kernels' scratch. */
+static void links_sweep(double t, const double *q, const double *qd, const double *qdd, const double *dir,
+                        const double *p, const double *cells, double *tau, double *dtau, double *w)
 {
     /* Each link's record, copied in and out (the workspace is doubles). */
-    double *links = w, *loads = links + LINK_COUNT * SA_LINK_DOUBLES, *out = loads + 3 * LINK_LOADS + 1;
-    double *f = out + 2 * LINK_CELL_LEN(LINK_MAX_DOF), *scratch = f + 2 * NQ_LINKS;
-    double cp[LINK_CELL_PARAMS], x[LINK_MAX_DOF], xd[LINK_MAX_DOF], xdd[LINK_MAX_DOF];
-    double dx[2 * LINK_MAX_DOF];
+    double *links = w, *f = links + LINK_COUNT * SA_LINK_DOUBLES, *scratch = f + 2 * NQ_LINKS;
+    double xdd[LINK_MAX_DOF], xd[LINK_MAX_DOF], dqd[LINK_MAX_DOF];
     double base[3][3], quat[4];
     sa_frame frame;
     sa_d3 gravity, moment, force;
     sa_dual t_acc[NQ_LINKS];
     size_t k, i, c;
-    for (i = 0; i < 3; i++) gravity.c[i] = sa_dc(inertial ? 0.0 : p[GRAVITY[i]]);
+    for (i = 0; i < 3; i++) gravity.c[i] = sa_dc(p[GRAVITY[i]]);
     sa_base(p, base, quat);
     for (i = 0; i < 3; i++) {
         for (c = 0; c < 3; c++) frame.r[i].c[c] = sa_dc(base[i][c]);
         frame.pos.c[i] = sa_dc(p[BASE_POSITION[i]]);
     }
     frame.omega = frame.alpha = frame.acc = sa_zero3();
-    links_loads(t, q, qd, p, loads, scratch);
     for (k = 0; k < LINK_COUNT; k++) {
         size_t nc = LINK_DOF[k];
         sa_dual rates[LINK_MAX_DOF];
         sa_link l;
-        sa_link_params(k, p, loads, cp);
-        sa_local(k, p, q, x);
-        sa_local(k, p, qd, xd);
         sa_local(k, p, qdd, xdd);
-        /* The cell's direction: the coordinates' then the rates'. */
-        {
-            double dq_local[LINK_MAX_DOF], dqd_local[LINK_MAX_DOF];
-            sa_local(k, p, dir, dq_local);
-            sa_local(k, p, dir + NQ_LINKS, dqd_local);
-            for (i = 0; i < nc; i++) {
-                dx[i] = dq_local[i];
-                dx[nc + i] = dqd_local[i];
-            }
+        if (VARIABLE_INERTIA) {
+            sa_local(k, p, qd, xd);
+            sa_local(k, p, dir + NQ_LINKS, dqd);
             for (i = 0; i < nc; i++) {
                 rates[i].v = xd[i];
-                rates[i].d = dqd_local[i];
+                rates[i].d = dqd[i];
             }
         }
-        cell_tangent(LINK_CELL[k], x, xd, dx, cp, out, scratch);
-        sa_link_forward(&frame, out, nc, xdd, VARIABLE_INERTIA ? rates : NULL, gravity, &l);
-        if (inertial)
-            for (i = 0; i < nc; i++) l.local_force[i] = sa_dc(0.0);
+        sa_link_forward(&frame, cells + k * 2 * LINK_CELL_LEN(LINK_MAX_DOF), nc, xdd,
+                        VARIABLE_INERTIA ? rates : NULL, gravity, &l);
         memcpy(links + k * SA_LINK_DOUBLES, &l, sizeof l);
     }
-    sa_tip_wrench(&frame, p, gravity, inertial, &moment, &force);
+    sa_tip_wrench(&frame, p, gravity, &moment, &force);
     for (i = 0; i < NQ_LINKS; i++) t_acc[i] = sa_dc(0.0);
     for (k = LINK_COUNT; k-- > 0;) {
         sa_link link;
@@ -340,7 +358,7 @@ static void links_inverse_dynamics(double t, const double *q, const double *qd, 
         tau[i] = t_acc[i].v;
         dtau[i] = t_acc[i].d;
     }
-    if (LINK_FORCES && !inertial) {
+    if (LINK_FORCES) {
         links_forces_tangent(t, q, qd, qdd, dir, p, f, scratch);
         for (i = 0; i < NQ_LINKS; i++) {
             tau[i] += f[i];
@@ -461,31 +479,163 @@ static void links_outputs(double t, const double *q, const double *qd, const dou
     for (i = 0; i < 4; i++) out[5 + i] = quat[i];
 }
 
-/* The kernels the library calls, on the recursion. M qdd + h packed:
- * h at qdd = 0, then column j of M as the inertial tau of a unit qdd_j. */
+/* Per link: its centroid, its end, and its coordinates' columns (the end
+ * frame's angular and end point velocity, the body's angular and centroid
+ * velocity), in the world frame. */
+#define SA_GEOMETRY (6 + 12 * LINK_MAX_DOF)
+
+/* M, all its columns in one sweep (the composite bodies' sums of
+ * links/mod.rs in another order): at qd = 0 every velocity vanishes and
+ * the accelerations are linear in qdd, so each frame's angular and linear
+ * acceleration is carried for every unit qdd_j at once (NQ_LINKS columns),
+ * from the cells at (q, 0) (`links_cells`), and the wrench past each link
+ * projected on its coordinates' twists gives column j of M. Into the
+ * packed upper triangle `out`. w: per link its centroid and columns, then
+ * each column's force and torque. */
+static void links_mass(const double *p, const double *cells, double *out, double *w)
+{
+    double *geometry = w, *acc = geometry + LINK_COUNT * SA_GEOMETRY;
+    double *alpha = acc + 3 * NQ_LINKS, *forces = alpha + 3 * NQ_LINKS;
+    double *moment = forces + LINK_COUNT * 6 * NQ_LINKS, *force = moment + 3 * NQ_LINKS;
+    double *tau = force + 3 * NQ_LINKS;
+    double r[3][3], quat[4], pos[3];
+    size_t k, j, f, i;
+    int a, b;
+    sa_base(p, r, quat);
+    for (a = 0; a < 3; a++) pos[a] = p[BASE_POSITION[a]];
+    memset(acc, 0, 6 * NQ_LINKS * sizeof(double));
+    for (k = 0; k < LINK_COUNT; k++) {
+        size_t nc = LINK_DOF[k], len = LINK_CELL_LEN(nc);
+        const double *o = cells + k * 2 * LINK_CELL_LEN(LINK_MAX_DOF);
+        double *g = geometry + k * SA_GEOMETRY, rel[3][3], next[3][3], d[3], cen[3], axis[3];
+        double xdd[LINK_MAX_DOF][NQ_LINKS + 1], m = o[LINK_MASS], lateral = o[LINK_MASS + 1],
+                                                axial = o[LINK_MASS + 2];
+        (void)len;
+        sa_turn(r, o + LINK_END, d);
+        sa_turn(r, o + LINK_CENTROID, cen);
+        sa_turn(r, o + LINK_AXIS, axis);
+        for (a = 0; a < 3; a++) {
+            g[a] = pos[a] + cen[a];
+            g[3 + a] = pos[a] + d[a];
+        }
+        for (f = 0; f < nc; f++)
+            for (i = 0; i < 4; i++) sa_turn(r, o + LINK_COLUMNS + 12 * f + 3 * i, g + 6 + 12 * f + 3 * i);
+        /* Cell coordinate f's acceleration for each unit qdd_j. */
+        for (f = 0; f < nc; f++) {
+            size_t at = LINK_TERMS[k][f];
+            double sc = LINK_SCALE[k][f] < 0 ? 1.0 : p[LINK_SCALE[k][f]];
+            for (j = 0; j < NQ_LINKS; j++) xdd[f][j] = 0.0;
+            for (i = TERM_START[at]; i < TERM_START[at + 1]; i++) xdd[f][TERM_COORD[i]] += sc * TERM_WEIGHT[i];
+        }
+        for (j = 0; j < NQ_LINKS; j++) {
+            double *aj = acc + 3 * j, *alj = alpha + 3 * j, *fj = forces + (k * NQ_LINKS + j) * 6;
+            double body_a[3], body_alpha[3], c1[3], ddd[3] = {0.0, 0.0, 0.0}, w_rel_d[3] = {0.0, 0.0, 0.0};
+            double aw;
+            sa_cross(alj, cen, c1);
+            for (a = 0; a < 3; a++) {
+                body_a[a] = aj[a] + c1[a];
+                body_alpha[a] = alj[a];
+            }
+            for (f = 0; f < nc; f++) {
+                const double *col = g + 6 + 12 * f;
+                for (a = 0; a < 3; a++) {
+                    ddd[a] += xdd[f][j] * col[3 + a];
+                    w_rel_d[a] += xdd[f][j] * col[a];
+                    body_alpha[a] += xdd[f][j] * col[6 + a];
+                    body_a[a] += xdd[f][j] * col[9 + a];
+                }
+            }
+            aw = sa_dot(axis, body_alpha);
+            for (a = 0; a < 3; a++) {
+                fj[a] = m * body_a[a];
+                fj[3 + a] = lateral * body_alpha[a] + (axial - lateral) * aw * axis[a];
+            }
+            /* The end frame's accelerations. */
+            sa_cross(alj, d, c1);
+            for (a = 0; a < 3; a++) {
+                aj[a] += c1[a] + ddd[a];
+                alj[a] += w_rel_d[a];
+            }
+        }
+        for (a = 0; a < 3; a++)
+            for (b = 0; b < 3; b++) rel[a][b] = o[LINK_ROTATION + 3 * a + b];
+        for (a = 0; a < 3; a++)
+            for (b = 0; b < 3; b++) next[a][b] = r[a][0] * rel[0][b] + r[a][1] * rel[1][b] + r[a][2] * rel[2][b];
+        memcpy(r, next, sizeof next);
+        for (a = 0; a < 3; a++) pos[a] += d[a];
+    }
+    /* The tip body's wrench for each column. */
+    memset(moment, 0, 6 * NQ_LINKS * sizeof(double));
+    if (TIP_MASS >= 0) {
+        double m = p[TIP_MASS], length = TIP_LENGTH < 0 ? 0.0 : p[TIP_LENGTH], axis[3], offset[3], centre[3];
+        double lateral = TIP_LATERAL < 0 ? 0.0 : p[TIP_LATERAL], axial = TIP_AXIAL < 0 ? 0.0 : p[TIP_AXIAL];
+        for (a = 0; a < 3; a++) {
+            axis[a] = r[a][0];
+            offset[a] = 0.5 * length * axis[a];
+            centre[a] = pos[a] + offset[a];
+        }
+        for (j = 0; j < NQ_LINKS; j++) {
+            double c1[3], torque[3], aw = sa_dot(axis, alpha + 3 * j);
+            sa_cross(alpha + 3 * j, offset, c1);
+            for (a = 0; a < 3; a++) {
+                force[3 * j + a] = m * (acc[3 * j + a] + c1[a]);
+                torque[a] = lateral * alpha[3 * j + a] + (axial - lateral) * aw * axis[a];
+            }
+            sa_cross(centre, force + 3 * j, c1);
+            for (a = 0; a < 3; a++) moment[3 * j + a] = torque[a] + c1[a];
+        }
+    }
+    /* Back from the tip: column j's wrench past each link on its twists. */
+    memset(tau, 0, NQ_LINKS * NQ_LINKS * sizeof(double));
+    for (k = LINK_COUNT; k-- > 0;) {
+        const double *g = geometry + k * SA_GEOMETRY;
+        for (j = 0; j < NQ_LINKS; j++) {
+            const double *fj = forces + (k * NQ_LINKS + j) * 6;
+            double *mj = moment + 3 * j, *Fj = force + 3 * j, c1[3];
+            for (f = 0; f < LINK_DOF[k]; f++) {
+                const double *col = g + 6 + 12 * f;
+                size_t at = LINK_TERMS[k][f];
+                double sc = LINK_SCALE[k][f] < 0 ? 1.0 : p[LINK_SCALE[k][f]], gf;
+                sa_cross(col, g + 3, c1);
+                gf = sa_dot(col, mj) + (col[3] - c1[0]) * Fj[0] + (col[4] - c1[1]) * Fj[1] +
+                     (col[5] - c1[2]) * Fj[2] + sa_dot(col + 9, fj) + sa_dot(col + 6, fj + 3);
+                for (i = TERM_START[at]; i < TERM_START[at + 1]; i++)
+                    tau[j * NQ_LINKS + TERM_COORD[i]] += sc * TERM_WEIGHT[i] * gf;
+            }
+            sa_cross(g, fj, c1);
+            for (a = 0; a < 3; a++) {
+                mj[a] += fj[3 + a] + c1[a];
+                Fj[a] += fj[a];
+            }
+        }
+    }
+    for (j = 0; j < NQ_LINKS; j++)
+        for (i = 0; i <= j; i++) out[sa_packed(NQ_LINKS, i, j)] = tau[j * NQ_LINKS + i];
+}
+
+/* The kernels the library calls, on the recursion. M qdd + h packed: h
+ * from the cells at (q, qd) at qdd = 0, M from the cells at (q, 0). */
+#define SA_CELLS (LINK_COUNT * 2 * LINK_CELL_LEN(LINK_MAX_DOF))
 static void k_mass_bias(double t, const double *q, const double *qd, const double *qdd, const double *dir,
                         const double *p, const double *aux, double *out, double *scratch)
 {
-    double *zero = scratch, *unit = zero + 2 * NQ_LINKS, *tau = unit + NQ_LINKS, *dtau = tau + NQ_LINKS;
-    double *w = dtau + NQ_LINKS;
-    size_t i, j;
+    double *zero = scratch, *dtau = zero + 2 * NQ_LINKS, *cells = dtau + NQ_LINKS, *w = cells + SA_CELLS;
     (void)qdd; (void)dir; (void)aux;
-    memset(zero, 0, 3 * NQ_LINKS * sizeof(double));
-    links_inverse_dynamics(t, q, qd, zero, zero, p, 0, out + NQ_LINKS * (NQ_LINKS + 1) / 2, dtau, w);
-    for (j = 0; j < NQ_LINKS; j++) {
-        unit[j] = 1.0;
-        links_inverse_dynamics(t, q, zero, unit, zero, p, 1, tau, dtau, w);
-        unit[j] = 0.0;
-        for (i = 0; i <= j; i++) out[sa_packed(NQ_LINKS, i, j)] = tau[i];
-    }
+    memset(zero, 0, 2 * NQ_LINKS * sizeof(double));
+    links_cells(t, q, qd, zero, p, cells, w);
+    links_sweep(t, q, qd, zero, zero, p, cells, out + NQ_LINKS * (NQ_LINKS + 1) / 2, dtau, w);
+    links_cells(t, q, zero, zero, p, cells, w);
+    links_mass(p, cells, out, w);
 }
 
 /* The directional derivative of tau = M qdd + h along dir = (dq, dqd). */
 static void k_jvp(double t, const double *q, const double *qd, const double *qdd, const double *dir,
                   const double *p, const double *aux, double *out, double *scratch)
 {
+    double *tau = scratch, *cells = tau + NQ_LINKS, *w = cells + SA_CELLS;
     (void)aux;
-    links_inverse_dynamics(t, q, qd, qdd, dir, p, 0, scratch, out, scratch + NQ_LINKS);
+    links_cells(t, q, qd, dir, p, cells, w);
+    links_sweep(t, q, qd, qdd, dir, p, cells, tau, out, w);
 }
 
 static void k_outputs(double t, const double *q, const double *qd, const double *qdd, const double *dir,
@@ -494,3 +644,49 @@ static void k_outputs(double t, const double *q, const double *qd, const double 
     (void)qdd; (void)dir; (void)aux;
     links_outputs(t, q, qd, p, out, scratch);
 }
+
+#if LINK_SHAPE
+/* The shape: the base, then the end of each element: row r ends after
+ * links LINK_ROW_FROM[r - 1] to LINK_ROW_FROM[r] - 1 (a kink's turn goes
+ * with the element after it), each a point and the section's quaternion. */
+static void links_shape(double t, const double *q, const double *p, double *out, double *w)
+{
+    double *loads = w, *o = loads + 3 * LINK_LOADS + 1, *zero = o + LINK_POSE_LEN, *scratch = zero + NQ_LINKS;
+    double r[3][3], quat[4], pos[3], cp[LINK_CELL_PARAMS], x[LINK_MAX_DOF], xd[LINK_MAX_DOF];
+    size_t k, row = 0;
+    int i, j;
+    memset(zero, 0, NQ_LINKS * sizeof(double));
+    for (i = 0; i < 3; i++) pos[i] = p[BASE_POSITION[i]];
+    sa_base(p, r, quat);
+    links_loads(t, q, zero, p, loads, scratch);
+    for (;;) {
+        double rel[3][3], d[3], next[3][3], q2[4];
+        for (i = 0; i < 3; i++) out[7 * row + i] = pos[i];
+        for (i = 0; i < 4; i++) out[7 * row + 3 + i] = quat[i];
+        row++;
+        if (row == LINK_ROWS) break;
+        for (k = LINK_ROW_FROM[row - 1]; k < LINK_ROW_FROM[row]; k++) {
+            sa_link_params(k, p, loads, cp);
+            sa_local(k, p, q, x);
+            sa_local(k, p, zero, xd);
+            cell_pose(LINK_CELL[k], x, xd, cp, o, scratch);
+            for (i = 0; i < 3; i++)
+                for (j = 0; j < 3; j++) rel[i][j] = o[POSE_ROTATION + 3 * i + j];
+            sa_turn(r, o + POSE_END, d);
+            for (i = 0; i < 3; i++) pos[i] += d[i];
+            for (i = 0; i < 3; i++)
+                for (j = 0; j < 3; j++) next[i][j] = r[i][0] * rel[0][j] + r[i][1] * rel[1][j] + r[i][2] * rel[2][j];
+            memcpy(r, next, sizeof next);
+            sa_quat_mul(quat, o + POSE_QUAT, q2);
+            memcpy(quat, q2, sizeof q2);
+        }
+    }
+}
+
+static void k_shape(double t, const double *q, const double *qd, const double *qdd, const double *dir,
+                    const double *p, const double *aux, double *out, double *scratch)
+{
+    (void)qd; (void)qdd; (void)dir; (void)aux;
+    links_shape(t, q, p, out, scratch);
+}
+#endif

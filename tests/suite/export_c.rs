@@ -411,6 +411,46 @@ fn a_viscoelastic_arms_relaxed_forces_are_exported_as_states() {
     check_export_of("relaxing_finger", &relaxing, dir.path());
 }
 
+/// Models no build has, each a chain of link cells: the right-angle frame
+/// (a kink, a link without coordinates) and the tapered tentacle (its
+/// chambers' loads from inputs). The library is the cells and the
+/// recursion: its kernels agree with softarm's as every model's do; four
+/// times the elements leave the cells' kernels as they were, and the C
+/// grows by the parameters' names, fields and defaults and the layout's
+/// tables (the whole-arm kernels took 5.7 kB more C an element).
+#[test]
+fn a_chain_of_link_cells_exports_its_cells_and_the_recursion() {
+    for name in ["right_angle_frame", "tapered_tentacle"] {
+        let dir = tempfile::tempdir().unwrap();
+        let spec = root().join("examples").join(format!("{name}.toml"));
+        check_export_of(name, &spec, dir.path());
+    }
+    let spec = root().join("examples/tapered_tentacle.toml");
+    let source = |elements: usize| {
+        let dir = tempfile::tempdir().unwrap();
+        let set =
+            [eomgen::model::Override::parse(&format!("segment.0.elements={elements}")).unwrap()];
+        let export =
+            softarm::export::export_c(spec.to_str().unwrap(), &set, dir.path(), None).unwrap();
+        std::fs::read_to_string(&export.files[1]).unwrap()
+    };
+    // The cells' kernels: from each `k_cell_` function to the end of it.
+    let cells = |c: &str| -> Vec<String> {
+        c.split("static void k_cell_")
+            .skip(1)
+            .map(|f| f[..f.find("\n}\n").unwrap()].to_string())
+            .collect()
+    };
+    let (small, large) = (source(9), source(36));
+    assert!(large.contains("links_sweep"), "no recursion");
+    assert!(!cells(&small).is_empty() && cells(&small) == cells(&large));
+    let per_element = (large.len() - small.len()) / 27;
+    assert!(
+        per_element < 2_000,
+        "{per_element} characters of C an element"
+    );
+}
+
 /// A 3D arm among obstacles of every shape (a plane, a sphere, a capped
 /// cylinder and a turned box, each crossing the arm's reach) with self
 /// contact, and two arms and a ball on a floor (point-on-body pairs):
