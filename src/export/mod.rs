@@ -3,7 +3,8 @@
 //! Simulink S-functions and anything else that links C.
 //!
 //! The kernels are the model's tapes, each a C function running the
-//! interpreter's operations in its order (`c_tape`); the state derivative
+//! interpreter's operations in its order (`c_tape`); a chain of link cells
+//! is its cells' tapes and the link recursion (`c_links`); the state derivative
 //! solves M qdd = -h by L D L^T (and the joints' rows by their Schur
 //! complement, as `runtime::constraints`), its Jacobian comes column by
 //! column from the inverse dynamics' directional derivative, as the
