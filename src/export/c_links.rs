@@ -34,18 +34,22 @@ pub struct Links<'a> {
 }
 
 impl<'a> Links<'a> {
-    /// The chain of `tapes`, if the recursion covers it.
+    /// The chain of `tapes`, if the recursion covers it and pays.
     pub fn of(tapes: &'a TapeSet) -> Option<Self> {
-        Some(Self::new(tapes.links.as_ref()?, tapes.info.dof()))
+        Self::new(tapes.links.as_ref()?, tapes.info.dof())
     }
 
-    /// A chain of `dof` coordinates by `links`.
-    pub fn new(links: &'a LinkKernels, dof: usize) -> Self {
-        Self {
+    /// A chain of `dof` coordinates by `links`, where compiled code takes
+    /// M and h from the recursion too (`LinkKernels::mass_bias`: 3D chains
+    /// of four links or more, planar ones of 32): a shorter chain's flat
+    /// kernels are small, and quicker than the recursion in C as in Rust
+    /// (the soft finger's state derivative 5 against 17 us).
+    pub fn new(links: &'a LinkKernels, dof: usize) -> Option<Self> {
+        links.mass_bias.then_some(Self {
             links,
             dof,
             rows: None,
-        }
+        })
     }
 
     /// Draw the shape's `rows` (the base and each element's end) by the

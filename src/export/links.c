@@ -488,7 +488,8 @@ static void links_outputs(double t, const double *q, const double *qd, const dou
  * links/mod.rs in another order): at qd = 0 every velocity vanishes and
  * the accelerations are linear in qdd, so each frame's angular and linear
  * acceleration is carried for every unit qdd_j at once (NQ_LINKS columns),
- * from the cells at (q, 0) (`links_cells`), and the wrench past each link
+ * from the cells' frames, columns and inertia (`links_cells`: the rates
+ * change none of them), and the wrench past each link
  * projected on its coordinates' twists gives column j of M. Into the
  * packed upper triangle `out`. w: per link its centroid and columns, then
  * each column's force and torque. */
@@ -613,8 +614,9 @@ static void links_mass(const double *p, const double *cells, double *out, double
         for (i = 0; i <= j; i++) out[sa_packed(NQ_LINKS, i, j)] = tau[j * NQ_LINKS + i];
 }
 
-/* The kernels the library calls, on the recursion. M qdd + h packed: h
- * from the cells at (q, qd) at qdd = 0, M from the cells at (q, 0). */
+/* The kernels the library calls, on the recursion. M qdd + h packed from
+ * the cells at (q, qd): h at qdd = 0, and M, which reads only what of the
+ * cells the rates do not change (frames, columns, inertia). */
 #define SA_CELLS (LINK_COUNT * 2 * LINK_CELL_LEN(LINK_MAX_DOF))
 static void k_mass_bias(double t, const double *q, const double *qd, const double *qdd, const double *dir,
                         const double *p, const double *aux, double *out, double *scratch)
@@ -624,7 +626,6 @@ static void k_mass_bias(double t, const double *q, const double *qd, const doubl
     memset(zero, 0, 2 * NQ_LINKS * sizeof(double));
     links_cells(t, q, qd, zero, p, cells, w);
     links_sweep(t, q, qd, zero, zero, p, cells, out + NQ_LINKS * (NQ_LINKS + 1) / 2, dtau, w);
-    links_cells(t, q, zero, zero, p, cells, w);
     links_mass(p, cells, out, w);
 }
 

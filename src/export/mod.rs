@@ -120,7 +120,7 @@ pub fn export(
         _ => None,
     };
     let links = c_links::Links::of(&tapes)
-        .or_else(|| (derived_links.as_ref()).map(|l| c_links::Links::new(l, tapes.info.dof())))
+        .or_else(|| (derived_links.as_ref()).and_then(|l| c_links::Links::new(l, tapes.info.dof())))
         .map(|l| l.with_shape(shape.tape.outputs.len() / eomgen::shape::ROW));
     let prefix = c_api::identifier(&model.name);
     let library = c_api::Library {

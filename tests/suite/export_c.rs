@@ -62,6 +62,12 @@ fn rust_blocks(
         block("outputs", arm.outputs(t, q, qd).to_vec()),
         block("shape", shape.eval(t, q, &arm.params_at(t))),
     ];
+    // The inverse dynamics' derivative along (dq, dqd) = (qd, q) at qdd = 0:
+    // no solve, so the tangent's every term shows at 1e-12.
+    let dir: Vec<f64> = qd.iter().chain(q).copied().collect();
+    let mut dtau = vec![0.0; n];
+    arm.eval_direction(runtime::KernelKind::Jvp, t, q, qd, &dir, &[], &mut dtau);
+    blocks.push(block("jvp", dtau));
     let mut ws = runtime::Workspace::new(n);
     // qdd, then a viscoelastic arm's relaxed forces' rates.
     let mut dx = vec![0.0; x.len()];
@@ -127,6 +133,7 @@ fn driver(
          static void put(const double *v, size_t k) {{ size_t i; for (i = 0; i < k; i++) printf(\"%.17g\\n\", v[i]); }}\n\
          int main(void) {{\n  static {p}_params v; static {p}_model m;\n  \
          static double mass[{nn}], bias[{n}], out[{no}], shape[{up}_NSHAPE * 7], dx[{nx}], jac[{nxx}];\n  \
+         static double zeros[{n}], dtau[{n}];\n  \
          static double phi[{up}_NCONSTRAINTS + 1], cj[({up}_NCONSTRAINTS + 1) * {n}], gamma[{up}_NCONSTRAINTS + 1];\n  \
          size_t i;\n  {p}_default_params(&v);\n  {p}_init(&m, &v);\n",
         nn = n * n,
@@ -159,6 +166,7 @@ fn driver(
             "0.0 }};\n    {p}_mass_bias(&m, {t:?}, x, x + {n}, mass, bias); put(mass, {nn}); put(bias, {n});\n    \
              {p}_outputs(&m, {t:?}, x, x + {n}, out); put(out, {no});\n    \
              {p}_shape(&m, {t:?}, x, shape); put(shape, {up}_NSHAPE * 7);\n    \
+             {p}_inverse_dynamics_jvp(&m, {t:?}, x, x + {n}, zeros, x + {n}, x, dtau); put(dtau, {n});\n    \
              if ({p}_state_derivative(&m, {t:?}, x, dx)) return 3;\n    put(dx + {n}, {});",
             nx - n,
             nn = n * n,
@@ -412,8 +420,9 @@ fn a_viscoelastic_arms_relaxed_forces_are_exported_as_states() {
 }
 
 /// Models no build has, each a chain of link cells: the right-angle frame
-/// (a kink, a link without coordinates) and the tapered tentacle (its
-/// chambers' loads from inputs). The library is the cells and the
+/// (a kink, a link without coordinates), the tapered tentacle (its
+/// chambers' loads from inputs) and a planar finger of 32 arcs (an inertia
+/// that changes with the coordinates). The library is the cells and the
 /// recursion: its kernels agree with softarm's as every model's do; four
 /// times the elements leave the cells' kernels as they were, and the C
 /// grows by the parameters' names, fields and defaults and the layout's
@@ -425,6 +434,15 @@ fn a_chain_of_link_cells_exports_its_cells_and_the_recursion() {
         let spec = root().join("examples").join(format!("{name}.toml"));
         check_export_of(name, &spec, dir.path());
     }
+    // A planar pcc finger long enough for the recursion (32 elements): its
+    // arcs' inertia changes with their curvature.
+    let dir = tempfile::tempdir().unwrap();
+    let finger = std::fs::read_to_string(root().join("models/soft_finger.toml")).unwrap();
+    let long = finger.replace("elements = 8", "elements = 32");
+    assert_ne!(long, finger);
+    let spec = dir.path().join("long_finger.toml");
+    std::fs::write(&spec, long).unwrap();
+    check_export_of("long_finger", &spec, dir.path());
     let spec = root().join("examples/tapered_tentacle.toml");
     let source = |elements: usize| {
         let dir = tempfile::tempdir().unwrap();
