@@ -105,7 +105,7 @@ impl<'a> Links<'a> {
         let cells = 2 * cell::len(MAX_LINK_DOF) * layout.links.len();
         // `links_mass`: each link's geometry and its force and torque for
         // each column, the frames' accelerations, wrenches and M.
-        let mass = layout.links.len() * (6 + 12 * MAX_LINK_DOF + 6 * n) + 12 * n + n * n;
+        let mass = layout.links.len() * (6 + 15 * MAX_LINK_DOF + 6 * n) + 12 * n + n * n;
         mass + 5 * n
             + cells
             + layout.links.len() * LINK_RECORD
@@ -244,6 +244,14 @@ impl<'a> Links<'a> {
             scale.push(format!("{{{}}}", sc.join(", ")));
             terms.push(format!("{{{}}}", at.join(", ")));
         }
+        // Each coordinate's first link: M's sweep starts its column there.
+        let mut first = vec![layout.links.len(); self.dof];
+        for (k, spec) in layout.links.iter().enumerate() {
+            for &(a, _) in spec.map.iter().flat_map(|c| &c.terms) {
+                first[a] = first[a].min(k);
+            }
+        }
+        let first = first.iter().map(|k| k.to_string()).collect();
         let width = ELEMENT_PARAMS + REST_PARAMS;
         let list = |v: Vec<String>| match v.is_empty() {
             true => "0".to_string(),
@@ -255,7 +263,8 @@ impl<'a> Links<'a> {
              static const int LINK_SCALE[][{MAX_LINK_DOF}] = {{{}}};\n\
              static const size_t LINK_TERMS[][{MAX_LINK_DOF}] = {{{}}};\n\
              static const size_t TERM_START[] = {{{}}};\nstatic const size_t TERM_COORD[] = {{{}}};\n\
-             static const double TERM_WEIGHT[] = {{{}}};\n\n",
+             static const double TERM_WEIGHT[] = {{{}}};\n\
+             static const size_t COORD_FIRST_LINK[] = {{{}}};\n\n",
             list(dof),
             list(cells),
             list(params),
@@ -265,6 +274,7 @@ impl<'a> Links<'a> {
             list(start),
             list(coord),
             list(weight),
+            list(first),
         )
     }
 

@@ -481,8 +481,9 @@ static void links_outputs(double t, const double *q, const double *qd, const dou
 
 /* Per link: its centroid, its end, and its coordinates' columns (the end
  * frame's angular and end point velocity, the body's angular and centroid
- * velocity), in the world frame. */
-#define SA_GEOMETRY (6 + 12 * LINK_MAX_DOF)
+ * velocity, then the linear part of the twist at the world origin), in
+ * the world frame. */
+#define SA_GEOMETRY (6 + 15 * LINK_MAX_DOF)
 
 /* M, all its columns in one sweep (the composite bodies' sums of
  * links/mod.rs in another order): at qd = 0 every velocity vanishes and
@@ -519,8 +520,13 @@ static void links_mass(const double *p, const double *cells, double *out, double
             g[a] = pos[a] + cen[a];
             g[3 + a] = pos[a] + d[a];
         }
-        for (f = 0; f < nc; f++)
-            for (i = 0; i < 4; i++) sa_turn(r, o + LINK_COLUMNS + 12 * f + 3 * i, g + 6 + 12 * f + 3 * i);
+        for (f = 0; f < nc; f++) {
+            double *col = g + 6 + 15 * f, c1[3];
+            for (i = 0; i < 4; i++) sa_turn(r, o + LINK_COLUMNS + 12 * f + 3 * i, col + 3 * i);
+            /* v_end - s_w x end. */
+            sa_cross(col, g + 3, c1);
+            for (a = 0; a < 3; a++) col[12 + a] = col[3 + a] - c1[a];
+        }
         /* Cell coordinate f's acceleration for each unit qdd_j. */
         for (f = 0; f < nc; f++) {
             size_t at = LINK_TERMS[k][f];
@@ -532,13 +538,15 @@ static void links_mass(const double *p, const double *cells, double *out, double
             double *aj = acc + 3 * j, *alj = alpha + 3 * j, *fj = forces + (k * NQ_LINKS + j) * 6;
             double body_a[3], body_alpha[3], c1[3], ddd[3] = {0.0, 0.0, 0.0}, w_rel_d[3] = {0.0, 0.0, 0.0};
             double aw;
+            /* Before the first link coordinate j moves, nothing accelerates. */
+            if (k < COORD_FIRST_LINK[j]) continue;
             sa_cross(alj, cen, c1);
             for (a = 0; a < 3; a++) {
                 body_a[a] = aj[a] + c1[a];
                 body_alpha[a] = alj[a];
             }
             for (f = 0; f < nc; f++) {
-                const double *col = g + 6 + 12 * f;
+                const double *col = g + 6 + 15 * f;
                 for (a = 0; a < 3; a++) {
                     ddd[a] += xdd[f][j] * col[3 + a];
                     w_rel_d[a] += xdd[f][j] * col[a];
@@ -586,20 +594,21 @@ static void links_mass(const double *p, const double *cells, double *out, double
             for (a = 0; a < 3; a++) moment[3 * j + a] = torque[a] + c1[a];
         }
     }
-    /* Back from the tip: column j's wrench past each link on its twists. */
+    /* Back from the tip: column j's wrench past each link on its twists,
+     * down to the first link coordinate j moves: the rows of coordinates
+     * no earlier link moves are complete (the others come by symmetry). */
     memset(tau, 0, NQ_LINKS * NQ_LINKS * sizeof(double));
     for (k = LINK_COUNT; k-- > 0;) {
         const double *g = geometry + k * SA_GEOMETRY;
         for (j = 0; j < NQ_LINKS; j++) {
             const double *fj = forces + (k * NQ_LINKS + j) * 6;
             double *mj = moment + 3 * j, *Fj = force + 3 * j, c1[3];
+            if (k < COORD_FIRST_LINK[j]) continue;
             for (f = 0; f < LINK_DOF[k]; f++) {
-                const double *col = g + 6 + 12 * f;
+                const double *col = g + 6 + 15 * f;
                 size_t at = LINK_TERMS[k][f];
-                double sc = LINK_SCALE[k][f] < 0 ? 1.0 : p[LINK_SCALE[k][f]], gf;
-                sa_cross(col, g + 3, c1);
-                gf = sa_dot(col, mj) + (col[3] - c1[0]) * Fj[0] + (col[4] - c1[1]) * Fj[1] +
-                     (col[5] - c1[2]) * Fj[2] + sa_dot(col + 9, fj) + sa_dot(col + 6, fj + 3);
+                double sc = LINK_SCALE[k][f] < 0 ? 1.0 : p[LINK_SCALE[k][f]];
+                double gf = sa_dot(col, mj) + sa_dot(col + 12, Fj) + sa_dot(col + 9, fj) + sa_dot(col + 6, fj + 3);
                 for (i = TERM_START[at]; i < TERM_START[at + 1]; i++)
                     tau[j * NQ_LINKS + TERM_COORD[i]] += sc * TERM_WEIGHT[i] * gf;
             }
@@ -611,7 +620,9 @@ static void links_mass(const double *p, const double *cells, double *out, double
         }
     }
     for (j = 0; j < NQ_LINKS; j++)
-        for (i = 0; i <= j; i++) out[sa_packed(NQ_LINKS, i, j)] = tau[j * NQ_LINKS + i];
+        for (i = 0; i <= j; i++)
+            out[sa_packed(NQ_LINKS, i, j)] =
+                COORD_FIRST_LINK[j] >= COORD_FIRST_LINK[i] ? tau[i * NQ_LINKS + j] : tau[j * NQ_LINKS + i];
 }
 
 /* The kernels the library calls, on the recursion. M qdd + h packed from
