@@ -547,9 +547,23 @@ impl Library<'_> {
         c
     }
 
-    /// dx = (qd, qdd): L D L^T of M, then the joints' Schur complement.
+    /// Whether the state derivative is the articulated-body recursion's
+    /// (`Links::with_articulated`).
+    fn articulated(&self) -> bool {
+        self.links.as_ref().is_some_and(|l| l.articulated())
+    }
+
+    /// dx = (qd, qdd): L D L^T of M, then the joints' Schur complement; or
+    /// the articulated-body recursion.
     fn state_derivative(&self) -> String {
         let (p, n, m) = (self.prefix, self.n(), self.m());
+        if self.articulated() {
+            return format!(
+                "int {p}_state_derivative({p}_model *m, double t, const double *x, double *dx)\n{{\n    \
+                 size_t i;\n    for (i = 0; i < {n}; i++) dx[i] = x[{n} + i];\n    \
+                 return links_accelerations(t, x, x + {n}, m->p, dx + {n}, SCRATCH) ? 0 : 1;\n}}\n\n"
+            );
+        }
         let tri = n * (n + 1) / 2;
         let mut c = format!(
             "int {p}_state_derivative({p}_model *m, double t, const double *x, double *dx)\n{{\n    \
@@ -668,7 +682,7 @@ impl Library<'_> {
             "int {p}_state_jacobian({p}_model *m, double t, const double *x, double *jac)\n{{\n    \
              const double *q = x, *qd = x + {n};\n    size_t i, col;\n    \
              int status = {p}_state_derivative(m, t, x, DX);\n    \
-             if (status) return status;\n    \
+             if (status) return status;\n{factor}    \
              memset(jac, 0, {nx} * {nx} * sizeof(double));\n    \
              for (i = 0; i < {n}; i++) jac[i * {nx} + {n} + i] = 1.0;\n    \
              for (col = 0; col < {nx}; col++) {{\n        \
@@ -678,7 +692,15 @@ impl Library<'_> {
              sa_ldlt_solve({n}, LOWER, PIVOTS, DTAU);\n        \
              for (i = 0; i < {n}; i++) jac[({n} + i) * {nx} + col] = DTAU[i];\n    }}\n    \
              return 0;\n}}\n",
-            nx = 2 * n
+            nx = 2 * n,
+            // The articulated state derivative forms no M: factor it here.
+            factor = match self.articulated() {
+                true => format!(
+                    "    k_mass_bias(t, q, qd, NULL, NULL, m->p, NULL, PACKED, SCRATCH);\n    \
+                     if (sa_ldlt_factor({n}, PACKED, LOWER, PIVOTS)) return 1;\n"
+                ),
+                false => String::new(),
+            },
         )
     }
 }

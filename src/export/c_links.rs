@@ -22,8 +22,11 @@ use super::c_tape::{self, literal};
 const RECURSION: &str = include_str!("links.c");
 
 /// Doubles a link's record (links.c's `sa_link`) takes: centroid, force,
-/// torque, four twists a coordinate and its local force, as duals.
-const LINK_RECORD: usize = 2 * (9 + 12 * MAX_LINK_DOF + MAX_LINK_DOF);
+/// torque, axis, mass and inertia, four twists a coordinate and its local
+/// force, as duals.
+const LINK_RECORD: usize = 2 * (15 + 12 * MAX_LINK_DOF + MAX_LINK_DOF);
+/// Doubles a link's elimination (links.c's `sa_eliminated`) takes.
+const ELIMINATED: usize = 3 * 6 * MAX_LINK_DOF + MAX_LINK_DOF;
 
 pub struct Links<'a> {
     links: &'a LinkKernels,
@@ -31,6 +34,8 @@ pub struct Links<'a> {
     /// Where each shape row's links end, when the links' ends are the
     /// shape's rows (`shape_rows`).
     rows: Option<Vec<usize>>,
+    /// The state derivative runs the articulated-body recursion.
+    articulated: bool,
 }
 
 impl<'a> Links<'a> {
@@ -49,6 +54,7 @@ impl<'a> Links<'a> {
             links,
             dof,
             rows: None,
+            articulated: false,
         })
     }
 
@@ -65,6 +71,25 @@ impl<'a> Links<'a> {
         let covered = ends.last() == Some(&self.links.layout.links.len());
         self.rows = (covered && ends.len() == rows).then_some(ends);
         self
+    }
+
+    /// Run the state derivative by the articulated-body recursion where
+    /// it applies, as softarm's compiled chains do (links that own their
+    /// coordinates, no non-local forces, no inertia that changes with the
+    /// coordinates) and `alone`: nothing else needs M (joints, contact,
+    /// relaxed forces).
+    pub fn with_articulated(mut self, alone: bool) -> Self {
+        let layout = &self.links.layout;
+        self.articulated = alone
+            && runtime::links::all_owned(layout)
+            && !layout.forces
+            && !layout.variable_inertia;
+        self
+    }
+
+    /// Whether the state derivative runs the articulated-body recursion.
+    pub fn articulated(&self) -> bool {
+        self.articulated
     }
 
     /// Whether the recursion draws the shape.
@@ -106,7 +131,9 @@ impl<'a> Links<'a> {
         // `links_mass`: each link's geometry and its force and torque for
         // each column, the frames' accelerations, wrenches and M.
         let mass = layout.links.len() * (6 + 15 * MAX_LINK_DOF + 6 * n) + 12 * n + n * n;
-        mass + 5 * n
+        let articulated = layout.links.len() * ELIMINATED + 2 * n;
+        mass + articulated
+            + 5 * n
             + cells
             + layout.links.len() * LINK_RECORD
             + 3 * layout.loads
@@ -175,6 +202,7 @@ impl<'a> Links<'a> {
             ("TIP_LATERAL", index(layout.tip_inertia.map(|[l, _]| l))),
             ("TIP_AXIAL", index(layout.tip_inertia.map(|[_, a]| a))),
             ("TIP_FRAME", flag(layout.tip_frame).to_string()),
+            ("LINK_ABA", flag(self.articulated()).to_string()),
         ];
         for (name, v) in defines {
             let _ = writeln!(c, "#define {name} {v}");

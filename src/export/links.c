@@ -93,7 +93,8 @@ static sa_d3 sa_cell_v3(const double *out, size_t len, size_t i)
 
 /* What the sweep back needs of a link (links/tangent.rs' LinkForces). */
 typedef struct {
-    sa_d3 centroid, force, torque;
+    sa_d3 centroid, force, torque, axis;
+    sa_dual m, lateral, axial;
     sa_d3 twist_w[LINK_MAX_DOF], twist_v[LINK_MAX_DOF], own_w[LINK_MAX_DOF], own_v[LINK_MAX_DOF];
     sa_dual local_force[LINK_MAX_DOF];
 } sa_link;
@@ -212,6 +213,10 @@ static void sa_link_forward(sa_frame *frame, const double *out, size_t nc, const
             l->local_force[f] = sa_dsub(l->local_force[f], sa_dmul(half_w2, sa_cell_dual(out, len, rates + f)));
     }
     l->centroid = sa_add3(f0.pos, cen);
+    l->axis = axis;
+    l->m = m;
+    l->lateral = lateral;
+    l->axial = axial;
     l->force = sa_scale3(m, sa_sub3(body_a, gravity));
     l->torque = torque;
     for (i = 0; i < 3; i++) {
@@ -295,28 +300,20 @@ static void links_cells(double t, const double *q, const double *qd, const doubl
     }
 }
 
-/* tau = M qdd + h into tau and its derivative along dir into dtau from
- * the cells `links_cells` gave at (q, qd, dir) (links/tangent.rs'
- * inverse_dynamics_tangent). w: the links' records, then the non-local
- * forces and the kernels' scratch. */
-static void links_sweep(double t, const double *q, const double *qd, const double *qdd, const double *dir,
-                        const double *p, const double *cells, double *tau, double *dtau, double *w)
+/* The sweep out at qdd from the cells `links_cells` gave: each link's
+ * record into links, the end frame into *end, gravity into *gravity. */
+static void links_forward(const double *qd, const double *qdd, const double *dir, const double *p,
+                          const double *cells, double *links, sa_frame *end, sa_d3 *gravity)
 {
-    /* Each link's record, copied in and out (the workspace is doubles). */
-    double *links = w, *f = links + LINK_COUNT * SA_LINK_DOUBLES, *scratch = f + 2 * NQ_LINKS;
-    double xdd[LINK_MAX_DOF], xd[LINK_MAX_DOF], dqd[LINK_MAX_DOF];
-    double base[3][3], quat[4];
-    sa_frame frame;
-    sa_d3 gravity, moment, force;
-    sa_dual t_acc[NQ_LINKS];
+    double xdd[LINK_MAX_DOF], xd[LINK_MAX_DOF], dqd[LINK_MAX_DOF], base[3][3], quat[4];
     size_t k, i, c;
-    for (i = 0; i < 3; i++) gravity.c[i] = sa_dc(p[GRAVITY[i]]);
+    for (i = 0; i < 3; i++) gravity->c[i] = sa_dc(p[GRAVITY[i]]);
     sa_base(p, base, quat);
     for (i = 0; i < 3; i++) {
-        for (c = 0; c < 3; c++) frame.r[i].c[c] = sa_dc(base[i][c]);
-        frame.pos.c[i] = sa_dc(p[BASE_POSITION[i]]);
+        for (c = 0; c < 3; c++) end->r[i].c[c] = sa_dc(base[i][c]);
+        end->pos.c[i] = sa_dc(p[BASE_POSITION[i]]);
     }
-    frame.omega = frame.alpha = frame.acc = sa_zero3();
+    end->omega = end->alpha = end->acc = sa_zero3();
     for (k = 0; k < LINK_COUNT; k++) {
         size_t nc = LINK_DOF[k];
         sa_dual rates[LINK_MAX_DOF];
@@ -330,10 +327,26 @@ static void links_sweep(double t, const double *q, const double *qd, const doubl
                 rates[i].d = dqd[i];
             }
         }
-        sa_link_forward(&frame, cells + k * 2 * LINK_CELL_LEN(LINK_MAX_DOF), nc, xdd,
-                        VARIABLE_INERTIA ? rates : NULL, gravity, &l);
+        sa_link_forward(end, cells + k * 2 * LINK_CELL_LEN(LINK_MAX_DOF), nc, xdd, VARIABLE_INERTIA ? rates : NULL,
+                        *gravity, &l);
         memcpy(links + k * SA_LINK_DOUBLES, &l, sizeof l);
     }
+}
+
+/* tau = M qdd + h into tau and its derivative along dir into dtau from
+ * the cells `links_cells` gave at (q, qd, dir) (links/tangent.rs'
+ * inverse_dynamics_tangent). w: the links' records, then the non-local
+ * forces and the kernels' scratch. */
+static void links_sweep(double t, const double *q, const double *qd, const double *qdd, const double *dir,
+                        const double *p, const double *cells, double *tau, double *dtau, double *w)
+{
+    /* Each link's record, copied in and out (the workspace is doubles). */
+    double *links = w, *f = links + LINK_COUNT * SA_LINK_DOUBLES, *scratch = f + 2 * NQ_LINKS;
+    sa_frame frame;
+    sa_d3 gravity, moment, force;
+    sa_dual t_acc[NQ_LINKS];
+    size_t k, i;
+    links_forward(qd, qdd, dir, p, cells, links, &frame, &gravity);
     sa_tip_wrench(&frame, p, gravity, &moment, &force);
     for (i = 0; i < NQ_LINKS; i++) t_acc[i] = sa_dc(0.0);
     for (k = LINK_COUNT; k-- > 0;) {
@@ -649,6 +662,210 @@ static void k_jvp(double t, const double *q, const double *qd, const double *qdd
     links_cells(t, q, qd, dir, p, cells, w);
     links_sweep(t, q, qd, qdd, dir, p, cells, tau, out, w);
 }
+
+#if LINK_ABA
+/* The articulated-body recursion of a chain whose links own their
+ * coordinates (links/articulated.rs): qdd = -M^-1 h without M, each link
+ * eliminating its own coordinates from the tip, then the accelerations
+ * from the base. Twists (w, v at the world origin) and wrenches (moment
+ * about the origin, force) as six values. */
+
+/* A spatial inertia about the world origin: mass, first moment, J (xx,
+ * yy, zz, xy, xz, yz). */
+typedef struct {
+    double m, h[3], j[6];
+} sa_inertia;
+
+static void sa_add_body(sa_inertia *in, double m, const double *r, double lateral, double axial, const double *axis)
+{
+    static const int pa[6] = {0, 1, 2, 0, 0, 1}, pb[6] = {0, 1, 2, 1, 2, 2};
+    double r2 = sa_dot(r, r), d = axial - lateral, diag = lateral + m * r2;
+    int k;
+    in->m += m;
+    for (k = 0; k < 3; k++) in->h[k] += m * r[k];
+    for (k = 0; k < 6; k++)
+        in->j[k] += (k < 3 ? diag : 0.0) + d * axis[pa[k]] * axis[pb[k]] - m * r[pa[k]] * r[pb[k]];
+}
+
+/* The momentum of the twist tw: (J w + h x v, m v + w x h). */
+static void sa_momentum(const sa_inertia *in, const double *tw, double *out)
+{
+    const double *j = in->j, *w = tw, *v = tw + 3;
+    double c1[3], c2[3];
+    int k;
+    sa_cross(in->h, v, c1);
+    sa_cross(w, in->h, c2);
+    out[0] = j[0] * w[0] + j[3] * w[1] + j[4] * w[2] + c1[0];
+    out[1] = j[3] * w[0] + j[1] * w[1] + j[5] * w[2] + c1[1];
+    out[2] = j[4] * w[0] + j[5] * w[1] + j[2] * w[2] + c1[2];
+    for (k = 0; k < 3; k++) out[3 + k] = in->m * v[k] + c2[k];
+}
+
+/* Its 6 x 6 matrix. */
+static void sa_inertia_matrix(const sa_inertia *in, double a[6][6])
+{
+    int c, k;
+    for (c = 0; c < 6; c++) {
+        double e[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}, col[6];
+        e[c] = 1.0;
+        sa_momentum(in, e, col);
+        for (k = 0; k < 6; k++) a[k][c] = col[k];
+    }
+}
+
+static double sa_dot6(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
+}
+
+/* L D L^T of the n x n lower triangle of d in place; 0 unless positive
+ * definite. */
+static int sa_factor_small(double d[LINK_MAX_DOF][LINK_MAX_DOF], size_t n)
+{
+    size_t i, j, k;
+    for (j = 0; j < n; j++) {
+        double p = d[j][j];
+        for (k = 0; k < j; k++) p -= d[j][k] * d[j][k] * d[k][k];
+        if (!(p > 0.0)) return 0;
+        d[j][j] = p;
+        for (i = j + 1; i < n; i++) {
+            double s = d[i][j];
+            for (k = 0; k < j; k++) s -= d[i][k] * d[j][k] * d[k][k];
+            d[i][j] = s / p;
+        }
+    }
+    return 1;
+}
+
+/* x = D^-1 x in place by sa_factor_small's factors. */
+static void sa_solve_small(double d[LINK_MAX_DOF][LINK_MAX_DOF], size_t n, double *x)
+{
+    size_t i, k;
+    for (i = 0; i < n; i++)
+        for (k = 0; k < i; k++) x[i] -= d[i][k] * x[k];
+    for (i = 0; i < n; i++) x[i] /= d[i][i];
+    for (i = n; i-- > 0;)
+        for (k = i + 1; k < n; k++) x[i] -= d[k][i] * x[k];
+}
+
+/* What the sweep from the tip keeps of a link for the sweep from the base. */
+typedef struct {
+    double s_e[LINK_MAX_DOF][6], u_cols[LINK_MAX_DOF][6], d[LINK_MAX_DOF][LINK_MAX_DOF], u[LINK_MAX_DOF];
+} sa_eliminated;
+#define SA_ELIMINATED_DOUBLES ((sizeof(sa_eliminated) + sizeof(double) - 1) / sizeof(double))
+
+/* qdd = -M^-1 h at (q, qd); 0 unless every link's D is positive definite
+ * (M is then too). w: LINKS_ABA_WORK values. */
+static int links_accelerations(double t, const double *q, const double *qd, const double *p, double *qdd,
+                               double *w)
+{
+    double *zero = w, *cells = zero + 2 * NQ_LINKS, *links = cells + SA_CELLS;
+    double *kept = links + LINK_COUNT * SA_LINK_DOUBLES, *scratch = kept + LINK_COUNT * SA_ELIMINATED_DOUBLES;
+    double ia[6][6], pa[6], a[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    sa_inertia past;
+    sa_frame end;
+    sa_d3 gravity, moment, force;
+    size_t k, f, f2, i, j, at;
+    memset(zero, 0, 2 * NQ_LINKS * sizeof(double));
+    memset(&past, 0, sizeof past);
+    links_cells(t, q, qd, zero, p, cells, scratch);
+    links_forward(qd, zero, zero, p, cells, links, &end, &gravity);
+    sa_tip_wrench(&end, p, gravity, &moment, &force);
+    if (TIP_MASS >= 0) {
+        double length = TIP_LENGTH < 0 ? 0.0 : p[TIP_LENGTH], axis[3], centre[3];
+        for (i = 0; i < 3; i++) {
+            axis[i] = end.r[i].c[0].v;
+            centre[i] = end.pos.c[i].v + 0.5 * length * axis[i];
+        }
+        sa_add_body(&past, p[TIP_MASS], centre, TIP_LATERAL < 0 ? 0.0 : p[TIP_LATERAL],
+                    TIP_AXIAL < 0 ? 0.0 : p[TIP_AXIAL], axis);
+    }
+    sa_inertia_matrix(&past, ia);
+    for (i = 0; i < 3; i++) {
+        pa[i] = moment.c[i].v;
+        pa[3 + i] = force.c[i].v;
+    }
+    for (k = LINK_COUNT; k-- > 0;) {
+        size_t nc = LINK_DOF[k];
+        sa_link l;
+        sa_eliminated e;
+        sa_inertia body;
+        double ib[6][6], fb[6], s_b[LINK_MAX_DOF][6], ib_sb[LINK_MAX_DOF][6], ia_se[LINK_MAX_DOF][6];
+        double wm[LINK_MAX_DOF][6], cen[3], axis[3], c1[3];
+        memcpy(&l, links + k * SA_LINK_DOUBLES, sizeof l);
+        memset(&e, 0, sizeof e);
+        memset(&body, 0, sizeof body);
+        for (i = 0; i < 3; i++) {
+            cen[i] = l.centroid.c[i].v;
+            axis[i] = l.axis.c[i].v;
+        }
+        sa_add_body(&body, l.m.v, cen, l.lateral.v, l.axial.v, axis);
+        sa_inertia_matrix(&body, ib);
+        for (i = 0; i < 3; i++) {
+            double fv[3] = {l.force.c[0].v, l.force.c[1].v, l.force.c[2].v};
+            sa_cross(cen, fv, c1);
+            fb[i] = l.torque.c[i].v + c1[i];
+            fb[3 + i] = fv[i];
+        }
+        for (f = 0; f < nc; f++) {
+            double ow[3], ov[3];
+            for (i = 0; i < 3; i++) {
+                ow[i] = l.own_w[f].c[i].v;
+                ov[i] = l.own_v[f].c[i].v;
+            }
+            /* The body's column as a twist about the origin. */
+            sa_cross(ow, cen, c1);
+            for (i = 0; i < 3; i++) {
+                s_b[f][i] = ow[i];
+                s_b[f][3 + i] = ov[i] - c1[i];
+                e.s_e[f][i] = l.twist_w[f].c[i].v;
+                e.s_e[f][3 + i] = l.twist_v[f].c[i].v;
+            }
+            sa_momentum(&body, s_b[f], ib_sb[f]);
+            for (i = 0; i < 6; i++) ia_se[f][i] = sa_dot6(ia[i], e.s_e[f]);
+            for (i = 0; i < 6; i++) e.u_cols[f][i] = ib_sb[f][i] + ia_se[f][i];
+            e.u[f] = sa_dot6(s_b[f], fb) + sa_dot6(e.s_e[f], pa) + l.local_force[f].v;
+        }
+        for (f = 0; f < nc; f++)
+            for (f2 = 0; f2 <= f; f2++) e.d[f][f2] = sa_dot6(s_b[f], ib_sb[f2]) + sa_dot6(e.s_e[f], ia_se[f2]);
+        if (!sa_factor_small(e.d, nc)) return 0;
+        /* IA <- I_b + IA - U D^-1 U^T, pA <- F_b + pA - U D^-1 u. */
+        for (i = 0; i < 6; i++) {
+            double row[LINK_MAX_DOF];
+            for (f = 0; f < nc; f++) row[f] = e.u_cols[f][i];
+            sa_solve_small(e.d, nc, row);
+            for (f = 0; f < nc; f++) wm[f][i] = row[f];
+        }
+        for (i = 0; i < 6; i++) {
+            double v;
+            for (j = i; j < 6; j++) {
+                v = ib[i][j] + ia[i][j];
+                for (f = 0; f < nc; f++) v -= e.u_cols[f][i] * wm[f][j];
+                ia[i][j] = ia[j][i] = v;
+            }
+            v = fb[i] + pa[i];
+            for (f = 0; f < nc; f++) v -= wm[f][i] * e.u[f];
+            pa[i] = v;
+        }
+        memcpy(kept + k * SA_ELIMINATED_DOUBLES, &e, sizeof e);
+    }
+    /* From the base: x = -D^-1 (u + U^T a), a += S_e x. */
+    for (k = 0, at = 0; k < LINK_COUNT; k++) {
+        size_t nc = LINK_DOF[k];
+        sa_eliminated e;
+        double x[LINK_MAX_DOF];
+        memcpy(&e, kept + k * SA_ELIMINATED_DOUBLES, sizeof e);
+        for (f = 0; f < nc; f++) x[f] = -(e.u[f] + sa_dot6(e.u_cols[f], a));
+        sa_solve_small(e.d, nc, x);
+        for (f = 0; f < nc; f++) {
+            qdd[at + f] = x[f];
+            for (i = 0; i < 6; i++) a[i] += e.s_e[f][i] * x[f];
+        }
+        at += nc;
+    }
+    return 1;
+}
+#endif
 
 static void k_outputs(double t, const double *q, const double *qd, const double *qdd, const double *dir,
                       const double *p, const double *aux, double *out, double *scratch)

@@ -121,7 +121,11 @@ pub fn export(
     };
     let links = c_links::Links::of(&tapes)
         .or_else(|| (derived_links.as_ref()).and_then(|l| c_links::Links::new(l, tapes.info.dof())))
-        .map(|l| l.with_shape(shape.tape.outputs.len() / eomgen::shape::ROW));
+        .map(|l| l.with_shape(shape.tape.outputs.len() / eomgen::shape::ROW))
+        .map(|l| {
+            let alone = tapes.info.constraints.is_empty() && relax.is_none() && contact.is_none();
+            l.with_articulated(alone)
+        });
     let prefix = c_api::identifier(&model.name);
     let library = c_api::Library {
         prefix: &prefix,
