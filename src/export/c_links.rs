@@ -1,10 +1,12 @@
 //! A chain the link recursion covers, exported as its cells and the
 //! recursion (`links.c`) rather than as whole-arm kernels: each distinct
-//! cell's tangent and pose kernels as C functions, the chain's layout as
-//! tables, and the sweeps of `runtime_kernels::links` written once in C.
-//! `k_mass_bias`, `k_jvp` and `k_outputs` are then functions of the
-//! recursion with the kernels' signature, so the rest of the library calls
-//! them as it calls tapes. The library's size grows with the distinct
+//! cell's value, tangent and pose kernels as C functions, the chain's
+//! layout as tables, and the sweeps of `runtime_kernels::links` written
+//! once in C. `k_mass_bias`, `k_jvp`, `k_outputs` (and `k_shape` where the
+//! links' ends are the shape's rows) are then functions of the recursion
+//! with the kernels' signature, so the rest of the library calls them as
+//! it calls tapes; a chain of links that own their coordinates takes its
+//! state derivative from the articulated-body recursion. The library's size grows with the distinct
 //! cells, not with the links times the coordinates (a rom arm's flat
 //! kernels are megabytes of C).
 
@@ -28,11 +30,13 @@ const LINK_RECORD: usize = 2 * (15 + 12 * MAX_LINK_DOF + MAX_LINK_DOF);
 /// Doubles a link's elimination (links.c's `sa_eliminated`) takes.
 const ELIMINATED: usize = 3 * 6 * MAX_LINK_DOF + MAX_LINK_DOF;
 
+/// A chain's export: its link kernels and layout, whether the recursion
+/// draws the shape, and whether it gives the state derivative.
 pub struct Links<'a> {
     links: &'a LinkKernels,
     dof: usize,
     /// Where each shape row's links end, when the links' ends are the
-    /// shape's rows (`shape_rows`).
+    /// shape's rows (`with_shape`).
     rows: Option<Vec<usize>>,
     /// The state derivative runs the articulated-body recursion.
     articulated: bool,

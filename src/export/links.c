@@ -3,9 +3,11 @@
  * and gravity forces, and the wrench past each link projected on its
  * coordinates' twists. One sweep gives tau = M qdd + h and, in dual
  * numbers through the cells' tangents, its directional derivative along
- * (dq, dqd) (links/tangent.rs); M column by column from the inertial
- * part alone; the outputs by a sweep over the pose cells (links/outputs.rs).
- * The layout (LINK_*, TERM_*, the base, the tip) is the model's, above. */
+ * (dq, dqd) (links/tangent.rs); M by one sweep carrying all its columns;
+ * with LINK_ABA, the accelerations by the articulated-body recursion
+ * without M (links/articulated.rs); the outputs and the shape by sweeps
+ * over the pose cells (links/outputs.rs). The layout (LINK_*, TERM_*, the
+ * base, the tip) is the model's, above. */
 
 typedef struct {
     double v, d;
