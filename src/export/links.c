@@ -403,6 +403,16 @@ static void sa_turn(double r[3][3], const double *v, double *o)
     int i;
     for (i = 0; i < 3; i++) o[i] = sa_dot(r[i], v);
 }
+/* r <- r rel, rel the 3 x 3 rows at `rows` (a cell's relative rotation). */
+static void sa_compose(double r[3][3], const double *rows)
+{
+    double next[3][3];
+    int i, j;
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) next[i][j] = r[i][0] * rows[j] + r[i][1] * rows[3 + j] + r[i][2] * rows[6 + j];
+    memcpy(r, next, sizeof next);
+}
+
 /* Kinetic energy of a body of mass m, axisymmetric inertia about axis,
  * moving at (v, w). */
 static double sa_kinetic(double m, double lateral, double axial, const double *axis, const double *v,
@@ -423,7 +433,7 @@ static void links_outputs(double t, const double *q, const double *qd, const dou
     double r[3][3], quat[4], pos[3], v[3] = {0.0, 0.0, 0.0}, omega[3] = {0.0, 0.0, 0.0}, ke = 0.0, pe = 0.0;
     double gravity[3], cp[LINK_CELL_PARAMS], x[LINK_MAX_DOF], xd[LINK_MAX_DOF], axis[3], point[3], length;
     size_t k;
-    int i, j;
+    int i;
     for (i = 0; i < 3; i++) {
         gravity[i] = p[GRAVITY[i]];
         pos[i] = p[BASE_POSITION[i]];
@@ -431,14 +441,11 @@ static void links_outputs(double t, const double *q, const double *qd, const dou
     sa_base(p, r, quat);
     links_loads(t, q, qd, p, loads, scratch);
     for (k = 0; k < LINK_COUNT; k++) {
-        double rel[3][3], d[3], dd[3], w_rel[3], cen[3], cend[3], w_b[3], ax[3], body_v[3], body_w[3], c1[3],
-            next[3][3], q2[4], m;
+        double d[3], dd[3], w_rel[3], cen[3], cend[3], w_b[3], ax[3], body_v[3], body_w[3], c1[3], q2[4], m;
         sa_link_params(k, p, loads, cp);
         sa_local(k, p, q, x);
         sa_local(k, p, qd, xd);
         cell_pose(LINK_CELL[k], x, xd, cp, o, scratch);
-        for (i = 0; i < 3; i++)
-            for (j = 0; j < 3; j++) rel[i][j] = o[POSE_ROTATION + 3 * i + j];
         sa_turn(r, o + POSE_END, d);
         sa_turn(r, o + POSE_END + 3, dd);
         sa_turn(r, o + POSE_OMEGA, w_rel);
@@ -461,9 +468,7 @@ static void links_outputs(double t, const double *q, const double *qd, const dou
             omega[i] += w_rel[i];
             pos[i] += d[i];
         }
-        for (i = 0; i < 3; i++)
-            for (j = 0; j < 3; j++) next[i][j] = r[i][0] * rel[0][j] + r[i][1] * rel[1][j] + r[i][2] * rel[2][j];
-        memcpy(r, next, sizeof next);
+        sa_compose(r, o + POSE_ROTATION);
         sa_quat_mul(quat, o + POSE_QUAT, q2);
         memcpy(quat, q2, sizeof q2);
     }
@@ -517,14 +522,14 @@ static void links_mass(const double *p, const double *cells, double *out, double
     double *tau = force + 3 * NQ_LINKS;
     double r[3][3], quat[4], pos[3];
     size_t k, j, f, i;
-    int a, b;
+    int a;
     sa_base(p, r, quat);
     for (a = 0; a < 3; a++) pos[a] = p[BASE_POSITION[a]];
     memset(acc, 0, 6 * NQ_LINKS * sizeof(double));
     for (k = 0; k < LINK_COUNT; k++) {
         size_t nc = LINK_DOF[k], len = LINK_CELL_LEN(nc);
         const double *o = cells + k * 2 * LINK_CELL_LEN(LINK_MAX_DOF);
-        double *g = geometry + k * SA_GEOMETRY, rel[3][3], next[3][3], d[3], cen[3], axis[3];
+        double *g = geometry + k * SA_GEOMETRY, d[3], cen[3], axis[3];
         double xdd[LINK_MAX_DOF][NQ_LINKS + 1], m = o[LINK_MASS], lateral = o[LINK_MASS + 1],
                                                 axial = o[LINK_MASS + 2];
         (void)len;
@@ -581,11 +586,7 @@ static void links_mass(const double *p, const double *cells, double *out, double
                 alj[a] += w_rel_d[a];
             }
         }
-        for (a = 0; a < 3; a++)
-            for (b = 0; b < 3; b++) rel[a][b] = o[LINK_ROTATION + 3 * a + b];
-        for (a = 0; a < 3; a++)
-            for (b = 0; b < 3; b++) next[a][b] = r[a][0] * rel[0][b] + r[a][1] * rel[1][b] + r[a][2] * rel[2][b];
-        memcpy(r, next, sizeof next);
+        sa_compose(r, o + LINK_ROTATION);
         for (a = 0; a < 3; a++) pos[a] += d[a];
     }
     /* The tip body's wrench for each column. */
@@ -885,13 +886,13 @@ static void links_shape(double t, const double *q, const double *p, double *out,
     double *loads = w, *o = loads + 3 * LINK_LOADS + 1, *zero = o + LINK_POSE_LEN, *scratch = zero + NQ_LINKS;
     double r[3][3], quat[4], pos[3], cp[LINK_CELL_PARAMS], x[LINK_MAX_DOF], xd[LINK_MAX_DOF];
     size_t k, row = 0;
-    int i, j;
+    int i;
     memset(zero, 0, NQ_LINKS * sizeof(double));
     for (i = 0; i < 3; i++) pos[i] = p[BASE_POSITION[i]];
     sa_base(p, r, quat);
     links_loads(t, q, zero, p, loads, scratch);
     for (;;) {
-        double rel[3][3], d[3], next[3][3], q2[4];
+        double d[3], q2[4];
         for (i = 0; i < 3; i++) out[7 * row + i] = pos[i];
         for (i = 0; i < 4; i++) out[7 * row + 3 + i] = quat[i];
         row++;
@@ -901,13 +902,9 @@ static void links_shape(double t, const double *q, const double *p, double *out,
             sa_local(k, p, q, x);
             sa_local(k, p, zero, xd);
             cell_pose(LINK_CELL[k], x, xd, cp, o, scratch);
-            for (i = 0; i < 3; i++)
-                for (j = 0; j < 3; j++) rel[i][j] = o[POSE_ROTATION + 3 * i + j];
             sa_turn(r, o + POSE_END, d);
             for (i = 0; i < 3; i++) pos[i] += d[i];
-            for (i = 0; i < 3; i++)
-                for (j = 0; j < 3; j++) next[i][j] = r[i][0] * rel[0][j] + r[i][1] * rel[1][j] + r[i][2] * rel[2][j];
-            memcpy(r, next, sizeof next);
+            sa_compose(r, o + POSE_ROTATION);
             sa_quat_mul(quat, o + POSE_QUAT, q2);
             memcpy(quat, q2, sizeof q2);
         }

@@ -562,8 +562,18 @@ fn what_the_export_cannot_carry_is_refused_and_nothing_is_written() {
     let impulse_text = tap.replace("model = \"hunt_crossley\"", "model = \"impulse\"");
     assert_ne!(impulse_text, tap);
     std::fs::write(&impulse, impulse_text).unwrap();
-    {
-        let (spec, key) = (impulse.as_path(), "[contact]");
+    // A moving obstacle: the table driven by an input channel.
+    let moving = dir.path().join("moving.toml");
+    let moving_text = tap.replace(
+        "name = \"table\"",
+        "name = \"table\"\ntranslation_inputs = [\"vent\", \"vent\"]",
+    );
+    assert_ne!(moving_text, tap);
+    std::fs::write(&moving, moving_text).unwrap();
+    for (spec, key) in [
+        (impulse.as_path(), "[contact]"),
+        (moving.as_path(), "\"table\" moves"),
+    ] {
         let out = dir.path().join("c");
         let err = softarm::export::export_c(
             spec.to_str().unwrap(),
