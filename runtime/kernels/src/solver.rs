@@ -20,6 +20,10 @@ pub enum Solver {
     Euler,
     /// Radau IIA order 5, implicit, L-stable, adaptive (stiff systems).
     Radau5,
+    /// Radau IIA order 5 at a fixed step: L-stable, for stiff, lightly
+    /// damped structures whose stiffest modes nothing reads.
+    #[serde(rename = "radau5-fixed")]
+    Radau5Fixed,
     /// Variable-order BDF 1-5, implicit, adaptive (the ode15s family).
     Bdf,
     /// TR-BDF2, L-stable, second order, adaptive (MATLAB's ode23tb).
@@ -42,7 +46,7 @@ pub enum Solver {
 
 /// Every solver with its name and the order of its global error (bdf's
 /// highest; auto's dopri5's), in the order `--solver` lists them.
-const TABLE: [(Solver, &str, u32); 12] = [
+const TABLE: [(Solver, &str, u32); 13] = [
     (Solver::Dopri5, "dopri5", 5),
     (Solver::Bs23, "bs23", 3),
     (Solver::Dop853, "dop853", 8),
@@ -54,6 +58,7 @@ const TABLE: [(Solver, &str, u32); 12] = [
     (Solver::Esdirk, "esdirk", 3),
     (Solver::GenAlpha, "genalpha", 2),
     (Solver::Gauss, "gauss", 4),
+    (Solver::Radau5Fixed, "radau5-fixed", 5),
     (Solver::Auto, "auto", 5),
 ];
 
@@ -106,14 +111,23 @@ impl Solver {
 
     /// Fixed-step methods (no error estimate: `dt` sets the step).
     pub fn fixed_step(self) -> bool {
-        matches!(self, Self::Rk4 | Self::Euler | Self::Gauss)
+        matches!(
+            self,
+            Self::Rk4 | Self::Euler | Self::Gauss | Self::Radau5Fixed
+        )
     }
 
     /// Implicit methods (they use the analytic Jacobian).
     pub fn implicit(self) -> bool {
         matches!(
             self,
-            Self::Radau5 | Self::Bdf | Self::Trbdf2 | Self::Esdirk | Self::GenAlpha | Self::Gauss
+            Self::Radau5
+                | Self::Radau5Fixed
+                | Self::Bdf
+                | Self::Trbdf2
+                | Self::Esdirk
+                | Self::GenAlpha
+                | Self::Gauss
         )
     }
 }

@@ -17,7 +17,8 @@ use nalgebra::{DMatrix, DVector};
 use differential_equations::interpolate::Interpolation;
 
 use super::super::stepper::{
-    Contraction, Converging, Counts, OdeSystem, Options, REUSE_JACOBIAN_BELOW, StepFn, begin_step,
+    Contraction, Converging, Counts, OdeSystem, Options, REUSE_JACOBIAN_BELOW, STAGE_TOL, StepFn,
+    begin_step,
 };
 
 const S3: f64 = 1.732_050_807_568_877_2;
@@ -28,14 +29,6 @@ const A: [[f64; 2]; 2] = [[0.25, 0.25 - S3 / 6.0], [0.25 + S3 / 6.0, 0.25]];
 /// Y_i - y): no right-hand side at the converged stages.
 const D: [f64; 2] = [-S3, S3];
 const MAX_NEWTON: usize = 10;
-/// Newton stops when the update it expects next is below the user's
-/// rtol, relative to the state ([`update_norm`]): at a fixed step, rtol
-/// says how finely the stages are solved; within limits: tighter than
-/// round-off cannot be met, and looser than 1e-4 leaves the stages
-/// unsolved whatever rtol says. On the steel rod (rtol 1e-3) Newton
-/// contracts by 1e-3 an iteration: two iterations where 1e-6 took three,
-/// the tip the same to 0.01 mm over 25 s.
-const NEWTON_TOL: (f64, f64) = (1e-10, 1e-4);
 
 /// The Newton matrix I - h (A x J) of step `h`, factored.
 fn factor(j: &DMatrix<f64>, h: f64) -> nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn> {
@@ -169,7 +162,7 @@ pub fn integrate(
     counts: &mut Counts,
 ) -> Result<(), Error<f64, Vec<f64>>> {
     let m = y0.len();
-    let tol = opts.rtol.clamp(NEWTON_TOL.0, NEWTON_TOL.1);
+    let tol = opts.rtol.clamp(STAGE_TOL.0, STAGE_TOL.1);
     let (mut t, mut y) = (t0, y0);
     let mut jac = DMatrix::zeros(m, m);
     let mut lu: Option<(f64, nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>)> = None;

@@ -14,6 +14,7 @@ mod euler;
 pub mod gauss;
 pub mod genalpha;
 pub mod radau5;
+mod radau5_fixed;
 mod rk4;
 pub mod trbdf2;
 
@@ -47,6 +48,7 @@ pub(super) fn of(solver: Solver) -> &'static dyn Integrator {
         Solver::Rk4 => &rk4::Rk4,
         Solver::Euler => &euler::Euler,
         Solver::Radau5 => &Own(radau5::integrate),
+        Solver::Radau5Fixed => &Own(radau5_fixed::integrate),
         Solver::Bdf => &bdf::Bdf,
         Solver::Trbdf2 => &Own(trbdf2::integrate),
         Solver::Esdirk => &esdirk::Esdirk,

@@ -24,7 +24,7 @@ use super::super::stepper::{Counts, OdeSystem, Options, REUSE_JACOBIAN_BELOW, St
 /// sqrt(6)
 const SQ6: f64 = 2.449_489_742_783_178;
 /// Collocation nodes.
-const C: [f64; 3] = [(4.0 - SQ6) / 10.0, (4.0 + SQ6) / 10.0, 1.0];
+pub(super) const C: [f64; 3] = [(4.0 - SQ6) / 10.0, (4.0 + SQ6) / 10.0, 1.0];
 /// The Butcher matrix of Radau IIA, order 5 (the Newton iteration uses
 /// its inverse's eigendecomposition, [`T`]).
 #[cfg_attr(not(test), allow(dead_code))]
@@ -88,12 +88,12 @@ const MAX_NEWTON: usize = 7;
 
 /// The dense output of the last accepted step.
 pub struct Dense {
-    t_prev: f64,
-    t_curr: f64,
-    h: f64,
-    y_curr: Vec<f64>,
+    pub(super) t_prev: f64,
+    pub(super) t_curr: f64,
+    pub(super) h: f64,
+    pub(super) y_curr: Vec<f64>,
     /// Newton divided differences of the collocation polynomial.
-    cont: [Vec<f64>; 3],
+    pub(super) cont: [Vec<f64>; 3],
 }
 
 impl Interpolation<f64, Vec<f64>> for Dense {
@@ -116,6 +116,16 @@ impl Interpolation<f64, Vec<f64>> for Dense {
     }
 }
 
+/// The scaled tolerances (rtol, atol) and the Newton tolerance in their
+/// units. Hairer's transformation: the estimate is of order 3, so rtol' =
+/// 0.1 rtol^(2/3) makes the global error track rtol.
+fn tolerances(opts: &Options) -> (f64, f64, f64) {
+    let rtol = 0.1 * opts.rtol.powf(2.0 / 3.0);
+    let atol = rtol * (opts.atol / opts.rtol);
+    let newton_tol = (10.0 * f64::EPSILON / rtol).max(0.03f64.min(rtol.sqrt()));
+    (rtol, atol, newton_tol)
+}
+
 /// Integrate from (t0, y0) to `opts.t_end`. Errors carry the time and
 /// state reached.
 pub fn integrate(
@@ -128,11 +138,7 @@ pub fn integrate(
 ) -> Result<(), Error<f64, Vec<f64>>> {
     let t_end = opts.t_end;
     let m = y0.len();
-    // Hairer's tolerance transformation: the estimate is of order 3, so
-    // rtol' = 0.1 rtol^(2/3) makes the global error track rtol.
-    let rtol = 0.1 * opts.rtol.powf(2.0 / 3.0);
-    let atol = rtol * (opts.atol / opts.rtol);
-    let newton_tol = (10.0 * f64::EPSILON / rtol).max(0.03f64.min(rtol.sqrt()));
+    let (rtol, atol, newton_tol) = tolerances(opts);
     let (mut t, mut y) = (t0, y0);
     let mut f0 = vec![0.0; m];
     sys.rhs(t, &y, &mut f0);
@@ -260,7 +266,7 @@ pub fn integrate(
 
 impl Dense {
     /// The collocation polynomial past its step (the next step's Newton guess).
-    fn extrapolate(&self, t: f64) -> Vec<f64> {
+    pub(super) fn extrapolate(&self, t: f64) -> Vec<f64> {
         let s = (t - self.t_curr) / self.h;
         let (c1m1, c2m1) = (C[0] - 1.0, C[1] - 1.0);
         let c = &self.cont;
@@ -272,7 +278,7 @@ impl Dense {
 
 /// Divided differences of the collocation polynomial through y (s = -1)
 /// and y + Z_k (s = c_k - 1), in the variable s = (t - t_new) / h.
-fn divided_differences(z: &[Vec<f64>]) -> [Vec<f64>; 3] {
+pub(super) fn divided_differences(z: &[Vec<f64>]) -> [Vec<f64>; 3] {
     let m = z[0].len();
     let (c1, c2) = (C[0], C[1]);
     let (c1m1, c2m1) = (c1 - 1.0, c2 - 1.0);
@@ -289,7 +295,7 @@ fn divided_differences(z: &[Vec<f64>]) -> [Vec<f64>; 3] {
     d
 }
 
-type Lu = nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>;
+pub(super) type Lu = nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>;
 
 /// The filtered error vector and its scaled RMS norm, `filter` the real
 /// Newton matrix gamma/h - J at `h` ([`newton_matrices`]).
@@ -319,11 +325,11 @@ fn estimate(
     (e, norm)
 }
 
-type ComplexLu = nalgebra::LU<Complex<f64>, nalgebra::Dyn, nalgebra::Dyn>;
+pub(super) type ComplexLu = nalgebra::LU<Complex<f64>, nalgebra::Dyn, nalgebra::Dyn>;
 
 /// The transformed Newton matrices gamma/h - J and (alpha + i beta)/h - J,
 /// factored.
-fn newton_matrices(j: &DMatrix<f64>, h: f64, m: usize) -> (Lu, ComplexLu) {
+pub(super) fn newton_matrices(j: &DMatrix<f64>, h: f64, m: usize) -> (Lu, ComplexLu) {
     let mut real = -j.clone();
     let mut complex = j.map(|v| Complex::new(-v, 0.0));
     for i in 0..m {
@@ -334,17 +340,17 @@ fn newton_matrices(j: &DMatrix<f64>, h: f64, m: usize) -> (Lu, ComplexLu) {
 }
 
 /// Where a step starts: time, state and step size.
-struct StagePoint<'a> {
-    t: f64,
-    y: &'a [f64],
-    h: f64,
+pub(super) struct StagePoint<'a> {
+    pub(super) t: f64,
+    pub(super) y: &'a [f64],
+    pub(super) h: f64,
 }
 
 /// Simplified Newton on G(Z) = Z - h (A (x) I) F(Z) from the given Z, in
 /// the transformed variables W = T^-1 Z, with the matrices of
 /// [`newton_matrices`]: whether it converged, the iterations taken and
 /// the last contraction rate theta.
-fn simplified_newton(
+pub(super) fn simplified_newton(
     sys: &mut dyn OdeSystem,
     (real, complex): (&Lu, &ComplexLu),
     at: &StagePoint,

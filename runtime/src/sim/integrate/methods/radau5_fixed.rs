@@ -1,0 +1,241 @@
+//! Radau IIA of order 5 at a fixed step (`dt`): radau5's stages, Newton
+//! and collocation polynomial (`radau5.rs`) without its error control.
+//! L-stable, where gauss is not: a mode far above the step is gone in one
+//! step (R(infinity) = 0), while those the step resolves keep their
+//! amplitude and period to O((w h)^5). It is for stiff, lightly damped
+//! structures whose stiffest modes the motion excites but nothing reads
+//! (the stretch and shear of a steel rod, 10^5 rad/s): gauss keeps them
+//! ringing undamped, and as the motion feeds them its Newton iteration
+//! slows; adaptive radau5's estimate counts them and takes 40 us steps.
+//!
+//! Newton measures its updates on the positions alone (as gauss does): a
+//! position's stage rows are linear in the rates, so the rates' updates
+//! show through them, while the rates of modes far above the step swing by
+//! their size each step and held the iteration to updates that moved no
+//! position.
+
+use differential_equations::error::Error;
+use nalgebra::DMatrix;
+
+use super::super::stepper::{Counts, OdeSystem, Options, STAGE_TOL, StepFn, begin_step};
+use super::radau5::{
+    C, ComplexLu, Dense, Lu, StagePoint, divided_differences, newton_matrices, simplified_newton,
+};
+
+/// Keep the Jacobian while Newton contracts faster than this. At a fixed
+/// step a Jacobian kept costs only iterations, never a refactorisation for
+/// a new step nor a rejected one, and an arm's Jacobian costs 2n
+/// directional derivatives: on the steel rod with stretch and shear (30
+/// coordinates, 3 ms), 0.3 took 13 Jacobians where radau5's 0.1 took 226,
+/// for 1 % more right-hand sides and the same tip.
+const REUSE_JACOBIAN_BELOW: f64 = 0.3;
+
+/// Integrate from (t0, y0) to `opts.t_end` at the step `opts.dt`.
+pub fn integrate(
+    sys: &mut dyn OdeSystem,
+    t0: f64,
+    y0: Vec<f64>,
+    opts: &Options,
+    step: &mut StepFn<'_>,
+    counts: &mut Counts,
+) -> Result<(), Error<f64, Vec<f64>>> {
+    let m = y0.len();
+    let tol = opts.rtol.clamp(STAGE_TOL.0, STAGE_TOL.1);
+    let (mut t, mut y) = (t0, y0);
+    let mut j = DMatrix::zeros(m, m);
+    let (mut z, mut fz) = (vec![vec![0.0; m]; 3], vec![vec![0.0; m]; 3]);
+    let mut dense: Option<Dense> = None;
+    // The Newton matrices of the Jacobian in hand at step `.0`.
+    let mut factored: Option<(f64, Lu, ComplexLu)> = None;
+    let (mut need_jacobian, mut fresh) = (true, false);
+    let n = opts.positions.min(m / 2);
+    // The first step's stages from the derivative at the start; each later
+    // one's from the last step's collocation polynomial.
+    let mut f0 = vec![0.0; m];
+    sys.rhs(t, &y, &mut f0);
+    loop {
+        let mut h = opts.dt;
+        let last = begin_step(counts, opts, t, &mut h, &y)?;
+        let mut attempt = 0;
+        let iterations = loop {
+            if std::mem::take(&mut need_jacobian) {
+                sys.jacobian(t, &y, &mut j);
+                (fresh, factored) = (true, None);
+            }
+            if factored.as_ref().is_none_or(|f| f.0 != h) {
+                let (real, complex) = newton_matrices(&j, h, m);
+                factored = Some((h, real, complex));
+            }
+            predict(dense.as_ref(), (t, h), (&y, &f0), &mut z);
+            let scale = scale(&y, &z, n, tol);
+            let (_, real, complex) = factored.as_ref().expect("factored above");
+            let stage = StagePoint { t, y: &y, h };
+            let (converged, iterations, theta) =
+                simplified_newton(sys, (real, complex), &stage, &mut z, &mut fz, &scale, 1.0)?;
+            match (converged, fresh) {
+                (true, _) => break (iterations, theta),
+                // A Jacobian from an earlier state: a new one, once.
+                (false, false) if attempt == 0 => {
+                    counts.rejected += 1;
+                    attempt += 1;
+                    need_jacobian = true;
+                }
+                _ => return Err(Error::StepSize { t, y }),
+            }
+        };
+        let (iterations, theta) = iterations;
+        let y_new: Vec<f64> = (0..m).map(|i| y[i] + z[2][i]).collect();
+        if y_new.iter().any(|v| !v.is_finite()) {
+            return Err(Error::StepSize { t, y });
+        }
+        let t_new = if last { opts.t_end } else { t + h };
+        let d = dense.insert(Dense {
+            t_prev: t,
+            t_curr: t_new,
+            h,
+            y_curr: y_new.clone(),
+            cont: divided_differences(&z),
+        });
+        counts.accepted += 1;
+        if !step(t, t_new, &y, &y_new, d) || last {
+            return Ok(());
+        }
+        (t, y) = (t_new, y_new);
+        // One Newton iteration measures no contraction: J was good.
+        need_jacobian = iterations > 1 && theta > REUSE_JACOBIAN_BELOW;
+        fresh = false;
+    }
+}
+
+/// Newton's scale of each state component: `tol` times the size of its
+/// part of the state (the positions, the further states such as relaxing
+/// forces, or without positions the whole state), or of the step's
+/// predicted change where the state is zero (a start at rest in the rest
+/// shape); the rates' infinite (read through the positions, above).
+fn scale(y: &[f64], z: &[Vec<f64>], n: usize, tol: f64) -> Vec<f64> {
+    let m = y.len();
+    let size = |range: std::ops::Range<usize>| {
+        let of = |v: &[f64]| v[range.clone()].iter().fold(0.0f64, |s, x| s.max(x.abs()));
+        let change = z.iter().fold(0.0f64, |s, zk| s.max(of(zk)));
+        tol * of(y).max(change).max(f64::MIN_POSITIVE)
+    };
+    let (positions, rest) = match n {
+        0 => (size(0..m), 0.0),
+        _ => (size(0..n), if 2 * n < m { size(2 * n..m) } else { 0.0 }),
+    };
+    (0..m)
+        .map(|i| match (n, i) {
+            (0, _) => positions,
+            (_, i) if i < n => positions,
+            (_, i) if i < 2 * n => f64::INFINITY,
+            _ => rest,
+        })
+        .collect()
+}
+
+/// The stage increments' guess: the last step's collocation polynomial,
+/// extrapolated; at the start, the derivative `f0` there times each
+/// stage's time.
+fn predict(
+    dense: Option<&Dense>,
+    (t, h): (f64, f64),
+    (y, f0): (&[f64], &[f64]),
+    z: &mut [Vec<f64>],
+) {
+    for (k, zk) in z.iter_mut().enumerate() {
+        match dense {
+            Some(d) => {
+                let yk = d.extrapolate(t + C[k] * h);
+                for (i, zi) in zk.iter_mut().enumerate() {
+                    *zi = yk[i] - y[i];
+                }
+            }
+            None => {
+                for (zi, fi) in zk.iter_mut().zip(f0) {
+                    *zi = C[k] * h * fi;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use differential_equations::interpolate::Interpolation;
+    use nalgebra::Complex;
+
+    use super::*;
+
+    /// x'' = -w^2 x as y = (x, v).
+    struct Oscillator(f64);
+
+    impl OdeSystem for Oscillator {
+        fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) {
+            dy[0] = y[1];
+            dy[1] = -self.0 * self.0 * y[0];
+        }
+        fn jacobian(&mut self, _t: f64, _y: &[f64], j: &mut DMatrix<f64>) {
+            j.fill(0.0);
+            j[(0, 1)] = 1.0;
+            j[(1, 0)] = -self.0 * self.0;
+        }
+    }
+
+    /// Radau IIA's stability function (1 + 2z/5 + z^2/20) / (1 - 3z/5 +
+    /// 3z^2/20 - z^3/60): from x = 1, v = 0, k steps give x = Re R(i w h)^k
+    /// and v = Re(i w R(i w h)^k). A mode the step resolves (w h = 0.5)
+    /// keeps its amplitude to 2e-6 a step; one far above it (w h = 100) is
+    /// divided by about w h / 3 each step.
+    #[test]
+    fn each_step_multiplies_a_mode_by_the_stability_function() {
+        for (w, h, steps) in [(1.0f64, 0.5, 40usize), (100.0, 1.0, 3)] {
+            let opts = Options {
+                t_end: steps as f64 * h,
+                rtol: 1e-12,
+                atol: 1e-12,
+                max_steps: 1000,
+                rho_inf: 1.0,
+                dt: h,
+                positions: 1,
+            };
+            let mut last = vec![];
+            let mut on_step =
+                |_: f64, _: f64, _: &[f64], y: &[f64], _: &mut dyn Interpolation<f64, Vec<f64>>| {
+                    last = y.to_vec();
+                    true
+                };
+            let mut counts = Counts::default();
+            integrate(
+                &mut Oscillator(w),
+                0.0,
+                vec![1.0, 0.0],
+                &opts,
+                &mut on_step,
+                &mut counts,
+            )
+            .unwrap();
+            assert_eq!(counts.accepted, steps);
+            let z = Complex::new(0.0, w * h);
+            let r =
+                (1.0 + z * 0.4 + z * z / 20.0) / (1.0 - z * 0.6 + z * z * 0.15 - z * z * z / 60.0);
+            let rk = r.powu(steps as u32);
+            let (x, v) = (rk.re, (Complex::new(0.0, w) * rk).re);
+            assert!(
+                (last[0] - x).abs() < 1e-9,
+                "w h {}: x {} against {x}",
+                w * h,
+                last[0]
+            );
+            assert!(
+                (last[1] - v).abs() < 1e-9 * w,
+                "w h {}: v {} against {v}",
+                w * h,
+                last[1]
+            );
+            match w * h {
+                wh if wh < 1.0 => assert!((1.0 - r.norm()).abs() < 1e-5, "|R| {}", r.norm()),
+                wh => assert!(r.norm() < 4.0 / wh, "|R| {}", r.norm()),
+            }
+        }
+    }
+}
