@@ -119,9 +119,11 @@ impl Interpolation<f64, Vec<f64>> for Dense {
 /// The scaled tolerances (rtol, atol) and the Newton tolerance in their
 /// units. Hairer's transformation: the estimate is of order 3, so rtol' =
 /// 0.1 rtol^(2/3) makes the global error track rtol.
-fn tolerances(opts: &Options) -> (f64, f64, f64) {
-    let rtol = 0.1 * opts.rtol.powf(2.0 / 3.0);
-    let atol = rtol * (opts.atol / opts.rtol);
+pub(super) fn tolerances(rtol: f64, atol: f64) -> (f64, f64, f64) {
+    let (rtol, atol) = (
+        0.1 * rtol.powf(2.0 / 3.0),
+        0.1 * rtol.powf(2.0 / 3.0) * (atol / rtol),
+    );
     let newton_tol = (10.0 * f64::EPSILON / rtol).max(0.03f64.min(rtol.sqrt()));
     (rtol, atol, newton_tol)
 }
@@ -138,7 +140,7 @@ pub fn integrate(
 ) -> Result<(), Error<f64, Vec<f64>>> {
     let t_end = opts.t_end;
     let m = y0.len();
-    let (rtol, atol, newton_tol) = tolerances(opts);
+    let (rtol, atol, newton_tol) = tolerances(opts.rtol, opts.atol);
     let (mut t, mut y) = (t0, y0);
     let mut f0 = vec![0.0; m];
     sys.rhs(t, &y, &mut f0);
