@@ -249,22 +249,8 @@ fn extrapolate(z: &[f64], ratio: f64) -> Vec<f64> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::Oscillator;
     use super::*;
-
-    /// x'' = -w^2 x as y = (x, v).
-    struct Oscillator(f64);
-
-    impl OdeSystem for Oscillator {
-        fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) {
-            dy[0] = y[1];
-            dy[1] = -self.0 * self.0 * y[0];
-        }
-        fn jacobian(&mut self, _t: f64, _y: &[f64], j: &mut DMatrix<f64>) {
-            j.fill(0.0);
-            j[(0, 1)] = 1.0;
-            j[(1, 0)] = -self.0 * self.0;
-        }
-    }
 
     /// A mode far above the step (w h = 50) keeps its amplitude and turns
     /// by the method's own phase a step, arg R(i w h), with the stability

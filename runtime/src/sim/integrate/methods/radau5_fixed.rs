@@ -183,22 +183,8 @@ mod tests {
     use differential_equations::interpolate::Interpolation;
     use nalgebra::Complex;
 
+    use super::super::Oscillator;
     use super::*;
-
-    /// x'' = -w^2 x as y = (x, v).
-    struct Oscillator(f64);
-
-    impl OdeSystem for Oscillator {
-        fn rhs(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) {
-            dy[0] = y[1];
-            dy[1] = -self.0 * self.0 * y[0];
-        }
-        fn jacobian(&mut self, _t: f64, _y: &[f64], j: &mut DMatrix<f64>) {
-            j.fill(0.0);
-            j[(0, 1)] = 1.0;
-            j[(1, 0)] = -self.0 * self.0;
-        }
-    }
 
     /// Radau IIA's stability function (1 + 2z/5 + z^2/20) / (1 - 3z/5 +
     /// 3z^2/20 - z^3/60): from x = 1, v = 0, k steps give x = Re R(i w h)^k
