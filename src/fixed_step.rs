@@ -1,6 +1,7 @@
 //! The largest fixed step that keeps a run within a tolerance (the
 //! chapter's step-size procedure for fixed-step use, as a controller
-//! needs): a tight variable-step reference, then fixed steps of T / 2^k
+//! needs): a tight variable-step reference (dop853, or radau5 for the
+//! implicit gauss and radau5-fixed), then fixed steps of T / 2^k
 //! until the tip stays within the tolerance of the reference at every
 //! sample.
 
@@ -22,7 +23,8 @@ pub struct StepChoice {
     /// the first step tried already held).
     pub coarser_dt: Option<f64>,
     pub coarser_error_m: Option<f64>,
-    /// The reference: dop853's steps at rtol 1e-10.
+    /// The reference's steps: dop853 at rtol 1e-10, or radau5 for an
+    /// implicit method (whose arm may be stiff).
     pub reference_steps: usize,
     pub tolerance_m: f64,
 }
@@ -49,7 +51,7 @@ pub fn choose(
 ) -> Result<StepChoice> {
     if !solver.fixed_step() {
         bail!(
-            "--solver {}: not a fixed-step solver (rk4 or euler)",
+            "--solver {}: not a fixed-step solver (rk4, euler, gauss or radau5-fixed)",
             solver.name()
         );
     }
@@ -62,15 +64,20 @@ pub fn choose(
         output_dt: t_end / SAMPLES,
         ..Default::default()
     };
+    // An implicit method's arm may be stiff: its reference is implicit too.
     let reference = SimOptions {
-        solver: Solver::Dop853,
+        solver: match solver.implicit() {
+            true => Solver::Radau5,
+            false => Solver::Dop853,
+        },
         rtol: 1e-10,
         atol: 1e-13,
         ..base.clone()
     };
+    let by = reference.solver.name();
     let Some((want, reference_steps)) = tips(loaded, x0, reference) else {
         bail!(
-            "the reference run (dop853 at rtol 1e-10) failed: the arm cannot be run over {t_end} s"
+            "the reference run ({by} at rtol 1e-10) failed: the arm cannot be run over {t_end} s"
         );
     };
     let error = |dt: f64| -> f64 {

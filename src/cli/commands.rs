@@ -935,7 +935,7 @@ pub struct FixedStepArgs {
     #[command(flatten)]
     pub model: ModelArgs,
     /// The fixed-step solver.
-    #[arg(long, default_value = "rk4", value_parser = ["rk4", "euler"])]
+    #[arg(long, default_value = "rk4", value_parser = ["rk4", "euler", "gauss", "radau5-fixed"])]
     pub solver: String,
     /// The tip's largest allowed distance from the reference (m).
     #[arg(long, default_value_t = 1e-3)]

@@ -348,14 +348,26 @@ fn a_fixed_step_run_records_its_end_and_restarts_at_t0() {
 
 /// `softarm fixed-step`: the step it picks keeps the tip within the
 /// tolerance of a tight run by another method (radau5 at rtol 1e-10), and
-/// the step twice as large does not.
+/// the step twice as large does not; for an explicit method and an
+/// implicit one.
 #[test]
 fn the_fixed_step_chosen_holds_the_tolerance_and_twice_it_does_not() {
     let l = loaded("soft_finger", &[]);
     let n = l.arm.dof();
     let x0 = vec![0.0; 2 * n];
-    let (t_end, tol) = (0.5, 1e-4);
-    let choice = softarm::fixed_step::choose(&l, &x0, t_end, Solver::Rk4, tol).unwrap();
+    // radau5-fixed's largest step tried (T / 200) meets 1e-4 already.
+    for (solver, tol) in [(Solver::Rk4, 1e-4), (Solver::Radau5Fixed, 1e-7)] {
+        fixed_step_holds(&l, &x0, (0.5, tol), solver);
+    }
+}
+
+fn fixed_step_holds(
+    l: &softarm::backend::Loaded,
+    x0: &[f64],
+    (t_end, tol): (f64, f64),
+    solver: Solver,
+) {
+    let choice = softarm::fixed_step::choose(l, x0, t_end, solver, tol).unwrap();
     let tips = |solver: Solver, dt: f64, rtol: f64| {
         let opts = SimOptions {
             t_end,
@@ -366,12 +378,12 @@ fn the_fixed_step_chosen_holds_the_tolerance_and_twice_it_does_not() {
             output_dt: t_end / 200.0,
             ..Default::default()
         };
-        let (traj, _) = simulate(&*l.arm, x0.clone(), &opts).unwrap();
-        softarm::run::tips(&l, &traj)
+        let (traj, _) = simulate(&*l.arm, x0.to_vec(), &opts).unwrap();
+        softarm::run::tips(l, &traj)
     };
     let reference = tips(Solver::Radau5, 0.0, 1e-10);
     let distance = |dt: f64| {
-        (tips(Solver::Rk4, dt, 0.0).iter().zip(&reference))
+        (tips(solver, dt, 1e-6).iter().zip(&reference))
             .map(|((_, a), (_, b))| (0..3).map(|c| (a[c] - b[c]).powi(2)).sum::<f64>().sqrt())
             .fold(0.0, f64::max)
     };
