@@ -406,3 +406,34 @@ fn an_arm_on_anothers_tip_moves_as_the_same_arms_welded() {
     assert!(scale > 0.1, "the arms sag: {scale}");
     assert!(worst < 2e-5 * scale, "differ by {worst:e}");
 }
+
+/// An arm on a segment's end (`on = "ARM.segment.K.end"`) of a two-segment
+/// arm is the same mechanism as a one-segment arm whose tip carries two
+/// arms: the second segment continued straight, and the branch.
+#[test]
+fn an_arm_on_a_segments_end_moves_as_a_branch_at_that_point() {
+    let arm = |name: &str, on: &str, direction: &str, length: f64, elements: usize| {
+        let base = match on {
+            "" => String::new(),
+            on => format!("on = \"{on}\"\n"),
+        };
+        format!(
+            "[[arm]]\nname = \"{name}\"\n[arm.base]\n{base}direction = {direction}\n[[arm.segment]]\nlength = {length}\nelements = {elements}\n{SEGMENT}\n"
+        )
+    };
+    let on_segment = format!(
+        "name = \"a\"\n{SPACE}\n{}[[arm.segment]]\nlength = 0.15\nelements = 3\n{SEGMENT}\n{}",
+        arm("upper", "", "[1.0, 0.0, 0.0]", 0.2, 4),
+        arm("lower", "upper.segment.0.end", "[0.0, 1.0, 0.5]", 0.1, 2)
+    );
+    let branched = format!(
+        "name = \"b\"\n{SPACE}\n{}{}{}",
+        arm("upper", "", "[1.0, 0.0, 0.0]", 0.2, 4),
+        arm("rest", "upper.tip", "[1.0, 0.0, 0.0]", 0.15, 3),
+        arm("lower", "upper.tip", "[0.0, 1.0, 0.5]", 0.1, 2)
+    );
+    let (statics, motion, scale) = differences(&on_segment, &branched);
+    assert!(scale > 0.1, "the arms sag: {scale}");
+    assert!(statics < 1e-9 * scale, "statics differ by {statics:e}");
+    assert!(motion < 1e-7 * scale, "motion differs by {motion:e}");
+}
