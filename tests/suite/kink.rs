@@ -190,8 +190,8 @@ end = 2.0
 /// 8.32, the trough -9.21 and the crest after the double hump 7.50, 8.2 s
 /// from crest to trough and 19.2 s from the first crest to the third.
 /// The digitised curve starts its rise about 0.8 s before this solution
-/// (and every converged method here: pcc, ebr and pcs at 10 and 20
-/// elements a leg agree to 0.05), a shift of its whole time axis, so
+/// (ebr at 20 elements a leg, pcc and pcs at 10 agree with this one to
+/// 0.05 at the crests and the trough), a shift of its whole time axis, so
 /// the times are compared as intervals. The tolerances are the figure's
 /// reading and the paper's coarse mesh (ten linear elements a leg).
 #[test]
