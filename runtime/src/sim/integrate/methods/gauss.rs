@@ -249,7 +249,7 @@ fn extrapolate(z: &[f64], ratio: f64) -> Vec<f64> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::Oscillator;
+    use super::super::oscillate;
     use super::*;
 
     /// A mode far above the step (w h = 50) keeps its amplitude and turns
@@ -260,31 +260,7 @@ mod tests {
     #[test]
     fn a_mode_far_above_the_step_keeps_its_amplitude() {
         let (w, h, steps) = (1.0e4, 5e-3, 7);
-        let opts = Options {
-            t_end: steps as f64 * h,
-            rtol: 1e-6,
-            atol: 1e-9,
-            max_steps: 100,
-            rho_inf: 1.0,
-            dt: h,
-            positions: 1,
-        };
-        let mut last = vec![];
-        let mut on_step =
-            |_: f64, _: f64, _: &[f64], y: &[f64], _: &mut dyn Interpolation<f64, Vec<f64>>| {
-                last = y.to_vec();
-                true
-            };
-        let mut counts = Counts::default();
-        integrate(
-            &mut Oscillator(w),
-            0.0,
-            vec![1.0, 0.0],
-            &opts,
-            &mut on_step,
-            &mut counts,
-        )
-        .unwrap();
+        let (last, counts) = oscillate(integrate, (w, h, steps), 1e-6);
         let wh = w * h;
         let phase = 2.0 * (wh / 2.0).atan2(1.0 - wh * wh / 12.0);
         let n = counts.accepted as f64;

@@ -76,6 +76,47 @@ impl super::stepper::OdeSystem for Oscillator {
     }
 }
 
+/// `steps` steps of `method` at the fixed step h on [`Oscillator`]`(w)`
+/// from x = 1, v = 0, the stages solved to `rtol`: the last state and
+/// the counts.
+#[cfg(test)]
+pub(super) fn oscillate(
+    method: OwnIntegrator,
+    (w, h, steps): (f64, f64, usize),
+    rtol: f64,
+) -> (Vec<f64>, super::stepper::Counts) {
+    let opts = super::stepper::Options {
+        t_end: steps as f64 * h,
+        rtol,
+        atol: 1e-3 * rtol,
+        max_steps: 100 * steps,
+        rho_inf: 1.0,
+        dt: h,
+        positions: 1,
+    };
+    let mut last = vec![];
+    let mut on_step =
+        |_: f64,
+         _: f64,
+         _: &[f64],
+         y: &[f64],
+         _: &mut dyn differential_equations::interpolate::Interpolation<f64, Vec<f64>>| {
+            last = y.to_vec();
+            true
+        };
+    let mut counts = super::stepper::Counts::default();
+    method(
+        &mut Oscillator(w),
+        0.0,
+        vec![1.0, 0.0],
+        &opts,
+        &mut on_step,
+        &mut counts,
+    )
+    .unwrap();
+    (last, counts)
+}
+
 #[cfg(test)]
 mod tests {
     use differential_equations::interpolate::Interpolation;
