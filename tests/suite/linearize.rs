@@ -146,43 +146,24 @@ fn the_pressed_module_linearises_as_its_differences() {
 /// 5 L^3 / (48 E I), the load's lever on the tip.
 #[test]
 fn a_load_along_the_arm_linearises_to_its_static_gain() {
-    let (l, e, r): (f64, f64, f64) = (0.2, 1e6, 0.01);
-    let text = format!(
-        r#"
-name = "midspan"
-dimensions = 3
-gravity = [0.0, 0.0, 0.0]
-[base]
-direction = [1.0, 0.0, 0.0]
-[[segment]]
-method = "pcc"
-length = {l}
-elements = 16
-density = 1000.0
-outer_radius = {r}
-youngs_modulus = {e}
-[[load]]
-segment = 0
-s = {}
-force_inputs = ["zero", "zero", "push"]
-[inputs.zero]
-kind = "constant"
-value = 0.0
-[inputs.push]
-kind = "constant"
-value = 0.0
-"#,
-        l / 2.0
+    use crate::loads::{L, cantilever, ei};
+    let load = format!(
+        "[[load]]\nsegment = 0\ns = {}\nforce_inputs = [\"zero\", \"zero\", \"push\"]\n\
+         [inputs.zero]\nkind = \"constant\"\nvalue = 0.0\n\
+         [inputs.push]\nkind = \"constant\"\nvalue = 0.0",
+        L / 2.0
     );
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("midspan.toml");
-    std::fs::write(&path, text).unwrap();
+    std::fs::write(&path, cantilever(3, &load)).unwrap();
     let o = softarm(
         &[
             "linearize",
             path.to_str().unwrap(),
             "--inputs",
             "push",
+            "--set",
+            "segment.0.elements=16",
             "--json",
         ],
         dir.path(),
@@ -196,8 +177,7 @@ value = 0.0
     };
     let (a, b, c) = (matrix("A"), matrix("B"), matrix("C"));
     let gain = -(&c * a.lu().solve(&b).unwrap());
-    let ei = e * std::f64::consts::PI * r.powi(4) / 4.0;
-    let want = 5.0 * l.powi(3) / (48.0 * ei);
+    let want = 5.0 * L.powi(3) / (48.0 * ei());
     // C's rows: the tip's x, y, z first.
     assert_close(gain[(2, 0)], want, 2e-3, 0.0, "the tip's z per newton");
     assert_close(

@@ -16,15 +16,16 @@ use std::f64::consts::PI;
 
 use crate::common::*;
 
-const L: f64 = 0.2;
-const E: f64 = 1e6;
-const R: f64 = 0.01;
+pub(crate) const L: f64 = 0.2;
+pub(crate) const E: f64 = 1e6;
+pub(crate) const R: f64 = 0.01;
 
-fn ei() -> f64 {
+pub(crate) fn ei() -> f64 {
     E * PI * R.powi(4) / 4.0
 }
 
-fn cantilever(dimensions: u8, extra: &str) -> String {
+/// The loaded cantilever, eight pcc elements, with `extra` (its loads).
+pub(crate) fn cantilever(dimensions: u8, extra: &str) -> String {
     format!(
         r#"
 name = "loaded"
