@@ -39,9 +39,9 @@ pub enum CacheStatus {
     Hit,
     Miss,
     /// Compiled link cells of another model's, linked to this chain's
-    /// layout (`runtime::linked::LinkedKernels`): no tape needed but an
-    /// arm with contact's, for its contact kernels (from the cache or
-    /// derived into it).
+    /// layout (`runtime::linked::LinkedKernels`): no tape needed but, for
+    /// their contact kernels, an assembly's and an arm's whose contact
+    /// points are off its links' arcs (from the cache or derived into it).
     Linked,
 }
 
@@ -130,8 +130,9 @@ pub fn read_model(spec: &str, overrides: &[Override]) -> Result<(Model, String)>
 /// A chain whose element count (or rom order) no compiled-in model has, on
 /// the compiled cells of its link shapes when every one is compiled in
 /// (found by key), with the seconds its layout took to derive; or why it
-/// cannot run so. An arm with contact takes its contact kernels from its
-/// tapes ([`tapes`]: the cache's, else derived and cached); an assembly
+/// cannot run so. Its contact kernels are the recursion's where its points
+/// lie on its links' arcs, else its tapes' ([`tapes`]: the cache's, else
+/// derived and cached); an assembly
 /// its arms' kernels so, and the rest, its joints and contact by its
 /// tapes (`runtime::assembled::BlockKernels`).
 fn linked(
@@ -198,19 +199,22 @@ fn linked(
             Box::new(BlockKernels::new(tapes, kinds).ok_or_else(not_cells)?),
             note,
         )
+    } else if let Some((info, links)) = eomgen::derive::derive_links(structure) {
+        // Contact too, where its points lie on the links' arcs.
+        let cells = compiled_cells(&links);
+        let note = taped(&cells);
+        (Box::new(LinkedKernels::new(info, links, cells)), note)
     } else if structure.contact_points > 0 {
         let (tapes, _, _) = tapes(model, &structure.hash(), cache_dir);
         let cells = compiled_cells(tapes.links.as_ref().ok_or_else(not_cells)?);
-        let note = taped(&cells);
+        // Its points are not all on the links' arcs (a rigid chain's).
+        let note = format!(", its contact kernels interpreted{}", taped(&cells));
         (
             Box::new(LinkedKernels::with_tapes(tapes, cells).ok_or_else(not_cells)?),
             note,
         )
     } else {
-        let (info, links) = eomgen::derive::derive_links(structure).ok_or_else(not_cells)?;
-        let cells = compiled_cells(&links);
-        let note = taped(&cells);
-        (Box::new(LinkedKernels::new(info, links, cells)), note)
+        return Err(not_cells());
     };
     let (kernels, note) = kernels;
     Ok((kernels, start.elapsed().as_secs_f64(), note))
@@ -320,10 +324,6 @@ pub fn load(
         (_, Some(Ok((_, _, note)))) if structure.assembly.is_some() => format!(
             "compiled link cells of bundled models, linked to each arm's layout, the rest of \
              the assembly interpreted{note}"
-        ),
-        (_, Some(Ok((_, _, note)))) if structure.contact_points > 0 => format!(
-            "compiled link cells of bundled models, linked to its layout, its contact kernels \
-             interpreted{note}"
         ),
         (_, Some(Ok((_, _, note)))) => {
             format!("compiled link cells of bundled models, linked to its layout{note}")

@@ -20,13 +20,20 @@ pub fn derive(model: &Model) -> TapeSet {
 /// chain of compiled-in link shapes needs to run on linked compiled cells
 /// (`runtime::linked::LinkedKernels`), derived in milliseconds at any
 /// element count. `None` where the recursion does not give every kernel:
-/// assemblies, contact, elements that are no link cell.
+/// assemblies, elements that are no link cell, contact points off the
+/// links' arcs.
 pub fn derive_links(structure: &Structure) -> Option<(ModelInfo, runtime::links::LinkKernels)> {
-    if structure.assembly.is_some() || structure.contact_points > 0 {
+    if structure.assembly.is_some() {
         return None;
     }
     let layout = ParamLayout::of(structure);
     let links = link_chain(structure, &layout)?;
+    let points = structure.contact_points;
+    let elements = links.layout.contact.len() / points.max(1);
+    if points > 0 && elements == 0 {
+        return None;
+    }
+    let n = links.layout.dof;
     let info = ModelInfo {
         hash: structure.hash(),
         coordinates: crate::method::coordinate_names(structure),
@@ -36,11 +43,25 @@ pub fn derive_links(structure: &Structure) -> Option<(ModelInfo, runtime::links:
         loads: layout.loads(),
         constraints: Vec::new(),
         blocks: Vec::new(),
-        contact_points: 0,
-        contact_groups: Vec::new(),
+        contact_points: links.layout.contact.len(),
+        contact_groups: element_groups(elements, points, 2 * n),
         contact_frames: 0,
     };
     Some((info, links))
+}
+
+/// The contact groups of a chain's points: an element's points each, up to
+/// `most` groups (the kernel's `dir` selects them), neighbours merged past
+/// that.
+fn element_groups(elements: usize, points: usize, most: usize) -> Vec<usize> {
+    if elements == 0 {
+        return Vec::new();
+    }
+    let per = elements.div_ceil(most.max(1));
+    (0..elements)
+        .step_by(per)
+        .map(|e| points * per.min(elements - e))
+        .collect()
 }
 
 /// Derive the kernels of a structure. Only the structure and its parameter

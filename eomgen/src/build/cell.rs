@@ -100,6 +100,8 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     let mut cells: Vec<(Shape, [Tape; 3])> = Vec::new();
     let mut links = Vec::new();
     let mut roms = Vec::new();
+    // Each element's links, where its points lie on their arcs.
+    let mut element_links = Vec::new();
     let (mut first, mut k) = (0, 0);
     for (s, g) in st.segments.iter().enumerate() {
         let method = crate::method::of(g.method);
@@ -162,6 +164,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                     load: None,
                 });
             }
+            let own = links.len()..links.len() + maps.len();
             for map in maps {
                 links.push(LinkSpec {
                     cell: c,
@@ -170,6 +173,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                     load,
                 });
             }
+            element_links.push(method.points_on_arcs().then_some(own));
             if rom.is_none() {
                 first += count;
             }
@@ -180,8 +184,10 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             roms.push((r, k - g.elements));
         }
     }
+    let contact = contact_points(&element_links, st.contact_points);
     let layout = LinkLayout {
         links,
+        contact,
         dof: first,
         forces: !roms.is_empty(),
         loads: actuated.len(),
@@ -216,6 +222,35 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         kernels.poses.push(pose);
     }
     Some(kernels)
+}
+
+/// The chain's contact points (`points` an element, at s = 1/points, ...,
+/// 1 along it) on the links of each element: an element of one link at
+/// s along it, one of two halves (a half-arc pcc element, a rom slice) on
+/// the first at 2 s up to its middle, else on the second at 2 s - 1, as the
+/// methods sample them. None without contact or where an element's points
+/// are not on its links' arcs: its contact kernels are then its tapes'.
+fn contact_points(
+    elements: &[Option<std::ops::Range<usize>>],
+    points: usize,
+) -> Vec<runtime::links::ContactPoint> {
+    let on = |link: usize, at: f64| runtime::links::ContactPoint { link, at };
+    let mut out = Vec::with_capacity(elements.len() * points);
+    for links in elements {
+        let Some(links) = links else {
+            return Vec::new();
+        };
+        for j in 1..=points {
+            let s = j as f64 / points as f64;
+            out.push(match links.len() {
+                1 => on(links.start, s),
+                2 if s <= 0.5 => on(links.start, 2.0 * s),
+                2 => on(links.start + 1, 2.0 * s - 1.0),
+                _ => return Vec::new(),
+            });
+        }
+    }
+    out
 }
 
 /// Segment s's kink as a link of no coordinates before it, of cell

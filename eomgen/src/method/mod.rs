@@ -88,6 +88,13 @@ pub(crate) trait ModellingMethod: Sync {
         false
     }
 
+    /// Its elements' sampled points lie on their links' constant-strain
+    /// arcs, the point at s the arc cut at s (`runtime::links`'s contact
+    /// kernels place them so).
+    fn points_on_arcs(&self) -> bool {
+        false
+    }
+
     /// A method of statics alone (no equations of motion: nothing to
     /// derive, sample or simulate).
     fn statics_only(&self) -> bool {

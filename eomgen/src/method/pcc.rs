@@ -83,6 +83,10 @@ impl ModellingMethod for Pcc {
     fn link_cells(&self) -> bool {
         true
     }
+
+    fn points_on_arcs(&self) -> bool {
+        true
+    }
 }
 
 /// A pcc element of length l bent by theta, by the chord construction:

@@ -43,4 +43,8 @@ impl ModellingMethod for Pcs {
     fn link_cells(&self) -> bool {
         Pcc.link_cells()
     }
+
+    fn points_on_arcs(&self) -> bool {
+        Pcc.points_on_arcs()
+    }
 }

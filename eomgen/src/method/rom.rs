@@ -146,6 +146,10 @@ impl ModellingMethod for Rom {
     fn link_cells(&self) -> bool {
         true
     }
+
+    fn points_on_arcs(&self) -> bool {
+        true
+    }
 }
 
 /// A rom segment: strain fields sum_i c_i P_i(sigma) over sigma = s / L in

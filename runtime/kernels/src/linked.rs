@@ -14,7 +14,7 @@ use std::cell::RefCell;
 use crate::kernels::{Interpreted, KernelKind, Kernels, ModelInfo, TapeSet};
 use crate::linalg::Ldlt;
 use crate::links::{
-    Cells, CompiledCell, LinkKernels, accelerations_owned, all_owned, by_lanes,
+    self, Cells, CompiledCell, LinkKernels, accelerations_owned, all_owned, by_lanes,
     inverse_dynamics_tangent, mass_bias_owned, mass_bias_shared_dyn, outputs,
 };
 use crate::tape::{Inputs, Tape};
@@ -30,6 +30,8 @@ pub struct LinkedKernels {
     cells: Vec<Option<CompiledCell>>,
     slots: RefCell<Vec<f64>>,
     rest: Option<Interpreted>,
+    /// Each contact point's group (`ModelInfo::contact_groups`).
+    group_of: Vec<usize>,
 }
 
 impl LinkedKernels {
@@ -37,7 +39,11 @@ impl LinkedKernels {
     /// no compiled-in model has it: its tapes then run.
     pub fn new(info: ModelInfo, links: LinkKernels, cells: Vec<Option<CompiledCell>>) -> Self {
         assert_eq!(cells.len(), links.cells.len(), "one compiled cell a cell");
+        let group_of = (info.contact_groups.iter().enumerate())
+            .flat_map(|(g, &len)| std::iter::repeat_n(g, len))
+            .collect();
         Self {
+            group_of,
             info,
             links,
             cells,
@@ -52,14 +58,27 @@ impl LinkedKernels {
     /// recursion and the mass solve, never the tapes' symbolic solve.
     pub fn with_tapes(tapes: TapeSet, cells: Vec<Option<CompiledCell>>) -> Option<Self> {
         let links = tapes.links.clone()?;
+        let by_links = contact_by_links(&links, &tapes.info);
         let info = ModelInfo {
             accel: false,
+            // The recursion's contact kernels read no frames.
+            contact_frames: if by_links {
+                0
+            } else {
+                tapes.info.contact_frames
+            },
             ..tapes.info.clone()
         };
         let mut linked = Self::new(info, links, cells);
         linked.rest = Some(Interpreted::new(tapes));
         Some(linked)
     }
+}
+
+/// Whether the recursion gives the chain's contact kernels: its layout
+/// places every contact point on a link.
+fn contact_by_links(links: &LinkKernels, info: &ModelInfo) -> bool {
+    info.contact_points > 0 && links.layout.contact.len() == info.contact_points
 }
 
 struct Linked<'a> {
@@ -232,6 +251,24 @@ unsafe fn solve_fma(packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
 }
 
 impl LinkedKernels {
+    /// A contact kernel by the recursion: `ContactJacobian` for the
+    /// groups `dir` selects (empty: every group), `ContactJvp` along the
+    /// first n of `dir`.
+    #[inline(always)]
+    fn contact(&self, kind: KernelKind, cells: &mut Linked, inp: &Inputs, out: &mut [f64]) {
+        let layout = &self.links.layout;
+        let (q, qd, p) = (inp.q, inp.qd, inp.p);
+        match kind {
+            KernelKind::Contact => links::contact_points(layout, cells, q, qd, p, out),
+            KernelKind::ContactJacobian => {
+                let mask = inp.dir;
+                let want = |i: usize| mask.is_empty() || mask[self.group_of[i]] != 0.0;
+                links::contact_jacobian(layout, cells, (q, qd, p), want, out)
+            }
+            _ => links::contact_jvp(layout, cells, (q, qd, p), &inp.dir[..layout.dof], out),
+        }
+    }
+
     /// The articulated-body sweeps built for FMA.
     #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
     unsafe fn accelerations_fma(&self, inp: &Inputs, qdd: &mut [f64]) -> bool {
@@ -272,6 +309,11 @@ impl LinkedKernels {
                 inverse_dynamics_tangent(
                     layout, &mut cells, inp.q, inp.qd, inp.qdd, inp.dir, inp.p, &mut tau, out,
                 )
+            }
+            KernelKind::Contact | KernelKind::ContactJacobian | KernelKind::ContactJvp
+                if contact_by_links(&self.links, &self.info) =>
+            {
+                self.contact(kind, &mut cells, inp, out)
             }
             // No symbolic solve (`with_tapes` says so); derived parameters
             // and contact from the tapes when the chain has them.

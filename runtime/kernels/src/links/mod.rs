@@ -25,11 +25,13 @@ use crate::rows;
 
 mod articulated;
 mod compiled;
+mod contact;
 mod outputs;
 mod planar;
 mod tangent;
 pub use articulated::accelerations_owned;
 pub use compiled::{CellFn, CellLanesFn, CellTangentFn, CompiledCell};
+pub use contact::{ContactPoint, contact_jacobian, contact_jvp, contact_points};
 pub use outputs::outputs;
 pub use tangent::inverse_dynamics_tangent;
 
@@ -183,6 +185,10 @@ pub struct LinkLayout {
     pub tip_mass: Option<usize>,
     pub tip_length: Option<usize>,
     pub tip_inertia: Option<[usize; 2]>,
+    /// The chain's contact points, in the order of the contact kernels,
+    /// when the recursion gives them (`contact`); empty otherwise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contact: Vec<ContactPoint>,
     /// [`LinkLayout::weights`], computed on first use.
     #[serde(skip)]
     pub weights: std::sync::OnceLock<Vec<f64>>,

@@ -17,20 +17,20 @@
 use super::{Cells, LinkLayout, MAX_LINK_DOF, cell, local};
 use crate::dual::Dual;
 
-type V3 = [Dual; 3];
+pub(super) type V3 = [Dual; 3];
 type M3 = [[Dual; 3]; 3];
-const V0: V3 = [Dual::ZERO; 3];
+pub(super) const V0: V3 = [Dual::ZERO; 3];
 
 #[inline(always)]
-fn add(a: V3, b: V3) -> V3 {
+pub(super) fn add(a: V3, b: V3) -> V3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 #[inline(always)]
-fn sub(a: V3, b: V3) -> V3 {
+pub(super) fn sub(a: V3, b: V3) -> V3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 #[inline(always)]
-fn scale(s: Dual, a: V3) -> V3 {
+pub(super) fn scale(s: Dual, a: V3) -> V3 {
     [s * a[0], s * a[1], s * a[2]]
 }
 #[inline(always)]
@@ -38,7 +38,7 @@ fn dot(a: V3, b: V3) -> Dual {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 #[inline(always)]
-fn cross(a: V3, b: V3) -> V3 {
+pub(super) fn cross(a: V3, b: V3) -> V3 {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -46,11 +46,11 @@ fn cross(a: V3, b: V3) -> V3 {
     ]
 }
 #[inline(always)]
-fn mat_vec(r: &M3, v: V3) -> V3 {
+pub(super) fn mat_vec(r: &M3, v: V3) -> V3 {
     [dot(r[0], v), dot(r[1], v), dot(r[2], v)]
 }
 #[inline(always)]
-fn mat_mat(a: &M3, b: &M3) -> M3 {
+pub(super) fn mat_mat(a: &M3, b: &M3) -> M3 {
     std::array::from_fn(|i| std::array::from_fn(|j| dot(a[i], [b[0][j], b[1][j], b[2][j]])))
 }
 /// Axisymmetric inertia applied to a vector.
@@ -299,7 +299,7 @@ fn cell_dual(out: &[f64], len: usize, i: usize) -> Dual {
 
 /// Outputs `i..i + 3` of a cell's tangent kernel as a dual vector.
 #[inline(always)]
-fn cell_v3(out: &[f64], len: usize, i: usize) -> V3 {
+pub(super) fn cell_v3(out: &[f64], len: usize, i: usize) -> V3 {
     [0, 1, 2].map(|k| cell_dual(out, len, i + k))
 }
 

@@ -1,0 +1,274 @@
+//! The contact kernels of a link chain (`Contact`, `ContactJacobian`,
+//! `ContactJvp`) by one sweep out over the links' cells, so that a chain
+//! with contact needs no flat kernel of its points: the generated or
+//! interpreted size grows with the distinct cells, not with the points
+//! times the coordinates.
+//!
+//! A contact point lies on a constant-strain link at a fraction `at` of
+//! its arc (`ContactPoint`). A constant-strain arc cut at `at` is the same
+//! arc with every strain coordinate and the length scaled by `at` (the
+//! strain's `part`, as the methods sample their points), so the point in
+//! its link's base frame is the end point of the link's own cell at
+//! (at x, at xd, length at l), and its columns in the cell coordinates are
+//! `at` times that cell's end-point columns. Composed with the link's
+//! world frame (R, O) and the twists (W_a, V_a) that each arm coordinate's
+//! rate gives the frames before it (about the world origin):
+//!
+//! * p = O + R l;
+//! * dp/dq_a = V_a + W_a x p + R sum_f w_fa at dl/dx'_f (its own link's
+//!   cell coordinates f, with their weights);
+//! * v = (dp/dq) qd.
+//!
+//! The sweep runs in dual numbers along dq (the cells' tangents), which
+//! gives `ContactJvp`'s dv and d(dp/dq) from the same sums.
+
+use serde::{Deserialize, Serialize};
+
+use super::tangent::{V0, V3, add, cell_v3, cross, mat_mat, mat_vec, scale};
+use super::{CELL_PARAMS, Cells, LinkLayout, MAX_LINK_DOF, cell, cell_params, local};
+use crate::dual::Dual;
+
+/// A contact point of a chain: on link `link`, at the fraction `at` of the
+/// link's arc (in (0, 1]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContactPoint {
+    pub link: usize,
+    pub at: f64,
+}
+
+/// The state a sweep runs at: q, qd, the direction dq its duals move along
+/// (None: they do not), p.
+type At<'a> = (&'a [f64], &'a [f64], Option<&'a [f64]>, &'a [f64]);
+
+/// A point's kinematics as the sweep gives them: position, velocity and
+/// dp/dq (one column per arm coordinate), each with its derivative along
+/// the sweep's direction.
+struct PointMotion<'a> {
+    p: V3,
+    v: V3,
+    columns: &'a [V3],
+}
+
+/// One cell at (x, xd) moving along dx (all `nc` long) with parameters
+/// `params`, as duals in `out` ([`cell::len`] values, then their
+/// derivatives): its tangent where dx moves it, else its values alone.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn cell_at<C: Cells>(
+    cells: &mut C,
+    c: usize,
+    x: &[f64],
+    xd: &[f64],
+    dx: &[f64],
+    params: &[f64; CELL_PARAMS],
+    out: &mut [f64],
+) {
+    let len = out.len() / 2;
+    if dx.iter().all(|&v| v == 0.0) {
+        cells.one(c, x, xd, params, &mut out[..len]);
+        out[len..].fill(0.0);
+    } else {
+        let dxd = [0.0; MAX_LINK_DOF];
+        cells.tangent(c, x, xd, dx, &dxd[..x.len()], params, out);
+    }
+}
+
+/// The sweep out: for every point `want` asks for (in the chain's order),
+/// `emit(i, motion)`; with `columns` false only the positions are
+/// computed (the columns and velocity are left zero). Stops past the last link a
+/// wanted point is on.
+#[inline(always)]
+fn sweep<C: Cells>(
+    layout: &LinkLayout,
+    cells: &mut C,
+    (q, qd, dq, p): At,
+    want: impl Fn(usize) -> bool,
+    columns: bool,
+    mut emit: impl FnMut(usize, &PointMotion),
+) {
+    let n = layout.dof;
+    let points = &layout.contact;
+    let Some(last) = (0..points.len()).rev().find(|&i| want(i)) else {
+        return;
+    };
+    let last_link = points[last].link;
+    let base = super::base_orientation(layout, p).0;
+    let mut r = base.map(|row| row.map(Dual::constant));
+    let mut pos: V3 = layout.base_position.map(|i| Dual::constant(p[i]));
+    // Per arm coordinate, the twist (W, V) its rate gives the frame the
+    // sweep has reached, about the world origin.
+    let mut twists: Vec<(V3, V3)> = vec![(V0, V0); if columns { n } else { 0 }];
+    let mut own = vec![V0; if columns { n } else { 0 }];
+    let mut params: Vec<[f64; CELL_PARAMS]> = Vec::new();
+    cell_params(layout, cells, p, &mut params);
+    let zeros = [0.0; MAX_LINK_DOF];
+    let mut out = vec![0.0; 2 * cell::len(MAX_LINK_DOF)];
+    let mut next = 0;
+    for (k, spec) in layout.links.iter().enumerate().take(last_link + 1) {
+        let nc = spec.map.len();
+        let len = cell::len(nc);
+        let (x, xd) = (local(spec, p, q), local(spec, p, qd));
+        let dx = dq.map_or(zeros, |dq| local(spec, p, dq));
+        // Each cell coordinate's weight on each arm coordinate.
+        let weight = |f: usize| {
+            let c = &spec.map[f];
+            let sc = c.scale.map_or(1.0, |i| p[i]);
+            c.terms.iter().map(move |&(a, w)| (a, sc * w))
+        };
+        while next < points.len() && points[next].link == k {
+            let i = next;
+            next += 1;
+            if !want(i) {
+                continue;
+            }
+            let at = points[i].at;
+            let cut = |v: &[f64; MAX_LINK_DOF]| -> [f64; MAX_LINK_DOF] { v.map(|v| at * v) };
+            let mut cut_params = params[k];
+            cut_params[0] *= at;
+            let o = &mut out[..2 * len];
+            let (xa, xda, dxa) = (cut(&x), cut(&xd), cut(&dx));
+            cell_at(
+                cells,
+                spec.cell,
+                &xa[..nc],
+                &xda[..nc],
+                &dxa[..nc],
+                &cut_params,
+                o,
+            );
+            let point = add(pos, mat_vec(&r, cell_v3(o, len, cell::END)));
+            if columns {
+                for (a, col) in own.iter_mut().enumerate() {
+                    let (w, v) = twists[a];
+                    *col = add(v, cross(w, point));
+                }
+                let at = Dual::constant(at);
+                for f in 0..nc {
+                    let turned = mat_vec(&r, cell_v3(o, len, cell::COLUMNS + 12 * f + 3));
+                    for (a, w) in weight(f) {
+                        own[a] = add(own[a], scale(at * Dual::constant(w), turned));
+                    }
+                }
+            }
+            let mut v = V0;
+            if columns {
+                for (col, &rate) in own.iter().zip(qd) {
+                    v = add(v, scale(Dual::constant(rate), *col));
+                }
+            }
+            emit(
+                i,
+                &PointMotion {
+                    p: point,
+                    v,
+                    columns: &own,
+                },
+            );
+        }
+        // The frame past the link, and the twists its coordinates give it.
+        let o = &mut out[..2 * len];
+        cell_at(
+            cells,
+            spec.cell,
+            &x[..nc],
+            &xd[..nc],
+            &dx[..nc],
+            &params[k],
+            o,
+        );
+        let rel: [V3; 3] = std::array::from_fn(|i| cell_v3(o, len, cell::ROTATION + 3 * i));
+        let end = add(pos, mat_vec(&r, cell_v3(o, len, cell::END)));
+        if columns {
+            for f in 0..nc {
+                let col = cell::COLUMNS + 12 * f;
+                let s_w = mat_vec(&r, cell_v3(o, len, col));
+                let v_end = mat_vec(&r, cell_v3(o, len, col + 3));
+                let twist = (s_w, super::tangent::sub(v_end, cross(s_w, end)));
+                for (a, w) in weight(f) {
+                    let w = Dual::constant(w);
+                    let (tw, tv) = &mut twists[a];
+                    *tw = add(*tw, scale(w, twist.0));
+                    *tv = add(*tv, scale(w, twist.1));
+                }
+            }
+        }
+        r = mat_mat(&r, &rel);
+        pos = end;
+    }
+}
+
+/// The `Contact` kernel: every point's position (3 each).
+pub fn contact_points<C: Cells>(
+    layout: &LinkLayout,
+    cells: &mut C,
+    q: &[f64],
+    qd: &[f64],
+    p: &[f64],
+    out: &mut [f64],
+) {
+    sweep(
+        layout,
+        cells,
+        (q, qd, None, p),
+        |_| true,
+        false,
+        |i, m| {
+            for c in 0..3 {
+                out[3 * i + c] = m.p[c].v;
+            }
+        },
+    );
+}
+
+/// The `ContactJacobian` kernel for the points `want` asks for: per point
+/// p (3), v (3), dp/dq (3 x n, row-major); the other points' outputs are
+/// left as they were.
+pub fn contact_jacobian<C: Cells>(
+    layout: &LinkLayout,
+    cells: &mut C,
+    (q, qd, p): (&[f64], &[f64], &[f64]),
+    want: impl Fn(usize) -> bool,
+    out: &mut [f64],
+) {
+    let n = layout.dof;
+    let width = 6 + 3 * n;
+    sweep(layout, cells, (q, qd, None, p), want, true, |i, m| {
+        let o = &mut out[i * width..(i + 1) * width];
+        for c in 0..3 {
+            o[c] = m.p[c].v;
+            o[3 + c] = m.v[c].v;
+            for (a, col) in m.columns.iter().enumerate() {
+                o[6 + c * n + a] = col[c].v;
+            }
+        }
+    });
+}
+
+/// The `ContactJvp` kernel: per point dv (3) and d(dp/dq) (3 x n,
+/// row-major) along `dq`.
+pub fn contact_jvp<C: Cells>(
+    layout: &LinkLayout,
+    cells: &mut C,
+    (q, qd, p): (&[f64], &[f64], &[f64]),
+    dq: &[f64],
+    out: &mut [f64],
+) {
+    let n = layout.dof;
+    let width = 3 + 3 * n;
+    sweep(
+        layout,
+        cells,
+        (q, qd, Some(dq), p),
+        |_| true,
+        true,
+        |i, m| {
+            let o = &mut out[i * width..(i + 1) * width];
+            for c in 0..3 {
+                o[c] = m.v[c].d;
+                for (a, col) in m.columns.iter().enumerate() {
+                    o[3 + c * n + a] = col[c].d;
+                }
+            }
+        },
+    );
+}
