@@ -1304,7 +1304,16 @@ value = 1000.0
     let (b, r) = route(&example.to_string_lossy(), "", auto);
     assert_eq!(b, "interpreted");
     assert!(r.contains("sits on another arm"), "{r}");
+    // Contact by the recursion where the points lie on the links' arcs;
+    // a rigid chain's points do not: its contact kernels are its tapes'.
     let (b, r) = route("finger_tap", "segment.0.elements=5", auto);
+    assert_eq!(b, "compiled");
+    assert!(r.contains("link cells") && !r.contains("contact"), "{r}");
+    let rigid = dir.path().join("rigid_on_floor.toml");
+    let text = std::fs::read_to_string(model_path("chain")).unwrap();
+    let floor = "\n[[obstacle]]\nname = \"floor\"\nshape = \"plane\"\npoint = [0.0, -0.7, 0.0]\nnormal = [0.0, 1.0, 0.0]\n\n[contact]\nstiffness = 1.0e4\n";
+    std::fs::write(&rigid, format!("{text}{floor}")).unwrap();
+    let (b, r) = route(&rigid.to_string_lossy(), "", auto);
     assert_eq!(b, "compiled");
     assert!(
         r.contains("link cells") && r.contains("contact kernels interpreted"),

@@ -24,7 +24,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::tangent::{V0, V3, add, cell_v3, cross, mat_mat, mat_vec, scale};
+use super::num::{Num, add, cell_v3, cross, mat_mat, mat_vec, scale, sub};
 use super::{CELL_PARAMS, Cells, LinkLayout, MAX_LINK_DOF, cell, cell_params, local};
 use crate::dual::Dual;
 
@@ -37,39 +37,41 @@ pub struct ContactPoint {
 }
 
 /// The state a sweep runs at: q, qd, the direction dq its duals move along
-/// (None: they do not), p.
+/// (None: the sweep runs on `f64`), p.
 type At<'a> = (&'a [f64], &'a [f64], Option<&'a [f64]>, &'a [f64]);
 
 /// A point's kinematics as the sweep gives them: position, velocity and
 /// dp/dq (one column per arm coordinate), each with its derivative along
-/// the sweep's direction.
-struct PointMotion<'a> {
-    p: V3,
-    v: V3,
-    columns: &'a [V3],
+/// the sweep's direction where it runs on duals.
+struct PointMotion<'a, N> {
+    p: [N; 3],
+    v: [N; 3],
+    columns: &'a [[N; 3]],
 }
 
-/// One cell at (x, xd) moving along dx (all `nc` long) with parameters
-/// `params`, as duals in `out` ([`cell::len`] values, then their
-/// derivatives): its tangent where dx moves it, else its values alone.
+/// One cell at (x, xd) moving along dx (all `nc` long; None: not moving)
+/// with parameters `params`, into `out`: its values ([`cell::len`]), then
+/// where dx is given their derivatives (zero where dx does not move it).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn cell_at<C: Cells>(
     cells: &mut C,
     c: usize,
-    x: &[f64],
-    xd: &[f64],
-    dx: &[f64],
+    (x, xd, dx): (&[f64], &[f64], Option<&[f64]>),
+    len: usize,
     params: &[f64; CELL_PARAMS],
     out: &mut [f64],
 ) {
-    let len = out.len() / 2;
-    if dx.iter().all(|&v| v == 0.0) {
-        cells.one(c, x, xd, params, &mut out[..len]);
-        out[len..].fill(0.0);
-    } else {
-        let dxd = [0.0; MAX_LINK_DOF];
-        cells.tangent(c, x, xd, dx, &dxd[..x.len()], params, out);
+    match dx {
+        Some(dx) if dx.iter().any(|&v| v != 0.0) => {
+            let dxd = [0.0; MAX_LINK_DOF];
+            cells.tangent(c, x, xd, dx, &dxd[..x.len()], params, &mut out[..2 * len]);
+        }
+        Some(_) => {
+            cells.one(c, x, xd, params, &mut out[..len]);
+            out[len..2 * len].fill(0.0);
+        }
+        None => cells.one(c, x, xd, params, &mut out[..len]),
     }
 }
 
@@ -78,13 +80,13 @@ fn cell_at<C: Cells>(
 /// computed (the columns and velocity are left zero). Stops past the last link a
 /// wanted point is on.
 #[inline(always)]
-fn sweep<C: Cells>(
+fn sweep<N: Num, C: Cells>(
     layout: &LinkLayout,
     cells: &mut C,
     (q, qd, dq, p): At,
     want: impl Fn(usize) -> bool,
     columns: bool,
-    mut emit: impl FnMut(usize, &PointMotion),
+    mut emit: impl FnMut(usize, &PointMotion<N>),
 ) {
     let n = layout.dof;
     let points = &layout.contact;
@@ -92,23 +94,23 @@ fn sweep<C: Cells>(
         return;
     };
     let last_link = points[last].link;
+    let v0 = [N::ZERO; 3];
     let base = super::base_orientation(layout, p).0;
-    let mut r = base.map(|row| row.map(Dual::constant));
-    let mut pos: V3 = layout.base_position.map(|i| Dual::constant(p[i]));
+    let mut r = base.map(|row| row.map(N::constant));
+    let mut pos: [N; 3] = layout.base_position.map(|i| N::constant(p[i]));
     // Per arm coordinate, the twist (W, V) its rate gives the frame the
     // sweep has reached, about the world origin.
-    let mut twists: Vec<(V3, V3)> = vec![(V0, V0); if columns { n } else { 0 }];
-    let mut own = vec![V0; if columns { n } else { 0 }];
+    let mut twists = vec![(v0, v0); if columns { n } else { 0 }];
+    let mut own = vec![v0; if columns { n } else { 0 }];
     let mut params: Vec<[f64; CELL_PARAMS]> = Vec::new();
     cell_params(layout, cells, p, &mut params);
-    let zeros = [0.0; MAX_LINK_DOF];
     let mut out = vec![0.0; 2 * cell::len(MAX_LINK_DOF)];
     let mut next = 0;
     for (k, spec) in layout.links.iter().enumerate().take(last_link + 1) {
         let nc = spec.map.len();
         let len = cell::len(nc);
         let (x, xd) = (local(spec, p, q), local(spec, p, qd));
-        let dx = dq.map_or(zeros, |dq| local(spec, p, dq));
+        let dx = dq.map(|dq| local(spec, p, dq));
         // Each cell coordinate's weight on each arm coordinate.
         let weight = |f: usize| {
             let c = &spec.map[f];
@@ -125,67 +127,46 @@ fn sweep<C: Cells>(
             let cut = |v: &[f64; MAX_LINK_DOF]| -> [f64; MAX_LINK_DOF] { v.map(|v| at * v) };
             let mut cut_params = params[k];
             cut_params[0] *= at;
-            let o = &mut out[..2 * len];
-            let (xa, xda, dxa) = (cut(&x), cut(&xd), cut(&dx));
-            cell_at(
-                cells,
-                spec.cell,
-                &xa[..nc],
-                &xda[..nc],
-                &dxa[..nc],
-                &cut_params,
-                o,
-            );
-            let point = add(pos, mat_vec(&r, cell_v3(o, len, cell::END)));
+            let (xa, xda, dxa) = (cut(&x), cut(&xd), dx.as_ref().map(cut));
+            let moving = (&xa[..nc], &xda[..nc], dxa.as_ref().map(|d| &d[..nc]));
+            cell_at(cells, spec.cell, moving, len, &cut_params, &mut out);
+            let point = add(pos, mat_vec(&r, cell_v3(&out, len, cell::END)));
+            let mut v = v0;
             if columns {
                 for (a, col) in own.iter_mut().enumerate() {
                     let (w, v) = twists[a];
                     *col = add(v, cross(w, point));
                 }
-                let at = Dual::constant(at);
                 for f in 0..nc {
-                    let turned = mat_vec(&r, cell_v3(o, len, cell::COLUMNS + 12 * f + 3));
+                    let turned = mat_vec(&r, cell_v3(&out, len, cell::COLUMNS + 12 * f + 3));
                     for (a, w) in weight(f) {
-                        own[a] = add(own[a], scale(at * Dual::constant(w), turned));
+                        own[a] = add(own[a], scale(N::constant(at * w), turned));
                     }
                 }
-            }
-            let mut v = V0;
-            if columns {
                 for (col, &rate) in own.iter().zip(qd) {
-                    v = add(v, scale(Dual::constant(rate), *col));
+                    v = add(v, scale(N::constant(rate), *col));
                 }
             }
-            emit(
-                i,
-                &PointMotion {
-                    p: point,
-                    v,
-                    columns: &own,
-                },
-            );
+            let motion = PointMotion {
+                p: point,
+                v,
+                columns: &own,
+            };
+            emit(i, &motion);
         }
         // The frame past the link, and the twists its coordinates give it.
-        let o = &mut out[..2 * len];
-        cell_at(
-            cells,
-            spec.cell,
-            &x[..nc],
-            &xd[..nc],
-            &dx[..nc],
-            &params[k],
-            o,
-        );
-        let rel: [V3; 3] = std::array::from_fn(|i| cell_v3(o, len, cell::ROTATION + 3 * i));
-        let end = add(pos, mat_vec(&r, cell_v3(o, len, cell::END)));
+        let moving = (&x[..nc], &xd[..nc], dx.as_ref().map(|d| &d[..nc]));
+        cell_at(cells, spec.cell, moving, len, &params[k], &mut out);
+        let rel: [[N; 3]; 3] = std::array::from_fn(|i| cell_v3(&out, len, cell::ROTATION + 3 * i));
+        let end = add(pos, mat_vec(&r, cell_v3(&out, len, cell::END)));
         if columns {
             for f in 0..nc {
                 let col = cell::COLUMNS + 12 * f;
-                let s_w = mat_vec(&r, cell_v3(o, len, col));
-                let v_end = mat_vec(&r, cell_v3(o, len, col + 3));
-                let twist = (s_w, super::tangent::sub(v_end, cross(s_w, end)));
+                let s_w = mat_vec(&r, cell_v3(&out, len, col));
+                let v_end = mat_vec(&r, cell_v3(&out, len, col + 3));
+                let twist = (s_w, sub(v_end, cross(s_w, end)));
                 for (a, w) in weight(f) {
-                    let w = Dual::constant(w);
+                    let w = N::constant(w);
                     let (tw, tv) = &mut twists[a];
                     *tw = add(*tw, scale(w, twist.0));
                     *tv = add(*tv, scale(w, twist.1));
@@ -212,11 +193,7 @@ pub fn contact_points<C: Cells>(
         (q, qd, None, p),
         |_| true,
         false,
-        |i, m| {
-            for c in 0..3 {
-                out[3 * i + c] = m.p[c].v;
-            }
-        },
+        |i, m: &PointMotion<f64>| out[3 * i..3 * i + 3].copy_from_slice(&m.p),
     );
 }
 
@@ -232,16 +209,23 @@ pub fn contact_jacobian<C: Cells>(
 ) {
     let n = layout.dof;
     let width = 6 + 3 * n;
-    sweep(layout, cells, (q, qd, None, p), want, true, |i, m| {
-        let o = &mut out[i * width..(i + 1) * width];
-        for c in 0..3 {
-            o[c] = m.p[c].v;
-            o[3 + c] = m.v[c].v;
-            for (a, col) in m.columns.iter().enumerate() {
-                o[6 + c * n + a] = col[c].v;
+    sweep(
+        layout,
+        cells,
+        (q, qd, None, p),
+        want,
+        true,
+        |i, m: &PointMotion<f64>| {
+            let o = &mut out[i * width..(i + 1) * width];
+            for c in 0..3 {
+                o[c] = m.p[c];
+                o[3 + c] = m.v[c];
+                for (a, col) in m.columns.iter().enumerate() {
+                    o[6 + c * n + a] = col[c];
+                }
             }
-        }
-    });
+        },
+    );
 }
 
 /// The `ContactJvp` kernel: per point dv (3) and d(dp/dq) (3 x n,
@@ -261,7 +245,7 @@ pub fn contact_jvp<C: Cells>(
         (q, qd, Some(dq), p),
         |_| true,
         true,
-        |i, m| {
+        |i, m: &PointMotion<Dual>| {
             let o = &mut out[i * width..(i + 1) * width];
             for c in 0..3 {
                 o[c] = m.v[c].d;

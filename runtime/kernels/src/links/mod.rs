@@ -26,6 +26,7 @@ use crate::rows;
 mod articulated;
 mod compiled;
 mod contact;
+mod num;
 mod outputs;
 mod planar;
 mod tangent;

@@ -14,45 +14,14 @@
 //! an unrolled Jacobian of the whole arm (which grew with arm length times
 //! coordinates).
 
+use super::num::{Num, add, cell_v3, cross, dot, mat_mat, mat_vec, scale, sub};
 use super::{Cells, LinkLayout, MAX_LINK_DOF, cell, local};
 use crate::dual::Dual;
 
-pub(super) type V3 = [Dual; 3];
+type V3 = [Dual; 3];
 type M3 = [[Dual; 3]; 3];
-pub(super) const V0: V3 = [Dual::ZERO; 3];
+const V0: V3 = [Dual::ZERO; 3];
 
-#[inline(always)]
-pub(super) fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-#[inline(always)]
-pub(super) fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-#[inline(always)]
-pub(super) fn scale(s: Dual, a: V3) -> V3 {
-    [s * a[0], s * a[1], s * a[2]]
-}
-#[inline(always)]
-fn dot(a: V3, b: V3) -> Dual {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-#[inline(always)]
-pub(super) fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-#[inline(always)]
-pub(super) fn mat_vec(r: &M3, v: V3) -> V3 {
-    [dot(r[0], v), dot(r[1], v), dot(r[2], v)]
-}
-#[inline(always)]
-pub(super) fn mat_mat(a: &M3, b: &M3) -> M3 {
-    std::array::from_fn(|i| std::array::from_fn(|j| dot(a[i], [b[0][j], b[1][j], b[2][j]])))
-}
 /// Axisymmetric inertia applied to a vector.
 #[inline(always)]
 fn apply_body(lateral: Dual, axial: Dual, axis: V3, w: V3) -> V3 {
@@ -209,7 +178,7 @@ fn link_forward(
     gravity: V3,
 ) -> LinkForces {
     let len = cell::len(nc);
-    let o = |i: usize| cell_dual(out, len, i);
+    let o = |i: usize| <Dual as Num>::of_cell(out, len, i);
     let v3 = |i: usize| cell_v3(out, len, i);
     let rel: M3 = std::array::from_fn(|i| v3(cell::ROTATION + 3 * i));
     let Frame {
@@ -284,23 +253,6 @@ fn link_forward(
         acc: point_accel(acc, alpha, omega, d, dd, ddd),
     };
     forces
-}
-
-/// Output `i` of a cell's tangent kernel (`len` values, then their
-/// derivatives) as a dual number. Functions, not closures, so that they
-/// inline into the FMA-built caller.
-#[inline(always)]
-fn cell_dual(out: &[f64], len: usize, i: usize) -> Dual {
-    Dual {
-        v: out[i],
-        d: out[len + i],
-    }
-}
-
-/// Outputs `i..i + 3` of a cell's tangent kernel as a dual vector.
-#[inline(always)]
-pub(super) fn cell_v3(out: &[f64], len: usize, i: usize) -> V3 {
-    [0, 1, 2].map(|k| cell_dual(out, len, i + k))
 }
 
 /// The wrench (about the world origin: moment, force) of what hangs on
