@@ -2,6 +2,7 @@
 //! for every bundled model, and the tape cache is hit on a second run.
 
 use crate::common::*;
+use runtime::kernels::CONTACT_BOUND;
 use runtime::{Arm, Dynamics, Interpreted, KernelKind, ModelInfo, output};
 use softarm::backend::{BackendChoice, load};
 use softarm::generated::MODELS;
@@ -151,6 +152,27 @@ fn assert_contact_agrees(
     eval(compiled, KernelKind::Contact, &[], &mut a);
     eval(interpreted, KernelKind::Contact, &[], &mut b);
     close(&a[..3 * points], &b[..3 * points], "contact point");
+    // The broad phase's bounds, where the kernels give them without the
+    // points: every point of a group lies in the ellipsoid of foci A, B
+    // and major axis L (the triangle inequality along its centreline),
+    // as the Contact kernel's frames say too.
+    let mut bounds = vec![f64::NAN; info.contact_frames];
+    if compiled.contact_bounds(t, q, qd, &mut bounds) {
+        close(&bounds, &a[3 * points..], "contact bounds");
+        for (g, (first, len)) in info.contact_group_ranges().enumerate() {
+            let bound = &bounds[CONTACT_BOUND * g..];
+            let (from, to, l) = (&bound[..3], &bound[3..6], bound[6]);
+            for i in first..first + len {
+                let p = &b[3 * i..3 * i + 3];
+                let dist = |x: &[f64]| (0..3).map(|c| (p[c] - x[c]).powi(2)).sum::<f64>().sqrt();
+                let reach = dist(from) + dist(to);
+                assert!(
+                    reach <= l * (1.0 + 1e-12),
+                    "{what}: point {i} outside its bound: {reach} > {l}"
+                );
+            }
+        }
+    }
     eval(compiled, KernelKind::ContactJacobian, &[], &mut a);
     eval(interpreted, KernelKind::ContactJacobian, &[], &mut b);
     close(&a, &b, "contact jacobian");

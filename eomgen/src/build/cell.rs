@@ -173,7 +173,10 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                     load,
                 });
             }
-            element_links.push(method.points_on_arcs().then_some(own));
+            // An inextensible, unshearable centreline is its element's
+            // length long: the broad phase's bound.
+            let length = (!g.extension && !g.shear).then_some(params[0]);
+            element_links.push(method.points_on_arcs().then_some((own, length)));
             if rom.is_none() {
                 first += count;
             }
@@ -185,9 +188,20 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         }
     }
     let contact = contact_points(&element_links, st.contact_points);
+    let contact_elements = match contact.is_empty() {
+        true => Vec::new(),
+        false => (element_links.iter().flatten())
+            .map(|(links, length)| runtime::links::ContactElement {
+                first: links.start,
+                last: links.end - 1,
+                length: *length,
+            })
+            .collect(),
+    };
     let layout = LinkLayout {
         links,
         contact,
+        contact_elements,
         dof: first,
         forces: !roms.is_empty(),
         loads: actuated.len(),
@@ -231,13 +245,13 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
 /// methods sample them. None without contact or where an element's points
 /// are not on its links' arcs: its contact kernels are then its tapes'.
 fn contact_points(
-    elements: &[Option<std::ops::Range<usize>>],
+    elements: &[Option<(std::ops::Range<usize>, Option<usize>)>],
     points: usize,
 ) -> Vec<runtime::links::ContactPoint> {
     let on = |link: usize, at: f64| runtime::links::ContactPoint { link, at };
     let mut out = Vec::with_capacity(elements.len() * points);
-    for links in elements {
-        let Some(links) = links else {
+    for element in elements {
+        let Some((links, _)) = element else {
             return Vec::new();
         };
         for j in 1..=points {

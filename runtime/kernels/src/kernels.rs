@@ -223,6 +223,14 @@ pub trait Kernels {
     fn accelerations(&self, _inp: &Inputs, _qdd: &mut [f64]) -> Option<bool> {
         None
     }
+
+    /// The contact frames' bounds alone (`CONTACT_BOUND` values a group,
+    /// the whole of `ModelInfo::contact_frames`), without the points, where
+    /// the kernel set gives them so: the broad phase of a chain without
+    /// an `Accel` kernel. False where it does not.
+    fn contact_bounds(&self, _inp: &Inputs, _out: &mut [f64]) -> bool {
+        false
+    }
 }
 
 /// A boxed set of kernels is one: the backends are chosen at run time.
@@ -241,6 +249,9 @@ impl<K: Kernels + ?Sized> Kernels for Box<K> {
     }
     fn accelerations(&self, inp: &Inputs, qdd: &mut [f64]) -> Option<bool> {
         (**self).accelerations(inp, qdd)
+    }
+    fn contact_bounds(&self, inp: &Inputs, out: &mut [f64]) -> bool {
+        (**self).contact_bounds(inp, out)
     }
 }
 

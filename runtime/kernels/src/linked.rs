@@ -11,7 +11,7 @@
 
 use std::cell::RefCell;
 
-use crate::kernels::{Interpreted, KernelKind, Kernels, ModelInfo, TapeSet};
+use crate::kernels::{CONTACT_BOUND, Interpreted, KernelKind, Kernels, ModelInfo, TapeSet};
 use crate::linalg::Ldlt;
 use crate::links::{
     self, Cells, CompiledCell, LinkKernels, accelerations_owned, all_owned, by_lanes,
@@ -39,6 +39,16 @@ impl LinkedKernels {
     /// no compiled-in model has it: its tapes then run.
     pub fn new(info: ModelInfo, links: LinkKernels, cells: Vec<Option<CompiledCell>>) -> Self {
         assert_eq!(cells.len(), links.cells.len(), "one compiled cell a cell");
+        let mut info = info;
+        if contact_by_links(&links, &info) {
+            // The recursion's contact kernels read no frames but the
+            // bounds of its groups, where it has them.
+            let groups = &info.contact_groups;
+            info.contact_frames = match links::has_contact_bounds(&links.layout, groups) {
+                true => CONTACT_BOUND * groups.len(),
+                false => 0,
+            };
+        }
         let group_of = (info.contact_groups.iter().enumerate())
             .flat_map(|(g, &len)| std::iter::repeat_n(g, len))
             .collect();
@@ -58,15 +68,8 @@ impl LinkedKernels {
     /// recursion and the mass solve, never the tapes' symbolic solve.
     pub fn with_tapes(tapes: TapeSet, cells: Vec<Option<CompiledCell>>) -> Option<Self> {
         let links = tapes.links.clone()?;
-        let by_links = contact_by_links(&links, &tapes.info);
         let info = ModelInfo {
             accel: false,
-            // The recursion's contact kernels read no frames.
-            contact_frames: if by_links {
-                0
-            } else {
-                tapes.info.contact_frames
-            },
             ..tapes.info.clone()
         };
         let mut linked = Self::new(info, links, cells);
@@ -229,6 +232,16 @@ impl Kernels for LinkedKernels {
         unsafe { solve_fma(packed, b, ws) }
     }
 
+    fn contact_bounds(&self, inp: &Inputs, out: &mut [f64]) -> bool {
+        if self.info.contact_frames == 0 || !contact_by_links(&self.links, &self.info) {
+            return false;
+        }
+        crate::cpu::require_fma();
+        // SAFETY: `require_fma` has checked that the processor has FMA.
+        unsafe { self.bounds_fma(inp, out) };
+        true
+    }
+
     fn accelerations(&self, inp: &Inputs, qdd: &mut [f64]) -> Option<bool> {
         let layout = &self.links.layout;
         if !all_owned(layout) || layout.forces || layout.variable_inertia {
@@ -259,7 +272,13 @@ impl LinkedKernels {
         let layout = &self.links.layout;
         let (q, qd, p) = (inp.q, inp.qd, inp.p);
         match kind {
-            KernelKind::Contact => links::contact_points(layout, cells, q, qd, p, out),
+            KernelKind::Contact => {
+                links::contact_points(layout, cells, q, qd, p, out);
+                let (groups, points) = (&self.info.contact_groups, 3 * self.info.contact_points);
+                if self.info.contact_frames > 0 {
+                    links::contact_bounds(layout, cells, (q, qd, p), groups, &mut out[points..]);
+                }
+            }
             KernelKind::ContactJacobian => {
                 let mask = inp.dir;
                 let want = |i: usize| mask.is_empty() || mask[self.group_of[i]] != 0.0;
@@ -267,6 +286,20 @@ impl LinkedKernels {
             }
             _ => links::contact_jvp(layout, cells, (q, qd, p), &inp.dir[..layout.dof], out),
         }
+    }
+
+    /// The contact groups' bounds built for FMA.
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    unsafe fn bounds_fma(&self, inp: &Inputs, out: &mut [f64]) {
+        let mut slots = self.slots.borrow_mut();
+        let mut cells = Linked {
+            links: &self.links,
+            cells: &self.cells,
+            inp: *inp,
+            slots: &mut slots,
+        };
+        let (layout, groups) = (&self.links.layout, &self.info.contact_groups);
+        links::contact_bounds(layout, &mut cells, (inp.q, inp.qd, inp.p), groups, out);
     }
 
     /// The articulated-body sweeps built for FMA.

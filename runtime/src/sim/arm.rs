@@ -87,6 +87,11 @@ pub trait Dynamics {
         aux: &[f64],
         out: &mut [f64],
     );
+    /// The contact frames' bounds alone, without the points, where the
+    /// kernels give them so ([`Kernels::contact_bounds`]); false where not.
+    fn contact_bounds(&self, _t: f64, _q: &[f64], _qd: &[f64], _out: &mut [f64]) -> bool {
+        false
+    }
     /// The obstacles and pairs this system touches (none by default).
     fn contact(&self) -> Option<&crate::contact::ContactSet> {
         None
@@ -376,6 +381,22 @@ impl<K: Kernels> Dynamics for Arm<K> {
     }
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
         self.kernels.solve_mass(packed, b, ws)
+    }
+    fn contact_bounds(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> bool {
+        let mut given = false;
+        self.with_params(t, |p| {
+            let inp = Inputs {
+                t,
+                q,
+                qd,
+                qdd: &[],
+                dir: &[],
+                p,
+                aux: &[],
+            };
+            given = self.kernels.contact_bounds(&inp, out);
+        });
+        given
     }
     fn direct_accelerations(&self, t: f64, q: &[f64], qd: &[f64], qdd: &mut [f64]) -> Option<bool> {
         let mut solved = None;

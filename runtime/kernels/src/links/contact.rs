@@ -40,6 +40,17 @@ pub struct ContactPoint {
 /// (None: the sweep runs on `f64`), p.
 type At<'a> = (&'a [f64], &'a [f64], Option<&'a [f64]>, &'a [f64]);
 
+/// The links an element's contact points lie on (first and last), and
+/// where its centreline cannot stretch or shear, the parameter that is its
+/// length: the broad phase's bound ([`contact_bounds`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContactElement {
+    pub first: usize,
+    pub last: usize,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length: Option<usize>,
+}
+
 /// A point's kinematics as the sweep gives them: position, velocity and
 /// dp/dq (one column per arm coordinate), each with its derivative along
 /// the sweep's direction where it runs on duals.
@@ -255,4 +266,63 @@ pub fn contact_jvp<C: Cells>(
             }
         },
     );
+}
+
+/// Whether [`contact_bounds`] gives the bounds of `groups` (points per
+/// group): every element's centreline of known length, and every group
+/// whole elements.
+pub fn has_contact_bounds(layout: &LinkLayout, groups: &[usize]) -> bool {
+    let elements = &layout.contact_elements;
+    let points = layout.contact.len();
+    !elements.is_empty()
+        && points % elements.len() == 0
+        && elements.iter().all(|e| e.length.is_some())
+        && groups.iter().all(|&g| g % (points / elements.len()) == 0)
+        && groups.iter().sum::<usize>() == points
+}
+
+/// The broad phase's bound of each group of `groups` (points per group;
+/// [`has_contact_bounds`]), `runtime::CONTACT_BOUND` values each: the
+/// origin A its first element starts from, the end B of its last, and
+/// the centreline's length L between them (every point of the group lies
+/// in the ellipsoid of foci A and B and major axis L). One sweep over the
+/// links' frames, no point computed.
+pub fn contact_bounds<C: Cells>(
+    layout: &LinkLayout,
+    cells: &mut C,
+    (q, qd, p): (&[f64], &[f64], &[f64]),
+    groups: &[usize],
+    out: &mut [f64],
+) {
+    let elements = &layout.contact_elements;
+    let per = layout.contact.len() / elements.len();
+    let mut params: Vec<[f64; CELL_PARAMS]> = Vec::new();
+    cell_params(layout, cells, p, &mut params);
+    let mut r = super::base_orientation(layout, p).0;
+    let mut pos = layout.base_position.map(|i| p[i]);
+    // Each link's base origin and end, as far as the last element's.
+    let reach = elements.last().map_or(0, |e| e.last + 1);
+    let mut ends = Vec::with_capacity(reach + 1);
+    ends.push(pos);
+    let mut o = vec![0.0; cell::len(MAX_LINK_DOF)];
+    for (k, spec) in layout.links.iter().enumerate().take(reach) {
+        let nc = spec.map.len();
+        let len = cell::len(nc);
+        let (x, xd) = (local(spec, p, q), local(spec, p, qd));
+        cells.one(spec.cell, &x[..nc], &xd[..nc], &params[k], &mut o[..len]);
+        let rel: [[f64; 3]; 3] = std::array::from_fn(|i| cell_v3(&o, len, cell::ROTATION + 3 * i));
+        pos = add(pos, mat_vec(&r, cell_v3(&o, len, cell::END)));
+        r = mat_mat(&r, &rel);
+        ends.push(pos);
+    }
+    let mut e = 0;
+    for (g, &points) in groups.iter().enumerate() {
+        let count = points / per;
+        let span = &elements[e..e + count];
+        let b = &mut out[7 * g..7 * g + 7];
+        b[..3].copy_from_slice(&ends[span[0].first]);
+        b[3..6].copy_from_slice(&ends[span[count - 1].last + 1]);
+        b[6] = span.iter().map(|e| e.length.map_or(0.0, |i| p[i])).sum();
+        e += count;
+    }
 }

@@ -32,7 +32,10 @@ mod planar;
 mod tangent;
 pub use articulated::accelerations_owned;
 pub use compiled::{CellFn, CellLanesFn, CellTangentFn, CompiledCell};
-pub use contact::{ContactPoint, contact_jacobian, contact_jvp, contact_points};
+pub use contact::{
+    ContactElement, ContactPoint, contact_bounds, contact_jacobian, contact_jvp, contact_points,
+    has_contact_bounds,
+};
 pub use outputs::outputs;
 pub use tangent::inverse_dynamics_tangent;
 
@@ -190,6 +193,9 @@ pub struct LinkLayout {
     /// when the recursion gives them (`contact`); empty otherwise.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub contact: Vec<ContactPoint>,
+    /// The elements those points are on, in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contact_elements: Vec<ContactElement>,
     /// [`LinkLayout::weights`], computed on first use.
     #[serde(skip)]
     pub weights: std::sync::OnceLock<Vec<f64>>,

@@ -418,6 +418,25 @@ impl PointKinematics {
         self.have.fill(false);
     }
 
+    /// The contact frames' bounds alone, where the kernels give them
+    /// without the points (`Dynamics::contact_bounds`): the broad phase then
+    /// picks the groups to evaluate. False (nothing changed) where not.
+    fn update_bounds<D: Dynamics + ?Sized>(
+        &mut self,
+        d: &D,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+    ) -> bool {
+        self.n = q.len();
+        if self.frames.is_empty() || !d.contact_bounds(t, q, qd, &mut self.frames) {
+            return false;
+        }
+        self.all_positions = false;
+        self.have.fill(false);
+        true
+    }
+
     /// Positions, velocities and dp/dq.
     pub fn with_jacobian<D: Dynamics + ?Sized>(d: &D, t: f64, q: &[f64], qd: &[f64]) -> Self {
         let mut k = Self::eval(d, t, q, qd);
@@ -902,7 +921,9 @@ pub fn generalised_force_at<D: Dynamics + ?Sized>(
     let k = s
         .points
         .get_or_insert_with(|| PointKinematics::empty(d, q.len()));
-    k.update_from(d, t, q, qd, accel);
+    if accel.is_some() || !k.update_bounds(d, t, q, qd) {
+        k.update_from(d, t, q, qd, accel);
+    }
     // From the contact frames: the elements that may touch, and their
     // points alone.
     if !k.all_positions {
