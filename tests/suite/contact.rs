@@ -1130,16 +1130,31 @@ fn the_contact_frames_place_the_points_as_the_flat_kinematics_does() {
 }
 
 /// Q_c by the hot path from the contact frames (the broad phase, then the
-/// groups it keeps) and from every point's position (the `Contact`
-/// kernel): whether they push must agree, and Q_c to 1e-9. True if they
-/// push.
-fn both_routes_agree(arm: &dyn runtime::Dynamics, q: &[f64], qd: &[f64], what: &str) -> bool {
+/// groups it keeps: the `Accel` kernel's frames, or the bounds alone where
+/// the kernels give them without it, linked cells') and from every
+/// point's position (the `Contact` kernel, of `reference`: the same arm,
+/// or for linked cells the interpreter's): whether they push must agree,
+/// and Q_c to 1e-9. True if they push.
+fn both_routes_agree(
+    arm: &dyn runtime::Dynamics,
+    reference: &dyn runtime::Dynamics,
+    q: &[f64],
+    qd: &[f64],
+    what: &str,
+) -> bool {
     use runtime::contact::generalised_force_at;
     let n = q.len();
-    let frames = contact_frames(arm, q, qd);
+    let frames = arm.info().accel.then(|| contact_frames(arm, q, qd));
+    if frames.is_none() {
+        let mut bounds = vec![0.0; arm.info().contact_frames];
+        assert!(
+            arm.contact_bounds(0.0, q, qd, &mut bounds),
+            "{what}: no bounds"
+        );
+    }
     let (mut from_frames, mut from_points) = (vec![0.0; n], vec![0.0; n]);
-    let a = generalised_force_at(arm, 0.0, q, qd, Some(&frames), &mut from_frames);
-    let b = generalised_force_at(arm, 0.0, q, qd, None, &mut from_points);
+    let a = generalised_force_at(arm, 0.0, q, qd, frames.as_deref(), &mut from_frames);
+    let b = generalised_force_at(reference, 0.0, q, qd, None, &mut from_points);
     assert_eq!(a, b, "{what}: pushes");
     if a {
         let scale = from_points.iter().fold(0.0, |m: f64, x| m.max(x.abs()));
@@ -1164,8 +1179,20 @@ fn the_broad_phase_misses_no_contact() {
     use runtime::contact::Shape;
     use softarm::backend::{BackendChoice, load};
     let mut rng = Rng::new(5);
-    for name in ["finger_tap", "wrap"] {
-        let mut l = load(name, &[], BackendChoice::Compiled, None).unwrap();
+    // Compiled in (the `Accel` kernel's frames), and on linked cells (their
+    // bounds alone) against the interpreter's points.
+    let linked = [eomgen::model::Override::parse("segment.0.elements=7").unwrap()];
+    for (name, sets) in [
+        ("finger_tap", &[][..]),
+        ("wrap", &[]),
+        ("finger_tap", &linked),
+        ("wrap", &linked),
+    ] {
+        let mut l = load(name, sets, BackendChoice::Auto, None).unwrap();
+        let mut reference = match l.arm.info().accel {
+            true => None,
+            false => Some(load(name, sets, BackendChoice::Interpreted, None).unwrap()),
+        };
         let base_set = l.arm.contact().unwrap().clone();
         let n = l.arm.dof();
         let points = l.arm.info().contact_points;
@@ -1242,7 +1269,15 @@ fn the_broad_phase_misses_no_contact() {
                     let a = u[1].atan2(u[0]);
                     let half = [0, 1, 2].map(|_| rng.uniform(0.002, 0.02));
                     let flat_u = [a.cos(), a.sin(), 0.0];
-                    let center = std::array::from_fn(|c| p[c] - (r + delta + half[0]) * flat_u[c]);
+                    // Off p's mid-planes across the box by a tenth of its
+                    // size: a point deep in on a mid-plane has two nearest
+                    // faces, and round-off would pick one.
+                    let across = [-a.sin(), a.cos(), 0.0];
+                    let center = std::array::from_fn(|c| {
+                        p[c] - (r + delta + half[0]) * flat_u[c]
+                            + 0.1 * half[1] * across[c]
+                            + if c == 2 { 0.1 * half[2] } else { 0.0 }
+                    });
                     Shape::Box {
                         center,
                         rotation: [
@@ -1256,9 +1291,13 @@ fn the_broad_phase_misses_no_contact() {
             };
             let mut set = base_set.clone();
             set.obstacles[0].shape = shape.clone();
+            if let Some(r) = reference.as_mut() {
+                r.arm.set_contact(Some(set.clone()));
+            }
             l.arm.set_contact(Some(set));
-            let what = format!("{name} trial {trial} ({shape:?})");
-            if both_routes_agree(&*l.arm, &q, &qd, &what) {
+            let what = format!("{name} {sets:?} trial {trial} ({shape:?})");
+            let reference = reference.as_ref().map_or(&*l.arm, |r| &*r.arm);
+            if both_routes_agree(&*l.arm, reference, &q, &qd, &what) {
                 pushed += 1;
             }
             // How many elements the broad phase could skip: those whose
@@ -1309,7 +1348,7 @@ fn the_broad_phase_between_elements_misses_no_contact() {
     for trial in 0..2000 {
         let q = rng.vec(n, -2.5, 2.5);
         let qd = rng.vec(n, -1.0, 1.0);
-        if both_routes_agree(&*l.arm, &q, &qd, &format!("trial {trial}")) {
+        if both_routes_agree(&*l.arm, &*l.arm, &q, &qd, &format!("trial {trial}")) {
             pushed += 1;
         }
     }

@@ -165,8 +165,7 @@ pub struct ModelInfo {
     pub contact_frames: usize,
 }
 
-/// Values per group at the head of the contact frames: A (3), B (3), L.
-pub const CONTACT_BOUND: usize = 7;
+pub use crate::links::CONTACT_BOUND;
 
 impl ModelInfo {
     pub fn dof(&self) -> usize {

@@ -11,7 +11,7 @@
 
 use std::cell::RefCell;
 
-use crate::kernels::{CONTACT_BOUND, Interpreted, KernelKind, Kernels, ModelInfo, TapeSet};
+use crate::kernels::{Interpreted, KernelKind, Kernels, ModelInfo, TapeSet};
 use crate::linalg::Ldlt;
 use crate::links::{
     self, Cells, CompiledCell, LinkKernels, accelerations_owned, all_owned, by_lanes,
@@ -45,7 +45,7 @@ impl LinkedKernels {
             // bounds of its groups, where it has them.
             let groups = &info.contact_groups;
             info.contact_frames = match links::has_contact_bounds(&links.layout, groups) {
-                true => CONTACT_BOUND * groups.len(),
+                true => links::CONTACT_BOUND * groups.len(),
                 false => 0,
             };
         }

@@ -28,6 +28,10 @@ use super::num::{Num, add, cell_v3, cross, mat_mat, mat_vec, scale, sub};
 use super::{CELL_PARAMS, Cells, LinkLayout, MAX_LINK_DOF, cell, cell_params, local};
 use crate::dual::Dual;
 
+/// Values per group at the head of the contact frames (`ModelInfo::
+/// contact_frames`): A (3), B (3), L.
+pub const CONTACT_BOUND: usize = 7;
+
 /// A contact point of a chain: on link `link`, at the fraction `at` of the
 /// link's arc (in (0, 1]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -282,7 +286,7 @@ pub fn has_contact_bounds(layout: &LinkLayout, groups: &[usize]) -> bool {
 }
 
 /// The broad phase's bound of each group of `groups` (points per group;
-/// [`has_contact_bounds`]), `runtime::CONTACT_BOUND` values each: the
+/// [`has_contact_bounds`]), [`CONTACT_BOUND`] values each: the
 /// origin A its first element starts from, the end B of its last, and
 /// the centreline's length L between them (every point of the group lies
 /// in the ellipsoid of foci A and B and major axis L). One sweep over the
@@ -319,7 +323,7 @@ pub fn contact_bounds<C: Cells>(
     for (g, &points) in groups.iter().enumerate() {
         let count = points / per;
         let span = &elements[e..e + count];
-        let b = &mut out[7 * g..7 * g + 7];
+        let b = &mut out[CONTACT_BOUND * g..CONTACT_BOUND * (g + 1)];
         b[..3].copy_from_slice(&ends[span[0].first]);
         b[3..6].copy_from_slice(&ends[span[count - 1].last + 1]);
         b[6] = span.iter().map(|e| e.length.map_or(0.0, |i| p[i])).sum();
