@@ -194,6 +194,7 @@ fn sweep<N: Num, C: Cells>(
 }
 
 /// The `Contact` kernel: every point's position (3 each).
+#[inline(always)]
 pub fn contact_points<C: Cells>(
     layout: &LinkLayout,
     cells: &mut C,
@@ -215,6 +216,7 @@ pub fn contact_points<C: Cells>(
 /// The `ContactJacobian` kernel for the points `want` asks for: per point
 /// p (3), v (3), dp/dq (3 x n, row-major); the other points' outputs are
 /// left as they were.
+#[inline(always)]
 pub fn contact_jacobian<C: Cells>(
     layout: &LinkLayout,
     cells: &mut C,
@@ -245,6 +247,7 @@ pub fn contact_jacobian<C: Cells>(
 
 /// The `ContactJvp` kernel: per point dv (3) and d(dp/dq) (3 x n,
 /// row-major) along `dq`.
+#[inline(always)]
 pub fn contact_jvp<C: Cells>(
     layout: &LinkLayout,
     cells: &mut C,
@@ -291,6 +294,7 @@ pub fn has_contact_bounds(layout: &LinkLayout, groups: &[usize]) -> bool {
 /// the centreline's length L between them (every point of the group lies
 /// in the ellipsoid of foci A and B and major axis L). One sweep over the
 /// links' frames, no point computed.
+#[inline(always)]
 pub fn contact_bounds<C: Cells>(
     layout: &LinkLayout,
     cells: &mut C,
