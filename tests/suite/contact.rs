@@ -1046,6 +1046,20 @@ fn the_contact_frames_place_the_points_as_the_flat_kinematics_does() {
     use runtime::KernelKind;
     use softarm::backend::{BackendChoice, load};
     let dir = tempfile::tempdir().unwrap();
+    // The files on the interpreter, whose tapes carry the frames (on
+    // linked cells their contact is the recursion's: tests/suite/backends.rs).
+    let interpreted_text = |dir: &std::path::Path, name: &str, text: &str| {
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let cache = Some(dir.join("cache"));
+        load(
+            &path.to_string_lossy(),
+            &[],
+            BackendChoice::Interpreted,
+            cache,
+        )
+        .unwrap()
+    };
     let models = [
         (
             "finger_tap",
@@ -1055,17 +1069,20 @@ fn the_contact_frames_place_the_points_as_the_flat_kinematics_does() {
             "wrap",
             load("wrap", &[], BackendChoice::Compiled, None).unwrap(),
         ),
-        ("3D twist", load_text(dir.path(), &hanging_pcc(""), &[])),
+        (
+            "3D twist",
+            interpreted_text(dir.path(), "twist", &hanging_pcc("")),
+        ),
         (
             "vc, two segments",
-            load_text(dir.path(), &two_vc_segments(), &[]),
+            interpreted_text(dir.path(), "vc", &two_vc_segments()),
         ),
         (
             "3D stretch and shear",
-            load_text(
+            interpreted_text(
                 dir.path(),
+                "shear",
                 &hanging_pcc("extension = true\nshear = true"),
-                &[],
             ),
         ),
     ];

@@ -188,16 +188,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         }
     }
     let contact = contact_points(&element_links, st.contact_points);
-    let contact_elements = match contact.is_empty() {
-        true => Vec::new(),
-        false => (element_links.iter().flatten())
-            .map(|(links, length)| runtime::links::ContactElement {
-                first: links.start,
-                last: links.end - 1,
-                length: *length,
-            })
-            .collect(),
-    };
+    let contact_elements = contact_elements(&element_links, &contact);
     let layout = LinkLayout {
         links,
         contact,
@@ -265,6 +256,24 @@ fn contact_points(
         }
     }
     out
+}
+
+/// The elements the contact points are on (none without them): their
+/// first and last links and their centreline's length where it is fixed.
+fn contact_elements(
+    elements: &[Option<(std::ops::Range<usize>, Option<usize>)>],
+    points: &[runtime::links::ContactPoint],
+) -> Vec<runtime::links::ContactElement> {
+    if points.is_empty() {
+        return Vec::new();
+    }
+    (elements.iter().flatten())
+        .map(|(links, length)| runtime::links::ContactElement {
+            first: links.start,
+            last: links.end - 1,
+            length: *length,
+        })
+        .collect()
 }
 
 /// Segment s's kink as a link of no coordinates before it, of cell

@@ -32,6 +32,8 @@ pub struct LinkedKernels {
     rest: Option<Interpreted>,
     /// Each contact point's group (`ModelInfo::contact_groups`).
     group_of: Vec<usize>,
+    /// The links' cells at the state the contact kernels last ran at.
+    kept: RefCell<links::LinkOutputs>,
 }
 
 impl LinkedKernels {
@@ -54,6 +56,7 @@ impl LinkedKernels {
             .collect();
         Self {
             group_of,
+            kept: RefCell::new(links::LinkOutputs::default()),
             info,
             links,
             cells,
@@ -270,21 +273,24 @@ impl LinkedKernels {
     #[inline(always)]
     fn contact(&self, kind: KernelKind, cells: &mut Linked, inp: &Inputs, out: &mut [f64]) {
         let layout = &self.links.layout;
-        let (q, qd, p) = (inp.q, inp.qd, inp.p);
+        let state = (inp.q, inp.qd, inp.p);
+        let mut kept = self.kept.borrow_mut();
+        let kept = &mut *kept;
         match kind {
             KernelKind::Contact => {
-                links::contact_points(layout, cells, q, qd, p, out);
+                links::contact_points(layout, (cells, kept), state, out);
                 let (groups, points) = (&self.info.contact_groups, 3 * self.info.contact_points);
                 if self.info.contact_frames > 0 {
-                    links::contact_bounds(layout, cells, (q, qd, p), groups, &mut out[points..]);
+                    let out = &mut out[points..];
+                    links::contact_bounds(layout, (cells, kept), state, groups, out);
                 }
             }
             KernelKind::ContactJacobian => {
                 let mask = inp.dir;
                 let want = |i: usize| mask.is_empty() || mask[self.group_of[i]] != 0.0;
-                links::contact_jacobian(layout, cells, (q, qd, p), want, out)
+                links::contact_jacobian(layout, (cells, kept), state, want, out)
             }
-            _ => links::contact_jvp(layout, cells, (q, qd, p), &inp.dir[..layout.dof], out),
+            _ => links::contact_jvp(layout, cells, state, &inp.dir[..layout.dof], out),
         }
     }
 
@@ -299,7 +305,9 @@ impl LinkedKernels {
             slots: &mut slots,
         };
         let (layout, groups) = (&self.links.layout, &self.info.contact_groups);
-        links::contact_bounds(layout, &mut cells, (inp.q, inp.qd, inp.p), groups, out);
+        let mut kept = self.kept.borrow_mut();
+        let state = (inp.q, inp.qd, inp.p);
+        links::contact_bounds(layout, (&mut cells, &mut kept), state, groups, out);
     }
 
     /// The articulated-body sweeps built for FMA.

@@ -55,6 +55,58 @@ pub struct ContactElement {
     pub length: Option<usize>,
 }
 
+/// Each link's cell outputs at the state the contact kernels last ran at
+/// (q, qd, p), so that the kernels a right-hand side asks for at one state
+/// (the bounds, then the groups the broad phase keeps) evaluate each link's
+/// cell once.
+#[derive(Default)]
+pub struct LinkOutputs {
+    state: Vec<f64>,
+    outs: Vec<Vec<f64>>,
+}
+
+impl LinkOutputs {
+    /// Keep what is kept only if it is of (q, qd, p).
+    #[inline(always)]
+    fn at(&mut self, q: &[f64], qd: &[f64], p: &[f64]) {
+        let same = self.state.len() == q.len() + qd.len() + p.len()
+            && (q.iter().chain(qd).chain(p))
+                .zip(&self.state)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+        if !same {
+            self.state.clear();
+            self.state.extend(q.iter().chain(qd).chain(p));
+            self.outs.iter_mut().for_each(Vec::clear);
+        }
+    }
+
+    /// Link k's cell (`c`, at x, xd, with `params`) into `out[..len]`:
+    /// kept, or evaluated and kept.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn link<C: Cells>(
+        &mut self,
+        cells: &mut C,
+        (k, c): (usize, usize),
+        x: &[f64],
+        xd: &[f64],
+        params: &[f64; CELL_PARAMS],
+        out: &mut [f64],
+    ) {
+        if self.outs.len() <= k {
+            self.outs.resize(k + 1, Vec::new());
+        }
+        let kept = &mut self.outs[k];
+        if kept.len() == out.len() {
+            out.copy_from_slice(kept);
+        } else {
+            cells.one(c, x, xd, params, out);
+            kept.clear();
+            kept.extend_from_slice(out);
+        }
+    }
+}
+
 /// A point's kinematics as the sweep gives them: position, velocity and
 /// dp/dq (one column per arm coordinate), each with its derivative along
 /// the sweep's direction where it runs on duals.
@@ -100,7 +152,7 @@ fn sweep<N: Num, C: Cells>(
     cells: &mut C,
     (q, qd, dq, p): At,
     want: impl Fn(usize) -> bool,
-    columns: bool,
+    (columns, mut kept): (bool, Option<&mut LinkOutputs>),
     mut emit: impl FnMut(usize, &PointMotion<N>),
 ) {
     let n = layout.dof;
@@ -170,8 +222,16 @@ fn sweep<N: Num, C: Cells>(
             emit(i, &motion);
         }
         // The frame past the link, and the twists its coordinates give it.
-        let moving = (&x[..nc], &xd[..nc], dx.as_ref().map(|d| &d[..nc]));
-        cell_at(cells, spec.cell, moving, len, &params[k], &mut out);
+        match kept.as_deref_mut() {
+            Some(kept) if dx.is_none() => {
+                let (x, xd) = (&x[..nc], &xd[..nc]);
+                kept.link(cells, (k, spec.cell), x, xd, &params[k], &mut out[..len]);
+            }
+            _ => {
+                let moving = (&x[..nc], &xd[..nc], dx.as_ref().map(|d| &d[..nc]));
+                cell_at(cells, spec.cell, moving, len, &params[k], &mut out);
+            }
+        }
         let rel: [[N; 3]; 3] = std::array::from_fn(|i| cell_v3(&out, len, cell::ROTATION + 3 * i));
         let end = add(pos, mat_vec(&r, cell_v3(&out, len, cell::END)));
         if columns {
@@ -197,18 +257,17 @@ fn sweep<N: Num, C: Cells>(
 #[inline(always)]
 pub fn contact_points<C: Cells>(
     layout: &LinkLayout,
-    cells: &mut C,
-    q: &[f64],
-    qd: &[f64],
-    p: &[f64],
+    (cells, kept): (&mut C, &mut LinkOutputs),
+    (q, qd, p): (&[f64], &[f64], &[f64]),
     out: &mut [f64],
 ) {
+    kept.at(q, qd, p);
     sweep(
         layout,
         cells,
         (q, qd, None, p),
         |_| true,
-        false,
+        (false, Some(kept)),
         |i, m: &PointMotion<f64>| out[3 * i..3 * i + 3].copy_from_slice(&m.p),
     );
 }
@@ -219,11 +278,12 @@ pub fn contact_points<C: Cells>(
 #[inline(always)]
 pub fn contact_jacobian<C: Cells>(
     layout: &LinkLayout,
-    cells: &mut C,
+    (cells, kept): (&mut C, &mut LinkOutputs),
     (q, qd, p): (&[f64], &[f64], &[f64]),
     want: impl Fn(usize) -> bool,
     out: &mut [f64],
 ) {
+    kept.at(q, qd, p);
     let n = layout.dof;
     let width = 6 + 3 * n;
     sweep(
@@ -231,7 +291,7 @@ pub fn contact_jacobian<C: Cells>(
         cells,
         (q, qd, None, p),
         want,
-        true,
+        (true, Some(kept)),
         |i, m: &PointMotion<f64>| {
             let o = &mut out[i * width..(i + 1) * width];
             for c in 0..3 {
@@ -262,7 +322,7 @@ pub fn contact_jvp<C: Cells>(
         cells,
         (q, qd, Some(dq), p),
         |_| true,
-        true,
+        (true, None),
         |i, m: &PointMotion<Dual>| {
             let o = &mut out[i * width..(i + 1) * width];
             for c in 0..3 {
@@ -282,9 +342,9 @@ pub fn has_contact_bounds(layout: &LinkLayout, groups: &[usize]) -> bool {
     let elements = &layout.contact_elements;
     let points = layout.contact.len();
     !elements.is_empty()
-        && points % elements.len() == 0
+        && points.is_multiple_of(elements.len())
         && elements.iter().all(|e| e.length.is_some())
-        && groups.iter().all(|&g| g % (points / elements.len()) == 0)
+        && groups.iter().all(|&g| g.is_multiple_of(points / elements.len()))
         && groups.iter().sum::<usize>() == points
 }
 
@@ -297,11 +357,12 @@ pub fn has_contact_bounds(layout: &LinkLayout, groups: &[usize]) -> bool {
 #[inline(always)]
 pub fn contact_bounds<C: Cells>(
     layout: &LinkLayout,
-    cells: &mut C,
+    (cells, kept): (&mut C, &mut LinkOutputs),
     (q, qd, p): (&[f64], &[f64], &[f64]),
     groups: &[usize],
     out: &mut [f64],
 ) {
+    kept.at(q, qd, p);
     let elements = &layout.contact_elements;
     let per = layout.contact.len() / elements.len();
     let mut params: Vec<[f64; CELL_PARAMS]> = Vec::new();
@@ -317,7 +378,14 @@ pub fn contact_bounds<C: Cells>(
         let nc = spec.map.len();
         let len = cell::len(nc);
         let (x, xd) = (local(spec, p, q), local(spec, p, qd));
-        cells.one(spec.cell, &x[..nc], &xd[..nc], &params[k], &mut o[..len]);
+        kept.link(
+            cells,
+            (k, spec.cell),
+            &x[..nc],
+            &xd[..nc],
+            &params[k],
+            &mut o[..len],
+        );
         let rel: [[f64; 3]; 3] = std::array::from_fn(|i| cell_v3(&o, len, cell::ROTATION + 3 * i));
         pos = add(pos, mat_vec(&r, cell_v3(&o, len, cell::END)));
         r = mat_mat(&r, &rel);

@@ -33,8 +33,8 @@ mod tangent;
 pub use articulated::accelerations_owned;
 pub use compiled::{CellFn, CellLanesFn, CellTangentFn, CompiledCell};
 pub use contact::{
-    CONTACT_BOUND, ContactElement, ContactPoint, contact_bounds, contact_jacobian, contact_jvp,
-    contact_points, has_contact_bounds,
+    CONTACT_BOUND, ContactElement, ContactPoint, LinkOutputs, contact_bounds, contact_jacobian,
+    contact_jvp, contact_points, has_contact_bounds,
 };
 pub use outputs::outputs;
 pub use tangent::inverse_dynamics_tangent;
