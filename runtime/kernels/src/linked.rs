@@ -294,16 +294,22 @@ impl LinkedKernels {
         }
     }
 
+    /// The cells of this chain at `inp`, its tapes' scratch in `slots`.
+    #[inline(always)]
+    fn linked<'a>(&'a self, inp: &Inputs<'a>, slots: &'a mut Vec<f64>) -> Linked<'a> {
+        Linked {
+            links: &self.links,
+            cells: &self.cells,
+            inp: *inp,
+            slots,
+        }
+    }
+
     /// The contact groups' bounds built for FMA.
     #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
     unsafe fn bounds_fma(&self, inp: &Inputs, out: &mut [f64]) {
         let mut slots = self.slots.borrow_mut();
-        let mut cells = Linked {
-            links: &self.links,
-            cells: &self.cells,
-            inp: *inp,
-            slots: &mut slots,
-        };
+        let mut cells = self.linked(inp, &mut slots);
         let (layout, groups) = (&self.links.layout, &self.info.contact_groups);
         let mut kept = self.kept.borrow_mut();
         let state = (inp.q, inp.qd, inp.p);
@@ -314,12 +320,7 @@ impl LinkedKernels {
     #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
     unsafe fn accelerations_fma(&self, inp: &Inputs, qdd: &mut [f64]) -> bool {
         let mut slots = self.slots.borrow_mut();
-        let mut cells = Linked {
-            links: &self.links,
-            cells: &self.cells,
-            inp: *inp,
-            slots: &mut slots,
-        };
+        let mut cells = self.linked(inp, &mut slots);
         accelerations_owned(&self.links.layout, &mut cells, inp.q, inp.qd, inp.p, qdd)
     }
 
@@ -328,12 +329,7 @@ impl LinkedKernels {
     #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
     unsafe fn eval_fma(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
         let mut slots = self.slots.borrow_mut();
-        let mut cells = Linked {
-            links: &self.links,
-            cells: &self.cells,
-            inp: *inp,
-            slots: &mut slots,
-        };
+        let mut cells = self.linked(inp, &mut slots);
         let layout = &self.links.layout;
         match kind {
             KernelKind::MassBias if all_owned(layout) => {

@@ -270,6 +270,22 @@ impl<K: Kernels> Arm<K> {
         f(&live)
     }
 
+    /// `f` of the kernels' inputs at (t, q, qd): the parameters at t, no
+    /// accelerations, direction or frames.
+    fn at<R>(&self, t: f64, q: &[f64], qd: &[f64], f: impl FnOnce(&Inputs) -> R) -> R {
+        self.with_params(t, |p| {
+            f(&Inputs {
+                t,
+                q,
+                qd,
+                qdd: &[],
+                dir: &[],
+                p,
+                aux: &[],
+            })
+        })
+    }
+
     /// Base parameters followed by the derived ones.
     pub fn params(&self) -> &[f64] {
         &self.params
@@ -282,18 +298,7 @@ impl<K: Kernels> Arm<K> {
     fn eval_packed(&self, kind: KernelKind, t: f64, q: &[f64], qd: &[f64], f: impl FnOnce(&[f64])) {
         let mut packed = self.packed.borrow_mut();
         packed.resize(kind.output_len(self.kernels.info()), 0.0);
-        self.with_params(t, |p| {
-            let inp = Inputs {
-                t,
-                q,
-                qd,
-                qdd: &[],
-                dir: &[],
-                p,
-                aux: &[],
-            };
-            self.kernels.eval(kind, &inp, &mut packed);
-        });
+        self.at(t, q, qd, |inp| self.kernels.eval(kind, inp, &mut packed));
         f(&packed);
     }
 }
@@ -366,53 +371,16 @@ impl<K: Kernels> Dynamics for Arm<K> {
         out
     }
     fn eval_kernel(&self, kind: KernelKind, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) {
-        self.with_params(t, |p| {
-            let inp = Inputs {
-                t,
-                q,
-                qd,
-                qdd: &[],
-                dir: &[],
-                p,
-                aux: &[],
-            };
-            self.kernels.eval(kind, &inp, out);
-        });
+        self.at(t, q, qd, |inp| self.kernels.eval(kind, inp, out))
     }
     fn solve_mass(&self, packed: &[f64], b: &mut [f64], ws: &mut Ldlt) -> bool {
         self.kernels.solve_mass(packed, b, ws)
     }
     fn contact_bounds(&self, t: f64, q: &[f64], qd: &[f64], out: &mut [f64]) -> bool {
-        let mut given = false;
-        self.with_params(t, |p| {
-            let inp = Inputs {
-                t,
-                q,
-                qd,
-                qdd: &[],
-                dir: &[],
-                p,
-                aux: &[],
-            };
-            given = self.kernels.contact_bounds(&inp, out);
-        });
-        given
+        self.at(t, q, qd, |inp| self.kernels.contact_bounds(inp, out))
     }
     fn direct_accelerations(&self, t: f64, q: &[f64], qd: &[f64], qdd: &mut [f64]) -> Option<bool> {
-        let mut solved = None;
-        self.with_params(t, |p| {
-            let inp = Inputs {
-                t,
-                q,
-                qd,
-                qdd: &[],
-                dir: &[],
-                p,
-                aux: &[],
-            };
-            solved = self.kernels.accelerations(&inp, qdd);
-        });
-        solved
+        self.at(t, q, qd, |inp| self.kernels.accelerations(inp, qdd))
     }
     fn jacobian_parts(&self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], out: &mut [f64]) {
         // Column j of d tau/dq along dq = e_j, of d tau/dqd along dqd = e_j.

@@ -344,7 +344,9 @@ pub fn has_contact_bounds(layout: &LinkLayout, groups: &[usize]) -> bool {
     !elements.is_empty()
         && points.is_multiple_of(elements.len())
         && elements.iter().all(|e| e.length.is_some())
-        && groups.iter().all(|&g| g.is_multiple_of(points / elements.len()))
+        && groups
+            .iter()
+            .all(|&g| g.is_multiple_of(points / elements.len()))
         && groups.iter().sum::<usize>() == points
 }
 
