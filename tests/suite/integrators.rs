@@ -258,6 +258,20 @@ fn auto_takes_generalized_alpha_for_a_lightly_damped_stiff_structure() {
             "{sets:?} at rtol {rtol}: {}",
             switch.reason
         );
+        // Where the report recommends generalized-alpha and radau5 runs,
+        // the reason says why.
+        let recommended = switch
+            .reason
+            .contains("generalized-alpha steps with the motion");
+        let instead = switch
+            .reason
+            .contains("radau5 instead at rtol 1e-6, tighter than 1e-4");
+        assert_eq!(
+            instead,
+            recommended && want == Solver::Radau5,
+            "{sets:?} at rtol {rtol}: {}",
+            switch.reason
+        );
         let (reference, _) = run(sets, 1e-9, Solver::Dopri5);
         let err = relative_error(&q, &reference);
         eprintln!("{sets:?} at rtol {rtol}: the tip {err:.2e} from dopri5's");

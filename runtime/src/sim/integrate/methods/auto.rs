@@ -43,6 +43,20 @@ impl Integrator for Auto {
             "genalpha" if opts.rtol >= GENALPHA_RTOL && second_order => Solver::GenAlpha,
             _ => Solver::Radau5,
         };
+        // The report's reason, and why radau5 where it recommends
+        // generalized-alpha.
+        let why = |r: &crate::stiffness::StiffnessReport| match (r.recommended_solver, implicit(r))
+        {
+            ("genalpha", Solver::Radau5) if !second_order => format!(
+                "{}; radau5 instead, for its first-order states (relaxed forces)",
+                r.reason
+            ),
+            ("genalpha", Solver::Radau5) => format!(
+                "{}; radau5 instead at rtol {:e}, tighter than {GENALPHA_RTOL:e}: its fifth order takes the larger steps",
+                r.reason, opts.rtol
+            ),
+            _ => r.reason.clone(),
+        };
         let as_auto = |mut stats: SimStats, at_s: f64, to: Solver, reason: String| {
             stats.solver = Solver::Auto;
             stats.switched = Some(SolverSwitch { at_s, to, reason });
@@ -51,7 +65,7 @@ impl Integrator for Auto {
         if let Some(r) = analyse_at(t0, &x0)
             && r.stiffness_ratio > STIFF_RATIO
         {
-            let reason = format!("stiff from the start: {}", r.reason);
+            let reason = format!("stiff from the start: {}", why(&r));
             let to = implicit(&r);
             let opts = SimOptions {
                 solver: to,
@@ -74,7 +88,7 @@ impl Integrator for Auto {
                 chosen.set(implicit(&r));
                 format!(
                     "dopri5 held at the stability limit ({h:.2e} s steps) of a stiff arm: {}",
-                    r.reason
+                    why(&r)
                 )
             })
         };
