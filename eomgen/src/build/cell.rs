@@ -233,8 +233,9 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
 /// 1 along it) on the links of each element: an element of one link at
 /// s along it, one of two halves (a half-arc pcc element, a rom slice) on
 /// the first at 2 s up to its middle, else on the second at 2 s - 1, as the
-/// methods sample them. None without contact or where an element's points
-/// are not on its links' arcs: its contact kernels are then its tapes'.
+/// methods sample them, in the links' order. Empty without contact or
+/// where an element's points are not on its links' arcs: its contact
+/// kernels are then its tapes'.
 fn contact_points(
     elements: &[Option<(std::ops::Range<usize>, Option<usize>)>],
     points: usize,

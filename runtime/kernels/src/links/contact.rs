@@ -157,6 +157,8 @@ fn sweep<N: Num, C: Cells>(
 ) {
     let n = layout.dof;
     let points = &layout.contact;
+    // The sweep meets each point on its link, in the links' order.
+    debug_assert!(points.windows(2).all(|w| w[0].link <= w[1].link));
     let Some(last) = (0..points.len()).rev().find(|&i| want(i)) else {
         return;
     };
