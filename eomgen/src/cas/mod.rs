@@ -17,10 +17,9 @@ mod fuse;
 mod lower;
 mod reverse;
 mod substitute;
-#[cfg(test)]
-mod tests;
 mod turning;
 
 pub(crate) use expr::Variables;
 pub use expr::{Cas, ExprId, Func, Node, Scope, SymId, SymKind};
+pub use fuse::fuse_multiply_adds;
 pub use lower::{Hoist, Lowerer};

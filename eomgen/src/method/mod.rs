@@ -302,6 +302,8 @@ macro_rules! dispatch {
 
 crate::model::methods!(dispatch);
 
+pub use rom::{RomFields, legendre};
+
 /// The generalised coordinates' names of a structure, in order: one angle
 /// an element in the plane, else each segment's method's.
 pub fn coordinate_names(st: &Structure) -> Vec<String> {

@@ -13,7 +13,7 @@ mod equations;
 pub(crate) mod inertia;
 pub(crate) mod planar;
 mod solve;
-pub(crate) mod spatial;
+pub mod spatial;
 pub(crate) mod system;
 
 pub(crate) use cell_outputs::with_tangent;

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use proptest::prelude::*;
 use runtime::tape::Inputs;
 
-use super::*;
+use eomgen::cas::*;
 
 fn vals(pairs: &[(&str, f64)]) -> HashMap<String, f64> {
     pairs.iter().map(|(k, v)| (k.to_string(), *v)).collect()

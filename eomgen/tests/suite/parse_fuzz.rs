@@ -5,7 +5,7 @@ use eomgen::load::parse_model;
 use eomgen::model::Override;
 use proptest::prelude::*;
 
-const GOOD: &str = include_str!("../../models/double_pendulum.toml");
+const GOOD: &str = include_str!("../../../models/double_pendulum.toml");
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
