@@ -79,6 +79,9 @@ pub fn sweep(a: SweepArgs) -> Result<ExitCode> {
         .iter()
         .map(|s| Vary::parse(s))
         .collect::<Result<_>>()?;
+    // A grid past what a sweep makes is refused before its values are
+    // read one by one (a model read each).
+    crate::grid::checked_size(&varies, true, "--yes")?;
     check_values(&a.simulate.model, &varies)?;
     checked_size_with(&varies, a.yes, "--yes", |runs| pilot(&a, &varies, runs))?;
     let combos = grid(&varies);

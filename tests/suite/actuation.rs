@@ -77,7 +77,13 @@ fn arc(len: f64, theta: f64, n: [f64; 3]) -> [f64; 3] {
 
 fn assert_tip(got: [f64; 3], want: [f64; 3], what: &str) {
     for k in 0..3 {
-        assert_close(got[k], want[k], 1e-9, L, &format!("{what}, component {k}"));
+        assert_close(
+            got[k],
+            want[k],
+            1e-9,
+            L,
+            format_args!("{what}, component {k}"),
+        );
     }
 }
 
@@ -225,7 +231,7 @@ value = 0.0
             want[1],
             1e-6,
             L,
-            &format!("{angles}: a moment about z"),
+            format_args!("{angles}: a moment about z"),
         );
     }
 }
@@ -497,7 +503,7 @@ sensor_offset = [0.010, 0.0, 0.0]
                 want[k],
                 1e-12,
                 1e-3,
-                &format!("t = {t}, component {k}"),
+                format_args!("t = {t}, component {k}"),
             );
         }
     }
@@ -627,7 +633,7 @@ frequency = 2.0
     for t in [0.05, 0.1, 0.3] {
         let qdd = accelerations(&loaded, t, &[0.7], &[-1.1]);
         let want = 0.03 * (2.0 * PI * 2.0 * t).sin() / inertia;
-        assert_close(qdd[0], want, 1e-12, 0.0, &format!("theta'' at t = {t}"));
+        assert_close(qdd[0], want, 1e-12, 0.0, format_args!("theta'' at t = {t}"));
     }
 }
 
@@ -746,10 +752,16 @@ fn a_load_in_the_world_the_tip_and_a_sensor_frame_bends_the_arm_alike() {
         let (tip_pos, q) = static_tip(dir.path(), &text, &[]);
         eprintln!("{what}: tip {tip_pos:?} against {tip_w:?}");
         for k in 0..3 {
-            assert_close(tip_pos[k], tip_w[k], 1e-12, L, &format!("{what}: tip {k}"));
+            assert_close(
+                tip_pos[k],
+                tip_w[k],
+                1e-12,
+                L,
+                format_args!("{what}: tip {k}"),
+            );
         }
         for (a, b) in q.iter().zip(&sol.q) {
-            assert_close(*a, *b, 1e-10, 1e-6, &format!("{what}: coordinates"));
+            assert_close(*a, *b, 1e-10, 1e-6, format_args!("{what}: coordinates"));
         }
     }
 }

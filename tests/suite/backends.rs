@@ -34,7 +34,7 @@ fn compiled_and_interpreted_agree_on_every_bundled_model() {
             .zip(interpreted.params())
             .enumerate()
         {
-            assert_close(*a, *b, 1e-12, 0.0, &format!("{} parameter {k}", m.name));
+            assert_close(*a, *b, 1e-12, 0.0, format_args!("{} parameter {k}", m.name));
         }
         assert_backends_agree(m.name, &compiled, &interpreted, &mut rng, 12);
     }
@@ -92,7 +92,13 @@ fn assert_backends_agree(
                     },
                     _ => (1e-12, 0.0),
                 };
-                assert_close(a[k], b[k], rel, floor, &format!("{} {kind:?}[{k}]", what));
+                assert_close(
+                    a[k],
+                    b[k],
+                    rel,
+                    floor,
+                    format_args!("{} {kind:?}[{k}]", what),
+                );
             }
         }
         assert_contact_agrees(what, compiled, interpreted, rng, t, &q, &qd);
@@ -105,16 +111,19 @@ fn assert_backends_agree(
         // numbers (runtime/kernels/src/links/tangent.rs), eba from its parts:
         // another order of the same sums, held to 1e-12 of each
         // block's largest entry.
+        let floors: Vec<f64> = b
+            .chunks(n * n)
+            .map(|block| block.iter().fold(1e-300f64, |s, x| s.max(x.abs())))
+            .collect();
         for k in 0..2 * n * n {
             assert!(a[k].is_finite(), "{} Jacobian part {k} not finite", what);
-            let block = &b[(k / (n * n)) * n * n..][..n * n];
-            let floor = block.iter().fold(1e-300f64, |s, x| s.max(x.abs()));
+            let floor = floors[k / (n * n)];
             assert_close(
                 a[k],
                 b[k],
                 1e-12,
                 floor,
-                &format!("{} Jacobian part {k}", what),
+                format_args!("{} Jacobian part {k}", what),
             );
         }
     }
@@ -141,7 +150,7 @@ fn assert_contact_agrees(
         let scale = b.iter().fold(1e-300f64, |s, x| s.max(x.abs()));
         for (k, (x, y)) in a.iter().zip(b).enumerate() {
             assert!(x.is_finite(), "{what} {label}[{k}] not finite");
-            assert_close(*x, *y, 1e-12, scale, &format!("{what} {label}[{k}]"));
+            assert_close(*x, *y, 1e-12, scale, format_args!("{what} {label}[{k}]"));
         }
     };
     let eval = |d: &dyn Dynamics, kind: KernelKind, dir: &[f64], out: &mut Vec<f64>| {
@@ -345,7 +354,7 @@ fn generated_mass_solve_matches_a_dense_solve() {
                     reference[i],
                     1e-9,
                     scale,
-                    &format!("{} qdd[{i}]", m.name),
+                    format_args!("{} qdd[{i}]", m.name),
                 );
                 assert!(out[n + i] > 0.0, "{}: pivot {i} not positive", m.name);
             }
@@ -381,7 +390,7 @@ fn generated_mass_solve_matches_a_dense_solve() {
                     *b,
                     1e-14,
                     1.0,
-                    &format!("{} point coordinate {i}", m.name),
+                    format_args!("{} point coordinate {i}", m.name),
                 );
             }
         }
@@ -827,7 +836,7 @@ fn recursion_matches_at(
                 want[k],
                 1e-12,
                 floor,
-                &format!("{what} shared {shared} entry {k}"),
+                format_args!("{what} shared {shared} entry {k}"),
             );
         }
     }
@@ -903,14 +912,14 @@ fn recursion_matches_at(
             want_tau[i],
             1e-12,
             tau_scale,
-            &format!("tau {what}"),
+            format_args!("tau {what}"),
         );
         assert_close(
             dtau[i],
             want_jvp[i],
             1e-12,
             jvp_scale,
-            &format!("jvp {what}"),
+            format_args!("jvp {what}"),
         );
     }
 }
@@ -1033,7 +1042,7 @@ fn eba_parts_match_the_flat_tapes() {
                     want_jvp[i],
                     1e-12,
                     jvp_scale,
-                    &format!("jvp {what}"),
+                    format_args!("jvp {what}"),
                 );
             }
         }
@@ -1202,7 +1211,7 @@ fn articulated_body_accelerations_equal_the_mass_matrix_solve() {
                     reference[k],
                     1e-9,
                     scale,
-                    &format!("{what} qdd[{k}]"),
+                    format_args!("{what} qdd[{k}]"),
                 );
             }
         }

@@ -209,7 +209,7 @@ fn a_contact_that_begins_at_rest_settles_within_ten_periods() {
             depth,
             0.01,
             0.0,
-            &format!("{contact}: depth after ten periods"),
+            format_args!("{contact}: depth after ten periods"),
         );
         // At rest there: the speed a hundredth of the settling scale.
         let scale = depth / period;
@@ -597,7 +597,7 @@ fn a_rod_struck_on_its_support_stops_and_rests_on_it() {
                 m * g / 2.0,
                 1e-6,
                 0.0,
-                &format!("support force column at {t}"),
+                format_args!("support force column at {t}"),
             );
         }
     }
@@ -826,10 +826,10 @@ exponent = {n_exp}
             load,
             1e-9,
             0.0,
-            &format!("{method}: balance"),
+            format_args!("{method}: balance"),
         );
         let law = (table / k_c).powf(1.0 / n_exp);
-        assert_close(depth, law, 1e-6, 0.0, &format!("{method}: depth"));
+        assert_close(depth, law, 1e-6, 0.0, format_args!("{method}: depth"));
     }
 }
 

@@ -63,7 +63,7 @@ fn check(arm: &dyn Dynamics, label: &str) {
                     m_ref[i][j],
                     1e-12,
                     0.0,
-                    &format!("{label} M[{i}][{j}] at {q:?}"),
+                    format_args!("{label} M[{i}][{j}] at {q:?}"),
                 );
             }
             // The floor covers terms that cancel to near zero in one form only.
@@ -72,7 +72,7 @@ fn check(arm: &dyn Dynamics, label: &str) {
                 h_ref[i],
                 1e-12,
                 1e-3,
-                &format!("{label} h[{i}] at {q:?} {qd:?}"),
+                format_args!("{label} h[{i}] at {q:?} {qd:?}"),
             );
         }
     }

@@ -510,7 +510,7 @@ fn the_steel_rod_rings_for_25_s_within_a_millimetre_of_its_converged_run() {
             closed,
             1e-3,
             0.0,
-            &format!("{example}: the first bending mode"),
+            format_args!("{example}: the first bending mode"),
         );
     }
 }

@@ -92,7 +92,7 @@ fn generated_jacobian_matches_central_differences() {
                         fd,
                         1e-6,
                         scale,
-                        &format!("{} J[{i}][{j}] (state {it})", m.name),
+                        format_args!("{} J[{i}][{j}] (state {it})", m.name),
                     );
                 }
             }

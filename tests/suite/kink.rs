@@ -78,7 +78,7 @@ fn assert_deflection(got: [f64; 3], want: [f64; 3], what: &str) {
             want[c],
             2e-3,
             scale,
-            &format!("{what}, component {c}"),
+            format_args!("{what}, component {c}"),
         );
     }
 }

@@ -51,15 +51,15 @@ value = 0.0
     let expect_a = [[0.0, 1.0], [-k / inertia, -c / inertia]];
     for (i, row) in expect_a.iter().enumerate() {
         for (j, e) in row.iter().enumerate() {
-            assert_close(at("A", i, j), *e, 1e-12, 1e-12, &format!("A[{i}][{j}]"));
+            assert_close(at("A", i, j), *e, 1e-12, 1e-12, format_args!("A[{i}][{j}]"));
         }
     }
     assert_close(at("B", 0, 0), 0.0, 0.0, 1e-9, "B[0]");
     assert_close(at("B", 1, 0), 1.0 / inertia, 1e-8, 0.0, "B[1]");
     for (i, e) in [0.0, l, 0.0].iter().enumerate() {
-        assert_close(at("C", i, 0), *e, 1e-8, 1e-9, &format!("C[{i}][0]"));
-        assert_close(at("C", i, 1), 0.0, 0.0, 1e-12, &format!("C[{i}][1]"));
-        assert_close(at("D", i, 0), 0.0, 0.0, 1e-9, &format!("D[{i}]"));
+        assert_close(at("C", i, 0), *e, 1e-8, 1e-9, format_args!("C[{i}][0]"));
+        assert_close(at("C", i, 1), 0.0, 0.0, 1e-12, format_args!("C[{i}][1]"));
+        assert_close(at("D", i, 0), 0.0, 0.0, 1e-9, format_args!("D[{i}]"));
     }
     assert_eq!(v["states"][1], "theta_0_0_dot");
 }

@@ -136,7 +136,7 @@ fn a_local_point_load_at_the_tip_is_the_tip_force_in_the_tips_frame() {
     let b = static_tip(dir.path(), &cantilever(3, &tip), &[]);
     assert!(a[2] < -0.2 * L, "bent far: {a:?}");
     for c in 0..3 {
-        assert_close(a[c], b[c], 1e-9, L, &format!("component {c}"));
+        assert_close(a[c], b[c], 1e-9, L, format_args!("component {c}"));
     }
     // An input drives it as the constant does.
     let driven = point.replace(
@@ -145,6 +145,6 @@ fn a_local_point_load_at_the_tip_is_the_tip_force_in_the_tips_frame() {
     );
     let c = static_tip(dir.path(), &cantilever(3, &driven), &[]);
     for k in 0..3 {
-        assert_close(c[k], a[k], 1e-12, L, &format!("driven, component {k}"));
+        assert_close(c[k], a[k], 1e-12, L, format_args!("driven, component {k}"));
     }
 }

@@ -89,7 +89,7 @@ fn a_link_on_a_shaken_base_feels_minus_m_a_at_its_centre_of_mass() {
                 want,
                 1e-10,
                 1e-12,
-                &format!("{dimensions}D theta'' at t = {t}"),
+                format_args!("{dimensions}D theta'' at t = {t}"),
             );
         }
     }
@@ -143,7 +143,7 @@ frequency = 0.7
                 want,
                 1e-10,
                 1e-12,
-                &format!("{dimensions}D ({base}) theta'' at t = {t}"),
+                format_args!("{dimensions}D ({base}) theta'' at t = {t}"),
             );
         }
     }
@@ -168,7 +168,7 @@ value = 1.5707963267948966
     let l = load_text(dir.path(), &link(3, base, inputs), &[]);
     let o = l.arm.outputs(0.0, &[0.0], &[0.0]);
     for (k, want) in [0.1, 0.2, 0.3 - L].into_iter().enumerate() {
-        assert_close(o[k], want, 1e-12, 1e-15, &format!("tip component {k}"));
+        assert_close(o[k], want, 1e-12, 1e-15, format_args!("tip component {k}"));
     }
 }
 
@@ -223,7 +223,7 @@ value = 0.0
             accelerations(&carried, t, &q, &qd),
         );
         for i in 0..n {
-            assert_close(b[i], a[i], 1e-10, 1e-9, &format!("qdd[{i}] at t = {t}"));
+            assert_close(b[i], a[i], 1e-10, 1e-9, format_args!("qdd[{i}] at t = {t}"));
         }
         let (oa, ob) = (
             still.arm.outputs(t, &q, &qd),
@@ -310,7 +310,7 @@ value = 0.0
                     a[i],
                     1e-9,
                     1e-9,
-                    &format!("{method}: qdd[{i}] ({}) at t = {t}", names[i]),
+                    format_args!("{method}: qdd[{i}] ({}) at t = {t}", names[i]),
                 );
             }
         }

@@ -235,7 +235,7 @@ fn the_force_holding_a_deflection_relaxes_as_the_prony_series() {
                 share * f0[i],
                 1e-7,
                 1e-12,
-                &format!("holding force {i} at t = {t}"),
+                format_args!("holding force {i} at t = {t}"),
             );
         }
     }

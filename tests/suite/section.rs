@@ -47,7 +47,13 @@ fn a_planar_arm_bends_by_its_sections_second_moment_in_the_plane() {
         let theta = m * L / (E * iz);
         let want = [L * theta.sin() / theta, L * (1.0 - theta.cos()) / theta];
         for c in 0..2 {
-            assert_close(tip[c], want[c], 1e-9, L, &format!("{shape}, component {c}"));
+            assert_close(
+                tip[c],
+                want[c],
+                1e-9,
+                L,
+                format_args!("{shape}, component {c}"),
+            );
         }
     }
     // Its own weight, in the plane: q = rho w h g.
@@ -175,13 +181,19 @@ fn a_rectangular_rod_deflects_under_a_tip_force_by_each_axis_stiffness() {
         let shear = f * L / (E / 3.0 * w * h);
         let cosserat = "segment.0.method=cosserat".to_string();
         let rod = static_tip(dir.path(), &text, std::slice::from_ref(&cosserat));
-        assert_close(rod[axis], bend, 1e-5, 0.0, &format!("the rod along {axis}"));
+        assert_close(
+            rod[axis],
+            bend,
+            1e-5,
+            0.0,
+            format_args!("the rod along {axis}"),
+        );
         let shearing = [cosserat, "segment.0.shear=true".into()];
         let rod = static_tip(dir.path(), &text, &shearing);
         let what = format!("the shearing rod along {axis}");
         assert_close(rod[axis], bend + shear, 1e-5, 0.0, &what);
         let pcc = static_tip(dir.path(), &text, &method_sets("pcc", 16));
-        assert_close(pcc[axis], bend, 1e-3, 0.0, &format!("pcc along {axis}"));
+        assert_close(pcc[axis], bend, 1e-3, 0.0, format_args!("pcc along {axis}"));
     }
 }
 
@@ -306,7 +318,7 @@ fn a_properties_section_shears_by_its_own_stiffness_along_each_axis() {
                 sign * want,
                 1e-4,
                 0.0,
-                &format!("{method} along {axis}"),
+                format_args!("{method} along {axis}"),
             );
         }
     }

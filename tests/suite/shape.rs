@@ -55,7 +55,7 @@ fn every_methods_centreline_ends_at_the_tip_the_outputs_kernel_computes() {
             let end = arm_rows.last().unwrap();
             let out = arm.outputs(0.3, &q, &qd);
             for (c, (a, b)) in end.pose.iter().zip(&out[..3]).enumerate() {
-                assert_close(*a, *b, 1e-12, 1e-12, &format!("{name} tip {c}"));
+                assert_close(*a, *b, 1e-12, 1e-12, format_args!("{name} tip {c}"));
             }
             let tip_quat = &out[5..9];
             let d = same_rotation(&end.pose[3..], tip_quat);
@@ -66,7 +66,7 @@ fn every_methods_centreline_ends_at_the_tip_the_outputs_kernel_computes() {
             );
             // Material coordinate: from 0 to the arm's length.
             let length: f64 = l.model.segments.iter().map(|s| s.length).sum();
-            assert_close(end.s, length, 1e-12, 0.0, &format!("{name} s"));
+            assert_close(end.s, length, 1e-12, 0.0, format_args!("{name} s"));
             assert_eq!(arm_rows[0].s, 0.0);
         }
     }

@@ -214,7 +214,7 @@ fn torsion_and_both_bending_frequencies_match_beam_theory() {
     for (k, beta) in [1.875104f64, 4.694091].into_iter().enumerate() {
         let exact = beta * beta / two_pi * scale;
         for f in &bending[2 * k..2 * k + 2] {
-            assert_close(*f, exact, 0.02, 0.0, &format!("bending mode {}", k + 1));
+            assert_close(*f, exact, 0.02, 0.0, format_args!("bending mode {}", k + 1));
         }
     }
     let g = E / 3.0;
@@ -613,7 +613,7 @@ fn tentacle3d_tmt_mass_and_bias_match_a_numeric_composite_body_recursion() {
         let h_scale = h.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         for (k, (&g, &w)) in got.iter().zip(&want).enumerate() {
             let floor = if k < m.len() { m_scale } else { h_scale };
-            assert_close(g, w, 1e-11, floor, &format!("trial {trial}, entry {k}"));
+            assert_close(g, w, 1e-11, floor, format_args!("trial {trial}, entry {k}"));
         }
     }
 }
@@ -670,7 +670,7 @@ fn a_thick_cantilever_bends_at_the_rayleigh_beams_frequencies() {
                 f[2 * k],
                 1e-6,
                 0.0,
-                &format!("{what}: pair {k}"),
+                format_args!("{what}: pair {k}"),
             );
         }
         let bending = [f[0], f[2], f[4]];
@@ -681,7 +681,7 @@ fn a_thick_cantilever_bends_at_the_rayleigh_beams_frequencies() {
                 reference[k],
                 tol,
                 0.0,
-                &format!("{what}: mode {k}"),
+                format_args!("{what}: mode {k}"),
             );
         }
     }

@@ -70,7 +70,7 @@ fn a_modes_sweep_over_e_scales_the_frequencies_as_its_square_root() {
                     want,
                     1e-9,
                     0.0,
-                    &format!("f ratio at E = {}, m = {mass}", r[e]),
+                    format_args!("f ratio at E = {}, m = {mass}", r[e]),
                 );
             }
         }

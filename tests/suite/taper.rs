@@ -140,7 +140,7 @@ fn a_tapered_cantilever_bent_far_matches_the_cosserat_rod() {
             rod[c],
             1e-4,
             L,
-            &format!("pcc's tip, component {c}"),
+            format_args!("pcc's tip, component {c}"),
         );
     }
 }

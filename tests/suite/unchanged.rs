@@ -1,7 +1,8 @@
 //! Every bundled model computes what it computed when its fixture was
 //! recorded: M and h, the outputs, the generated solve, the stiffness and
 //! the right-hand side's Jacobian (applied to a fixed vector) at fixed
-//! states, in both backends; the static solution; and a 1 s trajectory.
+//! states, in both backends; the static solution; and a trajectory (1 s,
+//! less for the stiffest rods: [`horizon`]).
 //!
 //! The fixtures in `tests/fixtures/` (the bundled models) and
 //! `tests/fixtures/variants/` (variants that exercise what the bundled
@@ -88,12 +89,17 @@ fn kernels_at_states(arm: &dyn Dynamics, seed: u64) -> Value {
     Value::Array(out)
 }
 
-/// How long a bundled model's recorded trajectory is: 1 s, but 0.1 s for
-/// rod_swing, whose 60 stiff strain coordinates (stretch and shear) take
-/// dopri5 about 118,000 steps a second: a tenth of them still covers every
-/// kernel and the step control, in a few seconds of test.
+/// How long a bundled model's recorded trajectory is: 1 s, but shorter
+/// for the 3D rods whose stiff strains (stretch, shear, rom's fields) take
+/// dopri5 6,000 to 110,000 steps a second of tens of coordinates: a tenth
+/// or a fiftieth of a second still runs every kernel and the step control
+/// over hundreds of steps or more, in a second or two of test.
 fn horizon(model: &str) -> f64 {
-    if model == "rod_swing" { 0.1 } else { 1.0 }
+    match model {
+        "rod_swing" | "eba_arm" => 0.02,
+        "rod_swing_rom" | "rom_arm" => 0.1,
+        _ => 1.0,
+    }
 }
 
 /// Static solution and a trajectory over [`horizon`], compiled backend.
@@ -111,7 +117,7 @@ fn simulations(loaded: &mut softarm::backend::Loaded) -> Value {
         rtol: file.rtol.unwrap_or(1e-6),
         atol: file.atol.unwrap_or(1e-9),
         dt: file.dt.unwrap_or(1e-3),
-        output_dt: 0.1,
+        output_dt: horizon(&loaded.model.name) / 10.0,
         ..Default::default()
     };
     // Start bent, so that every model moves; a model with joints from its

@@ -43,7 +43,8 @@ impl Rng {
 
 /// |a - b| <= rel * max(|a|, |b|, floor): relative, with an absolute floor
 /// for entries that are zero in closed form.
-pub fn assert_close(a: f64, b: f64, rel: f64, floor: f64, what: &str) {
+/// `what` is formatted only on failure: pass `format_args!` in hot loops.
+pub fn assert_close(a: f64, b: f64, rel: f64, floor: f64, what: impl std::fmt::Display) {
     let scale = a.abs().max(b.abs()).max(floor);
     assert!(
         (a - b).abs() <= rel * scale,
