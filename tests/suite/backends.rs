@@ -594,14 +594,9 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
             .iter()
             .map(|s| eomgen::model::Override::parse(s).unwrap())
             .collect();
-        let l = load(
-            &model,
-            &overrides,
-            BackendChoice::Interpreted,
-            Some(dir.clone()),
-        )
-        .unwrap();
-        let tapes = eomgen::derive::derive(&l.model);
+        // The model alone: its tapes are derived here, once.
+        let (m, _) = softarm::backend::read_model(&model, &overrides).unwrap();
+        let tapes = eomgen::derive::derive(&m);
         let links = tapes
             .links
             .clone()
@@ -612,13 +607,13 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
             jvp: tapes.jvp.clone(),
             outputs: tapes.outputs.clone(),
         };
-        let mut p: Vec<f64> = eomgen::load::parameters(&l.model)
+        let mut p: Vec<f64> = eomgen::load::parameters(&m)
             .into_iter()
             .map(|(_, v)| v)
             .collect();
         // Inputs at values of their kind's scale (a constant input's value
         // is not in the model's numbers).
-        let layout = eomgen::model::ParamLayout::of(&eomgen::model::Structure::of(&l.model));
+        let layout = eomgen::model::ParamLayout::of(&eomgen::model::Structure::of(&m));
         for d in layout.driven() {
             use eomgen::model::{ChamberParam, Param};
             let scale = match d.param {
@@ -930,7 +925,6 @@ fn recursion_matches_at(
 /// loads, extension and thinning.
 #[test]
 fn eba_parts_match_the_flat_tapes() {
-    let dir = std::env::temp_dir().join("softarm-test-cache");
     let cases: [&[&str]; 4] = [
         &["segment.0.method=eba", "gravity=[1,-2,-9.81]"],
         &[
@@ -960,21 +954,16 @@ fn eba_parts_match_the_flat_tapes() {
             .iter()
             .map(|s| eomgen::model::Override::parse(s).unwrap())
             .collect();
-        let l = load(
-            model,
-            &overrides,
-            BackendChoice::Interpreted,
-            Some(dir.clone()),
-        )
-        .unwrap();
-        let tapes = eomgen::derive::derive(&l.model);
+        // The model alone: its tapes are derived here, once.
+        let (m, _) = softarm::backend::read_model(model, &overrides).unwrap();
+        let tapes = eomgen::derive::derive(&m);
         let parts = tapes
             .parts
             .clone()
             .unwrap_or_else(|| panic!("parts cover {model} {sets:?}"));
         let (flat, jvp) = (tapes.mass_bias.clone(), tapes.jvp.clone());
         let flat_outputs = tapes.outputs.clone();
-        let p: Vec<f64> = eomgen::load::parameters(&l.model)
+        let p: Vec<f64> = eomgen::load::parameters(&m)
             .into_iter()
             .map(|(_, v)| v)
             .collect();
