@@ -44,15 +44,16 @@ fn reference(file: &str) -> Vec<[f64; 4]> {
 }
 
 /// The tip of `model` under gravity along -z by dopri5 at `rtol`, at the
-/// references' times (every 10 ms over 2 s).
-fn tips(model: &str, rtol: f64) -> Vec<(f64, [f64; 3])> {
+/// references' times (every 10 ms) to `t_end` (at most their 2 s).
+fn tips(model: &str, rtol: f64, t_end: f64) -> Vec<(f64, [f64; 3])> {
     let times: Vec<f64> = reference(ROD).iter().map(|r| r[0]).collect();
     assert_eq!(times.len(), 201, "2 s every 10 ms");
+    let times: Vec<f64> = times.into_iter().filter(|&t| t <= t_end + 1e-9).collect();
     let gravity = Override::parse("gravity=[0,0,-9.81]").unwrap();
     let l = load(model, &[gravity], BackendChoice::Auto, None).unwrap();
     let n = l.arm.dof();
     let opts = SimOptions {
-        t_end: 2.0,
+        t_end,
         solver: Solver::Dopri5,
         rtol,
         atol: rtol * 1e-3,
@@ -71,10 +72,10 @@ fn tips(model: &str, rtol: f64) -> Vec<(f64, [f64; 3])> {
 }
 
 /// The tips' largest distance from reference `file` over 0.5 s and over
-/// 2 s (% of L).
+/// their whole span (% of L).
 fn distance(tips: &[(f64, [f64; 3])], file: &str) -> (f64, f64) {
     let reference = reference(file);
-    assert_eq!(tips.len(), reference.len());
+    assert!(tips.len() <= reference.len());
     let (mut half, mut whole) = (0.0f64, 0.0f64);
     for ((t, o), r) in tips.iter().zip(&reference) {
         assert!((t - r[0]).abs() < 1e-9);
@@ -85,7 +86,8 @@ fn distance(tips: &[(f64, [f64; 3])], file: &str) -> (f64, f64) {
         }
     }
     let (half, whole) = (100.0 * half / L, 100.0 * whole / L);
-    eprintln!("against {file}: {half:.3} % of L over 0.5 s, {whole:.3} % over 2 s");
+    let span = tips.last().map_or(0.0, |t| t.0);
+    eprintln!("against {file}: {half:.3} % of L over 0.5 s, {whole:.3} % over {span} s");
     (half, whole)
 }
 
@@ -121,18 +123,27 @@ fn the_inextensible_pcc_rod_swings_within_its_recorded_distance() {
     // (docs/validation.md: 4.47 / 12.96 % of L from the inextensible rod,
     // 5.98 / 17.87 % from the rod), with a margin of 2 %.
     // The stretch it cannot follow is most of its distance from the rod.
-    let tips = tips("cantilever3d", 1e-8);
+    let tips = tips("cantilever3d", 1e-8, 2.0);
     let (half, whole) = distance(&tips, INEXTENSIBLE);
     assert!(half <= 4.56 && whole <= 13.22, "{half} / {whole} % of L");
     let (half, whole) = distance(&tips, ROD);
     assert!(half <= 6.10 && whole <= 18.23, "{half} / {whole} % of L");
 }
 
+// rod_swing, 10 pcs elements, 60 coordinates (docs/validation.md: 0.92
+// / 3.29 % of L at rtol 1e-6), with a margin of 2 %: its stretch and shear
+// take dopri5 about 60,000 steps a second, so the default run holds the
+// first half second and the long checks the whole 2 s.
 #[test]
 fn the_pcs_rod_that_stretches_and_shears_swings_within_its_recorded_distance() {
-    // rod_swing, 10 pcs elements, 60 coordinates (docs/validation.md: 0.92
-    // / 3.29 % of L at rtol 1e-6), with a margin of 2 %.
-    let (half, whole) = distance(&tips("rod_swing", 1e-6), ROD);
+    let (half, _) = distance(&tips("rod_swing", 1e-6, 0.5), ROD);
+    assert!(half <= 0.94, "{half} % of L over 0.5 s");
+}
+
+#[test]
+#[ignore = "long (2 s of a 60-coordinate rod, about 17 s): run by .ci/run's long checks"]
+fn the_pcs_rod_that_stretches_and_shears_swings_within_its_recorded_distance_for_two_seconds() {
+    let (half, whole) = distance(&tips("rod_swing", 1e-6, 2.0), ROD);
     assert!(half <= 0.94, "{half} % of L over 0.5 s");
     assert!(whole <= 3.36, "{whole} % of L over 2 s");
 }
@@ -144,7 +155,7 @@ fn the_six_strain_rom_follows_the_cosserat_rod_within_a_fifth_of_a_percent() {
     // against the rod, 0.556 and 0.753 % against PyElastica's law). The
     // goal is 1 % over 2 s; the recorded figures, with a margin, hold it to
     // what it reaches.
-    let tips = tips("rod_swing_rom", 1e-5);
+    let tips = tips("rod_swing_rom", 1e-5, 2.0);
     let (half, whole) = distance(&tips, ROD);
     assert!(half <= 0.075, "{half} % of L over 0.5 s");
     assert!(whole <= 0.18, "{whole} % of L over 2 s");
