@@ -302,6 +302,7 @@ macro_rules! dispatch {
 
 crate::model::methods!(dispatch);
 
+#[doc(hidden)]
 pub use rom::{RomFields, legendre};
 
 /// The generalised coordinates' names of a structure, in order: one angle

@@ -161,6 +161,7 @@ impl ModellingMethod for Rom {
 /// past order 5: the mass matrix inherits it and the step control stalls
 /// (docs/validation.md, the rom conditioning table).
 #[derive(Clone)]
+#[doc(hidden)] // white-box tests (tests/suite)
 pub struct RomFields {
     pub first: usize,
     pub order: usize,
@@ -510,6 +511,7 @@ fn gauss_legendre(m: usize) -> Vec<(f64, f64)> {
 /// P_0(y), ..., P_n(y), the Legendre polynomials on [-1, 1], by Bonnet's
 /// recurrence (k + 1) P_{k+1} = (2 k + 1) y P_k - k P_{k-1}: stable, no
 /// large coefficients.
+#[doc(hidden)] // white-box tests (tests/suite)
 pub fn legendre(n: usize, y: f64) -> Vec<f64> {
     let mut p = vec![1.0, y];
     for k in 1..n {

@@ -45,4 +45,6 @@ pub use section::SectionShape;
 pub use signals::{Compare, Input, Offset};
 pub(crate) use signals::{check_compare, check_input};
 pub use structure::{AssemblyShape, GENERATOR_VERSION, JointShape, SegmentShape, Structure};
-pub use suggest::{distance, with_suggestion};
+#[doc(hidden)]
+pub use suggest::distance;
+pub use suggest::with_suggestion;

@@ -45,6 +45,7 @@ fn unknown_and_allowed(message: &str) -> Option<(&str, Vec<&str>)> {
 }
 
 /// Levenshtein distance (insertions, deletions, substitutions).
+#[doc(hidden)] // white-box tests (tests/suite)
 pub fn distance(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();
     let mut row: Vec<usize> = (0..=b.len()).collect();

@@ -365,6 +365,7 @@ pub(crate) fn mid_arc_rotation(f: &Frame, a: &ArcStrain) -> impl FnOnce(&mut Cas
 
 /// The turn exp([rho]x): its rotation, quaternion and angular velocity
 /// (the left Jacobian applied to the rate) in the frame it turns from.
+#[doc(hidden)] // white-box tests (tests/suite)
 pub fn exp_turn(cas: &mut Cas, rho: &V3, rate: &V3) -> (M3, Quat, V3) {
     let wsq = cas.dot(rho, rho);
     let wsq = cas.bind(wsq);
