@@ -172,11 +172,8 @@ fn linked(
             "its chambers' levers vary along a segment, which link cells do not carry yet".into(),
         );
     }
-    if arms
-        .iter()
-        .any(|s| !s.loads.is_empty() || s.fluid.is_some())
-    {
-        return Err("its loads along the arm are not link cells yet".into());
+    if arms.iter().any(|s| s.fluid.is_some()) {
+        return Err("its fluid's buoyancy and drag are not link cells yet".into());
     }
     let not_cells = || "not every one of its methods' elements is a link cell".to_string();
     let kernels: (Box<dyn Kernels>, String) = if structure.assembly.is_some() {

@@ -54,7 +54,8 @@ impl<'a> Links<'a> {
     /// kernels are small, and quicker than the recursion in C as in Rust
     /// (the soft finger's state derivative 5 against 17 us).
     pub fn new(links: &'a LinkKernels, dof: usize) -> Option<Self> {
-        links.mass_bias.then_some(Self {
+        // Loads along the arm: the flat kernels carry them in C.
+        (links.mass_bias && links.layout.along.is_empty()).then_some(Self {
             links,
             dof,
             rows: None,

@@ -528,6 +528,103 @@ kind = "constant"
 value = 0.5
 "#;
 
+/// Loads along a 3D arm of a pcc (stretching), a rom and a vc segment:
+/// point forces inside an element, on an element boundary and at the
+/// base, a follower force and moment, a force per unit length in the
+/// world frame and one turning with the section, and a driven moment.
+const LOADED_3D: &str = r#"
+name = "loaded3d"
+dimensions = 3
+gravity = [0.0, -3.0, -9.81]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.12
+elements = 3
+density = 1100.0
+outer_radius = 0.012
+youngs_modulus = 2.0e5
+extension = true
+[[segment]]
+method = "rom"
+order = 2
+length = 0.1
+elements = 4
+density = 1100.0
+outer_radius = 0.01
+youngs_modulus = 2.0e5
+[[segment]]
+method = "vc"
+length = 0.08
+elements = 2
+density = 1100.0
+outer_radius = 0.008
+youngs_modulus = 2.0e5
+[[load]]
+segment = 0
+s = 0.05
+force = [0.1, -0.2, 0.3]
+[[load]]
+segment = 0
+s = 0.0
+force = [0.2, 0.1, -0.1]
+[[load]]
+segment = 0
+s = 0.08
+force = [0.0, 0.3, -0.2]
+moment = [0.01, -0.02, 0.03]
+frame = "local"
+[[load]]
+segment = 1
+s = 0.037
+moment = [0.02, 0.01, -0.01]
+[[load]]
+segment = 1
+force = [0.5, -1.0, 2.0]
+[[load]]
+segment = 2
+force = [-1.0, 0.5, 1.5]
+frame = "local"
+[[load]]
+segment = 2
+s = 0.05
+moment_inputs = ["m", "m", "m"]
+force = [0.1, 0.1, 0.1]
+[inputs.m]
+kind = "constant"
+value = 0.01
+"#;
+
+/// Loads along a planar pcc arm: a point force inside an element, a
+/// follower force at the tip and a moment, a force per unit length.
+const LOADED_2D: &str = r#"
+name = "loaded2d"
+gravity = [0.0, -9.81, 0.0]
+[base]
+direction = [1.0, -0.3, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.2
+elements = 5
+density = 1100.0
+outer_radius = 0.01
+youngs_modulus = 2.0e5
+[[load]]
+segment = 0
+s = 0.07
+force = [0.2, -0.3, 0.0]
+moment = [0.0, 0.0, 0.01]
+[[load]]
+segment = 0
+s = 0.2
+force = [0.0, 0.4, 0.0]
+frame = "local"
+[[load]]
+segment = 0
+force = [0.3, 1.0, 0.0]
+"#;
+
 /// A planar arm of a rigid link and a pcc segment with a tendon through
 /// both and chambers on the pcc segment, a tip body with a length and a
 /// tip wrench.
@@ -657,7 +754,16 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
     let actuated2d = dir.join("actuated2d.toml");
     std::fs::write(&actuated2d, ACTUATED_2D).unwrap();
     let actuated2d = actuated2d.to_str().unwrap().to_string();
+    let loaded = dir.join("loaded3d.toml");
+    std::fs::write(&loaded, LOADED_3D).unwrap();
+    let loaded = loaded.to_str().unwrap().to_string();
+    let loaded2d = dir.join("loaded2d.toml");
+    std::fs::write(&loaded2d, LOADED_2D).unwrap();
+    let loaded2d = loaded2d.to_str().unwrap().to_string();
     let mut models: Vec<(&str, &[&'static str])> = vec![
+        // Loads along the arm.
+        (&loaded, &[]),
+        (&loaded2d, &[]),
         // Planar chains: rigid links and pcc arcs (whose inertia changes
         // with the bend), a turned base, actuators, tip bodies and loads.
         ("double_pendulum", &[]),

@@ -5,7 +5,8 @@
 //! * a force P at mid-span bends the tip by 5 P L^3 / (48 E I) (plus
 //!   P a / (k G A) where the method shears), every method converging at
 //!   second order, in 3D and in the plane;
-//! * a moment M at a bends the tip by M a (2 L - a) / (2 E I);
+//! * a moment M at a bends the tip by M a (2 L - a) / (2 E I), on an
+//!   element boundary or inside an element;
 //! * a force q per unit length bends it by q L^4 / (8 E I), also on the
 //!   Cosserat rod;
 //! * a point load at the tip in the section's frame is the tip force in
@@ -114,6 +115,17 @@ fn a_moment_and_a_distributed_force_bend_it_as_beam_theory_says() {
         let text = cantilever(dims, &moment);
         let err = |n| (static_tip(dir.path(), &text, &method_sets("pcc", n))[1] - want) / want;
         converges((err(8), err(16)), &format!("a moment in {dims}D"));
+        // Inside an element, at the fraction f of it, the moment does work
+        // on the section's share f of the element's bend, which carries
+        // the element's whole length at f M / E I: the tip falls short by
+        // M l^2 f (1 - f) / (2 E I) of beam theory (7 elements: f = 3/4,
+        // 14: f = 1/2), exactly the model's own.
+        for (n, f) in [(7, 0.75), (14, 0.5)] {
+            let l = L / n as f64;
+            let short = m * l * l * f * (1.0 - f) / (2.0 * ei()) / want;
+            let what = format!("a moment inside an element, {n} elements, in {dims}D");
+            assert_close(err(n), -short, 1e-6, 0.0, &what);
+        }
     }
     let q = 1e-2;
     let spread = format!("[[load]]\nsegment = 0\nforce = [0.0, 0.0, {q}]");

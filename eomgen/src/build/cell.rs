@@ -17,16 +17,20 @@
 //! segment's slices are links whose cell coordinates are fixed
 //! combinations of the segment's coefficients (`LocalCoordinate`); its
 //! strain energy, integrated exactly over the segment, is one more small
-//! kernel (`derive_forces`). Other models keep the flat `MassBias` kernel.
+//! kernel (`derive_forces`). Loads along the arm act at points on the
+//! links' arcs (`runtime::links::AlongLoad`), where contact points are
+//! sampled. Other models keep the flat `MassBias` kernel.
 
 use runtime::Tape;
 use runtime::links::{
-    ACTUATION_LOADS, CELL_PARAMS, ELEMENT_PARAMS, LinkKernels, LinkLayout, LinkSpec,
-    LocalCoordinate, REST_PARAMS,
+    ACTUATION_LOADS, AlongLoad, CELL_PARAMS, ContactElement, ContactPoint, ELEMENT_PARAMS,
+    LinkKernels, LinkLayout, LinkSpec, LocalCoordinate, REST_PARAMS,
 };
 
 use crate::cas::{Cas, ExprId, SymKind};
-use crate::model::{ElementParam, Joints, KinkParam, Method, Param, ParamLayout, Structure, Xyz};
+use crate::model::{
+    ElementParam, Joints, KinkParam, LoadParam, Method, Param, ParamLayout, Structure, Xyz,
+};
 
 use super::planar_cell::derive_planar_cell;
 use crate::method::ebr::{before_joint, past_joint};
@@ -80,19 +84,7 @@ impl Shape {
 /// chains not compiled in take every kernel from it (linked cells).
 pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     let spatial = st.dimensions == 3;
-    // A planar element is covered when it is one body (`planar_cell`).
-    let covered = (!spatial
-        || st
-            .segments
-            .iter()
-            .all(|g| crate::method::of(g.method).link_cells()))
-        && st.torques.is_empty()
-        && !st.base_translates
-        && st.base_turns == 0
-        && (st.segments.iter()).all(|g| (!g.kink || spatial) && !g.anisotropic && !g.chambers_vary)
-        && st.loads.is_empty()
-        && st.fluid.is_none();
-    if !covered {
+    if !covered(st) {
         return None;
     }
     let index = |p: Param| params.index(p);
@@ -189,10 +181,12 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     }
     let contact = contact_points(&element_links, st.contact_points);
     let contact_elements = contact_elements(&element_links, &contact);
+    let along = along_loads(st, params, &element_links)?;
     let layout = LinkLayout {
         links,
         contact,
         contact_elements,
+        along,
         dof: first,
         forces: !roms.is_empty(),
         loads: actuated.len(),
@@ -229,6 +223,23 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     Some(kernels)
 }
 
+/// Whether the recursion may cover the structure, its elements' cells
+/// permitting (a planar element is covered when it is one body:
+/// `planar_cell`).
+fn covered(st: &Structure) -> bool {
+    let spatial = st.dimensions == 3;
+    (!spatial
+        || st
+            .segments
+            .iter()
+            .all(|g| crate::method::of(g.method).link_cells()))
+        && st.torques.is_empty()
+        && !st.base_translates
+        && st.base_turns == 0
+        && (st.segments.iter()).all(|g| (!g.kink || spatial) && !g.anisotropic && !g.chambers_vary)
+        && st.fluid.is_none()
+}
+
 /// The chain's contact points (`points` an element, at s = 1/points, ...,
 /// 1 along it) on the links of each element: an element of one link at
 /// s along it, one of two halves (a half-arc pcc element, a rom slice) on
@@ -236,40 +247,93 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
 /// methods sample them, in the links' order. Empty without contact or
 /// where an element's points are not on its links' arcs: its contact
 /// kernels are then its tapes'.
-fn contact_points(
-    elements: &[Option<(std::ops::Range<usize>, Option<usize>)>],
-    points: usize,
-) -> Vec<runtime::links::ContactPoint> {
-    let on = |link: usize, at: f64| runtime::links::ContactPoint { link, at };
+fn contact_points(elements: &[ElementLinks], points: usize) -> Vec<ContactPoint> {
     let mut out = Vec::with_capacity(elements.len() * points);
     for element in elements {
         let Some((links, _)) = element else {
             return Vec::new();
         };
         for j in 1..=points {
-            let s = j as f64 / points as f64;
-            out.push(match links.len() {
-                1 => on(links.start, s),
-                2 if s <= 0.5 => on(links.start, 2.0 * s),
-                2 => on(links.start + 1, 2.0 * s - 1.0),
-                _ => return Vec::new(),
-            });
+            match on_links(links, j as f64 / points as f64) {
+                Some(point) => out.push(point),
+                None => return Vec::new(),
+            }
         }
     }
     out
 }
 
+/// An element's links (where its points lie on their arcs) and the
+/// parameter of its centreline's length where that is fixed.
+type ElementLinks = Option<(std::ops::Range<usize>, Option<usize>)>;
+
+/// The point at the fraction `s` of an element on `links`, as the methods
+/// sample it: an element of one link at s along it, one of two halves (a
+/// half-arc pcc element, a rom slice) on the first at 2 s up to its
+/// middle, else on the second at 2 s - 1.
+fn on_links(links: &std::ops::Range<usize>, s: f64) -> Option<ContactPoint> {
+    let on = |link: usize, at: f64| ContactPoint { link, at };
+    match links.len() {
+        1 => Some(on(links.start, s)),
+        2 if s <= 0.5 => Some(on(links.start, 2.0 * s)),
+        2 => Some(on(links.start + 1, 2.0 * s - 1.0)),
+        _ => None,
+    }
+}
+
+/// The structure's loads along the arm at their points on the links, in
+/// the links' order, as `tmt::along` places them (a force per unit length
+/// at every element's middle, times its length); None where an element a
+/// load acts on has no points on its links' arcs.
+fn along_loads(
+    st: &Structure,
+    params: &ParamLayout,
+    elements: &[ElementLinks],
+) -> Option<Vec<AlongLoad>> {
+    let mut out = Vec::new();
+    for (i, l) in st.loads.iter().enumerate() {
+        let slots = |given: bool, what: fn(Xyz) -> LoadParam| {
+            given.then(|| Xyz::ALL.map(|c| params.index(Param::Load(i, what(c)))))
+        };
+        let (force, moment) = (
+            slots(l.force, LoadParam::Force),
+            slots(l.moment, LoadParam::Moment),
+        );
+        let place = |k: usize, s: f64| on_links(&elements.get(k)?.as_ref()?.0, s);
+        match l.at {
+            Some((k, bits)) => out.push(AlongLoad {
+                at: place(k, f64::from_bits(bits))?,
+                force,
+                moment,
+                local: l.local,
+                per_length: None,
+            }),
+            None => {
+                let first: usize = st.segments[..l.segment].iter().map(|g| g.elements).sum();
+                for k in first..first + st.segments[l.segment].elements {
+                    out.push(AlongLoad {
+                        at: place(k, 0.5)?,
+                        force,
+                        moment: None,
+                        local: l.local,
+                        per_length: Some(params.index(Param::Element(k, ElementParam::Length))),
+                    });
+                }
+            }
+        }
+    }
+    out.sort_by_key(|l| l.at.link);
+    Some(out)
+}
+
 /// The elements the contact points are on (none without them): their
 /// first and last links and their centreline's length where it is fixed.
-fn contact_elements(
-    elements: &[Option<(std::ops::Range<usize>, Option<usize>)>],
-    points: &[runtime::links::ContactPoint],
-) -> Vec<runtime::links::ContactElement> {
+fn contact_elements(elements: &[ElementLinks], points: &[ContactPoint]) -> Vec<ContactElement> {
     if points.is_empty() {
         return Vec::new();
     }
     (elements.iter().flatten())
-        .map(|(links, length)| runtime::links::ContactElement {
+        .map(|(links, length)| ContactElement {
             first: links.start,
             last: links.end - 1,
             length: *length,

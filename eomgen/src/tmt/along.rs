@@ -201,7 +201,7 @@ impl Applied {
         for (m, link) in self.moments {
             sys.moments.push(m);
             if let Some(c) = &mut sys.chain {
-                c.moment_link.push(link);
+                c.moment_link.push((link, true));
             }
         }
     }

@@ -330,9 +330,14 @@ impl<'a> ChainKinematics<'a> {
                     terms.push(cas.dot(&v, &p.force));
                 }
                 // A moment at the end of link l turns with the end frame,
-                // whose angular velocity column is the twist's.
+                // whose angular velocity column is the twist's; one inside
+                // it with its section, by that section's column.
                 for m in moments.iter().filter(|m| m.link == l) {
-                    terms.push(cas.dot(&self.twists[j].0, &m.moment));
+                    let column = match m.omega {
+                        Some(w) => w.map(|e| cas.diff(e, qd)),
+                        None => self.twists[j].0,
+                    };
+                    terms.push(cas.dot(&column, &m.moment));
                 }
                 cas.add_all(&terms)
             })
@@ -344,6 +349,9 @@ impl<'a> ChainKinematics<'a> {
 pub struct MomentItem {
     pub link: usize,
     pub moment: [ExprId; 3],
+    /// The angular velocity of the section it acts at, inside the link;
+    /// None at the link's end frame.
+    pub omega: Option<[ExprId; 3]>,
 }
 
 /// A force applied at a point of a chain.

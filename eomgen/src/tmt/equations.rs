@@ -142,7 +142,8 @@ pub fn assemble(cas: &mut Cas, sys: &System) -> Equations {
                 .iter()
                 .enumerate()
                 .map(|(i, m)| MomentItem {
-                    link: chain.moment_link[i],
+                    link: chain.moment_link[i].0,
+                    omega: chain.moment_link[i].1.then_some(m.omega),
                     moment: m.moment.map(|c| cas.neg(c)),
                 })
                 .collect();

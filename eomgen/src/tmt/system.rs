@@ -380,7 +380,7 @@ impl System {
         if let Some(m) = tip.moment {
             self.moments.push(m);
             if let Some(c) = &mut self.chain {
-                c.moment_link.push(link);
+                c.moment_link.push((link, false));
             }
         }
     }
@@ -489,8 +489,10 @@ pub struct Chain {
     /// The link of each point force (the link whose coordinates move the
     /// point non-rigidly).
     pub point_force_link: Vec<usize>,
-    /// The link at whose end each moment acts.
-    pub moment_link: Vec<usize>,
+    /// The link each moment acts on, and whether it acts at a section
+    /// inside the link (a load along the arm, turning with its section's
+    /// angular velocity) rather than at the link's end frame.
+    pub moment_link: Vec<(usize, bool)>,
 }
 
 pub struct Link {

@@ -247,7 +247,11 @@ impl Kernels for LinkedKernels {
 
     fn accelerations(&self, inp: &Inputs, qdd: &mut [f64]) -> Option<bool> {
         let layout = &self.links.layout;
-        if !all_owned(layout) || layout.forces || layout.variable_inertia {
+        if !all_owned(layout)
+            || layout.forces
+            || layout.variable_inertia
+            || !layout.along.is_empty()
+        {
             return None;
         }
         crate::cpu::require_fma();

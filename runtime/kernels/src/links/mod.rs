@@ -23,20 +23,24 @@ use serde::{Deserialize, Serialize};
 
 use crate::rows;
 
+mod along;
 mod articulated;
 mod compiled;
 mod contact;
 mod num;
 mod outputs;
 mod planar;
+mod points;
 mod tangent;
+pub use along::{AlongLoad, loads_potential, subtract_loads, subtract_loads_tangent};
 pub use articulated::accelerations_owned;
 pub use compiled::{CellFn, CellLanesFn, CellTangentFn, CompiledCell};
 pub use contact::{
-    CONTACT_BOUND, ContactElement, ContactPoint, LinkOutputs, contact_bounds, contact_jacobian,
-    contact_jvp, contact_points, has_contact_bounds,
+    CONTACT_BOUND, ContactElement, contact_bounds, contact_jacobian, contact_jvp, contact_points,
+    has_contact_bounds,
 };
 pub use outputs::outputs;
+pub use points::{ContactPoint, LinkOutputs};
 pub use tangent::inverse_dynamics_tangent;
 
 /// The element parameters a cell reads, in this order, per link:
@@ -196,6 +200,9 @@ pub struct LinkLayout {
     /// The elements those points are on, in order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub contact_elements: Vec<ContactElement>,
+    /// The loads along the chain, in the links' order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub along: Vec<AlongLoad>,
     /// [`LinkLayout::weights`], computed on first use.
     #[serde(skip)]
     pub weights: std::sync::OnceLock<Vec<f64>>,
@@ -367,7 +374,7 @@ pub(crate) struct Loads {
 
 impl Loads {
     #[inline(always)]
-    pub(crate) fn of<C: Cells>(layout: &LinkLayout, cells: &mut C) -> Self {
+    pub(crate) fn of<C: Cells + ?Sized>(layout: &LinkLayout, cells: &mut C) -> Self {
         let len = 3 * layout.loads;
         let mut loads = Loads {
             stack: [0.0; 3 * 8],
@@ -412,7 +419,7 @@ pub(crate) fn link_params(v: &mut [f64; CELL_PARAMS], spec: &LinkSpec, p: &[f64]
 }
 
 /// Every link's cell parameters ([`link_params`]).
-pub(crate) fn cell_params<C: Cells>(
+pub(crate) fn cell_params<C: Cells + ?Sized>(
     layout: &LinkLayout,
     cells: &mut C,
     p: &[f64],
@@ -870,6 +877,10 @@ pub fn mass_bias_owned<C: Cells>(
         true => planar::mass_bias(layout, cells, q, qd, p, out),
         false => mass_bias_spatial(layout, cells, q, qd, p, out),
     }
+    if !layout.along.is_empty() {
+        let n = layout.dof;
+        subtract_loads(layout, cells, (q, qd, p), &mut out[n * (n + 1) / 2..]);
+    }
 }
 
 /// [`mass_bias_owned`] in 3D; a planar chain's cells run here too (a
@@ -1035,6 +1046,9 @@ pub fn mass_bias_shared<const N: usize, C: Cells>(
         }
     }
     SCRATCH.set(scratch);
+    if !layout.along.is_empty() {
+        subtract_loads(layout, cells, (q, qd, p), &mut out[n * (n + 1) / 2..]);
+    }
 }
 
 /// Rows a chain of `dof` coordinates is summed in by the generated

@@ -34,7 +34,8 @@ fn kinetic(m: f64, lateral: f64, axial: f64, axis: V3, v: V3, w: V3) -> f64 {
 /// potential energy, tip quaternion w, x, y, z) of a chain the link
 /// recursion covers, into `out`. The potential energy is gravity's, the
 /// springs' (the actuators' work is not stored energy) and a world-frame
-/// tip force's -F . p; a force turning with the tip has none.
+/// tip force's -F . p (and a load's along the arm); a force turning with
+/// the tip has none.
 pub fn outputs<C: Cells>(
     layout: &LinkLayout,
     cells: &mut C,
@@ -89,6 +90,9 @@ pub fn outputs<C: Cells>(
     }
     if layout.forces {
         pe += cells.energy();
+    }
+    if !layout.along.is_empty() {
+        pe += super::loads_potential(layout, cells, (q, qd, p));
     }
     out[output::TIP].copy_from_slice(&point);
     out[output::KINETIC] = ke;

@@ -163,6 +163,9 @@ pub fn inverse_dynamics_tangent<C: Cells>(
             dtau[i] += f[n + i];
         }
     }
+    if !layout.along.is_empty() {
+        super::subtract_loads_tangent(layout, cells, (q, qd, p), dq, (tau, dtau));
+    }
 }
 
 /// One link of the sweep out: its cell's outputs (`out`: values, then

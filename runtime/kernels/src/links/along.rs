@@ -1,0 +1,132 @@
+//! Loads along a chain (`[[load]]` at a point of an element, or per unit
+//! length at every element's middle) by the sweep out to their points
+//! (`points.rs`), so that an arm with loads runs on its link cells: each
+//! load's generalised force Q_a = dp/dq_a . F + w_a . M (the point's
+//! column and its section's angular column), taken from h; its directional
+//! derivative from the Jvp; a constant world force's potential -F . p from
+//! the outputs' potential energy, as the flat kernels do
+//! (`eomgen/src/tmt/along.rs` places the same points).
+
+use serde::{Deserialize, Serialize};
+
+use super::num::{Num, dot, mat_vec};
+use super::points::{Asked, At, ContactPoint, PointMotion, sweep};
+use super::{Cells, LinkLayout};
+use crate::dual::Dual;
+
+/// A load at a point of the chain, its components' parameter slots.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AlongLoad {
+    /// Where it acts.
+    pub at: ContactPoint,
+    pub force: Option<[usize; 3]>,
+    pub moment: Option<[usize; 3]>,
+    /// Given in the section's frame, turning with it (a follower load).
+    pub local: bool,
+    /// A force per unit length: times this parameter (its element's
+    /// length, the midpoint rule).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub per_length: Option<usize>,
+}
+
+/// Load `i`'s force and moment in the world frame at its point.
+#[inline(always)]
+fn world<N: Num>(load: &AlongLoad, m: &PointMotion<N>, p: &[f64]) -> ([N; 3], [N; 3]) {
+    let times = load.per_length.map_or(1.0, |i| p[i]);
+    let vector = |slots: Option<[usize; 3]>, times: f64| -> [N; 3] {
+        let v = slots.map_or([N::ZERO; 3], |s| s.map(|i| N::constant(times * p[i])));
+        match load.local {
+            true => mat_vec(&m.rotation, v),
+            false => v,
+        }
+    };
+    (vector(load.force, times), vector(load.moment, 1.0))
+}
+
+/// Each load's generalised forces, `add(a, Q_a)` per arm coordinate a,
+/// on `N` (dual numbers: along `dq`).
+fn generalised<N: Num>(
+    layout: &LinkLayout,
+    cells: &mut dyn Cells,
+    (q, qd, dq, p): At,
+    mut add_to: impl FnMut(usize, N),
+) {
+    let loads = &layout.along;
+    let points: Vec<ContactPoint> = loads.iter().map(|l| l.at).collect();
+    let asked = Asked {
+        columns: true,
+        spin: loads.iter().any(|l| l.local || l.moment.is_some()),
+    };
+    sweep(
+        layout,
+        cells,
+        (q, qd, dq, p),
+        (&points, |_| true),
+        (asked, None),
+        |i, m: &PointMotion<N>| {
+            let (force, moment) = world(&loads[i], m, p);
+            for (a, col) in m.columns.iter().enumerate() {
+                let mut qa = dot(*col, force);
+                if loads[i].moment.is_some() {
+                    qa = qa + dot(m.spin[a], moment);
+                }
+                add_to(a, qa);
+            }
+        },
+    );
+}
+
+/// h minus the loads' generalised forces.
+pub fn subtract_loads(
+    layout: &LinkLayout,
+    cells: &mut dyn Cells,
+    (q, qd, p): (&[f64], &[f64], &[f64]),
+    h: &mut [f64],
+) {
+    generalised(layout, cells, (q, qd, None, p), |a, qa: f64| h[a] -= qa);
+}
+
+/// tau and its tangent `dtau` minus the loads' generalised forces and
+/// their derivative along `dq` (they depend on q and the parameters
+/// alone).
+pub fn subtract_loads_tangent(
+    layout: &LinkLayout,
+    cells: &mut dyn Cells,
+    (q, qd, p): (&[f64], &[f64], &[f64]),
+    dq: &[f64],
+    (tau, dtau): (&mut [f64], &mut [f64]),
+) {
+    generalised(layout, cells, (q, qd, Some(dq), p), |a, qa: Dual| {
+        tau[a] -= qa.v;
+        dtau[a] -= qa.d;
+    });
+}
+
+/// The potential of the loads' constant world forces, -F . p each (a
+/// follower force has none).
+pub fn loads_potential(
+    layout: &LinkLayout,
+    cells: &mut dyn Cells,
+    (q, qd, p): (&[f64], &[f64], &[f64]),
+) -> f64 {
+    let loads = &layout.along;
+    let points: Vec<ContactPoint> = loads.iter().map(|l| l.at).collect();
+    let world_force = |i: usize| !loads[i].local && loads[i].force.is_some();
+    let asked = Asked {
+        columns: false,
+        spin: false,
+    };
+    let mut pe = 0.0;
+    sweep(
+        layout,
+        cells,
+        (q, qd, None, p),
+        (&points, world_force),
+        (asked, None),
+        |i, m: &PointMotion<f64>| {
+            let (force, _) = world(&loads[i], m, p);
+            pe -= dot(force, m.p);
+        },
+    );
+    pe
+}
