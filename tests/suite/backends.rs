@@ -1252,9 +1252,28 @@ fn articulated_body_accelerations_equal_the_mass_matrix_solve() {
     // articulated-body sweeps (runtime/kernels/src/links/articulated.rs), O(links)
     // and without M; the reference is the interpreter's flat M and h and
     // a dense solve, -M^-1 h, at bent, moving states, with and without a
-    // tip body and tip loads.
+    // tip body and tip loads, and with loads along the arm.
     let mut rng = Rng::new(29);
+    // Loads along an arm of owned links (the rom segment as pcc, no
+    // stretch, whose half-arcs share their element's coordinates): their
+    // generalised forces enter each coordinate's elimination.
+    let dir = tempfile::tempdir().unwrap();
+    let owned = dir.path().join("loaded_owned.toml");
+    std::fs::write(
+        &owned,
+        LOADED_3D
+            .replace("method = \"rom\"\norder = 2", "method = \"pcc\"")
+            .replace("extension = true\n", "")
+            // The reference runs no input channels.
+            .replace(
+                "moment_inputs = [\"m\", \"m\", \"m\"]",
+                "moment = [0.01, -0.02, 0.01]",
+            ),
+    )
+    .unwrap();
+    let owned = owned.to_str().unwrap().to_string();
     for (model, sets) in [
+        (owned.as_str(), &[][..]),
         ("tentacle3d", &["segment.0.elements=13"][..]),
         ("cantilever3d", &["segment.0.elements=7"][..]),
         (

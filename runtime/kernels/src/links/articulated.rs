@@ -23,7 +23,8 @@
 //!   S_b^T (I_b (a + S_b x) + F_b) + S_e^T (IA (a + S_e x) + pA) + Q = 0
 //!
 //! (IA, pA: the articulated inertia and bias wrench past the end frame,
-//! Q the link's elastic and dissipative forces) give x = -D^-1 (u + U^T
+//! Q the link's elastic and dissipative forces and the loads along the
+//! arm's generalised forces on its coordinates) give x = -D^-1 (u + U^T
 //! a) with D = S_b^T I_b S_b + S_e^T IA S_e, U = I_b S_b + IA S_e, u =
 //! S_b^T F_b + S_e^T pA + Q, and the wrench the link passes to its base
 //! frame, (I_b + IA - U D^-1 U^T) a + F_b + pA - U D^-1 u: the next IA
@@ -162,6 +163,14 @@ pub fn accelerations_owned<C: Cells>(
             at += nc;
         }
         let tip = forward(layout, cells, p, s);
+        // Loads along the arm: generalised forces added to h, each to its
+        // own coordinate's u (`s.forces` is free: no rom forces here).
+        let n = layout.dof;
+        s.forces.clear();
+        s.forces.resize(n, 0.0);
+        if !layout.along.is_empty() {
+            super::subtract_loads(layout, cells, (q, qd, p), &mut s.forces);
+        }
         let mut ia = tip.past.matrix();
         let mut pa = six(tip.wrench);
         // Each link's elimination, kept for the sweep from the base.
@@ -190,7 +199,10 @@ pub fn accelerations_owned<C: Cells>(
                 e.s_e[f] = six(s.twist[at + f]);
                 ia_se[f] = mul6(&ia, &e.s_e[f]);
                 e.u_cols[f] = std::array::from_fn(|i| ib_sb[f][i] + ia_se[f][i]);
-                e.u[f] = dot6(&s_b[f], &fb) + dot6(&e.s_e[f], &pa) + s.local_force[at + f];
+                e.u[f] = dot6(&s_b[f], &fb)
+                    + dot6(&e.s_e[f], &pa)
+                    + s.local_force[at + f]
+                    + s.forces[at + f];
             }
             for f in 0..nc {
                 for f2 in 0..=f {
