@@ -34,6 +34,16 @@ pub struct LinkedKernels {
     group_of: Vec<usize>,
     /// The links' cells at the state the contact kernels last ran at.
     kept: RefCell<links::LinkOutputs>,
+    /// The actuation loads at the parameters they were last taken at:
+    /// every sweep of a right-hand side reads them, its tape runs once.
+    kept_loads: RefCell<KeptLoads>,
+}
+
+/// The actuation loads kernel's values at the parameters `p`.
+#[derive(Default)]
+struct KeptLoads {
+    p: Vec<f64>,
+    values: Vec<f64>,
 }
 
 impl LinkedKernels {
@@ -57,6 +67,7 @@ impl LinkedKernels {
         Self {
             group_of,
             kept: RefCell::new(links::LinkOutputs::default()),
+            kept_loads: RefCell::new(KeptLoads::default()),
             info,
             links,
             cells,
@@ -92,6 +103,7 @@ struct Linked<'a> {
     cells: &'a [Option<CompiledCell>],
     inp: Inputs<'a>,
     slots: &'a mut Vec<f64>,
+    kept_loads: &'a RefCell<KeptLoads>,
 }
 
 /// A cell's tape at its coordinates `x`, rates `xd`, parameters `p` and
@@ -191,7 +203,19 @@ impl Cells for Linked<'_> {
     }
 
     fn loads(&mut self, out: &mut [f64]) {
-        by_tape(&self.links.loads, "loads", &self.inp, self.slots, out)
+        let mut kept = self.kept_loads.borrow_mut();
+        let p = self.inp.p;
+        let same = kept.p.len() == p.len()
+            && kept.values.len() == out.len()
+            && links::bits_equal(&kept.p, p);
+        if !same {
+            by_tape(&self.links.loads, "loads", &self.inp, self.slots, out);
+            kept.p.clear();
+            kept.p.extend_from_slice(p);
+            kept.values.clear();
+            kept.values.extend_from_slice(out);
+        }
+        out.copy_from_slice(&kept.values);
     }
 
     fn pose(&mut self, c: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
@@ -302,6 +326,7 @@ impl LinkedKernels {
             cells: &self.cells,
             inp: *inp,
             slots,
+            kept_loads: &self.kept_loads,
         }
     }
 

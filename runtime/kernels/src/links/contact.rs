@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use super::num::{add, cell_v3, mat_mat, mat_vec};
 use super::points::{Asked, LinkOutputs, PointMotion, sweep};
-use super::{CELL_PARAMS, Cells, LinkLayout, MAX_LINK_DOF, cell, cell_params, local};
+use super::{CELL_PARAMS, Cells, LinkLayout, MAX_LINK_DOF, cell, local};
 use crate::dual::Dual;
 
 /// Values per group at the head of the contact frames (`ModelInfo::
@@ -156,7 +156,7 @@ pub fn contact_bounds<C: Cells>(
     let elements = &layout.contact_elements;
     let per = layout.contact.len() / elements.len();
     let mut params: Vec<[f64; CELL_PARAMS]> = Vec::new();
-    cell_params(layout, cells, p, &mut params);
+    kept.params(layout, cells, p, &mut params);
     let mut r = super::base_orientation(layout, p).0;
     let mut pos = layout.base_position.map(|i| p[i]);
     // Each link's base origin and end, as far as the last element's.

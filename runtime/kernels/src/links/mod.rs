@@ -40,6 +40,7 @@ pub use contact::{
     has_contact_bounds,
 };
 pub use outputs::outputs;
+pub(crate) use points::bits_equal;
 pub use points::{ContactPoint, LinkOutputs};
 pub use tangent::inverse_dynamics_tangent;
 

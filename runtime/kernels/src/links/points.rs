@@ -45,21 +45,47 @@ pub(super) type At<'a> = (&'a [f64], &'a [f64], Option<&'a [f64]>, &'a [f64]);
 pub struct LinkOutputs {
     state: Vec<f64>,
     outs: Vec<Vec<f64>>,
+    /// The links' cell parameters at that state, once taken.
+    params: Vec<[f64; CELL_PARAMS]>,
 }
 
 impl LinkOutputs {
-    /// Keep what is kept only if it is of (q, qd, p).
+    /// Keep what is kept only if it is of (q, qd, p). Compared slice by
+    /// slice, bit for bit, without branching per value: every contact
+    /// kernel of a right-hand side asks, and a chained comparison cost a
+    /// quarter of the bounds' sweep.
     #[inline(always)]
     pub(super) fn at(&mut self, q: &[f64], qd: &[f64], p: &[f64]) {
-        let same = self.state.len() == q.len() + qd.len() + p.len()
-            && (q.iter().chain(qd).chain(p))
-                .zip(&self.state)
-                .all(|(a, b)| a.to_bits() == b.to_bits());
+        let (nq, nqd) = (q.len(), qd.len());
+        let same = self.state.len() == nq + nqd + p.len()
+            && bits_equal(&self.state[..nq], q)
+            && bits_equal(&self.state[nq..nq + nqd], qd)
+            && bits_equal(&self.state[nq + nqd..], p);
         if !same {
             self.state.clear();
-            self.state.extend(q.iter().chain(qd).chain(p));
+            self.state.extend_from_slice(q);
+            self.state.extend_from_slice(qd);
+            self.state.extend_from_slice(p);
             self.outs.iter_mut().for_each(Vec::clear);
+            self.params.clear();
         }
+    }
+
+    /// The links' cell parameters at the kept state into `params`: kept,
+    /// or taken and kept.
+    #[inline(always)]
+    pub(super) fn params<C: Cells + ?Sized>(
+        &mut self,
+        layout: &LinkLayout,
+        cells: &mut C,
+        p: &[f64],
+        params: &mut Vec<[f64; CELL_PARAMS]>,
+    ) {
+        if self.params.len() != layout.links.len() {
+            cell_params(layout, cells, p, &mut self.params);
+        }
+        params.clear();
+        params.extend_from_slice(&self.params);
     }
 
     /// Link k's cell (`c`, at x, xd, with `params`) into `out[..len]`:
@@ -87,6 +113,16 @@ impl LinkOutputs {
             kept.extend_from_slice(out);
         }
     }
+}
+
+/// Whether two slices of equal length hold the same bits: or-ed
+/// differences, so that the loop runs in vector lanes.
+#[inline(always)]
+pub(crate) fn bits_equal(a: &[f64], b: &[f64]) -> bool {
+    a.iter()
+        .zip(b)
+        .fold(0u64, |acc, (x, y)| acc | (x.to_bits() ^ y.to_bits()))
+        == 0
 }
 
 /// A point's kinematics as the sweep gives them: position, velocity and
@@ -170,7 +206,10 @@ pub(super) fn sweep<N: Num, C: Cells + ?Sized>(
     let mut own = vec![v0; if columns { n } else { 0 }];
     let mut own_spin = vec![v0; if spin { n } else { 0 }];
     let mut params: Vec<[f64; CELL_PARAMS]> = Vec::new();
-    cell_params(layout, cells, p, &mut params);
+    match kept.as_deref_mut() {
+        Some(kept) => kept.params(layout, cells, p, &mut params),
+        None => cell_params(layout, cells, p, &mut params),
+    }
     let mut out = vec![0.0; 2 * cell::len(MAX_LINK_DOF)];
     let mut next = 0;
     for (k, spec) in layout.links.iter().enumerate().take(last_link + 1) {
