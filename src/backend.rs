@@ -133,8 +133,9 @@ pub fn read_model(spec: &str, overrides: &[Override]) -> Result<(Model, String)>
 /// cannot run so. Its contact kernels are the recursion's where its points
 /// lie on its links' arcs, else its tapes' ([`tapes`]: the cache's, else
 /// derived and cached); an assembly
-/// its arms' kernels so, and the rest, its joints and contact by its
-/// tapes (`runtime::assembled::BlockKernels`).
+/// its arms' kernels so (their contact points too), and the rest (the
+/// bodies, their contact points) and its joints by its tapes
+/// (`runtime::assembled::BlockKernels`).
 fn linked(
     model: &Model,
     structure: &Structure,

@@ -1208,8 +1208,9 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         (tentacle_ball.as_str(), "segment.0.elements=5"),
         (rod_ball.as_str(), "segment.0.elements=3"),
         (rom_ball.as_str(), "segment.0.quadrature=3"),
-        // Assemblies: each arm kind on its linked cells, the rest (the
-        // ball, the joints, contact) by the assembly's tapes.
+        // Assemblies: each arm kind on its linked cells, its contact
+        // points too; the rest (the ball, its contact point, the joints)
+        // by the assembly's tapes.
         ("falling_ball", "arm.left.segment.0.elements=7"),
         ("ball_drop", "arm.right.segment.1.elements=3"),
     ] {

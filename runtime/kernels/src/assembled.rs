@@ -1,19 +1,21 @@
 //! An assembly's kernels through its arms' own ([`ArmBlocks`]) at run
 //! time: what a compiled-in assembly's generated code does, for one that
 //! is not compiled in. Each distinct arm structure brings its own kernels
-//! (its link cells, linked); the rest of the system (bodies, what joins
-//! the arms), the joints and contact run on the assembly's tapes.
+//! (its link cells, linked), its contact points' too; the rest of the
+//! system (bodies, what joins the arms, the bodies' contact points) and
+//! the joints run on the assembly's tapes.
 
 use std::cell::RefCell;
 
 use crate::kernels::{ArmBlocks, Interpreted, KernelKind, Kernels, ModelInfo, TapeSet};
-use crate::linalg::add_block;
+use crate::linalg::{add_block, place_groups, place_point_rows};
 use crate::output;
 use crate::tape::{Inputs, Tape};
 
 /// An assembly's kernels: `MassBias`, `Jvp`, `Outputs` and `Derived` as
-/// the rest's tapes plus each arm's kernels in its block; the joints and
-/// contact by the assembly's tapes.
+/// the rest's tapes plus each arm's kernels in its block, the contact
+/// kernels so too where the tapes split them (`ArmBlocks::rest_contact`);
+/// the joints by the assembly's tapes.
 pub struct BlockKernels {
     info: ModelInfo,
     /// The assembly's tapes: its own derived parameters, joints, contact.
@@ -141,6 +143,94 @@ impl BlockKernels {
         }
     }
 
+    /// A contact kernel: each arm's points from its own kernels (the
+    /// `ContactJacobian` groups `inp.dir` selects, its columns placed in
+    /// the arm's block), then the bodies' from the rest's tapes; as the
+    /// generated code of a compiled-in assembly does (`eomgen::emit`).
+    fn contact(&self, kind: KernelKind, inp: &Inputs, out: &mut [f64]) {
+        let rest = self.blocks.rest_contact.as_ref().expect("split contact");
+        let n = self.info.dof();
+        let (width, tail) = (6 + 3 * n, 3 + 3 * n);
+        let all = inp.dir.is_empty();
+        let (mut point, mut group) = (0, 0);
+        let mut slots = self.slots.borrow_mut();
+        for i in 0..self.blocks.arms.len() {
+            let (kernels, first, arm) = self.arm(i, inp);
+            let info = kernels.info();
+            let (np, ng, m) = (info.contact_points, info.contact_groups.len(), arm.q.len());
+            // The arm's points, and its contact frames for its groups.
+            let mut own = vec![0.0; 3 * np + info.contact_frames];
+            if kind == KernelKind::Contact || info.contact_frames > 0 {
+                kernels.eval(KernelKind::Contact, &arm, &mut own);
+            }
+            match kind {
+                KernelKind::Contact => {
+                    out[3 * point..3 * (point + np)].copy_from_slice(&own[..3 * np]);
+                }
+                KernelKind::ContactJacobian => {
+                    let mut d = vec![0.0; 2 * m];
+                    if !all {
+                        d[..ng].copy_from_slice(&inp.dir[group..group + ng]);
+                    }
+                    if all || d.iter().any(|&x| x != 0.0) {
+                        let mut rows = vec![0.0; np * (6 + 3 * m)];
+                        let arm = Inputs {
+                            dir: if all { &[] } else { &d },
+                            aux: &own[3 * np..],
+                            ..arm
+                        };
+                        kernels.eval(KernelKind::ContactJacobian, &arm, &mut rows);
+                        let o = &mut out[point * width..(point + np) * width];
+                        place_groups(all, &d, &info.contact_groups, n, first, m, &rows, o);
+                    }
+                }
+                _ => {
+                    let mut d = vec![0.0; 2 * m];
+                    d[..m].copy_from_slice(&inp.dir[first..first + m]);
+                    let o = &mut out[point * tail..(point + np) * tail];
+                    // Along a direction off its block, an arm's points do
+                    // not move.
+                    if d.iter().any(|&x| x != 0.0) {
+                        let mut rows = vec![0.0; np * (3 + 3 * m)];
+                        kernels.eval(
+                            KernelKind::ContactJvp,
+                            &Inputs { dir: &d, ..arm },
+                            &mut rows,
+                        );
+                        place_point_rows(3, n, first, m, &rows, o);
+                    } else {
+                        o.fill(0.0);
+                    }
+                }
+            }
+            point += np;
+            group += ng;
+        }
+        if rest.groups.iter().sum::<usize>() == 0 {
+            return;
+        }
+        match kind {
+            KernelKind::Contact => rest.contact.eval(inp, &mut slots, &mut out[3 * point..]),
+            KernelKind::ContactJacobian => {
+                for (r, (tape, &len)) in rest.contact_jacobian.iter().zip(&rest.groups).enumerate()
+                {
+                    if all || inp.dir[group + r] != 0.0 {
+                        let o = &mut out[point * width..(point + len) * width];
+                        tape.eval(inp, &mut slots, o);
+                    }
+                    point += len;
+                }
+            }
+            _ => {
+                let n2 = 2 * n;
+                let zeros = vec![0.0; n2];
+                let inp = inp.zero_filled(&zeros);
+                rest.contact_jvp
+                    .eval(&inp, &mut slots, &mut out[point * tail..]);
+            }
+        }
+    }
+
     /// The rest's energies with each arm's added; the tip is the first
     /// arm's.
     fn outputs(&self, inp: &Inputs, out: &mut [f64]) {
@@ -170,8 +260,13 @@ impl Kernels for BlockKernels {
             KernelKind::MassBias => self.mass_bias(inp, out),
             KernelKind::Jvp => self.jvp(inp, out),
             KernelKind::Outputs => self.outputs(inp, out),
-            // No symbolic solve (`new` says so); joints and contact from
-            // the assembly's tapes.
+            KernelKind::Contact | KernelKind::ContactJacobian | KernelKind::ContactJvp
+                if self.blocks.rest_contact.is_some() =>
+            {
+                self.contact(kind, inp, out)
+            }
+            // No symbolic solve (`new` says so); the joints (and contact
+            // the tapes do not split) from the assembly's tapes.
             KernelKind::Accel
             | KernelKind::Constraints
             | KernelKind::Contact
