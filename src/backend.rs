@@ -152,12 +152,6 @@ fn linked(
     };
     if arms
         .iter()
-        .any(|s| s.dimensions == 2 && s.segments.iter().any(|g| g.kink))
-    {
-        return Err("its kinks in the plane are not link cells yet".into());
-    }
-    if arms
-        .iter()
         .any(|s| s.segments.iter().any(|g| g.anisotropic))
     {
         return Err(

@@ -625,6 +625,41 @@ segment = 0
 force = [0.3, 1.0, 0.0]
 "#;
 
+/// A planar arm of two pcc segments joined at a kink (turned and offset),
+/// a third after a kink with a turn alone.
+const KINKED_2D: &str = r#"
+name = "kinked2d"
+gravity = [0.0, -9.81, 0.0]
+[base]
+direction = [1.0, 0.2, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.1
+elements = 3
+density = 1100.0
+outer_radius = 0.01
+youngs_modulus = 2.0e5
+[[segment]]
+method = "pcc"
+length = 0.08
+elements = 2
+density = 1100.0
+outer_radius = 0.008
+youngs_modulus = 2.0e5
+turn = [70.0]
+offset = [0.01, 0.02, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.05
+elements = 2
+density = 1100.0
+outer_radius = 0.006
+youngs_modulus = 2.0e5
+turn = [-30.0]
+[tip]
+force = [0.1, -0.2, 0.0]
+"#;
+
 /// A planar arm of a rigid link and a pcc segment with a tendon through
 /// both and chambers on the pcc segment, a tip body with a length and a
 /// tip wrench.
@@ -760,10 +795,15 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
     let loaded2d = dir.join("loaded2d.toml");
     std::fs::write(&loaded2d, LOADED_2D).unwrap();
     let loaded2d = loaded2d.to_str().unwrap().to_string();
+    let kinked2d = dir.join("kinked2d.toml");
+    std::fs::write(&kinked2d, KINKED_2D).unwrap();
+    let kinked2d = kinked2d.to_str().unwrap().to_string();
     let mut models: Vec<(&str, &[&'static str])> = vec![
         // Loads along the arm.
         (&loaded, &[]),
         (&loaded2d, &[]),
+        // Kinks in the plane: links of no coordinates.
+        (&kinked2d, &[]),
         // Planar chains: rigid links and pcc arcs (whose inertia changes
         // with the bend), a turned base, actuators, tip bodies and loads.
         ("double_pendulum", &[]),

@@ -32,7 +32,7 @@ use crate::model::{
     ElementParam, Joints, KinkParam, LoadParam, Method, Param, ParamLayout, Structure, Xyz,
 };
 
-use super::planar_cell::derive_planar_cell;
+use super::planar_cell::{derive_planar_cell, derive_planar_kink_cell};
 use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
 use crate::tmt::actuation::{segment_loads, strain_work, thinning};
@@ -113,9 +113,10 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             if let Some(c) = cells.iter().position(|(s, _)| *s == shape) {
                 return Some(c);
             }
-            let kernels = match spatial {
-                true => derive_cell(shape),
-                false => derive_planar_cell(g)?,
+            let kernels = match (spatial, shape.kind) {
+                (true, _) => derive_cell(shape),
+                (false, CellKind::Kink) => derive_planar_kink_cell(),
+                (false, _) => derive_planar_cell(g)?,
             };
             cells.push((shape, kernels));
             Some(cells.len() - 1)
@@ -125,7 +126,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                 kind: CellKind::Kink,
                 ..Shape::bare()
             })?;
-            links.push(kink_link(params, s, kink));
+            links.push(kink_link(params, s, kink, spatial));
         }
         let c = cell_of(shape)?;
         // An ebr element's first half is a link of its own, before the
@@ -236,7 +237,7 @@ fn covered(st: &Structure) -> bool {
         && st.torques.is_empty()
         && !st.base_translates
         && st.base_turns == 0
-        && (st.segments.iter()).all(|g| (!g.kink || spatial) && !g.anisotropic && !g.chambers_vary)
+        && (st.segments.iter()).all(|g| !g.anisotropic && !g.chambers_vary)
         && st.fluid.is_none()
 }
 
@@ -342,14 +343,17 @@ fn contact_elements(elements: &[ElementLinks], points: &[ContactPoint]) -> Vec<C
 }
 
 /// Segment s's kink as a link of no coordinates before it, of cell
-/// `cell`: the kink's constant turn (about y, z) and offset in the cell's
-/// first parameter slots.
-fn kink_link(params: &ParamLayout, s: usize, cell: usize) -> LinkSpec {
+/// `cell`: the kink's constant turn (about y, z; in the plane its angle)
+/// and offset in the cell's first parameter slots.
+fn kink_link(params: &ParamLayout, s: usize, cell: usize, spatial: bool) -> LinkSpec {
     let index = |p: Param| params.index(p);
-    let turn = [0, 1].map(|i| index(Param::Kink(s, KinkParam::Turn(i))));
+    let turns = if spatial { 2 } else { 1 };
+    let turn: Vec<usize> = (0..turns)
+        .map(|i| index(Param::Kink(s, KinkParam::Turn(i))))
+        .collect();
     let offset = Xyz::ALL.map(|c| index(Param::Kink(s, KinkParam::Offset(c))));
     let slots = ElementParam::CELL.len() + ElementParam::REST_3D.len();
-    let mut params: Vec<usize> = turn.into_iter().chain(offset).collect();
+    let mut params: Vec<usize> = turn.iter().copied().chain(offset).collect();
     params.resize(slots, turn[0]);
     LinkSpec {
         cell,

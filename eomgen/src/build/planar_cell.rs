@@ -7,6 +7,7 @@
 //! arc's spread): the cell gives dI/dtheta and the layout says
 //! `variable_inertia`. Elements of more than one body (rigid links with
 //! midpoint joints) are not covered: their chains keep the flat kernels.
+//! A kink is a link of no coordinates and no body.
 
 use runtime::Tape;
 use runtime::links::{ACTUATION_LOADS, CELL_PARAMS, ELEMENT_PARAMS};
@@ -95,4 +96,46 @@ pub(super) fn derive_planar_cell(g: &SegmentShape) -> Option<[Tape; 3]> {
         with_tangent(cas, &out, &[q], &[qd]),
         cas.to_tape(&pose_out),
     ])
+}
+
+/// The cell of a planar kink: a link of no coordinates and no body whose
+/// end frame is the kink's constant offset (x, y in the frame before it)
+/// turned by its angle, as `PlanarArm::kink` moves the arm's frame; the
+/// turn in the first parameter slot, the offset in the next two
+/// (`build::cell`'s `kink_link`).
+pub(super) fn derive_planar_kink_cell() -> [Tape; 3] {
+    let mut cas = Cas::new();
+    let cas = &mut cas;
+    let p: Vec<ExprId> = (0..CELL_PARAMS)
+        .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
+        .collect();
+    let (zero, one) = (cas.zero(), cas.one());
+    let turn = p[0];
+    let (c, s) = (cas.cos(turn), cas.sin(turn));
+    let ns = cas.neg(s);
+    let half = cas.scaled(0.5, turn);
+    let quat = [cas.cos(half), zero, zero, cas.sin(half)];
+    let kin = LinkKinematics::new(
+        cas,
+        Motion {
+            rotation: [[c, ns, zero], [s, c, zero], [zero, zero, one]],
+            end: [p[1], p[2], zero],
+            omega: [zero; 3],
+            quat,
+            centroid: [zero; 3],
+            body_omega: [zero; 3],
+            axis: [one, zero, zero],
+        },
+        [zero; 4],
+        &[],
+        &[],
+        Rates::Plain,
+    );
+    let out = kin.cell(cas, &[], &[], zero, zero);
+    let pose_out = kin.pose(cas);
+    [
+        cas.to_tape(&out),
+        with_tangent(cas, &out, &[], &[]),
+        cas.to_tape(&pose_out),
+    ]
 }
