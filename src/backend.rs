@@ -159,14 +159,6 @@ fn linked(
                 .into(),
         );
     }
-    if arms
-        .iter()
-        .any(|s| s.segments.iter().any(|g| g.chambers_vary))
-    {
-        return Err(
-            "its chambers' levers vary along a segment, which link cells do not carry yet".into(),
-        );
-    }
     if arms.iter().any(|s| s.fluid.is_some()) {
         return Err("its fluid's buoyancy and drag are not link cells yet".into());
     }

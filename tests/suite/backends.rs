@@ -798,12 +798,27 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
     let kinked2d = dir.join("kinked2d.toml");
     std::fs::write(&kinked2d, KINKED_2D).unwrap();
     let kinked2d = kinked2d.to_str().unwrap().to_string();
+    // Chamber levers that vary along a segment (tapered, the chambers
+    // nearer the axis towards the tip): each element's own loads.
+    let varying = dir.join("varying3d.toml");
+    let text = ACTUATED_3D
+        .replace("outer_radius = 0.012", "outer_radius = [0.012, 0.009]")
+        .replace("distance = 0.007", "distance = [0.008, 0.005]")
+        .replace("distance = 0.006", "distance = [0.006, 0.004]");
+    std::fs::write(&varying, text).unwrap();
+    let varying = varying.to_str().unwrap().to_string();
+    let varying2d = dir.join("varying2d.toml");
+    let text = ACTUATED_2D.replacen("distance = 0.006", "distance = [0.007, 0.004]", 1);
+    std::fs::write(&varying2d, text).unwrap();
+    let varying2d = varying2d.to_str().unwrap().to_string();
     let mut models: Vec<(&str, &[&'static str])> = vec![
         // Loads along the arm.
         (&loaded, &[]),
         (&loaded2d, &[]),
         // Kinks in the plane: links of no coordinates.
         (&kinked2d, &[]),
+        (&varying, &[]),
+        (&varying2d, &[]),
         // Planar chains: rigid links and pcc arcs (whose inertia changes
         // with the bend), a turned base, actuators, tip bodies and loads.
         ("double_pendulum", &[]),

@@ -11,7 +11,8 @@
 //! Chains this covers: every segment pcc, vc or rom, base still, no
 //! driven joint torques. Chambers and tendons load each element's strain
 //! by their segment's loads (`actuation::segment_loads`: linear in the
-//! strain), which a small kernel of the parameters gives and the cells
+//! strain; an element's own where its chamber levers vary along the
+//! segment), which a small kernel of the parameters gives and the cells
 //! read as parameters: every cell reads them, zero where no actuator acts,
 //! so that an arm with chambers runs on a bare arm's cells. A rom
 //! segment's slices are links whose cell coordinates are fixed
@@ -35,7 +36,7 @@ use crate::model::{
 use super::planar_cell::{derive_planar_cell, derive_planar_kink_cell};
 use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
-use crate::tmt::actuation::{segment_loads, strain_work, thinning};
+use crate::tmt::actuation::{loads_on, segment_loads, strain_work, thinning};
 use crate::tmt::cell_kind::CellKind;
 use crate::tmt::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
 use crate::tmt::spatial::{
@@ -98,7 +99,6 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     for (s, g) in st.segments.iter().enumerate() {
         let method = crate::method::of(g.method);
         let rom = method.polynomial_fields().then(|| RomFields::of(g, first));
-        let load = actuated.iter().position(|&a| a == s);
         let shape = Shape {
             rest_3d: g.rest_3d,
             twist: g.twist,
@@ -141,6 +141,9 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             .flatten();
         let count = if spatial { g.coordinates_3d() } else { 1 };
         for e in 0..g.elements {
+            // The loads of its segment, or of the element itself.
+            let load =
+                (actuated.iter()).position(|&(seg, el)| seg == s && el.is_none_or(|el| el == k));
             // A planar cell reads no spatial parameter: their slots repeat
             // the length's.
             let length = index(Param::Element(k, ElementParam::Length));
@@ -237,7 +240,7 @@ fn covered(st: &Structure) -> bool {
         && st.torques.is_empty()
         && !st.base_translates
         && st.base_turns == 0
-        && (st.segments.iter()).all(|g| !g.anisotropic && !g.chambers_vary)
+        && (st.segments.iter()).all(|g| !g.anisotropic)
         && st.fluid.is_none()
 }
 
@@ -487,20 +490,44 @@ struct Shape {
 }
 
 /// The kernel of the actuated segments' loads (`actuation::segment_loads`,
-/// three per segment, of the parameters alone) and which segments they
-/// are; none without actuators.
-fn derive_loads(params: &ParamLayout, st: &Structure) -> (Option<Tape>, Vec<usize>) {
+/// three per segment, or per element where its chamber levers vary along
+/// the segment; of the parameters alone) and whose they are; none without
+/// actuators.
+fn derive_loads(params: &ParamLayout, st: &Structure) -> (Option<Tape>, Vec<LoadOwner>) {
     let mut cas = Cas::new();
     let cas = &mut cas;
     let symbols = ParamSymbols::new(cas, params);
     let loads = segment_loads(cas, &symbols, st);
-    let actuated: Vec<usize> = (0..loads.len()).filter(|&s| loads[s].is_some()).collect();
-    if actuated.is_empty() {
-        return (None, actuated);
+    let (mut owners, mut out) = (Vec::new(), Vec::new());
+    let mut first = 0;
+    for (s, g) in st.segments.iter().enumerate() {
+        if loads[s].is_some() {
+            // Chamber levers that vary along the segment: a triple per
+            // element, with its own levers.
+            let elements: Vec<Option<usize>> = match g.chambers_vary {
+                true => (first..first + g.elements).map(Some).collect(),
+                false => vec![None],
+            };
+            for element in elements {
+                let load = match element {
+                    Some(k) => loads_on(cas, &symbols, st, s, Some(k)),
+                    None => loads[s],
+                };
+                out.extend(load.expect("the segment is actuated"));
+                owners.push((s, element));
+            }
+        }
+        first += g.elements;
     }
-    let out: Vec<ExprId> = loads.into_iter().flatten().flatten().collect();
-    (Some(cas.to_tape(&out)), actuated)
+    if owners.is_empty() {
+        return (None, owners);
+    }
+    (Some(cas.to_tape(&out)), owners)
 }
+
+/// Whose actuation loads a triple of the `loads` kernel is: a segment's,
+/// or one element's of it (its chamber levers varying along it).
+type LoadOwner = (usize, Option<usize>);
 
 /// The generalised forces of the rom segments' strain energy and Rayleigh
 /// function (`RomFields::energies`, exact quadratics in the coefficients), as one

@@ -74,7 +74,7 @@ pub fn segment_loads(
 
 /// The loads on segment `s`'s strains ([`segment_loads`]), with element
 /// `element`'s own chamber levers where they vary along the segment.
-fn loads_on(
+pub fn loads_on(
     cas: &mut Cas,
     symbols: &ParamSymbols,
     structure: &Structure,
