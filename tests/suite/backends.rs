@@ -782,35 +782,30 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
     // Actuators on every covered method: chambers on a pcc and a rom
     // segment, a tendon through both, each link loaded by its segment's
     // loads (the `loads` kernel).
-    let actuated = dir.join("actuated3d.toml");
     std::fs::create_dir_all(dir).unwrap();
-    std::fs::write(&actuated, ACTUATED_3D).unwrap();
-    let actuated = actuated.to_str().unwrap().to_string();
-    let actuated2d = dir.join("actuated2d.toml");
-    std::fs::write(&actuated2d, ACTUATED_2D).unwrap();
-    let actuated2d = actuated2d.to_str().unwrap().to_string();
-    let loaded = dir.join("loaded3d.toml");
-    std::fs::write(&loaded, LOADED_3D).unwrap();
-    let loaded = loaded.to_str().unwrap().to_string();
-    let loaded2d = dir.join("loaded2d.toml");
-    std::fs::write(&loaded2d, LOADED_2D).unwrap();
-    let loaded2d = loaded2d.to_str().unwrap().to_string();
-    let kinked2d = dir.join("kinked2d.toml");
-    std::fs::write(&kinked2d, KINKED_2D).unwrap();
-    let kinked2d = kinked2d.to_str().unwrap().to_string();
+    let file = |name: &str, text: &str| {
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let actuated = file("actuated3d", ACTUATED_3D);
+    let actuated2d = file("actuated2d", ACTUATED_2D);
+    let loaded = file("loaded3d", LOADED_3D);
+    let loaded2d = file("loaded2d", LOADED_2D);
+    let kinked2d = file("kinked2d", KINKED_2D);
     // Chamber levers that vary along a segment (tapered, the chambers
     // nearer the axis towards the tip): each element's own loads.
-    let varying = dir.join("varying3d.toml");
-    let text = ACTUATED_3D
-        .replace("outer_radius = 0.012", "outer_radius = [0.012, 0.009]")
-        .replace("distance = 0.007", "distance = [0.008, 0.005]")
-        .replace("distance = 0.006", "distance = [0.006, 0.004]");
-    std::fs::write(&varying, text).unwrap();
-    let varying = varying.to_str().unwrap().to_string();
-    let varying2d = dir.join("varying2d.toml");
-    let text = ACTUATED_2D.replacen("distance = 0.006", "distance = [0.007, 0.004]", 1);
-    std::fs::write(&varying2d, text).unwrap();
-    let varying2d = varying2d.to_str().unwrap().to_string();
+    let varying = file(
+        "varying3d",
+        &ACTUATED_3D
+            .replace("outer_radius = 0.012", "outer_radius = [0.012, 0.009]")
+            .replace("distance = 0.007", "distance = [0.008, 0.005]")
+            .replace("distance = 0.006", "distance = [0.006, 0.004]"),
+    );
+    let varying2d = file(
+        "varying2d",
+        &ACTUATED_2D.replacen("distance = 0.006", "distance = [0.007, 0.004]", 1),
+    );
     let mut models: Vec<(&str, &[&'static str])> = vec![
         // Loads along the arm.
         (&loaded, &[]),

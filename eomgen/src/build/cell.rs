@@ -38,7 +38,7 @@ use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
 use crate::tmt::actuation::{loads_on, segment_loads, strain_work, thinning};
 use crate::tmt::cell_kind::CellKind;
-use crate::tmt::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
+use crate::tmt::cell_outputs::{LinkKinematics, Motion, Rates, bodiless_cells, with_tangent};
 use crate::tmt::spatial::{
     ArcStrain, Element3, Frame, Springs, V3, arc, compose, exp_turn, half_k_sq,
 };
@@ -835,19 +835,6 @@ fn derive_kink_cell() -> [Tape; 3] {
     let offset = [p[2], p[3], p[4]];
     let (r, quat, _) = exp_turn(cas, &turn, &[zero; 3]);
     let end = compose(cas, &identity, Some((&r, &quat)), Some(&offset), None);
-    let kin = LinkKinematics::new(
-        cas,
-        Motion::ending(&end, [zero; 3], [zero; 3], [one, zero, zero]),
-        [zero; 4],
-        &[],
-        &[],
-        Rates::Turned,
-    );
-    let out = kin.cell(cas, &[], &[], zero, zero);
-    let pose_out = kin.pose(cas);
-    [
-        cas.to_tape(&out),
-        with_tangent(cas, &out, &[], &[]),
-        cas.to_tape(&pose_out),
-    ]
+    let motion = Motion::ending(&end, [zero; 3], [zero; 3], [one, zero, zero]);
+    bodiless_cells(cas, motion, Rates::Turned)
 }

@@ -16,7 +16,7 @@ use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::SegmentShape;
 
 use crate::tmt::actuation::strain_work;
-use crate::tmt::cell_outputs::{LinkKinematics, Motion, Rates, with_tangent};
+use crate::tmt::cell_outputs::{LinkKinematics, Motion, Rates, bodiless_cells, with_tangent};
 use crate::tmt::inertia::Inertia;
 use crate::tmt::planar::{Element2, PlanarArm, half_k_sq};
 use crate::tmt::system::{Coordinates, ParamSymbols};
@@ -115,27 +115,14 @@ pub(super) fn derive_planar_kink_cell() -> [Tape; 3] {
     let ns = cas.neg(s);
     let half = cas.scaled(0.5, turn);
     let quat = [cas.cos(half), zero, zero, cas.sin(half)];
-    let kin = LinkKinematics::new(
-        cas,
-        Motion {
-            rotation: [[c, ns, zero], [s, c, zero], [zero, zero, one]],
-            end: [p[1], p[2], zero],
-            omega: [zero; 3],
-            quat,
-            centroid: [zero; 3],
-            body_omega: [zero; 3],
-            axis: [one, zero, zero],
-        },
-        [zero; 4],
-        &[],
-        &[],
-        Rates::Plain,
-    );
-    let out = kin.cell(cas, &[], &[], zero, zero);
-    let pose_out = kin.pose(cas);
-    [
-        cas.to_tape(&out),
-        with_tangent(cas, &out, &[], &[]),
-        cas.to_tape(&pose_out),
-    ]
+    let motion = Motion {
+        rotation: [[c, ns, zero], [s, c, zero], [zero, zero, one]],
+        end: [p[1], p[2], zero],
+        omega: [zero; 3],
+        quat,
+        centroid: [zero; 3],
+        body_omega: [zero; 3],
+        axis: [one, zero, zero],
+    };
+    bodiless_cells(cas, motion, Rates::Plain)
 }

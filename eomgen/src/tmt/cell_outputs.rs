@@ -200,3 +200,17 @@ impl LinkKinematics {
         out
     }
 }
+
+/// The cell, its tangent and its pose cell of a link of no coordinates and
+/// no body (a kink) whose end frame moves as `motion`.
+pub(crate) fn bodiless_cells(cas: &mut Cas, motion: Motion, rates: Rates) -> [Tape; 3] {
+    let zero = cas.zero();
+    let kin = LinkKinematics::new(cas, motion, [zero; 4], &[], &[], rates);
+    let out = kin.cell(cas, &[], &[], zero, zero);
+    let pose_out = kin.pose(cas);
+    [
+        cas.to_tape(&out),
+        with_tangent(cas, &out, &[], &[]),
+        cas.to_tape(&pose_out),
+    ]
+}
