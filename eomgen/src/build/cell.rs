@@ -24,8 +24,8 @@
 
 use runtime::Tape;
 use runtime::links::{
-    ACTUATION_LOADS, AlongLoad, CELL_PARAMS, ContactElement, ContactPoint, ELEMENT_PARAMS,
-    LinkKernels, LinkLayout, LinkSpec, LocalCoordinate, REST_PARAMS,
+    ACTUATION_LOADS, AlongLoad, ContactElement, ContactPoint, ELEMENT_PARAMS, LinkKernels,
+    LinkLayout, LinkSpec, LocalCoordinate, REST_PARAMS,
 };
 
 use crate::cas::{Cas, ExprId, SymKind};
@@ -38,7 +38,9 @@ use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rom::RomFields;
 use crate::tmt::actuation::{loads_on, segment_loads, strain_work, thinning};
 use crate::tmt::cell_kind::CellKind;
-use crate::tmt::cell_outputs::{LinkKinematics, Motion, Rates, bodiless_cells, with_tangent};
+use crate::tmt::cell_outputs::{
+    LinkKinematics, Motion, Rates, bodiless_cells, cell_param_symbols, with_tangent,
+};
 use crate::tmt::spatial::{
     ArcStrain, Element3, Frame, Springs, V3, arc, compose, exp_turn, half_k_sq,
 };
@@ -713,9 +715,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     let qd: Vec<ExprId> = (0..names.len())
         .map(|i| cas.symbol(&format!("{}_dot", names[i]), SymKind::Qd(i as u32)))
         .collect();
-    let p: Vec<ExprId> = (0..CELL_PARAMS)
-        .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
-        .collect();
+    let p = cell_param_symbols(cas);
     // In the order of `ElementParam::CELL`, then the actuation loads.
     let [l, m, lateral, axial, kb, db, rest, kt, dt, ks, ds, kg] = std::array::from_fn(|i| p[i]);
     let loads: [ExprId; ACTUATION_LOADS] = std::array::from_fn(|i| p[ELEMENT_PARAMS + i]);
@@ -826,9 +826,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
 fn derive_kink_cell() -> [Tape; 3] {
     let mut cas = Cas::new();
     let cas = &mut cas;
-    let p: Vec<ExprId> = (0..CELL_PARAMS)
-        .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
-        .collect();
+    let p = cell_param_symbols(cas);
     let (zero, one) = (cas.zero(), cas.one());
     let identity = Frame::at_rest(cas, [zero; 3]);
     let turn = [zero, p[0], p[1]];

@@ -10,13 +10,15 @@
 //! A kink is a link of no coordinates and no body.
 
 use runtime::Tape;
-use runtime::links::{ACTUATION_LOADS, CELL_PARAMS, ELEMENT_PARAMS};
+use runtime::links::{ACTUATION_LOADS, ELEMENT_PARAMS};
 
-use crate::cas::{Cas, ExprId, SymKind};
+use crate::cas::{Cas, ExprId};
 use crate::model::SegmentShape;
 
 use crate::tmt::actuation::strain_work;
-use crate::tmt::cell_outputs::{LinkKinematics, Motion, Rates, bodiless_cells, with_tangent};
+use crate::tmt::cell_outputs::{
+    LinkKinematics, Motion, Rates, bodiless_cells, cell_param_symbols, with_tangent,
+};
 use crate::tmt::inertia::Inertia;
 use crate::tmt::planar::{Element2, PlanarArm, half_k_sq};
 use crate::tmt::system::{Coordinates, ParamSymbols};
@@ -29,9 +31,7 @@ pub(super) fn derive_planar_cell(g: &SegmentShape) -> Option<[Tape; 3]> {
     let cas = &mut cas;
     let coords = Coordinates::new(cas, vec!["theta".into()]);
     let (q, qd) = (coords.q[0], coords.qd[0]);
-    let p: Vec<ExprId> = (0..CELL_PARAMS)
-        .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
-        .collect();
+    let p = cell_param_symbols(cas);
     // In the order of `ElementParam::CELL`: a planar element reads the
     // first three and the bend spring; then the actuation loads.
     let el = Element2 {
@@ -106,9 +106,7 @@ pub(super) fn derive_planar_cell(g: &SegmentShape) -> Option<[Tape; 3]> {
 pub(super) fn derive_planar_kink_cell() -> [Tape; 3] {
     let mut cas = Cas::new();
     let cas = &mut cas;
-    let p: Vec<ExprId> = (0..CELL_PARAMS)
-        .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
-        .collect();
+    let p = cell_param_symbols(cas);
     let (zero, one) = (cas.zero(), cas.one());
     let turn = p[0];
     let (c, s) = (cas.cos(turn), cas.sin(turn));

@@ -214,3 +214,11 @@ pub(crate) fn bodiless_cells(cas: &mut Cas, motion: Motion, rates: Rates) -> [Ta
         cas.to_tape(&pose_out),
     ]
 }
+
+/// A cell's parameters as symbols p0, p1, ... (`runtime::links::CELL_PARAMS`
+/// of them: its element's, its actuation loads, its rest strains).
+pub(crate) fn cell_param_symbols(cas: &mut Cas) -> Vec<ExprId> {
+    (0..runtime::links::CELL_PARAMS)
+        .map(|i| cas.symbol(&format!("p{i}"), SymKind::Param(i as u32)))
+        .collect()
+}
