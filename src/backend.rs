@@ -133,8 +133,9 @@ pub fn read_model(spec: &str, overrides: &[Override]) -> Result<(Model, String)>
 /// cannot run so. Its contact kernels are the recursion's where its points
 /// lie on its links' arcs, else its tapes' ([`tapes`]: the cache's, else
 /// derived and cached); an assembly
-/// its arms' kernels so (their contact points too), and the rest (the
-/// bodies, their contact points) and its joints by its tapes
+/// its arms' kernels so (their contact points too, and the frames its
+/// joints hold), and the rest (the bodies, their contact points, the
+/// joints' rows on those frames) by its tapes
 /// (`runtime::assembled::BlockKernels`).
 fn linked(
     model: &Model,
@@ -172,7 +173,12 @@ fn linked(
         let cells = (blocks.kinds.iter())
             .map(|kind| Ok(compiled_cells(kind.links.as_ref().ok_or_else(not_cells)?)))
             .collect::<std::result::Result<Vec<_>, String>>()?;
-        let note = taped(cells.iter().flatten());
+        let joints = match (&blocks.joints, tapes.info.constraints.is_empty()) {
+            (Some(_), _) => ", its joints' rows on the arms' frames",
+            (None, false) => ", its joints too",
+            (None, true) => "",
+        };
+        let note = format!("{joints}{}", taped(cells.iter().flatten()));
         let kinds = (blocks.kinds.iter().zip(cells))
             .map(|(kind, cells)| {
                 let arm = LinkedKernels::with_tapes(kind.clone(), cells).ok_or_else(not_cells)?;

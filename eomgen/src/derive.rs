@@ -1,11 +1,14 @@
 //! Model -> tapes: kinematics, TMT assembly, lowering.
 
+use runtime::joints::{FrameJoints, JointFrame};
 use runtime::kernels::{ArmBlocks, ArmInstance, RestContact};
+use runtime::links::ArmFrame;
 use runtime::{ModelInfo, TapeSet};
 
-use crate::build::{ArmBlock, assembly_system, link_chain, system};
+use crate::build::{ArmBlock, FrameRows, assembly_system, link_chain, system};
 use crate::cas::ExprId;
 use crate::cas::{Cas, Hoist, SymKind};
+use crate::model::assembly::FrameRef;
 use crate::model::{AssemblyShape, Model, ParamLayout, Structure};
 use crate::tmt::contact_frames::{PointGroup, contact_frames};
 use crate::tmt::{SYMBOLIC_SOLVE_MAX_DOF, System, assemble, solve_accelerations};
@@ -74,7 +77,7 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
         Some(a) => {
             let assembled = assembly_system(&mut cas, a, &layout);
             if arms_have_own_kernels(a) {
-                by_arms = Some((a, assembled.arms, assembled.rest));
+                by_arms = Some((a, assembled.arms, assembled.rest, assembled.on_frames));
             }
             // Arms on other arms' frames move with them: one block of M.
             let blocks = match a.tree() {
@@ -155,8 +158,11 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
             )
         }
     };
-    let arm_blocks = by_arms
-        .map(|(a, arms, rest)| arm_blocks(&mut cas, a, &arms, &rest, &contact_groups, &mut hoist));
+    let arm_blocks = by_arms.map(|(a, arms, rest, on_frames)| {
+        let mut blocks = arm_blocks(&mut cas, a, &arms, &rest, &contact_groups, &mut hoist);
+        blocks.joints = frame_joints(&mut cas, &sys, &blocks, on_frames, &mut hoist);
+        blocks
+    });
     let derived = hoist.finish(&mut cas);
     TapeSet {
         info: ModelInfo {
@@ -261,7 +267,60 @@ fn arm_blocks(
         kinds,
         arms: instances,
         rest_contact,
+        joints: None,
     }
+}
+
+/// The joints' rows on the frames they hold (`runtime::joints`), where
+/// the assembly has joints and every arm a joint holds runs on link cells:
+/// phi, d phi/dq of the coordinates the rows read (the bodies'), gamma,
+/// then d phi/dx per frame variable.
+fn frame_joints(
+    cas: &mut Cas,
+    sys: &System,
+    blocks: &ArmBlocks,
+    on: FrameRows,
+    hoist: &mut Hoist,
+) -> Option<FrameJoints> {
+    let frames: Vec<JointFrame> = (on.frames.iter())
+        .map(|&f| match f {
+            FrameRef::Tip(arm) => Some(JointFrame {
+                arm,
+                at: ArmFrame::Tip,
+            }),
+            FrameRef::SegmentEnd { arm, segment } => Some(JointFrame {
+                arm,
+                at: ArmFrame::SegmentEnd(segment),
+            }),
+            _ => None,
+        })
+        .collect::<Option<_>>()?;
+    let on_cells = |f: &JointFrame| blocks.kinds[blocks.arms[f.arm].kind].links.is_some();
+    if on.rows.is_empty() || !frames.iter().all(on_cells) {
+        return None;
+    }
+    let mut pairs = sys.coords.rate_pairs();
+    pairs.extend(&sys.seeds);
+    pairs.extend(&on.pairs);
+    let mut outs = on.rows.clone();
+    for &row in &on.rows {
+        for &q in &sys.coords.q {
+            outs.push(cas.diff(row, q));
+        }
+    }
+    let rate = cas.kinematic_rates(&on.rows, &pairs);
+    outs.extend(cas.kinematic_rates(&rate, &pairs));
+    for &row in &on.rows {
+        for vars in &on.vars {
+            for &x in vars {
+                outs.push(cas.diff(row, x));
+            }
+        }
+    }
+    Some(FrameJoints {
+        frames,
+        rows: cas.to_tape_hoisted(&outs, hoist),
+    })
 }
 
 /// The contact kernels of the points no arm has (the bodies' centres).

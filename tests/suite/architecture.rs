@@ -56,6 +56,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "linalg",
             "solver",
             "links",
+            "joints",
             "parts",
             "kernels",
             "linked",

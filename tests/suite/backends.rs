@@ -63,7 +63,13 @@ fn assert_backends_agree(
         }
         let qd = rng.vec(n, -3.0, 3.0);
         let t = rng.uniform(0.0, 10.0);
-        for kind in [KernelKind::MassBias, KernelKind::Outputs, KernelKind::Accel] {
+        let kinds = [
+            KernelKind::MassBias,
+            KernelKind::Outputs,
+            KernelKind::Accel,
+            KernelKind::Constraints,
+        ];
+        for kind in kinds {
             let len = kind.output_len(compiled.info());
             let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
             compiled.eval_kernel(kind, t, &q, &qd, &mut a);
@@ -80,6 +86,11 @@ fn assert_backends_agree(
             let largest =
                 |r: std::ops::Range<usize>| b[r].iter().fold(0.0f64, |s, x| s.max(x.abs()));
             let (m_scale, h_scale) = (largest(0..m_len.min(len)), largest(m_len.min(len)..len));
+            // The joints' phi, J and gamma: an assembly's through its arms'
+            // frames (runtime/kernels/src/joints.rs), each held to 1e-12 of
+            // its largest entry.
+            let rows = compiled.info().constraints.len();
+            let (phi, jac) = (0..rows, rows..rows * (n + 1));
             for k in 0..len {
                 assert!(a[k].is_finite(), "{} {kind:?}[{k}] not finite", what);
                 let (rel, floor) = match kind {
@@ -90,6 +101,9 @@ fn assert_backends_agree(
                         3 | 4 => (1e-12, largest(3..5)),
                         _ => (1e-12, 1.0),
                     },
+                    KernelKind::Constraints if phi.contains(&k) => (1e-12, largest(phi.clone())),
+                    KernelKind::Constraints if jac.contains(&k) => (1e-12, largest(jac.clone())),
+                    KernelKind::Constraints => (1e-12, largest(jac.end..len)),
                     _ => (1e-12, 0.0),
                 };
                 assert_close(
@@ -1194,6 +1208,55 @@ fn eba_parts_match_the_flat_tapes() {
     }
 }
 
+/// A 3D arm holding two free bodies: a weld at its tip (offset, turned),
+/// a pin at its first segment's end.
+const HELD_3D: &str = r#"
+name = "held_3d"
+dimensions = 3
+gravity = [0.0, -9.81, 0.0]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.3
+elements = 3
+mass = 1.0
+bending_stiffness = 0.6
+twist = false
+[[segment]]
+method = "pcc"
+length = 0.3
+elements = 2
+mass = 1.0
+bending_stiffness = 0.6
+twist = false
+[[body]]
+name = "ball"
+shape = "sphere"
+radius = 0.05
+mass = 1.0
+position = [0.65, 0.0, 0.0]
+[[body]]
+name = "ring"
+shape = "sphere"
+radius = 0.02
+mass = 0.1
+position = [0.3, 0.0, 0.0]
+[[joint]]
+name = "grip"
+kind = "weld"
+a = "tip"
+b = "ball"
+offset_a = [0.01, 0.02, -0.01]
+offset_b = [-0.05, 0.0, 0.0]
+orientation = [0.9689124217106447, 0.0, 0.24740395925452294, 0.0]
+[[joint]]
+name = "hold"
+kind = "pin"
+a = "segment.0.end"
+b = "ring"
+"#;
+
 #[test]
 fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
     // Structures no compiled-in model has, whose link shapes one has:
@@ -1230,6 +1293,12 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         std::fs::write(&path, format!("{text}{sphere}")).unwrap();
         path.to_string_lossy().into_owned()
     };
+    // Joints through the arms' frames: a 3D arm of two segments holding a
+    // ball at its tip (a weld) and a ring at its first segment's end (a
+    // pin), both free bodies on quaternions.
+    let held = dir.path().join("held_3d.toml");
+    std::fs::write(&held, HELD_3D).unwrap();
+    let held = held.to_string_lossy().into_owned();
     let (tentacle_ball, rod_ball, rom_ball) = (
         on_sphere("tentacle_ball", "tentacle3d"),
         on_sphere("rod_ball", "rod_swing"),
@@ -1262,6 +1331,7 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         // points too; the rest (the ball, its contact point, the joints)
         // by the assembly's tapes.
         ("falling_ball", "arm.left.segment.0.elements=7"),
+        (held.as_str(), "segment.1.elements=3"),
         ("ball_drop", "arm.right.segment.1.elements=3"),
     ] {
         let what = format!("{model} {set}");
@@ -1518,7 +1588,9 @@ value = 1000.0
     let (b, r) = route("falling_ball", "arm.left.segment.0.elements=3", auto);
     assert_eq!(b, "compiled");
     assert!(
-        r.contains("each arm's layout") && r.contains("assembly interpreted"),
+        r.contains("each arm's layout")
+            && r.contains("assembly interpreted")
+            && r.contains("joints' rows on the arms' frames"),
         "{r}"
     );
     let (b, r) = route(&stretching, "", auto);

@@ -15,6 +15,8 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
+use runtime::links::frame;
+
 use crate::cas::{Cas, ExprId, Scope, SymKind};
 use crate::model::assembly::{FrameRef, JointKind};
 use crate::model::{
@@ -32,6 +34,8 @@ pub struct Assembled {
     pub constraints: Vec<ExprId>,
     /// Their names: `JOINT.x`, `JOINT.angle`, `JOINT.rx`, `BODY.unit`, ...
     pub rows: Vec<String>,
+    /// The same rows with the arms' frames they hold as variables.
+    pub on_frames: FrameRows,
     /// Coordinates per independent subsystem (an arm with its compliant
     /// base, a free body), in order: M is block diagonal over them.
     pub blocks: Vec<usize>,
@@ -42,6 +46,56 @@ pub struct Assembled {
     /// compliant bases and whatever joins the arms. The assembly's M, h and their tangent are
     /// this system's plus each arm's, in its block.
     pub rest: System,
+}
+
+/// The joints' rows on the arms' frames they hold (an arm's tip or
+/// segment end), each frame's variables (`runtime::links::frame`: origin,
+/// planar angle, quaternion) symbols of the rows kernel's `aux`, with
+/// their rates and their accelerations at qdd = 0 after them
+/// (`runtime::joints`).
+#[derive(Default)]
+pub struct FrameRows {
+    /// The held frames, in `aux` order.
+    pub frames: Vec<FrameRef>,
+    /// Each frame's variables.
+    pub vars: Vec<[ExprId; frame::VARS]>,
+    /// (x, x') and (x', x''): the time derivatives of the frame symbols.
+    pub pairs: Vec<(ExprId, ExprId)>,
+    pub rows: Vec<ExprId>,
+}
+
+impl FrameRows {
+    /// Frame `f`'s pose of symbols, made on its first use.
+    fn pose(&mut self, cas: &mut Cas, f: FrameRef) -> Pose {
+        let k = match self.frames.iter().position(|&g| g == f) {
+            Some(k) => k,
+            None => {
+                let k = self.frames.len();
+                let sym = |cas: &mut Cas, i: usize| {
+                    let at = k * frame::STATE + i;
+                    cas.symbol(&format!("frame{k}.{i}"), SymKind::Aux(at as u32))
+                };
+                let x: [ExprId; frame::VARS] = std::array::from_fn(|i| sym(cas, i));
+                let rate: [ExprId; frame::VARS] =
+                    std::array::from_fn(|i| sym(cas, frame::RATE + i));
+                let accel: [ExprId; frame::VARS] =
+                    std::array::from_fn(|i| sym(cas, frame::ACCEL + i));
+                for i in 0..frame::VARS {
+                    self.pairs.push((x[i], rate[i]));
+                    self.pairs.push((rate[i], accel[i]));
+                }
+                self.frames.push(f);
+                self.vars.push(x);
+                k
+            }
+        };
+        let x = self.vars[k];
+        Pose {
+            point: [x[frame::POINT], x[frame::POINT + 1], x[frame::POINT + 2]],
+            angle: x[frame::ANGLE],
+            quat: std::array::from_fn(|i| x[frame::QUAT + i]),
+        }
+    }
 }
 
 /// An arm's place in the assembly: its coordinates `first..first + dof`
@@ -172,8 +226,28 @@ pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -
         FrameRef::SegmentEnd { arm, segment } => arm_frames[arm].segment_ends[segment],
     };
     let frames: Vec<(Pose, Pose)> = a.joints.iter().map(|j| (frame(j.a), frame(j.b))).collect();
-    for (k, (joint, (fa, fb))) in a.joints.iter().zip(frames).enumerate() {
-        b.joint(cas, k, joint, fa, fb);
+    // The same rows on the arms' frames as variables of their own.
+    let mut on_frames = FrameRows::default();
+    let mut held = |cas: &mut Cas, f: FrameRef| match f {
+        FrameRef::Tip(_) | FrameRef::SegmentEnd { .. } => on_frames.pose(cas, f),
+        _ => frame(f),
+    };
+    let held: Vec<(Pose, Pose)> = (a.joints.iter())
+        .map(|j| (held(cas, j.a), held(cas, j.b)))
+        .collect();
+    for (k, (joint, ((fa, fb), (ha, hb)))) in a
+        .joints
+        .iter()
+        .zip(frames.into_iter().zip(held))
+        .enumerate()
+    {
+        for (row, name) in b.joint(cas, k, joint, fa, fb) {
+            b.constraints.push(row);
+            b.rows.push(name);
+        }
+        on_frames
+            .rows
+            .extend(b.joint(cas, k, joint, ha, hb).into_iter().map(|r| r.0));
     }
     let units = std::mem::take(&mut b.units);
     for (name, q) in units {
@@ -181,9 +255,12 @@ pub fn assembly_system(cas: &mut Cas, a: &AssemblyShape, layout: &ParamLayout) -
         let norm = cas.add_all(&sq);
         let one = cas.one();
         let gap = cas.sub(norm, one);
-        b.constraints.push(cas.scaled(0.5, gap));
+        let row = cas.scaled(0.5, gap);
+        b.constraints.push(row);
+        on_frames.rows.push(row);
         b.rows.push(format!("{name}.unit"));
     }
+    b.on_frames = on_frames;
     let zero = cas.zero();
     let (tip, tip_orientation) = tips
         .first()
@@ -214,6 +291,7 @@ struct Builder {
     rows: Vec<String>,
     /// Free 3D bodies' quaternions, held to unit norm by the last rows.
     units: Vec<(String, [ExprId; 4])>,
+    on_frames: FrameRows,
     /// Contact points: the arms' samples, then the bodies' centres.
     samples: Vec<Sample>,
     /// The arms' base frames.
@@ -257,6 +335,7 @@ impl Builder {
             constraints: Vec::new(),
             rows: Vec::new(),
             units: Vec::new(),
+            on_frames: FrameRows::default(),
             samples: Vec::new(),
             bases: Vec::new(),
             arm_blocks: Vec::new(),
@@ -599,7 +678,15 @@ impl Builder {
     /// Joint k's rows: the gap between its two points, then a weld's angle
     /// (planar) or rotation (3D, 2 vec(q_b conj(q_a q_offset)): the world
     /// rotation from a's turned frame to b's, to first order).
-    fn joint(&mut self, cas: &mut Cas, k: usize, joint: &JointShape, fa: Pose, fb: Pose) {
+    fn joint(
+        &self,
+        cas: &mut Cas,
+        k: usize,
+        joint: &JointShape,
+        fa: Pose,
+        fb: Pose,
+    ) -> Vec<(ExprId, String)> {
+        let mut rows = Vec::new();
         let p = |w| Param::Joint(k as u16, w);
         let off_a = Xyz::ALL.map(|c| self.get(p(JointParam::OffsetA(c))));
         let off_b = Xyz::ALL.map(|c| self.get(p(JointParam::OffsetB(c))));
@@ -610,18 +697,16 @@ impl Builder {
             (planar_point(cas, &fa, off_a), planar_point(cas, &fb, off_b))
         };
         for c in 0..axes {
-            self.constraints.push(cas.sub(pa[c], pb[c]));
-            self.rows
-                .push(format!("{}.{}", joint.name, ["x", "y", "z"][c]));
+            let name = format!("{}.{}", joint.name, ["x", "y", "z"][c]);
+            rows.push((cas.sub(pa[c], pb[c]), name));
         }
         if joint.kind != JointKind::Weld {
-            return;
+            return rows;
         }
         if !self.spatial {
             let turned = cas.add(fa.angle, self.get(p(JointParam::Angle)));
-            self.constraints.push(cas.sub(fb.angle, turned));
-            self.rows.push(format!("{}.angle", joint.name));
-            return;
+            rows.push((cas.sub(fb.angle, turned), format!("{}.angle", joint.name)));
+            return rows;
         }
         let offset = [0, 1, 2, 3].map(|i| self.get(p(JointParam::Quaternion(i))));
         let target = quat_mul(cas, fa.quat, offset);
@@ -633,9 +718,12 @@ impl Builder {
         ];
         let rel = quat_mul(cas, fb.quat, conj);
         for (c, name) in ["rx", "ry", "rz"].iter().enumerate() {
-            self.constraints.push(cas.scaled(2.0, rel[c + 1]));
-            self.rows.push(format!("{}.{name}", joint.name));
+            rows.push((
+                cas.scaled(2.0, rel[c + 1]),
+                format!("{}.{name}", joint.name),
+            ));
         }
+        rows
     }
 
     fn finish(self, cas: &mut Cas, tip: [ExprId; 3], tip_orientation: [ExprId; 4]) -> Assembled {
@@ -667,6 +755,7 @@ impl Builder {
         };
         Assembled {
             sys,
+            on_frames: self.on_frames,
             constraints: self.constraints,
             rows: self.rows,
             blocks: self.blocks,

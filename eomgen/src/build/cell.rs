@@ -97,6 +97,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     let mut roms = Vec::new();
     // Each element's links, where its points lie on their arcs.
     let mut element_links = Vec::new();
+    let mut segment_ends = Vec::new();
     let (mut first, mut k) = (0, 0);
     for (s, g) in st.segments.iter().enumerate() {
         let method = crate::method::of(g.method);
@@ -184,6 +185,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             first += r.coordinates();
             roms.push((r, k - g.elements));
         }
+        segment_ends.push(links.len() - 1);
     }
     let contact = contact_points(&element_links, st.contact_points);
     let contact_elements = contact_elements(&element_links, &contact);
@@ -193,6 +195,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         contact,
         contact_elements,
         along,
+        segment_ends,
         dof: first,
         forces: !roms.is_empty(),
         loads: actuated.len(),

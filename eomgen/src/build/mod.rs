@@ -16,7 +16,7 @@ use crate::tmt::spatial::SpatialArm;
 use crate::tmt::system::MountFrame;
 use crate::tmt::{ParamSymbols, System};
 
-pub use assembly::{ArmBlock, Assembled, assembly_system};
+pub use assembly::{ArmBlock, Assembled, FrameRows, assembly_system};
 pub use cell::{cell_key, link_chain};
 
 /// The system of a structure: planar or spatial kinematics by

@@ -1,21 +1,25 @@
 //! An assembly's kernels through its arms' own ([`ArmBlocks`]) at run
 //! time: what a compiled-in assembly's generated code does, for one that
 //! is not compiled in. Each distinct arm structure brings its own kernels
-//! (its link cells, linked), its contact points' too; the rest of the
-//! system (bodies, what joins the arms, the bodies' contact points) and
-//! the joints run on the assembly's tapes.
+//! (its link cells, linked), its contact points' too, and the frames its
+//! joints hold; the rest of the system (bodies, what joins the arms, the
+//! bodies' contact points, the joints' rows on those frames) runs on the
+//! assembly's tapes.
 
 use std::cell::RefCell;
 
+use crate::joints::{self, HeldFrame};
 use crate::kernels::{ArmBlocks, Interpreted, KernelKind, Kernels, ModelInfo, TapeSet};
 use crate::linalg::{add_block, place_groups, place_point_rows};
+use crate::links::frame;
 use crate::output;
 use crate::tape::{Inputs, Tape};
 
 /// An assembly's kernels: `MassBias`, `Jvp`, `Outputs` and `Derived` as
 /// the rest's tapes plus each arm's kernels in its block, the contact
-/// kernels so too where the tapes split them (`ArmBlocks::rest_contact`);
-/// the joints by the assembly's tapes.
+/// kernels so too where the tapes split them (`ArmBlocks::rest_contact`),
+/// the joints on the arms' frames where the tapes have their rows on them
+/// (`ArmBlocks::joints`); else by the assembly's flat tapes.
 pub struct BlockKernels {
     info: ModelInfo,
     /// The assembly's tapes: its own derived parameters, joints, contact.
@@ -249,6 +253,43 @@ impl BlockKernels {
     }
 }
 
+impl BlockKernels {
+    /// The joints through their arms' frames (`crate::joints`); false,
+    /// leaving `out` to the flat tapes, where the assembly has no such
+    /// kernel or an arm's kernels give no frames.
+    fn joints(&self, inp: &Inputs, out: &mut [f64]) -> bool {
+        let Some(joints) = &self.blocks.joints else {
+            return false;
+        };
+        let mut motions = Vec::with_capacity(joints.frames.len());
+        for f in &joints.frames {
+            let (kernels, first, arm) = self.arm(f.arm, inp);
+            let dof = arm.q.len();
+            let mut motion = vec![0.0; frame::len(dof)];
+            if !kernels.frames(&arm, &[f.at], &mut motion) {
+                return false;
+            }
+            motions.push((first, dof, motion));
+        }
+        let held: Vec<HeldFrame> = (motions.iter())
+            .map(|(first, dof, motion)| HeldFrame {
+                first: *first,
+                dof: *dof,
+                motion,
+            })
+            .collect();
+        let mut aux = vec![0.0; frame::STATE * held.len()];
+        joints::aux(&held, &mut aux);
+        let n = self.info.dof();
+        let m = self.info.constraints.len();
+        let mut rows = vec![0.0; joints::rows_len(m, n, held.len())];
+        let at = Inputs { aux: &aux, ..*inp };
+        self.rest(&joints.rows, &at, &mut rows);
+        joints::constraints(n, &held, &rows, out);
+        true
+    }
+}
+
 impl Kernels for BlockKernels {
     fn info(&self) -> &ModelInfo {
         &self.info
@@ -265,6 +306,7 @@ impl Kernels for BlockKernels {
             {
                 self.contact(kind, inp, out)
             }
+            KernelKind::Constraints if self.joints(inp, out) => {}
             // No symbolic solve (`new` says so); the joints (and contact
             // the tapes do not split) from the assembly's tapes.
             KernelKind::Accel

@@ -6,6 +6,7 @@ use std::cell::RefCell;
 use serde::{Deserialize, Serialize};
 
 use crate::linalg::Ldlt;
+use crate::links::ArmFrame;
 pub use crate::output::{N_OUTPUTS, OUTPUT_NAMES};
 use crate::tape::{Inputs, Tape};
 
@@ -230,6 +231,14 @@ pub trait Kernels {
     fn contact_bounds(&self, _inp: &Inputs, _out: &mut [f64]) -> bool {
         false
     }
+
+    /// The frames `which` of a chain that joints hold, as
+    /// [`crate::links::frames`] gives them ([`crate::links::frame::len`]
+    /// values each), where the kernel set runs on link cells. False where
+    /// it does not: an assembly's joints then run on its flat tapes.
+    fn frames(&self, _inp: &Inputs, _which: &[ArmFrame], _out: &mut [f64]) -> bool {
+        false
+    }
 }
 
 /// A boxed set of kernels is one: the backends are chosen at run time.
@@ -251,6 +260,9 @@ impl<K: Kernels + ?Sized> Kernels for Box<K> {
     }
     fn contact_bounds(&self, inp: &Inputs, out: &mut [f64]) -> bool {
         (**self).contact_bounds(inp, out)
+    }
+    fn frames(&self, inp: &Inputs, which: &[ArmFrame], out: &mut [f64]) -> bool {
+        (**self).frames(inp, which, out)
     }
 }
 
@@ -352,6 +364,11 @@ pub struct ArmBlocks {
     /// assembly's flat contact kernels.
     #[serde(default)]
     pub rest_contact: Option<RestContact>,
+    /// The joints on their arms' frames (`crate::joints`), where every
+    /// arm a joint holds runs on link cells; `None`: the assembly's flat
+    /// `Constraints` kernel.
+    #[serde(default)]
+    pub joints: Option<crate::joints::FrameJoints>,
 }
 
 /// The contact kernels of an assembly's points that are no arm's, which

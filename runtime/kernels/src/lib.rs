@@ -12,6 +12,7 @@
 pub mod assembled;
 pub mod cpu;
 pub mod dual;
+pub mod joints;
 pub mod kernels;
 pub mod lanes;
 pub mod linalg;

@@ -269,6 +269,21 @@ impl Kernels for LinkedKernels {
         true
     }
 
+    fn frames(&self, inp: &Inputs, which: &[links::ArmFrame], out: &mut [f64]) -> bool {
+        let mut slots = self.slots.borrow_mut();
+        let mut cells = self.linked(inp, &mut slots);
+        links::frames(
+            &self.links.layout,
+            &mut cells,
+            inp.q,
+            inp.qd,
+            inp.p,
+            which,
+            out,
+        );
+        true
+    }
+
     fn accelerations(&self, inp: &Inputs, qdd: &mut [f64]) -> Option<bool> {
         let layout = &self.links.layout;
         if !all_owned(layout) || layout.forces || layout.variable_inertia {

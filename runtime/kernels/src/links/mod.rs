@@ -27,6 +27,7 @@ mod along;
 mod articulated;
 mod compiled;
 mod contact;
+mod frames;
 mod num;
 mod outputs;
 mod planar;
@@ -39,6 +40,7 @@ pub use contact::{
     CONTACT_BOUND, ContactElement, contact_bounds, contact_jacobian, contact_jvp, contact_points,
     has_contact_bounds,
 };
+pub use frames::{ArmFrame, frame, frames};
 pub use outputs::outputs;
 pub(crate) use points::bits_equal;
 pub use points::{ContactPoint, LinkOutputs};
@@ -204,6 +206,10 @@ pub struct LinkLayout {
     /// The loads along the chain, in the links' order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub along: Vec<AlongLoad>,
+    /// Each segment's last link: where its end frame, which joints may
+    /// hold, is.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub segment_ends: Vec<usize>,
     /// [`LinkLayout::weights`], computed on first use.
     #[serde(skip)]
     pub weights: std::sync::OnceLock<Vec<f64>>,

@@ -12,16 +12,8 @@ use super::{
     mat_mat, mat_vec, pose, scale,
 };
 use crate::output;
+use crate::rotation::quat_mul;
 
-/// The Hamilton product a b, (w, x, y, z).
-fn quat_mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
-    [
-        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
-        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
-        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
-        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
-    ]
-}
 /// Kinetic energy of a body of mass m, axisymmetric inertia about `axis`,
 /// moving at (v, w).
 fn kinetic(m: f64, lateral: f64, axial: f64, axis: V3, v: V3, w: V3) -> f64 {

@@ -22,3 +22,32 @@ fn a_quaternion_turns_as_its_axis_and_angle_say() {
         }
     }
 }
+
+/// A rotation's quaternion is the quaternion it was made from (its sign
+/// chosen w >= 0), in each of Shepperd's four branches: turns by up to
+/// nearly a half turn about axes along and between the three axes.
+#[test]
+fn a_rotations_quaternion_is_the_one_it_was_made_from() {
+    use runtime_kernels::rotation::to_unit_quaternion;
+    let axes = [
+        [2.0f64 / 7.0, 3.0 / 7.0, 6.0 / 7.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.6, -0.8, 0.0],
+    ];
+    for n in axes {
+        for a in [0.0f64, 0.3, 1.1, 2.5, 3.1, -2.9] {
+            let s = (a / 2.0).sin();
+            let q = [(a / 2.0).cos(), s * n[0], s * n[1], s * n[2]];
+            let q = if q[0] < 0.0 { q.map(|c| -c) } else { q };
+            let back = to_unit_quaternion(&from_unit_quaternion(q));
+            for k in 0..4 {
+                assert!(
+                    (back[k] - q[k]).abs() < 1e-15,
+                    "axis {n:?}, angle {a}: {back:?} vs {q:?}"
+                );
+            }
+        }
+    }
+}
