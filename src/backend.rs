@@ -167,7 +167,7 @@ fn linked(
     let kernels: (Box<dyn Kernels>, String) = if structure.assembly.is_some() {
         let (tapes, _, _) = tapes(model, &structure.hash(), cache_dir);
         let blocks = tapes.arm_blocks.as_ref().ok_or_else(|| {
-            "its arms run on the assembly's kernels (an arm has inputs, a compliant base or sits on another arm or a body)"
+            "its arms run on the assembly's kernels (an arm has a compliant base or sits on another arm or a body)"
                 .to_string()
         })?;
         let cells = (blocks.kinds.iter())

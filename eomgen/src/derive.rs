@@ -49,6 +49,7 @@ pub fn derive_links(structure: &Structure) -> Option<(ModelInfo, runtime::links:
         contact_points: links.layout.contact.len(),
         contact_groups: element_groups(elements, points, 2 * n),
         contact_frames: 0,
+        copies: Vec::new(),
     };
     Some((info, links))
 }
@@ -177,6 +178,7 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
             contact_points: sys.samples.len(),
             contact_groups,
             contact_frames,
+            copies: Vec::new(),
         },
         mass_bias,
         outputs,
@@ -201,12 +203,10 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
 /// (`runtime::arm_blocks`): not an arm on a compliant base (its
 /// coordinates move the arm's base, which a single arm's kernels hold
 /// still), nor one on another arm's frame or a body (their coordinates move
-/// it), nor one with inputs (its parameters are copied once per parameter
-/// set).
+/// it). An arm's inputs are copied into its slice each time they are
+/// written (`ModelInfo::copies`).
 fn arms_have_own_kernels(a: &AssemblyShape) -> bool {
-    !a.tree()
-        && (a.arms.iter())
-            .all(|(_, st)| !st.base_compliant && ParamLayout::of(st).driven().is_empty())
+    !a.tree() && (a.arms.iter()).all(|(_, st)| !st.base_compliant)
 }
 
 /// The rest of an assembly's `MassBias` and `Jvp` (hoisted with its other
@@ -235,6 +235,7 @@ fn arm_blocks(
                 contact_points: if contact { st.contact_points } else { 0 },
                 ..st.clone()
             };
+            let layout = ParamLayout::of(&st);
             let kind = match kinds.iter().position(|(s, _)| *s == st) {
                 Some(k) => k,
                 None => {
@@ -248,6 +249,9 @@ fn arm_blocks(
                 first: b.first,
                 dof: b.dof,
                 params: b.params,
+                driven: (layout.driven().iter())
+                    .map(|d| layout.index(d.param))
+                    .collect(),
             }
         })
         .collect();

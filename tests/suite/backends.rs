@@ -1208,8 +1208,8 @@ fn eba_parts_match_the_flat_tapes() {
     }
 }
 
-/// A 3D arm holding two free bodies: a weld at its tip (offset, turned),
-/// a pin at its first segment's end.
+/// A 3D arm holding two free bodies: a weld at its tip (the far end of a
+/// tip body; offset, turned), a pin at its first segment's end.
 const HELD_3D: &str = r#"
 name = "held_3d"
 dimensions = 3
@@ -1230,12 +1230,16 @@ elements = 2
 mass = 1.0
 bending_stiffness = 0.6
 twist = false
+[tip]
+mass = 0.01
+length = 0.02
+radius = 0.005
 [[body]]
 name = "ball"
 shape = "sphere"
 radius = 0.05
 mass = 1.0
-position = [0.65, 0.0, 0.0]
+position = [0.67, 0.0, 0.0]
 [[body]]
 name = "ring"
 shape = "sphere"
@@ -1255,6 +1259,66 @@ name = "hold"
 kind = "pin"
 a = "segment.0.end"
 b = "ring"
+"#;
+
+/// Two 3D arms holding a ball, one bent by a chamber whose pressure is a
+/// sine.
+const PINCH: &str = r#"
+name = "pinch"
+dimensions = 3
+gravity = [0.0, 0.0, -9.81]
+[[arm]]
+name = "left"
+base = { position = [0.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0] }
+[[arm.segment]]
+method = "pcc"
+length = 0.1
+elements = 3
+twist = false
+density = 1100.0
+outer_radius = 0.012
+youngs_modulus = 5e5
+[arm.segment.chambers]
+count = 3
+radius = 0.002
+distance = 0.006
+inputs = ["p", "q", "q"]
+[[arm]]
+name = "right"
+base = { position = [0.25, 0.0, 0.0], direction = [-1.0, 0.0, 0.0] }
+[[arm.segment]]
+method = "pcc"
+length = 0.1
+elements = 2
+twist = false
+density = 1100.0
+outer_radius = 0.012
+youngs_modulus = 5e5
+[[body]]
+name = "ball"
+shape = "sphere"
+radius = 0.02
+mass = 0.05
+position = [0.125, 0.0, 0.0]
+[[joint]]
+name = "grip"
+kind = "weld"
+a = "left.tip"
+b = "ball"
+offset_b = [-0.02, 0.0, 0.0]
+[[joint]]
+name = "hold"
+kind = "pin"
+a = "right.tip"
+b = "ball"
+offset_b = [0.02, 0.0, 0.0]
+[inputs.p]
+kind = "sine"
+amplitude = 3000.0
+frequency = 2.0
+[inputs.q]
+kind = "constant"
+value = 0.0
 "#;
 
 #[test]
@@ -1299,6 +1363,11 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
     let held = dir.path().join("held_3d.toml");
     std::fs::write(&held, HELD_3D).unwrap();
     let held = held.to_string_lossy().into_owned();
+    // An assembly whose arm has inputs: a driven chamber, whose pressure
+    // the arm's slice of the parameters gets each time it is written.
+    let pinch = dir.path().join("pinch.toml");
+    std::fs::write(&pinch, PINCH).unwrap();
+    let pinch = pinch.to_string_lossy().into_owned();
     let (tentacle_ball, rod_ball, rom_ball) = (
         on_sphere("tentacle_ball", "tentacle3d"),
         on_sphere("rod_ball", "rod_swing"),
@@ -1332,6 +1401,7 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         // by the assembly's tapes.
         ("falling_ball", "arm.left.segment.0.elements=7"),
         (held.as_str(), "segment.1.elements=3"),
+        (pinch.as_str(), "arm.right.segment.0.elements=3"),
         ("ball_drop", "arm.right.segment.1.elements=3"),
     ] {
         let what = format!("{model} {set}");

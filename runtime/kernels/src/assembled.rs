@@ -8,7 +8,7 @@
 
 use std::cell::RefCell;
 
-use crate::joints::{self, HeldFrame};
+use crate::joints::{self, HeldFrame, JointFrame};
 use crate::kernels::{ArmBlocks, Interpreted, KernelKind, Kernels, ModelInfo, TapeSet};
 use crate::linalg::{add_block, place_groups, place_point_rows};
 use crate::links::frame;
@@ -30,6 +30,8 @@ pub struct BlockKernels {
     /// Where each arm's parameters start among the derived ones.
     starts: Vec<usize>,
     slots: RefCell<Vec<f64>>,
+    /// The held frames' motions, the joints' `aux` and their rows.
+    joint_scratch: RefCell<Vec<f64>>,
 }
 
 impl BlockKernels {
@@ -42,6 +44,7 @@ impl BlockKernels {
         let info = ModelInfo {
             derived: total,
             accel: false,
+            copies: blocks.copies(tapes.info.parameters.len(), tapes.info.derived),
             ..tapes.info.clone()
         };
         Some(Self {
@@ -51,6 +54,7 @@ impl BlockKernels {
             kinds,
             starts,
             slots: RefCell::new(Vec::new()),
+            joint_scratch: RefCell::new(Vec::new()),
         })
     }
 
@@ -261,31 +265,42 @@ impl BlockKernels {
         let Some(joints) = &self.blocks.joints else {
             return false;
         };
-        let mut motions = Vec::with_capacity(joints.frames.len());
+        let dof = |f: &JointFrame| self.blocks.arms[f.arm].dof;
+        let (n, m) = (self.info.dof(), self.info.constraints.len());
+        let lens: usize = joints.frames.iter().map(|f| frame::len(dof(f))).sum();
+        let n_aux = frame::STATE * joints.frames.len();
+        let mut scratch = self.joint_scratch.borrow_mut();
+        scratch.resize(
+            lens + n_aux + joints::rows_len(m, n, joints.frames.len()),
+            0.0,
+        );
+        let (motions, rest) = scratch.split_at_mut(lens);
+        let (aux, rows) = rest.split_at_mut(n_aux);
+        let mut free = &mut motions[..];
         for f in &joints.frames {
-            let (kernels, first, arm) = self.arm(f.arm, inp);
-            let dof = arm.q.len();
-            let mut motion = vec![0.0; frame::len(dof)];
-            if !kernels.frames(&arm, &[f.at], &mut motion) {
+            let (kernels, _, arm) = self.arm(f.arm, inp);
+            let (motion, next) = free.split_at_mut(frame::len(dof(f)));
+            if !kernels.frames(&arm, &[f.at], motion) {
                 return false;
             }
-            motions.push((first, dof, motion));
+            free = next;
         }
-        let held: Vec<HeldFrame> = (motions.iter())
-            .map(|(first, dof, motion)| HeldFrame {
-                first: *first,
-                dof: *dof,
-                motion,
+        let mut at = 0;
+        let held: Vec<HeldFrame> = (joints.frames.iter())
+            .map(|f| {
+                let a = &self.blocks.arms[f.arm];
+                let motion = &motions[at..at + frame::len(a.dof)];
+                at += motion.len();
+                HeldFrame {
+                    first: a.first,
+                    dof: a.dof,
+                    motion,
+                }
             })
             .collect();
-        let mut aux = vec![0.0; frame::STATE * held.len()];
-        joints::aux(&held, &mut aux);
-        let n = self.info.dof();
-        let m = self.info.constraints.len();
-        let mut rows = vec![0.0; joints::rows_len(m, n, held.len())];
-        let at = Inputs { aux: &aux, ..*inp };
-        self.rest(&joints.rows, &at, &mut rows);
-        joints::constraints(n, &held, &rows, out);
+        joints::aux(&held, aux);
+        self.rest(&joints.rows, &Inputs { aux, ..*inp }, rows);
+        joints::constraints(n, &held, rows, out);
         true
     }
 }

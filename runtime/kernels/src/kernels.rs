@@ -164,6 +164,11 @@ pub struct ModelInfo {
     /// The `Accel` kernel gives them in place of the points.
     #[serde(default)]
     pub contact_frames: usize,
+    /// (j, k): extended parameter k holds a copy of base parameter j (an
+    /// assembly's arm reads its parameters as one slice: `ArmBlocks`), so
+    /// that a driven j is written to k too each time it is.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub copies: Vec<(usize, usize)>,
 }
 
 pub use crate::links::CONTACT_BOUND;
@@ -342,9 +347,10 @@ impl TapeSet {
 ///
 /// Each arm reads its parameters as one slice of the extended parameter
 /// vector: the `Derived` kernel copies the arm's base parameters there and
-/// computes the arm's derived ones after them, once per parameter set (an
-/// arm with inputs, whose values change during a run, keeps the flat
-/// kernels: a copy would be stale).
+/// computes the arm's derived ones after them, once per parameter set;
+/// an input's value, which changes during a run, is written to its copy
+/// too each time (`ModelInfo::copies`, [`ArmBlocks::copies`]). No derived
+/// parameter reads an input.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ArmBlocks {
     /// `MassBias` of the system without the arms' own terms (the
@@ -385,7 +391,7 @@ pub struct RestContact {
 }
 
 /// One arm of the assembly.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ArmInstance {
     /// Its structure: an index into `ArmBlocks::kinds`.
     pub kind: usize,
@@ -394,6 +400,9 @@ pub struct ArmInstance {
     pub dof: usize,
     /// Its base parameters: from `params` on, in its own layout's order.
     pub params: usize,
+    /// Its driven base parameters (inputs), in its own layout.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub driven: Vec<usize>,
 }
 
 impl ArmBlocks {
@@ -412,6 +421,20 @@ impl ArmBlocks {
             })
             .collect();
         (starts, at)
+    }
+
+    /// The copies of the arms' driven parameters in their slices
+    /// (`ModelInfo::copies`), for `n_base` base parameters and `own` of
+    /// the assembly's own derived ones.
+    pub fn copies(&self, n_base: usize, own: usize) -> Vec<(usize, usize)> {
+        let (starts, _) = self.derived_layout(own);
+        (self.arms.iter().zip(starts))
+            .flat_map(|(a, start)| {
+                a.driven
+                    .iter()
+                    .map(move |&i| (a.params + i, n_base + start + i))
+            })
+            .collect()
     }
 }
 

@@ -270,17 +270,9 @@ impl Kernels for LinkedKernels {
     }
 
     fn frames(&self, inp: &Inputs, which: &[links::ArmFrame], out: &mut [f64]) -> bool {
-        let mut slots = self.slots.borrow_mut();
-        let mut cells = self.linked(inp, &mut slots);
-        links::frames(
-            &self.links.layout,
-            &mut cells,
-            inp.q,
-            inp.qd,
-            inp.p,
-            which,
-            out,
-        );
+        crate::cpu::require_fma();
+        // SAFETY: `require_fma` has checked that the processor has FMA.
+        unsafe { self.frames_fma(inp, which, out) };
         true
     }
 
@@ -343,6 +335,15 @@ impl LinkedKernels {
             slots,
             kept_loads: &self.kept_loads,
         }
+    }
+
+    /// The frames joints hold, built for FMA.
+    #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
+    unsafe fn frames_fma(&self, inp: &Inputs, which: &[links::ArmFrame], out: &mut [f64]) {
+        let mut slots = self.slots.borrow_mut();
+        let mut cells = self.linked(inp, &mut slots);
+        let (q, qd, p) = (inp.q, inp.qd, inp.p);
+        links::frames(&self.links.layout, &mut cells, q, qd, p, which, out);
     }
 
     /// The contact groups' bounds built for FMA.

@@ -148,6 +148,8 @@ pub struct Arm<K> {
     /// Inputs: parameters set from signals at each evaluation's time (never
     /// inside derived parameters: the generator keeps them in the kernels).
     drives: Vec<Drive>,
+    /// Where else each drive's parameter is kept (`ModelInfo::copies`).
+    copies: Vec<Vec<usize>>,
     /// `params` with the driven entries at the last time asked for.
     live: RefCell<Vec<f64>>,
     /// Contact forces on the right-hand side (`crate::contact`).
@@ -177,6 +179,7 @@ impl<K: Kernels> Arm<K> {
             params: extended,
             packed: RefCell::new(Vec::new()),
             drives: Vec::new(),
+            copies: Vec::new(),
             live: RefCell::new(Vec::new()),
             contact: None,
             relax: None,
@@ -206,10 +209,19 @@ impl<K: Kernels> Arm<K> {
             return f(&without[g]);
         }
         let mut p = without[g].clone();
-        for d in &self.drives {
-            p[d.param] = d.signal.at(t);
-        }
+        self.drive(t, &mut p);
         f(&p)
+    }
+
+    /// The driven parameters of `p` (and their copies) at time t.
+    fn drive(&self, t: f64, p: &mut [f64]) {
+        for (d, copies) in self.drives.iter().zip(&self.copies) {
+            let v = d.signal.at(t);
+            p[d.param] = v;
+            for &k in copies {
+                p[k] = v;
+            }
+        }
     }
 
     /// h(q, 0) at parameters `p` into `out`.
@@ -264,9 +276,7 @@ impl<K: Kernels> Arm<K> {
         if live.len() != self.params.len() {
             live.clone_from(&self.params);
         }
-        for d in &self.drives {
-            live[d.param] = d.signal.at(t);
-        }
+        self.drive(t, &mut live);
         f(&live)
     }
 
@@ -501,6 +511,15 @@ impl<K: Kernels> Dynamics for Arm<K> {
             drives.iter().all(|d| d.param < n),
             "a drive names a parameter outside the layout"
         );
+        let copies = &self.kernels.info().copies;
+        self.copies = (drives.iter())
+            .map(|d| {
+                (copies.iter())
+                    .filter(|c| c.0 == d.param)
+                    .map(|c| c.1)
+                    .collect()
+            })
+            .collect();
         self.drives = drives;
         self.live.borrow_mut().clear();
     }

@@ -56,7 +56,6 @@ fn generalised<N: Num>(
     let asked = Asked {
         columns: true,
         spin: loads.iter().any(|l| l.local || l.moment.is_some()),
-        turns: false,
     };
     sweep(
         layout,
@@ -116,7 +115,6 @@ pub fn loads_potential(
     let asked = Asked {
         columns: false,
         spin: false,
-        turns: false,
     };
     let mut pe = 0.0;
     sweep(

@@ -35,12 +35,10 @@ pub struct ContactElement {
 const POSITIONS: Asked = Asked {
     columns: false,
     spin: false,
-    turns: false,
 };
 const COLUMNS: Asked = Asked {
     columns: true,
     spin: false,
-    turns: false,
 };
 
 /// The `Contact` kernel: every point's position (3 each).

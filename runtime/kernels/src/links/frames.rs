@@ -1,25 +1,27 @@
 //! The frames of a chain that an assembly's joints hold (a segment's end,
-//! the tip), with what the joints' rows need of them: by the sweep out to
-//! points (`points.rs`) on dual numbers along qd, so that one sweep gives
-//! each frame's pose, its velocity, its acceleration at qdd = 0 and its
-//! columns d/dq. The joints' rows are derived on these frame variables
-//! (`eomgen`'s assembly; the kernel layer's `joints` module), not on the links: an
-//! assembly's constraint kernels are then the size of its joints, not of
-//! its elements times its joints.
+//! the tip), with what the joints' rows need of them: each frame's pose,
+//! its velocity, its acceleration at qdd = 0 and its columns d/dq, by one
+//! sweep out over the links' cells in `f64` (the forward pass of
+//! `mass_bias`: the cells' convective accelerations carried from frame to
+//! frame, the twists each coordinate's rate gives the frames, as the
+//! contact points' sweep composes them). The joints' rows are derived on
+//! these frame variables (`eomgen`'s assembly; the kernel layer's `joints`
+//! module), not on the links: an assembly's constraint kernels are then
+//! the size of its joints, not of its elements times its joints.
 //!
 //! A frame's variables ([`frame`]) are its origin, its planar angle and its
 //! quaternion, as the generator's joints read them. The angle is the sum
-//! of the base's and every link's turn, and the quaternion their product
-//! (`PointMotion::angle`), as the generator composes them: a link turns
-//! by less than a half turn.
+//! of the base's and every link's turn, and the quaternion the product of
+//! the base's and every link's (w >= 0), as the generator composes them:
+//! a link turns by less than a half turn.
 
 use serde::{Deserialize, Serialize};
 
-use super::num::{add, cross};
-use super::points::{Asked, ContactPoint, PointMotion, sweep};
-use super::{Cells, LinkLayout};
-use crate::dual::Dual;
-use crate::rotation::quat_mul;
+use super::{
+    CELL_PARAMS, Cells, LinkLayout, Loads, M3, MAX_LINK_DOF, V3, add, base_orientation, cell,
+    cross, link_params, local, mat_mat, mat_vec, scale, sub,
+};
+use crate::rotation::{quat_mul, to_unit_quaternion};
 
 /// A frame of an arm that a joint may hold.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -61,8 +63,21 @@ fn link_of(layout: &LinkLayout, f: ArmFrame) -> usize {
     }
 }
 
+/// A frame's motion as the sweep reaches it: the world's.
+struct Motion {
+    r: M3,
+    point: V3,
+    v: V3,
+    acc: V3,
+    w: V3,
+    alpha: V3,
+    angle: f64,
+    quat: [f64; 4],
+}
+
 /// The frames `which` of the chain at (q, qd, p), [`frame::len`] values
 /// each, into `out` in their order.
+#[inline(always)]
 pub fn frames<C: Cells + ?Sized>(
     layout: &LinkLayout,
     cells: &mut C,
@@ -72,64 +87,108 @@ pub fn frames<C: Cells + ?Sized>(
     which: &[ArmFrame],
     out: &mut [f64],
 ) {
-    let len = frame::len(layout.dof);
+    let n = layout.dof;
+    let len = frame::len(n);
     assert_eq!(out.len(), which.len() * len, "a frame's values each");
-    // The sweep meets points in the links' order.
-    let mut order: Vec<usize> = (0..which.len()).collect();
-    order.sort_by_key(|&i| link_of(layout, which[i]));
-    let points: Vec<ContactPoint> = (order.iter())
-        .map(|&i| ContactPoint {
-            link: link_of(layout, which[i]),
-            at: 1.0,
-        })
-        .collect();
-    let asked = Asked {
-        columns: true,
-        spin: true,
-        turns: true,
+    let Some(last) = which.iter().map(|&f| link_of(layout, f)).max() else {
+        return;
     };
-    let at = (q, qd, Some(qd), p);
-    sweep::<Dual, C>(
-        layout,
-        cells,
-        at,
-        (&points, |_| true),
-        (asked, None),
-        |j, m| {
-            let f = order[j];
-            let tip = which[f] == ArmFrame::Tip;
-            write(layout, tip, m, (qd, p), &mut out[f * len..(f + 1) * len]);
-        },
-    );
+    let planar = layout.base_angle.is_some();
+    let loads = Loads::of(layout, cells);
+    let mut params = [0.0; CELL_PARAMS];
+    let (r, quat) = base_orientation(layout, p);
+    let mut m = Motion {
+        r,
+        point: layout.base_position.map(|i| p[i]),
+        v: [0.0; 3],
+        acc: [0.0; 3],
+        w: [0.0; 3],
+        alpha: [0.0; 3],
+        angle: layout.base_angle.map_or(0.0, |i| p[i]),
+        quat,
+    };
+    // Per arm coordinate, the twist (W, V) its rate gives the frame the
+    // sweep has reached, about the world origin.
+    let mut twists = vec![([0.0; 3], [0.0; 3]); n];
+    let mut c = [0.0; cell::len(MAX_LINK_DOF)];
+    for (k, spec) in layout.links.iter().enumerate().take(last + 1) {
+        let nc = spec.map.len();
+        let (x, xd) = (local(spec, p, q), local(spec, p, qd));
+        link_params(&mut params, spec, p, loads.values());
+        cells.one(
+            spec.cell,
+            &x[..nc],
+            &xd[..nc],
+            &params,
+            &mut c[..cell::len(nc)],
+        );
+        let v3 = |i: usize| [c[i], c[i + 1], c[i + 2]];
+        let turn = |i: usize| mat_vec(&m.r, v3(i));
+        let rel: M3 = std::array::from_fn(|i| v3(cell::ROTATION + 3 * i));
+        let (d, dd, ddd) = (turn(cell::END), turn(cell::END_RATE), turn(cell::END_ACCEL));
+        let (w_rel, w_rel_d) = (turn(cell::OMEGA), turn(cell::OMEGA_RATE));
+        let end = add(m.point, d);
+        for f in 0..nc {
+            let col = cell::COLUMNS + 12 * f;
+            let s_w = turn(col);
+            let twist = (s_w, sub(turn(col + 3), cross(s_w, end)));
+            let map = &spec.map[f];
+            let sc = map.scale.map_or(1.0, |i| p[i]);
+            for &(a, weight) in &map.terms {
+                let (tw, tv) = &mut twists[a];
+                *tw = add(*tw, scale(sc * weight, twist.0));
+                *tv = add(*tv, scale(sc * weight, twist.1));
+            }
+        }
+        let (w, alpha) = (m.w, m.alpha);
+        m.acc = add(
+            add(add(m.acc, cross(alpha, d)), cross(w, cross(w, d))),
+            add(scale(2.0, cross(w, dd)), ddd),
+        );
+        m.alpha = add(add(alpha, cross(w, w_rel)), w_rel_d);
+        m.v = add(add(m.v, cross(w, d)), dd);
+        m.w = add(w, w_rel);
+        m.point = end;
+        // The plane's joints read the angle, space's the quaternion.
+        match planar {
+            true => m.angle += rel[1][0].atan2(rel[0][0]),
+            false => m.quat = quat_mul(m.quat, to_unit_quaternion(&rel)),
+        }
+        m.r = mat_mat(&m.r, &rel);
+        for (f, &at) in which.iter().enumerate() {
+            if link_of(layout, at) == k {
+                let tip = at == ArmFrame::Tip;
+                write(
+                    layout,
+                    tip,
+                    &m,
+                    &twists,
+                    p,
+                    &mut out[f * len..(f + 1) * len],
+                );
+            }
+        }
+    }
 }
 
-/// A link end's motion `m` (on duals along qd) as a frame's values, moved
-/// out along the tip body where `tip` and the chain has one with a length.
+/// A link end's motion `m` and the coordinates' twists there as a frame's
+/// values, moved out along the tip body where `tip` and the chain has one
+/// with a length.
 fn write(
     layout: &LinkLayout,
     tip: bool,
-    m: &PointMotion<Dual>,
-    (qd, p): (&[f64], &[f64]),
+    m: &Motion,
+    twists: &[(V3, V3)],
+    p: &[f64],
     o: &mut [f64],
 ) {
     use frame::*;
     let n = layout.dof;
-    let value = |v: [Dual; 3]| v.map(|x| x.v);
-    let rate = |v: [Dual; 3]| v.map(|x| x.d);
-    // The angular velocity and its rate at qdd = 0 from the angular
-    // columns (and their derivatives along qd).
-    let (mut w, mut alpha) = ([0.0; 3], [0.0; 3]);
-    for (col, &r) in m.spin.iter().zip(qd) {
-        w = add(w, value(*col).map(|c| c * r));
-        alpha = add(alpha, rate(*col).map(|c| c * r));
-    }
-    let (mut point, mut v, mut a) = (value(m.p), value(m.v), rate(m.v));
+    let (w, alpha) = (m.w, m.alpha);
+    let (mut point, mut v, mut a) = (m.point, m.v, m.acc);
     // A tip body's far end: carried rigidly by the tip's frame.
     let offset = match (tip, layout.tip_length) {
-        (true, Some(i)) => {
-            let r = m.rotation.map(|row| row.map(|x| x.v));
-            Some([r[0][0], r[1][0], r[2][0]].map(|c| p[i] * c))
-        }
+        (true, Some(i)) => Some([m.r[0][0], m.r[1][0], m.r[2][0]].map(|c| p[i] * c)),
         _ => None,
     };
     if let Some(d) = offset {
@@ -139,7 +198,7 @@ fn write(
     }
     let quat = m.quat;
     // q' = (0, w) q / 2 for the world's angular velocity w.
-    let turn = |w: [f64; 3], q: [f64; 4]| quat_mul([0.0, w[0], w[1], w[2]], q).map(|c| 0.5 * c);
+    let turn = |w: V3, q: [f64; 4]| quat_mul([0.0, w[0], w[1], w[2]], q).map(|c| 0.5 * c);
     let quat_rate = turn(w, quat);
     let quat_accel = add4(turn(alpha, quat), turn(w, quat_rate));
     o[POINT..POINT + 3].copy_from_slice(&point);
@@ -152,11 +211,9 @@ fn write(
     o[ACCEL + ANGLE] = alpha[2];
     o[ACCEL + QUAT..ACCEL + QUAT + 4].copy_from_slice(&quat_accel);
     let columns = &mut o[COLUMNS..];
-    for (k, (col, spin)) in m.columns.iter().zip(m.spin).enumerate() {
-        let (mut c, s) = (value(*col), value(*spin));
-        if let Some(d) = offset {
-            c = add(c, cross(s, d));
-        }
+    for (k, &(s, vel)) in twists.iter().enumerate() {
+        // The point's column: the twist's velocity there.
+        let c = add(vel, cross(s, point));
         let dq = turn(s, quat);
         for i in 0..3 {
             columns[(POINT + i) * n + k] = c[i];

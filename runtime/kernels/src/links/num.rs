@@ -16,8 +16,6 @@ pub(super) trait Num:
     /// Output `i` of a cell's outputs (`len` values, then, for a dual
     /// number, their derivatives).
     fn of_cell(out: &[f64], len: usize, i: usize) -> Self;
-    /// Its value, without its derivative.
-    fn value(self) -> f64;
 }
 
 impl Num for f64 {
@@ -29,10 +27,6 @@ impl Num for f64 {
     #[inline(always)]
     fn of_cell(out: &[f64], _len: usize, i: usize) -> f64 {
         out[i]
-    }
-    #[inline(always)]
-    fn value(self) -> f64 {
-        self
     }
 }
 
@@ -48,10 +42,6 @@ impl Num for Dual {
             v: out[i],
             d: out[len + i],
         }
-    }
-    #[inline(always)]
-    fn value(self) -> f64 {
-        self.v
     }
 }
 

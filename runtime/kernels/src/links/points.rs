@@ -136,12 +136,6 @@ pub(super) struct PointMotion<'a, N> {
     pub columns: &'a [[N; 3]],
     pub rotation: [[N; 3]; 3],
     pub spin: &'a [[N; 3]],
-    /// Where asked ([`Asked::turns`]): the section's planar angle about z
-    /// (the base's and each link's turn, summed: not wrapped) and its
-    /// quaternion (the base's and each link's, w >= 0, composed), values
-    /// alone.
-    pub angle: f64,
-    pub quat: [f64; 4],
 }
 
 /// What a sweep computes besides the points' positions.
@@ -152,20 +146,6 @@ pub(super) struct Asked {
     /// The section's rotation and angular columns (with `columns`; else
     /// the rotation is the link's base frame's and no angular columns).
     pub spin: bool,
-    /// The section's angle and quaternion ([`PointMotion::angle`]).
-    pub turns: bool,
-}
-
-/// A frame's turn as the joints read it: the planar angle and the
-/// quaternion, each link's turn (its relative rotation `rel`, rows, of
-/// less than a half turn) added on.
-#[inline(always)]
-fn turned<N: Num>((angle, quat): (f64, [f64; 4]), rel: &[[N; 3]; 3]) -> (f64, [f64; 4]) {
-    let rel = rel.map(|row| row.map(N::value));
-    (
-        angle + rel[1][0].atan2(rel[0][0]),
-        crate::rotation::quat_mul(quat, crate::rotation::to_unit_quaternion(&rel)),
-    )
 }
 
 /// One cell at (x, xd) moving along dx (all `nc` long; None: not moving)
@@ -217,8 +197,7 @@ pub(super) fn sweep<N: Num, C: Cells + ?Sized>(
     };
     let last_link = points[last].link;
     let v0 = [N::ZERO; 3];
-    let (base, base_quat) = super::base_orientation(layout, p);
-    let mut turn = (layout.base_angle.map_or(0.0, |i| p[i]), base_quat);
+    let base = super::base_orientation(layout, p).0;
     let mut r = base.map(|row| row.map(N::constant));
     let mut pos: [N; 3] = layout.base_position.map(|i| N::constant(p[i]));
     // Per arm coordinate, the twist (W, V) its rate gives the frame the
@@ -260,12 +239,6 @@ pub(super) fn sweep<N: Num, C: Cells + ?Sized>(
             let point = add(pos, mat_vec(&r, cell_v3(&out, len, cell::END)));
             let mut v = v0;
             let mut rotation = r;
-            let mut at_turn = turn;
-            if asked.turns {
-                let rel: [[N; 3]; 3] =
-                    std::array::from_fn(|i| cell_v3(&out, len, cell::ROTATION + 3 * i));
-                at_turn = turned(turn, &rel);
-            }
             if columns {
                 for (a, col) in own.iter_mut().enumerate() {
                     let (w, v) = twists[a];
@@ -301,8 +274,6 @@ pub(super) fn sweep<N: Num, C: Cells + ?Sized>(
                 columns: &own,
                 rotation,
                 spin: &own_spin,
-                angle: at_turn.0,
-                quat: at_turn.1,
             };
             emit(i, &motion);
         }
@@ -332,9 +303,6 @@ pub(super) fn sweep<N: Num, C: Cells + ?Sized>(
                     *tv = add(*tv, scale(w, twist.1));
                 }
             }
-        }
-        if asked.turns {
-            turn = turned(turn, &rel);
         }
         r = mat_mat(&r, &rel);
         pos = end;
