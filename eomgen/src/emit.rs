@@ -1764,7 +1764,6 @@ fn emit_kernels(
             KernelKind::Contact | KernelKind::ContactJacobian | KernelKind::ContactJvp => {
                 b.rest_contact.is_some()
             }
-            KernelKind::Constraints => joints_on_frames(b).is_some(),
             _ => false,
         });
         match (&tapes.links, kind) {
@@ -1917,10 +1916,9 @@ fn emit_arm_blocks(
     let n_base = tapes.info.parameters.len();
     let own = tapes.info.derived;
     let (starts, n_derived) = blocks.derived_layout(own);
-    let held = joints_on_frames(blocks).is_some();
     let modules = blocks.kinds.iter().enumerate().map(|(k, kind)| {
         let name = format_ident!("arm_{}", k);
-        let items = model_tokens(kind, held);
+        let items = model_tokens(kind);
         quote! {
             /// The kernels of one arm structure of this assembly, as a single arm's.
             #[allow(dead_code, unused_imports)]
@@ -1996,12 +1994,10 @@ fn emit_arm_blocks(
     let n_mb = dof * (dof + 1) / 2 + dof;
     let inputs = quote!(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params]);
     let contact = emit_arm_contact(tapes, blocks, dof, n_params);
-    let joints = emit_frame_joints(tapes, blocks, dof, n_params);
     quote! {
         #(#modules)*
         #(#flat)*
         #contact
-        #joints
         /// Kernel `mass_bias`: the rest of the system's, then each arm's in its block.
         pub fn mass_bias(#inputs, out: &mut [f64; #n_mb]) {
             rest_mass_bias(t, q, qd, qdd, dir, p, out);
@@ -2023,85 +2019,6 @@ fn emit_arm_blocks(
         pub fn derived(#inputs, out: &mut [f64; #n_derived]) {
             own_derived(t, q, qd, qdd, dir, p, (&mut out[..#own]).try_into().expect("own derived parameters"));
             #({ #derived })*
-        }
-    }
-}
-
-/// The joints on the arms' frames where a compiled-in assembly takes them
-/// so: where every arm they hold runs its mass + bias on the link
-/// recursion too. A chain short enough to keep its flat `MassBias`
-/// (`build::cell`'s thresholds) keeps flat joints as well, quicker for
-/// its few links: falling_ball's, 0.37 us against 1.6 us through its
-/// frames.
-fn joints_on_frames(blocks: &ArmBlocks) -> Option<&runtime::joints::FrameJoints> {
-    let recursion = |f: &runtime::joints::JointFrame| {
-        let kind = &blocks.kinds[blocks.arms[f.arm].kind];
-        kind.links.as_ref().is_some_and(|l| l.mass_bias)
-    };
-    (blocks.joints.as_ref()).filter(|j| j.frames.iter().all(recursion))
-}
-
-/// The `constraints` kernel through the arms' frames
-/// (`ArmBlocks::joints`): each held frame from its arm's module
-/// (`frames`), the joints' rows on them (`joint_rows`), put together by
-/// `runtime::joints`. Nothing without `joints`.
-fn emit_frame_joints(
-    tapes: &TapeSet,
-    blocks: &ArmBlocks,
-    dof: usize,
-    n_params: usize,
-) -> TokenStream {
-    let Some(joints) = joints_on_frames(blocks) else {
-        return quote!();
-    };
-    let (starts, _) = blocks.derived_layout(tapes.info.derived);
-    let n_base = tapes.info.parameters.len();
-    let n_frames = joints.frames.len();
-    let n_aux = runtime::links::frame::STATE * n_frames;
-    let m_rows = tapes.info.constraints.len();
-    let n_rows = runtime::joints::rows_len(m_rows, dof, n_frames);
-    let n_out = m_rows * (dof + 2);
-    let rows = KernelEmitter::new(&joints.rows);
-    let reads_aux = rows.aux_len() > 0;
-    let kernel = rows.emit("joint_rows", dof, n_params, n_aux);
-    let (mut motions, mut held) = (Vec::new(), Vec::new());
-    for (f, jf) in joints.frames.iter().enumerate() {
-        let a = &blocks.arms[jf.arm];
-        let module = format_ident!("arm_{}", a.kind);
-        let kind = &blocks.kinds[a.kind];
-        let len = kind.info.parameters.len() + kind.info.derived;
-        let [aq, aqd, _, ap] = arm_slices(a.first, a.dof, n_base + starts[jf.arm], len);
-        let motion = format_ident!("frame_{}", f);
-        let n_motion = runtime::links::frame::len(a.dof);
-        let at = match jf.at {
-            runtime::links::ArmFrame::Tip => quote!(runtime::links::ArmFrame::Tip),
-            runtime::links::ArmFrame::SegmentEnd(s) => {
-                quote!(runtime::links::ArmFrame::SegmentEnd(#s))
-            }
-        };
-        motions.push(quote! {
-            let mut #motion = [0.0f64; #n_motion];
-            #module::frames(#aq, #aqd, #ap, &[#at], &mut #motion);
-        });
-        let (first, m) = (a.first, a.dof);
-        held.push(quote!(runtime::joints::HeldFrame { first: #first, dof: #m, motion: &#motion }));
-    }
-    let call = match reads_aux {
-        true => quote!(joint_rows(t, q, qd, qdd, dir, p, &aux, &mut rows)),
-        false => quote!(joint_rows(t, q, qd, qdd, dir, p, &mut rows)),
-    };
-    quote! {
-        #kernel
-        /// Kernel `constraints`: the joints' rows on the frames they hold,
-        /// each frame from its arm's link cells (`runtime::joints`).
-        pub fn constraints(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; 2 * #dof], p: &[f64; #n_params], out: &mut [f64; #n_out]) {
-            #(#motions)*
-            let held = [#(#held),*];
-            let mut aux = [0.0f64; #n_aux];
-            runtime::joints::aux(&held, &mut aux);
-            let mut rows = [0.0f64; #n_rows];
-            #call;
-            runtime::joints::constraints(#dof, &held, &rows, out);
         }
     }
 }
@@ -2256,7 +2173,7 @@ fn emit_arm_contact(
 
 /// Rust source of one compiled-in model.
 pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
-    let tokens = unsuffixed(model_tokens(tapes, false));
+    let tokens = unsuffixed(model_tokens(tapes));
     let file: syn::File = syn::parse2(tokens).expect("emitted tokens parse as a Rust file");
     format!(
         "// @generated by eomgen from {source_path}: do not edit; `cargo build` or `softarm derive` rewrites it.\n\
@@ -2267,10 +2184,8 @@ pub fn emit_model(source_path: &str, tapes: &TapeSet) -> String {
 }
 
 /// The items of one model's module: its constants, its `Compiled` kernels
-/// and their functions (an assembly's arms' in modules of their own);
-/// `held`: an arm whose frames the assembly's joints hold
-/// (`runtime::links::frames`, for its `constraints`).
-fn model_tokens(tapes: &TapeSet, held: bool) -> TokenStream {
+/// and their functions (an assembly's arms' in modules of their own).
+fn model_tokens(tapes: &TapeSet) -> TokenStream {
     // An assembly on its arms' kernels has their parameters after its own
     // derived ones.
     let mut info = tapes.info.clone();
@@ -2306,9 +2221,6 @@ fn model_tokens(tapes: &TapeSet, held: bool) -> TokenStream {
     if let Some(links) = &tapes.links {
         let n_out = tapes.mass_bias.outputs.len();
         kernels.push(emit_link_recursion(links, dof, n_params, n_out));
-        if held {
-            kernels.push(emit_held_frames(dof, n_params));
-        }
     } else {
         kernels.push(emit_arm_cells(tapes));
     }
@@ -2425,26 +2337,6 @@ fn emit_arm_cells(tapes: &TapeSet) -> TokenStream {
     quote! {
         /// This model's cells, for chains of other lengths to link.
         pub static CELLS: &[runtime::links::CompiledCell] = &[#(#arm_cells)*];
-    }
-}
-
-/// An arm's `frames`: the frames of it that an assembly's joints hold
-/// (`runtime::links::frames`), by its link cells.
-fn emit_held_frames(dof: usize, n_params: usize) -> TokenStream {
-    quote! {
-        /// The frames of this arm that the assembly's joints hold
-        /// (`runtime::links::frames`).
-        pub fn frames(q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], which: &[runtime::links::ArmFrame], out: &mut [f64]) {
-            runtime::cpu::require_fma();
-            // SAFETY: `require_fma` has checked that the processor has FMA.
-            unsafe { frames_fma(q, qd, p, which, out) }
-        }
-        #[inline(never)]
-        #[cfg_attr(target_arch = "x86_64", target_feature(enable = "fma"))]
-        unsafe fn frames_fma(q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], which: &[runtime::links::ArmFrame], out: &mut [f64]) {
-            let mut cells = LinkCells { q, qd, p };
-            runtime::links::frames(&LINKS, &mut cells, q, qd, p, which, out)
-        }
     }
 }
 
