@@ -54,8 +54,11 @@ impl<'a> Links<'a> {
     /// kernels are small, and quicker than the recursion in C as in Rust
     /// (the soft finger's state derivative 5 against 17 us).
     pub fn new(links: &'a LinkKernels, dof: usize) -> Option<Self> {
-        // Loads along the arm: the flat kernels carry them in C.
-        (links.mass_bias && links.layout.along.is_empty()).then_some(Self {
+        // Loads along the arm, a driven base translation: the flat kernels
+        // carry them in C.
+        let layout = &links.layout;
+        let covered = layout.along.is_empty() && layout.base_translation.is_none();
+        (links.mass_bias && covered).then_some(Self {
             links,
             dof,
             rows: None,

@@ -788,6 +788,20 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
     }
 }
 
+/// `text` on a base moved along the path of the channels `inputs` (sines
+/// in x and y, still in z).
+fn shaken(text: &str, inputs: &str) -> String {
+    let signals = "[inputs.sx]\nkind = \"sine\"\namplitude = 0.02\nfrequency = 3.0\n\
+                   [inputs.sy]\nkind = \"sine\"\namplitude = 0.01\nfrequency = 2.0\n\
+                   [inputs.sz]\nkind = \"constant\"\nvalue = 0.0\n";
+    let text = text.replacen(
+        "[base]",
+        &format!("[base]\ntranslation_inputs = {inputs}"),
+        1,
+    );
+    format!("{text}{signals}")
+}
+
 /// A chain of every link shape and tip the recursion covers: every
 /// bundled chain, actuated arms of every covered method, and cantilever3d
 /// under rom slices, stretch, thinning, vc, tip wrenches and tip bodies;
@@ -807,6 +821,10 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
     let loaded = file("loaded3d", LOADED_3D);
     let loaded2d = file("loaded2d", LOADED_2D);
     let kinked2d = file("kinked2d", KINKED_2D);
+    // The loaded arms on a base moved along a driven path: its
+    // acceleration carries every body, its velocity every point.
+    let shaken3d = file("shaken3d", &shaken(LOADED_3D, r#"["sx", "sy", "sz"]"#));
+    let shaken2d = file("shaken2d", &shaken(LOADED_2D, r#"["sx", "sy"]"#));
     // Chamber levers that vary along a segment (tapered, the chambers
     // nearer the axis towards the tip): each element's own loads.
     let varying = file(
@@ -826,6 +844,8 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
         (&loaded2d, &[]),
         // Kinks in the plane: links of no coordinates.
         (&kinked2d, &[]),
+        (&shaken3d, &[]),
+        (&shaken2d, &[]),
         (&varying, &[]),
         (&varying2d, &[]),
         // Planar chains: rigid links and pcc arcs (whose inertia changes
@@ -1368,6 +1388,12 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
     let pinch = dir.path().join("pinch.toml");
     std::fs::write(&pinch, PINCH).unwrap();
     let pinch = pinch.to_string_lossy().into_owned();
+    // A finger on a base moved along a driven path, tapping: the contact
+    // points' velocities carry the base's.
+    let shaken_tap = dir.path().join("shaken_tap.toml");
+    let text = std::fs::read_to_string(model_path("finger_tap")).unwrap() + "\n";
+    std::fs::write(&shaken_tap, shaken(&text, r#"["sx", "sy"]"#)).unwrap();
+    let shaken_tap = shaken_tap.to_string_lossy().into_owned();
     let (tentacle_ball, rod_ball, rom_ball) = (
         on_sphere("tentacle_ball", "tentacle3d"),
         on_sphere("rod_ball", "rod_swing"),
@@ -1393,6 +1419,7 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         // contact kernels (3D, planar with friction).
         ("finger_tap", "segment.0.elements=7"),
         ("wrap", "segment.0.elements=9"),
+        (shaken_tap.as_str(), "segment.0.elements=7"),
         (tentacle_ball.as_str(), "segment.0.elements=5"),
         (rod_ball.as_str(), "segment.0.elements=3"),
         (rom_ball.as_str(), "segment.0.quadrature=3"),

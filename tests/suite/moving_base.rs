@@ -304,11 +304,16 @@ value = 0.0
                 accelerations(&still, t, &q, &qd),
                 accelerations(&moving, t, &q, &qd),
             );
+            // The table's second differences are g to its samples'
+            // rounding (3e-15 of it at t = 1.23), which a pcc arm's M,
+            // conditioned about 1e5 by its twist's small inertia, makes
+            // 1e-9 of qdd: the flat tapes and the link cells of the same
+            // still arm differ by 5e-10 there.
             for i in 0..n {
                 assert_close(
                     b[i],
                     a[i],
-                    1e-9,
+                    1e-8,
                     1e-9,
                     format_args!("{method}: qdd[{i}] ({}) at t = {t}", names[i]),
                 );

@@ -8,8 +8,8 @@
 //! dissipative generalised forces, as one tape of the link's coordinates
 //! and [`CELL_PARAMS`] parameters. Links of the same shape share a cell.
 //!
-//! Chains this covers: every segment pcc, vc or rom, base still, no
-//! driven joint torques. Chambers and tendons load each element's strain
+//! Chains this covers: every segment pcc, vc or rom, the base still or
+//! moved along a driven path (not turned), no driven joint torques. Chambers and tendons load each element's strain
 //! by their segment's loads (`actuation::segment_loads`: linear in the
 //! strain; an element's own where its chamber levers vary along the
 //! segment), which a small kernel of the parameters gives and the cells
@@ -30,7 +30,7 @@ use runtime::links::{
 
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{
-    ElementParam, Joints, KinkParam, LoadParam, Method, Param, ParamLayout, Structure, Xyz,
+    ElementParam, Joints, KinkParam, LoadParam, Method, Param, ParamLayout, Rate, Structure, Xyz,
 };
 
 use super::planar_cell::{derive_planar_cell, derive_planar_kink_cell};
@@ -243,7 +243,6 @@ fn covered(st: &Structure) -> bool {
             .iter()
             .all(|g| crate::method::of(g.method).link_cells()))
         && st.torques.is_empty()
-        && !st.base_translates
         && st.base_turns == 0
         && (st.segments.iter()).all(|g| !g.anisotropic)
         && st.fluid.is_none()
@@ -451,6 +450,9 @@ fn globals(st: &Structure, params: &ParamLayout) -> LinkLayout {
     LinkLayout {
         gravity: triple(Param::Gravity),
         base_position: triple(Param::BasePosition),
+        base_translation: st
+            .base_translates
+            .then(|| Rate::ALL.map(|r| Xyz::ALL.map(|c| index(Param::BaseTranslation(r, c))))),
         base_rotation: match spatial {
             true => {
                 std::array::from_fn(|i| index(Param::BaseRotation((i / 3) as u8, (i % 3) as u8)))

@@ -158,7 +158,7 @@ pub fn contact_bounds<C: Cells>(
     let mut params: Vec<[f64; CELL_PARAMS]> = Vec::new();
     kept.params(layout, cells, p, &mut params);
     let mut r = super::base_orientation(layout, p).0;
-    let mut pos = layout.base_position.map(|i| p[i]);
+    let mut pos = super::base_motion(layout, p).0;
     // Each link's base origin and end, as far as the last element's.
     let reach = elements.last().map_or(0, |e| e.last + 1);
     let mut ends = Vec::with_capacity(reach + 1);

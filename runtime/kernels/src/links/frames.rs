@@ -18,8 +18,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::{
-    CELL_PARAMS, Cells, LinkLayout, Loads, M3, MAX_LINK_DOF, V3, add, base_orientation, cell,
-    cross, link_params, local, mat_mat, mat_vec, scale, sub,
+    CELL_PARAMS, Cells, LinkLayout, Loads, M3, MAX_LINK_DOF, V3, add, base_motion,
+    base_orientation, cell, cross, link_params, local, mat_mat, mat_vec, scale, sub,
 };
 use crate::rotation::{quat_mul, to_unit_quaternion};
 
@@ -97,11 +97,12 @@ pub fn frames<C: Cells + ?Sized>(
     let loads = Loads::of(layout, cells);
     let mut params = [0.0; CELL_PARAMS];
     let (r, quat) = base_orientation(layout, p);
+    let (point, v, acc) = base_motion(layout, p);
     let mut m = Motion {
         r,
-        point: layout.base_position.map(|i| p[i]),
-        v: [0.0; 3],
-        acc: [0.0; 3],
+        point,
+        v,
+        acc,
         w: [0.0; 3],
         alpha: [0.0; 3],
         angle: layout.base_angle.map_or(0.0, |i| p[i]),

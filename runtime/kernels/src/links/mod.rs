@@ -173,6 +173,11 @@ pub struct LinkLayout {
     pub loads: usize,
     pub gravity: [usize; 3],
     pub base_position: [usize; 3],
+    /// A base moved along a driven path: its offset from `base_position`,
+    /// the offset's rate and its acceleration (the slots of each's x, y,
+    /// z), inputs the runtime writes at every evaluation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base_translation: Option<[[usize; 3]; 3]>,
     /// Rows of the base rotation (3D chains).
     pub base_rotation: [usize; 9],
     /// A planar chain's base angle about z, which stands for the rotation
@@ -358,6 +363,24 @@ pub(crate) fn base_orientation(layout: &LinkLayout, p: &[f64]) -> ([[f64; 3]; 3]
             layout.base_quaternion.map(|i| p[i]),
         ),
     }
+}
+
+/// The base's origin, its velocity and its acceleration: a driven base
+/// translation's, else at rest at `base_position`.
+pub(crate) fn base_motion(layout: &LinkLayout, p: &[f64]) -> (V3, V3, V3) {
+    let pos = layout.base_position.map(|i| p[i]);
+    match layout.base_translation {
+        None => (pos, [0.0; 3], [0.0; 3]),
+        Some([x, v, a]) => (add(pos, x.map(|i| p[i])), v.map(|i| p[i]), a.map(|i| p[i])),
+    }
+}
+
+/// The gravity the sums of forces see: gravity less a driven base's
+/// acceleration, which carries every body alike (so that a base lifted at
+/// g is gravity, to the last bit).
+pub(crate) fn felt_gravity(layout: &LinkLayout, p: &[f64]) -> V3 {
+    let g = layout.gravity.map(|i| p[i]);
+    sub(g, base_motion(layout, p).2)
 }
 
 /// A link's cell coordinates (or their rates, accelerations, directions)
@@ -682,9 +705,9 @@ fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scra
     s.local_force.resize(total, 0.0);
     evaluate_cells(layout, cells, p, s);
 
-    let gravity = layout.gravity.map(|i| p[i]);
+    let gravity = felt_gravity(layout, p);
     let mut r: M3 = base_orientation(layout, p).0;
-    let mut pos = layout.base_position.map(|i| p[i]);
+    let mut pos = base_motion(layout, p).0;
     let (mut omega, mut alpha, mut acc) = ([0.0; 3], [0.0; 3], [0.0; 3]);
     for (k, spec) in layout.links.iter().enumerate() {
         let nc = spec.map.len();

@@ -38,8 +38,8 @@ pub fn outputs<C: Cells>(
 ) {
     let gravity: V3 = layout.gravity.map(|i| p[i]);
     let (mut r, mut quat) = super::base_orientation(layout, p);
-    let mut pos = layout.base_position.map(|i| p[i]);
-    let (mut v, mut omega) = ([0.0; 3], [0.0; 3]);
+    let (mut pos, mut v, _) = super::base_motion(layout, p);
+    let mut omega = [0.0; 3];
     let (mut ke, mut pe) = (0.0, 0.0);
     let mut params: Vec<[f64; CELL_PARAMS]> = Vec::new();
     cell_params(layout, cells, p, &mut params);

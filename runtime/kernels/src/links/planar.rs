@@ -232,11 +232,13 @@ fn forward<C: Cells>(
 ) -> Tip {
     let loads = Loads::of(layout, cells);
     let loads = loads.values();
-    let gravity = [p[layout.gravity[0]], p[layout.gravity[1]]];
+    let felt = super::felt_gravity(layout, p);
+    let gravity = [felt[0], felt[1]];
     let (sn, cs) = layout.base_angle.map_or(0.0, |i| p[i]).sin_cos();
+    let pos = super::base_motion(layout, p).0;
     let mut frame = Frame {
         turn: [cs, sn],
-        pos: [p[layout.base_position[0]], p[layout.base_position[1]]],
+        pos: [pos[0], pos[1]],
         omega: 0.0,
         alpha: 0.0,
         acc: [0.0; 2],

@@ -199,7 +199,11 @@ pub(super) fn sweep<N: Num, C: Cells + ?Sized>(
     let v0 = [N::ZERO; 3];
     let base = super::base_orientation(layout, p).0;
     let mut r = base.map(|row| row.map(N::constant));
-    let mut pos: [N; 3] = layout.base_position.map(|i| N::constant(p[i]));
+    // A driven base's velocity moves every point; it does not move along
+    // dq.
+    let (base_pos, base_v, _) = super::base_motion(layout, p);
+    let mut pos: [N; 3] = base_pos.map(N::constant);
+    let moving_base = base_v.map(N::constant);
     // Per arm coordinate, the twist (W, V) its rate gives the frame the
     // sweep has reached, about the world origin.
     let mut twists = vec![(v0, v0); if columns { n } else { 0 }];
@@ -237,7 +241,7 @@ pub(super) fn sweep<N: Num, C: Cells + ?Sized>(
             let moving = (&xa[..nc], &xda[..nc], dxa.as_ref().map(|d| &d[..nc]));
             cell_at(cells, spec.cell, moving, len, &cut_params, &mut out);
             let point = add(pos, mat_vec(&r, cell_v3(&out, len, cell::END)));
-            let mut v = v0;
+            let mut v = moving_base;
             let mut rotation = r;
             if columns {
                 for (a, col) in own.iter_mut().enumerate() {

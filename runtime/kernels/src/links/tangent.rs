@@ -88,11 +88,11 @@ pub fn inverse_dynamics_tangent<C: Cells>(
     assert!(q.len() == n && qd.len() == n && qdd.len() == n && dir.len() == 2 * n);
     assert!(layout.links.iter().all(|l| l.map.len() <= MAX_LINK_DOF));
     let (dq, dqd) = dir.split_at(n);
-    let gravity: V3 = layout.gravity.map(|i| Dual::constant(p[i]));
+    let gravity: V3 = super::felt_gravity(layout, p).map(Dual::constant);
     let base = super::base_orientation(layout, p).0;
     let mut frame = Frame {
         r: base.map(|row| row.map(Dual::constant)),
-        pos: layout.base_position.map(|i| Dual::constant(p[i])),
+        pos: super::base_motion(layout, p).0.map(Dual::constant),
         omega: V0,
         alpha: V0,
         acc: V0,
