@@ -160,8 +160,8 @@ fn linked(
                 .into(),
         );
     }
-    if arms.iter().any(|s| s.fluid.is_some()) {
-        return Err("its fluid's buoyancy and drag are not link cells yet".into());
+    if arms.iter().any(|s| s.fluid == Some(true)) {
+        return Err("its fluid's drag is not a link cell yet".into());
     }
     let not_cells = || "not every one of its methods' elements is a link cell".to_string();
     let kernels: (Box<dyn Kernels>, String) = if structure.assembly.is_some() {

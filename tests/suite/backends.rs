@@ -788,6 +788,10 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
     }
 }
 
+/// Immersed without drag: each link's body buoyed by its share of its
+/// element's displaced fluid.
+const IMMERSED: &str = "\n[fluid]\ndensity = 1500.0\n";
+
 /// `text` on a base moved along the path of the channels `inputs` (sines
 /// in x and y, still in z).
 fn shaken(text: &str, inputs: &str) -> String {
@@ -821,10 +825,11 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
     let loaded = file("loaded3d", LOADED_3D);
     let loaded2d = file("loaded2d", LOADED_2D);
     let kinked2d = file("kinked2d", KINKED_2D);
-    // The loaded arms on a base moved along a driven path: its
-    // acceleration carries every body, its velocity every point.
+    // The loaded arms on a base moved along a driven path, and immersed.
     let shaken3d = file("shaken3d", &shaken(LOADED_3D, r#"["sx", "sy", "sz"]"#));
     let shaken2d = file("shaken2d", &shaken(LOADED_2D, r#"["sx", "sy"]"#));
+    let immersed3d = file("immersed3d", &format!("{ACTUATED_3D}{IMMERSED}"));
+    let immersed2d = file("immersed2d", &format!("{LOADED_2D}{IMMERSED}"));
     // Chamber levers that vary along a segment (tapered, the chambers
     // nearer the axis towards the tip): each element's own loads.
     let varying = file(
@@ -846,6 +851,8 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
         (&kinked2d, &[]),
         (&shaken3d, &[]),
         (&shaken2d, &[]),
+        (&immersed3d, &[]),
+        (&immersed2d, &[]),
         (&varying, &[]),
         (&varying2d, &[]),
         // Planar chains: rigid links and pcc arcs (whose inertia changes

@@ -30,7 +30,8 @@ use runtime::links::{
 
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{
-    ElementParam, Joints, KinkParam, LoadParam, Method, Param, ParamLayout, Rate, Structure, Xyz,
+    ElementParam, FluidParam, Joints, KinkParam, LoadParam, Method, Param, ParamLayout, Rate,
+    Structure, Xyz,
 };
 
 use super::planar_cell::{derive_planar_cell, derive_planar_kink_cell};
@@ -149,6 +150,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                 (actuated.iter()).position(|&(seg, el)| seg == s && el.is_none_or(|el| el == k));
             // A planar cell reads no spatial parameter: their slots repeat
             // the length's.
+            let displaced = displaced_volume(st, params, k);
             let length = index(Param::Element(k, ElementParam::Length));
             let params: Vec<usize> = (ElementParam::CELL.iter())
                 .chain(&ElementParam::REST_3D)
@@ -161,6 +163,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                     map: Vec::new(),
                     params: params.clone(),
                     load: None,
+                    displaced,
                 });
             }
             let own = links.len()..links.len() + maps.len();
@@ -170,6 +173,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                     map,
                     params: params.clone(),
                     load,
+                    displaced,
                 });
             }
             // An inextensible, unshearable centreline is its element's
@@ -232,6 +236,12 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     Some(kernels)
 }
 
+/// The slot of the volume element k displaces, where the arm is immersed:
+/// its bodies' buoyancy (`runtime::links::link_gravity`).
+fn displaced_volume(st: &Structure, params: &ParamLayout, k: usize) -> Option<usize> {
+    (st.fluid.is_some()).then(|| params.index(Param::Element(k, ElementParam::Volume)))
+}
+
 /// Whether the recursion may cover the structure, its elements' cells
 /// permitting (a planar element is covered when it is one body:
 /// `planar_cell`).
@@ -245,7 +255,8 @@ fn covered(st: &Structure) -> bool {
         && st.torques.is_empty()
         && st.base_turns == 0
         && (st.segments.iter()).all(|g| !g.anisotropic)
-        && st.fluid.is_none()
+        // Buoyancy is each link's felt gravity; drag is not a cell's yet.
+        && st.fluid != Some(true)
 }
 
 /// The chain's contact points (`points` an element, at s = 1/points, ...,
@@ -367,6 +378,7 @@ fn kink_link(params: &ParamLayout, s: usize, cell: usize, spatial: bool) -> Link
         map: Vec::new(),
         params,
         load: None,
+        displaced: None,
     }
 }
 
@@ -450,6 +462,10 @@ fn globals(st: &Structure, params: &ParamLayout) -> LinkLayout {
     LinkLayout {
         gravity: triple(Param::Gravity),
         base_position: triple(Param::BasePosition),
+        fluid_density: st
+            .fluid
+            .is_some()
+            .then(|| index(Param::Fluid(FluidParam::Density))),
         base_translation: st
             .base_translates
             .then(|| Rate::ALL.map(|r| Xyz::ALL.map(|c| index(Param::BaseTranslation(r, c))))),

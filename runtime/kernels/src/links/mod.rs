@@ -155,6 +155,10 @@ pub struct LinkSpec {
     /// loads are; None: none act on it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub load: Option<usize>,
+    /// The slot of the volume its element displaces, where the arm is
+    /// immersed (`LinkLayout::fluid_density`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub displaced: Option<usize>,
 }
 
 /// A chain of links and where its global parameters are.
@@ -178,6 +182,11 @@ pub struct LinkLayout {
     /// z), inputs the runtime writes at every evaluation.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub base_translation: Option<[[usize; 3]; 3]>,
+    /// An immersed arm's fluid density: each link's body is buoyed by the
+    /// weight of its share of its element's displaced fluid
+    /// ([`link_gravity`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fluid_density: Option<usize>,
     /// Rows of the base rotation (3D chains).
     pub base_rotation: [usize; 9],
     /// A planar chain's base angle about z, which stands for the rotation
@@ -381,6 +390,21 @@ pub(crate) fn base_motion(layout: &LinkLayout, p: &[f64]) -> (V3, V3, V3) {
 pub(crate) fn felt_gravity(layout: &LinkLayout, p: &[f64]) -> V3 {
     let g = layout.gravity.map(|i| p[i]);
     sub(g, base_motion(layout, p).2)
+}
+
+/// The gravity link `spec`'s body feels, `felt` ([`felt_gravity`]) less
+/// the buoyancy of an immersed arm: its element displaces rho V of fluid,
+/// shared among its bodies as their mass m_b is among the element's m,
+/// so that a body's buoyancy is m_b (rho V / m) g, opposite its weight.
+#[inline(always)]
+pub(crate) fn link_gravity(layout: &LinkLayout, spec: &LinkSpec, p: &[f64], felt: V3) -> V3 {
+    match (layout.fluid_density, spec.displaced) {
+        (Some(rho), Some(v)) => {
+            let lift = p[rho] * p[v] / p[spec.params[1]];
+            sub(felt, scale(lift, layout.gravity.map(|i| p[i])))
+        }
+        _ => felt,
+    }
 }
 
 /// A link's cell coordinates (or their rates, accelerations, directions)
@@ -748,7 +772,7 @@ fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scra
             m,
             lateral,
             axial,
-            force: scale(m, sub(body_a, gravity)),
+            force: scale(m, sub(body_a, link_gravity(layout, spec, p, gravity))),
             torque: add(
                 apply_body(lateral, axial, axis, body_alpha),
                 cross(body_w, iw),

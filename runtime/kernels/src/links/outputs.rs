@@ -59,7 +59,9 @@ pub fn outputs<C: Cells>(
         let body_v = add(add(v, cross(omega, cen)), cend);
         let body_w = add(omega, w_b);
         ke += kinetic(m, o[pose::LATERAL], o[pose::AXIAL], axis, body_v, body_w);
-        pe += o[pose::ENERGY] - m * dot(gravity, add(pos, cen));
+        // Weight, less an immersed body's buoyancy.
+        let g = super::link_gravity(layout, spec, p, gravity);
+        pe += o[pose::ENERGY] - m * dot(g, add(pos, cen));
         v = add(add(v, cross(omega, d)), dd);
         omega = add(omega, w_rel);
         pos = add(pos, d);

@@ -261,7 +261,15 @@ fn forward<C: Cells>(
             }
         };
         let nc = spec.map.len();
-        let (link, next) = place(&out, &frame, nc, xd, layout.variable_inertia, gravity);
+        let felt = super::link_gravity(layout, spec, p, [gravity[0], gravity[1], 0.0]);
+        let (link, next) = place(
+            &out,
+            &frame,
+            nc,
+            xd,
+            layout.variable_inertia,
+            [felt[0], felt[1]],
+        );
         s.links.push(link);
         frame = next;
     }

@@ -119,13 +119,14 @@ pub fn inverse_dynamics_tangent<C: Cells>(
             d: dxd.get(f).copied().unwrap_or(0.0),
         });
         let inertia_rates = layout.variable_inertia.then_some(&xd);
+        let felt = super::link_gravity(layout, spec, p, gravity.map(|g| g.v));
         links.push(link_forward(
             &mut frame,
             out,
             nc,
             &xdd,
             inertia_rates,
-            gravity,
+            felt.map(Dual::constant),
         ));
     }
     let mut wrench = tip_wrench(layout, &frame, p, gravity);
