@@ -32,6 +32,9 @@ pub struct BlockKernels {
     slots: RefCell<Vec<f64>>,
     /// The held frames' motions, the joints' `aux` and their rows.
     joint_scratch: RefCell<Vec<f64>>,
+    /// The arms' outputs before they are placed in the assembly's
+    /// ([`BlockKernels::scratch`]).
+    scratch: RefCell<Vec<f64>>,
 }
 
 impl BlockKernels {
@@ -55,6 +58,7 @@ impl BlockKernels {
             starts,
             slots: RefCell::new(Vec::new()),
             joint_scratch: RefCell::new(Vec::new()),
+            scratch: RefCell::new(Vec::new()),
         })
     }
 
@@ -76,6 +80,16 @@ impl BlockKernels {
             ..*inp
         };
         (kernels, first, arm)
+    }
+
+    /// `len` zeros for an arm's outputs, reused from call to call: a
+    /// right-hand side asks for every arm's mass + bias and contact, an
+    /// implicit step for 2n Jvp columns.
+    fn scratch(&self, len: usize) -> std::cell::RefMut<'_, Vec<f64>> {
+        let mut s = self.scratch.borrow_mut();
+        s.clear();
+        s.resize(len, 0.0);
+        s
     }
 
     fn rest(&self, tape: &Tape, inp: &Inputs, out: &mut [f64]) {
@@ -116,7 +130,7 @@ impl BlockKernels {
         for i in 0..self.blocks.arms.len() {
             let (kernels, first, arm) = self.arm(i, inp);
             let dof = arm.q.len();
-            let mut block = vec![0.0; dof * (dof + 1) / 2 + dof];
+            let mut block = self.scratch(dof * (dof + 1) / 2 + dof);
             kernels.eval(KernelKind::MassBias, &arm, &mut block);
             add_block(n, first, dof, &block, out);
         }
@@ -126,26 +140,29 @@ impl BlockKernels {
     /// as zeros, as every backend's).
     fn jvp(&self, inp: &Inputs, out: &mut [f64]) {
         let n = self.info.dof();
-        let zeros = vec![0.0; 2 * n];
-        let inp = inp.zero_filled(&zeros);
+        let most = self.blocks.arms.iter().map(|a| a.dof).max().unwrap_or(0);
+        let mut scratch = self.scratch(2 * n + 3 * most);
+        let (zeros, free) = scratch.split_at_mut(2 * n);
+        let inp = inp.zero_filled(zeros);
         self.rest(&self.blocks.rest_jvp, &inp, out);
         for i in 0..self.blocks.arms.len() {
             let (kernels, first, arm) = self.arm(i, &inp);
             let dof = arm.q.len();
-            let mut d = vec![0.0; 2 * dof];
+            let (d, tau) = free.split_at_mut(2 * dof);
+            let tau = &mut tau[..dof];
             d[..dof].copy_from_slice(&inp.dir[first..first + dof]);
             d[dof..].copy_from_slice(&inp.dir[n + first..n + first + dof]);
             if d.iter().all(|&x| x == 0.0) {
                 continue;
             }
-            let mut tau = vec![0.0; dof];
             let arm = Inputs {
                 qdd: &inp.qdd[first..first + dof],
-                dir: &d,
+                dir: d,
                 ..arm
             };
-            kernels.eval(KernelKind::Jvp, &arm, &mut tau);
-            for (o, x) in out[first..first + dof].iter_mut().zip(&tau) {
+            tau.fill(0.0);
+            kernels.eval(KernelKind::Jvp, &arm, tau);
+            for (o, x) in out[first..first + dof].iter_mut().zip(tau.iter()) {
                 *o += x;
             }
         }
@@ -166,46 +183,43 @@ impl BlockKernels {
             let (kernels, first, arm) = self.arm(i, inp);
             let info = kernels.info();
             let (np, ng, m) = (info.contact_points, info.contact_groups.len(), arm.q.len());
-            // The arm's points, and its contact frames for its groups.
-            let mut own = vec![0.0; 3 * np + info.contact_frames];
+            // The arm's points, and its contact frames for its groups; a
+            // direction; the rows of its groups.
+            let n_own = 3 * np + info.contact_frames;
+            let mut scratch = self.scratch(n_own + 2 * m + np * (6 + 3 * m));
+            let (own, free) = scratch.split_at_mut(n_own);
+            let (d, rows) = free.split_at_mut(2 * m);
             if kind == KernelKind::Contact || info.contact_frames > 0 {
-                kernels.eval(KernelKind::Contact, &arm, &mut own);
+                kernels.eval(KernelKind::Contact, &arm, own);
             }
             match kind {
                 KernelKind::Contact => {
                     out[3 * point..3 * (point + np)].copy_from_slice(&own[..3 * np]);
                 }
                 KernelKind::ContactJacobian => {
-                    let mut d = vec![0.0; 2 * m];
                     if !all {
                         d[..ng].copy_from_slice(&inp.dir[group..group + ng]);
                     }
                     if all || d.iter().any(|&x| x != 0.0) {
-                        let mut rows = vec![0.0; np * (6 + 3 * m)];
                         let arm = Inputs {
-                            dir: if all { &[] } else { &d },
+                            dir: if all { &[] } else { d },
                             aux: &own[3 * np..],
                             ..arm
                         };
-                        kernels.eval(KernelKind::ContactJacobian, &arm, &mut rows);
+                        kernels.eval(KernelKind::ContactJacobian, &arm, rows);
                         let o = &mut out[point * width..(point + np) * width];
-                        place_groups(all, &d, &info.contact_groups, n, first, m, &rows, o);
+                        place_groups(all, d, &info.contact_groups, n, first, m, rows, o);
                     }
                 }
                 _ => {
-                    let mut d = vec![0.0; 2 * m];
                     d[..m].copy_from_slice(&inp.dir[first..first + m]);
                     let o = &mut out[point * tail..(point + np) * tail];
                     // Along a direction off its block, an arm's points do
                     // not move.
                     if d.iter().any(|&x| x != 0.0) {
-                        let mut rows = vec![0.0; np * (3 + 3 * m)];
-                        kernels.eval(
-                            KernelKind::ContactJvp,
-                            &Inputs { dir: &d, ..arm },
-                            &mut rows,
-                        );
-                        place_point_rows(3, n, first, m, &rows, o);
+                        let rows = &mut rows[..np * (3 + 3 * m)];
+                        kernels.eval(KernelKind::ContactJvp, &Inputs { dir: d, ..arm }, rows);
+                        place_point_rows(3, n, first, m, rows, o);
                     } else {
                         o.fill(0.0);
                     }
