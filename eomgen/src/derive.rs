@@ -139,7 +139,7 @@ pub fn derive_structure(structure: &Structure) -> TapeSet {
     let constraints = if phi.is_empty() {
         runtime::Tape::default()
     } else {
-        let outs = constraint_outputs(&mut cas, &sys, &phi);
+        let outs = constraint_outputs(&mut cas, &sys, &phi, &[]);
         cas.to_tape_hoisted(&outs, &mut hoist)
     };
     let (contact, contact_jacobian, contact_jvp, contact_groups, contact_frames) = match &contact {
@@ -303,17 +303,7 @@ fn frame_joints(
     if on.rows.is_empty() || !frames.iter().all(on_cells) {
         return None;
     }
-    let mut pairs = sys.coords.rate_pairs();
-    pairs.extend(&sys.seeds);
-    pairs.extend(&on.pairs);
-    let mut outs = on.rows.clone();
-    for &row in &on.rows {
-        for &q in &sys.coords.q {
-            outs.push(cas.diff(row, q));
-        }
-    }
-    let rate = cas.kinematic_rates(&on.rows, &pairs);
-    outs.extend(cas.kinematic_rates(&rate, &pairs));
+    let mut outs = constraint_outputs(cas, sys, &on.rows, &on.pairs);
     for &row in &on.rows {
         for vars in &on.vars {
             for &x in vars {
@@ -342,10 +332,18 @@ fn rest_contact(cas: &mut Cas, rest: &System, hoist: &mut Hoist) -> RestContact 
 }
 
 /// The `Constraints` kernel's outputs: phi, J = d phi/dq row by row, and
-/// gamma = (d/dt J) qd, the time derivative of phi' = J qd at qdd = 0.
-fn constraint_outputs(cas: &mut Cas, sys: &System, phi: &[ExprId]) -> Vec<ExprId> {
+/// gamma = (d/dt J) qd, the time derivative of phi' = J qd at qdd = 0;
+/// `more`: the (symbol, rate) pairs of symbols besides the coordinates
+/// that phi reads (a held frame's variables, `FrameRows`).
+fn constraint_outputs(
+    cas: &mut Cas,
+    sys: &System,
+    phi: &[ExprId],
+    more: &[(ExprId, ExprId)],
+) -> Vec<ExprId> {
     let mut pairs = sys.coords.rate_pairs();
     pairs.extend(&sys.seeds);
+    pairs.extend(more);
     let mut outs = phi.to_vec();
     for &row in phi {
         for &q in &sys.coords.q {

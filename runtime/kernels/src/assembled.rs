@@ -30,10 +30,8 @@ pub struct BlockKernels {
     /// Where each arm's parameters start among the derived ones.
     starts: Vec<usize>,
     slots: RefCell<Vec<f64>>,
-    /// The held frames' motions, the joints' `aux` and their rows.
-    joint_scratch: RefCell<Vec<f64>>,
-    /// The arms' outputs before they are placed in the assembly's
-    /// ([`BlockKernels::scratch`]).
+    /// The arms' outputs before they are placed in the assembly's, the
+    /// held frames' motions ([`BlockKernels::scratch`]).
     scratch: RefCell<Vec<f64>>,
 }
 
@@ -57,7 +55,6 @@ impl BlockKernels {
             kinds,
             starts,
             slots: RefCell::new(Vec::new()),
-            joint_scratch: RefCell::new(Vec::new()),
             scratch: RefCell::new(Vec::new()),
         })
     }
@@ -269,9 +266,7 @@ impl BlockKernels {
             }
         }
     }
-}
 
-impl BlockKernels {
     /// The joints through their arms' frames (`crate::joints`); false,
     /// leaving `out` to the flat tapes, where the assembly has no such
     /// kernel or an arm's kernels give no frames.
@@ -283,11 +278,7 @@ impl BlockKernels {
         let (n, m) = (self.info.dof(), self.info.constraints.len());
         let lens: usize = joints.frames.iter().map(|f| frame::len(dof(f))).sum();
         let n_aux = frame::STATE * joints.frames.len();
-        let mut scratch = self.joint_scratch.borrow_mut();
-        scratch.resize(
-            lens + n_aux + joints::rows_len(m, n, joints.frames.len()),
-            0.0,
-        );
+        let mut scratch = self.scratch(lens + n_aux + joints::rows_len(m, n, joints.frames.len()));
         let (motions, rest) = scratch.split_at_mut(lens);
         let (aux, rows) = rest.split_at_mut(n_aux);
         let mut free = &mut motions[..];
