@@ -151,15 +151,6 @@ fn linked(
         Some(a) => a.arms.iter().map(|(_, s)| s).collect(),
         None => vec![structure],
     };
-    if arms
-        .iter()
-        .any(|s| s.segments.iter().any(|g| g.anisotropic))
-    {
-        return Err(
-            "its sections bend or shear unequally along y and z, which link cells do not carry yet"
-                .into(),
-        );
-    }
     if arms.iter().any(|s| s.fluid == Some(true)) {
         return Err("its fluid's drag is not a link cell yet".into());
     }

@@ -136,6 +136,9 @@ static void sa_link_params(size_t k, const double *p, const double *loads, doubl
         v[LINK_ELEMENT_PARAMS + i] = LINK_LOAD[k] < 0 ? 0.0 : loads[3 * LINK_LOAD[k] + i];
     for (i = 0; i < LINK_REST_PARAMS; i++)
         v[LINK_ELEMENT_PARAMS + LINK_ACTUATION + i] = p[LINK_PARAM[k][LINK_ELEMENT_PARAMS + i]];
+    /* Sections that bend unequally stay on the flat kernels in C. */
+    for (i = LINK_ELEMENT_PARAMS + LINK_ACTUATION + LINK_REST_PARAMS; i < LINK_CELL_PARAMS; i++)
+        v[i] = 0.0;
 }
 
 /* The base frame's rotation (rows) and quaternion. */

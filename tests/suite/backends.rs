@@ -734,8 +734,47 @@ value = 0.3
 #[test]
 fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
     let dir = std::env::temp_dir().join("softarm-test-cache");
-    let mut rng = Rng::new(11);
-    for (model, sets) in link_shapes(&dir) {
+    recursion_matches_flat_tapes(link_shapes(&dir), 11);
+}
+
+/// Sections that bend unequally about y and z, on every covered 3D
+/// method, with shear, stretch, thinning and a rest shape: a test of its
+/// own, to keep each under its time.
+#[test]
+fn link_recursion_matches_the_flat_tape_for_anisotropic_sections() {
+    let dir = std::env::temp_dir().join("softarm-test-cache");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("ribbon3d.toml");
+    std::fs::write(&path, RIBBON_3D).unwrap();
+    let ribbon = path.to_str().unwrap();
+    let cases: [&[&'static str]; 5] = [
+        &[],
+        &[
+            "segment.0.shear=true",
+            "segment.1.shear=true",
+            "segment.1.extension=true",
+            "segment.2.shear=true",
+        ],
+        &[
+            "segment.0.method=vc",
+            "segment.1.incompressible=true",
+            "segment.1.extension=true",
+        ],
+        &[
+            "segment.0.method=ebr",
+            "segment.0.rest_curvature=[1.0,-2.0]",
+        ],
+        &["segment.0.method=pcs", "segment.0.twist=true"],
+    ];
+    let models = cases.iter().map(|sets| (ribbon.to_string(), sets.to_vec()));
+    recursion_matches_flat_tapes(models.collect(), 12);
+}
+
+/// Each model (with its `--set`s) by its link recursion against its flat
+/// tapes at random states ([`recursion_matches_at`]).
+fn recursion_matches_flat_tapes(models: Vec<(String, Vec<&'static str>)>, seed: u64) {
+    let mut rng = Rng::new(seed);
+    for (model, sets) in models {
         let overrides: Vec<eomgen::model::Override> = sets
             .iter()
             .map(|s| eomgen::model::Override::parse(s).unwrap())
@@ -787,6 +826,40 @@ fn link_recursion_matches_the_flat_tape_for_every_link_shape_and_tip() {
         }
     }
 }
+
+/// Sections that bend unequally about y and z (a rectangle, an ellipse
+/// of tapered stiffness, a section given by unequal properties): their bodies' inertia has principal axes of
+/// its own, their bend about y and shear along z springs of their own.
+const RIBBON_3D: &str = r#"
+name = "ribbon3d"
+dimensions = 3
+gravity = [0.0, -3.0, -9.81]
+[base]
+direction = [1.0, 0.0, 0.0]
+[[segment]]
+method = "pcc"
+length = 0.12
+elements = 3
+density = 1100.0
+section = { shape = "rectangle", width = 0.02, height = 0.006 }
+youngs_modulus = 2.0e5
+extension = true
+[[segment]]
+method = "rom"
+order = 2
+length = 0.1
+elements = 4
+density = 1100.0
+section = { shape = "ellipse", width = 0.016, height = 0.008 }
+youngs_modulus = [2.0e5, 1.0e5]
+[[segment]]
+method = "pcc"
+length = 0.08
+elements = 2
+section = { shape = "properties", axial_stiffness = 20.0, shear_stiffness = [5.0, 12.0], bending_stiffness = [1.0e-4, 2.5e-4], torsional_stiffness = 8.0e-5, mass_per_length = 0.1, rotary_inertia = [4.0e-7, 1.0e-6] }
+[tip]
+mass = 0.01
+"#;
 
 /// Immersed without drag: each link's body buoyed by its share of its
 /// element's displaced fluid.

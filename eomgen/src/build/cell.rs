@@ -24,8 +24,8 @@
 
 use runtime::Tape;
 use runtime::links::{
-    ACTUATION_LOADS, AlongLoad, ContactElement, ContactPoint, ELEMENT_PARAMS, LinkKernels,
-    LinkLayout, LinkSpec, LocalCoordinate, REST_PARAMS,
+    ACTUATION_LOADS, AlongLoad, CELL_PARAMS, ContactElement, ContactPoint, ELEMENT_PARAMS,
+    LinkKernels, LinkLayout, LinkSpec, LocalCoordinate, PRINCIPAL_PARAMS, REST_PARAMS,
 };
 
 use crate::cas::{Cas, ExprId, SymKind};
@@ -43,7 +43,8 @@ use crate::tmt::cell_outputs::{
     LinkKinematics, Motion, Rates, bodiless_cells, cell_param_symbols, with_tangent,
 };
 use crate::tmt::spatial::{
-    ArcStrain, Element3, Frame, Springs, V3, arc, compose, exp_turn, half_k_sq,
+    ArcStrain, Element3, Frame, M3, Springs, V3, arc, compose, exp_turn, half_k_sq,
+    mid_arc_rotation,
 };
 use crate::tmt::system::{Coordinates, ParamSymbols};
 
@@ -69,6 +70,7 @@ impl Shape {
     fn bare() -> Self {
         Shape {
             rest_3d: false,
+            principal: false,
             twist: false,
             extension: false,
             shear: false,
@@ -105,6 +107,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         let rom = method.polynomial_fields().then(|| RomFields::of(g, first));
         let shape = Shape {
             rest_3d: g.rest_3d,
+            principal: g.anisotropic,
             twist: g.twist,
             extension: g.extension,
             shear: g.shear,
@@ -152,6 +155,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             // the length's.
             let displaced = displaced_volume(st, params, k);
             let length = index(Param::Element(k, ElementParam::Length));
+            let principal = g.anisotropic.then(|| principal_params(params, k));
             let params: Vec<usize> = (ElementParam::CELL.iter())
                 .chain(&ElementParam::REST_3D)
                 .map(|&e| params.get(Param::Element(k, e)).unwrap_or(length))
@@ -164,6 +168,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                     params: params.clone(),
                     load: None,
                     displaced,
+                    principal,
                 });
             }
             let own = links.len()..links.len() + maps.len();
@@ -174,6 +179,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                     params: params.clone(),
                     load,
                     displaced,
+                    principal,
                 });
             }
             // An inextensible, unshearable centreline is its element's
@@ -242,6 +248,26 @@ fn displaced_volume(st: &Structure, params: &ParamLayout, k: usize) -> Option<us
     (st.fluid.is_some()).then(|| params.index(Param::Element(k, ElementParam::Volume)))
 }
 
+/// The slots of element k's `ElementParam::ANISOTROPIC` parameters, each
+/// its axisymmetric counterpart's where the element has none (as
+/// `SpatialArm::element` and `strain_element` read them); a shear
+/// stiffness the element lacks, its length's (a cell without shear reads
+/// none).
+fn principal_params(params: &ParamLayout, k: usize) -> [usize; PRINCIPAL_PARAMS] {
+    let slot = |e: ElementParam| params.get(Param::Element(k, e));
+    let length = params.index(Param::Element(k, ElementParam::Length));
+    let fallback = [
+        ElementParam::BendStiffness,
+        ElementParam::Inertia,
+        ElementParam::ShearStiffness,
+    ];
+    std::array::from_fn(|i| {
+        (slot(ElementParam::ANISOTROPIC[i]))
+            .or_else(|| slot(fallback[i]))
+            .unwrap_or(length)
+    })
+}
+
 /// Whether the recursion may cover the structure, its elements' cells
 /// permitting (a planar element is covered when it is one body:
 /// `planar_cell`).
@@ -254,7 +280,6 @@ fn covered(st: &Structure) -> bool {
             .all(|g| crate::method::of(g.method).link_cells()))
         && st.torques.is_empty()
         && st.base_turns == 0
-        && (st.segments.iter()).all(|g| !g.anisotropic)
         // Buoyancy is each link's felt gravity; drag is not a cell's yet.
         && st.fluid != Some(true)
 }
@@ -379,6 +404,7 @@ fn kink_link(params: &ParamLayout, s: usize, cell: usize, spatial: bool) -> Link
         params,
         load: None,
         displaced: None,
+        principal: None,
     }
 }
 
@@ -497,6 +523,9 @@ fn globals(st: &Structure, params: &ParamLayout) -> LinkLayout {
 struct Shape {
     /// It reads a rest bend about y, twist and stretch.
     rest_3d: bool,
+    /// Its section bends unequally about y and z: it reads
+    /// `runtime::links::PRINCIPAL_PARAMS` and reports its body's y axis.
+    principal: bool,
     twist: bool,
     extension: bool,
     shear: bool,
@@ -616,15 +645,15 @@ fn cell_springs(
     rom: bool,
     incompressible: bool,
     zero: ExprId,
-    k: [ExprId; 7],
+    k: [ExprId; 8],
     [rest_y, rest_twist, rest_stretch]: [ExprId; REST_PARAMS],
 ) -> Springs {
-    let [kb, db, rest, kt, dt, ks, ds] = k;
+    let [kb, kb_y, db, rest, kt, dt, ks, ds] = k;
     if rom {
         let local = |k: ExprId| if incompressible { k } else { zero };
         Springs {
             bend: local(kb),
-            bend_y: local(kb),
+            bend_y: local(kb_y),
             bend_damping: zero,
             rest: [local(rest_y), local(rest)],
             twist: local(kt),
@@ -637,7 +666,7 @@ fn cell_springs(
     } else {
         Springs {
             bend: kb,
-            bend_y: kb,
+            bend_y: kb_y,
             bend_damping: db,
             rest: [rest_y, rest],
             twist: kt,
@@ -662,15 +691,18 @@ struct LinkStrain {
 
 /// A link's motion from the identity frame by its kind: its body's
 /// centroid, axis and angular velocity, its end frame and its body (an arc,
-/// half an arc, or an ebr element's half before or past its joint).
+/// half an arc, or an ebr element's half before or past its joint), and
+/// where `principal` its body's y axis (a principal axis of an anisotropic
+/// section's inertia: `Element3::body`).
 fn link_motion(
     cas: &mut Cas,
-    kind: CellKind,
+    (kind, principal): (CellKind, bool),
     identity: &Frame,
     element: Element3,
     half_m: ExprId,
     s: LinkStrain,
-) -> (V3, V3, V3, Frame, Element3) {
+) -> (V3, V3, V3, Frame, Element3, Option<V3>) {
+    let y_of = |r: M3| principal.then(|| [r[0][1], r[1][1], r[2][1]]);
     match kind {
         CellKind::Arc | CellKind::HalfArc => {
             let strain = ArcStrain {
@@ -684,7 +716,8 @@ fn link_motion(
                 _ => (strain, element),
             };
             let (c, a, w, end) = arc(cas, identity, &strain);
-            (c, a, w, end, body)
+            let y = principal.then(|| mid_arc_rotation(identity, &strain)(cas));
+            (c, a, w, end, body, y.and_then(y_of))
         }
         CellKind::BeforeJoint => {
             let (quarter, half) = (cas.scaled(0.25, element.l), cas.scaled(0.5, element.l));
@@ -693,7 +726,7 @@ fn link_motion(
                 m: half_m,
                 ..element
             };
-            (c, identity.axis(), identity.w, end, body)
+            (c, identity.axis(), identity.w, end, body, y_of(identity.r))
         }
         CellKind::PastJoint => {
             let half = cas.scaled(0.5, element.l);
@@ -703,7 +736,7 @@ fn link_motion(
                 m: half_m,
                 ..element
             };
-            (c, a, w, end, body)
+            (c, a, w, end, body, y_of(joint.r))
         }
         CellKind::Kink => unreachable!("a kink's cell is `derive_kink_cell`"),
     }
@@ -739,6 +772,12 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     let p = cell_param_symbols(cas);
     // In the order of `ElementParam::CELL`, then the actuation loads.
     let [l, m, lateral, axial, kb, db, rest, kt, dt, ks, ds, kg] = std::array::from_fn(|i| p[i]);
+    // A section that bends unequally: its bend stiffness about y, inertia
+    // about y and shear stiffness along z, last.
+    let [kb_y, lateral_y, kg_z] = match shape.principal {
+        true => std::array::from_fn(|i| p[CELL_PARAMS - PRINCIPAL_PARAMS + i]),
+        false => [kb, lateral, kg],
+    };
     let loads: [ExprId; ACTUATION_LOADS] = std::array::from_fn(|i| p[ELEMENT_PARAMS + i]);
     let zero = cas.zero();
     let rests: [ExprId; REST_PARAMS] = match rest_3d {
@@ -769,7 +808,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         rom,
         incompressible,
         zero,
-        [kb, db, rest, kt, dt, ks, ds],
+        [kb, kb_y, db, rest, kt, dt, ks, ds],
         rests,
     );
     let (mut elastic, mut rayleigh) = match kind {
@@ -780,7 +819,7 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         // As `SpatialArm::strain_element` has them: k G A / l springs, the
         // rates damped as the stretch's.
         let (y, z) = ((q[i], qd[i]), (q[i + 1], qd[i + 1]));
-        let terms = [elastic, half_k_sq(cas, kg, y.0), half_k_sq(cas, kg, z.0)];
+        let terms = [elastic, half_k_sq(cas, kg, y.0), half_k_sq(cas, kg_z, z.0)];
         elastic = cas.add_all(&terms);
         let terms = [rayleigh, half_k_sq(cas, ds, y.1), half_k_sq(cas, ds, z.1)];
         rayleigh = cas.add_all(&terms);
@@ -807,12 +846,14 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
     let rho = [tw, by, bz];
     let rate = [tw_d, by_d, bz_d];
     let half_m = cas.scaled(0.5, m);
-    // Cells carry axisymmetric sections (anisotropic ones run interpreted).
-    let element = Element3::axisymmetric(l, m, lateral, axial);
+    let element = Element3 {
+        lateral_y,
+        ..Element3::axisymmetric(l, m, lateral, axial)
+    };
     let shear = shear_at.map(|i| [q[i], q[i + 1]]);
-    let (centroid, axis, omega, end, body) = link_motion(
+    let (centroid, axis, omega, end, body, y_axis) = link_motion(
         cas,
-        kind,
+        (kind, shape.principal),
         &identity,
         element,
         half_m,
@@ -831,7 +872,8 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         &q,
         &qd,
         Rates::Turned,
-    );
+    )
+    .with_principal(y_axis.map(|y| (y, body.lateral_y)));
     let out = kin.cell(cas, &q, &qd, elastic, rayleigh);
     let pose_out = kin.pose(cas);
     [

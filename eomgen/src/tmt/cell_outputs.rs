@@ -81,6 +81,9 @@ pub(crate) struct LinkKinematics {
     body_omega_rate: V3,
     /// Mass, lateral and axial inertia, the springs' energy.
     body: [ExprId; 4],
+    /// A body whose inertia is not axisymmetric: its y axis and its
+    /// inertia about it (`runtime::links::cell::PRINCIPAL`).
+    principal: Option<(V3, ExprId)>,
 }
 
 impl LinkKinematics {
@@ -115,6 +118,21 @@ impl LinkKinematics {
             centroid_accel,
             body_omega_rate,
             body,
+            principal: None,
+        }
+    }
+
+    /// The body's y axis and its inertia about it, reported after the
+    /// rest where given.
+    pub fn with_principal(self, principal: Option<(V3, ExprId)>) -> Self {
+        Self { principal, ..self }
+    }
+
+    /// Appends the body's y axis and its inertia about it, where given.
+    fn principal_into(&self, out: &mut Vec<ExprId>) {
+        if let Some((y, lateral_y)) = self.principal {
+            out.extend_from_slice(&y);
+            out.push(lateral_y);
         }
     }
 
@@ -169,6 +187,8 @@ impl LinkKinematics {
             out[cell::forces(n) + c] = cas.add(de, dr);
             out[cell::inertia_rates(n) + c] = cas.diff(lateral, q[c]);
         }
+        self.principal_into(&mut out);
+        debug_assert_eq!(out.len(), cell::len_of(n, self.principal.is_some()));
         out
     }
 
@@ -197,6 +217,8 @@ impl LinkKinematics {
         out[pose::AXIAL] = axial;
         out[pose::QUAT..pose::QUAT + 4].copy_from_slice(&m.quat);
         out[pose::ENERGY] = stored;
+        self.principal_into(&mut out);
+        debug_assert!(self.principal.is_none() || out.len() == pose::PRINCIPAL_LEN);
         out
     }
 }

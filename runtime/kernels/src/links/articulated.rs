@@ -182,7 +182,7 @@ pub fn accelerations_owned<C: Cells>(
             let l = s.links[k];
             let at = s.start[k];
             let mut body = Inertia::default();
-            body.add_body(l.m, l.centroid, l.lateral, l.axial, l.axis);
+            body.add_body(l.m, l.centroid, &l.rotary);
             let ib = body.matrix();
             let fb = six((add(l.torque, cross(l.centroid, l.force)), l.force));
             let e = &mut kept[k];

@@ -163,10 +163,10 @@ pub fn contact_bounds<C: Cells>(
     let reach = elements.last().map_or(0, |e| e.last + 1);
     let mut ends = Vec::with_capacity(reach + 1);
     ends.push(pos);
-    let mut o = vec![0.0; cell::len(MAX_LINK_DOF)];
+    let mut o = vec![0.0; cell::len_of(MAX_LINK_DOF, true)];
     for (k, spec) in layout.links.iter().enumerate().take(reach) {
         let nc = spec.map.len();
-        let len = cell::len(nc);
+        let len = spec.cell_len();
         let (x, xd) = (local(spec, p, q), local(spec, p, qd));
         kept.link(
             cells,

@@ -111,7 +111,7 @@ pub fn frames<C: Cells + ?Sized>(
     // Per arm coordinate, the twist (W, V) its rate gives the frame the
     // sweep has reached, about the world origin.
     let mut twists = vec![([0.0; 3], [0.0; 3]); n];
-    let mut c = [0.0; cell::len(MAX_LINK_DOF)];
+    let mut c = [0.0; cell::len_of(MAX_LINK_DOF, true)];
     for (k, spec) in layout.links.iter().enumerate().take(last + 1) {
         let nc = spec.map.len();
         let (x, xd) = (local(spec, p, q), local(spec, p, qd));
@@ -121,7 +121,7 @@ pub fn frames<C: Cells + ?Sized>(
             &x[..nc],
             &xd[..nc],
             &params,
-            &mut c[..cell::len(nc)],
+            &mut c[..spec.cell_len()],
         );
         let v3 = |i: usize| [c[i], c[i + 1], c[i + 2]];
         let turn = |i: usize| mat_vec(&m.r, v3(i));

@@ -58,8 +58,13 @@ pub const ACTUATION_LOADS: usize = 3;
 /// twist, stretch: `ElementParam::REST_3D`), which a cell of a 3D rest
 /// shape reads; other cells' slots repeat the length's.
 pub const REST_PARAMS: usize = 3;
+/// Then, for a section that bends unequally about y and z
+/// ([`LinkSpec::principal`]), its bend stiffness about y, its bodies'
+/// rotary inertia about y and its shear stiffness along z
+/// (`ElementParam::ANISOTROPIC`); zero for other links.
+pub const PRINCIPAL_PARAMS: usize = 3;
 /// Everything a cell reads besides its coordinates.
-pub const CELL_PARAMS: usize = ELEMENT_PARAMS + ACTUATION_LOADS + REST_PARAMS;
+pub const CELL_PARAMS: usize = ELEMENT_PARAMS + ACTUATION_LOADS + REST_PARAMS + PRINCIPAL_PARAMS;
 
 /// Where a cell's outputs sit, for a link of `n` coordinates.
 pub mod cell {
@@ -105,6 +110,17 @@ pub mod cell {
     pub const fn len(n: usize) -> usize {
         COLUMNS + 14 * n
     }
+
+    /// A cell whose body's inertia is not axisymmetric
+    /// (`LinkSpec::principal`) reports after the rest its body's y axis
+    /// (3) and its inertia about it (1): [`PRINCIPAL`] more values.
+    pub const PRINCIPAL: usize = 4;
+
+    /// The length of the outputs of a cell of `n` coordinates, with
+    /// [`PRINCIPAL`] more where `principal`.
+    pub const fn len_of(n: usize, principal: bool) -> usize {
+        len(n) + if principal { PRINCIPAL } else { 0 }
+    }
 }
 
 /// Where a *pose cell*'s outputs sit: what the `Outputs` kernel needs of a
@@ -128,6 +144,11 @@ pub mod pose {
     /// The link's strain energy (springs; not the actuators' potential).
     pub const ENERGY: usize = 37;
     pub const LEN: usize = 38;
+    /// A body whose inertia is not axisymmetric: its y axis and its
+    /// inertia about it, after the rest.
+    pub const Y_AXIS: usize = 38;
+    pub const LATERAL_Y: usize = 41;
+    pub const PRINCIPAL_LEN: usize = 42;
 }
 
 /// A coordinate of a cell: a fixed linear combination of the arm's
@@ -159,6 +180,19 @@ pub struct LinkSpec {
     /// immersed (`LinkLayout::fluid_density`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub displaced: Option<usize>,
+    /// A section that bends unequally about y and z: the slots of its
+    /// [`PRINCIPAL_PARAMS`]. Its body's inertia then has a principal axis
+    /// y of its own, which its cell reports ([`cell::len_of`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub principal: Option<[usize; PRINCIPAL_PARAMS]>,
+}
+
+impl LinkSpec {
+    /// The length of this link's cell's outputs ([`cell::len_of`]).
+    #[inline(always)]
+    pub fn cell_len(&self) -> usize {
+        cell::len_of(self.map.len(), self.principal.is_some())
+    }
 }
 
 /// A chain of links and where its global parameters are.
@@ -467,8 +501,17 @@ pub(crate) fn link_params(v: &mut [f64; CELL_PARAMS], spec: &LinkSpec, p: &[f64]
     for (f, v) in actuation.iter_mut().enumerate() {
         *v = at.map_or(0.0, |at| loads[at + f]);
     }
+    let (rest_v, principal) = rest_v.split_at_mut(REST_PARAMS);
     for (v, &i) in rest_v.iter_mut().zip(rest) {
         *v = p[i];
+    }
+    match spec.principal {
+        Some(at) => {
+            for (v, i) in principal.iter_mut().zip(at) {
+                *v = p[i];
+            }
+        }
+        None => principal.fill(0.0),
     }
 }
 
@@ -526,13 +569,45 @@ pub(super) fn mat_mat(a: &M3, b: &M3) -> M3 {
 fn pair(a: (V3, V3), b: (V3, V3)) -> f64 {
     dot(a.0, b.0) + dot(a.1, b.1)
 }
-/// Axisymmetric inertia applied to a vector.
-#[inline(always)]
-fn apply_body(lateral: f64, axial: f64, axis: V3, w: V3) -> V3 {
-    add(
-        scale(lateral, w),
-        scale((axial - lateral) * dot(axis, w), axis),
-    )
+/// A body's rotary inertia about its centroid: `lateral` about every axis
+/// normal to its `axis` and `axial` about it, and for a section that bends
+/// unequally `extra` more about its y axis `y`:
+/// J = lateral 1 + (axial - lateral) a a^T + extra y y^T.
+#[derive(Clone, Copy, Default)]
+struct Rotary {
+    lateral: f64,
+    axial: f64,
+    axis: V3,
+    y: V3,
+    extra: f64,
+}
+
+impl Rotary {
+    /// An axisymmetric body's.
+    #[inline(always)]
+    fn axisymmetric(lateral: f64, axial: f64, axis: V3) -> Self {
+        Rotary {
+            lateral,
+            axial,
+            axis,
+            ..Default::default()
+        }
+    }
+
+    /// J w.
+    #[inline(always)]
+    fn apply(&self, w: V3) -> V3 {
+        let j = add(
+            scale(self.lateral, w),
+            scale((self.axial - self.lateral) * dot(self.axis, w), self.axis),
+        );
+        // A branch, not a product by zero: axisymmetric bodies are the
+        // common case and the recursion's hot path.
+        match self.extra != 0.0 {
+            true => add(j, scale(self.extra * dot(self.y, w), self.y)),
+            false => j,
+        }
+    }
 }
 
 /// A spatial inertia about the world origin: mass, first moment m r and
@@ -545,13 +620,13 @@ struct Inertia {
 }
 
 impl Inertia {
-    /// Adds a body of mass m at r, axisymmetric about `axis`:
-    /// J += lateral 1 + (axial - lateral) a a^T + m (|r|^2 1 - r r^T).
+    /// Adds a body of mass m at r of rotary inertia `j` ([`Rotary`]):
+    /// J += j + m (|r|^2 1 - r r^T).
     #[inline(always)]
-    fn add_body(&mut self, m: f64, r: V3, lateral: f64, axial: f64, axis: V3) {
+    fn add_body(&mut self, m: f64, r: V3, j: &Rotary) {
         let r2 = dot(r, r);
-        let d = axial - lateral;
-        let diag = lateral + m * r2;
+        let d = j.axial - j.lateral;
+        let diag = j.lateral + m * r2;
         self.m += m;
         self.h = add(self.h, scale(m, r));
         for (k, (a, b)) in [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)]
@@ -559,7 +634,10 @@ impl Inertia {
             .enumerate()
         {
             let base = if k < 3 { diag } else { 0.0 };
-            self.j[k] += base + d * axis[a] * axis[b] - m * r[a] * r[b];
+            self.j[k] += base + d * j.axis[a] * j.axis[b] - m * r[a] * r[b];
+            if j.extra != 0.0 {
+                self.j[k] += j.extra * j.y[a] * j.y[b];
+            }
         }
     }
 
@@ -583,10 +661,8 @@ impl Inertia {
 #[derive(Clone, Copy, Default)]
 struct Link {
     centroid: V3,
-    axis: V3,
     m: f64,
-    lateral: f64,
-    axial: f64,
+    rotary: Rotary,
     force: V3,
     torque: V3,
 }
@@ -594,7 +670,7 @@ struct Link {
 /// Most coordinates a cell has (bend pair, twist, stretch, shear pair).
 pub const MAX_LINK_DOF: usize = 6;
 /// Room for the outputs of any cell.
-const CELL_STRIDE: usize = cell::len(MAX_LINK_DOF);
+const CELL_STRIDE: usize = cell::len_of(MAX_LINK_DOF, true);
 
 type Twist = (V3, V3);
 
@@ -672,11 +748,12 @@ fn evaluate_cells<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &m
     let mut k = 0;
     while k < nl {
         let (c, nc) = (layout.links[k].cell, layout.links[k].map.len());
-        let len = cell::len(nc);
+        let len = layout.links[k].cell_len();
         if s.cell_out.len() < used + CELL_STRIDE {
             s.cell_out.resize(used + CELL_STRIDE, [0.0; 4]);
         }
         let out = &mut s.cell_out[used..used + len];
+        // Links of one cell have one principal layout: the cell's.
         if k + 4 <= nl && layout.links[k..k + 4].iter().all(|l| l.cell == c) {
             let x: [[f64; 4]; MAX_LINK_DOF] =
                 std::array::from_fn(|f| std::array::from_fn(|l| s.x[k + l][f]));
@@ -753,8 +830,13 @@ fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scra
         );
         let (w_rel, w_rel_d) = (turn(cell::OMEGA), turn(cell::OMEGA_RATE));
         let (w_b, w_b_d) = (turn(cell::BODY_OMEGA), turn(cell::BODY_OMEGA_RATE));
-        let axis = turn(cell::AXIS);
-        let (m, lateral, axial) = (c(cell::MASS), c(cell::LATERAL), c(cell::AXIAL));
+        let m = c(cell::MASS);
+        let mut rotary = Rotary::axisymmetric(c(cell::LATERAL), c(cell::AXIAL), turn(cell::AXIS));
+        if spec.principal.is_some() {
+            let at = cell::len(nc);
+            rotary.y = turn(at);
+            rotary.extra = c(at + 3) - rotary.lateral;
+        }
 
         // The body: centroid, convective accelerations, inertial and
         // gravity forces.
@@ -764,19 +846,14 @@ fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scra
         );
         let body_w = add(omega, w_b);
         let body_alpha = add(add(alpha, cross(omega, w_b)), w_b_d);
-        let iw = apply_body(lateral, axial, axis, body_w);
+        let iw = rotary.apply(body_w);
         let end = add(pos, d);
         s.links[k] = Link {
             centroid: add(pos, cen),
-            axis,
             m,
-            lateral,
-            axial,
+            rotary,
             force: scale(m, sub(body_a, link_gravity(layout, spec, p, gravity))),
-            torque: add(
-                apply_body(lateral, axial, axis, body_alpha),
-                cross(body_w, iw),
-            ),
+            torque: add(rotary.apply(body_alpha), cross(body_w, iw)),
         };
         let force_at = cell::forces(nc);
         for f in 0..nc {
@@ -821,14 +898,15 @@ fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scra
         let offset = scale(0.5 * length, axis);
         let centre = add(pos, offset);
         let (lateral, axial) = layout.tip_inertia.map_or((0.0, 0.0), |[l, a]| (p[l], p[a]));
+        let rotary = Rotary::axisymmetric(lateral, axial, axis);
         let a_c = add(
             add(acc, cross(alpha, offset)),
             cross(omega, cross(omega, offset)),
         );
         let force = scale(m, sub(a_c, gravity));
-        let iw = apply_body(lateral, axial, axis, omega);
-        let torque = add(apply_body(lateral, axial, axis, alpha), cross(omega, iw));
-        past.add_body(m, centre, lateral, axial, axis);
+        let iw = rotary.apply(omega);
+        let torque = add(rotary.apply(alpha), cross(omega, iw));
+        past.add_body(m, centre, &rotary);
         wrench = (add(torque, cross(centre, force)), force);
     }
     // Applied loads enter as forces of the opposite sign.
@@ -872,7 +950,7 @@ fn link_sums(
     #[allow(clippy::needless_range_loop)] // own and body side by side
     for f in 0..nc {
         let (ow, ov) = s.own[at + f];
-        body[f] = (apply_body(l.lateral, l.axial, l.axis, ow), scale(l.m, ov));
+        body[f] = (l.rotary.apply(ow), scale(l.m, ov));
     }
     for f in 0..nc {
         let (ow, ov) = s.own[at + f];
@@ -892,8 +970,7 @@ fn link_sums(
             block[f2][f] = block[f][f2];
         }
     }
-    tip.past
-        .add_body(l.m, l.centroid, l.lateral, l.axial, l.axis);
+    tip.past.add_body(l.m, l.centroid, &l.rotary);
     let torque = add(l.torque, cross(l.centroid, l.force));
     tip.wrench = (add(tip.wrench.0, torque), add(tip.wrench.1, l.force));
     (momentum, block, g)

@@ -14,12 +14,20 @@ use super::{
 use crate::output;
 use crate::rotation::quat_mul;
 
-/// Kinetic energy of a body of mass m, axisymmetric inertia about `axis`,
-/// moving at (v, w).
-fn kinetic(m: f64, lateral: f64, axial: f64, axis: V3, v: V3, w: V3) -> f64 {
+/// Kinetic energy of a body of mass m, moving at (v, w), its inertia
+/// `lateral` normal to `axis` and `axial` about it, and `extra` more
+/// about a y axis of its own where its section bends unequally.
+fn kinetic(
+    m: f64,
+    (lateral, axial, axis): (f64, f64, V3),
+    extra: Option<(f64, V3)>,
+    v: V3,
+    w: V3,
+) -> f64 {
     let aw = dot(axis, w);
     let iw = add(scale(lateral, w), scale((axial - lateral) * aw, axis));
-    0.5 * (m * dot(v, v) + dot(w, iw))
+    let more = extra.map_or(0.0, |(extra, y)| extra * dot(y, w) * dot(y, w));
+    0.5 * (m * dot(v, v) + dot(w, iw) + more)
 }
 
 /// The outputs (`runtime::OUTPUT_NAMES`: tip x, y, z, kinetic energy,
@@ -43,12 +51,16 @@ pub fn outputs<C: Cells>(
     let (mut ke, mut pe) = (0.0, 0.0);
     let mut params: Vec<[f64; CELL_PARAMS]> = Vec::new();
     cell_params(layout, cells, p, &mut params);
-    let mut o = [0.0; pose::LEN];
+    let mut o = [0.0; pose::PRINCIPAL_LEN];
     for (spec, params) in layout.links.iter().zip(&params) {
         let nc = spec.map.len();
         debug_assert!(nc <= MAX_LINK_DOF);
         let (x, xd) = (local(spec, p, q), local(spec, p, qd));
-        cells.pose(spec.cell, &x[..nc], &xd[..nc], params, &mut o);
+        let len = match spec.principal {
+            Some(_) => pose::PRINCIPAL_LEN,
+            None => pose::LEN,
+        };
+        cells.pose(spec.cell, &x[..nc], &xd[..nc], params, &mut o[..len]);
         let v3 = |i: usize| [o[i], o[i + 1], o[i + 2]];
         let rel: M3 = std::array::from_fn(|i| v3(pose::ROTATION + 3 * i));
         let turn = |at: usize| mat_vec(&r, v3(at));
@@ -58,7 +70,10 @@ pub fn outputs<C: Cells>(
         let m = o[pose::MASS];
         let body_v = add(add(v, cross(omega, cen)), cend);
         let body_w = add(omega, w_b);
-        ke += kinetic(m, o[pose::LATERAL], o[pose::AXIAL], axis, body_v, body_w);
+        let extra = (spec.principal.is_some())
+            .then(|| (o[pose::LATERAL_Y] - o[pose::LATERAL], turn(pose::Y_AXIS)));
+        let rotary = (o[pose::LATERAL], o[pose::AXIAL], axis);
+        ke += kinetic(m, rotary, extra, body_v, body_w);
         // Weight, less an immersed body's buoyancy.
         let g = super::link_gravity(layout, spec, p, gravity);
         pe += o[pose::ENERGY] - m * dot(g, add(pos, cen));
@@ -74,7 +89,7 @@ pub fn outputs<C: Cells>(
         let offset = scale(0.5 * length, axis);
         let (lateral, axial) = layout.tip_inertia.map_or((0.0, 0.0), |[l, a]| (p[l], p[a]));
         let v_c = add(v, cross(omega, offset));
-        ke += kinetic(m, lateral, axial, axis, v_c, omega);
+        ke += kinetic(m, (lateral, axial, axis), None, v_c, omega);
         pe -= m * dot(gravity, add(pos, offset));
     }
     // The tip point: the far end of a tip body with a length.

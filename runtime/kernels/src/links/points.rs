@@ -214,11 +214,11 @@ pub(super) fn sweep<N: Num, C: Cells + ?Sized>(
         Some(kept) => kept.params(layout, cells, p, &mut params),
         None => cell_params(layout, cells, p, &mut params),
     }
-    let mut out = vec![0.0; 2 * cell::len(MAX_LINK_DOF)];
+    let mut out = vec![0.0; 2 * cell::len_of(MAX_LINK_DOF, true)];
     let mut next = 0;
     for (k, spec) in layout.links.iter().enumerate().take(last_link + 1) {
         let nc = spec.map.len();
-        let len = cell::len(nc);
+        let len = spec.cell_len();
         let (x, xd) = (local(spec, p, q), local(spec, p, qd));
         let dx = dq.map(|dq| local(spec, p, dq));
         // Each cell coordinate's weight on each arm coordinate.

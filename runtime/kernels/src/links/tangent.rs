@@ -22,13 +22,19 @@ type V3 = [Dual; 3];
 type M3 = [[Dual; 3]; 3];
 const V0: V3 = [Dual::ZERO; 3];
 
-/// Axisymmetric inertia applied to a vector.
+/// A body's rotary inertia applied to a vector, as `links::Rotary`'s:
+/// lateral 1 + (axial - lateral) a a^T, and `extra` y y^T more about
+/// its y axis for a section that bends unequally.
 #[inline(always)]
-fn apply_body(lateral: Dual, axial: Dual, axis: V3, w: V3) -> V3 {
-    add(
+fn apply_body(lateral: Dual, axial: Dual, axis: V3, extra: Option<(Dual, V3)>, w: V3) -> V3 {
+    let j = add(
         scale(lateral, w),
         scale((axial - lateral) * dot(axis, w), axis),
-    )
+    );
+    match extra {
+        Some((extra, y)) => add(j, scale(extra * dot(y, w), y)),
+        None => j,
+    }
 }
 /// The rate of a point at `r` of a frame moving with (w, alpha) and origin
 /// acceleration `a`, plus its own motion in the frame (`rate`, `accel`):
@@ -100,11 +106,11 @@ pub fn inverse_dynamics_tangent<C: Cells>(
     let mut params = Vec::new();
     super::cell_params(layout, cells, p, &mut params);
     let mut links = Vec::with_capacity(layout.links.len());
-    let mut out = vec![0.0; 2 * cell::len(MAX_LINK_DOF)];
+    let mut out = vec![0.0; 2 * cell::len_of(MAX_LINK_DOF, true)];
     for (spec, params) in layout.links.iter().zip(&params) {
         let nc = spec.map.len();
         let [x, xd, xdd, dx, dxd] = [q, qd, qdd, dq, dqd].map(|v| local(spec, p, v));
-        let len = cell::len(nc);
+        let len = spec.cell_len();
         let (x, xd, dx, dxd) = (&x[..nc], &xd[..nc], &dx[..nc], &dxd[..nc]);
         let out = &mut out[..2 * len];
         if dx.iter().chain(dxd).all(|&v| v == 0.0) {
@@ -123,7 +129,7 @@ pub fn inverse_dynamics_tangent<C: Cells>(
         links.push(link_forward(
             &mut frame,
             out,
-            nc,
+            (nc, spec.principal.is_some()),
             &xdd,
             inertia_rates,
             felt.map(Dual::constant),
@@ -176,12 +182,12 @@ pub fn inverse_dynamics_tangent<C: Cells>(
 fn link_forward(
     frame: &mut Frame,
     out: &[f64],
-    nc: usize,
+    (nc, principal): (usize, bool),
     xdd: &[f64; MAX_LINK_DOF],
     inertia_rates: Option<&[Dual; MAX_LINK_DOF]>,
     gravity: V3,
 ) -> LinkForces {
-    let len = cell::len(nc);
+    let len = cell::len_of(nc, principal);
     let o = |i: usize| <Dual as Num>::of_cell(out, len, i);
     let v3 = |i: usize| cell_v3(out, len, i);
     let rel: M3 = std::array::from_fn(|i| v3(cell::ROTATION + 3 * i));
@@ -198,6 +204,8 @@ fn link_forward(
     let (w_rel, w_b) = (turn(cell::OMEGA), turn(cell::BODY_OMEGA));
     let axis = turn(cell::AXIS);
     let (m, lateral, axial) = (o(cell::MASS), o(cell::LATERAL), o(cell::AXIAL));
+    let y = cell::len(nc);
+    let extra = principal.then(|| (o(y + 3) - lateral, turn(y)));
     // Convective accelerations (the cell's, at qdd = 0), then each cell
     // coordinate's acceleration along its columns.
     let (mut ddd, mut w_rel_d) = (turn(cell::END_ACCEL), turn(cell::OMEGA_RATE));
@@ -223,9 +231,9 @@ fn link_forward(
     let body_a = point_accel(acc, alpha, omega, cen, cend, cendd);
     let body_w = add(omega, w_b);
     let body_alpha = add(add(alpha, cross(omega, w_b)), w_b_d);
-    let iw = apply_body(lateral, axial, axis, body_w);
+    let iw = apply_body(lateral, axial, axis, extra, body_w);
     let mut torque = add(
-        apply_body(lateral, axial, axis, body_alpha),
+        apply_body(lateral, axial, axis, extra, body_alpha),
         cross(body_w, iw),
     );
     if let Some(xd) = inertia_rates {
@@ -284,8 +292,11 @@ fn tip_wrench(layout: &LinkLayout, frame: &Frame, p: &[f64], gravity: V3) -> (V3
             .map_or((Dual::ZERO, Dual::ZERO), |[l, a]| (c(l), c(a)));
         let a_c = point_accel(*acc, *alpha, *omega, offset, V0, V0);
         let force = scale(m, sub(a_c, gravity));
-        let iw = apply_body(lateral, axial, axis, *omega);
-        let torque = add(apply_body(lateral, axial, axis, *alpha), cross(*omega, iw));
+        let iw = apply_body(lateral, axial, axis, None, *omega);
+        let torque = add(
+            apply_body(lateral, axial, axis, None, *alpha),
+            cross(*omega, iw),
+        );
         wrench = (add(torque, cross(centre, force)), force);
     }
     let load = |idx: Option<[usize; 3]>| -> V3 {

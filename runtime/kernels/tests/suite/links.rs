@@ -101,6 +101,7 @@ fn chain() -> (LinkLayout, Vec<f64>) {
             params: (at..at + ELEMENT_PARAMS).chain([at; REST_PARAMS]).collect(),
             load: None,
             displaced: None,
+            principal: None,
         });
     }
     let layout = LinkLayout {
