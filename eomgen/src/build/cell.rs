@@ -93,7 +93,6 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     if !covered(st) {
         return None;
     }
-    let index = |p: Param| params.index(p);
     let (loads, actuated) = derive_loads(params, st);
     let mut cells: Vec<(Shape, [Tape; 3])> = Vec::new();
     let mut links = Vec::new();
@@ -151,15 +150,9 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             // The loads of its segment, or of the element itself.
             let load =
                 (actuated.iter()).position(|&(seg, el)| seg == s && el.is_none_or(|el| el == k));
-            // A planar cell reads no spatial parameter: their slots repeat
-            // the length's.
             let displaced = displaced_volume(st, params, k);
-            let length = index(Param::Element(k, ElementParam::Length));
             let principal = g.anisotropic.then(|| principal_params(params, k));
-            let params: Vec<usize> = (ElementParam::CELL.iter())
-                .chain(&ElementParam::REST_3D)
-                .map(|&e| params.get(Param::Element(k, e)).unwrap_or(length))
-                .collect();
+            let params = cell_slots(params, k);
             let maps = coordinate_maps(rom.as_ref(), e, count, first, params[0], shape.kind);
             if let Some(b) = before {
                 links.push(LinkSpec {
@@ -246,6 +239,17 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
 /// its bodies' buoyancy (`runtime::links::link_gravity`).
 fn displaced_volume(st: &Structure, params: &ParamLayout, k: usize) -> Option<usize> {
     (st.fluid.is_some()).then(|| params.index(Param::Element(k, ElementParam::Volume)))
+}
+
+/// The slots of element k's cell parameters (`ElementParam::CELL`, then
+/// `REST_3D`); a planar cell reads no spatial parameter, and a cell
+/// without a rest shape none of its: their slots repeat the length's.
+fn cell_slots(params: &ParamLayout, k: usize) -> Vec<usize> {
+    let length = params.index(Param::Element(k, ElementParam::Length));
+    (ElementParam::CELL.iter())
+        .chain(&ElementParam::REST_3D)
+        .map(|&e| params.get(Param::Element(k, e)).unwrap_or(length))
+        .collect()
 }
 
 /// The slots of element k's `ElementParam::ANISOTROPIC` parameters, each
