@@ -154,6 +154,11 @@ fn linked(
     if arms.iter().any(|s| s.fluid == Some(true)) {
         return Err("its fluid's drag is not a link cell yet".into());
     }
+    if arms.iter().any(|s| s.base_turns > 0) {
+        return Err(
+            "a base turned by its inputs (`rotation_inputs`) is not a link cell yet".into(),
+        );
+    }
     let not_cells = || "not every one of its methods' elements is a link cell".to_string();
     let kernels: (Box<dyn Kernels>, String) = if structure.assembly.is_some() {
         let (tapes, _, _) = tapes(model, &structure.hash(), cache_dir);
@@ -342,7 +347,7 @@ pub fn load(
         );
     }
     let values = layout.values(&model);
-    let mut arm: Box<dyn Dynamics> = Box::new(Arm::new(kernels, values));
+    let mut arm = Arm::boxed(kernels, values);
     let base_dir = base_dir(spec);
     let drives = crate::inputs::model_drives(&model, &layout, &base_dir)
         .with_context(|| format!("{origin}: reading the input channels"))?;

@@ -54,10 +54,11 @@ impl<'a> Links<'a> {
     /// kernels are small, and quicker than the recursion in C as in Rust
     /// (the soft finger's state derivative 5 against 17 us).
     pub fn new(links: &'a LinkKernels, dof: usize) -> Option<Self> {
-        // Loads along the arm, a driven base translation, buoyancy, a
-        // section that bends unequally: the flat kernels carry them in C.
+        // Loads along the arm or on its coordinates, a driven base
+        // translation, buoyancy, a section that bends unequally: the flat
+        // kernels carry them in C.
         let layout = &links.layout;
-        let covered = layout.along.is_empty()
+        let covered = !layout.loaded()
             && layout.base_translation.is_none()
             && layout.fluid_density.is_none()
             && layout.links.iter().all(|l| l.principal.is_none());

@@ -770,6 +770,24 @@ fn link_recursion_matches_the_flat_tape_for_anisotropic_sections() {
     recursion_matches_flat_tapes(models.collect(), 12);
 }
 
+/// Driven forces on named coordinates (`[[torque]]`) on 3D and planar
+/// actuated arms: taken from h, the tangent unchanged.
+#[test]
+fn link_recursion_matches_the_flat_tape_under_coordinate_forces() {
+    let dir = std::env::temp_dir().join("softarm-test-cache");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut models = Vec::new();
+    for (name, text) in [
+        ("torqued3d", format!("{ACTUATED_3D}{TORQUES_3D}")),
+        ("torqued2d", format!("{ACTUATED_2D}{TORQUES_2D}")),
+    ] {
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, text).unwrap();
+        models.push((path.to_str().unwrap().to_string(), Vec::new()));
+    }
+    recursion_matches_flat_tapes(models, 13);
+}
+
 /// Each model (with its `--set`s) by its link recursion against its flat
 /// tapes at random states ([`recursion_matches_at`]).
 fn recursion_matches_flat_tapes(models: Vec<(String, Vec<&'static str>)>, seed: u64) {
@@ -859,6 +877,36 @@ elements = 2
 section = { shape = "properties", axial_stiffness = 20.0, shear_stiffness = [5.0, 12.0], bending_stiffness = [1.0e-4, 2.5e-4], torsional_stiffness = 8.0e-5, mass_per_length = 0.1, rotary_inertia = [4.0e-7, 1.0e-6] }
 [tip]
 mass = 0.01
+"#;
+
+/// Driven forces on a 3D arm's coordinates: a moment on a pcc element's
+/// bend, a force on its stretch, one on a rom segment's coefficient.
+const TORQUES_3D: &str = r#"
+[[torque]]
+coordinate = "bend_y_0_1"
+input = "tq"
+[[torque]]
+coordinate = "stretch_0_2"
+input = "pull"
+[[torque]]
+coordinate = "bend_z_1_c1"
+input = "tq"
+[inputs.tq]
+kind = "constant"
+value = 0.01
+"#;
+
+/// A rigid joint's torque and a moment on a planar pcc element.
+const TORQUES_2D: &str = r#"
+[[torque]]
+coordinate = "theta_0_0"
+input = "tq"
+[[torque]]
+coordinate = "theta_1_2"
+input = "pull"
+[inputs.tq]
+kind = "constant"
+value = 0.01
 "#;
 
 /// Immersed without drag: each link's body buoyed by its share of its
@@ -1566,7 +1614,11 @@ fn articulated_body_accelerations_equal_the_mass_matrix_solve() {
             .replace(
                 "moment_inputs = [\"m\", \"m\", \"m\"]",
                 "moment = [0.01, -0.02, 0.01]",
-            ),
+            )
+            // A driven moment on an element's bend, the reference's
+            // parameters at its input's value.
+            + "[[torque]]\ncoordinate = \"bend_z_1_2\"\ninput = \"tq\"\n\
+               [inputs.tq]\nkind = \"constant\"\nvalue = 0.02\n",
     )
     .unwrap();
     let owned = owned.to_str().unwrap().to_string();
@@ -1596,10 +1648,9 @@ fn articulated_body_accelerations_equal_the_mass_matrix_solve() {
             "{what}: not linked"
         );
         let tapes = eomgen::derive::derive(&l.model);
-        let p: Vec<f64> = eomgen::load::parameters(&l.model)
-            .into_iter()
-            .map(|(_, v)| v)
-            .collect();
+        // The parameters at t = 0.3, driven ones from their channels.
+        let base = l.arm.base_params().len();
+        let p = l.arm.params_at(0.3)[..base].to_vec();
         let interpreted = Arm::new(Interpreted::new(tapes), p);
         let n = l.arm.dof();
         let names = l.arm.info().coordinates.clone();
@@ -1701,6 +1752,12 @@ value = 1000.0
     )
     .unwrap();
     let tapered = tapered.to_string_lossy().into_owned();
+    // The same with a driven moment on an element's bend.
+    let torqued = dir.path().join("torqued.toml");
+    let text = std::fs::read_to_string(&tapered).unwrap()
+        + "[[torque]]\ncoordinate = \"bend_y_1_0\"\ninput = \"p\"\n";
+    std::fs::write(&torqued, text).unwrap();
+    let torqued = torqued.to_string_lossy().into_owned();
     // A stretching pcc arm whose section keeps its area: a link shape no
     // bundled model has (stiff_flop's stretch thins its section).
     let stretching = dir.path().join("stretching.toml");
@@ -1714,6 +1771,7 @@ value = 1000.0
     for (model, set) in [
         ("tentacle3d", "segment.0.elements=13"),
         (tapered.as_str(), ""),
+        (torqued.as_str(), ""),
         ("soft_finger", "segment.0.elements=7"),
     ] {
         let (b, r) = route(model, set, auto);
@@ -1745,6 +1803,15 @@ value = 1000.0
     let (b, r) = route(&example.to_string_lossy(), "", auto);
     assert_eq!(b, "compiled", "{r}");
     assert!(r.contains("link cells") && r.contains("tapes"), "{r}");
+    // A base turned by an input: the interpreter, and the route says why.
+    let turned = dir.path().join("turned.toml");
+    let text = std::fs::read_to_string(&tapered)
+        .unwrap()
+        .replace("[base]\n", "[base]\nrotation_inputs = [\"p\"]\n");
+    std::fs::write(&turned, text).unwrap();
+    let (b, r) = route(&turned.to_string_lossy(), "", auto);
+    assert_eq!(b, "interpreted", "{r}");
+    assert!(r.contains("rotation_inputs"), "{r}");
     let example = root().join("examples/palm.toml");
     let (b, r) = route(&example.to_string_lossy(), "", auto);
     assert_eq!(b, "interpreted");

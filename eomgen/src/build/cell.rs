@@ -8,19 +8,21 @@
 //! dissipative generalised forces, as one tape of the link's coordinates
 //! and [`CELL_PARAMS`] parameters. Links of the same shape share a cell.
 //!
-//! Chains this covers: every segment pcc, vc or rom, the base still or
-//! moved along a driven path (not turned), no driven joint torques. Chambers and tendons load each element's strain
-//! by their segment's loads (`actuation::segment_loads`: linear in the
-//! strain; an element's own where its chamber levers vary along the
-//! segment), which a small kernel of the parameters gives and the cells
-//! read as parameters: every cell reads them, zero where no actuator acts,
-//! so that an arm with chambers runs on a bare arm's cells. A rom
-//! segment's slices are links whose cell coordinates are fixed
-//! combinations of the segment's coefficients (`LocalCoordinate`); its
-//! strain energy, integrated exactly over the segment, is one more small
-//! kernel (`derive_forces`). Loads along the arm act at points on the
-//! links' arcs (`runtime::links::AlongLoad`), where contact points are
-//! sampled. Other models keep the flat `MassBias` kernel.
+//! Chains this covers: every segment of a method with link cells
+//! (the method's `link_cells`), the base still or moved along a driven path
+//! (not turned). Chambers and tendons load each element's strain by their
+//! segment's loads (`actuation::segment_loads`: linear in the strain; an
+//! element's own where its chamber levers vary along the segment), which
+//! a small kernel of the parameters gives and the cells read as
+//! parameters: every cell reads them, zero where no actuator acts, so
+//! that an arm with chambers runs on a bare arm's cells. A rom segment's
+//! slices are links whose cell coordinates are fixed combinations of the
+//! segment's coefficients (`LocalCoordinate`); its strain energy,
+//! integrated exactly over the segment, is one more small kernel
+//! (`derive_forces`). Loads along the arm act at points on the links'
+//! arcs (`runtime::links::AlongLoad`), where contact points are sampled;
+//! driven forces on named coordinates (`[[torque]]`) go straight into h.
+//! Other models keep the flat `MassBias` kernel.
 
 use runtime::Tape;
 use runtime::links::{
@@ -282,7 +284,6 @@ fn covered(st: &Structure) -> bool {
             .segments
             .iter()
             .all(|g| crate::method::of(g.method).link_cells()))
-        && st.torques.is_empty()
         && st.base_turns == 0
         // Buoyancy is each link's felt gravity; drag is not a cell's yet.
         && st.fluid != Some(true)
@@ -518,8 +519,25 @@ fn globals(st: &Structure, params: &ParamLayout) -> LinkLayout {
         tip_length: st.tip_length.then(|| index(Param::TipLength)),
         tip_inertia: (st.tip_mass && st.tip_length)
             .then(|| [index(Param::TipInertia), index(Param::TipAxialInertia)]),
+        torques: coordinate_torques(st, params),
         ..Default::default()
     }
+}
+
+/// The driven forces on named coordinates: each coordinate's index among
+/// the arm's (the flat kernels' order) and its value's slot.
+fn coordinate_torques(st: &Structure, params: &ParamLayout) -> Vec<[usize; 2]> {
+    if st.torques.is_empty() {
+        return Vec::new();
+    }
+    let names = crate::method::coordinate_names(st);
+    (st.torques.iter().enumerate())
+        .map(|(i, name)| {
+            // Validation checked the name against the coordinates.
+            let k = (names.iter().position(|n| n == name)).expect("validated coordinate name");
+            [k, params.index(Param::Torque(i))]
+        })
+        .collect()
 }
 
 /// What a cell depends on besides its parameters' values.

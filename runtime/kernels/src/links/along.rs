@@ -5,7 +5,9 @@
 //! column and its section's angular column), taken from h; its directional
 //! derivative from the Jvp; a constant world force's potential -F . p from
 //! the outputs' potential energy, as the flat kernels do
-//! (`eomgen/src/tmt/along.rs` places the same points).
+//! (`eomgen/src/tmt/along.rs` places the same points). Driven forces on
+//! the arm's coordinates (`[[torque]]`, `LinkLayout::torques`) are taken
+//! from h here too; they have no potential, as in the flat kernels.
 
 use serde::{Deserialize, Serialize};
 
@@ -51,7 +53,13 @@ fn generalised<N: Num>(
     (q, qd, dq, p): At,
     mut add_to: impl FnMut(usize, N),
 ) {
+    for &[a, slot] in &layout.torques {
+        add_to(a, N::constant(p[slot]));
+    }
     let loads = &layout.along;
+    if loads.is_empty() {
+        return;
+    }
     let points: Vec<ContactPoint> = loads.iter().map(|l| l.at).collect();
     let asked = Asked {
         columns: true,
@@ -76,7 +84,8 @@ fn generalised<N: Num>(
     );
 }
 
-/// h minus the loads' generalised forces.
+/// h minus the loads' generalised forces, the coordinates' driven ones
+/// included.
 pub fn subtract_loads(
     layout: &LinkLayout,
     cells: &mut dyn Cells,
@@ -88,7 +97,7 @@ pub fn subtract_loads(
 
 /// tau and its tangent `dtau` minus the loads' generalised forces and
 /// their derivative along `dq` (they depend on q and the parameters
-/// alone).
+/// alone; the coordinates' driven ones on the parameters alone).
 pub fn subtract_loads_tangent(
     layout: &LinkLayout,
     cells: &mut dyn Cells,

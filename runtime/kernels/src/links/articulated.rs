@@ -163,12 +163,12 @@ pub fn accelerations_owned<C: Cells>(
             at += nc;
         }
         let tip = forward(layout, cells, p, s);
-        // Loads along the arm: generalised forces added to h, each to its
-        // own coordinate's u (`s.forces` is free: no rom forces here).
+        // Loads along the arm and on its coordinates: generalised forces
+        // added to h, each to its own coordinate's u (`s.forces` is free: no rom forces here).
         let n = layout.dof;
         s.forces.clear();
         s.forces.resize(n, 0.0);
-        if !layout.along.is_empty() {
+        if layout.loaded() {
             super::subtract_loads(layout, cells, (q, qd, p), &mut s.forces);
         }
         let mut ia = tip.past.matrix();
@@ -179,7 +179,7 @@ pub fn accelerations_owned<C: Cells>(
         let mut ok = true;
         for k in (0..nl).rev() {
             let nc = layout.links[k].map.len();
-            let l = s.links[k];
+            let l = &s.links[k];
             let at = s.start[k];
             let mut body = Inertia::default();
             body.add_body(l.m, l.centroid, &l.rotary);

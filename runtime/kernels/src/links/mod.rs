@@ -254,6 +254,10 @@ pub struct LinkLayout {
     /// The loads along the chain, in the links' order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub along: Vec<AlongLoad>,
+    /// Driven generalised forces on the arm's coordinates (`[[torque]]`):
+    /// each an arm coordinate and the slot of its value.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub torques: Vec<[usize; 2]>,
     /// Each segment's last link: where its end frame, which joints may
     /// hold, is.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -264,6 +268,12 @@ pub struct LinkLayout {
 }
 
 impl LinkLayout {
+    /// Whether applied loads other than the tip's act: loads along the
+    /// chain or on its coordinates ([`subtract_loads`]).
+    pub fn loaded(&self) -> bool {
+        !self.along.is_empty() || !self.torques.is_empty()
+    }
+
     /// The weights of every link's cell coordinates, dense: for link k
     /// and cell coordinate f < [`MAX_LINK_DOF`], a row of the arm's
     /// coordinates padded to [`padded`]`(dof)` (zeros for unused f), at
@@ -629,13 +639,13 @@ impl Inertia {
         let diag = j.lateral + m * r2;
         self.m += m;
         self.h = add(self.h, scale(m, r));
-        for (k, (a, b)) in [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)]
-            .into_iter()
-            .enumerate()
-        {
+        const PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
+        for (k, (a, b)) in PAIRS.into_iter().enumerate() {
             let base = if k < 3 { diag } else { 0.0 };
             self.j[k] += base + d * j.axis[a] * j.axis[b] - m * r[a] * r[b];
-            if j.extra != 0.0 {
+        }
+        if j.extra != 0.0 {
+            for (k, (a, b)) in PAIRS.into_iter().enumerate() {
                 self.j[k] += j.extra * j.y[a] * j.y[b];
             }
         }
@@ -939,7 +949,8 @@ fn link_sums(
     [[f64; MAX_LINK_DOF]; MAX_LINK_DOF],
     [f64; MAX_LINK_DOF],
 ) {
-    let l = s.links[k];
+    // By reference: a copy of the link is a call to memcpy.
+    let l = &s.links[k];
     let at = s.start[k];
     let mut momentum = [([0.0; 3], [0.0; 3]); MAX_LINK_DOF];
     let mut block = [[0.0; MAX_LINK_DOF]; MAX_LINK_DOF];
@@ -1008,7 +1019,7 @@ pub fn mass_bias_owned<C: Cells>(
         true => planar::mass_bias(layout, cells, q, qd, p, out),
         false => mass_bias_spatial(layout, cells, q, qd, p, out),
     }
-    if !layout.along.is_empty() {
+    if layout.loaded() {
         let n = layout.dof;
         subtract_loads(layout, cells, (q, qd, p), &mut out[n * (n + 1) / 2..]);
     }
@@ -1177,7 +1188,7 @@ pub fn mass_bias_shared<const N: usize, C: Cells>(
         }
     }
     SCRATCH.set(scratch);
-    if !layout.along.is_empty() {
+    if layout.loaded() {
         subtract_loads(layout, cells, (q, qd, p), &mut out[n * (n + 1) / 2..]);
     }
 }

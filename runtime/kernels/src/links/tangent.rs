@@ -170,7 +170,7 @@ pub fn inverse_dynamics_tangent<C: Cells>(
             dtau[i] += f[n + i];
         }
     }
-    if !layout.along.is_empty() {
+    if layout.loaded() {
         super::subtract_loads_tangent(layout, cells, (q, qd, p), dq, (tau, dtau));
     }
 }
