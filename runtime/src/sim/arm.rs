@@ -165,7 +165,7 @@ impl Arm<Box<dyn Kernels>> {
     /// An arm on kernels chosen at run time, as the integrators see it. Not
     /// generic, so that this arm's methods are compiled here with the
     /// runtime's optimisation, not in the caller's crate (the CLI's is
-    /// built at opt-level 1: chain's mass + bias 11 % slower through it).
+    /// built at opt-level 1: chain's mass + bias 8 to 13 % slower through it).
     pub fn boxed(kernels: Box<dyn Kernels>, params: Vec<f64>) -> Box<dyn Dynamics> {
         Box::new(Self::new(kernels, params))
     }

@@ -164,7 +164,8 @@ pub fn accelerations_owned<C: Cells>(
         }
         let tip = forward(layout, cells, p, s);
         // Loads along the arm and on its coordinates: generalised forces
-        // added to h, each to its own coordinate's u (`s.forces` is free: no rom forces here).
+        // added to h, each to its own coordinate's u (`s.forces` is free:
+        // no rom forces here).
         let n = layout.dof;
         s.forces.clear();
         s.forces.resize(n, 0.0);
