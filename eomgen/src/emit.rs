@@ -1215,13 +1215,15 @@ fn emit_link_recursion(
     let n_outputs = runtime::N_OUTPUTS;
     // Chains of owned links sum by composite bodies; shared links (rom
     // slices) need the arm's coordinates in rows of a fixed length.
+    // The sweep is built for the bodies this chain has.
+    let bodies = layout.general_bodies();
     let call = if runtime::links::all_owned(layout) {
-        quote!(runtime::links::mass_bias_owned(
+        quote!(runtime::links::mass_bias_owned::<_, #bodies>(
             &LINKS, &mut cells, q, qd, p, out
         ))
     } else {
         let rows = runtime::links::padded(dof);
-        quote!(runtime::links::mass_bias_shared::<#rows, _>(&LINKS, &mut cells, q, qd, p, out))
+        quote!(runtime::links::mass_bias_shared::<#rows, _, #bodies>(&LINKS, &mut cells, q, qd, p, out))
     };
     let cells_impl = emit_cells_impl(
         links,

@@ -362,7 +362,11 @@ impl LinkedKernels {
     unsafe fn accelerations_fma(&self, inp: &Inputs, qdd: &mut [f64]) -> bool {
         let mut slots = self.slots.borrow_mut();
         let mut cells = self.linked(inp, &mut slots);
-        accelerations_owned(&self.links.layout, &mut cells, inp.q, inp.qd, inp.p, qdd)
+        let layout = &self.links.layout;
+        match layout.general_bodies() {
+            true => accelerations_owned::<_, true>(layout, &mut cells, inp.q, inp.qd, inp.p, qdd),
+            false => accelerations_owned::<_, false>(layout, &mut cells, inp.q, inp.qd, inp.p, qdd),
+        }
     }
 
     /// The recursion built for FMA as the generated kernels build it: its
@@ -373,9 +377,10 @@ impl LinkedKernels {
         let mut cells = self.linked(inp, &mut slots);
         let layout = &self.links.layout;
         match kind {
-            KernelKind::MassBias if all_owned(layout) => {
-                mass_bias_owned(layout, &mut cells, inp.q, inp.qd, inp.p, out)
-            }
+            KernelKind::MassBias if all_owned(layout) => match layout.general_bodies() {
+                true => mass_bias_owned::<_, true>(layout, &mut cells, inp.q, inp.qd, inp.p, out),
+                false => mass_bias_owned::<_, false>(layout, &mut cells, inp.q, inp.qd, inp.p, out),
+            },
             KernelKind::MassBias => {
                 mass_bias_shared_dyn(layout, &mut cells, inp.q, inp.qd, inp.p, out)
             }

@@ -138,9 +138,10 @@ pub(super) struct Eliminated {
 /// qdd = -M^-1 h of a chain whose links own their coordinates
 /// ([`all_owned`]) into `qdd`, by the articulated-body recursion; false
 /// unless every link's D is positive definite (M is then too).
-/// Inlined into its caller, which builds it for FMA.
+/// `BODIES`: [`LinkLayout::general_bodies`]. Inlined into its caller,
+/// which builds it for FMA.
 #[inline(always)]
-pub fn accelerations_owned<C: Cells>(
+pub fn accelerations_owned<C: Cells, const BODIES: bool>(
     layout: &LinkLayout,
     cells: &mut C,
     q: &[f64],
@@ -162,7 +163,7 @@ pub fn accelerations_owned<C: Cells>(
             s.xd[k][..nc].copy_from_slice(&qd[at..at + nc]);
             at += nc;
         }
-        let tip = forward(layout, cells, p, s);
+        let tip = forward::<C, BODIES>(layout, cells, p, s);
         // Loads along the arm and on its coordinates: generalised forces
         // added to h, each to its own coordinate's u (`s.forces` is free:
         // no rom forces here).
@@ -183,7 +184,7 @@ pub fn accelerations_owned<C: Cells>(
             let l = &s.links[k];
             let at = s.start[k];
             let mut body = Inertia::default();
-            body.add_body(l.m, l.centroid, &l.rotary);
+            body.add_body::<BODIES>(l.m, l.centroid, &l.rotary);
             let ib = body.matrix();
             let fb = six((add(l.torque, cross(l.centroid, l.force)), l.force));
             let e = &mut kept[k];

@@ -274,6 +274,15 @@ impl LinkLayout {
         !self.along.is_empty() || !self.torques.is_empty()
     }
 
+    /// Whether some link's body needs more than an axisymmetric inertia
+    /// in still air: a section that bends unequally
+    /// ([`LinkSpec::principal`]) or an immersed arm's buoyancy. The
+    /// recursion is built for each answer (its `BODIES` parameter), so
+    /// that the common chain's sweep carries neither term.
+    pub fn general_bodies(&self) -> bool {
+        self.fluid_density.is_some() || self.links.iter().any(|l| l.principal.is_some())
+    }
+
     /// The weights of every link's cell coordinates, dense: for link k
     /// and cell coordinate f < [`MAX_LINK_DOF`], a row of the arm's
     /// coordinates padded to [`padded`]`(dof)` (zeros for unused f), at
@@ -604,16 +613,14 @@ impl Rotary {
         }
     }
 
-    /// J w.
+    /// J w; `BODIES` as [`LinkLayout::general_bodies`].
     #[inline(always)]
-    fn apply(&self, w: V3) -> V3 {
+    fn apply<const BODIES: bool>(&self, w: V3) -> V3 {
         let j = add(
             scale(self.lateral, w),
             scale((self.axial - self.lateral) * dot(self.axis, w), self.axis),
         );
-        // A branch, not a product by zero: axisymmetric bodies are the
-        // common case and the recursion's hot path.
-        match self.extra != 0.0 {
+        match BODIES && self.extra != 0.0 {
             true => add(j, scale(self.extra * dot(self.y, w), self.y)),
             false => j,
         }
@@ -631,9 +638,10 @@ struct Inertia {
 
 impl Inertia {
     /// Adds a body of mass m at r of rotary inertia `j` ([`Rotary`]):
-    /// J += j + m (|r|^2 1 - r r^T).
+    /// J += j + m (|r|^2 1 - r r^T); `BODIES` as
+    /// [`LinkLayout::general_bodies`].
     #[inline(always)]
-    fn add_body(&mut self, m: f64, r: V3, j: &Rotary) {
+    fn add_body<const BODIES: bool>(&mut self, m: f64, r: V3, j: &Rotary) {
         let r2 = dot(r, r);
         let d = j.axial - j.lateral;
         let diag = j.lateral + m * r2;
@@ -644,7 +652,7 @@ impl Inertia {
             let base = if k < 3 { diag } else { 0.0 };
             self.j[k] += base + d * j.axis[a] * j.axis[b] - m * r[a] * r[b];
         }
-        if j.extra != 0.0 {
+        if BODIES && j.extra != 0.0 {
             for (k, (a, b)) in PAIRS.into_iter().enumerate() {
                 self.j[k] += j.extra * j.y[a] * j.y[b];
             }
@@ -799,9 +807,15 @@ fn evaluate_cells<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &m
 /// far, its body's inertial and gravity forces, the twists of its cell
 /// coordinates; then the tip body and loads. The caller has put the cell
 /// coordinates and rates in `s.x`, `s.xd` and the links' starts in
-/// `s.start`.
+/// `s.start`. `BODIES`: [`LinkLayout::general_bodies`].
 #[inline(always)]
-fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scratch) -> Tip {
+fn forward<C: Cells, const BODIES: bool>(
+    layout: &LinkLayout,
+    cells: &mut C,
+    p: &[f64],
+    s: &mut Scratch,
+) -> Tip {
+    debug_assert!(BODIES || !layout.general_bodies());
     let nl = layout.links.len();
     s.links.resize(nl, Link::default());
     s.start.clear();
@@ -842,7 +856,7 @@ fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scra
         let (w_b, w_b_d) = (turn(cell::BODY_OMEGA), turn(cell::BODY_OMEGA_RATE));
         let m = c(cell::MASS);
         let mut rotary = Rotary::axisymmetric(c(cell::LATERAL), c(cell::AXIAL), turn(cell::AXIS));
-        if spec.principal.is_some() {
+        if BODIES && spec.principal.is_some() {
             let at = cell::len(nc);
             rotary.y = turn(at);
             rotary.extra = c(at + 3) - rotary.lateral;
@@ -856,14 +870,18 @@ fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scra
         );
         let body_w = add(omega, w_b);
         let body_alpha = add(add(alpha, cross(omega, w_b)), w_b_d);
-        let iw = rotary.apply(body_w);
+        let iw = rotary.apply::<BODIES>(body_w);
         let end = add(pos, d);
+        let g = match BODIES {
+            true => link_gravity(layout, spec, p, gravity),
+            false => gravity,
+        };
         s.links[k] = Link {
             centroid: add(pos, cen),
             m,
             rotary,
-            force: scale(m, sub(body_a, link_gravity(layout, spec, p, gravity))),
-            torque: add(rotary.apply(body_alpha), cross(body_w, iw)),
+            force: scale(m, sub(body_a, g)),
+            torque: add(rotary.apply::<BODIES>(body_alpha), cross(body_w, iw)),
         };
         let force_at = cell::forces(nc);
         for f in 0..nc {
@@ -914,9 +932,9 @@ fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scra
             cross(omega, cross(omega, offset)),
         );
         let force = scale(m, sub(a_c, gravity));
-        let iw = rotary.apply(omega);
-        let torque = add(rotary.apply(alpha), cross(omega, iw));
-        past.add_body(m, centre, &rotary);
+        let iw = rotary.apply::<false>(omega);
+        let torque = add(rotary.apply::<false>(alpha), cross(omega, iw));
+        past.add_body::<false>(m, centre, &rotary);
         wrench = (add(torque, cross(centre, force)), force);
     }
     // Applied loads enter as forces of the opposite sign.
@@ -939,7 +957,7 @@ fn forward<C: Cells>(layout: &LinkLayout, cells: &mut C, p: &[f64], s: &mut Scra
 /// link's own block of M, the generalised bias. Then the link joins the
 /// composite.
 #[inline(always)]
-fn link_sums(
+fn link_sums<const BODIES: bool>(
     s: &Scratch,
     k: usize,
     nc: usize,
@@ -961,7 +979,7 @@ fn link_sums(
     #[allow(clippy::needless_range_loop)] // own and body side by side
     for f in 0..nc {
         let (ow, ov) = s.own[at + f];
-        body[f] = (l.rotary.apply(ow), scale(l.m, ov));
+        body[f] = (l.rotary.apply::<BODIES>(ow), scale(l.m, ov));
     }
     for f in 0..nc {
         let (ow, ov) = s.own[at + f];
@@ -981,7 +999,7 @@ fn link_sums(
             block[f2][f] = block[f][f2];
         }
     }
-    tip.past.add_body(l.m, l.centroid, &l.rotary);
+    tip.past.add_body::<BODIES>(l.m, l.centroid, &l.rotary);
     let torque = add(l.torque, cross(l.centroid, l.force));
     tip.wrench = (add(tip.wrench.0, torque), add(tip.wrench.1, l.force));
     (momentum, block, g)
@@ -1003,10 +1021,12 @@ fn take_scratch(layout: &LinkLayout, out: &[f64]) -> Scratch {
 /// coordinates ([`all_owned`]: pcc, vc) into `out` (the `MassBias`
 /// layout), by composite bodies from the tip: a link's rows of M are its
 /// coordinates' twists against the momenta of the composite past it.
-/// `cells` evaluates the links' cells ([`Cells`]).
-/// Inlined into its caller, which the generated code builds for FMA.
+/// `cells` evaluates the links' cells ([`Cells`]); `BODIES` is the
+/// layout's [`LinkLayout::general_bodies`], known where the call is
+/// emitted. Inlined into its caller, which the generated code builds for
+/// FMA.
 #[inline(always)]
-pub fn mass_bias_owned<C: Cells>(
+pub fn mass_bias_owned<C: Cells, const BODIES: bool>(
     layout: &LinkLayout,
     cells: &mut C,
     q: &[f64],
@@ -1017,7 +1037,7 @@ pub fn mass_bias_owned<C: Cells>(
     debug_assert!(all_owned(layout));
     match planar::covers(layout) {
         true => planar::mass_bias(layout, cells, q, qd, p, out),
-        false => mass_bias_spatial(layout, cells, q, qd, p, out),
+        false => mass_bias_spatial::<C, BODIES>(layout, cells, q, qd, p, out),
     }
     if layout.loaded() {
         let n = layout.dof;
@@ -1029,7 +1049,7 @@ pub fn mass_bias_owned<C: Cells>(
 /// rotation about z), which the tests compare with `planar`'s sums.
 #[inline(always)]
 #[doc(hidden)] // white-box tests (tests/suite)
-pub fn mass_bias_spatial<C: Cells>(
+pub fn mass_bias_spatial<C: Cells, const BODIES: bool>(
     layout: &LinkLayout,
     cells: &mut C,
     q: &[f64],
@@ -1051,13 +1071,13 @@ pub fn mass_bias_spatial<C: Cells>(
             s.xd[k][..nc].copy_from_slice(&qd[at..at + nc]);
             at += nc;
         }
-        let mut tip = forward(layout, cells, p, s);
+        let mut tip = forward::<C, BODIES>(layout, cells, p, s);
         s.momentum.resize(n, ([0.0; 3], [0.0; 3]));
         let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
         let index = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
         for (k, spec) in layout.links.iter().enumerate().rev() {
             let (a, nc) = (s.start[k], spec.map.len());
-            let (momentum, block, g) = link_sums(s, k, nc, &mut tip);
+            let (momentum, block, g) = link_sums::<BODIES>(s, k, nc, &mut tip);
             for f in 0..nc {
                 bias[a + f] = g[f];
                 for f2 in f..nc {
@@ -1094,9 +1114,10 @@ pub fn mass_bias_spatial<C: Cells>(
 /// links past e (F_e: the momenta of e's cell rates on e and past):
 /// M = X + X^T with X = sum_e W_e^T (S_e^T R_e + D_e W_e / 2). Each link
 /// costs O(cell coordinates x arm coordinates), not a Jacobian product
-/// over all pairs of the arm's coordinates.
+/// over all pairs of the arm's coordinates. `BODIES`: as
+/// [`mass_bias_owned`]'s.
 #[inline(always)]
-pub fn mass_bias_shared<const N: usize, C: Cells>(
+pub fn mass_bias_shared<const N: usize, C: Cells, const BODIES: bool>(
     layout: &LinkLayout,
     cells: &mut C,
     q: &[f64],
@@ -1130,7 +1151,7 @@ pub fn mass_bias_shared<const N: usize, C: Cells>(
                 };
             }
         }
-        let mut tip = forward(layout, cells, p, s);
+        let mut tip = forward::<C, BODIES>(layout, cells, p, s);
         let mut reach = [[0.0; N]; 6];
         let mut x = [[0.0; N]; N];
         let mut h = [0.0; N];
@@ -1142,7 +1163,7 @@ pub fn mass_bias_shared<const N: usize, C: Cells>(
             let sc: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| {
                 spec.map.get(f).and_then(|c| c.scale).map_or(1.0, |i| p[i])
             });
-            let (momentum, block, g) = link_sums(s, k, nc, &mut tip);
+            let (momentum, block, g) = link_sums::<BODIES>(s, k, nc, &mut tip);
             // Unused cell coordinates have zero blocks, forces and momenta.
             let gs: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| g[f] * sc[f]);
             rows::add_combination(simd, &mut h, &gs, w);
@@ -1209,10 +1230,10 @@ pub fn mass_bias<C: Cells>(
     p: &[f64],
     out: &mut [f64],
 ) {
-    if all_owned(layout) {
-        mass_bias_owned(layout, cells, q, qd, p, out)
-    } else {
-        mass_bias_shared_dyn(layout, cells, q, qd, p, out)
+    match (all_owned(layout), layout.general_bodies()) {
+        (true, true) => mass_bias_owned::<C, true>(layout, cells, q, qd, p, out),
+        (true, false) => mass_bias_owned::<C, false>(layout, cells, q, qd, p, out),
+        (false, _) => mass_bias_shared_dyn(layout, cells, q, qd, p, out),
     }
 }
 
@@ -1220,7 +1241,8 @@ pub fn mass_bias<C: Cells>(
 /// keeps larger ones on the flat kernel.
 pub const MAX_SHARED_DOF: usize = 64;
 
-/// [`mass_bias_shared`] with `N` picked at run time ([`padded`]); for any
+/// [`mass_bias_shared`] with `N` and `BODIES` picked at run time
+/// ([`padded`], [`LinkLayout::general_bodies`]); for any
 /// chain, owned links included (tests check the two strategies agree).
 /// Inlined into its caller, which linked chains build for FMA.
 #[inline(always)]
@@ -1234,9 +1256,10 @@ pub fn mass_bias_shared_dyn<C: Cells>(
 ) {
     macro_rules! pick {
         ($($n:literal)*) => {
-            match padded(layout.dof) {
-                $($n => mass_bias_shared::<$n, C>(layout, cells, q, qd, p, out),)*
-                w => panic!("shared sums stop at {MAX_SHARED_DOF} coordinates, not {w}"),
+            match (padded(layout.dof), layout.general_bodies()) {
+                $(($n, true) => mass_bias_shared::<$n, C, true>(layout, cells, q, qd, p, out),
+                ($n, false) => mass_bias_shared::<$n, C, false>(layout, cells, q, qd, p, out),)*
+                (w, _) => panic!("shared sums stop at {MAX_SHARED_DOF} coordinates, not {w}"),
             }
         };
     }

@@ -253,7 +253,7 @@ fn planar_sums_equal_the_spatial_recursion() {
     let n = spatial.dof;
     let (q, qd) = ([0.4, -0.7, 1.1], [0.5, -1.2, 2.0]);
     let mut want = vec![f64::NAN; n * (n + 1) / 2 + n];
-    mass_bias_spatial(&spatial, &mut Pendulums, &q, &qd, &p, &mut want);
+    mass_bias_spatial::<_, false>(&spatial, &mut Pendulums, &q, &qd, &p, &mut want);
     let mut got = vec![f64::NAN; want.len()];
     mass_bias(&planar, &mut Pendulums, &q, &qd, &p, &mut got);
     for (i, (g, w)) in got.iter().zip(&want).enumerate() {
