@@ -154,11 +154,6 @@ fn linked(
     if arms.iter().any(|s| s.fluid == Some(true)) {
         return Err("its fluid's drag is not a link cell yet".into());
     }
-    if arms.iter().any(|s| s.base_turns > 0) {
-        return Err(
-            "a base turned by its inputs (`rotation_inputs`) is not a link cell yet".into(),
-        );
-    }
     let not_cells = || "not every one of its methods' elements is a link cell".to_string();
     let kernels: (Box<dyn Kernels>, String) = if structure.assembly.is_some() {
         let (tapes, _, _) = tapes(model, &structure.hash(), cache_dir);

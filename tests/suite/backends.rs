@@ -927,6 +927,24 @@ fn shaken(text: &str, inputs: &str) -> String {
     format!("{text}{signals}")
 }
 
+/// `text` on a base turned by inputs: in space (`dimensions` 3) a yaw
+/// and a pitch about axes of any length, in the plane one turn.
+fn turned(text: &str, dimensions: u8) -> String {
+    let turns = match dimensions {
+        3 => {
+            "rotation_inputs = [\"yaw\", \"pitch\"]\nrotation_axes = [[0.0, 0.0, 2.0], [0.3, 1.0, 0.0]]"
+        }
+        _ => "rotation_inputs = [\"yaw\"]",
+    };
+    let mut signals =
+        "[inputs.yaw]\nkind = \"sine\"\namplitude = 0.4\nfrequency = 1.5\n".to_string();
+    if dimensions == 3 {
+        signals += "[inputs.pitch]\nkind = \"sine\"\namplitude = 0.3\nfrequency = 2.5\n";
+    }
+    let text = text.replacen("[base]", &format!("[base]\n{turns}"), 1);
+    format!("{text}{signals}")
+}
+
 /// A chain of every link shape and tip the recursion covers: every
 /// bundled chain, actuated arms of every covered method, and cantilever3d
 /// under rom slices, stretch, thinning, vc, tip wrenches and tip bodies;
@@ -951,6 +969,13 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
     let shaken2d = file("shaken2d", &shaken(LOADED_2D, r#"["sx", "sy"]"#));
     let immersed3d = file("immersed3d", &format!("{ACTUATED_3D}{IMMERSED}"));
     let immersed2d = file("immersed2d", &format!("{LOADED_2D}{IMMERSED}"));
+    // Turned by inputs: in space two turns about axes of any length on a
+    // shaken base, in the plane one.
+    let turned3d = file(
+        "turned3d",
+        &turned(&shaken(LOADED_3D, r#"["sx", "sy", "sz"]"#), 3),
+    );
+    let turned2d = file("turned2d", &turned(LOADED_2D, 2));
     // Chamber levers that vary along a segment (tapered, the chambers
     // nearer the axis towards the tip): each element's own loads.
     let varying = file(
@@ -974,6 +999,8 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
         (&shaken2d, &[]),
         (&immersed3d, &[]),
         (&immersed2d, &[]),
+        (&turned3d, &[]),
+        (&turned2d, &[]),
         (&varying, &[]),
         (&varying2d, &[]),
         // Planar chains: rigid links and pcc arcs (whose inertia changes
@@ -1015,7 +1042,17 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
         (&actuated, &[]),
         (&actuated, &["segment.1.incompressible=true"]),
     ];
-    let cases: [&[&str]; 9] = [
+    let cases = cantilever3d_cases();
+    models.extend(cases.iter().map(|&sets| ("cantilever3d", sets)));
+    (models.into_iter())
+        .map(|(m, sets)| (m.to_string(), sets.to_vec()))
+        .collect()
+}
+
+/// cantilever3d's variants in [`link_shapes`]: rom slices, stretch,
+/// thinning, vc, tip wrenches and tip bodies.
+fn cantilever3d_cases() -> [&'static [&'static str]; 9] {
+    [
         // rom slices: coordinates shared along the segment, the segment's
         // energies from the forces kernel.
         &[
@@ -1075,11 +1112,7 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
             "tip.force=[0.0,0.3,0.0]",
             "gravity=[0,-9.81,0]",
         ],
-    ];
-    models.extend(cases.iter().map(|&sets| ("cantilever3d", sets)));
-    (models.into_iter())
-        .map(|(m, sets)| (m.to_string(), sets.to_vec()))
-        .collect()
+    ]
 }
 
 /// The flat tapes of a chain and its link recursion.
@@ -1522,6 +1555,27 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
     let text = std::fs::read_to_string(model_path("finger_tap")).unwrap() + "\n";
     std::fs::write(&shaken_tap, shaken(&text, r#"["sx", "sy"]"#)).unwrap();
     let shaken_tap = shaken_tap.to_string_lossy().into_owned();
+    // Turned by inputs, tapping and on the sphere: the points'
+    // velocities carry the base's spin.
+    let turned_tap = dir.path().join("turned_tap.toml");
+    let text = std::fs::read_to_string(model_path("finger_tap")).unwrap() + "\n";
+    std::fs::write(&turned_tap, turned(&text, 2)).unwrap();
+    let turned_tap = turned_tap.to_string_lossy().into_owned();
+    let turned_ball = dir.path().join("turned_ball.toml");
+    let text = std::fs::read_to_string(model_path("tentacle3d")).unwrap();
+    std::fs::write(&turned_ball, turned(&format!("{text}{sphere}"), 3)).unwrap();
+    let turned_ball = turned_ball.to_string_lossy().into_owned();
+    // An assembly whose arm turns on its base.
+    let turned_ball_drop = dir.path().join("turned_falling_ball.toml");
+    let text = std::fs::read_to_string(model_path("falling_ball")).unwrap().replacen(
+        "base = { position = [0.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0] }",
+        "base = { position = [0.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0], rotation_inputs = [\"yaw\"] }",
+        1,
+    );
+    assert!(text.contains("rotation_inputs"));
+    let text = format!("{text}\n[inputs.yaw]\nkind = \"sine\"\namplitude = 0.4\nfrequency = 1.5\n");
+    std::fs::write(&turned_ball_drop, text).unwrap();
+    let turned_ball_drop = turned_ball_drop.to_string_lossy().into_owned();
     let (tentacle_ball, rod_ball, rom_ball) = (
         on_sphere("tentacle_ball", "tentacle3d"),
         on_sphere("rod_ball", "rod_swing"),
@@ -1548,6 +1602,8 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         ("finger_tap", "segment.0.elements=7"),
         ("wrap", "segment.0.elements=9"),
         (shaken_tap.as_str(), "segment.0.elements=7"),
+        (turned_tap.as_str(), "segment.0.elements=7"),
+        (turned_ball.as_str(), "segment.0.elements=5"),
         (tentacle_ball.as_str(), "segment.0.elements=5"),
         (rod_ball.as_str(), "segment.0.elements=3"),
         (rom_ball.as_str(), "segment.0.quadrature=3"),
@@ -1555,6 +1611,7 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         // points too; the rest (the ball, its contact point, the joints)
         // by the assembly's tapes.
         ("falling_ball", "arm.left.segment.0.elements=7"),
+        (turned_ball_drop.as_str(), "arm.left.segment.0.elements=7"),
         (held.as_str(), "segment.1.elements=3"),
         (pinch.as_str(), "arm.right.segment.0.elements=3"),
         ("ball_drop", "arm.right.segment.1.elements=3"),
@@ -1622,8 +1679,14 @@ fn articulated_body_accelerations_equal_the_mass_matrix_solve() {
     )
     .unwrap();
     let owned = owned.to_str().unwrap().to_string();
+    // On a base turned by inputs: the sweep starts in the spinning frame.
+    let spun = dir.path().join("turned_tentacle.toml");
+    let text = std::fs::read_to_string(model_path("tentacle3d")).unwrap();
+    std::fs::write(&spun, turned(&text, 3)).unwrap();
+    let spun = spun.to_str().unwrap().to_string();
     for (model, sets) in [
         (owned.as_str(), &[][..]),
+        (spun.as_str(), &["segment.0.elements=13"][..]),
         ("tentacle3d", &["segment.0.elements=13"][..]),
         ("cantilever3d", &["segment.0.elements=7"][..]),
         (
@@ -1701,26 +1764,8 @@ fn articulated_body_accelerations_equal_the_mass_matrix_solve() {
 /// cells for a new element count of a compiled-in chain (planar, 3D, with
 /// contact, an assembly's arms), and for the interpreter what the
 /// compiled routes lacked (a link shape no model has).
-#[test]
-fn a_run_says_which_route_it_took_and_why() {
-    let route = |model: &str, set: &str, choice: BackendChoice| {
-        let sets: Vec<_> = (!set.is_empty())
-            .then(|| eomgen::model::Override::parse(set).unwrap())
-            .into_iter()
-            .collect();
-        let dir = tempfile::tempdir().unwrap();
-        let l = load(model, &sets, choice, Some(dir.path().to_path_buf())).unwrap();
-        (l.arm.backend(), l.route)
-    };
-    let auto = BackendChoice::Auto;
-    // A tapered 3D pcc arm with chambers: no bundled model has its
-    // structure, but every link shape (cells read their actuation loads,
-    // zero where none act: tentacle3d's bare cells serve it).
-    let dir = tempfile::tempdir().unwrap();
-    let tapered = dir.path().join("tapered.toml");
-    std::fs::write(
-        &tapered,
-        r#"
+/// A tapered 3D pcc arm of two segments, chambers in the first.
+const TAPERED_3D: &str = r#"
 name = "tapered"
 dimensions = 3
 gravity = [0.0, 0.0, -9.81]
@@ -1748,9 +1793,26 @@ youngs_modulus = 5e5
 [inputs.p]
 kind = "constant"
 value = 1000.0
-"#,
-    )
-    .unwrap();
+"#;
+
+#[test]
+fn a_run_says_which_route_it_took_and_why() {
+    let route = |model: &str, set: &str, choice: BackendChoice| {
+        let sets: Vec<_> = (!set.is_empty())
+            .then(|| eomgen::model::Override::parse(set).unwrap())
+            .into_iter()
+            .collect();
+        let dir = tempfile::tempdir().unwrap();
+        let l = load(model, &sets, choice, Some(dir.path().to_path_buf())).unwrap();
+        (l.arm.backend(), l.route)
+    };
+    let auto = BackendChoice::Auto;
+    // A tapered 3D pcc arm with chambers: no bundled model has its
+    // structure, but every link shape (cells read their actuation loads,
+    // zero where none act: tentacle3d's bare cells serve it).
+    let dir = tempfile::tempdir().unwrap();
+    let tapered = dir.path().join("tapered.toml");
+    std::fs::write(&tapered, TAPERED_3D).unwrap();
     let tapered = tapered.to_string_lossy().into_owned();
     // The same with a driven moment on an element's bend.
     let torqued = dir.path().join("torqued.toml");
@@ -1803,15 +1865,16 @@ value = 1000.0
     let (b, r) = route(&example.to_string_lossy(), "", auto);
     assert_eq!(b, "compiled", "{r}");
     assert!(r.contains("link cells") && r.contains("tapes"), "{r}");
-    // A base turned by an input: the interpreter, and the route says why.
+    // A base turned by an input: the same link cells, the sweeps started
+    // in the turning frame.
     let turned = dir.path().join("turned.toml");
     let text = std::fs::read_to_string(&tapered)
         .unwrap()
         .replace("[base]\n", "[base]\nrotation_inputs = [\"p\"]\n");
     std::fs::write(&turned, text).unwrap();
     let (b, r) = route(&turned.to_string_lossy(), "", auto);
-    assert_eq!(b, "interpreted", "{r}");
-    assert!(r.contains("rotation_inputs"), "{r}");
+    assert_eq!(b, "compiled", "{r}");
+    assert!(r.contains("link cells") && !r.contains("tapes"), "{r}");
     let example = root().join("examples/palm.toml");
     let (b, r) = route(&example.to_string_lossy(), "", auto);
     assert_eq!(b, "interpreted");

@@ -284,7 +284,6 @@ fn covered(st: &Structure) -> bool {
             .segments
             .iter()
             .all(|g| crate::method::of(g.method).link_cells()))
-        && st.base_turns == 0
         // Buoyancy is each link's felt gravity; drag is not a cell's yet.
         && st.fluid != Some(true)
 }
@@ -500,6 +499,12 @@ fn globals(st: &Structure, params: &ParamLayout) -> LinkLayout {
         base_translation: st
             .base_translates
             .then(|| Rate::ALL.map(|r| Xyz::ALL.map(|c| index(Param::BaseTranslation(r, c))))),
+        base_turns: (0..st.base_turns)
+            .map(|i| runtime::links::BaseTurn {
+                angle: Rate::ALL.map(|r| index(Param::BaseTurn(r, i))),
+                axis: spatial.then(|| Xyz::ALL.map(|c| index(Param::BaseTurnAxis(i, c)))),
+            })
+            .collect(),
         base_rotation: match spatial {
             true => {
                 std::array::from_fn(|i| index(Param::BaseRotation((i / 3) as u8, (i % 3) as u8)))

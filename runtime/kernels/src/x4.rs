@@ -220,6 +220,14 @@ impl Scalar for X4 {
     #[inline(always)]
     fn rodrigues_family<const N: usize>(self) -> [[Self; N]; FAMILY_J] {
         // SAFETY: as `lanewise!`.
-        unsafe { lanes::family::<N>(self.0) }.map(|row| row.map(X4))
+        let v = unsafe { lanes::family::<N>(self.0) };
+        // A loop, as `from_arrays`: the maps' closures stay out of line.
+        let mut c = [[<Self as Scalar>::c(0.0); N]; FAMILY_J];
+        for (c, v) in c.iter_mut().zip(&v) {
+            for (c, v) in c.iter_mut().zip(v) {
+                *c = X4(*v);
+            }
+        }
+        c
     }
 }

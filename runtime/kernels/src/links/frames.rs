@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{
     CELL_PARAMS, Cells, LinkLayout, Loads, M3, MAX_LINK_DOF, V3, add, base_motion,
-    base_orientation, cell, cross, link_params, local, mat_mat, mat_vec, scale, sub,
+    base_orientation, base_rates, cell, cross, link_params, local, mat_mat, mat_vec, scale, sub,
 };
 use crate::rotation::{quat_mul, to_unit_quaternion};
 
@@ -98,14 +98,17 @@ pub fn frames<C: Cells + ?Sized>(
     let mut params = [0.0; CELL_PARAMS];
     let (r, quat) = base_orientation(layout, p);
     let (point, v, acc) = base_motion(layout, p);
+    let (w, alpha) = base_rates(layout, p);
+    // A planar chain's turns are about z: its angle is their sum.
+    let turned: f64 = layout.base_turns.iter().map(|t| p[t.angle[0]]).sum();
     let mut m = Motion {
         r,
         point,
         v,
         acc,
-        w: [0.0; 3],
-        alpha: [0.0; 3],
-        angle: layout.base_angle.map_or(0.0, |i| p[i]),
+        w,
+        alpha,
+        angle: layout.base_angle.map_or(0.0, |i| p[i]) + turned,
         quat,
     };
     // Per arm coordinate, the twist (W, V) its rate gives the frame the

@@ -25,6 +25,7 @@ use crate::rows;
 
 mod along;
 mod articulated;
+mod base;
 mod compiled;
 mod contact;
 mod frames;
@@ -35,6 +36,8 @@ mod points;
 mod tangent;
 pub use along::{AlongLoad, loads_potential, subtract_loads, subtract_loads_tangent};
 pub use articulated::accelerations_owned;
+pub use base::BaseTurn;
+pub(crate) use base::{base_motion, base_orientation, base_rates, felt_gravity};
 pub use compiled::{CellFn, CellLanesFn, CellTangentFn, CompiledCell};
 pub use contact::{
     CONTACT_BOUND, ContactElement, contact_bounds, contact_jacobian, contact_jvp, contact_points,
@@ -216,6 +219,10 @@ pub struct LinkLayout {
     /// z), inputs the runtime writes at every evaluation.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub base_translation: Option<[[usize; 3]; 3]>,
+    /// The base's turns by inputs, in sequence ([`BaseTurn`]), before the
+    /// declared direction.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub base_turns: Vec<BaseTurn>,
     /// An immersed arm's fluid density: each link's body is buoyed by the
     /// weight of its share of its element's displaced fluid
     /// ([`link_gravity`]).
@@ -406,43 +413,6 @@ pub(crate) fn by_lanes(
             out[l] = *v;
         }
     }
-}
-
-/// The base frame's rotation (rows) and quaternion (w, x, y, z): from the
-/// rotation and quaternion parameters, or about z by a planar base angle.
-pub(crate) fn base_orientation(layout: &LinkLayout, p: &[f64]) -> ([[f64; 3]; 3], [f64; 4]) {
-    match layout.base_angle {
-        Some(i) => {
-            let (s, c) = p[i].sin_cos();
-            let (sh, ch) = (0.5 * p[i]).sin_cos();
-            (
-                [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]],
-                [ch, 0.0, 0.0, sh],
-            )
-        }
-        None => (
-            std::array::from_fn(|i| std::array::from_fn(|j| p[layout.base_rotation[3 * i + j]])),
-            layout.base_quaternion.map(|i| p[i]),
-        ),
-    }
-}
-
-/// The base's origin, its velocity and its acceleration: a driven base
-/// translation's, else at rest at `base_position`.
-pub(crate) fn base_motion(layout: &LinkLayout, p: &[f64]) -> (V3, V3, V3) {
-    let pos = layout.base_position.map(|i| p[i]);
-    match layout.base_translation {
-        None => (pos, [0.0; 3], [0.0; 3]),
-        Some([x, v, a]) => (add(pos, x.map(|i| p[i])), v.map(|i| p[i]), a.map(|i| p[i])),
-    }
-}
-
-/// The gravity the sums of forces see: gravity less a driven base's
-/// acceleration, which carries every body alike (so that a base lifted at
-/// g is gravity, to the last bit).
-pub(crate) fn felt_gravity(layout: &LinkLayout, p: &[f64]) -> V3 {
-    let g = layout.gravity.map(|i| p[i]);
-    sub(g, base_motion(layout, p).2)
 }
 
 /// The gravity link `spec`'s body feels, `felt` ([`felt_gravity`]) less
@@ -833,7 +803,8 @@ fn forward<C: Cells, const BODIES: bool>(
     let gravity = felt_gravity(layout, p);
     let mut r: M3 = base_orientation(layout, p).0;
     let mut pos = base_motion(layout, p).0;
-    let (mut omega, mut alpha, mut acc) = ([0.0; 3], [0.0; 3], [0.0; 3]);
+    let (mut omega, mut alpha) = base_rates(layout, p);
+    let mut acc = [0.0; 3];
     for (k, spec) in layout.links.iter().enumerate() {
         let nc = spec.map.len();
         let at = s.start[k];

@@ -47,7 +47,7 @@ pub fn outputs<C: Cells>(
     let gravity: V3 = layout.gravity.map(|i| p[i]);
     let (mut r, mut quat) = super::base_orientation(layout, p);
     let (mut pos, mut v, _) = super::base_motion(layout, p);
-    let mut omega = [0.0; 3];
+    let mut omega = super::base_rates(layout, p).0;
     let (mut ke, mut pe) = (0.0, 0.0);
     let mut params: Vec<[f64; CELL_PARAMS]> = Vec::new();
     cell_params(layout, cells, p, &mut params);

@@ -107,9 +107,12 @@ struct Link {
 type Column = (T3, T3);
 
 /// Whether the sums in the plane cover a layout: a planar chain (a base
-/// angle) of links of at most one coordinate each.
+/// angle) of links of at most one coordinate each, on a base no input
+/// turns (the spatial sums take the turning frame).
 pub(super) fn covers(layout: &LinkLayout) -> bool {
-    layout.base_angle.is_some() && layout.links.iter().all(|l| l.map.len() <= 1)
+    layout.base_angle.is_some()
+        && layout.base_turns.is_empty()
+        && layout.links.iter().all(|l| l.map.len() <= 1)
 }
 
 /// What hangs on the end frame: the composite inertia and wrench.

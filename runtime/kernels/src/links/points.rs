@@ -204,6 +204,9 @@ pub(super) fn sweep<N: Num, C: Cells + ?Sized>(
     let (base_pos, base_v, _) = super::base_motion(layout, p);
     let mut pos: [N; 3] = base_pos.map(N::constant);
     let moving_base = base_v.map(N::constant);
+    // A turning base carries every point about its origin.
+    let spinning = (!layout.base_turns.is_empty())
+        .then(|| (super::base_rates(layout, p).0.map(N::constant), pos));
     // Per arm coordinate, the twist (W, V) its rate gives the frame the
     // sweep has reached, about the world origin.
     let mut twists = vec![(v0, v0); if columns { n } else { 0 }];
@@ -241,7 +244,10 @@ pub(super) fn sweep<N: Num, C: Cells + ?Sized>(
             let moving = (&xa[..nc], &xda[..nc], dxa.as_ref().map(|d| &d[..nc]));
             cell_at(cells, spec.cell, moving, len, &cut_params, &mut out);
             let point = add(pos, mat_vec(&r, cell_v3(&out, len, cell::END)));
-            let mut v = moving_base;
+            let mut v = match spinning {
+                Some((w, origin)) => add(moving_base, cross(w, sub(point, origin))),
+                None => moving_base,
+            };
             let mut rotation = r;
             if columns {
                 for (a, col) in own.iter_mut().enumerate() {

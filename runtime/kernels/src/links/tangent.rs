@@ -96,11 +96,12 @@ pub fn inverse_dynamics_tangent<C: Cells>(
     let (dq, dqd) = dir.split_at(n);
     let gravity: V3 = super::felt_gravity(layout, p).map(Dual::constant);
     let base = super::base_orientation(layout, p).0;
+    let (omega, alpha) = super::base_rates(layout, p);
     let mut frame = Frame {
         r: base.map(|row| row.map(Dual::constant)),
         pos: super::base_motion(layout, p).0.map(Dual::constant),
-        omega: V0,
-        alpha: V0,
+        omega: omega.map(Dual::constant),
+        alpha: alpha.map(Dual::constant),
         acc: V0,
     };
     let mut params = Vec::new();
