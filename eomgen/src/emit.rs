@@ -1221,6 +1221,10 @@ fn emit_link_recursion(
         quote!(runtime::links::mass_bias_owned::<_, #bodies>(
             &LINKS, &mut cells, q, qd, p, out
         ))
+    } else if dof > runtime::links::AT_ONCE {
+        quote!(runtime::links::mass_bias_wide::<_, #bodies>(
+            &LINKS, &mut cells, q, qd, p, out
+        ))
     } else {
         let rows = runtime::links::padded(dof);
         quote!(runtime::links::mass_bias_shared::<#rows, _, #bodies>(&LINKS, &mut cells, q, qd, p, out))

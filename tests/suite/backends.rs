@@ -770,6 +770,29 @@ fn link_recursion_matches_the_flat_tape_for_anisotropic_sections() {
     recursion_matches_flat_tapes(models.collect(), 12);
 }
 
+/// Arms of more coordinates than the shared sums take at once
+/// (`runtime::links::AT_ONCE`), summed a block of columns at a time:
+/// pcs's half-arcs and two rom segments of all six strains.
+#[test]
+fn link_recursion_matches_the_flat_tape_past_one_block() {
+    let dir = std::env::temp_dir().join("softarm-test-cache");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(model_path("rod_swing_rom")).unwrap();
+    let (head, rest) = text.split_at(text.find("[[segment]]").unwrap());
+    let (segment, tail) = rest.split_at(rest.find("[simulate]").unwrap());
+    let segment = segment.replace("length = 0.3", "length = 0.15");
+    let path = dir.join("rom_pair.toml");
+    std::fs::write(&path, format!("{head}{segment}{segment}{tail}")).unwrap();
+    let models = vec![
+        ("rod_swing".to_string(), vec!["segment.0.elements=11"]),
+        (
+            path.to_str().unwrap().to_string(),
+            vec!["segment.1.order=4"],
+        ),
+    ];
+    recursion_matches_flat_tapes(models, 14);
+}
+
 /// Driven forces on named coordinates (`[[torque]]`) on 3D and planar
 /// actuated arms: taken from h, the tangent unchanged.
 #[test]
@@ -1587,6 +1610,8 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         ("tentacle3d", "segment.0.elements=13"),
         ("cantilever3d", "segment.0.elements=7"),
         ("rod_swing", "segment.0.elements=4"),
+        // Past the shared sums' width: a block of columns at a time.
+        ("rod_swing", "segment.0.elements=11"),
         ("rom_arm", "segment.0.order=5"),
         ("stiff_flop", "segment.0.elements=5"),
         (chambered.as_str(), "segment.0.elements=4"),

@@ -206,10 +206,6 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         loads: actuated.len(),
         ..globals(st, params)
     };
-    // The shared sums hold the arm's coordinates in fixed rows.
-    if !runtime::links::all_owned(&layout) && first > runtime::links::MAX_SHARED_DOF {
-        return None;
-    }
     let forces = (!roms.is_empty()).then(|| derive_forces(params, first, &roms));
     let [forces, forces_tangent, energy] = match forces {
         Some(kernels) => kernels.map(Some),

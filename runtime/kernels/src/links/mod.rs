@@ -21,8 +21,6 @@ use std::cell::RefCell;
 
 use serde::{Deserialize, Serialize};
 
-use crate::rows;
-
 mod along;
 mod articulated;
 mod base;
@@ -33,6 +31,7 @@ mod num;
 mod outputs;
 mod planar;
 mod points;
+mod shared;
 mod tangent;
 pub use along::{AlongLoad, loads_potential, subtract_loads, subtract_loads_tangent};
 pub use articulated::accelerations_owned;
@@ -47,6 +46,7 @@ pub use frames::{ArmFrame, frame, frames};
 pub use outputs::outputs;
 pub(crate) use points::bits_equal;
 pub use points::{ContactPoint, LinkOutputs};
+pub use shared::{AT_ONCE, mass_bias_shared, mass_bias_shared_dyn, mass_bias_wide, padded};
 pub use tangent::inverse_dynamics_tangent;
 
 /// The element parameters a cell reads, in this order, per link:
@@ -695,6 +695,8 @@ struct Scratch {
     /// Per link, the articulated-body sweep's elimination of its
     /// coordinates (`articulated`).
     eliminated: Vec<articulated::Eliminated>,
+    /// A wide arm's rows of X, a block of columns at a time (`shared`).
+    wide: Vec<[f64; shared::BLOCK]>,
 }
 
 thread_local! {
@@ -717,6 +719,7 @@ pub fn all_owned(layout: &LinkLayout) -> bool {
 
 /// The end frame of the chain after the forward sweep, and what hangs on
 /// it: the composite inertia and wrench the sums from the tip start with.
+#[derive(Clone, Copy)]
 struct Tip {
     past: Inertia,
     wrench: Twist,
@@ -1072,125 +1075,6 @@ pub fn mass_bias_spatial<C: Cells, const BODIES: bool>(
     SCRATCH.set(scratch);
 }
 
-/// M and h like [`mass_bias_owned`] for any chain, links of shared
-/// coordinates included (a rom segment's slices), `N` the arm's
-/// coordinates padded to whole vectors ([`padded`]). `Cells::forces`
-/// gives the generalised forces that are not any link's (a rom segment's
-/// strain energy and damping, integrated over the segment), added to h,
-/// when `layout.forces`.
-///
-/// With W_e the map from the arm's rates to link e's cell rates (rows of
-/// `LinkSpec::map`), S_e the twists of e's cell rates, D_e e's own block
-/// and R_e = sum_{e' > e} F_e' W_e' the momenta the arm's rates give the
-/// links past e (F_e: the momenta of e's cell rates on e and past):
-/// M = X + X^T with X = sum_e W_e^T (S_e^T R_e + D_e W_e / 2). Each link
-/// costs O(cell coordinates x arm coordinates), not a Jacobian product
-/// over all pairs of the arm's coordinates. `BODIES`: as
-/// [`mass_bias_owned`]'s.
-#[inline(always)]
-pub fn mass_bias_shared<const N: usize, C: Cells, const BODIES: bool>(
-    layout: &LinkLayout,
-    cells: &mut C,
-    q: &[f64],
-    qd: &[f64],
-    p: &[f64],
-    out: &mut [f64],
-) {
-    let n = layout.dof;
-    assert_eq!(N, padded(n), "rows of padded(dof)");
-    let mut scratch = take_scratch(layout, out);
-    {
-        let s = &mut scratch;
-        let simd = rows::simd_available();
-        let weights = layout.weights();
-        let row = |k: usize, f: usize| -> &[f64; N] {
-            let at = (k * MAX_LINK_DOF + f) * N;
-            weights[at..at + N].try_into().expect("rows of N")
-        };
-        let (mut qp, mut qdp) = ([0.0; N], [0.0; N]);
-        qp[..n].copy_from_slice(&q[..n]);
-        qdp[..n].copy_from_slice(&qd[..n]);
-        let nl = layout.links.len();
-        s.x.resize(nl, [0.0; MAX_LINK_DOF]);
-        s.xd.resize(nl, [0.0; MAX_LINK_DOF]);
-        for (k, spec) in layout.links.iter().enumerate() {
-            for (f, c) in spec.map.iter().enumerate() {
-                let (x, xd) = rows::dot2(simd, row(k, f), &qp, &qdp);
-                (s.x[k][f], s.xd[k][f]) = match c.scale {
-                    Some(i) => (x * p[i], xd * p[i]),
-                    None => (x, xd),
-                };
-            }
-        }
-        let mut tip = forward::<C, BODIES>(layout, cells, p, s);
-        let mut reach = [[0.0; N]; 6];
-        let mut x = [[0.0; N]; N];
-        let mut h = [0.0; N];
-        for (k, spec) in layout.links.iter().enumerate().rev() {
-            let nc = spec.map.len();
-            let w: [&[f64; N]; MAX_LINK_DOF] = std::array::from_fn(|f| row(k, f));
-            // A cell coordinate's scale goes into every coefficient of its
-            // weights.
-            let sc: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| {
-                spec.map.get(f).and_then(|c| c.scale).map_or(1.0, |i| p[i])
-            });
-            let (momentum, block, g) = link_sums::<BODIES>(s, k, nc, &mut tip);
-            // Unused cell coordinates have zero blocks, forces and momenta.
-            let gs: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| g[f] * sc[f]);
-            rows::add_combination(simd, &mut h, &gs, w);
-            for f in 0..nc {
-                let t = flat(s.twist[s.start[k] + f]);
-                let mut row = [0.0; N];
-                rows::add_combination(simd, &mut row, &t, std::array::from_fn(|k| &reach[k]));
-                let half: [f64; MAX_LINK_DOF] =
-                    std::array::from_fn(|f2| 0.5 * block[f][f2] * sc[f2]);
-                rows::add_combination(simd, &mut row, &half, w);
-                // Terms name distinct coordinates (eomgen's maps).
-                for &(a, _) in &spec.map[f].terms {
-                    rows::add_combination(simd, &mut x[a], &[w[f][a] * sc[f]], [&row]);
-                }
-            }
-            let m: [[f64; 6]; MAX_LINK_DOF] = momentum.map(flat);
-            for (kk, rk) in reach.iter_mut().enumerate() {
-                let mk: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| m[f][kk] * sc[f]);
-                match nc {
-                    3 => {
-                        rows::add_combination(simd, rk, &[mk[0], mk[1], mk[2]], [w[0], w[1], w[2]])
-                    }
-                    _ => rows::add_combination(simd, rk, &mk, w),
-                }
-            }
-        }
-        let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
-        let mut at = 0;
-        #[allow(clippy::needless_range_loop)] // X's row and column
-        for i in 0..n {
-            for j in i..n {
-                mass[at] = x[i][j] + x[j][i];
-                at += 1;
-            }
-        }
-        bias.copy_from_slice(&h[..n]);
-        if layout.forces {
-            s.forces.resize(n, 0.0);
-            cells.forces(&mut s.forces);
-            for (h, f) in bias.iter_mut().zip(&s.forces) {
-                *h += f;
-            }
-        }
-    }
-    SCRATCH.set(scratch);
-    if layout.loaded() {
-        subtract_loads(layout, cells, (q, qd, p), &mut out[n * (n + 1) / 2..]);
-    }
-}
-
-/// Rows a chain of `dof` coordinates is summed in by the generated
-/// [`mass_bias_shared`]: the next multiple of four.
-pub fn padded(dof: usize) -> usize {
-    dof.div_ceil(4) * 4
-}
-
 /// The link recursion for any layout, choosing as the generated code does
 /// ([`all_owned`], [`padded`]); for tests and tools, not built for FMA.
 pub fn mass_bias<C: Cells>(
@@ -1206,33 +1090,4 @@ pub fn mass_bias<C: Cells>(
         (true, false) => mass_bias_owned::<C, false>(layout, cells, q, qd, p, out),
         (false, _) => mass_bias_shared_dyn(layout, cells, q, qd, p, out),
     }
-}
-
-/// Most coordinates a chain with shared links may have: the generator
-/// keeps larger ones on the flat kernel.
-pub const MAX_SHARED_DOF: usize = 64;
-
-/// [`mass_bias_shared`] with `N` and `BODIES` picked at run time
-/// ([`padded`], [`LinkLayout::general_bodies`]); for any
-/// chain, owned links included (tests check the two strategies agree).
-/// Inlined into its caller, which linked chains build for FMA.
-#[inline(always)]
-pub fn mass_bias_shared_dyn<C: Cells>(
-    layout: &LinkLayout,
-    cells: &mut C,
-    q: &[f64],
-    qd: &[f64],
-    p: &[f64],
-    out: &mut [f64],
-) {
-    macro_rules! pick {
-        ($($n:literal)*) => {
-            match (padded(layout.dof), layout.general_bodies()) {
-                $(($n, true) => mass_bias_shared::<$n, C, true>(layout, cells, q, qd, p, out),
-                ($n, false) => mass_bias_shared::<$n, C, false>(layout, cells, q, qd, p, out),)*
-                (w, _) => panic!("shared sums stop at {MAX_SHARED_DOF} coordinates, not {w}"),
-            }
-        };
-    }
-    pick!(4 8 12 16 20 24 28 32 36 40 44 48 52 56 60 64)
 }
