@@ -318,9 +318,13 @@ fn block_sums<const N: usize, const BODIES: bool>(
                 rows::add_combination(simd, &mut x[a], &[weight * sc[f]], [&row]);
             }
         }
-        let m: [[f64; 6]; MAX_LINK_DOF] = momentum.map(flat);
         for (kk, rk) in reach.iter_mut().enumerate() {
-            let mk: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| m[f][kk] * sc[f]);
+            // Component kk of the momenta (angular, then linear), read in
+            // place: a flattened copy is a call to memcpy.
+            let mk: [f64; MAX_LINK_DOF] = std::array::from_fn(|f| {
+                let (w, v) = &momentum[f];
+                (if kk < 3 { w[kk] } else { v[kk - 3] }) * sc[f]
+            });
             match nc {
                 3 => rows::add_combination(simd, rk, &[mk[0], mk[1], mk[2]], [w[0], w[1], w[2]]),
                 _ => rows::add_combination(simd, rk, &mk, w),
