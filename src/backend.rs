@@ -146,14 +146,6 @@ fn linked(
         return Err("this processor lacks the fused multiply-add compiled code needs".into());
     }
     let start = Instant::now();
-    // The arm, or an assembly's arms.
-    let arms: Vec<&Structure> = match &structure.assembly {
-        Some(a) => a.arms.iter().map(|(_, s)| s).collect(),
-        None => vec![structure],
-    };
-    if arms.iter().any(|s| s.fluid == Some(true)) {
-        return Err("its fluid's drag is not a link cell yet".into());
-    }
     let not_cells = || "not every one of its methods' elements is a link cell".to_string();
     let kernels: (Box<dyn Kernels>, String) = if structure.assembly.is_some() {
         let (tapes, _, _) = tapes(model, &structure.hash(), cache_dir);

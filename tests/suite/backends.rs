@@ -770,6 +770,36 @@ fn link_recursion_matches_the_flat_tape_for_anisotropic_sections() {
     recursion_matches_flat_tapes(models.collect(), 12);
 }
 
+/// The loaded arms on bases moved along driven paths and turned by
+/// inputs, immersed (buoyed) and dragged by a current, in space and in
+/// the plane.
+#[test]
+fn link_recursion_matches_the_flat_tape_on_moving_bases_and_in_fluids() {
+    let dir = std::env::temp_dir().join("softarm-test-cache");
+    std::fs::create_dir_all(&dir).unwrap();
+    let shaken3d = shaken(LOADED_3D, r#"["sx", "sy", "sz"]"#);
+    let models = [
+        ("shaken3d", shaken3d.clone()),
+        ("shaken2d", shaken(LOADED_2D, r#"["sx", "sy"]"#)),
+        ("immersed3d", format!("{ACTUATED_3D}{IMMERSED}")),
+        ("immersed2d", format!("{LOADED_2D}{IMMERSED}")),
+        ("dragged3d", format!("{ACTUATED_3D}{DRAGGED}")),
+        ("dragged2d", format!("{LOADED_2D}{DRAGGED}")),
+        // Two turns about axes of any length on a shaken base; one in
+        // the plane.
+        ("turned3d", turned(&shaken3d, 3)),
+        ("turned2d", turned(LOADED_2D, 2)),
+    ];
+    let models = (models.into_iter())
+        .map(|(name, text)| {
+            let path = dir.join(format!("{name}.toml"));
+            std::fs::write(&path, text).unwrap();
+            (path.to_str().unwrap().to_string(), Vec::new())
+        })
+        .collect();
+    recursion_matches_flat_tapes(models, 15);
+}
+
 /// Arms of more coordinates than the shared sums take at once
 /// (`runtime::links::AT_ONCE`), summed a block of columns at a time:
 /// pcs's half-arcs and two rom segments of all six strains.
@@ -936,6 +966,10 @@ value = 0.01
 /// element's displaced fluid.
 const IMMERSED: &str = "\n[fluid]\ndensity = 1500.0\n";
 
+/// Dragged across and along by a fluid flowing past: Morison's drag at
+/// each element's middle, of its velocity relative to the current.
+const DRAGGED: &str = "\n[fluid]\ndensity = 1000.0\ndrag_normal = 1.2\ndrag_tangential = 0.05\ncurrent = [0.1, -0.2, 0.3]\n";
+
 /// `text` on a base moved along the path of the channels `inputs` (sines
 /// in x and y, still in z).
 fn shaken(text: &str, inputs: &str) -> String {
@@ -987,18 +1021,6 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
     let loaded = file("loaded3d", LOADED_3D);
     let loaded2d = file("loaded2d", LOADED_2D);
     let kinked2d = file("kinked2d", KINKED_2D);
-    // The loaded arms on a base moved along a driven path, and immersed.
-    let shaken3d = file("shaken3d", &shaken(LOADED_3D, r#"["sx", "sy", "sz"]"#));
-    let shaken2d = file("shaken2d", &shaken(LOADED_2D, r#"["sx", "sy"]"#));
-    let immersed3d = file("immersed3d", &format!("{ACTUATED_3D}{IMMERSED}"));
-    let immersed2d = file("immersed2d", &format!("{LOADED_2D}{IMMERSED}"));
-    // Turned by inputs: in space two turns about axes of any length on a
-    // shaken base, in the plane one.
-    let turned3d = file(
-        "turned3d",
-        &turned(&shaken(LOADED_3D, r#"["sx", "sy", "sz"]"#), 3),
-    );
-    let turned2d = file("turned2d", &turned(LOADED_2D, 2));
     // Chamber levers that vary along a segment (tapered, the chambers
     // nearer the axis towards the tip): each element's own loads.
     let varying = file(
@@ -1018,12 +1040,6 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
         (&loaded2d, &[]),
         // Kinks in the plane: links of no coordinates.
         (&kinked2d, &[]),
-        (&shaken3d, &[]),
-        (&shaken2d, &[]),
-        (&immersed3d, &[]),
-        (&immersed2d, &[]),
-        (&turned3d, &[]),
-        (&turned2d, &[]),
         (&varying, &[]),
         (&varying2d, &[]),
         // Planar chains: rigid links and pcc arcs (whose inertia changes
@@ -1525,25 +1541,17 @@ kind = "constant"
 value = 0.0
 "#;
 
-#[test]
-fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
-    // Structures no compiled-in model has, whose link shapes one has:
-    // pcc without twist (tentacle3d's), with twist (cantilever3d's), pcs's
-    // half-arcs (rod_swing's), rom slices of another order (rom_arm's).
-    // And arms with chambers on bare arms' cells: stiff_flop at another
-    // element count, and tentacle3d with chambers in it (its cells read
-    // their segment's actuation loads, zero where none act). And planar
-    // arms.
-    let mut rng = Rng::new(11);
-    let dir = tempfile::tempdir().unwrap();
-    let chambered = dir.path().join("chambered.toml");
+/// Models no compiled-in model has, whose link shapes one has, written
+/// into `dir`, each with its `--set`: (file or name, set).
+fn linked_cases(dir: &std::path::Path) -> Vec<(String, &'static str)> {
+    let chambered = dir.join("chambered.toml");
     let text = std::fs::read_to_string(model_path("tentacle3d")).unwrap();
     let chambers = "[segment.chambers]\ncount = 3\nradius = 0.002\ndistance = 0.006\ninputs = [\"p\", \"q\", \"q\"]\n\n[inputs.p]\nkind = \"constant\"\nvalue = 3000.0\n\n[inputs.q]\nkind = \"constant\"\nvalue = 0.0\n\n[tip]";
     std::fs::write(&chambered, text.replace("[tip]", chambers)).unwrap();
     let chambered = chambered.to_string_lossy().into_owned();
     // A link shape no compiled-in model has (a stretching pcc arc): its
     // cell runs on its tapes, the rest of the recursion compiled.
-    let stretching = dir.path().join("stretching.toml");
+    let stretching = dir.join("stretching.toml");
     let text = text.replace("twist = false", "twist = false\nextension = true");
     assert!(text.contains("extension = true"));
     std::fs::write(&stretching, text).unwrap();
@@ -1556,7 +1564,7 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
     // half-arcs (all six strains) and rom slices.
     let sphere = "\n[[obstacle]]\nname = \"ball\"\nshape = \"sphere\"\ncenter = [0.15, 0.0, -0.08]\nradius = 0.05\n\n[contact]\nmodel = \"hunt_crossley\"\nstiffness = 1.0e4\nrestitution = 0.5\nfriction = 0.4\npoints_per_element = 4\n";
     let on_sphere = |name: &str, model: &str| {
-        let path = dir.path().join(format!("{name}.toml"));
+        let path = dir.join(format!("{name}.toml"));
         let text = std::fs::read_to_string(model_path(model)).unwrap();
         std::fs::write(&path, format!("{text}{sphere}")).unwrap();
         path.to_string_lossy().into_owned()
@@ -1564,32 +1572,36 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
     // Joints through the arms' frames: a 3D arm of two segments holding a
     // ball at its tip (a weld) and a ring at its first segment's end (a
     // pin), both free bodies on quaternions.
-    let held = dir.path().join("held_3d.toml");
+    let held = dir.join("held_3d.toml");
     std::fs::write(&held, HELD_3D).unwrap();
     let held = held.to_string_lossy().into_owned();
     // An assembly whose arm has inputs: a driven chamber, whose pressure
     // the arm's slice of the parameters gets each time it is written.
-    let pinch = dir.path().join("pinch.toml");
+    let pinch = dir.join("pinch.toml");
     std::fs::write(&pinch, PINCH).unwrap();
     let pinch = pinch.to_string_lossy().into_owned();
     // A finger on a base moved along a driven path, tapping: the contact
     // points' velocities carry the base's.
-    let shaken_tap = dir.path().join("shaken_tap.toml");
+    let shaken_tap = dir.join("shaken_tap.toml");
     let text = std::fs::read_to_string(model_path("finger_tap")).unwrap() + "\n";
     std::fs::write(&shaken_tap, shaken(&text, r#"["sx", "sy"]"#)).unwrap();
     let shaken_tap = shaken_tap.to_string_lossy().into_owned();
     // Turned by inputs, tapping and on the sphere: the points'
     // velocities carry the base's spin.
-    let turned_tap = dir.path().join("turned_tap.toml");
+    let turned_tap = dir.join("turned_tap.toml");
     let text = std::fs::read_to_string(model_path("finger_tap")).unwrap() + "\n";
     std::fs::write(&turned_tap, turned(&text, 2)).unwrap();
     let turned_tap = turned_tap.to_string_lossy().into_owned();
-    let turned_ball = dir.path().join("turned_ball.toml");
+    let turned_ball = dir.join("turned_ball.toml");
     let text = std::fs::read_to_string(model_path("tentacle3d")).unwrap();
     std::fs::write(&turned_ball, turned(&format!("{text}{sphere}"), 3)).unwrap();
     let turned_ball = turned_ball.to_string_lossy().into_owned();
+    // Swimming on the sphere: the drag beside the contact.
+    let dragged_ball = dir.join("dragged_ball.toml");
+    std::fs::write(&dragged_ball, format!("{text}{sphere}{DRAGGED}")).unwrap();
+    let dragged_ball = dragged_ball.to_string_lossy().into_owned();
     // An assembly whose arm turns on its base.
-    let turned_ball_drop = dir.path().join("turned_falling_ball.toml");
+    let turned_ball_drop = dir.join("turned_falling_ball.toml");
     let text = std::fs::read_to_string(model_path("falling_ball")).unwrap().replacen(
         "base = { position = [0.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0] }",
         "base = { position = [0.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0], rotation_inputs = [\"yaw\"] }",
@@ -1604,7 +1616,7 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         on_sphere("rod_ball", "rod_swing"),
         on_sphere("rom_ball", "rod_swing_rom"),
     );
-    for (model, set) in [
+    let cases: Vec<(&str, &'static str)> = vec![
         (stretching.as_str(), "segment.0.elements=6"),
         (frame.as_str(), "segment.1.offset=[0.01, -0.02, 0.005]"),
         ("tentacle3d", "segment.0.elements=13"),
@@ -1629,6 +1641,7 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         (shaken_tap.as_str(), "segment.0.elements=7"),
         (turned_tap.as_str(), "segment.0.elements=7"),
         (turned_ball.as_str(), "segment.0.elements=5"),
+        (dragged_ball.as_str(), "segment.0.elements=5"),
         (tentacle_ball.as_str(), "segment.0.elements=5"),
         (rod_ball.as_str(), "segment.0.elements=3"),
         (rom_ball.as_str(), "segment.0.quadrature=3"),
@@ -1640,7 +1653,25 @@ fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
         (held.as_str(), "segment.1.elements=3"),
         (pinch.as_str(), "arm.right.segment.0.elements=3"),
         ("ball_drop", "arm.right.segment.1.elements=3"),
-    ] {
+    ];
+    (cases.into_iter())
+        .map(|(m, set)| (m.to_string(), set))
+        .collect()
+}
+
+#[test]
+fn other_element_counts_and_orders_run_on_linked_compiled_cells() {
+    // Structures no compiled-in model has, whose link shapes one has:
+    // pcc without twist (tentacle3d's), with twist (cantilever3d's), pcs's
+    // half-arcs (rod_swing's), rom slices of another order (rom_arm's).
+    // And arms with chambers on bare arms' cells: stiff_flop at another
+    // element count, and tentacle3d with chambers in it (its cells read
+    // their segment's actuation loads, zero where none act). And planar
+    // arms.
+    let mut rng = Rng::new(11);
+    let dir = tempfile::tempdir().unwrap();
+    for (model, set) in linked_cases(dir.path()) {
+        let model = model.as_str();
         let what = format!("{model} {set}");
         let sets = [eomgen::model::Override::parse(set).unwrap()];
         let tapes = tempfile::tempdir().unwrap();
@@ -1709,8 +1740,13 @@ fn articulated_body_accelerations_equal_the_mass_matrix_solve() {
     let text = std::fs::read_to_string(model_path("tentacle3d")).unwrap();
     std::fs::write(&spun, turned(&text, 3)).unwrap();
     let spun = spun.to_str().unwrap().to_string();
+    // Dragged by a current: forces of the rates in each elimination.
+    let dragged = dir.path().join("dragged_tentacle.toml");
+    std::fs::write(&dragged, format!("{text}{DRAGGED}")).unwrap();
+    let dragged = dragged.to_str().unwrap().to_string();
     for (model, sets) in [
         (owned.as_str(), &[][..]),
+        (dragged.as_str(), &["segment.0.elements=7"][..]),
         (spun.as_str(), &["segment.0.elements=13"][..]),
         ("tentacle3d", &["segment.0.elements=13"][..]),
         ("cantilever3d", &["segment.0.elements=7"][..]),

@@ -26,8 +26,9 @@
 
 use runtime::Tape;
 use runtime::links::{
-    ACTUATION_LOADS, AlongLoad, CELL_PARAMS, ContactElement, ContactPoint, ELEMENT_PARAMS,
-    LinkKernels, LinkLayout, LinkSpec, LocalCoordinate, PRINCIPAL_PARAMS, REST_PARAMS,
+    ACTUATION_LOADS, AlongLoad, CELL_PARAMS, ContactElement, ContactPoint, Drag, DragPoint,
+    ELEMENT_PARAMS, LinkKernels, LinkLayout, LinkSpec, LocalCoordinate, PRINCIPAL_PARAMS,
+    REST_PARAMS,
 };
 
 use crate::cas::{Cas, ExprId, SymKind};
@@ -195,7 +196,9 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     let contact = contact_points(&element_links, st.contact_points);
     let contact_elements = contact_elements(&element_links, &contact);
     let along = along_loads(st, params, &element_links)?;
+    let drag = fluid_drag(st, params, &element_links)?;
     let layout = LinkLayout {
+        drag,
         links,
         contact,
         contact_elements,
@@ -275,13 +278,7 @@ fn principal_params(params: &ParamLayout, k: usize) -> [usize; PRINCIPAL_PARAMS]
 /// `planar_cell`).
 fn covered(st: &Structure) -> bool {
     let spatial = st.dimensions == 3;
-    (!spatial
-        || st
-            .segments
-            .iter()
-            .all(|g| crate::method::of(g.method).link_cells()))
-        // Buoyancy is each link's felt gravity; drag is not a cell's yet.
-        && st.fluid != Some(true)
+    !spatial || (st.segments.iter()).all(|g| crate::method::of(g.method).link_cells())
 }
 
 /// The chain's contact points (`points` an element, at s = 1/points, ...,
@@ -368,6 +365,37 @@ fn along_loads(
     }
     out.sort_by_key(|l| l.at.link);
     Some(out)
+}
+
+/// An immersed arm's drag at its elements' middles, as `tmt::along`
+/// places it; `Some(None)` where it does not drag, None where a middle is
+/// not on its links' arcs.
+fn fluid_drag(
+    st: &Structure,
+    params: &ParamLayout,
+    elements: &[ElementLinks],
+) -> Option<Option<Drag>> {
+    if st.fluid != Some(true) {
+        return Some(None);
+    }
+    let fluid = |f| params.index(Param::Fluid(f));
+    let element = |k, e| params.index(Param::Element(k, e));
+    let points = (elements.iter().enumerate())
+        .map(|(k, links)| {
+            Some(DragPoint {
+                at: on_links(&links.as_ref()?.0, 0.5)?,
+                width: element(k, ElementParam::Width),
+                length: element(k, ElementParam::Length),
+            })
+        })
+        .collect::<Option<Vec<_>>>()?;
+    Some(Some(Drag {
+        density: fluid(FluidParam::Density),
+        normal: fluid(FluidParam::DragNormal),
+        tangential: fluid(FluidParam::DragTangential),
+        current: Xyz::ALL.map(|c| fluid(FluidParam::Current(c))),
+        points,
+    }))
 }
 
 /// The elements the contact points are on (none without them): their

@@ -31,6 +31,92 @@ pub struct AlongLoad {
     pub per_length: Option<usize>,
 }
 
+/// An immersed arm's drag (`[fluid]` with drag coefficients): Morison's,
+/// at each element's middle, of its velocity relative to the current, as
+/// `eomgen/src/tmt/along.rs`'s dissipation gives it. Parameter slots.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Drag {
+    pub density: usize,
+    pub normal: usize,
+    pub tangential: usize,
+    pub current: [usize; 3],
+    pub points: Vec<DragPoint>,
+}
+
+/// An element's middle and the slots of its width and length.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DragPoint {
+    pub at: ContactPoint,
+    pub width: usize,
+    pub length: usize,
+}
+
+/// The drag force at a point moving at `v` (relative to the current
+/// `current`) whose section's axis is `axis`: -dD/dv of the dissipation
+/// D = (c_n |v_n|^3 + c_t |v_t|^3) / 6, c_n = rho C_n d l, c_t = pi rho C_t
+/// d l, each magnitude sqrt(v^2 + eps^2) (eps 1 um/s) as the flat kernels
+/// take it: -(c_n |v_n| v_n + c_t |v_t| v_t) / 2.
+#[inline(always)]
+fn drag_force<N: Num>(
+    drag: &Drag,
+    point: &DragPoint,
+    p: &[f64],
+    v: [N; 3],
+    axis: [N; 3],
+) -> [N; 3] {
+    let rel: [N; 3] = std::array::from_fn(|c| v[c] - N::constant(p[drag.current[c]]));
+    let along = dot(rel, axis);
+    let across2 = dot(rel, rel) - along * along;
+    let eps2 = N::constant(1e-12);
+    let base = p[drag.density] * p[point.width] * p[point.length];
+    let cn = N::constant(0.5 * p[drag.normal] * base) * (across2 + eps2).sqrt();
+    let ct = N::constant(0.5 * std::f64::consts::PI * p[drag.tangential] * base)
+        * (along * along + eps2).sqrt();
+    std::array::from_fn(|c| N::ZERO - (cn * (rel[c] - along * axis[c]) + ct * along * axis[c]))
+}
+
+/// The drag's generalised forces, `add(a, Q_a)` per arm coordinate a; on
+/// dual numbers along (dq, `dqd`).
+fn drag_forces<N: Num>(
+    layout: &LinkLayout,
+    cells: &mut dyn Cells,
+    (q, qd, dq, p): At,
+    dqd: Option<&[f64]>,
+    add_to: &mut impl FnMut(usize, N),
+) {
+    let Some(drag) = &layout.drag else {
+        return;
+    };
+    let points: Vec<ContactPoint> = drag.points.iter().map(|d| d.at).collect();
+    let asked = Asked {
+        columns: true,
+        spin: true,
+    };
+    sweep(
+        layout,
+        cells,
+        (q, qd, dq, p),
+        (&points, |_| true),
+        (asked, None),
+        |i, m: &PointMotion<N>| {
+            // The velocity's derivative along dqd: the columns times it.
+            let mut v = m.v;
+            if let Some(dqd) = dqd {
+                for (col, &r) in m.columns.iter().zip(dqd) {
+                    for c in 0..3 {
+                        v[c] = v[c] + col[c] * N::moving(0.0, r);
+                    }
+                }
+            }
+            let axis = [m.rotation[0][0], m.rotation[1][0], m.rotation[2][0]];
+            let force = drag_force(drag, &drag.points[i], p, v, axis);
+            for (a, col) in m.columns.iter().enumerate() {
+                add_to(a, dot(*col, force));
+            }
+        },
+    );
+}
+
 /// Load `i`'s force and moment in the world frame at its point.
 #[inline(always)]
 fn world<N: Num>(load: &AlongLoad, m: &PointMotion<N>, p: &[f64]) -> ([N; 3], [N; 3]) {
@@ -51,11 +137,13 @@ fn generalised<N: Num>(
     layout: &LinkLayout,
     cells: &mut dyn Cells,
     (q, qd, dq, p): At,
+    dqd: Option<&[f64]>,
     mut add_to: impl FnMut(usize, N),
 ) {
     for &[a, slot] in &layout.torques {
         add_to(a, N::constant(p[slot]));
     }
+    drag_forces(layout, cells, (q, qd, dq, p), dqd, &mut add_to);
     let loads = &layout.along;
     if loads.is_empty() {
         return;
@@ -92,23 +180,32 @@ pub fn subtract_loads(
     (q, qd, p): (&[f64], &[f64], &[f64]),
     h: &mut [f64],
 ) {
-    generalised(layout, cells, (q, qd, None, p), |a, qa: f64| h[a] -= qa);
+    generalised(layout, cells, (q, qd, None, p), None, |a, qa: f64| {
+        h[a] -= qa
+    });
 }
 
 /// tau and its tangent `dtau` minus the loads' generalised forces and
-/// their derivative along `dq` (they depend on q and the parameters
-/// alone; the coordinates' driven ones on the parameters alone).
+/// their derivative along (dq, dqd) (the loads depend on q and the
+/// parameters, the coordinates' driven ones on the parameters, the drag
+/// on q and qd too).
 pub fn subtract_loads_tangent(
     layout: &LinkLayout,
     cells: &mut dyn Cells,
     (q, qd, p): (&[f64], &[f64], &[f64]),
-    dq: &[f64],
+    (dq, dqd): (&[f64], &[f64]),
     (tau, dtau): (&mut [f64], &mut [f64]),
 ) {
-    generalised(layout, cells, (q, qd, Some(dq), p), |a, qa: Dual| {
-        tau[a] -= qa.v;
-        dtau[a] -= qa.d;
-    });
+    generalised(
+        layout,
+        cells,
+        (q, qd, Some(dq), p),
+        Some(dqd),
+        |a, qa: Dual| {
+            tau[a] -= qa.v;
+            dtau[a] -= qa.d;
+        },
+    );
 }
 
 /// The potential of the loads' constant world forces, -F . p each (a

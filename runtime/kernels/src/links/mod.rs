@@ -33,7 +33,9 @@ mod planar;
 mod points;
 mod shared;
 mod tangent;
-pub use along::{AlongLoad, loads_potential, subtract_loads, subtract_loads_tangent};
+pub use along::{
+    AlongLoad, Drag, DragPoint, loads_potential, subtract_loads, subtract_loads_tangent,
+};
 pub use articulated::accelerations_owned;
 pub use base::BaseTurn;
 pub(crate) use base::{base_motion, base_orientation, base_rates, felt_gravity};
@@ -261,6 +263,9 @@ pub struct LinkLayout {
     /// The loads along the chain, in the links' order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub along: Vec<AlongLoad>,
+    /// An immersed arm's drag at its elements' middles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drag: Option<Drag>,
     /// Driven generalised forces on the arm's coordinates (`[[torque]]`):
     /// each an arm coordinate and the slot of its value.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -276,9 +281,10 @@ pub struct LinkLayout {
 
 impl LinkLayout {
     /// Whether applied loads other than the tip's act: loads along the
-    /// chain or on its coordinates ([`subtract_loads`]).
+    /// chain, a fluid's drag or forces on its coordinates
+    /// ([`subtract_loads`]).
     pub fn loaded(&self) -> bool {
-        !self.along.is_empty() || !self.torques.is_empty()
+        !self.along.is_empty() || !self.torques.is_empty() || self.drag.is_some()
     }
 
     /// Whether some link's body needs more than an axisymmetric inertia

@@ -16,6 +16,9 @@ pub(super) trait Num:
     /// Output `i` of a cell's outputs (`len` values, then, for a dual
     /// number, their derivatives).
     fn of_cell(out: &[f64], len: usize, i: usize) -> Self;
+    /// A value `v` moving at `d` along the direction (an `f64` has none).
+    fn moving(v: f64, d: f64) -> Self;
+    fn sqrt(self) -> Self;
 }
 
 impl Num for f64 {
@@ -27,6 +30,14 @@ impl Num for f64 {
     #[inline(always)]
     fn of_cell(out: &[f64], _len: usize, i: usize) -> f64 {
         out[i]
+    }
+    #[inline(always)]
+    fn moving(v: f64, _d: f64) -> f64 {
+        v
+    }
+    #[inline(always)]
+    fn sqrt(self) -> f64 {
+        f64::sqrt(self)
     }
 }
 
@@ -42,6 +53,14 @@ impl Num for Dual {
             v: out[i],
             d: out[len + i],
         }
+    }
+    #[inline(always)]
+    fn moving(v: f64, d: f64) -> Dual {
+        Dual { v, d }
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Dual {
+        Dual::sqrt(self)
     }
 }
 

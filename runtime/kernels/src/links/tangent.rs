@@ -172,7 +172,7 @@ pub fn inverse_dynamics_tangent<C: Cells>(
         }
     }
     if layout.loaded() {
-        super::subtract_loads_tangent(layout, cells, (q, qd, p), dq, (tau, dtau));
+        super::subtract_loads_tangent(layout, cells, (q, qd, p), (dq, dqd), (tau, dtau));
     }
 }
 
