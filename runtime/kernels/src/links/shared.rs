@@ -58,11 +58,9 @@ pub fn mass_bias_shared<const N: usize, C: Cells, const BODIES: bool>(
 ) {
     let n = layout.dof;
     assert_eq!(N, padded(n), "rows of padded(dof)");
-    let mut scratch = take_scratch(layout, out);
+    let (mut scratch, tip) = start::<N, C, BODIES>(layout, cells, q, qd, p, out);
     {
         let s = &mut scratch;
-        cell_coordinates::<N>(layout, q, qd, p, s);
-        let tip = forward::<C, BODIES>(layout, cells, p, s);
         let mut x = [[0.0; N]; N];
         let mut h = [0.0; N];
         let every = layout.links.len();
@@ -77,12 +75,8 @@ pub fn mass_bias_shared<const N: usize, C: Cells, const BODIES: bool>(
             }
         }
         bias.copy_from_slice(&h[..n]);
-        add_forces(layout, cells, s, bias);
     }
-    SCRATCH.set(scratch);
-    if layout.loaded() {
-        subtract_loads(layout, cells, (q, qd, p), &mut out[n * (n + 1) / 2..]);
-    }
+    finish(layout, cells, (q, qd, p), scratch, out);
 }
 
 /// [`mass_bias_shared`] for an arm of more than [`AT_ONCE`] coordinates:
@@ -98,11 +92,9 @@ pub fn mass_bias_wide<C: Cells, const BODIES: bool>(
 ) {
     let n = layout.dof;
     let stride = padded(n);
-    let mut scratch = take_scratch(layout, out);
+    let (mut scratch, tip) = start::<BLOCK, C, BODIES>(layout, cells, q, qd, p, out);
     {
         let s = &mut scratch;
-        cell_coordinates::<BLOCK>(layout, q, qd, p, s);
-        let tip = forward::<C, BODIES>(layout, cells, p, s);
         let mut x = std::mem::take(&mut s.wide);
         x.resize(n, [0.0; BLOCK]);
         let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
@@ -140,12 +132,8 @@ pub fn mass_bias_wide<C: Cells, const BODIES: bool>(
             }
         }
         s.wide = x;
-        add_forces(layout, cells, s, bias);
     }
-    SCRATCH.set(scratch);
-    if layout.loaded() {
-        subtract_loads(layout, cells, (q, qd, p), &mut out[n * (n + 1) / 2..]);
-    }
+    finish(layout, cells, (q, qd, p), scratch, out);
 }
 
 /// [`mass_bias_shared`] or [`mass_bias_wide`] with `N` and `BODIES`
@@ -333,15 +321,46 @@ fn block_sums<const N: usize, const BODIES: bool>(
     }
 }
 
-/// The generalised forces not local to a link (`layout.forces`: a rom
-/// segment's energies) added to h.
+/// Both sums' start: the scratch, the cell coordinates (`N` columns at a
+/// time) and the forward sweep.
 #[inline(always)]
-fn add_forces<C: Cells>(layout: &LinkLayout, cells: &mut C, s: &mut Scratch, bias: &mut [f64]) {
+fn start<const N: usize, C: Cells, const BODIES: bool>(
+    layout: &LinkLayout,
+    cells: &mut C,
+    q: &[f64],
+    qd: &[f64],
+    p: &[f64],
+    out: &[f64],
+) -> (Scratch, Tip) {
+    let mut scratch = take_scratch(layout, out);
+    cell_coordinates::<N>(layout, q, qd, p, &mut scratch);
+    let tip = forward::<C, BODIES>(layout, cells, p, &mut scratch);
+    (scratch, tip)
+}
+
+/// Both sums' end, M and h in `out`: the generalised forces not local to
+/// a link (`layout.forces`: a rom segment's energies) added to h, the
+/// scratch put back, the applied loads taken from h.
+#[inline(always)]
+fn finish<C: Cells>(
+    layout: &LinkLayout,
+    cells: &mut C,
+    (q, qd, p): (&[f64], &[f64], &[f64]),
+    mut scratch: Scratch,
+    out: &mut [f64],
+) {
+    let n = layout.dof;
+    let bias = &mut out[n * (n + 1) / 2..];
     if layout.forces {
-        s.forces.resize(layout.dof, 0.0);
+        let s = &mut scratch;
+        s.forces.resize(n, 0.0);
         cells.forces(&mut s.forces);
         for (h, f) in bias.iter_mut().zip(&s.forces) {
             *h += f;
         }
+    }
+    SCRATCH.set(scratch);
+    if layout.loaded() {
+        subtract_loads(layout, cells, (q, qd, p), bias);
     }
 }
