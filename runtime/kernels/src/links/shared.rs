@@ -56,27 +56,12 @@ pub fn mass_bias_shared<const N: usize, C: Cells, const BODIES: bool>(
     p: &[f64],
     out: &mut [f64],
 ) {
-    let n = layout.dof;
-    assert_eq!(N, padded(n), "rows of padded(dof)");
-    let (mut scratch, tip) = start::<N, C, BODIES>(layout, cells, q, qd, p, out);
-    {
-        let s = &mut scratch;
-        let mut x = [[0.0; N]; N];
-        let mut h = [0.0; N];
-        let every = layout.links.len();
-        block_sums::<N, BODIES>(layout, s, &tip, p, (0, every), &mut x[..n], &mut h);
-        let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
-        let mut at = 0;
-        #[allow(clippy::needless_range_loop)] // X's row and column
-        for i in 0..n {
-            for j in i..n {
-                mass[at] = x[i][j] + x[j][i];
-                at += 1;
-            }
-        }
-        bias.copy_from_slice(&h[..n]);
-    }
-    finish(layout, cells, (q, qd, p), scratch, out);
+    assert_eq!(N, padded(layout.dof), "rows of padded(dof)");
+    let mut s = take_scratch(layout, out);
+    cell_coordinates::<N>(layout, q, qd, p, &mut s);
+    let tip = forward::<C, BODIES>(layout, cells, p, &mut s);
+    sums::<N, BODIES>(layout, &mut s, &tip, p, out);
+    finish(layout, cells, (q, qd, p), s, out);
 }
 
 /// [`mass_bias_shared`] for an arm of more than [`AT_ONCE`] coordinates:
@@ -90,56 +75,23 @@ pub fn mass_bias_wide<C: Cells, const BODIES: bool>(
     p: &[f64],
     out: &mut [f64],
 ) {
-    let n = layout.dof;
-    let stride = padded(n);
-    let (mut scratch, tip) = start::<BLOCK, C, BODIES>(layout, cells, q, qd, p, out);
-    {
-        let s = &mut scratch;
-        let mut x = std::mem::take(&mut s.wide);
-        x.resize(n, [0.0; BLOCK]);
-        let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
-        mass.fill(0.0);
-        let index = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
-        // The smallest coordinate of each link and those past it: a block
-        // left of it has nothing of them but their sums from the tip.
-        let mut first = vec![usize::MAX; layout.links.len()];
-        let mut least = usize::MAX;
-        for (k, spec) in layout.links.iter().enumerate().rev() {
-            let own = spec
-                .map
-                .iter()
-                .flat_map(|c| c.terms.iter().map(|t| t.0))
-                .min();
-            least = least.min(own.unwrap_or(usize::MAX));
-            first[k] = least;
-        }
-        for c0 in (0..stride).step_by(BLOCK) {
-            x.fill([0.0; BLOCK]);
-            let mut h = [0.0; BLOCK];
-            let rows_to = first.partition_point(|&a| a < c0 + BLOCK);
-            block_sums::<BLOCK, BODIES>(layout, s, &tip, p, (c0, rows_to), &mut x, &mut h);
-            let end = n.min(c0 + BLOCK);
-            bias[c0..end].copy_from_slice(&h[..end - c0]);
-            // M = X + X^T: each X_ij into the upper entry of its pair.
-            for (i, row) in x.iter().enumerate() {
-                for (j, &v) in (c0..end).zip(row) {
-                    match i.cmp(&j) {
-                        std::cmp::Ordering::Less => mass[index(i, j)] += v,
-                        std::cmp::Ordering::Greater => mass[index(j, i)] += v,
-                        std::cmp::Ordering::Equal => mass[index(i, i)] = v + v,
-                    }
-                }
-            }
-        }
-        s.wide = x;
-    }
-    finish(layout, cells, (q, qd, p), scratch, out);
+    let mut s = take_scratch(layout, out);
+    cell_coordinates::<BLOCK>(layout, q, qd, p, &mut s);
+    let tip = forward::<C, BODIES>(layout, cells, p, &mut s);
+    sums::<0, BODIES>(layout, &mut s, &tip, p, out);
+    finish(layout, cells, (q, qd, p), s, out);
 }
 
 /// [`mass_bias_shared`] or [`mass_bias_wide`] with `N` and `BODIES`
 /// picked at run time ([`padded`], [`LinkLayout::general_bodies`]); for
 /// any chain, owned links included (tests check the two strategies
-/// agree). Inlined into its caller, which linked chains build for FMA.
+/// agree). The forward sweep is built once for the cells and the bodies,
+/// the row operations once for each width: each in a function of its
+/// own, built for FMA where the processor has it (every width's sweep
+/// inlined into one caller would be slow to build, and past what the
+/// compiler inlines: the rows' vector code and the sweep's closures would
+/// then stay out of line, without FMA). Inlined into its caller, which
+/// linked chains build for FMA.
 #[inline(always)]
 pub fn mass_bias_shared_dyn<C: Cells>(
     layout: &LinkLayout,
@@ -149,67 +101,190 @@ pub fn mass_bias_shared_dyn<C: Cells>(
     p: &[f64],
     out: &mut [f64],
 ) {
-    macro_rules! pick {
+    let mut s = take_scratch(layout, out);
+    let (n, bodies) = (padded(layout.dof), layout.general_bodies());
+    macro_rules! by_width {
         ($($n:literal)*) => {
-            match (padded(layout.dof), layout.general_bodies()) {
-                $(($n, true) => apart::<$n, C, true>(layout, cells, q, qd, p, out),
-                ($n, false) => apart::<$n, C, false>(layout, cells, q, qd, p, out),)*
-                (_, true) => apart::<0, C, true>(layout, cells, q, qd, p, out),
-                (_, false) => apart::<0, C, false>(layout, cells, q, qd, p, out),
+            match n {
+                $($n => coordinates_apart::<$n>(layout, (q, qd, p), &mut s),)*
+                _ => coordinates_apart::<0>(layout, (q, qd, p), &mut s),
+            }
+            let tip = match bodies {
+                true => forward_apart::<C, true>(layout, cells, p, &mut s),
+                false => forward_apart::<C, false>(layout, cells, p, &mut s),
+            };
+            match (n, bodies) {
+                $(($n, true) => sums_apart::<$n, true>(layout, &mut s, &tip, p, out),
+                ($n, false) => sums_apart::<$n, false>(layout, &mut s, &tip, p, out),)*
+                (_, true) => sums_apart::<0, true>(layout, &mut s, &tip, p, out),
+                (_, false) => sums_apart::<0, false>(layout, &mut s, &tip, p, out),
             }
         };
     }
-    pick!(4 8 12 16 20 24 28 32 36 40 44 48 52 56 60 64)
+    by_width!(4 8 12 16 20 24 28 32 36 40 44 48 52 56 60 64);
+    finish(layout, cells, (q, qd, p), s, out);
 }
 
-/// [`mass_bias_shared`] at `N` (0: [`mass_bias_wide`]) in a function of
-/// its own, built for FMA where the processor has it: the sweeps of
-/// every width inlined into one caller would push it past what the
-/// compiler inlines (the rows' vector code and the forward sweep's
-/// closures then stay out of line, without FMA).
+/// [`cell_coordinates`] `N` columns at a time (0: [`BLOCK`]), apart.
 #[inline(never)]
-fn apart<const N: usize, C: Cells, const BODIES: bool>(
+fn coordinates_apart<const N: usize>(
+    layout: &LinkLayout,
+    (q, qd, p): (&[f64], &[f64], &[f64]),
+    s: &mut Scratch,
+) {
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,fma")]
+    unsafe fn fma<const N: usize>(l: &LinkLayout, a: [&[f64]; 3], s: &mut Scratch) {
+        plain::<N>(l, a, s)
+    }
+    #[inline(always)]
+    fn plain<const N: usize>(l: &LinkLayout, [q, qd, p]: [&[f64]; 3], s: &mut Scratch) {
+        match N {
+            0 => cell_coordinates::<BLOCK>(l, q, qd, p, s),
+            _ => cell_coordinates::<N>(l, q, qd, p, s),
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
+    if rows::simd_available() {
+        // SAFETY: the processor has AVX and FMA.
+        return unsafe { fma::<N>(layout, [q, qd, p], s) };
+    }
+    plain::<N>(layout, [q, qd, p], s)
+}
+
+/// [`forward`], apart.
+#[inline(never)]
+fn forward_apart<C: Cells, const BODIES: bool>(
     layout: &LinkLayout,
     cells: &mut C,
-    q: &[f64],
-    qd: &[f64],
+    p: &[f64],
+    s: &mut Scratch,
+) -> Tip {
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,fma")]
+    unsafe fn fma<C: Cells, const BODIES: bool>(
+        l: &LinkLayout,
+        cells: &mut C,
+        p: &[f64],
+        s: &mut Scratch,
+    ) -> Tip {
+        forward::<C, BODIES>(l, cells, p, s)
+    }
+    #[cfg(target_arch = "x86_64")]
+    if rows::simd_available() {
+        // SAFETY: the processor has AVX and FMA.
+        return unsafe { fma::<C, BODIES>(layout, cells, p, s) };
+    }
+    forward::<C, BODIES>(layout, cells, p, s)
+}
+
+/// [`sums`], apart.
+#[inline(never)]
+fn sums_apart<const N: usize, const BODIES: bool>(
+    layout: &LinkLayout,
+    s: &mut Scratch,
+    tip: &Tip,
     p: &[f64],
     out: &mut [f64],
 ) {
     #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,fma")]
+    unsafe fn fma<const N: usize, const BODIES: bool>(
+        l: &LinkLayout,
+        s: &mut Scratch,
+        tip: &Tip,
+        p: &[f64],
+        out: &mut [f64],
+    ) {
+        sums::<N, BODIES>(l, s, tip, p, out)
+    }
+    #[cfg(target_arch = "x86_64")]
     if rows::simd_available() {
         // SAFETY: the processor has AVX and FMA.
-        return unsafe { apart_fma::<N, C, BODIES>(layout, cells, q, qd, p, out) };
+        return unsafe { fma::<N, BODIES>(layout, s, tip, p, out) };
     }
-    either::<N, C, BODIES>(layout, cells, q, qd, p, out)
+    sums::<N, BODIES>(layout, s, tip, p, out)
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx,fma")]
-unsafe fn apart_fma<const N: usize, C: Cells, const BODIES: bool>(
-    layout: &LinkLayout,
-    cells: &mut C,
-    q: &[f64],
-    qd: &[f64],
-    p: &[f64],
-    out: &mut [f64],
-) {
-    either::<N, C, BODIES>(layout, cells, q, qd, p, out)
-}
-
+/// M and h into `out` from the forward sweep's scratch and `tip`: X in
+/// rows of `N` columns, or (`N` = 0, an arm wider than [`AT_ONCE`]) a
+/// block of [`BLOCK`] columns at a time; M = X + X^T.
 #[inline(always)]
-fn either<const N: usize, C: Cells, const BODIES: bool>(
+fn sums<const N: usize, const BODIES: bool>(
     layout: &LinkLayout,
-    cells: &mut C,
-    q: &[f64],
-    qd: &[f64],
+    s: &mut Scratch,
+    tip: &Tip,
     p: &[f64],
     out: &mut [f64],
 ) {
-    match N {
-        0 => mass_bias_wide::<C, BODIES>(layout, cells, q, qd, p, out),
-        _ => mass_bias_shared::<N, C, BODIES>(layout, cells, q, qd, p, out),
+    if N == 0 {
+        return wide_sums::<BODIES>(layout, s, tip, p, out);
     }
+    let n = layout.dof;
+    let mut x = [[0.0; N]; N];
+    let mut h = [0.0; N];
+    let every = layout.links.len();
+    block_sums::<N, BODIES>(layout, s, tip, p, (0, every), &mut x[..n], &mut h);
+    let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
+    let mut at = 0;
+    #[allow(clippy::needless_range_loop)] // X's row and column
+    for i in 0..n {
+        for j in i..n {
+            mass[at] = x[i][j] + x[j][i];
+            at += 1;
+        }
+    }
+    bias.copy_from_slice(&h[..n]);
+}
+
+/// [`sums`] a block of [`BLOCK`] columns at a time.
+#[inline(always)]
+fn wide_sums<const BODIES: bool>(
+    layout: &LinkLayout,
+    s: &mut Scratch,
+    tip: &Tip,
+    p: &[f64],
+    out: &mut [f64],
+) {
+    let n = layout.dof;
+    let stride = padded(n);
+    let mut x = std::mem::take(&mut s.wide);
+    x.resize(n, [0.0; BLOCK]);
+    let (mass, bias) = out.split_at_mut(n * (n + 1) / 2);
+    mass.fill(0.0);
+    let index = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
+    // The smallest coordinate of each link and those past it: a block
+    // left of it has nothing of them but their sums from the tip.
+    let mut first = vec![usize::MAX; layout.links.len()];
+    let mut least = usize::MAX;
+    for (k, spec) in layout.links.iter().enumerate().rev() {
+        let own = spec
+            .map
+            .iter()
+            .flat_map(|c| c.terms.iter().map(|t| t.0))
+            .min();
+        least = least.min(own.unwrap_or(usize::MAX));
+        first[k] = least;
+    }
+    for c0 in (0..stride).step_by(BLOCK) {
+        x.fill([0.0; BLOCK]);
+        let mut h = [0.0; BLOCK];
+        let rows_to = first.partition_point(|&a| a < c0 + BLOCK);
+        block_sums::<BLOCK, BODIES>(layout, s, tip, p, (c0, rows_to), &mut x, &mut h);
+        let end = n.min(c0 + BLOCK);
+        bias[c0..end].copy_from_slice(&h[..end - c0]);
+        // M = X + X^T: each X_ij into the upper entry of its pair.
+        for (i, row) in x.iter().enumerate() {
+            for (j, &v) in (c0..end).zip(row) {
+                match i.cmp(&j) {
+                    std::cmp::Ordering::Less => mass[index(i, j)] += v,
+                    std::cmp::Ordering::Greater => mass[index(j, i)] += v,
+                    std::cmp::Ordering::Equal => mass[index(i, i)] = v + v,
+                }
+            }
+        }
+    }
+    s.wide = x;
 }
 
 /// Each link's cell coordinates and rates into `s.x`, `s.xd`: its rows of
@@ -319,23 +394,6 @@ fn block_sums<const N: usize, const BODIES: bool>(
             }
         }
     }
-}
-
-/// Both sums' start: the scratch, the cell coordinates (`N` columns at a
-/// time) and the forward sweep.
-#[inline(always)]
-fn start<const N: usize, C: Cells, const BODIES: bool>(
-    layout: &LinkLayout,
-    cells: &mut C,
-    q: &[f64],
-    qd: &[f64],
-    p: &[f64],
-    out: &[f64],
-) -> (Scratch, Tip) {
-    let mut scratch = take_scratch(layout, out);
-    cell_coordinates::<N>(layout, q, qd, p, &mut scratch);
-    let tip = forward::<C, BODIES>(layout, cells, p, &mut scratch);
-    (scratch, tip)
 }
 
 /// Both sums' end, M and h in `out`: the generalised forces not local to
