@@ -529,6 +529,8 @@ fn report_run(
     );
     if arm.backend() == "interpreted" {
         eprintln!("  why interpreted: {}", loaded.route);
+    } else if loaded.cache == backend::CacheStatus::Linked {
+        eprintln!("  route: {}", loaded.route);
     }
     if let Some(e) = &tip_error {
         eprintln!(

@@ -770,6 +770,66 @@ fn link_recursion_matches_the_flat_tape_for_anisotropic_sections() {
     recursion_matches_flat_tapes(models.collect(), 12);
 }
 
+/// Rigid chains in space: joints of one to three axes in any order at
+/// the links' bases and middles, a rest shape in the plane and in space,
+/// an anisotropic section, gravity, a tip body, chambers and a tendon.
+#[test]
+fn link_recursion_matches_the_flat_tape_for_rigid_joints_in_space() {
+    let dir = std::env::temp_dir().join("softarm-test-cache");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = |name: &str, text: &str| {
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let ribbon = file("ribbon3d", RIBBON_3D);
+    let actuated = file("actuated3d", ACTUATED_3D);
+    let cases: [(&str, &[&'static str]); 7] = [
+        ("cantilever3d", &["segment.0.method=rigid"]),
+        (
+            "cantilever3d",
+            &[
+                "segment.0.method=rigid",
+                "segment.0.joints=\"base\"",
+                "segment.0.joint_axes=[\"y\",\"x\",\"z\"]",
+                "segment.0.rest_curvature=1.5",
+                "gravity=[0,-9.81,0]",
+                "tip.mass=0.01",
+            ],
+        ),
+        (
+            "cantilever3d",
+            &[
+                "segment.0.method=rigid",
+                "segment.0.joint_axes=[\"x\"]",
+                "segment.0.rest_curvature=[1.0,-2.0]",
+                "gravity=[0,-9.81,-3.0]",
+            ],
+        ),
+        (
+            "cantilever3d",
+            &[
+                "segment.0.method=rigid",
+                "segment.0.joint_axes=[\"z\",\"y\"]",
+                "tip.length=0.05",
+                "tip.mass=0.005",
+                "tip.radius=0.005",
+            ],
+        ),
+        (
+            &ribbon,
+            &["segment.0.method=rigid", "segment.2.method=rigid"],
+        ),
+        (&actuated, &["segment.0.method=rigid"]),
+        (
+            &actuated,
+            &["segment.0.method=rigid", "segment.0.joints=\"base\""],
+        ),
+    ];
+    let models = cases.iter().map(|(m, sets)| (m.to_string(), sets.to_vec()));
+    recursion_matches_flat_tapes(models.collect(), 16);
+}
+
 /// The loaded arms on bases moved along driven paths and turned by
 /// inputs, immersed (buoyed) and dragged by a current, in space and in
 /// the plane.
@@ -1936,6 +1996,11 @@ fn a_run_says_which_route_it_took_and_why() {
     let (b, r) = route(&turned.to_string_lossy(), "", auto);
     assert_eq!(b, "compiled", "{r}");
     assert!(r.contains("link cells") && !r.contains("tapes"), "{r}");
+    // A rigid chain in space: its joints' link cells (the half before a
+    // midpoint joint is ebr_arm's).
+    let (b, r) = route("cantilever3d", "segment.0.method=rigid", auto);
+    assert_eq!(b, "compiled", "{r}");
+    assert!(r.contains("link cells") && r.contains("1 of its 2"), "{r}");
     let example = root().join("examples/palm.toml");
     let (b, r) = route(&example.to_string_lossy(), "", auto);
     assert_eq!(b, "interpreted");

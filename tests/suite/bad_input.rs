@@ -1085,6 +1085,14 @@ fn three_d_method_cases() -> Vec<FileCase> {
             vec!["segment[0].joint_axes", "1 to 3 axes"],
         ),
         (
+            "a joint axis twice",
+            r(
+                "method = \"pcc\"",
+                "method = \"rigid\"\njoint_axes = [\"z\", \"y\", \"z\"]",
+            ),
+            vec!["segment[0].joint_axes", "each axis once", "z twice"],
+        ),
+        (
             "joint axes on pcc",
             r("elements = 2", "joint_axes = [\"z\"]"),
             vec!["segment[0].joint_axes", "only rigid segments"],

@@ -33,12 +33,13 @@ use runtime::links::{
 
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{
-    ElementParam, FluidParam, Joints, KinkParam, LoadParam, Method, Param, ParamLayout, Rate,
+    Axis, ElementParam, FluidParam, Joints, KinkParam, LoadParam, Method, Param, ParamLayout, Rate,
     Structure, Xyz,
 };
 
 use super::planar_cell::{derive_planar_cell, derive_planar_kink_cell};
 use crate::method::ebr::{before_joint, past_joint};
+use crate::method::rigid::{JointSprings, RestTurn, joint_turn};
 use crate::method::rom::RomFields;
 use crate::tmt::actuation::{loads_on, segment_loads, strain_work, thinning};
 use crate::tmt::cell_kind::CellKind;
@@ -46,7 +47,7 @@ use crate::tmt::cell_outputs::{
     LinkKinematics, Motion, Rates, bodiless_cells, cell_param_symbols, with_tangent,
 };
 use crate::tmt::spatial::{
-    ArcStrain, Element3, Frame, M3, Springs, V3, arc, compose, exp_turn, half_k_sq,
+    ArcStrain, Element3, Frame, M3, Springs, V3, advance, arc, compose, exp_turn, half_k_sq,
     mid_arc_rotation,
 };
 use crate::tmt::system::{Coordinates, ParamSymbols};
@@ -140,7 +141,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         let c = cell_of(shape)?;
         // An ebr element's first half is a link of its own, before the
         // joint's.
-        let before = (shape.kind == CellKind::PastJoint)
+        let before = (shape.kind.after_half())
             .then(|| {
                 cell_of(Shape {
                     kind: CellKind::BeforeJoint,
@@ -672,8 +673,17 @@ fn cell_coordinates(
     shear: bool,
     kind: CellKind,
 ) -> Vec<&'static str> {
-    if kind == CellKind::BeforeJoint {
-        return Vec::new();
+    match kind {
+        CellKind::BeforeJoint => return Vec::new(),
+        CellKind::Revolute { axes, .. } => {
+            let turns = ["turn_0", "turn_1", "turn_2"];
+            return turns
+                .into_iter()
+                .zip(axes.iter().flatten())
+                .map(|(n, _)| n)
+                .collect();
+        }
+        _ => {}
     }
     let mut names = vec!["bend_y", "bend_z"];
     if twist {
@@ -790,6 +800,7 @@ fn link_motion(
             (c, a, w, end, body, y_of(joint.r))
         }
         CellKind::Kink => unreachable!("a kink's cell is `derive_kink_cell`"),
+        CellKind::Revolute { .. } => unreachable!("a joint's cell is `derive_revolute_cell`"),
     }
 }
 
@@ -798,8 +809,10 @@ fn link_motion(
 /// the cell [`with_tangent`]; and its pose cell (`runtime::links::pose`:
 /// what the `Outputs` need of the link).
 fn derive_cell(shape: Shape) -> [Tape; 3] {
-    if shape.kind == CellKind::Kink {
-        return derive_kink_cell();
+    match shape.kind {
+        CellKind::Kink => return derive_kink_cell(),
+        CellKind::Revolute { axes, whole } => return derive_revolute_cell(shape, axes, whole),
+        _ => {}
     }
     let Shape {
         twist,
@@ -925,6 +938,77 @@ fn derive_cell(shape: Shape) -> [Tape; 3] {
         Rates::Turned,
     )
     .with_principal(y_axis.map(|y| (y, body.lateral_y)));
+    let out = kin.cell(cas, &q, &qd, elastic, rayleigh);
+    let pose_out = kin.pose(cas);
+    [
+        cas.to_tape(&out),
+        with_tangent(cas, &out, &q, &qd),
+        cas.to_tape(&pose_out),
+    ]
+}
+
+/// A rigid element's joint cell ([`CellKind::Revolute`]): the joint's turn
+/// from the identity frame (`rigid::joint_turn`, its springs and dampers),
+/// then the straight link of the whole element (`whole`) or of its half
+/// past the joint, its body at its middle, as `method::rigid` builds the
+/// arm's.
+fn derive_revolute_cell(shape: Shape, axes: [Option<Axis>; 3], whole: bool) -> [Tape; 3] {
+    let mut cas = Cas::new();
+    let cas = &mut cas;
+    let axes: Vec<Axis> = axes.into_iter().flatten().collect();
+    let names = cell_coordinates(false, false, false, shape.kind);
+    let q: Vec<ExprId> = (0..names.len())
+        .map(|i| cas.symbol(names[i], SymKind::Q(i as u32)))
+        .collect();
+    let qd: Vec<ExprId> = (0..names.len())
+        .map(|i| cas.symbol(&format!("{}_dot", names[i]), SymKind::Qd(i as u32)))
+        .collect();
+    let p = cell_param_symbols(cas);
+    // In the order of `ElementParam::CELL`, then the actuation loads.
+    let [l, m, lateral, axial, kb, db, rest, kt] = std::array::from_fn(|i| p[i]);
+    let [kb_y, lateral_y] = match shape.principal {
+        true => std::array::from_fn(|i| p[CELL_PARAMS - PRINCIPAL_PARAMS + i]),
+        false => [kb, lateral],
+    };
+    let loads: [ExprId; ACTUATION_LOADS] = std::array::from_fn(|i| p[ELEMENT_PARAMS + i]);
+    let [rest_y, rest_twist, _]: [ExprId; REST_PARAMS] =
+        std::array::from_fn(|i| p[ELEMENT_PARAMS + ACTUATION_LOADS + i]);
+    let rest = match shape.rest_3d {
+        true => RestTurn::Vector([rest_twist, rest_y, rest]),
+        false => RestTurn::AboutZ(rest),
+    };
+    let springs = JointSprings {
+        twist: kt,
+        bend_y: kb_y,
+        bend: kb,
+        damping: db,
+    };
+    let zero = cas.zero();
+    let identity = Frame::at_rest(cas, [zero; 3]);
+    let angles: Vec<(ExprId, ExprId)> = q.iter().copied().zip(qd.iter().copied()).collect();
+    let turn = joint_turn(cas, &identity, (&axes, &angles), rest, springs);
+    let stored = cas.add_all(&turn.elastic);
+    let rayleigh = cas.add_all(&turn.rayleigh);
+    let work = strain_work(cas, loads, zero, turn.rho, None);
+    let elastic = cas.sub(stored, work);
+    let (length, mass) = match whole {
+        true => (l, m),
+        false => (cas.scaled(0.5, l), cas.scaled(0.5, m)),
+    };
+    let joint = turn.frame;
+    let middle = cas.scaled(0.5, length);
+    let centroid = advance(cas, &joint, middle).p;
+    let end = advance(cas, &joint, length);
+    let y = [joint.r[0][1], joint.r[1][1], joint.r[2][1]];
+    let kin = LinkKinematics::new(
+        cas,
+        Motion::ending(&end, centroid, joint.w, joint.axis()),
+        [mass, lateral, axial, stored],
+        &q,
+        &qd,
+        Rates::Turned,
+    )
+    .with_principal(shape.principal.then_some((y, lateral_y)));
     let out = kin.cell(cas, &q, &qd, elastic, rayleigh);
     let pose_out = kin.pose(cas);
     [

@@ -687,6 +687,19 @@ fn segment_dimension_keys(ck: &Check, i: usize, s: &Segment) -> Result<(), Model
                 format!("give 1 to 3 axes (\"x\", \"y\", \"z\"), got {}", axes.len()),
             );
         }
+        // A second turn about an axis would name a second coordinate
+        // alike and, about the same axis twice in a row, leave the mass
+        // matrix singular.
+        if let Some(axes) = &s.joint_axes
+            && let Some(a) =
+                (axes.iter().enumerate()).find_map(|(i, a)| axes[..i].contains(a).then_some(a))
+        {
+            return ck.err(
+                p("joint_axes"),
+                format!("give each axis once (\"x\", \"y\", \"z\"), got {a:?} twice")
+                    .to_lowercase(),
+            );
+        }
         let method = crate::method::of(s.method);
         // Joints of the method's own with their stiffness hold the twist.
         let joints_hold =

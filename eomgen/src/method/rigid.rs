@@ -8,6 +8,7 @@ use super::{Carried, ModellingMethod, half_links_inertia};
 use crate::cas::{Cas, ExprId};
 use crate::model::{Axis, Check, ElementParam, Joints, ModelError, Segment, SegmentShape};
 use crate::tmt::actuation::Strain;
+use crate::tmt::cell_kind::CellKind;
 use crate::tmt::planar::{self, Element2, PlanarArm};
 use crate::tmt::spatial::{Frame, SpatialArm, advance, compose, exp_turn, half_k_sq, revolute};
 
@@ -20,6 +21,27 @@ impl ModellingMethod for Rigid {
 
     fn joint_axes(&self, s: &Segment) -> Vec<Axis> {
         s.axes()
+    }
+
+    /// In 3D each element's joint and the link past it are one link cell
+    /// (after a cell of its first half, at a midpoint joint); a planar
+    /// element is one body (`planar_cell`).
+    fn link_cells(&self) -> bool {
+        true
+    }
+
+    fn cell_kind(&self, g: &SegmentShape, spatial: bool) -> CellKind {
+        if !spatial {
+            return CellKind::Arc;
+        }
+        let mut axes = [None; 3];
+        for (slot, &a) in axes.iter_mut().zip(&g.axes) {
+            *slot = Some(a);
+        }
+        CellKind::Revolute {
+            axes,
+            whole: g.joints == Joints::Base,
+        }
     }
 
     fn coordinates_per_element(&self, g: &SegmentShape) -> usize {
@@ -202,70 +224,124 @@ fn rotation_vector(cas: &mut Cas, turns: &[(usize, ExprId)], zero: ExprId) -> [E
     theta
 }
 
-/// The end frame turned by the element's joint: first by its rest angle
-/// about z, then by its angles about their axes in sequence. Its springs
-/// (twist about x, bend about y and z) and dampers act on the rotation
-/// vector of the turn from rest, to second order (Baker-Campbell-Hausdorff:
-/// theta = sum q_i e_i + 1/2 sum_{i<j} q_i q_j e_i x e_j), about the axes
-/// the joint has. Springs on the angles themselves, with the rest angle
-/// taken from the angle about z, made the chain converge at first order,
-/// to an answer that depended on the order of the axes. The joint's lumped
-/// strain is its angles (exact for one axis, first order for several).
+/// The end frame turned by the element's joint (`joint_turn`), its
+/// springs, dampers and lumped strain added to the arm.
 fn joint(cas: &mut Cas, arm: &mut SpatialArm, g: &SegmentShape, s: usize) -> Frame {
     let e = |p| arm.symbols.element(arm.k, p);
-    let (stiff, twist) = (
-        e(ElementParam::BendStiffness),
-        e(ElementParam::TwistStiffness),
-    );
-    let (damp, rest) = (e(ElementParam::BendDamping), e(ElementParam::Rest));
-    let stiff_y = (arm.symbols).element_or(arm.k, ElementParam::BendStiffnessY, stiff);
-    let zero = arm.zero;
-    // Half the rest turn before the joint and half after: its angles are
-    // then measured in the frame midway between its links, as a rod's
-    // strains are at that point (measured in the incoming link's frame,
-    // the twist and bend of a curved rod mixed at first order).
-    // A 3D rest shape turns it by the rotation vector (twist, bend y, bend
-    // z) at rest, as a whole.
-    let rest_3d = g
-        .rest_3d
-        .then(|| [ElementParam::RestTwist, ElementParam::RestY, ElementParam::Rest].map(e));
-    let half_turn = |cas: &mut Cas, f: &Frame| -> Frame {
-        let Some(rho) = rest_3d else {
-            let half_rest = cas.scaled(0.5, rest);
-            return revolute(cas, f, 2, half_rest, zero);
-        };
-        let rho = rho.map(|r| cas.scaled(0.5, r));
-        let (r, q, _) = exp_turn(cas, &rho, &[zero; 3]);
-        compose(cas, f, Some((&r, &q)), None, None)
+    let stiff = e(ElementParam::BendStiffness);
+    let springs = JointSprings {
+        twist: e(ElementParam::TwistStiffness),
+        bend_y: (arm.symbols).element_or(arm.k, ElementParam::BendStiffnessY, stiff),
+        bend: stiff,
+        damping: e(ElementParam::BendDamping),
     };
-    let mut f = half_turn(cas, &arm.f);
-    let mut rho = [zero; 3];
-    let mut turns: Vec<(usize, ExprId)> = Vec::new();
-    for &a in &g.axes {
-        let (q, qd) = arm.take();
-        rho[a.index()] = cas.add(rho[a.index()], q);
-        f = revolute(cas, &f, a.index(), q, qd);
-        arm.rayleigh.push(half_k_sq(cas, damp, qd));
-        turns.push((a.index(), q));
-    }
-    f = half_turn(cas, &f);
-    let theta = rotation_vector(cas, &turns, zero);
-    for (k, &th) in theta.iter().enumerate() {
-        if turns.iter().any(|&(a, _)| a == k) {
-            let kq = match k {
-                0 => twist,
-                1 => stiff_y,
-                _ => stiff,
-            };
-            arm.elastic.push(half_k_sq(cas, kq, th));
-        }
-    }
+    let rest = match g.rest_3d {
+        true => RestTurn::Vector([ElementParam::RestTwist, ElementParam::RestY, ElementParam::Rest].map(e)),
+        false => RestTurn::AboutZ(e(ElementParam::Rest)),
+    };
+    let angles: Vec<(ExprId, ExprId)> = g.axes.iter().map(|_| arm.take()).collect();
+    let turn = joint_turn(cas, &arm.f, (&g.axes, &angles), rest, springs);
+    arm.rayleigh.extend(turn.rayleigh);
+    arm.elastic.extend(turn.elastic);
+    let zero = arm.zero;
     arm.strains.push(Strain {
         segment: s,
         element: arm.k,
         stretch: zero,
-        rho,
+        rho: turn.rho,
         offset_scale: None,
     });
-    f
+    turn.frame
+}
+
+/// A rigid joint's rest turn: about z by an angle, or (a 3D rest shape)
+/// by the rotation vector (twist, bend y, bend z).
+pub(crate) enum RestTurn {
+    AboutZ(ExprId),
+    Vector([ExprId; 3]),
+}
+
+/// A rigid joint's springs (about x, y and z) and the damping on each of
+/// its angles' rates.
+pub(crate) struct JointSprings {
+    pub twist: ExprId,
+    pub bend_y: ExprId,
+    pub bend: ExprId,
+    pub damping: ExprId,
+}
+
+/// A rigid joint's turned frame, its strain energy and Rayleigh function
+/// (as terms) and its lumped strain (the angles summed by axis).
+pub(crate) struct JointTurn {
+    pub frame: Frame,
+    pub elastic: Vec<ExprId>,
+    pub rayleigh: Vec<ExprId>,
+    pub rho: [ExprId; 3],
+}
+
+/// Frame `f` turned by a joint: half its rest turn, then its angles
+/// (`angles`, each with its rate) about their `axes` in sequence, then the
+/// other half. Its springs (twist about x, bend about y and z) and
+/// dampers act on the rotation vector of the turn from rest, to second
+/// order (Baker-Campbell-Hausdorff: theta = sum q_i e_i + 1/2 sum_{i<j}
+/// q_i q_j e_i x e_j), about the axes the joint has. Springs on the angles
+/// themselves, with the rest angle taken from the angle about z, made the
+/// chain converge at first order, to an answer that depended on the order
+/// of the axes. The joint's lumped strain is its angles (exact for one
+/// axis, first order for several). The arm's elements and a link cell
+/// (`build::cell`) turn by this one joint.
+pub(crate) fn joint_turn(
+    cas: &mut Cas,
+    f: &Frame,
+    (axes, angles): (&[Axis], &[(ExprId, ExprId)]),
+    rest: RestTurn,
+    springs: JointSprings,
+) -> JointTurn {
+    let zero = cas.zero();
+    // Half the rest turn before the joint and half after: its angles are
+    // then measured in the frame midway between its links, as a rod's
+    // strains are at that point (measured in the incoming link's frame,
+    // the twist and bend of a curved rod mixed at first order).
+    let half_turn = |cas: &mut Cas, f: &Frame| -> Frame {
+        match rest {
+            RestTurn::AboutZ(rest) => {
+                let half_rest = cas.scaled(0.5, rest);
+                revolute(cas, f, 2, half_rest, zero)
+            }
+            RestTurn::Vector(rho) => {
+                let rho = rho.map(|r| cas.scaled(0.5, r));
+                let (r, q, _) = exp_turn(cas, &rho, &[zero; 3]);
+                compose(cas, f, Some((&r, &q)), None, None)
+            }
+        }
+    };
+    let mut frame = half_turn(cas, f);
+    let mut rho = [zero; 3];
+    let mut turns: Vec<(usize, ExprId)> = Vec::new();
+    let mut rayleigh = Vec::new();
+    for (&a, &(q, qd)) in axes.iter().zip(angles) {
+        rho[a.index()] = cas.add(rho[a.index()], q);
+        frame = revolute(cas, &frame, a.index(), q, qd);
+        rayleigh.push(half_k_sq(cas, springs.damping, qd));
+        turns.push((a.index(), q));
+    }
+    let frame = half_turn(cas, &frame);
+    let theta = rotation_vector(cas, &turns, zero);
+    let mut elastic = Vec::new();
+    for (k, &th) in theta.iter().enumerate() {
+        if turns.iter().any(|&(a, _)| a == k) {
+            let kq = match k {
+                0 => springs.twist,
+                1 => springs.bend_y,
+                _ => springs.bend,
+            };
+            elastic.push(half_k_sq(cas, kq, th));
+        }
+    }
+    JointTurn {
+        frame,
+        elastic,
+        rayleigh,
+        rho,
+    }
 }

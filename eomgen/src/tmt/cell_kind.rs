@@ -1,5 +1,7 @@
 //! The kinds of link cell (`build::cell`); a method names its own.
 
+use crate::model::Axis;
+
 /// The kinematics of a 3D link.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub(crate) enum CellKind {
@@ -13,7 +15,26 @@ pub(crate) enum CellKind {
     BeforeJoint,
     /// An ebr element's joint and the half past it.
     PastJoint,
+    /// A rigid element's joint (its axes in sequence, `method::rigid`'s
+    /// `joint_turn`) and the link past it: the whole link where the joint
+    /// is at its base, else the half past a midpoint joint (the half
+    /// before it a [`CellKind::BeforeJoint`]).
+    Revolute {
+        axes: [Option<Axis>; 3],
+        whole: bool,
+    },
     /// A kink before a segment: its constant turn and offset, no
     /// coordinates, no body.
     Kink,
+}
+
+impl CellKind {
+    /// An element of this kind is a link of no coordinates (its half
+    /// before a midpoint joint) and then one of this kind.
+    pub(crate) fn after_half(self) -> bool {
+        matches!(
+            self,
+            CellKind::PastJoint | CellKind::Revolute { whole: false, .. }
+        )
+    }
 }
