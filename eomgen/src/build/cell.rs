@@ -42,7 +42,7 @@ use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rigid::{JointSprings, RestTurn, joint_turn};
 use crate::method::rom::RomFields;
 use crate::tmt::actuation::{loads_on, segment_loads, strain_work, thinning};
-use crate::tmt::cell_kind::CellKind;
+use crate::tmt::cell_kind::{CellKind, PointsOn};
 use crate::tmt::cell_outputs::{
     LinkKinematics, Motion, Rates, bodiless_cells, cell_param_symbols, with_tangent,
 };
@@ -158,6 +158,8 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             let principal = g.anisotropic.then(|| principal_params(params, k));
             let params = cell_slots(params, k);
             let maps = coordinate_maps(rom.as_ref(), e, count, first, params[0], shape.kind);
+            // The element's links, its half before a joint included.
+            let own = links.len()..links.len() + usize::from(before.is_some()) + maps.len();
             if let Some(b) = before {
                 links.push(LinkSpec {
                     cell: b,
@@ -168,7 +170,6 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
                     principal,
                 });
             }
-            let own = links.len()..links.len() + maps.len();
             for map in maps {
                 links.push(LinkSpec {
                     cell: c,
@@ -182,7 +183,12 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             // An inextensible, unshearable centreline is its element's
             // length long: the broad phase's bound.
             let length = (!g.extension && !g.shear).then_some(params[0]);
-            element_links.push(method.points_on_arcs().then_some((own, length)));
+            let on = method.points_on_links(g, spatial);
+            element_links.push(on.map(|on| ElementLinks {
+                links: own,
+                on,
+                length,
+            }));
             if rom.is_none() {
                 first += count;
             }
@@ -289,10 +295,10 @@ fn covered(st: &Structure) -> bool {
 /// methods sample them, in the links' order. Empty without contact or
 /// where an element's points are not on its links' arcs: its contact
 /// kernels are then its tapes'.
-fn contact_points(elements: &[ElementLinks], points: usize) -> Vec<ContactPoint> {
+fn contact_points(elements: &[Option<ElementLinks>], points: usize) -> Vec<ContactPoint> {
     let mut out = Vec::with_capacity(elements.len() * points);
     for element in elements {
-        let Some((links, _)) = element else {
+        let Some(links) = element else {
             return Vec::new();
         };
         for j in 1..=points {
@@ -305,16 +311,23 @@ fn contact_points(elements: &[ElementLinks], points: usize) -> Vec<ContactPoint>
     out
 }
 
-/// An element's links (where its points lie on their arcs) and the
-/// parameter of its centreline's length where that is fixed.
-type ElementLinks = Option<(std::ops::Range<usize>, Option<usize>)>;
+/// An element's links, where its points lie on them: how they lie, and
+/// the parameter of its centreline's length where that is fixed.
+struct ElementLinks {
+    links: std::ops::Range<usize>,
+    on: PointsOn,
+    length: Option<usize>,
+}
 
-/// The point at the fraction `s` of an element on `links`, as the methods
-/// sample it: an element of one link at s along it, one of two halves (a
-/// half-arc pcc element, a rom slice) on the first at 2 s up to its
-/// middle, else on the second at 2 s - 1.
-fn on_links(links: &std::ops::Range<usize>, s: f64) -> Option<ContactPoint> {
-    let on = |link: usize, at: f64| ContactPoint { link, at };
+/// The point at the fraction `s` of an element on its links, as the
+/// methods sample it: an element of one link at s along it, one of two
+/// halves (a half-arc pcc element, a rom slice, a rigid element's halves
+/// about a midpoint joint) on the first at 2 s up to its middle, else on
+/// the second at 2 s - 1.
+fn on_links(element: &ElementLinks, s: f64) -> Option<ContactPoint> {
+    let links = &element.links;
+    let straight = element.on == PointsOn::Straight;
+    let on = |link: usize, at: f64| ContactPoint { link, at, straight };
     match links.len() {
         1 => Some(on(links.start, s)),
         2 if s <= 0.5 => Some(on(links.start, 2.0 * s)),
@@ -330,7 +343,7 @@ fn on_links(links: &std::ops::Range<usize>, s: f64) -> Option<ContactPoint> {
 fn along_loads(
     st: &Structure,
     params: &ParamLayout,
-    elements: &[ElementLinks],
+    elements: &[Option<ElementLinks>],
 ) -> Option<Vec<AlongLoad>> {
     let mut out = Vec::new();
     for (i, l) in st.loads.iter().enumerate() {
@@ -341,7 +354,7 @@ fn along_loads(
             slots(l.force, LoadParam::Force),
             slots(l.moment, LoadParam::Moment),
         );
-        let place = |k: usize, s: f64| on_links(&elements.get(k)?.as_ref()?.0, s);
+        let place = |k: usize, s: f64| on_links(elements.get(k)?.as_ref()?, s);
         match l.at {
             Some((k, bits)) => out.push(AlongLoad {
                 at: place(k, f64::from_bits(bits))?,
@@ -374,7 +387,7 @@ fn along_loads(
 fn fluid_drag(
     st: &Structure,
     params: &ParamLayout,
-    elements: &[ElementLinks],
+    elements: &[Option<ElementLinks>],
 ) -> Option<Option<Drag>> {
     if st.fluid != Some(true) {
         return Some(None);
@@ -384,7 +397,7 @@ fn fluid_drag(
     let points = (elements.iter().enumerate())
         .map(|(k, links)| {
             Some(DragPoint {
-                at: on_links(&links.as_ref()?.0, 0.5)?,
+                at: on_links(links.as_ref()?, 0.5)?,
                 width: element(k, ElementParam::Width),
                 length: element(k, ElementParam::Length),
             })
@@ -401,15 +414,18 @@ fn fluid_drag(
 
 /// The elements the contact points are on (none without them): their
 /// first and last links and their centreline's length where it is fixed.
-fn contact_elements(elements: &[ElementLinks], points: &[ContactPoint]) -> Vec<ContactElement> {
+fn contact_elements(
+    elements: &[Option<ElementLinks>],
+    points: &[ContactPoint],
+) -> Vec<ContactElement> {
     if points.is_empty() {
         return Vec::new();
     }
     (elements.iter().flatten())
-        .map(|(links, length)| ContactElement {
-            first: links.start,
-            last: links.end - 1,
-            length: *length,
+        .map(|e| ContactElement {
+            first: e.links.start,
+            last: e.links.end - 1,
+            length: e.length,
         })
         .collect()
 }

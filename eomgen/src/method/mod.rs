@@ -20,7 +20,7 @@
 use crate::cas::Cas;
 
 use crate::model::{Axis, Check, Joints, Method, ModelError, Segment, SegmentShape, Structure};
-use crate::tmt::cell_kind::CellKind;
+use crate::tmt::cell_kind::{CellKind, PointsOn};
 use crate::tmt::planar::{Element2, PlanarArm};
 use crate::tmt::spatial::SpatialArm;
 use crate::tmt::system::{ParamSymbols, System};
@@ -88,11 +88,11 @@ pub(crate) trait ModellingMethod: Sync {
         false
     }
 
-    /// Its elements' sampled points lie on their links' constant-strain
-    /// arcs, the point at s the arc cut at s (`runtime::links`'s contact
-    /// kernels place them so).
-    fn points_on_arcs(&self) -> bool {
-        false
+    /// How its elements' sampled points lie on their links, where they
+    /// do (`runtime::links`'s contact kernels and loads along the arm
+    /// place them so); None: the flat kernels sample them.
+    fn points_on_links(&self, _g: &SegmentShape, _spatial: bool) -> Option<PointsOn> {
+        None
     }
 
     /// A method of statics alone (no equations of motion: nothing to

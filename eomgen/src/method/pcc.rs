@@ -7,7 +7,7 @@
 use super::{ModellingMethod, needs_bending_stiffness, strain_coordinate_names};
 use crate::cas::{Cas, ExprId, Func};
 use crate::model::{Check, ModelError, Segment, SegmentShape};
-use crate::tmt::cell_kind::CellKind;
+use crate::tmt::cell_kind::{CellKind, PointsOn};
 use crate::tmt::planar::{self, Element2, Frame, PlanarArm};
 use crate::tmt::spatial::{SpatialArm, arc, bind3, in_halves, mid_arc_rotation};
 
@@ -84,8 +84,8 @@ impl ModellingMethod for Pcc {
         true
     }
 
-    fn points_on_arcs(&self) -> bool {
-        true
+    fn points_on_links(&self, _g: &SegmentShape, _spatial: bool) -> Option<PointsOn> {
+        Some(PointsOn::Arcs)
     }
 }
 

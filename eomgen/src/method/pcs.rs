@@ -11,6 +11,7 @@ use super::{Method, ModellingMethod};
 use super::pcc::Pcc;
 use crate::cas::Cas;
 use crate::model::{Check, ModelError, Segment, SegmentShape};
+use crate::tmt::cell_kind::PointsOn;
 use crate::tmt::spatial::SpatialArm;
 
 pub(super) struct Pcs;
@@ -44,7 +45,7 @@ impl ModellingMethod for Pcs {
         Pcc.link_cells()
     }
 
-    fn points_on_arcs(&self) -> bool {
-        Pcc.points_on_arcs()
+    fn points_on_links(&self, g: &SegmentShape, spatial: bool) -> Option<PointsOn> {
+        Pcc.points_on_links(g, spatial)
     }
 }

@@ -8,7 +8,7 @@ use super::{Carried, ModellingMethod, half_links_inertia};
 use crate::cas::{Cas, ExprId};
 use crate::model::{Axis, Check, ElementParam, Joints, ModelError, Segment, SegmentShape};
 use crate::tmt::actuation::Strain;
-use crate::tmt::cell_kind::CellKind;
+use crate::tmt::cell_kind::{CellKind, PointsOn};
 use crate::tmt::planar::{self, Element2, PlanarArm};
 use crate::tmt::spatial::{Frame, SpatialArm, advance, compose, exp_turn, half_k_sq, revolute};
 
@@ -42,6 +42,12 @@ impl ModellingMethod for Rigid {
             axes,
             whole: g.joints == Joints::Base,
         }
+    }
+
+    /// Each link turns at its joint and is straight past it; a planar
+    /// element of a midpoint joint is one link of two straight halves.
+    fn points_on_links(&self, g: &SegmentShape, spatial: bool) -> Option<PointsOn> {
+        (spatial || g.joints == Joints::Base).then_some(PointsOn::Straight)
     }
 
     fn coordinates_per_element(&self, g: &SegmentShape) -> usize {

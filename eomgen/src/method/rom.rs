@@ -8,7 +8,7 @@ use super::{ModellingMethod, needs_bending_stiffness};
 use crate::cas::{Cas, ExprId};
 use crate::model::{Check, ElementParam, ModelError, Segment, SegmentShape};
 use crate::tmt::actuation::{Strain, thinning};
-use crate::tmt::cell_kind::CellKind;
+use crate::tmt::cell_kind::{CellKind, PointsOn};
 use crate::tmt::spatial::{ArcStrain, SpatialArm, V3, arc, bind3, half_k_sq, mid_arc_rotation};
 use crate::tmt::system::{Coordinates, ParamSymbols};
 
@@ -147,8 +147,8 @@ impl ModellingMethod for Rom {
         true
     }
 
-    fn points_on_arcs(&self) -> bool {
-        true
+    fn points_on_links(&self, _g: &SegmentShape, _spatial: bool) -> Option<PointsOn> {
+        Some(PointsOn::Arcs)
     }
 }
 

@@ -8,6 +8,7 @@ use super::pcc::Pcc;
 use crate::cas::Cas;
 use crate::model::{Check, ModelError, Segment, SegmentShape};
 use crate::tmt::planar::{Element2, PlanarArm};
+use crate::tmt::cell_kind::PointsOn;
 use crate::tmt::spatial::SpatialArm;
 
 pub(super) struct Vc;
@@ -37,7 +38,7 @@ impl ModellingMethod for Vc {
         Pcc.link_cells()
     }
 
-    fn points_on_arcs(&self) -> bool {
-        Pcc.points_on_arcs()
+    fn points_on_links(&self, g: &SegmentShape, spatial: bool) -> Option<PointsOn> {
+        Pcc.points_on_links(g, spatial)
     }
 }

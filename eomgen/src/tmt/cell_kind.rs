@@ -28,6 +28,17 @@ pub(crate) enum CellKind {
     Kink,
 }
 
+/// How an element's sampled points lie on its links.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(crate) enum PointsOn {
+    /// Constant-strain arcs: the point at s is its link's arc cut at s.
+    Arcs,
+    /// Links that turn at their start and are straight past it (rigid
+    /// links past their joints): the point at s is s times its link's end
+    /// point, its section turned as the end.
+    Straight,
+}
+
 impl CellKind {
     /// An element of this kind is a link of no coordinates (its half
     /// before a midpoint joint) and then one of this kind.

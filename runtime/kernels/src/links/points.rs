@@ -19,6 +19,12 @@
 //!   cell coordinates f, with their weights), its angular column
 //!   W_a + R sum_f w_fa at dw/dx'_f;
 //! * v = (dp/dq) qd.
+//!
+//! A link that turns at its start and is straight past it (a rigid link
+//! past its joint: `ContactPoint::straight`) is not cut: the point is
+//! `at` times its whole cell's end point, its columns `at` times the end
+//! point's, and its section turns as the end, by the whole angular
+//! columns.
 
 use serde::{Deserialize, Serialize};
 
@@ -26,11 +32,14 @@ use super::num::{Num, add, cell_v3, cross, mat_mat, mat_vec, scale, sub};
 use super::{CELL_PARAMS, Cells, LinkLayout, MAX_LINK_DOF, cell, cell_params, local};
 
 /// A point of a chain (a contact point, where a load acts): on link
-/// `link`, at the fraction `at` of the link's arc (in [0, 1]).
+/// `link`, at the fraction `at` of the link's arc (in [0, 1]), or where
+/// `straight`, of its straight line past its turn at the start.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ContactPoint {
     pub link: usize,
     pub at: f64,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub straight: bool,
 }
 
 /// The state a sweep runs at: q, qd, the direction dq its duals move along
@@ -236,14 +245,19 @@ pub(super) fn sweep<N: Num, C: Cells + ?Sized>(
             if !want(i) {
                 continue;
             }
-            let at = points[i].at;
-            let cut = |v: &[f64; MAX_LINK_DOF]| -> [f64; MAX_LINK_DOF] { v.map(|v| at * v) };
+            let ContactPoint { at, straight, .. } = points[i];
+            // An arc cut at `at`; a straight link whole (and its end
+            // point scaled below).
+            let cut_by = if straight { 1.0 } else { at };
+            let cut = |v: &[f64; MAX_LINK_DOF]| -> [f64; MAX_LINK_DOF] { v.map(|v| cut_by * v) };
             let mut cut_params = params[k];
-            cut_params[0] *= at;
+            cut_params[0] *= cut_by;
             let (xa, xda, dxa) = (cut(&x), cut(&xd), dx.as_ref().map(cut));
             let moving = (&xa[..nc], &xda[..nc], dxa.as_ref().map(|d| &d[..nc]));
             cell_at(cells, spec.cell, moving, len, &cut_params, &mut out);
-            let point = add(pos, mat_vec(&r, cell_v3(&out, len, cell::END)));
+            let end_by = N::constant(if straight { at } else { 1.0 });
+            let local_point = scale(end_by, cell_v3(&out, len, cell::END));
+            let point = add(pos, mat_vec(&r, local_point));
             let mut v = match spinning {
                 Some((w, origin)) => add(moving_base, cross(w, sub(point, origin))),
                 None => moving_base,
@@ -265,6 +279,7 @@ pub(super) fn sweep<N: Num, C: Cells + ?Sized>(
                         let s = N::constant(at * w);
                         own[a] = add(own[a], scale(s, turned));
                         if let Some(tw) = turned_w {
+                            let s = N::constant(cut_by * w);
                             own_spin[a] = add(own_spin[a], scale(s, tw));
                         }
                     }
