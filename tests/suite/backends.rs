@@ -1118,6 +1118,13 @@ fn link_shapes(dir: &std::path::Path) -> Vec<(String, Vec<&'static str>)> {
         // with the bend), a turned base, actuators, tip bodies and loads.
         ("double_pendulum", &[]),
         ("chain", &["base.direction=[0.6,-0.8,0.0]"]),
+        // Rigid elements of midpoint joints: two links each, the half
+        // before the joint without a coordinate.
+        ("chain", &["segment.0.joints=\"midpoint\""]),
+        (
+            "double_pendulum",
+            &["segment.1.joints=\"midpoint\"", "segment.1.elements=3"],
+        ),
         ("chain32", &[]),
         // Every bundled 3D model as it is.
         ("cantilever3d", &[]),
@@ -1727,6 +1734,7 @@ fn linked_cases(dir: &std::path::Path) -> Vec<(String, &'static str)> {
         // space (the halves about midpoint joints) and in the plane.
         (rigid_ball.as_str(), "segment.0.method=rigid"),
         (chain_floor.as_str(), "segment.0.elements=9"),
+        (chain_floor.as_str(), "segment.0.joints=\"midpoint\""),
         // Assemblies: each arm kind on its linked cells, its contact
         // points too; the rest (the ball, its contact point, the joints)
         // by the assembly's tapes.
@@ -2040,6 +2048,15 @@ fn a_run_says_which_route_it_took_and_why() {
     let (b, r) = route(&rigid.to_string_lossy(), "", auto);
     assert_eq!(b, "compiled");
     assert!(r.contains("link cells") && !r.contains("contact"), "{r}");
+    // Its halves about midpoint joints: link cells no compiled-in model
+    // has.
+    let midpoint = "segment.0.joints=\"midpoint\"";
+    let (b, r) = route(&rigid.to_string_lossy(), midpoint, auto);
+    assert_eq!(b, "compiled");
+    assert!(
+        r.contains("2 of its 2 link shapes") && !r.contains("contact"),
+        "{r}"
+    );
     let (b, r) = route("falling_ball", "arm.left.segment.0.elements=3", auto);
     assert_eq!(b, "compiled");
     assert!(

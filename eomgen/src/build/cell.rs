@@ -37,7 +37,7 @@ use crate::model::{
     Structure, Xyz,
 };
 
-use super::planar_cell::{derive_planar_cell, derive_planar_kink_cell};
+use super::planar_cell::{PlanarPart, derive_planar_cell, derive_planar_kink_cell};
 use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rigid::{JointSprings, RestTurn, joint_turn};
 use crate::method::rom::RomFields;
@@ -126,7 +126,9 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             let kernels = match (spatial, shape.kind) {
                 (true, _) => derive_cell(shape),
                 (false, CellKind::Kink) => derive_planar_kink_cell(),
-                (false, _) => derive_planar_cell(g)?,
+                (false, CellKind::BeforeJoint) => derive_planar_cell(g, PlanarPart::BeforeJoint)?,
+                (false, kind) if kind.after_half() => derive_planar_cell(g, PlanarPart::PastJoint)?,
+                (false, _) => derive_planar_cell(g, PlanarPart::Whole)?,
             };
             cells.push((shape, kernels));
             Some(cells.len() - 1)

@@ -5,9 +5,10 @@
 //!
 //! A planar element's body may change its inertia with the bend (a pcc
 //! arc's spread): the cell gives dI/dtheta and the layout says
-//! `variable_inertia`. Elements of more than one body (rigid links with
-//! midpoint joints) are not covered: their chains keep the flat kernels.
-//! A kink is a link of no coordinates and no body.
+//! `variable_inertia`. A rigid element of a midpoint joint is two links,
+//! each one body: its half before the joint (no coordinate) and the joint
+//! with the half past it (`rigid::planar_half`). A kink is a link of no
+//! coordinates and no body.
 
 use runtime::Tape;
 use runtime::links::{ACTUATION_LOADS, ELEMENT_PARAMS};
@@ -15,6 +16,7 @@ use runtime::links::{ACTUATION_LOADS, ELEMENT_PARAMS};
 use crate::cas::{Cas, ExprId};
 use crate::model::SegmentShape;
 
+use crate::method::rigid::planar_half;
 use crate::tmt::actuation::strain_work;
 use crate::tmt::cell_outputs::{
     LinkKinematics, Motion, Rates, bodiless_cells, cell_param_symbols, with_tangent,
@@ -23,14 +25,32 @@ use crate::tmt::inertia::Inertia;
 use crate::tmt::planar::{Element2, PlanarArm, half_k_sq};
 use crate::tmt::system::{Coordinates, ParamSymbols};
 
-/// The cell, its tangent and its pose cell of one element of segment
-/// shape `g` (with its segment's actuation loads, zero where no actuator
-/// acts), or None when the element is not one body.
-pub(super) fn derive_planar_cell(g: &SegmentShape) -> Option<[Tape; 3]> {
+/// What of a planar element a link is.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum PlanarPart {
+    /// The element, placed by its method.
+    Whole,
+    /// A rigid element's half before its midpoint joint.
+    BeforeJoint,
+    /// That element's joint and the half past it.
+    PastJoint,
+}
+
+/// The cell, its tangent and its pose cell of `part` of one element of
+/// segment shape `g` (with its segment's actuation loads, zero where no
+/// actuator acts), or None when it is not one body.
+pub(super) fn derive_planar_cell(g: &SegmentShape, part: PlanarPart) -> Option<[Tape; 3]> {
     let mut cas = Cas::new();
     let cas = &mut cas;
-    let coords = Coordinates::new(cas, vec!["theta".into()]);
-    let (q, qd) = (coords.q[0], coords.qd[0]);
+    let names = match part {
+        PlanarPart::BeforeJoint => Vec::new(),
+        _ => vec!["theta".into()],
+    };
+    let coords = Coordinates::new(cas, names);
+    let zero = cas.zero();
+    let (q, qd) = (coords.q.first(), coords.qd.first());
+    let (q, qd) = (q.copied().unwrap_or(zero), qd.copied().unwrap_or(zero));
+    let (qs, qds) = (coords.q.clone(), coords.qd.clone());
     let p = cell_param_symbols(cas);
     // In the order of `ElementParam::CELL`: a planar element reads the
     // first three and the bend spring; then the actuation loads.
@@ -48,7 +68,10 @@ pub(super) fn derive_planar_cell(g: &SegmentShape) -> Option<[Tape; 3]> {
     // The element reads its own parameters only: an empty layout.
     let symbols = ParamSymbols::new(cas, &Default::default());
     let mut arm = PlanarArm::at_origin(cas, coords, &symbols);
-    crate::method::of(g.method).place_planar(cas, &mut arm, g, &el);
+    match part {
+        PlanarPart::Whole => crate::method::of(g.method).place_planar(cas, &mut arm, g, &el),
+        _ => planar_half(cas, &mut arm, &el, part == PlanarPart::PastJoint),
+    }
     let [body] = arm.bodies() else {
         return None;
     };
@@ -57,16 +80,20 @@ pub(super) fn derive_planar_cell(g: &SegmentShape) -> Option<[Tape; 3]> {
     };
     let (mass, centroid, body_w) = (body.mass, body.position, body.omega[2]);
     let f = arm.f;
-    let zero = cas.zero();
     let one = cas.one();
 
     // The element's spring and damper (as `PlanarArm::end_element`) and the
-    // actuators' work on its bend.
-    let bend = cas.sub(q, el.rest);
-    let stored = half_k_sq(cas, el.stiff, bend);
-    let rayleigh = half_k_sq(cas, el.damp, qd);
-    let work = strain_work(cas, loads, zero, [zero, zero, q], None);
-    let elastic = cas.sub(stored, work);
+    // actuators' work on its bend; none on a half before a joint.
+    let (stored, rayleigh, elastic) = match part {
+        PlanarPart::BeforeJoint => (zero, zero, zero),
+        _ => {
+            let bend = cas.sub(q, el.rest);
+            let stored = half_k_sq(cas, el.stiff, bend);
+            let rayleigh = half_k_sq(cas, el.damp, qd);
+            let work = strain_work(cas, loads, zero, [zero, zero, q], None);
+            (stored, rayleigh, cas.sub(stored, work))
+        }
+    };
 
     let (c, s) = (cas.cos(f.phi), cas.sin(f.phi));
     let ns = cas.neg(s);
@@ -85,15 +112,15 @@ pub(super) fn derive_planar_cell(g: &SegmentShape) -> Option<[Tape; 3]> {
             axis: [one, zero, zero],
         },
         [mass, inertia, inertia, stored],
-        &[q],
-        &[qd],
+        &qs,
+        &qds,
         Rates::Plain,
     );
-    let out = kin.cell(cas, &[q], &[qd], elastic, rayleigh);
+    let out = kin.cell(cas, &qs, &qds, elastic, rayleigh);
     let pose_out = kin.pose(cas);
     Some([
         cas.to_tape(&out),
-        with_tangent(cas, &out, &[q], &[qd]),
+        with_tangent(cas, &out, &qs, &qds),
         cas.to_tape(&pose_out),
     ])
 }

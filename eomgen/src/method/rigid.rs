@@ -23,17 +23,15 @@ impl ModellingMethod for Rigid {
         s.axes()
     }
 
-    /// In 3D each element's joint and the link past it are one link cell
-    /// (after a cell of its first half, at a midpoint joint); a planar
-    /// element is one body (`planar_cell`).
+    /// Each element's joint and the link past it are one link cell, after
+    /// a cell of its first half at a midpoint joint.
     fn link_cells(&self) -> bool {
         true
     }
 
-    fn cell_kind(&self, g: &SegmentShape, spatial: bool) -> CellKind {
-        if !spatial {
-            return CellKind::Arc;
-        }
+    /// A joint and the link past it, in space and in the plane (there
+    /// about z alone).
+    fn cell_kind(&self, g: &SegmentShape, _spatial: bool) -> CellKind {
         let mut axes = [None; 3];
         for (slot, &a) in axes.iter_mut().zip(&g.axes) {
             *slot = Some(a);
@@ -44,10 +42,9 @@ impl ModellingMethod for Rigid {
         }
     }
 
-    /// Each link turns at its joint and is straight past it; a planar
-    /// element of a midpoint joint is one link of two straight halves.
-    fn points_on_links(&self, g: &SegmentShape, spatial: bool) -> Option<PointsOn> {
-        (spatial || g.joints == Joints::Base).then_some(PointsOn::Straight)
+    /// Each link turns at its joint and is straight past it.
+    fn points_on_links(&self, _g: &SegmentShape, _spatial: bool) -> Option<PointsOn> {
+        Some(PointsOn::Straight)
     }
 
     fn coordinates_per_element(&self, g: &SegmentShape) -> usize {
@@ -139,8 +136,7 @@ impl ModellingMethod for Rigid {
                 arm.f = planar::advance(cas, arm.f, l);
             }
             Joints::Midpoint => {
-                let (quarter, half) = (cas.scaled(0.25, l), cas.scaled(0.5, l));
-                let half_m = cas.scaled(0.5, m);
+                let half = cas.scaled(0.5, l);
                 let f = arm.f;
                 arm.sample(cas, None, |cas, s| {
                     if s <= 0.5 {
@@ -152,13 +148,8 @@ impl ModellingMethod for Rigid {
                     let d = cas.scaled(s - 0.5, l);
                     planar::advance(cas, turned, d)
                 });
-                let c = planar::along(cas, &arm.f, quarter);
-                arm.body(cas, c, arm.f.w, half_m, el.inertia);
-                arm.f = planar::advance(cas, arm.f, half);
-                arm.f = planar::rotate(cas, arm.f, el.q, el.qd);
-                let c = planar::along(cas, &arm.f, quarter);
-                arm.body(cas, c, arm.f.w, half_m, el.inertia);
-                arm.f = planar::advance(cas, arm.f, half);
+                planar_half(cas, arm, el, false);
+                planar_half(cas, arm, el, true);
             }
         }
     }
@@ -207,6 +198,22 @@ impl ModellingMethod for Rigid {
             arm.close_link(first);
         }
     }
+}
+
+/// Half a planar element about its midpoint joint: the joint's turn
+/// first where `past`, then the half link, its body (half the element's
+/// mass, its centroid a quarter of the element along) and its end. The
+/// arm's elements and the link cells of the halves (`build::planar_cell`)
+/// are these two.
+pub(crate) fn planar_half(cas: &mut Cas, arm: &mut PlanarArm, el: &Element2, past: bool) {
+    if past {
+        arm.f = planar::rotate(cas, arm.f, el.q, el.qd);
+    }
+    let (quarter, half) = (cas.scaled(0.25, el.l), cas.scaled(0.5, el.l));
+    let half_m = cas.scaled(0.5, el.m);
+    let c = planar::along(cas, &arm.f, quarter);
+    arm.body(cas, c, arm.f.w, half_m, el.inertia);
+    arm.f = planar::advance(cas, arm.f, half);
 }
 
 /// The rotation vector of turns about coordinate axes in sequence, to
