@@ -34,7 +34,7 @@ use runtime::links::{
 use crate::cas::{Cas, ExprId, SymKind};
 use crate::model::{
     Axis, ElementParam, FluidParam, Joints, KinkParam, LoadParam, Method, Param, ParamLayout, Rate,
-    Structure, Xyz,
+    SegmentShape, Structure, Xyz,
 };
 
 use super::planar_cell::{PlanarPart, derive_planar_cell, derive_planar_kink_cell};
@@ -123,14 +123,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
             if let Some(c) = cells.iter().position(|(s, _)| *s == shape) {
                 return Some(c);
             }
-            let kernels = match (spatial, shape.kind) {
-                (true, _) => derive_cell(shape),
-                (false, CellKind::Kink) => derive_planar_kink_cell(),
-                (false, CellKind::BeforeJoint) => derive_planar_cell(g, PlanarPart::BeforeJoint)?,
-                (false, kind) if kind.after_half() => derive_planar_cell(g, PlanarPart::PastJoint)?,
-                (false, _) => derive_planar_cell(g, PlanarPart::Whole)?,
-            };
-            cells.push((shape, kernels));
+            cells.push((shape, shape_cell(shape, g, spatial)?));
             Some(cells.len() - 1)
         };
         if g.kink {
@@ -243,6 +236,18 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         kernels.poses.push(pose);
     }
     Some(kernels)
+}
+
+/// The cell of a link of `shape` in segment `g` (its three tapes), None
+/// where no cell expresses it.
+fn shape_cell(shape: Shape, g: &SegmentShape, spatial: bool) -> Option<[Tape; 3]> {
+    Some(match (spatial, shape.kind) {
+        (true, _) => derive_cell(shape),
+        (false, CellKind::Kink) => derive_planar_kink_cell(),
+        (false, CellKind::BeforeJoint) => derive_planar_cell(g, PlanarPart::BeforeJoint)?,
+        (false, kind) if kind.after_half() => derive_planar_cell(g, PlanarPart::PastJoint)?,
+        (false, _) => derive_planar_cell(g, PlanarPart::Whole)?,
+    })
 }
 
 /// The slot of the volume element k displaces, where the arm is immersed:
