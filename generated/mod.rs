@@ -57,6 +57,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(ball_drop::Compiled::default()),
         cells: ball_drop::CELLS,
+        parts: ball_drop::PART_KERNELS,
     },
     CompiledModel {
         name: "cantilever",
@@ -66,6 +67,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(cantilever::Compiled::default()),
         cells: cantilever::CELLS,
+        parts: cantilever::PART_KERNELS,
     },
     CompiledModel {
         name: "cantilever3d",
@@ -75,6 +77,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(cantilever3d::Compiled::default()),
         cells: cantilever3d::CELLS,
+        parts: cantilever3d::PART_KERNELS,
     },
     CompiledModel {
         name: "chain",
@@ -84,6 +87,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(chain::Compiled::default()),
         cells: chain::CELLS,
+        parts: chain::PART_KERNELS,
     },
     CompiledModel {
         name: "chain32",
@@ -93,6 +97,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(chain32::Compiled::default()),
         cells: chain32::CELLS,
+        parts: chain32::PART_KERNELS,
     },
     CompiledModel {
         name: "double_pendulum",
@@ -102,6 +107,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(double_pendulum::Compiled::default()),
         cells: double_pendulum::CELLS,
+        parts: double_pendulum::PART_KERNELS,
     },
     CompiledModel {
         name: "eba_arm",
@@ -111,6 +117,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(eba_arm::Compiled::default()),
         cells: eba_arm::CELLS,
+        parts: eba_arm::PART_KERNELS,
     },
     CompiledModel {
         name: "ebr_arm",
@@ -120,6 +127,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(ebr_arm::Compiled::default()),
         cells: ebr_arm::CELLS,
+        parts: ebr_arm::PART_KERNELS,
     },
     CompiledModel {
         name: "falling_ball",
@@ -129,6 +137,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(falling_ball::Compiled::default()),
         cells: falling_ball::CELLS,
+        parts: falling_ball::PART_KERNELS,
     },
     CompiledModel {
         name: "finger_free",
@@ -138,6 +147,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(finger_free::Compiled::default()),
         cells: finger_free::CELLS,
+        parts: finger_free::PART_KERNELS,
     },
     CompiledModel {
         name: "finger_tap",
@@ -147,6 +157,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(finger_tap::Compiled::default()),
         cells: finger_tap::CELLS,
+        parts: finger_tap::PART_KERNELS,
     },
     CompiledModel {
         name: "hybrid_arm",
@@ -156,6 +167,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(hybrid_arm::Compiled::default()),
         cells: hybrid_arm::CELLS,
+        parts: hybrid_arm::PART_KERNELS,
     },
     CompiledModel {
         name: "long_arm",
@@ -165,6 +177,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(long_arm::Compiled::default()),
         cells: long_arm::CELLS,
+        parts: long_arm::PART_KERNELS,
     },
     CompiledModel {
         name: "rod_swing",
@@ -174,6 +187,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(rod_swing::Compiled::default()),
         cells: rod_swing::CELLS,
+        parts: rod_swing::PART_KERNELS,
     },
     CompiledModel {
         name: "rod_swing_rom",
@@ -183,6 +197,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(rod_swing_rom::Compiled::default()),
         cells: rod_swing_rom::CELLS,
+        parts: rod_swing_rom::PART_KERNELS,
     },
     CompiledModel {
         name: "rom_arm",
@@ -192,6 +207,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(rom_arm::Compiled::default()),
         cells: rom_arm::CELLS,
+        parts: rom_arm::PART_KERNELS,
     },
     CompiledModel {
         name: "soft_finger",
@@ -201,6 +217,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(soft_finger::Compiled::default()),
         cells: soft_finger::CELLS,
+        parts: soft_finger::PART_KERNELS,
     },
     CompiledModel {
         name: "stiff_flop",
@@ -213,6 +230,7 @@ pub static MODELS: &[CompiledModel] = &[
         ],
         kernels: || Box::new(stiff_flop::Compiled::default()),
         cells: stiff_flop::CELLS,
+        parts: stiff_flop::PART_KERNELS,
     },
     CompiledModel {
         name: "stiff_flop_rom",
@@ -225,6 +243,7 @@ pub static MODELS: &[CompiledModel] = &[
         ],
         kernels: || Box::new(stiff_flop_rom::Compiled::default()),
         cells: stiff_flop_rom::CELLS,
+        parts: stiff_flop_rom::PART_KERNELS,
     },
     CompiledModel {
         name: "tentacle3d",
@@ -234,6 +253,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(tentacle3d::Compiled::default()),
         cells: tentacle3d::CELLS,
+        parts: tentacle3d::PART_KERNELS,
     },
     CompiledModel {
         name: "vc_arm",
@@ -243,6 +263,7 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(vc_arm::Compiled::default()),
         cells: vc_arm::CELLS,
+        parts: vc_arm::PART_KERNELS,
     },
     CompiledModel {
         name: "wrap",
@@ -252,5 +273,6 @@ pub static MODELS: &[CompiledModel] = &[
         files: &[],
         kernels: || Box::new(wrap::Compiled::default()),
         cells: wrap::CELLS,
+        parts: wrap::PART_KERNELS,
     },
 ];

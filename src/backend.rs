@@ -13,7 +13,9 @@ use eomgen::load::parse_model;
 use eomgen::model::{Model, Override, ParamLayout, Structure};
 use runtime::assembled::BlockKernels;
 use runtime::linked::LinkedKernels;
+use runtime::linked_parts::LinkedPartKernels;
 use runtime::links::{CompiledCell, LinkKernels};
+use runtime::parts::{CompiledPart, PartKernels};
 use runtime::{Arm, CompiledModel, Dynamics, Interpreted, Kernels, TapeSet};
 use serde::Serialize;
 
@@ -172,6 +174,17 @@ fn linked(
             Box::new(BlockKernels::new(tapes, kinds).ok_or_else(not_cells)?),
             note,
         )
+    } else if let Some((info, parts)) = eomgen::derive::derive_parts(structure) {
+        let compiled = compiled_parts(&parts);
+        let k = compiled.iter().filter(|c| c.is_none()).count();
+        let note = format!(
+            ", its elements parts of {} kinds, {k} on their tapes (the tip's part reads the whole model)",
+            compiled.len()
+        );
+        (
+            Box::new(LinkedPartKernels::new(info, parts, compiled)),
+            note,
+        )
     } else if let Some((info, links)) = eomgen::derive::derive_links(structure) {
         // Contact too, where its points lie on the links' arcs.
         let cells = compiled_cells(&links);
@@ -199,7 +212,19 @@ fn linked(
 fn compiled_cells(links: &LinkKernels) -> Vec<Option<CompiledCell>> {
     let found = |key: String| MODELS.iter().flat_map(|m| m.cells).find(|c| c.key == key);
     (links.cells.iter().zip(&links.tangents).zip(&links.poses))
-        .map(|((cell, tangent), pose)| found(eomgen::build::cell_key(cell, tangent, pose)).copied())
+        .map(|((cell, tangent), pose)| {
+            found(eomgen::build::kernel_key(&[cell, tangent, pose])).copied()
+        })
+        .collect()
+}
+
+/// The compiled part kernels of a system's kinds of parts, found by key
+/// among the compiled-in models'; None for a kind no compiled-in model
+/// has, whose tapes then run.
+fn compiled_parts(parts: &PartKernels) -> Vec<Option<CompiledPart>> {
+    let found = |key: String| MODELS.iter().flat_map(|m| m.parts).find(|c| c.key == key);
+    (parts.kernels.iter().zip(&parts.tangents))
+        .map(|(kernel, tangent)| found(eomgen::build::kernel_key(&[kernel, tangent])).copied())
         .collect()
 }
 

@@ -54,6 +54,32 @@ pub fn derive_links(structure: &Structure) -> Option<(ModelInfo, runtime::links:
     Some((info, links))
 }
 
+/// The part kernels of a system of parts (a bare eba arm, no contact)
+/// and its metadata, without the rest of its tapes: for a layout that
+/// links the compiled-in part kernels (`runtime::linked_parts`).
+pub fn derive_parts(structure: &Structure) -> Option<(ModelInfo, runtime::parts::PartKernels)> {
+    if structure.assembly.is_some() || structure.contact_points > 0 {
+        return None;
+    }
+    let layout = ParamLayout::of(structure);
+    let parts = crate::method::eba::part_kernels(structure, &layout)?;
+    let info = ModelInfo {
+        hash: structure.hash(),
+        coordinates: crate::method::coordinate_names(structure),
+        parameters: layout.names(),
+        derived: 0,
+        accel: false,
+        loads: layout.loads(),
+        constraints: Vec::new(),
+        blocks: Vec::new(),
+        contact_points: 0,
+        contact_groups: Vec::new(),
+        contact_frames: 0,
+        copies: Vec::new(),
+    };
+    Some((info, parts))
+}
+
 /// The contact groups of a chain's points: an element's points each, up to
 /// `most` groups (the kernel's `dir` selects them), neighbours merged past
 /// that.

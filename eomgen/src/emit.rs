@@ -914,7 +914,7 @@ fn emit_linked_cell(
     (tape, tangent, pose): (&Tape, &Tape, &Tape),
     (f, f4, ft, fp): (&Ident, Option<&Ident>, &Ident, &Ident),
 ) -> (TokenStream, TokenStream) {
-    let key = crate::build::cell_key(tape, tangent, pose);
+    let key = crate::build::kernel_key(&[tape, tangent, pose]);
     let (l4, four) = (
         format_ident!("cell_{c}_x4_linked"),
         format_ident!("CELL_{c}_FOUR"),
@@ -1314,8 +1314,10 @@ fn emit_parts(
     n_out: usize,
 ) -> TokenStream {
     let mut defs = Vec::new();
-    let (mut evals, mut tangents) = (Vec::new(), Vec::new());
+    let (mut evals, mut tangents, mut registry) = (Vec::new(), Vec::new(), Vec::new());
     for (k, (tape, tangent)) in parts.kernels.iter().zip(&parts.tangents).enumerate() {
+        let key = crate::build::kernel_key(&[tape, tangent]);
+        registry.push(quote!(runtime::compiled_part!(#key, PartKernels, #k),));
         let spec = parts
             .layout
             .parts
@@ -1367,6 +1369,8 @@ fn emit_parts(
         });
         /// The compiled part kernels.
         struct PartKernels;
+        /// This model's part kernels, for systems of other lengths to link.
+        pub static PART_KERNELS: &[runtime::parts::CompiledPart] = &[#(#registry)*];
         impl runtime::parts::Parts for PartKernels {
             fn eval(&mut self, k: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
                 match k {
@@ -2217,9 +2221,15 @@ fn model_tokens(tapes: &TapeSet) -> TokenStream {
     let (coords, params) = (names(&info.coordinates), names(&info.parameters));
     let frames_fn = emit_framed_groups(dof, n_params, n_aux, contact_points);
     let (mut kernels, arms) = emit_kernels(tapes, dof, n_params, n_aux);
-    if let Some(parts) = &tapes.parts {
-        let n_out = tapes.mass_bias.outputs.len();
-        kernels.push(emit_parts(parts, dof, n_params, n_out));
+    match &tapes.parts {
+        Some(parts) => {
+            let n_out = tapes.mass_bias.outputs.len();
+            kernels.push(emit_parts(parts, dof, n_params, n_out));
+        }
+        None => kernels.push(quote! {
+            /// This model's part kernels: none.
+            pub static PART_KERNELS: &[runtime::parts::CompiledPart] = &[];
+        }),
     }
     if let Some(blocks) = &tapes.arm_blocks {
         kernels.push(emit_arm_blocks(tapes, blocks, dof, n_params));

@@ -243,7 +243,7 @@ fn registry_source(stems: &[Entry], absolute: Option<&Path>) -> String {
             format!("{files}\n        ")
         };
         s.push_str(&format!(
-            "    CompiledModel {{\n        name: \"{stem}\",\n        hash: {stem}::HASH,\n        dof: {stem}::DOF,\n        source: include_str!({source}),\n        files: &[{files}],\n        kernels: || Box::new({stem}::Compiled::default()),\n        cells: {stem}::CELLS,\n    }},\n"
+            "    CompiledModel {{\n        name: \"{stem}\",\n        hash: {stem}::HASH,\n        dof: {stem}::DOF,\n        source: include_str!({source}),\n        files: &[{files}],\n        kernels: || Box::new({stem}::Compiled::default()),\n        cells: {stem}::CELLS,\n        parts: {stem}::PART_KERNELS,\n    }},\n"
         ));
     }
     s.push_str("];\n");

@@ -12,8 +12,8 @@
 //!   them.
 
 pub use runtime_kernels::{
-    assembled, cpu, kernels, lanes, linalg, linked, links, obstacle, output, parts, rodrigues,
-    rotation, rows, solver, special, tape,
+    assembled, cpu, kernels, lanes, linalg, linked, linked_parts, links, obstacle, output, parts,
+    rodrigues, rotation, rows, solver, special, tape,
 };
 
 mod sim;

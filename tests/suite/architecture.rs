@@ -60,6 +60,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "parts",
             "kernels",
             "linked",
+            "linked_parts",
             "assembled",
         ],
     ),

@@ -1743,6 +1743,9 @@ fn linked_cases(dir: &std::path::Path) -> Vec<(String, &'static str)> {
         (held.as_str(), "segment.1.elements=3"),
         (pinch.as_str(), "arm.right.segment.0.elements=3"),
         ("ball_drop", "arm.right.segment.1.elements=3"),
+        // A system of parts: eba's elements, each a part of its kind's
+        // kernels (`parts.rs`), the tip's on its tapes.
+        ("eba_arm", "segment.0.elements=4"),
     ];
     (cases.into_iter())
         .map(|(m, set)| (m.to_string(), set))
@@ -2063,6 +2066,14 @@ fn a_run_says_which_route_it_took_and_why() {
         r.contains("each arm's layout")
             && r.contains("assembly interpreted")
             && r.contains("joints' rows on the arms' frames"),
+        "{r}"
+    );
+    // A system of parts (eba): each kind of part compiled, the tip's
+    // part on its tapes.
+    let (b, r) = route("eba_arm", "segment.0.elements=4", auto);
+    assert_eq!(b, "compiled");
+    assert!(
+        r.contains("link cells") && r.contains("parts of 4 kinds, 1 on their tapes"),
         "{r}"
     );
     let (b, r) = route(&stretching, "", auto);

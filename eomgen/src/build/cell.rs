@@ -511,26 +511,6 @@ fn coordinate_maps(
     }
 }
 
-/// The key a cell is compiled and linked by (`runtime::links::CompiledCell`):
-/// a digest of its three tapes, so that equal keys compute the same.
-pub fn cell_key(cell: &Tape, tangent: &Tape, pose: &Tape) -> String {
-    use sha2::{Digest, Sha256};
-    let mut h = Sha256::new();
-    for t in [cell, tangent, pose] {
-        h.update(
-            serde_json::to_string(t)
-                .expect("a tape serialises")
-                .as_bytes(),
-        );
-        h.update(b"\n");
-    }
-    h.finalize()
-        .iter()
-        .take(12)
-        .map(|b| format!("{b:02x}"))
-        .collect()
-}
-
 /// Where a chain's gravity, base, tip body and tip loads are in the
 /// parameter vector (its links, coordinates and kernels left empty).
 fn globals(st: &Structure, params: &ParamLayout) -> LinkLayout {

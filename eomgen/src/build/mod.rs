@@ -4,6 +4,7 @@
 
 mod assembly;
 mod cell;
+mod kernel_key;
 mod planar_cell;
 
 use crate::cas::Cas;
@@ -17,7 +18,8 @@ use crate::tmt::system::MountFrame;
 use crate::tmt::{ParamSymbols, System};
 
 pub use assembly::{ArmBlock, Assembled, FrameRows, assembly_system};
-pub use cell::{cell_key, link_chain};
+pub use cell::link_chain;
+pub use kernel_key::kernel_key;
 
 /// The system of a structure: planar or spatial kinematics by
 /// `dimensions`, absolute coordinates for eba; its parameters are the

@@ -556,4 +556,7 @@ pub struct CompiledModel {
     /// Its link cells, which chains of the same link shapes and other
     /// lengths link (`linked::LinkedKernels`).
     pub cells: &'static [crate::links::CompiledCell],
+    /// Its part kernels, which systems of the same kinds of parts and
+    /// other lengths link (`linked_parts::LinkedPartKernels`).
+    pub parts: &'static [crate::parts::CompiledPart],
 }

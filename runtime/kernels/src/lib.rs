@@ -17,6 +17,7 @@ pub mod kernels;
 pub mod lanes;
 pub mod linalg;
 pub mod linked;
+pub mod linked_parts;
 pub mod links;
 pub mod obstacle;
 pub mod output;

@@ -8,6 +8,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::links::{CellFn, CellTangentFn};
 use crate::output;
 
 /// One part: its kernel, the arm's coordinates it reads (its local
@@ -67,6 +68,71 @@ pub trait Parts {
     fn pose(&mut self, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]);
     /// The offsets kernel of the model's `p`.
     fn offsets(&mut self, p: &[f64], out: &mut [f64]);
+}
+
+/// A part kernel compiled into a model, found by key
+/// (`eomgen::build::kernel_key` of its tape and tangent) by systems of the
+/// same kinds of parts and other lengths (`LinkedParts`).
+#[derive(Clone, Copy)]
+pub struct CompiledPart {
+    pub key: &'static str,
+    /// At local coordinates, rates and parameters, into the part's outputs.
+    pub eval: CellFn,
+    /// Those and their derivatives along (dx, dxd): x, xd, dx, dxd, p, out.
+    pub tangent: CellTangentFn,
+}
+
+/// The part kernels a model compiled in ([`CompiledPart`]), by a call to
+/// its `Parts` implementation (`$parts`) for kernel `$k`.
+#[macro_export]
+macro_rules! compiled_part {
+    ($key:expr, $parts:expr, $k:literal) => {
+        $crate::parts::CompiledPart {
+            key: $key,
+            eval: |x, xd, p, out| $crate::parts::Parts::eval(&mut $parts, $k, x, xd, p, out),
+            tangent: |x, xd, dx, dxd, p, out| {
+                $crate::parts::Parts::tangent(&mut $parts, $k, x, xd, dx, dxd, p, out)
+            },
+        }
+    };
+}
+
+/// Part kernels compiled where a compiled-in model has them
+/// (`compiled[k]`), else their tapes; the pose and offsets (of the whole
+/// model's parameters) always the tapes.
+pub struct LinkedParts<'a> {
+    pub tapes: TapeParts<'a>,
+    pub compiled: &'a [Option<CompiledPart>],
+}
+
+impl Parts for LinkedParts<'_> {
+    fn eval(&mut self, k: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+        match self.compiled[k] {
+            Some(c) => (c.eval)(x, xd, p, out),
+            None => self.tapes.eval(k, x, xd, p, out),
+        }
+    }
+    fn tangent(
+        &mut self,
+        k: usize,
+        x: &[f64],
+        xd: &[f64],
+        dx: &[f64],
+        dxd: &[f64],
+        p: &[f64],
+        out: &mut [f64],
+    ) {
+        match self.compiled[k] {
+            Some(c) => (c.tangent)(x, xd, dx, dxd, p, out),
+            None => self.tapes.tangent(k, x, xd, dx, dxd, p, out),
+        }
+    }
+    fn pose(&mut self, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
+        self.tapes.pose(x, xd, p, out)
+    }
+    fn offsets(&mut self, p: &[f64], out: &mut [f64]) {
+        self.tapes.offsets(p, out)
+    }
 }
 
 /// What a part kernel writes for `m` coordinates: M's block, h's block,
