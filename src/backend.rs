@@ -178,7 +178,7 @@ fn linked(
         let compiled = compiled_parts(&parts);
         let k = compiled.iter().filter(|c| c.is_none()).count();
         let note = format!(
-            ", its elements parts of {} kinds, {k} on their tapes (the tip's part reads the whole model)",
+            ", its elements parts of {} kinds, {k} on their tapes",
             compiled.len()
         );
         (

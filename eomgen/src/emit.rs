@@ -1355,6 +1355,19 @@ fn emit_parts(
     let np = parts.layout.pose_coords.len();
     defs.push(KernelEmitter::new(pose).emit("part_pose", np, n_params, 0));
     defs.push(KernelEmitter::new(offsets).emit("part_offsets", 0, n_params, 0));
+    let loads = match &parts.loads {
+        Some(loads) => {
+            defs.push(KernelEmitter::new(loads).emit("part_loads", 0, n_params, 0));
+            quote! {
+                part_loads(0.0, &[], &[], &[], &[], p.try_into().expect("parameter vector length"),
+                           out.try_into().expect("loads outputs"))
+            }
+        }
+        None => quote! {
+            let _ = p;
+            debug_assert!(out.is_empty(), "no actuator acts")
+        },
+    };
     let np2 = 2 * np;
     let json = serde_json::to_string(&parts.layout).expect("a part layout serialises");
     let n_dir = 2 * dof;
@@ -1392,6 +1405,9 @@ fn emit_parts(
             fn offsets(&mut self, p: &[f64], out: &mut [f64]) {
                 part_offsets(0.0, &[], &[], &[], &[], p.try_into().expect("parameter vector length"),
                              out.try_into().expect("offsets outputs"))
+            }
+            fn loads(&mut self, p: &[f64], out: &mut [f64]) {
+                #loads
             }
         }
         /// Kernel `outputs`: the parts' energies, the pose and the offsets (`runtime::parts::outputs`).

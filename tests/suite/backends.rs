@@ -487,6 +487,16 @@ impl runtime::links::Cells for TapeCells<'_> {
     }
 }
 
+/// [`ACTUATED_3D`] of eba elements.
+fn actuated_eba() -> String {
+    let text = ACTUATED_3D
+        .replace("method = \"pcc\"", "method = \"eba\"")
+        .replace("method = \"rom\"\norder = 2", "method = \"eba\"")
+        .replace("extension = true\n", "");
+    assert_eq!(text.matches("\"eba\"").count(), 2);
+    text
+}
+
 /// A 3D arm whose pcc and rom segments both carry chambers, with a tendon
 /// through both.
 const ACTUATED_3D: &str = r#"
@@ -1416,7 +1426,17 @@ fn eba_parts_match_the_flat_tapes() {
         &["segment.0.method=eba", "segment.0.bending_damping=0.01"],
     ];
     let mut rng = Rng::new(29);
-    let mut models: Vec<(&str, &[&str])> = vec![("ebr_arm", &["segment.0.method=eba"])];
+    // Chambers and a tendon across two segments, the first's chamber
+    // levers tapering (a triple of loads per element), the second's not.
+    let dir = tempfile::tempdir().unwrap();
+    let actuated = dir.path().join("actuated_eba.toml");
+    std::fs::write(&actuated, actuated_eba()).unwrap();
+    let actuated = actuated.to_string_lossy().into_owned();
+    let mut models: Vec<(&str, &[&str])> = vec![
+        ("ebr_arm", &["segment.0.method=eba"]),
+        (&actuated, &["segment.0.chambers.distance=[0.008, 0.006]"]),
+        (&actuated, &["segment.0.incompressible=true"]),
+    ];
     models.extend(cases.iter().map(|&s| ("cantilever3d", s)));
     for (model, sets) in models {
         let overrides: Vec<eomgen::model::Override> = sets
@@ -1437,14 +1457,26 @@ fn eba_parts_match_the_flat_tapes() {
             .map(|(_, v)| v)
             .collect();
         let arm = Arm::new(Interpreted::new(tapes), p);
-        let p = arm.params().to_vec();
         let n = arm.dof();
+        // The parameters the kernels read at a time, chamber pressures and
+        // tendon tensions driven by their inputs (zero at rest).
+        let cache = tempfile::tempdir().unwrap();
+        let choice = BackendChoice::Interpreted;
+        let driven = load(model, &overrides, choice, Some(cache.path().to_path_buf())).unwrap();
+        let p = driven.arm.params_at(0.5);
+        assert_eq!(p.len(), arm.params().len());
         let mut tp = runtime::parts::TapeParts {
             kernels: &parts,
             slots: Vec::new(),
         };
+        // An incompressible element compressed past its length has no
+        // section: its displacements stay a fraction of an element's.
+        let incompressible = sets.iter().any(|s| s.contains("incompressible"));
         for trial in 0..4 {
             let mut q = rng.vec(n, -0.3, 0.3);
+            if incompressible {
+                (q.chunks_mut(6)).for_each(|c| c[..3].iter_mut().for_each(|u| *u *= 0.05));
+            }
             if trial == 0 {
                 q.fill(0.0);
             }
@@ -1701,6 +1733,9 @@ fn linked_cases(dir: &std::path::Path) -> Vec<(String, &'static str)> {
     let text = std::fs::read_to_string(model_path("chain")).unwrap();
     std::fs::write(&chain_floor, format!("{text}{FLOOR}")).unwrap();
     let chain_floor = chain_floor.to_string_lossy().into_owned();
+    let actuated_eba_file = dir.join("actuated_eba.toml");
+    std::fs::write(&actuated_eba_file, self::actuated_eba()).unwrap();
+    let actuated_eba = actuated_eba_file.to_string_lossy().into_owned();
     let cases: Vec<(&str, &'static str)> = vec![
         (stretching.as_str(), "segment.0.elements=6"),
         (frame.as_str(), "segment.1.offset=[0.01, -0.02, 0.005]"),
@@ -1744,8 +1779,10 @@ fn linked_cases(dir: &std::path::Path) -> Vec<(String, &'static str)> {
         (pinch.as_str(), "arm.right.segment.0.elements=3"),
         ("ball_drop", "arm.right.segment.1.elements=3"),
         // A system of parts: eba's elements, each a part of its kind's
-        // kernels (`parts.rs`), the tip's on its tapes.
+        // kernels (`parts.rs`), the tip's too; chambers and a tendon on
+        // the bare arm's joints (their loads zero where none act).
         ("eba_arm", "segment.0.elements=4"),
+        (actuated_eba.as_str(), "segment.1.elements=2"),
     ];
     (cases.into_iter())
         .map(|(m, set)| (m.to_string(), set))
@@ -2069,11 +2106,12 @@ fn a_run_says_which_route_it_took_and_why() {
         "{r}"
     );
     // A system of parts (eba): each kind of part compiled, the tip's
-    // part on its tapes.
+    // too (it reads the tip's, the base's and the last element's
+    // parameters, whatever the element count).
     let (b, r) = route("eba_arm", "segment.0.elements=4", auto);
     assert_eq!(b, "compiled");
     assert!(
-        r.contains("link cells") && r.contains("parts of 4 kinds, 1 on their tapes"),
+        r.contains("link cells") && r.contains("parts of 4 kinds, 0 on their tapes"),
         "{r}"
     );
     let (b, r) = route(&stretching, "", auto);

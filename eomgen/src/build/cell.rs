@@ -41,7 +41,7 @@ use super::planar_cell::{PlanarPart, derive_planar_cell, derive_planar_kink_cell
 use crate::method::ebr::{before_joint, past_joint};
 use crate::method::rigid::{JointSprings, RestTurn, joint_turn};
 use crate::method::rom::RomFields;
-use crate::tmt::actuation::{loads_on, segment_loads, strain_work, thinning};
+use crate::tmt::actuation::{ActuationLoads, strain_work, thinning};
 use crate::tmt::cell_kind::{CellKind, PointsOn};
 use crate::tmt::cell_outputs::{
     LinkKinematics, Motion, Rates, bodiless_cells, cell_param_symbols, with_tangent,
@@ -97,7 +97,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
     if !covered(st) {
         return None;
     }
-    let (loads, actuated) = derive_loads(params, st);
+    let actuated = ActuationLoads::of(params, st);
     let mut cells: Vec<(Shape, [Tape; 3])> = Vec::new();
     let mut links = Vec::new();
     let mut roms = Vec::new();
@@ -147,8 +147,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         let count = if spatial { g.coordinates_3d() } else { 1 };
         for e in 0..g.elements {
             // The loads of its segment, or of the element itself.
-            let load =
-                (actuated.iter()).position(|&(seg, el)| seg == s && el.is_none_or(|el| el == k));
+            let load = actuated.find(s, k);
             let displaced = displaced_volume(st, params, k);
             let principal = g.anisotropic.then(|| principal_params(params, k));
             let params = cell_slots(params, k);
@@ -208,7 +207,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         segment_ends,
         dof: first,
         forces: !roms.is_empty(),
-        loads: actuated.len(),
+        loads: actuated.owners.len(),
         ..globals(st, params)
     };
     let forces = (!roms.is_empty()).then(|| derive_forces(params, first, &roms));
@@ -227,7 +226,7 @@ pub fn link_chain(st: &Structure, params: &ParamLayout) -> Option<LinkKernels> {
         forces,
         forces_tangent,
         energy,
-        loads,
+        loads: actuated.tape,
         ..Default::default()
     };
     for (_, [cell, tangent, pose]) in cells {
@@ -595,46 +594,6 @@ struct Shape {
     /// What the link is of a 3D element.
     kind: CellKind,
 }
-
-/// The kernel of the actuated segments' loads (`actuation::segment_loads`,
-/// three per segment, or per element where its chamber levers vary along
-/// the segment; of the parameters alone) and whose they are; none without
-/// actuators.
-fn derive_loads(params: &ParamLayout, st: &Structure) -> (Option<Tape>, Vec<LoadOwner>) {
-    let mut cas = Cas::new();
-    let cas = &mut cas;
-    let symbols = ParamSymbols::new(cas, params);
-    let loads = segment_loads(cas, &symbols, st);
-    let (mut owners, mut out) = (Vec::new(), Vec::new());
-    let mut first = 0;
-    for (s, g) in st.segments.iter().enumerate() {
-        if loads[s].is_some() {
-            // Chamber levers that vary along the segment: a triple per
-            // element, with its own levers.
-            let elements: Vec<Option<usize>> = match g.chambers_vary {
-                true => (first..first + g.elements).map(Some).collect(),
-                false => vec![None],
-            };
-            for element in elements {
-                let load = match element {
-                    Some(k) => loads_on(cas, &symbols, st, s, Some(k)),
-                    None => loads[s],
-                };
-                out.extend(load.expect("the segment is actuated"));
-                owners.push((s, element));
-            }
-        }
-        first += g.elements;
-    }
-    if owners.is_empty() {
-        return (None, owners);
-    }
-    (Some(cas.to_tape(&out)), owners)
-}
-
-/// Whose actuation loads a triple of the `loads` kernel is: a segment's,
-/// or one element's of it (its chamber levers varying along it).
-type LoadOwner = (usize, Option<usize>);
 
 /// The generalised forces of the rom segments' strain energy and Rayleigh
 /// function (`RomFields::energies`, exact quadratics in the coefficients), as one

@@ -37,7 +37,7 @@ use crate::model::{
     Check, ElementParam, FluidParam, ModelError, Param, ParamLayout, Segment, SegmentShape,
     Structure, Xyz,
 };
-use crate::tmt::actuation::{Strain, actuation, thinning};
+use crate::tmt::actuation::{ActuationLoads, Strain, actuation, strain_work, thinning};
 use crate::tmt::along::{self, Applied, Drag, along_loads};
 use crate::tmt::assemble;
 use crate::tmt::spatial::{
@@ -759,16 +759,14 @@ fn beam_springs(
 /// neighbours (one) and to the clamp (one), and the tip's loads and body
 /// (one, reading the model's parameters). Centres are taken relative to a
 /// common point, which changes neither M nor h, so a part does not depend
-/// on the arc length to its element. None for an arm with actuators, a
-/// moving base, joint torques, loads along it or a fluid (terms not split
-/// into parts yet).
+/// on the arc length to its element. The chambers' and tendons' loads
+/// act on the joints' strains. None for an arm with a moving base, joint
+/// torques, loads along it or a fluid (terms not split into parts yet).
 pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartKernels> {
     let covered = st.segments.iter().all(|g| g.method == Method::Eba)
         && !st.base_translates
         && st.base_turns == 0
         && st.torques.is_empty()
-        && st.chambers.iter().all(|&c| c == 0)
-        && st.tendons.is_empty()
         && st.segments.iter().all(|g| !g.anisotropic && !g.rest_3d)
         && st.loads.is_empty()
         && st.fluid.is_none();
@@ -785,6 +783,12 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
         .iter()
         .flat_map(|g| std::iter::repeat_n(g.incompressible, g.elements))
         .collect();
+    let segment_of: Vec<usize> = (st.segments.iter().enumerate())
+        .flat_map(|(s, g)| std::iter::repeat_n(s, g.elements))
+        .collect();
+    // The chambers' and tendons' loads, read past the model's parameters
+    // by the joints they act across.
+    let actuation = ActuationLoads::of(layout, st);
     let mut kernels = PartKernels::default();
     // Kernel keys: 0 body; 1 + (incompressible) clamp joint; 3 + (..) joint.
     let mut keys: Vec<usize> = Vec::new();
@@ -829,6 +833,10 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
         };
         params.extend(joint(k));
         params.extend(&r0);
+        // Its segment's loads; a bare segment's the zero triple past
+        // them, so that actuated and bare arms share their joints' kernels.
+        let load = (actuation.find(segment_of[k], k)).unwrap_or(actuation.owners.len());
+        params.extend((0..3).map(|i| layout.len() + 3 * load + i));
         let j = kernel(&mut kernels, key, &|| joint_part(k == 0, inc));
         parts.push(PartSpec {
             kernel: j,
@@ -836,20 +844,23 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
             params,
         });
     }
-    if let Some(tip) = tip_part(st, layout) {
+    if let Some((tip, reads)) = tip_part(st, layout) {
         kernels.kernels.push(tip[0].clone());
         kernels.tangents.push(tip[1].clone());
         parts.push(PartSpec {
             kernel: kernels.kernels.len() - 1,
             coords: (6 * n - 6..6 * n).collect(),
-            params: (0..layout.len()).collect(),
+            params: reads.iter().map(|&p| index(p)).collect(),
         });
     }
     kernels.layout = PartLayout {
         dof: 6 * n,
         parts,
         pose_coords: (6 * n - 6..6 * n).collect(),
+        loads: 3 * actuation.owners.len() + 3,
+        params: layout.len(),
     };
+    kernels.loads = actuation.tape;
     kernels.pose = Some(pose_tape(st, layout));
     kernels.offsets = Some(offsets_tape(st, layout));
     Some(kernels)
@@ -941,7 +952,9 @@ fn body_part() -> [Tape; 2] {
 
 /// The beam springs to an element from the previous one (coordinates of
 /// both, parameters: the previous length, `JointParams`, base rotation) or
-/// from the clamp (`first`: its coordinates, `JointParams`, base rotation).
+/// from the clamp (`first`: its coordinates, `JointParams`, base
+/// rotation); then its segment's actuation loads on the joint's strain
+/// (c_st, c_by, c_bz of `actuation::segment_loads`; zero where none act).
 fn joint_part(first: bool, incompressible: bool) -> [Tape; 2] {
     let mut cas = Cas::new();
     let cas = &mut cas;
@@ -955,7 +968,7 @@ fn joint_part(first: bool, incompressible: bool) -> [Tape; 2] {
         names.extend(["ux", "uy", "uz", "rx", "ry", "rz"].map(|c| format!("{c}_b")));
         (Coordinates::new(cas, names), 1)
     };
-    let p = part_params(cas, before + 8 + 9);
+    let p = part_params(cas, before + 8 + 9 + 3);
     let jp = JointParams::from(std::array::from_fn(|i| p[before + i]));
     let r0 = rows(&p[before + 8..]);
     let base_axis = [r0[0][0], r0[1][0], r0[2][0]];
@@ -997,18 +1010,42 @@ fn joint_part(first: bool, incompressible: bool) -> [Tape; 2] {
     let mut sys = empty_system(cas, coords, [zero; 3]);
     sys.elastic = cas.add_all(&joint.elastic);
     sys.rayleigh = cas.add_all(&joint.rayleigh);
+    let loads = std::array::from_fn(|i| p[before + 8 + 9 + i]);
+    let strain = &joint.strain;
+    let work = strain_work(cas, loads, strain.stretch, strain.rho, strain.offset_scale);
+    sys.actuation = cas.neg(work);
     part_tapes(cas, &sys)
 }
 
-/// The tip's loads and body on the last element, reading the model's
-/// parameters; None without any.
-fn tip_part(st: &Structure, layout: &ParamLayout) -> Option<[Tape; 2]> {
+/// The tip's loads and body on the last element, and the parameters it
+/// reads (the world's, the base's, the tip's and the last element's
+/// length: the same tapes at any element count); None without any.
+fn tip_part(st: &Structure, layout: &ParamLayout) -> Option<([Tape; 2], Vec<Param>)> {
     if !(st.tip_mass || st.tip_force || st.tip_moment) {
         return None;
     }
+    let last = Param::Element(st.elements() - 1, ElementParam::Length);
+    let reads: Vec<Param> = (layout.params().iter().copied())
+        .filter(|&p| {
+            p == last
+                || matches!(
+                    p,
+                    Param::Gravity(_)
+                        | Param::BasePosition(_)
+                        | Param::BaseRotation(..)
+                        | Param::BaseQuaternion(_)
+                        | Param::TipMass
+                        | Param::TipForce(_)
+                        | Param::TipMoment(_)
+                        | Param::TipLength
+                        | Param::TipInertia
+                        | Param::TipAxialInertia
+                )
+        })
+        .collect();
     let mut cas = Cas::new();
-    let sys = tip_system(&mut cas, st, layout);
-    Some(part_tapes(&mut cas, &sys))
+    let sys = tip_system(&mut cas, st, &ParamLayout::local(&reads));
+    Some((part_tapes(&mut cas, &sys), reads))
 }
 
 /// The tip point relative to the last element's straight-arm centre and

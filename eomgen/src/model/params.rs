@@ -564,6 +564,17 @@ impl ParamLayout {
         }
     }
 
+    /// A kernel's own layout of just `keep`, in that order (a part's,
+    /// which reads them as p0, p1, ... wherever the model keeps them), so
+    /// that its tape does not change with the rest of the model.
+    pub fn local(keep: &[Param]) -> Self {
+        Self {
+            params: keep.to_vec(),
+            index: keep.iter().enumerate().map(|(i, &q)| (q, i)).collect(),
+            ..Self::default()
+        }
+    }
+
     /// The slot of `p`. The generator asks only for parameters its
     /// structure has, so a miss is a generator bug.
     pub fn index(&self, p: Param) -> usize {

@@ -17,7 +17,8 @@
 //! their change with the configuration.
 
 use crate::cas::{Cas, ExprId, Func};
-use crate::model::{ChamberParam, Param, Structure};
+use crate::model::{ChamberParam, Param, ParamLayout, Structure};
+use runtime::Tape;
 
 use super::system::ParamSymbols;
 
@@ -175,4 +176,53 @@ pub fn actuation(
     }
     let work = cas.add_all(&work);
     cas.neg(work)
+}
+
+/// The actuated segments' loads ([`segment_loads`]) as a kernel of the
+/// parameters alone, three values a segment, or an element where its
+/// chamber levers vary along the segment: what the link cells and an eba
+/// arm's joint parts read their loads from, so that an actuated arm and a
+/// bare one share those kernels.
+pub struct ActuationLoads {
+    /// None without actuators.
+    pub tape: Option<Tape>,
+    /// Whose each triple is: a segment's (element None), or one element's
+    /// of it.
+    pub owners: Vec<(usize, Option<usize>)>,
+}
+
+impl ActuationLoads {
+    pub fn of(params: &ParamLayout, st: &Structure) -> Self {
+        let mut cas = Cas::new();
+        let cas = &mut cas;
+        let symbols = ParamSymbols::new(cas, params);
+        let loads = segment_loads(cas, &symbols, st);
+        let (mut owners, mut out) = (Vec::new(), Vec::new());
+        let mut first = 0;
+        for (s, g) in st.segments.iter().enumerate() {
+            if loads[s].is_some() {
+                let elements: Vec<Option<usize>> = match g.chambers_vary {
+                    true => (first..first + g.elements).map(Some).collect(),
+                    false => vec![None],
+                };
+                for element in elements {
+                    let load = match element {
+                        Some(k) => loads_on(cas, &symbols, st, s, Some(k)),
+                        None => loads[s],
+                    };
+                    out.extend(load.expect("the segment is actuated"));
+                    owners.push((s, element));
+                }
+            }
+            first += g.elements;
+        }
+        let tape = (!owners.is_empty()).then(|| cas.to_tape(&out));
+        Self { tape, owners }
+    }
+
+    /// Which triple acts on element `k` of segment `s`; None where no
+    /// actuator acts.
+    pub fn find(&self, s: usize, k: usize) -> Option<usize> {
+        (self.owners.iter()).position(|&(seg, el)| seg == s && el.is_none_or(|el| el == k))
+    }
 }

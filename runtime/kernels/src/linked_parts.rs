@@ -2,8 +2,8 @@
 //! arm) whose element count no compiled-in model has sums the compiled
 //! kernels of the same kinds of parts (`parts::CompiledPart`, found by
 //! key), as `linked` does for link cells. A kind no compiled-in model has
-//! (the tip's, which reads the whole model's parameters) runs on its
-//! tapes, as do the pose and the offsets.
+//! runs on its tapes, as do the pose and the offsets (of the whole
+//! model's parameters, once per call).
 
 use std::cell::RefCell;
 

@@ -6,6 +6,8 @@
 //! `links`). Identical parts share one kernel, so generated code
 //! grows with the kinds of parts, not with their number.
 
+use std::borrow::Cow;
+
 use serde::{Deserialize, Serialize};
 
 use crate::links::{CellFn, CellTangentFn};
@@ -13,7 +15,8 @@ use crate::output;
 
 /// One part: its kernel, the arm's coordinates it reads (its local
 /// coordinate i is the arm's `coords[i]`) and its parameters (its local
-/// parameter i is `p[params[i]]`).
+/// parameter i is `p[params[i]]`, past the model's parameters the
+/// actuation loads': [`PartLayout::loads`]).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct PartSpec {
     pub kernel: usize,
@@ -28,6 +31,14 @@ pub struct PartLayout {
     pub parts: Vec<PartSpec>,
     /// The coordinates the pose kernel reads (the last element's).
     pub pose_coords: Vec<usize>,
+    /// How many values the loads kernel ([`Parts::loads`]: the actuators'
+    /// loads, of the parameters alone, then a zero triple for the bare
+    /// segments) gives; the parts read them past the model's `params`
+    /// parameters (not past derived ones).
+    #[serde(default)]
+    pub loads: usize,
+    #[serde(default)]
+    pub params: usize,
 }
 
 /// The part kernels of a model: kernel k maps a part's local coordinates,
@@ -46,6 +57,9 @@ pub struct PartKernels {
     pub tangents: Vec<crate::Tape>,
     pub pose: Option<crate::Tape>,
     pub offsets: Option<crate::Tape>,
+    /// The actuators' loads ([`PartLayout::loads`] values but the zero
+    /// triple); None without actuators.
+    pub loads: Option<crate::Tape>,
 }
 
 /// What the sums evaluate: generated code, or the tapes in tests.
@@ -68,6 +82,22 @@ pub trait Parts {
     fn pose(&mut self, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]);
     /// The offsets kernel of the model's `p`.
     fn offsets(&mut self, p: &[f64], out: &mut [f64]);
+    /// The loads kernel of the model's `p`: the actuators' loads
+    /// ([`PartKernels::loads`]; nothing without actuators).
+    fn loads(&mut self, p: &[f64], out: &mut [f64]);
+}
+
+/// The parameters the parts read: the model's, then the actuation loads
+/// and a zero triple (once per call, not per part).
+fn with_loads<'a, P: Parts>(layout: &PartLayout, parts: &mut P, p: &'a [f64]) -> Cow<'a, [f64]> {
+    if layout.loads == 0 {
+        return Cow::Borrowed(p);
+    }
+    let n = layout.params;
+    let mut all = p[..n].to_vec();
+    all.resize(n + layout.loads, 0.0);
+    parts.loads(p, &mut all[n..n + layout.loads - 3]);
+    Cow::Owned(all)
 }
 
 /// A part kernel compiled into a model, found by key
@@ -133,6 +163,9 @@ impl Parts for LinkedParts<'_> {
     fn offsets(&mut self, p: &[f64], out: &mut [f64]) {
         self.tapes.offsets(p, out)
     }
+    fn loads(&mut self, p: &[f64], out: &mut [f64]) {
+        self.tapes.loads(p, out)
+    }
 }
 
 /// What a part kernel writes for `m` coordinates: M's block, h's block,
@@ -163,6 +196,7 @@ pub fn mass_bias<P: Parts>(
 ) {
     let n = layout.dof;
     assert_eq!(out.len(), tri(n) + n, "MassBias output length");
+    let p = &*with_loads(layout, parts, p);
     out.fill(0.0);
     let (mass, bias) = out.split_at_mut(tri(n));
     let index = |i: usize, j: usize| {
@@ -209,6 +243,7 @@ pub fn jvp<P: Parts>(
 ) {
     let n = layout.dof;
     assert!(dir.len() == 2 * n && dtau.len() == n);
+    let p = &*with_loads(layout, parts, p);
     let (dq, dqd) = dir.split_at(n);
     dtau.fill(0.0);
     let mut out = Vec::new();
@@ -252,12 +287,13 @@ pub fn outputs<P: Parts>(
 ) {
     let mut offsets = [0.0; 4];
     parts.offsets(p, &mut offsets);
+    let all = with_loads(layout, parts, p);
     let (mut ke, mut pe) = (0.0, offsets[0]);
     let mut local = Vec::new();
     for spec in &layout.parts {
         let m = spec.coords.len();
         local.resize(part_len(m), 0.0);
-        let params: Vec<f64> = spec.params.iter().map(|&i| p[i]).collect();
+        let params: Vec<f64> = spec.params.iter().map(|&i| all[i]).collect();
         let xd = gather(spec, qd);
         parts.eval(spec.kernel, &gather(spec, q), &xd, &params, &mut local);
         let mut at = 0;
@@ -349,5 +385,20 @@ impl Parts for TapeParts<'_> {
         };
         let offsets = self.kernels.offsets.as_ref().expect("an offsets kernel");
         offsets.eval(&inp, &mut self.slots, out)
+    }
+    fn loads(&mut self, p: &[f64], out: &mut [f64]) {
+        let inp = crate::Inputs {
+            t: 0.0,
+            q: &[],
+            qd: &[],
+            qdd: &[],
+            dir: &[],
+            p,
+            aux: &[],
+        };
+        match &self.kernels.loads {
+            Some(loads) => loads.eval(&inp, &mut self.slots, out),
+            None => debug_assert!(out.is_empty(), "no actuator acts"),
+        }
     }
 }
