@@ -1432,10 +1432,19 @@ fn eba_parts_match_the_flat_tapes() {
     let actuated = dir.path().join("actuated_eba.toml");
     std::fs::write(&actuated, actuated_eba()).unwrap();
     let actuated = actuated.to_string_lossy().into_owned();
+    // Driven torques on an element's turn and its displacement.
+    let torqued = dir.path().join("torqued_eba.toml");
+    let text = actuated_eba()
+        + "[[torque]]\ncoordinate = \"ry_0_1\"\ninput = \"tq\"\n\
+           [[torque]]\ncoordinate = \"uz_1_2\"\ninput = \"tq\"\n\
+           [inputs.tq]\nkind = \"constant\"\nvalue = 0.02\n";
+    std::fs::write(&torqued, text).unwrap();
+    let torqued = torqued.to_string_lossy().into_owned();
     let mut models: Vec<(&str, &[&str])> = vec![
         ("ebr_arm", &["segment.0.method=eba"]),
         (&actuated, &["segment.0.chambers.distance=[0.008, 0.006]"]),
         (&actuated, &["segment.0.incompressible=true"]),
+        (&torqued, &[]),
     ];
     models.extend(cases.iter().map(|&s| ("cantilever3d", s)));
     for (model, sets) in models {

@@ -760,13 +760,13 @@ fn beam_springs(
 /// (one, reading the model's parameters). Centres are taken relative to a
 /// common point, which changes neither M nor h, so a part does not depend
 /// on the arc length to its element. The chambers' and tendons' loads
-/// act on the joints' strains. None for an arm with a moving base, joint
-/// torques, loads along it or a fluid (terms not split into parts yet).
+/// act on the joints' strains, a driven torque on its coordinate. None
+/// for an arm with a moving base, loads along it or a fluid (terms not
+/// split into parts yet).
 pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartKernels> {
     let covered = st.segments.iter().all(|g| g.method == Method::Eba)
         && !st.base_translates
         && st.base_turns == 0
-        && st.torques.is_empty()
         && st.segments.iter().all(|g| !g.anisotropic && !g.rest_3d)
         && st.loads.is_empty()
         && st.fluid.is_none();
@@ -790,7 +790,8 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
     // by the joints they act across.
     let actuation = ActuationLoads::of(layout, st);
     let mut kernels = PartKernels::default();
-    // Kernel keys: 0 body; 1 + (incompressible) clamp joint; 3 + (..) joint.
+    // Kernel keys: 0 body; 1 + (incompressible) clamp joint; 3 + (..)
+    // joint; 5 torque.
     let mut keys: Vec<usize> = Vec::new();
     let mut kernel =
         |kernels: &mut PartKernels, key: usize, make: &dyn Fn() -> [Tape; 2]| match keys
@@ -842,6 +843,17 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
             kernel: j,
             coords,
             params,
+        });
+    }
+    // A driven torque: a part of its coordinate alone.
+    let names = crate::method::coordinate_names(st);
+    for (i, name) in st.torques.iter().enumerate() {
+        let c = (names.iter().position(|n| n == name)).expect("validated coordinate name");
+        let t = kernel(&mut kernels, 5, &torque_part);
+        parts.push(PartSpec {
+            kernel: t,
+            coords: vec![c],
+            params: vec![index(Param::Torque(i))],
         });
     }
     if let Some((tip, reads)) = tip_part(st, layout) {
@@ -947,6 +959,20 @@ fn body_part() -> [Tape; 2] {
     };
     let mut sys = empty_system(cas, coords, [p[3], p[4], p[5]]);
     sys.bodies.push(body);
+    part_tapes(cas, &sys)
+}
+
+/// A driven generalised force Q on one coordinate q (parameter: Q), as
+/// the flat arm takes it: the potential -Q q among the actuators'.
+fn torque_part() -> [Tape; 2] {
+    let mut cas = Cas::new();
+    let cas = &mut cas;
+    let coords = Coordinates::new(cas, vec!["q".to_string()]);
+    let p = part_params(cas, 1);
+    let zero = cas.zero();
+    let work = cas.mul(p[0], coords.q[0]);
+    let mut sys = empty_system(cas, coords, [zero; 3]);
+    sys.actuation = cas.neg(work);
     part_tapes(cas, &sys)
 }
 
