@@ -487,14 +487,21 @@ impl runtime::links::Cells for TapeCells<'_> {
     }
 }
 
-/// [`ACTUATED_3D`] of eba elements.
-fn actuated_eba() -> String {
-    let text = ACTUATED_3D
+/// A model of pcc, rom and vc segments, of eba elements.
+fn as_eba(text: &str) -> String {
+    let segments = text.matches("[[segment]]").count();
+    let text = text
         .replace("method = \"pcc\"", "method = \"eba\"")
         .replace("method = \"rom\"\norder = 2", "method = \"eba\"")
+        .replace("method = \"vc\"", "method = \"eba\"")
         .replace("extension = true\n", "");
-    assert_eq!(text.matches("\"eba\"").count(), 2);
+    assert_eq!(text.matches("\"eba\"").count(), segments);
     text
+}
+
+/// [`ACTUATED_3D`] of eba elements.
+fn actuated_eba() -> String {
+    as_eba(ACTUATED_3D)
 }
 
 /// A 3D arm whose pcc and rom segments both carry chambers, with a tendon
@@ -1402,9 +1409,10 @@ fn recursion_matches_at(
 /// springs, the tip) against the flat `MassBias`, `Jvp` and `Outputs`
 /// tapes of the whole system at 1e-12 of their scale, with tip bodies and
 /// loads, extension and thinning.
-#[test]
-fn eba_parts_match_the_flat_tapes() {
-    let cases: [&[&str]; 4] = [
+/// The eba arms whose parts are compared with their flat tapes, their
+/// files written into `dir`: (model, overrides).
+fn eba_part_cases(dir: &std::path::Path) -> Vec<(String, &'static [&'static str])> {
+    let cases: [&'static [&'static str]; 4] = [
         &["segment.0.method=eba", "gravity=[1,-2,-9.81]"],
         &[
             "segment.0.method=eba",
@@ -1425,29 +1433,46 @@ fn eba_parts_match_the_flat_tapes() {
         ],
         &["segment.0.method=eba", "segment.0.bending_damping=0.01"],
     ];
-    let mut rng = Rng::new(29);
     // Chambers and a tendon across two segments, the first's chamber
     // levers tapering (a triple of loads per element), the second's not.
-    let dir = tempfile::tempdir().unwrap();
-    let actuated = dir.path().join("actuated_eba.toml");
+    let actuated = dir.join("actuated_eba.toml");
     std::fs::write(&actuated, actuated_eba()).unwrap();
     let actuated = actuated.to_string_lossy().into_owned();
     // Driven torques on an element's turn and its displacement.
-    let torqued = dir.path().join("torqued_eba.toml");
+    let torqued = dir.join("torqued_eba.toml");
     let text = actuated_eba()
         + "[[torque]]\ncoordinate = \"ry_0_1\"\ninput = \"tq\"\n\
            [[torque]]\ncoordinate = \"uz_1_2\"\ninput = \"tq\"\n\
            [inputs.tq]\nkind = \"constant\"\nvalue = 0.02\n";
     std::fs::write(&torqued, text).unwrap();
     let torqued = torqued.to_string_lossy().into_owned();
-    let mut models: Vec<(&str, &[&str])> = vec![
-        ("ebr_arm", &["segment.0.method=eba"]),
-        (&actuated, &["segment.0.chambers.distance=[0.008, 0.006]"]),
-        (&actuated, &["segment.0.incompressible=true"]),
-        (&torqued, &[]),
+    // Loads along the arm: point forces inside an element, at the base
+    // and on an element boundary, a follower force and moment, forces per
+    // unit length in the world frame and turning with the section, a
+    // driven moment.
+    let loaded = dir.join("loaded_eba.toml");
+    std::fs::write(&loaded, as_eba(LOADED_3D)).unwrap();
+    let loaded = loaded.to_string_lossy().into_owned();
+    let mut models: Vec<(String, &[&str])> = vec![
+        (loaded, &[]),
+        ("ebr_arm".into(), &["segment.0.method=eba"]),
+        (
+            actuated.clone(),
+            &["segment.0.chambers.distance=[0.008, 0.006]"],
+        ),
+        (actuated, &["segment.0.incompressible=true"]),
+        (torqued, &[]),
     ];
-    models.extend(cases.iter().map(|&s| ("cantilever3d", s)));
-    for (model, sets) in models {
+    models.extend(cases.iter().map(|&s| ("cantilever3d".into(), s)));
+    models
+}
+
+#[test]
+fn eba_parts_match_the_flat_tapes() {
+    let mut rng = Rng::new(29);
+    let dir = tempfile::tempdir().unwrap();
+    for (model, sets) in eba_part_cases(dir.path()) {
+        let model = model.as_str();
         let overrides: Vec<eomgen::model::Override> = sets
             .iter()
             .map(|s| eomgen::model::Override::parse(s).unwrap())
@@ -1745,6 +1770,9 @@ fn linked_cases(dir: &std::path::Path) -> Vec<(String, &'static str)> {
     let actuated_eba_file = dir.join("actuated_eba.toml");
     std::fs::write(&actuated_eba_file, self::actuated_eba()).unwrap();
     let actuated_eba = actuated_eba_file.to_string_lossy().into_owned();
+    let loaded_eba = dir.join("loaded_eba.toml");
+    std::fs::write(&loaded_eba, as_eba(LOADED_3D)).unwrap();
+    let loaded_eba = loaded_eba.to_string_lossy().into_owned();
     let cases: Vec<(&str, &'static str)> = vec![
         (stretching.as_str(), "segment.0.elements=6"),
         (frame.as_str(), "segment.1.offset=[0.01, -0.02, 0.005]"),
@@ -1792,6 +1820,8 @@ fn linked_cases(dir: &std::path::Path) -> Vec<(String, &'static str)> {
         // the bare arm's joints (their loads zero where none act).
         ("eba_arm", "segment.0.elements=4"),
         (actuated_eba.as_str(), "segment.1.elements=2"),
+        // Loads along it, each element's on its own part (on its tapes).
+        (loaded_eba.as_str(), "segment.2.elements=3"),
     ];
     (cases.into_iter())
         .map(|(m, set)| (m.to_string(), set))

@@ -760,15 +760,14 @@ fn beam_springs(
 /// (one, reading the model's parameters). Centres are taken relative to a
 /// common point, which changes neither M nor h, so a part does not depend
 /// on the arc length to its element. The chambers' and tendons' loads
-/// act on the joints' strains, a driven torque on its coordinate. None
-/// for an arm with a moving base, loads along it or a fluid (terms not
-/// split into parts yet).
+/// act on the joints' strains, a driven torque on its coordinate, loads
+/// along the arm on their elements. None for an arm with a moving base or
+/// in a fluid (terms not split into parts yet).
 pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartKernels> {
     let covered = st.segments.iter().all(|g| g.method == Method::Eba)
         && !st.base_translates
         && st.base_turns == 0
         && st.segments.iter().all(|g| !g.anisotropic && !g.rest_3d)
-        && st.loads.is_empty()
         && st.fluid.is_none();
     if !covered {
         return None;
@@ -844,6 +843,19 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
             coords,
             params,
         });
+    }
+    // The loads along the arm on each element's slab.
+    for k in 0..n {
+        if let Some((tapes, reads)) = load_part(st, layout, k) {
+            let [t, d] = tapes;
+            kernels.kernels.push(t);
+            kernels.tangents.push(d);
+            parts.push(PartSpec {
+                kernel: kernels.kernels.len() - 1,
+                coords: (6 * k..6 * k + 6).collect(),
+                params: reads.iter().map(|&p| index(p)).collect(),
+            });
+        }
     }
     // A driven torque: a part of its coordinate alone.
     let names = crate::method::coordinate_names(st);
@@ -960,6 +972,60 @@ fn body_part() -> [Tape; 2] {
     let mut sys = empty_system(cas, coords, [p[3], p[4], p[5]]);
     sys.bodies.push(body);
     part_tapes(cas, &sys)
+}
+
+/// The loads along the arm on element k (`[[load]]`: forces and moments
+/// at fractions of it, a force per length at its middle) on its slab, as
+/// `SlabLoads` applies them, and the parameters they read; None where
+/// none acts.
+fn load_part(st: &Structure, layout: &ParamLayout, k: usize) -> Option<([Tape; 2], Vec<Param>)> {
+    let reads: Vec<Param> = (layout.params().iter().copied())
+        .filter(|p| {
+            matches!(
+                p,
+                Param::Load(..)
+                    | Param::Element(_, ElementParam::Length)
+                    | Param::BaseRotation(..)
+            )
+        })
+        .collect();
+    let mut cas = Cas::new();
+    let cas = &mut cas;
+    let symbols = ParamSymbols::new(cas, &ParamLayout::local(&reads));
+    let loads = along_loads(cas, st, &symbols);
+    if !loads.iter().any(|l| l.element == k) {
+        return None;
+    }
+    let coords = element_coordinates(cas, "");
+    let zero = cas.zero();
+    let r0: M3 = std::array::from_fn(|i| {
+        std::array::from_fn(|j| symbols.get(Param::BaseRotation(i as u8, j as u8)))
+    });
+    let psi: V3 = std::array::from_fn(|i| coords.q[3 + i]);
+    let psi_d: V3 = std::array::from_fn(|i| coords.qd[3 + i]);
+    let (r, omega, _) = element_frame(cas, &r0, &[zero; 3], &psi, &psi_d);
+    let slab = Slab {
+        r,
+        centre: bind3(cas, std::array::from_fn(|i| coords.q[i])),
+        half: cas.scaled(0.5, symbols.element(k, ElementParam::Length)),
+    };
+    let pairs = coords.rate_pairs();
+    let mut applied = Applied::default();
+    applied.element(
+        cas,
+        &loads,
+        (k, 0),
+        &mut |cas, fraction| along::Placed {
+            point: slab.end(cas, 2.0 * fraction - 1.0),
+            rotation: slab.r,
+            omega,
+        },
+        &pairs,
+        &symbols,
+    );
+    let mut sys = empty_system(cas, coords, [zero; 3]);
+    applied.attach(cas, &mut sys, &symbols, &[]);
+    Some((part_tapes(cas, &sys), reads))
 }
 
 /// A driven generalised force Q on one coordinate q (parameter: Q), as
@@ -1087,8 +1153,9 @@ fn pose_tape(st: &Structure, layout: &ParamLayout) -> Tape {
 
 /// The parameters-only offsets of the outputs (`runtime::parts::outputs`):
 /// the potential energy the parts leave out (every body's and the tip's
-/// weight, and a world-frame tip force, at the straight-arm centres they
-/// are relative to), then the last element's straight-arm centre.
+/// weight, and world-frame forces at the tip and along the arm, at the
+/// straight-arm centres they are relative to), then the last element's
+/// straight-arm centre.
 fn offsets_tape(st: &Structure, layout: &ParamLayout) -> Tape {
     let mut cas = Cas::new();
     let cas = &mut cas;
@@ -1099,6 +1166,7 @@ fn offsets_tape(st: &Structure, layout: &ParamLayout) -> Tape {
     let mut along = cas.zero();
     let mut terms = Vec::new();
     let mut centre = p0;
+    let loads = along_loads(cas, st, &symbols);
     for k in 0..st.elements() {
         let l = symbols.element(k, ElementParam::Length);
         let half = cas.scaled(0.5, l);
@@ -1112,6 +1180,14 @@ fn offsets_tape(st: &Structure, layout: &ParamLayout) -> Tape {
         let gc = cas.dot(&g, &centre);
         let mgc = cas.mul(m, gc);
         terms.push(cas.neg(mgc));
+        // A world-frame force along the arm: -F . p, its load part's p
+        // relative to this centre.
+        for l in loads.iter().filter(|l| l.element == k && !l.local) {
+            if let Some(f) = l.force {
+                let fc = cas.dot(&f, &centre);
+                terms.push(cas.neg(fc));
+            }
+        }
     }
     if st.tip_mass {
         let gc = cas.dot(&g, &centre);
