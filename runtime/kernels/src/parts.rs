@@ -180,8 +180,23 @@ fn tri(m: usize) -> usize {
 }
 
 /// The part's local values of the arm's `v`, and its parameters.
-fn gather(spec: &PartSpec, v: &[f64]) -> Vec<f64> {
-    spec.coords.iter().map(|&i| v[i]).collect()
+/// `v` at `at` into `buf`, reusing its allocation across parts.
+fn gather<'a>(buf: &'a mut Vec<f64>, at: &[usize], v: &[f64]) -> &'a [f64] {
+    buf.clear();
+    buf.extend(at.iter().map(|&i| v[i]));
+    buf
+}
+
+/// A part's inputs, gathered into buffers reused from part to part.
+#[derive(Default)]
+struct Gathered {
+    x: Vec<f64>,
+    xd: Vec<f64>,
+    params: Vec<f64>,
+    /// The Jvp's: the direction's parts and the accelerations.
+    dx: Vec<f64>,
+    dxd: Vec<f64>,
+    xdd: Vec<f64>,
 }
 
 /// M (upper triangle, row by row) and h into `out` (the `MassBias`
@@ -203,18 +218,14 @@ pub fn mass_bias<P: Parts>(
         let (i, j) = (i.min(j), i.max(j));
         i * n - i * (i + 1) / 2 + j
     };
-    let mut local = Vec::new();
+    let (mut local, mut g) = (Vec::new(), Gathered::default());
     for spec in &layout.parts {
         let m = spec.coords.len();
         local.resize(part_len(m), 0.0);
-        let params: Vec<f64> = spec.params.iter().map(|&i| p[i]).collect();
-        parts.eval(
-            spec.kernel,
-            &gather(spec, q),
-            &gather(spec, qd),
-            &params,
-            &mut local,
-        );
+        let x = gather(&mut g.x, &spec.coords, q);
+        let xd = gather(&mut g.xd, &spec.coords, qd);
+        let params = gather(&mut g.params, &spec.params, p);
+        parts.eval(spec.kernel, x, xd, params, &mut local);
         let mut at = 0;
         for a in 0..m {
             for b in a..m {
@@ -246,19 +257,21 @@ pub fn jvp<P: Parts>(
     let p = &*with_loads(layout, parts, p);
     let (dq, dqd) = dir.split_at(n);
     dtau.fill(0.0);
-    let mut out = Vec::new();
+    let (mut out, mut g) = (Vec::new(), Gathered::default());
     for spec in &layout.parts {
-        let (dx, dxd) = (gather(spec, dq), gather(spec, dqd));
-        if dx.iter().chain(&dxd).all(|&v| v == 0.0) {
+        let dx = gather(&mut g.dx, &spec.coords, dq);
+        let dxd = gather(&mut g.dxd, &spec.coords, dqd);
+        if dx.iter().chain(dxd).all(|&v| v == 0.0) {
             continue;
         }
         let m = spec.coords.len();
         let len = part_len(m);
         out.resize(2 * len, 0.0);
-        let params: Vec<f64> = spec.params.iter().map(|&i| p[i]).collect();
-        let (x, xd) = (gather(spec, q), gather(spec, qd));
-        parts.tangent(spec.kernel, &x, &xd, &dx, &dxd, &params, &mut out);
-        let a_local = gather(spec, qdd);
+        let params = gather(&mut g.params, &spec.params, p);
+        let x = gather(&mut g.x, &spec.coords, q);
+        let xd = gather(&mut g.xd, &spec.coords, qd);
+        parts.tangent(spec.kernel, x, xd, dx, dxd, params, &mut out);
+        let a_local = gather(&mut g.xdd, &spec.coords, qdd);
         // Row a of the block's derivative times the local accelerations.
         let entry = |a: usize, b: usize| {
             let (a, b) = (a.min(b), a.max(b));
@@ -289,13 +302,14 @@ pub fn outputs<P: Parts>(
     parts.offsets(p, &mut offsets);
     let all = with_loads(layout, parts, p);
     let (mut ke, mut pe) = (0.0, offsets[0]);
-    let mut local = Vec::new();
+    let (mut local, mut g) = (Vec::new(), Gathered::default());
     for spec in &layout.parts {
         let m = spec.coords.len();
         local.resize(part_len(m), 0.0);
-        let params: Vec<f64> = spec.params.iter().map(|&i| all[i]).collect();
-        let xd = gather(spec, qd);
-        parts.eval(spec.kernel, &gather(spec, q), &xd, &params, &mut local);
+        let params = gather(&mut g.params, &spec.params, &all);
+        let x = gather(&mut g.x, &spec.coords, q);
+        let xd = gather(&mut g.xd, &spec.coords, qd);
+        parts.eval(spec.kernel, x, xd, params, &mut local);
         let mut at = 0;
         for a in 0..m {
             for b in a..m {
