@@ -200,7 +200,7 @@ fn linked(
             note,
         )
     } else {
-        return Err(not_cells());
+        return Err(eomgen::derive::why_not_linked(structure));
     };
     let (kernels, note) = kernels;
     Ok((kernels, start.elapsed().as_secs_f64(), note))

@@ -80,6 +80,20 @@ pub fn derive_parts(structure: &Structure) -> Option<(ModelInfo, runtime::parts:
     Some((info, parts))
 }
 
+/// Why a single arm runs on neither the link cells nor the parts: its eba
+/// segments' reason (which eba's parts do not cover yet), else that some
+/// method's elements are no link cells.
+pub fn why_not_linked(structure: &Structure) -> String {
+    let eba = (structure.segments.iter()).any(|g| g.method == crate::model::Method::Eba);
+    match eba
+        .then(|| crate::method::eba::not_parts(structure))
+        .flatten()
+    {
+        Some(why) => format!("{why}, which eba's parts do not cover yet"),
+        None => "not every one of its methods' elements is a link cell".into(),
+    }
+}
+
 /// The contact groups of a chain's points: an element's points each, up to
 /// `most` groups (the kernel's `dir` selects them), neighbours merged past
 /// that.

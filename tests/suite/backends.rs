@@ -2153,6 +2153,13 @@ fn a_run_says_which_route_it_took_and_why() {
         r.contains("link cells") && r.contains("parts of 4 kinds, 0 on their tapes"),
         "{r}"
     );
+    // An immersed eba arm: what the parts lack, said.
+    let immersed = dir.path().join("immersed_eba.toml");
+    let text = std::fs::read_to_string(model_path("eba_arm")).unwrap();
+    std::fs::write(&immersed, format!("{text}\n[fluid]\ndensity = 1000.0\n")).unwrap();
+    let (b, r) = route(&immersed.to_string_lossy(), "", auto);
+    assert_eq!(b, "interpreted");
+    assert!(r.contains("its eba elements are immersed"), "{r}");
     let (b, r) = route(&stretching, "", auto);
     assert_eq!(b, "compiled");
     assert!(

@@ -764,12 +764,7 @@ fn beam_springs(
 /// along the arm on their elements. None for an arm with a moving base or
 /// in a fluid (terms not split into parts yet).
 pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartKernels> {
-    let covered = st.segments.iter().all(|g| g.method == Method::Eba)
-        && !st.base_translates
-        && st.base_turns == 0
-        && st.segments.iter().all(|g| !g.anisotropic && !g.rest_3d)
-        && st.fluid.is_none();
-    if !covered {
+    if not_parts(st).is_some() {
         return None;
     }
     let index = |p: Param| layout.index(p);
@@ -888,6 +883,23 @@ pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartK
     kernels.pose = Some(pose_tape(st, layout));
     kernels.offsets = Some(offsets_tape(st, layout));
     Some(kernels)
+}
+
+/// Why an arm is no system of parts ([`part_kernels`]); None where it is.
+pub(crate) fn not_parts(st: &Structure) -> Option<&'static str> {
+    if !st.segments.iter().all(|g| g.method == Method::Eba) {
+        return Some("its eba segments share the arm with other methods");
+    }
+    if st.base_translates || st.base_turns > 0 {
+        return Some("its eba elements sit on a moving base");
+    }
+    if st.segments.iter().any(|g| g.anisotropic || g.rest_3d) {
+        return Some("its eba elements have an anisotropic section or a rest shape");
+    }
+    if st.fluid.is_some() {
+        return Some("its eba elements are immersed");
+    }
+    None
 }
 
 /// An element's coordinates (u, psi) in a fresh CAS.
