@@ -1453,8 +1453,21 @@ fn eba_part_cases(dir: &std::path::Path) -> Vec<(String, &'static [&'static str]
     let loaded = dir.join("loaded_eba.toml");
     std::fs::write(&loaded, as_eba(LOADED_3D)).unwrap();
     let loaded = loaded.to_string_lossy().into_owned();
+    // Immersed: buoyancy, Morison drag and a current on the underwater
+    // arm (a chamber driven), and buoyancy alone with the loads along.
+    let underwater = dir.join("underwater_eba.toml");
+    let text = std::fs::read_to_string(root().join("examples/underwater_arm.toml")).unwrap();
+    std::fs::write(&underwater, as_eba(&text)).unwrap();
+    let underwater = underwater.to_string_lossy().into_owned();
+    let afloat = dir.join("afloat_eba.toml");
+    let text = as_eba(LOADED_3D).replace("[inputs.m]", "[fluid]\ndensity = 1000.0\n\n[inputs.m]");
+    assert!(text.contains("[fluid]"));
+    std::fs::write(&afloat, text).unwrap();
+    let afloat = afloat.to_string_lossy().into_owned();
     let mut models: Vec<(String, &[&str])> = vec![
         (loaded, &[]),
+        (underwater, &[]),
+        (afloat, &[]),
         ("ebr_arm".into(), &["segment.0.method=eba"]),
         (
             actuated.clone(),
@@ -2153,13 +2166,20 @@ fn a_run_says_which_route_it_took_and_why() {
         r.contains("link cells") && r.contains("parts of 4 kinds, 0 on their tapes"),
         "{r}"
     );
-    // An immersed eba arm: what the parts lack, said.
-    let immersed = dir.path().join("immersed_eba.toml");
-    let text = std::fs::read_to_string(model_path("eba_arm")).unwrap();
-    std::fs::write(&immersed, format!("{text}\n[fluid]\ndensity = 1000.0\n")).unwrap();
-    let (b, r) = route(&immersed.to_string_lossy(), "", auto);
+    // An eba arm on a moving base: what the parts lack, said.
+    let shaken = dir.path().join("shaken_eba.toml");
+    let text = std::fs::read_to_string(model_path("eba_arm"))
+        .unwrap()
+        .replacen(
+            "[base]\n",
+            "[base]\ntranslation_inputs = [\"x\", \"x\", \"x\"]\n",
+            1,
+        );
+    let text = format!("{text}\n[inputs.x]\nkind = \"sine\"\namplitude = 0.01\nfrequency = 1.0\n");
+    std::fs::write(&shaken, text).unwrap();
+    let (b, r) = route(&shaken.to_string_lossy(), "", auto);
     assert_eq!(b, "interpreted");
-    assert!(r.contains("its eba elements are immersed"), "{r}");
+    assert!(r.contains("its eba elements sit on a moving base"), "{r}");
     let (b, r) = route(&stretching, "", auto);
     assert_eq!(b, "compiled");
     assert!(

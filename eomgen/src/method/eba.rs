@@ -46,7 +46,7 @@ use crate::tmt::spatial::{
     quat_mul, rotation, rotation_quat,
 };
 use crate::tmt::system::{
-    Body, Coordinates, Inertia, ParamSymbols, Sample, System, TipMount, tip_loads,
+    Body, Coordinates, Inertia, ParamSymbols, PointForce, Sample, System, TipMount, tip_loads,
 };
 
 pub(super) struct Eba;
@@ -761,8 +761,8 @@ fn beam_springs(
 /// common point, which changes neither M nor h, so a part does not depend
 /// on the arc length to its element. The chambers' and tendons' loads
 /// act on the joints' strains, a driven torque on its coordinate, loads
-/// along the arm on their elements. None for an arm with a moving base or
-/// in a fluid (terms not split into parts yet).
+/// along the arm and a fluid's buoyancy and drag on their elements. None
+/// for an arm on a moving base (terms not split into parts yet).
 pub(crate) fn part_kernels(st: &Structure, layout: &ParamLayout) -> Option<PartKernels> {
     if not_parts(st).is_some() {
         return None;
@@ -896,9 +896,6 @@ pub(crate) fn not_parts(st: &Structure) -> Option<&'static str> {
     if st.segments.iter().any(|g| g.anisotropic || g.rest_3d) {
         return Some("its eba elements have an anisotropic section or a rest shape");
     }
-    if st.fluid.is_some() {
-        return Some("its eba elements are immersed");
-    }
     None
 }
 
@@ -996,8 +993,13 @@ fn load_part(st: &Structure, layout: &ParamLayout, k: usize) -> Option<([Tape; 2
             matches!(
                 p,
                 Param::Load(..)
-                    | Param::Element(_, ElementParam::Length)
+                    | Param::Element(
+                        _,
+                        ElementParam::Length | ElementParam::Volume | ElementParam::Width
+                    )
                     | Param::BaseRotation(..)
+                    | Param::Gravity(_)
+                    | Param::Fluid(_)
             )
         })
         .collect();
@@ -1005,7 +1007,7 @@ fn load_part(st: &Structure, layout: &ParamLayout, k: usize) -> Option<([Tape; 2
     let cas = &mut cas;
     let symbols = ParamSymbols::new(cas, &ParamLayout::local(&reads));
     let loads = along_loads(cas, st, &symbols);
-    if !loads.iter().any(|l| l.element == k) {
+    if st.fluid.is_none() && !loads.iter().any(|l| l.element == k) {
         return None;
     }
     let coords = element_coordinates(cas, "");
@@ -1023,6 +1025,7 @@ fn load_part(st: &Structure, layout: &ParamLayout, k: usize) -> Option<([Tape; 2
     };
     let pairs = coords.rate_pairs();
     let mut applied = Applied::default();
+    applied.drag = Drag::of(st, &symbols);
     applied.element(
         cas,
         &loads,
@@ -1037,6 +1040,18 @@ fn load_part(st: &Structure, layout: &ParamLayout, k: usize) -> Option<([Tape; 2
     );
     let mut sys = empty_system(cas, coords, [zero; 3]);
     applied.attach(cas, &mut sys, &symbols, &[]);
+    // Immersed: the weight of the fluid it displaces, up through its
+    // centre (its body's, as `along::buoyancy` lifts the flat arm's).
+    if st.fluid.is_some() {
+        let rho = symbols.get(Param::Fluid(FluidParam::Density));
+        let displaced = cas.mul(rho, symbols.element(k, ElementParam::Volume));
+        let lift = cas.neg(displaced);
+        let force = symbols.gravity().map(|c| cas.mul(lift, c));
+        sys.point_forces.push(PointForce {
+            point: slab.centre,
+            force,
+        });
+    }
     Some((part_tapes(cas, &sys), reads))
 }
 
@@ -1193,12 +1208,18 @@ fn offsets_tape(st: &Structure, layout: &ParamLayout) -> Tape {
         let mgc = cas.mul(m, gc);
         terms.push(cas.neg(mgc));
         // A world-frame force along the arm: -F . p, its load part's p
-        // relative to this centre.
+        // relative to this centre; buoyancy's too.
         for l in loads.iter().filter(|l| l.element == k && !l.local) {
             if let Some(f) = l.force {
                 let fc = cas.dot(&f, &centre);
                 terms.push(cas.neg(fc));
             }
+        }
+        if st.fluid.is_some() {
+            let rho = symbols.get(Param::Fluid(FluidParam::Density));
+            let displaced = cas.mul(rho, symbols.element(k, ElementParam::Volume));
+            let gc = cas.dot(&g, &centre);
+            terms.push(cas.mul(displaced, gc));
         }
     }
     if st.tip_mass {
