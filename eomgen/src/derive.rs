@@ -84,11 +84,7 @@ pub fn derive_parts(structure: &Structure) -> Option<(ModelInfo, runtime::parts:
 /// segments' reason (which eba's parts do not cover yet), else that some
 /// method's elements are no link cells.
 pub fn why_not_linked(structure: &Structure) -> String {
-    let eba = (structure.segments.iter()).any(|g| g.method == crate::model::Method::Eba);
-    match eba
-        .then(|| crate::method::eba::not_parts(structure))
-        .flatten()
-    {
+    match crate::method::why_not_parts(structure) {
         Some(why) => format!("{why}, which eba's parts do not cover yet"),
         None => "not every one of its methods' elements is a link cell".into(),
     }

@@ -2038,17 +2038,71 @@ kind = "constant"
 value = 1000.0
 "#;
 
+/// The backend and route of `model` with one override (none if empty).
+fn route_of(model: &str, set: &str, choice: BackendChoice) -> (&'static str, String) {
+    let sets: Vec<_> = (!set.is_empty())
+        .then(|| eomgen::model::Override::parse(set).unwrap())
+        .into_iter()
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let l = load(model, &sets, choice, Some(dir.path().to_path_buf())).unwrap();
+    (l.arm.backend(), l.route)
+}
+
+#[test]
+fn rigid_chains_and_systems_of_parts_say_their_route() {
+    let (auto, route) = (BackendChoice::Auto, route_of);
+    let dir = tempfile::tempdir().unwrap();
+    // A rigid chain in space: its joints' link cells (the half before a
+    // midpoint joint is ebr_arm's).
+    let (b, r) = route("cantilever3d", "segment.0.method=rigid", auto);
+    assert_eq!(b, "compiled", "{r}");
+    assert!(r.contains("link cells") && r.contains("1 of its 2"), "{r}");
+    // A rigid chain's points lie on its straight links past their
+    // joints.
+    let rigid = dir.path().join("rigid_on_floor.toml");
+    let text = std::fs::read_to_string(model_path("chain")).unwrap();
+    std::fs::write(&rigid, format!("{text}{FLOOR}")).unwrap();
+    let (b, r) = route(&rigid.to_string_lossy(), "", auto);
+    assert_eq!(b, "compiled");
+    assert!(r.contains("link cells") && !r.contains("contact"), "{r}");
+    // Its halves about midpoint joints: link cells no compiled-in model
+    // has.
+    let midpoint = "segment.0.joints=\"midpoint\"";
+    let (b, r) = route(&rigid.to_string_lossy(), midpoint, auto);
+    assert_eq!(b, "compiled");
+    assert!(
+        r.contains("2 of its 2 link shapes") && !r.contains("contact"),
+        "{r}"
+    );
+    // A system of parts (eba): each kind of part compiled, the tip's
+    // too (it reads the tip's, the base's and the last element's
+    // parameters, whatever the element count).
+    let (b, r) = route("eba_arm", "segment.0.elements=4", auto);
+    assert_eq!(b, "compiled");
+    assert!(
+        r.contains("link cells") && r.contains("parts of 4 kinds, 0 on their tapes"),
+        "{r}"
+    );
+    // An eba arm on a moving base: what the parts lack, said.
+    let shaken = dir.path().join("shaken_eba.toml");
+    let text = std::fs::read_to_string(model_path("eba_arm"))
+        .unwrap()
+        .replacen(
+            "[base]\n",
+            "[base]\ntranslation_inputs = [\"x\", \"x\", \"x\"]\n",
+            1,
+        );
+    let text = format!("{text}\n[inputs.x]\nkind = \"sine\"\namplitude = 0.01\nfrequency = 1.0\n");
+    std::fs::write(&shaken, text).unwrap();
+    let (b, r) = route(&shaken.to_string_lossy(), "", auto);
+    assert_eq!(b, "interpreted");
+    assert!(r.contains("its eba elements sit on a moving base"), "{r}");
+}
+
 #[test]
 fn a_run_says_which_route_it_took_and_why() {
-    let route = |model: &str, set: &str, choice: BackendChoice| {
-        let sets: Vec<_> = (!set.is_empty())
-            .then(|| eomgen::model::Override::parse(set).unwrap())
-            .into_iter()
-            .collect();
-        let dir = tempfile::tempdir().unwrap();
-        let l = load(model, &sets, choice, Some(dir.path().to_path_buf())).unwrap();
-        (l.arm.backend(), l.route)
-    };
+    let route = route_of;
     let auto = BackendChoice::Auto;
     // A tapered 3D pcc arm with chambers: no bundled model has its
     // structure, but every link shape (cells read their actuation loads,
@@ -2118,11 +2172,6 @@ fn a_run_says_which_route_it_took_and_why() {
     let (b, r) = route(&turned.to_string_lossy(), "", auto);
     assert_eq!(b, "compiled", "{r}");
     assert!(r.contains("link cells") && !r.contains("tapes"), "{r}");
-    // A rigid chain in space: its joints' link cells (the half before a
-    // midpoint joint is ebr_arm's).
-    let (b, r) = route("cantilever3d", "segment.0.method=rigid", auto);
-    assert_eq!(b, "compiled", "{r}");
-    assert!(r.contains("link cells") && r.contains("1 of its 2"), "{r}");
     let example = root().join("examples/palm.toml");
     let (b, r) = route(&example.to_string_lossy(), "", auto);
     assert_eq!(b, "interpreted");
@@ -2132,23 +2181,6 @@ fn a_run_says_which_route_it_took_and_why() {
     let (b, r) = route("finger_tap", "segment.0.elements=5", auto);
     assert_eq!(b, "compiled");
     assert!(r.contains("link cells") && !r.contains("contact"), "{r}");
-    // A rigid chain's points lie on its straight links past their
-    // joints.
-    let rigid = dir.path().join("rigid_on_floor.toml");
-    let text = std::fs::read_to_string(model_path("chain")).unwrap();
-    std::fs::write(&rigid, format!("{text}{FLOOR}")).unwrap();
-    let (b, r) = route(&rigid.to_string_lossy(), "", auto);
-    assert_eq!(b, "compiled");
-    assert!(r.contains("link cells") && !r.contains("contact"), "{r}");
-    // Its halves about midpoint joints: link cells no compiled-in model
-    // has.
-    let midpoint = "segment.0.joints=\"midpoint\"";
-    let (b, r) = route(&rigid.to_string_lossy(), midpoint, auto);
-    assert_eq!(b, "compiled");
-    assert!(
-        r.contains("2 of its 2 link shapes") && !r.contains("contact"),
-        "{r}"
-    );
     let (b, r) = route("falling_ball", "arm.left.segment.0.elements=3", auto);
     assert_eq!(b, "compiled");
     assert!(
@@ -2157,29 +2189,6 @@ fn a_run_says_which_route_it_took_and_why() {
             && r.contains("joints' rows on the arms' frames"),
         "{r}"
     );
-    // A system of parts (eba): each kind of part compiled, the tip's
-    // too (it reads the tip's, the base's and the last element's
-    // parameters, whatever the element count).
-    let (b, r) = route("eba_arm", "segment.0.elements=4", auto);
-    assert_eq!(b, "compiled");
-    assert!(
-        r.contains("link cells") && r.contains("parts of 4 kinds, 0 on their tapes"),
-        "{r}"
-    );
-    // An eba arm on a moving base: what the parts lack, said.
-    let shaken = dir.path().join("shaken_eba.toml");
-    let text = std::fs::read_to_string(model_path("eba_arm"))
-        .unwrap()
-        .replacen(
-            "[base]\n",
-            "[base]\ntranslation_inputs = [\"x\", \"x\", \"x\"]\n",
-            1,
-        );
-    let text = format!("{text}\n[inputs.x]\nkind = \"sine\"\namplitude = 0.01\nfrequency = 1.0\n");
-    std::fs::write(&shaken, text).unwrap();
-    let (b, r) = route(&shaken.to_string_lossy(), "", auto);
-    assert_eq!(b, "interpreted");
-    assert!(r.contains("its eba elements sit on a moving base"), "{r}");
     let (b, r) = route(&stretching, "", auto);
     assert_eq!(b, "compiled");
     assert!(

@@ -380,3 +380,10 @@ fn strain_coordinate_names(g: &SegmentShape, s: usize) -> Vec<String> {
     }
     names
 }
+
+/// Why an arm with eba segments is no system of parts (eba's reason:
+/// `eba::not_parts`); None for an arm without them, or one that is.
+pub fn why_not_parts(st: &Structure) -> Option<&'static str> {
+    let eba = st.segments.iter().any(|g| g.method == Method::Eba);
+    eba.then(|| eba::not_parts(st)).flatten()
+}
