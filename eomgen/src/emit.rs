@@ -1263,6 +1263,24 @@ fn emit_link_recursion(
         },
         false => quote!(),
     };
+    let accelerations = match links.mass_bias && layout.direct_accelerations() {
+        true => quote! {
+            /// The accelerations by the articulated-body sweeps
+            /// (`runtime::links::accelerations_owned`), O(links), without M;
+            /// false where a link's D is not positive definite.
+            pub fn link_accelerations(q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], qdd: &mut [f64; #dof]) -> bool {
+                runtime::cpu::require_fma();
+                // SAFETY: `require_fma` has checked that the processor has FMA.
+                unsafe { link_accelerations_fma(q, qd, p, qdd) }
+            }
+            #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx,fma"))]
+            unsafe fn link_accelerations_fma(q: &[f64; #dof], qd: &[f64; #dof], p: &[f64; #n_params], qdd: &mut [f64; #dof]) -> bool {
+                let mut cells = LinkCells { q, qd, p };
+                runtime::links::accelerations_owned::<_, #bodies>(&LINKS, &mut cells, q, qd, p, qdd)
+            }
+        },
+        false => quote!(),
+    };
     let json = serde_json::to_string(layout).expect("a link layout serialises");
     // A raw string: JSON's quotes unescaped (it has no `#`).
     assert!(!json.contains('#'), "a link layout's JSON has no #");
@@ -1276,6 +1294,7 @@ fn emit_link_recursion(
             serde_json::from_str(#json).expect("the generated link layout parses")
         });
         #mass_bias
+        #accelerations
         #[doc = #doc_jvp]
         pub fn jvp(t: f64, q: &[f64; #dof], qd: &[f64; #dof], qdd: &[f64; #dof], dir: &[f64; #n_dir], p: &[f64; #n_params], out: &mut [f64; #dof]) {
             runtime::cpu::require_fma();
@@ -1727,6 +1746,23 @@ pub const HASH_PREFIX: &str = "// structural-hash: ";
 /// `contact_jacobian_framed`: the groups with the contact frames given
 /// (`aux`, `n_aux` values), or from the `contact` kernel for a caller that
 /// has not run `accel`; nothing without frames.
+/// `Kernels::accelerations` of a chain whose accelerations come from the
+/// articulated-body sweeps (`link_accelerations`); nothing otherwise (the
+/// trait's None: M and its solve).
+fn emit_accelerations_method(tapes: &TapeSet) -> TokenStream {
+    match &tapes.links {
+        Some(links) if links.mass_bias && links.layout.direct_accelerations() => quote! {
+            fn accelerations(&self, inp: &Inputs, qdd: &mut [f64]) -> Option<bool> {
+                let q = inp.q.try_into().expect("q has DOF entries");
+                let qd = inp.qd.try_into().expect("qd has DOF entries");
+                let p = inp.p.try_into().expect("parameter vector length");
+                Some(link_accelerations(q, qd, p, qdd.try_into().expect("qdd has DOF entries")))
+            }
+        },
+        _ => quote!(),
+    }
+}
+
 fn emit_framed_groups(
     dof: usize,
     n_params: usize,
@@ -2236,6 +2272,7 @@ fn model_tokens(tapes: &TapeSet) -> TokenStream {
     let hash = &info.hash;
     let (coords, params) = (names(&info.coordinates), names(&info.parameters));
     let frames_fn = emit_framed_groups(dof, n_params, n_aux, contact_points);
+    let accelerations_fn = emit_accelerations_method(tapes);
     let (mut kernels, arms) = emit_kernels(tapes, dof, n_params, n_aux);
     match &tapes.parts {
         Some(parts) => {
@@ -2349,6 +2386,7 @@ fn model_tokens(tapes: &TapeSet) -> TokenStream {
                     #(#arms)*
                 }
             }
+            #accelerations_fn
         }
 
         #frames_fn

@@ -12,7 +12,7 @@ use super::schema::{Axis, Joints, Method};
 
 /// Bumped whenever derivation or emission changes what is generated, so
 /// that cached tapes and generated files are re-derived.
-pub const GENERATOR_VERSION: u32 = 115;
+pub const GENERATOR_VERSION: u32 = 116;
 
 /// The structural part of one segment.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]

@@ -278,7 +278,7 @@ impl Kernels for LinkedKernels {
 
     fn accelerations(&self, inp: &Inputs, qdd: &mut [f64]) -> Option<bool> {
         let layout = &self.links.layout;
-        if !all_owned(layout) || layout.forces || layout.variable_inertia {
+        if !layout.direct_accelerations() {
             return None;
         }
         crate::cpu::require_fma();

@@ -35,9 +35,7 @@
 // the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::{
-    Cells, Inertia, LinkLayout, MAX_LINK_DOF, SCRATCH, Twist, add, all_owned, cross, forward, sub,
-};
+use super::{Cells, Inertia, LinkLayout, MAX_LINK_DOF, SCRATCH, Twist, add, cross, forward, sub};
 
 type M6 = [[f64; 6]; 6];
 type V6 = [f64; 6];
@@ -149,7 +147,7 @@ pub fn accelerations_owned<C: Cells, const BODIES: bool>(
     p: &[f64],
     qdd: &mut [f64],
 ) -> bool {
-    debug_assert!(all_owned(layout) && !layout.forces && !layout.variable_inertia);
+    debug_assert!(layout.direct_accelerations());
     let mut scratch = SCRATCH.take();
     let ok = {
         let s = &mut scratch;

@@ -296,6 +296,13 @@ impl LinkLayout {
         self.fluid_density.is_some() || self.links.iter().any(|l| l.principal.is_some())
     }
 
+    /// Whether the articulated-body sweeps give the chain's accelerations
+    /// ([`accelerations_owned`]): its links own their coordinates, no
+    /// forces kernel adds to h and no link's inertia varies.
+    pub fn direct_accelerations(&self) -> bool {
+        all_owned(self) && !self.forces && !self.variable_inertia
+    }
+
     /// The weights of every link's cell coordinates, dense: for link k
     /// and cell coordinate f < [`MAX_LINK_DOF`], a row of the arm's
     /// coordinates padded to [`padded`]`(dof)` (zeros for unused f), at
