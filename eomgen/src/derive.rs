@@ -38,32 +38,17 @@ pub fn derive_links(structure: &Structure) -> Option<(ModelInfo, runtime::links:
     }
     let n = links.layout.dof;
     let info = ModelInfo {
-        hash: structure.hash(),
-        coordinates: crate::method::coordinate_names(structure),
-        parameters: layout.names(),
-        derived: 0,
-        accel: false,
-        loads: layout.loads(),
-        constraints: Vec::new(),
-        blocks: Vec::new(),
         contact_points: links.layout.contact.len(),
         contact_groups: element_groups(elements, points, 2 * n),
-        contact_frames: 0,
-        copies: Vec::new(),
+        ..single_arm_info(structure, &layout)
     };
     Some((info, links))
 }
 
-/// The part kernels of a system of parts (a bare eba arm, no contact)
-/// and its metadata, without the rest of its tapes: for a layout that
-/// links the compiled-in part kernels (`runtime::linked_parts`).
-pub fn derive_parts(structure: &Structure) -> Option<(ModelInfo, runtime::parts::PartKernels)> {
-    if structure.assembly.is_some() || structure.contact_points > 0 {
-        return None;
-    }
-    let layout = ParamLayout::of(structure);
-    let parts = crate::method::eba::part_kernels(structure, &layout)?;
-    let info = ModelInfo {
+/// The model info of a single arm run by its linked kernels alone: no
+/// derived parameters, symbolic solve, joints or contact.
+fn single_arm_info(structure: &Structure, layout: &ParamLayout) -> ModelInfo {
+    ModelInfo {
         hash: structure.hash(),
         coordinates: crate::method::coordinate_names(structure),
         parameters: layout.names(),
@@ -76,8 +61,19 @@ pub fn derive_parts(structure: &Structure) -> Option<(ModelInfo, runtime::parts:
         contact_groups: Vec::new(),
         contact_frames: 0,
         copies: Vec::new(),
-    };
-    Some((info, parts))
+    }
+}
+
+/// The part kernels of a system of parts (a bare eba arm, no contact)
+/// and its metadata, without the rest of its tapes: for a layout that
+/// links the compiled-in part kernels (`runtime::linked_parts`).
+pub fn derive_parts(structure: &Structure) -> Option<(ModelInfo, runtime::parts::PartKernels)> {
+    if structure.assembly.is_some() || structure.contact_points > 0 {
+        return None;
+    }
+    let layout = ParamLayout::of(structure);
+    let parts = crate::method::eba::part_kernels(structure, &layout)?;
+    Some((single_arm_info(structure, &layout), parts))
 }
 
 /// Why a single arm runs on neither the link cells nor the parts: its eba

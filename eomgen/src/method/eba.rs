@@ -1012,9 +1012,7 @@ fn load_part(st: &Structure, layout: &ParamLayout, k: usize) -> Option<([Tape; 2
     }
     let coords = element_coordinates(cas, "");
     let zero = cas.zero();
-    let r0: M3 = std::array::from_fn(|i| {
-        std::array::from_fn(|j| symbols.get(Param::BaseRotation(i as u8, j as u8)))
-    });
+    let r0: M3 = symbols.base_rotation();
     let psi: V3 = std::array::from_fn(|i| coords.q[3 + i]);
     let psi_d: V3 = std::array::from_fn(|i| coords.qd[3 + i]);
     let (r, omega, _) = element_frame(cas, &r0, &[zero; 3], &psi, &psi_d);
@@ -1243,9 +1241,7 @@ fn tip_system(cas: &mut Cas, st: &Structure, layout: &ParamLayout) -> System {
     let symbols = ParamSymbols::new(cas, layout);
     let coords = element_coordinates(cas, "");
     let zero = cas.zero();
-    let r0: M3 = std::array::from_fn(|i| {
-        std::array::from_fn(|j| symbols.get(Param::BaseRotation(i as u8, j as u8)))
-    });
+    let r0: M3 = symbols.base_rotation();
     let psi: V3 = std::array::from_fn(|i| coords.q[3 + i]);
     let psi_d: V3 = std::array::from_fn(|i| coords.qd[3 + i]);
     let (r, omega, q_rel) = element_frame(cas, &r0, &[zero; 3], &psi, &psi_d);

@@ -843,9 +843,7 @@ pub(crate) fn base_frame(
     base: &super::system::BaseMotion,
 ) -> Frame {
     let (position, turns) = (base.position, &base.turns);
-    let r: M3 = std::array::from_fn(|i| {
-        std::array::from_fn(|j| symbols.get(Param::BaseRotation(i as u8, j as u8)))
-    });
+    let r: M3 = symbols.base_rotation();
     let q = std::array::from_fn(|c| symbols.get(Param::BaseQuaternion(c as u8)));
     if let Some(super::system::MountFrame::Spatial { r: mr, p, w, quat }) = symbols.mount() {
         // On another arm's frame: the position, then the direction, in it.

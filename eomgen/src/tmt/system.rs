@@ -146,6 +146,14 @@ impl ParamSymbols {
     pub fn gravity(&self) -> [ExprId; 3] {
         self.xyz(Param::Gravity)
     }
+
+    /// The base's declared rotation (rows: world from the base frame, the
+    /// one that turns world +x onto `direction`).
+    pub fn base_rotation(&self) -> [[ExprId; 3]; 3] {
+        std::array::from_fn(|i| {
+            std::array::from_fn(|j| self.get(Param::BaseRotation(i as u8, j as u8)))
+        })
+    }
 }
 
 /// Where the base is and how it moves: a prescribed displacement and turn

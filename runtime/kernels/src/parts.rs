@@ -37,6 +37,7 @@ pub struct PartLayout {
     /// parameters (not past derived ones).
     #[serde(default)]
     pub loads: usize,
+    /// The model's parameter count (where the loads start).
     #[serde(default)]
     pub params: usize,
 }
@@ -179,8 +180,8 @@ fn tri(m: usize) -> usize {
     m * (m + 1) / 2
 }
 
-/// The part's local values of the arm's `v`, and its parameters.
-/// `v` at `at` into `buf`, reusing its allocation across parts.
+/// `v` at `at` into `buf` (a part's local values of the arm's `v`, or
+/// its parameters), reusing its allocation across parts.
 fn gather<'a>(buf: &'a mut Vec<f64>, at: &[usize], v: &[f64]) -> &'a [f64] {
     buf.clear();
     buf.extend(at.iter().map(|&i| v[i]));
@@ -332,6 +333,20 @@ pub fn outputs<P: Parts>(
     out[output::ORIENTATION].copy_from_slice(&pose[3..7]);
 }
 
+/// A part tape's inputs: local coordinates, rates and direction, no time
+/// or accelerations (parts read neither).
+fn still<'a>(q: &'a [f64], qd: &'a [f64], dir: &'a [f64], p: &'a [f64]) -> crate::Inputs<'a> {
+    crate::Inputs {
+        t: 0.0,
+        q,
+        qd,
+        qdd: &[],
+        dir,
+        p,
+        aux: &[],
+    }
+}
+
 /// The part kernels run by the tape interpreter: the interpreted
 /// backend's `MassBias` and `Jvp` of a system of parts, and the tests'.
 pub struct TapeParts<'a> {
@@ -341,15 +356,7 @@ pub struct TapeParts<'a> {
 
 impl Parts for TapeParts<'_> {
     fn eval(&mut self, k: usize, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
-        let inp = crate::Inputs {
-            t: 0.0,
-            q: x,
-            qd: xd,
-            qdd: &[],
-            dir: &[],
-            p,
-            aux: &[],
-        };
+        let inp = still(x, xd, &[], p);
         self.kernels.kernels[k].eval(&inp, &mut self.slots, out)
     }
     fn tangent(
@@ -363,53 +370,21 @@ impl Parts for TapeParts<'_> {
         out: &mut [f64],
     ) {
         let dir: Vec<f64> = dx.iter().chain(dxd).copied().collect();
-        let inp = crate::Inputs {
-            t: 0.0,
-            q: x,
-            qd: xd,
-            qdd: &[],
-            dir: &dir,
-            p,
-            aux: &[],
-        };
+        let inp = still(x, xd, &dir, p);
         self.kernels.tangents[k].eval(&inp, &mut self.slots, out)
     }
     fn pose(&mut self, x: &[f64], xd: &[f64], p: &[f64], out: &mut [f64]) {
-        let inp = crate::Inputs {
-            t: 0.0,
-            q: x,
-            qd: xd,
-            qdd: &[],
-            dir: &[],
-            p,
-            aux: &[],
-        };
+        let inp = still(x, xd, &[], p);
         let pose = self.kernels.pose.as_ref().expect("a pose kernel");
         pose.eval(&inp, &mut self.slots, out)
     }
     fn offsets(&mut self, p: &[f64], out: &mut [f64]) {
-        let inp = crate::Inputs {
-            t: 0.0,
-            q: &[],
-            qd: &[],
-            qdd: &[],
-            dir: &[],
-            p,
-            aux: &[],
-        };
+        let inp = still(&[], &[], &[], p);
         let offsets = self.kernels.offsets.as_ref().expect("an offsets kernel");
         offsets.eval(&inp, &mut self.slots, out)
     }
     fn loads(&mut self, p: &[f64], out: &mut [f64]) {
-        let inp = crate::Inputs {
-            t: 0.0,
-            q: &[],
-            qd: &[],
-            qdd: &[],
-            dir: &[],
-            p,
-            aux: &[],
-        };
+        let inp = still(&[], &[], &[], p);
         match &self.kernels.loads {
             Some(loads) => loads.eval(&inp, &mut self.slots, out),
             None => debug_assert!(out.is_empty(), "no actuator acts"),
